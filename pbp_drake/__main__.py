@@ -1,0 +1,3 @@
+from pbp_drake.cli import main
+
+raise SystemExit(main())

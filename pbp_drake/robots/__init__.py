@@ -1,0 +1,1 @@
+"""Robot models and the helpers that load them into Drake."""

@@ -1,0 +1,93 @@
+"""Loads our primitive-shape Toyota HSR model into a Drake MultibodyPlant.
+
+The model (``models/pbp_drake_models/hsr/hsrb_primitive.urdf``) is our own, written
+from published kinematic facts. It has an omnidirectional base on a planar joint to
+the world (``base_planar_joint``: x, y, yaw), five actuated arm joints, a torso that
+follows the arm lift at half its travel (a coupler constraint from the URDF
+``<mimic>``), and an end-effector frame ``hand_ee_link`` between the fingertips whose
+z axis points out of the hand.
+
+Example::
+
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.001)
+    hsr = add_hsr(plant)
+    plant.Finalize()
+"""
+
+from pathlib import Path
+
+import numpy as np
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.tree import ModelInstanceIndex
+
+PACKAGE_NAME = "pbp_drake_models"
+HSR_URL = "package://pbp_drake_models/hsr/hsrb_primitive.urdf"
+
+BASE_JOINT_NAME = "base_planar_joint"
+TORSO_JOINT_NAME = "torso_lift_joint"
+# The torso is not actuated: the coupler keeps torso = ratio * arm_lift.
+TORSO_TO_ARM_LIFT_RATIO = 0.5
+ARM_JOINT_NAMES = (
+    "arm_lift_joint",
+    "arm_flex_joint",
+    "arm_roll_joint",
+    "wrist_flex_joint",
+    "wrist_roll_joint",
+)
+END_EFFECTOR_FRAME = "hand_ee_link"
+# HSR's "neutral" pose (arm up, hand facing forward), in ARM_JOINT_NAMES order.
+NEUTRAL_ARM_POSITIONS = (0.0, 0.0, 0.0, -1.57, 0.0)
+# Base speed limits (x, y in m/s; yaw in rad/s) used by HSR's planning software.
+# URDF cannot express limits on a planar joint, so add_hsr sets them.
+BASE_VELOCITY_LIMITS = (0.2, 0.2, 1.0)
+
+
+def models_dir() -> Path:
+    """Returns the folder that holds the ``pbp_drake_models`` package.
+
+    An installed wheel ships the models as ``pbp_drake/_models``; a source checkout
+    keeps them in the top-level ``models/`` folder. The wheel location wins.
+    """
+    package_root = Path(__file__).resolve().parent.parent  # .../pbp_drake
+    candidates = (package_root / "_models", package_root.parent / "models")
+    for folder in candidates:
+        if (folder / PACKAGE_NAME / "package.xml").is_file():
+            return folder
+    raise FileNotFoundError(
+        f"Cannot find the {PACKAGE_NAME} models: looked for "
+        + " and ".join(str(c / PACKAGE_NAME / "package.xml") for c in candidates)
+        + ". Reinstall pbp_drake or run from a full checkout."
+    )
+
+
+def configure_parser(parser: Parser) -> None:
+    """Lets ``parser`` resolve ``package://pbp_drake_models/...`` from local files.
+
+    Registering our package.xml keeps loading offline (Drake's own remote model
+    packages would need the network). Calling this twice on one parser is harmless.
+    """
+    package_xml = models_dir() / PACKAGE_NAME / "package.xml"
+    parser.package_map().AddPackageXml(str(package_xml))
+
+
+def add_hsr(plant, parser: Parser | None = None) -> ModelInstanceIndex:
+    """Adds the HSR to ``plant`` (before Finalize) and returns its model instance.
+
+    Args:
+        plant: a MultibodyPlant that is not finalized yet. Use a discrete plant with
+            the SAP or lagged (default) contact approximation, so that the torso
+            coupler constraint is enforced in simulation.
+        parser: an optional Parser for ``plant`` (e.g. one with auto-renaming to add
+            several robots); a new one is made otherwise.
+
+    Returns:
+        The model instance of the robot.
+    """
+    if parser is None:
+        parser = Parser(plant)
+    configure_parser(parser)
+    (model,) = parser.AddModels(url=HSR_URL)
+    limits = np.array(BASE_VELOCITY_LIMITS)
+    plant.GetJointByName(BASE_JOINT_NAME, model).set_velocity_limits(-limits, limits)
+    return model

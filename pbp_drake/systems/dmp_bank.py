@@ -1,0 +1,113 @@
+"""The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot."""
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+
+class DmpBank(LeafSystem):
+    """Steps K DMPs (one per goal) every control period from the robot's measured state.
+
+    .. pydrake_system::
+
+        name: DmpBank
+        input_ports:
+        - robot_state
+        - goals
+        - operator_active (optional)
+        output_ports:
+        - references
+        - phase
+        - predicted_paths
+
+    `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
+    `(K, D)`. Each period the bank advances every DMP one exact step from the robot's position
+    (keeping each DMP's own velocity, see `pbp_drake.core.dmp`). With
+    `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the phases
+    and the DMPs follow the robot until the operator lets go.
+
+    `references` is the K next states `[positions (K*D), velocities (K*D)]`, `phase` the K
+    phases; `predicted_paths` (declared when `prediction_steps > 0`) is each DMP's open-loop
+    path from its current state, `(K, prediction_steps + 1, D)` flattened, for drawing.
+    All state lives in the Context.
+    """
+
+    def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
+                 prediction_steps=0):
+        super().__init__()
+        self._bank = bank
+        self._period = float(control_period)
+        self._lock = bool(lock_phase_when_operator_acts)
+        self._prediction_steps = int(prediction_steps)
+        k, d = bank.goal_count, bank.dimension
+        self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
+        self._goals_port = self.DeclareVectorInputPort("goals", k * d)
+        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        phase, positions, scaled_velocity = bank.initial_state()
+        self._phase_index = self.DeclareDiscreteState(phase)
+        self._position_index = self.DeclareDiscreteState(positions.reshape(-1))
+        self._velocity_index = self.DeclareDiscreteState(scaled_velocity.reshape(-1))
+        self._references_port = self.DeclareVectorOutputPort(
+            "references", 2 * k * d, self._calc_references)
+        self._phase_port = self.DeclareStateOutputPort("phase", self._phase_index)
+        self._predicted_paths_port = None
+        if self._prediction_steps > 0:
+            self._predicted_paths_port = self.DeclareVectorOutputPort(
+                "predicted_paths", k * (self._prediction_steps + 1) * d,
+                self._calc_predicted_paths)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
+
+    @property
+    def bank(self):
+        return self._bank
+
+    def get_robot_state_input_port(self):
+        return self._robot_state_port
+
+    def get_goals_input_port(self):
+        return self._goals_port
+
+    def get_operator_active_input_port(self):
+        return self._operator_active_port
+
+    def get_references_output_port(self):
+        return self._references_port
+
+    def get_phase_output_port(self):
+        return self._phase_port
+
+    def get_predicted_paths_output_port(self):
+        return self._predicted_paths_port
+
+    def _state(self, context):
+        d, k = self._bank.dimension, self._bank.goal_count
+        return (context.get_discrete_state(self._phase_index).value(),
+                context.get_discrete_state(self._position_index).value().reshape(d, k),
+                context.get_discrete_state(self._velocity_index).value().reshape(d, k))
+
+    def _update(self, context, discrete_state):
+        d = self._bank.dimension
+        robot_state = self._robot_state_port.Eval(context)
+        goals = self._bank.goals_matrix(self._goals_port.Eval(context))
+        locked = None
+        if self._lock and self._operator_active_port.HasValue(context):
+            locked = bool(self._operator_active_port.Eval(context)[0] > 0.5)
+        phase, _, scaled_velocity = self._state(context)
+        phase, positions, scaled_velocity = self._bank.advance(
+            phase, robot_state[:d, np.newaxis], scaled_velocity, goals, self._period,
+            locked=locked, robot_velocity=robot_state[d:])
+        discrete_state.get_mutable_vector(self._phase_index).set_value(phase)
+        discrete_state.get_mutable_vector(self._position_index).set_value(positions.reshape(-1))
+        discrete_state.get_mutable_vector(self._velocity_index).set_value(
+            scaled_velocity.reshape(-1))
+
+    def _calc_references(self, context, output):
+        _, positions, scaled_velocity = self._state(context)
+        output.SetFromVector(np.concatenate(
+            [positions.T.reshape(-1), (scaled_velocity / self._bank.duration).T.reshape(-1)]))
+
+    def _calc_predicted_paths(self, context, output):
+        phase, positions, scaled_velocity = self._state(context)
+        goals = self._bank.goals_matrix(self._goals_port.Eval(context))
+        paths = self._bank.predict(phase, positions, scaled_velocity, goals, self._period,
+                                   self._prediction_steps)
+        output.SetFromVector(paths.reshape(-1))

@@ -1,0 +1,58 @@
+"""Base of every operator system: a command sampled into discrete state each control tick."""
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core.arbitration import validate_command
+
+
+class SampledOperator(LeafSystem):
+    """An operator whose command is sampled at the control ticks and held in between.
+
+    .. pydrake_system::
+
+        name: SampledOperator
+        output_ports:
+        - operator_command
+        - operator_active
+
+    Subclasses implement `_sample(context) -> (command (D,), active)`, may declare input
+    ports first, and call `_declare_operator_outputs()` once. Sampling into discrete state
+    keeps the operator deterministic and loggable, and its command stays constant over a
+    control period as a human's keyboard read would. `operator_command` is a velocity (D);
+    `operator_active` is 1 while the operator acts, else 0.
+    """
+
+    def __init__(self, dimension, control_period):
+        super().__init__()
+        self._dimension = int(dimension)
+        self._period = float(control_period)
+
+    def _declare_operator_outputs(self):
+        d = self._dimension
+        self._sample_index = self.DeclareDiscreteState(d + 1)
+        self._command_port = self.DeclareVectorOutputPort(
+            "operator_command", d,
+            lambda context, output: output.SetFromVector(self._held(context)[:d]))
+        self._active_port = self.DeclareVectorOutputPort(
+            "operator_active", 1,
+            lambda context, output: output.SetFromVector(self._held(context)[d:]))
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
+
+    def get_operator_command_output_port(self):
+        return self._command_port
+
+    def get_operator_active_output_port(self):
+        return self._active_port
+
+    def _held(self, context):
+        return context.get_discrete_state(self._sample_index).value()
+
+    def _update(self, context, discrete_state):
+        command, active = self._sample(context)
+        command = validate_command(np.asarray(command, float).reshape(self._dimension))
+        discrete_state.get_mutable_vector(self._sample_index).set_value(
+            np.append(command, 1.0 if active else 0.0))
+
+    def _sample(self, context):
+        raise NotImplementedError

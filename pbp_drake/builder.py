@@ -5,9 +5,12 @@
     robot.state ──> dmp_bank (or demonstration_player for explicit arbitration) ──> blender
     goals ──> dmp_bank;  blender.command ──> robot.command
 
-Every control tick the DMP bank, the operator and the sample of the robot state update from
-the robot's state at that tick, and the blender combines them into the command the robot
-tracks until the next tick. Loggers named `robot_state_log`, `operator_active_log`,
+Every control tick `t_k` the operator and the sample of the robot state update from the
+robot's state at `t_k`; a quarter plant step later (before the plant, which steps half a
+step off the ticks, moves) the DMP bank steps from the same state, seeing the operator's
+decision of this tick; the blender combines them into the command the robot tracks until
+the next tick. Logs are taken at the ticks: the phase logged at `t_k` is the phase with
+which tick k steps. Loggers named `robot_state_log`, `operator_active_log`,
 `operator_command_log`, `command_log` and (PBP) `phase_log` record each tick.
 """
 
@@ -71,7 +74,7 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
         dmp_bank = policy = builder.AddNamedSystem("dmp_bank", DmpBank(
             make_dmp_bank(scenario), period,
             lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
-            prediction_steps=prediction_steps))
+            prediction_steps=prediction_steps, update_offset=scenario.robot.time_step / 4))
         goals_source = builder.AddNamedSystem("goals", ConstantVectorSource(goals.reshape(-1)))
         builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
         builder.Connect(robot_state, dmp_bank.get_robot_state_input_port())

@@ -152,7 +152,7 @@ class AlphaStudy:
 
 
 @dataclasses.dataclass
-class AltVsContStudy:
+class AltVsCont:
     """The same DMP and open-loop input in continuous and alternated mode (Fig. 4)."""
 
     # Both modes must end this close to the goal.
@@ -164,7 +164,7 @@ class ScenarioFile:
     """The top level of a file in `diagrams/`."""
 
     scenario: Scenario = dataclasses.field(default_factory=Scenario)
-    study: typing.Optional[typing.Union[AlphaStudy, AltVsContStudy]] = None
+    study: typing.Optional[typing.Union[AlphaStudy, AltVsCont]] = None
 
 
 def load_scenario_file(path):

@@ -29,10 +29,16 @@ class DmpBank(LeafSystem):
     phases; `predicted_paths` (declared when `prediction_steps > 0`) is each DMP's open-loop
     path from its current state, `(K, prediction_steps + 1, D)` flattened, for drawing.
     All state lives in the Context.
+
+    The bank updates `update_offset` seconds after each control tick. Discrete updates at
+    one instant all see the values from before that instant, so a bank updating exactly at
+    the tick would lock on the operator's decision of the previous tick; a small offset
+    (the builder uses a quarter of the plant step, before the plant moves) lets it lock on
+    the decision of the same tick, as Alg. 2 does.
     """
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
-                 prediction_steps=0):
+                 prediction_steps=0, update_offset=0.0):
         super().__init__()
         self._bank = bank
         self._period = float(control_period)
@@ -54,7 +60,7 @@ class DmpBank(LeafSystem):
             self._predicted_paths_port = self.DeclareVectorOutputPort(
                 "predicted_paths", k * (self._prediction_steps + 1) * d,
                 self._calc_predicted_paths)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     @property
     def bank(self):

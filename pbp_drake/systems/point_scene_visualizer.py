@@ -6,7 +6,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.framework import LeafSystem
 
 ROBOT_COLOUR = Rgba(0.1, 0.3, 0.9, 1.0)
-OPERATOR_COLOUR = Rgba(1.0, 0.55, 0.0, 1.0)
+OPERATOR_HALO = Rgba(1.0, 0.55, 0.0, 0.5)
 GOAL_COLOUR = Rgba(0.1, 0.7, 0.2, 1.0)
 OBSTACLE_COLOUR = Rgba(0.85, 0.15, 0.15, 0.8)
 PATH_COLOUR = Rgba(0.2, 0.2, 0.8, 1.0)
@@ -83,7 +83,7 @@ class PointSceneVisualizer(LeafSystem):
                             Rgba(0.3, 0.3, 0.3, 1.0))
             everything += list(demonstration)
         meshcat.SetObject("/pbp/robot", Sphere(0.03), ROBOT_COLOUR)
-        meshcat.SetObject("/pbp/robot/operator", Sphere(0.045), OPERATOR_COLOUR.with_alpha(0.5))
+        meshcat.SetObject("/pbp/robot/operator", Sphere(0.045), OPERATOR_HALO)
         meshcat.SetProperty("/pbp/robot/operator", "visible", False)
         meshcat.SetTransform("/pbp/robot", RigidTransform(self._to_3d(start)[0]))
         if self._dimension == 2:

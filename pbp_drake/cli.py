@@ -1,0 +1,135 @@
+"""The `pbp-drake` command line: `run` one scenario in Meshcat, `study` a scenario file."""
+
+import argparse
+import dataclasses
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+from pbp_drake.scenarios import METHODS, ScenarioError, load_scenario_file
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog="pbp-drake",
+        description="Policy Blending with Primitives (PBP): shared control on Drake.")
+    commands = parser.add_subparsers(dest="command", required=True)
+
+    run = commands.add_parser("run", help="simulate one scenario in Meshcat")
+    run.add_argument("scenario", help="a scenario file, e.g. diagrams/toy_alpha_study.yaml")
+    run.add_argument("--method", help=f"override the scenario's method: {', '.join(METHODS)}")
+    run.add_argument("--alpha", type=float, help="override alpha (fixed_alpha)")
+    run.add_argument("--scene", help="use the obstacles of this scene of the file's study")
+    run.add_argument("--headless", action="store_true",
+                     help="simulate as fast as possible without waiting for a browser")
+    run.add_argument("--record", metavar="FILE.html",
+                     help="save a self-contained replay of the run")
+    run.add_argument("--realtime-rate", type=float, default=1.0,
+                     help="target simulated seconds per wall second (ignored when headless)")
+    run.add_argument("--port", type=int, default=0, help="Meshcat port (0: a free one)")
+    run.add_argument("--wait-for-browser", type=float, default=15.0, metavar="SECONDS",
+                     help="before starting, wait this long for a browser to open the page")
+
+    study = commands.add_parser("study", help="run the study a scenario file describes")
+    study.add_argument("scenario", help="a scenario file with a `study:` section")
+    study.add_argument("--output", required=True, help="folder for summary.json and figures")
+
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "run":
+            return _run(args)
+        return _study(args)
+    except ScenarioError as error:
+        print(f"pbp-drake: {error}", file=sys.stderr)
+        return 2
+
+
+def scenario_for_run(scenario_file, method=None, alpha=None, scene=None):
+    """The file's scenario with the command line's overrides applied and checked."""
+    from pbp_drake.scenarios import validate_scenario
+
+    scenario = scenario_file.scenario
+    if method is not None:
+        scenario = dataclasses.replace(scenario, method=method)
+    if alpha is not None:
+        scenario = dataclasses.replace(scenario, alpha=alpha)
+    if scene is not None:
+        scenes = getattr(scenario_file.study, "scenes", [])
+        names = [s.name for s in scenes]
+        if scene not in names:
+            raise ScenarioError(f"--scene {scene!r} is not in this file's study; scenes: {names}")
+        chosen = scenes[names.index(scene)]
+        scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{scene}",
+                                       obstacles=list(chosen.obstacles))
+    try:
+        validate_scenario(scenario)
+    except ScenarioError as error:
+        raise ScenarioError(f"{error} (after the command-line overrides)") from None
+    return scenario
+
+
+def _run(args):
+    from pydrake.geometry import Meshcat, MeshcatParams, Rgba
+
+    from pbp_drake.builder import build_diagram
+    from pbp_drake.core.toy_scene import collision_ratio
+    from pbp_drake.simulation import simulate
+
+    scenario = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
+                                args.scene)
+    meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
+    print(f"Meshcat: {meshcat.web_url()}", flush=True)
+    diagram = build_diagram(scenario, meshcat)
+    if not args.headless and sys.stdin.isatty():
+        deadline = time.monotonic() + args.wait_for_browser
+        while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
+            time.sleep(0.1)
+    if args.record:
+        meshcat.StartRecording(frames_per_second=30.0)
+    trajectory = simulate(scenario, realtime_rate=0.0 if args.headless else args.realtime_rate,
+                          diagram=diagram)
+    positions = np.zeros((len(trajectory.positions), 3))
+    positions[:, :trajectory.positions.shape[1]] = trajectory.positions[:, :3]
+    meshcat.SetLine("/pbp/executed", positions.T, 2.0, Rgba(0.1, 0.3, 0.9, 1.0))
+    ratio = collision_ratio(trajectory.positions, [o.center for o in scenario.obstacles],
+                            [o.radius for o in scenario.obstacles])
+    if args.record:
+        meshcat.StopRecording()
+        meshcat.PublishRecording()
+        record = pathlib.Path(args.record)
+        record.parent.mkdir(parents=True, exist_ok=True)
+        record.write_text(meshcat.StaticHtml())
+        print(f"Replay saved to {record}")
+    print(f"{scenario.name} [{scenario.method}]: final position "
+          f"{np.array2string(trajectory.positions[-1], precision=3)}, collision ratio "
+          f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}")
+    if not args.headless and sys.stdin.isatty():
+        input("Press Enter to quit (the page stays live until then). ")
+    return 0
+
+
+def _study(args):
+    from pbp_drake.toy_studies import run_study
+
+    scenario_file = load_scenario_file(args.scenario)
+    if scenario_file.study is None:
+        raise ScenarioError(f"{args.scenario}: has no `study:` section to run")
+    output = pathlib.Path(args.output)
+    started = time.monotonic()
+    summary = run_study(scenario_file, output)
+    print(f"Study {summary['study']} done in {time.monotonic() - started:.1f} s.")
+    if summary["study"] == "alpha_study":
+        for scene in summary["scenes"]:
+            print(f"  {scene['name']}: ideal alpha {scene['ideal_alpha']}, collision ratio "
+                  f"PBP-Alt {scene['pbp_alternated_collision_ratio']:.3f}, "
+                  f"PBP-Cont {scene['pbp_continuous_collision_ratio']:.3f}")
+    else:
+        for method, mode in summary["modes"].items():
+            print(f"  {method}: final error {mode['final_error'] * 100:.2f} cm, phase constant "
+                  f"while the operator acts: {mode['phase_constant_while_operator_acts']}, "
+                  f"strictly increasing: {mode['phase_strictly_increasing']}")
+    for name in ("summary.json", *sorted(p.name for p in output.glob("fig*.png"))):
+        print(f"  wrote {output / name}")
+    return 0

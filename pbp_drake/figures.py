@@ -1,0 +1,121 @@
+"""The paper's figures, drawn with matplotlib (headless)."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.patches import Circle  # noqa: E402
+
+from pbp_drake.scenarios import demonstration_samples, resolved_goals, resolved_start  # noqa: E402
+
+SCENE_COLOURS = ["tab:red", "tab:purple", "tab:brown", "tab:olive"]
+
+
+def _draw_obstacles(axes, obstacles, colour, label=None, fill=True):
+    for index, obstacle in enumerate(obstacles):
+        axes.add_patch(Circle(obstacle.center, obstacle.radius, color=colour,
+                              alpha=0.3 if fill else 1.0, fill=fill,
+                              label=label if index == 0 else None))
+
+
+def _draw_task(axes, scenario):
+    demo = demonstration_samples(scenario.demonstration)[1]
+    axes.plot(demo[:, 0], demo[:, 1], "k--", lw=1.2, label="demonstration")
+    start, goal = resolved_start(scenario), resolved_goals(scenario)[0]
+    axes.plot(*start, "ko", ms=5)
+    axes.plot(*goal, "k*", ms=10)
+    axes.set_aspect("equal")
+    axes.set_xlabel("x")
+    axes.set_ylabel("y")
+
+
+def plot_alpha_study(scenario, study, summary, trajectories, path):
+    """Fig. 2: (a) the scenes, (b) collision ratio against alpha, (c) trajectories under
+    explicit arbitration, (d) trajectories under PBP."""
+    figure, axes = plt.subplots(2, 2, figsize=(11, 8.5))
+    (scenes_axes, ratio_axes), (alpha_axes, pbp_axes) = axes
+
+    _draw_task(scenes_axes, scenario)
+    _draw_obstacles(scenes_axes, study.demonstration_obstacles, "0.5", "during demonstration")
+    for index, scene in enumerate(study.scenes):
+        _draw_obstacles(scenes_axes, scene.obstacles, SCENE_COLOURS[index % 4], scene.name)
+    scenes_axes.set_title("(a) demonstration and the test scenes")
+    scenes_axes.legend(fontsize=8, loc="lower center")
+
+    for index, scene in enumerate(summary["scenes"]):
+        alphas = [float(a) for a in scene["collision_ratio_by_alpha"]]
+        ratios = list(scene["collision_ratio_by_alpha"].values())
+        colour = SCENE_COLOURS[index % 4]
+        ratio_axes.plot(alphas, ratios, "o-", color=colour, label=scene["name"])
+        if scene["ideal_alpha"] is not None:
+            ratio_axes.axvline(scene["ideal_alpha"], color=colour, ls=":",
+                               label=f"ideal alpha {scene['ideal_alpha']:.1f}")
+        ratio_axes.plot([], [], " ", label=(
+            f"PBP-Alt {scene['pbp_alternated_collision_ratio']:.3f}, "
+            f"PBP-Cont {scene['pbp_continuous_collision_ratio']:.3f}"))
+    ratio_axes.set_xlabel("alpha (1: robot only)")
+    ratio_axes.set_ylabel("ratio of states in collision")
+    ratio_axes.set_title("(b) explicit arbitration: collisions against alpha")
+    ratio_axes.legend(fontsize=8)
+
+    colour_map = plt.get_cmap("viridis")
+    for index, scene in enumerate(study.scenes):
+        colour = SCENE_COLOURS[index % 4]
+        for target in (alpha_axes, pbp_axes):
+            _draw_obstacles(target, scene.obstacles, colour, scene.name)
+        for alpha in study.alphas:
+            positions = trajectories[(scene.name, alpha)]
+            alpha_axes.plot(positions[:, 0], positions[:, 1], color=colour_map(alpha), lw=1,
+                            alpha=0.8)
+        for method, style in (("pbp_alternated", "-"), ("pbp_continuous", "--")):
+            positions = trajectories[(scene.name, method)]
+            pbp_axes.plot(positions[:, 0], positions[:, 1], style, color=colour, lw=1.5,
+                          label=f"{scene.name} {method}")
+    for target in (alpha_axes, pbp_axes):
+        _draw_task(target, scenario)
+    mappable = plt.cm.ScalarMappable(cmap=colour_map, norm=plt.Normalize(0, 1))
+    figure.colorbar(mappable, ax=alpha_axes, label="alpha")
+    alpha_axes.set_title("(c) explicit arbitration, every alpha")
+    pbp_axes.set_title("(d) PBP (no alpha)")
+    pbp_axes.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def plot_alt_vs_cont(scenario, summary, path):
+    """Fig. 4: the two modes' paths, their y against the phase, and the input."""
+    figure, (path_axes, phase_axes, input_axes) = plt.subplots(1, 3, figsize=(14, 4))
+    labels = {"pbp_continuous": "PBP-Cont", "pbp_alternated": "PBP-Alt"}
+    colours = {"pbp_continuous": "tab:blue", "pbp_alternated": "tab:orange"}
+    for method, mode in summary["modes"].items():
+        positions = np.asarray(mode["positions"])
+        phase = np.asarray(mode["phase"])
+        active = np.asarray(mode["operator_active"], bool)
+        path_axes.plot(positions[:, 0], positions[:, 1], color=colours[method],
+                       label=f"{labels[method]} (final error {mode['final_error'] * 100:.2f} cm)")
+        phase_axes.plot(phase, positions[:, 1], color=colours[method], label=labels[method])
+        phase_axes.plot(phase[active], positions[active, 1], ".", color=colours[method], ms=3)
+        input_axes.plot(mode["times"], phase, color=colours[method], label=labels[method])
+    goal = summary["goal"]
+    path_axes.plot(*goal[:2], "k*", ms=10)
+    path_axes.set_xlabel("x")
+    path_axes.set_ylabel("y")
+    path_axes.set_title("paths under the same input")
+    path_axes.legend(fontsize=8)
+    phase_axes.set_xlabel("phase (t / tau while running)")
+    phase_axes.set_ylabel("y")
+    phase_axes.set_title("y against phase (dots: operator acting)")
+    phase_axes.legend(fontsize=8)
+    any_mode = next(iter(summary["modes"].values()))
+    input_axes.fill_between(any_mode["times"], 0, np.max([m["phase"] for m in
+                            summary["modes"].values()]), where=np.asarray(
+                            any_mode["operator_active"], bool), color="0.85", label="input on")
+    input_axes.set_xlabel("time (s)")
+    input_axes.set_ylabel("phase")
+    input_axes.set_title("phase against time")
+    input_axes.legend(fontsize=8)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)

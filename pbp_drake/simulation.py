@@ -10,13 +10,14 @@ from pbp_drake.builder import build_diagram
 
 @dataclasses.dataclass
 class Trajectory:
-    """One simulation, sampled at the control ticks.
+    """One simulation, indexed by control tick k = 0..T-1 (`t_k = k * control_period`).
 
     Attributes:
-        times: (T,). positions, velocities: (T, D) of the robot.
-        operator_active: (T,) bools; operator_command: (T, D).
-        command: (T, 2 D) the blender's output from each tick on.
-        phase: (T, K) DMP phases after each tick's update, or None without DMPs.
+        times: (T,). positions, velocities: (T, D) the robot's state at `t_k`.
+        operator_active: (T,) bools, the operator's decision at tick k;
+        operator_command: (T, D) its command at tick k.
+        command: (T, 2 D) the reference the blender sent from tick k on.
+        phase: (T, K) the DMP phases with which tick k stepped, or None without DMPs.
     """
 
     times: np.ndarray
@@ -34,27 +35,38 @@ def simulate(scenario, meshcat=None, realtime_rate=0.0, diagram=None):
     simulator = Simulator(diagram)
     simulator.set_target_realtime_rate(realtime_rate)
     simulator.Initialize()
-    simulator.AdvanceTo(scenario.duration)
-    return read_trajectory(diagram, simulator.get_context())
+    # One tick past the end: the loggers record tick k's decisions at t_(k+1) (see below).
+    ticks = int(round(scenario.duration / scenario.control_period))
+    simulator.AdvanceTo((ticks + 1) * scenario.control_period)
+    return read_trajectory(diagram, simulator.get_context(), ticks + 1)
 
 
-def read_trajectory(diagram, context):
-    def log(name):
+def read_trajectory(diagram, context, tick_count):
+    """The first `tick_count` ticks of the loggers the builder adds.
+
+    Drake dispatches the publish events of an instant (the loggers) before its discrete
+    updates, so a logger at `t_k` sees the robot state at `t_k` and the phase tick k steps
+    with, but the operator's and blender's outputs of tick k - 1: those are read one sample
+    later, and the simulation must run one tick past the last one read.
+    """
+    def log(name, shift=0):
         if not diagram.HasSubsystemNamed(name):
             return None, None
-        sink = diagram.GetSubsystemByName(name)
-        found = sink.FindLog(context)
-        return found.sample_times(), found.data().T
+        found = diagram.GetSubsystemByName(name).FindLog(context)
+        if found.num_samples() < tick_count + shift:
+            raise ValueError(f"{name} has {found.num_samples()} samples; "
+                             f"{tick_count + shift} are needed")
+        window = slice(shift, shift + tick_count)
+        return found.sample_times()[:tick_count], found.data().T[window]
 
     times, state = log("robot_state_log")
     dimension = state.shape[1] // 2
-    phase = log("phase_log")[1]
     return Trajectory(
         times=times,
         positions=state[:, :dimension],
         velocities=state[:, dimension:],
-        operator_active=log("operator_active_log")[1][:, 0] > 0.5,
-        operator_command=log("operator_command_log")[1],
-        command=log("command_log")[1],
-        phase=phase,
+        operator_active=log("operator_active_log", shift=1)[1][:, 0] > 0.5,
+        operator_command=log("operator_command_log", shift=1)[1],
+        command=log("command_log", shift=1)[1],
+        phase=log("phase_log")[1],
     )

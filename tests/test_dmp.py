@@ -1,0 +1,147 @@
+"""The DMP math (pbp_drake.core.dmp): learning, convergence, the vectorised bank, bad input."""
+
+import numpy as np
+import pytest
+
+from pbp_drake.core.dmp import FORMULATIONS, Dmp, DmpBank, DmpSettings, minimum_jerk
+from pbp_drake.core.toy_scene import bent_path
+
+
+def path_length(positions):
+    return np.sum(np.linalg.norm(np.diff(positions, axis=0), axis=1))
+
+
+def curvy_demonstration():
+    """A 3-D demonstration, rest to rest, with a detour and a dimension that starts and ends
+    at the same value."""
+    times = np.linspace(0.0, 1.5, 300)
+    u = times / times[-1]
+    s = 10 * u**3 - 15 * u**4 + 6 * u**5
+    positions = np.stack([s**2 * 0.8 + 0.1, 0.4 * np.sin(np.pi * s), 0.3 * s - 0.2 * s**3], 1)
+    return times, positions
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+@pytest.mark.parametrize("demonstration", [curvy_demonstration(),
+                                           bent_path([0, 0], [1, 0], 0.3, 1.0)])
+def test_learned_dmp_reproduces_its_demonstration(formulation, demonstration):
+    times, positions = demonstration
+    dmp = Dmp.from_demonstration(times, positions, DmpSettings(formulation=formulation))
+    reproduced = dmp.rollout(times[1] - times[0])
+    rmse = np.sqrt(np.mean(np.sum((reproduced - positions) ** 2, axis=1)))
+    assert rmse < 0.01 * path_length(positions)
+
+
+def all_kinds_of_dmp(formulation, start, goal):
+    settings = DmpSettings(formulation=formulation)
+    times, positions = curvy_demonstration()
+    learned = Dmp.from_demonstration(times, positions, settings)
+    learned.start, learned.goal = start, goal
+    return [learned, Dmp.straight(start, goal, 1.0, settings),
+            Dmp.straight(start, goal, 0.7, settings, profile="zero_forcing")]
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_every_dmp_converges_to_its_goal_from_any_start(formulation):
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        start, goal = rng.uniform(-2, 2, 3), rng.uniform(-2, 2, 3)
+        for dmp in all_kinds_of_dmp(formulation, start, goal):
+            # Disturbed: started away from its start, moving in a random direction.
+            dmp.reset(position=rng.uniform(-3, 3, 3), scaled_velocity=rng.uniform(-5, 5, 3))
+            path = dmp.rollout(0.01, duration=5 * dmp.duration)
+            assert np.linalg.norm(path[-1] - goal) < 1e-3
+
+
+def test_straight_dmp_moves_on_the_line_and_arrives_on_time():
+    dmp = Dmp.straight([0.0, 0.0], [1.0, 2.0], 1.0)
+    path = dmp.rollout(0.01, duration=1.0)
+    off_line = np.abs(path[:, 1] - 2.0 * path[:, 0])
+    assert off_line.max() < 1e-9
+    assert np.linalg.norm(path[-1] - [1.0, 2.0]) < 0.03
+    _, expected = minimum_jerk([0.0, 0.0], [1.0, 2.0], 1.0, 101)
+    assert np.abs(path - expected).max() < 0.05
+
+
+def test_bank_of_k_equals_k_single_dmps():
+    rng = np.random.default_rng(3)
+    settings = DmpSettings(basis_count=30)
+    times, positions = curvy_demonstration()
+    dmps = []
+    for k in range(6):
+        warped = positions * rng.uniform(0.5, 1.5, 3) + rng.uniform(-1, 1, 3)
+        dmps.append(Dmp.from_demonstration(times, warped, settings))
+    bank = DmpBank.from_dmps(dmps)
+    goals = rng.uniform(-1, 1, (6, 3))
+    robot_position = rng.uniform(-1, 1, 3)
+    for step in range(120):
+        robot_velocity = rng.uniform(-1, 1, 3)
+        locked = 40 <= step < 50
+        bank_positions, bank_velocities = bank.next_step(
+            goals, robot_position, 0.01, yd_robot=robot_velocity, phase_locked=locked)
+        for k, dmp in enumerate(dmps):
+            position, velocity = dmp.next_step(0.01, goals[k], robot_position, robot_velocity,
+                                               phase_locked=locked)
+            np.testing.assert_allclose(bank_positions[k], position, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(bank_velocities[k], velocity, rtol=0, atol=1e-12)
+            assert bank.phase[k] == pytest.approx(dmp.phase, abs=1e-15)
+        # The robot follows the first DMP loosely: a stand-in for a lagging tracker.
+        robot_position = 0.7 * robot_position + 0.3 * bank_positions[0]
+
+
+def test_shared_demonstration_bank_sends_one_shape_to_every_goal():
+    times, positions = bent_path([0, 0], [1, 0], 0.3, 1.0)
+    goals = np.array([[1.0, 0.0], [2.0, 0.0], [1.0, 1.0]])
+    bank = DmpBank.from_demonstration(times, positions, goal_count=3)
+    assert bank.shared_weights
+    dt = times[1] - times[0]
+    paths = bank.predict(bank.phase, bank.position, bank.scaled_velocity,
+                         bank.goals_matrix(goals), dt, 5 * (len(times) - 1))
+    # The DMP sent to the demonstration's goal reproduces the demonstration...
+    error = np.linalg.norm(paths[0, :len(times)] - positions, axis=1)
+    assert np.sqrt(np.mean(error**2)) < 0.01 * path_length(positions)
+    # ...and every DMP reaches its own goal, keeping the sideways detour (y scaling is off
+    # in the demonstration, whose start and goal share y).
+    np.testing.assert_allclose(paths[:, -1], goals, atol=1e-3)
+    assert paths[1, :, 1].max() == pytest.approx(0.3, abs=0.02)
+
+
+def test_phase_lock_holds_the_phase_and_follows_the_robot():
+    bank = DmpBank.straight([0.0, 0.0], goal_count=2, duration=1.0)
+    goals = [[1.0, 0.0], [0.0, 1.0]]
+    bank.next_step(goals, [0.0, 0.0], 0.01)
+    phase = bank.phase.copy()
+    positions, velocities = bank.next_step(goals, [0.3, -0.2], 0.01, yd_robot=[0.5, 0.1],
+                                           phase_locked=True)
+    np.testing.assert_array_equal(bank.phase, phase)
+    np.testing.assert_allclose(positions, [[0.3, -0.2], [0.3, -0.2]])
+    np.testing.assert_allclose(velocities, [[0.5, 0.1], [0.5, 0.1]])
+
+
+@pytest.mark.parametrize("goals", [[], np.zeros((0, 2))])
+def test_empty_goal_set_is_refused(goals):
+    bank = DmpBank.straight([0.0, 0.0], goal_count=1, duration=1.0)
+    with pytest.raises(ValueError, match="goals is empty"):
+        bank.next_step(goals, [0.0, 0.0], 0.01)
+    with pytest.raises(ValueError, match="at least one goal"):
+        DmpBank.straight([0.0, 0.0], goal_count=0, duration=1.0)
+
+
+def test_nan_goal_is_refused():
+    bank = DmpBank.straight([0.0, 0.0], goal_count=1, duration=1.0)
+    with pytest.raises(ValueError, match="goals contains NaN"):
+        bank.next_step([[np.nan, 0.0]], [0.0, 0.0], 0.01)
+
+
+def test_short_or_nan_demonstrations_are_refused():
+    with pytest.raises(ValueError, match="2 samples; at least 3"):
+        Dmp.from_demonstration([0.0, 1.0], [[0.0, 0.0], [1.0, 1.0]])
+    times, positions = bent_path([0, 0], [1, 0], 0.3, 1.0)
+    positions[17, 1] = np.nan
+    with pytest.raises(ValueError, match="NaN or infinite at sample 17"):
+        Dmp.from_demonstration(times, positions)
+
+
+def test_unknown_formulation_is_refused():
+    with pytest.raises(ValueError, match="formulation 'ijsperet' is unknown"):
+        DmpSettings(formulation="ijsperet")

@@ -1,0 +1,83 @@
+"""Scenario files: what loads, and the clear errors on what cannot be used."""
+
+import textwrap
+
+import pytest
+
+from pbp_drake.cli import main
+from pbp_drake.scenarios import ScenarioError, load_scenario_file
+
+VALID = """
+scenario:
+  method: pbp_continuous
+  start: [0.0, 0.0]
+  goals: [[1.0, 0.0]]
+  dmp: {duration: 1.0}
+  operator: !ObstacleRepulsion {speed: 1.0}
+"""
+
+
+def write(tmp_path, text):
+    path = tmp_path / "scenario.yaml"
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_every_shipped_scenario_loads(repo):
+    files = sorted((repo / "diagrams").glob("*.yaml"))
+    assert files
+    for path in files:
+        assert load_scenario_file(path).scenario.method
+
+
+def test_a_valid_file_loads(tmp_path):
+    loaded = load_scenario_file(write(tmp_path, VALID))
+    assert loaded.scenario.operator.speed == 1.0
+
+
+@pytest.mark.parametrize("text, message", [
+    (VALID.replace("speed:", "sped:"), r"\['sped'\] were unknown.*did you mean 'speed'"),
+    (VALID.replace("method:", "methd:"), r"\['methd'\] were unknown.*did you mean 'method'"),
+    (VALID.replace("!ObstacleRepulsion", "!ObstacleRepulson"), "ObstacleRepulson"),
+    (VALID.replace("pbp_continuous", "pbp_continous"),
+     "scenario.method 'pbp_continous' is unknown.*did you mean 'pbp_continuous'"),
+    (VALID + "  alpha: 1.5\n", r"scenario.alpha = 1.5 is outside \[0, 1\]"),
+    (VALID + "  alpha: -0.5\n", r"scenario.alpha = -0.5 is outside \[0, 1\]"),
+    (VALID.replace("goals: [[1.0, 0.0]]", "goals: []"), "scenario.goals"),
+    (VALID.replace("goals: [[1.0, 0.0]]", "goals: [[1.0, .nan]]"), "scenario.goals"),
+    (VALID.replace("start: [0.0, 0.0]\n  goals: [[1.0, 0.0]]\n",
+                   "demonstration: !RecordedPath {times: [0, 1], positions: [[0, 0], [1, 0]]}\n"),
+     "scenario.demonstration: demonstration has 2 samples; at least 3"),
+    (VALID.replace("start: [0.0, 0.0]\n  goals: [[1.0, 0.0]]\n",
+                   "demonstration: !RecordedPath {times: [0, 0.5, 1], "
+                   "positions: [[0, 0], [.nan, 0], [1, 0]]}\n"),
+     "scenario.demonstration: demonstration positions are NaN or infinite at sample 1"),
+    (VALID.replace("!ObstacleRepulsion {speed: 1.0}",
+                   "!ScriptedCommands {times: [0.0], commands: [[.nan, 0.0]]}"),
+     "scenario.operator.commands contain NaN"),
+    (VALID.replace("!ObstacleRepulsion {speed: 1.0}",
+                   "!ScriptedCommands {times: [0.0], commands: [[.inf, 0.0]]}"),
+     "scenario.operator.commands contain NaN or infinite"),
+])
+def test_bad_scenarios_name_the_field(tmp_path, text, message):
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(write(tmp_path, text))
+
+
+def test_alpha_study_with_alpha_outside_unit_interval_is_refused(tmp_path, repo):
+    text = (repo / "diagrams/toy_alpha_study.yaml").read_text()
+    text = text.replace("alphas: [0.0, 0.1,", "alphas: [-0.2, 0.1,")
+    with pytest.raises(ScenarioError, match=r"study.alphas has -0.2, outside \[0, 1\]"):
+        load_scenario_file(write(tmp_path, text))
+
+
+def test_cli_reports_bad_input_without_a_traceback(tmp_path, capsys, repo):
+    assert main(["run", str(repo / "diagrams/toy_alpha_study.yaml"), "--method", "telop",
+                 "--headless"]) == 2
+    assert "scenario.method 'telop' is unknown" in capsys.readouterr().err
+    assert main(["run", str(repo / "diagrams/toy_alpha_study.yaml"), "--scene", "nowhere",
+                 "--headless"]) == 2
+    assert "--scene 'nowhere' is not in this file's study" in capsys.readouterr().err
+    bad = write(tmp_path, VALID.replace("speed:", "sped:"))
+    assert main(["study", str(bad), "--output", str(tmp_path / "out")]) == 2
+    assert "sped" in capsys.readouterr().err

@@ -16,12 +16,15 @@ which tick k steps. Loggers named `robot_state_log`, `operator_active_log`,
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, ZeroOrderHold
+from pydrake.systems.primitives import (
+    ConstantVectorSource, Demultiplexer, LogVectorOutput, Multiplexer, ZeroOrderHold)
 
 from pbp_drake.core.dmp import DmpBank as DmpBankMath
 from pbp_drake.scenarios import (
-    NoOperator as NoOperatorConfig, ObstacleRepulsion, ScriptedCommands, SinusoidalStep,
-    demonstration_samples, dmp_settings, resolved_goals, resolved_start, validate_scenario)
+    Gamepad as GamepadConfig, Hsr, Keyboard as KeyboardConfig, NoOperator as NoOperatorConfig,
+    ObstacleRepulsion, ScriptedCommands, SinusoidalStep,
+    VirtualParticipant as VirtualParticipantConfig, demonstration_samples, dmp_settings,
+    goal_estimator_settings, reach_scene, resolved_goals, resolved_start, validate_scenario)
 from pbp_drake.systems import (
     Blender, DemonstrationPlayer, DmpBank, NoOperator, ObstacleRepulsionOperator, PointRobot,
     ScriptedOperator)
@@ -43,6 +46,8 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
     far ahead the DMP bank predicts its paths for drawing.
     """
     validate_scenario(scenario)
+    if isinstance(scenario.robot, Hsr):
+        return _build_hsr_diagram(scenario, meshcat)
     period = scenario.control_period
     start = resolved_start(scenario)
     goals = resolved_goals(scenario)
@@ -158,3 +163,164 @@ def sinusoidal_step_commands(config, control_period, duration):
     magnitude = np.where(on, config.amplitude * np.sin(2 * np.pi * elapsed / config.period), 0.0)
     axis = np.asarray(config.axis, float)
     return times, np.outer(magnitude, axis / np.linalg.norm(axis))
+
+
+# How far ahead the HSR scene draws the DMPs' paths, in samples over the DMP's duration.
+HSR_PREDICTION_SAMPLES = 40
+
+
+def _build_hsr_diagram(scenario, meshcat):
+    """The HSR reaching task (section IV-B.1 of the paper):
+
+        station.ee_state ──> ee_state_sample (ZeroOrderHold) ──> dmp_bank, goal_estimator,
+                                                                 task_monitor, blender
+        station.ee_state, task_monitor.target, goal_estimator ──> operator
+        operator.operator_command [vx, vy, vz, yaw_rate] ──> blender (v), heading_command
+        blender.command [p, v] + heading ──> station.ee_command (whole-body differential IK)
+
+    The operator samples at the control ticks; a quarter plant step later the DMP bank, the
+    goal estimator, the heading and the task monitor update from the same sampled state and
+    the operator's decision of that tick, before the plant moves.
+    """
+    from pbp_drake.robots.hsr_station import add_hsr_station
+    from pbp_drake.systems.goal_estimator import GoalEstimator
+    from pbp_drake.systems.heading_command import HeadingCommand
+    from pbp_drake.systems.task_monitor import TaskMonitor
+
+    period = scenario.control_period
+    task = scenario.task
+    scene = reach_scene(scenario)
+    goals = scene.objects
+    goal_count = len(goals)
+    offset = scenario.robot.time_step / 4
+    builder = DiagramBuilder()
+
+    station = add_hsr_station(builder, time_step=scenario.robot.time_step, meshcat=meshcat,
+                              ee_height=task.height)
+    start = station.initial_ee_state[:3]
+    ee_state = station.ee_state
+    sample = builder.AddNamedSystem("ee_state_sample", ZeroOrderHold(period, 8))
+    builder.Connect(ee_state, sample.get_input_port())
+    ee_split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, 2]))
+    builder.Connect(sample.get_output_port(), ee_split.get_input_port())
+    ee_position_velocity = ee_split.get_output_port(0)
+
+    goals_source = builder.AddNamedSystem("goals", ConstantVectorSource(goals.reshape(-1)))
+    estimator = builder.AddNamedSystem("goal_estimator", GoalEstimator(
+        goal_count, goal_estimator_settings(scenario.goal_estimator), period,
+        update_offset=offset))
+    builder.Connect(sample.get_output_port(), estimator.get_ee_state_input_port())
+    builder.Connect(goals_source.get_output_port(), estimator.get_goals_input_port())
+
+    monitor = builder.AddNamedSystem("task_monitor", TaskMonitor(
+        goals, scene.targets, task.switch_schedule, start, task.success_distance, period,
+        update_offset=offset))
+    builder.Connect(sample.get_output_port(), monitor.get_ee_state_input_port())
+
+    operator = builder.AddNamedSystem("operator", make_hsr_operator(scenario, meshcat))
+    for port_name, source in [("ee_state", ee_state),
+                              ("target", monitor.get_target_output_port()),
+                              ("selected_goal", estimator.get_selected_goal_output_port())]:
+        if operator.HasInputPort(port_name):
+            builder.Connect(source, operator.GetInputPort(port_name))
+    operator_active = operator.get_operator_active_output_port()
+    operator_command = operator.get_operator_command_output_port()
+    builder.Connect(operator_active, monitor.get_operator_active_input_port())
+
+    bank = make_hsr_dmp_bank(scenario, start, goals)
+    prediction_steps = HSR_PREDICTION_SAMPLES if meshcat is not None else 0
+    dmp_bank = builder.AddNamedSystem("dmp_bank", DmpBank(
+        bank, period, lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
+        prediction_steps=prediction_steps, update_offset=offset,
+        prediction_period=bank.duration / HSR_PREDICTION_SAMPLES))
+    builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
+    builder.Connect(ee_position_velocity, dmp_bank.get_robot_state_input_port())
+    builder.Connect(operator_active, dmp_bank.get_operator_active_input_port())
+
+    command_split = builder.AddNamedSystem("operator_command_split", Demultiplexer([3, 1]))
+    builder.Connect(operator_command, command_split.get_input_port())
+    heading = builder.AddNamedSystem("heading_command", HeadingCommand(
+        station.initial_ee_state[6], period, update_offset=offset))
+    builder.Connect(operator_command, heading.get_operator_command_input_port())
+
+    blender = builder.AddNamedSystem("blender", Blender(
+        BLEND_MODE_OF_METHOD[scenario.method], 3, goal_count, period, scenario.alpha))
+    builder.Connect(ee_position_velocity, blender.get_robot_state_input_port())
+    builder.Connect(dmp_bank.get_references_output_port(), blender.get_references_input_port())
+    builder.Connect(estimator.get_selected_goal_output_port(),
+                    blender.get_selected_goal_input_port())
+    builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
+    builder.Connect(operator_active, blender.get_operator_active_input_port())
+    ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
+    builder.Connect(blender.get_command_output_port(), ee_command.get_input_port(0))
+    builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
+    builder.Connect(ee_command.get_output_port(), station.ee_command)
+
+    for name, port in [("ee_state_log", ee_state),
+                       ("operator_active_log", operator_active),
+                       ("operator_command_log", operator_command),
+                       ("command_log", ee_command.get_output_port()),
+                       ("selected_goal_log", estimator.get_selected_goal_output_port()),
+                       ("target_log", monitor.get_target_output_port()),
+                       ("phase_log", dmp_bank.get_phase_output_port())]:
+        LogVectorOutput(port, builder, period).set_name(name)
+
+    if meshcat is not None:
+        from pbp_drake.systems.reach_scene_visualizer import ReachSceneVisualizer
+
+        visualizer = builder.AddNamedSystem("task_visualizer", ReachSceneVisualizer(
+            meshcat, goals, prediction_steps))
+        builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
+        builder.Connect(estimator.get_selected_goal_output_port(),
+                        visualizer.get_selected_goal_input_port())
+        builder.Connect(operator_active, visualizer.get_operator_active_input_port())
+        builder.Connect(ee_state, visualizer.get_ee_state_input_port())
+        builder.Connect(dmp_bank.get_predicted_paths_output_port(),
+                        visualizer.get_predicted_paths_input_port())
+
+    diagram = builder.Build()
+    diagram.set_name(scenario.name)
+    return diagram
+
+
+def make_hsr_dmp_bank(scenario, start, goals):
+    """One straight-path DMP per object from the end effector's start; the duration gives
+    the farthest object the nominal speed `scenario.robot.speed`."""
+    distance = np.max(np.linalg.norm(np.asarray(goals) - start, axis=1))
+    duration = scenario.dmp.duration if scenario.dmp.duration > 0 else (
+        distance / scenario.robot.speed)
+    return DmpBankMath.straight(start, len(goals), duration, dmp_settings(scenario.dmp))
+
+
+def make_hsr_operator(scenario, meshcat):
+    """The HSR task's operator: a person at the keyboard or gamepad, or the virtual one."""
+    config = scenario.operator
+    period = scenario.control_period
+    allow_forward = scenario.method == "teleop"
+    speed = getattr(config, "speed", 0.0) or scenario.robot.speed
+    if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
+        return NoOperator(4, period)
+    if isinstance(config, VirtualParticipantConfig):
+        from pbp_drake.systems.virtual_participant import VirtualParticipant
+
+        return VirtualParticipant(
+            period, mode="drive" if allow_forward else "assist", speed=speed,
+            rotation_speed=config.rotation_speed, reaction_delay=config.reaction_delay,
+            direction_noise=config.direction_noise, speed_noise=config.speed_noise,
+            seed=scenario.seed)
+    if meshcat is None:
+        raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "
+                         "Meshcat (pbp-drake run without --headless)")
+    if isinstance(config, KeyboardConfig):
+        from pbp_drake.systems.keyboard_operator import KeyboardOperator
+
+        return KeyboardOperator(meshcat, period, allow_forward, speed=speed,
+                                rotation_speed=config.rotation_speed,
+                                hold_time=config.hold_time)
+    if isinstance(config, GamepadConfig):
+        from pbp_drake.systems.gamepad_operator import GamepadOperator
+
+        return GamepadOperator(meshcat, period, allow_forward, speed=speed,
+                               rotation_speed=config.rotation_speed,
+                               dead_zone=config.dead_zone)
+    raise TypeError(f"unknown operator config {type(config).__name__}")

@@ -106,7 +106,90 @@ class ScriptedCommands:
     commands: list[list[float]] = dataclasses.field(default_factory=list)
 
 
-OperatorConfig = typing.Union[NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands]
+@dataclasses.dataclass
+class Keyboard:
+    """A person at the browser's keyboard (HSR tasks): arrows move the end effector (forward
+    only in teleop), Q and E turn it. `speed` 0 takes the DMPs' nominal speed."""
+
+    speed: float = 0.0
+    rotation_speed: float = 0.6
+    # A key counts as held this long after its last press (the browser repeats held keys).
+    hold_time: float = 0.25
+
+
+@dataclasses.dataclass
+class Gamepad:
+    """A person with a gamepad in the browser (HSR tasks): left stick moves, right stick
+    turns. `speed` 0 takes the DMPs' nominal speed."""
+
+    speed: float = 0.0
+    rotation_speed: float = 0.6
+    dead_zone: float = 0.15
+
+
+@dataclasses.dataclass
+class VirtualParticipant:
+    """The stand-in for the paper's participants (HSR tasks): sees the true target; in PBP
+    it turns and sidesteps only until the estimated goal is the target, in teleop it drives
+    the whole way. `speed` 0 takes the DMPs' nominal speed. Noise comes from the scenario's
+    seed."""
+
+    speed: float = 0.0
+    rotation_speed: float = 0.8
+    reaction_delay: float = 0.3
+    direction_noise: float = 0.1
+    speed_noise: float = 0.1
+
+
+OperatorConfig = typing.Union[NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands,
+                              Keyboard, Gamepad, VirtualParticipant]
+HSR_OPERATORS = (NoOperator, Keyboard, Gamepad, VirtualParticipant)
+TOY_OPERATORS = (NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands)
+# The names `pbp-drake run --operator` takes for the HSR tasks.
+OPERATOR_NAMES = {"keyboard": Keyboard, "gamepad": Gamepad, "virtual": VirtualParticipant,
+                  "none": NoOperator}
+
+
+@dataclasses.dataclass
+class Hsr:
+    """The simulated Toyota HSR (our primitive-shape model) under whole-body differential IK;
+    the PBP loop commands its end effector in task space."""
+
+    time_step: float = 0.005
+    # The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it.
+    speed: float = 0.12
+
+
+@dataclasses.dataclass
+class MultiGoalReach:
+    """The paper's multi-goal reaching task (section IV-B.1): objects drawn from the seed in
+    a rectangle in front of the robot at one height; the target switches to another object
+    at each progress threshold of `switch_schedule` after the first (0 %)."""
+
+    object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
+    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    height: float = 0.7
+    min_separation: float = 0.2
+    switch_schedule: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.3, 0.6])
+    success_distance: float = 0.05
+    # Fixed objects `(M, 3)` and targets (object indices, one per schedule entry) instead of
+    # drawing them from the seed.
+    objects: list[list[float]] = dataclasses.field(default_factory=list)
+    targets: list[int] = dataclasses.field(default_factory=list)
+
+
+@dataclasses.dataclass
+class GoalEstimatorOptions:
+    """Which goal the operator intends (see `pbp_drake.core.goal_estimation`)."""
+
+    # angle (the paper's heuristic), nearest or bayesian.
+    method: str = "angle"
+    temperature: float = 0.3
+    beta: float = 5.0
+    # Hysteresis: a challenger must beat the selection by `margin` for `hold_steps` updates.
+    margin: float = 0.1
+    hold_steps: int = 2
 
 
 @dataclasses.dataclass
@@ -120,7 +203,7 @@ class Scenario:
     alpha: float = 0.5
     control_period: float = 0.01
     duration: float = 2.0
-    robot: PointRobot = dataclasses.field(default_factory=PointRobot)
+    robot: typing.Union[PointRobot, Hsr] = dataclasses.field(default_factory=PointRobot)
     # The robot's initial position; empty: the demonstration's start.
     start: list[float] = dataclasses.field(default_factory=list)
     # Candidate goals, one DMP each; empty: the demonstration's goal.
@@ -130,6 +213,11 @@ class Scenario:
     dmp: DmpOptions = dataclasses.field(default_factory=DmpOptions)
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     operator: OperatorConfig = dataclasses.field(default_factory=NoOperator)
+    # HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
+    task: typing.Optional[MultiGoalReach] = None
+    goal_estimator: GoalEstimatorOptions = dataclasses.field(
+        default_factory=GoalEstimatorOptions)
+    seed: int = 0
 
 
 @dataclasses.dataclass
@@ -160,11 +248,22 @@ class AltVsCont:
 
 
 @dataclasses.dataclass
+class MethodComparison:
+    """The same seeded scenes for each method (trial i uses seed `seed + i`), driven by the
+    scenario's operator; `pbp-drake study --methods --trials --seed` override these."""
+
+    methods: list[str] = dataclasses.field(
+        default_factory=lambda: ["pbp_alternated", "pbp_continuous", "teleop"])
+    trials: int = 10
+    seed: int = 0
+
+
+@dataclasses.dataclass
 class ScenarioFile:
     """The top level of a file in `diagrams/`."""
 
     scenario: Scenario = dataclasses.field(default_factory=Scenario)
-    study: typing.Optional[typing.Union[AlphaStudy, AltVsCont]] = None
+    study: typing.Optional[typing.Union[AlphaStudy, AltVsCont, MethodComparison]] = None
 
 
 def load_scenario_file(path):
@@ -180,6 +279,8 @@ def load_scenario_file(path):
         validate_scenario(loaded.scenario)
         if isinstance(loaded.study, AlphaStudy):
             _validate_alpha_study(loaded.study, loaded.scenario)
+        if isinstance(loaded.study, MethodComparison):
+            validate_method_comparison(loaded.study, loaded.scenario)
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from None
     return loaded
@@ -226,6 +327,13 @@ def validate_scenario(scenario):
     if abs(steps - round(steps)) > 1e-9 or round(steps) < 1:
         raise ScenarioError(
             "scenario.control_period must be a whole multiple of scenario.robot.time_step")
+    if isinstance(scenario.robot, Hsr):
+        _validate_hsr_scenario(scenario)
+        return
+    if scenario.task is not None or not isinstance(scenario.operator, TOY_OPERATORS):
+        raise ScenarioError(
+            f"scenario.task and operator !{type(scenario.operator).__name__} need "
+            "robot: !Hsr {...}")
     if scenario.demonstration is not None:
         try:
             validate_demonstration(*demonstration_samples(scenario.demonstration))
@@ -259,6 +367,88 @@ def validate_scenario(scenario):
                 f"scenario.obstacles[{index}] needs a center of dimension {start.size} and a "
                 "positive radius")
     _validate_operator(scenario.operator, start.size)
+
+
+def _validate_hsr_scenario(scenario):
+    if scenario.task is None:
+        raise ScenarioError("robot !Hsr needs scenario.task, e.g. task: !MultiGoalReach {}")
+    if not isinstance(scenario.operator, HSR_OPERATORS):
+        raise ScenarioError(
+            f"scenario.operator !{type(scenario.operator).__name__} drives the 2-D toy robot; "
+            f"the HSR takes one of {[c.__name__ for c in HSR_OPERATORS]}")
+    if scenario.demonstration is not None or scenario.goals or scenario.start:
+        raise ScenarioError("the HSR task draws its own goals (the objects) and starts "
+                            "where the robot stands: remove scenario.demonstration, goals "
+                            "and start")
+    if not scenario.robot.speed > 0:
+        raise ScenarioError("scenario.robot.speed must be positive")
+    task = scenario.task
+    if not (0 < task.success_distance and 0 < task.min_separation):
+        raise ScenarioError("scenario.task.success_distance and min_separation must be "
+                            "positive")
+    schedule = np.asarray(task.switch_schedule, float)
+    if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
+            or schedule[-1] >= 1.0):
+        raise ScenarioError(f"scenario.task.switch_schedule {task.switch_schedule} must start "
+                            "at 0.0 and increase strictly below 1.0")
+    try:
+        reach_scene(scenario)
+    except ValueError as error:
+        raise ScenarioError(f"scenario.task: {error}") from None
+    try:
+        goal_estimator_settings(scenario.goal_estimator)
+    except ValueError as error:
+        raise ScenarioError(f"scenario.goal_estimator: {error}") from None
+    try:
+        dmp_settings(scenario.dmp)
+    except ValueError as error:
+        raise ScenarioError(f"scenario.dmp: {error}") from None
+    operator = scenario.operator
+    for name in ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
+                 "direction_noise", "speed_noise"):
+        value = getattr(operator, name, 0.0)
+        if not (np.isfinite(value) and value >= 0):
+            raise ScenarioError(f"scenario.operator.{name} must be finite and not negative")
+
+
+def reach_scene(scenario):
+    """The objects and target sequence of an HSR task: given, or drawn from the seed."""
+    from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
+
+    task = scenario.task
+    if task.objects:
+        objects = validate_objects(task.objects, task.min_separation)
+        targets = tuple(int(t) for t in task.targets)
+        if len(targets) != len(task.switch_schedule):
+            raise ValueError(f"targets {list(targets)} needs one object index per entry of "
+                             f"switch_schedule {task.switch_schedule}")
+        if any(not 0 <= t < len(objects) for t in targets):
+            raise ValueError(f"targets {list(targets)} name objects that do not exist "
+                             f"({len(objects)} objects)")
+        if any(a == b for a, b in zip(targets, targets[1:])):
+            raise ValueError(f"targets {list(targets)}: each switch must go to a different "
+                             "object")
+        if len(task.switch_schedule) > 1 and len(objects) < 2:
+            raise ValueError("target switching needs at least 2 objects")
+        return ReachScene(objects=objects, targets=targets)
+    if task.targets:
+        raise ValueError("targets are given without objects")
+    corners = [[x, y, task.height] for x in task.x_range for y in task.y_range]
+    if len(task.x_range) != 2 or len(task.y_range) != 2:
+        raise ValueError("x_range and y_range must be [low, high]")
+    validate_objects(corners, 0.0)
+    scene = sample_reach_scene(scenario.seed, tuple(task.object_count), tuple(task.x_range),
+                               tuple(task.y_range), task.height,
+                               tuple(task.switch_schedule), task.min_separation)
+    return scene
+
+
+def goal_estimator_settings(options):
+    from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+
+    return GoalEstimatorSettings(
+        method=options.method, temperature=options.temperature, beta=options.beta,
+        margin=options.margin, hold_steps=options.hold_steps)
 
 
 def dmp_settings(options):
@@ -302,6 +492,21 @@ def _validate_alpha_study(study, scenario):
             raise ScenarioError(f"study.alphas has {alpha}, outside [0, 1]")
     if scenario.demonstration is None:
         raise ScenarioError("the alpha study needs scenario.demonstration")
+
+
+def validate_method_comparison(study, scenario):
+    if not isinstance(scenario.robot, Hsr):
+        raise ScenarioError("study !MethodComparison runs HSR tasks: use robot: !Hsr")
+    if not study.methods:
+        raise ScenarioError("study.methods is empty")
+    for method in study.methods:
+        if method not in METHODS:
+            raise ScenarioError(f"study.methods has {method!r}, which is unknown; choose from "
+                                f"{METHODS}{_close(method, METHODS)}")
+    if study.trials < 1:
+        raise ScenarioError(f"study.trials must be at least 1, got {study.trials}")
+    if isinstance(scenario.operator, (Keyboard, Gamepad)):
+        raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
 
 
 def _all_field_names(schema=ScenarioFile, seen=None):

@@ -27,7 +27,8 @@ class DmpBank(LeafSystem):
 
     `references` is the K next states `[positions (K*D), velocities (K*D)]`, `phase` the K
     phases; `predicted_paths` (declared when `prediction_steps > 0`) is each DMP's open-loop
-    path from its current state, `(K, prediction_steps + 1, D)` flattened, for drawing.
+    path from its current state, `(K, prediction_steps + 1, D)` flattened, for drawing,
+    sampled every `prediction_period` (default: the control period).
     All state lives in the Context.
 
     The bank updates `update_offset` seconds after each control tick. Discrete updates at
@@ -38,10 +39,13 @@ class DmpBank(LeafSystem):
     """
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
-                 prediction_steps=0, update_offset=0.0):
+                 prediction_steps=0, update_offset=0.0, prediction_period=None):
         super().__init__()
         self._bank = bank
         self._period = float(control_period)
+        # Drawing a long horizon at the control period would cost hundreds of steps a frame;
+        # the exact zero-order-hold step is as exact at any step size.
+        self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)
         k, d = bank.goal_count, bank.dimension
@@ -114,6 +118,6 @@ class DmpBank(LeafSystem):
     def _calc_predicted_paths(self, context, output):
         phase, positions, scaled_velocity = self._state(context)
         goals = self._bank.goals_matrix(self._goals_port.Eval(context))
-        paths = self._bank.predict(phase, positions, scaled_velocity, goals, self._period,
-                                   self._prediction_steps)
+        paths = self._bank.predict(phase, positions, scaled_velocity, goals,
+                                   self._prediction_period, self._prediction_steps)
         output.SetFromVector(paths.reshape(-1))

@@ -50,6 +50,10 @@ class SampledOperator(LeafSystem):
 
     def _update(self, context, discrete_state):
         command, active = self._sample(context)
+        self._store_sample(discrete_state, command, active)
+
+    def _store_sample(self, discrete_state, command, active):
+        """Writes one sample; subclasses that override `_update` call this."""
         command = validate_command(np.asarray(command, float).reshape(self._dimension))
         discrete_state.get_mutable_vector(self._sample_index).set_value(
             np.append(command, 1.0 if active else 0.0))

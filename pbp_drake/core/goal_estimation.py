@@ -1,0 +1,214 @@
+"""Which of K goals the operator means (the paper's GOAL_ESTIMATOR), in pure NumPy.
+
+Every estimator scores the K goals `(K, 3)` from the end effector's position `p` (3) and
+heading (rad, the pointing direction on the floor plane, counter-clockwise from +x) and
+turns the scores into probabilities that sum to 1:
+
+- ``angle`` (the paper, section III-C): the absolute angle between the heading and the floor
+  direction from `p` to each goal; probabilities `softmax(-angle / temperature)`. A goal
+  straight above or below `p` (floor distance under `FLOOR_EPSILON`) has no direction and
+  scores angle 0: the end effector is already at it.
+- ``nearest``: the Euclidean distance from `p`; probabilities `softmax(-distance /
+  temperature)`.
+- ``bayesian`` (Dragan & Srinivasa 2013, path-length cost, uniform prior):
+  `P(g | S->Q) ∝ exp(-beta (C(S->Q) + |Q - g|)) / exp(-beta |S - g|)`, with `S` the start,
+  `Q = p` and `C(S->Q)` the length of the path travelled so far. `C` is the same for every
+  goal, so it cancels in the normalised posterior: it is kept in `bayesian_log_posterior`
+  for the formula's sake and does not change the probabilities.
+
+All three are vectorised over K (no Python loop over goals) and computed in log space, so a
+small temperature or a large beta gives a one-hot vector rather than NaN.
+
+The selection is the most probable goal, with hysteresis so that it does not chatter: the
+current selection is kept unless, for `hold_steps` consecutive updates, the most probable
+goal beats it by more than `margin`; then the selection moves to the goal most probable at
+that update. The hysteresis memory (`SelectionMemory`) is passed in and returned, so every
+function here is pure.
+"""
+
+import dataclasses
+import math
+import typing
+
+import numpy as np
+
+GOAL_ESTIMATION_METHODS = ("angle", "nearest", "bayesian")
+
+# A goal closer than this (m) to the end effector on the floor plane has no direction.
+FLOOR_EPSILON = 1e-9
+
+# `SelectionMemory.challenger` when no goal challenges the selection.
+NO_CHALLENGER = -1
+
+
+@dataclasses.dataclass(frozen=True)
+class GoalEstimatorSettings:
+    """How goals are scored and how sticky the selection is.
+
+    `temperature` scales ``angle`` (rad) and ``nearest`` (m) scores; `beta` (1/m) is the
+    rationality of ``bayesian``. The selection switches once another goal beats it by more
+    than `margin` (in probability) for `hold_steps` consecutive updates; `margin=0,
+    hold_steps=1` switches to the most probable goal at once.
+    """
+
+    method: str = "angle"
+    temperature: float = 0.2
+    beta: float = 5.0
+    margin: float = 0.1
+    hold_steps: int = 2
+
+    def __post_init__(self):
+        if self.method not in GOAL_ESTIMATION_METHODS:
+            raise ValueError(f"goal estimation method {self.method!r} is unknown; choose one "
+                             f"of {GOAL_ESTIMATION_METHODS}")
+        for name in ("temperature", "beta"):
+            value = getattr(self, name)
+            if not _is_real(value) or not math.isfinite(value) or value <= 0.0:
+                raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        if not _is_real(self.margin) or not 0.0 <= self.margin < 1.0:
+            raise ValueError(f"margin must lie in [0, 1), got {self.margin!r}")
+        if (isinstance(self.hold_steps, bool) or not isinstance(self.hold_steps, (int, np.integer))
+                or self.hold_steps < 1):
+            raise ValueError(f"hold_steps must be an integer >= 1, got {self.hold_steps!r}")
+
+
+class SelectionMemory(typing.NamedTuple):
+    """The hysteresis memory: the selected goal, the goal challenging it (`NO_CHALLENGER`
+    if none) and for how many consecutive updates a challenger has beaten it."""
+
+    selected: int
+    challenger: int = NO_CHALLENGER
+    count: int = 0
+
+
+class GoalEstimate(typing.NamedTuple):
+    """What `estimate` returns: the selected goal index, the K probabilities, the memory to
+    pass to the next call."""
+
+    selected: int
+    probabilities: np.ndarray
+    memory: SelectionMemory
+
+
+def _is_real(value):
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, bool)
+
+
+def validate_goals(goals):
+    """Goals as a float `(K, 3)` array with K >= 1 and no NaN or infinite entry."""
+    goals = np.asarray(goals, dtype=float)
+    if goals.ndim != 2 or goals.shape[1] != 3 or len(goals) == 0:
+        raise ValueError(f"goals must be (K, 3) with K >= 1, got shape {goals.shape}")
+    if not np.isfinite(goals).all():
+        bad = np.flatnonzero(~np.isfinite(goals).all(axis=1))
+        raise ValueError(f"goals contain NaN or infinite values (goal {bad[0]})")
+    return goals
+
+
+def validate_point(point, name):
+    """A point as a float (3,) array with finite entries; errors name `name`."""
+    point = np.asarray(point, dtype=float)
+    if point.shape != (3,):
+        raise ValueError(f"{name} must have 3 entries, got shape {point.shape}")
+    if not np.isfinite(point).all():
+        raise ValueError(f"{name} is NaN or infinite: {point}")
+    return point
+
+
+def _validate_scalar(value, name, minimum=None):
+    if not _is_real(value) or not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    if minimum is not None and value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value!r}")
+    return float(value)
+
+
+def softmax_of_costs(costs, scale):
+    """`softmax(-costs / scale)`, shifted by the smallest cost so it never overflows."""
+    costs = np.asarray(costs, dtype=float)
+    weights = np.exp(-(costs - costs.min()) / scale)
+    return weights / weights.sum()
+
+
+def heading_angles(goals, position, heading):
+    """Absolute angle (rad, in [0, pi]) between `heading` and the floor direction from
+    `position` to each goal; 0 for a goal with no floor direction."""
+    offset = goals[:, :2] - position[:2]
+    directions = np.arctan2(offset[:, 1], offset[:, 0])
+    angles = np.abs(np.angle(np.exp(1j * (directions - heading))))
+    return np.where(np.hypot(offset[:, 0], offset[:, 1]) <= FLOOR_EPSILON, 0.0, angles)
+
+
+def angle_probabilities(goals, position, heading, temperature):
+    return softmax_of_costs(heading_angles(goals, position, heading), temperature)
+
+
+def nearest_probabilities(goals, position, temperature):
+    return softmax_of_costs(np.linalg.norm(goals - position, axis=1), temperature)
+
+
+def bayesian_log_posterior(goals, position, start, path_length, beta):
+    """Unnormalised `log P(g | S->Q)` of every goal (uniform prior):
+    `-beta (C(S->Q) + |Q - g|) + beta |S - g|`."""
+    return -beta * (path_length + np.linalg.norm(goals - position, axis=1)
+                    - np.linalg.norm(goals - start, axis=1))
+
+
+def bayesian_probabilities(goals, position, start, path_length, beta):
+    log_posterior = bayesian_log_posterior(goals, position, start, path_length, beta)
+    weights = np.exp(log_posterior - log_posterior.max())
+    return weights / weights.sum()
+
+
+def goal_probabilities(settings, goals, position, heading, start=None, path_length=0.0):
+    """The K probabilities of `settings.method`; `start` and `path_length` (the length of the
+    path from `start` to `position`) are needed by ``bayesian`` only."""
+    goals = validate_goals(goals)
+    position = validate_point(position, "position")
+    if settings.method == "angle":
+        heading = _validate_scalar(heading, "heading")
+        return angle_probabilities(goals, position, heading, settings.temperature)
+    if settings.method == "nearest":
+        return nearest_probabilities(goals, position, settings.temperature)
+    if settings.method == "bayesian":
+        if start is None:
+            raise ValueError("the bayesian goal estimator needs start (the end effector's "
+                             "position when estimation began)")
+        start = validate_point(start, "start")
+        path_length = _validate_scalar(path_length, "path_length", minimum=0.0)
+        return bayesian_probabilities(goals, position, start, path_length, settings.beta)
+    raise ValueError(f"goal estimation method {settings.method!r} is unknown; choose one of "
+                     f"{GOAL_ESTIMATION_METHODS}")
+
+
+def update_selection(probabilities, memory, margin, hold_steps):
+    """The hysteresis step: the new `SelectionMemory` given this update's probabilities.
+
+    With no memory (`None`) or a selection out of range, selects the most probable goal at
+    once. Otherwise a challenger is counted while the most probable goal beats the
+    selection by more than `margin`; the count resets as soon as none does, and at
+    `hold_steps` the selection moves to the most probable goal.
+    """
+    probabilities = np.asarray(probabilities, dtype=float)
+    best = int(np.argmax(probabilities))
+    if memory is None or not 0 <= int(memory.selected) < len(probabilities):
+        return SelectionMemory(best)
+    selected = int(memory.selected)
+    if best == selected or probabilities[best] - probabilities[selected] <= margin:
+        return SelectionMemory(selected)
+    count = int(memory.count) + 1
+    if count >= hold_steps:
+        return SelectionMemory(best)
+    return SelectionMemory(selected, best, count)
+
+
+def estimate(settings, goals, position, heading, memory=None, start=None, path_length=0.0):
+    """One estimator update: `GoalEstimate(selected, probabilities, memory)`.
+
+    Pass the returned `memory` to the next call; `memory=None` (the first call) selects the
+    most probable goal without hysteresis.
+    """
+    probabilities = goal_probabilities(settings, goals, position, heading, start, path_length)
+    memory = update_selection(probabilities, memory, settings.margin, settings.hold_steps)
+    return GoalEstimate(memory.selected, probabilities, memory)

@@ -1,0 +1,91 @@
+"""The multi-goal reaching task of the paper (section IV-B.1), in pure NumPy.
+
+A scene has 2 to 4 objects drawn uniformly in a rectangle in front of the robot, all at one
+height, and a sequence of targets: the first is drawn at the start (0 % progress), and at
+each later threshold of the schedule (30 %, 60 %) the target switches, unannounced, to a
+different object. Progress is how much of the distance from the end effector's start to
+the current target has been covered, `1 - |p - target| / |start - target|`, clipped at 0.
+Success is the end effector within `success_distance` of the current target.
+"""
+
+import dataclasses
+
+import numpy as np
+
+
+@dataclasses.dataclass(frozen=True)
+class ReachScene:
+    """Objects `(M, 3)` and the target sequence (object indices, one per schedule entry)."""
+
+    objects: np.ndarray
+    targets: tuple
+
+
+def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(-1.05, 1.05),
+                       height=0.7, switch_schedule=(0.0, 0.3, 0.6), min_separation=0.2):
+    """Draws a scene from `seed` alone (the same seed, the same scene, for every method).
+
+    Objects closer than `min_separation` are redrawn, so that each can be told apart.
+    """
+    low, high = object_count
+    if low < 1 or high < low:
+        raise ValueError(f"object_count must be [min, max] with 1 <= min <= max, got "
+                         f"{list(object_count)}")
+    if len(switch_schedule) > 1 and low < 2:
+        raise ValueError("target switching needs at least 2 objects: set object_count to "
+                         "at least [2, ...] or switch_schedule to [0.0]")
+    rng = np.random.default_rng(seed)
+    count = int(rng.integers(low, high + 1))
+    objects = np.empty((count, 3))
+    for index in range(count):
+        for _ in range(1000):
+            candidate = [rng.uniform(*x_range), rng.uniform(*y_range), height]
+            if index == 0 or np.min(np.linalg.norm(
+                    objects[:index, :2] - candidate[:2], axis=1)) >= min_separation:
+                break
+        else:
+            raise ValueError(f"cannot place {count} objects {min_separation} m apart in "
+                             f"x {list(x_range)}, y {list(y_range)}")
+        objects[index] = candidate
+    targets = [int(rng.integers(count))]
+    for _ in switch_schedule[1:]:
+        others = [i for i in range(count) if i != targets[-1]]
+        targets.append(int(others[rng.integers(len(others))]))
+    return ReachScene(objects=objects, targets=tuple(targets))
+
+
+def validate_objects(objects, min_separation, reach_x=(0.3, 3.5), reach_height=(0.0, 1.1)):
+    """Clear errors for objects the HSR cannot reach or that overlap."""
+    objects = np.asarray(objects, dtype=float)
+    if objects.ndim != 2 or objects.shape[1] != 3 or len(objects) == 0:
+        raise ValueError(f"objects must be (M, 3) with M >= 1, got shape {objects.shape}")
+    if not np.isfinite(objects).all():
+        raise ValueError("objects contain NaN or infinite values")
+    for index, point in enumerate(objects):
+        if not (reach_height[0] <= point[2] <= reach_height[1]):
+            raise ValueError(f"object {index} at height {point[2]:.2f} m is out of the "
+                             f"HSR's reach (heights {reach_height[0]}..{reach_height[1]} m)")
+        if not (reach_x[0] <= np.linalg.norm(point[:2]) <= reach_x[1]):
+            raise ValueError(f"object {index} at {point.tolist()} is out of reach: keep "
+                             f"objects {reach_x[0]}..{reach_x[1]} m from the robot")
+    gaps = np.linalg.norm(objects[:, None, :] - objects[None, :, :], axis=-1)
+    gaps[np.diag_indices(len(objects))] = np.inf
+    if gaps.min() < min_separation:
+        first, second = np.unravel_index(np.argmin(gaps), gaps.shape)
+        raise ValueError(f"objects {first} and {second} overlap: {gaps.min():.3f} m apart, "
+                         f"less than {min_separation} m")
+    return objects
+
+
+def reach_progress(position, start, target):
+    """`1 - |p - target| / |start - target|`, clipped to [0, 1]."""
+    total = np.linalg.norm(np.asarray(target) - start)
+    if total <= 0.0:
+        return 1.0
+    return float(np.clip(1.0 - np.linalg.norm(np.asarray(target) - position) / total, 0.0, 1.0))
+
+
+def heading_error(heading, position, point):
+    """Signed angle (rad, in (-pi, pi]) from `heading` to the floor direction to `point`."""
+    direction = np.arctan2(point[1] - position[1], point[0] - position[0])
+    return float(np.angle(np.exp(1j * (direction - heading))))

@@ -1,0 +1,118 @@
+"""Draws the reaching task in Meshcat: objects, the target, the estimated goal, DMP paths."""
+
+import numpy as np
+from pydrake.geometry import Box, Cylinder, Rgba, Sphere
+from pydrake.math import RigidTransform
+from pydrake.systems.framework import LeafSystem
+
+OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
+TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
+# Pure, saturated colours so that a screenshot can find them.
+TARGET_COLOUR = Rgba(1.0, 0.9, 0.0, 1.0)
+ESTIMATE_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
+ACTIVE_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
+OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
+OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
+
+OBJECT_RADIUS = 0.03
+OBJECT_HEIGHT = 0.1
+# Markers float above the objects: the target's yellow ball, and higher the estimate's blue.
+TARGET_LIFT = 0.12
+ESTIMATE_LIFT = 0.25
+
+
+class ReachSceneVisualizer(LeafSystem):
+    """Publishes the reaching task's markers to Meshcat under `/task`.
+
+    .. pydrake_system::
+
+        name: ReachSceneVisualizer
+        input_ports:
+        - target
+        - selected_goal
+        - operator_active (optional)
+        - ee_state (optional)
+        - predicted_paths (optional)
+
+    The objects stand on small tables, drawn once at construction. Each publish moves the
+    yellow ball above the current `target` (`[p (3), index]`) and the blue ball above the
+    estimated goal (`selected_goal`), with `time_in_recording` so that
+    `Meshcat.StartRecording` replays them; an orange ring around the hand shows when the
+    operator acts. The selected DMP's predicted path is drawn as a line, the others faint
+    (live only: Meshcat replays transforms and visibility, not lines). Call from the thread
+    that made `meshcat`.
+    """
+
+    def __init__(self, meshcat, objects, prediction_steps=0, publish_period=1.0 / 30.0):
+        super().__init__()
+        self._meshcat = meshcat
+        self._objects = np.asarray(objects, dtype=float)
+        self._prediction_steps = int(prediction_steps)
+        k = len(self._objects)
+        self._target_port = self.DeclareVectorInputPort("target", 4)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._predicted_paths_port = self.DeclareVectorInputPort(
+            "predicted_paths", max(1, k * (self._prediction_steps + 1) * 3))
+        self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
+        self.DeclareInitializationPublishEvent(self._publish)
+        self._draw_scene()
+
+    def get_target_input_port(self):
+        return self._target_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_operator_active_input_port(self):
+        return self._operator_active_port
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def get_predicted_paths_input_port(self):
+        return self._predicted_paths_port
+
+    def _draw_scene(self):
+        meshcat = self._meshcat
+        meshcat.Delete("/task")
+        for index, point in enumerate(self._objects):
+            table_height = point[2] - OBJECT_HEIGHT / 2
+            meshcat.SetObject(f"/task/tables/{index}", Box(0.3, 0.3, table_height), TABLE_COLOUR)
+            meshcat.SetTransform(f"/task/tables/{index}",
+                                 RigidTransform([point[0], point[1], table_height / 2]))
+            meshcat.SetObject(f"/task/objects/{index}",
+                              Cylinder(OBJECT_RADIUS, OBJECT_HEIGHT), OBJECT_COLOUR)
+            meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(point))
+        meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
+        meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
+        meshcat.SetObject("/task/operator", Cylinder(0.09, 0.01), OPERATOR_COLOUR)
+        meshcat.SetProperty("/task/operator", "visible", False)
+        centre = self._objects.mean(axis=0)
+        # A camera behind and above the robot that sees it and every object.
+        meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
+
+    def _publish(self, context):
+        time = context.get_time()
+        meshcat = self._meshcat
+        target = self._target_port.Eval(context)
+        meshcat.SetTransform("/task/target",
+                             RigidTransform(target[:3] + [0, 0, TARGET_LIFT]), time)
+        selected = int(self._selected_goal_port.Eval(context)[0])
+        meshcat.SetTransform(
+            "/task/estimated_goal",
+            RigidTransform(self._objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
+        if self._ee_state_port.HasValue(context):
+            position = self._ee_state_port.Eval(context)[:3]
+            meshcat.SetTransform("/task/operator", RigidTransform(position), time)
+            if self._operator_active_port.HasValue(context):
+                active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
+                meshcat.SetProperty("/task/operator", "visible", active, time)
+        if self._prediction_steps and self._predicted_paths_port.HasValue(context):
+            paths = self._predicted_paths_port.Eval(context).reshape(
+                len(self._objects), self._prediction_steps + 1, 3)
+            for index, path in enumerate(paths):
+                colour = ACTIVE_PATH_COLOUR if index == selected else OTHER_PATH_COLOUR
+                meshcat.SetLine(f"/task/predictions/{index}", path.T,
+                                3.0 if index == selected else 1.5, colour)

@@ -1,0 +1,125 @@
+"""A virtual participant for the HSR tasks: stands in for the paper's users in automated runs."""
+
+import numpy as np
+
+from pbp_drake.core.reach_task import heading_error
+from pbp_drake.systems.sampled_operator import SampledOperator
+
+PARTICIPANT_MODES = ("assist", "drive")
+
+
+class VirtualParticipant(SampledOperator):
+    """Sees the true target and the robot, and acts as a person would.
+
+    .. pydrake_system::
+
+        name: VirtualParticipant
+        input_ports:
+        - ee_state
+        - target
+        - selected_goal
+        output_ports:
+        - operator_command
+        - operator_active
+
+    `mode="assist"` (PBP and arbitration): acts only when needed. While the estimated goal
+    (`selected_goal`) is not the target, it turns the end effector toward the target and
+    sidesteps toward it; otherwise it lets go. It never pushes forward, as in the paper
+    where the forward key is disabled. Facing the target while the estimate is still another
+    object (the two almost in line), it steps aside to tell them apart. `mode="drive"` (teleoperation): it drives the whole
+    way, toward the target at `speed` (slowing within `slow_radius`), turning to face it.
+
+    It notices a new target only `reaction_delay` seconds after it appears, and its
+    commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
+    scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
+    is reproducible and the system keeps no state outside its Context.
+
+    Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
+    `selected_goal` `[index]`. Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the
+    world frame (vz = 0).
+    """
+
+    def __init__(self, control_period, mode="assist", speed=0.2, rotation_speed=0.6,
+                 reaction_delay=0.3, direction_noise=0.1, speed_noise=0.1, seed=0,
+                 slow_radius=0.15, aligned_angle=0.05):
+        if mode not in PARTICIPANT_MODES:
+            raise ValueError(f"participant mode {mode!r} is unknown; use one of "
+                             f"{PARTICIPANT_MODES}")
+        super().__init__(4, control_period)
+        self._mode = mode
+        self._speed = float(speed)
+        self._rotation_speed = float(rotation_speed)
+        self._reaction_ticks = int(round(reaction_delay / control_period))
+        self._direction_noise = float(direction_noise)
+        self._speed_noise = float(speed_noise)
+        self._seed = int(seed)
+        self._slow_radius = float(slow_radius)
+        self._aligned_angle = float(aligned_angle)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._target_port = self.DeclareVectorInputPort("target", 4)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        # What the participant believes: the target index it knows and how many ticks a
+        # different target has been on screen.
+        self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        self._declare_operator_outputs()
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def get_target_input_port(self):
+        return self._target_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def _update(self, context, discrete_state):
+        # The belief moves first, and the command of this tick acts on the new belief.
+        known, unseen_ticks = context.get_discrete_state(self._belief_index).value()
+        shown = self._target_port.Eval(context)[3]
+        if known < 0:
+            known, unseen_ticks = shown, 0  # the first target is known from the start
+        elif shown != known:
+            unseen_ticks += 1
+            if unseen_ticks > self._reaction_ticks:
+                known, unseen_ticks = shown, 0
+        discrete_state.get_mutable_vector(self._belief_index).set_value([known, unseen_ticks])
+        command, active = self._decide(context, int(known))
+        self._store_sample(discrete_state, command, active)
+
+    def _decide(self, context, known_target):
+        ee_state = self._ee_state_port.Eval(context)
+        position, heading = ee_state[:3], ee_state[6]
+        target = self._target_port.Eval(context)
+        if known_target != int(target[3]):
+            return np.zeros(4), False  # has not noticed the new target yet
+        angle = heading_error(heading, position, target[:3])
+        rng = np.random.default_rng([self._seed, int(round(context.get_time() / self._period))])
+        noise_angle = rng.normal(0.0, self._direction_noise)
+        speed_scale = max(0.0, 1.0 + rng.normal(0.0, self._speed_noise))
+        offset = target[:2] - position[:2]
+        distance = np.linalg.norm(offset)
+        if self._mode == "assist":
+            if int(round(self._selected_goal_port.Eval(context)[0])) == int(target[3]):
+                return np.zeros(4), False
+            # Sidestep toward the target: the part of its direction across the heading.
+            left = np.array([-np.sin(heading), np.cos(heading)])
+            lateral = (offset / max(distance, 1e-9)) @ left
+            if abs(angle) <= 2 * self._aligned_angle:
+                # Facing the target while another object is picked: the two lie almost in
+                # line, so step aside (toward the middle of the room) to tell them apart.
+                lateral = 0.5 if position[1] <= 0.0 else -0.5
+            velocity = self._speed * speed_scale * lateral * _rotate(left, noise_angle)
+        else:
+            if distance < 1e-9:
+                return np.zeros(4), False
+            speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
+            velocity = speed * _rotate(offset / distance, noise_angle)
+        yaw_rate = 0.0
+        if abs(angle) > self._aligned_angle:
+            yaw_rate = np.sign(angle) * self._rotation_speed * min(1.0, abs(angle) / 0.3)
+        return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
+
+
+def _rotate(vector, angle):
+    cos, sin = np.cos(angle), np.sin(angle)
+    return np.array([cos * vector[0] - sin * vector[1], sin * vector[0] + cos * vector[1]])

@@ -113,8 +113,9 @@ class Keyboard:
 
     speed: float = 0.0
     rotation_speed: float = 0.6
-    # A key counts as held this long after its last press (the browser repeats held keys).
-    hold_time: float = 0.25
+    # A key counts as held this long after its last press. The browser repeats a held key,
+    # but only after the system's repeat delay (often 0.25..0.66 s): bridge it.
+    hold_time: float = 0.6
 
 
 @dataclasses.dataclass

@@ -1,0 +1,81 @@
+"""A person with a gamepad in a Meshcat browser: sticks move and turn the end effector."""
+
+import numpy as np
+
+from pbp_drake.systems.sampled_operator import SampledOperator
+
+# Standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN.
+LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X = 0, 1, 2
+
+
+class GamepadOperator(SampledOperator):
+    """Task-space velocity commands from the gamepad Meshcat sees.
+
+    .. pydrake_system::
+
+        name: GamepadOperator
+        input_ports:
+        - ee_state
+        output_ports:
+        - operator_command
+        - operator_active
+
+    Reads `meshcat.GetGamepad()` each control tick. The left stick moves the end effector
+    in the robot frame (up = forward along the heading, left = heading + 90 deg) at up to
+    `speed` (m/s); the right stick's x turns it (left = positive yaw rate) at up to
+    `rotation_speed` (rad/s). Each stick has a radial dead zone of `dead_zone`, outside
+    which its deflection is rescaled from 0 so the output is continuous. With
+    `allow_forward=False` (PBP modes, where forward motion comes from the DMP phase) the
+    forward part of the left stick is dropped; back still works.
+
+    Input `ee_state` `[p (3), v (3), heading, heading_rate]` gives the heading. Output
+    `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0);
+    `operator_active` is 1 while a stick is outside its dead zone (a stick pushed only
+    forward does not count when forward is not allowed). With no gamepad (Meshcat
+    has received none, or the browser reported it disconnected) the command is zero and
+    inactive. Meshcat must be used only from the thread that created it.
+    """
+
+    def __init__(self, meshcat, control_period, allow_forward, speed=0.2,
+                 rotation_speed=0.6, dead_zone=0.15):
+        if not 0.0 <= dead_zone < 1.0:
+            raise ValueError(f"dead_zone must be in [0, 1), not {dead_zone}")
+        super().__init__(4, control_period)
+        self._meshcat = meshcat
+        self._allow_forward = bool(allow_forward)
+        self._speed = float(speed)
+        self._rotation_speed = float(rotation_speed)
+        self._dead_zone = float(dead_zone)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._declare_operator_outputs()
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def _sample(self, context):
+        gamepad = self._meshcat.GetGamepad()
+        axes = list(gamepad.axes)
+        # The browser sends an empty status when the gamepad disconnects; Meshcat then
+        # keeps the old index, so empty axes also mean "no gamepad".
+        if gamepad.index is None or len(axes) < 2:
+            return np.zeros(4), False
+        axes += [0.0] * (3 - len(axes))
+        # Browser axes: x right, y down. Robot frame: forward, left.
+        stick = self._apply_dead_zone(np.array([-axes[LEFT_STICK_Y], -axes[LEFT_STICK_X]]))
+        turn = self._apply_dead_zone(np.array([-axes[RIGHT_STICK_X]]))[0]
+        if not self._allow_forward:
+            stick[0] = min(stick[0], 0.0)
+        active = bool(np.any(stick != 0) or turn != 0)
+        local = self._speed * stick
+        heading = self._ee_state_port.Eval(context)[6]
+        cos, sin = np.cos(heading), np.sin(heading)
+        velocity = np.array([cos * local[0] - sin * local[1], sin * local[0] + cos * local[1]])
+        return np.array([velocity[0], velocity[1], 0.0, self._rotation_speed * turn]), active
+
+    def _apply_dead_zone(self, stick):
+        """Zero within `dead_zone` of the centre, then rising from 0 to 1 at full tilt."""
+        magnitude = np.linalg.norm(stick)
+        if magnitude <= self._dead_zone:
+            return np.zeros_like(stick)
+        scaled = (min(magnitude, 1.0) - self._dead_zone) / (1.0 - self._dead_zone)
+        return stick * (scaled / magnitude)

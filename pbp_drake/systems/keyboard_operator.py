@@ -1,0 +1,144 @@
+"""A person at the keyboard of a Meshcat browser: arrow keys move the end effector, Q/E turn it."""
+
+import numpy as np
+
+from pbp_drake.systems.sampled_operator import SampledOperator
+
+FORWARD_BUTTON = "Forward (↑)"
+BACK_BUTTON = "Back (↓)"
+LEFT_BUTTON = "Left (←)"
+RIGHT_BUTTON = "Right (→)"
+TURN_LEFT_BUTTON = "Turn left (Q)"
+TURN_RIGHT_BUTTON = "Turn right (E)"
+
+#: Button name -> JavaScript `KeyboardEvent.code` that clicks it.
+KEY_BUTTONS = {
+    FORWARD_BUTTON: "ArrowUp",
+    BACK_BUTTON: "ArrowDown",
+    LEFT_BUTTON: "ArrowLeft",
+    RIGHT_BUTTON: "ArrowRight",
+    TURN_LEFT_BUTTON: "KeyQ",
+    TURN_RIGHT_BUTTON: "KeyE",
+}
+
+# What one held key adds to [forward, left, yaw] (robot frame, unit speeds).
+_KEY_AXES = {
+    FORWARD_BUTTON: (1.0, 0.0, 0.0),
+    BACK_BUTTON: (-1.0, 0.0, 0.0),
+    LEFT_BUTTON: (0.0, 1.0, 0.0),
+    RIGHT_BUTTON: (0.0, -1.0, 0.0),
+    TURN_LEFT_BUTTON: (0.0, 0.0, 1.0),
+    TURN_RIGHT_BUTTON: (0.0, 0.0, -1.0),
+}
+
+
+class KeyboardOperator(SampledOperator):
+    """Task-space velocity commands from Meshcat buttons bound to keys.
+
+    .. pydrake_system::
+
+        name: KeyboardOperator
+        input_ports:
+        - ee_state
+        output_ports:
+        - operator_command
+        - operator_active
+
+    Adds one Meshcat button per key (see `KEY_BUTTONS`): ↑/↓ forward/back along the end
+    effector's heading, ←/→ sideways (left = heading + 90 deg), Q/E turn left/right. A
+    click of a button (or a keydown of its key in the browser, auto-repeated while the key
+    is held) keeps the key held for `hold_time` seconds; a tap gives a short motion.
+    Meshcat's page clicks a button on every `keydown`, repeats included, so a held key
+    re-clicks at the OS repeat rate (~25-33 Hz) after the OS repeat delay (often 0.25-0.6 s):
+    with a `hold_time` below that delay a held key moves, pauses briefly, then moves on.
+    Translation keys combine into one direction at `speed` (m/s); Q/E give a yaw rate of
+    ±`rotation_speed` (rad/s). With `allow_forward=False` (PBP modes, where forward motion
+    comes from the DMP phase) the forward button is not added and ↑ does nothing; ↓ still
+    works.
+
+    Input `ee_state` `[p (3), v (3), heading, heading_rate]` gives the heading used to turn
+    the robot-frame keys into the world frame. Output `operator_command` is
+    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0); `operator_active` is 1 while any
+    effective key is held (even if
+    opposite keys cancel).
+
+    Click counts are snapshotted at initialisation, and the last counts and click times are
+    kept in discrete state, so the system holds no state outside its Context. Meshcat must
+    be used only from the thread that created it (run the simulator there). The buttons
+    stay in Meshcat until `Delete()` is called.
+    """
+
+    def __init__(self, meshcat, control_period, allow_forward, speed=0.2,
+                 rotation_speed=0.6, hold_time=0.25):
+        super().__init__(4, control_period)
+        self._meshcat = meshcat
+        self._allow_forward = bool(allow_forward)
+        self._speed = float(speed)
+        self._rotation_speed = float(rotation_speed)
+        self._hold_time = float(hold_time)
+        self._buttons = [name for name in KEY_BUTTONS
+                         if allow_forward or name != FORWARD_BUTTON]
+        for name in self._buttons:
+            meshcat.AddButton(name, KEY_BUTTONS[name])
+        self._axes = np.array([_KEY_AXES[name] for name in self._buttons])
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        n = len(self._buttons)
+        # Per button: the click count last seen, then the time of its last click.
+        self._keys_index = self.DeclareDiscreteState(
+            np.concatenate([np.zeros(n), np.full(n, -np.inf)]))
+        self.DeclareInitializationDiscreteUpdateEvent(self._snapshot)
+        self._declare_operator_outputs()
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def button_names(self):
+        """The names of the buttons this operator added to Meshcat."""
+        return list(self._buttons)
+
+    def Delete(self):
+        """Removes this operator's buttons from Meshcat (they stay there otherwise)."""
+        for name in self._buttons:
+            self._meshcat.DeleteButton(name, strict=False)
+
+    def _clicks(self):
+        return np.array([self._meshcat.GetButtonClicks(name) for name in self._buttons],
+                        float)
+
+    def _snapshot(self, context, discrete_state):
+        n = len(self._buttons)
+        discrete_state.get_mutable_vector(self._keys_index).set_value(
+            np.concatenate([self._clicks(), np.full(n, -np.inf)]))
+
+    def _update(self, context, discrete_state):
+        # Meshcat is read once a tick; the key state and the command come from that read.
+        keys = self._next_keys(context, self._clicks())
+        discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
+        self._store_sample(discrete_state, *self._command(context, keys))
+
+    def _sample(self, context):
+        # Not called by the periodic update (overridden above); what a tick would sample now.
+        return self._command(context, self._next_keys(context, self._clicks()))
+
+    def _next_keys(self, context, clicks):
+        n = len(self._buttons)
+        keys = context.get_discrete_state(self._keys_index).value()
+        last_clicks, last_times = keys[:n], keys[n:]
+        # A count that drops (the button was re-added elsewhere) resyncs without a click.
+        clicked = clicks > last_clicks
+        times = np.where(clicked, context.get_time(), last_times)
+        return np.concatenate([clicks, times])
+
+    def _command(self, context, keys):
+        n = len(self._buttons)
+        held = context.get_time() - keys[n:] < self._hold_time - 1e-9
+        forward, left, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(3)
+        local = np.array([forward, left])
+        norm = np.linalg.norm(local)
+        if norm > 0:
+            local *= self._speed / norm  # e.g. ↑ with ← goes diagonally at `speed`
+        heading = self._ee_state_port.Eval(context)[6]
+        cos, sin = np.cos(heading), np.sin(heading)
+        velocity = np.array([cos * local[0] - sin * local[1], sin * local[0] + cos * local[1]])
+        yaw_rate = self._rotation_speed * yaw
+        return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), bool(held.any())

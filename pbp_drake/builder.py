@@ -185,6 +185,7 @@ def _build_hsr_diagram(scenario, meshcat):
     from pbp_drake.robots.hsr_station import add_hsr_station
     from pbp_drake.systems.goal_estimator import GoalEstimator
     from pbp_drake.systems.heading_command import HeadingCommand
+    from pbp_drake.systems.sample_hold import SampleHold
     from pbp_drake.systems.task_monitor import TaskMonitor
 
     period = scenario.control_period
@@ -196,10 +197,11 @@ def _build_hsr_diagram(scenario, meshcat):
     builder = DiagramBuilder()
 
     station = add_hsr_station(builder, time_step=scenario.robot.time_step, meshcat=meshcat,
-                              ee_height=task.height)
+                              ee_height=task.height, command_period=period)
     start = station.initial_ee_state[:3]
     ee_state = station.ee_state
-    sample = builder.AddNamedSystem("ee_state_sample", ZeroOrderHold(period, 8))
+    sample = builder.AddNamedSystem("ee_state_sample",
+                                    SampleHold(period, station.initial_ee_state))
     builder.Connect(ee_state, sample.get_input_port())
     ee_split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, 2]))
     builder.Connect(sample.get_output_port(), ee_split.get_input_port())

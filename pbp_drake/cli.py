@@ -8,7 +8,8 @@ import time
 
 import numpy as np
 
-from pbp_drake.scenarios import METHODS, ScenarioError, load_scenario_file
+from pbp_drake.scenarios import (
+    METHODS, OPERATOR_NAMES, Hsr, MethodComparison, ScenarioError, load_scenario_file)
 
 
 def main(argv=None):
@@ -22,6 +23,9 @@ def main(argv=None):
     run.add_argument("--method", help=f"override the scenario's method: {', '.join(METHODS)}")
     run.add_argument("--alpha", type=float, help="override alpha (fixed_alpha)")
     run.add_argument("--scene", help="use the obstacles of this scene of the file's study")
+    run.add_argument("--operator", help="HSR tasks: who drives, one of "
+                     f"{', '.join(OPERATOR_NAMES)} (keyboard and gamepad: in the browser)")
+    run.add_argument("--seed", type=int, help="HSR tasks: the seed of the scene and the noise")
     run.add_argument("--headless", action="store_true",
                      help="simulate as fast as possible without waiting for a browser")
     run.add_argument("--record", metavar="FILE.html",
@@ -35,6 +39,9 @@ def main(argv=None):
     study = commands.add_parser("study", help="run the study a scenario file describes")
     study.add_argument("scenario", help="a scenario file with a `study:` section")
     study.add_argument("--output", required=True, help="folder for summary.json and figures")
+    study.add_argument("--methods", help="comma-separated methods to compare (HSR tasks)")
+    study.add_argument("--trials", type=int, help="seeded scenes per method (HSR tasks)")
+    study.add_argument("--seed", type=int, help="the first scene's seed (HSR tasks)")
 
     args = parser.parse_args(argv)
     try:
@@ -46,11 +53,23 @@ def main(argv=None):
         return 2
 
 
-def scenario_for_run(scenario_file, method=None, alpha=None, scene=None):
+def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operator=None,
+                     seed=None):
     """The file's scenario with the command line's overrides applied and checked."""
     from pbp_drake.scenarios import validate_scenario
 
     scenario = scenario_file.scenario
+    if operator is not None:
+        if operator not in OPERATOR_NAMES:
+            raise ScenarioError(f"--operator {operator!r} is unknown; choose one of "
+                                f"{list(OPERATOR_NAMES)}")
+        if not isinstance(scenario.robot, Hsr):
+            raise ScenarioError("--operator chooses who drives the HSR tasks; this scenario "
+                                "uses the 2-D toy robot")
+        if not isinstance(scenario.operator, OPERATOR_NAMES[operator]):
+            scenario = dataclasses.replace(scenario, operator=OPERATOR_NAMES[operator]())
+    if seed is not None:
+        scenario = dataclasses.replace(scenario, seed=seed)
     if method is not None:
         scenario = dataclasses.replace(scenario, method=method)
     if alpha is not None:
@@ -78,9 +97,11 @@ def _run(args):
     from pbp_drake.simulation import simulate
 
     scenario = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
-                                args.scene)
+                                args.scene, args.operator, args.seed)
     meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
     print(f"Meshcat: {meshcat.web_url()}", flush=True)
+    if isinstance(scenario.robot, Hsr):
+        return _run_task(args, scenario, meshcat)
     diagram = build_diagram(scenario, meshcat)
     if not args.headless and sys.stdin.isatty():
         deadline = time.monotonic() + args.wait_for_browser
@@ -96,12 +117,7 @@ def _run(args):
     ratio = collision_ratio(trajectory.positions, [o.center for o in scenario.obstacles],
                             [o.radius for o in scenario.obstacles])
     if args.record:
-        meshcat.StopRecording()
-        meshcat.PublishRecording()
-        record = pathlib.Path(args.record)
-        record.parent.mkdir(parents=True, exist_ok=True)
-        record.write_text(meshcat.StaticHtml())
-        print(f"Replay saved to {record}")
+        _save_recording(meshcat, args.record)
     print(f"{scenario.name} [{scenario.method}]: final position "
           f"{np.array2string(trajectory.positions[-1], precision=3)}, collision ratio "
           f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}")
@@ -110,10 +126,54 @@ def _run(args):
     return 0
 
 
+def _run_task(args, scenario, meshcat):
+    from pbp_drake.builder import build_diagram
+    from pbp_drake.scenarios import Gamepad, Keyboard
+    from pbp_drake.task_run import run_task
+
+    diagram = build_diagram(scenario, meshcat)
+    person = isinstance(scenario.operator, (Keyboard, Gamepad))
+    if args.headless and person:
+        raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
+                            "--operator virtual")
+    if person or (not args.headless and sys.stdin.isatty()):
+        # A person needs the page open before the task starts.
+        print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
+              f"(waiting up to {args.wait_for_browser:.0f} s).", flush=True)
+        if person:
+            print("Keys: arrows move the hand (forward only in teleop), Q and E turn it.",
+                  flush=True)
+        deadline = time.monotonic() + args.wait_for_browser
+        while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
+            time.sleep(0.1)
+    if args.record:
+        meshcat.StartRecording(frames_per_second=30.0)
+    result = run_task(scenario, realtime_rate=0.0 if args.headless else args.realtime_rate,
+                      diagram=diagram)
+    if args.record:
+        _save_recording(meshcat, args.record)
+    print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
+          f"{result.summary_line()}", flush=True)
+    if not args.headless and sys.stdin.isatty():
+        input("Press Enter to quit (the page stays live until then). ")
+    return 0 if result.success else 1
+
+
+def _save_recording(meshcat, path):
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    record = pathlib.Path(path)
+    record.parent.mkdir(parents=True, exist_ok=True)
+    record.write_text(meshcat.StaticHtml())
+    print(f"Replay saved to {record}")
+
+
 def _study(args):
     from pbp_drake.toy_studies import run_study
 
     scenario_file = load_scenario_file(args.scenario)
+    if isinstance(scenario_file.scenario.robot, Hsr):
+        return _method_study(args, scenario_file)
     if scenario_file.study is None:
         raise ScenarioError(f"{args.scenario}: has no `study:` section to run")
     output = pathlib.Path(args.output)
@@ -131,5 +191,42 @@ def _study(args):
                   f"while the operator acts: {mode['phase_constant_while_operator_acts']}, "
                   f"strictly increasing: {mode['phase_strictly_increasing']}")
     for name in ("summary.json", *sorted(p.name for p in output.glob("fig*.png"))):
+        print(f"  wrote {output / name}")
+    return 0
+
+
+def _method_study(args, scenario_file):
+    from pbp_drake.method_study import run_method_comparison
+    from pbp_drake.scenarios import validate_method_comparison
+
+    study = scenario_file.study or MethodComparison()
+    if not isinstance(study, MethodComparison):
+        raise ScenarioError(f"{args.scenario}: HSR tasks take study: !MethodComparison")
+    if args.methods is not None:
+        study = dataclasses.replace(study, methods=[m.strip() for m in args.methods.split(",")
+                                                    if m.strip()])
+    if args.trials is not None:
+        study = dataclasses.replace(study, trials=args.trials)
+    if args.seed is not None:
+        study = dataclasses.replace(study, seed=args.seed)
+    try:
+        validate_method_comparison(study, scenario_file.scenario)
+    except ScenarioError as error:
+        raise ScenarioError(f"{error} (after the command-line overrides)") from None
+    output = pathlib.Path(args.output)
+
+    def progress(done, total, record, elapsed):
+        outcome = "ok" if record["success"] else (record["error"] or "failed")
+        print(f"  [{done}/{total}] {record['method']} trial {record['trial']} "
+              f"(seed {record['seed']}): {outcome}, {elapsed:.0f} s elapsed", flush=True)
+
+    summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
+                                    study.seed, output, progress)
+    for method, entry in summary["methods"].items():
+        print(f"  {method}: success {100 * entry['success_rate']:.0f} %, intervention ratio "
+              f"{entry['intervention_ratio']['mean']:.3f} +- "
+              f"{entry['intervention_ratio']['std']:.3f}, task time "
+              f"{entry['task_time']['mean']:.1f} +- {entry['task_time']['std']:.1f} s")
+    for name in ("summary.json", "trials.json", "fig_reach_study.png"):
         print(f"  wrote {output / name}")
     return 0

@@ -372,7 +372,7 @@ def validate_scenario(scenario):
 
 def _validate_hsr_scenario(scenario):
     if scenario.task is None:
-        raise ScenarioError("robot !Hsr needs scenario.task, e.g. task: !MultiGoalReach {}")
+        raise ScenarioError("robot !Hsr needs scenario.task, e.g. task: {object_count: [2, 4]}")
     if not isinstance(scenario.operator, HSR_OPERATORS):
         raise ScenarioError(
             f"scenario.operator !{type(scenario.operator).__name__} drives the 2-D toy robot; "
@@ -420,6 +420,9 @@ def reach_scene(scenario):
     if task.objects:
         objects = validate_objects(task.objects, task.min_separation)
         targets = tuple(int(t) for t in task.targets)
+        if len(task.switch_schedule) > 1 and len(objects) < 2:
+            raise ValueError("target switching needs at least 2 objects: add objects or set "
+                             "switch_schedule to [0.0]")
         if len(targets) != len(task.switch_schedule):
             raise ValueError(f"targets {list(targets)} needs one object index per entry of "
                              f"switch_schedule {task.switch_schedule}")
@@ -429,8 +432,6 @@ def reach_scene(scenario):
         if any(a == b for a, b in zip(targets, targets[1:])):
             raise ValueError(f"targets {list(targets)}: each switch must go to a different "
                              "object")
-        if len(task.switch_schedule) > 1 and len(objects) < 2:
-            raise ValueError("target switching needs at least 2 objects")
         return ReachScene(objects=objects, targets=targets)
     if task.targets:
         raise ValueError("targets are given without objects")

@@ -56,6 +56,8 @@ READY_ARM_FLEX = -0.5
 # N·m·s/rad). The plant applies them implicitly, so high gains stay stable.
 ARM_KP = (2000.0, 1000.0, 500.0, 300.0, 300.0)
 ARM_KD = (200.0, 100.0, 50.0, 30.0, 30.0)
+# How far the robot lags behind the pose it tracks (s): about one diff-IK step and the PD.
+TRACKING_LAG = 0.005
 # Base PD (x, y in N/m, N·s/m; yaw in N·m/rad, N·m·s/rad). These forces are explicit (one
 # time step behind), so damping stays well below mass / time_step (35 kg, ~3 kg·m²).
 BASE_KP = (8000.0, 8000.0, 1500.0)
@@ -109,13 +111,20 @@ class EeCommandToPose(LeafSystem):
         - X_WE_desired
 
     `ee_command` is `[p (3), v (3), heading]`; the pose is `(Rz(heading) R_E0, p)` where
-    `R_E0` is the hand pointing along world +x. The velocity is not used: diff IK
-    follows the position samples, which for a smooth command is the same motion.
+    `R_E0` is the hand pointing along world +x.
+
+    With a `command_period` (a control loop that sends, at each tick, the state to be in at
+    the next tick), the position ramps into `p` at velocity `v`: `p - v (t_next - t - lead)`.
+    Tracking `p` as a step once a tick would leave the robot behind by most of a tick's
+    travel, and a policy re-integrated from the robot's state (PBP) would then run slow.
+    `lead` makes up for the lag of differential IK and PD behind the pose they track.
     """
 
-    def __init__(self, R_E0: RotationMatrix):
+    def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
         super().__init__()
         self._R_E0 = RotationMatrix(R_E0)
+        self._period = command_period
+        self._lead = float(lead)
         self._command_port = self.DeclareVectorInputPort("ee_command", 7)
         self._pose_port = self.DeclareAbstractOutputPort(
             "X_WE_desired", lambda: AbstractValue.Make(RigidTransform()), self._calc_pose)
@@ -129,7 +138,12 @@ class EeCommandToPose(LeafSystem):
     def _calc_pose(self, context, output):
         command = self._command_port.Eval(context)
         R = RotationMatrix.MakeZRotation(command[6]) @ self._R_E0
-        output.set_value(RigidTransform(R, command[:3]))
+        position = command[:3]
+        if self._period:
+            time = context.get_time()
+            next_tick = np.ceil(time / self._period - 1e-9) * self._period
+            position = position - command[3:6] * (max(0.0, next_tick - time) - self._lead)
+        output.set_value(RigidTransform(R, position))
 
 
 class EeStateFromPlant(LeafSystem):
@@ -270,7 +284,7 @@ def _make_diff_ik(plant, model, q0, time_step):
 
 
 def add_hsr_station(builder, time_step=0.005, meshcat=None, initial_base=(0.0, 0.0, 0.0),
-                    ee_height=0.7, diff_ik_time_step=None) -> HsrStation:
+                    ee_height=0.7, diff_ik_time_step=None, command_period=None) -> HsrStation:
     """Adds the HSR, its whole-body end-effector controller and (optionally) a
     visualizer to ``builder``.
 
@@ -284,6 +298,9 @@ def add_hsr_station(builder, time_step=0.005, meshcat=None, initial_base=(0.0, 0
             the base's +x in front of the base.
         diff_ik_time_step: period of the diff-IK integrator (s), ``time_step`` by
             default; a multiple of ``time_step`` costs fewer QP solves.
+        command_period: the period of a control loop that sends each tick the state
+            ``[p, v]`` to reach at the next tick; the station then ramps into ``p`` at
+            ``v`` (see EeCommandToPose). None: track ``p`` as given.
 
     Returns:
         An HsrStation. A fresh context starts at rest in the ready pose with the diff
@@ -310,7 +327,8 @@ def add_hsr_station(builder, time_step=0.005, meshcat=None, initial_base=(0.0, 0
     R_E0 = RotationMatrix.MakeZRotation(-heading0) @ X_WE0.rotation()
     initial_ee_state = np.concatenate([X_WE0.translation(), np.zeros(3), [heading0, 0.0]])
 
-    command_to_pose = builder.AddNamedSystem("ee_command_to_pose", EeCommandToPose(R_E0))
+    command_to_pose = builder.AddNamedSystem(
+        "ee_command_to_pose", EeCommandToPose(R_E0, command_period, lead=TRACKING_LAG))
     diff_ik = builder.AddNamedSystem(
         "diff_ik", _make_diff_ik(plant, model, q0, diff_ik_time_step))
     builder.Connect(command_to_pose.get_pose_output_port(),

@@ -31,12 +31,17 @@ class SampledOperator(LeafSystem):
     def _declare_operator_outputs(self):
         d = self._dimension
         self._sample_index = self.DeclareDiscreteState(d + 1)
+        # Both outputs depend on the held sample alone (no direct feedthrough), so an
+        # operator may watch systems that depend on its own output.
+        held = {self.discrete_state_ticket(self._sample_index)}
         self._command_port = self.DeclareVectorOutputPort(
             "operator_command", d,
-            lambda context, output: output.SetFromVector(self._held(context)[:d]))
+            lambda context, output: output.SetFromVector(self._held(context)[:d]),
+            prerequisites_of_calc=held)
         self._active_port = self.DeclareVectorOutputPort(
             "operator_active", 1,
-            lambda context, output: output.SetFromVector(self._held(context)[d:]))
+            lambda context, output: output.SetFromVector(self._held(context)[d:]),
+            prerequisites_of_calc=held)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
 
     def get_operator_command_output_port(self):

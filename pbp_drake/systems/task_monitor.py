@@ -48,7 +48,9 @@ class TaskMonitor(LeafSystem):
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._status_index = self.DeclareDiscreteState(len(TASK_STATUS_FIELDS))
-        self._target_port = self.DeclareVectorOutputPort("target", 4, self._calc_target)
+        self._target_port = self.DeclareVectorOutputPort(
+            "target", 4, self._calc_target,
+            prerequisites_of_calc={self.discrete_state_ticket(self._status_index)})
         self._status_port = self.DeclareStateOutputPort("task_status", self._status_index)
         self.DeclarePeriodicDiscreteUpdateEvent(control_period, update_offset, self._update)
 
@@ -63,6 +65,10 @@ class TaskMonitor(LeafSystem):
 
     def get_task_status_output_port(self):
         return self._status_port
+
+    @property
+    def objects(self):
+        return self._objects
 
     def target_index(self, stage):
         return self._targets[int(stage)]

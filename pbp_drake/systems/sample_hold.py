@@ -1,0 +1,38 @@
+"""A zero-order hold that starts from a given value."""
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+
+class SampleHold(LeafSystem):
+    """Samples its input at each control tick and holds it; starts at `initial_value`.
+
+    .. pydrake_system::
+
+        name: SampleHold
+        input_ports:
+        - u
+        output_ports:
+        - y
+
+    Drake's ZeroOrderHold starts at zero, which before its first sample would tell the
+    systems downstream that the robot stands at the world's origin; this one starts where
+    the robot does.
+    """
+
+    def __init__(self, period, initial_value):
+        super().__init__()
+        initial_value = np.asarray(initial_value, dtype=float)
+        self._input_port = self.DeclareVectorInputPort("u", initial_value.size)
+        index = self.DeclareDiscreteState(initial_value)
+        self._output_port = self.DeclareStateOutputPort("y", index)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+
+    def get_input_port(self):
+        return self._input_port
+
+    def get_output_port(self):
+        return self._output_port
+
+    def _update(self, context, discrete_state):
+        discrete_state.get_mutable_vector().set_value(self._input_port.Eval(context))

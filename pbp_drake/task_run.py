@@ -1,0 +1,101 @@
+"""Running one HSR task to its end and reading back its result and time series."""
+
+import dataclasses
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import EventStatus
+
+from pbp_drake.builder import build_diagram
+from pbp_drake.systems.task_monitor import INTERVENTION_RATIO, STAGE, SUCCESS, TASK_TIME
+
+
+@dataclasses.dataclass
+class TaskResult:
+    """One run of an HSR task, its metrics and its time series indexed by control tick k.
+
+    Attributes:
+        success: the end effector came within the success distance of the final target.
+        task_time: seconds until success (the time limit when it failed).
+        intervention_ratio: ticks with operator input / ticks of the task.
+        switches: how many times the target switched.
+        times: (T,) tick times. ee_positions: (T, 3); headings: (T,).
+        commands: (T, 7) `[p, v, heading]` sent from tick k on.
+        operator_active: (T,) bools; operator_commands: (T, 4).
+        selected_goals, targets: (T,) object indices (estimate and truth) at tick k.
+        objects: (M, 3).
+    """
+
+    success: bool
+    task_time: float
+    intervention_ratio: float
+    switches: int
+    times: np.ndarray
+    ee_positions: np.ndarray
+    headings: np.ndarray
+    commands: np.ndarray
+    operator_active: np.ndarray
+    operator_commands: np.ndarray
+    selected_goals: np.ndarray
+    targets: np.ndarray
+    objects: np.ndarray
+
+    def summary_line(self):
+        outcome = "success" if self.success else "FAILED"
+        return (f"{outcome} in {self.task_time:.2f} s, intervention ratio "
+                f"{self.intervention_ratio:.3f}, {self.switches} target switches")
+
+
+def run_task(scenario, meshcat=None, realtime_rate=0.0, diagram=None):
+    """Simulates an HSR task until success or `scenario.duration` (the time limit)."""
+    diagram = build_diagram(scenario, meshcat) if diagram is None else diagram
+    monitor = diagram.GetSubsystemByName("task_monitor")
+    status_port = monitor.get_task_status_output_port()
+    simulator = Simulator(diagram)
+    simulator.set_target_realtime_rate(realtime_rate)
+
+    def stop_at_success(root_context):
+        status = status_port.Eval(monitor.GetMyContextFromRoot(root_context))
+        if status[SUCCESS] > 0.5:
+            return EventStatus.ReachedTermination(monitor, "the target is reached")
+        return EventStatus.Succeeded()
+
+    simulator.set_monitor(stop_at_success)
+    simulator.Initialize()
+    period = scenario.control_period
+    ticks = int(round(scenario.duration / period))
+    simulator.AdvanceTo((ticks + 1) * period)
+    context = simulator.get_context()
+    status = status_port.Eval(monitor.GetMyContextFromRoot(context))
+    return _read_result(diagram, context, status, monitor)
+
+
+def _read_result(diagram, context, status, monitor):
+    def log(name):
+        return diagram.GetSubsystemByName(name).FindLog(context)
+
+    # Loggers publish before the discrete updates of their instant: at t_k they see the
+    # plant's state at t_k but the decisions of tick k - 1 (see simulation.read_trajectory).
+    ee_log = log("ee_state_log")
+    tick_count = ee_log.num_samples() - 1
+
+    def decisions(name):
+        return log(name).data().T[1:tick_count + 1]
+
+    ee_state = ee_log.data().T[:tick_count]
+    success = bool(status[SUCCESS] > 0.5)
+    return TaskResult(
+        success=success,
+        task_time=float(status[TASK_TIME]),
+        intervention_ratio=float(status[INTERVENTION_RATIO]),
+        switches=int(status[STAGE]),
+        times=ee_log.sample_times()[:tick_count],
+        ee_positions=ee_state[:, :3],
+        headings=ee_state[:, 6],
+        commands=decisions("command_log"),
+        operator_active=decisions("operator_active_log")[:, 0] > 0.5,
+        operator_commands=decisions("operator_command_log"),
+        selected_goals=decisions("selected_goal_log")[:, 0].astype(int),
+        targets=decisions("target_log")[:, 3].astype(int),
+        objects=monitor.objects.copy(),
+    )

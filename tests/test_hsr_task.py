@@ -1,0 +1,174 @@
+"""The HSR reaching task end to end: the scenario file, PBP and teleop with the virtual
+participant, goal switching, the keyboard in the full task, the CLI and bad input."""
+
+import dataclasses
+import json
+import textwrap
+
+import msgpack
+import numpy as np
+import pytest
+from pydrake.geometry import Meshcat, MeshcatParams
+from pydrake.systems.analysis import Simulator
+
+from pbp_drake.builder import build_diagram
+from pbp_drake.cli import main
+from pbp_drake.scenarios import Keyboard, ScenarioError, load_scenario_file
+from pbp_drake.systems.keyboard_operator import LEFT_BUTTON
+from pbp_drake.task_run import run_task
+
+# Two objects ahead, left and right; the target starts on the right, switches to the left
+# at 30 % and back at 60 %: both switches need the operator.
+FIXED_TASK = """
+scenario:
+  name: two_objects
+  method: pbp_alternated
+  control_period: 0.03
+  duration: 40.0
+  robot: !Hsr {}
+  task:
+    objects: [[1.6, -0.5, 0.7], [1.6, 0.5, 0.7]]
+    targets: [0, 1, 0]
+  operator: !VirtualParticipant {}
+  seed: 3
+"""
+
+
+def write(tmp_path, text, name="task.yaml"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+@pytest.fixture(scope="module")
+def fixed_task(tmp_path_factory):
+    return load_scenario_file(write(tmp_path_factory.mktemp("task"), FIXED_TASK)).scenario
+
+
+@pytest.fixture(scope="module")
+def pbp_run(fixed_task):
+    return run_task(fixed_task)
+
+
+def test_pbp_alternated_reaches_the_switching_target_with_little_input(pbp_run):
+    assert pbp_run.success
+    assert pbp_run.switches == 2
+    assert np.linalg.norm(pbp_run.ee_positions[-1] - pbp_run.objects[0]) < 0.06
+    # The participant acts only to turn toward each new target; the DMPs do the rest.
+    assert 0.0 < pbp_run.intervention_ratio < 0.5
+    # In PBP the operator never pushes forward: the DMP phase does.
+    assert np.all(pbp_run.operator_commands[:, 2] == 0.0)
+
+
+def test_the_estimated_goal_follows_the_target(pbp_run):
+    # At the end the estimate agrees with the target; it changed at least once per switch.
+    assert pbp_run.selected_goals[-1] == pbp_run.targets[-1]
+    assert np.count_nonzero(np.diff(pbp_run.selected_goals)) >= 2
+
+
+def test_switching_goal_moves_the_command_no_more_than_one_step(pbp_run):
+    positions = pbp_run.commands[:, :3]
+    jumps = np.linalg.norm(np.diff(positions, axis=0), axis=1)
+    switches = np.flatnonzero(np.diff(pbp_run.selected_goals)) + 1
+    assert len(switches) >= 2
+    travel = np.linalg.norm(np.diff(pbp_run.ee_positions, axis=0), axis=1)
+    # One control step's travel: the most the end effector itself moves in one tick.
+    step_travel = travel.max()
+    assert step_travel < 0.02
+    assert np.all(jumps[switches - 1] <= step_travel + 1e-3), (
+        jumps[switches - 1], step_travel)
+
+
+def test_teleop_participant_drives_the_whole_way(fixed_task):
+    result = run_task(dataclasses.replace(fixed_task, method="teleop"))
+    assert result.success
+    assert result.intervention_ratio > 0.85
+
+
+def test_the_same_seed_gives_the_same_run(fixed_task, pbp_run):
+    again = run_task(fixed_task)
+    assert again.task_time == pbp_run.task_time
+    np.testing.assert_array_equal(again.ee_positions, pbp_run.ee_positions)
+
+
+def test_keyboard_left_key_moves_the_hand_left(fixed_task):
+    meshcat = Meshcat(MeshcatParams(host="localhost", port=0))
+    scenario = dataclasses.replace(fixed_task, method="teleop", operator=Keyboard())
+    diagram = build_diagram(scenario, meshcat)
+    simulator = Simulator(diagram)
+    simulator.Initialize()
+    station_state = diagram.GetSubsystemByName("ee_state_sample")
+    start = station_state.get_output_port().Eval(
+        station_state.GetMyContextFromRoot(simulator.get_context()))[:3].copy()
+    for step in range(20):
+        meshcat._InjectWebsocketMessage(msgpack.packb({"type": "button", "name": LEFT_BUTTON}))
+        simulator.AdvanceTo(0.1 * (step + 1))
+    end = station_state.get_output_port().Eval(
+        station_state.GetMyContextFromRoot(simulator.get_context()))[:3]
+    moved = end - start
+    # The hand points along +x, so its left is +y.
+    assert moved[1] > 0.2
+    assert abs(moved[0]) < 0.05 and abs(moved[2]) < 0.02
+
+
+def test_run_with_the_virtual_participant_prints_one_result_line(tmp_path, capsys, fixed_task):
+    path = write(tmp_path, FIXED_TASK)
+    record = tmp_path / "replay.html"
+    code = main(["run", str(path), "--operator", "virtual", "--headless",
+                 "--record", str(record)])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "success in" in out and "intervention ratio" in out
+    assert record.stat().st_size > 10_000
+
+
+def test_study_compares_methods_on_the_same_scenes(tmp_path, capsys):
+    text = FIXED_TASK.replace("objects: [[1.6, -0.5, 0.7], [1.6, 0.5, 0.7]]\n    targets: [0, 1, 0]",
+                              "object_count: [2, 3]")
+    path = write(tmp_path, text)
+    output = tmp_path / "study"
+    assert main(["study", str(path), "--methods", "pbp_alternated,teleop", "--trials", "2",
+                 "--seed", "5", "--output", str(output)]) == 0
+    summary = json.loads((output / "summary.json").read_text())
+    assert set(summary["methods"]) == {"pbp_alternated", "teleop"}
+    for entry in summary["methods"].values():
+        assert set(entry) >= {"success_rate", "intervention_ratio", "task_time"}
+        assert set(entry["task_time"]) == {"mean", "std"}
+    trials = json.loads((output / "trials.json").read_text())
+    assert [t["seed"] for t in trials] == [5, 6, 5, 6]
+    assert (output / "fig_reach_study.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("change, message", [
+    (("objects: [[1.6, -0.5, 0.7], [1.6, 0.5, 0.7]]\n    targets: [0, 1, 0]",
+      "objects: [[1.6, 0.0, 0.7]]\n    targets: [0, 0, 0]"), "at least 2 objects"),
+    (("[1.6, 0.5, 0.7]", "[1.6, -0.45, 0.7]"), "overlap"),
+    (("[1.6, 0.5, 0.7]", "[6.0, 0.5, 0.7]"), "out of reach"),
+    (("[1.6, 0.5, 0.7]", "[1.6, 0.5, 2.5]"), "out of the HSR's reach"),
+    (("method: pbp_alternated", "method: pbp_alternatd"), "did you mean 'pbp_alternated'"),
+    (("!VirtualParticipant {}", "!Virtual {}"), "Virtual"),
+])
+def test_bad_task_input_names_the_problem(tmp_path, change, message):
+    path = write(tmp_path, FIXED_TASK.replace(*change))
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(path)
+
+
+def test_one_object_with_switching_on_is_refused(tmp_path):
+    text = FIXED_TASK.replace(
+        "objects: [[1.6, -0.5, 0.7], [1.6, 0.5, 0.7]]\n    targets: [0, 1, 0]",
+        "object_count: [1, 1]")
+    with pytest.raises(ScenarioError, match="switching needs at least 2 objects"):
+        load_scenario_file(write(tmp_path, text))
+
+
+def test_unknown_operator_on_the_command_line(tmp_path, capsys):
+    assert main(["run", str(write(tmp_path, FIXED_TASK)), "--operator", "joystik",
+                 "--headless"]) == 2
+    assert "--operator 'joystik' is unknown" in capsys.readouterr().err
+
+
+def test_a_person_cannot_drive_a_headless_run(tmp_path, capsys):
+    assert main(["run", str(write(tmp_path, FIXED_TASK)), "--operator", "keyboard",
+                 "--headless"]) == 2
+    assert "--operator virtual" in capsys.readouterr().err

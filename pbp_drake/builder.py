@@ -306,7 +306,7 @@ def make_hsr_operator(scenario, meshcat):
         from pbp_drake.systems.virtual_participant import VirtualParticipant
 
         return VirtualParticipant(
-            period, mode="drive" if allow_forward else "assist", speed=speed,
+            period, reach_scene(scenario).objects, mode="drive" if allow_forward else "assist", speed=speed,
             rotation_speed=config.rotation_speed, reaction_delay=config.reaction_delay,
             direction_noise=config.direction_noise, speed_noise=config.speed_noise,
             seed=scenario.seed)

@@ -30,6 +30,8 @@ def main(argv=None):
                      help="simulate as fast as possible without waiting for a browser")
     run.add_argument("--record", metavar="FILE.html",
                      help="save a self-contained replay of the run")
+    run.add_argument("--duration", type=float, metavar="SECONDS",
+                     help="HSR tasks: override the scenario's duration (the time limit)")
     run.add_argument("--realtime-rate", type=float, default=1.0,
                      help="target simulated seconds per wall second (ignored when headless)")
     run.add_argument("--port", type=int, default=0, help="Meshcat port (0: a free one)")
@@ -131,6 +133,11 @@ def _run_task(args, scenario, meshcat):
     from pbp_drake.scenarios import Gamepad, Keyboard
     from pbp_drake.task_run import run_task
 
+    if args.duration is not None:
+        if not (np.isfinite(args.duration) and args.duration > 0):
+            raise ScenarioError(f"--duration {args.duration:g} must be a positive number of "
+                                "seconds")
+        scenario = dataclasses.replace(scenario, duration=args.duration)
     diagram = build_diagram(scenario, meshcat)
     person = isinstance(scenario.operator, (Keyboard, Gamepad))
     if args.headless and person:
@@ -152,8 +159,11 @@ def _run_task(args, scenario, meshcat):
                       diagram=diagram)
     if args.record:
         _save_recording(meshcat, args.record)
+    hand = ""
+    if len(result.ee_positions):
+        hand = ", hand at [" + ", ".join(f"{x:.3f}" for x in result.ee_positions[-1]) + "]"
     print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
-          f"{result.summary_line()}", flush=True)
+          f"{result.summary_line()}{hand}", flush=True)
     if not args.headless and sys.stdin.isatty():
         input("Press Enter to quit (the page stays live until then). ")
     return 0 if result.success else 1

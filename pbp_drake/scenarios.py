@@ -186,7 +186,9 @@ class GoalEstimatorOptions:
 
     # angle (the paper's heuristic), nearest or bayesian.
     method: str = "angle"
-    temperature: float = 0.3
+    # Softmax temperature (rad for angle, m for nearest): low enough that objects a few
+    # degrees apart are told apart.
+    temperature: float = 0.1
     beta: float = 5.0
     # Hysteresis: a challenger must beat the selection by `margin` for `hold_steps` updates.
     margin: float = 0.1

@@ -26,7 +26,8 @@ class VirtualParticipant(SampledOperator):
     (`selected_goal`) is not the target, it turns the end effector toward the target and
     sidesteps toward it; otherwise it lets go. It never pushes forward, as in the paper
     where the forward key is disabled. Facing the target while the estimate is still another
-    object (the two almost in line), it steps aside to tell them apart. `mode="drive"` (teleoperation): it drives the whole
+    object (the two almost in line), it steps aside, to the side that widens the angle
+    between them, to tell them apart; it sees all the `objects` (M, 3). `mode="drive"` (teleoperation): it drives the whole
     way, toward the target at `speed` (slowing within `slow_radius`), turning to face it.
 
     It notices a new target only `reaction_delay` seconds after it appears, and its
@@ -39,7 +40,7 @@ class VirtualParticipant(SampledOperator):
     world frame (vz = 0).
     """
 
-    def __init__(self, control_period, mode="assist", speed=0.2, rotation_speed=0.6,
+    def __init__(self, control_period, objects, mode="assist", speed=0.2, rotation_speed=0.6,
                  reaction_delay=0.3, direction_noise=0.1, speed_noise=0.1, seed=0,
                  slow_radius=0.15, aligned_angle=0.05):
         if mode not in PARTICIPANT_MODES:
@@ -47,6 +48,7 @@ class VirtualParticipant(SampledOperator):
                              f"{PARTICIPANT_MODES}")
         super().__init__(4, control_period)
         self._mode = mode
+        self._objects = np.asarray(objects, dtype=float)
         self._speed = float(speed)
         self._rotation_speed = float(rotation_speed)
         self._reaction_ticks = int(round(reaction_delay / control_period))
@@ -86,6 +88,21 @@ class VirtualParticipant(SampledOperator):
         command, active = self._decide(context, int(known))
         self._store_sample(discrete_state, command, active)
 
+    def _aside_direction(self, position, heading, target, selected):
+        """+1 (left) or -1: the sidestep that widens the angle between the target and the
+        object picked instead, when the two stand almost in line.
+
+        Stepping left by d turns the view of a point at distance r by -d / r, so the gap
+        `angle(picked) - angle(target)` changes by `-d (1 / r_picked - 1 / r_target)`.
+        """
+        picked = self._objects[selected]
+        gap = (_apparent_angle(position, heading, picked)
+               - _apparent_angle(position, heading, target[:3]))
+        closeness = (1.0 / max(np.linalg.norm(picked[:2] - position[:2]), 1e-6)
+                     - 1.0 / max(np.linalg.norm(target[:2] - position[:2]), 1e-6))
+        direction = -np.sign(gap) * np.sign(closeness)
+        return direction if direction != 0 else 1.0
+
     def _decide(self, context, known_target):
         ee_state = self._ee_state_port.Eval(context)
         position, heading = ee_state[:3], ee_state[6]
@@ -99,15 +116,14 @@ class VirtualParticipant(SampledOperator):
         offset = target[:2] - position[:2]
         distance = np.linalg.norm(offset)
         if self._mode == "assist":
-            if int(round(self._selected_goal_port.Eval(context)[0])) == int(target[3]):
+            selected = int(round(self._selected_goal_port.Eval(context)[0]))
+            if selected == int(target[3]):
                 return np.zeros(4), False
             # Sidestep toward the target: the part of its direction across the heading.
             left = np.array([-np.sin(heading), np.cos(heading)])
             lateral = (offset / max(distance, 1e-9)) @ left
             if abs(angle) <= 2 * self._aligned_angle:
-                # Facing the target while another object is picked: the two lie almost in
-                # line, so step aside (toward the middle of the room) to tell them apart.
-                lateral = 0.5 if position[1] <= 0.0 else -0.5
+                lateral = 0.5 * self._aside_direction(position, heading, target, selected)
             velocity = self._speed * speed_scale * lateral * _rotate(left, noise_angle)
         else:
             if distance < 1e-9:
@@ -118,6 +134,10 @@ class VirtualParticipant(SampledOperator):
         if abs(angle) > self._aligned_angle:
             yaw_rate = np.sign(angle) * self._rotation_speed * min(1.0, abs(angle) / 0.3)
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
+
+
+def _apparent_angle(position, heading, point):
+    return heading_error(heading, position, point)
 
 
 def _rotate(vector, angle):

@@ -1,0 +1,133 @@
+"""A person at the browser, end to end: `pbp-drake run` the HSR reaching task with the
+keyboard operator, open its Meshcat page in headless Chromium, hold the Left arrow, and
+check that the hand went left and that the page shows the yellow target marker.
+
+Needs Debian's `chromium` (`make test` installs it where it can) and Playwright from PyPI
+(the `test` extra; never `playwright install`). Skipped where either is missing.
+"""
+
+import io
+import queue
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import matplotlib.image
+import numpy as np
+import pytest
+
+CHROMIUM = shutil.which("chromium")
+try:
+    from playwright.sync_api import sync_playwright
+except ImportError:  # pragma: no cover - depends on the environment
+    sync_playwright = None
+
+pytestmark = [
+    pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed"),
+    pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed"),
+]
+
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--enable-unsafe-swiftshader",
+                 "--disable-background-networking"]
+DURATION = 12.0  # the task's time limit: the run ends by itself after it
+START_Y = 0.08  # the hand starts at about (0.53, 0.08, 0.70), pointing along world +x
+RESULT = re.compile(r"^hsr_reach \[teleop, seed 0\]: .*, hand at \[(\S+), (\S+), (\S+)\]$")
+
+
+def free_port():
+    with socket.socket() as probe:
+        probe.bind(("localhost", 0))
+        return probe.getsockname()[1]
+
+
+class Output:
+    """The lines of a process's output, read on a thread so that every wait has a timeout."""
+
+    def __init__(self, stream):
+        self.lines = []
+        self._queue = queue.Queue()
+        threading.Thread(target=self._read, args=(stream,), daemon=True).start()
+
+    def _read(self, stream):
+        for line in stream:
+            self._queue.put(line.rstrip("\n"))
+        self._queue.put(None)
+
+    def wait_for(self, pattern, timeout):
+        """The first match of `pattern` in the lines to come, or None at the timeout or end."""
+        deadline = time.monotonic() + timeout
+        while (remaining := deadline - time.monotonic()) > 0:
+            try:
+                line = self._queue.get(timeout=remaining)
+            except queue.Empty:
+                return None
+            if line is None:
+                return None
+            self.lines.append(line)
+            if match := re.search(pattern, line):
+                return match
+        return None
+
+    def text(self):
+        return "\n".join(self.lines[-40:])
+
+
+def yellow_pixel_count(png):
+    image = matplotlib.image.imread(io.BytesIO(png), format="png")  # floats in [0, 1]
+    rgb = np.round(image[..., :3] * 255).astype(int)
+    red, green, blue = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    return int(np.count_nonzero((red > 200) & (green > 180) & (blue < 80)))
+
+
+@pytest.mark.timeout(120)
+def test_holding_the_left_arrow_in_the_browser_moves_the_hand_left(repo, tmp_path):
+    port = free_port()
+    command = [sys.executable, "-m", "pbp_drake", "run", "diagrams/hsr_reach.yaml",
+               "--method", "teleop", "--operator", "keyboard",
+               "--duration", str(DURATION), "--port", str(port)]
+    process = subprocess.Popen(command, cwd=repo, stdin=subprocess.DEVNULL,
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        output = Output(process.stdout)
+        url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
+        assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
+        with sync_playwright() as playwright:
+            browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
+                                                 timeout=30_000)
+            try:
+                page = browser.new_page(viewport={"width": 1280, "height": 720})
+                page.set_default_timeout(20_000)
+                page.goto(url.group(1), wait_until="load")
+                page.wait_for_selector("canvas")
+                # The task starts when the page connects; give the scene time to arrive
+                # and render (the HSR meshes are the bulk of it).
+                page.wait_for_timeout(4_000)
+                # Meshcat clicks a key's button on every keydown on `window`; a key counts
+                # as held for hold_time (0.6 s) after its last click. Press it as a browser's
+                # key auto-repeat would, every 50 ms, for 2 s.
+                for _ in range(40):
+                    page.keyboard.press("ArrowLeft")
+                    page.wait_for_timeout(50)
+                page.wait_for_timeout(500)
+                png = page.screenshot(type="png")
+            finally:
+                browser.close()
+        (tmp_path / "meshcat.png").write_bytes(png)
+        result = output.wait_for(RESULT.pattern, timeout=DURATION + 30)
+        assert result, f"no result line from pbp-drake:\n{output.text()}"
+        process.wait(timeout=10)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait(timeout=10)
+
+    hand = np.array([float(value) for value in result.groups()])
+    assert hand[1] > START_Y + 0.1, (
+        f"the hand did not go left: it ended at {hand}\n{output.text()}")
+    yellow = yellow_pixel_count(png)
+    assert yellow >= 30, (f"only {yellow} yellow pixels of the target marker in the "
+                          f"screenshot {tmp_path / 'meshcat.png'}")

@@ -5,7 +5,7 @@ PYTHON := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 DEMO_DIR := outputs/demo
 
-.PHONY: demo test clean
+.PHONY: demo test chromium clean
 
 $(STAMP): pyproject.toml
 	test -x $(PYTHON) || python3 -m venv $(VENV)
@@ -18,7 +18,22 @@ demo: $(STAMP)
 	$(VENV)/bin/pbp-drake run diagrams/toy_alpha_study.yaml --scene scene_1 \
 		--method pbp_alternated --headless --record $(DEMO_DIR)/replay.html
 
-test: $(STAMP)
+# The headless browser tests drive Debian's `chromium` (never a browser download, never
+# `playwright install`): install it when it is missing and apt-get is usable as root;
+# otherwise say so and go on (those tests skip). Under CI a failed install is an error.
+chromium:
+	@if command -v chromium >/dev/null 2>&1; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+		echo "Installing Debian's chromium for the browser tests"; \
+		{ apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
+			apt-get install -y -qq chromium >/dev/null; } </dev/null \
+		|| { echo "note: installing chromium failed (an error under CI; elsewhere the browser tests skip)"; \
+		     [ -z "$${CI:-}" ]; }; \
+	else \
+		echo "note: chromium is missing (installing it needs root and apt-get); the browser tests will skip"; \
+	fi
+
+test: $(STAMP) chromium
 	$(PYTHON) -m pytest
 
 clean:

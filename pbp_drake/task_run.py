@@ -24,6 +24,8 @@ class TaskResult:
         operator_active: (T,) bools; operator_commands: (T, 4).
         selected_goals, targets: (T,) object indices (estimate and truth) at tick k.
         objects: (M, 3).
+        collision_ratio: ratio of ticks with the robot in collision (obstacle tasks; 0 in
+            tasks without obstacles). in_collision: (T,) bools, or None without obstacles.
     """
 
     success: bool
@@ -39,6 +41,8 @@ class TaskResult:
     selected_goals: np.ndarray
     targets: np.ndarray
     objects: np.ndarray
+    collision_ratio: float = 0.0
+    in_collision: np.ndarray | None = None
 
     def summary_line(self):
         outcome = "success" if self.success else "FAILED"

@@ -24,7 +24,7 @@ from pbp_drake.scenarios import (
     Gamepad as GamepadConfig, Hsr, Keyboard as KeyboardConfig, NoOperator as NoOperatorConfig,
     ObstacleRepulsion, ScriptedCommands, SinusoidalStep,
     VirtualParticipant as VirtualParticipantConfig, demonstration_samples, dmp_settings,
-    goal_estimator_settings, reach_scene, resolved_goals, resolved_start, validate_scenario)
+    goal_estimator_settings, resolved_goals, resolved_start, task_layout, validate_scenario)
 from pbp_drake.systems import (
     Blender, DemonstrationPlayer, DmpBank, NoOperator, ObstacleRepulsionOperator, PointRobot,
     ScriptedOperator)
@@ -35,6 +35,7 @@ BLEND_MODE_OF_METHOD = {
     "pbp_continuous": "pbp_continuous",
     "pbp_no_user": "pbp_continuous",
     "fixed_alpha": "fixed_alpha",
+    "confidence_alpha": "confidence_alpha",
     "teleop": "teleop",
 }
 
@@ -190,8 +191,8 @@ def _build_hsr_diagram(scenario, meshcat):
 
     period = scenario.control_period
     task = scenario.task
-    scene = reach_scene(scenario)
-    goals = scene.objects
+    layout = task_layout(scenario)
+    goals = layout.objects
     goal_count = len(goals)
     offset = scenario.robot.time_step / 4
     builder = DiagramBuilder()
@@ -215,15 +216,23 @@ def _build_hsr_diagram(scenario, meshcat):
     builder.Connect(goals_source.get_output_port(), estimator.get_goals_input_port())
 
     monitor = builder.AddNamedSystem("task_monitor", TaskMonitor(
-        goals, scene.targets, task.switch_schedule, start, task.success_distance, period,
+        goals, layout.targets, layout.switch_schedule, start, task.success_distance, period,
         update_offset=offset))
     builder.Connect(sample.get_output_port(), monitor.get_ee_state_input_port())
+    obstacles = None
+    if layout.obstacles is not None:
+        obstacles = _add_obstacles(builder, scenario, station, layout.obstacles, sample,
+                                   monitor, offset)
 
-    operator = builder.AddNamedSystem("operator", make_hsr_operator(scenario, meshcat))
+    operator = builder.AddNamedSystem("operator", make_hsr_operator(
+        scenario, meshcat, layout.objects,
+        obstacles.radius + scenario.task.obstacle_clearance if obstacles else 0.0))
     for port_name, source in [("ee_state", ee_state),
                               ("target", monitor.get_target_output_port()),
-                              ("selected_goal", estimator.get_selected_goal_output_port())]:
-        if operator.HasInputPort(port_name):
+                              ("selected_goal", estimator.get_selected_goal_output_port()),
+                              ("obstacle_positions", obstacles and
+                               obstacles.get_obstacle_positions_output_port())]:
+        if operator.HasInputPort(port_name) and source is not None:
             builder.Connect(source, operator.GetInputPort(port_name))
     operator_active = operator.get_operator_active_output_port()
     operator_command = operator.get_operator_command_output_port()
@@ -251,6 +260,8 @@ def _build_hsr_diagram(scenario, meshcat):
     builder.Connect(dmp_bank.get_references_output_port(), blender.get_references_input_port())
     builder.Connect(estimator.get_selected_goal_output_port(),
                     blender.get_selected_goal_input_port())
+    builder.Connect(estimator.get_goal_probabilities_output_port(),
+                    blender.get_goal_probabilities_input_port())
     builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
     builder.Connect(operator_active, blender.get_operator_active_input_port())
     ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
@@ -294,8 +305,46 @@ def make_hsr_dmp_bank(scenario, start, goals):
     return DmpBankMath.straight(start, len(goals), duration, dmp_settings(scenario.dmp))
 
 
-def make_hsr_operator(scenario, meshcat):
-    """The HSR task's operator: a person at the keyboard or gamepad, or the virtual one."""
+def _add_obstacles(builder, scenario, station, obstacle_scene, sample, monitor, offset):
+    """The moving cylinders, measured against the robot's collision geometry."""
+    from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
+
+    from pbp_drake.systems.collision_monitor import CollisionMonitor
+    from pbp_drake.systems.moving_obstacles import MovingObstacles
+
+    task = scenario.task
+    plant, scene_graph = station.plant, station.scene_graph
+    obstacles = builder.AddNamedSystem("obstacles", MovingObstacles(
+        scene_graph, obstacle_scene, station.initial_ee_state[:3], task.obstacle_radius,
+        task.obstacle_height, task.obstacle_speed, scenario.control_period,
+        update_offset=offset))
+    builder.Connect(sample.get_output_port(), obstacles.get_ee_state_input_port())
+    builder.Connect(obstacles.get_geometry_pose_output_port(),
+                    scene_graph.get_source_pose_port(obstacles.source_id))
+    robot_geometries = [geometry for body in plant.GetBodyIndices(station.model)
+                        for geometry in plant.GetCollisionGeometriesForBody(plant.get_body(body))]
+    # The obstacles are measured, not felt: keep them out of the plant's contact (which
+    # also refuses pairs of geometries it does not own, such as two obstacles meeting).
+    scene_graph.collision_filter_manager().Apply(
+        CollisionFilterDeclaration()
+        .ExcludeBetween(GeometrySet(robot_geometries), GeometrySet(obstacles.geometry_ids))
+        .ExcludeWithin(GeometrySet(obstacles.geometry_ids)))
+    collisions = builder.AddNamedSystem(
+        "collision_monitor", CollisionMonitor(robot_geometries, obstacles.geometry_ids))
+    builder.Connect(scene_graph.get_query_output_port(),
+                    collisions.get_query_object_input_port())
+    builder.Connect(collisions.get_in_collision_output_port(),
+                    monitor.get_in_collision_input_port())
+    LogVectorOutput(collisions.get_in_collision_output_port(), builder,
+                    scenario.control_period).set_name("in_collision_log")
+    return obstacles
+
+
+def make_hsr_operator(scenario, meshcat, objects, obstacle_keep_out=0.0):
+    """The HSR task's operator: a person at the keyboard or gamepad, or the virtual one.
+
+    `obstacle_keep_out` (m) is how far the virtual participant keeps the robot's footprint
+    from an obstacle's centre; 0 without obstacles."""
     config = scenario.operator
     period = scenario.control_period
     allow_forward = scenario.method == "teleop"
@@ -306,10 +355,12 @@ def make_hsr_operator(scenario, meshcat):
         from pbp_drake.systems.virtual_participant import VirtualParticipant
 
         return VirtualParticipant(
-            period, reach_scene(scenario).objects, mode="drive" if allow_forward else "assist", speed=speed,
+            period, objects, mode="drive" if allow_forward else "assist", speed=speed,
             rotation_speed=config.rotation_speed, reaction_delay=config.reaction_delay,
             direction_noise=config.direction_noise, speed_noise=config.speed_noise,
-            seed=scenario.seed)
+            seed=scenario.seed, obstacle_count=(
+                scenario.task.obstacle_count if obstacle_keep_out else 0),
+            obstacle_keep_out=obstacle_keep_out)
     if meshcat is None:
         raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "
                          "Meshcat (pbp-drake run without --headless)")

@@ -15,7 +15,8 @@ import typing
 import numpy as np
 from pydrake.common.yaml import yaml_load_typed
 
-METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "teleop", "pbp_no_user")
+METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
+           "pbp_no_user")
 
 
 class ScenarioError(ValueError):
@@ -181,6 +182,30 @@ class MultiGoalReach:
 
 
 @dataclasses.dataclass
+class DynamicObstacles:
+    """The paper's obstacle task (section IV-B.2): one target drawn from the seed; cylinder
+    obstacles start still at random places and, once the progress passes each one's
+    threshold (drawn in `activation_range`), move at `obstacle_speed` to the midpoint of the
+    line from the hand to the target. Collisions are measured on the HSR's collision
+    geometry and do not push the robot."""
+
+    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    height: float = 0.7
+    success_distance: float = 0.05
+    obstacle_count: int = 3
+    obstacle_radius: float = 0.12
+    obstacle_height: float = 1.2
+    obstacle_speed: float = 0.15
+    # How far from an obstacle's surface the virtual participant keeps the robot's
+    # centre line (the base is 0.23 m in radius).
+    obstacle_clearance: float = 0.4
+    obstacle_x_range: list[float] = dataclasses.field(default_factory=lambda: [0.9, 2.6])
+    obstacle_y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.3, 1.3])
+    activation_range: list[float] = dataclasses.field(default_factory=lambda: [0.05, 0.5])
+
+
+@dataclasses.dataclass
 class GoalEstimatorOptions:
     """Which goal the operator intends (see `pbp_drake.core.goal_estimation`)."""
 
@@ -217,7 +242,8 @@ class Scenario:
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     operator: OperatorConfig = dataclasses.field(default_factory=NoOperator)
     # HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
-    task: typing.Optional[MultiGoalReach] = None
+    # An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task.
+    task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles]] = None
     goal_estimator: GoalEstimatorOptions = dataclasses.field(
         default_factory=GoalEstimatorOptions)
     seed: int = 0
@@ -352,6 +378,9 @@ def validate_scenario(scenario):
             f"scenario.goals have dimension {goals.shape[1]}, scenario.start has {start.size}")
     if not (np.isfinite(goals).all() and np.isfinite(start).all()):
         raise ScenarioError("scenario.goals and scenario.start must be finite")
+    if scenario.method == "confidence_alpha":
+        raise ScenarioError("scenario.method confidence_alpha needs a goal estimator's "
+                            "confidence: use it in the HSR tasks (robot: !Hsr)")
     if scenario.method == "fixed_alpha" and scenario.demonstration is None:
         raise ScenarioError(
             "scenario.method fixed_alpha plays the demonstration as P: give "
@@ -386,16 +415,19 @@ def _validate_hsr_scenario(scenario):
     if not scenario.robot.speed > 0:
         raise ScenarioError("scenario.robot.speed must be positive")
     task = scenario.task
-    if not (0 < task.success_distance and 0 < task.min_separation):
-        raise ScenarioError("scenario.task.success_distance and min_separation must be "
-                            "positive")
-    schedule = np.asarray(task.switch_schedule, float)
-    if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
-            or schedule[-1] >= 1.0):
-        raise ScenarioError(f"scenario.task.switch_schedule {task.switch_schedule} must start "
-                            "at 0.0 and increase strictly below 1.0")
+    if isinstance(task, DynamicObstacles):
+        _validate_obstacle_task(scenario)
+    else:
+        if not (0 < task.success_distance and 0 < task.min_separation):
+            raise ScenarioError("scenario.task.success_distance and min_separation must be "
+                                "positive")
+        schedule = np.asarray(task.switch_schedule, float)
+        if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
+                or schedule[-1] >= 1.0):
+            raise ScenarioError(f"scenario.task.switch_schedule {task.switch_schedule} must "
+                                "start at 0.0 and increase strictly below 1.0")
     try:
-        reach_scene(scenario)
+        task_layout(scenario)
     except ValueError as error:
         raise ScenarioError(f"scenario.task: {error}") from None
     try:
@@ -412,6 +444,53 @@ def _validate_hsr_scenario(scenario):
         value = getattr(operator, name, 0.0)
         if not (np.isfinite(value) and value >= 0):
             raise ScenarioError(f"scenario.operator.{name} must be finite and not negative")
+
+
+def _validate_obstacle_task(scenario):
+    task = scenario.task
+    for name in ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"):
+        if not (np.isfinite(getattr(task, name)) and getattr(task, name) > 0):
+            raise ScenarioError(f"scenario.task.{name} must be positive")
+    if task.obstacle_count < 0:
+        raise ScenarioError("scenario.task.obstacle_count must not be negative")
+    for name in ("x_range", "y_range", "obstacle_x_range", "obstacle_y_range",
+                 "activation_range"):
+        low_high = getattr(task, name)
+        if len(low_high) != 2 or not low_high[0] <= low_high[1]:
+            raise ScenarioError(f"scenario.task.{name} must be [low, high], got {low_high}")
+    if not 0.0 <= task.activation_range[0] <= task.activation_range[1] <= 1.0:
+        raise ScenarioError("scenario.task.activation_range must lie in [0, 1]")
+
+
+@dataclasses.dataclass(frozen=True)
+class TaskLayout:
+    """What an HSR task puts in front of the robot: the goals `(K, 3)` (one DMP each), the
+    target sequence and its switch schedule, and the obstacles (None without)."""
+
+    objects: np.ndarray
+    targets: tuple
+    switch_schedule: tuple
+    obstacles: typing.Any = None
+
+
+def task_layout(scenario):
+    """The goals, targets and obstacles of an HSR task, drawn from the seed when asked."""
+    from pbp_drake.core.obstacle_task import sample_obstacle_scene
+    from pbp_drake.core.reach_task import validate_objects
+
+    task = scenario.task
+    if isinstance(task, DynamicObstacles):
+        corners = [[x, y, task.height] for x in task.x_range for y in task.y_range]
+        validate_objects(corners, 0.0)
+        obstacles = sample_obstacle_scene(
+            scenario.seed, tuple(task.x_range), tuple(task.y_range), task.height,
+            task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
+            tuple(task.activation_range))
+        return TaskLayout(objects=obstacles.target[np.newaxis, :], targets=(0,),
+                          switch_schedule=(0.0,), obstacles=obstacles)
+    scene = reach_scene(scenario)
+    return TaskLayout(objects=scene.objects, targets=scene.targets,
+                      switch_schedule=tuple(task.switch_schedule))
 
 
 def reach_scene(scenario):

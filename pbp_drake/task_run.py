@@ -7,7 +7,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
 from pbp_drake.builder import build_diagram
-from pbp_drake.systems.task_monitor import INTERVENTION_RATIO, STAGE, SUCCESS, TASK_TIME
+from pbp_drake.systems.task_monitor import (
+    COLLISION_RATIO, INTERVENTION_RATIO, STAGE, SUCCESS, TASK_TIME)
 
 
 @dataclasses.dataclass
@@ -102,4 +103,8 @@ def _read_result(diagram, context, status, monitor):
         selected_goals=decisions("selected_goal_log")[:, 0].astype(int),
         targets=decisions("target_log")[:, 3].astype(int),
         objects=monitor.objects.copy(),
+        collision_ratio=float(status[COLLISION_RATIO]),
+        # Measured on the plant's state, like ee_state: not shifted.
+        in_collision=(log("in_collision_log").data()[0, :tick_count] > 0.5
+                      if diagram.HasSubsystemNamed("in_collision_log") else None),
     )

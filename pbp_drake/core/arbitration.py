@@ -11,12 +11,41 @@ move the robot from `y` to `U = y + u dt`.
 - ``fixed_alpha`` (Dragan & Srinivasa 2013): `T = (1 - alpha) U + alpha P` while the
   operator acts, `T = P` otherwise (an idle operator has no command to blend; at alpha 0 the
   operator has full control when acting, at alpha 1 the operator is ignored).
+- ``confidence_alpha`` (Dragan & Srinivasa 2013, arbitration as a function of the robot's
+  confidence): the same law as ``fixed_alpha``, but `alpha` is recomputed every control
+  period from the goal estimator's probabilities by `confidence_alpha` below (the caller
+  passes the result to `blend` as `alpha`). An idle operator again gives `T = P`.
 - ``teleop``: `T = U`.
+
+Confidence, for ``confidence_alpha``, is the Jain-style margin (Jain & Argall 2019) of the
+selected goal: its probability minus the highest probability among the other goals,
+clipped at 0,
+
+    confidence = max(0, p[selected] - max_{j != selected} p[j]),
+
+after normalising the probabilities to sum 1. A uniform distribution gives 0, a one-hot
+distribution on the selected goal gives 1, and a single goal (K = 1) gives 1. The margin
+(rather than the normalised maximum `(p_max - 1/K) / (1 - 1/K)`) is used because it is 0
+whenever the selected goal is tied with another one, however the rest of the mass is
+spread (e.g. `[0.5, 0.5, 0]`), and because it measures the *selected* goal, which the goal
+estimator's hysteresis may keep for a while after another goal became more probable
+(the confidence is then 0, and the operator keeps full control). The confidence is mapped
+to `alpha` by the "timid/aggressive" linear ramp
+
+    alpha = clip((confidence - low) / (high - low), 0, 1) * alpha_max,
+
+so the robot does not assist below `low`, reaches `alpha_max` at `high` and above.
 """
 
 import numpy as np
 
-BLEND_MODES = ("pbp_continuous", "pbp_alternated", "fixed_alpha", "teleop")
+BLEND_MODES = ("pbp_continuous", "pbp_alternated", "fixed_alpha", "teleop",
+               "confidence_alpha")
+
+# Defaults of the confidence -> alpha ramp of ``confidence_alpha``.
+DEFAULT_CONFIDENCE_LOW = 0.0
+DEFAULT_CONFIDENCE_HIGH = 1.0
+DEFAULT_ALPHA_MAX = 1.0
 
 
 def validate_mode(mode, alpha=None):
@@ -25,6 +54,60 @@ def validate_mode(mode, alpha=None):
     if mode == "fixed_alpha":
         if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
             raise ValueError(f"alpha must lie in [0, 1] for fixed_alpha, got {alpha}")
+
+
+def validate_confidence_ramp(low=DEFAULT_CONFIDENCE_LOW, high=DEFAULT_CONFIDENCE_HIGH,
+                             alpha_max=DEFAULT_ALPHA_MAX):
+    """Checks the ramp of ``confidence_alpha``: `0 <= low < high <= 1`, `0 < alpha_max <= 1`."""
+    for name, value in (("confidence_low", low), ("confidence_high", high),
+                        ("alpha_max", alpha_max)):
+        if isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value):
+            raise ValueError(f"{name} must be a finite number, got {value!r}")
+    if not 0.0 <= low <= 1.0:
+        raise ValueError(f"confidence_low must lie in [0, 1], got {low}")
+    if not 0.0 <= high <= 1.0:
+        raise ValueError(f"confidence_high must lie in [0, 1], got {high}")
+    if not low < high:
+        raise ValueError(f"confidence_low must be below confidence_high, got "
+                         f"confidence_low={low}, confidence_high={high}")
+    if not 0.0 < alpha_max <= 1.0:
+        raise ValueError(f"alpha_max must lie in (0, 1], got {alpha_max}")
+
+
+def goal_confidence(probabilities, selected):
+    """The margin of the selected goal: `p[selected] - max_{j != selected} p[j]`, at least 0.
+
+    `probabilities` (K >= 1, finite, non-negative, not all 0) are normalised to sum 1 first.
+    Uniform gives 0, one-hot on `selected` gives 1, K = 1 gives 1.
+    """
+    probabilities = np.asarray(probabilities, dtype=float).reshape(-1)
+    k = probabilities.size
+    if k == 0:
+        raise ValueError("goal_probabilities is empty")
+    if not np.isfinite(probabilities).all() or (probabilities < 0.0).any():
+        raise ValueError(f"goal_probabilities must be finite and non-negative, got "
+                         f"{probabilities}")
+    total = probabilities.sum()
+    if total <= 0.0:
+        raise ValueError(f"goal_probabilities sum to {total}; they must sum to a positive "
+                         f"number")
+    if isinstance(selected, bool) or int(selected) != selected or not 0 <= selected < k:
+        raise ValueError(f"selected goal {selected!r} is not one of the {k} goals")
+    probabilities = probabilities / total
+    selected = int(selected)
+    others = np.delete(probabilities, selected)
+    runner_up = others.max() if others.size else 0.0
+    return float(np.clip(probabilities[selected] - runner_up, 0.0, 1.0))
+
+
+def confidence_alpha(probabilities, selected, low=DEFAULT_CONFIDENCE_LOW,
+                     high=DEFAULT_CONFIDENCE_HIGH, alpha_max=DEFAULT_ALPHA_MAX):
+    """The arbitration weight of ``confidence_alpha``:
+    `clip((confidence - low) / (high - low), 0, 1) * alpha_max`, with `confidence` the
+    margin of the selected goal (`goal_confidence`)."""
+    validate_confidence_ramp(low, high, alpha_max)
+    confidence = goal_confidence(probabilities, selected)
+    return float(np.clip((confidence - low) / (high - low), 0.0, 1.0) * alpha_max)
 
 
 def validate_command(command, name="operator_command"):
@@ -40,7 +123,9 @@ def blend(mode, robot_position, policy_position, policy_velocity, command, activ
 
     `policy_*` is the robot policy's next state (the selected DMP's, or the open-loop
     demonstration's for explicit arbitration); `command` the operator's velocity; `active`
-    whether the operator acts this step.
+    whether the operator acts this step. `alpha` is the arbitration weight of
+    ``fixed_alpha`` and ``confidence_alpha`` (for the latter computed by `confidence_alpha`
+    each control period); the other modes ignore it.
     """
     command = validate_command(command)
     operator_position = robot_position + command * dt
@@ -50,7 +135,9 @@ def blend(mode, robot_position, policy_position, policy_velocity, command, activ
         return operator_position, command
     if mode == "pbp_alternated" or not active:
         return policy_position, policy_velocity
-    if mode == "fixed_alpha":
+    if mode in ("fixed_alpha", "confidence_alpha"):
+        if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"alpha must lie in [0, 1] for {mode}, got {alpha}")
         return ((1.0 - alpha) * operator_position + alpha * policy_position,
                 (1.0 - alpha) * command + alpha * policy_velocity)
     raise ValueError(f"blending mode {mode!r} is unknown; choose one of {BLEND_MODES}")

@@ -3,7 +3,9 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.core.arbitration import blend, validate_mode
+from pbp_drake.core.arbitration import (
+    DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW, blend, confidence_alpha,
+    validate_confidence_ramp, validate_mode)
 
 
 class Blender(LeafSystem):
@@ -18,22 +20,41 @@ class Blender(LeafSystem):
         - selected_goal (optional)
         - operator_command
         - operator_active
+        - goal_probabilities (optional)
         output_ports:
         - command
 
     Modes (see `pbp_drake.core.arbitration`): `pbp_continuous` (Alg. 1, `y + u`),
     `pbp_alternated` (Alg. 2, `u` alone while the operator acts), `fixed_alpha`
-    (`(1 - alpha) U + alpha P`) and `teleop` (`U`). `robot_state` must be the state sampled
+    (`(1 - alpha) U + alpha P`), `confidence_alpha` (the same with `alpha` from the goal
+    estimator's confidence) and `teleop` (`U`). `robot_state` must be the state sampled
     at the control tick (the builder puts a ZeroOrderHold in front); `references` holds K
     next states and `selected_goal` picks one (goal 0 when unconnected). The output is
     `[position (D), velocity (D)]`. A NaN or infinite operator command raises.
+
+    `goal_probabilities` (K) is read only in `confidence_alpha` mode, where it must be
+    connected (evaluating the command raises otherwise). There, each control period,
+    `alpha = clip((c - low) / (high - low), 0, 1) * alpha_max` with `(low, high) =
+    confidence_range` and `c` the margin of the selected goal's probability over the next
+    most probable goal (`pbp_drake.core.arbitration.confidence_alpha`); an idle operator
+    gives `P`. `confidence_range` and `alpha_max` are ignored by the other modes.
     """
 
-    def __init__(self, mode, dimension, goal_count, control_period, alpha=None):
+    def __init__(self, mode, dimension, goal_count, control_period, alpha=None, *,
+                 confidence_range=(DEFAULT_CONFIDENCE_LOW, DEFAULT_CONFIDENCE_HIGH),
+                 alpha_max=DEFAULT_ALPHA_MAX):
         super().__init__()
         validate_mode(mode, alpha)
+        try:
+            low, high = confidence_range
+        except (TypeError, ValueError):
+            raise ValueError(f"confidence_range must be a pair (confidence_low, "
+                             f"confidence_high), got {confidence_range!r}") from None
+        validate_confidence_ramp(low, high, alpha_max)
         self._mode = mode
         self._alpha = alpha
+        self._confidence_range = (float(low), float(high))
+        self._alpha_max = float(alpha_max)
         self._dimension = int(dimension)
         self._goal_count = int(goal_count)
         self._period = float(control_period)
@@ -43,6 +64,7 @@ class Blender(LeafSystem):
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._operator_command_port = self.DeclareVectorInputPort("operator_command", d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._goal_probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
         self._command_port = self.DeclareVectorOutputPort("command", 2 * d, self._calc_command)
 
     @property
@@ -64,16 +86,48 @@ class Blender(LeafSystem):
     def get_operator_active_input_port(self):
         return self._operator_active_port
 
+    def get_goal_probabilities_input_port(self):
+        return self._goal_probabilities_port
+
+    @property
+    def confidence_range(self):
+        return self._confidence_range
+
+    @property
+    def alpha_max(self):
+        return self._alpha_max
+
+    def alpha(self, context):
+        """The arbitration weight used in `context`: `alpha` for `fixed_alpha`, the ramp of
+        the goal confidence for `confidence_alpha`, None for the other modes."""
+        if self._mode != "confidence_alpha":
+            return self._alpha
+        if not self._goal_probabilities_port.HasValue(context):
+            raise RuntimeError(
+                "Blender in confidence_alpha mode needs its goal_probabilities input port "
+                "connected (e.g. to GoalEstimator's goal_probabilities output)")
+        return confidence_alpha(self._goal_probabilities_port.Eval(context),
+                                self._selected_goal(context), *self._confidence_range,
+                                self._alpha_max)
+
+    def _selected_goal(self, context):
+        if not self._selected_goal_port.HasValue(context):
+            return 0
+        selected = int(self._selected_goal_port.Eval(context)[0])
+        if not 0 <= selected < self._goal_count:
+            raise ValueError(f"selected_goal {selected} is not one of the "
+                             f"{self._goal_count} goals")
+        return selected
+
     def get_command_output_port(self):
         return self._command_port
 
     def _calc_command(self, context, output):
         d, k = self._dimension, self._goal_count
-        selected = 0
-        if self._selected_goal_port.HasValue(context):
-            selected = int(self._selected_goal_port.Eval(context)[0])
-            if not 0 <= selected < k:
-                raise ValueError(f"selected_goal {selected} is not one of the {k} goals")
+        selected = self._selected_goal(context)
+        # Computed (and the port checked) even while the operator is idle, when the law
+        # plays P: a missing goal_probabilities connection fails at the first tick.
+        alpha = self.alpha(context)
         references = self._references_port.Eval(context).reshape(2, k, d)
         position, velocity = blend(
             self._mode,
@@ -83,6 +137,6 @@ class Blender(LeafSystem):
             self._operator_command_port.Eval(context),
             self._operator_active_port.Eval(context)[0] > 0.5,
             self._period,
-            self._alpha,
+            alpha,
         )
         output.SetFromVector(np.concatenate([position, velocity]))

@@ -6,9 +6,9 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.reach_task import reach_progress
 
 # Layout of the `task_status` output.
-PROGRESS, STAGE, SUCCESS, TASK_TIME, INTERVENTION_RATIO, STEPS = range(6)
+PROGRESS, STAGE, SUCCESS, TASK_TIME, INTERVENTION_RATIO, STEPS, COLLISION_RATIO = range(7)
 TASK_STATUS_FIELDS = ("progress", "stage", "success", "task_time", "intervention_ratio",
-                      "steps")
+                      "steps", "collision_ratio")
 
 
 class TaskMonitor(LeafSystem):
@@ -20,6 +20,7 @@ class TaskMonitor(LeafSystem):
         input_ports:
         - ee_state
         - operator_active
+        - in_collision (optional)
         output_ports:
         - target
         - task_status
@@ -32,7 +33,8 @@ class TaskMonitor(LeafSystem):
 
     `target` is `[position (3), object index]`; `task_status` is `[progress, stage (number
     of switches so far), success (0/1), task time (s, frozen at success), intervention
-    ratio (steps with operator input / steps of the task), steps]`.
+    ratio (steps with operator input / steps of the task), steps, collision ratio (steps
+    with `in_collision` / steps; 0 when unconnected)]`.
     """
 
     def __init__(self, objects, targets, switch_schedule, start, success_distance,
@@ -47,6 +49,7 @@ class TaskMonitor(LeafSystem):
         self._success_distance = float(success_distance)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._in_collision_port = self.DeclareVectorInputPort("in_collision", 1)
         self._status_index = self.DeclareDiscreteState(len(TASK_STATUS_FIELDS))
         self._target_port = self.DeclareVectorOutputPort(
             "target", 4, self._calc_target,
@@ -59,6 +62,9 @@ class TaskMonitor(LeafSystem):
 
     def get_operator_active_input_port(self):
         return self._operator_active_port
+
+    def get_in_collision_input_port(self):
+        return self._in_collision_port
 
     def get_target_output_port(self):
         return self._target_port
@@ -87,6 +93,10 @@ class TaskMonitor(LeafSystem):
         status[STEPS] += 1
         active_steps = status[INTERVENTION_RATIO] * (status[STEPS] - 1) + acting
         status[INTERVENTION_RATIO] = active_steps / status[STEPS]
+        colliding = (self._in_collision_port.HasValue(context)
+                     and self._in_collision_port.Eval(context)[0] > 0.5)
+        collided_steps = status[COLLISION_RATIO] * (status[STEPS] - 1) + colliding
+        status[COLLISION_RATIO] = collided_steps / status[STEPS]
         stage = int(status[STAGE])
         target = self._objects[self._targets[stage]]
         progress = reach_progress(position, self._start, target)

@@ -6,6 +6,8 @@ from pbp_drake.core.reach_task import heading_error
 from pbp_drake.systems.sampled_operator import SampledOperator
 
 PARTICIPANT_MODES = ("assist", "drive")
+# How far the HSR's hand stands in front of its base in the task's start pose (m).
+HAND_AHEAD_OF_BASE = 0.53
 
 
 class VirtualParticipant(SampledOperator):
@@ -18,6 +20,7 @@ class VirtualParticipant(SampledOperator):
         - ee_state
         - target
         - selected_goal
+        - obstacle_positions (optional)
         output_ports:
         - operator_command
         - operator_active
@@ -35,14 +38,19 @@ class VirtualParticipant(SampledOperator):
     scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
     is reproducible and the system keeps no state outside its Context.
 
+    With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` and, in every
+    mode, steps aside (and backs off when one is close) while an obstacle stands within
+    `obstacle_keep_out` of the path its robot will sweep, as people did in the paper.
+
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
-    `selected_goal` `[index]`. Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the
+    `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the
     world frame (vz = 0).
     """
 
     def __init__(self, control_period, objects, mode="assist", speed=0.2, rotation_speed=0.6,
                  reaction_delay=0.3, direction_noise=0.1, speed_noise=0.1, seed=0,
-                 slow_radius=0.15, aligned_angle=0.05):
+                 slow_radius=0.15, aligned_angle=0.05, obstacle_count=0,
+                 obstacle_keep_out=0.0):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
@@ -60,6 +68,11 @@ class VirtualParticipant(SampledOperator):
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
         self._target_port = self.DeclareVectorInputPort("target", 4)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._obstacle_keep_out = float(obstacle_keep_out)
+        self._obstacles_port = None
+        if obstacle_count > 0:
+            self._obstacles_port = self.DeclareVectorInputPort(
+                "obstacle_positions", 2 * int(obstacle_count))
         # What the participant believes: the target index it knows and how many ticks a
         # different target has been on screen.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
@@ -73,6 +86,9 @@ class VirtualParticipant(SampledOperator):
 
     def get_selected_goal_input_port(self):
         return self._selected_goal_port
+
+    def get_obstacle_positions_input_port(self):
+        return self._obstacles_port
 
     def _update(self, context, discrete_state):
         # The belief moves first, and the command of this tick acts on the new belief.
@@ -103,6 +119,36 @@ class VirtualParticipant(SampledOperator):
         direction = -np.sign(gap) * np.sign(closeness)
         return direction if direction != 0 else 1.0
 
+    def _dodge(self, position, heading, target_xy, obstacles):
+        """The unit direction that takes the robot off an obstacle's way, or None.
+
+        The robot's footprint runs from its base (about 0.53 m behind the hand) to the
+        hand. An obstacle is in the way when its centre comes within `obstacle_keep_out` of
+        the path the base will sweep to the target; the participant then steps sideways,
+        away from it, and also backs off when the obstacle is already at the hand.
+        """
+        facing = np.array([np.cos(heading), np.sin(heading)])
+        base = position[:2] - HAND_AHEAD_OF_BASE * facing
+        path = target_xy - base
+        length = np.linalg.norm(path)
+        if length < 1e-9:
+            return None
+        along_unit = path / length
+        left = np.array([-along_unit[1], along_unit[0]])
+        relative = obstacles - base
+        along = relative @ along_unit
+        across = relative @ left
+        ahead = (along > -self._obstacle_keep_out) & (along < length)
+        blocking = ahead & (np.abs(across) < self._obstacle_keep_out)
+        if not np.any(blocking):
+            return None
+        nearest = np.flatnonzero(blocking)[np.argmin(along[blocking])]
+        side = -np.sign(across[nearest]) or 1.0
+        direction = side * left
+        if along[nearest] < HAND_AHEAD_OF_BASE + 0.5 * self._obstacle_keep_out:
+            direction = direction - 0.5 * along_unit
+        return direction / np.linalg.norm(direction)
+
     def _decide(self, context, known_target):
         ee_state = self._ee_state_port.Eval(context)
         position, heading = ee_state[:3], ee_state[6]
@@ -115,6 +161,16 @@ class VirtualParticipant(SampledOperator):
         speed_scale = max(0.0, 1.0 + rng.normal(0.0, self._speed_noise))
         offset = target[:2] - position[:2]
         distance = np.linalg.norm(offset)
+        if self._obstacles_port is not None:
+            dodge = self._dodge(position, heading, target[:2],
+                                self._obstacles_port.Eval(context).reshape(-1, 2))
+            if dodge is not None:
+                if self._mode == "drive" and distance > 1e-9:
+                    # Keep driving on, around the obstacle.
+                    dodge = dodge + offset / distance
+                    dodge /= np.linalg.norm(dodge)
+                velocity = self._speed * speed_scale * _rotate(dodge, noise_angle)
+                return np.array([velocity[0], velocity[1], 0.0, 0.0]), True
         if self._mode == "assist":
             selected = int(round(self._selected_goal_port.Eval(context)[0]))
             if selected == int(target[3]):

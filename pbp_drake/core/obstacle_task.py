@@ -1,0 +1,73 @@
+"""The dynamic-obstacle task of the paper (section IV-B.2), in pure NumPy.
+
+One target object; cylinder obstacles stand still at random places until the robot's
+progress to the target passes each one's activation threshold. An activated obstacle then
+moves, at a fixed speed, to intercept the robot at the midpoint of the line from the
+robot (as it stood at activation) to the target, and stops there.
+"""
+
+import dataclasses
+
+import numpy as np
+
+
+@dataclasses.dataclass(frozen=True)
+class ObstacleScene:
+    """The target `(3,)`, obstacles' start positions `(N, 2)` on the floor and their
+    activation thresholds `(N,)` (fractions of progress)."""
+
+    target: np.ndarray
+    obstacle_starts: np.ndarray
+    thresholds: np.ndarray
+
+
+def sample_obstacle_scene(seed, x_range=(1.25, 2.5), y_range=(-1.05, 1.05), height=0.7,
+                          obstacle_count=3, obstacle_x_range=(0.9, 2.6),
+                          obstacle_y_range=(-1.3, 1.3), activation_range=(0.05, 0.5),
+                          clearance=0.45, robot_xy=(0.0, 0.0)):
+    """Draws a scene from `seed` alone. Obstacles start at least `clearance` from the
+    robot's base, the target and each other, so that nothing starts in collision."""
+    rng = np.random.default_rng(seed)
+    target = np.array([rng.uniform(*x_range), rng.uniform(*y_range), height])
+    keep_away = [np.asarray(robot_xy, float), target[:2]]
+    starts = []
+    for index in range(obstacle_count):
+        for _ in range(1000):
+            candidate = np.array([rng.uniform(*obstacle_x_range), rng.uniform(*obstacle_y_range)])
+            if all(np.linalg.norm(candidate - other) >= clearance
+                   for other in keep_away + starts):
+                break
+        else:
+            raise ValueError(f"cannot place {obstacle_count} obstacles {clearance} m from the "
+                             f"robot, the target and each other in x {list(obstacle_x_range)}, "
+                             f"y {list(obstacle_y_range)}")
+        starts.append(candidate)
+    thresholds = np.sort(rng.uniform(*activation_range, size=obstacle_count))
+    return ObstacleScene(target=target, obstacle_starts=np.array(starts).reshape(-1, 2),
+                         thresholds=thresholds)
+
+
+def step_obstacles(positions, intercepts, active, progress, robot_xy, target_xy, thresholds,
+                   speed, dt):
+    """One control step of the obstacles; pure, returns new arrays.
+
+    Args:
+        positions: (N, 2) obstacle positions. intercepts: (N, 2) where each active one goes.
+        active: (N,) bools. progress: the robot's progress to the target in [0, 1].
+        robot_xy, target_xy: (2,) the robot's reference point and the target on the floor.
+    Returns:
+        (positions, intercepts, active).
+    """
+    positions = np.array(positions, dtype=float)
+    intercepts = np.array(intercepts, dtype=float)
+    active = np.array(active, dtype=bool)
+    waking = ~active & (progress >= np.asarray(thresholds))
+    if np.any(waking):
+        intercepts[waking] = (np.asarray(robot_xy) + np.asarray(target_xy)) / 2.0
+        active = active | waking
+    offset = intercepts - positions
+    distance = np.linalg.norm(offset, axis=1)
+    travel = np.minimum(distance, speed * dt)
+    moving = active & (distance > 0.0)
+    positions[moving] += offset[moving] * (travel[moving] / distance[moving])[:, None]
+    return positions, intercepts, active

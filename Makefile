@@ -13,10 +13,14 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# The HSR reaching task with PBP-Alt and the virtual participant, then the 2-D alpha study.
 demo: $(STAMP)
+	$(VENV)/bin/pbp-drake run diagrams/hsr_reach.yaml --method pbp_alternated \
+		--operator virtual --headless --record $(DEMO_DIR)/hsr_reach.html
 	$(VENV)/bin/pbp-drake study diagrams/toy_alpha_study.yaml --output $(DEMO_DIR)
 	$(VENV)/bin/pbp-drake run diagrams/toy_alpha_study.yaml --scene scene_1 \
 		--method pbp_alternated --headless --record $(DEMO_DIR)/replay.html
+	@echo "Open $(DEMO_DIR)/hsr_reach.html in a browser to replay the HSR task."
 
 # The headless browser tests drive Debian's `chromium` (never a browser download, never
 # `playwright install`): install it when it is missing and apt-get is usable as root;

@@ -7,6 +7,6 @@ import pytest
 sys.path.insert(0, str(pathlib.Path(__file__).parent))
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def repo():
     return pathlib.Path(__file__).resolve().parents[1]

@@ -1,0 +1,70 @@
+"""The dynamic-obstacle task: obstacles wake and cut the robot off; collisions are measured
+with SceneGraph on the HSR's collision geometry."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from pbp_drake.core.obstacle_task import sample_obstacle_scene, step_obstacles
+from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.task_run import run_task
+
+
+def test_an_obstacle_waits_for_its_threshold_then_heads_for_the_midpoint():
+    positions, intercepts, active = np.array([[1.0, 1.0]]), np.array([[1.0, 1.0]]), [False]
+    robot, target = np.array([0.0, 0.0]), np.array([2.0, 0.0])
+    positions, intercepts, active = step_obstacles(
+        positions, intercepts, active, 0.2, robot, target, [0.3], 0.5, 0.1)
+    assert not active[0] and np.allclose(positions, [[1.0, 1.0]])
+    positions, intercepts, active = step_obstacles(
+        positions, intercepts, active, 0.3, robot, target, [0.3], 0.5, 0.1)
+    assert active[0] and np.allclose(intercepts, [[1.0, 0.0]])
+    assert np.allclose(positions, [[1.0, 0.95]])
+    for _ in range(100):
+        positions, intercepts, active = step_obstacles(
+            positions, intercepts, active, 0.3, robot + 0.5, target, [0.3], 0.5, 0.1)
+    # It stops where it meant to cut the robot off, even as the robot moves on.
+    assert np.allclose(positions, [[1.0, 0.0]])
+
+
+def test_scenes_keep_obstacles_clear_of_the_robot_and_the_target():
+    for seed in range(20):
+        scene = sample_obstacle_scene(seed)
+        assert scene.obstacle_starts.shape == (3, 2)
+        assert np.all(np.diff(scene.thresholds) >= 0)
+        for start in scene.obstacle_starts:
+            assert np.linalg.norm(start) >= 0.45
+            assert np.linalg.norm(start - scene.target[:2]) >= 0.45
+
+
+@pytest.fixture(scope="module")
+def obstacle_task(repo):
+    return load_scenario_file(repo / "diagrams" / "hsr_obstacles.yaml").scenario
+
+
+def test_without_a_user_the_robot_runs_into_the_obstacles(obstacle_task):
+    result = run_task(dataclasses.replace(obstacle_task, method="pbp_no_user", seed=1))
+    assert result.success
+    assert result.intervention_ratio == 0.0
+    assert result.collision_ratio >= 0.2
+    # The monitor's ratio and the logged series agree.
+    assert abs(result.in_collision.mean() - result.collision_ratio) < 0.02
+    assert not result.in_collision[0]
+
+
+def test_reach_tasks_report_no_collisions(repo):
+    scenario = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario
+    result = run_task(dataclasses.replace(scenario, method="pbp_no_user", duration=3.0))
+    assert result.collision_ratio == 0.0 and result.in_collision is None
+
+
+def test_bad_obstacle_settings_name_the_field(tmp_path, repo):
+    text = (repo / "diagrams" / "hsr_obstacles.yaml").read_text()
+    path = tmp_path / "bad.yaml"
+    path.write_text(text.replace("obstacle_speed: 0.4", "obstacle_speed: -1.0"))
+    with pytest.raises(ScenarioError, match="obstacle_speed must be positive"):
+        load_scenario_file(path)
+    path.write_text(text.replace("activation_range: [0.05, 0.5]", "activation_range: [0.5, 0.1]"))
+    with pytest.raises(ScenarioError, match="activation_range"):
+        load_scenario_file(path)

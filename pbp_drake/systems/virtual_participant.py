@@ -8,6 +8,10 @@ from pbp_drake.systems.sampled_operator import SampledOperator
 PARTICIPANT_MODES = ("assist", "drive")
 # How far the HSR's hand stands in front of its base in the task's start pose (m).
 HAND_AHEAD_OF_BASE = 0.53
+# Within this distance of the target (m) the participant no longer steps around obstacles.
+FINAL_APPROACH = 0.3
+# How much closer the arm may pass an obstacle than the base (m).
+BASE_WIDER_THAN_ARM = 0.15
 
 
 class VirtualParticipant(SampledOperator):
@@ -50,7 +54,7 @@ class VirtualParticipant(SampledOperator):
     def __init__(self, control_period, objects, mode="assist", speed=0.2, rotation_speed=0.6,
                  reaction_delay=0.3, direction_noise=0.1, speed_noise=0.1, seed=0,
                  slow_radius=0.15, aligned_angle=0.05, obstacle_count=0,
-                 obstacle_keep_out=0.0):
+                 obstacle_keep_out=0.0, dodge_time=0.5):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
@@ -70,6 +74,9 @@ class VirtualParticipant(SampledOperator):
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._obstacle_keep_out = float(obstacle_keep_out)
         self._obstacles_port = None
+        self._dodge_ticks = max(1, int(round(dodge_time / control_period)))
+        # [ticks of the current sidestep still to go, its direction (2)].
+        self._dodge_index = self.DeclareDiscreteState(np.zeros(3))
         if obstacle_count > 0:
             self._obstacles_port = self.DeclareVectorInputPort(
                 "obstacle_positions", 2 * int(obstacle_count))
@@ -101,7 +108,22 @@ class VirtualParticipant(SampledOperator):
             if unseen_ticks > self._reaction_ticks:
                 known, unseen_ticks = shown, 0
         discrete_state.get_mutable_vector(self._belief_index).set_value([known, unseen_ticks])
-        command, active = self._decide(context, int(known))
+        dodge = None
+        if self._obstacles_port is not None:
+            # A person commits to a sidestep for a moment rather than twitching each tick.
+            ticks_left, *direction = context.get_discrete_state(self._dodge_index).value()
+            if ticks_left > 0:
+                dodge, ticks_left = np.array(direction), ticks_left - 1
+            else:
+                ee_state = self._ee_state_port.Eval(context)
+                dodge = self._dodge(ee_state[:3], ee_state[6],
+                                    self._target_port.Eval(context)[:2],
+                                    self._obstacles_port.Eval(context).reshape(-1, 2))
+                if dodge is not None:
+                    ticks_left, direction = self._dodge_ticks - 1, dodge
+            discrete_state.get_mutable_vector(self._dodge_index).set_value(
+                [ticks_left, *direction])
+        command, active = self._decide(context, int(known), dodge)
         self._store_sample(discrete_state, command, active)
 
     def _aside_direction(self, position, heading, target, selected):
@@ -125,7 +147,8 @@ class VirtualParticipant(SampledOperator):
         The robot's footprint runs from its base (about 0.53 m behind the hand) to the
         hand. An obstacle is in the way when its centre comes within `obstacle_keep_out` of
         the path the base will sweep to the target; the participant then steps sideways,
-        away from it, and also backs off when the obstacle is already at the hand.
+        away from it, and also backs off when the obstacle is already at the hand. Each
+        sidestep lasts `dodge_time` at least.
         """
         facing = np.array([np.cos(heading), np.sin(heading)])
         base = position[:2] - HAND_AHEAD_OF_BASE * facing
@@ -138,8 +161,15 @@ class VirtualParticipant(SampledOperator):
         relative = obstacles - base
         along = relative @ along_unit
         across = relative @ left
+        # On the last stretch people push on through.
+        if np.linalg.norm(target_xy - position[:2]) < FINAL_APPROACH:
+            return None
+        # The base stops short of the target by the hand's reach; beyond that only the
+        # thinner arm passes.
+        keep_out = np.where(along < length - HAND_AHEAD_OF_BASE, self._obstacle_keep_out,
+                            max(self._obstacle_keep_out - BASE_WIDER_THAN_ARM, 0.0))
         ahead = (along > -self._obstacle_keep_out) & (along < length)
-        blocking = ahead & (np.abs(across) < self._obstacle_keep_out)
+        blocking = ahead & (np.abs(across) < keep_out)
         if not np.any(blocking):
             return None
         nearest = np.flatnonzero(blocking)[np.argmin(along[blocking])]
@@ -149,7 +179,7 @@ class VirtualParticipant(SampledOperator):
             direction = direction - 0.5 * along_unit
         return direction / np.linalg.norm(direction)
 
-    def _decide(self, context, known_target):
+    def _decide(self, context, known_target, dodge=None):
         ee_state = self._ee_state_port.Eval(context)
         position, heading = ee_state[:3], ee_state[6]
         target = self._target_port.Eval(context)
@@ -161,16 +191,13 @@ class VirtualParticipant(SampledOperator):
         speed_scale = max(0.0, 1.0 + rng.normal(0.0, self._speed_noise))
         offset = target[:2] - position[:2]
         distance = np.linalg.norm(offset)
-        if self._obstacles_port is not None:
-            dodge = self._dodge(position, heading, target[:2],
-                                self._obstacles_port.Eval(context).reshape(-1, 2))
-            if dodge is not None:
-                if self._mode == "drive" and distance > 1e-9:
-                    # Keep driving on, around the obstacle.
-                    dodge = dodge + offset / distance
-                    dodge /= np.linalg.norm(dodge)
-                velocity = self._speed * speed_scale * _rotate(dodge, noise_angle)
-                return np.array([velocity[0], velocity[1], 0.0, 0.0]), True
+        if dodge is not None:
+            if self._mode == "drive" and distance > 1e-9:
+                # Keep driving on, around the obstacle.
+                dodge = dodge + offset / distance
+                dodge /= np.linalg.norm(dodge)
+            velocity = self._speed * speed_scale * _rotate(dodge, noise_angle)
+            return np.array([velocity[0], velocity[1], 0.0, 0.0]), True
         if self._mode == "assist":
             selected = int(round(self._selected_goal_port.Eval(context)[0]))
             if selected == int(target[3]):

@@ -31,7 +31,7 @@ def main(argv=None):
     run.add_argument("--record", metavar="FILE.html",
                      help="save a self-contained replay of the run")
     run.add_argument("--duration", type=float, metavar="SECONDS",
-                     help="HSR tasks: override the scenario's duration (the time limit)")
+                     help="override the scenario's duration (for HSR tasks, the time limit)")
     run.add_argument("--realtime-rate", type=float, default=1.0,
                      help="target simulated seconds per wall second (ignored when headless)")
     run.add_argument("--port", type=int, default=0, help="Meshcat port (0: a free one)")
@@ -44,11 +44,22 @@ def main(argv=None):
     study.add_argument("--methods", help="comma-separated methods to compare (HSR tasks)")
     study.add_argument("--trials", type=int, help="seeded scenes per method (HSR tasks)")
     study.add_argument("--seed", type=int, help="the first scene's seed (HSR tasks)")
+    study.add_argument("--jobs", type=int, default=1,
+                       help="HSR tasks: trials run in this many processes at once (default 1)")
+    study.add_argument("--retry-errors", action="store_true",
+                       help="HSR tasks: run again the trials on disk that failed with an error")
+
+    report = commands.add_parser(
+        "report", help="rebuild the summary, table and figures of a study folder from its "
+        "trial files, without simulating")
+    report.add_argument("output", help="the --output folder of `pbp-drake study`")
 
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
             return _run(args)
+        if args.command == "report":
+            return _report(args)
         return _study(args)
     except ScenarioError as error:
         print(f"pbp-drake: {error}", file=sys.stderr)
@@ -56,11 +67,16 @@ def main(argv=None):
 
 
 def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operator=None,
-                     seed=None):
+                     seed=None, duration=None):
     """The file's scenario with the command line's overrides applied and checked."""
     from pbp_drake.scenarios import validate_scenario
 
     scenario = scenario_file.scenario
+    if duration is not None:
+        if not (np.isfinite(duration) and duration > 0):
+            raise ScenarioError(f"--duration {duration:g} must be a positive number of "
+                                "seconds")
+        scenario = dataclasses.replace(scenario, duration=duration)
     if operator is not None:
         if operator not in OPERATOR_NAMES:
             raise ScenarioError(f"--operator {operator!r} is unknown; choose one of "
@@ -99,7 +115,7 @@ def _run(args):
     from pbp_drake.simulation import simulate
 
     scenario = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
-                                args.scene, args.operator, args.seed)
+                                args.scene, args.operator, args.seed, args.duration)
     meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
     print(f"Meshcat: {meshcat.web_url()}", flush=True)
     if isinstance(scenario.robot, Hsr):
@@ -133,11 +149,6 @@ def _run_task(args, scenario, meshcat):
     from pbp_drake.scenarios import Gamepad, Keyboard
     from pbp_drake.task_run import run_task
 
-    if args.duration is not None:
-        if not (np.isfinite(args.duration) and args.duration > 0):
-            raise ScenarioError(f"--duration {args.duration:g} must be a positive number of "
-                                "seconds")
-        scenario = dataclasses.replace(scenario, duration=args.duration)
     diagram = build_diagram(scenario, meshcat)
     person = isinstance(scenario.operator, (Keyboard, Gamepad))
     if args.headless and person:
@@ -206,7 +217,7 @@ def _study(args):
 
 
 def _method_study(args, scenario_file):
-    from pbp_drake.method_study import run_method_comparison
+    from pbp_drake.method_study import ProgressBar, run_method_comparison
     from pbp_drake.scenarios import validate_method_comparison
 
     study = scenario_file.study or MethodComparison()
@@ -219,24 +230,57 @@ def _method_study(args, scenario_file):
         study = dataclasses.replace(study, trials=args.trials)
     if args.seed is not None:
         study = dataclasses.replace(study, seed=args.seed)
+    if args.jobs < 1:
+        raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
+    if len(set(study.methods)) != len(study.methods):
+        raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
     try:
         validate_method_comparison(study, scenario_file.scenario)
     except ScenarioError as error:
         raise ScenarioError(f"{error} (after the command-line overrides)") from None
     output = pathlib.Path(args.output)
+    total = len(study.methods) * study.trials
+    print(f"Study {scenario_file.scenario.name}: {', '.join(study.methods)}, "
+          f"{study.trials} trials each (seeds {study.seed} to {study.seed + study.trials - 1}),"
+          f" {args.jobs} job{'s' if args.jobs > 1 else ''}, into {output}", flush=True)
+    bar = ProgressBar()
+    runs = []
 
-    def progress(done, total, record, elapsed):
-        outcome = "ok" if record["success"] else (record["error"] or "failed")
-        print(f"  [{done}/{total}] {record['method']} trial {record['trial']} "
-              f"(seed {record['seed']}): {outcome}, {elapsed:.0f} s elapsed", flush=True)
+    def progress(done, total_now, record, elapsed):
+        runs.append(done)
+        bar(done, total_now, record, elapsed)
 
-    summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
-                                    study.seed, output, progress)
+    started = time.monotonic()
+    try:
+        summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
+                                        study.seed, output, progress, jobs=args.jobs,
+                                        retry_errors=args.retry_errors)
+    except KeyboardInterrupt:
+        print(f"\nInterrupted: the finished trials are in {output / 'trials'}; the same "
+              "command resumes the study.", file=sys.stderr)
+        return 130
+    reused = total - len(runs)
+    print(f"Ran {len(runs)} trials in {time.monotonic() - started:.1f} s"
+          + (f"; {reused} were already on disk." if reused else "."), flush=True)
+    _print_report(summary, output)
+    return 0
+
+
+def _print_report(summary, output):
+    from pbp_drake.method_study import FIGURES, results_table
+
+    print(results_table(summary), end="")
     for method, entry in summary["methods"].items():
-        print(f"  {method}: success {100 * entry['success_rate']:.0f} %, intervention ratio "
-              f"{entry['intervention_ratio']['mean']:.3f} +- "
-              f"{entry['intervention_ratio']['std']:.3f}, task time "
-              f"{entry['task_time']['mean']:.1f} +- {entry['task_time']['std']:.1f} s")
-    for name in ("summary.json", "trials.json", "fig_reach_study.png"):
+        if entry["errors"]:
+            print(f"  {method}: {entry['errors']} trials failed with an error (seeds "
+                  f"{entry['error_seeds']}); see {output / 'trials' / method}")
+    for name in ("summary.json", "results.md", "trials.json", *FIGURES):
         print(f"  wrote {output / name}")
+
+
+def _report(args):
+    from pbp_drake.method_study import report
+
+    output = pathlib.Path(args.output)
+    _print_report(report(output), output)
     return 0

@@ -136,7 +136,9 @@ def test_study_compares_methods_on_the_same_scenes(tmp_path, capsys):
         assert set(entry["task_time"]) == {"mean", "std"}
     trials = json.loads((output / "trials.json").read_text())
     assert [t["seed"] for t in trials] == [5, 6, 5, 6]
-    assert (output / "fig_reach_study.png").stat().st_size > 0
+    for name in ("fig7a_intervention.png", "fig7b_task_time.png", "fig7c_collisions.png"):
+        assert (output / name).stat().st_size > 0
+    assert len(list((output / "trials").glob("*/seed_*.csv"))) == 4
 
 
 @pytest.mark.parametrize("change, message", [

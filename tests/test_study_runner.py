@@ -1,0 +1,279 @@
+"""The method comparison study runner: the same bytes with any --jobs, resuming, failed and
+crashed trials, the trial files read back, and `pbp-drake report` rebuilding from disk."""
+
+import dataclasses
+import io
+import json
+import os
+import shutil
+import textwrap
+
+import numpy as np
+import pytest
+
+from pbp_drake.cli import main
+from pbp_drake.method_study import (
+    FIGURES, HISTOGRAM_EDGES, ProgressBar, StudyFolderError, collision_histogram,
+    load_task_result, read_time_series, run_method_comparison, trial_paths, write_trial)
+from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.task_run import TaskResult, run_task
+
+# Two objects drawn from each seed; 30 s is enough for every method in these scenes.
+TASK = """
+scenario:
+  name: two_random_objects
+  method: pbp_alternated
+  control_period: 0.03
+  duration: 30.0
+  robot: !Hsr {}
+  task:
+    object_count: [2, 2]
+  operator: !VirtualParticipant {}
+  seed: 0
+"""
+METHODS = ["pbp_alternated", "teleop"]
+
+
+@pytest.fixture(scope="module")
+def task_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("task") / "task.yaml"
+    path.write_text(textwrap.dedent(TASK))
+    return path
+
+
+@pytest.fixture(scope="module")
+def scenario(task_file):
+    return load_scenario_file(task_file).scenario
+
+
+def study_args(task_file, output, jobs):
+    return ["study", str(task_file), "--methods", ",".join(METHODS), "--trials", "2",
+            "--seed", "5", "--output", str(output), "--jobs", str(jobs)]
+
+
+@pytest.fixture(scope="module")
+def studies(task_file, tmp_path_factory):
+    """The same study run with --jobs 1 and with --jobs 2 (real simulations)."""
+    root = tmp_path_factory.mktemp("studies")
+    assert main(study_args(task_file, root / "jobs1", 1)) == 0
+    assert main(study_args(task_file, root / "jobs2", 2)) == 0
+    return root / "jobs1", root / "jobs2"
+
+
+def test_jobs_1_and_2_write_the_same_summary_bytes(studies):
+    one, two = studies
+    assert (one / "summary.json").read_bytes() == (two / "summary.json").read_bytes()
+    assert (one / "results.md").read_bytes() == (two / "results.md").read_bytes()
+    summary = json.loads((one / "summary.json").read_text())
+    assert list(summary["methods"]) == METHODS
+    for entry in summary["methods"].values():
+        assert entry["trials"] == 2 and entry["errors"] == 0 and entry["missing"] == 0
+        assert 0.0 <= entry["success_rate"] <= 1.0
+        assert set(entry["intervention_ratio"]) == set(entry["task_time"]) == {"mean", "std"}
+        # No obstacles: every trial has collision ratio 0, all in the first bin.
+        assert entry["collision_ratio"]["mean"] == 0.0
+        assert entry["collision_ratio"]["histogram"][0] == 2
+        assert sum(entry["collision_ratio"]["histogram"]) == 2
+    assert summary["collision_histogram_edges"] == list(HISTOGRAM_EDGES)
+    # Nothing that depends on the machine or the run.
+    text = (one / "summary.json").read_text()
+    assert str(one) not in text and "wall_time" not in text
+    for method in METHODS:
+        for seed in (5, 6):
+            assert all(path.is_file() for path in trial_paths(one, method, seed))
+
+
+def test_report_rebuilds_summary_and_figures_from_the_trial_files(studies, capsys):
+    one, _ = studies
+    expected = (one / "summary.json").read_bytes()
+    for name in ("summary.json", "results.md", "trials.json", *FIGURES):
+        (one / name).unlink()
+    capsys.readouterr()
+    assert main(["report", str(one)]) == 0
+    out = capsys.readouterr().out
+    assert "| PBP-Alt |" in out and "| Teleop |" in out
+    assert (one / "summary.json").read_bytes() == expected
+    for name in FIGURES:
+        assert (one / name).stat().st_size > 5_000
+    trials = json.loads((one / "trials.json").read_text())
+    assert [(t["method"], t["seed"]) for t in trials] == [
+        ("pbp_alternated", 5), ("pbp_alternated", 6), ("teleop", 5), ("teleop", 6)]
+
+
+def test_the_time_series_read_back_equals_the_task_result(studies, scenario):
+    one, _ = studies
+    direct = run_task(dataclasses.replace(scenario, method="teleop", seed=6))
+    loaded = load_task_result(one, "teleop", 6)
+    for field in dataclasses.fields(TaskResult):
+        expected, actual = getattr(direct, field.name), getattr(loaded, field.name)
+        if isinstance(expected, np.ndarray):
+            np.testing.assert_array_equal(actual, expected, err_msg=field.name)
+            assert actual.dtype.kind == expected.dtype.kind, field.name
+        else:
+            assert actual == expected, field.name
+    record = json.loads(trial_paths(one, "teleop", 6)[0].read_text())
+    assert record["scenario"] == "two_random_objects" and record["error"] is None
+    np.testing.assert_array_equal(record["objects"], direct.objects)
+    assert len(record["targets"]) == 3 and record["ticks"] == len(direct.times)
+
+
+def test_an_interrupted_study_runs_only_the_missing_trial(studies, task_file, scenario,
+                                                          tmp_path):
+    folder = tmp_path / "resumed"
+    shutil.copytree(studies[0], folder)
+    expected = (folder / "summary.json").read_bytes()
+    for path in trial_paths(folder, "teleop", 6):
+        path.unlink()
+    # What an interrupted write leaves: a temporary file, never a half trial file.
+    (folder / "trials" / "teleop" / ".seed_6.json.999.tmp").write_text("{")
+    kept = {path: path.stat().st_mtime_ns for path in (folder / "trials").rglob("seed_*")}
+    ran = []
+    run_method_comparison(scenario, METHODS, 2, 5, folder,
+                          progress=lambda done, total, record, elapsed: ran.append(
+                              (record["method"], record["seed"], total)))
+    assert ran == [("teleop", 6, 1)]
+    assert {path: path.stat().st_mtime_ns for path in kept} == kept
+    assert (folder / "summary.json").read_bytes() == expected
+    assert not list(folder.rglob("*.tmp"))
+
+
+# Fake runs: no simulation, a TaskResult drawn from the seed. Module level, so that worker
+# processes can import them.
+def fake_run(scenario):
+    rng = np.random.default_rng(scenario.seed)
+    ticks = 5
+    in_collision = rng.random(ticks) < 0.4
+    return TaskResult(
+        success=bool(scenario.seed % 2), task_time=float(rng.uniform(5, 20)),
+        intervention_ratio=float(rng.random()), switches=2,
+        times=0.03 * np.arange(ticks), ee_positions=rng.normal(size=(ticks, 3)),
+        headings=rng.normal(size=ticks), commands=rng.normal(size=(ticks, 7)),
+        operator_active=rng.random(ticks) < 0.5, operator_commands=rng.normal(size=(ticks, 4)),
+        selected_goals=rng.integers(0, 2, ticks), targets=rng.integers(0, 2, ticks),
+        objects=rng.normal(size=(2, 3)), collision_ratio=float(in_collision.mean()),
+        in_collision=in_collision)
+
+
+def raising_run(scenario):
+    if scenario.seed == 6 and scenario.method == "teleop":
+        raise RuntimeError("the simulator gave up")
+    return fake_run(scenario)
+
+
+def crashing_run(scenario):
+    if scenario.seed == 6 and scenario.method == "teleop":
+        os._exit(3)  # the worker process dies
+    return fake_run(scenario)
+
+
+def test_a_trial_that_raises_is_recorded_and_the_study_goes_on(scenario, tmp_path):
+    summary = run_method_comparison(scenario, METHODS, 3, 5, tmp_path, run=raising_run)
+    record = json.loads(trial_paths(tmp_path, "teleop", 6)[0].read_text())
+    assert record["success"] is False
+    assert record["error"] == "RuntimeError: the simulator gave up"
+    assert record["time_series"] is None and not trial_paths(tmp_path, "teleop", 6)[1].exists()
+    assert summary["methods"]["teleop"]["errors"] == 1
+    assert summary["methods"]["teleop"]["error_seeds"] == [6]
+    assert summary["methods"]["teleop"]["trials"] == 3
+    assert summary["methods"]["pbp_alternated"]["errors"] == 0
+    for method, seed in [("teleop", 5), ("teleop", 7), ("pbp_alternated", 6)]:
+        assert json.loads(trial_paths(tmp_path, method, seed)[0].read_text())["error"] is None
+    # Resuming keeps the failed trial; retry_errors runs it (and only it) again.
+    ran = []
+
+    def progress(done, total, record, elapsed):
+        ran.append((record["method"], record["seed"]))
+
+    run_method_comparison(scenario, METHODS, 3, 5, tmp_path, progress, run=fake_run)
+    assert ran == []
+    summary = run_method_comparison(scenario, METHODS, 3, 5, tmp_path, progress, run=fake_run,
+                                    retry_errors=True)
+    assert ran == [("teleop", 6)]
+    assert summary["methods"]["teleop"]["errors"] == 0
+
+
+def test_a_crashed_worker_process_fails_only_its_trial(scenario, tmp_path):
+    summary = run_method_comparison(scenario, METHODS, 3, 5, tmp_path, jobs=2,
+                                    run=crashing_run)
+    record = json.loads(trial_paths(tmp_path, "teleop", 6)[0].read_text())
+    assert record["error"].startswith("BrokenProcessPool")
+    assert summary["methods"]["teleop"]["error_seeds"] == [6]
+    assert summary["methods"]["pbp_alternated"]["errors"] == 0
+    assert summary["methods"]["teleop"]["trials"] == 3
+    assert not list(tmp_path.rglob("*.running"))
+
+
+def test_in_collision_round_trips_through_the_csv(scenario, tmp_path):
+    result = fake_run(dataclasses.replace(scenario, seed=11))
+    run_method_comparison(scenario, ["pbp_alternated"], 1, 11, tmp_path, run=fake_run)
+    loaded = load_task_result(tmp_path, "pbp_alternated", 11)
+    np.testing.assert_array_equal(loaded.in_collision, result.in_collision)
+    np.testing.assert_array_equal(loaded.commands, result.commands)
+    assert loaded.collision_ratio == result.collision_ratio
+    series = read_time_series(trial_paths(tmp_path, "pbp_alternated", 11)[1])
+    assert list(series)[-1] == "in_collision"
+
+
+def test_a_folder_of_another_scenario_is_refused(scenario, tmp_path):
+    run_method_comparison(scenario, METHODS, 1, 0, tmp_path, run=fake_run)
+    other = dataclasses.replace(scenario, duration=31.0)
+    with pytest.raises(StudyFolderError, match="another scenario"):
+        run_method_comparison(other, METHODS, 1, 0, tmp_path, run=fake_run)
+    # Without study.json the trial files themselves tell.
+    (tmp_path / "study.json").unlink()
+    with pytest.raises(StudyFolderError, match="another scenario"):
+        run_method_comparison(other, METHODS, 1, 0, tmp_path, run=fake_run)
+
+
+def test_write_trial_leaves_no_temporary_files(tmp_path):
+    record = {"method": "teleop", "seed": 1, "format": 1, "error": "X: y"}
+    write_trial(tmp_path, record)
+    assert [p.name for p in tmp_path.rglob("*") if p.is_file()] == ["seed_1.json"]
+
+
+@pytest.mark.parametrize("jobs", [0, -2])
+def test_jobs_must_be_positive(task_file, tmp_path, capsys, scenario, jobs):
+    assert main(study_args(task_file, tmp_path, jobs)) == 2
+    assert f"--jobs {jobs}" in capsys.readouterr().err
+    with pytest.raises(ScenarioError, match="jobs"):
+        run_method_comparison(scenario, METHODS, 1, 0, tmp_path, jobs=jobs, run=fake_run)
+
+
+def test_more_jobs_than_trials_is_fine(scenario, tmp_path):
+    summary = run_method_comparison(scenario, ["teleop"], 1, 3, tmp_path, jobs=4, run=fake_run)
+    assert summary["methods"]["teleop"]["trials"] == 1
+
+
+def test_report_of_a_folder_without_a_study(tmp_path, capsys):
+    assert main(["report", str(tmp_path)]) == 2
+    assert "no study.json" in capsys.readouterr().err
+
+
+def test_collision_histogram_bins():
+    counts = collision_histogram([0.0, 0.0, 0.049, 0.05, 0.5, 0.99, 1.0])
+    assert len(counts) == len(HISTOGRAM_EDGES) - 1 == 20
+    assert counts[0] == 3 and counts[1] == 1 and counts[10] == 1 and counts[19] == 2
+
+
+class Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_progress_bar_on_a_terminal_and_in_a_log():
+    ok = {"success": True, "error": None, "method": "teleop", "seed": 0}
+    bad = {"success": False, "error": "RuntimeError: x", "method": "teleop", "seed": 1}
+    terminal = Terminal()
+    bar = ProgressBar(terminal)
+    bar(1, 2, ok, 10.0)
+    bar(2, 2, bad, 20.0)
+    text = terminal.getvalue()
+    assert text.startswith("\r[") and text.count("\r") == 2 and text.endswith("\n")
+    assert "1/2 trials" in text and "ETA 10s" in text and "1 failed (1 errors)" in text
+    log = io.StringIO()
+    bar = ProgressBar(log, every=2)
+    for done in range(1, 5):
+        bar(done, 4, ok, float(done))
+    lines = log.getvalue().splitlines()
+    assert len(lines) == 2 and "2/4 trials" in lines[0] and "4/4 trials" in lines[1]
+    assert "\r" not in log.getvalue()

@@ -46,6 +46,14 @@ def main(argv=None):
     study.add_argument("--seed", type=int, help="the first scene's seed (HSR tasks)")
     study.add_argument("--jobs", type=int, default=1,
                        help="HSR tasks: trials run in this many processes at once (default 1)")
+    study.add_argument("--backend", choices=("local", "ray"), default="local",
+                       help="HSR tasks: run the trials in local processes (default) or as "
+                       "Ray tasks, at most --jobs at once (needs: pip install "
+                       "'pbp_drake[ray]')")
+    study.add_argument("--ray-address", metavar="ADDRESS",
+                       help="with --backend ray: the Ray cluster to use, e.g. auto or "
+                       "ray://HEAD:10001 (its workers must have pbp_drake installed); "
+                       "default: start a local Ray with --jobs CPUs")
     study.add_argument("--retry-errors", action="store_true",
                        help="HSR tasks: run again the trials on disk that failed with an error")
 
@@ -232,6 +240,8 @@ def _method_study(args, scenario_file):
         study = dataclasses.replace(study, seed=args.seed)
     if args.jobs < 1:
         raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
+    if args.ray_address is not None and args.backend != "ray":
+        raise ScenarioError("--ray-address needs --backend ray")
     if len(set(study.methods)) != len(study.methods):
         raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
     try:
@@ -242,7 +252,9 @@ def _method_study(args, scenario_file):
     total = len(study.methods) * study.trials
     print(f"Study {scenario_file.scenario.name}: {', '.join(study.methods)}, "
           f"{study.trials} trials each (seeds {study.seed} to {study.seed + study.trials - 1}),"
-          f" {args.jobs} job{'s' if args.jobs > 1 else ''}, into {output}", flush=True)
+          f" {args.jobs} job{'s' if args.jobs > 1 else ''}"
+          + ("" if args.backend == "local" else
+             f" on Ray ({args.ray_address or 'local'})") + f", into {output}", flush=True)
     bar = ProgressBar()
     runs = []
 
@@ -254,7 +266,8 @@ def _method_study(args, scenario_file):
     try:
         summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
                                         study.seed, output, progress, jobs=args.jobs,
-                                        retry_errors=args.retry_errors)
+                                        retry_errors=args.retry_errors,
+                                        backend=args.backend, ray_address=args.ray_address)
     except KeyboardInterrupt:
         print(f"\nInterrupted: the finished trials are in {output / 'trials'}; the same "
               "command resumes the study.", file=sys.stderr)

@@ -12,6 +12,10 @@ A study folder `DIR` holds everything needed to rebuild its tables and figures:
 Trial i of every method uses seed `seed + i`: the same scene and participant noise. Each trial
 file is written atomically (a temporary file, then a rename), so an interrupted study leaves
 only whole trials, and running the same study again runs only the missing ones.
+
+Trials run in local processes (`--jobs`), or as Ray tasks (`--backend ray`, on a local Ray
+or a cluster): then the tasks only compute, and this process writes every trial file, so
+the folder is the same as with local processes.
 """
 
 import concurrent.futures
@@ -185,9 +189,14 @@ def _trial_record(scenario_name, digest, method, trial, seed):
 
 def write_trial(output, record, result=None):
     """Writes a trial's CSV (when it ran) and then its JSON: the JSON marks it done."""
+    _write_trial_files(output, record, None if result is None else time_series_csv(result))
+
+
+def _write_trial_files(output, record, csv_text):
+    """write_trial with the time series already as CSV text (None: the trial did not run)."""
     json_path, csv_path = trial_paths(output, record["method"], record["seed"])
-    if result is not None:
-        _write_atomically(csv_path, time_series_csv(result))
+    if csv_text is not None:
+        _write_atomically(csv_path, csv_text)
         record["time_series"] = csv_path.name
     _write_atomically(json_path, json.dumps(record, indent=1) + "\n")
 
@@ -226,14 +235,23 @@ def _scene_of(scenario):
 def run_trial(scenario, method, trial, seed, output, digest, run=None):
     """Runs one trial and writes its files; a trial that raises is written as failed with
     its error. Returns its record. This is what a worker process runs."""
+    marker = _running_marker(output, method, seed)
+    marker.parent.mkdir(parents=True, exist_ok=True)
+    marker.write_text(f"{os.getpid()}\n")
+    record, result = compute_trial(scenario, method, trial, seed, digest, run)
+    write_trial(output, record, result)
+    marker.unlink(missing_ok=True)
+    return record
+
+
+def compute_trial(scenario, method, trial, seed, digest, run=None):
+    """Runs one trial without touching the disk: its record and TaskResult (None when it
+    raised: the record then holds the error)."""
     if run is None:
         from pbp_drake.task_run import run_task as run
     started = time.monotonic()
     record = _trial_record(scenario.name, digest, method, trial, seed)
     result = None
-    marker = _running_marker(output, method, seed)
-    marker.parent.mkdir(parents=True, exist_ok=True)
-    marker.write_text(f"{os.getpid()}\n")
     warnings = _DrakeWarnings()
     try:
         trial_scenario = dataclasses.replace(scenario, method=method, seed=seed)
@@ -251,9 +269,14 @@ def run_trial(scenario, method, trial, seed, output, digest, run=None):
         warnings.close()
     record["drake_warnings"] = warnings.count
     record["wall_time"] = round(time.monotonic() - started, 3)
-    write_trial(output, record, result)
-    marker.unlink(missing_ok=True)
-    return record
+    return record, result
+
+
+def _ray_trial(scenario, method, trial, seed, digest, run=None):
+    """What a Ray task runs: the trial's record and its time series as CSV text (the
+    process that runs the study writes the files: a cluster's nodes may not see them)."""
+    record, result = compute_trial(scenario, method, trial, seed, digest, run)
+    return record, None if result is None else time_series_csv(result)
 
 
 class _DrakeWarnings(logging.Handler):
@@ -332,11 +355,107 @@ def _ignore_interrupts():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+BACKENDS = ("local", "ray")
+RAY_INSTALL_HINT = "pip install 'pbp_drake[ray]'"
+# A Ray task whose worker process dies runs once more (as a local worker's trial runs again
+# alone) before it is recorded as failed; a trial that raises is recorded at once.
+RAY_MAX_RETRIES = 1
+
+
+def _import_ray():
+    try:
+        import ray
+    except ImportError as error:
+        raise StudyError(f"--backend ray needs Ray, which is not installed ({error}): "
+                         f"{RAY_INSTALL_HINT}") from None
+    return ray
+
+
+class _RaySession:
+    """Ray for one study: with no address, a new local Ray of `jobs` CPUs, whose workers
+    see this process's sys.path (as local worker processes do), shut down at the end; with
+    an address, that cluster (left running). A Ray this process already runs is used as is."""
+
+    def __init__(self, jobs, address=None):
+        self.ray = _import_ray()
+        self.started = False
+        if self.ray.is_initialized():
+            return
+        quiet = {"log_to_driver": False, "configure_logging": False}
+        try:
+            if address is None:
+                path = os.pathsep.join(p for p in sys.path if p)
+                self.ray.init(address="local", num_cpus=jobs, include_dashboard=False,
+                              runtime_env={"env_vars": {"PYTHONPATH": path}}, **quiet)
+            else:
+                self.ray.init(address=address, **quiet)
+        except Exception as error:
+            where = "start a local Ray" if address is None else f"connect to Ray at {address}"
+            raise StudyError(f"could not {where}: {type(error).__name__}: {error}") from None
+        self.started = True
+
+    def close(self):
+        if self.started:
+            self.started = False
+            self.ray.shutdown()
+
+
+def _ray_error_text(ray, error):
+    """A failed task's error as `Type: message`: a trial's own exception when it has one
+    (as the local backend records it), else Ray's (e.g. WorkerCrashedError)."""
+    cause = getattr(error, "cause", None) if isinstance(
+        error, ray.exceptions.RayTaskError) else None
+    error = cause if isinstance(cause, BaseException) else error
+    return f"{type(error).__name__}: {error}"
+
+
+def _run_on_ray(pending, jobs, address, submit_args, output, on_done, on_error):
+    """Runs `pending` trial keys as Ray tasks, at most `jobs` at once, and writes each
+    trial's files here as its task finishes; a task that fails is recorded as failed."""
+    session = _RaySession(jobs, address)
+    ray = session.ray
+    running = {}
+    try:
+        task = ray.remote(num_cpus=1, max_retries=RAY_MAX_RETRIES)(_ray_trial)
+        scenario, *_, digest, run = submit_args(pending[0])
+        scenario_ref, run_ref = ray.put(scenario), ray.put(run)
+        queue = list(pending)
+        while queue or running:
+            while queue and len(running) < jobs:
+                key = queue.pop(0)
+                _, method, trial, seed, *_ = submit_args(key)
+                running[task.remote(scenario_ref, method, trial, seed, digest, run_ref)] = key
+            ready, _ = ray.wait(list(running), num_returns=1)
+            for ref in ready:
+                key = running.pop(ref)
+                try:
+                    record, csv_text = ray.get(ref)
+                except Exception as error:  # the task failed: record it, go on
+                    on_error(key, _ray_error_text(ray, error))
+                else:
+                    _write_trial_files(output, record, csv_text)
+                    on_done(key, record)
+    except BaseException:  # Ctrl-C: stop the tasks; the trials on disk are whole
+        for ref in running:
+            try:
+                ray.cancel(ref, force=True)
+            except Exception:
+                pass
+        raise
+    finally:
+        session.close()
+
+
 def run_method_comparison(scenario, methods, trials, seed, output, progress=None, jobs=1,
-                          run=None, retry_errors=False):
+                          run=None, retry_errors=False, backend="local", ray_address=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     processes, writes every trial under `output/trials/`, then the summary, tables and
     figures (see `report`). Returns the summary dict.
+
+    `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
+    Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "ray://head:10001", "auto"),
+    whose workers must be able to import pbp_drake. This process writes the trial files,
+    the same as with local processes, so the summary is the same bytes.
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except
     those that failed with an error). A trial that raises, or whose worker process dies, is
@@ -346,6 +465,10 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     """
     if not isinstance(jobs, int) or jobs < 1:
         raise ScenarioError(f"jobs must be a positive number of processes, got {jobs}")
+    if backend not in BACKENDS:
+        raise ScenarioError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
+    if ray_address is not None and backend != "ray":
+        raise ScenarioError("ray_address needs backend='ray'")
     if trials < 1:
         raise ScenarioError(f"trials must be at least 1, got {trials}")
     output = pathlib.Path(output)
@@ -354,7 +477,9 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     keys = [(method, trial) for method in methods for trial in range(trials)]
     for leftover in [*output.glob("trials/*/*.running"), *output.glob("trials/*/.*.tmp")]:
         leftover.unlink(missing_ok=True)  # left by an interrupted study
-    if jobs > 1 and run is not None:
+    if backend == "ray":
+        _import_ray()  # fail before touching the folder when Ray is missing
+    if backend == "local" and jobs > 1 and run is not None:
         try:
             pickle.dumps(run)
         except Exception as error:
@@ -379,16 +504,19 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
         method, trial = key
         return (scenario, method, trial, seed + trial, output, digest, run)
 
-    if jobs == 1:
+    def on_error(key, error):
+        method, trial = key
+        _running_marker(output, method, seed + trial).unlink(missing_ok=True)
+        on_done(key, _failed_record(scenario, digest, method, trial, seed + trial, error,
+                                    output))
+
+    if backend == "ray":
+        if pending:
+            _run_on_ray(pending, jobs, ray_address, submit_args, output, on_done, on_error)
+    elif jobs == 1:
         for key in pending:
             on_done(key, run_trial(*submit_args(key)))
     else:
-        def on_error(key, error):
-            method, trial = key
-            _running_marker(output, method, seed + trial).unlink(missing_ok=True)
-            on_done(key, _failed_record(scenario, digest, method, trial, seed + trial, error,
-                                        output))
-
         queue = list(pending)
         while queue:
             # A dead worker breaks the pool. The trials that had started run again, each

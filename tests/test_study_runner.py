@@ -4,9 +4,13 @@ crashed trials, the trial files read back, and `pbp-drake report` rebuilding fro
 import dataclasses
 import io
 import json
+import importlib.util
 import os
 import shutil
+import subprocess
+import sys
 import textwrap
+import time
 
 import numpy as np
 import pytest
@@ -277,3 +281,86 @@ def test_progress_bar_on_a_terminal_and_in_a_log():
     lines = log.getvalue().splitlines()
     assert len(lines) == 2 and "2/4 trials" in lines[0] and "4/4 trials" in lines[1]
     assert "\r" not in log.getvalue()
+
+
+# ---------------------------------------------------------------------------------------------
+# --backend ray (a local Ray of --jobs CPUs; about 4 s to start here)
+
+needs_ray = pytest.mark.skipif(importlib.util.find_spec("ray") is None,
+                               reason="ray is not installed: pip install 'pbp_drake[ray]'")
+
+
+@needs_ray
+def test_ray_backend_writes_the_same_files_as_local_processes(studies, task_file, tmp_path):
+    one, _ = studies
+    folder = tmp_path / "ray"
+    started = time.monotonic()
+    assert main(study_args(task_file, folder, 2) + ["--backend", "ray"]) == 0
+    print(f"ray study: {time.monotonic() - started:.1f} s")
+    for name in ("summary.json", "results.md", "trials.json"):
+        assert (folder / name).read_bytes() == (one / name).read_bytes(), name
+    for method in METHODS:
+        for seed in (5, 6):
+            local_json, local_csv = trial_paths(one, method, seed)
+            ray_json, ray_csv = trial_paths(folder, method, seed)
+            assert ray_csv.read_bytes() == local_csv.read_bytes()
+            ours, theirs = json.loads(ray_json.read_text()), json.loads(local_json.read_text())
+            ours.pop("wall_time"), theirs.pop("wall_time")
+            assert ours == theirs
+    assert not [p for p in folder.rglob("*") if p.suffix in (".tmp", ".running")]
+    import ray
+    assert not ray.is_initialized()  # the Ray it started is shut down
+
+
+@needs_ray
+def test_ray_backend_records_a_trial_that_raises_and_resumes(scenario, tmp_path):
+    summary = run_method_comparison(scenario, METHODS, 3, 5, tmp_path, jobs=2,
+                                    run=raising_run, backend="ray")
+    record = json.loads(trial_paths(tmp_path, "teleop", 6)[0].read_text())
+    assert record["error"] == "RuntimeError: the simulator gave up"
+    assert record["time_series"] is None and not trial_paths(tmp_path, "teleop", 6)[1].exists()
+    assert summary["methods"]["teleop"]["error_seeds"] == [6]
+    assert summary["methods"]["pbp_alternated"]["errors"] == 0
+    local = tmp_path / "local"
+    assert run_method_comparison(scenario, METHODS, 3, 5, local, run=raising_run) == summary
+    assert (local / "summary.json").read_bytes() == (tmp_path / "summary.json").read_bytes()
+    # Resuming keeps the failed trial and runs nothing (retry_errors is the same code as
+    # with local processes; not run here, to start Ray once).
+    ran = []
+    run_method_comparison(scenario, METHODS, 3, 5, tmp_path, run=fake_run, backend="ray",
+                          progress=lambda done, total, record, elapsed: ran.append(record))
+    assert ran == []
+
+
+def test_ray_backend_without_ray_says_how_to_install_it(task_file, tmp_path, capsys,
+                                                        monkeypatch):
+    monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` raises ImportError
+    assert main(study_args(task_file, tmp_path / "out", 2) + ["--backend", "ray"]) == 2
+    assert "pip install 'pbp_drake[ray]'" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
+    assert main(study_args(task_file, tmp_path, 1) + ["--ray-address", "auto"]) == 2
+    assert "--ray-address needs --backend ray" in capsys.readouterr().err
+
+
+def test_the_local_backend_does_not_import_ray(scenario, tmp_path):
+    code = textwrap.dedent("""
+        import sys
+        from pbp_drake.cli import main
+        from pbp_drake.method_study import run_method_comparison
+        from pbp_drake.scenarios import load_scenario_file
+
+        def run(scenario):
+            raise RuntimeError("no simulation")
+
+        scenario = load_scenario_file(sys.argv[1]).scenario
+        summary = run_method_comparison(scenario, ["teleop"], 1, 0, sys.argv[2], run=run)
+        assert summary["methods"]["teleop"]["errors"] == 1
+        assert "ray" not in sys.modules, "ray was imported"
+    """)
+    task = tmp_path / "task.yaml"
+    task.write_text(textwrap.dedent(TASK))
+    subprocess.run([sys.executable, "-c", code, str(task), str(tmp_path / "out")], check=True,
+                   timeout=120)

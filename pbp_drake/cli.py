@@ -62,6 +62,20 @@ def main(argv=None):
         "trial files, without simulating")
     report.add_argument("output", help="the --output folder of `pbp-drake study`")
 
+    # Their own argument parsers live with them; the rest of the line is passed on.
+    for name, help_text in [("bench", "time the DMP bank against the DMP libraries people "
+                                      "use (pbp-drake bench --help)"),
+                            ("draw", "write a scenario's system diagram as SVG "
+                                     "(pbp-drake draw --help)")]:
+        tool = commands.add_parser(name, help=help_text, add_help=False)
+        tool.add_argument("arguments", nargs=argparse.REMAINDER)
+
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0] in ("bench", "draw"):
+        # Before argparse, which would take their options (e.g. --help) for its own.
+        import importlib
+
+        return importlib.import_module(f"pbp_drake.{argv[0]}").main(argv[1:])
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
@@ -130,9 +144,7 @@ def _run(args):
         return _run_task(args, scenario, meshcat)
     diagram = build_diagram(scenario, meshcat)
     if not args.headless and sys.stdin.isatty():
-        deadline = time.monotonic() + args.wait_for_browser
-        while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.1)
+        _wait_for_browser(meshcat, args.wait_for_browser)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     trajectory = simulate(scenario, realtime_rate=0.0 if args.headless else args.realtime_rate,
@@ -169,9 +181,7 @@ def _run_task(args, scenario, meshcat):
         if person:
             print("Keys: arrows move the hand (forward only in teleop), Q and E turn it.",
                   flush=True)
-        deadline = time.monotonic() + args.wait_for_browser
-        while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.1)
+        _wait_for_browser(meshcat, args.wait_for_browser)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     result = run_task(scenario, realtime_rate=0.0 if args.headless else args.realtime_rate,
@@ -186,6 +196,12 @@ def _run_task(args, scenario, meshcat):
     if not args.headless and sys.stdin.isatty():
         input("Press Enter to quit (the page stays live until then). ")
     return 0 if result.success else 1
+
+
+def _wait_for_browser(meshcat, seconds):
+    deadline = time.monotonic() + seconds
+    while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
+        time.sleep(0.1)
 
 
 def _save_recording(meshcat, path):

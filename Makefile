@@ -5,7 +5,7 @@ PYTHON := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 DEMO_DIR := outputs/demo
 
-.PHONY: demo test chromium clean
+.PHONY: demo test chromium graphviz tutorials diagrams bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(PYTHON) || python3 -m venv $(VENV)
@@ -37,8 +37,44 @@ chromium:
 		echo "note: chromium is missing (installing it needs root and apt-get); the browser tests will skip"; \
 	fi
 
-test: $(STAMP) chromium
+# Graphviz's `dot` (Debian's `graphviz`) draws the system diagrams (`pbp-drake draw`): the
+# tests compare the drawings in diagrams/ with what it draws now. Installed like chromium;
+# without it those tests skip.
+graphviz:
+	@if command -v dot >/dev/null 2>&1; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+		echo "Installing Debian's graphviz for the diagram drawings"; \
+		{ apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
+			apt-get install -y -qq graphviz >/dev/null; } </dev/null \
+		|| { echo "note: installing graphviz failed (an error under CI; elsewhere the drawing tests skip)"; \
+		     [ -z "$${CI:-}" ]; }; \
+	else \
+		echo "note: graphviz is missing (installing it needs root and apt-get); the drawing tests will skip"; \
+	fi
+
+test: $(STAMP) chromium graphviz
 	$(PYTHON) -m pytest
+
+# The tutorial notebooks (tutorials/*.ipynb) in Jupyter, in the project's venv.
+$(VENV)/.installed-tutorials: $(STAMP)
+	$(PYTHON) -m pip install --quiet -e '.[test,tutorials]'
+	touch $@
+
+tutorials: $(VENV)/.installed-tutorials graphviz
+	$(VENV)/bin/jupyter lab tutorials
+
+# Redraw every scenario's system diagram beside its YAML (diagrams/*.svg).
+diagrams: $(STAMP) graphviz
+	$(PYTHON) -m pbp_drake.draw diagrams/*.yaml
+
+# `pbp-drake bench`: the DMP bank against pydmps and movement_primitives, the closed-loop HSR
+# speed and the control-rate figure, into outputs/bench (bench.json, bench_control_rate.png).
+$(VENV)/.installed-bench: $(STAMP)
+	$(PYTHON) -m pip install --quiet -e '.[test,bench]'
+	touch $@
+
+bench: $(VENV)/.installed-bench
+	$(VENV)/bin/python -m pbp_drake.bench
 
 clean:
 	rm -rf $(VENV) outputs build *.egg-info

@@ -294,7 +294,16 @@ class DmpBank:
 
     Use it statefully, as NumPy users would (`reset`, then `next_step(goals, y_robot)` each
     control step), or through the pure `advance` that Drake's `DmpBank` system calls with the
-    state it keeps in its Context.
+    state it keeps in its Context; `advance_into` is the same step written into arrays the
+    caller owns (the Context's own vectors), with no allocation.
+
+    Speed. When all phases are equal (DMPs started together and locked together: the normal
+    case), the basis is evaluated once, `(N,)`, and contracted with the weights: shared
+    weights give a `(D,)` shape broadcast to all goals (O(N D + D K)); distinct weights are
+    one `(N,) x (N, D*K)` matrix-vector product over contiguous memory (memory bound). The
+    per-goal-phase path (phases made unequal by per-goal locks) evaluates `(N, K)` bases.
+    The step then makes a fixed number of passes over `(D, K)` work arrays kept in the bank,
+    using the one cached 2x2 transition. `amplitude_scaling` is read at construction.
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
@@ -332,7 +341,35 @@ class DmpBank:
         self.amplitude_scaling = np.ascontiguousarray(scaling.T)
         self._centres, self._widths = settings.basis()
         self._transitions = {}
+        self._decays = {}
+        self._allocate_work()
         self.reset()
+
+    def _allocate_work(self):
+        """Work arrays reused by every step (so that a step allocates nothing)."""
+        d, k, n = self.dimension, self.goal_count, self.settings.basis_count
+        self._negative_widths = -self._widths
+        self._ijspeert = self.settings.formulation == "ijspeert"
+        self._unscaled = ~self.amplitude_scaling
+        self._all_scaled = not self._unscaled.any()
+        self._psi = np.empty(n)
+        self._coefficients = np.empty(d)
+        self._coefficient_column = self._coefficients[:, np.newaxis]
+        self._shape = np.empty((d, k))
+        self._shape_flat = self._shape.reshape(-1)
+        self._attractor = np.empty((d, k))
+        self._offset = np.empty((d, k))
+        self._work = np.empty((d, k))
+        # Shared weights and a per-dimension amplitude scaling: with equal phases and one
+        # robot position, the step is linear in (g, y0, z, 1) with per-dimension coefficients,
+        # so it is two batched (1 x 4) @ (4 x K) products over rows kept side by side.
+        self._rows = None
+        scaling = self.amplitude_scaling
+        self._row_kernel = (self.shared_weights
+                            and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all()))
+        if self._row_kernel:
+            self._rows_starts = None
+            self._scaled_rows = scaling[:, 0].astype(float)
 
     @classmethod
     def from_dmps(cls, dmps):
@@ -401,7 +438,9 @@ class DmpBank:
                 f"goals has {goals.size} numbers; the bank expects {self.goal_count} goals of "
                 f"dimension {self.dimension}"
             )
-        if not np.isfinite(goals).all():
+        # One reduction without a temporary: a finite sum proves every entry finite; only
+        # when it is not (NaN, infinity, or an overflow of huge finite goals) look closer.
+        if not math.isfinite(goals.sum()) and not np.isfinite(goals).all():
             raise ValueError("goals contains NaN or infinite values")
         return goals.reshape(self.goal_count, self.dimension).T
 
@@ -412,18 +451,70 @@ class DmpBank:
             )
         return self._transitions[dt]
 
+    def decay(self, dt):
+        """The phase factor `exp(-alpha_x dt / tau)` of one step (cached per `dt`)."""
+        factor = self._decays.get(dt)
+        if factor is None:
+            factor = self._decays[dt] = math.exp(-self.settings.alpha_x * dt / self.duration)
+        return factor
+
     def attractors(self, phase, goals_dk):
         """The moving attractors `(D, K)` for phases `(K,)` and goals `(D, K)`."""
-        phi = normalized_basis(phase, self._centres, self._widths)  # (N, K)
-        if self.shared_weights:
-            shape = self._weights.T @ phi  # (D, K)
+        return self._attractors_into(np.asarray(phase, dtype=float), goals_dk).copy()
+
+    def _attractors_into(self, phase, goals_dk):
+        """The attractors written into the bank's work array (returned; valid until the next
+        call)."""
+        shape, x = self._shaped_forcing(phase)  # shape already times x (and / K)
+        attractor = self._attractor
+        np.subtract(goals_dk, self.starts, out=attractor)
+        if self._ijspeert:
+            # g + shape x (g - y0) / K, with 1 for (g - y0) where the scaling is off.
+            if not self._all_scaled:
+                np.copyto(attractor, 1.0, where=self._unscaled)
+            attractor *= shape
+            attractor += goals_dk
         else:
-            shape = np.einsum("nk,ndk->dk", phi, self._weights)
+            # g - (g - y0) x + shape x
+            attractor *= x
+            np.subtract(goals_dk, attractor, out=attractor)
+            attractor += shape
+        return attractor
+
+    def _shaped_forcing(self, phase):
+        """`(psi.w / sum psi) x`, divided by K in the Ijspeert form, and the phase.
+
+        Equal phases: the shape is `(D, 1)` (shared weights) or `(D, K)`, the phase a float;
+        a phase per goal: the shape is `(D, K)`, the phase `(K,)`. The shape is a work array.
+        """
+        if phase.size == 1 or phase.min() == phase.max():
+            x = float(phase.flat[0])
+            psi = self._psi
+            np.subtract(x, self._centres, out=psi)
+            np.square(psi, out=psi)
+            psi *= self._negative_widths
+            np.exp(psi, out=psi)
+            scale = x / psi.sum()
+            if self._ijspeert:
+                scale /= self.settings.stiffness
+            psi *= scale
+            if self.shared_weights:
+                np.dot(psi, self._weights, out=self._coefficients)
+                return self._coefficient_column, x
+            n = self.settings.basis_count
+            np.dot(psi, self._weights.reshape(n, -1), out=self._shape_flat)
+            return self._shape, x
+        # A phase per goal: K bases.
+        phi = normalized_basis(phase, self._centres, self._widths)  # (N, K)
+        shape = self._shape
+        if self.shared_weights:
+            np.matmul(self._weights.T, phi, out=shape)
+        else:
+            np.einsum("nk,ndk->dk", phi, self._weights, out=shape)
         shape *= phase
-        if self.settings.formulation == "ijspeert":
-            amplitude = np.where(self.amplitude_scaling, goals_dk - self.starts, 1.0)
-            return goals_dk + shape * amplitude / self.settings.stiffness
-        return goals_dk - (goals_dk - self.starts) * phase + shape
+        if self._ijspeert:
+            shape /= self.settings.stiffness
+        return shape, phase
 
     def advance(self, phase, positions, scaled_velocity, goals_dk, dt, locked=None,
                 robot_velocity=None):
@@ -438,42 +529,166 @@ class DmpBank:
         Returns:
             (phase, positions, scaled_velocity) after the step, new arrays.
         """
-        positions = np.broadcast_to(positions, scaled_velocity.shape)
-        transition = self.transition(dt)
-        attractor = self.attractors(phase, goals_dk)
-        offset = positions - attractor
-        new_positions = attractor + transition[0, 0] * offset + transition[0, 1] * scaled_velocity
-        new_velocity = transition[1, 0] * offset + transition[1, 1] * scaled_velocity
-        new_phase = phase * math.exp(-self.settings.alpha_x * dt / self.duration)
-        if locked is not None and np.any(locked):
-            locked = np.broadcast_to(np.asarray(locked, bool), phase.shape)
-            new_phase = np.where(locked, phase, new_phase)
-            new_positions = np.where(locked, positions, new_positions)
-            held = (scaled_velocity if robot_velocity is None
-                    else self.duration * np.asarray(robot_velocity, float)[:, None])
-            new_velocity = np.where(locked, held, new_velocity)
+        phase = np.asarray(phase, dtype=float)
+        scaled_velocity = np.asarray(scaled_velocity, dtype=float)
+        new_phase = np.empty(phase.shape)
+        new_positions = np.empty(scaled_velocity.shape)
+        new_velocity = np.empty(scaled_velocity.shape)
+        self.advance_into(phase, positions, scaled_velocity, goals_dk, dt,
+                          new_phase, new_positions, new_velocity, locked, robot_velocity)
         return new_phase, new_positions, new_velocity
+
+    def advance_into(self, phase, positions, scaled_velocity, goals_dk, dt,
+                     out_phase, out_positions, out_velocity, locked=None, robot_velocity=None):
+        """`advance` written into `out_phase` (K,), `out_positions` and `out_velocity` (D, K).
+
+        The outputs may be the inputs themselves (`out_phase is phase`,
+        `out_velocity is scaled_velocity`, `out_positions is positions`): the step then
+        updates the state in place. Allocates nothing unless some (not all) DMPs are locked.
+        """
+        if locked is not None and not isinstance(locked, (bool, np.bool_)):
+            locked = np.asarray(locked, bool)
+            if locked.ndim == 0 or locked.all():
+                locked = bool(locked.all())
+            elif not locked.any():
+                locked = False
+            else:
+                return self._advance_partly_locked(
+                    phase, positions, scaled_velocity, goals_dk, dt, out_phase, out_positions,
+                    out_velocity, np.broadcast_to(locked, np.shape(phase)), robot_velocity)
+        if locked:
+            # Every phase frozen: the DMPs stay at the given positions and follow the robot.
+            if out_phase is not phase:
+                out_phase[...] = phase
+            if out_positions is not positions:
+                out_positions[...] = positions
+            if robot_velocity is not None:
+                np.multiply(np.asarray(robot_velocity, float)[:, np.newaxis], self.duration,
+                            out=out_velocity)
+            elif out_velocity is not scaled_velocity:
+                out_velocity[...] = scaled_velocity
+            return
+        transition = self.transition(dt)
+        if (self._row_kernel and self.goal_count >= 64
+                and np.shape(positions) == (self.dimension, 1)
+                and out_positions.flags.c_contiguous and out_velocity.flags.c_contiguous
+                and (phase.size == 1 or phase.min() == phase.max())):
+            self._advance_rows(phase, positions, scaled_velocity, goals_dk, transition,
+                               dt, out_phase, out_positions, out_velocity)
+            return
+        attractor = self._attractors_into(phase, goals_dk)
+        offset, work = self._offset, self._work
+        np.subtract(positions, attractor, out=offset)
+        # Velocity first, into the work array: `out_positions` may alias `positions`...
+        np.multiply(offset, transition[1, 0], out=work)
+        # ...position: attractor + Phi00 offset + Phi01 z (z still the old one).
+        np.multiply(offset, transition[0, 0], out=offset)
+        offset += attractor
+        np.multiply(scaled_velocity, transition[0, 1], out=attractor)
+        np.add(offset, attractor, out=out_positions)
+        # ...then z' = Phi10 offset + Phi11 z, in place if `out_velocity` is z.
+        np.multiply(scaled_velocity, transition[1, 1], out=out_velocity)
+        out_velocity += work
+        np.multiply(phase, self.decay(dt), out=out_phase)
+
+    def _prepare_rows(self):
+        """Rows `(g, z, 1)` per dimension when every DMP starts at the same point (y0 then
+        folds into the constant), else `(g, z, 1, y0)`."""
+        d, k = self.dimension, self.goal_count
+        starts = self.starts
+        uniform = bool((starts == starts[:, :1]).all())
+        rows = np.empty((d, 3 if uniform else 4, k))
+        rows[:, 2, :] = 1.0
+        if not uniform:
+            rows[:, 3, :] = starts
+        self._rows = rows
+        self._uniform_start = starts[:, 0].copy() if uniform else None
+        self._row_coefficients = np.zeros((2, d, 1, rows.shape[1]))
+        self._rows_starts = starts
+
+    def _advance_rows(self, phase, positions, scaled_velocity, goals_dk, transition, dt,
+                      out_phase, out_positions, out_velocity):
+        """The step for shared weights, equal phases and one robot position (the fast path).
+
+        The attractor is `a = alpha_g g + alpha_y y0 + alpha_1` per dimension, so the new
+        position `a + Phi00 (p - a) + Phi01 z` and `z' = Phi10 (p - a) + Phi11 z` are dot
+        products of per-dimension coefficients with the rows `(g, z, 1[, y0])`: two batched
+        `(1 x R) @ (R x K)` products.
+        """
+        d, k = self.dimension, self.goal_count
+        if self._rows_starts is not self.starts:
+            self._prepare_rows()
+        rows = self._rows
+        np.copyto(rows[:, 0, :], goals_dk)
+        np.copyto(rows[:, 1, :], scaled_velocity)
+        shape, x = self._shaped_forcing(phase)  # (D, 1): the forcing (times x, / K)
+        c = shape[:, 0]
+        if self._ijspeert:
+            # a = g + c (g - y0) where scaled, g + c where not.
+            cs = c * self._scaled_rows
+            alpha_g, alpha_y, alpha_1 = 1.0 + cs, -cs, c - cs
+        else:
+            # a = g - (g - y0) x + c.
+            alpha_g, alpha_y, alpha_1 = np.full(d, 1.0 - x), np.full(d, x), c
+        if self._uniform_start is not None:
+            alpha_1 = alpha_1 + alpha_y * self._uniform_start
+        p = positions[:, 0]
+        (t00, t01), (t10, t11) = transition
+        m = self._row_coefficients
+        m[0, :, 0, 0] = (1.0 - t00) * alpha_g
+        m[0, :, 0, 1] = t01
+        m[0, :, 0, 2] = (1.0 - t00) * alpha_1 + t00 * p
+        m[1, :, 0, 0] = -t10 * alpha_g
+        m[1, :, 0, 1] = t11
+        m[1, :, 0, 2] = t10 * (p - alpha_1)
+        if self._uniform_start is None:
+            m[0, :, 0, 3] = (1.0 - t00) * alpha_y
+            m[1, :, 0, 3] = -t10 * alpha_y
+        np.matmul(m[0], rows, out=out_positions.reshape(d, 1, k))
+        np.matmul(m[1], rows, out=out_velocity.reshape(d, 1, k))
+        np.multiply(phase, self.decay(dt), out=out_phase)
+
+    def _advance_partly_locked(self, phase, positions, scaled_velocity, goals_dk, dt,
+                               out_phase, out_positions, out_velocity, locked,
+                               robot_velocity):
+        """Some DMPs locked, some not: the plain path with temporaries (rare)."""
+        phase = np.array(phase, dtype=float)
+        positions = np.array(np.broadcast_to(positions, np.shape(scaled_velocity)), float)
+        scaled_velocity = np.array(scaled_velocity, dtype=float)
+        new_phase = np.empty_like(phase)
+        new_positions = np.empty_like(scaled_velocity)
+        new_velocity = np.empty_like(scaled_velocity)
+        self.advance_into(phase, positions, scaled_velocity, goals_dk, dt,
+                          new_phase, new_positions, new_velocity)
+        held = (scaled_velocity if robot_velocity is None
+                else self.duration * np.asarray(robot_velocity, float)[:, None])
+        out_phase[...] = np.where(locked, phase, new_phase)
+        out_positions[...] = np.where(locked, positions, new_positions)
+        out_velocity[...] = np.where(locked, held, new_velocity)
 
     def next_step(self, goals, y_robot, dt, yd_robot=None, phase_locked=False):
         """Stateful step from the robot's position: returns positions and velocities `(K, D)`.
 
-        `yd_robot` is used only while `phase_locked` (see the module docstring).
+        `yd_robot` is used only while `phase_locked` (see the module docstring). The bank's
+        `phase`, `position` and `scaled_velocity` arrays are updated in place.
         """
         robot = _as_point(y_robot, "y_robot", dimension=self.dimension)[:, None]
-        self.phase, self.position, self.scaled_velocity = self.advance(
+        self.advance_into(
             self.phase, robot, self.scaled_velocity, self.goals_matrix(goals), dt,
-            locked=phase_locked if phase_locked else None, robot_velocity=yd_robot)
+            self.phase, self.position, self.scaled_velocity,
+            locked=phase_locked if phase_locked is not False else None,
+            robot_velocity=yd_robot)
         return self.position.T.copy(), (self.scaled_velocity / self.duration).T.copy()
 
     def predict(self, phase, position, scaled_velocity, goals_dk, dt, steps):
         """Open-loop paths `(K, steps + 1, D)` from one state, for drawing predictions."""
         path = np.empty((steps + 1, self.dimension, self.goal_count))
-        positions = np.broadcast_to(position, scaled_velocity.shape).copy()
-        path[0] = positions
+        path[0] = np.broadcast_to(position, np.shape(scaled_velocity))
+        phase = np.array(phase, dtype=float)
+        scaled_velocity = np.array(scaled_velocity, dtype=float)
         for step in range(steps):
-            phase, positions, scaled_velocity = self.advance(
-                phase, positions, scaled_velocity, goals_dk, dt)
-            path[step + 1] = positions
+            self.advance_into(phase, path[step], scaled_velocity, goals_dk, dt,
+                              phase, path[step + 1], scaled_velocity)
         return path.transpose(2, 0, 1)
 
 

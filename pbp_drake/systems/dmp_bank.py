@@ -56,14 +56,19 @@ class DmpBank(LeafSystem):
         self._phase_index = self.DeclareDiscreteState(phase)
         self._position_index = self.DeclareDiscreteState(positions.reshape(-1))
         self._velocity_index = self.DeclareDiscreteState(scaled_velocity.reshape(-1))
+        # The outputs depend on the bank's own state (and the goals) only: say so, so that
+        # Drake does not recompute them after every plant step.
         self._references_port = self.DeclareVectorOutputPort(
-            "references", 2 * k * d, self._calc_references)
+            "references", 2 * k * d, self._calc_references,
+            prerequisites_of_calc={self.xd_ticket()})
         self._phase_port = self.DeclareStateOutputPort("phase", self._phase_index)
         self._predicted_paths_port = None
         if self._prediction_steps > 0:
             self._predicted_paths_port = self.DeclareVectorOutputPort(
                 "predicted_paths", k * (self._prediction_steps + 1) * d,
-                self._calc_predicted_paths)
+                self._calc_predicted_paths,
+                prerequisites_of_calc={self.xd_ticket(),
+                                       self._goals_port.ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     @property
@@ -89,31 +94,37 @@ class DmpBank(LeafSystem):
         return self._predicted_paths_port
 
     def _state(self, context):
+        """Read-only views of the phase (K,), positions and scaled velocities (D, K)."""
         d, k = self._bank.dimension, self._bank.goal_count
-        return (context.get_discrete_state(self._phase_index).value(),
-                context.get_discrete_state(self._position_index).value().reshape(d, k),
-                context.get_discrete_state(self._velocity_index).value().reshape(d, k))
+        return (context.get_discrete_state(self._phase_index).get_value(),
+                context.get_discrete_state(self._position_index).get_value().reshape(d, k),
+                context.get_discrete_state(self._velocity_index).get_value().reshape(d, k))
 
     def _update(self, context, discrete_state):
-        d = self._bank.dimension
-        robot_state = self._robot_state_port.Eval(context)
-        goals = self._bank.goals_matrix(self._goals_port.Eval(context))
+        # Ports are read through views (no copies) and the step is written straight into the
+        # discrete state's vectors, which Drake fills with the current state beforehand.
+        bank = self._bank
+        d, k = bank.dimension, bank.goal_count
+        robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
+        goals = bank.goals_matrix(self._goals_port.EvalAbstract(context).get_value().get_value())
         locked = None
         if self._lock and self._operator_active_port.HasValue(context):
             locked = bool(self._operator_active_port.Eval(context)[0] > 0.5)
-        phase, _, scaled_velocity = self._state(context)
-        phase, positions, scaled_velocity = self._bank.advance(
-            phase, robot_state[:d, np.newaxis], scaled_velocity, goals, self._period,
-            locked=locked, robot_velocity=robot_state[d:])
-        discrete_state.get_mutable_vector(self._phase_index).set_value(phase)
-        discrete_state.get_mutable_vector(self._position_index).set_value(positions.reshape(-1))
-        discrete_state.get_mutable_vector(self._velocity_index).set_value(
-            scaled_velocity.reshape(-1))
+        phase = discrete_state.get_mutable_vector(self._phase_index).get_mutable_value()
+        positions = discrete_state.get_mutable_vector(
+            self._position_index).get_mutable_value().reshape(d, k)
+        scaled_velocity = discrete_state.get_mutable_vector(
+            self._velocity_index).get_mutable_value().reshape(d, k)
+        bank.advance_into(phase, robot_state[:d, np.newaxis], scaled_velocity, goals,
+                          self._period, phase, positions, scaled_velocity,
+                          locked=locked, robot_velocity=robot_state[d:])
 
     def _calc_references(self, context, output):
         _, positions, scaled_velocity = self._state(context)
-        output.SetFromVector(np.concatenate(
-            [positions.T.reshape(-1), (scaled_velocity / self._bank.duration).T.reshape(-1)]))
+        d, k = self._bank.dimension, self._bank.goal_count
+        references = output.get_mutable_value().reshape(2, k, d)
+        references[0] = positions.T
+        np.divide(scaled_velocity.T, self._bank.duration, out=references[1])
 
     def _calc_predicted_paths(self, context, output):
         phase, positions, scaled_velocity = self._state(context)

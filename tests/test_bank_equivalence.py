@@ -1,0 +1,194 @@
+"""The fast DMP bank equals a plain per-goal loop of single DMPs, and pydmps agrees with the
+Ijspeert form.
+
+The bank takes shortcuts (one basis evaluation for equal phases, a matrix-vector product for
+distinct weights, a linear-combination kernel for shared weights); the single `Dmp` steps each
+dimension in a Python loop. They must give the same states to 1e-12, with distinct and
+shared weights, both formulations, mixed amplitude scaling, goals locked one by one (unequal
+phases), and inside the Drake LeafSystem. Timing lives in `pbp-drake bench`, not here.
+"""
+
+import numpy as np
+import pytest
+
+from pbp_drake.core.dmp import FORMULATIONS, Dmp, DmpBank, DmpSettings, fit_weights
+
+DT = 0.01
+
+
+def demonstration(dimension):
+    """A rest-to-rest path whose last dimension starts and ends at one value (so the Ijspeert
+    amplitude scaling is switched off there)."""
+    times = np.linspace(0.0, 1.2, 240)
+    s = times / times[-1]
+    s = 10 * s**3 - 15 * s**4 + 6 * s**5
+    columns = [s * (1.0 + 0.3 * d) + 0.2 * np.sin(np.pi * s) * d for d in range(dimension - 1)]
+    columns.append(0.4 * np.sin(np.pi * s))
+    return times, np.stack(columns, axis=1)
+
+
+def make_banks(formulation, shared, goal_count, dimension, uniform_start, seed):
+    """A bank and the equal list of single DMPs."""
+    rng = np.random.default_rng(seed)
+    settings = DmpSettings(formulation=formulation, basis_count=20)
+    times, positions = demonstration(dimension)
+    weights, scaling = fit_weights(times, positions, settings)
+    starts = (np.broadcast_to(rng.uniform(-0.5, 0.5, dimension), (goal_count, dimension))
+              if uniform_start else rng.uniform(-0.5, 0.5, (goal_count, dimension)))
+    duration = 0.9
+    if shared:
+        bank = DmpBank(weights, starts, duration, settings, scaling, goal_count=goal_count)
+        per_goal_weights = [weights] * goal_count
+    else:
+        distinct = weights[None] * rng.uniform(0.5, 1.5, (goal_count, 1, dimension))
+        bank = DmpBank(distinct, starts, duration, settings, scaling)
+        per_goal_weights = list(distinct)
+    dmps = [Dmp(w, starts[k], starts[k] + 1.0, duration, settings, scaling)
+            for k, w in enumerate(per_goal_weights)]
+    goals = rng.uniform(-1.5, 1.5, (goal_count, dimension))
+    return bank, dmps, goals
+
+
+def run_both(bank, dmps, goals, steps, lock_pattern, seed):
+    rng = np.random.default_rng(seed + 1)
+    k, d = bank.goal_count, bank.dimension
+    phase, _, scaled_velocity = bank.initial_state()
+    goals_dk = bank.goals_matrix(goals)
+    robot = rng.uniform(-1, 1, d)
+    worst = 0.0
+    for step in range(steps):
+        robot_velocity = rng.uniform(-1, 1, d)
+        locked = lock_pattern(step, k)
+        phase, positions, scaled_velocity = bank.advance(
+            phase, robot[:, None], scaled_velocity, goals_dk, DT, locked=locked,
+            robot_velocity=robot_velocity)
+        for j, dmp in enumerate(dmps):
+            is_locked = bool(np.broadcast_to(locked, (k,))[j]) if locked is not None else False
+            position, velocity = dmp.next_step(DT, goals[j], robot, robot_velocity,
+                                               phase_locked=is_locked)
+            worst = max(worst, np.abs(positions[:, j] - position).max(),
+                        np.abs(scaled_velocity[:, j] / bank.duration - velocity).max())
+            assert phase[j] == pytest.approx(dmp.phase, abs=1e-15)
+        # The robot follows DMP 0 loosely, a stand-in for a lagging tracker.
+        robot = 0.7 * robot + 0.3 * positions[:, 0]
+    return worst
+
+
+def never(step, k):
+    return None
+
+
+def all_together(step, k):
+    return 20 <= step < 30  # PBP-Alt: the operator acts, every phase freezes
+
+
+def one_by_one(step, k):
+    # Goals locked at different times: the phases become unequal (the per-goal path).
+    return (np.arange(k) % 3 == step % 3) if 10 <= step < 25 else None
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+@pytest.mark.parametrize("goal_count", [5, 70])  # 70 >= 64 takes the shared-weights kernel
+@pytest.mark.parametrize("uniform_start", [True, False], ids=["one_start", "many_starts"])
+@pytest.mark.parametrize("locks", [never, all_together, one_by_one],
+                         ids=["free", "locked", "locked_one_by_one"])
+def test_fast_bank_equals_a_plain_per_goal_loop(formulation, shared, goal_count,
+                                                uniform_start, locks):
+    bank, dmps, goals = make_banks(formulation, shared, goal_count, 3, uniform_start, seed=4)
+    assert run_both(bank, dmps, goals, 40, locks, seed=4) < 1e-12
+
+
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+def test_stateful_next_step_and_predict_match_advance(shared):
+    bank, _, goals = make_banks("ijspeert", shared, 70, 2, True, seed=9)
+    other, _, _ = make_banks("ijspeert", shared, 70, 2, True, seed=9)
+    phase, _, scaled_velocity = other.initial_state()
+    robot = np.array([0.1, -0.2])
+    for _ in range(15):
+        positions, velocities = bank.next_step(goals, robot, DT)
+        phase, expected, scaled_velocity = other.advance(
+            phase, robot[:, None], scaled_velocity, other.goals_matrix(goals), DT)
+        np.testing.assert_allclose(positions, expected.T, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(velocities, scaled_velocity.T / other.duration,
+                                   rtol=0, atol=1e-12)
+    saved = bank.phase.copy(), bank.position.copy(), bank.scaled_velocity.copy()
+    paths = bank.predict(bank.phase, bank.position, bank.scaled_velocity,
+                         bank.goals_matrix(goals), DT, 10)
+    for before, after in zip(saved, (bank.phase, bank.position, bank.scaled_velocity)):
+        np.testing.assert_array_equal(before, after)  # predict leaves its inputs alone
+    p, y, z = saved
+    for step in range(10):
+        p, y, z = bank.advance(p, y, z, bank.goals_matrix(goals), DT)
+        np.testing.assert_allclose(paths[:, step + 1], y.T, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+def test_leaf_system_equals_the_per_goal_loop(shared):
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+
+    bank, dmps, goals = make_banks("ijspeert", shared, 90, 3, True, seed=2)
+    robot = np.array([0.05, -0.1, 0.2])
+    builder = DiagramBuilder()
+    system = builder.AddSystem(DmpBankSystem(bank, DT))
+    robot_source = builder.AddSystem(ConstantVectorSource(np.concatenate([robot, np.zeros(3)])))
+    goal_source = builder.AddSystem(ConstantVectorSource(goals.reshape(-1)))
+    builder.Connect(robot_source.get_output_port(), system.get_robot_state_input_port())
+    builder.Connect(goal_source.get_output_port(), system.get_goals_input_port())
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    steps = 25
+    simulator.AdvanceTo((steps - 0.5) * DT)  # updates at 0, DT, ..., (steps - 1) DT
+    context = system.GetMyContextFromRoot(simulator.get_context())
+    references = system.get_references_output_port().Eval(context).reshape(2, 90, 3)
+    for j, dmp in enumerate(dmps):
+        for _ in range(steps):
+            position, velocity = dmp.next_step(DT, goals[j], robot)
+        np.testing.assert_allclose(references[0, j], position, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(references[1, j], velocity, rtol=0, atol=1e-12)
+
+
+def pydmps_path(dmp_parameters, dt, duration, y_start, yd_start):
+    """pydmps' DMPs_discrete from a disturbed state: its positions at every `dt`."""
+    pydmps = pytest.importorskip("pydmps")
+    weights, start, goal, centres, widths, alpha_x = dmp_parameters
+    other = pydmps.DMPs_discrete(n_dmps=start.size, n_bfs=weights.shape[0], dt=dt,
+                                 y0=start.copy(), goal=goal.copy(), w=weights.T.copy(),
+                                 ax=alpha_x)
+    other.c, other.h = centres.copy(), widths.copy()
+    other.y, other.dy = y_start.copy(), yd_start.copy()
+    return np.array([other.step()[0].copy() for _ in range(int(round(duration / dt)))])
+
+
+def test_pydmps_agrees_with_the_ijspeert_form():
+    """pydmps integrates `ydd = alpha_z (beta_z (g - y) - yd) + x (g - y0) psi.w / sum psi`
+    (tau = 1) with explicit Euler on the phase and semi-implicit Euler on (y, yd); ours steps
+    the same ODE exactly with the forcing held over each step. Same parameters (alpha_z 25,
+    beta_z 25/4, alpha_x, our centres and widths, weights, y0, g) and the same disturbed start.
+    Both are first-order in dt in their own way, so they cannot agree to rounding; they must
+    agree to O(dt), and halving dt must halve the gap (else it is a parameter mismatch, which
+    would not shrink)."""
+    pytest.importorskip("pydmps")
+    settings = DmpSettings(basis_count=20)
+    times, positions = demonstration(2)
+    positions = positions + np.array([0.0, 0.3]) * (times / times[-1])[:, None]
+    weights, _ = fit_weights(times, positions, settings)
+    start, goal = np.array([0.0, 0.0]), np.array([1.3, 0.6])
+    centres, widths = settings.basis()
+    parameters = (weights, start, goal, centres, widths, settings.alpha_x)
+    y_start, yd_start = np.array([0.2, -0.3]), np.array([-1.0, 0.8])  # pushed off its start
+
+    gaps = []
+    for dt in (4e-4, 2e-4):
+        ours = Dmp(weights, start, goal, 1.0, settings)
+        ours.reset(position=y_start, scaled_velocity=yd_start)  # tau = 1: z = yd
+        path = np.array([ours.next_step(dt)[0] for _ in range(int(round(1.5 / dt)))])
+        theirs = pydmps_path(parameters, dt, 1.5, y_start, yd_start)
+        gaps.append(np.abs(path - theirs).max())
+    scale = np.abs(path).max()
+    assert gaps[1] < 2e-3 * scale  # O(dt) at dt = 0.2 ms
+    assert 0.4 < gaps[1] / gaps[0] < 0.6  # first order: the gap is discretisation only

@@ -126,3 +126,17 @@ def test_python_dash_m_is_the_same_command(fresh_venv, tmp_path):
     assert by_module.returncode == by_script.returncode == 0, by_module.stderr
     assert by_module.stdout == by_script.stdout
     assert "run" in by_module.stdout and "study" in by_module.stdout
+
+
+def test_every_public_name_imports_from_the_package():
+    import pbp_drake
+
+    for name in pbp_drake.__all__:
+        assert getattr(pbp_drake, name) is not None, name
+
+
+def test_importing_the_package_does_not_import_drake():
+    result = subprocess.run(
+        [sys.executable, "-c", "import sys, pbp_drake, pbp_drake.core.dmp; "
+         "print('pydrake' in sys.modules)"], capture_output=True, text=True, timeout=60)
+    assert result.stdout.strip() == "False", result.stderr

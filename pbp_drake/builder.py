@@ -360,7 +360,9 @@ def make_hsr_operator(scenario, meshcat, objects, obstacle_keep_out=0.0):
             direction_noise=config.direction_noise, speed_noise=config.speed_noise,
             seed=scenario.seed, obstacle_count=(
                 scenario.task.obstacle_count if obstacle_keep_out else 0),
-            obstacle_keep_out=obstacle_keep_out)
+            obstacle_keep_out=obstacle_keep_out,
+            obstacle_radius=getattr(scenario.task, "obstacle_radius", None),
+            policy_adds=scenario.method == "pbp_continuous")
     if meshcat is None:
         raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "
                          "Meshcat (pbp-drake run without --headless)")

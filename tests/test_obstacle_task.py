@@ -68,3 +68,11 @@ def test_bad_obstacle_settings_name_the_field(tmp_path, repo):
     path.write_text(text.replace("activation_range: [0.05, 0.5]", "activation_range: [0.5, 0.1]"))
     with pytest.raises(ScenarioError, match="activation_range"):
         load_scenario_file(path)
+
+
+def test_the_virtual_participant_steers_pbp_alt_around_the_obstacles(obstacle_task):
+    result = run_task(dataclasses.replace(obstacle_task, method="pbp_alternated", seed=2))
+    assert result.success
+    assert result.collision_ratio == 0.0 and not result.in_collision.any()
+    # It lets the DMP drive part of the way.
+    assert 0.0 < result.intervention_ratio < 0.95

@@ -2,16 +2,30 @@
 
 import numpy as np
 
+from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
 from pbp_drake.core.reach_task import heading_error
 from pbp_drake.systems.sampled_operator import SampledOperator
 
 PARTICIPANT_MODES = ("assist", "drive")
-# How far the HSR's hand stands in front of its base in the task's start pose (m).
-HAND_AHEAD_OF_BASE = 0.53
-# Within this distance of the target (m) the participant no longer steps around obstacles.
-FINAL_APPROACH = 0.3
-# How much closer the arm may pass an obstacle than the base (m).
-BASE_WIDER_THAN_ARM = 0.15
+# Within this distance of the target (m) the participant no longer minds obstacles...
+FINAL_APPROACH = 0.08
+# ...and within this one it pushes on through when no way round is left.
+PUSH_THROUGH = 0.3
+# The times (s) ahead at which it checks a motion, and how far ahead it guesses where a
+# moving obstacle will stop (it stops on the line from the hand to the target).
+PLAN_TIMES = np.array([0.1, 0.3, 0.6, 1.0, 1.5])
+SETTLE_TIME = 4.0
+DIRECTIONS = 24
+MAX_TURN_RATE = 0.5
+TURN_WEIGHT = 0.6
+KEEP_ON_WEIGHT = 0.15
+# It lets go once the policy's path is clear by RELEASE_FACTOR margins and the robot faces
+# the way it wants to (rad); it keeps control at least `hold_time`.
+RELEASE_FACTOR = 1.5
+RELEASE_HEADING_GAP = 0.05
+GOAL_MARGIN_FACTOR = 1.0
+# PBP-Cont: how much faster than `speed` it may push against the policy.
+POLICY_COMPENSATION = 3.0
 
 
 class VirtualParticipant(SampledOperator):
@@ -42,9 +56,14 @@ class VirtualParticipant(SampledOperator):
     scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
     is reproducible and the system keeps no state outside its Context.
 
-    With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` and, in every
-    mode, steps aside (and backs off when one is close) while an obstacle stands within
-    `obstacle_keep_out` of the path its robot will sweep, as people did in the paper.
+    With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (their velocities
+    from the positions it remembers in discrete state) and keeps the robot's footprint (base
+    disc and arm, `footprint_clearance`) `obstacle_margin` clear of them: each tick it scores
+    a fan of velocities and yaw rates over a short horizon (progress to the target, turning
+    toward a heading whose footprint fits at the target, clearance), and in PBP it lets go
+    whenever the DMP's path (pulled back to its start-target line) looks clear for a while.
+    In the last `FINAL_APPROACH` it no longer minds obstacles, and within `PUSH_THROUGH` it
+    pushes on when no clear way is left.
 
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
     `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the
@@ -54,7 +73,8 @@ class VirtualParticipant(SampledOperator):
     def __init__(self, control_period, objects, mode="assist", speed=0.2, rotation_speed=0.6,
                  reaction_delay=0.3, direction_noise=0.1, speed_noise=0.1, seed=0,
                  slow_radius=0.15, aligned_angle=0.05, obstacle_count=0,
-                 obstacle_keep_out=0.0, dodge_time=0.5):
+                 obstacle_keep_out=0.0, obstacle_radius=None, obstacle_margin=None,
+                 policy_adds=False, hold_time=0.5):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
@@ -73,13 +93,30 @@ class VirtualParticipant(SampledOperator):
         self._target_port = self.DeclareVectorInputPort("target", 4)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._obstacle_keep_out = float(obstacle_keep_out)
+        self._policy_adds = bool(policy_adds)
         self._obstacles_port = None
-        self._dodge_ticks = max(1, int(round(dodge_time / control_period)))
-        # [ticks of the current sidestep still to go, its direction (2)].
-        self._dodge_index = self.DeclareDiscreteState(np.zeros(3))
+        # The obstacles' radius (m); by default what the keep-out leaves after the margin
+        # the participant keeps from the robot's footprint.
+        # PBP-Alt lets the DMP pull the robot back to its line after each release, so the
+        # participant keeps a wider margin there; under PBP-Cont (and in teleop) a wider one
+        # only makes it fight the policy longer.
+        if obstacle_margin is None:
+            obstacle_margin = 0.08 if mode == "assist" and not policy_adds else 0.06
+        self._obstacle_margin = float(obstacle_margin)
+        self._release_heading_gap = (0.12 if mode == "assist" and not policy_adds
+                                     else RELEASE_HEADING_GAP)
+        self._obstacle_radius = float(
+            obstacle_radius if obstacle_radius is not None
+            else max(self._obstacle_keep_out - 0.32, 0.0))
+        # With an additive blend (PBP-Cont) the policy keeps moving under the operator's
+        # command; the participant then asks for the motion it wants minus the policy's.
+        self._hold_ticks = int(round(hold_time / control_period))
         if obstacle_count > 0:
             self._obstacles_port = self.DeclareVectorInputPort(
                 "obstacle_positions", 2 * int(obstacle_count))
+            # [seen (0/1), the hand's start (2), ticks it still keeps control,
+            #  the obstacles' positions at the last tick (2N)].
+            self._track_index = self.DeclareDiscreteState(np.zeros(4 + 2 * int(obstacle_count)))
         # What the participant believes: the target index it knows and how many ticks a
         # different target has been on screen.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
@@ -108,22 +145,10 @@ class VirtualParticipant(SampledOperator):
             if unseen_ticks > self._reaction_ticks:
                 known, unseen_ticks = shown, 0
         discrete_state.get_mutable_vector(self._belief_index).set_value([known, unseen_ticks])
-        dodge = None
         if self._obstacles_port is not None:
-            # A person commits to a sidestep for a moment rather than twitching each tick.
-            ticks_left, *direction = context.get_discrete_state(self._dodge_index).value()
-            if ticks_left > 0:
-                dodge, ticks_left = np.array(direction), ticks_left - 1
-            else:
-                ee_state = self._ee_state_port.Eval(context)
-                dodge = self._dodge(ee_state[:3], ee_state[6],
-                                    self._target_port.Eval(context)[:2],
-                                    self._obstacles_port.Eval(context).reshape(-1, 2))
-                if dodge is not None:
-                    ticks_left, direction = self._dodge_ticks - 1, dodge
-            discrete_state.get_mutable_vector(self._dodge_index).set_value(
-                [ticks_left, *direction])
-        command, active = self._decide(context, int(known), dodge)
+            command, active = self._avoid(context, discrete_state, int(known))
+        else:
+            command, active = self._decide(context, int(known))
         self._store_sample(discrete_state, command, active)
 
     def _aside_direction(self, position, heading, target, selected):
@@ -141,45 +166,132 @@ class VirtualParticipant(SampledOperator):
         direction = -np.sign(gap) * np.sign(closeness)
         return direction if direction != 0 else 1.0
 
-    def _dodge(self, position, heading, target_xy, obstacles):
-        """The unit direction that takes the robot off an obstacle's way, or None.
+    def _avoid(self, context, discrete_state, known_target):
+        """The command while obstacles are about: a local plan around them (see the class
+        docstring). Returns `(command, active)`."""
+        ee_state = self._ee_state_port.Eval(context)
+        hand, velocity, heading = ee_state[:2], ee_state[3:5], ee_state[6]
+        target = self._target_port.Eval(context)
+        target_xy = target[:2]
+        obstacles = self._obstacles_port.Eval(context).reshape(-1, 2)
+        track = np.array(context.get_discrete_state(self._track_index).value())
+        count = len(obstacles)
+        if track[0] < 0.5:
+            track[0], track[1:3], track[4:] = 1.0, hand, obstacles.reshape(-1)
+        start = track[1:3]
+        obstacle_velocity = (obstacles - track[4:].reshape(count, 2)) / self._period
+        hold = track[3]
+        track[3] = max(hold - 1.0, 0.0)
+        track[4:] = obstacles.reshape(-1)
+        held = self._held(context)
+        was_active = held[4] > 0.5
+        last_command = held[:2] if was_active else np.zeros(2)
 
-        The robot's footprint runs from its base (about 0.53 m behind the hand) to the
-        hand. An obstacle is in the way when its centre comes within `obstacle_keep_out` of
-        the path the base will sweep to the target; the participant then steps sideways,
-        away from it, and also backs off when the obstacle is already at the hand. Each
-        sidestep lasts `dodge_time` at least.
-        """
-        facing = np.array([np.cos(heading), np.sin(heading)])
-        base = position[:2] - HAND_AHEAD_OF_BASE * facing
-        path = target_xy - base
-        length = np.linalg.norm(path)
-        if length < 1e-9:
-            return None
-        along_unit = path / length
-        left = np.array([-along_unit[1], along_unit[0]])
-        relative = obstacles - base
-        along = relative @ along_unit
-        across = relative @ left
-        # On the last stretch people push on through.
-        if np.linalg.norm(target_xy - position[:2]) < FINAL_APPROACH:
-            return None
-        # The base stops short of the target by the hand's reach; beyond that only the
-        # thinner arm passes.
-        keep_out = np.where(along < length - HAND_AHEAD_OF_BASE, self._obstacle_keep_out,
-                            max(self._obstacle_keep_out - BASE_WIDER_THAN_ARM, 0.0))
-        ahead = (along > -self._obstacle_keep_out) & (along < length)
-        blocking = ahead & (np.abs(across) < keep_out)
-        if not np.any(blocking):
-            return None
-        nearest = np.flatnonzero(blocking)[np.argmin(along[blocking])]
-        side = -np.sign(across[nearest]) or 1.0
-        direction = side * left
-        if along[nearest] < HAND_AHEAD_OF_BASE + 0.5 * self._obstacle_keep_out:
-            direction = direction - 0.5 * along_unit
-        return direction / np.linalg.norm(direction)
+        def finish(command, active, hold_ticks=None):
+            if hold_ticks is not None:
+                track[3] = hold_ticks
+            discrete_state.get_mutable_vector(self._track_index).set_value(track)
+            return command, active
 
-    def _decide(self, context, known_target, dodge=None):
+        if known_target != int(target[3]):
+            return finish(np.zeros(4), False)
+        offset = target_xy - hand
+        distance = np.linalg.norm(offset)
+        rng = np.random.default_rng([self._seed, int(round(context.get_time() / self._period))])
+        noise_angle = rng.normal(0.0, self._direction_noise)
+        speed_scale = max(0.0, 1.0 + rng.normal(0.0, self._speed_noise))
+        drive = self._mode == "drive"
+        if distance < FINAL_APPROACH:
+            # The last few centimetres: straight on, whatever stands there.
+            if not drive:
+                return finish(np.zeros(4), False, 0.0)
+            speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
+            step = speed * _rotate(offset / max(distance, 1e-9), noise_angle)
+            return finish(np.array([step[0], step[1], 0.0, 0.0]), True)
+
+        predicted = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
+                                       PLAN_TIMES)
+        settled = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
+                                     np.array([SETTLE_TIME]))[0]
+        goal_heading = self._goal_heading(heading, target_xy, settled)
+        heading_gap = abs(_wrap(heading - goal_heading))
+        if not drive:
+            # Would the policy, left alone, keep the robot clear?
+            policy_clear = footprint_clearance(
+                policy_path(hand, start, target_xy, self._speed, PLAN_TIMES), heading,
+                predicted, self._obstacle_radius).min()
+            if was_active:
+                release = (hold <= 0 and heading_gap < self._release_heading_gap
+                           and policy_clear >= RELEASE_FACTOR * self._obstacle_margin)
+            else:
+                moving_clear = footprint_clearance(
+                    hand + velocity * PLAN_TIMES[:, None], heading, predicted,
+                    self._obstacle_radius).min()
+                release = (heading_gap < 2 * self._release_heading_gap
+                           and min(policy_clear, moving_clear) >= self._obstacle_margin)
+            if release:
+                return finish(np.zeros(4), False)
+
+        planned, yaw_rate, clear = self._plan(hand, heading, target_xy, predicted,
+                                              goal_heading, last_command)
+        if clear < 0.0 and distance < PUSH_THROUGH:
+            # Boxed in next to the target: on through it, as people did.
+            planned = self._speed * min(1.0, distance / self._slow_radius) * offset / distance
+            yaw_rate = 0.0
+        command = speed_scale * _rotate(planned, noise_angle)
+        if self._policy_adds:
+            # The policy's own motion: what the hand does minus what was asked of it.
+            policy_velocity = velocity - last_command
+            command = command - policy_velocity
+            norm = np.linalg.norm(command)
+            if norm > POLICY_COMPENSATION * self._speed:
+                command *= POLICY_COMPENSATION * self._speed / norm
+        hold_ticks = track[3] if was_active or drive else self._hold_ticks
+        return finish(np.array([command[0], command[1], 0.0, yaw_rate]), True, hold_ticks)
+
+    def _goal_heading(self, heading, target_xy, obstacles):
+        """The heading nearest the present one whose footprint, hand on the target, keeps
+        clear of where the obstacles will stand; the clearest one when none does."""
+        turns = np.deg2rad(np.arange(-180.0, 180.0, 15.0))
+        headings = heading + turns
+        clear = footprint_clearance(np.broadcast_to(target_xy, (len(turns), 2)), headings,
+                                    np.broadcast_to(obstacles, (len(turns),) + obstacles.shape),
+                                    self._obstacle_radius)
+        fine = clear >= GOAL_MARGIN_FACTOR * self._obstacle_margin
+        if np.any(fine):
+            return headings[fine][np.argmin(np.abs(turns[fine]))]
+        return headings[np.argmax(clear)]
+
+    def _plan(self, hand, heading, target_xy, predicted, goal_heading, last_command):
+        """The best velocity (2) and yaw rate over a short horizon, and its clearance."""
+        offset = target_xy - hand
+        distance = np.linalg.norm(offset)
+        toward = offset / max(distance, 1e-9)
+        speed = self._speed * min(1.0, max(distance, 0.02) / self._slow_radius)
+        angles = np.arctan2(toward[1], toward[0]) + np.linspace(0.0, 2 * np.pi, DIRECTIONS,
+                                                                endpoint=False)
+        directions = np.vstack([np.stack([np.cos(angles), np.sin(angles)], 1), [[0.0, 0.0]]])
+        yaw = min(self._rotation_speed, MAX_TURN_RATE)
+        velocities = np.repeat(speed * directions, 3, axis=0)
+        yaw_rates = np.tile([0.0, yaw, -yaw], len(directions))
+        hands = hand + velocities[:, None, :] * PLAN_TIMES[None, :, None]
+        headings = heading + yaw_rates[:, None] * PLAN_TIMES[None, :]
+        clear = footprint_clearance(hands, headings, predicted[None],
+                                    self._obstacle_radius).min(axis=1)
+        progress = velocities @ toward / self._speed
+        gap_now = abs(_wrap(heading - goal_heading))
+        gap_then = np.abs(_wrap(headings[:, -1] - goal_heading))
+        turning = (gap_now - gap_then) / (MAX_TURN_RATE * PLAN_TIMES[-1])
+        last_norm = np.linalg.norm(last_command)
+        keep_on = (velocities @ last_command / (self._speed * last_norm) if last_norm > 1e-9
+                   else np.zeros(len(velocities)))
+        shortfall = np.maximum(self._obstacle_margin - clear, 0.0)
+        score = (progress + TURN_WEIGHT * turning + KEEP_ON_WEIGHT * keep_on
+                 - 20.0 * shortfall - 5.0 * (shortfall > 0))
+        best = int(np.argmax(score))
+        return velocities[best], yaw_rates[best], clear[best]
+
+    def _decide(self, context, known_target):
         ee_state = self._ee_state_port.Eval(context)
         position, heading = ee_state[:3], ee_state[6]
         target = self._target_port.Eval(context)
@@ -191,13 +303,6 @@ class VirtualParticipant(SampledOperator):
         speed_scale = max(0.0, 1.0 + rng.normal(0.0, self._speed_noise))
         offset = target[:2] - position[:2]
         distance = np.linalg.norm(offset)
-        if dodge is not None:
-            if self._mode == "drive" and distance > 1e-9:
-                # Keep driving on, around the obstacle.
-                dodge = dodge + offset / distance
-                dodge /= np.linalg.norm(dodge)
-            velocity = self._speed * speed_scale * _rotate(dodge, noise_angle)
-            return np.array([velocity[0], velocity[1], 0.0, 0.0]), True
         if self._mode == "assist":
             selected = int(round(self._selected_goal_port.Eval(context)[0]))
             if selected == int(target[3]):
@@ -217,6 +322,10 @@ class VirtualParticipant(SampledOperator):
         if abs(angle) > self._aligned_angle:
             yaw_rate = np.sign(angle) * self._rotation_speed * min(1.0, abs(angle) / 0.3)
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
+
+
+def _wrap(angle):
+    return np.angle(np.exp(1j * np.asarray(angle)))
 
 
 def _apparent_angle(position, heading, point):

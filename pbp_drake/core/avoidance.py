@@ -1,0 +1,63 @@
+"""How the virtual participant sees obstacles around the HSR, in pure NumPy: the robot's
+footprint, where moving obstacles will stop, and where the DMP will take the hand."""
+
+import numpy as np
+
+# How far the HSR's hand stands in front of its base in the task's start pose (m).
+HAND_AHEAD_OF_BASE = 0.53
+# The footprint kept clear of obstacles: the base (and the body over it) as a disc, the arm
+# as a thick segment from the base to the hand (m).
+BASE_RADIUS = 0.25
+ARM_RADIUS = 0.08
+# How far ahead on its line the DMP aims when it pulls the hand back (m).
+POLICY_LOOKAHEAD = 0.25
+
+
+def footprint_clearance(hands, headings, obstacles, radius):
+    """The smallest gap (m) between the robot's footprint and cylinders of `radius`.
+
+    `hands` (..., 2) and `headings` (...) place the footprint: a disc of `BASE_RADIUS` at
+    `HAND_AHEAD_OF_BASE` behind the hand and the arm, a segment of `ARM_RADIUS` from there
+    to the hand. `obstacles` (..., N, 2) broadcast against them. Returns (...)."""
+    hands = np.asarray(hands, float)
+    headings = np.broadcast_to(headings, hands.shape[:-1])
+    arm = HAND_AHEAD_OF_BASE * np.stack([np.cos(headings), np.sin(headings)], axis=-1)
+    bases = hands - arm
+    relative = np.asarray(obstacles, float) - bases[..., None, :]
+    base_gap = np.linalg.norm(relative, axis=-1) - BASE_RADIUS
+    along = np.clip((relative * arm[..., None, :]).sum(-1) / HAND_AHEAD_OF_BASE ** 2, 0.0, 1.0)
+    arm_gap = np.linalg.norm(relative - along[..., None] * arm[..., None, :], axis=-1) - ARM_RADIUS
+    return np.minimum(base_gap, arm_gap).min(axis=-1) - radius
+
+
+def predict_obstacles(obstacles, velocities, hand, target_xy, times):
+    """Where the obstacles will be at `times` (T,): moving on until they reach the line
+    from the hand to the target, where they stop. Returns (T, N, 2)."""
+    line = target_xy - hand
+    length = np.linalg.norm(line)
+    normal = (np.array([-line[1], line[0]]) / length if length > 1e-9 else np.zeros(2))
+    side = (obstacles - hand) @ normal
+    closing = velocities @ normal
+    with np.errstate(divide="ignore", invalid="ignore"):
+        stop = np.where((side * closing < 0.0) & (np.abs(closing) > 1e-6),
+                        -side / closing, np.inf)
+    travel = np.minimum(np.asarray(times, float)[:, None], stop[None, :])
+    return obstacles[None] + travel[..., None] * velocities[None]
+
+
+def policy_path(hand, start, target_xy, speed, times):
+    """Roughly where the DMP takes the hand when let go: toward a point a little ahead on
+    its straight path from the start to the target (it pulls back to that line)."""
+    path = target_xy - start
+    length = np.linalg.norm(path)
+    unit = path / length if length > 1e-9 else np.zeros(2)
+    points, point, now = [], np.array(hand, float), 0.0
+    for time in times:
+        along = np.clip((point - start) @ unit + POLICY_LOOKAHEAD, 0.0, length)
+        aim = start + along * unit - point
+        gap = np.linalg.norm(aim)
+        step = min(gap, speed * (time - now))
+        point = point + (aim / gap * step if gap > 1e-9 else 0.0)
+        points.append(point)
+        now = time
+    return np.array(points)

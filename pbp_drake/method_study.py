@@ -35,7 +35,7 @@ import time
 
 import numpy as np
 
-from pbp_drake.scenarios import ScenarioError
+from pbp_drake.scenarios import ScenarioError, with_method
 
 TRIAL_FORMAT = 1
 # Collision-ratio histogram: 20 bins of 0.05 over [0, 1] (the last bin includes 1).
@@ -254,7 +254,7 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
     result = None
     warnings = _DrakeWarnings()
     try:
-        trial_scenario = dataclasses.replace(scenario, method=method, seed=seed)
+        trial_scenario = dataclasses.replace(with_method(scenario, method), seed=seed)
         record["objects"], record["targets"] = _scene_of(trial_scenario)
         result = run(trial_scenario)
         record.update(success=bool(result.success), task_time=_float(result.task_time),

@@ -577,15 +577,36 @@ def _validate_alpha_study(study, scenario):
         raise ScenarioError("the alpha study needs scenario.demonstration")
 
 
+def with_method(scenario, label):
+    """The scenario run by the method `label`: a name of METHODS, or `fixed_alpha=A` for
+    explicit arbitration with weight A (so that one study can sweep alpha)."""
+    name, _, alpha = label.partition("=")
+    if name not in METHODS:
+        raise ScenarioError(f"method {label!r} is unknown; choose from {METHODS} or "
+                            f"fixed_alpha=A{_close(name, METHODS)}")
+    if not alpha:
+        return dataclasses.replace(scenario, method=name)
+    if name != "fixed_alpha":
+        raise ScenarioError(f"method {label!r}: only fixed_alpha takes a weight (=A)")
+    try:
+        value = float(alpha)
+    except ValueError:
+        value = math.nan
+    if not (np.isfinite(value) and 0.0 <= value <= 1.0):
+        raise ScenarioError(f"method {label!r}: alpha must be a number in [0, 1]")
+    return dataclasses.replace(scenario, method=name, alpha=value)
+
+
 def validate_method_comparison(study, scenario):
     if not isinstance(scenario.robot, Hsr):
         raise ScenarioError("study !MethodComparison runs HSR tasks: use robot: !Hsr")
     if not study.methods:
         raise ScenarioError("study.methods is empty")
     for method in study.methods:
-        if method not in METHODS:
-            raise ScenarioError(f"study.methods has {method!r}, which is unknown; choose from "
-                                f"{METHODS}{_close(method, METHODS)}")
+        try:
+            with_method(scenario, method)
+        except ScenarioError as error:
+            raise ScenarioError(f"study.methods: {error}") from None
     if study.trials < 1:
         raise ScenarioError(f"study.trials must be at least 1, got {study.trials}")
     if isinstance(scenario.operator, (Keyboard, Gamepad)):

@@ -81,3 +81,14 @@ def test_cli_reports_bad_input_without_a_traceback(tmp_path, capsys, repo):
     bad = write(tmp_path, VALID.replace("speed:", "sped:"))
     assert main(["study", str(bad), "--output", str(tmp_path / "out")]) == 2
     assert "sped" in capsys.readouterr().err
+
+
+def test_a_method_label_can_carry_the_arbitration_weight():
+    from pbp_drake.scenarios import Scenario, with_method
+
+    assert with_method(Scenario(), "fixed_alpha=0.3").alpha == 0.3
+    assert with_method(Scenario(), "teleop").method == "teleop"
+    for bad, message in [("fixed_alpha=2", "in \\[0, 1\\]"), ("teleop=0.5", "only fixed_alpha"),
+                         ("fixed_alfa", "did you mean 'fixed_alpha'")]:
+        with pytest.raises(ScenarioError, match=message):
+            with_method(Scenario(), bad)

@@ -226,10 +226,10 @@ def read_trial(output, method, seed, digest=None):
 
 
 def _scene_of(scenario):
-    from pbp_drake.scenarios import reach_scene
+    from pbp_drake.scenarios import task_layout
 
-    scene = reach_scene(scenario)
-    return (np.asarray(scene.objects, float).tolist(), [int(t) for t in scene.targets])
+    layout = task_layout(scenario)
+    return (np.asarray(layout.objects, float).tolist(), [int(t) for t in layout.targets])
 
 
 def run_trial(scenario, method, trial, seed, output, digest, run=None):

@@ -76,3 +76,16 @@ def test_the_virtual_participant_steers_pbp_alt_around_the_obstacles(obstacle_ta
     assert result.collision_ratio == 0.0 and not result.in_collision.any()
     # It lets the DMP drive part of the way.
     assert 0.0 < result.intervention_ratio < 0.95
+
+
+def test_a_study_of_the_obstacle_task_records_collisions(tmp_path, repo):
+    from pbp_drake.cli import main
+
+    output = tmp_path / "study"
+    assert main(["study", str(repo / "diagrams" / "hsr_obstacles.yaml"), "--methods",
+                 "pbp_no_user", "--trials", "1", "--seed", "1", "--output", str(output)]) == 0
+    import json
+
+    entry = json.loads((output / "summary.json").read_text())["methods"]["pbp_no_user"]
+    assert entry["errors"] == 0 and entry["success_rate"] == 1.0
+    assert entry["collision_ratio"]["mean"] >= 0.2

@@ -26,6 +26,14 @@ def main(argv=None):
     run.add_argument("--operator", help="HSR tasks: who drives, one of "
                      f"{', '.join(OPERATOR_NAMES)} (keyboard and gamepad: in the browser)")
     run.add_argument("--seed", type=int, help="HSR tasks: the seed of the scene and the noise")
+    run.add_argument("--participant", metavar="ID",
+                     help="HSR tasks: a user-study session; every method of --methods once, "
+                     "in an order counterbalanced across participants, saved in the study "
+                     "format under --output (`pbp-drake report` reads it)")
+    run.add_argument("--methods", help="with --participant: the methods of the session "
+                     "(default: pbp_alternated,pbp_continuous,teleop)")
+    run.add_argument("--output", help="with --participant: the session's folder "
+                     "(default: outputs/participants/ID)")
     run.add_argument("--headless", action="store_true",
                      help="simulate as fast as possible without waiting for a browser")
     run.add_argument("--record", metavar="FILE.html",
@@ -169,11 +177,15 @@ def _run_task(args, scenario, meshcat):
     from pbp_drake.scenarios import Gamepad, Keyboard
     from pbp_drake.task_run import run_task
 
-    diagram = build_diagram(scenario, meshcat)
     person = isinstance(scenario.operator, (Keyboard, Gamepad))
     if args.headless and person:
         raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
                             "--operator virtual")
+    if args.participant is not None:
+        return _run_session(args, scenario, meshcat, person)
+    if args.methods is not None or args.output is not None:
+        raise ScenarioError("--methods and --output belong to a session: add --participant ID")
+    diagram = build_diagram(scenario, meshcat)
     if person or (not args.headless and sys.stdin.isatty()):
         # A person needs the page open before the task starts.
         print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
@@ -196,6 +208,50 @@ def _run_task(args, scenario, meshcat):
     if not args.headless and sys.stdin.isatty():
         input("Press Enter to quit (the page stays live until then). ")
     return 0 if result.success else 1
+
+
+def _run_session(args, scenario, meshcat, person):
+    from pbp_drake.builder import build_diagram
+    from pbp_drake.scenarios import with_method
+    from pbp_drake.task_run import run_task
+    from pbp_drake.user_study import DEFAULT_SESSION_METHODS, run_session, session_order
+
+    if args.record:
+        raise ScenarioError("--record saves one run; a session saves every run under --output")
+    methods = ([m.strip() for m in args.methods.split(",") if m.strip()] if args.methods
+               else list(DEFAULT_SESSION_METHODS))
+    for method in methods:
+        with_method(scenario, method)
+    try:
+        order = session_order(methods, args.participant)
+    except ValueError as error:
+        raise ScenarioError(f"--participant: {error}") from None
+    output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
+                                                       args.participant))
+    print(f"Participant {args.participant}: {', '.join(order)}, in this order; saved in "
+          f"{output}", flush=True)
+    if person:
+        print(f"Open {meshcat.web_url()} in a browser (waiting up to "
+              f"{args.wait_for_browser:.0f} s).", flush=True)
+        _wait_for_browser(meshcat, args.wait_for_browser)
+
+    def run_one(trial_scenario):
+        diagram = build_diagram(trial_scenario, meshcat)
+        print(f"Next: {trial_scenario.method}.", flush=True)
+        if person and sys.stdin.isatty():
+            input("Press Enter to start. ")
+        result = run_task(trial_scenario, realtime_rate=0.0 if args.headless else
+                          args.realtime_rate, diagram=diagram)
+        operator = diagram.GetSubsystemByName("operator")
+        if hasattr(operator, "Delete"):
+            operator.Delete()  # the next method may want other keys
+        print(f"  {trial_scenario.method}: {result.summary_line()}", flush=True)
+        return result
+
+    summary = run_session(scenario, args.participant, methods, output, run_one)
+    failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
+    print(f"Session saved in {output} (`pbp-drake report {output}` rebuilds its tables).")
+    return 1 if failed else 0
 
 
 def _wait_for_browser(meshcat, seconds):

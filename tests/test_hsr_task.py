@@ -174,3 +174,30 @@ def test_a_person_cannot_drive_a_headless_run(tmp_path, capsys):
     assert main(["run", str(write(tmp_path, FIXED_TASK)), "--operator", "keyboard",
                  "--headless"]) == 2
     assert "--operator virtual" in capsys.readouterr().err
+
+
+def test_a_participant_session_runs_every_method_in_a_counterbalanced_order(tmp_path):
+    from pbp_drake.user_study import session_order
+
+    methods = ["pbp_alternated", "pbp_continuous", "teleop"]
+    orders = [session_order(methods, f"P{number}") for number in range(3)]
+    # A cyclic Latin square: each method once in each place over three participants.
+    for place in range(3):
+        assert sorted(order[place] for order in orders) == sorted(methods)
+
+    path = write(tmp_path, FIXED_TASK)
+    output = tmp_path / "P1"
+    assert main(["run", str(path), "--operator", "virtual", "--headless", "--participant",
+                 "P1", "--methods", "pbp_alternated,teleop", "--output", str(output)]) == 0
+    study = json.loads((output / "study.json").read_text())
+    assert study["methods"] == ["teleop", "pbp_alternated"]
+    summary = json.loads((output / "summary.json").read_text())
+    assert summary["methods"]["teleop"]["success_rate"] == 1.0
+    assert main(["report", str(output)]) == 0
+
+
+def test_a_session_needs_a_participant_id(tmp_path, capsys):
+    path = write(tmp_path, FIXED_TASK)
+    assert main(["run", str(path), "--operator", "virtual", "--headless",
+                 "--methods", "teleop"]) == 2
+    assert "--participant" in capsys.readouterr().err

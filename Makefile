@@ -22,35 +22,30 @@ demo: $(STAMP)
 		--method pbp_alternated --headless --record $(DEMO_DIR)/replay.html
 	@echo "Open $(DEMO_DIR)/hsr_reach.html in a browser to replay the HSR task."
 
-# The headless browser tests drive Debian's `chromium` (never a browser download, never
-# `playwright install`): install it when it is missing and apt-get is usable as root;
-# otherwise say so and go on (those tests skip). Under CI a failed install is an error.
-chromium:
-	@if command -v chromium >/dev/null 2>&1; then :; \
+# $(call debian_tool,COMMAND,PACKAGE,PURPOSE): some tests need a Debian program (never a
+# download of its own): install PACKAGE when COMMAND is missing and apt-get is usable as
+# root; otherwise say so and go on (those tests skip). Under CI a failed install is an error.
+define debian_tool
+	@if command -v $(1) >/dev/null 2>&1; then :; \
 	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
-		echo "Installing Debian's chromium for the browser tests"; \
+		echo "Installing Debian's $(2) for $(3)"; \
 		{ apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
-			apt-get install -y -qq chromium >/dev/null; } </dev/null \
-		|| { echo "note: installing chromium failed (an error under CI; elsewhere the browser tests skip)"; \
+			apt-get install -y -qq $(2) >/dev/null; } </dev/null \
+		|| { echo "note: installing $(2) failed (an error under CI; elsewhere $(3) skip)"; \
 		     [ -z "$${CI:-}" ]; }; \
 	else \
-		echo "note: chromium is missing (installing it needs root and apt-get); the browser tests will skip"; \
+		echo "note: $(1) is missing (installing it needs root and apt-get); $(3) will skip"; \
 	fi
+endef
 
-# Graphviz's `dot` (Debian's `graphviz`) draws the system diagrams (`pbp-drake draw`): the
-# tests compare the drawings in diagrams/ with what it draws now. Installed like chromium;
-# without it those tests skip.
+# The headless browser tests drive Debian's `chromium` (never `playwright install`).
+chromium:
+	$(call debian_tool,chromium,chromium,the browser tests)
+
+# Graphviz's `dot` draws the system diagrams (`pbp-drake draw`): the tests compare the
+# drawings in diagrams/ with what it draws now.
 graphviz:
-	@if command -v dot >/dev/null 2>&1; then :; \
-	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
-		echo "Installing Debian's graphviz for the diagram drawings"; \
-		{ apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
-			apt-get install -y -qq graphviz >/dev/null; } </dev/null \
-		|| { echo "note: installing graphviz failed (an error under CI; elsewhere the drawing tests skip)"; \
-		     [ -z "$${CI:-}" ]; }; \
-	else \
-		echo "note: graphviz is missing (installing it needs root and apt-get); the drawing tests will skip"; \
-	fi
+	$(call debian_tool,dot,graphviz,the drawing tests)
 
 test: $(STAMP) chromium graphviz
 	$(PYTHON) -m pytest

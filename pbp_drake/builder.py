@@ -198,7 +198,8 @@ def _build_hsr_diagram(scenario, meshcat):
     builder = DiagramBuilder()
 
     station = add_hsr_station(builder, time_step=scenario.robot.time_step, meshcat=meshcat,
-                              ee_height=task.height, command_period=period)
+                              ee_height=task.height, command_period=period,
+                              diff_ik_time_step=scenario.robot.diff_ik_time_step)
     start = station.initial_ee_state[:3]
     ee_state = station.ee_state
     sample = builder.AddNamedSystem("ee_state_sample",

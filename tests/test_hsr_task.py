@@ -149,6 +149,7 @@ def test_study_compares_methods_on_the_same_scenes(tmp_path, capsys):
     (("[1.6, 0.5, 0.7]", "[1.6, 0.5, 2.5]"), "out of the HSR's reach"),
     (("method: pbp_alternated", "method: pbp_alternatd"), "did you mean 'pbp_alternated'"),
     (("!VirtualParticipant {}", "!Virtual {}"), "Virtual"),
+    (("robot: !Hsr {}", "robot: !Hsr {diff_ik_time_step: 0.007}"), "whole multiple"),
 ])
 def test_bad_task_input_names_the_problem(tmp_path, change, message):
     path = write(tmp_path, FIXED_TASK.replace(*change))

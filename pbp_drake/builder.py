@@ -226,8 +226,7 @@ def _build_hsr_diagram(scenario, meshcat):
                                    monitor, offset)
 
     operator = builder.AddNamedSystem("operator", make_hsr_operator(
-        scenario, meshcat, layout.objects,
-        obstacles.radius + scenario.task.obstacle_clearance if obstacles else 0.0))
+        scenario, meshcat, layout.objects, obstacles is not None))
     for port_name, source in [("ee_state", ee_state),
                               ("target", monitor.get_target_output_port()),
                               ("selected_goal", estimator.get_selected_goal_output_port()),
@@ -341,11 +340,9 @@ def _add_obstacles(builder, scenario, station, obstacle_scene, sample, monitor, 
     return obstacles
 
 
-def make_hsr_operator(scenario, meshcat, objects, obstacle_keep_out=0.0):
-    """The HSR task's operator: a person at the keyboard or gamepad, or the virtual one.
-
-    `obstacle_keep_out` (m) is how far the virtual participant keeps the robot's footprint
-    from an obstacle's centre; 0 without obstacles."""
+def make_hsr_operator(scenario, meshcat, objects, with_obstacles=False):
+    """The HSR task's operator: a person at the keyboard or gamepad, or the virtual one
+    (which, `with_obstacles`, watches the task's obstacles)."""
     config = scenario.operator
     period = scenario.control_period
     allow_forward = scenario.method == "teleop"
@@ -359,10 +356,9 @@ def make_hsr_operator(scenario, meshcat, objects, obstacle_keep_out=0.0):
             period, objects, mode="drive" if allow_forward else "assist", speed=speed,
             rotation_speed=config.rotation_speed, reaction_delay=config.reaction_delay,
             direction_noise=config.direction_noise, speed_noise=config.speed_noise,
-            seed=scenario.seed, obstacle_count=(
-                scenario.task.obstacle_count if obstacle_keep_out else 0),
-            obstacle_keep_out=obstacle_keep_out,
-            obstacle_radius=getattr(scenario.task, "obstacle_radius", None),
+            seed=scenario.seed,
+            obstacle_count=scenario.task.obstacle_count if with_obstacles else 0,
+            obstacle_radius=scenario.task.obstacle_radius if with_obstacles else 0.0,
             policy_adds=scenario.method == "pbp_continuous")
     if meshcat is None:
         raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "

@@ -201,9 +201,6 @@ class DynamicObstacles:
     obstacle_radius: float = 0.12
     obstacle_height: float = 1.2
     obstacle_speed: float = 0.15
-    # How far from an obstacle's surface the virtual participant keeps the robot's
-    # centre line (the base is 0.23 m in radius).
-    obstacle_clearance: float = 0.32
     obstacle_x_range: list[float] = dataclasses.field(default_factory=lambda: [0.9, 2.6])
     obstacle_y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.3, 1.3])
     activation_range: list[float] = dataclasses.field(default_factory=lambda: [0.05, 0.5])

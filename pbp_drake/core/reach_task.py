@@ -85,7 +85,19 @@ def reach_progress(position, start, target):
     return float(np.clip(1.0 - np.linalg.norm(np.asarray(target) - position) / total, 0.0, 1.0))
 
 
+def wrap_angle(angle):
+    """Angles (rad) brought into (-pi, pi]."""
+    return np.angle(np.exp(1j * np.asarray(angle)))
+
+
 def heading_error(heading, position, point):
     """Signed angle (rad, in (-pi, pi]) from `heading` to the floor direction to `point`."""
     direction = np.arctan2(point[1] - position[1], point[0] - position[0])
-    return float(np.angle(np.exp(1j * (direction - heading))))
+    return float(wrap_angle(direction - heading))
+
+
+def rotate_planar(vector, angle):
+    """The floor vector `(x, y)` turned by `angle` (rad): with the robot's heading, a
+    robot-frame `(forward, left)` in the world frame."""
+    cos, sin = np.cos(angle), np.sin(angle)
+    return np.array([cos * vector[0] - sin * vector[1], sin * vector[0] + cos * vector[1]])

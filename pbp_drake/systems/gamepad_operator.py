@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from pbp_drake.core.reach_task import rotate_planar
 from pbp_drake.systems.sampled_operator import SampledOperator
 
 # Standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN.
@@ -66,10 +67,7 @@ class GamepadOperator(SampledOperator):
         if not self._allow_forward:
             stick[0] = min(stick[0], 0.0)
         active = bool(np.any(stick != 0) or turn != 0)
-        local = self._speed * stick
-        heading = self._ee_state_port.Eval(context)[6]
-        cos, sin = np.cos(heading), np.sin(heading)
-        velocity = np.array([cos * local[0] - sin * local[1], sin * local[0] + cos * local[1]])
+        velocity = rotate_planar(self._speed * stick, self._ee_state_port.Eval(context)[6])
         return np.array([velocity[0], velocity[1], 0.0, self._rotation_speed * turn]), active
 
     def _apply_dead_zone(self, stick):

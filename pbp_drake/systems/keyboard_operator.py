@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from pbp_drake.core.reach_task import rotate_planar
 from pbp_drake.systems.sampled_operator import SampledOperator
 
 FORWARD_BUTTON = "Forward (↑)"
@@ -116,10 +117,6 @@ class KeyboardOperator(SampledOperator):
         discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
         self._store_sample(discrete_state, *self._command(context, keys))
 
-    def _sample(self, context):
-        # Not called by the periodic update (overridden above); what a tick would sample now.
-        return self._command(context, self._next_keys(context, self._clicks()))
-
     def _next_keys(self, context, clicks):
         n = len(self._buttons)
         keys = context.get_discrete_state(self._keys_index).value()
@@ -137,8 +134,6 @@ class KeyboardOperator(SampledOperator):
         norm = np.linalg.norm(local)
         if norm > 0:
             local *= self._speed / norm  # e.g. ↑ with ← goes diagonally at `speed`
-        heading = self._ee_state_port.Eval(context)[6]
-        cos, sin = np.cos(heading), np.sin(heading)
-        velocity = np.array([cos * local[0] - sin * local[1], sin * local[0] + cos * local[1]])
+        velocity = rotate_planar(local, self._ee_state_port.Eval(context)[6])
         yaw_rate = self._rotation_speed * yaw
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), bool(held.any())

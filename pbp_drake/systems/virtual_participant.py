@@ -3,7 +3,7 @@
 import numpy as np
 
 from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
-from pbp_drake.core.reach_task import heading_error
+from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
 from pbp_drake.systems.sampled_operator import SampledOperator
 
 PARTICIPANT_MODES = ("assist", "drive")
@@ -48,15 +48,17 @@ class VirtualParticipant(SampledOperator):
     sidesteps toward it; otherwise it lets go. It never pushes forward, as in the paper
     where the forward key is disabled. Facing the target while the estimate is still another
     object (the two almost in line), it steps aside, to the side that widens the angle
-    between them, to tell them apart; it sees all the `objects` (M, 3). `mode="drive"` (teleoperation): it drives the whole
-    way, toward the target at `speed` (slowing within `slow_radius`), turning to face it.
+    between them, to tell them apart; it sees all the `objects` (M, 3). `mode="drive"`
+    (teleoperation): it drives the whole way, toward the target at `speed` (slowing within
+    `slow_radius`), turning to face it.
 
     It notices a new target only `reaction_delay` seconds after it appears, and its
     commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
     scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
     is reproducible and the system keeps no state outside its Context.
 
-    With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (their velocities
+    With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (cylinders of
+    `obstacle_radius`; their velocities
     from the positions it remembers in discrete state) and keeps the robot's footprint (base
     disc and arm, `footprint_clearance`) `obstacle_margin` clear of them: each tick it scores
     a fan of velocities and yaw rates over a short horizon (progress to the target, turning
@@ -66,14 +68,14 @@ class VirtualParticipant(SampledOperator):
     pushes on when no clear way is left.
 
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
-    `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the
-    world frame (vz = 0).
+    `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is
+    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0).
     """
 
     def __init__(self, control_period, objects, mode="assist", speed=0.2, rotation_speed=0.6,
                  reaction_delay=0.3, direction_noise=0.1, speed_noise=0.1, seed=0,
                  slow_radius=0.15, aligned_angle=0.05, obstacle_count=0,
-                 obstacle_keep_out=0.0, obstacle_radius=None, obstacle_margin=None,
+                 obstacle_radius=0.0, obstacle_margin=None,
                  policy_adds=False, hold_time=0.5):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
@@ -92,11 +94,14 @@ class VirtualParticipant(SampledOperator):
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
         self._target_port = self.DeclareVectorInputPort("target", 4)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
-        self._obstacle_keep_out = float(obstacle_keep_out)
+        # With an additive blend (PBP-Cont) the policy keeps moving under the operator's
+        # command; the participant then asks for the motion it wants minus the policy's.
         self._policy_adds = bool(policy_adds)
         self._obstacles_port = None
-        # The obstacles' radius (m); by default what the keep-out leaves after the margin
-        # the participant keeps from the robot's footprint.
+        if obstacle_count > 0 and not obstacle_radius > 0:
+            raise ValueError(f"obstacle_radius must be positive with obstacles, got "
+                             f"{obstacle_radius}")
+        self._obstacle_radius = float(obstacle_radius)
         # PBP-Alt lets the DMP pull the robot back to its line after each release, so the
         # participant keeps a wider margin there; under PBP-Cont (and in teleop) a wider one
         # only makes it fight the policy longer.
@@ -105,11 +110,6 @@ class VirtualParticipant(SampledOperator):
         self._obstacle_margin = float(obstacle_margin)
         self._release_heading_gap = (0.12 if mode == "assist" and not policy_adds
                                      else RELEASE_HEADING_GAP)
-        self._obstacle_radius = float(
-            obstacle_radius if obstacle_radius is not None
-            else max(self._obstacle_keep_out - 0.32, 0.0))
-        # With an additive blend (PBP-Cont) the policy keeps moving under the operator's
-        # command; the participant then asks for the motion it wants minus the policy's.
         self._hold_ticks = int(round(hold_time / control_period))
         if obstacle_count > 0:
             self._obstacles_port = self.DeclareVectorInputPort(
@@ -151,6 +151,12 @@ class VirtualParticipant(SampledOperator):
             command, active = self._decide(context, int(known))
         self._store_sample(discrete_state, command, active)
 
+    def _noise(self, context):
+        """This tick's direction error (rad) and speed factor, drawn from `(seed, tick)`."""
+        rng = np.random.default_rng([self._seed, int(round(context.get_time() / self._period))])
+        return (rng.normal(0.0, self._direction_noise),
+                max(0.0, 1.0 + rng.normal(0.0, self._speed_noise)))
+
     def _aside_direction(self, position, heading, target, selected):
         """+1 (left) or -1: the sidestep that widens the angle between the target and the
         object picked instead, when the two stand almost in line.
@@ -159,8 +165,8 @@ class VirtualParticipant(SampledOperator):
         `angle(picked) - angle(target)` changes by `-d (1 / r_picked - 1 / r_target)`.
         """
         picked = self._objects[selected]
-        gap = (_apparent_angle(position, heading, picked)
-               - _apparent_angle(position, heading, target[:3]))
+        gap = (heading_error(heading, position, picked)
+               - heading_error(heading, position, target[:3]))
         closeness = (1.0 / max(np.linalg.norm(picked[:2] - position[:2]), 1e-6)
                      - 1.0 / max(np.linalg.norm(target[:2] - position[:2]), 1e-6))
         direction = -np.sign(gap) * np.sign(closeness)
@@ -197,16 +203,14 @@ class VirtualParticipant(SampledOperator):
             return finish(np.zeros(4), False)
         offset = target_xy - hand
         distance = np.linalg.norm(offset)
-        rng = np.random.default_rng([self._seed, int(round(context.get_time() / self._period))])
-        noise_angle = rng.normal(0.0, self._direction_noise)
-        speed_scale = max(0.0, 1.0 + rng.normal(0.0, self._speed_noise))
+        noise_angle, speed_scale = self._noise(context)
         drive = self._mode == "drive"
         if distance < FINAL_APPROACH:
             # The last few centimetres: straight on, whatever stands there.
             if not drive:
                 return finish(np.zeros(4), False, 0.0)
             speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
-            step = speed * _rotate(offset / max(distance, 1e-9), noise_angle)
+            step = speed * rotate_planar(offset / max(distance, 1e-9), noise_angle)
             return finish(np.array([step[0], step[1], 0.0, 0.0]), True)
 
         predicted = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
@@ -214,7 +218,7 @@ class VirtualParticipant(SampledOperator):
         settled = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
                                      np.array([SETTLE_TIME]))[0]
         goal_heading = self._goal_heading(heading, target_xy, settled)
-        heading_gap = abs(_wrap(heading - goal_heading))
+        heading_gap = abs(wrap_angle(heading - goal_heading))
         if not drive:
             # Would the policy, left alone, keep the robot clear?
             policy_clear = footprint_clearance(
@@ -238,7 +242,7 @@ class VirtualParticipant(SampledOperator):
             # Boxed in next to the target: on through it, as people did.
             planned = self._speed * min(1.0, distance / self._slow_radius) * offset / distance
             yaw_rate = 0.0
-        command = speed_scale * _rotate(planned, noise_angle)
+        command = speed_scale * rotate_planar(planned, noise_angle)
         if self._policy_adds:
             # The policy's own motion: what the hand does minus what was asked of it.
             policy_velocity = velocity - last_command
@@ -279,8 +283,8 @@ class VirtualParticipant(SampledOperator):
         clear = footprint_clearance(hands, headings, predicted[None],
                                     self._obstacle_radius).min(axis=1)
         progress = velocities @ toward / self._speed
-        gap_now = abs(_wrap(heading - goal_heading))
-        gap_then = np.abs(_wrap(headings[:, -1] - goal_heading))
+        gap_now = abs(wrap_angle(heading - goal_heading))
+        gap_then = np.abs(wrap_angle(headings[:, -1] - goal_heading))
         turning = (gap_now - gap_then) / (MAX_TURN_RATE * PLAN_TIMES[-1])
         last_norm = np.linalg.norm(last_command)
         keep_on = (velocities @ last_command / (self._speed * last_norm) if last_norm > 1e-9
@@ -298,9 +302,7 @@ class VirtualParticipant(SampledOperator):
         if known_target != int(target[3]):
             return np.zeros(4), False  # has not noticed the new target yet
         angle = heading_error(heading, position, target[:3])
-        rng = np.random.default_rng([self._seed, int(round(context.get_time() / self._period))])
-        noise_angle = rng.normal(0.0, self._direction_noise)
-        speed_scale = max(0.0, 1.0 + rng.normal(0.0, self._speed_noise))
+        noise_angle, speed_scale = self._noise(context)
         offset = target[:2] - position[:2]
         distance = np.linalg.norm(offset)
         if self._mode == "assist":
@@ -312,26 +314,14 @@ class VirtualParticipant(SampledOperator):
             lateral = (offset / max(distance, 1e-9)) @ left
             if abs(angle) <= 2 * self._aligned_angle:
                 lateral = 0.5 * self._aside_direction(position, heading, target, selected)
-            velocity = self._speed * speed_scale * lateral * _rotate(left, noise_angle)
+            velocity = self._speed * speed_scale * lateral * rotate_planar(left, noise_angle)
         else:
             if distance < 1e-9:
                 return np.zeros(4), False
             speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
-            velocity = speed * _rotate(offset / distance, noise_angle)
+            velocity = speed * rotate_planar(offset / distance, noise_angle)
         yaw_rate = 0.0
         if abs(angle) > self._aligned_angle:
             yaw_rate = np.sign(angle) * self._rotation_speed * min(1.0, abs(angle) / 0.3)
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
 
-
-def _wrap(angle):
-    return np.angle(np.exp(1j * np.asarray(angle)))
-
-
-def _apparent_angle(position, heading, point):
-    return heading_error(heading, position, point)
-
-
-def _rotate(vector, angle):
-    cos, sin = np.cos(angle), np.sin(angle)
-    return np.array([cos * vector[0] - sin * vector[1], sin * vector[0] + cos * vector[1]])

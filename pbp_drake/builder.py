@@ -173,8 +173,8 @@ HSR_PREDICTION_SAMPLES = 40
 def _build_hsr_diagram(scenario, meshcat):
     """The HSR reaching task (section IV-B.1 of the paper):
 
-        station.ee_state ──> ee_state_sample (ZeroOrderHold) ──> dmp_bank, goal_estimator,
-                                                                 task_monitor, blender
+        station.ee_state ──> ee_state_sample (SampleHold) ──> dmp_bank, goal_estimator,
+                                                              task_monitor, blender
         station.ee_state, task_monitor.target, goal_estimator ──> operator
         operator.operator_command [vx, vy, vz, yaw_rate] ──> blender (v), heading_command
         blender.command [p, v] + heading ──> station.ee_command (whole-body differential IK)

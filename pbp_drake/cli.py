@@ -218,8 +218,7 @@ def _run_session(args, scenario, meshcat, person):
 
     if args.record:
         raise ScenarioError("--record saves one run; a session saves every run under --output")
-    methods = ([m.strip() for m in args.methods.split(",") if m.strip()] if args.methods
-               else list(DEFAULT_SESSION_METHODS))
+    methods = _method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
     for method in methods:
         with_method(scenario, method)
     try:
@@ -252,6 +251,11 @@ def _run_session(args, scenario, meshcat, person):
     failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
     print(f"Session saved in {output} (`pbp-drake report {output}` rebuilds its tables).")
     return 1 if failed else 0
+
+
+def _method_list(text):
+    """`--methods a,b,c` as a list."""
+    return [method.strip() for method in text.split(",") if method.strip()]
 
 
 def _wait_for_browser(meshcat, seconds):
@@ -304,8 +308,7 @@ def _method_study(args, scenario_file):
     if not isinstance(study, MethodComparison):
         raise ScenarioError(f"{args.scenario}: HSR tasks take study: !MethodComparison")
     if args.methods is not None:
-        study = dataclasses.replace(study, methods=[m.strip() for m in args.methods.split(",")
-                                                    if m.strip()])
+        study = dataclasses.replace(study, methods=_method_list(args.methods))
     if args.trials is not None:
         study = dataclasses.replace(study, trials=args.trials)
     if args.seed is not None:

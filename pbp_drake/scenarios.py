@@ -481,12 +481,10 @@ class TaskLayout:
 def task_layout(scenario):
     """The goals, targets and obstacles of an HSR task, drawn from the seed when asked."""
     from pbp_drake.core.obstacle_task import sample_obstacle_scene
-    from pbp_drake.core.reach_task import validate_objects
 
     task = scenario.task
     if isinstance(task, DynamicObstacles):
-        corners = [[x, y, task.height] for x in task.x_range for y in task.y_range]
-        validate_objects(corners, 0.0)
+        _validate_region(task)
         obstacles = sample_obstacle_scene(
             scenario.seed, tuple(task.x_range), tuple(task.y_range), task.height,
             task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
@@ -521,14 +519,19 @@ def reach_scene(scenario):
         return ReachScene(objects=objects, targets=targets)
     if task.targets:
         raise ValueError("targets are given without objects")
-    corners = [[x, y, task.height] for x in task.x_range for y in task.y_range]
+    _validate_region(task)
+    return sample_reach_scene(scenario.seed, tuple(task.object_count), tuple(task.x_range),
+                              tuple(task.y_range), task.height, tuple(task.switch_schedule),
+                              task.min_separation)
+
+
+def _validate_region(task):
+    """Every corner of the region the task draws its targets from must be in reach."""
+    from pbp_drake.core.reach_task import validate_objects
+
     if len(task.x_range) != 2 or len(task.y_range) != 2:
         raise ValueError("x_range and y_range must be [low, high]")
-    validate_objects(corners, 0.0)
-    scene = sample_reach_scene(scenario.seed, tuple(task.object_count), tuple(task.x_range),
-                               tuple(task.y_range), task.height,
-                               tuple(task.switch_schedule), task.min_separation)
-    return scene
+    validate_objects([[x, y, task.height] for x in task.x_range for y in task.y_range], 0.0)
 
 
 def goal_estimator_settings(options):

@@ -41,23 +41,28 @@ def simulate(scenario, meshcat=None, realtime_rate=0.0, diagram=None):
     return read_trajectory(diagram, simulator.get_context(), ticks + 1)
 
 
-def read_trajectory(diagram, context, tick_count):
-    """The first `tick_count` ticks of the loggers the builder adds.
+def read_log(diagram, context, name, tick_count, shift=0):
+    """Tick times `(T,)` and samples `(T, n)` of the first `tick_count` ticks of the logger
+    `name`, or (None, None) when the diagram has none.
 
     Drake dispatches the publish events of an instant (the loggers) before its discrete
-    updates, so a logger at `t_k` sees the robot state at `t_k` and the phase tick k steps
-    with, but the operator's and blender's outputs of tick k - 1: those are read one sample
-    later, and the simulation must run one tick past the last one read.
+    updates, so a logger at `t_k` sees the plant's state at `t_k` but the decisions of tick
+    k - 1 (operator, blender, estimator): read those with `shift=1`, one sample later, from
+    a simulation run one tick past the last tick read.
     """
+    if not diagram.HasSubsystemNamed(name):
+        return None, None
+    found = diagram.GetSubsystemByName(name).FindLog(context)
+    if found.num_samples() < tick_count + shift:
+        raise ValueError(f"{name} has {found.num_samples()} samples; "
+                         f"{tick_count + shift} are needed")
+    return found.sample_times()[:tick_count], found.data().T[shift:shift + tick_count]
+
+
+def read_trajectory(diagram, context, tick_count):
+    """The first `tick_count` ticks of the loggers the builder adds (see `read_log`)."""
     def log(name, shift=0):
-        if not diagram.HasSubsystemNamed(name):
-            return None, None
-        found = diagram.GetSubsystemByName(name).FindLog(context)
-        if found.num_samples() < tick_count + shift:
-            raise ValueError(f"{name} has {found.num_samples()} samples; "
-                             f"{tick_count + shift} are needed")
-        window = slice(shift, shift + tick_count)
-        return found.sample_times()[:tick_count], found.data().T[window]
+        return read_log(diagram, context, name, tick_count, shift)
 
     times, state = log("robot_state_log")
     dimension = state.shape[1] // 2

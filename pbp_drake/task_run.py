@@ -7,6 +7,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
 from pbp_drake.builder import build_diagram
+from pbp_drake.simulation import read_log
 from pbp_drake.systems.task_monitor import (
     COLLISION_RATIO, INTERVENTION_RATIO, STAGE, SUCCESS, TASK_TIME)
 
@@ -76,25 +77,21 @@ def run_task(scenario, meshcat=None, realtime_rate=0.0, diagram=None):
 
 
 def _read_result(diagram, context, status, monitor):
-    def log(name):
-        return diagram.GetSubsystemByName(name).FindLog(context)
-
-    # Loggers publish before the discrete updates of their instant: at t_k they see the
-    # plant's state at t_k but the decisions of tick k - 1 (see simulation.read_trajectory).
-    ee_log = log("ee_state_log")
-    tick_count = ee_log.num_samples() - 1
+    # The last sample holds only the decisions of the tick before it (see read_log).
+    tick_count = diagram.GetSubsystemByName("ee_state_log").FindLog(context).num_samples() - 1
 
     def decisions(name):
-        return log(name).data().T[1:tick_count + 1]
+        return read_log(diagram, context, name, tick_count, shift=1)[1]
 
-    ee_state = ee_log.data().T[:tick_count]
-    success = bool(status[SUCCESS] > 0.5)
+    times, ee_state = read_log(diagram, context, "ee_state_log", tick_count)
+    # Measured on the plant's state, like ee_state: not shifted.
+    in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
     return TaskResult(
-        success=success,
+        success=bool(status[SUCCESS] > 0.5),
         task_time=float(status[TASK_TIME]),
         intervention_ratio=float(status[INTERVENTION_RATIO]),
         switches=int(status[STAGE]),
-        times=ee_log.sample_times()[:tick_count],
+        times=times,
         ee_positions=ee_state[:, :3],
         headings=ee_state[:, 6],
         commands=decisions("command_log"),
@@ -104,7 +101,5 @@ def _read_result(diagram, context, status, monitor):
         targets=decisions("target_log")[:, 3].astype(int),
         objects=monitor.objects.copy(),
         collision_ratio=float(status[COLLISION_RATIO]),
-        # Measured on the plant's state, like ee_state: not shifted.
-        in_collision=(log("in_collision_log").data()[0, :tick_count] > 0.5
-                      if diagram.HasSubsystemNamed("in_collision_log") else None),
+        in_collision=None if in_collision is None else in_collision[:, 0] > 0.5,
     )

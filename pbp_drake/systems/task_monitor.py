@@ -51,6 +51,8 @@ class TaskMonitor(LeafSystem):
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._in_collision_port = self.DeclareVectorInputPort("in_collision", 1)
         self._status_index = self.DeclareDiscreteState(len(TASK_STATUS_FIELDS))
+        # Steps with operator input and steps in collision.
+        self._counts_index = self.DeclareDiscreteState(2)
         self._target_port = self.DeclareVectorOutputPort(
             "target", 4, self._calc_target,
             prerequisites_of_calc={self.discrete_state_ticket(self._status_index)})
@@ -76,9 +78,6 @@ class TaskMonitor(LeafSystem):
     def objects(self):
         return self._objects
 
-    def target_index(self, stage):
-        return self._targets[int(stage)]
-
     def _calc_target(self, context, output):
         stage = int(context.get_discrete_state(self._status_index).value()[STAGE])
         index = self._targets[stage]
@@ -90,13 +89,13 @@ class TaskMonitor(LeafSystem):
             return
         position = self._ee_state_port.Eval(context)[:3]
         acting = self._operator_active_port.Eval(context)[0] > 0.5
-        status[STEPS] += 1
-        active_steps = status[INTERVENTION_RATIO] * (status[STEPS] - 1) + acting
-        status[INTERVENTION_RATIO] = active_steps / status[STEPS]
         colliding = (self._in_collision_port.HasValue(context)
                      and self._in_collision_port.Eval(context)[0] > 0.5)
-        collided_steps = status[COLLISION_RATIO] * (status[STEPS] - 1) + colliding
-        status[COLLISION_RATIO] = collided_steps / status[STEPS]
+        # The ratios come from whole counts of steps, kept beside the status.
+        counts = context.get_discrete_state(self._counts_index).value() + [acting, colliding]
+        discrete_state.get_mutable_vector(self._counts_index).set_value(counts)
+        status[STEPS] += 1
+        status[INTERVENTION_RATIO], status[COLLISION_RATIO] = counts / status[STEPS]
         stage = int(status[STAGE])
         target = self._objects[self._targets[stage]]
         progress = reach_progress(position, self._start, target)

@@ -87,25 +87,3 @@ def plot_collision_histogram(summary, path):
     figure.savefig(path, dpi=120)
     plt.close(figure)
 
-
-def plot_method_comparison(records, methods, path):
-    """Intervention ratio and task time per method side by side (box plots), with the
-    success rate in the labels."""
-    figure, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-    labels = []
-    for method in methods:
-        rows = [r for r in records if r["method"] == method]
-        rate = np.mean([r["success"] for r in rows])
-        labels.append(f"{method}\n{100 * rate:.0f} % success")
-    for axis, field, title in [(axes[0], "intervention_ratio", "intervention ratio"),
-                               (axes[1], "task_time", "task time (s)")]:
-        data = [[r[field] for r in records if r["method"] == m and r[field] is not None
-                 and np.isfinite(r[field])] for m in methods]
-        axis.boxplot(data)
-        axis.set_xticks(range(1, len(methods) + 1), labels, fontsize=8)
-        axis.set_title(title)
-        axis.grid(axis="y", alpha=0.3)
-    axes[0].set_ylim(0.0, 1.05)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)

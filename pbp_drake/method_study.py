@@ -638,8 +638,44 @@ def summarize(study, records):
             "intervention_ratio": _mean_std([r["intervention_ratio"] for r in ran]),
             "task_time": _mean_std([r["task_time"] for r in ran]),
             "collision_ratio": collision,
+            "collision_free_trials": sum(ratio == 0.0 for ratio in ratios) if ratios else None,
         }
+    arbitration = ideal_alpha(summary["methods"])
+    if arbitration is not None:
+        summary["arbitration"] = arbitration
     return summary
+
+
+# The paper's ideal arbitration (section IV-A) is the highest alpha that still lets the
+# operator do the task, since a lower one takes autonomy from the robot for nothing. Doing
+# the task here: this success rate, and where collisions are measured, most trials without
+# any (the bar PBP has to meet in the obstacle task).
+IDEAL_ALPHA_SUCCESS = 0.95
+
+
+def ideal_alpha(methods):
+    """`{"alphas": [...], "ideal_alpha": A or None, "criterion": text}` over the study's
+    `fixed_alpha=A` methods (None when it has none)."""
+    swept = []
+    for label, entry in methods.items():
+        name, _, alpha = label.partition("=")
+        if name == "fixed_alpha" and alpha:
+            swept.append((float(alpha), entry))
+    if not swept:
+        return None
+    good = []
+    for alpha, entry in sorted(swept, key=lambda item: item[0]):
+        ran = entry["trials"] - entry["errors"]
+        does_task = (entry["success_rate"] is not None
+                     and entry["success_rate"] >= IDEAL_ALPHA_SUCCESS)
+        if entry["collision_free_trials"] is not None:
+            does_task = does_task and 2 * entry["collision_free_trials"] > ran
+        if does_task:
+            good.append(alpha)
+    return {"alphas": sorted(alpha for alpha, _ in swept),
+            "ideal_alpha": max(good) if good else None,
+            "criterion": f"highest alpha with success >= {IDEAL_ALPHA_SUCCESS:.0%} and, "
+                         "where collisions are measured, most trials free of them"}
 
 
 def _cell(entry, field, digits):
@@ -654,8 +690,8 @@ def results_table(summary):
     from pbp_drake.study_figures import METHOD_LABELS
 
     lines = ["| method | trials | success | intervention ratio | task time (s) | "
-             "collision ratio | errors |",
-             "|---|---|---|---|---|---|---|"]
+             "collision ratio | collision-free trials | errors |",
+             "|---|---|---|---|---|---|---|---|"]
     for method, entry in summary["methods"].items():
         rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
         trials = f"{entry['trials']}" + (f" ({entry['missing']} missing)"
@@ -663,8 +699,17 @@ def results_table(summary):
         lines.append(f"| {METHOD_LABELS.get(method, method)} | {trials} | {rate} | "
                      f"{_cell(entry, 'intervention_ratio', 3)} | "
                      f"{_cell(entry, 'task_time', 1)} | {_cell(entry, 'collision_ratio', 3)} | "
-                     f"{entry['errors']} |")
+                     f"{_count(entry['collision_free_trials'])} | {entry['errors']} |")
+    arbitration = summary.get("arbitration")
+    if arbitration is not None:
+        ideal = arbitration["ideal_alpha"]
+        lines += ["", f"Ideal fixed alpha: {'none' if ideal is None else ideal} "
+                      f"({arbitration['criterion']})."]
     return "\n".join(lines) + "\n"
+
+
+def _count(value):
+    return "-" if value is None else str(value)
 
 
 def _flat_trials(study, records):

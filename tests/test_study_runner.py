@@ -17,7 +17,7 @@ import pytest
 
 from pbp_drake.cli import main
 from pbp_drake.method_study import (
-    FIGURES, HISTOGRAM_EDGES, ProgressBar, StudyFolderError, collision_histogram,
+    FIGURES, HISTOGRAM_EDGES, ProgressBar, StudyFolderError, collision_histogram, ideal_alpha,
     load_task_result, read_time_series, run_method_comparison, trial_paths, write_trial)
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
 from pbp_drake.task_run import TaskResult, run_task
@@ -257,6 +257,25 @@ def test_collision_histogram_bins():
     counts = collision_histogram([0.0, 0.0, 0.049, 0.05, 0.5, 0.99, 1.0])
     assert len(counts) == len(HISTOGRAM_EDGES) - 1 == 20
     assert counts[0] == 3 and counts[1] == 1 and counts[10] == 1 and counts[19] == 2
+
+
+def _entry(success_rate, collision_free, trials=10, errors=0):
+    return {"trials": trials, "errors": errors, "success_rate": success_rate,
+            "collision_free_trials": collision_free}
+
+
+def test_ideal_alpha_is_the_highest_that_still_does_the_task():
+    # The paper's choice: the most autonomy that still lets the operator do the task.
+    reach = {"teleop": _entry(1.0, 10), "fixed_alpha=0.2": _entry(1.0, 10),
+             "fixed_alpha=0.9": _entry(0.9, 10), "fixed_alpha=0.5": _entry(1.0, 10)}
+    assert ideal_alpha(reach)["ideal_alpha"] == 0.5
+    assert ideal_alpha(reach)["alphas"] == [0.2, 0.5, 0.9]
+    # Collisions measured: most trials (of those that ran) must be free of them.
+    obstacles = {"fixed_alpha=0.1": _entry(1.0, 6), "fixed_alpha=0.3": _entry(1.0, 5),
+                 "fixed_alpha=0.6": _entry(1.0, 5, errors=1)}
+    assert ideal_alpha(obstacles)["ideal_alpha"] == 0.6
+    assert ideal_alpha({"fixed_alpha=0.3": _entry(1.0, 2)})["ideal_alpha"] is None
+    assert ideal_alpha({"teleop": _entry(1.0, 10)}) is None
 
 
 class Terminal(io.StringIO):

@@ -172,9 +172,8 @@ class _NullBank:
                 self.DeclareVectorInputPort("robot_state", 2 * d)
                 self.DeclareVectorInputPort("goals", k * d)
                 self.DeclareVectorInputPort("operator_active", 1)
-                self.DeclareDiscreteState(np.ones(k))
-                self.DeclareDiscreteState(np.zeros(k * d))
-                self.DeclareDiscreteState(np.zeros(k * d))
+                # The DmpBank system's one state vector [phase, held, p, z, offset].
+                self.DeclareDiscreteState(np.zeros(2 + d + 2 * k * d))
                 self.DeclarePeriodicDiscreteUpdateEvent(DT, 0.0, self._update)
 
             def _update(self, context, discrete_state):

@@ -17,7 +17,7 @@ which tick k steps. Loggers named `robot_state_log`, `operator_active_log`,
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import (
-    ConstantVectorSource, Demultiplexer, LogVectorOutput, Multiplexer, ZeroOrderHold)
+    ConstantVectorSource, LogVectorOutput, Multiplexer, ZeroOrderHold)
 
 from pbp_drake.core.dmp import DmpBank as DmpBankMath
 from pbp_drake.scenarios import (
@@ -188,6 +188,7 @@ def _build_hsr_diagram(scenario, meshcat):
     from pbp_drake.systems.heading_command import HeadingCommand
     from pbp_drake.systems.sample_hold import SampleHold
     from pbp_drake.systems.task_monitor import TaskMonitor
+    from pbp_drake.systems.vector_split import VectorSplit
 
     period = scenario.control_period
     task = scenario.task
@@ -205,7 +206,7 @@ def _build_hsr_diagram(scenario, meshcat):
     sample = builder.AddNamedSystem("ee_state_sample",
                                     SampleHold(period, station.initial_ee_state))
     builder.Connect(ee_state, sample.get_input_port())
-    ee_split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, 2]))
+    ee_split = builder.AddNamedSystem("ee_state_split", VectorSplit([6, 2]))
     builder.Connect(sample.get_output_port(), ee_split.get_input_port())
     ee_position_velocity = ee_split.get_output_port(0)
 
@@ -248,7 +249,7 @@ def _build_hsr_diagram(scenario, meshcat):
     builder.Connect(ee_position_velocity, dmp_bank.get_robot_state_input_port())
     builder.Connect(operator_active, dmp_bank.get_operator_active_input_port())
 
-    command_split = builder.AddNamedSystem("operator_command_split", Demultiplexer([3, 1]))
+    command_split = builder.AddNamedSystem("operator_command_split", VectorSplit([3, 1]))
     builder.Connect(operator_command, command_split.get_input_port())
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
         station.initial_ee_state[6], period, update_offset=offset))

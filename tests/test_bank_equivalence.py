@@ -2,7 +2,7 @@
 Ijspeert form.
 
 The bank takes shortcuts (one basis evaluation for equal phases, a matrix-vector product for
-distinct weights, a linear-combination kernel for shared weights); the single `Dmp` steps each
+distinct weights, an attractor affine in the goal for shared weights and one start); the single `Dmp` steps each
 dimension in a Python loop. They must give the same states to 1e-12, with distinct and
 shared weights, both formulations, mixed amplitude scaling, goals locked one by one (unequal
 phases), and inside the Drake LeafSystem. Timing lives in `pbp-drake bench`, not here.
@@ -89,7 +89,7 @@ def one_by_one(step, k):
 
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
-@pytest.mark.parametrize("goal_count", [5, 70])  # 70 >= 64 takes the shared-weights kernel
+@pytest.mark.parametrize("goal_count", [5, 70])
 @pytest.mark.parametrize("uniform_start", [True, False], ids=["one_start", "many_starts"])
 @pytest.mark.parametrize("locks", [never, all_together, one_by_one],
                          ids=["free", "locked", "locked_one_by_one"])
@@ -150,6 +150,38 @@ def test_leaf_system_equals_the_per_goal_loop(shared):
             position, velocity = dmp.next_step(DT, goals[j], robot)
         np.testing.assert_allclose(references[0, j], position, rtol=0, atol=1e-12)
         np.testing.assert_allclose(references[1, j], velocity, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+def test_leaf_system_follows_the_bank_through_locks_and_moving_goals(shared):
+    """The system keeps its state in another form (see its docstring); stepped with a moving
+    robot, goals that change and PBP-Alt locks, it must read out what `advance` returns."""
+    from pydrake.systems.analysis import Simulator
+
+    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+
+    bank, _, goals = make_banks("ijspeert", shared, 12, 3, not shared, seed=5)
+    system = DmpBankSystem(bank, DT, lock_phase_when_operator_acts=True)
+    simulator = Simulator(system)
+    context = simulator.get_mutable_context()
+    rng = np.random.default_rng(5)
+    phase, positions, scaled_velocity = bank.initial_state()
+    for step in range(40):
+        robot = rng.uniform(-1, 1, 6)
+        goals = goals + (0.05 if step % 7 == 0 else 0.0)
+        locked = 12 <= step < 18 or step == 30
+        system.get_robot_state_input_port().FixValue(context, robot)
+        system.get_goals_input_port().FixValue(context, goals.reshape(-1))
+        system.get_operator_active_input_port().FixValue(context, [float(locked)])
+        simulator.AdvanceTo(step * DT + DT / 2)  # the update at step * DT
+        phase, positions, scaled_velocity = bank.advance(
+            phase, robot[:3, None], scaled_velocity, bank.goals_matrix(goals), DT,
+            locked=locked, robot_velocity=robot[3:])
+        references = system.get_references_output_port().Eval(context).reshape(2, 12, 3)
+        np.testing.assert_allclose(references[0], positions.T, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(references[1], scaled_velocity.T / bank.duration,
+                                   rtol=0, atol=1e-12)
+        np.testing.assert_array_equal(system.get_phase_output_port().Eval(context), phase)
 
 
 def pydmps_path(dmp_parameters, dt, duration, y_start, yd_start):

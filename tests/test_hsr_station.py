@@ -158,3 +158,26 @@ def test_meshcat_visualizer_draws_the_robot():
     diagram.ForcedPublish(context)
     assert station.visualizer is not None
     assert meshcat.HasPath("/drake/visualizer/hsrb")
+
+
+def test_base_pd_pushes_only_the_base_toward_the_desired_state():
+    from pydrake.multibody.plant import MultibodyPlant
+
+    from pbp_drake.robots.hsr_model import add_hsr
+    from pbp_drake.robots.hsr_station import BASE_KD, BASE_KP, base_pd_gain
+
+    plant = MultibodyPlant(0.005)
+    model = add_hsr(plant)
+    plant.Finalize()
+    base = plant.GetJointByName(BASE_JOINT_NAME, model)
+    nq, nv = plant.num_positions(), plant.num_velocities()
+    rng = np.random.default_rng(0)
+    desired, state = rng.normal(size=nq + nv), rng.normal(size=nq + nv)
+    force = base_pd_gain(plant, base, BASE_KP, BASE_KD) @ np.concatenate([desired, state])
+    q = slice(base.position_start(), base.position_start() + 3)
+    v = slice(nq + base.velocity_start(), nq + base.velocity_start() + 3)
+    on_base = slice(base.velocity_start(), base.velocity_start() + 3)
+    np.testing.assert_allclose(
+        force[on_base], np.multiply(BASE_KP, desired[q] - state[q])
+        + np.multiply(BASE_KD, desired[v] - state[v]), rtol=1e-12)
+    assert not np.delete(force, np.arange(nv)[on_base]).any()

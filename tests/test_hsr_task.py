@@ -79,6 +79,42 @@ def test_switching_goal_moves_the_command_no_more_than_one_step(pbp_run):
         jumps[switches - 1], step_travel)
 
 
+def test_the_blend_is_computed_once_per_control_tick(fixed_task, monkeypatch):
+    # Between ticks nothing the blender reads changes; redoing it at every 5 ms plant step
+    # (as behind Drake's Demultiplexer) cost the closed loop a fifth of its speed.
+    from pbp_drake.systems.blender import Blender
+
+    calls = []
+    original = Blender._calc_command
+    monkeypatch.setattr(Blender, "_calc_command",
+                        lambda self, context, output: (calls.append(context.get_time()),
+                                                       original(self, context, output)))
+    simulator = Simulator(build_diagram(fixed_task))
+    simulator.AdvanceTo(0.6)
+    ticks = round(0.6 / fixed_task.control_period) + 1
+    assert ticks <= len(calls) <= 2 * ticks  # one per tick (and the operator's own moment)
+    assert len(calls) < round(0.6 / fixed_task.robot.time_step)
+
+
+def test_vector_split_gives_consecutive_pieces():
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from pbp_drake.systems.vector_split import VectorSplit
+
+    builder = DiagramBuilder()
+    split = builder.AddSystem(VectorSplit([2, 1, 3]))
+    source = builder.AddSystem(ConstantVectorSource(np.arange(6.0)))
+    builder.Connect(source.get_output_port(), split.get_input_port())
+    diagram = builder.Build()
+    context = split.GetMyContextFromRoot(diagram.CreateDefaultContext())
+    pieces = [split.get_output_port(i).Eval(context) for i in range(3)]
+    np.testing.assert_array_equal(np.concatenate(pieces), np.arange(6.0))
+    assert [len(piece) for piece in pieces] == [2, 1, 3]
+    with pytest.raises(ValueError, match="positive"):
+        VectorSplit([2, 0])
+
+
 def test_teleop_participant_drives_the_whole_way(fixed_task):
     result = run_task(dataclasses.replace(fixed_task, method="teleop"))
     assert result.success

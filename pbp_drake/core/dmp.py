@@ -293,17 +293,20 @@ class DmpBank:
     start and its own phase.
 
     Use it statefully, as NumPy users would (`reset`, then `next_step(goals, y_robot)` each
-    control step), or through the pure `advance` that Drake's `DmpBank` system calls with the
-    state it keeps in its Context; `advance_into` is the same step written into arrays the
-    caller owns (the Context's own vectors), with no allocation.
+    control step), or through the pure `advance`; `advance_into` is the same step written
+    into arrays the caller owns, with no allocation, and `offsets_into`,
+    `stepped_positions_into` and `stepped_velocity_into` are its parts (Drake's `DmpBank`
+    system keeps the offsets in its Context and reads the stepped state out on demand).
 
     Speed. When all phases are equal (DMPs started together and locked together: the normal
     case), the basis is evaluated once, `(N,)`, and contracted with the weights: shared
     weights give a `(D,)` shape broadcast to all goals (O(N D + D K)); distinct weights are
     one `(N,) x (N, D*K)` matrix-vector product over contiguous memory (memory bound). The
     per-goal-phase path (phases made unequal by per-goal locks) evaluates `(N, K)` bases.
-    The step then makes a fixed number of passes over `(D, K)` work arrays kept in the bank,
-    using the one cached 2x2 transition. `amplitude_scaling` is read at construction.
+    With shared weights, equal phases and one start, the attractor is affine in the goal
+    with per-dimension coefficients, so no per-goal shape is ever formed. The step then
+    makes a fixed number of passes over `(D, K)` work arrays kept in the bank, using the
+    one cached 2x2 transition. `amplitude_scaling` and `starts` are read at construction.
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
@@ -360,16 +363,18 @@ class DmpBank:
         self._attractor = np.empty((d, k))
         self._offset = np.empty((d, k))
         self._work = np.empty((d, k))
-        # Shared weights and a per-dimension amplitude scaling: with equal phases and one
-        # robot position, the step is linear in (g, y0, z, 1) with per-dimension coefficients,
-        # so it is two batched (1 x 4) @ (4 x K) products over rows kept side by side.
-        self._rows = None
+        # Shared weights, a per-dimension amplitude scaling and one start: with equal phases
+        # the attractor is `alpha_g g + alpha_c` per dimension (see `offsets_into`).
         scaling = self.amplitude_scaling
-        self._row_kernel = (self.shared_weights
-                            and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all()))
-        if self._row_kernel:
-            self._rows_starts = None
-            self._scaled_rows = scaling[:, 0].astype(float)
+        starts = self.starts
+        self._affine_attractor = (
+            self.shared_weights and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all())
+            and bool((starts == starts[:, :1]).all()))
+        self._uniform_start = starts[:, :1].copy()
+        self._scaled_rows = scaling[:, :1].astype(float)
+        self._alpha_goal = np.empty((d, 1))
+        self._alpha_constant = np.empty((d, 1))
+        self._column = np.empty((d, 1))
 
     @classmethod
     def from_dmps(cls, dmps):
@@ -568,85 +573,75 @@ class DmpBank:
             elif out_velocity is not scaled_velocity:
                 out_velocity[...] = scaled_velocity
             return
-        transition = self.transition(dt)
-        if (self._row_kernel and self.goal_count >= 64
-                and np.shape(positions) == (self.dimension, 1)
-                and out_positions.flags.c_contiguous and out_velocity.flags.c_contiguous
-                and (phase.size == 1 or phase.min() == phase.max())):
-            self._advance_rows(phase, positions, scaled_velocity, goals_dk, transition,
-                               dt, out_phase, out_positions, out_velocity)
-            return
-        attractor = self._attractors_into(phase, goals_dk)
-        offset, work = self._offset, self._work
-        np.subtract(positions, attractor, out=offset)
-        # Velocity first, into the work array: `out_positions` may alias `positions`...
-        np.multiply(offset, transition[1, 0], out=work)
-        # ...position: attractor + Phi00 offset + Phi01 z (z still the old one).
-        np.multiply(offset, transition[0, 0], out=offset)
-        offset += attractor
-        np.multiply(scaled_velocity, transition[0, 1], out=attractor)
-        np.add(offset, attractor, out=out_positions)
-        # ...then z' = Phi10 offset + Phi11 z, in place if `out_velocity` is z.
-        np.multiply(scaled_velocity, transition[1, 1], out=out_velocity)
-        out_velocity += work
+        offset = self.offsets_into(phase, positions, goals_dk, self._offset)
+        # Positions first: `out_velocity` may alias `scaled_velocity`, which they read.
+        self.stepped_positions_into(positions, offset, scaled_velocity, dt, out_positions)
+        self.stepped_velocity_into(offset, scaled_velocity, dt, out_velocity)
         np.multiply(phase, self.decay(dt), out=out_phase)
 
-    def _prepare_rows(self):
-        """Rows `(g, z, 1)` per dimension when every DMP starts at the same point (y0 then
-        folds into the constant), else `(g, z, 1, y0)`."""
-        d, k = self.dimension, self.goal_count
-        starts = self.starts
-        uniform = bool((starts == starts[:, :1]).all())
-        rows = np.empty((d, 3 if uniform else 4, k))
-        rows[:, 2, :] = 1.0
-        if not uniform:
-            rows[:, 3, :] = starts
-        self._rows = rows
-        self._uniform_start = starts[:, 0].copy() if uniform else None
-        self._row_coefficients = np.zeros((2, d, 1, rows.shape[1]))
-        self._rows_starts = starts
+    # The step, in parts. With `offset = y - a` (the position stepped from minus the
+    # attractor), the exact zero-order-hold step is
+    #     y' = y + (Phi00 - 1) offset + Phi01 z,    z' = Phi10 offset + Phi11 z,
+    # so a caller may keep `(offset, z)` and read `(y', z')` out later (Drake's DmpBank does:
+    # PBP never feeds the DMPs' own positions back, only the robot's).
 
-    def _advance_rows(self, phase, positions, scaled_velocity, goals_dk, transition, dt,
-                      out_phase, out_positions, out_velocity):
-        """The step for shared weights, equal phases and one robot position (the fast path).
+    def offsets_into(self, phase, positions, goals_dk, out):
+        """`out = positions - attractor(phase, goals)`, `(D, K)`; `positions` (D, K) or
+        (D, 1). Two passes over `(D, K)` when the DMPs share weights, phase and start."""
+        if self._affine_attractor and (phase.size == 1 or phase.min() == phase.max()):
+            negative_alpha_goal, alpha_constant = self._affine_attractor_coefficients(phase)
+            # positions - (alpha_g g + alpha_c) = -alpha_g g + (positions - alpha_c)
+            np.multiply(goals_dk, negative_alpha_goal, out=out)
+            if positions.shape[1] == 1:
+                np.subtract(positions, alpha_constant, out=self._column)
+                out += self._column
+            else:
+                out += positions
+                out -= alpha_constant
+            return out
+        np.subtract(positions, self._attractors_into(phase, goals_dk), out=out)
+        return out
 
-        The attractor is `a = alpha_g g + alpha_y y0 + alpha_1` per dimension, so the new
-        position `a + Phi00 (p - a) + Phi01 z` and `z' = Phi10 (p - a) + Phi11 z` are dot
-        products of per-dimension coefficients with the rows `(g, z, 1[, y0])`: two batched
-        `(1 x R) @ (R x K)` products.
-        """
-        d, k = self.dimension, self.goal_count
-        if self._rows_starts is not self.starts:
-            self._prepare_rows()
-        rows = self._rows
-        np.copyto(rows[:, 0, :], goals_dk)
-        np.copyto(rows[:, 1, :], scaled_velocity)
+    def stepped_positions_into(self, positions, offset, scaled_velocity, dt, out):
+        """`out = positions + (Phi00 - 1) offset + Phi01 z`: the positions after the step."""
+        (t00, t01), _ = self.transition(dt)
+        work = self._work
+        np.multiply(offset, t00 - 1.0, out=work)
+        np.add(positions, work, out=out)  # `out` may be `positions`
+        np.multiply(scaled_velocity, t01, out=work)
+        out += work
+        return out
+
+    def stepped_velocity_into(self, offset, scaled_velocity, dt, out):
+        """`out = Phi10 offset + Phi11 z`: the scaled velocities after the step (`out` may be
+        `scaled_velocity`)."""
+        _, (t10, t11) = self.transition(dt)
+        np.multiply(offset, t10, out=self._work)
+        np.multiply(scaled_velocity, t11, out=out)
+        out += self._work
+        return out
+
+    def _affine_attractor_coefficients(self, phase):
+        """Per dimension `(-alpha_g, alpha_c)` `(D, 1)` with `attractor = alpha_g g + alpha_c`
+        for every goal: shared weights, one phase and one start make it affine in g."""
         shape, x = self._shaped_forcing(phase)  # (D, 1): the forcing (times x, / K)
-        c = shape[:, 0]
+        alpha_goal, alpha_constant = self._alpha_goal, self._alpha_constant
+        start = self._uniform_start
         if self._ijspeert:
             # a = g + c (g - y0) where scaled, g + c where not.
-            cs = c * self._scaled_rows
-            alpha_g, alpha_y, alpha_1 = 1.0 + cs, -cs, c - cs
+            scaled = self._scaled_rows
+            np.multiply(shape, scaled, out=alpha_goal)
+            np.multiply(alpha_goal, -start, out=alpha_constant)
+            alpha_constant += shape
+            alpha_constant -= alpha_goal
+            alpha_goal += 1.0
         else:
             # a = g - (g - y0) x + c.
-            alpha_g, alpha_y, alpha_1 = np.full(d, 1.0 - x), np.full(d, x), c
-        if self._uniform_start is not None:
-            alpha_1 = alpha_1 + alpha_y * self._uniform_start
-        p = positions[:, 0]
-        (t00, t01), (t10, t11) = transition
-        m = self._row_coefficients
-        m[0, :, 0, 0] = (1.0 - t00) * alpha_g
-        m[0, :, 0, 1] = t01
-        m[0, :, 0, 2] = (1.0 - t00) * alpha_1 + t00 * p
-        m[1, :, 0, 0] = -t10 * alpha_g
-        m[1, :, 0, 1] = t11
-        m[1, :, 0, 2] = t10 * (p - alpha_1)
-        if self._uniform_start is None:
-            m[0, :, 0, 3] = (1.0 - t00) * alpha_y
-            m[1, :, 0, 3] = -t10 * alpha_y
-        np.matmul(m[0], rows, out=out_positions.reshape(d, 1, k))
-        np.matmul(m[1], rows, out=out_velocity.reshape(d, 1, k))
-        np.multiply(phase, self.decay(dt), out=out_phase)
+            alpha_goal.fill(1.0 - x)
+            np.multiply(start, x, out=alpha_constant)
+            alpha_constant += shape
+        np.negative(alpha_goal, out=alpha_goal)
+        return alpha_goal, alpha_constant
 
     def _advance_partly_locked(self, phase, positions, scaled_velocity, goals_dk, dt,
                                out_phase, out_positions, out_velocity, locked,

@@ -6,7 +6,7 @@ policy's) end-effector command and the robot's motion::
     ee_command ─► EeCommandToPose ─► DifferentialInverseKinematicsIntegrator ─► q_d
     q_d ─► DiscreteDerivative ─► v_d
     [q_d, v_d] ─► arm: the plant's PD-controlled actuators (desired_state input)
-               └► base: BasePdController ─► applied_generalized_force
+               └► base: PD as one MatrixGain on [desired, state] ─► applied_generalized_force
     plant ─► EeStateFromPlant ─► ee_state
 
 Gravity is off, which stands for the ideal gravity compensation of the real robot's
@@ -189,51 +189,21 @@ class EeStateFromPlant(LeafSystem):
             [X_WE.translation(), v, [heading_of(X_WE.rotation()), w[2]]]))
 
 
-class BasePdController(LeafSystem):
-    """PD forces on the unactuated planar base, applied as generalized forces.
-
-    .. pydrake_system::
-
-        name: BasePdController
-        input_ports:
-        - desired_state
-        - state
-        output_ports:
-        - generalized_force
-
-    `desired_state` and `state` are full plant states `[q, v]`; `generalized_force` has
-    one entry per plant velocity, zero except on the base's (x, y, yaw).
-    """
-
-    def __init__(self, plant, base_joint, kp, kd):
-        super().__init__()
-        nq, nv = plant.num_positions(), plant.num_velocities()
-        self._q = slice(base_joint.position_start(), base_joint.position_start() + 3)
-        self._v = slice(nq + base_joint.velocity_start(), nq + base_joint.velocity_start() + 3)
-        self._force_dofs = slice(base_joint.velocity_start(), base_joint.velocity_start() + 3)
-        self._kp, self._kd = np.asarray(kp, float), np.asarray(kd, float)
-        self._nv = nv
-        self._desired_port = self.DeclareVectorInputPort("desired_state", nq + nv)
-        self._state_port = self.DeclareVectorInputPort("state", nq + nv)
-        self._force_port = self.DeclareVectorOutputPort(
-            "generalized_force", nv, self._calc_force)
-
-    def get_desired_state_input_port(self):
-        return self._desired_port
-
-    def get_state_input_port(self):
-        return self._state_port
-
-    def get_generalized_force_output_port(self):
-        return self._force_port
-
-    def _calc_force(self, context, output):
-        desired = self._desired_port.Eval(context)
-        state = self._state_port.Eval(context)
-        force = np.zeros(self._nv)
-        force[self._force_dofs] = (self._kp * (desired[self._q] - state[self._q])
-                                   + self._kd * (desired[self._v] - state[self._v]))
-        output.SetFromVector(force)
+def base_pd_gain(plant, base_joint, kp, kd):
+    """The matrix `G` (nv, 2 (nq + nv)) of PD forces on the unactuated planar base:
+    `G [desired_state; state]` is `kp (q_d - q) + kd (v_d - v)` on the base's (x, y, yaw)
+    generalized forces and zero elsewhere. Applied by a MatrixGain (in C++: a Python
+    system here would run at every plant step)."""
+    nq, nv = plant.num_positions(), plant.num_velocities()
+    nx = nq + nv
+    gain = np.zeros((nv, 2 * nx))
+    for axis, (p_gain, d_gain) in enumerate(zip(kp, kd)):
+        force = base_joint.velocity_start() + axis
+        q = base_joint.position_start() + axis
+        v = nq + base_joint.velocity_start() + axis
+        gain[force, q], gain[force, nx + q] = p_gain, -p_gain
+        gain[force, v], gain[force, nx + v] = d_gain, -d_gain
+    return gain
 
 
 def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
@@ -354,11 +324,13 @@ def add_hsr_station(builder, time_step=0.005, meshcat=None, initial_base=(0.0, 0
     builder.Connect(desired.get_output_port(), arm_selector.get_input_port())
     builder.Connect(arm_selector.get_output_port(), plant.get_desired_state_input_port(model))
 
-    base_pd = builder.AddNamedSystem("base_pd", BasePdController(
-        plant, plant.GetJointByName(BASE_JOINT_NAME, model), BASE_KP, BASE_KD))
-    builder.Connect(desired.get_output_port(), base_pd.get_desired_state_input_port())
-    builder.Connect(plant.get_state_output_port(), base_pd.get_state_input_port())
-    builder.Connect(base_pd.get_generalized_force_output_port(),
+    base_pd_input = builder.AddNamedSystem("base_pd_input", Multiplexer([nq + nv, nq + nv]))
+    builder.Connect(desired.get_output_port(), base_pd_input.get_input_port(0))
+    builder.Connect(plant.get_state_output_port(), base_pd_input.get_input_port(1))
+    base_pd = builder.AddNamedSystem("base_pd", MatrixGain(base_pd_gain(
+        plant, plant.GetJointByName(BASE_JOINT_NAME, model), BASE_KP, BASE_KD)))
+    builder.Connect(base_pd_input.get_output_port(), base_pd.get_input_port())
+    builder.Connect(base_pd.get_output_port(),
                     plant.get_applied_generalized_force_input_port())
 
     ee_body = plant.GetFrameByName(END_EFFECTOR_FRAME, model).body()

@@ -65,7 +65,11 @@ class Blender(LeafSystem):
         self._operator_command_port = self.DeclareVectorInputPort("operator_command", d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._goal_probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
-        self._command_port = self.DeclareVectorOutputPort("command", 2 * d, self._calc_command)
+        # The blend is a function of the inputs alone: say so, so that Drake does not redo it
+        # at every plant step in between the control ticks that change them.
+        self._command_port = self.DeclareVectorOutputPort(
+            "command", 2 * d, self._calc_command,
+            prerequisites_of_calc={self.all_input_ports_ticket()})
 
     @property
     def mode(self):

@@ -31,6 +31,15 @@ class DmpBank(LeafSystem):
     sampled every `prediction_period` (default: the control period).
     All state lives in the Context.
 
+    The state is one vector `[phase, held, p (D), z (D*K), offset (D*K)]`. PBP steps every
+    DMP from the robot's position `p` and never from the DMP's own, so the state keeps, of
+    each step, what its outputs are read from: the DMPs' velocities `z` before the step and
+    `offset = p - attractor`; `references` reads the stepped positions and velocities out
+    (`pbp_drake.core.dmp.DmpBank.offsets_into`). An update is then three passes over
+    `(D, K)` and Drake copies two `(D, K)` arrays, not three and a phase per goal. While
+    `held` (at the start, and while PBP-Alt locks the phases) the DMPs sit at `p - offset`
+    with velocity `z`. All DMPs of the system share one phase: the lock is one input.
+
     The bank updates `update_offset` seconds after each control tick. Discrete updates at
     one instant all see the values from before that instant, so a bank updating exactly at
     the tick would lock on the operator's decision of the previous tick; a small offset
@@ -52,16 +61,20 @@ class DmpBank(LeafSystem):
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._goals_port = self.DeclareVectorInputPort("goals", k * d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
-        phase, positions, scaled_velocity = bank.initial_state()
-        self._phase_index = self.DeclareDiscreteState(phase)
-        self._position_index = self.DeclareDiscreteState(positions.reshape(-1))
-        self._velocity_index = self.DeclareDiscreteState(scaled_velocity.reshape(-1))
-        # The outputs depend on the bank's own state (and the goals) only: say so, so that
-        # Drake does not recompute them after every plant step.
+        # Held at the start: the DMPs sit at their starts (p = 0, offset = -starts), at rest.
+        self._z = slice(2 + d, 2 + d + k * d)
+        self._offset = slice(2 + d + k * d, 2 + d + 2 * k * d)
+        initial = np.zeros(2 + d + 2 * k * d)
+        initial[0], initial[1] = 1.0, 1.0
+        initial[self._offset] = -bank.starts.reshape(-1)
+        self._state_index = self.DeclareDiscreteState(initial)
+        # The outputs depend on the bank's own state only: say so, so that Drake does not
+        # recompute them after every plant step.
         self._references_port = self.DeclareVectorOutputPort(
             "references", 2 * k * d, self._calc_references,
             prerequisites_of_calc={self.xd_ticket()})
-        self._phase_port = self.DeclareStateOutputPort("phase", self._phase_index)
+        self._phase_port = self.DeclareVectorOutputPort(
+            "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
         self._predicted_paths_port = None
         if self._prediction_steps > 0:
             self._predicted_paths_port = self.DeclareVectorOutputPort(
@@ -93,41 +106,63 @@ class DmpBank(LeafSystem):
     def get_predicted_paths_output_port(self):
         return self._predicted_paths_port
 
-    def _state(self, context):
-        """Read-only views of the phase (K,), positions and scaled velocities (D, K)."""
+    def _split(self, vector):
+        """Views of a state vector: phase (1,), held (1,), p (D, 1), z and offset (D, K)."""
         d, k = self._bank.dimension, self._bank.goal_count
-        return (context.get_discrete_state(self._phase_index).get_value(),
-                context.get_discrete_state(self._position_index).get_value().reshape(d, k),
-                context.get_discrete_state(self._velocity_index).get_value().reshape(d, k))
+        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
+                vector[self._z].reshape(d, k), vector[self._offset].reshape(d, k))
+
+    def dmp_states(self, context):
+        """The K DMPs' state after the last update: phases (K,), positions and scaled
+        velocities (D, K), new arrays (what `references` reads out)."""
+        bank = self._bank
+        phase, held, robot, z, offset = self._split(
+            context.get_discrete_state(self._state_index).get_value())
+        positions = np.empty(z.shape)
+        velocity = np.empty(z.shape)
+        if held[0]:
+            np.subtract(robot, offset, out=positions)
+            velocity[...] = z
+        else:
+            bank.stepped_positions_into(robot, offset, z, self._period, positions)
+            bank.stepped_velocity_into(offset, z, self._period, velocity)
+        return np.full(bank.goal_count, phase[0]), positions, velocity
 
     def _update(self, context, discrete_state):
-        # Ports are read through views (no copies) and the step is written straight into the
-        # discrete state's vectors, which Drake fills with the current state beforehand.
-        bank = self._bank
-        d, k = bank.dimension, bank.goal_count
+        # Drake fills `discrete_state` with the current state; the update writes into it.
+        bank, period = self._bank, self._period
+        d = bank.dimension
+        phase, held, robot, z, offset = self._split(
+            discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
+        # The velocities the last step left, read out in place (see the class docstring).
+        if not held[0]:
+            bank.stepped_velocity_into(offset, z, period, z)
         robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
+        robot[:, 0] = robot_state[:d]
+        if (self._lock and self._operator_active_port.HasValue(context)
+                and self._operator_active_port.Eval(context)[0] > 0.5):
+            # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
+            held[0] = 1.0
+            offset.fill(0.0)
+            np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
+            return
         goals = bank.goals_matrix(self._goals_port.EvalAbstract(context).get_value().get_value())
-        locked = None
-        if self._lock and self._operator_active_port.HasValue(context):
-            locked = bool(self._operator_active_port.Eval(context)[0] > 0.5)
-        phase = discrete_state.get_mutable_vector(self._phase_index).get_mutable_value()
-        positions = discrete_state.get_mutable_vector(
-            self._position_index).get_mutable_value().reshape(d, k)
-        scaled_velocity = discrete_state.get_mutable_vector(
-            self._velocity_index).get_mutable_value().reshape(d, k)
-        bank.advance_into(phase, robot_state[:d, np.newaxis], scaled_velocity, goals,
-                          self._period, phase, positions, scaled_velocity,
-                          locked=locked, robot_velocity=robot_state[d:])
+        held[0] = 0.0
+        bank.offsets_into(phase, robot, goals, offset)
+        phase *= bank.decay(period)
 
     def _calc_references(self, context, output):
-        _, positions, scaled_velocity = self._state(context)
+        _, positions, scaled_velocity = self.dmp_states(context)
         d, k = self._bank.dimension, self._bank.goal_count
         references = output.get_mutable_value().reshape(2, k, d)
         references[0] = positions.T
         np.divide(scaled_velocity.T, self._bank.duration, out=references[1])
 
+    def _calc_phase(self, context, output):
+        output.get_mutable_value()[:] = context.get_discrete_state(self._state_index)[0]
+
     def _calc_predicted_paths(self, context, output):
-        phase, positions, scaled_velocity = self._state(context)
+        phase, positions, scaled_velocity = self.dmp_states(context)
         goals = self._bank.goals_matrix(self._goals_port.Eval(context))
         paths = self._bank.predict(phase, positions, scaled_velocity, goals,
                                    self._prediction_period, self._prediction_steps)

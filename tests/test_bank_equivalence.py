@@ -184,6 +184,22 @@ def test_leaf_system_follows_the_bank_through_locks_and_moving_goals(shared):
         np.testing.assert_array_equal(system.get_phase_output_port().Eval(context), phase)
 
 
+def test_leaf_system_refuses_a_nan_goal_at_its_first_update():
+    from pydrake.systems.analysis import Simulator
+
+    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+
+    bank, _, goals = make_banks("ijspeert", True, 4, 3, True, seed=1)
+    system = DmpBankSystem(bank, DT)
+    simulator = Simulator(system)
+    context = simulator.get_mutable_context()
+    goals[2, 1] = np.nan
+    system.get_robot_state_input_port().FixValue(context, np.zeros(6))
+    system.get_goals_input_port().FixValue(context, goals.reshape(-1))
+    with pytest.raises(ValueError, match="goals contains NaN"):
+        simulator.AdvanceTo(DT / 2)
+
+
 def pydmps_path(dmp_parameters, dt, duration, y_start, yd_start):
     """pydmps' DMPs_discrete from a disturbed state: its positions at every `dt`."""
     pydmps = pytest.importorskip("pydmps")

@@ -612,13 +612,15 @@ class DmpBank:
         out += work
         return out
 
-    def stepped_velocity_into(self, offset, scaled_velocity, dt, out):
+    def stepped_velocity_into(self, offset, scaled_velocity, dt, out, scratch=None):
         """`out = Phi10 offset + Phi11 z`: the scaled velocities after the step (`out` may be
-        `scaled_velocity`)."""
+        `scaled_velocity`). `scratch` (D, K) holds `Phi10 offset` (default: the bank's work
+        array); a caller done with `offset` may pass `offset` itself, all passes in place."""
         _, (t10, t11) = self.transition(dt)
-        np.multiply(offset, t10, out=self._work)
+        scratch = self._work if scratch is None else scratch
+        np.multiply(offset, t10, out=scratch)
         np.multiply(scaled_velocity, t11, out=out)
-        out += self._work
+        out += scratch
         return out
 
     def _affine_attractor_coefficients(self, phase):

@@ -1,7 +1,8 @@
 """The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot."""
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import LeafSystem, ValueProducer
 
 
 class DmpBank(LeafSystem):
@@ -35,8 +36,9 @@ class DmpBank(LeafSystem):
     DMP from the robot's position `p` and never from the DMP's own, so the state keeps, of
     each step, what its outputs are read from: the DMPs' velocities `z` before the step and
     `offset = p - attractor`; `references` reads the stepped positions and velocities out
-    (`pbp_drake.core.dmp.DmpBank.offsets_into`). An update is then three passes over
-    `(D, K)` and Drake copies two `(D, K)` arrays, not three and a phase per goal. While
+    (`pbp_drake.core.dmp.DmpBank.offsets_into`). With shared weights an update is then five
+    passes over `(D, K)`, and Drake copies two `(D, K)` arrays, not three and a phase per
+    goal; the goals are checked and laid out `(D, K)` in a cache entry, once per change. While
     `held` (at the start, and while PBP-Alt locks the phases) the DMPs sit at `p - offset`
     with velocity `z`. All DMPs of the system share one phase: the lock is one input.
 
@@ -68,6 +70,12 @@ class DmpBank(LeafSystem):
         initial[0], initial[1] = 1.0, 1.0
         initial[self._offset] = -bank.starts.reshape(-1)
         self._state_index = self.DeclareDiscreteState(initial)
+        # The goals checked and laid out (D, K) once each time they change, not each tick.
+        self._goals_dk = self.DeclareCacheEntry(
+            "goals, validated, (D, K) contiguous",
+            ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((d, k))),
+                          calc=self._calc_goals_dk),
+            prerequisites_of_calc={self._goals_port.ticket()})
         # The outputs depend on the bank's own state only: say so, so that Drake does not
         # recompute them after every plant step.
         self._references_port = self.DeclareVectorOutputPort(
@@ -134,9 +142,10 @@ class DmpBank(LeafSystem):
         d = bank.dimension
         phase, held, robot, z, offset = self._split(
             discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
-        # The velocities the last step left, read out in place (see the class docstring).
+        # The velocities the last step left, read out in place (see the class docstring);
+        # the offsets are rewritten below, so they serve as the scratch.
         if not held[0]:
-            bank.stepped_velocity_into(offset, z, period, z)
+            bank.stepped_velocity_into(offset, z, period, z, scratch=offset)
         robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
         robot[:, 0] = robot_state[:d]
         if (self._lock and self._operator_active_port.HasValue(context)
@@ -146,10 +155,13 @@ class DmpBank(LeafSystem):
             offset.fill(0.0)
             np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
             return
-        goals = bank.goals_matrix(self._goals_port.EvalAbstract(context).get_value().get_value())
         held[0] = 0.0
-        bank.offsets_into(phase, robot, goals, offset)
+        bank.offsets_into(phase, robot, self._goals_dk.Eval(context), offset)
         phase *= bank.decay(period)
+
+    def _calc_goals_dk(self, context, value):
+        goals = self._bank.goals_matrix(self._goals_port.Eval(context))
+        value.get_mutable_value()[...] = goals
 
     def _calc_references(self, context, output):
         _, positions, scaled_velocity = self.dmp_states(context)
@@ -163,7 +175,7 @@ class DmpBank(LeafSystem):
 
     def _calc_predicted_paths(self, context, output):
         phase, positions, scaled_velocity = self.dmp_states(context)
-        goals = self._bank.goals_matrix(self._goals_port.Eval(context))
+        goals = self._goals_dk.Eval(context)
         paths = self._bank.predict(phase, positions, scaled_velocity, goals,
                                    self._prediction_period, self._prediction_steps)
         output.SetFromVector(paths.reshape(-1))

@@ -29,6 +29,7 @@ _PUBLIC = {
     "Blender": "pbp_drake.systems",
     "DmpBank": "pbp_drake.systems",
     "GoalEstimator": "pbp_drake.systems",
+    "GoalsSource": "pbp_drake.systems",
     "TaskMonitor": "pbp_drake.systems",
     "HeadingCommand": "pbp_drake.systems",
     "KeyboardOperator": "pbp_drake.systems",

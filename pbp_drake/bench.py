@@ -189,6 +189,7 @@ def leaf_simulator(case, bank=None):
     from pydrake.systems.primitives import ConstantVectorSource
 
     from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+    from pbp_drake.systems.goals_source import GoalsSource
 
     builder = DiagramBuilder()
     d = case.dimension
@@ -197,7 +198,9 @@ def leaf_simulator(case, bank=None):
     else:
         system = builder.AddSystem(DmpBankSystem(bank, DT))
     robot = builder.AddSystem(ConstantVectorSource(np.concatenate([case.robot, np.zeros(d)])))
-    goals = builder.AddSystem(ConstantVectorSource(case.goals.reshape(-1)))
+    # Our goals source, as the builder uses: Drake's ConstantVectorSource would make the
+    # bank re-read its goals at every update.
+    goals = builder.AddSystem(GoalsSource(case.goals))
     builder.Connect(robot.get_output_port(), system.get_input_port(0))
     builder.Connect(goals.get_output_port(), system.get_input_port(1))
     simulator = Simulator(builder.Build())

@@ -16,8 +16,7 @@ which tick k steps. Loggers named `robot_state_log`, `operator_active_log`,
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import (
-    ConstantVectorSource, LogVectorOutput, Multiplexer, ZeroOrderHold)
+from pydrake.systems.primitives import LogVectorOutput, Multiplexer, ZeroOrderHold
 
 from pbp_drake.core.dmp import DmpBank as DmpBankMath
 from pbp_drake.scenarios import (
@@ -26,8 +25,8 @@ from pbp_drake.scenarios import (
     VirtualParticipant as VirtualParticipantConfig, demonstration_samples, dmp_settings,
     goal_estimator_settings, resolved_goals, resolved_start, task_layout, validate_scenario)
 from pbp_drake.systems import (
-    Blender, DemonstrationPlayer, DmpBank, NoOperator, ObstacleRepulsionOperator, PointRobot,
-    ScriptedOperator)
+    Blender, DemonstrationPlayer, DmpBank, GoalsSource, NoOperator, ObstacleRepulsionOperator,
+    PointRobot, ScriptedOperator)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
 BLEND_MODE_OF_METHOD = {
@@ -81,7 +80,7 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
             make_dmp_bank(scenario), period,
             lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
             prediction_steps=prediction_steps, update_offset=scenario.robot.time_step / 4))
-        goals_source = builder.AddNamedSystem("goals", ConstantVectorSource(goals.reshape(-1)))
+        goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
         builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
         builder.Connect(robot_state, dmp_bank.get_robot_state_input_port())
         builder.Connect(operator.get_operator_active_output_port(),
@@ -210,7 +209,7 @@ def _build_hsr_diagram(scenario, meshcat):
     builder.Connect(sample.get_output_port(), ee_split.get_input_port())
     ee_position_velocity = ee_split.get_output_port(0)
 
-    goals_source = builder.AddNamedSystem("goals", ConstantVectorSource(goals.reshape(-1)))
+    goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
     estimator = builder.AddNamedSystem("goal_estimator", GoalEstimator(
         goal_count, goal_estimator_settings(scenario.goal_estimator), period,
         update_offset=offset))

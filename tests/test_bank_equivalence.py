@@ -240,3 +240,32 @@ def test_pydmps_agrees_with_the_ijspeert_form():
     scale = np.abs(path).max()
     assert gaps[1] < 2e-3 * scale  # O(dt) at dt = 0.2 ms
     assert 0.4 < gaps[1] / gaps[0] < 0.6  # first order: the gap is discretisation only
+
+
+def test_the_goals_are_read_once_per_change_from_a_goals_source(monkeypatch):
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+    from pbp_drake.systems.goals_source import GoalsSource
+
+    bank, _, goals = make_banks("ijspeert", True, 6, 3, True, seed=3)
+    builder = DiagramBuilder()
+    system = builder.AddSystem(DmpBankSystem(bank, DT))
+    source = builder.AddSystem(GoalsSource(goals))
+    robot = builder.AddSystem(ConstantVectorSource(np.zeros(6)))
+    builder.Connect(source.get_goals_output_port(), system.get_goals_input_port())
+    builder.Connect(robot.get_output_port(), system.get_robot_state_input_port())
+    simulator = Simulator(builder.Build())
+    reads = []
+    original = bank.goals_matrix
+    monkeypatch.setattr(bank, "goals_matrix", lambda g: (reads.append(1), original(g))[1])
+    simulator.AdvanceTo(10 * DT)
+    assert len(reads) == 1
+    # New goals in the context are seen at the next update.
+    source.set_goals(source.GetMyContextFromRoot(simulator.get_mutable_context()), goals + 1)
+    simulator.AdvanceTo(11.5 * DT)
+    assert len(reads) == 2
+    with pytest.raises(ValueError, match="shape"):
+        source.set_goals(source.CreateDefaultContext(), goals[:2])

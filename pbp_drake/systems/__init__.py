@@ -15,6 +15,7 @@ from pbp_drake.systems.demonstration_player import DemonstrationPlayer
 from pbp_drake.systems.dmp_bank import DmpBank
 from pbp_drake.systems.gamepad_operator import GamepadOperator
 from pbp_drake.systems.goal_estimator import GoalEstimator
+from pbp_drake.systems.goals_source import GoalsSource
 from pbp_drake.systems.heading_command import HeadingCommand
 from pbp_drake.systems.keyboard_operator import KeyboardOperator
 from pbp_drake.systems.no_operator import NoOperator
@@ -27,7 +28,7 @@ from pbp_drake.systems.task_monitor import TaskMonitor
 from pbp_drake.systems.virtual_participant import VirtualParticipant
 
 __all__ = [
-    "Blender", "DemonstrationPlayer", "DmpBank", "GamepadOperator", "GoalEstimator",
+    "Blender", "DemonstrationPlayer", "DmpBank", "GamepadOperator", "GoalEstimator", "GoalsSource",
     "HeadingCommand", "KeyboardOperator", "NoOperator", "ObstacleRepulsionOperator",
     "PointRobot", "ReachSceneVisualizer", "SampleHold", "ScriptedOperator", "TaskMonitor",
     "VirtualParticipant",

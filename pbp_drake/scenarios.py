@@ -159,9 +159,10 @@ class Hsr:
 
     time_step: float = 0.005
     # The whole-body differential IK's period (s), a whole multiple of time_step. Its QP is
-    # the loop's largest cost: 0.015 runs the reaching task 10.8x real time instead of 8.6x,
-    # but the teleop participant then fails 3 of 30 reaches.
-    diff_ik_time_step: float = 0.005
+    # the loop's largest cost: 0.01 runs the reaching task about 11x real time, 0.005 about
+    # 9.5x, with the same success (30 of 30 for teleop and PBP-Alt); at 0.015 the teleop
+    # participant failed 3 of 30 reaches.
+    diff_ik_time_step: float = 0.01
     # The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it.
     speed: float = 0.12
 

@@ -165,6 +165,8 @@ class _NullBank:
     def build(goal_count, dimension):
         from pydrake.systems.framework import LeafSystem
 
+        from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+
         class NullBank(LeafSystem):
             def __init__(self):
                 super().__init__()
@@ -172,8 +174,7 @@ class _NullBank:
                 self.DeclareVectorInputPort("robot_state", 2 * d)
                 self.DeclareVectorInputPort("goals", k * d)
                 self.DeclareVectorInputPort("operator_active", 1)
-                # The DmpBank system's one state vector [phase, held, p, z, offset].
-                self.DeclareDiscreteState(np.zeros(2 + d + 2 * k * d))
+                self.DeclareDiscreteState(np.zeros(DmpBankSystem.state_size(k, d)))
                 self.DeclarePeriodicDiscreteUpdateEvent(DT, 0.0, self._update)
 
             def _update(self, context, discrete_state):

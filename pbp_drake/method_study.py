@@ -35,7 +35,7 @@ import time
 
 import numpy as np
 
-from pbp_drake.scenarios import ScenarioError, with_method
+from pbp_drake.scenarios import ScenarioError, parse_method_label, with_method
 
 TRIAL_FORMAT = 1
 # Collision-ratio histogram: 20 bins of 0.05 over [0, 1] (the last bin includes 1).
@@ -658,13 +658,13 @@ def ideal_alpha(methods):
     `fixed_alpha=A` methods (None when it has none)."""
     swept = []
     for label, entry in methods.items():
-        name, _, alpha = label.partition("=")
-        if name == "fixed_alpha" and alpha:
-            swept.append((float(alpha), entry))
+        name, alpha = parse_method_label(label)
+        if name == "fixed_alpha" and alpha is not None:
+            swept.append((alpha, entry))
     if not swept:
         return None
     good = []
-    for alpha, entry in sorted(swept, key=lambda item: item[0]):
+    for alpha, entry in swept:
         ran = entry["trials"] - entry["errors"]
         does_task = (entry["success_rate"] is not None
                      and entry["success_rate"] >= IDEAL_ALPHA_SUCCESS)

@@ -586,15 +586,15 @@ def _validate_alpha_study(study, scenario):
         raise ScenarioError("the alpha study needs scenario.demonstration")
 
 
-def with_method(scenario, label):
-    """The scenario run by the method `label`: a name of METHODS, or `fixed_alpha=A` for
-    explicit arbitration with weight A (so that one study can sweep alpha)."""
+def parse_method_label(label):
+    """`(name, alpha)` of a method label: a name of METHODS (alpha None), or `fixed_alpha=A`
+    for explicit arbitration with weight A (so that one study can sweep alpha)."""
     name, _, alpha = label.partition("=")
     if name not in METHODS:
         raise ScenarioError(f"method {label!r} is unknown; choose from {METHODS} or "
                             f"fixed_alpha=A{_close(name, METHODS)}")
     if not alpha:
-        return dataclasses.replace(scenario, method=name)
+        return name, None
     if name != "fixed_alpha":
         raise ScenarioError(f"method {label!r}: only fixed_alpha takes a weight (=A)")
     try:
@@ -603,7 +603,15 @@ def with_method(scenario, label):
         value = math.nan
     if not (np.isfinite(value) and 0.0 <= value <= 1.0):
         raise ScenarioError(f"method {label!r}: alpha must be a number in [0, 1]")
-    return dataclasses.replace(scenario, method=name, alpha=value)
+    return name, value
+
+
+def with_method(scenario, label):
+    """The scenario run by the method `label` (see `parse_method_label`)."""
+    name, alpha = parse_method_label(label)
+    if alpha is None:
+        return dataclasses.replace(scenario, method=name)
+    return dataclasses.replace(scenario, method=name, alpha=alpha)
 
 
 def validate_method_comparison(study, scenario):

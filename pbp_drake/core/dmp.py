@@ -371,7 +371,7 @@ class DmpBank:
             self.shared_weights and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all())
             and bool((starts == starts[:, :1]).all()))
         self._uniform_start = starts[:, :1].copy()
-        self._scaled_rows = scaling[:, :1].astype(float)
+        self._scaled_dimensions = scaling[:, :1].astype(float)
         self._alpha_goal = np.empty((d, 1))
         self._alpha_constant = np.empty((d, 1))
         self._column = np.empty((d, 1))
@@ -631,7 +631,7 @@ class DmpBank:
         start = self._uniform_start
         if self._ijspeert:
             # a = g + c (g - y0) where scaled, g + c where not.
-            scaled = self._scaled_rows
+            scaled = self._scaled_dimensions
             np.multiply(shape, scaled, out=alpha_goal)
             np.multiply(alpha_goal, -start, out=alpha_constant)
             alpha_constant += shape

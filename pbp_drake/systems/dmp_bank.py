@@ -65,8 +65,8 @@ class DmpBank(LeafSystem):
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         # Held at the start: the DMPs sit at their starts (p = 0, offset = -starts), at rest.
         self._z = slice(2 + d, 2 + d + k * d)
-        self._offset = slice(2 + d + k * d, 2 + d + 2 * k * d)
-        initial = np.zeros(2 + d + 2 * k * d)
+        self._offset = slice(2 + d + k * d, self.state_size(k, d))
+        initial = np.zeros(self.state_size(k, d))
         initial[0], initial[1] = 1.0, 1.0
         initial[self._offset] = -bank.starts.reshape(-1)
         self._state_index = self.DeclareDiscreteState(initial)
@@ -91,6 +91,11 @@ class DmpBank(LeafSystem):
                 prerequisites_of_calc={self.xd_ticket(),
                                        self._goals_port.ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
+
+    @staticmethod
+    def state_size(goal_count, dimension):
+        """The length of the one state vector `[phase, held, p, z, offset]`."""
+        return 2 + dimension + 2 * goal_count * dimension
 
     @property
     def bank(self):

@@ -1,0 +1,27 @@
+"""Named layouts of the HSR task's vectors, in one place (`pydrake` `namedview`s).
+
+Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
+``EeState.size`` is its length. Every system that declares such a port takes its size here.
+"""
+
+from pydrake.common.containers import namedview
+
+
+def _view(name, fields):
+    view = namedview(name, fields)
+    view.size = len(fields)
+    return view
+
+
+# The end effector's state, world frame: position, velocity, heading on the floor plane
+# (rad, counter-clockwise from +x) and its rate.
+EeState = _view("EeState", ["x", "y", "z", "vx", "vy", "vz", "heading", "heading_rate"])
+# The command the HSR station follows: the position to be at, its velocity, the heading.
+EeCommand = _view("EeCommand", ["x", "y", "z", "vx", "vy", "vz", "heading"])
+# An operator's command on the HSR: a world-frame velocity and a yaw rate.
+OperatorCommand = _view("OperatorCommand", ["vx", "vy", "vz", "yaw_rate"])
+# The current target of the task: its position and the object's index.
+Target = _view("Target", ["x", "y", "z", "index"])
+# The task monitor's status (see `TaskMonitor`).
+TaskStatus = _view("TaskStatus", ["progress", "stage", "success", "task_time",
+                                  "intervention_ratio", "steps", "collision_ratio"])

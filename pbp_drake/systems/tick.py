@@ -1,0 +1,31 @@
+"""The order within one control tick, stated once for every system and every diagram.
+
+Drake computes all discrete updates of one instant from the values before that instant, so
+two systems that update at the same tick cannot see each other's new state. A PBP tick has
+two stages, in this order:
+
+1. **sense** at `t_k` (offset `SENSE_OFFSET`): the robot's state is sampled (`SampleHold`)
+   and the operator decides (it reads the robot's state and Meshcat's input).
+2. **decide** at `t_k + decide_offset(period)`: the DMP bank, the goal estimator, the heading,
+   the task monitor and the moving obstacles update from the state sampled at `t_k` and the
+   operator's decision of the same tick (as the paper's Alg. 2 reads them). The blender's
+   output depends on its inputs only, so the command the robot follows from `t_k` on is
+   the one of tick k.
+
+The decide stage sits a millionth of the control period after the tick: long before any
+plant step that follows the tick, and far from the next tick. Systems of the decide stage
+use it by default, so neither a diagram nor user code states an offset.
+
+Loggers publish before the updates of their instant: a log sample at `t_k` holds the plant's
+state at `t_k` but the decisions of tick k - 1. `DECISION_LOG_SHIFT` is how many samples
+later the decisions of tick k appear (see `pbp_drake.simulation.read_log`).
+"""
+
+SENSE_OFFSET = 0.0
+DECIDE_FRACTION = 1e-6
+DECISION_LOG_SHIFT = 1
+
+
+def decide_offset(control_period):
+    """The offset (s) after each tick at which the decide stage updates."""
+    return float(control_period) * DECIDE_FRACTION

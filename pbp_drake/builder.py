@@ -18,45 +18,32 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, Multiplexer, ZeroOrderHold
 
-from pbp_drake.core.dmp import DmpBank as DmpBankMath
 from pbp_drake.scenarios import (
-    Gamepad as GamepadConfig, Hsr, Keyboard as KeyboardConfig, NoOperator as NoOperatorConfig,
-    ObstacleRepulsion, ScriptedCommands, SinusoidalStep,
-    VirtualParticipant as VirtualParticipantConfig, demonstration_samples, dmp_settings,
-    goal_estimator_settings, resolved_goals, resolved_start, task_layout, validate_scenario)
+    Gamepad as GamepadConfig, Keyboard as KeyboardConfig, NoOperator as NoOperatorConfig,
+    ObstacleRepulsion, ResolvedScenario, ScriptedCommands, SinusoidalStep,
+    VirtualParticipant as VirtualParticipantConfig, resolve)
 from pbp_drake.systems import (
     Blender, DemonstrationPlayer, DmpBank, GoalsSource, NoOperator, ObstacleRepulsionOperator,
     PointRobot, ScriptedOperator)
 
-# How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
-BLEND_MODE_OF_METHOD = {
-    "pbp_alternated": "pbp_alternated",
-    "pbp_continuous": "pbp_continuous",
-    "pbp_no_user": "pbp_continuous",
-    "fixed_alpha": "fixed_alpha",
-    "confidence_alpha": "confidence_alpha",
-    "teleop": "teleop",
-}
-
 
 def build_diagram(scenario, meshcat=None, prediction_steps=None):
-    """Builds the scenario's Diagram; with `meshcat`, also draws it there.
+    """Builds the Diagram of a `ResolvedScenario` (or of a `Scenario`, resolved here once);
+    with `meshcat`, also draws it there.
 
     `prediction_steps` (default: the DMP's duration in control periods when drawing) sets how
     far ahead the DMP bank predicts its paths for drawing.
     """
-    validate_scenario(scenario)
-    if isinstance(scenario.robot, Hsr):
-        return _build_hsr_diagram(scenario, meshcat)
+    resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
+    if resolved.is_hsr:
+        return _build_hsr_diagram(resolved, meshcat)
+    scenario = resolved.scenario
     period = scenario.control_period
-    start = resolved_start(scenario)
-    goals = resolved_goals(scenario)
+    start, goals = resolved.start, resolved.goals
     goal_count, dimension = goals.shape
     builder = DiagramBuilder()
 
-    robot = builder.AddNamedSystem("robot", PointRobot(
-        start, scenario.robot.mass, scenario.robot.stiffness, scenario.robot.damping,
-        scenario.robot.time_step))
+    robot = builder.AddNamedSystem("robot", PointRobot(start, scenario.robot))
     robot_state = robot.get_state_output_port()
     sample = builder.AddNamedSystem("robot_state_sample", ZeroOrderHold(period, 2 * dimension))
     builder.Connect(robot_state, sample.get_input_port())
@@ -66,18 +53,18 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
         builder.Connect(robot_state, operator.get_input_port(0))
 
     blender = builder.AddNamedSystem("blender", Blender(
-        BLEND_MODE_OF_METHOD[scenario.method], dimension, goal_count, period, scenario.alpha))
+        resolved.blend_mode, dimension, goal_count, period, scenario.alpha))
     dmp_bank = None
     if scenario.method == "fixed_alpha":
-        times, positions = demonstration_samples(scenario.demonstration)
+        times, positions = resolved.demonstration
         policy = builder.AddNamedSystem(
             "demonstration_player", DemonstrationPlayer(times, positions, period))
     else:
         if prediction_steps is None:
             prediction_steps = 0 if meshcat is None else int(round(
-                make_dmp_bank(scenario).duration / period))
+                resolved.dmp_bank.duration / period))
         dmp_bank = policy = builder.AddNamedSystem("dmp_bank", DmpBank(
-            make_dmp_bank(scenario), period,
+            resolved.dmp_bank, period,
             lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
             prediction_steps=prediction_steps, update_offset=scenario.robot.time_step / 4))
         goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
@@ -106,8 +93,8 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
         from pbp_drake.systems.point_scene_visualizer import PointSceneVisualizer
 
         demonstration = None
-        if scenario.demonstration is not None:
-            demonstration = demonstration_samples(scenario.demonstration)[1]
+        if resolved.demonstration is not None:
+            demonstration = resolved.demonstration[1]
         visualizer = builder.AddNamedSystem("visualizer", PointSceneVisualizer(
             meshcat, start, goals, scenario.obstacles, demonstration,
             prediction_steps if dmp_bank is not None else 0))
@@ -123,19 +110,6 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
     return diagram
 
 
-def make_dmp_bank(scenario):
-    """The DMP math of the scenario: learned from its demonstration, else straight paths."""
-    settings = dmp_settings(scenario.dmp)
-    start = resolved_start(scenario)
-    goal_count = resolved_goals(scenario).shape[0]
-    duration = scenario.dmp.duration if scenario.dmp.duration > 0 else None
-    if scenario.demonstration is None:
-        return DmpBankMath.straight(start, goal_count, duration, settings)
-    times, positions = demonstration_samples(scenario.demonstration)
-    return DmpBankMath.from_demonstration(times, positions, goal_count, settings, start,
-                                          duration)
-
-
 def make_operator(scenario, dimension):
     """The operator system the scenario asks for (none at all for PBP-NoUser)."""
     config = scenario.operator
@@ -145,8 +119,7 @@ def make_operator(scenario, dimension):
     if isinstance(config, ObstacleRepulsion):
         return ObstacleRepulsionOperator(
             [o.center for o in scenario.obstacles], [o.radius for o in scenario.obstacles],
-            dimension, period, config.distance_threshold, config.speed,
-            config.axis if config.axis else None)
+            dimension, period, config)
     if isinstance(config, SinusoidalStep):
         times, commands = sinusoidal_step_commands(config, period, scenario.duration)
         return ScriptedOperator(times, commands, period)
@@ -169,7 +142,7 @@ def sinusoidal_step_commands(config, control_period, duration):
 HSR_PREDICTION_SAMPLES = 40
 
 
-def _build_hsr_diagram(scenario, meshcat):
+def _build_hsr_diagram(resolved, meshcat):
     """The HSR reaching task (section IV-B.1 of the paper):
 
         station.ee_state ──> ee_state_sample (SampleHold) ──> dmp_bank, goal_estimator,
@@ -189,17 +162,18 @@ def _build_hsr_diagram(scenario, meshcat):
     from pbp_drake.systems.task_monitor import TaskMonitor
     from pbp_drake.systems.vector_split import VectorSplit
 
+    scenario = resolved.scenario
     period = scenario.control_period
     task = scenario.task
-    layout = task_layout(scenario)
+    layout = resolved.layout
     goals = layout.objects
     goal_count = len(goals)
-    offset = scenario.robot.time_step / 4
+    offset = resolved.station.plant.time_step / 4
     builder = DiagramBuilder()
 
-    station = add_hsr_station(builder, time_step=scenario.robot.time_step, meshcat=meshcat,
-                              ee_height=task.height, command_period=period,
-                              diff_ik_time_step=scenario.robot.diff_ik_time_step)
+    station = add_hsr_station(builder, time_step=resolved.station.plant.time_step,
+                              meshcat=meshcat, ee_height=task.height, command_period=period,
+                              diff_ik_time_step=resolved.station.diff_ik_time_step)
     start = station.initial_ee_state[:3]
     ee_state = station.ee_state
     sample = builder.AddNamedSystem("ee_state_sample",
@@ -211,7 +185,7 @@ def _build_hsr_diagram(scenario, meshcat):
 
     goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
     estimator = builder.AddNamedSystem("goal_estimator", GoalEstimator(
-        goal_count, goal_estimator_settings(scenario.goal_estimator), period,
+        goal_count, scenario.goal_estimator, period,
         update_offset=offset))
     builder.Connect(sample.get_output_port(), estimator.get_ee_state_input_port())
     builder.Connect(goals_source.get_output_port(), estimator.get_goals_input_port())
@@ -226,7 +200,7 @@ def _build_hsr_diagram(scenario, meshcat):
                                    monitor, offset)
 
     operator = builder.AddNamedSystem("operator", make_hsr_operator(
-        scenario, meshcat, layout.objects, obstacles is not None))
+        resolved, meshcat, obstacles is not None))
     for port_name, source in [("ee_state", ee_state),
                               ("target", monitor.get_target_output_port()),
                               ("selected_goal", estimator.get_selected_goal_output_port()),
@@ -238,7 +212,7 @@ def _build_hsr_diagram(scenario, meshcat):
     operator_command = operator.get_operator_command_output_port()
     builder.Connect(operator_active, monitor.get_operator_active_input_port())
 
-    bank = make_hsr_dmp_bank(scenario, start, goals)
+    bank = resolved.dmp_bank
     prediction_steps = HSR_PREDICTION_SAMPLES if meshcat is not None else 0
     dmp_bank = builder.AddNamedSystem("dmp_bank", DmpBank(
         bank, period, lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
@@ -255,7 +229,7 @@ def _build_hsr_diagram(scenario, meshcat):
     builder.Connect(operator_command, heading.get_operator_command_input_port())
 
     blender = builder.AddNamedSystem("blender", Blender(
-        BLEND_MODE_OF_METHOD[scenario.method], 3, goal_count, period, scenario.alpha))
+        resolved.blend_mode, 3, goal_count, period, scenario.alpha))
     builder.Connect(ee_position_velocity, blender.get_robot_state_input_port())
     builder.Connect(dmp_bank.get_references_output_port(), blender.get_references_input_port())
     builder.Connect(estimator.get_selected_goal_output_port(),
@@ -296,15 +270,6 @@ def _build_hsr_diagram(scenario, meshcat):
     return diagram
 
 
-def make_hsr_dmp_bank(scenario, start, goals):
-    """One straight-path DMP per object from the end effector's start; the duration gives
-    the farthest object the nominal speed `scenario.robot.speed`."""
-    distance = np.max(np.linalg.norm(np.asarray(goals) - start, axis=1))
-    duration = scenario.dmp.duration if scenario.dmp.duration > 0 else (
-        distance / scenario.robot.speed)
-    return DmpBankMath.straight(start, len(goals), duration, dmp_settings(scenario.dmp))
-
-
 def _add_obstacles(builder, scenario, station, obstacle_scene, sample, monitor, offset):
     """The moving cylinders, measured against the robot's collision geometry."""
     from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
@@ -340,23 +305,22 @@ def _add_obstacles(builder, scenario, station, obstacle_scene, sample, monitor, 
     return obstacles
 
 
-def make_hsr_operator(scenario, meshcat, objects, with_obstacles=False):
+def make_hsr_operator(resolved, meshcat, with_obstacles=False):
     """The HSR task's operator: a person at the keyboard or gamepad, or the virtual one
     (which, `with_obstacles`, watches the task's obstacles)."""
+    scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
     allow_forward = scenario.method == "teleop"
-    speed = getattr(config, "speed", 0.0) or scenario.robot.speed
+    speed = resolved.nominal_speed
     if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
         return NoOperator(4, period)
     if isinstance(config, VirtualParticipantConfig):
         from pbp_drake.systems.virtual_participant import VirtualParticipant
 
         return VirtualParticipant(
-            period, objects, mode="drive" if allow_forward else "assist", speed=speed,
-            rotation_speed=config.rotation_speed, reaction_delay=config.reaction_delay,
-            direction_noise=config.direction_noise, speed_noise=config.speed_noise,
-            seed=scenario.seed,
+            period, resolved.layout.objects, mode="drive" if allow_forward else "assist",
+            params=config, nominal_speed=speed, seed=scenario.seed,
             obstacle_count=scenario.task.obstacle_count if with_obstacles else 0,
             obstacle_radius=scenario.task.obstacle_radius if with_obstacles else 0.0,
             policy_adds=scenario.method == "pbp_continuous")
@@ -366,13 +330,9 @@ def make_hsr_operator(scenario, meshcat, objects, with_obstacles=False):
     if isinstance(config, KeyboardConfig):
         from pbp_drake.systems.keyboard_operator import KeyboardOperator
 
-        return KeyboardOperator(meshcat, period, allow_forward, speed=speed,
-                                rotation_speed=config.rotation_speed,
-                                hold_time=config.hold_time)
+        return KeyboardOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
     if isinstance(config, GamepadConfig):
         from pbp_drake.systems.gamepad_operator import GamepadOperator
 
-        return GamepadOperator(meshcat, period, allow_forward, speed=speed,
-                               rotation_speed=config.rotation_speed,
-                               dead_zone=config.dead_zone)
+        return GamepadOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
     raise TypeError(f"unknown operator config {type(config).__name__}")

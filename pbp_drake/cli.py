@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from pbp_drake.scenarios import (
-    METHODS, OPERATOR_NAMES, Hsr, MethodComparison, ScenarioError, load_scenario_file)
+    METHODS, OPERATOR_NAMES, Hsr, MethodComparison, ScenarioError, load_scenario_file, resolve)
 
 
 def main(argv=None):
@@ -98,9 +98,8 @@ def main(argv=None):
 
 def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operator=None,
                      seed=None, duration=None):
-    """The file's scenario with the command line's overrides applied and checked."""
-    from pbp_drake.scenarios import validate_scenario
-
+    """The file's resolved scenario with the command line's overrides applied: resolved again
+    only when an override changes what is derived (a method or alpha does not)."""
     scenario = scenario_file.scenario
     if duration is not None:
         if not (np.isfinite(duration) and duration > 0):
@@ -118,10 +117,6 @@ def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operato
             scenario = dataclasses.replace(scenario, operator=OPERATOR_NAMES[operator]())
     if seed is not None:
         scenario = dataclasses.replace(scenario, seed=seed)
-    if method is not None:
-        scenario = dataclasses.replace(scenario, method=method)
-    if alpha is not None:
-        scenario = dataclasses.replace(scenario, alpha=alpha)
     if scene is not None:
         scenes = getattr(scenario_file.study, "scenes", [])
         names = [s.name for s in scenes]
@@ -131,10 +126,19 @@ def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operato
         scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{scene}",
                                        obstacles=list(chosen.obstacles))
     try:
-        validate_scenario(scenario)
+        resolved = (scenario_file.resolved if scenario is scenario_file.scenario
+                    else resolve(scenario))
+        method = method or scenario.method
+        if alpha is not None:
+            if method != "fixed_alpha":
+                raise ScenarioError(f"--alpha sets the weight of fixed_alpha; the method is "
+                                    f"{method}")
+            method = f"fixed_alpha={alpha}"
+        if method != scenario.method or alpha is not None:
+            resolved = resolved.with_method(method)
     except ScenarioError as error:
         raise ScenarioError(f"{error} (after the command-line overrides)") from None
-    return scenario
+    return resolved
 
 
 def _run(args):
@@ -144,13 +148,14 @@ def _run(args):
     from pbp_drake.core.toy_scene import collision_ratio
     from pbp_drake.simulation import simulate
 
-    scenario = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
+    resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
                                 args.scene, args.operator, args.seed, args.duration)
+    scenario = resolved.scenario
     meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
     print(f"Meshcat: {meshcat.web_url()}", flush=True)
-    if isinstance(scenario.robot, Hsr):
-        return _run_task(args, scenario, meshcat)
-    diagram = build_diagram(scenario, meshcat)
+    if resolved.is_hsr:
+        return _run_task(args, resolved, meshcat)
+    diagram = build_diagram(resolved, meshcat)
     if not args.headless and sys.stdin.isatty():
         _wait_for_browser(meshcat, args.wait_for_browser)
     if args.record:
@@ -172,20 +177,21 @@ def _run(args):
     return 0
 
 
-def _run_task(args, scenario, meshcat):
+def _run_task(args, resolved, meshcat):
     from pbp_drake.builder import build_diagram
     from pbp_drake.scenarios import Gamepad, Keyboard
     from pbp_drake.task_run import run_task
 
+    scenario = resolved.scenario
     person = isinstance(scenario.operator, (Keyboard, Gamepad))
     if args.headless and person:
         raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
                             "--operator virtual")
     if args.participant is not None:
-        return _run_session(args, scenario, meshcat, person)
+        return _run_session(args, resolved, meshcat, person)
     if args.methods is not None or args.output is not None:
         raise ScenarioError("--methods and --output belong to a session: add --participant ID")
-    diagram = build_diagram(scenario, meshcat)
+    diagram = build_diagram(resolved, meshcat)
     if person or (not args.headless and sys.stdin.isatty()):
         # A person needs the page open before the task starts.
         print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
@@ -210,12 +216,13 @@ def _run_task(args, scenario, meshcat):
     return 0 if result.success else 1
 
 
-def _run_session(args, scenario, meshcat, person):
+def _run_session(args, resolved, meshcat, person):
     from pbp_drake.builder import build_diagram
     from pbp_drake.scenarios import with_method
     from pbp_drake.task_run import run_task
     from pbp_drake.user_study import DEFAULT_SESSION_METHODS, run_session, session_order
 
+    scenario = resolved.scenario
     if args.record:
         raise ScenarioError("--record saves one run; a session saves every run under --output")
     methods = _method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
@@ -302,7 +309,7 @@ def _study(args):
 
 def _method_study(args, scenario_file):
     from pbp_drake.method_study import ProgressBar, run_method_comparison
-    from pbp_drake.scenarios import validate_method_comparison
+    from pbp_drake.scenarios import check_method_comparison
 
     study = scenario_file.study or MethodComparison()
     if not isinstance(study, MethodComparison):
@@ -320,7 +327,7 @@ def _method_study(args, scenario_file):
     if len(set(study.methods)) != len(study.methods):
         raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
     try:
-        validate_method_comparison(study, scenario_file.scenario)
+        check_method_comparison(study, scenario_file.scenario)
     except ScenarioError as error:
         raise ScenarioError(f"{error} (after the command-line overrides)") from None
     output = pathlib.Path(args.output)

@@ -6,32 +6,34 @@ robot's state, the blender forms the command, and the robot makes its plant step
 
 import numpy as np
 
-from pbp_drake.builder import BLEND_MODE_OF_METHOD, sinusoidal_step_commands
+from pbp_drake.builder import sinusoidal_step_commands
 from pbp_drake.core.arbitration import blend
 from pbp_drake.core.dmp import DmpBank
 from pbp_drake.core.point_robot import MassSpringDamper
 from pbp_drake.core.toy_scene import repulsion_command
 from pbp_drake.scenarios import (
-    NoOperator, ObstacleRepulsion, SinusoidalStep, demonstration_samples, dmp_settings,
-    resolved_goals, resolved_start)
+    BLEND_MODE_OF_METHOD, NoOperator, ObstacleRepulsion, SinusoidalStep, demonstration_samples)
 
 
 def plain_loop(scenario):
     """Returns the robot's positions (T, D) at the control ticks."""
     period = scenario.control_period
-    start, goals = resolved_start(scenario), resolved_goals(scenario)
+    demonstration = (None if scenario.demonstration is None
+                     else demonstration_samples(scenario.demonstration)[1])
+    start = np.asarray(scenario.start or demonstration[0], float)
+    goals = np.asarray(scenario.goals or demonstration[-1:], float)
     robot = MassSpringDamper(scenario.robot.mass, scenario.robot.stiffness,
                              scenario.robot.damping, scenario.robot.time_step)
     plant_steps = int(round(period / scenario.robot.time_step))
     ticks = int(round(scenario.duration / period))
     mode = BLEND_MODE_OF_METHOD[scenario.method]
-    settings = dmp_settings(scenario.dmp)
+    settings = scenario.dmp
     if scenario.demonstration is not None:
         times, demo = demonstration_samples(scenario.demonstration)
         bank = DmpBank.from_demonstration(times, demo, len(goals), settings, start,
-                                          scenario.dmp.duration or None)
+                                          scenario.dmp_duration or None)
     else:
-        bank = DmpBank.straight(start, len(goals), scenario.dmp.duration, settings)
+        bank = DmpBank.straight(start, len(goals), scenario.dmp_duration, settings)
     phase, _, scaled_velocity = bank.initial_state()
     goals_dk = bank.goals_matrix(goals)
     operator = scenario.operator

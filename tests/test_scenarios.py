@@ -12,7 +12,7 @@ scenario:
   method: pbp_continuous
   start: [0.0, 0.0]
   goals: [[1.0, 0.0]]
-  dmp: {duration: 1.0}
+  dmp_duration: 1.0
   operator: !ObstacleRepulsion {speed: 1.0}
 """
 
@@ -74,7 +74,7 @@ def test_alpha_study_with_alpha_outside_unit_interval_is_refused(tmp_path, repo)
 def test_cli_reports_bad_input_without_a_traceback(tmp_path, capsys, repo):
     assert main(["run", str(repo / "diagrams/toy_alpha_study.yaml"), "--method", "telop",
                  "--headless"]) == 2
-    assert "scenario.method 'telop' is unknown" in capsys.readouterr().err
+    assert "method 'telop' is unknown" in capsys.readouterr().err
     assert main(["run", str(repo / "diagrams/toy_alpha_study.yaml"), "--scene", "nowhere",
                  "--headless"]) == 2
     assert "--scene 'nowhere' is not in this file's study" in capsys.readouterr().err

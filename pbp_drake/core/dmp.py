@@ -35,7 +35,7 @@ from pbp_drake.core.linear import second_order_transition
 FORMULATIONS = ("ijspeert", "pastor")
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass
 class DmpSettings:
     """Gains and basis of a DMP; the defaults are those of DMP_NOTES.md.
 
@@ -54,6 +54,11 @@ class DmpSettings:
     alpha_x: float = math.log(100.0)
 
     def __post_init__(self):
+        self.validate()
+
+    def validate(self):
+        """Raises ValueError naming the first field that cannot be used (a YAML loader sets
+        the fields after construction, so `resolve` calls this again)."""
         if self.formulation not in FORMULATIONS:
             raise ValueError(
                 f"formulation {self.formulation!r} is unknown; choose one of {FORMULATIONS}"

@@ -41,23 +41,31 @@ FLOOR_EPSILON = 1e-9
 NO_CHALLENGER = -1
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass
 class GoalEstimatorSettings:
-    """How goals are scored and how sticky the selection is.
+    """How goals are scored and how sticky the selection is (scenario files: the
+    `goal_estimator` section).
 
-    `temperature` scales ``angle`` (rad) and ``nearest`` (m) scores; `beta` (1/m) is the
-    rationality of ``bayesian``. The selection switches once another goal beats it by more
-    than `margin` (in probability) for `hold_steps` consecutive updates; `margin=0,
-    hold_steps=1` switches to the most probable goal at once.
+    `method` is ``angle`` (the paper's heuristic), ``nearest`` or ``bayesian``.
+    `temperature` scales ``angle`` (rad) and ``nearest`` (m) scores: low enough that objects
+    a few degrees apart are told apart. `beta` (1/m) is the rationality of ``bayesian``.
+    The selection switches once another goal beats it by more than `margin` (in
+    probability) for `hold_steps` consecutive updates; `margin=0, hold_steps=1` switches to
+    the most probable goal at once.
     """
 
     method: str = "angle"
-    temperature: float = 0.2
+    temperature: float = 0.1
     beta: float = 5.0
     margin: float = 0.1
     hold_steps: int = 2
 
     def __post_init__(self):
+        self.validate()
+
+    def validate(self):
+        """Raises ValueError naming the first field that cannot be used (a YAML loader sets
+        the fields after construction, so `resolve` calls this again)."""
         if self.method not in GOAL_ESTIMATION_METHODS:
             raise ValueError(f"goal estimation method {self.method!r} is unknown; choose one "
                              f"of {GOAL_ESTIMATION_METHODS}")

@@ -23,6 +23,7 @@ Example::
     diagram = builder.Build()
 """
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,6 +92,26 @@ class HsrStation:
     ee_state: object
     initial_ee_state: np.ndarray
     visualizer: MeshcatVisualizer | None = None
+
+
+@dataclass
+class HsrStationConfig:
+    """TEMPORARY (replaced by the station branch)."""
+
+    plant: MultibodyPlantConfig = dataclasses.field(default_factory=lambda: MultibodyPlantConfig(
+        time_step=0.005, discrete_contact_approximation="sap"))
+    diff_ik_time_step: float = 0.01
+    command_period: float = 0.0
+    initial_base: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
+    ee_height: float = 0.7
+
+
+def hsr_initial_ee_state(config):
+    """TEMPORARY."""
+    from pydrake.systems.framework import DiagramBuilder
+    station = add_hsr_station(DiagramBuilder(), config.plant.time_step,
+                              initial_base=config.initial_base, ee_height=config.ee_height)
+    return station.initial_ee_state
 
 
 def heading_of(R_WE: RotationMatrix) -> float:

@@ -1,12 +1,26 @@
 """A person with a gamepad in a Meshcat browser: sticks move and turn the end effector."""
 
+import dataclasses
+
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
-from pbp_drake.systems.sampled_operator import SampledOperator
+from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 # Standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN.
 LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X = 0, 1, 2
+
+
+@dataclasses.dataclass
+class GamepadParams:
+    """A person with a gamepad in the browser (HSR tasks): the left stick moves the end
+    effector at up to `speed` (m/s; 0 takes the task's nominal speed, that of its DMPs),
+    the right stick turns it at up to `rotation_speed` (rad/s); `dead_zone` is each stick's
+    radial dead zone, in [0, 1)."""
+
+    speed: float = 0.0
+    rotation_speed: float = 0.6
+    dead_zone: float = 0.15
 
 
 class GamepadOperator(SampledOperator):
@@ -37,16 +51,17 @@ class GamepadOperator(SampledOperator):
     inactive. Meshcat must be used only from the thread that created it.
     """
 
-    def __init__(self, meshcat, control_period, allow_forward, speed=0.2,
-                 rotation_speed=0.6, dead_zone=0.15):
-        if not 0.0 <= dead_zone < 1.0:
-            raise ValueError(f"dead_zone must be in [0, 1), not {dead_zone}")
+    def __init__(self, meshcat, control_period, allow_forward, params=GamepadParams(),
+                 nominal_speed=None):
+        if not 0.0 <= params.dead_zone < 1.0:
+            raise ValueError(f"dead_zone must be in [0, 1), not {params.dead_zone}")
         super().__init__(4, control_period)
+        self.params = dataclasses.replace(params)
         self._meshcat = meshcat
         self._allow_forward = bool(allow_forward)
-        self._speed = float(speed)
-        self._rotation_speed = float(rotation_speed)
-        self._dead_zone = float(dead_zone)
+        self._speed = operator_speed(params.speed, nominal_speed)
+        self._rotation_speed = float(params.rotation_speed)
+        self._dead_zone = float(params.dead_zone)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
         self._declare_operator_outputs()
 

@@ -1,5 +1,7 @@
 """The goal estimator as a Drake system: which of K goals the operator means."""
 
+import dataclasses
+
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
@@ -45,12 +47,14 @@ class GoalEstimator(LeafSystem):
         if not isinstance(settings, GoalEstimatorSettings):
             raise ValueError(f"settings must be a GoalEstimatorSettings, got "
                              f"{type(settings).__name__}")
+        settings.validate()
         if not np.isfinite(control_period) or control_period <= 0.0:
             raise ValueError(f"control_period must be positive, got {control_period!r}")
         if not np.isfinite(update_offset) or update_offset < 0.0:
             raise ValueError(f"update_offset must be >= 0, got {update_offset!r}")
         self._goal_count = int(goal_count)
-        self._settings = settings
+        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
+        self._settings = dataclasses.replace(settings)
         self._period = float(control_period)
         k = self._goal_count
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)

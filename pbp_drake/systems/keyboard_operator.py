@@ -1,9 +1,11 @@
 """A person at the keyboard of a Meshcat browser: arrow keys move the end effector, Q/E turn it."""
 
+import dataclasses
+
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
-from pbp_drake.systems.sampled_operator import SampledOperator
+from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 FORWARD_BUTTON = "Forward (↑)"
 BACK_BUTTON = "Back (↓)"
@@ -31,6 +33,19 @@ _KEY_AXES = {
     TURN_LEFT_BUTTON: (0.0, 0.0, 1.0),
     TURN_RIGHT_BUTTON: (0.0, 0.0, -1.0),
 }
+
+
+@dataclasses.dataclass
+class KeyboardParams:
+    """A person at the browser's keyboard (HSR tasks): arrows move the end effector at
+    `speed` (m/s; 0 takes the task's nominal speed, that of its DMPs), Q and E turn it at
+    `rotation_speed` (rad/s)."""
+
+    speed: float = 0.0
+    rotation_speed: float = 0.6
+    # A key counts as held this long (s) after its last press. The browser repeats a held
+    # key, but only after the system's repeat delay (often 0.25..0.66 s): bridge it.
+    hold_time: float = 0.6
 
 
 class KeyboardOperator(SampledOperator):
@@ -69,14 +84,15 @@ class KeyboardOperator(SampledOperator):
     stay in Meshcat until `Delete()` is called.
     """
 
-    def __init__(self, meshcat, control_period, allow_forward, speed=0.2,
-                 rotation_speed=0.6, hold_time=0.25):
+    def __init__(self, meshcat, control_period, allow_forward, params=KeyboardParams(),
+                 nominal_speed=None):
         super().__init__(4, control_period)
+        self.params = dataclasses.replace(params)
         self._meshcat = meshcat
         self._allow_forward = bool(allow_forward)
-        self._speed = float(speed)
-        self._rotation_speed = float(rotation_speed)
-        self._hold_time = float(hold_time)
+        self._speed = operator_speed(params.speed, nominal_speed)
+        self._rotation_speed = float(params.rotation_speed)
+        self._hold_time = float(params.hold_time)
         self._buttons = [name for name in KEY_BUTTONS
                          if allow_forward or name != FORWARD_BUTTON]
         for name in self._buttons:

@@ -1,9 +1,22 @@
 """The 2-D (any-D) robot of the paper's toy experiments as a Drake system."""
 
+import dataclasses
+
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.point_robot import MassSpringDamper
+
+
+@dataclasses.dataclass
+class PointRobotParams:
+    """The point robot's dynamics: mass (kg), the tracking spring (N/m) and damper (N s/m),
+    and its discrete time step (s). Scenario files give it as `robot: {...}`."""
+
+    mass: float = 1.0
+    stiffness: float = 400.0
+    damping: float = 40.0
+    time_step: float = 0.001
 
 
 class PointRobot(LeafSystem):
@@ -23,12 +36,14 @@ class PointRobot(LeafSystem):
     sees a settled state and its command applies from the very next plant step.
     """
 
-    def __init__(self, initial_position, mass=1.0, stiffness=400.0, damping=40.0,
-                 time_step=0.001):
+    def __init__(self, initial_position, params=PointRobotParams()):
         super().__init__()
         initial_position = np.asarray(initial_position, dtype=float)
         self._dimension = initial_position.size
-        self._dynamics = MassSpringDamper(mass, stiffness, damping, time_step)
+        self.params = dataclasses.replace(params)
+        time_step = params.time_step
+        self._dynamics = MassSpringDamper(params.mass, params.stiffness, params.damping,
+                                          time_step)
         self._command_port = self.DeclareVectorInputPort("command", 2 * self._dimension)
         state_index = self.DeclareDiscreteState(
             np.concatenate([initial_position, np.zeros(self._dimension)]))

@@ -1,9 +1,21 @@
 """Base of every operator system: a command sampled into discrete state each control tick."""
 
+import math
+
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.arbitration import validate_command
+
+
+def operator_speed(speed, nominal_speed):
+    """The speed (m/s) an HSR operator moves the hand at: `speed`, or where that is 0 (its
+    parameters' default) the task's nominal speed, the speed of its DMPs."""
+    chosen = speed or nominal_speed
+    if chosen is None or not (math.isfinite(chosen) and chosen > 0):
+        raise ValueError(f"the operator's speed must be positive: got speed {speed!r} and "
+                         f"nominal_speed {nominal_speed!r} (speed 0 takes nominal_speed)")
+    return float(chosen)
 
 
 class SampledOperator(LeafSystem):

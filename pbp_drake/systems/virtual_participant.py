@@ -1,10 +1,12 @@
 """A virtual participant for the HSR tasks: stands in for the paper's users in automated runs."""
 
+import dataclasses
+
 import numpy as np
 
 from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
 from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
-from pbp_drake.systems.sampled_operator import SampledOperator
+from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 PARTICIPANT_MODES = ("assist", "drive")
 # Within this distance of the target (m) the participant no longer minds obstacles...
@@ -26,6 +28,27 @@ RELEASE_HEADING_GAP = 0.05
 GOAL_MARGIN_FACTOR = 1.0
 # PBP-Cont: how much faster than `speed` it may push against the policy.
 POLICY_COMPENSATION = 3.0
+
+
+@dataclasses.dataclass
+class VirtualParticipantParams:
+    """How the virtual participant behaves (see `VirtualParticipant`). `speed` (m/s) 0 takes
+    the task's nominal speed, that of its DMPs. Its noise comes from the scenario's seed."""
+
+    speed: float = 0.0
+    rotation_speed: float = 0.8
+    # It notices a new target this long (s) after it appears.
+    reaction_delay: float = 0.3
+    # Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
+    # (1 + N(0, speed_noise)).
+    direction_noise: float = 0.1
+    speed_noise: float = 0.1
+    # Driving (teleop), it slows within this distance (m) of the target.
+    slow_radius: float = 0.15
+    # It counts as facing a point within this angle (rad).
+    aligned_angle: float = 0.05
+    # Once it takes control among obstacles, it keeps it at least this long (s).
+    hold_time: float = 0.5
 
 
 class VirtualParticipant(SampledOperator):
@@ -72,25 +95,25 @@ class VirtualParticipant(SampledOperator):
     `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0).
     """
 
-    def __init__(self, control_period, objects, mode="assist", speed=0.2, rotation_speed=0.6,
-                 reaction_delay=0.3, direction_noise=0.1, speed_noise=0.1, seed=0,
-                 slow_radius=0.15, aligned_angle=0.05, obstacle_count=0,
-                 obstacle_radius=0.0, obstacle_margin=None,
-                 policy_adds=False, hold_time=0.5):
+    def __init__(self, control_period, objects, mode="assist",
+                 params=VirtualParticipantParams(), nominal_speed=None, seed=0,
+                 obstacle_count=0, obstacle_radius=0.0, obstacle_margin=None,
+                 policy_adds=False):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
         super().__init__(4, control_period)
         self._mode = mode
         self._objects = np.asarray(objects, dtype=float)
-        self._speed = float(speed)
-        self._rotation_speed = float(rotation_speed)
-        self._reaction_ticks = int(round(reaction_delay / control_period))
-        self._direction_noise = float(direction_noise)
-        self._speed_noise = float(speed_noise)
+        self.params = dataclasses.replace(params)
+        self._speed = operator_speed(params.speed, nominal_speed)
+        self._rotation_speed = float(params.rotation_speed)
+        self._reaction_ticks = int(round(params.reaction_delay / control_period))
+        self._direction_noise = float(params.direction_noise)
+        self._speed_noise = float(params.speed_noise)
         self._seed = int(seed)
-        self._slow_radius = float(slow_radius)
-        self._aligned_angle = float(aligned_angle)
+        self._slow_radius = float(params.slow_radius)
+        self._aligned_angle = float(params.aligned_angle)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
         self._target_port = self.DeclareVectorInputPort("target", 4)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
@@ -110,7 +133,7 @@ class VirtualParticipant(SampledOperator):
         self._obstacle_margin = float(obstacle_margin)
         self._release_heading_gap = (0.12 if mode == "assist" and not policy_adds
                                      else RELEASE_HEADING_GAP)
-        self._hold_ticks = int(round(hold_time / control_period))
+        self._hold_ticks = int(round(params.hold_time / control_period))
         if obstacle_count > 0:
             self._obstacles_port = self.DeclareVectorInputPort(
                 "obstacle_positions", 2 * int(obstacle_count))

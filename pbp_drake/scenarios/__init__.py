@@ -1,0 +1,29 @@
+"""Scenario files: the schema (`schema`), reading them (`loading`) and resolving them
+(`resolution`: everything checked and derived once by `resolve`).
+
+Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario` ->
+`pbp_drake.builder.build_diagram`.
+"""
+
+from pbp_drake.scenarios.loading import (
+    LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file)
+from pbp_drake.scenarios.resolution import (
+    BLEND_MODE_OF_METHOD, ResolvedScenario, TaskLayout, demonstration_samples,
+    parse_method_label, resolve, task_layout, with_method)
+from pbp_drake.scenarios.schema import (
+    HSR_OPERATORS, METHODS, OPERATOR_NAMES, TOY_OPERATORS, AlphaStudy, AltVsCont, BentPath,
+    DynamicObstacles, Gamepad, Hsr, Keyboard, MethodComparison, MultiGoalReach, NoOperator,
+    Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot, RecordedPath, Scenario,
+    ScenarioError, ScenarioFile, SceneVariant, ScriptedCommands, SinusoidalStep,
+    VirtualParticipant)
+
+__all__ = [
+    "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHODS", "OPERATOR_NAMES", "TOY_OPERATORS",
+    "AlphaStudy", "AltVsCont", "BentPath", "DynamicObstacles", "Gamepad", "Hsr", "Keyboard",
+    "LoadedScenarioFile", "MethodComparison", "MultiGoalReach", "NoOperator", "Obstacle",
+    "ObstacleRepulsion", "OperatorConfig", "PointRobot", "RecordedPath", "ResolvedScenario",
+    "Scenario", "ScenarioError", "ScenarioFile", "SceneVariant", "ScriptedCommands",
+    "SinusoidalStep", "TaskLayout", "VirtualParticipant", "check_alpha_study",
+    "check_method_comparison", "demonstration_samples", "load_scenario_file",
+    "parse_method_label", "resolve", "task_layout", "with_method",
+]

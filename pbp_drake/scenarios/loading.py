@@ -1,0 +1,106 @@
+"""Reading a scenario file: parsed by `yaml_load_typed`, then resolved (which checks it).
+
+Unknown or misspelled keys are errors that name the key (with a suggestion); values are
+checked by `resolve`, and a study section by the checks here.
+"""
+
+import dataclasses
+import pathlib
+import typing
+
+import numpy as np
+from pydrake.common.yaml import yaml_load_typed
+
+from pbp_drake.scenarios.resolution import ResolvedScenario, close_match, resolve, with_method
+from pbp_drake.scenarios.schema import (
+    AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
+    ScenarioFile)
+
+
+@dataclasses.dataclass(frozen=True)
+class LoadedScenarioFile:
+    """A scenario file read and resolved: its `scenario` and `study` configs as written, and
+    `resolved`, the scenario with everything derived (see `resolve`)."""
+
+    path: pathlib.Path
+    scenario: Scenario
+    study: typing.Any
+    resolved: ResolvedScenario
+
+
+def load_scenario_file(path):
+    """Reads, checks and resolves a scenario file; errors name the file and the field."""
+    path = pathlib.Path(path)
+    if not path.is_file():
+        raise ScenarioError(f"{path}: no such scenario file")
+    try:
+        loaded = yaml_load_typed(schema=ScenarioFile, filename=str(path))
+    except RuntimeError as error:
+        raise ScenarioError(f"{path}: {error}{_suggestion(str(error))}") from None
+    try:
+        resolved = resolve(loaded.scenario)
+        if isinstance(loaded.study, AlphaStudy):
+            check_alpha_study(loaded.study, loaded.scenario)
+        if isinstance(loaded.study, MethodComparison):
+            check_method_comparison(loaded.study, loaded.scenario)
+    except ScenarioError as error:
+        raise ScenarioError(f"{path}: {error}") from None
+    return LoadedScenarioFile(path=path, scenario=loaded.scenario, study=loaded.study,
+                              resolved=resolved)
+
+
+def check_alpha_study(study, scenario):
+    if not study.scenes:
+        raise ScenarioError("study.scenes is empty")
+    if not study.alphas:
+        raise ScenarioError("study.alphas is empty")
+    for alpha in study.alphas:
+        if not (np.isfinite(alpha) and 0.0 <= alpha <= 1.0):
+            raise ScenarioError(f"study.alphas has {alpha}, outside [0, 1]")
+    if scenario.demonstration is None:
+        raise ScenarioError("the alpha study needs scenario.demonstration")
+
+
+def check_method_comparison(study, scenario):
+    if not isinstance(scenario.robot, Hsr):
+        raise ScenarioError("study !MethodComparison runs HSR tasks: use robot: !Hsr")
+    if not study.methods:
+        raise ScenarioError("study.methods is empty")
+    for method in study.methods:
+        try:
+            with_method(scenario, method)
+        except ScenarioError as error:
+            raise ScenarioError(f"study.methods: {error}") from None
+    if study.trials < 1:
+        raise ScenarioError(f"study.trials must be at least 1, got {study.trials}")
+    if isinstance(scenario.operator, (Keyboard, Gamepad)):
+        raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
+
+
+def _all_field_names(schema=ScenarioFile, seen=None):
+    seen = set() if seen is None else seen
+    names = set()
+    if not dataclasses.is_dataclass(schema) or schema in seen:
+        return names
+    seen.add(schema)
+    for field in dataclasses.fields(schema):
+        names.add(field.name)
+        for inner in _dataclasses_in(field.type):
+            names |= _all_field_names(inner, seen)
+    return names
+
+
+def _dataclasses_in(annotation):
+    if dataclasses.is_dataclass(annotation):
+        return [annotation]
+    return [inner for arg in typing.get_args(annotation) for inner in _dataclasses_in(arg)]
+
+
+def _suggestion(message):
+    """`did you mean` for Drake's "The fields ['sped'] were unknown" messages."""
+    start, end = message.find("["), message.find("]")
+    if start < 0 or end < start:
+        return ""
+    unknown = [name.strip(" '\"") for name in message[start + 1:end].split(",")]
+    known = _all_field_names()
+    return "".join(close_match(name, known - {name}) for name in unknown)

@@ -1,0 +1,380 @@
+"""Resolving a scenario: every value checked and everything derived, once.
+
+`resolve(scenario)` turns the configs of a scenario file into a `ResolvedScenario`: the
+robot's start, the goals, the demonstration's samples, the fitted DMP bank, the task's
+layout (objects, targets, obstacles, drawn from the seed), the HSR station's config and
+the blend mode. Validating is resolving: a value that cannot be used raises a
+`ScenarioError` naming its field, and nothing downstream (the builder, the studies, the
+CLI) derives any of these again.
+"""
+
+import dataclasses
+import difflib
+import math
+import typing
+
+import numpy as np
+
+from pbp_drake.core.dmp import DmpBank, validate_demonstration
+from pbp_drake.core.obstacle_task import sample_obstacle_scene
+from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
+from pbp_drake.core.toy_scene import bent_path
+from pbp_drake.robots.hsr_station import hsr_initial_ee_state
+from pbp_drake.scenarios.schema import (
+    HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, Hsr, ObstacleRepulsion,
+    Scenario, ScenarioError, ScriptedCommands, SinusoidalStep)
+
+# How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
+BLEND_MODE_OF_METHOD = {
+    "pbp_alternated": "pbp_alternated",
+    "pbp_continuous": "pbp_continuous",
+    "pbp_no_user": "pbp_continuous",
+    "fixed_alpha": "fixed_alpha",
+    "confidence_alpha": "confidence_alpha",
+    "teleop": "teleop",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class TaskLayout:
+    """What an HSR task puts in front of the robot: the goals `(K, 3)` (one DMP each), the
+    target sequence and its switch schedule, and the obstacles (None without)."""
+
+    objects: np.ndarray
+    targets: tuple
+    switch_schedule: tuple
+    obstacles: typing.Any = None
+
+
+@dataclasses.dataclass(frozen=True)
+class ResolvedScenario:
+    """A scenario with everything derived from it (see `resolve`).
+
+    Attributes:
+        scenario: the configs it was resolved from.
+        blend_mode: the blender's mode for `scenario.method`.
+        start: (D,) where the robot (2-D scenes) or the hand (HSR) starts.
+        goals: (K, D) the goals, one DMP each.
+        demonstration: (times (T,), positions (T, D)) or None.
+        dmp_bank: the fitted `pbp_drake.core.dmp.DmpBank` (read-only by convention).
+        layout: the HSR task's `TaskLayout`, None in 2-D scenes.
+        station: the HSR station's config (hand height and command period filled in from
+            the task), None in 2-D scenes.
+        initial_ee_state: (8,) the HSR hand's state at the start, None in 2-D scenes.
+        nominal_speed: the DMPs' nominal speed (m/s) on the HSR, None in 2-D scenes.
+    """
+
+    scenario: Scenario
+    blend_mode: str
+    start: np.ndarray
+    goals: np.ndarray
+    demonstration: typing.Optional[tuple]
+    dmp_bank: DmpBank
+    layout: typing.Optional[TaskLayout] = None
+    station: typing.Any = None
+    initial_ee_state: typing.Optional[np.ndarray] = None
+    nominal_speed: typing.Optional[float] = None
+
+    @property
+    def is_hsr(self):
+        return self.layout is not None
+
+    def with_method(self, label):
+        """This scenario run by the method `label` (see `parse_method_label`); what does not
+        depend on the method (the DMPs, the scene) is kept, not derived again."""
+        scenario = with_method(self.scenario, label)
+        _check_method(scenario, self.goals.shape[0])
+        return dataclasses.replace(self, scenario=scenario,
+                                   blend_mode=BLEND_MODE_OF_METHOD[scenario.method])
+
+
+def resolve(scenario):
+    """Checks `scenario` and derives everything a build needs; see `ResolvedScenario`.
+
+    Raises ScenarioError naming the first field whose value cannot be used.
+    """
+    _check_common(scenario)
+    if isinstance(scenario.robot, Hsr):
+        return _resolve_hsr(scenario)
+    return _resolve_point_robot(scenario)
+
+
+def parse_method_label(label):
+    """`(name, alpha)` of a method label: a name of METHODS (alpha None), or `fixed_alpha=A`
+    for explicit arbitration with weight A (so that one study can sweep alpha)."""
+    name, _, alpha = label.partition("=")
+    if name not in METHODS:
+        raise ScenarioError(f"method {label!r} is unknown; choose from {METHODS} or "
+                            f"fixed_alpha=A{close_match(name, METHODS)}")
+    if not alpha:
+        return name, None
+    if name != "fixed_alpha":
+        raise ScenarioError(f"method {label!r}: only fixed_alpha takes a weight (=A)")
+    try:
+        value = float(alpha)
+    except ValueError:
+        value = math.nan
+    if not (np.isfinite(value) and 0.0 <= value <= 1.0):
+        raise ScenarioError(f"method {label!r}: alpha must be a number in [0, 1]")
+    return name, value
+
+
+def with_method(scenario, label):
+    """The scenario run by the method `label` (see `parse_method_label`)."""
+    name, alpha = parse_method_label(label)
+    if alpha is None:
+        return dataclasses.replace(scenario, method=name)
+    return dataclasses.replace(scenario, method=name, alpha=alpha)
+
+
+def close_match(name, choices):
+    """` (did you mean 'x'?)` when one of `choices` is close to `name`, else ``."""
+    matches = difflib.get_close_matches(name, list(choices), n=1)
+    return f" (did you mean {matches[0]!r}?)" if matches else ""
+
+
+def _check_common(scenario):
+    if scenario.method not in METHODS:
+        raise ScenarioError(
+            f"scenario.method {scenario.method!r} is unknown; choose one of {METHODS}"
+            f"{close_match(scenario.method, METHODS)}")
+    if not (np.isfinite(scenario.alpha) and 0.0 <= scenario.alpha <= 1.0):
+        raise ScenarioError(f"scenario.alpha = {scenario.alpha} is outside [0, 1]")
+    for name in ("control_period", "duration"):
+        if not getattr(scenario, name) > 0:
+            raise ScenarioError(f"scenario.{name} must be positive")
+    _settings_checked("scenario.dmp", scenario.dmp)
+    _settings_checked("scenario.goal_estimator", scenario.goal_estimator)
+    if not (np.isfinite(scenario.dmp_duration) and scenario.dmp_duration >= 0):
+        raise ScenarioError("scenario.dmp_duration must be finite and not negative")
+
+
+def _settings_checked(field, settings):
+    try:
+        settings.validate()
+    except ValueError as error:
+        raise ScenarioError(f"{field}: {error}") from None
+
+
+def _whole_multiple(value, step):
+    ratio = value / step
+    return round(ratio) >= 1 and abs(ratio - round(ratio)) < 1e-9
+
+
+def _check_method(scenario, goal_count):
+    """What the method asks of the rest of the scenario."""
+    if isinstance(scenario.robot, Hsr):
+        return
+    if scenario.method == "confidence_alpha":
+        raise ScenarioError("scenario.method confidence_alpha needs a goal estimator's "
+                            "confidence: use it in the HSR tasks (robot: !Hsr)")
+    if scenario.method == "fixed_alpha" and scenario.demonstration is None:
+        raise ScenarioError(
+            "scenario.method fixed_alpha plays the demonstration as P: give "
+            "scenario.demonstration")
+    if scenario.method == "fixed_alpha" and goal_count != 1:
+        raise ScenarioError("scenario.method fixed_alpha takes exactly one goal here")
+
+
+def demonstration_samples(demonstration):
+    """Times `(T,)` and positions `(T, D)` of a demonstration config."""
+    if isinstance(demonstration, BentPath):
+        return bent_path(demonstration.start, demonstration.goal, demonstration.bend,
+                         demonstration.duration, demonstration.sample_count)
+    return (np.asarray(demonstration.times, float),
+            np.asarray(demonstration.positions, float))
+
+
+def _resolve_point_robot(scenario):
+    if not _whole_multiple(scenario.control_period, scenario.robot.time_step):
+        raise ScenarioError(
+            "scenario.control_period must be a whole multiple of scenario.robot.time_step")
+    if scenario.task is not None or not isinstance(scenario.operator, TOY_OPERATORS):
+        raise ScenarioError(
+            f"scenario.task and operator !{type(scenario.operator).__name__} need "
+            "robot: !Hsr {...}")
+    demonstration = None
+    if scenario.demonstration is not None:
+        try:
+            demonstration = validate_demonstration(
+                *demonstration_samples(scenario.demonstration))
+        except ValueError as error:
+            raise ScenarioError(f"scenario.demonstration: {error}") from None
+    elif not scenario.start or not scenario.goals:
+        raise ScenarioError(
+            "scenario.start and scenario.goals are needed when there is no demonstration")
+    start = (np.asarray(scenario.start, float) if scenario.start
+             else demonstration[1][0].copy())
+    goals = (np.asarray(scenario.goals, float).reshape(len(scenario.goals), -1)
+             if scenario.goals else demonstration[1][-1][np.newaxis, :].copy())
+    if goals.shape[1] != start.size:
+        raise ScenarioError(
+            f"scenario.goals have dimension {goals.shape[1]}, scenario.start has {start.size}")
+    if not (np.isfinite(goals).all() and np.isfinite(start).all()):
+        raise ScenarioError("scenario.goals and scenario.start must be finite")
+    _check_method(scenario, goals.shape[0])
+    if scenario.dmp_duration <= 0 and demonstration is None:
+        raise ScenarioError("scenario.dmp_duration is needed when there is no demonstration")
+    for index, obstacle in enumerate(scenario.obstacles):
+        if len(obstacle.center) != start.size or not obstacle.radius > 0:
+            raise ScenarioError(
+                f"scenario.obstacles[{index}] needs a center of dimension {start.size} and a "
+                "positive radius")
+    _check_toy_operator(scenario.operator, start.size)
+    duration = scenario.dmp_duration if scenario.dmp_duration > 0 else None
+    if demonstration is None:
+        bank = DmpBank.straight(start, goals.shape[0], duration, scenario.dmp)
+    else:
+        bank = DmpBank.from_demonstration(*demonstration, goals.shape[0], scenario.dmp,
+                                          start, duration)
+    return ResolvedScenario(
+        scenario=scenario, blend_mode=BLEND_MODE_OF_METHOD[scenario.method], start=start,
+        goals=goals, demonstration=demonstration, dmp_bank=bank)
+
+
+def _check_toy_operator(operator, dimension):
+    if isinstance(operator, ObstacleRepulsion):
+        if operator.axis and (len(operator.axis) != dimension or not np.any(operator.axis)):
+            raise ScenarioError(
+                f"scenario.operator.axis must be a nonzero vector of dimension {dimension}")
+        if not np.isfinite(operator.speed) or not operator.distance_threshold > 0:
+            raise ScenarioError("scenario.operator.speed must be finite and "
+                                "distance_threshold positive")
+    elif isinstance(operator, SinusoidalStep):
+        if len(operator.axis) != dimension:
+            raise ScenarioError(f"scenario.operator.axis must have dimension {dimension}")
+        if not (np.isfinite(operator.amplitude) and operator.duration > 0 and operator.period > 0):
+            raise ScenarioError("scenario.operator.amplitude must be finite, duration and "
+                                "period positive")
+    elif isinstance(operator, ScriptedCommands):
+        commands = np.asarray(operator.commands, float)
+        if commands.ndim != 2 or commands.shape != (len(operator.times), dimension):
+            raise ScenarioError(
+                f"scenario.operator.commands must be one command of dimension {dimension} "
+                "per time")
+        if not np.isfinite(commands).all():
+            raise ScenarioError("scenario.operator.commands contain NaN or infinite values")
+
+
+def _resolve_hsr(scenario):
+    robot = scenario.robot
+    if scenario.task is None:
+        raise ScenarioError("robot !Hsr needs scenario.task, e.g. task: {object_count: [2, 4]}")
+    if not isinstance(scenario.operator, HSR_OPERATORS):
+        raise ScenarioError(
+            f"scenario.operator !{type(scenario.operator).__name__} drives the 2-D toy robot; "
+            f"the HSR takes one of {[c.__name__ for c in HSR_OPERATORS]}")
+    if scenario.demonstration is not None or scenario.goals or scenario.start:
+        raise ScenarioError("the HSR task draws its own goals (the objects) and starts "
+                            "where the robot stands: remove scenario.demonstration, goals "
+                            "and start")
+    if not (np.isfinite(robot.speed) and robot.speed > 0):
+        raise ScenarioError("scenario.robot.speed must be positive")
+    if not _whole_multiple(scenario.control_period, robot.station.plant.time_step):
+        raise ScenarioError("scenario.control_period must be a whole multiple of "
+                            "scenario.robot.station.plant.time_step")
+    operator = scenario.operator
+    for name in ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
+                 "direction_noise", "speed_noise"):
+        value = getattr(operator, name, 0.0)
+        if not (np.isfinite(value) and value >= 0):
+            raise ScenarioError(f"scenario.operator.{name} must be finite and not negative")
+    task = scenario.task
+    if isinstance(task, DynamicObstacles):
+        _check_obstacle_task(task)
+    else:
+        _check_reach_task(task)
+    try:
+        layout = task_layout(task, scenario.seed)
+    except ValueError as error:
+        raise ScenarioError(f"scenario.task: {error}") from None
+    # The hand starts at the task's height; the station ramps between the loop's ticks.
+    station = dataclasses.replace(robot.station, ee_height=task.height,
+                                  command_period=scenario.control_period)
+    try:
+        initial_ee_state = hsr_initial_ee_state(station)
+    except ValueError as error:
+        raise ScenarioError(f"scenario.robot.station: {error}") from None
+    start = initial_ee_state[:3].copy()
+    goals = np.asarray(layout.objects, float)
+    distance = np.max(np.linalg.norm(goals - start, axis=1))
+    duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
+    bank = DmpBank.straight(start, len(goals), duration, scenario.dmp)
+    return ResolvedScenario(
+        scenario=scenario, blend_mode=BLEND_MODE_OF_METHOD[scenario.method], start=start,
+        goals=goals, demonstration=None, dmp_bank=bank, layout=layout, station=station,
+        initial_ee_state=initial_ee_state, nominal_speed=float(robot.speed))
+
+
+def _check_reach_task(task):
+    if not (0 < task.success_distance and 0 < task.min_separation):
+        raise ScenarioError("scenario.task.success_distance and min_separation must be "
+                            "positive")
+    schedule = np.asarray(task.switch_schedule, float)
+    if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
+            or schedule[-1] >= 1.0):
+        raise ScenarioError(f"scenario.task.switch_schedule {task.switch_schedule} must "
+                            "start at 0.0 and increase strictly below 1.0")
+
+
+def _check_obstacle_task(task):
+    for name in ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"):
+        if not (np.isfinite(getattr(task, name)) and getattr(task, name) > 0):
+            raise ScenarioError(f"scenario.task.{name} must be positive")
+    if task.obstacle_count < 0:
+        raise ScenarioError("scenario.task.obstacle_count must not be negative")
+    for name in ("x_range", "y_range", "obstacle_x_range", "obstacle_y_range",
+                 "activation_range"):
+        low_high = getattr(task, name)
+        if len(low_high) != 2 or not low_high[0] <= low_high[1]:
+            raise ScenarioError(f"scenario.task.{name} must be [low, high], got {low_high}")
+    if not 0.0 <= task.activation_range[0] <= task.activation_range[1] <= 1.0:
+        raise ScenarioError("scenario.task.activation_range must lie in [0, 1]")
+
+
+def task_layout(task, seed):
+    """The goals, targets and obstacles of an HSR task, drawn from `seed` when asked."""
+    if isinstance(task, DynamicObstacles):
+        _check_region(task)
+        obstacles = sample_obstacle_scene(
+            seed, tuple(task.x_range), tuple(task.y_range), task.height,
+            task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
+            tuple(task.activation_range))
+        return TaskLayout(objects=obstacles.target[np.newaxis, :], targets=(0,),
+                          switch_schedule=(0.0,), obstacles=obstacles)
+    scene = _reach_scene(task, seed)
+    return TaskLayout(objects=scene.objects, targets=scene.targets,
+                      switch_schedule=tuple(task.switch_schedule))
+
+
+def _reach_scene(task, seed):
+    """The objects and target sequence of a reaching task: given, or drawn from the seed."""
+    if task.objects:
+        objects = validate_objects(task.objects, task.min_separation)
+        targets = tuple(int(t) for t in task.targets)
+        if len(task.switch_schedule) > 1 and len(objects) < 2:
+            raise ValueError("target switching needs at least 2 objects: add objects or set "
+                             "switch_schedule to [0.0]")
+        if len(targets) != len(task.switch_schedule):
+            raise ValueError(f"targets {list(targets)} needs one object index per entry of "
+                             f"switch_schedule {task.switch_schedule}")
+        if any(not 0 <= t < len(objects) for t in targets):
+            raise ValueError(f"targets {list(targets)} name objects that do not exist "
+                             f"({len(objects)} objects)")
+        if any(a == b for a, b in zip(targets, targets[1:])):
+            raise ValueError(f"targets {list(targets)}: each switch must go to a different "
+                             "object")
+        return ReachScene(objects=objects, targets=targets)
+    if task.targets:
+        raise ValueError("targets are given without objects")
+    _check_region(task)
+    return sample_reach_scene(seed, tuple(task.object_count), tuple(task.x_range),
+                              tuple(task.y_range), task.height, tuple(task.switch_schedule),
+                              task.min_separation)
+
+
+def _check_region(task):
+    """Every corner of the region the task draws its targets from must be in reach."""
+    if len(task.x_range) != 2 or len(task.y_range) != 2:
+        raise ValueError("x_range and y_range must be [low, high]")
+    validate_objects([[x, y, task.height] for x in task.x_range for y in task.y_range], 0.0)

@@ -1,0 +1,249 @@
+"""The schema of a scenario file: dataclasses read from YAML with `yaml_load_typed`.
+
+A file holds one `scenario` (everything one simulation needs: robot, method, operator,
+goals, demonstration, obstacles, rates) and optionally a `study` that varies it. Variants
+are chosen with YAML tags, e.g. ``operator: !ObstacleRepulsion {speed: 1.0}``.
+
+One default per knob: where a system is configurable, its section IS that system's
+parameter dataclass (``goal_estimator`` is `GoalEstimatorSettings`, ``dmp`` is
+`DmpSettings`, ``operator: !Keyboard`` a `KeyboardParams`, the HSR's ``station`` an
+`HsrStationConfig`), so a Python user constructing the system and a YAML user get the same
+robot. The tag classes below (`Keyboard`, `PointRobot`, ...) only name the variants; they
+add no field and no default. Drake's own config structs are nested where they exist
+(`SimulatorConfig`). `pbp_drake.scenarios.resolve` checks and derives everything else.
+"""
+
+import dataclasses
+import typing
+
+from pydrake.systems.analysis import SimulatorConfig
+
+from pbp_drake.core.dmp import DmpSettings
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.robots.hsr_station import HsrStationConfig
+from pbp_drake.systems.gamepad_operator import GamepadParams
+from pbp_drake.systems.keyboard_operator import KeyboardParams
+from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionParams
+from pbp_drake.systems.point_robot import PointRobotParams
+from pbp_drake.systems.virtual_participant import VirtualParticipantParams
+
+class ScenarioError(ValueError):
+    """A scenario file or value that cannot be used; the message names the field."""
+
+
+METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
+           "pbp_no_user")
+
+
+@dataclasses.dataclass
+class Obstacle:
+    """A disc (sphere in 3-D) the 2-D robot must not enter."""
+
+    center: list[float] = dataclasses.field(default_factory=list)
+    radius: float = 0.1
+
+
+class PointRobot(PointRobotParams):
+    """`robot: {...}` (the default variant): the toy robot, a point mass-spring-damper."""
+
+
+@dataclasses.dataclass
+class Hsr:
+    """`robot: !Hsr {...}`: the simulated Toyota HSR (our primitive-shape model) under
+    whole-body differential IK; the PBP loop commands its end effector in task space."""
+
+    station: HsrStationConfig = dataclasses.field(default_factory=HsrStationConfig)
+    # The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it,
+    # and operators whose speed is 0 move the hand at it.
+    speed: float = 0.12
+
+
+@dataclasses.dataclass
+class BentPath:
+    """A demonstration from `start` to `goal` that bows sideways by `bend` at mid-path."""
+
+    start: list[float] = dataclasses.field(default_factory=list)
+    goal: list[float] = dataclasses.field(default_factory=list)
+    bend: float = 0.0
+    duration: float = 1.0
+    sample_count: int = 200
+
+
+@dataclasses.dataclass
+class RecordedPath:
+    """A demonstration given sample by sample."""
+
+    times: list[float] = dataclasses.field(default_factory=list)
+    positions: list[list[float]] = dataclasses.field(default_factory=list)
+
+
+@dataclasses.dataclass
+class NoOperator:
+    """No operator input at all (u = 0)."""
+
+
+class ObstacleRepulsion(ObstacleRepulsionParams):
+    """`operator: !ObstacleRepulsion {...}`: the paper's virtual human of the 2-D scenes."""
+
+
+@dataclasses.dataclass
+class SinusoidalStep:
+    """Open-loop input along `axis`: `amplitude * sin(2 pi (t - start_time) / period)` for
+    `start_time <= t < start_time + duration`, then it stops at once (Fig. 4's input)."""
+
+    axis: list[float] = dataclasses.field(default_factory=list)
+    amplitude: float = 1.0
+    start_time: float = 0.2
+    duration: float = 0.4
+    period: float = 1.6
+
+
+@dataclasses.dataclass
+class ScriptedCommands:
+    """Commands `(T, D)` held from each of `times` until the next."""
+
+    times: list[float] = dataclasses.field(default_factory=list)
+    commands: list[list[float]] = dataclasses.field(default_factory=list)
+
+
+class Keyboard(KeyboardParams):
+    """`operator: !Keyboard {...}`: a person at the browser's keyboard (HSR tasks)."""
+
+
+class Gamepad(GamepadParams):
+    """`operator: !Gamepad {...}`: a person with a gamepad in the browser (HSR tasks)."""
+
+
+class VirtualParticipant(VirtualParticipantParams):
+    """`operator: !VirtualParticipant {...}`: the stand-in for the paper's participants."""
+
+
+OperatorConfig = typing.Union[NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands,
+                              Keyboard, Gamepad, VirtualParticipant]
+HSR_OPERATORS = (NoOperator, Keyboard, Gamepad, VirtualParticipant)
+TOY_OPERATORS = (NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands)
+# The names `pbp-drake run --operator` takes for the HSR tasks.
+OPERATOR_NAMES = {"keyboard": Keyboard, "gamepad": Gamepad, "virtual": VirtualParticipant,
+                  "none": NoOperator}
+
+
+@dataclasses.dataclass
+class MultiGoalReach:
+    """The paper's multi-goal reaching task (section IV-B.1): objects drawn from the seed in
+    a rectangle in front of the robot at one height; the target switches to another object
+    at each progress threshold of `switch_schedule` after the first (0 %)."""
+
+    object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
+    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    height: float = 0.7
+    min_separation: float = 0.2
+    switch_schedule: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.3, 0.6])
+    success_distance: float = 0.05
+    # Fixed objects `(M, 3)` and targets (object indices, one per schedule entry) instead of
+    # drawing them from the seed.
+    objects: list[list[float]] = dataclasses.field(default_factory=list)
+    targets: list[int] = dataclasses.field(default_factory=list)
+
+
+@dataclasses.dataclass
+class DynamicObstacles:
+    """The paper's obstacle task (section IV-B.2): one target drawn from the seed; cylinder
+    obstacles start still at random places and, once the progress passes each one's
+    threshold (drawn in `activation_range`), move at `obstacle_speed` to the midpoint of the
+    line from the hand to the target. Collisions are measured on the HSR's collision
+    geometry and do not push the robot."""
+
+    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    height: float = 0.7
+    success_distance: float = 0.05
+    obstacle_count: int = 3
+    obstacle_radius: float = 0.12
+    obstacle_height: float = 1.2
+    obstacle_speed: float = 0.15
+    obstacle_x_range: list[float] = dataclasses.field(default_factory=lambda: [0.9, 2.6])
+    obstacle_y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.3, 1.3])
+    activation_range: list[float] = dataclasses.field(default_factory=lambda: [0.05, 0.5])
+
+
+@dataclasses.dataclass
+class Scenario:
+    """Everything one simulation needs."""
+
+    name: str = "scenario"
+    # One of METHODS.
+    method: str = "pbp_alternated"
+    # The arbitration weight of `fixed_alpha`, in [0, 1].
+    alpha: float = 0.5
+    control_period: float = 0.01
+    # The time limit (s) of a run.
+    duration: float = 2.0
+    robot: typing.Union[PointRobot, Hsr] = dataclasses.field(default_factory=PointRobot)
+    # The robot's initial position; empty: the demonstration's start.
+    start: list[float] = dataclasses.field(default_factory=list)
+    # Candidate goals, one DMP each; empty: the demonstration's goal.
+    goals: list[list[float]] = dataclasses.field(default_factory=list)
+    # The demonstration the DMPs learn from; none: straight paths.
+    demonstration: typing.Optional[typing.Union[BentPath, RecordedPath]] = None
+    dmp: DmpSettings = dataclasses.field(default_factory=DmpSettings)
+    # The DMPs' duration tau (s); 0 takes the demonstration's duration (2-D scenes) or the
+    # farthest goal's distance over `robot.speed` (HSR).
+    dmp_duration: float = 0.0
+    obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
+    operator: OperatorConfig = dataclasses.field(default_factory=NoOperator)
+    # HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
+    # An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task.
+    task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles]] = None
+    goal_estimator: GoalEstimatorSettings = dataclasses.field(
+        default_factory=GoalEstimatorSettings)
+    seed: int = 0
+    # How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
+    # its target_realtime_rate).
+    simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
+
+
+@dataclasses.dataclass
+class SceneVariant:
+    """A test scene of the alpha study: the scenario with its obstacles replaced."""
+
+    name: str = ""
+    obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
+
+
+@dataclasses.dataclass
+class AlphaStudy:
+    """Explicit arbitration over `alphas` against PBP, in each scene (Fig. 2)."""
+
+    # Where the obstacles stood when the demonstration was given (drawn in panel a).
+    demonstration_obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
+    scenes: list[SceneVariant] = dataclasses.field(default_factory=list)
+    alphas: list[float] = dataclasses.field(
+        default_factory=lambda: [round(0.1 * i, 1) for i in range(11)])
+
+
+@dataclasses.dataclass
+class AltVsCont:
+    """The same DMP and open-loop input in continuous and alternated mode (Fig. 4)."""
+
+    # Both modes must end this close to the goal.
+    goal_tolerance: float = 0.01
+
+
+@dataclasses.dataclass
+class MethodComparison:
+    """The same seeded scenes for each method (trial i uses seed `seed + i`), driven by the
+    scenario's operator; `pbp-drake study --methods --trials --seed` override these."""
+
+    methods: list[str] = dataclasses.field(
+        default_factory=lambda: ["pbp_alternated", "pbp_continuous", "teleop"])
+    trials: int = 10
+    seed: int = 0
+
+
+@dataclasses.dataclass
+class ScenarioFile:
+    """The top level of a file in `diagrams/`."""
+
+    scenario: Scenario = dataclasses.field(default_factory=Scenario)
+    study: typing.Optional[typing.Union[AlphaStudy, AltVsCont, MethodComparison]] = None

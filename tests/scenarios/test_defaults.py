@@ -1,0 +1,71 @@
+"""One default per knob: a system built from a scenario file that leaves a section out has
+the same parameters as the same system constructed in Python with its defaults."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from pydrake.common.yaml import yaml_load_typed
+
+from pbp_drake.builder import build_diagram
+from pbp_drake.core.dmp import DmpSettings
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.scenarios import Scenario, resolve
+from pbp_drake.systems import (
+    GamepadOperator, GoalEstimator, KeyboardOperator, ObstacleRepulsionOperator, PointRobot,
+    VirtualParticipant)
+
+PERIOD = 0.03
+HSR = "robot: !Hsr {}\ntask: {}\ncontrol_period: 0.03\n"
+TOY = "start: [0.0, 0.0]\ngoals: [[1.0, 0.0]]\ndmp_duration: 1.0\n"
+
+
+def built(yaml_text, meshcat=None):
+    """The diagram and resolved scenario of a scenario written in YAML."""
+    resolved = resolve(yaml_load_typed(schema=Scenario, data=yaml_text))
+    return build_diagram(resolved, meshcat), resolved
+
+
+def params_of(system):
+    """A system's parameters as plain data (the YAML tag classes add no field)."""
+    return dataclasses.asdict(system.params)
+
+
+def test_virtual_participant_defaults_match(meshcat):
+    diagram, resolved = built(HSR + "operator: !VirtualParticipant {}\n")
+    from_yaml = diagram.GetSubsystemByName("operator")
+    in_python = VirtualParticipant(PERIOD, resolved.goals, nominal_speed=0.12)
+    assert params_of(from_yaml) == params_of(in_python)
+
+
+@pytest.mark.parametrize("tag, system", [("Keyboard", KeyboardOperator),
+                                         ("Gamepad", GamepadOperator)])
+def test_browser_operator_defaults_match(meshcat, tag, system):
+    diagram, _ = built(HSR + f"operator: !{tag} {{}}\nmethod: teleop\n", meshcat)
+    from_yaml = diagram.GetSubsystemByName("operator")
+    in_python = system(meshcat, PERIOD, allow_forward=True, nominal_speed=0.12)
+    assert params_of(from_yaml) == params_of(in_python)
+
+
+def test_goal_estimator_and_dmp_defaults_match():
+    diagram, resolved = built(HSR)
+    estimator = diagram.GetSubsystemByName("goal_estimator")
+    assert estimator.settings == GoalEstimator(2, GoalEstimatorSettings(), PERIOD).settings
+    assert diagram.GetSubsystemByName("dmp_bank").bank.settings == DmpSettings()
+
+
+def test_point_robot_and_repulsion_defaults_match():
+    diagram, _ = built(TOY + "obstacles: [{center: [0.5, 0.0]}]\n"
+                       "operator: !ObstacleRepulsion {}\n")
+    robot = diagram.GetSubsystemByName("robot")
+    assert params_of(robot) == params_of(PointRobot(np.zeros(2)))
+    operator = diagram.GetSubsystemByName("operator")
+    in_python = ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.01)
+    assert params_of(operator) == params_of(in_python)
+
+
+def test_changed_yaml_value_reaches_the_system():
+    diagram, _ = built(HSR + "operator: !VirtualParticipant {rotation_speed: 0.5}\n"
+                       "goal_estimator: {temperature: 0.3}\n")
+    assert diagram.GetSubsystemByName("operator").params.rotation_speed == 0.5
+    assert diagram.GetSubsystemByName("goal_estimator").settings.temperature == 0.3

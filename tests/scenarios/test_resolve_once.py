@@ -1,0 +1,48 @@
+"""Data goes through once: building a shipped scenario computes its demonstration once,
+fits its DMPs once and draws its scene once."""
+
+import collections
+import pathlib
+
+import pytest
+
+import pbp_drake.core.dmp as dmp_module
+import pbp_drake.scenarios.resolution as resolve_module
+from pbp_drake.builder import build_diagram
+from pbp_drake.scenarios import BentPath, load_scenario_file
+
+SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
+# Where each piece of work is done, by the name the caller looks it up under.
+COUNTED = [(resolve_module, "bent_path"), (dmp_module, "fit_weights"),
+           (resolve_module, "sample_reach_scene"), (resolve_module, "sample_obstacle_scene")]
+
+
+@pytest.fixture
+def work(monkeypatch):
+    """Counts the calls of each piece of work in COUNTED."""
+    counts = collections.Counter()
+    for module, name in COUNTED:
+        original = getattr(module, name)
+
+        def counting(*args, _name=name, _original=original, **kwargs):
+            counts[_name] += 1
+            return _original(*args, **kwargs)
+
+        monkeypatch.setattr(module, name, counting)
+    return counts
+
+
+def test_every_shipped_scenario_is_counted():
+    assert {path.stem for path in SHIPPED} >= {"toy_alpha_study", "toy_alt_vs_cont",
+                                               "hsr_reach", "hsr_obstacles"}
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda path: path.stem)
+def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
+    loaded = load_scenario_file(path)
+    build_diagram(loaded.resolved, meshcat)
+    scenario = loaded.scenario
+    assert work["bent_path"] == (1 if isinstance(scenario.demonstration, BentPath) else 0)
+    assert work["fit_weights"] == 1
+    scenes = work["sample_reach_scene"] + work["sample_obstacle_scene"]
+    assert scenes == (1 if scenario.task is not None else 0)

@@ -13,6 +13,7 @@ from pbp_drake.core.arbitration import (
 from pbp_drake.scenarios import ScriptedCommands, load_scenario_file
 from pbp_drake.simulation import simulate
 from pbp_drake.systems import Blender, PointRobot
+from pbp_drake.systems.point_robot import PointRobotParams
 
 
 @pytest.mark.parametrize("mode", ["pbp_continuous", "pbp_alternated", "fixed_alpha",
@@ -86,7 +87,7 @@ def test_nan_or_infinite_operator_command_stops_the_simulation(bad):
 
 def test_point_robot_settles_on_a_constant_reference():
     builder = DiagramBuilder()
-    robot = builder.AddSystem(PointRobot([0.0, 0.0], time_step=0.001))
+    robot = builder.AddSystem(PointRobot([0.0, 0.0], PointRobotParams(time_step=0.001)))
     source = builder.AddSystem(ConstantVectorSource([0.5, -0.2, 0.0, 0.0]))
     builder.Connect(source.get_output_port(), robot.get_command_input_port())
     diagram = builder.Build()

@@ -12,10 +12,10 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.systems.gamepad_operator import GamepadOperator
+from pbp_drake.systems.gamepad_operator import GamepadOperator, GamepadParams
 from pbp_drake.systems.keyboard_operator import (
     BACK_BUTTON, FORWARD_BUTTON, KEY_BUTTONS, LEFT_BUTTON, TURN_LEFT_BUTTON,
-    TURN_RIGHT_BUTTON, KeyboardOperator)
+    TURN_RIGHT_BUTTON, KeyboardOperator, KeyboardParams)
 
 PERIOD = 0.05
 SPEED, ROTATION_SPEED, HOLD_TIME = 0.2, 0.6, 0.25
@@ -75,12 +75,12 @@ def set_gamepad(meshcat, axes, index=0):
 
 
 def keyboard_rig(meshcat, allow_forward):
-    return Rig(KeyboardOperator(meshcat, PERIOD, allow_forward, speed=SPEED,
-                                rotation_speed=ROTATION_SPEED, hold_time=HOLD_TIME))
+    return Rig(KeyboardOperator(meshcat, PERIOD, allow_forward, KeyboardParams(
+        speed=SPEED, rotation_speed=ROTATION_SPEED, hold_time=HOLD_TIME)))
 
 
 def test_keyboard_buttons_carry_their_keys(meshcat):
-    operator = KeyboardOperator(meshcat, PERIOD, allow_forward=True)
+    operator = KeyboardOperator(meshcat, PERIOD, allow_forward=True, nominal_speed=SPEED)
     assert set(meshcat.GetButtonNames()) == set(KEY_BUTTONS)
     assert KEY_BUTTONS[LEFT_BUTTON] == "ArrowLeft"
     assert KEY_BUTTONS[TURN_LEFT_BUTTON] == "KeyQ"
@@ -115,7 +115,7 @@ def test_repeated_clicks_keep_a_key_held(meshcat):
 
 
 def test_clicks_before_initialisation_are_ignored(meshcat):
-    operator = KeyboardOperator(meshcat, PERIOD, allow_forward=False)
+    operator = KeyboardOperator(meshcat, PERIOD, allow_forward=False, nominal_speed=SPEED)
     click(meshcat, LEFT_BUTTON)
     rig = Rig(operator)
     rig.advance(2 * PERIOD)
@@ -167,8 +167,8 @@ def test_two_keys_combine(meshcat):
 
 
 def gamepad_rig(meshcat, allow_forward):
-    return Rig(GamepadOperator(meshcat, PERIOD, allow_forward, speed=SPEED,
-                               rotation_speed=ROTATION_SPEED, dead_zone=0.15))
+    return Rig(GamepadOperator(meshcat, PERIOD, allow_forward, GamepadParams(
+        speed=SPEED, rotation_speed=ROTATION_SPEED, dead_zone=0.15)))
 
 
 def test_no_gamepad_is_inactive(meshcat):

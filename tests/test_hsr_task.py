@@ -93,7 +93,7 @@ def test_the_blend_is_computed_once_per_control_tick(fixed_task, monkeypatch):
     simulator.AdvanceTo(0.6)
     ticks = round(0.6 / fixed_task.control_period) + 1
     assert ticks <= len(calls) <= 2 * ticks  # one per tick (and the operator's own moment)
-    assert len(calls) < round(0.6 / fixed_task.robot.time_step)
+    assert len(calls) < round(0.6 / fixed_task.robot.station.plant.time_step)
 
 
 def test_vector_split_gives_consecutive_pieces():
@@ -185,7 +185,7 @@ def test_study_compares_methods_on_the_same_scenes(tmp_path, capsys):
     (("[1.6, 0.5, 0.7]", "[1.6, 0.5, 2.5]"), "out of the HSR's reach"),
     (("method: pbp_alternated", "method: pbp_alternatd"), "did you mean 'pbp_alternated'"),
     (("!VirtualParticipant {}", "!Virtual {}"), "Virtual"),
-    (("robot: !Hsr {}", "robot: !Hsr {diff_ik_time_step: 0.007}"), "whole multiple"),
+    (("robot: !Hsr {}", "robot: !Hsr {station: {diff_ik_time_step: 0.007}}"), "whole multiple"),
 ])
 def test_bad_task_input_names_the_problem(tmp_path, change, message):
     path = write(tmp_path, FIXED_TASK.replace(*change))

@@ -3,6 +3,7 @@
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
+from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.sampled_operator import SampledOperator
 
 FORWARD_BUTTON = "Forward (↑)"
@@ -71,7 +72,7 @@ class KeyboardOperator(SampledOperator):
 
     def __init__(self, meshcat, control_period, allow_forward, speed=0.2,
                  rotation_speed=0.6, hold_time=0.25):
-        super().__init__(4, control_period)
+        super().__init__(OperatorCommand.size, control_period)
         self._meshcat = meshcat
         self._allow_forward = bool(allow_forward)
         self._speed = float(speed)
@@ -82,7 +83,7 @@ class KeyboardOperator(SampledOperator):
         for name in self._buttons:
             meshcat.AddButton(name, KEY_BUTTONS[name])
         self._axes = np.array([_KEY_AXES[name] for name in self._buttons])
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         n = len(self._buttons)
         # Per button: the click count last seen, then the time of its last click.
         self._keys_index = self.DeclareDiscreteState(
@@ -134,6 +135,6 @@ class KeyboardOperator(SampledOperator):
         norm = np.linalg.norm(local)
         if norm > 0:
             local *= self._speed / norm  # e.g. ↑ with ← goes diagonally at `speed`
-        velocity = rotate_planar(local, self._ee_state_port.Eval(context)[6])
+        velocity = rotate_planar(local, EeState(self._ee_state_port.Eval(context)).heading)
         yaw_rate = self._rotation_speed * yaw
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), bool(held.any())

@@ -2,7 +2,7 @@
 
 Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
 ``EeState.size`` is its length. Every system that declares such a port takes its size here.
-`position` reads the `[x, y, z]` of any view that has those fields.
+`position_of` reads the `[x, y, z]` of any view that has those fields.
 """
 
 import numpy as np
@@ -29,6 +29,6 @@ TaskStatus = _view("TaskStatus", ["progress", "stage", "success", "task_time",
                                   "intervention_ratio", "steps", "collision_ratio"])
 
 
-def position(view):
+def position_of(view):
     """`[x, y, z]` of a view with those fields (`EeState`, `EeCommand`, `Target`), a copy."""
     return np.array([view.x, view.y, view.z])

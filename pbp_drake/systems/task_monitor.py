@@ -8,7 +8,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import EventStatus, LeafSystem
 
 from pbp_drake.core.reach_task import reach_progress
-from pbp_drake.systems.layouts import EeState, Target, TaskStatus, position
+from pbp_drake.systems.layouts import EeState, Target, TaskStatus, position_of
 from pbp_drake.systems.tick import decide_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
@@ -144,7 +144,7 @@ class TaskMonitor(LeafSystem):
         counts = self.counts(context)
         if counts.success:
             return EventStatus.DidNothing()
-        here = position(EeState(self._ee_state_port.Eval(context)))
+        here = position_of(EeState(self._ee_state_port.Eval(context)))
         acting = self._operator_active_port.Eval(context)[0] > 0.5
         colliding = (self._in_collision_port.HasValue(context)
                      and self._in_collision_port.Eval(context)[0] > 0.5)

@@ -317,7 +317,8 @@ class VirtualParticipant(SampledOperator):
             left = np.array([-np.sin(heading), np.cos(heading)])
             lateral = (offset / max(distance, 1e-9)) @ left
             if abs(angle) <= 2 * self._aligned_angle:
-                lateral = 0.5 * self._aside_direction(position, heading, target_position, selected)
+                lateral = 0.5 * self._aside_direction(position, heading, target_position,
+                                                      selected)
             velocity = self._speed * speed_scale * lateral * rotate_planar(left, noise_angle)
         else:
             if distance < 1e-9:

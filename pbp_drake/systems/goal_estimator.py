@@ -26,10 +26,10 @@ class GoalEstimator(LeafSystem):
         - selected_goal
         - goal_probabilities
 
-    `ee_state` is `EeState` (`[p (3), v (3), heading, heading_rate]`); `goals` is the K goals flattened
-    row-major `(K, 3)`. `selected_goal` is `[index]` (the goal index as a float) and
-    `goal_probabilities` the K probabilities of `settings.method`; both are read from the
-    state, so they hold between updates.
+    `ee_state` is `EeState` (`[p (3), v (3), heading, heading_rate]`); `goals` is the K
+    goals flattened row-major `(K, 3)`. `selected_goal` is `[index]` (the goal index as a
+    float) and `goal_probabilities` the K probabilities of `settings.method`; both are read
+    from the state, so they hold between updates.
 
     At initialisation (`Simulator.Initialize`) the estimator records the end effector's
     position as the start `S` and selects the most probable goal at once, without

@@ -4,12 +4,10 @@ import dataclasses
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import EventStatus
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.simulation import read_log
-from pbp_drake.systems.task_monitor import (
-    COLLISION_RATIO, INTERVENTION_RATIO, STAGE, SUCCESS, TASK_TIME)
+from pbp_drake.systems.layouts import TaskStatus
 
 
 @dataclasses.dataclass
@@ -59,20 +57,13 @@ def run_task(scenario, meshcat=None, realtime_rate=0.0, diagram=None):
     status_port = monitor.get_task_status_output_port()
     simulator = Simulator(diagram)
     simulator.set_target_realtime_rate(realtime_rate)
-
-    def stop_at_success(root_context):
-        status = status_port.Eval(monitor.GetMyContextFromRoot(root_context))
-        if status[SUCCESS] > 0.5:
-            return EventStatus.ReachedTermination(monitor, "the target is reached")
-        return EventStatus.Succeeded()
-
-    simulator.set_monitor(stop_at_success)
+    # The task monitor itself ends the simulation at success.
     simulator.Initialize()
     period = scenario.control_period
     ticks = int(round(scenario.duration / period))
     simulator.AdvanceTo((ticks + 1) * period)
     context = simulator.get_context()
-    status = status_port.Eval(monitor.GetMyContextFromRoot(context))
+    status = TaskStatus(status_port.Eval(monitor.GetMyContextFromRoot(context)))
     return _read_result(diagram, context, status, monitor)
 
 
@@ -87,10 +78,10 @@ def _read_result(diagram, context, status, monitor):
     # Measured on the plant's state, like ee_state: not shifted.
     in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
     return TaskResult(
-        success=bool(status[SUCCESS] > 0.5),
-        task_time=float(status[TASK_TIME]),
-        intervention_ratio=float(status[INTERVENTION_RATIO]),
-        switches=int(status[STAGE]),
+        success=bool(status.success > 0.5),
+        task_time=float(status.task_time),
+        intervention_ratio=float(status.intervention_ratio),
+        switches=int(status.stage),
         times=times,
         ee_positions=ee_state[:, :3],
         headings=ee_state[:, 6],
@@ -100,6 +91,6 @@ def _read_result(diagram, context, status, monitor):
         selected_goals=decisions("selected_goal_log")[:, 0].astype(int),
         targets=decisions("target_log")[:, 3].astype(int),
         objects=monitor.objects.copy(),
-        collision_ratio=float(status[COLLISION_RATIO]),
+        collision_ratio=float(status.collision_ratio),
         in_collision=None if in_collision is None else in_collision[:, 0] > 0.5,
     )

@@ -9,11 +9,12 @@ import msgpack
 import numpy as np
 import pytest
 from pydrake.geometry import Meshcat, MeshcatParams
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import Simulator, SimulatorStatus
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.cli import main
 from pbp_drake.scenarios import Keyboard, ScenarioError, load_scenario_file
+from pbp_drake.systems.layouts import TaskStatus
 from pbp_drake.systems.keyboard_operator import LEFT_BUTTON
 from pbp_drake.task_run import run_task
 
@@ -119,6 +120,21 @@ def test_teleop_participant_drives_the_whole_way(fixed_task):
     result = run_task(dataclasses.replace(fixed_task, method="teleop"))
     assert result.success
     assert result.intervention_ratio > 0.85
+
+
+def test_a_plain_simulator_of_the_built_task_stops_at_success(fixed_task, pbp_run):
+    # No runner, no monitor callback: the task monitor ends the simulation itself.
+    diagram = build_diagram(fixed_task)
+    simulator = Simulator(diagram)
+    result = simulator.AdvanceTo(60.0)
+    assert result.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
+    monitor = diagram.GetSubsystemByName("task_monitor")
+    status = TaskStatus(monitor.get_task_status_output_port().Eval(
+        monitor.GetMyContextFromRoot(simulator.get_context())))
+    assert status.success == 1.0
+    assert simulator.get_context().get_time() < pbp_run.task_time + fixed_task.control_period
+    assert (status.task_time, status.intervention_ratio, status.stage) == (
+        pbp_run.task_time, pbp_run.intervention_ratio, pbp_run.switches)
 
 
 def test_the_same_seed_gives_the_same_run(fixed_task, pbp_run):

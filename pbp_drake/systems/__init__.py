@@ -7,7 +7,8 @@ Port names are the public contract: `robot_state`, `goals`, `operator_command`,
 Vector layouts: a robot state is `[positions (D), velocities (D)]`; `references` of K goals is
 `[positions (K*D, row-major (K, D)), velocities (K*D)]`; `command` is `[position (D),
 velocity (D)]`. On the HSR, `ee_state` is `[p (3), v (3), heading, heading_rate]` and an
-operator's command `[vx, vy, vz, yaw_rate]` in the world frame.
+operator's command `[vx, vy, vz, yaw_rate]` in the world frame; `systems.layouts` names their
+entries. `systems.tick` states the order of the updates within a control tick.
 """
 
 from pbp_drake.systems.blender import Blender

@@ -5,6 +5,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
+from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 # Standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN.
@@ -55,14 +56,14 @@ class GamepadOperator(SampledOperator):
                  nominal_speed=None):
         if not 0.0 <= params.dead_zone < 1.0:
             raise ValueError(f"dead_zone must be in [0, 1), not {params.dead_zone}")
-        super().__init__(4, control_period)
+        super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
         self._meshcat = meshcat
         self._allow_forward = bool(allow_forward)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
         self._dead_zone = float(params.dead_zone)
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._declare_operator_outputs()
 
     def get_ee_state_input_port(self):
@@ -82,7 +83,8 @@ class GamepadOperator(SampledOperator):
         if not self._allow_forward:
             stick[0] = min(stick[0], 0.0)
         active = bool(np.any(stick != 0) or turn != 0)
-        velocity = rotate_planar(self._speed * stick, self._ee_state_port.Eval(context)[6])
+        heading = EeState(self._ee_state_port.Eval(context)).heading
+        velocity = rotate_planar(self._speed * stick, heading)
         return np.array([velocity[0], velocity[1], 0.0, self._rotation_speed * turn]), active
 
     def _apply_dead_zone(self, stick):

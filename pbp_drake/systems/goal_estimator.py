@@ -7,6 +7,8 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.goal_estimation import (
     NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate, validate_goals)
+from pbp_drake.systems.layouts import EeState, position_of
+from pbp_drake.systems.tick import decide_offset
 
 # Layout of the `memory` discrete state group.
 CHALLENGER, COUNT, START, PATH_LENGTH, LAST_POSITION, INITIALISED = 0, 1, 2, 5, 6, 9
@@ -26,21 +28,22 @@ class GoalEstimator(LeafSystem):
         - selected_goal
         - goal_probabilities
 
-    `ee_state` is `[p (3), v (3), heading, heading_rate]`; `goals` is the K goals flattened
-    row-major `(K, 3)`. `selected_goal` is `[index]` (the goal index as a float) and
-    `goal_probabilities` the K probabilities of `settings.method`; both are read from the
-    state, so they hold between updates.
+    `ee_state` is `EeState` (`[p (3), v (3), heading, heading_rate]`); `goals` is the K
+    goals flattened row-major `(K, 3)`. `selected_goal` is `[index]` (the goal index as a
+    float) and `goal_probabilities` the K probabilities of `settings.method`; both are read
+    from the state, so they hold between updates.
 
     At initialisation (`Simulator.Initialize`) the estimator records the end effector's
     position as the start `S` and selects the most probable goal at once, without
     hysteresis; a Context never initialised does so at its first periodic update instead.
-    Each update, `update_offset` seconds after each control tick, adds the distance moved
+    Each update, `update_offset` seconds after each control tick (by default the decide
+    stage, `pbp_drake.systems.tick.decide_offset`), adds the distance moved
     since the last update to the path length (for ``bayesian``), recomputes the
     probabilities and moves the selection with hysteresis. Before initialisation the
     selection is goal 0 and the probabilities are uniform.
     """
 
-    def __init__(self, goal_count, settings, control_period, update_offset=0.0):
+    def __init__(self, goal_count, settings, control_period, update_offset=None):
         super().__init__()
         if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
             raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
@@ -50,6 +53,8 @@ class GoalEstimator(LeafSystem):
         settings.validate()
         if not np.isfinite(control_period) or control_period <= 0.0:
             raise ValueError(f"control_period must be positive, got {control_period!r}")
+        if update_offset is None:
+            update_offset = decide_offset(control_period)
         if not np.isfinite(update_offset) or update_offset < 0.0:
             raise ValueError(f"update_offset must be >= 0, got {update_offset!r}")
         self._goal_count = int(goal_count)
@@ -57,7 +62,7 @@ class GoalEstimator(LeafSystem):
         self._settings = dataclasses.replace(settings)
         self._period = float(control_period)
         k = self._goal_count
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._goals_port = self.DeclareVectorInputPort("goals", 3 * k)
         self._selected_index = self.DeclareDiscreteState(np.zeros(1))
         self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
@@ -92,9 +97,9 @@ class GoalEstimator(LeafSystem):
         return self._probabilities_port
 
     def _inputs(self, context):
-        ee_state = self._ee_state_port.Eval(context)
+        ee_state = EeState(self._ee_state_port.Eval(context))
         goals = validate_goals(self._goals_port.Eval(context).reshape(self._goal_count, 3))
-        return ee_state[:3].copy(), float(ee_state[6]), goals
+        return position_of(ee_state), float(ee_state.heading), goals
 
     def _write(self, discrete_state, result, memory):
         memory[CHALLENGER] = result.memory.challenger

@@ -3,6 +3,9 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.layouts import OperatorCommand
+from pbp_drake.systems.tick import decide_offset
+
 
 class HeadingCommand(LeafSystem):
     """Integrates the operator's yaw rate into the commanded heading.
@@ -15,16 +18,20 @@ class HeadingCommand(LeafSystem):
         output_ports:
         - heading
 
-    `operator_command` is `[vx, vy, vz, yaw_rate]`; each control period the heading moves
-    by `yaw_rate * control_period`. The DMPs never turn the robot: in PBP the operator's
-    turning is how it tells the goal estimator where it wants to go. Like the DMP bank, it
-    updates `update_offset` after the tick to use the operator's command of that tick.
+    `operator_command` is `OperatorCommand` (`[vx, vy, vz, yaw_rate]`); each control period
+    the heading moves by `yaw_rate * control_period`. The DMPs never turn the robot: in PBP
+    the operator's turning is how it tells the goal estimator where it wants to go. Like the
+    DMP bank, it updates at the decide stage (`update_offset` after the tick, by default
+    `pbp_drake.systems.tick.decide_offset`) to use the operator's command of that tick.
     """
 
-    def __init__(self, initial_heading, control_period, update_offset=0.0):
+    def __init__(self, initial_heading, control_period, update_offset=None):
         super().__init__()
         self._period = float(control_period)
-        self._command_port = self.DeclareVectorInputPort("operator_command", 4)
+        if update_offset is None:
+            update_offset = decide_offset(self._period)
+        self._command_port = self.DeclareVectorInputPort("operator_command",
+                                                         OperatorCommand.size)
         index = self.DeclareDiscreteState(np.array([float(initial_heading)]))
         self._heading_port = self.DeclareStateOutputPort("heading", index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
@@ -37,5 +44,5 @@ class HeadingCommand(LeafSystem):
 
     def _update(self, context, discrete_state):
         heading = context.get_discrete_state_vector().value()[0]
-        yaw_rate = self._command_port.Eval(context)[3]
+        yaw_rate = OperatorCommand(self._command_port.Eval(context)).yaw_rate
         discrete_state.get_mutable_vector().set_value([heading + yaw_rate * self._period])

@@ -5,6 +5,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
+from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 FORWARD_BUTTON = "Forward (↑)"
@@ -86,7 +87,7 @@ class KeyboardOperator(SampledOperator):
 
     def __init__(self, meshcat, control_period, allow_forward, params=KeyboardParams(),
                  nominal_speed=None):
-        super().__init__(4, control_period)
+        super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
         self._meshcat = meshcat
         self._allow_forward = bool(allow_forward)
@@ -98,7 +99,7 @@ class KeyboardOperator(SampledOperator):
         for name in self._buttons:
             meshcat.AddButton(name, KEY_BUTTONS[name])
         self._axes = np.array([_KEY_AXES[name] for name in self._buttons])
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         n = len(self._buttons)
         # Per button: the click count last seen, then the time of its last click.
         self._keys_index = self.DeclareDiscreteState(
@@ -150,6 +151,6 @@ class KeyboardOperator(SampledOperator):
         norm = np.linalg.norm(local)
         if norm > 0:
             local *= self._speed / norm  # e.g. ↑ with ← goes diagonally at `speed`
-        velocity = rotate_planar(local, self._ee_state_port.Eval(context)[6])
+        velocity = rotate_planar(local, EeState(self._ee_state_port.Eval(context)).heading)
         yaw_rate = self._rotation_speed * yaw
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), bool(held.any())

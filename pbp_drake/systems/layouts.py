@@ -2,8 +2,10 @@
 
 Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
 ``EeState.size`` is its length. Every system that declares such a port takes its size here.
+`position_of` reads the `[x, y, z]` of any view that has those fields.
 """
 
+import numpy as np
 from pydrake.common.containers import namedview
 
 
@@ -25,3 +27,8 @@ Target = _view("Target", ["x", "y", "z", "index"])
 # The task monitor's status (see `TaskMonitor`).
 TaskStatus = _view("TaskStatus", ["progress", "stage", "success", "task_time",
                                   "intervention_ratio", "steps", "collision_ratio"])
+
+
+def position_of(view):
+    """`[x, y, z]` of a view with those fields (`EeState`, `EeCommand`, `Target`), a copy."""
+    return np.array([view.x, view.y, view.z])

@@ -10,6 +10,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.obstacle_task import step_obstacles
 from pbp_drake.core.reach_task import reach_progress
+from pbp_drake.systems.tick import decide_offset
 
 OBSTACLE_RGBA = [0.85, 0.15, 0.15, 1.0]
 
@@ -28,7 +29,8 @@ class MovingObstacles(LeafSystem):
 
     Registers one cylinder per obstacle with `scene_graph` (proximity and illustration
     roles; connect `geometry_pose` to `scene_graph.get_source_pose_port(source_id)`).
-    Every control period, `update_offset` after the tick, it computes the hand's progress to
+    Every control period, `update_offset` after the tick (by default the decide stage,
+    `pbp_drake.systems.tick.decide_offset`), it computes the hand's progress to
     the target from `ee_state` and steps the obstacles (`core.obstacle_task.step_obstacles`):
     each wakes when the progress passes its threshold and then moves at `speed` to the
     midpoint between the hand and the target, where it stops. `obstacle_positions` is
@@ -36,7 +38,7 @@ class MovingObstacles(LeafSystem):
     """
 
     def __init__(self, scene_graph, scene, start, radius, height, speed, control_period,
-                 update_offset=0.0):
+                 update_offset=None):
         super().__init__()
         self._scene = scene
         self._start = np.asarray(start, dtype=float)
@@ -44,6 +46,8 @@ class MovingObstacles(LeafSystem):
         self._height = float(height)
         self._speed = float(speed)
         self._period = float(control_period)
+        if update_offset is None:
+            update_offset = decide_offset(self._period)
         count = len(scene.obstacle_starts)
         self._count = count
         self.source_id = scene_graph.RegisterSource("moving_obstacles")

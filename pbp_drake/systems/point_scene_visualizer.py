@@ -24,7 +24,9 @@ class PointSceneVisualizer(LeafSystem):
         - operator_active (optional)
         - predicted_paths (optional)
 
-    The static scene is drawn at construction under `/pbp`. Each publish moves the robot
+    The static scene (obstacles, goals, the demonstration, the robot at `start`) is drawn
+    under `/pbp`, after deleting it, at each initialisation (`Simulator.Initialize`), so a
+    second run or a run after `meshcat.Delete()` draws it again. Each publish moves the robot
     (with `time_in_recording`, so `Meshcat.StartRecording` captures a replay), shows an
     orange halo while the operator acts, and redraws the predicted path of every DMP (live
     only: Meshcat replays transforms and visibility, not lines). Call from the thread that
@@ -43,8 +45,12 @@ class PointSceneVisualizer(LeafSystem):
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._predicted_paths_port = self.DeclareVectorInputPort(
             "predicted_paths", max(1, k * (self._prediction_steps + 1) * d))
+        self._start = np.asarray(start, float)
+        self._goals = goals
+        self._obstacles = list(obstacles)
+        self._demonstration = demonstration
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
-        self._draw_scene(np.asarray(start, float), goals, obstacles, demonstration)
+        self.DeclareInitializationPublishEvent(self._draw_scene)
 
     def get_robot_state_input_port(self):
         return self._robot_state_port
@@ -61,8 +67,10 @@ class PointSceneVisualizer(LeafSystem):
         padded[:, :min(3, self._dimension)] = points[:, :3]
         return padded
 
-    def _draw_scene(self, start, goals, obstacles, demonstration):
+    def _draw_scene(self, context):
         meshcat = self._meshcat
+        start, goals = self._start, self._goals
+        obstacles, demonstration = self._obstacles, self._demonstration
         meshcat.Delete("/pbp")
         everything = [start, *goals]
         for index, obstacle in enumerate(obstacles):

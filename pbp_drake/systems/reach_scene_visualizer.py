@@ -5,6 +5,8 @@ from pydrake.geometry import Box, Cylinder, Rgba, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.layouts import EeState, Target, position_of
+
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
 TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
 # Pure, saturated colours so that a screenshot can find them.
@@ -34,8 +36,10 @@ class ReachSceneVisualizer(LeafSystem):
         - ee_state (optional)
         - predicted_paths (optional)
 
-    The objects stand on small tables, drawn once at construction. Each publish moves the
-    yellow ball above the current `target` (`[p (3), index]`) and the blue ball above the
+    The objects stand on small tables, drawn (after deleting `/task`) at each
+    initialisation (`Simulator.Initialize`), so a second run or a run after
+    `meshcat.Delete()` draws them again. Each publish moves the yellow ball above the
+    current `target` (`Target`, `[p (3), index]`) and the blue ball above the
     estimated goal (`selected_goal`), with `time_in_recording` so that
     `Meshcat.StartRecording` replays them; an orange ring around the hand shows when the
     operator acts. The selected DMP's predicted path is drawn as a line, the others faint
@@ -49,15 +53,14 @@ class ReachSceneVisualizer(LeafSystem):
         self._objects = np.asarray(objects, dtype=float)
         self._prediction_steps = int(prediction_steps)
         k = len(self._objects)
-        self._target_port = self.DeclareVectorInputPort("target", 4)
+        self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._predicted_paths_port = self.DeclareVectorInputPort(
             "predicted_paths", max(1, k * (self._prediction_steps + 1) * 3))
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
-        self.DeclareInitializationPublishEvent(self._publish)
-        self._draw_scene()
+        self.DeclareInitializationPublishEvent(self._initialise)
 
     def get_target_input_port(self):
         return self._target_port
@@ -73,6 +76,10 @@ class ReachSceneVisualizer(LeafSystem):
 
     def get_predicted_paths_input_port(self):
         return self._predicted_paths_port
+
+    def _initialise(self, context):
+        self._draw_scene()
+        self._publish(context)
 
     def _draw_scene(self):
         meshcat = self._meshcat
@@ -96,15 +103,15 @@ class ReachSceneVisualizer(LeafSystem):
     def _publish(self, context):
         time = context.get_time()
         meshcat = self._meshcat
-        target = self._target_port.Eval(context)
+        target = position_of(Target(self._target_port.Eval(context)))
         meshcat.SetTransform("/task/target",
-                             RigidTransform(target[:3] + [0, 0, TARGET_LIFT]), time)
+                             RigidTransform(target + [0, 0, TARGET_LIFT]), time)
         selected = int(self._selected_goal_port.Eval(context)[0])
         meshcat.SetTransform(
             "/task/estimated_goal",
             RigidTransform(self._objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
         if self._ee_state_port.HasValue(context):
-            position = self._ee_state_port.Eval(context)[:3]
+            position = position_of(EeState(self._ee_state_port.Eval(context)))
             meshcat.SetTransform("/task/operator", RigidTransform(position), time)
             if self._operator_active_port.HasValue(context):
                 active = bool(self._operator_active_port.Eval(context)[0] > 0.5)

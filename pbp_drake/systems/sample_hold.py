@@ -3,6 +3,8 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.tick import SENSE_OFFSET
+
 
 class SampleHold(LeafSystem):
     """Samples its input at each control tick and holds it; starts at `initial_value`.
@@ -17,7 +19,7 @@ class SampleHold(LeafSystem):
 
     Drake's ZeroOrderHold starts at zero, which before its first sample would tell the
     systems downstream that the robot stands at the world's origin; this one starts where
-    the robot does.
+    the robot does. It samples at the sense stage of each tick (`pbp_drake.systems.tick`).
     """
 
     def __init__(self, period, initial_value):
@@ -26,7 +28,7 @@ class SampleHold(LeafSystem):
         self._input_port = self.DeclareVectorInputPort("u", initial_value.size)
         index = self.DeclareDiscreteState(initial_value)
         self._output_port = self.DeclareStateOutputPort("y", index)
-        self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, SENSE_OFFSET, self._update)
 
     def get_input_port(self):
         return self._input_port

@@ -6,6 +6,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.arbitration import validate_command
+from pbp_drake.systems.tick import SENSE_OFFSET
 
 
 def operator_speed(speed, nominal_speed):
@@ -31,7 +32,8 @@ class SampledOperator(LeafSystem):
     Subclasses implement `_sample(context) -> (command (D,), active)`, may declare input
     ports first, and call `_declare_operator_outputs()` once. Sampling into discrete state
     keeps the operator deterministic and loggable, and its command stays constant over a
-    control period as a human's keyboard read would. `operator_command` is a velocity (D);
+    control period as a human's keyboard read would. It samples at the sense stage of each tick
+    (`pbp_drake.systems.tick`). `operator_command` is a velocity (D);
     `operator_active` is 1 while the operator acts, else 0.
     """
 
@@ -54,7 +56,7 @@ class SampledOperator(LeafSystem):
             "operator_active", 1,
             lambda context, output: output.SetFromVector(self._held(context)[d:]),
             prerequisites_of_calc=held)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, SENSE_OFFSET, self._update)
 
     def get_operator_command_output_port(self):
         return self._command_port

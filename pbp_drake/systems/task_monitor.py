@@ -1,18 +1,34 @@
-"""The referee of the multi-goal reaching task: targets, switches, success, metrics."""
+"""The referee of the multi-goal reaching task: targets, switches, success, metrics; it ends
+the simulation at success."""
+
+import dataclasses
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import EventStatus, LeafSystem
 
 from pbp_drake.core.reach_task import reach_progress
+from pbp_drake.systems.layouts import EeState, Target, TaskStatus, position_of
+from pbp_drake.systems.tick import decide_offset, report_offset
 
-# Layout of the `task_status` output.
-PROGRESS, STAGE, SUCCESS, TASK_TIME, INTERVENTION_RATIO, STEPS, COLLISION_RATIO = range(7)
-TASK_STATUS_FIELDS = ("progress", "stage", "success", "task_time", "intervention_ratio",
-                      "steps", "collision_ratio")
+SUCCESS_MESSAGE = "the target is reached"
+
+
+@dataclasses.dataclass(frozen=True)
+class TaskCounts:
+    """The task's whole numbers, held as one immutable value in the monitor's abstract state
+    (an update replaces it, so two contexts never share a mutable object)."""
+
+    stage: int = 0  # target switches so far
+    steps: int = 0  # control ticks counted, up to success
+    acted_steps: int = 0  # of which the operator acted
+    colliding_steps: int = 0  # of which the robot was in collision
+    success: bool = False
 
 
 class TaskMonitor(LeafSystem):
-    """Switches the target at the progress schedule and keeps the task's metrics.
+    """Switches the target at the progress schedule, keeps the task's metrics, and ends the
+    simulation at success.
 
     .. pydrake_system::
 
@@ -25,20 +41,31 @@ class TaskMonitor(LeafSystem):
         - target
         - task_status
 
-    `ee_state` is `[p (3), v (3), heading, heading_rate]`. Every control period, until
-    success: count the step (and whether the operator acted), compute the progress toward
-    the current target from the end effector's start, switch to the next target of
+    `ee_state` is `EeState` (`[p (3), v (3), heading, heading_rate]`). Every control period,
+    `update_offset` after the tick (the decide stage of `pbp_drake.systems.tick` by default),
+    until success: count the step (and whether the operator acted), compute the progress
+    toward the current target from the end effector's start, switch to the next target of
     `targets` once progress reaches the next entry of `switch_schedule`, and declare success
     when the end effector is within `success_distance` of the current target.
 
-    `target` is `[position (3), object index]`; `task_status` is `[progress, stage (number
-    of switches so far), success (0/1), task time (s, frozen at success), intervention
-    ratio (steps with operator input / steps of the task), steps, collision ratio (steps
-    with `in_collision` / steps; 0 when unconnected)]`.
+    At success the monitor ends the simulation: a publish event at the report stage (a
+    millionth of a period after the update) returns `EventStatus.ReachedTermination`, so any
+    `Simulator.AdvanceTo` returns there, before the plant moves again, with
+    `SimulatorStatus.reason()` `kReachedTerminationCondition`. The status then stays frozen;
+    a later `AdvanceTo` stops again one control period on.
+
+    `target` is `Target` (`[position (3), object index]`); `task_status` is `TaskStatus`
+    (`[progress, stage (number of switches so far), success (0/1), task time (s, frozen at
+    success), intervention ratio (steps with operator input / steps of the task), steps,
+    collision ratio (steps with `in_collision` / steps; 0 when unconnected)]`).
+
+    The counts are integers (`TaskCounts`) in abstract state, the progress and task time a
+    discrete vector; the update is therefore an unrestricted one, which Drake applies before
+    the discrete updates of the same instant (no decide-stage system reads this monitor).
     """
 
     def __init__(self, objects, targets, switch_schedule, start, success_distance,
-                 control_period, update_offset=0.0):
+                 control_period, update_offset=None):
         super().__init__()
         self._objects = np.asarray(objects, dtype=float)
         self._targets = tuple(int(t) for t in targets)
@@ -47,17 +74,27 @@ class TaskMonitor(LeafSystem):
             raise ValueError("one target per entry of switch_schedule")
         self._start = np.asarray(start, dtype=float)
         self._success_distance = float(success_distance)
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
+        period = float(control_period)
+        if update_offset is None:
+            update_offset = decide_offset(period)
+        end_offset = report_offset(period, update_offset)
+        if not 0.0 <= update_offset < end_offset < period:
+            raise ValueError(f"update_offset must be in [0, control_period), got "
+                             f"{update_offset!r}")
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._in_collision_port = self.DeclareVectorInputPort("in_collision", 1)
-        self._status_index = self.DeclareDiscreteState(len(TASK_STATUS_FIELDS))
-        # Steps with operator input and steps in collision.
-        self._counts_index = self.DeclareDiscreteState(2)
+        self._counts_index = self.DeclareAbstractState(AbstractValue.Make(TaskCounts()))
+        # [progress, task time]: the status's real-valued entries.
+        self._measures_index = self.DeclareDiscreteState(2)
         self._target_port = self.DeclareVectorOutputPort(
-            "target", 4, self._calc_target,
-            prerequisites_of_calc={self.discrete_state_ticket(self._status_index)})
-        self._status_port = self.DeclareStateOutputPort("task_status", self._status_index)
-        self.DeclarePeriodicDiscreteUpdateEvent(control_period, update_offset, self._update)
+            "target", Target.size, self._calc_target,
+            prerequisites_of_calc={self.abstract_state_ticket(self._counts_index)})
+        self._status_port = self.DeclareVectorOutputPort(
+            "task_status", TaskStatus.size, self._calc_status,
+            prerequisites_of_calc={self.all_state_ticket()})
+        self.DeclarePeriodicUnrestrictedUpdateEvent(period, update_offset, self._update)
+        self.DeclarePeriodicPublishEvent(period, end_offset, self._end_at_success)
 
     def get_ee_state_input_port(self):
         return self._ee_state_port
@@ -78,34 +115,56 @@ class TaskMonitor(LeafSystem):
     def objects(self):
         return self._objects
 
-    def _calc_target(self, context, output):
-        stage = int(context.get_discrete_state(self._status_index).value()[STAGE])
-        index = self._targets[stage]
-        output.SetFromVector(np.append(self._objects[index], index))
+    def counts(self, context):
+        """The `TaskCounts` held in this system's `context`."""
+        return context.get_abstract_state(self._counts_index).get_value()
 
-    def _update(self, context, discrete_state):
-        status = context.get_discrete_state(self._status_index).value().copy()
-        if status[SUCCESS] > 0.5:
-            return
-        position = self._ee_state_port.Eval(context)[:3]
+    def _calc_target(self, context, output):
+        index = self._targets[self.counts(context).stage]
+        target = Target(np.empty(Target.size))
+        target.x, target.y, target.z = self._objects[index]
+        target.index = index
+        output.SetFromVector(target[:])
+
+    def _calc_status(self, context, output):
+        counts = self.counts(context)
+        progress, task_time = context.get_discrete_state(self._measures_index).value()
+        status = TaskStatus(np.zeros(TaskStatus.size))
+        status.progress = progress
+        status.stage = counts.stage
+        status.success = float(counts.success)
+        status.task_time = task_time
+        status.steps = counts.steps
+        if counts.steps:
+            status.intervention_ratio = counts.acted_steps / counts.steps
+            status.collision_ratio = counts.colliding_steps / counts.steps
+        output.SetFromVector(status[:])
+
+    def _update(self, context, state):
+        counts = self.counts(context)
+        if counts.success:
+            return EventStatus.DidNothing()
+        here = position_of(EeState(self._ee_state_port.Eval(context)))
         acting = self._operator_active_port.Eval(context)[0] > 0.5
         colliding = (self._in_collision_port.HasValue(context)
                      and self._in_collision_port.Eval(context)[0] > 0.5)
-        # The ratios come from whole counts of steps, kept beside the status.
-        counts = context.get_discrete_state(self._counts_index).value() + [acting, colliding]
-        discrete_state.get_mutable_vector(self._counts_index).set_value(counts)
-        status[STEPS] += 1
-        status[INTERVENTION_RATIO], status[COLLISION_RATIO] = counts / status[STEPS]
-        stage = int(status[STAGE])
+        stage = counts.stage
         target = self._objects[self._targets[stage]]
-        progress = reach_progress(position, self._start, target)
+        progress = reach_progress(here, self._start, target)
         if stage + 1 < len(self._schedule) and progress >= self._schedule[stage + 1]:
             stage += 1
             target = self._objects[self._targets[stage]]
-            progress = reach_progress(position, self._start, target)
-        status[STAGE] = stage
-        status[PROGRESS] = progress
-        status[TASK_TIME] = context.get_time()
-        if np.linalg.norm(position - target) <= self._success_distance:
-            status[SUCCESS] = 1.0
-        discrete_state.get_mutable_vector(self._status_index).set_value(status)
+            progress = reach_progress(here, self._start, target)
+        state.get_mutable_abstract_state(self._counts_index).set_value(TaskCounts(
+            stage=stage, steps=counts.steps + 1,
+            acted_steps=counts.acted_steps + int(acting),
+            colliding_steps=counts.colliding_steps + int(colliding),
+            success=bool(np.linalg.norm(here - target) <= self._success_distance)))
+        state.get_mutable_discrete_state(self._measures_index).set_value(
+            [progress, context.get_time()])
+        return EventStatus.Succeeded()
+
+    def _end_at_success(self, context):
+        if self.counts(context).success:
+            return EventStatus.ReachedTermination(self, SUCCESS_MESSAGE)
+        return EventStatus.DidNothing()

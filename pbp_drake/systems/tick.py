@@ -2,7 +2,7 @@
 
 Drake computes all discrete updates of one instant from the values before that instant, so
 two systems that update at the same tick cannot see each other's new state. A PBP tick has
-two stages, in this order:
+three stages, in this order:
 
 1. **sense** at `t_k` (offset `SENSE_OFFSET`): the robot's state is sampled (`SampleHold`)
    and the operator decides (it reads the robot's state and Meshcat's input).
@@ -11,10 +11,20 @@ two stages, in this order:
    operator's decision of the same tick (as the paper's Alg. 2 reads them). The blender's
    output depends on its inputs only, so the command the robot follows from `t_k` on is
    the one of tick k.
+3. **report**, a millionth of a period after a decide-stage update (`report_offset`):
+   publish events that must see the decisions of tick k, such as the task monitor ending
+   the simulation at success. A publish at the decide instant itself would run before that
+   instant's updates (Drake publishes at the end of the step that reaches an instant and
+   updates at the start of the next one).
 
 The decide stage sits a millionth of the control period after the tick: long before any
 plant step that follows the tick, and far from the next tick. Systems of the decide stage
 use it by default, so neither a diagram nor user code states an offset.
+
+The task monitor's update is an unrestricted one (its counts are integers in abstract state).
+Drake applies unrestricted updates before the discrete updates of the same instant, so no
+decide-stage system reads the monitor's outputs: the operators read its `target` at the
+sense stage.
 
 Loggers publish before the updates of their instant: a log sample at `t_k` holds the plant's
 state at `t_k` but the decisions of tick k - 1. `DECISION_LOG_SHIFT` is how many samples
@@ -29,3 +39,11 @@ DECISION_LOG_SHIFT = 1
 def decide_offset(control_period):
     """The offset (s) after each tick at which the decide stage updates."""
     return float(control_period) * DECIDE_FRACTION
+
+
+def report_offset(control_period, update_offset=None):
+    """The offset (s) after each tick at which a publish sees the decisions of an update at
+    `update_offset` (the decide stage when None)."""
+    if update_offset is None:
+        update_offset = decide_offset(control_period)
+    return float(update_offset) + decide_offset(control_period)

@@ -6,6 +6,7 @@ import numpy as np
 
 from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
 from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
+from pbp_drake.systems.layouts import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 PARTICIPANT_MODES = ("assist", "drive")
@@ -102,7 +103,7 @@ class VirtualParticipant(SampledOperator):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
-        super().__init__(4, control_period)
+        super().__init__(OperatorCommand.size, control_period)
         self._mode = mode
         self._objects = np.asarray(objects, dtype=float)
         self.params = dataclasses.replace(params)
@@ -114,8 +115,8 @@ class VirtualParticipant(SampledOperator):
         self._seed = int(seed)
         self._slow_radius = float(params.slow_radius)
         self._aligned_angle = float(params.aligned_angle)
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", 8)
-        self._target_port = self.DeclareVectorInputPort("target", 4)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         # With an additive blend (PBP-Cont) the policy keeps moving under the operator's
         # command; the participant then asks for the motion it wants minus the policy's.
@@ -160,7 +161,7 @@ class VirtualParticipant(SampledOperator):
     def _update(self, context, discrete_state):
         # The belief moves first, and the command of this tick acts on the new belief.
         known, unseen_ticks = context.get_discrete_state(self._belief_index).value()
-        shown = self._target_port.Eval(context)[3]
+        shown = Target(self._target_port.Eval(context)).index
         if known < 0:
             known, unseen_ticks = shown, 0  # the first target is known from the start
         elif shown != known:
@@ -181,15 +182,15 @@ class VirtualParticipant(SampledOperator):
                 max(0.0, 1.0 + rng.normal(0.0, self._speed_noise)))
 
     def _aside_direction(self, position, heading, target, selected):
-        """+1 (left) or -1: the sidestep that widens the angle between the target and the
-        object picked instead, when the two stand almost in line.
+        """+1 (left) or -1: the sidestep that widens the angle between the target (its
+        position, 3) and the object picked instead, when the two stand almost in line.
 
         Stepping left by d turns the view of a point at distance r by -d / r, so the gap
         `angle(picked) - angle(target)` changes by `-d (1 / r_picked - 1 / r_target)`.
         """
         picked = self._objects[selected]
         gap = (heading_error(heading, position, picked)
-               - heading_error(heading, position, target[:3]))
+               - heading_error(heading, position, target))
         closeness = (1.0 / max(np.linalg.norm(picked[:2] - position[:2]), 1e-6)
                      - 1.0 / max(np.linalg.norm(target[:2] - position[:2]), 1e-6))
         direction = -np.sign(gap) * np.sign(closeness)
@@ -198,10 +199,12 @@ class VirtualParticipant(SampledOperator):
     def _avoid(self, context, discrete_state, known_target):
         """The command while obstacles are about: a local plan around them (see the class
         docstring). Returns `(command, active)`."""
-        ee_state = self._ee_state_port.Eval(context)
-        hand, velocity, heading = ee_state[:2], ee_state[3:5], ee_state[6]
-        target = self._target_port.Eval(context)
-        target_xy = target[:2]
+        ee_state = EeState(self._ee_state_port.Eval(context))
+        hand = np.array([ee_state.x, ee_state.y])
+        velocity = np.array([ee_state.vx, ee_state.vy])
+        heading = ee_state.heading
+        target = Target(self._target_port.Eval(context))
+        target_xy = np.array([target.x, target.y])
         obstacles = self._obstacles_port.Eval(context).reshape(-1, 2)
         track = np.array(context.get_discrete_state(self._track_index).value())
         count = len(obstacles)
@@ -222,7 +225,7 @@ class VirtualParticipant(SampledOperator):
             discrete_state.get_mutable_vector(self._track_index).set_value(track)
             return command, active
 
-        if known_target != int(target[3]):
+        if known_target != int(target.index):
             return finish(np.zeros(4), False)
         offset = target_xy - hand
         distance = np.linalg.norm(offset)
@@ -319,24 +322,26 @@ class VirtualParticipant(SampledOperator):
         return velocities[best], yaw_rates[best], clear[best]
 
     def _decide(self, context, known_target):
-        ee_state = self._ee_state_port.Eval(context)
-        position, heading = ee_state[:3], ee_state[6]
-        target = self._target_port.Eval(context)
-        if known_target != int(target[3]):
+        ee_state = EeState(self._ee_state_port.Eval(context))
+        position, heading = position_of(ee_state), ee_state.heading
+        target = Target(self._target_port.Eval(context))
+        if known_target != int(target.index):
             return np.zeros(4), False  # has not noticed the new target yet
-        angle = heading_error(heading, position, target[:3])
+        target_position = position_of(target)
+        angle = heading_error(heading, position, target_position)
         noise_angle, speed_scale = self._noise(context)
-        offset = target[:2] - position[:2]
+        offset = target_position[:2] - position[:2]
         distance = np.linalg.norm(offset)
         if self._mode == "assist":
             selected = int(round(self._selected_goal_port.Eval(context)[0]))
-            if selected == int(target[3]):
+            if selected == int(target.index):
                 return np.zeros(4), False
             # Sidestep toward the target: the part of its direction across the heading.
             left = np.array([-np.sin(heading), np.cos(heading)])
             lateral = (offset / max(distance, 1e-9)) @ left
             if abs(angle) <= 2 * self._aligned_angle:
-                lateral = 0.5 * self._aside_direction(position, heading, target, selected)
+                lateral = 0.5 * self._aside_direction(position, heading, target_position,
+                                                      selected)
             velocity = self._speed * speed_scale * lateral * rotate_planar(left, noise_angle)
         else:
             if distance < 1e-9:

@@ -1,0 +1,66 @@
+"""HeadingCommand behind an operator sampled at the sense stage, as in the HSR diagram."""
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+
+from pbp_drake.systems.heading_command import HeadingCommand
+from pbp_drake.systems.layouts import OperatorCommand
+from pbp_drake.systems.sample_hold import SampleHold
+from pbp_drake.systems.tick import decide_offset
+
+PERIOD = 0.1
+INITIAL_HEADING = 0.3
+YAW_RATE = 0.5
+# The operator starts turning between two ticks: the tick at 1.0 s is the first to see it.
+TURN_START = 0.95
+
+
+def build():
+    """A yaw rate that steps up at `TURN_START`, sampled at each tick like an operator."""
+    builder = DiagramBuilder()
+    commands = np.zeros((OperatorCommand.size, 2))
+    OperatorCommand(commands[:, 1]).yaw_rate = YAW_RATE
+    source = builder.AddSystem(TrajectorySource(
+        PiecewisePolynomial.ZeroOrderHold([0.0, TURN_START, 100.0],
+                                          np.column_stack([commands, commands[:, 1]]))))
+    operator = builder.AddSystem(SampleHold(PERIOD, np.zeros(OperatorCommand.size)))
+    builder.Connect(source.get_output_port(), operator.get_input_port())
+    heading = builder.AddSystem(HeadingCommand(INITIAL_HEADING, PERIOD))
+    builder.Connect(operator.get_output_port(), heading.get_operator_command_input_port())
+    return builder.Build(), heading
+
+
+def heading_at(simulator, heading, time):
+    simulator.AdvanceTo(time)
+    context = heading.GetMyContextFromRoot(simulator.get_context())
+    return heading.get_heading_output_port().Eval(context)[0]
+
+
+def test_the_heading_starts_at_its_initial_value():
+    diagram, heading = build()
+    simulator = Simulator(diagram)
+    simulator.Initialize()
+    assert heading_at(simulator, heading, 0.0) == INITIAL_HEADING
+    assert heading_at(simulator, heading, 0.95) == INITIAL_HEADING
+
+
+def test_the_heading_turns_at_the_decide_stage_with_the_command_of_the_same_tick():
+    diagram, heading = build()
+    simulator = Simulator(diagram)
+    # At the tick itself the operator has sampled the turn, the heading not yet.
+    assert heading_at(simulator, heading, 1.0) == INITIAL_HEADING
+    # Right after the decide stage of that tick the heading has moved by one period's turn.
+    turned = heading_at(simulator, heading, 1.0 + 2 * decide_offset(PERIOD))
+    assert turned == pytest.approx(INITIAL_HEADING + YAW_RATE * PERIOD, abs=1e-12)
+
+
+def test_the_heading_integrates_the_yaw_rate_over_the_ticks():
+    diagram, heading = build()
+    simulator = Simulator(diagram)
+    # Ticks 1.0, 1.1, ..., 2.0 s turn: 11 periods.
+    assert heading_at(simulator, heading, 2.05) == pytest.approx(
+        INITIAL_HEADING + 11 * YAW_RATE * PERIOD, abs=1e-12)

@@ -5,7 +5,7 @@ PYTHON := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 DEMO_DIR := outputs/demo
 
-.PHONY: demo test chromium graphviz tutorials diagrams bench clean
+.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(PYTHON) || python3 -m venv $(VENV)
@@ -49,6 +49,10 @@ graphviz:
 
 test: $(STAMP) chromium graphviz
 	$(PYTHON) -m pytest
+
+# Everything but the tests marked slow: the layers one by one, in under a minute.
+test-fast: $(STAMP) graphviz
+	$(PYTHON) -m pytest -m "not slow"
 
 # The tutorial notebooks (tutorials/*.ipynb) in Jupyter, in the project's venv.
 $(VENV)/.installed-tutorials: $(STAMP)

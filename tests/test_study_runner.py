@@ -16,9 +16,14 @@ import numpy as np
 import pytest
 
 from pbp_drake.cli import main
-from pbp_drake.method_study import (
-    FIGURES, HISTOGRAM_EDGES, ProgressBar, StudyFolderError, collision_histogram, ideal_alpha,
-    load_task_result, read_time_series, run_method_comparison, trial_paths, write_trial)
+from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.progress import ProgressBar
+from pbp_drake.studies.report import FIGURES
+from pbp_drake.studies.summary import (
+    HISTOGRAM_EDGES, arbitration, collision_free, collision_histogram, does_the_hsr_task,
+    ideal_alpha)
+from pbp_drake.studies.trial_files import (
+    StudyFolderError, load_task_result, read_time_series, trial_paths, write_trial)
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
 from pbp_drake.task_run import TaskResult, run_task
 
@@ -268,14 +273,25 @@ def test_ideal_alpha_is_the_highest_that_still_does_the_task():
     # The paper's choice: the most autonomy that still lets the operator do the task.
     reach = {"teleop": _entry(1.0, 10), "fixed_alpha=0.2": _entry(1.0, 10),
              "fixed_alpha=0.9": _entry(0.9, 10), "fixed_alpha=0.5": _entry(1.0, 10)}
-    assert ideal_alpha(reach)["ideal_alpha"] == 0.5
-    assert ideal_alpha(reach)["alphas"] == [0.2, 0.5, 0.9]
+    assert arbitration(reach)["ideal_alpha"] == 0.5
+    assert arbitration(reach)["alphas"] == [0.2, 0.5, 0.9]
     # Collisions measured: most trials (of those that ran) must be free of them.
     obstacles = {"fixed_alpha=0.1": _entry(1.0, 6), "fixed_alpha=0.3": _entry(1.0, 5),
                  "fixed_alpha=0.6": _entry(1.0, 5, errors=1)}
-    assert ideal_alpha(obstacles)["ideal_alpha"] == 0.6
-    assert ideal_alpha({"fixed_alpha=0.3": _entry(1.0, 2)})["ideal_alpha"] is None
-    assert ideal_alpha({"teleop": _entry(1.0, 10)}) is None
+    assert arbitration(obstacles)["ideal_alpha"] == 0.6
+    assert arbitration({"fixed_alpha=0.3": _entry(1.0, 2)})["ideal_alpha"] is None
+    assert arbitration({"teleop": _entry(1.0, 10)}) is None
+
+
+def test_one_ideal_alpha_serves_the_hsr_comparison_and_the_2d_alpha_study():
+    # The HSR method comparison: summary entries judged by success and collisions.
+    swept = [(0.2, _entry(1.0, 10)), (0.9, _entry(0.9, 10)), (0.5, _entry(1.0, 10))]
+    assert ideal_alpha(swept, does_the_hsr_task) == 0.5
+    # The 2-D alpha study: collision ratios, the task is to touch no obstacle.
+    ratios = [(0.0, 0.0), (0.3, 0.0), (0.4, 0.02), (0.6, 0.0), (1.0, 0.4)]
+    assert ideal_alpha(ratios, collision_free) == 0.6
+    assert ideal_alpha([(0.5, 0.1), (1.0, 0.3)], collision_free) is None
+    assert ideal_alpha([], collision_free) is None
 
 
 class Terminal(io.StringIO):
@@ -368,7 +384,7 @@ def test_the_local_backend_does_not_import_ray(scenario, tmp_path):
     code = textwrap.dedent("""
         import sys
         from pbp_drake.cli import main
-        from pbp_drake.method_study import run_method_comparison
+        from pbp_drake.studies.comparison import run_method_comparison
         from pbp_drake.scenarios import load_scenario_file
 
         def run(scenario):

@@ -14,6 +14,8 @@ import numpy as np
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolved_goals
 from pbp_drake.simulation import simulate
+from pbp_drake.studies.figures import plot_alpha_study, plot_alt_vs_cont
+from pbp_drake.studies.summary import collision_free, ideal_alpha
 
 
 def run_study(scenario_file, output_dir):
@@ -55,20 +57,20 @@ def run_alpha_study(scenario, study, output_dir):
             run = simulate(dataclasses.replace(base, method=method))
             pbp[method] = _ratio(run, scene.obstacles)
             trajectories[(scene.name, method)] = run.positions
-        safe = [alpha for alpha in study.alphas if ratios[f"{alpha:.2f}"] == 0.0]
+        # The highest alpha that still lets the operator pass the obstacles untouched.
+        ideal = ideal_alpha([(alpha, ratios[f"{alpha:.2f}"]) for alpha in study.alphas],
+                            collision_free)
         scenes.append({
             "name": scene.name,
             "obstacles": [dataclasses.asdict(o) for o in scene.obstacles],
             "collision_ratio_by_alpha": ratios,
-            "ideal_alpha": max(safe) if safe else None,
+            "ideal_alpha": ideal,
             "pbp_alternated_collision_ratio": pbp["pbp_alternated"],
             "pbp_continuous_collision_ratio": pbp["pbp_continuous"],
         })
     summary = {"study": "alpha_study", "scenario": scenario.name, "alphas": study.alphas,
                "scenes": scenes}
     _write_json(output_dir / "summary.json", summary)
-    from pbp_drake.figures import plot_alpha_study
-
     plot_alpha_study(scenario, study, summary, trajectories, output_dir / "fig2_alpha_study.png")
     return summary
 
@@ -112,8 +114,6 @@ def run_alt_vs_cont(scenario, study, output_dir):
         "both_reach_goal": all(m["final_error"] <= study.goal_tolerance for m in modes.values()),
     }
     _write_json(output_dir / "summary.json", summary)
-    from pbp_drake.figures import plot_alt_vs_cont
-
     plot_alt_vs_cont(scenario, summary, output_dir / "fig4_alt_vs_cont.png")
     return summary
 

@@ -163,7 +163,9 @@ def test_study_and_bench_modules_are_short_and_import_at_the_top(package):
     import pbp_drake
 
     folder = pathlib.Path(pbp_drake.__file__).parent / package
-    for path in sorted(folder.glob("*.py")):
+    paths = sorted(folder.glob("*.py"))
+    assert paths, f"{folder} has no modules"
+    for path in paths:
         text = path.read_text()
         assert len(text.splitlines()) <= 450, f"{path.name} is over 450 lines"
         tree = ast.parse(text)

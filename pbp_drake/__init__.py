@@ -21,7 +21,7 @@ _PUBLIC = {
     "build_diagram": "pbp_drake.builder",
     "simulate": "pbp_drake.simulation",
     "run_task": "pbp_drake.task_run",
-    "run_method_comparison": "pbp_drake.method_study",
+    "run_method_comparison": "pbp_drake.studies.comparison",
     # The robot.
     "add_hsr": "pbp_drake.robots.hsr_model",
     "add_hsr_station": "pbp_drake.robots.hsr_station",

@@ -7,9 +7,22 @@ import sys
 import time
 
 import numpy as np
+from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
+from pbp_drake.bench.run import main as bench_main
+from pbp_drake.builder import build_diagram
+from pbp_drake.core.toy_scene import collision_ratio
+from pbp_drake.draw import main as draw_main
 from pbp_drake.scenarios import (
-    METHODS, OPERATOR_NAMES, Hsr, MethodComparison, ScenarioError, load_scenario_file, resolve)
+    METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, MethodComparison, ScenarioError,
+    check_method_comparison, load_scenario_file, resolve, with_method)
+from pbp_drake.simulation import simulate
+from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.progress import ProgressBar
+from pbp_drake.studies.report import FIGURES, report, results_table
+from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
+from pbp_drake.studies.toy import run_study
+from pbp_drake.task_run import run_task
 
 
 def main(argv=None):
@@ -79,11 +92,10 @@ def main(argv=None):
         tool.add_argument("arguments", nargs=argparse.REMAINDER)
 
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv and argv[0] in ("bench", "draw"):
+    tools = {"bench": bench_main, "draw": draw_main}
+    if argv and argv[0] in tools:
         # Before argparse, which would take their options (e.g. --help) for its own.
-        import importlib
-
-        return importlib.import_module(f"pbp_drake.{argv[0]}").main(argv[1:])
+        return tools[argv[0]](argv[1:])
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
@@ -142,12 +154,6 @@ def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operato
 
 
 def _run(args):
-    from pydrake.geometry import Meshcat, MeshcatParams, Rgba
-
-    from pbp_drake.builder import build_diagram
-    from pbp_drake.core.toy_scene import collision_ratio
-    from pbp_drake.simulation import simulate
-
     resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
                                 args.scene, args.operator, args.seed, args.duration)
     scenario = resolved.scenario
@@ -178,10 +184,6 @@ def _run(args):
 
 
 def _run_task(args, resolved, meshcat):
-    from pbp_drake.builder import build_diagram
-    from pbp_drake.scenarios import Gamepad, Keyboard
-    from pbp_drake.task_run import run_task
-
     scenario = resolved.scenario
     person = isinstance(scenario.operator, (Keyboard, Gamepad))
     if args.headless and person:
@@ -217,11 +219,6 @@ def _run_task(args, resolved, meshcat):
 
 
 def _run_session(args, resolved, meshcat, person):
-    from pbp_drake.builder import build_diagram
-    from pbp_drake.scenarios import with_method
-    from pbp_drake.task_run import run_task
-    from pbp_drake.user_study import DEFAULT_SESSION_METHODS, run_session, session_order
-
     scenario = resolved.scenario
     if args.record:
         raise ScenarioError("--record saves one run; a session saves every run under --output")
@@ -281,8 +278,6 @@ def _save_recording(meshcat, path):
 
 
 def _study(args):
-    from pbp_drake.toy_studies import run_study
-
     scenario_file = load_scenario_file(args.scenario)
     if isinstance(scenario_file.scenario.robot, Hsr):
         return _method_study(args, scenario_file)
@@ -308,9 +303,6 @@ def _study(args):
 
 
 def _method_study(args, scenario_file):
-    from pbp_drake.method_study import ProgressBar, run_method_comparison
-    from pbp_drake.scenarios import check_method_comparison
-
     study = scenario_file.study or MethodComparison()
     if not isinstance(study, MethodComparison):
         raise ScenarioError(f"{args.scenario}: HSR tasks take study: !MethodComparison")
@@ -362,8 +354,6 @@ def _method_study(args, scenario_file):
 
 
 def _print_report(summary, output):
-    from pbp_drake.method_study import FIGURES, results_table
-
     print(results_table(summary), end="")
     for method, entry in summary["methods"].items():
         if entry["errors"]:
@@ -374,8 +364,6 @@ def _print_report(summary, output):
 
 
 def _report(args):
-    from pbp_drake.method_study import report
-
     output = pathlib.Path(args.output)
     _print_report(report(output), output)
     return 0

@@ -10,12 +10,14 @@ date: `make diagrams` (or `pbp-drake draw diagrams/*.yaml`) redraws them.
 """
 
 import argparse
-import dataclasses
 import pathlib
 import re
 import shutil
 import subprocess
 import sys
+
+from pbp_drake.builder import build_diagram
+from pbp_drake.scenarios import ScenarioError, load_scenario_file
 
 # Node ids: `digraph _143`, `cluster143diagram`, `s2 [...]`, `s2:y0:e -> s5:u1:w`.
 _ID = re.compile(r"(?<![\w])(?:(digraph _)|(cluster)|(s))(\d+)(?=[ :a-z{])")
@@ -66,8 +68,6 @@ def render_svg(source):
 
 def scenario_svg(scenario, max_depth=None):
     """The SVG bytes of the diagram `build_diagram(scenario)` builds."""
-    from pbp_drake.builder import build_diagram
-
     return render_svg(dot_source(build_diagram(scenario), max_depth))
 
 
@@ -94,20 +94,16 @@ def main(argv=None):
     if args.output and len(args.scenarios) > 1:
         parser.error("--output takes one scenario")
 
-    from pbp_drake.scenarios import ScenarioError, load_scenario_file, validate_scenario
-    from pbp_drake.builder import build_diagram
-
     stale = []
     for path in args.scenarios:
         try:
-            scenario = load_scenario_file(path).scenario
+            resolved = load_scenario_file(path).resolved
             if args.method:
-                scenario = dataclasses.replace(scenario, method=args.method)
-                validate_scenario(scenario)
+                resolved = resolved.with_method(args.method)
         except ScenarioError as error:
             print(f"pbp-drake draw: {error}", file=sys.stderr)
             return 2
-        source = dot_source(build_diagram(scenario))
+        source = dot_source(build_diagram(resolved))
         if args.format == "dot":
             data = source.encode()
         else:

@@ -3,9 +3,10 @@
 import dataclasses
 
 import numpy as np
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from pbp_drake.builder import build_diagram
+from pbp_drake.scenarios import ResolvedScenario, resolve
 
 
 @dataclasses.dataclass
@@ -29,11 +30,15 @@ class Trajectory:
     phase: np.ndarray | None
 
 
-def simulate(scenario, meshcat=None, realtime_rate=0.0, diagram=None):
+def simulate(scenario, meshcat=None, realtime_rate=None, diagram=None):
     """Simulates `scenario` for its duration and returns its Trajectory."""
-    diagram = build_diagram(scenario, meshcat) if diagram is None else diagram
+    resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
+    scenario = resolved.scenario
+    diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
     simulator = Simulator(diagram)
-    simulator.set_target_realtime_rate(realtime_rate)
+    ApplySimulatorConfig(scenario.simulator, simulator)
+    if realtime_rate is not None:
+        simulator.set_target_realtime_rate(realtime_rate)
     simulator.Initialize()
     # One tick past the end: the loggers record tick k's decisions at t_(k+1) (see below).
     ticks = int(round(scenario.duration / scenario.control_period))

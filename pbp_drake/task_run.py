@@ -3,9 +3,10 @@
 import dataclasses
 
 import numpy as np
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from pbp_drake.builder import build_diagram
+from pbp_drake.scenarios import ResolvedScenario, resolve
 from pbp_drake.simulation import read_log
 from pbp_drake.systems.layouts import TaskStatus
 
@@ -50,13 +51,17 @@ class TaskResult:
                 f"{self.intervention_ratio:.3f}, {self.switches} target switches")
 
 
-def run_task(scenario, meshcat=None, realtime_rate=0.0, diagram=None):
+def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None):
     """Simulates an HSR task until success or `scenario.duration` (the time limit)."""
-    diagram = build_diagram(scenario, meshcat) if diagram is None else diagram
+    resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
+    scenario = resolved.scenario
+    diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
     monitor = diagram.GetSubsystemByName("task_monitor")
     status_port = monitor.get_task_status_output_port()
     simulator = Simulator(diagram)
-    simulator.set_target_realtime_rate(realtime_rate)
+    ApplySimulatorConfig(scenario.simulator, simulator)
+    if realtime_rate is not None:
+        simulator.set_target_realtime_rate(realtime_rate)
     # The task monitor itself ends the simulation at success.
     simulator.Initialize()
     period = scenario.control_period

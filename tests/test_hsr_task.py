@@ -230,7 +230,7 @@ def test_a_person_cannot_drive_a_headless_run(tmp_path, capsys):
 
 
 def test_a_participant_session_runs_every_method_in_a_counterbalanced_order(tmp_path):
-    from pbp_drake.user_study import session_order
+    from pbp_drake.studies.sessions import session_order
 
     methods = ["pbp_alternated", "pbp_continuous", "teleop"]
     orders = [session_order(methods, f"P{number}") for number in range(3)]

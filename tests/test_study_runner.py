@@ -16,10 +16,15 @@ import numpy as np
 import pytest
 
 from pbp_drake.cli import main
-from pbp_drake.method_study import (
-    FIGURES, HISTOGRAM_EDGES, ProgressBar, StudyFolderError, collision_histogram, ideal_alpha,
-    load_task_result, read_time_series, run_method_comparison, trial_paths, write_trial)
-from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.progress import ProgressBar
+from pbp_drake.studies.report import FIGURES
+from pbp_drake.studies.summary import (
+    HISTOGRAM_EDGES, arbitration, collision_free, collision_histogram, does_the_hsr_task,
+    ideal_alpha)
+from pbp_drake.studies.trial_files import (
+    StudyFolderError, load_task_result, read_time_series, trial_paths, write_trial)
+from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
 from pbp_drake.task_run import TaskResult, run_task
 
 # Two objects drawn from each seed; 30 s is enough for every method in these scenes.
@@ -143,7 +148,8 @@ def test_an_interrupted_study_runs_only_the_missing_trial(studies, task_file, sc
 
 # Fake runs: no simulation, a TaskResult drawn from the seed. Module level, so that worker
 # processes can import them.
-def fake_run(scenario):
+def fake_run(resolved):
+    scenario = resolved.scenario
     rng = np.random.default_rng(scenario.seed)
     ticks = 5
     in_collision = rng.random(ticks) < 0.4
@@ -158,16 +164,16 @@ def fake_run(scenario):
         in_collision=in_collision)
 
 
-def raising_run(scenario):
-    if scenario.seed == 6 and scenario.method == "teleop":
+def raising_run(resolved):
+    if resolved.scenario.seed == 6 and resolved.scenario.method == "teleop":
         raise RuntimeError("the simulator gave up")
-    return fake_run(scenario)
+    return fake_run(resolved)
 
 
-def crashing_run(scenario):
-    if scenario.seed == 6 and scenario.method == "teleop":
+def crashing_run(resolved):
+    if resolved.scenario.seed == 6 and resolved.scenario.method == "teleop":
         os._exit(3)  # the worker process dies
-    return fake_run(scenario)
+    return fake_run(resolved)
 
 
 def test_a_trial_that_raises_is_recorded_and_the_study_goes_on(scenario, tmp_path):
@@ -208,7 +214,7 @@ def test_a_crashed_worker_process_fails_only_its_trial(scenario, tmp_path):
 
 
 def test_in_collision_round_trips_through_the_csv(scenario, tmp_path):
-    result = fake_run(dataclasses.replace(scenario, seed=11))
+    result = fake_run(resolve(dataclasses.replace(scenario, seed=11)))
     run_method_comparison(scenario, ["pbp_alternated"], 1, 11, tmp_path, run=fake_run)
     loaded = load_task_result(tmp_path, "pbp_alternated", 11)
     np.testing.assert_array_equal(loaded.in_collision, result.in_collision)
@@ -268,14 +274,25 @@ def test_ideal_alpha_is_the_highest_that_still_does_the_task():
     # The paper's choice: the most autonomy that still lets the operator do the task.
     reach = {"teleop": _entry(1.0, 10), "fixed_alpha=0.2": _entry(1.0, 10),
              "fixed_alpha=0.9": _entry(0.9, 10), "fixed_alpha=0.5": _entry(1.0, 10)}
-    assert ideal_alpha(reach)["ideal_alpha"] == 0.5
-    assert ideal_alpha(reach)["alphas"] == [0.2, 0.5, 0.9]
+    assert arbitration(reach)["ideal_alpha"] == 0.5
+    assert arbitration(reach)["alphas"] == [0.2, 0.5, 0.9]
     # Collisions measured: most trials (of those that ran) must be free of them.
     obstacles = {"fixed_alpha=0.1": _entry(1.0, 6), "fixed_alpha=0.3": _entry(1.0, 5),
                  "fixed_alpha=0.6": _entry(1.0, 5, errors=1)}
-    assert ideal_alpha(obstacles)["ideal_alpha"] == 0.6
-    assert ideal_alpha({"fixed_alpha=0.3": _entry(1.0, 2)})["ideal_alpha"] is None
-    assert ideal_alpha({"teleop": _entry(1.0, 10)}) is None
+    assert arbitration(obstacles)["ideal_alpha"] == 0.6
+    assert arbitration({"fixed_alpha=0.3": _entry(1.0, 2)})["ideal_alpha"] is None
+    assert arbitration({"teleop": _entry(1.0, 10)}) is None
+
+
+def test_one_ideal_alpha_serves_the_hsr_comparison_and_the_2d_alpha_study():
+    # The HSR method comparison: summary entries judged by success and collisions.
+    swept = [(0.2, _entry(1.0, 10)), (0.9, _entry(0.9, 10)), (0.5, _entry(1.0, 10))]
+    assert ideal_alpha(swept, does_the_hsr_task) == 0.5
+    # The 2-D alpha study: collision ratios, the task is to touch no obstacle.
+    ratios = [(0.0, 0.0), (0.3, 0.0), (0.4, 0.02), (0.6, 0.0), (1.0, 0.4)]
+    assert ideal_alpha(ratios, collision_free) == 0.6
+    assert ideal_alpha([(0.5, 0.1), (1.0, 0.3)], collision_free) is None
+    assert ideal_alpha([], collision_free) is None
 
 
 class Terminal(io.StringIO):
@@ -368,7 +385,7 @@ def test_the_local_backend_does_not_import_ray(scenario, tmp_path):
     code = textwrap.dedent("""
         import sys
         from pbp_drake.cli import main
-        from pbp_drake.method_study import run_method_comparison
+        from pbp_drake.studies.comparison import run_method_comparison
         from pbp_drake.scenarios import load_scenario_file
 
         def run(scenario):

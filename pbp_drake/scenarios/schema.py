@@ -13,9 +13,12 @@ add no field and no default. Drake's own config structs are nested where they ex
 (`SimulatorConfig`). `pbp_drake.scenarios.resolve` checks and derives everything else.
 """
 
+import copyreg
 import dataclasses
 import typing
 
+from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
+from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
 from pbp_drake.core.dmp import DmpSettings
@@ -26,6 +29,20 @@ from pbp_drake.systems.keyboard_operator import KeyboardParams
 from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionParams
 from pbp_drake.systems.point_robot import PointRobotParams
 from pbp_drake.systems.virtual_participant import VirtualParticipantParams
+
+def _config_from_yaml(config_type, text):
+    return yaml_load_typed(schema=config_type, data=text)
+
+
+def _reduce_config(config):
+    return _config_from_yaml, (type(config), yaml_dump_typed(config))
+
+
+# Drake's config structs do not pickle, and a study sends its scenario to worker processes:
+# they travel as their YAML.
+for _config_type in (MultibodyPlantConfig, SimulatorConfig):
+    copyreg.pickle(_config_type, _reduce_config)
+
 
 class ScenarioError(ValueError):
     """A scenario file or value that cannot be used; the message names the field."""

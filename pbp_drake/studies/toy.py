@@ -12,8 +12,10 @@ import pathlib
 import numpy as np
 
 from pbp_drake.core.toy_scene import collision_ratio
-from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolved_goals
+from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolve
 from pbp_drake.simulation import simulate
+from pbp_drake.studies.figures import plot_alpha_study, plot_alt_vs_cont
+from pbp_drake.studies.summary import collision_free, ideal_alpha
 
 
 def run_study(scenario_file, output_dir):
@@ -21,9 +23,9 @@ def run_study(scenario_file, output_dir):
     output_dir = pathlib.Path(output_dir)
     output_dir.mkdir(parents=True, exist_ok=True)
     if isinstance(scenario_file.study, AlphaStudy):
-        return run_alpha_study(scenario_file.scenario, scenario_file.study, output_dir)
+        return run_alpha_study(scenario_file.resolved, scenario_file.study, output_dir)
     if isinstance(scenario_file.study, AltVsCont):
-        return run_alt_vs_cont(scenario_file.scenario, scenario_file.study, output_dir)
+        return run_alt_vs_cont(scenario_file.resolved, scenario_file.study, output_dir)
     raise ValueError("this scenario file has no `study:` section to run")
 
 
@@ -38,38 +40,40 @@ def _ratio(trajectory, obstacles):
                            [o.radius for o in obstacles])
 
 
-def run_alpha_study(scenario, study, output_dir):
+def run_alpha_study(resolved, study, output_dir):
     """Explicit arbitration over alpha (P: the demonstration, open loop) against PBP-Alt and
     PBP-Cont (P: a DMP learned from it), the same virtual operator in every run."""
+    scenario = resolved.scenario
     scenes = []
     trajectories = {}
     for scene in study.scenes:
-        base = scene_scenario(scenario, scene)
+        # Each scene's obstacles are resolved once; the methods share its DMPs.
+        base = resolve(scene_scenario(scenario, scene))
         ratios = {}
         for alpha in study.alphas:
-            run = simulate(dataclasses.replace(base, method="fixed_alpha", alpha=alpha))
+            run = simulate(base.with_method(f"fixed_alpha={alpha!r}"))
             ratios[f"{alpha:.2f}"] = _ratio(run, scene.obstacles)
             trajectories[(scene.name, alpha)] = run.positions
         pbp = {}
         for method in ("pbp_alternated", "pbp_continuous"):
-            run = simulate(dataclasses.replace(base, method=method))
+            run = simulate(base.with_method(method))
             pbp[method] = _ratio(run, scene.obstacles)
             trajectories[(scene.name, method)] = run.positions
-        safe = [alpha for alpha in study.alphas if ratios[f"{alpha:.2f}"] == 0.0]
+        # The highest alpha that still lets the operator pass the obstacles untouched.
+        ideal = ideal_alpha([(alpha, ratios[f"{alpha:.2f}"]) for alpha in study.alphas],
+                            collision_free)
         scenes.append({
             "name": scene.name,
             "obstacles": [dataclasses.asdict(o) for o in scene.obstacles],
             "collision_ratio_by_alpha": ratios,
-            "ideal_alpha": max(safe) if safe else None,
+            "ideal_alpha": ideal,
             "pbp_alternated_collision_ratio": pbp["pbp_alternated"],
             "pbp_continuous_collision_ratio": pbp["pbp_continuous"],
         })
     summary = {"study": "alpha_study", "scenario": scenario.name, "alphas": study.alphas,
                "scenes": scenes}
     _write_json(output_dir / "summary.json", summary)
-    from pbp_drake.figures import plot_alpha_study
-
-    plot_alpha_study(scenario, study, summary, trajectories, output_dir / "fig2_alpha_study.png")
+    plot_alpha_study(resolved, study, summary, trajectories, output_dir / "fig2_alpha_study.png")
     return summary
 
 
@@ -79,13 +83,14 @@ def phase_progress(phase, alpha_x):
     return -np.log(np.maximum(phase, 1e-300)) / alpha_x
 
 
-def run_alt_vs_cont(scenario, study, output_dir):
+def run_alt_vs_cont(resolved, study, output_dir):
     """The same DMP under the same open-loop input in continuous and alternated mode."""
-    goal = resolved_goals(scenario)[0]
+    scenario = resolved.scenario
+    goal = resolved.goals[0]
     modes = {}
     runs = {}
     for method in ("pbp_continuous", "pbp_alternated"):
-        run = simulate(dataclasses.replace(scenario, method=method))
+        run = simulate(resolved.with_method(method))
         runs[method] = run
         progress = phase_progress(run.phase[:, 0], scenario.dmp.alpha_x)
         # progress[k] is the phase with which tick k steps; tick k changed it iff
@@ -112,9 +117,7 @@ def run_alt_vs_cont(scenario, study, output_dir):
         "both_reach_goal": all(m["final_error"] <= study.goal_tolerance for m in modes.values()),
     }
     _write_json(output_dir / "summary.json", summary)
-    from pbp_drake.figures import plot_alt_vs_cont
-
-    plot_alt_vs_cont(scenario, summary, output_dir / "fig4_alt_vs_cont.png")
+    plot_alt_vs_cont(resolved, summary, output_dir / "fig4_alt_vs_cont.png")
     return summary
 
 

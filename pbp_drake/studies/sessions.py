@@ -4,6 +4,8 @@ in the study runner's format (one folder per participant; `pbp-drake report` rea
 import hashlib
 import re
 
+from pbp_drake.studies.comparison import run_method_comparison
+
 DEFAULT_SESSION_METHODS = ("pbp_alternated", "pbp_continuous", "teleop")
 
 
@@ -31,8 +33,6 @@ def run_session(scenario, participant, methods, output, run, progress=None):
     """Runs `run(scenario)` (one task, e.g. driven from the browser) for each method in the
     participant's order, all on the scenario's seed, and saves each as a trial under
     `output`. Returns the summary of the session."""
-    from pbp_drake.method_study import run_method_comparison
-
     order = session_order(methods, participant)
     return run_method_comparison(scenario, order, 1, scenario.seed, output, progress=progress,
                                  run=run)

@@ -1,4 +1,7 @@
-"""The paper's figures, drawn with matplotlib (headless)."""
+"""The paper's figures, drawn with matplotlib (headless): the 2-D studies' Fig. 2 (the alpha
+study) and Fig. 4 (Alt vs Cont), and the method comparison's Fig. 7: (a) box plots of the
+intervention ratio, (b) of the task time, (c) the histogram of per-trial collision ratios.
+Fig. 7 reads trial records (dicts from the trial files), never a simulation."""
 
 import matplotlib
 
@@ -7,7 +10,92 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
-from pbp_drake.scenarios import demonstration_samples, resolved_goals, resolved_start  # noqa: E402
+
+# ---------------------------------------------------------------------------------------------
+# The method comparison (Fig. 7)
+
+METHOD_LABELS = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont",
+                 "teleop": "Teleop", "pbp_no_user": "PBP-NoUser", "fixed_alpha": "Fixed alpha"}
+METHOD_COLOURS = {"pbp_alternated": "tab:orange", "pbp_continuous": "tab:blue",
+                  "teleop": "tab:green", "pbp_no_user": "tab:gray", "fixed_alpha": "tab:purple"}
+
+
+def _label(method, rows=None):
+    label = METHOD_LABELS.get(method, method)
+    if rows:
+        rate = np.mean([bool(r["success"]) for r in rows])
+        label += f"\n{100 * rate:.0f} % success"
+    return label
+
+
+def _values(records, method, field):
+    return [r[field] for r in records if r["method"] == method and r.get("error") is None
+            and r.get(field) is not None and np.isfinite(r[field])]
+
+
+def _box_plot(records, methods, field, ylabel, title, path, ylim=None):
+    figure, axis = plt.subplots(figsize=(1.6 + 1.3 * len(methods), 3.6))
+    data = [_values(records, method, field) for method in methods]
+    labels = [_label(m, [r for r in records if r["method"] == m]) for m in methods]
+    # A method with no finished trial gets an empty box (matplotlib needs one value: NaN).
+    boxes = axis.boxplot([d if d else [np.nan] for d in data], patch_artist=True)
+    for patch, method in zip(boxes["boxes"], methods):
+        patch.set_facecolor(METHOD_COLOURS.get(method, "0.8"))
+        patch.set_alpha(0.6)
+    for index, values in enumerate(data, start=1):
+        jitter = np.linspace(-0.12, 0.12, len(values)) if len(values) > 1 else np.zeros(
+            len(values))
+        axis.plot(index + jitter, values, "k.", ms=3, alpha=0.6)
+    axis.set_xticks(range(1, len(methods) + 1), labels, fontsize=8)
+    axis.set_ylabel(ylabel)
+    axis.set_title(title)
+    axis.grid(axis="y", alpha=0.3)
+    if ylim is not None:
+        axis.set_ylim(*ylim)
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def plot_intervention(records, methods, path):
+    """Fig. 7a: the intervention ratio per method (box plots, one dot per trial)."""
+    _box_plot(records, methods, "intervention_ratio", "intervention ratio",
+              "(a) intervention ratio", path, ylim=(-0.02, 1.05))
+
+
+def plot_task_time(records, methods, path):
+    """Fig. 7b: the task time per method (a failed trial counts with the time limit)."""
+    _box_plot(records, methods, "task_time", "task time (s)", "(b) task time", path)
+
+
+def plot_collision_histogram(summary, path):
+    """Fig. 7c: how many trials of each method had each collision ratio, in the summary's
+    fixed bins (all zeros, as in tasks without obstacles, make one bar per method)."""
+    edges = np.asarray(summary["collision_histogram_edges"], float)
+    methods = list(summary["methods"])
+    figure, axis = plt.subplots(figsize=(7, 3.6))
+    width = np.diff(edges) / (len(methods) + 1)
+    for index, method in enumerate(methods):
+        entry = summary["methods"][method]["collision_ratio"]
+        mean = entry["mean"]
+        label = METHOD_LABELS.get(method, method) + (
+            f" (mean {mean:.3f})" if mean is not None else " (no trials)")
+        axis.bar(edges[:-1] + (index + 0.5) * width, entry["histogram"], width=width,
+                 align="edge", color=METHOD_COLOURS.get(method), label=label, alpha=0.85)
+    axis.set_xlim(edges[0], edges[-1])
+    axis.set_xlabel("collision ratio (ticks in collision / ticks)")
+    axis.set_ylabel("trials")
+    axis.set_title("(c) collision ratios")
+    axis.yaxis.get_major_locator().set_params(integer=True)
+    axis.legend(fontsize=8)
+    axis.grid(axis="y", alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+# ---------------------------------------------------------------------------------------------
+# The 2-D studies (Fig. 2 and 4)
 
 SCENE_COLOURS = ["tab:red", "tab:purple", "tab:brown", "tab:olive"]
 
@@ -19,10 +107,10 @@ def _draw_obstacles(axes, obstacles, colour, label=None, fill=True):
                               label=label if index == 0 else None))
 
 
-def _draw_task(axes, scenario):
-    demo = demonstration_samples(scenario.demonstration)[1]
+def _draw_task(axes, resolved):
+    demo = resolved.demonstration[1]
     axes.plot(demo[:, 0], demo[:, 1], "k--", lw=1.2, label="demonstration")
-    start, goal = resolved_start(scenario), resolved_goals(scenario)[0]
+    start, goal = resolved.start, resolved.goals[0]
     axes.plot(*start, "ko", ms=5)
     axes.plot(*goal, "k*", ms=10)
     axes.set_aspect("equal")
@@ -30,13 +118,13 @@ def _draw_task(axes, scenario):
     axes.set_ylabel("y")
 
 
-def plot_alpha_study(scenario, study, summary, trajectories, path):
+def plot_alpha_study(resolved, study, summary, trajectories, path):
     """Fig. 2: (a) the scenes, (b) collision ratio against alpha, (c) trajectories under
     explicit arbitration, (d) trajectories under PBP."""
     figure, axes = plt.subplots(2, 2, figsize=(11, 8.5))
     (scenes_axes, ratio_axes), (alpha_axes, pbp_axes) = axes
 
-    _draw_task(scenes_axes, scenario)
+    _draw_task(scenes_axes, resolved)
     _draw_obstacles(scenes_axes, study.demonstration_obstacles, "0.5", "during demonstration")
     for index, scene in enumerate(study.scenes):
         _draw_obstacles(scenes_axes, scene.obstacles, SCENE_COLOURS[index % 4], scene.name)
@@ -73,7 +161,7 @@ def plot_alpha_study(scenario, study, summary, trajectories, path):
             pbp_axes.plot(positions[:, 0], positions[:, 1], style, color=colour, lw=1.5,
                           label=f"{scene.name} {method}")
     for target in (alpha_axes, pbp_axes):
-        _draw_task(target, scenario)
+        _draw_task(target, resolved)
     mappable = plt.cm.ScalarMappable(cmap=colour_map, norm=plt.Normalize(0, 1))
     figure.colorbar(mappable, ax=alpha_axes, label="alpha")
     alpha_axes.set_title("(c) explicit arbitration, every alpha")
@@ -84,7 +172,7 @@ def plot_alpha_study(scenario, study, summary, trajectories, path):
     plt.close(figure)
 
 
-def plot_alt_vs_cont(scenario, summary, path):
+def plot_alt_vs_cont(resolved, summary, path):
     """Fig. 4: the two modes' paths, their y against the phase, and the input."""
     figure, (path_axes, phase_axes, input_axes) = plt.subplots(1, 3, figsize=(14, 4))
     labels = {"pbp_continuous": "PBP-Cont", "pbp_alternated": "PBP-Alt"}
@@ -119,4 +207,3 @@ def plot_alt_vs_cont(scenario, summary, path):
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
-

@@ -1,0 +1,7 @@
+"""`python -m pbp_drake.bench`: the same as `pbp-drake bench`."""
+
+import sys
+
+from pbp_drake.bench.run import main
+
+sys.exit(main())

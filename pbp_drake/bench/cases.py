@@ -1,0 +1,106 @@
+"""The cases timed: one bank of K DMPs in D dimensions, and the steps of it that the bench
+times (the bank math alone, the bank inside its LeafSystem, and a LeafSystem with the same
+ports and state whose update does nothing: Drake's own cost)."""
+
+import dataclasses
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import ConstantVectorSource
+
+from pbp_drake.core.dmp import DmpBank, DmpSettings, fit_weights, minimum_jerk
+from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+from pbp_drake.systems.goals_source import GoalsSource
+
+BASIS = 50
+DT = 0.001  # a 1 kHz control loop
+
+
+@dataclasses.dataclass
+class Case:
+    dimension: int
+    goal_count: int
+    start: np.ndarray  # (D,)
+    goals: np.ndarray  # (K, D)
+    robot: np.ndarray  # (D,) the robot's position every step re-integrates from
+    weights: np.ndarray | None  # (K, N, D) distinct, or None
+    shared_weights: np.ndarray  # (N, D) of one demonstration
+
+
+def make_case(dimension, goal_count, distinct, seed=0):
+    rng = np.random.default_rng(seed + 1000 * dimension + goal_count)
+    start = np.zeros(dimension)
+    goals = rng.uniform(0.5, 1.5, (goal_count, dimension))
+    robot = rng.uniform(-0.05, 0.05, dimension)
+    times, path = minimum_jerk(start, np.ones(dimension), 1.0)
+    path = path + 0.2 * np.sin(np.pi * times / times[-1])[:, None] * np.arange(dimension)
+    shared, _ = fit_weights(times, path, DmpSettings(basis_count=BASIS))
+    weights = None
+    if distinct:
+        # Learned-looking weights, different for every goal (the bank does not care how).
+        weights = shared[None] * rng.uniform(0.5, 1.5, (goal_count, 1, dimension))
+    return Case(dimension, goal_count, start, goals, robot, weights, shared)
+
+
+def make_bank(case):
+    settings = DmpSettings(basis_count=BASIS)
+    if case.weights is not None:
+        return DmpBank(case.weights, case.start, 1.0, settings)
+    return DmpBank(case.shared_weights, case.start, 1.0, settings, goal_count=case.goal_count)
+
+
+def bank_math_step(bank, case):
+    """One step of the bank from the robot's position, in place, goals validated each step."""
+    phase, positions, scaled_velocity = bank.initial_state()
+    robot = case.robot[:, None]
+    goals = case.goals.reshape(-1)
+
+    def step():
+        bank.advance_into(phase, robot, scaled_velocity, bank.goals_matrix(goals), DT,
+                          phase, positions, scaled_velocity)
+    return step
+
+
+class NullBank(LeafSystem):
+    """A LeafSystem with the DmpBank system's ports and state and an update that does
+    nothing: Drake's own cost of one periodic discrete update."""
+
+    def __init__(self, goal_count, dimension):
+        super().__init__()
+        k, d = goal_count, dimension
+        self.DeclareVectorInputPort("robot_state", 2 * d)
+        self.DeclareVectorInputPort("goals", k * d)
+        self.DeclareVectorInputPort("operator_active", 1)
+        self.DeclareDiscreteState(np.zeros(DmpBankSystem.state_size(k, d)))
+        self.DeclarePeriodicDiscreteUpdateEvent(DT, 0.0, self._update)
+
+    def _update(self, context, discrete_state):
+        pass
+
+
+def leaf_simulator(case, bank=None):
+    """A Simulator of the bank's LeafSystem (or the null one) fed by constant sources."""
+    builder = DiagramBuilder()
+    d = case.dimension
+    if bank is None:
+        system = builder.AddSystem(NullBank(case.goal_count, d))
+    else:
+        system = builder.AddSystem(DmpBankSystem(bank, DT))
+    robot = builder.AddSystem(ConstantVectorSource(np.concatenate([case.robot, np.zeros(d)])))
+    # Our goals source, as the builder uses: Drake's ConstantVectorSource would make the
+    # bank re-read its goals at every update.
+    goals = builder.AddSystem(GoalsSource(case.goals))
+    builder.Connect(robot.get_output_port(), system.get_input_port(0))
+    builder.Connect(goals.get_output_port(), system.get_input_port(1))
+    simulator = Simulator(builder.Build())
+    simulator.Initialize()
+    return simulator
+
+
+def leaf_step(simulator, steps):
+    """Advances `steps` control periods; the timed unit is one period."""
+    def step():
+        context = simulator.get_context()
+        simulator.AdvanceTo(context.get_time() + steps * DT)
+    return step

@@ -1,0 +1,54 @@
+"""Closed loop: simulated seconds per wall second of the HSR reaching task with K goals."""
+
+import dataclasses
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+
+from pbp_drake.builder import build_diagram
+from pbp_drake.scenarios import load_scenario_file
+
+HSR_KS = (4, 100, 1000)
+# The repository's diagrams/ folder (this file is pbp_drake/bench/closed_loop.py).
+DIAGRAMS = Path(__file__).resolve().parents[2] / "diagrams"
+
+
+def hsr_scenario(goal_count, seed=0):
+    """The HSR reaching scenario of `diagrams/hsr_reach.yaml` with `goal_count` objects on a
+    jittered grid in the paper's region, the target the first of them, no switches."""
+    scenario = load_scenario_file(DIAGRAMS / "hsr_reach.yaml").scenario
+    task = scenario.task
+    (x0, x1), (y0, y1) = task.x_range, task.y_range
+    rows = max(1, int(math.ceil(math.sqrt(goal_count * (x1 - x0) / (y1 - y0)))))
+    columns = int(math.ceil(goal_count / rows))
+    dx, dy = (x1 - x0) / rows, (y1 - y0) / columns
+    rng = np.random.default_rng(seed)
+    cells = rng.permutation(rows * columns)[:goal_count]
+    jitter = rng.uniform(-0.25, 0.25, (goal_count, 2))
+    objects = np.stack([x0 + (cells // columns + 0.5 + jitter[:, 0]) * dx,
+                        y0 + (cells % columns + 0.5 + jitter[:, 1]) * dy,
+                        np.full(goal_count, task.height)], axis=1)
+    task = dataclasses.replace(task, objects=objects.tolist(), targets=[0],
+                               switch_schedule=[0.0],
+                               min_separation=min(task.min_separation, 0.4 * min(dx, dy)))
+    return dataclasses.replace(scenario, task=task)
+
+
+def hsr_speed(goal_count, simulated_seconds, meshcat=None):
+    """Simulated seconds per wall second of the HSR task (and the build time)."""
+    scenario = hsr_scenario(goal_count)
+    began = time.perf_counter()
+    diagram = build_diagram(scenario, meshcat)
+    simulator = Simulator(diagram)
+    simulator.set_target_realtime_rate(0.0)
+    simulator.Initialize()
+    built = time.perf_counter() - began
+    began = time.perf_counter()
+    simulator.AdvanceTo(simulated_seconds)
+    wall = time.perf_counter() - began
+    return {"goals": goal_count, "simulated_s": simulated_seconds, "wall_s": wall,
+            "realtime_factor": simulated_seconds / wall, "build_s": built,
+            "control_period_s": scenario.control_period}

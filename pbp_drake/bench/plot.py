@@ -1,0 +1,44 @@
+"""The bench's figure: the control rate reached (1 / step time) versus K."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from pbp_drake.bench.cases import BASIS  # noqa: E402
+
+
+def plot_control_rate(rows, path):
+    """Control rate reached (1 / step time) versus K, for D = 3 (or the first D measured)."""
+    dimensions = sorted({row["D"] for row in rows})
+    dimension = 3 if 3 in dimensions else dimensions[0]
+    figure, axes = plt.subplots(figsize=(7.5, 5))
+    series = [("leaf_us", "distinct", "bank in LeafSystem, distinct weights", "C0", "-o"),
+              ("leaf_us", "shared", "bank in LeafSystem, one shared demo", "C1", "-o"),
+              ("bank_math_us", "distinct", "bank math, distinct weights", "C0", ":."),
+              ("bank_math_us", "shared", "bank math, one shared demo", "C1", ":."),
+              ("mp_stacked_us", "distinct", "movement_primitives, K*D stacked", "C2", "--s"),
+              ("pydmps_per_goal_us", "distinct", "pydmps, one object per goal", "C3", "--^"),
+              ("mp_per_goal_us", "distinct", "movement_primitives, one per goal", "C4", "--v")]
+    for key, weights, label, color, style in series:
+        points = [(row["K"], 1e6 / row[key]) for row in rows
+                  if row["D"] == dimension and row["weights"] == weights and row.get(key)]
+        if points:
+            k, rate = zip(*points)
+            axes.plot(k, rate, style, color=color, label=label)
+    axes.axhline(1000, color="grey", lw=0.8, ls="--")
+    axes.axhline(30, color="grey", lw=0.8, ls=":")
+    axes.text(1, 1100, "1 kHz", color="grey")
+    axes.text(1, 33, "30 Hz (paper)", color="grey")
+    axes.plot([100], [30], "k*", ms=12, label="paper, Fig. 6c: 100 DMPs at 30 Hz")
+    axes.set_xscale("log")
+    axes.set_yscale("log")
+    axes.set_xlabel("goals K (one DMP each)")
+    axes.set_ylabel("control rate reached (Hz) = 1 / step time")
+    axes.set_title(f"DMP bank step, D = {dimension}, N = {BASIS} basis functions")
+    axes.grid(True, which="both", alpha=0.3)
+    axes.legend(fontsize=8, loc="lower left")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+    return path

@@ -1,0 +1,105 @@
+"""The bench's report: the table of step times, the closed-loop speeds, and the issue's
+acceptance numbers, each with its measured value and verdict."""
+
+
+def microseconds(seconds):
+    return None if seconds is None else seconds * 1e6
+
+
+def ratio(numerator, denominator):
+    if numerator is None or denominator is None:
+        return None
+    return numerator / denominator
+
+
+def _fmt(value, width=9):
+    if value is None:
+        return "-".rjust(width)
+    if value >= 100:
+        return f"{value:,.0f}".rjust(width)
+    return f"{value:.1f}".rjust(width)
+
+
+def _find(rows, dimension, goal_count, weights):
+    for row in rows:
+        if (row["D"], row["K"], row["weights"]) == (dimension, goal_count, weights):
+            return row
+    return None
+
+
+def acceptance(rows, closed_loop, bandwidth):
+    """The issue's acceptance numbers, each with its measured value and verdict."""
+    checks = []
+
+    def check(name, value, limit, passes, unit=""):
+        checks.append({"criterion": name, "value": value, "limit": limit, "unit": unit,
+                       "pass": None if value is None else bool(passes(value))})
+
+    row = _find(rows, 3, 10000, "distinct")
+    check("K=10,000, D=3, distinct: bank inside its LeafSystem <= 1 ms",
+          row and row["leaf_us"], 1000.0, lambda v: v <= 1000.0, "us")
+    row = _find(rows, 3, 100000, "shared")
+    check("K=100,000, one shared demonstration (D=3): inside its LeafSystem <= 1 ms",
+          row and row["leaf_us"], 1000.0, lambda v: v <= 1000.0, "us")
+    row = _find(rows, 3, 1000, "distinct")
+    check("K=1,000 (D=3, distinct): bank math >= 100x the faster one-object-per-goal peer",
+          row and row["speedup_vs_per_goal"], 100.0, lambda v: v >= 100.0, "x")
+    row = _find(rows, 3, 10000, "distinct")
+    check("K=10,000 (D=3, distinct): bank math >= 5x movement_primitives stacked",
+          row and row["speedup_vs_stacked"], 5.0, lambda v: v >= 5.0, "x")
+    check("K=10,000 (D=3, distinct): bank math within 2x of weights / memory bandwidth",
+          row and row["bank_math_us"] / row["bandwidth_bound_us"], 2.0,
+          lambda v: v <= 2.0, "x bound")
+    run = next((r for r in closed_loop if r["goals"] == 100 and not r["meshcat"]), None)
+    check("HSR reaching, K=100, headless: >= 10x real time",
+          run and run["realtime_factor"], 10.0, lambda v: v >= 10.0, "x real time")
+    return checks
+
+
+def format_report(report):
+    lines = []
+    bandwidth = report["memory_bandwidth"]
+    lines.append(f"Memory bandwidth: read {bandwidth['read_gb_per_s']:.1f} GB/s, copy "
+                 f"{bandwidth['copy_gb_per_s']:.1f} GB/s ({bandwidth['array_megabytes']} MB); "
+                 f"cache-sized read {bandwidth['cache_read_gb_per_s']:.1f} GB/s. "
+                 f"{report['machine']['blas']}.")
+    lines.append("One step of all K DMPs from one robot state, microseconds (median); "
+                 "N = 50, dt = 1 ms.")
+    lines.append("math: DmpBank.advance_into; leaf: the DmpBank LeafSystem per 1 ms period "
+                 "in a Simulator (includes Drake); drake: a LeafSystem with the same ports "
+                 "and an empty update;")
+    lines.append("bound: weight bytes / measured read bandwidth (cache-sized bound in "
+                 "brackets); pydmps/goal, mp/goal: one object per goal; mp stacked: one "
+                 "K*D DMP; x per-goal, x stacked: speed-ups of the bank math.")
+    header = (f"{'D':>2} {'K':>7} {'weights':>8} {'math':>9} {'leaf':>9} {'drake':>7} "
+              f"{'bound':>9} {'[cache]':>9} {'pydmps/goal':>12} {'mp/goal':>10} "
+              f"{'mp stacked':>11} {'x per-goal':>10} {'x stacked':>9} {'rate Hz':>9}")
+    lines.append(header)
+    lines.append("-" * len(header))
+    for row in report["steps"]:
+        bound = row["bandwidth_bound_us"] if row["weights"] == "distinct" else None
+        cache = row["cache_bandwidth_bound_us"] if row["weights"] == "distinct" else None
+        lines.append(
+            f"{row['D']:>2} {row['K']:>7} {row['weights']:>8} {_fmt(row['bank_math_us'])} "
+            f"{_fmt(row['leaf_us'])} {_fmt(row['drake_overhead_us'], 7)} {_fmt(bound)} "
+            f"{_fmt(cache)} {_fmt(row['pydmps_per_goal_us'], 12)} "
+            f"{_fmt(row['mp_per_goal_us'], 10)} {_fmt(row['mp_stacked_us'], 11)} "
+            f"{_fmt(row['speedup_vs_per_goal'], 10)} {_fmt(row['speedup_vs_stacked'], 9)} "
+            f"{_fmt(row['control_rate_hz'])}")
+    if report["closed_loop"]:
+        lines.append("")
+        lines.append("Closed loop, HSR reaching task (straight-path DMPs, virtual participant, "
+                     "PBP-Alt): simulated seconds per wall second")
+        for run in report["closed_loop"]:
+            lines.append(f"  K = {run['goals']:>5} {'Meshcat' if run['meshcat'] else 'headless':>8}:"
+                         f" {run['realtime_factor']:7.2f}x real time "
+                         f"({run['simulated_s']:.1f} s in {run['wall_s']:.2f} s wall; "
+                         f"built in {run['build_s']:.1f} s)")
+    lines.append("")
+    lines.append("Acceptance (issue 6):")
+    for item in report["acceptance"]:
+        verdict = {True: "PASS", False: "FAIL", None: "n/a "}[item["pass"]]
+        value = "not measured" if item["value"] is None else (
+            f"{item['value']:.2f} {item['unit']} (limit {item['limit']:g})")
+        lines.append(f"  [{verdict}] {item['criterion']}: {value}")
+    return "\n".join(lines)

@@ -1,0 +1,169 @@
+"""`pbp-drake bench` (`python -m pbp_drake.bench`): its command line, one row of step
+timings per (D, K, weights), the closed-loop runs, and the files it writes."""
+
+import argparse
+import json
+import os
+import platform
+from pathlib import Path
+
+import numpy as np
+from pydrake.geometry import Meshcat, MeshcatParams
+
+import pbp_drake.bench
+from pbp_drake.bench.cases import (
+    BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case)
+from pbp_drake.bench.closed_loop import HSR_KS, hsr_speed
+from pbp_drake.bench.peers import (
+    available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
+from pbp_drake.bench.plot import plot_control_rate
+from pbp_drake.bench.report import acceptance, format_report, microseconds, ratio
+from pbp_drake.bench.timing import limit_blas, memory_bandwidth, timed
+
+KS = (1, 10, 100, 1000, 10000, 100000)
+DS = (2, 3, 6)
+
+
+def _parse(argv):
+    parser = argparse.ArgumentParser(prog="pbp-drake bench",
+                                     description=pbp_drake.bench.__doc__.split("\n")[0])
+    parser.add_argument("--output", default="outputs/bench", help="folder for bench.json "
+                        "and bench_control_rate.png (default: outputs/bench)")
+    parser.add_argument("--quick", action="store_true",
+                        help="a short run: D = 3 only, fewer repeats, 1 s of HSR simulation")
+    parser.add_argument("--goals", type=int, nargs="+", default=list(KS),
+                        help=f"goal counts K (default: {' '.join(map(str, KS))})")
+    parser.add_argument("--dimensions", type=int, nargs="+", default=None,
+                        help="dimensions D (default: 2 3 6; --quick: 3)")
+    parser.add_argument("--peer-max-goals", type=int, default=1000,
+                        help="largest K for the one-object-per-goal peers (default 1000)")
+    parser.add_argument("--hsr-goals", type=int, nargs="*", default=list(HSR_KS),
+                        help="goal counts of the closed-loop HSR runs (none to skip)")
+    parser.add_argument("--hsr-seconds", type=float, default=None,
+                        help="simulated seconds per HSR run (default 5; --quick: 1)")
+    parser.add_argument("--no-meshcat", action="store_true",
+                        help="skip the closed-loop runs with Meshcat publishing")
+    parser.add_argument("--blas-threads", type=int, default=1,
+                        help="BLAS threads for every backend (0: library default)")
+    parser.add_argument("--min-time", type=float, default=None,
+                        help="seconds of repeats per measurement (default 0.3; --quick 0.08)")
+    return parser.parse_args(argv)
+
+
+def main(argv=None):
+    args = _parse(argv)
+    output = Path(args.output)
+    output.mkdir(parents=True, exist_ok=True)
+    dimensions = args.dimensions or ([3] if args.quick else list(DS))
+    min_time = args.min_time or (0.08 if args.quick else 0.3)
+    hsr_seconds = args.hsr_seconds or (1.0 if args.quick else 5.0)
+    blas_note = limit_blas(args.blas_threads)
+    have_pydmps = available("pydmps")
+    have_mp = available("movement_primitives.dmp")
+    print(f"pbp-drake bench: {platform.processor() or platform.machine()}, "
+          f"{os.cpu_count()} CPUs, Python {platform.python_version()}, NumPy "
+          f"{np.__version__}; {blas_note}")
+    for name, present in [("pydmps", have_pydmps), ("movement_primitives", have_mp)]:
+        if not present:
+            print(f"note: {name} is not installed (pip install -e '.[bench]'); its columns "
+                  "stay empty")
+
+    print("Measuring memory bandwidth ...", flush=True)
+    bandwidth = memory_bandwidth()
+    print(f"  read {bandwidth['read_gb_per_s']:.1f} GB/s, copy "
+          f"{bandwidth['copy_gb_per_s']:.1f} GB/s ({bandwidth['array_megabytes']} MB array); "
+          f"read {bandwidth['cache_read_gb_per_s']:.1f} GB/s from a "
+          f"{bandwidth['cache_array_megabytes']} MB array (cache)")
+
+    rows = []
+    for dimension in dimensions:
+        for goal_count in args.goals:
+            for distinct in (True, False):
+                rows.append(_measure_row(dimension, goal_count, distinct, min_time,
+                                         args.peer_max_goals, have_pydmps, have_mp,
+                                         bandwidth))
+                _print_progress(rows[-1])
+
+    closed_loop = []
+    for goal_count in args.hsr_goals:
+        for with_meshcat in ([False] if args.no_meshcat else [False, True]):
+            print(f"HSR reaching, K = {goal_count}, "
+                  f"{'Meshcat' if with_meshcat else 'headless'} ...", flush=True)
+            meshcat = Meshcat(MeshcatParams(host="localhost")) if with_meshcat else None
+            result = hsr_speed(goal_count, hsr_seconds, meshcat)
+            result["meshcat"] = with_meshcat
+            closed_loop.append(result)
+            del meshcat
+
+    report = {
+        "machine": {"processor": platform.processor() or platform.machine(),
+                    "cpus": os.cpu_count(), "python": platform.python_version(),
+                    "numpy": np.__version__, "blas": blas_note,
+                    "load_average": os.getloadavg() if hasattr(os, "getloadavg") else None},
+        "settings": {"basis_count": BASIS, "dt": DT, "min_time_s": min_time,
+                     "quick": args.quick},
+        "memory_bandwidth": bandwidth,
+        "steps": rows,
+        "closed_loop": closed_loop,
+    }
+    report["acceptance"] = acceptance(rows, closed_loop, bandwidth)
+    text = format_report(report)
+    print(text)
+    (output / "bench.json").write_text(json.dumps(report, indent=2))
+    (output / "bench.txt").write_text(text + "\n")
+    figure = plot_control_rate(rows, output / "bench_control_rate.png")
+    print(f"Wrote {output / 'bench.json'}, {output / 'bench.txt'}"
+          + (f" and {figure}" if figure else ""))
+    return 0
+
+
+def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have_pydmps,
+                 have_mp, bandwidth):
+    case = make_case(dimension, goal_count, distinct)
+    bank = make_bank(case)
+    row = {"D": dimension, "K": goal_count, "weights": "distinct" if distinct else "shared"}
+    math_median, math_min, repeats = timed(bank_math_step(bank, case), min_time)
+    row.update(bank_math_us=microseconds(math_median), bank_math_min_us=microseconds(math_min),
+               bank_math_repeats=repeats)
+
+    # Inside the LeafSystem: several periods per timed call, so that Simulator.AdvanceTo's
+    # own call cost is spread; the bank and the null system alike.
+    periods = 10 if goal_count <= 10000 else 2
+    for label, leaf_bank in [("leaf", make_bank(case)), ("drake_overhead", None)]:
+        simulator = leaf_simulator(case, leaf_bank)
+        median, minimum, _ = timed(leaf_step(simulator, periods), min_time, warmup=1)
+        row[f"{label}_us"] = microseconds(median / periods)
+        row[f"{label}_min_us"] = microseconds(minimum / periods)
+        del simulator
+    del bank
+
+    weight_bytes = (case.weights.nbytes if distinct else case.shared_weights.nbytes)
+    row["weight_bytes"] = weight_bytes
+    row["bandwidth_bound_us"] = microseconds(weight_bytes / (bandwidth["read_gb_per_s"] * 1e9))
+    row["cache_bandwidth_bound_us"] = microseconds(
+        weight_bytes / (bandwidth["cache_read_gb_per_s"] * 1e9))
+
+    peer_time = max(min_time / 3, 0.02)
+    for label, present, factory, limit in [
+            ("pydmps_per_goal", have_pydmps, pydmps_step, peer_max_goals),
+            ("mp_per_goal", have_mp, movement_primitives_step, peer_max_goals),
+            ("mp_stacked", have_mp, movement_primitives_stacked_step, 10**9)]:
+        row[f"{label}_us"] = None
+        if present and goal_count <= limit and not (
+                label == "mp_stacked" and goal_count * dimension > 600000):
+            step = factory(case)
+            median, _, _ = timed(step, peer_time, max_repeats=500, min_repeats=3, warmup=1)
+            row[f"{label}_us"] = microseconds(median)
+            del step
+    per_goal = [row[k] for k in ("pydmps_per_goal_us", "mp_per_goal_us") if row[k]]
+    row["speedup_vs_per_goal"] = ratio(min(per_goal) if per_goal else None,
+                                       row["bank_math_us"])
+    row["speedup_vs_stacked"] = ratio(row["mp_stacked_us"], row["bank_math_us"])
+    row["control_rate_hz"] = 1e6 / row["leaf_us"]
+    return row
+
+
+def _print_progress(row):
+    print(f"  D={row['D']} K={row['K']:>6} {row['weights']:>8}: math "
+          f"{row['bank_math_us']:.1f} us, in LeafSystem {row['leaf_us']:.1f} us "
+          f"(Drake {row['drake_overhead_us']:.1f} us)", flush=True)

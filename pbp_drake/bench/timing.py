@@ -1,0 +1,63 @@
+"""Timing: the median of repeated calls, BLAS threads pinned for the whole run, and this
+machine's memory bandwidth (the bound on streaming distinct weights)."""
+
+import time
+
+import numpy as np
+
+
+def timed(step, min_time, max_repeats=5000, min_repeats=3, warmup=2):
+    """Median and minimum seconds of `step()`, repeated for at least `min_time` seconds."""
+    for _ in range(warmup):
+        step()
+    samples = []
+    began = time.perf_counter()
+    while len(samples) < max_repeats and (
+            len(samples) < min_repeats or time.perf_counter() - began < min_time):
+        start = time.perf_counter()
+        step()
+        samples.append(time.perf_counter() - start)
+    samples = np.array(samples)
+    return float(np.median(samples)), float(samples.min()), len(samples)
+
+
+def limit_blas(threads):
+    """Limits BLAS threads for the whole run; returns a note for the report."""
+    if threads <= 0:
+        return "BLAS threads: library default"
+    try:
+        # Deferred on purpose: threadpoolctl is optional (pip install -e '.[bench]').
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return (f"BLAS threads: default (threadpoolctl missing; set OPENBLAS_NUM_THREADS="
+                f"{threads} before starting Python to limit them)")
+    limit_blas.handle = threadpool_limits(limits=threads, user_api="blas")
+    return f"BLAS threads: {threads} (threadpoolctl)"
+
+
+def memory_bandwidth(megabytes=400, cache_megabytes=12, repeats=5):
+    """GB/s of a NumPy sum (read) and copy (read + write) of a large array, and of a sum of
+    an array the size of the weights of K = 10,000, D = 3 (which may stay in cache)."""
+    n = int(megabytes * 1e6 / 8)
+    a = np.ones(n)
+    b = np.empty(n)
+    a.sum()
+    np.copyto(b, a)
+    sum_time = min(_clock(a.sum) for _ in range(repeats))
+    copy_time = min(_clock(lambda: np.copyto(b, a)) for _ in range(repeats))
+    del a, b
+    small = np.ones(int(cache_megabytes * 1e6 / 8))
+    cache_time = timed(small.sum, 0.2, max_repeats=200)[1]
+    return {
+        "array_megabytes": megabytes,
+        "read_gb_per_s": megabytes * 1e6 / sum_time / 1e9,
+        "copy_gb_per_s": 2 * megabytes * 1e6 / copy_time / 1e9,
+        "cache_array_megabytes": cache_megabytes,
+        "cache_read_gb_per_s": cache_megabytes * 1e6 / cache_time / 1e9,
+    }
+
+
+def _clock(function):
+    start = time.perf_counter()
+    function()
+    return time.perf_counter() - start

@@ -1,0 +1,28 @@
+"""Studies: seeded trials of scenarios, their files, summaries, reports and figures.
+
+A study folder `DIR` holds everything needed to rebuild its tables and figures:
+
+    DIR/study.json                        the study: scenario name and hash, methods, trials, seed
+    DIR/trials/<method>/seed_<seed>.json  one trial: its metrics, scene, error (the marker that
+                                          the trial is done)
+    DIR/trials/<method>/seed_<seed>.csv   its time series, one row per control tick
+    DIR/summary.json, DIR/results.md, DIR/trials.json, DIR/fig7*.png
+                                          rebuilt from the files above by `report`
+
+One job per module:
+
+- `trial_files`: the trial and study files (format, paths, atomic writes, CSV time series,
+  reading back) and the scenario hash that keeps different scenarios apart;
+- `runners`: one trial (run, or computed without the disk) and the local process pool;
+- `ray_backend`: the same trials as Ray tasks (Ray is imported only when asked for);
+- `comparison`: `run_method_comparison`, which trials to run, where, then the report;
+- `summary`: the summary of a study folder and the one definition of the ideal alpha;
+- `report`: `report(DIR)`, the summary, `results.md`, `trials.json` and the figures;
+- `progress`: the text progress bar;
+- `sessions`: a participant's session of a user study;
+- `figures`: the paper's figures (Fig. 2, 4 and 7), drawn with matplotlib;
+- `toy`: the paper's 2-D studies (the alpha study and Alt vs Cont).
+
+This package's `__init__` imports nothing, so that a worker process that imports
+`runners` does not import matplotlib.
+"""

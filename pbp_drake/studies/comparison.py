@@ -1,0 +1,91 @@
+"""Comparing methods on the same seeded HSR scenes: `pbp-drake study diagrams/hsr_reach.yaml`.
+
+`run_method_comparison` decides which trials still have to run (those not on disk for the
+same scenario), runs them in local processes (`--jobs`) or as Ray tasks (`--backend ray`),
+then rebuilds the summary, tables and figures from the files (`report`).
+"""
+
+import pathlib
+import pickle
+import time
+
+from pbp_drake.scenarios import ScenarioError
+from pbp_drake.studies.ray_backend import import_ray, run_on_ray
+from pbp_drake.studies.report import report
+from pbp_drake.studies.runners import failed_record, run_locally
+from pbp_drake.studies.trial_files import (
+    check_folder, read_trial, running_marker, scenario_hash, write_study)
+
+BACKENDS = ("local", "ray")
+
+
+def run_method_comparison(scenario, methods, trials, seed, output, progress=None, jobs=1,
+                          run=None, retry_errors=False, backend="local", ray_address=None):
+    """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
+    processes, writes every trial under `output/trials/`, then the summary, tables and
+    figures (see `report`). Returns the summary dict.
+
+    `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
+    Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "ray://head:10001", "auto"),
+    whose workers must be able to import pbp_drake. This process writes the trial files,
+    the same as with local processes, so the summary is the same bytes.
+
+    Trials already on disk for the same scenario are not run again (`retry_errors`: except
+    those that failed with an error). A trial that raises, or whose worker process dies, is
+    recorded as failed with its error. `progress(done, total, record, elapsed)` is called
+    after each trial run now. `run(scenario) -> TaskResult` replaces `run_task` (it must be
+    picklable when `jobs > 1`).
+    """
+    if not isinstance(jobs, int) or jobs < 1:
+        raise ScenarioError(f"jobs must be a positive number of processes, got {jobs}")
+    if backend not in BACKENDS:
+        raise ScenarioError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
+    if ray_address is not None and backend != "ray":
+        raise ScenarioError("ray_address needs backend='ray'")
+    if trials < 1:
+        raise ScenarioError(f"trials must be at least 1, got {trials}")
+    output = pathlib.Path(output)
+    digest = scenario_hash(scenario)
+    check_folder(output, scenario, digest)
+    keys = [(method, trial) for method in methods for trial in range(trials)]
+    for leftover in [*output.glob("trials/*/*.running"), *output.glob("trials/*/.*.tmp")]:
+        leftover.unlink(missing_ok=True)  # left by an interrupted study
+    if backend == "ray":
+        import_ray()  # fail before touching the folder when Ray is missing
+    if backend == "local" and jobs > 1 and run is not None:
+        try:
+            pickle.dumps(run)
+        except Exception as error:
+            raise ScenarioError(f"run={run!r} cannot be sent to worker processes ({error}): "
+                                "use a module-level function, or jobs=1") from None
+    pending = []
+    for method, trial in keys:
+        record = read_trial(output, method, seed + trial, digest)
+        if record is None or (retry_errors and record["error"] is not None):
+            pending.append((method, trial))
+    write_study(output, scenario, digest, methods, trials, seed)
+
+    started = time.monotonic()
+    done = []
+
+    def on_done(key, record):
+        done.append(key)
+        if progress is not None:
+            progress(len(done), len(pending), record, time.monotonic() - started)
+
+    def submit_args(key):
+        method, trial = key
+        return (scenario, method, trial, seed + trial, output, digest, run)
+
+    def on_error(key, error):
+        method, trial = key
+        running_marker(output, method, seed + trial).unlink(missing_ok=True)
+        on_done(key, failed_record(scenario, digest, method, trial, seed + trial, error,
+                                   output))
+
+    if backend == "ray":
+        if pending:
+            run_on_ray(pending, jobs, ray_address, submit_args, output, on_done, on_error)
+    else:
+        run_locally(pending, jobs, output, seed, submit_args, on_done, on_error)
+    return report(output)

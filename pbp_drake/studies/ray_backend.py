@@ -1,0 +1,110 @@
+"""The trials as Ray tasks (`--backend ray`), on a local Ray or a cluster.
+
+The tasks only compute; the process that runs the study writes every trial file (a
+cluster's nodes may not see the folder), so the folder is the same as with local processes.
+Ray is imported only when this backend is asked for: it is an optional, heavy dependency
+(`pip install 'pbp_drake[ray]'`), and the local backend must never load it.
+"""
+
+import os
+import sys
+
+from pbp_drake.studies.runners import compute_trial
+from pbp_drake.studies.trial_files import StudyError, time_series_csv, write_trial_files
+
+RAY_INSTALL_HINT = "pip install 'pbp_drake[ray]'"
+# A Ray task whose worker process dies runs once more (as a local worker's trial runs again
+# alone) before it is recorded as failed; a trial that raises is recorded at once.
+RAY_MAX_RETRIES = 1
+
+
+def import_ray():
+    """The `ray` module, or a StudyError that says how to install it."""
+    try:
+        import ray  # deferred on purpose: optional and heavy (see the module docstring)
+    except ImportError as error:
+        raise StudyError(f"--backend ray needs Ray, which is not installed ({error}): "
+                         f"{RAY_INSTALL_HINT}") from None
+    return ray
+
+
+def _ray_trial(scenario, method, trial, seed, digest, run=None):
+    """What a Ray task runs: the trial's record and its time series as CSV text (the
+    process that runs the study writes the files: a cluster's nodes may not see them)."""
+    record, result = compute_trial(scenario, method, trial, seed, digest, run)
+    return record, None if result is None else time_series_csv(result)
+
+
+class _RaySession:
+    """Ray for one study: with no address, a new local Ray of `jobs` CPUs, whose workers
+    see this process's sys.path (as local worker processes do), shut down at the end; with
+    an address, that cluster (left running). A Ray this process already runs is used as is."""
+
+    def __init__(self, jobs, address=None):
+        self.ray = import_ray()
+        self.started = False
+        if self.ray.is_initialized():
+            return
+        quiet = {"log_to_driver": False, "configure_logging": False}
+        try:
+            if address is None:
+                path = os.pathsep.join(p for p in sys.path if p)
+                self.ray.init(address="local", num_cpus=jobs, include_dashboard=False,
+                              runtime_env={"env_vars": {"PYTHONPATH": path}}, **quiet)
+            else:
+                self.ray.init(address=address, **quiet)
+        except Exception as error:
+            where = "start a local Ray" if address is None else f"connect to Ray at {address}"
+            raise StudyError(f"could not {where}: {type(error).__name__}: {error}") from None
+        self.started = True
+
+    def close(self):
+        if self.started:
+            self.started = False
+            self.ray.shutdown()
+
+
+def _ray_error_text(ray, error):
+    """A failed task's error as `Type: message`: a trial's own exception when it has one
+    (as the local backend records it), else Ray's (e.g. WorkerCrashedError)."""
+    cause = getattr(error, "cause", None) if isinstance(
+        error, ray.exceptions.RayTaskError) else None
+    error = cause if isinstance(cause, BaseException) else error
+    return f"{type(error).__name__}: {error}"
+
+
+def run_on_ray(pending, jobs, address, submit_args, output, on_done, on_error):
+    """Runs `pending` trial keys as Ray tasks, at most `jobs` at once, and writes each
+    trial's files here as its task finishes; a task that fails is recorded as failed."""
+    session = _RaySession(jobs, address)
+    ray = session.ray
+    running = {}
+    try:
+        task = ray.remote(num_cpus=1, max_retries=RAY_MAX_RETRIES)(_ray_trial)
+        scenario, *_, digest, run = submit_args(pending[0])
+        scenario_ref, run_ref = ray.put(scenario), ray.put(run)
+        queue = list(pending)
+        while queue or running:
+            while queue and len(running) < jobs:
+                key = queue.pop(0)
+                _, method, trial, seed, *_ = submit_args(key)
+                running[task.remote(scenario_ref, method, trial, seed, digest, run_ref)] = key
+            ready, _ = ray.wait(list(running), num_returns=1)
+            for ref in ready:
+                key = running.pop(ref)
+                try:
+                    record, csv_text = ray.get(ref)
+                except Exception as error:  # the task failed: record it, go on
+                    on_error(key, _ray_error_text(ray, error))
+                else:
+                    write_trial_files(output, record, csv_text)
+                    on_done(key, record)
+    except BaseException:  # Ctrl-C: stop the tasks; the trials on disk are whole
+        for ref in running:
+            try:
+                ray.cancel(ref, force=True)
+            except Exception:
+                pass
+        raise
+    finally:
+        session.close()

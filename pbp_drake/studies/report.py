@@ -1,0 +1,72 @@
+"""`pbp-drake report DIR`: a study folder's `summary.json`, `results.md`, `trials.json` and
+figures, rebuilt from its study.json and trial files only (no simulation)."""
+
+import json
+import pathlib
+
+from pbp_drake.studies.figures import (
+    METHOD_LABELS, plot_collision_histogram, plot_intervention, plot_task_time)
+from pbp_drake.studies.summary import summarize
+from pbp_drake.studies.trial_files import TRIAL_FIELDS, read_study, write_atomically
+
+FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png", "fig7c_collisions.png")
+
+
+def _cell(entry, field, digits):
+    value = entry[field]
+    if value["mean"] is None:
+        return "-"
+    return f"{value['mean']:.{digits}f} ± {value['std']:.{digits}f}"
+
+
+def _count(value):
+    return "-" if value is None else str(value)
+
+
+def results_table(summary):
+    """The summary as a Markdown table, one row per method."""
+    lines = ["| method | trials | success | intervention ratio | task time (s) | "
+             "collision ratio | collision-free trials | errors |",
+             "|---|---|---|---|---|---|---|---|"]
+    for method, entry in summary["methods"].items():
+        rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
+        trials = f"{entry['trials']}" + (f" ({entry['missing']} missing)"
+                                         if entry["missing"] else "")
+        lines.append(f"| {METHOD_LABELS.get(method, method)} | {trials} | {rate} | "
+                     f"{_cell(entry, 'intervention_ratio', 3)} | "
+                     f"{_cell(entry, 'task_time', 1)} | {_cell(entry, 'collision_ratio', 3)} | "
+                     f"{_count(entry['collision_free_trials'])} | {entry['errors']} |")
+    arbitration = summary.get("arbitration")
+    if arbitration is not None:
+        ideal = arbitration["ideal_alpha"]
+        lines += ["", f"Ideal fixed alpha: {'none' if ideal is None else ideal} "
+                      f"({arbitration['criterion']})."]
+    return "\n".join(lines) + "\n"
+
+
+def _flat_trials(study, records):
+    rows = []
+    for method in study["methods"]:
+        for trial in range(study["trials"]):
+            record = records[(method, trial)]
+            if record is not None:
+                rows.append({field: record[field] for field in TRIAL_FIELDS})
+    return rows
+
+
+def report(output):
+    """Rebuilds `summary.json`, `results.md`, `trials.json` and the figures of a study folder
+    from its study.json and trial files only (no simulation). Returns the summary."""
+    output = pathlib.Path(output)
+    study, records = read_study(output)
+    summary = summarize(study, records)
+    write_atomically(output / "summary.json", json.dumps(summary, indent=2) + "\n")
+    write_atomically(output / "results.md", results_table(summary))
+    write_atomically(output / "trials.json",
+                     json.dumps(_flat_trials(study, records), indent=1) + "\n")
+    rows = [r for r in records.values() if r is not None]
+    methods = study["methods"]
+    plot_intervention(rows, methods, output / FIGURES[0])
+    plot_task_time(rows, methods, output / FIGURES[1])
+    plot_collision_histogram(summary, output / FIGURES[2])
+    return summary

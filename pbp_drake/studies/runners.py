@@ -1,0 +1,176 @@
+"""Running trials: one trial (on disk, or computed only), and many in local processes
+(`--jobs`).
+
+Trial i of every method uses seed `seed + i`: the same scene and participant noise. A trial
+that raises is recorded as failed with its error; one whose worker process dies runs again
+alone, so that only a trial that kills its own process is recorded as failed.
+"""
+
+import concurrent.futures
+import dataclasses
+import logging
+import multiprocessing
+import os
+import signal
+import time
+
+import numpy as np
+
+from pbp_drake.scenarios import resolve, with_method
+from pbp_drake.studies.trial_files import (
+    StudyError, json_float, running_marker, trial_record, write_trial)
+from pbp_drake.task_run import run_task
+
+
+def _scene_of(resolved):
+    layout = resolved.layout
+    return (np.asarray(layout.objects, float).tolist(), [int(t) for t in layout.targets])
+
+
+def run_trial(scenario, method, trial, seed, output, digest, run=None):
+    """Runs one trial and writes its files; a trial that raises is written as failed with
+    its error. Returns its record. This is what a worker process runs."""
+    marker = running_marker(output, method, seed)
+    marker.parent.mkdir(parents=True, exist_ok=True)
+    marker.write_text(f"{os.getpid()}\n")
+    record, result = compute_trial(scenario, method, trial, seed, digest, run)
+    write_trial(output, record, result)
+    marker.unlink(missing_ok=True)
+    return record
+
+
+def compute_trial(scenario, method, trial, seed, digest, run=None):
+    """Runs one trial without touching the disk: its record and TaskResult (None when it
+    raised: the record then holds the error). `run(resolved_scenario)` defaults to
+    `run_task`."""
+    if run is None:
+        run = run_task
+    started = time.monotonic()
+    record = trial_record(scenario.name, digest, method, trial, seed)
+    result = None
+    warnings = _DrakeWarnings()
+    try:
+        # Resolved once: the scene is drawn and the DMPs fitted for this trial only here.
+        trial = resolve(dataclasses.replace(with_method(scenario, method), seed=seed))
+        record["objects"], record["targets"] = _scene_of(trial)
+        result = run(trial)
+        record.update(success=bool(result.success), task_time=json_float(result.task_time),
+                      intervention_ratio=json_float(result.intervention_ratio),
+                      switches=int(result.switches),
+                      collision_ratio=json_float(result.collision_ratio),
+                      ticks=len(result.times))
+    except Exception as error:  # a broken trial must not lose the study
+        result = None
+        record.update(success=False, error=f"{type(error).__name__}: {error}")
+    finally:
+        warnings.close()
+    record["drake_warnings"] = warnings.count
+    record["wall_time"] = round(time.monotonic() - started, 3)
+    return record, result
+
+
+class _DrakeWarnings(logging.Handler):
+    """Counts Drake's log messages during a trial instead of printing them (differential IK
+    reports every stuck step; in a study they would bury the progress bar)."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.count = 0
+        self.logger = logging.getLogger("drake")
+        self.saved = self.logger.propagate, list(self.logger.handlers)
+        self.logger.handlers = [self]
+        self.logger.propagate = False
+
+    def emit(self, record):
+        self.count += 1
+
+    def close(self):
+        self.logger.propagate, self.logger.handlers = self.saved
+        super().close()
+
+
+def failed_record(scenario, digest, method, trial, seed, error, output):
+    """Writes and returns the record of a trial that failed outside its own code (e.g. its
+    worker died)."""
+    record = trial_record(scenario.name, digest, method, trial, seed)
+    record["error"] = error
+    write_trial(output, record)
+    return record
+
+
+# ---------------------------------------------------------------------------------------------
+# Local processes
+
+
+def run_locally(pending, jobs, output, seed, submit_args, on_done, on_error):
+    """Runs `pending` (method, trial) keys here (`jobs == 1`) or in a pool of `jobs`
+    processes; `submit_args(key)` gives `run_trial`'s arguments."""
+    if jobs == 1:
+        for key in pending:
+            on_done(key, run_trial(*submit_args(key)))
+        return
+    queue = list(pending)
+    while queue:
+        # A dead worker breaks the pool. The trials that had started run again, each
+        # alone, so that only one that kills its own process is recorded as failed; those
+        # that had not started go to a new pool.
+        unfinished = _run_in_pool(queue, min(jobs, len(queue)), submit_args, on_done,
+                                  on_error)
+        started_keys = [key for key, _ in unfinished
+                        if running_marker(output, key[0], seed + key[1]).exists()]
+        if unfinished and not started_keys:
+            started_keys = [key for key, _ in unfinished]  # died before any trial began
+        queue = [key for key, _ in unfinished if key not in started_keys]
+        for key in started_keys:
+            marker = running_marker(output, key[0], seed + key[1])
+            marker.unlink(missing_ok=True)
+            for _, error in _run_in_pool([key], 1, submit_args, on_done, on_error):
+                if not marker.exists():
+                    raise StudyError(
+                        f"a worker process died before it began a trial ({error}): see "
+                        "the error above; a script that runs a study with jobs > 1 needs "
+                        "`if __name__ == '__main__':`")
+                on_error(key, error)
+
+
+def _context():
+    """forkserver (a clean server that has imported Drake once, each worker a fork of it),
+    else spawn; never a fork of a parent whose Drake may hold threads."""
+    methods = multiprocessing.get_all_start_methods()
+    if "forkserver" in methods:
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(["pbp_drake.studies.runners", "pbp_drake.task_run"])
+        return context
+    return multiprocessing.get_context("spawn")
+
+
+def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
+    """Runs `pending` trial keys in a pool of `jobs` processes. Returns the keys that were
+    unfinished when a worker process died (the pool is then broken), with the error."""
+    with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=_context(),
+                                                initializer=_ignore_interrupts) as pool:
+        futures = {pool.submit(run_trial, *submit_args(key)): key for key in pending}
+        unfinished = []
+        try:
+            for future in concurrent.futures.as_completed(futures):
+                key = futures[future]
+                try:
+                    record = future.result()
+                except concurrent.futures.process.BrokenProcessPool as error:
+                    unfinished.append((key, f"{type(error).__name__}: {error}"))
+                except Exception as error:  # e.g. the worker could not write the files
+                    on_error(key, f"{type(error).__name__}: {error}")
+                else:
+                    on_done(key, record)
+        except BaseException:  # Ctrl-C: stop now; the trials on disk are whole
+            processes = list((getattr(pool, "_processes", None) or {}).values())
+            pool.shutdown(wait=False, cancel_futures=True)
+            for process in processes:
+                process.terminate()
+            raise
+    return unfinished
+
+
+def _ignore_interrupts():
+    """Workers leave Ctrl-C to the study's process, which stops them."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -1,0 +1,132 @@
+"""A study's summary, from its trial files only, and the one definition of the ideal alpha.
+
+The summary holds only values from the trial files, in a fixed order, rounded: it is the
+same bytes for any `--jobs` and either backend.
+"""
+
+import math
+
+import numpy as np
+
+from pbp_drake.scenarios import parse_method_label
+
+# Collision-ratio histogram: 20 bins of 0.05 over [0, 1] (the last bin includes 1).
+HISTOGRAM_EDGES = tuple(round(0.05 * i, 2) for i in range(21))
+SIGNIFICANT_DIGITS = 12
+
+
+# ---------------------------------------------------------------------------------------------
+# The ideal alpha
+
+
+def ideal_alpha(outcomes, does_task):
+    """The paper's ideal arbitration (section IV-A): the highest alpha that still lets the
+    operator do the task, since a lower one takes autonomy from the robot for nothing.
+
+    `outcomes` is a list of `(alpha, outcome)` pairs, `does_task(outcome)` says whether
+    that alpha let the operator do the task. Returns the alpha, or None when none did.
+    The HSR method comparison judges its `fixed_alpha=A` methods with
+    `does_the_hsr_task`, the 2-D alpha study its runs with `collision_free`.
+    """
+    good = [alpha for alpha, outcome in outcomes if does_task(outcome)]
+    return max(good) if good else None
+
+
+# Doing the HSR task: this success rate, and where collisions are measured, most trials
+# without any (the bar PBP has to meet in the obstacle task).
+IDEAL_ALPHA_SUCCESS = 0.95
+HSR_CRITERION = (f"highest alpha with success >= {IDEAL_ALPHA_SUCCESS:.0%} and, "
+                 "where collisions are measured, most trials free of them")
+
+
+def does_the_hsr_task(entry):
+    """Whether a method's summary entry does the HSR task (see IDEAL_ALPHA_SUCCESS)."""
+    ran = entry["trials"] - entry["errors"]
+    does_task = (entry["success_rate"] is not None
+                 and entry["success_rate"] >= IDEAL_ALPHA_SUCCESS)
+    if entry["collision_free_trials"] is not None:
+        does_task = does_task and 2 * entry["collision_free_trials"] > ran
+    return does_task
+
+
+def collision_free(collision_ratio):
+    """The 2-D alpha study's task: reach the goal past the obstacles without touching one."""
+    return collision_ratio == 0.0
+
+
+def arbitration(methods):
+    """`{"alphas": [...], "ideal_alpha": A or None, "criterion": text}` over the `fixed_alpha=A`
+    entries of a summary's methods (None when it has none)."""
+    swept = []
+    for label, entry in methods.items():
+        name, alpha = parse_method_label(label)
+        if name == "fixed_alpha" and alpha is not None:
+            swept.append((alpha, entry))
+    if not swept:
+        return None
+    return {"alphas": sorted(alpha for alpha, _ in swept),
+            "ideal_alpha": ideal_alpha(swept, does_the_hsr_task),
+            "criterion": HSR_CRITERION}
+
+
+# ---------------------------------------------------------------------------------------------
+# The summary
+
+
+def _round(value):
+    if value is None or not math.isfinite(value):
+        return None
+    return float(f"{value:.{SIGNIFICANT_DIGITS}g}")
+
+
+def mean_std(values):
+    """`{"mean", "std"}` (population std) of the finite values, rounded; None for none."""
+    values = [v for v in values if v is not None and math.isfinite(v)]
+    if not values:
+        return {"mean": None, "std": None}
+    mean = math.fsum(values) / len(values)
+    variance = math.fsum((v - mean) ** 2 for v in values) / len(values)
+    return {"mean": _round(mean), "std": _round(math.sqrt(variance))}
+
+
+def collision_histogram(ratios):
+    """Counts of collision ratios in the bins of HISTOGRAM_EDGES (the last includes 1)."""
+    counts = [0] * (len(HISTOGRAM_EDGES) - 1)
+    for ratio in ratios:
+        index = int(np.searchsorted(HISTOGRAM_EDGES, ratio, side="right")) - 1
+        counts[min(max(index, 0), len(counts) - 1)] += 1
+    return counts
+
+
+def summarize(study, records):
+    """Per method: how many trials, errors and missing; success rate over the trials on
+    disk; mean and (population) std of intervention ratio and task time, and the mean, std
+    and histogram of the collision ratio, over the trials that ran without error; and the
+    ideal alpha when the study sweeps fixed alphas."""
+    summary = {"study": "method_comparison", "scenario": study["scenario"],
+               "scenario_hash": study["scenario_hash"], "trials": study["trials"],
+               "seed": study["seed"], "collision_histogram_edges": list(HISTOGRAM_EDGES),
+               "methods": {}}
+    for method in study["methods"]:
+        rows = [records[(method, trial)] for trial in range(study["trials"])]
+        present = [r for r in rows if r is not None]
+        ran = [r for r in present if r["error"] is None]
+        ratios = [r["collision_ratio"] for r in ran if r["collision_ratio"] is not None]
+        collision = mean_std(ratios)
+        collision["histogram"] = collision_histogram(ratios)
+        summary["methods"][method] = {
+            "trials": len(present),
+            "missing": len(rows) - len(present),
+            "errors": len(present) - len(ran),
+            "error_seeds": [r["seed"] for r in present if r["error"] is not None],
+            "success_rate": _round(sum(bool(r["success"]) for r in present) / len(present))
+            if present else None,
+            "intervention_ratio": mean_std([r["intervention_ratio"] for r in ran]),
+            "task_time": mean_std([r["task_time"] for r in ran]),
+            "collision_ratio": collision,
+            "collision_free_trials": sum(ratio == 0.0 for ratio in ratios) if ratios else None,
+        }
+    swept = arbitration(summary["methods"])
+    if swept is not None:
+        summary["arbitration"] = swept
+    return summary

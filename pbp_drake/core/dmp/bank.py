@@ -329,7 +329,7 @@ class DmpBank:
     def offsets_into(self, phase, positions, goals_dk, out, workspace):
         """`out = positions - attractor(phase, goals)`, `(D, K)`; `positions` (D, K) or
         (D, 1). Two passes over `(D, K)` when the DMPs share weights, phase and start.
-        `out` must not be one of the workspace's arrays other than `workspace.offset`."""
+        `out` is the caller's array or `workspace.offset` (the other work arrays are used)."""
         if self._affine_attractor and (phase.size == 1 or phase.min() == phase.max()):
             negative_alpha_goal, alpha_constant = self._affine_attractor_coefficients(
                 phase, workspace)

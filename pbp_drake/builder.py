@@ -66,7 +66,7 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
         dmp_bank = policy = builder.AddNamedSystem("dmp_bank", DmpBank(
             resolved.dmp_bank, period,
             lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
-            prediction_steps=prediction_steps, update_offset=scenario.robot.time_step / 4))
+            prediction_steps=prediction_steps))
         goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
         builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
         builder.Connect(robot_state, dmp_bank.get_robot_state_input_port())

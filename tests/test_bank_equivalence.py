@@ -100,27 +100,75 @@ def test_fast_bank_equals_a_plain_per_goal_loop(formulation, shared, goal_count,
 
 
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
-def test_stateful_next_step_and_predict_match_advance(shared):
+def test_in_place_steps_with_a_workspace_and_predict_match_advance(shared):
     bank, _, goals = make_banks("ijspeert", shared, 70, 2, True, seed=9)
-    other, _, _ = make_banks("ijspeert", shared, 70, 2, True, seed=9)
-    phase, _, scaled_velocity = other.initial_state()
-    robot = np.array([0.1, -0.2])
+    goals_dk = bank.goals_matrix(goals)
+    workspace = bank.make_workspace()
+    phase, positions, scaled_velocity = bank.initial_state()
+    expected = bank.initial_state()
+    robot = np.array([[0.1], [-0.2]])
     for _ in range(15):
-        positions, velocities = bank.next_step(goals, robot, DT)
-        phase, expected, scaled_velocity = other.advance(
-            phase, robot[:, None], scaled_velocity, other.goals_matrix(goals), DT)
-        np.testing.assert_allclose(positions, expected.T, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(velocities, scaled_velocity.T / other.duration,
-                                   rtol=0, atol=1e-12)
-    saved = bank.phase.copy(), bank.position.copy(), bank.scaled_velocity.copy()
-    paths = bank.predict(bank.phase, bank.position, bank.scaled_velocity,
-                         bank.goals_matrix(goals), DT, 10)
-    for before, after in zip(saved, (bank.phase, bank.position, bank.scaled_velocity)):
+        bank.advance_into(phase, robot, scaled_velocity, goals_dk, DT,
+                          phase, positions, scaled_velocity, workspace)
+        expected = bank.advance(expected[0], robot, expected[2], goals_dk, DT)
+        for ours, theirs in zip((phase, positions, scaled_velocity), expected):
+            np.testing.assert_array_equal(ours, theirs)
+    saved = phase.copy(), positions.copy(), scaled_velocity.copy()
+    paths = bank.predict(phase, positions, scaled_velocity, goals_dk, DT, 10, workspace)
+    for before, after in zip(saved, (phase, positions, scaled_velocity)):
         np.testing.assert_array_equal(before, after)  # predict leaves its inputs alone
+    np.testing.assert_array_equal(
+        paths, bank.predict(phase, positions, scaled_velocity, goals_dk, DT, 10))
     p, y, z = saved
     for step in range(10):
-        p, y, z = bank.advance(p, y, z, bank.goals_matrix(goals), DT)
+        p, y, z = bank.advance(p, y, z, goals_dk, DT)
         np.testing.assert_allclose(paths[:, step + 1], y.T, rtol=0, atol=1e-12)
+
+
+def _model_arrays(bank):
+    return {name: value for name, value in vars(bank).items() if isinstance(value, np.ndarray)}
+
+
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_the_bank_model_is_immutable_and_untouched_by_steps(formulation, shared):
+    """Every array of the model is read-only (a write raises), no attribute can be set, and
+    stepping (free, locked, partly locked, predicting) leaves the model as it was."""
+    bank, _, goals = make_banks(formulation, shared, 9, 3, False, seed=6)
+    arrays = _model_arrays(bank)
+    assert {"starts", "amplitude_scaling", "_weights"} <= set(arrays)
+    before = {name: value.copy() for name, value in arrays.items()}
+    attributes = dict(vars(bank))
+    for name, value in arrays.items():
+        assert not value.flags.writeable, name
+        with pytest.raises(ValueError, match="read-only"):
+            value.flat[0] = value.flat[0]
+    with pytest.raises(AttributeError, match="immutable"):
+        bank.duration = 2.0
+    with pytest.raises(AttributeError, match="immutable"):
+        bank.scratch = np.zeros(3)
+
+    goals_dk = bank.goals_matrix(goals)
+    workspace = bank.make_workspace()
+    phase, positions, scaled_velocity = bank.initial_state()
+    robot = np.array([[0.2], [0.1], [-0.3]])
+    for locked in (None, True, np.arange(9) % 2 == 0, None):
+        bank.advance_into(phase, robot, scaled_velocity, goals_dk, DT, phase, positions,
+                          scaled_velocity, workspace, locked, robot_velocity=[0.1, 0.0, 0.2])
+        bank.advance(phase, positions, scaled_velocity, goals_dk, 2 * DT)
+    bank.predict(phase, positions, scaled_velocity, goals_dk, DT, 5)
+    bank.attractors(phase, goals_dk)
+    assert vars(bank).keys() == attributes.keys()
+    for name, value in vars(bank).items():
+        assert value is attributes[name], name
+    for name, value in before.items():
+        np.testing.assert_array_equal(arrays[name], value, err_msg=name)
+    # The caller's arrays are not the model's: changing them later changes nothing.
+    weights = np.ones((bank.settings.basis_count, 3))
+    other = DmpBank(weights, np.zeros(3), 1.0, bank.settings, goal_count=2)
+    weights[...] = 5.0
+    assert weights.flags.writeable
+    np.testing.assert_array_equal(other._weights, 1.0)
 
 
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
@@ -259,8 +307,10 @@ def test_the_goals_are_read_once_per_change_from_a_goals_source(monkeypatch):
     builder.Connect(robot.get_output_port(), system.get_robot_state_input_port())
     simulator = Simulator(builder.Build())
     reads = []
-    original = bank.goals_matrix
-    monkeypatch.setattr(bank, "goals_matrix", lambda g: (reads.append(1), original(g))[1])
+    original = DmpBank.goals_matrix
+    # On the class: the bank itself is immutable.
+    monkeypatch.setattr(DmpBank, "goals_matrix",
+                        lambda self, g: (reads.append(1), original(self, g))[1])
     simulator.AdvanceTo(10 * DT)
     assert len(reads) == 1
     # New goals in the context are seen at the next update.

@@ -73,18 +73,22 @@ def test_bank_of_k_equals_k_single_dmps():
         dmps.append(Dmp.from_demonstration(times, warped, settings))
     bank = DmpBank.from_dmps(dmps)
     goals = rng.uniform(-1, 1, (6, 3))
+    goals_dk = bank.goals_matrix(goals)
+    phase, _, scaled_velocity = bank.initial_state()
     robot_position = rng.uniform(-1, 1, 3)
     for step in range(120):
         robot_velocity = rng.uniform(-1, 1, 3)
         locked = 40 <= step < 50
-        bank_positions, bank_velocities = bank.next_step(
-            goals, robot_position, 0.01, yd_robot=robot_velocity, phase_locked=locked)
+        phase, bank_positions, scaled_velocity = bank.advance(
+            phase, robot_position[:, None], scaled_velocity, goals_dk, 0.01, locked=locked,
+            robot_velocity=robot_velocity)
+        bank_positions, bank_velocities = bank_positions.T, scaled_velocity.T / bank.duration
         for k, dmp in enumerate(dmps):
             position, velocity = dmp.next_step(0.01, goals[k], robot_position, robot_velocity,
                                                phase_locked=locked)
             np.testing.assert_allclose(bank_positions[k], position, rtol=0, atol=1e-12)
             np.testing.assert_allclose(bank_velocities[k], velocity, rtol=0, atol=1e-12)
-            assert bank.phase[k] == pytest.approx(dmp.phase, abs=1e-15)
+            assert phase[k] == pytest.approx(dmp.phase, abs=1e-15)
         # The robot follows the first DMP loosely: a stand-in for a lagging tracker.
         robot_position = 0.7 * robot_position + 0.3 * bank_positions[0]
 
@@ -95,8 +99,8 @@ def test_shared_demonstration_bank_sends_one_shape_to_every_goal():
     bank = DmpBank.from_demonstration(times, positions, goal_count=3)
     assert bank.shared_weights
     dt = times[1] - times[0]
-    paths = bank.predict(bank.phase, bank.position, bank.scaled_velocity,
-                         bank.goals_matrix(goals), dt, 5 * (len(times) - 1))
+    paths = bank.predict(*bank.initial_state(), bank.goals_matrix(goals), dt,
+                         5 * (len(times) - 1))
     # The DMP sent to the demonstration's goal reproduces the demonstration...
     error = np.linalg.norm(paths[0, :len(times)] - positions, axis=1)
     assert np.sqrt(np.mean(error**2)) < 0.01 * path_length(positions)
@@ -108,21 +112,23 @@ def test_shared_demonstration_bank_sends_one_shape_to_every_goal():
 
 def test_phase_lock_holds_the_phase_and_follows_the_robot():
     bank = DmpBank.straight([0.0, 0.0], goal_count=2, duration=1.0)
-    goals = [[1.0, 0.0], [0.0, 1.0]]
-    bank.next_step(goals, [0.0, 0.0], 0.01)
-    phase = bank.phase.copy()
-    positions, velocities = bank.next_step(goals, [0.3, -0.2], 0.01, yd_robot=[0.5, 0.1],
-                                           phase_locked=True)
-    np.testing.assert_array_equal(bank.phase, phase)
-    np.testing.assert_allclose(positions, [[0.3, -0.2], [0.3, -0.2]])
-    np.testing.assert_allclose(velocities, [[0.5, 0.1], [0.5, 0.1]])
+    goals_dk = bank.goals_matrix([[1.0, 0.0], [0.0, 1.0]])
+    phase, _, scaled_velocity = bank.initial_state()
+    phase, _, scaled_velocity = bank.advance(phase, np.zeros((2, 1)), scaled_velocity,
+                                             goals_dk, 0.01)
+    locked_phase, positions, scaled_velocity = bank.advance(
+        phase, np.array([[0.3], [-0.2]]), scaled_velocity, goals_dk, 0.01, locked=True,
+        robot_velocity=[0.5, 0.1])
+    np.testing.assert_array_equal(locked_phase, phase)
+    np.testing.assert_allclose(positions.T, [[0.3, -0.2], [0.3, -0.2]])
+    np.testing.assert_allclose(scaled_velocity.T / bank.duration, [[0.5, 0.1], [0.5, 0.1]])
 
 
 @pytest.mark.parametrize("goals", [[], np.zeros((0, 2))])
 def test_empty_goal_set_is_refused(goals):
     bank = DmpBank.straight([0.0, 0.0], goal_count=1, duration=1.0)
     with pytest.raises(ValueError, match="goals is empty"):
-        bank.next_step(goals, [0.0, 0.0], 0.01)
+        bank.goals_matrix(goals)
     with pytest.raises(ValueError, match="at least one goal"):
         DmpBank.straight([0.0, 0.0], goal_count=0, duration=1.0)
 
@@ -130,7 +136,7 @@ def test_empty_goal_set_is_refused(goals):
 def test_nan_goal_is_refused():
     bank = DmpBank.straight([0.0, 0.0], goal_count=1, duration=1.0)
     with pytest.raises(ValueError, match="goals contains NaN"):
-        bank.next_step([[np.nan, 0.0]], [0.0, 0.0], 0.01)
+        bank.goals_matrix([[np.nan, 0.0]])
 
 
 def test_short_or_nan_demonstrations_are_refused():

@@ -55,10 +55,11 @@ def bank_math_step(bank, case):
     phase, positions, scaled_velocity = bank.initial_state()
     robot = case.robot[:, None]
     goals = case.goals.reshape(-1)
+    workspace = bank.make_workspace()
 
     def step():
         bank.advance_into(phase, robot, scaled_velocity, bank.goals_matrix(goals), DT,
-                          phase, positions, scaled_velocity)
+                          phase, positions, scaled_velocity, workspace)
     return step
 
 

@@ -1,8 +1,17 @@
-"""The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot."""
+"""The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot.
+
+The system holds the bank's immutable model (`pbp_drake.core.dmp.DmpBank`) and nothing
+else that a step changes: the DMPs' state is the Context's discrete state and the step's
+scratch arrays (a `DmpWorkspace`) are a cache entry, which Drake allocates once per
+Context. Two Contexts of one system, or two Simulators of one diagram, are therefore
+independent, whichever order or thread steps them.
+"""
 
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
+
+from pbp_drake.systems.tick import decide_offset
 
 
 class DmpBank(LeafSystem):
@@ -30,27 +39,27 @@ class DmpBank(LeafSystem):
     phases; `predicted_paths` (declared when `prediction_steps > 0`) is each DMP's open-loop
     path from its current state, `(K, prediction_steps + 1, D)` flattened, for drawing,
     sampled every `prediction_period` (default: the control period).
-    All state lives in the Context.
+    All state lives in the Context, and so does the step's scratch memory (a cache entry).
 
-    The state is one vector `[phase, held, p (D), z (D*K), offset (D*K)]`. PBP steps every
-    DMP from the robot's position `p` and never from the DMP's own, so the state keeps, of
-    each step, what its outputs are read from: the DMPs' velocities `z` before the step and
-    `offset = p - attractor`; `references` reads the stepped positions and velocities out
+    The state is one vector `[phase, held, p (D), z (D*K), offset (D*K)]` (`_split` is the
+    one place that knows the layout). PBP steps every DMP from the robot's position `p` and
+    never from the DMP's own, so the state keeps, of each step, what its outputs are read
+    from: the DMPs' velocities `z` before the step and `offset = p - attractor`;
+    `references` reads the stepped positions and velocities out
     (`pbp_drake.core.dmp.DmpBank.offsets_into`). With shared weights an update is then five
     passes over `(D, K)`, and Drake copies two `(D, K)` arrays, not three and a phase per
     goal; the goals are checked and laid out `(D, K)` in a cache entry, once per change. While
     `held` (at the start, and while PBP-Alt locks the phases) the DMPs sit at `p - offset`
     with velocity `z`. All DMPs of the system share one phase: the lock is one input.
 
-    The bank updates `update_offset` seconds after each control tick. Discrete updates at
-    one instant all see the values from before that instant, so a bank updating exactly at
-    the tick would lock on the operator's decision of the previous tick; a small offset
-    (the builder uses a quarter of the plant step, before the plant moves) lets it lock on
-    the decision of the same tick, as Alg. 2 does.
+    The bank updates at the decide stage of each control tick
+    (`pbp_drake.systems.tick.decide_offset`), so that it reads the robot's state sampled at
+    the tick and the operator's decision of the same tick, as Alg. 2 does. `update_offset`
+    (seconds after the tick) overrides it, for experts with their own tick order.
     """
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
-                 prediction_steps=0, update_offset=0.0, prediction_period=None):
+                 prediction_steps=0, update_offset=None, prediction_period=None):
         super().__init__()
         self._bank = bank
         self._period = float(control_period)
@@ -59,16 +68,20 @@ class DmpBank(LeafSystem):
         self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)
+        if update_offset is None:
+            update_offset = decide_offset(self._period)
+        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
+            raise ValueError(
+                f"update_offset must be in [0, control_period), got {update_offset!r}")
         k, d = bank.goal_count, bank.dimension
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._goals_port = self.DeclareVectorInputPort("goals", k * d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         # Held at the start: the DMPs sit at their starts (p = 0, offset = -starts), at rest.
-        self._z = slice(2 + d, 2 + d + k * d)
-        self._offset = slice(2 + d + k * d, self.state_size(k, d))
         initial = np.zeros(self.state_size(k, d))
-        initial[0], initial[1] = 1.0, 1.0
-        initial[self._offset] = -bank.starts.reshape(-1)
+        phase, held, _, _, offset = self._split(initial)
+        phase[0], held[0] = 1.0, 1.0
+        offset[...] = -bank.starts
         self._state_index = self.DeclareDiscreteState(initial)
         # The goals checked and laid out (D, K) once each time they change, not each tick.
         self._goals_dk = self.DeclareCacheEntry(
@@ -76,6 +89,14 @@ class DmpBank(LeafSystem):
             ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((d, k))),
                           calc=self._calc_goals_dk),
             prerequisites_of_calc={self._goals_port.ticket()})
+        # Scratch of the bank's step, one workspace per Context. It is never calculated nor
+        # marked up to date (it depends on nothing and holds nothing between calls), so
+        # `_workspace` may always take it mutably; a cloned Context deep-copies it.
+        self._workspace_entry = self.DeclareCacheEntry(
+            "DmpWorkspace: scratch arrays of the bank's step",
+            ValueProducer(allocate=lambda: AbstractValue.Make(bank.make_workspace()),
+                          calc=self._never_calculated),
+            prerequisites_of_calc={self.nothing_ticket()})
         # The outputs depend on the bank's own state only: say so, so that Drake does not
         # recompute them after every plant step.
         self._references_port = self.DeclareVectorOutputPort(
@@ -122,8 +143,18 @@ class DmpBank(LeafSystem):
     def _split(self, vector):
         """Views of a state vector: phase (1,), held (1,), p (D, 1), z and offset (D, K)."""
         d, k = self._bank.dimension, self._bank.goal_count
+        z_end = 2 + d + k * d
         return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
-                vector[self._z].reshape(d, k), vector[self._offset].reshape(d, k))
+                vector[2 + d:z_end].reshape(d, k), vector[z_end:z_end + k * d].reshape(d, k))
+
+    def _workspace(self, context):
+        """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""
+        return self._workspace_entry.get_mutable_cache_entry_value(
+            context).GetMutableValueOrThrow()
+
+    @staticmethod
+    def _never_calculated(context, value):
+        raise RuntimeError("the DmpBank workspace is scratch memory, never evaluated")
 
     def dmp_states(self, context):
         """The K DMPs' state after the last update: phases (K,), positions and scaled
@@ -137,8 +168,9 @@ class DmpBank(LeafSystem):
             np.subtract(robot, offset, out=positions)
             velocity[...] = z
         else:
-            bank.stepped_positions_into(robot, offset, z, self._period, positions)
-            bank.stepped_velocity_into(offset, z, self._period, velocity)
+            workspace = self._workspace(context)
+            bank.stepped_positions_into(robot, offset, z, self._period, positions, workspace)
+            bank.stepped_velocity_into(offset, z, self._period, velocity, workspace)
         return np.full(bank.goal_count, phase[0]), positions, velocity
 
     def _update(self, context, discrete_state):
@@ -147,21 +179,26 @@ class DmpBank(LeafSystem):
         d = bank.dimension
         phase, held, robot, z, offset = self._split(
             discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
+        # Every input is evaluated before the workspace is taken: an input's evaluation may
+        # reach this system's outputs, whose calculation uses the same workspace.
+        robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
+        lock = (self._lock and self._operator_active_port.HasValue(context)
+                and self._operator_active_port.Eval(context)[0] > 0.5)
+        goals_dk = None if lock else self._goals_dk.Eval(context)
+        workspace = self._workspace(context)
         # The velocities the last step left, read out in place (see the class docstring);
         # the offsets are rewritten below, so they serve as the scratch.
         if not held[0]:
-            bank.stepped_velocity_into(offset, z, period, z, scratch=offset)
-        robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
+            bank.stepped_velocity_into(offset, z, period, z, workspace, overwrite_offset=True)
         robot[:, 0] = robot_state[:d]
-        if (self._lock and self._operator_active_port.HasValue(context)
-                and self._operator_active_port.Eval(context)[0] > 0.5):
+        if lock:
             # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
             held[0] = 1.0
             offset.fill(0.0)
             np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
             return
         held[0] = 0.0
-        bank.offsets_into(phase, robot, self._goals_dk.Eval(context), offset)
+        bank.offsets_into(phase, robot, goals_dk, offset, workspace)
         phase *= bank.decay(period)
 
     def _calc_goals_dk(self, context, value):
@@ -176,11 +213,13 @@ class DmpBank(LeafSystem):
         np.divide(scaled_velocity.T, self._bank.duration, out=references[1])
 
     def _calc_phase(self, context, output):
-        output.get_mutable_value()[:] = context.get_discrete_state(self._state_index)[0]
+        phase = self._split(context.get_discrete_state(self._state_index).get_value())[0]
+        output.get_mutable_value()[:] = phase[0]
 
     def _calc_predicted_paths(self, context, output):
         phase, positions, scaled_velocity = self.dmp_states(context)
         goals = self._goals_dk.Eval(context)
         paths = self._bank.predict(phase, positions, scaled_velocity, goals,
-                                   self._prediction_period, self._prediction_steps)
+                                   self._prediction_period, self._prediction_steps,
+                                   self._workspace(context))
         output.SetFromVector(paths.reshape(-1))

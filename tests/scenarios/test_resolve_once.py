@@ -6,14 +6,16 @@ import pathlib
 
 import pytest
 
-import pbp_drake.core.dmp as dmp_module
+import pbp_drake.core.dmp.bank as dmp_bank_module
+import pbp_drake.core.dmp.single as single_dmp_module
 import pbp_drake.scenarios.resolution as resolve_module
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import BentPath, load_scenario_file
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
 # Where each piece of work is done, by the name the caller looks it up under.
-COUNTED = [(resolve_module, "bent_path"), (dmp_module, "fit_weights"),
+COUNTED = [(resolve_module, "bent_path"), (dmp_bank_module, "fit_weights"),
+           (single_dmp_module, "fit_weights"),
            (resolve_module, "sample_reach_scene"), (resolve_module, "sample_obstacle_scene")]
 
 

@@ -1,0 +1,46 @@
+"""Discrete Dynamical Movement Primitives (DMPs) in D dimensions, and a bank of K of them.
+
+Notation (as in Ijspeert et al. 2013): `y` position, `z = tau * dy/dt` scaled velocity,
+`x` phase, `g` goal, `y0` start, `tau` duration. Two formulations, chosen by name:
+
+- ``"ijspeert"`` (the paper's form):
+  `tau dz = alpha_z (beta_z (g - y) - z) + f(x)`, `f(x) = (psi.w / sum psi) x (g - y0)`;
+- ``"pastor"`` (Pastor et al. 2009, Hoffmann et al. 2009; robust to goal changes and to
+  `g` close to `y0`): `tau dz = K (g - y) - D z - K (g - y0) x + K (psi.w / sum psi) x`.
+
+With `K = alpha_z beta_z` and `D = alpha_z`, both read `tau dz = K (y_attr - y) - D z`
+around a moving attractor
+
+- ijspeert: `y_attr = g + (psi.w / sum psi) x a / K`, `a = g - y0` (or 1 where the
+  demonstration's amplitude guard switched the scaling off);
+- pastor:   `y_attr = g - (g - y0) x + (psi.w / sum psi) x`,
+
+so a single exact zero-order-hold step (forcing held over the step) serves both, at the
+cost of one 2x2 matrix shared by every goal and dimension.
+
+PBP re-integrates the DMP every control step from the robot's measured position. The DMP
+keeps its own velocity state: resetting it to the robot's measured velocity each step stalls
+the DMP behind a lagging tracker (see DMP_NOTES.md). Only while the phase is locked (the
+operator is driving, PBP-Alt) does the DMP's velocity follow the robot's, so that it resumes
+from the robot's actual state when the operator lets go.
+
+The modules, all NumPy only (no Drake import):
+
+- `settings`: `DmpSettings`, the basis, and the memoised constants of one step;
+- `fitting`: `minimum_jerk`, `validate_demonstration`, `fit_weights` (one demonstration);
+- `single`: `Dmp`, one DMP with a stateful API, the readable reference;
+- `bank`: `DmpBank`, K DMPs as one immutable model, stepped by pure and in-place calls;
+- `workspace`: `DmpWorkspace`, the scratch arrays a caller of the in-place step owns.
+"""
+
+from pbp_drake.core.dmp.bank import DmpBank
+from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration
+from pbp_drake.core.dmp.settings import (
+    FORMULATIONS, DmpSettings, normalized_basis, phase_decay, transition)
+from pbp_drake.core.dmp.single import Dmp
+from pbp_drake.core.dmp.workspace import DmpWorkspace
+
+__all__ = [
+    "FORMULATIONS", "Dmp", "DmpBank", "DmpSettings", "DmpWorkspace", "fit_weights",
+    "minimum_jerk", "normalized_basis", "phase_decay", "transition", "validate_demonstration",
+]

@@ -1,0 +1,34 @@
+"""Input checks shared by the DMP modules: each names the field it refuses (DESIGN.md)."""
+
+import numpy as np
+
+
+def as_point(value, name, dimension=None):
+    """`value` as a new finite float vector `(D,)`; refuses empty, wrong-sized or NaN input."""
+    point = np.array(value, dtype=float).reshape(-1)
+    if point.size == 0:
+        raise ValueError(f"{name} is empty")
+    if dimension is not None and point.size != dimension:
+        raise ValueError(f"{name} has {point.size} numbers, expected {dimension}")
+    if not np.isfinite(point).all():
+        raise ValueError(f"{name} contains NaN or infinite values: {point}")
+    return point
+
+
+def positive(value, name):
+    """`value` as a float, refused unless finite and positive."""
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be positive and finite, got {value}")
+    return float(value)
+
+
+def broadcast_goalwise(values, goal_count, dimension, name):
+    """Per-goal rows `(K, D)` (or one row `(D,)` for all goals) as a new `(D, K)` array."""
+    values = np.asarray(values, dtype=float)
+    if values.ndim == 1:
+        values = np.broadcast_to(values, (goal_count, values.size))
+    if values.shape != (goal_count, dimension):
+        raise ValueError(f"{name} must be ({goal_count}, {dimension}) or ({dimension},)")
+    if not np.isfinite(values).all():
+        raise ValueError(f"{name} contains NaN or infinite values")
+    return np.array(values.T, order="C")

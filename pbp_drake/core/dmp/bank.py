@@ -1,0 +1,431 @@
+"""K DMPs, one per goal, as one immutable model stepped by pure and in-place functions.
+
+The model (weights, starts, amplitude scaling, settings, duration, basis and what is derived
+from them) is fixed at construction: its arrays are read-only and assigning an attribute
+after `__init__` raises. The state of the DMPs (phases, positions, scaled velocities) is
+passed in and out of every call, and the scratch arrays of the in-place step live in a
+`DmpWorkspace` the caller owns (`make_workspace`). So one bank may serve any number of
+threads, Drake Contexts or Simulators at once, each with its own state and workspace.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from pbp_drake.core.dmp._checks import as_point, broadcast_goalwise, positive
+from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
+from pbp_drake.core.dmp.settings import (
+    DmpSettings, normalized_basis, phase_decay, transition)
+from pbp_drake.core.dmp.single import Dmp
+from pbp_drake.core.dmp.workspace import DmpWorkspace
+
+
+def _read_only(array):
+    """A private read-only copy of `array`: the bank's model must not change under it, nor
+    may it change an array its caller still holds."""
+    array = np.array(array, order="C")
+    array.setflags(write=False)
+    return array
+
+
+class DmpBank:
+    """K DMPs, one per goal, stepped together from one shared robot state.
+
+    Vectorised over goals and dimensions; arrays are laid out `(D, K)` internally. All DMPs
+    share `duration` and `settings` (so one 2x2 transition serves all of them); each has its
+    own weights (or all share one set, e.g. straight paths or one demonstration), its own
+    start and its own phase.
+
+    The bank is immutable and keeps no state: `initial_state` gives the state at the start
+    of a movement and the pure `advance` steps it, returning new arrays. `advance_into` is
+    the same step written into arrays the caller owns, with no allocation, using a workspace
+    from `make_workspace`; `offsets_into`, `stepped_positions_into` and
+    `stepped_velocity_into` are its parts (Drake's `DmpBank` system keeps the offsets in its
+    Context and reads the stepped state out on demand).
+
+    Speed. When all phases are equal (DMPs started together and locked together: the normal
+    case), the basis is evaluated once, `(N,)`, and contracted with the weights: shared
+    weights give a `(D,)` shape broadcast to all goals (O(N D + D K)); distinct weights are
+    one `(N,) x (N, D*K)` matrix-vector product over contiguous memory (memory bound). The
+    per-goal-phase path (phases made unequal by per-goal locks) evaluates `(N, K)` bases.
+    With shared weights, equal phases and one start, the attractor is affine in the goal
+    with per-dimension coefficients, so no per-goal shape is ever formed. The step then
+    makes a fixed number of passes over the workspace's `(D, K)` arrays, using one 2x2
+    transition memoised per step size (`pbp_drake.core.dmp.settings.transition`).
+    """
+
+    def __init__(self, weights, starts, duration, settings=DmpSettings(),
+                 amplitude_scaling=None, goal_count=None):
+        settings.validate()
+        # A private copy: the settings are a plain dataclass the caller may change later.
+        self._settings = dataclasses.replace(settings)
+        settings = self._settings
+        self.duration = positive(duration, "duration")
+        weights = np.asarray(weights, dtype=float)
+        if weights.ndim == 2:
+            # One set of weights for every goal: shared work, one (N, D) matrix.
+            self.shared_weights = True
+            if goal_count is None:
+                goal_count = 1 if np.ndim(starts) == 1 else np.shape(starts)[0]
+            self._weights = _read_only(weights)
+            dimension = weights.shape[1]
+        elif weights.ndim == 3:
+            self.shared_weights = False
+            goal_count = weights.shape[0]
+            dimension = weights.shape[2]
+            self._weights = _read_only(weights.transpose(1, 2, 0))  # (N, D, K)
+        else:
+            raise ValueError(f"weights must be (N, D) or (K, N, D), got shape {weights.shape}")
+        if weights.shape[-2] != settings.basis_count:
+            raise ValueError(
+                f"weights have {weights.shape[-2]} basis functions, settings say "
+                f"{settings.basis_count}"
+            )
+        if goal_count < 1:
+            raise ValueError("a DMP bank needs at least one goal")
+        self.goal_count = goal_count
+        self.dimension = dimension
+        self.starts = _read_only(broadcast_goalwise(starts, goal_count, dimension, "starts"))
+        scaling = np.ones((goal_count, dimension), bool) if amplitude_scaling is None else (
+            np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, dimension)))
+        self.amplitude_scaling = _read_only(scaling.T)  # (D, K)
+        centres, widths = settings.basis()
+        self._centres, self._widths = _read_only(centres), _read_only(widths)
+        self._derive_constants()
+        self._frozen = True
+
+    def __setattr__(self, name, value):
+        # Immutable after construction: a bank shared by threads or Drake Contexts must not
+        # change under any of them (the arrays are read-only for the same reason).
+        if getattr(self, "_frozen", False):
+            raise AttributeError(f"DmpBank is immutable: cannot set {name!r}")
+        object.__setattr__(self, name, value)
+
+    def _derive_constants(self):
+        """Per-bank constants of the step, computed once (read-only)."""
+        self._negative_widths = _read_only(-self._widths)
+        self._ijspeert = self._settings.formulation == "ijspeert"
+        self._stiffness = self._settings.stiffness
+        self._unscaled = _read_only(~self.amplitude_scaling)
+        self._all_scaled = not self._unscaled.any()
+        # Shared weights, a per-dimension amplitude scaling and one start: with equal phases
+        # the attractor is `alpha_g g + alpha_c` per dimension (see `offsets_into`).
+        scaling, starts = self.amplitude_scaling, self.starts
+        self._affine_attractor = (
+            self.shared_weights and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all())
+            and bool((starts == starts[:, :1]).all()))
+        self._uniform_start = _read_only(starts[:, :1])
+        self._scaled_dimensions = _read_only(scaling[:, :1].astype(float))
+
+    @classmethod
+    def from_dmps(cls, dmps):
+        """A bank of the given single DMPs (same duration and settings)."""
+        if not dmps:
+            raise ValueError("a DMP bank needs at least one DMP")
+        first = dmps[0]
+        for other in dmps[1:]:
+            if other.duration != first.duration or other.settings != first.settings:
+                raise ValueError("all DMPs of a bank must share duration and settings")
+        return cls(
+            np.stack([dmp.weights for dmp in dmps]),
+            np.stack([dmp.start for dmp in dmps]),
+            first.duration,
+            first.settings,
+            np.stack([dmp.amplitude_scaling for dmp in dmps]),
+        )
+
+    @classmethod
+    def from_demonstration(cls, times, positions, goal_count=1, settings=DmpSettings(),
+                           start=None, duration=None):
+        """K DMPs that share ONE demonstration's shape, sent to K goals given at run time.
+
+        The Ijspeert form rescales the shape by each goal's `(g - y0)`; the Pastor form keeps
+        it as learned. `duration` (tau) defaults to the demonstration's.
+        """
+        times, positions = validate_demonstration(times, positions)
+        weights, scaling = fit_weights(times, positions, settings)
+        start = positions[0] if start is None else start
+        duration = times[-1] - times[0] if duration is None else duration
+        return cls(weights, start, duration, settings, scaling, goal_count)
+
+    @classmethod
+    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
+        """K straight-path DMPs from `start` to goals given at run time (no demonstration).
+
+        Ijspeert: the minimum-jerk shape, shared by all goals (it scales with `g - y0`).
+        Pastor: `f = 0`, whose attractor already slides from `y0` to `g` along the line.
+        """
+        dimension = as_point(start, "start").size
+        if settings.formulation == "ijspeert":
+            unit = Dmp.straight(np.zeros(1), np.ones(1), duration, settings)
+            weights = np.repeat(unit.weights, dimension, axis=1)
+        else:
+            weights = np.zeros((settings.basis_count, dimension))
+        return cls(weights, start, duration, settings, goal_count=goal_count)
+
+    @property
+    def settings(self):
+        """The bank's gains and basis (a copy: changing it does not change the bank)."""
+        return dataclasses.replace(self._settings)
+
+    def make_workspace(self):
+        """New scratch arrays for the in-place step; one per thread or Drake Context."""
+        return DmpWorkspace(self.dimension, self.goal_count, self._settings.basis_count)
+
+    def initial_state(self, position=None):
+        """(phase (K,), position (D, K), scaled velocity (D, K)) at the start of a movement."""
+        positions = np.array(self.starts) if position is None else np.repeat(
+            as_point(position, "position", dimension=self.dimension)[:, None],
+            self.goal_count, axis=1)
+        return (np.ones(self.goal_count), positions,
+                np.zeros((self.dimension, self.goal_count)))
+
+    def goals_matrix(self, goals):
+        """Validates goals given as `(K, D)` (or flat `K*D`) and returns them as `(D, K)`."""
+        goals = np.asarray(goals, dtype=float)
+        if goals.size == 0:
+            raise ValueError("goals is empty: give at least one goal")
+        if goals.size != self.goal_count * self.dimension:
+            raise ValueError(
+                f"goals has {goals.size} numbers; the bank expects {self.goal_count} goals of "
+                f"dimension {self.dimension}"
+            )
+        # One reduction without a temporary: a finite sum proves every entry finite; only
+        # when it is not (NaN, infinity, or an overflow of huge finite goals) look closer.
+        if not math.isfinite(goals.sum()) and not np.isfinite(goals).all():
+            raise ValueError("goals contains NaN or infinite values")
+        return goals.reshape(self.goal_count, self.dimension).T
+
+    def transition(self, dt):
+        """The read-only 2x2 zero-order-hold transition of one step of `dt` (memoised)."""
+        return transition(self._stiffness, self._settings.damping, self.duration, dt)
+
+    def decay(self, dt):
+        """The phase factor `exp(-alpha_x dt / tau)` of one step."""
+        return phase_decay(self._settings, self.duration, dt)
+
+    def attractors(self, phase, goals_dk):
+        """The moving attractors `(D, K)` for phases `(K,)` and goals `(D, K)`, a new array."""
+        return self._attractors_into(np.asarray(phase, dtype=float), goals_dk,
+                                     self.make_workspace()).copy()
+
+    def _attractors_into(self, phase, goals_dk, workspace):
+        """The attractors written into `workspace.attractor` (returned)."""
+        shape, x = self._shaped_forcing(phase, workspace)  # shape already times x (and / K)
+        attractor = workspace.attractor
+        np.subtract(goals_dk, self.starts, out=attractor)
+        if self._ijspeert:
+            # g + shape x (g - y0) / K, with 1 for (g - y0) where the scaling is off.
+            if not self._all_scaled:
+                np.copyto(attractor, 1.0, where=self._unscaled)
+            attractor *= shape
+            attractor += goals_dk
+        else:
+            # g - (g - y0) x + shape x
+            attractor *= x
+            np.subtract(goals_dk, attractor, out=attractor)
+            attractor += shape
+        return attractor
+
+    def _shaped_forcing(self, phase, workspace):
+        """`(psi.w / sum psi) x`, divided by K in the Ijspeert form, and the phase.
+
+        Equal phases: the shape is `(D, 1)` (shared weights) or `(D, K)`, the phase a float;
+        a phase per goal: the shape is `(D, K)`, the phase `(K,)`. The shape is a view of
+        the workspace.
+        """
+        if phase.size == 1 or phase.min() == phase.max():
+            x = float(phase.flat[0])
+            psi = workspace.psi
+            np.subtract(x, self._centres, out=psi)
+            np.square(psi, out=psi)
+            psi *= self._negative_widths
+            np.exp(psi, out=psi)
+            scale = x / psi.sum()
+            if self._ijspeert:
+                scale /= self._stiffness
+            psi *= scale
+            if self.shared_weights:
+                np.dot(psi, self._weights, out=workspace.coefficients)
+                return workspace.coefficients[:, np.newaxis], x
+            n = self._settings.basis_count
+            np.dot(psi, self._weights.reshape(n, -1), out=workspace.shape.reshape(-1))
+            return workspace.shape, x
+        # A phase per goal: K bases.
+        phi = normalized_basis(phase, self._centres, self._widths)  # (N, K)
+        shape = workspace.shape
+        if self.shared_weights:
+            np.matmul(self._weights.T, phi, out=shape)
+        else:
+            np.einsum("nk,ndk->dk", phi, self._weights, out=shape)
+        shape *= phase
+        if self._ijspeert:
+            shape /= self._stiffness
+        return shape, phase
+
+    def advance(self, phase, positions, scaled_velocity, goals_dk, dt, locked=None,
+                robot_velocity=None):
+        """One exact zero-order-hold step of all K DMPs; pure: returns the new state.
+
+        Args:
+            phase: (K,) phases; positions: (D, K) or (D, 1) positions to step from (PBP passes
+                the robot's position); scaled_velocity: (D, K) the DMPs' own `z`.
+            goals_dk: (D, K) goals.
+            locked: None, or a bool (or (K,) bools) freezing those DMPs' phases; their
+                velocity then follows `robot_velocity` (D,) and their position stays.
+        Returns:
+            (phase, positions, scaled_velocity) after the step, new arrays.
+        """
+        phase = np.asarray(phase, dtype=float)
+        scaled_velocity = np.asarray(scaled_velocity, dtype=float)
+        new_phase = np.empty(phase.shape)
+        new_positions = np.empty(scaled_velocity.shape)
+        new_velocity = np.empty(scaled_velocity.shape)
+        self.advance_into(phase, positions, scaled_velocity, goals_dk, dt,
+                          new_phase, new_positions, new_velocity, self.make_workspace(),
+                          locked, robot_velocity)
+        return new_phase, new_positions, new_velocity
+
+    def advance_into(self, phase, positions, scaled_velocity, goals_dk, dt,
+                     out_phase, out_positions, out_velocity, workspace, locked=None,
+                     robot_velocity=None):
+        """`advance` written into `out_phase` (K,), `out_positions` and `out_velocity` (D, K),
+        with `workspace` (from `make_workspace`) as scratch.
+
+        The outputs may be the inputs themselves (`out_phase is phase`,
+        `out_velocity is scaled_velocity`, `out_positions is positions`): the step then
+        updates the state in place. Allocates nothing unless some (not all) DMPs are locked.
+        """
+        if locked is not None and not isinstance(locked, (bool, np.bool_)):
+            locked = np.asarray(locked, bool)
+            if locked.ndim == 0 or locked.all():
+                locked = bool(locked.all())
+            elif not locked.any():
+                locked = False
+            else:
+                return self._advance_partly_locked(
+                    phase, positions, scaled_velocity, goals_dk, dt, out_phase, out_positions,
+                    out_velocity, workspace, np.broadcast_to(locked, np.shape(phase)),
+                    robot_velocity)
+        if locked:
+            # Every phase frozen: the DMPs stay at the given positions and follow the robot.
+            if out_phase is not phase:
+                out_phase[...] = phase
+            if out_positions is not positions:
+                out_positions[...] = positions
+            if robot_velocity is not None:
+                np.multiply(np.asarray(robot_velocity, float)[:, np.newaxis], self.duration,
+                            out=out_velocity)
+            elif out_velocity is not scaled_velocity:
+                out_velocity[...] = scaled_velocity
+            return
+        offset = self.offsets_into(phase, positions, goals_dk, workspace.offset, workspace)
+        # Positions first: `out_velocity` may alias `scaled_velocity`, which they read.
+        self.stepped_positions_into(positions, offset, scaled_velocity, dt, out_positions,
+                                    workspace)
+        # `offset` is the workspace's and read no more: it serves as the velocity's scratch.
+        self.stepped_velocity_into(offset, scaled_velocity, dt, out_velocity, workspace,
+                                   overwrite_offset=True)
+        np.multiply(phase, self.decay(dt), out=out_phase)
+
+    # The step, in parts. With `offset = y - a` (the position stepped from minus the
+    # attractor), the exact zero-order-hold step is
+    #     y' = y + (Phi00 - 1) offset + Phi01 z,    z' = Phi10 offset + Phi11 z,
+    # so a caller may keep `(offset, z)` and read `(y', z')` out later (Drake's DmpBank does:
+    # PBP never feeds the DMPs' own positions back, only the robot's).
+
+    def offsets_into(self, phase, positions, goals_dk, out, workspace):
+        """`out = positions - attractor(phase, goals)`, `(D, K)`; `positions` (D, K) or
+        (D, 1). Two passes over `(D, K)` when the DMPs share weights, phase and start.
+        `out` is the caller's array or `workspace.offset` (the other work arrays are used)."""
+        if self._affine_attractor and (phase.size == 1 or phase.min() == phase.max()):
+            negative_alpha_goal, alpha_constant = self._affine_attractor_coefficients(
+                phase, workspace)
+            # positions - (alpha_g g + alpha_c) = -alpha_g g + (positions - alpha_c)
+            np.multiply(goals_dk, negative_alpha_goal, out=out)
+            if positions.shape[1] == 1:
+                np.subtract(positions, alpha_constant, out=workspace.column)
+                out += workspace.column
+            else:
+                out += positions
+                out -= alpha_constant
+            return out
+        np.subtract(positions, self._attractors_into(phase, goals_dk, workspace), out=out)
+        return out
+
+    def stepped_positions_into(self, positions, offset, scaled_velocity, dt, out, workspace):
+        """`out = positions + (Phi00 - 1) offset + Phi01 z`: the positions after the step
+        (`workspace.work` holds the terms)."""
+        (t00, t01), _ = self.transition(dt)
+        work = workspace.work
+        np.multiply(offset, t00 - 1.0, out=work)
+        np.add(positions, work, out=out)  # `out` may be `positions`
+        np.multiply(scaled_velocity, t01, out=work)
+        out += work
+        return out
+
+    def stepped_velocity_into(self, offset, scaled_velocity, dt, out, workspace,
+                              overwrite_offset=False):
+        """`out = Phi10 offset + Phi11 z`: the scaled velocities after the step (`out` may be
+        `scaled_velocity`). `workspace.work` holds `Phi10 offset`, or, with
+        `overwrite_offset` (a caller done with `offset`), `offset` itself: all passes then
+        stay in arrays the caller already touches."""
+        _, (t10, t11) = self.transition(dt)
+        scratch = offset if overwrite_offset else workspace.work
+        np.multiply(offset, t10, out=scratch)
+        np.multiply(scaled_velocity, t11, out=out)
+        out += scratch
+        return out
+
+    def _affine_attractor_coefficients(self, phase, workspace):
+        """Per dimension `(-alpha_g, alpha_c)` `(D, 1)` with `attractor = alpha_g g + alpha_c`
+        for every goal: shared weights, one phase and one start make it affine in g."""
+        shape, x = self._shaped_forcing(phase, workspace)  # (D, 1): the forcing (x, / K)
+        alpha_goal, alpha_constant = workspace.alpha_goal, workspace.alpha_constant
+        start = self._uniform_start
+        if self._ijspeert:
+            # a = g + c (g - y0) where scaled, g + c where not.
+            np.multiply(shape, self._scaled_dimensions, out=alpha_goal)
+            np.multiply(alpha_goal, -start, out=alpha_constant)
+            alpha_constant += shape
+            alpha_constant -= alpha_goal
+            alpha_goal += 1.0
+        else:
+            # a = g - (g - y0) x + c.
+            alpha_goal.fill(1.0 - x)
+            np.multiply(start, x, out=alpha_constant)
+            alpha_constant += shape
+        np.negative(alpha_goal, out=alpha_goal)
+        return alpha_goal, alpha_constant
+
+    def _advance_partly_locked(self, phase, positions, scaled_velocity, goals_dk, dt,
+                               out_phase, out_positions, out_velocity, workspace, locked,
+                               robot_velocity):
+        """Some DMPs locked, some not: the plain path with temporaries (rare)."""
+        phase = np.array(phase, dtype=float)
+        positions = np.array(np.broadcast_to(positions, np.shape(scaled_velocity)), float)
+        scaled_velocity = np.array(scaled_velocity, dtype=float)
+        new_phase = np.empty_like(phase)
+        new_positions = np.empty_like(scaled_velocity)
+        new_velocity = np.empty_like(scaled_velocity)
+        self.advance_into(phase, positions, scaled_velocity, goals_dk, dt,
+                          new_phase, new_positions, new_velocity, workspace)
+        held = (scaled_velocity if robot_velocity is None
+                else self.duration * np.asarray(robot_velocity, float)[:, None])
+        out_phase[...] = np.where(locked, phase, new_phase)
+        out_positions[...] = np.where(locked, positions, new_positions)
+        out_velocity[...] = np.where(locked, held, new_velocity)
+
+    def predict(self, phase, position, scaled_velocity, goals_dk, dt, steps, workspace=None):
+        """Open-loop paths `(K, steps + 1, D)` from one state, for drawing predictions; the
+        inputs are left alone. `workspace` saves allocating one (the paths are new anyway)."""
+        workspace = self.make_workspace() if workspace is None else workspace
+        path = np.empty((steps + 1, self.dimension, self.goal_count))
+        path[0] = np.broadcast_to(position, np.shape(scaled_velocity))
+        phase = np.array(phase, dtype=float)
+        scaled_velocity = np.array(scaled_velocity, dtype=float)
+        for step in range(steps):
+            self.advance_into(phase, path[step], scaled_velocity, goals_dk, dt,
+                              phase, path[step + 1], scaled_velocity, workspace)
+        return path.transpose(2, 0, 1)

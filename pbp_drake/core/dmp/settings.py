@@ -1,0 +1,103 @@
+"""DMP settings, the Gaussian basis, and the constants of one exact step.
+
+The step constants (the 2x2 zero-order-hold transition and the phase decay) depend on the
+settings, the duration and the step only, so they are pure functions here rather than state
+of any DMP object: `transition` is memoised with `functools.lru_cache` (thread-safe in
+CPython: two threads missing together both compute the same value, and the cache's own
+bookkeeping is locked), and it returns a read-only array, so the one array every caller
+shares cannot be changed by any of them.
+"""
+
+import dataclasses
+import functools
+import math
+
+import numpy as np
+
+from pbp_drake.core.linear import second_order_transition
+
+FORMULATIONS = ("ijspeert", "pastor")
+
+
+@dataclasses.dataclass
+class DmpSettings:
+    """Gains and basis of a DMP (scenario files: the `dmp` section).
+
+    A plain dataclass, so that `yaml_load_typed` can read it; a `DmpBank` keeps its own copy.
+
+    Attributes:
+        formulation: "ijspeert" or "pastor".
+        basis_count: number of Gaussian basis functions.
+        alpha_z: damping gain; `beta_z` defaults to `alpha_z / 4` (critically damped).
+        beta_z: stiffness ratio, `None` for `alpha_z / 4`.
+        alpha_x: phase decay; `ln 100` makes the phase reach 0.01 at `t = tau`.
+    """
+
+    formulation: str = "ijspeert"
+    basis_count: int = 50
+    alpha_z: float = 25.0
+    beta_z: float | None = None
+    alpha_x: float = math.log(100.0)
+
+    def __post_init__(self):
+        self.validate()
+
+    def validate(self):
+        """Raises ValueError naming the first field that cannot be used (a YAML loader sets
+        the fields after construction, so `resolve` calls this again)."""
+        if self.formulation not in FORMULATIONS:
+            raise ValueError(
+                f"formulation {self.formulation!r} is unknown; choose one of {FORMULATIONS}"
+            )
+        if self.basis_count < 2:
+            raise ValueError(f"basis_count must be at least 2, got {self.basis_count}")
+        for name in ("alpha_z", "alpha_x"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
+        if self.beta_z is not None and not self.beta_z > 0:
+            raise ValueError(f"beta_z must be positive, got {self.beta_z}")
+
+    @property
+    def stiffness(self):
+        """`K = alpha_z beta_z`."""
+        beta_z = self.alpha_z / 4.0 if self.beta_z is None else self.beta_z
+        return self.alpha_z * beta_z
+
+    @property
+    def damping(self):
+        """`D = alpha_z`."""
+        return self.alpha_z
+
+    def basis(self):
+        """Centres `c_i = exp(-alpha_x i / (N - 1))` and widths crossing neighbours at 0.7."""
+        n = self.basis_count
+        centres = np.exp(-self.alpha_x * np.arange(n) / (n - 1))
+        widths = np.empty(n)
+        widths[:-1] = 4.0 * math.log(1.0 / 0.7) / np.diff(centres) ** 2
+        widths[-1] = widths[-2]
+        return centres, widths
+
+
+def normalized_basis(phase, centres, widths):
+    """`psi_i(x) / sum_j psi_j(x)` for phases of any shape: returns `(N,) + phase.shape`."""
+    phase = np.asarray(phase, dtype=float)
+    offsets = phase[np.newaxis, ...] - centres.reshape((-1,) + (1,) * phase.ndim)
+    psi = np.exp(-widths.reshape((-1,) + (1,) * phase.ndim) * offsets**2)
+    return psi / psi.sum(axis=0)
+
+
+@functools.lru_cache(maxsize=256)
+def transition(stiffness, damping, duration, dt):
+    """The read-only 2x2 `Phi = expm(A dt)` of the transformation system around its moving
+    attractor (see `pbp_drake.core.dmp`): one matrix for every goal and dimension.
+
+    Keyed on plain floats, not on `DmpSettings`, because hashing four floats is cheap enough
+    for a call every control step and hashing the dataclass is not."""
+    phi = second_order_transition(stiffness, damping, duration, dt)
+    phi.setflags(write=False)
+    return phi
+
+
+def phase_decay(settings, duration, dt):
+    """The phase factor `exp(-alpha_x dt / tau)` of one step."""
+    return math.exp(-settings.alpha_x * dt / duration)

@@ -1,0 +1,127 @@
+"""One DMP, stepped with a plain per-dimension loop: the readable reference.
+
+`Dmp` keeps a state of its own (`phase`, `position`, `scaled_velocity`) and a stateful API
+(`reset`, `next_step`, `rollout`), as NumPy users expect of one movement primitive. That is
+safe here because a `Dmp` is one object per goal that its user steps; no Drake system holds
+one, and it is the oracle the vectorised, immutable `DmpBank` is tested against, so it stays
+written the plain way.
+"""
+
+import numpy as np
+
+from pbp_drake.core.dmp._checks import as_point, positive
+from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration
+from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, transition
+
+
+class Dmp:
+    """One DMP in D dimensions, stepped with a plain per-dimension loop.
+
+    The reference implementation for a single goal: readable, and the oracle the vectorised
+    `DmpBank` is tested against.
+    """
+
+    def __init__(self, weights, start, goal, duration, settings=DmpSettings(),
+                 amplitude_scaling=None):
+        self.settings = settings
+        self.start = as_point(start, "start")
+        self.goal = as_point(goal, "goal", dimension=self.start.size)
+        self.weights = np.asarray(weights, dtype=float).reshape(settings.basis_count, -1)
+        if self.weights.shape[1] != self.start.size:
+            raise ValueError(
+                f"weights have {self.weights.shape[1]} dimensions, start has {self.start.size}"
+            )
+        self.duration = positive(duration, "duration")
+        self.amplitude_scaling = (
+            np.ones(self.start.size, bool)
+            if amplitude_scaling is None
+            else np.asarray(amplitude_scaling, bool).reshape(self.start.size)
+        )
+        self._centres, self._widths = settings.basis()
+        self.reset()
+
+    @classmethod
+    def from_demonstration(cls, times, positions, settings=DmpSettings()):
+        """Learns the DMP of ONE demonstration; start, goal and duration are the demo's."""
+        times, positions = validate_demonstration(times, positions)
+        weights, scaling = fit_weights(times, positions, settings)
+        return cls(weights, positions[0], positions[-1], times[-1] - times[0], settings, scaling)
+
+    @classmethod
+    def straight(cls, start, goal, duration, settings=DmpSettings(), profile="minimum_jerk"):
+        """A DMP with no demonstration: a straight path from `start` to `goal`.
+
+        `profile="minimum_jerk"` fits a minimum-jerk reach (bell-shaped speed, done at
+        `duration`); `profile="zero_forcing"` uses `f = 0` (straight too, from rest, but with
+        the abrupt start of a critically damped spring).
+        """
+        start = as_point(start, "start")
+        goal = as_point(goal, "goal", dimension=start.size)
+        if profile == "zero_forcing":
+            weights = np.zeros((settings.basis_count, start.size))
+            return cls(weights, start, goal, duration, settings)
+        if profile != "minimum_jerk":
+            raise ValueError(f"profile {profile!r} is unknown; use 'minimum_jerk' or 'zero_forcing'")
+        # Fit in each dimension on a unit reach so that dimensions with g = y0 still get the
+        # straight-path shape; the Ijspeert (g - y0) factor then scales it to any goal.
+        times, unit = minimum_jerk(np.zeros(1), np.ones(1), duration)
+        unit_weights, _ = fit_weights(times, unit, settings)
+        span = goal - start if settings.formulation == "pastor" else np.ones(start.size)
+        return cls(unit_weights * span, start, goal, duration, settings)
+
+    def reset(self, position=None, scaled_velocity=None):
+        """Phase to 1, position to `start` (or `position`), scaled velocity to 0 (or given)."""
+        self.phase = 1.0
+        self.position = self.start.copy() if position is None else as_point(position, "position")
+        self.scaled_velocity = (
+            np.zeros(self.start.size) if scaled_velocity is None else np.array(scaled_velocity, float)
+        )
+
+    def attractor(self, phase, goal):
+        """The moving attractor `y_attr(x, g)` of the module docstring, per dimension."""
+        psi = np.exp(-self._widths * (phase - self._centres) ** 2)
+        shape = (psi @ self.weights) / psi.sum() * phase
+        result = np.empty(self.start.size)
+        for dim in range(self.start.size):
+            if self.settings.formulation == "ijspeert":
+                amplitude = goal[dim] - self.start[dim] if self.amplitude_scaling[dim] else 1.0
+                result[dim] = goal[dim] + shape[dim] * amplitude / self.settings.stiffness
+            else:
+                result[dim] = goal[dim] - (goal[dim] - self.start[dim]) * phase + shape[dim]
+        return result
+
+    def next_step(self, dt, goal=None, robot_position=None, robot_velocity=None,
+                  phase_locked=False):
+        """Advances one control step from the robot's state; returns (position, velocity).
+
+        `robot_position` replaces the DMP's position (PBP's re-integration from the robot);
+        while `phase_locked`, the DMP does not advance: its velocity follows `robot_velocity`
+        and it returns the robot's state.
+        """
+        goal = self.goal if goal is None else as_point(goal, "goal", dimension=self.start.size)
+        if robot_position is not None:
+            self.position = as_point(robot_position, "robot_position", dimension=self.start.size)
+        tau = self.duration
+        if phase_locked:
+            if robot_velocity is not None:
+                self.scaled_velocity = tau * np.asarray(robot_velocity, float)
+            return self.position.copy(), self.scaled_velocity / tau
+        phi = transition(self.settings.stiffness, self.settings.damping, tau, dt)
+        attractor = self.attractor(self.phase, goal)
+        for dim in range(self.start.size):
+            offset = self.position[dim] - attractor[dim]
+            z = self.scaled_velocity[dim]
+            self.position[dim] = attractor[dim] + phi[0, 0] * offset + phi[0, 1] * z
+            self.scaled_velocity[dim] = phi[1, 0] * offset + phi[1, 1] * z
+        self.phase *= phase_decay(self.settings, tau, dt)
+        return self.position.copy(), self.scaled_velocity / tau
+
+    def rollout(self, dt, duration=None):
+        """Open-loop positions `(steps + 1, D)` from the current state, the state kept."""
+        saved = (self.phase, self.position.copy(), self.scaled_velocity.copy())
+        steps = int(round((self.duration if duration is None else duration) / dt))
+        path = [self.position.copy()]
+        for _ in range(steps):
+            path.append(self.next_step(dt)[0])
+        self.phase, self.position, self.scaled_velocity = saved
+        return np.array(path)

@@ -24,7 +24,9 @@ _PUBLIC = {
     "run_method_comparison": "pbp_drake.method_study",
     # The robot.
     "add_hsr": "pbp_drake.robots.hsr_model",
-    "add_hsr_station": "pbp_drake.robots.hsr_station",
+    "make_hsr_station": "pbp_drake.robots.hsr_station",
+    "HsrStationConfig": "pbp_drake.robots.hsr_station",
+    "hsr_initial_ee_state": "pbp_drake.robots.hsr_station",
     # Drake systems.
     "Blender": "pbp_drake.systems",
     "DmpBank": "pbp_drake.systems",

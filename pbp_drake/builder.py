@@ -15,6 +15,7 @@ which tick k steps. Loggers named `robot_state_log`, `operator_active_log`,
 """
 
 import numpy as np
+from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, Multiplexer, ZeroOrderHold
 
@@ -24,9 +25,14 @@ from pbp_drake.scenarios import (
     ObstacleRepulsion, ScriptedCommands, SinusoidalStep,
     VirtualParticipant as VirtualParticipantConfig, demonstration_samples, dmp_settings,
     goal_estimator_settings, resolved_goals, resolved_start, task_layout, validate_scenario)
+from pbp_drake.robots import (
+    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, make_hsr_station)
 from pbp_drake.systems import (
-    Blender, DemonstrationPlayer, DmpBank, GoalsSource, NoOperator, ObstacleRepulsionOperator,
-    PointRobot, ScriptedOperator)
+    Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HeadingCommand,
+    NoOperator, ObstacleRepulsionOperator, PointRobot, ReachSceneVisualizer, SampleHold,
+    ScriptedOperator, TaskMonitor)
+from pbp_drake.systems.moving_obstacles import MovingObstacles
+from pbp_drake.systems.vector_split import VectorSplit
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
 BLEND_MODE_OF_METHOD = {
@@ -177,18 +183,16 @@ def _build_hsr_diagram(scenario, meshcat):
         station.ee_state, task_monitor.target, goal_estimator ──> operator
         operator.operator_command [vx, vy, vz, yaw_rate] ──> blender (v), heading_command
         blender.command [p, v] + heading ──> station.ee_command (whole-body differential IK)
+        obstacles.obstacle_positions ──> station.obstacle_positions (obstacle task)
+        station.in_collision ──> task_monitor
+
+    The station (`make_hsr_station`: plant, diff IK, PD, obstacle geometry, collision
+    monitor, Meshcat visualizer) is one block named `hsr_station`.
 
     The operator samples at the control ticks; a quarter plant step later the DMP bank, the
     goal estimator, the heading and the task monitor update from the same sampled state and
     the operator's decision of that tick, before the plant moves.
     """
-    from pbp_drake.robots.hsr_station import add_hsr_station
-    from pbp_drake.systems.goal_estimator import GoalEstimator
-    from pbp_drake.systems.heading_command import HeadingCommand
-    from pbp_drake.systems.sample_hold import SampleHold
-    from pbp_drake.systems.task_monitor import TaskMonitor
-    from pbp_drake.systems.vector_split import VectorSplit
-
     period = scenario.control_period
     task = scenario.task
     layout = task_layout(scenario)
@@ -197,13 +201,12 @@ def _build_hsr_diagram(scenario, meshcat):
     offset = scenario.robot.time_step / 4
     builder = DiagramBuilder()
 
-    station = add_hsr_station(builder, time_step=scenario.robot.time_step, meshcat=meshcat,
-                              ee_height=task.height, command_period=period,
-                              diff_ik_time_step=scenario.robot.diff_ik_time_step)
-    start = station.initial_ee_state[:3]
-    ee_state = station.ee_state
-    sample = builder.AddNamedSystem("ee_state_sample",
-                                    SampleHold(period, station.initial_ee_state))
+    station = builder.AddNamedSystem("hsr_station", make_hsr_station(
+        hsr_station_config(scenario, layout), meshcat))
+    initial_ee_state = hsr_initial_ee_state(station)
+    start = initial_ee_state[:3]
+    ee_state = station.GetOutputPort("ee_state")
+    sample = builder.AddNamedSystem("ee_state_sample", SampleHold(period, initial_ee_state))
     builder.Connect(ee_state, sample.get_input_port())
     ee_split = builder.AddNamedSystem("ee_state_split", VectorSplit([6, 2]))
     builder.Connect(sample.get_output_port(), ee_split.get_input_port())
@@ -222,7 +225,7 @@ def _build_hsr_diagram(scenario, meshcat):
     builder.Connect(sample.get_output_port(), monitor.get_ee_state_input_port())
     obstacles = None
     if layout.obstacles is not None:
-        obstacles = _add_obstacles(builder, scenario, station, layout.obstacles, sample,
+        obstacles = _add_obstacles(builder, scenario, station, layout.obstacles, start, sample,
                                    monitor, offset)
 
     operator = builder.AddNamedSystem("operator", make_hsr_operator(
@@ -231,7 +234,7 @@ def _build_hsr_diagram(scenario, meshcat):
                               ("target", monitor.get_target_output_port()),
                               ("selected_goal", estimator.get_selected_goal_output_port()),
                               ("obstacle_positions", obstacles and
-                               obstacles.get_obstacle_positions_output_port())]:
+                               obstacles.get_floor_positions_output_port())]:
         if operator.HasInputPort(port_name) and source is not None:
             builder.Connect(source, operator.GetInputPort(port_name))
     operator_active = operator.get_operator_active_output_port()
@@ -251,7 +254,7 @@ def _build_hsr_diagram(scenario, meshcat):
     command_split = builder.AddNamedSystem("operator_command_split", VectorSplit([3, 1]))
     builder.Connect(operator_command, command_split.get_input_port())
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
-        station.initial_ee_state[6], period, update_offset=offset))
+        initial_ee_state[6], period, update_offset=offset))
     builder.Connect(operator_command, heading.get_operator_command_input_port())
 
     blender = builder.AddNamedSystem("blender", Blender(
@@ -267,7 +270,7 @@ def _build_hsr_diagram(scenario, meshcat):
     ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
     builder.Connect(blender.get_command_output_port(), ee_command.get_input_port(0))
     builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
-    builder.Connect(ee_command.get_output_port(), station.ee_command)
+    builder.Connect(ee_command.get_output_port(), station.GetInputPort("ee_command"))
 
     for name, port in [("ee_state_log", ee_state),
                        ("operator_active_log", operator_active),
@@ -279,8 +282,6 @@ def _build_hsr_diagram(scenario, meshcat):
         LogVectorOutput(port, builder, period).set_name(name)
 
     if meshcat is not None:
-        from pbp_drake.systems.reach_scene_visualizer import ReachSceneVisualizer
-
         visualizer = builder.AddNamedSystem("task_visualizer", ReachSceneVisualizer(
             meshcat, goals, prediction_steps))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
@@ -305,38 +306,34 @@ def make_hsr_dmp_bank(scenario, start, goals):
     return DmpBankMath.straight(start, len(goals), duration, dmp_settings(scenario.dmp))
 
 
-def _add_obstacles(builder, scenario, station, obstacle_scene, sample, monitor, offset):
-    """The moving cylinders, measured against the robot's collision geometry."""
-    from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
-
-    from pbp_drake.systems.collision_monitor import CollisionMonitor
-    from pbp_drake.systems.moving_obstacles import MovingObstacles
-
+def hsr_station_config(scenario, layout):
+    """The HSR station of the scenario: its robot's rates, the task's height, the control
+    loop's period (the station ramps between ticks) and the task's cylinders, if any."""
     task = scenario.task
-    plant, scene_graph = station.plant, station.scene_graph
+    obstacles = []
+    if layout.obstacles is not None:
+        obstacles = [CylinderObstacle(radius=task.obstacle_radius, height=task.obstacle_height)
+                     for _ in layout.obstacles.obstacle_starts]
+    return HsrStationConfig(
+        plant=MultibodyPlantConfig(time_step=scenario.robot.time_step,
+                                   discrete_contact_approximation="sap"),
+        diff_ik_time_step=scenario.robot.diff_ik_time_step,
+        command_period=scenario.control_period, ee_height=task.height, obstacles=obstacles)
+
+
+def _add_obstacles(builder, scenario, station, obstacle_scene, start, sample, monitor, offset):
+    """The moving cylinders' behaviour; the station holds their geometry and measures them
+    against the robot."""
+    task = scenario.task
     obstacles = builder.AddNamedSystem("obstacles", MovingObstacles(
-        scene_graph, obstacle_scene, station.initial_ee_state[:3], task.obstacle_radius,
-        task.obstacle_height, task.obstacle_speed, scenario.control_period,
-        update_offset=offset))
+        obstacle_scene, start, task.obstacle_height, task.obstacle_speed,
+        scenario.control_period, update_offset=offset))
     builder.Connect(sample.get_output_port(), obstacles.get_ee_state_input_port())
-    builder.Connect(obstacles.get_geometry_pose_output_port(),
-                    scene_graph.get_source_pose_port(obstacles.source_id))
-    robot_geometries = [geometry for body in plant.GetBodyIndices(station.model)
-                        for geometry in plant.GetCollisionGeometriesForBody(plant.get_body(body))]
-    # The obstacles are measured, not felt: keep them out of the plant's contact (which
-    # also refuses pairs of geometries it does not own, such as two obstacles meeting).
-    scene_graph.collision_filter_manager().Apply(
-        CollisionFilterDeclaration()
-        .ExcludeBetween(GeometrySet(robot_geometries), GeometrySet(obstacles.geometry_ids))
-        .ExcludeWithin(GeometrySet(obstacles.geometry_ids)))
-    collisions = builder.AddNamedSystem(
-        "collision_monitor", CollisionMonitor(robot_geometries, obstacles.geometry_ids))
-    builder.Connect(scene_graph.get_query_output_port(),
-                    collisions.get_query_object_input_port())
-    builder.Connect(collisions.get_in_collision_output_port(),
-                    monitor.get_in_collision_input_port())
-    LogVectorOutput(collisions.get_in_collision_output_port(), builder,
-                    scenario.control_period).set_name("in_collision_log")
+    builder.Connect(obstacles.get_obstacle_positions_output_port(),
+                    station.GetInputPort("obstacle_positions"))
+    in_collision = station.GetOutputPort("in_collision")
+    builder.Connect(in_collision, monitor.get_in_collision_input_port())
+    LogVectorOutput(in_collision, builder, scenario.control_period).set_name("in_collision_log")
     return obstacles
 
 

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.geometry import Meshcat
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, TrajectorySource
@@ -16,7 +17,8 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.robots import (
     CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, make_hsr_station)
-from pbp_drake.robots.hsr_model import BASE_JOINT_NAMES, add_hsr
+from pbp_drake.robots.hsr_model import (
+    BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
 from pbp_drake.systems.layouts import EeCommand, EeState
 
 EE_HEIGHT = 0.7
@@ -24,17 +26,17 @@ BASE_RADIUS = 0.226  # the lower base's cylinder in the model
 BASE_SPEED_LIMITS = (0.2, 0.2, 1.0)  # published, in the model file
 
 
-def base_position_indices():
-    """Where the base's (x, y, yaw) sit in the plant's positions."""
-    from pydrake.multibody.plant import MultibodyPlant
-
+def position_indices():
+    """Where each joint sits in the plant's positions, by name."""
     plant = MultibodyPlant(0.005)
     model = add_hsr(plant)
     plant.Finalize()
-    return [plant.GetJointByName(name, model).position_start() for name in BASE_JOINT_NAMES]
+    return {plant.get_joint(index).name(): plant.get_joint(index).position_start()
+            for index in plant.GetJointIndices(model)}
 
 
-BASE = base_position_indices()
+POSITION_INDEX = position_indices()
+BASE = [POSITION_INDEX[name] for name in BASE_JOINT_NAMES]
 
 
 def simulate(knots, duration, with_desired_state=False, **config_args):
@@ -175,6 +177,10 @@ def test_position_ramp_is_tracked_and_moves_the_base(start, axis):
     base = state_log.data()[BASE]
     assert base[axis, -1] - base[axis, 0] > 0.2
     assert np.abs(base[2]).max() < 0.05
+    # The torso follows the arm lift (the coupler constraint, enforced by SAP).
+    torso = state_log.data()[POSITION_INDEX[TORSO_JOINT_NAME]]
+    lift = state_log.data()[POSITION_INDEX["arm_lift_joint"]]
+    np.testing.assert_allclose(torso, TORSO_TO_ARM_LIFT_RATIO * lift, atol=1e-4)
 
 
 def test_base_is_driven_within_its_velocity_limits(start):

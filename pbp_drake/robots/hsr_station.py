@@ -6,7 +6,7 @@ motion, in the shape of manipulation's hardware station::
 
     ee_command ─► EeCommandToPose ─► DifferentialInverseKinematicsIntegrator ─► q_d
     q_d (motor joints) ─► StateInterpolatorWithDiscreteDerivative ─► [q_d, v_d]
-    [q_d, v_d] ─► the plant's PD on every motor, base and arm (desired_state input)
+    [q_d (+ h v_d on the base), v_d] ─► the plant's PD on every motor (desired_state)
     plant ─► EeStateFromPlant ─► ee_state
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
 
@@ -50,7 +50,6 @@ from pbp_drake.robots.hsr_model import (
     add_hsr,
 )
 from pbp_drake.systems.collision_monitor import CollisionMonitor
-from pbp_drake.systems.layouts import EeState
 from pbp_drake.systems.obstacle_geometry import CylinderObstacleGeometry
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
@@ -96,8 +95,8 @@ class HsrStationConfig:
     ee_height: float = 0.7
     # Base (x, y, yaw). The robot (34 kg, about 3 kg·m² about z) follows the diff IK's
     # velocity feed-forward; implicit damping stays stable beyond the explicit bound
-    # mass / time_step, so it is heavy here: setting off, the base's speed overshoots its
-    # limit by about 5 % (15 % at 1200 / 200), and the hand's path barely changes.
+    # mass / time_step, so it is heavy here: setting off at full speed, the base
+    # overshoots its speed limit by about 7 % (18 % at 1200 / 200).
     base_kp: list[float] = dataclasses.field(default_factory=lambda: [8000.0, 8000.0, 1500.0])
     base_kd: list[float] = dataclasses.field(default_factory=lambda: [3000.0, 3000.0, 400.0])
     # Arm (lift, flex, roll, wrist flex, wrist roll).
@@ -227,7 +226,8 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``); ``ee_state`` is
     ``[p (3), v (3), heading, heading_rate]`` (``EeState``) of the hand in the world.
     ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]`` the plant's PD
-    tracks, in motor order (``ACTUATED_JOINT_NAMES``); ``body_poses`` and
+    tracks, in motor order (``ACTUATED_JOINT_NAMES``; the base's q_d one plant step ahead,
+    where the implicit PD measures the positions); ``body_poses`` and
     ``query_object`` are the plant's and SceneGraph's. ``obstacle_positions`` is
     ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the
     smallest robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
@@ -274,9 +274,22 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
         selector[row, joint.position_start()] = 1.0
     motor_positions = builder.AddNamedSystem("motor_positions", MatrixGain(selector))
     builder.Connect(diff_ik.get_output_port(), motor_positions.get_input_port())
-    desired = builder.AddNamedSystem("desired_state", StateInterpolatorWithDiscreteDerivative(
-        len(motor_joints), config.diff_ik_time_step))
-    builder.Connect(motor_positions.get_output_port(), desired.get_input_port())
+    interpolator = builder.AddNamedSystem(
+        "motor_velocities",
+        StateInterpolatorWithDiscreteDerivative(len(motor_joints), config.diff_ik_time_step))
+    builder.Connect(motor_positions.get_output_port(), interpolator.get_input_port())
+    # The plant's implicit PD compares q_d with the positions at the END of its step, so
+    # [q_d, v_d] at t_n leaves a motor h v_d behind: 0.8 mm at 0.15 m/s, which a control
+    # loop re-integrating from the robot's state (PBP, teleop) turns into 15 % less speed.
+    # The base's q_d is fed one step ahead, q_d + h v_d; the arm's lag is already made up
+    # by EeCommandToPose's lead (TRACKING_LAG, tuned with the arm's PD).
+    motors, h = len(motor_joints), config.plant.time_step
+    look_ahead = np.eye(2 * motors)
+    for row, joint in enumerate(motor_joints):
+        if joint.name() in BASE_JOINT_NAMES:
+            look_ahead[row, motors + row] = h
+    desired = builder.AddNamedSystem("desired_state", MatrixGain(look_ahead))
+    builder.Connect(interpolator.get_output_port(), desired.get_input_port())
     builder.Connect(desired.get_output_port(), plant.get_desired_state_input_port(model))
 
     ee_body = plant.GetFrameByName(END_EFFECTOR_FRAME, model).body()
@@ -329,6 +342,4 @@ def _add_obstacles(builder, plant, scene_graph, model, obstacles):
 def hsr_initial_ee_state(station: Diagram) -> np.ndarray:
     """The hand's ``ee_state`` (``EeState``) where ``station`` (from ``make_hsr_station``)
     starts: read off a fresh context, so nothing is built twice."""
-    state = station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext())
-    assert state.size == EeState.size
-    return np.array(state)
+    return np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))

@@ -19,12 +19,14 @@ _PUBLIC = {
     # Scenarios, diagrams, runs and studies.
     "load_scenario_file": "pbp_drake.scenarios",
     "build_diagram": "pbp_drake.builder",
-    "simulate": "pbp_drake.simulation",
-    "run_task": "pbp_drake.task_run",
+    "simulate": "pbp_drake.builder",
+    "run_task": "pbp_drake.builder",
     "run_method_comparison": "pbp_drake.studies.comparison",
     # The robot.
     "add_hsr": "pbp_drake.robots.hsr_model",
-    "add_hsr_station": "pbp_drake.robots.hsr_station",
+    "make_hsr_station": "pbp_drake.robots.hsr_station",
+    "HsrStationConfig": "pbp_drake.robots.hsr_station",
+    "hsr_initial_ee_state": "pbp_drake.robots.hsr_station",
     # Drake systems.
     "Blender": "pbp_drake.systems",
     "DmpBank": "pbp_drake.systems",

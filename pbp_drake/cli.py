@@ -16,13 +16,13 @@ from pbp_drake.draw import main as draw_main
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, MethodComparison, ScenarioError,
     check_method_comparison, load_scenario_file, resolve, with_method)
-from pbp_drake.simulation import simulate
+from pbp_drake.builder.run import simulate
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.progress import ProgressBar
 from pbp_drake.studies.report import FIGURES, report, results_table
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
 from pbp_drake.studies.toy import run_study
-from pbp_drake.task_run import run_task
+from pbp_drake.builder.run import run_task
 
 
 def main(argv=None):
@@ -166,7 +166,7 @@ def _run(args):
         _wait_for_browser(meshcat, args.wait_for_browser)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
-    trajectory = simulate(scenario, realtime_rate=0.0 if args.headless else args.realtime_rate,
+    trajectory = simulate(resolved, realtime_rate=0.0 if args.headless else args.realtime_rate,
                           diagram=diagram)
     positions = np.zeros((len(trajectory.positions), 3))
     positions[:, :trajectory.positions.shape[1]] = trajectory.positions[:, :3]
@@ -204,7 +204,7 @@ def _run_task(args, resolved, meshcat):
         _wait_for_browser(meshcat, args.wait_for_browser)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
-    result = run_task(scenario, realtime_rate=0.0 if args.headless else args.realtime_rate,
+    result = run_task(resolved, realtime_rate=0.0 if args.headless else args.realtime_rate,
                       diagram=diagram)
     if args.record:
         _save_recording(meshcat, args.record)
@@ -238,17 +238,17 @@ def _run_session(args, resolved, meshcat, person):
               f"{args.wait_for_browser:.0f} s).", flush=True)
         _wait_for_browser(meshcat, args.wait_for_browser)
 
-    def run_one(trial_scenario):
-        diagram = build_diagram(trial_scenario, meshcat)
-        print(f"Next: {trial_scenario.method}.", flush=True)
+    def run_one(trial):
+        diagram = build_diagram(trial, meshcat)
+        print(f"Next: {trial.scenario.method}.", flush=True)
         if person and sys.stdin.isatty():
             input("Press Enter to start. ")
-        result = run_task(trial_scenario, realtime_rate=0.0 if args.headless else
+        result = run_task(trial, realtime_rate=0.0 if args.headless else
                           args.realtime_rate, diagram=diagram)
         operator = diagram.GetSubsystemByName("operator")
         if hasattr(operator, "Delete"):
             operator.Delete()  # the next method may want other keys
-        print(f"  {trial_scenario.method}: {result.summary_line()}", flush=True)
+        print(f"  {trial.scenario.method}: {result.summary_line()}", flush=True)
         return result
 
     summary = run_session(scenario, args.participant, methods, output, run_one)

@@ -11,7 +11,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 from pbp_drake.core.arbitration import (
     BLEND_MODES, blend, confidence_alpha, goal_confidence, validate_mode)
 from pbp_drake.scenarios import ScriptedCommands, load_scenario_file
-from pbp_drake.simulation import simulate
+from pbp_drake.builder.run import simulate
 from pbp_drake.systems import Blender, PointRobot
 from pbp_drake.systems.point_robot import PointRobotParams
 
@@ -100,7 +100,7 @@ def test_point_robot_settles_on_a_constant_reference():
 
 def test_simulations_are_restartable_and_contexts_independent(repo):
     from pbp_drake.builder import build_diagram
-    from pbp_drake.simulation import read_trajectory
+    from pbp_drake.builder.run import read_trajectory
 
     scenario = load_scenario_file(repo / "diagrams/toy_alpha_study.yaml").scenario
     diagram = build_diagram(scenario)

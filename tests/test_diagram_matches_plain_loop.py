@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pbp_drake.scenarios import load_scenario_file
-from pbp_drake.simulation import simulate
+from pbp_drake.builder.run import simulate
 from plain_loop import plain_loop
 
 

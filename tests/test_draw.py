@@ -2,6 +2,7 @@
 checked in beside their YAML and must match what `draw` produces now."""
 
 import pathlib
+import re
 
 import pytest
 
@@ -94,3 +95,11 @@ def test_pbp_drake_draw_is_the_same_command(tmp_path, capsys):
         pytest.skip("`pbp-drake draw` is not hooked into the CLI yet")
     assert code == 0
     assert output.read_bytes() == path.with_suffix(".svg").read_bytes()
+
+
+def test_the_hsr_task_drawing_has_the_station_as_one_block_at_page_width():
+    svg = (DIAGRAMS / "hsr_reach.svg").read_text()
+    width = float(re.search(r'<svg width="([\d.]+)pt"', svg).group(1))
+    assert width <= 1000  # a README page is about 1000 pt wide
+    assert "name=hsr_station" in svg and "name=pbp_controller" in svg
+    assert "MultibodyPlant" not in svg and "DmpBank" not in svg  # inside the blocks

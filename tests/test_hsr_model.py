@@ -11,12 +11,14 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from pbp_drake.robots.hsr_model import (
+    ACTUATED_JOINT_NAMES,
     ARM_JOINT_NAMES,
-    BASE_JOINT_NAME,
+    BASE_JOINT_NAMES,
     END_EFFECTOR_FRAME,
     NEUTRAL_ARM_POSITIONS,
     TORSO_JOINT_NAME,
     TORSO_TO_ARM_LIFT_RATIO,
+    actuator_name,
     add_hsr,
     models_dir,
 )
@@ -63,13 +65,18 @@ def test_models_dir_holds_the_package():
     assert (models_dir() / "pbp_drake_models" / "package.xml").is_file()
 
 
-def test_loads_with_planar_base_and_arm(hsr):
+def test_loads_with_actuated_base_and_arm(hsr):
     _, plant, model = hsr
     assert plant.is_finalized()
-    assert plant.GetJointByName(BASE_JOINT_NAME, model).type_name() == "planar"
-    # 3 base + torso + 5 arm joints; only the arm is actuated.
+    assert [plant.GetJointByName(name, model).type_name() for name in BASE_JOINT_NAMES] \
+        == ["prismatic", "prismatic", "revolute"]
+    # 3 base + torso + 5 arm joints; every one but the (coupled) torso has a motor.
     assert plant.num_positions() == 9
-    assert plant.num_actuated_dofs() == len(ARM_JOINT_NAMES)
+    assert plant.num_actuated_dofs() == len(ACTUATED_JOINT_NAMES) == 8
+    motors = [plant.get_joint_actuator(index) for index in plant.GetJointActuatorIndices(model)]
+    assert [motor.name() for motor in motors] == [
+        actuator_name(name) for name in ACTUATED_JOINT_NAMES]
+    assert [motor.joint().name() for motor in motors] == list(ACTUATED_JOINT_NAMES)
     context = plant.CreateDefaultContext()
     assert 30.0 < plant.CalcTotalMass(context) < 40.0  # published sum: 34.8 kg
     plant.GetFrameByName(END_EFFECTOR_FRAME, model)
@@ -84,15 +91,22 @@ def test_joint_has_published_limits(hsr, name):
     np.testing.assert_allclose(joint.position_upper_limits(), [upper])
     np.testing.assert_allclose(joint.velocity_upper_limits(), [velocity])
     if effort is not None:
-        actuator = plant.GetJointActuatorByName(name.replace("_joint", "_motor"), model)
+        actuator = plant.GetJointActuatorByName(actuator_name(name), model)
         assert actuator.joint().name() == name
         assert actuator.effort_limit() == effort
 
 
-def test_base_velocity_limits(hsr):
+@pytest.mark.parametrize("name, speed, position_limit", [
+    ("base_x_joint", 0.2, 10.0), ("base_y_joint", 0.2, 10.0), ("base_yaw_joint", 1.0, np.inf)])
+def test_base_limits_are_in_the_model_file(hsr, name, speed, position_limit):
+    # Speeds of HSR's planning software (0.2 m/s, 1.0 rad/s); positions wide, yaw free.
     _, plant, model = hsr
-    joint = plant.GetJointByName(BASE_JOINT_NAME, model)
-    np.testing.assert_allclose(joint.velocity_upper_limits(), [0.2, 0.2, 1.0])
+    joint = plant.GetJointByName(name, model)
+    np.testing.assert_allclose(joint.velocity_lower_limits(), [-speed])
+    np.testing.assert_allclose(joint.velocity_upper_limits(), [speed])
+    np.testing.assert_allclose(joint.position_lower_limits(), [-position_limit])
+    np.testing.assert_allclose(joint.position_upper_limits(), [position_limit])
+    assert plant.GetJointActuatorByName(actuator_name(name), model).effort_limit() > 0
 
 
 def test_neutral_pose_matches_published_forward_kinematics(hsr):

@@ -1,43 +1,64 @@
-"""Tests of the HSR station as its user sees it: the hand follows end-effector commands
-(position and heading), the base takes over what the arm cannot reach, and the hand
-stays at the object height while doing so."""
+"""Tests of the HSR station as its user sees it: one Diagram whose hand follows
+end-effector commands (position and heading), whose base (driven by the plant's own PD,
+within its velocity limits) takes over what the arm cannot reach, and which measures the
+robot against obstacles placed through a port."""
+
+import dataclasses
 
 import numpy as np
 import pytest
+from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.geometry import Meshcat
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from pbp_drake.robots.hsr_model import BASE_JOINT_NAME
-from pbp_drake.robots.hsr_station import add_hsr_station
+from pbp_drake.robots import (
+    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, make_hsr_station)
+from pbp_drake.robots.hsr_model import (
+    BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
+from pbp_drake.systems.layouts import EeCommand, EeState
 
 EE_HEIGHT = 0.7
 BASE_RADIUS = 0.226  # the lower base's cylinder in the model
+BASE_SPEED_LIMITS = (0.2, 0.2, 1.0)  # published, in the model file
 
 
-def simulate(knots, duration, **station_args):
+def position_indices():
+    """Where each joint sits in the plant's positions, by name."""
+    plant = MultibodyPlant(0.005)
+    model = add_hsr(plant)
+    plant.Finalize()
+    return {plant.get_joint(index).name(): plant.get_joint(index).position_start()
+            for index in plant.GetJointIndices(model)}
+
+
+POSITION_INDEX = position_indices()
+BASE = [POSITION_INDEX[name] for name in BASE_JOINT_NAMES]
+
+
+def simulate(knots, duration, with_desired_state=False, **config_args):
     """Runs the station under a piecewise-linear command through ``knots``
-    (a list of (time, 7-vector)) and returns the station, the ee_state log and the
-    base (x, y, yaw) log, both sampled every 10 ms."""
+    (a list of (time, 7-vector)) and returns the ee_state log and the plant state log
+    (and, ``with_desired_state``, the desired_state log), sampled every 10 ms."""
+    station = make_hsr_station(HsrStationConfig(**config_args))
     builder = DiagramBuilder()
-    station = add_hsr_station(builder, **station_args)
+    builder.AddNamedSystem("hsr_station", station)
     times = [t for t, _ in knots]
     values = np.column_stack([c for _, c in knots])
     source = builder.AddSystem(
         TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, values)))
-    builder.Connect(source.get_output_port(), station.ee_command)
-    ee_logger = LogVectorOutput(station.ee_state, builder, 0.01)
-    state_logger = LogVectorOutput(
-        station.plant.get_state_output_port(station.model), builder, 0.01)
-    diagram = builder.Build()
-    simulator = Simulator(diagram)
+    builder.Connect(source.get_output_port(), station.GetInputPort("ee_command"))
+    ee_logger = LogVectorOutput(station.GetOutputPort("ee_state"), builder, 0.01)
+    state_logger = LogVectorOutput(station.GetOutputPort("state"), builder, 0.01)
+    desired_logger = LogVectorOutput(station.GetOutputPort("desired_state"), builder, 0.01)
+    simulator = Simulator(builder.Build())
     simulator.AdvanceTo(duration)
     context = simulator.get_context()
-    base = station.plant.GetJointByName(BASE_JOINT_NAME, station.model).position_start()
-    state_log = state_logger.FindLog(context)
-    return station, ee_logger.FindLog(context), state_log.data()[base:base + 3]
+    logs = ee_logger.FindLog(context), state_logger.FindLog(context)
+    return logs + (desired_logger.FindLog(context),) if with_desired_state else logs
 
 
 def ramp(start, delta, speed):
@@ -48,51 +69,95 @@ def ramp(start, delta, speed):
 
 
 @pytest.fixture(scope="module")
-def start():
-    builder = DiagramBuilder()
-    return add_hsr_station(builder).initial_ee_state[:7]
+def station():
+    return make_hsr_station()
 
 
-def test_starts_level_in_front_of_the_base_at_object_height():
-    builder = DiagramBuilder()
-    station = add_hsr_station(builder)
-    diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
-    ee_state = station.ee_state.Eval(station.ee_state.get_system().GetMyContextFromRoot(context))
-    np.testing.assert_allclose(ee_state, station.initial_ee_state, atol=1e-9)
-    p, v, heading, heading_rate = ee_state[:3], ee_state[3:6], ee_state[6], ee_state[7]
-    assert p[2] == pytest.approx(EE_HEIGHT, abs=1e-9)
-    assert p[0] > BASE_RADIUS + 0.1  # in front of the base, not above the body
-    assert heading == pytest.approx(0.0, abs=1e-9)
-    np.testing.assert_allclose(v, 0.0)
-    assert heading_rate == 0.0
+@pytest.fixture(scope="module")
+def start(station):
+    return hsr_initial_ee_state(station)[:EeCommand.size]
+
+
+def test_is_one_diagram_with_named_ports(station):
+    assert station.get_name() == "hsr_station"
+    assert [station.get_input_port(i).get_name() for i in range(station.num_input_ports())] \
+        == ["ee_command"]
+    outputs = {station.get_output_port(i).get_name(): station.get_output_port(i)
+               for i in range(station.num_output_ports())}
+    assert {"ee_state", "state", "desired_state", "body_poses", "query_object"} \
+        == set(outputs)
+    assert station.GetInputPort("ee_command").size() == EeCommand.size
+    assert outputs["ee_state"].size() == EeState.size
+    assert outputs["state"].size() == 2 * 9  # 3 base + torso + 5 arm
+    assert outputs["desired_state"].size() == 2 * 8  # every motor: 3 base + 5 arm
+    assert "in_collision" not in outputs  # only with obstacles
+
+
+def test_config_round_trips_through_yaml():
+    config = HsrStationConfig(diff_ik_time_step=0.02, command_period=1 / 30,
+                              obstacles=[CylinderObstacle(radius=0.1, height=1.0)])
+    loaded = yaml_load_typed(schema=HsrStationConfig, data=yaml_dump_typed(config))
+    assert loaded.obstacles == config.obstacles
+    assert loaded.command_period == config.command_period
+    partial = yaml_load_typed(schema=HsrStationConfig, data="plant: {time_step: 0.002}")
+    assert partial.plant.time_step == 0.002
+    assert partial.plant.discrete_contact_approximation == "sap"  # the default is kept
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("diff_ik_time_step", 0.0125, "diff_ik_time_step must be a whole multiple"),
+    ("command_period", -0.1, "command_period"),
+    ("initial_base", [0.0, 0.0], "initial_base"),
+    ("base_kp", [1.0, 1.0], "base_kp"),
+    ("obstacles", [CylinderObstacle(radius=0.0)], r"obstacles\[0\]"),
+])
+def test_config_errors_name_the_field(field, value, message):
+    with pytest.raises(ValueError, match=message):
+        make_hsr_station(dataclasses.replace(HsrStationConfig(), **{field: value}))
+
+
+def test_rejects_tamsi_which_ignores_the_torso_coupler():
+    config = HsrStationConfig()
+    config.plant.discrete_contact_approximation = "tamsi"
+    with pytest.raises(ValueError, match="discrete_contact_approximation"):
+        make_hsr_station(config)
+
+
+def test_starts_level_in_front_of_the_base_at_object_height(station):
+    context = station.CreateDefaultContext()
+    ee_state = EeState(station.GetOutputPort("ee_state").Eval(context))
+    np.testing.assert_allclose(ee_state[:], hsr_initial_ee_state(station), atol=1e-12)
+    assert ee_state.z == pytest.approx(EE_HEIGHT, abs=1e-9)
+    assert ee_state.x > BASE_RADIUS + 0.1  # in front of the base, not above the body
+    assert ee_state.heading == pytest.approx(0.0, abs=1e-9)
+    np.testing.assert_allclose([ee_state.vx, ee_state.vy, ee_state.vz], 0.0)
+    assert ee_state.heading_rate == 0.0
     # The hand points horizontally forward.
-    plant = station.plant
-    plant_context = plant.GetMyContextFromRoot(context)
+    plant = station.GetSubsystemByName("plant")
     z_axis = plant.GetFrameByName("hand_ee_link").CalcPoseInWorld(
-        plant_context).rotation().matrix()[:, 2]
+        plant.GetMyContextFromRoot(context)).rotation().matrix()[:, 2]
     np.testing.assert_allclose(z_axis, [1, 0, 0], atol=1e-9)
 
 
 def test_initial_base_pose_moves_the_start():
-    builder = DiagramBuilder()
-    station = add_hsr_station(builder, initial_base=(1.0, -0.5, np.pi / 2))
-    p, heading = station.initial_ee_state[:3], station.initial_ee_state[6]
-    assert heading == pytest.approx(np.pi / 2, abs=1e-9)
-    assert p[2] == pytest.approx(EE_HEIGHT, abs=1e-9)
-    assert p[1] > -0.5 + BASE_RADIUS  # in front of the base, which faces +y
+    station = make_hsr_station(HsrStationConfig(initial_base=[1.0, -0.5, np.pi / 2]))
+    ee_state = EeState(hsr_initial_ee_state(station))
+    assert ee_state.heading == pytest.approx(np.pi / 2, abs=1e-9)
+    assert ee_state.z == pytest.approx(EE_HEIGHT, abs=1e-9)
+    assert ee_state.y > -0.5 + BASE_RADIUS  # in front of the base, which faces +y
 
 
 def test_rejects_an_unreachable_start_height():
     with pytest.raises(ValueError, match="ee_height"):
-        add_hsr_station(DiagramBuilder(), ee_height=2.0)
+        make_hsr_station(HsrStationConfig(ee_height=2.0))
 
 
-def test_holding_the_initial_command_keeps_the_hand_still(start):
-    _, ee_log, base_log = simulate([(0.0, start), (2.0, start)], 2.0)
+def test_holding_the_initial_command_keeps_still(start):
+    ee_log, state_log = simulate([(0.0, start), (2.0, start)], 2.0)
     drift = np.linalg.norm(ee_log.data()[:3] - start[:3, None], axis=0)
     assert drift.max() < 1e-3
-    assert np.abs(base_log - base_log[:, :1]).max() < 1e-3
+    positions = state_log.data()[:9]
+    assert np.abs(positions - positions[:, :1]).max() < 1e-3
 
 
 @pytest.mark.parametrize("axis", [0, 1], ids=["forward", "sideways"])
@@ -101,29 +166,56 @@ def test_position_ramp_is_tracked_and_moves_the_base(start, axis):
     delta[axis] = 0.45  # 0.15 m/s for 3 s: beyond what the arm alone reaches
     knots, duration = ramp(start, delta, speed=0.15)
     assert duration == pytest.approx(3.0)
-    _, ee_log, base_log = simulate(knots, duration)
+    ee_log, state_log = simulate(knots, duration)
     p = ee_log.data()[:3]
     assert np.linalg.norm(p[:, -1] - (start + delta)[:3]) < 0.03
     assert np.abs(p[2] - EE_HEIGHT).max() < 0.02
-    # The hand moves at the commanded speed mid-ramp (ee_state's velocity part).
+    # The hand moves at the commanded speed mid-ramp (ee_state's velocity part), and
+    # hardly behind the command: a control loop that re-integrates from the robot's state
+    # loses the lag at every tick.
     middle = np.argmin(np.abs(ee_log.sample_times() - duration / 2))
     assert ee_log.data()[3 + axis, middle] == pytest.approx(0.15, abs=0.02)
+    commanded = start[axis] + 0.15 * ee_log.sample_times()[middle]
+    assert 0.0 < commanded - p[axis, middle] < 0.0015
     # The base carried a good part of the motion, and did not turn.
-    assert base_log[axis, -1] - base_log[axis, 0] > 0.2
-    assert np.abs(base_log[2]).max() < 0.05
+    base = state_log.data()[BASE]
+    assert base[axis, -1] - base[axis, 0] > 0.2
+    assert np.abs(base[2]).max() < 0.05
+    # The torso follows the arm lift (the coupler constraint, enforced by SAP).
+    torso = state_log.data()[POSITION_INDEX[TORSO_JOINT_NAME]]
+    lift = state_log.data()[POSITION_INDEX["arm_lift_joint"]]
+    np.testing.assert_allclose(torso, TORSO_TO_ARM_LIFT_RATIO * lift, atol=1e-4)
+
+
+def test_base_is_driven_within_its_velocity_limits(start):
+    # A far, fast command: diff IK asks the base for its full speed (the model file's
+    # limits), and the plant's PD on the base motors follows it.
+    delta = np.zeros(7)
+    delta[:2] = [1.0, 0.6]
+    delta[6] = 1.0
+    knots, _ = ramp(start, delta, speed=0.5)
+    ee_log, state_log, desired_log = simulate(knots, 3.0, with_desired_state=True)
+    # desired_state is [q_d, v_d] in motor order, the base's three motors first.
+    desired_velocities = desired_log.data()[8:11]
+    base_velocities = state_log.data()[9:][BASE]
+    for axis, limit in enumerate(BASE_SPEED_LIMITS):
+        assert np.abs(desired_velocities[axis]).max() <= limit + 1e-9
+        # The PD catches up the lag of setting off with a brief overshoot only.
+        assert np.abs(base_velocities[axis]).max() < 1.1 * limit
+    assert base_velocities[0, -1] == pytest.approx(BASE_SPEED_LIMITS[0], rel=0.01)
 
 
 def test_heading_ramp_turns_the_hand_and_the_base_follows(start):
     turned = start.copy()
     turned[6] = 0.5
-    _, ee_log, base_log = simulate([(0.0, start), (1.0, turned)], 3.0)
+    ee_log, state_log = simulate([(0.0, start), (1.0, turned)], 3.0)
     heading = ee_log.data()[6]
     assert heading[-1] == pytest.approx(0.5, abs=0.05)
     assert np.abs(ee_log.data()[7]).max() > 0.3  # heading_rate saw the turn
     assert np.linalg.norm(ee_log.data()[:3, -1] - start[:3]) < 0.01
     assert np.abs(ee_log.data()[2] - EE_HEIGHT).max() < 0.02
     # The arm drifts back to its ready pose, so the base ends up facing the new heading.
-    assert base_log[2, -1] > 0.35
+    assert state_log.data()[BASE[2], -1] > 0.35
 
 
 def test_reaches_a_point_in_the_object_region(start):
@@ -131,7 +223,7 @@ def test_reaches_a_point_in_the_object_region(start):
     delta = np.zeros(7)
     delta[:3] = target - start[:3]
     knots, duration = ramp(start, delta, speed=0.2)
-    _, ee_log, _ = simulate(knots, duration)
+    ee_log, _ = simulate(knots, duration)
     p = ee_log.data()[:3]
     assert np.linalg.norm(p[:, -1] - target) < 0.05
     assert np.abs(p[2] - EE_HEIGHT).max() < 0.02
@@ -141,43 +233,62 @@ def test_coarser_diff_ik_period_still_tracks(start):
     delta = np.zeros(7)
     delta[1] = 0.3
     knots, duration = ramp(start, delta, speed=0.15)
-    _, ee_log, _ = simulate(knots, duration, diff_ik_time_step=0.02)
+    ee_log, _ = simulate(knots, duration, diff_ik_time_step=0.02)
     p = ee_log.data()[:3]
     assert np.linalg.norm(p[:, -1] - (start + delta)[:3]) < 0.03
     assert np.abs(p[2] - EE_HEIGHT).max() < 0.02
 
 
-def test_meshcat_visualizer_draws_the_robot():
-    meshcat = Meshcat()
+def obstacle_station_context(centres, meshcat=None):
+    """A station with two cylinders at ``centres`` (2, 3), its context, the diagram."""
+    station = make_hsr_station(
+        HsrStationConfig(obstacles=[CylinderObstacle(0.1, 1.0), CylinderObstacle(0.2, 0.5)]),
+        meshcat)
+    context = station.CreateDefaultContext()
+    station.GetInputPort("obstacle_positions").FixValue(context, np.ravel(centres))
+    return station, context
+
+
+def test_obstacles_are_measured_against_the_robot():
+    station, context = obstacle_station_context([[1.0, 0.0, 0.5], [0.0, 2.0, 0.25]])
+    assert station.GetInputPort("obstacle_positions").size() == 6
+    clearance = station.GetOutputPort("clearance").Eval(context)[0]
+    # The first cylinder (radius 0.1) is nearest: 1.0 - 0.1 from the base's axis, less
+    # how far the hand (0.53 m ahead of the base) reaches toward it.
+    assert 0.2 < clearance < 1.0 - 0.1 - 0.226
+    assert station.GetOutputPort("in_collision").Eval(context)[0] == 0.0
+
+    # Moved onto the hand: the same station now reports the overlap.
+    hand = hsr_initial_ee_state(station)[:3]
+    station.GetInputPort("obstacle_positions").FixValue(
+        context, np.concatenate([hand, [0.0, 2.0, 0.25]]))
+    assert station.GetOutputPort("clearance").Eval(context)[0] < 0.0
+    assert station.GetOutputPort("in_collision").Eval(context)[0] == 1.0
+
+
+def test_obstacles_do_not_push_the_robot(start):
+    station, _ = obstacle_station_context([[0.0, 0.0, 0.0]] * 2)
     builder = DiagramBuilder()
-    station = add_hsr_station(builder, meshcat=meshcat)
-    builder.ExportInput(station.ee_command, "ee_command")
-    diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
-    diagram.get_input_port().FixValue(context, station.initial_ee_state[:7])
-    diagram.ForcedPublish(context)
-    assert station.visualizer is not None
+    builder.AddNamedSystem("hsr_station", station)
+    hand = hsr_initial_ee_state(station)[:3]
+    on_robot = builder.AddSystem(ConstantVectorSource(np.concatenate([hand, [0.0, 0.0, 0.3]])))
+    builder.Connect(on_robot.get_output_port(), station.GetInputPort("obstacle_positions"))
+    hold = builder.AddSystem(ConstantVectorSource(start))
+    builder.Connect(hold.get_output_port(), station.GetInputPort("ee_command"))
+    log = LogVectorOutput(station.GetOutputPort("in_collision"), builder, 0.1)
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(0.5)
+    context = simulator.get_context()
+    assert log.FindLog(context).data().min() == 1.0  # inside the obstacles all along
+    ee_state = station.GetOutputPort("ee_state").Eval(station.GetMyContextFromRoot(context))
+    np.testing.assert_allclose(ee_state[:3], hand, atol=1e-3)
+
+
+def test_meshcat_draws_the_robot_and_the_obstacles():
+    meshcat = Meshcat()
+    station, context = obstacle_station_context([[1.0, 0.0, 0.5], [0.0, 2.0, 0.25]], meshcat)
+    station.GetInputPort("ee_command").FixValue(context, hsr_initial_ee_state(station)[:7])
+    station.ForcedPublish(context)
     assert meshcat.HasPath("/drake/visualizer/hsrb")
-
-
-def test_base_pd_pushes_only_the_base_toward_the_desired_state():
-    from pydrake.multibody.plant import MultibodyPlant
-
-    from pbp_drake.robots.hsr_model import add_hsr
-    from pbp_drake.robots.hsr_station import BASE_KD, BASE_KP, base_pd_gain
-
-    plant = MultibodyPlant(0.005)
-    model = add_hsr(plant)
-    plant.Finalize()
-    base = plant.GetJointByName(BASE_JOINT_NAME, model)
-    nq, nv = plant.num_positions(), plant.num_velocities()
-    rng = np.random.default_rng(0)
-    desired, state = rng.normal(size=nq + nv), rng.normal(size=nq + nv)
-    force = base_pd_gain(plant, base, BASE_KP, BASE_KD) @ np.concatenate([desired, state])
-    q = slice(base.position_start(), base.position_start() + 3)
-    v = slice(nq + base.velocity_start(), nq + base.velocity_start() + 3)
-    on_base = slice(base.velocity_start(), base.velocity_start() + 3)
-    np.testing.assert_allclose(
-        force[on_base], np.multiply(BASE_KP, desired[q] - state[q])
-        + np.multiply(BASE_KD, desired[v] - state[v]), rtol=1e-12)
-    assert not np.delete(force, np.arange(nv)[on_base]).any()
+    assert meshcat.HasPath("/drake/visualizer/obstacle_0")
+    assert meshcat.HasPath("/drake/visualizer/obstacle_1")

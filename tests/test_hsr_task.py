@@ -16,7 +16,7 @@ from pbp_drake.cli import main
 from pbp_drake.scenarios import Keyboard, ScenarioError, load_scenario_file
 from pbp_drake.systems.layouts import TaskStatus
 from pbp_drake.systems.keyboard_operator import LEFT_BUTTON
-from pbp_drake.task_run import run_task
+from pbp_drake.builder.run import run_task
 
 # Two objects ahead, left and right; the target starts on the right, switches to the left
 # at 30 % and back at 60 %: both switches need the operator.

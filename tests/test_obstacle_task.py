@@ -8,7 +8,7 @@ import pytest
 
 from pbp_drake.core.obstacle_task import sample_obstacle_scene, step_obstacles
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
-from pbp_drake.task_run import run_task
+from pbp_drake.builder.run import run_task
 
 
 def test_an_obstacle_waits_for_its_threshold_then_heads_for_the_midpoint():

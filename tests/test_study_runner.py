@@ -25,7 +25,7 @@ from pbp_drake.studies.summary import (
 from pbp_drake.studies.trial_files import (
     StudyFolderError, load_task_result, read_time_series, trial_paths, write_trial)
 from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
-from pbp_drake.task_run import TaskResult, run_task
+from pbp_drake.builder.run import TaskResult, run_task
 
 # Two objects drawn from each seed; 30 s is enough for every method in these scenes.
 TASK = """

@@ -20,7 +20,7 @@ else:
 TUTORIALS = pathlib.Path(__file__).resolve().parents[1] / "tutorials"
 NOTEBOOKS = sorted(TUTORIALS.glob("*.ipynb"))
 EXPECTED = ["01_dmp_basics", "02_policy_blending_2d", "03_hsr_multi_goal",
-            "04_build_your_own_diagram", "05_run_a_study"]
+            "04_build_your_own_diagram", "05_run_a_study", "06_hsr_station"]
 
 # Run first in every notebook's kernel.
 STRICT_WARNINGS = """\
@@ -30,7 +30,7 @@ warnings.simplefilter("error", DrakeDeprecationWarning)
 """
 
 
-def test_all_five_tutorials_are_there():
+def test_all_six_tutorials_are_there():
     assert [path.stem for path in NOTEBOOKS] == EXPECTED
 
 

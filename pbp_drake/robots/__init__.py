@@ -1,1 +1,13 @@
-"""Robot models and the helpers that load them into Drake."""
+"""Robot models and the helpers that load them into Drake; the HSR station."""
+
+from pbp_drake.robots.hsr_model import add_hsr
+from pbp_drake.robots.hsr_station import (
+    CylinderObstacle,
+    HsrStationConfig,
+    hsr_initial_ee_state,
+    hsr_ready_ee_state,
+    make_hsr_station,
+)
+
+__all__ = ["CylinderObstacle", "HsrStationConfig", "add_hsr", "hsr_initial_ee_state",
+           "hsr_ready_ee_state", "make_hsr_station"]

@@ -1,8 +1,9 @@
 """Loads our primitive-shape Toyota HSR model into a Drake MultibodyPlant.
 
 The model (``models/pbp_drake_models/hsr/hsrb_primitive.urdf``) is our own, written
-from published kinematic facts. It has an omnidirectional base on a planar joint to
-the world (``base_planar_joint``: x, y, yaw), five actuated arm joints, a torso that
+from published kinematic facts. It has an omnidirectional base on three actuated joints
+(``BASE_JOINT_NAMES``: prismatic x, prismatic y, revolute yaw; their speed limits are in
+the model file), five actuated arm joints, a torso that
 follows the arm lift at half its travel (a coupler constraint from the URDF
 ``<mimic>``), and an end-effector frame ``hand_ee_link`` between the fingertips whose
 z axis points out of the hand.
@@ -17,14 +18,14 @@ Example::
 
 from pathlib import Path
 
-import numpy as np
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.tree import ModelInstanceIndex
 
 PACKAGE_NAME = "pbp_drake_models"
 HSR_URL = "package://pbp_drake_models/hsr/hsrb_primitive.urdf"
 
-BASE_JOINT_NAME = "base_planar_joint"
+# The base's joints, in the order of its (x, y, yaw) pose.
+BASE_JOINT_NAMES = ("base_x_joint", "base_y_joint", "base_yaw_joint")
 TORSO_JOINT_NAME = "torso_lift_joint"
 # The torso is not actuated: the coupler keeps torso = ratio * arm_lift.
 TORSO_TO_ARM_LIFT_RATIO = 0.5
@@ -38,9 +39,8 @@ ARM_JOINT_NAMES = (
 END_EFFECTOR_FRAME = "hand_ee_link"
 # HSR's "neutral" pose (arm up, hand facing forward), in ARM_JOINT_NAMES order.
 NEUTRAL_ARM_POSITIONS = (0.0, 0.0, 0.0, -1.57, 0.0)
-# Base speed limits (x, y in m/s; yaw in rad/s) used by HSR's planning software.
-# URDF cannot express limits on a planar joint, so add_hsr sets them.
-BASE_VELOCITY_LIMITS = (0.2, 0.2, 1.0)
+# Every joint with a motor, base first; a motor is named after its joint ("_motor").
+ACTUATED_JOINT_NAMES = BASE_JOINT_NAMES + ARM_JOINT_NAMES
 
 
 def models_dir() -> Path:
@@ -88,6 +88,9 @@ def add_hsr(plant, parser: Parser | None = None) -> ModelInstanceIndex:
         parser = Parser(plant)
     configure_parser(parser)
     (model,) = parser.AddModels(url=HSR_URL)
-    limits = np.array(BASE_VELOCITY_LIMITS)
-    plant.GetJointByName(BASE_JOINT_NAME, model).set_velocity_limits(-limits, limits)
     return model
+
+
+def actuator_name(joint_name: str) -> str:
+    """The name of the motor on ``joint_name`` (the model's transmissions follow it)."""
+    return joint_name.replace("_joint", "_motor")

@@ -19,7 +19,7 @@ from pbp_drake.core.dmp import DmpBank, validate_demonstration
 from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
 from pbp_drake.core.toy_scene import bent_path
-from pbp_drake.robots.hsr_station import hsr_initial_ee_state
+from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, Hsr, ObstacleRepulsion,
     Scenario, ScenarioError, ScriptedCommands, SinusoidalStep)
@@ -288,11 +288,15 @@ def _resolve_hsr(scenario):
         layout = task_layout(task, scenario.seed)
     except ValueError as error:
         raise ScenarioError(f"scenario.task: {error}") from None
-    # The hand starts at the task's height; the station ramps between the loop's ticks.
+    # The hand starts at the task's height, the station ramps between the loop's ticks, and
+    # it measures the task's cylinders against the robot.
+    cylinders = [] if layout.obstacles is None else [
+        CylinderObstacle(radius=task.obstacle_radius, height=task.obstacle_height)
+        for _ in layout.obstacles.obstacle_starts]
     station = dataclasses.replace(robot.station, ee_height=task.height,
-                                  command_period=scenario.control_period)
+                                  command_period=scenario.control_period, obstacles=cylinders)
     try:
-        initial_ee_state = hsr_initial_ee_state(station)
+        initial_ee_state = hsr_ready_ee_state(station)
     except ValueError as error:
         raise ScenarioError(f"scenario.robot.station: {error}") from None
     start = initial_ee_state[:3].copy()

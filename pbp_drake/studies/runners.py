@@ -19,7 +19,7 @@ import numpy as np
 from pbp_drake.scenarios import resolve, with_method
 from pbp_drake.studies.trial_files import (
     StudyError, json_float, running_marker, trial_record, write_trial)
-from pbp_drake.task_run import run_task
+from pbp_drake.builder.run import run_task
 
 
 def _scene_of(resolved):
@@ -139,7 +139,7 @@ def _context():
     methods = multiprocessing.get_all_start_methods()
     if "forkserver" in methods:
         context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(["pbp_drake.studies.runners", "pbp_drake.task_run"])
+        context.set_forkserver_preload(["pbp_drake.studies.runners", "pbp_drake.builder.run"])
         return context
     return multiprocessing.get_context("spawn")
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolve
-from pbp_drake.simulation import simulate
+from pbp_drake.builder.run import simulate
 from pbp_drake.studies.figures import plot_alpha_study, plot_alt_vs_cont
 from pbp_drake.studies.summary import collision_free, ideal_alpha
 

@@ -17,7 +17,7 @@ import numpy as np
 from pydrake.common.yaml import yaml_dump_typed, yaml_load
 
 from pbp_drake.scenarios import ScenarioError
-from pbp_drake.task_run import TaskResult
+from pbp_drake.builder.run import TaskResult
 
 TRIAL_FORMAT = 1
 # The metrics of a trial, in the order of the trial files and of trials.json.

@@ -6,7 +6,7 @@ from pydrake.systems.framework import LeafSystem
 
 
 class CollisionMonitor(LeafSystem):
-    """Reports whether any robot geometry overlaps any obstacle geometry.
+    """Reports the robot's clearance to the obstacles and whether it touches one.
 
     .. pydrake_system::
 
@@ -19,10 +19,11 @@ class CollisionMonitor(LeafSystem):
 
     Connect `query_object` to `scene_graph.get_query_output_port()`. The pairs are queried
     one by one with `ComputeSignedDistancePairClosestPoints`, which ignores collision
-    filters: the builder filters robot-obstacle contact out of the plant (the obstacles
-    are measured, they do not push), and this monitor still sees the overlap.
-    `in_collision` is 1 when some pair's signed distance is negative; `clearance` is the
-    smallest signed distance (m).
+    filters: robot-obstacle contact is filtered out of the plant (the obstacles are
+    measured, they do not push), and this monitor still sees the overlap.
+    `clearance` is the smallest signed distance over the pairs (m); `in_collision` is 1
+    when it is negative. Each pair is queried once per evaluation: `in_collision` reads
+    the cached `clearance` output rather than querying again.
     """
 
     def __init__(self, robot_geometry_ids, obstacle_geometry_ids):
@@ -33,11 +34,9 @@ class CollisionMonitor(LeafSystem):
         self._query_port = self.DeclareAbstractInputPort(
             "query_object", AbstractValue.Make(QueryObject()))
         self._collision_port = self.DeclareVectorOutputPort(
-            "in_collision", 1, lambda context, output: output.SetFromVector(
-                [1.0 if self._clearance(context) < 0.0 else 0.0]))
+            "in_collision", 1, self._calc_in_collision)
         self._clearance_port = self.DeclareVectorOutputPort(
-            "clearance", 1,
-            lambda context, output: output.SetFromVector([self._clearance(context)]))
+            "clearance", 1, self._calc_clearance)
 
     def get_query_object_input_port(self):
         return self._query_port
@@ -48,7 +47,10 @@ class CollisionMonitor(LeafSystem):
     def get_clearance_output_port(self):
         return self._clearance_port
 
-    def _clearance(self, context):
+    def _calc_clearance(self, context, output):
         query = self._query_port.Eval(context)
-        return min(query.ComputeSignedDistancePairClosestPoints(a, b).distance
-                   for a, b in self._pairs)
+        output.SetAtIndex(0, min(query.ComputeSignedDistancePairClosestPoints(a, b).distance
+                                 for a, b in self._pairs))
+
+    def _calc_in_collision(self, context, output):
+        output.SetAtIndex(0, 1.0 if self._clearance_port.Eval(context)[0] < 0.0 else 0.0)

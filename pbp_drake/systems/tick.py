@@ -28,7 +28,7 @@ sense stage.
 
 Loggers publish before the updates of their instant: a log sample at `t_k` holds the plant's
 state at `t_k` but the decisions of tick k - 1. `DECISION_LOG_SHIFT` is how many samples
-later the decisions of tick k appear (see `pbp_drake.simulation.read_log`).
+later the decisions of tick k appear (see `pbp_drake.builder.run.read_log`).
 """
 
 SENSE_OFFSET = 0.0

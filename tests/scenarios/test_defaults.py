@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from pydrake.common.yaml import yaml_load_typed
 
-from pbp_drake.builder import build_diagram
+from pbp_drake.builder import build_diagram, find_system
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.scenarios import Scenario, resolve
@@ -49,9 +49,9 @@ def test_browser_operator_defaults_match(meshcat, tag, system):
 
 def test_goal_estimator_and_dmp_defaults_match():
     diagram, resolved = built(HSR)
-    estimator = diagram.GetSubsystemByName("goal_estimator")
+    estimator = find_system(diagram, "goal_estimator")
     assert estimator.settings == GoalEstimator(2, GoalEstimatorSettings(), PERIOD).settings
-    assert diagram.GetSubsystemByName("dmp_bank").bank.settings == DmpSettings()
+    assert find_system(diagram, "dmp_bank").bank.settings == DmpSettings()
 
 
 def test_point_robot_and_repulsion_defaults_match():
@@ -68,4 +68,4 @@ def test_changed_yaml_value_reaches_the_system():
     diagram, _ = built(HSR + "operator: !VirtualParticipant {rotation_speed: 0.5}\n"
                        "goal_estimator: {temperature: 0.3}\n")
     assert diagram.GetSubsystemByName("operator").params.rotation_speed == 0.5
-    assert diagram.GetSubsystemByName("goal_estimator").settings.temperature == 0.3
+    assert find_system(diagram, "goal_estimator").settings.temperature == 0.3

@@ -8,7 +8,6 @@ x = 0.42, obstacle 1 (threshold 0.6075) at the tick of 12.2 s with the hand at x
 
 import numpy as np
 import pytest
-from pydrake.geometry import SceneGraph
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
@@ -32,15 +31,10 @@ SCENE = ObstacleScene(target=TARGET, obstacle_starts=STARTS,
 
 
 def add_obstacles(builder):
-    """MovingObstacles wired for its positions alone; it still registers its cylinders
-    with a SceneGraph (the one place to change once the station registers them)."""
-    scene_graph = builder.AddSystem(SceneGraph())
-    obstacles = builder.AddSystem(MovingObstacles(
-        scene_graph, SCENE, start=[0.0, 0.0, HEIGHT], radius=0.1, height=1.0,
-        speed=OBSTACLE_SPEED, control_period=PERIOD))
-    builder.Connect(obstacles.get_geometry_pose_output_port(),
-                    scene_graph.get_source_pose_port(obstacles.source_id))
-    return obstacles
+    """MovingObstacles alone: the HSR station holds the cylinders' geometry."""
+    return builder.AddSystem(MovingObstacles(
+        SCENE, start=[0.0, 0.0, HEIGHT], height=1.0, speed=OBSTACLE_SPEED,
+        control_period=PERIOD))
 
 
 def build():
@@ -60,7 +54,7 @@ def build():
 def positions_at(simulator, obstacles, time):
     simulator.AdvanceTo(time)
     context = obstacles.GetMyContextFromRoot(simulator.get_context())
-    return obstacles.get_obstacle_positions_output_port().Eval(context).reshape(-1, 2)
+    return obstacles.get_floor_positions_output_port().Eval(context).reshape(-1, 2)
 
 
 def expected(index, time):
@@ -91,6 +85,16 @@ def test_they_move_to_the_cut_off_point_at_their_speed_and_stop_there(time):
     positions = positions_at(simulator, obstacles, time)
     for index in range(2):
         np.testing.assert_allclose(positions[index], expected(index, time), atol=1e-6)
+
+
+def test_the_centres_stand_on_the_floor_positions_at_half_the_height():
+    diagram, obstacles = build()
+    simulator = Simulator(diagram)
+    floor = positions_at(simulator, obstacles, 13.0)
+    context = obstacles.GetMyContextFromRoot(simulator.get_context())
+    centres = obstacles.get_obstacle_positions_output_port().Eval(context).reshape(-1, 3)
+    np.testing.assert_array_equal(centres[:, :2], floor)
+    np.testing.assert_array_equal(centres[:, 2], 0.5)
 
 
 def test_at_the_end_each_stands_half_way_between_the_hand_at_its_wake_and_the_target():

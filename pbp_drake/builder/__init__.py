@@ -1,0 +1,18 @@
+"""Layer 4: a resolved scenario in, a Drake Diagram out, and runs of it.
+
+- `build`: `build_diagram` (the one entry point) and `find_system`;
+- `point_robot`: the 2-D scenes; `hsr`: the HSR tasks, with `pbp_controller` (the PBP loop
+  as one Diagram) and `pbp_drake.robots.make_hsr_station`; `operators`: who drives;
+- `run`: `simulate`, `run_task`, `read_log` and their results.
+"""
+
+from pbp_drake.builder.build import build_diagram, find_system
+from pbp_drake.builder.operators import (
+    make_hsr_operator, make_operator, sinusoidal_step_commands)
+from pbp_drake.builder.pbp_controller import make_pbp_controller
+from pbp_drake.builder.run import (
+    TaskResult, Trajectory, read_log, read_trajectory, run_task, simulate)
+
+__all__ = ["TaskResult", "Trajectory", "build_diagram", "find_system", "make_hsr_operator",
+           "make_operator", "make_pbp_controller", "read_log", "read_trajectory", "run_task",
+           "simulate", "sinusoidal_step_commands"]

@@ -1,0 +1,30 @@
+"""The one entry point from a scenario to a Drake Diagram."""
+
+from pbp_drake.builder.hsr import build_hsr_diagram
+from pbp_drake.builder.point_robot import build_point_robot_diagram
+from pbp_drake.scenarios import ResolvedScenario, resolve
+
+
+def build_diagram(scenario, meshcat=None, prediction_steps=None):
+    """The Diagram of a `ResolvedScenario` (or of a `Scenario`, resolved here once); with
+    `meshcat`, also drawn there. `prediction_steps` (2-D scenes) sets how far ahead the DMPs'
+    paths are drawn (default: their duration, when drawing)."""
+    resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
+    if resolved.is_hsr:
+        return build_hsr_diagram(resolved, meshcat)
+    return build_point_robot_diagram(resolved, meshcat, prediction_steps)
+
+
+def find_system(diagram, name):
+    """The subsystem called `name` anywhere in `diagram` (nested diagrams included, depth
+    first), e.g. `find_system(diagram, "dmp_bank")` inside the HSR task's
+    `pbp_controller`. Raises KeyError when there is none."""
+    if diagram.HasSubsystemNamed(name):
+        return diagram.GetSubsystemByName(name)
+    for system in diagram.GetSystems():
+        if hasattr(system, "HasSubsystemNamed"):
+            try:
+                return find_system(system, name)
+            except KeyError:
+                pass
+    raise KeyError(f"{diagram.get_name()!r} has no subsystem named {name!r}")

@@ -1,0 +1,106 @@
+"""The HSR tasks' diagram (sections IV-B.1 and IV-B.2 of the paper), a handful of blocks:
+
+    hsr_station.ee_state ──> ee_state_sample (SampleHold) ──> pbp_controller, task_monitor,
+                                                               obstacles
+    hsr_station.ee_state, task_monitor.target, pbp_controller.selected_goal ──> operator
+    operator ──> pbp_controller (operator_command, operator_active), task_monitor
+    pbp_controller.ee_command ──> hsr_station.ee_command (whole-body differential IK)
+    obstacles.obstacle_positions ──> hsr_station;  hsr_station.in_collision ──> task_monitor
+
+`hsr_station` (`pbp_drake.robots.make_hsr_station`: plant, diff IK, PD, obstacle geometry,
+collision monitor, Meshcat visualizer) and `pbp_controller`
+(`pbp_drake.builder.pbp_controller`) are Diagrams of their own. The order within a tick is
+`pbp_drake.systems.tick`'s. Loggers named `ee_state_log`, `operator_active_log`,
+`operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` and
+(with obstacles) `in_collision_log` record each tick; the task monitor ends the simulation
+at success.
+"""
+
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput
+
+from pbp_drake.builder.operators import make_hsr_operator
+from pbp_drake.builder.pbp_controller import HSR_PREDICTION_SAMPLES, make_pbp_controller
+from pbp_drake.robots import make_hsr_station
+from pbp_drake.systems import ReachSceneVisualizer, SampleHold, TaskMonitor
+from pbp_drake.systems.moving_obstacles import MovingObstacles
+
+
+def build_hsr_diagram(resolved, meshcat=None):
+    """The Diagram of a resolved HSR scenario; with `meshcat`, drawn there too."""
+    scenario = resolved.scenario
+    period = scenario.control_period
+    task = scenario.task
+    layout = resolved.layout
+    start = resolved.start
+    builder = DiagramBuilder()
+
+    station = builder.AddNamedSystem("hsr_station", make_hsr_station(resolved.station,
+                                                                     meshcat))
+    ee_state = station.GetOutputPort("ee_state")
+    sample = builder.AddNamedSystem("ee_state_sample",
+                                    SampleHold(period, resolved.initial_ee_state))
+    builder.Connect(ee_state, sample.get_input_port())
+    sampled = sample.get_output_port()
+
+    monitor = builder.AddNamedSystem("task_monitor", TaskMonitor(
+        layout.objects, layout.targets, layout.switch_schedule, start, task.success_distance,
+        period))
+    builder.Connect(sampled, monitor.get_ee_state_input_port())
+
+    prediction_steps = HSR_PREDICTION_SAMPLES if meshcat is not None else 0
+    controller = builder.AddNamedSystem("pbp_controller",
+                                        make_pbp_controller(resolved, prediction_steps))
+    builder.Connect(sampled, controller.GetInputPort("ee_state"))
+    builder.Connect(controller.GetOutputPort("ee_command"), station.GetInputPort("ee_command"))
+
+    obstacles = None
+    if layout.obstacles is not None:
+        obstacles = builder.AddNamedSystem("obstacles", MovingObstacles(
+            layout.obstacles, start, task.obstacle_height, task.obstacle_speed, period))
+        builder.Connect(sampled, obstacles.get_ee_state_input_port())
+        builder.Connect(obstacles.get_obstacle_positions_output_port(),
+                        station.GetInputPort("obstacle_positions"))
+        builder.Connect(station.GetOutputPort("in_collision"),
+                        monitor.get_in_collision_input_port())
+
+    operator = builder.AddNamedSystem("operator", make_hsr_operator(resolved, meshcat))
+    selected_goal = controller.GetOutputPort("selected_goal")
+    for port_name, source in [("ee_state", ee_state),
+                              ("target", monitor.get_target_output_port()),
+                              ("selected_goal", selected_goal),
+                              ("obstacle_positions", obstacles and
+                               obstacles.get_floor_positions_output_port())]:
+        if operator.HasInputPort(port_name) and source is not None:
+            builder.Connect(source, operator.GetInputPort(port_name))
+    operator_active = operator.get_operator_active_output_port()
+    operator_command = operator.get_operator_command_output_port()
+    builder.Connect(operator_active, monitor.get_operator_active_input_port())
+    builder.Connect(operator_active, controller.GetInputPort("operator_active"))
+    builder.Connect(operator_command, controller.GetInputPort("operator_command"))
+
+    logged = [("ee_state_log", ee_state),
+              ("operator_active_log", operator_active),
+              ("operator_command_log", operator_command),
+              ("command_log", controller.GetOutputPort("ee_command")),
+              ("selected_goal_log", selected_goal),
+              ("target_log", monitor.get_target_output_port()),
+              ("phase_log", controller.GetOutputPort("phase"))]
+    if obstacles is not None:
+        logged.append(("in_collision_log", station.GetOutputPort("in_collision")))
+    for name, port in logged:
+        LogVectorOutput(port, builder, period).set_name(name)
+
+    if meshcat is not None:
+        visualizer = builder.AddNamedSystem("task_visualizer", ReachSceneVisualizer(
+            meshcat, layout.objects, prediction_steps))
+        builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
+        builder.Connect(selected_goal, visualizer.get_selected_goal_input_port())
+        builder.Connect(operator_active, visualizer.get_operator_active_input_port())
+        builder.Connect(ee_state, visualizer.get_ee_state_input_port())
+        builder.Connect(controller.GetOutputPort("predicted_paths"),
+                        visualizer.get_predicted_paths_input_port())
+
+    diagram = builder.Build()
+    diagram.set_name(scenario.name)
+    return diagram

@@ -1,0 +1,68 @@
+"""The operator system a scenario asks for: scripted or virtual in the 2-D scenes; a person
+at the keyboard or gamepad, or the virtual participant, on the HSR."""
+
+import numpy as np
+
+from pbp_drake.scenarios import (
+    Gamepad, Keyboard, NoOperator as NoOperatorConfig, ObstacleRepulsion, ScriptedCommands,
+    SinusoidalStep, VirtualParticipant as VirtualParticipantConfig)
+from pbp_drake.systems import (
+    GamepadOperator, KeyboardOperator, NoOperator, ObstacleRepulsionOperator, ScriptedOperator,
+    VirtualParticipant)
+from pbp_drake.systems.layouts import OperatorCommand
+
+
+def make_operator(scenario, dimension):
+    """The operator of a 2-D scene (none at all for PBP-NoUser)."""
+    config = scenario.operator
+    period = scenario.control_period
+    if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
+        return NoOperator(dimension, period)
+    if isinstance(config, ObstacleRepulsion):
+        return ObstacleRepulsionOperator(
+            [o.center for o in scenario.obstacles], [o.radius for o in scenario.obstacles],
+            dimension, period, config)
+    if isinstance(config, SinusoidalStep):
+        times, commands = sinusoidal_step_commands(config, period, scenario.duration)
+        return ScriptedOperator(times, commands, period)
+    if isinstance(config, ScriptedCommands):
+        return ScriptedOperator(config.times, config.commands, period)
+    raise TypeError(f"unknown operator config {type(config).__name__}")
+
+
+def sinusoidal_step_commands(config, control_period, duration):
+    """Samples a SinusoidalStep at the control ticks: times `(T,)`, commands `(T, D)`."""
+    times = np.arange(0.0, duration + control_period / 2, control_period)
+    elapsed = times - config.start_time
+    on = (elapsed >= -1e-12) & (elapsed < config.duration - 1e-12)
+    magnitude = np.where(on, config.amplitude * np.sin(2 * np.pi * elapsed / config.period), 0.0)
+    axis = np.asarray(config.axis, float)
+    return times, np.outer(magnitude, axis / np.linalg.norm(axis))
+
+
+def make_hsr_operator(resolved, meshcat):
+    """The HSR task's operator: a person at the keyboard or gamepad (they need `meshcat`),
+    or the virtual participant (which watches the task's obstacles, if any)."""
+    scenario = resolved.scenario
+    config = scenario.operator
+    period = scenario.control_period
+    allow_forward = scenario.method == "teleop"
+    speed = resolved.nominal_speed
+    if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
+        return NoOperator(OperatorCommand.size, period)
+    if isinstance(config, VirtualParticipantConfig):
+        obstacles = resolved.station.obstacles
+        return VirtualParticipant(
+            period, resolved.layout.objects, mode="drive" if allow_forward else "assist",
+            params=config, nominal_speed=speed, seed=scenario.seed,
+            obstacle_count=len(obstacles),
+            obstacle_radius=obstacles[0].radius if obstacles else 0.0,
+            policy_adds=scenario.method == "pbp_continuous")
+    if meshcat is None:
+        raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "
+                         "Meshcat (pbp-drake run without --headless)")
+    if isinstance(config, Keyboard):
+        return KeyboardOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
+    if isinstance(config, Gamepad):
+        return GamepadOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
+    raise TypeError(f"unknown operator config {type(config).__name__}")

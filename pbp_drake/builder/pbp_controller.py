@@ -1,0 +1,103 @@
+"""The PBP controller of the HSR tasks as one Diagram: goals, goal estimator, DMP bank,
+blender and the heading, between the hand's sampled state and the station's command.
+
+    ee_state (sampled) ──> ee_state_split ──[p, v]──> dmp_bank, blender
+                       └─> goal_estimator ──> blender (selected_goal, goal_probabilities)
+    goals ──> dmp_bank, goal_estimator
+    operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
+                                            └─> heading_command
+    operator_active ──> dmp_bank (PBP-Alt's phase lock), blender
+    blender.command [p, v] + heading_command.heading ──> ee_command (the station's input)
+
+A user with a station of their own (`pbp_drake.robots.make_hsr_station`) wires it as the
+builder does: `station.ee_state` through a `SampleHold` into `ee_state`, the operator's
+outputs into `operator_command` and `operator_active`, and `ee_command` back into the
+station.
+"""
+
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import Multiplexer
+
+from pbp_drake.systems import Blender, DmpBank, GoalEstimator, GoalsSource, HeadingCommand
+from pbp_drake.systems.layouts import EeState, OperatorCommand
+from pbp_drake.systems.vector_split import VectorSplit
+
+# How far ahead the HSR scene draws the DMPs' paths, in samples over the DMP's duration.
+HSR_PREDICTION_SAMPLES = 40
+
+
+def make_pbp_controller(resolved, prediction_steps=0):
+    """The PBP controller of a resolved HSR scenario, a Diagram named `pbp_controller`.
+
+    .. pydrake_system::
+
+        name: pbp_controller
+        input_ports:
+        - ee_state
+        - operator_command
+        - operator_active
+        output_ports:
+        - ee_command
+        - selected_goal
+        - goal_probabilities
+        - phase
+        - predicted_paths (with prediction_steps > 0)
+
+    `prediction_steps` > 0 adds `predicted_paths` (each DMP's path over its duration in
+    that many samples, for drawing).
+    """
+    scenario = resolved.scenario
+    period = scenario.control_period
+    goals = resolved.goals
+    goal_count = len(goals)
+    bank = resolved.dmp_bank
+    builder = DiagramBuilder()
+
+    split = builder.AddNamedSystem("ee_state_split", VectorSplit([6, EeState.size - 6]))
+    builder.ExportInput(split.get_input_port(), "ee_state")
+    position_velocity = split.get_output_port(0)
+    goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
+
+    estimator = builder.AddNamedSystem("goal_estimator", GoalEstimator(
+        goal_count, scenario.goal_estimator, period))
+    builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
+    builder.Connect(goals_source.get_output_port(), estimator.get_goals_input_port())
+
+    dmp_bank = builder.AddNamedSystem("dmp_bank", DmpBank(
+        bank, period, lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
+        prediction_steps=prediction_steps,
+        prediction_period=bank.duration / max(prediction_steps, 1)))
+    builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
+    builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
+    builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
+
+    command_split = builder.AddNamedSystem("operator_command_split", VectorSplit(
+        [3, OperatorCommand.size - 3]))
+    builder.ExportInput(command_split.get_input_port(), "operator_command")
+    heading = builder.AddNamedSystem("heading_command", HeadingCommand(
+        EeState(resolved.initial_ee_state).heading, period))
+    builder.ConnectInput("operator_command", heading.get_operator_command_input_port())
+
+    blender = builder.AddNamedSystem("blender", Blender(
+        resolved.blend_mode, 3, goal_count, period, scenario.alpha))
+    builder.Connect(position_velocity, blender.get_robot_state_input_port())
+    builder.Connect(dmp_bank.get_references_output_port(), blender.get_references_input_port())
+    builder.Connect(estimator.get_selected_goal_output_port(),
+                    blender.get_selected_goal_input_port())
+    builder.Connect(estimator.get_goal_probabilities_output_port(),
+                    blender.get_goal_probabilities_input_port())
+    builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
+    builder.ConnectInput("operator_active", blender.get_operator_active_input_port())
+
+    ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
+    builder.Connect(blender.get_command_output_port(), ee_command.get_input_port(0))
+    builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
+    builder.ExportOutput(ee_command.get_output_port(), "ee_command")
+    builder.ExportOutput(estimator.get_selected_goal_output_port(), "selected_goal")
+    builder.ExportOutput(estimator.get_goal_probabilities_output_port(), "goal_probabilities")
+    builder.ExportOutput(dmp_bank.get_phase_output_port(), "phase")
+    if prediction_steps:
+        builder.ExportOutput(dmp_bank.get_predicted_paths_output_port(), "predicted_paths")
+    diagram = builder.Build()
+    diagram.set_name("pbp_controller")
+    return diagram

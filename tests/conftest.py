@@ -4,8 +4,8 @@ import sys
 import pytest
 from pydrake.geometry import Meshcat, MeshcatParams
 
-# Test helpers (the plain NumPy loop) live beside the tests.
-sys.path.insert(0, str(pathlib.Path(__file__).parent))
+# The plain NumPy loop (the diagram's oracle) lives beside the builder tests.
+sys.path.insert(0, str(pathlib.Path(__file__).parent / "builder"))
 
 
 @pytest.fixture(scope="session")

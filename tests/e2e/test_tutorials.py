@@ -17,7 +17,10 @@ else:
     nbclient = pytest.importorskip("nbclient")
     pytest.importorskip("ipykernel")
 
-TUTORIALS = pathlib.Path(__file__).resolve().parents[1] / "tutorials"
+# Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
+
+TUTORIALS = pathlib.Path(__file__).resolve().parents[2] / "tutorials"
 NOTEBOOKS = sorted(TUTORIALS.glob("*.ipynb"))
 EXPECTED = ["01_dmp_basics", "02_policy_blending_2d", "03_hsr_multi_goal",
             "04_build_your_own_diagram", "05_run_a_study", "06_hsr_station"]
@@ -26,6 +29,7 @@ EXPECTED = ["01_dmp_basics", "02_policy_blending_2d", "03_hsr_multi_goal",
 STRICT_WARNINGS = """\
 import warnings
 from pydrake.common.deprecation import DrakeDeprecationWarning
+
 warnings.simplefilter("error", DrakeDeprecationWarning)
 """
 

@@ -1,7 +1,6 @@
 """The built wheel carries the robot models: the HSR loads from an install outside the
 checkout, and the wheel installed into a new venv runs the HSR task from another folder."""
 
-import ast
 import os
 import pathlib
 import subprocess
@@ -10,6 +9,9 @@ import sysconfig
 import textwrap
 
 import pytest
+
+# Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
 
 LOAD_THE_HSR = textwrap.dedent("""
     import pathlib
@@ -152,27 +154,3 @@ def test_the_bench_runs_as_a_module_and_as_a_command():
     assert by_module.returncode == by_command.returncode == 0, by_module.stderr
     assert by_module.stdout == by_command.stdout
     assert "usage: pbp-drake bench" in by_module.stdout
-
-
-# Imports a module may defer into a function: heavy optional packages, on purpose.
-DEFERRED_IMPORTS = {"ray", "pydmps", "movement_primitives.dmp", "threadpoolctl"}
-
-
-@pytest.mark.parametrize("package", ["studies", "bench"])
-def test_study_and_bench_modules_are_short_and_import_at_the_top(package):
-    import pbp_drake
-
-    folder = pathlib.Path(pbp_drake.__file__).parent / package
-    paths = sorted(folder.glob("*.py"))
-    assert paths, f"{folder} has no modules"
-    for path in paths:
-        text = path.read_text()
-        assert len(text.splitlines()) <= 450, f"{path.name} is over 450 lines"
-        tree = ast.parse(text)
-        top = set(map(id, tree.body))
-        for node in ast.walk(tree):
-            if isinstance(node, (ast.Import, ast.ImportFrom)) and id(node) not in top:
-                modules = ([node.module] if isinstance(node, ast.ImportFrom)
-                           else [alias.name for alias in node.names])
-                assert set(modules) <= DEFERRED_IMPORTS, (
-                    f"{path.name}:{node.lineno} imports {modules} inside a function")

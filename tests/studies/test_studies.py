@@ -10,10 +10,13 @@ import pytest
 
 from pbp_drake.cli import main
 
+# Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def alpha_study(tmp_path_factory):
-    repo = __import__("pathlib").Path(__file__).resolve().parents[1]
+    repo = __import__("pathlib").Path(__file__).resolve().parents[2]
     output = tmp_path_factory.mktemp("alpha_study")
     assert main(["study", str(repo / "diagrams/toy_alpha_study.yaml"), "--output",
                  str(output)]) == 0

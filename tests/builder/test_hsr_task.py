@@ -18,6 +18,9 @@ from pbp_drake.systems.layouts import TaskStatus
 from pbp_drake.systems.keyboard_operator import LEFT_BUTTON
 from pbp_drake.builder.run import run_task
 
+# Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
+
 # Two objects ahead, left and right; the target starts on the right, switches to the left
 # at 30 % and back at 60 %: both switches need the operator.
 FIXED_TASK = """

@@ -27,6 +27,9 @@ from pbp_drake.studies.trial_files import (
 from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
 from pbp_drake.builder.run import TaskResult, run_task
 
+# Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
+
 # Two objects drawn from each seed; 30 s is enough for every method in these scenes.
 TASK = """
 scenario:

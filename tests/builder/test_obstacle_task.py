@@ -10,6 +10,9 @@ from pbp_drake.core.obstacle_task import sample_obstacle_scene, step_obstacles
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
 from pbp_drake.builder.run import run_task
 
+# Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
+
 
 def test_an_obstacle_waits_for_its_threshold_then_heads_for_the_midpoint():
     positions, intercepts, active = np.array([[1.0, 1.0]]), np.array([[1.0, 1.0]]), [False]

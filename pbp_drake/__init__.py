@@ -1,7 +1,8 @@
 """pbp_drake: Policy Blending with Primitives (PBP) for shared control, on Drake.
 
 The math lives in `pbp_drake.core` (NumPy only); the Drake systems in `pbp_drake.systems`;
-`pbp_drake.builder.build_diagram` turns a scenario file into a Diagram. The names below
+`pbp_drake.scenarios.resolve` derives everything from a scenario once, and
+`pbp_drake.builder.build_diagram` turns it into a Diagram. The names below
 can be imported from `pbp_drake` directly; each is loaded on first use, so that
 `import pbp_drake` stays cheap and the NumPy core never pulls in Drake.
 """
@@ -18,7 +19,11 @@ _PUBLIC = {
     "GoalEstimatorSettings": "pbp_drake.core.goal_estimation",
     # Scenarios, diagrams, runs and studies.
     "load_scenario_file": "pbp_drake.scenarios",
+    "resolve": "pbp_drake.scenarios",
+    "ResolvedScenario": "pbp_drake.scenarios",
     "build_diagram": "pbp_drake.builder",
+    "find_system": "pbp_drake.builder",
+    "make_pbp_controller": "pbp_drake.builder",
     "simulate": "pbp_drake.builder",
     "run_task": "pbp_drake.builder",
     "run_method_comparison": "pbp_drake.studies.comparison",
@@ -27,6 +32,7 @@ _PUBLIC = {
     "make_hsr_station": "pbp_drake.robots.hsr_station",
     "HsrStationConfig": "pbp_drake.robots.hsr_station",
     "hsr_initial_ee_state": "pbp_drake.robots.hsr_station",
+    "hsr_ready_ee_state": "pbp_drake.robots.hsr_station",
     # Drake systems.
     "Blender": "pbp_drake.systems",
     "DmpBank": "pbp_drake.systems",

@@ -55,8 +55,8 @@ class TaskMonitor(LeafSystem):
     a later `AdvanceTo` stops again one control period on.
 
     `target` is `Target` (`[position (3), object index]`); `task_status` is `TaskStatus`
-    (`[progress, stage (number of switches so far), success (0/1), task time (s, frozen at
-    success), intervention ratio (steps with operator input / steps of the task), steps,
+    (`[progress, stage (number of switches so far), success (0/1), task time (s, the time
+    of the last tick counted: at success, the tick that reached the target), intervention ratio (steps with operator input / steps of the task), steps,
     collision ratio (steps with `in_collision` / steps; 0 when unconnected)]`).
 
     The counts are integers (`TaskCounts`) in abstract state, the progress and task time a
@@ -77,6 +77,7 @@ class TaskMonitor(LeafSystem):
         period = float(control_period)
         if update_offset is None:
             update_offset = decide_offset(period)
+        self._update_offset = float(update_offset)
         end_offset = report_offset(period, update_offset)
         if not 0.0 <= update_offset < end_offset < period:
             raise ValueError(f"update_offset must be in [0, control_period), got "
@@ -160,8 +161,9 @@ class TaskMonitor(LeafSystem):
             acted_steps=counts.acted_steps + int(acting),
             colliding_steps=counts.colliding_steps + int(colliding),
             success=bool(np.linalg.norm(here - target) <= self._success_distance)))
+        # The task time is the tick's: the update runs a fraction of a period after it.
         state.get_mutable_discrete_state(self._measures_index).set_value(
-            [progress, context.get_time()])
+            [progress, context.get_time() - self._update_offset])
         return EventStatus.Succeeded()
 
     def _end_at_success(self, context):

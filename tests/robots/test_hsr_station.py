@@ -16,7 +16,8 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Tr
 from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.robots import (
-    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, make_hsr_station)
+    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, hsr_ready_ee_state,
+    make_hsr_station)
 from pbp_drake.robots.hsr_model import (
     BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
 from pbp_drake.systems.layouts import EeCommand, EeState
@@ -292,3 +293,10 @@ def test_meshcat_draws_the_robot_and_the_obstacles():
     assert meshcat.HasPath("/drake/visualizer/hsrb")
     assert meshcat.HasPath("/drake/visualizer/obstacle_0")
     assert meshcat.HasPath("/drake/visualizer/obstacle_1")
+
+
+@pytest.mark.parametrize("height, base", [(0.7, [0.0, 0.0, 0.0]), (0.9, [0.4, -0.3, 0.6])])
+def test_the_ready_state_from_the_model_alone_is_where_the_station_starts(height, base):
+    config = HsrStationConfig(ee_height=height, initial_base=base)
+    np.testing.assert_allclose(hsr_ready_ee_state(config),
+                               hsr_initial_ee_state(make_hsr_station(config)), atol=1e-12)

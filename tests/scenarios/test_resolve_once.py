@@ -11,6 +11,7 @@ import pbp_drake.core.dmp.single as single_dmp_module
 import pbp_drake.scenarios.resolution as resolve_module
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import BentPath, load_scenario_file
+from pbp_drake.studies.runners import compute_trial
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
 # Where each piece of work is done, by the name the caller looks it up under.
@@ -48,3 +49,21 @@ def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     assert work["fit_weights"] == 1
     scenes = work["sample_reach_scene"] + work["sample_obstacle_scene"]
     assert scenes == (1 if scenario.task is not None else 0)
+
+
+def build_then_stop(resolved):
+    """A trial's run that builds the task's diagram as `run_task` does, then stops."""
+    build_diagram(resolved)
+    raise RuntimeError("built")
+
+
+@pytest.mark.parametrize("name", ["hsr_reach", "hsr_obstacles"])
+def test_one_study_trial_resolves_once(name, work):
+    loaded = load_scenario_file(SHIPPED[0].parent / f"{name}.yaml")
+    work.clear()
+    record, _ = compute_trial(loaded.scenario, "pbp_alternated", 0, 7, "digest",
+                              run=build_then_stop)
+    assert record["error"] == "RuntimeError: built"
+    assert record["objects"]  # the scene the trial ran is recorded from the same draw
+    assert work["fit_weights"] == 1
+    assert work["sample_reach_scene"] + work["sample_obstacle_scene"] == 1

@@ -86,7 +86,7 @@ def test_success_stops_a_plain_simulator_with_the_task_time_of_the_success_tick(
         SUCCESS_TIME + report_offset(PERIOD), abs=1e-9)
     target, status = read(monitor, simulator)
     assert status.success == 1.0 and status.stage == 1 and target.index == 1
-    assert status.task_time == pytest.approx(SUCCESS_TIME + decide_offset(PERIOD), abs=1e-9)
+    assert status.task_time == pytest.approx(SUCCESS_TIME, abs=1e-9)
     assert status.steps == STEPS
     assert monitor.counts(monitor.GetMyContextFromRoot(simulator.get_context())).steps == STEPS
 

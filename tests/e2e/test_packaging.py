@@ -2,7 +2,6 @@
 checkout, and the wheel installed into a new venv runs the HSR task from another folder."""
 
 import os
-import pathlib
 import subprocess
 import sys
 import sysconfig

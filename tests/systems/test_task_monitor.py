@@ -14,7 +14,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.systems.layouts import EeState, Target, TaskStatus
 from pbp_drake.systems.task_monitor import SUCCESS_MESSAGE, TaskMonitor
-from pbp_drake.systems.tick import decide_offset, report_offset
+from pbp_drake.systems.tick import report_offset
 
 PERIOD = 0.1
 SPEED = 0.1

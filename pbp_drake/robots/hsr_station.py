@@ -27,7 +27,8 @@ import dataclasses
 
 import numpy as np
 from pydrake.geometry import (
-    CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Role)
+    CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Rgba,
+    Role)
 from pydrake.math import RotationMatrix
 from pydrake.multibody.inverse_kinematics import (
     DifferentialInverseKinematicsIntegrator,
@@ -37,6 +38,7 @@ from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant, Multibody
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import MatrixGain, StateInterpolatorWithDiscreteDerivative
+from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.robots.hsr_ee_systems import EeCommandToPose, EeStateFromPlant, heading_of
 from pbp_drake.robots.hsr_model import (
@@ -71,6 +73,13 @@ class CylinderObstacle:
 def _default_plant_config():
     # SAP enforces the torso's coupler constraint and applies the motors' PD implicitly.
     return MultibodyPlantConfig(time_step=0.005, discrete_contact_approximation="sap")
+
+
+def _default_visualization():
+    # Meshcat only: the proximity shapes, contact forces and inertias are off by default
+    # (each is a publisher at every frame).
+    return VisualizationConfig(publish_proximity=False, publish_contacts=False,
+                               publish_inertia=False)
 
 
 @dataclasses.dataclass
@@ -110,6 +119,10 @@ class HsrStationConfig:
     # Cylinders measured against the robot (not felt by it); with any, the station has
     # the input obstacle_positions and the outputs in_collision and clearance.
     obstacles: list[CylinderObstacle] = dataclasses.field(default_factory=list)
+    # What the station shows in Meshcat when it is given one (Drake's config; its
+    # illustration and proximity settings are used, its LCM and contact parts are not).
+    visualization: VisualizationConfig = dataclasses.field(
+        default_factory=_default_visualization)
 
 
 def validate_hsr_station_config(config: HsrStationConfig) -> None:
@@ -307,8 +320,7 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     if config.obstacles:
         _add_obstacles(builder, plant, scene_graph, model, config.obstacles)
     if meshcat is not None:
-        MeshcatVisualizer.AddToBuilder(
-            builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration))
+        _add_meshcat_visualizers(builder, scene_graph, meshcat, config.visualization)
     station = builder.Build()
     station.set_name("hsr_station")
     return station
@@ -337,6 +349,26 @@ def _add_obstacles(builder, plant, scene_graph, model, obstacles):
     builder.ExportInput(geometry.get_obstacle_positions_input_port(), "obstacle_positions")
     builder.ExportOutput(collisions.get_in_collision_output_port(), "in_collision")
     builder.ExportOutput(collisions.get_clearance_output_port(), "clearance")
+
+
+def _add_meshcat_visualizers(builder, scene_graph, meshcat, visualization):
+    """What `visualization` asks of Meshcat (Drake's `VisualizationConfig`, read here
+    without its LCM side): the illustration geometry, and the proximity geometry (hidden
+    at first) when `publish_proximity`."""
+    if visualization.publish_illustration:
+        MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(
+            role=Role.kIllustration, publish_period=visualization.publish_period,
+            default_color=visualization.default_illustration_color,
+            delete_on_initialization_event=visualization.delete_on_initialization_event,
+            enable_alpha_slider=visualization.enable_alpha_sliders))
+    if visualization.publish_proximity:
+        color = visualization.default_proximity_color
+        MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(
+            role=Role.kProximity, prefix="proximity", visible_by_default=False,
+            publish_period=visualization.publish_period,
+            default_color=Rgba(color.r(), color.g(), color.b(),
+                               visualization.initial_proximity_alpha),
+            delete_on_initialization_event=visualization.delete_on_initialization_event))
 
 
 def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:

@@ -10,7 +10,8 @@ parameter dataclass (``goal_estimator`` is `GoalEstimatorSettings`, ``dmp`` is
 `HsrStationConfig`), so a Python user constructing the system and a YAML user get the same
 robot. The tag classes below (`Keyboard`, `PointRobot`, ...) only name the variants; they
 add no field and no default. Drake's own config structs are nested where they exist
-(`SimulatorConfig`). `pbp_drake.scenarios.resolve` checks and derives everything else.
+(`SimulatorConfig` here; `MultibodyPlantConfig` and `VisualizationConfig` in the HSR's
+station). `pbp_drake.scenarios.resolve` checks and derives everything else.
 """
 
 import copyreg
@@ -20,6 +21,7 @@ import typing
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
+from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
@@ -40,7 +42,7 @@ def _reduce_config(config):
 
 # Drake's config structs do not pickle, and a study sends its scenario to worker processes:
 # they travel as their YAML.
-for _config_type in (MultibodyPlantConfig, SimulatorConfig):
+for _config_type in (MultibodyPlantConfig, SimulatorConfig, VisualizationConfig):
     copyreg.pickle(_config_type, _reduce_config)
 
 

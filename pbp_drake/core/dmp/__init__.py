@@ -20,7 +20,7 @@ cost of one 2x2 matrix shared by every goal and dimension.
 
 PBP re-integrates the DMP every control step from the robot's measured position. The DMP
 keeps its own velocity state: resetting it to the robot's measured velocity each step stalls
-the DMP behind a lagging tracker (see DMP_NOTES.md). Only while the phase is locked (the
+the DMP behind a lagging tracker (the re-integration trap). Only while the phase is locked (the
 operator is driving, PBP-Alt) does the DMP's velocity follow the robot's, so that it resumes
 from the robot's actual state when the operator lets go.
 

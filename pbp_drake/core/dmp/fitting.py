@@ -1,7 +1,7 @@
 """Demonstrations and learning: the minimum-jerk reach, input checks, and the one-demo fit.
 
-The fit is locally weighted regression per basis function on ONE demonstration (see
-DMP_NOTES.md): `w_i = sum_t s_t psi_i(x_t) f_t / sum_t s_t^2 psi_i(x_t)`, written here in
+The fit is locally weighted regression per basis function on ONE demonstration (Ijspeert
+et al. 2013): `w_i = sum_t s_t psi_i(x_t) f_t / sum_t s_t^2 psi_i(x_t)`, written here in
 attractor form (`tau dz = K (y_attr - y) - D z`, solved for `y_attr` along the demo).
 """
 

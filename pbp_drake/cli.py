@@ -10,19 +10,17 @@ import numpy as np
 from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
 from pbp_drake.bench.run import main as bench_main
-from pbp_drake.builder import build_diagram
+from pbp_drake.builder import build_diagram, run_task, simulate
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.draw import main as draw_main
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, MethodComparison, ScenarioError,
     check_method_comparison, load_scenario_file, resolve, with_method)
-from pbp_drake.builder.run import simulate
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.progress import ProgressBar
 from pbp_drake.studies.report import FIGURES, report, results_table
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
 from pbp_drake.studies.toy import run_study
-from pbp_drake.builder.run import run_task
 
 
 def main(argv=None):

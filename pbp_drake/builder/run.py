@@ -39,18 +39,31 @@ class Trajectory:
     phase: np.ndarray | None
 
 
-def simulate(scenario, meshcat=None, realtime_rate=None, diagram=None):
-    """Simulates `scenario` for its duration and returns its Trajectory."""
+def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=None):
+    """`(scenario, diagram, simulator)` of a scenario (resolved once if it is not): the
+    diagram built unless given, the simulator configured by the scenario's
+    `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
-    scenario = resolved.scenario
     diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
     simulator = Simulator(diagram)
-    ApplySimulatorConfig(scenario.simulator, simulator)
+    ApplySimulatorConfig(resolved.scenario.simulator, simulator)
     if realtime_rate is not None:
         simulator.set_target_realtime_rate(realtime_rate)
     simulator.Initialize()
-    # One tick past the end: the loggers record tick k's decisions at t_(k+1) (see below).
-    ticks = int(round(scenario.duration / scenario.control_period))
+    return resolved.scenario, diagram, simulator
+
+
+def ticks_of(scenario):
+    """How many control ticks the scenario's time limit holds."""
+    return int(round(scenario.duration / scenario.control_period))
+
+
+def simulate(scenario, meshcat=None, realtime_rate=None, diagram=None):
+    """Simulates `scenario` for its duration and returns its Trajectory."""
+    scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
+                                                         diagram)
+    # One tick past the end: the loggers record tick k's decisions one sample later.
+    ticks = ticks_of(scenario)
     simulator.AdvanceTo((ticks + 1) * scenario.control_period)
     return read_trajectory(diagram, simulator.get_context(), ticks + 1)
 
@@ -133,20 +146,12 @@ class TaskResult:
 
 def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None):
     """Simulates an HSR task until success or `scenario.duration` (the time limit)."""
-    resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
-    scenario = resolved.scenario
-    diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
+    scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
+                                                         diagram)
     monitor = diagram.GetSubsystemByName("task_monitor")
     status_port = monitor.get_task_status_output_port()
-    simulator = Simulator(diagram)
-    ApplySimulatorConfig(scenario.simulator, simulator)
-    if realtime_rate is not None:
-        simulator.set_target_realtime_rate(realtime_rate)
     # The task monitor itself ends the simulation at success.
-    simulator.Initialize()
-    period = scenario.control_period
-    ticks = int(round(scenario.duration / period))
-    simulator.AdvanceTo((ticks + 1) * period)
+    simulator.AdvanceTo((ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()
     status = TaskStatus(status_port.Eval(monitor.GetMyContextFromRoot(context)))
     return _read_result(diagram, context, status, monitor)

@@ -5,11 +5,12 @@ import dataclasses
 
 import numpy as np
 import pytest
-from pydrake.common.yaml import yaml_load_typed
+from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
 from pbp_drake.builder import build_diagram, find_system
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.robots import HsrStationConfig
 from pbp_drake.scenarios import Scenario, resolve
 from pbp_drake.systems import (
     GamepadOperator, GoalEstimator, KeyboardOperator, ObstacleRepulsionOperator, PointRobot,
@@ -69,3 +70,11 @@ def test_changed_yaml_value_reaches_the_system():
                        "goal_estimator: {temperature: 0.3}\n")
     assert diagram.GetSubsystemByName("operator").params.rotation_speed == 0.5
     assert find_system(diagram, "goal_estimator").settings.temperature == 0.3
+
+
+def test_hsr_station_defaults_match():
+    _, resolved = built(HSR)
+    # The task sets the hand's start height, the loop's period and the obstacles.
+    derived = {"ee_height": 0.7, "command_period": PERIOD, "obstacles": []}
+    in_python = dataclasses.replace(HsrStationConfig(), **derived)
+    assert yaml_dump_typed(resolved.station) == yaml_dump_typed(in_python)

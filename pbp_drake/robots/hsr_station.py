@@ -52,6 +52,7 @@ from pbp_drake.robots.hsr_model import (
     add_hsr,
 )
 from pbp_drake.systems.collision_monitor import CollisionMonitor
+from pbp_drake.systems.layouts import EeState
 from pbp_drake.systems.obstacle_geometry import CylinderObstacleGeometry
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
@@ -190,6 +191,14 @@ def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
     return plant.GetPositions(context)
 
 
+def _ready_pose(plant, model, config):
+    """The ready positions of `config` (see `ready_positions`) and the hand's pose there."""
+    q0 = ready_positions(plant, model, config.initial_base, config.ee_height)
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q0)
+    return q0, plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(context)
+
+
 def _make_diff_ik(plant, model, q0, config):
     ee = plant.GetFrameByName(END_EFFECTOR_FRAME, model)
     nq = plant.num_positions()
@@ -262,10 +271,8 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
             PdControllerGains(p=kp, d=kd))
     plant.Finalize()
 
-    q0 = ready_positions(plant, model, config.initial_base, config.ee_height)
+    q0, X_WE0 = _ready_pose(plant, model, config)
     plant.SetDefaultPositions(q0)
-    X_WE0 = plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(
-        plant.CreateDefaultContext())
     # R_E0 is the hand's orientation at heading 0, whatever the initial base yaw.
     R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
 
@@ -379,11 +386,11 @@ def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:
     plant = MultibodyPlant(config.plant.time_step)
     model = add_hsr(plant)
     plant.Finalize()
-    context = plant.CreateDefaultContext()
-    plant.SetPositions(context, ready_positions(plant, model, config.initial_base,
-                                                config.ee_height))
-    X_WE = plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(context)
-    return np.concatenate([X_WE.translation(), np.zeros(3), [heading_of(X_WE.rotation()), 0.0]])
+    _, X_WE = _ready_pose(plant, model, config)
+    state = EeState(np.zeros(EeState.size))  # at rest
+    state.x, state.y, state.z = X_WE.translation()
+    state.heading = heading_of(X_WE.rotation())
+    return state[:]
 
 
 def hsr_initial_ee_state(station: Diagram) -> np.ndarray:

@@ -52,7 +52,6 @@ class ResolvedScenario:
 
     Attributes:
         scenario: the configs it was resolved from.
-        blend_mode: the blender's mode for `scenario.method`.
         start: (D,) where the robot (2-D scenes) or the hand (HSR) starts.
         goals: (K, D) the goals, one DMP each.
         demonstration: (times (T,), positions (T, D)) or None.
@@ -65,7 +64,6 @@ class ResolvedScenario:
     """
 
     scenario: Scenario
-    blend_mode: str
     start: np.ndarray
     goals: np.ndarray
     demonstration: typing.Optional[tuple]
@@ -76,6 +74,11 @@ class ResolvedScenario:
     nominal_speed: typing.Optional[float] = None
 
     @property
+    def blend_mode(self):
+        """The blender's mode for `scenario.method`."""
+        return BLEND_MODE_OF_METHOD[self.scenario.method]
+
+    @property
     def is_hsr(self):
         return self.layout is not None
 
@@ -84,8 +87,7 @@ class ResolvedScenario:
         depend on the method (the DMPs, the scene) is kept, not derived again."""
         scenario = with_method(self.scenario, label)
         _check_method(scenario, self.goals.shape[0])
-        return dataclasses.replace(self, scenario=scenario,
-                                   blend_mode=BLEND_MODE_OF_METHOD[scenario.method])
+        return dataclasses.replace(self, scenario=scenario)
 
 
 def resolve(scenario):
@@ -228,8 +230,8 @@ def _resolve_point_robot(scenario):
         bank = DmpBank.from_demonstration(*demonstration, goals.shape[0], scenario.dmp,
                                           start, duration)
     return ResolvedScenario(
-        scenario=scenario, blend_mode=BLEND_MODE_OF_METHOD[scenario.method], start=start,
-        goals=goals, demonstration=demonstration, dmp_bank=bank)
+        scenario=scenario, start=start, goals=goals, demonstration=demonstration,
+        dmp_bank=bank)
 
 
 def _check_toy_operator(operator, dimension):
@@ -305,8 +307,8 @@ def _resolve_hsr(scenario):
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
     bank = DmpBank.straight(start, len(goals), duration, scenario.dmp)
     return ResolvedScenario(
-        scenario=scenario, blend_mode=BLEND_MODE_OF_METHOD[scenario.method], start=start,
-        goals=goals, demonstration=None, dmp_bank=bank, layout=layout, station=station,
+        scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=bank,
+        layout=layout, station=station,
         initial_ee_state=initial_ee_state, nominal_speed=float(robot.speed))
 
 

@@ -57,10 +57,16 @@ def plain(value):
     return value
 
 
+def scenario_content(scenario):
+    """Everything in the scenario but its method and seed (a study sets those per trial),
+    as plain data."""
+    return plain(dataclasses.replace(scenario, method="", seed=0))
+
+
 def scenario_hash(scenario):
-    """A short hash of everything in the scenario but its method and seed (a study sets
-    those per trial): trials of different scenarios are never mixed in one folder."""
-    content = plain(dataclasses.replace(scenario, method="", seed=0))
+    """A short hash of `scenario_content`: trials of different scenarios are never mixed in
+    one folder."""
+    content = scenario_content(scenario)
     text = json.dumps(content, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -153,7 +159,7 @@ def write_study(output, scenario, digest, methods, trials, seed):
     """Writes the folder's study.json: which scenario, methods, trials and seeds."""
     study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
-             "scenario_content": plain(dataclasses.replace(scenario, method="", seed=0))}
+             "scenario_content": scenario_content(scenario)}
     write_atomically(output / "study.json", json.dumps(study, indent=2) + "\n")
 
 

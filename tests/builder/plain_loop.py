@@ -18,18 +18,17 @@ from pbp_drake.scenarios import (
 def plain_loop(scenario):
     """Returns the robot's positions (T, D) at the control ticks."""
     period = scenario.control_period
-    demonstration = (None if scenario.demonstration is None
-                     else demonstration_samples(scenario.demonstration)[1])
-    start = np.asarray(scenario.start or demonstration[0], float)
-    goals = np.asarray(scenario.goals or demonstration[-1:], float)
+    times, demo = (None, None) if scenario.demonstration is None else (
+        demonstration_samples(scenario.demonstration))
+    start = np.asarray(scenario.start or demo[0], float)
+    goals = np.asarray(scenario.goals or demo[-1:], float)
     robot = MassSpringDamper(scenario.robot.mass, scenario.robot.stiffness,
                              scenario.robot.damping, scenario.robot.time_step)
     plant_steps = int(round(period / scenario.robot.time_step))
     ticks = int(round(scenario.duration / period))
     mode = BLEND_MODE_OF_METHOD[scenario.method]
     settings = scenario.dmp
-    if scenario.demonstration is not None:
-        times, demo = demonstration_samples(scenario.demonstration)
+    if demo is not None:
         bank = DmpBank.from_demonstration(times, demo, len(goals), settings, start,
                                           scenario.dmp_duration or None)
     else:

@@ -2,12 +2,14 @@
 blender and the heading, between the hand's sampled state and the station's command.
 
     ee_state (sampled) ──> ee_state_split ──[p, v]──> dmp_bank, blender
-                       └─> goal_estimator ──> blender (selected_goal, goal_probabilities)
+                       └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
+                                              dmp_bank (followed_goal)
     goals ──> dmp_bank, goal_estimator
     operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
                                             └─> heading_command
     operator_active ──> dmp_bank (PBP-Alt's phase lock), blender
-    blender.command [p, v] + heading_command.heading ──> ee_command (the station's input)
+    blender.command [p, v] ──> hand_over (the hand-over law: bounded acceleration)
+    hand_over.command + heading_command.heading ──> ee_command (the station's input)
 
 A user with a station of their own (`pbp_drake.robots.make_hsr_station`) wires it as the
 builder does: `station.ee_state` through a `SampleHold` into `ee_state`, the operator's
@@ -18,7 +20,8 @@ station.
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import Multiplexer
 
-from pbp_drake.systems import Blender, DmpBank, GoalEstimator, GoalsSource, HeadingCommand
+from pbp_drake.systems import (
+    Blender, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand)
 from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.vector_split import VectorSplit
 
@@ -84,13 +87,21 @@ def make_pbp_controller(resolved, prediction_steps=0):
     builder.Connect(dmp_bank.get_references_output_port(), blender.get_references_input_port())
     builder.Connect(estimator.get_selected_goal_output_port(),
                     blender.get_selected_goal_input_port())
+    # Read at the decide stage before the estimator updates: the goal followed last tick.
+    builder.Connect(estimator.get_selected_goal_output_port(),
+                    dmp_bank.get_followed_goal_input_port())
     builder.Connect(estimator.get_goal_probabilities_output_port(),
                     blender.get_goal_probabilities_input_port())
     builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
     builder.ConnectInput("operator_active", blender.get_operator_active_input_port())
 
+    hand_over = builder.AddNamedSystem("hand_over", HandOver(
+        resolved.start, scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
+        period))
+    builder.Connect(blender.get_command_output_port(), hand_over.get_reference_input_port())
+
     ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
-    builder.Connect(blender.get_command_output_port(), ee_command.get_input_port(0))
+    builder.Connect(hand_over.get_command_output_port(), ee_command.get_input_port(0))
     builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
     builder.ExportOutput(ee_command.get_output_port(), "ee_command")
     builder.ExportOutput(estimator.get_selected_goal_output_port(), "selected_goal")

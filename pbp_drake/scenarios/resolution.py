@@ -16,6 +16,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core.dmp import DmpBank, validate_demonstration
+from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
 from pbp_drake.core.toy_scene import bent_path
@@ -276,6 +277,7 @@ def _resolve_hsr(scenario):
         raise ScenarioError("scenario.control_period must be a whole multiple of "
                             "scenario.robot.station.plant.time_step")
     operator = scenario.operator
+    _check_hand_over(scenario)
     for name in ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
                  "direction_noise", "speed_noise"):
         value = getattr(operator, name, 0.0)
@@ -310,6 +312,28 @@ def _resolve_hsr(scenario):
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=bank,
         layout=layout, station=station,
         initial_ee_state=initial_ee_state, nominal_speed=float(robot.speed))
+
+
+def _check_hand_over(scenario):
+    """The hand-over's limits must let the hand reach the task's speeds (the DMPs' and the
+    operator's) within the time limit."""
+    robot = scenario.robot
+    try:
+        acceleration = check_limit(robot.max_hand_acceleration,
+                                   "scenario.robot.max_hand_acceleration", "m/s^2")
+        top_speed = check_limit(robot.max_hand_speed, "scenario.robot.max_hand_speed", "m/s")
+    except ValueError as error:
+        raise ScenarioError(str(error)) from None
+    speed = max(robot.speed, getattr(scenario.operator, "speed", 0.0) or 0.0)
+    if speed > top_speed:
+        raise ScenarioError(
+            f"scenario.robot.max_hand_speed {top_speed} m/s is below the task's speed "
+            f"{speed} m/s (scenario.robot.speed or scenario.operator.speed): raise it")
+    if speed / acceleration > scenario.duration:
+        raise ScenarioError(
+            f"scenario.robot.max_hand_acceleration {acceleration} m/s^2 takes "
+            f"{speed / acceleration:.1f} s to reach the task's speed {speed} m/s, longer "
+            f"than scenario.duration {scenario.duration} s: raise it")
 
 
 def _check_reach_task(task):

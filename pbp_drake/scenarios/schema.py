@@ -75,6 +75,12 @@ class Hsr:
     # The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it,
     # and operators whose speed is 0 move the hand at it.
     speed: float = 0.12
+    # The hand-over law (`pbp_drake.core.hand_over`): a goal switch, the operator pressing
+    # or releasing changes the hand's commanded velocity by at most max_hand_acceleration
+    # (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command never exceeds
+    # max_hand_speed (m/s), however far a primitive is from its attractor.
+    max_hand_acceleration: float = 1.0
+    max_hand_speed: float = 0.25
 
 
 @dataclasses.dataclass

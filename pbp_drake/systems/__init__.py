@@ -17,6 +17,7 @@ from pbp_drake.systems.dmp_bank import DmpBank
 from pbp_drake.systems.gamepad_operator import GamepadOperator
 from pbp_drake.systems.goal_estimator import GoalEstimator
 from pbp_drake.systems.goals_source import GoalsSource
+from pbp_drake.systems.hand_over import HandOver
 from pbp_drake.systems.heading_command import HeadingCommand
 from pbp_drake.systems.keyboard_operator import KeyboardOperator
 from pbp_drake.systems.no_operator import NoOperator
@@ -30,7 +31,7 @@ from pbp_drake.systems.virtual_participant import VirtualParticipant
 
 __all__ = [
     "Blender", "DemonstrationPlayer", "DmpBank", "GamepadOperator", "GoalEstimator", "GoalsSource",
-    "HeadingCommand", "KeyboardOperator", "NoOperator", "ObstacleRepulsionOperator",
+    "HandOver", "HeadingCommand", "KeyboardOperator", "NoOperator", "ObstacleRepulsionOperator",
     "PointRobot", "ReachSceneVisualizer", "SampleHold", "ScriptedOperator", "TaskMonitor",
     "VirtualParticipant",
 ]

@@ -24,6 +24,7 @@ class DmpBank(LeafSystem):
         - robot_state
         - goals
         - operator_active (optional)
+        - followed_goal (optional)
         output_ports:
         - references
         - phase
@@ -34,6 +35,15 @@ class DmpBank(LeafSystem):
     (keeping each DMP's own velocity, see `pbp_drake.core.dmp`). With
     `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the phases
     and the DMPs follow the robot until the operator lets go.
+
+    `followed_goal` (optional) is the index of the goal whose reference the robot followed
+    since the last update (the goal estimator's selection, read before it updates). When it
+    is connected, each update first gives every DMP the followed DMP's velocity: all DMPs
+    then step from the robot's position AND the velocity it is being driven at, so the
+    selection may move to any of them without a jump of the commanded velocity (the
+    velocities then differ by the attractors' pull over one period only, which vanishes with
+    the period). Unconnected, each DMP keeps a velocity of its own, which relaxes toward its
+    own attractor while the robot follows another.
 
     `references` is the K next states `[positions (K*D), velocities (K*D)]`, `phase` the K
     phases; `predicted_paths` (declared when `prediction_steps > 0`) is each DMP's open-loop
@@ -77,6 +87,7 @@ class DmpBank(LeafSystem):
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._goals_port = self.DeclareVectorInputPort("goals", k * d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
         # Held at the start: the DMPs sit at their starts (p = 0, offset = -starts), at rest.
         initial = np.zeros(self.state_size(k, d))
         phase, held, _, _, offset = self._split(initial)
@@ -130,6 +141,20 @@ class DmpBank(LeafSystem):
 
     def get_operator_active_input_port(self):
         return self._operator_active_port
+
+    def get_followed_goal_input_port(self):
+        return self._followed_goal_port
+
+    def _followed_goal(self, context):
+        """The index of the goal whose reference the robot followed since the last update,
+        or None when `followed_goal` is unconnected."""
+        if not self._followed_goal_port.HasValue(context):
+            return None
+        followed = int(self._followed_goal_port.Eval(context)[0])
+        if not 0 <= followed < self._bank.goal_count:
+            raise ValueError(f"followed_goal {followed} is not one of the "
+                             f"{self._bank.goal_count} goals")
+        return followed
 
     def get_references_output_port(self):
         return self._references_port
@@ -185,11 +210,16 @@ class DmpBank(LeafSystem):
         lock = (self._lock and self._operator_active_port.HasValue(context)
                 and self._operator_active_port.Eval(context)[0] > 0.5)
         goals_dk = None if lock else self._goals_dk.Eval(context)
+        followed = self._followed_goal(context)
         workspace = self._workspace(context)
         # The velocities the last step left, read out in place (see the class docstring);
         # the offsets are rewritten below, so they serve as the scratch.
         if not held[0]:
             bank.stepped_velocity_into(offset, z, period, z, workspace, overwrite_offset=True)
+            if followed is not None:
+                # Every DMP continues from the velocity of the one the robot followed, so
+                # that a switch to another goal keeps the command's velocity.
+                z[...] = z[:, followed:followed + 1]
         robot[:, 0] = robot_state[:d]
         if lock:
             # Phases frozen: the DMPs stay at the robot's position and follow its velocity.

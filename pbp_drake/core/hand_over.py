@@ -1,0 +1,52 @@
+"""The hand-over law: how the command passes between the operator and the primitives.
+
+Whatever the blending law sends, the robot's command changes its velocity by at most
+`a_max dt` per control period `dt` and never exceeds the speed `v_max`. With `(p_k, v_k)` the
+blended reference of tick k and `v'_{k-1}` the velocity commanded at tick k - 1, the command
+of tick k is
+
+    v'_k = v'_{k-1} + clip(cap(v_k) - v'_{k-1}, a_max dt)
+    p'_k = p_k + (v'_k - v_k) dt
+
+with `clip(d, r) = d min(1, r / |d|)` and `cap(v) = clip(v, v_max)`. The velocity moves
+toward the (capped) reference along the straight line between them, no faster than `a_max`,
+and the position is the reference's shifted by the velocity not yet reached over one
+period. Both `v'_{k-1}` and `cap(v_k)` lie within the speed limit, so every point between
+them does. In steady motion below `v_max`, `v'_k = v_k` and the law is the blending law
+itself; it acts only where the reference jumps: a goal switch, the operator pressing
+(PBP-Alt hands the robot to the operator, explicit arbitration mixes the operator in) and
+releasing (the primitives take the robot back), and where a primitive far from its
+attractor would rush.
+"""
+
+import math
+
+import numpy as np
+
+
+def check_limit(value, name, unit):
+    """`value` as a float; raises ValueError naming `name` unless it is a finite positive
+    number."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise ValueError(f"{name} must be a number ({unit}), got {value!r}")
+    value = float(value)
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"{name} must be finite and positive ({unit}), got {value}")
+    return value
+
+
+def _clip(vector, largest):
+    """`vector` scaled down to length `largest` when it is longer (a new array)."""
+    size = float(np.linalg.norm(vector))
+    return vector * (largest / size) if size > largest else np.array(vector, dtype=float)
+
+
+def hand_over(previous_velocity, position, velocity, max_acceleration, max_speed, dt):
+    """The command `(position, velocity)` of one tick under the hand-over law (module
+    docstring), from the velocity commanded at the tick before and the blended reference
+    `(position, velocity)`. New arrays; the inputs are left alone."""
+    previous_velocity = np.asarray(previous_velocity, dtype=float)
+    velocity = np.asarray(velocity, dtype=float)
+    change = _clip(_clip(velocity, max_speed) - previous_velocity, max_acceleration * dt)
+    commanded = previous_velocity + change
+    return np.asarray(position, dtype=float) + (commanded - velocity) * dt, commanded

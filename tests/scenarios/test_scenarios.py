@@ -92,3 +92,29 @@ def test_a_method_label_can_carry_the_arbitration_weight():
                          ("fixed_alfa", "did you mean 'fixed_alpha'")]:
         with pytest.raises(ScenarioError, match=message):
             with_method(Scenario(), bad)
+
+
+HSR = """
+scenario:
+  method: pbp_alternated
+  duration: 60.0
+  robot: !Hsr {{{robot}}}
+  task: !MultiGoalReach {{}}
+  operator: !VirtualParticipant {{}}
+"""
+
+
+@pytest.mark.parametrize("robot, message", [
+    ("max_hand_acceleration: 0.0", "scenario.robot.max_hand_acceleration must be finite and "
+                                   "positive"),
+    ("max_hand_acceleration: -1.0", "scenario.robot.max_hand_acceleration must be finite"),
+    ("max_hand_acceleration: .inf", "scenario.robot.max_hand_acceleration must be finite"),
+    # 0.12 m/s at 0.001 m/s^2 takes 120 s, over the 60 s time limit.
+    ("max_hand_acceleration: 0.001", r"max_hand_acceleration 0.001 m/s\^2 takes 120.0 s"),
+    ("max_hand_speed: 0.0", "scenario.robot.max_hand_speed must be finite and positive"),
+    ("max_hand_speed: 0.1", "scenario.robot.max_hand_speed 0.1 m/s is below the task's "
+                            "speed 0.12"),
+])
+def test_hand_over_limits_that_cannot_work_are_refused(tmp_path, robot, message):
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(write(tmp_path, HSR.format(robot=robot)))

@@ -1,0 +1,156 @@
+"""The hand-over: goal switches, presses and releases keep the command's velocity
+continuous, in every blending mode, and PBP still does not stall behind a lagging robot."""
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, ZeroOrderHold
+
+from pbp_drake.core.arbitration import BLEND_MODES
+from pbp_drake.core.dmp import DmpBank as DmpModel
+from pbp_drake.core.hand_over import hand_over
+from pbp_drake.systems import (
+    Blender, DmpBank, GoalsSource, HandOver, PointRobot, ScriptedOperator)
+from pbp_drake.systems.point_robot import PointRobotParams
+from pbp_drake.systems.tick import decide_offset
+
+GOALS = np.array([[2.0, 1.0], [2.0, -1.0]])
+
+
+def test_the_law_bounds_the_change_of_velocity_and_the_speed():
+    rng = np.random.default_rng(1)
+    velocity = np.zeros(3)
+    for _ in range(500):
+        reference_position, reference_velocity = rng.normal(size=(2, 3))
+        position, new_velocity = hand_over(velocity, reference_position, reference_velocity,
+                                           2.0, 0.5, 0.03)
+        assert np.linalg.norm(new_velocity - velocity) <= 2.0 * 0.03 + 1e-12
+        assert np.linalg.norm(new_velocity) <= 0.5 + 1e-12
+        # The position is the reference's, shifted by the velocity not yet reached.
+        np.testing.assert_allclose(
+            position, reference_position + (new_velocity - reference_velocity) * 0.03)
+        velocity = new_velocity
+
+
+def test_the_law_passes_steady_motion_through_unchanged():
+    position, velocity = hand_over([0.1, 0.0], [1.0, 2.0], [0.11, 0.01], 1.0, 0.25, 0.03)
+    np.testing.assert_array_equal(position, [1.0, 2.0])
+    np.testing.assert_array_equal(velocity, [0.11, 0.01])
+
+
+@pytest.mark.parametrize("limits", [(0.0, 1.0), (-1.0, 1.0), (1.0, float("inf")),
+                                    (float("nan"), 1.0), (True, 1.0)])
+def test_hand_over_refuses_limits_that_are_not_finite_positive_numbers(limits):
+    with pytest.raises(ValueError, match="max_acceleration|max_speed"):
+        HandOver(np.zeros(2), *limits, 0.03)
+
+
+class ScriptedSelection(LeafSystem):
+    """The selected goal as a goal estimator publishes it: a state updated at the decide
+    stage, so that the DMP bank (same stage) reads the goal followed until then."""
+
+    def __init__(self, switch_time, period):
+        super().__init__()
+        self._switch_time = switch_time
+        index = self.DeclareDiscreteState(np.zeros(1))
+        self.DeclareStateOutputPort("selected_goal", index)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, decide_offset(period), self._update)
+
+    def _update(self, context, state):
+        state.set_value([1.0 if context.get_time() >= self._switch_time else 0.0])
+
+
+def run_loop(mode, dt=0.03, continuous=True, operator=None, params=PointRobotParams(),
+             duration=10.0, goals=GOALS, switch_time=3.0, limits=(1.0, 0.5), seconds=9.0):
+    """A point robot under a DMP bank, the blender and (with `continuous`) the hand-over
+    and the followed goal; the selection switches from goal 0 to 1 at `switch_time`.
+    Returns the commands (T, 2 D) and the robot's states (T, 2 D) at the ticks."""
+    dimension = goals.shape[1]
+    builder = DiagramBuilder()
+    robot = builder.AddSystem(PointRobot(np.zeros(dimension), params))
+    sample = builder.AddSystem(ZeroOrderHold(dt, 2 * dimension))
+    builder.Connect(robot.get_state_output_port(), sample.get_input_port())
+    bank = builder.AddSystem(DmpBank(DmpModel.straight(np.zeros(dimension), len(goals),
+                                                       duration), dt,
+                                     lock_phase_when_operator_acts=mode == "pbp_alternated"))
+    builder.Connect(builder.AddSystem(GoalsSource(goals)).get_output_port(),
+                    bank.get_goals_input_port())
+    builder.Connect(robot.get_state_output_port(), bank.get_robot_state_input_port())
+    times, commands = operator if operator is not None else ([0.0], [[0.0] * dimension])
+    person = builder.AddSystem(ScriptedOperator(times, commands, dt))
+    selection = builder.AddSystem(ScriptedSelection(switch_time, dt))
+    blender = builder.AddSystem(Blender(mode, dimension, len(goals), dt, alpha=0.5))
+    builder.Connect(sample.get_output_port(), blender.get_robot_state_input_port())
+    builder.Connect(bank.get_references_output_port(), blender.get_references_input_port())
+    builder.Connect(selection.get_output_port(), blender.get_selected_goal_input_port())
+    builder.Connect(person.get_operator_command_output_port(),
+                    blender.get_operator_command_input_port())
+    for port in (blender.get_operator_active_input_port(),
+                 bank.get_operator_active_input_port()):
+        builder.Connect(person.get_operator_active_output_port(), port)
+    # confidence_alpha reads probabilities: one-hot on goal 0 gives alpha_max.
+    builder.Connect(builder.AddSystem(ConstantVectorSource([1.0, 0.0])).get_output_port(),
+                    blender.get_goal_probabilities_input_port())
+    command = blender.get_command_output_port()
+    if continuous:
+        builder.Connect(selection.get_output_port(), bank.get_followed_goal_input_port())
+        hand = builder.AddSystem(HandOver(np.zeros(dimension), *limits, dt))
+        builder.Connect(command, hand.get_reference_input_port())
+        command = hand.get_command_output_port()
+    builder.Connect(command, robot.get_command_input_port())
+    command_log = LogVectorOutput(command, builder, dt)
+    state_log = LogVectorOutput(sample.get_output_port(), builder, dt)
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    simulator.AdvanceTo(seconds)
+    context = simulator.get_context()
+    # A log sample at t_k holds the decisions of tick k - 1 (pbp_drake.systems.tick).
+    return (command_log.FindLog(context).data().T[1:],
+            state_log.FindLog(context).data().T[1:])
+
+
+def largest_velocity_change(commands):
+    dimension = commands.shape[1] // 2
+    return np.linalg.norm(np.diff(commands[:, dimension:], axis=0), axis=1).max()
+
+
+def test_minimal_reproduction_the_switch_keeps_the_dmps_velocity():
+    """Two straight DMPs to (2, 1) and (2, -1), tau 10 s, 30 Hz, the robot on DMP 0 for 3 s:
+    selecting DMP 1 used to make the command jump by 0.41 m/s in one tick."""
+    stiff = PointRobotParams(stiffness=4e4, damping=400.0)  # follows its command closely
+    jumps = {}
+    for dt in (0.03, 0.015):
+        for continuous in (False, True):
+            commands, _ = run_loop("pbp_alternated", dt, continuous, params=stiff,
+                                   limits=(1e3, 1e3), seconds=4.0)
+            jumps[dt, continuous] = largest_velocity_change(commands)
+    assert jumps[0.03, False] == pytest.approx(0.41, abs=0.02)
+    assert jumps[0.015, False] == pytest.approx(0.41, abs=0.02)
+    # The DMPs step from the followed DMP's velocity: what is left is the other attractor's
+    # pull over one period, which halves with the period (continuous in the limit).
+    assert jumps[0.03, True] < 0.05
+    assert jumps[0.015, True] < 0.6 * jumps[0.03, True]
+
+
+@pytest.mark.parametrize("mode", BLEND_MODES)
+def test_switch_press_and_release_change_the_command_by_at_most_the_limit(mode):
+    """A forced switch at 3 s, a press at 5 s (0.15 m/s sideways) and a release at 6 s."""
+    operator = ([0.0, 5.0, 6.0], [[0.0, 0.0], [0.0, 0.15], [0.0, 0.0]])
+    commands, _ = run_loop(mode, operator=operator)
+    assert largest_velocity_change(commands) <= 1.0 * 0.03 + 1e-9
+    assert np.linalg.norm(commands[:, 2:], axis=1).max() <= 0.5 + 1e-9
+    # Without the hand-over the same script makes steps far over the limit.
+    commands, _ = run_loop(mode, operator=operator, continuous=False)
+    assert largest_velocity_change(commands) > 0.1
+
+
+def test_pbp_does_not_stall_behind_a_lagging_robot():
+    """The re-integration trap (each step resetting the DMP to the robot's measured velocity
+    stalls it behind a lagging tracker): a soft robot, no operator, a 1 m reach of 1 s at
+    100 Hz is within 5 cm of its goal at 1.5 s."""
+    soft = PointRobotParams(stiffness=100.0, damping=20.0)
+    goals = np.array([[1.0, 0.0], [0.0, 1.0]])
+    _, states = run_loop("pbp_continuous", dt=0.01, params=soft, duration=1.0, goals=goals,
+                         switch_time=100.0, limits=(20.0, 5.0), seconds=1.52)
+    assert np.linalg.norm(states[150, :2] - goals[0]) < 0.05

@@ -120,6 +120,12 @@ class TaskResult:
         objects: (M, 3).
         collision_ratio: ratio of ticks with the robot in collision (obstacle tasks; 0 in
             tasks without obstacles). in_collision: (T,) bools, or None without obstacles.
+        peak_hand_speed: m/s, the largest one-tick hand speed over the run's ticks 0..T-1,
+            max_k |ee(t_{k+1}) - ee(t_k)| / control_period, ee = `ee_positions`.
+        peak_command_acceleration: m/s^2, the largest change of the commanded velocity
+            between two ticks over the period, max_k |v(k+1) - v(k)| / control_period,
+            v = `commands[:, 3:6]`. Both from `motion_peaks`; None when unknown (fewer
+            than two ticks, or a TaskResult made without them).
     """
 
     success: bool
@@ -137,11 +143,34 @@ class TaskResult:
     objects: np.ndarray
     collision_ratio: float = 0.0
     in_collision: np.ndarray | None = None
+    peak_hand_speed: float | None = None
+    peak_command_acceleration: float | None = None
 
     def summary_line(self):
         outcome = "success" if self.success else "FAILED"
         return (f"{outcome} in {self.task_time:.2f} s, intervention ratio "
-                f"{self.intervention_ratio:.3f}, {self.switches} target switches")
+                f"{self.intervention_ratio:.3f}, {self.switches} target switches, "
+                f"peak hand speed {_or_na(self.peak_hand_speed, 3)} m/s, "
+                f"peak command acceleration {_or_na(self.peak_command_acceleration, 2)} m/s^2")
+
+
+def _or_na(value, digits):
+    return "n/a" if value is None else f"{value:.{digits}f}"
+
+
+def motion_peaks(ee_positions, command_velocities, control_period):
+    """`(peak_hand_speed, peak_command_acceleration)` of a run's ticks 0..T-1:
+    max_k |ee(t_{k+1}) - ee(t_k)| / control_period (m/s) over the hand positions `(T, 3)`,
+    and max_k |v(k+1) - v(k)| / control_period (m/s^2) over the commanded velocities
+    `(T, 3)`; (None, None) with fewer than two ticks."""
+    if len(ee_positions) < 2:
+        return None, None
+
+    def peak(series):
+        steps = np.linalg.norm(np.diff(np.asarray(series, float), axis=0), axis=1)
+        return float(steps.max() / control_period)
+
+    return peak(ee_positions), peak(command_velocities)
 
 
 def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None):
@@ -154,10 +183,10 @@ def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None):
     simulator.AdvanceTo((ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()
     status = TaskStatus(status_port.Eval(monitor.GetMyContextFromRoot(context)))
-    return _read_result(diagram, context, status, monitor)
+    return _read_result(diagram, context, status, monitor, scenario.control_period)
 
 
-def _read_result(diagram, context, status, monitor):
+def _read_result(diagram, context, status, monitor, control_period):
     # The last sample holds only the decisions of the tick before it (see read_log).
     tick_count = diagram.GetSubsystemByName("ee_state_log").FindLog(context).num_samples() - 1
 
@@ -167,6 +196,9 @@ def _read_result(diagram, context, status, monitor):
     times, ee_state = read_log(diagram, context, "ee_state_log", tick_count)
     # Measured on the plant's state, like ee_state: not shifted.
     in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
+    commands = decisions("command_log")
+    peak_hand_speed, peak_command_acceleration = motion_peaks(
+        ee_state[:, :3], commands[:, 3:6], control_period)
     return TaskResult(
         success=bool(status.success > 0.5),
         task_time=float(status.task_time),
@@ -175,7 +207,7 @@ def _read_result(diagram, context, status, monitor):
         times=times,
         ee_positions=ee_state[:, :3],
         headings=ee_state[:, 6],
-        commands=decisions("command_log"),
+        commands=commands,
         operator_active=decisions("operator_active_log")[:, 0] > 0.5,
         operator_commands=decisions("operator_command_log"),
         selected_goals=decisions("selected_goal_log")[:, 0].astype(int),
@@ -183,4 +215,6 @@ def _read_result(diagram, context, status, monitor):
         objects=monitor.objects.copy(),
         collision_ratio=float(status.collision_ratio),
         in_collision=None if in_collision is None else in_collision[:, 0] > 0.5,
+        peak_hand_speed=peak_hand_speed,
+        peak_command_acceleration=peak_command_acceleration,
     )

@@ -19,15 +19,26 @@ def _cell(entry, field, digits):
     return f"{value['mean']:.{digits}f} ± {value['std']:.{digits}f}"
 
 
+def _peak_cell(entry, field, digits):
+    """`max / mean` of a per-trial peak; n/a when no trial recorded it (older trials)."""
+    value = entry[field]
+    if value["max"] is None:
+        return "n/a"
+    return f"{value['max']:.{digits}f} / {value['mean']:.{digits}f}"
+
+
 def _count(value):
     return "-" if value is None else str(value)
 
 
 def results_table(summary):
-    """The summary as a Markdown table, one row per method."""
+    """The summary as a Markdown table, one row per method: mean ± std of the intervention
+    ratio, task time and collision ratio, max / mean of the trials' peak hand speed and peak
+    command acceleration (see `summarize`)."""
     lines = ["| method | trials | success | intervention ratio | task time (s) | "
-             "collision ratio | collision-free trials | errors |",
-             "|---|---|---|---|---|---|---|---|"]
+             "collision ratio | collision-free trials | peak hand speed (m/s), max / mean | "
+             "peak command acceleration (m/s²), max / mean | errors |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for method, entry in summary["methods"].items():
         rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
         trials = f"{entry['trials']}" + (f" ({entry['missing']} missing)"
@@ -35,7 +46,10 @@ def results_table(summary):
         lines.append(f"| {METHOD_LABELS.get(method, method)} | {trials} | {rate} | "
                      f"{_cell(entry, 'intervention_ratio', 3)} | "
                      f"{_cell(entry, 'task_time', 1)} | {_cell(entry, 'collision_ratio', 3)} | "
-                     f"{_count(entry['collision_free_trials'])} | {entry['errors']} |")
+                     f"{_count(entry['collision_free_trials'])} | "
+                     f"{_peak_cell(entry, 'peak_hand_speed', 3)} | "
+                     f"{_peak_cell(entry, 'peak_command_acceleration', 2)} | "
+                     f"{entry['errors']} |")
     arbitration = summary.get("arbitration")
     if arbitration is not None:
         ideal = arbitration["ideal_alpha"]
@@ -50,7 +64,8 @@ def _flat_trials(study, records):
         for trial in range(study["trials"]):
             record = records[(method, trial)]
             if record is not None:
-                rows.append({field: record[field] for field in TRIAL_FIELDS})
+                # Trials written before a field existed lack it: None.
+                rows.append({field: record.get(field) for field in TRIAL_FIELDS})
     return rows
 
 

@@ -58,6 +58,8 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
                       intervention_ratio=json_float(result.intervention_ratio),
                       switches=int(result.switches),
                       collision_ratio=json_float(result.collision_ratio),
+                      peak_hand_speed=json_float(result.peak_hand_speed),
+                      peak_command_acceleration=json_float(result.peak_command_acceleration),
                       ticks=len(result.times))
     except Exception as error:  # a broken trial must not lose the study
         result = None

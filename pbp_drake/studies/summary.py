@@ -89,6 +89,15 @@ def mean_std(values):
     return {"mean": _round(mean), "std": _round(math.sqrt(variance))}
 
 
+def max_mean(values):
+    """`{"max", "mean"}` of the finite values, rounded; None for none (e.g. trials written
+    before the value was recorded)."""
+    values = [v for v in values if v is not None and math.isfinite(v)]
+    if not values:
+        return {"max": None, "mean": None}
+    return {"max": _round(max(values)), "mean": _round(math.fsum(values) / len(values))}
+
+
 def collision_histogram(ratios):
     """Counts of collision ratios in the bins of HISTOGRAM_EDGES (the last includes 1)."""
     counts = [0] * (len(HISTOGRAM_EDGES) - 1)
@@ -101,8 +110,11 @@ def collision_histogram(ratios):
 def summarize(study, records):
     """Per method: how many trials, errors and missing; success rate over the trials on
     disk; mean and (population) std of intervention ratio and task time, and the mean, std
-    and histogram of the collision ratio, over the trials that ran without error; and the
-    ideal alpha when the study sweeps fixed alphas."""
+    and histogram of the collision ratio, and the max and mean of each trial's
+    peak_hand_speed (m/s, the largest one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| /
+    control_period) and peak_command_acceleration (m/s^2, max_k |v_cmd(k+1) - v_cmd(k)| /
+    control_period), over the trials that ran without error (those that recorded them);
+    and the ideal alpha when the study sweeps fixed alphas."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "collision_histogram_edges": list(HISTOGRAM_EDGES),
@@ -125,6 +137,9 @@ def summarize(study, records):
             "task_time": mean_std([r["task_time"] for r in ran]),
             "collision_ratio": collision,
             "collision_free_trials": sum(ratio == 0.0 for ratio in ratios) if ratios else None,
+            "peak_hand_speed": max_mean([r.get("peak_hand_speed") for r in ran]),
+            "peak_command_acceleration": max_mean(
+                [r.get("peak_command_acceleration") for r in ran]),
         }
     swept = arbitration(summary["methods"])
     if swept is not None:

@@ -19,9 +19,17 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.builder.run import TaskResult
 
+# A trial file of another format counts as not on disk (it runs again). Fields added since
+# (peak_hand_speed, peak_command_acceleration) are read as None when a file lacks them, so
+# they did not change the format: older trials still count and report them as n/a.
 TRIAL_FORMAT = 1
-# The metrics of a trial, in the order of the trial files and of trials.json.
-METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio")
+# The metrics of a trial, in the order of the trial files and of trials.json. The peaks are
+# TaskResult's (see pbp_drake.builder.run.motion_peaks): peak_hand_speed (m/s), the largest
+# one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| / control_period, and
+# peak_command_acceleration (m/s^2), max_k |v_cmd(k+1) - v_cmd(k)| / control_period, over
+# the CSV's ee_x..ee_z and command_vx..command_vz columns (ticks 0..T-1).
+METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio",
+           "peak_hand_speed", "peak_command_acceleration")
 TRIAL_FIELDS = ("method", "trial", "seed", *METRICS, "error")
 
 
@@ -137,7 +145,8 @@ def trial_record(scenario_name, digest, method, trial, seed):
     return {"format": TRIAL_FORMAT, "scenario": scenario_name, "scenario_hash": digest,
             "method": method, "trial": trial, "seed": seed, "success": False,
             "task_time": None, "intervention_ratio": None, "switches": None,
-            "collision_ratio": None, "ticks": 0, "objects": None, "targets": None,
+            "collision_ratio": None, "peak_hand_speed": None,
+            "peak_command_acceleration": None, "ticks": 0, "objects": None, "targets": None,
             "time_series": None, "error": None, "drake_warnings": 0, "wall_time": None}
 
 
@@ -220,7 +229,9 @@ def load_task_result(output, method, seed):
             "operator_vx", "operator_vy", "operator_vz", "operator_yaw_rate")]),
         selected_goals=series["selected_goal"], targets=series["target"],
         objects=np.array(record["objects"], float),
-        collision_ratio=record["collision_ratio"], in_collision=in_collision)
+        collision_ratio=record["collision_ratio"], in_collision=in_collision,
+        peak_hand_speed=record.get("peak_hand_speed"),
+        peak_command_acceleration=record.get("peak_command_acceleration"))
 
 
 def read_trial(output, method, seed, digest=None):

@@ -1,8 +1,11 @@
 """The HSR reaching task end to end: the scenario file, PBP and teleop with the virtual
 participant, goal switching, the keyboard in the full task, the CLI and bad input."""
 
+import csv
 import dataclasses
+import io
 import json
+import math
 import textwrap
 
 import msgpack
@@ -62,6 +65,26 @@ def test_pbp_alternated_reaches_the_switching_target_with_little_input(pbp_run):
     assert 0.0 < pbp_run.intervention_ratio < 0.5
     # In PBP the operator never pushes forward: the DMP phase does.
     assert np.all(pbp_run.operator_commands[:, 2] == 0.0)
+
+
+def test_the_peaks_are_those_of_the_time_series_columns(fixed_task, pbp_run):
+    # Recomputed here from the CSV a study would write: the largest step between ticks of
+    # the hand (ee_x..ee_z) and of the commanded velocity (command_vx..vz), over the period.
+    from pbp_drake.studies.trial_files import time_series_csv
+
+    rows = list(csv.DictReader(io.StringIO(time_series_csv(pbp_run))))
+    assert len(rows) == len(pbp_run.times)
+
+    def peak(columns):
+        points = [[float(row[column]) for column in columns] for row in rows]
+        steps = [math.dist(a, b) for a, b in zip(points, points[1:])]
+        return max(steps) / fixed_task.control_period
+
+    assert pbp_run.peak_hand_speed == pytest.approx(peak(("ee_x", "ee_y", "ee_z")),
+                                                    rel=1e-12)
+    assert pbp_run.peak_command_acceleration == pytest.approx(
+        peak(("command_vx", "command_vy", "command_vz")), rel=1e-12)
+    assert pbp_run.peak_hand_speed > 0.0 and pbp_run.peak_command_acceleration > 0.0
 
 
 def test_the_estimated_goal_follows_the_target(pbp_run):
@@ -166,7 +189,8 @@ def test_keyboard_left_key_moves_the_hand_left(fixed_task):
     assert abs(moved[0]) < 0.05 and abs(moved[2]) < 0.02
 
 
-def test_run_with_the_virtual_participant_prints_one_result_line(tmp_path, capsys, fixed_task):
+def test_run_with_the_virtual_participant_prints_one_result_line(tmp_path, capsys, fixed_task,
+                                                                 pbp_run):
     path = write(tmp_path, FIXED_TASK)
     record = tmp_path / "replay.html"
     code = main(["run", str(path), "--operator", "virtual", "--headless",
@@ -174,6 +198,9 @@ def test_run_with_the_virtual_participant_prints_one_result_line(tmp_path, capsy
     out = capsys.readouterr().out
     assert code == 0
     assert "success in" in out and "intervention ratio" in out
+    # The same seeded run as pbp_run: the line gives its peaks.
+    assert (f", peak hand speed {pbp_run.peak_hand_speed:.3f} m/s, peak command "
+            f"acceleration {pbp_run.peak_command_acceleration:.2f} m/s^2") in out
     assert record.stat().st_size > 10_000
 
 

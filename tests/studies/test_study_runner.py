@@ -1,10 +1,12 @@
 """The method comparison study runner: the same bytes with any --jobs, resuming, failed and
 crashed trials, the trial files read back, and `pbp-drake report` rebuilding from disk."""
 
+import csv
 import dataclasses
 import io
 import json
 import importlib.util
+import math
 import os
 import shutil
 import subprocess
@@ -127,6 +129,94 @@ def test_the_time_series_read_back_equals_the_task_result(studies, scenario):
     assert record["scenario"] == "two_random_objects" and record["error"] is None
     np.testing.assert_array_equal(record["objects"], direct.objects)
     assert len(record["targets"]) == 3 and record["ticks"] == len(direct.times)
+    # The run's own peaks are those of its CSV columns.
+    speed, acceleration = _peaks_from_csv(trial_paths(one, "teleop", 6)[1],
+                                          scenario.control_period)
+    assert direct.peak_hand_speed == pytest.approx(speed, rel=1e-12)
+    assert direct.peak_command_acceleration == pytest.approx(acceleration, rel=1e-12)
+
+
+def _peaks_from_csv(path, control_period):
+    """Peak hand speed and peak command acceleration recomputed from a trial's CSV alone:
+    the largest step between consecutive rows of ee_x..ee_z, and of command_vx..command_vz,
+    over the control period."""
+    with open(path, newline="") as stream:
+        rows = list(csv.DictReader(stream))
+
+    def peak(columns):
+        points = [[float(row[column]) for column in columns] for row in rows]
+        return max(math.dist(a, b) for a, b in zip(points, points[1:])) / control_period
+
+    return peak(("ee_x", "ee_y", "ee_z")), peak(("command_vx", "command_vy", "command_vz"))
+
+
+def test_each_trial_records_the_peaks_of_its_csv_columns(studies, scenario):
+    one, _ = studies
+    for method in METHODS:
+        for seed in (5, 6):
+            json_path, csv_path = trial_paths(one, method, seed)
+            record = json.loads(json_path.read_text())
+            speed, acceleration = _peaks_from_csv(csv_path, scenario.control_period)
+            assert speed > 0.0 and acceleration > 0.0
+            assert record["peak_hand_speed"] == pytest.approx(speed, rel=1e-12)
+            assert record["peak_command_acceleration"] == pytest.approx(acceleration,
+                                                                        rel=1e-12)
+
+
+def test_summary_and_results_give_each_methods_peak_max_and_mean(studies):
+    one, _ = studies
+    summary = json.loads((one / "summary.json").read_text())
+    table = (one / "results.md").read_text()
+    assert "peak hand speed (m/s), max / mean" in table
+    assert "peak command acceleration (m/s²), max / mean" in table
+    for method, label in zip(METHODS, ("PBP-Alt", "Teleop")):
+        records = [json.loads(trial_paths(one, method, seed)[0].read_text())
+                   for seed in (5, 6)]
+        row = next(line for line in table.splitlines() if line.startswith(f"| {label} |"))
+        for field, digits in (("peak_hand_speed", 3), ("peak_command_acceleration", 2)):
+            values = [record[field] for record in records]
+            peak, mean = max(values), sum(values) / len(values)
+            entry = summary["methods"][method][field]
+            assert entry["max"] == pytest.approx(peak, rel=1e-11)
+            assert entry["mean"] == pytest.approx(mean, rel=1e-11)
+            assert f"| {peak:.{digits}f} / {mean:.{digits}f} |" in row
+    trials = json.loads((one / "trials.json").read_text())
+    assert all(t["peak_hand_speed"] > 0 and t["peak_command_acceleration"] > 0
+               for t in trials)
+
+
+def test_trials_written_without_the_peaks_still_count_and_report_n_a(studies, scenario,
+                                                                     tmp_path, capsys):
+    folder = tmp_path / "older"
+    shutil.copytree(studies[0], folder)
+    for seed in (5, 6):  # teleop's trials as written before the peaks were recorded
+        path = trial_paths(folder, "teleop", seed)[0]
+        record = json.loads(path.read_text())
+        del record["peak_hand_speed"], record["peak_command_acceleration"]
+        path.write_text(json.dumps(record, indent=1) + "\n")
+    ran = []
+    run_method_comparison(scenario, METHODS, 2, 5, folder,
+                          progress=lambda done, total, record, elapsed: ran.append(record))
+    assert ran == []  # still done: nothing runs again
+    capsys.readouterr()
+    assert main(["report", str(folder)]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines()
+               if line.startswith("| Teleop |"))
+    # The rest of the row as before; the two peak cells say n/a.
+    before = next(line for line in (studies[0] / "results.md").read_text().splitlines()
+                  if line.startswith("| Teleop |")).split(" | ")
+    assert row.split(" | ") == before[:-3] + ["n/a", "n/a"] + before[-1:]
+    summary = json.loads((folder / "summary.json").read_text())
+    teleop = summary["methods"]["teleop"]
+    assert teleop["trials"] == 2 and teleop["missing"] == 0 and teleop["errors"] == 0
+    assert teleop["peak_hand_speed"] == {"max": None, "mean": None}
+    assert teleop["peak_command_acceleration"] == {"max": None, "mean": None}
+    original = json.loads((studies[0] / "summary.json").read_text())
+    assert summary["methods"]["pbp_alternated"] == original["methods"]["pbp_alternated"]
+    trials = [t for t in json.loads((folder / "trials.json").read_text())
+              if t["method"] == "teleop"]
+    assert [t["peak_hand_speed"] for t in trials] == [None, None]
+    assert load_task_result(folder, "teleop", 5).peak_hand_speed is None
 
 
 def test_an_interrupted_study_runs_only_the_missing_trial(studies, task_file, scenario,

@@ -5,7 +5,8 @@ The bank takes shortcuts (the bases at a step's two phases evaluated once for eq
 one product with distinct weights, step terms affine in the goal for shared weights and one
 start); the single `Dmp` steps each dimension in a Python loop. They must give the same
 states to 1e-12, with distinct and shared weights, both formulations, mixed amplitude
-scaling, goals locked one by one (unequal phases), and inside the Drake LeafSystem. Timing lives in `pbp-drake bench`, not here.
+scaling, goals locked one by one (unequal phases), and inside the Drake LeafSystem. Timing
+lives in `pbp-drake bench`, not here.
 """
 
 import numpy as np

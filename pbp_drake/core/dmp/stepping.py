@@ -2,9 +2,10 @@
 
 Around its moving attractor `a` the transformation system is linear (see
 `pbp_drake.core.dmp`). Over a step the attractor goes linearly in time from `a0`, its value
-at the step's phase `x0`, to `a1`, its value at the next phase `x1 = x0 exp(-alpha_x dt / tau)`
-(a first-order hold), which keeps the step in closed form: with `e = y - a0`, the increment
-`da = a1 - a0` and `(Phi, Gamma)` of `pbp_drake.core.dmp.settings.step_matrices`,
+at the step's phase `x0`, to `a1`, its value at the next phase
+`x1 = x0 exp(-alpha_x dt / tau)` (a first-order hold), which keeps the step in closed
+form: with `e = y - a0`, the increment `da = a1 - a0` and `(Phi, Gamma)` of
+`pbp_drake.core.dmp.settings.step_matrices`,
 
     y' = a1 + Phi00 e + Phi01 z - Gamma00 da / dt,    z' = Phi10 e + Phi11 z - Gamma10 da / dt.
 
@@ -19,9 +20,12 @@ and `stepped_velocity_into` add the velocity's part. Drake's `DmpBank` system ke
 `(z, dp, dz)` in its Context and reads the stepped state out on demand.
 
 Writing `b(x) = a(x) - g` (the attractor relative to the goal),
-`dp = (Phi00 - 1)(p - g) + C00 b(x0) + C01 b(x1)` and `dz = Phi10 (p - g) + C10 b(x0) + C11 b(x1)`
-with the 2x2 `C` of `StepConstants.combination`; `b` is linear in the normalised basis, so the
-weights are contracted once with both rows' combinations of the bases at `x0` and `x1`.
+
+    dp = (Phi00 - 1)(p - g) + C00 b(x0) + C01 b(x1),
+    dz = Phi10 (p - g) + C10 b(x0) + C11 b(x1),
+
+with the 2x2 `C` of `StepConstants.combination`; `b` is linear in the normalised basis, so
+the weights are contracted once with both rows' combinations of the bases at `x0` and `x1`.
 """
 
 import functools
@@ -34,9 +38,9 @@ from pbp_drake.core.dmp.settings import normalized_basis, phase_decay, step_matr
 _IDENTITY = np.eye(2)
 _IDENTITY.setflags(write=False)
 # Distinct weights: the (2, N) x (N, D*K) product runs in blocks of columns that fit the L2
-# cache (about this many bytes of weights each). OpenBLAS's one long two-row dgemm took
-# twice a one-row dgemv here; in blocks it takes what the dgemv takes (the weights are read
-# once, the step's second phase costs no memory traffic).
+# cache (about this many bytes of weights each). OpenBLAS's one long two-row dgemm took up
+# to twice a one-row dgemv here; in blocks it takes what the dgemv takes (the weights are
+# read once: the step's second phase costs no memory traffic).
 _BLOCK_BYTES = 800_000
 
 

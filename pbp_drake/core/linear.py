@@ -1,8 +1,11 @@
-"""Exact zero-order-hold discretisation of small linear systems.
+"""Closed-form discretisation of small linear systems.
 
-Both the DMP transformation system and the point robot are linear between control ticks, so
-stepping them with `expm(A dt)` is exact and costs no more than Euler. NumPy has no `expm` and
-the core must not depend on SciPy or Drake, hence this small scaling-and-squaring version.
+The point robot is linear between plant steps with its command held, so stepping it with
+`expm(A dt)` is exact (zero-order hold) and costs no more than Euler. The DMP transformation
+system is linear around its moving attractor; holding the attractor linear in time over a
+step (first-order hold) adds one integral of `expm(A s)` (`second_order_step`). NumPy has no
+`expm` and the core must not depend on SciPy or Drake, hence this small
+scaling-and-squaring version.
 """
 
 import numpy as np
@@ -29,11 +32,18 @@ def expm(matrix):
     return result
 
 
-def second_order_transition(stiffness, damping, time_scale, dt):
-    """Transition matrix of `time_scale * [y', z'] = [z, -stiffness*y - damping*z]` over `dt`.
+def second_order_step(stiffness, damping, time_scale, dt):
+    """`(Phi, Gamma)` of `time_scale * [y', z'] = [z, -stiffness*y - damping*z]` over `dt`:
+    `Phi = expm(A dt)` and `Gamma = integral_0^dt expm(A s) ds`, both 2x2, from one
+    exponential of the augmented matrix `[[A, I], [0, 0]] dt`.
 
-    This is the DMP transformation system written around its moving attractor; the returned
-    2x2 `Phi` maps `[y - y_attractor, z]` at `t` to the same at `t + dt`.
+    This is the DMP transformation system written around its moving attractor `a(t)`: with
+    `w = [y - a, z]`, `w' = A w - [a', 0]`, so `w(dt) = Phi w(0) - Gamma [r, 0]` when `a`
+    moves at the constant rate `r` over the step (and `Phi w(0)` when it stands still).
     """
-    a = np.array([[0.0, 1.0], [-stiffness, -damping]]) / time_scale
-    return expm(a * dt)
+    augmented = np.zeros((4, 4))
+    augmented[:2, :2] = np.array([[0.0, 1.0], [-stiffness, -damping]]) / time_scale
+    augmented[:2, 2:] = np.eye(2)
+    exponential = expm(augmented * dt)
+    return exponential[:2, :2], exponential[:2, 2:]
+

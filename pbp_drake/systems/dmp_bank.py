@@ -31,8 +31,8 @@ class DmpBank(LeafSystem):
         - predicted_paths
 
     `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
-    `(K, D)`. Each period the bank advances every DMP one exact step from the robot's position
-    (keeping each DMP's own velocity, see `pbp_drake.core.dmp`). With
+    `(K, D)`. Each period the bank advances every DMP one step from the robot's position
+    (keeping each DMP's own velocity; the first-order-hold step of `pbp_drake.core.dmp`). With
     `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the phases
     and the DMPs follow the robot until the operator lets go.
 
@@ -51,16 +51,17 @@ class DmpBank(LeafSystem):
     sampled every `prediction_period` (default: the control period).
     All state lives in the Context, and so does the step's scratch memory (a cache entry).
 
-    The state is one vector `[phase, held, p (D), z (D*K), offset (D*K)]` (`_split` is the
-    one place that knows the layout). PBP steps every DMP from the robot's position `p` and
-    never from the DMP's own, so the state keeps, of each step, what its outputs are read
-    from: the DMPs' velocities `z` before the step and `offset = p - attractor`;
-    `references` reads the stepped positions and velocities out
-    (`pbp_drake.core.dmp.DmpBank.offsets_into`). With shared weights an update is then five
-    passes over `(D, K)`, and Drake copies two `(D, K)` arrays, not three and a phase per
-    goal; the goals are checked and laid out `(D, K)` in a cache entry, once per change. While
-    `held` (at the start, and while PBP-Alt locks the phases) the DMPs sit at `p - offset`
-    with velocity `z`. All DMPs of the system share one phase: the lock is one input.
+    The state is one vector `[phase, held, p (D), z (D*K), dp (D*K), dz (D*K)]` (`_split` is
+    the one place that knows the layout). PBP steps every DMP from the robot's position `p`
+    and never from the DMP's own, and the step is affine in the DMP's velocity `z`
+    (`p' = p + dp + Phi01 z`, `z' = dz + Phi11 z`, see `pbp_drake.core.dmp.stepping`), so
+    the state keeps, of each step, what its outputs are read from: the DMPs' velocities `z`
+    before the step and the step's attractor terms `dp`, `dz`; `references` reads the
+    stepped positions and velocities out. With shared weights an update is then six passes
+    over `(D, K)`, and Drake copies three `(D, K)` arrays; the goals are checked and laid
+    out `(D, K)` in a cache entry, once per change. While `held` (at the start, and while
+    PBP-Alt locks the phases) the DMPs sit at `p + dp` with velocity `z`. All DMPs of the
+    system share one phase: the lock is one input.
 
     The bank updates at the decide stage of each control tick
     (`pbp_drake.systems.tick.decide_offset`), so that it reads the robot's state sampled at
@@ -74,7 +75,7 @@ class DmpBank(LeafSystem):
         self._bank = bank
         self._period = float(control_period)
         # Drawing a long horizon at the control period would cost hundreds of steps a frame;
-        # the exact zero-order-hold step is as exact at any step size.
+        # the first-order-hold step stays close at coarser steps (second order in the step).
         self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)
@@ -88,11 +89,11 @@ class DmpBank(LeafSystem):
         self._goals_port = self.DeclareVectorInputPort("goals", k * d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
-        # Held at the start: the DMPs sit at their starts (p = 0, offset = -starts), at rest.
+        # Held at the start: the DMPs sit at their starts (p = 0, dp = starts), at rest.
         initial = np.zeros(self.state_size(k, d))
-        phase, held, _, _, offset = self._split(initial)
+        phase, held, _, _, dp, _ = self._split(initial)
         phase[0], held[0] = 1.0, 1.0
-        offset[...] = -bank.starts
+        dp[...] = bank.starts
         self._state_index = self.DeclareDiscreteState(initial)
         # The goals checked and laid out (D, K) once each time they change, not each tick.
         self._goals_dk = self.DeclareCacheEntry(
@@ -126,8 +127,8 @@ class DmpBank(LeafSystem):
 
     @staticmethod
     def state_size(goal_count, dimension):
-        """The length of the one state vector `[phase, held, p, z, offset]`."""
-        return 2 + dimension + 2 * goal_count * dimension
+        """The length of the one state vector `[phase, held, p, z, dp, dz]`."""
+        return 2 + dimension + 3 * goal_count * dimension
 
     @property
     def bank(self):
@@ -166,11 +167,12 @@ class DmpBank(LeafSystem):
         return self._predicted_paths_port
 
     def _split(self, vector):
-        """Views of a state vector: phase (1,), held (1,), p (D, 1), z and offset (D, K)."""
+        """Views of a state vector: phase (1,), held (1,), p (D, 1), z, dp and dz (D, K)."""
         d, k = self._bank.dimension, self._bank.goal_count
-        z_end = 2 + d + k * d
+        z, dp, dz = (2 + d + i * k * d for i in range(3))
         return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
-                vector[2 + d:z_end].reshape(d, k), vector[z_end:z_end + k * d].reshape(d, k))
+                vector[z:dp].reshape(d, k), vector[dp:dz].reshape(d, k),
+                vector[dz:dz + k * d].reshape(d, k))
 
     def _workspace(self, context):
         """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""
@@ -185,24 +187,24 @@ class DmpBank(LeafSystem):
         """The K DMPs' state after the last update: phases (K,), positions and scaled
         velocities (D, K), new arrays (what `references` reads out)."""
         bank = self._bank
-        phase, held, robot, z, offset = self._split(
+        phase, held, robot, z, dp, dz = self._split(
             context.get_discrete_state(self._state_index).get_value())
         positions = np.empty(z.shape)
         velocity = np.empty(z.shape)
         if held[0]:
-            np.subtract(robot, offset, out=positions)
+            np.add(robot, dp, out=positions)
             velocity[...] = z
         else:
-            workspace = self._workspace(context)
-            bank.stepped_positions_into(robot, offset, z, self._period, positions, workspace)
-            bank.stepped_velocity_into(offset, z, self._period, velocity, workspace)
+            bank.stepped_positions_into(robot, dp, z, self._period, positions,
+                                        self._workspace(context))
+            bank.stepped_velocity_into(dz, z, self._period, velocity)
         return np.full(bank.goal_count, phase[0]), positions, velocity
 
     def _update(self, context, discrete_state):
         # Drake fills `discrete_state` with the current state; the update writes into it.
         bank, period = self._bank, self._period
         d = bank.dimension
-        phase, held, robot, z, offset = self._split(
+        phase, held, robot, z, dp, dz = self._split(
             discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
         # Every input is evaluated before the workspace is taken: an input's evaluation may
         # reach this system's outputs, whose calculation uses the same workspace.
@@ -212,10 +214,9 @@ class DmpBank(LeafSystem):
         goals_dk = None if lock else self._goals_dk.Eval(context)
         followed = self._followed_goal(context)
         workspace = self._workspace(context)
-        # The velocities the last step left, read out in place (see the class docstring);
-        # the offsets are rewritten below, so they serve as the scratch.
+        # The velocities the last step left, read out in place (see the class docstring).
         if not held[0]:
-            bank.stepped_velocity_into(offset, z, period, z, workspace, overwrite_offset=True)
+            bank.stepped_velocity_into(dz, z, period, z)
             if followed is not None:
                 # Every DMP continues from the velocity of the one the robot followed, so
                 # that a switch to another goal keeps the command's velocity.
@@ -224,11 +225,11 @@ class DmpBank(LeafSystem):
         if lock:
             # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
             held[0] = 1.0
-            offset.fill(0.0)
+            dp.fill(0.0)
             np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
             return
         held[0] = 0.0
-        bank.offsets_into(phase, robot, goals_dk, offset, workspace)
+        bank.attractor_terms_into(phase, robot, goals_dk, period, dp, dz, workspace)
         phase *= bank.decay(period)
 
     def _calc_goals_dk(self, context, value):

@@ -1,11 +1,12 @@
 """The fast DMP bank equals a plain per-goal loop of single DMPs, and pydmps agrees with the
 Ijspeert form.
 
-The bank takes shortcuts (one basis evaluation for equal phases, a matrix-vector product for
-distinct weights, an attractor affine in the goal for shared weights and one start); the single `Dmp` steps each
-dimension in a Python loop. They must give the same states to 1e-12, with distinct and
-shared weights, both formulations, mixed amplitude scaling, goals locked one by one (unequal
-phases), and inside the Drake LeafSystem. Timing lives in `pbp-drake bench`, not here.
+The bank takes shortcuts (the bases at a step's two phases evaluated once for equal phases,
+one product with distinct weights, step terms affine in the goal for shared weights and one
+start); the single `Dmp` steps each dimension in a Python loop. They must give the same
+states to 1e-12, with distinct and shared weights, both formulations, mixed amplitude
+scaling, goals locked one by one (unequal phases), and inside the Drake LeafSystem. Timing
+lives in `pbp-drake bench`, not here.
 """
 
 import numpy as np
@@ -97,6 +98,46 @@ def test_fast_bank_equals_a_plain_per_goal_loop(formulation, shared, goal_count,
                                                 uniform_start, locks):
     bank, dmps, goals = make_banks(formulation, shared, goal_count, 3, uniform_start, seed=4)
     assert run_both(bank, dmps, goals, 40, locks, seed=4) < 1e-12
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+@pytest.mark.parametrize("uniform_start", [True, False], ids=["one_start", "many_starts"])
+def test_a_position_per_goal_steps_as_the_per_goal_loop(formulation, shared, uniform_start):
+    """Positions given `(D, K)`, one per DMP (as `predict` passes them), not the robot's."""
+    bank, dmps, goals = make_banks(formulation, shared, 7, 3, uniform_start, seed=3)
+    rng = np.random.default_rng(3)
+    phase, _, scaled_velocity = bank.initial_state()
+    goals_dk = bank.goals_matrix(goals)
+    for _ in range(20):
+        positions = rng.uniform(-1, 1, (3, 7))
+        phase, stepped, scaled_velocity = bank.advance(phase, positions, scaled_velocity,
+                                                       goals_dk, DT)
+        for j, dmp in enumerate(dmps):
+            position, velocity = dmp.next_step(DT, goals[j], positions[:, j])
+            np.testing.assert_allclose(stepped[:, j], position, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(scaled_velocity[:, j] / bank.duration, velocity,
+                                       rtol=0, atol=1e-12)
+
+
+def test_many_distinct_goals_step_as_the_per_goal_loop():
+    """Enough distinct weights for the product to run in column blocks and a tail
+    (`stepping._BLOCK_BYTES`); a sample of goals, the last ones included, checked."""
+    goal_count = 3400
+    bank, dmps, goals = make_banks("ijspeert", False, goal_count, 3, False, seed=8)
+    assert bank._weight_blocks is not None and bank._weight_tail.shape[1] > 0
+    checked = list(range(0, goal_count, 97)) + [goal_count - 2, goal_count - 1]
+    phase, _, scaled_velocity = bank.initial_state()
+    goals_dk = bank.goals_matrix(goals)
+    robot = np.array([0.1, -0.3, 0.2])
+    for _ in range(5):
+        phase, positions, scaled_velocity = bank.advance(phase, robot[:, None],
+                                                         scaled_velocity, goals_dk, DT)
+        for j in checked:
+            position, velocity = dmps[j].next_step(DT, goals[j], robot)
+            np.testing.assert_allclose(positions[:, j], position, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(scaled_velocity[:, j] / bank.duration, velocity,
+                                       rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
@@ -263,11 +304,11 @@ def pydmps_path(dmp_parameters, dt, duration, y_start, yd_start):
 def test_pydmps_agrees_with_the_ijspeert_form():
     """pydmps integrates `ydd = alpha_z (beta_z (g - y) - yd) + x (g - y0) psi.w / sum psi`
     (tau = 1) with explicit Euler on the phase and semi-implicit Euler on (y, yd); ours steps
-    the same ODE exactly with the forcing held over each step. Same parameters (alpha_z 25,
-    beta_z 25/4, alpha_x, our centres and widths, weights, y0, g) and the same disturbed start.
-    Both are first-order in dt in their own way, so they cannot agree to rounding; they must
-    agree to O(dt), and halving dt must halve the gap (else it is a parameter mismatch, which
-    would not shrink)."""
+    the same ODE in closed form with the forcing linear in time over each step (second order
+    in dt). Same parameters (alpha_z 25, beta_z 25/4, alpha_x, our centres and widths,
+    weights, y0, g) and the same disturbed start. They cannot agree to rounding; they must
+    agree to O(dt), and halving dt must halve the gap, pydmps' first-order error (else it is
+    a parameter mismatch, which would not shrink)."""
     pytest.importorskip("pydmps")
     settings = DmpSettings(basis_count=20)
     times, positions = demonstration(2)

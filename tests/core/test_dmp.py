@@ -151,3 +151,41 @@ def test_short_or_nan_demonstrations_are_refused():
 def test_unknown_formulation_is_refused():
     with pytest.raises(ValueError, match="formulation 'ijsperet' is unknown"):
         DmpSettings(formulation="ijsperet")
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_the_step_is_second_order_against_the_continuous_ode(formulation):
+    """The step against SciPy's `solve_ivp` (DOP853, rtol = atol = 1e-12) on the continuous
+    DMP: a 1-D minimum-jerk `Dmp.straight` reach from 0 to 1 m with tau = 1.5 s and the
+    default settings (alpha_z 25, beta_z 25/4, alpha_x ln 100, 50 basis functions), from
+    rest, the phase `x(t) = exp(-alpha_x t / tau)` continuous, compared at every step of a
+    rollout over tau; the error is the largest position difference.
+
+    The zero-order hold this step replaced (attractor held over each step, first order) was
+    20.8 mm off at 30 Hz and 6.2 mm at 100 Hz; the first-order hold is 0.31 mm and 0.044 mm.
+    """
+    integrate = pytest.importorskip("scipy.integrate")
+    settings = DmpSettings(formulation=formulation)
+    tau = 1.5
+    dmp = Dmp.straight([0.0], [1.0], tau, settings)
+
+    def derivative(t, state):
+        attractor = dmp.attractor(np.exp(-settings.alpha_x * t / tau), dmp.goal)[0]
+        position, z = state
+        return [z / tau, (settings.stiffness * (attractor - position) - settings.damping * z)
+                / tau]
+
+    errors = {}
+    for rate in (30, 100):
+        dt = 1.0 / rate
+        path = dmp.rollout(dt)[:, 0]
+        times = dt * np.arange(path.size)
+        exact = integrate.solve_ivp(derivative, (0.0, times[-1]), [0.0, 0.0], method="DOP853",
+                                    t_eval=times, rtol=1e-12, atol=1e-12)
+        assert exact.success
+        assert exact.y[0, -1] == pytest.approx(1.0, abs=0.02)  # the whole reach
+        errors[rate] = np.abs(path - exact.y[0]).max()
+    assert errors[30] < 2e-3
+    assert errors[100] < 1e-4
+    # Second order: (100 / 30)^2 = 11 asymptotically; 7 here, a first-order step gives 3.3.
+    assert errors[30] / errors[100] > 6

@@ -15,8 +15,19 @@ around a moving attractor
   demonstration's amplitude guard switched the scaling off);
 - pastor:   `y_attr = g - (g - y0) x + (psi.w / sum psi) x`,
 
-so a single exact zero-order-hold step (forcing held over the step) serves both, at the
-cost of one 2x2 matrix shared by every goal and dimension.
+so one closed-form step serves both, at the cost of two 2x2 matrices shared by every goal
+and dimension. Over a step the attractor is taken linear in time between its values at the
+step's phase and at the next phase (a first-order hold): with `A` the system's matrix,
+`Phi = expm(A dt)` and `Gamma = integral_0^dt expm(A s) ds` (`settings.step_matrices`),
+`e = y - y_attr(x0)` and `r = (y_attr(x1) - y_attr(x0)) / dt`,
+
+    y' = y_attr(x1) + Phi00 e + Phi01 z - Gamma00 r,    z' = Phi10 e + Phi11 z - Gamma10 r.
+
+The step is exact for an attractor linear in time over the step, and second order in dt
+for the real one (the phase decays exponentially and the basis is Gaussian): on a 1 m
+minimum-jerk reach with tau = 1.5 s it is 0.31 mm from the continuous ODE at 30 Hz and
+0.044 mm at 100 Hz, where holding the attractor constant over the step (zero-order hold,
+first order) was 20.8 mm and 6.2 mm off (`tests/core/test_dmp.py`).
 
 PBP re-integrates the DMP every control step from the robot's measured position. The DMP
 keeps its own velocity state: resetting it to the robot's measured velocity each step stalls
@@ -27,6 +38,7 @@ from the robot's actual state when the operator lets go.
 The modules, all NumPy only (no Drake import):
 
 - `settings`: `DmpSettings`, the basis, and the memoised constants of one step;
+- `stepping`: the bank's step, vectorised over goals and dimensions (mixed into `DmpBank`);
 - `fitting`: `minimum_jerk`, `validate_demonstration`, `fit_weights` (one demonstration);
 - `single`: `Dmp`, one DMP with a stateful API, the readable reference;
 - `bank`: `DmpBank`, K DMPs as one immutable model, stepped by pure and in-place calls;
@@ -36,11 +48,12 @@ The modules, all NumPy only (no Drake import):
 from pbp_drake.core.dmp.bank import DmpBank
 from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration
 from pbp_drake.core.dmp.settings import (
-    FORMULATIONS, DmpSettings, normalized_basis, phase_decay, transition)
+    FORMULATIONS, DmpSettings, normalized_basis, phase_decay, step_matrices, transition)
 from pbp_drake.core.dmp.single import Dmp
 from pbp_drake.core.dmp.workspace import DmpWorkspace
 
 __all__ = [
     "FORMULATIONS", "Dmp", "DmpBank", "DmpSettings", "DmpWorkspace", "fit_weights",
-    "minimum_jerk", "normalized_basis", "phase_decay", "transition", "validate_demonstration",
+    "minimum_jerk", "normalized_basis", "phase_decay", "step_matrices", "transition",
+    "validate_demonstration",
 ]

@@ -15,9 +15,9 @@ import numpy as np
 
 from pbp_drake.core.dmp._checks import as_point, broadcast_goalwise, positive
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
-from pbp_drake.core.dmp.settings import (
-    DmpSettings, normalized_basis, phase_decay, transition)
+from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import Dmp
+from pbp_drake.core.dmp.stepping import BankStep
 from pbp_drake.core.dmp.workspace import DmpWorkspace
 
 
@@ -29,30 +29,32 @@ def _read_only(array):
     return array
 
 
-class DmpBank:
+class DmpBank(BankStep):
     """K DMPs, one per goal, stepped together from one shared robot state.
 
     Vectorised over goals and dimensions; arrays are laid out `(D, K)` internally. All DMPs
-    share `duration` and `settings` (so one 2x2 transition serves all of them); each has its
-    own weights (or all share one set, e.g. straight paths or one demonstration), its own
-    start and its own phase.
+    share `duration` and `settings` (so one pair of 2x2 step matrices serves all of them);
+    each has its own weights (or all share one set, e.g. straight paths or one
+    demonstration), its own start and its own phase.
 
     The bank is immutable and keeps no state: `initial_state` gives the state at the start
     of a movement and the pure `advance` steps it, returning new arrays. `advance_into` is
     the same step written into arrays the caller owns, with no allocation, using a workspace
-    from `make_workspace`; `offsets_into`, `stepped_positions_into` and
-    `stepped_velocity_into` are its parts (Drake's `DmpBank` system keeps the offsets in its
-    Context and reads the stepped state out on demand).
+    from `make_workspace`; `attractor_terms_into`, `stepped_positions_into` and
+    `stepped_velocity_into` are its parts (`pbp_drake.core.dmp.stepping`; Drake's `DmpBank`
+    system keeps the attractor terms in its Context and reads the stepped state out on
+    demand).
 
     Speed. When all phases are equal (DMPs started together and locked together: the normal
-    case), the basis is evaluated once, `(N,)`, and contracted with the weights: shared
-    weights give a `(D,)` shape broadcast to all goals (O(N D + D K)); distinct weights are
-    one `(N,) x (N, D*K)` matrix-vector product over contiguous memory (memory bound). The
-    per-goal-phase path (phases made unequal by per-goal locks) evaluates `(N, K)` bases.
-    With shared weights, equal phases and one start, the attractor is affine in the goal
-    with per-dimension coefficients, so no per-goal shape is ever formed. The step then
-    makes a fixed number of passes over the workspace's `(D, K)` arrays, using one 2x2
-    transition memoised per step size (`pbp_drake.core.dmp.settings.transition`).
+    case), the basis is evaluated at the step's two phases, `(2, N)`, and contracted with the
+    weights once: shared weights give `(2, D)` shapes broadcast to all goals
+    (O(N D + D K)); distinct weights are one `(2, N) x (N, D*K)` product over contiguous
+    memory (memory bound: the weights are read once). The per-goal-phase path (phases made
+    unequal by per-goal locks) evaluates `(N, K)` bases. With shared weights, equal phases
+    and one start, the step's terms are affine in the goal with per-dimension coefficients,
+    so no per-goal shape is ever formed. The step then makes a fixed number of passes over
+    the workspace's `(D, K)` arrays, using constants memoised per step size
+    (`pbp_drake.core.dmp.stepping.step_constants`).
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
@@ -101,22 +103,6 @@ class DmpBank:
         if getattr(self, "_frozen", False):
             raise AttributeError(f"DmpBank is immutable: cannot set {name!r}")
         object.__setattr__(self, name, value)
-
-    def _derive_constants(self):
-        """Per-bank constants of the step, computed once (read-only)."""
-        self._negative_widths = _read_only(-self._widths)
-        self._ijspeert = self._settings.formulation == "ijspeert"
-        self._stiffness = self._settings.stiffness
-        self._unscaled = _read_only(~self.amplitude_scaling)
-        self._all_scaled = not self._unscaled.any()
-        # Shared weights, a per-dimension amplitude scaling and one start: with equal phases
-        # the attractor is `alpha_g g + alpha_c` per dimension (see `offsets_into`).
-        scaling, starts = self.amplitude_scaling, self.starts
-        self._affine_attractor = (
-            self.shared_weights and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all())
-            and bool((starts == starts[:, :1]).all()))
-        self._uniform_start = _read_only(starts[:, :1])
-        self._scaled_dimensions = _read_only(scaling[:, :1].astype(float))
 
     @classmethod
     def from_dmps(cls, dmps):
@@ -197,76 +183,10 @@ class DmpBank:
             raise ValueError("goals contains NaN or infinite values")
         return goals.reshape(self.goal_count, self.dimension).T
 
-    def transition(self, dt):
-        """The read-only 2x2 zero-order-hold transition of one step of `dt` (memoised)."""
-        return transition(self._stiffness, self._settings.damping, self.duration, dt)
-
-    def decay(self, dt):
-        """The phase factor `exp(-alpha_x dt / tau)` of one step."""
-        return phase_decay(self._settings, self.duration, dt)
-
-    def attractors(self, phase, goals_dk):
-        """The moving attractors `(D, K)` for phases `(K,)` and goals `(D, K)`, a new array."""
-        return self._attractors_into(np.asarray(phase, dtype=float), goals_dk,
-                                     self.make_workspace()).copy()
-
-    def _attractors_into(self, phase, goals_dk, workspace):
-        """The attractors written into `workspace.attractor` (returned)."""
-        shape, x = self._shaped_forcing(phase, workspace)  # shape already times x (and / K)
-        attractor = workspace.attractor
-        np.subtract(goals_dk, self.starts, out=attractor)
-        if self._ijspeert:
-            # g + shape x (g - y0) / K, with 1 for (g - y0) where the scaling is off.
-            if not self._all_scaled:
-                np.copyto(attractor, 1.0, where=self._unscaled)
-            attractor *= shape
-            attractor += goals_dk
-        else:
-            # g - (g - y0) x + shape x
-            attractor *= x
-            np.subtract(goals_dk, attractor, out=attractor)
-            attractor += shape
-        return attractor
-
-    def _shaped_forcing(self, phase, workspace):
-        """`(psi.w / sum psi) x`, divided by K in the Ijspeert form, and the phase.
-
-        Equal phases: the shape is `(D, 1)` (shared weights) or `(D, K)`, the phase a float;
-        a phase per goal: the shape is `(D, K)`, the phase `(K,)`. The shape is a view of
-        the workspace.
-        """
-        if phase.size == 1 or phase.min() == phase.max():
-            x = float(phase.flat[0])
-            psi = workspace.psi
-            np.subtract(x, self._centres, out=psi)
-            np.square(psi, out=psi)
-            psi *= self._negative_widths
-            np.exp(psi, out=psi)
-            scale = x / psi.sum()
-            if self._ijspeert:
-                scale /= self._stiffness
-            psi *= scale
-            if self.shared_weights:
-                np.dot(psi, self._weights, out=workspace.coefficients)
-                return workspace.coefficients[:, np.newaxis], x
-            n = self._settings.basis_count
-            np.dot(psi, self._weights.reshape(n, -1), out=workspace.shape.reshape(-1))
-            return workspace.shape, x
-        # A phase per goal: K bases.
-        phi = normalized_basis(phase, self._centres, self._widths)  # (N, K)
-        shape = workspace.shape
-        if self.shared_weights:
-            np.matmul(self._weights.T, phi, out=shape)
-        else:
-            np.einsum("nk,ndk->dk", phi, self._weights, out=shape)
-        shape *= phase
-        if self._ijspeert:
-            shape /= self._stiffness
-        return shape, phase
-
     def advance(self, phase, positions, scaled_velocity, goals_dk, dt, locked=None,
                 robot_velocity=None):
-        """One exact zero-order-hold step of all K DMPs; pure: returns the new state.
+        """One first-order-hold step of all K DMPs (see `pbp_drake.core.dmp`); pure: returns
+        the new state.
 
         Args:
             phase: (K,) phases; positions: (D, K) or (D, 1) positions to step from (PBP passes
@@ -320,84 +240,13 @@ class DmpBank:
             elif out_velocity is not scaled_velocity:
                 out_velocity[...] = scaled_velocity
             return
-        offset = self.offsets_into(phase, positions, goals_dk, workspace.offset, workspace)
+        dp, dz = workspace.dp, workspace.dz
+        self.attractor_terms_into(phase, positions, goals_dk, dt, dp, dz, workspace)
         # Positions first: `out_velocity` may alias `scaled_velocity`, which they read.
-        self.stepped_positions_into(positions, offset, scaled_velocity, dt, out_positions,
+        self.stepped_positions_into(positions, dp, scaled_velocity, dt, out_positions,
                                     workspace)
-        # `offset` is the workspace's and read no more: it serves as the velocity's scratch.
-        self.stepped_velocity_into(offset, scaled_velocity, dt, out_velocity, workspace,
-                                   overwrite_offset=True)
+        self.stepped_velocity_into(dz, scaled_velocity, dt, out_velocity)
         np.multiply(phase, self.decay(dt), out=out_phase)
-
-    # The step, in parts. With `offset = y - a` (the position stepped from minus the
-    # attractor), the exact zero-order-hold step is
-    #     y' = y + (Phi00 - 1) offset + Phi01 z,    z' = Phi10 offset + Phi11 z,
-    # so a caller may keep `(offset, z)` and read `(y', z')` out later (Drake's DmpBank does:
-    # PBP never feeds the DMPs' own positions back, only the robot's).
-
-    def offsets_into(self, phase, positions, goals_dk, out, workspace):
-        """`out = positions - attractor(phase, goals)`, `(D, K)`; `positions` (D, K) or
-        (D, 1). Two passes over `(D, K)` when the DMPs share weights, phase and start.
-        `out` is the caller's array or `workspace.offset` (the other work arrays are used)."""
-        if self._affine_attractor and (phase.size == 1 or phase.min() == phase.max()):
-            negative_alpha_goal, alpha_constant = self._affine_attractor_coefficients(
-                phase, workspace)
-            # positions - (alpha_g g + alpha_c) = -alpha_g g + (positions - alpha_c)
-            np.multiply(goals_dk, negative_alpha_goal, out=out)
-            if positions.shape[1] == 1:
-                np.subtract(positions, alpha_constant, out=workspace.column)
-                out += workspace.column
-            else:
-                out += positions
-                out -= alpha_constant
-            return out
-        np.subtract(positions, self._attractors_into(phase, goals_dk, workspace), out=out)
-        return out
-
-    def stepped_positions_into(self, positions, offset, scaled_velocity, dt, out, workspace):
-        """`out = positions + (Phi00 - 1) offset + Phi01 z`: the positions after the step
-        (`workspace.work` holds the terms)."""
-        (t00, t01), _ = self.transition(dt)
-        work = workspace.work
-        np.multiply(offset, t00 - 1.0, out=work)
-        np.add(positions, work, out=out)  # `out` may be `positions`
-        np.multiply(scaled_velocity, t01, out=work)
-        out += work
-        return out
-
-    def stepped_velocity_into(self, offset, scaled_velocity, dt, out, workspace,
-                              overwrite_offset=False):
-        """`out = Phi10 offset + Phi11 z`: the scaled velocities after the step (`out` may be
-        `scaled_velocity`). `workspace.work` holds `Phi10 offset`, or, with
-        `overwrite_offset` (a caller done with `offset`), `offset` itself: all passes then
-        stay in arrays the caller already touches."""
-        _, (t10, t11) = self.transition(dt)
-        scratch = offset if overwrite_offset else workspace.work
-        np.multiply(offset, t10, out=scratch)
-        np.multiply(scaled_velocity, t11, out=out)
-        out += scratch
-        return out
-
-    def _affine_attractor_coefficients(self, phase, workspace):
-        """Per dimension `(-alpha_g, alpha_c)` `(D, 1)` with `attractor = alpha_g g + alpha_c`
-        for every goal: shared weights, one phase and one start make it affine in g."""
-        shape, x = self._shaped_forcing(phase, workspace)  # (D, 1): the forcing (x, / K)
-        alpha_goal, alpha_constant = workspace.alpha_goal, workspace.alpha_constant
-        start = self._uniform_start
-        if self._ijspeert:
-            # a = g + c (g - y0) where scaled, g + c where not.
-            np.multiply(shape, self._scaled_dimensions, out=alpha_goal)
-            np.multiply(alpha_goal, -start, out=alpha_constant)
-            alpha_constant += shape
-            alpha_constant -= alpha_goal
-            alpha_goal += 1.0
-        else:
-            # a = g - (g - y0) x + c.
-            alpha_goal.fill(1.0 - x)
-            np.multiply(start, x, out=alpha_constant)
-            alpha_constant += shape
-        np.negative(alpha_goal, out=alpha_goal)
-        return alpha_goal, alpha_constant
 
     def _advance_partly_locked(self, phase, positions, scaled_velocity, goals_dk, dt,
                                out_phase, out_positions, out_velocity, workspace, locked,

@@ -1,11 +1,11 @@
-"""DMP settings, the Gaussian basis, and the constants of one exact step.
+"""DMP settings, the Gaussian basis, and the constants of one step.
 
-The step constants (the 2x2 zero-order-hold transition and the phase decay) depend on the
-settings, the duration and the step only, so they are pure functions here rather than state
-of any DMP object: `transition` is memoised with `functools.lru_cache` (thread-safe in
-CPython: two threads missing together both compute the same value, and the cache's own
-bookkeeping is locked), and it returns a read-only array, so the one array every caller
-shares cannot be changed by any of them.
+The step constants (the 2x2 matrices `Phi` and `Gamma` of the first-order-hold step, see
+`pbp_drake.core.dmp`, and the phase decay) depend on the settings, the duration and the step
+only, so they are pure functions here rather than state of any DMP object: `step_matrices`
+is memoised with `functools.lru_cache` (thread-safe in CPython: two threads missing together
+both compute the same value, and the cache's own bookkeeping is locked), and it returns
+read-only arrays, so the arrays every caller shares cannot be changed by any of them.
 """
 
 import dataclasses
@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from pbp_drake.core.linear import second_order_transition
+from pbp_drake.core.linear import second_order_step
 
 FORMULATIONS = ("ijspeert", "pastor")
 
@@ -87,15 +87,24 @@ def normalized_basis(phase, centres, widths):
 
 
 @functools.lru_cache(maxsize=256)
-def transition(stiffness, damping, duration, dt):
-    """The read-only 2x2 `Phi = expm(A dt)` of the transformation system around its moving
-    attractor (see `pbp_drake.core.dmp`): one matrix for every goal and dimension.
+def step_matrices(stiffness, damping, duration, dt):
+    """The read-only 2x2 `(Phi, Gamma)` of one step of the transformation system around its
+    moving attractor (see `pbp_drake.core.dmp`): `Phi = expm(A dt)` carries
+    `[y - attractor, z]` over the step, `Gamma = integral_0^dt expm(A s) ds` carries the
+    attractor's motion. One pair for every goal and dimension.
 
     Keyed on plain floats, not on `DmpSettings`, because hashing four floats is cheap enough
     for a call every control step and hashing the dataclass is not."""
-    phi = second_order_transition(stiffness, damping, duration, dt)
+    phi, gamma = second_order_step(stiffness, damping, duration, dt)
+    phi, gamma = np.array(phi), np.array(gamma)
     phi.setflags(write=False)
-    return phi
+    gamma.setflags(write=False)
+    return phi, gamma
+
+
+def transition(stiffness, damping, duration, dt):
+    """The read-only 2x2 `Phi = expm(A dt)` of `step_matrices` (memoised there)."""
+    return step_matrices(stiffness, damping, duration, dt)[0]
 
 
 def phase_decay(settings, duration, dt):

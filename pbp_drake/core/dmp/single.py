@@ -11,7 +11,7 @@ import numpy as np
 
 from pbp_drake.core.dmp._checks import as_point, positive
 from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration
-from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, transition
+from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, step_matrices
 
 
 class Dmp:
@@ -106,14 +106,20 @@ class Dmp:
             if robot_velocity is not None:
                 self.scaled_velocity = tau * np.asarray(robot_velocity, float)
             return self.position.copy(), self.scaled_velocity / tau
-        phi = transition(self.settings.stiffness, self.settings.damping, tau, dt)
-        attractor = self.attractor(self.phase, goal)
+        phi, gamma = step_matrices(self.settings.stiffness, self.settings.damping, tau, dt)
+        decay = phase_decay(self.settings, tau, dt)
+        # The attractor moves linearly in time from its value at this step's phase to its
+        # value at the next (first-order hold).
+        start = self.attractor(self.phase, goal)
+        end = self.attractor(self.phase * decay, goal)
         for dim in range(self.start.size):
-            offset = self.position[dim] - attractor[dim]
+            offset = self.position[dim] - start[dim]
             z = self.scaled_velocity[dim]
-            self.position[dim] = attractor[dim] + phi[0, 0] * offset + phi[0, 1] * z
-            self.scaled_velocity[dim] = phi[1, 0] * offset + phi[1, 1] * z
-        self.phase *= phase_decay(self.settings, tau, dt)
+            rate = (end[dim] - start[dim]) / dt
+            self.position[dim] = (end[dim] + phi[0, 0] * offset + phi[0, 1] * z
+                                  - gamma[0, 0] * rate)
+            self.scaled_velocity[dim] = phi[1, 0] * offset + phi[1, 1] * z - gamma[1, 0] * rate
+        self.phase *= decay
         return self.position.copy(), self.scaled_velocity / tau
 
     def rollout(self, dt, duration=None):

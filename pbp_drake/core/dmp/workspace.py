@@ -16,29 +16,34 @@ class DmpWorkspace:
     """Work arrays for a bank of K DMPs in D dimensions with N basis functions.
 
     Attributes:
-        psi: (N,) the basis at one phase.
-        coefficients: (D,) the shared-weights forcing shape.
-        shape: (D, K) the per-goal forcing shape.
-        attractor: (D, K) the moving attractors.
-        offset: (D, K) positions minus attractors (used by `advance_into`).
-        work: (D, K) the last pass of a step.
-        alpha_goal, alpha_constant: (D, 1) the affine attractor's coefficients.
-        column: (D, 1) one position minus `alpha_constant`.
+        phases, scale: (2, 1) the step's two phases, and their basis's scale.
+        psi: (2, N) the basis at the two phases; basis: (2, N) its two combinations.
+        lam: (2, 1) the phases' two combinations.
+        coefficients: (2, D) the shared-weights forcing shapes.
+        shape: (2, D, K) the per-goal forcing shapes (or scratch).
+        amplitude: (D, K) `g - y0`; work: (D, K) `p - g`, and the last pass of a step.
+        dp, dz: (D, K) the step's attractor terms (used by `advance_into`).
+        alpha, beta, column: (2, D, 1) the affine terms' coefficients, and scratch.
     """
 
-    __slots__ = ("dimension", "goal_count", "basis_count", "psi", "coefficients", "shape",
-                 "attractor", "offset", "work", "alpha_goal", "alpha_constant", "column")
+    __slots__ = ("dimension", "goal_count", "basis_count", "phases", "scale", "psi", "basis",
+                 "lam", "coefficients", "shape", "amplitude", "work", "dp", "dz", "alpha",
+                 "beta", "column")
 
     def __init__(self, dimension, goal_count, basis_count):
         d, k, n = dimension, goal_count, basis_count
         self.dimension, self.goal_count, self.basis_count = d, k, n
-        self.psi = np.empty(n)
-        self.coefficients = np.empty(d)
-        self.shape = np.empty((d, k))
-        self.attractor = np.empty((d, k))
-        self.offset = np.empty((d, k))
+        self.phases = np.empty((2, 1))
+        self.scale = np.empty((2, 1))
+        self.psi = np.empty((2, n))
+        self.basis = np.empty((2, n))
+        self.lam = np.empty((2, 1))
+        self.coefficients = np.empty((2, d))
+        self.shape = np.empty((2, d, k))
+        self.amplitude = np.empty((d, k))
         self.work = np.empty((d, k))
-        self.alpha_goal = np.empty((d, 1))
-        self.alpha_constant = np.empty((d, 1))
-        self.column = np.empty((d, 1))
-
+        self.dp = np.empty((d, k))
+        self.dz = np.empty((d, k))
+        self.alpha = np.empty((2, d, 1))
+        self.beta = np.empty((2, d, 1))
+        self.column = np.empty((2, d, 1))

@@ -1,0 +1,287 @@
+"""The step of a `DmpBank`: K DMPs advanced one first-order-hold step, vectorised over (D, K).
+
+Around its moving attractor `a` the transformation system is linear (see
+`pbp_drake.core.dmp`). Over a step the attractor goes linearly in time from `a0`, its value
+at the step's phase `x0`, to `a1`, its value at the next phase
+`x1 = x0 exp(-alpha_x dt / tau)` (a first-order hold), which keeps the step in closed
+form: with `e = y - a0`, the increment `da = a1 - a0` and `(Phi, Gamma)` of
+`pbp_drake.core.dmp.settings.step_matrices`,
+
+    y' = a1 + Phi00 e + Phi01 z - Gamma00 da / dt,    z' = Phi10 e + Phi11 z - Gamma10 da / dt.
+
+The step is affine in the DMP's own velocity `z`:
+
+    y' = y + dp + Phi01 z,    z' = dz + Phi11 z,
+    dp = (Phi00 - 1) e + (1 - Gamma00 / dt) da,    dz = Phi10 e - (Gamma10 / dt) da,
+
+and PBP steps from the robot's position `y = p`, so `(dp, dz)`, "the attractor terms", depend
+on the phase, `p`, the goals and `dt` only (`attractor_terms_into`); `stepped_positions_into`
+and `stepped_velocity_into` add the velocity's part. Drake's `DmpBank` system keeps
+`(z, dp, dz)` in its Context and reads the stepped state out on demand.
+
+Writing `b(x) = a(x) - g` (the attractor relative to the goal),
+
+    dp = (Phi00 - 1)(p - g) + C00 b(x0) + C01 b(x1),
+    dz = Phi10 (p - g) + C10 b(x0) + C11 b(x1),
+
+with the 2x2 `C` of `StepConstants.combination`; `b` is linear in the normalised basis, so
+the weights are contracted once with both rows' combinations of the bases at `x0` and `x1`.
+"""
+
+import functools
+from typing import NamedTuple
+
+import numpy as np
+
+from pbp_drake.core.dmp.settings import normalized_basis, phase_decay, step_matrices
+
+_IDENTITY = np.eye(2)
+_IDENTITY.setflags(write=False)
+# Distinct weights: the (2, N) x (N, D*K) product runs in blocks of columns that fit the L2
+# cache (about this many bytes of weights each). OpenBLAS's one long two-row dgemm took up
+# to twice a one-row dgemv here; in blocks it takes what the dgemv takes (the weights are
+# read once: the step's second phase costs no memory traffic).
+_BLOCK_BYTES = 800_000
+
+
+class StepConstants(NamedTuple):
+    """The numbers of one step of `dt` (see the module docstring), shared by every DMP.
+
+    Attributes:
+        position_offset, position_velocity: `Phi00 - 1`, `Phi01`.
+        velocity_offset, velocity_velocity: `Phi10`, `Phi11`.
+        offset_gains: (2, 1, 1) read-only, `[Phi00 - 1, Phi10]`.
+        combination: (2, 2) read-only `C`:
+            `[[Gamma00 / dt - Phi00, 1 - Gamma00 / dt], [Gamma10 / dt - Phi10, -Gamma10 / dt]]`.
+    """
+
+    position_offset: float
+    position_velocity: float
+    velocity_offset: float
+    velocity_velocity: float
+    offset_gains: np.ndarray
+    combination: np.ndarray
+
+
+@functools.lru_cache(maxsize=256)
+def step_constants(stiffness, damping, duration, dt):
+    """The memoised `StepConstants` of one step (keyed on plain floats, as `step_matrices`)."""
+    phi, gamma = step_matrices(stiffness, damping, duration, dt)
+    g0, g1 = gamma[0, 0] / dt, gamma[1, 0] / dt
+    # dp = (Phi00 - 1) e + (1 - g0) da and dz = Phi10 e - g1 da, with e = (p - g) - b0 and
+    # da = b1 - b0: the coefficients of b0 and b1.
+    combination = np.array([[g0 - phi[0, 0], 1.0 - g0], [g1 - phi[1, 0], -g1]])
+    gains = np.array([phi[0, 0] - 1.0, phi[1, 0]]).reshape(2, 1, 1)
+    combination.setflags(write=False)
+    gains.setflags(write=False)
+    return StepConstants(float(phi[0, 0] - 1.0), float(phi[0, 1]), float(phi[1, 0]),
+                         float(phi[1, 1]), gains, combination)
+
+
+class BankStep:
+    """The stepping half of `pbp_drake.core.dmp.DmpBank`, mixed into it.
+
+    Reads the model `DmpBank.__init__` sets (`_settings`, `duration`, `starts`,
+    `amplitude_scaling`, `_weights`, `shared_weights`, `_centres`, `_widths`) and the
+    constants `_derive_constants` adds; writes only into arrays its callers pass.
+    """
+
+    def _derive_constants(self):
+        """Per-bank constants of the step, computed once (read-only)."""
+        def frozen(array):
+            array = np.array(array, dtype=float)
+            array.setflags(write=False)
+            return array
+
+        self._negative_widths = frozen(-self._widths)
+        self._ijspeert = self._settings.formulation == "ijspeert"
+        self._stiffness = self._settings.stiffness
+        self._damping = self._settings.damping
+        self._unscaled = ~self.amplitude_scaling
+        self._unscaled.setflags(write=False)
+        self._all_scaled = not self._unscaled.any()
+        # Shared weights, a per-dimension amplitude scaling and one start: with equal phases
+        # the attractor terms are `alpha g + beta` per dimension (see `_affine_terms_into`).
+        scaling, starts = self.amplitude_scaling, self.starts
+        self._affine_in_goal = (
+            self.shared_weights and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all())
+            and bool((starts == starts[:, :1]).all()))
+        self._uniform_start = frozen(starts[:, :1])
+        # Read-only views of the distinct weights `(N, D*K)` in column blocks (see
+        # `_BLOCK_BYTES`): `(blocks, N, width)`, and the columns left over.
+        self._weight_blocks = self._weight_tail = None
+        if not self.shared_weights:
+            flat = self._weights.reshape(self._settings.basis_count, -1)
+            width = max(64, _BLOCK_BYTES // flat.itemsize // flat.shape[0])
+            blocks = flat.shape[1] // width
+            if blocks > 1:
+                covered = blocks * width
+                self._weight_blocks = flat[:, :covered].reshape(-1, blocks, width).transpose(
+                    1, 0, 2)
+                self._weight_tail = flat[:, covered:]
+        # b = S (sigma g + rho) for Ijspeert (S the shape; sigma 1 where scaled, and
+        # rho = 1 - sigma (1 + y0)); b = S - lambda (g - y0) for Pastor.
+        sigma = scaling[:, :1].astype(float)
+        self._goal_weight = frozen(sigma if self._ijspeert else np.zeros_like(sigma))
+        self._shape_weight = frozen(
+            1.0 - sigma * (1.0 + starts[:, :1]) if self._ijspeert else np.ones_like(sigma))
+
+    def step_constants(self, dt):
+        """The `StepConstants` of one step of `dt` (memoised)."""
+        return step_constants(self._stiffness, self._damping, self.duration, dt)
+
+    def transition(self, dt):
+        """The read-only 2x2 `Phi = expm(A dt)` of one step of `dt` (memoised)."""
+        return step_matrices(self._stiffness, self._damping, self.duration, dt)[0]
+
+    def decay(self, dt):
+        """The phase factor `exp(-alpha_x dt / tau)` of one step."""
+        return phase_decay(self._settings, self.duration, dt)
+
+    def attractors(self, phase, goals_dk):
+        """The moving attractors `(D, K)` for phases `(K,)` and goals `(D, K)`, a new array."""
+        workspace = self.make_workspace()
+        shapes, lam = self._combined_shapes(np.asarray(phase, dtype=float), 1.0, _IDENTITY,
+                                            workspace)
+        attractor = np.array(goals_dk, dtype=float)
+        self._add_relative_attractor(attractor, shapes[0], lam[0],
+                                     self._amplitudes(goals_dk, workspace), workspace.shape[0])
+        return attractor
+
+    def attractor_terms_into(self, phase, positions, goals_dk, dt, out_dp, out_dz, workspace):
+        """The attractor terms `(dp, dz)` (D, K) of the step from `positions` (D, K) or
+        (D, 1) at phases `phase` (K,) towards `goals_dk`, into `out_dp` and `out_dz` (the
+        caller's, or the workspace's `dp` and `dz`; the other work arrays are used).
+
+        Four passes over `(D, K)` when the DMPs share weights, phase and start."""
+        constants = self.step_constants(dt)
+        equal = phase.size == 1 or phase.min() == phase.max()
+        shapes, lam = self._combined_shapes(phase, self.decay(dt), constants.combination,
+                                            workspace, equal)
+        if self._affine_in_goal and equal:
+            self._affine_terms_into(shapes, lam, positions, goals_dk, constants, out_dp,
+                                    out_dz, workspace)
+            return
+        amplitudes = self._amplitudes(goals_dk, workspace)
+        relative = workspace.work
+        np.subtract(positions, goals_dk, out=relative)  # p - g
+        for row, out, gain in ((0, out_dp, constants.position_offset),
+                               (1, out_dz, constants.velocity_offset)):
+            np.multiply(relative, gain, out=out)
+            self._add_relative_attractor(out, shapes[row], lam[row], amplitudes,
+                                         workspace.shape[row])
+
+    def stepped_positions_into(self, positions, dp, scaled_velocity, dt, out, workspace):
+        """`out = positions + dp + Phi01 z`: the positions after the step (`out` may be
+        `positions`; `workspace.work` holds `Phi01 z`)."""
+        work = workspace.work
+        np.multiply(scaled_velocity, self.step_constants(dt).position_velocity, out=work)
+        np.add(positions, dp, out=out)
+        out += work
+        return out
+
+    def stepped_velocity_into(self, dz, scaled_velocity, dt, out):
+        """`out = dz + Phi11 z`: the scaled velocities after the step (`out` may be
+        `scaled_velocity`, not `dz`). Two passes, no scratch."""
+        np.multiply(scaled_velocity, self.step_constants(dt).velocity_velocity, out=out)
+        out += dz
+        return out
+
+    def _amplitudes(self, goals_dk, workspace):
+        """`g - y0` into `workspace.amplitude`, 1 where the Ijspeert scaling is off."""
+        amplitude = workspace.amplitude
+        np.subtract(goals_dk, self.starts, out=amplitude)
+        if self._ijspeert and not self._all_scaled:
+            np.copyto(amplitude, 1.0, where=self._unscaled)
+        return amplitude
+
+    def _add_relative_attractor(self, out, shape, lam, amplitudes, scratch):
+        """`out += b`, one row's combination of the relative attractors `b = a - g`:
+        `shape * amplitude` (Ijspeert) or `shape - amplitude * lambda` (Pastor). `scratch`
+        is `(D, K)` and may be `shape`."""
+        if self._ijspeert:
+            np.multiply(shape, amplitudes, out=scratch)
+            out += scratch
+        else:
+            out += shape
+            np.multiply(amplitudes, lam, out=scratch)
+            out -= scratch
+
+    def _combined_shapes(self, phase, decay, combination, workspace, equal=None):
+        """For the rows r of `combination` (2x2): the forcing shapes
+        `S_r = C_r0 s(x0) + C_r1 s(x1)`, `s(x) = (psi.w / sum psi) x` (divided by K in the
+        Ijspeert form), `(2, D, 1)` (shared weights, equal phases) or `(2, D, K)`, and
+        `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`, with `x1 = x0 decay`.
+
+        Equal phases: the basis is evaluated at the two phases, `(2, N)`, combined, and
+        contracted with the weights once. A phase per goal: `(N, K)` bases (allocates)."""
+        if equal is None:
+            equal = phase.size == 1 or phase.min() == phase.max()
+        n = self._settings.basis_count
+        if equal:
+            phases, psi, scale = workspace.phases, workspace.psi, workspace.scale
+            phases[0, 0] = phase.flat[0]
+            phases[1, 0] = phases[0, 0] * decay
+            np.subtract(phases, self._centres, out=psi)
+            np.square(psi, out=psi)
+            psi *= self._negative_widths
+            np.exp(psi, out=psi)
+            np.sum(psi, axis=1, keepdims=True, out=scale)
+            np.divide(phases, scale, out=scale)
+            if self._ijspeert:
+                scale /= self._stiffness
+            psi *= scale
+            np.dot(combination, psi, out=workspace.basis)
+            np.dot(combination, phases, out=workspace.lam)
+            if self.shared_weights:
+                np.dot(workspace.basis, self._weights, out=workspace.coefficients)
+                return workspace.coefficients[:, :, np.newaxis], workspace.lam
+            flat = workspace.shape.reshape(2, -1)
+            if self._weight_blocks is None:
+                np.dot(workspace.basis, self._weights.reshape(n, -1), out=flat)
+            else:
+                blocks, _, width = self._weight_blocks.shape
+                covered = blocks * width
+                np.matmul(workspace.basis, self._weight_blocks,
+                          out=flat[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
+                np.matmul(workspace.basis, self._weight_tail, out=flat[:, covered:])
+            return workspace.shape, workspace.lam
+        # A phase per goal: K bases at each end of the step.
+        phases = np.stack([phase, phase * decay])  # (2, K)
+        scaled = [normalized_basis(x, self._centres, self._widths) * x for x in phases]
+        if self._ijspeert:
+            scaled = [basis / self._stiffness for basis in scaled]
+        shapes = workspace.shape
+        for row in range(2):
+            combined = combination[row, 0] * scaled[0] + combination[row, 1] * scaled[1]
+            if self.shared_weights:
+                np.matmul(self._weights.T, combined, out=shapes[row])
+            else:
+                np.einsum("nk,ndk->dk", combined, self._weights, out=shapes[row])
+        return shapes, combination @ phases
+
+    def _affine_terms_into(self, shapes, lam, positions, goals_dk, constants, out_dp, out_dz,
+                           workspace):
+        """Shared weights, one phase and one start: each row's term is `alpha g + beta`
+        with `(D, 1)` coefficients, two passes over `(D, K)` per row."""
+        gains, alpha, beta = constants.offset_gains, workspace.alpha, workspace.beta
+        column = workspace.column
+        # term = gain (p - g) + S (sigma g + rho) [Ijspeert] or + S - lambda (g - y0) [Pastor]
+        np.multiply(shapes, self._goal_weight, out=alpha)
+        alpha -= gains
+        np.multiply(shapes, self._shape_weight, out=beta)
+        if not self._ijspeert:
+            lam = lam[:, :, np.newaxis]
+            alpha -= lam
+            np.multiply(lam, self._uniform_start, out=column)
+            beta += column
+        single = positions.shape[1] == 1
+        if single:
+            np.multiply(gains, positions, out=column)
+            beta += column
+        for row, out in ((0, out_dp), (1, out_dz)):
+            np.multiply(goals_dk, alpha[row], out=out)
+            out += beta[row]
+            if not single:
+                np.multiply(positions, gains[row, 0, 0], out=workspace.work)
+                out += workspace.work

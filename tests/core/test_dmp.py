@@ -189,3 +189,24 @@ def test_the_step_is_second_order_against_the_continuous_ode(formulation):
     assert errors[100] < 1e-4
     # Second order: (100 / 30)^2 = 11 asymptotically; 7 here, a first-order step gives 3.3.
     assert errors[30] / errors[100] > 6
+
+
+def test_a_goal_switch_keeps_the_velocity_of_the_followed_dmp():
+    """The issue's minimal reproduction: two straight DMPs to (2, 1) and (2, -1), tau 10 s,
+    30 Hz, the robot on DMP 0 for 3 s. Each DMP keeping its own velocity, selecting DMP 1
+    makes the commanded velocity jump by 0.41 m/s; stepping every DMP from DMP 0's velocity
+    leaves only the other attractor's pull over one step."""
+    bank = DmpBank.straight([0.0, 0.0], goal_count=2, duration=10.0)
+    goals_dk = bank.goals_matrix([[2.0, 1.0], [2.0, -1.0]])
+    jumps = {}
+    for followed in (None, 0):
+        phase, positions, scaled_velocity = bank.initial_state()
+        robot = positions[:, :1]
+        for _ in range(100):
+            phase, positions, scaled_velocity = bank.advance(
+                phase, robot, scaled_velocity, goals_dk, 0.03, followed=followed)
+            robot = positions[:, :1]  # the robot follows DMP 0 exactly
+        velocities = scaled_velocity.T / bank.duration
+        jumps[followed] = np.linalg.norm(velocities[1] - velocities[0])
+    assert jumps[None] == pytest.approx(0.41, abs=0.02)
+    assert jumps[0] < 0.05

@@ -184,7 +184,7 @@ class DmpBank(BankStep):
         return goals.reshape(self.goal_count, self.dimension).T
 
     def advance(self, phase, positions, scaled_velocity, goals_dk, dt, locked=None,
-                robot_velocity=None):
+                robot_velocity=None, followed=None):
         """One first-order-hold step of all K DMPs (see `pbp_drake.core.dmp`); pure: returns
         the new state.
 
@@ -194,11 +194,21 @@ class DmpBank(BankStep):
             goals_dk: (D, K) goals.
             locked: None, or a bool (or (K,) bools) freezing those DMPs' phases; their
                 velocity then follows `robot_velocity` (D,) and their position stays.
+            followed: None, or the index of the DMP the robot followed until now: every DMP
+                then steps from that DMP's velocity, so that the robot may switch to any of
+                them without a jump of its commanded velocity (PBP's goal switch; see the
+                hand-over law in the README). None: each DMP keeps its own.
         Returns:
             (phase, positions, scaled_velocity) after the step, new arrays.
         """
         phase = np.asarray(phase, dtype=float)
         scaled_velocity = np.asarray(scaled_velocity, dtype=float)
+        if followed is not None:
+            if not 0 <= int(followed) < self.goal_count:
+                raise ValueError(f"followed {followed} is not one of the {self.goal_count} "
+                                 "goals")
+            scaled_velocity = np.repeat(scaled_velocity[:, [int(followed)]], self.goal_count,
+                                        axis=1)
         new_phase = np.empty(phase.shape)
         new_positions = np.empty(scaled_velocity.shape)
         new_velocity = np.empty(scaled_velocity.shape)

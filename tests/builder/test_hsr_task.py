@@ -118,8 +118,10 @@ def test_the_blend_is_computed_once_per_control_tick(fixed_task, monkeypatch):
                                                        original(self, context, output)))
     simulator = Simulator(build_diagram(fixed_task))
     simulator.AdvanceTo(0.6)
-    ticks = round(0.6 / fixed_task.control_period) + 1
-    assert ticks <= len(calls) <= 2 * ticks  # one per tick (and the operator's own moment)
+    # One per tick, at its report stage where the hand-over reads it (the tick at 0.6 s
+    # reports just after the end), and maybe at the operator's own moment.
+    ticks = round(0.6 / fixed_task.control_period)
+    assert ticks <= len(calls) <= 2 * ticks
     assert len(calls) < round(0.6 / fixed_task.robot.station.plant.time_step)
 
 
@@ -185,7 +187,7 @@ def test_keyboard_left_key_moves_the_hand_left(fixed_task):
         station_state.GetMyContextFromRoot(simulator.get_context()))[:3]
     moved = end - start
     # The hand points along +x, so its left is +y.
-    assert moved[1] > 0.2
+    assert moved[1] > 0.15  # 2 s at the keyboard speed, less the hand-over ramps
     assert abs(moved[0]) < 0.05 and abs(moved[2]) < 0.02
 
 

@@ -27,13 +27,17 @@ class EeCommandToPose(LeafSystem):
         - X_WE_desired
 
     `ee_command` is `[p (3), v (3), heading]` (`EeCommand`); the pose is
-    `(Rz(heading) R_E0, p)` where `R_E0` is the hand pointing along world +x.
+    `(Rz(heading) R_E0, position)` where `R_E0` is the hand pointing along world +x, and
+    the position is where the command puts the hand `lead` seconds after now.
 
     With a `command_period` (a control loop that sends, at each tick, the state to be in at
-    the next tick), the position ramps into `p` at velocity `v`: `p - v (t_next - t - lead)`.
-    Tracking `p` as a step once a tick would leave the robot behind by most of a tick's
-    travel, and a policy re-integrated from the robot's state (PBP) would then run slow.
-    `lead` makes up for the lag of differential IK and PD behind the pose they track.
+    the next tick), the position ramps into `p` at velocity `v`: `p - v (t_next - t -
+    lead)`. Tracking `p` as a step once a tick would leave the robot behind by most of a
+    tick's travel, and a policy re-integrated from the robot's state (PBP) would then run
+    slow. Without one, the position is `p + v lead`.
+
+    `lead` is how far ahead the reader wants the pose: the station's diff IK reads it as
+    the pose to have at the end of its step, so it is the diff IK's period there.
     """
 
     def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
@@ -55,11 +59,13 @@ class EeCommandToPose(LeafSystem):
         command = EeCommand(self._command_port.Eval(context))
         R = RotationMatrix.MakeZRotation(command.heading) @ self._R_E0
         position = np.array([command.x, command.y, command.z])
+        velocity = np.array([command.vx, command.vy, command.vz])
+        ahead = self._lead
         if self._period:
             time = context.get_time()
             next_tick = np.ceil(time / self._period - 1e-9) * self._period
-            velocity = np.array([command.vx, command.vy, command.vz])
-            position = position - velocity * (max(0.0, next_tick - time) - self._lead)
+            ahead -= max(0.0, next_tick - time)
+        position = position + velocity * ahead
         output.set_value(RigidTransform(R, position))
 
 

@@ -178,10 +178,15 @@ def test_position_ramp_is_tracked_and_moves_the_base(start, axis):
     assert ee_log.data()[3 + axis, middle] == pytest.approx(0.15, abs=0.02)
     commanded = start[axis] + 0.15 * ee_log.sample_times()[middle]
     assert 0.0 < commanded - p[axis, middle] < 0.0015
-    # The base carried a good part of the motion, and did not turn.
+    # The base carried a good part of the motion, and turned little. Its sideways
+    # acceleration is limited and its yaw's is not (none is published), so diff IK sets
+    # off sideways partly by turning the base (0.12 rad here), which the arm's drift back
+    # to its ready pose then undoes.
     base = state_log.data()[BASE]
     assert base[axis, -1] - base[axis, 0] > 0.2
-    assert np.abs(base[2]).max() < 0.05
+    turn = np.abs(base[2]).max()
+    assert turn < (0.05 if axis == 0 else 0.15)
+    assert np.abs(base[2, -1]) < 0.5 * turn
     # The torso follows the arm lift (the coupler constraint, enforced by SAP).
     torso = state_log.data()[POSITION_INDEX[TORSO_JOINT_NAME]]
     lift = state_log.data()[POSITION_INDEX["arm_lift_joint"]]

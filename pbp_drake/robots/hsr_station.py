@@ -12,10 +12,11 @@ motion, in the shape of manipulation's hardware station::
 Gravity is off, which stands for the ideal gravity compensation of the real robot's
 controllers; nothing else compensates it. The base and the arm are solved together by
 one differential IK, so a target out of the arm's reach moves the base; its plan keeps
-every joint within its velocity limit and the base within its acceleration limits
-(``HsrStationConfig``), and stiff motor servos hold the robot on that plan.
+every joint within its velocity and acceleration limits (the model file's and
+``HsrStationConfig``'s), and stiff motor servos hold the robot on that plan.
 
-Nothing lags: each hand-off reads its reference at the time it is due. The diff IK
+No lag is left to make up: each hand-off reads its reference at the time it is due. The
+diff IK
 steps to the pose the command's ramp reaches at the end of its step (EeCommandToPose
 evaluates the ramp ``diff_ik_time_step`` ahead), and the plant's PD, which compares
 q_d with its positions at the end of its step, is given the plan's position at that
@@ -38,9 +39,6 @@ from pydrake.geometry import (
     CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Rgba,
     Role)
 from pydrake.math import RotationMatrix
-from pydrake.multibody.inverse_kinematics import (
-    DifferentialInverseKinematicsParameters,
-)
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
@@ -116,31 +114,25 @@ def _ready_pose(plant, model, config):
 def _make_diff_ik(plant, model, q0, config, motor_joints):
     """The whole-body diff IK with the model's position and velocity limits and the
     config's acceleration limits, the arm drifting back to the ready pose ``q0``."""
-    ee = plant.GetFrameByName(END_EFFECTOR_FRAME, model)
-    nq = plant.num_positions()
-    params = DifferentialInverseKinematicsParameters(nq, plant.num_velocities())
-    params.set_joint_position_limits(
-        (plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()))
     v_lower, v_upper = plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()
     # The torso does not move the hand (it carries only the head) and follows the lift
     # through the coupler in the plant, so diff IK leaves it where it is.
     torso = plant.GetJointByName(TORSO_JOINT_NAME, model).velocity_start()
     v_lower[torso] = v_upper[torso] = 0.0
-    params.set_joint_velocity_limits((v_lower, v_upper))
     accelerations = np.full(plant.num_velocities(), np.inf)
-    for name, limit in zip(ACTUATED_JOINT_NAMES,
-                           config.base_acceleration_limits + config.arm_acceleration_limits):
-        accelerations[plant.GetJointByName(name, model).velocity_start()] = limit
-    if np.isfinite(accelerations).any():
-        params.set_joint_acceleration_limits((-accelerations, accelerations))
-    params.set_nominal_joint_position(q0)
-    centering = np.zeros(nq)
-    for name in ARM_JOINT_NAMES:
-        centering[plant.GetJointByName(name, model).position_start()] = (
-            config.arm_centering_gain)
-    params.set_joint_centering_gain(np.diag(centering))
-    return WholeBodyDiffIk(plant, ee, config.diff_ik_time_step, params,
-                           config.plant.time_step, motor_joints)
+    centering = np.zeros(plant.num_positions())
+    limits = config.base_acceleration_limits + config.arm_acceleration_limits
+    for name, limit in zip(ACTUATED_JOINT_NAMES, limits):
+        joint = plant.GetJointByName(name, model)
+        accelerations[joint.velocity_start()] = limit
+        if name in ARM_JOINT_NAMES:
+            centering[joint.position_start()] = config.arm_centering_gain
+    return WholeBodyDiffIk(
+        plant, plant.GetFrameByName(END_EFFECTOR_FRAME, model), config.diff_ik_time_step,
+        config.plant.time_step, motor_joints,
+        position_limits=(plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()),
+        velocity_limits=(v_lower, v_upper), acceleration_limits=(-accelerations, accelerations),
+        q_nominal=q0, centering_gain=centering)
 
 
 def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Diagram:

@@ -36,7 +36,8 @@ class HsrStationConfig:
     Gains are the plant's PD on each motor (base x, y in N/m and N·s/m, yaw and the arm's
     revolute joints in N·m/rad and N·m·s/rad, arm lift in N/m); the plant applies them
     implicitly, so stiff gains stay stable at a coarse time step. Acceleration limits are
-    in m/s² (base x, y, arm lift) and rad/s² (the others); ``.inf`` is no limit.
+    in m/s² (base x, y, arm lift) and rad/s² (the others); ``.inf`` is no limit. What is
+    published about the robot is in the model file and these comments; the rest is ours.
     """
 
     plant: MultibodyPlantConfig = dataclasses.field(default_factory=_default_plant_config)
@@ -50,34 +51,41 @@ class HsrStationConfig:
     initial_base: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
     # The hand's height at the start (m); it starts level, pointing along the base's +x.
     ee_height: float = 0.7
-    # Base (x, y, yaw) and arm (lift, flex, roll, wrist flex, wrist roll): stiff servos
-    # (about 100 rad/s, critically damped, on the robot's mass, 34 kg and 1 kg·m² for the
-    # base, 6 kg for the lift with the torso, 0.31 kg·m² for the flex; the light wrist
-    # joints stiffer still) that hold the diff IK's plan to a few hundredths of a mm, so
-    # a control loop re-integrating from the measured hand sees no lag.
-    base_kp: list[float] = dataclasses.field(default_factory=lambda: [3.5e5, 3.5e5, 1.0e4])
-    base_kd: list[float] = dataclasses.field(default_factory=lambda: [7000.0, 7000.0, 200.0])
+    # Base (x, y, yaw) and arm (lift, flex, roll, wrist flex, wrist roll): stiff servos,
+    # kp = I w² and kd = 2 I w (critically damped) with w = 300 rad/s on each joint's
+    # inertia I at the ready pose (34 kg for x and y, 1.0 kg·m² for yaw, 6.1 kg for the
+    # lift with the torso, 0.31, 0.013, 0.015, 0.001 kg·m² for the others). Accelerating at
+    # its limit a joint then trails the plan by a / w², at most a few hundredths of a mm
+    # at the hand, so a control loop re-integrating from the measured hand sees no lag.
+    # At w = 200, a diagonal drive at 0.12 m/s kept swinging by +-9 % a tick.
+    base_kp: list[float] = dataclasses.field(default_factory=lambda: [3.0e6, 3.0e6, 9.0e4])
+    base_kd: list[float] = dataclasses.field(default_factory=lambda: [2.0e4, 2.0e4, 600.0])
     arm_kp: list[float] = dataclasses.field(
-        default_factory=lambda: [6.0e4, 3000.0, 500.0, 300.0, 300.0])
+        default_factory=lambda: [5.5e5, 2.8e4, 1200.0, 1400.0, 90.0])
     arm_kd: list[float] = dataclasses.field(
-        default_factory=lambda: [1200.0, 60.0, 50.0, 30.0, 30.0])
-    # The base's acceleration limits (x, y, yaw), enforced by the diff IK on its plan.
-    # Published (hsrb_moveit_config joint_limits.yaml): 0.05 m/s² for x and y, none for
-    # yaw. Ours for x and y: 0.3 m/s², a departure. At 0.05 m/s² the base needs 3.2 s to
-    # reach 0.16 m/s, more than the arm can cover: driven at 0.16 m/s along x, the hand
-    # fell to 0.52 of it for 2 s, and stopping from it, the base dragged the hand on by
-    # 19 cm (26 cm on the diagonal). 0.2 m/s² was the least that followed and stopped in
-    # every case we drove; 0.3 leaves a margin.
+        default_factory=lambda: [3700.0, 190.0, 7.8, 9.0, 0.6])
+    # Acceleration limits, enforced by the diff IK on its plan (the servos follow it; see
+    # WholeBodyDiffIk). Base (x, y, yaw): published (hsrb_moveit_config joint_limits.yaml)
+    # 0.05 m/s² for x and y, none for yaw. Ours, for x and y, 0.3: a departure. At 0.05
+    # the base needs 3.2 s to reach 0.16 m/s, more than the arm can cover: driven at
+    # 0.16 m/s along x the hand fell to 0.63 of it and stayed under 0.9 for 1.7 s, and
+    # told to stop, the base dragged it on by 7 cm. At 0.1 the hand followed and stopped,
+    # but turning back from 0.16 m/s along x took 2 s to get within 10 % of the command
+    # again (1.2 s at 0.2, 0.15 s at 0.3). Yaw, ours: 5 rad/s², its top speed in 0.2 s.
+    # With none, diff IK swung the base at up to 100 rad/s² to set the hand off sideways,
+    # and at 0.16 m/s sideways the hand's speed kept swinging by 10 % a tick.
     base_acceleration_limits: list[float] = dataclasses.field(
-        default_factory=lambda: [0.3, 0.3, np.inf])
-    # The arm's acceleration limits (lift, flex, roll, wrist flex, wrist roll). None is
-    # published and none is set: the arm takes up what the base cannot yet do, and
-    # Drake's diff IK scales the whole hand motion down to meet any limit, so arm limits
-    # made the hand surge and stall at every start (at [5, 20, 40, 30, 30] it overshot
-    # by 44 % in a tick). The motors' effort limits (the model's) bound the arm's
-    # accelerations in the plant.
+        default_factory=lambda: [0.3, 0.3, 5.0])
+    # Arm (lift, flex, roll, wrist flex, wrist roll): none is published. Ours: the lift
+    # and the flex, which carry the arm, reach their top speed (0.2 m/s, 1.2 rad/s) in
+    # 0.2 s; the roll and the wrist joints, which carry the hand only, theirs (2.0, 1.5,
+    # 1.5 rad/s) in 0.05 s. The hand then sets off within about three control ticks.
+    # Without limits the arm's joints took up to 310 rad/s² and overran their speed
+    # limits by up to 24 %; lift and flex twice as fast made a vertical start overshoot
+    # by 12 %; roll and wrists as slow as the flex made the base first turn 0.38 rad the
+    # wrong way when the hand's heading turned at 0.5 rad/s.
     arm_acceleration_limits: list[float] = dataclasses.field(
-        default_factory=lambda: [np.inf] * 5)
+        default_factory=lambda: [1.0, 6.0, 40.0, 30.0, 30.0])
     # How fast the arm drifts back to the ready pose (1/s) inside the diff IK's null
     # space; the base has no centering, so it takes over what the arm held.
     arm_centering_gain: float = 1.0

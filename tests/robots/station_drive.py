@@ -1,28 +1,30 @@
 """Drives an HSR station the way the PBP control loop does (a test helper).
 
-Every control period the driver samples the hand's position y at the tick and commands
-``[y + v dt, v, heading0]``: the state to be in at the next tick, re-integrated from the
-measured hand, so any tracking lag directly slows the hand.
+Every control period the hand's state is sampled at the tick (a ``SampleHold``, as in the
+PBP diagram) and, at the tick's decide stage, the driver commands ``[y + v dt, v,
+heading0]``: the state to be in at the next tick, re-integrated from the measured hand, so
+any tracking lag directly slows the hand.
 """
+
+import dataclasses
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput
 
 from pbp_drake.robots import HsrStationConfig, hsr_initial_ee_state, make_hsr_station
 from pbp_drake.systems import SampleHold
-from pbp_drake.systems.layouts import EeCommand, EeState
+from pbp_drake.systems.layouts import EeState
 from pbp_drake.systems.tick import decide_offset
 
 CONTROL_PERIOD = 0.03
 
 
 class TickDriver(LeafSystem):
-    """Commands ``[y + v dt, v, heading0]`` each tick, with ``y`` the hand's position
-    sampled at the tick (a ``SampleHold`` in front, as in the PBP diagram) and ``v =
-    velocity(t_k)``; it decides at the decide stage of the tick
-    (``pbp_drake.systems.tick``), as the PBP controller does."""
+    """Commands ``[y + v dt, v, heading0]`` at each tick's decide stage
+    (``pbp_drake.systems.tick``), with ``y`` the hand's position sampled at the tick and
+    ``v = velocity(t_k)``."""
 
     def __init__(self, period, start, velocity):
         super().__init__()
@@ -41,14 +43,29 @@ class TickDriver(LeafSystem):
         discrete_state.set_value(np.concatenate([y + v * self._period, v, [self._heading]]))
 
 
-def drive(velocity, duration, config=None, state_period=None):
-    """Runs a station (``config``, ``command_period`` set to the tick) under the driver.
+@dataclasses.dataclass
+class Drive:
+    """What a drive logged. At a tick the loggers hold the state at that tick and the
+    command decided at the tick before."""
 
-    Returns (tick times, hand positions at the ticks (3, N), plant state times, plant
-    states (2 nq... as logged every ``state_period``, the plant step when None)).
-    """
-    config = config if config is not None else HsrStationConfig()
-    config.command_period = CONTROL_PERIOD
+    tick_times: np.ndarray
+    hands: np.ndarray  # (3, ticks): the hand's position at each tick
+    commands: np.ndarray  # (7, ticks): the command in force up to each tick
+    state_times: np.ndarray
+    states: np.ndarray  # the plant's state every state_period
+    desired_states: np.ndarray  # the station's desired_state every state_period
+
+    def speeds(self, direction):
+        """The hand's per-tick speed along ``direction`` (unit): one-tick differences of
+        its positions at the ticks, over the period."""
+        return np.asarray(direction) @ np.diff(self.hands, axis=1) / CONTROL_PERIOD
+
+
+def drive(velocity, duration, config=None, state_period=None):
+    """Runs a station of ``config`` (its ``command_period`` set to the tick) under the
+    driver for ``duration`` seconds; the plant's state and the desired state are logged
+    every ``state_period`` (the plant's step when None)."""
+    config = dataclasses.replace(config or HsrStationConfig(), command_period=CONTROL_PERIOD)
     station = make_hsr_station(config)
     builder = DiagramBuilder()
     builder.AddNamedSystem("hsr_station", station)
@@ -58,16 +75,13 @@ def drive(velocity, duration, config=None, state_period=None):
     driver = builder.AddNamedSystem("driver", TickDriver(CONTROL_PERIOD, start, velocity))
     builder.Connect(sample.get_output_port(), driver.get_input_port())
     builder.Connect(driver.get_output_port(), station.GetInputPort("ee_command"))
-    ee_log = LogVectorOutput(station.GetOutputPort("ee_state"), builder, CONTROL_PERIOD)
-    state_log = LogVectorOutput(station.GetOutputPort("state"), builder,
-                                state_period or config.plant.time_step)
+    period = state_period or config.plant.time_step
+    logs = [LogVectorOutput(station.GetOutputPort("ee_state"), builder, CONTROL_PERIOD),
+            LogVectorOutput(driver.get_output_port(), builder, CONTROL_PERIOD),
+            LogVectorOutput(station.GetOutputPort("state"), builder, period),
+            LogVectorOutput(station.GetOutputPort("desired_state"), builder, period)]
     simulator = Simulator(builder.Build())
     simulator.AdvanceTo(duration)
-    context = simulator.get_context()
-    ee, state = ee_log.FindLog(context), state_log.FindLog(context)
-    return ee.sample_times(), ee.data()[:3], state.sample_times(), state.data()
-
-
-def tick_speeds(positions, direction):
-    """Per-tick speed along ``direction`` (unit): one-tick differences / the period."""
-    return np.asarray(direction) @ np.diff(positions, axis=1) / CONTROL_PERIOD
+    ee, commands, states, desired = (log.FindLog(simulator.get_context()) for log in logs)
+    return Drive(ee.sample_times(), ee.data()[:3], commands.data(), states.sample_times(),
+                 states.data(), desired.data())

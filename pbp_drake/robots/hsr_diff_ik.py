@@ -7,50 +7,74 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
-# How much more a unit of hand-velocity error (m/s, rad/s) weighs than a unit of the arm's
-# drift toward its ready pose (rad/s), when the limits do not allow both.
+# How much more a unit of the hand's velocity error (m/s) weighs than a unit of the joints'
+# drift toward their nominal positions (m/s, rad/s), so that the drift costs the hand
+# nothing measurable (it biases the hand's velocity by about 1e-6 of the drift's).
 TASK_WEIGHT = 1e6
-# The weight of falling short along the desired twist (rather than straying from it).
-ALONG_WEIGHT = 1e5
+# Where the limits do not allow the whole desired twist, falling short along it weighs a
+# tenth of straying from it: the hand slows down rather than swerve.
+ALONG_WEIGHT = 0.1
+# An angular velocity error of 1 rad/s weighs as 0.32 m/s: where the limits bind, the
+# hand's heading gives before its position.
+ROTATION_WEIGHT = 0.1
+# The plan closes its gap to the command over this many steps (the command's own velocity
+# is fed forward), so that what the limits held back is not made up in one burst.
+CATCH_UP_STEPS = 3
 
 
-def solve_box_qp(H, g, lower, upper, max_iterations=100):
+def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     """``argmin 0.5 x'Hx - g'x`` subject to ``lower <= x <= upper`` (H positive definite,
-    ``lower <= upper``), by a primal active-set method: exact, and quick for the few
-    variables of a robot's joints."""
-    x = np.linalg.solve(H, g)
-    if np.all(x >= lower) and np.all(x <= upper):
-        return x
-    x = np.clip(x, lower, upper)
-    fixed = (x <= lower) | (x >= upper)
+    ``lower <= upper``), exactly, by a primal active-set method, quick for the few
+    variables of a robot's joints.
+
+    ``hold`` guesses which variables end at a bound (-1 lower, 1 upper, 0 neither), such
+    as the last solution's; a good guess saves iterations, and any guess gives the same
+    minimum. Returns the minimizer and which variables it holds at a bound.
+    """
+    n = g.size
+    identity = np.eye(n)
+    hold = np.zeros(n) if hold is None else np.asarray(hold)
+    fixed = (hold != 0) | (lower == upper)
+    x = np.clip(np.where(hold < 0, lower, np.where(hold > 0, upper, 0.0)), lower, upper)
     tolerance = 1e-12 * (1.0 + np.abs(g).max())
-    for _ in range(max_iterations):
-        free = ~fixed
-        target = x.copy()
-        if free.any():
-            H_free = H[free]
-            target[free] = np.linalg.solve(H_free[:, free], g[free] - H_free[:, fixed] @ x[fixed])
-        step = target - x
-        with np.errstate(divide="ignore", invalid="ignore"):
-            reach = np.where(step < 0, (lower - x) / step,
-                             np.where(step > 0, (upper - x) / step, np.inf))
-        reach[fixed] = np.inf
-        blocking = int(np.argmin(reach))
-        if reach[blocking] < 1.0:
-            # Go as far as the first bound in the way and hold that variable there.
-            x = np.clip(x + reach[blocking] * step, lower, upper)
-            x[blocking] = lower[blocking] if step[blocking] < 0 else upper[blocking]
+    for iteration in range(max_iterations):
+        # The minimum over the free variables, the held ones where they are.
+        target = np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
+        target[fixed] = x[fixed]
+        below, above = ~fixed & (target < lower), ~fixed & (target > upper)
+        outside = below | above
+        if outside.any():
+            if iteration == 0:
+                # The guess left these out of their bounds: hold them at the bounds
+                # they passed, and go on from there (a feasible point).
+                x = np.clip(target, lower, upper)
+                fixed |= outside
+                continue
+            # Go as far toward the minimum as the first bound in the way, and hold that
+            # variable there.
+            bound = np.where(below, lower, upper)
+            step = target - x
+            ratios = (bound[outside] - x[outside]) / step[outside]
+            k = int(np.argmin(ratios))
+            blocking = int(np.flatnonzero(outside)[k])
+            x = np.clip(x + ratios[k] * step, lower, upper)
+            x[blocking] = bound[blocking]
             fixed[blocking] = True
             continue
-        x = np.clip(target, lower, upper)
+        x = target
+        # Held variables whose bound the cost pulls away from are let go: all at once,
+        # or the one pulled hardest once that has taken long (which always ends).
         gradient = H @ x - g
-        # A held variable may leave its bound if the cost falls that way.
         leaving = fixed & (lower < upper) & (((x <= lower) & (gradient < -tolerance))
                                              | ((x >= upper) & (gradient > tolerance)))
         if not leaving.any():
-            return x
-        fixed[int(np.argmax(np.abs(gradient) * leaving))] = False
-    return x
+            return x, np.where(fixed & (x <= lower), -1.0,
+                               np.where(fixed & (x >= upper), 1.0, 0.0))
+        if iteration < 2 * n:
+            fixed &= ~leaving
+        else:
+            fixed[int(np.argmax(np.abs(gradient) * leaving))] = False
+    raise RuntimeError(f"solve_box_qp did not converge in {max_iterations} iterations")
 
 
 class WholeBodyDiffIk(LeafSystem):
@@ -62,19 +86,21 @@ class WholeBodyDiffIk(LeafSystem):
         name: WholeBodyDiffIk
         input_ports:
         - X_WE_desired
+        - V_WE_desired
         - robot_state
         output_ports:
         - desired_state
 
-    At each step ``t_n`` (period ``time_step``) it picks the velocity ``v_n`` that
-    brings the end effector from the plan's pose to ``X_WE_desired`` by ``t_n +
-    time_step`` as nearly as the joints' position, velocity and acceleration limits
-    allow (a least-squares QP; the accelerations relative to the plan's previous
-    velocity; where the limits bind, the hand rather falls short along its motion than
-    strays from it), and in the rest of the joint space drifts toward ``q_nominal`` at
-    ``centering_gain`` (1/s, per joint). The plan then moves at ``v_n`` until ``t_n +
-    time_step``: it is piecewise linear in position. ``X_WE_desired`` is thus read as
-    the pose to have at the end of the step.
+    At each step ``t_n`` (period ``time_step``) it picks the velocity ``v_n`` of the
+    plan until ``t_n + time_step``: the hand's desired twist ``V_WE_desired`` (in the
+    world frame, ``[w, v]``) plus what closes the gap from the plan's pose to
+    ``X_WE_desired`` over ``CATCH_UP_STEPS`` steps, as nearly as the joints' position,
+    velocity and acceleration limits allow (a least-squares QP, the accelerations taken
+    relative to the plan's previous velocity), and in the rest of the joint space a drift
+    toward ``q_nominal`` at ``centering_gain`` (1/s, per joint). ``X_WE_desired`` is
+    thus read as the pose to have at the end of the step: on a pose moving at
+    ``V_WE_desired`` the plan stays exactly on it. The plan is piecewise linear in
+    position.
 
     Drake's ``DifferentialInverseKinematicsIntegrator`` does not do for this: it keeps
     positions only, so it would take acceleration limits relative to zero velocity (a
@@ -115,13 +141,19 @@ class WholeBodyDiffIk(LeafSystem):
         self._q_nominal = np.asarray(q_nominal, float)
         self._centering_gain = np.broadcast_to(np.asarray(centering_gain, float), (nq,))
         self._identity = np.eye(nv)
-        self._identity6 = np.eye(6)
+        self._task_weights = TASK_WEIGHT * np.array([ROTATION_WEIGHT] * 3 + [1.0] * 3)
+        self._world = plant.world_frame()
+        self._origin = np.zeros(3)
+        self._q_output = self._position_indices
+        self._v_output = nq + self._velocity_indices
         self._pose_port = self.DeclareAbstractInputPort(
             "X_WE_desired", AbstractValue.Make(RigidTransform()))
+        self._twist_port = self.DeclareVectorInputPort("V_WE_desired", 6)
         self._robot_state_port = self.DeclareVectorInputPort(
             "robot_state", plant.num_multibody_states())
-        # [q at t_end, v, t_end]: the plan reaches q at t_end moving at v.
-        self._plan = self.DeclareDiscreteState(nq + nv + 1)
+        # [q at t_end, v, t_end, hold]: the plan reaches q at t_end moving at v; hold is
+        # which velocities the last step's QP held at a bound (its next first guess).
+        self._plan = self.DeclareDiscreteState(nq + 2 * nv + 1)
         self.DeclarePeriodicDiscreteUpdateEvent(self._time_step, 0.0, self._step)
         self.DeclareInitializationDiscreteUpdateEvent(self._start)
         self._desired_port = self.DeclareVectorOutputPort(
@@ -130,6 +162,9 @@ class WholeBodyDiffIk(LeafSystem):
 
     def get_X_WE_desired_input_port(self):
         return self._pose_port
+
+    def get_V_WE_desired_input_port(self):
+        return self._twist_port
 
     def get_robot_state_input_port(self):
         return self._robot_state_port
@@ -140,43 +175,39 @@ class WholeBodyDiffIk(LeafSystem):
     def _start(self, context, discrete_state):
         q = self._robot_state_port.Eval(context)[:self._nq]
         discrete_state.set_value(np.concatenate([q, np.zeros(self._nq),
-                                                 [context.get_time()]]))
+                                                 [context.get_time()], np.zeros(self._nq)]))
 
     def _step(self, context, discrete_state):
         plan = context.get_discrete_state(self._plan).get_value()
-        q, v = plan[:self._nq], plan[self._nq:2 * self._nq]
-        dt = self._time_step
-        v_next = self._solve(q, v, self._pose_port.Eval(context))
+        n, dt = self._nq, self._time_step
+        q, v, hold = plan[:n], plan[n:2 * n], plan[2 * n + 1:]
+        v_next, hold = self._solve(q, v, self._pose_port.Eval(context),
+                                   self._twist_port.Eval(context), hold)
         q_next = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
-        discrete_state.set_value(np.concatenate([q_next, v_next, [context.get_time() + dt]]))
+        discrete_state.set_value(
+            np.concatenate([q_next, v_next, [context.get_time() + dt], hold]))
 
-    def _solve(self, q, v, X_WE_desired):
-        """The velocity for the next step: the hand's desired twist in least squares,
-        the drift to the nominal positions in the Jacobian's null space, in the limits."""
-        plant, context, dt = self._plant, self._plant_context, self._time_step
+    def _solve(self, q, v, X_WE_desired, V_WE_desired, hold):
+        """The velocity for the next step, and which velocities it holds at a bound."""
+        plant, context, dt, world = self._plant, self._plant_context, self._time_step, self._world
         plant.SetPositions(context, q)
-        world = plant.world_frame()
         X_WE = self._frame_E.CalcPose(context, world)
         J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, self._frame_E,
-                                              np.zeros(3), world, world)
+                                              self._origin, world, world)
         rotation = (X_WE_desired.rotation() @ X_WE.rotation().inverse()).ToAngleAxis()
-        twist = np.concatenate([rotation.axis() * rotation.angle(),
-                                X_WE_desired.translation() - X_WE.translation()]) / dt
-        # The projector onto J's null space, I - J⁺J (damped a little, should J lose
-        # rank at a singularity of the arm).
-        null_space = self._identity - J.T @ np.linalg.solve(J @ J.T + 1e-10 * self._identity6,
-                                                            J)
-        centering = self._centering_gain * (self._q_nominal - q)
-        # Where the limits do not allow the whole twist, falling short along it costs
-        # less than straying from it: the hand slows down rather than swerve.
-        norm = np.linalg.norm(twist)
-        W = TASK_WEIGHT * self._identity6
+        gap = np.concatenate([rotation.axis() * rotation.angle(),
+                              X_WE_desired.translation() - X_WE.translation()])
+        twist = V_WE_desired + (gap - dt * V_WE_desired) / (CATCH_UP_STEPS * dt)
+        # The cost |J v - twist|² in the task weights D, with its part along the twist
+        # weighing ALONG_WEIGHT of the rest: W = D - (1 - ALONG_WEIGHT) D t t' D / t'D t.
+        JD = J.T * self._task_weights
+        JDt = JD @ twist
+        H = JD @ J + self._identity
+        g = self._centering_gain * (self._q_nominal - q)
+        norm = twist @ (self._task_weights * twist)
         if norm > 0:
-            along = twist / norm
-            W = W - (TASK_WEIGHT - ALONG_WEIGHT) * np.outer(along, along)
-        JW = J.T @ W
-        H = JW @ J + null_space
-        g = JW @ twist + null_space @ centering
+            H -= (1.0 - ALONG_WEIGHT) / norm * np.outer(JDt, JDt)
+            g += ALONG_WEIGHT * JDt
         # Within the velocity limits, the acceleration limits from v, and the position
         # limits by the end of the step; where the last two conflict, brake.
         accel_lower = v + self._a_lower * dt
@@ -184,12 +215,12 @@ class WholeBodyDiffIk(LeafSystem):
         lower = np.maximum(np.maximum(self._v_lower, accel_lower), (self._q_lower - q) / dt)
         upper = np.minimum(np.minimum(self._v_upper, accel_upper), (self._q_upper - q) / dt)
         conflict = lower > upper
-        lower[conflict] = upper[conflict] = np.clip(0.0, accel_lower, accel_upper)[conflict]
-        return solve_box_qp(H, g, lower, upper)
+        if conflict.any():
+            lower[conflict] = upper[conflict] = np.clip(0.0, accel_lower, accel_upper)[conflict]
+        return solve_box_qp(H, g, lower, upper, hold)
 
     def _calc_desired_state(self, context, output):
         plan = context.get_discrete_state(self._plan).get_value()
-        q, v, t_end = plan[:self._nq], plan[self._nq:2 * self._nq], plan[-1]
-        q_d = q + v * (context.get_time() + self._look_ahead - t_end)
-        output.SetFromVector(np.concatenate(
-            [q_d[self._position_indices], v[self._velocity_indices]]))
+        v_d = plan[self._v_output]
+        ahead = context.get_time() + self._look_ahead - plan[2 * self._nq]
+        output.SetFromVector(np.concatenate([plan[self._q_output] + ahead * v_d, v_d]))

@@ -4,8 +4,8 @@
 everything between an operator's (or a policy's) end-effector command and the robot's
 motion, in the shape of manipulation's hardware station::
 
-    ee_command ─► EeCommandToPose ─► WholeBodyDiffIk ─► [q_d, v_d] (desired_state)
-    [q_d, v_d] (motor joints) ─► the plant's PD on every motor
+    ee_command ─► EeCommandToPose ─► X_WE_desired, V_WE_desired ─► WholeBodyDiffIk
+    WholeBodyDiffIk ─► [q_d, v_d] (desired_state) ─► the plant's PD on every motor
     plant ─► EeStateFromPlant ─► ee_state
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
 
@@ -15,15 +15,15 @@ one differential IK, so a target out of the arm's reach moves the base; its plan
 every joint within its velocity and acceleration limits (the model file's and
 ``HsrStationConfig``'s), and stiff motor servos hold the robot on that plan.
 
-No lag is left to make up: each hand-off reads its reference at the time it is due. The
-diff IK
-steps to the pose the command's ramp reaches at the end of its step (EeCommandToPose
-evaluates the ramp ``diff_ik_time_step`` ahead), and the plant's PD, which compares
-q_d with its positions at the end of its step, is given the plan's position at that
-time (``WholeBodyDiffIk``). A control loop that re-integrates its command from the
-measured hand (``p = y + v dt``, as PBP and teleoperation do) thus moves the hand at
-``v``, and a hand sampled at a tick is the hand at that tick (the plant's output ports
-are live; see ``validate_hsr_station_config``).
+No lag is left to make up: each hand-off reads its reference at the time it is due, with
+the velocity it moves at. EeCommandToPose ramps the command between ticks (position and
+heading) and gives the pose the ramp reaches at the end of a diff IK step, and its
+velocity; the diff IK plans to be there then, its servos given the plan's position at
+the end of each plant step, which is where the plant's implicit PD compares it. A
+control loop that re-integrates its command from the measured hand (``p = y + v dt``,
+as PBP and teleoperation do) thus moves the hand at ``v``, and a hand sampled at a tick
+is the hand at that tick (the plant's output ports are live; see
+``validate_hsr_station_config``).
 
 Example::
 
@@ -200,6 +200,8 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
                                                               motor_joints))
     builder.Connect(command_to_pose.get_pose_output_port(),
                     diff_ik.get_X_WE_desired_input_port())
+    builder.Connect(command_to_pose.get_velocity_output_port(),
+                    diff_ik.get_V_WE_desired_input_port())
     # Read at initialization only, so that the plan starts from the plant's state (no
     # jump even if the caller moves the robot in the context).
     builder.Connect(plant.get_state_output_port(), diff_ik.get_robot_state_input_port())

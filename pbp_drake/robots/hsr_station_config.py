@@ -57,7 +57,8 @@ class HsrStationConfig:
     # lift with the torso, 0.31, 0.013, 0.015, 0.001 kg·m² for the others). Accelerating at
     # its limit a joint then trails the plan by a / w², at most a few hundredths of a mm
     # at the hand, so a control loop re-integrating from the measured hand sees no lag.
-    # At w = 200, a diagonal drive at 0.12 m/s kept swinging by +-9 % a tick.
+    # At w = 100, setting off at 0.08 to 0.12 m/s overshot the command by up to 13 % for
+    # a tick (8 % at 150).
     base_kp: list[float] = dataclasses.field(default_factory=lambda: [3.0e6, 3.0e6, 9.0e4])
     base_kd: list[float] = dataclasses.field(default_factory=lambda: [2.0e4, 2.0e4, 600.0])
     arm_kp: list[float] = dataclasses.field(
@@ -72,22 +73,22 @@ class HsrStationConfig:
     # told to stop, the base dragged it on by 7 cm. At 0.1 the hand followed and stopped,
     # but turning back from 0.16 m/s along x took 2 s to get within 10 % of the command
     # again (1.2 s at 0.2, 0.15 s at 0.3). Yaw, ours: 5 rad/s², its top speed in 0.2 s.
-    # With none, diff IK swung the base at up to 100 rad/s² to set the hand off sideways,
-    # and at 0.16 m/s sideways the hand's speed kept swinging by 10 % a tick.
+    # With none, diff IK swung the base at up to 95 rad/s² to set the hand off sideways,
+    # and the hand overshot a 0.16 m/s sideways command by 18 %.
     base_acceleration_limits: list[float] = dataclasses.field(
         default_factory=lambda: [0.3, 0.3, 5.0])
     # Arm (lift, flex, roll, wrist flex, wrist roll): none is published. Ours: the lift
     # and the flex, which carry the arm, reach their top speed (0.2 m/s, 1.2 rad/s) in
     # 0.2 s; the roll and the wrist joints, which carry the hand only, theirs (2.0, 1.5,
     # 1.5 rad/s) in 0.05 s. The hand then sets off within about three control ticks.
-    # Without limits the arm's joints took up to 310 rad/s² and overran their speed
-    # limits by up to 24 %; lift and flex twice as fast made a vertical start overshoot
-    # by 12 %; roll and wrists as slow as the flex made the base first turn 0.38 rad the
-    # wrong way when the hand's heading turned at 0.5 rad/s.
+    # Without limits the flex and the wrist flex took up to 200 rad/s² and the lift
+    # 27 m/s²; lift and flex twice as fast made a vertical start overshoot by 17 %; roll
+    # and wrists as slow as the flex let a teleoperated hand, turning as it went, run up
+    # to 22 % over the fastest command.
     arm_acceleration_limits: list[float] = dataclasses.field(
         default_factory=lambda: [1.0, 6.0, 40.0, 30.0, 30.0])
-    # How fast the arm drifts back to the ready pose (1/s) inside the diff IK's null
-    # space; the base has no centering, so it takes over what the arm held.
+    # How fast the arm drifts back to the ready pose (1/s) in the joint motion the hand's
+    # leaves free; the base has no centering, so it takes over what the arm held.
     arm_centering_gain: float = 1.0
     # Cylinders measured against the robot (not felt by it); with any, the station has
     # the input obstacle_positions and the outputs in_collision and clearance.

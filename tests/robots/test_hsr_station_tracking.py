@@ -111,6 +111,28 @@ def test_joints_keep_within_their_velocity_and_acceleration_limits(case):
     assert np.all(tick_accelerations.max(axis=1) <= bound * acceleration_limits)
 
 
+def test_hand_keeps_its_speed_while_its_heading_turns():
+    # Along an arc: the hand moves at 0.12 m/s where it points, and its heading turns at
+    # 0.8 rad/s (the virtual participant's turning speed), so the base must both turn and
+    # swing round.
+    rate, speed = 0.8, 0.12
+
+    def velocity(t):
+        return speed * np.array([np.cos(rate * t), np.sin(rate * t), 0.0])
+
+    result = drive(velocity, 4.0, turn=lambda t: rate * t)
+    steps = np.diff(result.hands, axis=1) / CONTROL_PERIOD
+    speeds = np.linalg.norm(steps, axis=0) / speed
+    assert speeds.max() < 1.1
+    settled = speeds[result.tick_times[1:] > 1.0]
+    assert settled.min() > 0.9
+    # Each command asks for the next tick's heading; the hand keeps to that ramp, a tick
+    # behind the command.
+    lag = np.angle(np.exp(1j * (rate * (result.tick_times - CONTROL_PERIOD)
+                                - result.headings)))
+    assert np.abs(lag[result.tick_times > 1.0]).max() < 0.01
+
+
 @pytest.mark.parametrize("direction", [[1.0, 0.0, 0.0], DIAGONAL], ids=["x", "diagonal"])
 def test_hand_stops_where_it_is_told_to(direction):
     # At 0.16 m/s for 3 s (the base at full speed by then), then v = 0: the hand stops

@@ -8,8 +8,8 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
 # How much more a unit of the hand's velocity error (m/s) weighs than a unit of the joints'
-# drift toward their nominal positions (m/s, rad/s), so that the drift costs the hand
-# nothing measurable (it biases the hand's velocity by about 1e-6 of the drift's).
+# drift toward their nominal positions (m/s, rad/s): the drift takes what the hand's motion
+# leaves free and costs the hand nothing measurable.
 TASK_WEIGHT = 1e6
 # Where the limits do not allow the whole desired twist, falling short along it weighs a
 # tenth of straying from it: the hand slows down rather than swerve.

@@ -30,7 +30,7 @@ _PUBLIC = {
     # The robot.
     "add_hsr": "pbp_drake.robots.hsr_model",
     "make_hsr_station": "pbp_drake.robots.hsr_station",
-    "HsrStationConfig": "pbp_drake.robots.hsr_station",
+    "HsrStationConfig": "pbp_drake.robots.hsr_station_config",
     "hsr_initial_ee_state": "pbp_drake.robots.hsr_station",
     "hsr_ready_ee_state": "pbp_drake.robots.hsr_station",
     # Drake systems.

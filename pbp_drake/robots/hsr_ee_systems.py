@@ -7,6 +7,7 @@ from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.layouts import EeCommand, EeState
+from pbp_drake.systems.tick import decide_offset
 
 
 def heading_of(R_WE: RotationMatrix) -> float:
@@ -16,7 +17,7 @@ def heading_of(R_WE: RotationMatrix) -> float:
 
 
 class EeCommandToPose(LeafSystem):
-    """Turns the end-effector command into the desired pose for diff IK.
+    """Turns the end-effector command into the desired pose and velocity for diff IK.
 
     .. pydrake_system::
 
@@ -25,15 +26,25 @@ class EeCommandToPose(LeafSystem):
         - ee_command
         output_ports:
         - X_WE_desired
+        - V_WE_desired
 
-    `ee_command` is `[p (3), v (3), heading]` (`EeCommand`); the pose is
-    `(Rz(heading) R_E0, p)` where `R_E0` is the hand pointing along world +x.
+    `ee_command` is `[p (3), v (3), heading]` (`EeCommand`). `X_WE_desired` is where the
+    command puts the hand `lead` seconds from now, `(Rz(heading) R_E0, position)` with
+    `R_E0` the hand pointing along world +x; `V_WE_desired` is the hand's spatial velocity
+    `[w (3), v (3)]` in the world frame along the way.
 
     With a `command_period` (a control loop that sends, at each tick, the state to be in at
-    the next tick), the position ramps into `p` at velocity `v`: `p - v (t_next - t - lead)`.
-    Tracking `p` as a step once a tick would leave the robot behind by most of a tick's
-    travel, and a policy re-integrated from the robot's state (PBP) would then run slow.
-    `lead` makes up for the lag of differential IK and PD behind the pose they track.
+    the next tick) both ramp: the position into `p` at `v`, `p - v (t_next - t - lead)`,
+    and the heading into the command's from the last tick's command, at a constant rate.
+    Stepping to `p` and the heading once a tick would leave the robot behind by most of a
+    tick's travel (a policy re-integrated from the robot's state, PBP, would then run
+    slow), and would ask the robot for the whole turn at once. The last tick's heading is
+    sampled just after each tick, before a controller that decides at the PBP loop's
+    decide stage (`pbp_drake.systems.tick`) changes the command. Without a
+    `command_period`, the position is `p + v lead` and the heading the command's.
+
+    `lead` is how far ahead the reader wants the pose: the station's diff IK reads it as
+    the pose to have at the end of its step, so it is the diff IK's period there.
     """
 
     def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
@@ -42,8 +53,15 @@ class EeCommandToPose(LeafSystem):
         self._period = command_period
         self._lead = float(lead)
         self._command_port = self.DeclareVectorInputPort("ee_command", EeCommand.size)
+        self._last_heading = self.DeclareDiscreteState(1)
+        self.DeclareInitializationDiscreteUpdateEvent(self._sample_heading)
+        if command_period:
+            self.DeclarePeriodicDiscreteUpdateEvent(
+                command_period, 0.5 * decide_offset(command_period), self._sample_heading)
         self._pose_port = self.DeclareAbstractOutputPort(
             "X_WE_desired", lambda: AbstractValue.Make(RigidTransform()), self._calc_pose)
+        self._velocity_port = self.DeclareVectorOutputPort(
+            "V_WE_desired", 6, self._calc_velocity)
 
     def get_ee_command_input_port(self):
         return self._command_port
@@ -51,16 +69,37 @@ class EeCommandToPose(LeafSystem):
     def get_pose_output_port(self):
         return self._pose_port
 
+    def get_velocity_output_port(self):
+        return self._velocity_port
+
+    def _sample_heading(self, context, discrete_state):
+        discrete_state.set_value(self._last_heading,
+                                 [EeCommand(self._command_port.Eval(context)).heading])
+
+    def _heading_rate(self, context, command):
+        if not self._period:
+            return 0.0
+        last = context.get_discrete_state(self._last_heading).get_value()[0]
+        turn = (command.heading - last + np.pi) % (2 * np.pi) - np.pi
+        return turn / self._period
+
+    def _calc_velocity(self, context, output):
+        command = EeCommand(self._command_port.Eval(context))
+        output.SetFromVector([0.0, 0.0, self._heading_rate(context, command),
+                              command.vx, command.vy, command.vz])
+
     def _calc_pose(self, context, output):
         command = EeCommand(self._command_port.Eval(context))
-        R = RotationMatrix.MakeZRotation(command.heading) @ self._R_E0
         position = np.array([command.x, command.y, command.z])
+        velocity = np.array([command.vx, command.vy, command.vz])
+        ahead = self._lead
         if self._period:
             time = context.get_time()
             next_tick = np.ceil(time / self._period - 1e-9) * self._period
-            velocity = np.array([command.vx, command.vy, command.vz])
-            position = position - velocity * (max(0.0, next_tick - time) - self._lead)
-        output.set_value(RigidTransform(R, position))
+            ahead -= max(0.0, next_tick - time)
+        heading = command.heading + self._heading_rate(context, command) * ahead
+        R = RotationMatrix.MakeZRotation(heading) @ self._R_E0
+        output.set_value(RigidTransform(R, position + velocity * ahead))
 
 
 class EeStateFromPlant(LeafSystem):

@@ -4,15 +4,26 @@
 everything between an operator's (or a policy's) end-effector command and the robot's
 motion, in the shape of manipulation's hardware station::
 
-    ee_command ─► EeCommandToPose ─► DifferentialInverseKinematicsIntegrator ─► q_d
-    q_d (motor joints) ─► StateInterpolatorWithDiscreteDerivative ─► [q_d, v_d]
-    [q_d (+ h v_d on the base), v_d] ─► the plant's PD on every motor (desired_state)
+    ee_command ─► EeCommandToPose ─► X_WE_desired, V_WE_desired ─► WholeBodyDiffIk
+    WholeBodyDiffIk ─► [q_d, v_d] (desired_state) ─► the plant's PD on every motor
     plant ─► EeStateFromPlant ─► ee_state
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
 
 Gravity is off, which stands for the ideal gravity compensation of the real robot's
 controllers; nothing else compensates it. The base and the arm are solved together by
-one differential IK, so a target out of the arm's reach moves the base.
+one differential IK, so a target out of the arm's reach moves the base; its plan keeps
+every joint within its velocity and acceleration limits (the model file's and
+``HsrStationConfig``'s), and stiff motor servos hold the robot on that plan.
+
+No lag is left to make up: each hand-off reads its reference at the time it is due, with
+the velocity it moves at. EeCommandToPose ramps the command between ticks (position and
+heading) and gives the pose the ramp reaches at the end of a diff IK step, and its
+velocity; the diff IK plans to be there then, its servos given the plan's position at
+the end of each plant step, which is where the plant's implicit PD compares it. A
+control loop that re-integrates its command from the measured hand (``p = y + v dt``,
+as PBP and teleoperation do) thus moves the hand at ``v``, and a hand sampled at a tick
+is the hand at that tick (the plant's output ports are live; see
+``validate_hsr_station_config``).
 
 Example::
 
@@ -23,23 +34,16 @@ Example::
     builder.Connect(hold.get_output_port(), station.GetInputPort("ee_command"))
 """
 
-import dataclasses
-
 import numpy as np
 from pydrake.geometry import (
     CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Rgba,
     Role)
 from pydrake.math import RotationMatrix
-from pydrake.multibody.inverse_kinematics import (
-    DifferentialInverseKinematicsIntegrator,
-    DifferentialInverseKinematicsParameters,
-)
-from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant, MultibodyPlantConfig
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
-from pydrake.systems.primitives import MatrixGain, StateInterpolatorWithDiscreteDerivative
-from pydrake.visualization import VisualizationConfig
 
+from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
 from pbp_drake.robots.hsr_ee_systems import EeCommandToPose, EeStateFromPlant, heading_of
 from pbp_drake.robots.hsr_model import (
     ACTUATED_JOINT_NAMES,
@@ -51,6 +55,11 @@ from pbp_drake.robots.hsr_model import (
     actuator_name,
     add_hsr,
 )
+from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
+    CylinderObstacle,
+    HsrStationConfig,
+    validate_hsr_station_config,
+)
 from pbp_drake.systems.collision_monitor import CollisionMonitor
 from pbp_drake.systems.layouts import EeState
 from pbp_drake.systems.obstacle_geometry import CylinderObstacleGeometry
@@ -59,103 +68,6 @@ from pbp_drake.systems.obstacle_geometry import CylinderObstacleGeometry
 # the hand starts in front of the base with room to move both ways along x with the
 # arm alone; arm_lift then sets the height.
 READY_ARM_FLEX = -0.5
-# How far the robot lags behind the pose it tracks (s): about one diff-IK step and the PD.
-TRACKING_LAG = 0.005
-
-
-@dataclasses.dataclass
-class CylinderObstacle:
-    """An upright cylinder the station measures the robot against (m)."""
-
-    radius: float = 0.12
-    height: float = 1.2
-
-
-def _default_plant_config():
-    # SAP enforces the torso's coupler constraint and applies the motors' PD implicitly.
-    return MultibodyPlantConfig(time_step=0.005, discrete_contact_approximation="sap")
-
-
-def _default_visualization():
-    # Meshcat only: the proximity shapes, contact forces and inertias are off by default
-    # (each is a publisher at every frame).
-    return VisualizationConfig(publish_proximity=False, publish_contacts=False,
-                               publish_inertia=False)
-
-
-@dataclasses.dataclass
-class HsrStationConfig:
-    """Everything ``make_hsr_station`` builds from; loads with ``yaml_load_typed``.
-
-    Gains are the plant's PD on each motor (base x, y in N/m and N·s/m, yaw and the arm's
-    revolute joints in N·m/rad and N·m·s/rad, arm lift in N/m); the plant applies them
-    implicitly, so stiff gains stay stable at a coarse time step.
-    """
-
-    plant: MultibodyPlantConfig = dataclasses.field(default_factory=_default_plant_config)
-    # The whole-body differential IK's period (s), a whole multiple of plant.time_step;
-    # its QP is the station's largest cost.
-    diff_ik_time_step: float = 0.01
-    # The period of a control loop that sends each tick the state [p, v] to reach at the
-    # next tick; the station then ramps into p at v (see EeCommandToPose). None: track p.
-    command_period: float | None = None
-    # The base's pose (x, y in m, yaw in rad) at the start; x, y within the model's 10 m.
-    initial_base: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
-    # The hand's height at the start (m); it starts level, pointing along the base's +x.
-    ee_height: float = 0.7
-    # Base (x, y, yaw). The robot (34 kg, about 3 kg·m² about z) follows the diff IK's
-    # velocity feed-forward; implicit damping stays stable beyond the explicit bound
-    # mass / time_step, so it is heavy here: setting off at full speed, the base
-    # overshoots its speed limit by about 7 % (18 % at 1200 / 200).
-    base_kp: list[float] = dataclasses.field(default_factory=lambda: [8000.0, 8000.0, 1500.0])
-    base_kd: list[float] = dataclasses.field(default_factory=lambda: [3000.0, 3000.0, 400.0])
-    # Arm (lift, flex, roll, wrist flex, wrist roll).
-    arm_kp: list[float] = dataclasses.field(
-        default_factory=lambda: [2000.0, 1000.0, 500.0, 300.0, 300.0])
-    arm_kd: list[float] = dataclasses.field(
-        default_factory=lambda: [200.0, 100.0, 50.0, 30.0, 30.0])
-    # How fast the arm drifts back to the ready pose (1/s) inside the diff IK's null
-    # space; the base has no centering, so it takes over what the arm held.
-    arm_centering_gain: float = 1.0
-    # Cylinders measured against the robot (not felt by it); with any, the station has
-    # the input obstacle_positions and the outputs in_collision and clearance.
-    obstacles: list[CylinderObstacle] = dataclasses.field(default_factory=list)
-    # What the station shows in Meshcat when it is given one (Drake's config; its
-    # illustration and proximity settings are used, its LCM and contact parts are not).
-    visualization: VisualizationConfig = dataclasses.field(
-        default_factory=_default_visualization)
-
-
-def validate_hsr_station_config(config: HsrStationConfig) -> None:
-    """Raises ValueError naming the first field of ``config`` that cannot work."""
-    time_step = config.plant.time_step
-    if not time_step > 0:
-        raise ValueError(f"HsrStationConfig.plant.time_step must be positive (a discrete "
-                         f"plant enforces the torso coupler), got {time_step}")
-    if config.plant.discrete_contact_approximation == "tamsi":
-        raise ValueError("HsrStationConfig.plant.discrete_contact_approximation 'tamsi' "
-                         "ignores the torso coupler; use 'sap' or 'lagged'")
-    steps = config.diff_ik_time_step / time_step
-    if not (config.diff_ik_time_step > 0 and abs(steps - round(steps)) < 1e-9):
-        raise ValueError(f"HsrStationConfig.diff_ik_time_step must be a whole multiple of "
-                         f"plant.time_step {time_step}, got {config.diff_ik_time_step}")
-    if config.command_period is not None and not config.command_period > 0:
-        raise ValueError(f"HsrStationConfig.command_period must be positive or None, got "
-                         f"{config.command_period}")
-    if len(config.initial_base) != 3 or not np.all(np.isfinite(config.initial_base)):
-        raise ValueError(f"HsrStationConfig.initial_base must be finite [x, y, yaw], got "
-                         f"{config.initial_base}")
-    for name, size in [("base_kp", 3), ("base_kd", 3), ("arm_kp", 5), ("arm_kd", 5)]:
-        gains = getattr(config, name)
-        if len(gains) != size or not all(np.isfinite(gains)) or min(gains) < 0:
-            raise ValueError(f"HsrStationConfig.{name} must be {size} gains >= 0, got {gains}")
-    if not config.arm_centering_gain >= 0:
-        raise ValueError(f"HsrStationConfig.arm_centering_gain must be >= 0, got "
-                         f"{config.arm_centering_gain}")
-    for index, obstacle in enumerate(config.obstacles):
-        if not (obstacle.radius > 0 and obstacle.height > 0):
-            raise ValueError(f"HsrStationConfig.obstacles[{index}] needs a positive radius "
-                             f"and height, got {obstacle}")
 
 
 def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
@@ -199,26 +111,28 @@ def _ready_pose(plant, model, config):
     return q0, plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(context)
 
 
-def _make_diff_ik(plant, model, q0, config):
-    ee = plant.GetFrameByName(END_EFFECTOR_FRAME, model)
-    nq = plant.num_positions()
-    params = DifferentialInverseKinematicsParameters(nq, plant.num_velocities())
-    params.set_joint_position_limits(
-        (plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()))
+def _make_diff_ik(plant, model, q0, config, motor_joints):
+    """The whole-body diff IK with the model's position and velocity limits and the
+    config's acceleration limits, the arm drifting back to the ready pose ``q0``."""
     v_lower, v_upper = plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()
     # The torso does not move the hand (it carries only the head) and follows the lift
     # through the coupler in the plant, so diff IK leaves it where it is.
     torso = plant.GetJointByName(TORSO_JOINT_NAME, model).velocity_start()
     v_lower[torso] = v_upper[torso] = 0.0
-    params.set_joint_velocity_limits((v_lower, v_upper))
-    params.set_nominal_joint_position(q0)
-    centering = np.zeros(nq)
-    for name in ARM_JOINT_NAMES:
-        centering[plant.GetJointByName(name, model).position_start()] = (
-            config.arm_centering_gain)
-    params.set_joint_centering_gain(np.diag(centering))
-    return DifferentialInverseKinematicsIntegrator(
-        plant, ee, config.diff_ik_time_step, params, log_only_when_result_state_changes=True)
+    accelerations = np.full(plant.num_velocities(), np.inf)
+    centering = np.zeros(plant.num_positions())
+    limits = config.base_acceleration_limits + config.arm_acceleration_limits
+    for name, limit in zip(ACTUATED_JOINT_NAMES, limits):
+        joint = plant.GetJointByName(name, model)
+        accelerations[joint.velocity_start()] = limit
+        if name in ARM_JOINT_NAMES:
+            centering[joint.position_start()] = config.arm_centering_gain
+    return WholeBodyDiffIk(
+        plant, plant.GetFrameByName(END_EFFECTOR_FRAME, model), config.diff_ik_time_step,
+        config.plant.time_step, motor_joints,
+        position_limits=(plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()),
+        velocity_limits=(v_lower, v_upper), acceleration_limits=(-accelerations, accelerations),
+        q_nominal=q0, centering_gain=centering)
 
 
 def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Diagram:
@@ -248,8 +162,8 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``); ``ee_state`` is
     ``[p (3), v (3), heading, heading_rate]`` (``EeState``) of the hand in the world.
     ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]`` the plant's PD
-    tracks, in motor order (``ACTUATED_JOINT_NAMES``; the base's q_d one plant step ahead,
-    where the implicit PD measures the positions); ``body_poses`` and
+    tracks, in motor order (``ACTUATED_JOINT_NAMES``; q_d is the diff IK's plan one plant
+    step ahead, where the implicit PD measures the positions); ``body_poses`` and
     ``query_object`` are the plant's and SceneGraph's. ``obstacle_positions`` is
     ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the
     smallest robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
@@ -276,41 +190,23 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     # R_E0 is the hand's orientation at heading 0, whatever the initial base yaw.
     R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
 
+    # The diff IK reads its input as the pose to have at the end of its step.
     command_to_pose = builder.AddNamedSystem("ee_command_to_pose", EeCommandToPose(
-        R_E0, config.command_period, lead=TRACKING_LAG))
-    diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, model, q0, config))
-    builder.Connect(command_to_pose.get_pose_output_port(),
-                    diff_ik.GetInputPort("X_AE_desired"))
-    # Connected only so that the integrator's initialization event starts it from the
-    # plant's state (no jump even if the caller moves the robot in the context); with
-    # use_robot_state unconnected it then integrates its own state, which is stable.
-    builder.Connect(plant.get_state_output_port(), diff_ik.GetInputPort("robot_state"))
-
+        R_E0, config.command_period, lead=config.diff_ik_time_step))
     # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()
                     for index in plant.GetJointActuatorIndices(model)]
-    selector = np.zeros((len(motor_joints), plant.num_positions()))
-    for row, joint in enumerate(motor_joints):
-        selector[row, joint.position_start()] = 1.0
-    motor_positions = builder.AddNamedSystem("motor_positions", MatrixGain(selector))
-    builder.Connect(diff_ik.get_output_port(), motor_positions.get_input_port())
-    interpolator = builder.AddNamedSystem(
-        "motor_velocities",
-        StateInterpolatorWithDiscreteDerivative(len(motor_joints), config.diff_ik_time_step))
-    builder.Connect(motor_positions.get_output_port(), interpolator.get_input_port())
-    # The plant's implicit PD compares q_d with the positions at the END of its step, so
-    # [q_d, v_d] at t_n leaves a motor h v_d behind: 0.8 mm at 0.15 m/s, which a control
-    # loop re-integrating from the robot's state (PBP, teleop) turns into 15 % less speed.
-    # The base's q_d is fed one step ahead, q_d + h v_d; the arm's lag is already made up
-    # by EeCommandToPose's lead (TRACKING_LAG, tuned with the arm's PD).
-    motors, h = len(motor_joints), config.plant.time_step
-    look_ahead = np.eye(2 * motors)
-    for row, joint in enumerate(motor_joints):
-        if joint.name() in BASE_JOINT_NAMES:
-            look_ahead[row, motors + row] = h
-    desired = builder.AddNamedSystem("desired_state", MatrixGain(look_ahead))
-    builder.Connect(interpolator.get_output_port(), desired.get_input_port())
-    builder.Connect(desired.get_output_port(), plant.get_desired_state_input_port(model))
+    diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, model, q0, config,
+                                                              motor_joints))
+    builder.Connect(command_to_pose.get_pose_output_port(),
+                    diff_ik.get_X_WE_desired_input_port())
+    builder.Connect(command_to_pose.get_velocity_output_port(),
+                    diff_ik.get_V_WE_desired_input_port())
+    # Read at initialization only, so that the plan starts from the plant's state (no
+    # jump even if the caller moves the robot in the context).
+    builder.Connect(plant.get_state_output_port(), diff_ik.get_robot_state_input_port())
+    builder.Connect(diff_ik.get_desired_state_output_port(),
+                    plant.get_desired_state_input_port(model))
 
     ee_body = plant.GetFrameByName(END_EFFECTOR_FRAME, model).body()
     ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(ee_body.index()))
@@ -321,7 +217,7 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     builder.ExportInput(command_to_pose.get_ee_command_input_port(), "ee_command")
     builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
     builder.ExportOutput(plant.get_state_output_port(), "state")
-    builder.ExportOutput(desired.get_output_port(), "desired_state")
+    builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
     builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
     if config.obstacles:

@@ -25,7 +25,7 @@ from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
-from pbp_drake.robots.hsr_station import HsrStationConfig
+from pbp_drake.robots.hsr_station_config import HsrStationConfig
 from pbp_drake.systems.gamepad_operator import GamepadParams
 from pbp_drake.systems.keyboard_operator import KeyboardParams
 from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionParams

@@ -78,7 +78,8 @@ def make_pbp_controller(resolved, prediction_steps=0):
         [3, OperatorCommand.size - 3]))
     builder.ExportInput(command_split.get_input_port(), "operator_command")
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
-        EeState(resolved.initial_ee_state).heading, period))
+        EeState(resolved.initial_ee_state).heading, period,
+        scenario.robot.max_hand_yaw_acceleration))
     builder.ConnectInput("operator_command", heading.get_operator_command_input_port())
 
     blender = builder.AddNamedSystem("blender", Blender(

@@ -322,6 +322,8 @@ def _check_hand_over(scenario):
         acceleration = check_limit(robot.max_hand_acceleration,
                                    "scenario.robot.max_hand_acceleration", "m/s^2")
         top_speed = check_limit(robot.max_hand_speed, "scenario.robot.max_hand_speed", "m/s")
+        yaw_acceleration = check_limit(robot.max_hand_yaw_acceleration,
+                                       "scenario.robot.max_hand_yaw_acceleration", "rad/s^2")
     except ValueError as error:
         raise ScenarioError(str(error)) from None
     speed = max(robot.speed, getattr(scenario.operator, "speed", 0.0) or 0.0)
@@ -334,6 +336,12 @@ def _check_hand_over(scenario):
             f"scenario.robot.max_hand_acceleration {acceleration} m/s^2 takes "
             f"{speed / acceleration:.1f} s to reach the task's speed {speed} m/s, longer "
             f"than scenario.duration {scenario.duration} s: raise it")
+    turn = getattr(scenario.operator, "rotation_speed", 0.0) or 0.0
+    if turn / yaw_acceleration > scenario.duration:
+        raise ScenarioError(
+            f"scenario.robot.max_hand_yaw_acceleration {yaw_acceleration} rad/s^2 takes "
+            f"{turn / yaw_acceleration:.1f} s to reach the operator's rotation_speed {turn} "
+            f"rad/s, longer than scenario.duration {scenario.duration} s: raise it")
 
 
 def _check_reach_task(task):

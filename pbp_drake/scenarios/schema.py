@@ -81,6 +81,8 @@ class Hsr:
     # max_hand_speed (m/s), however far a primitive is from its attractor.
     max_hand_acceleration: float = 1.0
     max_hand_speed: float = 0.25
+    # The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
+    max_hand_yaw_acceleration: float = 4.0
 
 
 @dataclasses.dataclass

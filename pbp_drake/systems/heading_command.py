@@ -3,6 +3,7 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.core.hand_over import check_limit, hand_over
 from pbp_drake.systems.layouts import OperatorCommand
 from pbp_drake.systems.tick import decide_offset
 
@@ -19,20 +20,27 @@ class HeadingCommand(LeafSystem):
         - heading
 
     `operator_command` is `OperatorCommand` (`[vx, vy, vz, yaw_rate]`); each control period
-    the heading moves by `yaw_rate * control_period`. The DMPs never turn the robot: in PBP
-    the operator's turning is how it tells the goal estimator where it wants to go. Like the
+    the heading moves by `yaw_rate * control_period`; with `max_yaw_acceleration` (rad/s^2)
+    the rate it turns at follows the operator's under the hand-over law
+    (`pbp_drake.core.hand_over`), so starting and stopping a turn is not a step. The DMPs
+    never turn the robot: in PBP the operator's turning is how it tells the goal estimator
+    where it wants to go. Like the
     DMP bank, it updates at the decide stage (`update_offset` after the tick, by default
     `pbp_drake.systems.tick.decide_offset`) to use the operator's command of that tick.
     """
 
-    def __init__(self, initial_heading, control_period, update_offset=None):
+    def __init__(self, initial_heading, control_period, max_yaw_acceleration=None,
+                 update_offset=None):
         super().__init__()
         self._period = float(control_period)
         if update_offset is None:
             update_offset = decide_offset(self._period)
+        self._max_yaw_acceleration = (np.inf if max_yaw_acceleration is None else check_limit(
+            max_yaw_acceleration, "max_yaw_acceleration", "rad/s^2"))
         self._command_port = self.DeclareVectorInputPort("operator_command",
                                                          OperatorCommand.size)
         index = self.DeclareDiscreteState(np.array([float(initial_heading)]))
+        self._yaw_rate_index = self.DeclareDiscreteState(np.zeros(1))
         self._heading_port = self.DeclareStateOutputPort("heading", index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
@@ -43,6 +51,11 @@ class HeadingCommand(LeafSystem):
         return self._heading_port
 
     def _update(self, context, discrete_state):
-        heading = context.get_discrete_state_vector().value()[0]
-        yaw_rate = OperatorCommand(self._command_port.Eval(context)).yaw_rate
-        discrete_state.get_mutable_vector().set_value([heading + yaw_rate * self._period])
+        heading = discrete_state.get_mutable_vector(0).get_mutable_value()
+        yaw_rate = discrete_state.get_mutable_vector(self._yaw_rate_index).get_mutable_value()
+        wanted = OperatorCommand(self._command_port.Eval(context)).yaw_rate
+        # The hand-over law in one dimension: the turn's rate changes by at most
+        # max_yaw_acceleration * period a tick, and the heading moves at that rate.
+        heading[:], yaw_rate[:] = hand_over(yaw_rate, heading + wanted * self._period,
+                                            [wanted], self._max_yaw_acceleration, np.inf,
+                                            self._period)

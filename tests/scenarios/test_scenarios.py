@@ -112,6 +112,8 @@ scenario:
     # 0.12 m/s at 0.001 m/s^2 takes 120 s, over the 60 s time limit.
     ("max_hand_acceleration: 0.001", r"max_hand_acceleration 0.001 m/s\^2 takes 120.0 s"),
     ("max_hand_speed: 0.0", "scenario.robot.max_hand_speed must be finite and positive"),
+    ("max_hand_yaw_acceleration: -2.0", "scenario.robot.max_hand_yaw_acceleration must be "
+                                        "finite and positive"),
     ("max_hand_speed: 0.1", "scenario.robot.max_hand_speed 0.1 m/s is below the task's "
                             "speed 0.12"),
 ])

@@ -19,7 +19,7 @@ YAW_RATE = 0.5
 TURN_START = 0.95
 
 
-def build():
+def build(max_yaw_acceleration=None):
     """A yaw rate that steps up at `TURN_START`, sampled at each tick like an operator."""
     builder = DiagramBuilder()
     commands = np.zeros((OperatorCommand.size, 2))
@@ -29,7 +29,7 @@ def build():
                                           np.column_stack([commands, commands[:, 1]]))))
     operator = builder.AddSystem(SampleHold(PERIOD, np.zeros(OperatorCommand.size)))
     builder.Connect(source.get_output_port(), operator.get_input_port())
-    heading = builder.AddSystem(HeadingCommand(INITIAL_HEADING, PERIOD))
+    heading = builder.AddSystem(HeadingCommand(INITIAL_HEADING, PERIOD, max_yaw_acceleration))
     builder.Connect(operator.get_output_port(), heading.get_operator_command_input_port())
     return builder.Build(), heading
 
@@ -64,3 +64,19 @@ def test_the_heading_integrates_the_yaw_rate_over_the_ticks():
     # Ticks 1.0, 1.1, ..., 2.0 s turn: 11 periods.
     assert heading_at(simulator, heading, 2.05) == pytest.approx(
         INITIAL_HEADING + 11 * YAW_RATE * PERIOD, abs=1e-12)
+
+
+def test_with_an_acceleration_limit_the_turn_starts_as_a_ramp():
+    diagram, heading = build(max_yaw_acceleration=1.0)
+    simulator = Simulator(diagram)
+    headings = [heading_at(simulator, heading, 0.95 + 0.1 * k) for k in range(12)]
+    rates = np.diff(headings) / PERIOD
+    # 0.1 rad/s more each tick until the operator's 0.5 rad/s, then steady.
+    np.testing.assert_allclose(rates, [0.1, 0.2, 0.3, 0.4, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5],
+                               atol=1e-12)
+
+
+@pytest.mark.parametrize("limit", [0.0, -1.0, float("inf"), float("nan")])
+def test_a_yaw_acceleration_limit_must_be_finite_and_positive(limit):
+    with pytest.raises(ValueError, match="max_yaw_acceleration"):
+        HeadingCommand(0.0, PERIOD, limit)

@@ -78,9 +78,11 @@ class Hsr:
     # The hand-over law (`pbp_drake.core.hand_over`): a goal switch, the operator pressing
     # or releasing changes the hand's commanded velocity by at most max_hand_acceleration
     # (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command never exceeds
-    # max_hand_speed (m/s), however far a primitive is from its attractor.
+    # max_hand_speed (m/s), however far a primitive is from its attractor. 0.2 m/s is the
+    # base's published speed limit: a hand driven faster for long runs its arm out of
+    # range, and the whole-body IK then lurches.
     max_hand_acceleration: float = 1.0
-    max_hand_speed: float = 0.25
+    max_hand_speed: float = 0.2
     # The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
     max_hand_yaw_acceleration: float = 4.0
 

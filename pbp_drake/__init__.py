@@ -38,6 +38,7 @@ _PUBLIC = {
     "DmpBank": "pbp_drake.systems",
     "GoalEstimator": "pbp_drake.systems",
     "GoalsSource": "pbp_drake.systems",
+    "HandOver": "pbp_drake.systems",
     "TaskMonitor": "pbp_drake.systems",
     "HeadingCommand": "pbp_drake.systems",
     "KeyboardOperator": "pbp_drake.systems",

@@ -277,12 +277,12 @@ def _resolve_hsr(scenario):
         raise ScenarioError("scenario.control_period must be a whole multiple of "
                             "scenario.robot.station.plant.time_step")
     operator = scenario.operator
-    _check_hand_over(scenario)
     for name in ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
                  "direction_noise", "speed_noise"):
         value = getattr(operator, name, 0.0)
         if not (np.isfinite(value) and value >= 0):
             raise ScenarioError(f"scenario.operator.{name} must be finite and not negative")
+    _check_hand_over(scenario)
     task = scenario.task
     if isinstance(task, DynamicObstacles):
         _check_obstacle_task(task)

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from scipy import integrate
 
 from pbp_drake.core.dmp import FORMULATIONS, Dmp, DmpBank, DmpSettings, minimum_jerk
 from pbp_drake.core.toy_scene import bent_path
@@ -164,7 +165,6 @@ def test_the_step_is_second_order_against_the_continuous_ode(formulation):
     The zero-order hold this step replaced (attractor held over each step, first order) was
     20.8 mm off at 30 Hz and 6.2 mm at 100 Hz; the first-order hold is 0.31 mm and 0.044 mm.
     """
-    integrate = pytest.importorskip("scipy.integrate")
     settings = DmpSettings(formulation=formulation)
     tau = 1.5
     dmp = Dmp.straight([0.0], [1.0], tau, settings)

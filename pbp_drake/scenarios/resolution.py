@@ -144,8 +144,9 @@ def _check_common(scenario):
     if not (np.isfinite(scenario.alpha) and 0.0 <= scenario.alpha <= 1.0):
         raise ScenarioError(f"scenario.alpha = {scenario.alpha} is outside [0, 1]")
     for name in ("control_period", "duration"):
-        if not getattr(scenario, name) > 0:
-            raise ScenarioError(f"scenario.{name} must be positive")
+        value = getattr(scenario, name)
+        if not (np.isfinite(value) and value > 0):
+            raise ScenarioError(f"scenario.{name} must be finite and positive, got {value}")
     _settings_checked("scenario.dmp", scenario.dmp)
     _settings_checked("scenario.goal_estimator", scenario.goal_estimator)
     if not (np.isfinite(scenario.dmp_duration) and scenario.dmp_duration >= 0):
@@ -188,7 +189,19 @@ def demonstration_samples(demonstration):
             np.asarray(demonstration.positions, float))
 
 
+def _check_point_robot(robot):
+    """The toy robot's dynamics: a positive mass and time step, springs and dampers that
+    are finite and not negative."""
+    for name, least in (("mass", "positive"), ("time_step", "positive"),
+                        ("stiffness", "not negative"), ("damping", "not negative")):
+        value = getattr(robot, name)
+        if not (np.isfinite(value) and (value > 0 if least == "positive" else value >= 0)):
+            raise ScenarioError(f"scenario.robot.{name} must be finite and {least}, got "
+                                f"{value}")
+
+
 def _resolve_point_robot(scenario):
+    _check_point_robot(scenario.robot)
     if not _whole_multiple(scenario.control_period, scenario.robot.time_step):
         raise ScenarioError(
             "scenario.control_period must be a whole multiple of scenario.robot.time_step")
@@ -219,10 +232,12 @@ def _resolve_point_robot(scenario):
     if scenario.dmp_duration <= 0 and demonstration is None:
         raise ScenarioError("scenario.dmp_duration is needed when there is no demonstration")
     for index, obstacle in enumerate(scenario.obstacles):
-        if len(obstacle.center) != start.size or not obstacle.radius > 0:
+        if (len(obstacle.center) != start.size or not np.isfinite(obstacle.center).all()
+                or not (np.isfinite(obstacle.radius) and obstacle.radius > 0)):
             raise ScenarioError(
-                f"scenario.obstacles[{index}] needs a center of dimension {start.size} and a "
-                "positive radius")
+                f"scenario.obstacles[{index}] needs a finite center of dimension {start.size} "
+                f"and a finite positive radius, got center {obstacle.center}, radius "
+                f"{obstacle.radius}")
     _check_toy_operator(scenario.operator, start.size)
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else None
     if demonstration is None:
@@ -305,6 +320,11 @@ def _resolve_hsr(scenario):
         raise ScenarioError(f"scenario.robot.station: {error}") from None
     start = initial_ee_state[:3].copy()
     goals = np.asarray(layout.objects, float)
+    nearest = float(np.min(np.linalg.norm(goals - start, axis=1)))
+    if task.success_distance >= nearest:
+        raise ScenarioError(
+            f"scenario.task.success_distance {task.success_distance} m reaches the nearest "
+            f"object ({nearest:.2f} m from the hand's start): the task would succeed at once")
     distance = np.max(np.linalg.norm(goals - start, axis=1))
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
     bank = DmpBank.straight(start, len(goals), duration, scenario.dmp)
@@ -345,9 +365,11 @@ def _check_hand_over(scenario):
 
 
 def _check_reach_task(task):
-    if not (0 < task.success_distance and 0 < task.min_separation):
-        raise ScenarioError("scenario.task.success_distance and min_separation must be "
-                            "positive")
+    for name in ("success_distance", "min_separation"):
+        value = getattr(task, name)
+        if not (np.isfinite(value) and value > 0):
+            raise ScenarioError(f"scenario.task.{name} must be finite and positive, got "
+                                f"{value}")
     schedule = np.asarray(task.switch_schedule, float)
     if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
             or schedule[-1] >= 1.0):

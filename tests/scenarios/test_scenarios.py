@@ -120,3 +120,32 @@ scenario:
 def test_hand_over_limits_that_cannot_work_are_refused(tmp_path, robot, message):
     with pytest.raises(ScenarioError, match=message):
         load_scenario_file(write(tmp_path, HSR.format(robot=robot)))
+
+
+@pytest.mark.parametrize("extra, message", [
+    ("  control_period: .inf\n", "scenario.control_period must be finite and positive"),
+    ("  duration: .inf\n", "scenario.duration must be finite and positive"),
+    ("  robot: {mass: 0.0}\n", "scenario.robot.mass must be finite and positive"),
+    ("  robot: {time_step: 0.0}\n", "scenario.robot.time_step must be finite and positive"),
+    ("  robot: {damping: -1.0}\n", "scenario.robot.damping must be finite and not negative"),
+    ("  robot: {stiffness: .inf}\n", "scenario.robot.stiffness must be finite"),
+    ("  obstacles: [{center: [.nan, 0.0], radius: 0.1}]\n",
+     r"scenario.obstacles\[0\] needs a finite center"),
+    ("  obstacles: [{center: [0.5, 0.0], radius: .inf}]\n",
+     r"scenario.obstacles\[0\] needs a finite center of dimension 2 and a finite positive"),
+])
+def test_numbers_that_are_not_finite_or_in_range_are_refused(tmp_path, extra, message):
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(write(tmp_path, VALID + extra))
+
+
+@pytest.mark.parametrize("distance, message", [
+    (".inf", "scenario.task.success_distance must be finite and positive"),
+    ("3.0", r"scenario.task.success_distance 3.0 m reaches the nearest object .* succeed at "
+            "once"),
+])
+def test_a_success_distance_that_ends_the_task_at_once_is_refused(tmp_path, distance, message):
+    text = HSR.format(robot="").replace("!MultiGoalReach {}",
+                                        f"!MultiGoalReach {{success_distance: {distance}}}")
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(write(tmp_path, text))

@@ -13,6 +13,7 @@ from pbp_drake.bench.run import main as bench_main
 from pbp_drake.builder import build_diagram, run_task, simulate
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.draw import main as draw_main
+from pbp_drake.output_paths import check_output_folder, check_record_path, mark_replay
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, MethodComparison, ScenarioError,
     check_method_comparison, load_scenario_file, resolve, with_method)
@@ -49,6 +50,8 @@ def main(argv=None):
                      help="simulate as fast as possible without waiting for a browser")
     run.add_argument("--record", metavar="FILE.html",
                      help="save a self-contained replay of the run")
+    run.add_argument("--force", action="store_true",
+                     help="let --record overwrite an existing file that is not a replay")
     run.add_argument("--duration", type=float, metavar="SECONDS",
                      help="override the scenario's duration (for HSR tasks, the time limit)")
     run.add_argument("--realtime-rate", type=float, default=1.0,
@@ -152,6 +155,11 @@ def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operato
 
 
 def _run(args):
+    # The paths first: a bad one must not cost a run, let alone a person's session.
+    if args.record:
+        check_record_path(args.record, force=args.force)
+    if args.output is not None:
+        check_output_folder(args.output)
     resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
                                 args.scene, args.operator, args.seed, args.duration)
     scenario = resolved.scenario
@@ -271,11 +279,12 @@ def _save_recording(meshcat, path):
     meshcat.PublishRecording()
     record = pathlib.Path(path)
     record.parent.mkdir(parents=True, exist_ok=True)
-    record.write_text(meshcat.StaticHtml())
+    record.write_text(mark_replay(meshcat.StaticHtml()))
     print(f"Replay saved to {record}")
 
 
 def _study(args):
+    check_output_folder(args.output)
     scenario_file = load_scenario_file(args.scenario)
     if isinstance(scenario_file.scenario.robot, Hsr):
         return _method_study(args, scenario_file)

@@ -1,0 +1,114 @@
+"""`run --record`, `run --output` and `study --output` are checked before anything is built or
+simulated: a bad path is a user error (`pbp-drake: ...`, exit 2) that names the path, fast,
+and an existing file that is not a replay is only overwritten with --force."""
+
+import os
+import time
+
+import pytest
+
+from pbp_drake.cli import main
+from pbp_drake.output_paths import REPLAY_MARKER, is_replay, mark_replay
+
+QUICK = "diagrams/toy_alt_vs_cont.yaml"  # about a second headless
+FAST = 0.5  # seconds: far less than building and simulating the scenario
+
+
+def refused(argv, capsys, path):
+    """Runs the CLI, asserting it refuses with exit 2, fast, naming `path`, no traceback."""
+    started = time.monotonic()
+    code = main(argv)
+    elapsed = time.monotonic() - started
+    err = capsys.readouterr().err
+    assert code == 2
+    assert elapsed < FAST, f"took {elapsed:.2f} s: something ran before the check"
+    assert err.startswith("pbp-drake: ") and str(path) in err
+    assert "Traceback" not in err
+    return err
+
+
+def test_record_into_a_folder_is_refused(tmp_path, repo, capsys):
+    err = refused(["run", str(repo / QUICK), "--headless", "--record", str(tmp_path)],
+                  capsys, tmp_path)
+    assert "is a folder" in err
+
+
+def test_record_under_a_file_is_refused(tmp_path, repo, capsys):
+    blocker = tmp_path / "notes.txt"
+    blocker.write_text("not a folder")
+    record = blocker / "replay.html"
+    err = refused(["run", str(repo / QUICK), "--headless", "--record", str(record)],
+                  capsys, record)
+    assert str(blocker) in err and "is a file" in err
+    assert blocker.read_text() == "not a folder"
+
+
+def test_record_over_a_file_that_is_not_a_replay_needs_force(tmp_path, repo, capsys):
+    record = tmp_path / "thesis.html"
+    record.write_text("<html>three years of work</html>")
+    stamp = record.stat().st_mtime_ns
+    err = refused(["run", str(repo / QUICK), "--headless", "--record", str(record)],
+                  capsys, record)
+    assert "--force" in err
+    assert record.read_text() == "<html>three years of work</html>"
+    assert record.stat().st_mtime_ns == stamp
+    assert main(["run", str(repo / QUICK), "--headless", "--record", str(record),
+                 "--force"]) == 0
+    assert is_replay(record) and record.stat().st_size > 10_000
+    assert f"Replay saved to {record}" in capsys.readouterr().out
+
+
+def test_record_writes_a_replay_and_overwrites_its_own(tmp_path, repo, capsys):
+    record = tmp_path / "new" / "folder" / "replay.html"
+    assert main(["run", str(repo / QUICK), "--headless", "--record", str(record)]) == 0
+    assert is_replay(record) and "<script src=" not in record.read_text()
+    record.write_text(mark_replay("<!DOCTYPE html>\n<html>an older replay</html>"))
+    # A replay of a previous run is replaced without --force.
+    assert main(["run", str(repo / QUICK), "--headless", "--record", str(record)]) == 0
+    assert "an older replay" not in record.read_text() and is_replay(record)
+
+
+@pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0,
+                    reason="permissions do not bind root")
+def test_record_into_a_read_only_folder_is_refused(tmp_path, repo, capsys):
+    folder = tmp_path / "locked"
+    folder.mkdir()
+    folder.chmod(0o500)
+    try:
+        record = folder / "replay.html"
+        err = refused(["run", str(repo / QUICK), "--headless", "--record", str(record)],
+                      capsys, record)
+        assert "not writable" in err
+    finally:
+        folder.chmod(0o700)
+
+
+def test_study_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
+    output = tmp_path / "summary.txt"
+    output.write_text("keep me")
+    err = refused(["study", str(repo / QUICK), "--output", str(output)], capsys, output)
+    assert "is a file" in err
+    assert output.read_text() == "keep me"
+
+
+def test_study_output_under_a_file_is_refused(tmp_path, repo, capsys):
+    blocker = tmp_path / "summary.txt"
+    blocker.write_text("keep me")
+    output = blocker / "study"
+    refused(["study", str(repo / "diagrams/hsr_reach.yaml"), "--trials", "1", "--output",
+             str(output)], capsys, output)
+    assert blocker.read_text() == "keep me"
+
+
+def test_session_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
+    output = tmp_path / "P01"
+    output.write_text("keep me")
+    refused(["run", str(repo / "diagrams/hsr_reach.yaml"), "--operator", "virtual",
+             "--headless", "--participant", "P01", "--output", str(output)], capsys, output)
+    assert output.read_text() == "keep me"
+
+
+def test_the_replay_marker_follows_the_doctype():
+    html = mark_replay("<!DOCTYPE html>\n<html></html>")
+    assert html.splitlines()[:2] == ["<!DOCTYPE html>", REPLAY_MARKER]
+    assert mark_replay("<html></html>").startswith(REPLAY_MARKER)

@@ -357,7 +357,20 @@ def _method_study(args, scenario_file):
     print(f"Ran {len(runs)} trials in {time.monotonic() - started:.1f} s"
           + (f"; {reused} were already on disk." if reused else "."), flush=True)
     _print_report(summary, output)
-    return 0
+    return _failed_trials(summary, output)
+
+
+def _failed_trials(summary, output):
+    """1, with a line on stderr, when trials recorded an error or did not run (a trial
+    that ran but missed its target is a result, not an error); else 0."""
+    errors = sum(entry["errors"] for entry in summary["methods"].values())
+    missing = sum(entry["missing"] for entry in summary["methods"].values())
+    if not errors and not missing:
+        return 0
+    print(f"{errors} of {summary['trials'] * len(summary['methods'])} trials failed with an "
+          f"error (in the `error` field of their {output / 'trials'}/METHOD/seed_SEED.json)"
+          + (f" and {missing} did not run" if missing else "") + ".", file=sys.stderr)
+    return 1
 
 
 def _print_report(summary, output):

@@ -11,7 +11,9 @@ import dataclasses
 import logging
 import multiprocessing
 import os
+import select
 import signal
+import threading
 import time
 
 import numpy as np
@@ -150,7 +152,8 @@ def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
     """Runs `pending` trial keys in a pool of `jobs` processes. Returns the keys that were
     unfinished when a worker process died (the pool is then broken), with the error."""
     with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=_context(),
-                                                initializer=_ignore_interrupts) as pool:
+                                                initializer=_start_worker,
+                                                initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(run_trial, *submit_args(key)): key for key in pending}
         unfinished = []
         try:
@@ -173,6 +176,37 @@ def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
     return unfinished
 
 
-def _ignore_interrupts():
-    """Workers leave Ctrl-C to the study's process, which stops them."""
+def _start_worker(study_pid):
+    """Workers leave Ctrl-C to the study's process, which stops them; and they end when
+    that process ends, however it ends (even SIGKILL), so that none goes on writing trials.
+    Under forkserver a worker's parent is the fork server, which lives as long as a worker
+    holds its pipe: so each worker watches the study's process itself. When the workers
+    are gone, the fork server and the resource tracker see their pipes close and exit."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_exit_with, args=(study_pid,), name="exit-with-study",
+                     daemon=True).start()
+
+
+def _exit_with(pid):
+    """Kills this process when process `pid` has ended: at once through a pidfd (Linux
+    5.3+), else by polling."""
+    try:
+        handle = os.pidfd_open(pid)
+    except ProcessLookupError:
+        handle = None  # already gone
+    except (AttributeError, OSError):  # no pidfd here: poll
+        while _alive(pid):
+            time.sleep(0.2)
+    else:
+        select.select([handle], [], [])  # readable once the process has ended
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

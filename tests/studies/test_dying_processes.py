@@ -1,0 +1,122 @@
+"""A study's processes die with it (issue 13): SIGKILL of the study leaves no worker, fork
+server or resource tracker behind, and the same command then resumes the study. A study
+whose trials fail with an error exits non-zero."""
+
+import json
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+from pbp_drake.cli import main
+
+pytestmark = pytest.mark.slow
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+TASK = """
+scenario:
+  name: two_random_objects
+  method: teleop
+  control_period: 0.03
+  duration: 30.0
+  robot: !Hsr {}
+  task:
+    object_count: [2, 2]
+  operator: !VirtualParticipant {}
+  seed: 0
+"""
+
+
+@pytest.fixture
+def task_file(tmp_path):
+    path = tmp_path / "task.yaml"
+    path.write_text(textwrap.dedent(TASK))
+    return path
+
+
+def study_command(task_file, output, trials):
+    return [sys.executable, "-m", "pbp_drake", "study", str(task_file), "--methods", "teleop",
+            "--trials", str(trials), "--jobs", "2", "--output", str(output)]
+
+
+def _stat(pid):
+    """(parent pid, state, start time) of a live process, else None."""
+    try:
+        text = pathlib.Path(f"/proc/{pid}/stat").read_text()
+    except (FileNotFoundError, ProcessLookupError):
+        return None
+    fields = text[text.rindex(")") + 2:].split()
+    return int(fields[1]), fields[0], fields[19]
+
+
+def descendants(root):
+    """The processes under `root`, as {pid: start time}."""
+    children = {}
+    for entry in pathlib.Path("/proc").iterdir():
+        if entry.name.isdigit() and (stat := _stat(int(entry.name))) is not None:
+            children.setdefault(stat[0], []).append((int(entry.name), stat[2]))
+    found, todo = {}, [root]
+    while todo:
+        for pid, started in children.get(todo.pop(), []):
+            found[pid] = started
+            todo.append(pid)
+    return found
+
+
+def alive(processes):
+    return [pid for pid, started in processes.items()
+            if (stat := _stat(pid)) is not None and stat[2] == started and stat[1] != "Z"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_sigkill_of_the_study_ends_its_processes_and_the_study_resumes(task_file, tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    trials = 8
+    expected_folder = tmp_path / "whole"
+    subprocess.run(study_command(task_file, expected_folder, trials), env=env, check=True,
+                   stdout=subprocess.DEVNULL)
+    folder = tmp_path / "killed"
+    study = subprocess.Popen(study_command(task_file, folder, trials), env=env,
+                             stdout=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not list((folder / "trials").glob("*/seed_*.json")):
+        assert study.poll() is None and time.monotonic() < deadline, "no trial written"
+        time.sleep(0.1)
+    processes = descendants(study.pid)
+    assert len(processes) >= 3  # the fork server, the resource tracker, the workers
+    study.send_signal(signal.SIGKILL)
+    study.wait()
+    deadline = time.monotonic() + 5
+    while alive(processes) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert alive(processes) == []
+    written = len(list((folder / "trials").glob("*/seed_*.json")))
+    assert written < trials, "the study had finished before it was killed"
+    time.sleep(1)  # nothing writes trials any more
+    assert len(list((folder / "trials").glob("*/seed_*.json"))) == written
+
+    resumed = subprocess.run(study_command(task_file, folder, trials), env=env, check=True,
+                             capture_output=True, text=True)
+    assert f"{written} were already on disk" in resumed.stdout
+    assert ((folder / "summary.json").read_bytes()
+            == (expected_folder / "summary.json").read_bytes())
+
+
+def test_a_study_with_failed_trials_exits_1_after_writing_its_summary(task_file, tmp_path,
+                                                                     capsys):
+    # Seed -1 makes trial 0 fail with an error (a negative seed is refused); seed 0 runs.
+    output = tmp_path / "study"
+    args = ["study", str(task_file), "--methods", "teleop", "--trials", "2", "--seed", "-1",
+            "--output", str(output)]
+    assert main(args) == 1
+    summary = json.loads((output / "summary.json").read_text())
+    assert summary["methods"]["teleop"]["errors"] == 1
+    err = capsys.readouterr().err
+    assert "1 of 2 trials failed with an error" in err and str(output / "trials") in err
+    record = json.loads((output / "trials" / "teleop" / "seed_-1.json").read_text())
+    assert record["error"] is not None

@@ -21,7 +21,7 @@ from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.progress import ProgressBar
 from pbp_drake.studies.report import FIGURES, report, results_table
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
-from pbp_drake.studies.toy import run_study
+from pbp_drake.studies.toy import TOY_FIGURES, run_study
 
 
 def main(argv=None):
@@ -81,7 +81,8 @@ def main(argv=None):
 
     report = commands.add_parser(
         "report", help="rebuild the summary, table and figures of a study folder from its "
-        "trial files, without simulating")
+        "trial files, without simulating; damaged or foreign files are named on stderr and "
+        "skipped (exit 1 when there were any, 2 when there is nothing to report)")
     report.add_argument("output", help="the --output folder of `pbp-drake study`")
 
     # Their own argument parsers live with them; the rest of the line is passed on.
@@ -304,7 +305,7 @@ def _study(args):
             print(f"  {method}: final error {mode['final_error'] * 100:.2f} cm, phase constant "
                   f"while the operator acts: {mode['phase_constant_while_operator_acts']}, "
                   f"strictly increasing: {mode['phase_strictly_increasing']}")
-    for name in ("summary.json", *sorted(p.name for p in output.glob("fig*.png"))):
+    for name in ("summary.json", TOY_FIGURES[summary["study"]]):
         print(f"  wrote {output / name}")
     return 0
 
@@ -384,6 +385,13 @@ def _print_report(summary, output):
 
 
 def _report(args):
+    """Exit 0; 1 when damaged or foreign files were skipped (what could be read is still
+    reported and written); 2 (ScenarioError) when there is nothing to report."""
     output = pathlib.Path(args.output)
-    _print_report(report(output), output)
+    summary = report(output)
+    _print_report(summary, output)
+    if summary["damaged"]:
+        print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
+              f"(listed above and in {output / 'summary.json'})", file=sys.stderr)
+        return 1
     return 0

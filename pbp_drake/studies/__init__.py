@@ -13,6 +13,8 @@ One job per module:
 
 - `trial_files`: the trial and study files (format, paths, atomic writes, CSV time series,
   reading back) and the scenario hash that keeps different scenarios apart;
+- `folders`: which kind of study an output folder holds (a method comparison or a 2-D
+  study), so neither is written into the other's folder;
 - `runners`: one trial (run, or computed without the disk) and the local process pool;
 - `ray_backend`: the same trials as Ray tasks (Ray is imported only when asked for);
 - `comparison`: `run_method_comparison`, which trials to run, where, then the report;

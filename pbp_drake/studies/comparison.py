@@ -14,7 +14,8 @@ from pbp_drake.studies.ray_backend import import_ray, run_on_ray
 from pbp_drake.studies.report import report
 from pbp_drake.studies.runners import failed_record, run_locally
 from pbp_drake.studies.trial_files import (
-    check_folder, read_trial, running_marker, scenario_hash, write_study)
+    StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, write_study)
+from pbp_drake.studies.folders import check_folder
 
 BACKENDS = ("local", "ray")
 
@@ -58,11 +59,18 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
         except Exception as error:
             raise ScenarioError(f"run={run!r} cannot be sent to worker processes ({error}): "
                                 "use a module-level function, or jobs=1") from None
-    pending = []
+    pending, damaged = [], []
     for method, trial in keys:
-        record = read_trial(output, method, seed + trial, digest)
+        # A damaged trial file is not a finished trial: it is named, and runs again. A trial
+        # of another scenario refuses the folder (StudyFolderError).
+        before = len(damaged)
+        record = read_trial(output, method, seed + trial, digest, damaged, (method, trial))
+        if len(damaged) > before and "another scenario" in damaged[-1].problem:
+            raise StudyFolderError(f"{damaged[-1].path} is {damaged[-1].problem}: choose "
+                                   "another --output folder")
         if record is None or (retry_errors and record["error"] is not None):
             pending.append((method, trial))
+    name_damaged([d._replace(problem=f"{d.problem}; runs again") for d in damaged])
     write_study(output, scenario, digest, methods, trials, seed)
 
     started = time.monotonic()

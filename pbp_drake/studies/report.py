@@ -7,7 +7,8 @@ import pathlib
 from pbp_drake.studies.figures import (
     METHOD_LABELS, plot_collision_histogram, plot_intervention, plot_task_time)
 from pbp_drake.studies.summary import summarize
-from pbp_drake.studies.trial_files import TRIAL_FIELDS, read_study, write_atomically
+from pbp_drake.studies.trial_files import (
+    TRIAL_FIELDS, name_damaged, read_study, write_atomically)
 
 FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png", "fig7c_collisions.png")
 
@@ -41,8 +42,8 @@ def results_table(summary):
              "|---|---|---|---|---|---|---|---|---|---|"]
     for method, entry in summary["methods"].items():
         rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
-        trials = f"{entry['trials']}" + (f" ({entry['missing']} missing)"
-                                         if entry["missing"] else "")
+        gone = [f"{entry[k]} {k}" for k in ("missing", "damaged") if entry.get(k)]
+        trials = f"{entry['trials']}" + (f" ({', '.join(gone)})" if gone else "")
         lines.append(f"| {METHOD_LABELS.get(method, method)} | {trials} | {rate} | "
                      f"{_cell(entry, 'intervention_ratio', 3)} | "
                      f"{_cell(entry, 'task_time', 1)} | {_cell(entry, 'collision_ratio', 3)} | "
@@ -50,6 +51,10 @@ def results_table(summary):
                      f"{_peak_cell(entry, 'peak_hand_speed', 3)} | "
                      f"{_peak_cell(entry, 'peak_command_acceleration', 2)} | "
                      f"{entry['errors']} |")
+    if summary.get("damaged"):
+        lines += ["", f"Skipped as damaged or foreign: {len(summary['damaged'])} files "
+                      f"({sum(e.get('damaged', 0) for e in summary['methods'].values())} "
+                      "trials); see summary.json."]
     arbitration = summary.get("arbitration")
     if arbitration is not None:
         ideal = arbitration["ideal_alpha"]
@@ -71,10 +76,14 @@ def _flat_trials(study, records):
 
 def report(output):
     """Rebuilds `summary.json`, `results.md`, `trials.json` and the figures of a study folder
-    from its study.json and trial files only (no simulation). Returns the summary."""
+    from its study.json and trial files only (no simulation). Returns the summary.
+
+    Damaged or foreign files (see `read_study`) are named on stderr and skipped: the
+    summary counts each method's damaged trials and lists the files under "damaged"."""
     output = pathlib.Path(output)
-    study, records = read_study(output)
-    summary = summarize(study, records)
+    study, records, damaged = read_study(output)
+    name_damaged(damaged)
+    summary = summarize(study, records, damaged, output)
     write_atomically(output / "summary.json", json.dumps(summary, indent=2) + "\n")
     write_atomically(output / "results.md", results_table(summary))
     write_atomically(output / "trials.json",

@@ -5,6 +5,7 @@ same bytes for any `--jobs` and either backend.
 """
 
 import math
+import pathlib
 
 import numpy as np
 
@@ -107,14 +108,24 @@ def collision_histogram(ratios):
     return counts
 
 
-def summarize(study, records):
+def _relative(path, output):
+    try:
+        return str(pathlib.Path(path).relative_to(output)) if output is not None else path
+    except ValueError:
+        return path
+
+
+def summarize(study, records, damaged=(), output=None):
     """Per method: how many trials, errors and missing; success rate over the trials on
     disk; mean and (population) std of intervention ratio and task time, and the mean, std
     and histogram of the collision ratio, and the max and mean of each trial's
     peak_hand_speed (m/s, the largest one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| /
     control_period) and peak_command_acceleration (m/s^2, max_k |v_cmd(k+1) - v_cmd(k)| /
     control_period), over the trials that ran without error (those that recorded them);
-    and the ideal alpha when the study sweeps fixed alphas."""
+    and the ideal alpha when the study sweeps fixed alphas. `damaged` (Damage tuples, see
+    trial_files.read_study) gives each method's count of trials skipped as damaged (not
+    counted as missing) and the summary's "damaged" list of files (paths relative to
+    `output`) and problems."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "collision_histogram_edges": list(HISTOGRAM_EDGES),
@@ -122,13 +133,15 @@ def summarize(study, records):
     for method in study["methods"]:
         rows = [records[(method, trial)] for trial in range(study["trials"])]
         present = [r for r in rows if r is not None]
+        broken = {d.key for d in damaged if d.key is not None and d.key[0] == method}
         ran = [r for r in present if r["error"] is None]
         ratios = [r["collision_ratio"] for r in ran if r["collision_ratio"] is not None]
         collision = mean_std(ratios)
         collision["histogram"] = collision_histogram(ratios)
         summary["methods"][method] = {
             "trials": len(present),
-            "missing": len(rows) - len(present),
+            "missing": len(rows) - len(present) - len(broken),
+            "damaged": len(broken),
             "errors": len(present) - len(ran),
             "error_seeds": [r["seed"] for r in present if r["error"] is not None],
             "success_rate": _round(sum(bool(r["success"]) for r in present) / len(present))
@@ -141,6 +154,8 @@ def summarize(study, records):
             "peak_command_acceleration": max_mean(
                 [r.get("peak_command_acceleration") for r in ran]),
         }
+    summary["damaged"] = [{"file": _relative(d.path, output), "problem": d.problem}
+                          for d in damaged]
     swept = arbitration(summary["methods"])
     if swept is not None:
         summary["arbitration"] = swept

@@ -15,18 +15,32 @@ from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolve
 from pbp_drake.builder.run import simulate
 from pbp_drake.studies.figures import plot_alpha_study, plot_alt_vs_cont
+from pbp_drake.studies.folders import folder_kind
+from pbp_drake.studies.trial_files import StudyFolderError
 from pbp_drake.studies.summary import collision_free, ideal_alpha
 
 
+# The figure each 2-D study writes beside its summary.json.
+TOY_FIGURES = {"alpha_study": "fig2_alpha_study.png", "alt_vs_cont": "fig4_alt_vs_cont.png"}
+
+
 def run_study(scenario_file, output_dir):
-    """Runs the study a scenario file describes; returns its summary."""
+    """Runs the study a scenario file describes; returns its summary. Raises
+    StudyFolderError when `output_dir` holds a study of another kind (a method comparison,
+    or the other 2-D study), whose summary.json it would overwrite."""
     output_dir = pathlib.Path(output_dir)
-    output_dir.mkdir(parents=True, exist_ok=True)
     if isinstance(scenario_file.study, AlphaStudy):
-        return run_alpha_study(scenario_file.resolved, scenario_file.study, output_dir)
-    if isinstance(scenario_file.study, AltVsCont):
-        return run_alt_vs_cont(scenario_file.resolved, scenario_file.study, output_dir)
-    raise ValueError("this scenario file has no `study:` section to run")
+        kind, run = "alpha_study", run_alpha_study
+    elif isinstance(scenario_file.study, AltVsCont):
+        kind, run = "alt_vs_cont", run_alt_vs_cont
+    else:
+        raise ValueError("this scenario file has no `study:` section to run")
+    held = folder_kind(output_dir)
+    if held is not None and held != kind:
+        raise StudyFolderError(f"{output_dir} holds a {held} study, not a 2-D {kind}: choose "
+                               "another --output folder")
+    output_dir.mkdir(parents=True, exist_ok=True)
+    return run(scenario_file.resolved, scenario_file.study, output_dir)
 
 
 def scene_scenario(scenario, scene):

@@ -5,6 +5,7 @@ Each trial file is written atomically (a temporary file, then a rename), so an i
 study leaves only whole trials, and running the same study again runs only the missing ones.
 """
 
+import collections
 import csv
 import dataclasses
 import hashlib
@@ -12,6 +13,7 @@ import json
 import math
 import os
 import pathlib
+import sys
 
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed, yaml_load
@@ -172,45 +174,83 @@ def write_study(output, scenario, digest, methods, trials, seed):
     write_atomically(output / "study.json", json.dumps(study, indent=2) + "\n")
 
 
-def check_folder(output, scenario, digest):
-    """Raises StudyFolderError when `output` holds a study of another scenario."""
-    study_path = output / "study.json"
-    if not study_path.is_file():
-        return
-    try:
-        study = json.loads(study_path.read_text())
-    except ValueError:
-        return
-    if study.get("scenario_hash") != digest:
-        raise StudyFolderError(
-            f"{output} holds a study of another scenario ({study.get('scenario')!r}, hash "
-            f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}): "
-            "choose another --output folder")
-
-
 # ---------------------------------------------------------------------------------------------
 # Reading
 
+# A damaged or foreign file of a study folder: its path and what is wrong with it. `key` is
+# the trial's (method, trial) when the file belongs to one (None for study.json).
+Damage = collections.namedtuple("Damage", "path problem key", defaults=(None,))
+# The JSON types of a trial record's fields (None is allowed for all but these first ones).
+_REQUIRED = {"success": (bool,), "method": (str,), "seed": (int,)}
+_NUMBER = (int, float)
+_TYPES = {"scenario": (str,), "scenario_hash": (str,), "trial": (int,), "task_time": _NUMBER,
+          "intervention_ratio": _NUMBER, "switches": (int,), "collision_ratio": _NUMBER,
+          "peak_hand_speed": _NUMBER, "peak_command_acceleration": _NUMBER, "ticks": (int,),
+          "objects": (list,), "targets": (list,), "time_series": (str,), "error": (str,)}
+_INTEGER_COLUMNS = {"operator_active", "selected_goal", "target", "in_collision"}
 
-def read_time_series(path):
-    """A trial's CSV as a dict of arrays keyed by column name."""
+
+class DamagedFile(ValueError):
+    """A trial or study file that cannot be read: truncated, empty, malformed."""
+
+
+def _type_name(value):
+    return "null" if value is None else type(value).__name__
+
+
+def record_problem(record):
+    """What is wrong with the types of a trial record's fields, or None."""
+    if not isinstance(record, dict):
+        return f"holds a {_type_name(record)}, not a trial record"
+    for field, types in {**_REQUIRED, **_TYPES}.items():
+        value = record.get(field)
+        if value is None and field not in _REQUIRED:
+            continue
+        if isinstance(value, bool) and bool not in types or not isinstance(value, types):
+            wanted = " or ".join(t.__name__ for t in types)
+            return f"field {field!r} is {_type_name(value)} {value!r:.40}, not {wanted}"
+    return None
+
+
+def read_time_series(path, ticks=None):
+    """A trial's CSV as a dict of arrays keyed by column name. Raises DamagedFile, naming the
+    file, when it is empty or malformed (or has not `ticks` rows, when given)."""
     with open(path, newline="") as stream:
         reader = csv.reader(stream)
-        columns = next(reader)
+        columns = next(reader, None)
         rows = list(reader)
-    integers = {"operator_active", "selected_goal", "target", "in_collision"}
+    if not columns:
+        raise DamagedFile(f"{path}: empty CSV (no header)")
+    if columns not in (time_series_columns(False), time_series_columns(True)):
+        raise DamagedFile(f"{path}: malformed CSV: its header is not a trial's time series")
+    for number, row in enumerate(rows, start=2):
+        if len(row) != len(columns):
+            raise DamagedFile(f"{path}: malformed CSV: line {number} has {len(row)} fields, "
+                              f"not {len(columns)} (truncated?)")
+    if ticks is not None and len(rows) != ticks:
+        raise DamagedFile(f"{path}: truncated CSV: {len(rows)} rows, the trial has {ticks} "
+                          "ticks")
     data = {}
     for index, name in enumerate(columns):
         values = [row[index] for row in rows]
-        data[name] = (np.array(values, dtype=int) if name in integers
-                      else np.array(values, dtype=float))
+        try:
+            data[name] = (np.array(values, dtype=int) if name in _INTEGER_COLUMNS
+                          else np.array(values, dtype=float))
+        except ValueError as error:
+            raise DamagedFile(f"{path}: malformed CSV: column {name!r}: {error}") from None
     return data
 
 
 def load_task_result(output, method, seed):
     """The TaskResult of a finished trial, read back from its JSON and CSV files."""
     json_path, csv_path = trial_paths(output, method, seed)
-    record = json.loads(json_path.read_text())
+    try:
+        record = json.loads(json_path.read_text())
+    except ValueError as error:
+        raise DamagedFile(f"{json_path}: truncated or invalid JSON ({error})") from None
+    problem = record_problem(record)
+    if problem is not None:
+        raise DamagedFile(f"{json_path}: {problem}")
     if record["error"] is not None:
         raise ValueError(f"{json_path}: the trial failed: {record['error']}")
     series = read_time_series(csv_path)
@@ -234,41 +274,133 @@ def load_task_result(output, method, seed):
         peak_command_acceleration=record.get("peak_command_acceleration"))
 
 
-def read_trial(output, method, seed, digest=None):
-    """A trial's JSON record if it is on disk and whole, else None. Raises StudyFolderError
-    when it belongs to another scenario than `digest`."""
+def read_trial(output, method, seed, digest=None, damaged=None, key=None):
+    """A trial's JSON record if it is on disk and whole, else None. A trial file that is on
+    disk but damaged (truncated or invalid JSON, wrong field types, an empty, malformed or
+    missing CSV), or of another format, is appended to `damaged` as a Damage (when given),
+    and reads as None: a study runs it again. Raises StudyFolderError when the trial belongs
+    to another scenario than `digest` (unless `damaged` is given: then it is named there)."""
     json_path, csv_path = trial_paths(output, method, seed)
+
+    def bad(path, problem):
+        if damaged is not None:
+            damaged.append(Damage(str(path), problem, key))
+
+    if not json_path.exists():
+        return None
     try:
         record = json.loads(json_path.read_text())
-    except (OSError, ValueError):
-        return None
-    if (not isinstance(record, dict) or record.get("format") != TRIAL_FORMAT
-            or record.get("method") != method or record.get("seed") != seed):
-        return None
+    except OSError as error:
+        return bad(json_path, f"unreadable ({error.strerror})")
+    except ValueError as error:
+        return bad(json_path, f"truncated or invalid JSON ({error})")
+    problem = record_problem(record)
+    if problem is None and record.get("format") != TRIAL_FORMAT:
+        problem = f"a trial of format {record.get('format')!r}, not {TRIAL_FORMAT}"
+    if problem is None and (record["method"] != method or record["seed"] != seed):
+        problem = f"holds the trial of {record['method']!r}, seed {record['seed']}"
+    if problem is not None:
+        return bad(json_path, problem)
     if digest is not None and record.get("scenario_hash") != digest:
-        raise StudyFolderError(
-            f"{json_path} is a trial of another scenario ({record.get('scenario')!r}, hash "
-            f"{record.get('scenario_hash')}, not {digest}): choose another --output folder")
-    if record["error"] is None and not csv_path.is_file():
-        return None
+        message = (f"a trial of another scenario ({record.get('scenario')!r}, hash "
+                   f"{record.get('scenario_hash')}, not {digest})")
+        if damaged is None:
+            raise StudyFolderError(f"{json_path} is {message}: choose another --output folder")
+        return bad(json_path, message)
+    if record["error"] is None:
+        if not csv_path.is_file():
+            return bad(csv_path, "missing: the trial's time series CSV is not on disk")
+        try:
+            read_time_series(csv_path, record.get("ticks"))
+        except DamagedFile as error:
+            return bad(csv_path, str(error).removeprefix(f"{csv_path}: "))
+        except OSError as error:
+            return bad(csv_path, f"unreadable ({error.strerror})")
     return record
 
 
+def study_problem(study):
+    """What makes a parsed study.json not a method comparison's, or None."""
+    if not isinstance(study, dict):
+        return f"holds a {_type_name(study)}, not a study"
+    if study.get("study") != "method_comparison":
+        return f"a study.json of another kind ({study.get('study')!r}, not 'method_comparison')"
+    methods, trials, seed = study.get("methods"), study.get("trials"), study.get("seed")
+    if not (isinstance(methods, list) and methods and all(isinstance(m, str) for m in methods)):
+        return "field 'methods' is not a list of method names"
+    for field, value in (("trials", trials), ("seed", seed)):
+        if isinstance(value, bool) or not isinstance(value, int):
+            return f"field {field!r} is {_type_name(value)}, not int"
+    if trials < 1:
+        return f"field 'trials' is {trials}, not a positive number"
+    for field in ("scenario", "scenario_hash"):
+        if not isinstance(study.get(field), str):
+            return f"field {field!r} is {_type_name(study.get(field))}, not str"
+    return None
+
+
+def infer_study(output):
+    """The study a folder's trial files describe, without study.json: every method folder
+    under trials/ (sorted by name), the seeds from the lowest to the highest on disk, and
+    the scenario most of the readable trials name. None when there are no trial files."""
+    seeds, methods, hashes = set(), [], collections.Counter()
+    for folder in sorted(p for p in (output / "trials").glob("*") if p.is_dir()):
+        found = [p for p in folder.glob("seed_*.*") if p.suffix in (".json", ".csv")]
+        numbers = {int(p.stem[5:]) for p in found if p.stem[5:].isdigit()}
+        if numbers:
+            methods.append(folder.name)
+            seeds |= numbers
+        for path in found:
+            try:
+                record = json.loads(path.read_text()) if path.suffix == ".json" else None
+            except (OSError, ValueError):
+                continue
+            if isinstance(record, dict) and isinstance(record.get("scenario_hash"), str):
+                hashes[(record["scenario_hash"], str(record.get("scenario")))] += 1
+    if not methods:
+        return None
+    (digest, name), _ = hashes.most_common(1)[0] if hashes else ((None, None), 0)
+    return {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": name,
+            "scenario_hash": digest, "methods": methods, "seed": min(seeds),
+            "trials": max(seeds) - min(seeds) + 1}
+
+
 def read_study(output):
-    """The study.json of a study folder and its trials' records, in method then seed order
-    (None for a trial not on disk)."""
+    """The study.json of a study folder, its trials' records, in method then seed order
+    (None for a trial not on disk or damaged), and the list of Damage: every damaged or
+    foreign file. When study.json is damaged or of another kind, the study is the one its
+    trial files describe (see infer_study). Raises StudyFolderError when there is neither
+    a study.json nor any trial file."""
     output = pathlib.Path(output)
     study_path = output / "study.json"
+    damaged = []
     try:
         study = json.loads(study_path.read_text())
-    except OSError:
-        raise StudyFolderError(f"{output} has no study.json: is it the --output folder of a "
-                               "`pbp-drake study`?") from None
+        problem = study_problem(study)
+    except FileNotFoundError:
+        study, problem = None, "missing"
+    except OSError as error:
+        study, problem = None, f"unreadable ({error.strerror})"
     except ValueError as error:
-        raise StudyFolderError(f"{study_path} is not valid JSON: {error}") from None
+        study, problem = None, f"truncated or invalid JSON ({error})"
+    if problem is not None:
+        study = infer_study(output)
+        if study is None:
+            raise StudyFolderError(
+                f"{output} has no study.json of a method comparison ({study_path}: {problem}) "
+                "and no trial files: is it the --output folder of a `pbp-drake study`?")
+        damaged.append(Damage(str(study_path), f"{problem}; reporting the trials on disk"))
     records = {}
     for method in study["methods"]:
         for trial in range(study["trials"]):
             records[(method, trial)] = read_trial(output, method, study["seed"] + trial,
-                                                  study["scenario_hash"])
-    return study, records
+                                                  study["scenario_hash"], damaged,
+                                                  (method, trial))
+    return study, records, damaged
+
+
+def name_damaged(damaged, stream=None):
+    """Names each damaged or foreign file on `stream` (stderr): its path and what is wrong."""
+    for item in damaged:
+        print(f"pbp-drake: damaged: {item.path}: {item.problem}",
+              file=stream or sys.stderr, flush=True)

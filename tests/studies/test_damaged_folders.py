@@ -1,0 +1,115 @@
+"""Damaged study folders (issue 13): `pbp-drake report` names every damaged or foreign file
+and reports the rest; a 2-D study and a method comparison refuse each other's folders."""
+
+import json
+
+import pytest
+
+from pbp_drake.cli import main
+from pbp_drake.studies.trial_files import (
+    read_study, time_series_columns, trial_paths, trial_record, write_trial_files)
+
+METHODS = ("teleop", "pbp_alternated")
+
+
+def _csv(ticks=3):
+    columns = time_series_columns(False)
+    row = ",".join("0" if name in {"operator_active", "selected_goal", "target"} else "0.5"
+                   for name in columns)
+    return ",".join(columns) + "\n" + "".join(row + "\n" for _ in range(ticks))
+
+
+def _study(folder, trials=2):
+    """A method comparison's folder written without simulating: every trial succeeded."""
+    study = {"study": "method_comparison", "format": 1, "scenario": "fake",
+             "scenario_hash": "abc", "methods": list(METHODS), "trials": trials, "seed": 0}
+    (folder / "study.json").write_text(json.dumps(study))
+    for method in METHODS:
+        for trial in range(trials):
+            record = trial_record("fake", "abc", method, trial, trial)
+            record.update(success=True, task_time=10.0 + trial, intervention_ratio=0.5,
+                          switches=1, collision_ratio=0.0, ticks=3, objects=[[1, 0, 0.7]],
+                          targets=[0])
+            write_trial_files(folder, record, _csv())
+    return folder
+
+
+def test_a_clean_folder_reports_without_complaint(tmp_path, capsys):
+    assert main(["report", str(_study(tmp_path))]) == 0
+    assert "damaged" not in capsys.readouterr().err
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["damaged"] == []
+    assert summary["methods"]["teleop"]["trials"] == 2
+
+
+def test_report_names_each_damaged_file_and_reports_the_rest(tmp_path, capsys):
+    folder = _study(tmp_path, trials=3)
+    truncated = trial_paths(folder, "teleop", 0)[0]
+    truncated.write_text(truncated.read_text()[:80])
+    empty = trial_paths(folder, "pbp_alternated", 1)[1]
+    empty.write_text("")
+    wrong = trial_paths(folder, "teleop", 2)[0]
+    record = json.loads(wrong.read_text())
+    wrong.write_text(json.dumps({**record, "task_time": "ten"}))
+    (folder / "study.json").write_text(json.dumps({"study": "alpha_study", "scenes": []}))
+
+    # Exit 1: files were skipped; what could be read is still reported and written.
+    assert main(["report", str(folder)]) == 1
+    out, err = capsys.readouterr()
+    assert f"{truncated}: truncated or invalid JSON" in err
+    assert f"{empty}: empty CSV" in err
+    assert f"{wrong}: field 'task_time' is str" in err
+    assert f"{folder / 'study.json'}: a study.json of another kind ('alpha_study'" in err
+    assert "Traceback" not in err
+    summary = json.loads((folder / "summary.json").read_text())
+    assert {d["file"] for d in summary["damaged"]} == {
+        "study.json", "trials/teleop/seed_0.json", "trials/pbp_alternated/seed_1.csv",
+        "trials/teleop/seed_2.json"}
+    teleop, alternated = summary["methods"]["teleop"], summary["methods"]["pbp_alternated"]
+    assert (teleop["trials"], teleop["damaged"], teleop["missing"]) == (1, 2, 0)
+    assert (alternated["trials"], alternated["damaged"], alternated["missing"]) == (2, 1, 0)
+    assert alternated["task_time"]["mean"] == 11.0  # seeds 0 and 2
+    assert "1 (2 damaged)" in out
+    assert "Skipped as damaged or foreign: 4 files (3 trials)" in (
+        folder / "results.md").read_text()
+    assert len(json.loads((folder / "trials.json").read_text())) == 3
+
+
+@pytest.mark.parametrize("text, problem", [
+    ("time,ee_x\n1,2\n", "malformed CSV: its header"),
+    (_csv().rsplit("\n", 2)[0] + "\n", "truncated CSV: 2 rows"),
+    (_csv().replace("0.5", "x", 1), "malformed CSV: column"),
+    (_csv()[:-5] + "\n", "malformed CSV: line 4"),
+])
+def test_a_malformed_csv_is_named(tmp_path, text, problem):
+    folder = _study(tmp_path, trials=1)
+    trial_paths(folder, "teleop", 0)[1].write_text(text)
+    _, records, damaged = read_study(folder)
+    assert records[("teleop", 0)] is None and records[("pbp_alternated", 0)] is not None
+    assert [(d.key, problem in d.problem) for d in damaged] == [(("teleop", 0), True)]
+
+
+def test_nothing_to_report_exits_2(tmp_path, capsys):
+    (tmp_path / "study.json").write_text("{")
+    assert main(["report", str(tmp_path)]) == 2
+    assert "no trial files" in capsys.readouterr().err
+
+
+def test_a_2d_study_refuses_a_method_comparison_folder(tmp_path, repo, capsys):
+    folder = _study(tmp_path)
+    before = (folder / "study.json").read_text()
+    assert main(["study", str(repo / "diagrams/toy_alpha_study.yaml"), "--output",
+                 str(folder)]) == 2
+    out, err = capsys.readouterr()
+    assert "holds a method_comparison study, not a 2-D alpha_study" in err
+    assert "wrote" not in out and "Traceback" not in err
+    assert not (folder / "summary.json").exists()
+    assert (folder / "study.json").read_text() == before
+
+
+def test_a_method_comparison_refuses_a_2d_study_folder(tmp_path, repo, capsys):
+    (tmp_path / "summary.json").write_text(json.dumps({"study": "alt_vs_cont"}))
+    assert main(["study", str(repo / "diagrams/hsr_reach.yaml"), "--trials", "1",
+                 "--methods", "teleop", "--output", str(tmp_path)]) == 2
+    assert "holds a alt_vs_cont study, not a method comparison" in capsys.readouterr().err
+    assert not (tmp_path / "trials").exists()

@@ -15,8 +15,8 @@ def check_folder(output, scenario, digest):
     written again)."""
     kind = folder_kind(output)
     if kind is not None and kind != "method_comparison":
-        raise StudyFolderError(f"{output} holds a {kind} study, not a method comparison: "
-                               "choose another --output folder")
+        raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a method "
+                               "comparison: choose another --output folder")
     study_path = output / "study.json"
     if not study_path.is_file():
         return

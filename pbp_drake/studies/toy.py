@@ -37,8 +37,8 @@ def run_study(scenario_file, output_dir):
         raise ValueError("this scenario file has no `study:` section to run")
     held = folder_kind(output_dir)
     if held is not None and held != kind:
-        raise StudyFolderError(f"{output_dir} holds a {held} study, not a 2-D {kind}: choose "
-                               "another --output folder")
+        raise StudyFolderError(f"{output_dir} holds a study of kind {held!r}, not a 2-D "
+                               f"{kind}: choose another --output folder")
     output_dir.mkdir(parents=True, exist_ok=True)
     return run(scenario_file.resolved, scenario_file.study, output_dir)
 

@@ -101,7 +101,7 @@ def test_a_2d_study_refuses_a_method_comparison_folder(tmp_path, repo, capsys):
     assert main(["study", str(repo / "diagrams/toy_alpha_study.yaml"), "--output",
                  str(folder)]) == 2
     out, err = capsys.readouterr()
-    assert "holds a method_comparison study, not a 2-D alpha_study" in err
+    assert "holds a study of kind 'method_comparison', not a 2-D alpha_study" in err
     assert "wrote" not in out and "Traceback" not in err
     assert not (folder / "summary.json").exists()
     assert (folder / "study.json").read_text() == before
@@ -111,5 +111,5 @@ def test_a_method_comparison_refuses_a_2d_study_folder(tmp_path, repo, capsys):
     (tmp_path / "summary.json").write_text(json.dumps({"study": "alt_vs_cont"}))
     assert main(["study", str(repo / "diagrams/hsr_reach.yaml"), "--trials", "1",
                  "--methods", "teleop", "--output", str(tmp_path)]) == 2
-    assert "holds a alt_vs_cont study, not a method comparison" in capsys.readouterr().err
+    assert "holds a study of kind 'alt_vs_cont', not a method comparison" in capsys.readouterr().err
     assert not (tmp_path / "trials").exists()

@@ -11,6 +11,7 @@ from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
 from pbp_drake.bench.run import main as bench_main
 from pbp_drake.builder import build_diagram, run_task, simulate
+from pbp_drake.cli_types import port, realtime_rate, wait_seconds
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.draw import main as draw_main
 from pbp_drake.output_paths import check_output_folder, check_record_path, mark_replay
@@ -54,11 +55,15 @@ def main(argv=None):
                      help="let --record overwrite an existing file that is not a replay")
     run.add_argument("--duration", type=float, metavar="SECONDS",
                      help="override the scenario's duration (for HSR tasks, the time limit)")
-    run.add_argument("--realtime-rate", type=float, default=1.0,
-                     help="target simulated seconds per wall second (ignored when headless)")
-    run.add_argument("--port", type=int, default=0, help="Meshcat port (0: a free one)")
-    run.add_argument("--wait-for-browser", type=float, default=15.0, metavar="SECONDS",
-                     help="before starting, wait this long for a browser to open the page")
+    run.add_argument("--realtime-rate", type=realtime_rate, default=1.0, metavar="RATE",
+                     help="target simulated seconds per wall second, positive (default 1; "
+                     "--headless runs as fast as possible)")
+    run.add_argument("--port", type=port, default=0,
+                     help="Meshcat port, 0..65535 (default 0: a free one)")
+    run.add_argument("--wait-for-browser", type=wait_seconds, default=15.0, metavar="SECONDS",
+                     help="before starting, wait this long for a browser to open the page "
+                     "(default 15); a keyboard or gamepad run that no browser joins in time "
+                     "stops with exit 2, having run and recorded nothing")
 
     study = commands.add_parser("study", help="run the study a scenario file describes")
     study.add_argument("scenario", help="a scenario file with a `study:` section")
@@ -204,11 +209,11 @@ def _run_task(args, resolved, meshcat):
     if person or (not args.headless and sys.stdin.isatty()):
         # A person needs the page open before the task starts.
         print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
-              f"(waiting up to {args.wait_for_browser:.0f} s).", flush=True)
+              f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
         if person:
             print("Keys: arrows move the hand (forward only in teleop), Q and E turn it.",
                   flush=True)
-        _wait_for_browser(meshcat, args.wait_for_browser)
+        _wait_for_browser(meshcat, args.wait_for_browser, person)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     result = run_task(resolved, realtime_rate=0.0 if args.headless else args.realtime_rate,
@@ -241,9 +246,9 @@ def _run_session(args, resolved, meshcat, person):
     print(f"Participant {args.participant}: {', '.join(order)}, in this order; saved in "
           f"{output}", flush=True)
     if person:
-        print(f"Open {meshcat.web_url()} in a browser (waiting up to "
-              f"{args.wait_for_browser:.0f} s).", flush=True)
-        _wait_for_browser(meshcat, args.wait_for_browser)
+        print(f"Open {meshcat.web_url()} in a browser; the session starts when it connects "
+              f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
+        _wait_for_browser(meshcat, args.wait_for_browser, person)
 
     def run_one(trial):
         diagram = build_diagram(trial, meshcat)
@@ -269,10 +274,16 @@ def _method_list(text):
     return [method.strip() for method in text.split(",") if method.strip()]
 
 
-def _wait_for_browser(meshcat, seconds):
+def _wait_for_browser(meshcat, seconds, person=False):
+    """Waits up to `seconds` for a browser on the page. A person's run (keyboard, gamepad)
+    cannot go on without one: it stops with exit 2 before anything runs or is recorded."""
     deadline = time.monotonic() + seconds
     while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
-        time.sleep(0.1)
+        time.sleep(0.05)
+    if person and meshcat.GetNumActiveConnections() == 0:
+        raise ScenarioError(f"no browser opened {meshcat.web_url()} within {seconds:g} s "
+                            "(--wait-for-browser): the keyboard and gamepad are read in the "
+                            "page, so nothing was run or recorded")
 
 
 def _save_recording(meshcat, path):

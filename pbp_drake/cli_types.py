@@ -1,0 +1,45 @@
+"""Argument types of `pbp-drake run`: each flag's value is checked when the line is parsed,
+and a bad one is refused by argparse (exit 2) as `argument --FLAG: what is wrong`."""
+
+import argparse
+import math
+
+
+def _finite(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a finite number")
+    return value
+
+
+def port(text):
+    """`--port`: an integer in 0..65535, 0 for a free one."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a port: give an integer in 0..65535 (0: a free one)")
+    return value
+
+
+def realtime_rate(text):
+    """`--realtime-rate`: finite and positive."""
+    value = _finite(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give a positive rate (1: real time); --headless runs as fast as "
+            "possible")
+    return value
+
+
+def wait_seconds(text):
+    """`--wait-for-browser`: finite and not negative."""
+    value = _finite(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a number of seconds, 0 or more")
+    return value

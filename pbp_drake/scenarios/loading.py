@@ -15,6 +15,7 @@ from pbp_drake.scenarios.resolution import ResolvedScenario, close_match, resolv
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     ScenarioFile)
+from pbp_drake.scenarios.yaml_checks import describe_load_error, read_scenario_text
 
 
 @dataclasses.dataclass(frozen=True)
@@ -34,9 +35,17 @@ def load_scenario_file(path):
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
     try:
-        loaded = yaml_load_typed(schema=ScenarioFile, filename=str(path))
+        text = read_scenario_text(path)
+    except ScenarioError as error:
+        raise ScenarioError(f"{path}: {error}") from None
+    try:
+        loaded = yaml_load_typed(schema=ScenarioFile, data=text)
     except RuntimeError as error:
+        if getattr(error, "problem_mark", None) is not None:
+            raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
         raise ScenarioError(f"{path}: {error}{_suggestion(str(error))}") from None
+    except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad values
+        raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
     try:
         resolved = resolve(loaded.scenario)
         if isinstance(loaded.study, AlphaStudy):

@@ -17,6 +17,9 @@ import numpy as np
 from pbp_drake.core.linear import second_order_step
 
 FORMULATIONS = ("ijspeert", "pastor")
+# The most basis functions a DMP may have: far more than any trajectory needs (the paper
+# uses 50), and a bound that refuses at once what would otherwise fail to allocate later.
+MAX_BASIS_COUNT = 10_000
 
 
 @dataclasses.dataclass
@@ -27,7 +30,7 @@ class DmpSettings:
 
     Attributes:
         formulation: "ijspeert" or "pastor".
-        basis_count: number of Gaussian basis functions.
+        basis_count: number of Gaussian basis functions, 2 to `MAX_BASIS_COUNT` (10,000).
         alpha_z: damping gain; `beta_z` defaults to `alpha_z / 4` (critically damped).
         beta_z: stiffness ratio, `None` for `alpha_z / 4`.
         alpha_x: phase decay; `ln 100` makes the phase reach 0.01 at `t = tau`.
@@ -51,6 +54,9 @@ class DmpSettings:
             )
         if self.basis_count < 2:
             raise ValueError(f"basis_count must be at least 2, got {self.basis_count}")
+        if self.basis_count > MAX_BASIS_COUNT:
+            raise ValueError(f"basis_count must be at most {MAX_BASIS_COUNT}, got "
+                             f"{self.basis_count}")
         for name in ("alpha_z", "alpha_x"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)}")

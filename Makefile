@@ -16,10 +16,10 @@ $(STAMP): pyproject.toml
 # The HSR reaching task with PBP-Alt and the virtual participant, then the 2-D alpha study.
 demo: $(STAMP)
 	$(VENV)/bin/pbp-drake run diagrams/hsr_reach.yaml --method pbp_alternated \
-		--operator virtual --headless --record $(DEMO_DIR)/hsr_reach.html
+		--operator virtual --headless --record $(DEMO_DIR)/hsr_reach.html --force
 	$(VENV)/bin/pbp-drake study diagrams/toy_alpha_study.yaml --output $(DEMO_DIR)
 	$(VENV)/bin/pbp-drake run diagrams/toy_alpha_study.yaml --scene scene_1 \
-		--method pbp_alternated --headless --record $(DEMO_DIR)/replay.html
+		--method pbp_alternated --headless --record $(DEMO_DIR)/replay.html --force
 	@echo "Open $(DEMO_DIR)/hsr_reach.html in a browser to replay the HSR task."
 
 # $(call debian_tool,COMMAND,PACKAGE,PURPOSE): some tests need a Debian program (never a

@@ -11,7 +11,8 @@ import typing
 import numpy as np
 from pydrake.common.yaml import yaml_load_typed
 
-from pbp_drake.scenarios.resolution import ResolvedScenario, close_match, resolve, with_method
+from pbp_drake.scenarios.resolution import (
+    ResolvedScenario, check_obstacles, close_match, resolve, with_method)
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     ScenarioFile)
@@ -49,7 +50,7 @@ def load_scenario_file(path):
     try:
         resolved = resolve(loaded.scenario)
         if isinstance(loaded.study, AlphaStudy):
-            check_alpha_study(loaded.study, loaded.scenario)
+            check_alpha_study(loaded.study, loaded.scenario, resolved.start.size)
         if isinstance(loaded.study, MethodComparison):
             check_method_comparison(loaded.study, loaded.scenario)
     except ScenarioError as error:
@@ -58,7 +59,9 @@ def load_scenario_file(path):
                               resolved=resolved)
 
 
-def check_alpha_study(study, scenario):
+def check_alpha_study(study, scenario, dimension):
+    """The alpha study's scenes and alphas, for a scenario of `dimension` (2 for the
+    paper's toy)."""
     if not study.scenes:
         raise ScenarioError("study.scenes is empty")
     if not study.alphas:
@@ -68,6 +71,15 @@ def check_alpha_study(study, scenario):
             raise ScenarioError(f"study.alphas has {alpha}, outside [0, 1]")
     if scenario.demonstration is None:
         raise ScenarioError("the alpha study needs scenario.demonstration")
+    names = [scene.name for scene in study.scenes]
+    for index, scene in enumerate(study.scenes):
+        if not scene.name:
+            raise ScenarioError(f"study.scenes[{index}] needs a name")
+        if names.index(scene.name) != index:
+            raise ScenarioError(f"study.scenes[{index}]: the name {scene.name!r} is taken by "
+                                f"study.scenes[{names.index(scene.name)}]; give each scene "
+                                "its own")
+        check_obstacles(scene.obstacles, dimension, f"study.scenes[{index}].obstacles")
 
 
 def check_method_comparison(study, scenario):

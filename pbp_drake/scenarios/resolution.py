@@ -231,13 +231,7 @@ def _resolve_point_robot(scenario):
     _check_method(scenario, goals.shape[0])
     if scenario.dmp_duration <= 0 and demonstration is None:
         raise ScenarioError("scenario.dmp_duration is needed when there is no demonstration")
-    for index, obstacle in enumerate(scenario.obstacles):
-        if (len(obstacle.center) != start.size or not np.isfinite(obstacle.center).all()
-                or not (np.isfinite(obstacle.radius) and obstacle.radius > 0)):
-            raise ScenarioError(
-                f"scenario.obstacles[{index}] needs a finite center of dimension {start.size} "
-                f"and a finite positive radius, got center {obstacle.center}, radius "
-                f"{obstacle.radius}")
+    check_obstacles(scenario.obstacles, start.size)
     _check_toy_operator(scenario.operator, start.size)
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else None
     if demonstration is None:
@@ -248,6 +242,18 @@ def _resolve_point_robot(scenario):
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=demonstration,
         dmp_bank=bank)
+
+
+def check_obstacles(obstacles, dimension, field="scenario.obstacles"):
+    """Each obstacle of a 2-D (any-D) scene has a finite center of `dimension` and a finite
+    positive radius; the error names `field[i]`."""
+    for index, obstacle in enumerate(obstacles):
+        if (len(obstacle.center) != dimension or not np.isfinite(obstacle.center).all()
+                or not (np.isfinite(obstacle.radius) and obstacle.radius > 0)):
+            raise ScenarioError(
+                f"{field}[{index}] needs a finite center of dimension {dimension} and a "
+                f"finite positive radius, got center {obstacle.center}, radius "
+                f"{obstacle.radius}")
 
 
 def _check_toy_operator(operator, dimension):

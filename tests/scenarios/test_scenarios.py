@@ -149,3 +149,19 @@ def test_a_success_distance_that_ends_the_task_at_once_is_refused(tmp_path, dist
                                         f"!MultiGoalReach {{success_distance: {distance}}}")
     with pytest.raises(ScenarioError, match=message):
         load_scenario_file(write(tmp_path, text))
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("name: scene_2", "name: scene_1", r"study.scenes\[1\]: the name 'scene_1' is taken"),
+    ("{center: [0.5, 0.4], radius: 0.12}", "{center: [0.5, 0.4, 0.0], radius: 0.12}",
+     r"study.scenes\[1\].obstacles\[0\] needs a finite center of dimension 2"),
+    ("{center: [0.5, 0.4], radius: 0.12}", "{center: [0.5, .nan], radius: 0.12}",
+     r"study.scenes\[1\].obstacles\[0\] needs a finite center"),
+])
+def test_alpha_study_scenes_are_checked_when_the_file_loads(tmp_path, repo, old, new, message):
+    text = (repo / "diagrams/toy_alpha_study.yaml").read_text()
+    assert old in text
+    path = tmp_path / "study.yaml"
+    path.write_text(text.replace(old, new))
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(path)

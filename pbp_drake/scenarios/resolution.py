@@ -143,14 +143,20 @@ def _check_common(scenario):
             f"{close_match(scenario.method, METHODS)}")
     if not (np.isfinite(scenario.alpha) and 0.0 <= scenario.alpha <= 1.0):
         raise ScenarioError(f"scenario.alpha = {scenario.alpha} is outside [0, 1]")
-    for name in ("control_period", "duration"):
-        value = getattr(scenario, name)
-        if not (np.isfinite(value) and value > 0):
-            raise ScenarioError(f"scenario.{name} must be finite and positive, got {value}")
+    _require_finite(scenario, "scenario", ("control_period", "duration"))
     _settings_checked("scenario.dmp", scenario.dmp)
     _settings_checked("scenario.goal_estimator", scenario.goal_estimator)
-    if not (np.isfinite(scenario.dmp_duration) and scenario.dmp_duration >= 0):
-        raise ScenarioError("scenario.dmp_duration must be finite and not negative")
+    _require_finite(scenario, "scenario", ("dmp_duration",), positive=False)
+
+
+def _require_finite(config, field, names, positive=True):
+    """Each of `names` of `config` (0 where it has no such field) is finite and positive,
+    or with `positive=False` finite and not negative; the error names `field.name`."""
+    least = "positive" if positive else "not negative"
+    for name in names:
+        value = getattr(config, name, 0.0)
+        if not (np.isfinite(value) and (value > 0 if positive else value >= 0)):
+            raise ScenarioError(f"{field}.{name} must be finite and {least}, got {value}")
 
 
 def _settings_checked(field, settings):
@@ -192,12 +198,8 @@ def demonstration_samples(demonstration):
 def _check_point_robot(robot):
     """The toy robot's dynamics: a positive mass and time step, springs and dampers that
     are finite and not negative."""
-    for name, least in (("mass", "positive"), ("time_step", "positive"),
-                        ("stiffness", "not negative"), ("damping", "not negative")):
-        value = getattr(robot, name)
-        if not (np.isfinite(value) and (value > 0 if least == "positive" else value >= 0)):
-            raise ScenarioError(f"scenario.robot.{name} must be finite and {least}, got "
-                                f"{value}")
+    _require_finite(robot, "scenario.robot", ("mass", "time_step"))
+    _require_finite(robot, "scenario.robot", ("stiffness", "damping"), positive=False)
 
 
 def _resolve_point_robot(scenario):
@@ -292,17 +294,14 @@ def _resolve_hsr(scenario):
         raise ScenarioError("the HSR task draws its own goals (the objects) and starts "
                             "where the robot stands: remove scenario.demonstration, goals "
                             "and start")
-    if not (np.isfinite(robot.speed) and robot.speed > 0):
-        raise ScenarioError("scenario.robot.speed must be positive")
+    _require_finite(robot, "scenario.robot", ("speed",))
     if not _whole_multiple(scenario.control_period, robot.station.plant.time_step):
         raise ScenarioError("scenario.control_period must be a whole multiple of "
                             "scenario.robot.station.plant.time_step")
     operator = scenario.operator
-    for name in ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
-                 "direction_noise", "speed_noise"):
-        value = getattr(operator, name, 0.0)
-        if not (np.isfinite(value) and value >= 0):
-            raise ScenarioError(f"scenario.operator.{name} must be finite and not negative")
+    _require_finite(operator, "scenario.operator",
+                    ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
+                     "direction_noise", "speed_noise"), positive=False)
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(task, DynamicObstacles):
@@ -352,7 +351,7 @@ def _check_hand_over(scenario):
                                        "scenario.robot.max_hand_yaw_acceleration", "rad/s^2")
     except ValueError as error:
         raise ScenarioError(str(error)) from None
-    speed = max(robot.speed, getattr(scenario.operator, "speed", 0.0) or 0.0)
+    speed = max(robot.speed, getattr(scenario.operator, "speed", 0.0))
     if speed > top_speed:
         raise ScenarioError(
             f"scenario.robot.max_hand_speed {top_speed} m/s is below the task's speed "
@@ -362,7 +361,7 @@ def _check_hand_over(scenario):
             f"scenario.robot.max_hand_acceleration {acceleration} m/s^2 takes "
             f"{speed / acceleration:.1f} s to reach the task's speed {speed} m/s, longer "
             f"than scenario.duration {scenario.duration} s: raise it")
-    turn = getattr(scenario.operator, "rotation_speed", 0.0) or 0.0
+    turn = getattr(scenario.operator, "rotation_speed", 0.0)
     if turn / yaw_acceleration > scenario.duration:
         raise ScenarioError(
             f"scenario.robot.max_hand_yaw_acceleration {yaw_acceleration} rad/s^2 takes "
@@ -371,11 +370,7 @@ def _check_hand_over(scenario):
 
 
 def _check_reach_task(task):
-    for name in ("success_distance", "min_separation"):
-        value = getattr(task, name)
-        if not (np.isfinite(value) and value > 0):
-            raise ScenarioError(f"scenario.task.{name} must be finite and positive, got "
-                                f"{value}")
+    _require_finite(task, "scenario.task", ("success_distance", "min_separation"))
     schedule = np.asarray(task.switch_schedule, float)
     if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
             or schedule[-1] >= 1.0):
@@ -384,9 +379,8 @@ def _check_reach_task(task):
 
 
 def _check_obstacle_task(task):
-    for name in ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"):
-        if not (np.isfinite(getattr(task, name)) and getattr(task, name) > 0):
-            raise ScenarioError(f"scenario.task.{name} must be positive")
+    _require_finite(task, "scenario.task",
+                    ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"))
     if task.obstacle_count < 0:
         raise ScenarioError("scenario.task.obstacle_count must not be negative")
     for name in ("x_range", "y_range", "obstacle_x_range", "obstacle_y_range",

@@ -6,6 +6,7 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.arbitration import (
     DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW, blend, confidence_alpha,
     validate_confidence_ramp, validate_mode)
+from pbp_drake.systems.layouts import goal_index
 
 
 class Blender(LeafSystem):
@@ -115,13 +116,7 @@ class Blender(LeafSystem):
                                 self._alpha_max)
 
     def _selected_goal(self, context):
-        if not self._selected_goal_port.HasValue(context):
-            return 0
-        selected = int(self._selected_goal_port.Eval(context)[0])
-        if not 0 <= selected < self._goal_count:
-            raise ValueError(f"selected_goal {selected} is not one of the "
-                             f"{self._goal_count} goals")
-        return selected
+        return goal_index(self._selected_goal_port, context, self._goal_count, unconnected=0)
 
     def get_command_output_port(self):
         return self._command_port

@@ -11,6 +11,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
+from pbp_drake.systems.layouts import goal_index
 from pbp_drake.systems.tick import decide_offset
 
 
@@ -146,17 +147,6 @@ class DmpBank(LeafSystem):
     def get_followed_goal_input_port(self):
         return self._followed_goal_port
 
-    def _followed_goal(self, context):
-        """The index of the goal whose reference the robot followed since the last update,
-        or None when `followed_goal` is unconnected."""
-        if not self._followed_goal_port.HasValue(context):
-            return None
-        followed = int(self._followed_goal_port.Eval(context)[0])
-        if not 0 <= followed < self._bank.goal_count:
-            raise ValueError(f"followed_goal {followed} is not one of the "
-                             f"{self._bank.goal_count} goals")
-        return followed
-
     def get_references_output_port(self):
         return self._references_port
 
@@ -212,7 +202,8 @@ class DmpBank(LeafSystem):
         lock = (self._lock and self._operator_active_port.HasValue(context)
                 and self._operator_active_port.Eval(context)[0] > 0.5)
         goals_dk = None if lock else self._goals_dk.Eval(context)
-        followed = self._followed_goal(context)
+        # The goal the robot followed since the last update (None: unconnected).
+        followed = goal_index(self._followed_goal_port, context, bank.goal_count)
         workspace = self._workspace(context)
         # The velocities the last step left, read out in place (see the class docstring).
         if not held[0]:

@@ -2,7 +2,8 @@
 
 Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
 ``EeState.size`` is its length. Every system that declares such a port takes its size here.
-`position_of` reads the `[x, y, z]` of any view that has those fields.
+`position_of` reads the `[x, y, z]` of any view that has those fields; `goal_index` reads a
+goal index port (`selected_goal`, `followed_goal`).
 """
 
 import numpy as np
@@ -32,3 +33,14 @@ TaskStatus = _view("TaskStatus", ["progress", "stage", "success", "task_time",
 def position_of(view):
     """`[x, y, z]` of a view with those fields (`EeState`, `EeCommand`, `Target`), a copy."""
     return np.array([view.x, view.y, view.z])
+
+
+def goal_index(port, context, goal_count, unconnected=None):
+    """The goal index `[k]` on `port` as an int, checked to be one of `goal_count` goals;
+    `unconnected` when nothing is connected to the port."""
+    if not port.HasValue(context):
+        return unconnected
+    index = int(port.Eval(context)[0])
+    if not 0 <= index < goal_count:
+        raise ValueError(f"{port.get_name()} {index} is not one of the {goal_count} goals")
+    return index

@@ -66,7 +66,7 @@ def test_bad_obstacle_settings_name_the_field(tmp_path, repo):
     text = (repo / "diagrams" / "hsr_obstacles.yaml").read_text()
     path = tmp_path / "bad.yaml"
     path.write_text(text.replace("obstacle_speed: 0.4", "obstacle_speed: -1.0"))
-    with pytest.raises(ScenarioError, match="obstacle_speed must be positive"):
+    with pytest.raises(ScenarioError, match="obstacle_speed must be finite and positive"):
         load_scenario_file(path)
     path.write_text(text.replace("activation_range: [0.05, 0.5]", "activation_range: [0.5, 0.1]"))
     with pytest.raises(ScenarioError, match="activation_range"):

@@ -24,9 +24,9 @@ class HeadingCommand(LeafSystem):
     the rate it turns at follows the operator's under the hand-over law
     (`pbp_drake.core.hand_over`), so starting and stopping a turn is not a step. The DMPs
     never turn the robot: in PBP the operator's turning is how it tells the goal estimator
-    where it wants to go. Like the
-    DMP bank, it updates at the decide stage (`update_offset` after the tick, by default
-    `pbp_drake.systems.tick.decide_offset`) to use the operator's command of that tick.
+    where it wants to go. Like the DMP bank, it updates at the decide stage (`update_offset`
+    after the tick, by default `pbp_drake.systems.tick.decide_offset`) to use the
+    operator's command of that tick.
     """
 
     def __init__(self, initial_heading, control_period, max_yaw_acceleration=None,
@@ -39,9 +39,9 @@ class HeadingCommand(LeafSystem):
             max_yaw_acceleration, "max_yaw_acceleration", "rad/s^2"))
         self._command_port = self.DeclareVectorInputPort("operator_command",
                                                          OperatorCommand.size)
-        index = self.DeclareDiscreteState(np.array([float(initial_heading)]))
+        self._heading_index = self.DeclareDiscreteState(np.array([float(initial_heading)]))
         self._yaw_rate_index = self.DeclareDiscreteState(np.zeros(1))
-        self._heading_port = self.DeclareStateOutputPort("heading", index)
+        self._heading_port = self.DeclareStateOutputPort("heading", self._heading_index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     def get_operator_command_input_port(self):
@@ -51,7 +51,7 @@ class HeadingCommand(LeafSystem):
         return self._heading_port
 
     def _update(self, context, discrete_state):
-        heading = discrete_state.get_mutable_vector(0).get_mutable_value()
+        heading = discrete_state.get_mutable_vector(self._heading_index).get_mutable_value()
         yaw_rate = discrete_state.get_mutable_vector(self._yaw_rate_index).get_mutable_value()
         wanted = OperatorCommand(self._command_port.Eval(context)).yaw_rate
         # The hand-over law in one dimension: the turn's rate changes by at most

@@ -14,6 +14,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from pbp_drake.builder.build import build_diagram
 from pbp_drake.scenarios import ResolvedScenario, resolve
+from pbp_drake.systems.browser_guard import reset_pacing_after_pauses
 from pbp_drake.systems.layouts import TaskStatus
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
 
@@ -42,10 +43,13 @@ class Trajectory:
 def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=None):
     """`(scenario, diagram, simulator)` of a scenario (resolved once if it is not): the
     diagram built unless given, the simulator configured by the scenario's
-    `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized."""
+    `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized. An
+    operator's pause for a shared browser page restarts the real-time pacing
+    (`reset_pacing_after_pauses`)."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
     diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
     simulator = Simulator(diagram)
+    reset_pacing_after_pauses(diagram, simulator)
     ApplySimulatorConfig(resolved.scenario.simulator, simulator)
     if realtime_rate is not None:
         simulator.set_target_realtime_rate(realtime_rate)

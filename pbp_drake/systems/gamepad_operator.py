@@ -5,11 +5,13 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
+from pbp_drake.systems.browser_guard import BrowserGuard
 from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 # Standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN.
 LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X = 0, 1, 2
+_STICK_AXES = 3
 
 
 @dataclasses.dataclass
@@ -49,34 +51,56 @@ class GamepadOperator(SampledOperator):
     `operator_active` is 1 while a stick is outside its dead zone (a stick pushed only
     forward does not count when forward is not allowed). With no gamepad (Meshcat
     has received none, or the browser reported it disconnected) the command is zero and
-    inactive. Meshcat must be used only from the thread that created it.
+    inactive.
+
+    With `exclusive` (the default) a `BrowserGuard` (`browser_guard`) pauses the simulation
+    while more than one browser is connected to the page. Meshcat keeps the last gamepad
+    state it received, from whichever page sent it: after a pause, that state is ignored
+    (zero, inactive) until the sticks report something new. Meshcat must be used only from
+    the thread that created it.
     """
 
     def __init__(self, meshcat, control_period, allow_forward, params=GamepadParams(),
-                 nominal_speed=None):
+                 nominal_speed=None, exclusive=True):
         if not 0.0 <= params.dead_zone < 1.0:
             raise ValueError(f"dead_zone must be in [0, 1), not {params.dead_zone}")
         super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
         self._meshcat = meshcat
+        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
         self._allow_forward = bool(allow_forward)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
         self._dead_zone = float(params.dead_zone)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        # The stick axes Meshcat held when the last pause ended (NaN: none to ignore).
+        self._stale_index = self.DeclareDiscreteState(np.full(_STICK_AXES, np.nan))
         self._declare_operator_outputs()
 
     def get_ee_state_input_port(self):
         return self._ee_state_port
 
-    def _sample(self, context):
+    def _update(self, context, discrete_state):
+        # Read before the connections are counted (see KeyboardOperator._update).
         gamepad = self._meshcat.GetGamepad()
+        stale = context.get_discrete_state(self._stale_index).value()
+        if self.browser_guard is not None and self.browser_guard.wait_while_shared():
+            stale = _stick_axes(self._meshcat.GetGamepad())
+        elif not np.array_equal(_stick_axes(gamepad), stale, equal_nan=True):
+            stale = np.full(_STICK_AXES, np.nan)  # the sticks moved since: read them again
+        discrete_state.get_mutable_vector(self._stale_index).set_value(stale)
+        if np.isnan(stale).all():
+            self._store_sample(discrete_state, *self._command(context, gamepad))
+        else:
+            self._store_sample(discrete_state, np.zeros(OperatorCommand.size), False)
+
+    def _command(self, context, gamepad):
         axes = list(gamepad.axes)
         # The browser sends an empty status when the gamepad disconnects; Meshcat then
         # keeps the old index, so empty axes also mean "no gamepad".
         if gamepad.index is None or len(axes) < 2:
             return np.zeros(4), False
-        axes += [0.0] * (3 - len(axes))
+        axes += [0.0] * (_STICK_AXES - len(axes))
         # Browser axes: x right, y down. Robot frame: forward, left.
         stick = self._apply_dead_zone(np.array([-axes[LEFT_STICK_Y], -axes[LEFT_STICK_X]]))
         turn = self._apply_dead_zone(np.array([-axes[RIGHT_STICK_X]]))[0]
@@ -94,3 +118,9 @@ class GamepadOperator(SampledOperator):
             return np.zeros_like(stick)
         scaled = (min(magnitude, 1.0) - self._dead_zone) / (1.0 - self._dead_zone)
         return stick * (scaled / magnitude)
+
+
+def _stick_axes(gamepad):
+    """The first stick axes of a Meshcat gamepad status (missing ones NaN)."""
+    axes = list(gamepad.axes)[:_STICK_AXES]
+    return np.array(axes + [np.nan] * (_STICK_AXES - len(axes)), float)

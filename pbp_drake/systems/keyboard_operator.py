@@ -5,6 +5,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
+from pbp_drake.systems.browser_guard import BrowserGuard
 from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
@@ -79,6 +80,10 @@ class KeyboardOperator(SampledOperator):
     effective key is held (even if
     opposite keys cancel).
 
+    With `exclusive` (the default) a `BrowserGuard` (`browser_guard`) pauses the simulation
+    while more than one browser is connected to the page, and the clicks sent meanwhile
+    are dropped and every key released: no second page drives the robot.
+
     Click counts are snapshotted at initialisation, and the last counts and click times are
     kept in discrete state, so the system holds no state outside its Context. Meshcat must
     be used only from the thread that created it (run the simulator there). The buttons
@@ -86,10 +91,11 @@ class KeyboardOperator(SampledOperator):
     """
 
     def __init__(self, meshcat, control_period, allow_forward, params=KeyboardParams(),
-                 nominal_speed=None):
+                 nominal_speed=None, exclusive=True):
         super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
         self._meshcat = meshcat
+        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
         self._allow_forward = bool(allow_forward)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
@@ -123,14 +129,22 @@ class KeyboardOperator(SampledOperator):
         return np.array([self._meshcat.GetButtonClicks(name) for name in self._buttons],
                         float)
 
+    def _released_keys(self):
+        """The key state with the clicks so far seen and no key held."""
+        return np.concatenate([self._clicks(), np.full(len(self._buttons), -np.inf)])
+
     def _snapshot(self, context, discrete_state):
-        n = len(self._buttons)
-        discrete_state.get_mutable_vector(self._keys_index).set_value(
-            np.concatenate([self._clicks(), np.full(n, -np.inf)]))
+        discrete_state.get_mutable_vector(self._keys_index).set_value(self._released_keys())
 
     def _update(self, context, discrete_state):
         # Meshcat is read once a tick; the key state and the command come from that read.
-        keys = self._next_keys(context, self._clicks())
+        # The connections are counted after the read: a click read here came from a page
+        # connected before the count.
+        clicks = self._clicks()
+        if self.browser_guard is not None and self.browser_guard.wait_while_shared():
+            keys = self._released_keys()  # what another page sent does not count
+        else:
+            keys = self._next_keys(context, clicks)
         discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
         self._store_sample(discrete_state, *self._command(context, keys))
 

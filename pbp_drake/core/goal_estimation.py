@@ -32,6 +32,8 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.coordinates import check_positions
+
 GOAL_ESTIMATION_METHODS = ("angle", "nearest", "bayesian")
 
 # A goal closer than this (m) to the end effector on the floor plane has no direction.
@@ -104,13 +106,12 @@ def _is_real(value):
 
 
 def validate_goals(goals):
-    """Goals as a float `(K, 3)` array with K >= 1 and no NaN or infinite entry."""
+    """Goals as a float `(K, 3)` array with K >= 1, finite and within the toolbox's bounds
+    (`pbp_drake.core.coordinates`)."""
     goals = np.asarray(goals, dtype=float)
     if goals.ndim != 2 or goals.shape[1] != 3 or len(goals) == 0:
         raise ValueError(f"goals must be (K, 3) with K >= 1, got shape {goals.shape}")
-    if not np.isfinite(goals).all():
-        bad = np.flatnonzero(~np.isfinite(goals).all(axis=1))
-        raise ValueError(f"goals contain NaN or infinite values (goal {bad[0]})")
+    check_positions(goals, "goal")
     return goals
 
 

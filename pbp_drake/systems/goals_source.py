@@ -3,6 +3,8 @@
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem, NumericParameterIndex
 
+from pbp_drake.core.coordinates import check_positions
+
 
 class GoalsSource(LeafSystem):
     """Outputs K goals `(K, D)` flattened row-major, kept in a numeric parameter.
@@ -24,6 +26,7 @@ class GoalsSource(LeafSystem):
         goals = np.asarray(goals, dtype=float)
         if goals.ndim != 2 or goals.size == 0:
             raise ValueError(f"goals must be a non-empty (K, D) array, got shape {goals.shape}")
+        check_positions(goals, "goal")
         self._shape = goals.shape
         self._index = self.DeclareNumericParameter(BasicVector(goals.reshape(-1)))
         self._goals_port = self.DeclareVectorOutputPort(
@@ -35,8 +38,10 @@ class GoalsSource(LeafSystem):
         return self._goals_port
 
     def set_goals(self, context, goals):
-        """Sets the goals `(K, D)` (the same K and D) in `context`."""
+        """Sets the goals `(K, D)` (the same K and D, finite and within
+        `pbp_drake.core.coordinates`' bounds) in `context`."""
         goals = np.asarray(goals, dtype=float)
         if goals.shape != self._shape:
             raise ValueError(f"goals has shape {goals.shape}, the source holds {self._shape}")
+        check_positions(goals, "goal")
         context.get_mutable_numeric_parameter(self._index).SetFromVector(goals.reshape(-1))

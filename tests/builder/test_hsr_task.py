@@ -191,6 +191,28 @@ def test_keyboard_left_key_moves_the_hand_left(fixed_task):
     assert abs(moved[0]) < 0.05 and abs(moved[2]) < 0.02
 
 
+def test_a_goal_moved_out_of_the_world_mid_run_stops_the_run_with_one_message(fixed_task,
+                                                                              capfd):
+    diagram = build_diagram(fixed_task)
+    simulator = Simulator(diagram)
+    simulator.Initialize()
+    simulator.AdvanceTo(1.0)
+    source = diagram.GetSubsystemByName("pbp_controller").GetSubsystemByName("goals")
+    context = source.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    moved = source.get_goals_output_port().Eval(context).reshape(-1, 3).copy()
+    moved[1, 0] = 1e200
+    with pytest.raises(ValueError, match=r"goal 1 is \[1e\+200, "):
+        source.set_goals(context, moved)
+    # Written past set_goals (as a diagram of one's own may feed its goals), the DMP bank
+    # refuses it at the next tick, before anything reaches the whole-body QP.
+    context.get_mutable_numeric_parameter(0).SetFromVector(moved.reshape(-1))
+    with pytest.raises(ValueError, match=r"goal 1 is .*positions must be finite and within"):
+        simulator.AdvanceTo(1.5)
+    output = capfd.readouterr()
+    assert "OSQP" not in output.out + output.err
+    assert "DifferentialInverseKinematics" not in output.out + output.err
+
+
 def test_run_with_the_virtual_participant_prints_one_result_line(tmp_path, capsys, fixed_task,
                                                                  pbp_run):
     path = write(tmp_path, FIXED_TASK)

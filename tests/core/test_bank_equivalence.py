@@ -285,7 +285,7 @@ def test_leaf_system_refuses_a_nan_goal_at_its_first_update():
     goals[2, 1] = np.nan
     system.get_robot_state_input_port().FixValue(context, np.zeros(6))
     system.get_goals_input_port().FixValue(context, goals.reshape(-1))
-    with pytest.raises(ValueError, match="goals contains NaN"):
+    with pytest.raises(ValueError, match="goal 2 is .*must be finite"):
         simulator.AdvanceTo(DT / 2)
 
 

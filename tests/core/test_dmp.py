@@ -134,10 +134,13 @@ def test_empty_goal_set_is_refused(goals):
         DmpBank.straight([0.0, 0.0], goal_count=0, duration=1.0)
 
 
-def test_nan_goal_is_refused():
-    bank = DmpBank.straight([0.0, 0.0], goal_count=1, duration=1.0)
-    with pytest.raises(ValueError, match="goals contains NaN"):
-        bank.goals_matrix([[np.nan, 0.0]])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, 1e200, -2e6])
+def test_a_goal_that_is_not_a_position_is_refused_by_number(bad):
+    bank = DmpBank.straight([0.0, 0.0], goal_count=2, duration=1.0)
+    with pytest.raises(ValueError, match=r"goal 1 is \[.*\]: positions must be finite and "
+                                         r"within ±1e\+06 m"):
+        bank.goals_matrix([[0.5, 0.0], [bad, 0.0]])
+    bank.goals_matrix([[0.5, 0.0], [-1e6, 1e6]])  # the bound itself is a position
 
 
 def test_short_or_nan_demonstrations_are_refused():

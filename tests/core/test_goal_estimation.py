@@ -185,7 +185,8 @@ def test_bad_settings_name_the_field(field, value, message):
 @pytest.mark.parametrize("goals, message", [
     (np.empty((0, 3)), "goals must be"),
     (np.zeros((2, 2)), "goals must be"),
-    (np.array([[1.0, np.nan, 0.7]]), "goals contain NaN"),
+    (np.array([[1.0, np.nan, 0.7]]), "goal 0 is .*must be finite"),
+    (np.array([[1.0, 0.0, 0.7], [1e200, 0.0, 0.7]]), "goal 1 is .*within"),
 ])
 def test_bad_goals_are_refused(goals, message):
     with pytest.raises(ValueError, match=message):

@@ -9,10 +9,10 @@ threads, Drake Contexts or Simulators at once, each with its own state and works
 """
 
 import dataclasses
-import math
 
 import numpy as np
 
+from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp._checks import as_point, broadcast_goalwise, positive
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
 from pbp_drake.core.dmp.settings import DmpSettings
@@ -177,10 +177,7 @@ class DmpBank(BankStep):
                 f"goals has {goals.size} numbers; the bank expects {self.goal_count} goals of "
                 f"dimension {self.dimension}"
             )
-        # One reduction without a temporary: a finite sum proves every entry finite; only
-        # when it is not (NaN, infinity, or an overflow of huge finite goals) look closer.
-        if not math.isfinite(goals.sum()) and not np.isfinite(goals).all():
-            raise ValueError("goals contains NaN or infinite values")
+        check_positions(goals.reshape(self.goal_count, self.dimension), "goal")
         return goals.reshape(self.goal_count, self.dimension).T
 
     def advance(self, phase, positions, scaled_velocity, goals_dk, dt, locked=None,

@@ -1,0 +1,35 @@
+"""The positions the toolbox accepts: finite, and within `MAX_COORDINATE` metres of the
+origin on every axis.
+
+The bound is far beyond any scene a robot works in, so it refuses only data errors (a wrong
+unit, a corrupted value). Past about 1e154 a squared distance overflows to infinity: a goal
+moved to 1e200 used to reach the whole-body QP as infinite costs, where OSQP and the
+differential IK warned at every tick and the run went on. Refused here, it stops with one
+message naming the goal.
+"""
+
+import numpy as np
+
+MAX_COORDINATE = 1e6  # metres
+
+
+def within_bounds(values):
+    """True when every entry of `values` is finite and within ±`MAX_COORDINATE`. Two
+    reductions, no temporary array: a NaN fails both comparisons."""
+    values = np.asarray(values, dtype=float)
+    return values.size == 0 or bool(values.min() >= -MAX_COORDINATE
+                                    and values.max() <= MAX_COORDINATE)
+
+
+def check_positions(positions, name):
+    """Raises ValueError naming the first row of `positions` `(K, D)` (or one point `(D,)`)
+    that is not finite or not within ±`MAX_COORDINATE` m, as `name` `k`."""
+    positions = np.asarray(positions, dtype=float)
+    if within_bounds(positions):
+        return
+    rows = np.atleast_2d(positions)
+    bad = ~(np.isfinite(rows) & (np.abs(rows) <= MAX_COORDINATE)).all(axis=1)
+    index = int(np.flatnonzero(bad)[0])
+    label = name if positions.ndim < 2 else f"{name} {index}"
+    raise ValueError(f"{label} is {rows[index].tolist()}: positions must be finite and "
+                     f"within ±{MAX_COORDINATE:g} m on every axis")

@@ -22,6 +22,7 @@ from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.progress import ProgressBar
 from pbp_drake.studies.report import FIGURES, report, results_table
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
+from pbp_drake.studies.splits import SPLITS, first_seed, split_of
 from pbp_drake.studies.toy import TOY_FIGURES, run_study
 
 
@@ -70,7 +71,11 @@ def main(argv=None):
     study.add_argument("--output", required=True, help="folder for summary.json and figures")
     study.add_argument("--methods", help="comma-separated methods to compare (HSR tasks)")
     study.add_argument("--trials", type=int, help="seeded scenes per method (HSR tasks)")
-    study.add_argument("--seed", type=int, help="the first scene's seed (HSR tasks)")
+    study.add_argument("--split", choices=SPLITS,
+                       help="HSR tasks: run the study's tuning or evaluation seeds (default: "
+                            "the study's `split`)")
+    study.add_argument("--seed", type=int, help="the first scene's seed (HSR tasks; results "
+                       "are labelled with the split the seeds fall in)")
     study.add_argument("--jobs", type=int, default=1,
                        help="HSR tasks: trials run in this many processes at once (default 1)")
     study.add_argument("--backend", choices=("local", "ray"), default="local",
@@ -329,8 +334,10 @@ def _method_study(args, scenario_file):
         study = dataclasses.replace(study, methods=_method_list(args.methods))
     if args.trials is not None:
         study = dataclasses.replace(study, trials=args.trials)
-    if args.seed is not None:
-        study = dataclasses.replace(study, seed=args.seed)
+    if args.split is not None:
+        study = dataclasses.replace(study, split=args.split)
+    seed = first_seed(study, study.split) if args.seed is None else args.seed
+    split = split_of(study, seed, study.trials)
     if args.jobs < 1:
         raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
     if args.ray_address is not None and args.backend != "ray":
@@ -344,7 +351,7 @@ def _method_study(args, scenario_file):
     output = pathlib.Path(args.output)
     total = len(study.methods) * study.trials
     print(f"Study {scenario_file.scenario.name}: {', '.join(study.methods)}, "
-          f"{study.trials} trials each (seeds {study.seed} to {study.seed + study.trials - 1}),"
+          f"{study.trials} trials each ({split} seeds {seed} to {seed + study.trials - 1}),"
           f" {args.jobs} job{'s' if args.jobs > 1 else ''}"
           + ("" if args.backend == "local" else
              f" on Ray ({args.ray_address or 'local'})") + f", into {output}", flush=True)
@@ -358,7 +365,7 @@ def _method_study(args, scenario_file):
     started = time.monotonic()
     try:
         summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
-                                        study.seed, output, progress, jobs=args.jobs,
+                                        seed, output, progress, jobs=args.jobs, split=split,
                                         retry_errors=args.retry_errors,
                                         backend=args.backend, ray_address=args.ray_address)
     except KeyboardInterrupt:

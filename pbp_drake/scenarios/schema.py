@@ -261,13 +261,19 @@ class AltVsCont:
 
 @dataclasses.dataclass
 class MethodComparison:
-    """The same seeded scenes for each method (trial i uses seed `seed + i`), driven by the
-    scenario's operator; `pbp-drake study --methods --trials --seed` override these."""
+    """The same seeded scenes for each method, driven by the scenario's operator: trial i
+    of `split` uses seed `tuning_seed + i` or `evaluation_seed + i`. Seeds from
+    `tuning_seed` below `evaluation_seed` are the only ones the virtual participant may be
+    tuned on; seeds from `evaluation_seed` on are for judging and publishing (see
+    `pbp_drake.studies.splits`). `pbp-drake study --methods --trials --split --seed`
+    override these."""
 
     methods: list[str] = dataclasses.field(
         default_factory=lambda: ["pbp_alternated", "pbp_continuous", "teleop"])
     trials: int = 10
-    seed: int = 0
+    tuning_seed: int = 0
+    evaluation_seed: int = 10_000
+    split: str = "evaluation"
 
 
 @dataclasses.dataclass

@@ -21,10 +21,12 @@ BACKENDS = ("local", "ray")
 
 
 def run_method_comparison(scenario, methods, trials, seed, output, progress=None, jobs=1,
-                          run=None, retry_errors=False, backend="local", ray_address=None):
+                          run=None, retry_errors=False, backend="local", ray_address=None,
+                          split=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     processes, writes every trial under `output/trials/`, then the summary, tables and
-    figures (see `report`). Returns the summary dict.
+    figures (see `report`). Returns the summary dict. `split` labels the seeds in
+    study.json and the results ("tuning", "evaluation", ...: see `studies.splits`).
 
     `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
     Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "ray://head:10001", "auto"),
@@ -71,7 +73,7 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
         if record is None or (retry_errors and record["error"] is not None):
             pending.append((method, trial))
     name_damaged([d._replace(problem=f"{d.problem}; runs again") for d in damaged])
-    write_study(output, scenario, digest, methods, trials, seed)
+    write_study(output, scenario, digest, methods, trials, seed, split)
 
     started = time.monotonic()
     done = []

@@ -6,6 +6,7 @@ import pathlib
 
 from pbp_drake.studies.figures import (
     METHOD_LABELS, plot_collision_histogram, plot_intervention, plot_task_time)
+from pbp_drake.studies.splits import seeds_line
 from pbp_drake.studies.summary import summarize
 from pbp_drake.studies.trial_files import (
     TRIAL_FIELDS, name_damaged, read_study, write_atomically)
@@ -36,7 +37,9 @@ def results_table(summary):
     """The summary as a Markdown table, one row per method: mean ± std of the intervention
     ratio, task time and collision ratio, max / mean of the trials' peak hand speed and peak
     command acceleration (see `summarize`)."""
-    lines = ["| method | trials | success | intervention ratio | task time (s) | "
+    seeds = seeds_line(summary)
+    lines = [seeds, ""] if seeds else []
+    lines += ["| method | trials | success | intervention ratio | task time (s) | "
              "collision ratio | collision-free trials | peak hand speed (m/s), max / mean | "
              "peak command acceleration (m/s²), max / mean | errors |",
              "|---|---|---|---|---|---|---|---|---|---|"]

@@ -128,7 +128,9 @@ def summarize(study, records, damaged=(), output=None):
     `output`) and problems."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
-               "seed": study["seed"], "collision_histogram_edges": list(HISTOGRAM_EDGES),
+               "seed": study["seed"], "split": study.get("split"),
+               "seeds": [study["seed"], study["seed"] + study["trials"] - 1],
+               "collision_histogram_edges": list(HISTOGRAM_EDGES),
                "methods": {}}
     for method in study["methods"]:
         rows = [records[(method, trial)] for trial in range(study["trials"])]

@@ -166,11 +166,12 @@ def write_trial_files(output, record, csv_text):
     write_atomically(json_path, json.dumps(record, indent=1) + "\n")
 
 
-def write_study(output, scenario, digest, methods, trials, seed):
-    """Writes the folder's study.json: which scenario, methods, trials and seeds."""
+def write_study(output, scenario, digest, methods, trials, seed, split=None):
+    """Writes the folder's study.json: which scenario, methods, trials and seeds, and the
+    split the seeds belong to (`studies.splits`; None when not known)."""
     study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
-             "scenario_content": scenario_content(scenario)}
+             "split": split, "scenario_content": scenario_content(scenario)}
     write_atomically(output / "study.json", json.dumps(study, indent=2) + "\n")
 
 
@@ -333,6 +334,8 @@ def study_problem(study):
             return f"field {field!r} is {_type_name(value)}, not int"
     if trials < 1:
         return f"field 'trials' is {trials}, not a positive number"
+    if not isinstance(study.get("split"), (str, type(None))):
+        return f"field 'split' is {_type_name(study.get('split'))}, not str"
     for field in ("scenario", "scenario_hash"):
         if not isinstance(study.get(field), str):
             return f"field {field!r} is {_type_name(study.get(field))}, not str"

@@ -89,6 +89,9 @@ def test_jobs_1_and_2_write_the_same_summary_bytes(studies):
         assert entry["collision_ratio"]["histogram"][0] == 2
         assert sum(entry["collision_ratio"]["histogram"]) == 2
     assert summary["collision_histogram_edges"] == list(HISTOGRAM_EDGES)
+    # Seeds 5 and 6 lie below the default evaluation seeds (10,000): the tuning split.
+    assert summary["split"] == "tuning" and summary["seeds"] == [5, 6]
+    assert (one / "results.md").read_text().startswith("Seeds 5 to 6: tuning seeds")
     # Nothing that depends on the machine or the run.
     text = (one / "summary.json").read_text()
     assert str(one) not in text and "wall_time" not in text

@@ -23,7 +23,7 @@ from pbp_drake.studies.progress import ProgressBar
 from pbp_drake.studies.report import FIGURES, report, results_table
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
 from pbp_drake.studies.splits import SPLITS, first_seed, split_of
-from pbp_drake.studies.toy import TOY_FIGURES, run_study
+from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
 
 
 def main(argv=None):
@@ -312,10 +312,7 @@ def _study(args):
     summary = run_study(scenario_file, output)
     print(f"Study {summary['study']} done in {time.monotonic() - started:.1f} s.")
     if summary["study"] == "alpha_study":
-        for scene in summary["scenes"]:
-            print(f"  {scene['name']}: ideal alpha {scene['ideal_alpha']}, collision ratio "
-                  f"PBP-Alt {scene['pbp_alternated_collision_ratio']:.3f}, "
-                  f"PBP-Cont {scene['pbp_continuous_collision_ratio']:.3f}")
+        print_alpha_study(summary)
     else:
         for method, mode in summary["modes"].items():
             print(f"  {method}: final error {mode['final_error'] * 100:.2f} cm, phase constant "

@@ -71,6 +71,7 @@ def check_alpha_study(study, scenario, dimension):
             raise ScenarioError(f"study.alphas has {alpha}, outside [0, 1]")
     if scenario.demonstration is None:
         raise ScenarioError("the alpha study needs scenario.demonstration")
+    check_operator_speeds(study, scenario)
     names = [scene.name for scene in study.scenes]
     for index, scene in enumerate(study.scenes):
         if not scene.name:
@@ -80,6 +81,25 @@ def check_alpha_study(study, scenario, dimension):
                                 f"study.scenes[{names.index(scene.name)}]; give each scene "
                                 "its own")
         check_obstacles(scene.obstacles, dimension, f"study.scenes[{index}].obstacles")
+
+
+def check_operator_speeds(study, scenario):
+    """The alpha study's `operator_speeds` (each the virtual operator's `speed`) and its
+    goal tolerance."""
+    if not (np.isfinite(study.goal_tolerance) and study.goal_tolerance > 0):
+        raise ScenarioError(f"study.goal_tolerance must be positive, got {study.goal_tolerance}")
+    if not study.operator_speeds:
+        return
+    if not hasattr(scenario.operator, "speed"):
+        raise ScenarioError(f"study.operator_speeds needs an operator with a speed, not "
+                            f"!{type(scenario.operator).__name__}")
+    for speed in study.operator_speeds:
+        if not (np.isfinite(speed) and speed >= 0):
+            raise ScenarioError(f"study.operator_speeds has {speed}: speeds are finite, >= 0")
+    # The summary keys results by the speed written with %g: two speeds must not share one.
+    keys = [f"{speed:g}" for speed in study.operator_speeds]
+    if len(set(keys)) != len(keys):
+        raise ScenarioError(f"study.operator_speeds repeats a speed: {study.operator_speeds}")
 
 
 def check_method_comparison(study, scenario):

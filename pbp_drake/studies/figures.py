@@ -1,6 +1,7 @@
 """The paper's figures, drawn with matplotlib (headless): the 2-D studies' Fig. 2 (the alpha
-study) and Fig. 4 (Alt vs Cont), and the method comparison's Fig. 7: (a) box plots of the
-intervention ratio, (b) of the task time, (c) the histogram of per-trial collision ratios.
+study, with its final distances and operator speeds) and Fig. 4 (Alt vs Cont), and the
+method comparison's Fig. 7: (a) box plots of the intervention ratio, (b) of the task time,
+(c) the histogram of per-trial collision ratios.
 Fig. 7 reads trial records (dicts from the trial files), never a simulation."""
 
 import matplotlib
@@ -118,57 +119,101 @@ def _draw_task(axes, resolved):
     axes.set_ylabel("y")
 
 
+SPEED_STYLES = ["-", "--", ":", "-."]
+
+
+def _trajectory_speed(summary, resolved):
+    """The key of the operator speed whose explicit-arbitration runs panel (d) draws: the
+    scenario operator's own speed when swept, else the first swept."""
+    own = getattr(resolved.scenario.operator, "speed", None)
+    keys = list(summary["scenes"][0]["by_operator_speed"])
+    speeds = summary["operator_speeds"]
+    return keys[speeds.index(own)] if own in speeds else keys[0]
+
+
+def _outcome_text(outcome):
+    return (f"coll. {outcome['collision_ratio']:.3f}, "
+            f"ends {outcome['final_distance']:.2f} from goal")
+
+
 def plot_alpha_study(resolved, study, summary, trajectories, path):
-    """Fig. 2: (a) the scenes, (b) collision ratio against alpha, (c) trajectories under
-    explicit arbitration, (d) trajectories under PBP."""
-    figure, axes = plt.subplots(2, 2, figsize=(11, 8.5))
-    (scenes_axes, ratio_axes), (alpha_axes, pbp_axes) = axes
+    """Fig. 2: (a) the scenes, (b) collision ratio and (c) final distance to the goal
+    against alpha, per scene and operator speed, (d) trajectories under explicit
+    arbitration, then one panel of PBP trajectories per operator speed."""
+    # Trajectories are keyed (scene name, speed key as in the summary, alpha or method).
+    speeds = list(summary["scenes"][0]["by_operator_speed"])
+    columns = max(3, 1 + len(speeds))
+    figure, axes = plt.subplots(2, columns, figsize=(5.2 * columns, 9), squeeze=False)
+    scenes_axes, ratio_axes, distance_axes = axes[0, :3]
+    for spare in axes[0, 3:]:
+        spare.axis("off")
+    alpha_axes, pbp_axes = axes[1, 0], axes[1, 1:1 + len(speeds)]
+    for spare in axes[1, 1 + len(speeds):]:
+        spare.axis("off")
 
     _draw_task(scenes_axes, resolved)
     _draw_obstacles(scenes_axes, study.demonstration_obstacles, "0.5", "during demonstration")
     for index, scene in enumerate(study.scenes):
         _draw_obstacles(scenes_axes, scene.obstacles, SCENE_COLOURS[index % 4], scene.name)
     scenes_axes.set_title("(a) demonstration and the test scenes")
-    scenes_axes.legend(fontsize=8, loc="lower center")
+    scenes_axes.legend(fontsize=7, loc="lower center")
 
     for index, scene in enumerate(summary["scenes"]):
-        alphas = [float(a) for a in scene["collision_ratio_by_alpha"]]
-        ratios = list(scene["collision_ratio_by_alpha"].values())
         colour = SCENE_COLOURS[index % 4]
-        ratio_axes.plot(alphas, ratios, "o-", color=colour, label=scene["name"])
-        if scene["ideal_alpha"] is not None:
-            ratio_axes.axvline(scene["ideal_alpha"], color=colour, ls=":",
-                               label=f"ideal alpha {scene['ideal_alpha']:.1f}")
-        ratio_axes.plot([], [], " ", label=(
-            f"PBP-Alt {scene['pbp_alternated_collision_ratio']:.3f}, "
-            f"PBP-Cont {scene['pbp_continuous_collision_ratio']:.3f}"))
+        for speed_index, (key, results) in enumerate(scene["by_operator_speed"].items()):
+            style = SPEED_STYLES[speed_index % len(SPEED_STYLES)]
+            alphas = [float(a) for a in results["fixed_alpha"]]
+            outcomes = list(results["fixed_alpha"].values())
+            label = f"{scene['name']}, speed {key}"
+            ratio_axes.plot(alphas, [o["collision_ratio"] for o in outcomes], "o" + style,
+                            color=colour, ms=3, label=label + (
+                                f" (ideal alpha {results['ideal_alpha']:.1f})"
+                                if results["ideal_alpha"] is not None else ""))
+            distance_axes.plot(alphas, [o["final_distance"] for o in outcomes], "o" + style,
+                               color=colour, ms=3, label=label)
+    distance_axes.axhline(summary["goal_tolerance"], color="k", lw=0.8,
+                          label=f"goal tolerance {summary['goal_tolerance']:g}")
     ratio_axes.set_xlabel("alpha (1: robot only)")
     ratio_axes.set_ylabel("ratio of states in collision")
     ratio_axes.set_title("(b) explicit arbitration: collisions against alpha")
-    ratio_axes.legend(fontsize=8)
+    ratio_axes.legend(fontsize=6)
+    distance_axes.set_xlabel("alpha (1: robot only)")
+    distance_axes.set_ylabel("final distance to the goal")
+    distance_axes.set_title("(c) explicit arbitration: final distance against alpha")
+    distance_axes.legend(fontsize=6)
 
     colour_map = plt.get_cmap("viridis")
+    drawn_speed = _trajectory_speed(summary, resolved)
     for index, scene in enumerate(study.scenes):
         colour = SCENE_COLOURS[index % 4]
-        for target in (alpha_axes, pbp_axes):
-            _draw_obstacles(target, scene.obstacles, colour, scene.name)
+        # The PBP panels' legends name the runs; their obstacles need no entry.
+        _draw_obstacles(alpha_axes, scene.obstacles, colour, scene.name)
+        for target in pbp_axes:
+            _draw_obstacles(target, scene.obstacles, colour)
         for alpha in study.alphas:
-            positions = trajectories[(scene.name, alpha)]
+            positions = trajectories[(scene.name, drawn_speed, alpha)]
             alpha_axes.plot(positions[:, 0], positions[:, 1], color=colour_map(alpha), lw=1,
                             alpha=0.8)
-        for method, style in (("pbp_alternated", "-"), ("pbp_continuous", "--")):
-            positions = trajectories[(scene.name, method)]
-            pbp_axes.plot(positions[:, 0], positions[:, 1], style, color=colour, lw=1.5,
-                          label=f"{scene.name} {method}")
-    for target in (alpha_axes, pbp_axes):
+        results = summary["scenes"][index]["by_operator_speed"]
+        for speed, target in zip(speeds, pbp_axes):
+            outcomes = results[speed]
+            for method, style in (("pbp_alternated", "-"), ("pbp_continuous", "--")):
+                positions = trajectories[(scene.name, speed, method)]
+                target.plot(positions[:, 0], positions[:, 1], style, color=colour, lw=1.5,
+                            label=f"{scene.name} {METHOD_LABELS[method]}: "
+                                  f"{_outcome_text(outcomes[method])}")
+    for target in (alpha_axes, *pbp_axes):
         _draw_task(target, resolved)
     mappable = plt.cm.ScalarMappable(cmap=colour_map, norm=plt.Normalize(0, 1))
     figure.colorbar(mappable, ax=alpha_axes, label="alpha")
-    alpha_axes.set_title("(c) explicit arbitration, every alpha")
-    pbp_axes.set_title("(d) PBP (no alpha)")
-    pbp_axes.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    alpha_axes.set_title(f"(d) explicit arbitration, every alpha\n"
+                         f"(operator speed {drawn_speed})")
+    for letter, speed, target in zip("efghij", speeds, pbp_axes):
+        target.set_title(f"({letter}) PBP (no alpha), operator speed {speed}")
+        target.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.12))
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
+    # "tight" keeps the legends under the PBP panels in the image.
+    figure.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(figure)
 
 

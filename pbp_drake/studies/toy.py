@@ -54,41 +54,112 @@ def _ratio(trajectory, obstacles):
                            [o.radius for o in obstacles])
 
 
+PBP_METHODS = ("pbp_alternated", "pbp_continuous")
+
+
+def operator_speeds(scenario, study):
+    """The operator speeds each scene runs at: the study's `operator_speeds`, or else the
+    scenario operator's own speed (None for an operator without one)."""
+    return list(study.operator_speeds) or [getattr(scenario.operator, "speed", None)]
+
+
+def speed_key(speed):
+    """How the summary names an operator speed (`None`: the operator has none)."""
+    return "-" if speed is None else f"{speed:g}"
+
+
+def with_operator_speed(scenario, speed):
+    """The scenario with its virtual operator pushing at `speed` (None: unchanged)."""
+    if speed is None:
+        return scenario
+    return dataclasses.replace(scenario, operator=dataclasses.replace(scenario.operator,
+                                                                      speed=float(speed)))
+
+
+def run_outcome(run, obstacles, goal, goal_tolerance):
+    """What a user reads off one run: how much of it sat in an obstacle, how far from the
+    goal it ended, and whether that is within the tolerance."""
+    final_distance = float(np.linalg.norm(run.positions[-1] - goal))
+    return {"collision_ratio": _ratio(run, obstacles), "final_distance": final_distance,
+            "reached": final_distance <= goal_tolerance}
+
+
 def run_alpha_study(resolved, study, output_dir):
     """Explicit arbitration over alpha (P: the demonstration, open loop) against PBP-Alt and
-    PBP-Cont (P: a DMP learned from it), the same virtual operator in every run."""
+    PBP-Cont (P: a DMP learned from it), the same virtual operator in every run of a scene
+    and speed; each scene runs at each of the study's operator speeds."""
     scenario = resolved.scenario
+    goal = resolved.goals[0]
+    speeds = operator_speeds(scenario, study)
     scenes = []
     trajectories = {}
     for scene in study.scenes:
-        # Each scene's obstacles are resolved once; the methods share its DMPs.
-        base = resolve(scene_scenario(scenario, scene))
-        ratios = {}
-        for alpha in study.alphas:
-            run = simulate(base.with_method(f"fixed_alpha={alpha!r}"))
-            ratios[f"{alpha:.2f}"] = _ratio(run, scene.obstacles)
-            trajectories[(scene.name, alpha)] = run.positions
-        pbp = {}
-        for method in ("pbp_alternated", "pbp_continuous"):
-            run = simulate(base.with_method(method))
-            pbp[method] = _ratio(run, scene.obstacles)
-            trajectories[(scene.name, method)] = run.positions
-        # The highest alpha that still lets the operator pass the obstacles untouched.
-        ideal = ideal_alpha([(alpha, ratios[f"{alpha:.2f}"]) for alpha in study.alphas],
-                            collision_free)
+        # Each (scene, speed) is resolved once; its methods share its DMPs.
+        by_speed = {}
+        for speed in speeds:
+            base = resolve(with_operator_speed(scene_scenario(scenario, scene), speed))
+            by_speed[speed_key(speed)] = _scene_at_speed(base, study, scene, goal, speed,
+                                                         trajectories)
         scenes.append({
             "name": scene.name,
             "obstacles": [dataclasses.asdict(o) for o in scene.obstacles],
-            "collision_ratio_by_alpha": ratios,
-            "ideal_alpha": ideal,
-            "pbp_alternated_collision_ratio": pbp["pbp_alternated"],
-            "pbp_continuous_collision_ratio": pbp["pbp_continuous"],
+            "by_operator_speed": by_speed,
         })
     summary = {"study": "alpha_study", "scenario": scenario.name, "alphas": study.alphas,
+               "goal": goal.tolist(), "goal_tolerance": study.goal_tolerance,
+               "operator_speeds": speeds,
+               "ideal_alpha_criterion": "highest alpha with no collision (the paper's); "
+                                        "reaching the goal is reported, not judged",
                "scenes": scenes}
     _write_json(output_dir / "summary.json", summary)
     plot_alpha_study(resolved, study, summary, trajectories, output_dir / "fig2_alpha_study.png")
     return summary
+
+
+def _scene_at_speed(base, study, scene, goal, speed, trajectories):
+    """One scene at one operator speed: every fixed alpha, then PBP-Alt and PBP-Cont."""
+    fixed = {}
+    for alpha in study.alphas:
+        run = simulate(base.with_method(f"fixed_alpha={alpha!r}"))
+        fixed[f"{alpha:.2f}"] = run_outcome(run, scene.obstacles, goal, study.goal_tolerance)
+        trajectories[(scene.name, speed_key(speed), alpha)] = run.positions
+    # The highest alpha that still lets the operator pass the obstacles untouched.
+    results = {"operator_speed": speed, "ideal_alpha": ideal_alpha(
+        [(alpha, fixed[f"{alpha:.2f}"]["collision_ratio"]) for alpha in study.alphas],
+        collision_free), "fixed_alpha": fixed}
+    pushes = []
+    for method in PBP_METHODS:
+        run = simulate(base.with_method(method))
+        results[method] = run_outcome(run, scene.obstacles, goal, study.goal_tolerance)
+        trajectories[(scene.name, speed_key(speed), method)] = run.positions
+        pushes.append(np.linalg.norm(run.operator_command, axis=-1).max())
+    # The fastest push the operator gave in PBP's runs, as measured: the speed it was set to
+    # whenever it acted at all (0: it never did).
+    results["measured_operator_speed"] = float(max(pushes))
+    return results
+
+
+def print_alpha_study(summary):
+    """One line per scene and operator speed: the ideal alpha, then each PBP mode's
+    collision ratio and final distance to the goal (the fixed alphas' are in the summary)."""
+    tolerance = summary["goal_tolerance"]
+    print(f"  (collision ratio / final distance to the goal; reached: within {tolerance:g})")
+    for scene in summary["scenes"]:
+        for key, results in scene["by_operator_speed"].items():
+            fixed = results["fixed_alpha"]
+            ideal = results["ideal_alpha"]
+            ideal_text = "none" if ideal is None else (
+                f"{ideal:.1f} ({_outcome_text(fixed[f'{ideal:.2f}'])})")
+            reaching = sum(outcome["reached"] for outcome in fixed.values())
+            print(f"  {scene['name']}, operator speed {key}: ideal alpha {ideal_text}; "
+                  f"{reaching} of {len(fixed)} alphas reach the goal; "
+                  f"PBP-Alt {_outcome_text(results['pbp_alternated'])}; "
+                  f"PBP-Cont {_outcome_text(results['pbp_continuous'])}")
+
+
+def _outcome_text(outcome):
+    return (f"{outcome['collision_ratio']:.3f} / {outcome['final_distance']:.3f}"
+            f"{' reached' if outcome['reached'] else ' NOT reached'}")
 
 
 def phase_progress(phase, alpha_x):

@@ -23,21 +23,47 @@ def alpha_study(tmp_path_factory):
     return output
 
 
-def test_alpha_study_shows_no_alpha_transfers_while_pbp_never_collides(alpha_study):
+def test_alpha_study_shows_no_alpha_transfers(alpha_study):
     summary = json.loads((alpha_study / "summary.json").read_text())
-    scenes = summary["scenes"]
-    assert [scene["name"] for scene in scenes] == ["scene_1", "scene_2"]
-    for scene in scenes:
-        ratios = scene["collision_ratio_by_alpha"]
-        assert len(ratios) == 11
-        # Alpha 1 ignores the operator: the demonstration runs into the moved obstacle.
-        assert ratios["1.00"] > 0
-        # The ideal alpha is the highest collision-free one.
-        safe = [float(alpha) for alpha, ratio in ratios.items() if ratio == 0]
-        assert scene["ideal_alpha"] == max(safe)
-        assert scene["pbp_alternated_collision_ratio"] == 0.0
-        assert scene["pbp_continuous_collision_ratio"] == 0.0
-    assert abs(scenes[0]["ideal_alpha"] - scenes[1]["ideal_alpha"]) >= 0.3 - 1e-9
+    scenes = {scene["name"]: scene["by_operator_speed"] for scene in summary["scenes"]}
+    assert list(scenes) == ["scene_1", "scene_2", "scene_3", "scene_4"]
+    assert summary["operator_speeds"] == [1.0, 2.0]
+    for by_speed in scenes.values():
+        assert list(by_speed) == ["1", "2"]
+        for results in by_speed.values():
+            fixed = results["fixed_alpha"]
+            assert len(fixed) == 11
+            # Alpha 1 ignores the operator: the demonstration runs into the moved obstacle.
+            assert fixed["1.00"]["collision_ratio"] > 0
+            # The ideal alpha is the highest collision-free one (reaching is not judged).
+            safe = [float(a) for a, outcome in fixed.items() if outcome["collision_ratio"] == 0]
+            assert results["ideal_alpha"] == max(safe)
+            # PBP-Alt never collides: while the operator acts the DMP's phase stands still.
+            assert results["pbp_alternated"]["collision_ratio"] == 0.0
+    assert abs(scenes["scene_1"]["2"]["ideal_alpha"] - scenes["scene_2"]["2"]["ideal_alpha"]
+               ) >= 0.3 - 1e-9
+    # The paper's two scenes at our speed 2: PBP-Cont passes untouched too.
+    for name in ("scene_1", "scene_2"):
+        assert scenes[name]["2"]["pbp_continuous"]["collision_ratio"] == 0.0
+
+
+def test_alpha_study_reports_where_pbp_ends_short_of_the_goal(alpha_study):
+    summary = json.loads((alpha_study / "summary.json").read_text())
+    tolerance = summary["goal_tolerance"]
+    for scene in summary["scenes"]:
+        for results in scene["by_operator_speed"].values():
+            for outcome in [results["pbp_alternated"], results["pbp_continuous"],
+                            *results["fixed_alpha"].values()]:
+                assert outcome["reached"] == (outcome["final_distance"] <= tolerance)
+            assert results["measured_operator_speed"] == results["operator_speed"]
+    goal_near = summary["scenes"][3]["by_operator_speed"]
+    for results in goal_near.values():
+        # The goal lies within the operator's reach of the obstacle: it keeps pushing away.
+        for method in ("pbp_alternated", "pbp_continuous"):
+            assert not results[method]["reached"]
+            assert results[method]["final_distance"] > 0.1
+        # Only alpha 1, which ignores the operator (and collides), reaches it.
+        assert [a for a, o in results["fixed_alpha"].items() if o["reached"]] == ["1.00"]
 
 
 def test_alpha_study_draws_the_four_panel_figure(alpha_study):

@@ -16,6 +16,7 @@ from pbp_drake.scenarios.resolution import (
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     ScenarioFile)
+from pbp_drake.scenarios.value_checks import check_numbers
 from pbp_drake.scenarios.yaml_checks import describe_load_error, read_scenario_text
 
 
@@ -49,6 +50,7 @@ def load_scenario_file(path):
         raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
     try:
         resolved = resolve(loaded.scenario)
+        check_numbers(loaded.study, "study")
         if isinstance(loaded.study, AlphaStudy):
             check_alpha_study(loaded.study, loaded.scenario, resolved.start.size)
         if isinstance(loaded.study, MethodComparison):

@@ -12,11 +12,12 @@ import numpy as np
 from pydrake.common.yaml import yaml_load_typed
 
 from pbp_drake.scenarios.resolution import (
-    ResolvedScenario, check_obstacles, close_match, resolve, with_method)
+    ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     ScenarioFile)
-from pbp_drake.scenarios.value_checks import check_numbers
+from pbp_drake.scenarios.unknown_keys import unknown_key_message
+from pbp_drake.scenarios.value_checks import check_numbers, check_seed
 from pbp_drake.scenarios.yaml_checks import describe_load_error, read_scenario_text
 
 
@@ -45,7 +46,8 @@ def load_scenario_file(path):
     except RuntimeError as error:
         if getattr(error, "problem_mark", None) is not None:
             raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
-        raise ScenarioError(f"{path}: {error}{_suggestion(str(error))}") from None
+        located = unknown_key_message(text, ScenarioFile)
+        raise ScenarioError(f"{path}: {located or error}") from None
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad values
         raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
     try:
@@ -96,34 +98,6 @@ def check_method_comparison(study, scenario):
             raise ScenarioError(f"study.methods: {error}") from None
     if study.trials < 1:
         raise ScenarioError(f"study.trials must be at least 1, got {study.trials}")
+    check_seed(study.seed, "study.seed")
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
-
-
-def _all_field_names(schema=ScenarioFile, seen=None):
-    seen = set() if seen is None else seen
-    names = set()
-    if not dataclasses.is_dataclass(schema) or schema in seen:
-        return names
-    seen.add(schema)
-    for field in dataclasses.fields(schema):
-        names.add(field.name)
-        for inner in _dataclasses_in(field.type):
-            names |= _all_field_names(inner, seen)
-    return names
-
-
-def _dataclasses_in(annotation):
-    if dataclasses.is_dataclass(annotation):
-        return [annotation]
-    return [inner for arg in typing.get_args(annotation) for inner in _dataclasses_in(arg)]
-
-
-def _suggestion(message):
-    """`did you mean` for Drake's "The fields ['sped'] were unknown" messages."""
-    start, end = message.find("["), message.find("]")
-    if start < 0 or end < start:
-        return ""
-    unknown = [name.strip(" '\"") for name in message[start + 1:end].split(",")]
-    known = _all_field_names()
-    return "".join(close_match(name, known - {name}) for name in unknown)

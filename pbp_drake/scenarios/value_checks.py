@@ -77,10 +77,10 @@ def check_time_steps(time_steps):
                                 f"{SHORTEST_TIME_STEP:g} s")
 
 
-def check_seed(seed):
+def check_seed(seed, field="scenario.seed"):
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-        raise ScenarioError(f"scenario.seed {seed!r} cannot seed the random draws; expected "
-                            "a non-negative integer")
+        raise ScenarioError(f"{field} {seed!r} cannot seed the random draws; expected a "
+                            "non-negative integer")
 
 
 def check_range(config, field, name, within=None):

@@ -36,8 +36,10 @@ def test_a_valid_file_loads(tmp_path):
 
 
 @pytest.mark.parametrize("text, message", [
-    (VALID.replace("speed:", "sped:"), r"\['sped'\] were unknown.*did you mean 'speed'"),
-    (VALID.replace("method:", "methd:"), r"\['methd'\] were unknown.*did you mean 'method'"),
+    (VALID.replace("speed:", "sped:"),
+     r"scenario.operator: unknown key 'sped' \(did you mean 'speed'\?\); expected one of "),
+    (VALID.replace("method:", "methd:"),
+     r"scenario: unknown key 'methd' \(did you mean 'method'\?\); expected one of "),
     (VALID.replace("!ObstacleRepulsion", "!ObstacleRepulson"), "ObstacleRepulson"),
     (VALID.replace("pbp_continuous", "pbp_continous"),
      "scenario.method 'pbp_continous' is unknown.*did you mean 'pbp_continuous'"),

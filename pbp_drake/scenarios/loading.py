@@ -43,13 +43,8 @@ def load_scenario_file(path):
         raise ScenarioError(f"{path}: {error}") from None
     try:
         loaded = yaml_load_typed(schema=ScenarioFile, data=text)
-    except RuntimeError as error:
-        if getattr(error, "problem_mark", None) is not None:
-            raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
-        located = unknown_key_message(text, ScenarioFile)
-        raise ScenarioError(f"{path}: {located or error}") from None
-    except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad values
-        raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
+    except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
+        raise ScenarioError(f"{path}: {_load_error_message(error, text)}") from None
     try:
         resolved = resolve(loaded.scenario)
         check_numbers(loaded.study, "study")
@@ -101,3 +96,13 @@ def check_method_comparison(study, scenario):
     check_seed(study.seed, "study.seed")
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
+
+
+def _load_error_message(error, text):
+    """Drake's "The fields ['k'] were unknown to the schema" does not say where: walk the
+    file to name the mapping; everything else names its field by `describe_load_error`."""
+    if "were unknown to the schema" in str(error):
+        located = unknown_key_message(text, ScenarioFile)
+        if located:
+            return located
+    return describe_load_error(error)

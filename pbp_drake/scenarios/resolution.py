@@ -192,10 +192,10 @@ def demonstration_samples(demonstration):
 
 
 def _check_point_robot(robot):
-    """The toy robot's dynamics: a positive mass and time step, springs and dampers that
-    are finite and not negative."""
-    require_finite(robot, "scenario.robot", ("mass", "time_step"))
-    require_finite(robot, "scenario.robot", ("stiffness", "damping"), positive=False)
+    """The toy robot's dynamics: a positive mass, time step and spring (without a spring
+    the robot never follows the reference's position), a damper that is not negative."""
+    require_finite(robot, "scenario.robot", ("mass", "time_step", "stiffness"))
+    require_finite(robot, "scenario.robot", ("damping",), positive=False)
     check_time_steps([("scenario.robot.time_step", robot.time_step)])
 
 

@@ -135,6 +135,7 @@ def test_hand_over_limits_that_cannot_work_are_refused(tmp_path, robot, message)
     ("  robot: {time_step: 0.0}\n", "scenario.robot.time_step must be finite and positive"),
     ("  robot: {damping: -1.0}\n", "scenario.robot.damping must be finite and not negative"),
     ("  robot: {stiffness: .inf}\n", "scenario.robot.stiffness: inf is infinite"),
+    ("  robot: {stiffness: 0.0}\n", "scenario.robot.stiffness must be finite and positive"),
     ("  obstacles: [{center: [.nan, 0.0], radius: 0.1}]\n",
      r"scenario.obstacles\[0\].center\[0\]: NaN is not a number here"),
     ("  obstacles: [{center: [0.5, 0.0], radius: .inf}]\n",

@@ -6,6 +6,7 @@ checked by `resolve`, and a study section by the checks here.
 
 import dataclasses
 import pathlib
+import re
 import typing
 
 import numpy as np
@@ -101,6 +102,12 @@ def check_method_comparison(study, scenario):
 def _load_error_message(error, text):
     """Drake's "The fields ['k'] were unknown to the schema" does not say where: walk the
     file to name the mapping; everything else names its field by `describe_load_error`."""
+    root = re.match(r"YAML root was a <class '(\w+)'>", str(error))
+    if root:
+        found = {"NoneType": "nothing", "str": "a string", "list": "a list", "int": "a number",
+                 "float": "a number", "bool": "true or false"}.get(root[1], root[1])
+        return (f"the file's top level holds {found}; expected a mapping with `scenario:` "
+                "(and optionally `study:`)")
     if "were unknown to the schema" in str(error):
         located = unknown_key_message(text, ScenarioFile)
         if located:

@@ -98,9 +98,10 @@ def check_range(config, field, name, within=None):
                             f"expected [low, high] inside it")
 
 
-def check_count(value, field, least, most):
+def check_count(value, field, least, most, hint=""):
     if not least <= value <= most:
-        raise ScenarioError(f"{field} {value} is out of range; expected {least} to {most}")
+        raise ScenarioError(f"{field} {value} is out of range; expected {least} to "
+                            f"{most}{hint}")
 
 
 def check_dmp_duration(duration, control_period, field):
@@ -132,7 +133,9 @@ def check_obstacle_task(task):
     require_finite(task, "scenario.task",
                    ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"))
     # Obstacles start 0.45 m from each other, the robot and the target: a few dozen fit.
-    check_count(task.obstacle_count, "scenario.task.obstacle_count", 0, 100)
+    # Without any, the station has no obstacle input for the task to drive.
+    check_count(task.obstacle_count, "scenario.task.obstacle_count", 1, 100,
+                " (a task without obstacles is the reaching task: an untagged task)")
     for name in ("x_range", "y_range", "obstacle_x_range", "obstacle_y_range"):
         check_range(task, "scenario.task", name)
     check_range(task, "scenario.task", "activation_range", within=(0.0, 1.0))

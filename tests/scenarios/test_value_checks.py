@@ -35,6 +35,9 @@ DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
     ("toy_alt_vs_cont.yaml", "axis: [0.0, 1.0]", "axis: [0.0, 1.0e-300]",
      r"scenario.operator.axis \[0.0, 1e-300\] is no direction; expected a vector of "
      r"dimension 2 and length at least 1e-6"),
+    # Accepted, then the diagram was wired to an obstacle input the station did not have.
+    ("hsr_obstacles.yaml", "obstacle_count: 3", "obstacle_count: 0",
+     r"scenario.task.obstacle_count 0 is out of range; expected 1 to 100"),
     # Accepted as "not negative", then refused by the robot when the diagram was built.
     ("toy_alpha_study.yaml", "stiffness: 400.0", "stiffness: 0.0",
      r"scenario.robot.stiffness must be finite and positive, got 0.0"),

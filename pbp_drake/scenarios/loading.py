@@ -17,7 +17,7 @@ from pbp_drake.scenarios.resolution import (
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     ScenarioFile)
-from pbp_drake.scenarios.unknown_keys import unknown_key_message
+from pbp_drake.scenarios.schema_walk import shape_problem
 from pbp_drake.scenarios.value_checks import check_numbers, check_seed
 from pbp_drake.scenarios.yaml_checks import describe_load_error, read_scenario_text
 
@@ -42,10 +42,14 @@ def load_scenario_file(path):
         text = read_scenario_text(path)
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from None
+    # Before the loader: it accepts some of these and misreports the others.
+    problem = shape_problem(text, ScenarioFile)
+    if problem:
+        raise ScenarioError(f"{path}: {problem}")
     try:
         loaded = yaml_load_typed(schema=ScenarioFile, data=text)
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
-        raise ScenarioError(f"{path}: {_load_error_message(error, text)}") from None
+        raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
     try:
         resolved = resolve(loaded.scenario)
         check_numbers(loaded.study, "study")
@@ -99,17 +103,13 @@ def check_method_comparison(study, scenario):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
 
 
-def _load_error_message(error, text):
-    """Drake's "The fields ['k'] were unknown to the schema" does not say where: walk the
-    file to name the mapping; everything else names its field by `describe_load_error`."""
+def _load_error_message(error):
+    """A root that is not a mapping, said plainly; everything else names its field by
+    `describe_load_error`."""
     root = re.match(r"YAML root was a <class '(\w+)'>", str(error))
     if root:
         found = {"NoneType": "nothing", "str": "a string", "list": "a list", "int": "a number",
                  "float": "a number", "bool": "true or false"}.get(root[1], root[1])
         return (f"the file's top level holds {found}; expected a mapping with `scenario:` "
                 "(and optionally `study:`)")
-    if "were unknown to the schema" in str(error):
-        located = unknown_key_message(text, ScenarioFile)
-        if located:
-            return located
     return describe_load_error(error)

@@ -72,3 +72,24 @@ def test_an_endless_hsr_task_names_the_duration(tmp_path, run_refused, file):
     message = _message(run_refused, _broken(tmp_path, file, "duration: 60.0",
                                             "duration: .inf"))
     assert message.startswith("scenario.duration: inf is infinite; expected a finite"), message
+
+
+@pytest.mark.parametrize("file, old, new, message", [
+    # Drake's loader put the 3 into the first variant and failed later with a TypeError...
+    ("toy_alpha_study.yaml", "  demonstration: !BentPath {start: [0.0, 0.0], goal: [1.0, 0.0], "
+     "bend: 0.3, duration: 1.0}", "  demonstration: 3",
+     "scenario.demonstration: got 3; expected a mapping, tagged with one of !BentPath, "
+     "!RecordedPath (untagged: BentPath)"),
+    # ...or ran the scenario on a default robot, the value silently dropped...
+    ("toy_alpha_study.yaml", "  robot: {mass: 1.0, stiffness: 400.0, damping: 40.0, "
+     "time_step: 0.001}", "  robot: 3",
+     "scenario.robot: got 3; expected a mapping, tagged with one of !PointRobot, !Hsr "
+     "(untagged: PointRobot)"),
+    # ...or complained about an empty study.scenes.
+    ("toy_alt_vs_cont.yaml", "study: !AltVsCont\n  goal_tolerance: 0.01", "study: fast",
+     "study: got 'fast'; expected a mapping, tagged with one of !AlphaStudy, !AltVsCont, "
+     "!MethodComparison (untagged: AlphaStudy)"),
+])
+def test_a_value_where_a_section_belongs_says_what_belongs(tmp_path, run_refused, file, old,
+                                                          new, message):
+    assert _message(run_refused, _broken(tmp_path, file, old, new)) == message

@@ -74,7 +74,7 @@ def _at(node, path):
 
 @st.composite
 def damaged(draw, name):
-    """`(text of the damaged file, what was done)`."""
+    """`(text of the damaged file, what was done, the damaged key and its sections)`."""
     data = copy.deepcopy(SHIPPED[name])
     kind = draw(st.sampled_from(["replace"] * 3 + ["nudge"] * 2 + ["delete", "add"]))
     numbers = [path for path in sorted(set(_leaves(data)), key=str)
@@ -85,11 +85,13 @@ def damaged(draw, name):
         value = _at(data, path) * draw(st.sampled_from([0.0, 0.5, 0.9, 1.1, 2.0, -1.0]))
         _at(data, path[:-1])[path[-1]] = type(_at(data, path))(value)
         done = f"{'.'.join(map(str, path))} = {value!r}"
+        touched = path
     elif kind == "replace":
         path = draw(st.sampled_from(sorted(set(_leaves(data)), key=str)))
         value = draw(JUNK)
         _at(data, path[:-1])[path[-1]] = value
         done = f"{'.'.join(map(str, path))} = {value!r}"
+        touched = path
     else:
         path = draw(st.sampled_from(list(_mappings(data))))
         mapping = _at(data, path)
@@ -98,11 +100,13 @@ def damaged(draw, name):
             key = draw(st.sampled_from(keys))
             del mapping[key]
             done = f"deleted {'.'.join(map(str, path + (key,)))}"
+            touched = path + (key,)
         else:
             key = draw(st.sampled_from(["beta", "colour", "sped", "x_rang"]))
             mapping[key] = draw(JUNK)
             done = f"added {'.'.join(map(str, path + (key,)))}"
-    return yaml_dump(data), done
+            touched = path + (key,)
+    return yaml_dump(data), done, [key for key in touched if isinstance(key, str)]
 
 
 def _first_second(resolved):
@@ -127,7 +131,7 @@ def _outputs(resolved):
 NAMED_FIELD = re.compile(r"\b(scenario|study)\b|\bline \d+|the file's top level")
 
 
-def _check_damaged(name, text, done):
+def _check_damaged(name, text, done, keys):
     with tempfile.TemporaryDirectory() as folder:
         path = pathlib.Path(folder) / name
         path.write_text(text)
@@ -140,6 +144,8 @@ def _check_damaged(name, text, done):
                 message = str(error)
                 assert message.startswith(f"{path}: "), (done, message)
                 assert NAMED_FIELD.search(message[len(f"{path}: "):]), (done, message)
+                # ...and the damaged key or a section holding it, below the top level.
+                assert not keys[1:] or any(key in message for key in keys[1:]), (done, message)
                 event("refused")
                 return
             for series in _outputs(loaded.resolved):

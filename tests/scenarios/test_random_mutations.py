@@ -87,7 +87,9 @@ def damaged(draw, name):
         done = f"{'.'.join(map(str, path))} = {value!r}"
         touched = path
     elif kind == "replace":
-        path = draw(st.sampled_from(sorted(set(_leaves(data)), key=str)))
+        # Any value, a whole section too (`robot: 3`).
+        sections = [path for path in _mappings(data) if path]
+        path = draw(st.sampled_from(sorted(set(_leaves(data)) | set(sections), key=str)))
         value = draw(JUNK)
         _at(data, path[:-1])[path[-1]] = value
         done = f"{'.'.join(map(str, path))} = {value!r}"

@@ -303,8 +303,8 @@ def _resolve_hsr(scenario):
                             "scenario.robot.station.plant.time_step")
     operator = scenario.operator
     require_finite(operator, "scenario.operator",
-                    ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
-                     "direction_noise", "speed_noise"), positive=False)
+                   ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
+                    "direction_noise", "speed_noise"), positive=False)
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(task, DynamicObstacles):

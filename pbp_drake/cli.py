@@ -92,7 +92,8 @@ def main(argv=None):
     report = commands.add_parser(
         "report", help="rebuild the summary, table and figures of a study folder from its "
         "trial files, without simulating; damaged or foreign files are named on stderr and "
-        "skipped (exit 1 when there were any, 2 when there is nothing to report)")
+        "skipped (exit 1 when there were any, or when trials failed with an error or did not "
+        "run, as `study` does; 2 when there is nothing to report)")
     report.add_argument("output", help="the --output folder of `pbp-drake study`")
 
     # Their own argument parsers live with them; the rest of the line is passed on.
@@ -400,13 +401,15 @@ def _print_report(summary, output):
 
 
 def _report(args):
-    """Exit 0; 1 when damaged or foreign files were skipped (what could be read is still
-    reported and written); 2 (ScenarioError) when there is nothing to report."""
+    """Exit 0; 1, like `study`, when trials recorded an error or did not run, and when
+    damaged or foreign files were skipped (what could be read is still reported and
+    written); 2 (ScenarioError) when there is nothing to report."""
     output = pathlib.Path(args.output)
     summary = report(output)
     _print_report(summary, output)
+    failed = _failed_trials(summary, output)
     if summary["damaged"]:
         print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
               f"(listed above and in {output / 'summary.json'})", file=sys.stderr)
         return 1
-    return 0
+    return failed

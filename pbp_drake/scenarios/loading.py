@@ -6,16 +6,19 @@ checked by `resolve`, and a study section by the checks here.
 
 import dataclasses
 import pathlib
+import re
 import typing
 
 import numpy as np
 from pydrake.common.yaml import yaml_load_typed
 
 from pbp_drake.scenarios.resolution import (
-    ResolvedScenario, check_obstacles, close_match, resolve, with_method)
+    ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     ScenarioFile)
+from pbp_drake.scenarios.schema_walk import shape_problem
+from pbp_drake.scenarios.value_checks import check_numbers, check_seed
 from pbp_drake.scenarios.yaml_checks import describe_load_error, read_scenario_text
 
 
@@ -39,16 +42,17 @@ def load_scenario_file(path):
         text = read_scenario_text(path)
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from None
+    # Before the loader: it accepts some of these and misreports the others.
+    problem = shape_problem(text, ScenarioFile)
+    if problem:
+        raise ScenarioError(f"{path}: {problem}")
     try:
         loaded = yaml_load_typed(schema=ScenarioFile, data=text)
-    except RuntimeError as error:
-        if getattr(error, "problem_mark", None) is not None:
-            raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
-        raise ScenarioError(f"{path}: {error}{_suggestion(str(error))}") from None
-    except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad values
-        raise ScenarioError(f"{path}: {describe_load_error(error)}") from None
+    except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
+        raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
     try:
         resolved = resolve(loaded.scenario)
+        check_numbers(loaded.study, "study")
         if isinstance(loaded.study, AlphaStudy):
             check_alpha_study(loaded.study, loaded.scenario, resolved.start.size)
         if isinstance(loaded.study, MethodComparison):
@@ -114,34 +118,18 @@ def check_method_comparison(study, scenario):
             raise ScenarioError(f"study.methods: {error}") from None
     if study.trials < 1:
         raise ScenarioError(f"study.trials must be at least 1, got {study.trials}")
+    check_seed(study.seed, "study.seed")
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
 
 
-def _all_field_names(schema=ScenarioFile, seen=None):
-    seen = set() if seen is None else seen
-    names = set()
-    if not dataclasses.is_dataclass(schema) or schema in seen:
-        return names
-    seen.add(schema)
-    for field in dataclasses.fields(schema):
-        names.add(field.name)
-        for inner in _dataclasses_in(field.type):
-            names |= _all_field_names(inner, seen)
-    return names
-
-
-def _dataclasses_in(annotation):
-    if dataclasses.is_dataclass(annotation):
-        return [annotation]
-    return [inner for arg in typing.get_args(annotation) for inner in _dataclasses_in(arg)]
-
-
-def _suggestion(message):
-    """`did you mean` for Drake's "The fields ['sped'] were unknown" messages."""
-    start, end = message.find("["), message.find("]")
-    if start < 0 or end < start:
-        return ""
-    unknown = [name.strip(" '\"") for name in message[start + 1:end].split(",")]
-    known = _all_field_names()
-    return "".join(close_match(name, known - {name}) for name in unknown)
+def _load_error_message(error):
+    """A root that is not a mapping, said plainly; everything else names its field by
+    `describe_load_error`."""
+    root = re.match(r"YAML root was a <class '(\w+)'>", str(error))
+    if root:
+        found = {"NoneType": "nothing", "str": "a string", "list": "a list", "int": "a number",
+                 "float": "a number", "bool": "true or false"}.get(root[1], root[1])
+        return (f"the file's top level holds {found}; expected a mapping with `scenario:` "
+                "(and optionally `study:`)")
+    return describe_load_error(error)

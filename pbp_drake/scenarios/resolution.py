@@ -24,6 +24,9 @@ from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, Hsr, ObstacleRepulsion,
     Scenario, ScenarioError, ScriptedCommands, SinusoidalStep)
+from pbp_drake.scenarios.value_checks import (
+    check_bent_path, check_direction, check_dmp_duration, check_numbers, check_obstacle_task,
+    check_reach_task, check_seed, check_time_steps, require_finite)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
 BLEND_MODE_OF_METHOD = {
@@ -137,26 +140,19 @@ def close_match(name, choices):
 
 
 def _check_common(scenario):
+    check_numbers(scenario)
     if scenario.method not in METHODS:
         raise ScenarioError(
             f"scenario.method {scenario.method!r} is unknown; choose one of {METHODS}"
             f"{close_match(scenario.method, METHODS)}")
     if not (np.isfinite(scenario.alpha) and 0.0 <= scenario.alpha <= 1.0):
         raise ScenarioError(f"scenario.alpha = {scenario.alpha} is outside [0, 1]")
-    _require_finite(scenario, "scenario", ("control_period", "duration"))
+    require_finite(scenario, "scenario", ("control_period", "duration"))
     _settings_checked("scenario.dmp", scenario.dmp)
     _settings_checked("scenario.goal_estimator", scenario.goal_estimator)
-    _require_finite(scenario, "scenario", ("dmp_duration",), positive=False)
-
-
-def _require_finite(config, field, names, positive=True):
-    """Each of `names` of `config` (0 where it has no such field) is finite and positive,
-    or with `positive=False` finite and not negative; the error names `field.name`."""
-    least = "positive" if positive else "not negative"
-    for name in names:
-        value = getattr(config, name, 0.0)
-        if not (np.isfinite(value) and (value > 0 if positive else value >= 0)):
-            raise ScenarioError(f"{field}.{name} must be finite and {least}, got {value}")
+    require_finite(scenario, "scenario", ("dmp_duration",), positive=False)
+    check_time_steps([("scenario.control_period", scenario.control_period)])
+    check_seed(scenario.seed)
 
 
 def _settings_checked(field, settings):
@@ -196,10 +192,11 @@ def demonstration_samples(demonstration):
 
 
 def _check_point_robot(robot):
-    """The toy robot's dynamics: a positive mass and time step, springs and dampers that
-    are finite and not negative."""
-    _require_finite(robot, "scenario.robot", ("mass", "time_step"))
-    _require_finite(robot, "scenario.robot", ("stiffness", "damping"), positive=False)
+    """The toy robot's dynamics: a positive mass, time step and spring (without a spring
+    the robot never follows the reference's position), a damper that is not negative."""
+    require_finite(robot, "scenario.robot", ("mass", "time_step", "stiffness"))
+    require_finite(robot, "scenario.robot", ("damping",), positive=False)
+    check_time_steps([("scenario.robot.time_step", robot.time_step)])
 
 
 def _resolve_point_robot(scenario):
@@ -213,6 +210,8 @@ def _resolve_point_robot(scenario):
             "robot: !Hsr {...}")
     demonstration = None
     if scenario.demonstration is not None:
+        if isinstance(scenario.demonstration, BentPath):
+            check_bent_path(scenario.demonstration)
         try:
             demonstration = validate_demonstration(
                 *demonstration_samples(scenario.demonstration))
@@ -236,6 +235,9 @@ def _resolve_point_robot(scenario):
     check_obstacles(scenario.obstacles, start.size)
     _check_toy_operator(scenario.operator, start.size)
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else None
+    check_dmp_duration(
+        duration or demonstration[0][-1] - demonstration[0][0], scenario.control_period,
+        "scenario.dmp_duration" if duration else "scenario.demonstration's duration")
     if demonstration is None:
         bank = DmpBank.straight(start, goals.shape[0], duration, scenario.dmp)
     else:
@@ -260,15 +262,13 @@ def check_obstacles(obstacles, dimension, field="scenario.obstacles"):
 
 def _check_toy_operator(operator, dimension):
     if isinstance(operator, ObstacleRepulsion):
-        if operator.axis and (len(operator.axis) != dimension or not np.any(operator.axis)):
-            raise ScenarioError(
-                f"scenario.operator.axis must be a nonzero vector of dimension {dimension}")
+        if operator.axis:
+            check_direction(operator.axis, dimension, "scenario.operator.axis")
         if not np.isfinite(operator.speed) or not operator.distance_threshold > 0:
             raise ScenarioError("scenario.operator.speed must be finite and "
                                 "distance_threshold positive")
     elif isinstance(operator, SinusoidalStep):
-        if len(operator.axis) != dimension:
-            raise ScenarioError(f"scenario.operator.axis must have dimension {dimension}")
+        check_direction(operator.axis, dimension, "scenario.operator.axis")
         if not (np.isfinite(operator.amplitude) and operator.duration > 0 and operator.period > 0):
             raise ScenarioError("scenario.operator.amplitude must be finite, duration and "
                                 "period positive")
@@ -294,20 +294,23 @@ def _resolve_hsr(scenario):
         raise ScenarioError("the HSR task draws its own goals (the objects) and starts "
                             "where the robot stands: remove scenario.demonstration, goals "
                             "and start")
-    _require_finite(robot, "scenario.robot", ("speed",))
+    require_finite(robot, "scenario.robot", ("speed",))
+    check_time_steps([
+        ("scenario.robot.station.plant.time_step", robot.station.plant.time_step),
+        ("scenario.robot.station.diff_ik_time_step", robot.station.diff_ik_time_step)])
     if not _whole_multiple(scenario.control_period, robot.station.plant.time_step):
         raise ScenarioError("scenario.control_period must be a whole multiple of "
                             "scenario.robot.station.plant.time_step")
     operator = scenario.operator
-    _require_finite(operator, "scenario.operator",
-                    ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
-                     "direction_noise", "speed_noise"), positive=False)
+    require_finite(operator, "scenario.operator",
+                   ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
+                    "direction_noise", "speed_noise"), positive=False)
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(task, DynamicObstacles):
-        _check_obstacle_task(task)
+        check_obstacle_task(task)
     else:
-        _check_reach_task(task)
+        check_reach_task(task)
     try:
         layout = task_layout(task, scenario.seed)
     except ValueError as error:
@@ -332,6 +335,8 @@ def _resolve_hsr(scenario):
             f"object ({nearest:.2f} m from the hand's start): the task would succeed at once")
     distance = np.max(np.linalg.norm(goals - start, axis=1))
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
+    check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
+                       scenario.dmp_duration > 0 else "scenario.robot.speed")
     bank = DmpBank.straight(start, len(goals), duration, scenario.dmp)
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=bank,
@@ -367,29 +372,6 @@ def _check_hand_over(scenario):
             f"scenario.robot.max_hand_yaw_acceleration {yaw_acceleration} rad/s^2 takes "
             f"{turn / yaw_acceleration:.1f} s to reach the operator's rotation_speed {turn} "
             f"rad/s, longer than scenario.duration {scenario.duration} s: raise it")
-
-
-def _check_reach_task(task):
-    _require_finite(task, "scenario.task", ("success_distance", "min_separation"))
-    schedule = np.asarray(task.switch_schedule, float)
-    if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
-            or schedule[-1] >= 1.0):
-        raise ScenarioError(f"scenario.task.switch_schedule {task.switch_schedule} must "
-                            "start at 0.0 and increase strictly below 1.0")
-
-
-def _check_obstacle_task(task):
-    _require_finite(task, "scenario.task",
-                    ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"))
-    if task.obstacle_count < 0:
-        raise ScenarioError("scenario.task.obstacle_count must not be negative")
-    for name in ("x_range", "y_range", "obstacle_x_range", "obstacle_y_range",
-                 "activation_range"):
-        low_high = getattr(task, name)
-        if len(low_high) != 2 or not low_high[0] <= low_high[1]:
-            raise ScenarioError(f"scenario.task.{name} must be [low, high], got {low_high}")
-    if not 0.0 <= task.activation_range[0] <= task.activation_range[1] <= 1.0:
-        raise ScenarioError("scenario.task.activation_range must lie in [0, 1]")
 
 
 def task_layout(task, seed):

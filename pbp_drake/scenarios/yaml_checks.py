@@ -36,6 +36,10 @@ def read_scenario_text(path):
         if "\t" in indent and line.strip():
             raise ScenarioError(f"line {number}: a tab in the indentation; YAML indents with "
                                 "spaces only")
+    if all(not line.strip() or line.lstrip().startswith("#") for line in text.splitlines()):
+        # Drake's loader reads an empty document as None and fails with a TypeError.
+        raise ScenarioError("the file is empty; expected a scenario file starting with "
+                            "`scenario:`")
     check_duplicate_keys(text)
     return text
 

@@ -89,6 +89,33 @@ def test_a_malformed_csv_is_named(tmp_path, text, problem):
     assert [(d.key, problem in d.problem) for d in damaged] == [(("teleop", 0), True)]
 
 
+def test_a_folder_with_errored_trials_reports_them_and_exits_1(tmp_path, capsys):
+    folder = _study(tmp_path, trials=3)
+    record = trial_record("fake", "abc", "teleop", 1, 1)
+    record["error"] = "RuntimeError: the solver failed"
+    trial_paths(folder, "teleop", 1)[1].unlink()
+    write_trial_files(folder, record, None)
+
+    # Exit 1, as `pbp-drake study` exits on the same trials; the summary is still written.
+    assert main(["report", str(folder)]) == 1
+    out, err = capsys.readouterr()
+    assert "1 of 6 trials failed with an error" in err
+    assert "teleop: 1 trials failed with an error (seeds [1])" in out
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["methods"]["teleop"]["errors"] == 1
+
+
+def test_a_folder_with_trials_that_did_not_run_exits_1(tmp_path, capsys):
+    folder = _study(tmp_path, trials=3)
+    for path in trial_paths(folder, "pbp_alternated", 2):
+        path.unlink()
+    assert main(["report", str(folder)]) == 1
+    err = capsys.readouterr().err
+    assert "0 of 6 trials failed with an error" in err and "and 1 did not run" in err
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["methods"]["pbp_alternated"]["missing"] == 1
+
+
 def test_nothing_to_report_exits_2(tmp_path, capsys):
     (tmp_path / "study.json").write_text("{")
     assert main(["report", str(tmp_path)]) == 2

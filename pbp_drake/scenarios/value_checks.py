@@ -1,0 +1,163 @@
+"""Checks of a scenario's numbers before anything is computed from them: every number of
+every section finite and of a sensible size (`check_numbers`), the time steps not so small
+that a second never ends (`check_time_steps`), the seed, the tasks' ranges and counts.
+
+Each raises ScenarioError as `field.path: what is wrong, what is expected`.
+"""
+
+import dataclasses
+import math
+import numbers
+
+import numpy as np
+
+from pbp_drake.scenarios.schema import ScenarioError
+
+# No length, time, gain or speed of a scenario comes near this; beyond it a norm or a
+# square overflows (1e300 squared is inf) and numpy answers with warnings and NaN.
+LARGEST_NUMBER = 1e12
+# The shortest time step (s) a scenario may ask for: a simulated second then takes a
+# million steps; a smaller one (1e-300 passes every "positive" check) never ends.
+SHORTEST_TIME_STEP = 1e-6
+# The longest a DMP may last (s); a far goal over a tiny robot.speed would otherwise give
+# a duration whose square overflows in the DMP's gains.
+LONGEST_DMP_DURATION = 1e6
+# Fields where `.inf` is a documented value ("no limit"), by their path's last name.
+INFINITY_MEANS_NO_LIMIT = ("base_acceleration_limits", "arm_acceleration_limits")
+
+
+def check_numbers(config, field="scenario"):
+    """Every number in `config` (dataclasses, Drake's config structs and lists, nested) is
+    finite and at most LARGEST_NUMBER in size; `.inf` only where it means no limit."""
+    if isinstance(config, bool) or config is None or isinstance(config, str):
+        return
+    if isinstance(config, numbers.Real):
+        _check_number(config, field)
+    elif isinstance(config, (list, tuple)):
+        for index, item in enumerate(config):
+            check_numbers(item, f"{field}[{index}]")
+    elif dataclasses.is_dataclass(config):
+        for member in dataclasses.fields(config):
+            check_numbers(getattr(config, member.name), f"{field}.{member.name}")
+    elif getattr(type(config), "__fields__", None) is not None:
+        for member in type(config).__fields__:
+            check_numbers(getattr(config, member.name), f"{field}.{member.name}")
+
+
+def _check_number(value, field):
+    if isinstance(value, numbers.Integral):
+        # Integers: the seed may be any size numpy takes; counts are bounded where used.
+        return
+    if math.isnan(value):
+        raise ScenarioError(f"{field}: NaN is not a number here; expected a finite number")
+    if math.isinf(value):
+        if value > 0 and field.split(".")[-1].split("[")[0] in INFINITY_MEANS_NO_LIMIT:
+            return
+        raise ScenarioError(f"{field}: {value} is infinite; expected a finite number")
+    if abs(value) > LARGEST_NUMBER:
+        raise ScenarioError(f"{field}: {value:g} is too large; expected a number of size at "
+                            f"most {LARGEST_NUMBER:g}")
+
+
+def require_finite(config, field, names, positive=True):
+    """Each of `names` of `config` (0 where it has no such field) is finite and positive,
+    or with `positive=False` finite and not negative; the error names `field.name`."""
+    least = "positive" if positive else "not negative"
+    for name in names:
+        value = getattr(config, name, 0.0)
+        if not (np.isfinite(value) and (value > 0 if positive else value >= 0)):
+            raise ScenarioError(f"{field}.{name} must be finite and {least}, got {value}")
+
+
+def check_time_steps(time_steps):
+    """`time_steps`: (field, value) pairs, each at least SHORTEST_TIME_STEP."""
+    for field, value in time_steps:
+        if not value >= SHORTEST_TIME_STEP:
+            raise ScenarioError(f"{field} {value:g} s is too short; expected at least "
+                                f"{SHORTEST_TIME_STEP:g} s")
+
+
+def check_seed(seed, field="scenario.seed"):
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise ScenarioError(f"{field} {seed!r} cannot seed the random draws; expected a "
+                            "non-negative integer")
+
+
+def check_range(config, field, name, within=None):
+    """`config.name` is `[low, high]` with low <= high (and inside `within`)."""
+    low_high = getattr(config, name)
+    if len(low_high) != 2:
+        raise ScenarioError(f"{field}.{name} {low_high} needs two numbers; expected "
+                            "[low, high]")
+    low, high = low_high
+    if low > high:
+        raise ScenarioError(f"{field}.{name} {low_high} is reversed; expected [low, high] "
+                            "with low <= high")
+    if within is not None and not within[0] <= low <= high <= within[1]:
+        raise ScenarioError(f"{field}.{name} {low_high} leaves [{within[0]}, {within[1]}]; "
+                            f"expected [low, high] inside it")
+
+
+def check_count(value, field, least, most, hint=""):
+    if not least <= value <= most:
+        raise ScenarioError(f"{field} {value} is out of range; expected {least} to "
+                            f"{most}{hint}")
+
+
+def check_dmp_duration(duration, control_period, field):
+    """The DMPs last at least one control tick (a shorter one is over before it is
+    stepped, and its gains, 1 / duration squared, blow up) and at most
+    LONGEST_DMP_DURATION."""
+    if not control_period <= duration <= LONGEST_DMP_DURATION:
+        raise ScenarioError(f"{field} gives the DMPs a duration of {duration:g} s; expected "
+                            f"{control_period:g} s (scenario.control_period) to "
+                            f"{LONGEST_DMP_DURATION:g} s")
+
+
+def check_reach_task(task):
+    require_finite(task, "scenario.task", ("success_distance", "min_separation"))
+    for name in ("x_range", "y_range"):
+        check_range(task, "scenario.task", name)
+    check_range(task, "scenario.task", "object_count")
+    # Objects are placed min_separation apart in front of the robot: a few dozen fit.
+    check_count(task.object_count[0], "scenario.task.object_count[0]", 1, 100)
+    check_count(task.object_count[1], "scenario.task.object_count[1]", 1, 100)
+    schedule = np.asarray(task.switch_schedule, float)
+    if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
+            or schedule[-1] >= 1.0):
+        raise ScenarioError(f"scenario.task.switch_schedule {task.switch_schedule} must "
+                            "start at 0.0 and increase strictly below 1.0")
+
+
+def check_obstacle_task(task):
+    require_finite(task, "scenario.task",
+                   ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"))
+    # Obstacles start 0.45 m from each other, the robot and the target: a few dozen fit.
+    # Without any, the station has no obstacle input for the task to drive.
+    check_count(task.obstacle_count, "scenario.task.obstacle_count", 1, 100,
+                " (a task without obstacles is the reaching task: an untagged task)")
+    for name in ("x_range", "y_range", "obstacle_x_range", "obstacle_y_range"):
+        check_range(task, "scenario.task", name)
+    check_range(task, "scenario.task", "activation_range", within=(0.0, 1.0))
+
+
+def check_bent_path(path):
+    """A `BentPath` is 2-D, goes somewhere, and has a sensible number of samples."""
+    field = "scenario.demonstration"
+    if len(path.start) != 2 or len(path.goal) != 2:
+        raise ScenarioError(f"{field}.start {path.start} and goal {path.goal}: a bent path "
+                            "is 2-D; expected two numbers each")
+    if math.hypot(path.goal[0] - path.start[0], path.goal[1] - path.start[1]) < 1e-6:
+        raise ScenarioError(f"{field}.goal {path.goal} is where start is; expected a goal "
+                            "at least 1e-6 away")
+    require_finite(path, field, ("duration",))
+    check_time_steps([(f"{field}.duration", path.duration)])
+    check_count(path.sample_count, f"{field}.sample_count", 3, 100_000)
+
+
+def check_direction(axis, dimension, field):
+    """`axis` is a vector of `dimension` long enough to be normalized (1e-300 passes a
+    nonzero test, but its norm underflows to 0)."""
+    if len(axis) != dimension or not math.hypot(*axis) >= 1e-6:
+        raise ScenarioError(f"{field} {axis} is no direction; expected a vector of "
+                            f"dimension {dimension} and length at least 1e-6")

@@ -16,7 +16,7 @@ from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
-    ScenarioFile)
+    STUDY_SPLITS, ScenarioFile)
 from pbp_drake.scenarios.schema_walk import shape_problem
 from pbp_drake.scenarios.value_checks import check_numbers, check_seed
 from pbp_drake.scenarios.yaml_checks import describe_load_error, read_scenario_text
@@ -118,7 +118,15 @@ def check_method_comparison(study, scenario):
             raise ScenarioError(f"study.methods: {error}") from None
     if study.trials < 1:
         raise ScenarioError(f"study.trials must be at least 1, got {study.trials}")
-    check_seed(study.seed, "study.seed")
+    check_seed(study.tuning_seed, "study.tuning_seed")
+    check_seed(study.evaluation_seed, "study.evaluation_seed")
+    if study.evaluation_seed <= study.tuning_seed:
+        raise ScenarioError(f"study.evaluation_seed {study.evaluation_seed} is not above "
+                            f"study.tuning_seed {study.tuning_seed}; expected the evaluation "
+                            "seeds after the tuning seeds")
+    if study.split not in STUDY_SPLITS:
+        raise ScenarioError(f"study.split {study.split!r} is unknown; expected one of "
+                            f"{', '.join(STUDY_SPLITS)}")
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
 

@@ -266,6 +266,10 @@ class AltVsCont:
     goal_tolerance: float = 0.01
 
 
+#: The two parts of a method study's seeds (see MethodComparison).
+STUDY_SPLITS = ("tuning", "evaluation")
+
+
 @dataclasses.dataclass
 class MethodComparison:
     """The same seeded scenes for each method, driven by the scenario's operator: trial i

@@ -9,7 +9,7 @@ are published. `pbp-drake study` runs the split the file names (`--split` choose
 label goes into study.json, summary.json and results.md.
 """
 
-SPLITS = ("tuning", "evaluation")
+from pbp_drake.scenarios.schema import STUDY_SPLITS as SPLITS
 
 #: What each label tells a reader of the results.
 SPLIT_NOTES = {

@@ -130,7 +130,7 @@ NAMED = [
     (HSR, _set(R + ("station", "plant", "time_step"), 0.0), ["time_step"]),
     (HSR, _set(R + ("station", "plant", "time_step"), -0.005), ["time_step"]),
     (HSR, _set(S + ("seed",), -1), ["seed"]),
-    (HSR, _set(("study", "seed"), -1), ["seed"]),
+    (HSR, _set(("study", "tuning_seed"), -1), ["tuning_seed"]),
     (HSR, _set(T + ("x_range",), [2.5, 1.25]), ["x_range", "reversed"]),
     (HSR, _set(T + ("y_range",), [1.05, -1.05]), ["y_range", "reversed"]),
     (HSR, _set(S + ("duration",), math.inf), ["duration"]),

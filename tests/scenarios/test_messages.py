@@ -49,8 +49,8 @@ def test_an_unknown_key_names_its_mapping_and_the_real_keys(tmp_path, run_refuse
 @pytest.mark.parametrize("file, old, field", [
     ("hsr_reach.yaml", "  seed: 0\nstudy", "scenario.seed"),
     ("hsr_obstacles.yaml", "  seed: 0\nstudy", "scenario.seed"),
-    # The study's trials draw seeds seed, seed + 1, ...: the first would be -1.
-    ("hsr_reach.yaml", "  trials: 50\n  seed: 0", "study.seed"),
+    # The study's trials draw seeds tuning_seed, tuning_seed + 1, ...: the first would be -1.
+    ("hsr_reach.yaml", "  tuning_seed: 0", "study.tuning_seed"),
 ])
 def test_a_negative_seed_names_the_seed(tmp_path, run_refused, file, old, field):
     message = _message(run_refused, _broken(tmp_path, file, old, old.replace("seed: 0",
@@ -82,7 +82,7 @@ def test_an_endless_hsr_task_names_the_duration(tmp_path, run_refused, file):
      "!RecordedPath (untagged: BentPath)"),
     # ...or ran the scenario on a default robot, the value silently dropped...
     ("toy_alpha_study.yaml", "  robot: {mass: 1.0, stiffness: 400.0, damping: 40.0, "
-     "time_step: 0.001}", "  robot: 3",
+     "time_step: 0.01}", "  robot: 3",
      "scenario.robot: got 3; expected a mapping, tagged with one of !PointRobot, !Hsr "
      "(untagged: PointRobot)"),
     # ...or complained about an empty study.scenes.
@@ -93,3 +93,14 @@ def test_an_endless_hsr_task_names_the_duration(tmp_path, run_refused, file):
 def test_a_value_where_a_section_belongs_says_what_belongs(tmp_path, run_refused, file, old,
                                                           new, message):
     assert _message(run_refused, _broken(tmp_path, file, old, new)) == message
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("evaluation_seed: 10000", "evaluation_seed: 0",
+     "study.evaluation_seed 0 is not above study.tuning_seed 0; expected the evaluation "
+     "seeds after the tuning seeds"),
+    ("split: evaluation", "split: test",
+     "study.split 'test' is unknown; expected one of tuning, evaluation"),
+])
+def test_the_study_splits_are_checked(tmp_path, run_refused, old, new, message):
+    assert _message(run_refused, _broken(tmp_path, "hsr_reach.yaml", old, new)) == message

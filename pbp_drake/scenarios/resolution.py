@@ -15,6 +15,7 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBank, validate_demonstration
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.obstacle_task import sample_obstacle_scene
@@ -227,8 +228,13 @@ def _resolve_point_robot(scenario):
     if goals.shape[1] != start.size:
         raise ScenarioError(
             f"scenario.goals have dimension {goals.shape[1]}, scenario.start has {start.size}")
-    if not (np.isfinite(goals).all() and np.isfinite(start).all()):
-        raise ScenarioError("scenario.goals and scenario.start must be finite")
+    # The bound every goal of a running diagram is held to (GoalsSource, the DMP bank).
+    for field, name, points in (("scenario.goals", "goal", goals),
+                                ("scenario.start", "start", start)):
+        try:
+            check_positions(points, name)
+        except ValueError as error:
+            raise ScenarioError(f"{field}: {error}") from None
     _check_method(scenario, goals.shape[0])
     if scenario.dmp_duration <= 0 and demonstration is None:
         raise ScenarioError("scenario.dmp_duration is needed when there is no demonstration")

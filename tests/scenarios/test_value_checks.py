@@ -38,6 +38,11 @@ DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
     # Accepted, then the diagram was wired to an obstacle input the station did not have.
     ("hsr_obstacles.yaml", "obstacle_count: 3", "obstacle_count: 0",
      r"scenario.task.obstacle_count 0 is out of range; expected 1 to 100"),
+    # A goal beyond the bound every running goal is held to (core.coordinates): a
+    # ValueError from the goals source, with a traceback, when the diagram was built.
+    ("toy_alpha_study.yaml", "goal: [1.0, 0.0]", "goal: [1.0e9, 0.0]",
+     r"scenario.goals: goal 0 is \[1000000000.0, .*\]: positions must be finite and within "
+     r"±1e\+06 m"),
     # Accepted as "not negative", then refused by the robot when the diagram was built.
     ("toy_alpha_study.yaml", "stiffness: 400.0", "stiffness: 0.0",
      r"scenario.robot.stiffness must be finite and positive, got 0.0"),

@@ -5,8 +5,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
-from pbp_drake.core.participant_reach import (
-    assist_motion, drive_motion, faces_target)
+from pbp_drake.core.participant_reach import assist_motion, drive_motion, faces_target
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.layouts import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.participant_params import VirtualParticipantParams

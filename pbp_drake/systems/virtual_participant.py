@@ -5,8 +5,10 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
-from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
+from pbp_drake.core.participant_reach import assist_motion, drive_motion, faces_target
+from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.layouts import EeState, OperatorCommand, Target, position_of
+from pbp_drake.systems.participant_params import VirtualParticipantParams
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 PARTICIPANT_MODES = ("assist", "drive")
@@ -31,27 +33,6 @@ GOAL_MARGIN_FACTOR = 1.0
 POLICY_COMPENSATION = 3.0
 
 
-@dataclasses.dataclass
-class VirtualParticipantParams:
-    """How the virtual participant behaves (see `VirtualParticipant`). `speed` (m/s) 0 takes
-    the task's nominal speed, that of its DMPs. Its noise comes from the scenario's seed."""
-
-    speed: float = 0.0
-    rotation_speed: float = 0.8
-    # It notices a new target this long (s) after it appears.
-    reaction_delay: float = 0.3
-    # Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
-    # (1 + N(0, speed_noise)).
-    direction_noise: float = 0.1
-    speed_noise: float = 0.1
-    # Driving (teleop), it slows within this distance (m) of the target.
-    slow_radius: float = 0.15
-    # It counts as facing a point within this angle (rad).
-    aligned_angle: float = 0.05
-    # Once it takes control among obstacles, it keeps it at least this long (s).
-    hold_time: float = 0.5
-
-
 class VirtualParticipant(SampledOperator):
     """Sees the true target and the robot, and acts as a person would.
 
@@ -67,14 +48,15 @@ class VirtualParticipant(SampledOperator):
         - operator_command
         - operator_active
 
-    `mode="assist"` (PBP and arbitration): acts only when needed. While the estimated goal
-    (`selected_goal`) is not the target, it turns the end effector toward the target and
-    sidesteps toward it; otherwise it lets go. It never pushes forward, as in the paper
-    where the forward key is disabled. Facing the target while the estimate is still another
-    object (the two almost in line), it steps aside, to the side that widens the angle
-    between them, to tell them apart; it sees all the `objects` (M, 3). `mode="drive"`
-    (teleoperation): it drives the whole way, toward the target at `speed` (slowing within
-    `slow_radius`), turning to face it.
+    `mode="assist"` (PBP and arbitration): acts only while the estimated goal
+    (`selected_goal`) is not the target, and never pushes forward, as in the paper where the
+    forward key is disabled. It turns the end effector to face the target and moves toward
+    it and away from the object picked instead, as far as the keys allow; it steps aside
+    when the two stand in line; and once it has faced the target `insist_time` to no avail,
+    it turns the target to its side and sidesteps to it (`pbp_drake.core.participant_reach`
+    says why each goal estimator can read this). It sees all the `objects` (M, 3).
+    `mode="drive"` (teleoperation): it drives the whole way, toward the target at `speed`
+    (slowing within `slow_radius`), turning to face it.
 
     It notices a new target only `reaction_delay` seconds after it appears, and its
     commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
@@ -114,7 +96,6 @@ class VirtualParticipant(SampledOperator):
         self._speed_noise = float(params.speed_noise)
         self._seed = int(seed)
         self._slow_radius = float(params.slow_radius)
-        self._aligned_angle = float(params.aligned_angle)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
@@ -144,6 +125,10 @@ class VirtualParticipant(SampledOperator):
         # What the participant believes: the target index it knows and how many ticks a
         # different target has been on screen.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        # Assisting in the reaching task: the target it counts for and how many ticks it has
+        # faced it while the estimate named another object (`insist_time`).
+        self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        self._insist_ticks = int(round(params.insist_time / control_period))
         self._declare_operator_outputs()
 
     def get_ee_state_input_port(self):
@@ -172,7 +157,7 @@ class VirtualParticipant(SampledOperator):
         if self._obstacles_port is not None:
             command, active = self._avoid(context, discrete_state, int(known))
         else:
-            command, active = self._decide(context, int(known))
+            command, active = self._decide(context, discrete_state, int(known))
         self._store_sample(discrete_state, command, active)
 
     def _noise(self, context):
@@ -180,21 +165,6 @@ class VirtualParticipant(SampledOperator):
         rng = np.random.default_rng([self._seed, int(round(context.get_time() / self._period))])
         return (rng.normal(0.0, self._direction_noise),
                 max(0.0, 1.0 + rng.normal(0.0, self._speed_noise)))
-
-    def _aside_direction(self, position, heading, target, selected):
-        """+1 (left) or -1: the sidestep that widens the angle between the target (its
-        position, 3) and the object picked instead, when the two stand almost in line.
-
-        Stepping left by d turns the view of a point at distance r by -d / r, so the gap
-        `angle(picked) - angle(target)` changes by `-d (1 / r_picked - 1 / r_target)`.
-        """
-        picked = self._objects[selected]
-        gap = (heading_error(heading, position, picked)
-               - heading_error(heading, position, target))
-        closeness = (1.0 / max(np.linalg.norm(picked[:2] - position[:2]), 1e-6)
-                     - 1.0 / max(np.linalg.norm(target[:2] - position[:2]), 1e-6))
-        direction = -np.sign(gap) * np.sign(closeness)
-        return direction if direction != 0 else 1.0
 
     def _avoid(self, context, discrete_state, known_target):
         """The command while obstacles are about: a local plan around them (see the class
@@ -321,35 +291,64 @@ class VirtualParticipant(SampledOperator):
         best = int(np.argmax(score))
         return velocities[best], yaw_rates[best], clear[best]
 
-    def _decide(self, context, known_target):
+    def _decide(self, context, discrete_state, known_target):
+        """The command in the reaching task (`pbp_drake.core.participant_reach`). Returns
+        `(command, active)`."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         position, heading = position_of(ee_state), ee_state.heading
         target = Target(self._target_port.Eval(context))
         if known_target != int(target.index):
             return np.zeros(4), False  # has not noticed the new target yet
         target_position = position_of(target)
-        angle = heading_error(heading, position, target_position)
         noise_angle, speed_scale = self._noise(context)
-        offset = target_position[:2] - position[:2]
-        distance = np.linalg.norm(offset)
         if self._mode == "assist":
             selected = int(round(self._selected_goal_port.Eval(context)[0]))
-            if selected == int(target.index):
+            insisting = self._count_insistence(context, discrete_state, known_target,
+                                               selected, position, heading, target_position)
+            if selected == known_target:
                 return np.zeros(4), False
-            # Sidestep toward the target: the part of its direction across the heading.
-            left = np.array([-np.sin(heading), np.cos(heading)])
-            lateral = (offset / max(distance, 1e-9)) @ left
-            if abs(angle) <= 2 * self._aligned_angle:
-                lateral = 0.5 * self._aside_direction(position, heading, target_position,
-                                                      selected)
-            velocity = self._speed * speed_scale * lateral * rotate_planar(left, noise_angle)
+            velocity, yaw_rate = assist_motion(
+                self.params, self._speed, position, heading, target_position,
+                self._objects[selected], insisting)
         else:
-            if distance < 1e-9:
+            insisting = False
+            if np.linalg.norm(target_position[:2] - position[:2]) < 1e-9:
                 return np.zeros(4), False
-            speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
-            velocity = speed * rotate_planar(offset / distance, noise_angle)
-        yaw_rate = 0.0
-        if abs(angle) > self._aligned_angle:
-            yaw_rate = np.sign(angle) * self._rotation_speed * min(1.0, abs(angle) / 0.3)
+            velocity, yaw_rate = drive_motion(self.params, self._speed, position, heading,
+                                              target_position)
+        velocity = speed_scale * rotate_planar(velocity, noise_angle)
+        if self._mode == "assist" and insisting and self._policy_adds:
+            # Under PBP-Cont the DMP of the picked object keeps pulling the hand to it, and
+            # near it that pull matches `speed`: going to the target, the participant pushes
+            # against it as it does among obstacles (`_avoid`).
+            velocity = self._against_policy(context, ee_state, velocity)
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
 
+    def _against_policy(self, context, ee_state, wanted):
+        """The command that moves the hand at `wanted` (2) under an additive blend: `wanted`
+        minus the policy's own motion (what the hand does minus what was asked of it), at
+        most `POLICY_COMPENSATION` times `speed`."""
+        held = self._held(context)
+        last_command = held[:2] if held[4] > 0.5 else np.zeros(2)
+        policy_velocity = np.array([ee_state.vx, ee_state.vy]) - last_command
+        command = wanted - policy_velocity
+        norm = np.linalg.norm(command)
+        if norm > POLICY_COMPENSATION * self._speed:
+            command *= POLICY_COMPENSATION * self._speed / norm
+        return command
+
+    def _count_insistence(self, context, discrete_state, known_target, selected, position,
+                          heading, target_position):
+        """Whether it has faced `known_target` `insist_time` while the estimate named another
+        object; it keeps insisting on that target, once it has, until a new one appears
+        (turning back to face it would only undo what it has gained)."""
+        counted_target, ticks = context.get_discrete_state(self._insist_index).value()
+        if counted_target != known_target:
+            counted_target, ticks = known_target, 0.0
+        insisting = ticks >= self._insist_ticks
+        if (not insisting and selected != known_target
+                and faces_target(self.params, position, heading, target_position)):
+            ticks += 1.0
+        discrete_state.get_mutable_vector(self._insist_index).set_value(
+            [counted_target, ticks])
+        return insisting

@@ -1,0 +1,110 @@
+"""What the virtual participant does in the reaching task, in pure NumPy (the system,
+`pbp_drake.systems.virtual_participant`, adds the belief, the noise and the timing).
+
+Assisting (PBP, arbitration) with the forward key disabled, a person shows the goal they
+mean with what the keys still allow: turning, sidestepping and backing. Each of the shipped
+goal estimators reads a different part of that: ``angle`` where the hand points, ``nearest``
+which object the hand is closest to, ``bayesian`` which object the hand has gained on since
+the start. `assist_motion` serves all three with one behaviour:
+
+- it turns to face the target (``angle``), and moves along `u_target - u_picked`, the unit
+  direction to the target minus that to the object picked instead, with its forward part
+  removed. Along `u_target - u_picked` the distance to the target shrinks fastest against
+  the distance to the picked object (the gradient of `|p - target| - |p - picked|`), which
+  is what ``nearest`` and ``bayesian`` compare. Facing the target, it is a sidestep away
+  from the picked object.
+- when the two stand in line (no sidestep separates them), it steps aside to widen the
+  angle between them, as before.
+- when it has faced the target for `insist_time` and the estimate still names another
+  object (the target is behind the picked one, say, and only forward motion would tell
+  them apart), it goes to the target itself as far as the keys allow: it turns the target
+  to its side and sidesteps toward it, slowing near it as when driving.
+"""
+
+import numpy as np
+
+from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
+
+
+def unit(vector):
+    """`vector` scaled to length 1 (zero stays zero)."""
+    norm = np.linalg.norm(vector)
+    return vector / norm if norm > 1e-9 else np.zeros_like(vector)
+
+
+def facing(heading):
+    """The floor unit vector the heading points along."""
+    return np.array([np.cos(heading), np.sin(heading)])
+
+
+def without_forward(velocity, heading):
+    """The part of a floor `velocity` (2) the keys can command with the forward key
+    disabled: its component along the heading removed when that component points forward."""
+    ahead = facing(heading)
+    return velocity - max(float(velocity @ ahead), 0.0) * ahead
+
+
+def turn_rate(params, angle):
+    """The yaw rate (rad/s) that turns the heading by `angle` (rad): full `rotation_speed`
+    far from it, in proportion within `turn_slowdown_angle`, none once aligned."""
+    if abs(angle) <= params.aligned_angle:
+        return 0.0
+    return float(np.sign(angle) * params.rotation_speed
+                 * min(1.0, abs(angle) / params.turn_slowdown_angle))
+
+
+def aside_direction(position, heading, target, picked):
+    """+1 (left) or -1: the sidestep that widens the angle between the `target` and the
+    `picked` object (positions, 3) when they stand almost in line.
+
+    Stepping left by d turns the view of a point at distance r by -d / r, so the gap
+    `angle(picked) - angle(target)` changes by `-d (1 / r_picked - 1 / r_target)`.
+    """
+    gap = heading_error(heading, position, picked) - heading_error(heading, position, target)
+    closeness = (1.0 / max(np.linalg.norm(picked[:2] - position[:2]), 1e-6)
+                 - 1.0 / max(np.linalg.norm(target[:2] - position[:2]), 1e-6))
+    direction = -np.sign(gap) * np.sign(closeness)
+    return direction if direction != 0 else 1.0
+
+
+def faces_target(params, position, heading, target):
+    """Whether the hand points at the target closely enough to count as facing it (twice
+    `aligned_angle`: the turn stops within `aligned_angle`, and noise moves it)."""
+    return abs(heading_error(heading, position, target)) <= 2 * params.aligned_angle
+
+
+def assist_motion(params, speed, position, heading, target, picked, insisting):
+    """The floor velocity (2, m/s) and yaw rate (rad/s) of a participant who sees the
+    estimate name `picked` instead of `target` (positions, 3), the hand at `position` with
+    `heading`; `insisting` once it has faced the target `insist_time` to no avail. No
+    velocity it returns points forward (`without_forward`)."""
+    offset = target[:2] - position[:2]
+    distance = np.linalg.norm(offset)
+    toward_target = unit(offset)
+    toward_picked = unit(picked[:2] - position[:2])
+    if insisting:
+        # The target to the side it is already nearer, so the turn is the shorter one.
+        side = 1.0 if heading_error(heading, position, target) >= 0.0 else -1.0
+        wanted_heading = np.arctan2(toward_target[1], toward_target[0]) - side * np.pi / 2
+        slow = min(1.0, distance / params.slow_radius)
+        velocity = speed * slow * without_forward(toward_target, heading)
+        return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
+    separation = np.arccos(np.clip(toward_target @ toward_picked, -1.0, 1.0))
+    if separation < params.in_line_angle:
+        left = rotate_planar([0.0, 1.0], heading)
+        side = aside_direction(position, heading, target, picked)
+        velocity = params.aside_speed_fraction * speed * side * left
+    else:
+        velocity = speed * without_forward(unit(toward_target - toward_picked), heading)
+    return velocity, turn_rate(params, heading_error(heading, position, target))
+
+
+def drive_motion(params, speed, position, heading, target):
+    """Teleop: the floor velocity (2) toward the target at `speed`, slowing within
+    `slow_radius`, and the yaw rate that turns the hand to face it."""
+    offset = target[:2] - position[:2]
+    distance = np.linalg.norm(offset)
+    if distance < 1e-9:
+        return np.zeros(2), 0.0
+    velocity = speed * min(1.0, distance / params.slow_radius) * offset / distance
+    return velocity, turn_rate(params, heading_error(heading, position, target))

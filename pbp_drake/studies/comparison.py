@@ -26,7 +26,8 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     processes, writes every trial under `output/trials/`, then the summary, tables and
     figures (see `report`). Returns the summary dict. `split` labels the seeds in
-    study.json and the results ("tuning", "evaluation", ...: see `studies.splits`).
+    study.json and the results ("tuning", "evaluation", ...: see `studies.splits`); None
+    keeps the label the folder holds for the same seeds.
 
     `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
     Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "ray://head:10001", "auto"),
@@ -49,7 +50,10 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
         raise ScenarioError(f"trials must be at least 1, got {trials}")
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
-    check_folder(output, scenario, digest)
+    recorded = check_folder(output, scenario, digest)
+    if split is None and recorded and (recorded.get("seed"), recorded.get("trials")) == (
+            seed, trials) and isinstance(recorded.get("split"), str):
+        split = recorded["split"]  # resuming the same seeds keeps their label
     keys = [(method, trial) for method in methods for trial in range(trials)]
     for leftover in [*output.glob("trials/*/*.running"), *output.glob("trials/*/.*.tmp")]:
         leftover.unlink(missing_ok=True)  # left by an interrupted study

@@ -12,14 +12,14 @@ TOY_STUDIES = ("alpha_study", "alt_vs_cont")
 def check_folder(output, scenario, digest):
     """Raises StudyFolderError when `output` holds a study of another scenario or kind (a 2-D
     study's summary.json, a study.json of another kind); names a damaged study.json (it is
-    written again)."""
+    written again). Returns the folder's readable study.json as a dict, or None."""
     kind = folder_kind(output)
     if kind is not None and kind != "method_comparison":
         raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a method "
                                "comparison: choose another --output folder")
     study_path = output / "study.json"
     if not study_path.is_file():
-        return
+        return None
     try:
         study = json.loads(study_path.read_text())
         problem = None if isinstance(study, dict) else f"holds a {type(study).__name__}"
@@ -27,12 +27,13 @@ def check_folder(output, scenario, digest):
         problem = f"truncated or invalid JSON ({error})"
     if problem is not None:
         name_damaged([Damage(str(study_path), f"{problem}; written again")])
-        return
+        return None
     if study.get("scenario_hash") != digest:
         raise StudyFolderError(
             f"{output} holds a study of another scenario ({study.get('scenario')!r}, hash "
             f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}): "
             "choose another --output folder")
+    return study
 
 
 def folder_kind(output):

@@ -110,12 +110,14 @@ class _LogTail:
         return self._split(len(self._samples[DECISION_LOGS[0]]))
 
     def _split(self, count):
-        """The `_Series` of the first `count` pending ticks, which leave the tail."""
-        times, self._times = self._times[:count], self._times[count:]
+        """The `_Series` of the first `count` pending ticks, which leave the tail. What
+        stays, and what is taken, are copies: a slice would keep alive the whole chunk it
+        was cut from (a streamed run's empty series held one chunk per run, 50 kB)."""
+        times, self._times = self._times[:count].copy(), self._times[count:].copy()
         taken = {}
         for name in self._samples:
-            taken[name], self._samples[name] = (self._samples[name][:count],
-                                                self._samples[name][count:])
+            taken[name], self._samples[name] = (self._samples[name][:count].copy(),
+                                                self._samples[name][count:].copy())
         return _Series(series_fields(times, taken["ee_state_log"],
                                      taken.get("in_collision_log"),
                                      {name: taken[name] for name in DECISION_LOGS}))

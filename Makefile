@@ -5,7 +5,7 @@ PYTHON := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 DEMO_DIR := outputs/demo
 
-.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench clean
+.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench soak clean
 
 $(STAMP): pyproject.toml
 	test -x $(PYTHON) || python3 -m venv $(VENV)
@@ -74,6 +74,12 @@ $(VENV)/.installed-bench: $(STAMP)
 
 bench: $(VENV)/.installed-bench
 	$(VENV)/bin/python -m pbp_drake.bench
+
+# An hour of simulated time of the HSR reaching task with Meshcat on, runs back to back in
+# one process; fails when memory grows 10 % or more after the first minute (20-25 minutes
+# of wall time on a shared 2-core machine).
+soak: $(STAMP)
+	$(PYTHON) -m pbp_drake.soak --minutes 60
 
 clean:
 	rm -rf $(VENV) outputs build *.egg-info

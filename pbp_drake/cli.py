@@ -10,11 +10,12 @@ import numpy as np
 from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
 from pbp_drake.bench.run import main as bench_main
-from pbp_drake.builder import build_diagram, run_task, simulate
+from pbp_drake.builder import build_diagram, run_task, run_task_streamed, simulate
 from pbp_drake.cli_types import port, realtime_rate, wait_seconds
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.draw import main as draw_main
-from pbp_drake.output_paths import check_output_folder, check_record_path, mark_replay
+from pbp_drake.output_paths import (
+    check_log_path, check_output_folder, check_record_path, mark_replay)
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, MethodComparison, ScenarioError,
     check_method_comparison, load_scenario_file, resolve, with_method)
@@ -52,8 +53,11 @@ def main(argv=None):
                      help="simulate as fast as possible without waiting for a browser")
     run.add_argument("--record", metavar="FILE.html",
                      help="save a self-contained replay of the run")
+    run.add_argument("--log", metavar="FILE.csv", help="HSR tasks: write the per-tick rows to "
+                     "this CSV as the task runs (nothing of them kept in memory)")
     run.add_argument("--force", action="store_true",
-                     help="let --record overwrite an existing file that is not a replay")
+                     help="let --record (--log) overwrite an existing file that is not a "
+                     "replay (time series)")
     run.add_argument("--duration", type=float, metavar="SECONDS",
                      help="override the scenario's duration (for HSR tasks, the time limit)")
     run.add_argument("--realtime-rate", type=realtime_rate, default=1.0, metavar="RATE",
@@ -170,6 +174,8 @@ def _run(args):
     # The paths first: a bad one must not cost a run, let alone a person's session.
     if args.record:
         check_record_path(args.record, force=args.force)
+    if args.log:
+        check_log_path(args.log, force=args.force)
     if args.output is not None:
         check_output_folder(args.output)
     resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
@@ -179,6 +185,9 @@ def _run(args):
     print(f"Meshcat: {meshcat.web_url()}", flush=True)
     if resolved.is_hsr:
         return _run_task(args, resolved, meshcat)
+    if args.log:
+        raise ScenarioError("--log streams an HSR task's per-tick rows; this scenario uses "
+                            "the 2-D toy robot")
     diagram = build_diagram(resolved, meshcat)
     if not args.headless and sys.stdin.isatty():
         _wait_for_browser(meshcat, args.wait_for_browser)
@@ -222,13 +231,16 @@ def _run_task(args, resolved, meshcat):
         _wait_for_browser(meshcat, args.wait_for_browser, person)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
-    result = run_task(resolved, realtime_rate=0.0 if args.headless else args.realtime_rate,
-                      diagram=diagram)
+    rate = 0.0 if args.headless else args.realtime_rate
+    result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram)
+              if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram))
     if args.record:
         _save_recording(meshcat, args.record)
     hand = ""
     if len(result.ee_positions):
         hand = ", hand at [" + ", ".join(f"{x:.3f}" for x in result.ee_positions[-1]) + "]"
+    if args.log:
+        hand = f"; per-tick rows in {args.log}"
     print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
           f"{result.summary_line()}{hand}", flush=True)
     if not args.headless and sys.stdin.isatty():
@@ -238,8 +250,9 @@ def _run_task(args, resolved, meshcat):
 
 def _run_session(args, resolved, meshcat, person):
     scenario = resolved.scenario
-    if args.record:
-        raise ScenarioError("--record saves one run; a session saves every run under --output")
+    if args.record or args.log:
+        raise ScenarioError("--record and --log save one run; a session saves every run under "
+                            "--output")
     methods = _method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
     for method in methods:
         with_method(scenario, method)

@@ -1,10 +1,11 @@
 """Checks of the command line's output paths, made before anything is built or simulated:
-`run --record FILE.html`, `run --output DIR` and `study --output DIR`. A path that cannot be
+`run --record FILE.html`, `run --log FILE.csv`, `run --output DIR` and `study --output DIR`. A path that cannot be
 written is a user error (a ScenarioError: `pbp-drake: ...`, exit 2), not a lost run."""
 
 import os
 import pathlib
 
+from pbp_drake.builder.time_series import time_series_header
 from pbp_drake.scenarios import ScenarioError
 
 # Written into every replay just after its doctype: an existing file that holds it is a
@@ -51,6 +52,32 @@ def check_record_path(path, force=False):
             raise OutputPathError(f"--record {record}: the file is not writable")
         return
     _check_can_create(record.parent, f"--record {record}")
+
+
+def check_log_path(path, force=False):
+    """Raises OutputPathError unless `path` can take a run's per-tick CSV: not a folder, its
+    folder exists or can be made and is writable, and an existing file there is a previous
+    time series CSV (its header is the trial CSV's) or `force` is set."""
+    log = pathlib.Path(path)
+    if log.is_dir():
+        raise OutputPathError(f"--log {log}: is a folder; give a file, e.g. {log / 'run.csv'}")
+    if log.exists() or log.is_symlink():
+        if not force and not _is_time_series(log):
+            raise OutputPathError(f"--log {log}: the file exists and is not a time series "
+                                  f"written by pbp-drake; add --force to overwrite it")
+        if not os.access(log, os.W_OK):
+            raise OutputPathError(f"--log {log}: the file is not writable")
+        return
+    _check_can_create(log.parent, f"--log {log}")
+
+
+def _is_time_series(path):
+    try:
+        with open(path, newline="") as stream:
+            head = stream.readline()
+    except (OSError, UnicodeDecodeError):
+        return False
+    return head in (time_series_header(False), time_series_header(True))
 
 
 def check_output_folder(path, option="--output"):

@@ -3,7 +3,9 @@
 - `build`: `build_diagram` (the one entry point) and `find_system`;
 - `point_robot`: the 2-D scenes; `hsr`: the HSR tasks, with `pbp_controller` (the PBP loop
   as one Diagram) and `pbp_drake.robots.make_hsr_station`; `operators`: who drives;
-- `run`: `simulate`, `run_task`, `read_log` and their results.
+- `run`: `simulate`, `run_task`, `read_log` and their results; `streamed_run`:
+  `run_task_streamed`, a task whose per-tick rows go to a CSV file as it runs
+  (`time_series`: the CSV's columns and rows, shared with a study's trial files).
 """
 
 from pbp_drake.builder.build import build_diagram, find_system
@@ -12,7 +14,8 @@ from pbp_drake.builder.operators import (
 from pbp_drake.builder.pbp_controller import make_pbp_controller
 from pbp_drake.builder.run import (
     TaskResult, Trajectory, read_log, read_trajectory, run_task, simulate)
+from pbp_drake.builder.streamed_run import run_task_streamed
 
 __all__ = ["TaskResult", "Trajectory", "build_diagram", "find_system", "make_hsr_operator",
            "make_operator", "make_pbp_controller", "read_log", "read_trajectory", "run_task",
-           "simulate", "sinusoidal_step_commands"]
+           "run_task_streamed", "simulate", "sinusoidal_step_commands"]

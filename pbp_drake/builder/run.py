@@ -190,35 +190,52 @@ def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None):
     return _read_result(diagram, context, status, monitor, scenario.control_period)
 
 
+# The loggers that hold decisions (read `DECISION_LOG_SHIFT` samples later, see read_log)
+# and those measured on the plant's state (not shifted) that make a TaskResult's series.
+DECISION_LOGS = ("command_log", "operator_active_log", "operator_command_log",
+                 "selected_goal_log", "target_log")
+STATE_LOGS = ("ee_state_log", "in_collision_log")
+
+
 def _read_result(diagram, context, status, monitor, control_period):
     # The last sample holds only the decisions of the tick before it (see read_log).
     tick_count = diagram.GetSubsystemByName("ee_state_log").FindLog(context).num_samples() - 1
-
-    def decisions(name):
-        return read_log(diagram, context, name, tick_count, shift=DECISION_LOG_SHIFT)[1]
-
     times, ee_state = read_log(diagram, context, "ee_state_log", tick_count)
-    # Measured on the plant's state, like ee_state: not shifted.
     in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
-    commands = decisions("command_log")
+    decisions = {name: read_log(diagram, context, name, tick_count, shift=DECISION_LOG_SHIFT)[1]
+                 for name in DECISION_LOGS}
+    series = series_fields(times, ee_state, in_collision, decisions)
     peak_hand_speed, peak_command_acceleration = motion_peaks(
-        ee_state[:, :3], commands[:, 3:6], control_period)
+        series["ee_positions"], series["commands"][:, 3:6], control_period)
+    return task_result(status, monitor, series, peak_hand_speed, peak_command_acceleration)
+
+
+def series_fields(times, ee_state, in_collision, decisions):
+    """A TaskResult's time series fields, as a dict, from the samples of its ticks: `times`
+    and `ee_state` of `ee_state_log`, `in_collision` of `in_collision_log` (None without
+    obstacles), and `decisions` of each of DECISION_LOGS by name, already shifted."""
+    return dict(
+        times=times,
+        ee_positions=ee_state[:, :3],
+        headings=ee_state[:, 6],
+        commands=decisions["command_log"],
+        operator_active=decisions["operator_active_log"][:, 0] > 0.5,
+        operator_commands=decisions["operator_command_log"],
+        selected_goals=decisions["selected_goal_log"][:, 0].astype(int),
+        targets=decisions["target_log"][:, 3].astype(int),
+        in_collision=None if in_collision is None else in_collision[:, 0] > 0.5)
+
+
+def task_result(status, monitor, series, peak_hand_speed, peak_command_acceleration):
+    """The TaskResult of a run: the task monitor's final `status` (TaskStatus) and objects,
+    the `series` fields (see series_fields) and the peaks (see motion_peaks)."""
     return TaskResult(
         success=bool(status.success > 0.5),
         task_time=float(status.task_time),
         intervention_ratio=float(status.intervention_ratio),
         switches=int(status.stage),
-        times=times,
-        ee_positions=ee_state[:, :3],
-        headings=ee_state[:, 6],
-        commands=commands,
-        operator_active=decisions("operator_active_log")[:, 0] > 0.5,
-        operator_commands=decisions("operator_command_log"),
-        selected_goals=decisions("selected_goal_log")[:, 0].astype(int),
-        targets=decisions("target_log")[:, 3].astype(int),
         objects=monitor.objects.copy(),
         collision_ratio=float(status.collision_ratio),
-        in_collision=None if in_collision is None else in_collision[:, 0] > 0.5,
         peak_hand_speed=peak_hand_speed,
         peak_command_acceleration=peak_command_acceleration,
-    )
+        **series)

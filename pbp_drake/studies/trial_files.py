@@ -20,6 +20,7 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load
 
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.builder.run import TaskResult
+from pbp_drake.builder.time_series import time_series_columns, time_series_csv
 
 # A trial file of another format counts as not on disk (it runs again). Fields added since
 # (peak_hand_speed, peak_command_acceleration) are read as None when a file lacks them, so
@@ -114,32 +115,6 @@ def json_float(value):
         return None
     value = float(value)
     return value if math.isfinite(value) else None
-
-
-def time_series_columns(has_collision):
-    return ["time", "ee_x", "ee_y", "ee_z", "heading",
-            "command_x", "command_y", "command_z", "command_vx", "command_vy", "command_vz",
-            "command_heading", "operator_active",
-            "operator_vx", "operator_vy", "operator_vz", "operator_yaw_rate",
-            "selected_goal", "target"] + (["in_collision"] if has_collision else [])
-
-
-def time_series_csv(result):
-    """The per-tick time series of a TaskResult as CSV text; floats are written in their
-    shortest exact form, so reading them back gives the same numbers."""
-    has_collision = result.in_collision is not None
-    columns = time_series_columns(has_collision)
-    lines = [",".join(columns)]
-    for k in range(len(result.times)):
-        row = [result.times[k], *result.ee_positions[k], result.headings[k], *result.commands[k]]
-        row = [repr(float(x)) for x in row]
-        row.append(str(int(bool(result.operator_active[k]))))
-        row += [repr(float(x)) for x in result.operator_commands[k]]
-        row += [str(int(result.selected_goals[k])), str(int(result.targets[k]))]
-        if has_collision:
-            row.append(str(int(bool(result.in_collision[k]))))
-        lines.append(",".join(row))
-    return "\n".join(lines) + "\n"
 
 
 def trial_record(scenario_name, digest, method, trial, seed):

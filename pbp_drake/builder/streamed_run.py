@@ -1,0 +1,150 @@
+"""Running an HSR task with its per-tick rows streamed to a CSV file (`run_task_streamed`),
+for runs too long to keep their time series in memory (`pbp_drake.soak` runs one for an
+hour of simulated time).
+
+The simulator advances in chunks of simulated time. After each chunk the rows of the ticks
+it completed are appended to the file (the format of a study's trial CSV,
+`pbp_drake.builder.time_series`) and every logger of the diagram is cleared, so memory holds
+at most one chunk of samples however long the run. What needs the whole series (the motion
+peaks) is carried from chunk to chunk.
+
+A tick's row joins the plant's state logged at `t_k` with the decisions of tick k, which the
+loggers hold one sample later (`DECISION_LOG_SHIFT`, see `pbp_drake.builder.run.read_log`):
+a chunk's last state sample waits for the next chunk's first decision sample, and the run's
+last state sample, whose decisions are never logged, is not written (as in `run_task`).
+"""
+
+import numpy as np
+from pydrake.systems.analysis import SimulatorStatus
+from pydrake.systems.primitives import VectorLogSink
+
+from pbp_drake.builder.run import (
+    DECISION_LOGS, STATE_LOGS, initialized_simulator, series_fields, task_result, ticks_of)
+from pbp_drake.builder.time_series import time_series_header, time_series_rows
+from pbp_drake.systems.layouts import TaskStatus
+from pbp_drake.systems.tick import DECISION_LOG_SHIFT
+
+DEFAULT_CHUNK_SECONDS = 10.0
+
+
+def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diagram=None,
+                      chunk_seconds=DEFAULT_CHUNK_SECONDS, after_chunk=None):
+    """Simulates an HSR task until success or `scenario.duration` (the time limit), like
+    `run_task`, writing one CSV row per control tick to `log_path` (header first) as it goes.
+
+    Returns the TaskResult `run_task` would return, with the same metrics and peaks, but
+    whose time series (`times`, `ee_positions`, ..., `in_collision`) are empty (no ticks):
+    they are in the file. `after_chunk(time)`, when given, is called after each chunk is
+    written, with the simulated time reached.
+    """
+    scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
+                                                         diagram)
+    period = scenario.control_period
+    chunk_ticks = max(1, int(round(chunk_seconds / period)))
+    # One tick past the end, as run_task: the loggers record tick k's decisions one sample later.
+    last_tick = ticks_of(scenario) + 1
+    tail = _LogTail(diagram)
+    hand_speed, command_acceleration = _LargestStep(), _LargestStep()
+    context = simulator.get_context()
+    with open(log_path, "w", newline="") as stream:
+        stream.write(time_series_header(tail.has_collision))
+        tick = 0
+        while True:
+            tick = min(tick + chunk_ticks, last_tick)
+            reason = simulator.AdvanceTo(tick * period).reason()
+            series = tail.take(context)
+            stream.write(time_series_rows(series))
+            stream.flush()
+            hand_speed.add(series.ee_positions)
+            command_acceleration.add(series.commands[:, 3:6])
+            if after_chunk is not None:
+                after_chunk(context.get_time())
+            # The task monitor ends the simulation at success.
+            if (tick == last_tick
+                    or reason == SimulatorStatus.ReturnReason.kReachedTerminationCondition):
+                break
+    monitor = diagram.GetSubsystemByName("task_monitor")
+    status = TaskStatus(monitor.get_task_status_output_port().Eval(
+        monitor.GetMyContextFromRoot(context)))
+    return task_result(status, monitor, tail.empty_series(),
+                       hand_speed.peak(period), command_acceleration.peak(period))
+
+
+class _Series:
+    """A TaskResult's time series fields as attributes (what `time_series_rows` reads)."""
+
+    def __init__(self, fields):
+        self.__dict__.update(fields)
+        self.fields = fields
+
+
+class _LogTail:
+    """The samples read from the diagram's loggers and not yet written as rows."""
+
+    def __init__(self, diagram):
+        self._named = {name: diagram.GetSubsystemByName(name)
+                       for name in STATE_LOGS + DECISION_LOGS if diagram.HasSubsystemNamed(name)}
+        # Every logger, those not written too (phase_log): all are cleared.
+        self._all = [system for system in diagram.GetSystems()
+                     if isinstance(system, VectorLogSink)]
+        self._times = np.zeros(0)
+        self._samples = {name: np.zeros((0, logger.get_input_port().size()))
+                         for name, logger in self._named.items()}
+        self._to_skip = DECISION_LOG_SHIFT  # decision samples before tick 0's
+        self.has_collision = "in_collision_log" in self._named
+
+    def take(self, context):
+        """Reads the new samples of every logger and clears them all; returns the `_Series`
+        of the ticks whose state and decisions are both read, and keeps the rest."""
+        times = self._named["ee_state_log"].FindLog(context).sample_times()
+        self._times = np.concatenate([self._times, times])
+        for name, logger in self._named.items():
+            self._samples[name] = np.vstack([self._samples[name],
+                                             logger.FindLog(context).data().T])
+        for logger in self._all:
+            logger.FindMutableLog(context).Clear()
+        skipped = min(self._to_skip, len(self._samples[DECISION_LOGS[0]]))
+        for name in DECISION_LOGS:
+            self._samples[name] = self._samples[name][skipped:]
+        self._to_skip -= skipped
+        return self._split(len(self._samples[DECISION_LOGS[0]]))
+
+    def _split(self, count):
+        """The `_Series` of the first `count` pending ticks, which leave the tail. What
+        stays, and what is taken, are copies: a slice would keep alive the whole chunk it
+        was cut from (a streamed run's empty series held one chunk per run, 50 kB)."""
+        times, self._times = self._times[:count].copy(), self._times[count:].copy()
+        taken = {}
+        for name in self._samples:
+            taken[name], self._samples[name] = (self._samples[name][:count].copy(),
+                                                self._samples[name][count:].copy())
+        return _Series(series_fields(times, taken["ee_state_log"],
+                                     taken.get("in_collision_log"),
+                                     {name: taken[name] for name in DECISION_LOGS}))
+
+    def empty_series(self):
+        """The series fields of no ticks (what a streamed run's TaskResult holds)."""
+        return self._split(0).fields
+
+
+class _LargestStep:
+    """The largest step `max_k |x(k+1) - x(k)|` of a series fed in pieces, the step across
+    two pieces included: `motion_peaks` over a series never held whole."""
+
+    def __init__(self):
+        self._last = None
+        self._largest = None  # until two rows
+
+    def add(self, rows):
+        if len(rows) == 0:
+            return
+        rows = np.asarray(rows, float)
+        joined = rows if self._last is None else np.vstack([self._last, rows])
+        if len(joined) >= 2:
+            step = float(np.linalg.norm(np.diff(joined, axis=0), axis=1).max())
+            self._largest = step if self._largest is None else max(self._largest, step)
+        self._last = rows[-1:].copy()
+
+    def peak(self, control_period):
+        """The largest step over the period (as `motion_peaks`), or None before two rows."""
+        return None if self._largest is None else float(self._largest / control_period)

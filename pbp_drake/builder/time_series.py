@@ -1,0 +1,41 @@
+"""The per-tick time series of an HSR task as CSV: its columns and rows, one row per control
+tick. A study's trial files (`pbp_drake.studies.trial_files`) and a run streamed to disk
+(`pbp_drake.builder.streamed_run`) write the same format with these functions."""
+
+
+def time_series_columns(has_collision):
+    return ["time", "ee_x", "ee_y", "ee_z", "heading",
+            "command_x", "command_y", "command_z", "command_vx", "command_vy", "command_vz",
+            "command_heading", "operator_active",
+            "operator_vx", "operator_vy", "operator_vz", "operator_yaw_rate",
+            "selected_goal", "target"] + (["in_collision"] if has_collision else [])
+
+
+def time_series_header(has_collision):
+    """The CSV's header line, newline included."""
+    return ",".join(time_series_columns(has_collision)) + "\n"
+
+
+def time_series_rows(series):
+    """The CSV lines (newlines included, no header) of the per-tick series of `series`: a
+    TaskResult, or any object with its time series attributes (`times`, `ee_positions`,
+    `headings`, `commands`, `operator_active`, `operator_commands`, `selected_goals`,
+    `targets`, `in_collision`). Floats are written in their shortest exact form, so reading
+    them back gives the same numbers."""
+    has_collision = series.in_collision is not None
+    lines = []
+    for k in range(len(series.times)):
+        row = [series.times[k], *series.ee_positions[k], series.headings[k], *series.commands[k]]
+        row = [repr(float(x)) for x in row]
+        row.append(str(int(bool(series.operator_active[k]))))
+        row += [repr(float(x)) for x in series.operator_commands[k]]
+        row += [str(int(series.selected_goals[k])), str(int(series.targets[k]))]
+        if has_collision:
+            row.append(str(int(bool(series.in_collision[k]))))
+        lines.append(",".join(row) + "\n")
+    return "".join(lines)
+
+
+def time_series_csv(result):
+    """The per-tick time series of a TaskResult as CSV text, header first."""
+    return time_series_header(result.in_collision is not None) + time_series_rows(result)

@@ -1,0 +1,91 @@
+"""An HSR task streamed to a CSV file gives the run `run_task` gives: the same metrics and
+peaks, and the file holds the rows `run_task`'s series would (its loggers emptied as it
+goes). The soak keeps memory flat over several minutes of runs."""
+
+import dataclasses
+
+import pytest
+from pydrake.geometry import Meshcat, MeshcatParams
+
+from pbp_drake.builder import run_task, run_task_streamed
+from pbp_drake.builder.time_series import time_series_csv
+from pbp_drake.cli import main
+from pbp_drake.scenarios import load_scenario_file, resolve
+from pbp_drake.soak import run_soak
+from pbp_drake.studies.trial_files import read_time_series
+
+# Whole tasks: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
+
+METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio",
+           "peak_hand_speed", "peak_command_acceleration")
+
+
+@pytest.mark.parametrize("file_name, duration", [
+    ("hsr_reach.yaml", None),  # to success, target switches
+    ("hsr_obstacles.yaml", None),  # the in_collision column
+    ("hsr_reach.yaml", 3.0),  # stopped by the time limit
+])
+def test_a_streamed_run_matches_the_in_memory_run(repo, tmp_path, file_name, duration):
+    scenario = load_scenario_file(repo / "diagrams" / file_name).scenario
+    if duration is not None:
+        scenario = dataclasses.replace(scenario, duration=duration)
+    resolved = resolve(scenario)
+    in_memory = run_task(resolved)
+    log = tmp_path / "run.csv"
+    # Chunks of 0.7 s: many chunk boundaries, none on a whole second.
+    streamed = run_task_streamed(resolved, log, chunk_seconds=0.7)
+
+    assert in_memory.success == (duration is None)
+    for metric in METRICS:
+        assert getattr(streamed, metric) == getattr(in_memory, metric), metric
+    assert streamed.peak_hand_speed is not None
+    # Row for row what a study would write for the in-memory run, and readable as a trial's.
+    assert log.read_text() == time_series_csv(in_memory)
+    assert len(read_time_series(log, len(in_memory.times))["time"]) == len(in_memory.times)
+    # The series are in the file, not in the result, which holds on to no chunk of them
+    # (a run after run soak would keep every run's last chunk).
+    series = [streamed.times, streamed.ee_positions, streamed.headings, streamed.commands,
+              streamed.operator_active, streamed.operator_commands, streamed.selected_goals,
+              streamed.targets]
+    assert all(len(array) == 0 for array in series)
+    assert all((array if array.base is None else array.base).nbytes == 0 for array in series)
+
+
+def test_a_short_soak_keeps_memory_flat_and_logs_every_tick(tmp_path):
+    meshcat = Meshcat(MeshcatParams(host="localhost", port=None))
+    soak = run_soak(4, tmp_path, meshcat)
+
+    minutes = [simulated / 60 for simulated, _, _ in soak.samples]
+    assert len(minutes) == 4 and minutes[0] >= 1.0 and minutes[-1] == pytest.approx(4.0, abs=0.01)
+    assert soak.growth_percent < 10.0
+    assert all(result.success for result in soak.results[:-1])
+    period = 0.03
+    for path, result in zip(soak.log_paths, soak.results):
+        times = read_time_series(path)["time"]
+        # One row per tick, none missing or repeated: t_k = k * period.
+        assert times == pytest.approx([k * period for k in range(len(times))])
+        if result.success:  # to the tick before the one that reached the target, as run_task
+            assert times[-1] + period == pytest.approx(result.task_time)
+    total = sum(len(read_time_series(path)["time"]) for path in soak.log_paths)
+    assert total == pytest.approx(4 * 60 / period, abs=len(soak.results) + 1)
+
+
+def test_run_log_writes_the_rows_and_refuses_a_file_it_did_not_write(repo, tmp_path, capsys):
+    scenario = str(repo / "diagrams" / "hsr_reach.yaml")
+    notes = tmp_path / "notes.csv"
+    notes.write_text("my notes\n")
+    assert main(["run", scenario, "--operator", "virtual", "--headless", "--duration", "2",
+                 "--log", str(notes)]) == 2
+    assert "--log" in capsys.readouterr().err and notes.read_text() == "my notes\n"
+
+    log = tmp_path / "run.csv"
+    assert main(["run", scenario, "--operator", "virtual", "--headless", "--duration", "2",
+                 "--log", str(log)]) == 1  # 2 s is too short to reach the target
+    assert f"per-tick rows in {log}" in capsys.readouterr().out
+    # As run_task: rows of ticks 0..67 (a 2 s limit is 67 ticks; the run goes one tick past).
+    assert len(read_time_series(log)["time"]) == 68
+    # A time series it wrote may be overwritten.
+    assert main(["run", scenario, "--operator", "virtual", "--headless", "--duration", "1",
+                 "--log", str(log)]) == 1
+    assert len(read_time_series(log)["time"]) == 34

@@ -10,7 +10,7 @@ from pbp_drake.core.dmp import DmpBank as DmpBankMath
 from pbp_drake.core.dmp import DmpSettings, fit_weights
 from pbp_drake.systems.dmp_bank import DmpBank
 from pbp_drake.systems.participant_avoidance import (
-    PROGRESS_STEP, STALL_TIME, is_pushing_through, start_watch, update_watch)
+    PROGRESS_STEP, STALL_TIME, is_pushing_through, robot_closes_in, start_watch, update_watch)
 
 PERIOD = 0.03
 HAND_SPEED_LIMIT = 0.2
@@ -78,3 +78,13 @@ def test_once_pushing_a_participant_keeps_pushing_until_it_arrives():
     ticks = int(STALL_TIME / PERIOD) + 2
     watch = watch_after([0.62] * ticks + list(np.linspace(0.6, 0.1, 50)))
     assert is_pushing_through(watch)
+
+
+def test_near_the_target_a_participant_lets_a_robot_that_closes_in_finish_alone():
+    assert robot_closes_in([0.05, 0.0], [0.07, 0.0], nominal_speed=0.12)
+
+
+def test_near_the_target_a_participant_drives_a_robot_that_has_parked():
+    # The PBP-Alt DMP, its phase frozen early, balanced 8 cm short of the target.
+    assert not robot_closes_in([0.004, 0.003], [0.07, 0.04], nominal_speed=0.12)
+    assert not robot_closes_in([-0.03, 0.0], [0.07, 0.0], nominal_speed=0.12)

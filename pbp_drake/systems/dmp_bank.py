@@ -35,7 +35,9 @@ class DmpBank(LeafSystem):
     `(K, D)`. Each period the bank advances every DMP one step from the robot's position
     (keeping each DMP's own velocity; the first-order-hold step of `pbp_drake.core.dmp`). With
     `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the phases
-    and the DMPs follow the robot until the operator lets go.
+    and the DMPs follow the robot until the operator lets go. With `max_speed` (m/s), each
+    DMP's own velocity is scaled down to it before every step (anti-windup: PBP-Cont gives
+    the hand-over law's speed limit, which the hand can never exceed anyway).
 
     `followed_goal` (optional) is the index of the goal whose reference the robot followed
     since the last update (the goal estimator's selection, read before it updates). When it

@@ -90,8 +90,9 @@ class VirtualParticipant(SampledOperator):
     a fan of velocities and yaw rates over a short horizon (progress to the target, turning
     toward a heading whose footprint fits at the target, clearance), and in PBP it lets go
     whenever the DMP's path (pulled back to its start-target line) looks clear for a while.
-    In the last `FINAL_APPROACH` it no longer minds obstacles, and within `PUSH_THROUGH` it
-    pushes on when no clear way is left.
+    In the last `FINAL_APPROACH` it no longer minds obstacles (in PBP it drives there only
+    when the robot does not close in by itself), and within `PUSH_THROUGH`, or after
+    `participant_avoidance.STALL_TIME` without getting closer, it pushes on through.
 
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
     `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is

@@ -69,7 +69,12 @@ def make_pbp_controller(resolved, prediction_steps=0):
     dmp_bank = builder.AddNamedSystem("dmp_bank", DmpBank(
         bank, period, lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
         prediction_steps=prediction_steps,
-        prediction_period=bank.duration / max(prediction_steps, 1)))
+        prediction_period=bank.duration / max(prediction_steps, 1),
+        # PBP-Cont adds the operator to a DMP that keeps running: without the limit, an
+        # operator holding the hand off the DMP's path winds the DMP's velocity up past the
+        # hand's speed limit until it overrides them (the other modes never hold it so).
+        max_speed=(scenario.robot.max_hand_speed if resolved.blend_mode == "pbp_continuous"
+                   else None)))
     builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")

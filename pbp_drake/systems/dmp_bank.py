@@ -35,7 +35,9 @@ class DmpBank(LeafSystem):
     `(K, D)`. Each period the bank advances every DMP one step from the robot's position
     (keeping each DMP's own velocity; the first-order-hold step of `pbp_drake.core.dmp`). With
     `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the phases
-    and the DMPs follow the robot until the operator lets go.
+    and the DMPs follow the robot until the operator lets go. With `max_speed` (m/s), each
+    DMP's own velocity is scaled down to it before every step (anti-windup: PBP-Cont gives
+    the hand-over law's speed limit, which the hand can never exceed anyway).
 
     `followed_goal` (optional) is the index of the goal whose reference the robot followed
     since the last update (the goal estimator's selection, read before it updates). When it
@@ -71,9 +73,13 @@ class DmpBank(LeafSystem):
     """
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
-                 prediction_steps=0, update_offset=None, prediction_period=None):
+                 prediction_steps=0, update_offset=None, prediction_period=None,
+                 max_speed=None):
         super().__init__()
         self._bank = bank
+        # Anti-windup: the hand-over law never lets the hand move faster than this (m/s), so
+        # a DMP must not remember a faster velocity either (see `_update`).
+        self._max_speed = None if max_speed is None else float(max_speed)
         self._period = float(control_period)
         # Drawing a long horizon at the control period would cost hundreds of steps a frame;
         # the first-order-hold step stays close at coarser steps (second order in the step).
@@ -212,6 +218,8 @@ class DmpBank(LeafSystem):
                 # Every DMP continues from the velocity of the one the robot followed, so
                 # that a switch to another goal keeps the command's velocity.
                 z[...] = z[:, followed:followed + 1]
+            if self._max_speed is not None:
+                self._limit_speed(z)
         robot[:, 0] = robot_state[:d]
         if lock:
             # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
@@ -222,6 +230,18 @@ class DmpBank(LeafSystem):
         held[0] = 0.0
         bank.attractor_terms_into(phase, robot, goals_dk, period, dp, dz, workspace)
         phase *= bank.decay(period)
+
+    def _limit_speed(self, z):
+        """Scales each DMP's velocity (a column of `z`, times the duration) down to
+        `max_speed`. Without it, a DMP stepped from a robot that the operator holds off its
+        path (PBP-Cont adds the operator to the DMP, which keeps running) winds its own
+        velocity up toward `beta (g - y) / tau`, far above what the hand may do: the hand
+        then follows the DMP's direction whatever the operator asks, since the speed limit
+        scales their sum as one vector."""
+        speeds = np.linalg.norm(z, axis=0) / self._bank.duration
+        too_fast = speeds > self._max_speed
+        if np.any(too_fast):
+            z[:, too_fast] *= self._max_speed / speeds[too_fast]
 
     def _calc_goals_dk(self, context, value):
         goals = self._bank.goals_matrix(self._goals_port.Eval(context))

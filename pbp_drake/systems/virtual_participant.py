@@ -8,6 +8,8 @@ from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_o
 from pbp_drake.core.participant_reach import assist_motion, drive_motion, faces_target
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.layouts import EeState, OperatorCommand, Target, position_of
+from pbp_drake.systems.participant_avoidance import (
+    WATCH_SIZE, is_pushing_through, robot_closes_in, start_watch, update_watch)
 from pbp_drake.systems.participant_params import VirtualParticipantParams
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
@@ -70,8 +72,9 @@ class VirtualParticipant(SampledOperator):
     a fan of velocities and yaw rates over a short horizon (progress to the target, turning
     toward a heading whose footprint fits at the target, clearance), and in PBP it lets go
     whenever the DMP's path (pulled back to its start-target line) looks clear for a while.
-    In the last `FINAL_APPROACH` it no longer minds obstacles, and within `PUSH_THROUGH` it
-    pushes on when no clear way is left.
+    In the last `FINAL_APPROACH` it no longer minds obstacles (in PBP it drives there only
+    when the robot does not close in by itself), and within `PUSH_THROUGH`, or after
+    `participant_avoidance.STALL_TIME` without getting closer, it pushes on through.
 
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
     `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is
@@ -120,8 +123,10 @@ class VirtualParticipant(SampledOperator):
             self._obstacles_port = self.DeclareVectorInputPort(
                 "obstacle_positions", 2 * int(obstacle_count))
             # [seen (0/1), the hand's start (2), ticks it still keeps control,
-            #  the obstacles' positions at the last tick (2N)].
-            self._track_index = self.DeclareDiscreteState(np.zeros(4 + 2 * int(obstacle_count)))
+            #  the obstacles' positions at the last tick (2N), the stall watch of
+            #  `participant_avoidance` (WATCH_SIZE)].
+            self._track_index = self.DeclareDiscreteState(
+                np.zeros(4 + 2 * int(obstacle_count) + WATCH_SIZE))
         # What the participant believes: the target index it knows and how many ticks a
         # different target has been on screen.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
@@ -178,13 +183,16 @@ class VirtualParticipant(SampledOperator):
         obstacles = self._obstacles_port.Eval(context).reshape(-1, 2)
         track = np.array(context.get_discrete_state(self._track_index).value())
         count = len(obstacles)
+        remembered = slice(4, 4 + 2 * count)
+        watch = slice(4 + 2 * count, None)
         if track[0] < 0.5:
-            track[0], track[1:3], track[4:] = 1.0, hand, obstacles.reshape(-1)
+            track[0], track[1:3], track[remembered] = 1.0, hand, obstacles.reshape(-1)
+            track[watch] = start_watch(np.linalg.norm(target_xy - hand))
         start = track[1:3]
-        obstacle_velocity = (obstacles - track[4:].reshape(count, 2)) / self._period
+        obstacle_velocity = (obstacles - track[remembered].reshape(count, 2)) / self._period
         hold = track[3]
         track[3] = max(hold - 1.0, 0.0)
-        track[4:] = obstacles.reshape(-1)
+        track[remembered] = obstacles.reshape(-1)
         held = self._held(context)
         was_active = held[4] > 0.5
         last_command = held[:2] if was_active else np.zeros(2)
@@ -201,9 +209,12 @@ class VirtualParticipant(SampledOperator):
         distance = np.linalg.norm(offset)
         noise_angle, speed_scale = self._noise(context)
         drive = self._mode == "drive"
+        track[watch] = update_watch(track[watch], distance, self._period)
+        pushing_through = is_pushing_through(track[watch])
         if distance < FINAL_APPROACH:
-            # The last few centimetres: straight on, whatever stands there.
-            if not drive:
+            # The last few centimetres: straight on, whatever stands there; in PBP only
+            # when the robot does not get there by itself.
+            if not drive and robot_closes_in(velocity, offset, self._speed):
                 return finish(np.zeros(4), False, 0.0)
             speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
             step = speed * rotate_planar(offset / max(distance, 1e-9), noise_angle)
@@ -215,7 +226,7 @@ class VirtualParticipant(SampledOperator):
                                      np.array([SETTLE_TIME]))[0]
         goal_heading = self._goal_heading(heading, target_xy, settled)
         heading_gap = abs(wrap_angle(heading - goal_heading))
-        if not drive:
+        if not drive and not pushing_through:
             # Would the policy, left alone, keep the robot clear?
             policy_clear = footprint_clearance(
                 policy_path(hand, start, target_xy, self._speed, PLAN_TIMES), heading,
@@ -234,8 +245,9 @@ class VirtualParticipant(SampledOperator):
 
         planned, yaw_rate, clear = self._plan(hand, heading, target_xy, predicted,
                                               goal_heading, last_command)
-        if clear < 0.0 and distance < PUSH_THROUGH:
-            # Boxed in next to the target: on through it, as people did.
+        if pushing_through or (clear < 0.0 and distance < PUSH_THROUGH):
+            # Boxed in next to the target, or no closer for a long while
+            # (`participant_avoidance`): on through, as people did.
             planned = self._speed * min(1.0, distance / self._slow_radius) * offset / distance
             yaw_rate = 0.0
         command = speed_scale * rotate_planar(planned, noise_angle)

@@ -1,0 +1,90 @@
+"""The two causes of the obstacle task's failures, each checked on its own: a DMP held off
+its path by the operator in PBP-Cont must not wind its velocity up past the hand's speed
+limit (it then overrode the operator and dragged the robot through the cylinders), and a
+participant whose way round has stalled must push on instead of waiting for ever."""
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+
+from pbp_drake.core.dmp import DmpBank as DmpBankMath
+from pbp_drake.core.dmp import DmpSettings, fit_weights
+from pbp_drake.systems.dmp_bank import DmpBank
+from pbp_drake.systems.participant_avoidance import (
+    PROGRESS_STEP, STALL_TIME, is_pushing_through, robot_closes_in, start_watch, update_watch)
+
+PERIOD = 0.03
+HAND_SPEED_LIMIT = 0.2
+
+
+def straight_reach_bank():
+    """One DMP of a 1 m straight reach along x, 8 s long (0.125 m/s on average)."""
+    settings = DmpSettings(basis_count=20)
+    times = np.linspace(0.0, 8.0, 200)
+    s = times / times[-1]
+    path = np.stack([10 * s**3 - 15 * s**4 + 6 * s**5, 0 * s, 0 * s], 1)
+    weights, scaling = fit_weights(times, path, settings)
+    return DmpBankMath(weights, np.zeros(3), 8.0, settings, scaling, goal_count=1)
+
+
+def peak_reference_speed_while_held(max_speed):
+    """The fastest reference velocity over 12 s of a DMP whose robot the operator holds
+    at its start, a metre from the goal (PBP-Cont: the phase runs on)."""
+    system = DmpBank(straight_reach_bank(), PERIOD, max_speed=max_speed)
+    context = system.CreateDefaultContext()
+    system.get_robot_state_input_port().FixValue(context, np.zeros(6))
+    system.get_goals_input_port().FixValue(context, [1.0, 0.0, 0.0])
+    system.get_operator_active_input_port().FixValue(context, [1.0])
+    simulator = Simulator(system, context)
+    peak = 0.0
+    for tick in range(int(12.0 / PERIOD)):
+        simulator.AdvanceTo((tick + 0.9) * PERIOD)
+        velocity = system.get_references_output_port().Eval(context).reshape(2, 3)[1]
+        peak = max(peak, np.linalg.norm(velocity))
+    return peak
+
+
+def test_a_held_dmp_winds_up_past_the_hand_speed_limit_without_the_limit():
+    assert peak_reference_speed_while_held(None) > 2 * HAND_SPEED_LIMIT
+
+
+def test_a_held_dmp_stays_near_the_hand_speed_limit_with_it():
+    # One step of the attractor on top of the limited velocity exceeds it a little (the
+    # hand-over law caps that); without the limit this DMP reaches 0.79 m/s.
+    assert peak_reference_speed_while_held(HAND_SPEED_LIMIT) < 1.3 * HAND_SPEED_LIMIT
+
+
+def watch_after(distances):
+    watch = start_watch(distances[0])
+    for distance in distances[1:]:
+        watch = update_watch(watch, distance, PERIOD)
+    return watch
+
+
+def test_a_participant_parked_before_a_wall_pushes_through_once_it_has_waited():
+    ticks = int(STALL_TIME / PERIOD)
+    parked = [0.62] * (ticks + 2)
+    assert not is_pushing_through(watch_after(parked[: ticks - 5]))
+    assert is_pushing_through(watch_after(parked))
+
+
+def test_a_participant_that_keeps_getting_closer_never_pushes_through():
+    # 1 cm a second, slower than any real run: every PROGRESS_STEP resets the wait.
+    distances = 1.0 - 0.01 * PERIOD * np.arange(int(10 * STALL_TIME / PERIOD))
+    assert PROGRESS_STEP / 0.01 < STALL_TIME
+    assert not is_pushing_through(watch_after(distances))
+
+
+def test_once_pushing_a_participant_keeps_pushing_until_it_arrives():
+    ticks = int(STALL_TIME / PERIOD) + 2
+    watch = watch_after([0.62] * ticks + list(np.linspace(0.6, 0.1, 50)))
+    assert is_pushing_through(watch)
+
+
+def test_near_the_target_a_participant_lets_a_robot_that_closes_in_finish_alone():
+    assert robot_closes_in([0.05, 0.0], [0.07, 0.0], nominal_speed=0.12)
+
+
+def test_near_the_target_a_participant_drives_a_robot_that_has_parked():
+    # The PBP-Alt DMP, its phase frozen early, balanced 8 cm short of the target.
+    assert not robot_closes_in([0.004, 0.003], [0.07, 0.04], nominal_speed=0.12)
+    assert not robot_closes_in([-0.03, 0.0], [0.07, 0.0], nominal_speed=0.12)

@@ -40,35 +40,32 @@ def check_record_path(path, force=False):
     """Raises OutputPathError unless `path` can take a replay: not a folder, its folder
     exists or can be made and is writable, and an existing file there is a previous replay
     (or `force` is set)."""
-    record = pathlib.Path(path)
-    if record.is_dir():
-        raise OutputPathError(f"--record {record}: is a folder; give a file, e.g. "
-                              f"{record / 'replay.html'}")
-    if record.exists() or record.is_symlink():
-        if not force and not is_replay(record):
-            raise OutputPathError(f"--record {record}: the file exists and is not a replay "
-                                  f"written by pbp-drake; add --force to overwrite it")
-        if not os.access(record, os.W_OK):
-            raise OutputPathError(f"--record {record}: the file is not writable")
-        return
-    _check_can_create(record.parent, f"--record {record}")
+    _check_output_file(path, "--record", "replay.html", is_replay, "a replay", force)
 
 
 def check_log_path(path, force=False):
     """Raises OutputPathError unless `path` can take a run's per-tick CSV: not a folder, its
     folder exists or can be made and is writable, and an existing file there is a previous
     time series CSV (its header is the trial CSV's) or `force` is set."""
-    log = pathlib.Path(path)
-    if log.is_dir():
-        raise OutputPathError(f"--log {log}: is a folder; give a file, e.g. {log / 'run.csv'}")
-    if log.exists() or log.is_symlink():
-        if not force and not _is_time_series(log):
-            raise OutputPathError(f"--log {log}: the file exists and is not a time series "
+    _check_output_file(path, "--log", "run.csv", _is_time_series, "a time series", force)
+
+
+def _check_output_file(path, flag, example, is_ours, kind, force):
+    """The checks both output files share: `path` is not a folder (`example` names a file
+    in it), an existing file there is one `is_ours` recognises (`kind`, written by
+    pbp-drake) or `force` is set, and it or its folder is writable."""
+    file = pathlib.Path(path)
+    if file.is_dir():
+        raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
+                              f"{file / example}")
+    if file.exists() or file.is_symlink():
+        if not force and not is_ours(file):
+            raise OutputPathError(f"{flag} {file}: the file exists and is not {kind} "
                                   f"written by pbp-drake; add --force to overwrite it")
-        if not os.access(log, os.W_OK):
-            raise OutputPathError(f"--log {log}: the file is not writable")
+        if not os.access(file, os.W_OK):
+            raise OutputPathError(f"{flag} {file}: the file is not writable")
         return
-    _check_can_create(log.parent, f"--log {log}")
+    _check_can_create(file.parent, f"{flag} {file}")
 
 
 def _is_time_series(path):

@@ -76,8 +76,8 @@ bench: $(VENV)/.installed-bench
 	$(VENV)/bin/python -m pbp_drake.bench
 
 # An hour of simulated time of the HSR reaching task with Meshcat on, runs back to back in
-# one process; fails when memory grows 10 % or more after the first minute (20-25 minutes
-# of wall time on a shared 2-core machine).
+# one process; fails when memory grows 10 % or more after the first minute (about 15
+# minutes of wall time on an idle 2-core machine, 25 on a shared one).
 soak: $(STAMP)
 	$(PYTHON) -m pbp_drake.soak --minutes 60
 

@@ -167,27 +167,51 @@ def motion_peaks(ee_positions, command_velocities, control_period):
     max_k |ee(t_{k+1}) - ee(t_k)| / control_period (m/s) over the hand positions `(T, 3)`,
     and max_k |v(k+1) - v(k)| / control_period (m/s^2) over the commanded velocities
     `(T, 3)`; (None, None) with fewer than two ticks."""
-    if len(ee_positions) < 2:
-        return None, None
+    hand, command = LargestStep(), LargestStep()
+    hand.add(ee_positions)
+    command.add(command_velocities)
+    return hand.peak(control_period), command.peak(control_period)
 
-    def peak(series):
-        steps = np.linalg.norm(np.diff(np.asarray(series, float), axis=0), axis=1)
-        return float(steps.max() / control_period)
 
-    return peak(ee_positions), peak(command_velocities)
+class LargestStep:
+    """The largest step `max_k |x(k+1) - x(k)|` of a series, fed whole (`motion_peaks`) or
+    in pieces (a streamed run), the step across two pieces included."""
+
+    def __init__(self):
+        self._last = None
+        self._largest = None  # until two rows
+
+    def add(self, rows):
+        if len(rows) == 0:
+            return
+        rows = np.asarray(rows, float)
+        joined = rows if self._last is None else np.vstack([self._last, rows])
+        if len(joined) >= 2:
+            step = float(np.linalg.norm(np.diff(joined, axis=0), axis=1).max())
+            self._largest = step if self._largest is None else max(self._largest, step)
+        self._last = rows[-1:].copy()
+
+    def peak(self, control_period):
+        """The largest step over the period, or None before two rows."""
+        return None if self._largest is None else float(self._largest / control_period)
 
 
 def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None):
     """Simulates an HSR task until success or `scenario.duration` (the time limit)."""
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
                                                          diagram)
-    monitor = diagram.GetSubsystemByName("task_monitor")
-    status_port = monitor.get_task_status_output_port()
     # The task monitor itself ends the simulation at success.
     simulator.AdvanceTo((ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()
-    status = TaskStatus(status_port.Eval(monitor.GetMyContextFromRoot(context)))
+    status, monitor = final_status(diagram, context)
     return _read_result(diagram, context, status, monitor, scenario.control_period)
+
+
+def final_status(diagram, context):
+    """`(TaskStatus, task monitor)` of a task's diagram once its simulation has ended."""
+    monitor = diagram.GetSubsystemByName("task_monitor")
+    return TaskStatus(monitor.get_task_status_output_port().Eval(
+        monitor.GetMyContextFromRoot(context))), monitor
 
 
 # The loggers that hold decisions (read `DECISION_LOG_SHIFT` samples later, see read_log)

@@ -19,9 +19,9 @@ from pydrake.systems.analysis import SimulatorStatus
 from pydrake.systems.primitives import VectorLogSink
 
 from pbp_drake.builder.run import (
-    DECISION_LOGS, STATE_LOGS, initialized_simulator, series_fields, task_result, ticks_of)
+    DECISION_LOGS, STATE_LOGS, LargestStep, final_status, initialized_simulator,
+    series_fields, task_result, ticks_of)
 from pbp_drake.builder.time_series import time_series_header, time_series_rows
-from pbp_drake.systems.layouts import TaskStatus
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
 
 DEFAULT_CHUNK_SECONDS = 10.0
@@ -44,7 +44,7 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
     # One tick past the end, as run_task: the loggers record tick k's decisions one sample later.
     last_tick = ticks_of(scenario) + 1
     tail = _LogTail(diagram)
-    hand_speed, command_acceleration = _LargestStep(), _LargestStep()
+    hand_speed, command_acceleration = LargestStep(), LargestStep()
     context = simulator.get_context()
     with open(log_path, "w", newline="") as stream:
         stream.write(time_series_header(tail.has_collision))
@@ -63,9 +63,7 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
             if (tick == last_tick
                     or reason == SimulatorStatus.ReturnReason.kReachedTerminationCondition):
                 break
-    monitor = diagram.GetSubsystemByName("task_monitor")
-    status = TaskStatus(monitor.get_task_status_output_port().Eval(
-        monitor.GetMyContextFromRoot(context)))
+    status, monitor = final_status(diagram, context)
     return task_result(status, monitor, tail.empty_series(),
                        hand_speed.peak(period), command_acceleration.peak(period))
 
@@ -125,26 +123,3 @@ class _LogTail:
     def empty_series(self):
         """The series fields of no ticks (what a streamed run's TaskResult holds)."""
         return self._split(0).fields
-
-
-class _LargestStep:
-    """The largest step `max_k |x(k+1) - x(k)|` of a series fed in pieces, the step across
-    two pieces included: `motion_peaks` over a series never held whole."""
-
-    def __init__(self):
-        self._last = None
-        self._largest = None  # until two rows
-
-    def add(self, rows):
-        if len(rows) == 0:
-            return
-        rows = np.asarray(rows, float)
-        joined = rows if self._last is None else np.vstack([self._last, rows])
-        if len(joined) >= 2:
-            step = float(np.linalg.norm(np.diff(joined, axis=0), axis=1).max())
-            self._largest = step if self._largest is None else max(self._largest, step)
-        self._last = rows[-1:].copy()
-
-    def peak(self, control_period):
-        """The largest step over the period (as `motion_peaks`), or None before two rows."""
-        return None if self._largest is None else float(self._largest / control_period)

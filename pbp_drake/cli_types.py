@@ -43,3 +43,8 @@ def wait_seconds(text):
     if value < 0:
         raise argparse.ArgumentTypeError(f"{text!r}: give a number of seconds, 0 or more")
     return value
+
+
+def method_list(text):
+    """`--methods a,b,c` as a list."""
+    return [method.strip() for method in text.split(",") if method.strip()]

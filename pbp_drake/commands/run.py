@@ -1,0 +1,246 @@
+"""`pbp-drake run`: one scenario in Meshcat, or a participant's session of a user study."""
+
+import dataclasses
+import pathlib
+import sys
+import time
+
+import numpy as np
+from pydrake.geometry import Meshcat, MeshcatParams, Rgba
+
+from pbp_drake.builder import build_diagram, run_task, run_task_streamed, simulate
+from pbp_drake.cli_types import method_list, port, realtime_rate, wait_seconds
+from pbp_drake.core.toy_scene import collision_ratio
+from pbp_drake.output_paths import (
+    check_log_path, check_output_folder, check_record_path, mark_replay)
+from pbp_drake.scenarios import (
+    METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, ScenarioError, load_scenario_file,
+    resolve, with_method)
+from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
+
+
+def add_run_command(commands):
+    """The `run` subcommand and its arguments."""
+    run = commands.add_parser("run", help="simulate one scenario in Meshcat")
+    run.add_argument("scenario", help="a scenario file, e.g. diagrams/toy_alpha_study.yaml")
+    run.add_argument("--method", help=f"override the scenario's method: {', '.join(METHODS)}")
+    run.add_argument("--alpha", type=float, help="override alpha (fixed_alpha)")
+    run.add_argument("--scene", help="use the obstacles of this scene of the file's study")
+    run.add_argument("--operator", help="HSR tasks: who drives, one of "
+                     f"{', '.join(OPERATOR_NAMES)} (keyboard and gamepad: in the browser)")
+    run.add_argument("--seed", type=int, help="HSR tasks: the seed of the scene and the noise")
+    run.add_argument("--participant", metavar="ID",
+                     help="HSR tasks: a user-study session; every method of --methods once, "
+                     "in an order counterbalanced across participants, saved in the study "
+                     "format under --output (`pbp-drake report` reads it)")
+    run.add_argument("--methods", help="with --participant: the methods of the session "
+                     "(default: pbp_alternated,pbp_continuous,teleop)")
+    run.add_argument("--output", help="with --participant: the session's folder "
+                     "(default: outputs/participants/ID)")
+    run.add_argument("--headless", action="store_true",
+                     help="simulate as fast as possible without waiting for a browser")
+    run.add_argument("--record", metavar="FILE.html",
+                     help="save a self-contained replay of the run")
+    run.add_argument("--log", metavar="FILE.csv", help="HSR tasks: write the per-tick rows to "
+                     "this CSV as the task runs (nothing of them kept in memory)")
+    run.add_argument("--force", action="store_true",
+                     help="let --record (--log) overwrite an existing file that is not a "
+                     "replay (time series)")
+    run.add_argument("--duration", type=float, metavar="SECONDS",
+                     help="override the scenario's duration (for HSR tasks, the time limit)")
+    run.add_argument("--realtime-rate", type=realtime_rate, default=1.0, metavar="RATE",
+                     help="target simulated seconds per wall second, positive (default 1; "
+                     "--headless runs as fast as possible)")
+    run.add_argument("--port", type=port, default=0,
+                     help="Meshcat port, 0..65535 (default 0: a free one)")
+    run.add_argument("--wait-for-browser", type=wait_seconds, default=15.0, metavar="SECONDS",
+                     help="before starting, wait this long for a browser to open the page "
+                     "(default 15); a keyboard or gamepad run that no browser joins in time "
+                     "stops with exit 2, having run and recorded nothing")
+    run.set_defaults(handler=_run)
+
+
+def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operator=None,
+                     seed=None, duration=None):
+    """The file's resolved scenario with the command line's overrides applied: resolved again
+    only when an override changes what is derived (a method or alpha does not)."""
+    scenario = scenario_file.scenario
+    if duration is not None:
+        if not (np.isfinite(duration) and duration > 0):
+            raise ScenarioError(f"--duration {duration:g} must be a positive number of "
+                                "seconds")
+        scenario = dataclasses.replace(scenario, duration=duration)
+    if operator is not None:
+        if operator not in OPERATOR_NAMES:
+            raise ScenarioError(f"--operator {operator!r} is unknown; choose one of "
+                                f"{list(OPERATOR_NAMES)}")
+        if not isinstance(scenario.robot, Hsr):
+            raise ScenarioError("--operator chooses who drives the HSR tasks; this scenario "
+                                "uses the 2-D toy robot")
+        if not isinstance(scenario.operator, OPERATOR_NAMES[operator]):
+            scenario = dataclasses.replace(scenario, operator=OPERATOR_NAMES[operator]())
+    if seed is not None:
+        scenario = dataclasses.replace(scenario, seed=seed)
+    if scene is not None:
+        scenes = getattr(scenario_file.study, "scenes", [])
+        names = [s.name for s in scenes]
+        if scene not in names:
+            raise ScenarioError(f"--scene {scene!r} is not in this file's study; scenes: {names}")
+        chosen = scenes[names.index(scene)]
+        scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{scene}",
+                                       obstacles=list(chosen.obstacles))
+    try:
+        resolved = (scenario_file.resolved if scenario is scenario_file.scenario
+                    else resolve(scenario))
+        method = method or scenario.method
+        if alpha is not None:
+            if method != "fixed_alpha":
+                raise ScenarioError(f"--alpha sets the weight of fixed_alpha; the method is "
+                                    f"{method}")
+            method = f"fixed_alpha={alpha}"
+        if method != scenario.method or alpha is not None:
+            resolved = resolved.with_method(method)
+    except ScenarioError as error:
+        raise ScenarioError(f"{error} (after the command-line overrides)") from None
+    return resolved
+
+
+def _run(args):
+    # The paths first: a bad one must not cost a run, let alone a person's session.
+    if args.record:
+        check_record_path(args.record, force=args.force)
+    if args.log:
+        check_log_path(args.log, force=args.force)
+    if args.output is not None:
+        check_output_folder(args.output)
+    resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
+                                args.scene, args.operator, args.seed, args.duration)
+    scenario = resolved.scenario
+    meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
+    print(f"Meshcat: {meshcat.web_url()}", flush=True)
+    if resolved.is_hsr:
+        return _run_task(args, resolved, meshcat)
+    if args.log:
+        raise ScenarioError("--log streams an HSR task's per-tick rows; this scenario uses "
+                            "the 2-D toy robot")
+    diagram = build_diagram(resolved, meshcat)
+    if not args.headless and sys.stdin.isatty():
+        _wait_for_browser(meshcat, args.wait_for_browser)
+    if args.record:
+        meshcat.StartRecording(frames_per_second=30.0)
+    trajectory = simulate(resolved, realtime_rate=0.0 if args.headless else args.realtime_rate,
+                          diagram=diagram)
+    positions = np.zeros((len(trajectory.positions), 3))
+    positions[:, :trajectory.positions.shape[1]] = trajectory.positions[:, :3]
+    meshcat.SetLine("/pbp/executed", positions.T, 2.0, Rgba(0.1, 0.3, 0.9, 1.0))
+    ratio = collision_ratio(trajectory.positions, [o.center for o in scenario.obstacles],
+                            [o.radius for o in scenario.obstacles])
+    if args.record:
+        _save_recording(meshcat, args.record)
+    print(f"{scenario.name} [{scenario.method}]: final position "
+          f"{np.array2string(trajectory.positions[-1], precision=3)}, collision ratio "
+          f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}")
+    if not args.headless and sys.stdin.isatty():
+        input("Press Enter to quit (the page stays live until then). ")
+    return 0
+
+
+def _run_task(args, resolved, meshcat):
+    scenario = resolved.scenario
+    person = isinstance(scenario.operator, (Keyboard, Gamepad))
+    if args.headless and person:
+        raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
+                            "--operator virtual")
+    if args.participant is not None:
+        return _run_session(args, resolved, meshcat, person)
+    if args.methods is not None or args.output is not None:
+        raise ScenarioError("--methods and --output belong to a session: add --participant ID")
+    diagram = build_diagram(resolved, meshcat)
+    if person or (not args.headless and sys.stdin.isatty()):
+        # A person needs the page open before the task starts.
+        print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
+              f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
+        if person:
+            print("Keys: arrows move the hand (forward only in teleop), Q and E turn it.",
+                  flush=True)
+        _wait_for_browser(meshcat, args.wait_for_browser, person)
+    if args.record:
+        meshcat.StartRecording(frames_per_second=30.0)
+    rate = 0.0 if args.headless else args.realtime_rate
+    result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram)
+              if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram))
+    if args.record:
+        _save_recording(meshcat, args.record)
+    hand = ""
+    if len(result.ee_positions):
+        hand = ", hand at [" + ", ".join(f"{x:.3f}" for x in result.ee_positions[-1]) + "]"
+    if args.log:
+        hand = f"; per-tick rows in {args.log}"
+    print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
+          f"{result.summary_line()}{hand}", flush=True)
+    if not args.headless and sys.stdin.isatty():
+        input("Press Enter to quit (the page stays live until then). ")
+    return 0 if result.success else 1
+
+
+def _run_session(args, resolved, meshcat, person):
+    scenario = resolved.scenario
+    if args.record or args.log:
+        raise ScenarioError("--record and --log save one run; a session saves every run under "
+                            "--output")
+    methods = method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
+    for method in methods:
+        with_method(scenario, method)
+    try:
+        order = session_order(methods, args.participant)
+    except ValueError as error:
+        raise ScenarioError(f"--participant: {error}") from None
+    output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
+                                                       args.participant))
+    print(f"Participant {args.participant}: {', '.join(order)}, in this order; saved in "
+          f"{output}", flush=True)
+    if person:
+        print(f"Open {meshcat.web_url()} in a browser; the session starts when it connects "
+              f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
+        _wait_for_browser(meshcat, args.wait_for_browser, person)
+
+    def run_one(trial):
+        diagram = build_diagram(trial, meshcat)
+        print(f"Next: {trial.scenario.method}.", flush=True)
+        if person and sys.stdin.isatty():
+            input("Press Enter to start. ")
+        result = run_task(trial, realtime_rate=0.0 if args.headless else
+                          args.realtime_rate, diagram=diagram)
+        operator = diagram.GetSubsystemByName("operator")
+        if hasattr(operator, "Delete"):
+            operator.Delete()  # the next method may want other keys
+        print(f"  {trial.scenario.method}: {result.summary_line()}", flush=True)
+        return result
+
+    summary = run_session(scenario, args.participant, methods, output, run_one)
+    failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
+    print(f"Session saved in {output} (`pbp-drake report {output}` rebuilds its tables).")
+    return 1 if failed else 0
+
+
+def _wait_for_browser(meshcat, seconds, person=False):
+    """Waits up to `seconds` for a browser on the page. A person's run (keyboard, gamepad)
+    cannot go on without one: it stops with exit 2 before anything runs or is recorded."""
+    deadline = time.monotonic() + seconds
+    while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    if person and meshcat.GetNumActiveConnections() == 0:
+        raise ScenarioError(f"no browser opened {meshcat.web_url()} within {seconds:g} s "
+                            "(--wait-for-browser): the keyboard and gamepad are read in the "
+                            "page, so nothing was run or recorded")
+
+
+def _save_recording(meshcat, path):
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    record = pathlib.Path(path)
+    record.parent.mkdir(parents=True, exist_ok=True)
+    record.write_text(mark_replay(meshcat.StaticHtml()))
+    print(f"Replay saved to {record}")
+
+

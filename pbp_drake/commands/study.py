@@ -1,0 +1,166 @@
+"""`pbp-drake study` (a scenario file's study) and `pbp-drake report` (a study folder's
+tables and figures, rebuilt from its trial files)."""
+
+import dataclasses
+import pathlib
+import sys
+import time
+
+from pbp_drake.cli_types import method_list
+from pbp_drake.output_paths import check_output_folder
+from pbp_drake.scenarios import (
+    Hsr, MethodComparison, ScenarioError, check_method_comparison, load_scenario_file)
+from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.progress import ProgressBar
+from pbp_drake.studies.report import FIGURES, report, results_table
+from pbp_drake.studies.splits import SPLITS, first_seed, split_of
+from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
+
+
+def add_study_commands(commands):
+    """The `study` and `report` subcommands and their arguments."""
+    study = commands.add_parser("study", help="run the study a scenario file describes")
+    study.add_argument("scenario", help="a scenario file with a `study:` section")
+    study.add_argument("--output", required=True, help="folder for summary.json and figures")
+    study.add_argument("--methods", help="comma-separated methods to compare (HSR tasks)")
+    study.add_argument("--trials", type=int, help="seeded scenes per method (HSR tasks)")
+    study.add_argument("--split", choices=SPLITS,
+                       help="HSR tasks: run the study's tuning or evaluation seeds (default: "
+                            "the study's `split`)")
+    study.add_argument("--seed", type=int, help="the first scene's seed (HSR tasks; results "
+                       "are labelled with the split the seeds fall in)")
+    study.add_argument("--jobs", type=int, default=1,
+                       help="HSR tasks: trials run in this many processes at once (default 1)")
+    study.add_argument("--backend", choices=("local", "ray"), default="local",
+                       help="HSR tasks: run the trials in local processes (default) or as "
+                       "Ray tasks, at most --jobs at once (needs: pip install "
+                       "'pbp_drake[ray]')")
+    study.add_argument("--ray-address", metavar="ADDRESS",
+                       help="with --backend ray: the Ray cluster to use, e.g. auto or "
+                       "ray://HEAD:10001 (its workers must have pbp_drake installed); "
+                       "default: start a local Ray with --jobs CPUs")
+    study.add_argument("--retry-errors", action="store_true",
+                       help="HSR tasks: run again the trials on disk that failed with an error")
+
+    report = commands.add_parser(
+        "report", help="rebuild the summary, table and figures of a study folder from its "
+        "trial files, without simulating; damaged or foreign files are named on stderr and "
+        "skipped (exit 1 when there were any, or when trials failed with an error or did not "
+        "run, as `study` does; 2 when there is nothing to report)")
+    report.add_argument("output", help="the --output folder of `pbp-drake study`")
+    study.set_defaults(handler=_study)
+    report.set_defaults(handler=_report)
+
+
+def _study(args):
+    check_output_folder(args.output)
+    scenario_file = load_scenario_file(args.scenario)
+    if isinstance(scenario_file.scenario.robot, Hsr):
+        return _method_study(args, scenario_file)
+    if scenario_file.study is None:
+        raise ScenarioError(f"{args.scenario}: has no `study:` section to run")
+    output = pathlib.Path(args.output)
+    started = time.monotonic()
+    summary = run_study(scenario_file, output)
+    print(f"Study {summary['study']} done in {time.monotonic() - started:.1f} s.")
+    if summary["study"] == "alpha_study":
+        print_alpha_study(summary)
+    else:
+        for method, mode in summary["modes"].items():
+            print(f"  {method}: final error {mode['final_error'] * 100:.2f} cm, phase constant "
+                  f"while the operator acts: {mode['phase_constant_while_operator_acts']}, "
+                  f"strictly increasing: {mode['phase_strictly_increasing']}")
+    for name in ("summary.json", TOY_FIGURES[summary["study"]]):
+        print(f"  wrote {output / name}")
+    return 0
+
+
+def _method_study(args, scenario_file):
+    study = scenario_file.study or MethodComparison()
+    if not isinstance(study, MethodComparison):
+        raise ScenarioError(f"{args.scenario}: HSR tasks take study: !MethodComparison")
+    if args.methods is not None:
+        study = dataclasses.replace(study, methods=method_list(args.methods))
+    if args.trials is not None:
+        study = dataclasses.replace(study, trials=args.trials)
+    if args.split is not None:
+        study = dataclasses.replace(study, split=args.split)
+    seed = first_seed(study, study.split) if args.seed is None else args.seed
+    split = split_of(study, seed, study.trials)
+    if args.jobs < 1:
+        raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
+    if args.ray_address is not None and args.backend != "ray":
+        raise ScenarioError("--ray-address needs --backend ray")
+    if len(set(study.methods)) != len(study.methods):
+        raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
+    try:
+        check_method_comparison(study, scenario_file.scenario)
+    except ScenarioError as error:
+        raise ScenarioError(f"{error} (after the command-line overrides)") from None
+    output = pathlib.Path(args.output)
+    total = len(study.methods) * study.trials
+    print(f"Study {scenario_file.scenario.name}: {', '.join(study.methods)}, "
+          f"{study.trials} trials each ({split} seeds {seed} to {seed + study.trials - 1}),"
+          f" {args.jobs} job{'s' if args.jobs > 1 else ''}"
+          + ("" if args.backend == "local" else
+             f" on Ray ({args.ray_address or 'local'})") + f", into {output}", flush=True)
+    bar = ProgressBar()
+    runs = []
+
+    def progress(done, total_now, record, elapsed):
+        runs.append(done)
+        bar(done, total_now, record, elapsed)
+
+    started = time.monotonic()
+    try:
+        summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
+                                        seed, output, progress, jobs=args.jobs, split=split,
+                                        retry_errors=args.retry_errors,
+                                        backend=args.backend, ray_address=args.ray_address)
+    except KeyboardInterrupt:
+        print(f"\nInterrupted: the finished trials are in {output / 'trials'}; the same "
+              "command resumes the study.", file=sys.stderr)
+        return 130
+    reused = total - len(runs)
+    print(f"Ran {len(runs)} trials in {time.monotonic() - started:.1f} s"
+          + (f"; {reused} were already on disk." if reused else "."), flush=True)
+    _print_report(summary, output)
+    return _failed_trials(summary, output)
+
+
+def _failed_trials(summary, output):
+    """1, with a line on stderr, when trials recorded an error or did not run (a trial
+    that ran but missed its target is a result, not an error); else 0."""
+    errors = sum(entry["errors"] for entry in summary["methods"].values())
+    missing = sum(entry["missing"] for entry in summary["methods"].values())
+    if not errors and not missing:
+        return 0
+    print(f"{errors} of {summary['trials'] * len(summary['methods'])} trials failed with an "
+          f"error (in the `error` field of their {output / 'trials'}/METHOD/seed_SEED.json)"
+          + (f" and {missing} did not run" if missing else "") + ".", file=sys.stderr)
+    return 1
+
+
+def _print_report(summary, output):
+    print(results_table(summary), end="")
+    for method, entry in summary["methods"].items():
+        if entry["errors"]:
+            print(f"  {method}: {entry['errors']} trials failed with an error (seeds "
+                  f"{entry['error_seeds']}); see {output / 'trials' / method}")
+    for name in ("summary.json", "results.md", "trials.json", *FIGURES):
+        print(f"  wrote {output / name}")
+
+
+def _report(args):
+    """Exit 0; 1, like `study`, when trials recorded an error or did not run, and when
+    damaged or foreign files were skipped (what could be read is still reported and
+    written); 2 (ScenarioError) when there is nothing to report."""
+    output = pathlib.Path(args.output)
+    summary = report(output)
+    _print_report(summary, output)
+    failed = _failed_trials(summary, output)
+    if summary["damaged"]:
+        print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
+              f"(listed above and in {output / 'summary.json'})", file=sys.stderr)
+        return 1
+    return failed

@@ -2,7 +2,7 @@
 --record FILE.html`, opened in headless Chromium, shows the start (magenta disc), the goal
 (green) and the robot (blue) inside the page, seen from above, at the start of the
 animation and later on, where the robot has moved towards the goal and the DMP's path (teal
-dots) has changed.
+dots) has changed. An HSR replay's DMP paths (blue dots) move with the hand likewise.
 
 Needs Debian's `chromium` and Playwright from PyPI (the `test` extra; never
 `playwright install`). Skipped where either is missing.
@@ -84,20 +84,18 @@ def seek(page, time):
     return page.screenshot(type="png")
 
 
-@pytest.mark.timeout(180)
-def test_a_2d_replay_shows_start_goal_and_robot_inside_the_page_and_paths_that_move(
-        repo, tmp_path):
-    replay = tmp_path / "replay.html"
+def record(repo, scenario, replay, duration, *options, exit_code=0):
+    """Runs `pbp-drake run SCENARIO --headless --record REPLAY`; returns the replay's text."""
     run = subprocess.run(
-        [sys.executable, "-m", "pbp_drake", "run", "diagrams/toy_alpha_study.yaml",
-         "--headless", "--record", str(replay), "--duration", str(DURATION)],
+        [sys.executable, "-m", "pbp_drake", "run", scenario, "--headless", "--record",
+         str(replay), "--duration", str(duration), *options],
         cwd=repo, stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=120)
-    assert run.returncode == 0, run.stdout + run.stderr
-    html = replay.read_text()
-    # The recording itself holds the path's motion, not only its last frame.
-    times, first_dot = animation_tracks(html)["/pbp/predictions/0/0", ".position"]
-    assert times[-1] >= DURATION - 0.05 and np.ptp(first_dot[:, 0]) > 0.3
+    assert run.returncode == exit_code, run.stdout + run.stderr
+    return replay.read_text()
 
+
+def screenshots(replay, times):
+    """Screenshots of the replay file at each of `times` (seconds into its animation)."""
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
                                              timeout=30_000)
@@ -107,11 +105,30 @@ def test_a_2d_replay_shows_start_goal_and_robot_inside_the_page_and_paths_that_m
             page.goto(replay.as_uri(), wait_until="load")
             # The page decodes its commands asynchronously; the animation comes last.
             page.wait_for_function("() => viewer.animator.duration > 0")
-            first, later = seek(page, 0.0), seek(page, LATER)
+            shots = [seek(page, time) for time in times]
         finally:
             browser.close()
-    (tmp_path / "first.png").write_bytes(first)
-    (tmp_path / "later.png").write_bytes(later)
+    for time, png in zip(times, shots):
+        (replay.parent / f"{replay.stem}_{time:g}s.png").write_bytes(png)
+    return shots
+
+
+def assert_moved(first, later, hue, what):
+    masks = [colour_mask(png, hue) for png in (first, later)]
+    changed = np.count_nonzero(masks[0] ^ masks[1])
+    assert changed > 0.5 * np.count_nonzero(masks[0]), (
+        f"{what} barely moved ({changed} pixels changed) between the two screenshots")
+
+
+@pytest.mark.timeout(180)
+def test_a_2d_replay_shows_start_goal_and_robot_inside_the_page_and_paths_that_move(
+        repo, tmp_path):
+    replay = tmp_path / "toy.html"
+    html = record(repo, "diagrams/toy_alpha_study.yaml", replay, DURATION)
+    # The recording itself holds the path's motion, not only its last frame.
+    times, first_dot = animation_tracks(html)["/pbp/predictions/0/0", ".position"]
+    assert times[-1] >= DURATION - 0.05 and np.ptp(first_dot[:, 0]) > 0.3
+    first, later = screenshots(replay, [0.0, LATER])
 
     start, goal, robot = (assert_inside(first, name) for name in ["start", "goal", "robot"])
     assert np.linalg.norm(robot - start) < 10, "at 0 s the robot is not on the start"
@@ -120,7 +137,18 @@ def test_a_2d_replay_shows_start_goal_and_robot_inside_the_page_and_paths_that_m
     assert_inside(later, "start"), assert_inside(later, "goal")
     moved = assert_inside(later, "robot")
     assert start[0] + 100 < moved[0] < goal[0], f"at {LATER} s the robot is at {moved}"
-    paths = [colour_mask(png, HUES["path"]) for png in (first, later)]
-    changed = np.count_nonzero(paths[0] ^ paths[1])
-    assert changed > 0.5 * np.count_nonzero(paths[0]), (
-        f"the path's dots barely moved ({changed} pixels) between 0 s and {LATER} s")
+    assert_moved(first, later, HUES["path"], "the DMP path's dots")
+
+
+@pytest.mark.timeout(180)
+def test_an_hsr_replay_moves_the_dmp_paths_with_the_hand(repo, tmp_path):
+    # The hand moves about 0.1 m in 4 s; the paths start from it (blue dots, the estimate's
+    # bold, the others faint).
+    replay = tmp_path / "hsr.html"
+    # (Exit code 1: the task stops at its 4 s time limit, short of the target.)
+    html = record(repo, "diagrams/hsr_reach.yaml", replay, 4.0, "--operator", "virtual",
+                  exit_code=1)
+    _, first_dot = animation_tracks(html)["/task/predictions/selected/0", ".position"]
+    assert np.linalg.norm(first_dot[-1] - first_dot[0]) > 0.05
+    first, later = screenshots(replay, [0.3, 3.7])
+    assert_moved(first, later, HUES["robot"], "the blue DMP paths")

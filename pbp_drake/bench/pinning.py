@@ -71,9 +71,8 @@ def blas_threads(requested):
     if requested <= 0:
         note = f"BLAS threads: library default, not pinned ({reads})"
     elif pinned:
-        names = ", ".join(name for name in THREAD_VARIABLES[:3])
-        note = (f"BLAS threads: {requested} ({names} and the others set to {requested} "
-                f"before NumPy loaded; {reads})")
+        note = (f"BLAS threads: {requested} ({', '.join(THREAD_VARIABLES[:3])} and the "
+                f"others set to {requested} before NumPy loaded; {reads})")
     else:
         note = (f"BLAS threads: NOT pinned to {requested} (this process was not started "
                 f"with the thread variables set; {reads})")

@@ -14,12 +14,12 @@ from pydrake.geometry import Meshcat, MeshcatParams
 import pbp_drake.bench
 from pbp_drake.bench.cases import (
     BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case)
+from pbp_drake.bench.checks import PEERS, evaluate, exit_code
 from pbp_drake.bench.closed_loop import HSR_KS, hsr_speed
 from pbp_drake.bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
-from pbp_drake.bench.plot import plot_control_rate
-from pbp_drake.bench.checks import evaluate, exit_code
 from pbp_drake.bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
+from pbp_drake.bench.plot import plot_control_rate
 from pbp_drake.bench.report import format_report, microseconds, ratio
 from pbp_drake.bench.timing import memory_bandwidth, timed
 
@@ -84,15 +84,15 @@ def _measure(args):
     dimensions, min_time = settings["dimensions"], settings["min_time"]
     hsr_seconds = settings["hsr_seconds"]
     blas = blas_threads(args.blas_threads)
-    have_pydmps = available("pydmps")
-    have_mp = available("movement_primitives.dmp")
-    installed = {name for name, present in [("pydmps", have_pydmps),
-                                            ("movement_primitives", have_mp)] if present}
+    installed = {name for name, module in [("pydmps", "pydmps"),
+                                           ("movement_primitives", "movement_primitives.dmp")]
+                 if available(module)}
+    have_pydmps, have_mp = "pydmps" in installed, "movement_primitives" in installed
     print(f"pbp-drake bench: {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} CPUs, Python {platform.python_version()}, NumPy "
           f"{np.__version__}; {blas['note']}")
-    for name, present in [("pydmps", have_pydmps), ("movement_primitives", have_mp)]:
-        if not present:
+    for name in PEERS:
+        if name not in installed:
             print(f"note: {name} is not installed (pip install -e '.[bench]'); its columns "
                   "stay empty and the checks against it are skipped")
 

@@ -54,9 +54,10 @@ def read_participants(study_dir):
         raise ScenarioError(f"{study_dir}: no such folder")
     folders = participant_folders(study_dir)
     if not folders:
-        raise ScenarioError(f"{study_dir} holds no participant folders (ID/study.json, "
+        raise ScenarioError(f"{study_dir} has no study.json and no trial files of a "
+                            "`pbp-drake study`, and no participant folders (ID/study.json, "
                             "written by `pbp-drake run SCENARIO --participant ID --output "
-                            f"{study_dir}/ID`) and is not a study folder: nothing to report")
+                            f"{study_dir}/ID`): nothing to report")
     sessions, damaged = {}, []
     for folder in folders:
         study, records, broken = read_study(folder)

@@ -112,7 +112,8 @@ def test_a_folder_without_participants_is_refused(tmp_path, capsys):
     (tmp_path / "notes").mkdir()
     assert main(["report", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"pbp-drake: {tmp_path} holds no participant folders")
+    assert err.startswith(f"pbp-drake: {tmp_path} has no study.json")
+    assert "and no participant folders" in err and "nothing to report" in err
 
 
 def test_a_participant_of_another_scenario_is_refused(repo, study, tmp_path, capsys):

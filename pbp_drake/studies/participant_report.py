@@ -12,8 +12,6 @@ import pathlib
 import statistics
 import warnings
 
-import scipy.stats
-
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.studies.figures import METHOD_LABELS
 from pbp_drake.studies.questionnaire import QUESTIONS, read_answers
@@ -113,6 +111,10 @@ def wilcoxon_rows(values, methods):
     """Each pair of methods' two-sided Wilcoxon signed-rank test (scipy.stats.wilcoxon,
     its defaults) over the participants with a value for both, paired by participant:
     dicts of pair, n, statistic, p (None when scipy gives none, with `note` why)."""
+    # Deferred: scipy.stats takes about 0.7 s to import, which every pbp-drake command
+    # would pay at start-up for the one report that uses it.
+    import scipy.stats
+
     rows = []
     for first, second in itertools.combinations(methods, 2):
         paired = sorted(set(values[first]) & set(values[second]))

@@ -160,7 +160,9 @@ def _print_report(summary, output):
 def _report(args):
     """Exit 0; 1, like `study`, when trials recorded an error or did not run, and when
     damaged or foreign files were skipped (what could be read is still reported and
-    written); 2 (ScenarioError) when there is nothing to report."""
+    written); 2 (ScenarioError) when there is nothing to report. A folder that is not a
+    study but holds participant folders gets the user study's report (exit 1 when damaged
+    files were skipped; 2 for a participant of another scenario or a bad answer)."""
     output = pathlib.Path(args.output)
     if is_participant_collection(output):
         text, damaged = participant_report(output)

@@ -61,48 +61,57 @@ def run_session(scenario, participant, methods, output, run, page, practice=Fals
     """Runs `run(scenario)` (one task, e.g. driven from the browser) for each method in the
     participant's order, all on the scenario's seed, and saves each as a trial under
     `output`. `page` (console.questionnaire: the Meshcat page or FixedAnswers) shows each
-    method's Start before it runs and asks the questionnaire after it, saving each answer
-    at once. `practice`: first one run of each method, in the same order, on other scenes,
-    saved under `output/practice` (skipped once recorded runs exist). Returns the summary
-    of the session."""
+    method's Start before it runs, and asks the questionnaire once its trial is saved,
+    saving each answer at once. `practice`: first one run of each method, in the same order,
+    on other scenes, saved under `output/practice` (skipped once recorded runs exist).
+    `progress` as run_method_comparison's. Returns the summary of the session."""
     order = session_order(methods, participant)
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
     # Before any run: a folder of another scenario, or a damaged questionnaire, stops here.
     check_folder(output, scenario, digest)
     read_answers(output)
+    practice_folder = output / PRACTICE_FOLDER
+    practice_seed = scenario.seed + PRACTICE_SEED_OFFSET
 
-    def saved(method):
-        return read_trial(output, method, scenario.seed, digest) is not None
+    def unsaved(folder, seed):
+        return [m for m in order if read_trial(folder, m, seed, digest) is None]
+
+    def start_next(folder, seed, practising):
+        # Start is shown between trials, not inside `run`: the trial's wall_time is then
+        # the run's, not the person's pause before it.
+        waiting = unsaved(folder, seed)
+        if waiting:
+            page.start(waiting[0], order.index(waiting[0]) + 1, len(order), practising)
 
     def ask_unanswered():
-        # Every saved method without all its answers, in order: after the run just saved,
-        # and, on resuming, one whose questions were cut short.
+        # Every saved method without all its answers, in order: the run just saved, and,
+        # on resuming, one whose questions were cut short.
+        waiting = unsaved(output, scenario.seed)
         for position, method in enumerate(order, start=1):
-            if not saved(method):
+            if method in waiting:
                 continue
             answered = read_answers(output).get(method, {})
             missing = [q for q in QUESTIONS if q not in answered]
             for question in missing:
                 save_answer(output, method, question, page.answer(method, question))
-            if missing and position < len(order) and not saved(order[position]):
+            if missing and position < len(order) and order[position] in waiting:
                 page.next(position + 1, len(order))
 
-    def with_start(practising):
-        def run_one(trial):
-            method = trial.scenario.method
-            if not practising:
-                ask_unanswered()
-            page.start(method, order.index(method) + 1, len(order), practice=practising)
-            return run(trial)
-        return run_one
+    def after_practice_run(done, total, record, elapsed):
+        start_next(practice_folder, practice_seed, True)
 
-    if practice and not any(saved(method) for method in order):
-        run_method_comparison(scenario, order, 1, scenario.seed + PRACTICE_SEED_OFFSET,
-                              output / PRACTICE_FOLDER, split="practice",
-                              run=with_start(True))
+    def after_run(done, total, record, elapsed):
+        ask_unanswered()
+        if progress is not None:
+            progress(done, total, record, elapsed)
+        start_next(output, scenario.seed, False)
+
+    if practice and len(unsaved(output, scenario.seed)) == len(order):
+        start_next(practice_folder, practice_seed, True)
+        run_method_comparison(scenario, order, 1, practice_seed, practice_folder,
+                              progress=after_practice_run, split="practice", run=run)
     ask_unanswered()
-    summary = run_method_comparison(scenario, order, 1, scenario.seed, output,
-                                    progress=progress, run=with_start(False))
-    ask_unanswered()
-    return summary
+    start_next(output, scenario.seed, False)
+    return run_method_comparison(scenario, order, 1, scenario.seed, output,
+                                 progress=after_run, run=run)

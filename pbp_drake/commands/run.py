@@ -43,9 +43,10 @@ def add_run_command(commands):
                      help="with --participant: first one practice run of each method, in "
                      "the same order on other scenes, saved apart in ID/practice and never "
                      "counted in a report")
-    run.add_argument("--answers", metavar="[METHOD:]QUESTION=VALUE,...",
+    run.add_argument("--answers", metavar="ANSWERS",
                      help="with --participant and --operator virtual: fixed questionnaire "
-                     "answers, 0 (bad) to 5 (good), for unattended sessions, e.g. "
+                     "answers, 0 (bad) to 5 (good), for unattended sessions: comma-separated "
+                     "[METHOD:]QUESTION=VALUE (QUESTION tiredness or ease), e.g. "
                      "tiredness=3,ease=4,teleop:tiredness=1 (a person answers in the page)")
     run.add_argument("--headless", action="store_true",
                      help="simulate as fast as possible without waiting for a browser")

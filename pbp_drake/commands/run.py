@@ -16,6 +16,8 @@ from pbp_drake.output_paths import (
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, ScenarioError, load_scenario_file,
     resolve, with_method)
+from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
+from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
 
 
@@ -37,6 +39,15 @@ def add_run_command(commands):
                      "(default: pbp_alternated,pbp_continuous,teleop)")
     run.add_argument("--output", help="with --participant: the session's folder "
                      "(default: outputs/participants/ID)")
+    run.add_argument("--practice", action="store_true",
+                     help="with --participant: first one practice run of each method, in "
+                     "the same order on other scenes, saved apart in ID/practice and never "
+                     "counted in a report")
+    run.add_argument("--answers", metavar="ANSWERS",
+                     help="with --participant and --operator virtual: fixed questionnaire "
+                     "answers, 0 (bad) to 5 (good), for unattended sessions: comma-separated "
+                     "[METHOD:]QUESTION=VALUE (QUESTION tiredness or ease), e.g. "
+                     "tiredness=3,ease=4,teleop:tiredness=1 (a person answers in the page)")
     run.add_argument("--headless", action="store_true",
                      help="simulate as fast as possible without waiting for a browser")
     run.add_argument("--record", metavar="FILE.html",
@@ -153,8 +164,9 @@ def _run_task(args, resolved, meshcat):
                             "--operator virtual")
     if args.participant is not None:
         return _run_session(args, resolved, meshcat, person)
-    if args.methods is not None or args.output is not None:
-        raise ScenarioError("--methods and --output belong to a session: add --participant ID")
+    if args.methods is not None or args.output is not None or args.practice or args.answers:
+        raise ScenarioError("--methods, --output, --practice and --answers belong to a "
+                            "session: add --participant ID")
     diagram = build_diagram(resolved, meshcat)
     if person or (not args.headless and sys.stdin.isatty()):
         # A person needs the page open before the task starts.
@@ -195,20 +207,26 @@ def _run_session(args, resolved, meshcat, person):
         order = session_order(methods, args.participant)
     except ValueError as error:
         raise ScenarioError(f"--participant: {error}") from None
+    page = _session_page(args, meshcat, methods, person)
     output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
                                                        args.participant))
-    print(f"Participant {args.participant}: {', '.join(order)}, in this order; saved in "
-          f"{output}", flush=True)
-    if person:
+    print(f"Participant {args.participant}: {', '.join(order)}, in this order"
+          + (", each practised first" if args.practice else "") + f"; saved in {output}",
+          flush=True)
+    if isinstance(page, MeshcatSessionPage):
         print(f"Open {meshcat.web_url()} in a browser; the session starts when it connects "
-              f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
+              f"(waiting up to {args.wait_for_browser:g} s). Start, the questions and Next "
+              "are buttons in its control panel (Open Controls).", flush=True)
         _wait_for_browser(meshcat, args.wait_for_browser, person)
+        if meshcat.GetNumActiveConnections() == 0:
+            raise ScenarioError(f"no browser opened {meshcat.web_url()} within "
+                                f"{args.wait_for_browser:g} s (--wait-for-browser): the "
+                                "session's Start buttons and questions are in the page, so "
+                                "nothing was run or saved")
 
     def run_one(trial):
         diagram = build_diagram(trial, meshcat)
-        print(f"Next: {trial.scenario.method}.", flush=True)
-        if person and sys.stdin.isatty():
-            input("Press Enter to start. ")
+        print(f"  {trial.scenario.method}: running (seed {trial.scenario.seed})", flush=True)
         result = run_task(trial, realtime_rate=0.0 if args.headless else
                           args.realtime_rate, diagram=diagram)
         operator = diagram.GetSubsystemByName("operator")
@@ -217,10 +235,33 @@ def _run_session(args, resolved, meshcat, person):
         print(f"  {trial.scenario.method}: {result.summary_line()}", flush=True)
         return result
 
-    summary = run_session(scenario, args.participant, methods, output, run_one)
+    try:
+        summary = run_session(scenario, args.participant, methods, output, run_one, page,
+                              practice=args.practice)
+    except KeyboardInterrupt:
+        print(f"\nInterrupted: the methods and answers saved so far are in {output}; the "
+              "same command resumes the session.", file=sys.stderr)
+        return 130
     failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
-    print(f"Session saved in {output} (`pbp-drake report {output}` rebuilds its tables).")
+    print(f"Session saved in {output}, answers in {output / QUESTIONNAIRE_FILE} "
+          f"(`pbp-drake report {output.parent}` compares the participants).")
     return 1 if failed else 0
+
+
+def _session_page(args, meshcat, methods, person):
+    """Where the session's Start, questions and Next are: the Meshcat page, or `--answers`
+    (the virtual operator only, which needs no browser)."""
+    if args.answers is not None:
+        if person:
+            raise ScenarioError("--answers stands in for a person's answers: it goes with "
+                                "--operator virtual; a keyboard or gamepad participant "
+                                "answers in the page")
+        return FixedAnswers(parse_answers(args.answers, methods))
+    if args.headless:
+        raise ScenarioError("a --headless session needs --answers (e.g. --answers "
+                            "tiredness=3,ease=4): otherwise the questions are asked in the "
+                            "browser")
+    return MeshcatSessionPage(meshcat)
 
 
 def _wait_for_browser(meshcat, seconds, person=False):

@@ -11,6 +11,8 @@ from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
     Hsr, MethodComparison, ScenarioError, check_method_comparison, load_scenario_file)
 from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.participant_report import is_participant_collection, participant_report
+from pbp_drake.studies.questionnaire_figure import FIG8
 from pbp_drake.studies.progress import ProgressBar
 from pbp_drake.studies.report import figure_names, report, results_table
 from pbp_drake.studies.splits import SPLITS, first_seed, split_of
@@ -47,7 +49,11 @@ def add_study_commands(commands):
         "trial files, without simulating; damaged or foreign files are named on stderr and "
         "skipped (exit 1 when there were any, or when trials failed with an error or did not "
         "run, as `study` does; 2 when there is nothing to report)")
-    report.add_argument("output", help="the --output folder of `pbp-drake study`")
+    report.add_argument("output", help="the --output folder of `pbp-drake study`, or a user "
+                        "study's folder of participant folders (`pbp-drake run --participant "
+                        "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
+                        "Wilcoxon tests and Fig. 8 in DIR/results.md and "
+                        f"DIR/{FIG8}")
     study.set_defaults(handler=_study)
     report.set_defaults(handler=_report)
 
@@ -154,8 +160,19 @@ def _print_report(summary, output):
 def _report(args):
     """Exit 0; 1, like `study`, when trials recorded an error or did not run, and when
     damaged or foreign files were skipped (what could be read is still reported and
-    written); 2 (ScenarioError) when there is nothing to report."""
+    written); 2 (ScenarioError) when there is nothing to report. A folder that is not a
+    study but holds participant folders gets the user study's report (exit 1 when damaged
+    files were skipped; 2 for a participant of another scenario or a bad answer)."""
     output = pathlib.Path(args.output)
+    if is_participant_collection(output):
+        text, damaged = participant_report(output)
+        print(text, end="")
+        for name in ("results.md", FIG8):
+            print(f"  wrote {output / name}")
+        if damaged:
+            print(f"pbp-drake: {damaged} damaged files skipped (listed above)",
+                  file=sys.stderr)
+        return 1 if damaged else 0
     summary = report(output)
     _print_report(summary, output)
     failed = _failed_trials(summary, output)

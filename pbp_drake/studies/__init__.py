@@ -21,7 +21,11 @@ One job per module:
 - `summary`: the summary of a study folder and the one definition of the ideal alpha;
 - `report`: `report(DIR)`, the summary, `results.md`, `trials.json` and the figures;
 - `progress`: the text progress bar;
-- `sessions`: a participant's session of a user study;
+- `sessions`: a participant's session of a user study (its order, practice, resuming);
+- `questionnaire`: the paper's two questions, their answers and `questionnaire.json`;
+- `participant_report`: the report of a folder of participant folders (per-method metrics
+  and answers, pairwise Wilcoxon tests with Bonferroni correction);
+- `questionnaire_figure`: the paper's Fig. 8, the proportions of the answers;
 - `figures`: the paper's figures (Fig. 2, 4 and 7), drawn with matplotlib;
 - `toy`: the paper's 2-D studies (the alpha study and Alt vs Cont).
 

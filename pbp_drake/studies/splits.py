@@ -17,6 +17,7 @@ SPLIT_NOTES = {
     "evaluation": "evaluation seeds: no tuning of the virtual participant has seen these scenes",
     "mixed": "seeds from both the tuning and the evaluation split",
     "unlabelled": "seeds below the study's tuning seeds, in no split",
+    "practice": "a participant's practice runs (`run --practice`), never counted in a report",
 }
 
 

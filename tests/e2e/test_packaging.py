@@ -56,7 +56,7 @@ def test_the_wheel_ships_the_models(wheel, tmp_path):
 def fresh_venv(wheel, tmp_path_factory):
     """A new venv in a temporary folder with the wheel installed into it.
 
-    Its dependencies (drake, numpy, matplotlib) come from this venv through a `.pth` file
+    Its dependencies (drake, numpy, matplotlib, scipy) come from this venv through a `.pth` file
     that adds this venv's site-packages as a plain path: no network, and none of this venv's
     own `.pth` files (such as the checkout's editable install) take effect there.
     """

@@ -1,0 +1,1 @@
+"""Pages in the Meshcat control panel for a person at the browser."""

@@ -1,0 +1,101 @@
+"""The pages of a user-study session in the Meshcat control panel: before each method a Start
+button that names it, after it the paper's two questions as six buttons each (0 bad .. 5
+good), then a Next button. `FixedAnswers` is the same flow without a browser, for the
+virtual operator (`--answers`).
+
+Both are driven by `studies.sessions.run_session` through three calls: `start`, `answer`,
+`next`. Meshcat's controls are polled from the thread that made the Meshcat (Drake's rule);
+each page's buttons are deleted before the next page shows, so a click meant for one page
+cannot answer another.
+"""
+
+import time
+
+from pbp_drake.studies.figures import METHOD_LABELS
+from pbp_drake.studies.questionnaire import QUESTIONS, SCALE
+
+POLL_PERIOD = 0.05  # s between looks at the buttons: a click feels immediate
+
+
+def method_name(method):
+    """The name a participant sees: the paper's (PBP-Alt, PBP-Cont, Teleop)."""
+    return METHOD_LABELS.get(method, method)
+
+
+def start_label(method, position, total, practice=False):
+    """The Start button of a method: which method, which of how many, practice or not."""
+    if practice:
+        return f"Start practice {position} of {total}: {method_name(method)} (not recorded)"
+    return f"Start method {position} of {total}: {method_name(method)}"
+
+
+def answer_labels(question):
+    """The six buttons of a question, by label: the value first, so that a label the panel
+    cuts short still shows it."""
+    ends = {SCALE[0]: " (bad)", SCALE[-1]: " (good)"}
+    return {f"{value}{ends.get(value, '')}: {QUESTIONS[question]}": value for value in SCALE}
+
+
+def next_label(position, total):
+    """The Next button after a method's questions, naming the method it leads to."""
+    return f"Next: on to method {position} of {total}"
+
+
+class MeshcatSessionPage:
+    """The session's pages in a Meshcat's control panel (a person clicks; nothing times out,
+    Ctrl-C in the terminal stops the session, which the same command resumes)."""
+
+    def __init__(self, meshcat, poll_period=POLL_PERIOD):
+        self._meshcat = meshcat
+        self._poll_period = poll_period
+
+    def start(self, method, position, total, practice=False):
+        """Shows the Start button of `method` and returns when it is clicked."""
+        self._wait_for_click([start_label(method, position, total, practice)])
+
+    def answer(self, method, question):
+        """Shows `question`'s six answers (about `method`, just run) and returns the value
+        clicked."""
+        labels = answer_labels(question)
+        return labels[self._wait_for_click(list(labels))]
+
+    def next(self, position, total):
+        """Shows the Next button that leads to method `position` and returns when clicked."""
+        self._wait_for_click([next_label(position, total)])
+
+    def _wait_for_click(self, names):
+        # A button's click count starts at zero when it is added (Meshcat's AddButton), so
+        # only clicks on this page count.
+        for name in names:
+            self._meshcat.AddButton(name)
+        try:
+            while True:
+                for name in names:
+                    if self._meshcat.GetButtonClicks(name) > 0:
+                        return name
+                time.sleep(self._poll_period)
+        finally:
+            for name in names:
+                self._meshcat.DeleteButton(name, strict=False)
+
+
+class FixedAnswers:
+    """The session's pages answered by themselves: Start and Next go on at once, each
+    question gets its answer from `answers` (`{method: {question: value}}`, see
+    `studies.questionnaire.parse_answers`). `asked` lists the `(method, question)` asked, in
+    order."""
+
+    def __init__(self, answers):
+        self.answers = answers
+        self.asked = []
+
+    def start(self, method, position, total, practice=False):
+        """Nothing to wait for."""
+
+    def answer(self, method, question):
+        """The fixed answer."""
+        self.asked.append((method, question))
+        return self.answers[method][question]
+
+    def next(self, position, total):
+        """Nothing to wait for."""

@@ -1,0 +1,237 @@
+"""`pbp-drake report STUDY_DIR` for a user study: STUDY_DIR holds one folder per participant
+(`pbp-drake run ... --participant ID`). Per method, the metrics of the recorded runs
+(intervention ratio, task time, success) and the questionnaire's answers; pairwise Wilcoxon
+signed-rank tests with Bonferroni correction on intervention, task time, tiredness and ease,
+as the paper reports them (section V-C); Fig. 8 (`fig8_questionnaire.png`); all in
+STUDY_DIR/results.md. Practice runs (ID/practice) are never read.
+"""
+
+import collections
+import itertools
+import pathlib
+import statistics
+import warnings
+
+from pbp_drake.scenarios import ScenarioError
+from pbp_drake.studies.figures import METHOD_LABELS
+from pbp_drake.studies.questionnaire import QUESTIONS, read_answers
+from pbp_drake.studies.questionnaire_figure import FIG8, answer_counts, plot_questionnaire
+from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, PRACTICE_FOLDER
+from pbp_drake.studies.trial_files import name_damaged, read_study, write_atomically
+
+ALPHA = 0.05  # the family-wise level; each measure's pairs are Bonferroni-corrected
+# The measures tested, in the paper's order: (key, name in the tables, source).
+MEASURES = (("intervention_ratio", "intervention ratio", "trial"),
+            ("task_time", "task time (s)", "trial"),
+            ("tiredness", "tiredness (0-5)", "answer"),
+            ("ease", "ease (0-5)", "answer"))
+
+
+def is_participant_collection(folder):
+    """Whether `folder` is not itself a study folder (no study.json, no trials/): then
+    `pbp-drake report` reads it as a folder of participant folders."""
+    folder = pathlib.Path(folder)
+    return not (folder / "study.json").exists() and not (folder / "trials").is_dir()
+
+
+def participant_folders(study_dir):
+    """The participant folders in `study_dir`: its sub-folders holding a session's
+    study.json or trials/, by name."""
+    return sorted(p for p in pathlib.Path(study_dir).iterdir() if p.is_dir()
+                  and ((p / "study.json").is_file() or (p / "trials").is_dir()))
+
+
+def read_participants(study_dir):
+    """`(sessions, damaged)`: per participant folder name, its study, its recorded runs by
+    method (None when not on disk or damaged) and its answers; and every damaged file
+    (named, skipped). Raises ScenarioError when there are no participant folders, or when
+    one holds a session of another scenario than the others (by the scenario hash its
+    study.json and trial files carry)."""
+    study_dir = pathlib.Path(study_dir)
+    if not study_dir.is_dir():
+        raise ScenarioError(f"{study_dir}: no such folder")
+    folders = participant_folders(study_dir)
+    if not folders:
+        raise ScenarioError(f"{study_dir} has no study.json and no trial files of a "
+                            "`pbp-drake study`, and no participant folders (ID/study.json, "
+                            "written by `pbp-drake run SCENARIO --participant ID --output "
+                            f"{study_dir}/ID`): nothing to report")
+    sessions, damaged = {}, []
+    for folder in folders:
+        study, records, broken = read_study(folder)
+        foreign = [d for d in broken if "another scenario" in d.problem]
+        if foreign:
+            raise ScenarioError(f"{foreign[0].path} is {foreign[0].problem}: participant "
+                                f"folder {folder} mixes scenarios; move it out of {study_dir}")
+        damaged += broken
+        runs = {method: records.get((method, 0)) for method in study["methods"]}
+        sessions[folder.name] = {"study": study, "runs": runs,
+                                 "answers": read_answers(folder)}
+    hashes = collections.Counter(s["study"]["scenario_hash"] for s in sessions.values())
+    digest = hashes.most_common(1)[0][0]
+    reference = next(s["study"] for s in sessions.values() if s["study"]["scenario_hash"]
+                     == digest)
+    for name, session in sessions.items():
+        study = session["study"]
+        if study["scenario_hash"] != digest:
+            raise ScenarioError(
+                f"{study_dir / name} is a session of another scenario ({study['scenario']!r}, "
+                f"hash {study['scenario_hash']}) than the other participants "
+                f"({reference['scenario']!r}, hash {digest}): move it out of {study_dir}, "
+                "or report it on its own")
+    return sessions, damaged
+
+
+def method_order(sessions):
+    """The methods of all sessions: the paper's (PBP-Alt, PBP-Cont, Teleop) first, in
+    that order, then any other in the order first met."""
+    found = list(dict.fromkeys(m for s in sessions.values() for m in s["study"]["methods"]))
+    return ([m for m in DEFAULT_SESSION_METHODS if m in found]
+            + [m for m in found if m not in DEFAULT_SESSION_METHODS])
+
+
+def measure_values(sessions, methods, measure, source):
+    """`{method: {participant: value}}` of one measure; a run that failed with an error,
+    or is missing, and an unanswered question give no value."""
+    values = {method: {} for method in methods}
+    for name, session in sessions.items():
+        for method in methods:
+            if source == "trial":
+                record = session["runs"].get(method)
+                value = (None if record is None or record["error"] is not None
+                         else record.get(measure))
+            else:
+                value = session["answers"].get(method, {}).get(measure)
+            if value is not None:
+                values[method][name] = value
+    return values
+
+
+def wilcoxon_rows(values, methods):
+    """Each pair of methods' two-sided Wilcoxon signed-rank test (scipy.stats.wilcoxon,
+    its defaults) over the participants with a value for both, paired by participant:
+    dicts of pair, n, statistic, p (None when scipy gives none, with `note` why)."""
+    # Deferred: scipy.stats takes about 0.7 s to import, which every pbp-drake command
+    # would pay at start-up for the one report that uses it.
+    import scipy.stats
+
+    rows = []
+    for first, second in itertools.combinations(methods, 2):
+        paired = sorted(set(values[first]) & set(values[second]))
+        x = [values[first][p] for p in paired]
+        y = [values[second][p] for p in paired]
+        row = {"pair": (first, second), "n": len(paired), "statistic": None, "p": None,
+               "note": ""}
+        if not paired:
+            row["note"] = "no participant has both"
+        else:
+            try:
+                with warnings.catch_warnings():
+                    # All differences zero: scipy warns and gives p = 1; the row says so.
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    result = scipy.stats.wilcoxon(x, y)
+                row["statistic"], row["p"] = float(result.statistic), float(result.pvalue)
+                if all(a == b for a, b in zip(x, y)):
+                    row["note"] = "all differences zero"
+            except ValueError as error:
+                row["note"] = str(error)
+        if row["p"] is not None and row["p"] != row["p"]:  # NaN
+            row["p"], row["note"] = None, row["note"] or "scipy gave no p-value"
+        rows.append(row)
+    return rows
+
+
+def _label(method):
+    return METHOD_LABELS.get(method, method)
+
+
+def _mean_std(values):
+    values = list(values)
+    if not values:
+        return "-"
+    return f"{statistics.fmean(values):.3f} ± {statistics.pstdev(values):.3f}"
+
+
+def _median_mean(values):
+    values = list(values)
+    if not values:
+        return "-"
+    return f"{statistics.median(values):g} ({statistics.fmean(values):.2f})"
+
+
+def participant_results(study_dir):
+    """The report as Markdown text, and what it was made of:
+    `(text, sessions, methods, damaged)`."""
+    sessions, damaged = read_participants(study_dir)
+    methods = method_order(sessions)
+    values = {key: measure_values(sessions, methods, key, source)
+              for key, _, source in MEASURES}
+    first = next(iter(sessions.values()))["study"]
+    lines = [f"# User study: {first['scenario']} (scenario hash {first['scenario_hash']})", "",
+             f"{len(sessions)} participants: {', '.join(sessions)}. Practice runs "
+             f"({PRACTICE_FOLDER}/ in a participant folder) are not counted.", "",
+             "## Per method", "",
+             "| method | participants | success | intervention ratio | task time (s) | "
+             "tiredness, median (mean) | ease, median (mean) |", "|---|---|---|---|---|---|---|"]
+    for method in methods:
+        runs = [s["runs"].get(method) for s in sessions.values()]
+        ran = [r for r in runs if r is not None]
+        lines.append(
+            f"| {_label(method)} | {len(ran)} | {sum(bool(r['success']) for r in ran)} of "
+            f"{len(ran)} | {_mean_std(values['intervention_ratio'][method].values())} | "
+            f"{_mean_std(values['task_time'][method].values())} | "
+            f"{_median_mean(values['tiredness'][method].values())} | "
+            f"{_median_mean(values['ease'][method].values())} |")
+    lines += ["", "Answers, counts of 0 (bad) to 5 (good) (Fig. 8, "
+              f"{FIG8}):", "", "| method | question | 0 | 1 | 2 | 3 | 4 | 5 |",
+              "|---|---|---|---|---|---|---|---|"]
+    answers = {name: s["answers"] for name, s in sessions.items()}
+    for question, text in QUESTIONS.items():
+        counts = answer_counts(answers, methods, question)
+        for method in methods:
+            lines.append(f"| {_label(method)} | {text} | "
+                         + " | ".join(str(c) for c in counts[method]) + " |")
+    pairs = len(methods) * (len(methods) - 1) // 2
+    threshold = ALPHA / max(pairs, 1)
+    lines += ["", "## Pairwise Wilcoxon signed-rank tests", "",
+              "Two-sided, paired by participant (scipy.stats.wilcoxon, its defaults), over "
+              "the participants with a value for both methods. Bonferroni correction over "
+              f"the {pairs} pairs of each measure: significant when p < {ALPHA:g} / {pairs} "
+              f"= {threshold:.4g} (the corrected p is p × {pairs}, at most 1).", "",
+              "| measure | pair | n | W | p | corrected p | significant |",
+              "|---|---|---|---|---|---|---|"]
+    for key, name, _ in MEASURES:
+        for row in wilcoxon_rows(values[key], methods):
+            pair = f"{_label(row['pair'][0])} vs {_label(row['pair'][1])}"
+            if row["p"] is None:
+                lines.append(f"| {name} | {pair} | {row['n']} | - | n/a ({row['note']}) | "
+                             "- | - |")
+                continue
+            note = f" ({row['note']})" if row["note"] else ""
+            lines.append(f"| {name} | {pair} | {row['n']} | {row['statistic']:g} | "
+                         f"{row['p']:.4g}{note} | {min(1.0, row['p'] * pairs):.4g} | "
+                         f"{'yes' if row['p'] < threshold else 'no'} |")
+    lines += ["", "## Participants", "", "| participant | order | seed | answers "
+              "(tiredness / ease) |", "|---|---|---|---|"]
+    for name, session in sessions.items():
+        study = session["study"]
+        given = "; ".join(f"{_label(m)} {a.get('tiredness', '-')} / {a.get('ease', '-')}"
+                          for m, a in session["answers"].items()) or "none"
+        lines.append(f"| {name} | {', '.join(_label(m) for m in study['methods'])} | "
+                     f"{study['seed']} | {given} |")
+    if damaged:
+        lines += ["", f"Skipped as damaged: {len(damaged)} files (named by `pbp-drake "
+                      "report`)."]
+    return "\n".join(lines) + "\n", sessions, methods, damaged
+
+
+def participant_report(study_dir):
+    """Writes STUDY_DIR/results.md and STUDY_DIR/fig8_questionnaire.png; names damaged files
+    on stderr. Returns `(results text, number of damaged files)`."""
+    study_dir = pathlib.Path(study_dir)
+    text, sessions, methods, damaged = participant_results(study_dir)
+    name_damaged(damaged)
+    write_atomically(study_dir / "results.md", text)
+    plot_questionnaire({name: s["answers"] for name, s in sessions.items()}, methods,
+                       study_dir / FIG8)
+    return text, len(damaged)

@@ -1,0 +1,140 @@
+"""`pbp-drake report STUDY_DIR` over participant folders, as the paper reports its user study:
+three real sessions of the virtual operator with fixed answers, the Wilcoxon table checked
+against scipy.stats.wilcoxon computed straight from the trial and questionnaire files, Fig. 8,
+practice runs left out, and the folders the report refuses."""
+
+import itertools
+import json
+import re
+import shutil
+import warnings
+
+import matplotlib.image
+import pytest
+import scipy.stats
+
+from pbp_drake.cli import main
+from pbp_drake.studies.figures import METHOD_LABELS
+
+pytestmark = pytest.mark.slow  # nine short tasks and their reports (about 20 s)
+
+TASK = "diagrams/hsr_reach.yaml"
+METHODS = ["pbp_alternated", "pbp_continuous", "teleop"]
+DURATION = "4"  # short runs: every method still gives real intervention ratios
+SESSIONS = {  # participant: (seed, fixed answers)
+    "P01": (1, "tiredness=3,ease=4,teleop:tiredness=1,pbp_continuous:ease=2"),
+    "P02": (2, "tiredness=4,ease=3,teleop:tiredness=2,teleop:ease=4"),
+    "P03": (3, "tiredness=5,ease=5,teleop:tiredness=1,pbp_continuous:tiredness=2"),
+}
+ROW = re.compile(r"^\| (intervention ratio|task time \(s\)|tiredness \(0-5\)|ease \(0-5\)) \| "
+                 r"(\S+) vs (\S+) \| (\d+) \| (\S+) \| (\S+)")
+
+
+def session(repo, study, participant, *extra, duration=DURATION):
+    seed, answers = SESSIONS.get(participant, (0, "tiredness=3,ease=3"))
+    return main(["run", str(repo / TASK), "--headless", "--operator", "virtual",
+                 "--participant", participant, "--seed", str(seed), "--answers", answers,
+                 "--duration", duration, "--output", str(study / participant), *extra])
+
+
+@pytest.fixture(scope="module")
+def study(repo, tmp_path_factory):
+    study = tmp_path_factory.mktemp("user_study")
+    for participant in SESSIONS:
+        practice = ["--practice"] if participant == "P01" else []
+        assert session(repo, study, participant, *practice) in (0, 1)  # 1: a run failed
+    return study
+
+
+def from_files(study):
+    """`{measure: {method: {participant: value}}}` read straight from the files."""
+    values = {m: {method: {} for method in METHODS}
+              for m in ("intervention ratio", "task time (s)", "tiredness (0-5)",
+                        "ease (0-5)")}
+    for folder in sorted(p for p in study.iterdir() if p.is_dir()):
+        answers = json.loads((folder / "questionnaire.json").read_text())
+        for method in METHODS:
+            (trial,) = (folder / "trials" / method).glob("seed_*.json")
+            record = json.loads(trial.read_text())
+            values["intervention ratio"][method][folder.name] = record["intervention_ratio"]
+            values["task time (s)"][method][folder.name] = record["task_time"]
+            values["tiredness (0-5)"][method][folder.name] = answers[method]["tiredness"]
+            values["ease (0-5)"][method][folder.name] = answers[method]["ease"]
+    return values
+
+
+def test_the_wilcoxon_table_is_scipys_on_the_files(study, capsys):
+    assert main(["report", str(study)]) == 0
+    results = (study / "results.md").read_text()
+    assert capsys.readouterr().out.startswith(results)
+    assert "significant when p < 0.05 / 3 = 0.01667" in results
+    rows = {}
+    for line in results.splitlines():
+        if match := ROW.match(line):
+            measure, first, second, n, statistic, p = match.groups()
+            rows[(measure, first, second)] = (int(n), statistic, p)
+    values = from_files(study)
+    assert len(rows) == 4 * 3
+    for measure, (first, second) in itertools.product(values, itertools.combinations(
+            METHODS, 2)):
+        x = [values[measure][first][p] for p in SESSIONS]
+        y = [values[measure][second][p] for p in SESSIONS]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all differences zero
+            expected = scipy.stats.wilcoxon(x, y)
+        n, statistic, p = rows[(measure, METHOD_LABELS[first], METHOD_LABELS[second])]
+        assert n == 3
+        assert float(statistic) == pytest.approx(float(expected.statistic))
+        assert p == f"{expected.pvalue:.4g}", (measure, first, second)
+    # The answers the sessions gave, as a person reads them in the table of counts.
+    assert "| Teleop | How tired did you feel? | 0 | 2 | 1 | 0 | 0 | 0 |" in results
+
+
+def test_fig8_shows_the_answers(study):
+    assert main(["report", str(study)]) == 0
+    image = matplotlib.image.imread(study / "fig8_questionnaire.png")
+    assert image.shape[0] > 200 and image.shape[1] > 600
+
+
+def test_practice_runs_are_kept_apart_and_not_counted(study):
+    practice = study / "P01" / "practice"
+    assert json.loads((practice / "study.json").read_text())["split"] == "practice"
+    assert len(list((practice / "trials").rglob("seed_*.json"))) == 3
+    assert main(["report", str(study)]) == 0
+    results = (study / "results.md").read_text()
+    for method in METHODS:  # three participants, one recorded run each
+        assert re.search(rf"^\| {re.escape(METHOD_LABELS[method])} \| 3 \| \d of 3 \|",
+                         results, re.M)
+    assert "3 participants: P01, P02, P03." in results
+
+
+def test_a_folder_without_participants_is_refused(tmp_path, capsys):
+    (tmp_path / "notes").mkdir()
+    assert main(["report", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pbp-drake: {tmp_path} has no study.json")
+    assert "and no participant folders" in err and "nothing to report" in err
+
+
+def test_a_participant_of_another_scenario_is_refused(repo, study, tmp_path, capsys):
+    mixed = tmp_path / "mixed"
+    for participant in ("P01", "P02"):
+        shutil.copytree(study / participant, mixed / participant)
+    assert session(repo, mixed, "P09", "--methods", "teleop", duration="3") in (0, 1)
+    capsys.readouterr()
+    assert main(["report", str(mixed)]) == 2
+    err = capsys.readouterr().err
+    assert f"{mixed / 'P09'} is a session of another scenario" in err
+    assert not (mixed / "results.md").exists()
+
+
+def test_an_answer_outside_0_to_5_is_refused(study, tmp_path, capsys):
+    edited = tmp_path / "edited"
+    shutil.copytree(study / "P02", edited / "P02")
+    path = edited / "P02" / "questionnaire.json"
+    answers = json.loads(path.read_text())
+    answers["teleop"]["ease"] = 7  # as a hand edit of the file would
+    path.write_text(json.dumps(answers))
+    assert main(["report", str(edited)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: teleop ease: the answer 7 is outside 0 (bad) to 5 (good)" in err

@@ -1,0 +1,160 @@
+"""A participant's session: its order, the questionnaire's answers and files, practice runs,
+resuming after an interruption without asking or overwriting anything again, and the bad
+input a session or its report refuses (exit 2, the problem named)."""
+
+import dataclasses
+import json
+
+import pytest
+
+from pbp_drake.builder.run import run_task
+from pbp_drake.cli import main
+from pbp_drake.console.questionnaire import FixedAnswers
+from pbp_drake.scenarios import load_scenario_file
+from pbp_drake.studies.questionnaire import QuestionnaireError, parse_answers, save_answer
+from pbp_drake.studies.sessions import PRACTICE_SEED_OFFSET, run_session, session_order
+from pbp_drake.studies.trial_files import trial_paths
+
+TASK = "diagrams/hsr_reach.yaml"
+METHODS = ["pbp_alternated", "pbp_continuous", "teleop"]
+ANSWERS = "tiredness=3,ease=4,teleop:tiredness=1"
+
+
+@pytest.fixture(scope="module")
+def short_task(repo):
+    """hsr_reach with a 1.5 s limit: every run is short, its files are real."""
+    return dataclasses.replace(load_scenario_file(repo / TASK).scenario, duration=1.5)
+
+
+def session_files(output, methods):
+    """Bytes and modification time of each method's trial files."""
+    files = {}
+    for method in methods:
+        for path in trial_paths(output, method, 0):
+            files[path] = (path.read_bytes(), path.stat().st_mtime_ns)
+    return files
+
+
+def test_the_order_rotates_with_the_participant_number():
+    orders = [session_order(METHODS, f"P{n:02d}") for n in range(3)]
+    assert orders == [METHODS, METHODS[1:] + METHODS[:1], METHODS[2:] + METHODS[:2]]
+    for place in range(3):  # each method once in each place over three participants
+        assert sorted(order[place] for order in orders) == sorted(METHODS)
+
+
+def test_fixed_answers_hold_for_every_method_unless_a_method_overrides_them():
+    answers = parse_answers(ANSWERS, METHODS)
+    assert answers == {"pbp_alternated": {"tiredness": 3, "ease": 4},
+                       "pbp_continuous": {"tiredness": 3, "ease": 4},
+                       "teleop": {"tiredness": 1, "ease": 4}}
+
+
+@pytest.mark.parametrize("text, message", [
+    ("tiredness=6,ease=4", "the answer 6 is outside 0 (bad) to 5 (good)"),
+    ("tiredness=-1,ease=4", "the answer -1 is outside 0 (bad) to 5 (good)"),
+    ("tiredness=3", "no ease for pbp_alternated"),
+    ("tiredness=3,ease=four", "'four' is not a whole number"),
+    ("tired=3,ease=4", "unknown question 'tired'"),
+    ("fixed_alpha:tiredness=3,ease=4", "'fixed_alpha' is not a method of this session"),
+])
+def test_bad_fixed_answers_are_named(text, message):
+    with pytest.raises(QuestionnaireError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        parse_answers(text, METHODS)
+
+
+def test_a_saved_answer_is_never_overwritten(tmp_path):
+    save_answer(tmp_path, "teleop", "tiredness", 2)
+    with pytest.raises(QuestionnaireError, match="already answered"):
+        save_answer(tmp_path, "teleop", "tiredness", 5)
+    with pytest.raises(QuestionnaireError, match="outside 0"):
+        save_answer(tmp_path, "teleop", "ease", 9)
+    assert json.loads((tmp_path / "questionnaire.json").read_text()) == {
+        "teleop": {"tiredness": 2}}
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--participant", "lab/P07", "--answers", ANSWERS], "holds a path separator"),
+    (["--participant", "..", "--answers", ANSWERS], "not only dots"),
+    (["--participant", "P07", "--answers", "tiredness=7,ease=4"],
+     "the answer 7 is outside 0 (bad) to 5 (good)"),
+    (["--participant", "P07"], "a --headless session needs --answers"),
+    (["--participant", "P07", "--answers", ANSWERS, "--operator", "keyboard"],
+     "--answers stands in for a person's answers"),
+    (["--answers", ANSWERS], "belong to a session: add --participant ID"),
+])
+def test_a_bad_session_stops_before_it_runs(repo, tmp_path, capsys, argv, message):
+    output = tmp_path / "P07"
+    argv = ["run", str(repo / TASK), "--headless", "--operator", "virtual", "--output",
+            str(output), *argv]
+    if "keyboard" in argv:
+        argv.remove("--headless")
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pbp-drake: ") and message in err and "Traceback" not in err
+    assert not output.exists()
+
+
+@pytest.mark.slow
+def test_an_interrupted_session_resumes_where_it_stopped(short_task, tmp_path):
+    output = tmp_path / "P00"
+    order = session_order(METHODS, "P00")
+    ran = []
+
+    def interrupted_at_second(trial):
+        if trial.scenario.seed == short_task.seed:  # the recorded runs, after practice
+            if ran:
+                raise KeyboardInterrupt  # Ctrl-C during the second method
+            ran.append(trial.scenario.method)
+        return run_task(trial)
+
+    first = FixedAnswers(parse_answers(ANSWERS, METHODS))
+    with pytest.raises(KeyboardInterrupt):
+        run_session(short_task, "P00", METHODS, output, interrupted_at_second, first,
+                    practice=True)
+    assert ran == [order[0]]
+    assert first.asked == [(order[0], "tiredness"), (order[0], "ease")]
+    saved = session_files(output, order[:1])
+    practice = sorted(p.name for p in (output / "practice" / "trials").rglob("*.json"))
+    assert practice == [f"seed_{PRACTICE_SEED_OFFSET}.json"] * 3
+
+    # Stopped again, this time between the second method's two questions.
+    class StopsAtEase(FixedAnswers):
+        def answer(self, method, question):
+            if method == order[1] and question == "ease":
+                raise KeyboardInterrupt
+            return super().answer(method, question)
+
+    second = StopsAtEase(parse_answers(ANSWERS, METHODS))
+    with pytest.raises(KeyboardInterrupt):
+        run_session(short_task, "P00", METHODS, output, run_task, second, practice=True)
+    assert second.asked == [(order[1], "tiredness")]
+    assert trial_paths(output, order[1], 0)[0].is_file()
+
+    third = FixedAnswers(parse_answers(ANSWERS, METHODS))
+    reran = []
+    summary = run_session(short_task, "P00", METHODS, output,
+                          lambda trial: reran.append(trial.scenario.method) or run_task(trial),
+                          third, practice=True)
+    # Nothing saved is run, asked or written again; the rest of the session is done.
+    assert reran == [order[2]]
+    assert third.asked == [(order[1], "ease"), (order[2], "tiredness"), (order[2], "ease")]
+    assert session_files(output, order[:1]) == saved
+    assert sorted(summary["methods"]) == sorted(METHODS)
+    assert all(entry["trials"] == 1 for entry in summary["methods"].values())
+    assert json.loads((output / "questionnaire.json").read_text()) == parse_answers(
+        ANSWERS, METHODS)
+    assert sorted(p.name for p in (output / "practice" / "trials").rglob("*.json")) == practice
+
+
+@pytest.mark.slow
+def test_a_session_refuses_a_folder_of_another_scenario(repo, tmp_path, capsys):
+    output = tmp_path / "P01"
+    base = ["run", str(repo / TASK), "--headless", "--operator", "virtual", "--participant",
+            "P01", "--methods", "teleop", "--answers", ANSWERS, "--output", str(output)]
+    assert main([*base, "--duration", "1"]) in (0, 1)
+    saved = session_files(output, ["teleop"])
+    capsys.readouterr()
+    assert main([*base, "--duration", "1.5"]) == 2
+    err = capsys.readouterr().err
+    assert "holds a study of another scenario" in err and "choose another --output" in err
+    assert session_files(output, ["teleop"]) == saved

@@ -28,6 +28,10 @@ def main(argv=None):
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 1
+    except KeyboardInterrupt:
+        # Ctrl-C is how a person ends a run: a word, not a traceback (128 + SIGINT).
+        print("\npbp-drake: interrupted", file=sys.stderr)
+        return 130
 
 
 def _main(argv):

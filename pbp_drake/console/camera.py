@@ -8,10 +8,10 @@ CAMERAS = ("overview", "robot")
 
 # Behind and above the head, looking down past the hand to the shelf: the view of a person
 # standing behind the robot (metres).
-BEHIND = 1.0
-ABOVE = 0.45
-AHEAD = 1.5
-TARGET_HEIGHT = 0.6
+BEHIND = 1.1
+ABOVE = 0.85
+AHEAD = 1.4
+TARGET_HEIGHT = 0.4
 
 
 def behind_head_view(head_position, yaw):

@@ -1,10 +1,12 @@
 """The command line around a run (issue 15): `--version`, `--no-meshcat` (no server, no
-URL), the progress line, and a closed pipe (`pbp-drake report DIR | head -1`) that ends the
-command quietly."""
+URL), the progress line, and a closed pipe (`pbp-drake report DIR | head -1`) or Ctrl-C that
+end the command quietly."""
 
 import json
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -69,3 +71,16 @@ def test_a_closed_pipe_ends_report_quietly(repo, tmp_path):
     err = process.communicate(timeout=100)[1].decode()
     assert "Traceback" not in err and "Exception ignored" not in err, err
     assert process.returncode == 1
+
+
+@pytest.mark.timeout(60)
+def test_ctrl_c_ends_a_run_without_a_traceback(repo):
+    process = subprocess.Popen([sys.executable, "-m", "pbp_drake", "run", QUICK], cwd=repo,
+                               stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    assert process.stdout.readline().startswith("Meshcat: http://")
+    time.sleep(0.5)  # into the 3 s of the scene, run at real time
+    process.send_signal(signal.SIGINT)
+    err = process.communicate(timeout=30)[1]
+    assert process.returncode == 130
+    assert "pbp-drake: interrupted" in err and "Traceback" not in err, err

@@ -123,7 +123,6 @@ def _run(args):
         check_output_folder(args.output)
     resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
                                 args.scene, args.operator, args.seed, args.duration)
-    scenario = resolved.scenario
     if args.camera == "robot" and not resolved.is_hsr:
         raise ScenarioError("--camera robot follows the HSR; this scenario uses the 2-D toy "
                             "robot")
@@ -137,13 +136,20 @@ def _run(args):
         print(f"Meshcat: {meshcat.web_url()}", flush=True)
     if resolved.is_hsr:
         return _run_task(args, resolved, meshcat)
+    return _run_scene(args, resolved, meshcat)
+
+
+def _run_scene(args, resolved, meshcat):
+    """A 2-D scene: live in the page (its console has Stop alone) for its duration."""
+    scenario = resolved.scenario
     if args.log:
         raise ScenarioError("--log streams an HSR task's per-tick rows; this scenario uses "
                             "the 2-D toy robot")
     diagram = build_diagram(resolved, meshcat)
-    console = live = None
+    console = None
     if meshcat is not None:
         console = _console(meshcat, args, scenario, choices=("stop",))
+        console.show_title(method_name(scenario.method, _alpha(scenario)))
     if _interactive(args, meshcat):
         _wait_for_browser(meshcat, args.wait_for_browser)
     if args.record:

@@ -29,8 +29,8 @@ class Console:
             `CHOICE_BUTTONS`: Stop, Restart, Next scene), in this order.
         alpha: with a number, an alpha slider (0..1, step 0.05) starting there; `alpha()`
             reads it.
-        realtime_rate: with a positive number, a real-time-rate slider (`RATE_RANGE`)
-            starting there; `realtime_rate()` reads it.
+        realtime_rate: with a positive number, a real-time-rate slider (`RATE_RANGE`,
+            widened to hold the number) starting there; `realtime_rate()` reads it.
 
     The panel then shows, top to bottom: the choice buttons, the sliders, the title line
     (`show_title`), the status line (`show_status`) and the result line (`show_result`).
@@ -66,8 +66,9 @@ class Console:
             self._sliders.append(ALPHA_SLIDER)
         if realtime_rate is not None:
             low, high, step = RATE_RANGE
-            meshcat.AddSlider(RATE_SLIDER, low, high, step,
-                              min(max(float(realtime_rate), low), high))
+            rate = float(realtime_rate)
+            # Widened to hold the rate asked for: the slider must not clip the command line.
+            meshcat.AddSlider(RATE_SLIDER, min(low, rate), max(high, rate), step, rate)
             self._sliders.append(RATE_SLIDER)
         # Line name -> the label shown now, in the order the lines are shown.
         self._lines = {"title": None, "status": None, "result": None}

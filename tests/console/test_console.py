@@ -84,6 +84,9 @@ def test_the_sliders_read_what_the_person_set(meshcat):
     assert console.alpha() == pytest.approx(0.8)
     assert console.realtime_rate() == pytest.approx(0.5)
     assert Console(meshcat, choices=()).alpha() is None
+    console.close()
+    # A rate asked for on the command line is not clipped by the slider's range.
+    assert Console(meshcat, realtime_rate=5.0).realtime_rate() == pytest.approx(5.0)
 
 
 def test_stop_ends_a_run_where_it_stands(repo, meshcat):

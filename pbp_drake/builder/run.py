@@ -165,9 +165,15 @@ class TaskResult:
     peak_command_acceleration: float | None = None
 
     def summary_line(self):
+        """One line: outcome, time, intervention ratio, the collision ratio where the task
+        measures collisions (the obstacle task: `in_collision` is logged), target switches
+        and the peaks."""
         outcome = "success" if self.success else "FAILED"
+        # A reach task's collision_ratio is 0 because nothing measured it: left out.
+        collisions = ("" if self.in_collision is None
+                      else f", collision ratio {self.collision_ratio:.3f}")
         return (f"{outcome} in {self.task_time:.2f} s, intervention ratio "
-                f"{self.intervention_ratio:.3f}, {self.switches} target switches, "
+                f"{self.intervention_ratio:.3f}{collisions}, {self.switches} target switches, "
                 f"peak hand speed {_or_na(self.peak_hand_speed, 3)} m/s, "
                 f"peak command acceleration {_or_na(self.peak_command_acceleration, 2)} m/s^2")
 

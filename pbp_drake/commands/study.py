@@ -12,7 +12,7 @@ from pbp_drake.scenarios import (
     Hsr, MethodComparison, ScenarioError, check_method_comparison, load_scenario_file)
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.progress import ProgressBar
-from pbp_drake.studies.report import FIGURES, report, results_table
+from pbp_drake.studies.report import figure_names, report, results_table
 from pbp_drake.studies.splits import SPLITS, first_seed, split_of
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
 
@@ -147,7 +147,7 @@ def _print_report(summary, output):
         if entry["errors"]:
             print(f"  {method}: {entry['errors']} trials failed with an error (seeds "
                   f"{entry['error_seeds']}); see {output / 'trials' / method}")
-    for name in ("summary.json", "results.md", "trials.json", *FIGURES):
+    for name in ("summary.json", "results.md", "trials.json", *figure_names(summary)):
         print(f"  wrote {output / name}")
 
 

@@ -24,10 +24,10 @@ from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, Hsr, ObstacleRepulsion,
-    Scenario, ScenarioError, ScriptedCommands, SinusoidalStep)
+    Scenario, ScenarioError, ScriptedCommands, SinusoidalStep, VirtualParticipant)
 from pbp_drake.scenarios.value_checks import (
     check_bent_path, check_direction, check_dmp_duration, check_numbers, check_obstacle_task,
-    check_reach_task, check_seed, check_time_steps, require_finite)
+    check_reach_task, check_seed, check_time_steps, check_virtual_participant, require_finite)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
 BLEND_MODE_OF_METHOD = {
@@ -311,6 +311,8 @@ def _resolve_hsr(scenario):
     require_finite(operator, "scenario.operator",
                    ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
                     "direction_noise", "speed_noise"), positive=False)
+    if isinstance(operator, VirtualParticipant):
+        check_virtual_participant(operator)
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(task, DynamicObstacles):

@@ -161,3 +161,33 @@ def check_direction(axis, dimension, field):
     if len(axis) != dimension or not math.hypot(*axis) >= 1e-6:
         raise ScenarioError(f"{field} {axis} is no direction; expected a vector of "
                             f"dimension {dimension} and length at least 1e-6")
+
+
+# The virtual participant's plan scores 3 (directions + 1) motions at each of its times,
+# every tick: a direction a degree is already far finer than the plan needs.
+MOST_PLAN_DIRECTIONS = 360
+MOST_PLAN_TIMES = 100
+
+
+def check_virtual_participant(operator, field="scenario.operator"):
+    """The obstacle fields of `operator: !VirtualParticipant` (`VirtualParticipantParams`):
+    times, rates and steps positive, distances, weights and factors not negative,
+    `plan_directions` a count and `plan_times` positive times that increase."""
+    require_finite(operator, field, (
+        "settle_time", "max_turn_rate", "release_heading_gap", "release_heading_gap_alternated",
+        "policy_compensation", "progress_step", "stall_time"))
+    require_finite(operator, field, (
+        "final_approach_radius", "push_through_radius", "turn_weight", "keep_on_weight",
+        "release_factor", "goal_margin_factor", "min_closing_fraction"), positive=False)
+    directions = operator.plan_directions
+    if isinstance(directions, bool) or not isinstance(directions, numbers.Integral):
+        raise ScenarioError(f"{field}.plan_directions {directions!r} is no count; expected "
+                            f"a whole number, 1 to {MOST_PLAN_DIRECTIONS}")
+    check_count(directions, f"{field}.plan_directions", 1, MOST_PLAN_DIRECTIONS)
+    times = np.asarray(operator.plan_times, float)
+    if (times.ndim != 1 or not 1 <= len(times) <= MOST_PLAN_TIMES
+            or not np.all(np.isfinite(times)) or times[0] <= 0
+            or np.any(np.diff(times) <= 0)):
+        raise ScenarioError(f"{field}.plan_times {operator.plan_times} must be 1 to "
+                            f"{MOST_PLAN_TIMES} positive times (s) that increase strictly, "
+                            "e.g. [0.1, 0.3, 0.6, 1.0, 1.5]")

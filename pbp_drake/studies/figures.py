@@ -1,7 +1,8 @@
 """The paper's figures, drawn with matplotlib (headless): the 2-D studies' Fig. 2 (the alpha
 study, with its final distances and operator speeds) and Fig. 4 (Alt vs Cont), and the
 method comparison's Fig. 7: (a) box plots of the intervention ratio, (b) of the task time,
-(c) the histogram of per-trial collision ratios.
+(c) the histogram of per-trial collision ratios, drawn only for tasks that measure
+collisions (the obstacle task; see `studies.report.figure_names`).
 Fig. 7 reads trial records (dicts from the trial files), never a simulation."""
 
 import matplotlib

@@ -11,7 +11,15 @@ from pbp_drake.studies.summary import summarize
 from pbp_drake.studies.trial_files import (
     TRIAL_FIELDS, name_damaged, read_study, write_atomically)
 
-FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png", "fig7c_collisions.png")
+BOX_FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png")
+# Drawn only for tasks that measure collisions (summary["measures_collisions"]).
+COLLISION_FIGURE = "fig7c_collisions.png"
+
+
+def figure_names(summary):
+    """The figures `report` writes for this summary, in order: Fig. 7a and 7b, and Fig. 7c
+    where the task measures collisions."""
+    return BOX_FIGURES + ((COLLISION_FIGURE,) if summary["measures_collisions"] else ())
 
 
 def _cell(entry, field, digits):
@@ -35,25 +43,28 @@ def _count(value):
 
 def results_table(summary):
     """The summary as a Markdown table, one row per method: mean ± std of the intervention
-    ratio, task time and collision ratio, max / mean of the trials' peak hand speed and peak
+    ratio and task time, and of the collision ratio with the count of collision-free trials
+    where the task measures collisions; max / mean of the trials' peak hand speed and peak
     command acceleration (see `summarize`)."""
     seeds = seeds_line(summary)
     lines = [seeds, ""] if seeds else []
-    lines += ["| method | trials | success | intervention ratio | task time (s) | "
-             "collision ratio | collision-free trials | peak hand speed (m/s), max / mean | "
-             "peak command acceleration (m/s²), max / mean | errors |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    collisions = summary["measures_collisions"]
+    columns = ["method", "trials", "success", "intervention ratio", "task time (s)",
+               *(("collision ratio", "collision-free trials") if collisions else ()),
+               "peak hand speed (m/s), max / mean",
+               "peak command acceleration (m/s²), max / mean", "errors"]
+    lines += ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for method, entry in summary["methods"].items():
         rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
         gone = [f"{entry[k]} {k}" for k in ("missing", "damaged") if entry.get(k)]
         trials = f"{entry['trials']}" + (f" ({', '.join(gone)})" if gone else "")
-        lines.append(f"| {METHOD_LABELS.get(method, method)} | {trials} | {rate} | "
-                     f"{_cell(entry, 'intervention_ratio', 3)} | "
-                     f"{_cell(entry, 'task_time', 1)} | {_cell(entry, 'collision_ratio', 3)} | "
-                     f"{_count(entry['collision_free_trials'])} | "
-                     f"{_peak_cell(entry, 'peak_hand_speed', 3)} | "
-                     f"{_peak_cell(entry, 'peak_command_acceleration', 2)} | "
-                     f"{entry['errors']} |")
+        collision = ((_cell(entry, "collision_ratio", 3),
+                      _count(entry["collision_free_trials"])) if collisions else ())
+        cells = [METHOD_LABELS.get(method, method), trials, rate,
+                 _cell(entry, "intervention_ratio", 3), _cell(entry, "task_time", 1),
+                 *collision, _peak_cell(entry, "peak_hand_speed", 3),
+                 _peak_cell(entry, "peak_command_acceleration", 2), str(entry["errors"])]
+        lines.append("| " + " | ".join(cells) + " |")
     if summary.get("damaged"):
         lines += ["", f"Skipped as damaged or foreign: {len(summary['damaged'])} files "
                       f"({sum(e.get('damaged', 0) for e in summary['methods'].values())} "
@@ -79,7 +90,8 @@ def _flat_trials(study, records):
 
 def report(output):
     """Rebuilds `summary.json`, `results.md`, `trials.json` and the figures of a study folder
-    from its study.json and trial files only (no simulation). Returns the summary.
+    (`figure_names`) from its study.json and trial files only (no simulation). Returns the
+    summary.
 
     Damaged or foreign files (see `read_study`) are named on stderr and skipped: the
     summary counts each method's damaged trials and lists the files under "damaged"."""
@@ -93,7 +105,12 @@ def report(output):
                      json.dumps(_flat_trials(study, records), indent=1) + "\n")
     rows = [r for r in records.values() if r is not None]
     methods = study["methods"]
-    plot_intervention(rows, methods, output / FIGURES[0])
-    plot_task_time(rows, methods, output / FIGURES[1])
-    plot_collision_histogram(summary, output / FIGURES[2])
+    plot_intervention(rows, methods, output / BOX_FIGURES[0])
+    plot_task_time(rows, methods, output / BOX_FIGURES[1])
+    if summary["measures_collisions"]:
+        plot_collision_histogram(summary, output / COLLISION_FIGURE)
+    else:
+        # A Fig. 7c an older version drew for this task (all zeros: nothing was measured)
+        # would stand beside the new figures as if it were a result.
+        (output / COLLISION_FIGURE).unlink(missing_ok=True)
     return summary

@@ -9,7 +9,8 @@ import pathlib
 
 import numpy as np
 
-from pbp_drake.scenarios import parse_method_label
+from pbp_drake.scenarios import DynamicObstacles, parse_method_label
+from pbp_drake.studies.trial_files import trial_paths
 
 # Collision-ratio histogram: 20 bins of 0.05 over [0, 1] (the last bin includes 1).
 HISTOGRAM_EDGES = tuple(round(0.05 * i, 2) for i in range(21))
@@ -45,7 +46,8 @@ def does_the_hsr_task(entry):
     ran = entry["trials"] - entry["errors"]
     does_task = (entry["success_rate"] is not None
                  and entry["success_rate"] >= IDEAL_ALPHA_SUCCESS)
-    if entry["collision_free_trials"] is not None:
+    # Absent or None where the task measures no collisions (see measures_collisions).
+    if entry.get("collision_free_trials") is not None:
         does_task = does_task and 2 * entry["collision_free_trials"] > ran
     return does_task
 
@@ -115,10 +117,35 @@ def _relative(path, output):
         return path
 
 
+def measures_collisions(study, records, output=None):
+    """Whether the study's task measures collisions: the obstacle task does, reaching does
+    not (its trials record a collision ratio of 0 that means "not measured", not "none").
+
+    Read off the scenario study.json holds; a study without it (inferred from the trial
+    files, or written by an older version) is judged by its trials' CSV files, whose
+    `in_collision` column only a task that measures collisions writes."""
+    content = study.get("scenario_content")
+    if isinstance(content, dict):
+        task = content.get("task")
+        return isinstance(task, dict) and task.get("!type") == DynamicObstacles.__name__
+    if output is None:
+        return False
+    for (method, _), record in records.items():
+        if record is None or not record.get("time_series"):
+            continue
+        try:
+            with open(trial_paths(output, method, record["seed"])[1]) as stream:
+                return "in_collision" in stream.readline().strip().split(",")
+        except OSError:
+            continue
+    return False
+
+
 def summarize(study, records, damaged=(), output=None):
     """Per method: how many trials, errors and missing; success rate over the trials on
-    disk; mean and (population) std of intervention ratio and task time, and the mean, std
-    and histogram of the collision ratio, and the max and mean of each trial's
+    disk; mean and (population) std of intervention ratio and task time, and, in tasks that
+    measure collisions (`measures_collisions`, also in the summary), the mean, std and
+    histogram of the collision ratio and the count of collision-free trials; the max and mean of each trial's
     peak_hand_speed (m/s, the largest one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| /
     control_period) and peak_command_acceleration (m/s^2, max_k |v_cmd(k+1) - v_cmd(k)| /
     control_period), over the trials that ran without error (those that recorded them);
@@ -129,18 +156,18 @@ def summarize(study, records, damaged=(), output=None):
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),
-               "seeds": [study["seed"], study["seed"] + study["trials"] - 1],
-               "collision_histogram_edges": list(HISTOGRAM_EDGES),
-               "methods": {}}
+               "seeds": [study["seed"], study["seed"] + study["trials"] - 1]}
+    collisions = measures_collisions(study, records, output)
+    summary["measures_collisions"] = collisions
+    if collisions:
+        summary["collision_histogram_edges"] = list(HISTOGRAM_EDGES)
+    summary["methods"] = {}
     for method in study["methods"]:
         rows = [records[(method, trial)] for trial in range(study["trials"])]
         present = [r for r in rows if r is not None]
         broken = {d.key for d in damaged if d.key is not None and d.key[0] == method}
         ran = [r for r in present if r["error"] is None]
-        ratios = [r["collision_ratio"] for r in ran if r["collision_ratio"] is not None]
-        collision = mean_std(ratios)
-        collision["histogram"] = collision_histogram(ratios)
-        summary["methods"][method] = {
+        summary["methods"][method] = entry = {
             "trials": len(present),
             "missing": len(rows) - len(present) - len(broken),
             "damaged": len(broken),
@@ -150,12 +177,16 @@ def summarize(study, records, damaged=(), output=None):
             if present else None,
             "intervention_ratio": mean_std([r["intervention_ratio"] for r in ran]),
             "task_time": mean_std([r["task_time"] for r in ran]),
-            "collision_ratio": collision,
-            "collision_free_trials": sum(ratio == 0.0 for ratio in ratios) if ratios else None,
             "peak_hand_speed": max_mean([r.get("peak_hand_speed") for r in ran]),
             "peak_command_acceleration": max_mean(
                 [r.get("peak_command_acceleration") for r in ran]),
         }
+        if collisions:
+            ratios = [r["collision_ratio"] for r in ran if r["collision_ratio"] is not None]
+            entry["collision_ratio"] = {**mean_std(ratios),
+                                        "histogram": collision_histogram(ratios)}
+            entry["collision_free_trials"] = (sum(ratio == 0.0 for ratio in ratios)
+                                              if ratios else None)
     summary["damaged"] = [{"file": _relative(d.path, output), "problem": d.problem}
                           for d in damaged]
     swept = arbitration(summary["methods"])

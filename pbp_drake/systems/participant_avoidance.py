@@ -5,20 +5,16 @@ two. When the cylinders settle into a wall across the line to the target, every 
 that keeps clear gets no closer, and standing still wins each tick, forever: before this
 watch, such trials ran into the time limit with the hand parked in front of the wall.
 People in the paper's study pushed on through at such moments, at the risk of a collision;
-the participant now does the same once it has not come `PROGRESS_STEP` closer to the target
-for `STALL_TIME`, and keeps pushing until it arrives (turning back to avoiding would park
-it at the next wall, a few centimetres on).
+the participant now does the same once it has not come `progress_step` closer to the target
+for `stall_time` (`VirtualParticipantParams`), and keeps pushing until it arrives (turning
+back to avoiding would park it at the next wall, a few centimetres on).
 """
 
 import numpy as np
 
-# It counts as getting closer once it beats its best distance to the target by this (m).
-PROGRESS_STEP = 0.02
-# How long (s) it waits for a way round before pushing through: the time the moving
-# cylinders take to settle (the participant's own SETTLE_TIME).
-STALL_TIME = 4.0
 # The watch's state: [closest distance to the target so far (m), seconds since it got
-# closer, 1 once it has given up on going round].
+# closer, 1 once it has given up on going round]. The layout of the participant's discrete
+# state, not a behaviour: no scenario field.
 WATCH_SIZE = 3
 
 
@@ -27,15 +23,17 @@ def start_watch(distance):
     return np.array([float(distance), 0.0, 0.0])
 
 
-def update_watch(watch, distance, elapsed):
+def update_watch(params, watch, distance, elapsed):
     """The watch after one tick of `elapsed` seconds that left the hand `distance` (m)
-    from the target: a new array `[closest, stalled_for, pushing]`."""
+    from the target: a new array `[closest, stalled_for, pushing]`. It counts as getting
+    closer once it beats its best distance by `params.progress_step`, and gives up going
+    round after `params.stall_time` without (`VirtualParticipantParams`)."""
     closest, stalled_for, pushing = (float(value) for value in watch)
-    if distance < closest - PROGRESS_STEP:
+    if distance < closest - params.progress_step:
         closest, stalled_for = distance, 0.0
     else:
         stalled_for += elapsed
-    if stalled_for >= STALL_TIME:
+    if stalled_for >= params.stall_time:
         pushing = 1.0
     return np.array([closest, stalled_for, pushing])
 
@@ -45,14 +43,10 @@ def is_pushing_through(watch):
     return bool(watch[2] > 0.5)
 
 
-# In the last few centimetres (PBP) the participant leaves the robot alone only while it
-# closes in on the target at least this fraction of the nominal speed.
-MIN_CLOSING_FRACTION = 0.25
-
-
-def robot_closes_in(velocity, offset, nominal_speed):
+def robot_closes_in(params, velocity, offset, nominal_speed):
     """Whether the hand's `velocity` (2) carries it toward the target, `offset` (2) away,
-    at `MIN_CLOSING_FRACTION` of `nominal_speed` or more.
+    at `params.min_closing_fraction` of `nominal_speed` or more: in the last few centimetres
+    (PBP) the participant leaves the robot alone only then.
 
     In PBP-Alt every takeover freezes the DMP's phase, so after a run of takeovers the DMP
     is still early in its motion when the hand is almost there; early on, its forcing term
@@ -64,4 +58,4 @@ def robot_closes_in(velocity, offset, nominal_speed):
     if distance < 1e-9:
         return True
     return float(np.asarray(velocity) @ np.asarray(offset)) / distance >= (
-        MIN_CLOSING_FRACTION * nominal_speed)
+        params.min_closing_fraction * nominal_speed)

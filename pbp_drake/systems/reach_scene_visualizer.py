@@ -6,6 +6,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.layouts import EeState, Target, position_of
+from pbp_drake.systems.scene_drawing import PathDots
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
 TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
@@ -14,6 +15,10 @@ TARGET_COLOUR = Rgba(1.0, 0.9, 0.0, 1.0)
 ESTIMATE_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 ACTIVE_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
+# Dots per path (each of HSR_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
+# every path update, so their count and rate set most of its size.
+PATH_DOTS = 24
+ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008
 OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
 
 OBJECT_RADIUS = 0.03
@@ -42,12 +47,15 @@ class ReachSceneVisualizer(LeafSystem):
     current `target` (`Target`, `[p (3), index]`) and the blue ball above the
     estimated goal (`selected_goal`), with `time_in_recording` so that
     `Meshcat.StartRecording` replays them; an orange ring around the hand shows when the
-    operator acts. The selected DMP's predicted path is drawn as a line, the others faint
-    (live only: Meshcat replays transforms and visibility, not lines). Call from the thread
-    that made `meshcat`.
+    operator acts. Each `path_period` (default 0.1 s: paths change slowly, and a
+    replay interpolates between updates) every DMP's predicted path is drawn as faint dots
+    and the selected one's again as bold dots (`PathDots`, with `time_in_recording`, so a
+    replay shows each path where it was at that time). Call from the thread that made
+    `meshcat`.
     """
 
-    def __init__(self, meshcat, objects, prediction_steps=0, publish_period=1.0 / 30.0):
+    def __init__(self, meshcat, objects, prediction_steps=0, publish_period=1.0 / 30.0,
+                 path_period=0.1):
         super().__init__()
         self._meshcat = meshcat
         self._objects = np.asarray(objects, dtype=float)
@@ -59,7 +67,14 @@ class ReachSceneVisualizer(LeafSystem):
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._predicted_paths_port = self.DeclareVectorInputPort(
             "predicted_paths", max(1, k * (self._prediction_steps + 1) * 3))
+        self._other_paths = [PathDots(f"/task/predictions/{index}", PATH_DOTS,
+                                      OTHER_DOT_RADIUS, OTHER_PATH_COLOUR)
+                             for index in range(k)]
+        self._active_path = PathDots("/task/predictions/selected", PATH_DOTS,
+                                     ACTIVE_DOT_RADIUS, ACTIVE_PATH_COLOUR)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
+        if self._prediction_steps:
+            self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)
         self.DeclareInitializationPublishEvent(self._initialise)
 
     def get_target_input_port(self):
@@ -80,6 +95,8 @@ class ReachSceneVisualizer(LeafSystem):
     def _initialise(self, context):
         self._draw_scene()
         self._publish(context)
+        if self._prediction_steps:
+            self._publish_paths(context)
 
     def _draw_scene(self):
         meshcat = self._meshcat
@@ -96,6 +113,9 @@ class ReachSceneVisualizer(LeafSystem):
         meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
         meshcat.SetObject("/task/operator", Cylinder(0.09, 0.01), OPERATOR_COLOUR)
         meshcat.SetProperty("/task/operator", "visible", False)
+        if self._prediction_steps:
+            for dots in [*self._other_paths, self._active_path]:
+                dots.draw(meshcat)
         centre = self._objects.mean(axis=0)
         # A camera behind and above the robot that sees it and every object.
         meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
@@ -116,10 +136,14 @@ class ReachSceneVisualizer(LeafSystem):
             if self._operator_active_port.HasValue(context):
                 active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
                 meshcat.SetProperty("/task/operator", "visible", active, time)
-        if self._prediction_steps and self._predicted_paths_port.HasValue(context):
-            paths = self._predicted_paths_port.Eval(context).reshape(
-                len(self._objects), self._prediction_steps + 1, 3)
-            for index, path in enumerate(paths):
-                colour = ACTIVE_PATH_COLOUR if index == selected else OTHER_PATH_COLOUR
-                meshcat.SetLine(f"/task/predictions/{index}", path.T,
-                                3.0 if index == selected else 1.5, colour)
+
+    def _publish_paths(self, context):
+        if not self._predicted_paths_port.HasValue(context):
+            return
+        time = context.get_time()
+        paths = self._predicted_paths_port.Eval(context).reshape(
+            len(self._objects), self._prediction_steps + 1, 3)
+        for dots, path in zip(self._other_paths, paths):
+            dots.show(self._meshcat, path, time)
+        selected = int(self._selected_goal_port.Eval(context)[0])
+        self._active_path.show(self._meshcat, paths[selected], time)

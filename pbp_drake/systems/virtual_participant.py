@@ -1,6 +1,6 @@
 """A virtual participant for the HSR tasks: stands in for the paper's users in automated runs."""
 
-import dataclasses
+import copy
 
 import numpy as np
 
@@ -14,25 +14,6 @@ from pbp_drake.systems.participant_params import VirtualParticipantParams
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 PARTICIPANT_MODES = ("assist", "drive")
-# Within this distance of the target (m) the participant no longer minds obstacles...
-FINAL_APPROACH = 0.08
-# ...and within this one it pushes on through when no way round is left.
-PUSH_THROUGH = 0.3
-# The times (s) ahead at which it checks a motion, and how far ahead it guesses where a
-# moving obstacle will stop (it stops on the line from the hand to the target).
-PLAN_TIMES = np.array([0.1, 0.3, 0.6, 1.0, 1.5])
-SETTLE_TIME = 4.0
-DIRECTIONS = 24
-MAX_TURN_RATE = 0.5
-TURN_WEIGHT = 0.6
-KEEP_ON_WEIGHT = 0.15
-# It lets go once the policy's path is clear by RELEASE_FACTOR margins and the robot faces
-# the way it wants to (rad); it keeps control at least `hold_time`.
-RELEASE_FACTOR = 1.5
-RELEASE_HEADING_GAP = 0.05
-GOAL_MARGIN_FACTOR = 1.0
-# PBP-Cont: how much faster than `speed` it may push against the policy.
-POLICY_COMPENSATION = 3.0
 
 
 class VirtualParticipant(SampledOperator):
@@ -72,9 +53,10 @@ class VirtualParticipant(SampledOperator):
     a fan of velocities and yaw rates over a short horizon (progress to the target, turning
     toward a heading whose footprint fits at the target, clearance), and in PBP it lets go
     whenever the DMP's path (pulled back to its start-target line) looks clear for a while.
-    In the last `FINAL_APPROACH` it no longer minds obstacles (in PBP it drives there only
-    when the robot does not close in by itself), and within `PUSH_THROUGH`, or after
-    `participant_avoidance.STALL_TIME` without getting closer, it pushes on through.
+    In the last `final_approach_radius` it no longer minds obstacles (in PBP it drives there
+    only when the robot does not close in by itself), and within `push_through_radius`, or
+    after `stall_time` without getting closer (`participant_avoidance`), it pushes on
+    through. `VirtualParticipantParams` documents each of these fields.
 
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
     `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is
@@ -91,7 +73,8 @@ class VirtualParticipant(SampledOperator):
         super().__init__(OperatorCommand.size, control_period)
         self._mode = mode
         self._objects = np.asarray(objects, dtype=float)
-        self.params = dataclasses.replace(params)
+        self.params = copy.deepcopy(params)
+        self._plan_times = np.array(params.plan_times, dtype=float)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
         self._reaction_ticks = int(round(params.reaction_delay / control_period))
@@ -116,8 +99,9 @@ class VirtualParticipant(SampledOperator):
         if obstacle_margin is None:
             obstacle_margin = 0.08 if mode == "assist" and not policy_adds else 0.06
         self._obstacle_margin = float(obstacle_margin)
-        self._release_heading_gap = (0.12 if mode == "assist" and not policy_adds
-                                     else RELEASE_HEADING_GAP)
+        self._release_heading_gap = (params.release_heading_gap_alternated
+                                     if mode == "assist" and not policy_adds
+                                     else params.release_heading_gap)
         self._hold_ticks = int(round(params.hold_time / control_period))
         if obstacle_count > 0:
             self._obstacles_port = self.DeclareVectorInputPort(
@@ -209,34 +193,35 @@ class VirtualParticipant(SampledOperator):
         distance = np.linalg.norm(offset)
         noise_angle, speed_scale = self._noise(context)
         drive = self._mode == "drive"
-        track[watch] = update_watch(track[watch], distance, self._period)
+        params = self.params
+        track[watch] = update_watch(params, track[watch], distance, self._period)
         pushing_through = is_pushing_through(track[watch])
-        if distance < FINAL_APPROACH:
+        if distance < params.final_approach_radius:
             # The last few centimetres: straight on, whatever stands there; in PBP only
             # when the robot does not get there by itself.
-            if not drive and robot_closes_in(velocity, offset, self._speed):
+            if not drive and robot_closes_in(params, velocity, offset, self._speed):
                 return finish(np.zeros(4), False, 0.0)
             speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
             step = speed * rotate_planar(offset / max(distance, 1e-9), noise_angle)
             return finish(np.array([step[0], step[1], 0.0, 0.0]), True)
 
         predicted = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
-                                       PLAN_TIMES)
+                                       self._plan_times)
         settled = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
-                                     np.array([SETTLE_TIME]))[0]
+                                     np.array([params.settle_time]))[0]
         goal_heading = self._goal_heading(heading, target_xy, settled)
         heading_gap = abs(wrap_angle(heading - goal_heading))
         if not drive and not pushing_through:
             # Would the policy, left alone, keep the robot clear?
             policy_clear = footprint_clearance(
-                policy_path(hand, start, target_xy, self._speed, PLAN_TIMES), heading,
+                policy_path(hand, start, target_xy, self._speed, self._plan_times), heading,
                 predicted, self._obstacle_radius).min()
             if was_active:
                 release = (hold <= 0 and heading_gap < self._release_heading_gap
-                           and policy_clear >= RELEASE_FACTOR * self._obstacle_margin)
+                           and policy_clear >= params.release_factor * self._obstacle_margin)
             else:
                 moving_clear = footprint_clearance(
-                    hand + velocity * PLAN_TIMES[:, None], heading, predicted,
+                    hand + velocity * self._plan_times[:, None], heading, predicted,
                     self._obstacle_radius).min()
                 release = (heading_gap < 2 * self._release_heading_gap
                            and min(policy_clear, moving_clear) >= self._obstacle_margin)
@@ -245,7 +230,7 @@ class VirtualParticipant(SampledOperator):
 
         planned, yaw_rate, clear = self._plan(hand, heading, target_xy, predicted,
                                               goal_heading, last_command)
-        if pushing_through or (clear < 0.0 and distance < PUSH_THROUGH):
+        if pushing_through or (clear < 0.0 and distance < params.push_through_radius):
             # Boxed in next to the target, or no closer for a long while
             # (`participant_avoidance`): on through, as people did.
             planned = self._speed * min(1.0, distance / self._slow_radius) * offset / distance
@@ -256,8 +241,9 @@ class VirtualParticipant(SampledOperator):
             policy_velocity = velocity - last_command
             command = command - policy_velocity
             norm = np.linalg.norm(command)
-            if norm > POLICY_COMPENSATION * self._speed:
-                command *= POLICY_COMPENSATION * self._speed / norm
+            limit = params.policy_compensation * self._speed
+            if norm > limit:
+                command *= limit / norm
         hold_ticks = track[3] if was_active or drive else self._hold_ticks
         return finish(np.array([command[0], command[1], 0.0, yaw_rate]), True, hold_ticks)
 
@@ -269,36 +255,37 @@ class VirtualParticipant(SampledOperator):
         clear = footprint_clearance(np.broadcast_to(target_xy, (len(turns), 2)), headings,
                                     np.broadcast_to(obstacles, (len(turns),) + obstacles.shape),
                                     self._obstacle_radius)
-        fine = clear >= GOAL_MARGIN_FACTOR * self._obstacle_margin
+        fine = clear >= self.params.goal_margin_factor * self._obstacle_margin
         if np.any(fine):
             return headings[fine][np.argmin(np.abs(turns[fine]))]
         return headings[np.argmax(clear)]
 
     def _plan(self, hand, heading, target_xy, predicted, goal_heading, last_command):
         """The best velocity (2) and yaw rate over a short horizon, and its clearance."""
+        params, plan_times = self.params, self._plan_times
         offset = target_xy - hand
         distance = np.linalg.norm(offset)
         toward = offset / max(distance, 1e-9)
         speed = self._speed * min(1.0, max(distance, 0.02) / self._slow_radius)
-        angles = np.arctan2(toward[1], toward[0]) + np.linspace(0.0, 2 * np.pi, DIRECTIONS,
-                                                                endpoint=False)
+        angles = np.arctan2(toward[1], toward[0]) + np.linspace(
+            0.0, 2 * np.pi, params.plan_directions, endpoint=False)
         directions = np.vstack([np.stack([np.cos(angles), np.sin(angles)], 1), [[0.0, 0.0]]])
-        yaw = min(self._rotation_speed, MAX_TURN_RATE)
+        yaw = min(self._rotation_speed, params.max_turn_rate)
         velocities = np.repeat(speed * directions, 3, axis=0)
         yaw_rates = np.tile([0.0, yaw, -yaw], len(directions))
-        hands = hand + velocities[:, None, :] * PLAN_TIMES[None, :, None]
-        headings = heading + yaw_rates[:, None] * PLAN_TIMES[None, :]
+        hands = hand + velocities[:, None, :] * plan_times[None, :, None]
+        headings = heading + yaw_rates[:, None] * plan_times[None, :]
         clear = footprint_clearance(hands, headings, predicted[None],
                                     self._obstacle_radius).min(axis=1)
         progress = velocities @ toward / self._speed
         gap_now = abs(wrap_angle(heading - goal_heading))
         gap_then = np.abs(wrap_angle(headings[:, -1] - goal_heading))
-        turning = (gap_now - gap_then) / (MAX_TURN_RATE * PLAN_TIMES[-1])
+        turning = (gap_now - gap_then) / (params.max_turn_rate * plan_times[-1])
         last_norm = np.linalg.norm(last_command)
         keep_on = (velocities @ last_command / (self._speed * last_norm) if last_norm > 1e-9
                    else np.zeros(len(velocities)))
         shortfall = np.maximum(self._obstacle_margin - clear, 0.0)
-        score = (progress + TURN_WEIGHT * turning + KEEP_ON_WEIGHT * keep_on
+        score = (progress + params.turn_weight * turning + params.keep_on_weight * keep_on
                  - 20.0 * shortfall - 5.0 * (shortfall > 0))
         best = int(np.argmax(score))
         return velocities[best], yaw_rates[best], clear[best]
@@ -339,14 +326,15 @@ class VirtualParticipant(SampledOperator):
     def _against_policy(self, context, ee_state, wanted):
         """The command that moves the hand at `wanted` (2) under an additive blend: `wanted`
         minus the policy's own motion (what the hand does minus what was asked of it), at
-        most `POLICY_COMPENSATION` times `speed`."""
+        most `policy_compensation` times `speed`."""
         held = self._held(context)
         last_command = held[:2] if held[4] > 0.5 else np.zeros(2)
         policy_velocity = np.array([ee_state.vx, ee_state.vy]) - last_command
         command = wanted - policy_velocity
         norm = np.linalg.norm(command)
-        if norm > POLICY_COMPENSATION * self._speed:
-            command *= POLICY_COMPENSATION * self._speed / norm
+        limit = self.params.policy_compensation * self._speed
+        if norm > limit:
+            command *= limit / norm
         return command
 
     def _count_insistence(self, context, discrete_state, known_target, selected, position,

@@ -242,8 +242,11 @@ def test_study_compares_methods_on_the_same_scenes(tmp_path, capsys):
         assert set(entry["task_time"]) == {"mean", "std"}
     trials = json.loads((output / "trials.json").read_text())
     assert [t["seed"] for t in trials] == [5, 6, 5, 6]
-    for name in ("fig7a_intervention.png", "fig7b_task_time.png", "fig7c_collisions.png"):
+    for name in ("fig7a_intervention.png", "fig7b_task_time.png"):
         assert (output / name).stat().st_size > 0
+    # Reaching measures no collisions: no Fig. 7c, no collision column.
+    assert not (output / "fig7c_collisions.png").exists()
+    assert "collision" not in (output / "results.md").read_text()
     assert len(list((output / "trials").glob("*/seed_*.csv"))) == 4
 
 

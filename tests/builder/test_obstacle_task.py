@@ -97,3 +97,5 @@ def test_a_study_of_the_obstacle_task_records_collisions(tmp_path, repo):
     entry = json.loads((output / "summary.json").read_text())["methods"]["pbp_no_user"]
     assert entry["errors"] == 0 and entry["success_rate"] == 1.0
     assert entry["collision_ratio"]["mean"] >= 0.2
+    assert (output / "fig7c_collisions.png").stat().st_size > 0
+    assert "| collision ratio | collision-free trials |" in (output / "results.md").read_text()

@@ -50,6 +50,33 @@ def test_notebook_is_stored_without_outputs(path):
             assert cell.outputs == [] and cell.execution_count is None, cell.source[:60]
 
 
+def _indented_lines(markdown):
+    """The lines of a Markdown text that start with four spaces outside fenced code blocks:
+    Markdown shows them as code (a title so indented renders as a code block)."""
+    indented, fenced = [], False
+    for line in markdown.splitlines():
+        if line.lstrip().startswith(("```", "~~~")):
+            fenced = not fenced
+        elif not fenced and line.startswith("    "):
+            indented.append(line)
+    return indented
+
+
+def test_the_indentation_check_tells_code_from_text():
+    assert _indented_lines("    # 01 · DMP basics\n\ntext") == ["    # 01 · DMP basics"]
+    assert _indented_lines("text\n```sh\n    make demo\n```\n1. item\n   more") == []
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+def test_markdown_cells_render_as_text_not_code(path):
+    notebook = nbformat.read(path, as_version=4)
+    for index, cell in enumerate(notebook.cells):
+        if cell.cell_type == "markdown":
+            assert not _indented_lines(cell.source), (
+                f"cell {index} has lines indented by four spaces, which render as a code "
+                f"block: {_indented_lines(cell.source)[:2]}")
+
+
 @pytest.mark.timeout(300)
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
 def test_notebook_runs(path, tmp_path, monkeypatch):

@@ -23,7 +23,8 @@ from pbp_drake.robots.hsr_model import (
     models_dir,
 )
 
-# Published HSR-B limits (hsr_facts.md, section 3): lower, upper, max velocity, max effort.
+# Published HSR-B limits (each part's urdf.xacro in Toyota's hsr_description and
+# hsrb_description, e.g. urdf/arm_v0/arm.urdf.xacro): lower, upper, max velocity, max effort.
 PUBLISHED_LIMITS = {
     "torso_lift_joint": (0.0, 0.345, 0.1, None),  # mimic joint: no actuator
     "arm_lift_joint": (0.0, 0.69, 0.2, 100.0),

@@ -104,3 +104,23 @@ def test_a_value_where_a_section_belongs_says_what_belongs(tmp_path, run_refused
 ])
 def test_the_study_splits_are_checked(tmp_path, run_refused, old, new, message):
     assert _message(run_refused, _broken(tmp_path, "hsr_reach.yaml", old, new)) == message
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("stall_time: 4.0", "stall_time: 0.0",
+     "scenario.operator.stall_time must be finite and positive, got 0.0"),
+    ("plan_directions: 24", "plan_directions: 2.5",
+     "scenario.operator.plan_directions: got 2.5; expected an integer"),
+    ("plan_times: [0.1, 0.3, 0.6, 1.0, 1.5]", "plan_times: [1.5, 1.0]",
+     "scenario.operator.plan_times [1.5, 1.0] must be 1 to 100 positive times (s) that "
+     "increase strictly, e.g. [0.1, 0.3, 0.6, 1.0, 1.5]"),
+])
+def test_a_bad_participant_field_is_named(tmp_path, run_refused, old, new, message):
+    assert _message(run_refused, _broken(tmp_path, "hsr_obstacles.yaml", old, new)) == message
+
+
+def test_a_misspelt_participant_field_is_suggested(tmp_path, run_refused):
+    message = _message(run_refused, _broken(tmp_path, "hsr_obstacles.yaml", "stall_time: 4.0",
+                                            "stall_tme: 4.0"))
+    assert message.startswith("scenario.operator: unknown key 'stall_tme' (did you mean "
+                              "'stall_time'?)"), message

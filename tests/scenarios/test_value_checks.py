@@ -54,3 +54,55 @@ def test_values_that_broke_a_computation_are_refused(tmp_path, file, old, new, m
     path.write_text(text.replace(old, new, 1))
     with pytest.raises(ScenarioError, match=message):
         load_scenario_file(path)
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("stall_time: 4.0", "stall_time: 0.0",
+     r"scenario.operator.stall_time must be finite and positive, got 0.0"),
+    ("settle_time: 4.0", "settle_time: -1.0",
+     r"scenario.operator.settle_time must be finite and positive, got -1.0"),
+    ("progress_step: 0.02", "progress_step: 0.0",
+     r"scenario.operator.progress_step must be finite and positive"),
+    # Divided by in the plan's turning score.
+    ("max_turn_rate: 0.5", "max_turn_rate: 0.0",
+     r"scenario.operator.max_turn_rate must be finite and positive, got 0.0"),
+    ("release_heading_gap_alternated: 0.12", "release_heading_gap_alternated: -0.1",
+     r"scenario.operator.release_heading_gap_alternated must be finite and positive"),
+    ("policy_compensation: 3.0", "policy_compensation: 0.0",
+     r"scenario.operator.policy_compensation must be finite and positive"),
+    ("turn_weight: 0.6", "turn_weight: -0.6",
+     r"scenario.operator.turn_weight must be finite and not negative, got -0.6"),
+    ("final_approach_radius: 0.08", "final_approach_radius: -0.08",
+     r"scenario.operator.final_approach_radius must be finite and not negative"),
+    ("min_closing_fraction: 0.25", "min_closing_fraction: -1.0",
+     r"scenario.operator.min_closing_fraction must be finite and not negative"),
+    ("push_through_radius: 0.3", "push_through_radius: .nan",
+     r"scenario.operator.push_through_radius: NaN is not a number here"),
+    ("plan_directions: 24", "plan_directions: 0",
+     r"scenario.operator.plan_directions 0 is out of range; expected 1 to 360"),
+    ("plan_times: [0.1, 0.3, 0.6, 1.0, 1.5]", "plan_times: []",
+     r"scenario.operator.plan_times \[\] must be 1 to 100 positive times \(s\) that increase "
+     r"strictly"),
+    ("plan_times: [0.1, 0.3, 0.6, 1.0, 1.5]", "plan_times: [0.1, 0.6, 0.3]",
+     r"scenario.operator.plan_times \[0.1, 0.6, 0.3\] must be 1 to 100 positive times"),
+    ("plan_times: [0.1, 0.3, 0.6, 1.0, 1.5]", "plan_times: [0.0, 0.3]",
+     r"scenario.operator.plan_times \[0.0, 0.3\] must be 1 to 100 positive times"),
+])
+def test_a_bad_participant_value_is_refused_naming_its_field(tmp_path, old, new, message):
+    text = (DIAGRAMS / "hsr_obstacles.yaml").read_text()
+    assert old in text, old
+    path = tmp_path / "hsr_obstacles.yaml"
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(path)
+
+
+def test_the_participant_fields_are_checked_in_the_reaching_task_too(tmp_path):
+    text = (DIAGRAMS / "hsr_reach.yaml").read_text()
+    path = tmp_path / "hsr_reach.yaml"
+    path.write_text(text.replace("    speed_noise: 0.1\n",
+                                 "    speed_noise: 0.1\n    policy_compensation: 0.0\n", 1))
+    with pytest.raises(ScenarioError,
+                       match=r"scenario.operator.policy_compensation must be finite and "
+                             r"positive, got 0.0"):
+        load_scenario_file(path)

@@ -20,7 +20,7 @@ import pytest
 from pbp_drake.cli import main
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.progress import ProgressBar
-from pbp_drake.studies.report import FIGURES
+from pbp_drake.studies.report import BOX_FIGURES
 from pbp_drake.studies.summary import (
     HISTOGRAM_EDGES, arbitration, collision_free, collision_histogram, does_the_hsr_task,
     ideal_alpha)
@@ -84,11 +84,10 @@ def test_jobs_1_and_2_write_the_same_summary_bytes(studies):
         assert entry["trials"] == 2 and entry["errors"] == 0 and entry["missing"] == 0
         assert 0.0 <= entry["success_rate"] <= 1.0
         assert set(entry["intervention_ratio"]) == set(entry["task_time"]) == {"mean", "std"}
-        # No obstacles: every trial has collision ratio 0, all in the first bin.
-        assert entry["collision_ratio"]["mean"] == 0.0
-        assert entry["collision_ratio"]["histogram"][0] == 2
-        assert sum(entry["collision_ratio"]["histogram"]) == 2
-    assert summary["collision_histogram_edges"] == list(HISTOGRAM_EDGES)
+        # No obstacles: nothing measured collisions, so nothing reports them.
+        assert "collision_ratio" not in entry and "collision_free_trials" not in entry
+    assert summary["measures_collisions"] is False
+    assert "collision_histogram_edges" not in summary
     # Seeds 5 and 6 lie below the default evaluation seeds (10,000): the tuning split.
     assert summary["split"] == "tuning" and summary["seeds"] == [5, 6]
     assert (one / "results.md").read_text().startswith("Seeds 5 to 6: tuning seeds")
@@ -103,14 +102,14 @@ def test_jobs_1_and_2_write_the_same_summary_bytes(studies):
 def test_report_rebuilds_summary_and_figures_from_the_trial_files(studies, capsys):
     one, _ = studies
     expected = (one / "summary.json").read_bytes()
-    for name in ("summary.json", "results.md", "trials.json", *FIGURES):
+    for name in ("summary.json", "results.md", "trials.json", *BOX_FIGURES):
         (one / name).unlink()
     capsys.readouterr()
     assert main(["report", str(one)]) == 0
     out = capsys.readouterr().out
     assert "| PBP-Alt |" in out and "| Teleop |" in out
     assert (one / "summary.json").read_bytes() == expected
-    for name in FIGURES:
+    for name in BOX_FIGURES:
         assert (one / name).stat().st_size > 5_000
     trials = json.loads((one / "trials.json").read_text())
     assert [(t["method"], t["seed"]) for t in trials] == [

@@ -3,16 +3,25 @@ its path by the operator in PBP-Cont must not wind its velocity up past the hand
 limit (it then overrode the operator and dragged the robot through the cylinders), and a
 participant whose way round has stalled must push on instead of waiting for ever."""
 
+import dataclasses
+
 import numpy as np
+import pytest
 from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.core.dmp import DmpBank as DmpBankMath
 from pbp_drake.core.dmp import DmpSettings, fit_weights
+from pbp_drake.systems import VirtualParticipant
 from pbp_drake.systems.dmp_bank import DmpBank
 from pbp_drake.systems.participant_avoidance import (
-    PROGRESS_STEP, STALL_TIME, is_pushing_through, robot_closes_in, start_watch, update_watch)
+    is_pushing_through, robot_closes_in, start_watch, update_watch)
+from pbp_drake.systems.participant_params import VirtualParticipantParams
 
 PERIOD = 0.03
+PARAMS = VirtualParticipantParams()
+STALL_TIME = PARAMS.stall_time
 HAND_SPEED_LIMIT = 0.2
 
 
@@ -56,7 +65,7 @@ def test_a_held_dmp_stays_near_the_hand_speed_limit_with_it():
 def watch_after(distances):
     watch = start_watch(distances[0])
     for distance in distances[1:]:
-        watch = update_watch(watch, distance, PERIOD)
+        watch = update_watch(PARAMS, watch, distance, PERIOD)
     return watch
 
 
@@ -68,9 +77,9 @@ def test_a_participant_parked_before_a_wall_pushes_through_once_it_has_waited():
 
 
 def test_a_participant_that_keeps_getting_closer_never_pushes_through():
-    # 1 cm a second, slower than any real run: every PROGRESS_STEP resets the wait.
+    # 1 cm a second, slower than any real run: every progress_step resets the wait.
     distances = 1.0 - 0.01 * PERIOD * np.arange(int(10 * STALL_TIME / PERIOD))
-    assert PROGRESS_STEP / 0.01 < STALL_TIME
+    assert PARAMS.progress_step / 0.01 < STALL_TIME
     assert not is_pushing_through(watch_after(distances))
 
 
@@ -81,10 +90,64 @@ def test_once_pushing_a_participant_keeps_pushing_until_it_arrives():
 
 
 def test_near_the_target_a_participant_lets_a_robot_that_closes_in_finish_alone():
-    assert robot_closes_in([0.05, 0.0], [0.07, 0.0], nominal_speed=0.12)
+    assert robot_closes_in(PARAMS, [0.05, 0.0], [0.07, 0.0], nominal_speed=0.12)
 
 
 def test_near_the_target_a_participant_drives_a_robot_that_has_parked():
     # The PBP-Alt DMP, its phase frozen early, balanced 8 cm short of the target.
-    assert not robot_closes_in([0.004, 0.003], [0.07, 0.04], nominal_speed=0.12)
-    assert not robot_closes_in([-0.03, 0.0], [0.07, 0.0], nominal_speed=0.12)
+    assert not robot_closes_in(PARAMS, [0.004, 0.003], [0.07, 0.04], nominal_speed=0.12)
+    assert not robot_closes_in(PARAMS, [-0.03, 0.0], [0.07, 0.0], nominal_speed=0.12)
+
+
+def test_a_lower_closing_fraction_lets_a_slow_robot_finish_alone():
+    # 0.02 m/s toward the target is under a quarter of 0.12 m/s, over a tenth of it.
+    slow = ([0.02, 0.0], [0.07, 0.0])
+    assert not robot_closes_in(PARAMS, *slow, nominal_speed=0.12)
+    patient = dataclasses.replace(PARAMS, min_closing_fraction=0.1)
+    assert robot_closes_in(patient, *slow, nominal_speed=0.12)
+
+
+# A wall of three cylinders 0.35 m ahead of a parked hand, the target 1.5 m beyond: no
+# way round gets it closer, so it stalls.
+HAND = np.array([0.0, 0.0])
+TARGET = np.array([1.5, 0.0])
+WALL = np.array([[0.35, -0.3], [0.35, 0.0], [0.35, 0.3]])
+
+
+def first_push_time(params, seconds):
+    """When (s) a participant whose hand stays parked before WALL first commands the
+    push-through (straight at the target, no turning); None if not within `seconds`."""
+    params = dataclasses.replace(params, direction_noise=0.0, speed_noise=0.0,
+                                 reaction_delay=0.0)
+    builder = DiagramBuilder()
+    participant = builder.AddSystem(VirtualParticipant(
+        PERIOD, [[*TARGET, 0.7]], mode="drive", params=params, nominal_speed=0.12,
+        obstacle_count=len(WALL), obstacle_radius=0.15))
+    for port, value in ((participant.get_ee_state_input_port(), [*HAND, 0.7] + [0.0] * 5),
+                        (participant.get_target_input_port(), [*TARGET, 0.7, 0]),
+                        (participant.get_selected_goal_input_port(), [0]),
+                        (participant.get_obstacle_positions_input_port(), WALL.ravel())):
+        source = builder.AddSystem(ConstantVectorSource(np.asarray(value, dtype=float)))
+        builder.Connect(source.get_output_port(), port)
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    context = participant.GetMyContextFromRoot(simulator.get_context())
+    toward = (TARGET - HAND) / np.linalg.norm(TARGET - HAND)
+    for tick in range(1, int(round(seconds / PERIOD))):
+        simulator.AdvanceTo((tick + 0.5) * PERIOD)
+        command = participant.get_operator_command_output_port().Eval(context)
+        speed = np.linalg.norm(command[:2])
+        if speed > 0.1 and command[3] == 0.0 and command[:2] @ toward > 0.999999 * speed:
+            return tick * PERIOD
+    return None
+
+
+@pytest.mark.parametrize("stall_time", [2.0, 4.0])
+def test_the_stall_time_is_how_long_a_parked_participant_waits_before_pushing(stall_time):
+    pushed = first_push_time(dataclasses.replace(PARAMS, stall_time=stall_time), 7.0)
+    assert pushed is not None and stall_time - 0.1 <= pushed <= stall_time + 0.1
+
+
+def test_a_longer_stall_time_delays_the_push_through():
+    assert first_push_time(PARAMS, 5.0) is not None
+    assert first_push_time(dataclasses.replace(PARAMS, stall_time=8.0), 5.0) is None

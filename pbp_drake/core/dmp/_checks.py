@@ -1,4 +1,5 @@
-"""Input checks shared by the DMP modules: each names the field it refuses (DESIGN.md)."""
+"""Input checks shared by the DMP modules: each names the field it refuses, as every input
+check of the package does."""
 
 import numpy as np
 

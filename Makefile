@@ -67,7 +67,8 @@ diagrams: $(STAMP) graphviz
 	$(PYTHON) -m pbp_drake.draw diagrams/*.yaml
 
 # `pbp-drake bench`: the DMP bank against pydmps and movement_primitives, the closed-loop HSR
-# speed and the control-rate figure, into outputs/bench (bench.json, bench_control_rate.png).
+# speed and the control-rate figure, into outputs/bench (bench.json, bench_control_rate.png);
+# fails (exit code 1) when one of its checks fails.
 $(VENV)/.installed-bench: $(STAMP)
 	$(PYTHON) -m pip install --quiet -e '.[test,bench]'
 	touch $@

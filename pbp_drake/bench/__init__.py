@@ -16,12 +16,18 @@ Measured in one run on this machine (issue 6):
   headless and with Meshcat publishing;
 - the control rate reached versus K, as a figure (`bench_control_rate.png`).
 
-Writes `bench.json` and the figure into `--output` (default `outputs/bench`). Timings are
-medians over repeats (the repeat count adapts to K); BLAS is limited to `--blas-threads`
-(default 1, through threadpoolctl when installed) for every backend alike.
+Writes `bench.json`, `bench.txt` and the figure into `--output` (default `outputs/bench`).
+Timings are medians over repeats (the repeat count adapts to K). BLAS runs `--blas-threads`
+threads (default 1) for every backend alike, pinned without any optional package: the bench
+measures in a fresh Python process whose OPENBLAS_NUM_THREADS, OMP_NUM_THREADS,
+MKL_NUM_THREADS, ... are set before NumPy loads, and its header says what the BLAS library
+reports. Each check is named for what it measures; a check whose peer library is not
+installed is skipped (neither a pass nor a failure); the exit code is 1 when any check
+fails, else 0. `--quick` runs the same checks at fewer repeats.
 
-Modules: `timing` (the timer, BLAS pinning, memory bandwidth), `cases` (the banks and the
-steps timed), `peers` (pydmps and movement_primitives), `closed_loop` (the HSR task's
-speed), `report` (the table and the acceptance checks), `plot` (the control-rate figure),
-`run` (the command line; `python -m pbp_drake.bench`).
+Modules: `pinning` (the fresh, pinned process), `timing` (the timer, memory bandwidth),
+`cases` (the banks and the steps timed), `peers` (pydmps and movement_primitives),
+`closed_loop` (the HSR task's speed), `checks` (the checks, their verdicts and the exit
+code), `report` (the table), `plot` (the control-rate figure), `run` (the command line;
+`python -m pbp_drake.bench`).
 """

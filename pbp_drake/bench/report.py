@@ -1,5 +1,7 @@
-"""The bench's report: the table of step times, the closed-loop speeds, and the issue's
-acceptance numbers, each with its measured value and verdict."""
+"""The bench's report: the table of step times, the closed-loop speeds, and the checks
+(`pbp_drake.bench.checks`), each with its measured value and verdict."""
+
+from pbp_drake.bench.checks import format_results
 
 
 def microseconds(seconds):
@@ -20,49 +22,13 @@ def _fmt(value, width=9):
     return f"{value:.1f}".rjust(width)
 
 
-def _find(rows, dimension, goal_count, weights):
-    for row in rows:
-        if (row["D"], row["K"], row["weights"]) == (dimension, goal_count, weights):
-            return row
-    return None
-
-
-def acceptance(rows, closed_loop, bandwidth):
-    """The issue's acceptance numbers, each with its measured value and verdict."""
-    checks = []
-
-    def check(name, value, limit, passes, unit=""):
-        checks.append({"criterion": name, "value": value, "limit": limit, "unit": unit,
-                       "pass": None if value is None else bool(passes(value))})
-
-    row = _find(rows, 3, 10000, "distinct")
-    check("K=10,000, D=3, distinct: bank inside its LeafSystem <= 1 ms",
-          row and row["leaf_us"], 1000.0, lambda v: v <= 1000.0, "us")
-    row = _find(rows, 3, 100000, "shared")
-    check("K=100,000, one shared demonstration (D=3): inside its LeafSystem <= 1 ms",
-          row and row["leaf_us"], 1000.0, lambda v: v <= 1000.0, "us")
-    row = _find(rows, 3, 1000, "distinct")
-    check("K=1,000 (D=3, distinct): bank math >= 100x the faster one-object-per-goal peer",
-          row and row["speedup_vs_per_goal"], 100.0, lambda v: v >= 100.0, "x")
-    row = _find(rows, 3, 10000, "distinct")
-    check("K=10,000 (D=3, distinct): bank math >= 5x movement_primitives stacked",
-          row and row["speedup_vs_stacked"], 5.0, lambda v: v >= 5.0, "x")
-    check("K=10,000 (D=3, distinct): bank math within 2x of weights / memory bandwidth",
-          row and row["bank_math_us"] / row["bandwidth_bound_us"], 2.0,
-          lambda v: v <= 2.0, "x bound")
-    run = next((r for r in closed_loop if r["goals"] == 100 and not r["meshcat"]), None)
-    check("HSR reaching, K=100, headless: >= 10x real time",
-          run and run["realtime_factor"], 10.0, lambda v: v >= 10.0, "x real time")
-    return checks
-
-
 def format_report(report):
     lines = []
     bandwidth = report["memory_bandwidth"]
     lines.append(f"Memory bandwidth: read {bandwidth['read_gb_per_s']:.1f} GB/s, copy "
                  f"{bandwidth['copy_gb_per_s']:.1f} GB/s ({bandwidth['array_megabytes']} MB); "
                  f"cache-sized read {bandwidth['cache_read_gb_per_s']:.1f} GB/s. "
-                 f"{report['machine']['blas']}.")
+                 f"{report['machine']['blas']['note']}.")
     lines.append("One step of all K DMPs from one robot state, microseconds (median); "
                  "N = 50, dt = 1 ms.")
     lines.append("math: DmpBank.advance_into; leaf: the DmpBank LeafSystem per 1 ms period "
@@ -96,10 +62,5 @@ def format_report(report):
                          f"({run['simulated_s']:.1f} s in {run['wall_s']:.2f} s wall; "
                          f"built in {run['build_s']:.1f} s)")
     lines.append("")
-    lines.append("Acceptance (issue 6):")
-    for item in report["acceptance"]:
-        verdict = {True: "PASS", False: "FAIL", None: "n/a "}[item["pass"]]
-        value = "not measured" if item["value"] is None else (
-            f"{item['value']:.2f} {item['unit']} (limit {item['limit']:g})")
-        lines.append(f"  [{verdict}] {item['criterion']}: {value}")
+    lines.append(format_results(report["checks"]))
     return "\n".join(lines)

@@ -5,6 +5,7 @@ import argparse
 import json
 import os
 import platform
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,12 +14,14 @@ from pydrake.geometry import Meshcat, MeshcatParams
 import pbp_drake.bench
 from pbp_drake.bench.cases import (
     BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case)
+from pbp_drake.bench.checks import PEERS, evaluate, exit_code
 from pbp_drake.bench.closed_loop import HSR_KS, hsr_speed
 from pbp_drake.bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
+from pbp_drake.bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
 from pbp_drake.bench.plot import plot_control_rate
-from pbp_drake.bench.report import acceptance, format_report, microseconds, ratio
-from pbp_drake.bench.timing import limit_blas, memory_bandwidth, timed
+from pbp_drake.bench.report import format_report, microseconds, ratio
+from pbp_drake.bench.timing import memory_bandwidth, timed
 
 KS = (1, 10, 100, 1000, 10000, 100000)
 DS = (2, 3, 6)
@@ -44,29 +47,54 @@ def _parse(argv):
     parser.add_argument("--no-meshcat", action="store_true",
                         help="skip the closed-loop runs with Meshcat publishing")
     parser.add_argument("--blas-threads", type=int, default=1,
-                        help="BLAS threads for every backend (0: library default)")
+                        help="BLAS threads for every backend (default 1): the bench measures "
+                        "in a fresh Python process with OPENBLAS_NUM_THREADS, "
+                        "OMP_NUM_THREADS, MKL_NUM_THREADS, ... set before NumPy loads "
+                        "(0: the library's default, measured in this process)")
     parser.add_argument("--min-time", type=float, default=None,
                         help="seconds of repeats per measurement (default 0.3; --quick 0.08)")
     return parser.parse_args(argv)
 
 
+def plan(args):
+    """What a run measures. `--quick` keeps every check's case (D = 3; the default goal
+    counts and HSR runs) and takes fewer repeats and a shorter HSR simulation."""
+    return {"dimensions": args.dimensions or ([3] if args.quick else list(DS)),
+            "goals": list(args.goals), "hsr_goals": list(args.hsr_goals),
+            "min_time": args.min_time or (0.08 if args.quick else 0.3),
+            "hsr_seconds": args.hsr_seconds or (1.0 if args.quick else 5.0)}
+
+
 def main(argv=None):
+    """Runs the bench; returns its exit code: 1 when a check fails, else 0."""
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = _parse(argv)
+    if args.blas_threads > 0 and not in_measuring_process():
+        # NumPy is loaded in this process already (pbp_drake.cli and this module import
+        # it), too late for the thread variables: measure in a fresh process pinned from
+        # its start (pbp_drake.bench.pinning).
+        return measure_in_fresh_process(argv, args.blas_threads)
+    return _measure(args)
+
+
+def _measure(args):
     output = Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
-    dimensions = args.dimensions or ([3] if args.quick else list(DS))
-    min_time = args.min_time or (0.08 if args.quick else 0.3)
-    hsr_seconds = args.hsr_seconds or (1.0 if args.quick else 5.0)
-    blas_note = limit_blas(args.blas_threads)
-    have_pydmps = available("pydmps")
-    have_mp = available("movement_primitives.dmp")
+    settings = plan(args)
+    dimensions, min_time = settings["dimensions"], settings["min_time"]
+    hsr_seconds = settings["hsr_seconds"]
+    blas = blas_threads(args.blas_threads)
+    installed = {name for name, module in [("pydmps", "pydmps"),
+                                           ("movement_primitives", "movement_primitives.dmp")]
+                 if available(module)}
+    have_pydmps, have_mp = "pydmps" in installed, "movement_primitives" in installed
     print(f"pbp-drake bench: {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} CPUs, Python {platform.python_version()}, NumPy "
-          f"{np.__version__}; {blas_note}")
-    for name, present in [("pydmps", have_pydmps), ("movement_primitives", have_mp)]:
-        if not present:
+          f"{np.__version__}; {blas['note']}")
+    for name in PEERS:
+        if name not in installed:
             print(f"note: {name} is not installed (pip install -e '.[bench]'); its columns "
-                  "stay empty")
+                  "stay empty and the checks against it are skipped")
 
     print("Measuring memory bandwidth ...", flush=True)
     bandwidth = memory_bandwidth()
@@ -77,7 +105,7 @@ def main(argv=None):
 
     rows = []
     for dimension in dimensions:
-        for goal_count in args.goals:
+        for goal_count in settings["goals"]:
             for distinct in (True, False):
                 rows.append(_measure_row(dimension, goal_count, distinct, min_time,
                                          args.peer_max_goals, have_pydmps, have_mp,
@@ -85,7 +113,7 @@ def main(argv=None):
                 _print_progress(rows[-1])
 
     closed_loop = []
-    for goal_count in args.hsr_goals:
+    for goal_count in settings["hsr_goals"]:
         for with_meshcat in ([False] if args.no_meshcat else [False, True]):
             print(f"HSR reaching, K = {goal_count}, "
                   f"{'Meshcat' if with_meshcat else 'headless'} ...", flush=True)
@@ -98,15 +126,15 @@ def main(argv=None):
     report = {
         "machine": {"processor": platform.processor() or platform.machine(),
                     "cpus": os.cpu_count(), "python": platform.python_version(),
-                    "numpy": np.__version__, "blas": blas_note,
+                    "numpy": np.__version__, "blas": blas,
                     "load_average": os.getloadavg() if hasattr(os, "getloadavg") else None},
         "settings": {"basis_count": BASIS, "dt": DT, "min_time_s": min_time,
-                     "quick": args.quick},
+                     "quick": args.quick, "hsr_seconds": hsr_seconds},
         "memory_bandwidth": bandwidth,
         "steps": rows,
         "closed_loop": closed_loop,
     }
-    report["acceptance"] = acceptance(rows, closed_loop, bandwidth)
+    report["checks"] = evaluate(rows, closed_loop, installed, blas)
     text = format_report(report)
     print(text)
     (output / "bench.json").write_text(json.dumps(report, indent=2))
@@ -114,7 +142,7 @@ def main(argv=None):
     figure = plot_control_rate(rows, output / "bench_control_rate.png")
     print(f"Wrote {output / 'bench.json'}, {output / 'bench.txt'}"
           + (f" and {figure}" if figure else ""))
-    return 0
+    return exit_code(report["checks"])
 
 
 def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have_pydmps,

@@ -1,5 +1,5 @@
-"""Timing: the median of repeated calls, BLAS threads pinned for the whole run, and this
-machine's memory bandwidth (the bound on streaming distinct weights)."""
+"""Timing: the median of repeated calls, and this machine's memory bandwidth (the bound on
+streaming distinct weights). BLAS threads are pinned before NumPy loads (`pinning`)."""
 
 import time
 
@@ -19,20 +19,6 @@ def timed(step, min_time, max_repeats=5000, min_repeats=3, warmup=2):
         samples.append(time.perf_counter() - start)
     samples = np.array(samples)
     return float(np.median(samples)), float(samples.min()), len(samples)
-
-
-def limit_blas(threads):
-    """Limits BLAS threads for the whole run; returns a note for the report."""
-    if threads <= 0:
-        return "BLAS threads: library default"
-    try:
-        # Deferred on purpose: threadpoolctl is optional (pip install -e '.[bench]').
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        return (f"BLAS threads: default (threadpoolctl missing; set OPENBLAS_NUM_THREADS="
-                f"{threads} before starting Python to limit them)")
-    limit_blas.handle = threadpool_limits(limits=threads, user_api="blas")
-    return f"BLAS threads: {threads} (threadpoolctl)"
 
 
 def memory_bandwidth(megabytes=400, cache_megabytes=12, repeats=5):

@@ -1,0 +1,134 @@
+"""The bench's checks: each named for what it measures, with its limit, its verdict (pass,
+fail, or skipped with the reason: a peer library not installed, or a case this run did not
+measure), the summary line, and the exit code (1 when any check fails).
+
+`--quick` runs the same checks with the same limits at fewer repeats: every check's case is
+in the quick run (see `pbp_drake.bench.run.plan`)."""
+
+import dataclasses
+from collections.abc import Callable
+
+PEERS = ("pydmps", "movement_primitives")
+
+
+@dataclasses.dataclass(frozen=True)
+class Check:
+    name: str
+    limit: float
+    at_most: bool  # passes when value <= limit (else when value >= limit)
+    unit: str
+    value: Callable  # the row of steps (or the closed-loop run) -> the measured value
+    row: tuple | None = None  # (D, K, weights) of the step row it reads
+    hsr_goals: int | None = None  # K of the headless closed-loop HSR run it reads
+    peers: tuple = ()  # it needs one of these peer libraries
+
+
+_K10K = (3, 10000, "distinct")
+CHECKS = (
+    Check("K=10,000 goals (D=3, distinct weights): one step in the LeafSystem <= 1 ms",
+          1000.0, True, "us", lambda row: row["leaf_us"], row=_K10K),
+    Check("K=100,000 goals sharing one demonstration (D=3): one step in the LeafSystem "
+          "<= 1 ms", 1000.0, True, "us", lambda row: row["leaf_us"],
+          row=(3, 100000, "shared")),
+    Check("K=1,000 goals (D=3, distinct weights): bank math >= 100x faster than one DMP "
+          "object per goal (the faster of pydmps and movement_primitives)", 100.0, False, "x",
+          lambda row: row["speedup_vs_per_goal"], row=(3, 1000, "distinct"), peers=PEERS),
+    Check("K=10,000 goals (D=3, distinct weights): bank math >= 5x faster than "
+          "movement_primitives with the goals stacked into one K*D DMP", 5.0, False, "x",
+          lambda row: row["speedup_vs_stacked"], row=_K10K,
+          peers=("movement_primitives",)),
+    Check("K=10,000 goals (D=3, distinct weights): bank math <= 2x the memory-bandwidth "
+          "bound (weight bytes / measured read bandwidth)", 2.0, True, "x the bound",
+          lambda row: row["bank_math_us"] / row["bandwidth_bound_us"], row=_K10K),
+    Check("HSR reaching task, K=100 goals, headless: closed loop >= 10x real time", 10.0,
+          False, "x real time", lambda run: run["realtime_factor"], hsr_goals=100),
+)
+
+
+def evaluate(rows, closed_loop, installed, blas=None):
+    """Every check's result: {"check", "value", "limit", "unit", "verdict", "reason"}, the
+    verdict "pass", "fail" or "skipped" (then "reason" says why). `installed` is the set of
+    peer libraries present; `blas` (from `pinning.blas_threads`) adds the pinning check."""
+    results = []
+    for check in CHECKS:
+        result = {"check": check.name, "value": None, "limit": check.limit,
+                  "unit": check.unit, "verdict": "skipped", "reason": None}
+        results.append(result)
+        if check.peers and not set(check.peers) & set(installed):
+            result["reason"] = f"{', '.join(check.peers)} not installed"
+            continue
+        source, where = _source(check, rows, closed_loop)
+        value = None if source is None else check.value(source)
+        if value is None:
+            result["reason"] = ("not measured: " + where if source is None else
+                                "not measured: K above --peer-max-goals")
+            continue
+        result["value"] = float(value)
+        passes = value <= check.limit if check.at_most else value >= check.limit
+        result["verdict"] = "pass" if passes else "fail"
+    if blas is not None:
+        results.append(_blas_check(blas))
+    return results
+
+
+def _source(check, rows, closed_loop):
+    if check.row is not None:
+        dimension, goals, weights = check.row
+        for row in rows:
+            if (row["D"], row["K"], row["weights"]) == check.row:
+                return row, None
+        return None, f"D={dimension}, K={goals:,}, {weights} weights not in --dimensions/--goals"
+    for run in closed_loop:
+        if run["goals"] == check.hsr_goals and not run["meshcat"]:
+            return run, None
+    return None, f"no headless HSR run with K={check.hsr_goals} in --hsr-goals"
+
+
+def _blas_check(blas):
+    requested = blas["requested"]
+    result = {"check": f"BLAS threads in the measuring process = {requested} "
+                       "(--blas-threads), as the BLAS library reports them",
+              "value": blas["library_threads"], "limit": requested, "unit": "threads",
+              "verdict": "skipped", "reason": None}
+    if requested <= 0:
+        result["reason"] = "--blas-threads 0 (library default)"
+    elif blas["library_threads"] is None:
+        result["reason"] = "the BLAS library's thread count cannot be read here"
+    else:
+        result["verdict"] = "pass" if blas["library_threads"] == requested else "fail"
+    return result
+
+
+def exit_code(results):
+    """1 when any check failed, else 0 (skipped checks count neither way)."""
+    return 1 if any(result["verdict"] == "fail" for result in results) else 0
+
+
+def summary(results):
+    """One line: how many passed, failed and were skipped (and why), and the exit code."""
+    counts = {verdict: sum(r["verdict"] == verdict for r in results)
+              for verdict in ("pass", "fail", "skipped")}
+    # Grouped by why: "pydmps, movement_primitives not installed", "not measured", ...
+    reasons = [r["reason"].split(":")[0] for r in results if r["verdict"] == "skipped"]
+    skipped = f"{counts['skipped']} skipped"
+    if reasons:
+        skipped += " (" + "; ".join(f"{reason}: {reasons.count(reason)}"
+                                    for reason in dict.fromkeys(reasons)) + ")"
+    return (f"Checks: {counts['pass']} passed, {counts['fail']} failed, {skipped}; "
+            f"skipped checks count neither as passes nor as failures; exit code "
+            f"{exit_code(results)}")
+
+
+def format_results(results):
+    """The checks' lines and the summary line."""
+    lines = ["Checks (each against its limit):"]
+    for result in results:
+        verdict = {"pass": "PASS", "fail": "FAIL", "skipped": "SKIP"}[result["verdict"]]
+        if result["verdict"] == "skipped":
+            detail = f"skipped: {result['reason']}"
+        else:
+            detail = (f"{result['value']:.2f} {result['unit']} "
+                      f"(limit {result['limit']:g})")
+        lines.append(f"  [{verdict}] {result['check']}: {detail}")
+    lines.append(summary(results))
+    return "\n".join(lines)

@@ -3,8 +3,10 @@
 in `pbp_drake.commands`."""
 
 import argparse
+import os
 import sys
 
+from pbp_drake import __version__
 from pbp_drake.bench.run import main as bench_main
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.study import add_study_commands
@@ -13,9 +15,30 @@ from pbp_drake.scenarios import ScenarioError
 
 
 def main(argv=None):
+    """Runs the command line `argv` (default: sys.argv[1:]); returns the exit code."""
+    try:
+        code = _main(argv)
+        # Inside the try: a closed pipe (`pbp-drake report DIR | head`) shows here, not
+        # at the interpreter's last flush, where it would print an "Exception ignored".
+        sys.stdout.flush()
+        return code
+    except BrokenPipeError:
+        # As the Python docs recommend (signal module, "Note on SIGPIPE"): point stdout at
+        # devnull, so that the interpreter's last flush does not fail again, and exit quietly.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 1
+    except KeyboardInterrupt:
+        # Ctrl-C is how a person ends a run: a word, not a traceback (128 + SIGINT).
+        print("\npbp-drake: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv):
     parser = argparse.ArgumentParser(
         prog="pbp-drake",
         description="Policy Blending with Primitives (PBP): shared control on Drake.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     commands = parser.add_subparsers(dest="command", required=True)
 
     add_run_command(commands)

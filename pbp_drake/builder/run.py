@@ -3,14 +3,17 @@ HSR task to success or its time limit (`run_task`), and reading back the loggers
 adds (`read_log`).
 
 Both take a `ResolvedScenario` (or a `Scenario`, resolved here once) and apply the scenario's
-`SimulatorConfig`; `realtime_rate` overrides its target real-time rate. The order within a
-tick, and so which log sample holds which tick's decisions, is `pbp_drake.systems.tick`'s.
+`SimulatorConfig`; `realtime_rate` overrides its target real-time rate. `advance`, when
+given, replaces `advance_to` (one `Simulator.AdvanceTo`): the operator's console
+(`pbp_drake.console.LiveRun`) advances in slices and may end the run early. The order
+within a tick, and so which log sample holds which tick's decisions, is
+`pbp_drake.systems.tick`'s.
 """
 
 import dataclasses
 
 import numpy as np
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorStatus
 
 from pbp_drake.builder.build import build_diagram
 from pbp_drake.scenarios import ResolvedScenario, resolve
@@ -62,14 +65,25 @@ def ticks_of(scenario):
     return int(round(scenario.duration / scenario.control_period))
 
 
-def simulate(scenario, meshcat=None, realtime_rate=None, diagram=None):
-    """Simulates `scenario` for its duration and returns its Trajectory."""
+def advance_to(simulator, time):
+    """Advances `simulator` to `time`; True when it stopped earlier, at a termination event
+    (the task monitor's at success)."""
+    return (simulator.AdvanceTo(time).reason()
+            == SimulatorStatus.ReturnReason.kReachedTerminationCondition)
+
+
+def simulate(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=None):
+    """Simulates `scenario` for its duration and returns its Trajectory (the ticks up to
+    where `advance` stopped, when it stopped early)."""
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
                                                          diagram)
     # One tick past the end: the loggers record tick k's decisions one sample later.
     ticks = ticks_of(scenario)
-    simulator.AdvanceTo((ticks + 1) * scenario.control_period)
-    return read_trajectory(diagram, simulator.get_context(), ticks + 1)
+    context = simulator.get_context()
+    if (advance or advance_to)(simulator, (ticks + 1) * scenario.control_period):
+        samples = diagram.GetSubsystemByName("robot_state_log").FindLog(context).num_samples()
+        ticks = max(0, samples - DECISION_LOG_SHIFT - 1)
+    return read_trajectory(diagram, context, ticks + 1)
 
 
 def read_log(diagram, context, name, tick_count, shift=0):
@@ -202,12 +216,13 @@ class LargestStep:
         return None if self._largest is None else float(self._largest / control_period)
 
 
-def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None):
-    """Simulates an HSR task until success or `scenario.duration` (the time limit)."""
+def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=None):
+    """Simulates an HSR task until success or `scenario.duration` (the time limit), or
+    until `advance` stops it."""
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
                                                          diagram)
     # The task monitor itself ends the simulation at success.
-    simulator.AdvanceTo((ticks_of(scenario) + 1) * scenario.control_period)
+    (advance or advance_to)(simulator, (ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()
     status, monitor = final_status(diagram, context)
     return _read_result(diagram, context, status, monitor, scenario.control_period)

@@ -15,11 +15,10 @@ last state sample, whose decisions are never logged, is not written (as in `run_
 """
 
 import numpy as np
-from pydrake.systems.analysis import SimulatorStatus
 from pydrake.systems.primitives import VectorLogSink
 
 from pbp_drake.builder.run import (
-    DECISION_LOGS, STATE_LOGS, LargestStep, final_status, initialized_simulator,
+    DECISION_LOGS, STATE_LOGS, LargestStep, advance_to, final_status, initialized_simulator,
     series_fields, task_result, ticks_of)
 from pbp_drake.builder.time_series import time_series_header, time_series_rows
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
@@ -28,14 +27,15 @@ DEFAULT_CHUNK_SECONDS = 10.0
 
 
 def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diagram=None,
-                      chunk_seconds=DEFAULT_CHUNK_SECONDS, after_chunk=None):
+                      chunk_seconds=DEFAULT_CHUNK_SECONDS, after_chunk=None, advance=None):
     """Simulates an HSR task until success or `scenario.duration` (the time limit), like
     `run_task`, writing one CSV row per control tick to `log_path` (header first) as it goes.
 
     Returns the TaskResult `run_task` would return, with the same metrics and peaks, but
     whose time series (`times`, `ee_positions`, ..., `in_collision`) are empty (no ticks):
     they are in the file. `after_chunk(time)`, when given, is called after each chunk is
-    written, with the simulated time reached.
+    written, with the simulated time reached. `advance` replaces `advance_to` (see
+    `pbp_drake.builder.run`); the run ends when it returns True.
     """
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
                                                          diagram)
@@ -51,7 +51,7 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
         tick = 0
         while True:
             tick = min(tick + chunk_ticks, last_tick)
-            reason = simulator.AdvanceTo(tick * period).reason()
+            ended = (advance or advance_to)(simulator, tick * period)
             series = tail.take(context)
             stream.write(time_series_rows(series))
             stream.flush()
@@ -59,9 +59,8 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
             command_acceleration.add(series.commands[:, 3:6])
             if after_chunk is not None:
                 after_chunk(context.get_time())
-            # The task monitor ends the simulation at success.
-            if (tick == last_tick
-                    or reason == SimulatorStatus.ReturnReason.kReachedTerminationCondition):
+            # The task monitor ends the simulation at success (or the person, at a console).
+            if tick == last_tick or ended:
                 break
     status, monitor = final_status(diagram, context)
     return task_result(status, monitor, tail.empty_series(),

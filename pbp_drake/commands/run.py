@@ -8,8 +8,10 @@ import time
 import numpy as np
 from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
-from pbp_drake.builder import build_diagram, run_task, run_task_streamed, simulate
+from pbp_drake.builder import build_diagram, find_system, run_task, run_task_streamed, simulate
 from pbp_drake.cli_types import method_list, port, realtime_rate, wait_seconds
+from pbp_drake.console import (
+    CAMERAS, Console, LiveRun, Progress, RobotCamera, method_name, result_text)
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, mark_replay)
@@ -49,7 +51,13 @@ def add_run_command(commands):
                      "[METHOD:]QUESTION=VALUE (QUESTION tiredness or ease), e.g. "
                      "tiredness=3,ease=4,teleop:tiredness=1 (a person answers in the page)")
     run.add_argument("--headless", action="store_true",
-                     help="simulate as fast as possible without waiting for a browser")
+                     help="simulate as fast as possible without waiting for a browser (the "
+                     "page still shows the run) and quit at the end")
+    run.add_argument("--no-meshcat", action="store_true",
+                     help="no Meshcat server and no page at all (implies --headless)")
+    run.add_argument("--camera", choices=CAMERAS, default="overview",
+                     help="HSR tasks: the page's camera; overview (default, free to orbit) "
+                     "or robot (follows the robot from behind its head)")
     run.add_argument("--record", metavar="FILE.html",
                      help="save a self-contained replay of the run")
     run.add_argument("--log", metavar="FILE.csv", help="HSR tasks: write the per-tick rows to "
@@ -126,63 +134,135 @@ def _run(args):
         check_output_folder(args.output)
     resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
                                 args.scene, args.operator, args.seed, args.duration)
-    scenario = resolved.scenario
-    meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
-    print(f"Meshcat: {meshcat.web_url()}", flush=True)
+    if args.camera == "robot" and not resolved.is_hsr:
+        raise ScenarioError("--camera robot follows the HSR; this scenario uses the 2-D toy "
+                            "robot")
+    meshcat = None
+    if args.no_meshcat:
+        if args.record or args.camera == "robot":
+            raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
+        args.headless = True
+    else:
+        meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
+        print(f"Meshcat: {meshcat.web_url()}", flush=True)
     if resolved.is_hsr:
         return _run_task(args, resolved, meshcat)
+    return _run_scene(args, resolved, meshcat)
+
+
+def _run_scene(args, resolved, meshcat):
+    """A 2-D scene: live in the page (its console has Stop alone) for its duration."""
+    scenario = resolved.scenario
     if args.log:
         raise ScenarioError("--log streams an HSR task's per-tick rows; this scenario uses "
                             "the 2-D toy robot")
     diagram = build_diagram(resolved, meshcat)
-    if not args.headless and sys.stdin.isatty():
+    console = None
+    if meshcat is not None:
+        console = _console(meshcat, args, scenario, choices=("stop",))
+        console.show_title(method_name(scenario.method, _alpha(scenario)))
+    if _interactive(args, meshcat):
         _wait_for_browser(meshcat, args.wait_for_browser)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
+    live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration))
     trajectory = simulate(resolved, realtime_rate=0.0 if args.headless else args.realtime_rate,
-                          diagram=diagram)
-    positions = np.zeros((len(trajectory.positions), 3))
-    positions[:, :trajectory.positions.shape[1]] = trajectory.positions[:, :3]
-    meshcat.SetLine("/pbp/executed", positions.T, 2.0, Rgba(0.1, 0.3, 0.9, 1.0))
+                          diagram=diagram, advance=live.advance)
     ratio = collision_ratio(trajectory.positions, [o.center for o in scenario.obstacles],
                             [o.radius for o in scenario.obstacles])
+    if meshcat is not None:
+        positions = np.zeros((len(trajectory.positions), 3))
+        positions[:, :trajectory.positions.shape[1]] = trajectory.positions[:, :3]
+        meshcat.SetLine("/pbp/executed", positions.T, 2.0, Rgba(0.1, 0.3, 0.9, 1.0))
+        console.show_result(f"stopped at {trajectory.times[-1]:.1f} s" if live.choice
+                            else f"done, collision ratio {ratio:.3f}")
     if args.record:
         _save_recording(meshcat, args.record)
     print(f"{scenario.name} [{scenario.method}]: final position "
           f"{np.array2string(trajectory.positions[-1], precision=3)}, collision ratio "
           f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}")
-    if not args.headless and sys.stdin.isatty():
-        input("Press Enter to quit (the page stays live until then). ")
+    if live.choice is None and _interactive(args, meshcat):
+        _wait_for_stop(console)
     return 0
 
 
 def _run_task(args, resolved, meshcat):
     scenario = resolved.scenario
     person = isinstance(scenario.operator, (Keyboard, Gamepad))
+    if meshcat is None and person:
+        raise ScenarioError("--no-meshcat: a keyboard or gamepad is read in the page; use "
+                            "--operator virtual")
     if args.headless and person:
         raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
                             "--operator virtual")
     if args.participant is not None:
+        if meshcat is None:
+            raise ScenarioError("--participant: a session shows each run in the page; drop "
+                                "--no-meshcat")
         return _run_session(args, resolved, meshcat, person)
     if args.methods is not None or args.output is not None or args.practice or args.answers:
         raise ScenarioError("--methods, --output, --practice and --answers belong to a "
                             "session: add --participant ID")
-    diagram = build_diagram(resolved, meshcat)
-    if person or (not args.headless and sys.stdin.isatty()):
-        # A person needs the page open before the task starts.
-        print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
-              f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
-        if person:
-            print("Keys: arrows move the hand (forward only in teleop), Q and E turn it.",
-                  flush=True)
-        _wait_for_browser(meshcat, args.wait_for_browser, person)
+    console = None
+    if meshcat is not None:
+        console = _console(meshcat, args, scenario)
+    first = True
+    while True:
+        scenario = resolved.scenario
+        diagram = build_diagram(resolved, meshcat)
+        if first and (person or _interactive(args, meshcat)):
+            # A person needs the page open before the task starts.
+            print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
+                  f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
+            if person:
+                print("Keys: arrows move the hand (forward only in teleop), Q and E turn it.",
+                      flush=True)
+            _wait_for_browser(meshcat, args.wait_for_browser, person)
+        first = False
+        result, live = _run_task_once(args, resolved, diagram, meshcat, console)
+        code = 0 if result.success else 1
+        if console is None:
+            return code
+        choice = live.choice
+        if choice is None and _interactive(args, meshcat):
+            print("The page stays live: Stop (or Enter, or Ctrl-C) quits, Restart runs the "
+                  "scene again, Next scene the next seed.", flush=True)
+            choice = console.wait_for_choice(stdin=sys.stdin)
+        if choice in (None, "stop"):
+            return code
+        operator = diagram.GetSubsystemByName("operator")
+        if hasattr(operator, "Delete"):
+            operator.Delete()  # the next build adds its buttons again
+        if choice == "next":
+            resolved = resolve(dataclasses.replace(scenario, seed=scenario.seed + 1))
+        print(f"{'Restart' if choice == 'restart' else 'Next scene'}: seed "
+              f"{resolved.scenario.seed}.", flush=True)
+
+
+def _run_task_once(args, resolved, diagram, meshcat, console):
+    """One run of the task in `diagram`, live in `console` and the terminal: `(TaskResult,
+    LiveRun)`."""
+    scenario = resolved.scenario
+    camera = None
+    if args.camera == "robot":
+        camera = RobotCamera(meshcat, find_system(diagram, "plant"))
+    if console is not None:
+        console.show_title(f"{method_name(scenario.method, _alpha(scenario))}, seed "
+                           f"{scenario.seed}")
+        console.clear_result()
+    live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration), camera)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     rate = 0.0 if args.headless else args.realtime_rate
-    result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram)
-              if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram))
+    result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram,
+                                advance=live.advance)
+              if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram,
+                                        advance=live.advance))
     if args.record:
         _save_recording(meshcat, args.record)
+    outcome = result_text(result.success, result.task_time, stopped=live.choice is not None)
+    if console is not None:
+        console.show_result(outcome)
     hand = ""
     if len(result.ee_positions):
         hand = ", hand at [" + ", ".join(f"{x:.3f}" for x in result.ee_positions[-1]) + "]"
@@ -190,9 +270,7 @@ def _run_task(args, resolved, meshcat):
         hand = f"; per-tick rows in {args.log}"
     print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
           f"{result.summary_line()}{hand}", flush=True)
-    if not args.headless and sys.stdin.isatty():
-        input("Press Enter to quit (the page stays live until then). ")
-    return 0 if result.success else 1
+    return result, live
 
 
 def _run_session(args, resolved, meshcat, person):
@@ -224,24 +302,36 @@ def _run_session(args, resolved, meshcat, person):
                                 "session's Start buttons and questions are in the page, so "
                                 "nothing was run or saved")
 
+    # The live status and Stop, Restart, Next scene, as in a single run. Within a session,
+    # Stop ends it (resumable, like Ctrl-C), Restart runs the method again (the stopped run
+    # is not saved), and Next scene ends this method's run as it stands (saved, not a
+    # success) and goes on to its questions: the next scene of a session is the next run.
+    console = _console(meshcat, args, scenario)
+
     def run_one(trial):
-        diagram = build_diagram(trial, meshcat)
-        print(f"  {trial.scenario.method}: running (seed {trial.scenario.seed})", flush=True)
-        result = run_task(trial, realtime_rate=0.0 if args.headless else
-                          args.realtime_rate, diagram=diagram)
-        operator = diagram.GetSubsystemByName("operator")
-        if hasattr(operator, "Delete"):
-            operator.Delete()  # the next method may want other keys
-        print(f"  {trial.scenario.method}: {result.summary_line()}", flush=True)
-        return result
+        console.choice()  # clicks made between runs (on the questions) do not count
+        while True:
+            diagram = build_diagram(trial, meshcat)
+            result, live = _run_task_once(args, trial, diagram, meshcat, console)
+            operator = diagram.GetSubsystemByName("operator")
+            if hasattr(operator, "Delete"):
+                operator.Delete()  # the next method may want other keys
+            if live.choice == "stop":
+                raise KeyboardInterrupt
+            if live.choice != "restart":
+                return result
+            print(f"Restart: {trial.scenario.method} again, seed {trial.scenario.seed} "
+                  "(the stopped run is not saved).", flush=True)
 
     try:
         summary = run_session(scenario, args.participant, methods, output, run_one, page,
                               practice=args.practice)
     except KeyboardInterrupt:
-        print(f"\nInterrupted: the methods and answers saved so far are in {output}; the "
+        print(f"\nStopped: the methods and answers saved so far are in {output}; the "
               "same command resumes the session.", file=sys.stderr)
         return 130
+    finally:
+        console.close()
     failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
     print(f"Session saved in {output}, answers in {output / QUESTIONNAIRE_FILE} "
           f"(`pbp-drake report {output.parent}` compares the participants).")
@@ -262,6 +352,28 @@ def _session_page(args, meshcat, methods, person):
                             "tiredness=3,ease=4): otherwise the questions are asked in the "
                             "browser")
     return MeshcatSessionPage(meshcat)
+
+
+def _interactive(args, meshcat):
+    """A person may be watching: the run waits for a browser, and the page stays live after
+    the run. Not with --headless or --no-meshcat, nor without a terminal (a script's run)."""
+    return meshcat is not None and not args.headless and sys.stdin.isatty()
+
+
+def _alpha(scenario):
+    return scenario.alpha if scenario.method == "fixed_alpha" else None
+
+
+def _console(meshcat, args, scenario, choices=("stop", "restart", "next")):
+    """The page's console: the choices, the alpha slider (fixed_alpha) and the real-time
+    rate slider (not when running as fast as possible)."""
+    return Console(meshcat, choices, alpha=_alpha(scenario),
+                   realtime_rate=None if args.headless else args.realtime_rate)
+
+
+def _wait_for_stop(console):
+    print("The page stays live: Stop (or Enter, or Ctrl-C) quits.", flush=True)
+    console.wait_for_choice(stdin=sys.stdin)
 
 
 def _wait_for_browser(meshcat, seconds, person=False):

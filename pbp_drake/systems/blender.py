@@ -1,7 +1,7 @@
 """The blender: how the operator's command and the robot policy become the robot's command."""
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
+from pydrake.systems.framework import BasicVector, LeafSystem
 
 from pbp_drake.core.arbitration import (
     DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW, blend, confidence_alpha,
@@ -39,6 +39,10 @@ class Blender(LeafSystem):
     confidence_range` and `c` the margin of the selected goal's probability over the next
     most probable goal (`pbp_drake.core.arbitration.confidence_alpha`); an idle operator
     gives `P`. `confidence_range` and `alpha_max` are ignored by the other modes.
+
+    In `fixed_alpha` mode `alpha` is a numeric parameter of the Context (its default the
+    constructor's), so that it can change during a run without rebuilding: `set_alpha`
+    (the console's alpha slider, `pbp_drake.console`).
     """
 
     def __init__(self, mode, dimension, goal_count, control_period, alpha=None, *,
@@ -66,11 +70,16 @@ class Blender(LeafSystem):
         self._operator_command_port = self.DeclareVectorInputPort("operator_command", d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._goal_probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
-        # The blend is a function of the inputs alone: say so, so that Drake does not redo it
-        # at every plant step in between the control ticks that change them.
+        # A Context parameter, not a Python attribute: a live change (set_alpha) then
+        # belongs to one Context and invalidates the cached command.
+        self._alpha_index = (self.DeclareNumericParameter(BasicVector([float(alpha)]))
+                             if mode == "fixed_alpha" else None)
+        # The blend is a function of the inputs (and alpha) alone: say so, so that Drake
+        # does not redo it at every plant step in between the control ticks that change them.
         self._command_port = self.DeclareVectorOutputPort(
             "command", 2 * d, self._calc_command,
-            prerequisites_of_calc={self.all_input_ports_ticket()})
+            prerequisites_of_calc={self.all_input_ports_ticket(),
+                                   self.all_parameters_ticket()})
 
     @property
     def mode(self):
@@ -105,6 +114,8 @@ class Blender(LeafSystem):
     def alpha(self, context):
         """The arbitration weight used in `context`: `alpha` for `fixed_alpha`, the ramp of
         the goal confidence for `confidence_alpha`, None for the other modes."""
+        if self._alpha_index is not None:
+            return float(context.get_numeric_parameter(self._alpha_index)[0])
         if self._mode != "confidence_alpha":
             return self._alpha
         if not self._goal_probabilities_port.HasValue(context):
@@ -114,6 +125,14 @@ class Blender(LeafSystem):
         return confidence_alpha(self._goal_probabilities_port.Eval(context),
                                 self._selected_goal(context), *self._confidence_range,
                                 self._alpha_max)
+
+    def set_alpha(self, context, alpha):
+        """Sets the weight of `fixed_alpha` in this system's `context` (from the next
+        evaluation of `command` on). Raises ValueError outside [0, 1] or in another mode."""
+        if self._alpha_index is None:
+            raise ValueError(f"alpha is a weight of fixed_alpha; this blender is {self._mode}")
+        validate_mode(self._mode, alpha)
+        context.get_mutable_numeric_parameter(self._alpha_index).SetAtIndex(0, float(alpha))
 
     def _selected_goal(self, context):
         return goal_index(self._selected_goal_port, context, self._goal_count, unconnected=0)

@@ -290,3 +290,15 @@ def test_other_modes_ignore_the_goal_probabilities_port():
     diagram = builder.Build()
     np.testing.assert_allclose(diagram.get_output_port().Eval(diagram.CreateDefaultContext()),
                                [0.25, 0.075, 0.5, 0.75])
+
+
+def test_fixed_alpha_is_a_context_parameter_set_live():
+    blender = Blender("fixed_alpha", 2, 1, 0.1, alpha=0.3)
+    context, other = blender.CreateDefaultContext(), blender.CreateDefaultContext()
+    blender.set_alpha(context, 0.8)
+    assert blender.alpha(context) == 0.8 and blender.alpha(other) == 0.3
+    for bad in (-0.1, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="alpha must lie in"):
+            blender.set_alpha(context, bad)
+    with pytest.raises(ValueError, match="this blender is teleop"):
+        Blender("teleop", 2, 1, 0.1).set_alpha(context, 0.5)

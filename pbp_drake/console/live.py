@@ -1,0 +1,141 @@
+"""A run, live: the simulation advanced in short slices of simulated time, and between two
+slices (on the thread that made Meshcat) the console's status, the person's choices, the
+sliders, the following camera and the terminal's progress line.
+
+Slices rather than a Simulator monitor: a monitor is called at every plant step (a
+thousand a second), and it sees a const Context, where the alpha slider must write a
+parameter. Between slices the Context is the caller's to change, and nothing runs per step.
+"""
+
+import math
+import sys
+import time
+
+from pbp_drake.builder.build import find_system
+from pbp_drake.builder.run import advance_to
+from pbp_drake.console.text import progress_text, status_text
+from pbp_drake.systems.layouts import TaskStatus
+
+# Simulated seconds between two looks at the page: 20 a second at real time, so that the
+# robot camera moves smoothly and a click ends the run within a twentieth of a second.
+SLICE_SECONDS = 0.05
+# Wall seconds between two status lines: the page redraws its panel at each.
+STATUS_PERIOD = 0.25
+
+
+class Progress:
+    """The terminal's progress line: rewritten in place with a carriage return every
+    quarter second when `stream` is a terminal, a new line every `line_period` seconds
+    otherwise (a log file, a pipe)."""
+
+    def __init__(self, duration, stream=None, line_period=5.0):
+        self._stream = stream or sys.stdout
+        self._duration = float(duration)
+        self._tty = self._stream.isatty()
+        self._period = 0.25 if self._tty else float(line_period)
+        self._last = time.monotonic()  # the first line one period in, not at t = 0
+        self._width = 0
+
+    def show(self, now, realtime_factor, force=False):
+        wall = time.monotonic()
+        if not force and wall - self._last < self._period:
+            return
+        self._last = wall
+        text = progress_text(now, self._duration, realtime_factor)
+        if self._tty:
+            self._stream.write("\r" + text.ljust(self._width))
+            self._width = len(text)
+        else:
+            self._stream.write(text + "\n")
+        self._stream.flush()
+
+    def finish(self):
+        """Clears a terminal's progress line, so that the next line starts clean."""
+        if self._tty and self._width:
+            self._stream.write("\r" + " " * self._width + "\r")
+            self._stream.flush()
+            self._width = 0
+
+
+class LiveRun:
+    """Drives `console` (a `pbp_drake.console.Console`, or None) and `progress` (a
+    `Progress`, or None) from the simulation of `diagram`, a task of `duration` seconds.
+
+    Pass `advance` as the `advance` argument of `run_task`, `run_task_streamed` or
+    `simulate`: it advances the simulator to the time asked in slices of `SLICE_SECONDS`
+    and, after each, shows the status (time left, and from the diagram's `task_monitor`,
+    when it has one, the target switches and intervention ratio so far), moves `camera`
+    (a `RobotCamera`, or None), applies the alpha slider to the `blender` (fixed_alpha) and
+    the real-time-rate slider to the simulator. A click on a choice button ends the run
+    there: `advance` returns True, and `choice` holds "stop", "restart" or "next".
+    """
+
+    def __init__(self, diagram, duration, console=None, progress=None, camera=None):
+        self._console = console
+        self._progress = progress
+        self._camera = camera
+        self._duration = float(duration)
+        self._monitor = (diagram.GetSubsystemByName("task_monitor")
+                         if diagram.HasSubsystemNamed("task_monitor") else None)
+        has_alpha = console is not None and console.alpha() is not None
+        self._blender = find_system(diagram, "blender") if has_alpha else None
+        # None: the sliders' values are applied at the start (a restarted run keeps them).
+        self._alpha = self._rate = None
+        self._last_status = -math.inf
+        self.choice = None
+
+    def advance(self, simulator, end_time):
+        """Advances `simulator` to `end_time`; True when the run ended before it (the
+        task's termination event, or a choice of the person's)."""
+        context = simulator.get_context()
+        if self._console is not None:
+            self._apply_sliders(simulator)
+        while (now := context.get_time()) < end_time:
+            step = min((math.floor(now / SLICE_SECONDS + 1e-9) + 1) * SLICE_SECONDS, end_time)
+            ended = advance_to(simulator, step)
+            self._update(simulator)
+            if ended or self.choice is not None:
+                break
+        # The last word, whatever the rate limits: the page and terminal end where the run did.
+        if self._console is not None:
+            self._console.show_status(self.status(context))
+        if self._progress is not None:
+            self._progress.show(context.get_time(), simulator.get_actual_realtime_rate(),
+                                force=True)
+            self._progress.finish()
+        return context.get_time() < end_time
+
+    def status(self, root_context):
+        """The status line at `root_context`'s time (`pbp_drake.console.text.status_text`)."""
+        if self._monitor is None:
+            return status_text(self._duration, root_context.get_time())
+        status = TaskStatus(self._monitor.get_task_status_output_port().Eval(
+            self._monitor.GetMyContextFromRoot(root_context)))
+        return status_text(self._duration, root_context.get_time(), int(status.stage),
+                           float(status.intervention_ratio))
+
+    def _update(self, simulator):
+        context = simulator.get_context()
+        if self._progress is not None:
+            self._progress.show(context.get_time(), simulator.get_actual_realtime_rate())
+        if self._camera is not None:
+            self._camera.update(context)
+        if self._console is None:
+            return
+        self.choice = self._console.choice()
+        self._apply_sliders(simulator)
+        if time.monotonic() - self._last_status >= STATUS_PERIOD:
+            self._last_status = time.monotonic()
+            self._console.show_status(self.status(context))
+
+    def _apply_sliders(self, simulator):
+        if (alpha := self._console.alpha()) != self._alpha:
+            self._alpha = alpha
+            self._blender.set_alpha(self._blender.GetMyMutableContextFromRoot(
+                simulator.get_mutable_context()), alpha)
+        if (rate := self._console.realtime_rate()) != self._rate:
+            self._rate = rate
+            simulator.set_target_realtime_rate(rate)
+            # The pacing counts from its last reset: without one, a faster rate would rush
+            # to catch up on the past at the new rate, a slower one would stall.
+            simulator.ResetStatistics()

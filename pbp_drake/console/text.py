@@ -1,0 +1,57 @@
+"""The console's words: what the page and the terminal say about a run, as pure functions
+of numbers (no Meshcat, no Drake), so that a session, a test or another front end says the
+same thing the same way."""
+
+import math
+
+#: How the page names each method (the paper's names where it has them).
+METHOD_NAMES = {
+    "pbp_alternated": "PBP-Alt",
+    "pbp_continuous": "PBP-Cont",
+    "pbp_no_user": "PBP without the user",
+    "fixed_alpha": "fixed alpha",
+    "confidence_alpha": "confidence alpha",
+    "teleop": "teleoperation",
+}
+
+
+def method_name(method, alpha=None):
+    """The method as a person reads it: `method_name("pbp_alternated")` is "PBP-Alt",
+    `method_name("fixed_alpha", 0.5)` is "fixed alpha 0.50"; unknown names pass through."""
+    name = METHOD_NAMES.get(method, method)
+    if method == "fixed_alpha" and alpha is not None:
+        name = f"{name} {alpha:.2f}"
+    return name
+
+
+def time_left(duration, now):
+    """"time left 41 s": whole seconds until the time limit, rounded up (the last second
+    shows as 1 s, not 0 s), never negative."""
+    return f"time left {max(0, math.ceil(duration - now - 1e-9)):d} s"
+
+
+def status_text(duration, now, switches=None, intervention_ratio=None):
+    """The live status line of a run at simulated time `now` of `duration`: "time left
+    41 s · 2 target switches · intervention 31 %". `switches` and `intervention_ratio`
+    (0..1) are left out when None (a 2-D scene has no targets to switch)."""
+    parts = [time_left(duration, now)]
+    if switches is not None:
+        parts.append(f"{switches:d} target switch" + ("" if switches == 1 else "es"))
+    if intervention_ratio is not None:
+        parts.append(f"intervention {100.0 * intervention_ratio:.0f} %")
+    return " · ".join(parts)
+
+
+def result_text(success, task_time, stopped=False):
+    """A task's outcome: "success in 14.2 s", "failed: time limit", or, when the person
+    ended the run before either (Stop, Restart, Next scene), "stopped at 9.0 s"."""
+    if success:
+        return f"success in {task_time:.1f} s"
+    if stopped:
+        return f"stopped at {task_time:.1f} s"
+    return "failed: time limit"
+
+
+def progress_text(now, duration, realtime_factor):
+    """The terminal's progress line: "t = 12.3 s of 60 s, 1.00x real time"."""
+    return f"t = {now:.1f} s of {duration:g} s, {realtime_factor:.2f}x real time"

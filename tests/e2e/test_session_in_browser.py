@@ -1,18 +1,24 @@
-"""A keyboard participant's session through `pbp-drake run ... --participant`, in headless
-Chromium: the page's Start buttons, the questionnaire's buttons and Next, clicked in the
-control panel as a person would; the session saves both runs and the answers, and nothing is
-asked on the terminal. (The person presses no key: the runs end at their short time limit.)
+"""A keyboard participant's whole session through `pbp-drake run ... --participant`, in
+headless Chromium (issue 15's acceptance): the three methods started from the page's Start
+buttons and driven with the arrow keys, the questionnaire answered with clicks, Next clicked;
+while each method runs the page shows the live status (the method's name, the time left,
+then the result) and the Stop, Restart and Next scene buttons. The session then holds every
+method's trial, with the keys' input in it, and `questionnaire.json` the clicked answers.
 
 Needs Debian's `chromium` and Playwright from PyPI, as tests/e2e/test_browser_end_to_end.py.
 """
 
 import json
+import re
 import subprocess
 import sys
+import time
 
 import pytest
 
 from pbp_drake.console.questionnaire import answer_labels, next_label, start_label
+from pbp_drake.console.text import method_name
+from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
 from test_browser_end_to_end import (
     CHROMIUM, CHROMIUM_ARGS, Output, free_port, sync_playwright)
 
@@ -22,24 +28,48 @@ pytestmark = [
     pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed"),
 ]
 
+# Each run's time limit (s): the session moves on when it passes. Long enough for the keys
+# to land: a page rendered in software handles them seconds late while the robot moves.
+DURATION = 10.0
+ANSWERS = {"pbp_alternated": (4, 3), "pbp_continuous": (2, 5), "teleop": (1, 0)}
+
 
 def label_of(question, value):
     return next(label for label, v in answer_labels(question).items() if v == value)
 
 
-@pytest.mark.timeout(180)
-def test_a_keyboard_session_is_run_from_the_page(repo, tmp_path):
+def control(page, label):
+    """The row of the page's control panel (Meshcat's dat.gui) labelled exactly `label`, a
+    regular expression."""
+    return page.locator(".dg li.cr").filter(
+        has=page.locator(".property-name", has_text=re.compile(f"^{label}$")))
+
+
+def click(page, label):
+    row = control(page, re.escape(label))
+    row.wait_for(state="attached", timeout=60_000)  # until the page shows it
+    row.dispatch_event("click")  # the panel may be folded: the click its row would send
+
+
+def hold_left(page, seconds):
+    """The Left arrow held for `seconds`, as a browser's key auto-repeat sends it."""
+    end = time.monotonic() + seconds
+    while (now := time.monotonic()) < end:
+        page.keyboard.press("ArrowLeft")
+        time.sleep(max(0.0, 0.05 - (time.monotonic() - now)))
+
+
+@pytest.mark.timeout(300)
+def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
     output = tmp_path / "P03"
-    # P03 rotates teleop,pbp_alternated by 3 % 2 = 1: PBP-Alt comes first.
-    clicks = [start_label("pbp_alternated", 1, 2), label_of("tiredness", 4),
-              label_of("ease", 3), next_label(2, 2), start_label("teleop", 2, 2),
-              label_of("tiredness", 1), label_of("ease", 5)]
+    order = session_order(DEFAULT_SESSION_METHODS, "P03")
     command = [sys.executable, "-m", "pbp_drake", "run", "diagrams/hsr_reach.yaml",
-               "--operator", "keyboard", "--participant", "P03", "--methods",
-               "teleop,pbp_alternated", "--duration", "2", "--port", str(free_port()),
-               "--output", str(output), "--wait-for-browser", "60"]
+               "--operator", "keyboard", "--participant", "P03", "--duration", str(DURATION),
+               "--port", str(free_port()), "--output", str(output),
+               "--wait-for-browser", "60"]
     process = subprocess.Popen(command, cwd=repo, stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    seen = {}
     try:
         lines = Output(process.stdout)
         url = lines.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
@@ -48,24 +78,43 @@ def test_a_keyboard_session_is_run_from_the_page(repo, tmp_path):
             browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
                                                  timeout=30_000)
             try:
-                page = browser.new_page(viewport={"width": 1280, "height": 720})
+                page = browser.new_page(viewport={"width": 800, "height": 600})
+                page.set_default_timeout(30_000)
                 page.goto(url.group(1), wait_until="load")
-                page.get_by_text("Open Controls", exact=True).click(timeout=30_000)
-                for label in clicks:
-                    name = page.locator("span.property-name").get_by_text(label, exact=True)
-                    button = page.locator("li.cr.function", has=name)
-                    button.click(timeout=60_000)  # waits until the page shows it
+                for position, method in enumerate(order, start=1):
+                    click(page, start_label(method, position, len(order)))
+                    # The keys work once the page has the keyboard operator's buttons,
+                    # which come with the run: press at once, while it runs.
+                    page.wait_for_selector("text=Left (←)", state="attached")
+                    hold_left(page, 1.5)
+                    name = re.escape(method_name(method))
+                    control(page, f"{name}, seed 0").wait_for(state="attached")
+                    control(page, r"time left \d+ s · \d+ target switch(es)? · "
+                            r"intervention \d+ %").wait_for(state="attached")
+                    seen[method] = {b: control(page, b).count()
+                                    for b in ("Stop", "Restart", "Next scene")}
+                    control(page, r"Result: (success in|failed: time limit).*").wait_for(
+                        state="attached", timeout=(DURATION + 30) * 1000)
+                    tiredness, ease = ANSWERS[method]
+                    click(page, label_of("tiredness", tiredness))
+                    click(page, label_of("ease", ease))
+                    if position < len(order):
+                        click(page, next_label(position + 1, len(order)))
             finally:
                 browser.close()
         done = lines.wait_for(r"^Session saved in ", timeout=60)
         assert done, f"the session did not end:\n{lines.text()}"
-        assert process.wait(timeout=30) == 1  # no key pressed: both runs failed
+        process.wait(timeout=30)
     finally:
         if process.poll() is None:
             process.kill()
             process.wait(timeout=10)
+    assert seen == {m: {"Stop": 1, "Restart": 1, "Next scene": 1} for m in order}
     assert json.loads((output / "questionnaire.json").read_text()) == {
-        "pbp_alternated": {"tiredness": 4, "ease": 3}, "teleop": {"tiredness": 1, "ease": 5}}
-    assert sorted(p.parent.name for p in (output / "trials").rglob("seed_0.json")) == [
-        "pbp_alternated", "teleop"]
+        method: {"tiredness": t, "ease": e} for method, (t, e) in ANSWERS.items()}
+    trials = {method: json.loads((output / "trials" / method / "seed_0.json").read_text())
+              for method in order}
+    # The held arrow reached the robot: the person's input is in every method's run.
+    assert all(trials[m]["intervention_ratio"] > 0 for m in order), {
+        m: trials[m]["intervention_ratio"] for m in order}
     assert "Press Enter" not in lines.text()

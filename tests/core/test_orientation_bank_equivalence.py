@@ -123,3 +123,52 @@ def test_the_bank_model_is_immutable():
         assert not array.flags.writeable
     with pytest.raises(AttributeError, match="immutable"):
         bank.duration = 2.0
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_in_place_steps_with_one_workspace_match_advance_when_goals_change(formulation):
+    """`advance_into` stepping the state in place with one workspace (which keeps the start
+    errors of the last goals) equals `advance`, as the goals move every few steps; a copied
+    workspace and another bank's workspace recompute them."""
+    bank, _, goals = make_banks(formulation, False, 6, False, seed=27)
+    other_bank, _, _ = make_banks(formulation, False, 6, False, seed=28)
+    rng = np.random.default_rng(29)
+    goals_4k = bank.goals_matrix(goals)
+    workspace = bank.make_workspace()
+    phase, orientations, velocity = bank.initial_state()
+    expected = bank.initial_state()
+    for step in range(20):
+        if step % 4 == 3:
+            goals_4k = bank.goals_matrix(random_rows(6, rng))
+        if step == 10:
+            other_bank.advance_into(*other_bank.initial_state(), goals_4k, DT,
+                                    *other_bank.initial_state(), workspace)
+        robot = orientations[:, :1].copy()
+        bank.advance_into(phase, robot, velocity, goals_4k, DT, phase, orientations,
+                          velocity, workspace)
+        expected = bank.advance(expected[0], robot, expected[2], goals_4k, DT)
+        for ours, theirs in zip((phase, orientations, velocity), expected):
+            np.testing.assert_array_equal(ours, theirs)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_the_bank_equals_single_dmps_at_tiny_angles_and_half_turns(formulation):
+    """Measured orientations at 0, 1e-12, 1e-6, 5e-3 and 2e-2 rad from their goals (both
+    sides of the series' switch) and at 180 degrees less 1e-9 and exactly: the bank's
+    allocation-free kernels against `pbp_drake.core.quaternion`."""
+    offsets = [0.0, 1e-12, 1e-6, 5e-3, 2e-2, np.pi - 1e-9, np.pi]
+    count = len(offsets)
+    bank, dmps, goals = make_banks(formulation, True, count, True, seed=30)
+    rng = np.random.default_rng(31)
+    axes = rng.normal(size=(3, count))
+    axes /= np.linalg.norm(axes, axis=0)
+    measured = quaternion.multiply(quaternion.exp_map(axes * offsets), goals.T)
+    velocity = rng.normal(size=(3, count))
+    phase = np.full(count, 0.4)
+    stepped = bank.advance(phase, measured, velocity, bank.goals_matrix(goals), DT)
+    for k, dmp in enumerate(dmps):
+        dmp.phase, dmp.scaled_angular_velocity = 0.4, velocity[:, k].copy()
+        orientation, angular_velocity = dmp.next_step(DT, goals[k], measured[:, k])
+        np.testing.assert_allclose(stepped[1][:, k], orientation, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(stepped[2][:, k] / bank.duration, angular_velocity,
+                                   rtol=0, atol=1e-12)

@@ -107,7 +107,9 @@ def test_the_step_matches_the_continuous_equations(formulation, case):
     own: the quaternion integrated through `dq/dt = (0, omega) q / 2` (not through `Exp`),
     `omega = J(e) z / tau`, `tau dz/dt = K (a(x) - e) - D z`, `e` from SciPy's rotation
     vector of `q g*`, `J` from its matrix form. Compared at every step of a rollout over
-    1.5 tau: the step is within 0.5 degree at 30 Hz, and second order."""
+    1.5 tau; the error is the largest rotation angle between the two. Measured: 0.061 and
+    0.0086 degree at 30 and 100 Hz (demonstration of 170 degrees), 0.056 and 0.0078 (straight
+    over 179 degrees), second order as the position step; the issue asks for 0.5 at 30 Hz."""
     settings = DmpSettings(formulation=formulation)
     if case == "demonstration_170_degrees":
         dmp = OrientationDmp.from_demonstration(
@@ -161,8 +163,8 @@ def test_the_step_matches_the_continuous_equations(formulation, case):
         exact_path = exact.y[:4].T / np.linalg.norm(exact.y[:4], axis=0)[:, None]
         assert angles(exact_path[0], exact_path[-1]) > np.radians(160)  # the whole turn
         errors[rate] = angles(path, exact_path).max()
-    assert errors[30] < np.radians(0.5)
-    assert errors[100] < np.radians(0.05)
+    assert errors[30] < np.radians(0.1)
+    assert errors[100] < np.radians(0.015)
     assert errors[30] / errors[100] > 6  # second order: (100 / 30)^2 = 11
 
 

@@ -21,10 +21,13 @@ import numpy as np
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp._checks import positive
 from pbp_drake.core.dmp.orientation import (
-    AXES, OrientationDmp, fit_orientation_weights, orientation_errors, straight_weights,
+    AXES, fit_orientation_weights, straight_weights,
     validate_orientation_demonstration)
+from pbp_drake.core.dmp.orientation_kernels import (
+    OrientationWorkspace, error_quaternions_into, exp_into, inverse_jacobian_into,
+    jacobian_into, log_into, product_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis, phase_decay
-from pbp_drake.core.dmp.stepping import step_constants
+from pbp_drake.core.dmp.stepping import _BLOCK_BYTES, step_constants
 
 
 def _read_only(array):
@@ -78,6 +81,21 @@ class OrientationDmpBank:
         self.amplitude_scaling = np.array(scaling.T)  # (3, K)
         self.amplitude_scaling.setflags(write=False)
         self._all_scaled = bool(scaling.all())
+        # Distinct weights `(N, 3 K)` in column blocks that fit the L2 cache, as the position
+        # bank (`stepping._BLOCK_BYTES`): `(blocks, N, width)` views, and the rest.
+        self._weight_blocks = self._weight_tail = None
+        if not self.shared_weights:
+            width = max(64, _BLOCK_BYTES // self._weights.itemsize // settings.basis_count)
+            blocks = self._weights.shape[1] // width
+            if blocks > 1:
+                covered = blocks * width
+                self._weight_blocks = self._weights[:, :covered].reshape(
+                    -1, blocks, width).transpose(1, 0, 2)
+                self._weight_tail = self._weights[:, covered:]
+        self._ijspeert = settings.formulation == "ijspeert"
+        # One start for all: `q0 g*` is then one 4x4 product (`error_quaternions_into`).
+        self._uniform_start = (_read_only(self.starts[:, :1])
+                               if (self.starts == self.starts[:, :1]).all() else None)
         centres, widths = settings.basis()
         self._centres, self._widths = _read_only(centres), _read_only(widths)
         self._frozen = True
@@ -148,13 +166,19 @@ class OrientationDmpBank:
                              f"{self.goal_count}")
         return np.array(goals.T, order="C")
 
+    def make_workspace(self):
+        """New scratch arrays for `advance_into`; one per thread or Drake Context."""
+        return OrientationWorkspace(self.goal_count, self._settings.basis_count)
+
     def attractors(self, phase, goals_4k):
-        """The moving attractors `a(x)` `(3, K)` in `e = Log(q g*)` coordinates."""
+        """The moving attractors `a(x)` `(3, K)` in `e = Log(q g*)` coordinates, a new array."""
+        workspace = self.make_workspace()
         phase = np.broadcast_to(np.asarray(phase, dtype=float), (self.goal_count,))
-        identity = np.eye(2)
-        shapes, lam = self._combined_shapes(phase, 1.0, identity)
-        return self._relative_attractor(shapes[0], lam[0], orientation_errors(
-            self.starts, goals_4k))
+        shapes, lam = self._combined_shapes(phase, 1.0, np.eye(2), workspace)
+        self._start_errors_into(goals_4k, workspace)
+        attractor = np.zeros((AXES, self.goal_count))
+        self._add_relative_attractor(attractor, shapes[0], lam[0], workspace)
+        return attractor
 
     def advance(self, phase, orientations, scaled_angular_velocity, goals_4k, dt,
                 locked=None, robot_angular_velocity=None, followed=None):
@@ -174,88 +198,158 @@ class OrientationDmpBank:
         """
         phase = np.asarray(phase, dtype=float)
         velocity = np.asarray(scaled_angular_velocity, dtype=float)
-        orientations = quaternion.unit_quaternions(
-            np.asarray(orientations, dtype=float).reshape(4, -1).T, "orientations").T
         if followed is not None:
             if not 0 <= int(followed) < self.goal_count:
                 raise ValueError(f"followed {followed} is not one of the {self.goal_count} "
                                  "goals")
             velocity = np.repeat(velocity[:, [int(followed)]], self.goal_count, axis=1)
+        new_state = (np.empty(phase.shape), np.empty((4, self.goal_count)),
+                     np.empty((AXES, self.goal_count)))
+        self.advance_into(phase, orientations, velocity, goals_4k, dt, *new_state,
+                          self.make_workspace(), locked, robot_angular_velocity)
+        return new_state
+
+    def advance_into(self, phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                     out_phase, out_orientations, out_velocity, workspace, locked=None,
+                     robot_angular_velocity=None):
+        """`advance` written into `out_phase` (K,), `out_orientations` (4, K) and
+        `out_velocity` (3, K), with `workspace` (`make_workspace`) as scratch.
+
+        The outputs may be the inputs (`out_velocity is scaled_angular_velocity`, ...): the
+        state is then stepped in place. From one measured orientation `(4, 1)` it allocates
+        nothing of size K, unless some (not all) DMPs are locked; orientations `(4, K)` are
+        checked and normalised into a new array first."""
+        orientations = quaternion.unit_quaternions(
+            np.asarray(orientations, dtype=float).reshape(4, -1).T, "orientations").T
         if locked is not None:
-            locked = np.broadcast_to(np.asarray(locked, bool), phase.shape)
+            locked = np.broadcast_to(np.asarray(locked, bool), np.shape(phase))
             if not locked.any():
                 locked = None
-        held_velocity = velocity if robot_angular_velocity is None else np.broadcast_to(
-            self.duration * np.asarray(robot_angular_velocity, float).reshape(AXES, 1),
-            velocity.shape)
-        if locked is not None and locked.all():
-            return (phase.copy(), np.array(np.broadcast_to(orientations, (4, phase.size))),
-                    np.array(held_velocity))
-        new_state = self._step(phase, orientations, velocity, goals_4k, dt)
-        if locked is None:
-            return new_state
-        new_phase, new_orientations, new_velocity = new_state
-        return (np.where(locked, phase, new_phase),
-                np.where(locked, orientations, new_orientations),
-                np.where(locked, held_velocity, new_velocity))
+        if locked is not None:
+            held = (scaled_angular_velocity if robot_angular_velocity is None else
+                    np.broadcast_to(self.duration * np.asarray(
+                        robot_angular_velocity, float).reshape(AXES, 1), out_velocity.shape))
+            if not locked.all():
+                # Some locked, some not: the free step into temporaries, then chosen (rare).
+                stepped = (np.empty_like(out_phase), np.empty_like(out_orientations),
+                           np.empty_like(out_velocity))
+                self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                                *stepped, workspace)
+                held, stepped_phase = np.array(held), stepped[0]
+                orientations = np.broadcast_to(orientations, out_orientations.shape)
+                out_phase[...] = np.where(locked, phase, stepped_phase)
+                out_orientations[...] = np.where(locked, orientations, stepped[1])
+                out_velocity[...] = np.where(locked, held, stepped[2])
+                return
+            out_phase[...] = phase
+            out_orientations[...] = orientations
+            out_velocity[...] = held
+            return
+        self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                        out_phase, out_orientations, out_velocity, workspace)
 
-    def predict(self, phase, orientation, scaled_angular_velocity, goals_4k, dt, steps):
+    def predict(self, phase, orientation, scaled_angular_velocity, goals_4k, dt, steps,
+                workspace=None):
         """Open-loop orientations `(K, steps + 1, 4)` from one state (inputs left alone)."""
+        workspace = self.make_workspace() if workspace is None else workspace
         path = np.empty((steps + 1, 4, self.goal_count))
         path[0] = np.broadcast_to(orientation, (4, self.goal_count))
+        phase = np.array(phase, dtype=float)
+        velocity = np.array(scaled_angular_velocity, dtype=float)
         for step in range(steps):
-            phase, path[step + 1], scaled_angular_velocity = self.advance(
-                phase, path[step], scaled_angular_velocity, goals_4k, dt)
+            self.advance_into(phase, path[step], velocity, goals_4k, dt, phase,
+                              path[step + 1], velocity, workspace)
         return path.transpose(2, 0, 1)
 
-    def _step(self, phase, orientations, velocity, goals_4k, dt):
-        """The free step (see `pbp_drake.core.dmp.orientation`), vectorised over K."""
+    def _start_errors_into(self, goals_4k, workspace):
+        """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`
+        (1 where the fit switched the scaling off) into `workspace.amplitude`."""
+        if (workspace.starts_of_start_errors is self.starts
+                and np.array_equal(workspace.goals_of_start_errors, goals_4k)):
+            return  # the goals did not change: one pass instead of a log map
+        starts = self._uniform_start if self._uniform_start is not None else self.starts
+        error_quaternions_into(starts, goals_4k, workspace.error_quaternions, workspace.row)
+        log_into(workspace.error_quaternions, workspace.start_errors, workspace)
+        if self._ijspeert:
+            np.negative(workspace.start_errors, out=workspace.amplitude)
+            if not self._all_scaled:
+                np.copyto(workspace.amplitude, 1.0, where=~self.amplitude_scaling)
+        workspace.goals_of_start_errors[...] = goals_4k
+        workspace.starts_of_start_errors = self.starts
+
+    def _step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
+                   out_orientations, out_velocity, workspace):
+        """The free step (see `pbp_drake.core.dmp.orientation`), vectorised over K:
+        `e, z` from the measured orientation, the position step, back to `q', eta'`."""
+        ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)
         decay = self.decay(dt)
-        errors = orientation_errors(orientations, goals_4k)  # (3, K)
-        z = quaternion.left_jacobian_inverse_times(errors, velocity)
-        start_errors = orientation_errors(self.starts, goals_4k)
-        shapes, lam = self._combined_shapes(phase, decay, constants.combination)
-        # dp = (Phi00 - 1) e + (C00 b0 + C01 b1), dz = Phi10 e + (C10 b0 + C11 b1), and
-        # e' = e + dp + Phi01 z, z' = dz + Phi11 z (the position bank's step, goal 0).
-        new_errors = (errors * (1.0 + constants.position_offset)
-                      + self._relative_attractor(shapes[0], lam[0], start_errors)
-                      + constants.position_velocity * z)
-        new_z = (errors * constants.velocity_offset
-                 + self._relative_attractor(shapes[1], lam[1], start_errors)
-                 + constants.velocity_velocity * z)
-        new_orientations = quaternion.aligned(
-            quaternion.multiply(quaternion.exp_map(new_errors), goals_4k), orientations)
-        new_velocity = quaternion.left_jacobian_times(new_errors, new_z)
-        return phase * decay, new_orientations, new_velocity
+        shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
+        self._start_errors_into(goals_4k, ws)
+        error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
+        log_into(ws.error_quaternions, ws.errors, ws)
+        inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
+        # e' = Phi00 e + Phi01 z + b, z' = Phi10 e + Phi11 z + b', with b and b' the rows'
+        # combinations of the attractor (the position bank's step, goal 0).
+        rows = ((ws.new_errors, 1.0 + constants.position_offset, constants.position_velocity),
+                (ws.new_log_velocity, constants.velocity_offset, constants.velocity_velocity))
+        for row, (target, error_gain, velocity_gain) in enumerate(rows):
+            np.multiply(ws.errors, error_gain, out=target)
+            np.multiply(ws.log_velocity, velocity_gain, out=ws.work)
+            target += ws.work
+            self._add_relative_attractor(target, shapes[row], lam[row], ws)
+        turned = ws.error_quaternions  # Exp(e'), then q' = Exp(e') g
+        exp_into(ws.new_errors, turned, ws)
+        jacobian_into(ws.new_errors, ws.new_log_velocity, out_velocity, ws)
+        product_into(turned, goals_4k, ws.product, ws.row)
+        # Signed as the measured orientation, so that a stream of them stays continuous.
+        if orientations.shape[1] == 1:
+            np.dot(orientations[:, 0], ws.product, out=ws.row)
+        else:
+            np.multiply(ws.product, orientations, out=turned)
+            np.sum(turned, axis=0, out=ws.row)
+        np.less(ws.row, 0.0, out=ws.small)
+        np.multiply(ws.small, -2.0, out=ws.row)  # -1 where the sign flips, else +1
+        ws.row += 1.0
+        np.multiply(ws.product, ws.row, out=out_orientations)
+        np.multiply(phase, decay, out=out_phase)
 
-    def _relative_attractor(self, shape, lam, start_errors):
-        """A combination of attractors, `(3, K)`: Ijspeert `S (-e0)` (S alone where the
-        scaling is off), Pastor `S + lambda e0`."""
-        if self._settings.formulation == "ijspeert":
-            amplitude = -start_errors
-            if not self._all_scaled:
-                amplitude = np.where(self.amplitude_scaling, amplitude, 1.0)
-            return shape * amplitude
-        return shape + lam * start_errors
+    def _add_relative_attractor(self, target, shape, lam, workspace):
+        """`target += b`, a combination of attractors: Ijspeert `S (-e0)` (S alone where
+        the scaling is off), Pastor `S + lambda e0`."""
+        if self._ijspeert:
+            np.multiply(shape, workspace.amplitude, out=workspace.work)
+        else:
+            target += shape
+            np.multiply(workspace.start_errors, lam, out=workspace.work)
+        target += workspace.work
 
-    def _combined_shapes(self, phase, decay, combination):
+    def _combined_shapes(self, phase, decay, combination, workspace):
         """Rows r of `combination` (2x2): `S_r = C_r0 s(x0) + C_r1 s(x1)` with
         `s(x) = (psi.w / sum psi) x` (over K in the Ijspeert form), `(2, 3, 1)` or
         `(2, 3, K)`, and `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`."""
         n = self._settings.basis_count
-        scale = 1.0 / self._settings.stiffness if self._settings.formulation == "ijspeert" else 1.0
+        scale = 1.0 / self._settings.stiffness if self._ijspeert else 1.0
         if phase.size == 1 or phase.min() == phase.max():
             # Equal phases: the basis at the step's two phases only, (N, 2).
             phases = np.array([phase.flat[0], phase.flat[0] * decay])
             scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
             basis = combination @ scaled.T  # (2, N)
+            lam = (combination @ phases)[:, np.newaxis]
             if self.shared_weights:
-                return (basis @ self._weights)[:, :, np.newaxis], (combination @ phases)[:, None]
-            shapes = (basis @ self._weights).reshape(2, AXES, self.goal_count)
-            return shapes, (combination @ phases)[:, None]
-        # A phase per goal: (N, 2, K) bases.
+                return (basis @ self._weights)[:, :, np.newaxis], lam
+            flat = workspace.shape.reshape(2, -1)
+            if self._weight_blocks is None:
+                np.dot(basis, self._weights, out=flat)
+            else:
+                blocks, _, width = self._weight_blocks.shape
+                covered = blocks * width
+                np.matmul(basis, self._weight_blocks,
+                          out=flat[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
+                np.matmul(basis, self._weight_tail, out=flat[:, covered:])
+            return workspace.shape, lam
+        # A phase per goal: (N, 2, K) bases (allocates).
         phases = np.stack([phase, phase * decay])
         scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
         combined = np.einsum("rs,nsk->rnk", combination, scaled)  # (2, N, K)

@@ -22,10 +22,9 @@ and the orientation and its world-frame angular velocity follow from it exactly:
 
 with `J` the left Jacobian of `Exp` (`quaternion.left_jacobian_times`). Because `e` obeys
 the linear position DMP, the closed-form first-order-hold step, the fit and the
-convergence of the position DMP carry over as they are. (Ude et al. 2014 integrate
-`tau deta/dt = K 2 Log(g q*) - D eta + f`, `dq/dt = eta q / (2 tau)` instead; that system is
-not the linear DMP in any coordinates, and its fit, which assumes it is, distorts large
-rotations.)
+convergence of the position DMP carry over as they are. (Ude et al. 2014 write the DMP on
+the quaternion itself, `tau deta/dt = K 2 Log(g q*) - D eta + f`, `dq/dt = eta q / (2 tau)`;
+its error dynamics are linear in no coordinates, so none of that would carry over.)
 
 The velocity state kept is the DMP's own scaled angular velocity `eta = tau omega` (world
 frame), not `z`: it is the same physical quantity whichever goal the log is taken against,

@@ -172,3 +172,14 @@ def test_the_bank_equals_single_dmps_at_tiny_angles_and_half_turns(formulation):
         np.testing.assert_allclose(stepped[1][:, k], orientation, rtol=0, atol=1e-12)
         np.testing.assert_allclose(stepped[2][:, k] / bank.duration, angular_velocity,
                                    rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+def test_the_banks_attractors_are_the_single_dmps(formulation, shared):
+    bank, dmps, goals = make_banks(formulation, shared, 5, False, seed=32)
+    phases = np.array([1.0, 0.7, 0.3, 0.05, 0.7])
+    attractors = bank.attractors(phases, bank.goals_matrix(goals))
+    for k, dmp in enumerate(dmps):
+        np.testing.assert_allclose(attractors[:, k], dmp.attractor(phases[k], goals[k]),
+                                   rtol=0, atol=1e-12)

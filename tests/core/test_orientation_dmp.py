@@ -286,14 +286,19 @@ def test_non_unit_and_nan_quaternions_are_refused_by_name():
     bank = OrientationDmpBank.straight(good, 2, 1.0)
     with pytest.raises(ValueError, match=r"goals is not a unit quaternion .* quaternion 1"):
         bank.goals_matrix([good, [0.0, 0.0, 0.0, 0.0]])
-    with pytest.raises(ValueError, match="goals has 1 quaternions; the bank expects 2"):
+    with pytest.raises(ValueError, match=r"goals has 4 numbers; the bank expects 2 "
+                                         r"quaternions \(w, x, y, z\)"):
         bank.goals_matrix([good])
+    with pytest.raises(ValueError, match="goals has 0 numbers"):
+        bank.goals_matrix([])
     with pytest.raises(ValueError, match="starts is not a unit quaternion"):
         OrientationDmpBank.straight([1.0, 0, 0, 0.01], 2, 1.0)
     phase, robot, velocity = bank.initial_state()
     goals = bank.goals_matrix([good, good])
     with pytest.raises(ValueError, match="orientations contains NaN"):
         bank.advance(phase, np.full((4, 1), np.nan), velocity, goals, 0.03)
+    with pytest.raises(ValueError, match=r"orientations must be \(4, 1\) or \(4, 2\)"):
+        bank.advance(phase, np.ones((3, 1)), velocity, goals, 0.03)
     dmp = OrientationDmp.straight(good, good, 1.0)
     with pytest.raises(ValueError, match="robot_orientation is not a unit quaternion"):
         dmp.next_step(0.03, robot_orientation=[0.5, 0, 0, 0])

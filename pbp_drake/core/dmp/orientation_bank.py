@@ -159,11 +159,11 @@ class OrientationDmpBank:
 
     def goals_matrix(self, goals):
         """Checks goal orientations given as `(K, 4)` rows (w, x, y, z) and returns `(4, K)`."""
-        goals = quaternion.unit_quaternions(np.reshape(goals, (-1, 4)) if np.size(goals)
-                                            else goals, "goals")
-        if goals.shape != (self.goal_count, 4):
-            raise ValueError(f"goals has {goals.shape[0]} quaternions; the bank expects "
-                             f"{self.goal_count}")
+        size = np.size(goals)
+        if size != 4 * self.goal_count:
+            raise ValueError(f"goals has {size} numbers; the bank expects {self.goal_count} "
+                             "quaternions (w, x, y, z)")
+        goals = quaternion.unit_quaternions(np.reshape(goals, (self.goal_count, 4)), "goals")
         return np.array(goals.T, order="C")
 
     def make_workspace(self):
@@ -219,8 +219,12 @@ class OrientationDmpBank:
         state is then stepped in place. From one measured orientation `(4, 1)` it allocates
         nothing of size K, unless some (not all) DMPs are locked; orientations `(4, K)` are
         checked and normalised into a new array first."""
-        orientations = quaternion.unit_quaternions(
-            np.asarray(orientations, dtype=float).reshape(4, -1).T, "orientations").T
+        orientations = np.asarray(orientations, dtype=float)
+        if orientations.size not in (4, 4 * self.goal_count):
+            raise ValueError(f"orientations must be (4, 1) or (4, {self.goal_count}), got shape "
+                             f"{orientations.shape}")
+        orientations = quaternion.unit_quaternions(orientations.reshape(4, -1).T,
+                                                   "orientations").T
         if locked is not None:
             locked = np.broadcast_to(np.asarray(locked, bool), np.shape(phase))
             if not locked.any():

@@ -11,7 +11,10 @@ PBP-Alt's lock is the same `locked` flag passed to both.
 
 The step is the position bank's first-order-hold step on `e = Log(q g*)` (3, K), with the
 memoised `stepping.step_constants`: the basis is evaluated at the step's two phases only
-when the phases are equal (the normal case), and contracted with the weights once.
+when the phases are equal (the normal case), and contracted with the weights once. The
+quaternion math around it (`orientation_kernels`) writes into an `OrientationWorkspace` the
+caller owns (`make_workspace`), so that `advance_into` from one measured orientation
+allocates nothing of size K; `advance` is the same step into new arrays.
 """
 
 import dataclasses
@@ -42,7 +45,8 @@ class OrientationDmpBank:
 
     All share `duration` and `settings`; each has its own start orientation and phase, and
     its own weights `(K, N, 3)` or one set `(N, 3)` shared by all (straight paths, or one
-    demonstration sent to K goals). Immutable: the state is passed in and out of `advance`.
+    demonstration sent to K goals). Immutable: the state is passed in and out of `advance`
+    (pure) and `advance_into` (into the caller's arrays, with a workspace).
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),

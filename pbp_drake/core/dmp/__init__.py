@@ -42,18 +42,26 @@ The modules, all NumPy only (no Drake import):
 - `fitting`: `minimum_jerk`, `validate_demonstration`, `fit_weights` (one demonstration);
 - `single`: `Dmp`, one DMP with a stateful API, the readable reference;
 - `bank`: `DmpBank`, K DMPs as one immutable model, stepped by pure and in-place calls;
-- `workspace`: `DmpWorkspace`, the scratch arrays a caller of the in-place step owns.
+- `workspace`: `DmpWorkspace`, the scratch arrays a caller of the in-place step owns;
+- `orientation`: orientation DMPs on unit quaternions `(w, x, y, z)`, the position DMP on
+  `e = Log(q g*)` (Koutras and Doulgeri 2020), its fit, and `OrientationDmp`, the reference;
+- `orientation_bank`: `OrientationDmpBank`, K of them with the position bank's API;
+- `orientation_kernels`: its step's quaternion math into an `OrientationWorkspace`.
 """
 
 from pbp_drake.core.dmp.bank import DmpBank
 from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration
+from pbp_drake.core.dmp.orientation import OrientationDmp, fit_orientation_weights
+from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
+from pbp_drake.core.dmp.orientation_kernels import OrientationWorkspace
 from pbp_drake.core.dmp.settings import (
     FORMULATIONS, DmpSettings, normalized_basis, phase_decay, step_matrices, transition)
 from pbp_drake.core.dmp.single import Dmp
 from pbp_drake.core.dmp.workspace import DmpWorkspace
 
 __all__ = [
-    "FORMULATIONS", "Dmp", "DmpBank", "DmpSettings", "DmpWorkspace", "fit_weights",
+    "FORMULATIONS", "Dmp", "DmpBank", "DmpSettings", "DmpWorkspace", "OrientationDmp",
+    "OrientationDmpBank", "OrientationWorkspace", "fit_orientation_weights", "fit_weights",
     "minimum_jerk", "normalized_basis", "phase_decay", "step_matrices", "transition",
     "validate_demonstration",
 ]

@@ -1,0 +1,214 @@
+"""Orientation DMPs on unit quaternions: the formulation, the one-demonstration fit, and one
+DMP stepped the plain way (the readable reference the vectorised bank is tested against).
+
+The formulation is Koutras and Doulgeri's (2020): the position DMP, unchanged, on the
+logarithm of the orientation error. Quaternions are `(w, x, y, z)`
+(`pbp_drake.core.quaternion`). With `g` the goal orientation, the DMP's "position" is the
+rotation vector of the rotation from the goal to the orientation `q`,
+
+    e = Log(q g*)        (3,), |e| <= pi, the same for q or -q, g or -g,
+
+which is 0 at the goal. `e` follows the position DMP of `pbp_drake.core.dmp` with goal 0
+and start `e0 = Log(q0 g*)`, same gains, basis, phase and formulation:
+
+    tau de/dt = z,    tau dz/dt = K (a(x) - e) - D z,    tau dx/dt = -alpha_x x,
+    ijspeert:  a(x) = (sum_i psi_i w_i / sum_i psi_i) x (-e0) / K   (per axis; 1 for -e0
+               where the fit switched the amplitude scaling off),
+    pastor:    a(x) = e0 x + (sum_i psi_i w_i / sum_i psi_i) x,
+
+and the orientation and its world-frame angular velocity follow from it exactly:
+
+    q = Exp(e) g,    omega = J(e) de/dt,
+
+with `J` the left Jacobian of `Exp` (`quaternion.left_jacobian_times`). Because `e` obeys
+the linear position DMP, the closed-form first-order-hold step, the fit and the
+convergence of the position DMP carry over as they are. (Ude et al. 2014 write the DMP on
+the quaternion itself, `tau deta/dt = K 2 Log(g q*) - D eta + f`, `dq/dt = eta q / (2 tau)`;
+its error dynamics are linear in no coordinates, so none of that would carry over.)
+
+The velocity state kept is the DMP's own scaled angular velocity `eta = tau omega` (world
+frame), not `z`: it is the same physical quantity whichever goal the log is taken against,
+so PBP's goal switch can copy it from one DMP to another and the phase lock can set it from
+the robot's angular velocity, as the position DMP does with `z`. A step from the robot's
+measured orientation `q_m` (PBP's re-integration) is
+
+    e = Log(q_m g*),  z = J(e)^-1 eta,  (e, z) -> (e', z') by the position step,
+    q' = Exp(e') g (signed as q_m),  eta' = J(e') z',  x' = x exp(-alpha_x dt / tau).
+
+Open loop, `Log(Exp(e') g g*) = e'` and `J^-1 J = I`, so the rollout is the position DMP's
+rollout of `e`. A demonstration's orientations must stay within 180 degrees of its last one
+(else `e` would jump from `pi u` to `-pi u`); a start or a measured orientation may be
+anywhere, the DMP then turns the shorter way (either way at exactly 180 degrees, chosen as
+`quaternion.canonical` does, the same for `q` and `-q`).
+"""
+
+import numpy as np
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.dmp._checks import positive
+from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk
+from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, step_matrices
+
+AXES = 3
+
+
+def orientation_errors(orientations, goals):
+    """`e = Log(q g*)`, `(3, ...)`, of orientations and goals `(4, ...)` (broadcast)."""
+    return quaternion.log_map(quaternion.multiply(orientations, quaternion.conjugate(goals)))
+
+
+def validate_orientation_demonstration(times, orientations):
+    """Checks a demonstration and returns float arrays `(T,)`, unit quaternion rows `(T, 4)`.
+
+    Refuses (ValueError) fewer than 3 samples, times that are not finite and increasing,
+    non-unit or NaN quaternions, and a path that turns through 180 degrees away from its
+    last orientation (the log of the error would jump there)."""
+    orientations = quaternion.unit_quaternions(orientations, "demonstration orientations")
+    if orientations.ndim != 2 or orientations.shape[0] < 3:
+        raise ValueError(f"demonstration orientations must be (T, 4) with T >= 3, got shape "
+                         f"{orientations.shape}")
+    times = np.asarray(times, dtype=float)
+    if times.shape != (orientations.shape[0],):
+        raise ValueError(f"demonstration times have shape {times.shape}, expected "
+                         f"({orientations.shape[0]},)")
+    if not np.isfinite(times).all() or not (np.diff(times) > 0).all():
+        raise ValueError("demonstration times must be finite and strictly increasing")
+    errors = orientation_errors(orientations.T, orientations[-1][:, np.newaxis])
+    jumps = np.flatnonzero(np.linalg.norm(np.diff(errors, axis=1), axis=0) > np.pi)
+    if jumps.size:
+        raise ValueError(f"demonstration orientations pass 180 degrees from the last one "
+                         f"between samples {jumps[0]} and {jumps[0] + 1}; orientation DMPs "
+                         f"need a demonstration that stays within 180 degrees of its end")
+    return times, orientations
+
+
+def fit_orientation_weights(times, orientations, settings=DmpSettings()):
+    """Weights `(N, 3)` and amplitude scaling `(3,)` of ONE demonstration of orientations
+    `(T, 4)`: the position fit (`fitting.fit_weights`) on `e_t = Log(q_t q_T*)`."""
+    times, orientations = validate_orientation_demonstration(times, orientations)
+    errors = orientation_errors(orientations.T, orientations[-1][:, np.newaxis]).T
+    return fit_weights(times, errors, settings)
+
+
+def straight_weights(settings, duration, span):
+    """Weights `(N, 3)` of a minimum-jerk straight path in `e` (a slerp in orientation).
+
+    Fitted on a unit reach so that an axis with no rotation still gets the shape; the
+    Ijspeert factor `-e0` then scales it per axis, the Pastor form takes `span = -e0`."""
+    times, unit = minimum_jerk(np.zeros(1), np.ones(1), duration)
+    unit_weights, _ = fit_weights(times, unit, settings)
+    return unit_weights * (span if settings.formulation == "pastor" else np.ones(AXES))
+
+
+class OrientationDmp:
+    """One orientation DMP, stepped with a plain per-axis loop: the readable reference.
+
+    State: `phase`, `orientation` (4,) and `scaled_angular_velocity` (3,) `eta = tau omega`.
+    """
+
+    def __init__(self, weights, start, goal, duration, settings=DmpSettings(),
+                 amplitude_scaling=None):
+        self.settings = settings
+        self.start = quaternion.unit_quaternions(start, "start").reshape(4)
+        self.goal = quaternion.unit_quaternions(goal, "goal").reshape(4)
+        self.weights = np.asarray(weights, dtype=float).reshape(settings.basis_count, AXES)
+        self.duration = positive(duration, "duration")
+        self.amplitude_scaling = (np.ones(AXES, bool) if amplitude_scaling is None
+                                  else np.asarray(amplitude_scaling, bool).reshape(AXES))
+        self._centres, self._widths = settings.basis()
+        self.reset()
+
+    @classmethod
+    def from_demonstration(cls, times, orientations, settings=DmpSettings()):
+        """Learns the DMP of ONE demonstration `(T, 4)`; start, goal, duration are its own."""
+        times, orientations = validate_orientation_demonstration(times, orientations)
+        weights, scaling = fit_orientation_weights(times, orientations, settings)
+        return cls(weights, orientations[0], orientations[-1], times[-1] - times[0],
+                   settings, scaling)
+
+    @classmethod
+    def straight(cls, start, goal, duration, settings=DmpSettings(), profile="minimum_jerk"):
+        """No demonstration: the shorter arc from `start` to `goal` (a slerp path).
+
+        `"minimum_jerk"`: bell-shaped angular speed, done at `duration`; `"zero_forcing"`:
+        `f = 0` (the same arc, with a critically damped spring's abrupt start)."""
+        start = quaternion.unit_quaternions(start, "start").reshape(4)
+        goal = quaternion.unit_quaternions(goal, "goal").reshape(4)
+        if profile == "zero_forcing":
+            return cls(np.zeros((settings.basis_count, AXES)), start, goal, duration, settings)
+        if profile != "minimum_jerk":
+            raise ValueError(f"profile {profile!r} is unknown; use 'minimum_jerk' or "
+                             "'zero_forcing'")
+        span = -orientation_errors(start, goal)
+        return cls(straight_weights(settings, duration, span), start, goal, duration,
+                   settings)
+
+    def reset(self, orientation=None, scaled_angular_velocity=None):
+        """Phase 1, orientation `start` (or given), scaled angular velocity 0 (or given)."""
+        self.phase = 1.0
+        self.orientation = (self.start.copy() if orientation is None else
+                            quaternion.unit_quaternions(orientation, "orientation").reshape(4))
+        self.scaled_angular_velocity = (np.zeros(AXES) if scaled_angular_velocity is None
+                                        else np.array(scaled_angular_velocity, float))
+
+    def attractor(self, phase, goal):
+        """The moving attractor `a(x)` in `e = Log(q g*)` coordinates, `(3,)`."""
+        start_error = orientation_errors(self.start, goal)
+        psi = np.exp(-self._widths * (phase - self._centres) ** 2)
+        shape = (psi @ self.weights) / psi.sum() * phase
+        result = np.empty(AXES)
+        for axis in range(AXES):
+            if self.settings.formulation == "ijspeert":
+                amplitude = -start_error[axis] if self.amplitude_scaling[axis] else 1.0
+                result[axis] = shape[axis] * amplitude / self.settings.stiffness
+            else:
+                result[axis] = start_error[axis] * phase + shape[axis]
+        return result
+
+    def next_step(self, dt, goal=None, robot_orientation=None, robot_angular_velocity=None,
+                  phase_locked=False):
+        """One control step from the robot's orientation; returns (orientation (4,),
+        angular velocity (3,)).
+
+        `robot_orientation` replaces the DMP's (PBP's re-integration); while
+        `phase_locked`, the phase stays, the orientation is the robot's and the angular
+        velocity follows `robot_angular_velocity`."""
+        goal = (self.goal if goal is None
+                else quaternion.unit_quaternions(goal, "goal").reshape(4))
+        if robot_orientation is not None:
+            self.orientation = quaternion.unit_quaternions(
+                robot_orientation, "robot_orientation").reshape(4)
+        tau = self.duration
+        if phase_locked:
+            if robot_angular_velocity is not None:
+                self.scaled_angular_velocity = tau * np.asarray(robot_angular_velocity, float)
+            return self.orientation.copy(), self.scaled_angular_velocity / tau
+        error = orientation_errors(self.orientation, goal)
+        z = quaternion.left_jacobian_inverse_times(error, self.scaled_angular_velocity)
+        phi, gamma = step_matrices(self.settings.stiffness, self.settings.damping, tau, dt)
+        decay = phase_decay(self.settings, tau, dt)
+        # First-order hold: the attractor moves linearly in time over the step.
+        start = self.attractor(self.phase, goal)
+        end = self.attractor(self.phase * decay, goal)
+        new_error, new_z = np.empty(AXES), np.empty(AXES)
+        for axis in range(AXES):
+            offset = error[axis] - start[axis]
+            rate = (end[axis] - start[axis]) / dt
+            new_error[axis] = (end[axis] + phi[0, 0] * offset + phi[0, 1] * z[axis]
+                               - gamma[0, 0] * rate)
+            new_z[axis] = phi[1, 0] * offset + phi[1, 1] * z[axis] - gamma[1, 0] * rate
+        self.orientation = quaternion.aligned(
+            quaternion.multiply(quaternion.exp_map(new_error), goal), self.orientation)
+        self.scaled_angular_velocity = quaternion.left_jacobian_times(new_error, new_z)
+        self.phase *= decay
+        return self.orientation.copy(), self.scaled_angular_velocity / tau
+
+    def rollout(self, dt, duration=None):
+        """Open-loop orientations `(steps + 1, 4)` from the current state, the state kept."""
+        saved = (self.phase, self.orientation.copy(), self.scaled_angular_velocity.copy())
+        steps = int(round((self.duration if duration is None else duration) / dt))
+        path = [self.orientation.copy()]
+        for _ in range(steps):
+            path.append(self.next_step(dt)[0])
+        self.phase, self.orientation, self.scaled_angular_velocity = saved
+        return np.array(path)

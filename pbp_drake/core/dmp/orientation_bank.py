@@ -1,0 +1,369 @@
+"""K orientation DMPs, one per goal orientation, as one immutable model stepped by a pure
+function vectorised over goals (the formulation: `pbp_drake.core.dmp.orientation`).
+
+The API is the position `DmpBank`'s, with orientations for positions, so that a 6-DoF bank
+can step both halves side by side: the state is `(phase (K,), orientations (4, K),
+scaled angular velocities (3, K))`, `eta = tau omega` in the world frame; goals are `(4, K)`
+(`goals_matrix` checks `(K, 4)` rows); `advance` steps from the robot's measured orientation
+`(4, 1)` (or one per DMP, `(4, K)`) and the DMPs' own `eta`. The two banks share the phase
+variable: given the same settings, `tau` and `locked`, their phases stay equal, and
+PBP-Alt's lock is the same `locked` flag passed to both.
+
+The step is the position bank's first-order-hold step on `e = Log(q g*)` (3, K), with the
+memoised `stepping.step_constants`: the basis is evaluated at the step's two phases only
+when the phases are equal (the normal case), and contracted with the weights once. The
+quaternion math around it (`orientation_kernels`) writes into an `OrientationWorkspace` the
+caller owns (`make_workspace`), so that `advance_into` from one measured orientation
+allocates nothing of size K; `advance` is the same step into new arrays.
+"""
+
+import dataclasses
+
+import numpy as np
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.dmp._checks import positive
+from pbp_drake.core.dmp.orientation import (
+    AXES, fit_orientation_weights, straight_weights,
+    validate_orientation_demonstration)
+from pbp_drake.core.dmp.orientation_kernels import (
+    OrientationWorkspace, error_quaternions_into, exp_into, inverse_jacobian_into,
+    jacobian_into, log_into, product_into)
+from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis, phase_decay
+from pbp_drake.core.dmp.stepping import _BLOCK_BYTES, step_constants
+
+
+def _read_only(array):
+    """A private read-only copy: the model must not change under its users."""
+    array = np.array(array, dtype=float, order="C")
+    array.setflags(write=False)
+    return array
+
+
+class OrientationDmpBank:
+    """K orientation DMPs, stepped together from one measured orientation.
+
+    All share `duration` and `settings`; each has its own start orientation and phase, and
+    its own weights `(K, N, 3)` or one set `(N, 3)` shared by all (straight paths, or one
+    demonstration sent to K goals). Immutable: the state is passed in and out of `advance`
+    (pure) and `advance_into` (into the caller's arrays, with a workspace).
+    """
+
+    def __init__(self, weights, starts, duration, settings=DmpSettings(),
+                 amplitude_scaling=None, goal_count=None):
+        settings.validate()
+        self._settings = dataclasses.replace(settings)
+        self.duration = positive(duration, "duration")
+        weights = np.asarray(weights, dtype=float)
+        starts = quaternion.unit_quaternions(starts, "starts")
+        if weights.ndim == 2:
+            self.shared_weights = True
+            if goal_count is None:
+                goal_count = 1 if starts.ndim == 1 else starts.shape[0]
+            self._weights = _read_only(weights)  # (N, 3)
+        elif weights.ndim == 3:
+            self.shared_weights = False
+            goal_count = weights.shape[0]
+            # (N, 3 K): the step contracts it with the basis in one product.
+            self._weights = _read_only(weights.transpose(1, 2, 0).reshape(weights.shape[1], -1))
+        else:
+            raise ValueError(f"weights must be (N, 3) or (K, N, 3), got shape {weights.shape}")
+        if weights.shape[-2:] != (settings.basis_count, AXES):
+            raise ValueError(f"weights must have {settings.basis_count} basis functions "
+                             f"(the settings') and 3 axes, got shape {weights.shape}")
+        if goal_count < 1:
+            raise ValueError("an orientation DMP bank needs at least one goal")
+        self.goal_count = goal_count
+        self.dimension = AXES
+        if starts.ndim == 1:
+            starts = np.broadcast_to(starts, (goal_count, 4))
+        if starts.shape != (goal_count, 4):
+            raise ValueError(f"starts must be ({goal_count}, 4) or (4,), got {starts.shape}")
+        self.starts = _read_only(starts.T)  # (4, K)
+        scaling = (np.ones((goal_count, AXES), bool) if amplitude_scaling is None else
+                   np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, AXES)))
+        self.amplitude_scaling = np.array(scaling.T)  # (3, K)
+        self.amplitude_scaling.setflags(write=False)
+        self._all_scaled = bool(scaling.all())
+        # Distinct weights `(N, 3 K)` in column blocks that fit the L2 cache, as the position
+        # bank (`stepping._BLOCK_BYTES`): `(blocks, N, width)` views, and the rest.
+        self._weight_blocks = self._weight_tail = None
+        if not self.shared_weights:
+            width = max(64, _BLOCK_BYTES // self._weights.itemsize // settings.basis_count)
+            blocks = self._weights.shape[1] // width
+            if blocks > 1:
+                covered = blocks * width
+                self._weight_blocks = self._weights[:, :covered].reshape(
+                    -1, blocks, width).transpose(1, 0, 2)
+                self._weight_tail = self._weights[:, covered:]
+        self._ijspeert = settings.formulation == "ijspeert"
+        # One start for all: `q0 g*` is then one 4x4 product (`error_quaternions_into`).
+        self._uniform_start = (_read_only(self.starts[:, :1])
+                               if (self.starts == self.starts[:, :1]).all() else None)
+        centres, widths = settings.basis()
+        self._centres, self._widths = _read_only(centres), _read_only(widths)
+        self._frozen = True
+
+    def __setattr__(self, name, value):
+        # Immutable after construction, as the position bank: shared by threads or Contexts.
+        if getattr(self, "_frozen", False):
+            raise AttributeError(f"OrientationDmpBank is immutable: cannot set {name!r}")
+        object.__setattr__(self, name, value)
+
+    @classmethod
+    def from_dmps(cls, dmps):
+        """A bank of the given single `OrientationDmp`s (same duration and settings)."""
+        if not dmps:
+            raise ValueError("an orientation DMP bank needs at least one DMP")
+        first = dmps[0]
+        if any(d.duration != first.duration or d.settings != first.settings for d in dmps):
+            raise ValueError("all DMPs of a bank must share duration and settings")
+        return cls(np.stack([d.weights for d in dmps]), np.stack([d.start for d in dmps]),
+                   first.duration, first.settings,
+                   np.stack([d.amplitude_scaling for d in dmps]))
+
+    @classmethod
+    def from_demonstration(cls, times, orientations, goal_count=1, settings=DmpSettings(),
+                           start=None, duration=None):
+        """K DMPs sharing ONE demonstration's shape `(T, 4)`, sent to goals given at run
+        time; start and `tau` default to the demonstration's."""
+        times, orientations = validate_orientation_demonstration(times, orientations)
+        weights, scaling = fit_orientation_weights(times, orientations, settings)
+        start = orientations[0] if start is None else start
+        duration = times[-1] - times[0] if duration is None else duration
+        return cls(weights, start, duration, settings, scaling, goal_count)
+
+    @classmethod
+    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
+        """K DMPs along the shorter arc (slerp) from `start` to goals given at run time.
+
+        Ijspeert: the minimum-jerk shape, shared, scaled per goal by `-e0`; Pastor: `f = 0`,
+        whose attractor `e0 x` already slides along the arc."""
+        if settings.formulation == "ijspeert":
+            weights = straight_weights(settings, duration, np.ones(AXES))
+        else:
+            weights = np.zeros((settings.basis_count, AXES))
+        return cls(weights, start, duration, settings, goal_count=goal_count)
+
+    @property
+    def settings(self):
+        """The bank's gains and basis (a copy)."""
+        return dataclasses.replace(self._settings)
+
+    def decay(self, dt):
+        """The phase factor `exp(-alpha_x dt / tau)` of one step (the position bank's)."""
+        return phase_decay(self._settings, self.duration, dt)
+
+    def initial_state(self, orientation=None):
+        """(phase (K,), orientations (4, K), scaled angular velocity (3, K)) at the start."""
+        orientations = (np.array(self.starts) if orientation is None else np.repeat(
+            quaternion.unit_quaternions(orientation, "orientation").reshape(4, 1),
+            self.goal_count, axis=1))
+        return np.ones(self.goal_count), orientations, np.zeros((AXES, self.goal_count))
+
+    def goals_matrix(self, goals):
+        """Checks goal orientations given as `(K, 4)` rows (w, x, y, z) and returns `(4, K)`."""
+        size = np.size(goals)
+        if size != 4 * self.goal_count:
+            raise ValueError(f"goals has {size} numbers; the bank expects {self.goal_count} "
+                             "quaternions (w, x, y, z)")
+        goals = quaternion.unit_quaternions(np.reshape(goals, (self.goal_count, 4)), "goals")
+        return np.array(goals.T, order="C")
+
+    def make_workspace(self):
+        """New scratch arrays for `advance_into`; one per thread or Drake Context."""
+        return OrientationWorkspace(self.goal_count, self._settings.basis_count)
+
+    def attractors(self, phase, goals_4k):
+        """The moving attractors `a(x)` `(3, K)` in `e = Log(q g*)` coordinates, a new array."""
+        workspace = self.make_workspace()
+        phase = np.broadcast_to(np.asarray(phase, dtype=float), (self.goal_count,))
+        shapes, lam = self._combined_shapes(phase, 1.0, np.eye(2), workspace)
+        self._start_errors_into(goals_4k, workspace)
+        attractor = np.zeros((AXES, self.goal_count))
+        self._add_relative_attractor(attractor, shapes[0], lam[0], workspace)
+        return attractor
+
+    def advance(self, phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                locked=None, robot_angular_velocity=None, followed=None):
+        """One step of all K DMPs from the measured orientation; pure, new arrays.
+
+        Args:
+            phase: (K,). orientations: (4, 1) the robot's measured orientation (PBP), or
+                (4, K) one per DMP; unit within `quaternion.UNIT_TOLERANCE`.
+            scaled_angular_velocity: (3, K) the DMPs' own `eta = tau omega`.
+            goals_4k: (4, K) goal orientations (`goals_matrix`).
+            locked: None, a bool or (K,) bools freezing those phases (PBP-Alt): those DMPs
+                stay at the given orientation and `eta` follows `robot_angular_velocity` (3,).
+            followed: None, or the index of the DMP the robot followed: every DMP then steps
+                from its `eta` (PBP's goal switch, as in the position bank).
+        Returns:
+            (phase (K,), orientations (4, K), scaled angular velocity (3, K)).
+        """
+        phase = np.asarray(phase, dtype=float)
+        velocity = np.asarray(scaled_angular_velocity, dtype=float)
+        if followed is not None:
+            if not 0 <= int(followed) < self.goal_count:
+                raise ValueError(f"followed {followed} is not one of the {self.goal_count} "
+                                 "goals")
+            velocity = np.repeat(velocity[:, [int(followed)]], self.goal_count, axis=1)
+        new_state = (np.empty(phase.shape), np.empty((4, self.goal_count)),
+                     np.empty((AXES, self.goal_count)))
+        self.advance_into(phase, orientations, velocity, goals_4k, dt, *new_state,
+                          self.make_workspace(), locked, robot_angular_velocity)
+        return new_state
+
+    def advance_into(self, phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                     out_phase, out_orientations, out_velocity, workspace, locked=None,
+                     robot_angular_velocity=None):
+        """`advance` written into `out_phase` (K,), `out_orientations` (4, K) and
+        `out_velocity` (3, K), with `workspace` (`make_workspace`) as scratch.
+
+        The outputs may be the inputs (`out_velocity is scaled_angular_velocity`, ...): the
+        state is then stepped in place. From one measured orientation `(4, 1)` it allocates
+        nothing of size K, unless some (not all) DMPs are locked; orientations `(4, K)` are
+        checked and normalised into a new array first."""
+        orientations = np.asarray(orientations, dtype=float)
+        if orientations.size not in (4, 4 * self.goal_count):
+            raise ValueError(f"orientations must be (4, 1) or (4, {self.goal_count}), got shape "
+                             f"{orientations.shape}")
+        orientations = quaternion.unit_quaternions(orientations.reshape(4, -1).T,
+                                                   "orientations").T
+        if locked is not None:
+            locked = np.broadcast_to(np.asarray(locked, bool), np.shape(phase))
+            if not locked.any():
+                locked = None
+        if locked is not None:
+            held = (scaled_angular_velocity if robot_angular_velocity is None else
+                    np.broadcast_to(self.duration * np.asarray(
+                        robot_angular_velocity, float).reshape(AXES, 1), out_velocity.shape))
+            if not locked.all():
+                # Some locked, some not: the free step into temporaries, then chosen (rare).
+                stepped = (np.empty_like(out_phase), np.empty_like(out_orientations),
+                           np.empty_like(out_velocity))
+                self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                                *stepped, workspace)
+                held, stepped_phase = np.array(held), stepped[0]
+                orientations = np.broadcast_to(orientations, out_orientations.shape)
+                out_phase[...] = np.where(locked, phase, stepped_phase)
+                out_orientations[...] = np.where(locked, orientations, stepped[1])
+                out_velocity[...] = np.where(locked, held, stepped[2])
+                return
+            out_phase[...] = phase
+            out_orientations[...] = orientations
+            out_velocity[...] = held
+            return
+        self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                        out_phase, out_orientations, out_velocity, workspace)
+
+    def predict(self, phase, orientation, scaled_angular_velocity, goals_4k, dt, steps,
+                workspace=None):
+        """Open-loop orientations `(K, steps + 1, 4)` from one state (inputs left alone)."""
+        workspace = self.make_workspace() if workspace is None else workspace
+        path = np.empty((steps + 1, 4, self.goal_count))
+        path[0] = np.broadcast_to(orientation, (4, self.goal_count))
+        phase = np.array(phase, dtype=float)
+        velocity = np.array(scaled_angular_velocity, dtype=float)
+        for step in range(steps):
+            self.advance_into(phase, path[step], velocity, goals_4k, dt, phase,
+                              path[step + 1], velocity, workspace)
+        return path.transpose(2, 0, 1)
+
+    def _start_errors_into(self, goals_4k, workspace):
+        """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`
+        (1 where the fit switched the scaling off) into `workspace.amplitude`."""
+        if (workspace.starts_of_start_errors is self.starts
+                and np.array_equal(workspace.goals_of_start_errors, goals_4k)):
+            return  # the goals did not change: one pass instead of a log map
+        starts = self._uniform_start if self._uniform_start is not None else self.starts
+        error_quaternions_into(starts, goals_4k, workspace.error_quaternions, workspace.row)
+        log_into(workspace.error_quaternions, workspace.start_errors, workspace)
+        if self._ijspeert:
+            np.negative(workspace.start_errors, out=workspace.amplitude)
+            if not self._all_scaled:
+                np.copyto(workspace.amplitude, 1.0, where=~self.amplitude_scaling)
+        workspace.goals_of_start_errors[...] = goals_4k
+        workspace.starts_of_start_errors = self.starts
+
+    def _step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
+                   out_orientations, out_velocity, workspace):
+        """The free step (see `pbp_drake.core.dmp.orientation`), vectorised over K:
+        `e, z` from the measured orientation, the position step, back to `q', eta'`."""
+        ws = workspace
+        constants = step_constants(self._settings.stiffness, self._settings.damping,
+                                   self.duration, dt)
+        decay = self.decay(dt)
+        shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
+        self._start_errors_into(goals_4k, ws)
+        error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
+        log_into(ws.error_quaternions, ws.errors, ws)
+        inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
+        # e' = Phi00 e + Phi01 z + b, z' = Phi10 e + Phi11 z + b', with b and b' the rows'
+        # combinations of the attractor (the position bank's step, goal 0).
+        rows = ((ws.new_errors, 1.0 + constants.position_offset, constants.position_velocity),
+                (ws.new_log_velocity, constants.velocity_offset, constants.velocity_velocity))
+        for row, (target, error_gain, velocity_gain) in enumerate(rows):
+            np.multiply(ws.errors, error_gain, out=target)
+            np.multiply(ws.log_velocity, velocity_gain, out=ws.work)
+            target += ws.work
+            self._add_relative_attractor(target, shapes[row], lam[row], ws)
+        turned = ws.error_quaternions  # Exp(e'), then q' = Exp(e') g
+        exp_into(ws.new_errors, turned, ws)
+        jacobian_into(ws.new_errors, ws.new_log_velocity, out_velocity, ws)
+        product_into(turned, goals_4k, ws.product, ws.row)
+        # Signed as the measured orientation, so that a stream of them stays continuous.
+        if orientations.shape[1] == 1:
+            np.dot(orientations[:, 0], ws.product, out=ws.row)
+        else:
+            np.multiply(ws.product, orientations, out=turned)
+            np.sum(turned, axis=0, out=ws.row)
+        np.less(ws.row, 0.0, out=ws.small)
+        np.multiply(ws.small, -2.0, out=ws.row)  # -1 where the sign flips, else +1
+        ws.row += 1.0
+        np.multiply(ws.product, ws.row, out=out_orientations)
+        np.multiply(phase, decay, out=out_phase)
+
+    def _add_relative_attractor(self, target, shape, lam, workspace):
+        """`target += b`, a combination of attractors: Ijspeert `S (-e0)` (S alone where
+        the scaling is off), Pastor `S + lambda e0`."""
+        if self._ijspeert:
+            np.multiply(shape, workspace.amplitude, out=workspace.work)
+        else:
+            target += shape
+            np.multiply(workspace.start_errors, lam, out=workspace.work)
+        target += workspace.work
+
+    def _combined_shapes(self, phase, decay, combination, workspace):
+        """Rows r of `combination` (2x2): `S_r = C_r0 s(x0) + C_r1 s(x1)` with
+        `s(x) = (psi.w / sum psi) x` (over K in the Ijspeert form), `(2, 3, 1)` or
+        `(2, 3, K)`, and `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`."""
+        n = self._settings.basis_count
+        scale = 1.0 / self._settings.stiffness if self._ijspeert else 1.0
+        if phase.size == 1 or phase.min() == phase.max():
+            # Equal phases: the basis at the step's two phases only, (N, 2).
+            phases = np.array([phase.flat[0], phase.flat[0] * decay])
+            scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
+            basis = combination @ scaled.T  # (2, N)
+            lam = (combination @ phases)[:, np.newaxis]
+            if self.shared_weights:
+                return (basis @ self._weights)[:, :, np.newaxis], lam
+            flat = workspace.shape.reshape(2, -1)
+            if self._weight_blocks is None:
+                np.dot(basis, self._weights, out=flat)
+            else:
+                blocks, _, width = self._weight_blocks.shape
+                covered = blocks * width
+                np.matmul(basis, self._weight_blocks,
+                          out=flat[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
+                np.matmul(basis, self._weight_tail, out=flat[:, covered:])
+            return workspace.shape, lam
+        # A phase per goal: (N, 2, K) bases (allocates).
+        phases = np.stack([phase, phase * decay])
+        scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
+        combined = np.einsum("rs,nsk->rnk", combination, scaled)  # (2, N, K)
+        if self.shared_weights:
+            shapes = np.einsum("nd,rnk->rdk", self._weights, combined)
+        else:
+            weights = self._weights.reshape(n, AXES, self.goal_count)
+            shapes = np.einsum("ndk,rnk->rdk", weights, combined)
+        return shapes, combination @ phases

@@ -6,7 +6,8 @@ but for where it ran, and the trials spread over both nodes.
 The nodes run `ray start --block` in process groups of their own, without this test's
 PYTHONPATH, and the studies run outside the checkout: the workers get pbp_drake from the
 study, as on a real cluster. The nodes are killed by their groups and ids, never with
-`ray stop`, which stops every Ray on the machine, other users' too."""
+`ray stop`, which stops every Ray on the machine, other users' too: by the fixture's
+finalizer, or by a watchdog process when this test's process is killed."""
 
 import importlib.util
 import json
@@ -46,6 +47,15 @@ OBJECT_STORE_BYTES = 100 * 1024 * 1024
 # Ray's token authentication, with a token of this test's own (not ~/.ray/auth_token): the
 # nodes listen on this host's address, and every node and driver must give the token.
 AUTH = {"RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": secrets.token_hex(32)}
+# Waits for process argv[1] to end (a pidfd is readable then, zombie or not), then kills
+# process group argv[2] and removes folder argv[3].
+WATCHDOG = textwrap.dedent("""
+    import os, select, shutil, signal, sys, time
+    select.select([os.pidfd_open(int(sys.argv[1]))], [], [])
+    os.killpg(int(sys.argv[2]), signal.SIGKILL)
+    time.sleep(2)
+    shutil.rmtree(sys.argv[3], ignore_errors=True)
+""")
 # ray.nodes() from a driver of its own: the ids of the alive nodes, once there are two.
 ALIVE_NODES = textwrap.dedent("""
     import json, sys, time
@@ -100,6 +110,15 @@ def start_node(root, name, head_args):
     return process
 
 
+def watch(process, root):
+    """A process of its own that kills `process`'s group and removes `root` when this
+    test's process ends, however it ends (even SIGKILL, when no finalizer runs); the
+    finalizer kills it first."""
+    return subprocess.Popen([sys.executable, "-c", WATCHDOG, str(os.getpid()),
+                             str(process.pid), str(root)], stdin=subprocess.DEVNULL,
+                            start_new_session=True)
+
+
 def wait_for(condition, timeout, what, root, process):
     deadline = time.monotonic() + timeout
     while not condition():
@@ -110,7 +129,7 @@ def wait_for(condition, timeout, what, root, process):
         time.sleep(0.5)
 
 
-def stop_nodes(processes, root):
+def stop_nodes(processes, watchdogs, root):
     """Kills the nodes as `ray stop --force` would, but only these: their process groups,
     their descendants (Ray's workers run in groups of their own) and any process whose
     command line names this test's temp folder, each by its id. (They do not end on
@@ -129,6 +148,9 @@ def stop_nodes(processes, root):
     deadline = time.monotonic() + 30
     while any(_group_alive(p.pid) for p in processes) and time.monotonic() < deadline:
         time.sleep(0.2)
+    for watchdog in watchdogs:
+        watchdog.kill()
+        watchdog.wait(timeout=10)
     print(f"Ray nodes stopped in {time.monotonic() - started:.1f} s")
 
 
@@ -186,20 +208,22 @@ def cluster(request):
     """A head node and a second node joining it, on this host: (address, node ids)."""
     # Short: a node's Unix sockets live under it, and their paths must stay under 108 bytes.
     root = pathlib.Path(tempfile.mkdtemp(prefix="pbpray", dir="/tmp"))
-    processes = []
-    request.addfinalizer(lambda: (stop_nodes(processes, root),
+    processes, watchdogs = [], []
+    request.addfinalizer(lambda: (stop_nodes(processes, watchdogs, root),
                                   shutil.rmtree(root, ignore_errors=True)))
     port, dashboard = free_ports(2)  # Ray starts a dashboard process even without the UI
     started = time.monotonic()
     processes.append(start_node(root, "head", [
         "--head", f"--port={port}", "--include-dashboard=false",
         f"--dashboard-port={dashboard}"]))
+    watchdogs.append(watch(processes[-1], root))
     address_file = root / "head" / "ray_current_cluster"
     wait_for(address_file.exists, NODE_TIMEOUT, "the head node did not start", root,
              processes[0])
     address = address_file.read_text().strip()
     assert address.endswith(f":{port}")
     processes.append(start_node(root, "worker", [f"--address={address}"]))
+    watchdogs.append(watch(processes[-1], root))
     alive = subprocess.run(
         [sys.executable, "-c", ALIVE_NODES, address, str(NODE_TIMEOUT)], env=node_env(),
         capture_output=True, text=True, timeout=NODE_TIMEOUT + 60, stdin=subprocess.DEVNULL)

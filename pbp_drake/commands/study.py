@@ -38,9 +38,10 @@ def add_study_commands(commands):
                        "Ray tasks, at most --jobs at once (needs: pip install "
                        "'pbp_drake[ray]')")
     study.add_argument("--ray-address", metavar="ADDRESS",
-                       help="with --backend ray: the Ray cluster to use, e.g. auto or "
-                       "ray://HEAD:10001 (its workers must have pbp_drake installed); "
-                       "default: start a local Ray with --jobs CPUs")
+                       help="with --backend ray: the Ray cluster to use, e.g. HEAD:6379, "
+                       "auto or ray://HEAD:10001 (its nodes need pbp_drake installed; they "
+                       "run this machine's copy of it); default: start a local Ray with "
+                       "--jobs CPUs")
     study.add_argument("--retry-errors", action="store_true",
                        help="HSR tasks: run again the trials on disk that failed with an error")
 

@@ -30,9 +30,10 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     keeps the label the folder holds for the same seeds.
 
     `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
-    Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "ray://head:10001", "auto"),
-    whose workers must be able to import pbp_drake. This process writes the trial files,
-    the same as with local processes, so the summary is the same bytes.
+    Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "HEAD:6379", "auto",
+    "ray://head:10001"), whose nodes need pbp_drake's dependencies installed (its workers
+    get this process's pbp_drake package: see `ray_backend`). This process writes the trial
+    files, the same as with local processes, so the summary is the same bytes.
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except
     those that failed with an error). A trial that raises, or whose worker process dies, is

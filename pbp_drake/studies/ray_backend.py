@@ -1,12 +1,16 @@
 """The trials as Ray tasks (`--backend ray`), on a local Ray or a cluster.
 
 The tasks only compute; the process that runs the study writes every trial file (a
-cluster's nodes may not see the folder), so the folder is the same as with local processes.
+cluster's nodes may not see the folder), so the folder is the same as with local processes,
+but for where each trial ran: its `host` and `ray_node` (the Ray node's id), which only Ray
+trials record (informational: no reader needs them, so older folders read the same).
 Ray is imported only when this backend is asked for: it is an optional, heavy dependency
 (`pip install 'pbp_drake[ray]'`), and the local backend must never load it.
 """
 
 import os
+import pathlib
+import socket
 import sys
 
 from pbp_drake.studies.runners import compute_trial
@@ -16,6 +20,8 @@ RAY_INSTALL_HINT = "pip install 'pbp_drake[ray]'"
 # A Ray task whose worker process dies runs once more (as a local worker's trial runs again
 # alone) before it is recorded as failed; a trial that raises is recorded at once.
 RAY_MAX_RETRIES = 1
+# This process's pbp_drake, which a cluster's workers import (see _cluster_runtime_env).
+PACKAGE_DIR = pathlib.Path(__file__).resolve().parents[1]
 
 
 def import_ray():
@@ -32,13 +38,25 @@ def _ray_trial(scenario, method, trial, seed, digest, run=None):
     """What a Ray task runs: the trial's record and its time series as CSV text (the
     process that runs the study writes the files: a cluster's nodes may not see them)."""
     record, result = compute_trial(scenario, method, trial, seed, digest, run)
+    record["host"] = socket.gethostname()
+    record["ray_node"] = import_ray().get_runtime_context().get_node_id()
     return record, None if result is None else time_series_csv(result)
+
+
+def _cluster_runtime_env():
+    """The runtime environment of a study's tasks on a cluster: this process's pbp_drake
+    package, uploaded to the cluster and put first on the workers' path, so that they run
+    the same code as this process, whatever version of it the nodes have installed. The
+    nodes still need its dependencies (pydrake, NumPy, ...): `pip install 'pbp_drake[ray]'`
+    on each. The package, with the HSR models it ships, is under a megabyte."""
+    return {"py_modules": [str(PACKAGE_DIR)], "excludes": ["__pycache__"]}
 
 
 class _RaySession:
     """Ray for one study: with no address, a new local Ray of `jobs` CPUs, whose workers
     see this process's sys.path (as local worker processes do), shut down at the end; with
-    an address, that cluster (left running). A Ray this process already runs is used as is."""
+    an address, that cluster (left running), its workers given this process's pbp_drake.
+    A Ray this process already runs is used as is."""
 
     def __init__(self, jobs, address=None):
         self.ray = import_ray()
@@ -52,16 +70,29 @@ class _RaySession:
                 self.ray.init(address="local", num_cpus=jobs, include_dashboard=False,
                               runtime_env={"env_vars": {"PYTHONPATH": path}}, **quiet)
             else:
-                self.ray.init(address=address, **quiet)
+                self.ray.init(address=address, runtime_env=_cluster_runtime_env(), **quiet)
         except Exception as error:
             where = "start a local Ray" if address is None else f"connect to Ray at {address}"
-            raise StudyError(f"could not {where}: {type(error).__name__}: {error}") from None
+            raise StudyError(f"could not {where}: {type(error).__name__}: {error}"
+                             f"{_reason(error.__cause__)}") from None
         self.started = True
 
     def close(self):
         if self.started:
             self.started = False
             self.ray.shutdown()
+
+
+def _reason(cause):
+    """Ray's own reason for a bare "Failed to connect to Ray cluster" (e.g. a cluster that
+    wants an authentication token), which is its cause: ` (Type: message)`, or the last
+    line of a cause that holds a traceback's text; "" when there is none."""
+    if cause is None:
+        return ""
+    lines = [line.strip() for line in str(cause).splitlines() if line.strip()]
+    if len(lines) == 1:
+        return f" ({type(cause).__name__}: {lines[0]})"
+    return f" ({lines[-1] if lines else type(cause).__name__})"
 
 
 def _ray_error_text(ray, error):

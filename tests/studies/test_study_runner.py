@@ -9,6 +9,7 @@ import importlib.util
 import math
 import os
 import shutil
+import socket
 import subprocess
 import sys
 import textwrap
@@ -437,6 +438,8 @@ def test_ray_backend_writes_the_same_files_as_local_processes(studies, task_file
             assert ray_csv.read_bytes() == local_csv.read_bytes()
             ours, theirs = json.loads(ray_json.read_text()), json.loads(local_json.read_text())
             ours.pop("wall_time"), theirs.pop("wall_time")
+            # Only a Ray trial says where it ran: this machine, the local Ray's one node.
+            assert ours.pop("host") == socket.gethostname() and ours.pop("ray_node")
             assert ours == theirs
     assert not [p for p in folder.rglob("*") if p.suffix in (".tmp", ".running")]
     import ray

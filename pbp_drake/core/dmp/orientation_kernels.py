@@ -46,8 +46,9 @@ class OrientationWorkspace:
     Attributes:
         error_quaternions, product: (4, K) `q g*`, and the new orientations before signing.
         start_errors, amplitude: (3, K) `e0 = Log(q0 g*)`, and `-e0` (1 where unscaled).
-        log_state: (2, 3, K) `e` and `z = J(e)^-1 eta` (views `errors`, `log_velocity`).
-        new_log_state: (2, 3, K) `e'` and `z'` (views `new_errors`, `new_log_velocity`).
+        log_state: (2, 3, K) `e` and `z = J(e)^-1 eta` (properties `errors`,
+            `log_velocity` give its two halves).
+        new_log_state: (2, 3, K) `e'` and `z'` (`new_errors`, `new_log_velocity`).
         cross, work: (3, K) scratch. cross_dot: (4, K) `r x v` and `r.v` for one `v`.
         angle, sine, cosine, ratio, first, second, coefficient, dot, row: (K,) per goal.
         small: (K,) mask. shape: (2, 3, K) forcing shapes of distinct weights (scratch).
@@ -55,13 +56,16 @@ class OrientationWorkspace:
             starts (the array itself) that `start_errors` and `amplitude` were computed for:
             they depend on nothing else, so a step to unchanged goals reuses them. A copied
             workspace has copied starts, which are not the bank's, and so recomputes.
+
+    The halves of `log_state` are properties, not attributes holding views: a deep copy
+    (Drake cloning a Context) copies every array apart, and views would then stop being
+    the halves the step writes.
     """
 
     __slots__ = ("goal_count", "basis_count", "error_quaternions", "product", "start_errors",
-                 "amplitude", "log_state", "errors", "log_velocity", "new_log_state",
-                 "new_errors", "new_log_velocity", "cross", "work", "cross_dot", "angle",
-                 "sine", "cosine", "ratio", "first", "second", "coefficient", "dot", "row",
-                 "small", "shape", "goals_of_start_errors", "starts_of_start_errors")
+                 "amplitude", "log_state", "new_log_state", "cross", "work", "cross_dot",
+                 "angle", "sine", "cosine", "ratio", "first", "second", "coefficient", "dot",
+                 "row", "small", "shape", "goals_of_start_errors", "starts_of_start_errors")
 
     def __init__(self, goal_count, basis_count):
         k = goal_count
@@ -74,13 +78,27 @@ class OrientationWorkspace:
                      "dot", "row"):
             setattr(self, name, np.empty(k))
         self.log_state = np.empty((2, 3, k))
-        self.errors, self.log_velocity = self.log_state
         self.new_log_state = np.empty((2, 3, k))
-        self.new_errors, self.new_log_velocity = self.new_log_state
         self.small = np.empty(k, bool)
         self.shape = np.empty((2, 3, k))
         self.goals_of_start_errors = np.full((4, k), np.nan)
         self.starts_of_start_errors = None
+
+    @property
+    def errors(self):
+        return self.log_state[0]
+
+    @property
+    def log_velocity(self):
+        return self.log_state[1]
+
+    @property
+    def new_errors(self):
+        return self.new_log_state[0]
+
+    @property
+    def new_log_velocity(self):
+        return self.new_log_state[1]
 
 
 def left_product_matrix(quaternion):

@@ -66,7 +66,9 @@ class PoseDmpBank(LeafSystem):
     until the operator lets go. `followed_goal` (the goal estimator's selection before it
     updates) makes every DMP continue from the followed DMP's linear AND angular velocity,
     so a switch of goal keeps the commanded twist (as `DmpBank`); unconnected, each keeps
-    its own.
+    its own. `max_speed` (m/s) and `max_angular_speed` (rad/s) scale each DMP's own
+    velocities down to them before every step (anti-windup, as `DmpBank`'s `max_speed`;
+    give the hand-over's limits).
 
     `references` is the K next pose references, K `PoseState` rows (pose after one step,
     twist) flattened; `selected_reference` is the one of `selected_goal` (unconnected: the
@@ -81,9 +83,15 @@ class PoseDmpBank(LeafSystem):
     """
 
     def __init__(self, position_bank, orientation_bank, control_period,
-                 lock_phase_when_operator_acts=False, update_offset=None):
+                 lock_phase_when_operator_acts=False, update_offset=None, max_speed=None,
+                 max_angular_speed=None):
         super().__init__()
         _check_banks(position_bank, orientation_bank, control_period)
+        # Anti-windup, as DmpBank's `max_speed`: the hand-over never lets the hand move or
+        # turn faster, so no DMP may remember a faster velocity (see `_limit`).
+        self._max_speed = None if max_speed is None else float(max_speed)
+        self._max_angular_speed = (None if max_angular_speed is None
+                                   else float(max_angular_speed))
         self._positions, self._orientations = position_bank, orientation_bank
         self._period = float(control_period)
         self._lock = bool(lock_phase_when_operator_acts)
@@ -229,6 +237,8 @@ class PoseDmpBank(LeafSystem):
                     log_state[0], log_state[1], goals[3:], q,
                     workspace.orientations, workspace.eta, workspace.orientation)
                 eta = workspace.eta
+            _limit(z, self._max_speed, positions.duration)
+            _limit(eta, self._max_angular_speed, orientations.duration)
         else:
             eta = np.array(eta_held)  # the robot's (locked) or 0 (at the start), (3, 1)
         robot[:, 0] = position
@@ -309,6 +319,19 @@ class PoseDmpBank(LeafSystem):
     def _calc_phase(self, context, output):
         phase = self._split(context.get_discrete_state(self._state_index).get_value())[0]
         output.get_mutable_value()[:] = phase[0]
+
+
+def _limit(scaled_velocities, max_speed, duration):
+    """Scales the columns of `tau v` (3, K) down to the speed `max_speed` (None: no limit),
+    in place. Without it a DMP stepped from a hand that the operator (PBP-Cont) or the
+    hand-over holds back winds its own velocity up toward `beta (g - y) / tau`, far above
+    what the hand may do (see `DmpBank._limit_speed`)."""
+    if max_speed is None:
+        return
+    speeds = np.linalg.norm(scaled_velocities, axis=0) / duration
+    too_fast = speeds > max_speed
+    if np.any(too_fast):
+        scaled_velocities[:, too_fast] *= max_speed / speeds[too_fast]
 
 
 def _check_banks(position_bank, orientation_bank, control_period):

@@ -16,8 +16,7 @@ from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
 from pbp_drake.core.pose_arbitration import HandOverLimits
 from pbp_drake.systems.goals_source import GoalsSource
-from pbp_drake.systems.pose_blender import PoseBlender, PoseHandOver
-from pbp_drake.systems.pose_dmp_bank import PoseDmpBank
+from pbp_drake.systems import PoseBlender, PoseDmpBank, PoseHandOver
 
 DT = 0.01
 ANGULAR_STEP = 0.3  # rad/s: the most the commanded angular velocity may change per tick

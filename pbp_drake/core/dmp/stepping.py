@@ -210,7 +210,6 @@ class BankStep:
         contracted with the weights once. A phase per goal: `(N, K)` bases (allocates)."""
         if equal is None:
             equal = phase.size == 1 or phase.min() == phase.max()
-        n = self._settings.basis_count
         if equal:
             phases, psi, scale = workspace.phases, workspace.psi, workspace.scale
             phases[0, 0] = phase.flat[0]

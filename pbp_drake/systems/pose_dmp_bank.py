@@ -13,6 +13,7 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one
 from pbp_drake.core.pose_arbitration import PoseReference
 from pbp_drake.systems.layouts import GoalPose, PoseState, goal_index
 from pbp_drake.systems.tick import decide_offset
@@ -230,8 +231,8 @@ class PoseDmpBank(LeafSystem):
             positions.stepped_velocity_into(dz, z, period, z)
             if followed is not None:
                 z[...] = z[:, followed:followed + 1]
-                eta = quaternion.left_jacobian_times(
-                    log_state[0, :, followed], log_state[1, :, followed])[:, np.newaxis]
+                eta = jacobian_of_one(log_state[0, :, followed],
+                                      log_state[1, :, followed])[:, np.newaxis]
             else:
                 orientations.orientations_from_log_into(
                     log_state[0], log_state[1], goals[3:], q,
@@ -310,7 +311,7 @@ class PoseDmpBank(LeafSystem):
         goal = self._goals_entry.Eval(context)[3:, k]
         rotation = quaternion.aligned(
             quaternion.multiply(quaternion.exp_map(error), goal), q[:, 0])
-        eta = quaternion.left_jacobian_times(error, log_velocity)
+        eta = jacobian_of_one(error, log_velocity)
         return PoseReference(position, rotation, velocity / tau_v, eta / tau_w)
 
     def _calc_selected_reference(self, context, output):

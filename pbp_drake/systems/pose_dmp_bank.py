@@ -206,9 +206,9 @@ class PoseDmpBank(LeafSystem):
         """The measured position (3,), orientation (4,), velocity (3,) and angular velocity
         (3,), checked."""
         state = np.asarray(self._robot_state_port.Eval(context), dtype=float)
-        bad = [name for name, value in zip(PoseState.get_fields(), state)
-               if not np.isfinite(value)]
-        if bad:
+        if not np.isfinite(state).all():
+            bad = [name for name, value in zip(PoseState.get_fields(), state)
+                   if not np.isfinite(value)]
             raise ValueError(f"robot_state {', '.join(bad)} is NaN or infinite: "
                              f"{state.tolist()}")
         orientation = quaternion.unit_quaternions(state[3:7], "robot_state orientation")

@@ -45,7 +45,11 @@ class PoseBlender(LeafSystem):
                  alpha_max=DEFAULT_ALPHA_MAX):
         super().__init__()
         validate_pose_mode(mode, alpha)
-        low, high = confidence_range
+        try:
+            low, high = confidence_range
+        except (TypeError, ValueError):
+            raise ValueError(f"confidence_range must be a pair (confidence_low, "
+                             f"confidence_high), got {confidence_range!r}") from None
         validate_confidence_ramp(low, high, alpha_max)
         self._mode, self._alpha = mode, alpha
         self._confidence_range = (float(low), float(high))

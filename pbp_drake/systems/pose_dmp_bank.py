@@ -7,6 +7,8 @@ the first: the DMPs' state is the Context's discrete state and the scratch array
 cache entry (one per Context), so Contexts and Simulators stay independent.
 """
 
+import math
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
@@ -211,8 +213,11 @@ class PoseDmpBank(LeafSystem):
                    if not np.isfinite(value)]
             raise ValueError(f"robot_state {', '.join(bad)} is NaN or infinite: "
                              f"{state.tolist()}")
-        orientation = quaternion.unit_quaternions(state[3:7], "robot_state orientation")
-        return state[:3], orientation, state[7:10], state[10:13]
+        norm = math.sqrt(float(state[3:7] @ state[3:7]))
+        if abs(norm - 1.0) > quaternion.UNIT_TOLERANCE:
+            quaternion.unit_quaternions(state[3:7], "robot_state orientation")  # raises
+        # `unit_quaternions` costs 50 us a call; one quaternion is checked by hand.
+        return state[:3], state[3:7] / norm, state[7:10], state[10:13]
 
     def _update(self, context, discrete_state):
         positions, orientations, period = self._positions, self._orientations, self._period

@@ -142,3 +142,10 @@ def test_banks_with_different_phases_are_refused():
     slower = OrientationDmpBank.straight(quaternion.IDENTITY, K, 2.0, SETTINGS)
     with pytest.raises(ValueError, match="share one phase"):
         PoseDmpBank(positions, slower, DT)
+
+
+def test_a_hand_quaternion_that_is_not_unit_is_refused_by_name():
+    robot = ROBOT.copy()
+    robot[3:7] *= 1.01
+    with pytest.raises(ValueError, match="robot_state orientation is not a unit quaternion"):
+        simulate(0.02, robot=robot)

@@ -19,6 +19,7 @@ class Check:
     unit: str
     value: Callable  # the row of steps (or the closed-loop run) -> the measured value
     row: tuple | None = None  # (D, K, weights) of the step row it reads
+    pose: bool = False  # the row is the six-DoF pose bank's (`pbp_drake.bench.pose_cases`)
     hsr_goals: int | None = None  # K of the headless closed-loop HSR run it reads
     peers: tuple = ()  # it needs one of these peer libraries
 
@@ -27,6 +28,9 @@ _K10K = (3, 10000, "distinct")
 CHECKS = (
     Check("K=10,000 goals (D=3, distinct weights): one step in the LeafSystem <= 1 ms",
           1000.0, True, "us", lambda row: row["leaf_us"], row=_K10K),
+    Check("K=10,000 goals, 6-DoF pose, distinct weights: one step in the LeafSystem <= 1 ms",
+          1000.0, True, "us", lambda row: row["leaf_us"], row=(6, 10000, "distinct"),
+          pose=True),
     Check("K=100,000 goals sharing one demonstration (D=3): one step in the LeafSystem "
           "<= 1 ms", 1000.0, True, "us", lambda row: row["leaf_us"],
           row=(3, 100000, "shared")),
@@ -75,8 +79,11 @@ def _source(check, rows, closed_loop):
     if check.row is not None:
         dimension, goals, weights = check.row
         for row in rows:
-            if (row["D"], row["K"], row["weights"]) == check.row:
+            if ((row["D"], row["K"], row["weights"]) == check.row
+                    and bool(row.get("pose")) == check.pose):
                 return row, None
+        if check.pose:
+            return None, f"6-DoF pose, K={goals:,}, {weights} weights not in --goals"
         return None, f"D={dimension}, K={goals:,}, {weights} weights not in --dimensions/--goals"
     for run in closed_loop:
         if run["goals"] == check.hsr_goals and not run["meshcat"]:

@@ -1,11 +1,12 @@
-"""How long one step of an `OrientationDmpBank` takes: a helper for `pbp-drake bench` to
-come, not a test.
+"""How long one step of an `OrientationDmpBank` takes: a helper, not a test.
 
 `python -m pbp_drake.bench.orientation_step [K ...]` prints, for K DMPs stepped from one
 measured orientation with equal phases (the normal case), the median wall time and the mean
 CPU time of one in-place step (`advance_into` with one workspace), for straight DMPs (one
-shared shape) and for distinct weights per goal, with one BLAS thread (`timing.limit_blas`)
-as the bench runs. On a machine shared with other work the CPU time is the steadier.
+shared shape) and for distinct weights per goal. Run it with OPENBLAS_NUM_THREADS=1 (and
+the other thread variables) as the bench measures; it prints what the BLAS library reports.
+On a machine shared with other work the CPU time is the steadier. `pbp-drake bench` times
+the bank inside the six-DoF LeafSystem (`pbp_drake.bench.pose_cases`).
 """
 
 import sys
@@ -13,7 +14,7 @@ import time
 
 import numpy as np
 
-from pbp_drake.bench.timing import limit_blas
+from pbp_drake.bench.pinning import blas_threads
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
 from pbp_drake.core.dmp.settings import DmpSettings
@@ -53,7 +54,7 @@ def step_seconds(goal_count, distinct_weights=False, repeats=100, seed=0):
 
 def main(argv):
     counts = [int(value) for value in argv] or [1, 10, 100, 1_000, 10_000]
-    print(limit_blas(1))
+    print(blas_threads(1)["note"])  # set OPENBLAS_NUM_THREADS=1 before running to pin
     for count in counts:
         (shared, shared_cpu), (distinct, distinct_cpu) = (
             step_seconds(count), step_seconds(count, distinct_weights=True))

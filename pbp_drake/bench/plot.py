@@ -10,6 +10,7 @@ from pbp_drake.bench.cases import BASIS  # noqa: E402
 
 def plot_control_rate(rows, path):
     """Control rate reached (1 / step time) versus K, for D = 3 (or the first D measured)."""
+    rows = [row for row in rows if not row.get("pose")]  # the position bank's rows
     dimensions = sorted({row["D"] for row in rows})
     dimension = 3 if 3 in dimensions else dimensions[0]
     figure, axes = plt.subplots(figsize=(7.5, 5))

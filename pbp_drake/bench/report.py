@@ -22,6 +22,10 @@ def _fmt(value, width=9):
     return f"{value:.1f}".rjust(width)
 
 
+def _dimension(row):
+    return "6p" if row.get("pose") else row["D"]
+
+
 def format_report(report):
     lines = []
     bandwidth = report["memory_bandwidth"]
@@ -36,7 +40,9 @@ def format_report(report):
                  "and an empty update;")
     lines.append("bound: weight bytes / measured read bandwidth (cache-sized bound in "
                  "brackets); pydmps/goal, mp/goal: one object per goal; mp stacked: one "
-                 "K*D DMP; x per-goal, x stacked: speed-ups of the bank math.")
+                 "K*D DMP; x per-goal, x stacked: speed-ups of the bank math. D = 6p: the "
+                 "six-DoF pose bank (3-D positions and unit-quaternion orientations, "
+                 "PoseDmpBank with followed_goal connected).")
     header = (f"{'D':>2} {'K':>7} {'weights':>8} {'math':>9} {'leaf':>9} {'drake':>7} "
               f"{'bound':>9} {'[cache]':>9} {'pydmps/goal':>12} {'mp/goal':>10} "
               f"{'mp stacked':>11} {'x per-goal':>10} {'x stacked':>9} {'rate Hz':>9}")
@@ -46,12 +52,23 @@ def format_report(report):
         bound = row["bandwidth_bound_us"] if row["weights"] == "distinct" else None
         cache = row["cache_bandwidth_bound_us"] if row["weights"] == "distinct" else None
         lines.append(
-            f"{row['D']:>2} {row['K']:>7} {row['weights']:>8} {_fmt(row['bank_math_us'])} "
+            f"{_dimension(row):>2} {row['K']:>7} {row['weights']:>8} {_fmt(row['bank_math_us'])} "
             f"{_fmt(row['leaf_us'])} {_fmt(row['drake_overhead_us'], 7)} {_fmt(bound)} "
             f"{_fmt(cache)} {_fmt(row['pydmps_per_goal_us'], 12)} "
             f"{_fmt(row['mp_per_goal_us'], 10)} {_fmt(row['mp_stacked_us'], 11)} "
             f"{_fmt(row['speedup_vs_per_goal'], 10)} {_fmt(row['speedup_vs_stacked'], 9)} "
             f"{_fmt(row['control_rate_hz'])}")
+    poses = [row for row in report["steps"] if row.get("pose")]
+    if poses:
+        lines.append("")
+        lines.append("Six-DoF pose bank in its LeafSystem against the 3-D position bank of "
+                     "this run (same K and weights):")
+        for row in poses:
+            versus = row.get("leaf_vs_position_3d")
+            lines.append(f"  K = {row['K']:>6} {row['weights']:>8}: {_fmt(row['leaf_us'])} us "
+                         f"(each DMP its own velocities: {_fmt(row['leaf_own_us'])} us), "
+                         + (f"{versus:.2f}x the position bank" if versus else
+                            "no position row"))
     if report["closed_loop"]:
         lines.append("")
         lines.append("Closed loop, HSR reaching task (straight-path DMPs, virtual participant, "

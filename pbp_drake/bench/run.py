@@ -20,11 +20,13 @@ from pbp_drake.bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
 from pbp_drake.bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
 from pbp_drake.bench.plot import plot_control_rate
+from pbp_drake.bench.pose_cases import measure_pose_row
 from pbp_drake.bench.report import format_report, microseconds, ratio
 from pbp_drake.bench.timing import memory_bandwidth, timed
 
 KS = (1, 10, 100, 1000, 10000, 100000)
 DS = (2, 3, 6)
+POSE_MAX_GOALS = 10000
 
 
 def _parse(argv):
@@ -61,6 +63,8 @@ def plan(args):
     counts and HSR runs) and takes fewer repeats and a shorter HSR simulation."""
     return {"dimensions": args.dimensions or ([3] if args.quick else list(DS)),
             "goals": list(args.goals), "hsr_goals": list(args.hsr_goals),
+            # The six-DoF pose bank (PoseDmpBank), up to K = 10,000 (its check's case).
+            "pose_goals": [k for k in args.goals if k <= POSE_MAX_GOALS],
             "min_time": args.min_time or (0.08 if args.quick else 0.3),
             "hsr_seconds": args.hsr_seconds or (1.0 if args.quick else 5.0)}
 
@@ -111,6 +115,16 @@ def _measure(args):
                                          args.peer_max_goals, have_pydmps, have_mp,
                                          bandwidth))
                 _print_progress(rows[-1])
+    for goal_count in settings["pose_goals"]:
+        for distinct in (True, False):
+            row = measure_pose_row(goal_count, distinct, min_time, bandwidth)
+            # Against the 3-D position bank of the same run (the machine may be loaded).
+            position = [r for r in rows if (r["D"], r["K"], r["weights"], r.get("pose")) ==
+                        (3, goal_count, row["weights"], None)]
+            row["leaf_vs_position_3d"] = (ratio(row["leaf_us"], position[0]["leaf_us"])
+                                          if position else None)
+            rows.append(row)
+            _print_progress(rows[-1])
 
     closed_loop = []
     for goal_count in settings["hsr_goals"]:
@@ -192,6 +206,7 @@ def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have
 
 
 def _print_progress(row):
-    print(f"  D={row['D']} K={row['K']:>6} {row['weights']:>8}: math "
+    kind = " pose" if row.get("pose") else ""
+    print(f"  D={row['D']}{kind} K={row['K']:>6} {row['weights']:>8}: math "
           f"{row['bank_math_us']:.1f} us, in LeafSystem {row['leaf_us']:.1f} us "
           f"(Drake {row['drake_overhead_us']:.1f} us)", flush=True)

@@ -41,12 +41,19 @@ def _clip(vector, largest):
     return vector * (largest / size) if size > largest else np.array(vector, dtype=float)
 
 
+def limited_velocity(previous_velocity, velocity, max_change, max_speed):
+    """`v' = v'_prev + clip(cap(v) - v'_prev, max_change)`: the velocity law of the module
+    docstring (`max_change = a_max dt`), a new array. The 6-DoF hand-over applies it to the
+    angular velocity too (`pbp_drake.core.pose_arbitration`)."""
+    previous_velocity = np.asarray(previous_velocity, dtype=float)
+    velocity = np.asarray(velocity, dtype=float)
+    return previous_velocity + _clip(_clip(velocity, max_speed) - previous_velocity, max_change)
+
+
 def hand_over(previous_velocity, position, velocity, max_acceleration, max_speed, dt):
     """The command `(position, velocity)` of one tick under the hand-over law (module
     docstring), from the velocity commanded at the tick before and the blended reference
     `(position, velocity)`. New arrays; the inputs are left alone."""
-    previous_velocity = np.asarray(previous_velocity, dtype=float)
     velocity = np.asarray(velocity, dtype=float)
-    change = _clip(_clip(velocity, max_speed) - previous_velocity, max_acceleration * dt)
-    commanded = previous_velocity + change
+    commanded = limited_velocity(previous_velocity, velocity, max_acceleration * dt, max_speed)
     return np.asarray(position, dtype=float) + (commanded - velocity) * dt, commanded

@@ -8,7 +8,8 @@ Vector layouts: a robot state is `[positions (D), velocities (D)]`; `references`
 `[positions (K*D, row-major (K, D)), velocities (K*D)]`; `command` is `[position (D),
 velocity (D)]`. On the HSR, `ee_state` is `[p (3), v (3), heading, heading_rate]` and an
 operator's command `[vx, vy, vz, yaw_rate]` in the world frame; `systems.layouts` names their
-entries. `systems.tick` states the order of the updates within a control tick.
+entries. Six-DoF PBP (`PoseDmpBank`, `PoseBlender`, `PoseHandOver`) uses `PoseState`
+`[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]` and `OperatorTwist` (docs/six_dof.md). `systems.tick` states the order of the updates within a control tick.
 """
 
 from pbp_drake.systems.blender import Blender
@@ -23,6 +24,9 @@ from pbp_drake.systems.keyboard_operator import KeyboardOperator
 from pbp_drake.systems.no_operator import NoOperator
 from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionOperator
 from pbp_drake.systems.point_robot import PointRobot
+from pbp_drake.systems.pose_blender import PoseBlender
+from pbp_drake.systems.pose_dmp_bank import PoseDmpBank
+from pbp_drake.systems.pose_hand_over import PoseHandOver
 from pbp_drake.systems.reach_scene_visualizer import ReachSceneVisualizer
 from pbp_drake.systems.sample_hold import SampleHold
 from pbp_drake.systems.scripted_operator import ScriptedOperator
@@ -32,6 +36,6 @@ from pbp_drake.systems.virtual_participant import VirtualParticipant
 __all__ = [
     "Blender", "DemonstrationPlayer", "DmpBank", "GamepadOperator", "GoalEstimator", "GoalsSource",
     "HandOver", "HeadingCommand", "KeyboardOperator", "NoOperator", "ObstacleRepulsionOperator",
-    "PointRobot", "ReachSceneVisualizer", "SampleHold", "ScriptedOperator", "TaskMonitor",
+    "PointRobot", "PoseBlender", "PoseDmpBank", "PoseHandOver", "ReachSceneVisualizer", "SampleHold", "ScriptedOperator", "TaskMonitor",
     "VirtualParticipant",
 ]

@@ -2,8 +2,8 @@
 
 Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
 ``EeState.size`` is its length. Every system that declares such a port takes its size here.
-`position_of` reads the `[x, y, z]` of any view that has those fields; `goal_index` reads a
-goal index port (`selected_goal`, `followed_goal`).
+`position_of` reads the `[x, y, z]` of any view that has those fields (the pose views too);
+`goal_index` reads a goal index port (`selected_goal`, `followed_goal`).
 """
 
 import numpy as np
@@ -44,3 +44,15 @@ def goal_index(port, context, goal_count, unconnected=None):
     if not 0 <= index < goal_count:
         raise ValueError(f"{port.get_name()} {index} is not one of the {goal_count} goals")
     return index
+
+
+# Six-DoF PBP (`PoseDmpBank`, `PoseBlender`, `PoseHandOver`): orientations are unit
+# quaternions (w, x, y, z), angular velocities world-frame rad/s (see docs/six_dof.md).
+# A hand's measured pose and twist; also the layout of a pose reference or command (the
+# pose to be at after one control period, and the twist to move at).
+PoseState = _view("PoseState", ["x", "y", "z", "qw", "qx", "qy", "qz",
+                                "vx", "vy", "vz", "wx", "wy", "wz"])
+# A goal pose, one row of a pose bank's `goal_poses` (K rows flattened).
+GoalPose = _view("GoalPose", ["x", "y", "z", "qw", "qx", "qy", "qz"])
+# An operator's six-DoF command: a world-frame linear and angular velocity.
+OperatorTwist = _view("OperatorTwist", ["vx", "vy", "vz", "wx", "wy", "wz"])

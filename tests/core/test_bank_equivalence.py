@@ -121,11 +121,12 @@ def test_a_position_per_goal_steps_as_the_per_goal_loop(formulation, shared, uni
 
 
 def test_many_distinct_goals_step_as_the_per_goal_loop():
-    """Enough distinct weights for the product to run in column blocks and a tail
-    (`stepping._BLOCK_BYTES`); a sample of goals, the last ones included, checked."""
+    """Many distinct weights, contracted over the basis rows that matter at each phase
+    (`pbp_drake.core.dmp.contraction`, its blocks tested in tests/core/test_contraction.py);
+    a sample of goals, the last ones included, checked."""
     goal_count = 3400
     bank, dmps, goals = make_banks("ijspeert", False, goal_count, 3, False, seed=8)
-    assert bank._weight_blocks is not None and bank._weight_tail.shape[1] > 0
+    assert bank._weight_rows is not None
     checked = list(range(0, goal_count, 97)) + [goal_count - 2, goal_count - 1]
     phase, _, scaled_velocity = bank.initial_state()
     goals_dk = bank.goals_matrix(goals)

@@ -45,9 +45,14 @@ def _row(dimension, goals, weights, leaf_us=500.0, math_us=100.0, per_goal=200.0
             "speedup_vs_stacked": stacked, "bandwidth_bound_us": bound_us}
 
 
+def _pose_row(goals, weights, leaf_us=500.0):
+    return dict(_row(6, goals, weights, leaf_us), pose=True)
+
+
 def _all_cases(leaf_us=500.0):
     rows = [_row(3, goals, weights, leaf_us) for goals in (1000, 10000, 100000)
             for weights in ("distinct", "shared")]
+    rows.append(_pose_row(10000, "distinct", leaf_us))
     return rows, [{"goals": 100, "meshcat": False, "realtime_factor": 12.0}]
 
 
@@ -79,7 +84,7 @@ def test_missing_peers_are_skipped_neither_passed_nor_failed():
                                      "movement_primitives not installed"}
     assert exit_code(results) == 0
     assert summary(results).startswith(
-        "Checks: 4 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
+        "Checks: 5 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
         " movement_primitives not installed: 1)")
     # One peer is enough for the per-goal check.
     results = evaluate(rows, closed_loop, installed={"pydmps"})
@@ -91,6 +96,7 @@ def test_quick_keeps_every_check_with_the_same_limits():
     for settings in (quick, full):
         rows = [_row(d, k, w) for d in settings["dimensions"] for k in settings["goals"]
                 for w in ("distinct", "shared")]
+        rows += [_pose_row(k, w) for k in settings["pose_goals"] for w in ("distinct", "shared")]
         closed_loop = [{"goals": k, "meshcat": False, "realtime_factor": 12.0}
                        for k in settings["hsr_goals"]]
         results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"})
@@ -151,7 +157,7 @@ def test_the_bench_command_pins_blas_and_exits_with_the_checks(
     assert "threadpoolctl" not in result.stdout and "Acceptance" not in result.stdout
     verdict = "PASS" if code == 0 else "FAIL"
     assert f"[{verdict}] {K10K_LEAF}: " in result.stdout
-    passed, failed = (3, 0) if code == 0 else (1, 2)
+    passed, failed = (4, 0) if code == 0 else (1, 3)
     assert (f"Checks: {passed} passed, {failed} failed, 4 skipped (not measured: 2; "
             "pydmps, movement_primitives not installed: 1; movement_primitives not "
             "installed: 1)") in result.stdout

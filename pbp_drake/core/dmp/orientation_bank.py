@@ -18,11 +18,13 @@ allocates nothing of size K; `advance` is the same step into new arrays.
 """
 
 import dataclasses
+import functools
 
 import numpy as np
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp._checks import positive
+from pbp_drake.core.dmp.contraction import WeightRows
 from pbp_drake.core.dmp.orientation import (
     AXES, fit_orientation_weights, straight_weights,
     validate_orientation_demonstration)
@@ -38,6 +40,17 @@ def _read_only(array):
     array = np.array(array, dtype=float, order="C")
     array.setflags(write=False)
     return array
+
+
+@functools.lru_cache(maxsize=64)
+def _log_transition(position_offset, position_velocity, velocity_offset, velocity_velocity):
+    """`Phi (x) I3` (6, 6), read-only, for `[e'; z'] = (Phi (x) I3) [e; z] + ...`, from
+    `StepConstants`' numbers (memoised on plain floats, as `step_constants`)."""
+    transition = np.array([[1.0 + position_offset, position_velocity],
+                           [velocity_offset, velocity_velocity]])
+    matrix = np.kron(transition, np.eye(AXES))
+    matrix.setflags(write=False)
+    return matrix
 
 
 class OrientationDmpBank:
@@ -85,17 +98,10 @@ class OrientationDmpBank:
         self.amplitude_scaling = np.array(scaling.T)  # (3, K)
         self.amplitude_scaling.setflags(write=False)
         self._all_scaled = bool(scaling.all())
-        # Distinct weights `(N, 3 K)` in column blocks that fit the L2 cache, as the position
-        # bank (`stepping._BLOCK_BYTES`): `(blocks, N, width)` views, and the rest.
-        self._weight_blocks = self._weight_tail = None
-        if not self.shared_weights:
-            width = max(64, _BLOCK_BYTES // self._weights.itemsize // settings.basis_count)
-            blocks = self._weights.shape[1] // width
-            if blocks > 1:
-                covered = blocks * width
-                self._weight_blocks = self._weights[:, :covered].reshape(
-                    -1, blocks, width).transpose(1, 0, 2)
-                self._weight_tail = self._weights[:, covered:]
+        # Distinct weights `(N, 3 K)`: contracted over the basis rows that matter, in
+        # column blocks that fit the L2 cache, as the position bank.
+        self._weight_rows = (None if self.shared_weights else
+                             WeightRows(self._weights, _BLOCK_BYTES))
         self._ijspeert = settings.formulation == "ijspeert"
         # One start for all: `q0 g*` is then one 4x4 product (`error_quaternions_into`).
         self._uniform_start = (_read_only(self.starts[:, :1])
@@ -288,7 +294,20 @@ class OrientationDmpBank:
     def _step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
                    out_orientations, out_velocity, workspace):
         """The free step (see `pbp_drake.core.dmp.orientation`), vectorised over K:
-        `e, z` from the measured orientation, the position step, back to `q', eta'`."""
+        `log_step_into`, then `orientations_from_log_into`."""
+        ws = workspace
+        self.log_step_into(phase, orientations, velocity, goals_4k, dt, out_phase,
+                           ws.new_log_state, ws)
+        self.orientations_from_log_into(ws.new_errors, ws.new_log_velocity, goals_4k,
+                                        orientations, out_orientations, out_velocity, ws)
+
+    def log_step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
+                      out_log_state, workspace):
+        """The free step in log coordinates: `e = Log(q g*)` and `z = J(e)^-1 eta` from the
+        measured orientations `(4, 1)` or `(4, K)` (unit) and `eta` `(3, K)` or `(3, 1)`
+        (one for all: PBP's goal switch), stepped as the position bank steps `(y, z)`:
+        `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase`. Drake's
+        pose bank keeps `(e', z')` and reads the orientations out on demand."""
         ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)
@@ -298,30 +317,39 @@ class OrientationDmpBank:
         error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
         log_into(ws.error_quaternions, ws.errors, ws)
         inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
-        # e' = Phi00 e + Phi01 z + b, z' = Phi10 e + Phi11 z + b', with b and b' the rows'
-        # combinations of the attractor (the position bank's step, goal 0).
-        rows = ((ws.new_errors, 1.0 + constants.position_offset, constants.position_velocity),
-                (ws.new_log_velocity, constants.velocity_offset, constants.velocity_velocity))
-        for row, (target, error_gain, velocity_gain) in enumerate(rows):
-            np.multiply(ws.errors, error_gain, out=target)
-            np.multiply(ws.log_velocity, velocity_gain, out=ws.work)
-            target += ws.work
-            self._add_relative_attractor(target, shapes[row], lam[row], ws)
-        turned = ws.error_quaternions  # Exp(e'), then q' = Exp(e') g
-        exp_into(ws.new_errors, turned, ws)
-        jacobian_into(ws.new_errors, ws.new_log_velocity, out_velocity, ws)
-        product_into(turned, goals_4k, ws.product, ws.row)
-        # Signed as the measured orientation, so that a stream of them stays continuous.
-        if orientations.shape[1] == 1:
-            np.dot(orientations[:, 0], ws.product, out=ws.row)
+        # [e'; z'] = (Phi (x) I3) [e; z] + [b; b'] (the position bank's step, goal 0): one
+        # (6, 6) x (6, K) product, then the attractor's combinations `b`, `b'`.
+        np.dot(_log_transition(*constants[:4]), ws.log_state.reshape(2 * AXES, -1),
+               out=out_log_state.reshape(2 * AXES, -1))
+        if self._ijspeert:
+            # b = S (-e0) (S alone where the fit switched the scaling off).
+            np.multiply(shapes, ws.amplitude, out=ws.shape)
         else:
-            np.multiply(ws.product, orientations, out=turned)
+            # b = S + lambda e0 (`shapes` may be `ws.shape` itself: added first).
+            out_log_state += shapes
+            np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.shape)
+        out_log_state += ws.shape
+        np.multiply(phase, decay, out=out_phase)
+
+    def orientations_from_log_into(self, errors, log_velocity, goals_4k, reference,
+                                   out_orientations, out_velocity, workspace):
+        """`q = Exp(e) g` (4, K), signed as `reference` (4, 1) or (4, K) so that a stream
+        stays continuous, and `eta = J(e) z` (3, K), from log coordinates `(e, z)`
+        (`log_step_into`'s outputs may be the inputs here, not the outputs)."""
+        ws = workspace
+        turned = ws.error_quaternions  # Exp(e'), then q' = Exp(e') g
+        exp_into(errors, turned, ws)
+        jacobian_into(errors, log_velocity, out_velocity, ws)
+        product_into(turned, goals_4k, ws.product, ws.row)
+        if reference.shape[1] == 1:
+            np.dot(reference[:, 0], ws.product, out=ws.row)
+        else:
+            np.multiply(ws.product, reference, out=turned)
             np.sum(turned, axis=0, out=ws.row)
         np.less(ws.row, 0.0, out=ws.small)
         np.multiply(ws.small, -2.0, out=ws.row)  # -1 where the sign flips, else +1
         ws.row += 1.0
         np.multiply(ws.product, ws.row, out=out_orientations)
-        np.multiply(phase, decay, out=out_phase)
 
     def _add_relative_attractor(self, target, shape, lam, workspace):
         """`target += b`, a combination of attractors: Ijspeert `S (-e0)` (S alone where
@@ -347,15 +375,7 @@ class OrientationDmpBank:
             lam = (combination @ phases)[:, np.newaxis]
             if self.shared_weights:
                 return (basis @ self._weights)[:, :, np.newaxis], lam
-            flat = workspace.shape.reshape(2, -1)
-            if self._weight_blocks is None:
-                np.dot(basis, self._weights, out=flat)
-            else:
-                blocks, _, width = self._weight_blocks.shape
-                covered = blocks * width
-                np.matmul(basis, self._weight_blocks,
-                          out=flat[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
-                np.matmul(basis, self._weight_tail, out=flat[:, covered:])
+            self._weight_rows.contract_into(basis, workspace.shape.reshape(2, -1))
             return workspace.shape, lam
         # A phase per goal: (N, 2, K) bases (allocates).
         phases = np.stack([phase, phase * decay])

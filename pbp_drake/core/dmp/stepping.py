@@ -33,6 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from pbp_drake.core.dmp.contraction import WeightRows
 from pbp_drake.core.dmp.settings import normalized_basis, phase_decay, step_matrices
 
 _IDENTITY = np.eye(2)
@@ -107,18 +108,10 @@ class BankStep:
             self.shared_weights and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all())
             and bool((starts == starts[:, :1]).all()))
         self._uniform_start = frozen(starts[:, :1])
-        # Read-only views of the distinct weights `(N, D*K)` in column blocks (see
-        # `_BLOCK_BYTES`): `(blocks, N, width)`, and the columns left over.
-        self._weight_blocks = self._weight_tail = None
-        if not self.shared_weights:
-            flat = self._weights.reshape(self._settings.basis_count, -1)
-            width = max(64, _BLOCK_BYTES // flat.itemsize // flat.shape[0])
-            blocks = flat.shape[1] // width
-            if blocks > 1:
-                covered = blocks * width
-                self._weight_blocks = flat[:, :covered].reshape(-1, blocks, width).transpose(
-                    1, 0, 2)
-                self._weight_tail = flat[:, covered:]
+        # Distinct weights `(N, D*K)`: contracted over the basis rows that matter at the
+        # step's phase, in column blocks (`pbp_drake.core.dmp.contraction`).
+        self._weight_rows = (None if self.shared_weights else WeightRows(
+            self._weights.reshape(self._settings.basis_count, -1), _BLOCK_BYTES))
         # b = S (sigma g + rho) for Ijspeert (S the shape; sigma 1 where scaled, and
         # rho = 1 - sigma (1 + y0)); b = S - lambda (g - y0) for Pastor.
         sigma = scaling[:, :1].astype(float)
@@ -217,7 +210,6 @@ class BankStep:
         contracted with the weights once. A phase per goal: `(N, K)` bases (allocates)."""
         if equal is None:
             equal = phase.size == 1 or phase.min() == phase.max()
-        n = self._settings.basis_count
         if equal:
             phases, psi, scale = workspace.phases, workspace.psi, workspace.scale
             phases[0, 0] = phase.flat[0]
@@ -236,15 +228,7 @@ class BankStep:
             if self.shared_weights:
                 np.dot(workspace.basis, self._weights, out=workspace.coefficients)
                 return workspace.coefficients[:, :, np.newaxis], workspace.lam
-            flat = workspace.shape.reshape(2, -1)
-            if self._weight_blocks is None:
-                np.dot(workspace.basis, self._weights.reshape(n, -1), out=flat)
-            else:
-                blocks, _, width = self._weight_blocks.shape
-                covered = blocks * width
-                np.matmul(workspace.basis, self._weight_blocks,
-                          out=flat[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
-                np.matmul(workspace.basis, self._weight_tail, out=flat[:, covered:])
+            self._weight_rows.contract_into(workspace.basis, workspace.shape.reshape(2, -1))
             return workspace.shape, workspace.lam
         # A phase per goal: K bases at each end of the step.
         phases = np.stack([phase, phase * decay])  # (2, K)

@@ -1,0 +1,65 @@
+"""The contraction of distinct weights with the basis, `(2, N) x (N, M)`, reading only the
+basis rows that matter at the step's phase: shared by the position and orientation banks.
+
+The normalised Gaussian basis is nearly zero away from the phase: at any phase of the
+default 50 functions only 5 to 12 neighbours are above `2^-53 / N` of the largest (the
+others are smaller than `0.7^(4 m^2)` for the m-th neighbour, see `DmpSettings.basis`). The
+weights are laid out `(N, M)`, so the rows that matter are one contiguous slice, and the
+product reads a quarter of the bytes (the step's cost at large K is reading the weights).
+
+Exactness: a row n is left out only when `max_r |b_rn| max_m |W_nm|` (the largest term it
+could add to any column) is below `2^-53 / N` of the largest such bound over the rows; the
+rows left out then add, together, less than one rounding unit of the largest term, which
+is below the rounding error the full product makes anyway (`N` rounding units of it).
+"""
+
+import numpy as np
+
+# The most the left-out rows may add, over the largest row's bound, per row.
+_RELATIVE_PER_ROW = 2.0 ** -53
+
+
+class WeightRows:
+    """Distinct weights `(N, M)` (read-only, C order) prepared for `contract_into`: each
+    row's largest magnitude, and column blocks that fit the L2 cache.
+
+    `block_bytes`: OpenBLAS's one long two-row dgemm took up to twice a one-row dgemv on
+    this project's machines; in column blocks of about this many bytes it takes what the
+    dgemv takes (`pbp_drake.core.dmp.stepping._BLOCK_BYTES`)."""
+
+    __slots__ = ("weights", "row_bounds", "block_bytes")
+
+    def __init__(self, weights, block_bytes):
+        self.weights = weights
+        bounds = np.abs(weights).max(axis=1)
+        bounds.setflags(write=False)
+        self.row_bounds = bounds
+        self.block_bytes = block_bytes
+
+    def window(self, basis):
+        """`(first, stop)`: the rows of the basis `(2, N)` whose terms can matter (module
+        docstring); at least one row."""
+        bounds = np.abs(basis).max(axis=0)
+        bounds *= self.row_bounds
+        largest = bounds.max()
+        kept = np.flatnonzero(bounds >= largest * (_RELATIVE_PER_ROW / bounds.size))
+        if kept.size == 0 or largest == 0.0:
+            return 0, 1  # every term is 0: any one row gives the exact 0
+        return int(kept[0]), int(kept[-1]) + 1
+
+    def contract_into(self, basis, out):
+        """`out = basis @ weights` `(2, M)` over the rows that matter (`window`)."""
+        first, stop = self.window(basis)
+        basis = basis[:, first:stop]
+        weights = self.weights[first:stop]
+        rows, columns = weights.shape
+        # Fewer rows, wider blocks: each block keeps about `block_bytes` of weights.
+        width = max(64, self.block_bytes // weights.itemsize // rows)
+        blocks = columns // width
+        if blocks <= 1:
+            np.dot(basis, weights, out=out)
+            return
+        covered = blocks * width
+        np.matmul(basis, weights[:, :covered].reshape(rows, blocks, width).transpose(1, 0, 2),
+                  out=out[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
+        np.matmul(basis, weights[:, covered:], out=out[:, covered:])

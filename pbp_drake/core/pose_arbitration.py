@@ -1,0 +1,162 @@
+"""Six-DoF blending: the operator's twist and the policy's pose reference become one pose
+reference, and the six-DoF hand-over law (formulas and reasons: docs/six_dof.md).
+
+A pose reference is the pose to be at after one control period and the twist to move at:
+`PoseReference(position (3,), orientation (4,) unit (w, x, y, z), velocity (3,),
+angular_velocity (3,))`, velocities in the world frame. The operator's command is a twist
+`u = (u_v, u_w)`; over one period `dt` the operator alone would take the hand from
+`(y, q_y)` to
+
+    U = (y + u_v dt, Exp(u_w dt) q_y),
+
+turning it at the world-frame angular velocity `u_w` (`Exp` of `pbp_drake.core.quaternion`).
+The laws are the position ones (`pbp_drake.core.arbitration`), with the orientation on SO(3):
+
+- ``pbp_continuous``: the policy's next pose moved by the operator's displacement,
+  `(p_P + u_v dt, Exp(u_w dt) q_P)`, twist `(v_P + u_v, w_P + u_w)`;
+- ``pbp_alternated``: `U` with twist `u` while the operator acts, else `P`;
+- ``fixed_alpha`` and ``confidence_alpha``: while the operator acts, positions and twists
+  mixed linearly, `(1 - alpha) U + alpha P`, and the orientation by the geodesic,
+  `slerp(q_U, q_P, alpha)`; else `P`;
+- ``teleop``: `U` with twist `u`; ``pbp_no_user``: `P` (the operator is ignored).
+
+Angular velocities are vectors of one tangent space (the world frame's), so adding and
+mixing them as vectors is exact; orientations are never mixed as vectors nor as angles.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.arbitration import BLEND_MODES
+from pbp_drake.core.hand_over import check_limit, limited_velocity
+
+POSE_BLEND_MODES = BLEND_MODES + ("pbp_no_user",)
+TWIST_FIELDS = ("vx", "vy", "vz", "wx", "wy", "wz")
+
+
+class PoseReference(NamedTuple):
+    """A pose to be at after one control period and the twist to move at (world frame)."""
+
+    position: np.ndarray  # (3,) m
+    orientation: np.ndarray  # (4,) unit quaternion (w, x, y, z)
+    velocity: np.ndarray  # (3,) m/s
+    angular_velocity: np.ndarray  # (3,) rad/s
+
+    @classmethod
+    def from_vector(cls, vector):
+        """From `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]` (`PoseState`'s layout)."""
+        vector = np.asarray(vector, dtype=float).reshape(13)
+        return cls(vector[:3].copy(), vector[3:7].copy(), vector[7:10].copy(),
+                   vector[10:13].copy())
+
+    def to_vector(self):
+        """`[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]`, a new array."""
+        return np.concatenate([self.position, self.orientation, self.velocity,
+                               self.angular_velocity])
+
+
+class HandOverLimits(NamedTuple):
+    """The six-DoF hand-over's limits: the linear ones of `pbp_drake.core.hand_over` and
+    their angular twins (rad/s^2 and rad/s). The commanded angular velocity then changes by
+    at most `max_angular_acceleration * dt` between two ticks."""
+
+    max_acceleration: float
+    max_speed: float
+    max_angular_acceleration: float
+    max_angular_speed: float
+
+    def checked(self):
+        """The limits as floats; raises ValueError naming the first that is not finite and
+        positive."""
+        units = ("m/s^2", "m/s", "rad/s^2", "rad/s")
+        return HandOverLimits(*(check_limit(value, name, unit) for value, name, unit in
+                                zip(self, self._fields, units)))
+
+
+def validate_pose_mode(mode, alpha=None):
+    """Raises ValueError for an unknown mode, or a `fixed_alpha` without alpha in [0, 1]."""
+    if mode not in POSE_BLEND_MODES:
+        raise ValueError(f"blending mode {mode!r} is unknown; choose one of {POSE_BLEND_MODES}")
+    if mode == "fixed_alpha" and (alpha is None or not np.isfinite(alpha)
+                                  or not 0.0 <= alpha <= 1.0):
+        raise ValueError(f"alpha must lie in [0, 1] for fixed_alpha, got {alpha}")
+
+
+def validate_twist(twist, name="operator_twist"):
+    """The twist `(vx, vy, vz, wx, wy, wz)` as a new float array; raises ValueError naming
+    `name` and the fields that are NaN or infinite, or the wrong size."""
+    twist = np.array(twist, dtype=float).reshape(-1)
+    if twist.size != len(TWIST_FIELDS):
+        raise ValueError(f"{name} must be 6 numbers {TWIST_FIELDS}, got {twist.size}")
+    bad = np.flatnonzero(~np.isfinite(twist))
+    if bad.size:
+        fields = ", ".join(TWIST_FIELDS[i] for i in bad)
+        raise ValueError(f"{name} {fields} is NaN or infinite: {twist.tolist()}")
+    return twist
+
+
+def turned(orientation, angular_velocity, dt):
+    """`Exp(w dt) q`: the orientation `q` (4,) turned for `dt` at the world-frame angular
+    velocity `w` (3,), signed as `q` (a stream of them stays continuous)."""
+    turn = quaternion.exp_map(np.asarray(angular_velocity, dtype=float) * dt)
+    return quaternion.aligned(quaternion.multiply(turn, orientation), orientation)
+
+
+def blend_pose(mode, robot_position, robot_orientation, policy, twist, active, dt,
+               alpha=None):
+    """The pose reference of one control period under `mode` (module docstring).
+
+    `policy` is the policy's `PoseReference` (the selected DMP's next pose and twist);
+    `twist` the operator's `(vx, vy, vz, wx, wy, wz)`, refused when NaN or infinite;
+    `active` whether the operator acts; `alpha` the weight of ``fixed_alpha`` and
+    ``confidence_alpha``. The result is signed as the robot's orientation."""
+    twist = validate_twist(twist)
+    linear, angular = twist[:3], twist[3:]
+    robot_orientation = np.asarray(robot_orientation, dtype=float)
+    policy = PoseReference(*(np.asarray(part, dtype=float) for part in policy))
+    policy = policy._replace(orientation=quaternion.aligned(policy.orientation,
+                                                            robot_orientation))
+    if mode == "pbp_continuous":
+        return PoseReference(policy.position + linear * dt,
+                             turned(policy.orientation, angular, dt),
+                             policy.velocity + linear, policy.angular_velocity + angular)
+    operator = PoseReference(np.asarray(robot_position, dtype=float) + linear * dt,
+                             turned(robot_orientation, angular, dt), linear, angular)
+    if mode == "teleop" or (mode == "pbp_alternated" and active):
+        return operator
+    if mode in ("pbp_alternated", "pbp_no_user") or not active:
+        return policy
+    if mode in ("fixed_alpha", "confidence_alpha"):
+        if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"alpha must lie in [0, 1] for {mode}, got {alpha}")
+        return PoseReference(
+            (1.0 - alpha) * operator.position + alpha * policy.position,
+            quaternion.slerp(operator.orientation, policy.orientation, alpha),
+            (1.0 - alpha) * operator.velocity + alpha * policy.velocity,
+            (1.0 - alpha) * operator.angular_velocity + alpha * policy.angular_velocity)
+    raise ValueError(f"blending mode {mode!r} is unknown; choose one of {POSE_BLEND_MODES}")
+
+
+def pose_hand_over(previous_velocity, previous_angular_velocity, reference, limits, dt):
+    """The command `PoseReference` of one tick under the six-DoF hand-over law.
+
+    Linear part: `pbp_drake.core.hand_over.hand_over`. Angular part, the same velocity law
+    (`limited_velocity`) with the angular limits, and the orientation turned by the angular
+    velocity not yet reached over one period, as the position is shifted:
+
+        w'_k = w'_{k-1} + clip(cap(w_k) - w'_{k-1}, alpha_max dt),
+        q'_k = Exp((w'_k - w_k) dt) q_k.
+
+    `limits` is a checked `HandOverLimits`; the previous velocities are the command's of
+    the tick before. New arrays."""
+    velocity = limited_velocity(previous_velocity, reference.velocity,
+                                limits.max_acceleration * dt, limits.max_speed)
+    angular = limited_velocity(previous_angular_velocity, reference.angular_velocity,
+                               limits.max_angular_acceleration * dt,
+                               limits.max_angular_speed)
+    return PoseReference(
+        np.asarray(reference.position, dtype=float) + (velocity - reference.velocity) * dt,
+        turned(reference.orientation, angular - reference.angular_velocity, dt),
+        velocity, angular)

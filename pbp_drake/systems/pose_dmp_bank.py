@@ -1,0 +1,356 @@
+"""The six-DoF DMP bank as a Drake system: K goal poses, each a position DMP and an
+orientation DMP re-integrated every control step from the hand's measured pose.
+
+A thin LeafSystem over the NumPy banks `pbp_drake.core.dmp.DmpBank` (positions, D = 3) and
+`OrientationDmpBank` (unit quaternions), as `pbp_drake.systems.dmp_bank.DmpBank` is over
+the first: the DMPs' state is the Context's discrete state and the scratch arrays are a
+cache entry (one per Context), so Contexts and Simulators stay independent.
+"""
+
+import math
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import LeafSystem, ValueProducer
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one
+from pbp_drake.core.pose_arbitration import PoseReference
+from pbp_drake.systems.layouts import GoalPose, PoseState, goal_index
+from pbp_drake.systems.tick import decide_offset
+
+# `held` in the state: stepping, holding at the robot (PBP-Alt's lock), at the starts.
+_STEPPING, _ON_ROBOT, _AT_START = 0.0, 1.0, 2.0
+
+
+class PoseWorkspace:
+    """Scratch of one Context: the two banks' workspaces, a phase, and the orientation
+    readout's arrays (`eta` of every DMP when no followed goal is connected)."""
+
+    __slots__ = ("position", "orientation", "phase", "orientations", "eta")
+
+    def __init__(self, position_bank, orientation_bank):
+        k = position_bank.goal_count
+        self.position = position_bank.make_workspace()
+        self.orientation = orientation_bank.make_workspace()
+        self.phase = np.empty(1)
+        self.orientations = np.empty((4, k))
+        self.eta = np.empty((3, k))
+
+
+class PoseDmpBank(LeafSystem):
+    """Steps K pose DMPs (one per goal pose) every control period from the hand's pose.
+
+    .. pydrake_system::
+
+        name: PoseDmpBank
+        input_ports:
+        - robot_state
+        - goal_poses
+        - operator_active (optional)
+        - followed_goal (optional)
+        - selected_goal (optional)
+        output_ports:
+        - references
+        - selected_reference
+        - phase
+
+    `robot_state` is a `PoseState` `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]`
+    (quaternion unit within `quaternion.UNIT_TOLERANCE`, angular velocity world frame);
+    `goal_poses` is K `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened (a goal that
+    is not finite, or whose quaternion is not unit, is refused naming `goal_poses`).
+
+    Each period every DMP advances one step from the measured pose: the position part as
+    `DmpBank`, the orientation part as `OrientationDmpBank` (`e = Log(q g*)`, the same
+    first-order-hold step, see docs/dmp.md). Both parts share one phase, so one lock stops
+    both: with `lock_phase_when_operator_acts` (PBP-Alt) a nonzero `operator_active`
+    freezes the phase and the DMPs follow the hand (its pose, and `tau` times its twist)
+    until the operator lets go. `followed_goal` (the goal estimator's selection before it
+    updates) makes every DMP continue from the followed DMP's linear AND angular velocity,
+    so a switch of goal keeps the commanded twist (as `DmpBank`); unconnected, each keeps
+    its own. `max_speed` (m/s) and `max_angular_speed` (rad/s) scale each DMP's own
+    velocities down to them before every step (anti-windup, as `DmpBank`'s `max_speed`;
+    give the hand-over's limits).
+
+    `references` is the K next pose references, K `PoseState` rows (pose after one step,
+    twist) flattened; `selected_reference` is the one of `selected_goal` (unconnected: the
+    followed goal, else goal 0), a `PoseState`, computed alone (what a blender needs;
+    `references` costs K exp maps). `phase` is the K (equal) phases.
+
+    The state is one vector `[phase, held, p (3), q (4), eta_held (3), z, dp, dz (3K each),
+    e', z' (3K each)]` (`_split` knows the layout): the position part as `DmpBank` keeps
+    it, and the orientation DMPs' stepped log coordinates `(e', z')` (`log_step_into`),
+    from which the outputs read the orientations and angular velocities on demand. The
+    bank updates at the decide stage of each tick (`update_offset` overrides it).
+    """
+
+    def __init__(self, position_bank, orientation_bank, control_period,
+                 lock_phase_when_operator_acts=False, update_offset=None, max_speed=None,
+                 max_angular_speed=None):
+        super().__init__()
+        _check_banks(position_bank, orientation_bank, control_period)
+        # Anti-windup, as DmpBank's `max_speed`: the hand-over never lets the hand move or
+        # turn faster, so no DMP may remember a faster velocity (see `_limit`).
+        self._max_speed = None if max_speed is None else float(max_speed)
+        self._max_angular_speed = (None if max_angular_speed is None
+                                   else float(max_angular_speed))
+        self._positions, self._orientations = position_bank, orientation_bank
+        self._period = float(control_period)
+        self._lock = bool(lock_phase_when_operator_acts)
+        if update_offset is None:
+            update_offset = decide_offset(self._period)
+        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
+            raise ValueError(
+                f"update_offset must be in [0, control_period), got {update_offset!r}")
+        k = self._goal_count = position_bank.goal_count
+        self._robot_state_port = self.DeclareVectorInputPort("robot_state", PoseState.size)
+        self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
+        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        initial = np.zeros(self.state_size(k))
+        phase, held, _, q, _, _, dp, _, _ = self._split(initial)
+        phase[0], held[0] = 1.0, _AT_START
+        q[:, 0] = quaternion.IDENTITY
+        dp[...] = position_bank.starts
+        self._state_index = self.DeclareDiscreteState(initial)
+        self._goals_entry = self.DeclareCacheEntry(
+            "goal poses, validated, (7, K): positions then quaternions",
+            ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((GoalPose.size, k))),
+                          calc=self._calc_goals),
+            prerequisites_of_calc={self._goals_port.ticket()})
+        # Scratch, never calculated nor marked up to date (see DmpBank's workspace entry).
+        self._workspace_entry = self.DeclareCacheEntry(
+            "PoseWorkspace: scratch arrays of the banks' step",
+            ValueProducer(allocate=lambda: AbstractValue.Make(
+                PoseWorkspace(position_bank, orientation_bank)),
+                calc=self._never_calculated),
+            prerequisites_of_calc={self.nothing_ticket()})
+        self._references_port = self.DeclareVectorOutputPort(
+            "references", k * PoseState.size, self._calc_references,
+            prerequisites_of_calc={self.xd_ticket(), self._goals_port.ticket()})
+        self._selected_reference_port = self.DeclareVectorOutputPort(
+            "selected_reference", PoseState.size, self._calc_selected_reference,
+            prerequisites_of_calc={self.xd_ticket(), self._goals_port.ticket(),
+                                   self._selected_goal_port.ticket(),
+                                   self._followed_goal_port.ticket()})
+        self._phase_port = self.DeclareVectorOutputPort(
+            "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
+
+    @staticmethod
+    def state_size(goal_count):
+        """The length of the one state vector (class docstring)."""
+        return 2 + 3 + 4 + 3 + 5 * 3 * goal_count
+
+    @property
+    def position_bank(self):
+        return self._positions
+
+    @property
+    def orientation_bank(self):
+        return self._orientations
+
+    def get_robot_state_input_port(self):
+        return self._robot_state_port
+
+    def get_goal_poses_input_port(self):
+        return self._goals_port
+
+    def get_operator_active_input_port(self):
+        return self._operator_active_port
+
+    def get_followed_goal_input_port(self):
+        return self._followed_goal_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_references_output_port(self):
+        return self._references_port
+
+    def get_selected_reference_output_port(self):
+        return self._selected_reference_port
+
+    def get_phase_output_port(self):
+        return self._phase_port
+
+    def _split(self, vector):
+        """Views: phase (1,), held (1,), p (3, 1), q (4, 1), eta_held (3, 1), z, dp, dz
+        (3, K) and the log coordinates (2, 3, K)."""
+        k = self._goal_count
+        z = 12
+        dp, dz, log = z + 3 * k, z + 6 * k, z + 9 * k
+        return (vector[0:1], vector[1:2], vector[2:5].reshape(3, 1),
+                vector[5:9].reshape(4, 1), vector[9:12].reshape(3, 1),
+                vector[z:dp].reshape(3, k), vector[dp:dz].reshape(3, k),
+                vector[dz:log].reshape(3, k), vector[log:log + 6 * k].reshape(2, 3, k))
+
+    def _workspace(self, context):
+        return self._workspace_entry.get_mutable_cache_entry_value(
+            context).GetMutableValueOrThrow()
+
+    @staticmethod
+    def _never_calculated(context, value):
+        raise RuntimeError("the PoseDmpBank workspace is scratch memory, never evaluated")
+
+    def _calc_goals(self, context, value):
+        rows = np.asarray(self._goals_port.Eval(context), dtype=float).reshape(
+            self._goal_count, GoalPose.size)
+        check_positions(rows[:, :3], "goal_poses position")
+        orientations = quaternion.unit_quaternions(rows[:, 3:], "goal_poses orientation")
+        goals = value.get_mutable_value()
+        goals[:3] = rows[:, :3].T
+        goals[3:] = orientations.T
+
+    def _robot(self, context):
+        """The measured position (3,), orientation (4,), velocity (3,) and angular velocity
+        (3,), checked."""
+        state = np.asarray(self._robot_state_port.Eval(context), dtype=float)
+        if not np.isfinite(state).all():
+            bad = [name for name, value in zip(PoseState.get_fields(), state)
+                   if not np.isfinite(value)]
+            raise ValueError(f"robot_state {', '.join(bad)} is NaN or infinite: "
+                             f"{state.tolist()}")
+        norm = math.sqrt(float(state[3:7] @ state[3:7]))
+        if abs(norm - 1.0) > quaternion.UNIT_TOLERANCE:
+            quaternion.unit_quaternions(state[3:7], "robot_state orientation")  # raises
+        # `unit_quaternions` costs 50 us a call; one quaternion is checked by hand.
+        return state[:3], state[3:7] / norm, state[7:10], state[10:13]
+
+    def _update(self, context, discrete_state):
+        positions, orientations, period = self._positions, self._orientations, self._period
+        phase, held, robot, q, eta_held, z, dp, dz, log_state = self._split(
+            discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
+        # Every input before the workspace (an input may reach this system's outputs).
+        position, orientation, velocity, angular_velocity = self._robot(context)
+        lock = (self._lock and self._operator_active_port.HasValue(context)
+                and self._operator_active_port.Eval(context)[0] > 0.5)
+        goals = self._goals_entry.Eval(context)
+        followed = goal_index(self._followed_goal_port, context, self._goal_count)
+        workspace = self._workspace(context)
+        # The DMPs' velocities at the end of the last step: linear read out in place, the
+        # orientation part's eta as a column (one for all) or per DMP.
+        if held[0] == _STEPPING:
+            positions.stepped_velocity_into(dz, z, period, z)
+            if followed is not None:
+                z[...] = z[:, followed:followed + 1]
+                eta = jacobian_of_one(log_state[0, :, followed],
+                                      log_state[1, :, followed])[:, np.newaxis]
+            else:
+                orientations.orientations_from_log_into(
+                    log_state[0], log_state[1], goals[3:], q,
+                    workspace.orientations, workspace.eta, workspace.orientation)
+                eta = workspace.eta
+            _limit(z, self._max_speed, positions.duration)
+            _limit(eta, self._max_angular_speed, orientations.duration)
+        else:
+            eta = np.array(eta_held)  # the robot's (locked) or 0 (at the start), (3, 1)
+        robot[:, 0] = position
+        q[:, 0] = orientation
+        if lock:
+            # Both phases frozen: the DMPs sit at the hand's pose and follow its twist.
+            held[0] = _ON_ROBOT
+            dp.fill(0.0)
+            np.multiply(velocity[:, np.newaxis], positions.duration, out=z)
+            eta_held[:, 0] = angular_velocity * orientations.duration
+            return
+        held[0] = _STEPPING
+        positions.attractor_terms_into(phase, robot, goals[:3], period, dp, dz,
+                                       workspace.position)
+        orientations.log_step_into(phase, q, eta, goals[3:], period, workspace.phase,
+                                   log_state, workspace.orientation)
+        phase *= positions.decay(period)
+
+    def dmp_states(self, context):
+        """The K DMPs after the last update: phases (K,), positions (3, K), orientations
+        (4, K), and the scaled velocities `tau v` and `tau omega` (3, K), new arrays."""
+        positions, orientations, period = self._positions, self._orientations, self._period
+        phase, held, robot, q, eta_held, z, dp, dz, log_state = self._split(
+            context.get_discrete_state(self._state_index).get_value())
+        k = self._goal_count
+        stepped = np.empty((3, k))
+        velocity = np.empty((3, k))
+        rotations = np.empty((4, k))
+        eta = np.empty((3, k))
+        if held[0] != _STEPPING:
+            np.add(robot, dp, out=stepped)
+            velocity[...] = z
+            rotations[...] = orientations.starts if held[0] == _AT_START else q
+            eta[...] = eta_held
+        else:
+            goals = self._goals_entry.Eval(context)
+            workspace = self._workspace(context)
+            positions.stepped_positions_into(robot, dp, z, period, stepped,
+                                             workspace.position)
+            positions.stepped_velocity_into(dz, z, period, velocity)
+            orientations.orientations_from_log_into(log_state[0], log_state[1], goals[3:], q,
+                                                    rotations, eta, workspace.orientation)
+        return np.full(k, phase[0]), stepped, rotations, velocity, eta
+
+    def _calc_references(self, context, output):
+        _, stepped, rotations, velocity, eta = self.dmp_states(context)
+        rows = output.get_mutable_value().reshape(self._goal_count, PoseState.size)
+        rows[:, :3] = stepped.T
+        rows[:, 3:7] = rotations.T
+        rows[:, 7:10] = velocity.T / self._positions.duration
+        rows[:, 10:13] = eta.T / self._orientations.duration
+
+    def selected_reference(self, context):
+        """The `PoseReference` of `selected_goal` (unconnected: the followed goal, else 0)."""
+        k = goal_index(self._selected_goal_port, context, self._goal_count)
+        if k is None:
+            k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
+        _, held, robot, q, eta_held, z, dp, dz, log_state = self._split(
+            context.get_discrete_state(self._state_index).get_value())
+        tau_v, tau_w = self._positions.duration, self._orientations.duration
+        if held[0] != _STEPPING:
+            start = self._orientations.starts[:, k] if held[0] == _AT_START else q[:, 0]
+            return PoseReference(robot[:, 0] + dp[:, k], np.array(start), z[:, k] / tau_v,
+                                 eta_held[:, 0] / tau_w)
+        constants = self._positions.step_constants(self._period)
+        position = robot[:, 0] + dp[:, k] + constants.position_velocity * z[:, k]
+        velocity = dz[:, k] + constants.velocity_velocity * z[:, k]
+        error, log_velocity = log_state[0, :, k], log_state[1, :, k]
+        goal = self._goals_entry.Eval(context)[3:, k]
+        rotation = quaternion.aligned(
+            quaternion.multiply(quaternion.exp_map(error), goal), q[:, 0])
+        eta = jacobian_of_one(error, log_velocity)
+        return PoseReference(position, rotation, velocity / tau_v, eta / tau_w)
+
+    def _calc_selected_reference(self, context, output):
+        output.SetFromVector(self.selected_reference(context).to_vector())
+
+    def _calc_phase(self, context, output):
+        phase = self._split(context.get_discrete_state(self._state_index).get_value())[0]
+        output.get_mutable_value()[:] = phase[0]
+
+
+def _limit(scaled_velocities, max_speed, duration):
+    """Scales the columns of `tau v` (3, K) down to the speed `max_speed` (None: no limit),
+    in place. Without it a DMP stepped from a hand that the operator (PBP-Cont) or the
+    hand-over holds back winds its own velocity up toward `beta (g - y) / tau`, far above
+    what the hand may do (see `DmpBank._limit_speed`)."""
+    if max_speed is None:
+        return
+    speeds = np.linalg.norm(scaled_velocities, axis=0) / duration
+    too_fast = speeds > max_speed
+    if np.any(too_fast):
+        scaled_velocities[:, too_fast] *= max_speed / speeds[too_fast]
+
+
+def _check_banks(position_bank, orientation_bank, control_period):
+    """The two banks must describe the same K goals with one phase: 3-D positions, equal
+    goal counts, and equal phase decays over the control period."""
+    if position_bank.dimension != 3:
+        raise ValueError(f"the position bank must be 3-D, got D = {position_bank.dimension}")
+    if position_bank.goal_count != orientation_bank.goal_count:
+        raise ValueError(f"the banks have {position_bank.goal_count} and "
+                         f"{orientation_bank.goal_count} goals; a pose bank needs one count")
+    period = float(control_period)
+    if not (np.isfinite(period) and period > 0.0):
+        raise ValueError(f"control_period must be positive, got {control_period!r}")
+    if position_bank.decay(period) != orientation_bank.decay(period):
+        raise ValueError("the position and orientation banks must share one phase: give them "
+                         "the same duration and alpha_x")

@@ -1,0 +1,173 @@
+"""The six-DoF DMP bank system: the NumPy banks' steps inside a LeafSystem (to 1e-12), one
+phase lock for position and orientation, and bad goals and hand states refused by name."""
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.dmp import DmpBank as PositionModel
+from pbp_drake.core.dmp import DmpSettings
+from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
+from pbp_drake.systems.goals_source import GoalsSource
+from pbp_drake.systems.pose_dmp_bank import PoseDmpBank
+
+DT = 0.01
+K = 5
+SETTINGS = DmpSettings(basis_count=20)
+ROBOT_ORIENTATION = quaternion.exp_map(np.array([0.3, -0.2, 0.5]))
+ROBOT = np.concatenate([[0.1, -0.2, 0.3], ROBOT_ORIENTATION, [0.05, 0.0, -0.02],
+                        [0.1, -0.3, 0.2]])
+
+
+def make_banks(seed=0):
+    """Distinct weights for every goal in both parts (as learned ones would be)."""
+    rng = np.random.default_rng(seed)
+    straight = OrientationDmpBank.straight(quaternion.IDENTITY, K, 1.2, SETTINGS)
+    rotation_weights = np.asarray(straight._weights)[None] * rng.uniform(0.5, 1.5, (K, 1, 3))
+    orientations = OrientationDmpBank(rotation_weights, quaternion.IDENTITY, 1.2, SETTINGS)
+    position_weights = rng.normal(0.0, 50.0, (K, SETTINGS.basis_count, 3))
+    positions = PositionModel(position_weights, np.zeros(3), 1.2, SETTINGS)
+    goal_rows = rng.normal(size=(K, 4))
+    goal_rows /= np.linalg.norm(goal_rows, axis=1, keepdims=True)
+    goals = np.hstack([rng.uniform(0.3, 0.8, (K, 3)), goal_rows])
+    return positions, orientations, goals
+
+
+def simulate(seconds, followed=None, active=None, lock=False, robot=ROBOT, goals=None):
+    positions, orientations, default_goals = make_banks()
+    goals = default_goals if goals is None else goals
+    builder = DiagramBuilder()
+    bank = builder.AddSystem(PoseDmpBank(positions, orientations, DT,
+                                         lock_phase_when_operator_acts=lock))
+    state = builder.AddSystem(ConstantVectorSource(robot))
+    builder.Connect(state.get_output_port(), bank.get_robot_state_input_port())
+    source = builder.AddSystem(GoalsSource(goals))
+    builder.Connect(source.get_output_port(), bank.get_goal_poses_input_port())
+    if followed is not None:
+        index = builder.AddSystem(ConstantVectorSource([float(followed)]))
+        builder.Connect(index.get_output_port(), bank.get_followed_goal_input_port())
+    if active is not None:
+        times, values = active
+        script = builder.AddSystem(TrajectorySource(PiecewisePolynomial.ZeroOrderHold(
+            times, np.asarray(values, dtype=float)[np.newaxis])))
+        builder.Connect(script.get_output_port(), bank.get_operator_active_input_port())
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(seconds)
+    context = bank.GetMyContextFromRoot(simulator.get_context())
+    return bank, context, (positions, orientations, goals)
+
+
+def numpy_references(models, steps, followed=None):
+    """The banks stepped `steps` times from the fixed hand pose: (K, 13) references."""
+    positions, orientations, goals = models
+    phase, _, velocity = positions.initial_state()
+    rotation_phase, _, eta = orientations.initial_state()
+    goals_dk = positions.goals_matrix(goals[:, :3])
+    goals_4k = orientations.goals_matrix(goals[:, 3:])
+    for _ in range(steps):
+        phase, stepped, velocity = positions.advance(phase, ROBOT[:3, None], velocity,
+                                                     goals_dk, DT, followed=followed)
+        rotation_phase, rotations, eta = orientations.advance(
+            rotation_phase, ROBOT_ORIENTATION[:, None], eta, goals_4k, DT, followed=followed)
+    np.testing.assert_array_equal(phase, rotation_phase)  # one phase for both parts
+    return np.hstack([stepped.T, rotations.T, velocity.T / positions.duration,
+                      eta.T / orientations.duration]), phase
+
+
+def steps_taken(bank, context):
+    """How many free steps the bank took: its phase is `decay^steps`."""
+    phase = bank.get_phase_output_port().Eval(context)[0]
+    return int(round(np.log(phase) / np.log(bank.position_bank.decay(DT))))
+
+
+@pytest.mark.parametrize("followed", [None, 3], ids=["own velocities", "followed goal"])
+def test_the_system_steps_as_the_numpy_banks(followed):
+    bank, context, models = simulate(0.255, followed=followed)
+    steps = steps_taken(bank, context)
+    assert steps == 26  # one step at each tick, 0.00 to 0.25 s
+    expected, phase = numpy_references(models, steps, followed)
+    references = bank.get_references_output_port().Eval(context).reshape(K, 13)
+    np.testing.assert_allclose(references, expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(bank.get_phase_output_port().Eval(context), phase, rtol=1e-15)
+
+
+def test_the_selected_reference_is_that_goals_row():
+    bank, context, _ = simulate(0.155, followed=2)
+    references = bank.get_references_output_port().Eval(context).reshape(K, 13)
+    selected = bank.get_selected_reference_output_port().Eval(context)
+    np.testing.assert_allclose(selected, references[2], rtol=0, atol=1e-14)
+
+
+def test_pbp_alternated_locks_both_phases_while_the_operator_acts():
+    presses = ([0.0, 0.1, 0.2, 1.0], [0.0, 1.0, 0.0, 0.0])  # pressed from 0.1 s to 0.2 s
+    phases, rows = [], []
+    bank, context, _ = simulate(0.095, active=presses, lock=True)
+    phases.append(bank.get_phase_output_port().Eval(context)[0])
+    for seconds in (0.135, 0.195):
+        bank, context, _ = simulate(seconds, active=presses, lock=True)
+        phases.append(bank.get_phase_output_port().Eval(context)[0])
+        rows.append(bank.get_references_output_port().Eval(context).reshape(K, 13))
+    bank, context, _ = simulate(0.255, active=presses, lock=True)
+    after = bank.get_phase_output_port().Eval(context)[0]
+    assert phases[0] == phases[1] == phases[2]  # frozen from the press on
+    assert after < phases[2]  # running again after the release
+    for references in rows:
+        # Every DMP sits at the hand's pose and moves with its twist, both parts.
+        np.testing.assert_allclose(references[:, :3], np.tile(ROBOT[:3], (K, 1)), atol=1e-15)
+        assert all(quaternion.angle_between(row[3:7], ROBOT_ORIENTATION) < 1e-12
+                   for row in references)
+        np.testing.assert_allclose(references[:, 7:], np.tile(ROBOT[7:], (K, 1)), atol=1e-15)
+
+
+def test_a_goal_whose_quaternion_is_not_unit_is_refused_by_name():
+    _, _, goals = make_banks()
+    goals[3, 3:] *= 1.5
+    with pytest.raises(ValueError, match="goal_poses orientation is not a unit quaternion"):
+        simulate(0.02, goals=goals)
+
+
+def test_a_nan_hand_twist_is_refused_with_its_field_named():
+    robot = ROBOT.copy()
+    robot[11] = np.nan
+    with pytest.raises(ValueError, match="robot_state wy is NaN or infinite"):
+        simulate(0.02, robot=robot)
+
+
+def test_banks_with_different_phases_are_refused():
+    positions, _, _ = make_banks()
+    slower = OrientationDmpBank.straight(quaternion.IDENTITY, K, 2.0, SETTINGS)
+    with pytest.raises(ValueError, match="share one phase"):
+        PoseDmpBank(positions, slower, DT)
+
+
+def test_a_hand_quaternion_that_is_not_unit_is_refused_by_name():
+    robot = ROBOT.copy()
+    robot[3:7] *= 1.01
+    with pytest.raises(ValueError, match="robot_state orientation is not a unit quaternion"):
+        simulate(0.02, robot=robot)
+
+
+def test_a_cloned_context_steps_as_the_original():
+    """The state and the scratch (a cache entry, deep-copied with the Context) are the
+    Context's: a clone stepped in between the original's steps gives the same numbers."""
+    positions, orientations, goals = make_banks()
+    builder = DiagramBuilder()
+    bank = builder.AddSystem(PoseDmpBank(positions, orientations, DT))
+    state = builder.AddSystem(ConstantVectorSource(ROBOT))
+    source = builder.AddSystem(GoalsSource(goals))
+    builder.Connect(state.get_output_port(), bank.get_robot_state_input_port())
+    builder.Connect(source.get_output_port(), bank.get_goal_poses_input_port())
+    diagram = builder.Build()
+    first = Simulator(diagram)
+    first.AdvanceTo(0.05)
+    second = Simulator(diagram, first.get_context().Clone())
+    for seconds in (0.1, 0.15):
+        first.AdvanceTo(seconds)
+        second.AdvanceTo(seconds)
+        rows = [bank.get_references_output_port().Eval(
+            bank.GetMyContextFromRoot(simulator.get_context())) for simulator in (first, second)]
+        np.testing.assert_array_equal(rows[0], rows[1])

@@ -298,7 +298,8 @@ def test_a_participant_session_runs_every_method_in_a_counterbalanced_order(tmp_
     path = write(tmp_path, FIXED_TASK)
     output = tmp_path / "P1"
     assert main(["run", str(path), "--operator", "virtual", "--headless", "--participant",
-                 "P1", "--methods", "pbp_alternated,teleop", "--output", str(output)]) == 0
+                 "P1", "--methods", "pbp_alternated,teleop", "--answers", "tiredness=3,ease=4",
+                 "--output", str(output)]) == 0
     study = json.loads((output / "study.json").read_text())
     assert study["methods"] == ["teleop", "pbp_alternated"]
     summary = json.loads((output / "summary.json").read_text())

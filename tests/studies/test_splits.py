@@ -28,10 +28,12 @@ def test_seeds_below_the_tuning_seeds_are_in_no_split():
 
 
 def test_the_results_table_opens_with_the_seeds_and_their_split():
-    summary = {"seeds": [10_000, 10_029], "split": "evaluation", "methods": {}}
+    summary = {"seeds": [10_000, 10_029], "split": "evaluation", "methods": {},
+               "measures_collisions": False}
     table = results_table(summary)
     assert table.startswith("Seeds 10000 to 10029: evaluation seeds: no tuning of the "
                             "virtual participant has seen these scenes.\n")
     # A folder written before splits were recorded says nothing of them.
     assert seeds_line({"methods": {}}) == ""
-    assert results_table({"methods": {}}).startswith("| method |")
+    assert results_table({"methods": {}, "measures_collisions": False}).startswith(
+        "| method |")

@@ -2,6 +2,7 @@
 position, velocity and acceleration limits, and the desired state the plant's PD tracks."""
 
 import numpy as np
+from numpy.linalg import _umath_linalg
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
@@ -20,6 +21,16 @@ ROTATION_WEIGHT = 0.1
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
 CATCH_UP_STEPS = 3
+# The identity of each size solve_box_qp has met: np.eye costs as much as a solve here.
+_IDENTITIES = {}
+
+
+def _solve_linear(a, b):
+    """``np.linalg.solve(a, b)`` for a square ``a`` and a vector ``b``, the same LAPACK
+    call (numpy's gufunc) without the wrapper's checks and error-state context, which cost
+    more than the solve itself at a robot's size and run a few times every diff IK step. A
+    singular ``a`` gives non-finite entries instead of LinAlgError: the caller checks."""
+    return _umath_linalg.solve1(a, b, signature="dd->d")
 
 
 def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
@@ -32,14 +43,16 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     minimum. Returns the minimizer and which variables it holds at a bound.
     """
     n = g.size
-    identity = np.eye(n)
+    identity = _IDENTITIES.get(n)
+    if identity is None:
+        identity = _IDENTITIES[n] = np.eye(n)
     hold = np.zeros(n) if hold is None else np.asarray(hold)
     fixed = (hold != 0) | (lower == upper)
     x = np.clip(np.where(hold < 0, lower, np.where(hold > 0, upper, 0.0)), lower, upper)
     tolerance = 1e-12 * (1.0 + np.abs(g).max())
     for iteration in range(max_iterations):
         # The minimum over the free variables, the held ones where they are.
-        target = np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
+        target = _solve_linear(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
         target[fixed] = x[fixed]
         below, above = ~fixed & (target < lower), ~fixed & (target > upper)
         outside = below | above
@@ -68,6 +81,9 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
         leaving = fixed & (lower < upper) & (((x <= lower) & (gradient < -tolerance))
                                              | ((x >= upper) & (gradient > tolerance)))
         if not leaving.any():
+            if not np.isfinite(x).all():  # a singular system: raise as numpy does
+                np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
+                raise np.linalg.LinAlgError("solve_box_qp met a singular system")
             return x, np.where(fixed & (x <= lower), -1.0,
                                np.where(fixed & (x >= upper), 1.0, 0.0))
         if iteration < 2 * n:

@@ -25,6 +25,11 @@ class TaskCounts:
     colliding_steps: int = 0  # of which the robot was in collision
     success: bool = False
 
+    def __deepcopy__(self, memo):
+        # Drake clones abstract state twice a tick (pydrake clones a Python value with
+        # copy.deepcopy); an immutable value of whole numbers is its own copy.
+        return self
+
 
 class TaskMonitor(LeafSystem):
     """Switches the target at the progress schedule, keeps the task's metrics, and ends the

@@ -3,7 +3,6 @@
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform, RotationMatrix
-from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.layouts import EeCommand, EeState
@@ -103,44 +102,49 @@ class EeCommandToPose(LeafSystem):
 
 
 class EeStateFromPlant(LeafSystem):
-    """Reads the end effector's position, velocity and heading off the plant's outputs.
+    """Reads the end effector's position, velocity and heading off the plant's state.
 
     .. pydrake_system::
 
         name: EeStateFromPlant
         input_ports:
-        - body_poses
-        - body_spatial_velocities
+        - plant_state
         output_ports:
         - ee_state
 
-    `ee_state` is `[p_WE (3), v_WE (3), heading, heading_rate]` (`EeState`); heading_rate
-    is the hand's angular velocity about world z (the rate of the heading while the hand's
-    z axis stays near the floor plane).
+    `plant_state` is `plant`'s state output; `ee_state` is `[p_WE (3), v_WE (3), heading,
+    heading_rate]` (`EeState`) of `ee_body`; heading_rate is the hand's angular velocity
+    about world z (the rate of the heading while the hand's z axis stays near the floor
+    plane).
+
+    The hand's kinematics come from a context of `plant` of this system's own, set to the
+    plant's state: the same computation as the plant's `body_poses` and
+    `body_spatial_velocities` outputs, whose values would cross into Python as a list of
+    every body's pose and velocity (about half this system's time) for one body's.
     """
 
-    def __init__(self, ee_body_index):
+    def __init__(self, plant, ee_body):
         super().__init__()
-        self._index = int(ee_body_index)
-        self._poses_port = self.DeclareAbstractInputPort(
-            "body_poses", AbstractValue.Make([RigidTransform()]))
-        self._velocities_port = self.DeclareAbstractInputPort(
-            "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()]))
+        self._plant = plant
+        self._body = ee_body
+        self._plant_context = plant.CreateDefaultContext()
+        self._plant_state_port = self.DeclareVectorInputPort(
+            "plant_state", plant.num_multibody_states())
         self._state_port = self.DeclareVectorOutputPort(
             "ee_state", EeState.size, self._calc_state)
 
-    def get_body_poses_input_port(self):
-        return self._poses_port
-
-    def get_body_spatial_velocities_input_port(self):
-        return self._velocities_port
+    def get_plant_state_input_port(self):
+        return self._plant_state_port
 
     def get_ee_state_output_port(self):
         return self._state_port
 
     def _calc_state(self, context, output):
-        X_WE = self._poses_port.Eval(context)[self._index]
-        V_WE = self._velocities_port.Eval(context)[self._index]
+        plant_context = self._plant_context
+        self._plant.SetPositionsAndVelocities(plant_context,
+                                              self._plant_state_port.Eval(context))
+        X_WE = self._body.EvalPoseInWorld(plant_context)
+        V_WE = self._body.EvalSpatialVelocityInWorld(plant_context)
         w, v = V_WE.rotational(), V_WE.translational()
         output.SetFromVector(np.concatenate(
             [X_WE.translation(), v, [heading_of(X_WE.rotation()), w[2]]]))

@@ -209,10 +209,8 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
                     plant.get_desired_state_input_port(model))
 
     ee_body = plant.GetFrameByName(END_EFFECTOR_FRAME, model).body()
-    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(ee_body.index()))
-    builder.Connect(plant.get_body_poses_output_port(), ee_state.get_body_poses_input_port())
-    builder.Connect(plant.get_body_spatial_velocities_output_port(),
-                    ee_state.get_body_spatial_velocities_input_port())
+    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, ee_body))
+    builder.Connect(plant.get_state_output_port(), ee_state.get_plant_state_input_port())
 
     builder.ExportInput(command_to_pose.get_ee_command_input_port(), "ee_command")
     builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")

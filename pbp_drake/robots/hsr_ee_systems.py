@@ -8,6 +8,9 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.systems.layouts import EeCommand, EeState
 from pbp_drake.systems.tick import decide_offset
 
+# EeCommand's entries, by index.
+_POSITION, _VELOCITY, _HEADING = slice(0, 3), slice(3, 6), 6
+
 
 def heading_of(R_WE: RotationMatrix) -> float:
     """The direction the hand points in the floor plane: atan2 of its z axis' (x, y)."""
@@ -75,30 +78,32 @@ class EeCommandToPose(LeafSystem):
         discrete_state.set_value(self._last_heading,
                                  [EeCommand(self._command_port.Eval(context)).heading])
 
-    def _heading_rate(self, context, command):
+    # The diff IK reads both outputs every step (100 Hz): they index the command vector
+    # (EeCommand's layout) rather than build a named view of it each time.
+    def _heading_rate(self, context, heading):
         if not self._period:
             return 0.0
         last = context.get_discrete_state(self._last_heading).get_value()[0]
-        turn = (command.heading - last + np.pi) % (2 * np.pi) - np.pi
+        turn = (heading - last + np.pi) % (2 * np.pi) - np.pi
         return turn / self._period
 
     def _calc_velocity(self, context, output):
-        command = EeCommand(self._command_port.Eval(context))
-        output.SetFromVector([0.0, 0.0, self._heading_rate(context, command),
-                              command.vx, command.vy, command.vz])
+        command = self._command_port.Eval(context)
+        velocity = output.get_mutable_value()
+        velocity[:2] = 0.0
+        velocity[2] = self._heading_rate(context, command[_HEADING])
+        velocity[3:] = command[_VELOCITY]
 
     def _calc_pose(self, context, output):
-        command = EeCommand(self._command_port.Eval(context))
-        position = np.array([command.x, command.y, command.z])
-        velocity = np.array([command.vx, command.vy, command.vz])
+        command = self._command_port.Eval(context)
         ahead = self._lead
         if self._period:
             time = context.get_time()
             next_tick = np.ceil(time / self._period - 1e-9) * self._period
             ahead -= max(0.0, next_tick - time)
-        heading = command.heading + self._heading_rate(context, command) * ahead
+        heading = command[_HEADING] + self._heading_rate(context, command[_HEADING]) * ahead
         R = RotationMatrix.MakeZRotation(heading) @ self._R_E0
-        output.set_value(RigidTransform(R, position + velocity * ahead))
+        output.set_value(RigidTransform(R, command[_POSITION] + command[_VELOCITY] * ahead))
 
 
 class EeStateFromPlant(LeafSystem):

@@ -160,6 +160,7 @@ class WholeBodyDiffIk(LeafSystem):
         self._task_weights = TASK_WEIGHT * np.array([ROTATION_WEIGHT] * 3 + [1.0] * 3)
         self._world = plant.world_frame()
         self._origin = np.zeros(3)
+        self._motor_count = len(motor_joints)
         self._q_output = self._position_indices
         self._v_output = nq + self._velocity_indices
         self._pose_port = self.DeclareAbstractInputPort(
@@ -236,7 +237,11 @@ class WholeBodyDiffIk(LeafSystem):
         return solve_box_qp(H, g, lower, upper, hold)
 
     def _calc_desired_state(self, context, output):
+        # Evaluated at every plant step: written into the output in place.
         plan = context.get_discrete_state(self._plan).get_value()
-        v_d = plan[self._v_output]
+        desired = output.get_mutable_value()
+        q_d, v_d = desired[:self._motor_count], desired[self._motor_count:]
+        v_d[:] = plan[self._v_output]
         ahead = context.get_time() + self._look_ahead - plan[2 * self._nq]
-        output.SetFromVector(np.concatenate([plan[self._q_output] + ahead * v_d, v_d]))
+        np.multiply(ahead, v_d, out=q_d)
+        q_d += plan[self._q_output]

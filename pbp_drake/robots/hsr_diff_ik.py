@@ -155,6 +155,10 @@ class WholeBodyDiffIk(LeafSystem):
         self._a_lower, self._a_upper = (np.asarray(bound, float)
                                         for bound in acceleration_limits)
         self._q_nominal = np.asarray(q_nominal, float)
+        # Per-step constants, computed once (the same products the step would compute).
+        self._catch_up_time = CATCH_UP_STEPS * self._time_step
+        self._a_lower_step = self._a_lower * self._time_step
+        self._a_upper_step = self._a_upper * self._time_step
         self._centering_gain = np.broadcast_to(np.asarray(centering_gain, float), (nq,))
         self._identity = np.eye(nv)
         self._task_weights = TASK_WEIGHT * np.array([ROTATION_WEIGHT] * 3 + [1.0] * 3)
@@ -200,9 +204,12 @@ class WholeBodyDiffIk(LeafSystem):
         q, v, hold = plan[:n], plan[n:2 * n], plan[2 * n + 1:]
         v_next, hold = self._solve(q, v, self._pose_port.Eval(context),
                                    self._twist_port.Eval(context), hold)
-        q_next = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
-        discrete_state.set_value(
-            np.concatenate([q_next, v_next, [context.get_time() + dt], hold]))
+        # Written into the new plan in place (this runs at 100 Hz).
+        new_plan = discrete_state.get_mutable_value()
+        new_plan[:n] = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
+        new_plan[n:2 * n] = v_next
+        new_plan[2 * n] = context.get_time() + dt
+        new_plan[2 * n + 1:] = hold
 
     def _solve(self, q, v, X_WE_desired, V_WE_desired, hold):
         """The velocity for the next step, and which velocities it holds at a bound."""
@@ -214,7 +221,7 @@ class WholeBodyDiffIk(LeafSystem):
         rotation = (X_WE_desired.rotation() @ X_WE.rotation().inverse()).ToAngleAxis()
         gap = np.concatenate([rotation.axis() * rotation.angle(),
                               X_WE_desired.translation() - X_WE.translation()])
-        twist = V_WE_desired + (gap - dt * V_WE_desired) / (CATCH_UP_STEPS * dt)
+        twist = V_WE_desired + (gap - dt * V_WE_desired) / self._catch_up_time
         # The cost |J v - twist|² in the task weights D, with its part along the twist
         # weighing ALONG_WEIGHT of the rest: W = D - (1 - ALONG_WEIGHT) D t t' D / t'D t.
         JD = J.T * self._task_weights
@@ -223,12 +230,12 @@ class WholeBodyDiffIk(LeafSystem):
         g = self._centering_gain * (self._q_nominal - q)
         norm = twist @ (self._task_weights * twist)
         if norm > 0:
-            H -= (1.0 - ALONG_WEIGHT) / norm * np.outer(JDt, JDt)
+            H -= (1.0 - ALONG_WEIGHT) / norm * (JDt[:, None] * JDt)  # np.outer's product
             g += ALONG_WEIGHT * JDt
         # Within the velocity limits, the acceleration limits from v, and the position
         # limits by the end of the step; where the last two conflict, brake.
-        accel_lower = v + self._a_lower * dt
-        accel_upper = v + self._a_upper * dt
+        accel_lower = v + self._a_lower_step
+        accel_upper = v + self._a_upper_step
         lower = np.maximum(np.maximum(self._v_lower, accel_lower), (self._q_lower - q) / dt)
         upper = np.minimum(np.minimum(self._v_upper, accel_upper), (self._q_upper - q) / dt)
         conflict = lower > upper

@@ -50,11 +50,13 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     fixed = (hold != 0) | (lower == upper)
     x = np.clip(np.where(hold < 0, lower, np.where(hold > 0, upper, 0.0)), lower, upper)
     tolerance = 1e-12 * (1.0 + np.abs(g).max())
+    movable = lower < upper
     for iteration in range(max_iterations):
         # The minimum over the free variables, the held ones where they are.
         target = _solve_linear(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
-        target[fixed] = x[fixed]
-        below, above = ~fixed & (target < lower), ~fixed & (target > upper)
+        np.copyto(target, x, where=fixed)
+        free = ~fixed
+        below, above = free & (target < lower), free & (target > upper)
         outside = below | above
         if outside.any():
             if iteration == 0:
@@ -78,8 +80,8 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
         # Held variables whose bound the cost pulls away from are let go: all at once,
         # or the one pulled hardest once that has taken long (which always ends).
         gradient = H @ x - g
-        leaving = fixed & (lower < upper) & (((x <= lower) & (gradient < -tolerance))
-                                             | ((x >= upper) & (gradient > tolerance)))
+        leaving = fixed & movable & (((x <= lower) & (gradient < -tolerance))
+                                     | ((x >= upper) & (gradient > tolerance)))
         if not leaving.any():
             if not np.isfinite(x).all():  # a singular system: raise as numpy does
                 np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))

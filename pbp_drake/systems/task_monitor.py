@@ -32,6 +32,7 @@ class TaskCounts:
 
 
 _COUNTS_SIZE = len(dataclasses.fields(TaskCounts))
+_STAGE, _SUCCESS = 0, 4  # where TaskCounts' stage and success sit in the counts vector
 
 
 class TaskMonitor(LeafSystem):
@@ -128,10 +129,14 @@ class TaskMonitor(LeafSystem):
 
     def counts(self, context):
         """The `TaskCounts` held in this system's `context`."""
-        return TaskCounts.of_vector(context.get_discrete_state(self._counts_index).value())
+        return TaskCounts.of_vector(self._count_vector(context))
+
+    def _count_vector(self, context):
+        return context.get_discrete_state(self._counts_index).value()
 
     def _calc_target(self, context, output):
-        index = self._targets[self.counts(context).stage]
+        # Once a tick each, this and the end-of-tick check read one count, not all five.
+        index = self._targets[int(self._count_vector(context)[_STAGE])]
         target = Target(np.empty(Target.size))
         target.x, target.y, target.z = self._objects[index]
         target.index = index
@@ -176,6 +181,6 @@ class TaskMonitor(LeafSystem):
         return EventStatus.Succeeded()
 
     def _end_at_success(self, context):
-        if self.counts(context).success:
+        if self._count_vector(context)[_SUCCESS] > 0.5:
             return EventStatus.ReachedTermination(self, SUCCESS_MESSAGE)
         return EventStatus.DidNothing()

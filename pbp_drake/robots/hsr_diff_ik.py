@@ -8,6 +8,8 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.layouts import EeCommand
+
 # How much more a unit of the hand's velocity error (m/s) weighs than a unit of the joints'
 # drift toward their nominal positions (m/s, rad/s): the drift takes what the hand's motion
 # leaves free and costs the hand nothing measurable.
@@ -103,8 +105,9 @@ class WholeBodyDiffIk(LeafSystem):
 
         name: WholeBodyDiffIk
         input_ports:
-        - X_WE_desired
-        - V_WE_desired
+        - X_WE_desired (without command_ramp)
+        - V_WE_desired (without command_ramp)
+        - ee_command (with command_ramp)
         - robot_state
         output_ports:
         - desired_state
@@ -135,11 +138,17 @@ class WholeBodyDiffIk(LeafSystem):
 
     Limits are pairs (lower, upper) of arrays over the plant's velocities (positions for
     ``position_limits``); ``inf`` where there is none. The plant must have q̇ = v.
+
+    With a ``command_ramp`` (``EeCommandRamp``) it reads the end-effector command
+    ``ee_command`` instead and makes ``X_WE_desired`` and ``V_WE_desired`` from it itself,
+    as an ``EeCommandToPose`` in front of it would (the same arithmetic, its last-heading
+    state and sampling events declared here): the station does so, which spares two
+    Python calls at each step.
     """
 
     def __init__(self, plant, frame_E, time_step, plant_time_step, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
-                 centering_gain):
+                 centering_gain, command_ramp=None):
         super().__init__()
         nq, nv = plant.num_positions(), plant.num_velocities()
         if nq != nv:
@@ -169,9 +178,14 @@ class WholeBodyDiffIk(LeafSystem):
         self._motor_count = len(motor_joints)
         self._q_output = self._position_indices
         self._v_output = nq + self._velocity_indices
-        self._pose_port = self.DeclareAbstractInputPort(
-            "X_WE_desired", AbstractValue.Make(RigidTransform()))
-        self._twist_port = self.DeclareVectorInputPort("V_WE_desired", 6)
+        self._ramp = command_ramp
+        self._pose_port = self._twist_port = self._command_port = None
+        if command_ramp is None:
+            self._pose_port = self.DeclareAbstractInputPort(
+                "X_WE_desired", AbstractValue.Make(RigidTransform()))
+            self._twist_port = self.DeclareVectorInputPort("V_WE_desired", 6)
+        else:
+            self._command_port = self.DeclareVectorInputPort("ee_command", EeCommand.size)
         self._robot_state_port = self.DeclareVectorInputPort(
             "robot_state", plant.num_multibody_states())
         # [q at t_end, v, t_end, hold]: the plan reaches q at t_end moving at v; hold is
@@ -179,6 +193,9 @@ class WholeBodyDiffIk(LeafSystem):
         self._plan = self.DeclareDiscreteState(nq + 2 * nv + 1)
         self.DeclarePeriodicDiscreteUpdateEvent(self._time_step, 0.0, self._step)
         self.DeclareInitializationDiscreteUpdateEvent(self._start)
+        if command_ramp is not None:
+            self._last_heading = command_ramp.declare_heading_sample(self,
+                                                                     self._command_port)
         self._desired_port = self.DeclareVectorOutputPort(
             "desired_state", 2 * len(motor_joints), self._calc_desired_state,
             {self.time_ticket(), self.xd_ticket()})
@@ -189,6 +206,9 @@ class WholeBodyDiffIk(LeafSystem):
     def get_V_WE_desired_input_port(self):
         return self._twist_port
 
+    def get_ee_command_input_port(self):
+        return self._command_port
+
     def get_robot_state_input_port(self):
         return self._robot_state_port
 
@@ -197,21 +217,29 @@ class WholeBodyDiffIk(LeafSystem):
 
     def _start(self, context, discrete_state):
         q = self._robot_state_port.Eval(context)[:self._nq]
-        discrete_state.set_value(np.concatenate([q, np.zeros(self._nq),
-                                                 [context.get_time()], np.zeros(self._nq)]))
+        discrete_state.set_value(self._plan, np.concatenate(
+            [q, np.zeros(self._nq), [context.get_time()], np.zeros(self._nq)]))
 
     def _step(self, context, discrete_state):
         plan = context.get_discrete_state(self._plan).get_value()
         n, dt = self._nq, self._time_step
         q, v, hold = plan[:n], plan[n:2 * n], plan[2 * n + 1:]
-        v_next, hold = self._solve(q, v, self._pose_port.Eval(context),
-                                   self._twist_port.Eval(context), hold)
+        v_next, hold = self._solve(q, v, *self._desired(context), hold)
         # Written into the new plan in place (this runs at 100 Hz).
-        new_plan = discrete_state.get_mutable_value()
+        new_plan = discrete_state.get_mutable_value(self._plan)
         new_plan[:n] = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
         new_plan[n:2 * n] = v_next
         new_plan[2 * n] = context.get_time() + dt
         new_plan[2 * n + 1:] = hold
+
+    def _desired(self, context):
+        """`(X_WE_desired, V_WE_desired)` now: from the ports, or from the command."""
+        if self._ramp is None:
+            return self._pose_port.Eval(context), self._twist_port.Eval(context)
+        command = self._command_port.Eval(context)
+        rate = self._ramp.heading_rate(context, self._last_heading, command)
+        return (self._ramp.pose(command, rate, context.get_time()),
+                self._ramp.velocity_into(command, rate, np.empty(6)))
 
     def _solve(self, q, v, X_WE_desired, V_WE_desired, hold):
         """The velocity for the next step, and which velocities it holds at a bound."""

@@ -1,4 +1,5 @@
-"""The HSR station's two task-space adapters: the end-effector command in, its state out."""
+"""The HSR station's task-space adapters: the end-effector command in (as a system, or as
+the arithmetic the station's diff IK applies itself), its state out."""
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -51,15 +52,9 @@ class EeCommandToPose(LeafSystem):
 
     def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
         super().__init__()
-        self._R_E0 = RotationMatrix(R_E0)
-        self._period = command_period
-        self._lead = float(lead)
+        self._ramp = EeCommandRamp(R_E0, command_period, lead)
         self._command_port = self.DeclareVectorInputPort("ee_command", EeCommand.size)
-        self._last_heading = self.DeclareDiscreteState(1)
-        self.DeclareInitializationDiscreteUpdateEvent(self._sample_heading)
-        if command_period:
-            self.DeclarePeriodicDiscreteUpdateEvent(
-                command_period, 0.5 * decide_offset(command_period), self._sample_heading)
+        self._last_heading = self._ramp.declare_heading_sample(self, self._command_port)
         self._pose_port = self.DeclareAbstractOutputPort(
             "X_WE_desired", lambda: AbstractValue.Make(RigidTransform()), self._calc_pose)
         self._velocity_port = self.DeclareVectorOutputPort(
@@ -74,36 +69,68 @@ class EeCommandToPose(LeafSystem):
     def get_velocity_output_port(self):
         return self._velocity_port
 
-    def _sample_heading(self, context, discrete_state):
-        discrete_state.set_value(self._last_heading,
-                                 [EeCommand(self._command_port.Eval(context)).heading])
-
-    # The diff IK reads both outputs every step (100 Hz): they index the command vector
-    # (EeCommand's layout) rather than build a named view of it each time.
-    def _heading_rate(self, context, heading):
-        if not self._period:
-            return 0.0
-        last = context.get_discrete_state(self._last_heading).get_value()[0]
-        turn = (heading - last + np.pi) % (2 * np.pi) - np.pi
-        return turn / self._period
-
     def _calc_velocity(self, context, output):
         command = self._command_port.Eval(context)
-        velocity = output.get_mutable_value()
-        velocity[:2] = 0.0
-        velocity[2] = self._heading_rate(context, command[_HEADING])
-        velocity[3:] = command[_VELOCITY]
+        rate = self._ramp.heading_rate(context, self._last_heading, command)
+        self._ramp.velocity_into(command, rate, output.get_mutable_value())
 
     def _calc_pose(self, context, output):
         command = self._command_port.Eval(context)
-        ahead = self._lead
-        if self._period:
-            time = context.get_time()
-            next_tick = np.ceil(time / self._period - 1e-9) * self._period
+        rate = self._ramp.heading_rate(context, self._last_heading, command)
+        output.set_value(self._ramp.pose(command, rate, context.get_time()))
+
+
+class EeCommandRamp:
+    """`EeCommandToPose`'s arithmetic, for it and for a system that reads the command
+    itself: the station's diff IK (`WholeBodyDiffIk` with a `command_ramp`), which thus
+    needs no system between the command and itself (two Python calls fewer at each of its
+    steps). See `EeCommandToPose` for what the pose and velocity are."""
+
+    def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
+        self.R_E0 = RotationMatrix(R_E0)
+        self.period = command_period
+        self.lead = float(lead)
+
+    def declare_heading_sample(self, system, command_port):
+        """Declares on `system` the last tick's heading (a discrete state of one entry,
+        whose index it returns) and the events that sample it from `command_port`: at
+        initialization and, with a command period, just after each tick."""
+        index = system.DeclareDiscreteState(1)
+
+        def sample(context, discrete_state):
+            discrete_state.set_value(index, [command_port.Eval(context)[_HEADING]])
+
+        system.DeclareInitializationDiscreteUpdateEvent(sample)
+        if self.period:
+            system.DeclarePeriodicDiscreteUpdateEvent(
+                self.period, 0.5 * decide_offset(self.period), sample)
+        return index
+
+    def heading_rate(self, context, last_heading_index, command):
+        """The heading's rate (rad/s) from the last tick's heading (in `context`'s discrete
+        state `last_heading_index`) into the command's over a period; 0 without one."""
+        if not self.period:
+            return 0.0
+        last = context.get_discrete_state(last_heading_index).get_value()[0]
+        turn = (command[_HEADING] - last + np.pi) % (2 * np.pi) - np.pi
+        return turn / self.period
+
+    def velocity_into(self, command, heading_rate, velocity):
+        """Writes `V_WE_desired` `[w, v]` into `velocity` (6,) and returns it."""
+        velocity[:2] = 0.0
+        velocity[2] = heading_rate
+        velocity[3:] = command[_VELOCITY]
+        return velocity
+
+    def pose(self, command, heading_rate, time):
+        """`X_WE_desired` at `time`."""
+        ahead = self.lead
+        if self.period:
+            next_tick = np.ceil(time / self.period - 1e-9) * self.period
             ahead -= max(0.0, next_tick - time)
-        heading = command[_HEADING] + self._heading_rate(context, command[_HEADING]) * ahead
-        R = RotationMatrix.MakeZRotation(heading) @ self._R_E0
-        output.set_value(RigidTransform(R, command[_POSITION] + command[_VELOCITY] * ahead))
+        heading = command[_HEADING] + heading_rate * ahead
+        R = RotationMatrix.MakeZRotation(heading) @ self.R_E0
+        return RigidTransform(R, command[_POSITION] + command[_VELOCITY] * ahead)
 
 
 class EeStateFromPlant(LeafSystem):

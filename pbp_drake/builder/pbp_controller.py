@@ -18,12 +18,11 @@ station.
 """
 
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import Multiplexer
+from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from pbp_drake.systems import (
     Blender, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand)
 from pbp_drake.systems.layouts import EeState, OperatorCommand
-from pbp_drake.systems.vector_split import VectorSplit
 
 # How far ahead the HSR scene draws the DMPs' paths, in samples over the DMP's duration.
 HSR_PREDICTION_SAMPLES = 40
@@ -56,7 +55,12 @@ def make_pbp_controller(resolved, prediction_steps=0):
     bank = resolved.dmp_bank
     builder = DiagramBuilder()
 
-    split = builder.AddNamedSystem("ee_state_split", VectorSplit([6, EeState.size - 6]))
+    # Drake's (C++) Demultiplexers: their outputs depend on every source, time included,
+    # but everything downstream reads them once a tick (the DMP bank's and the estimator's
+    # updates, and the blender only through the hand-over's update), so nothing recomputes
+    # between ticks, and two Python calls a tick go (`VectorSplit` was for the blender's
+    # command fed to the station directly, before the hand-over held it).
+    split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, EeState.size - 6]))
     builder.ExportInput(split.get_input_port(), "ee_state")
     position_velocity = split.get_output_port(0)
     goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
@@ -79,7 +83,7 @@ def make_pbp_controller(resolved, prediction_steps=0):
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
 
-    command_split = builder.AddNamedSystem("operator_command_split", VectorSplit(
+    command_split = builder.AddNamedSystem("operator_command_split", Demultiplexer(
         [3, OperatorCommand.size - 3]))
     builder.ExportInput(command_split.get_input_port(), "operator_command")
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(

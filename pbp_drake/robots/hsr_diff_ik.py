@@ -2,10 +2,13 @@
 position, velocity and acceleration limits, and the desired state the plant's PD tracks."""
 
 import numpy as np
+from numpy.linalg import _umath_linalg
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.systems.layouts import EeCommand
 
 # How much more a unit of the hand's velocity error (m/s) weighs than a unit of the joints'
 # drift toward their nominal positions (m/s, rad/s): the drift takes what the hand's motion
@@ -20,6 +23,16 @@ ROTATION_WEIGHT = 0.1
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
 CATCH_UP_STEPS = 3
+# The identity of each size solve_box_qp has met: np.eye costs as much as a solve here.
+_IDENTITIES = {}
+
+
+def _solve_linear(a, b):
+    """``np.linalg.solve(a, b)`` for a square ``a`` and a vector ``b``, the same LAPACK
+    call (numpy's gufunc) without the wrapper's checks and error-state context, which cost
+    more than the solve itself at a robot's size and run a few times every diff IK step. A
+    singular ``a`` gives non-finite entries instead of LinAlgError: the caller checks."""
+    return _umath_linalg.solve1(a, b, signature="dd->d")
 
 
 def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
@@ -32,16 +45,20 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     minimum. Returns the minimizer and which variables it holds at a bound.
     """
     n = g.size
-    identity = np.eye(n)
+    identity = _IDENTITIES.get(n)
+    if identity is None:
+        identity = _IDENTITIES[n] = np.eye(n)
     hold = np.zeros(n) if hold is None else np.asarray(hold)
     fixed = (hold != 0) | (lower == upper)
     x = np.clip(np.where(hold < 0, lower, np.where(hold > 0, upper, 0.0)), lower, upper)
     tolerance = 1e-12 * (1.0 + np.abs(g).max())
+    movable = lower < upper
     for iteration in range(max_iterations):
         # The minimum over the free variables, the held ones where they are.
-        target = np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
-        target[fixed] = x[fixed]
-        below, above = ~fixed & (target < lower), ~fixed & (target > upper)
+        target = _solve_linear(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
+        np.copyto(target, x, where=fixed)
+        free = ~fixed
+        below, above = free & (target < lower), free & (target > upper)
         outside = below | above
         if outside.any():
             if iteration == 0:
@@ -65,9 +82,12 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
         # Held variables whose bound the cost pulls away from are let go: all at once,
         # or the one pulled hardest once that has taken long (which always ends).
         gradient = H @ x - g
-        leaving = fixed & (lower < upper) & (((x <= lower) & (gradient < -tolerance))
-                                             | ((x >= upper) & (gradient > tolerance)))
+        leaving = fixed & movable & (((x <= lower) & (gradient < -tolerance))
+                                     | ((x >= upper) & (gradient > tolerance)))
         if not leaving.any():
+            if not np.isfinite(x).all():  # a singular system: raise as numpy does
+                np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
+                raise np.linalg.LinAlgError("solve_box_qp met a singular system")
             return x, np.where(fixed & (x <= lower), -1.0,
                                np.where(fixed & (x >= upper), 1.0, 0.0))
         if iteration < 2 * n:
@@ -85,8 +105,9 @@ class WholeBodyDiffIk(LeafSystem):
 
         name: WholeBodyDiffIk
         input_ports:
-        - X_WE_desired
-        - V_WE_desired
+        - X_WE_desired (without command_ramp)
+        - V_WE_desired (without command_ramp)
+        - ee_command (with command_ramp)
         - robot_state
         output_ports:
         - desired_state
@@ -117,11 +138,17 @@ class WholeBodyDiffIk(LeafSystem):
 
     Limits are pairs (lower, upper) of arrays over the plant's velocities (positions for
     ``position_limits``); ``inf`` where there is none. The plant must have q̇ = v.
+
+    With a ``command_ramp`` (``EeCommandRamp``) it reads the end-effector command
+    ``ee_command`` instead and makes ``X_WE_desired`` and ``V_WE_desired`` from it itself,
+    as an ``EeCommandToPose`` in front of it would (the same arithmetic, its last-heading
+    state and sampling events declared here): the station does so, which spares two
+    Python calls at each step.
     """
 
     def __init__(self, plant, frame_E, time_step, plant_time_step, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
-                 centering_gain):
+                 centering_gain, command_ramp=None):
         super().__init__()
         nq, nv = plant.num_positions(), plant.num_velocities()
         if nq != nv:
@@ -139,16 +166,26 @@ class WholeBodyDiffIk(LeafSystem):
         self._a_lower, self._a_upper = (np.asarray(bound, float)
                                         for bound in acceleration_limits)
         self._q_nominal = np.asarray(q_nominal, float)
+        # Per-step constants, computed once (the same products the step would compute).
+        self._catch_up_time = CATCH_UP_STEPS * self._time_step
+        self._a_lower_step = self._a_lower * self._time_step
+        self._a_upper_step = self._a_upper * self._time_step
         self._centering_gain = np.broadcast_to(np.asarray(centering_gain, float), (nq,))
         self._identity = np.eye(nv)
         self._task_weights = TASK_WEIGHT * np.array([ROTATION_WEIGHT] * 3 + [1.0] * 3)
         self._world = plant.world_frame()
         self._origin = np.zeros(3)
+        self._motor_count = len(motor_joints)
         self._q_output = self._position_indices
         self._v_output = nq + self._velocity_indices
-        self._pose_port = self.DeclareAbstractInputPort(
-            "X_WE_desired", AbstractValue.Make(RigidTransform()))
-        self._twist_port = self.DeclareVectorInputPort("V_WE_desired", 6)
+        self._ramp = command_ramp
+        self._pose_port = self._twist_port = self._command_port = None
+        if command_ramp is None:
+            self._pose_port = self.DeclareAbstractInputPort(
+                "X_WE_desired", AbstractValue.Make(RigidTransform()))
+            self._twist_port = self.DeclareVectorInputPort("V_WE_desired", 6)
+        else:
+            self._command_port = self.DeclareVectorInputPort("ee_command", EeCommand.size)
         self._robot_state_port = self.DeclareVectorInputPort(
             "robot_state", plant.num_multibody_states())
         # [q at t_end, v, t_end, hold]: the plan reaches q at t_end moving at v; hold is
@@ -156,6 +193,9 @@ class WholeBodyDiffIk(LeafSystem):
         self._plan = self.DeclareDiscreteState(nq + 2 * nv + 1)
         self.DeclarePeriodicDiscreteUpdateEvent(self._time_step, 0.0, self._step)
         self.DeclareInitializationDiscreteUpdateEvent(self._start)
+        if command_ramp is not None:
+            self._last_heading = command_ramp.declare_heading_sample(self,
+                                                                     self._command_port)
         self._desired_port = self.DeclareVectorOutputPort(
             "desired_state", 2 * len(motor_joints), self._calc_desired_state,
             {self.time_ticket(), self.xd_ticket()})
@@ -166,6 +206,9 @@ class WholeBodyDiffIk(LeafSystem):
     def get_V_WE_desired_input_port(self):
         return self._twist_port
 
+    def get_ee_command_input_port(self):
+        return self._command_port
+
     def get_robot_state_input_port(self):
         return self._robot_state_port
 
@@ -174,18 +217,29 @@ class WholeBodyDiffIk(LeafSystem):
 
     def _start(self, context, discrete_state):
         q = self._robot_state_port.Eval(context)[:self._nq]
-        discrete_state.set_value(np.concatenate([q, np.zeros(self._nq),
-                                                 [context.get_time()], np.zeros(self._nq)]))
+        discrete_state.set_value(self._plan, np.concatenate(
+            [q, np.zeros(self._nq), [context.get_time()], np.zeros(self._nq)]))
 
     def _step(self, context, discrete_state):
         plan = context.get_discrete_state(self._plan).get_value()
         n, dt = self._nq, self._time_step
         q, v, hold = plan[:n], plan[n:2 * n], plan[2 * n + 1:]
-        v_next, hold = self._solve(q, v, self._pose_port.Eval(context),
-                                   self._twist_port.Eval(context), hold)
-        q_next = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
-        discrete_state.set_value(
-            np.concatenate([q_next, v_next, [context.get_time() + dt], hold]))
+        v_next, hold = self._solve(q, v, *self._desired(context), hold)
+        # Written into the new plan in place (this runs at 100 Hz).
+        new_plan = discrete_state.get_mutable_value(self._plan)
+        new_plan[:n] = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
+        new_plan[n:2 * n] = v_next
+        new_plan[2 * n] = context.get_time() + dt
+        new_plan[2 * n + 1:] = hold
+
+    def _desired(self, context):
+        """`(X_WE_desired, V_WE_desired)` now: from the ports, or from the command."""
+        if self._ramp is None:
+            return self._pose_port.Eval(context), self._twist_port.Eval(context)
+        command = self._command_port.Eval(context)
+        rate = self._ramp.heading_rate(context, self._last_heading, command)
+        return (self._ramp.pose(command, rate, context.get_time()),
+                self._ramp.velocity_into(command, rate, np.empty(6)))
 
     def _solve(self, q, v, X_WE_desired, V_WE_desired, hold):
         """The velocity for the next step, and which velocities it holds at a bound."""
@@ -197,7 +251,7 @@ class WholeBodyDiffIk(LeafSystem):
         rotation = (X_WE_desired.rotation() @ X_WE.rotation().inverse()).ToAngleAxis()
         gap = np.concatenate([rotation.axis() * rotation.angle(),
                               X_WE_desired.translation() - X_WE.translation()])
-        twist = V_WE_desired + (gap - dt * V_WE_desired) / (CATCH_UP_STEPS * dt)
+        twist = V_WE_desired + (gap - dt * V_WE_desired) / self._catch_up_time
         # The cost |J v - twist|² in the task weights D, with its part along the twist
         # weighing ALONG_WEIGHT of the rest: W = D - (1 - ALONG_WEIGHT) D t t' D / t'D t.
         JD = J.T * self._task_weights
@@ -206,12 +260,12 @@ class WholeBodyDiffIk(LeafSystem):
         g = self._centering_gain * (self._q_nominal - q)
         norm = twist @ (self._task_weights * twist)
         if norm > 0:
-            H -= (1.0 - ALONG_WEIGHT) / norm * np.outer(JDt, JDt)
+            H -= (1.0 - ALONG_WEIGHT) / norm * (JDt[:, None] * JDt)  # np.outer's product
             g += ALONG_WEIGHT * JDt
         # Within the velocity limits, the acceleration limits from v, and the position
         # limits by the end of the step; where the last two conflict, brake.
-        accel_lower = v + self._a_lower * dt
-        accel_upper = v + self._a_upper * dt
+        accel_lower = v + self._a_lower_step
+        accel_upper = v + self._a_upper_step
         lower = np.maximum(np.maximum(self._v_lower, accel_lower), (self._q_lower - q) / dt)
         upper = np.minimum(np.minimum(self._v_upper, accel_upper), (self._q_upper - q) / dt)
         conflict = lower > upper
@@ -220,7 +274,11 @@ class WholeBodyDiffIk(LeafSystem):
         return solve_box_qp(H, g, lower, upper, hold)
 
     def _calc_desired_state(self, context, output):
+        # Evaluated at every plant step: written into the output in place.
         plan = context.get_discrete_state(self._plan).get_value()
-        v_d = plan[self._v_output]
+        desired = output.get_mutable_value()
+        q_d, v_d = desired[:self._motor_count], desired[self._motor_count:]
+        v_d[:] = plan[self._v_output]
         ahead = context.get_time() + self._look_ahead - plan[2 * self._nq]
-        output.SetFromVector(np.concatenate([plan[self._q_output] + ahead * v_d, v_d]))
+        np.multiply(ahead, v_d, out=q_d)
+        q_d += plan[self._q_output]

@@ -1,13 +1,16 @@
-"""The HSR station's two task-space adapters: the end-effector command in, its state out."""
+"""The HSR station's task-space adapters: the end-effector command in (as a system, or as
+the arithmetic the station's diff IK applies itself), its state out."""
 
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform, RotationMatrix
-from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.layouts import EeCommand, EeState
 from pbp_drake.systems.tick import decide_offset
+
+# EeCommand's entries, by index.
+_POSITION, _VELOCITY, _HEADING = slice(0, 3), slice(3, 6), 6
 
 
 def heading_of(R_WE: RotationMatrix) -> float:
@@ -49,15 +52,9 @@ class EeCommandToPose(LeafSystem):
 
     def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
         super().__init__()
-        self._R_E0 = RotationMatrix(R_E0)
-        self._period = command_period
-        self._lead = float(lead)
+        self._ramp = EeCommandRamp(R_E0, command_period, lead)
         self._command_port = self.DeclareVectorInputPort("ee_command", EeCommand.size)
-        self._last_heading = self.DeclareDiscreteState(1)
-        self.DeclareInitializationDiscreteUpdateEvent(self._sample_heading)
-        if command_period:
-            self.DeclarePeriodicDiscreteUpdateEvent(
-                command_period, 0.5 * decide_offset(command_period), self._sample_heading)
+        self._last_heading = self._ramp.declare_heading_sample(self, self._command_port)
         self._pose_port = self.DeclareAbstractOutputPort(
             "X_WE_desired", lambda: AbstractValue.Make(RigidTransform()), self._calc_pose)
         self._velocity_port = self.DeclareVectorOutputPort(
@@ -72,75 +69,114 @@ class EeCommandToPose(LeafSystem):
     def get_velocity_output_port(self):
         return self._velocity_port
 
-    def _sample_heading(self, context, discrete_state):
-        discrete_state.set_value(self._last_heading,
-                                 [EeCommand(self._command_port.Eval(context)).heading])
-
-    def _heading_rate(self, context, command):
-        if not self._period:
-            return 0.0
-        last = context.get_discrete_state(self._last_heading).get_value()[0]
-        turn = (command.heading - last + np.pi) % (2 * np.pi) - np.pi
-        return turn / self._period
-
     def _calc_velocity(self, context, output):
-        command = EeCommand(self._command_port.Eval(context))
-        output.SetFromVector([0.0, 0.0, self._heading_rate(context, command),
-                              command.vx, command.vy, command.vz])
+        command = self._command_port.Eval(context)
+        rate = self._ramp.heading_rate(context, self._last_heading, command)
+        self._ramp.velocity_into(command, rate, output.get_mutable_value())
 
     def _calc_pose(self, context, output):
-        command = EeCommand(self._command_port.Eval(context))
-        position = np.array([command.x, command.y, command.z])
-        velocity = np.array([command.vx, command.vy, command.vz])
-        ahead = self._lead
-        if self._period:
-            time = context.get_time()
-            next_tick = np.ceil(time / self._period - 1e-9) * self._period
+        command = self._command_port.Eval(context)
+        rate = self._ramp.heading_rate(context, self._last_heading, command)
+        output.set_value(self._ramp.pose(command, rate, context.get_time()))
+
+
+class EeCommandRamp:
+    """`EeCommandToPose`'s arithmetic, for it and for a system that reads the command
+    itself: the station's diff IK (`WholeBodyDiffIk` with a `command_ramp`), which thus
+    needs no system between the command and itself (two Python calls fewer at each of its
+    steps). See `EeCommandToPose` for what the pose and velocity are."""
+
+    def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
+        self.R_E0 = RotationMatrix(R_E0)
+        self.period = command_period
+        self.lead = float(lead)
+
+    def declare_heading_sample(self, system, command_port):
+        """Declares on `system` the last tick's heading (a discrete state of one entry,
+        whose index it returns) and the events that sample it from `command_port`: at
+        initialization and, with a command period, just after each tick."""
+        index = system.DeclareDiscreteState(1)
+
+        def sample(context, discrete_state):
+            discrete_state.set_value(index, [command_port.Eval(context)[_HEADING]])
+
+        system.DeclareInitializationDiscreteUpdateEvent(sample)
+        if self.period:
+            system.DeclarePeriodicDiscreteUpdateEvent(
+                self.period, 0.5 * decide_offset(self.period), sample)
+        return index
+
+    def heading_rate(self, context, last_heading_index, command):
+        """The heading's rate (rad/s) from the last tick's heading (in `context`'s discrete
+        state `last_heading_index`) into the command's over a period; 0 without one."""
+        if not self.period:
+            return 0.0
+        last = context.get_discrete_state(last_heading_index).get_value()[0]
+        turn = (command[_HEADING] - last + np.pi) % (2 * np.pi) - np.pi
+        return turn / self.period
+
+    def velocity_into(self, command, heading_rate, velocity):
+        """Writes `V_WE_desired` `[w, v]` into `velocity` (6,) and returns it."""
+        velocity[:2] = 0.0
+        velocity[2] = heading_rate
+        velocity[3:] = command[_VELOCITY]
+        return velocity
+
+    def pose(self, command, heading_rate, time):
+        """`X_WE_desired` at `time`."""
+        ahead = self.lead
+        if self.period:
+            next_tick = np.ceil(time / self.period - 1e-9) * self.period
             ahead -= max(0.0, next_tick - time)
-        heading = command.heading + self._heading_rate(context, command) * ahead
-        R = RotationMatrix.MakeZRotation(heading) @ self._R_E0
-        output.set_value(RigidTransform(R, position + velocity * ahead))
+        heading = command[_HEADING] + heading_rate * ahead
+        R = RotationMatrix.MakeZRotation(heading) @ self.R_E0
+        return RigidTransform(R, command[_POSITION] + command[_VELOCITY] * ahead)
 
 
 class EeStateFromPlant(LeafSystem):
-    """Reads the end effector's position, velocity and heading off the plant's outputs.
+    """Reads the end effector's position, velocity and heading off the plant's state.
 
     .. pydrake_system::
 
         name: EeStateFromPlant
         input_ports:
-        - body_poses
-        - body_spatial_velocities
+        - plant_state
         output_ports:
         - ee_state
 
-    `ee_state` is `[p_WE (3), v_WE (3), heading, heading_rate]` (`EeState`); heading_rate
-    is the hand's angular velocity about world z (the rate of the heading while the hand's
-    z axis stays near the floor plane).
+    `plant_state` is `plant`'s state output; `ee_state` is `[p_WE (3), v_WE (3), heading,
+    heading_rate]` (`EeState`) of `ee_body`; heading_rate is the hand's angular velocity
+    about world z (the rate of the heading while the hand's z axis stays near the floor
+    plane).
+
+    The hand's kinematics come from a context of `plant` of this system's own, set to the
+    plant's state: the same computation as the plant's `body_poses` and
+    `body_spatial_velocities` outputs, whose values would cross into Python as a list of
+    every body's pose and velocity (about half this system's time) for one body's.
     """
 
-    def __init__(self, ee_body_index):
+    def __init__(self, plant, ee_body):
         super().__init__()
-        self._index = int(ee_body_index)
-        self._poses_port = self.DeclareAbstractInputPort(
-            "body_poses", AbstractValue.Make([RigidTransform()]))
-        self._velocities_port = self.DeclareAbstractInputPort(
-            "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()]))
+        self._plant = plant
+        self._body = ee_body
+        self._plant_context = plant.CreateDefaultContext()
+        self._plant_state_port = self.DeclareVectorInputPort(
+            "plant_state", plant.num_multibody_states())
         self._state_port = self.DeclareVectorOutputPort(
             "ee_state", EeState.size, self._calc_state)
 
-    def get_body_poses_input_port(self):
-        return self._poses_port
-
-    def get_body_spatial_velocities_input_port(self):
-        return self._velocities_port
+    def get_plant_state_input_port(self):
+        return self._plant_state_port
 
     def get_ee_state_output_port(self):
         return self._state_port
 
     def _calc_state(self, context, output):
-        X_WE = self._poses_port.Eval(context)[self._index]
-        V_WE = self._velocities_port.Eval(context)[self._index]
+        plant_context = self._plant_context
+        self._plant.SetPositionsAndVelocities(plant_context,
+                                              self._plant_state_port.Eval(context))
+        X_WE = self._body.EvalPoseInWorld(plant_context)
+        V_WE = self._body.EvalSpatialVelocityInWorld(plant_context)
         w, v = V_WE.rotational(), V_WE.translational()
         output.SetFromVector(np.concatenate(
             [X_WE.translation(), v, [heading_of(X_WE.rotation()), w[2]]]))

@@ -4,7 +4,7 @@
 everything between an operator's (or a policy's) end-effector command and the robot's
 motion, in the shape of manipulation's hardware station::
 
-    ee_command ─► EeCommandToPose ─► X_WE_desired, V_WE_desired ─► WholeBodyDiffIk
+    ee_command ─► WholeBodyDiffIk (its EeCommandRamp: X_WE_desired, V_WE_desired)
     WholeBodyDiffIk ─► [q_d, v_d] (desired_state) ─► the plant's PD on every motor
     plant ─► EeStateFromPlant ─► ee_state
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
@@ -16,10 +16,12 @@ every joint within its velocity and acceleration limits (the model file's and
 ``HsrStationConfig``'s), and stiff motor servos hold the robot on that plan.
 
 No lag is left to make up: each hand-off reads its reference at the time it is due, with
-the velocity it moves at. EeCommandToPose ramps the command between ticks (position and
-heading) and gives the pose the ramp reaches at the end of a diff IK step, and its
-velocity; the diff IK plans to be there then, its servos given the plan's position at
-the end of each plant step, which is where the plant's implicit PD compares it. A
+the velocity it moves at. The command is ramped between ticks (position and heading) as
+EeCommandToPose does, and the pose the ramp reaches at the end of a diff IK step, and its
+velocity, are what the diff IK aims at (it applies that arithmetic, ``EeCommandRamp``,
+itself: one Python system fewer at each of its steps); it plans to be there then, its
+servos given the plan's position at the end of each plant step, which is where the
+plant's implicit PD compares it. A
 control loop that re-integrates its command from the measured hand (``p = y + v dt``,
 as PBP and teleoperation do) thus moves the hand at ``v``, and a hand sampled at a tick
 is the hand at that tick (the plant's output ports are live; see
@@ -44,7 +46,7 @@ from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
-from pbp_drake.robots.hsr_ee_systems import EeCommandToPose, EeStateFromPlant, heading_of
+from pbp_drake.robots.hsr_ee_systems import EeCommandRamp, EeStateFromPlant, heading_of
 from pbp_drake.robots.hsr_model import (
     ACTUATED_JOINT_NAMES,
     ARM_JOINT_NAMES,
@@ -111,9 +113,10 @@ def _ready_pose(plant, model, config):
     return q0, plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(context)
 
 
-def _make_diff_ik(plant, model, q0, config, motor_joints):
+def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp):
     """The whole-body diff IK with the model's position and velocity limits and the
-    config's acceleration limits, the arm drifting back to the ready pose ``q0``."""
+    config's acceleration limits, the arm drifting back to the ready pose ``q0``, reading
+    the end-effector command through ``command_ramp``."""
     v_lower, v_upper = plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()
     # The torso does not move the hand (it carries only the head) and follows the lift
     # through the coupler in the plant, so diff IK leaves it where it is.
@@ -132,7 +135,7 @@ def _make_diff_ik(plant, model, q0, config, motor_joints):
         config.plant.time_step, motor_joints,
         position_limits=(plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()),
         velocity_limits=(v_lower, v_upper), acceleration_limits=(-accelerations, accelerations),
-        q_nominal=q0, centering_gain=centering)
+        q_nominal=q0, centering_gain=centering, command_ramp=command_ramp)
 
 
 def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Diagram:
@@ -190,18 +193,13 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     # R_E0 is the hand's orientation at heading 0, whatever the initial base yaw.
     R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
 
-    # The diff IK reads its input as the pose to have at the end of its step.
-    command_to_pose = builder.AddNamedSystem("ee_command_to_pose", EeCommandToPose(
-        R_E0, config.command_period, lead=config.diff_ik_time_step))
+    # The diff IK reads the command's pose as the one to have at the end of its step.
+    ramp = EeCommandRamp(R_E0, config.command_period, lead=config.diff_ik_time_step)
     # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()
                     for index in plant.GetJointActuatorIndices(model)]
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, model, q0, config,
-                                                              motor_joints))
-    builder.Connect(command_to_pose.get_pose_output_port(),
-                    diff_ik.get_X_WE_desired_input_port())
-    builder.Connect(command_to_pose.get_velocity_output_port(),
-                    diff_ik.get_V_WE_desired_input_port())
+                                                              motor_joints, ramp))
     # Read at initialization only, so that the plan starts from the plant's state (no
     # jump even if the caller moves the robot in the context).
     builder.Connect(plant.get_state_output_port(), diff_ik.get_robot_state_input_port())
@@ -209,12 +207,10 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
                     plant.get_desired_state_input_port(model))
 
     ee_body = plant.GetFrameByName(END_EFFECTOR_FRAME, model).body()
-    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(ee_body.index()))
-    builder.Connect(plant.get_body_poses_output_port(), ee_state.get_body_poses_input_port())
-    builder.Connect(plant.get_body_spatial_velocities_output_port(),
-                    ee_state.get_body_spatial_velocities_input_port())
+    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, ee_body))
+    builder.Connect(plant.get_state_output_port(), ee_state.get_plant_state_input_port())
 
-    builder.ExportInput(command_to_pose.get_ee_command_input_port(), "ee_command")
+    builder.ExportInput(diff_ik.get_ee_command_input_port(), "ee_command")
     builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
     builder.ExportOutput(plant.get_state_output_port(), "state")
     builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")

@@ -4,7 +4,6 @@ the simulation at success."""
 import dataclasses
 
 import numpy as np
-from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import EventStatus, LeafSystem
 
 from pbp_drake.core.reach_task import reach_progress
@@ -16,14 +15,24 @@ SUCCESS_MESSAGE = "the target is reached"
 
 @dataclasses.dataclass(frozen=True)
 class TaskCounts:
-    """The task's whole numbers, held as one immutable value in the monitor's abstract state
-    (an update replaces it, so two contexts never share a mutable object)."""
+    """The task's whole numbers, as `TaskMonitor.counts` reads them off its state (where
+    they are a discrete vector in this order, exact as floats)."""
 
     stage: int = 0  # target switches so far
     steps: int = 0  # control ticks counted, up to success
     acted_steps: int = 0  # of which the operator acted
     colliding_steps: int = 0  # of which the robot was in collision
     success: bool = False
+
+    @staticmethod
+    def of_vector(vector):
+        stage, steps, acted_steps, colliding_steps, success = vector
+        return TaskCounts(int(stage), int(steps), int(acted_steps), int(colliding_steps),
+                          bool(success > 0.5))
+
+
+_COUNTS_SIZE = len(dataclasses.fields(TaskCounts))
+_STAGE, _SUCCESS = 0, 4  # where TaskCounts' stage and success sit in the counts vector
 
 
 class TaskMonitor(LeafSystem):
@@ -59,9 +68,11 @@ class TaskMonitor(LeafSystem):
     of the last tick counted: at success, the tick that reached the target), intervention ratio (steps with operator input / steps of the task), steps,
     collision ratio (steps with `in_collision` / steps; 0 when unconnected)]`).
 
-    The counts are integers (`TaskCounts`) in abstract state, the progress and task time a
-    discrete vector; the update is therefore an unrestricted one, which Drake applies before
-    the discrete updates of the same instant (no decide-stage system reads this monitor).
+    The counts (`TaskCounts`, whole numbers held exactly as floats) and the progress and
+    task time are two discrete vectors. They were an unrestricted update (the counts in
+    abstract state) until it showed that Drake copies the whole diagram's state for each
+    unrestricted update; as a discrete update it reads the same values (no system that
+    updates at the decide stage reads this monitor, nor does it read theirs).
     """
 
     def __init__(self, objects, targets, switch_schedule, start, success_distance,
@@ -85,16 +96,16 @@ class TaskMonitor(LeafSystem):
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._in_collision_port = self.DeclareVectorInputPort("in_collision", 1)
-        self._counts_index = self.DeclareAbstractState(AbstractValue.Make(TaskCounts()))
+        self._counts_index = self.DeclareDiscreteState(_COUNTS_SIZE)
         # [progress, task time]: the status's real-valued entries.
         self._measures_index = self.DeclareDiscreteState(2)
         self._target_port = self.DeclareVectorOutputPort(
             "target", Target.size, self._calc_target,
-            prerequisites_of_calc={self.abstract_state_ticket(self._counts_index)})
+            prerequisites_of_calc={self.discrete_state_ticket(self._counts_index)})
         self._status_port = self.DeclareVectorOutputPort(
             "task_status", TaskStatus.size, self._calc_status,
             prerequisites_of_calc={self.all_state_ticket()})
-        self.DeclarePeriodicUnrestrictedUpdateEvent(period, update_offset, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, update_offset, self._update)
         self.DeclarePeriodicPublishEvent(period, end_offset, self._end_at_success)
 
     def get_ee_state_input_port(self):
@@ -118,10 +129,14 @@ class TaskMonitor(LeafSystem):
 
     def counts(self, context):
         """The `TaskCounts` held in this system's `context`."""
-        return context.get_abstract_state(self._counts_index).get_value()
+        return TaskCounts.of_vector(self._count_vector(context))
+
+    def _count_vector(self, context):
+        return context.get_discrete_state(self._counts_index).value()
 
     def _calc_target(self, context, output):
-        index = self._targets[self.counts(context).stage]
+        # Once a tick each, this and the end-of-tick check read one count, not all five.
+        index = self._targets[int(self._count_vector(context)[_STAGE])]
         target = Target(np.empty(Target.size))
         target.x, target.y, target.z = self._objects[index]
         target.index = index
@@ -156,17 +171,16 @@ class TaskMonitor(LeafSystem):
             stage += 1
             target = self._objects[self._targets[stage]]
             progress = reach_progress(here, self._start, target)
-        state.get_mutable_abstract_state(self._counts_index).set_value(TaskCounts(
-            stage=stage, steps=counts.steps + 1,
-            acted_steps=counts.acted_steps + int(acting),
-            colliding_steps=counts.colliding_steps + int(colliding),
-            success=bool(np.linalg.norm(here - target) <= self._success_distance)))
+        success = bool(np.linalg.norm(here - target) <= self._success_distance)
+        state.get_mutable_vector(self._counts_index).set_value(
+            [stage, counts.steps + 1, counts.acted_steps + int(acting),
+             counts.colliding_steps + int(colliding), float(success)])
         # The task time is the tick's: the update runs a fraction of a period after it.
-        state.get_mutable_discrete_state(self._measures_index).set_value(
+        state.get_mutable_vector(self._measures_index).set_value(
             [progress, context.get_time() - self._update_offset])
         return EventStatus.Succeeded()
 
     def _end_at_success(self, context):
-        if self.counts(context).success:
+        if self._count_vector(context)[_SUCCESS] > 0.5:
             return EventStatus.ReachedTermination(self, SUCCESS_MESSAGE)
         return EventStatus.DidNothing()

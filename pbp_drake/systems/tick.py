@@ -23,10 +23,9 @@ The decide stage sits a millionth of the control period after the tick: long bef
 plant step that follows the tick, and far from the next tick. Systems of the decide stage
 use it by default, so neither a diagram nor user code states an offset.
 
-The task monitor's update is an unrestricted one (its counts are integers in abstract state).
-Drake applies unrestricted updates before the discrete updates of the same instant, so no
-decide-stage system reads the monitor's outputs: the operators read its `target` at the
-sense stage.
+The task monitor updates at the decide stage too, so no other decide-stage system reads
+its outputs (they would see the last tick's): the operators read its `target` at the sense
+stage.
 
 Loggers publish before the updates of their instant: a log sample at `t_k` holds the plant's
 state at `t_k` but the decisions of tick k - 1. `DECISION_LOG_SHIFT` is how many samples

@@ -39,7 +39,11 @@ import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
 
-GOAL_ESTIMATION_METHODS = ("angle", "nearest", "bayesian", "pose")
+# The estimators that read the hand's position and heading (`goal_probabilities`) ...
+GOAL_ESTIMATION_METHODS = ("angle", "nearest", "bayesian")
+# ... and those that read its whole pose (`pbp_drake.core.grasp_estimation`).
+POSE_ESTIMATION_METHODS = ("pose",)
+ESTIMATION_METHODS = GOAL_ESTIMATION_METHODS + POSE_ESTIMATION_METHODS
 
 # A goal closer than this (m) to the end effector on the floor plane has no direction.
 FLOOR_EPSILON = 1e-9
@@ -82,9 +86,9 @@ class GoalEstimatorSettings:
     def validate(self):
         """Raises ValueError naming the first field that cannot be used (a YAML loader sets
         the fields after construction, so `resolve` calls this again)."""
-        if self.method not in GOAL_ESTIMATION_METHODS:
+        if self.method not in ESTIMATION_METHODS:
             raise ValueError(f"goal estimation method {self.method!r} is unknown; choose one "
-                             f"of {GOAL_ESTIMATION_METHODS}")
+                             f"of {ESTIMATION_METHODS}")
         for name in ("temperature", "beta"):
             value = getattr(self, name)
             if not _is_real(value) or not math.isfinite(value) or value <= 0.0:

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from pbp_drake import cli
 from pbp_drake.builder import build_diagram
 from pbp_drake.core.grasp_task import sample_grasp_scene
 from pbp_drake.scenarios import GraspTask, ScenarioError, load_scenario_file, resolve
@@ -115,3 +116,18 @@ def test_a_yaml_typo_in_the_task_names_the_key(shipped, tmp_path):
     with pytest.raises(ScenarioError, match=r"unknown key 'rol_range' \(did you mean "
                                             r"'roll_range'\?\)"):
         load_scenario_file(path)
+
+
+@pytest.mark.parametrize("command", [
+    ["run", "--headless", "--no-meshcat", "--operator", "virtual"],
+    ["study", "--output", "{tmp}/study"],
+    ["draw", "--output", "{tmp}/drawing.svg"],
+])
+def test_the_commands_refuse_it_before_they_start(repo, tmp_path, capsys, command):
+    name, *flags = command
+    arguments = [name, str(repo / "diagrams" / "hsr_grasp.yaml")] + [
+        flag.format(tmp=tmp_path) for flag in flags]
+    assert cli.main(arguments) == 2
+    assert "!GraspTask cannot be built yet" in capsys.readouterr().err
+    assert not (tmp_path / "study" / "trials").exists()
+    assert not (tmp_path / "drawing.svg").exists()

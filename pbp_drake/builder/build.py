@@ -2,7 +2,7 @@
 
 from pbp_drake.builder.hsr import build_hsr_diagram
 from pbp_drake.builder.point_robot import build_point_robot_diagram
-from pbp_drake.scenarios import ResolvedScenario, resolve
+from pbp_drake.scenarios import GraspTask, ResolvedScenario, ScenarioError, resolve
 
 
 def build_diagram(scenario, meshcat=None, prediction_steps=None):
@@ -10,9 +10,20 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
     `meshcat`, also drawn there. `prediction_steps` (2-D scenes) sets how far ahead the DMPs'
     paths are drawn (default: their duration, when drawing)."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
+    check_buildable(resolved)
     if resolved.is_hsr:
         return build_hsr_diagram(resolved, meshcat)
     return build_point_robot_diagram(resolved, meshcat, prediction_steps)
+
+
+def check_buildable(resolved):
+    """Raises ScenarioError for a resolved scenario the builder cannot build yet, so that the
+    commands refuse it before they start: the grasping task, whose hand pose the HSR
+    station cannot command until it has 6-DoF inverse kinematics."""
+    if isinstance(resolved.scenario.task, GraspTask):
+        raise ScenarioError("scenario.task !GraspTask cannot be built yet: the HSR station "
+                            "has no 6-DoF inverse kinematics (issue 17); the scenario loads "
+                            "and resolves, its scene is in ResolvedScenario.layout.grasps")
 
 
 def find_system(diagram, name):

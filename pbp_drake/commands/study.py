@@ -6,6 +6,7 @@ import pathlib
 import sys
 import time
 
+from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import method_list
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
@@ -62,6 +63,7 @@ def add_study_commands(commands):
 def _study(args):
     check_output_folder(args.output)
     scenario_file = load_scenario_file(args.scenario)
+    check_buildable(scenario_file.resolved)
     if isinstance(scenario_file.scenario.robot, Hsr):
         return _method_study(args, scenario_file)
     if scenario_file.study is None:

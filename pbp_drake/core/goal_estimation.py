@@ -16,7 +16,12 @@ turns the scores into probabilities that sum to 1:
   goal, so it cancels in the normalised posterior: it is kept in `bayesian_log_posterior`
   for the formula's sake and does not change the probabilities.
 
-All three are vectorised over K (no Python loop over goals) and computed in log space, so a
+- ``pose`` (the grasping task): reads position and orientation, see
+  `pbp_drake.core.grasp_estimation`; `goal_probabilities` here does not compute it (it needs
+  the grasp orientations and the hand's velocities), `grasp_estimation.pose_probabilities`
+  does, with the same settings and the same hysteresis (`update_selection`).
+
+All of them are vectorised over K (no Python loop over goals) and computed in log space, so a
 small temperature or a large beta gives a one-hot vector rather than NaN.
 
 The selection is the most probable goal, with hysteresis so that it does not chatter: the
@@ -34,7 +39,11 @@ import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
 
+# The estimators that read the hand's position and heading (`goal_probabilities`) ...
 GOAL_ESTIMATION_METHODS = ("angle", "nearest", "bayesian")
+# ... and those that read its whole pose (`pbp_drake.core.grasp_estimation`).
+POSE_ESTIMATION_METHODS = ("pose",)
+ESTIMATION_METHODS = GOAL_ESTIMATION_METHODS + POSE_ESTIMATION_METHODS
 
 # A goal closer than this (m) to the end effector on the floor plane has no direction.
 FLOOR_EPSILON = 1e-9
@@ -48,9 +57,14 @@ class GoalEstimatorSettings:
     """How goals are scored and how sticky the selection is (scenario files: the
     `goal_estimator` section).
 
-    `method` is ``angle`` (the paper's heuristic), ``nearest`` or ``bayesian``.
-    `temperature` scales ``angle`` (rad) and ``nearest`` (m) scores: low enough that objects
-    a few degrees apart are told apart. `beta` (1/m) is the rationality of ``bayesian``.
+    `method` is ``angle`` (the paper's heuristic), ``nearest``, ``bayesian`` or ``pose``
+    (grasping task only). `temperature` scales ``angle`` (rad), ``nearest`` (m) and
+    ``pose`` (rad) scores: low enough that objects a few degrees apart are told apart.
+    `beta` (1/m) is the rationality of ``bayesian``. The ``pose`` score
+    (`pbp_drake.core.grasp_estimation`) adds `distance_weight` (rad per m) times the
+    distance, `orientation_weight` (a factor) times the angle to the grasp orientation, and
+    subtracts the angle the hand's turning would take off it in `turn_horizon` (s); the
+    direction of travel counts only while the hand moves at `min_speed` (m/s) or more.
     The selection switches once another goal beats it by more than `margin` (in
     probability) for `hold_steps` consecutive updates; `margin=0, hold_steps=1` switches to
     the most probable goal at once.
@@ -61,6 +75,10 @@ class GoalEstimatorSettings:
     beta: float = 5.0
     margin: float = 0.1
     hold_steps: int = 2
+    distance_weight: float = 1.0
+    orientation_weight: float = 1.0
+    turn_horizon: float = 1.0
+    min_speed: float = 0.01
 
     def __post_init__(self):
         self.validate()
@@ -68,13 +86,17 @@ class GoalEstimatorSettings:
     def validate(self):
         """Raises ValueError naming the first field that cannot be used (a YAML loader sets
         the fields after construction, so `resolve` calls this again)."""
-        if self.method not in GOAL_ESTIMATION_METHODS:
+        if self.method not in ESTIMATION_METHODS:
             raise ValueError(f"goal estimation method {self.method!r} is unknown; choose one "
-                             f"of {GOAL_ESTIMATION_METHODS}")
+                             f"of {ESTIMATION_METHODS}")
         for name in ("temperature", "beta"):
             value = getattr(self, name)
             if not _is_real(value) or not math.isfinite(value) or value <= 0.0:
                 raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        for name in ("distance_weight", "orientation_weight", "turn_horizon", "min_speed"):
+            value = getattr(self, name)
+            if not _is_real(value) or not math.isfinite(value) or value < 0.0:
+                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
         if not _is_real(self.margin) or not 0.0 <= self.margin < 1.0:
             raise ValueError(f"margin must lie in [0, 1), got {self.margin!r}")
         if (isinstance(self.hold_steps, bool) or not isinstance(self.hold_steps, (int, np.integer))
@@ -187,6 +209,9 @@ def goal_probabilities(settings, goals, position, heading, start=None, path_leng
         start = validate_point(start, "start")
         path_length = _validate_scalar(path_length, "path_length", minimum=0.0)
         return bayesian_probabilities(goals, position, start, path_length, settings.beta)
+    if settings.method == "pose":
+        raise ValueError("the pose goal estimator reads grasp orientations and the hand's "
+                         "velocities: call pbp_drake.core.grasp_estimation.pose_probabilities")
     raise ValueError(f"goal estimation method {settings.method!r} is unknown; choose one of "
                      f"{GOAL_ESTIMATION_METHODS}")
 

@@ -14,18 +14,18 @@ from pbp_drake.scenarios.resolution import (
     parse_method_label, resolve, task_layout, with_method)
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, OPERATOR_NAMES, TOY_OPERATORS, AlphaStudy, AltVsCont, BentPath,
-    DynamicObstacles, Gamepad, Hsr, Keyboard, MethodComparison, MultiGoalReach, NoOperator,
-    Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot, RecordedPath, Scenario,
+    DynamicObstacles, Gamepad, GraspTask, Hsr, Keyboard, MethodComparison, MultiGoalReach,
+    NoOperator, Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot, RecordedPath, Scenario,
     ScenarioError, ScenarioFile, SceneVariant, ScriptedCommands, SinusoidalStep,
     VirtualParticipant)
 
 __all__ = [
     "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHODS", "OPERATOR_NAMES", "TOY_OPERATORS",
-    "AlphaStudy", "AltVsCont", "BentPath", "DynamicObstacles", "Gamepad", "Hsr", "Keyboard",
-    "LoadedScenarioFile", "MethodComparison", "MultiGoalReach", "NoOperator", "Obstacle",
-    "ObstacleRepulsion", "OperatorConfig", "PointRobot", "RecordedPath", "ResolvedScenario",
-    "Scenario", "ScenarioError", "ScenarioFile", "SceneVariant", "ScriptedCommands",
-    "SinusoidalStep", "TaskLayout", "VirtualParticipant", "check_alpha_study",
+    "AlphaStudy", "AltVsCont", "BentPath", "DynamicObstacles", "Gamepad", "GraspTask", "Hsr",
+    "Keyboard", "LoadedScenarioFile", "MethodComparison", "MultiGoalReach", "NoOperator",
+    "Obstacle", "ObstacleRepulsion", "OperatorConfig", "PointRobot", "RecordedPath",
+    "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile", "SceneVariant",
+    "ScriptedCommands", "SinusoidalStep", "TaskLayout", "VirtualParticipant", "check_alpha_study",
     "check_method_comparison", "demonstration_samples", "load_scenario_file",
     "parse_method_label", "resolve", "task_layout", "with_method",
 ]

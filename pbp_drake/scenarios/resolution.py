@@ -22,12 +22,15 @@ from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
+from pbp_drake.scenarios.grasp_layout import grasp_scene
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, Hsr, ObstacleRepulsion,
-    Scenario, ScenarioError, ScriptedCommands, SinusoidalStep, VirtualParticipant)
+    HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, GraspTask, Hsr,
+    ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands, SinusoidalStep,
+    VirtualParticipant)
 from pbp_drake.scenarios.value_checks import (
-    check_bent_path, check_direction, check_dmp_duration, check_numbers, check_obstacle_task,
-    check_reach_task, check_seed, check_time_steps, check_virtual_participant, require_finite)
+    check_bent_path, check_direction, check_dmp_duration, check_grasp_task, check_numbers,
+    check_obstacle_task, check_reach_task, check_seed, check_time_steps,
+    check_virtual_participant, require_finite)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
 BLEND_MODE_OF_METHOD = {
@@ -42,13 +45,15 @@ BLEND_MODE_OF_METHOD = {
 
 @dataclasses.dataclass(frozen=True)
 class TaskLayout:
-    """What an HSR task puts in front of the robot: the goals `(K, 3)` (one DMP each), the
-    target sequence and its switch schedule, and the obstacles (None without)."""
+    """What an HSR task puts in front of the robot: the goals `(K, 3)` (one DMP each; the
+    grasp positions in the grasping task), the target sequence and its switch schedule, the
+    obstacles (None without) and the grasping task's `GraspScene` (None in the others)."""
 
     objects: np.ndarray
     targets: tuple
     switch_schedule: tuple
     obstacles: typing.Any = None
+    grasps: typing.Any = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -151,6 +156,9 @@ def _check_common(scenario):
     require_finite(scenario, "scenario", ("control_period", "duration"))
     _settings_checked("scenario.dmp", scenario.dmp)
     _settings_checked("scenario.goal_estimator", scenario.goal_estimator)
+    if scenario.goal_estimator.method == "pose" and not isinstance(scenario.task, GraspTask):
+        raise ScenarioError("scenario.goal_estimator.method pose reads grasp orientations: "
+                            "use it with task: !GraspTask {...}")
     require_finite(scenario, "scenario", ("dmp_duration",), positive=False)
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_seed(scenario.seed)
@@ -317,6 +325,8 @@ def _resolve_hsr(scenario):
     task = scenario.task
     if isinstance(task, DynamicObstacles):
         check_obstacle_task(task)
+    elif isinstance(task, GraspTask):
+        check_grasp_task(task)
     else:
         check_reach_task(task)
     try:
@@ -392,6 +402,10 @@ def task_layout(task, seed):
             tuple(task.activation_range))
         return TaskLayout(objects=obstacles.target[np.newaxis, :], targets=(0,),
                           switch_schedule=(0.0,), obstacles=obstacles)
+    if isinstance(task, GraspTask):
+        grasps = grasp_scene(task, seed)
+        return TaskLayout(objects=grasps.grasp_positions, targets=grasps.targets,
+                          switch_schedule=tuple(task.switch_schedule), grasps=grasps)
     scene = _reach_scene(task, seed)
     return TaskLayout(objects=scene.objects, targets=scene.targets,
                       switch_schedule=tuple(task.switch_schedule))

@@ -197,6 +197,45 @@ class DynamicObstacles:
 
 
 @dataclasses.dataclass
+class GraspTask:
+    """The grasping task (issue 17, `pbp_drake.core.grasp_task`): upright cylinders drawn
+    from the seed, each on its own table in the reach task's rectangle, each with a grasp
+    pose of the hand, from the side at a yaw or from above with a wrist roll; the target
+    switches as in the reach task; success is the hand within `success_distance` of the
+    target's grasp position and within `success_angle` of its grasp orientation. It loads
+    and resolves; the HSR station cannot run it yet (no 6-DoF inverse kinematics)."""
+
+    object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
+    # The tables' centres are drawn in this rectangle (m), min_separation apart (at least
+    # the tables' diagonal, so that no two overlap).
+    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    min_separation: float = 0.45
+    # The height (m) the hand starts at (the station's ready pose), as the reach task's.
+    height: float = 0.7
+    # Each table is a box table_size (x, y) m wide with its top at table_height (m).
+    table_height: float = 0.6
+    table_size: list[float] = dataclasses.field(default_factory=lambda: [0.3, 0.3])
+    # Each object is an upright cylinder standing at its table's centre.
+    object_radius: float = 0.03
+    object_height: float = 0.15
+    # An object is grasped from above with this probability, else from the side.
+    top_probability: float = 0.5
+    # Side grasps approach horizontally at a yaw (degrees, counter-clockwise from the
+    # direction the robot faces) drawn here; inside [-90, 90].
+    approach_yaw_range: list[float] = dataclasses.field(default_factory=lambda: [-60.0, 60.0])
+    # Top grasps approach straight down with a wrist roll (degrees) drawn here; inside
+    # [-180, 180].
+    roll_range: list[float] = dataclasses.field(default_factory=lambda: [-90.0, 90.0])
+    # The palm stands this far (m) behind the point the fingers close on.
+    grasp_depth: float = 0.08
+    switch_schedule: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.3, 0.6])
+    success_distance: float = 0.03
+    # Degrees.
+    success_angle: float = 10.0
+
+
+@dataclasses.dataclass
 class Scenario:
     """Everything one simulation needs."""
 
@@ -222,8 +261,9 @@ class Scenario:
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     operator: OperatorConfig = dataclasses.field(default_factory=NoOperator)
     # HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
-    # An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task.
-    task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles]] = None
+    # An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,
+    # `!GraspTask {...}` the grasping task.
+    task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles, GraspTask]] = None
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
     seed: int = 0

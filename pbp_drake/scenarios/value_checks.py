@@ -122,11 +122,43 @@ def check_reach_task(task):
     # Objects are placed min_separation apart in front of the robot: a few dozen fit.
     check_count(task.object_count[0], "scenario.task.object_count[0]", 1, 100)
     check_count(task.object_count[1], "scenario.task.object_count[1]", 1, 100)
+    check_switch_schedule(task)
+
+
+def check_switch_schedule(task):
+    """The progress thresholds of the target switches: 0.0 first, increasing, below 1."""
     schedule = np.asarray(task.switch_schedule, float)
     if (len(schedule) == 0 or schedule[0] != 0.0 or np.any(np.diff(schedule) <= 0)
             or schedule[-1] >= 1.0):
         raise ScenarioError(f"scenario.task.switch_schedule {task.switch_schedule} must "
                             "start at 0.0 and increase strictly below 1.0")
+
+
+def check_grasp_task(task):
+    """The grasping task's (`GraspTask`) sizes, ranges, counts and success region."""
+    field = "scenario.task"
+    require_finite(task, field, ("min_separation", "height", "table_height", "object_radius",
+                                 "object_height", "success_distance", "success_angle"))
+    require_finite(task, field, ("grasp_depth",), positive=False)
+    for name in ("x_range", "y_range", "object_count"):
+        check_range(task, field, name)
+    check_count(task.object_count[0], f"{field}.object_count[0]", 1, 100)
+    check_count(task.object_count[1], f"{field}.object_count[1]", 1, 100)
+    # Beyond a quarter turn a side grasp approaches from behind the object, toward the
+    # robot, which the HSR's arm cannot do.
+    check_range(task, field, "approach_yaw_range", within=(-90.0, 90.0))
+    check_range(task, field, "roll_range", within=(-180.0, 180.0))
+    if not task.success_angle < 180.0:
+        raise ScenarioError(f"{field}.success_angle {task.success_angle} degrees admits "
+                            "every orientation; expected an angle below 180")
+    if not 0.0 <= task.top_probability <= 1.0:
+        raise ScenarioError(f"{field}.top_probability {task.top_probability} is no "
+                            "probability; expected a number in [0, 1]")
+    size = task.table_size
+    if len(size) != 2 or not all(np.isfinite(side) and side > 0 for side in size):
+        raise ScenarioError(f"{field}.table_size {size} needs two positive lengths (m); "
+                            "expected [x, y]")
+    check_switch_schedule(task)
 
 
 def check_obstacle_task(task):

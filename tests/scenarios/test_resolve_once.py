@@ -8,16 +8,20 @@ import pytest
 
 import pbp_drake.core.dmp.bank as dmp_bank_module
 import pbp_drake.core.dmp.single as single_dmp_module
+import pbp_drake.scenarios.grasp_layout as grasp_layout_module
 import pbp_drake.scenarios.resolution as resolve_module
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import BentPath, load_scenario_file
 from pbp_drake.studies.runners import compute_trial
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
+# Not built yet: the station has no 6-DoF IK (`build_diagram` refuses the grasping task).
+BUILDABLE = [path for path in SHIPPED if path.stem != "hsr_grasp"]
 # Where each piece of work is done, by the name the caller looks it up under.
 COUNTED = [(resolve_module, "bent_path"), (dmp_bank_module, "fit_weights"),
            (single_dmp_module, "fit_weights"),
-           (resolve_module, "sample_reach_scene"), (resolve_module, "sample_obstacle_scene")]
+           (resolve_module, "sample_reach_scene"), (resolve_module, "sample_obstacle_scene"),
+           (grasp_layout_module, "sample_grasp_scene")]
 
 
 @pytest.fixture
@@ -40,7 +44,7 @@ def test_every_shipped_scenario_is_counted():
                                                "hsr_reach", "hsr_obstacles"}
 
 
-@pytest.mark.parametrize("path", SHIPPED, ids=lambda path: path.stem)
+@pytest.mark.parametrize("path", BUILDABLE, ids=lambda path: path.stem)
 def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     loaded = load_scenario_file(path)
     build_diagram(loaded.resolved, meshcat)
@@ -49,6 +53,12 @@ def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     assert work["fit_weights"] == 1
     scenes = work["sample_reach_scene"] + work["sample_obstacle_scene"]
     assert scenes == (1 if scenario.task is not None else 0)
+
+
+def test_loading_the_grasping_task_draws_its_scene_once(work):
+    load_scenario_file(SHIPPED[0].parent / "hsr_grasp.yaml")
+    assert work["sample_grasp_scene"] == 1 and work["fit_weights"] == 1
+    assert work["sample_reach_scene"] + work["sample_obstacle_scene"] == 0
 
 
 def build_then_stop(resolved):

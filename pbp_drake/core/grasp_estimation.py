@@ -1,0 +1,110 @@
+"""The ``pose`` goal estimator of the grasping task: which of K grasp poses the operator
+means, read from the hand's position, orientation and their rates, in pure NumPy.
+
+For candidate k with grasp position `g_k` and grasp orientation `q_k`, the hand at `p`
+with orientation `q`, moving at `v` (m/s) and turning at `omega` (rad/s, world frame):
+
+    cost_k = alpha_k + distance_weight |g_k - p|
+             + orientation_weight max(0, theta_k - turn_horizon (omega . n_k))
+
+- `alpha_k` (rad, in [0, pi]): the angle between `v` and `g_k - p`, as the ``angle``
+  estimator's heading angle but with the direction of travel in 3-D; 0 for every candidate
+  while `|v| < min_speed` (a hand at rest shows no direction) and for a candidate the hand
+  is at.
+- `theta_k = angle_between(q, q_k)` (rad, in [0, pi], the same for `q_k` and `-q_k`) and
+  `n_k` the unit axis of `r_k = Log(q_k q*)`, the world-frame rotation that takes the
+  hand's orientation to `q_k`. Turning at `omega` changes `theta_k` at the rate
+  `-omega . n_k` exactly (the cross terms of the SO(3) Jacobian are perpendicular to
+  `r_k`), so `theta_k - turn_horizon (omega . n_k)` is the angle left after
+  `turn_horizon` seconds at the present turn rate (at least 0). A hand turning toward a
+  grasp orientation lowers that candidate's cost before it has got there; two objects at
+  the same place with different grasp orientations are told apart by this term alone.
+
+Probabilities are `softmax(-cost / temperature)` (temperature in rad), computed as
+`goal_estimation.softmax_of_costs`, vectorised over K; the selection is the shipped
+hysteresis (`goal_estimation.update_selection`). The settings are the scenario's
+`goal_estimator` section (`GoalEstimatorSettings` with `method: pose`).
+"""
+
+import numpy as np
+
+from pbp_drake.core.goal_estimation import (
+    GoalEstimate, softmax_of_costs, update_selection, validate_goals, validate_point)
+from pbp_drake.core.quaternion import conjugate, log_map, multiply, unit_quaternions
+
+# Below this distance (m) the hand is at a grasp position: no direction to it.
+AT_GOAL = 1e-9
+# Below this angle (rad) the hand has the grasp orientation: no axis to turn about.
+AT_ORIENTATION = 1e-9
+
+
+def validate_grasp_goals(grasp_positions, grasp_orientations):
+    """`(positions (K, 3), orientations (K, 4))` checked: one unit quaternion per position."""
+    positions = validate_goals(grasp_positions)
+    orientations = unit_quaternions(grasp_orientations, "grasp orientations")
+    if orientations.shape != (len(positions), 4):
+        raise ValueError(f"grasp orientations must be (K, 4) with K = {len(positions)} (one "
+                         f"per grasp position), got shape {orientations.shape}")
+    return positions, orientations
+
+
+def travel_angles(grasp_positions, position, velocity, min_speed):
+    """`alpha_k` (K,): the angle between `velocity` and the direction to each grasp
+    position; all 0 below `min_speed`."""
+    offsets = grasp_positions - position
+    distances = np.linalg.norm(offsets, axis=1)
+    speed = np.linalg.norm(velocity)
+    if speed < max(min_speed, 1e-12):
+        return np.zeros(len(grasp_positions))
+    cosines = offsets @ velocity / (np.maximum(distances, AT_GOAL) * speed)
+    return np.where(distances <= AT_GOAL, 0.0, np.arccos(np.clip(cosines, -1.0, 1.0)))
+
+
+def turn_errors(grasp_orientations, orientation, angular_velocity):
+    """`(theta (K,), closing (K,))`: the angle from the hand's orientation to each grasp
+    orientation and the rate (rad/s) at which turning at `angular_velocity` shrinks it."""
+    rotations = log_map(multiply(grasp_orientations.T, conjugate(orientation)[:, np.newaxis]))
+    angles = np.linalg.norm(rotations, axis=0)
+    axes = rotations / np.maximum(angles, AT_ORIENTATION)
+    closing = np.where(angles <= AT_ORIENTATION, 0.0, angular_velocity @ axes)
+    return angles, closing
+
+
+def pose_costs(settings, grasp_positions, grasp_orientations, position, orientation,
+               velocity, angular_velocity):
+    """`cost_k` (K,) of the module docstring (arrays already checked)."""
+    angles, closing = turn_errors(grasp_orientations, orientation, angular_velocity)
+    left_to_turn = np.maximum(angles - settings.turn_horizon * closing, 0.0)
+    return (travel_angles(grasp_positions, position, velocity, settings.min_speed)
+            + settings.distance_weight * np.linalg.norm(grasp_positions - position, axis=1)
+            + settings.orientation_weight * left_to_turn)
+
+
+def pose_probabilities(settings, grasp_positions, grasp_orientations, position, orientation,
+                       velocity, angular_velocity):
+    """The K probabilities of the ``pose`` estimator: `softmax(-cost / temperature)`."""
+    grasp_positions, grasp_orientations = validate_grasp_goals(grasp_positions,
+                                                               grasp_orientations)
+    position = validate_point(position, "position")
+    orientation = unit_quaternions(orientation, "orientation")
+    if orientation.shape != (4,):
+        raise ValueError(f"orientation must be one quaternion (4,), got shape "
+                         f"{orientation.shape}")
+    velocity = validate_point(velocity, "velocity")
+    angular_velocity = validate_point(angular_velocity, "angular_velocity")
+    costs = pose_costs(settings, grasp_positions, grasp_orientations, position, orientation,
+                       velocity, angular_velocity)
+    return softmax_of_costs(costs, settings.temperature)
+
+
+def estimate_pose(settings, grasp_positions, grasp_orientations, position, orientation,
+                  velocity, angular_velocity, memory=None):
+    """One ``pose`` estimator update: `GoalEstimate(selected, probabilities, memory)`, with
+    the hysteresis of `goal_estimation.estimate` (pass `memory` back in; None first)."""
+    if settings.method != "pose":
+        raise ValueError(f"estimate_pose computes the pose estimator; settings.method is "
+                         f"{settings.method!r}")
+    probabilities = pose_probabilities(settings, grasp_positions, grasp_orientations,
+                                       position, orientation, velocity, angular_velocity)
+    memory = update_selection(probabilities, memory, settings.margin, settings.hold_steps)
+    return GoalEstimate(memory.selected, probabilities, memory)

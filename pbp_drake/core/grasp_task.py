@@ -1,0 +1,210 @@
+"""The grasping task (issue 17): the reach task's scene with a grasp pose per object, in
+pure NumPy.
+
+Scene. 2 to 4 upright cylinders (`object_radius`, `object_height`), each standing at the
+centre of its own table, a box `table_size` (x, y) wide whose top is at `table_height`.
+The tables' centres are drawn uniformly in the reach task's rectangle in front of the robot
+(x in [1.25, 2.5], y in [-1.05, 1.05] by default), at least `min_separation` apart on the
+floor (redrawn otherwise, as in reach); the separation must exceed the tables' diagonal so
+that no two tables overlap (`sample_grasp_scene` checks it).
+
+Hand frame H (the station's end-effector frame, `hand_palm_link`): origin at the palm,
++z_H the approach direction (out of the palm, between the fingers; the station's
+`heading` is the floor angle of z_H), +y_H the direction the fingers close along,
+x_H = y_H x z_H. Orientations are unit quaternions (w, x, y, z) mapping H to the world
+(`pbp_drake.core.quaternion`). The world's +x is the direction the robot faces at its start.
+
+Grasp poses. Each object is grasped from the side or from above (from above with
+probability `top_probability`):
+
+- side, at a yaw psi drawn in `yaw_range` (default [-60, 60] degrees): z_H horizontal at
+  the floor angle psi from +x (0: straight ahead, away from the robot; positive: turned
+  counter-clockwise seen from above), y_H horizontal (the fingers close left-right), x_H
+  straight down. `side_grasp_orientation(psi) = Rz(psi) Ry(90 deg)`. At psi = 0 it is the
+  hand of the station's ready pose as this module assumes it (pointing ahead, level).
+- top, at a wrist roll rho drawn in `roll_range` (default [-90, 90] degrees): z_H straight
+  down; at rho = 0 the ready hand pitched down (x_H = -x, y_H = +y: the fingers close
+  left-right), turned by rho about its own approach axis (right-handed about z_H, so
+  clockwise seen from above). `top_grasp_orientation(rho) = Ry(180 deg) Rz(rho)`.
+
+The grasp point is the cylinder's axis at half its height (side) or at its top face (top);
+the hand's grasp position is `grasp_depth` behind it along the approach (the palm stands
+back from the point the fingertips close on): `grasp point - grasp_depth z_H`.
+
+Rules. The target sequence is drawn as in reach (a different object at each entry of the
+switch schedule, 0 %, 30 %, 60 %). Progress toward a target grasp pose mixes position and
+orientation with a length per radian `L`: `1 - e(now) / e(start)`, clipped to [0, 1], where
+`e = |p - g| + L angle(q, q_g)`; the task uses `L = success_distance / success_angle`, so a
+turn of the success angle counts as much as a move of the success distance. Success is the
+hand within `success_distance` (3 cm) of the target's grasp position AND within
+`success_angle` (10 degrees) of its grasp orientation, both bounds inclusive; the angle is
+`quaternion.angle_between`, the same for q and -q.
+"""
+
+import dataclasses
+
+import numpy as np
+
+from pbp_drake.core.quaternion import angle_between, exp_map, multiply, unit_quaternions
+
+APPROACHES = ("side", "top")
+# The region the shipped tasks draw from and the HSR reaches (`reach_task.validate_objects`).
+HAND_HEIGHTS = (0.0, 1.1)
+Z_AXIS = np.array([0.0, 0.0, 1.0])
+Y_AXIS = np.array([0.0, 1.0, 0.0])
+
+
+@dataclasses.dataclass(frozen=True)
+class GraspScene:
+    """One grasping scene; index i of every array is object i.
+
+    Attributes:
+        objects: (M, 3) each cylinder's centre (on its axis, at half its height).
+        tables: (M, 3) each table's top-face centre.
+        approaches: M strings of APPROACHES.
+        approach_angles: (M,) the side grasp's yaw or the top grasp's roll (rad).
+        grasp_positions: (M, 3) the hand frame's origin at each grasp.
+        grasp_orientations: (M, 4) the hand's orientation at each grasp (w, x, y, z).
+        targets: object indices, one per entry of the switch schedule.
+    """
+
+    objects: np.ndarray
+    tables: np.ndarray
+    approaches: tuple
+    approach_angles: np.ndarray
+    grasp_positions: np.ndarray
+    grasp_orientations: np.ndarray
+    targets: tuple
+
+
+def _about(axis, angle):
+    return exp_map(np.asarray(axis, dtype=float) * angle)
+
+
+def side_grasp_orientation(yaw):
+    """The hand's quaternion (4,) grasping from the side at `yaw` (rad): `Rz(yaw) Ry(90)`."""
+    return multiply(_about(Z_AXIS, yaw), _about(Y_AXIS, np.pi / 2))
+
+
+def top_grasp_orientation(roll):
+    """The hand's quaternion (4,) grasping from above with wrist `roll` (rad):
+    `Ry(180) Rz(roll)`."""
+    return multiply(_about(Y_AXIS, np.pi), _about(Z_AXIS, roll))
+
+
+def approach_direction(orientation):
+    """The world direction (3,) of the hand's approach axis z_H for a quaternion (4,)."""
+    w, x, y, z = orientation
+    return np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+
+
+def grasp_pose(center, approach, angle, object_height, grasp_depth):
+    """`(position (3,), orientation (4,))` of the hand grasping the cylinder centred at
+    `center` from `approach` ("side" or "top") at `angle` (yaw or roll, rad)."""
+    center = np.asarray(center, dtype=float)
+    if approach == "side":
+        orientation, point = side_grasp_orientation(angle), center
+    elif approach == "top":
+        orientation = top_grasp_orientation(angle)
+        point = center + [0.0, 0.0, 0.5 * object_height]
+    else:
+        raise ValueError(f"approach {approach!r} is unknown; use one of {APPROACHES}")
+    return point - grasp_depth * approach_direction(orientation), orientation
+
+
+def sample_grasp_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(-1.05, 1.05),
+                       table_height=0.6, table_size=(0.3, 0.3), object_radius=0.03,
+                       object_height=0.15, min_separation=0.45,
+                       switch_schedule=(0.0, 0.3, 0.6), yaw_range=(-np.pi / 3, np.pi / 3),
+                       roll_range=(-np.pi / 2, np.pi / 2), top_probability=0.5,
+                       grasp_depth=0.08):
+    """Draws a `GraspScene` from `seed` alone (the same seed, the same scene, for every
+    method). Angles in radians; lengths in metres."""
+    low, high = object_count
+    if low < 1 or high < low:
+        raise ValueError(f"object_count must be [min, max] with 1 <= min <= max, got "
+                         f"{list(object_count)}")
+    if len(switch_schedule) > 1 and low < 2:
+        raise ValueError("target switching needs at least 2 objects: set object_count to "
+                         "at least [2, ...] or switch_schedule to [0.0]")
+    diagonal = float(np.hypot(*table_size))
+    if min_separation < diagonal:
+        raise ValueError(f"min_separation {min_separation} m is less than the tables' "
+                         f"diagonal {diagonal:.3f} m: tables could overlap")
+    if 2 * object_radius > min(table_size):
+        raise ValueError(f"objects of radius {object_radius} m do not fit on tables "
+                         f"{list(table_size)} m wide")
+    rng = np.random.default_rng(seed)
+    count = int(rng.integers(low, high + 1))
+    floor = np.empty((count, 2))
+    for index in range(count):
+        for _ in range(1000):
+            candidate = np.array([rng.uniform(*x_range), rng.uniform(*y_range)])
+            if index == 0 or np.min(np.linalg.norm(floor[:index] - candidate, axis=1)) \
+                    >= min_separation:
+                break
+        else:
+            raise ValueError(f"cannot place {count} tables {min_separation} m apart in "
+                             f"x {list(x_range)}, y {list(y_range)}")
+        floor[index] = candidate
+    approaches = tuple("top" if rng.uniform() < top_probability else "side"
+                       for _ in range(count))
+    angles = np.array([rng.uniform(*(roll_range if approach == "top" else yaw_range))
+                       for approach in approaches])
+    tables = np.column_stack([floor, np.full(count, table_height)])
+    objects = tables + [0.0, 0.0, 0.5 * object_height]
+    poses = [grasp_pose(center, approach, angle, object_height, grasp_depth)
+             for center, approach, angle in zip(objects, approaches, angles)]
+    targets = [int(rng.integers(count))]
+    for _ in switch_schedule[1:]:
+        others = [i for i in range(count) if i != targets[-1]]
+        targets.append(int(others[rng.integers(len(others))]))
+    positions = np.array([position for position, _ in poses])
+    _check_reachable(positions)
+    return GraspScene(objects=objects, tables=tables, approaches=approaches,
+                      approach_angles=angles, grasp_positions=positions,
+                      grasp_orientations=np.array([orientation for _, orientation in poses]),
+                      targets=tuple(targets))
+
+
+def _check_reachable(positions):
+    heights = positions[:, 2]
+    bad = np.flatnonzero((heights < HAND_HEIGHTS[0]) | (heights > HAND_HEIGHTS[1]))
+    if bad.size:
+        raise ValueError(f"object {bad[0]}'s grasp puts the hand at height "
+                         f"{heights[bad[0]]:.2f} m, out of the HSR's reach (heights "
+                         f"{HAND_HEIGHTS[0]}..{HAND_HEIGHTS[1]} m): lower table_height or "
+                         "object_height")
+
+
+def grasp_errors(position, orientation, grasp_positions, grasp_orientations):
+    """`(distances (K,), angles (K,))` from the hand's pose (position (3,), quaternion
+    (4,)) to K grasp poses ((K, 3), (K, 4)); angles in [0, pi], antipodal-safe."""
+    distances = np.linalg.norm(np.asarray(grasp_positions, float) - position, axis=-1)
+    angles = angle_between(np.asarray(orientation, float)[:, np.newaxis],
+                           np.asarray(grasp_orientations, float).T)
+    return distances, angles
+
+
+def grasp_success(position, orientation, grasp_position, grasp_orientation,
+                  success_distance, success_angle):
+    """Whether the hand is within `success_distance` (m) AND `success_angle` (rad) of one
+    grasp pose (bounds inclusive)."""
+    orientation = unit_quaternions(orientation, "orientation")
+    distances, angles = grasp_errors(position, orientation, [grasp_position],
+                                     [grasp_orientation])
+    return bool(distances[0] <= success_distance and angles[0] <= success_angle)
+
+
+def grasp_progress(position, orientation, start_position, start_orientation,
+                   grasp_position, grasp_orientation, length_per_radian):
+    """`1 - e(hand) / e(start)` clipped to [0, 1], `e = |p - g| + L angle(q, q_g)`; 1 when
+    the start is the grasp pose itself."""
+    def pose_error(p, q):
+        distances, angles = grasp_errors(p, q, [grasp_position], [grasp_orientation])
+        return float(distances[0] + length_per_radian * angles[0])
+
+    total = pose_error(start_position, start_orientation)
+    if total <= 0.0:
+        return 1.0
+    return float(np.clip(1.0 - pose_error(position, orientation) / total, 0.0, 1.0))

@@ -1,0 +1,208 @@
+"""The grasping task's virtual participant (`pbp_drake.core.participant_grasp`), in a plain
+kinematic loop: the hand's pose integrated from the commanded twist."""
+
+import numpy as np
+import pytest
+
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.grasp_estimation import estimate_pose
+from pbp_drake.core.grasp_task import (
+    approach_direction, grasp_errors, grasp_success, sample_grasp_scene,
+    side_grasp_orientation, top_grasp_orientation)
+from pbp_drake.core.participant_grasp import (
+    GraspParticipant, GraspParticipantParams, ParticipantMemory, drive_twist,
+    notice_target)
+from pbp_drake.core.quaternion import angle_between, exp_map, multiply
+from pbp_drake.systems.participant_params import VirtualParticipantParams
+
+PERIOD = 0.03
+SPEED = 0.12
+HAND = np.array([0.53, 0.08, 0.7])
+LEVEL = side_grasp_orientation(0.0)
+SUCCESS_DISTANCE, SUCCESS_ANGLE = 0.03, np.radians(10.0)
+
+
+def integrate(position, orientation, twist):
+    """The hand's pose one tick later under the world-frame twist `[v, omega]`."""
+    return (position + PERIOD * twist[:3],
+            multiply(exp_map(PERIOD * twist[3:]), orientation))
+
+
+def drive(scene, target, seed, seconds=60.0):
+    """Teleop from the ready hand to `target`: the tick it succeeded at (None if not)."""
+    participant = GraspParticipant.create(GraspParticipantParams(), "drive", SPEED,
+                                          scene.grasp_positions, scene.grasp_orientations,
+                                          seed)
+    position, orientation, memory = HAND.copy(), LEVEL.copy(), ParticipantMemory()
+    for tick in range(int(seconds / PERIOD)):
+        if grasp_success(position, orientation, scene.grasp_positions[target],
+                         scene.grasp_orientations[target], SUCCESS_DISTANCE, SUCCESS_ANGLE):
+            return tick
+        twist, active, memory = participant.step(memory, tick * PERIOD, tick, position,
+                                                 orientation, target, -1)
+        assert active or tick * PERIOD < 0.5 - 1e-9
+        position, orientation = integrate(position, orientation, twist)
+    return None
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_driving_it_reaches_the_targets_grasp_pose(seed):
+    scene = sample_grasp_scene(seed)
+    tick = drive(scene, scene.targets[0], seed)
+    assert tick is not None, "did not reach the grasp pose within 60 s"
+    # Not before the straight-line time at the nominal speed plus its reaction.
+    distance = np.linalg.norm(scene.grasp_positions[scene.targets[0]] - HAND)
+    assert tick * PERIOD > distance / SPEED
+
+
+def test_it_notices_a_target_only_after_its_reaction_delay():
+    memory = ParticipantMemory()
+    for time, true_target, known in [(0.0, 2, -1), (0.3, 2, -1), (0.5, 2, 2), (0.6, 0, 2),
+                                     (1.05, 0, 2), (1.1, 0, 0), (1.2, 1, 0)]:
+        memory = notice_target(memory, true_target, time, 0.5)
+        assert memory.known_target == known, time
+
+
+def test_assisting_it_does_nothing_while_the_estimate_names_the_target():
+    scene = sample_grasp_scene(5)
+    participant = GraspParticipant.create(GraspParticipantParams(), "assist", SPEED,
+                                          scene.grasp_positions, scene.grasp_orientations, 5)
+    memory = ParticipantMemory()
+    target = scene.targets[0]
+    for tick in range(60):
+        twist, active, memory = participant.step(memory, tick * PERIOD, tick, HAND, LEVEL,
+                                                 target, target)
+        assert not active and not twist.any()
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_assisting_while_wrong_it_turns_toward_the_target_and_never_pushes_forward(seed):
+    scene = sample_grasp_scene(seed)
+    noisy, quiet = [GraspParticipant.create(
+        params, "assist", SPEED, scene.grasp_positions, scene.grasp_orientations, seed)
+        for params in (GraspParticipantParams(),
+                       GraspParticipantParams(direction_noise=0.0, speed_noise=0.0))]
+    target = scene.targets[0]
+    picked = scene.targets[1]
+    memory = notice_target(ParticipantMemory(), target, 0.0, 0.5)
+    rng = np.random.default_rng(seed)
+    for tick in range(17, 60):  # past its reaction delay
+        position = HAND + rng.uniform(-0.2, 0.2, 3)
+        orientation = multiply(exp_map(rng.normal(0.0, 0.5, 3)), LEVEL)
+        twist, active, _ = noisy.step(memory, tick * PERIOD, tick, position, orientation,
+                                      target, picked)
+        assert active
+        # Noise or not, the forward key stays disabled.
+        assert twist[:3] @ approach_direction(orientation) <= 1e-12
+        twist, active, memory = quiet.step(memory, tick * PERIOD, tick, position,
+                                           orientation, target, picked)
+        assert twist[:3] @ approach_direction(orientation) <= 1e-12
+        # Its turn shrinks the angle to the target's grasp orientation.
+        later = multiply(exp_map(1e-4 * twist[3:]), orientation)
+        goal = scene.grasp_orientations[target]
+        assert angle_between(later, goal) < angle_between(orientation, goal)
+        # Its motion gains on the target against the object picked instead.
+        moved = position + 1e-4 * twist[:3]
+        gap_now = np.subtract(*grasp_errors(position, orientation,
+                                            scene.grasp_positions[[target, picked]],
+                                            scene.grasp_orientations[[target, picked]])[0])
+        gap_then = np.subtract(*grasp_errors(moved, orientation,
+                                             scene.grasp_positions[[target, picked]],
+                                             scene.grasp_orientations[[target, picked]])[0])
+        assert gap_then <= gap_now + 1e-12
+
+
+def blend_loop(positions, orientations, target, start_picked, seconds=30.0, seed=0):
+    """PBP-Alt in a kinematic loop: the policy drives the hand to the selected grasp pose
+    (as the teleop participant would), the participant takes over while it acts; the pose
+    estimator selects. Returns the selections and the participant's activity per tick."""
+    policy_params = GraspParticipantParams()
+    participant = GraspParticipant.create(GraspParticipantParams(), "assist", SPEED,
+                                          positions, orientations, seed)
+    settings = GoalEstimatorSettings(method="pose")
+    position, orientation, memory = HAND.copy(), LEVEL.copy(), ParticipantMemory()
+    velocity, angular = np.zeros(3), np.zeros(3)
+    estimate = None
+    selected = start_picked
+    selections, activity = [], []
+    for tick in range(int(seconds / PERIOD)):
+        if tick:
+            selected, _, estimate = estimate_pose(settings, positions, orientations, position,
+                                                  orientation, velocity, angular, estimate)
+        twist, active, memory = participant.step(memory, tick * PERIOD, tick, position,
+                                                 orientation, target, selected)
+        if not active:
+            twist = np.concatenate(drive_twist(policy_params, SPEED, position, orientation,
+                                               positions[selected], orientations[selected]))
+        velocity, angular = twist[:3], twist[3:]
+        position, orientation = integrate(position, orientation, twist)
+        selections.append(selected)
+        activity.append(active)
+    return np.array(selections), np.array(activity)
+
+
+def test_in_a_blend_loop_it_brings_the_estimate_round_and_then_lets_go():
+    positions = np.array([[1.6, 0.5, 0.675], [1.6, -0.5, 0.675]])
+    orientations = np.array([side_grasp_orientation(0.4), side_grasp_orientation(-0.4)])
+    selections, activity = blend_loop(positions, orientations, target=1, start_picked=0)
+    assert activity.any()
+    first_right = int(np.argmax(selections == 1))
+    assert selections[first_right:].tolist() == [1] * (len(selections) - first_right)
+    assert not activity[first_right + 1:].any()
+
+
+def test_only_its_turn_tells_two_grasps_at_one_place_apart_in_the_loop():
+    place = np.array([1.6, 0.0, 0.83])
+    positions = np.array([place, place])
+    orientations = np.array([top_grasp_orientation(-1.0), top_grasp_orientation(1.0)])
+    selections, activity = blend_loop(positions, orientations, target=0, start_picked=1)
+    assert activity.any() and selections[-1] == 0
+    assert not activity[-10:].any()
+
+
+def test_its_noise_comes_from_the_seed_and_the_tick():
+    # Object 0 seen since the start: noticed by 1.0 s.
+    seen = notice_target(ParticipantMemory(), 0, 0.0, 0.5)
+    scene = sample_grasp_scene(2)
+    commands = {}
+    for seed in (2, 2, 3):
+        participant = GraspParticipant.create(GraspParticipantParams(), "drive", SPEED,
+                                              scene.grasp_positions,
+                                              scene.grasp_orientations, seed)
+        commands.setdefault(seed, []).append(participant.step(
+            seen, 1.0, 33, HAND, LEVEL, 0, -1)[0])
+    np.testing.assert_array_equal(commands[2][0], commands[2][1])
+    assert not np.allclose(commands[2][0], commands[3][0])
+    quiet = GraspParticipant.create(
+        GraspParticipantParams(direction_noise=0.0, speed_noise=0.0), "drive", SPEED,
+        scene.grasp_positions, scene.grasp_orientations, 2)
+    twist = quiet.step(seen, 1.0, 33, HAND, LEVEL, 0, -1)[0]
+    offset = scene.grasp_positions[0] - HAND
+    np.testing.assert_allclose(twist[:3], SPEED * offset / np.linalg.norm(offset))
+
+
+def test_it_takes_the_shared_fields_of_the_reach_participant():
+    reach = VirtualParticipantParams(speed=0.1, rotation_speed=0.6, reaction_delay=0.3,
+                                     turn_slowdown_angle=0.2)
+    params = GraspParticipantParams.from_virtual_participant(reach)
+    assert (params.speed, params.rotation_speed, params.reaction_delay,
+            params.slow_angle) == (0.1, 0.6, 0.3, 0.2)
+    assert params.slow_radius == reach.slow_radius
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (dict(mode="push"), "participant mode 'push' is unknown"),
+    (dict(params=GraspParticipantParams(rotation_speed=0.0)),
+     "rotation_speed must be finite and positive"),
+    (dict(params=GraspParticipantParams(reaction_delay=-1.0)),
+     "reaction_delay must be finite and not negative"),
+    (dict(nominal_speed=0.0), "nominal_speed must be finite and positive"),
+    (dict(grasp_orientations=[[1.0, 0, 0, 0]]), r"grasp_orientations \(M, 4\)"),
+])
+def test_bad_arguments_say_what_is_wrong(arguments, message):
+    values = dict(params=GraspParticipantParams(), mode="drive", nominal_speed=SPEED,
+                  grasp_positions=[[1.5, 0.0, 0.7], [1.5, 0.5, 0.7]],
+                  grasp_orientations=[LEVEL, LEVEL])
+    values.update(arguments)
+    with pytest.raises(ValueError, match=message):
+        GraspParticipant.create(**values)

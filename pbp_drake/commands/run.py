@@ -12,13 +12,13 @@ from pbp_drake.builder import build_diagram, find_system, run_task, run_task_str
 from pbp_drake.cli_types import method_list, port, realtime_rate, wait_seconds
 from pbp_drake.console import (
     CAMERAS, Console, LiveRun, Progress, RobotCamera, method_name, result_text)
+from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, mark_replay)
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, ScenarioError, load_scenario_file,
     resolve, with_method)
-from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
 
@@ -156,6 +156,14 @@ def _run_scene(args, resolved, meshcat):
     if args.log:
         raise ScenarioError("--log streams an HSR task's per-tick rows; this scenario uses "
                             "the 2-D toy robot")
+    session = [flag for flag, value in (("--participant", args.participant),
+                                        ("--methods", args.methods),
+                                        ("--output", args.output),
+                                        ("--practice", args.practice),
+                                        ("--answers", args.answers)) if value]
+    if session:
+        raise ScenarioError(f"{', '.join(session)}: user-study sessions run the HSR tasks; "
+                            "this scenario uses the 2-D toy robot")
     diagram = build_diagram(resolved, meshcat)
     console = None
     if meshcat is not None:

@@ -70,3 +70,13 @@ def test_a_session_that_no_browser_joins_stops_and_saves_nothing(repo, tmp_path,
     assert code == 2
     assert "no browser opened" in err and "nothing was run or recorded" in err
     assert not any(output.rglob("*")) if output.exists() else True
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["--participant", "P01"], "--participant"),
+    (["--methods", "teleop", "--answers", "tiredness=1,ease=2"], "--methods, --answers"),
+])
+def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
+    assert main(["run", str(repo / QUICK), "--no-meshcat", *argv]) == 2
+    err = capsys.readouterr().err
+    assert f"{named}: user-study sessions run the HSR tasks" in err

@@ -33,11 +33,11 @@ def check_pose_command(command, name="pose_command"):
     command = np.asarray(command)
     if not np.isfinite(command).all():
         bad = [field for field, value in zip(_FIELDS, command) if not np.isfinite(value)]
-        raise ValueError(f"{name} {', '.join(bad)} is NaN or infinite: {list(command)}")
+        raise ValueError(f"{name} {', '.join(bad)} is NaN or infinite: {command.tolist()}")
     quaternion = command[_QUATERNION]
     norm = float(np.sqrt(quaternion @ quaternion))
     if abs(norm - 1.0) > UNIT_TOLERANCE:
-        raise ValueError(f"{name} (qw, qx, qy, qz) {list(quaternion)} is not a unit "
+        raise ValueError(f"{name} (qw, qx, qy, qz) {quaternion.tolist()} is not a unit "
                          f"quaternion: norm {norm:.9g}, must be within {UNIT_TOLERANCE:g} "
                          f"of 1")
     return quaternion / norm

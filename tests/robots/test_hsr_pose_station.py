@@ -10,13 +10,14 @@ from pydrake.math import RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import ConstantVectorSource
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, ZeroOrderHold
 
 from pbp_drake.core.grasp_task import approach_direction, grasp_success, sample_grasp_scene
 from pbp_drake.core.quaternion import angle_between, exp_map, multiply
 from pbp_drake.robots import HsrStationConfig, hsr_initial_hand_pose, make_hsr_station
 from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, add_hsr
-from pose_drive import drive, turned
+from pbp_drake.systems.layouts import PoseState
+from pose_drive import PoseWaypoints, drive, turned
 
 POSITION_TOLERANCE = 0.01  # m, after settling
 ANGLE_TOLERANCE = np.radians(3.0)
@@ -160,3 +161,34 @@ def test_the_pose_station_has_pose_ports_and_an_unknown_command_is_refused():
     assert not make_hsr_station().HasOutputPort("hand_pose")
     with pytest.raises(ValueError, match="command must be one of"):
         make_hsr_station(command="twist")
+
+
+def test_a_control_loop_ticking_the_next_pose_finds_the_hand_there_at_each_tick(start):
+    # As PoseHandOver sends it: at each tick the pose to be at at the next tick and the
+    # twist to move at. The station ramps into it between ticks, so at every tick the hand
+    # is where the command of the tick before put it, turning and moving at once.
+    period = 0.03
+    station = make_hsr_station(HsrStationConfig(command_period=period), command="pose")
+    p, q = start[:3], start[3:7]
+    segments = [(0.5, 2.0, p + [0.1, 0.1, 0.05], turned([0, 0, 1], 45, q)),
+                (3.5, 2.5, p, turned([0, 1, 0], 90, q))]
+    builder = DiagramBuilder()
+    builder.AddSystem(station)
+    # The command sampled at tick k is the waypoints' pose at tick k + 1.
+    ahead = builder.AddSystem(PoseWaypoints(start, [(s[0] - period, *s[1:])
+                                                    for s in segments]))
+    hold = builder.AddSystem(ZeroOrderHold(period, PoseState.size))
+    builder.Connect(ahead.get_output_port(), hold.get_input_port())
+    builder.Connect(hold.get_output_port(), station.GetInputPort("pose_command"))
+    now = builder.AddSystem(PoseWaypoints(start, segments))
+    hands = LogVectorOutput(station.GetOutputPort("hand_pose"), builder, period)
+    poses = LogVectorOutput(now.get_output_port(), builder, period)
+    simulator = Simulator(builder.Build())
+    hold.SetVectorState(hold.GetMyMutableContextFromRoot(simulator.get_mutable_context()),
+                        start)
+    simulator.AdvanceTo(7.0)
+    hand = hands.FindLog(simulator.get_context()).data()
+    pose = poses.FindLog(simulator.get_context()).data()
+    assert np.linalg.norm(hand[:3] - pose[:3], axis=0).max() < 0.002
+    assert np.degrees(angle_between(hand[3:7], pose[3:7]).max()) < 1.0
+    assert np.degrees(angle_between(hand[3:7, -1], pose[3:7, -1])) < 0.01

@@ -8,8 +8,6 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.systems.layouts import EeCommand
-
 # How much more a unit of the hand's velocity error (m/s) weighs than a unit of the joints'
 # drift toward their nominal positions (m/s, rad/s): the drift takes what the hand's motion
 # leaves free and costs the hand nothing measurable.
@@ -107,7 +105,7 @@ class WholeBodyDiffIk(LeafSystem):
         input_ports:
         - X_WE_desired (without command_ramp)
         - V_WE_desired (without command_ramp)
-        - ee_command (with command_ramp)
+        - ee_command (with an EeCommandRamp; pose_command with a PoseCommandRamp)
         - robot_state
         output_ports:
         - desired_state
@@ -143,7 +141,8 @@ class WholeBodyDiffIk(LeafSystem):
     ``ee_command`` instead and makes ``X_WE_desired`` and ``V_WE_desired`` from it itself,
     as an ``EeCommandToPose`` in front of it would (the same arithmetic, its last-heading
     state and sampling events declared here): the station does so, which spares two
-    Python calls at each step.
+    Python calls at each step. With a ``PoseCommandRamp`` (``hsr_pose_systems``) the
+    command is a ``PoseState`` read on ``pose_command``: the ramp names and sizes the port.
     """
 
     def __init__(self, plant, frame_E, time_step, plant_time_step, motor_joints, *,
@@ -185,7 +184,8 @@ class WholeBodyDiffIk(LeafSystem):
                 "X_WE_desired", AbstractValue.Make(RigidTransform()))
             self._twist_port = self.DeclareVectorInputPort("V_WE_desired", 6)
         else:
-            self._command_port = self.DeclareVectorInputPort("ee_command", EeCommand.size)
+            self._command_port = self.DeclareVectorInputPort(command_ramp.port_name,
+                                                             command_ramp.command_size)
         self._robot_state_port = self.DeclareVectorInputPort(
             "robot_state", plant.num_multibody_states())
         # [q at t_end, v, t_end, hold]: the plan reaches q at t_end moving at v; hold is
@@ -207,6 +207,10 @@ class WholeBodyDiffIk(LeafSystem):
         return self._twist_port
 
     def get_ee_command_input_port(self):
+        return self._command_port
+
+    def get_command_input_port(self):
+        """The command port of a diff IK with a ramp, whichever command it reads."""
         return self._command_port
 
     def get_robot_state_input_port(self):

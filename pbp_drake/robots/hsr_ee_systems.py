@@ -86,6 +86,10 @@ class EeCommandRamp:
     needs no system between the command and itself (two Python calls fewer at each of its
     steps). See `EeCommandToPose` for what the pose and velocity are."""
 
+    # The diff IK's command port, which this ramp reads.
+    port_name = "ee_command"
+    command_size = EeCommand.size
+
     def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
         self.R_E0 = RotationMatrix(R_E0)
         self.period = command_period

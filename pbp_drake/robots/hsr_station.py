@@ -9,6 +9,11 @@ motion, in the shape of manipulation's hardware station::
     plant ─► EeStateFromPlant ─► ee_state
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
 
+``make_hsr_station(config, meshcat, command="pose")`` is the six-DoF station: the same
+plant and diff IK, commanding the hand frame ``hand_palm_link`` (the grasp task's H) by a
+``PoseState`` ``pose_command`` (``PoseCommandRamp``), with the measured ``hand_pose``
+(``PoseStateFromPlant``) as an output besides ``ee_state``; see docs/six_dof.md.
+
 Gravity is off, which stands for the ideal gravity compensation of the real robot's
 controllers; nothing else compensates it. The base and the arm are solved together by
 one differential IK, so a target out of the arm's reach moves the base; its plan keeps
@@ -57,6 +62,7 @@ from pbp_drake.robots.hsr_model import (
     actuator_name,
     add_hsr,
 )
+from pbp_drake.robots.hsr_pose_systems import HAND_FRAME, PoseCommandRamp, PoseStateFromPlant
 from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
     CylinderObstacle,
     HsrStationConfig,
@@ -70,6 +76,9 @@ from pbp_drake.systems.obstacle_geometry import CylinderObstacleGeometry
 # the hand starts in front of the base with room to move both ways along x with the
 # arm alone; arm_lift then sets the height.
 READY_ARM_FLEX = -0.5
+# What make_hsr_station's hand follows: an EeCommand (position and heading of hand_ee_link)
+# or a PoseState (the full pose and twist of hand_palm_link).
+COMMANDS = ("heading", "pose")
 
 
 def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
@@ -113,10 +122,11 @@ def _ready_pose(plant, model, config):
     return q0, plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(context)
 
 
-def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp):
-    """The whole-body diff IK with the model's position and velocity limits and the
-    config's acceleration limits, the arm drifting back to the ready pose ``q0``, reading
-    the end-effector command through ``command_ramp``."""
+def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp,
+                  frame_name=END_EFFECTOR_FRAME):
+    """The whole-body diff IK of the frame ``frame_name`` with the model's position and
+    velocity limits and the config's acceleration limits, the arm drifting back to the
+    ready pose ``q0``, reading the hand's command through ``command_ramp``."""
     v_lower, v_upper = plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()
     # The torso does not move the hand (it carries only the head) and follows the lift
     # through the coupler in the plant, so diff IK leaves it where it is.
@@ -131,14 +141,15 @@ def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp):
         if name in ARM_JOINT_NAMES:
             centering[joint.position_start()] = config.arm_centering_gain
     return WholeBodyDiffIk(
-        plant, plant.GetFrameByName(END_EFFECTOR_FRAME, model), config.diff_ik_time_step,
+        plant, plant.GetFrameByName(frame_name, model), config.diff_ik_time_step,
         config.plant.time_step, motor_joints,
         position_limits=(plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()),
         velocity_limits=(v_lower, v_upper), acceleration_limits=(-accelerations, accelerations),
         q_nominal=q0, centering_gain=centering, command_ramp=command_ramp)
 
 
-def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Diagram:
+def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
+                     command: str = "heading") -> Diagram:
     """The HSR, its whole-body end-effector controller, and optionally obstacles and a
     Meshcat visualizer, as one Diagram named ``hsr_station``.
 
@@ -146,15 +157,20 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
         config: the station's knobs (``HsrStationConfig()`` when None); validated here.
         meshcat: if given, a MeshcatVisualizer inside draws the illustration geometry
             (the robot and the obstacles).
+        command: ``"heading"`` (the hand follows ``ee_command``) or ``"pose"`` (the hand
+            frame ``hand_palm_link`` follows ``pose_command``, a ``PoseState``, and the
+            station outputs ``hand_pose`` too).
 
     .. pydrake_system::
 
         name: hsr_station
         input_ports:
-        - ee_command
+        - ee_command (command="heading")
+        - pose_command (command="pose")
         - obstacle_positions (with config.obstacles)
         output_ports:
         - ee_state
+        - hand_pose (command="pose")
         - state
         - desired_state
         - body_poses
@@ -172,11 +188,21 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     smallest robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
     The obstacles do not push the robot (their contact with it is filtered out).
 
+    ``pose_command`` is ``[p (3), q (4), v (3), w (3)]`` (``PoseState``, world frame) of
+    ``hand_palm_link``: the pose to be at (at the next tick with ``command_period``) and
+    the twist to move at; a NaN field or a quaternion whose norm is off 1 by more than
+    1e-6 is refused by name. ``hand_pose`` is that frame's measured ``PoseState`` (its
+    quaternion signed nearer the start orientation). The diff IK is the same QP, tracking
+    the whole pose (see ``PoseCommandRamp`` and docs/six_dof.md).
+
     A fresh context starts at rest in the ready pose with the diff IK already there, so
     holding ``hsr_initial_ee_state(station)[:7]`` keeps the robot still.
     """
     config = config if config is not None else HsrStationConfig()
     validate_hsr_station_config(config)
+    if command not in COMMANDS:
+        raise ValueError(f"make_hsr_station command must be one of {COMMANDS}, got "
+                         f"{command!r}")
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlant(config.plant, builder)
     model = add_hsr(plant)
@@ -195,11 +221,15 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
 
     # The diff IK reads the command's pose as the one to have at the end of its step.
     ramp = EeCommandRamp(R_E0, config.command_period, lead=config.diff_ik_time_step)
+    frame_name = END_EFFECTOR_FRAME
+    if command == "pose":
+        ramp = PoseCommandRamp(config.command_period, lead=config.diff_ik_time_step)
+        frame_name = HAND_FRAME
     # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()
                     for index in plant.GetJointActuatorIndices(model)]
-    diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, model, q0, config,
-                                                              motor_joints, ramp))
+    diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(
+        plant, model, q0, config, motor_joints, ramp, frame_name))
     # Read at initialization only, so that the plan starts from the plant's state (no
     # jump even if the caller moves the robot in the context).
     builder.Connect(plant.get_state_output_port(), diff_ik.get_robot_state_input_port())
@@ -210,8 +240,10 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, ee_body))
     builder.Connect(plant.get_state_output_port(), ee_state.get_plant_state_input_port())
 
-    builder.ExportInput(diff_ik.get_ee_command_input_port(), "ee_command")
+    builder.ExportInput(diff_ik.get_command_input_port(), ramp.port_name)
     builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
+    if command == "pose":
+        _add_hand_pose(builder, plant, model, q0)
     builder.ExportOutput(plant.get_state_output_port(), "state")
     builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
     builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
@@ -223,6 +255,18 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None) -> Di
     station = builder.Build()
     station.set_name("hsr_station")
     return station
+
+
+def _add_hand_pose(builder, plant, model, q0):
+    """The output hand_pose: hand_palm_link's PoseState, signed nearer its start."""
+    frame_H = plant.GetFrameByName(HAND_FRAME, model)
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q0)
+    q_start = frame_H.CalcPoseInWorld(context).rotation().ToQuaternion().wxyz()
+    hand_pose = builder.AddNamedSystem("hand_pose", PoseStateFromPlant(plant, frame_H,
+                                                                       q_start))
+    builder.Connect(plant.get_state_output_port(), hand_pose.get_plant_state_input_port())
+    builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
 
 
 def _add_obstacles(builder, plant, scene_graph, model, obstacles):
@@ -289,3 +333,10 @@ def hsr_initial_ee_state(station: Diagram) -> np.ndarray:
     """The hand's ``ee_state`` (``EeState``) where ``station`` (from ``make_hsr_station``)
     starts: read off a fresh context, so nothing is built twice."""
     return np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))
+
+
+def hsr_initial_hand_pose(station: Diagram) -> np.ndarray:
+    """The hand's ``hand_pose`` (``PoseState``) where a pose station (``make_hsr_station(
+    ..., command="pose")``) starts, at rest: holding its first 7 entries (and a zero
+    twist) as ``pose_command`` keeps the robot still."""
+    return np.array(station.GetOutputPort("hand_pose").Eval(station.CreateDefaultContext()))

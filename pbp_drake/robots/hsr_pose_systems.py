@@ -1,0 +1,145 @@
+"""The HSR pose station's task-space adapters: a six-DoF hand command (`PoseState`) in, as
+the arithmetic the station's diff IK applies itself (`PoseCommandRamp`), and the hand's
+measured pose and twist out (`PoseStateFromPlant`).
+
+The hand frame H is `hand_palm_link` (docs/grasp_task.md): origin at the palm, +z_H the
+approach direction, +y_H the direction the fingers close along. Orientations are unit
+quaternions (w, x, y, z) mapping H to the world (`pbp_drake.core.quaternion`); angular
+velocities are world-frame.
+"""
+
+import numpy as np
+from pydrake.common.eigen_geometry import Quaternion
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core.quaternion import UNIT_TOLERANCE, aligned, exp_map, multiply
+from pbp_drake.systems.layouts import PoseState
+
+# The frame the pose station commands and measures: the grasp task's hand frame H.
+HAND_FRAME = "hand_palm_link"
+# PoseState's entries, by index.
+_POSITION, _QUATERNION, _VELOCITY, _ANGULAR = (slice(0, 3), slice(3, 7), slice(7, 10),
+                                               slice(10, 13))
+_FIELDS = ("x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz")
+
+
+def check_pose_command(command, name="pose_command"):
+    """The command's unit quaternion (4,), or ValueError naming the fields that are NaN or
+    infinite, or the quaternion whose norm is not within `UNIT_TOLERANCE` of 1.
+
+    A bad command must stop the robot's controller with a reason, not turn into NaN joint
+    targets (which the plant's PD would follow into a crash far from the cause)."""
+    command = np.asarray(command)
+    if not np.isfinite(command).all():
+        bad = [field for field, value in zip(_FIELDS, command) if not np.isfinite(value)]
+        raise ValueError(f"{name} {', '.join(bad)} is NaN or infinite: {command.tolist()}")
+    quaternion = command[_QUATERNION]
+    norm = float(np.sqrt(quaternion @ quaternion))
+    if abs(norm - 1.0) > UNIT_TOLERANCE:
+        raise ValueError(f"{name} (qw, qx, qy, qz) {quaternion.tolist()} is not a unit "
+                         f"quaternion: norm {norm:.9g}, must be within {UNIT_TOLERANCE:g} "
+                         f"of 1")
+    return quaternion / norm
+
+
+class PoseCommandRamp:
+    """What `WholeBodyDiffIk` aims at, read from a six-DoF command `pose_command`
+    (`PoseState`: the hand's pose to be at, `[p (3), q (4)]`, and the twist to move at,
+    `[v (3), w (3)]`, world frame).
+
+    `X_WE_desired` at time t is the command carried along its own twist for `ahead`
+    seconds, `(Exp(w ahead) q, p + v ahead)`; `V_WE_desired` is `[w, v]`. `ahead` is `lead`
+    (the diff IK's period: it reads the pose as the one to have at the end of its step),
+    less, with a `command_period`, the time left to the next tick: a control loop sends at
+    each tick the state to be in at the next tick (as `PoseHandOver` does), so between
+    ticks the hand ramps into it along the command's twist instead of stepping to it once
+    a tick (which would leave the hand behind by most of a tick's travel and turn).
+
+    The command carries its angular velocity, so unlike `EeCommandRamp` (whose heading
+    rate comes from the last tick's heading) this ramp keeps no state: its
+    `declare_heading_sample` declares nothing and its `heading_rate` is not used (the
+    names are the ramp interface `WholeBodyDiffIk` calls).
+    """
+
+    port_name = "pose_command"
+    command_size = PoseState.size
+
+    def __init__(self, command_period=None, lead=0.0):
+        self.period = command_period
+        self.lead = float(lead)
+
+    def declare_heading_sample(self, system, command_port):
+        """No state: the command's twist is its own rate."""
+        return None
+
+    def heading_rate(self, context, last_heading_index, command):
+        """Unused by `pose` and `velocity_into` (the command carries `w`)."""
+        return 0.0
+
+    def velocity_into(self, command, heading_rate, velocity):
+        """Writes `V_WE_desired` `[w, v]` into `velocity` (6,) and returns it."""
+        velocity[:3] = command[_ANGULAR]
+        velocity[3:] = command[_VELOCITY]
+        return velocity
+
+    def pose(self, command, heading_rate, time):
+        """`X_WE_desired` at `time`; refuses a NaN or non-unit command (by field)."""
+        quaternion = check_pose_command(command, self.port_name)
+        ahead = self.lead
+        if self.period:
+            next_tick = np.ceil(time / self.period - 1e-9) * self.period
+            ahead -= max(0.0, next_tick - time)
+        turned = multiply(exp_map(command[_ANGULAR] * ahead), quaternion)
+        return RigidTransform(RotationMatrix(Quaternion(turned)),
+                              command[_POSITION] + command[_VELOCITY] * ahead)
+
+
+class PoseStateFromPlant(LeafSystem):
+    """Reads the hand's pose and twist off the plant's state.
+
+    .. pydrake_system::
+
+        name: PoseStateFromPlant
+        input_ports:
+        - plant_state
+        output_ports:
+        - hand_pose
+
+    `plant_state` is `plant`'s state output; `hand_pose` is `[p_WH (3), q_WH (4), v_WH (3),
+    w_WH (3)]` (`PoseState`) of `frame_H`, world frame. Of `q` and `-q` it gives the one
+    nearer `q_reference` (the station passes the hand's start orientation), so that the
+    stream does not flip sign as Drake's conversion from a rotation matrix may; users treat
+    both signs as one orientation anyway (`pbp_drake.core.quaternion`).
+
+    The kinematics come from a context of `plant` of this system's own, set to the plant's
+    state (as `EeStateFromPlant`: one body's pose rather than the plant's list of all).
+    """
+
+    def __init__(self, plant, frame_H, q_reference):
+        super().__init__()
+        self._plant = plant
+        self._frame = frame_H
+        self._world = plant.world_frame()
+        self._reference = np.asarray(q_reference, float)
+        self._plant_context = plant.CreateDefaultContext()
+        self._plant_state_port = self.DeclareVectorInputPort(
+            "plant_state", plant.num_multibody_states())
+        self._pose_port = self.DeclareVectorOutputPort(
+            "hand_pose", PoseState.size, self._calc_pose)
+
+    def get_plant_state_input_port(self):
+        return self._plant_state_port
+
+    def get_hand_pose_output_port(self):
+        return self._pose_port
+
+    def _calc_pose(self, context, output):
+        plant_context = self._plant_context
+        self._plant.SetPositionsAndVelocities(plant_context,
+                                              self._plant_state_port.Eval(context))
+        X_WH = self._frame.CalcPoseInWorld(plant_context)
+        V_WH = self._frame.CalcSpatialVelocityInWorld(plant_context)
+        quaternion = aligned(X_WH.rotation().ToQuaternion().wxyz(), self._reference)
+        output.SetFromVector(np.concatenate([X_WH.translation(), quaternion,
+                                             V_WH.translational(), V_WH.rotational()]))

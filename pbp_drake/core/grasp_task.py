@@ -82,14 +82,20 @@ def _about(axis, angle):
 
 
 def side_grasp_orientation(yaw):
-    """The hand's quaternion (4,) grasping from the side at `yaw` (rad): `Rz(yaw) Ry(90)`."""
-    return multiply(_about(Z_AXIS, yaw), _about(Y_AXIS, np.pi / 2))
+    """The hand's quaternion (4,) grasping from the side at `yaw` (rad):
+    `Rz(yaw) Ry(90) Rz(180)`. At yaw 0 it is the HSR's hand at the station's start (x_H up,
+    y_H along -y: the model's hand_palm_link), so a grasp straight ahead needs no wrist roll;
+    without the last half turn the robot reached it with the wrist flipped over."""
+    return multiply(multiply(_about(Z_AXIS, yaw), _about(Y_AXIS, np.pi / 2)),
+                    _about(Z_AXIS, np.pi))
 
 
 def top_grasp_orientation(roll):
     """The hand's quaternion (4,) grasping from above with wrist `roll` (rad):
-    `Ry(180) Rz(roll)`."""
-    return multiply(_about(Y_AXIS, np.pi), _about(Z_AXIS, roll))
+    `Ry(180) Rz(roll + 180)`: at roll 0 the start hand pitched down (the arm alone reaches
+    every roll in [-90, 90] degrees then; the model's wrist roll range leaves a gap near +50
+    degrees for the hand turned half a turn)."""
+    return multiply(_about(Y_AXIS, np.pi), _about(Z_AXIS, roll + np.pi))
 
 
 def approach_direction(orientation):

@@ -71,7 +71,8 @@ def test_a_side_grasp_approaches_level_at_its_yaw_with_the_fingers_level(yaw):
     frame = rotation_matrix(side_grasp_orientation(yaw))
     np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-12)
     np.testing.assert_allclose(frame[:, 2], [np.cos(yaw), np.sin(yaw), 0.0], atol=1e-12)
-    np.testing.assert_allclose(frame[:, 0], [0.0, 0.0, -1.0], atol=1e-12)
+    # As the HSR's hand at the start (x_H up): a grasp ahead needs no wrist roll.
+    np.testing.assert_allclose(frame[:, 0], [0.0, 0.0, 1.0], atol=1e-12)
     assert abs(frame[2, 1]) < 1e-12  # the fingers close in a level line
     np.testing.assert_allclose(approach_direction(side_grasp_orientation(yaw)), frame[:, 2],
                                atol=1e-12)
@@ -81,9 +82,9 @@ def test_a_side_grasp_approaches_level_at_its_yaw_with_the_fingers_level(yaw):
 def test_a_top_grasp_approaches_down_turned_by_its_roll(roll):
     frame = rotation_matrix(top_grasp_orientation(roll))
     np.testing.assert_allclose(frame[:, 2], [0.0, 0.0, -1.0], atol=1e-12)
-    # Roll 0: the ready hand pitched down, the fingers closing along +y; right-handed about
-    # the approach axis (down), i.e. clockwise seen from above.
-    np.testing.assert_allclose(frame[:, 1], [np.sin(roll), np.cos(roll), 0.0], atol=1e-12)
+    # Roll 0: the start hand pitched down, the fingers closing along -y (y_H of the start
+    # hand); right-handed about the approach axis (down), i.e. clockwise seen from above.
+    np.testing.assert_allclose(frame[:, 1], [-np.sin(roll), -np.cos(roll), 0.0], atol=1e-12)
 
 
 def test_the_grasp_position_stands_back_from_the_grasp_point_along_the_approach():

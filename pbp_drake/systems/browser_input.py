@@ -81,20 +81,27 @@ def _padded(values, count):
     return np.where(np.isfinite(values), values, 0.0)
 
 
-def raw_axes(gamepad, count):
-    """The first `count` axes of a Meshcat gamepad status as sent (missing ones NaN): what
-    an operator compares to tell whether the sticks moved since a pause."""
-    axes = list(gamepad.axes)[:count]
-    return np.array(axes + [np.nan] * (count - len(axes)), float)
+def raw_values(gamepad, axis_count, button_count=0):
+    """The first `axis_count` axes then `button_count` button values of a Meshcat gamepad
+    status as sent (missing ones NaN): what an operator compares to tell whether the
+    controls moved since a pause."""
+    return np.concatenate([_as_sent(gamepad.axes, axis_count),
+                           _as_sent(gamepad.button_values, button_count)])
 
 
-def fresh_after_pause(guard, meshcat, stale, gamepad, count):
+def _as_sent(values, count):
+    values = list(values)[:count]
+    return np.array(values + [np.nan] * (count - len(values)), float)
+
+
+def fresh_after_pause(guard, meshcat, stale, gamepad, axis_count, button_count=0):
     """The gamepad operators' rule after a `BrowserGuard` pause: Meshcat keeps the last state
-    it received from whichever page sent it, so the axes held when a pause ends are ignored
-    until they change. `stale` is the axes remembered (all NaN: none); returns the new
-    `stale` and whether `gamepad` (read before the guard) may be used."""
+    it received from whichever page sent it, so the controls held when a pause ends are
+    ignored until they change. `stale` is the `raw_values` remembered (all NaN: none);
+    returns the new `stale` and whether `gamepad` (read before the guard) may be used."""
     if guard is not None and guard.wait_while_shared():
-        stale = raw_axes(meshcat.GetGamepad(), count)
-    elif not np.array_equal(raw_axes(gamepad, count), stale, equal_nan=True):
-        stale = np.full(count, np.nan)  # the sticks moved since: read them again
+        stale = raw_values(meshcat.GetGamepad(), axis_count, button_count)
+    elif not np.array_equal(raw_values(gamepad, axis_count, button_count), stale,
+                            equal_nan=True):
+        stale = np.full(len(stale), np.nan)  # the controls moved since: read them again
     return stale, bool(np.isnan(stale).all())

@@ -8,6 +8,7 @@ import time
 import numpy as np
 import pytest
 from foreign_page import ForeignPage
+from test_browser_guard import Attack
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
@@ -218,6 +219,45 @@ def test_pbp_drops_the_forward_key_but_not_the_tip_down(meshcat, rigs):
     rig.press(FORWARD_KEY)
     assert rig.active()
     np.testing.assert_allclose(rig.twist(), twist(angular=ROTATION_SPEED * LEFT), atol=1e-12)
+
+
+def drive_through(rig, attack, after=0.3):
+    """Steps `rig` while `attack` (a second page) runs, then `after` seconds more; returns
+    whether the operator was ever active."""
+    active = False
+    attack.start()
+    while attack.is_alive():
+        rig.step()
+        active |= rig.active()
+        time.sleep(0.005)
+    for _ in range(round(after / PERIOD)):
+        rig.step()
+        active |= rig.active()
+    return active
+
+
+def test_a_second_page_cannot_drive_the_six_dof_keyboard(meshcat, rigs):
+    rig = rigs(keyboard(meshcat, allow_forward=True))
+    presses = [{"type": "button", "name": name}
+               for name in [LEFT_KEY, MODE_LABELS[TRANSLATE], LEFT_KEY] * 5]
+    assert not drive_through(rig, Attack(meshcat, presses=0, messages=presses))
+    assert rig.operator.browser_guard.pauses >= 1
+    assert rig.operator.mode(rig.context) == TRANSLATE  # its R was dropped too
+    rig.press(LEFT_KEY)  # the person's own page drives again
+    np.testing.assert_allclose(rig.twist(), twist(SPEED * LEFT), atol=1e-12)
+
+
+def test_a_second_pages_gamepad_is_ignored_until_the_controls_move(meshcat, rigs):
+    rig = rigs(gamepad(meshcat, allow_forward=True))
+    values = [0.0] * 17
+    values[7] = 1.0  # the other page leaves the right trigger pulled
+    pulled = {"type": "gamepad", "name": "",
+              "gamepad": {"index": 0, "button_values": values, "axes": [0.0] * 4}}
+    assert not drive_through(rig, Attack(meshcat, presses=0, messages=[pulled]))
+    assert list(meshcat.GetGamepad().button_values)[7] == 1.0  # Meshcat still holds it
+    assert not rig.active()
+    rig.gamepad(axes=(0, 1, 0, 0))  # the person's gamepad moves: read again
+    np.testing.assert_allclose(rig.twist(), twist(-SPEED * FORWARD), atol=1e-12)
 
 
 def test_a_nan_hand_pose_is_refused_by_field(meshcat):

@@ -8,10 +8,12 @@ Translations go along these three axes. Rotations are the hand's yaw about world
 roll about its own approach axis z_H (right-handed, the grasp task's roll rho): a side grasp
 differs by a yaw, a top grasp is a pitch down then a roll (docs/grasp_task.md).
 
-The heading is the floor direction of z_H, blended towards that of -x_H (the back of the
-hand) as z_H turns vertical: for a side grasp it is the approach's floor angle (the
-station's `heading`), and it stays defined for a hand pointing straight down, where -x_H
-points ahead (the ready hand pitched down keeps +x as forward).
+The heading is the floor direction of z_H, blended towards that of x_H as z_H turns
+vertical (by the square of z_H's vertical component), with x_H signed to lean the way the
+hand was pitched: -x_H (the back of the hand) for a hand pointing down, +x_H for one
+pointing up. For a side grasp it is the approach's floor angle (the station's `heading`);
+it stays defined, and continuous, through a pitch straight down or up, where the ready
+hand pitched by +-90 degrees keeps world +x as forward.
 """
 
 import numpy as np
@@ -35,12 +37,14 @@ def operator_frame(orientation):
     """`(forward, left, up)` world unit vectors (3,) of the operator frame of a hand at
     `orientation` (see the module's docstring)."""
     axes = hand_axes(orientation)
-    approach, back = axes[:, 2], -axes[:, 0]
-    blend = approach + approach[2] ** 2 * back
+    approach = axes[:, 2]
+    # x_H lies along the pitch's plane; approach_z * |approach_z| both weighs it in as z_H
+    # turns vertical and signs it to lean forward (a pitch down turns -x_H ahead).
+    blend = approach + approach[2] * abs(approach[2]) * axes[:, 0]
     heading = np.array([blend[0], blend[1], 0.0])
     norm = np.linalg.norm(heading)
-    # Rare poses cancel the blend (z_H tilted up and back with -x_H leaning the other way):
-    # take world +x rather than no frame.
+    # A pose whose two horizontal parts cancel exactly would have no heading: take world +x
+    # rather than none.
     forward = heading / norm if norm > 1e-9 else np.array([1.0, 0.0, 0.0])
     return forward, np.cross(UP, forward), UP.copy()
 

@@ -188,6 +188,7 @@ def test_the_mode_key_turns_the_arrows_from_translation_to_rotation(meshcat, rig
     # The page shows the mode: the button now carries the rotate label.
     assert MODE_LABELS[ROTATE] in meshcat.GetButtonNames()
     assert MODE_LABELS[TRANSLATE] not in meshcat.GetButtonNames()
+    wait_for(lambda: MODE_LABELS[ROTATE].encode() in rig.page.received())  # sent to the page
     rig.press(FORWARD_KEY)  # ↑ now tips the approach axis down (about the hand's left)
     np.testing.assert_allclose(rig.twist(), twist(angular=ROTATION_SPEED * LEFT), atol=1e-12)
     rig.step(round(HOLD_TIME / PERIOD))

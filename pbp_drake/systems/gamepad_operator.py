@@ -6,6 +6,7 @@ import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
 from pbp_drake.systems.browser_guard import BrowserGuard
+from pbp_drake.systems.browser_input import apply_dead_zone, fresh_after_pause, gamepad_values
 from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
@@ -83,44 +84,26 @@ class GamepadOperator(SampledOperator):
     def _update(self, context, discrete_state):
         # Read before the connections are counted (see KeyboardOperator._update).
         gamepad = self._meshcat.GetGamepad()
-        stale = context.get_discrete_state(self._stale_index).value()
-        if self.browser_guard is not None and self.browser_guard.wait_while_shared():
-            stale = _stick_axes(self._meshcat.GetGamepad())
-        elif not np.array_equal(_stick_axes(gamepad), stale, equal_nan=True):
-            stale = np.full(_STICK_AXES, np.nan)  # the sticks moved since: read them again
+        stale, fresh = fresh_after_pause(
+            self.browser_guard, self._meshcat,
+            context.get_discrete_state(self._stale_index).value(), gamepad, _STICK_AXES)
         discrete_state.get_mutable_vector(self._stale_index).set_value(stale)
-        if np.isnan(stale).all():
+        if fresh:
             self._store_sample(discrete_state, *self._command(context, gamepad))
         else:
             self._store_sample(discrete_state, np.zeros(OperatorCommand.size), False)
 
     def _command(self, context, gamepad):
-        axes = list(gamepad.axes)
-        # The browser sends an empty status when the gamepad disconnects; Meshcat then
-        # keeps the old index, so empty axes also mean "no gamepad".
-        if gamepad.index is None or len(axes) < 2:
+        values = gamepad_values(gamepad, _STICK_AXES)
+        if values is None:
             return np.zeros(4), False
-        axes += [0.0] * (_STICK_AXES - len(axes))
+        axes = values[0]
         # Browser axes: x right, y down. Robot frame: forward, left.
-        stick = self._apply_dead_zone(np.array([-axes[LEFT_STICK_Y], -axes[LEFT_STICK_X]]))
-        turn = self._apply_dead_zone(np.array([-axes[RIGHT_STICK_X]]))[0]
+        stick = apply_dead_zone([-axes[LEFT_STICK_Y], -axes[LEFT_STICK_X]], self._dead_zone)
+        turn = apply_dead_zone([-axes[RIGHT_STICK_X]], self._dead_zone)[0]
         if not self._allow_forward:
             stick[0] = min(stick[0], 0.0)
         active = bool(np.any(stick != 0) or turn != 0)
         heading = EeState(self._ee_state_port.Eval(context)).heading
         velocity = rotate_planar(self._speed * stick, heading)
         return np.array([velocity[0], velocity[1], 0.0, self._rotation_speed * turn]), active
-
-    def _apply_dead_zone(self, stick):
-        """Zero within `dead_zone` of the centre, then rising from 0 to 1 at full tilt."""
-        magnitude = np.linalg.norm(stick)
-        if magnitude <= self._dead_zone:
-            return np.zeros_like(stick)
-        scaled = (min(magnitude, 1.0) - self._dead_zone) / (1.0 - self._dead_zone)
-        return stick * (scaled / magnitude)
-
-
-def _stick_axes(gamepad):
-    """The first stick axes of a Meshcat gamepad status (missing ones NaN)."""
-    axes = list(gamepad.axes)[:_STICK_AXES]
-    return np.array(axes + [np.nan] * (_STICK_AXES - len(axes)), float)

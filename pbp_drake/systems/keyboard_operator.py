@@ -6,6 +6,7 @@ import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
 from pbp_drake.systems.browser_guard import BrowserGuard
+from pbp_drake.systems.browser_input import HeldButtons
 from pbp_drake.systems.layouts import EeState, OperatorCommand
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
@@ -94,22 +95,18 @@ class KeyboardOperator(SampledOperator):
                  nominal_speed=None, exclusive=True):
         super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
-        self._meshcat = meshcat
         self.browser_guard = BrowserGuard(meshcat) if exclusive else None
         self._allow_forward = bool(allow_forward)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
-        self._hold_time = float(params.hold_time)
-        self._buttons = [name for name in KEY_BUTTONS
-                         if allow_forward or name != FORWARD_BUTTON]
-        for name in self._buttons:
-            meshcat.AddButton(name, KEY_BUTTONS[name])
-        self._axes = np.array([_KEY_AXES[name] for name in self._buttons])
+        self._keys = HeldButtons(meshcat, {name: code for name, code in KEY_BUTTONS.items()
+                                           if allow_forward or name != FORWARD_BUTTON},
+                                 params.hold_time)
+        self._axes = np.array([_KEY_AXES[name] for name in self._keys.names])
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
-        n = len(self._buttons)
         # Per button: the click count last seen, then the time of its last click.
         self._keys_index = self.DeclareDiscreteState(
-            np.concatenate([np.zeros(n), np.full(n, -np.inf)]))
+            self._keys.released(np.zeros(len(self._keys))))
         self.DeclareInitializationDiscreteUpdateEvent(self._snapshot)
         self._declare_operator_outputs()
 
@@ -118,48 +115,30 @@ class KeyboardOperator(SampledOperator):
 
     def button_names(self):
         """The names of the buttons this operator added to Meshcat."""
-        return list(self._buttons)
+        return list(self._keys.names)
 
     def Delete(self):
         """Removes this operator's buttons from Meshcat (they stay there otherwise)."""
-        for name in self._buttons:
-            self._meshcat.DeleteButton(name, strict=False)
-
-    def _clicks(self):
-        return np.array([self._meshcat.GetButtonClicks(name) for name in self._buttons],
-                        float)
-
-    def _released_keys(self):
-        """The key state with the clicks so far seen and no key held."""
-        return np.concatenate([self._clicks(), np.full(len(self._buttons), -np.inf)])
+        self._keys.delete()
 
     def _snapshot(self, context, discrete_state):
-        discrete_state.get_mutable_vector(self._keys_index).set_value(self._released_keys())
+        discrete_state.get_mutable_vector(self._keys_index).set_value(self._keys.released())
 
     def _update(self, context, discrete_state):
         # Meshcat is read once a tick; the key state and the command come from that read.
         # The connections are counted after the read: a click read here came from a page
         # connected before the count.
-        clicks = self._clicks()
+        clicks = self._keys.clicks()
         if self.browser_guard is not None and self.browser_guard.wait_while_shared():
-            keys = self._released_keys()  # what another page sent does not count
+            keys = self._keys.released()  # what another page sent does not count
         else:
-            keys = self._next_keys(context, clicks)
+            keys = self._keys.step(context.get_discrete_state(self._keys_index).value(),
+                                   clicks, context.get_time())
         discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
         self._store_sample(discrete_state, *self._command(context, keys))
 
-    def _next_keys(self, context, clicks):
-        n = len(self._buttons)
-        keys = context.get_discrete_state(self._keys_index).value()
-        last_clicks, last_times = keys[:n], keys[n:]
-        # A count that drops (the button was re-added elsewhere) resyncs without a click.
-        clicked = clicks > last_clicks
-        times = np.where(clicked, context.get_time(), last_times)
-        return np.concatenate([clicks, times])
-
     def _command(self, context, keys):
-        n = len(self._buttons)
-        held = context.get_time() - keys[n:] < self._hold_time - 1e-9
+        held = self._keys.held(keys, context.get_time())
         forward, left, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(3)
         local = np.array([forward, left])
         norm = np.linalg.norm(local)

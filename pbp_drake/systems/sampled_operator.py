@@ -33,14 +33,16 @@ class SampledOperator(LeafSystem):
     ports first, and call `_declare_operator_outputs()` once. Sampling into discrete state
     keeps the operator deterministic and loggable, and its command stays constant over a
     control period as a human's keyboard read would. It samples at the sense stage of each tick
-    (`pbp_drake.systems.tick`). `operator_command` is a velocity (D);
+    (`pbp_drake.systems.tick`). `operator_command` is a velocity (D; a subclass may name
+    the port otherwise with `command_name`);
     `operator_active` is 1 while the operator acts, else 0.
     """
 
-    def __init__(self, dimension, control_period):
+    def __init__(self, dimension, control_period, command_name="operator_command"):
         super().__init__()
         self._dimension = int(dimension)
         self._period = float(control_period)
+        self._command_name = command_name
 
     def _declare_operator_outputs(self):
         d = self._dimension
@@ -49,7 +51,7 @@ class SampledOperator(LeafSystem):
         # operator may watch systems that depend on its own output.
         held = {self.discrete_state_ticket(self._sample_index)}
         self._command_port = self.DeclareVectorOutputPort(
-            "operator_command", d,
+            self._command_name, d,
             lambda context, output: output.SetFromVector(self._held(context)[:d]),
             prerequisites_of_calc=held)
         self._active_port = self.DeclareVectorOutputPort(
@@ -73,9 +75,13 @@ class SampledOperator(LeafSystem):
 
     def _store_sample(self, discrete_state, command, active):
         """Writes one sample; subclasses that override `_update` call this."""
-        command = validate_command(np.asarray(command, float).reshape(self._dimension))
+        command = self._validate(np.asarray(command, float).reshape(self._dimension))
         discrete_state.get_mutable_vector(self._sample_index).set_value(
             np.append(command, 1.0 if active else 0.0))
+
+    def _validate(self, command):
+        """The command checked (NaN or infinite refused by name), as a float array."""
+        return validate_command(command, self._command_name)
 
     def _sample(self, context):
         raise NotImplementedError

@@ -1,14 +1,17 @@
-"""Meshcat drawing shared by the scene visualizers: a top-down view framed on a 2-D scene, and
-paths drawn so that a recording replays them.
+"""Meshcat drawing shared by the scene visualizers: a top-down view framed on a 2-D scene,
+paths drawn so that a recording replays them, and axis triads for six-DoF poses.
 
 Meshcat's recordings (`StartRecording`) keep only `SetTransform` and `SetProperty` calls, as
 animation tracks of transforms, positions and visibility; `SetLine` and `SetObject` change the
 page at once and a replay shows their last geometry all along. So a path that changes over
-time is a fixed pool of small spheres (`PathDots`) whose positions are set at each publish.
+time is a fixed pool of small spheres (`PathDots`) whose positions are set at each publish,
+and a path of poses a pool of triads (`PathTriads`) whose transforms are.
 """
 
 import numpy as np
-from pydrake.geometry import Sphere
+from pydrake.common.eigen_geometry import Quaternion
+from pydrake.geometry import Cylinder, Rgba, Sphere
+from pydrake.math import RigidTransform, RotationMatrix
 
 from pbp_drake.core.scene_framing import resample_by_arc_length
 
@@ -19,6 +22,11 @@ CAMERA_HEIGHT = 10.0
 # +z "as much as possible", which is undefined when it looks straight down: a camera this far
 # towards -y has +y up on the page, and its tilt (1e-5 rad) shows nowhere.
 CAMERA_SLANT = 1e-4
+# A triad's axes x, y, z in pure red, green and blue (a screenshot can find them), and the
+# turn that lays a cylinder (along its z) along each axis.
+TRIAD_AXES = (("x", Rgba(1.0, 0.0, 0.0, 1.0), RotationMatrix.MakeYRotation(np.pi / 2)),
+              ("y", Rgba(0.0, 1.0, 0.0, 1.0), RotationMatrix.MakeXRotation(-np.pi / 2)),
+              ("z", Rgba(0.0, 0.0, 1.0, 1.0), RotationMatrix()))
 
 
 def frame_top_down(meshcat, view):
@@ -63,3 +71,59 @@ class PathDots:
         points[:, 2] += lift
         for index, point in enumerate(points):
             meshcat.SetProperty(f"{self.root}/{index}", "position", point.tolist(), time)
+
+
+def pose_transform(pose):
+    """The `RigidTransform` of a pose `[x, y, z, qw, qx, qy, qz]` (a `GoalPose` row)."""
+    pose = np.asarray(pose, dtype=float)
+    quaternion = pose[3:7] / np.linalg.norm(pose[3:7])
+    return RigidTransform(Quaternion(quaternion), pose[:3])
+
+
+def draw_triad(meshcat, path, pose=None, length=0.1, radius=0.005, opacity=1.0):
+    """Adds an axis triad at Meshcat `path`: three cylinders from its origin along its x, y
+    and z, red, green and blue, `length` long. With `pose` (`[x, y, z, qw, qx, qy, qz]`)
+    the triad is placed there; `SetTransform(path, ...)` moves it later."""
+    for axis, colour, rotation in TRIAD_AXES:
+        shade = Rgba(colour.r(), colour.g(), colour.b(), opacity)
+        meshcat.SetObject(f"{path}/{axis}", Cylinder(radius, length), shade)
+        # The cylinder is centred on its origin: shift it half its length along the axis.
+        meshcat.SetTransform(f"{path}/{axis}", RigidTransform(
+            rotation, rotation.multiply(np.array([0.0, 0.0, length / 2.0]))))
+    if pose is not None:
+        meshcat.SetTransform(path, pose_transform(pose))
+
+
+class PathTriads:
+    """A path of poses drawn as `count` triads under the Meshcat path `root`, evenly spaced
+    along its positions; `show` moves and turns them, with `time` so that a recording
+    replays them (one position and one quaternion track a triad)."""
+
+    def __init__(self, root, count, length, radius, opacity=1.0):
+        self.root = root
+        self._count = int(count)
+        self._shape = (float(length), float(radius), float(opacity))
+
+    def draw(self, meshcat):
+        """Adds the triads (all at the origin until `show`)."""
+        length, radius, opacity = self._shape
+        for index in range(self._count):
+            draw_triad(meshcat, f"{self.root}/{index}", None, length, radius, opacity)
+
+    def show(self, meshcat, poses, time=None):
+        """Places the triads at the poses of `poses` `(N, 7)` nearest to evenly spaced arc
+        lengths along it (its first and last included), each with its orientation."""
+        poses = np.atleast_2d(np.asarray(poses, dtype=float))
+        for index, row in enumerate(_spread(poses, self._count)):
+            meshcat.SetTransform(f"{self.root}/{index}", pose_transform(row), time)
+
+
+def _spread(poses, count):
+    """`count` rows of `poses` at evenly spaced arc lengths (by index where it has none)."""
+    steps = np.linalg.norm(np.diff(poses[:, :3], axis=0), axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(steps)])
+    if arc[-1] < 1e-9:  # a path standing still: its orientations may still turn
+        picks = np.linspace(0, len(poses) - 1, count)
+    else:
+        picks = np.interp(np.linspace(0.0, arc[-1], count), arc, np.arange(len(poses)))
+    return poses[np.round(picks).astype(int)]

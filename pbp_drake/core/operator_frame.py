@@ -10,8 +10,8 @@ differs by a yaw, a top grasp is a pitch down then a roll (docs/grasp_task.md).
 
 The heading is the floor direction of z_H, blended towards that of x_H as z_H turns
 vertical (by the square of z_H's vertical component), with x_H signed to lean the way the
-hand was pitched: -x_H (the back of the hand) for a hand pointing down, +x_H for one
-pointing up. For a side grasp it is the approach's floor angle (the station's `heading`);
+hand was pitched: +x_H for a hand pointing down, -x_H for one pointing up (the HSR's start
+hand has x_H up: pitched down, x_H turns ahead). For a side grasp it is the approach's floor angle (the station's `heading`);
 it stays defined, and continuous, through a pitch straight down or up, where the ready
 hand pitched by +-90 degrees keeps world +x as forward.
 """
@@ -39,8 +39,8 @@ def operator_frame(orientation):
     axes = hand_axes(orientation)
     approach = axes[:, 2]
     # x_H lies along the pitch's plane; approach_z * |approach_z| both weighs it in as z_H
-    # turns vertical and signs it to lean forward (a pitch down turns -x_H ahead).
-    blend = approach + approach[2] * abs(approach[2]) * axes[:, 0]
+    # turns vertical and signs it to lean forward (a pitch down turns x_H ahead).
+    blend = approach - approach[2] * abs(approach[2]) * axes[:, 0]
     heading = np.array([blend[0], blend[1], 0.0])
     norm = np.linalg.norm(heading)
     # A pose whose two horizontal parts cancel exactly would have no heading: take world +x

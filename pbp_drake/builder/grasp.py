@@ -28,9 +28,10 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.core.dmp import DmpBank, OrientationDmpBank
-from pbp_drake.core.grasp_task import approach_direction, grasp_errors
+from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
 from pbp_drake.core.pose_arbitration import HandOverLimits
+from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
 from pbp_drake.scenarios import NoOperator as NoOperatorConfig, ScenarioError
@@ -190,9 +191,8 @@ def grasp_series_fields(times, hand_poses, decisions, grasp_orientations):
     twists = decisions["operator_command_log"]
     targets = decisions["target_log"][:, 3].astype(int)
     orientations = hand_poses[:, 3:7]
-    angles = np.array([np.degrees(grasp_errors(np.zeros(3), q, [np.zeros(3)],
-                                               [grasp_orientations[k]])[1][0])
-                       for q, k in zip(orientations, targets)])
+    # Each tick's angle to its own target's grasp orientation (the same for q and -q).
+    angles = np.degrees(angle_between(orientations.T, np.asarray(grasp_orientations)[targets].T))
     return dict(
         times=times,
         ee_positions=hand_poses[:, :3],

@@ -36,11 +36,10 @@ from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
 from pbp_drake.scenarios import NoOperator as NoOperatorConfig, ScenarioError
 from pbp_drake.scenarios import VirtualParticipant as VirtualParticipantConfig
-from pbp_drake.systems import NoOperator, PoseBlender, PoseDmpBank, PoseHandOver, SampleHold
-from pbp_drake.systems.grasp_participant import GraspParticipantSystem
-from pbp_drake.systems.grasp_task_monitor import GraspTaskMonitor
+from pbp_drake.systems import (
+    GraspParticipantSystem, GraspTaskMonitor, NoOperator, PoseBlender, PoseDmpBank,
+    PoseGoalEstimator, PoseHandOver, SampleHold)
 from pbp_drake.systems.layouts import OperatorTwist
-from pbp_drake.systems.pose_goal_estimator import PoseGoalEstimator
 
 # Issue 17: the commanded angular velocity changes by at most this much (rad/s) between two
 # ticks, so a goal switch or the operator pressing never jerks the wrist.

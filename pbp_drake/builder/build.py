@@ -1,8 +1,9 @@
 """The one entry point from a scenario to a Drake Diagram."""
 
+from pbp_drake.builder.grasp import build_grasp_diagram, check_grasp_buildable
 from pbp_drake.builder.hsr import build_hsr_diagram
 from pbp_drake.builder.point_robot import build_point_robot_diagram
-from pbp_drake.scenarios import GraspTask, ResolvedScenario, ScenarioError, resolve
+from pbp_drake.scenarios import GraspTask, ResolvedScenario, resolve
 
 
 def build_diagram(scenario, meshcat=None, prediction_steps=None):
@@ -11,6 +12,8 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
     paths are drawn (default: their duration, when drawing)."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
     check_buildable(resolved)
+    if isinstance(resolved.scenario.task, GraspTask):
+        return build_grasp_diagram(resolved, meshcat)
     if resolved.is_hsr:
         return build_hsr_diagram(resolved, meshcat)
     return build_point_robot_diagram(resolved, meshcat, prediction_steps)
@@ -18,12 +21,10 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
 
 def check_buildable(resolved):
     """Raises ScenarioError for a resolved scenario the builder cannot build yet, so that the
-    commands refuse it before they start: the grasping task, whose hand pose the HSR
-    station cannot command until it has 6-DoF inverse kinematics."""
+    commands refuse it before they start: the grasping task driven by a person (its
+    keyboard and gamepad are not wired yet)."""
     if isinstance(resolved.scenario.task, GraspTask):
-        raise ScenarioError("scenario.task !GraspTask cannot be built yet: the HSR station "
-                            "has no 6-DoF inverse kinematics (issue 17); the scenario loads "
-                            "and resolves, its scene is in ResolvedScenario.layout.grasps")
+        check_grasp_buildable(resolved.scenario)
 
 
 def find_system(diagram, name):

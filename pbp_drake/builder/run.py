@@ -16,6 +16,7 @@ import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorStatus
 
 from pbp_drake.builder.build import build_diagram
+from pbp_drake.builder.grasp import grasp_series_fields
 from pbp_drake.scenarios import ResolvedScenario, resolve
 from pbp_drake.systems.browser_guard import reset_pacing_after_pauses
 from pbp_drake.systems.layouts import TaskStatus
@@ -144,6 +145,13 @@ class TaskResult:
             between two ticks over the period, max_k |v(k+1) - v(k)| / control_period,
             v = `commands[:, 3:6]`. Both from `motion_peaks`; None when unknown (fewer
             than two ticks, or a TaskResult made without them).
+        angles_to_target: (T,) degrees from the hand's orientation to the current target's
+            grasp orientation (the grasping task; None in the others).
+        command_angular_velocities: (T, 3) the commanded angular velocity (rad/s) sent from
+            tick k on; operator_twists: (T, 6) the operator's whole twist (the grasping
+            task; None in the others). `operator_commands` there is `[v, wz]`.
+        peak_command_angular_change: rad/s, the largest change of the commanded angular
+            velocity between two ticks (the grasping task; None in the others).
     """
 
     success: bool
@@ -163,6 +171,10 @@ class TaskResult:
     in_collision: np.ndarray | None = None
     peak_hand_speed: float | None = None
     peak_command_acceleration: float | None = None
+    angles_to_target: np.ndarray | None = None
+    command_angular_velocities: np.ndarray | None = None
+    operator_twists: np.ndarray | None = None
+    peak_command_angular_change: float | None = None
 
     def summary_line(self):
         """One line: outcome, time, intervention ratio, the collision ratio where the task
@@ -172,10 +184,16 @@ class TaskResult:
         # A reach task's collision_ratio is 0 because nothing measured it: left out.
         collisions = ("" if self.in_collision is None
                       else f", collision ratio {self.collision_ratio:.3f}")
+        # The grasping task's orientation: where the hand ended and the wrist's largest jolt.
+        turning = ("" if self.angles_to_target is None else
+                   f", final angle to target {self.angles_to_target[-1]:.1f} deg, peak "
+                   f"command angular change {_or_na(self.peak_command_angular_change, 3)} "
+                   "rad/s per tick")
         return (f"{outcome} in {self.task_time:.2f} s, intervention ratio "
                 f"{self.intervention_ratio:.3f}{collisions}, {self.switches} target switches, "
                 f"peak hand speed {_or_na(self.peak_hand_speed, 3)} m/s, "
-                f"peak command acceleration {_or_na(self.peak_command_acceleration, 2)} m/s^2")
+                f"peak command acceleration {_or_na(self.peak_command_acceleration, 2)} m/s^2"
+                f"{turning}")
 
 
 def _or_na(value, digits):
@@ -243,13 +261,22 @@ STATE_LOGS = ("ee_state_log", "in_collision_log")
 
 
 def _read_result(diagram, context, status, monitor, control_period):
+    # The grasping task logs the hand's pose (`builder.grasp`) where the others log ee_state.
+    grasp = diagram.HasSubsystemNamed("hand_pose_log")
+    state_log = "hand_pose_log" if grasp else "ee_state_log"
     # The last sample holds only the decisions of the tick before it (see read_log).
-    tick_count = diagram.GetSubsystemByName("ee_state_log").FindLog(context).num_samples() - 1
-    times, ee_state = read_log(diagram, context, "ee_state_log", tick_count)
+    tick_count = diagram.GetSubsystemByName(state_log).FindLog(context).num_samples() - 1
+    times, state = read_log(diagram, context, state_log, tick_count)
     in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
     decisions = {name: read_log(diagram, context, name, tick_count, shift=DECISION_LOG_SHIFT)[1]
                  for name in DECISION_LOGS}
-    series = series_fields(times, ee_state, in_collision, decisions)
+    if grasp:
+        series = grasp_series_fields(times, state, decisions, monitor.grasp_orientations)
+        turning = LargestStep()
+        turning.add(series["command_angular_velocities"])
+        series["peak_command_angular_change"] = turning.peak(1.0)
+    else:
+        series = series_fields(times, state, in_collision, decisions)
     peak_hand_speed, peak_command_acceleration = motion_peaks(
         series["ee_positions"], series["commands"][:, 3:6], control_period)
     return task_result(status, monitor, series, peak_hand_speed, peak_command_acceleration)

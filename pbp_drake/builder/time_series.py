@@ -3,26 +3,39 @@ tick. A study's trial files (`pbp_drake.studies.trial_files`) and a run streamed
 (`pbp_drake.builder.streamed_run`) write the same format with these functions."""
 
 
-def time_series_columns(has_collision):
+# The grasping task's orientation columns (`TaskResult.angles_to_target`, degrees; the
+# commanded and the operator's angular velocities, rad/s, world frame).
+GRASP_COLUMNS = ["angle_to_target", "command_wx", "command_wy", "command_wz",
+                 "operator_wx", "operator_wy", "operator_wz"]
+
+
+def time_series_columns(has_collision, has_grasp=False):
     return ["time", "ee_x", "ee_y", "ee_z", "heading",
             "command_x", "command_y", "command_z", "command_vx", "command_vy", "command_vz",
             "command_heading", "operator_active",
             "operator_vx", "operator_vy", "operator_vz", "operator_yaw_rate",
-            "selected_goal", "target"] + (["in_collision"] if has_collision else [])
+            "selected_goal", "target"] + (["in_collision"] if has_collision else []) + (
+            GRASP_COLUMNS if has_grasp else [])
 
 
-def time_series_header(has_collision):
+def time_series_header(has_collision, has_grasp=False):
     """The CSV's header line, newline included."""
-    return ",".join(time_series_columns(has_collision)) + "\n"
+    return ",".join(time_series_columns(has_collision, has_grasp)) + "\n"
+
+
+def _has_grasp(series):
+    return getattr(series, "angles_to_target", None) is not None
 
 
 def time_series_rows(series):
     """The CSV lines (newlines included, no header) of the per-tick series of `series`: a
     TaskResult, or any object with its time series attributes (`times`, `ee_positions`,
     `headings`, `commands`, `operator_active`, `operator_commands`, `selected_goals`,
-    `targets`, `in_collision`). Floats are written in their shortest exact form, so reading
+    `targets`, `in_collision`; the grasping task's `angles_to_target`,
+    `command_angular_velocities` and `operator_twists` too). Floats are written in their shortest exact form, so reading
     them back gives the same numbers."""
     has_collision = series.in_collision is not None
+    has_grasp = _has_grasp(series)
     lines = []
     for k in range(len(series.times)):
         row = [series.times[k], *series.ee_positions[k], series.headings[k], *series.commands[k]]
@@ -32,10 +45,15 @@ def time_series_rows(series):
         row += [str(int(series.selected_goals[k])), str(int(series.targets[k]))]
         if has_collision:
             row.append(str(int(bool(series.in_collision[k]))))
+        if has_grasp:
+            row += [repr(float(x)) for x in (series.angles_to_target[k],
+                                             *series.command_angular_velocities[k],
+                                             *series.operator_twists[k, 3:])]
         lines.append(",".join(row) + "\n")
     return "".join(lines)
 
 
 def time_series_csv(result):
     """The per-tick time series of a TaskResult as CSV text, header first."""
-    return time_series_header(result.in_collision is not None) + time_series_rows(result)
+    return (time_series_header(result.in_collision is not None, _has_grasp(result))
+            + time_series_rows(result))

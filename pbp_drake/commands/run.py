@@ -8,7 +8,8 @@ import time
 import numpy as np
 from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
-from pbp_drake.builder import build_diagram, find_system, run_task, run_task_streamed, simulate
+from pbp_drake.builder import (
+    build_diagram, check_buildable, find_system, run_task, run_task_streamed, simulate)
 from pbp_drake.cli_types import method_list, port, realtime_rate, wait_seconds
 from pbp_drake.console import (
     CAMERAS, Console, LiveRun, Progress, RobotCamera, method_name, result_text)
@@ -134,6 +135,7 @@ def _run(args):
         check_output_folder(args.output)
     resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
                                 args.scene, args.operator, args.seed, args.duration)
+    check_buildable(resolved)  # before the page opens: what the builder cannot build yet
     if args.camera == "robot" and not resolved.is_hsr:
         raise ScenarioError("--camera robot follows the HSR; this scenario uses the 2-D toy "
                             "robot")

@@ -202,8 +202,8 @@ class GraspTask:
     from the seed, each on its own table in the reach task's rectangle, each with a grasp
     pose of the hand, from the side at a yaw or from above with a wrist roll; the target
     switches as in the reach task; success is the hand within `success_distance` of the
-    target's grasp position and within `success_angle` of its grasp orientation. It loads
-    and resolves; the HSR station cannot run it yet (no 6-DoF inverse kinematics)."""
+    target's grasp position and within `success_angle` of its grasp orientation. It runs
+    on the pose station (`pbp_drake.builder.grasp`) with the virtual participant."""
 
     object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
     # The tables' centres are drawn in this rectangle (m), min_separation apart (at least

@@ -197,7 +197,8 @@ def read_time_series(path, ticks=None):
         rows = list(reader)
     if not columns:
         raise DamagedFile(f"{path}: empty CSV (no header)")
-    if columns not in (time_series_columns(False), time_series_columns(True)):
+    if columns not in (time_series_columns(False), time_series_columns(True),
+                       time_series_columns(False, has_grasp=True)):
         raise DamagedFile(f"{path}: malformed CSV: its header is not a trial's time series")
     for number, row in enumerate(rows, start=2):
         if len(row) != len(columns):
@@ -231,6 +232,15 @@ def load_task_result(output, method, seed):
         raise ValueError(f"{json_path}: the trial failed: {record['error']}")
     series = read_time_series(csv_path)
     in_collision = series["in_collision"].astype(bool) if "in_collision" in series else None
+    grasp = {}
+    if "angle_to_target" in series:  # the grasping task's orientation columns
+        grasp = dict(
+            angles_to_target=series["angle_to_target"],
+            command_angular_velocities=np.column_stack(
+                [series[c] for c in ("command_wx", "command_wy", "command_wz")]),
+            operator_twists=np.column_stack([series[c] for c in (
+                "operator_vx", "operator_vy", "operator_vz", "operator_wx", "operator_wy",
+                "operator_wz")]))
     return TaskResult(
         success=record["success"], task_time=record["task_time"],
         intervention_ratio=record["intervention_ratio"], switches=record["switches"],
@@ -247,7 +257,8 @@ def load_task_result(output, method, seed):
         objects=np.array(record["objects"], float),
         collision_ratio=record["collision_ratio"], in_collision=in_collision,
         peak_hand_speed=record.get("peak_hand_speed"),
-        peak_command_acceleration=record.get("peak_command_acceleration"))
+        peak_command_acceleration=record.get("peak_command_acceleration"),
+        peak_command_angular_change=record.get("peak_command_angular_change"), **grasp)
 
 
 def read_trial(output, method, seed, digest=None, damaged=None, key=None):

@@ -11,7 +11,9 @@ operator's command `[vx, vy, vz, yaw_rate]` in the world frame; `systems.layouts
 entries. Six-DoF PBP (`PoseDmpBank`, `PoseBlender`, `PoseHandOver`) uses `PoseState`
 `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]` and `OperatorTwist` (docs/six_dof.md); its browser
 operators (`GamepadTwistOperator`, `KeyboardTwistOperator`) take the hand's `hand_state` and
-output `operator_twist`. `systems.tick` states the order of the updates within a control tick.
+output `operator_twist`; so do the grasping task's `PoseGoalEstimator`,
+`GraspParticipantSystem` and `GraspTaskMonitor` (docs/grasp_task.md). `systems.tick` states
+the order of the updates within a control tick.
 """
 
 from pbp_drake.systems.blender import Blender
@@ -21,7 +23,9 @@ from pbp_drake.systems.gamepad_operator import GamepadOperator
 from pbp_drake.systems.gamepad_twist_operator import GamepadTwistOperator
 from pbp_drake.systems.goal_estimator import GoalEstimator
 from pbp_drake.systems.goals_source import GoalsSource
+from pbp_drake.systems.grasp_participant import GraspParticipantSystem
 from pbp_drake.systems.grasp_scene_visualizer import GraspSceneVisualizer
+from pbp_drake.systems.grasp_task_monitor import GraspTaskMonitor
 from pbp_drake.systems.hand_over import HandOver
 from pbp_drake.systems.heading_command import HeadingCommand
 from pbp_drake.systems.keyboard_operator import KeyboardOperator
@@ -31,6 +35,7 @@ from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionOpera
 from pbp_drake.systems.point_robot import PointRobot
 from pbp_drake.systems.pose_blender import PoseBlender
 from pbp_drake.systems.pose_dmp_bank import PoseDmpBank
+from pbp_drake.systems.pose_goal_estimator import PoseGoalEstimator
 from pbp_drake.systems.pose_hand_over import PoseHandOver
 from pbp_drake.systems.reach_scene_visualizer import ReachSceneVisualizer
 from pbp_drake.systems.sample_hold import SampleHold
@@ -44,4 +49,6 @@ __all__ = [
     "KeyboardOperator", "KeyboardTwistOperator", "NoOperator", "ObstacleRepulsionOperator",
     "PointRobot", "PoseBlender", "PoseDmpBank", "PoseHandOver", "ReachSceneVisualizer", "SampleHold", "ScriptedOperator", "TaskMonitor",
     "VirtualParticipant",
+    # The grasping task's (docs/grasp_task.md).
+    "GraspParticipantSystem", "GraspTaskMonitor", "PoseGoalEstimator",
 ]

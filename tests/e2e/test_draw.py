@@ -14,9 +14,7 @@ from pbp_drake.scenarios import load_scenario_file
 pytestmark = pytest.mark.slow
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
-# hsr_grasp.yaml cannot be built yet (the station has no 6-DoF IK; `build_diagram` refuses
-# it, tests/scenarios/test_grasp_scenario.py), so it has no drawing yet.
-SCENARIOS = sorted(path for path in DIAGRAMS.glob("*.yaml") if path.stem != "hsr_grasp")
+SCENARIOS = sorted(DIAGRAMS.glob("*.yaml"))
 needs_dot = pytest.mark.skipif(dot_program() is None,
                                reason="graphviz's dot is missing (make test installs it)")
 

@@ -15,8 +15,6 @@ from pbp_drake.scenarios import BentPath, load_scenario_file
 from pbp_drake.studies.runners import compute_trial
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
-# Not built yet: the station has no 6-DoF IK (`build_diagram` refuses the grasping task).
-BUILDABLE = [path for path in SHIPPED if path.stem != "hsr_grasp"]
 # Where each piece of work is done, by the name the caller looks it up under.
 COUNTED = [(resolve_module, "bent_path"), (dmp_bank_module, "fit_weights"),
            (single_dmp_module, "fit_weights"),
@@ -44,14 +42,17 @@ def test_every_shipped_scenario_is_counted():
                                                "hsr_reach", "hsr_obstacles"}
 
 
-@pytest.mark.parametrize("path", BUILDABLE, ids=lambda path: path.stem)
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda path: path.stem)
 def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     loaded = load_scenario_file(path)
     build_diagram(loaded.resolved, meshcat)
     scenario = loaded.scenario
     assert work["bent_path"] == (1 if isinstance(scenario.demonstration, BentPath) else 0)
-    assert work["fit_weights"] == 1
-    scenes = work["sample_reach_scene"] + work["sample_obstacle_scene"]
+    # The grasping task's builder fits its own position bank from the pose station's hand
+    # (hand_palm_link); the resolved one starts at the heading station's hand_ee_link.
+    assert work["fit_weights"] == (2 if path.stem == "hsr_grasp" else 1)
+    scenes = (work["sample_reach_scene"] + work["sample_obstacle_scene"]
+              + work["sample_grasp_scene"])
     assert scenes == (1 if scenario.task is not None else 0)
 
 

@@ -1,0 +1,208 @@
+"""The grasping task's diagram (issue 17, docs/grasp_task.md): six-DoF PBP on the pose
+station, the hand driven to a grasp pose (position and orientation).
+
+    hsr_station.hand_pose ──> hand_pose_sample (SampleHold) ──> goal_estimator, dmp_bank,
+                                                                 blender, task_monitor,
+                                                                 operator
+    goal_poses ──> goal_estimator, dmp_bank
+    goal_estimator.selected_goal ──> dmp_bank (followed_goal, selected_goal), operator
+    goal_estimator.goal_probabilities ──> blender (confidence_alpha)
+    dmp_bank.selected_reference ──> blender.policy_reference
+    operator (operator_command: OperatorTwist, operator_active) ──> blender, dmp_bank
+                                                                   (PBP-Alt's lock),
+                                                                   task_monitor
+    task_monitor.target ──> operator
+    blender.reference ──> hand_over (PoseHandOver) ──> hsr_station.pose_command
+
+`hsr_station` is `make_hsr_station(..., command="pose")`, its hand frame `hand_palm_link`;
+the DMPs start at the hand's real start pose there (`hsr_initial_hand_pose`). Loggers
+named `hand_pose_log`, `operator_active_log`, `operator_command_log`, `command_log`,
+`selected_goal_log`, `target_log`, `phase_log` record each tick (`run_task` reads them,
+`grasp_series_fields`); the task monitor ends the simulation at success. The operator is
+the grasp participant or none (PBP-NoUser); a person's keyboard or gamepad is not wired
+yet (`check_grasp_buildable`).
+"""
+
+import numpy as np
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
+
+from pbp_drake.core.dmp import DmpBank, OrientationDmpBank
+from pbp_drake.core.grasp_task import approach_direction
+from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
+from pbp_drake.core.pose_arbitration import HandOverLimits
+from pbp_drake.core.quaternion import angle_between
+from pbp_drake.robots import make_hsr_station
+from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
+from pbp_drake.scenarios import NoOperator as NoOperatorConfig, ScenarioError
+from pbp_drake.scenarios import VirtualParticipant as VirtualParticipantConfig
+from pbp_drake.systems import (
+    GraspParticipantSystem, GraspTaskMonitor, NoOperator, PoseBlender, PoseDmpBank,
+    PoseGoalEstimator, PoseHandOver, SampleHold)
+from pbp_drake.systems.layouts import OperatorTwist
+
+# Issue 17: the commanded angular velocity changes by at most this much (rad/s) between two
+# ticks, so a goal switch or the operator pressing never jerks the wrist.
+ANGULAR_CHANGE_PER_TICK = 0.3
+# The hand's angular speed cap (rad/s): above the participant's 0.8 rad/s with its speed
+# noise (10 %), so the cap does not slow the person, only a DMP far from its goal.
+MAX_HAND_ANGULAR_SPEED = 1.0
+
+
+def check_grasp_buildable(scenario):
+    """Raises ScenarioError for a grasping scenario whose operator is not wired yet."""
+    if not isinstance(scenario.operator, (VirtualParticipantConfig, NoOperatorConfig)):
+        raise ScenarioError(
+            f"scenario.operator !{type(scenario.operator).__name__}: the grasping task "
+            "cannot be driven from the browser yet (the 6-DoF keyboard and gamepad are not "
+            "wired); use --operator virtual")
+
+
+def hand_over_limits(scenario):
+    """The hand-over's `HandOverLimits`: the reach task's linear limits, and the angular
+    ones of issue 17."""
+    robot = scenario.robot
+    return HandOverLimits(robot.max_hand_acceleration, robot.max_hand_speed,
+                          ANGULAR_CHANGE_PER_TICK / scenario.control_period,
+                          MAX_HAND_ANGULAR_SPEED)
+
+
+def grasp_dmp_banks(resolved, start_pose):
+    """The position and orientation banks, straight paths from the hand's `start_pose`
+    `[p, q]` to the K grasp poses, one duration (the farthest grasp at the nominal speed),
+    so that they share one phase."""
+    scenario = resolved.scenario
+    goals = resolved.layout.grasps.grasp_positions
+    distance = float(np.max(np.linalg.norm(goals - start_pose[:3], axis=1)))
+    duration = (scenario.dmp_duration if scenario.dmp_duration > 0
+                else distance / resolved.nominal_speed)
+    return (DmpBank.straight(start_pose[:3], len(goals), duration, scenario.dmp),
+            OrientationDmpBank.straight(start_pose[3:7], len(goals), duration, scenario.dmp))
+
+
+def build_grasp_diagram(resolved, meshcat=None):
+    """The Diagram of a resolved grasping scenario; with `meshcat`, the robot drawn there."""
+    scenario = resolved.scenario
+    check_grasp_buildable(scenario)
+    period = scenario.control_period
+    task = scenario.task
+    grasps = resolved.layout.grasps
+    goal_count = len(grasps.grasp_positions)
+    builder = DiagramBuilder()
+
+    station = builder.AddNamedSystem("hsr_station", make_hsr_station(
+        resolved.station, meshcat, command="pose"))
+    start = hsr_initial_hand_pose(station)
+    hand_pose = station.GetOutputPort("hand_pose")
+    sample = builder.AddNamedSystem("hand_pose_sample", SampleHold(period, start))
+    builder.Connect(hand_pose, sample.get_input_port())
+    sampled = sample.get_output_port()
+
+    poses = np.hstack([grasps.grasp_positions, grasps.grasp_orientations]).reshape(-1)
+    goal_poses = builder.AddNamedSystem("goal_poses", ConstantVectorSource(poses))
+    estimator = builder.AddNamedSystem("goal_estimator", PoseGoalEstimator(
+        goal_count, scenario.goal_estimator, period))
+    builder.Connect(sampled, estimator.get_hand_pose_input_port())
+    builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
+    selected = estimator.get_selected_goal_output_port()
+
+    limits = hand_over_limits(scenario)
+    position_bank, orientation_bank = grasp_dmp_banks(resolved, start)
+    # The caps are the hand-over's: no DMP winds its velocity up past what the hand may do.
+    dmp_bank = builder.AddNamedSystem("dmp_bank", PoseDmpBank(
+        position_bank, orientation_bank, period,
+        lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
+        max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed))
+    builder.Connect(sampled, dmp_bank.get_robot_state_input_port())
+    builder.Connect(goal_poses.get_output_port(), dmp_bank.get_goal_poses_input_port())
+    # Read at the decide stage before the estimator updates: the goal followed last tick.
+    builder.Connect(selected, dmp_bank.get_followed_goal_input_port())
+    builder.Connect(selected, dmp_bank.get_selected_goal_input_port())
+
+    blender = builder.AddNamedSystem("blender", PoseBlender(
+        resolved.blend_mode, goal_count, period, scenario.alpha))
+    builder.Connect(sampled, blender.get_robot_state_input_port())
+    builder.Connect(dmp_bank.get_selected_reference_output_port(),
+                    blender.get_policy_reference_input_port())
+    builder.Connect(selected, blender.get_selected_goal_input_port())
+    builder.Connect(estimator.get_goal_probabilities_output_port(),
+                    blender.get_goal_probabilities_input_port())
+    hand_over = builder.AddNamedSystem("hand_over", PoseHandOver(start[:7], limits, period))
+    builder.Connect(blender.get_reference_output_port(), hand_over.get_reference_input_port())
+    builder.Connect(hand_over.get_command_output_port(), station.GetInputPort("pose_command"))
+
+    monitor = builder.AddNamedSystem("task_monitor", GraspTaskMonitor(
+        grasps.grasp_positions, grasps.grasp_orientations, grasps.targets,
+        task.switch_schedule, start[:7], task.success_distance,
+        np.radians(task.success_angle), period))
+    builder.Connect(sampled, monitor.get_hand_pose_input_port())
+
+    operator = builder.AddNamedSystem("operator", _operator(resolved, grasps))
+    if operator.HasInputPort("hand_pose"):
+        builder.Connect(sampled, operator.GetInputPort("hand_pose"))
+        builder.Connect(monitor.get_target_output_port(), operator.GetInputPort("target"))
+        builder.Connect(selected, operator.GetInputPort("selected_goal"))
+    active = operator.get_operator_active_output_port()
+    twist = operator.get_operator_command_output_port()
+    for port in (dmp_bank.get_operator_active_input_port(),
+                 blender.get_operator_active_input_port(),
+                 monitor.get_operator_active_input_port()):
+        builder.Connect(active, port)
+    builder.Connect(twist, blender.get_operator_twist_input_port())
+
+    for name, port in [("hand_pose_log", hand_pose), ("operator_active_log", active),
+                       ("operator_command_log", twist),
+                       ("command_log", hand_over.get_command_output_port()),
+                       ("selected_goal_log", selected),
+                       ("target_log", monitor.get_target_output_port()),
+                       ("phase_log", dmp_bank.get_phase_output_port())]:
+        LogVectorOutput(port, builder, period).set_name(name)
+    diagram = builder.Build()
+    diagram.set_name(scenario.name)
+    return diagram
+
+
+def _operator(resolved, grasps):
+    scenario = resolved.scenario
+    period = scenario.control_period
+    if scenario.method == "pbp_no_user" or isinstance(scenario.operator, NoOperatorConfig):
+        return NoOperator(OperatorTwist.size, period)
+    participant = GraspParticipant.create(
+        GraspParticipantParams.from_virtual_participant(scenario.operator),
+        "drive" if scenario.method == "teleop" else "assist", resolved.nominal_speed,
+        grasps.grasp_positions, grasps.grasp_orientations, scenario.seed)
+    return GraspParticipantSystem(participant, period)
+
+
+def _headings(orientations):
+    """The floor angle of the approach axis z_H of each quaternion row (the station's
+    `heading`)."""
+    return np.array([np.arctan2(*approach_direction(q)[1::-1]) for q in orientations])
+
+
+def grasp_series_fields(times, hand_poses, decisions, grasp_orientations):
+    """A grasping TaskResult's time series fields, as `run.series_fields` gives a reach
+    task's: `hand_poses` the `hand_pose_log` samples (T, 13), `decisions` the decision logs
+    by name, already shifted. Headings are the approach axis' floor angle; `commands` are
+    `[p, v, heading]` of the pose command; the operator's `[v, wz]` fill the reach task's
+    `operator_commands` and its whole twist is `operator_twists`."""
+    commands = decisions["command_log"]
+    twists = decisions["operator_command_log"]
+    targets = decisions["target_log"][:, 3].astype(int)
+    orientations = hand_poses[:, 3:7]
+    # Each tick's angle to its own target's grasp orientation (the same for q and -q).
+    angles = np.degrees(angle_between(orientations.T, np.asarray(grasp_orientations)[targets].T))
+    return dict(
+        times=times,
+        ee_positions=hand_poses[:, :3],
+        headings=_headings(orientations),
+        commands=np.column_stack([commands[:, :3], commands[:, 7:10],
+                                  _headings(commands[:, 3:7])]),
+        operator_active=decisions["operator_active_log"][:, 0] > 0.5,
+        operator_commands=twists[:, [0, 1, 2, 5]],
+        selected_goals=decisions["selected_goal_log"][:, 0].astype(int),
+        targets=targets,
+        in_collision=None,
+        angles_to_target=angles,
+        command_angular_velocities=commands[:, 10:13],
+        operator_twists=twists)

@@ -1,0 +1,90 @@
+"""The ``pose`` goal estimator as a Drake system: which of K grasp poses the operator means."""
+
+import dataclasses
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings, SelectionMemory
+from pbp_drake.core.grasp_estimation import estimate_pose
+from pbp_drake.systems.layouts import GoalPose, PoseState
+from pbp_drake.systems.tick import decide_offset
+
+
+class PoseGoalEstimator(LeafSystem):
+    """Estimates the intended grasp pose every control period
+    (`pbp_drake.core.grasp_estimation.estimate_pose`).
+
+    .. pydrake_system::
+
+        name: PoseGoalEstimator
+        input_ports:
+        - hand_pose
+        - goal_poses
+        output_ports:
+        - selected_goal
+        - goal_probabilities
+
+    `hand_pose` is the hand's `PoseState` (pose and world-frame twist); `goal_poses` the K
+    `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened. `selected_goal` is `[index]`
+    and `goal_probabilities` the K probabilities; both are read from the state, so they
+    hold between updates, as `GoalEstimator`'s.
+
+    At initialisation it selects the most probable grasp pose at once (no hysteresis);
+    each update, at the decide stage of the tick (`update_offset` overrides it), it
+    recomputes the probabilities and moves the selection with the shipped hysteresis.
+    """
+
+    def __init__(self, goal_count, settings, control_period, update_offset=None):
+        super().__init__()
+        if not isinstance(settings, GoalEstimatorSettings) or settings.method != "pose":
+            raise ValueError("settings must be a GoalEstimatorSettings with method 'pose'")
+        settings.validate()
+        if update_offset is None:
+            update_offset = decide_offset(control_period)
+        k = self._goal_count = int(goal_count)
+        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
+        self._settings = dataclasses.replace(settings)
+        self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
+        self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
+        self._selected_index = self.DeclareDiscreteState(np.zeros(1))
+        self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
+        # [challenger, count] of the hysteresis (`SelectionMemory`); -1: none yet.
+        self._memory_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        self._selected_port = self.DeclareStateOutputPort("selected_goal",
+                                                          self._selected_index)
+        self._probabilities_port = self.DeclareStateOutputPort("goal_probabilities",
+                                                               self._probabilities_index)
+        self.DeclareInitializationDiscreteUpdateEvent(
+            lambda context, state: self._estimate(context, state, None))
+        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period), update_offset,
+                                                self._update)
+
+    def get_hand_pose_input_port(self):
+        return self._hand_port
+
+    def get_goal_poses_input_port(self):
+        return self._goals_port
+
+    def get_selected_goal_output_port(self):
+        return self._selected_port
+
+    def get_goal_probabilities_output_port(self):
+        return self._probabilities_port
+
+    def _update(self, context, state):
+        challenger, count = context.get_discrete_state(self._memory_index).value()
+        selected = int(context.get_discrete_state(self._selected_index).value()[0])
+        self._estimate(context, state, SelectionMemory(selected, int(challenger), int(count)))
+
+    def _estimate(self, context, state, memory):
+        hand = np.asarray(self._hand_port.Eval(context), float)
+        goals = np.asarray(self._goals_port.Eval(context), float).reshape(
+            self._goal_count, GoalPose.size)
+        result = estimate_pose(self._settings, goals[:, :3], goals[:, 3:], hand[:3],
+                               hand[3:7] / np.linalg.norm(hand[3:7]), hand[7:10],
+                               hand[10:13], memory)
+        state.get_mutable_vector(self._selected_index).set_value([result.selected])
+        state.get_mutable_vector(self._probabilities_index).set_value(result.probabilities)
+        state.get_mutable_vector(self._memory_index).set_value(
+            [result.memory.challenger, result.memory.count])

@@ -1,0 +1,49 @@
+"""The grasping task end to end (issue 17): its diagram builds for every method, the virtual
+participant grasps the target by teleoperation and with PBP-Alt (with less intervention),
+and the commanded angular velocity never jumps by more than 0.3 rad/s in a tick."""
+
+import numpy as np
+import pytest
+
+from pbp_drake.builder import build_diagram, run_task
+from pbp_drake.builder.grasp import ANGULAR_CHANGE_PER_TICK, MAX_HAND_ANGULAR_SPEED
+from pbp_drake.scenarios import load_scenario_file
+
+METHODS = ["pbp_continuous", "pbp_alternated", "fixed_alpha", "confidence_alpha", "teleop",
+           "pbp_no_user"]
+
+
+@pytest.fixture(scope="module")
+def grasp(repo):
+    return load_scenario_file(repo / "diagrams" / "hsr_grasp.yaml").resolved
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_the_diagram_builds_for_every_method(grasp, method):
+    diagram = build_diagram(grasp.with_method(method))
+    for name in ("hsr_station", "goal_estimator", "dmp_bank", "blender", "hand_over",
+                 "task_monitor", "operator", "hand_pose_log", "command_log"):
+        assert diagram.HasSubsystemNamed(name), name
+
+
+@pytest.mark.slow
+def test_teleop_and_pbp_alternated_grasp_the_target_pbp_with_less_intervention(grasp):
+    teleop = run_task(grasp.with_method("teleop"))
+    alternated = run_task(grasp.with_method("pbp_alternated"))
+    for result in (teleop, alternated):
+        assert result.success and result.switches == 2
+        target = grasp.layout.grasps.targets[-1]
+        distance = np.linalg.norm(result.ee_positions[-1]
+                                  - grasp.layout.grasps.grasp_positions[target])
+        # The last row is the tick before success (3 cm and 10 degrees at the next tick):
+        # one tick of motion at the hand-over's top speeds away from them.
+        period = grasp.scenario.control_period
+        assert distance <= 0.03 + grasp.scenario.robot.max_hand_speed * period
+        assert result.angles_to_target[-1] <= 10.0 + np.degrees(MAX_HAND_ANGULAR_SPEED
+                                                                 * period)
+        # The wrist did turn, and never faster than issue 17 allows from tick to tick.
+        commanded = result.command_angular_velocities
+        steps = np.linalg.norm(np.diff(commanded, axis=0), axis=1)
+        assert np.abs(commanded).max() > 0.1
+        assert steps.max() <= ANGULAR_CHANGE_PER_TICK + 1e-9
+    assert alternated.intervention_ratio < teleop.intervention_ratio

@@ -154,6 +154,6 @@ def test_the_gamepad_drives_a_whole_grasp_through_the_page(grasp, meshcat, metho
     # carried part of the way (forward along the approach is theirs alone).
     assert result.intervention_ratio > 0.2
     if method == "pbp_alternated":
-        assert result.intervention_ratio < 1.0
+        assert result.intervention_ratio < 0.5  # 0.21 on this seed; teleop's is 1
     assert driver.sent >= len(result.times) - 1
     assert wall < 60.0

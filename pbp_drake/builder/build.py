@@ -20,9 +20,9 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
 
 
 def check_buildable(resolved):
-    """Raises ScenarioError for a resolved scenario the builder cannot build yet, so that the
-    commands refuse it before they start: the grasping task driven by a person (its
-    keyboard and gamepad are not wired yet)."""
+    """Raises ScenarioError for a resolved scenario the builder cannot build, so that the
+    commands refuse it before they start: a grasping task whose operator has no six-DoF
+    system."""
     if isinstance(resolved.scenario.task, GraspTask):
         check_grasp_buildable(resolved.scenario)
 

@@ -13,14 +13,20 @@ station, the hand driven to a grasp pose (position and orientation).
                                                                    task_monitor
     task_monitor.target ──> operator
     blender.reference ──> hand_over (PoseHandOver) ──> hsr_station.pose_command
+    task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
+    hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
 
 `hsr_station` is `make_hsr_station(..., command="pose")`, its hand frame `hand_palm_link`;
 the DMPs start at the hand's real start pose there (`hsr_initial_hand_pose`). Loggers
 named `hand_pose_log`, `operator_active_log`, `operator_command_log`, `command_log`,
 `selected_goal_log`, `target_log`, `phase_log` record each tick (`run_task` reads them,
 `grasp_series_fields`); the task monitor ends the simulation at success. The operator is
-the grasp participant or none (PBP-NoUser); a person's keyboard or gamepad is not wired
-yet (`check_grasp_buildable`).
+the grasp participant, none (PBP-NoUser), or a person in the Meshcat page: the
+`KeyboardTwistOperator` or the `GamepadTwistOperator` (their `hand_state` is the sampled
+hand pose; they need Meshcat). With Meshcat, `task_visualizer` draws the tables, objects,
+grasp triads, target and estimate, the hand, and the selected DMP's predicted path
+(`GRASP_PREDICTION_SAMPLES` poses over the DMPs' duration, rolled out at the visualizer's
+path rate, not each tick).
 """
 
 import numpy as np
@@ -34,11 +40,15 @@ from pbp_drake.core.pose_arbitration import HandOverLimits
 from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
-from pbp_drake.scenarios import NoOperator as NoOperatorConfig, ScenarioError
+from pbp_drake.scenarios import Gamepad, Keyboard, NoOperator as NoOperatorConfig, ScenarioError
 from pbp_drake.scenarios import VirtualParticipant as VirtualParticipantConfig
 from pbp_drake.systems import (
     GraspParticipantSystem, GraspTaskMonitor, NoOperator, PoseBlender, PoseDmpBank,
     PoseGoalEstimator, PoseHandOver, SampleHold)
+from pbp_drake.systems.gamepad_twist_operator import GamepadTwistOperator, GamepadTwistParams
+from pbp_drake.systems.grasp_scene_visualizer import GraspSceneVisualizer
+from pbp_drake.systems.keyboard_twist_operator import (
+    KeyboardTwistOperator, KeyboardTwistParams)
 from pbp_drake.systems.layouts import OperatorTwist
 
 # Issue 17: the commanded angular velocity changes by at most this much (rad/s) between two
@@ -47,15 +57,19 @@ ANGULAR_CHANGE_PER_TICK = 0.3
 # The hand's angular speed cap (rad/s): above the participant's 0.8 rad/s with its speed
 # noise (10 %), so the cap does not slow the person, only a DMP far from its goal.
 MAX_HAND_ANGULAR_SPEED = 1.0
+# How many poses ahead the page draws the selected DMP's path, over the DMPs' duration (as
+# the reach task's HSR_PREDICTION_SAMPLES).
+GRASP_PREDICTION_SAMPLES = 40
+_OPERATORS = (VirtualParticipantConfig, NoOperatorConfig, Keyboard, Gamepad)
 
 
 def check_grasp_buildable(scenario):
-    """Raises ScenarioError for a grasping scenario whose operator is not wired yet."""
-    if not isinstance(scenario.operator, (VirtualParticipantConfig, NoOperatorConfig)):
+    """Raises ScenarioError for a grasping scenario whose operator the builder has no
+    six-DoF system for."""
+    if not isinstance(scenario.operator, _OPERATORS):
         raise ScenarioError(
-            f"scenario.operator !{type(scenario.operator).__name__}: the grasping task "
-            "cannot be driven from the browser yet (the 6-DoF keyboard and gamepad are not "
-            "wired); use --operator virtual")
+            f"scenario.operator !{type(scenario.operator).__name__}: the grasping task takes "
+            "a keyboard, a gamepad, the virtual participant or none")
 
 
 def hand_over_limits(scenario):
@@ -108,11 +122,13 @@ def build_grasp_diagram(resolved, meshcat=None):
 
     limits = hand_over_limits(scenario)
     position_bank, orientation_bank = grasp_dmp_banks(resolved, start)
+    prediction_steps = GRASP_PREDICTION_SAMPLES if meshcat is not None else 0
     # The caps are the hand-over's: no DMP winds its velocity up past what the hand may do.
     dmp_bank = builder.AddNamedSystem("dmp_bank", PoseDmpBank(
         position_bank, orientation_bank, period,
         lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
-        max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed))
+        max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed,
+        prediction_steps=prediction_steps))
     builder.Connect(sampled, dmp_bank.get_robot_state_input_port())
     builder.Connect(goal_poses.get_output_port(), dmp_bank.get_goal_poses_input_port())
     # Read at the decide stage before the estimator updates: the goal followed last tick.
@@ -137,11 +153,14 @@ def build_grasp_diagram(resolved, meshcat=None):
         np.radians(task.success_angle), period))
     builder.Connect(sampled, monitor.get_hand_pose_input_port())
 
-    operator = builder.AddNamedSystem("operator", _operator(resolved, grasps))
+    operator = builder.AddNamedSystem("operator", _operator(resolved, grasps, meshcat))
     if operator.HasInputPort("hand_pose"):
         builder.Connect(sampled, operator.GetInputPort("hand_pose"))
         builder.Connect(monitor.get_target_output_port(), operator.GetInputPort("target"))
         builder.Connect(selected, operator.GetInputPort("selected_goal"))
+    if operator.HasInputPort("hand_state"):
+        # The sampled pose: the person's frame is the hand's as the tick saw it.
+        builder.Connect(sampled, operator.GetInputPort("hand_state"))
     active = operator.get_operator_active_output_port()
     twist = operator.get_operator_command_output_port()
     for port in (dmp_bank.get_operator_active_input_port(),
@@ -157,16 +176,40 @@ def build_grasp_diagram(resolved, meshcat=None):
                        ("target_log", monitor.get_target_output_port()),
                        ("phase_log", dmp_bank.get_phase_output_port())]:
         LogVectorOutput(port, builder, period).set_name(name)
+    if meshcat is not None:
+        visualizer = builder.AddNamedSystem("task_visualizer", GraspSceneVisualizer(
+            meshcat, grasps, prediction_steps, task.table_size, task.object_radius,
+            task.object_height))
+        builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
+        builder.Connect(selected, visualizer.get_selected_goal_input_port())
+        builder.Connect(dmp_bank.get_predicted_poses_output_port(),
+                        visualizer.get_predicted_poses_input_port())
+        # The measured pose, not the sample: the triad moves smoothly at 30 Hz.
+        builder.Connect(hand_pose, visualizer.get_hand_state_input_port())
     diagram = builder.Build()
     diagram.set_name(scenario.name)
     return diagram
 
 
-def _operator(resolved, grasps):
+def _operator(resolved, grasps, meshcat):
     scenario = resolved.scenario
+    config = scenario.operator
     period = scenario.control_period
-    if scenario.method == "pbp_no_user" or isinstance(scenario.operator, NoOperatorConfig):
+    if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
         return NoOperator(OperatorTwist.size, period)
+    # Only teleop lets the person push along the approach axis (the paper's forward key).
+    teleop = scenario.method == "teleop"
+    if isinstance(config, (Keyboard, Gamepad)) and meshcat is None:
+        raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "
+                         "Meshcat (pbp-drake run without --headless)")
+    if isinstance(config, Keyboard):
+        return KeyboardTwistOperator(meshcat, period, teleop, KeyboardTwistParams(
+            config.speed, config.rotation_speed, config.hold_time),
+            nominal_speed=resolved.nominal_speed)
+    if isinstance(config, Gamepad):
+        return GamepadTwistOperator(meshcat, period, teleop, GamepadTwistParams(
+            config.speed, config.rotation_speed, config.dead_zone),
+            nominal_speed=resolved.nominal_speed)
     participant = GraspParticipant.create(
         GraspParticipantParams.from_virtual_participant(scenario.operator),
         "drive" if scenario.method == "teleop" else "assist", resolved.nominal_speed,

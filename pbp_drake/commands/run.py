@@ -18,8 +18,8 @@ from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, mark_replay)
 from pbp_drake.scenarios import (
-    METHODS, OPERATOR_NAMES, Gamepad, Hsr, Keyboard, ScenarioError, load_scenario_file,
-    resolve, with_method)
+    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, Hsr, Keyboard, ScenarioError,
+    load_scenario_file, resolve, with_method)
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
 
@@ -225,8 +225,7 @@ def _run_task(args, resolved, meshcat):
             print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
                   f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
             if person:
-                print("Keys: arrows move the hand (forward only in teleop), Q and E turn it.",
-                      flush=True)
+                print(_controls_line(scenario), flush=True)
             _wait_for_browser(meshcat, args.wait_for_browser, person)
         first = False
         result, live = _run_task_once(args, resolved, diagram, meshcat, console)
@@ -247,6 +246,18 @@ def _run_task(args, resolved, meshcat):
             resolved = resolve(dataclasses.replace(scenario, seed=scenario.seed + 1))
         print(f"{'Restart' if choice == 'restart' else 'Next scene'}: seed "
               f"{resolved.scenario.seed}.", flush=True)
+
+
+def _controls_line(scenario):
+    """What the person's keys or gamepad do, printed before the task starts: the grasping
+    task steers the hand in six DoF, the reaching task in four."""
+    if not isinstance(scenario.task, GraspTask):
+        return "Keys: arrows move the hand (forward only in teleop), Q and E turn it."
+    if isinstance(scenario.operator, Gamepad):
+        return ("Gamepad: left stick moves the hand (forward only in teleop), triggers raise "
+                "(RT) and lower (LT) it; right stick yaws and pitches, shoulders roll.")
+    return ("Keys: arrows move the hand (forward only in teleop), PageUp/PageDown raise and "
+            "lower it; R switches to turning (arrows pitch and yaw, PageUp/PageDown roll).")
 
 
 def _run_task_once(args, resolved, diagram, meshcat, console):

@@ -55,6 +55,7 @@ class PoseDmpBank(LeafSystem):
         - references
         - selected_reference
         - phase
+        - predicted_poses (with prediction_steps > 0)
 
     `robot_state` is a `PoseState` `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]`
     (quaternion unit within `quaternion.UNIT_TOLERANCE`, angular velocity world frame);
@@ -76,7 +77,11 @@ class PoseDmpBank(LeafSystem):
     `references` is the K next pose references, K `PoseState` rows (pose after one step,
     twist) flattened; `selected_reference` is the one of `selected_goal` (unconnected: the
     followed goal, else goal 0), a `PoseState`, computed alone (what a blender needs;
-    `references` costs K exp maps). `phase` is the K (equal) phases.
+    `references` costs K exp maps). `phase` is the K (equal) phases. `predicted_poses`
+    (declared when `prediction_steps > 0`) is the selected DMP's open-loop rollout from its
+    current state, `prediction_steps + 1` `GoalPose` rows flattened, sampled every
+    `prediction_period` (default: the DMPs' duration over `prediction_steps`), for
+    drawing: it is computed only when read (a visualizer's publish), never per tick.
 
     The state is one vector `[phase, held, p (3), q (4), eta_held (3), z, dp, dz (3K each),
     e', z' (3K each)]` (`_split` knows the layout): the position part as `DmpBank` keeps
@@ -87,7 +92,7 @@ class PoseDmpBank(LeafSystem):
 
     def __init__(self, position_bank, orientation_bank, control_period,
                  lock_phase_when_operator_acts=False, update_offset=None, max_speed=None,
-                 max_angular_speed=None):
+                 max_angular_speed=None, prediction_steps=0, prediction_period=None):
         super().__init__()
         _check_banks(position_bank, orientation_bank, control_period)
         # Anti-windup, as DmpBank's `max_speed`: the hand-over never lets the hand move or
@@ -137,6 +142,17 @@ class PoseDmpBank(LeafSystem):
                                    self._followed_goal_port.ticket()})
         self._phase_port = self.DeclareVectorOutputPort(
             "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
+        self._prediction_steps = int(prediction_steps)
+        self._prediction_period = float(
+            prediction_period or position_bank.duration / max(self._prediction_steps, 1))
+        self._predicted_poses_port = None
+        if self._prediction_steps > 0:
+            self._predicted_poses_port = self.DeclareVectorOutputPort(
+                "predicted_poses", (self._prediction_steps + 1) * GoalPose.size,
+                self._calc_predicted_poses,
+                prerequisites_of_calc={self.xd_ticket(), self._goals_port.ticket(),
+                                       self._selected_goal_port.ticket(),
+                                       self._followed_goal_port.ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     @staticmethod
@@ -175,6 +191,9 @@ class PoseDmpBank(LeafSystem):
 
     def get_phase_output_port(self):
         return self._phase_port
+
+    def get_predicted_poses_output_port(self):
+        return self._predicted_poses_port
 
     def _split(self, vector):
         """Views: phase (1,), held (1,), p (3, 1), q (4, 1), eta_held (3, 1), z, dp, dz
@@ -325,6 +344,20 @@ class PoseDmpBank(LeafSystem):
     def _calc_phase(self, context, output):
         phase = self._split(context.get_discrete_state(self._state_index).get_value())[0]
         output.get_mutable_value()[:] = phase[0]
+
+
+    def _calc_predicted_poses(self, context, output):
+        k = goal_index(self._selected_goal_port, context, self._goal_count)
+        if k is None:
+            k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
+        phase, positions, orientations, velocity, eta = self.dmp_states(context)
+        goals = self._goals_entry.Eval(context)
+        # The banks roll out all K DMPs (their `predict` is vectorised over K); only the
+        # selected one is drawn. Read at a visualizer's rate (10 Hz), the cost is small.
+        dt, steps = self._prediction_period, self._prediction_steps
+        path = self._positions.predict(phase, positions, velocity, goals[:3], dt, steps)[k]
+        turns = self._orientations.predict(phase, orientations, eta, goals[3:], dt, steps)[k]
+        output.SetFromVector(np.hstack([path, turns]).reshape(-1))
 
 
 def _limit(scaled_velocities, max_speed, duration):

@@ -1,6 +1,6 @@
 """The grasping task's scenario (`task: !GraspTask`): diagrams/hsr_grasp.yaml loads and
-resolves, bad fields are refused naming them, and the builder refuses it as not yet
-buildable."""
+resolves, bad fields are refused naming them, and a person at the keyboard or gamepad
+drives it from the page (and only from the page)."""
 
 import dataclasses
 
@@ -11,7 +11,7 @@ from pbp_drake import cli
 from pbp_drake.builder import build_diagram
 from pbp_drake.core.grasp_task import sample_grasp_scene
 from pbp_drake.scenarios import (
-    GraspTask, Keyboard, ScenarioError, load_scenario_file, resolve)
+    Gamepad, GraspTask, Keyboard, ScenarioError, load_scenario_file, resolve)
 
 
 @pytest.fixture(scope="module")
@@ -50,11 +50,16 @@ def test_another_seed_another_scene(shipped):
     assert not np.array_equal(other.layout.objects[:2], shipped.resolved.layout.objects[:2])
 
 
-def test_the_builder_refuses_a_person_at_the_keyboard_as_not_yet_wired(shipped):
-    scenario = dataclasses.replace(shipped.scenario, operator=Keyboard())
-    with pytest.raises(ScenarioError, match="!Keyboard: the grasping task cannot be driven "
-                                            "from the browser yet"):
-        build_diagram(resolve(scenario))
+@pytest.mark.parametrize("config, system", [(Keyboard, "KeyboardTwistOperator"),
+                                             (Gamepad, "GamepadTwistOperator")])
+def test_a_person_drives_the_grasp_from_the_page_only(shipped, meshcat, config, system):
+    resolved = resolve(dataclasses.replace(shipped.scenario, operator=config()))
+    with pytest.raises(ValueError, match=f"operator !{config.__name__} reads the browser: "
+                                         "it needs Meshcat"):
+        build_diagram(resolved)
+    diagram = build_diagram(resolved, meshcat)
+    assert type(diagram.GetSubsystemByName("operator")).__name__ == system
+    assert diagram.HasSubsystemNamed("task_visualizer")
 
 
 def with_task(shipped, **fields):
@@ -120,8 +125,16 @@ def test_a_yaml_typo_in_the_task_names_the_key(shipped, tmp_path):
         load_scenario_file(path)
 
 
-def test_run_refuses_a_keyboard_before_it_starts(repo, capsys):
-    arguments = ["run", str(repo / "diagrams" / "hsr_grasp.yaml"), "--operator", "keyboard",
-                 "--headless"]
+@pytest.mark.parametrize("operator, controls", [
+    ("keyboard", "Keys: arrows move the hand (forward only in teleop), PageUp/PageDown"),
+    ("gamepad", "Gamepad: left stick moves the hand (forward only in teleop), triggers")])
+def test_run_waits_for_a_browser_and_refuses_when_none_joins(repo, capsys, operator,
+                                                             controls):
+    arguments = ["run", str(repo / "diagrams" / "hsr_grasp.yaml"), "--operator", operator,
+                 "--wait-for-browser", "0", "--port", "0"]
     assert cli.main(arguments) == 2
-    assert "cannot be driven from the browser yet" in capsys.readouterr().err
+    captured = capsys.readouterr()
+    assert "the task starts when it connects (waiting up to 0 s)" in captured.out
+    assert controls in captured.out
+    assert captured.err.startswith("pbp-drake: no browser opened http://")
+    assert "nothing was run or recorded" in captured.err

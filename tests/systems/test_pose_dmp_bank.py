@@ -171,3 +171,27 @@ def test_a_cloned_context_steps_as_the_original():
         rows = [bank.get_references_output_port().Eval(
             bank.GetMyContextFromRoot(simulator.get_context())) for simulator in (first, second)]
         np.testing.assert_array_equal(rows[0], rows[1])
+
+
+@pytest.mark.parametrize("selected", [1, 3])
+def test_the_predicted_poses_are_the_selected_dmps_rollout_to_its_goal(selected):
+    positions, orientations, goals = make_banks()
+    steps = 30
+    bank = PoseDmpBank(positions, orientations, DT, prediction_steps=steps)
+    context = bank.CreateDefaultContext()
+    bank.get_robot_state_input_port().FixValue(context, ROBOT)
+    bank.get_goal_poses_input_port().FixValue(context, goals.reshape(-1))
+    bank.get_selected_goal_input_port().FixValue(context, [float(selected)])
+    for _ in range(20):  # 0.2 s of steps, so the rollout starts mid-way
+        context.SetDiscreteState(bank.EvalUniquePeriodicDiscreteUpdate(context).value())
+    path = bank.get_predicted_poses_output_port().Eval(context).reshape(steps + 1, 7)
+    phase, stepped, rotations, velocity, eta = bank.dmp_states(context)
+    period = positions.duration / steps
+    expected = positions.predict(phase, stepped, velocity, goals[:, :3].T, period, steps)
+    turns = orientations.predict(phase, rotations, eta, goals[:, 3:].T, period, steps)
+    np.testing.assert_allclose(path[:, :3], expected[selected], atol=1e-12)
+    np.testing.assert_allclose(path[:, 3:], turns[selected], atol=1e-12)
+    # What the page draws: a path from the selected DMP's pose that ends near its goal.
+    np.testing.assert_allclose(path[0, :3], stepped[:, selected], atol=1e-12)
+    assert np.linalg.norm(path[-1, :3] - goals[selected, :3]) < 0.05
+    assert quaternion.angle_between(path[-1, 3:], goals[selected, 3:]) < 0.05

@@ -1,0 +1,62 @@
+"""The grasping task drawn in Meshcat by its own diagram (issue 17): a recording of a PBP-Alt
+run with the virtual participant shows the selected DMP's predicted path ending at the
+estimated goal's grasp pose and starting at the hand, and the hand's triad where the hand
+is; without Meshcat nothing is predicted at all."""
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from replay_tracks import animation_tracks, value_at
+
+from pbp_drake.builder import build_diagram
+from pbp_drake.builder.grasp import GRASP_PREDICTION_SAMPLES
+from pbp_drake.core.quaternion import angle_between
+from pbp_drake.scenarios import load_scenario_file
+from pbp_drake.systems.grasp_scene_visualizer import PATH_TRIADS
+
+DURATION = 1.5
+
+
+@pytest.fixture(scope="module")
+def grasp(repo):
+    return load_scenario_file(repo / "diagrams" / "hsr_grasp.yaml").resolved
+
+
+def test_the_replay_shows_the_selected_dmps_path_to_its_grasp(grasp, meshcat):
+    diagram = build_diagram(grasp, meshcat)
+    meshcat.StartRecording(frames_per_second=30.0)
+    simulator = Simulator(diagram)
+    simulator.AdvanceTo(DURATION)
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    tracks = animation_tracks(meshcat.StaticHtml())
+    context = simulator.get_context()
+    estimator = diagram.GetSubsystemByName("goal_estimator")
+    selected = int(estimator.get_selected_goal_output_port().Eval(
+        estimator.GetMyContextFromRoot(context))[0])
+    grasps = grasp.layout.grasps
+    # The path's last triad, at the last path publish (every 0.1 s): the DMP's rollout over
+    # its duration ends at (nearly) its goal, the estimated goal's grasp pose.
+    shown = 1.4
+    last = f"/task/prediction/{PATH_TRIADS - 1}"
+    position = value_at(tracks, last, ".position", shown)
+    np.testing.assert_allclose(position, grasps.grasp_positions[selected], atol=0.01)
+    # Meshcat (three.js) keeps quaternions as (x, y, z, w).
+    turn = np.roll(value_at(tracks, last, ".quaternion", shown), 1)
+    assert np.degrees(angle_between(turn, grasps.grasp_orientations[selected])) < 2.0
+    # The path starts at the hand, and the hand's triad is drawn where the hand is.
+    hand = value_at(tracks, "/task/hand", ".position", shown)
+    start = value_at(tracks, "/task/prediction/0", ".position", shown)
+    assert np.linalg.norm(start - hand) < 0.05
+    station = diagram.GetSubsystemByName("hsr_station")
+    now = np.asarray(station.GetOutputPort("hand_pose").Eval(
+        station.GetMyContextFromRoot(context)))[:3]
+    # The hand moves at most 0.12 m/s: within 0.1 s of its last drawing it is near it.
+    assert np.linalg.norm(value_at(tracks, "/task/hand", ".position", DURATION) - now) < 0.02
+
+
+def test_without_meshcat_the_pose_bank_predicts_nothing(grasp):
+    bank = build_diagram(grasp).GetSubsystemByName("dmp_bank")
+    assert bank.get_predicted_poses_output_port() is None
+    assert not bank.HasOutputPort("predicted_poses")
+    assert GRASP_PREDICTION_SAMPLES > 0

@@ -18,6 +18,11 @@ ALONG_WEIGHT = 0.1
 # An angular velocity error of 1 rad/s weighs as 0.32 m/s: where the limits bind, the
 # hand's heading gives before its position.
 ROTATION_WEIGHT = 0.1
+# With `limit_overshoot` (the pose station), a step whose hand would move along the twist
+# further than the twist itself is solved again with its part along the twist weighing this
+# many times the rest: the hand does not run ahead of the command where the limits bind
+# (issue 17: it sped up to 0.26 m/s while the command slowed to 0.15).
+OVERSHOOT_WEIGHT = 10.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
 CATCH_UP_STEPS = 3
@@ -143,12 +148,15 @@ class WholeBodyDiffIk(LeafSystem):
     state and sampling events declared here): the station does so, which spares two
     Python calls at each step. With a ``PoseCommandRamp`` (``hsr_pose_systems``) the
     command is a ``PoseState`` read on ``pose_command``: the ramp names and sizes the port.
+    With ``limit_overshoot`` (the pose station), a step whose hand would move further along
+    the twist than the twist is solved again with that part weighing ``OVERSHOOT_WEIGHT``.
     """
 
     def __init__(self, plant, frame_E, time_step, plant_time_step, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
-                 centering_gain, command_ramp=None):
+                 centering_gain, command_ramp=None, limit_overshoot=False):
         super().__init__()
+        self._limit_overshoot = bool(limit_overshoot)
         nq, nv = plant.num_positions(), plant.num_velocities()
         if nq != nv:
             raise ValueError("WholeBodyDiffIk needs q̇ = v (no quaternion joints)")
@@ -260,12 +268,13 @@ class WholeBodyDiffIk(LeafSystem):
         # weighing ALONG_WEIGHT of the rest: W = D - (1 - ALONG_WEIGHT) D t t' D / t'D t.
         JD = J.T * self._task_weights
         JDt = JD @ twist
-        H = JD @ J + self._identity
-        g = self._centering_gain * (self._q_nominal - q)
+        H0 = JD @ J + self._identity
+        g0 = self._centering_gain * (self._q_nominal - q)
+        H, g = H0, g0
         norm = twist @ (self._task_weights * twist)
         if norm > 0:
-            H -= (1.0 - ALONG_WEIGHT) / norm * (JDt[:, None] * JDt)  # np.outer's product
-            g += ALONG_WEIGHT * JDt
+            H = H0 - (1.0 - ALONG_WEIGHT) / norm * (JDt[:, None] * JDt)  # np.outer's product
+            g = g0 + ALONG_WEIGHT * JDt
         # Within the velocity limits, the acceleration limits from v, and the position
         # limits by the end of the step; where the last two conflict, brake.
         accel_lower = v + self._a_lower_step
@@ -275,7 +284,13 @@ class WholeBodyDiffIk(LeafSystem):
         conflict = lower > upper
         if conflict.any():
             lower[conflict] = upper[conflict] = np.clip(0.0, accel_lower, accel_upper)[conflict]
-        return solve_box_qp(H, g, lower, upper, hold)
+        v_next, hold_next = solve_box_qp(H, g, lower, upper, hold)
+        if self._limit_overshoot and norm > 0 and JDt @ v_next > norm:
+            # Ahead of the twist along it: weigh that part OVERSHOOT_WEIGHT times the rest.
+            H = H0 - (1.0 - OVERSHOOT_WEIGHT) / norm * (JDt[:, None] * JDt)
+            v_next, hold_next = solve_box_qp(H, g0 + OVERSHOOT_WEIGHT * JDt, lower, upper,
+                                             hold_next)
+        return v_next, hold_next
 
     def _calc_desired_state(self, context, output):
         # Evaluated at every plant step: written into the output in place.

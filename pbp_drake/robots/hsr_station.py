@@ -145,7 +145,8 @@ def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp,
         config.plant.time_step, motor_joints,
         position_limits=(plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()),
         velocity_limits=(v_lower, v_upper), acceleration_limits=(-accelerations, accelerations),
-        q_nominal=q0, centering_gain=centering, command_ramp=command_ramp)
+        q_nominal=q0, centering_gain=centering, command_ramp=command_ramp,
+        limit_overshoot=isinstance(command_ramp, PoseCommandRamp))
 
 
 def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,

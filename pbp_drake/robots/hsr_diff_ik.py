@@ -20,8 +20,10 @@ ALONG_WEIGHT = 0.1
 ROTATION_WEIGHT = 0.1
 # With `limit_overshoot` (the pose station), a step whose hand would move along the twist
 # further than the twist itself is solved again with its part along the twist weighing this
-# many times the rest: the hand does not run ahead of the command where the limits bind
-# (issue 17: it sped up to 0.26 m/s while the command slowed to 0.15).
+# many times the rest, and then, if the palm still moves further along the linear twist
+# than it (turning less to move more), with that too: the hand does not run ahead of the
+# command where the limits bind (issue 17: it sped up to 0.26 m/s while the command slowed
+# to 0.15).
 OVERSHOOT_WEIGHT = 10.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
@@ -149,7 +151,8 @@ class WholeBodyDiffIk(LeafSystem):
     Python calls at each step. With a ``PoseCommandRamp`` (``hsr_pose_systems``) the
     command is a ``PoseState`` read on ``pose_command``: the ramp names and sizes the port.
     With ``limit_overshoot`` (the pose station), a step whose hand would move further along
-    the twist than the twist is solved again with that part weighing ``OVERSHOOT_WEIGHT``.
+    the twist (then along its linear part) than the twist is solved again with that part
+    weighing ``OVERSHOOT_WEIGHT``.
     """
 
     def __init__(self, plant, frame_E, time_step, plant_time_step, motor_joints, *,
@@ -285,11 +288,23 @@ class WholeBodyDiffIk(LeafSystem):
         if conflict.any():
             lower[conflict] = upper[conflict] = np.clip(0.0, accel_lower, accel_upper)[conflict]
         v_next, hold_next = solve_box_qp(H, g, lower, upper, hold)
-        if self._limit_overshoot and norm > 0 and JDt @ v_next > norm:
+        if not self._limit_overshoot:
+            return v_next, hold_next
+        if norm > 0 and JDt @ v_next > norm:
             # Ahead of the twist along it: weigh that part OVERSHOOT_WEIGHT times the rest.
             H = H0 - (1.0 - OVERSHOOT_WEIGHT) / norm * (JDt[:, None] * JDt)
-            v_next, hold_next = solve_box_qp(H, g0 + OVERSHOOT_WEIGHT * JDt, lower, upper,
-                                             hold_next)
+            g = g0 + OVERSHOOT_WEIGHT * JDt
+            v_next, hold_next = solve_box_qp(H, g, lower, upper, hold_next)
+        linear = twist[3:]
+        speed2 = linear @ linear
+        Jl = J[3:].T @ linear
+        if speed2 > 0 and Jl @ v_next > speed2:
+            # The palm ahead of the linear twist (turning less to move more, rotation being
+            # cheap): add OVERSHOOT_WEIGHT (l'J v - |l|^2)^2 / |l|^2 in the task weight.
+            weighted = Jl * (TASK_WEIGHT * OVERSHOOT_WEIGHT / speed2)
+            H = H + weighted[:, None] * Jl
+            g = g + weighted * speed2
+            v_next, hold_next = solve_box_qp(H, g, lower, upper, hold_next)
         return v_next, hold_next
 
     def _calc_desired_state(self, context, output):

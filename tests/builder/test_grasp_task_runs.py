@@ -54,7 +54,7 @@ def test_the_palm_does_not_run_ahead_of_a_slowing_command(repo):
     """Issue 17's smooth motion: the hand within about 0.22 m/s. In this trial the operator
     presses (PBP-Alt) as the wrist starts turning; the command slows from 0.2 to 0.15 m/s
     and the diff IK, held by the base's acceleration limits, let the palm run ahead along
-    the twist at up to twice its speed: 0.256 m/s measured between two ticks."""
+    the twist at up to twice its speed: 0.256 m/s measured between two ticks (0.202 after)."""
     import dataclasses
 
     from pbp_drake.scenarios import resolve, with_method

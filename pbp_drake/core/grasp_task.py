@@ -46,6 +46,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.quaternion import angle_between, exp_map, multiply, unit_quaternions
+from pbp_drake.core.reach_task import check_object_count
 
 APPROACHES = ("side", "top")
 # The region the shipped tasks draw from and the HSR reaches (`reach_task.validate_objects`).
@@ -126,13 +127,7 @@ def sample_grasp_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
                        grasp_depth=0.08):
     """Draws a `GraspScene` from `seed` alone (the same seed, the same scene, for every
     method). Angles in radians; lengths in metres."""
-    low, high = object_count
-    if low < 1 or high < low:
-        raise ValueError(f"object_count must be [min, max] with 1 <= min <= max, got "
-                         f"{list(object_count)}")
-    if len(switch_schedule) > 1 and low < 2:
-        raise ValueError("target switching needs at least 2 objects: set object_count to "
-                         "at least [2, ...] or switch_schedule to [0.0]")
+    low, high = check_object_count(object_count, switch_schedule)
     diagonal = float(np.hypot(*table_size))
     if min_separation < diagonal:
         raise ValueError(f"min_separation {min_separation} m is less than the tables' "

@@ -21,12 +21,9 @@ class ReachScene:
     targets: tuple
 
 
-def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(-1.05, 1.05),
-                       height=0.7, switch_schedule=(0.0, 0.3, 0.6), min_separation=0.2):
-    """Draws a scene from `seed` alone (the same seed, the same scene, for every method).
-
-    Objects closer than `min_separation` are redrawn, so that each can be told apart.
-    """
+def check_object_count(object_count, switch_schedule):
+    """`(min, max)` of `object_count`, refused unless 1 <= min <= max, and min >= 2 when
+    the target switches (more than one entry in `switch_schedule`)."""
     low, high = object_count
     if low < 1 or high < low:
         raise ValueError(f"object_count must be [min, max] with 1 <= min <= max, got "
@@ -34,6 +31,16 @@ def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
     if len(switch_schedule) > 1 and low < 2:
         raise ValueError("target switching needs at least 2 objects: set object_count to "
                          "at least [2, ...] or switch_schedule to [0.0]")
+    return low, high
+
+
+def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(-1.05, 1.05),
+                       height=0.7, switch_schedule=(0.0, 0.3, 0.6), min_separation=0.2):
+    """Draws a scene from `seed` alone (the same seed, the same scene, for every method).
+
+    Objects closer than `min_separation` are redrawn, so that each can be told apart.
+    """
+    low, high = check_object_count(object_count, switch_schedule)
     rng = np.random.default_rng(seed)
     count = int(rng.integers(low, high + 1))
     objects = np.empty((count, 3))

@@ -10,7 +10,8 @@ station, the hand driven to a grasp pose (position and orientation).
     dmp_bank.selected_reference ──> blender.policy_reference
     operator (operator_command: OperatorTwist, operator_active) ──> blender, dmp_bank
                                                                    (PBP-Alt's lock),
-                                                                   task_monitor
+                                                                   task_monitor,
+                                                                   goal_estimator
     task_monitor.target ──> operator
     blender.reference ──> hand_over (PoseHandOver) ──> hsr_station.pose_command
     task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
@@ -168,6 +169,8 @@ def build_grasp_diagram(resolved, meshcat=None):
                  monitor.get_operator_active_input_port()):
         builder.Connect(active, port)
     builder.Connect(twist, blender.get_operator_twist_input_port())
+    # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
+    builder.Connect(twist, estimator.get_operator_twist_input_port())
 
     for name, port in [("hand_pose_log", hand_pose), ("operator_active_log", active),
                        ("operator_command_log", twist),

@@ -7,7 +7,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings, SelectionMemory
 from pbp_drake.core.grasp_estimation import estimate_pose
-from pbp_drake.systems.layouts import GoalPose, PoseState
+from pbp_drake.systems.layouts import GoalPose, OperatorTwist, PoseState
 from pbp_drake.systems.tick import decide_offset
 
 
@@ -21,12 +21,19 @@ class PoseGoalEstimator(LeafSystem):
         input_ports:
         - hand_pose
         - goal_poses
+        - operator_twist (optional)
         output_ports:
         - selected_goal
         - goal_probabilities
 
     `hand_pose` is the hand's `PoseState` (pose and world-frame twist); `goal_poses` the K
-    `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened. `selected_goal` is `[index]`
+    `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened. `operator_twist`, when
+    connected, is the operator's command, an `OperatorTwist` `[v (3), omega (3)]` (world
+    frame): the estimator's direction of travel and turn rate are then the operator's, not
+    the hand's. Connect it whenever a policy moves the hand too: the hand's own twist is
+    then mostly the selected DMP's, and reading it as the operator's intent holds the
+    selection on whatever the robot is heading for (docs/grasp_task.md). Unconnected, the
+    hand's twist from `hand_pose` is read. `selected_goal` is `[index]`
     and `goal_probabilities` the K probabilities; both are read from the state, so they
     hold between updates, as `GoalEstimator`'s.
 
@@ -47,6 +54,7 @@ class PoseGoalEstimator(LeafSystem):
         self._settings = dataclasses.replace(settings)
         self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
         self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
+        self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
         self._selected_index = self.DeclareDiscreteState(np.zeros(1))
         self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
         # [challenger, count] of the hysteresis (`SelectionMemory`); -1: none yet.
@@ -66,6 +74,9 @@ class PoseGoalEstimator(LeafSystem):
     def get_goal_poses_input_port(self):
         return self._goals_port
 
+    def get_operator_twist_input_port(self):
+        return self._twist_port
+
     def get_selected_goal_output_port(self):
         return self._selected_port
 
@@ -81,9 +92,11 @@ class PoseGoalEstimator(LeafSystem):
         hand = np.asarray(self._hand_port.Eval(context), float)
         goals = np.asarray(self._goals_port.Eval(context), float).reshape(
             self._goal_count, GoalPose.size)
+        twist = (np.asarray(self._twist_port.Eval(context), float)
+                 if self._twist_port.HasValue(context) else hand[7:13])
         result = estimate_pose(self._settings, goals[:, :3], goals[:, 3:], hand[:3],
-                               hand[3:7] / np.linalg.norm(hand[3:7]), hand[7:10],
-                               hand[10:13], memory)
+                               hand[3:7] / np.linalg.norm(hand[3:7]), twist[:3], twist[3:],
+                               memory)
         state.get_mutable_vector(self._selected_index).set_value([result.selected])
         state.get_mutable_vector(self._probabilities_index).set_value(result.probabilities)
         state.get_mutable_vector(self._memory_index).set_value(

@@ -75,7 +75,7 @@ class GoalEstimatorSettings:
     beta: float = 5.0
     margin: float = 0.1
     hold_steps: int = 2
-    distance_weight: float = 1.0
+    distance_weight: float = 0.1
     orientation_weight: float = 1.0
     turn_horizon: float = 1.0
     min_speed: float = 0.01

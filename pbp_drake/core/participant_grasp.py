@@ -18,6 +18,12 @@ in the world frame (m/s, rad/s):
   Any forward part along the hand's approach axis z_H is removed (`without_forward`), as
   with the paper's disabled forward key. Two grasps at one place differ only in
   orientation: it then only turns.
+- Once it has held the target's grasp orientation (within twice `aligned_angle`) for
+  `insist_time` while the estimate still names another object, it goes to the target
+  itself as far as the keys allow, as the reach participant does (`insist_twist`): along
+  the direction to the target without its forward part, slowing within `slow_radius`. It
+  keeps insisting until a new target appears. (Backing away from the picked object can
+  walk the hand off the scene when the target stands behind it.)
 
 Its commands carry noise drawn from `(seed, tick)` (`command_noise`): `v` rotated by
 N(0, `direction_noise`) rad about an axis perpendicular to it, the whole twist scaled by
@@ -32,7 +38,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core.grasp_task import approach_direction
-from pbp_drake.core.quaternion import conjugate, exp_map, log_map, multiply
+from pbp_drake.core.quaternion import angle_between, conjugate, exp_map, log_map, multiply
 
 GRASP_PARTICIPANT_MODES = ("assist", "drive")
 # `ParticipantMemory.known_target` before it has noticed any target.
@@ -63,6 +69,9 @@ class GraspParticipantParams:
     slow_angle: float = 0.3
     # ... and stops turning within this angle (rad): well inside the task's 10 degrees.
     aligned_angle: float = 0.05
+    # Assisting, once it has held the target's orientation this long (s) and the estimate
+    # still names another object, it goes to the target itself (`insist_twist`).
+    insist_time: float = 1.0
 
     @classmethod
     def from_virtual_participant(cls, params):
@@ -72,7 +81,7 @@ class GraspParticipantParams:
                    reaction_delay=params.reaction_delay,
                    direction_noise=params.direction_noise, speed_noise=params.speed_noise,
                    slow_radius=params.slow_radius, slow_angle=params.turn_slowdown_angle,
-                   aligned_angle=params.aligned_angle)
+                   aligned_angle=params.aligned_angle, insist_time=params.insist_time)
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
@@ -81,7 +90,7 @@ class GraspParticipantParams:
             if not (np.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be finite and positive, got {value!r}")
         for name in ("speed", "reaction_delay", "direction_noise", "speed_noise",
-                     "aligned_angle"):
+                     "aligned_angle", "insist_time"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be finite and not negative, got {value!r}")
@@ -89,11 +98,21 @@ class GraspParticipantParams:
 
 class ParticipantMemory(typing.NamedTuple):
     """What it remembers between ticks: the target it acts on (`NO_TARGET` before the
-    first is noticed), the newest target it has seen and since when (s)."""
+    first is noticed), the newest target it has seen and since when (s), since when (s,
+    -1: not) it has held the known target's orientation while the estimate named another
+    object, and whether it insists (`insist_twist`)."""
 
     known_target: int = NO_TARGET
     seen_target: int = NO_TARGET
     seen_since: float = 0.0
+    facing_since: float = -1.0
+    insisting: bool = False
+
+    @classmethod
+    def from_array(cls, values):
+        """The memory a system kept as floats (`np.array(memory, dtype=float)`)."""
+        known, seen, since, facing, insisting = values
+        return cls(int(known), int(seen), float(since), float(facing), bool(insisting))
 
 
 def notice_target(memory, true_target, time, reaction_delay):
@@ -102,9 +121,25 @@ def notice_target(memory, true_target, time, reaction_delay):
     if int(true_target) != memory.seen_target:
         memory = memory._replace(seen_target=int(true_target), seen_since=float(time))
     # A tick's float time may fall a hair short of the delay it was meant to reach.
-    if time - memory.seen_since >= reaction_delay - 1e-9:
-        memory = memory._replace(known_target=memory.seen_target)
+    if (time - memory.seen_since >= reaction_delay - 1e-9
+            and memory.known_target != memory.seen_target):
+        memory = memory._replace(known_target=memory.seen_target, facing_since=-1.0,
+                                 insisting=False)
     return memory
+
+
+def count_insistence(params, memory, time, orientation, target_orientation, selected):
+    """The memory after a tick in which the estimate names `selected`: it starts insisting
+    once it has held the known target's orientation (within twice `aligned_angle`, as noise
+    moves it) for `insist_time` while `selected` was another object."""
+    if memory.insisting:
+        return memory
+    if selected == memory.known_target or angle_between(
+            orientation, target_orientation) > 2 * params.aligned_angle:
+        return memory._replace(facing_since=-1.0)
+    since = memory.facing_since if memory.facing_since >= 0.0 else float(time)
+    return memory._replace(facing_since=since,
+                           insisting=time - since >= params.insist_time - 1e-9)
 
 
 def unit(vector):
@@ -149,6 +184,15 @@ def assist_twist(params, speed, position, orientation, target_position, target_o
     apart = unit(offset) - unit(np.asarray(picked_position, float) - position)
     slow = min(1.0, float(np.linalg.norm(offset)) / params.slow_radius)
     velocity = speed * slow * without_forward(unit(apart), orientation)
+    return velocity, turn_toward(params, orientation, target_orientation)
+
+
+def insist_twist(params, speed, position, orientation, target_position, target_orientation):
+    """Insisting: `(v (3), omega (3))`, `v` toward the target's grasp position without a
+    forward part, slowing within `slow_radius`, `omega` holding the grasp orientation."""
+    offset = np.asarray(target_position, float) - position
+    slow = min(1.0, float(np.linalg.norm(offset)) / params.slow_radius)
+    velocity = speed * slow * without_forward(unit(offset), orientation)
     return velocity, turn_toward(params, orientation, target_orientation)
 
 
@@ -223,11 +267,19 @@ class GraspParticipant:
         position = np.asarray(position, float)
         orientation = np.asarray(orientation, float)
         if self.mode == "assist":
+            memory = count_insistence(self.params, memory, time, orientation,
+                                      self.grasp_orientations[target], int(selected))
             if int(selected) == target:
                 return idle, False, memory
-            velocity, angular = assist_twist(
-                self.params, self.speed, position, orientation, self.grasp_positions[target],
-                self.grasp_orientations[target], self.grasp_positions[int(selected)])
+            if memory.insisting:
+                velocity, angular = insist_twist(
+                    self.params, self.speed, position, orientation,
+                    self.grasp_positions[target], self.grasp_orientations[target])
+            else:
+                velocity, angular = assist_twist(
+                    self.params, self.speed, position, orientation,
+                    self.grasp_positions[target], self.grasp_orientations[target],
+                    self.grasp_positions[int(selected)])
         else:
             velocity, angular = drive_twist(
                 self.params, self.speed, position, orientation, self.grasp_positions[target],

@@ -56,8 +56,8 @@ class GraspParticipantSystem(SampledOperator):
         return self._selected_port
 
     def _update(self, context, discrete_state):
-        known, seen, since = context.get_discrete_state(self._memory_index).value()
-        memory = ParticipantMemory(int(known), int(seen), float(since))
+        memory = ParticipantMemory.from_array(
+            context.get_discrete_state(self._memory_index).value())
         hand = np.asarray(self._hand_port.Eval(context), float)
         time = context.get_time()
         # Teleop never reads the estimate: its port may stay unconnected there.

@@ -206,3 +206,48 @@ def test_bad_arguments_say_what_is_wrong(arguments, message):
     values.update(arguments)
     with pytest.raises(ValueError, match=message):
         GraspParticipant.create(**values)
+
+
+def test_after_holding_the_targets_orientation_in_vain_it_goes_to_the_target_itself():
+    # The target stands behind the picked object, a little to the right: backing away from
+    # the picked object would walk the hand off the scene, as it did before this rule.
+    positions = np.array([[1.3, 0.05, 0.675], [2.3, -0.35, 0.675]])
+    orientations = np.array([LEVEL, LEVEL])
+    params = GraspParticipantParams(direction_noise=0.0, speed_noise=0.0)
+    participant = GraspParticipant.create(params, "assist", SPEED, positions, orientations)
+    memory = notice_target(ParticipantMemory(), 1, 0.0, 0.0)
+    ahead = approach_direction(LEVEL)
+    toward_target = positions[1] - HAND
+    insist_tick = int(round(params.insist_time / PERIOD))
+    for tick in range(insist_tick + 3):
+        twist, active, memory = participant.step(memory, tick * PERIOD, tick, HAND, LEVEL,
+                                                 1, 0)
+        assert active and twist[:3] @ ahead <= 1e-12  # never forward
+        if tick < insist_tick:
+            assert not memory.insisting
+            assert twist[:3] @ ahead < 0.0  # backing away from the picked object
+    assert memory.insisting
+    assert twist[:3] @ toward_target > 0.0 and twist[:3] @ ahead > -1e-12
+    # It insists until a new target appears, and then starts over.
+    twist, active, memory = participant.step(memory, 5.0, 200, HAND, LEVEL, 1, 1)
+    assert not active and memory.insisting
+    memory = notice_target(memory, 0, 5.0, 0.0)
+    assert not memory.insisting and memory.facing_since < 0.0
+
+
+def test_it_does_not_insist_before_it_holds_the_targets_orientation():
+    positions = np.array([[1.3, 0.05, 0.675], [2.3, -0.35, 0.675]])
+    orientations = np.array([LEVEL, side_grasp_orientation(0.8)])  # 46 degrees off
+    participant = GraspParticipant.create(GraspParticipantParams(), "assist", SPEED,
+                                          positions, orientations)
+    memory = notice_target(ParticipantMemory(), 1, 0.0, 0.0)
+    for tick in range(100):
+        _, _, memory = participant.step(memory, tick * PERIOD, tick, HAND, LEVEL, 1, 0)
+        assert not memory.insisting
+
+
+def test_the_insisting_time_comes_from_the_scenarios_participant():
+    reach = VirtualParticipantParams(insist_time=2.5)
+    assert GraspParticipantParams.from_virtual_participant(reach).insist_time == 2.5
+    with pytest.raises(ValueError, match="insist_time"):
+        GraspParticipantParams(insist_time=-1.0).validate()

@@ -183,3 +183,32 @@ def test_the_banks_attractors_are_the_single_dmps(formulation, shared):
     for k, dmp in enumerate(dmps):
         np.testing.assert_allclose(attractors[:, k], dmp.attractor(phases[k], goals[k]),
                                    rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+def test_one_orientation_and_one_velocity_for_all_equal_single_dmps(formulation, shared):
+    """The fused step (`orientation_log_step`: one measured orientation `(4, 1)` and one
+    `eta` `(3, 1)`, as the six-DoF system steps with a followed goal) against single DMPs,
+    with errors at 0, 1e-12, 1e-6, 5e-3 and 2e-2 rad (both sides of the series' switch),
+    180 degrees less 1e-9, and exactly 180 degrees (`w = 0` and `-0.0`)."""
+    offsets = [0.0, 1e-12, 1e-6, 5e-3, 2e-2, np.pi - 1e-9, 0.7, 2.5]
+    count = len(offsets) + 2
+    bank, dmps, _ = make_banks(formulation, shared, count, True, seed=33)
+    rng = np.random.default_rng(34)
+    axes = rng.normal(size=(3, len(offsets)))
+    axes /= np.linalg.norm(axes, axis=0)
+    measured = quaternion.IDENTITY[:, np.newaxis]
+    # q g* = Exp(offset axis) for g = Exp(offset axis)*, and two goals at exactly 180 degrees.
+    goals = np.hstack([quaternion.conjugate(quaternion.exp_map(axes * offsets)),
+                       [[0.0, -0.0], [0.0, 0.0], [0.6, -0.0], [-0.8, 1.0]]]).T
+    velocity = rng.normal(size=(3, 1))
+    for phase in (1.0, 0.4):
+        stepped = bank.advance(np.full(count, phase), measured, velocity,
+                               bank.goals_matrix(goals), DT)
+        for k, dmp in enumerate(dmps):
+            dmp.phase, dmp.scaled_angular_velocity = phase, velocity[:, 0].copy()
+            orientation, angular_velocity = dmp.next_step(DT, goals[k], measured[:, 0])
+            np.testing.assert_allclose(stepped[1][:, k], orientation, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(stepped[2][:, k] / bank.duration, angular_velocity,
+                                       rtol=0, atol=1e-12)

@@ -31,6 +31,7 @@ from pbp_drake.core.dmp.orientation import (
 from pbp_drake.core.dmp.orientation_kernels import (
     OrientationWorkspace, error_quaternions_into, exp_into, inverse_jacobian_into,
     jacobian_into, log_into, product_into)
+from pbp_drake.core.dmp.orientation_log_step import forcing_rows, log_step_from_one_into
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis, phase_decay
 from pbp_drake.core.dmp.stepping import _BLOCK_BYTES, step_constants
 
@@ -275,11 +276,12 @@ class OrientationDmpBank:
                               path[step + 1], velocity, workspace)
         return path.transpose(2, 0, 1)
 
-    def _start_errors_into(self, goals_4k, workspace):
+    def _start_errors_into(self, goals_4k, workspace, goals_unchanged=False):
         """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`
         (1 where the fit switched the scaling off) into `workspace.amplitude`."""
         if (workspace.starts_of_start_errors is self.starts
-                and np.array_equal(workspace.goals_of_start_errors, goals_4k)):
+                and (goals_unchanged
+                     or np.array_equal(workspace.goals_of_start_errors, goals_4k))):
             return  # the goals did not change: one pass instead of a log map
         starts = self._uniform_start if self._uniform_start is not None else self.starts
         error_quaternions_into(starts, goals_4k, workspace.error_quaternions, workspace.row)
@@ -302,33 +304,44 @@ class OrientationDmpBank:
                                         orientations, out_orientations, out_velocity, ws)
 
     def log_step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
-                      out_log_state, workspace):
+                      out_log_state, workspace, goals_unchanged=False):
         """The free step in log coordinates: `e = Log(q g*)` and `z = J(e)^-1 eta` from the
         measured orientations `(4, 1)` or `(4, K)` (unit) and `eta` `(3, K)` or `(3, 1)`
         (one for all: PBP's goal switch), stepped as the position bank steps `(y, z)`:
         `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase`. Drake's
-        pose bank keeps `(e', z')` and reads the orientations out on demand."""
+        pose bank keeps `(e', z')` and reads the orientations out on demand.
+
+        `goals_unchanged=True` vouches that `goals_4k` holds the goals of this workspace's
+        last step (Drake's pose bank knows when its goals were recomputed): the start
+        errors are then reused without comparing the goals."""
         ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)
         decay = self.decay(dt)
         shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
-        self._start_errors_into(goals_4k, ws)
-        error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
-        log_into(ws.error_quaternions, ws.errors, ws)
-        inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
-        # [e'; z'] = (Phi (x) I3) [e; z] + [b; b'] (the position bank's step, goal 0): one
-        # (6, 6) x (6, K) product, then the attractor's combinations `b`, `b'`.
-        np.dot(_log_transition(*constants[:4]), ws.log_state.reshape(2 * AXES, -1),
-               out=out_log_state.reshape(2 * AXES, -1))
-        if self._ijspeert:
-            # b = S (-e0) (S alone where the fit switched the scaling off).
-            np.multiply(shapes, ws.amplitude, out=ws.shape)
+        self._start_errors_into(goals_4k, ws, goals_unchanged)
+        # [e'; z'] = (Phi (x) I3) [e; z] + [b; b'] (the position bank's step, goal 0).
+        transition = _log_transition(*constants[:4])
+        if orientations.shape[1] == 1 and velocity.shape[1] == 1:
+            # One orientation and one velocity for all: fused, `b` within
+            # (`orientation_log_step`).
+            forcing = forcing_rows(shapes, lam, self._ijspeert, ws)
+            log_step_from_one_into(orientations, velocity, goals_4k,
+                                   transition[::AXES, ::AXES], forcing, out_log_state, ws)
         else:
-            # b = S + lambda e0 (`shapes` may be `ws.shape` itself: added first).
-            out_log_state += shapes
-            np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.shape)
-        out_log_state += ws.shape
+            error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
+            log_into(ws.error_quaternions, ws.errors, ws)
+            inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
+            np.dot(transition, ws.log_state.reshape(2 * AXES, -1),
+                   out=out_log_state.reshape(2 * AXES, -1))
+            if self._ijspeert:
+                # b = S (-e0) (S alone where the fit switched the scaling off).
+                np.multiply(shapes, ws.amplitude, out=ws.shape)
+            else:
+                # b = S + lambda e0 (`shapes` may be `ws.shape` itself: added first).
+                out_log_state += shapes
+                np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.shape)
+            out_log_state += ws.shape
         np.multiply(phase, decay, out=out_phase)
 
     def orientations_from_log_into(self, errors, log_velocity, goals_4k, reference,

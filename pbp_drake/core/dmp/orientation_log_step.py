@@ -101,17 +101,19 @@ def combination_matrix(transition, eta, forcing):
 def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, workspace):
     """`out` (2, 3, K) `= [e'; z']` of every goal, for one measured orientation `(4, 1)`
     (unit) and one `eta` (3, 1); `goals` (4, K), `transition` `Phi` (2, 2), and `forcing`
-    the columns of the attractor's rows (`forcing_rows`, called first). Writes `fused` and
-    four (K,) rows of `workspace` (an `OrientationWorkspace`); allocates nothing of size K.
+    the columns of the attractor's rows (`forcing_rows`, called first). Writes the
+    workspace's (an `OrientationWorkspace`) `fused` and `small`; allocates nothing of size
+    K.
 
-    Few arrays, each rewritten in place as soon as its value is dead (`fused`'s rows 0-8,
-    `w`, `v` (3), `v.eta`, then four free, become scratch, `k v`, `d`, `c (e.eta) e` (3) and
-    `p`): the step's cost at large K is the memory it touches."""
+    One array, its rows rewritten in place as soon as their values are dead (`fused`'s rows
+    0-8, `w`, `v` (3), `v.eta`, `k`, `h`, `4 c`, `p`, become scratch, `k v`, `d`,
+    `c (e.eta) e` (3) and `p`): the step's cost at large K is the memory it touches."""
     ws = workspace
     fused = ws.fused
     np.matmul(error_matrix(orientation, eta), goals, out=fused[:5])
     w, vector, along = fused[0], fused[1:4], fused[4]
-    ratio, half, quadruple = ws.sine, ws.angle, ws.second
+    # The per-goal numbers live in the rows `c (e.eta) e` and `p` take last: no more memory.
+    ratio, half, quadruple, p = fused[5], fused[6], fused[7], fused[8]
     np.einsum("ik,ik->k", vector, vector, out=ratio)
     np.sqrt(ratio, out=ratio)  # s = |v| = sin(t/2)
     if w.all():
@@ -132,7 +134,6 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
     # k = h / s (0 for the identity, whose v is 0 anyway; SMALLEST changes no s > 1e-284).
     ratio += SMALLEST
     np.divide(half, ratio, out=ratio)
-    p = fused[8]
     np.multiply(ratio, w, out=p)  # p = (t/2) cot(t/2) = h w / s
     vector *= ratio  # k v = e / 2
     # 4 c = (1 - p) / h^2, or its series where the angle is below SERIES_BELOW.
@@ -144,7 +145,7 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
     quadruple /= scratch
     if ws.small.any():
         _series_into(square, quadruple, p, scratch, ws.small)
-    # d = (4 c)(k v.eta), and c (e.eta) e = d (k v).
+    # d = (4 c)(k v.eta), and c (e.eta) e = d (k v) (over k, h and 4 c, dead by then).
     along *= ratio
     along *= quadruple
     np.multiply(vector, along, out=fused[5:8])

@@ -212,3 +212,29 @@ def test_one_orientation_and_one_velocity_for_all_equal_single_dmps(formulation,
             np.testing.assert_allclose(stepped[1][:, k], orientation, rtol=0, atol=1e-12)
             np.testing.assert_allclose(stepped[2][:, k] / bank.duration, angular_velocity,
                                        rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_in_place_steps_from_one_velocity_match_advance_when_goals_change(formulation):
+    """The fused step with one workspace (which keeps the start errors and the weights
+    times `-e0` of the last goals) equals `advance` with a new workspace each step, as the
+    goals move every few steps and another bank uses the workspace in between."""
+    bank, _, goals = make_banks(formulation, False, 6, False, seed=35)
+    other_bank, _, _ = make_banks(formulation, False, 6, False, seed=36)
+    rng = np.random.default_rng(37)
+    goals_4k = bank.goals_matrix(goals)
+    workspace = bank.make_workspace()
+    phase, orientations, velocity = bank.initial_state()
+    expected = bank.initial_state()
+    for step in range(40):
+        if step % 7 == 6:
+            goals_4k = bank.goals_matrix(random_rows(6, rng))
+        if step == 20:
+            other_bank.advance_into(*other_bank.initial_state()[:2], velocity[:, :1],
+                                    goals_4k, DT, *other_bank.initial_state(), workspace)
+        robot, eta = orientations[:, :1].copy(), velocity[:, 2:3].copy()
+        bank.advance_into(phase, robot, eta, goals_4k, DT, phase, orientations, velocity,
+                          workspace)
+        expected = bank.advance(expected[0], robot, expected[2][:, 2:3], goals_4k, DT)
+        for ours, theirs in zip((phase, orientations, velocity), expected):
+            np.testing.assert_array_equal(ours, theirs)

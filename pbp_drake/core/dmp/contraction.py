@@ -47,11 +47,13 @@ class WeightRows:
             return 0, 1  # every term is 0: any one row gives the exact 0
         return int(kept[0]), int(kept[-1]) + 1
 
-    def contract_into(self, basis, out):
-        """`out = basis @ weights` `(2, M)` over the rows that matter (`window`)."""
-        first, stop = self.window(basis)
+    def contract_into(self, basis, out, weights=None, window=None):
+        """`out = basis @ weights` `(2, M)` over the rows that matter (`window`, or the
+        one given); `weights`: another `(N, M)` array to contract in place of this one's
+        (the orientation bank's, multiplied by the goals' amplitudes), over the same rows."""
+        first, stop = self.window(basis) if window is None else window
         basis = basis[:, first:stop]
-        weights = self.weights[first:stop]
+        weights = (self.weights if weights is None else weights)[first:stop]
         rows, columns = weights.shape
         # Fewer rows, wider blocks: each block keeps about `block_bytes` of weights.
         width = max(64, self.block_bytes // weights.itemsize // rows)

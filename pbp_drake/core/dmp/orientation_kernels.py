@@ -56,6 +56,9 @@ class OrientationWorkspace:
         small: (K,) mask.
         fused: (15, K) the fused step's rows (`orientation_log_step`); its rows 9-14 are
             `shape` (property), (2, 3, K) forcing shapes of distinct weights (scratch).
+        scaled_weights, scaled_rows: distinct weights `(N, 3 K)` times `-e0`, and which of
+            their rows are, for the start errors' goals (None until the fused step needs
+            them; `orientation_log_step.scaled_weights`).
         goals_of_start_errors, starts_of_start_errors: the goals (a copy) and the bank's
             starts (the array itself) that `start_errors` and `amplitude` were computed for:
             they depend on nothing else, so a step to unchanged goals reuses them. A copied
@@ -69,8 +72,8 @@ class OrientationWorkspace:
     __slots__ = ("goal_count", "basis_count", "error_quaternions", "product", "start_errors",
                  "amplitude", "log_state", "new_log_state", "cross", "work", "cross_dot",
                  "angle", "sine", "cosine", "ratio", "first", "second", "coefficient", "dot",
-                 "row", "small", "fused", "goals_of_start_errors",
-                 "starts_of_start_errors")
+                 "row", "small", "fused", "scaled_weights", "scaled_rows",
+                 "goals_of_start_errors", "starts_of_start_errors")
 
     def __init__(self, goal_count, basis_count):
         k = goal_count
@@ -86,6 +89,7 @@ class OrientationWorkspace:
         self.new_log_state = np.empty((2, 3, k))
         self.small = np.empty(k, bool)
         self.fused = np.empty((15, k))
+        self.scaled_weights = self.scaled_rows = None
         self.goals_of_start_errors = np.full((4, k), np.nan)
         self.starts_of_start_errors = None
 

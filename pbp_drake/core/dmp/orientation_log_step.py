@@ -41,8 +41,8 @@ from pbp_drake.core.quaternion import SERIES_BELOW
 # `SERIES_BELOW`).
 _SQUARE_SERIES_BELOW = (0.5 * SERIES_BELOW) ** 2
 # The forcing rows' columns when they are `b` itself, six rows.
-_IDENTITY6 = np.eye(6)
-_IDENTITY6.setflags(write=False)
+IDENTITY6 = np.eye(6)
+IDENTITY6.setflags(write=False)
 
 
 def error_matrix(orientation, eta):
@@ -54,6 +54,26 @@ def error_matrix(orientation, eta):
     return np.array([[w, x, y, z], [x, -w, z, -y], [y, -z, -w, x], [z, y, -x, -w],
                      [a * x + b * y + c * z, -a * w - b * z + c * y,
                       a * z - b * w - c * x, -a * y + b * x - c * w]])
+
+
+def scaled_weights(weights, workspace, first, stop):
+    """Distinct weights `(N, 3 K)` times the goals' amplitudes `-e0` (the workspace's
+    `amplitude`, flattened as the weights' columns), valid in rows `first:stop`: kept in
+    the workspace (`scaled_weights`, allocated on first use) and scaled row by row when
+    first needed since the start errors were last computed (`scaled_rows`, which they
+    clear). The window moves one row every hundred steps or so; the product then has
+    `b = S (-e0)` at once (one rounding per term more, as the pass it saves)."""
+    ws = workspace
+    if ws.scaled_weights is None or ws.scaled_weights.shape != weights.shape:
+        ws.scaled_weights = np.empty_like(weights)
+        ws.scaled_rows = np.zeros(len(weights), bool)
+    rows = ws.scaled_rows[first:stop]
+    if not rows.all():
+        amplitude = ws.amplitude.reshape(-1)
+        for index in np.flatnonzero(~rows) + first:
+            np.multiply(weights[index], amplitude, out=ws.scaled_weights[index])
+        rows[...] = True
+    return ws.scaled_weights
 
 
 def forcing_rows(shapes, lam, ijspeert, workspace):
@@ -76,7 +96,7 @@ def forcing_rows(shapes, lam, ijspeert, workspace):
             np.copyto(forcing, shapes)
         np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.log_state)
         forcing += ws.log_state
-    return _IDENTITY6
+    return IDENTITY6
 
 
 def combination_matrix(transition, eta, forcing):

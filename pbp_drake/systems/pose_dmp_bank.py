@@ -27,8 +27,8 @@ _STEPPING, _ON_ROBOT, _AT_START = 0.0, 1.0, 2.0
 class PoseWorkspace:
     """Scratch of one Context: the two banks' workspaces, a phase, the orientation
     readout's arrays (`eta` of every DMP when no followed goal is connected), and whether
-    the goals were recomputed since the last step (`goals_changed`: if not, the
-    orientation bank reuses its start errors without comparing K goals)."""
+    the goals were recomputed since the last step (`goals_changed`: if not, the banks
+    reuse what they derived from the goals, without comparing K goals)."""
 
     __slots__ = ("position", "orientation", "phase", "orientations", "eta", "goals_changed")
 
@@ -286,11 +286,13 @@ class PoseDmpBank(LeafSystem):
             eta_held[:, 0] = angular_velocity * orientations.duration
             return
         held[0] = _STEPPING
+        # Both banks reuse what they derived from the goals while the goals cache entry has
+        # not been recomputed (they vouch for nothing else).
+        unchanged = not workspace.goals_changed
         positions.attractor_terms_into(phase, robot, goals[:3], period, dp, dz,
-                                       workspace.position)
+                                       workspace.position, goals_unchanged=unchanged)
         orientations.log_step_into(phase, q, eta, goals[3:], period, workspace.phase,
-                                   log_state, workspace.orientation,
-                                   goals_unchanged=not workspace.goals_changed)
+                                   log_state, workspace.orientation, goals_unchanged=unchanged)
         workspace.goals_changed = False
         phase *= positions.decay(period)
 

@@ -65,3 +65,24 @@ class WeightRows:
         np.matmul(basis, weights[:, :covered].reshape(rows, blocks, width).transpose(1, 0, 2),
                   out=out[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
         np.matmul(basis, weights[:, covered:], out=out[:, covered:])
+
+
+def scaled_weights(weights, workspace, first, stop):
+    """Distinct weights `(N, M)` times the goals' amplitudes (the workspace's `amplitude`,
+    flattened as the weights' columns), valid in rows `first:stop`: kept in the workspace
+    (`scaled_weights`, allocated on first use) and scaled row by row when first needed
+    since the amplitudes last changed (`scaled_rows`, which whoever changes them clears).
+    The window moves one row every hundred steps or so; the contraction then gives the
+    Ijspeert attractor's part `S * amplitude` at once (one rounding per term more, as the
+    pass over `S` it saves)."""
+    ws = workspace
+    if ws.scaled_weights is None or ws.scaled_weights.shape != weights.shape:
+        ws.scaled_weights = np.empty_like(weights)
+        ws.scaled_rows = np.zeros(len(weights), bool)
+    rows = ws.scaled_rows[first:stop]
+    if not rows.all():
+        amplitude = ws.amplitude.reshape(-1)
+        for index in np.flatnonzero(~rows) + first:
+            np.multiply(weights[index], amplitude, out=ws.scaled_weights[index])
+        rows[...] = True
+    return ws.scaled_weights

@@ -24,7 +24,7 @@ import numpy as np
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp._checks import positive
-from pbp_drake.core.dmp.contraction import WeightRows
+from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
     AXES, fit_orientation_weights, straight_weights,
     validate_orientation_demonstration)
@@ -32,7 +32,7 @@ from pbp_drake.core.dmp.orientation_kernels import (
     OrientationWorkspace, error_quaternions_into, exp_into, inverse_jacobian_into,
     jacobian_into, log_into, product_into)
 from pbp_drake.core.dmp.orientation_log_step import (
-    IDENTITY6, forcing_rows, log_step_from_one_into, scaled_weights)
+    IDENTITY6, forcing_rows, log_step_from_one_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis, phase_decay
 from pbp_drake.core.dmp.stepping import _BLOCK_BYTES, step_constants
 
@@ -392,7 +392,8 @@ class OrientationDmpBank:
 
     def _scaled_forcing(self, phase, decay, combination, workspace):
         """Ijspeert, distinct weights and equal phases: `b = S (-e0)` straight into the
-        workspace's `shape`, from the weights already multiplied by `-e0` (`scaled_weights`:
+        workspace's `shape`, from the weights already multiplied by `-e0`
+        (`contraction.scaled_weights`:
         the rows that matter, kept while the goals stay), so no pass multiplies `S`; the
         start errors must be the goals'. Returns `lambda`, or None in any other case."""
         if not self._ijspeert or self.shared_weights or phase.min() != phase.max():

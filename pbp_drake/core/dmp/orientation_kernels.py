@@ -58,7 +58,7 @@ class OrientationWorkspace:
             `shape` (property), (2, 3, K) forcing shapes of distinct weights (scratch).
         scaled_weights, scaled_rows: distinct weights `(N, 3 K)` times `-e0`, and which of
             their rows are, for the start errors' goals (None until the fused step needs
-            them; `orientation_log_step.scaled_weights`).
+            them; `contraction.scaled_weights`).
         goals_of_start_errors, starts_of_start_errors: the goals (a copy) and the bank's
             starts (the array itself) that `start_errors` and `amplitude` were computed for:
             they depend on nothing else, so a step to unchanged goals reuses them. A copied

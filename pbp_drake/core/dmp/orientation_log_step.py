@@ -56,26 +56,6 @@ def error_matrix(orientation, eta):
                       a * z - b * w - c * x, -a * y + b * x - c * w]])
 
 
-def scaled_weights(weights, workspace, first, stop):
-    """Distinct weights `(N, 3 K)` times the goals' amplitudes `-e0` (the workspace's
-    `amplitude`, flattened as the weights' columns), valid in rows `first:stop`: kept in
-    the workspace (`scaled_weights`, allocated on first use) and scaled row by row when
-    first needed since the start errors were last computed (`scaled_rows`, which they
-    clear). The window moves one row every hundred steps or so; the product then has
-    `b = S (-e0)` at once (one rounding per term more, as the pass it saves)."""
-    ws = workspace
-    if ws.scaled_weights is None or ws.scaled_weights.shape != weights.shape:
-        ws.scaled_weights = np.empty_like(weights)
-        ws.scaled_rows = np.zeros(len(weights), bool)
-    rows = ws.scaled_rows[first:stop]
-    if not rows.all():
-        amplitude = ws.amplitude.reshape(-1)
-        for index in np.flatnonzero(~rows) + first:
-            np.multiply(weights[index], amplitude, out=ws.scaled_weights[index])
-        rows[...] = True
-    return ws.scaled_weights
-
-
 def forcing_rows(shapes, lam, ijspeert, workspace):
     """Writes the attractor's part `b` (module docstring) into `fused`'s rows from 9 and
     returns the `(6, n)` columns of `M` that add it: Ijspeert `b = S (-e0)`, Pastor

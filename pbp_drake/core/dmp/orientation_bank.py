@@ -323,7 +323,6 @@ class OrientationDmpBank:
         decay = self.decay(dt)
         self._start_errors_into(goals_4k, ws, goals_unchanged)
         # [e'; z'] = (Phi (x) I3) [e; z] + [b; b'] (the position bank's step, goal 0).
-        transition = _log_transition(*constants[:4])
         if orientations.shape[1] == 1 and velocity.shape[1] == 1:
             # One orientation and one velocity for all: fused, `b` within
             # (`orientation_log_step`).
@@ -333,14 +332,16 @@ class OrientationDmpBank:
                 forcing = forcing_rows(shapes, lam, self._ijspeert, ws)
             else:
                 forcing = IDENTITY6  # `shape` is `b` already
-            log_step_from_one_into(orientations, velocity, goals_4k,
-                                   transition[::AXES, ::AXES], forcing, out_log_state, ws)
+            phi = ((1.0 + constants.position_offset, constants.position_velocity),
+                   (constants.velocity_offset, constants.velocity_velocity))
+            log_step_from_one_into(orientations, velocity, goals_4k, phi, forcing,
+                                   out_log_state, ws)
         else:
             shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
             error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
             log_into(ws.error_quaternions, ws.errors, ws)
             inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
-            np.dot(transition, ws.log_state.reshape(2 * AXES, -1),
+            np.dot(_log_transition(*constants[:4]), ws.log_state.reshape(2 * AXES, -1),
                    out=out_log_state.reshape(2 * AXES, -1))
             if self._ijspeert:
                 # b = S (-e0) (S alone where the fit switched the scaling off).

@@ -41,15 +41,14 @@ from pbp_drake.core.quaternion import SERIES_BELOW
 # `SERIES_BELOW`).
 _SQUARE_SERIES_BELOW = (0.5 * SERIES_BELOW) ** 2
 # The forcing rows' columns when they are `b` itself, six rows.
-IDENTITY6 = np.eye(6)
-IDENTITY6.setflags(write=False)
+IDENTITY6 = tuple(tuple(float(row == column) for column in range(6)) for row in range(6))
 
 
 def error_matrix(orientation, eta):
     """`A` (5, 4): `A g` is `q g*` (rows 0-3, `w` then `v`) and `v.eta` (row 4), for the
     measured orientation `(4, 1)` and velocity `(3, 1)`."""
-    w, x, y, z = (float(value) for value in orientation[:, 0])
-    a, b, c = (float(value) for value in eta[:, 0])
+    w, x, y, z = orientation[:, 0].tolist()
+    a, b, c = eta[:, 0].tolist()
     # q g* = L(q) diag(1, -1, -1, -1) g: L(q)'s columns 1-3 negated.
     return np.array([[w, x, y, z], [x, -w, z, -y], [y, -z, -w, x], [z, y, -x, -w],
                      [a * x + b * y + c * z, -a * w - b * z + c * y,
@@ -58,7 +57,8 @@ def error_matrix(orientation, eta):
 
 def forcing_rows(shapes, lam, ijspeert, workspace):
     """Writes the attractor's part `b` (module docstring) into `fused`'s rows from 9 and
-    returns the `(6, n)` columns of `M` that add it: Ijspeert `b = S (-e0)`, Pastor
+    returns the `(6, n)` columns of `M` that add it (rows of numbers, as
+    `combination_matrix` builds `M` in one call): Ijspeert `b = S (-e0)`, Pastor
     `b = S + lambda e0`, from `shapes` `S` (2, 3, 1) or (2, 3, K) (which may be the
     workspace's `shape`, rows 9-14) and `lam` (2, 1) or (2, K); the workspace's `amplitude`
     and `start_errors` must be the goals'."""
@@ -67,7 +67,8 @@ def forcing_rows(shapes, lam, ijspeert, workspace):
         # One shape for all (shared weights, equal phases): `b_r = diag(S_r) (-e0)`, three
         # rows instead of six.
         np.copyto(ws.fused[9:12], ws.amplitude)
-        return np.concatenate([np.diag(shapes[0, :, 0]), np.diag(shapes[1, :, 0])])
+        return [[value if row == column else 0.0 for column in range(3)]
+                for values in shapes[:, :, 0].tolist() for row, value in enumerate(values)]
     forcing = ws.shape
     if ijspeert:
         np.multiply(shapes, ws.amplitude, out=forcing)
@@ -81,27 +82,24 @@ def forcing_rows(shapes, lam, ijspeert, workspace):
 
 def combination_matrix(transition, eta, forcing):
     """`M` (6, 8 + n) with `[e'; z'] = M [k v; d; c (e.eta) e; p; forcing rows]` (module
-    docstring; `d`, a scratch row, gets a zero column), from `Phi` (2, 2), the velocity
-    `(3, 1)` and the forcing rows' columns `(6, n)`: row block `i` of the first eight
-    columns is `[2 Phi_i0 I + Phi_i1 [eta]x, 0, Phi_i1 I, Phi_i1 eta]` (`e = 2 k v`, and
-    `-(e x eta)/2 = [eta]x e / 2`)."""
-    a, b, c = (float(value) for value in eta[:, 0])
-    matrix = np.empty((6, 8 + forcing.shape[1]))
+    docstring; `d`, a scratch row, gets a zero column), from `Phi` ((2, 2) numbers), the
+    velocity `(3, 1)` and the forcing rows' columns (6 rows of n numbers): row block `i` of
+    the first eight columns is `[2 Phi_i0 I + Phi_i1 [eta]x, 0, Phi_i1 I, Phi_i1 eta]`
+    (`e = 2 k v`, and `-(e x eta)/2 = [eta]x e / 2`)."""
+    a, b, c = eta[:, 0].tolist()
     rows = []
-    for offset, velocity in transition:
-        twice, s = 2.0 * float(offset), float(velocity)
+    for offset, s in transition:
+        twice = 2.0 * offset
         rows += [[twice, -s * c, s * b, 0.0, s, 0.0, 0.0, s * a],
                  [s * c, twice, -s * a, 0.0, 0.0, s, 0.0, s * b],
                  [-s * b, s * a, twice, 0.0, 0.0, 0.0, s, s * c]]
-    matrix[:, :8] = rows
-    matrix[:, 8:] = forcing
-    return matrix
+    return np.array([row + list(extra) for row, extra in zip(rows, forcing)])
 
 
 def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, workspace):
     """`out` (2, 3, K) `= [e'; z']` of every goal, for one measured orientation `(4, 1)`
-    (unit) and one `eta` (3, 1); `goals` (4, K), `transition` `Phi` (2, 2), and `forcing`
-    the columns of the attractor's rows (`forcing_rows`, called first). Writes the
+    (unit) and one `eta` (3, 1); `goals` (4, K), `transition` `Phi` ((2, 2) numbers), and
+    `forcing` the columns of the attractor's rows (`forcing_rows`, called first). Writes the
     workspace's (an `OrientationWorkspace`) `fused` and `small`; allocates nothing of size
     K.
 
@@ -149,7 +147,7 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
     along *= ratio
     along *= quadruple
     np.multiply(vector, along, out=fused[5:8])
-    np.matmul(combination_matrix(transition, eta, forcing), fused[1:9 + forcing.shape[1]],
+    np.matmul(combination_matrix(transition, eta, forcing), fused[1:9 + len(forcing[0])],
               out=out.reshape(6, -1))
 
 

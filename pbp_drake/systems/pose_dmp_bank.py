@@ -25,10 +25,12 @@ _STEPPING, _ON_ROBOT, _AT_START = 0.0, 1.0, 2.0
 
 
 class PoseWorkspace:
-    """Scratch of one Context: the two banks' workspaces, a phase, and the orientation
-    readout's arrays (`eta` of every DMP when no followed goal is connected)."""
+    """Scratch of one Context: the two banks' workspaces, a phase, the orientation
+    readout's arrays (`eta` of every DMP when no followed goal is connected), and whether
+    the goals were recomputed since the last step (`goals_changed`: if not, the banks
+    reuse what they derived from the goals, without comparing K goals)."""
 
-    __slots__ = ("position", "orientation", "phase", "orientations", "eta")
+    __slots__ = ("position", "orientation", "phase", "orientations", "eta", "goals_changed")
 
     def __init__(self, position_bank, orientation_bank):
         k = position_bank.goal_count
@@ -37,6 +39,7 @@ class PoseWorkspace:
         self.phase = np.empty(1)
         self.orientations = np.empty((4, k))
         self.eta = np.empty((3, k))
+        self.goals_changed = True
 
 
 class PoseDmpBank(LeafSystem):
@@ -222,6 +225,7 @@ class PoseDmpBank(LeafSystem):
         goals = value.get_mutable_value()
         goals[:3] = rows[:, :3].T
         goals[3:] = orientations.T
+        self._workspace(context).goals_changed = True
 
     def _robot(self, context):
         """The measured position (3,), orientation (4,), velocity (3,) and angular velocity
@@ -252,17 +256,23 @@ class PoseDmpBank(LeafSystem):
         # The DMPs' velocities at the end of the last step: linear read out in place, the
         # orientation part's eta as a column (one for all) or per DMP.
         if held[0] == _STEPPING:
-            positions.stepped_velocity_into(dz, z, period, z)
             if followed is not None:
-                z[...] = z[:, followed:followed + 1]
+                # Every DMP continues from the followed one's: its column alone is read
+                # out (the same arithmetic as all K), then copied to all.
+                column = slice(followed, followed + 1)
+                positions.stepped_velocity_into(dz[:, column], z[:, column], period,
+                                                z[:, column])
+                _limit(z[:, column], self._max_speed, positions.duration)
+                z[...] = z[:, column]
                 eta = jacobian_of_one(log_state[0, :, followed],
                                       log_state[1, :, followed])[:, np.newaxis]
             else:
+                positions.stepped_velocity_into(dz, z, period, z)
+                _limit(z, self._max_speed, positions.duration)
                 orientations.orientations_from_log_into(
                     log_state[0], log_state[1], goals[3:], q,
                     workspace.orientations, workspace.eta, workspace.orientation)
                 eta = workspace.eta
-            _limit(z, self._max_speed, positions.duration)
             _limit(eta, self._max_angular_speed, orientations.duration)
         else:
             eta = np.array(eta_held)  # the robot's (locked) or 0 (at the start), (3, 1)
@@ -276,10 +286,14 @@ class PoseDmpBank(LeafSystem):
             eta_held[:, 0] = angular_velocity * orientations.duration
             return
         held[0] = _STEPPING
+        # Both banks reuse what they derived from the goals while the goals cache entry has
+        # not been recomputed (they vouch for nothing else).
+        unchanged = not workspace.goals_changed
         positions.attractor_terms_into(phase, robot, goals[:3], period, dp, dz,
-                                       workspace.position)
+                                       workspace.position, goals_unchanged=unchanged)
         orientations.log_step_into(phase, q, eta, goals[3:], period, workspace.phase,
-                                   log_state, workspace.orientation)
+                                   log_state, workspace.orientation, goals_unchanged=unchanged)
+        workspace.goals_changed = False
         phase *= positions.decay(period)
 
     def dmp_states(self, context):

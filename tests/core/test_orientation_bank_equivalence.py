@@ -183,3 +183,58 @@ def test_the_banks_attractors_are_the_single_dmps(formulation, shared):
     for k, dmp in enumerate(dmps):
         np.testing.assert_allclose(attractors[:, k], dmp.attractor(phases[k], goals[k]),
                                    rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+def test_one_orientation_and_one_velocity_for_all_equal_single_dmps(formulation, shared):
+    """The fused step (`orientation_log_step`: one measured orientation `(4, 1)` and one
+    `eta` `(3, 1)`, as the six-DoF system steps with a followed goal) against single DMPs,
+    with errors at 0, 1e-12, 1e-6, 5e-3 and 2e-2 rad (both sides of the series' switch),
+    180 degrees less 1e-9, and exactly 180 degrees (`w = 0` and `-0.0`)."""
+    offsets = [0.0, 1e-12, 1e-6, 5e-3, 2e-2, np.pi - 1e-9, 0.7, 2.5]
+    count = len(offsets) + 2
+    bank, dmps, _ = make_banks(formulation, shared, count, True, seed=33)
+    rng = np.random.default_rng(34)
+    axes = rng.normal(size=(3, len(offsets)))
+    axes /= np.linalg.norm(axes, axis=0)
+    measured = quaternion.IDENTITY[:, np.newaxis]
+    # q g* = Exp(offset axis) for g = Exp(offset axis)*, and two goals at exactly 180 degrees.
+    goals = np.hstack([quaternion.conjugate(quaternion.exp_map(axes * offsets)),
+                       [[0.0, -0.0], [0.0, 0.0], [0.6, -0.0], [-0.8, 1.0]]]).T
+    velocity = rng.normal(size=(3, 1))
+    for phase in (1.0, 0.4):
+        stepped = bank.advance(np.full(count, phase), measured, velocity,
+                               bank.goals_matrix(goals), DT)
+        for k, dmp in enumerate(dmps):
+            dmp.phase, dmp.scaled_angular_velocity = phase, velocity[:, 0].copy()
+            orientation, angular_velocity = dmp.next_step(DT, goals[k], measured[:, 0])
+            np.testing.assert_allclose(stepped[1][:, k], orientation, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(stepped[2][:, k] / bank.duration, angular_velocity,
+                                       rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_in_place_steps_from_one_velocity_match_advance_when_goals_change(formulation):
+    """The fused step with one workspace (which keeps the start errors and the weights
+    times `-e0` of the last goals) equals `advance` with a new workspace each step, as the
+    goals move every few steps and another bank uses the workspace in between."""
+    bank, _, goals = make_banks(formulation, False, 6, False, seed=35)
+    other_bank, _, _ = make_banks(formulation, False, 6, False, seed=36)
+    rng = np.random.default_rng(37)
+    goals_4k = bank.goals_matrix(goals)
+    workspace = bank.make_workspace()
+    phase, orientations, velocity = bank.initial_state()
+    expected = bank.initial_state()
+    for step in range(40):
+        if step % 7 == 6:
+            goals_4k = bank.goals_matrix(random_rows(6, rng))
+        if step == 20:
+            other_bank.advance_into(*other_bank.initial_state()[:2], velocity[:, :1],
+                                    goals_4k, DT, *other_bank.initial_state(), workspace)
+        robot, eta = orientations[:, :1].copy(), velocity[:, 2:3].copy()
+        bank.advance_into(phase, robot, eta, goals_4k, DT, phase, orientations, velocity,
+                          workspace)
+        expected = bank.advance(expected[0], robot, expected[2][:, 2:3], goals_4k, DT)
+        for ours, theirs in zip((phase, orientations, velocity), expected):
+            np.testing.assert_array_equal(ours, theirs)

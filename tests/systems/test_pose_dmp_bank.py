@@ -195,3 +195,38 @@ def test_the_predicted_poses_are_the_selected_dmps_rollout_to_its_goal(selected)
     np.testing.assert_allclose(path[0, :3], stepped[:, selected], atol=1e-12)
     assert np.linalg.norm(path[-1, :3] - goals[selected, :3]) < 0.05
     assert quaternion.angle_between(path[-1, 3:], goals[selected, 3:]) < 0.05
+
+
+def test_goals_set_between_steps_are_stepped_to():
+    """New goals (`GoalsSource.set_goals`) reach the next step: the orientation part then
+    recomputes its start errors (it reuses them only while the goals are not recomputed)."""
+    positions, orientations, goals = make_banks()
+    _, _, new_goals = make_banks(seed=1)
+    builder = DiagramBuilder()
+    bank = builder.AddSystem(PoseDmpBank(positions, orientations, DT))
+    state = builder.AddSystem(ConstantVectorSource(ROBOT))
+    source = builder.AddSystem(GoalsSource(goals))
+    index = builder.AddSystem(ConstantVectorSource([3.0]))
+    builder.Connect(state.get_output_port(), bank.get_robot_state_input_port())
+    builder.Connect(source.get_output_port(), bank.get_goal_poses_input_port())
+    builder.Connect(index.get_output_port(), bank.get_followed_goal_input_port())
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(0.105)
+    context = bank.GetMyContextFromRoot(simulator.get_context())
+    before = steps_taken(bank, context)
+    source.set_goals(source.GetMyMutableContextFromRoot(simulator.get_context()), new_goals)
+    simulator.AdvanceTo(0.255)
+    phase, _, velocity = positions.initial_state()
+    rotation_phase, _, eta = orientations.initial_state()
+    for step in range(steps_taken(bank, context)):
+        rows = goals if step < before else new_goals
+        phase, stepped, velocity = positions.advance(
+            phase, ROBOT[:3, None], velocity, positions.goals_matrix(rows[:, :3]), DT,
+            followed=3)
+        rotation_phase, rotations, eta = orientations.advance(
+            rotation_phase, ROBOT_ORIENTATION[:, None], eta,
+            orientations.goals_matrix(rows[:, 3:]), DT, followed=3)
+    expected = np.hstack([stepped.T, rotations.T, velocity.T / positions.duration,
+                          eta.T / orientations.duration])
+    references = bank.get_references_output_port().Eval(context).reshape(K, 13)
+    np.testing.assert_allclose(references, expected, rtol=0, atol=1e-12)

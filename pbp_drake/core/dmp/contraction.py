@@ -47,11 +47,13 @@ class WeightRows:
             return 0, 1  # every term is 0: any one row gives the exact 0
         return int(kept[0]), int(kept[-1]) + 1
 
-    def contract_into(self, basis, out):
-        """`out = basis @ weights` `(2, M)` over the rows that matter (`window`)."""
-        first, stop = self.window(basis)
+    def contract_into(self, basis, out, weights=None, window=None):
+        """`out = basis @ weights` `(2, M)` over the rows that matter (`window`, or the
+        one given); `weights`: another `(N, M)` array to contract in place of this one's
+        (the orientation bank's, multiplied by the goals' amplitudes), over the same rows."""
+        first, stop = self.window(basis) if window is None else window
         basis = basis[:, first:stop]
-        weights = self.weights[first:stop]
+        weights = (self.weights if weights is None else weights)[first:stop]
         rows, columns = weights.shape
         # Fewer rows, wider blocks: each block keeps about `block_bytes` of weights.
         width = max(64, self.block_bytes // weights.itemsize // rows)
@@ -63,3 +65,24 @@ class WeightRows:
         np.matmul(basis, weights[:, :covered].reshape(rows, blocks, width).transpose(1, 0, 2),
                   out=out[:, :covered].reshape(2, blocks, width).transpose(1, 0, 2))
         np.matmul(basis, weights[:, covered:], out=out[:, covered:])
+
+
+def scaled_weights(weights, workspace, first, stop):
+    """Distinct weights `(N, M)` times the goals' amplitudes (the workspace's `amplitude`,
+    flattened as the weights' columns), valid in rows `first:stop`: kept in the workspace
+    (`scaled_weights`, allocated on first use) and scaled row by row when first needed
+    since the amplitudes last changed (`scaled_rows`, which whoever changes them clears).
+    The window moves one row every hundred steps or so; the contraction then gives the
+    Ijspeert attractor's part `S * amplitude` at once (one rounding per term more, as the
+    pass over `S` it saves)."""
+    ws = workspace
+    if ws.scaled_weights is None or ws.scaled_weights.shape != weights.shape:
+        ws.scaled_weights = np.empty_like(weights)
+        ws.scaled_rows = np.zeros(len(weights), bool)
+    rows = ws.scaled_rows[first:stop]
+    if not rows.all():
+        amplitude = ws.amplitude.reshape(-1)
+        for index in np.flatnonzero(~rows) + first:
+            np.multiply(weights[index], amplitude, out=ws.scaled_weights[index])
+        rows[...] = True
+    return ws.scaled_weights

@@ -24,13 +24,15 @@ import numpy as np
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp._checks import positive
-from pbp_drake.core.dmp.contraction import WeightRows
+from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
     AXES, fit_orientation_weights, straight_weights,
     validate_orientation_demonstration)
 from pbp_drake.core.dmp.orientation_kernels import (
     OrientationWorkspace, error_quaternions_into, exp_into, inverse_jacobian_into,
     jacobian_into, log_into, product_into)
+from pbp_drake.core.dmp.orientation_log_step import (
+    IDENTITY6, forcing_rows, log_step_from_one_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis, phase_decay
 from pbp_drake.core.dmp.stepping import _BLOCK_BYTES, step_constants
 
@@ -275,11 +277,12 @@ class OrientationDmpBank:
                               path[step + 1], velocity, workspace)
         return path.transpose(2, 0, 1)
 
-    def _start_errors_into(self, goals_4k, workspace):
+    def _start_errors_into(self, goals_4k, workspace, goals_unchanged=False):
         """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`
         (1 where the fit switched the scaling off) into `workspace.amplitude`."""
         if (workspace.starts_of_start_errors is self.starts
-                and np.array_equal(workspace.goals_of_start_errors, goals_4k)):
+                and (goals_unchanged
+                     or np.array_equal(workspace.goals_of_start_errors, goals_4k))):
             return  # the goals did not change: one pass instead of a log map
         starts = self._uniform_start if self._uniform_start is not None else self.starts
         error_quaternions_into(starts, goals_4k, workspace.error_quaternions, workspace.row)
@@ -290,6 +293,8 @@ class OrientationDmpBank:
                 np.copyto(workspace.amplitude, 1.0, where=~self.amplitude_scaling)
         workspace.goals_of_start_errors[...] = goals_4k
         workspace.starts_of_start_errors = self.starts
+        if workspace.scaled_rows is not None:
+            workspace.scaled_rows[...] = False  # they were multiplied by the old `-e0`
 
     def _step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
                    out_orientations, out_velocity, workspace):
@@ -302,33 +307,50 @@ class OrientationDmpBank:
                                         orientations, out_orientations, out_velocity, ws)
 
     def log_step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
-                      out_log_state, workspace):
+                      out_log_state, workspace, goals_unchanged=False):
         """The free step in log coordinates: `e = Log(q g*)` and `z = J(e)^-1 eta` from the
         measured orientations `(4, 1)` or `(4, K)` (unit) and `eta` `(3, K)` or `(3, 1)`
         (one for all: PBP's goal switch), stepped as the position bank steps `(y, z)`:
         `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase`. Drake's
-        pose bank keeps `(e', z')` and reads the orientations out on demand."""
+        pose bank keeps `(e', z')` and reads the orientations out on demand.
+
+        `goals_unchanged=True` vouches that `goals_4k` holds the goals of this workspace's
+        last step (Drake's pose bank knows when its goals were recomputed): the start
+        errors are then reused without comparing the goals."""
         ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)
         decay = self.decay(dt)
-        shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
-        self._start_errors_into(goals_4k, ws)
-        error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
-        log_into(ws.error_quaternions, ws.errors, ws)
-        inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
-        # [e'; z'] = (Phi (x) I3) [e; z] + [b; b'] (the position bank's step, goal 0): one
-        # (6, 6) x (6, K) product, then the attractor's combinations `b`, `b'`.
-        np.dot(_log_transition(*constants[:4]), ws.log_state.reshape(2 * AXES, -1),
-               out=out_log_state.reshape(2 * AXES, -1))
-        if self._ijspeert:
-            # b = S (-e0) (S alone where the fit switched the scaling off).
-            np.multiply(shapes, ws.amplitude, out=ws.shape)
+        self._start_errors_into(goals_4k, ws, goals_unchanged)
+        # [e'; z'] = (Phi (x) I3) [e; z] + [b; b'] (the position bank's step, goal 0).
+        if orientations.shape[1] == 1 and velocity.shape[1] == 1:
+            # One orientation and one velocity for all: fused, `b` within
+            # (`orientation_log_step`).
+            lam = self._scaled_forcing(phase, decay, constants.combination, ws)
+            if lam is None:
+                shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
+                forcing = forcing_rows(shapes, lam, self._ijspeert, ws)
+            else:
+                forcing = IDENTITY6  # `shape` is `b` already
+            phi = ((1.0 + constants.position_offset, constants.position_velocity),
+                   (constants.velocity_offset, constants.velocity_velocity))
+            log_step_from_one_into(orientations, velocity, goals_4k, phi, forcing,
+                                   out_log_state, ws)
         else:
-            # b = S + lambda e0 (`shapes` may be `ws.shape` itself: added first).
-            out_log_state += shapes
-            np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.shape)
-        out_log_state += ws.shape
+            shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
+            error_quaternions_into(orientations, goals_4k, ws.error_quaternions, ws.row)
+            log_into(ws.error_quaternions, ws.errors, ws)
+            inverse_jacobian_into(ws.errors, velocity, ws.log_velocity, ws)
+            np.dot(_log_transition(*constants[:4]), ws.log_state.reshape(2 * AXES, -1),
+                   out=out_log_state.reshape(2 * AXES, -1))
+            if self._ijspeert:
+                # b = S (-e0) (S alone where the fit switched the scaling off).
+                np.multiply(shapes, ws.amplitude, out=ws.shape)
+            else:
+                # b = S + lambda e0 (`shapes` may be `ws.shape` itself: added first).
+                out_log_state += shapes
+                np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.shape)
+            out_log_state += ws.shape
         np.multiply(phase, decay, out=out_phase)
 
     def orientations_from_log_into(self, errors, log_velocity, goals_4k, reference,
@@ -361,6 +383,28 @@ class OrientationDmpBank:
             np.multiply(workspace.start_errors, lam, out=workspace.work)
         target += workspace.work
 
+    def _equal_phase_basis(self, phase, decay, combination):
+        """Equal phases: the basis at the step's two phases only, combined, `(2, N)`, and
+        `lambda` `(2, 1)` (see `_combined_shapes`)."""
+        scale = 1.0 / self._settings.stiffness if self._ijspeert else 1.0
+        phases = np.array([phase.flat[0], phase.flat[0] * decay])
+        scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
+        return combination @ scaled.T, (combination @ phases)[:, np.newaxis]
+
+    def _scaled_forcing(self, phase, decay, combination, workspace):
+        """Ijspeert, distinct weights and equal phases: `b = S (-e0)` straight into the
+        workspace's `shape`, from the weights already multiplied by `-e0`
+        (`contraction.scaled_weights`:
+        the rows that matter, kept while the goals stay), so no pass multiplies `S`; the
+        start errors must be the goals'. Returns `lambda`, or None in any other case."""
+        if not self._ijspeert or self.shared_weights or phase.min() != phase.max():
+            return None
+        basis, lam = self._equal_phase_basis(phase, decay, combination)
+        window = self._weight_rows.window(basis)
+        weights = scaled_weights(self._weights, workspace, *window)
+        self._weight_rows.contract_into(basis, workspace.shape.reshape(2, -1), weights, window)
+        return lam
+
     def _combined_shapes(self, phase, decay, combination, workspace):
         """Rows r of `combination` (2x2): `S_r = C_r0 s(x0) + C_r1 s(x1)` with
         `s(x) = (psi.w / sum psi) x` (over K in the Ijspeert form), `(2, 3, 1)` or
@@ -368,11 +412,7 @@ class OrientationDmpBank:
         n = self._settings.basis_count
         scale = 1.0 / self._settings.stiffness if self._ijspeert else 1.0
         if phase.size == 1 or phase.min() == phase.max():
-            # Equal phases: the basis at the step's two phases only, (N, 2).
-            phases = np.array([phase.flat[0], phase.flat[0] * decay])
-            scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
-            basis = combination @ scaled.T  # (2, N)
-            lam = (combination @ phases)[:, np.newaxis]
+            basis, lam = self._equal_phase_basis(phase, decay, combination)
             if self.shared_weights:
                 return (basis @ self._weights)[:, :, np.newaxis], lam
             self._weight_rows.contract_into(basis, workspace.shape.reshape(2, -1))

@@ -53,21 +53,27 @@ class OrientationWorkspace:
         new_log_state: (2, 3, K) `e'` and `z'` (`new_errors`, `new_log_velocity`).
         cross, work: (3, K) scratch. cross_dot: (4, K) `r x v` and `r.v` for one `v`.
         angle, sine, cosine, ratio, first, second, coefficient, dot, row: (K,) per goal.
-        small: (K,) mask. shape: (2, 3, K) forcing shapes of distinct weights (scratch).
+        small: (K,) mask.
+        fused: (15, K) the fused step's rows (`orientation_log_step`); its rows 9-14 are
+            `shape` (property), (2, 3, K) forcing shapes of distinct weights (scratch).
+        scaled_weights, scaled_rows: distinct weights `(N, 3 K)` times `-e0`, and which of
+            their rows are, for the start errors' goals (None until the fused step needs
+            them; `contraction.scaled_weights`).
         goals_of_start_errors, starts_of_start_errors: the goals (a copy) and the bank's
             starts (the array itself) that `start_errors` and `amplitude` were computed for:
             they depend on nothing else, so a step to unchanged goals reuses them. A copied
             workspace has copied starts, which are not the bank's, and so recomputes.
 
-    The halves of `log_state` are properties, not attributes holding views: a deep copy
-    (Drake cloning a Context) copies every array apart, and views would then stop being
-    the halves the step writes.
+    The halves of `log_state`, and `shape`, are properties, not attributes holding views: a
+    deep copy (Drake cloning a Context) copies every array apart, and views would then stop
+    being the rows the step writes.
     """
 
     __slots__ = ("goal_count", "basis_count", "error_quaternions", "product", "start_errors",
                  "amplitude", "log_state", "new_log_state", "cross", "work", "cross_dot",
                  "angle", "sine", "cosine", "ratio", "first", "second", "coefficient", "dot",
-                 "row", "small", "shape", "goals_of_start_errors", "starts_of_start_errors")
+                 "row", "small", "fused", "scaled_weights", "scaled_rows",
+                 "goals_of_start_errors", "starts_of_start_errors")
 
     def __init__(self, goal_count, basis_count):
         k = goal_count
@@ -82,9 +88,14 @@ class OrientationWorkspace:
         self.log_state = np.empty((2, 3, k))
         self.new_log_state = np.empty((2, 3, k))
         self.small = np.empty(k, bool)
-        self.shape = np.empty((2, 3, k))
+        self.fused = np.empty((15, k))
+        self.scaled_weights = self.scaled_rows = None
         self.goals_of_start_errors = np.full((4, k), np.nan)
         self.starts_of_start_errors = None
+
+    @property
+    def shape(self):
+        return self.fused[9:].reshape(2, 3, self.goal_count)
 
     @property
     def errors(self):

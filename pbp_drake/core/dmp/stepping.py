@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from pbp_drake.core.dmp.contraction import WeightRows
+from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.settings import normalized_basis, phase_decay, step_matrices
 
 _IDENTITY = np.eye(2)
@@ -141,14 +141,29 @@ class BankStep:
                                      self._amplitudes(goals_dk, workspace), workspace.shape[0])
         return attractor
 
-    def attractor_terms_into(self, phase, positions, goals_dk, dt, out_dp, out_dz, workspace):
+    def attractor_terms_into(self, phase, positions, goals_dk, dt, out_dp, out_dz, workspace,
+                             goals_unchanged=False):
         """The attractor terms `(dp, dz)` (D, K) of the step from `positions` (D, K) or
         (D, 1) at phases `phase` (K,) towards `goals_dk`, into `out_dp` and `out_dz` (the
         caller's, or the workspace's `dp` and `dz`; the other work arrays are used).
 
-        Four passes over `(D, K)` when the DMPs share weights, phase and start."""
+        Four passes over `(D, K)` when the DMPs share weights, phase and start.
+        `goals_unchanged=True` vouches that `goals_dk` holds the goals of this workspace's
+        last call (Drake's pose bank knows when its goals were recomputed): with distinct
+        weights (Ijspeert, equal phases) the step then contracts the weights already
+        multiplied by `g - y0`, kept in the workspace (`contraction.scaled_weights`), and
+        takes five passes."""
         constants = self.step_constants(dt)
         equal = phase.size == 1 or phase.min() == phase.max()
+        if (goals_unchanged and equal and self._ijspeert and not self.shared_weights
+                and workspace.scaled_rows is not None):
+            self._scaled_terms_into(phase, positions, goals_dk, constants, self.decay(dt),
+                                    out_dp, out_dz, workspace)
+            return
+        if workspace.scaled_rows is not None:
+            workspace.scaled_rows[...] = False  # the amplitudes below may be new goals'
+        elif goals_unchanged and self._ijspeert and not self.shared_weights:
+            workspace.scaled_rows = np.zeros(0, bool)  # the next call may take them
         shapes, lam = self._combined_shapes(phase, self.decay(dt), constants.combination,
                                             workspace, equal)
         if self._affine_in_goal and equal:
@@ -163,6 +178,22 @@ class BankStep:
             np.multiply(relative, gain, out=out)
             self._add_relative_attractor(out, shapes[row], lam[row], amplitudes,
                                          workspace.shape[row])
+
+    def _scaled_terms_into(self, phase, positions, goals_dk, constants, decay, out_dp, out_dz,
+                           workspace):
+        """`attractor_terms_into` with distinct weights times the amplitudes `g - y0` of
+        the workspace's last goals (the same goals): `b = S (g - y0)` from the contraction,
+        then `dp = (Phi00 - 1)(p - g) + b0`, `dz = Phi10 (p - g) + b1`."""
+        ws = workspace
+        self._combined_shapes(phase, decay, constants.combination, ws, True, basis_only=True)
+        window = self._weight_rows.window(ws.basis)
+        weights = scaled_weights(self._weight_rows.weights, ws, *window)
+        self._weight_rows.contract_into(ws.basis, ws.shape.reshape(2, -1), weights, window)
+        np.subtract(positions, goals_dk, out=out_dz)  # p - g
+        np.multiply(out_dz, constants.position_offset, out=out_dp)
+        out_dp += ws.shape[0]
+        out_dz *= constants.velocity_offset
+        out_dz += ws.shape[1]
 
     def stepped_positions_into(self, positions, dp, scaled_velocity, dt, out, workspace):
         """`out = positions + dp + Phi01 z`: the positions after the step (`out` may be
@@ -200,7 +231,8 @@ class BankStep:
             np.multiply(amplitudes, lam, out=scratch)
             out -= scratch
 
-    def _combined_shapes(self, phase, decay, combination, workspace, equal=None):
+    def _combined_shapes(self, phase, decay, combination, workspace, equal=None,
+                         basis_only=False):
         """For the rows r of `combination` (2x2): the forcing shapes
         `S_r = C_r0 s(x0) + C_r1 s(x1)`, `s(x) = (psi.w / sum psi) x` (divided by K in the
         Ijspeert form), `(2, D, 1)` (shared weights, equal phases) or `(2, D, K)`, and
@@ -225,6 +257,8 @@ class BankStep:
             psi *= scale
             np.dot(combination, psi, out=workspace.basis)
             np.dot(combination, phases, out=workspace.lam)
+            if basis_only:
+                return None
             if self.shared_weights:
                 np.dot(workspace.basis, self._weights, out=workspace.coefficients)
                 return workspace.coefficients[:, :, np.newaxis], workspace.lam

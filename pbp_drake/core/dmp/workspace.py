@@ -3,9 +3,10 @@
 The bank itself is an immutable model; every array a step writes to lives in a
 `DmpWorkspace` its caller owns (`bank.make_workspace()`), one per thread or per Drake
 Context, so callers stepping one bank from different threads or contexts cannot corrupt
-each other. A workspace holds nothing between calls: any call may overwrite all of it, and a
-copy of one is as good as a fresh one (so Drake's cloning of a Context, which deep-copies its
-cache values, is correct without help). Its fields are plain arrays, no views of each other,
+each other. A workspace holds nothing between calls (but for a caller that vouches that its
+goals have not changed: `scaled_weights`): any call may overwrite all of it, and a copy of one
+is as good as a fresh one (so Drake's cloning of a Context, which deep-copies its cache
+values, is correct without help). Its fields are plain arrays, no views of each other,
 for the same reason: `copy.deepcopy` would turn views into separate arrays.
 """
 
@@ -24,11 +25,15 @@ class DmpWorkspace:
         amplitude: (D, K) `g - y0`; work: (D, K) `p - g`, and the last pass of a step.
         dp, dz: (D, K) the step's attractor terms (used by `advance_into`).
         alpha, beta, column: (2, D, 1) the affine terms' coefficients, and scratch.
+        scaled_weights, scaled_rows: distinct weights times `amplitude`, and which rows
+            are (None until a caller vouches for unchanged goals, see
+            `BankStep.attractor_terms_into`): the one thing a workspace may keep between
+            calls, and only for the caller that vouches.
     """
 
     __slots__ = ("dimension", "goal_count", "basis_count", "phases", "scale", "psi", "basis",
                  "lam", "coefficients", "shape", "amplitude", "work", "dp", "dz", "alpha",
-                 "beta", "column")
+                 "beta", "column", "scaled_weights", "scaled_rows")
 
     def __init__(self, dimension, goal_count, basis_count):
         d, k, n = dimension, goal_count, basis_count
@@ -47,3 +52,4 @@ class DmpWorkspace:
         self.alpha = np.empty((2, d, 1))
         self.beta = np.empty((2, d, 1))
         self.column = np.empty((2, d, 1))
+        self.scaled_weights = self.scaled_rows = None

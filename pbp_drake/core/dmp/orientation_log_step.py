@@ -1,0 +1,166 @@
+"""The orientation bank's step in log coordinates from ONE measured orientation `q` (4, 1)
+and ONE scaled angular velocity `eta` (3, 1) for all K DMPs (PBP's goal switch, the six-DoF
+Drake system's every tick): the log map, `z = J(e)^-1 eta` and the transition fused into
+two small BLAS products around one chain of per-goal numbers.
+
+The step (`pbp_drake.core.dmp.orientation`) is, per goal `g`,
+
+    e = Log(q g*),  z = J(e)^-1 eta = p eta - (e x eta)/2 + c (e.eta) e,
+    [e'; z'] = (Phi (x) I3) [e; z] + b,
+
+with `p = (t/2) cot(t/2)`, `c = (1 - p)/t^2`, `t = |e|`. Everything in it that is linear
+in `g` or in `e` is a product with a small matrix, the same for every goal:
+
+- `q g*` and `v.eta` (`v` its vector part) are rows of `A g`, `A` (5, 4)
+  (`error_matrix`): one BLAS pass over the goals gives `w`, `v` and `v.eta`;
+- with `s = |v| = sin(t/2)`, `h = atan(s / w)` (`t/2` with the sign of `w`: the log of
+  `-q g*`, the same orientation, flipped to `w > 0`) and `k = h / s`: `e = 2 k v`,
+  `p = k w` and `c (e.eta) e = d k v` with `d = 4 c k (v.eta)`;
+- `[e'; z'] = M [k v; d; c (e.eta) e; p; forcing rows]`, `M` (6, 8 + n)
+  (`combination_matrix`): `e x eta = -eta x e` is linear in `e`, `p eta` in `p`, and the
+  attractor's part `b` in rows the caller fills (`forcing_rows`: `b` itself, or for one
+  shape shared by all goals the three rows of `-e0`).
+
+So the step is two BLAS products around 20 passes over K numbers (`sqrt`, one `arctan`,
+the rest multiplications and divisions), all in one (15, K) array and three (K,) rows
+rewritten in place: against the step through the general kernels (`orientation_kernels`:
+the log map, the inverse Jacobian, the transition and `b`, about 50 passes over a dozen
+arrays) it does less and touches less memory, which at large K is what the step costs
+(the arrays leave the cache between two ticks). The results equal those kernels' to
+rounding (`tests/core/test_orientation_bank_equivalence.py`): `atan(s / w)` is `atan2`'s
+value to one rounding of the quotient; a 180-degree error (`w = 0`) takes `atan2` and the
+sign rule of `quaternion.canonical`, as `orientation_kernels.log_into`.
+"""
+
+import numpy as np
+
+from pbp_drake.core.dmp.orientation_kernels import SMALLEST
+from pbp_drake.core.quaternion import SERIES_BELOW
+
+# The squared half angle below which `c` and `p` come from their series (the angle below
+# `SERIES_BELOW`).
+_SQUARE_SERIES_BELOW = (0.5 * SERIES_BELOW) ** 2
+# The forcing rows' columns when they are `b` itself, six rows.
+IDENTITY6 = tuple(tuple(float(row == column) for column in range(6)) for row in range(6))
+
+
+def error_matrix(orientation, eta):
+    """`A` (5, 4): `A g` is `q g*` (rows 0-3, `w` then `v`) and `v.eta` (row 4), for the
+    measured orientation `(4, 1)` and velocity `(3, 1)`."""
+    w, x, y, z = orientation[:, 0].tolist()
+    a, b, c = eta[:, 0].tolist()
+    # q g* = L(q) diag(1, -1, -1, -1) g: L(q)'s columns 1-3 negated.
+    return np.array([[w, x, y, z], [x, -w, z, -y], [y, -z, -w, x], [z, y, -x, -w],
+                     [a * x + b * y + c * z, -a * w - b * z + c * y,
+                      a * z - b * w - c * x, -a * y + b * x - c * w]])
+
+
+def forcing_rows(shapes, lam, ijspeert, workspace):
+    """Writes the attractor's part `b` (module docstring) into `fused`'s rows from 9 and
+    returns the `(6, n)` columns of `M` that add it (rows of numbers, as
+    `combination_matrix` builds `M` in one call): Ijspeert `b = S (-e0)`, Pastor
+    `b = S + lambda e0`, from `shapes` `S` (2, 3, 1) or (2, 3, K) (which may be the
+    workspace's `shape`, rows 9-14) and `lam` (2, 1) or (2, K); the workspace's `amplitude`
+    and `start_errors` must be the goals'."""
+    ws = workspace
+    if ijspeert and shapes.shape[2] == 1:
+        # One shape for all (shared weights, equal phases): `b_r = diag(S_r) (-e0)`, three
+        # rows instead of six.
+        np.copyto(ws.fused[9:12], ws.amplitude)
+        return [[value if row == column else 0.0 for column in range(3)]
+                for values in shapes[:, :, 0].tolist() for row, value in enumerate(values)]
+    forcing = ws.shape
+    if ijspeert:
+        np.multiply(shapes, ws.amplitude, out=forcing)
+    else:
+        if not np.may_share_memory(shapes, ws.fused):  # else they are `shape` already
+            np.copyto(forcing, shapes)
+        np.multiply(ws.start_errors, lam[:, np.newaxis, :], out=ws.log_state)
+        forcing += ws.log_state
+    return IDENTITY6
+
+
+def combination_matrix(transition, eta, forcing):
+    """`M` (6, 8 + n) with `[e'; z'] = M [k v; d; c (e.eta) e; p; forcing rows]` (module
+    docstring; `d`, a scratch row, gets a zero column), from `Phi` ((2, 2) numbers), the
+    velocity `(3, 1)` and the forcing rows' columns (6 rows of n numbers): row block `i` of
+    the first eight columns is `[2 Phi_i0 I + Phi_i1 [eta]x, 0, Phi_i1 I, Phi_i1 eta]`
+    (`e = 2 k v`, and `-(e x eta)/2 = [eta]x e / 2`)."""
+    a, b, c = eta[:, 0].tolist()
+    rows = []
+    for offset, s in transition:
+        twice = 2.0 * offset
+        rows += [[twice, -s * c, s * b, 0.0, s, 0.0, 0.0, s * a],
+                 [s * c, twice, -s * a, 0.0, 0.0, s, 0.0, s * b],
+                 [-s * b, s * a, twice, 0.0, 0.0, 0.0, s, s * c]]
+    return np.array([row + list(extra) for row, extra in zip(rows, forcing)])
+
+
+def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, workspace):
+    """`out` (2, 3, K) `= [e'; z']` of every goal, for one measured orientation `(4, 1)`
+    (unit) and one `eta` (3, 1); `goals` (4, K), `transition` `Phi` ((2, 2) numbers), and
+    `forcing` the columns of the attractor's rows (`forcing_rows`, called first). Writes the
+    workspace's (an `OrientationWorkspace`) `fused` and `small`; allocates nothing of size
+    K.
+
+    One array, its rows rewritten in place as soon as their values are dead (`fused`'s rows
+    0-8, `w`, `v` (3), `v.eta`, `k`, `h`, `4 c`, `p`, become scratch, `k v`, `d`,
+    `c (e.eta) e` (3) and `p`): the step's cost at large K is the memory it touches."""
+    ws = workspace
+    fused = ws.fused
+    np.matmul(error_matrix(orientation, eta), goals, out=fused[:5])
+    w, vector, along = fused[0], fused[1:4], fused[4]
+    # The per-goal numbers live in the rows `c (e.eta) e` and `p` take last: no more memory.
+    ratio, half, quadruple, p = fused[5], fused[6], fused[7], fused[8]
+    np.einsum("ik,ik->k", vector, vector, out=ratio)
+    np.sqrt(ratio, out=ratio)  # s = |v| = sin(t/2)
+    if w.all():
+        # h = atan(s / w) = sign(w) t/2 (|w| = cos(t/2)): `-q g*`'s angle with `q g*`'s
+        # sign, so that `h / s` is `k` and `h w / s` is `p` with no sign pass. One rounding
+        # of the quotient away from `atan2`, and 3.5 times faster.
+        np.divide(ratio, w, out=half)
+        np.arctan(half, out=half)
+    else:
+        # Some w = 0 exactly (180 degrees): the first nonzero of x, y, z decides the sign,
+        # as `quaternion.canonical`.
+        np.sign(w, out=ws.row)
+        for component in vector:
+            np.copyto(ws.row, np.sign(component), where=ws.row == 0.0)
+        np.abs(w, out=half)
+        np.arctan2(ratio, half, out=half)
+        half *= ws.row
+    # k = h / s (0 for the identity, whose v is 0 anyway; SMALLEST changes no s > 1e-284).
+    ratio += SMALLEST
+    np.divide(half, ratio, out=ratio)
+    np.multiply(ratio, w, out=p)  # p = (t/2) cot(t/2) = h w / s
+    vector *= ratio  # k v = e / 2
+    # 4 c = (1 - p) / h^2, or its series where the angle is below SERIES_BELOW.
+    square, scratch = half, w
+    square *= half
+    np.less(square, _SQUARE_SERIES_BELOW, out=ws.small)
+    np.subtract(1.0, p, out=quadruple)
+    np.add(square, SMALLEST, out=scratch)
+    quadruple /= scratch
+    if ws.small.any():
+        _series_into(square, quadruple, p, scratch, ws.small)
+    # d = (4 c)(k v.eta), and c (e.eta) e = d (k v) (over k, h and 4 c, dead by then).
+    along *= ratio
+    along *= quadruple
+    np.multiply(vector, along, out=fused[5:8])
+    np.matmul(combination_matrix(transition, eta, forcing), fused[1:9 + len(forcing[0])],
+              out=out.reshape(6, -1))
+
+
+def _series_into(square, quadruple, p, series, small):
+    """Where `small`: `4 c` and `p = 1 - c t^2` from `c = 1/12 + t^2/720 + t^4/30240`,
+    with `t^2 = 4 h^2` (`square` is `h^2`): the closed form loses digits there."""
+    np.multiply(square, 4.0 / 30240.0, out=series)  # in t^2 = 4 h^2
+    series += 1.0 / 720.0
+    series *= square
+    series *= 4.0
+    series += 1.0 / 12.0
+    series *= 4.0  # 4 c
+    np.copyto(quadruple, series, where=small)
+    series *= square  # 4 c h^2 = c t^2
+    np.subtract(1.0, series, out=series)
+    np.copyto(p, series, where=small)

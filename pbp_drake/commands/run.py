@@ -252,6 +252,8 @@ def _run_task_once(args, resolved, diagram, meshcat, console):
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     rate = 0.0 if args.headless else args.realtime_rate
+    if args.log:  # its folder may be made (check_log_path)
+        pathlib.Path(args.log).parent.mkdir(parents=True, exist_ok=True)
     result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram,
                                 advance=live.advance)
               if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram,

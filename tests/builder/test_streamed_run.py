@@ -107,7 +107,7 @@ def test_run_log_of_the_grasping_task_writes_the_rows_of_a_study_trial(repo, tmp
     study = tmp_path / "study"
     run_trial(scenario, method, 0, seed, study, digest=None)
 
-    log = tmp_path / "run.csv"
+    log = tmp_path / "logs" / "run.csv"  # its folder is made
     assert main(["run", str(path), "--operator", "virtual", "--no-meshcat", "--duration", "4",
                  "--method", method, "--seed", str(seed), "--log", str(log)]) == 1
     # Byte for byte the trial's CSV: the same columns (the orientation ones too) and rows.
@@ -116,3 +116,7 @@ def test_run_log_of_the_grasping_task_writes_the_rows_of_a_study_trial(repo, tmp
     out = capsys.readouterr().out
     summary = load_task_result(study, method, seed).summary_line()
     assert f"seed {seed}]: {summary}; per-tick rows in {log}" in out
+    # A grasp time series it wrote may be overwritten, as a reach one.
+    assert main(["run", str(path), "--operator", "virtual", "--no-meshcat", "--duration", "1",
+                 "--log", str(log)]) == 1
+    assert len(read_time_series(log)["angle_to_target"]) == 34

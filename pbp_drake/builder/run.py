@@ -281,7 +281,7 @@ def task_series(diagram, times, state, in_collision, decisions):
     """A TaskResult's time series fields, as a dict, of the task of `diagram`:
     `grasp_series_fields` for the grasping task, `series_fields` for the others; `state`
     the samples of `state_log_name(diagram)`."""
-    if diagram.HasSubsystemNamed("hand_pose_log"):
+    if state_log_name(diagram) == "hand_pose_log":
         grasps = diagram.GetSubsystemByName("task_monitor").grasp_orientations
         return grasp_series_fields(times, state, decisions, grasps)
     return series_fields(times, state, in_collision, decisions)

@@ -6,12 +6,15 @@ The simulator advances in chunks of simulated time. After each chunk the rows of
 it completed are appended to the file (the format of a study's trial CSV,
 `pbp_drake.builder.time_series`) and every logger of the diagram is cleared, so memory holds
 at most one chunk of samples however long the run. What needs the whole series (the motion
-peaks) is carried from chunk to chunk.
+peaks, the grasping task's last angle to the target) is carried from chunk to chunk.
 
-A tick's row joins the plant's state logged at `t_k` with the decisions of tick k, which the
-loggers hold one sample later (`DECISION_LOG_SHIFT`, see `pbp_drake.builder.run.read_log`):
-a chunk's last state sample waits for the next chunk's first decision sample, and the run's
-last state sample, whose decisions are never logged, is not written (as in `run_task`).
+The rows are those of `run_task`'s series, read by the same functions (`run.task_series`,
+`run.SeriesPeaks`): a reach task's from `ee_state_log`, the grasping task's from
+`hand_pose_log`, with its orientation columns. A tick's row joins the plant's state logged
+at `t_k` with the decisions of tick k, which the loggers hold one sample later
+(`DECISION_LOG_SHIFT`, see `pbp_drake.builder.run.read_log`): a chunk's last state sample
+waits for the next chunk's first decision sample, and the run's last state sample, whose
+decisions are never logged, is not written (as in `run_task`).
 """
 
 import numpy as np

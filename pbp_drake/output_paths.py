@@ -74,7 +74,9 @@ def _is_time_series(path):
             head = stream.readline()
     except (OSError, UnicodeDecodeError):
         return False
-    return head in (time_series_header(False), time_series_header(True))
+    # The reach tasks' (with or without in_collision) and the grasping task's.
+    return head in (time_series_header(False), time_series_header(True),
+                    time_series_header(False, has_grasp=True))
 
 
 def check_output_folder(path, option="--output"):

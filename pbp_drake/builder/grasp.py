@@ -203,8 +203,8 @@ def _operator(resolved, grasps, meshcat):
     # Only teleop lets the person push along the approach axis (the paper's forward key).
     teleop = scenario.method == "teleop"
     if isinstance(config, (Keyboard, Gamepad)) and meshcat is None:
-        raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "
-                         "Meshcat (pbp-drake run without --headless)")
+        raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
+                            "Meshcat (pbp-drake run without --headless)")
     if isinstance(config, Keyboard):
         return KeyboardTwistOperator(meshcat, period, teleop, KeyboardTwistParams(
             config.speed, config.rotation_speed, config.hold_time),

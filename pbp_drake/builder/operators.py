@@ -4,8 +4,8 @@ at the keyboard or gamepad, or the virtual participant, on the HSR."""
 import numpy as np
 
 from pbp_drake.scenarios import (
-    Gamepad, Keyboard, NoOperator as NoOperatorConfig, ObstacleRepulsion, ScriptedCommands,
-    SinusoidalStep, VirtualParticipant as VirtualParticipantConfig)
+    Gamepad, Keyboard, NoOperator as NoOperatorConfig, ObstacleRepulsion, ScenarioError,
+    ScriptedCommands, SinusoidalStep, VirtualParticipant as VirtualParticipantConfig)
 from pbp_drake.systems import (
     GamepadOperator, KeyboardOperator, NoOperator, ObstacleRepulsionOperator, ScriptedOperator,
     VirtualParticipant)
@@ -59,8 +59,8 @@ def make_hsr_operator(resolved, meshcat):
             obstacle_radius=obstacles[0].radius if obstacles else 0.0,
             policy_adds=scenario.method == "pbp_continuous")
     if meshcat is None:
-        raise ValueError(f"operator !{type(config).__name__} reads the browser: it needs "
-                         "Meshcat (pbp-drake run without --headless)")
+        raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
+                            "Meshcat (pbp-drake run without --headless)")
     if isinstance(config, Keyboard):
         return KeyboardOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
     if isinstance(config, Gamepad):

@@ -143,7 +143,7 @@ class TaskResult:
             max_k |ee(t_{k+1}) - ee(t_k)| / control_period, ee = `ee_positions`.
         peak_command_acceleration: m/s^2, the largest change of the commanded velocity
             between two ticks over the period, max_k |v(k+1) - v(k)| / control_period,
-            v = `commands[:, 3:6]`. Both from `motion_peaks`; None when unknown (fewer
+            v = `commands[:, 3:6]`. Both from `SeriesPeaks`; None when unknown (fewer
             than two ticks, or a TaskResult made without them).
         angles_to_target: (T,) degrees from the hand's orientation to the current target's
             grasp orientation (the grasping task; None in the others).
@@ -152,6 +152,8 @@ class TaskResult:
             task; None in the others). `operator_commands` there is `[v, wz]`.
         peak_command_angular_change: rad/s, the largest change of the commanded angular
             velocity between two ticks (the grasping task; None in the others).
+        final_angle_to_target: degrees, `angles_to_target` of the last tick (the grasping
+            task; None in the others), kept when the series are not (a streamed run's).
     """
 
     success: bool
@@ -175,6 +177,12 @@ class TaskResult:
     command_angular_velocities: np.ndarray | None = None
     operator_twists: np.ndarray | None = None
     peak_command_angular_change: float | None = None
+    final_angle_to_target: float | None = None
+
+    def __post_init__(self):
+        if (self.final_angle_to_target is None and self.angles_to_target is not None
+                and len(self.angles_to_target)):
+            self.final_angle_to_target = float(self.angles_to_target[-1])
 
     def summary_line(self):
         """One line: outcome, time, intervention ratio, the collision ratio where the task
@@ -186,7 +194,7 @@ class TaskResult:
                       else f", collision ratio {self.collision_ratio:.3f}")
         # The grasping task's orientation: where the hand ended and the wrist's largest jolt.
         turning = ("" if self.angles_to_target is None else
-                   f", final angle to target {self.angles_to_target[-1]:.1f} deg, peak "
+                   f", final angle to target {_or_na(self.final_angle_to_target, 1)} deg, peak "
                    f"command angular change {_or_na(self.peak_command_angular_change, 3)} "
                    "rad/s per tick")
         return (f"{outcome} in {self.task_time:.2f} s, intervention ratio "
@@ -200,20 +208,9 @@ def _or_na(value, digits):
     return "n/a" if value is None else f"{value:.{digits}f}"
 
 
-def motion_peaks(ee_positions, command_velocities, control_period):
-    """`(peak_hand_speed, peak_command_acceleration)` of a run's ticks 0..T-1:
-    max_k |ee(t_{k+1}) - ee(t_k)| / control_period (m/s) over the hand positions `(T, 3)`,
-    and max_k |v(k+1) - v(k)| / control_period (m/s^2) over the commanded velocities
-    `(T, 3)`; (None, None) with fewer than two ticks."""
-    hand, command = LargestStep(), LargestStep()
-    hand.add(ee_positions)
-    command.add(command_velocities)
-    return hand.peak(control_period), command.peak(control_period)
-
-
 class LargestStep:
-    """The largest step `max_k |x(k+1) - x(k)|` of a series, fed whole (`motion_peaks`) or
-    in pieces (a streamed run), the step across two pieces included."""
+    """The largest step `max_k |x(k+1) - x(k)|` of a series, fed whole (`run_task`) or in
+    pieces (a streamed run), the step across two pieces included."""
 
     def __init__(self):
         self._last = None
@@ -261,25 +258,66 @@ STATE_LOGS = ("ee_state_log", "in_collision_log")
 
 
 def _read_result(diagram, context, status, monitor, control_period):
-    # The grasping task logs the hand's pose (`builder.grasp`) where the others log ee_state.
-    grasp = diagram.HasSubsystemNamed("hand_pose_log")
-    state_log = "hand_pose_log" if grasp else "ee_state_log"
+    state_log = state_log_name(diagram)
     # The last sample holds only the decisions of the tick before it (see read_log).
     tick_count = diagram.GetSubsystemByName(state_log).FindLog(context).num_samples() - 1
     times, state = read_log(diagram, context, state_log, tick_count)
     in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
     decisions = {name: read_log(diagram, context, name, tick_count, shift=DECISION_LOG_SHIFT)[1]
                  for name in DECISION_LOGS}
-    if grasp:
-        series = grasp_series_fields(times, state, decisions, monitor.grasp_orientations)
-        turning = LargestStep()
-        turning.add(series["command_angular_velocities"])
-        series["peak_command_angular_change"] = turning.peak(1.0)
-    else:
-        series = series_fields(times, state, in_collision, decisions)
-    peak_hand_speed, peak_command_acceleration = motion_peaks(
-        series["ee_positions"], series["commands"][:, 3:6], control_period)
-    return task_result(status, monitor, series, peak_hand_speed, peak_command_acceleration)
+    series = task_series(diagram, times, state, in_collision, decisions)
+    peaks = SeriesPeaks(control_period)
+    peaks.add(series)
+    return peaks.task_result(status, monitor, series)
+
+
+def state_log_name(diagram):
+    """The logger of the hand's state in a task's diagram: the grasping task logs the hand's
+    pose (`builder.grasp`), the others `ee_state`."""
+    return "hand_pose_log" if diagram.HasSubsystemNamed("hand_pose_log") else "ee_state_log"
+
+
+def task_series(diagram, times, state, in_collision, decisions):
+    """A TaskResult's time series fields, as a dict, of the task of `diagram`:
+    `grasp_series_fields` for the grasping task, `series_fields` for the others; `state`
+    the samples of `state_log_name(diagram)`."""
+    if state_log_name(diagram) == "hand_pose_log":
+        grasps = diagram.GetSubsystemByName("task_monitor").grasp_orientations
+        return grasp_series_fields(times, state, decisions, grasps)
+    return series_fields(times, state, in_collision, decisions)
+
+
+class SeriesPeaks:
+    """What a TaskResult keeps of a run's whole series, fed whole (`run_task`) or chunk by
+    chunk (a streamed run): the motion peaks over ticks 0..T-1,
+    max_k |ee(t_{k+1}) - ee(t_k)| / control_period (m/s, ee = `ee_positions`) and
+    max_k |v(k+1) - v(k)| / control_period (m/s^2, v = `commands[:, 3:6]`), None before two
+    ticks; in the grasping task also the peak command angular change (rad/s per tick) and
+    the last tick's angle to the target."""
+
+    def __init__(self, control_period):
+        self._period = control_period
+        self._hand, self._command, self._turning = LargestStep(), LargestStep(), LargestStep()
+        self._grasp = False
+        self._final_angle = None
+
+    def add(self, series):
+        """Feeds the next ticks' series fields (a dict, see `task_series`)."""
+        self._hand.add(series["ee_positions"])
+        self._command.add(series["commands"][:, 3:6])
+        if series.get("angles_to_target") is not None:
+            self._grasp = True
+            self._turning.add(series["command_angular_velocities"])
+            if len(series["angles_to_target"]):
+                self._final_angle = float(series["angles_to_target"][-1])
+
+    def task_result(self, status, monitor, series):
+        """The run's TaskResult (see `task_result`) holding `series` and the peaks fed."""
+        if self._grasp:
+            series = dict(series, peak_command_angular_change=self._turning.peak(1.0),
+                          final_angle_to_target=self._final_angle)
+        return task_result(status, monitor, series, self._hand.peak(self._period),
+                           self._command.peak(self._period))
 
 
 def series_fields(times, ee_state, in_collision, decisions):
@@ -300,7 +338,7 @@ def series_fields(times, ee_state, in_collision, decisions):
 
 def task_result(status, monitor, series, peak_hand_speed, peak_command_acceleration):
     """The TaskResult of a run: the task monitor's final `status` (TaskStatus) and objects,
-    the `series` fields (see series_fields) and the peaks (see motion_peaks)."""
+    the `series` fields (see series_fields) and the peaks (see SeriesPeaks)."""
     return TaskResult(
         success=bool(status.success > 0.5),
         task_time=float(status.task_time),

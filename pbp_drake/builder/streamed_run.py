@@ -6,20 +6,23 @@ The simulator advances in chunks of simulated time. After each chunk the rows of
 it completed are appended to the file (the format of a study's trial CSV,
 `pbp_drake.builder.time_series`) and every logger of the diagram is cleared, so memory holds
 at most one chunk of samples however long the run. What needs the whole series (the motion
-peaks) is carried from chunk to chunk.
+peaks, the grasping task's last angle to the target) is carried from chunk to chunk.
 
-A tick's row joins the plant's state logged at `t_k` with the decisions of tick k, which the
-loggers hold one sample later (`DECISION_LOG_SHIFT`, see `pbp_drake.builder.run.read_log`):
-a chunk's last state sample waits for the next chunk's first decision sample, and the run's
-last state sample, whose decisions are never logged, is not written (as in `run_task`).
+The rows are those of `run_task`'s series, read by the same functions (`run.task_series`,
+`run.SeriesPeaks`): a reach task's from `ee_state_log`, the grasping task's from
+`hand_pose_log`, with its orientation columns. A tick's row joins the plant's state logged
+at `t_k` with the decisions of tick k, which the loggers hold one sample later
+(`DECISION_LOG_SHIFT`, see `pbp_drake.builder.run.read_log`): a chunk's last state sample
+waits for the next chunk's first decision sample, and the run's last state sample, whose
+decisions are never logged, is not written (as in `run_task`).
 """
 
 import numpy as np
 from pydrake.systems.primitives import VectorLogSink
 
 from pbp_drake.builder.run import (
-    DECISION_LOGS, STATE_LOGS, LargestStep, advance_to, final_status, initialized_simulator,
-    series_fields, task_result, ticks_of)
+    DECISION_LOGS, STATE_LOGS, SeriesPeaks, advance_to, final_status, initialized_simulator,
+    state_log_name, task_series, ticks_of)
 from pbp_drake.builder.time_series import time_series_header, time_series_rows
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
 
@@ -39,20 +42,15 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
     """
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
                                                          diagram)
-    if diagram.HasSubsystemNamed("hand_pose_log"):
-        # The stream reads the reach tasks' ee_state_log; the grasping task logs a pose.
-        raise ValueError("a grasping task streamed to a CSV (--log) is not wired yet: run it "
-                         "without --log, or with pbp-drake study, whose trial CSVs hold its "
-                         "time series")
     period = scenario.control_period
     chunk_ticks = max(1, int(round(chunk_seconds / period)))
     # One tick past the end, as run_task: the loggers record tick k's decisions one sample later.
     last_tick = ticks_of(scenario) + 1
     tail = _LogTail(diagram)
-    hand_speed, command_acceleration = LargestStep(), LargestStep()
+    peaks = SeriesPeaks(period)
     context = simulator.get_context()
     with open(log_path, "w", newline="") as stream:
-        stream.write(time_series_header(tail.has_collision))
+        stream.write(time_series_header(tail.has_collision, tail.has_grasp))
         tick = 0
         while True:
             tick = min(tick + chunk_ticks, last_tick)
@@ -60,16 +58,14 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
             series = tail.take(context)
             stream.write(time_series_rows(series))
             stream.flush()
-            hand_speed.add(series.ee_positions)
-            command_acceleration.add(series.commands[:, 3:6])
+            peaks.add(series.fields)
             if after_chunk is not None:
                 after_chunk(context.get_time())
             # The task monitor ends the simulation at success (or the person, at a console).
             if tick == last_tick or ended:
                 break
     status, monitor = final_status(diagram, context)
-    return task_result(status, monitor, tail.empty_series(),
-                       hand_speed.peak(period), command_acceleration.peak(period))
+    return peaks.task_result(status, monitor, tail.empty_series())
 
 
 class _Series:
@@ -84,8 +80,12 @@ class _LogTail:
     """The samples read from the diagram's loggers and not yet written as rows."""
 
     def __init__(self, diagram):
+        self._diagram = diagram
+        # The hand's state: the grasping task logs its pose, the others ee_state.
+        self._state_log = state_log_name(diagram)
         self._named = {name: diagram.GetSubsystemByName(name)
-                       for name in STATE_LOGS + DECISION_LOGS if diagram.HasSubsystemNamed(name)}
+                       for name in (self._state_log,) + STATE_LOGS + DECISION_LOGS
+                       if diagram.HasSubsystemNamed(name)}
         # Every logger, those not written too (phase_log): all are cleared.
         self._all = [system for system in diagram.GetSystems()
                      if isinstance(system, VectorLogSink)]
@@ -94,11 +94,12 @@ class _LogTail:
                          for name, logger in self._named.items()}
         self._to_skip = DECISION_LOG_SHIFT  # decision samples before tick 0's
         self.has_collision = "in_collision_log" in self._named
+        self.has_grasp = self._state_log == "hand_pose_log"
 
     def take(self, context):
         """Reads the new samples of every logger and clears them all; returns the `_Series`
         of the ticks whose state and decisions are both read, and keeps the rest."""
-        times = self._named["ee_state_log"].FindLog(context).sample_times()
+        times = self._named[self._state_log].FindLog(context).sample_times()
         self._times = np.concatenate([self._times, times])
         for name, logger in self._named.items():
             self._samples[name] = np.vstack([self._samples[name],
@@ -120,9 +121,9 @@ class _LogTail:
         for name in self._samples:
             taken[name], self._samples[name] = (self._samples[name][:count].copy(),
                                                 self._samples[name][count:].copy())
-        return _Series(series_fields(times, taken["ee_state_log"],
-                                     taken.get("in_collision_log"),
-                                     {name: taken[name] for name in DECISION_LOGS}))
+        return _Series(task_series(self._diagram, times, taken[self._state_log],
+                                   taken.get("in_collision_log"),
+                                   {name: taken[name] for name in DECISION_LOGS}))
 
     def empty_series(self):
         """The series fields of no ticks (what a streamed run's TaskResult holds)."""

@@ -10,7 +10,8 @@ from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
 from pbp_drake.builder import (
     build_diagram, check_buildable, find_system, run_task, run_task_streamed, simulate)
-from pbp_drake.cli_types import method_list, port, realtime_rate, wait_seconds
+from pbp_drake.cli_types import port, realtime_rate, wait_seconds
+from pbp_drake.commands.run_checks import check_run_flags, is_person, session_methods
 from pbp_drake.console import (
     CAMERAS, Console, LiveRun, Progress, RobotCamera, method_name, result_text)
 from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
@@ -18,10 +19,10 @@ from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, mark_replay)
 from pbp_drake.scenarios import (
-    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, Hsr, Keyboard, ScenarioError,
-    load_scenario_file, resolve, with_method)
+    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, Hsr, ScenarioError, load_scenario_file,
+    resolve)
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers
-from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, run_session, session_order
+from pbp_drake.studies.sessions import run_session
 
 
 def add_run_command(commands):
@@ -139,10 +140,9 @@ def _run(args):
     if args.camera == "robot" and not resolved.is_hsr:
         raise ScenarioError("--camera robot follows the HSR; this scenario uses the 2-D toy "
                             "robot")
+    check_run_flags(args, resolved)  # and the flags' combinations, before the page too
     meshcat = None
     if args.no_meshcat:
-        if args.record or args.camera == "robot":
-            raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
         args.headless = True
     else:
         meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
@@ -155,17 +155,6 @@ def _run(args):
 def _run_scene(args, resolved, meshcat):
     """A 2-D scene: live in the page (its console has Stop alone) for its duration."""
     scenario = resolved.scenario
-    if args.log:
-        raise ScenarioError("--log streams an HSR task's per-tick rows; this scenario uses "
-                            "the 2-D toy robot")
-    session = [flag for flag, value in (("--participant", args.participant),
-                                        ("--methods", args.methods),
-                                        ("--output", args.output),
-                                        ("--practice", args.practice),
-                                        ("--answers", args.answers)) if value]
-    if session:
-        raise ScenarioError(f"{', '.join(session)}: user-study sessions run the HSR tasks; "
-                            "this scenario uses the 2-D toy robot")
     diagram = build_diagram(resolved, meshcat)
     console = None
     if meshcat is not None:
@@ -198,21 +187,9 @@ def _run_scene(args, resolved, meshcat):
 
 def _run_task(args, resolved, meshcat):
     scenario = resolved.scenario
-    person = isinstance(scenario.operator, (Keyboard, Gamepad))
-    if meshcat is None and person:
-        raise ScenarioError("--no-meshcat: a keyboard or gamepad is read in the page; use "
-                            "--operator virtual")
-    if args.headless and person:
-        raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
-                            "--operator virtual")
+    person = is_person(scenario)
     if args.participant is not None:
-        if meshcat is None:
-            raise ScenarioError("--participant: a session shows each run in the page; drop "
-                                "--no-meshcat")
         return _run_session(args, resolved, meshcat, person)
-    if args.methods is not None or args.output is not None or args.practice or args.answers:
-        raise ScenarioError("--methods, --output, --practice and --answers belong to a "
-                            "session: add --participant ID")
     console = None
     if meshcat is not None:
         console = _console(meshcat, args, scenario)
@@ -275,6 +252,8 @@ def _run_task_once(args, resolved, diagram, meshcat, console):
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     rate = 0.0 if args.headless else args.realtime_rate
+    if args.log:  # its folder may be made (check_log_path)
+        pathlib.Path(args.log).parent.mkdir(parents=True, exist_ok=True)
     result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram,
                                 advance=live.advance)
               if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram,
@@ -296,17 +275,8 @@ def _run_task_once(args, resolved, diagram, meshcat, console):
 
 def _run_session(args, resolved, meshcat, person):
     scenario = resolved.scenario
-    if args.record or args.log:
-        raise ScenarioError("--record and --log save one run; a session saves every run under "
-                            "--output")
-    methods = method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
-    for method in methods:
-        with_method(scenario, method)
-    try:
-        order = session_order(methods, args.participant)
-    except ValueError as error:
-        raise ScenarioError(f"--participant: {error}") from None
-    page = _session_page(args, meshcat, methods, person)
+    methods, order = session_methods(args, scenario)  # checked by check_run_flags
+    page = _session_page(args, meshcat, methods)
     output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
                                                        args.participant))
     print(f"Participant {args.participant}: {', '.join(order)}, in this order"
@@ -359,19 +329,11 @@ def _run_session(args, resolved, meshcat, person):
     return 1 if failed else 0
 
 
-def _session_page(args, meshcat, methods, person):
+def _session_page(args, meshcat, methods):
     """Where the session's Start, questions and Next are: the Meshcat page, or `--answers`
-    (the virtual operator only, which needs no browser)."""
+    (the virtual operator only, which needs no browser; see check_run_flags)."""
     if args.answers is not None:
-        if person:
-            raise ScenarioError("--answers stands in for a person's answers: it goes with "
-                                "--operator virtual; a keyboard or gamepad participant "
-                                "answers in the page")
         return FixedAnswers(parse_answers(args.answers, methods))
-    if args.headless:
-        raise ScenarioError("a --headless session needs --answers (e.g. --answers "
-                            "tiredness=3,ease=4): otherwise the questions are asked in the "
-                            "browser")
     return MeshcatSessionPage(meshcat)
 
 

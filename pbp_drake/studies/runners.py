@@ -64,7 +64,7 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
                       peak_command_acceleration=json_float(result.peak_command_acceleration),
                       ticks=len(result.times))
         if result.angles_to_target is not None:  # the grasping task's orientation
-            record.update(final_angle_to_target=json_float(result.angles_to_target[-1]),
+            record.update(final_angle_to_target=json_float(result.final_angle_to_target),
                           peak_command_angular_change=json_float(
                               result.peak_command_angular_change))
     except Exception as error:  # a broken trial must not lose the study

@@ -27,7 +27,7 @@ from pbp_drake.builder.time_series import time_series_columns, time_series_csv
 # they did not change the format: older trials still count and report them as n/a.
 TRIAL_FORMAT = 1
 # The metrics of a trial, in the order of the trial files and of trials.json. The peaks are
-# TaskResult's (see pbp_drake.builder.run.motion_peaks): peak_hand_speed (m/s), the largest
+# TaskResult's (see pbp_drake.builder.run.SeriesPeaks): peak_hand_speed (m/s), the largest
 # one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| / control_period, and
 # peak_command_acceleration (m/s^2), max_k |v_cmd(k+1) - v_cmd(k)| / control_period, over
 # the CSV's ee_x..ee_z and command_vx..command_vz columns (ticks 0..T-1).

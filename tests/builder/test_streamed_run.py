@@ -1,6 +1,7 @@
 """An HSR task streamed to a CSV file gives the run `run_task` gives: the same metrics and
 peaks, and the file holds the rows `run_task`'s series would (its loggers emptied as it
-goes). The soak keeps memory flat over several minutes of runs."""
+goes), the grasping task's too (the rows of a study's trial CSV). The soak keeps memory
+flat over several minutes of runs."""
 
 import dataclasses
 
@@ -12,19 +13,23 @@ from pbp_drake.builder.time_series import time_series_csv
 from pbp_drake.cli import main
 from pbp_drake.scenarios import load_scenario_file, resolve
 from pbp_drake.soak import run_soak
-from pbp_drake.studies.trial_files import read_time_series
+from pbp_drake.studies.runners import run_trial
+from pbp_drake.studies.trial_files import load_task_result, read_time_series, trial_paths
 
 # Whole tasks: `make test-fast` leaves these out.
 pytestmark = pytest.mark.slow
 
 METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio",
-           "peak_hand_speed", "peak_command_acceleration")
+           "peak_hand_speed", "peak_command_acceleration",
+           # The grasping task's (None in the others).
+           "peak_command_angular_change", "final_angle_to_target")
 
 
 @pytest.mark.parametrize("file_name, duration", [
     ("hsr_reach.yaml", None),  # to success, target switches
     ("hsr_obstacles.yaml", None),  # the in_collision column
     ("hsr_reach.yaml", 3.0),  # stopped by the time limit
+    ("hsr_grasp.yaml", 5.0),  # the hand's pose logged, the orientation columns
 ])
 def test_a_streamed_run_matches_the_in_memory_run(repo, tmp_path, file_name, duration):
     scenario = load_scenario_file(repo / "diagrams" / file_name).scenario
@@ -48,6 +53,10 @@ def test_a_streamed_run_matches_the_in_memory_run(repo, tmp_path, file_name, dur
     series = [streamed.times, streamed.ee_positions, streamed.headings, streamed.commands,
               streamed.operator_active, streamed.operator_commands, streamed.selected_goals,
               streamed.targets]
+    if in_memory.angles_to_target is not None:
+        assert streamed.final_angle_to_target is not None
+        series += [streamed.angles_to_target, streamed.command_angular_velocities,
+                   streamed.operator_twists]
     assert all(len(array) == 0 for array in series)
     assert all((array if array.base is None else array.base).nbytes == 0 for array in series)
 
@@ -89,3 +98,25 @@ def test_run_log_writes_the_rows_and_refuses_a_file_it_did_not_write(repo, tmp_p
     assert main(["run", scenario, "--operator", "virtual", "--headless", "--duration", "1",
                  "--log", str(log)]) == 1
     assert len(read_time_series(log)["time"]) == 34
+
+
+def test_run_log_of_the_grasping_task_writes_the_rows_of_a_study_trial(repo, tmp_path, capsys):
+    path = repo / "diagrams" / "hsr_grasp.yaml"
+    scenario = dataclasses.replace(load_scenario_file(path).scenario, duration=4.0)
+    method, seed = "pbp_continuous", 10000
+    study = tmp_path / "study"
+    run_trial(scenario, method, 0, seed, study, digest=None)
+
+    log = tmp_path / "logs" / "run.csv"  # its folder is made
+    assert main(["run", str(path), "--operator", "virtual", "--no-meshcat", "--duration", "4",
+                 "--method", method, "--seed", str(seed), "--log", str(log)]) == 1
+    # Byte for byte the trial's CSV: the same columns (the orientation ones too) and rows.
+    assert log.read_bytes() == trial_paths(study, method, seed)[1].read_bytes()
+    # The result line of a run without --log (the trial's, read back), then the file.
+    out = capsys.readouterr().out
+    summary = load_task_result(study, method, seed).summary_line()
+    assert f"seed {seed}]: {summary}; per-tick rows in {log}" in out
+    # A grasp time series it wrote may be overwritten, as a reach one.
+    assert main(["run", str(path), "--operator", "virtual", "--no-meshcat", "--duration", "1",
+                 "--log", str(log)]) == 1
+    assert len(read_time_series(log)["angle_to_target"]) == 34

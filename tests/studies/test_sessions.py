@@ -1,6 +1,7 @@
 """A participant's session: its order, the questionnaire's answers and files, practice runs,
-resuming after an interruption without asking or overwriting anything again, and the bad
-input a session or its report refuses (exit 2, the problem named)."""
+resuming after an interruption without asking or overwriting anything again, the bad input
+a session or its report refuses (exit 2, the problem named, before Meshcat starts), and an
+unattended session on the grasping task with its report."""
 
 import dataclasses
 import json
@@ -81,17 +82,29 @@ def test_a_saved_answer_is_never_overwritten(tmp_path):
     (["--participant", "P07", "--answers", ANSWERS, "--operator", "keyboard"],
      "--answers stands in for a person's answers"),
     (["--answers", ANSWERS], "belong to a session: add --participant ID"),
+    (["--participant", "P07", "--answers", ANSWERS, "--log", "run.csv"],
+     "a session saves every run under --output"),
+    (["--participant", "P07", "--methods", "teleop,nope", "--answers", ANSWERS],
+     "'nope' is unknown"),
+    (["--participant", "P07", "--answers", ANSWERS, "--no-meshcat"],
+     "a session shows each run in the page"),
 ])
-def test_a_bad_session_stops_before_it_runs(repo, tmp_path, capsys, argv, message):
+@pytest.mark.parametrize("task", [TASK, "diagrams/hsr_grasp.yaml"])
+def test_a_bad_session_stops_before_it_runs(repo, tmp_path, capsys, monkeypatch, argv,
+                                            message, task):
+    monkeypatch.chdir(tmp_path)
     output = tmp_path / "P07"
-    argv = ["run", str(repo / TASK), "--headless", "--operator", "virtual", "--output",
+    argv = ["run", str(repo / task), "--headless", "--operator", "virtual", "--output",
             str(output), *argv]
     if "keyboard" in argv:
         argv.remove("--headless")
     assert main(argv) == 2
-    err = capsys.readouterr().err
+    captured = capsys.readouterr()
+    err = captured.err
     assert err.startswith("pbp-drake: ") and message in err and "Traceback" not in err
-    assert not output.exists()
+    # Refused before the Meshcat server starts, and before anything is written.
+    assert "Meshcat" not in captured.out
+    assert not output.exists() and not (tmp_path / "run.csv").exists()
 
 
 @pytest.mark.slow
@@ -158,3 +171,24 @@ def test_a_session_refuses_a_folder_of_another_scenario(repo, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "holds a study of another scenario" in err and "choose another --output" in err
     assert session_files(output, ["teleop"]) == saved
+
+
+@pytest.mark.slow
+def test_an_unattended_session_on_the_grasping_task_and_its_report(repo, tmp_path, capsys):
+    study = tmp_path / "grasp_study"
+    output = study / "P04"
+    assert main(["run", str(repo / "diagrams" / "hsr_grasp.yaml"), "--headless", "--operator",
+                 "virtual", "--participant", "P04", "--answers", ANSWERS, "--duration", "3",
+                 "--output", str(output)]) == 1  # 3 s is too short to grasp
+    for method in METHODS:
+        record_path, csv_path = trial_paths(output, method, 0)
+        record = json.loads(record_path.read_text())
+        assert record["error"] is None and record["final_angle_to_target"] is not None
+        # The trial's rows hold the grasping task's orientation columns.
+        assert "angle_to_target" in csv_path.read_text().splitlines()[0].split(",")
+    assert json.loads((output / "questionnaire.json").read_text()) == parse_answers(
+        ANSWERS, METHODS)
+    capsys.readouterr()
+    assert main(["report", str(study)]) == 0
+    results = (study / "results.md").read_text()
+    assert "| P04 |" in results and (study / "fig8_questionnaire.png").is_file()

@@ -1,0 +1,79 @@
+"""The checks of `pbp-drake run`'s flags against each other and against the scenario, made
+before the Meshcat server starts: a combination `run` refuses costs no page, no port and no
+run, and is named in one line (ScenarioError: `pbp-drake: ...`, exit 2)."""
+
+from pbp_drake.cli_types import method_list
+from pbp_drake.scenarios import Gamepad, Keyboard, ScenarioError, with_method
+from pbp_drake.studies.questionnaire import parse_answers
+from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
+
+
+def check_run_flags(args, resolved):
+    """Raises ScenarioError for flags of `run` (the parsed `args`) that do not go together,
+    or not with the resolved scenario. `--no-meshcat` implies `--headless`."""
+    if args.no_meshcat and (args.record or args.camera == "robot"):
+        raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
+    if not resolved.is_hsr:
+        _check_scene_flags(args)
+        return
+    person = is_person(resolved.scenario)
+    if args.no_meshcat and person:
+        raise ScenarioError("--no-meshcat: a keyboard or gamepad is read in the page; use "
+                            "--operator virtual")
+    if (args.headless or args.no_meshcat) and person:
+        raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
+                            "--operator virtual")
+    if args.participant is None:
+        if args.methods is not None or args.output is not None or args.practice or args.answers:
+            raise ScenarioError("--methods, --output, --practice and --answers belong to a "
+                                "session: add --participant ID")
+        return
+    if args.no_meshcat:
+        raise ScenarioError("--participant: a session shows each run in the page; drop "
+                            "--no-meshcat")
+    if args.record or args.log:
+        raise ScenarioError("--record and --log save one run; a session saves every run under "
+                            "--output")
+    methods, _ = session_methods(args, resolved.scenario)
+    if args.answers is not None:
+        if person:
+            raise ScenarioError("--answers stands in for a person's answers: it goes with "
+                                "--operator virtual; a keyboard or gamepad participant "
+                                "answers in the page")
+        parse_answers(args.answers, methods)
+    elif args.headless or args.no_meshcat:
+        raise ScenarioError("a --headless session needs --answers (e.g. --answers "
+                            "tiredness=3,ease=4): otherwise the questions are asked in the "
+                            "browser")
+
+
+def is_person(scenario):
+    """A person drives the scenario's robot from the page (keyboard or gamepad)."""
+    return isinstance(scenario.operator, (Keyboard, Gamepad))
+
+
+def session_methods(args, scenario):
+    """`(methods, order)` of a session: `--methods` (or the default ones), each a method the
+    scenario takes, and their order for `--participant`."""
+    methods = method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
+    for method in methods:
+        with_method(scenario, method)
+    try:
+        return methods, session_order(methods, args.participant)
+    except ValueError as error:
+        raise ScenarioError(f"--participant: {error}") from None
+
+
+def _check_scene_flags(args):
+    """A 2-D scene has no task to log nor session to run."""
+    if args.log:
+        raise ScenarioError("--log streams an HSR task's per-tick rows; this scenario uses "
+                            "the 2-D toy robot")
+    session = [flag for flag, value in (("--participant", args.participant),
+                                        ("--methods", args.methods),
+                                        ("--output", args.output),
+                                        ("--practice", args.practice),
+                                        ("--answers", args.answers)) if value]
+    if session:
+        raise ScenarioError(f"{', '.join(session)}: user-study sessions run the HSR tasks; "
+                            "this scenario uses the 2-D toy robot")

@@ -38,6 +38,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core.grasp_task import approach_direction
+from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.quaternion import angle_between, conjugate, exp_map, log_map, multiply
 
 GRASP_PARTICIPANT_MODES = ("assist", "drive")
@@ -45,43 +46,52 @@ GRASP_PARTICIPANT_MODES = ("assist", "drive")
 NO_TARGET = -1
 
 
+# The reach participant's calibrated defaults (issue 14), the one home of those this one
+# shares.
+_REACH_DEFAULTS = VirtualParticipantParams()
+# Each field shared with `VirtualParticipantParams`, by its name there.
+SHARED_WITH_REACH = {
+    "speed": "speed", "rotation_speed": "rotation_speed", "reaction_delay": "reaction_delay",
+    "direction_noise": "direction_noise", "speed_noise": "speed_noise",
+    "slow_radius": "slow_radius", "slow_angle": "turn_slowdown_angle",
+    "aligned_angle": "aligned_angle", "insist_time": "insist_time"}
+
+
 @dataclasses.dataclass
 class GraspParticipantParams:
-    """How the grasping task's virtual participant behaves (module docstring). The fields it
-    shares with the reach participant keep that one's calibrated defaults
-    (`VirtualParticipantParams`, issue 14); `from_virtual_participant` takes them from a
-    scenario's `operator: !VirtualParticipant {...}`."""
+    """How the grasping task's virtual participant behaves (module docstring). Every field
+    is one it shares with the reach participant (`SHARED_WITH_REACH`) and takes its
+    calibrated default from `VirtualParticipantParams` (issue 14);
+    `from_virtual_participant` takes them from a scenario's
+    `operator: !VirtualParticipant {...}`."""
 
     # Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
-    speed: float = 0.0
+    speed: float = _REACH_DEFAULTS.speed
     # How fast it turns the hand (rad/s).
-    rotation_speed: float = 0.8
+    rotation_speed: float = _REACH_DEFAULTS.rotation_speed
     # It notices a new target this long (s) after it appears.
-    reaction_delay: float = 0.5
+    reaction_delay: float = _REACH_DEFAULTS.reaction_delay
     # Its velocity's direction is rotated by N(0, direction_noise) rad, its twist scaled by
     # (1 + N(0, speed_noise)).
-    direction_noise: float = 0.1
-    speed_noise: float = 0.1
+    direction_noise: float = _REACH_DEFAULTS.direction_noise
+    speed_noise: float = _REACH_DEFAULTS.speed_noise
     # It slows in proportion within this distance (m) of the grasp position.
-    slow_radius: float = 0.15
+    slow_radius: float = _REACH_DEFAULTS.slow_radius
     # It turns in proportion within this angle (rad) of the grasp orientation, so that it
-    # does not overshoot ...
-    slow_angle: float = 0.3
+    # does not overshoot (the reach participant's `turn_slowdown_angle`) ...
+    slow_angle: float = _REACH_DEFAULTS.turn_slowdown_angle
     # ... and stops turning within this angle (rad): well inside the task's 10 degrees.
-    aligned_angle: float = 0.05
+    aligned_angle: float = _REACH_DEFAULTS.aligned_angle
     # Assisting, once it has held the target's orientation this long (s) and the estimate
     # still names another object, it goes to the target itself (`insist_twist`).
-    insist_time: float = 1.0
+    insist_time: float = _REACH_DEFAULTS.insist_time
 
     @classmethod
     def from_virtual_participant(cls, params):
         """The grasp participant with the fields a `VirtualParticipantParams` shares with
         it (its `turn_slowdown_angle` is `slow_angle` here)."""
-        return cls(speed=params.speed, rotation_speed=params.rotation_speed,
-                   reaction_delay=params.reaction_delay,
-                   direction_noise=params.direction_noise, speed_noise=params.speed_noise,
-                   slow_radius=params.slow_radius, slow_angle=params.turn_slowdown_angle,
-                   aligned_angle=params.aligned_angle, insist_time=params.insist_time)
+        return cls(**{name: getattr(params, reach_name)
+                      for name, reach_name in SHARED_WITH_REACH.items()})
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""

@@ -30,7 +30,7 @@ from pbp_drake.systems.gamepad_operator import GamepadParams
 from pbp_drake.systems.keyboard_operator import KeyboardParams
 from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionParams
 from pbp_drake.systems.point_robot import PointRobotParams
-from pbp_drake.systems.participant_params import VirtualParticipantParams
+from pbp_drake.core.participant_params import VirtualParticipantParams
 
 def _config_from_yaml(config_type, text):
     return yaml_load_typed(schema=config_type, data=text)

@@ -1,4 +1,6 @@
-"""The blender: how the operator's command and the robot policy become the robot's command."""
+"""The blender: how the operator's command and the robot policy become the robot's command.
+`BlenderBase` holds what it shares with the six-DoF `PoseBlender`: the mode, the
+`confidence_alpha` ramp and `fixed_alpha`'s weight."""
 
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
@@ -9,7 +11,81 @@ from pbp_drake.core.arbitration import (
 from pbp_drake.systems.layouts import goal_index
 
 
-class Blender(LeafSystem):
+class BlenderBase(LeafSystem):
+    """What `Blender` and `PoseBlender` share: the blending mode, the ramp of
+    `confidence_alpha` (`confidence_range`, `alpha_max`, checked here) and the weight of
+    `fixed_alpha`, a numeric parameter of the Context (its default the constructor's
+    `alpha`), so that it can change during a run without rebuilding (`set_alpha`).
+
+    A subclass declares its ports, among them `selected_goal` and `goal_probabilities` as
+    `_selected_goal_port` and `_goal_probabilities_port`, which `alpha` reads; it names the
+    check of its modes (`_validate_mode`) and the goal estimator whose `goal_probabilities`
+    output feeds it (`_estimator_name`).
+    """
+
+    _validate_mode = staticmethod(validate_mode)
+    _estimator_name = "GoalEstimator"
+
+    def __init__(self, mode, goal_count, control_period, alpha, confidence_range, alpha_max):
+        super().__init__()
+        self._validate_mode(mode, alpha)
+        try:
+            low, high = confidence_range
+        except (TypeError, ValueError):
+            raise ValueError(f"confidence_range must be a pair (confidence_low, "
+                             f"confidence_high), got {confidence_range!r}") from None
+        validate_confidence_ramp(low, high, alpha_max)
+        self._mode = mode
+        self._confidence_range = (float(low), float(high))
+        self._alpha_max = float(alpha_max)
+        self._goal_count = int(goal_count)
+        self._period = float(control_period)
+        # A Context parameter, not a Python attribute: a live change (set_alpha) then
+        # belongs to one Context and invalidates the cached output.
+        self._alpha_index = (self.DeclareNumericParameter(BasicVector([float(alpha)]))
+                             if mode == "fixed_alpha" else None)
+
+    @property
+    def mode(self):
+        return self._mode
+
+    @property
+    def confidence_range(self):
+        return self._confidence_range
+
+    @property
+    def alpha_max(self):
+        return self._alpha_max
+
+    def alpha(self, context):
+        """The arbitration weight used in `context`: `alpha` for `fixed_alpha`, the ramp of
+        the goal confidence for `confidence_alpha`, None for the other modes."""
+        if self._alpha_index is not None:
+            return float(context.get_numeric_parameter(self._alpha_index)[0])
+        if self._mode != "confidence_alpha":
+            return None
+        if not self._goal_probabilities_port.HasValue(context):
+            raise RuntimeError(
+                f"{type(self).__name__} in confidence_alpha mode needs its goal_probabilities "
+                f"input port connected (e.g. to {self._estimator_name}'s goal_probabilities "
+                f"output)")
+        return confidence_alpha(self._goal_probabilities_port.Eval(context),
+                                self._selected_goal(context), *self._confidence_range,
+                                self._alpha_max)
+
+    def set_alpha(self, context, alpha):
+        """Sets the weight of `fixed_alpha` in this system's `context` (from the next
+        evaluation of the output on). Raises ValueError outside [0, 1] or in another mode."""
+        if self._alpha_index is None:
+            raise ValueError(f"alpha is a weight of fixed_alpha; this blender is {self._mode}")
+        self._validate_mode(self._mode, alpha)
+        context.get_mutable_numeric_parameter(self._alpha_index).SetAtIndex(0, float(alpha))
+
+    def _selected_goal(self, context):
+        return goal_index(self._selected_goal_port, context, self._goal_count, unconnected=0)
+
+
+class Blender(BlenderBase):
     """Mixes the operator into the selected policy reference by one of the blending laws.
 
     .. pydrake_system::
@@ -48,21 +124,8 @@ class Blender(LeafSystem):
     def __init__(self, mode, dimension, goal_count, control_period, alpha=None, *,
                  confidence_range=(DEFAULT_CONFIDENCE_LOW, DEFAULT_CONFIDENCE_HIGH),
                  alpha_max=DEFAULT_ALPHA_MAX):
-        super().__init__()
-        validate_mode(mode, alpha)
-        try:
-            low, high = confidence_range
-        except (TypeError, ValueError):
-            raise ValueError(f"confidence_range must be a pair (confidence_low, "
-                             f"confidence_high), got {confidence_range!r}") from None
-        validate_confidence_ramp(low, high, alpha_max)
-        self._mode = mode
-        self._alpha = alpha
-        self._confidence_range = (float(low), float(high))
-        self._alpha_max = float(alpha_max)
+        super().__init__(mode, goal_count, control_period, alpha, confidence_range, alpha_max)
         self._dimension = int(dimension)
-        self._goal_count = int(goal_count)
-        self._period = float(control_period)
         d, k = self._dimension, self._goal_count
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._references_port = self.DeclareVectorInputPort("references", 2 * k * d)
@@ -70,20 +133,12 @@ class Blender(LeafSystem):
         self._operator_command_port = self.DeclareVectorInputPort("operator_command", d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._goal_probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
-        # A Context parameter, not a Python attribute: a live change (set_alpha) then
-        # belongs to one Context and invalidates the cached command.
-        self._alpha_index = (self.DeclareNumericParameter(BasicVector([float(alpha)]))
-                             if mode == "fixed_alpha" else None)
         # The blend is a function of the inputs (and alpha) alone: say so, so that Drake
         # does not redo it at every plant step in between the control ticks that change them.
         self._command_port = self.DeclareVectorOutputPort(
             "command", 2 * d, self._calc_command,
             prerequisites_of_calc={self.all_input_ports_ticket(),
                                    self.all_parameters_ticket()})
-
-    @property
-    def mode(self):
-        return self._mode
 
     def get_robot_state_input_port(self):
         return self._robot_state_port
@@ -102,40 +157,6 @@ class Blender(LeafSystem):
 
     def get_goal_probabilities_input_port(self):
         return self._goal_probabilities_port
-
-    @property
-    def confidence_range(self):
-        return self._confidence_range
-
-    @property
-    def alpha_max(self):
-        return self._alpha_max
-
-    def alpha(self, context):
-        """The arbitration weight used in `context`: `alpha` for `fixed_alpha`, the ramp of
-        the goal confidence for `confidence_alpha`, None for the other modes."""
-        if self._alpha_index is not None:
-            return float(context.get_numeric_parameter(self._alpha_index)[0])
-        if self._mode != "confidence_alpha":
-            return self._alpha
-        if not self._goal_probabilities_port.HasValue(context):
-            raise RuntimeError(
-                "Blender in confidence_alpha mode needs its goal_probabilities input port "
-                "connected (e.g. to GoalEstimator's goal_probabilities output)")
-        return confidence_alpha(self._goal_probabilities_port.Eval(context),
-                                self._selected_goal(context), *self._confidence_range,
-                                self._alpha_max)
-
-    def set_alpha(self, context, alpha):
-        """Sets the weight of `fixed_alpha` in this system's `context` (from the next
-        evaluation of `command` on). Raises ValueError outside [0, 1] or in another mode."""
-        if self._alpha_index is None:
-            raise ValueError(f"alpha is a weight of fixed_alpha; this blender is {self._mode}")
-        validate_mode(self._mode, alpha)
-        context.get_mutable_numeric_parameter(self._alpha_index).SetAtIndex(0, float(alpha))
-
-    def _selected_goal(self, context):
-        return goal_index(self._selected_goal_port, context, self._goal_count, unconnected=0)
 
     def get_command_output_port(self):
         return self._command_port

@@ -10,7 +10,7 @@ from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.layouts import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.participant_avoidance import (
     WATCH_SIZE, is_pushing_through, robot_closes_in, start_watch, update_watch)
-from pbp_drake.systems.participant_params import VirtualParticipantParams
+from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.systems.sampled_operator import SampledOperator, operator_speed
 
 PARTICIPANT_MODES = ("assist", "drive")

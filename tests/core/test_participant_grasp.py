@@ -1,6 +1,8 @@
 """The grasping task's virtual participant (`pbp_drake.core.participant_grasp`), in a plain
 kinematic loop: the hand's pose integrated from the commanded twist."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -10,10 +12,10 @@ from pbp_drake.core.grasp_task import (
     approach_direction, grasp_errors, grasp_success, sample_grasp_scene,
     side_grasp_orientation, top_grasp_orientation)
 from pbp_drake.core.participant_grasp import (
-    GraspParticipant, GraspParticipantParams, ParticipantMemory, drive_twist,
-    notice_target)
+    SHARED_WITH_REACH, GraspParticipant, GraspParticipantParams, ParticipantMemory,
+    drive_twist, notice_target)
+from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.quaternion import angle_between, exp_map, multiply
-from pbp_drake.systems.participant_params import VirtualParticipantParams
 
 PERIOD = 0.03
 SPEED = 0.12
@@ -189,6 +191,15 @@ def test_it_takes_the_shared_fields_of_the_reach_participant():
             params.slow_angle) == (0.1, 0.6, 0.3, 0.2)
     assert params.slow_radius == reach.slow_radius
 
+
+
+def test_its_shared_defaults_are_the_reach_participants():
+    # One home per default: VirtualParticipantParams' calibration (issue 14).
+    grasp, reach = GraspParticipantParams(), VirtualParticipantParams()
+    assert set(SHARED_WITH_REACH) == {field.name for field in dataclasses.fields(grasp)}
+    for name, reach_name in SHARED_WITH_REACH.items():
+        assert getattr(grasp, name) == getattr(reach, reach_name), name
+    assert GraspParticipantParams.from_virtual_participant(reach) == grasp
 
 @pytest.mark.parametrize("arguments, message", [
     (dict(mode="push"), "participant mode 'push' is unknown"),

@@ -13,11 +13,11 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.core.dmp import DmpBank as DmpBankMath
 from pbp_drake.core.dmp import DmpSettings, fit_weights
+from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.systems import VirtualParticipant
 from pbp_drake.systems.dmp_bank import DmpBank
 from pbp_drake.systems.participant_avoidance import (
     is_pushing_through, robot_closes_in, start_watch, update_watch)
-from pbp_drake.systems.participant_params import VirtualParticipantParams
 
 PERIOD = 0.03
 PARAMS = VirtualParticipantParams()

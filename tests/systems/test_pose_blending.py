@@ -154,3 +154,22 @@ def test_confidence_alpha_gives_a_sure_policy_the_command():
 def test_a_nan_operator_twist_is_refused_with_its_field_named():
     with pytest.raises(ValueError, match="operator_twist wz is NaN or infinite"):
         blender_reference("pbp_continuous", np.array([0.0, 0.0, 0.0, 0.0, 0.0, np.nan]))
+
+
+def test_its_weight_is_a_context_parameter_as_the_blenders():
+    blender = PoseBlender("fixed_alpha", 2, DT, 0.3)
+    context, other = blender.CreateDefaultContext(), blender.CreateDefaultContext()
+    blender.set_alpha(context, 0.8)
+    assert blender.alpha(context) == 0.8 and blender.alpha(other) == 0.3
+    with pytest.raises(ValueError, match="alpha must lie in"):
+        blender.set_alpha(context, 1.5)
+    no_user = PoseBlender("pbp_no_user", 2, DT)
+    assert no_user.alpha(no_user.CreateDefaultContext()) is None
+    with pytest.raises(ValueError, match="weight of fixed_alpha; this blender is pbp_no_user"):
+        no_user.set_alpha(no_user.CreateDefaultContext(), 0.5)
+    confident = PoseBlender("confidence_alpha", 2, DT, confidence_range=(0.2, 0.6),
+                            alpha_max=0.9)
+    assert (confident.confidence_range, confident.alpha_max) == ((0.2, 0.6), 0.9)
+    with pytest.raises(RuntimeError, match="PoseBlender in confidence_alpha mode needs its "
+                                           "goal_probabilities input port connected"):
+        confident.alpha(confident.CreateDefaultContext())

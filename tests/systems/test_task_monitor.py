@@ -1,4 +1,5 @@
-"""TaskMonitor in a small diagram: a hand that slides along +x past two objects.
+"""TaskMonitor (and GraspTaskMonitor, its rules with grasp poses) in a small diagram: a hand
+that slides along +x past two objects.
 
 The hand moves at 0.1 m/s from the origin; object 0 stands at x = 1 and object 1 at x = 2.
 The target switches to object 1 once the progress toward object 0 reaches 0.455 (the tick at
@@ -12,7 +13,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from pbp_drake.systems.layouts import EeState, Target, TaskStatus
+from pbp_drake.systems.grasp_task_monitor import GraspTaskMonitor
+from pbp_drake.systems.layouts import EeState, PoseState, Target, TaskStatus
 from pbp_drake.systems.task_monitor import SUCCESS_MESSAGE, TaskMonitor
 from pbp_drake.systems.tick import report_offset
 
@@ -134,3 +136,37 @@ def test_two_contexts_keep_their_own_counts():
 def test_an_update_offset_past_the_period_is_refused():
     with pytest.raises(ValueError, match="update_offset"):
         TaskMonitor(OBJECTS, [0], [0.0], [0.0, 0.0, 0.0], 0.05, PERIOD, update_offset=PERIOD)
+
+
+
+def test_the_grasp_monitor_keeps_the_same_rules():
+    # The hand slides as above, already at the grasp orientation: the same ticks switch and
+    # succeed, with no collision port.
+    builder = DiagramBuilder()
+    level = [1.0, 0.0, 0.0, 0.0]
+    monitor = builder.AddNamedSystem("task_monitor", GraspTaskMonitor(
+        OBJECTS, [level, level], targets=[0, 1], switch_schedule=[0.0, 0.455],
+        start_pose=[0.0, 0.0, 0.0, *level], success_distance=0.055,
+        success_angle=np.radians(10.0), control_period=PERIOD))
+    assert [monitor.get_input_port(i).get_name() for i in range(monitor.num_input_ports())] \
+        == ["hand_pose", "operator_active"]
+    hand = np.zeros((PoseState.size, 2))
+    hand[3, :] = 1.0
+    hand[0, 1] = SPEED * 100.0
+    pose = builder.AddSystem(TrajectorySource(
+        PiecewisePolynomial.FirstOrderHold([0.0, 100.0], hand)))
+    builder.Connect(pose.get_output_port(), monitor.get_hand_pose_input_port())
+    active = builder.AddSystem(zero_order_hold([0.0, 2.0, 100.0], [1.0, 0.0, 0.0]))
+    builder.Connect(active.get_output_port(), monitor.get_operator_active_input_port())
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(SWITCH_TIME + PERIOD / 2)
+    target, status = read(monitor, simulator)
+    assert (target.index, target.x, status.stage) == (1, 2.0, 1)
+    result = simulator.AdvanceTo(60.0)
+    assert result.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
+    assert result.message() == SUCCESS_MESSAGE
+    target, status = read(monitor, simulator)
+    assert status.success == 1.0 and target.index == 1 and status.steps == STEPS
+    assert status.task_time == pytest.approx(SUCCESS_TIME, abs=1e-9)
+    assert status.intervention_ratio == pytest.approx(20 / STEPS, abs=1e-12)
+    assert status.collision_ratio == 0.0

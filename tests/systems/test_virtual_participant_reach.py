@@ -11,10 +11,11 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings, goal_probabilities
+from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_reach import assist_motion, facing
 from pbp_drake.scenarios import Scenario, resolve
 from pbp_drake.systems import VirtualParticipant
-from pbp_drake.systems.participant_params import VirtualParticipantParams
+from pbp_drake.systems import participant_params as old_participant_params
 
 PERIOD = 0.03
 SPEED = 0.12
@@ -97,3 +98,8 @@ def test_facing_a_target_behind_the_picked_object_it_goes_there_itself():
     assert abs(yaw_rate) > 0.0
     assert velocity @ facing(sideways) <= 1e-12
     assert velocity[0] > 0.1  # toward the target, at nearly the whole speed
+
+
+def test_its_parameters_keep_their_old_import_path():
+    # They moved to pbp_drake.core (the grasp participant derives its defaults from them).
+    assert old_participant_params.VirtualParticipantParams is VirtualParticipantParams

@@ -30,10 +30,13 @@ class PoseGoalEstimator(LeafSystem):
     `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened. `operator_twist`, when
     connected, is the operator's command, an `OperatorTwist` `[v (3), omega (3)]` (world
     frame): the estimator's direction of travel and turn rate are then the operator's, not
-    the hand's. Connect it whenever a policy moves the hand too: the hand's own twist is
-    then mostly the selected DMP's, and reading it as the operator's intent holds the
-    selection on whatever the robot is heading for (docs/grasp_task.md). Unconnected, the
-    hand's twist from `hand_pose` is read. `selected_goal` is `[index]`
+    the hand's, and while the operator gives no input (a twist of all zeros) the selection
+    holds. Connect it whenever a policy moves the hand too: the hand's own twist is then
+    mostly the selected DMP's, and reading it as the operator's intent holds the selection
+    on whatever the robot is heading for; and with the operator idle, only the hand's
+    distances and angles to the grasps would be left to decide, which the policy's own
+    motion changes (docs/grasp_task.md). Unconnected, the hand's twist from `hand_pose`
+    is read and the selection follows it at every update. `selected_goal` is `[index]`
     and `goal_probabilities` the K probabilities; both are read from the state, so they
     hold between updates, as `GoalEstimator`'s.
 
@@ -97,6 +100,11 @@ class PoseGoalEstimator(LeafSystem):
         result = estimate_pose(self._settings, goals[:, :3], goals[:, 3:], hand[:3],
                                hand[3:7] / np.linalg.norm(hand[3:7]), twist[:3], twist[3:],
                                memory)
+        if memory is not None and self._twist_port.HasValue(context) and not twist.any():
+            # The operator gives no input: no new evidence of intent, so the selection
+            # holds (the probabilities still follow the hand).
+            result = result._replace(memory=SelectionMemory(memory.selected),
+                                     selected=memory.selected)
         state.get_mutable_vector(self._selected_index).set_value([result.selected])
         state.get_mutable_vector(self._probabilities_index).set_value(result.probabilities)
         state.get_mutable_vector(self._memory_index).set_value(

@@ -68,12 +68,13 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
         with open_page(url.group(1), (800, 600), timeout_ms=30_000) as page:
             for position, method in enumerate(order, start=1):
                 click(page, start_label(method, position, len(order)))
-                # The keys work once the page has the keyboard operator's buttons,
-                # which come with the run: press at once, while it runs.
+                # The keys work once the page has the keyboard operator's buttons and
+                # this method's run has started (its title shows as it starts; the
+                # buttons may be the last method's still): press at once, while it runs.
                 page.wait_for_selector("text=Left (←)", state="attached")
-                hold_left(page, 1.5)
                 name = re.escape(method_name(method))
                 control(page, f"{name}, seed 0").wait_for(state="attached")
+                hold_left(page, 1.5)
                 control(page, r"time left \d+ s · \d+ target switch(es)? · "
                         r"intervention \d+ %").wait_for(state="attached")
                 seen[method] = {b: control(page, b).count()

@@ -1,6 +1,6 @@
 """What the headless-browser tests share: Debian's chromium driven by Playwright (the PyPI
 package and its driver only, never `playwright install`), a page opened on a URL, a free
-port, and a process's output read with timeouts.
+port, and a command run for the test's length, its output read with timeouts.
 
 A test module that needs the browser sets `pytestmark = NEEDS_BROWSER` (slow, and skipped
 where chromium or Playwright is missing).
@@ -11,6 +11,7 @@ import queue
 import re
 import shutil
 import socket
+import subprocess
 import threading
 import time
 
@@ -48,6 +49,21 @@ def open_page(url, viewport=(1280, 720), timeout_ms=20_000):
             yield page
         finally:
             browser.close()
+
+
+@contextlib.contextmanager
+def running(command, cwd=None, stdin=subprocess.DEVNULL):
+    """`command` started (its stderr merged into its stdout, read as `Output`), as
+    `(process, output)`; on leaving, the process is killed when it still runs, so that a
+    failed test leaves nothing behind. `stdin` is passed to the process as given."""
+    process = subprocess.Popen(command, cwd=cwd, stdin=stdin, stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True)
+    try:
+        yield process, Output(process.stdout)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait(timeout=10)
 
 
 def free_port():

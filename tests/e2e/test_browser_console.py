@@ -10,11 +10,10 @@ Needs Debian's `chromium` and Playwright from PyPI; skipped where either is miss
 import os
 import pty
 import re
-import subprocess
 import sys
 
 import pytest
-from browser_page import NEEDS_BROWSER, Output, free_port, open_page
+from browser_page import NEEDS_BROWSER, free_port, open_page, running
 
 pytestmark = NEEDS_BROWSER
 
@@ -36,33 +35,28 @@ def test_the_page_shows_the_run_and_stop_ends_it(repo):
     command = [sys.executable, "-m", "pbp_drake", "run", "diagrams/hsr_reach.yaml",
                "--operator", "keyboard", "--camera", "robot", "--duration", str(DURATION),
                "--port", str(port)]
-    process = subprocess.Popen(command, cwd=repo, stdin=stdin, stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, text=True)
-    os.close(stdin)
     try:
-        output = Output(process.stdout)
-        url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
-        assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
-        with open_page(url.group(1)) as page:
-            control = controls_of(page)
-            control("PBP-Alt, seed 0").wait_for(state="attached")
-            control(r"time left \d+ s · 0 target switches · intervention 0 %").wait_for(
-                state="attached")
-            control("Result: failed: time limit").wait_for(
-                state="attached", timeout=(DURATION + 20) * 1000)
-            assert process.poll() is None, "the run quit before Stop"
-            assert all(control(name).count() == 1
-                       for name in ("Stop", "Restart", "Next scene"))
-            # The panel may be folded: send the click its row would. Next scene runs
-            # seed 1 at once; Stop then ends it, and the process, mid-run.
-            control("Next scene").dispatch_event("click")
-            control("PBP-Alt, seed 1").wait_for(state="attached")
-            control("Stop").dispatch_event("click")
-            code = process.wait(timeout=20)
+        with running(command, cwd=repo, stdin=stdin) as (process, output):
+            os.close(stdin)  # the process holds the terminal now
+            url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
+            assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
+            with open_page(url.group(1)) as page:
+                control = controls_of(page)
+                control("PBP-Alt, seed 0").wait_for(state="attached")
+                control(r"time left \d+ s · 0 target switches · intervention 0 %").wait_for(
+                    state="attached")
+                control("Result: failed: time limit").wait_for(
+                    state="attached", timeout=(DURATION + 20) * 1000)
+                assert process.poll() is None, "the run quit before Stop"
+                assert all(control(name).count() == 1
+                           for name in ("Stop", "Restart", "Next scene"))
+                # The panel may be folded: send the click its row would. Next scene runs
+                # seed 1 at once; Stop then ends it, and the process, mid-run.
+                control("Next scene").dispatch_event("click")
+                control("PBP-Alt, seed 1").wait_for(state="attached")
+                control("Stop").dispatch_event("click")
+                code = process.wait(timeout=20)
     finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait(timeout=10)
         os.close(terminal)
     output.wait_for(r"$^", timeout=2)  # the rest of the output, for the messages below
     assert code == 1, output.text()  # the task failed: no keys were pressed

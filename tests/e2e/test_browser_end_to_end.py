@@ -8,14 +8,13 @@ Needs Debian's `chromium` (`make test` installs it where it can) and Playwright 
 
 import io
 import re
-import subprocess
 import sys
 import time
 
 import matplotlib.image
 import numpy as np
 import pytest
-from browser_page import NEEDS_BROWSER, Output, free_port, open_page
+from browser_page import NEEDS_BROWSER, free_port, open_page, running
 
 pytestmark = NEEDS_BROWSER
 
@@ -47,10 +46,7 @@ def test_holding_the_left_arrow_in_the_browser_moves_the_hand_left(repo, tmp_pat
     command = [sys.executable, "-m", "pbp_drake", "run", "diagrams/hsr_reach.yaml",
                "--method", "teleop", "--operator", "keyboard",
                "--duration", str(DURATION), "--port", str(port)]
-    process = subprocess.Popen(command, cwd=repo, stdin=subprocess.DEVNULL,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    try:
-        output = Output(process.stdout)
+    with running(command, cwd=repo) as (process, output):
         url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
         with open_page(url.group(1)) as page:
@@ -77,10 +73,6 @@ def test_holding_the_left_arrow_in_the_browser_moves_the_hand_left(repo, tmp_pat
         result = output.wait_for(RESULT.pattern, timeout=DURATION + 30)
         assert result, f"no result line from pbp-drake:\n{output.text()}"
         process.wait(timeout=10)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait(timeout=10)
 
     hand = np.array([float(value) for value in result.groups()])
     assert hand[1] > START_Y + 0.1, (

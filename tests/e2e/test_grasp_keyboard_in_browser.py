@@ -7,13 +7,12 @@ Needs Debian's `chromium` and Playwright from PyPI (skipped where either is miss
 """
 
 import re
-import subprocess
 import sys
 import time
 
 import numpy as np
 import pytest
-from browser_page import NEEDS_BROWSER, Output, free_port, open_page
+from browser_page import NEEDS_BROWSER, free_port, open_page, running
 
 from pbp_drake.systems.keyboard_twist_operator import MODE_LABELS, ROTATE, TRANSLATE
 
@@ -39,10 +38,7 @@ def test_the_keyboard_moves_the_grasping_hand_from_the_page(repo):
     command = [sys.executable, "-m", "pbp_drake", "run", "diagrams/hsr_grasp.yaml",
                "--method", "teleop", "--operator", "keyboard",
                "--duration", str(DURATION), "--port", str(port)]
-    process = subprocess.Popen(command, cwd=repo, stdin=subprocess.DEVNULL,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    try:
-        output = Output(process.stdout)
+    with running(command, cwd=repo) as (process, output):
         url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
         assert output.wait_for(r"^Keys: arrows move the hand .*R switches to turning",
@@ -58,10 +54,6 @@ def test_the_keyboard_moves_the_grasping_hand_from_the_page(repo):
         result = output.wait_for(RESULT.pattern, timeout=DURATION + 30)
         assert result, f"no result line from pbp-drake:\n{output.text()}"
         process.wait(timeout=10)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait(timeout=10)
 
     hand = np.array([float(value) for value in result.groups()])
     assert hand[1] > START_Y + 0.1, (

@@ -70,17 +70,24 @@ def fresh_venv(wheel, tmp_path_factory):
     ours = {sysconfig.get_paths()[name] for name in ("purelib", "platlib")}
     with open(os.path.join(site_packages, "project_dependencies.pth"), "w") as pth:
         pth.write("".join(f"{path}\n" for path in sorted(ours)))
+    # Without PYTHONPATH: where it names the checkout (its pbp_drake.egg-info), pip would
+    # find pbp_drake installed in the new venv already and install nothing.
     subprocess.run([sys.executable, "-m", "pip", "--python", str(python), "install",
-                    "--no-deps", "--no-index", "-q", str(wheel)], check=True, timeout=240)
+                    "--no-deps", "--no-index", "-q", str(wheel)], check=True, timeout=240,
+                   env=_elsewhere_env())
     return venv
+
+
+def _elsewhere_env():
+    """This environment without what would lead another Python to this checkout or venv."""
+    return {key: value for key, value in os.environ.items()
+            if key not in ("PYTHONPATH", "VIRTUAL_ENV", "PYTHONHOME")}
 
 
 def _elsewhere(tmp_path):
     folder = tmp_path / "elsewhere"
     folder.mkdir()
-    env = {key: value for key, value in os.environ.items()
-           if key not in ("PYTHONPATH", "VIRTUAL_ENV", "PYTHONHOME")}
-    return folder, env
+    return folder, _elsewhere_env()
 
 
 def test_the_installed_wheel_runs_the_hsr_task_outside_the_checkout(repo, fresh_venv,

@@ -10,12 +10,11 @@ Needs Debian's `chromium` and Playwright from PyPI, as tests/e2e/test_browser_en
 
 import json
 import re
-import subprocess
 import sys
 import time
 
 import pytest
-from browser_page import NEEDS_BROWSER, Output, free_port, open_page
+from browser_page import NEEDS_BROWSER, free_port, open_page, running
 
 from pbp_drake.console.questionnaire import answer_labels, next_label, start_label
 from pbp_drake.console.text import method_name
@@ -62,22 +61,20 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
                "--operator", "keyboard", "--participant", "P03", "--duration", str(DURATION),
                "--port", str(free_port()), "--output", str(output),
                "--wait-for-browser", "60"]
-    process = subprocess.Popen(command, cwd=repo, stdin=subprocess.DEVNULL,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     seen = {}
-    try:
-        lines = Output(process.stdout)
+    with running(command, cwd=repo) as (process, lines):
         url = lines.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{lines.text()}"
         with open_page(url.group(1), (800, 600), timeout_ms=30_000) as page:
             for position, method in enumerate(order, start=1):
                 click(page, start_label(method, position, len(order)))
-                # The keys work once the page has the keyboard operator's buttons,
-                # which come with the run: press at once, while it runs.
+                # The keys work once the page has the keyboard operator's buttons and
+                # this method's run has started (its title shows as it starts; the
+                # buttons may be the last method's still): press at once, while it runs.
                 page.wait_for_selector("text=Left (←)", state="attached")
-                hold_left(page, 1.5)
                 name = re.escape(method_name(method))
                 control(page, f"{name}, seed 0").wait_for(state="attached")
+                hold_left(page, 1.5)
                 control(page, r"time left \d+ s · \d+ target switch(es)? · "
                         r"intervention \d+ %").wait_for(state="attached")
                 seen[method] = {b: control(page, b).count()
@@ -92,10 +89,6 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
         done = lines.wait_for(r"^Session saved in ", timeout=60)
         assert done, f"the session did not end:\n{lines.text()}"
         process.wait(timeout=30)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait(timeout=10)
     assert seen == {m: {"Stop": 1, "Restart": 1, "Next scene": 1} for m in order}
     assert json.loads((output / "questionnaire.json").read_text()) == {
         method: {"tiredness": t, "ease": e} for method, (t, e) in ANSWERS.items()}

@@ -166,9 +166,11 @@ def test_damaged_shipped_files_load_and_run_or_name_a_field(name, data):
     _check_damaged(name, *data.draw(damaged(name)))
 
 
+# 100 more a file (others than the fast test's 40: derandomize seeds the draws by the test),
+# 140 a file in all; 200 more took about 50 s of the suite, where these take half.
 @pytest.mark.slow
 @pytest.mark.parametrize("name", FILES)
-@settings(max_examples=200, **SETTINGS)
+@settings(max_examples=100, **SETTINGS)
 @given(data=st.data())
 def test_many_more_damaged_files(name, data):
     _check_damaged(name, *data.draw(damaged(name)))

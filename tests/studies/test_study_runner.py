@@ -89,6 +89,9 @@ def test_jobs_1_and_2_write_the_same_summary_bytes(studies):
         assert "collision_ratio" not in entry and "collision_free_trials" not in entry
     assert summary["measures_collisions"] is False
     assert "collision_histogram_edges" not in summary
+    # Reaching measures no collisions: no Fig. 7c, no collision column in the table.
+    assert not (one / "fig7c_collisions.png").exists()
+    assert "collision" not in (one / "results.md").read_text()
     # Seeds 5 and 6 lie below the default evaluation seeds (10,000): the tuning split.
     assert summary["split"] == "tuning" and summary["seeds"] == [5, 6]
     assert (one / "results.md").read_text().startswith("Seeds 5 to 6: tuning seeds")

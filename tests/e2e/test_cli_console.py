@@ -75,9 +75,12 @@ def test_a_closed_pipe_ends_report_quietly(repo, tmp_path):
 
 @pytest.mark.timeout(60)
 def test_ctrl_c_ends_a_run_without_a_traceback(repo):
+    # As from a terminal: a suite started in the background (`make test &`) has SIGINT
+    # ignored, and a child inherits that; the run must get the person's Ctrl-C.
     process = subprocess.Popen([sys.executable, "-m", "pbp_drake", "run", QUICK], cwd=repo,
                                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
+                               stderr=subprocess.PIPE, text=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert process.stdout.readline().startswith("Meshcat: http://")
     time.sleep(0.5)  # into the 3 s of the scene, run at real time
     process.send_signal(signal.SIGINT)

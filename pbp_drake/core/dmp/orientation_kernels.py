@@ -175,11 +175,19 @@ def log_into(quaternions, out, workspace):
         np.copysign(ws.ratio, quaternions[0], out=ws.coefficient)
     else:
         # Some w = 0 exactly (180 degrees): the first nonzero of x, y, z decides.
-        np.sign(quaternions[0], out=ws.row)
-        for component in vector:
-            np.copyto(ws.row, np.sign(component), where=ws.row == 0.0)
+        hemisphere_signs_into(quaternions[0], vector, ws.row)
         np.multiply(ws.ratio, ws.row, out=ws.coefficient)
     np.multiply(vector, ws.coefficient, out=out)
+
+
+def hemisphere_signs_into(w, vector, out):
+    """`quaternion.hemisphere_signs` in place into `out` (K,), from the scalar parts `w`
+    (K,) and the vector parts `vector` (3, K): the sign of `w`, or for `w = 0` exactly that
+    of the first nonzero of x, y, z."""
+    np.sign(w, out=out)
+    for component in vector:
+        np.copyto(out, np.sign(component), where=out == 0.0)
+    return out
 
 
 def exp_into(rotation_vectors, out, workspace):

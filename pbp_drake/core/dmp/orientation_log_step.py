@@ -34,7 +34,7 @@ sign rule of `quaternion.canonical`, as `orientation_kernels.log_into`.
 
 import numpy as np
 
-from pbp_drake.core.dmp.orientation_kernels import SMALLEST
+from pbp_drake.core.dmp.orientation_kernels import SMALLEST, hemisphere_signs_into
 from pbp_drake.core.quaternion import SERIES_BELOW
 
 # The squared half angle below which `c` and `p` come from their series (the angle below
@@ -123,9 +123,7 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
     else:
         # Some w = 0 exactly (180 degrees): the first nonzero of x, y, z decides the sign,
         # as `quaternion.canonical`.
-        np.sign(w, out=ws.row)
-        for component in vector:
-            np.copyto(ws.row, np.sign(component), where=ws.row == 0.0)
+        hemisphere_signs_into(w, vector, ws.row)
         np.abs(w, out=half)
         np.arctan2(ratio, half, out=half)
         half *= ws.row

@@ -5,15 +5,17 @@ import dataclasses
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.core.goal_estimation import GoalEstimatorSettings, SelectionMemory
-from pbp_drake.core.grasp_estimation import estimate_pose
+from pbp_drake.core.goal_estimation import (
+    GoalEstimatorSettings, SelectionMemory, update_selection)
+from pbp_drake.core.grasp_estimation import pose_probabilities
 from pbp_drake.systems.layouts import GoalPose, OperatorTwist, PoseState
 from pbp_drake.systems.tick import decide_offset
 
 
 class PoseGoalEstimator(LeafSystem):
     """Estimates the intended grasp pose every control period
-    (`pbp_drake.core.grasp_estimation.estimate_pose`).
+    (`pbp_drake.core.grasp_estimation.pose_probabilities` and the shipped hysteresis,
+    `goal_estimation.update_selection`).
 
     .. pydrake_system::
 
@@ -95,17 +97,19 @@ class PoseGoalEstimator(LeafSystem):
         hand = np.asarray(self._hand_port.Eval(context), float)
         goals = np.asarray(self._goals_port.Eval(context), float).reshape(
             self._goal_count, GoalPose.size)
-        twist = (np.asarray(self._twist_port.Eval(context), float)
-                 if self._twist_port.HasValue(context) else hand[7:13])
-        result = estimate_pose(self._settings, goals[:, :3], goals[:, 3:], hand[:3],
-                               hand[3:7] / np.linalg.norm(hand[3:7]), twist[:3], twist[3:],
-                               memory)
-        if memory is not None and self._twist_port.HasValue(context) and not twist.any():
+        operator = self._twist_port.HasValue(context)
+        twist = np.asarray(self._twist_port.Eval(context), float) if operator else hand[7:13]
+        probabilities = pose_probabilities(
+            self._settings, goals[:, :3], goals[:, 3:], hand[:3],
+            hand[3:7] / np.linalg.norm(hand[3:7]), twist[:3], twist[3:])
+        if memory is not None and operator and not twist.any():
             # The operator gives no input: no new evidence of intent, so the selection
             # holds (the probabilities still follow the hand).
-            result = result._replace(memory=SelectionMemory(memory.selected),
-                                     selected=memory.selected)
-        state.get_mutable_vector(self._selected_index).set_value([result.selected])
-        state.get_mutable_vector(self._probabilities_index).set_value(result.probabilities)
+            memory = SelectionMemory(memory.selected)
+        else:
+            memory = update_selection(probabilities, memory, self._settings.margin,
+                                      self._settings.hold_steps)
+        state.get_mutable_vector(self._selected_index).set_value([memory.selected])
+        state.get_mutable_vector(self._probabilities_index).set_value(probabilities)
         state.get_mutable_vector(self._memory_index).set_value(
-            [result.memory.challenger, result.memory.count])
+            [memory.challenger, memory.count])

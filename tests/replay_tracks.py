@@ -10,6 +10,7 @@ import re
 
 import msgpack
 import numpy as np
+from pydrake.systems.analysis import Simulator
 
 _PAYLOAD = re.compile(r'fetch\("data:application/octet-binary;base64,([^"]+)"\)')
 
@@ -41,3 +42,12 @@ def value_at(tracks, path, track, time):
     """The value of `track` of `path` at its key nearest `time`."""
     times, values = tracks[path, track]
     return values[int(np.argmin(np.abs(times - time)))]
+
+
+def recorded(meshcat, diagram, duration):
+    """The animation tracks of a recording of `duration` seconds of `diagram` in `meshcat`."""
+    meshcat.StartRecording(frames_per_second=30.0)
+    Simulator(diagram).AdvanceTo(duration)
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    return animation_tracks(meshcat.StaticHtml())

@@ -9,7 +9,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
-from replay_tracks import animation_tracks, commands, value_at
+from replay_tracks import commands, recorded, value_at
 
 from pbp_drake.core.grasp_task import (
     approach_direction, sample_grasp_scene, side_grasp_orientation)
@@ -66,14 +66,6 @@ def test_every_grasp_pose_is_drawn_as_a_triad_on_initialisation(meshcat):
     assert not any(meshcat.HasPath(path) for path in triads)
     Simulator(diagram).Initialize()
     assert all(meshcat.HasPath(path) for path in triads)
-
-
-def recorded(meshcat, diagram, duration):
-    meshcat.StartRecording(frames_per_second=30.0)
-    Simulator(diagram).AdvanceTo(duration)
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
-    return animation_tracks(meshcat.StaticHtml())
 
 
 def test_a_replay_moves_and_turns_the_predicted_paths_triads(meshcat):

@@ -12,7 +12,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
-from replay_tracks import animation_tracks, value_at
+from replay_tracks import recorded, value_at
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import load_scenario_file
@@ -102,15 +102,6 @@ def test_the_scene_comes_back_after_a_delete_and_in_a_second_run(meshcat, make, 
     Simulator(diagram).AdvanceTo(0.1)  # a second simulator on the same diagram
     assert drawn(meshcat, paths) == paths
 
-
-
-def recorded(meshcat, diagram, duration):
-    """The animation tracks of a recording of `duration` seconds of `diagram`."""
-    meshcat.StartRecording(frames_per_second=30.0)
-    Simulator(diagram).AdvanceTo(duration)
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
-    return animation_tracks(meshcat.StaticHtml())
 
 
 def test_a_2d_replay_shows_the_dmp_path_from_where_the_robot_is_at_each_time(repo, meshcat):

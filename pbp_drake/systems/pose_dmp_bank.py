@@ -25,18 +25,23 @@ _STEPPING, _ON_ROBOT, _AT_START = 0.0, 1.0, 2.0
 
 
 class PoseWorkspace:
-    """Scratch of one Context: the two banks' workspaces, a phase, the orientation
-    readout's arrays (`eta` of every DMP when no followed goal is connected), and whether
-    the goals were recomputed since the last step (`goals_changed`: if not, the banks
-    reuse what they derived from the goals, without comparing K goals)."""
+    """Scratch of one Context: the two banks' workspaces, a phase, the linear velocities
+    the step starts from (`column`, the followed DMP's; `velocities`, every DMP's when no
+    followed goal is connected), the orientation readout's arrays (`eta` of every DMP when no followed goal is
+    connected), and whether the goals were recomputed since the last step
+    (`goals_changed`: if not, the banks reuse what they derived from the goals, without
+    comparing K goals)."""
 
-    __slots__ = ("position", "orientation", "phase", "orientations", "eta", "goals_changed")
+    __slots__ = ("position", "orientation", "phase", "column", "velocities", "orientations",
+                 "eta", "goals_changed")
 
     def __init__(self, position_bank, orientation_bank):
         k = position_bank.goal_count
         self.position = position_bank.make_workspace()
         self.orientation = orientation_bank.make_workspace()
         self.phase = np.empty(1)
+        self.column = np.empty((3, 1))
+        self.velocities = np.empty((3, k))
         self.orientations = np.empty((4, k))
         self.eta = np.empty((3, k))
         self.goals_changed = True
@@ -86,11 +91,14 @@ class PoseDmpBank(LeafSystem):
     `prediction_period` (default: the DMPs' duration over `prediction_steps`), for
     drawing: it is computed only when read (a visualizer's publish), never per tick.
 
-    The state is one vector `[phase, held, p (3), q (4), eta_held (3), z, dp, dz (3K each),
-    e', z' (3K each)]` (`_split` knows the layout): the position part as `DmpBank` keeps
-    it, and the orientation DMPs' stepped log coordinates `(e', z')` (`log_step_into`),
-    from which the outputs read the orientations and angular velocities on demand. The
-    bank updates at the decide stage of each tick (`update_offset` overrides it).
+    The state is one vector `[phase, held, p (3), q (4), eta_held (3), y' - p, z' (3K
+    each), e', z' (3K each)]` (`_split` knows the layout): the position DMPs' stepped
+    positions relative to the measured one and their stepped scaled velocities (`DmpBank`'s
+    `p + dp + Phi01 z` and `dz + Phi11 z`, summed at the step), and the orientation DMPs'
+    stepped log coordinates `(e', z')` (`log_step_into`), from which the outputs read the
+    orientations and angular velocities on demand: 12 K numbers, which Drake copies twice
+    at each update (at K = 10,000 that copying is a sixth of the step). The bank updates
+    at the decide stage of each tick (`update_offset` overrides it).
     """
 
     def __init__(self, position_bank, orientation_bank, control_period,
@@ -118,10 +126,10 @@ class PoseDmpBank(LeafSystem):
         self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         initial = np.zeros(self.state_size(k))
-        phase, held, _, q, _, _, dp, _, _ = self._split(initial)
+        phase, held, _, q, _, stepped, _ = self._split(initial)
         phase[0], held[0] = 1.0, _AT_START
         q[:, 0] = quaternion.IDENTITY
-        dp[...] = position_bank.starts
+        stepped[0] = position_bank.starts  # from p = 0 at the start
         self._state_index = self.DeclareDiscreteState(initial)
         self._goals_entry = self.DeclareCacheEntry(
             "goal poses, validated, (7, K): positions then quaternions",
@@ -161,7 +169,7 @@ class PoseDmpBank(LeafSystem):
     @staticmethod
     def state_size(goal_count):
         """The length of the one state vector (class docstring)."""
-        return 2 + 3 + 4 + 3 + 5 * 3 * goal_count
+        return 2 + 3 + 4 + 3 + 4 * 3 * goal_count
 
     @property
     def position_bank(self):
@@ -199,15 +207,14 @@ class PoseDmpBank(LeafSystem):
         return self._predicted_poses_port
 
     def _split(self, vector):
-        """Views: phase (1,), held (1,), p (3, 1), q (4, 1), eta_held (3, 1), z, dp, dz
-        (3, K) and the log coordinates (2, 3, K)."""
+        """Views: phase (1,), held (1,), p (3, 1), q (4, 1), eta_held (3, 1), the position
+        DMPs' stepped offsets `y' - p` and scaled velocities `z'` (2, 3, K), and the log
+        coordinates (2, 3, K)."""
         k = self._goal_count
-        z = 12
-        dp, dz, log = z + 3 * k, z + 6 * k, z + 9 * k
         return (vector[0:1], vector[1:2], vector[2:5].reshape(3, 1),
                 vector[5:9].reshape(4, 1), vector[9:12].reshape(3, 1),
-                vector[z:dp].reshape(3, k), vector[dp:dz].reshape(3, k),
-                vector[dz:log].reshape(3, k), vector[log:log + 6 * k].reshape(2, 3, k))
+                vector[12:12 + 6 * k].reshape(2, 3, k),
+                vector[12 + 6 * k:12 + 12 * k].reshape(2, 3, k))
 
     def _workspace(self, context):
         return self._workspace_entry.get_mutable_cache_entry_value(
@@ -244,8 +251,9 @@ class PoseDmpBank(LeafSystem):
 
     def _update(self, context, discrete_state):
         positions, orientations, period = self._positions, self._orientations, self._period
-        phase, held, robot, q, eta_held, z, dp, dz, log_state = self._split(
+        phase, held, robot, q, eta_held, stepped, log_state = self._split(
             discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
+        offsets, velocities = stepped
         # Every input before the workspace (an input may reach this system's outputs).
         position, orientation, velocity, angular_velocity = self._robot(context)
         lock = (self._lock and self._operator_active_port.HasValue(context)
@@ -253,22 +261,21 @@ class PoseDmpBank(LeafSystem):
         goals = self._goals_entry.Eval(context)
         followed = goal_index(self._followed_goal_port, context, self._goal_count)
         workspace = self._workspace(context)
-        # The DMPs' velocities at the end of the last step: linear read out in place, the
-        # orientation part's eta as a column (one for all) or per DMP.
+        # The DMPs' velocities at the end of the last step, which the step overwrites: the
+        # followed one's linear velocity (every DMP continues from it), else each one's,
+        # and the orientation part's eta as a column (one for all) or per DMP.
+        if followed is not None:
+            scaled_velocity = workspace.column
+            scaled_velocity[:, 0] = velocities[:, followed]
+        else:
+            scaled_velocity = workspace.velocities
+            np.copyto(scaled_velocity, velocities)
         if held[0] == _STEPPING:
+            _limit(scaled_velocity, self._max_speed, positions.duration)
             if followed is not None:
-                # Every DMP continues from the followed one's: its column alone is read
-                # out (the same arithmetic as all K), then copied to all.
-                column = slice(followed, followed + 1)
-                positions.stepped_velocity_into(dz[:, column], z[:, column], period,
-                                                z[:, column])
-                _limit(z[:, column], self._max_speed, positions.duration)
-                z[...] = z[:, column]
                 eta = jacobian_of_one(log_state[0, :, followed],
                                       log_state[1, :, followed])[:, np.newaxis]
             else:
-                positions.stepped_velocity_into(dz, z, period, z)
-                _limit(z, self._max_speed, positions.duration)
                 orientations.orientations_from_log_into(
                     log_state[0], log_state[1], goals[3:], q,
                     workspace.orientations, workspace.eta, workspace.orientation)
@@ -281,16 +288,17 @@ class PoseDmpBank(LeafSystem):
         if lock:
             # Both phases frozen: the DMPs sit at the hand's pose and follow its twist.
             held[0] = _ON_ROBOT
-            dp.fill(0.0)
-            np.multiply(velocity[:, np.newaxis], positions.duration, out=z)
+            offsets.fill(0.0)
+            np.multiply(velocity[:, np.newaxis], positions.duration, out=velocities)
             eta_held[:, 0] = angular_velocity * orientations.duration
             return
         held[0] = _STEPPING
         # Both banks reuse what they derived from the goals while the goals cache entry has
         # not been recomputed (they vouch for nothing else).
         unchanged = not workspace.goals_changed
-        positions.attractor_terms_into(phase, robot, goals[:3], period, dp, dz,
-                                       workspace.position, goals_unchanged=unchanged)
+        positions.stepped_from_one_into(phase, robot, scaled_velocity, goals[:3], period,
+                                        stepped, workspace.position,
+                                        goals_unchanged=unchanged)
         orientations.log_step_into(phase, q, eta, goals[3:], period, workspace.phase,
                                    log_state, workspace.orientation, goals_unchanged=unchanged)
         workspace.goals_changed = False
@@ -299,28 +307,20 @@ class PoseDmpBank(LeafSystem):
     def dmp_states(self, context):
         """The K DMPs after the last update: phases (K,), positions (3, K), orientations
         (4, K), and the scaled velocities `tau v` and `tau omega` (3, K), new arrays."""
-        positions, orientations, period = self._positions, self._orientations, self._period
-        phase, held, robot, q, eta_held, z, dp, dz, log_state = self._split(
+        phase, held, robot, q, eta_held, (offsets, velocities), log_state = self._split(
             context.get_discrete_state(self._state_index).get_value())
         k = self._goal_count
-        stepped = np.empty((3, k))
-        velocity = np.empty((3, k))
         rotations = np.empty((4, k))
         eta = np.empty((3, k))
         if held[0] != _STEPPING:
-            np.add(robot, dp, out=stepped)
-            velocity[...] = z
-            rotations[...] = orientations.starts if held[0] == _AT_START else q
+            rotations[...] = self._orientations.starts if held[0] == _AT_START else q
             eta[...] = eta_held
         else:
             goals = self._goals_entry.Eval(context)
-            workspace = self._workspace(context)
-            positions.stepped_positions_into(robot, dp, z, period, stepped,
-                                             workspace.position)
-            positions.stepped_velocity_into(dz, z, period, velocity)
-            orientations.orientations_from_log_into(log_state[0], log_state[1], goals[3:], q,
-                                                    rotations, eta, workspace.orientation)
-        return np.full(k, phase[0]), stepped, rotations, velocity, eta
+            self._orientations.orientations_from_log_into(
+                log_state[0], log_state[1], goals[3:], q, rotations, eta,
+                self._workspace(context).orientation)
+        return np.full(k, phase[0]), robot + offsets, rotations, np.array(velocities), eta
 
     def _calc_references(self, context, output):
         _, stepped, rotations, velocity, eta = self.dmp_states(context)
@@ -335,22 +335,20 @@ class PoseDmpBank(LeafSystem):
         k = goal_index(self._selected_goal_port, context, self._goal_count)
         if k is None:
             k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
-        _, held, robot, q, eta_held, z, dp, dz, log_state = self._split(
+        _, held, robot, q, eta_held, (offsets, velocities), log_state = self._split(
             context.get_discrete_state(self._state_index).get_value())
-        tau_v, tau_w = self._positions.duration, self._orientations.duration
+        position = robot[:, 0] + offsets[:, k]
+        velocity = velocities[:, k] / self._positions.duration
+        tau_w = self._orientations.duration
         if held[0] != _STEPPING:
             start = self._orientations.starts[:, k] if held[0] == _AT_START else q[:, 0]
-            return PoseReference(robot[:, 0] + dp[:, k], np.array(start), z[:, k] / tau_v,
-                                 eta_held[:, 0] / tau_w)
-        constants = self._positions.step_constants(self._period)
-        position = robot[:, 0] + dp[:, k] + constants.position_velocity * z[:, k]
-        velocity = dz[:, k] + constants.velocity_velocity * z[:, k]
+            return PoseReference(position, np.array(start), velocity, eta_held[:, 0] / tau_w)
         error, log_velocity = log_state[0, :, k], log_state[1, :, k]
         goal = self._goals_entry.Eval(context)[3:, k]
         rotation = quaternion.aligned(
             quaternion.multiply(quaternion.exp_map(error), goal), q[:, 0])
         eta = jacobian_of_one(error, log_velocity)
-        return PoseReference(position, rotation, velocity / tau_v, eta / tau_w)
+        return PoseReference(position, rotation, velocity, eta / tau_w)
 
     def _calc_selected_reference(self, context, output):
         output.SetFromVector(self.selected_reference(context).to_vector())
@@ -380,6 +378,13 @@ def _limit(scaled_velocities, max_speed, duration):
     hand-over holds back winds its own velocity up toward `beta (g - y) / tau`, far above
     what the hand may do (see `DmpBank._limit_speed`)."""
     if max_speed is None:
+        return
+    if scaled_velocities.shape[1] == 1:
+        # One column (every tick with a followed goal): plain floats, a fifth of the time.
+        x, y, z = scaled_velocities[:, 0].tolist()
+        speed = math.sqrt(x * x + y * y + z * z) / duration
+        if speed > max_speed:
+            scaled_velocities *= max_speed / speed
         return
     speeds = np.linalg.norm(scaled_velocities, axis=0) / duration
     too_fast = speeds > max_speed

@@ -167,6 +167,34 @@ def test_in_place_steps_with_a_workspace_and_predict_match_advance(shared):
         np.testing.assert_allclose(paths[:, step + 1], y.T, rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_the_step_from_one_position_matches_advance_with_followed_velocities(formulation,
+                                                                             shared):
+    # What Drake's pose bank keeps: `y' - p` and `z'` from one measured position, every DMP
+    # continuing from one DMP's velocity; with unchanged goals the distinct Ijspeert weights
+    # take the shortcut of contracting straight into the output (goals switched midway).
+    bank, _, goals = make_banks(formulation, shared, 40, 3, False, seed=4)
+    workspace = bank.make_workspace()
+    stepped = np.empty((2, 3, 40))
+    expected = bank.initial_state()
+    rng = np.random.default_rng(5)
+    for step in range(25):
+        if step in (0, 12):
+            goals_dk = bank.goals_matrix(goals if step == 0 else goals[::-1])
+            unchanged = False
+        robot = rng.uniform(-1.0, 1.0, (3, 1))
+        followed = step % 7
+        phase = expected[0]
+        expected = bank.advance(phase, robot, expected[2], goals_dk, DT, followed=followed)
+        column = (bank.initial_state()[2] if step == 0 else stepped[1])[:, followed:followed + 1]
+        bank.stepped_from_one_into(phase, robot, column.copy(), goals_dk, DT, stepped,
+                                   workspace, goals_unchanged=unchanged)
+        unchanged = True
+        np.testing.assert_allclose(robot + stepped[0], expected[1], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(stepped[1], expected[2], rtol=0, atol=1e-12)
+
+
 def _model_arrays(bank):
     return {name: value for name, value in vars(bank).items() if isinstance(value, np.ndarray)}
 

@@ -179,6 +179,47 @@ class BankStep:
             self._add_relative_attractor(out, shapes[row], lam[row], amplitudes,
                                          workspace.shape[row])
 
+    def stepped_from_one_into(self, phase, position, scaled_velocity, goals_dk, dt, out,
+                              workspace, goals_unchanged=False):
+        """The step of every DMP from ONE measured position `position` (D, 1) and the scaled
+        velocities `z` (D, 1: one for all, PBP's goal switch; or D, K): `out[0] = y' - p =
+        dp + Phi01 z` and `out[1] = z' = dz + Phi11 z` (`out` (2, D, K)), what Drake's pose
+        bank keeps. `goals_unchanged` as `attractor_terms_into`.
+
+        With weights kept multiplied by the amplitudes (distinct weights, Ijspeert, equal
+        phases, the goals unchanged) and one `z`, the weights are contracted straight into
+        `out`, then `-(Phi00 - 1, Phi10) g` (kept with the weights while the goals stay)
+        and one column, `(Phi00 - 1, Phi10) p + (Phi01, Phi11) z`, are added: two passes
+        over `out` instead of the seven of the attractor terms and the velocity's part."""
+        constants = self.step_constants(dt)
+        ws = workspace
+        if (goals_unchanged and scaled_velocity.shape[1] == 1 and self._ijspeert
+                and not self.shared_weights and ws.scaled_rows is not None
+                and (phase.size == 1 or phase.min() == phase.max())):
+            self._combined_shapes(phase, self.decay(dt), constants.combination, ws, True,
+                                  basis_only=True)
+            window = self._weight_rows.window(ws.basis)
+            weights = scaled_weights(self._weight_rows.weights, ws, *window)
+            self._weight_rows.contract_into(ws.basis, out.reshape(2, -1), weights, window)
+            if ws.goal_terms is None or ws.goal_terms_dt != dt:
+                ws.goal_terms = np.multiply(constants.offset_gains, goals_dk)
+                np.negative(ws.goal_terms, out=ws.goal_terms)
+                ws.goal_terms_dt = dt
+            out += ws.goal_terms
+            np.multiply(constants.offset_gains, position, out=ws.column)
+            ws.column[0] += constants.position_velocity * scaled_velocity
+            ws.column[1] += constants.velocity_velocity * scaled_velocity
+            out += ws.column
+            return
+        self.attractor_terms_into(phase, position, goals_dk, dt, out[0], out[1], ws,
+                                  goals_unchanged)
+        ws.goal_terms = None  # the next fast step recomputes them (the goals may be new)
+        velocity_part = ws.column[0] if scaled_velocity.shape[1] == 1 else ws.work
+        np.multiply(scaled_velocity, constants.position_velocity, out=velocity_part)
+        out[0] += velocity_part
+        np.multiply(scaled_velocity, constants.velocity_velocity, out=velocity_part)
+        out[1] += velocity_part
+
     def _scaled_terms_into(self, phase, positions, goals_dk, constants, decay, out_dp, out_dz,
                            workspace):
         """`attractor_terms_into` with distinct weights times the amplitudes `g - y0` of

@@ -29,11 +29,14 @@ class DmpWorkspace:
             are (None until a caller vouches for unchanged goals, see
             `BankStep.attractor_terms_into`): the one thing a workspace may keep between
             calls, and only for the caller that vouches.
+        goal_terms, goal_terms_dt: `-(Phi00 - 1, Phi10) g` (2, D, K) of those goals for
+            steps of `goal_terms_dt` (`BankStep.stepped_from_one_into`), kept likewise.
     """
 
     __slots__ = ("dimension", "goal_count", "basis_count", "phases", "scale", "psi", "basis",
                  "lam", "coefficients", "shape", "amplitude", "work", "dp", "dz", "alpha",
-                 "beta", "column", "scaled_weights", "scaled_rows")
+                 "beta", "column", "scaled_weights", "scaled_rows", "goal_terms",
+                 "goal_terms_dt")
 
     def __init__(self, dimension, goal_count, basis_count):
         d, k, n = dimension, goal_count, basis_count
@@ -53,3 +56,4 @@ class DmpWorkspace:
         self.beta = np.empty((2, d, 1))
         self.column = np.empty((2, d, 1))
         self.scaled_weights = self.scaled_rows = None
+        self.goal_terms, self.goal_terms_dt = None, None

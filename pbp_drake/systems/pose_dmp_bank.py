@@ -112,6 +112,10 @@ class PoseDmpBank(LeafSystem):
         self._max_angular_speed = (None if max_angular_speed is None
                                    else float(max_angular_speed))
         self._positions, self._orientations = position_bank, orientation_bank
+        # Equal settings and durations: both parts' steps contract one basis (the position
+        # step's, passed on to the orientation step).
+        self._shared_basis = (position_bank.settings == orientation_bank.settings
+                              and position_bank.duration == orientation_bank.duration)
         self._period = float(control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         if update_offset is None:
@@ -299,8 +303,11 @@ class PoseDmpBank(LeafSystem):
         positions.stepped_from_one_into(phase, robot, scaled_velocity, goals[:3], period,
                                         stepped, workspace.position,
                                         goals_unchanged=unchanged)
+        basis = ((workspace.position.basis, workspace.position.lam) if self._shared_basis
+                 else None)
         orientations.log_step_into(phase, q, eta, goals[3:], period, workspace.phase,
-                                   log_state, workspace.orientation, goals_unchanged=unchanged)
+                                   log_state, workspace.orientation, goals_unchanged=unchanged,
+                                   basis=basis)
         workspace.goals_changed = False
         phase *= positions.decay(period)
 

@@ -307,7 +307,7 @@ class OrientationDmpBank:
                                         orientations, out_orientations, out_velocity, ws)
 
     def log_step_into(self, phase, orientations, velocity, goals_4k, dt, out_phase,
-                      out_log_state, workspace, goals_unchanged=False):
+                      out_log_state, workspace, goals_unchanged=False, basis=None):
         """The free step in log coordinates: `e = Log(q g*)` and `z = J(e)^-1 eta` from the
         measured orientations `(4, 1)` or `(4, K)` (unit) and `eta` `(3, K)` or `(3, 1)`
         (one for all: PBP's goal switch), stepped as the position bank steps `(y, z)`:
@@ -316,7 +316,10 @@ class OrientationDmpBank:
 
         `goals_unchanged=True` vouches that `goals_4k` holds the goals of this workspace's
         last step (Drake's pose bank knows when its goals were recomputed): the start
-        errors are then reused without comparing the goals."""
+        errors are then reused without comparing the goals. `basis`: the step's combined
+        basis `(2, N)` and `lambda` `(2, 1)` when the caller has them already (a position
+        bank of the same settings and duration stepped at the same phase: its workspace's
+        `basis` and `lam`), used with distinct Ijspeert weights at equal phases."""
         ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)
@@ -326,7 +329,7 @@ class OrientationDmpBank:
         if orientations.shape[1] == 1 and velocity.shape[1] == 1:
             # One orientation and one velocity for all: fused, `b` within
             # (`orientation_log_step`).
-            lam = self._scaled_forcing(phase, decay, constants.combination, ws)
+            lam = self._scaled_forcing(phase, decay, constants.combination, ws, basis)
             if lam is None:
                 shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
                 forcing = forcing_rows(shapes, lam, self._ijspeert, ws)
@@ -391,15 +394,17 @@ class OrientationDmpBank:
         scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
         return combination @ scaled.T, (combination @ phases)[:, np.newaxis]
 
-    def _scaled_forcing(self, phase, decay, combination, workspace):
+    def _scaled_forcing(self, phase, decay, combination, workspace, basis=None):
         """Ijspeert, distinct weights and equal phases: `b = S (-e0)` straight into the
         workspace's `shape`, from the weights already multiplied by `-e0`
         (`contraction.scaled_weights`:
         the rows that matter, kept while the goals stay), so no pass multiplies `S`; the
         start errors must be the goals'. Returns `lambda`, or None in any other case."""
-        if not self._ijspeert or self.shared_weights or phase.min() != phase.max():
+        if (not self._ijspeert or self.shared_weights
+                or (phase.size > 1 and phase.min() != phase.max())):
             return None
-        basis, lam = self._equal_phase_basis(phase, decay, combination)
+        basis, lam = (self._equal_phase_basis(phase, decay, combination) if basis is None
+                      else basis)
         window = self._weight_rows.window(basis)
         weights = scaled_weights(self._weights, workspace, *window)
         self._weight_rows.contract_into(basis, workspace.shape.reshape(2, -1), weights, window)

@@ -184,7 +184,9 @@ class BankStep:
         """The step of every DMP from ONE measured position `position` (D, 1) and the scaled
         velocities `z` (D, 1: one for all, PBP's goal switch; or D, K): `out[0] = y' - p =
         dp + Phi01 z` and `out[1] = z' = dz + Phi11 z` (`out` (2, D, K)), what Drake's pose
-        bank keeps. `goals_unchanged` as `attractor_terms_into`.
+        bank keeps. `goals_unchanged` as `attractor_terms_into`. With equal phases the step's
+        combined basis and `lambda` are left in `workspace.basis` and `workspace.lam` (an
+        orientation bank of the same settings steps with them: `log_step_into`'s `basis`).
 
         With weights kept multiplied by the amplitudes (distinct weights, Ijspeert, equal
         phases, the goals unchanged) and one `z`, the weights are contracted straight into

@@ -329,12 +329,15 @@ class OrientationDmpBank:
         if orientations.shape[1] == 1 and velocity.shape[1] == 1:
             # One orientation and one velocity for all: fused, `b` within
             # (`orientation_log_step`).
-            lam = self._scaled_forcing(phase, decay, constants.combination, ws, basis)
+            # Distinct Ijspeert weights: `b` contracted straight into the output, to which
+            # the step adds the rest (`forcing` None); else `b` in the fused rows.
+            into = out_log_state if out_log_state.flags.c_contiguous else ws.shape
+            lam = self._scaled_forcing(phase, decay, constants.combination, ws, basis, into)
             if lam is None:
                 shapes, lam = self._combined_shapes(phase, decay, constants.combination, ws)
                 forcing = forcing_rows(shapes, lam, self._ijspeert, ws)
             else:
-                forcing = IDENTITY6  # `shape` is `b` already
+                forcing = None if into is out_log_state else IDENTITY6
             phi = ((1.0 + constants.position_offset, constants.position_velocity),
                    (constants.velocity_offset, constants.velocity_velocity))
             log_step_from_one_into(orientations, velocity, goals_4k, phi, forcing,
@@ -394,9 +397,9 @@ class OrientationDmpBank:
         scaled = normalized_basis(phases, self._centres, self._widths) * (phases * scale)
         return combination @ scaled.T, (combination @ phases)[:, np.newaxis]
 
-    def _scaled_forcing(self, phase, decay, combination, workspace, basis=None):
-        """Ijspeert, distinct weights and equal phases: `b = S (-e0)` straight into the
-        workspace's `shape`, from the weights already multiplied by `-e0`
+    def _scaled_forcing(self, phase, decay, combination, workspace, basis=None, out=None):
+        """Ijspeert, distinct weights and equal phases: `b = S (-e0)` straight into `out`
+        (2, 3, K) (default: the workspace's `shape`), from the weights already multiplied by `-e0`
         (`contraction.scaled_weights`:
         the rows that matter, kept while the goals stay), so no pass multiplies `S`; the
         start errors must be the goals'. Returns `lambda`, or None in any other case."""
@@ -407,7 +410,8 @@ class OrientationDmpBank:
                       else basis)
         window = self._weight_rows.window(basis)
         weights = scaled_weights(self._weights, workspace, *window)
-        self._weight_rows.contract_into(basis, workspace.shape.reshape(2, -1), weights, window)
+        out = workspace.shape if out is None else out
+        self._weight_rows.contract_into(basis, out.reshape(2, -1), weights, window)
         return lam
 
     def _combined_shapes(self, phase, decay, combination, workspace):

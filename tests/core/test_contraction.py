@@ -29,14 +29,23 @@ def test_windowed_product_is_the_full_product(phase, block_bytes):
     assert np.all(np.abs(out - full) <= 1e-14 * scale)
 
 
-@pytest.mark.parametrize("phase", [1.0, 0.5, 0.05, 0.01])
+@pytest.mark.parametrize("phase", [1.0, 0.5, 0.05, 0.01, 1e-3, 1e-6, 1e-8])
 def test_the_window_reads_a_quarter_of_the_rows_or_fewer(phase):
-    """Over the movement (phase 1 to 0.01 at t = tau). Long after it, at phases far below
-    the last centre, the narrow first functions weigh as much as the last ones, and the
-    window widens to all rows, exactly as it should."""
-    rows = WeightRows(np.random.default_rng(4).normal(size=(50, 30)), 800_000)
-    first, stop = rows.window(_basis_rows(phase))
+    """Over the movement (phase 1 to 0.01 at t = tau) and long after it (1e-6 at 3 tau):
+    at phases far below the last centre every function is a nearly equal tiny share, so
+    relative to the largest term every row matters, but all but the last few add less than
+    2^-53, and the window must not read every row then. (Between, near phase 1e-4 at
+    2 tau, rows of 1e-17 are still kept with a fit's weights: the window widens there.)
+    The basis as the Ijspeert bank contracts it, over the stiffness; a fit's weights."""
+    weights = np.random.default_rng(4).normal(0.0, 1e3, (50, 30))
+    rows = WeightRows(weights, 800_000)
+    basis = _basis_rows(phase) / DmpSettings().stiffness
+    first, stop = rows.window(basis)
     assert stop - first <= 12
+    out = np.empty((2, 30))
+    rows.contract_into(basis, out)
+    full = basis @ weights
+    assert np.all(np.abs(out - full) <= 2.0 ** -53 + 1e-15 * np.abs(full))
 
 
 def test_zero_weights_give_zero_shapes():

@@ -8,14 +8,22 @@ weights are laid out `(N, M)`, so the rows that matter are one contiguous slice,
 product reads a quarter of the bytes (the step's cost at large K is reading the weights).
 
 Exactness: a row n is left out only when `max_r |b_rn| max_m |W_nm|` (the largest term it
-could add to any column) is below `2^-53 / N` of the largest such bound over the rows; the
-rows left out then add, together, less than one rounding unit of the largest term, which
-is below the rounding error the full product makes anyway (`N` rounding units of it).
+could add to any column) is below `2^-53 / N` of the largest such bound over the rows, or
+below `2^-53 / N` itself; the rows left out then add, together, less than one rounding unit
+of the largest term, which is below the rounding error the full product makes anyway (`N`
+rounding units of it), or less than `2^-53`. The second bound is what keeps the window
+narrow after the movement: at phases far below the last centre every function is a tiny,
+nearly equal share of the sum (the narrow last one fades as fast as the wide first ones),
+so that relative to the largest term every row matters, while all the rows but the last
+few add less than `1e-20`. The banks' weights are per unit of what the product is added to
+or multiplied by (the Ijspeert form's shape is multiplied by the amplitude `g - y0`, per
+column; Pastor's is in metres or radians), so `2^-53` is one rounding unit of the amplitude
+(of a position or angle of magnitude 1), far below what a position or orientation keeps.
 """
 
 import numpy as np
 
-# The most the left-out rows may add, over the largest row's bound, per row.
+# The most the left-out rows may add, over the largest row's bound (or absolutely), per row.
 _RELATIVE_PER_ROW = 2.0 ** -53
 
 
@@ -43,9 +51,11 @@ class WeightRows:
         bounds = np.maximum(np.abs(basis[0]), np.abs(basis[1]))
         bounds *= self.row_bounds
         largest = np.maximum.reduce(bounds)
-        kept = (bounds >= largest * (_RELATIVE_PER_ROW / bounds.size)).nonzero()[0]
-        if kept.size == 0 or largest == 0.0:
-            return 0, 1  # every term is 0: any one row gives the exact 0
+        floor = max(largest, 1.0) * (_RELATIVE_PER_ROW / bounds.size)
+        kept = (bounds >= floor).nonzero()[0]
+        if kept.size == 0:
+            first = int(np.argmax(bounds))  # every term is below 2^-53 / N: the largest
+            return first, first + 1
         return int(kept[0]), int(kept[-1]) + 1
 
     def contract_into(self, basis, out, weights=None, window=None):

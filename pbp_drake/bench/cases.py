@@ -9,12 +9,17 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
+from pbp_drake.bench.timing import timed_span
 from pbp_drake.core.dmp import DmpBank, DmpSettings, fit_weights, minimum_jerk
 from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
 from pbp_drake.systems.goals_source import GoalsSource
 
 BASIS = 50
 DT = 0.001  # a 1 kHz control loop
+# The LeafSystem checks time a whole movement and as long again after it: the phase goes
+# from 1 to 0.01 at tau, then to 1e-4. A step's cost moves with the phase (how many weight
+# rows matter), so the first moments alone could hide a slow stretch.
+MOTION_DURATIONS = 2.0
 
 
 @dataclasses.dataclass
@@ -105,3 +110,13 @@ def leaf_step(simulator, steps):
         context = simulator.get_context()
         simulator.AdvanceTo(context.get_time() + steps * DT)
     return step
+
+
+def motion_timing(simulator, duration, periods):
+    """Seconds per period of a fresh Simulator run over a whole movement of `duration` and as
+    long after it (`MOTION_DURATIONS`), in timed calls of `periods` periods: the median, and
+    the slowest eighth's median (a quarter of `duration`)."""
+    end = MOTION_DURATIONS * duration - 0.5 * DT
+    median, slowest, _ = timed_span(leaf_step(simulator, periods),
+                                    lambda: simulator.get_context().get_time() >= end)
+    return median / periods, slowest / periods

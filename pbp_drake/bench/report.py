@@ -69,6 +69,16 @@ def format_report(report):
                          f"(each DMP its own velocities: {_fmt(row['leaf_own_us'])} us), "
                          + (f"{versus:.2f}x the position bank" if versus else
                             "no position row"))
+    moving = [row for row in report["steps"] if row.get("leaf_motion_us") is not None]
+    if moving:
+        lines.append("")
+        lines.append("In the LeafSystem over a whole movement and as long after it (a fresh "
+                     "Simulator, phase 1 to 1e-4, 0 to 2 tau): median per period, and the "
+                     "slowest quarter tau's median:")
+        for row in moving:
+            lines.append(f"  D = {_dimension(row)} K = {row['K']:>6} {row['weights']:>8}: "
+                         f"{_fmt(row['leaf_motion_us'])} us (slowest "
+                         f"{_fmt(row['leaf_slowest_us'])} us)")
     if report["closed_loop"]:
         lines.append("")
         lines.append("Closed loop, HSR reaching task (straight-path DMPs, virtual participant, "

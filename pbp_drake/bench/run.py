@@ -13,8 +13,8 @@ from pydrake.geometry import Meshcat, MeshcatParams
 
 import pbp_drake.bench
 from pbp_drake.bench.cases import (
-    BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case)
-from pbp_drake.bench.checks import PEERS, evaluate, exit_code
+    BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_timing)
+from pbp_drake.bench.checks import MOTION_ROWS, PEERS, evaluate, exit_code
 from pbp_drake.bench.closed_loop import HSR_KS, hsr_speed
 from pbp_drake.bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
@@ -176,6 +176,11 @@ def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have
         median, minimum, _ = timed(leaf_step(simulator, periods), min_time, warmup=1)
         row[f"{label}_us"] = microseconds(median / periods)
         row[f"{label}_min_us"] = microseconds(minimum / periods)
+        del simulator
+    if ((dimension, goal_count, row["weights"]), False) in MOTION_ROWS:
+        simulator = leaf_simulator(case, make_bank(case))
+        motion, slowest = motion_timing(simulator, bank.duration, periods)
+        row.update(leaf_motion_us=microseconds(motion), leaf_slowest_us=microseconds(slowest))
         del simulator
     del bank
 

@@ -21,6 +21,20 @@ def timed(step, min_time, max_repeats=5000, min_repeats=3, warmup=2):
     return float(np.median(samples)), float(samples.min()), len(samples)
 
 
+def timed_span(step, done, stretches=8):
+    """Seconds of `step()` repeated until `done()`: the median, the largest median of
+    `stretches` equal consecutive stretches of the repeats (for a step whose cost moves
+    along the run), and the number of repeats."""
+    samples = []
+    while not done():
+        start = time.perf_counter()
+        step()
+        samples.append(time.perf_counter() - start)
+    slowest = max(float(np.median(part)) for part in np.array_split(
+        np.array(samples), min(stretches, len(samples))))
+    return float(np.median(samples)), slowest, len(samples)
+
+
 def memory_bandwidth(megabytes=400, cache_megabytes=12, repeats=5):
     """GB/s of a NumPy sum (read) and copy (read + write) of a large array, and of a sum of
     an array the size of the weights of K = 10,000, D = 3 (which may stay in cache)."""

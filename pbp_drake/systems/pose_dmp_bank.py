@@ -27,10 +27,9 @@ _STEPPING, _ON_ROBOT, _AT_START = 0.0, 1.0, 2.0
 class PoseWorkspace:
     """Scratch of one Context: the two banks' workspaces, a phase, the linear velocities
     the step starts from (`column`, the followed DMP's; `velocities`, every DMP's when no
-    followed goal is connected), the orientation readout's arrays (`eta` of every DMP when no followed goal is
-    connected), and whether the goals were recomputed since the last step
-    (`goals_changed`: if not, the banks reuse what they derived from the goals, without
-    comparing K goals)."""
+    followed goal is connected), the orientation readout's arrays (`eta` of every DMP,
+    likewise), and whether the goals were recomputed since the last step (`goals_changed`:
+    if not, the banks reuse what they derived from the goals, without comparing K goals)."""
 
     __slots__ = ("position", "orientation", "phase", "column", "velocities", "orientations",
                  "eta", "goals_changed")

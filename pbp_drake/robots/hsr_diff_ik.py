@@ -1,6 +1,8 @@
 """The HSR station's whole-body differential IK: a velocity plan within the joints'
 position, velocity and acceleration limits, and the desired state the plant's PD tracks."""
 
+import math
+
 import numpy as np
 from numpy.linalg import _umath_linalg
 from pydrake.common.value import AbstractValue
@@ -48,6 +50,11 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     ``hold`` guesses which variables end at a bound (-1 lower, 1 upper, 0 neither), such
     as the last solution's; a good guess saves iterations, and any guess gives the same
     minimum. Returns the minimizer and which variables it holds at a bound.
+
+    Every value is computed by numpy as before; which variables are out of their bounds,
+    block a step or leave a bound is decided on Python lists (a few entries: a numpy call
+    per test cost more than the test), and the system solved is kept from one iteration to
+    the next, a row changed where a variable is held or let go.
     """
     n = g.size
     identity = _IDENTITIES.get(n)
@@ -56,49 +63,70 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     hold = np.zeros(n) if hold is None else np.asarray(hold)
     fixed = (hold != 0) | (lower == upper)
     x = np.clip(np.where(hold < 0, lower, np.where(hold > 0, upper, 0.0)), lower, upper)
-    tolerance = 1e-12 * (1.0 + np.abs(g).max())
-    movable = lower < upper
+    gs = g.tolist()
+    tolerance = 1e-12 * (1.0 + max(map(abs, gs)))
+    lows, highs = lower.tolist(), upper.tolist()
+    held = fixed.tolist()
+    system = np.where(fixed[:, None], identity, H)
+    rhs = g.copy()
     for iteration in range(max_iterations):
-        # The minimum over the free variables, the held ones where they are.
-        target = _solve_linear(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
+        # The minimum over the free variables, the held ones where they are: the system's
+        # rows and right side are H's and g's for a free variable (restored when it is let
+        # go), the identity's and x's for a held one.
+        np.copyto(rhs, x, where=fixed)
+        target = _solve_linear(system, rhs)
         np.copyto(target, x, where=fixed)
-        free = ~fixed
-        below, above = free & (target < lower), free & (target > upper)
-        outside = below | above
-        if outside.any():
+        values = target.tolist()
+        # The held variables sit exactly at a bound (set there by clip or assignment), so
+        # only a free one can be found out of its bounds.
+        outside = [i for i in range(n) if values[i] < lows[i] or values[i] > highs[i]]
+        if outside:
             if iteration == 0:
                 # The guess left these out of their bounds: hold them at the bounds
                 # they passed, and go on from there (a feasible point).
                 x = np.clip(target, lower, upper)
-                fixed |= outside
+                for i in outside:
+                    held[i] = fixed[i] = True
+                    system[i] = identity[i]
                 continue
-            # Go as far toward the minimum as the first bound in the way, and hold that
-            # variable there.
-            bound = np.where(below, lower, upper)
+            # Go as far toward the minimum as the first bound in the way (the first of
+            # the smallest ratios, as np.argmin), and hold that variable there.
             step = target - x
-            ratios = (bound[outside] - x[outside]) / step[outside]
-            k = int(np.argmin(ratios))
-            blocking = int(np.flatnonzero(outside)[k])
-            x = np.clip(x + ratios[k] * step, lower, upper)
-            x[blocking] = bound[blocking]
-            fixed[blocking] = True
+            start = x.tolist()
+            blocking, ratio = -1, 0.0
+            for i in outside:
+                bound = lows[i] if values[i] < lows[i] else highs[i]
+                candidate = (bound - start[i]) / (values[i] - start[i])
+                if blocking < 0 or candidate < ratio:
+                    blocking, ratio, blocking_bound = i, candidate, bound
+            x = np.clip(x + ratio * step, lower, upper)
+            x[blocking] = blocking_bound
+            held[blocking] = fixed[blocking] = True
+            system[blocking] = identity[blocking]
             continue
         x = target
         # Held variables whose bound the cost pulls away from are let go: all at once,
         # or the one pulled hardest once that has taken long (which always ends).
         gradient = H @ x - g
-        leaving = fixed & movable & (((x <= lower) & (gradient < -tolerance))
-                                     | ((x >= upper) & (gradient > tolerance)))
-        if not leaving.any():
-            if not np.isfinite(x).all():  # a singular system: raise as numpy does
+        slopes = gradient.tolist()
+        leaving = [i for i in range(n) if held[i] and lows[i] < highs[i] and (
+            (values[i] <= lows[i] and slopes[i] < -tolerance)
+            or (values[i] >= highs[i] and slopes[i] > tolerance))]
+        if not leaving:
+            if not all(map(math.isfinite, values)):  # a singular system: raise as numpy does
                 np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
                 raise np.linalg.LinAlgError("solve_box_qp met a singular system")
-            return x, np.where(fixed & (x <= lower), -1.0,
-                               np.where(fixed & (x >= upper), 1.0, 0.0))
-        if iteration < 2 * n:
-            fixed &= ~leaving
-        else:
-            fixed[int(np.argmax(np.abs(gradient) * leaving))] = False
+            return x, np.array([(-1.0 if values[i] <= lows[i] else
+                                 1.0 if values[i] >= highs[i] else 0.0) if held[i] else 0.0
+                                for i in range(n)])
+        if iteration >= 2 * n:
+            pulled = np.zeros(n, bool)
+            pulled[leaving] = True
+            leaving = [int(np.argmax(np.abs(gradient) * pulled))]
+        for i in leaving:
+            held[i] = fixed[i] = False
+            system[i] = H[i]
+            rhs[i] = gs[i]
     raise RuntimeError(f"solve_box_qp did not converge in {max_iterations} iterations")
 
 

@@ -1,6 +1,8 @@
 """The HSR station's whole-body differential IK: a velocity plan within the joints'
 position, velocity and acceleration limits, and the desired state the plant's PD tracks."""
 
+import math
+
 import numpy as np
 from numpy.linalg import _umath_linalg
 from pydrake.common.value import AbstractValue
@@ -48,6 +50,11 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     ``hold`` guesses which variables end at a bound (-1 lower, 1 upper, 0 neither), such
     as the last solution's; a good guess saves iterations, and any guess gives the same
     minimum. Returns the minimizer and which variables it holds at a bound.
+
+    Every value is computed by numpy as before; which variables are out of their bounds,
+    block a step or leave a bound is decided on Python lists (a few entries: a numpy call
+    per test cost more than the test), and the system solved is kept from one iteration to
+    the next, a row changed where a variable is held or let go.
     """
     n = g.size
     identity = _IDENTITIES.get(n)
@@ -56,49 +63,70 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     hold = np.zeros(n) if hold is None else np.asarray(hold)
     fixed = (hold != 0) | (lower == upper)
     x = np.clip(np.where(hold < 0, lower, np.where(hold > 0, upper, 0.0)), lower, upper)
-    tolerance = 1e-12 * (1.0 + np.abs(g).max())
-    movable = lower < upper
+    gs = g.tolist()
+    tolerance = 1e-12 * (1.0 + max(map(abs, gs)))
+    lows, highs = lower.tolist(), upper.tolist()
+    held = fixed.tolist()
+    system = np.where(fixed[:, None], identity, H)
+    rhs = g.copy()
     for iteration in range(max_iterations):
-        # The minimum over the free variables, the held ones where they are.
-        target = _solve_linear(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
+        # The minimum over the free variables, the held ones where they are: the system's
+        # rows and right side are H's and g's for a free variable (restored when it is let
+        # go), the identity's and x's for a held one.
+        np.copyto(rhs, x, where=fixed)
+        target = _solve_linear(system, rhs)
         np.copyto(target, x, where=fixed)
-        free = ~fixed
-        below, above = free & (target < lower), free & (target > upper)
-        outside = below | above
-        if outside.any():
+        values = target.tolist()
+        # The held variables sit exactly at a bound (set there by clip or assignment), so
+        # only a free one can be found out of its bounds.
+        outside = [i for i in range(n) if values[i] < lows[i] or values[i] > highs[i]]
+        if outside:
             if iteration == 0:
                 # The guess left these out of their bounds: hold them at the bounds
                 # they passed, and go on from there (a feasible point).
                 x = np.clip(target, lower, upper)
-                fixed |= outside
+                for i in outside:
+                    held[i] = fixed[i] = True
+                    system[i] = identity[i]
                 continue
-            # Go as far toward the minimum as the first bound in the way, and hold that
-            # variable there.
-            bound = np.where(below, lower, upper)
+            # Go as far toward the minimum as the first bound in the way (the first of
+            # the smallest ratios, as np.argmin), and hold that variable there.
             step = target - x
-            ratios = (bound[outside] - x[outside]) / step[outside]
-            k = int(np.argmin(ratios))
-            blocking = int(np.flatnonzero(outside)[k])
-            x = np.clip(x + ratios[k] * step, lower, upper)
-            x[blocking] = bound[blocking]
-            fixed[blocking] = True
+            start = x.tolist()
+            blocking, ratio = -1, 0.0
+            for i in outside:
+                bound = lows[i] if values[i] < lows[i] else highs[i]
+                candidate = (bound - start[i]) / (values[i] - start[i])
+                if blocking < 0 or candidate < ratio:
+                    blocking, ratio, blocking_bound = i, candidate, bound
+            x = np.clip(x + ratio * step, lower, upper)
+            x[blocking] = blocking_bound
+            held[blocking] = fixed[blocking] = True
+            system[blocking] = identity[blocking]
             continue
         x = target
         # Held variables whose bound the cost pulls away from are let go: all at once,
         # or the one pulled hardest once that has taken long (which always ends).
         gradient = H @ x - g
-        leaving = fixed & movable & (((x <= lower) & (gradient < -tolerance))
-                                     | ((x >= upper) & (gradient > tolerance)))
-        if not leaving.any():
-            if not np.isfinite(x).all():  # a singular system: raise as numpy does
+        slopes = gradient.tolist()
+        leaving = [i for i in range(n) if held[i] and lows[i] < highs[i] and (
+            (values[i] <= lows[i] and slopes[i] < -tolerance)
+            or (values[i] >= highs[i] and slopes[i] > tolerance))]
+        if not leaving:
+            if not all(map(math.isfinite, values)):  # a singular system: raise as numpy does
                 np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
                 raise np.linalg.LinAlgError("solve_box_qp met a singular system")
-            return x, np.where(fixed & (x <= lower), -1.0,
-                               np.where(fixed & (x >= upper), 1.0, 0.0))
-        if iteration < 2 * n:
-            fixed &= ~leaving
-        else:
-            fixed[int(np.argmax(np.abs(gradient) * leaving))] = False
+            return x, np.array([(-1.0 if values[i] <= lows[i] else
+                                 1.0 if values[i] >= highs[i] else 0.0) if held[i] else 0.0
+                                for i in range(n)])
+        if iteration >= 2 * n:
+            pulled = np.zeros(n, bool)
+            pulled[leaving] = True
+            leaving = [int(np.argmax(np.abs(gradient) * pulled))]
+        for i in leaving:
+            held[i] = fixed[i] = False
+            system[i] = H[i]
+            rhs[i] = gs[i]
     raise RuntimeError(f"solve_box_qp did not converge in {max_iterations} iterations")
 
 
@@ -178,16 +206,20 @@ class WholeBodyDiffIk(LeafSystem):
         self._q_nominal = np.asarray(q_nominal, float)
         # Per-step constants, computed once (the same products the step would compute).
         self._catch_up_time = CATCH_UP_STEPS * self._time_step
-        self._a_lower_step = self._a_lower * self._time_step
-        self._a_upper_step = self._a_upper * self._time_step
+        # The acceleration and position limits' pairs as rows, both bounds in one call.
+        self._a_step_bounds = np.stack([self._a_lower * self._time_step,
+                                        self._a_upper * self._time_step])
+        self._q_bounds = np.stack([self._q_lower, self._q_upper])
         self._centering_gain = np.broadcast_to(np.asarray(centering_gain, float), (nq,))
         self._identity = np.eye(nv)
         self._task_weights = TASK_WEIGHT * np.array([ROTATION_WEIGHT] * 3 + [1.0] * 3)
         self._world = plant.world_frame()
         self._origin = np.zeros(3)
         self._motor_count = len(motor_joints)
-        self._q_output = self._position_indices
-        self._v_output = nq + self._velocity_indices
+        # Where desired_state's [q_end, v] of the motors and the plan's end time sit in it.
+        self._desired_gather = np.concatenate([self._position_indices,
+                                               nq + self._velocity_indices])
+        self._t_end = nq + nv
         self._ramp = command_ramp
         self._pose_port = self._twist_port = self._command_port = None
         if command_ramp is None:
@@ -248,24 +280,31 @@ class WholeBodyDiffIk(LeafSystem):
         new_plan[2 * n + 1:] = hold
 
     def _desired(self, context):
-        """`(X_WE_desired, V_WE_desired)` now: from the ports, or from the command."""
+        """`X_WE_desired` (as its rotation and position) and `V_WE_desired` now: from the
+        ports, or from the command."""
         if self._ramp is None:
-            return self._pose_port.Eval(context), self._twist_port.Eval(context)
+            X_WE_desired = self._pose_port.Eval(context)
+            return (X_WE_desired.rotation(), X_WE_desired.translation(),
+                    self._twist_port.Eval(context))
         command = self._command_port.Eval(context)
         rate = self._ramp.heading_rate(context, self._last_heading, command)
-        return (self._ramp.pose(command, rate, context.get_time()),
+        return (*self._ramp.rotation_and_position(command, rate, context.get_time()),
                 self._ramp.velocity_into(command, rate, np.empty(6)))
 
-    def _solve(self, q, v, X_WE_desired, V_WE_desired, hold):
-        """The velocity for the next step, and which velocities it holds at a bound."""
+    def _solve(self, q, v, R_WE_desired, p_WE_desired, V_WE_desired, hold):
+        """The velocity for the next step, and which velocities it holds at a bound.
+
+        Each value is the same arithmetic as ever; lower and upper bounds are computed
+        together as the rows of (2, n) arrays (each row what its own expression gave), a
+        numpy call per pair fewer at 100 Hz."""
         plant, context, dt, world = self._plant, self._plant_context, self._time_step, self._world
         plant.SetPositions(context, q)
         X_WE = self._frame_E.CalcPose(context, world)
         J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, self._frame_E,
                                               self._origin, world, world)
-        rotation = (X_WE_desired.rotation() @ X_WE.rotation().inverse()).ToAngleAxis()
+        rotation = (R_WE_desired @ X_WE.rotation().inverse()).ToAngleAxis()
         gap = np.concatenate([rotation.axis() * rotation.angle(),
-                              X_WE_desired.translation() - X_WE.translation()])
+                              p_WE_desired - X_WE.translation()])
         twist = V_WE_desired + (gap - dt * V_WE_desired) / self._catch_up_time
         # The cost |J v - twist|² in the task weights D, with its part along the twist
         # weighing ALONG_WEIGHT of the rest: W = D - (1 - ALONG_WEIGHT) D t t' D / t'D t.
@@ -276,17 +315,21 @@ class WholeBodyDiffIk(LeafSystem):
         H, g = H0, g0
         norm = twist @ (self._task_weights * twist)
         if norm > 0:
-            H = H0 - (1.0 - ALONG_WEIGHT) / norm * (JDt[:, None] * JDt)  # np.outer's product
+            # np.outer's product, scaled in place: (1 - ALONG_WEIGHT) / norm * outer.
+            outer = np.multiply.outer(JDt, JDt)
+            outer *= (1.0 - ALONG_WEIGHT) / norm
+            H = np.subtract(H0, outer, out=outer)
             g = g0 + ALONG_WEIGHT * JDt
         # Within the velocity limits, the acceleration limits from v, and the position
         # limits by the end of the step; where the last two conflict, brake.
-        accel_lower = v + self._a_lower_step
-        accel_upper = v + self._a_upper_step
-        lower = np.maximum(np.maximum(self._v_lower, accel_lower), (self._q_lower - q) / dt)
-        upper = np.minimum(np.minimum(self._v_upper, accel_upper), (self._q_upper - q) / dt)
+        accel = v + self._a_step_bounds
+        reach = self._q_bounds - q
+        reach /= dt
+        lower = np.maximum(np.maximum(self._v_lower, accel[0]), reach[0])
+        upper = np.minimum(np.minimum(self._v_upper, accel[1]), reach[1])
         conflict = lower > upper
         if conflict.any():
-            lower[conflict] = upper[conflict] = np.clip(0.0, accel_lower, accel_upper)[conflict]
+            lower[conflict] = upper[conflict] = np.clip(0.0, accel[0], accel[1])[conflict]
         v_next, hold_next = solve_box_qp(H, g, lower, upper, hold)
         if not self._limit_overshoot:
             return v_next, hold_next
@@ -308,11 +351,11 @@ class WholeBodyDiffIk(LeafSystem):
         return v_next, hold_next
 
     def _calc_desired_state(self, context, output):
-        # Evaluated at every plant step: written into the output in place.
+        # Evaluated at every plant step: [q_end, v] of the motors gathered in one call,
+        # q_end += ahead v in place (the sum as ever), set as the output in one call.
         plan = context.get_discrete_state(self._plan).get_value()
-        desired = output.get_mutable_value()
-        q_d, v_d = desired[:self._motor_count], desired[self._motor_count:]
-        v_d[:] = plan[self._v_output]
-        ahead = context.get_time() + self._look_ahead - plan[2 * self._nq]
-        np.multiply(ahead, v_d, out=q_d)
-        q_d += plan[self._q_output]
+        desired = plan[self._desired_gather]
+        ahead = context.get_time() + self._look_ahead - plan[self._t_end]
+        q_d = desired[:self._motor_count]
+        q_d += ahead * desired[self._motor_count:]
+        output.SetFromVector(desired)

@@ -128,13 +128,18 @@ class EeCommandRamp:
 
     def pose(self, command, heading_rate, time):
         """`X_WE_desired` at `time`."""
+        return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
+
+    def rotation_and_position(self, command, heading_rate, time):
+        """`X_WE_desired` at `time` as its `(RotationMatrix, position (3,))`: what the diff
+        IK reads, without building the RigidTransform at each of its steps."""
         ahead = self.lead
         if self.period:
             next_tick = np.ceil(time / self.period - 1e-9) * self.period
             ahead -= max(0.0, next_tick - time)
         heading = command[_HEADING] + heading_rate * ahead
         R = RotationMatrix.MakeZRotation(heading) @ self.R_E0
-        return RigidTransform(R, command[_POSITION] + command[_VELOCITY] * ahead)
+        return R, command[_POSITION] + command[_VELOCITY] * ahead
 
 
 class EeStateFromPlant(LeafSystem):

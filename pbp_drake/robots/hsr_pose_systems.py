@@ -85,14 +85,18 @@ class PoseCommandRamp:
 
     def pose(self, command, heading_rate, time):
         """`X_WE_desired` at `time`; refuses a NaN or non-unit command (by field)."""
+        return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
+
+    def rotation_and_position(self, command, heading_rate, time):
+        """`pose` as its `(RotationMatrix, position (3,))`, as the diff IK reads it."""
         quaternion = check_pose_command(command, self.port_name)
         ahead = self.lead
         if self.period:
             next_tick = np.ceil(time / self.period - 1e-9) * self.period
             ahead -= max(0.0, next_tick - time)
         turned = multiply(exp_map(command[_ANGULAR] * ahead), quaternion)
-        return RigidTransform(RotationMatrix(Quaternion(turned)),
-                              command[_POSITION] + command[_VELOCITY] * ahead)
+        return (RotationMatrix(Quaternion(turned)),
+                command[_POSITION] + command[_VELOCITY] * ahead)
 
 
 class PoseStateFromPlant(LeafSystem):

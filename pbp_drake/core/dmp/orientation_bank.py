@@ -399,10 +399,11 @@ class OrientationDmpBank:
 
     def _scaled_forcing(self, phase, decay, combination, workspace, basis=None, out=None):
         """Ijspeert, distinct weights and equal phases: `b = S (-e0)` straight into `out`
-        (2, 3, K) (default: the workspace's `shape`), from the weights already multiplied by `-e0`
-        (`contraction.scaled_weights`:
-        the rows that matter, kept while the goals stay), so no pass multiplies `S`; the
-        start errors must be the goals'. Returns `lambda`, or None in any other case."""
+        (2, 3, K) (default: the workspace's `shape`), from the weights already multiplied
+        by `-e0` (`contraction.scaled_weights`: the rows that matter, kept while the goals
+        stay), so no pass multiplies `S`; the start errors must be the goals'. `basis`:
+        `(basis, lambda)` computed by the caller, else here. Returns `lambda`, or None in
+        any other case."""
         if (not self._ijspeert or self.shared_weights
                 or (phase.size > 1 and phase.min() != phase.max())):
             return None

@@ -9,6 +9,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
+from pbp_drake.bench.report import microseconds
 from pbp_drake.bench.timing import timed_span
 from pbp_drake.core.dmp import DmpBank, DmpSettings, fit_weights, minimum_jerk
 from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
@@ -120,3 +121,9 @@ def motion_timing(simulator, duration, periods):
     median, slowest, _ = timed_span(leaf_step(simulator, periods),
                                     lambda: simulator.get_context().get_time() >= end)
     return median / periods, slowest / periods
+
+
+def motion_fields(simulator, duration, periods):
+    """A row's `leaf_motion_us` and `leaf_slowest_us` (`motion_timing`, microseconds)."""
+    median, slowest = motion_timing(simulator, duration, periods)
+    return {"leaf_motion_us": microseconds(median), "leaf_slowest_us": microseconds(slowest)}

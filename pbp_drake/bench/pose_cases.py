@@ -13,7 +13,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.bench.cases import BASIS, DT, leaf_step, make_bank, make_case, motion_timing
+from pbp_drake.bench.cases import BASIS, DT, leaf_step, make_bank, make_case, motion_fields
 from pbp_drake.bench.checks import MOTION_ROWS
 from pbp_drake.bench.report import microseconds
 from pbp_drake.bench.timing import timed
@@ -120,10 +120,9 @@ def measure_pose_row(goal_count, distinct, min_time, bandwidth):
         row[f"{label}_min_us"] = microseconds(minimum / periods)
         del simulator
     if ((6, goal_count, row["weights"]), True) in MOTION_ROWS:
-        simulator = pose_leaf_simulator(goal_count, goals, hand, (positions, orientations))
-        motion, slowest = motion_timing(simulator, positions.duration, periods)
-        row.update(leaf_motion_us=microseconds(motion), leaf_slowest_us=microseconds(slowest))
-        del simulator
+        row.update(motion_fields(
+            pose_leaf_simulator(goal_count, goals, hand, (positions, orientations)),
+            positions.duration, periods))
     weight_bytes = ((case.weights.nbytes if distinct else case.shared_weights.nbytes)
                     + np.asarray(orientations._weights).nbytes)
     row["weight_bytes"] = weight_bytes

@@ -13,7 +13,7 @@ from pydrake.geometry import Meshcat, MeshcatParams
 
 import pbp_drake.bench
 from pbp_drake.bench.cases import (
-    BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_timing)
+    BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_fields)
 from pbp_drake.bench.checks import MOTION_ROWS, PEERS, evaluate, exit_code
 from pbp_drake.bench.closed_loop import HSR_KS, hsr_speed
 from pbp_drake.bench.peers import (
@@ -185,10 +185,8 @@ def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have
         row[f"{label}_min_us"] = microseconds(minimum / periods)
         del simulator
     if ((dimension, goal_count, row["weights"]), False) in MOTION_ROWS:
-        simulator = leaf_simulator(case, make_bank(case))
-        motion, slowest = motion_timing(simulator, bank.duration, periods)
-        row.update(leaf_motion_us=microseconds(motion), leaf_slowest_us=microseconds(slowest))
-        del simulator
+        row.update(motion_fields(leaf_simulator(case, make_bank(case)), bank.duration,
+                                 periods))
     del bank
 
     weight_bytes = (case.weights.nbytes if distinct else case.shared_weights.nbytes)

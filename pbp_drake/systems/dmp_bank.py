@@ -11,6 +11,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
+from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.systems.layouts import goal_index
 from pbp_drake.systems.tick import decide_offset
 
@@ -218,8 +219,7 @@ class DmpBank(LeafSystem):
                 # Every DMP continues from the velocity of the one the robot followed, so
                 # that a switch to another goal keeps the command's velocity.
                 z[...] = z[:, followed:followed + 1]
-            if self._max_speed is not None:
-                self._limit_speed(z)
+            limit_speeds(z, self._max_speed, bank.duration)
         robot[:, 0] = robot_state[:d]
         if lock:
             # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
@@ -230,18 +230,6 @@ class DmpBank(LeafSystem):
         held[0] = 0.0
         bank.attractor_terms_into(phase, robot, goals_dk, period, dp, dz, workspace)
         phase *= bank.decay(period)
-
-    def _limit_speed(self, z):
-        """Scales each DMP's velocity (a column of `z`, times the duration) down to
-        `max_speed`. Without it, a DMP stepped from a robot that the operator holds off its
-        path (PBP-Cont adds the operator to the DMP, which keeps running) winds its own
-        velocity up toward `beta (g - y) / tau`, far above what the hand may do: the hand
-        then follows the DMP's direction whatever the operator asks, since the speed limit
-        scales their sum as one vector."""
-        speeds = np.linalg.norm(z, axis=0) / self._bank.duration
-        too_fast = speeds > self._max_speed
-        if np.any(too_fast):
-            z[:, too_fast] *= self._max_speed / speeds[too_fast]
 
     def _calc_goals_dk(self, context, value):
         goals = self._bank.goals_matrix(self._goals_port.Eval(context))

@@ -16,6 +16,7 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 from pbp_drake.core import quaternion
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one
+from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
 from pbp_drake.systems.layouts import GoalPose, PoseState, goal_index
 from pbp_drake.systems.tick import decide_offset
@@ -106,7 +107,7 @@ class PoseDmpBank(LeafSystem):
         super().__init__()
         _check_banks(position_bank, orientation_bank, control_period)
         # Anti-windup, as DmpBank's `max_speed`: the hand-over never lets the hand move or
-        # turn faster, so no DMP may remember a faster velocity (see `_limit`).
+        # turn faster, so no DMP may remember a faster velocity (`limit_speeds`).
         self._max_speed = None if max_speed is None else float(max_speed)
         self._max_angular_speed = (None if max_angular_speed is None
                                    else float(max_angular_speed))
@@ -274,7 +275,7 @@ class PoseDmpBank(LeafSystem):
             scaled_velocity = workspace.velocities
             np.copyto(scaled_velocity, velocities)
         if held[0] == _STEPPING:
-            _limit(scaled_velocity, self._max_speed, positions.duration)
+            limit_speeds(scaled_velocity, self._max_speed, positions.duration)
             if followed is not None:
                 eta = jacobian_of_one(log_state[0, :, followed],
                                       log_state[1, :, followed])[:, np.newaxis]
@@ -283,7 +284,7 @@ class PoseDmpBank(LeafSystem):
                     log_state[0], log_state[1], goals[3:], q,
                     workspace.orientations, workspace.eta, workspace.orientation)
                 eta = workspace.eta
-            _limit(eta, self._max_angular_speed, orientations.duration)
+            limit_speeds(eta, self._max_angular_speed, orientations.duration)
         else:
             eta = np.array(eta_held)  # the robot's (locked) or 0 (at the start), (3, 1)
         robot[:, 0] = position
@@ -376,26 +377,6 @@ class PoseDmpBank(LeafSystem):
         path = self._positions.predict(phase, positions, velocity, goals[:3], dt, steps)[k]
         turns = self._orientations.predict(phase, orientations, eta, goals[3:], dt, steps)[k]
         output.SetFromVector(np.hstack([path, turns]).reshape(-1))
-
-
-def _limit(scaled_velocities, max_speed, duration):
-    """Scales the columns of `tau v` (3, K) down to the speed `max_speed` (None: no limit),
-    in place. Without it a DMP stepped from a hand that the operator (PBP-Cont) or the
-    hand-over holds back winds its own velocity up toward `beta (g - y) / tau`, far above
-    what the hand may do (see `DmpBank._limit_speed`)."""
-    if max_speed is None:
-        return
-    if scaled_velocities.shape[1] == 1:
-        # One column (every tick with a followed goal): plain floats, a fifth of the time.
-        x, y, z = scaled_velocities[:, 0].tolist()
-        speed = math.sqrt(x * x + y * y + z * z) / duration
-        if speed > max_speed:
-            scaled_velocities *= max_speed / speed
-        return
-    speeds = np.linalg.norm(scaled_velocities, axis=0) / duration
-    too_fast = speeds > max_speed
-    if np.any(too_fast):
-        scaled_velocities[:, too_fast] *= max_speed / speeds[too_fast]
 
 
 def _check_banks(position_bank, orientation_bank, control_period):

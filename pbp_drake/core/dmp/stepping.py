@@ -29,6 +29,7 @@ the weights are contracted once with both rows' combinations of the bases at `x0
 """
 
 import functools
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -198,11 +199,7 @@ class BankStep:
         if (goals_unchanged and scaled_velocity.shape[1] == 1 and self._ijspeert
                 and not self.shared_weights and ws.scaled_rows is not None
                 and (phase.size == 1 or phase.min() == phase.max())):
-            self._combined_shapes(phase, self.decay(dt), constants.combination, ws, True,
-                                  basis_only=True)
-            window = self._weight_rows.window(ws.basis)
-            weights = scaled_weights(self._weight_rows.weights, ws, *window)
-            self._weight_rows.contract_into(ws.basis, out.reshape(2, -1), weights, window)
+            self._scaled_shapes_into(phase, self.decay(dt), constants, ws, out)
             if ws.goal_terms is None or ws.goal_terms_dt != dt:
                 ws.goal_terms = np.multiply(constants.offset_gains, goals_dk)
                 np.negative(ws.goal_terms, out=ws.goal_terms)
@@ -222,16 +219,23 @@ class BankStep:
         np.multiply(scaled_velocity, constants.velocity_velocity, out=velocity_part)
         out[1] += velocity_part
 
+    def _scaled_shapes_into(self, phase, decay, constants, workspace, out):
+        """`S (g - y0)` (2, D, K) into `out`: the step's combined basis at equal phases
+        (left in the workspace's `basis` and `lam`) contracted with the weights kept
+        multiplied by the amplitudes, over the rows that matter."""
+        ws = workspace
+        self._combined_shapes(phase, decay, constants.combination, ws, True, basis_only=True)
+        window = self._weight_rows.window(ws.basis)
+        weights = scaled_weights(self._weight_rows.weights, ws, *window)
+        self._weight_rows.contract_into(ws.basis, out.reshape(2, -1), weights, window)
+
     def _scaled_terms_into(self, phase, positions, goals_dk, constants, decay, out_dp, out_dz,
                            workspace):
         """`attractor_terms_into` with distinct weights times the amplitudes `g - y0` of
         the workspace's last goals (the same goals): `b = S (g - y0)` from the contraction,
         then `dp = (Phi00 - 1)(p - g) + b0`, `dz = Phi10 (p - g) + b1`."""
         ws = workspace
-        self._combined_shapes(phase, decay, constants.combination, ws, True, basis_only=True)
-        window = self._weight_rows.window(ws.basis)
-        weights = scaled_weights(self._weight_rows.weights, ws, *window)
-        self._weight_rows.contract_into(ws.basis, ws.shape.reshape(2, -1), weights, window)
+        self._scaled_shapes_into(phase, decay, constants, ws, ws.shape)
         np.subtract(positions, goals_dk, out=out_dz)  # p - g
         np.multiply(out_dz, constants.position_offset, out=out_dp)
         out_dp += ws.shape[0]
@@ -346,3 +350,27 @@ class BankStep:
             if not single:
                 np.multiply(positions, gains[row, 0, 0], out=workspace.work)
                 out += workspace.work
+
+
+def limit_speeds(scaled_velocities, max_speed, duration):
+    """Scales each column of the scaled velocities `tau v` (D, K) down to the speed
+    `max_speed` (None: no limit), in place: the systems' anti-windup. Without it, a DMP
+    stepped from a robot that the operator (PBP-Cont, which adds the operator to the DMP)
+    or the hand-over holds off its path winds its own velocity up toward
+    `beta (g - y) / tau`, far above what the hand may do: the hand then follows the DMP's
+    direction whatever the operator asks, since the speed limit scales their sum as one
+    vector."""
+    if max_speed is None:
+        return
+    if scaled_velocities.shape[1] == 1:
+        # One column (every tick with a followed goal): plain floats, a fifth of the time,
+        # summed in the order NumPy's norm sums a short column.
+        column = scaled_velocities[:, 0].tolist()
+        speed = math.sqrt(sum(value * value for value in column)) / duration
+        if speed > max_speed:
+            scaled_velocities *= max_speed / speed
+        return
+    speeds = np.linalg.norm(scaled_velocities, axis=0) / duration
+    too_fast = speeds > max_speed
+    if np.any(too_fast):
+        scaled_velocities[:, too_fast] *= max_speed / speeds[too_fast]

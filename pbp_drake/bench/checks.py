@@ -26,6 +26,8 @@ class Check:
 
 
 _K10K = (3, 10000, "distinct")
+# The K of the checked closed-loop run (its dynamic robot is measured beside it).
+CHECKED_HSR_GOALS = 100
 _OVER_A_MOVEMENT = "one step in the LeafSystem, median over a movement and as long after it,"
 
 
@@ -50,8 +52,9 @@ CHECKS = (
     Check("K=10,000 goals (D=3, distinct weights): bank math <= 2x the memory-bandwidth "
           "bound (weight bytes / measured read bandwidth)", 2.0, True, "x the bound",
           lambda row: row["bank_math_us"] / row["bandwidth_bound_us"], row=_K10K),
-    Check("HSR reaching task, K=100 goals, headless: closed loop >= 10x real time", 10.0,
-          False, "x real time", lambda run: run["realtime_factor"], hsr_goals=100),
+    Check(f"HSR reaching task, K={CHECKED_HSR_GOALS} goals, headless, the shipped "
+          "(kinematic) robot: closed loop >= 20x real time", 20.0, False, "x real time",
+          lambda run: run["realtime_factor"], hsr_goals=CHECKED_HSR_GOALS),
 )
 
 
@@ -97,7 +100,8 @@ def _source(check, rows, closed_loop):
             return None, f"6-DoF pose, K={goals:,}, {weights} weights not in --goals"
         return None, f"D={dimension}, K={goals:,}, {weights} weights not in --dimensions/--goals"
     for run in closed_loop:
-        if run["goals"] == check.hsr_goals and not run["meshcat"]:
+        if (run["goals"] == check.hsr_goals and not run["meshcat"]
+                and run.get("shipped_robot", True)):
             return run, None
     return None, f"no headless HSR run with K={check.hsr_goals} in --hsr-goals"
 

@@ -12,6 +12,8 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import load_scenario_file
 
 HSR_KS = (4, 100, 1000)
+# The station's dynamic robot, measured beside the shipped scenario's (kinematic) one.
+DYNAMIC = "dynamic"
 # The repository's diagrams/ folder (this file is pbp_drake/bench/closed_loop.py).
 DIAGRAMS = Path(__file__).resolve().parents[2] / "diagrams"
 
@@ -37,9 +39,19 @@ def hsr_scenario(goal_count, seed=0):
     return dataclasses.replace(scenario, task=task)
 
 
-def hsr_speed(goal_count, simulated_seconds, meshcat=None):
-    """Simulated seconds per wall second of the HSR task (and the build time)."""
+def with_motion(scenario, motion):
+    """`scenario` with its HSR station's `motion` ("dynamic" or "kinematic")."""
+    robot = scenario.robot
+    station = dataclasses.replace(robot.station, motion=motion)
+    return dataclasses.replace(scenario, robot=dataclasses.replace(robot, station=station))
+
+
+def hsr_speed(goal_count, simulated_seconds, meshcat=None, motion=None):
+    """Simulated seconds per wall second of the HSR task (and the build time), on the
+    scenario file's robot, or with `motion` the station's other motion model."""
     scenario = hsr_scenario(goal_count)
+    if motion is not None:
+        scenario = with_motion(scenario, motion)
     began = time.perf_counter()
     diagram = build_diagram(scenario, meshcat)
     simulator = Simulator(diagram)
@@ -49,6 +61,7 @@ def hsr_speed(goal_count, simulated_seconds, meshcat=None):
     began = time.perf_counter()
     simulator.AdvanceTo(simulated_seconds)
     wall = time.perf_counter() - began
-    return {"goals": goal_count, "simulated_s": simulated_seconds, "wall_s": wall,
+    return {"goals": goal_count, "motion": scenario.robot.station.motion,
+            "simulated_s": simulated_seconds, "wall_s": wall,
             "realtime_factor": simulated_seconds / wall, "build_s": built,
             "control_period_s": scenario.control_period}

@@ -82,9 +82,12 @@ def format_report(report):
     if report["closed_loop"]:
         lines.append("")
         lines.append("Closed loop, HSR reaching task (straight-path DMPs, virtual participant, "
-                     "PBP-Alt): simulated seconds per wall second")
+                     "PBP-Alt; the robot of diagrams/hsr_reach.yaml unless named): "
+                     "simulated seconds per wall second")
         for run in report["closed_loop"]:
-            lines.append(f"  K = {run['goals']:>5} {'Meshcat' if run['meshcat'] else 'headless':>8}:"
+            where = ("Meshcat" if run["meshcat"] else "headless") + (
+                "" if run.get("shipped_robot", True) else f", {run['motion']} robot")
+            lines.append(f"  K = {run['goals']:>5} {where:>8}:"
                          f" {run['realtime_factor']:7.2f}x real time "
                          f"({run['simulated_s']:.1f} s in {run['wall_s']:.2f} s wall; "
                          f"built in {run['build_s']:.1f} s)")

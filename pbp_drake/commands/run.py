@@ -243,7 +243,7 @@ def _run_task_once(args, resolved, diagram, meshcat, console):
     scenario = resolved.scenario
     camera = None
     if args.camera == "robot":
-        camera = RobotCamera(meshcat, find_system(diagram, "plant"))
+        camera = RobotCamera(meshcat, find_system(diagram, "hsr_station"))
     if console is not None:
         console.show_title(f"{method_name(scenario.method, _alpha(scenario))}, seed "
                            f"{scenario.seed}")

@@ -1,5 +1,6 @@
-"""`pbp-drake study` (a scenario file's study) and `pbp-drake report` (a study folder's
-tables and figures, rebuilt from its trial files)."""
+"""`pbp-drake study` (a scenario file's study), `pbp-drake report` (a study folder's
+tables and figures, rebuilt from its trial files) and `pbp-drake compare` (two studies of
+the same seeds, trial by trial)."""
 
 import dataclasses
 import pathlib
@@ -12,6 +13,7 @@ from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
     Hsr, MethodComparison, ScenarioError, check_method_comparison, load_scenario_file)
 from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.paired import paired_comparison, paired_table
 from pbp_drake.studies.participant_report import is_participant_collection, participant_report
 from pbp_drake.studies.questionnaire_figure import FIG8
 from pbp_drake.studies.progress import ProgressBar
@@ -56,8 +58,16 @@ def add_study_commands(commands):
                         "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
                         "Wilcoxon tests and Fig. 8 in DIR/results.md and "
                         f"DIR/{FIG8}")
+    compare = commands.add_parser(
+        "compare", help="compare two studies of the same seeds trial by trial (e.g. before "
+        "and after changing a setting): per method and metric, the paired difference and "
+        "its 95 % interval against the first study's trial-to-trial noise; exit 1 when a "
+        "metric moved by more than that noise")
+    compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
+    compare.add_argument("second", help="another, of the same seeds (B)")
     study.set_defaults(handler=_study)
     report.set_defaults(handler=_report)
+    compare.set_defaults(handler=_compare)
 
 
 def _study(args):
@@ -158,6 +168,22 @@ def _print_report(summary, output):
                   f"{entry['error_seeds']}); see {output / 'trials' / method}")
     for name in ("summary.json", "results.md", "trials.json", *figure_names(summary)):
         print(f"  wrote {output / name}")
+
+
+def _compare(args):
+    """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when any metric's mean
+    difference exceeds the first study's trial-to-trial standard deviation, 2 when the
+    studies share no method and seed."""
+    rows = paired_comparison(args.first, args.second)
+    if not rows:
+        raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
+                            "both ran without an error")
+    print(paired_table(rows, "A", "B"), end="")
+    moved = [row for row in rows if not row.within_sd]
+    print(f"A = {args.first}, B = {args.second}. " + (
+        f"{len(moved)} of {len(rows)} rows moved by more than A's trial-to-trial SD."
+        if moved else f"All {len(rows)} rows within A's trial-to-trial SD."))
+    return 1 if moved else 0
 
 
 def _report(args):

@@ -4,6 +4,8 @@ participants saw the robot."""
 
 import numpy as np
 
+from pbp_drake.robots.hsr_station import hsr_station_plant
+
 CAMERAS = ("overview", "robot")
 
 # Behind and above the head, looking down past the hand to the shelf: the view of a person
@@ -27,17 +29,23 @@ def behind_head_view(head_position, yaw):
 
 class RobotCamera:
     """Keeps `meshcat`'s camera behind the HSR's head: `update(root_context)` reads the
-    head's and the base's poses from `plant` (a MultibodyPlant inside the diagram whose
-    root context is given) and sets the camera. Use from Meshcat's thread."""
+    robot's `state` off `station` (an HSR station inside the diagram whose root context is
+    given, dynamic or kinematic), places the head and the base with the station's plant
+    and sets the camera. Use from Meshcat's thread."""
 
-    def __init__(self, meshcat, plant, head_body="head_link", base_body="base_link"):
+    def __init__(self, meshcat, station, head_body="head_link", base_body="base_link"):
         self._meshcat = meshcat
-        self._plant = plant
-        self._head = plant.GetBodyByName(head_body)
-        self._base = plant.GetBodyByName(base_body)
+        self._station = station
+        self._state_port = station.GetOutputPort("state")
+        self._plant = hsr_station_plant(station)
+        self._plant_context = self._plant.CreateDefaultContext()
+        self._head = self._plant.GetBodyByName(head_body)
+        self._base = self._plant.GetBodyByName(base_body)
 
     def update(self, root_context):
-        context = self._plant.GetMyContextFromRoot(root_context)
+        context = self._plant_context
+        self._plant.SetPositionsAndVelocities(context, self._state_port.Eval(
+            self._station.GetMyContextFromRoot(root_context)))
         head = self._head.EvalPoseInWorld(context).translation()
         rotation = self._base.EvalPoseInWorld(context).rotation().matrix()
         yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))

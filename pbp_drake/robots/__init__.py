@@ -5,9 +5,11 @@ from pbp_drake.robots.hsr_station import (
     hsr_initial_ee_state,
     hsr_initial_hand_pose,
     hsr_ready_ee_state,
+    hsr_station_plant,
     make_hsr_station,
 )
 from pbp_drake.robots.hsr_station_config import CylinderObstacle, HsrStationConfig
 
 __all__ = ["CylinderObstacle", "HsrStationConfig", "add_hsr", "hsr_initial_ee_state",
-           "hsr_initial_hand_pose", "hsr_ready_ee_state", "make_hsr_station"]
+           "hsr_initial_hand_pose", "hsr_ready_ee_state", "hsr_station_plant",
+           "make_hsr_station"]

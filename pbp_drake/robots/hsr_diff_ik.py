@@ -163,11 +163,14 @@ class WholeBodyDiffIk(LeafSystem):
     limits.
 
     ``desired_state`` is ``[q_d, v_d]`` of the motor joints (``motor_joints``, in that
-    order): the plan's position ``plant_time_step`` ahead of now and its velocity. The
+    order): the plan's position ``look_ahead`` seconds ahead of now and its velocity. The
     plant's implicit PD compares q_d with its positions at the end of its step, so the
-    plan's position at that time is what it must be given to track without lag.
+    plan's position at that time is what it must be given to track without lag (the
+    station's look-ahead is its plant's time step; 0 for kinematic joints, which are on
+    the plan).
     ``robot_state`` (the plant's state) is read only at initialization: the plan
-    starts there, at rest.
+    starts there, at rest. Before that the plan is ``q_nominal`` at rest, which is where
+    kinematic joints, whose state is this plan, start.
 
     Limits are pairs (lower, upper) of arrays over the plant's velocities (positions for
     ``position_limits``); ``inf`` where there is none. The plant must have q̇ = v.
@@ -183,7 +186,7 @@ class WholeBodyDiffIk(LeafSystem):
     weighing ``OVERSHOOT_WEIGHT``.
     """
 
-    def __init__(self, plant, frame_E, time_step, plant_time_step, motor_joints, *,
+    def __init__(self, plant, frame_E, time_step, look_ahead, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
                  centering_gain, command_ramp=None, limit_overshoot=False):
         super().__init__()
@@ -194,7 +197,7 @@ class WholeBodyDiffIk(LeafSystem):
         self._plant = plant
         self._frame_E = frame_E
         self._time_step = float(time_step)
-        self._look_ahead = float(plant_time_step)
+        self._look_ahead = float(look_ahead)
         self._plant_context = plant.CreateDefaultContext()
         self._nq = nq
         self._position_indices = np.array([joint.position_start() for joint in motor_joints])
@@ -233,7 +236,8 @@ class WholeBodyDiffIk(LeafSystem):
             "robot_state", plant.num_multibody_states())
         # [q at t_end, v, t_end, hold]: the plan reaches q at t_end moving at v; hold is
         # which velocities the last step's QP held at a bound (its next first guess).
-        self._plan = self.DeclareDiscreteState(nq + 2 * nv + 1)
+        self._plan = self.DeclareDiscreteState(np.concatenate(
+            [self._q_nominal, np.zeros(nv + 1 + nv)]))  # at q_nominal until initialized
         self.DeclarePeriodicDiscreteUpdateEvent(self._time_step, 0.0, self._step)
         self.DeclareInitializationDiscreteUpdateEvent(self._start)
         if command_ramp is not None:

@@ -52,6 +52,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
 from pbp_drake.robots.hsr_ee_systems import EeCommandRamp, EeStateFromPlant, heading_of
+from pbp_drake.robots.hsr_kinematic import add_kinematic_joints, add_kinematic_plant
 from pbp_drake.robots.hsr_model import (
     ACTUATED_JOINT_NAMES,
     ARM_JOINT_NAMES,
@@ -122,11 +123,12 @@ def _ready_pose(plant, model, config):
     return q0, plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(context)
 
 
-def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp,
+def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp, look_ahead,
                   frame_name=END_EFFECTOR_FRAME):
     """The whole-body diff IK of the frame ``frame_name`` with the model's position and
     velocity limits and the config's acceleration limits, the arm drifting back to the
-    ready pose ``q0``, reading the hand's command through ``command_ramp``."""
+    ready pose ``q0``, reading the hand's command through ``command_ramp``, its
+    ``desired_state`` the plan ``look_ahead`` seconds ahead."""
     v_lower, v_upper = plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()
     # The torso does not move the hand (it carries only the head) and follows the lift
     # through the coupler in the plant, so diff IK leaves it where it is.
@@ -142,7 +144,7 @@ def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp,
             centering[joint.position_start()] = config.arm_centering_gain
     return WholeBodyDiffIk(
         plant, plant.GetFrameByName(frame_name, model), config.diff_ik_time_step,
-        config.plant.time_step, motor_joints,
+        look_ahead, motor_joints,
         position_limits=(plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()),
         velocity_limits=(v_lower, v_upper), acceleration_limits=(-accelerations, accelerations),
         q_nominal=q0, centering_gain=centering, command_ramp=command_ramp,
@@ -184,7 +186,13 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]`` the plant's PD
     tracks, in motor order (``ACTUATED_JOINT_NAMES``; q_d is the diff IK's plan one plant
     step ahead, where the implicit PD measures the positions); ``body_poses`` and
-    ``query_object`` are the plant's and SceneGraph's. ``obstacle_positions`` is
+    ``query_object`` are the plant's and SceneGraph's.
+
+    With ``config.motion == "kinematic"`` no plant is stepped: the joints are on the diff
+    IK's plan at every instant (``KinematicJoints``, whose ``state`` has the plant's
+    layout; ``desired_state`` is then the plan now), the plant is used outside the
+    Diagram for its kinematics and geometry (``hsr_station_plant`` returns it), and there
+    is no ``body_poses`` output. Every other port is the same. ``obstacle_positions`` is
     ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the
     smallest robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
     The obstacles do not push the robot (their contact with it is filtered out).
@@ -205,7 +213,11 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
         raise ValueError(f"make_hsr_station command must be one of {COMMANDS}, got "
                          f"{command!r}")
     builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlant(config.plant, builder)
+    kinematic = config.motion == "kinematic"
+    if kinematic:
+        plant, scene_graph = add_kinematic_plant(builder, config.plant.time_step)
+    else:
+        plant, scene_graph = AddMultibodyPlant(config.plant, builder)
     model = add_hsr(plant)
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
     gains = zip(ACTUATED_JOINT_NAMES, config.base_kp + config.arm_kp,
@@ -229,25 +241,35 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()
                     for index in plant.GetJointActuatorIndices(model)]
+    # The plant's PD measures its positions at the end of its step, so it is given the
+    # plan one step ahead; kinematic joints are on the plan now.
+    look_ahead = 0.0 if kinematic else config.plant.time_step
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(
-        plant, model, q0, config, motor_joints, ramp, frame_name))
-    # Read at initialization only, so that the plan starts from the plant's state (no
+        plant, model, q0, config, motor_joints, ramp, look_ahead, frame_name))
+    if kinematic:
+        joints = add_kinematic_joints(builder, plant, model, scene_graph, motor_joints,
+                                      diff_ik.get_desired_state_output_port())
+        state = joints.get_state_output_port()
+    else:
+        state = plant.get_state_output_port()
+        builder.Connect(diff_ik.get_desired_state_output_port(),
+                        plant.get_desired_state_input_port(model))
+    # Read at initialization only, so that the plan starts from the robot's state (no
     # jump even if the caller moves the robot in the context).
-    builder.Connect(plant.get_state_output_port(), diff_ik.get_robot_state_input_port())
-    builder.Connect(diff_ik.get_desired_state_output_port(),
-                    plant.get_desired_state_input_port(model))
+    builder.Connect(state, diff_ik.get_robot_state_input_port())
 
     ee_body = plant.GetFrameByName(END_EFFECTOR_FRAME, model).body()
     ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, ee_body))
-    builder.Connect(plant.get_state_output_port(), ee_state.get_plant_state_input_port())
+    builder.Connect(state, ee_state.get_plant_state_input_port())
 
     builder.ExportInput(diff_ik.get_command_input_port(), ramp.port_name)
     builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
     if command == "pose":
-        _add_hand_pose(builder, plant, model, q0)
-    builder.ExportOutput(plant.get_state_output_port(), "state")
+        _add_hand_pose(builder, plant, model, q0, state)
+    builder.ExportOutput(state, "state")
     builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
-    builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
+    if not kinematic:
+        builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
     if config.obstacles:
         _add_obstacles(builder, plant, scene_graph, model, config.obstacles)
@@ -258,15 +280,16 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     return station
 
 
-def _add_hand_pose(builder, plant, model, q0):
-    """The output hand_pose: hand_palm_link's PoseState, signed nearer its start."""
+def _add_hand_pose(builder, plant, model, q0, state):
+    """The output hand_pose: hand_palm_link's PoseState (from the robot's `state`),
+    signed nearer its start."""
     frame_H = plant.GetFrameByName(HAND_FRAME, model)
     context = plant.CreateDefaultContext()
     plant.SetPositions(context, q0)
     q_start = frame_H.CalcPoseInWorld(context).rotation().ToQuaternion().wxyz()
     hand_pose = builder.AddNamedSystem("hand_pose", PoseStateFromPlant(plant, frame_H,
                                                                        q_start))
-    builder.Connect(plant.get_state_output_port(), hand_pose.get_plant_state_input_port())
+    builder.Connect(state, hand_pose.get_plant_state_input_port())
     builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
 
 
@@ -313,6 +336,14 @@ def _add_meshcat_visualizers(builder, scene_graph, meshcat, visualization):
             default_color=Rgba(color.r(), color.g(), color.b(),
                                visualization.initial_proximity_alpha),
             delete_on_initialization_event=visualization.delete_on_initialization_event))
+
+
+def hsr_station_plant(station: Diagram) -> MultibodyPlant:
+    """The MultibodyPlant of a station from ``make_hsr_station``: its subsystem ``plant``
+    (dynamic), or the kinematic joints' plant, which is outside the Diagram."""
+    if station.HasSubsystemNamed("plant"):
+        return station.GetSubsystemByName("plant")
+    return station.GetSubsystemByName("joints").plant()
 
 
 def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:

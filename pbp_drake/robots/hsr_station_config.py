@@ -15,6 +15,10 @@ class CylinderObstacle:
     height: float = 1.2
 
 
+# HsrStationConfig.motion's values.
+MOTIONS = ("dynamic", "kinematic")
+
+
 def _default_plant_config():
     # SAP enforces the torso's coupler constraint and applies the motors' PD implicitly.
     # Live output ports: see validate_hsr_station_config.
@@ -41,6 +45,14 @@ class HsrStationConfig:
     """
 
     plant: MultibodyPlantConfig = dataclasses.field(default_factory=_default_plant_config)
+    # How the robot moves along the diff IK's plan. "dynamic": the plant (SAP, every
+    # plant.time_step) and its stiff servos track the plan, a few hundredths of a mm
+    # behind it. "kinematic": the joints are on the plan at every instant (the servos'
+    # limit as w grows; the plant only gives the kinematics and the geometry, and its
+    # step, gains and plant settings go unused): about twice the closed loop's speed,
+    # and on the shipped tasks the same study results within noise (README, "A kinematic
+    # robot"). Nothing pushes the robot in either (gravity is off, obstacles measured).
+    motion: str = "dynamic"
     # The whole-body differential IK's period (s), a whole multiple of plant.time_step;
     # its QP is the station's largest cost.
     diff_ik_time_step: float = 0.01
@@ -101,6 +113,9 @@ class HsrStationConfig:
 
 def validate_hsr_station_config(config: HsrStationConfig) -> None:
     """Raises ValueError naming the first field of ``config`` that cannot work."""
+    if config.motion not in MOTIONS:
+        raise ValueError(f"HsrStationConfig.motion must be one of {MOTIONS}, got "
+                         f"{config.motion!r}")
     time_step = config.plant.time_step
     if not time_step > 0:
         raise ValueError(f"HsrStationConfig.plant.time_step must be positive (a discrete "

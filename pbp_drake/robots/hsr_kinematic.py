@@ -1,0 +1,90 @@
+"""The kinematic HSR: joints that are where the diff IK's plan is, at every instant.
+
+With ``HsrStationConfig.motion = "kinematic"`` the station steps no plant. The
+MultibodyPlant is finalized outside the Diagram, for its kinematics (the diff IK's and the
+hand's) and its geometry, which ``MultibodyPositionToGeometryPose`` places in SceneGraph
+from ``KinematicJoints``' state (collisions, Meshcat). What the dynamic station's stiff
+servos approach, a few hundredths of a mm behind the plan, this station is exactly.
+"""
+
+import numpy as np
+from pydrake.geometry import SceneGraph
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import LeafSystem
+from pydrake.systems.rendering import MultibodyPositionToGeometryPose
+
+from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO
+
+
+class KinematicJoints(LeafSystem):
+    """The plant's state, read off the diff IK's ``desired_state`` with no dynamics.
+
+    .. pydrake_system::
+
+        name: KinematicJoints
+        input_ports:
+        - desired_state
+        output_ports:
+        - state
+
+    ``desired_state`` is ``[q_d, v_d]`` of ``motor_joints`` (in that order; the diff IK's
+    plan at this instant, no look-ahead); ``state`` is ``plant``'s ``[q, v]`` with every
+    motor there and the torso where the coupler keeps it (``TORSO_TO_ARM_LIFT_RATIO``
+    times the arm lift). No state of its own: the robot is the plan.
+    """
+
+    def __init__(self, plant, model, motor_joints):
+        super().__init__()
+        self._plant = plant
+        nq = plant.num_positions()
+        # Where the motors' [q_d, v_d] go in [q, v], and the torso's and the lift's entries.
+        self._scatter = np.array([joint.position_start() for joint in motor_joints]
+                                 + [nq + joint.velocity_start() for joint in motor_joints])
+        torso = plant.GetJointByName(TORSO_JOINT_NAME, model)
+        lift = plant.GetJointByName("arm_lift_joint", model)
+        self._torso = [torso.position_start(), nq + torso.velocity_start()]
+        self._lift = [lift.position_start(), nq + lift.velocity_start()]
+        self._desired_port = self.DeclareVectorInputPort("desired_state",
+                                                         2 * len(motor_joints))
+        self._state_port = self.DeclareVectorOutputPort(
+            "state", plant.num_multibody_states(), self._calc_state)
+
+    def plant(self):
+        """The MultibodyPlant (outside any Diagram) whose state this system outputs."""
+        return self._plant
+
+    def get_desired_state_input_port(self):
+        return self._desired_port
+
+    def get_state_output_port(self):
+        return self._state_port
+
+    def _calc_state(self, context, output):
+        state = np.zeros(output.size())
+        state[self._scatter] = self._desired_port.Eval(context)
+        state[self._torso] = TORSO_TO_ARM_LIFT_RATIO * state[self._lift]
+        output.SetFromVector(state)
+
+
+def add_kinematic_plant(builder, time_step):
+    """A SceneGraph in `builder` and a MultibodyPlant registered with it but not added:
+    `(plant, scene_graph)`, the plant to be filled and finalized by the caller."""
+    scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
+    plant = MultibodyPlant(time_step)
+    plant.RegisterAsSourceForSceneGraph(scene_graph)
+    return plant, scene_graph
+
+
+def add_kinematic_joints(builder, plant, model, scene_graph, motor_joints, desired_state):
+    """`KinematicJoints` fed by `desired_state`, placing the plant's geometry in
+    `scene_graph`; returns it (its `state` is the robot's)."""
+    joints = builder.AddNamedSystem("joints", KinematicJoints(plant, model, motor_joints))
+    builder.Connect(desired_state, joints.get_desired_state_input_port())
+    # Keeps a reference to the plant, which the Diagram does not own (pydrake keeps the
+    # plant alive as long as this system).
+    to_pose = builder.AddNamedSystem(
+        "geometry_poses", MultibodyPositionToGeometryPose(plant, input_multibody_state=True))
+    builder.Connect(joints.get_state_output_port(), to_pose.get_input_port())
+    builder.Connect(to_pose.get_output_port(),
+                    scene_graph.get_source_pose_port(plant.get_source_id()))
+    return joints

@@ -1,0 +1,126 @@
+"""Two studies of the same seeds, compared trial by trial: `pbp-drake compare A B`.
+
+Change a setting (the robot's motion model, a time step, a gain), run the same study again
+into another folder, and ask whether any result moved by more than the trials differ among
+themselves. Each method's trials of A and B are paired by seed; for each metric the table
+gives A's mean, the paired difference B - A (its mean and 95 % confidence interval, on
+Student's t), and A's trial-to-trial standard deviation (SD) and standard error of the
+mean (SE = SD / sqrt(n)). A difference is *within noise* when its mean is no larger than
+A's SD: the spread one trial's result already carries. The SE, the uncertainty of A's
+reported mean, is the stricter yardstick, and the table marks which differences pass it
+too.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from pbp_drake.studies.summary import measures_collisions
+from pbp_drake.studies.trial_files import read_study
+
+# (name in the table, how a trial's value is read, whether both trials must have succeeded)
+_COLLISION_METRICS = ("collision_ratio", "collision_free")
+_METRICS = (
+    ("success", lambda record: float(bool(record["success"])), False),
+    ("intervention_ratio", lambda record: record["intervention_ratio"], False),
+    ("task_time", lambda record: record["task_time"], True),
+    ("switches", lambda record: record["switches"], False),
+    ("collision_ratio", lambda record: record["collision_ratio"], False),
+    ("collision_free", lambda record: (None if record["collision_ratio"] is None
+                                       else float(record["collision_ratio"] == 0.0)), False),
+    ("peak_hand_speed", lambda record: record["peak_hand_speed"], False),
+    ("peak_command_acceleration", lambda record: record["peak_command_acceleration"], False),
+)
+
+
+@dataclasses.dataclass
+class PairedRow:
+    """One metric of one method over the seeds both studies ran without error."""
+
+    metric: str
+    method: str
+    pairs: int
+    mean_a: float
+    mean_b: float
+    difference: float  # mean of B - A over the pairs
+    low: float  # its 95 % confidence interval
+    high: float
+    sd_a: float  # A's trial-to-trial standard deviation
+    se_a: float  # A's standard error of the mean
+
+    @property
+    def within_sd(self):
+        return abs(self.difference) <= self.sd_a
+
+    @property
+    def within_se(self):
+        return abs(self.difference) <= self.se_a
+
+
+def _by_seed(study, records, method):
+    """`{seed: record}` of the method's trials on disk that ran without an error."""
+    found = {}
+    for trial in range(study["trials"]):
+        record = records.get((method, trial))
+        if record is not None and record.get("error") is None:
+            found[study["seed"] + trial] = record
+    return found
+
+
+def _row(metric, method, values_a, values_b):
+    a, b = np.array(values_a, float), np.array(values_b, float)
+    n = len(a)
+    differences = b - a
+    difference = float(differences.mean())
+    # Deferred: scipy.stats takes about 0.7 s to import, which every command would pay.
+    import scipy.stats
+    spread = float(differences.std(ddof=1)) if n > 1 else 0.0
+    half = float(scipy.stats.t.ppf(0.975, n - 1)) * spread / math.sqrt(n) if n > 1 else math.inf
+    sd_a = float(a.std(ddof=1)) if n > 1 else 0.0
+    return PairedRow(metric, method, n, float(a.mean()), float(b.mean()), difference,
+                     difference - half, difference + half, sd_a, sd_a / math.sqrt(n))
+
+
+def paired_comparison(folder_a, folder_b):
+    """The `PairedRow`s of two study folders: every metric of every method both ran, over
+    the seeds both ran (collisions only where both tasks measure them)."""
+    study_a, records_a, _ = read_study(folder_a)
+    study_b, records_b, _ = read_study(folder_b)
+    collisions = (measures_collisions(study_a, records_a, folder_a)
+                  and measures_collisions(study_b, records_b, folder_b))
+    rows = []
+    for method in [m for m in study_a["methods"] if m in study_b["methods"]]:
+        trials_a = _by_seed(study_a, records_a, method)
+        trials_b = _by_seed(study_b, records_b, method)
+        seeds = sorted(set(trials_a) & set(trials_b))
+        for metric, read, needs_success in _METRICS:
+            if metric in _COLLISION_METRICS and not collisions:
+                continue
+            values_a, values_b = [], []
+            for seed in seeds:
+                record_a, record_b = trials_a[seed], trials_b[seed]
+                if needs_success and not (record_a["success"] and record_b["success"]):
+                    continue
+                value_a, value_b = read(record_a), read(record_b)
+                if value_a is not None and value_b is not None:
+                    values_a.append(value_a)
+                    values_b.append(value_b)
+            if values_a:
+                rows.append(_row(metric, method, values_a, values_b))
+    return rows
+
+
+def paired_table(rows, name_a="A", name_b="B"):
+    """The rows as a Markdown table, metric by metric."""
+    lines = [f"| metric | method | pairs | {name_a} | {name_b} - {name_a} [95 % CI] | "
+             f"SD of {name_a} | SE of {name_a} | within noise |",
+             "|---|---|---|---|---|---|---|---|"]
+    for row in sorted(rows, key=lambda row: [m for m, _, _ in _METRICS].index(row.metric)):
+        verdict = ("yes (within SE too)" if row.within_se else "yes" if row.within_sd
+                   else "**no**")
+        lines.append(
+            f"| {row.metric} | {row.method} | {row.pairs} | {row.mean_a:.4g} | "
+            f"{row.difference:+.3g} [{row.low:+.3g}, {row.high:+.3g}] | {row.sd_a:.3g} | "
+            f"{row.se_a:.3g} | {verdict} |")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,88 @@
+"""`pbp-drake compare A B`: two studies of the same seeds, trial by trial, as a user who
+changed a setting compares the two runs. The folders are written without simulating (a
+real study.json of the shipped scenario, trial files of a few ticks)."""
+
+import numpy as np
+import pytest
+
+from pbp_drake.cli import main
+from pbp_drake.scenarios import load_scenario_file
+from pbp_drake.studies.paired import paired_comparison
+from pbp_drake.studies.trial_files import (
+    scenario_hash, time_series_columns, trial_record, write_study, write_trial_files)
+
+METHODS = ("pbp_alternated", "teleop")
+TRIALS = 6
+# Task times of the six seeds: a trial-to-trial SD of 2.0 s (SE 0.82 s).
+TASK_TIMES = np.array([14.0, 17.0, 15.5, 19.0, 16.0, 13.5])
+
+
+def _csv(ticks=3):
+    columns = time_series_columns(False)
+    integers = {"operator_active", "selected_goal", "target"}
+    row = ",".join("0" if name in integers else "0.5" for name in columns)
+    return ",".join(columns) + "\n" + "".join(row + "\n" for _ in range(ticks))
+
+
+def _study(folder, scenario_path, shift=0.0, failed_seed=None):
+    """A finished reach study whose task times are TASK_TIMES + `shift` (the trial of
+    `failed_seed` missed its target)."""
+    scenario = load_scenario_file(scenario_path).scenario
+    digest = scenario_hash(scenario)
+    write_study(folder, scenario, digest, METHODS, TRIALS, 0, "tuning")
+    for method in METHODS:
+        for trial in range(TRIALS):
+            record = trial_record(scenario.name, digest, method, trial, trial)
+            record.update(success=trial != failed_seed,
+                          task_time=float(TASK_TIMES[trial] + shift),
+                          intervention_ratio=0.1 * trial, switches=2, collision_ratio=0.0,
+                          peak_hand_speed=0.2, peak_command_acceleration=1.0, ticks=3,
+                          objects=[[1.6, 0.0, 0.7]], targets=[0])
+            write_trial_files(folder, record, _csv())
+    return folder
+
+
+def _row(rows, metric, method="teleop"):
+    (row,) = [r for r in rows if (r.metric, r.method) == (metric, method)]
+    return row
+
+
+def test_pairs_the_trials_by_seed_against_the_first_studys_noise(tmp_path, repo):
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a = _study(tmp_path / "a", scenario)
+    b = _study(tmp_path / "b", scenario, shift=1.5, failed_seed=2)
+    rows = paired_comparison(a, b)
+    task_time = _row(rows, "task_time")
+    # Seed 2 missed in B: task time pairs only the trials both finished.
+    assert task_time.pairs == TRIALS - 1
+    assert task_time.difference == pytest.approx(1.5)
+    assert task_time.low == pytest.approx(1.5) and task_time.high == pytest.approx(1.5)
+    kept = np.delete(TASK_TIMES, 2)
+    assert task_time.sd_a == pytest.approx(kept.std(ddof=1))
+    assert task_time.se_a == pytest.approx(kept.std(ddof=1) / np.sqrt(TRIALS - 1))
+    assert task_time.within_sd and not task_time.within_se  # SD 2.2 s, SE 1.0 s
+    success = _row(rows, "success")
+    assert success.pairs == TRIALS and success.difference == pytest.approx(-1 / TRIALS)
+    # The reach task measures no collisions: no such rows.
+    assert not [r for r in rows if r.metric.startswith("collision")]
+
+
+def test_exit_code_says_whether_a_metric_moved_beyond_its_noise(tmp_path, repo, capsys):
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a = _study(tmp_path / "a", scenario)
+    assert main(["compare", str(a), str(_study(tmp_path / "near", scenario, 0.5))]) == 0
+    out = capsys.readouterr().out
+    assert "| task_time | teleop | 6 | 15.83 | +0.5 [+0.5, +0.5] |" in out
+    assert "All 12 rows within A's trial-to-trial SD." in out
+    assert main(["compare", str(a), str(_study(tmp_path / "far", scenario, 3.0))]) == 1
+    out = capsys.readouterr().out
+    assert "| task_time | teleop | 6 | 15.83 | +3 [+3, +3] | 2.02 | 0.823 | **no** |" in out
+    assert "2 of 12 rows moved by more than A's trial-to-trial SD." in out
+
+
+def test_refuses_folders_that_share_no_trial(tmp_path, repo, capsys):
+    a = _study(tmp_path / "a", repo / "diagrams" / "hsr_reach.yaml")
+    other = tmp_path / "empty"
+    other.mkdir()
+    assert main(["compare", str(a), str(other)]) == 2
+    assert "pbp-drake:" in capsys.readouterr().err

@@ -31,6 +31,10 @@ _METRICS = (
                                        else float(record["collision_ratio"] == 0.0)), False),
     ("peak_hand_speed", lambda record: record["peak_hand_speed"], False),
     ("peak_command_acceleration", lambda record: record["peak_command_acceleration"], False),
+    # The grasping task's orientation (other tasks' trials have neither).
+    ("final_angle_to_target", lambda record: record.get("final_angle_to_target"), False),
+    ("peak_command_angular_change", lambda record: record.get("peak_command_angular_change"),
+     False),
 )
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from pydrake.math import RigidTransform, RotationMatrix
 
-from pbp_drake.robots.hsr_diff_ik import solve_box_qp
+from pbp_drake.robots.hsr_diff_ik import solve_box_qp, solve_box_qp_primal
 from pbp_drake.robots.hsr_ee_systems import EeCommandToPose
 
 
@@ -30,9 +30,16 @@ def test_box_qp_meets_the_optimality_conditions(seed):
     assert np.all(np.abs(gradient[free]) < tolerance)
     assert np.all(gradient[(x <= lower) & (lower < upper)] > -tolerance)
     assert np.all(gradient[(x >= upper) & (lower < upper)] < tolerance)
-    # Any first guess of the bounds held gives the same minimum.
-    for guess in (hold, -hold, rng.choice([-1.0, 0.0, 1.0], n)):
-        np.testing.assert_allclose(solve_box_qp(H, g, lower, upper, guess)[0], x, atol=1e-9)
+    # Any first guess of the bounds held gives the same minimum; the primal method, which
+    # the primal-dual one falls back to, gives the same numbers bit for bit.
+    for guess in (None, hold, -hold, rng.choice([-1.0, 0.0, 1.0], n)):
+        if guess is not None:
+            np.testing.assert_allclose(solve_box_qp(H, g, lower, upper, guess)[0], x,
+                                       atol=1e-9)
+        x_guessed, hold_guessed = solve_box_qp(H, g, lower, upper, guess)
+        x_primal, hold_primal = solve_box_qp_primal(H, g, lower, upper, guess)
+        np.testing.assert_array_equal(x_guessed, x_primal)
+        np.testing.assert_array_equal(hold_guessed, hold_primal)
 
 
 def test_box_qp_without_active_bounds_is_the_unconstrained_minimum():
@@ -82,3 +89,9 @@ def test_command_to_pose_turns_the_heading_at_a_constant_rate():
     command[6] = -np.pi + 0.01
     _, velocity = command_to_pose(command, 0.01, 0.03, lead=0.01, last_heading=np.pi - 0.02)
     assert velocity[2] == pytest.approx(0.03 / 0.03)
+
+
+def test_box_qp_refuses_a_singular_system():
+    H = np.array([[1.0, 1.0], [1.0, 1.0]])
+    with pytest.raises(np.linalg.LinAlgError), np.errstate(invalid="ignore"):
+        solve_box_qp(H, np.array([1.0, 0.0]), np.full(2, -10.0), np.full(2, 10.0))

@@ -61,7 +61,7 @@ def add_study_commands(commands):
     compare = commands.add_parser(
         "compare", help="compare two studies of the same seeds trial by trial (e.g. before "
         "and after changing a setting): per method and metric, the paired difference and "
-        "its 95 % interval against the first study's trial-to-trial noise; exit 1 when a "
+        "its 95 %% interval against the first study's trial-to-trial noise; exit 1 when a "
         "metric moved by more than that noise")
     compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
     compare.add_argument("second", help="another, of the same seeds (B)")

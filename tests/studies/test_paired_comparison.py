@@ -86,3 +86,10 @@ def test_refuses_folders_that_share_no_trial(tmp_path, repo, capsys):
     other.mkdir()
     assert main(["compare", str(a), str(other)]) == 2
     assert "pbp-drake:" in capsys.readouterr().err
+
+
+def test_the_command_lines_help_names_it(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--help"])
+    assert exit_info.value.code == 0
+    assert "compare two studies of the same seeds" in capsys.readouterr().out

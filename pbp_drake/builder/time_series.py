@@ -2,6 +2,8 @@
 tick. A study's trial files (`pbp_drake.studies.trial_files`) and a run streamed to disk
 (`pbp_drake.builder.streamed_run`) write the same format with these functions."""
 
+import numpy as np
+
 
 # The grasping task's orientation columns (`TaskResult.angles_to_target`, degrees; the
 # commanded and the operator's angular velocities, rad/s, world frame).
@@ -36,19 +38,29 @@ def time_series_rows(series):
     them back gives the same numbers."""
     has_collision = series.in_collision is not None
     has_grasp = _has_grasp(series)
+    # Python lists once, not a numpy scalar per cell: the same numbers (repr of the same
+    # doubles) in a third of the time.
+    times, ee, headings, commands, active, operator, selected, targets = (
+        np.asarray(values).tolist() for values in (
+            series.times, series.ee_positions, series.headings, series.commands,
+            series.operator_active, series.operator_commands, series.selected_goals,
+            series.targets))
+    collisions = np.asarray(series.in_collision).tolist() if has_collision else None
+    if has_grasp:
+        angles, angular, twists = (np.asarray(values).tolist() for values in (
+            series.angles_to_target, series.command_angular_velocities,
+            np.asarray(series.operator_twists)[:, 3:]))
     lines = []
-    for k in range(len(series.times)):
-        row = [series.times[k], *series.ee_positions[k], series.headings[k], *series.commands[k]]
+    for k in range(len(times)):
+        row = [times[k], *ee[k], headings[k], *commands[k]]
         row = [repr(float(x)) for x in row]
-        row.append(str(int(bool(series.operator_active[k]))))
-        row += [repr(float(x)) for x in series.operator_commands[k]]
-        row += [str(int(series.selected_goals[k])), str(int(series.targets[k]))]
+        row.append(str(int(bool(active[k]))))
+        row += [repr(float(x)) for x in operator[k]]
+        row += [str(int(selected[k])), str(int(targets[k]))]
         if has_collision:
-            row.append(str(int(bool(series.in_collision[k]))))
+            row.append(str(int(bool(collisions[k]))))
         if has_grasp:
-            row += [repr(float(x)) for x in (series.angles_to_target[k],
-                                             *series.command_angular_velocities[k],
-                                             *series.operator_twists[k, 3:])]
+            row += [repr(float(x)) for x in (angles[k], *angular[k], *twists[k])]
         lines.append(",".join(row) + "\n")
     return "".join(lines)
 

@@ -6,12 +6,15 @@ import time
 from pathlib import Path
 
 import numpy as np
+from pydrake.geometry import Meshcat, MeshcatParams
 from pydrake.systems.analysis import Simulator
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import load_scenario_file
 
 HSR_KS = (4, 100, 1000)
+# Headless runs per K, of which the bench reports the median (one with Meshcat, slower).
+HSR_REPEATS = 5
 # The station's dynamic robot, measured beside the shipped scenario's (kinematic) one.
 DYNAMIC = "dynamic"
 # The repository's diagrams/ folder (this file is pbp_drake/bench/closed_loop.py).
@@ -47,8 +50,8 @@ def with_motion(scenario, motion):
 
 
 def hsr_speed(goal_count, simulated_seconds, meshcat=None, motion=None):
-    """Simulated seconds per wall second of the HSR task (and the build time), on the
-    scenario file's robot, or with `motion` the station's other motion model."""
+    """Simulated seconds per wall second of one run of the HSR task (and the build time),
+    on the scenario file's robot, or with `motion` the station's other motion model."""
     scenario = hsr_scenario(goal_count)
     if motion is not None:
         scenario = with_motion(scenario, motion)
@@ -65,3 +68,36 @@ def hsr_speed(goal_count, simulated_seconds, meshcat=None, motion=None):
             "simulated_s": simulated_seconds, "wall_s": wall,
             "realtime_factor": simulated_seconds / wall, "build_s": built,
             "control_period_s": scenario.control_period}
+
+
+def closed_loop_runs(goal_counts, simulated_seconds, dynamic_goals=None, meshcat=False,
+                     progress=print):
+    """The bench's closed-loop runs, each K's as one result: headless on the shipped
+    robot, and on the dynamic robot at K = `dynamic_goals`, each the median of
+    `HSR_REPEATS` runs taken in rounds over all of them (so that a slow stretch of this
+    shared machine, which lasts seconds, spreads over every K rather than falling on one
+    K's runs; every run's factor is kept in `realtime_factors`); then, with `meshcat`,
+    one run each with Meshcat publishing. In K order, headless first."""
+    headless = [(k, None) for k in goal_counts] + (
+        [(dynamic_goals, DYNAMIC)] if dynamic_goals in goal_counts else [])
+    samples = {config: [] for config in headless}
+    for round_ in range(HSR_REPEATS):
+        progress(f"HSR reaching, round {round_ + 1} of {HSR_REPEATS}: K = "
+                 + ", ".join(f"{k}{f' ({motion} robot)' if motion else ''}"
+                             for k, motion in headless) + ", headless ...")
+        for k, motion in headless:
+            samples[(k, motion)].append(hsr_speed(k, simulated_seconds, None, motion))
+    results = []
+    for (k, motion), runs in samples.items():
+        walls = [run["wall_s"] for run in runs]
+        result = dict(runs[int(np.argsort(walls)[len(walls) // 2])])  # the median run
+        result.update(meshcat=False, shipped_robot=motion is None,
+                      realtime_factors=[run["realtime_factor"] for run in runs])
+        results.append(result)
+    for k in goal_counts if meshcat else ():
+        progress(f"HSR reaching, K = {k}, Meshcat ...")
+        server = Meshcat(MeshcatParams(host="localhost"))
+        results.append(dict(hsr_speed(k, simulated_seconds, server), meshcat=True,
+                            shipped_robot=True))
+        del server
+    return sorted(results, key=lambda run: (run["goals"], run["meshcat"]))

@@ -87,9 +87,12 @@ def format_report(report):
         for run in report["closed_loop"]:
             where = ("Meshcat" if run["meshcat"] else "headless") + (
                 "" if run.get("shipped_robot", True) else f", {run['motion']} robot")
+            factors = run.get("realtime_factors", ())
+            of = (f"median of {', '.join(f'{factor:.1f}' for factor in factors)}; "
+                  if len(factors) > 1 else "")
             lines.append(f"  K = {run['goals']:>5} {where:>8}:"
-                         f" {run['realtime_factor']:7.2f}x real time "
-                         f"({run['simulated_s']:.1f} s in {run['wall_s']:.2f} s wall; "
+                         f" {run['realtime_factor']:7.2f}x real time ({of}"
+                         f"{run['simulated_s']:.1f} s in {run['wall_s']:.2f} s wall; "
                          f"built in {run['build_s']:.1f} s)")
     lines.append("")
     lines.append(format_results(report["checks"]))

@@ -9,14 +9,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Meshcat, MeshcatParams
 
 import pbp_drake.bench
 from pbp_drake.bench.cases import (
     BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_fields)
 from pbp_drake.bench.checks import MOTION_ROWS, PEERS, evaluate, exit_code
 from pbp_drake.bench.checks import CHECKED_HSR_GOALS
-from pbp_drake.bench.closed_loop import HSR_KS, DYNAMIC, hsr_speed
+from pbp_drake.bench.closed_loop import HSR_KS, closed_loop_runs
 from pbp_drake.bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
 from pbp_drake.bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
@@ -134,22 +133,9 @@ def _measure(args):
             _print_progress(rows[-1])
     rows.sort(key=lambda row: (bool(row.get("pose")), row["D"], row["K"]))
 
-    closed_loop = []
-    for goal_count in settings["hsr_goals"]:
-        runs = [(False, None)] if args.no_meshcat else [(False, None), (True, None)]
-        if goal_count == CHECKED_HSR_GOALS:
-            # The dynamic robot beside the shipped (kinematic) one, measured, not checked.
-            runs.append((False, DYNAMIC))
-        for with_meshcat, motion in runs:
-            print(f"HSR reaching, K = {goal_count}, "
-                  f"{'Meshcat' if with_meshcat else 'headless'}"
-                  f"{f', {motion} robot' if motion else ''} ...", flush=True)
-            meshcat = Meshcat(MeshcatParams(host="localhost")) if with_meshcat else None
-            result = hsr_speed(goal_count, hsr_seconds, meshcat, motion)
-            result["meshcat"] = with_meshcat
-            result["shipped_robot"] = motion is None
-            closed_loop.append(result)
-            del meshcat
+    closed_loop = closed_loop_runs(settings["hsr_goals"], hsr_seconds, CHECKED_HSR_GOALS,
+                                   meshcat=not args.no_meshcat,
+                                   progress=lambda text: print(text, flush=True))
 
     report = {
         "machine": {"processor": platform.processor() or platform.machine(),

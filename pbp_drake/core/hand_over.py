@@ -23,6 +23,8 @@ import math
 
 import numpy as np
 
+from pbp_drake.core.coordinates import vector_length
+
 
 def check_limit(value, name, unit):
     """`value` as a float; raises ValueError naming `name` unless it is a finite positive
@@ -37,7 +39,7 @@ def check_limit(value, name, unit):
 
 def _clip(vector, largest):
     """`vector` scaled down to length `largest` when it is longer (a new array)."""
-    size = float(np.linalg.norm(vector))
+    size = vector_length(vector)
     return vector * (largest / size) if size > largest else np.array(vector, dtype=float)
 
 

@@ -12,6 +12,8 @@ import dataclasses
 
 import numpy as np
 
+from pbp_drake.core.coordinates import vector_length
+
 
 @dataclasses.dataclass(frozen=True)
 class ReachScene:
@@ -86,10 +88,10 @@ def validate_objects(objects, min_separation, reach_x=(0.3, 3.5), reach_height=(
 
 def reach_progress(position, start, target):
     """`1 - |p - target| / |start - target|`, clipped to [0, 1]."""
-    total = np.linalg.norm(np.asarray(target) - start)
+    total = vector_length(np.asarray(target) - start)
     if total <= 0.0:
         return 1.0
-    return float(np.clip(1.0 - np.linalg.norm(np.asarray(target) - position) / total, 0.0, 1.0))
+    return float(np.clip(1.0 - vector_length(np.asarray(target) - position) / total, 0.0, 1.0))
 
 
 def wrap_angle(angle):

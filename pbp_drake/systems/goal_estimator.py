@@ -5,6 +5,7 @@ import dataclasses
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.goal_estimation import (
     NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate, validate_goals)
 from pbp_drake.systems.layouts import EeState, position_of
@@ -125,7 +126,7 @@ class GoalEstimator(LeafSystem):
             return
         position, heading, goals = self._inputs(context)
         memory = context.get_discrete_state(self._memory_index).value().copy()
-        memory[PATH_LENGTH] += np.linalg.norm(position - memory[LAST_POSITION:LAST_POSITION + 3])
+        memory[PATH_LENGTH] += vector_length(position - memory[LAST_POSITION:LAST_POSITION + 3])
         memory[LAST_POSITION:LAST_POSITION + 3] = position
         selected = int(context.get_discrete_state(self._selected_index).value()[0])
         previous = SelectionMemory(selected, int(memory[CHALLENGER]), int(memory[COUNT]))

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 from pydrake.systems.framework import EventStatus, LeafSystem
 
+from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.reach_task import reach_progress
 from pbp_drake.systems.layouts import EeState, Target, TaskStatus, position_of
 from pbp_drake.systems.tick import decide_offset, report_offset
@@ -228,4 +229,4 @@ class TaskMonitor(TaskMonitorBase):
         return reach_progress(hand, self._start, self._objects[index])
 
     def _reached(self, hand, index):
-        return bool(np.linalg.norm(hand - self._objects[index]) <= self._success_distance)
+        return bool(vector_length(hand - self._objects[index]) <= self._success_distance)

@@ -4,7 +4,8 @@ With ``HsrStationConfig.motion = "kinematic"`` the station steps no plant. The
 MultibodyPlant is finalized outside the Diagram, for its kinematics (the diff IK's and the
 hand's) and its geometry, which ``MultibodyPositionToGeometryPose`` places in SceneGraph
 from ``KinematicJoints``' state (collisions, Meshcat). What the dynamic station's stiff
-servos approach, a few hundredths of a mm behind the plan, this station is exactly.
+servos approach (hundredths of a mm behind the plan, a tenth at most where its velocity
+changes), this station is exactly.
 """
 
 import numpy as np

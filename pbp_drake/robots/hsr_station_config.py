@@ -50,8 +50,9 @@ class HsrStationConfig:
     # behind it. "kinematic": the joints are on the plan at every instant (the servos'
     # limit as w grows; the plant only gives the kinematics and the geometry, and its
     # step, gains and plant settings go unused): about twice the closed loop's speed,
-    # and on the shipped tasks the same study results within noise (README, "A kinematic
-    # robot"). Nothing pushes the robot in either (gravity is off, obstacles measured).
+    # and in the reaching and grasping tasks, which ship with it, the same study results
+    # within their trial-to-trial noise (README, "A kinematic robot"). Nothing pushes the
+    # robot in either (gravity is off, obstacles are measured).
     motion: str = "dynamic"
     # The whole-body differential IK's period (s), a whole multiple of plant.time_step;
     # its QP is the station's largest cost.

@@ -19,18 +19,21 @@ import numpy as np
 from pbp_drake.studies.summary import measures_collisions
 from pbp_drake.studies.trial_files import read_study
 
-# (name in the table, how a trial's value is read, whether both trials must have succeeded)
+# Metrics that only a task with obstacles measures.
 _COLLISION_METRICS = ("collision_ratio", "collision_free")
+# (name in the table, how a trial's value is read (None: not recorded, as in trials written
+# before the field existed), whether both trials must have succeeded)
 _METRICS = (
     ("success", lambda record: float(bool(record["success"])), False),
-    ("intervention_ratio", lambda record: record["intervention_ratio"], False),
-    ("task_time", lambda record: record["task_time"], True),
-    ("switches", lambda record: record["switches"], False),
-    ("collision_ratio", lambda record: record["collision_ratio"], False),
-    ("collision_free", lambda record: (None if record["collision_ratio"] is None
+    ("intervention_ratio", lambda record: record.get("intervention_ratio"), False),
+    ("task_time", lambda record: record.get("task_time"), True),
+    ("switches", lambda record: record.get("switches"), False),
+    ("collision_ratio", lambda record: record.get("collision_ratio"), False),
+    ("collision_free", lambda record: (None if record.get("collision_ratio") is None
                                        else float(record["collision_ratio"] == 0.0)), False),
-    ("peak_hand_speed", lambda record: record["peak_hand_speed"], False),
-    ("peak_command_acceleration", lambda record: record["peak_command_acceleration"], False),
+    ("peak_hand_speed", lambda record: record.get("peak_hand_speed"), False),
+    ("peak_command_acceleration", lambda record: record.get("peak_command_acceleration"),
+     False),
     # The grasping task's orientation (other tasks' trials have neither).
     ("final_angle_to_target", lambda record: record.get("final_angle_to_target"), False),
     ("peak_command_angular_change", lambda record: record.get("peak_command_angular_change"),

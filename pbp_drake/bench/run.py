@@ -13,8 +13,7 @@ import numpy as np
 import pbp_drake.bench
 from pbp_drake.bench.cases import (
     BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_fields)
-from pbp_drake.bench.checks import MOTION_ROWS, PEERS, evaluate, exit_code
-from pbp_drake.bench.checks import CHECKED_HSR_GOALS
+from pbp_drake.bench.checks import CHECKED_HSR_GOALS, MOTION_ROWS, PEERS, evaluate, exit_code
 from pbp_drake.bench.closed_loop import HSR_KS, closed_loop_runs
 from pbp_drake.bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)

@@ -119,9 +119,10 @@ def connect_reader(builder, port):
     builder.Connect(port, reader.get_input_port())
 
 
-def leaf_simulator(case, bank=None):
+def leaf_simulator(case, bank=None, read="selected_reference"):
     """A Simulator of the bank's LeafSystem (or the null one) fed by constant sources, its
-    followed and selected goal 0 and its selected reference read every period."""
+    followed and selected goal 0 and its output `read` read every period (`references`,
+    all K, for the report: the null system has none)."""
     builder = DiagramBuilder()
     d = case.dimension
     # The compact state wherever the builder would use it: a case's shared weights come
@@ -140,7 +141,7 @@ def leaf_simulator(case, bank=None):
     builder.Connect(goals.get_output_port(), system.GetInputPort("goals"))
     for name in ("followed_goal", "selected_goal"):
         builder.Connect(goal.get_output_port(), system.GetInputPort(name))
-    connect_reader(builder, system.GetOutputPort("selected_reference"))
+    connect_reader(builder, system.GetOutputPort(read))
     simulator = Simulator(builder.Build())
     simulator.Initialize()
     return simulator

@@ -1,6 +1,12 @@
 """The cases timed: one bank of K DMPs in D dimensions, and the steps of it that the bench
 times (the bank math alone, the bank inside its LeafSystem, and a LeafSystem with the same
-ports and state whose update does nothing: Drake's own cost)."""
+ports and state whose update does nothing: Drake's own cost).
+
+The LeafSystem is wired as the builder wires it: its `followed_goal` and `selected_goal`
+connected, a bank of shared weights in the compact state (`DmpBank(compact_state=True)`),
+and a reader that evaluates its `selected_reference` at every period, as the blender does:
+a step's time is its update and that read. (A bank could otherwise look fast by leaving
+its work to an output no timing reads.)"""
 
 import dataclasses
 
@@ -14,6 +20,7 @@ from pbp_drake.bench.timing import timed_span
 from pbp_drake.core.dmp import DmpBank, DmpSettings, fit_weights, minimum_jerk
 from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
 from pbp_drake.systems.goals_source import GoalsSource
+from pbp_drake.systems.tick import report_offset
 
 BASIS = 50
 DT = 0.001  # a 1 kHz control loop
@@ -71,35 +78,70 @@ def bank_math_step(bank, case):
 
 class NullBank(LeafSystem):
     """A LeafSystem with the DmpBank system's ports and state and an update that does
-    nothing: Drake's own cost of one periodic discrete update."""
+    nothing: Drake's own cost of one periodic discrete update (and of the read)."""
 
-    def __init__(self, goal_count, dimension):
+    def __init__(self, goal_count, dimension, compact_state):
         super().__init__()
         k, d = goal_count, dimension
         self.DeclareVectorInputPort("robot_state", 2 * d)
         self.DeclareVectorInputPort("goals", k * d)
         self.DeclareVectorInputPort("operator_active", 1)
-        self.DeclareDiscreteState(np.zeros(DmpBankSystem.state_size(k, d)))
+        self.DeclareVectorInputPort("followed_goal", 1)
+        self.DeclareVectorInputPort("selected_goal", 1)
+        self.DeclareDiscreteState(np.zeros(DmpBankSystem.state_size(k, d, compact_state)))
+        self.DeclareVectorOutputPort("selected_reference", 2 * d, self._calc_reference,
+                                     prerequisites_of_calc={self.xd_ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(DT, 0.0, self._update)
 
     def _update(self, context, discrete_state):
         pass
 
+    def _calc_reference(self, context, output):
+        pass
 
-def leaf_simulator(case, bank=None):
-    """A Simulator of the bank's LeafSystem (or the null one) fed by constant sources."""
+
+class ReferenceReader(LeafSystem):
+    """Evaluates its input once a period, after the bank's update (at the report stage of
+    `pbp_drake.systems.tick`, as the hand-over reads the blender): a consumer's read."""
+
+    def __init__(self, size):
+        super().__init__()
+        self._port = self.DeclareVectorInputPort("reference", size)
+        self.DeclarePeriodicPublishEvent(DT, report_offset(DT), self._read)
+
+    def _read(self, context):
+        self._port.EvalAbstract(context)
+
+
+def connect_reader(builder, port):
+    """A `ReferenceReader` of `port` in `builder`."""
+    reader = builder.AddSystem(ReferenceReader(port.size()))
+    builder.Connect(port, reader.get_input_port())
+
+
+def leaf_simulator(case, bank=None, read="selected_reference"):
+    """A Simulator of the bank's LeafSystem (or the null one) fed by constant sources, its
+    followed and selected goal 0 and its output `read` read every period (`references`,
+    all K, for the report: the null system has none)."""
     builder = DiagramBuilder()
     d = case.dimension
+    # The compact state wherever the builder would use it: a case's shared weights come
+    # with one start (`make_bank`), so its DMPs are affine in the goal.
+    compact = case.weights is None
     if bank is None:
-        system = builder.AddSystem(NullBank(case.goal_count, d))
+        system = builder.AddSystem(NullBank(case.goal_count, d, compact))
     else:
-        system = builder.AddSystem(DmpBankSystem(bank, DT))
+        system = builder.AddSystem(DmpBankSystem(bank, DT, compact_state=compact))
     robot = builder.AddSystem(ConstantVectorSource(np.concatenate([case.robot, np.zeros(d)])))
     # Our goals source, as the builder uses: Drake's ConstantVectorSource would make the
     # bank re-read its goals at every update.
     goals = builder.AddSystem(GoalsSource(case.goals))
-    builder.Connect(robot.get_output_port(), system.get_input_port(0))
-    builder.Connect(goals.get_output_port(), system.get_input_port(1))
+    goal = builder.AddSystem(ConstantVectorSource([0.0]))
+    builder.Connect(robot.get_output_port(), system.GetInputPort("robot_state"))
+    builder.Connect(goals.get_output_port(), system.GetInputPort("goals"))
+    for name in ("followed_goal", "selected_goal"):
+        builder.Connect(goal.get_output_port(), system.GetInputPort(name))
+    connect_reader(builder, system.GetOutputPort(read))
     simulator = Simulator(builder.Build())
     simulator.Initialize()
     return simulator

@@ -5,15 +5,18 @@ beside a LeafSystem with the same ports and state whose update does nothing.
 The LeafSystem is wired as the PBP controller wires the position bank: `followed_goal`
 connected (every DMP continues from the followed DMP's velocities), so that the update
 steps the orientation DMPs in log coordinates and reads one DMP's angular velocity back
-(`PoseDmpBank._update`). The row also times it unconnected (`leaf_own_us`: each DMP keeps
-its own velocities, and every update reads all K angular velocities back)."""
+(`PoseDmpBank._update`), and its `selected_reference` read at every period, as the pose
+blender reads it (`pbp_drake.bench.cases.ReferenceReader`). The row also times it with
+`followed_goal` unconnected (`leaf_own_us`: each DMP keeps its own velocities, and every
+update reads all K angular velocities back)."""
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.bench.cases import BASIS, DT, leaf_step, make_bank, make_case, motion_fields
+from pbp_drake.bench.cases import (
+    BASIS, DT, connect_reader, leaf_step, make_bank, make_case, motion_fields)
 from pbp_drake.bench.checks import MOTION_ROWS
 from pbp_drake.bench.report import microseconds
 from pbp_drake.bench.timing import timed
@@ -65,7 +68,8 @@ def pose_math_step(positions, orientations, goals, hand):
 
 
 class NullPoseBank(LeafSystem):
-    """The PoseDmpBank's ports and state, an update that does nothing: Drake's own cost."""
+    """The PoseDmpBank's ports and state, an update that does nothing: Drake's own cost
+    (and the read's)."""
 
     def __init__(self, goal_count):
         super().__init__()
@@ -73,9 +77,15 @@ class NullPoseBank(LeafSystem):
         self.DeclareVectorInputPort("goal_poses", goal_count * GoalPose.size)
         self.DeclareVectorInputPort("followed_goal", 1)
         self.DeclareDiscreteState(np.zeros(PoseDmpBank.state_size(goal_count)))
+        self.DeclareVectorOutputPort("selected_reference", PoseState.size,
+                                     self._calc_reference,
+                                     prerequisites_of_calc={self.xd_ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(DT, 0.0, self._update)
 
     def _update(self, context, discrete_state):
+        pass
+
+    def _calc_reference(self, context, output):
         pass
 
 
@@ -95,6 +105,7 @@ def pose_leaf_simulator(goal_count, goals, hand, banks=None, followed=True):
     if followed:
         index = builder.AddSystem(ConstantVectorSource([0.0]))
         builder.Connect(index.get_output_port(), followed_port)
+    connect_reader(builder, system.GetOutputPort("selected_reference"))
     simulator = Simulator(builder.Build())
     simulator.Initialize()
     return simulator

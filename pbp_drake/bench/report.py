@@ -36,8 +36,10 @@ def format_report(report):
     lines.append("One step of all K DMPs from one robot state, microseconds (median); "
                  "N = 50, dt = 1 ms.")
     lines.append("math: DmpBank.advance_into; leaf: the DmpBank LeafSystem per 1 ms period "
-                 "in a Simulator (includes Drake); drake: a LeafSystem with the same ports "
-                 "and an empty update;")
+                 "in a Simulator (includes Drake), wired as the builder wires it (followed "
+                 "and selected goal connected, shared weights in the compact state, the "
+                 "selected reference read every period); drake: a LeafSystem with the "
+                 "same ports and an empty update;")
     lines.append("bound: weight bytes / measured read bandwidth (cache-sized bound in "
                  "brackets); pydmps/goal, mp/goal: one object per goal; mp stacked: one "
                  "K*D DMP; x per-goal, x stacked: speed-ups of the bank math. D = 6p: the "
@@ -58,6 +60,16 @@ def format_report(report):
             f"{_fmt(row['mp_per_goal_us'], 10)} {_fmt(row['mp_stacked_us'], 11)} "
             f"{_fmt(row['speedup_vs_per_goal'], 10)} {_fmt(row['speedup_vs_stacked'], 9)} "
             f"{_fmt(row['control_rate_hz'])}")
+    every = [row for row in report["steps"] if row.get("leaf_all_references_us")]
+    if every:
+        lines.append("")
+        lines.append("leaf reads the selected goal's reference every period, as the "
+                     "builder's blender does (O(D)); reading all K references instead, "
+                     "as a consumer of every DMP would (microseconds per period):")
+        for row in every:
+            lines.append(f"  D = {row['D']} K = {row['K']:>6} {row['weights']:>8}: "
+                         f"{_fmt(row['leaf_all_references_us'])} us (leaf "
+                         f"{_fmt(row['leaf_us'])} us)")
     poses = [row for row in report["steps"] if row.get("pose")]
     if poses:
         lines.append("")

@@ -176,6 +176,11 @@ def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have
         row[f"{label}_us"] = microseconds(median / periods)
         row[f"{label}_min_us"] = microseconds(minimum / periods)
         del simulator
+    # What a consumer of all K references (not the builder's blender) would add.
+    simulator = leaf_simulator(case, make_bank(case), read="references")
+    row["leaf_all_references_us"] = microseconds(
+        timed(leaf_step(simulator, periods), min_time, warmup=1)[0] / periods)
+    del simulator
     if ((dimension, goal_count, row["weights"]), False) in MOTION_ROWS:
         row.update(motion_fields(leaf_simulator(case, make_bank(case)), bank.duration,
                                  periods))

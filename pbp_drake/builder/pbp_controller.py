@@ -3,7 +3,8 @@ blender and the heading, between the hand's sampled state and the station's comm
 
     ee_state (sampled) ──> ee_state_split ──[p, v]──> dmp_bank, blender
                        └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
-                                              dmp_bank (followed_goal)
+                                              dmp_bank (followed_goal, selected_goal)
+    dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
     goals ──> dmp_bank, goal_estimator
     operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
                                             └─> heading_command
@@ -78,7 +79,10 @@ def make_pbp_controller(resolved, prediction_steps=0):
         # operator holding the hand off the DMP's path winds the DMP's velocity up past the
         # hand's speed limit until it overrides them (the other modes never hold it so).
         max_speed=(scenario.robot.max_hand_speed if resolved.blend_mode == "pbp_continuous"
-                   else None)))
+                   else None),
+        # Every DMP steps from the followed one's velocity (connected below): with shared
+        # weights and start (every scenario's bank) the state is then O(D) whatever K.
+        compact_state=bank.affine_in_goal))
     builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
@@ -94,7 +98,11 @@ def make_pbp_controller(resolved, prediction_steps=0):
     blender = builder.AddNamedSystem("blender", Blender(
         resolved.blend_mode, 3, goal_count, period, scenario.alpha))
     builder.Connect(position_velocity, blender.get_robot_state_input_port())
-    builder.Connect(dmp_bank.get_references_output_port(), blender.get_references_input_port())
+    # The blender follows the selected goal's reference alone (O(D), not all K).
+    builder.Connect(dmp_bank.get_selected_reference_output_port(),
+                    blender.get_policy_reference_input_port())
+    builder.Connect(estimator.get_selected_goal_output_port(),
+                    dmp_bank.get_selected_goal_input_port())
     builder.Connect(estimator.get_selected_goal_output_port(),
                     blender.get_selected_goal_input_port())
     # Read at the decide stage before the estimator updates: the goal followed last tick.

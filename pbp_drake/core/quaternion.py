@@ -27,6 +27,8 @@ left Jacobian of SO(3) (`left_jacobian_times`)
 `SERIES_BELOW` radians, where the closed forms lose digits to cancellation.
 """
 
+import math
+
 import numpy as np
 
 # How far from 1 a quaternion's norm may be and still be taken as a unit quaternion (then
@@ -125,6 +127,28 @@ def exp_map(rotation_vector):
     # sin(angle / 2) / angle, exact at 0: numpy's sinc(u) = sin(pi u) / (pi u).
     half_sinc = 0.5 * np.sinc(angle / (2.0 * np.pi))
     return np.concatenate([np.cos(0.5 * angle)[np.newaxis], rotation_vector * half_sinc])
+
+
+def exp_times_aligned(rotation_vector, q, reference):
+    """`aligned(multiply(exp_map(r), q), reference)` for ONE rotation vector (3,) and
+    quaternions `q`, `reference` (4,), in float arithmetic: the same operations in the
+    same order, so the same numbers bit for bit, at a tenth of the time (at one quaternion
+    a NumPy call costs more than the whole product). A new (4,) array."""
+    rx, ry, rz = (float(value) for value in rotation_vector)
+    qw, qx, qy, qz = (float(value) for value in q)
+    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
+    # numpy's sinc(u) = sin(pi u) / (pi u), with u = 1e-20 at 0 (exp_map).
+    u = angle / (2.0 * math.pi)
+    y = math.pi * (u if u != 0.0 else 1.0e-20)
+    half_sinc = 0.5 * (math.sin(y) / y)
+    pw = math.cos(0.5 * angle)
+    px, py, pz = rx * half_sinc, ry * half_sinc, rz * half_sinc
+    product = [pw * qw - px * qx - py * qy - pz * qz,
+               pw * qx + px * qw + py * qz - pz * qy,
+               pw * qy - px * qz + py * qw + pz * qx,
+               pw * qz + px * qy - py * qx + pz * qw]
+    dot = sum(value * float(other) for value, other in zip(product, reference))
+    return -np.array(product) if dot < 0.0 else np.array(product)
 
 
 def angle_between(p, q):

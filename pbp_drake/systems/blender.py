@@ -93,7 +93,8 @@ class Blender(BlenderBase):
         name: Blender
         input_ports:
         - robot_state
-        - references
+        - references (optional)
+        - policy_reference (optional)
         - selected_goal (optional)
         - operator_command
         - operator_active
@@ -106,7 +107,10 @@ class Blender(BlenderBase):
     (`(1 - alpha) U + alpha P`), `confidence_alpha` (the same with `alpha` from the goal
     estimator's confidence) and `teleop` (`U`). `robot_state` must be the state sampled
     at the control tick (the builder puts a ZeroOrderHold in front); `references` holds K
-    next states and `selected_goal` picks one (goal 0 when unconnected). The output is
+    next states and `selected_goal` picks one (goal 0 when unconnected), unless
+    `policy_reference` is connected: the selected goal's next state alone
+    (`DmpBank.selected_reference`, O(D) where `references` is O(K D)), which is then
+    followed and `references` is not read. The output is
     `[position (D), velocity (D)]`. A NaN or infinite operator command raises.
 
     `goal_probabilities` (K) is read only in `confidence_alpha` mode, where it must be
@@ -129,6 +133,7 @@ class Blender(BlenderBase):
         d, k = self._dimension, self._goal_count
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._references_port = self.DeclareVectorInputPort("references", 2 * k * d)
+        self._policy_reference_port = self.DeclareVectorInputPort("policy_reference", 2 * d)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._operator_command_port = self.DeclareVectorInputPort("operator_command", d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
@@ -145,6 +150,9 @@ class Blender(BlenderBase):
 
     def get_references_input_port(self):
         return self._references_port
+
+    def get_policy_reference_input_port(self):
+        return self._policy_reference_port
 
     def get_selected_goal_input_port(self):
         return self._selected_goal_port
@@ -167,12 +175,15 @@ class Blender(BlenderBase):
         # Computed (and the port checked) even while the operator is idle, when the law
         # plays P: a missing goal_probabilities connection fails at the first tick.
         alpha = self.alpha(context)
-        references = self._references_port.Eval(context).reshape(2, k, d)
+        if self._policy_reference_port.HasValue(context):
+            reference = self._policy_reference_port.Eval(context).reshape(2, d)
+        else:
+            reference = self._references_port.Eval(context).reshape(2, k, d)[:, selected]
         position, velocity = blend(
             self._mode,
             self._robot_state_port.Eval(context)[:d],
-            references[0, selected],
-            references[1, selected],
+            reference[0],
+            reference[1],
             self._operator_command_port.Eval(context),
             self._operator_active_port.Eval(context)[0] > 0.5,
             self._period,

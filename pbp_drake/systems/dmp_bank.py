@@ -11,7 +11,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
-from pbp_drake.core.dmp.stepping import limit_speeds
+from pbp_drake.systems.dmp_bank_layouts import AffineLayout, PerGoalLayout
 from pbp_drake.systems.layouts import goal_index
 from pbp_drake.systems.tick import decide_offset
 
@@ -27,8 +27,10 @@ class DmpBank(LeafSystem):
         - goals
         - operator_active (optional)
         - followed_goal (optional)
+        - selected_goal (optional)
         output_ports:
         - references
+        - selected_reference
         - phase
         - predicted_paths
 
@@ -49,23 +51,26 @@ class DmpBank(LeafSystem):
     the period). Unconnected, each DMP keeps a velocity of its own, which relaxes toward its
     own attractor while the robot follows another.
 
-    `references` is the K next states `[positions (K*D), velocities (K*D)]`, `phase` the K
-    phases; `predicted_paths` (declared when `prediction_steps > 0`) is each DMP's open-loop
-    path from its current state, `(K, prediction_steps + 1, D)` flattened, for drawing,
-    sampled every `prediction_period` (default: the control period).
+    `references` is the K next states `[positions (K*D), velocities (K*D)]`;
+    `selected_reference` the next state `[position (D), velocity (D)]` of `selected_goal`
+    alone (unconnected: the followed goal, else goal 0), what a blender reads: O(D) to
+    compute where `references` is O(K D). `phase` is the K phases; `predicted_paths`
+    (declared when `prediction_steps > 0`) is each DMP's open-loop path from its current
+    state, `(K, prediction_steps + 1, D)` flattened, for drawing, sampled every
+    `prediction_period` (default: the control period).
     All state lives in the Context, and so does the step's scratch memory (a cache entry).
 
-    The state is one vector `[phase, held, p (D), z (D*K), dp (D*K), dz (D*K)]` (`_split` is
-    the one place that knows the layout). PBP steps every DMP from the robot's position `p`
-    and never from the DMP's own, and the step is affine in the DMP's velocity `z`
-    (`p' = p + dp + Phi01 z`, `z' = dz + Phi11 z`, see `pbp_drake.core.dmp.stepping`), so
-    the state keeps, of each step, what its outputs are read from: the DMPs' velocities `z`
-    before the step and the step's attractor terms `dp`, `dz`; `references` reads the
-    stepped positions and velocities out. With shared weights an update is then six passes
-    over `(D, K)`, and Drake copies three `(D, K)` arrays; the goals are checked and laid
-    out `(D, K)` in a cache entry, once per change. While `held` (at the start, and while
-    PBP-Alt locks the phases) the DMPs sit at `p + dp` with velocity `z`. All DMPs of the
-    system share one phase: the lock is one input.
+    The state is one vector, in one of two layouts (`pbp_drake.systems.dmp_bank_layouts`):
+    every DMP's velocity and attractor terms (`3 K D` numbers, which Drake copies twice an
+    update), or, with `compact_state=True`, `2 + 6 D` numbers whatever K: for DMPs that
+    share weights and start (`bank.affine_in_goal`; a bank from one demonstration or
+    straight, as every scenario's) when `followed_goal` is connected (it must be: an
+    update raises otherwise), since the attractor terms are then affine in the goal and
+    every DMP steps from one velocity. The outputs are then computed from the goals on
+    the port, and equal the per-goal layout's bit for bit while the goals do not change
+    between an update and a read (when they change, the outputs and the next update read
+    the new goals, as if the last step had been taken toward them). The goals are checked and laid out `(D, K)` in a cache
+    entry, once per change. All DMPs of the system share one phase: the lock is one input.
 
     The bank updates at the decide stage of each control tick
     (`pbp_drake.systems.tick.decide_offset`), so that it reads the robot's state sampled at
@@ -75,7 +80,7 @@ class DmpBank(LeafSystem):
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
                  prediction_steps=0, update_offset=None, prediction_period=None,
-                 max_speed=None):
+                 max_speed=None, compact_state=False):
         super().__init__()
         self._bank = bank
         # Anti-windup: the hand-over law never lets the hand move faster than this (m/s), so
@@ -93,16 +98,14 @@ class DmpBank(LeafSystem):
             raise ValueError(
                 f"update_offset must be in [0, control_period), got {update_offset!r}")
         k, d = bank.goal_count, bank.dimension
+        self._layout = (AffineLayout if compact_state else PerGoalLayout)(
+            bank, self._period, self._max_speed)
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._goals_port = self.DeclareVectorInputPort("goals", k * d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
-        # Held at the start: the DMPs sit at their starts (p = 0, dp = starts), at rest.
-        initial = np.zeros(self.state_size(k, d))
-        phase, held, _, _, dp, _ = self._split(initial)
-        phase[0], held[0] = 1.0, 1.0
-        dp[...] = bank.starts
-        self._state_index = self.DeclareDiscreteState(initial)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._state_index = self.DeclareDiscreteState(self._layout.initial())
         # The goals checked and laid out (D, K) once each time they change, not each tick.
         self._goals_dk = self.DeclareCacheEntry(
             "goals, validated, (D, K) contiguous",
@@ -117,11 +120,17 @@ class DmpBank(LeafSystem):
             ValueProducer(allocate=lambda: AbstractValue.Make(bank.make_workspace()),
                           calc=self._never_calculated),
             prerequisites_of_calc={self.nothing_ticket()})
-        # The outputs depend on the bank's own state only: say so, so that Drake does not
-        # recompute them after every plant step.
+        # The outputs depend on the bank's own state only (and, in the compact layout, on
+        # the goals): say so, so that Drake does not recompute them after every plant step.
+        state = {self.xd_ticket()}
+        if self._layout.reads_goals:
+            state.add(self._goals_port.ticket())
         self._references_port = self.DeclareVectorOutputPort(
-            "references", 2 * k * d, self._calc_references,
-            prerequisites_of_calc={self.xd_ticket()})
+            "references", 2 * k * d, self._calc_references, prerequisites_of_calc=state)
+        self._selected_reference_port = self.DeclareVectorOutputPort(
+            "selected_reference", 2 * d, self._calc_selected_reference,
+            prerequisites_of_calc=state | {self._selected_goal_port.ticket(),
+                                           self._followed_goal_port.ticket()})
         self._phase_port = self.DeclareVectorOutputPort(
             "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
         self._predicted_paths_port = None
@@ -134,9 +143,9 @@ class DmpBank(LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     @staticmethod
-    def state_size(goal_count, dimension):
-        """The length of the one state vector `[phase, held, p, z, dp, dz]`."""
-        return 2 + dimension + 3 * goal_count * dimension
+    def state_size(goal_count, dimension, compact_state=False):
+        """The length of the one state vector (`2 + 6 D` compact, else `2 + D + 3 K D`)."""
+        return 2 + (6 * dimension if compact_state else dimension + 3 * goal_count * dimension)
 
     @property
     def bank(self):
@@ -154,22 +163,20 @@ class DmpBank(LeafSystem):
     def get_followed_goal_input_port(self):
         return self._followed_goal_port
 
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
     def get_references_output_port(self):
         return self._references_port
+
+    def get_selected_reference_output_port(self):
+        return self._selected_reference_port
 
     def get_phase_output_port(self):
         return self._phase_port
 
     def get_predicted_paths_output_port(self):
         return self._predicted_paths_port
-
-    def _split(self, vector):
-        """Views of a state vector: phase (1,), held (1,), p (D, 1), z, dp and dz (D, K)."""
-        d, k = self._bank.dimension, self._bank.goal_count
-        z, dp, dz = (2 + d + i * k * d for i in range(3))
-        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
-                vector[z:dp].reshape(d, k), vector[dp:dz].reshape(d, k),
-                vector[dz:dz + k * d].reshape(d, k))
 
     def _workspace(self, context):
         """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""
@@ -180,29 +187,31 @@ class DmpBank(LeafSystem):
     def _never_calculated(context, value):
         raise RuntimeError("the DmpBank workspace is scratch memory, never evaluated")
 
+    def _state(self, context):
+        return context.get_discrete_state(self._state_index).get_value()
+
     def dmp_states(self, context):
         """The K DMPs' state after the last update: phases (K,), positions and scaled
         velocities (D, K), new arrays (what `references` reads out)."""
-        bank = self._bank
-        phase, held, robot, z, dp, dz = self._split(
-            context.get_discrete_state(self._state_index).get_value())
-        positions = np.empty(z.shape)
-        velocity = np.empty(z.shape)
-        if held[0]:
-            np.add(robot, dp, out=positions)
-            velocity[...] = z
-        else:
-            bank.stepped_positions_into(robot, dp, z, self._period, positions,
-                                        self._workspace(context))
-            bank.stepped_velocity_into(dz, z, self._period, velocity)
-        return np.full(bank.goal_count, phase[0]), positions, velocity
+        goals_dk = self._goals_dk.Eval(context) if self._layout.reads_goals else None
+        state = self._state(context)
+        positions, velocity = self._layout.read(state, goals_dk, self._workspace(context))
+        return np.full(self._bank.goal_count, self._layout.phase(state)), positions, velocity
+
+    def selected_reference(self, context):
+        """`[position (D), velocity (D)]` of `selected_goal` (unconnected: the followed
+        goal, else goal 0) after the last update, a new array."""
+        k = self._bank.goal_count
+        goal = goal_index(self._selected_goal_port, context, k)
+        if goal is None:
+            goal = goal_index(self._followed_goal_port, context, k, unconnected=0)
+        goals_dk = self._goals_dk.Eval(context) if self._layout.reads_goals else None
+        position, velocity = self._layout.read(self._state(context), goals_dk,
+                                               self._workspace(context), goal)
+        return np.concatenate([position[:, 0], velocity[:, 0] / self._bank.duration])
 
     def _update(self, context, discrete_state):
         # Drake fills `discrete_state` with the current state; the update writes into it.
-        bank, period = self._bank, self._period
-        d = bank.dimension
-        phase, held, robot, z, dp, dz = self._split(
-            discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
         # Every input is evaluated before the workspace is taken: an input's evaluation may
         # reach this system's outputs, whose calculation uses the same workspace.
         robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
@@ -210,26 +219,14 @@ class DmpBank(LeafSystem):
                 and self._operator_active_port.Eval(context)[0] > 0.5)
         goals_dk = None if lock else self._goals_dk.Eval(context)
         # The goal the robot followed since the last update (None: unconnected).
-        followed = goal_index(self._followed_goal_port, context, bank.goal_count)
-        workspace = self._workspace(context)
-        # The velocities the last step left, read out in place (see the class docstring).
-        if not held[0]:
-            bank.stepped_velocity_into(dz, z, period, z)
-            if followed is not None:
-                # Every DMP continues from the velocity of the one the robot followed, so
-                # that a switch to another goal keeps the command's velocity.
-                z[...] = z[:, followed:followed + 1]
-            limit_speeds(z, self._max_speed, bank.duration)
-        robot[:, 0] = robot_state[:d]
-        if lock:
-            # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
-            held[0] = 1.0
-            dp.fill(0.0)
-            np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
-            return
-        held[0] = 0.0
-        bank.attractor_terms_into(phase, robot, goals_dk, period, dp, dz, workspace)
-        phase *= bank.decay(period)
+        followed = goal_index(self._followed_goal_port, context, self._bank.goal_count)
+        if followed is None and self._layout.needs_followed_goal:
+            raise RuntimeError(
+                "DmpBank with compact_state=True steps every DMP from the followed DMP's "
+                "velocity: connect its followed_goal input port")
+        self._layout.update(
+            discrete_state.get_mutable_vector(self._state_index).get_mutable_value(),
+            robot_state, lock, goals_dk, followed, self._workspace(context))
 
     def _calc_goals_dk(self, context, value):
         goals = self._bank.goals_matrix(self._goals_port.Eval(context))
@@ -242,9 +239,11 @@ class DmpBank(LeafSystem):
         references[0] = positions.T
         np.divide(scaled_velocity.T, self._bank.duration, out=references[1])
 
+    def _calc_selected_reference(self, context, output):
+        output.SetFromVector(self.selected_reference(context))
+
     def _calc_phase(self, context, output):
-        phase = self._split(context.get_discrete_state(self._state_index).get_value())[0]
-        output.get_mutable_value()[:] = phase[0]
+        output.get_mutable_value()[:] = self._layout.phase(self._state(context))
 
     def _calc_predicted_paths(self, context, output):
         phase, positions, scaled_velocity = self.dmp_states(context)

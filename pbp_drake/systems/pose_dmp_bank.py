@@ -352,8 +352,7 @@ class PoseDmpBank(LeafSystem):
             return PoseReference(position, np.array(start), velocity, eta_held[:, 0] / tau_w)
         error, log_velocity = log_state[0, :, k], log_state[1, :, k]
         goal = self._goals_entry.Eval(context)[3:, k]
-        rotation = quaternion.aligned(
-            quaternion.multiply(quaternion.exp_map(error), goal), q[:, 0])
+        rotation = quaternion.exp_times_aligned(error, goal, q[:, 0])
         eta = jacobian_of_one(error, log_velocity)
         return PoseReference(position, rotation, velocity, eta / tau_w)
 

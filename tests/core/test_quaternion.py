@@ -116,3 +116,21 @@ def test_unit_quaternions_are_normalised_within_the_tolerance_and_bad_ones_named
         quaternion.unit_quaternions([np.nan, 1.0, 0, 0], "start")
     with pytest.raises(ValueError, match=r"start must be quaternions .* shape \(3,\)"):
         quaternion.unit_quaternions([1.0, 0, 0], "start")
+
+
+def test_exp_times_aligned_is_the_vectorised_composition_bit_for_bit():
+    rng = np.random.default_rng(7)
+    cases = [(np.zeros(3), quaternion.IDENTITY, quaternion.IDENTITY)]  # angle 0: sinc's 1e-20
+    for _ in range(2000):
+        q = rng.normal(size=4)
+        reference = rng.normal(size=4)
+        cases.append((rng.normal(scale=rng.choice([1e-9, 0.1, 1.0, 3.0]), size=3),
+                      q / np.linalg.norm(q), reference / np.linalg.norm(reference)))
+    flipped = 0
+    for rotation_vector, q, reference in cases:
+        expected = quaternion.aligned(quaternion.multiply(quaternion.exp_map(rotation_vector), q),
+                                      reference)
+        got = quaternion.exp_times_aligned(rotation_vector, q, reference)
+        assert np.array_equal(got, expected), (rotation_vector, q, reference)
+        flipped += np.array_equal(got, -quaternion.multiply(quaternion.exp_map(rotation_vector), q))
+    assert 500 < flipped < 1500  # both hemispheres were taken

@@ -325,10 +325,29 @@ class BankStep:
                 np.einsum("nk,ndk->dk", combined, self._weights, out=shapes[row])
         return shapes, combination @ phases
 
-    def _affine_terms_into(self, shapes, lam, positions, goals_dk, constants, out_dp, out_dz,
-                           workspace):
-        """Shared weights, one phase and one start: each row's term is `alpha g + beta`
-        with `(D, 1)` coefficients, two passes over `(D, K)` per row."""
+    @property
+    def affine_in_goal(self):
+        """True when the DMPs share weights and start (and each dimension's amplitude
+        scaling): at one phase, the step's attractor terms are then `alpha g + beta` with
+        per-dimension coefficients (`affine_coefficients`)."""
+        return self._affine_in_goal
+
+    def affine_coefficients(self, phase, position, dt, workspace):
+        """`(alpha, beta)`, each `(2, D, 1)` (views into `workspace`): the attractor terms of
+        the step of `dt` from ONE position `position` (D, 1) at the one phase `phase` are
+        `dp = alpha[0] g + beta[0]` and `dz = alpha[1] g + beta[1]` for every goal `g`,
+        computed as `attractor_terms_into` computes them (the same numbers, bit for bit).
+        Only for a bank `affine_in_goal`."""
+        if not self._affine_in_goal:
+            raise ValueError("affine_coefficients needs DMPs that share weights and start")
+        constants = self.step_constants(dt)
+        shapes, lam = self._combined_shapes(np.asarray(phase, dtype=float), self.decay(dt),
+                                            constants.combination, workspace, True)
+        return self._affine_coefficients_into(shapes, lam, position, constants, workspace)
+
+    def _affine_coefficients_into(self, shapes, lam, positions, constants, workspace):
+        """`alpha` and `beta` of `_affine_terms_into` (with `positions` (D, 1), its `p`
+        part in `beta`) in the workspace's arrays."""
         gains, alpha, beta = constants.offset_gains, workspace.alpha, workspace.beta
         column = workspace.column
         # term = gain (p - g) + S (sigma g + rho) [Ijspeert] or + S - lambda (g - y0) [Pastor]
@@ -340,10 +359,19 @@ class BankStep:
             alpha -= lam
             np.multiply(lam, self._uniform_start, out=column)
             beta += column
-        single = positions.shape[1] == 1
-        if single:
+        if positions.shape[1] == 1:
             np.multiply(gains, positions, out=column)
             beta += column
+        return alpha, beta
+
+    def _affine_terms_into(self, shapes, lam, positions, goals_dk, constants, out_dp, out_dz,
+                           workspace):
+        """Shared weights, one phase and one start: each row's term is `alpha g + beta`
+        with `(D, 1)` coefficients, two passes over `(D, K)` per row."""
+        gains = constants.offset_gains
+        alpha, beta = self._affine_coefficients_into(shapes, lam, positions, constants,
+                                                     workspace)
+        single = positions.shape[1] == 1
         for row, out in ((0, out_dp), (1, out_dz)):
             np.multiply(goals_dk, alpha[row], out=out)
             out += beta[row]

@@ -1,0 +1,174 @@
+"""The two state layouts of Drake's `DmpBank` system: what its discrete state holds, how an
+update writes it, and how the DMPs' stepped states are read out of it.
+
+PBP steps every DMP from the robot's position `p`, and the step is affine in the DMP's own
+velocity `z` (`p' = p + dp + Phi01 z`, `z' = dz + Phi11 z`; `pbp_drake.core.dmp.stepping`),
+so a layout keeps, of each step, what its outputs are read from: the velocities `z` before
+the step and the step's attractor terms `dp`, `dz`. While `held` (at the start, and while
+PBP-Alt locks the phases) the DMPs sit at `p + dp` with velocity `z`.
+
+- `PerGoalLayout`, `[phase, held, p (D), z, dp, dz (D, K each)]`: any bank, each DMP with
+  a velocity of its own or all with the followed one's. Drake copies its `3 K D` numbers
+  twice at every update.
+- `AffineLayout`, `[phase, held, p (D), z (D), alpha (2 D), beta (2 D)]`: DMPs that share
+  weights and start (`DmpBank.affine_in_goal`) and all step from the followed DMP's
+  velocity (`followed_goal` connected, as the builder wires PBP). The attractor terms are
+  then `dp = alpha[0] g + beta[0]`, `dz = alpha[1] g + beta[1]` for each goal `g`, so the
+  state is `2 + 6 D` numbers whatever K, an update costs O(D), and a read-out computes the
+  goals it is asked for from the goals on the port: O(D) for the selected goal's
+  reference. With the goals unchanged since the update, every number it gives is the
+  per-goal layout's, bit for bit (the same operations in the same order); when they
+  change, the read-out and the next update read the new goals, as if the last step had
+  been taken toward them.
+"""
+
+import numpy as np
+
+from pbp_drake.core.dmp.stepping import limit_speeds
+
+
+class PerGoalLayout:
+    """Every DMP's `z`, `dp` and `dz` in the state (see the module docstring)."""
+
+    def __init__(self, bank, period, max_speed):
+        self._bank, self._period, self._max_speed = bank, period, max_speed
+        d, k = bank.dimension, bank.goal_count
+        self.size = 2 + d + 3 * k * d
+        self.needs_followed_goal = False
+        self.reads_goals = False  # the read-out depends on the state alone
+
+    def _split(self, vector):
+        """Views: phase (1,), held (1,), p (D, 1), z, dp and dz (D, K)."""
+        d, k = self._bank.dimension, self._bank.goal_count
+        z, dp, dz = (2 + d + i * k * d for i in range(3))
+        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
+                vector[z:dp].reshape(d, k), vector[dp:dz].reshape(d, k),
+                vector[dz:dz + k * d].reshape(d, k))
+
+    def initial(self):
+        """Held at the start: the DMPs sit at their starts (p = 0, dp = starts), at rest."""
+        vector = np.zeros(self.size)
+        phase, held, _, _, dp, _ = self._split(vector)
+        phase[0], held[0] = 1.0, 1.0
+        dp[...] = self._bank.starts
+        return vector
+
+    def phase(self, vector):
+        return vector[0]
+
+    def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
+        """One update, in place (`goals_dk` may be None when `lock`)."""
+        bank, period = self._bank, self._period
+        d = bank.dimension
+        phase, held, robot, z, dp, dz = self._split(vector)
+        # The velocities the last step left, read out in place.
+        if not held[0]:
+            bank.stepped_velocity_into(dz, z, period, z)
+            if followed is not None:
+                # Every DMP continues from the velocity of the one the robot followed, so
+                # that a switch to another goal keeps the command's velocity.
+                z[...] = z[:, followed:followed + 1]
+            limit_speeds(z, self._max_speed, bank.duration)
+        robot[:, 0] = robot_state[:d]
+        if lock:
+            # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
+            held[0] = 1.0
+            dp.fill(0.0)
+            np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
+            return
+        held[0] = 0.0
+        bank.attractor_terms_into(phase, robot, goals_dk, period, dp, dz, workspace)
+        phase *= bank.decay(period)
+
+    def read(self, vector, goals_dk, workspace, goal=None):
+        """The stepped positions and scaled velocities `(D, K)` of every DMP, or `(D, 1)`
+        of DMP `goal`, new arrays."""
+        _, held, robot, z, dp, dz = self._split(vector)
+        if goal is not None:
+            z, dp, dz = (array[:, goal:goal + 1] for array in (z, dp, dz))
+        positions = np.add(robot, dp)
+        if held[0]:
+            return positions, np.array(z)
+        work = np.multiply(z, self._bank.step_constants(self._period).position_velocity,
+                           out=workspace.work if goal is None else None)
+        positions += work
+        return positions, self._bank.stepped_velocity_into(dz, z, self._period,
+                                                           np.empty(z.shape))
+
+
+class AffineLayout:
+    """One `z` and the attractor terms' per-dimension coefficients in the state (see the
+    module docstring)."""
+
+    def __init__(self, bank, period, max_speed):
+        if not bank.affine_in_goal:
+            raise ValueError(
+                "compact_state needs DMPs that share weights and start (a bank from one "
+                "demonstration, or straight): this bank's are distinct")
+        self._bank, self._period, self._max_speed = bank, period, max_speed
+        self.size = 2 + 6 * bank.dimension
+        self.needs_followed_goal = True
+        self.reads_goals = True  # the read-out evaluates the attractor terms at the goals
+
+    def _split(self, vector):
+        """Views: phase (1,), held (1,), p (D, 1), z (D, 1), alpha and beta (2, D, 1)."""
+        d = self._bank.dimension
+        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
+                vector[2 + d:2 + 2 * d].reshape(d, 1),
+                vector[2 + 2 * d:2 + 4 * d].reshape(2, d, 1),
+                vector[2 + 4 * d:2 + 6 * d].reshape(2, d, 1))
+
+    def initial(self):
+        """Held at the start, at rest at the (one) start: dp = 0 g + start."""
+        vector = np.zeros(self.size)
+        phase, held, _, _, _, beta = self._split(vector)
+        phase[0], held[0] = 1.0, 1.0
+        beta[0] = self._bank.starts[:, :1]
+        return vector
+
+    def phase(self, vector):
+        return vector[0]
+
+    def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
+        """One update, in place: the per-goal layout's arithmetic on the followed DMP."""
+        bank, period = self._bank, self._period
+        d = bank.dimension
+        phase, held, robot, z, alpha, beta = self._split(vector)
+        robot[:, 0] = robot_state[:d]
+        if lock:
+            # Phases frozen: the DMPs stay at the robot's position (dp = 0 g + 0) and
+            # follow its velocity (the velocity the last step left is not needed).
+            held[0] = 1.0
+            alpha.fill(0.0)
+            beta.fill(0.0)
+            np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
+            return
+        if not held[0]:
+            # The followed DMP's velocity after the last step: dz + Phi11 z, its dz from
+            # the last step's coefficients at its goal.
+            dz = np.multiply(goals_dk[:, followed:followed + 1], alpha[1])
+            dz += beta[1]
+            bank.stepped_velocity_into(dz, z, period, z)
+            limit_speeds(z, self._max_speed, bank.duration)
+        held[0] = 0.0
+        # `robot` is the state's copy: the coefficients' `p` part reads it.
+        new_alpha, new_beta = bank.affine_coefficients(phase, robot, period, workspace)
+        alpha[...] = new_alpha
+        beta[...] = new_beta
+        phase *= bank.decay(period)
+
+    def read(self, vector, goals_dk, workspace, goal=None):
+        """As `PerGoalLayout.read`, at the goals `goals_dk` (D, K) on the port."""
+        _, held, robot, z, alpha, beta = self._split(vector)
+        goals = goals_dk if goal is None else goals_dk[:, goal:goal + 1]
+        positions = np.multiply(goals, alpha[0])
+        positions += beta[0]  # dp
+        positions += robot  # p + dp (p + dp in the per-goal layout: the same sum)
+        if held[0]:
+            return positions, np.repeat(z, goals.shape[1], axis=1)
+        positions += z * self._bank.step_constants(self._period).position_velocity
+        velocity = np.multiply(goals, alpha[1])
+        velocity += beta[1]  # dz
+        # dz + Phi11 z, summed as the per-goal layout sums Phi11 z + dz.
+        velocity += z * self._bank.step_constants(self._period).velocity_velocity
+        return positions, velocity

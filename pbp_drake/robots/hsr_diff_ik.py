@@ -3,6 +3,7 @@ position, velocity and acceleration limits, and the desired state the plant's PD
 Its QP is `pbp_drake.robots.box_qp`'s."""
 
 import numpy as np
+from numpy._core.umath import clip as _clip
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
@@ -177,25 +178,25 @@ class WholeBodyDiffIk(LeafSystem):
         plan = context.get_discrete_state(self._plan).get_value()
         n, dt = self._nq, self._time_step
         q, v, hold = plan[:n], plan[n:2 * n], plan[2 * n + 1:]
-        v_next, hold = self._solve(q, v, *self._desired(context), hold)
-        # Written into the new plan in place (this runs at 100 Hz).
+        time = context.get_time()
+        v_next, hold = self._solve(q, v, *self._desired(context, time), hold)
+        # Written into the new plan in place (this runs at 100 Hz), the positions by
+        # np.clip's own ufunc: np.clip's Python wrappers cost more than clipping 9 numbers.
         new_plan = discrete_state.get_mutable_value(self._plan)
-        new_plan[:n] = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
+        _clip(q + dt * v_next, self._q_lower, self._q_upper, out=new_plan[:n])
         new_plan[n:2 * n] = v_next
-        new_plan[2 * n] = context.get_time() + dt
+        new_plan[2 * n] = time + dt
         new_plan[2 * n + 1:] = hold
 
-    def _desired(self, context):
-        """`X_WE_desired` (as its rotation and position) and `V_WE_desired` now: from the
-        ports, or from the command."""
+    def _desired(self, context, time):
+        """`X_WE_desired` (as its rotation and position) and `V_WE_desired` now, the
+        position and velocity as lists of floats: from the ports, or from the command."""
         if self._ramp is None:
             X_WE_desired = self._pose_port.Eval(context)
-            return (X_WE_desired.rotation(), X_WE_desired.translation(),
-                    self._twist_port.Eval(context))
-        command = self._command_port.Eval(context)
-        rate = self._ramp.heading_rate(context, self._last_heading, command)
-        return (*self._ramp.rotation_and_position(command, rate, context.get_time()),
-                self._ramp.velocity_into(command, rate, np.empty(6)))
+            return (X_WE_desired.rotation(), X_WE_desired.translation().tolist(),
+                    self._twist_port.Eval(context).tolist())
+        return self._ramp.desired(context, self._last_heading,
+                                  self._command_port.Eval(context), time)
 
     def _solve(self, q, v, R_WE_desired, p_WE_desired, V_WE_desired, hold):
         """The velocity for the next step, and which velocities it holds at a bound.
@@ -209,9 +210,15 @@ class WholeBodyDiffIk(LeafSystem):
         J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, self._frame_E,
                                               self._origin, world, world)
         rotation = (R_WE_desired @ X_WE.rotation().inverse()).ToAngleAxis()
-        gap = np.concatenate([rotation.axis() * rotation.angle(),
-                              p_WE_desired - X_WE.translation()])
-        twist = V_WE_desired + (gap - dt * V_WE_desired) / self._catch_up_time
+        # The gap [axis angle, p_desired - p] and the twist V + (gap - dt V) / catch-up,
+        # entry by entry in Python floats: numpy's elementwise operations in the same
+        # order, without seven numpy calls on 3- and 6-vectors at each step.
+        angle, catch_up_time = rotation.angle(), self._catch_up_time
+        gap = [entry * angle for entry in rotation.axis().tolist()]
+        gap += [desired - now for desired, now in zip(p_WE_desired,
+                                                      X_WE.translation().tolist())]
+        twist = np.array([V + (error - dt * V) / catch_up_time
+                          for V, error in zip(V_WE_desired, gap)])
         # The cost |J v - twist|² in the task weights D, with its part along the twist
         # weighing ALONG_WEIGHT of the rest: W = D - (1 - ALONG_WEIGHT) D t t' D / t'D t.
         JD = J.T * self._task_weights

@@ -1,14 +1,15 @@
 """The HSR station's whole-body differential IK: a velocity plan within the joints'
-position, velocity and acceleration limits, and the desired state the plant's PD tracks."""
-
-import math
+position, velocity and acceleration limits, and the desired state the plant's PD tracks.
+Its QP is `pbp_drake.robots.box_qp`'s."""
 
 import numpy as np
-from numpy.linalg import _umath_linalg
+from numpy._core.umath import clip as _clip
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.robots.box_qp import solve_box_qp
 
 # How much more a unit of the hand's velocity error (m/s) weighs than a unit of the joints'
 # drift toward their nominal positions (m/s, rad/s): the drift takes what the hand's motion
@@ -30,171 +31,6 @@ OVERSHOOT_WEIGHT = 10.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
 CATCH_UP_STEPS = 3
-# The identity of each size solve_box_qp has met: np.eye costs as much as a solve here.
-_IDENTITIES = {}
-
-
-def _solve_linear(a, b):
-    """``np.linalg.solve(a, b)`` for a square ``a`` and a vector ``b``, the same LAPACK
-    call (numpy's gufunc) without the wrapper's checks and error-state context, which cost
-    more than the solve itself at a robot's size and run a few times every diff IK step. A
-    singular ``a`` gives non-finite entries instead of LinAlgError: the caller checks."""
-    return _umath_linalg.solve1(a, b, signature="dd->d")
-
-
-def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
-    """``argmin 0.5 x'Hx - g'x`` subject to ``lower <= x <= upper`` (H positive definite,
-    ``lower <= upper``), exactly, quick for the few variables of a robot's joints.
-
-    ``hold`` guesses which variables end at a bound (-1 lower, 1 upper, 0 neither), such
-    as the last solution's. Returns the minimizer and which variables it holds at a bound.
-
-    A primal-dual active-set method first: each iteration solves with the variables held
-    where the last one put them, then holds every free variable found out of its bounds
-    and lets go every held one whose bound the cost pulls away from, all at once; it stops
-    when nothing changes, which is `solve_box_qp_primal`'s own test of the minimum, and
-    its answer is the one system solved there for that set of held variables, so the
-    same numbers, bit for bit (checked on 23,822 QPs of reach, obstacle and grasp
-    trials). It solves about as many systems as the primal method, which moves one bound
-    at a time (2.8 a QP against 2.3 on those), but each iteration is a solve, a product
-    and tests on Python lists, where the primal's step, clip and copies are numpy calls. Such a method can
-    cycle on some problems: after ``2 n + 2`` iterations it hands over to the primal
-    method, which always ends.
-    """
-    n = g.size
-    identity = _identity(n)
-    guess = [0.0] * n if hold is None else np.asarray(hold).tolist()
-    lows, highs, gs = lower.tolist(), upper.tolist(), g.tolist()
-    tolerance = 1e-12 * (1.0 + max(map(abs, gs)))
-    # -1 held at the lower bound, 1 at the upper, 0 free; a fixed variable is held.
-    sides = [-1 if lows[i] == highs[i] or guess[i] < 0 else 1 if guess[i] > 0 else 0
-             for i in range(n)]
-    system, rhs = H.copy(), g.copy()
-    for i in range(n):
-        if sides[i]:
-            system[i] = identity[i]
-            rhs[i] = lows[i] if sides[i] < 0 else highs[i]
-    for _ in range(2 * n + 2):
-        target = _solve_linear(system, rhs)
-        values = target.tolist()
-        slopes = (H @ target - g).tolist()
-        changed = False
-        for i in range(n):
-            side = sides[i]
-            if side == 0 and (values[i] < lows[i] or values[i] > highs[i]):
-                sides[i] = -1 if values[i] < lows[i] else 1
-                system[i] = identity[i]
-                rhs[i] = lows[i] if sides[i] < 0 else highs[i]
-                changed = True
-            elif side and lows[i] < highs[i] and ((side < 0 and slopes[i] < -tolerance)
-                                                  or (side > 0 and slopes[i] > tolerance)):
-                sides[i] = 0
-                system[i] = H[i]
-                rhs[i] = gs[i]
-                changed = True
-        if not changed:
-            if not all(map(math.isfinite, values)):
-                break  # a singular system: the primal method raises
-            for i in range(n):
-                if sides[i]:  # exactly at the bound, as the primal method sets them
-                    target[i] = lows[i] if sides[i] < 0 else highs[i]
-            return target, np.array(sides, dtype=float)
-    return solve_box_qp_primal(H, g, lower, upper, hold, max_iterations)
-
-
-def _identity(n):
-    """The identity of size n, made once (np.eye costs as much as a solve here)."""
-    identity = _IDENTITIES.get(n)
-    if identity is None:
-        identity = _IDENTITIES[n] = np.eye(n)
-    return identity
-
-
-def solve_box_qp_primal(H, g, lower, upper, hold=None, max_iterations=100):
-    """`solve_box_qp` by a primal active-set method, which always ends: from a feasible
-    point it moves toward the minimum over the free variables as far as the first bound
-    in the way, holding one variable at a time, and lets go of held ones whose bound the
-    cost pulls away from.
-
-    ``hold`` guesses which variables end at a bound (-1 lower, 1 upper, 0 neither), such
-    as the last solution's; a good guess saves iterations, and any guess gives the same
-    minimum. Returns the minimizer and which variables it holds at a bound.
-
-    Every value is computed by numpy as before; which variables are out of their bounds,
-    block a step or leave a bound is decided on Python lists (a few entries: a numpy call
-    per test cost more than the test), and the system solved is kept from one iteration to
-    the next, a row changed where a variable is held or let go.
-    """
-    n = g.size
-    identity = _identity(n)
-    hold = np.zeros(n) if hold is None else np.asarray(hold)
-    fixed = (hold != 0) | (lower == upper)
-    x = np.clip(np.where(hold < 0, lower, np.where(hold > 0, upper, 0.0)), lower, upper)
-    gs = g.tolist()
-    tolerance = 1e-12 * (1.0 + max(map(abs, gs)))
-    lows, highs = lower.tolist(), upper.tolist()
-    held = fixed.tolist()
-    system = np.where(fixed[:, None], identity, H)
-    rhs = g.copy()
-    for iteration in range(max_iterations):
-        # The minimum over the free variables, the held ones where they are: the system's
-        # rows and right side are H's and g's for a free variable (restored when it is let
-        # go), the identity's and x's for a held one.
-        np.copyto(rhs, x, where=fixed)
-        target = _solve_linear(system, rhs)
-        np.copyto(target, x, where=fixed)
-        values = target.tolist()
-        # The held variables sit exactly at a bound (set there by clip or assignment), so
-        # only a free one can be found out of its bounds.
-        outside = [i for i in range(n) if values[i] < lows[i] or values[i] > highs[i]]
-        if outside:
-            if iteration == 0:
-                # The guess left these out of their bounds: hold them at the bounds
-                # they passed, and go on from there (a feasible point).
-                x = np.clip(target, lower, upper)
-                for i in outside:
-                    held[i] = fixed[i] = True
-                    system[i] = identity[i]
-                continue
-            # Go as far toward the minimum as the first bound in the way (the first of
-            # the smallest ratios, as np.argmin), and hold that variable there.
-            step = target - x
-            start = x.tolist()
-            blocking, ratio = -1, 0.0
-            for i in outside:
-                bound = lows[i] if values[i] < lows[i] else highs[i]
-                candidate = (bound - start[i]) / (values[i] - start[i])
-                if blocking < 0 or candidate < ratio:
-                    blocking, ratio, blocking_bound = i, candidate, bound
-            x = np.clip(x + ratio * step, lower, upper)
-            x[blocking] = blocking_bound
-            held[blocking] = fixed[blocking] = True
-            system[blocking] = identity[blocking]
-            continue
-        x = target
-        # Held variables whose bound the cost pulls away from are let go: all at once,
-        # or the one pulled hardest once that has taken long (which always ends).
-        gradient = H @ x - g
-        slopes = gradient.tolist()
-        leaving = [i for i in range(n) if held[i] and lows[i] < highs[i] and (
-            (values[i] <= lows[i] and slopes[i] < -tolerance)
-            or (values[i] >= highs[i] and slopes[i] > tolerance))]
-        if not leaving:
-            if not all(map(math.isfinite, values)):  # a singular system: raise as numpy does
-                np.linalg.solve(np.where(fixed[:, None], identity, H), np.where(fixed, x, g))
-                raise np.linalg.LinAlgError("solve_box_qp met a singular system")
-            return x, np.array([(-1.0 if values[i] <= lows[i] else
-                                 1.0 if values[i] >= highs[i] else 0.0) if held[i] else 0.0
-                                for i in range(n)])
-        if iteration >= 2 * n:
-            pulled = np.zeros(n, bool)
-            pulled[leaving] = True
-            leaving = [int(np.argmax(np.abs(gradient) * pulled))]
-        for i in leaving:
-            held[i] = fixed[i] = False
-            system[i] = H[i]
-            rhs[i] = gs[i]
-    raise RuntimeError(f"solve_box_qp did not converge in {max_iterations} iterations")
 
 
 class WholeBodyDiffIk(LeafSystem):
@@ -342,25 +178,25 @@ class WholeBodyDiffIk(LeafSystem):
         plan = context.get_discrete_state(self._plan).get_value()
         n, dt = self._nq, self._time_step
         q, v, hold = plan[:n], plan[n:2 * n], plan[2 * n + 1:]
-        v_next, hold = self._solve(q, v, *self._desired(context), hold)
-        # Written into the new plan in place (this runs at 100 Hz).
+        time = context.get_time()
+        v_next, hold = self._solve(q, v, *self._desired(context, time), hold)
+        # Written into the new plan in place (this runs at 100 Hz), the positions by
+        # np.clip's own ufunc: np.clip's Python wrappers cost more than clipping 9 numbers.
         new_plan = discrete_state.get_mutable_value(self._plan)
-        new_plan[:n] = np.clip(q + dt * v_next, self._q_lower, self._q_upper)
+        _clip(q + dt * v_next, self._q_lower, self._q_upper, out=new_plan[:n])
         new_plan[n:2 * n] = v_next
-        new_plan[2 * n] = context.get_time() + dt
+        new_plan[2 * n] = time + dt
         new_plan[2 * n + 1:] = hold
 
-    def _desired(self, context):
-        """`X_WE_desired` (as its rotation and position) and `V_WE_desired` now: from the
-        ports, or from the command."""
+    def _desired(self, context, time):
+        """`X_WE_desired` (as its rotation and position) and `V_WE_desired` now, the
+        position and velocity as lists of floats: from the ports, or from the command."""
         if self._ramp is None:
             X_WE_desired = self._pose_port.Eval(context)
-            return (X_WE_desired.rotation(), X_WE_desired.translation(),
-                    self._twist_port.Eval(context))
-        command = self._command_port.Eval(context)
-        rate = self._ramp.heading_rate(context, self._last_heading, command)
-        return (*self._ramp.rotation_and_position(command, rate, context.get_time()),
-                self._ramp.velocity_into(command, rate, np.empty(6)))
+            return (X_WE_desired.rotation(), X_WE_desired.translation().tolist(),
+                    self._twist_port.Eval(context).tolist())
+        return self._ramp.desired(context, self._last_heading,
+                                  self._command_port.Eval(context), time)
 
     def _solve(self, q, v, R_WE_desired, p_WE_desired, V_WE_desired, hold):
         """The velocity for the next step, and which velocities it holds at a bound.
@@ -374,9 +210,15 @@ class WholeBodyDiffIk(LeafSystem):
         J = plant.CalcJacobianSpatialVelocity(context, JacobianWrtVariable.kV, self._frame_E,
                                               self._origin, world, world)
         rotation = (R_WE_desired @ X_WE.rotation().inverse()).ToAngleAxis()
-        gap = np.concatenate([rotation.axis() * rotation.angle(),
-                              p_WE_desired - X_WE.translation()])
-        twist = V_WE_desired + (gap - dt * V_WE_desired) / self._catch_up_time
+        # The gap [axis angle, p_desired - p] and the twist V + (gap - dt V) / catch-up,
+        # entry by entry in Python floats: numpy's elementwise operations in the same
+        # order, without seven numpy calls on 3- and 6-vectors at each step.
+        angle, catch_up_time = rotation.angle(), self._catch_up_time
+        gap = [entry * angle for entry in rotation.axis().tolist()]
+        gap += [desired - now for desired, now in zip(p_WE_desired,
+                                                      X_WE.translation().tolist())]
+        twist = np.array([V + (error - dt * V) / catch_up_time
+                          for V, error in zip(V_WE_desired, gap)])
         # The cost |J v - twist|² in the task weights D, with its part along the twist
         # weighing ALONG_WEIGHT of the rest: W = D - (1 - ALONG_WEIGHT) D t t' D / t'D t.
         JD = J.T * self._task_weights

@@ -1,6 +1,8 @@
 """The HSR station's task-space adapters: the end-effector command in (as a system, or as
 the arithmetic the station's diff IK applies itself), its state out."""
 
+import math
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform, RotationMatrix
@@ -115,8 +117,8 @@ class EeCommandRamp:
         state `last_heading_index`) into the command's over a period; 0 without one."""
         if not self.period:
             return 0.0
-        last = context.get_discrete_state(last_heading_index).get_value()[0]
-        turn = (command[_HEADING] - last + np.pi) % (2 * np.pi) - np.pi
+        last = float(context.get_discrete_state(last_heading_index).get_value()[0])
+        turn = (command[_HEADING] - last + math.pi) % (2 * math.pi) - math.pi
         return turn / self.period
 
     def velocity_into(self, command, heading_rate, velocity):
@@ -131,15 +133,27 @@ class EeCommandRamp:
         return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
 
     def rotation_and_position(self, command, heading_rate, time):
-        """`X_WE_desired` at `time` as its `(RotationMatrix, position (3,))`: what the diff
-        IK reads, without building the RigidTransform at each of its steps."""
+        """`X_WE_desired` at `time` as its `(RotationMatrix, position)`, the position a
+        list of 3 floats: what the diff IK reads, without building the RigidTransform at
+        each of its steps. `command` may be an array or a list of floats."""
         ahead = self.lead
         if self.period:
-            next_tick = np.ceil(time / self.period - 1e-9) * self.period
+            # math.ceil's integer times the period: the same product as np.ceil's float's.
+            next_tick = math.ceil(time / self.period - 1e-9) * self.period
             ahead -= max(0.0, next_tick - time)
         heading = command[_HEADING] + heading_rate * ahead
         R = RotationMatrix.MakeZRotation(heading) @ self.R_E0
-        return R, command[_POSITION] + command[_VELOCITY] * ahead
+        return R, [p + v * ahead for p, v in zip(command[_POSITION], command[_VELOCITY])]
+
+    def desired(self, context, last_heading_index, command, time):
+        """`(R_WE_desired, p_WE_desired, V_WE_desired)` at `time` for the diff IK's step,
+        the position and velocity as lists of floats. The command is read as a list once:
+        Python floats compute the ramp's few numbers with the same IEEE operations as numpy
+        and without a numpy call per operation (this runs at the diff IK's 100 Hz)."""
+        command = command.tolist()
+        rate = self.heading_rate(context, last_heading_index, command)
+        R, position = self.rotation_and_position(command, rate, time)
+        return R, position, [0.0, 0.0, rate, *command[_VELOCITY]]
 
 
 class EeStateFromPlant(LeafSystem):

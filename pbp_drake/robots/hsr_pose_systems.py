@@ -87,8 +87,14 @@ class PoseCommandRamp:
         """`X_WE_desired` at `time`; refuses a NaN or non-unit command (by field)."""
         return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
 
+    def desired(self, context, last_heading_index, command, time):
+        """`(R_WE_desired, p_WE_desired, V_WE_desired)` at `time` for the diff IK's step,
+        the position and velocity as lists of floats (as `EeCommandRamp.desired`)."""
+        R, position = self.rotation_and_position(command, 0.0, time)
+        return R, position.tolist(), self.velocity_into(command, 0.0, np.empty(6)).tolist()
+
     def rotation_and_position(self, command, heading_rate, time):
-        """`pose` as its `(RotationMatrix, position (3,))`, as the diff IK reads it."""
+        """`pose` as its `(RotationMatrix, position (3,))`."""
         quaternion = check_pose_command(command, self.port_name)
         ahead = self.lead
         if self.period:

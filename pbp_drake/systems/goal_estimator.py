@@ -7,7 +7,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.goal_estimation import (
-    NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate, validate_goals)
+    NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate)
 from pbp_drake.systems.layouts import EeState, position_of
 from pbp_drake.systems.tick import decide_offset
 
@@ -99,16 +99,17 @@ class GoalEstimator(LeafSystem):
 
     def _inputs(self, context):
         ee_state = EeState(self._ee_state_port.Eval(context))
-        goals = validate_goals(self._goals_port.Eval(context).reshape(self._goal_count, 3))
+        # Validated by `estimate` (`goal_probabilities`), which every caller calls.
+        goals = self._goals_port.Eval(context).reshape(self._goal_count, 3)
         return position_of(ee_state), float(ee_state.heading), goals
 
     def _write(self, discrete_state, result, memory):
         memory[CHALLENGER] = result.memory.challenger
         memory[COUNT] = result.memory.count
-        discrete_state.get_mutable_vector(self._selected_index).set_value([result.selected])
-        discrete_state.get_mutable_vector(self._probabilities_index).set_value(
-            result.probabilities)
-        discrete_state.get_mutable_vector(self._memory_index).set_value(memory)
+        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
+        discrete_state.set_value(self._selected_index, [result.selected])
+        discrete_state.set_value(self._probabilities_index, result.probabilities)
+        discrete_state.set_value(self._memory_index, memory)
 
     def _initialise(self, context, discrete_state):
         position, heading, goals = self._inputs(context)
@@ -121,14 +122,17 @@ class GoalEstimator(LeafSystem):
         self._write(discrete_state, result, memory)
 
     def _update(self, context, discrete_state):
-        if context.get_discrete_state(self._memory_index).value()[INITIALISED] < 0.5:
+        # The context's DiscreteValues read once, each group off it: fewer pybind calls.
+        state = context.get_discrete_state()
+        memory = state.value(self._memory_index)
+        if memory[INITIALISED] < 0.5:
             self._initialise(context, discrete_state)
             return
         position, heading, goals = self._inputs(context)
-        memory = context.get_discrete_state(self._memory_index).value().copy()
+        memory = memory.copy()
         memory[PATH_LENGTH] += vector_length(position - memory[LAST_POSITION:LAST_POSITION + 3])
         memory[LAST_POSITION:LAST_POSITION + 3] = position
-        selected = int(context.get_discrete_state(self._selected_index).value()[0])
+        selected = int(state.value(self._selected_index)[0])
         previous = SelectionMemory(selected, int(memory[CHALLENGER]), int(memory[COUNT]))
         result = estimate(self._settings, goals, position, heading, previous,
                           start=memory[START:START + 3], path_length=memory[PATH_LENGTH])

@@ -41,7 +41,8 @@ class HandOver(LeafSystem):
             raise ValueError(f"control_period must be positive, got {control_period!r}")
         self._dimension = d = initial_position.size
         self._reference_port = self.DeclareVectorInputPort("reference", 2 * d)
-        index = self.DeclareDiscreteState(np.concatenate([initial_position, np.zeros(d)]))
+        self._state_index = index = self.DeclareDiscreteState(
+            np.concatenate([initial_position, np.zeros(d)]))
         self._command_port = self.DeclareStateOutputPort("command", index)
         self.DeclarePeriodicDiscreteUpdateEvent(
             self._period, report_offset(self._period), self._update)
@@ -63,7 +64,8 @@ class HandOver(LeafSystem):
     def _update(self, context, discrete_state):
         d = self._dimension
         reference = self._reference_port.Eval(context)
-        state = discrete_state.get_mutable_vector().get_mutable_value()
+        # One pybind call for the group's array (get_mutable_vector and its value: two).
+        state = discrete_state.get_mutable_value(self._state_index)
         position, velocity = hand_over(state[d:], reference[:d], reference[d:],
                                        self._max_acceleration, self._max_speed,
                                        self._period)

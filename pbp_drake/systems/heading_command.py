@@ -51,8 +51,9 @@ class HeadingCommand(LeafSystem):
         return self._heading_port
 
     def _update(self, context, discrete_state):
-        heading = discrete_state.get_mutable_vector(self._heading_index).get_mutable_value()
-        yaw_rate = discrete_state.get_mutable_vector(self._yaw_rate_index).get_mutable_value()
+        # One pybind call a group's array (get_mutable_vector and its value: two).
+        heading = discrete_state.get_mutable_value(self._heading_index)
+        yaw_rate = discrete_state.get_mutable_value(self._yaw_rate_index)
         wanted = OperatorCommand(self._command_port.Eval(context)).yaw_rate
         # The hand-over law in one dimension: the turn's rate changes by at most
         # max_yaw_acceleration * period a tick, and the heading moves at that rate.

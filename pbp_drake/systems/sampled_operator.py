@@ -76,8 +76,9 @@ class SampledOperator(LeafSystem):
     def _store_sample(self, discrete_state, command, active):
         """Writes one sample; subclasses that override `_update` call this."""
         command = self._validate(np.asarray(command, float).reshape(self._dimension))
-        discrete_state.get_mutable_vector(self._sample_index).set_value(
-            np.append(command, 1.0 if active else 0.0))
+        # DiscreteValues.set_value: one pybind call (get_mutable_vector's: two).
+        sample = np.append(command, 1.0 if active else 0.0)
+        discrete_state.set_value(self._sample_index, sample)
 
     def _validate(self, command):
         """The command checked (NaN or infinite refused by name), as a float array."""

@@ -166,12 +166,13 @@ class TaskMonitorBase(LeafSystem):
             stage += 1
             progress = self._progress(hand, self._targets[stage])
         success = self._reached(hand, self._targets[stage])
-        state.get_mutable_vector(self._counts_index).set_value(
-            [stage, counts.steps + 1, counts.acted_steps + int(acting),
-             counts.colliding_steps + int(colliding), float(success)])
+        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
+        state.set_value(self._counts_index,
+                        [stage, counts.steps + 1, counts.acted_steps + int(acting),
+                         counts.colliding_steps + int(colliding), float(success)])
         # The task time is the tick's: the update runs a fraction of a period after it.
-        state.get_mutable_vector(self._measures_index).set_value(
-            [progress, context.get_time() - self._update_offset])
+        state.set_value(self._measures_index,
+                        [progress, context.get_time() - self._update_offset])
         return EventStatus.Succeeded()
 
     def _end_at_success(self, context):

@@ -142,7 +142,8 @@ class VirtualParticipant(SampledOperator):
             unseen_ticks += 1
             if unseen_ticks > self._reaction_ticks:
                 known, unseen_ticks = shown, 0
-        discrete_state.get_mutable_vector(self._belief_index).set_value([known, unseen_ticks])
+        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
+        discrete_state.set_value(self._belief_index, [known, unseen_ticks])
         if self._obstacles_port is not None:
             command, active = self._avoid(context, discrete_state, int(known))
         else:
@@ -184,7 +185,7 @@ class VirtualParticipant(SampledOperator):
         def finish(command, active, hold_ticks=None):
             if hold_ticks is not None:
                 track[3] = hold_ticks
-            discrete_state.get_mutable_vector(self._track_index).set_value(track)
+            discrete_state.set_value(self._track_index, track)
             return command, active
 
         if known_target != int(target.index):
@@ -349,6 +350,5 @@ class VirtualParticipant(SampledOperator):
         if (not insisting and selected != known_target
                 and faces_target(self.params, position, heading, target_position)):
             ticks += 1.0
-        discrete_state.get_mutable_vector(self._insist_index).set_value(
-            [counted_target, ticks])
+        discrete_state.set_value(self._insist_index, [counted_target, ticks])
         return insisting

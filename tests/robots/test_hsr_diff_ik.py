@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from pydrake.math import RigidTransform, RotationMatrix
 
-from pbp_drake.robots.hsr_diff_ik import solve_box_qp, solve_box_qp_primal
+from pbp_drake.robots.box_qp import solve_box_qp, solve_box_qp_primal
 from pbp_drake.robots.hsr_ee_systems import EeCommandToPose
 
 

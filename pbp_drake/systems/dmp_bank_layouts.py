@@ -27,11 +27,28 @@ import numpy as np
 from pbp_drake.core.dmp.stepping import limit_speeds
 
 
-class PerGoalLayout:
-    """Every DMP's `z`, `dp` and `dz` in the state (see the module docstring)."""
+class _Layout:
+    """What both layouts share: the state vector starts `[phase, held, ...]`."""
 
     def __init__(self, bank, period, max_speed):
         self._bank, self._period, self._max_speed = bank, period, max_speed
+
+    def initial(self):
+        """Held at the start, phase 1, the rest as `_at_start` sets it."""
+        vector = np.zeros(self.size)
+        vector[0:2] = 1.0
+        self._at_start(vector)
+        return vector
+
+    def phase(self, vector):
+        return vector[0]
+
+
+class PerGoalLayout(_Layout):
+    """Every DMP's `z`, `dp` and `dz` in the state (see the module docstring)."""
+
+    def __init__(self, bank, period, max_speed):
+        super().__init__(bank, period, max_speed)
         d, k = bank.dimension, bank.goal_count
         self.size = 2 + d + 3 * k * d
         self.needs_followed_goal = False
@@ -45,16 +62,9 @@ class PerGoalLayout:
                 vector[z:dp].reshape(d, k), vector[dp:dz].reshape(d, k),
                 vector[dz:dz + k * d].reshape(d, k))
 
-    def initial(self):
-        """Held at the start: the DMPs sit at their starts (p = 0, dp = starts), at rest."""
-        vector = np.zeros(self.size)
-        phase, held, _, _, dp, _ = self._split(vector)
-        phase[0], held[0] = 1.0, 1.0
-        dp[...] = self._bank.starts
-        return vector
-
-    def phase(self, vector):
-        return vector[0]
+    def _at_start(self, vector):
+        """The DMPs sit at their starts (p = 0, dp = starts), at rest."""
+        self._split(vector)[4][...] = self._bank.starts
 
     def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
         """One update, in place (`goals_dk` may be None when `lock`)."""
@@ -96,7 +106,7 @@ class PerGoalLayout:
                                                            np.empty(z.shape))
 
 
-class AffineLayout:
+class AffineLayout(_Layout):
     """One `z` and the attractor terms' per-dimension coefficients in the state (see the
     module docstring)."""
 
@@ -105,7 +115,7 @@ class AffineLayout:
             raise ValueError(
                 "compact_state needs DMPs that share weights and start (a bank from one "
                 "demonstration, or straight): this bank's are distinct")
-        self._bank, self._period, self._max_speed = bank, period, max_speed
+        super().__init__(bank, period, max_speed)
         self.size = 2 + 6 * bank.dimension
         self.needs_followed_goal = True
         self.reads_goals = True  # the read-out evaluates the attractor terms at the goals
@@ -118,16 +128,9 @@ class AffineLayout:
                 vector[2 + 2 * d:2 + 4 * d].reshape(2, d, 1),
                 vector[2 + 4 * d:2 + 6 * d].reshape(2, d, 1))
 
-    def initial(self):
-        """Held at the start, at rest at the (one) start: dp = 0 g + start."""
-        vector = np.zeros(self.size)
-        phase, held, _, _, _, beta = self._split(vector)
-        phase[0], held[0] = 1.0, 1.0
-        beta[0] = self._bank.starts[:, :1]
-        return vector
-
-    def phase(self, vector):
-        return vector[0]
+    def _at_start(self, vector):
+        """At rest at the (one) start: dp = 0 g + start."""
+        self._split(vector)[5][0] = self._bank.starts[:, :1]
 
     def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
         """One update, in place: the per-goal layout's arithmetic on the followed DMP."""

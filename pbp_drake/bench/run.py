@@ -168,22 +168,22 @@ def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have
                bank_math_repeats=repeats)
 
     # Inside the LeafSystem: several periods per timed call, so that Simulator.AdvanceTo's
-    # own call cost is spread; the bank and the null system alike.
+    # own call cost is spread; the bank and the null system alike. The bank is immutable:
+    # every Simulator steps the same one, each in its own Context.
     periods = 10 if goal_count <= 10000 else 2
-    for label, leaf_bank in [("leaf", make_bank(case)), ("drake_overhead", None)]:
+    for label, leaf_bank in [("leaf", bank), ("drake_overhead", None)]:
         simulator = leaf_simulator(case, leaf_bank)
         median, minimum, _ = timed(leaf_step(simulator, periods), min_time, warmup=1)
         row[f"{label}_us"] = microseconds(median / periods)
         row[f"{label}_min_us"] = microseconds(minimum / periods)
         del simulator
     # What a consumer of all K references (not the builder's blender) would add.
-    simulator = leaf_simulator(case, make_bank(case), read="references")
+    simulator = leaf_simulator(case, bank, read="references")
     row["leaf_all_references_us"] = microseconds(
         timed(leaf_step(simulator, periods), min_time, warmup=1)[0] / periods)
     del simulator
     if ((dimension, goal_count, row["weights"]), False) in MOTION_ROWS:
-        row.update(motion_fields(leaf_simulator(case, make_bank(case)), bank.duration,
-                                 periods))
+        row.update(motion_fields(leaf_simulator(case, bank), bank.duration, periods))
     del bank
 
     weight_bytes = (case.weights.nbytes if distinct else case.shared_weights.nbytes)

@@ -69,8 +69,9 @@ class DmpBank(LeafSystem):
     every DMP steps from one velocity. The outputs are then computed from the goals on
     the port, and equal the per-goal layout's bit for bit while the goals do not change
     between an update and a read (when they change, the outputs and the next update read
-    the new goals, as if the last step had been taken toward them). The goals are checked and laid out `(D, K)` in a cache
-    entry, once per change. All DMPs of the system share one phase: the lock is one input.
+    the new goals, as if the last step had been taken toward them). The goals are checked
+    and laid out `(D, K)` in a cache entry, once per change. All DMPs of the system share
+    one phase: the lock is one input.
 
     The bank updates at the decide stage of each control tick
     (`pbp_drake.systems.tick.decide_offset`), so that it reads the robot's state sampled at
@@ -145,7 +146,8 @@ class DmpBank(LeafSystem):
     @staticmethod
     def state_size(goal_count, dimension, compact_state=False):
         """The length of the one state vector (`2 + 6 D` compact, else `2 + D + 3 K D`)."""
-        return 2 + (6 * dimension if compact_state else dimension + 3 * goal_count * dimension)
+        layout = AffineLayout if compact_state else PerGoalLayout
+        return layout.size_of(goal_count, dimension)
 
     @property
     def bank(self):
@@ -190,12 +192,16 @@ class DmpBank(LeafSystem):
     def _state(self, context):
         return context.get_discrete_state(self._state_index).get_value()
 
+    def _goals_read(self, context):
+        """The goals `(D, K)` a read-out needs (the compact layout's), else None."""
+        return self._goals_dk.Eval(context) if self._layout.reads_goals else None
+
     def dmp_states(self, context):
         """The K DMPs' state after the last update: phases (K,), positions and scaled
         velocities (D, K), new arrays (what `references` reads out)."""
-        goals_dk = self._goals_dk.Eval(context) if self._layout.reads_goals else None
         state = self._state(context)
-        positions, velocity = self._layout.read(state, goals_dk, self._workspace(context))
+        positions, velocity = self._layout.read(state, self._goals_read(context),
+                                                self._workspace(context))
         return np.full(self._bank.goal_count, self._layout.phase(state)), positions, velocity
 
     def selected_reference(self, context):
@@ -205,8 +211,7 @@ class DmpBank(LeafSystem):
         goal = goal_index(self._selected_goal_port, context, k)
         if goal is None:
             goal = goal_index(self._followed_goal_port, context, k, unconnected=0)
-        goals_dk = self._goals_dk.Eval(context) if self._layout.reads_goals else None
-        position, velocity = self._layout.read(self._state(context), goals_dk,
+        position, velocity = self._layout.read(self._state(context), self._goals_read(context),
                                                self._workspace(context), goal)
         return np.concatenate([position[:, 0], velocity[:, 0] / self._bank.duration])
 

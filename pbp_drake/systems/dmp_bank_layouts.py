@@ -49,10 +49,13 @@ class PerGoalLayout(_Layout):
 
     def __init__(self, bank, period, max_speed):
         super().__init__(bank, period, max_speed)
-        d, k = bank.dimension, bank.goal_count
-        self.size = 2 + d + 3 * k * d
+        self.size = self.size_of(bank.goal_count, bank.dimension)
         self.needs_followed_goal = False
         self.reads_goals = False  # the read-out depends on the state alone
+
+    @staticmethod
+    def size_of(goal_count, dimension):
+        return 2 + dimension + 3 * goal_count * dimension
 
     def _split(self, vector):
         """Views: phase (1,), held (1,), p (D, 1), z, dp and dz (D, K)."""
@@ -116,9 +119,13 @@ class AffineLayout(_Layout):
                 "compact_state needs DMPs that share weights and start (a bank from one "
                 "demonstration, or straight): this bank's are distinct")
         super().__init__(bank, period, max_speed)
-        self.size = 2 + 6 * bank.dimension
+        self.size = self.size_of(bank.goal_count, bank.dimension)
         self.needs_followed_goal = True
         self.reads_goals = True  # the read-out evaluates the attractor terms at the goals
+
+    @staticmethod
+    def size_of(goal_count, dimension):
+        return 2 + 6 * dimension  # whatever K
 
     def _split(self, vector):
         """Views: phase (1,), held (1,), p (D, 1), z (D, 1), alpha and beta (2, D, 1)."""

@@ -2,13 +2,14 @@
 orientation DMP (`PoseDmpBank`), stepped by the bank math alone and inside the LeafSystem,
 beside a LeafSystem with the same ports and state whose update does nothing.
 
-The LeafSystem is wired as the PBP controller wires the position bank: `followed_goal`
-connected (every DMP continues from the followed DMP's velocities), so that the update
-steps the orientation DMPs in log coordinates and reads one DMP's angular velocity back
-(`PoseDmpBank._update`), and its `selected_reference` read at every period, as the pose
-blender reads it (`pbp_drake.bench.cases.ReferenceReader`). The row also times it with
-`followed_goal` unconnected (`leaf_own_us`: each DMP keeps its own velocities, and every
-update reads all K angular velocities back)."""
+The LeafSystem is wired as the grasp builder wires it: `followed_goal` connected (every DMP
+continues from the followed DMP's velocities) and the compact state (16 numbers; the K
+stepped DMPs a cache entry computed once per tick, `PoseDmpBank`), and its
+`selected_reference` read at every period, as the pose blender reads it
+(`pbp_drake.bench.cases.ReferenceReader`). The row also times it with the per-goal state
+(`leaf_per_goal_us`: 12 K numbers, which Drake copies twice per update) and with
+`followed_goal` unconnected (`leaf_own_us`: the per-goal state, each DMP keeps its own
+velocities, and every update reads all K angular velocities back)."""
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
@@ -68,15 +69,15 @@ def pose_math_step(positions, orientations, goals, hand):
 
 
 class NullPoseBank(LeafSystem):
-    """The PoseDmpBank's ports and state, an update that does nothing: Drake's own cost
-    (and the read's)."""
+    """The PoseDmpBank's ports and state (compact or per goal), an update that does
+    nothing: Drake's own cost (and the read's)."""
 
-    def __init__(self, goal_count):
+    def __init__(self, goal_count, compact):
         super().__init__()
         self.DeclareVectorInputPort("robot_state", PoseState.size)
         self.DeclareVectorInputPort("goal_poses", goal_count * GoalPose.size)
         self.DeclareVectorInputPort("followed_goal", 1)
-        self.DeclareDiscreteState(np.zeros(PoseDmpBank.state_size(goal_count)))
+        self.DeclareDiscreteState(np.zeros(PoseDmpBank.state_size(goal_count, compact)))
         self.DeclareVectorOutputPort("selected_reference", PoseState.size,
                                      self._calc_reference,
                                      prerequisites_of_calc={self.xd_ticket()})
@@ -89,14 +90,15 @@ class NullPoseBank(LeafSystem):
         pass
 
 
-def pose_leaf_simulator(goal_count, goals, hand, banks=None, followed=True):
-    """A Simulator of the PoseDmpBank (or the null system) fed by constant sources."""
+def pose_leaf_simulator(goal_count, goals, hand, banks=None, followed=True, compact=True):
+    """A Simulator of the PoseDmpBank (or the null system) fed by constant sources, in the
+    compact state or per goal (which `followed=False` needs)."""
     builder = DiagramBuilder()
     if banks is None:
-        system = builder.AddSystem(NullPoseBank(goal_count))
+        system = builder.AddSystem(NullPoseBank(goal_count, compact))
         followed_port = system.get_input_port(2)
     else:
-        system = builder.AddSystem(PoseDmpBank(*banks, DT))
+        system = builder.AddSystem(PoseDmpBank(*banks, DT, compact_state=compact))
         followed_port = system.get_followed_goal_input_port()
     state = builder.AddSystem(ConstantVectorSource(hand))
     source = builder.AddSystem(GoalsSource(goals))
@@ -122,18 +124,19 @@ def measure_pose_row(goal_count, distinct, min_time, bandwidth):
     row.update(bank_math_us=microseconds(median), bank_math_min_us=microseconds(minimum),
                bank_math_repeats=repeats)
     periods = 10
-    for label, banks, followed in [("leaf", (positions, orientations), True),
-                                   ("leaf_own", (positions, orientations), False),
-                                   ("drake_overhead", None, True)]:
-        simulator = pose_leaf_simulator(goal_count, goals, hand, banks, followed)
+    banks = (positions, orientations)
+    for label, system_banks, followed, compact in [
+            ("leaf", banks, True, True), ("leaf_per_goal", banks, True, False),
+            ("leaf_own", banks, False, False), ("drake_overhead", None, True, True)]:
+        simulator = pose_leaf_simulator(goal_count, goals, hand, system_banks, followed,
+                                        compact)
         median, minimum, _ = timed(leaf_step(simulator, periods), min_time, warmup=1)
         row[f"{label}_us"] = microseconds(median / periods)
         row[f"{label}_min_us"] = microseconds(minimum / periods)
         del simulator
     if ((6, goal_count, row["weights"]), True) in MOTION_ROWS:
-        row.update(motion_fields(
-            pose_leaf_simulator(goal_count, goals, hand, (positions, orientations)),
-            positions.duration, periods))
+        row.update(motion_fields(pose_leaf_simulator(goal_count, goals, hand, banks),
+                                 positions.duration, periods))
     weight_bytes = ((case.weights.nbytes if distinct else case.shared_weights.nbytes)
                     + np.asarray(orientations._weights).nbytes)
     row["weight_bytes"] = weight_bytes

@@ -44,7 +44,7 @@ def format_report(report):
                  "brackets); pydmps/goal, mp/goal: one object per goal; mp stacked: one "
                  "K*D DMP; x per-goal, x stacked: speed-ups of the bank math. D = 6p: the "
                  "six-DoF pose bank (3-D positions and unit-quaternion orientations, "
-                 "PoseDmpBank with followed_goal connected).")
+                 "PoseDmpBank with followed_goal connected, in the compact state).")
     header = (f"{'D':>2} {'K':>7} {'weights':>8} {'math':>9} {'leaf':>9} {'drake':>7} "
               f"{'bound':>9} {'[cache]':>9} {'pydmps/goal':>12} {'mp/goal':>10} "
               f"{'mp stacked':>11} {'x per-goal':>10} {'x stacked':>9} {'rate Hz':>9}")
@@ -78,7 +78,8 @@ def format_report(report):
         for row in poses:
             versus = row.get("leaf_vs_position_3d")
             lines.append(f"  K = {row['K']:>6} {row['weights']:>8}: {_fmt(row['leaf_us'])} us "
-                         f"(each DMP its own velocities: {_fmt(row['leaf_own_us'])} us), "
+                         f"(per-goal state: {_fmt(row['leaf_per_goal_us'])} us; each DMP "
+                         f"its own velocities: {_fmt(row['leaf_own_us'])} us), "
                          + (f"{versus:.2f}x the position bank" if versus else
                             "no position row"))
     moving = [row for row in report["steps"] if row.get("leaf_motion_us") is not None]

@@ -125,11 +125,13 @@ def build_grasp_diagram(resolved, meshcat=None):
     position_bank, orientation_bank = grasp_dmp_banks(resolved, start)
     prediction_steps = GRASP_PREDICTION_SAMPLES if meshcat is not None else 0
     # The caps are the hand-over's: no DMP winds its velocity up past what the hand may do.
+    # Every DMP continues from the followed one's velocities (connected below): the compact
+    # state, which Drake copies in 16 numbers instead of 12 K.
     dmp_bank = builder.AddNamedSystem("dmp_bank", PoseDmpBank(
         position_bank, orientation_bank, period,
         lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
         max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed,
-        prediction_steps=prediction_steps))
+        prediction_steps=prediction_steps, compact_state=True))
     builder.Connect(sampled, dmp_bank.get_robot_state_input_port())
     builder.Connect(goal_poses.get_output_port(), dmp_bank.get_goal_poses_input_port())
     # Read at the decide stage before the estimator updates: the goal followed last tick.

@@ -19,33 +19,10 @@ from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one
 from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
 from pbp_drake.systems.layouts import GoalPose, PoseState, goal_index
+from pbp_drake.systems.pose_dmp_bank_state import (
+    AT_START, ON_ROBOT, STEPPING, PoseWorkspace, compact_inputs, hold_into, per_goal_arrays,
+    split_head, state_size, step_all)
 from pbp_drake.systems.tick import decide_offset
-
-# `held` in the state: stepping, holding at the robot (PBP-Alt's lock), at the starts.
-_STEPPING, _ON_ROBOT, _AT_START = 0.0, 1.0, 2.0
-
-
-class PoseWorkspace:
-    """Scratch of one Context: the two banks' workspaces, a phase, the linear velocities
-    the step starts from (`column`, the followed DMP's; `velocities`, every DMP's when no
-    followed goal is connected), the orientation readout's arrays (`eta` of every DMP,
-    likewise), and whether the goals were recomputed since the last step (`goals_changed`:
-    if not, the banks reuse what they derived from the goals, without comparing K goals)."""
-
-    __slots__ = ("position", "orientation", "phase", "column", "velocities", "orientations",
-                 "eta", "goals_changed")
-
-    def __init__(self, position_bank, orientation_bank):
-        k = position_bank.goal_count
-        self.position = position_bank.make_workspace()
-        self.orientation = orientation_bank.make_workspace()
-        self.phase = np.empty(1)
-        self.column = np.empty((3, 1))
-        self.velocities = np.empty((3, k))
-        self.orientations = np.empty((4, k))
-        self.eta = np.empty((3, k))
-        self.goals_changed = True
-
 
 class PoseDmpBank(LeafSystem):
     """Steps K pose DMPs (one per goal pose) every control period from the hand's pose.
@@ -91,19 +68,29 @@ class PoseDmpBank(LeafSystem):
     `prediction_period` (default: the DMPs' duration over `prediction_steps`), for
     drawing: it is computed only when read (a visualizer's publish), never per tick.
 
-    The state is one vector `[phase, held, p (3), q (4), eta_held (3), y' - p, z' (3K
-    each), e', z' (3K each)]` (`_split` knows the layout): the position DMPs' stepped
-    positions relative to the measured one and their stepped scaled velocities (`DmpBank`'s
-    `p + dp + Phi01 z` and `dz + Phi11 z`, summed at the step), and the orientation DMPs'
-    stepped log coordinates `(e', z')` (`log_step_into`), from which the outputs read the
-    orientations and angular velocities on demand: 12 K numbers, which Drake copies twice
-    at each update (at K = 10,000 that copying is a sixth of the step). The bank updates
-    at the decide stage of each tick (`update_offset` overrides it).
+    The state is one vector `[phase, held, p (3), q (4), eta (3), ...]`, in one of two
+    layouts (`pbp_drake.systems.pose_dmp_bank_state`). Per goal (the default), the K DMPs'
+    stepped arrays follow: the position DMPs' stepped positions relative to the measured
+    one and their stepped scaled velocities (`DmpBank`'s `p + dp + Phi01 z` and
+    `dz + Phi11 z`, summed at the step), and the orientation DMPs' stepped log coordinates
+    `(e', z')` (`log_step_into`), from which the outputs read the orientations and angular
+    velocities on demand: 12 K numbers, which Drake copies twice at each update (at
+    K = 10,000 a fifth of the step). With `compact_state=True` (which needs `followed_goal`
+    connected: an update without it raises) the state is 16 numbers whatever K, what the
+    last step started from (its phase, the measured pose, the followed DMP's velocities
+    after the speed limits), and the K stepped DMPs are a cache entry computed from it and
+    the goals, with the same call, once per state when first read: by an output, or by the
+    next update, which continues from the followed DMP's velocities. Every DMP is still
+    stepped every tick; the outputs are the per-goal layout's bit for bit while the goals
+    stay, and if the goals change between an update and a read, the read steps toward the
+    new goals (as `DmpBank`'s compact state). The bank updates at the decide stage of each
+    tick (`update_offset` overrides it).
     """
 
     def __init__(self, position_bank, orientation_bank, control_period,
                  lock_phase_when_operator_acts=False, update_offset=None, max_speed=None,
-                 max_angular_speed=None, prediction_steps=0, prediction_period=None):
+                 max_angular_speed=None, prediction_steps=0, prediction_period=None,
+                 compact_state=False):
         super().__init__()
         _check_banks(position_bank, orientation_bank, control_period)
         # Anti-windup, as DmpBank's `max_speed`: the hand-over never lets the hand move or
@@ -129,11 +116,13 @@ class PoseDmpBank(LeafSystem):
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
-        initial = np.zeros(self.state_size(k))
-        phase, held, _, q, _, stepped, _ = self._split(initial)
-        phase[0], held[0] = 1.0, _AT_START
+        self._compact = bool(compact_state)
+        initial = np.zeros(self.state_size(k, self._compact))
+        phase, held, _, q, _ = split_head(initial)
+        phase[0], held[0] = 1.0, AT_START
         q[:, 0] = quaternion.IDENTITY
-        stepped[0] = position_bank.starts  # from p = 0 at the start
+        if not self._compact:
+            per_goal_arrays(initial, k)[0][0] = position_bank.starts  # from p = 0
         self._state_index = self.DeclareDiscreteState(initial)
         self._goals_entry = self.DeclareCacheEntry(
             "goal poses, validated, (7, K): positions then quaternions",
@@ -147,6 +136,12 @@ class PoseDmpBank(LeafSystem):
                 PoseWorkspace(position_bank, orientation_bank)),
                 calc=self._never_calculated),
             prerequisites_of_calc={self.nothing_ticket()})
+        if self._compact:
+            self._stepped_entry = self.DeclareCacheEntry(
+                "the K DMPs stepped from the compact state: [y' - p, z', e', z'] (12 K)",
+                ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(12 * k)),
+                              calc=self._calc_stepped),
+                prerequisites_of_calc={self.xd_ticket(), self._goals_entry.ticket()})
         self._references_port = self.DeclareVectorOutputPort(
             "references", k * PoseState.size, self._calc_references,
             prerequisites_of_calc={self.xd_ticket(), self._goals_port.ticket()})
@@ -171,9 +166,9 @@ class PoseDmpBank(LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     @staticmethod
-    def state_size(goal_count):
+    def state_size(goal_count, compact_state=False):
         """The length of the one state vector (class docstring)."""
-        return 2 + 3 + 4 + 3 + 4 * 3 * goal_count
+        return state_size(goal_count, compact_state)
 
     @property
     def position_bank(self):
@@ -210,15 +205,25 @@ class PoseDmpBank(LeafSystem):
     def get_predicted_poses_output_port(self):
         return self._predicted_poses_port
 
-    def _split(self, vector):
-        """Views: phase (1,), held (1,), p (3, 1), q (4, 1), eta_held (3, 1), the position
-        DMPs' stepped offsets `y' - p` and scaled velocities `z'` (2, 3, K), and the log
-        coordinates (2, 3, K)."""
-        k = self._goal_count
-        return (vector[0:1], vector[1:2], vector[2:5].reshape(3, 1),
-                vector[5:9].reshape(4, 1), vector[9:12].reshape(3, 1),
-                vector[12:12 + 6 * k].reshape(2, 3, k),
-                vector[12 + 6 * k:12 + 12 * k].reshape(2, 3, k))
+    def _stepped(self, context, vector):
+        """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K) of the state
+        `vector` (the Context's, or its copy being updated, which the compact layout's
+        cache entry, the Context's, must equal)."""
+        if self._compact:
+            return per_goal_arrays(self._stepped_entry.Eval(context), self._goal_count)
+        return per_goal_arrays(vector, self._goal_count)
+
+    def _calc_stepped(self, context, value):
+        vector = context.get_discrete_state(self._state_index).get_value()
+        _, held, robot, q, eta = split_head(vector)
+        phase, velocity = compact_inputs(vector)
+        stepped, log_state = per_goal_arrays(value.get_mutable_value(), self._goal_count)
+        if held[0] != STEPPING:
+            hold_into(held[0], robot, velocity, self._positions.starts, stepped)
+            return
+        step_all(self._positions, self._orientations, self._shared_basis, phase, robot, q,
+                 velocity, eta, self._goals_entry.Eval(context), self._period, stepped,
+                 log_state, self._workspace(context))
 
     def _workspace(self, context):
         return self._workspace_entry.get_mutable_cache_entry_value(
@@ -255,26 +260,36 @@ class PoseDmpBank(LeafSystem):
 
     def _update(self, context, discrete_state):
         positions, orientations, period = self._positions, self._orientations, self._period
-        phase, held, robot, q, eta_held, stepped, log_state = self._split(
-            discrete_state.get_mutable_vector(self._state_index).get_mutable_value())
-        offsets, velocities = stepped
+        vector = discrete_state.get_mutable_vector(self._state_index).get_mutable_value()
+        phase, held, robot, q, eta_state = split_head(vector)
+        stepping = held[0] == STEPPING
         # Every input before the workspace (an input may reach this system's outputs).
         position, orientation, velocity, angular_velocity = self._robot(context)
         lock = (self._lock and self._operator_active_port.HasValue(context)
                 and self._operator_active_port.Eval(context)[0] > 0.5)
         goals = self._goals_entry.Eval(context)
         followed = goal_index(self._followed_goal_port, context, self._goal_count)
+        if self._compact and followed is None:
+            raise RuntimeError(
+                "PoseDmpBank with compact_state=True steps every DMP from the followed DMP's "
+                "velocities: connect its followed_goal input port")
+        # The compact state's `z`: the velocity the last step started from, or the held one.
+        step_velocity = compact_inputs(vector)[1] if self._compact else None
+        if stepping or not self._compact:
+            stepped, log_state = self._stepped(context, vector)
+            offsets, velocities = stepped
         workspace = self._workspace(context)
         # The DMPs' velocities at the end of the last step, which the step overwrites: the
         # followed one's linear velocity (every DMP continues from it), else each one's,
         # and the orientation part's eta as a column (one for all) or per DMP.
         if followed is not None:
             scaled_velocity = workspace.column
-            scaled_velocity[:, 0] = velocities[:, followed]
+            scaled_velocity[:, 0] = (velocities[:, followed] if step_velocity is None
+                                     or stepping else step_velocity[:, 0])
         else:
             scaled_velocity = workspace.velocities
             np.copyto(scaled_velocity, velocities)
-        if held[0] == _STEPPING:
+        if stepping:
             limit_speeds(scaled_velocity, self._max_speed, positions.duration)
             if followed is not None:
                 eta = jacobian_of_one(log_state[0, :, followed],
@@ -286,41 +301,42 @@ class PoseDmpBank(LeafSystem):
                 eta = workspace.eta
             limit_speeds(eta, self._max_angular_speed, orientations.duration)
         else:
-            eta = np.array(eta_held)  # the robot's (locked) or 0 (at the start), (3, 1)
+            eta = np.array(eta_state)  # the robot's (locked) or 0 (at the start), (3, 1)
         robot[:, 0] = position
         q[:, 0] = orientation
         if lock:
             # Both phases frozen: the DMPs sit at the hand's pose and follow its twist.
-            held[0] = _ON_ROBOT
-            offsets.fill(0.0)
-            np.multiply(velocity[:, np.newaxis], positions.duration, out=velocities)
-            eta_held[:, 0] = angular_velocity * orientations.duration
+            held[0] = ON_ROBOT
+            eta_state[:, 0] = angular_velocity * orientations.duration
+            if self._compact:
+                np.multiply(velocity[:, np.newaxis], positions.duration, out=step_velocity)
+            else:
+                offsets.fill(0.0)
+                np.multiply(velocity[:, np.newaxis], positions.duration, out=velocities)
             return
-        held[0] = _STEPPING
-        # Both banks reuse what they derived from the goals while the goals cache entry has
-        # not been recomputed (they vouch for nothing else).
-        unchanged = not workspace.goals_changed
-        positions.stepped_from_one_into(phase, robot, scaled_velocity, goals[:3], period,
-                                        stepped, workspace.position,
-                                        goals_unchanged=unchanged)
-        basis = ((workspace.position.basis, workspace.position.lam) if self._shared_basis
-                 else None)
-        orientations.log_step_into(phase, q, eta, goals[3:], period, workspace.phase,
-                                   log_state, workspace.orientation, goals_unchanged=unchanged,
-                                   basis=basis)
-        workspace.goals_changed = False
+        held[0] = STEPPING
+        if self._compact:
+            # What the step starts from; the cache entry takes it (`_calc_stepped`).
+            compact_inputs(vector)[0][0] = phase[0]
+            step_velocity[...] = scaled_velocity
+            eta_state[...] = eta
+        else:
+            step_all(positions, orientations, self._shared_basis, phase, robot, q,
+                     scaled_velocity, eta, goals, period, stepped,
+                     log_state, workspace)
         phase *= positions.decay(period)
 
     def dmp_states(self, context):
         """The K DMPs after the last update: phases (K,), positions (3, K), orientations
         (4, K), and the scaled velocities `tau v` and `tau omega` (3, K), new arrays."""
-        phase, held, robot, q, eta_held, (offsets, velocities), log_state = self._split(
-            context.get_discrete_state(self._state_index).get_value())
+        vector = context.get_discrete_state(self._state_index).get_value()
+        phase, held, robot, q, eta_held = split_head(vector)
         k = self._goal_count
+        (offsets, velocities), log_state = self._stepped(context, vector)
         rotations = np.empty((4, k))
         eta = np.empty((3, k))
-        if held[0] != _STEPPING:
-            rotations[...] = self._orientations.starts if held[0] == _AT_START else q
+        if held[0] != STEPPING:
+            rotations[...] = self._orientations.starts if held[0] == AT_START else q
             eta[...] = eta_held
         else:
             goals = self._goals_entry.Eval(context)
@@ -342,13 +358,14 @@ class PoseDmpBank(LeafSystem):
         k = goal_index(self._selected_goal_port, context, self._goal_count)
         if k is None:
             k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
-        _, held, robot, q, eta_held, (offsets, velocities), log_state = self._split(
-            context.get_discrete_state(self._state_index).get_value())
+        vector = context.get_discrete_state(self._state_index).get_value()
+        _, held, robot, q, eta_held = split_head(vector)
+        (offsets, velocities), log_state = self._stepped(context, vector)
         position = robot[:, 0] + offsets[:, k]
         velocity = velocities[:, k] / self._positions.duration
         tau_w = self._orientations.duration
-        if held[0] != _STEPPING:
-            start = self._orientations.starts[:, k] if held[0] == _AT_START else q[:, 0]
+        if held[0] != STEPPING:
+            start = self._orientations.starts[:, k] if held[0] == AT_START else q[:, 0]
             return PoseReference(position, np.array(start), velocity, eta_held[:, 0] / tau_w)
         error, log_velocity = log_state[0, :, k], log_state[1, :, k]
         goal = self._goals_entry.Eval(context)[3:, k]
@@ -360,7 +377,7 @@ class PoseDmpBank(LeafSystem):
         output.SetFromVector(self.selected_reference(context).to_vector())
 
     def _calc_phase(self, context, output):
-        phase = self._split(context.get_discrete_state(self._state_index).get_value())[0]
+        phase = split_head(context.get_discrete_state(self._state_index).get_value())[0]
         output.get_mutable_value()[:] = phase[0]
 
 

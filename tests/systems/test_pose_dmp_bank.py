@@ -1,5 +1,8 @@
 """The six-DoF DMP bank system: the NumPy banks' steps inside a LeafSystem (to 1e-12), one
-phase lock for position and orientation, and bad goals and hand states refused by name."""
+phase lock for position and orientation, bad goals and hand states refused by name, and the
+compact state (`compact_state=True`: with `followed_goal` connected, 16 numbers whatever K,
+the K stepped DMPs a cache entry computed from them, the per-goal state's outputs bit for
+bit, distinct weights included)."""
 
 import numpy as np
 import pytest
@@ -230,3 +233,90 @@ def test_goals_set_between_steps_are_stepped_to():
                           eta.T / orientations.duration])
     references = bank.get_references_output_port().Eval(context).reshape(K, 13)
     np.testing.assert_allclose(references, expected, rtol=0, atol=1e-12)
+
+
+def drive_compact(system, context, step, goals):
+    """Fixes what tick `step` feeds the bank: a moving and turning hand, PBP-Alt locks now
+    and then, the followed and selected goals changing; the goals once (goals recomputed
+    may take the banks' other path, equal to rounding: the layouts then differ by it)."""
+    rng = np.random.default_rng(step)
+    hand = ROBOT.copy()
+    hand[:3] += rng.uniform(-0.1, 0.1, 3)
+    hand[3:7] = quaternion.exp_map(rng.uniform(-0.4, 0.4, 3))
+    hand[7:] = rng.uniform(-0.5, 0.5, 6)
+    system.get_robot_state_input_port().FixValue(context, hand)
+    if step == 0:
+        system.get_goal_poses_input_port().FixValue(context, goals.reshape(-1))
+    system.get_operator_active_input_port().FixValue(context, [float(step % 9 in (4, 5))])
+    system.get_followed_goal_input_port().FixValue(context, [float(step // 6 % K)])
+    system.get_selected_goal_input_port().FixValue(context, [float(step // 5 % K)])
+
+
+def outputs(system, context):
+    ports = (system.get_references_output_port(), system.get_selected_reference_output_port(),
+             system.get_phase_output_port(), system.get_predicted_poses_output_port())
+    return [port.Eval(context).copy() for port in ports]
+
+
+@pytest.mark.parametrize("limits", [(None, None), (0.2, 0.5)], ids=["free", "speed limits"])
+def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(limits):
+    positions, orientations, goals = make_banks()
+    runs = []
+    for compact in (False, True):
+        system = PoseDmpBank(positions, orientations, DT, lock_phase_when_operator_acts=True,
+                             max_speed=limits[0], max_angular_speed=limits[1],
+                             prediction_steps=3, compact_state=compact)
+        simulator = Simulator(system)
+        context = simulator.get_mutable_context()
+        run = []
+        for step in range(40):
+            drive_compact(system, context, step, goals)
+            simulator.AdvanceTo(step * DT + DT / 2)
+            # Every other tick read before the next update, as a blender would; the others
+            # leave the compact state's step to the next update.
+            if step % 2:
+                run.append(outputs(system, context))
+        runs.append(run)
+    per_goal, compact = runs
+    for step, (expected, got) in enumerate(zip(per_goal, compact)):
+        for name, a, b in zip(("references", "selected_reference", "phase", "poses"),
+                              expected, got):
+            assert np.array_equal(a, b), f"{name} differs at read {step}"
+    assert not np.array_equal(per_goal[2][0], per_goal[15][0])  # the run moved
+
+
+def test_the_compact_state_does_not_grow_with_the_goals():
+    positions, orientations, _ = make_banks()
+    system = PoseDmpBank(positions, orientations, DT, compact_state=True)
+    assert system.CreateDefaultContext().get_discrete_state_vector().size() == 16
+    assert PoseDmpBank.state_size(10_000, compact_state=True) == 16
+    assert PoseDmpBank.state_size(10_000) == 12 + 12 * 10_000
+
+
+def test_the_compact_state_needs_the_followed_goal_connected():
+    positions, orientations, goals = make_banks()
+    system = PoseDmpBank(positions, orientations, DT, compact_state=True)
+    simulator = Simulator(system)
+    context = simulator.get_mutable_context()
+    system.get_robot_state_input_port().FixValue(context, ROBOT)
+    system.get_goal_poses_input_port().FixValue(context, goals.reshape(-1))
+    with pytest.raises(RuntimeError, match="connect its followed_goal"):
+        simulator.AdvanceTo(DT)
+
+
+def test_a_cloned_context_of_the_compact_state_steps_as_the_original():
+    """The cache entry of the K stepped DMPs is the Context's: a clone stepped in between
+    the original's steps gives the same numbers."""
+    positions, orientations, goals = make_banks()
+    system = PoseDmpBank(positions, orientations, DT, compact_state=True)
+    first = Simulator(system)
+    drive_compact(system, first.get_mutable_context(), 0, goals)
+    first.AdvanceTo(0.05)
+    system.get_references_output_port().Eval(first.get_context())  # a cache up to date
+    second = Simulator(system, first.get_context().Clone())
+    for seconds in (0.1, 0.15):
+        first.AdvanceTo(seconds)
+        second.AdvanceTo(seconds)
+        rows = [system.get_references_output_port().Eval(simulator.get_context())
+                for simulator in (first, second)]
+        np.testing.assert_array_equal(rows[0], rows[1])

@@ -206,9 +206,10 @@ class PoseDmpBank(LeafSystem):
         return self._predicted_poses_port
 
     def _stepped(self, context, vector):
-        """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K) of the state
-        `vector` (the Context's, or its copy being updated, which the compact layout's
-        cache entry, the Context's, must equal)."""
+        """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K): views of
+        `vector` (the state read, or the update's copy of it) per goal; in the compact
+        layout, of the cache entry computed from the Context's state, which the update's
+        copy equals until the update writes it."""
         if self._compact:
             return per_goal_arrays(self._stepped_entry.Eval(context), self._goal_count)
         return per_goal_arrays(vector, self._goal_count)

@@ -37,8 +37,8 @@ def split_head(vector):
 
 
 def per_goal_arrays(vector, goal_count):
-    """Views of the per-goal layout's (or the compact cache's, from offset 0 given its
-    own vector) stepped arrays: `[y' - p, z']` (2, 3, K) and `[e', z']` (2, 3, K)."""
+    """Views of the stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K each) at the end
+    of `vector`: a per-goal state, or the compact layout's cache entry (12 K numbers)."""
     start = len(vector) - 12 * goal_count
     return (vector[start:start + 6 * goal_count].reshape(2, 3, goal_count),
             vector[start + 6 * goal_count:].reshape(2, 3, goal_count))

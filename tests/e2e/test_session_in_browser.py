@@ -55,7 +55,7 @@ def hold_left(page, seconds):
         time.sleep(max(0.0, 0.05 - (time.monotonic() - now)))
 
 
-@pytest.mark.timeout(300)
+@pytest.mark.timeout(480)
 def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
     output = tmp_path / "P03"
     order = session_order(DEFAULT_SESSION_METHODS, "P03")
@@ -87,8 +87,11 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
                 control(page, status + r"\d+ %").wait_for(state="attached")
                 seen[method] = {b: control(page, b).count()
                                 for b in ("Stop", "Restart", "Next scene")}
+                # A run is paced at real time when the machine keeps up; on a loaded one its
+                # 20 simulated seconds took over 50 s of wall time (a failure of the suite):
+                # wait up to four times the run, which a quiet machine never needs.
                 control(page, r"Result: (success in|failed: time limit).*").wait_for(
-                    state="attached", timeout=(DURATION + 30) * 1000)
+                    state="attached", timeout=(4 * DURATION + 30) * 1000)
                 tiredness, ease = ANSWERS[method]
                 click(page, label_of("tiredness", tiredness))
                 click(page, label_of("ease", ease))

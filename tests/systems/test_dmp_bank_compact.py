@@ -5,6 +5,7 @@ goal's reference alone, which the blender can follow instead of all K."""
 
 import numpy as np
 import pytest
+from bit_for_bit import assert_same_outputs
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
@@ -57,10 +58,8 @@ def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(formula
             run.append(outputs(system, context))
         runs.append(run)
     per_goal, compact = runs
-    for step, (expected, got) in enumerate(zip(per_goal, compact)):
-        for name, a, b in zip(("references", "selected_reference", "phase", "paths"),
-                              expected, got):
-            assert np.array_equal(a, b), f"{name} differs at step {step}"
+    assert_same_outputs(per_goal, compact,
+                        ("references", "selected_reference", "phase", "paths"))
     # The run did move, lock and unlock.
     assert not np.array_equal(per_goal[3][0], per_goal[30][0])
 

@@ -6,6 +6,7 @@ bit, distinct weights included)."""
 
 import numpy as np
 import pytest
+from bit_for_bit import assert_same_outputs
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
@@ -278,10 +279,8 @@ def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(limits)
                 run.append(outputs(system, context))
         runs.append(run)
     per_goal, compact = runs
-    for step, (expected, got) in enumerate(zip(per_goal, compact)):
-        for name, a, b in zip(("references", "selected_reference", "phase", "poses"),
-                              expected, got):
-            assert np.array_equal(a, b), f"{name} differs at read {step}"
+    assert_same_outputs(per_goal, compact,
+                        ("references", "selected_reference", "phase", "poses"))
     assert not np.array_equal(per_goal[2][0], per_goal[15][0])  # the run moved
 
 

@@ -37,9 +37,10 @@ def format_report(report):
                  "N = 50, dt = 1 ms.")
     lines.append("math: DmpBank.advance_into; leaf: the DmpBank LeafSystem per 1 ms period "
                  "in a Simulator (includes Drake), wired as the builder wires it (followed "
-                 "and selected goal connected, shared weights in the compact state, the "
-                 "selected reference read every period); drake: a LeafSystem with the "
-                 "same ports and an empty update;")
+                 "and selected goal connected, the compact state: affine in the goal with "
+                 "shared weights, the step's inputs with distinct ones; the selected "
+                 "reference read every period); drake: a LeafSystem with the same ports "
+                 "and state and an empty update;")
     lines.append("bound: weight bytes / measured read bandwidth (cache-sized bound in "
                  "brackets); pydmps/goal, mp/goal: one object per goal; mp stacked: one "
                  "K*D DMP; x per-goal, x stacked: speed-ups of the bank math. D = 6p: the "

@@ -80,9 +80,10 @@ def make_pbp_controller(resolved, prediction_steps=0):
         # hand's speed limit until it overrides them (the other modes never hold it so).
         max_speed=(scenario.robot.max_hand_speed if resolved.blend_mode == "pbp_continuous"
                    else None),
-        # Every DMP steps from the followed one's velocity (connected below): with shared
-        # weights and start (every scenario's bank) the state is then O(D) whatever K.
-        compact_state=bank.affine_in_goal))
+        # Every DMP steps from the followed one's velocity (connected below): the state is
+        # then O(D) whatever K (with shared weights and start, every scenario's bank, the
+        # outputs are O(D) too).
+        compact_state=True))
     builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")

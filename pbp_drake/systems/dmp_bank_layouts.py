@@ -20,6 +20,14 @@ PBP-Alt locks the phases) the DMPs sit at `p + dp` with velocity `z`.
   per-goal layout's, bit for bit (the same operations in the same order); when they
   change, the read-out and the next update read the new goals, as if the last step had
   been taken toward them.
+- `StepInputsLayout`, `[phase, held, p (D), z (D), the last step's phase]`: any bank
+  (distinct weights too) whose DMPs all step from the followed DMP's velocity. The step's
+  attractor terms are then a function of what it started from and the goals, so they are
+  not state but a cache entry the system computes from it (`terms_into`, the per-goal
+  update's call) once per state, when first read: by a read-out, or by the next update,
+  which takes the followed DMP's `dz` from them. `3 + 2 D` numbers whatever K; every
+  read-out is the per-goal layout's bit for bit while the goals stay (and steps toward
+  new goals as the affine layout does).
 """
 
 import numpy as np
@@ -51,7 +59,7 @@ class PerGoalLayout(_Layout):
         super().__init__(bank, period, max_speed)
         self.size = self.size_of(bank.goal_count, bank.dimension)
         self.needs_followed_goal = False
-        self.reads_goals = False  # the read-out depends on the state alone
+        self.reads = None  # the read-out depends on the state alone
 
     @staticmethod
     def size_of(goal_count, dimension):
@@ -69,8 +77,9 @@ class PerGoalLayout(_Layout):
         """The DMPs sit at their starts (p = 0, dp = starts), at rest."""
         self._split(vector)[4][...] = self._bank.starts
 
-    def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
-        """One update, in place (`goals_dk` may be None when `lock`)."""
+    def update(self, vector, robot_state, lock, goals_dk, followed, workspace, given=None):
+        """One update, in place (`goals_dk` may be None when `lock`; `given`, what the
+        layout `reads` besides the state, unused here)."""
         bank, period = self._bank, self._period
         d = bank.dimension
         phase, held, robot, z, dp, dz = self._split(vector)
@@ -93,9 +102,9 @@ class PerGoalLayout(_Layout):
         bank.attractor_terms_into(phase, robot, goals_dk, period, dp, dz, workspace)
         phase *= bank.decay(period)
 
-    def read(self, vector, goals_dk, workspace, goal=None):
+    def read(self, vector, given, workspace, goal=None):
         """The stepped positions and scaled velocities `(D, K)` of every DMP, or `(D, 1)`
-        of DMP `goal`, new arrays."""
+        of DMP `goal`, new arrays (`given`: what the layout `reads`, here nothing)."""
         _, held, robot, z, dp, dz = self._split(vector)
         if goal is not None:
             z, dp, dz = (array[:, goal:goal + 1] for array in (z, dp, dz))
@@ -121,7 +130,7 @@ class AffineLayout(_Layout):
         super().__init__(bank, period, max_speed)
         self.size = self.size_of(bank.goal_count, bank.dimension)
         self.needs_followed_goal = True
-        self.reads_goals = True  # the read-out evaluates the attractor terms at the goals
+        self.reads = "goals"  # the read-out evaluates the attractor terms at the goals
 
     @staticmethod
     def size_of(goal_count, dimension):
@@ -139,7 +148,7 @@ class AffineLayout(_Layout):
         """At rest at the (one) start: dp = 0 g + start."""
         self._split(vector)[5][0] = self._bank.starts[:, :1]
 
-    def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
+    def update(self, vector, robot_state, lock, goals_dk, followed, workspace, given=None):
         """One update, in place: the per-goal layout's arithmetic on the followed DMP."""
         bank, period = self._bank, self._period
         d = bank.dimension
@@ -167,8 +176,9 @@ class AffineLayout(_Layout):
         beta[...] = new_beta
         phase *= bank.decay(period)
 
-    def read(self, vector, goals_dk, workspace, goal=None):
-        """As `PerGoalLayout.read`, at the goals `goals_dk` (D, K) on the port."""
+    def read(self, vector, given, workspace, goal=None):
+        """As `PerGoalLayout.read`, at the goals `given` (D, K) on the port."""
+        goals_dk = given
         _, held, robot, z, alpha, beta = self._split(vector)
         goals = goals_dk if goal is None else goals_dk[:, goal:goal + 1]
         positions = np.multiply(goals, alpha[0])
@@ -182,3 +192,76 @@ class AffineLayout(_Layout):
         # dz + Phi11 z, summed as the per-goal layout sums Phi11 z + dz.
         velocity += z * self._bank.step_constants(self._period).velocity_velocity
         return positions, velocity
+
+
+# `held` in the step-inputs layout: 1 on the robot (as the others), 2 at the start (its
+# attractor terms, not kept, are then the starts).
+_AT_START = 2.0
+
+
+class StepInputsLayout(_Layout):
+    """What the last step started from in the state; its attractor terms a cache entry
+    (see the module docstring)."""
+
+    def __init__(self, bank, period, max_speed):
+        super().__init__(bank, period, max_speed)
+        self.size = self.size_of(bank.goal_count, bank.dimension)
+        self.needs_followed_goal = True
+        self.reads = "terms"  # the read-out and the update read the step's terms
+
+    @staticmethod
+    def size_of(goal_count, dimension):
+        return 3 + 2 * dimension  # whatever K
+
+    def _split(self, vector):
+        """Views: phase (1,), held (1,), p (D, 1), z (D, 1), the last step's phase (1,)."""
+        d = self._bank.dimension
+        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
+                vector[2 + d:2 + 2 * d].reshape(d, 1), vector[2 + 2 * d:3 + 2 * d])
+
+    def _at_start(self, vector):
+        """At rest at the starts (p = 0; the terms then give dp = the starts)."""
+        vector[1] = _AT_START
+
+    def terms_into(self, vector, goals_dk, workspace, terms):
+        """The last step's attractor terms `dp`, `dz` into `terms` (2, D, K), with the
+        per-goal layout's update's call; while held, `dp` is the starts (at the start) or
+        0 (on the robot), as that layout keeps it."""
+        _, held, robot, _, step_phase = self._split(vector)
+        dp, dz = terms
+        if held[0]:
+            dp[...] = self._bank.starts if held[0] == _AT_START else 0.0
+            dz.fill(0.0)  # not read while held
+            return
+        self._bank.attractor_terms_into(step_phase, robot, goals_dk, self._period, dp, dz,
+                                        workspace)
+
+    def update(self, vector, robot_state, lock, goals_dk, followed, workspace, given=None):
+        """One update, in place: the per-goal layout's arithmetic on the followed DMP,
+        whose `dz` comes from `given`, the terms of the state being updated."""
+        bank, period = self._bank, self._period
+        d = bank.dimension
+        phase, held, robot, z, step_phase = self._split(vector)
+        if not held[0]:
+            bank.stepped_velocity_into(given[1][:, followed:followed + 1], z, period, z)
+            limit_speeds(z, self._max_speed, bank.duration)
+        robot[:, 0] = robot_state[:d]
+        if lock:
+            # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
+            held[0] = 1.0
+            np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
+            return
+        held[0] = 0.0
+        step_phase[0] = phase[0]
+        phase *= bank.decay(period)
+
+    def read(self, vector, given, workspace, goal=None):
+        """As `PerGoalLayout.read`, from the terms `given` (2, D, K) of this state."""
+        _, held, robot, z, _ = self._split(vector)
+        dp, dz = given if goal is None else given[:, :, goal:goal + 1]
+        positions = np.add(robot, dp)
+        if held[0]:
+            return positions, np.repeat(z, dp.shape[1], axis=1)
+        positions += z * self._bank.step_constants(self._period).position_velocity
+        return positions, self._bank.stepped_velocity_into(dz, z, self._period,
+                                                           np.empty(dz.shape))

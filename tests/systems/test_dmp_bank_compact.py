@@ -1,7 +1,8 @@
-"""The DmpBank system's compact state (`compact_state=True`): for DMPs that share weights and
-start and step from the followed DMP's velocity, a state of `2 + 6 D` numbers whatever K,
-whose outputs are the per-goal state's bit for bit; and `selected_reference`, the selected
-goal's reference alone, which the blender can follow instead of all K."""
+"""The DmpBank system's compact state (`compact_state=True`): for DMPs that step from the
+followed DMP's velocity, a state whatever K (`2 + 6 D` numbers when they share weights and
+start, `3 + 2 D` with distinct weights, the step's terms then a cache entry), whose outputs
+are the per-goal state's bit for bit; and `selected_reference`, the selected goal's
+reference alone, which the blender can follow instead of all K."""
 
 import numpy as np
 import pytest
@@ -23,6 +24,13 @@ def shared_bank(formulation="ijspeert"):
     return DmpBankMath.straight(np.array([0.05, -0.02, 0.1]), len(GOALS), 1.2, settings)
 
 
+def distinct_bank(formulation="ijspeert"):
+    """Weights of its own for every goal, as learned ones would be."""
+    settings = DmpSettings(basis_count=15, formulation=formulation)
+    weights = np.random.default_rng(4).normal(0.0, 40.0, (len(GOALS), 15, 3))
+    return DmpBankMath(weights, np.array([0.05, -0.02, 0.1]), 1.2, settings)
+
+
 def drive(system, context, step):
     """Fixes what tick `step` feeds the bank: a moving robot, PBP-Alt locks now and then, and
     the followed goal changing."""
@@ -42,9 +50,12 @@ def outputs(system, context):
 
 @pytest.mark.parametrize("formulation", ["ijspeert", "pastor"])
 @pytest.mark.parametrize("max_speed", [None, 0.3])
+@pytest.mark.parametrize("make_bank", [shared_bank, distinct_bank],
+                         ids=["shared", "distinct"])
 def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(formulation,
-                                                                          max_speed):
-    bank = shared_bank(formulation)
+                                                                          max_speed, make_bank):
+    """Shared weights take the affine layout, distinct ones the step-inputs layout."""
+    bank = make_bank(formulation)
     runs = []
     for compact in (False, True):
         system = DmpBank(bank, DT, lock_phase_when_operator_acts=True, prediction_steps=3,
@@ -72,15 +83,16 @@ def test_the_compact_state_does_not_grow_with_the_goals():
     assert DmpBank.state_size(100_000, 3) == 2 + 3 + 9 * 100_000
 
 
-def test_the_compact_state_refuses_distinct_weights():
-    weights = np.ones((2, 15, 3)) * np.array([1.0, 2.0])[:, None, None]
-    bank = DmpBankMath(weights, np.zeros(3), 1.0, DmpSettings(basis_count=15))
-    with pytest.raises(ValueError, match="share weights and start"):
-        DmpBank(bank, DT, compact_state=True)
+def test_the_compact_state_of_distinct_weights_keeps_the_steps_inputs():
+    bank = distinct_bank()
+    system = DmpBank(bank, DT, compact_state=True)
+    assert system.CreateDefaultContext().get_discrete_state_vector().size() == 3 + 2 * 3
+    assert DmpBank.state_size(100_000, 3, compact_state=True, affine_in_goal=False) == 9
 
 
-def test_the_compact_state_needs_the_followed_goal_connected():
-    system = DmpBank(shared_bank(), DT, compact_state=True)
+@pytest.mark.parametrize("make_bank", [shared_bank, distinct_bank], ids=["shared", "distinct"])
+def test_the_compact_state_needs_the_followed_goal_connected(make_bank):
+    system = DmpBank(make_bank(), DT, compact_state=True)
     simulator = Simulator(system)
     context = simulator.get_mutable_context()
     system.get_robot_state_input_port().FixValue(context, np.zeros(6))

@@ -1,4 +1,4 @@
-"""The two state layouts of Drake's `DmpBank` system: what its discrete state holds, how an
+"""The three state layouts of Drake's `DmpBank` system: what its discrete state holds, how an
 update writes it, and how the DMPs' stepped states are read out of it.
 
 PBP steps every DMP from the robot's position `p`, and the step is affine in the DMP's own

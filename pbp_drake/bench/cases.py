@@ -4,9 +4,10 @@ ports and state whose update does nothing: Drake's own cost).
 
 The LeafSystem is wired as the builder wires it: its `followed_goal` and `selected_goal`
 connected, the compact state (`DmpBank(compact_state=True)`: affine in the goal with
-shared weights, the step's inputs with distinct ones), and a reader that evaluates its `selected_reference` at every period, as the blender does:
-a step's time is its update and that read. (A bank could otherwise look fast by leaving
-its work to an output no timing reads.)"""
+shared weights, the step's inputs with distinct ones), and a reader that evaluates its
+`selected_reference` at every period, as the blender does: a step's time is its update
+and that read. (A bank could otherwise look fast by leaving its work to an output no
+timing reads.)"""
 
 import dataclasses
 
@@ -89,7 +90,8 @@ class NullBank(LeafSystem):
         self.DeclareVectorInputPort("operator_active", 1)
         self.DeclareVectorInputPort("followed_goal", 1)
         self.DeclareVectorInputPort("selected_goal", 1)
-        self.DeclareDiscreteState(np.zeros(DmpBankSystem.state_size(k, d, True, affine_in_goal)))
+        size = DmpBankSystem.state_size(k, d, compact_state=True, affine_in_goal=affine_in_goal)
+        self.DeclareDiscreteState(np.zeros(size))
         self.DeclareVectorOutputPort("selected_reference", 2 * d, self._calc_reference,
                                      prerequisites_of_calc={self.xd_ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(DT, 0.0, self._update)
@@ -127,7 +129,8 @@ def leaf_simulator(case, bank=None, read="selected_reference"):
     builder = DiagramBuilder()
     d = case.dimension
     # The compact state, as the builder's: a case's shared weights come with one start
-    # (`make_bank`), so its DMPs are affine in the goal; distinct ones keep the step's inputs.
+    # (`make_bank`), so its DMPs are affine in the goal; distinct ones keep the step's
+    # inputs.
     if bank is None:
         system = builder.AddSystem(NullBank(case.goal_count, d, case.weights is None))
     else:

@@ -22,6 +22,9 @@ RAY_INSTALL_HINT = "pip install 'pbp_drake[ray]'"
 RAY_MAX_RETRIES = 1
 # This process's pbp_drake, which a cluster's workers import (see _cluster_runtime_env).
 PACKAGE_DIR = pathlib.Path(__file__).resolve().parents[1]
+# Seconds a `--ray-address` has to accept a connection before the study says nothing
+# answers there: Ray's own driver retries an address with no head for minutes, silently.
+CONNECT_TIMEOUT = 10.0
 
 
 def import_ray():
@@ -64,6 +67,8 @@ class _RaySession:
         if self.ray.is_initialized():
             return
         quiet = {"log_to_driver": False, "configure_logging": False}
+        if address is not None:
+            check_answers(address)
         try:
             if address is None:
                 path = os.pathsep.join(p for p in sys.path if p)
@@ -81,6 +86,26 @@ class _RaySession:
         if self.started:
             self.started = False
             self.ray.shutdown()
+
+
+def check_answers(address, timeout=CONNECT_TIMEOUT):
+    """A StudyError, naming the address, when nothing accepts a TCP connection at the
+    host and port of a `HOST:PORT` or `ray://HOST:PORT` address within `timeout` seconds
+    (a refused connection fails at once). Other forms (`auto`) are Ray's to resolve."""
+    target = address[len("ray://"):] if address.startswith("ray://") else address
+    host, colon, port = target.rpartition(":")
+    if not colon or not port.isdigit():
+        return
+    host = host.strip("[]") or "localhost"
+    try:
+        with socket.create_connection((host, int(port)), timeout=timeout):
+            pass
+    except OSError as error:
+        reason = f"{type(error).__name__}: {error}" if str(error) else type(error).__name__
+        raise StudyError(
+            f"could not connect to Ray at {address}: nothing answers at {host}:{port} within "
+            f"{timeout:g} s ({reason}); is its head node running (ray start --head)?"
+        ) from None
 
 
 def _reason(cause):

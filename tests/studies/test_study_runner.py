@@ -501,3 +501,20 @@ def test_the_local_backend_does_not_import_ray(scenario, tmp_path):
     task.write_text(textwrap.dedent(TASK))
     subprocess.run([sys.executable, "-c", code, str(task), str(tmp_path / "out")], check=True,
                    timeout=120)
+
+
+@needs_ray
+def test_a_ray_address_where_nothing_answers_is_named_at_once(task_file, tmp_path, capsys):
+    with socket.socket() as probe:  # a port of this host that nothing listens on once closed
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    started = time.monotonic()
+    args = study_args(task_file, tmp_path, 1) + ["--backend", "ray",
+                                                 "--ray-address", f"127.0.0.1:{port}"]
+    assert main(args) == 2
+    # Ray's own driver retried such an address for minutes, printing only its warnings.
+    assert time.monotonic() - started < 10
+    message = capsys.readouterr().err
+    assert f"could not connect to Ray at 127.0.0.1:{port}: nothing answers at" in message
+    assert "ray start --head" in message
+    assert not list(tmp_path.glob("trials/*/*.json"))

@@ -40,6 +40,7 @@ class _Layout:
 
     def __init__(self, bank, period, max_speed):
         self._bank, self._period, self._max_speed = bank, period, max_speed
+        self.size = self.size_of(bank.goal_count, bank.dimension)
 
     def initial(self):
         """Held at the start, phase 1, the rest as `_at_start` sets it."""
@@ -57,7 +58,6 @@ class PerGoalLayout(_Layout):
 
     def __init__(self, bank, period, max_speed):
         super().__init__(bank, period, max_speed)
-        self.size = self.size_of(bank.goal_count, bank.dimension)
         self.needs_followed_goal = False
         self.reads = None  # the read-out depends on the state alone
 
@@ -128,7 +128,6 @@ class AffineLayout(_Layout):
                 "compact_state needs DMPs that share weights and start (a bank from one "
                 "demonstration, or straight): this bank's are distinct")
         super().__init__(bank, period, max_speed)
-        self.size = self.size_of(bank.goal_count, bank.dimension)
         self.needs_followed_goal = True
         self.reads = "goals"  # the read-out evaluates the attractor terms at the goals
 
@@ -205,7 +204,6 @@ class StepInputsLayout(_Layout):
 
     def __init__(self, bank, period, max_speed):
         super().__init__(bank, period, max_speed)
-        self.size = self.size_of(bank.goal_count, bank.dimension)
         self.needs_followed_goal = True
         self.reads = "terms"  # the read-out and the update read the step's terms
 

@@ -52,6 +52,13 @@ class _Layout:
     def phase(self, vector):
         return vector[0]
 
+    def _one_velocity_head(self, vector):
+        """Views of the compact layouts' first numbers: phase (1,), held (1,), p (D, 1)
+        and the one velocity z (D, 1)."""
+        d = self._bank.dimension
+        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
+                vector[2 + d:2 + 2 * d].reshape(d, 1))
+
 
 class PerGoalLayout(_Layout):
     """Every DMP's `z`, `dp` and `dz` in the state (see the module docstring)."""
@@ -138,8 +145,7 @@ class AffineLayout(_Layout):
     def _split(self, vector):
         """Views: phase (1,), held (1,), p (D, 1), z (D, 1), alpha and beta (2, D, 1)."""
         d = self._bank.dimension
-        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
-                vector[2 + d:2 + 2 * d].reshape(d, 1),
+        return (*self._one_velocity_head(vector),
                 vector[2 + 2 * d:2 + 4 * d].reshape(2, d, 1),
                 vector[2 + 4 * d:2 + 6 * d].reshape(2, d, 1))
 
@@ -214,8 +220,7 @@ class StepInputsLayout(_Layout):
     def _split(self, vector):
         """Views: phase (1,), held (1,), p (D, 1), z (D, 1), the last step's phase (1,)."""
         d = self._bank.dimension
-        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
-                vector[2 + d:2 + 2 * d].reshape(d, 1), vector[2 + 2 * d:3 + 2 * d])
+        return (*self._one_velocity_head(vector), vector[2 + 2 * d:3 + 2 * d])
 
     def _at_start(self, vector):
         """At rest at the starts (p = 0; the terms then give dp = the starts)."""

@@ -130,10 +130,8 @@ class AffineLayout(_Layout):
     module docstring)."""
 
     def __init__(self, bank, period, max_speed):
-        if not bank.affine_in_goal:
-            raise ValueError(
-                "compact_state needs DMPs that share weights and start (a bank from one "
-                "demonstration, or straight): this bank's are distinct")
+        # Only for a bank `affine_in_goal` (`DmpBank` picks the layout; the bank's
+        # `affine_coefficients` refuses any other).
         super().__init__(bank, period, max_speed)
         self.needs_followed_goal = True
         self.reads = "goals"  # the read-out evaluates the attractor terms at the goals

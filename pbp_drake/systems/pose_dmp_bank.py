@@ -274,8 +274,9 @@ class PoseDmpBank(LeafSystem):
             raise RuntimeError(
                 "PoseDmpBank with compact_state=True steps every DMP from the followed DMP's "
                 "velocities: connect its followed_goal input port")
-        # The compact state's `z`: the velocity the last step started from, or the held one.
-        step_velocity = compact_inputs(vector)[1] if self._compact else None
+        # The compact state's tail: the phase and `z` the last step started from (`z`, or
+        # the held one).
+        step_phase, step_velocity = compact_inputs(vector) if self._compact else (None, None)
         if stepping or not self._compact:
             stepped, log_state = self._stepped(context, vector)
             offsets, velocities = stepped
@@ -318,7 +319,7 @@ class PoseDmpBank(LeafSystem):
         held[0] = STEPPING
         if self._compact:
             # What the step starts from; the cache entry takes it (`_calc_stepped`).
-            compact_inputs(vector)[0][0] = phase[0]
+            step_phase[0] = phase[0]
             step_velocity[...] = scaled_velocity
             eta_state[...] = eta
         else:

@@ -1,61 +1,115 @@
 """pbp_drake: Policy Blending with Primitives (PBP) for shared control, on Drake.
 
-The math lives in `pbp_drake.core` (NumPy only); the Drake systems in `pbp_drake.systems`;
-`pbp_drake.scenarios.resolve` derives everything from a scenario once, and
-`pbp_drake.builder.build_diagram` turns it into a Diagram. The names below
-can be imported from `pbp_drake` directly; each is loaded on first use, so that
-`import pbp_drake` stays cheap and the NumPy core never pulls in Drake.
+Every name the documentation lists imports from here: `from pbp_drake import DmpBank,
+make_hsr_station`. Each is loaded on first use, so that `import pbp_drake` stays cheap and
+the NumPy core never pulls in Drake. `API_GROUPS` says where each name belongs by topic (the
+API reference is generated from it); the subpackages hold the rest:
+
+- `pbp_drake.core`: the math, NumPy only (DMPs, blending, goal estimation, the tasks);
+- `pbp_drake.systems`: the Drake LeafSystems (`pbp`, `operators`, `tasks`, `visualizers`);
+- `pbp_drake.robots`: the HSR model and its station;
+- `pbp_drake.scenarios`: scenario files (schema, loading, checks, `resolve`);
+- `pbp_drake.builder`: a resolved scenario to a Diagram, and runs;
+- `pbp_drake.studies`, `pbp_drake.console`, `pbp_drake.bench`: studies, the operator's
+  page, the bench.
 """
 
 import importlib
 
 __version__ = "0.1.0"
 
-# Public name -> the module that defines it.
-_PUBLIC = {
-    # DMP math (NumPy only); the vectorised bank is `pbp_drake.core.dmp.DmpBank`.
-    "Dmp": "pbp_drake.core.dmp",
-    "DmpSettings": "pbp_drake.core.dmp",
-    "GoalEstimatorSettings": "pbp_drake.core.goal_estimation",
-    # Scenarios, diagrams, runs and studies.
-    "load_scenario_file": "pbp_drake.scenarios",
-    "resolve": "pbp_drake.scenarios",
-    "ResolvedScenario": "pbp_drake.scenarios",
-    "build_diagram": "pbp_drake.builder",
-    "find_system": "pbp_drake.builder",
-    "make_pbp_controller": "pbp_drake.builder",
-    "simulate": "pbp_drake.builder",
-    "run_task": "pbp_drake.builder",
-    "run_method_comparison": "pbp_drake.studies.comparison",
-    # The robot.
-    "add_hsr": "pbp_drake.robots.hsr_model",
-    "make_hsr_station": "pbp_drake.robots.hsr_station",
-    "HsrStationConfig": "pbp_drake.robots.hsr_station_config",
-    "hsr_initial_ee_state": "pbp_drake.robots.hsr_station",
-    "hsr_ready_ee_state": "pbp_drake.robots.hsr_station",
-    # Drake systems.
-    "Blender": "pbp_drake.systems",
-    "DmpBank": "pbp_drake.systems",
-    "GoalEstimator": "pbp_drake.systems",
-    "GoalsSource": "pbp_drake.systems",
-    "HandOver": "pbp_drake.systems",
-    "TaskMonitor": "pbp_drake.systems",
-    "HeadingCommand": "pbp_drake.systems",
-    "KeyboardOperator": "pbp_drake.systems",
-    "GamepadOperator": "pbp_drake.systems",
-    "VirtualParticipant": "pbp_drake.systems",
-    "NoOperator": "pbp_drake.systems",
-    "ObstacleRepulsionOperator": "pbp_drake.systems",
-    "ScriptedOperator": "pbp_drake.systems",
-    "PointRobot": "pbp_drake.systems",
-    "ReachSceneVisualizer": "pbp_drake.systems",
-    "MovingObstacles": "pbp_drake.systems.moving_obstacles",
-    "CollisionMonitor": "pbp_drake.systems.collision_monitor",
+# Topic -> {public name: the module that defines it}. One place: `__all__`, `__getattr__`
+# and the API reference all read it.
+API_GROUPS = {
+    "DMP math (NumPy)": {
+        "Dmp": "pbp_drake.core.dmp",
+        "DmpBankModel": "pbp_drake.core.dmp",
+        "DmpSettings": "pbp_drake.core.dmp",
+        "OrientationDmp": "pbp_drake.core.dmp",
+        "OrientationDmpBank": "pbp_drake.core.dmp",
+        "GoalEstimatorSettings": "pbp_drake.core.goal_estimation",
+        "quaternion": "pbp_drake.core",
+        "HandOverLimits": "pbp_drake.core.pose_arbitration",
+        "PoseReference": "pbp_drake.core.pose_arbitration",
+        "blend_pose": "pbp_drake.core.pose_arbitration",
+        "pose_hand_over": "pbp_drake.core.pose_arbitration",
+        "VirtualParticipantParams": "pbp_drake.core.participant_params",
+        "GraspParticipantParams": "pbp_drake.core.participant_grasp",
+    },
+    "The PBP loop's systems": {
+        name: "pbp_drake.systems.pbp" for name in [
+            "DmpBank", "GoalEstimator", "Blender", "HandOver", "GoalsSource",
+            "HeadingCommand", "DemonstrationPlayer"]},
+    "Six-DoF PBP systems": {
+        name: "pbp_drake.systems.pbp" for name in [
+            "PoseDmpBank", "PoseGoalEstimator", "PoseBlender", "PoseHandOver"]},
+    "Operators": {
+        name: "pbp_drake.systems.operators" for name in [
+            "KeyboardOperator", "GamepadOperator", "VirtualOperator", "ScriptedOperator",
+            "ObstacleRepulsionOperator", "IdleOperator", "PoseKeyboardOperator",
+            "PoseGamepadOperator", "PoseVirtualOperator"]},
+    "Tasks and drawing": {
+        **{name: "pbp_drake.systems.tasks" for name in [
+            "TaskMonitor", "GraspTaskMonitor", "MovingObstacles", "CollisionMonitor",
+            "CylinderObstacleGeometry", "PointRobotDynamics"]},
+        **{name: "pbp_drake.systems.visualizers" for name in [
+            "ReachSceneVisualizer", "GraspSceneVisualizer", "PointSceneVisualizer"]},
+        "SampleHold": "pbp_drake.systems",
+    },
+    "Port vectors": {
+        name: "pbp_drake.systems.ports" for name in [
+            "EeState", "EeCommand", "OperatorCommand", "Target", "TaskStatus", "PoseState",
+            "OperatorTwist"]},
+    "The HSR": {
+        "make_hsr_station": "pbp_drake.robots",
+        "HsrStationConfig": "pbp_drake.robots",
+        "add_hsr": "pbp_drake.robots",
+        "CylinderObstacle": "pbp_drake.robots",
+        "hsr_station_plant": "pbp_drake.robots",
+        "hsr_initial_ee_state": "pbp_drake.robots",
+        "hsr_initial_hand_pose": "pbp_drake.robots",
+        "hsr_ready_ee_state": "pbp_drake.robots",
+    },
+    "Scenario files": {
+        name: "pbp_drake.scenarios" for name in [
+            "load_scenario_file", "resolve", "ResolvedScenario", "ScenarioError",
+            "ScenarioFile", "Scenario", "Hsr", "PointRobot", "MultiGoalReach",
+            "DynamicObstacles", "GraspTask", "VirtualParticipant", "Keyboard", "Gamepad",
+            "NoOperator", "ScriptedCommands", "SinusoidalStep", "ObstacleRepulsion",
+            "BentPath", "RecordedPath", "Obstacle", "MethodComparison", "AlphaStudy",
+            "AltVsCont", "SceneVariant"]},
+    "Building and running": {
+        name: "pbp_drake.builder" for name in [
+            "build_diagram", "make_pbp_controller", "find_system", "simulate", "run_task",
+            "TaskResult"]},
+    "The 2-D scenes": {
+        "bent_path": "pbp_drake.core.toy_scene",
+        "collision_ratio": "pbp_drake.core.toy_scene",
+        "scene_scenario": "pbp_drake.studies.toy",
+        "phase_progress": "pbp_drake.studies.toy",
+        "run_study": "pbp_drake.studies.toy",
+    },
+    "Studies and the console": {
+        "run_method_comparison": "pbp_drake.studies.comparison",
+        "report": "pbp_drake.studies.report",
+        "load_task_result": "pbp_drake.studies.trial_files",
+        "Console": "pbp_drake.console",
+        "LiveRun": "pbp_drake.console",
+    },
 }
+_PUBLIC = {name: module for group in API_GROUPS.values() for name, module in group.items()}
 __all__ = ["__version__", *_PUBLIC]
 
 
 def __getattr__(name):
     if name in _PUBLIC:
-        return getattr(importlib.import_module(_PUBLIC[name]), name)
+        module = importlib.import_module(_PUBLIC[name])
+        try:
+            return getattr(module, name)
+        except AttributeError:  # a public submodule (`quaternion`)
+            return importlib.import_module(f"{module.__name__}.{name}")
     raise AttributeError(f"module 'pbp_drake' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted([*globals(), *_PUBLIC])

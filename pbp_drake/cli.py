@@ -7,7 +7,7 @@ import os
 import sys
 
 from pbp_drake import __version__
-from pbp_drake.bench.run import main as bench_main
+from pbp_drake.bench.main import main as bench_main
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.study import add_study_commands
 from pbp_drake.draw import main as draw_main

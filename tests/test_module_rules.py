@@ -1,12 +1,16 @@
-"""Rules every module of `pbp_drake` keeps: at most 450 lines, one job; imports at the top,
-except heavy optional packages deferred on purpose."""
+"""Rules every module of `pbp_drake` keeps: modules grouped by topic, one over 600 lines
+saying in its docstring why it is one module; imports at the top (except heavy optional
+packages deferred on purpose) and pointing one way, from the tools down to the math; no two
+modules sharing a file name but those the design page names as one concept in two layers."""
 
 import ast
+import collections
 import pathlib
 
 import pytest
 
-PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "pbp_drake"
+REPO = pathlib.Path(__file__).resolve().parents[1]
+PACKAGE = REPO / "pbp_drake"
 MODULES = sorted(path for path in PACKAGE.rglob("*.py") if "_models" not in path.parts)
 # Imports a module may defer into a function: heavy optional packages, on purpose.
 # scipy.stats: a dependency, but 0.7 s to import; only a user study's report needs it.
@@ -20,10 +24,12 @@ def test_the_package_has_modules():
 
 
 @pytest.mark.parametrize("path", MODULES, ids=lambda path: str(path.relative_to(PACKAGE)))
-def test_module_is_short_and_imports_at_the_top(path):
+def test_a_long_module_says_why_and_imports_are_at_the_top(path):
     text = path.read_text()
-    assert len(text.splitlines()) <= 450, f"{path.name} is over 450 lines"
     tree = ast.parse(text)
+    if len(text.splitlines()) > 600:
+        assert "one module" in (ast.get_docstring(tree) or "").lower(), (
+            f"{path.name} is over 600 lines and its docstring does not say why it is one module")
     top = set(map(id, tree.body))
     for node in ast.walk(tree):
         if isinstance(node, (ast.Import, ast.ImportFrom)) and id(node) not in top:
@@ -31,3 +37,56 @@ def test_module_is_short_and_imports_at_the_top(path):
                        else [alias.name for alias in node.names])
             assert set(modules) <= DEFERRED_IMPORTS, (
                 f"{path.name}:{node.lineno} imports {modules} inside a function")
+
+
+# The layers, from the math up: a module imports only from its own layer and those below.
+LAYERS = [{"core"}, {"systems"}, {"robots"}, {"scenarios"}, {"builder"}, {"studies"},
+          {"console"}, {"bench", "draw", "output_paths", "soak", "cli_types"}, {"commands"},
+          {"cli"}, {"__main__", "__init__"}]
+RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
+
+
+def _layer(path):
+    return path.relative_to(PACKAGE).parts[0].removesuffix(".py")
+
+
+def _imported_layers(tree):
+    for node in ast.walk(tree):
+        names = ([node.module] if isinstance(node, ast.ImportFrom) and node.module
+                 else [a.name for a in node.names] if isinstance(node, ast.Import) else [])
+        for name in names:
+            if name.startswith("pbp_drake."):
+                yield name.split(".")[1], node.lineno
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda path: str(path.relative_to(PACKAGE)))
+def test_imports_point_down_the_layers(path):
+    layer = _layer(path)
+    assert layer in RANK, f"{path.name}: the layer {layer!r} is not in LAYERS"
+    for imported, line in _imported_layers(ast.parse(path.read_text())):
+        assert RANK[imported] <= RANK[layer], (
+            f"{path.relative_to(PACKAGE)}:{line} imports pbp_drake.{imported}, a layer above")
+
+
+def test_the_systems_folder_is_grouped_by_topic():
+    entries = [p for p in (PACKAGE / "systems").iterdir() if p.name != "__pycache__"]
+    assert len(entries) <= 12, sorted(p.name for p in entries)
+
+
+# One concept in two or three layers (the math, the system, the diagram or the command):
+# the design page says which is which.
+SHARED_NAMES = {"hand_over.py", "point_robot.py", "questionnaire.py", "run.py"}
+
+
+def test_modules_share_a_file_name_only_as_one_concept_in_different_layers():
+    names = collections.Counter(path.name for path in MODULES)
+    shared = {name for name, count in names.items() if count > 1
+              and name not in {"__init__.py", "__main__.py"}}
+    assert shared <= SHARED_NAMES, f"modules sharing a file name: {sorted(shared - SHARED_NAMES)}"
+    design = (REPO / "docs" / "design.md").read_text()
+    for name in shared:
+        for path in MODULES:
+            if path.name == name:
+                assert str(path.relative_to(PACKAGE)) in design, (
+                    f"docs/design.md does not say which {name} is which "
+                    f"({path.relative_to(PACKAGE)})")

@@ -2,6 +2,6 @@
 
 import sys
 
-from pbp_drake.bench.run import main
+from pbp_drake.bench.main import main
 
 sys.exit(main())

@@ -16,11 +16,11 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.bench.report import microseconds
+from pbp_drake.bench.table import microseconds
 from pbp_drake.bench.timing import timed_span
-from pbp_drake.core.dmp import DmpBank, DmpSettings, fit_weights, minimum_jerk
-from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
-from pbp_drake.systems.goals_source import GoalsSource
+from pbp_drake.core.dmp import DmpBankModel, DmpSettings, fit_weights, minimum_jerk
+from pbp_drake.systems.pbp.dmp_bank import DmpBank as DmpBankSystem
+from pbp_drake.systems.pbp.goals_source import GoalsSource
 from pbp_drake.systems.tick import report_offset
 
 BASIS = 50
@@ -60,8 +60,8 @@ def make_case(dimension, goal_count, distinct, seed=0):
 def make_bank(case):
     settings = DmpSettings(basis_count=BASIS)
     if case.weights is not None:
-        return DmpBank(case.weights, case.start, 1.0, settings)
-    return DmpBank(case.shared_weights, case.start, 1.0, settings, goal_count=case.goal_count)
+        return DmpBankModel(case.weights, case.start, 1.0, settings)
+    return DmpBankModel(case.shared_weights, case.start, 1.0, settings, goal_count=case.goal_count)
 
 
 def bank_math_step(bank, case):
@@ -78,7 +78,7 @@ def bank_math_step(bank, case):
 
 
 class NullBank(LeafSystem):
-    """A LeafSystem with the DmpBank system's ports and compact state (of a bank
+    """A LeafSystem with the DmpBankModel system's ports and compact state (of a bank
     `affine_in_goal` or not) and an update that does nothing: Drake's own cost of one
     periodic discrete update (and of the read)."""
 

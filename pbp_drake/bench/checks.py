@@ -3,7 +3,7 @@ fail, or skipped with the reason: a peer library not installed, or a case this r
 measure), the summary line, and the exit code (1 when any check fails).
 
 `--quick` runs the same checks with the same limits at fewer repeats: every check's case is
-in the quick run (see `pbp_drake.bench.run.plan`)."""
+in the quick run (see `pbp_drake.bench.main.plan`)."""
 
 import dataclasses
 from collections.abc import Callable

@@ -26,7 +26,7 @@ MARKER = "PBP_DRAKE_BENCH_BLAS_THREADS"
 # same code, whatever its working directory holds.
 PACKAGE_ROOT = str(Path(__file__).resolve().parents[2])
 _CHILD = ("import sys; sys.path[0] = sys.argv.pop(1); "
-          "from pbp_drake.bench.run import main; sys.exit(main(sys.argv[1:]))")
+          "from pbp_drake.bench.main import main; sys.exit(main(sys.argv[1:]))")
 # OpenBLAS's thread-count getter under the names its builds export (NumPy's wheels bundle
 # scipy-openblas, whose symbols carry a prefix and a 64-bit-integer suffix).
 _OPENBLAS_GETTERS = ("openblas_get_num_threads", "openblas_get_num_threads64_",

@@ -19,14 +19,14 @@ from pydrake.systems.primitives import ConstantVectorSource
 from pbp_drake.bench.cases import (
     BASIS, DT, connect_reader, leaf_step, make_bank, make_case, motion_fields)
 from pbp_drake.bench.checks import MOTION_ROWS
-from pbp_drake.bench.report import microseconds
+from pbp_drake.bench.table import microseconds
 from pbp_drake.bench.timing import timed
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
-from pbp_drake.systems.goals_source import GoalsSource
-from pbp_drake.systems.layouts import GoalPose, PoseState
-from pbp_drake.systems.pose_dmp_bank import PoseDmpBank
+from pbp_drake.systems.pbp.goals_source import GoalsSource
+from pbp_drake.systems.ports import GoalPose, PoseState
+from pbp_drake.systems.pbp.pose_dmp_bank import PoseDmpBank
 
 
 def make_pose_case(goal_count, distinct, seed=0):

@@ -23,7 +23,7 @@ named `hand_pose_log`, `operator_active_log`, `operator_command_log`, `command_l
 `selected_goal_log`, `target_log`, `phase_log` record each tick (`run_task` reads them,
 `grasp_series_fields`); the task monitor ends the simulation at success. The operator is
 the grasp participant, none (PBP-NoUser), or a person in the Meshcat page: the
-`KeyboardTwistOperator` or the `GamepadTwistOperator` (their `hand_state` is the sampled
+`PoseKeyboardOperator` or the `PoseGamepadOperator` (their `hand_state` is the sampled
 hand pose; they need Meshcat). With Meshcat, `task_visualizer` draws the tables, objects,
 grasp triads, target and estimate, the hand, and the selected DMP's predicted path
 (`GRASP_PREDICTION_SAMPLES` poses over the DMPs' duration, rolled out at the visualizer's
@@ -34,23 +34,22 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
-from pbp_drake.core.dmp import DmpBank, OrientationDmpBank
+from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
 from pbp_drake.core.pose_arbitration import HandOverLimits
 from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
-from pbp_drake.scenarios import Gamepad, Keyboard, NoOperator as NoOperatorConfig, ScenarioError
-from pbp_drake.scenarios import VirtualParticipant as VirtualParticipantConfig
+from pbp_drake.scenarios import Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant
 from pbp_drake.systems import (
-    GraspParticipantSystem, GraspTaskMonitor, NoOperator, PoseBlender, PoseDmpBank,
+    PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
     PoseGoalEstimator, PoseHandOver, SampleHold)
-from pbp_drake.systems.gamepad_twist_operator import GamepadTwistOperator, GamepadTwistParams
-from pbp_drake.systems.grasp_scene_visualizer import GraspSceneVisualizer
-from pbp_drake.systems.keyboard_twist_operator import (
-    KeyboardTwistOperator, KeyboardTwistParams)
-from pbp_drake.systems.layouts import OperatorTwist
+from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator, PoseGamepadParams
+from pbp_drake.systems.visualizers.grasp_scene_visualizer import GraspSceneVisualizer
+from pbp_drake.systems.operators.pose_keyboard_operator import (
+    PoseKeyboardOperator, PoseKeyboardParams)
+from pbp_drake.systems.ports import OperatorTwist
 
 # Issue 17: the commanded angular velocity changes by at most this much (rad/s) between two
 # ticks, so a goal switch or the operator pressing never jerks the wrist.
@@ -61,7 +60,7 @@ MAX_HAND_ANGULAR_SPEED = 1.0
 # How many poses ahead the page draws the selected DMP's path, over the DMPs' duration (as
 # the reach task's HSR_PREDICTION_SAMPLES).
 GRASP_PREDICTION_SAMPLES = 40
-_OPERATORS = (VirtualParticipantConfig, NoOperatorConfig, Keyboard, Gamepad)
+_OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad)
 
 
 def check_grasp_buildable(scenario):
@@ -91,7 +90,7 @@ def grasp_dmp_banks(resolved, start_pose):
     distance = float(np.max(np.linalg.norm(goals - start_pose[:3], axis=1)))
     duration = (scenario.dmp_duration if scenario.dmp_duration > 0
                 else distance / resolved.nominal_speed)
-    return (DmpBank.straight(start_pose[:3], len(goals), duration, scenario.dmp),
+    return (DmpBankModel.straight(start_pose[:3], len(goals), duration, scenario.dmp),
             OrientationDmpBank.straight(start_pose[3:7], len(goals), duration, scenario.dmp))
 
 
@@ -200,26 +199,26 @@ def _operator(resolved, grasps, meshcat):
     scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
-    if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
-        return NoOperator(OperatorTwist.size, period)
+    if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
+        return IdleOperator(OperatorTwist.size, period)
     # Only teleop lets the person push along the approach axis (the paper's forward key).
     teleop = scenario.method == "teleop"
     if isinstance(config, (Keyboard, Gamepad)) and meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
     if isinstance(config, Keyboard):
-        return KeyboardTwistOperator(meshcat, period, teleop, KeyboardTwistParams(
+        return PoseKeyboardOperator(meshcat, period, teleop, PoseKeyboardParams(
             config.speed, config.rotation_speed, config.hold_time),
             nominal_speed=resolved.nominal_speed)
     if isinstance(config, Gamepad):
-        return GamepadTwistOperator(meshcat, period, teleop, GamepadTwistParams(
+        return PoseGamepadOperator(meshcat, period, teleop, PoseGamepadParams(
             config.speed, config.rotation_speed, config.dead_zone),
             nominal_speed=resolved.nominal_speed)
     participant = GraspParticipant.create(
         GraspParticipantParams.from_virtual_participant(scenario.operator),
         "drive" if scenario.method == "teleop" else "assist", resolved.nominal_speed,
         grasps.grasp_positions, grasps.grasp_orientations, scenario.seed)
-    return GraspParticipantSystem(participant, period)
+    return PoseVirtualOperator(participant, period)
 
 
 def _headings(orientations):

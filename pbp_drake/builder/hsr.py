@@ -23,7 +23,7 @@ from pbp_drake.builder.operators import make_hsr_operator
 from pbp_drake.builder.pbp_controller import HSR_PREDICTION_SAMPLES, make_pbp_controller
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.systems import ReachSceneVisualizer, SampleHold, TaskMonitor
-from pbp_drake.systems.moving_obstacles import MovingObstacles
+from pbp_drake.systems.tasks.moving_obstacles import MovingObstacles
 
 
 def build_hsr_diagram(resolved, meshcat=None):

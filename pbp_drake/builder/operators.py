@@ -4,20 +4,20 @@ at the keyboard or gamepad, or the virtual participant, on the HSR."""
 import numpy as np
 
 from pbp_drake.scenarios import (
-    Gamepad, Keyboard, NoOperator as NoOperatorConfig, ObstacleRepulsion, ScenarioError,
-    ScriptedCommands, SinusoidalStep, VirtualParticipant as VirtualParticipantConfig)
+    Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
+    ScriptedCommands, SinusoidalStep, VirtualParticipant)
 from pbp_drake.systems import (
-    GamepadOperator, KeyboardOperator, NoOperator, ObstacleRepulsionOperator, ScriptedOperator,
-    VirtualParticipant)
-from pbp_drake.systems.layouts import OperatorCommand
+    GamepadOperator, KeyboardOperator, IdleOperator, ObstacleRepulsionOperator, ScriptedOperator,
+    VirtualOperator)
+from pbp_drake.systems.ports import OperatorCommand
 
 
 def make_operator(scenario, dimension):
     """The operator of a 2-D scene (none at all for PBP-NoUser)."""
     config = scenario.operator
     period = scenario.control_period
-    if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
-        return NoOperator(dimension, period)
+    if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
+        return IdleOperator(dimension, period)
     if isinstance(config, ObstacleRepulsion):
         return ObstacleRepulsionOperator(
             [o.center for o in scenario.obstacles], [o.radius for o in scenario.obstacles],
@@ -48,11 +48,11 @@ def make_hsr_operator(resolved, meshcat):
     period = scenario.control_period
     allow_forward = scenario.method == "teleop"
     speed = resolved.nominal_speed
-    if scenario.method == "pbp_no_user" or isinstance(config, NoOperatorConfig):
-        return NoOperator(OperatorCommand.size, period)
-    if isinstance(config, VirtualParticipantConfig):
+    if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
+        return IdleOperator(OperatorCommand.size, period)
+    if isinstance(config, VirtualParticipant):
         obstacles = resolved.station.obstacles
-        return VirtualParticipant(
+        return VirtualOperator(
             period, resolved.layout.objects, mode="drive" if allow_forward else "assist",
             params=config, nominal_speed=speed, seed=scenario.seed,
             obstacle_count=len(obstacles),

@@ -23,7 +23,7 @@ from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from pbp_drake.systems import (
     Blender, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand)
-from pbp_drake.systems.layouts import EeState, OperatorCommand
+from pbp_drake.systems.ports import EeState, OperatorCommand
 
 # How far ahead the HSR scene draws the DMPs' paths, in samples over the DMP's duration.
 HSR_PREDICTION_SAMPLES = 40
@@ -59,8 +59,7 @@ def make_pbp_controller(resolved, prediction_steps=0):
     # Drake's (C++) Demultiplexers: their outputs depend on every source, time included,
     # but everything downstream reads them once a tick (the DMP bank's and the estimator's
     # updates, and the blender only through the hand-over's update), so nothing recomputes
-    # between ticks, and two Python calls a tick go (`VectorSplit` was for the blender's
-    # command fed to the station directly, before the hand-over held it).
+    # between ticks, and no Python call is spent on splitting.
     split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, EeState.size - 6]))
     builder.ExportInput(split.get_input_port(), "ee_state")
     position_velocity = split.get_output_port(0)

@@ -16,8 +16,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, ZeroOrderHold
 
 from pbp_drake.builder.operators import make_operator
-from pbp_drake.systems import Blender, DemonstrationPlayer, DmpBank, GoalsSource, PointRobot
-from pbp_drake.systems.point_scene_visualizer import PointSceneVisualizer
+from pbp_drake.systems import Blender, DemonstrationPlayer, DmpBank, GoalsSource, PointRobotDynamics
+from pbp_drake.systems.visualizers.point_scene_visualizer import PointSceneVisualizer
 
 
 def build_point_robot_diagram(resolved, meshcat=None, prediction_steps=None):
@@ -32,7 +32,7 @@ def build_point_robot_diagram(resolved, meshcat=None, prediction_steps=None):
     goal_count, dimension = goals.shape
     builder = DiagramBuilder()
 
-    robot = builder.AddNamedSystem("robot", PointRobot(start, scenario.robot))
+    robot = builder.AddNamedSystem("robot", PointRobotDynamics(start, scenario.robot))
     robot_state = robot.get_state_output_port()
     sample = builder.AddNamedSystem("robot_state_sample", ZeroOrderHold(period, 2 * dimension))
     builder.Connect(robot_state, sample.get_input_port())

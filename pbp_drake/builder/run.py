@@ -18,8 +18,8 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorS
 from pbp_drake.builder.build import build_diagram
 from pbp_drake.builder.grasp import grasp_series_fields
 from pbp_drake.scenarios import ResolvedScenario, resolve
-from pbp_drake.systems.browser_guard import reset_pacing_after_pauses
-from pbp_drake.systems.layouts import TaskStatus
+from pbp_drake.systems.operators.browser_guard import reset_pacing_after_pauses
+from pbp_drake.systems.ports import TaskStatus
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
 
 

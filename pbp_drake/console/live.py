@@ -14,7 +14,7 @@ import time
 from pbp_drake.builder.build import find_system
 from pbp_drake.builder.run import advance_to
 from pbp_drake.console.text import progress_text, status_text
-from pbp_drake.systems.layouts import TaskStatus
+from pbp_drake.systems.ports import TaskStatus
 
 # Simulated seconds between two looks at the page: 20 a second at real time, so that the
 # robot camera moves smoothly and a click ends the run within a twentieth of a second.

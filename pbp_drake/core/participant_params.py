@@ -1,6 +1,6 @@
 """The virtual participant's parameters: the scenario's `operator: !VirtualParticipant {...}`
 fields (`pbp_drake.scenarios.schema.VirtualParticipant` adds none). Pure data: the reach
-participant (`pbp_drake.systems.virtual_participant`) reads them, and the grasp participant
+participant (`pbp_drake.systems.operators.virtual_operator`) reads them, and the grasp participant
 (`pbp_drake.core.participant_grasp`) takes the defaults of the fields it shares from them."""
 
 import dataclasses
@@ -8,7 +8,7 @@ import dataclasses
 
 @dataclasses.dataclass
 class VirtualParticipantParams:
-    """How the virtual participant behaves (see `VirtualParticipant`). `speed` (m/s) 0 takes
+    """How the virtual participant behaves (see the `VirtualOperator` system). `speed` (m/s) 0 takes
     the task's nominal speed, that of its DMPs. Its noise comes from the scenario's seed.
 
     The defaults are the reach task's calibration (issue 14): teleop only, on the tuning
@@ -45,7 +45,7 @@ class VirtualParticipantParams:
     # Once it takes control among obstacles, it keeps it at least this long (s).
     hold_time: float = 0.5
 
-    # The fields below act among obstacles (the obstacle task, `VirtualParticipant._avoid`);
+    # The fields below act among obstacles (the obstacle task, `VirtualOperator._avoid`);
     # `policy_compensation` in the reaching task too.
 
     # Within this distance (m) of the target it no longer minds obstacles and goes straight

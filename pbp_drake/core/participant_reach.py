@@ -1,5 +1,5 @@
 """What the virtual participant does in the reaching task, in pure NumPy (the system,
-`pbp_drake.systems.virtual_participant`, adds the belief, the noise and the timing).
+`pbp_drake.systems.operators.virtual_operator`, adds the belief, the noise and the timing).
 
 Assisting (PBP, arbitration) with the forward key disabled, a person shows the goal they
 mean with what the keys still allow: turning, sidestepping and backing. Each of the shipped

@@ -8,7 +8,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.systems.layouts import EeCommand, EeState
+from pbp_drake.systems.ports import EeCommand, EeState
 from pbp_drake.systems.tick import decide_offset
 
 # EeCommand's entries, by index.

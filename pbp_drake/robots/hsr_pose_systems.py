@@ -14,7 +14,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.quaternion import UNIT_TOLERANCE, aligned, exp_map, multiply
-from pbp_drake.systems.layouts import PoseState
+from pbp_drake.systems.ports import PoseState
 
 # The frame the pose station commands and measures: the grasp task's hand frame H.
 HAND_FRAME = "hand_palm_link"

@@ -69,9 +69,9 @@ from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
     HsrStationConfig,
     validate_hsr_station_config,
 )
-from pbp_drake.systems.collision_monitor import CollisionMonitor
-from pbp_drake.systems.layouts import EeState
-from pbp_drake.systems.obstacle_geometry import CylinderObstacleGeometry
+from pbp_drake.systems.tasks.collision_monitor import CollisionMonitor
+from pbp_drake.systems.ports import EeState
+from pbp_drake.systems.tasks.obstacle_geometry import CylinderObstacleGeometry
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
 # the hand starts in front of the base with room to move both ways along x with the

@@ -1,7 +1,6 @@
-"""Scenario files: the schema (`schema`), reading them (`loading`, with the checks of the
-text in `yaml_checks` and of its shape against the schema in `schema_walk`) and resolving
-them (`resolution`: everything checked and derived once by `resolve`; the checks of its
-numbers in `value_checks`).
+"""Scenario files: the schema (`schema`), reading them (`loading`), the checks of their text,
+shape and numbers (`checks`) and resolving them (`resolution`: everything checked and
+derived once by `resolve`).
 
 Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario` ->
 `pbp_drake.builder.build_diagram`.

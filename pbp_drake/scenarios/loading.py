@@ -17,9 +17,8 @@ from pbp_drake.scenarios.resolution import (
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     STUDY_SPLITS, ScenarioFile)
-from pbp_drake.scenarios.schema_walk import shape_problem
-from pbp_drake.scenarios.value_checks import check_numbers, check_seed
-from pbp_drake.scenarios.yaml_checks import describe_load_error, read_scenario_text
+from pbp_drake.scenarios.checks import (
+    check_numbers, check_seed, describe_load_error, read_scenario_text, shape_problem)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -16,7 +16,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
-from pbp_drake.core.dmp import DmpBank, validate_demonstration
+from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
@@ -27,7 +27,7 @@ from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, GraspTask, Hsr,
     ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands, SinusoidalStep,
     VirtualParticipant)
-from pbp_drake.scenarios.value_checks import (
+from pbp_drake.scenarios.checks import (
     check_bent_path, check_direction, check_dmp_duration, check_grasp_task, check_numbers,
     check_obstacle_task, check_reach_task, check_seed, check_time_steps,
     check_virtual_participant, require_finite)
@@ -65,7 +65,7 @@ class ResolvedScenario:
         start: (D,) where the robot (2-D scenes) or the hand (HSR) starts.
         goals: (K, D) the goals, one DMP each.
         demonstration: (times (T,), positions (T, D)) or None.
-        dmp_bank: the fitted `pbp_drake.core.dmp.DmpBank` (read-only by convention).
+        dmp_bank: the fitted `pbp_drake.core.dmp.DmpBankModel` (read-only by convention).
         layout: the HSR task's `TaskLayout`, None in 2-D scenes.
         station: the HSR station's config (hand height and command period filled in from
             the task), None in 2-D scenes.
@@ -77,7 +77,7 @@ class ResolvedScenario:
     start: np.ndarray
     goals: np.ndarray
     demonstration: typing.Optional[tuple]
-    dmp_bank: DmpBank
+    dmp_bank: DmpBankModel
     layout: typing.Optional[TaskLayout] = None
     station: typing.Any = None
     initial_ee_state: typing.Optional[np.ndarray] = None
@@ -253,9 +253,9 @@ def _resolve_point_robot(scenario):
         duration or demonstration[0][-1] - demonstration[0][0], scenario.control_period,
         "scenario.dmp_duration" if duration else "scenario.demonstration's duration")
     if demonstration is None:
-        bank = DmpBank.straight(start, goals.shape[0], duration, scenario.dmp)
+        bank = DmpBankModel.straight(start, goals.shape[0], duration, scenario.dmp)
     else:
-        bank = DmpBank.from_demonstration(*demonstration, goals.shape[0], scenario.dmp,
+        bank = DmpBankModel.from_demonstration(*demonstration, goals.shape[0], scenario.dmp,
                                           start, duration)
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=demonstration,
@@ -355,7 +355,7 @@ def _resolve_hsr(scenario):
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
     check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
                        scenario.dmp_duration > 0 else "scenario.robot.speed")
-    bank = DmpBank.straight(start, len(goals), duration, scenario.dmp)
+    bank = DmpBankModel.straight(start, len(goals), duration, scenario.dmp)
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=bank,
         layout=layout, station=station,

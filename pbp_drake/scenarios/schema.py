@@ -26,10 +26,10 @@ from pydrake.visualization import VisualizationConfig
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.robots.hsr_station_config import HsrStationConfig
-from pbp_drake.systems.gamepad_operator import GamepadParams
-from pbp_drake.systems.keyboard_operator import KeyboardParams
-from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionParams
-from pbp_drake.systems.point_robot import PointRobotParams
+from pbp_drake.systems.operators.gamepad_operator import GamepadParams
+from pbp_drake.systems.operators.keyboard_operator import KeyboardParams
+from pbp_drake.systems.operators.obstacle_repulsion_operator import ObstacleRepulsionParams
+from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.core.participant_params import VirtualParticipantParams
 
 def _config_from_yaml(config_type, text):

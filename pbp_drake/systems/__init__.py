@@ -1,4 +1,12 @@
-"""Layer 2: thin Drake LeafSystems over `pbp_drake.core`, one system a file.
+"""Layer 2: thin Drake LeafSystems over `pbp_drake.core`, one system a file, by topic:
+
+- `systems.pbp`: the PBP loop (DMP banks, goal estimators, blenders, the hand-over), in
+  position form and in six-DoF pose form (the `Pose...` systems);
+- `systems.operators`: the person in the browser, the virtual participant, scripted inputs;
+- `systems.tasks`: the task monitors, the obstacle task's cylinders, the 2-D robot;
+- `systems.visualizers`: Meshcat drawing of each task's scene;
+- `systems.ports`: the named entries of the port vectors; `systems.tick`: the order of the
+  updates within a control tick; `SampleHold`: the tick's sample of the robot's state.
 
 Port names are the public contract: `robot_state`, `goals`, `operator_command`,
 `operator_active`, `references`, `selected_goal`, `goal_probabilities`, `command`, `state`,
@@ -7,48 +15,36 @@ Port names are the public contract: `robot_state`, `goals`, `operator_command`,
 Vector layouts: a robot state is `[positions (D), velocities (D)]`; `references` of K goals is
 `[positions (K*D, row-major (K, D)), velocities (K*D)]`; `command` is `[position (D),
 velocity (D)]`. On the HSR, `ee_state` is `[p (3), v (3), heading, heading_rate]` and an
-operator's command `[vx, vy, vz, yaw_rate]` in the world frame; `systems.layouts` names their
-entries. Six-DoF PBP (`PoseDmpBank`, `PoseBlender`, `PoseHandOver`) uses `PoseState`
-`[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]` and `OperatorTwist` (docs/six_dof.md); its browser
-operators (`GamepadTwistOperator`, `KeyboardTwistOperator`) take the hand's `hand_state` and
-output `operator_twist`; so do the grasping task's `PoseGoalEstimator`,
-`GraspParticipantSystem` and `GraspTaskMonitor` (docs/grasp_task.md). `systems.tick` states
-the order of the updates within a control tick.
+operator's command `[vx, vy, vz, yaw_rate]` in the world frame. The six-DoF systems use
+`PoseState` `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]` and `OperatorTwist`; their
+browser operators take the hand's `hand_state` and output `operator_twist`.
 """
 
-from pbp_drake.systems.blender import Blender
-from pbp_drake.systems.demonstration_player import DemonstrationPlayer
-from pbp_drake.systems.dmp_bank import DmpBank
-from pbp_drake.systems.gamepad_operator import GamepadOperator
-from pbp_drake.systems.gamepad_twist_operator import GamepadTwistOperator
-from pbp_drake.systems.goal_estimator import GoalEstimator
-from pbp_drake.systems.goals_source import GoalsSource
-from pbp_drake.systems.grasp_participant import GraspParticipantSystem
-from pbp_drake.systems.grasp_scene_visualizer import GraspSceneVisualizer
-from pbp_drake.systems.grasp_task_monitor import GraspTaskMonitor
-from pbp_drake.systems.hand_over import HandOver
-from pbp_drake.systems.heading_command import HeadingCommand
-from pbp_drake.systems.keyboard_operator import KeyboardOperator
-from pbp_drake.systems.keyboard_twist_operator import KeyboardTwistOperator
-from pbp_drake.systems.no_operator import NoOperator
-from pbp_drake.systems.obstacle_repulsion_operator import ObstacleRepulsionOperator
-from pbp_drake.systems.point_robot import PointRobot
-from pbp_drake.systems.pose_blender import PoseBlender
-from pbp_drake.systems.pose_dmp_bank import PoseDmpBank
-from pbp_drake.systems.pose_goal_estimator import PoseGoalEstimator
-from pbp_drake.systems.pose_hand_over import PoseHandOver
-from pbp_drake.systems.reach_scene_visualizer import ReachSceneVisualizer
+from pbp_drake.systems.operators import (
+    GamepadOperator, IdleOperator, KeyboardOperator, ObstacleRepulsionOperator,
+    PoseGamepadOperator, PoseKeyboardOperator, PoseVirtualOperator, ScriptedOperator,
+    VirtualOperator)
+from pbp_drake.systems.pbp import (
+    Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand,
+    PoseBlender, PoseDmpBank, PoseGoalEstimator, PoseHandOver)
 from pbp_drake.systems.sample_hold import SampleHold
-from pbp_drake.systems.scripted_operator import ScriptedOperator
-from pbp_drake.systems.task_monitor import TaskMonitor
-from pbp_drake.systems.virtual_participant import VirtualParticipant
+from pbp_drake.systems.tasks import (
+    CollisionMonitor, CylinderObstacleGeometry, GraspTaskMonitor, MovingObstacles,
+    PointRobotDynamics, TaskMonitor)
+from pbp_drake.systems.visualizers import (
+    GraspSceneVisualizer, PointSceneVisualizer, ReachSceneVisualizer)
 
 __all__ = [
-    "Blender", "DemonstrationPlayer", "DmpBank", "GamepadOperator", "GamepadTwistOperator",
-    "GoalEstimator", "GoalsSource", "GraspSceneVisualizer", "HandOver", "HeadingCommand",
-    "KeyboardOperator", "KeyboardTwistOperator", "NoOperator", "ObstacleRepulsionOperator",
-    "PointRobot", "PoseBlender", "PoseDmpBank", "PoseHandOver", "ReachSceneVisualizer", "SampleHold", "ScriptedOperator", "TaskMonitor",
-    "VirtualParticipant",
-    # The grasping task's (docs/grasp_task.md).
-    "GraspParticipantSystem", "GraspTaskMonitor", "PoseGoalEstimator",
+    # The PBP loop.
+    "Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource", "HandOver",
+    "HeadingCommand", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver",
+    # Operators.
+    "GamepadOperator", "IdleOperator", "KeyboardOperator", "ObstacleRepulsionOperator",
+    "PoseGamepadOperator", "PoseKeyboardOperator", "PoseVirtualOperator", "ScriptedOperator",
+    "VirtualOperator",
+    # Tasks.
+    "CollisionMonitor", "CylinderObstacleGeometry", "GraspTaskMonitor", "MovingObstacles",
+    "PointRobotDynamics", "TaskMonitor",
+    # Drawing, and the sample-and-hold every task's loop reads the robot through.
+    "GraspSceneVisualizer", "PointSceneVisualizer", "ReachSceneVisualizer", "SampleHold",
 ]

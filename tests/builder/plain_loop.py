@@ -8,7 +8,7 @@ import numpy as np
 
 from pbp_drake.builder import sinusoidal_step_commands
 from pbp_drake.core.arbitration import blend
-from pbp_drake.core.dmp import DmpBank
+from pbp_drake.core.dmp import DmpBankModel
 from pbp_drake.core.point_robot import MassSpringDamper
 from pbp_drake.core.toy_scene import repulsion_command
 from pbp_drake.scenarios import (
@@ -29,10 +29,10 @@ def plain_loop(scenario):
     mode = BLEND_MODE_OF_METHOD[scenario.method]
     settings = scenario.dmp
     if demo is not None:
-        bank = DmpBank.from_demonstration(times, demo, len(goals), settings, start,
+        bank = DmpBankModel.from_demonstration(times, demo, len(goals), settings, start,
                                           scenario.dmp_duration or None)
     else:
-        bank = DmpBank.straight(start, len(goals), scenario.dmp_duration, settings)
+        bank = DmpBankModel.straight(start, len(goals), scenario.dmp_duration, settings)
     phase, _, scaled_velocity = bank.initial_state()
     goals_dk = bank.goals_matrix(goals)
     operator = scenario.operator

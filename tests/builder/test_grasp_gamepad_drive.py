@@ -2,7 +2,7 @@
 whole grasp. A page on Meshcat's websocket (`foreign_page.ForeignPage`, the one page
 connected) sends the gamepad states a browser sends; a small driver reads the hand's pose
 and the target from the diagram each tick and pushes the sticks, triggers and shoulders
-towards the target's grasp pose, through the `GamepadTwistOperator` of the grasp diagram,
+towards the target's grasp pose, through the `PoseGamepadOperator` of the grasp diagram,
 until the task monitor declares success. Each message is awaited in Meshcat before the
 simulator steps on, so the run is in lock step with the sends (Meshcat is used only from
 the test's thread)."""
@@ -19,7 +19,7 @@ from pbp_drake.builder import build_diagram, run_task
 from pbp_drake.core import quaternion
 from pbp_drake.core.operator_frame import hand_axes, operator_frame
 from pbp_drake.scenarios import Gamepad, load_scenario_file, resolve
-from pbp_drake.systems.gamepad_twist_operator import (
+from pbp_drake.systems.operators.pose_gamepad_operator import (
     LEFT_SHOULDER, LEFT_STICK_X, LEFT_STICK_Y, LEFT_TRIGGER, RIGHT_SHOULDER, RIGHT_STICK_X,
     RIGHT_STICK_Y, RIGHT_TRIGGER)
 

@@ -12,7 +12,7 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.builder.grasp import GRASP_PREDICTION_SAMPLES
 from pbp_drake.core.quaternion import angle_between
 from pbp_drake.scenarios import load_scenario_file
-from pbp_drake.systems.grasp_scene_visualizer import PATH_TRIADS
+from pbp_drake.systems.visualizers.grasp_scene_visualizer import PATH_TRIADS
 
 DURATION = 1.5
 

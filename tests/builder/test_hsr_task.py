@@ -17,8 +17,8 @@ from pydrake.systems.analysis import Simulator, SimulatorStatus
 from pbp_drake.builder import build_diagram
 from pbp_drake.cli import main
 from pbp_drake.scenarios import Keyboard, ScenarioError, load_scenario_file
-from pbp_drake.systems.layouts import TaskStatus
-from pbp_drake.systems.keyboard_operator import LEFT_BUTTON
+from pbp_drake.systems.ports import TaskStatus
+from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON
 from pbp_drake.builder.run import run_task
 
 # Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
@@ -109,7 +109,7 @@ def test_switching_goal_moves_the_command_no_more_than_one_step(pbp_run):
 def test_the_blend_is_computed_once_per_control_tick(fixed_task, monkeypatch):
     # Between ticks nothing the blender reads changes; redoing it at every 5 ms plant step
     # (as behind Drake's Demultiplexer) cost the closed loop a fifth of its speed.
-    from pbp_drake.systems.blender import Blender
+    from pbp_drake.systems.pbp.blender import Blender
 
     calls = []
     original = Blender._calc_command
@@ -123,25 +123,6 @@ def test_the_blend_is_computed_once_per_control_tick(fixed_task, monkeypatch):
     ticks = round(0.6 / fixed_task.control_period)
     assert ticks <= len(calls) <= 2 * ticks
     assert len(calls) < round(0.6 / fixed_task.robot.station.plant.time_step)
-
-
-def test_vector_split_gives_consecutive_pieces():
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import ConstantVectorSource
-
-    from pbp_drake.systems.vector_split import VectorSplit
-
-    builder = DiagramBuilder()
-    split = builder.AddSystem(VectorSplit([2, 1, 3]))
-    source = builder.AddSystem(ConstantVectorSource(np.arange(6.0)))
-    builder.Connect(source.get_output_port(), split.get_input_port())
-    diagram = builder.Build()
-    context = split.GetMyContextFromRoot(diagram.CreateDefaultContext())
-    pieces = [split.get_output_port(i).Eval(context) for i in range(3)]
-    np.testing.assert_array_equal(np.concatenate(pieces), np.arange(6.0))
-    assert [len(piece) for piece in pieces] == [2, 1, 3]
-    with pytest.raises(ValueError, match="positive"):
-        VectorSplit([2, 0])
 
 
 def test_a_plain_simulator_of_the_built_task_stops_at_success(fixed_task, pbp_run):

@@ -12,7 +12,7 @@ lives in `pbp-drake bench`, not here.
 import numpy as np
 import pytest
 
-from pbp_drake.core.dmp import FORMULATIONS, Dmp, DmpBank, DmpSettings, fit_weights
+from pbp_drake.core.dmp import FORMULATIONS, Dmp, DmpBankModel, DmpSettings, fit_weights
 
 DT = 0.01
 
@@ -38,11 +38,11 @@ def make_banks(formulation, shared, goal_count, dimension, uniform_start, seed):
               if uniform_start else rng.uniform(-0.5, 0.5, (goal_count, dimension)))
     duration = 0.9
     if shared:
-        bank = DmpBank(weights, starts, duration, settings, scaling, goal_count=goal_count)
+        bank = DmpBankModel(weights, starts, duration, settings, scaling, goal_count=goal_count)
         per_goal_weights = [weights] * goal_count
     else:
         distinct = weights[None] * rng.uniform(0.5, 1.5, (goal_count, 1, dimension))
-        bank = DmpBank(distinct, starts, duration, settings, scaling)
+        bank = DmpBankModel(distinct, starts, duration, settings, scaling)
         per_goal_weights = list(distinct)
     dmps = [Dmp(w, starts[k], starts[k] + 1.0, duration, settings, scaling)
             for k, w in enumerate(per_goal_weights)]
@@ -235,7 +235,7 @@ def test_the_bank_model_is_immutable_and_untouched_by_steps(formulation, shared)
         np.testing.assert_array_equal(arrays[name], value, err_msg=name)
     # The caller's arrays are not the model's: changing them later changes nothing.
     weights = np.ones((bank.settings.basis_count, 3))
-    other = DmpBank(weights, np.zeros(3), 1.0, bank.settings, goal_count=2)
+    other = DmpBankModel(weights, np.zeros(3), 1.0, bank.settings, goal_count=2)
     weights[...] = 5.0
     assert weights.flags.writeable
     np.testing.assert_array_equal(other._weights, 1.0)
@@ -247,7 +247,7 @@ def test_leaf_system_equals_the_per_goal_loop(shared):
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import ConstantVectorSource
 
-    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+    from pbp_drake.systems.pbp.dmp_bank import DmpBank as DmpBankSystem
 
     bank, dmps, goals = make_banks("ijspeert", shared, 90, 3, True, seed=2)
     robot = np.array([0.05, -0.1, 0.2])
@@ -276,7 +276,7 @@ def test_leaf_system_follows_the_bank_through_locks_and_moving_goals(shared):
     robot, goals that change and PBP-Alt locks, it must read out what `advance` returns."""
     from pydrake.systems.analysis import Simulator
 
-    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+    from pbp_drake.systems.pbp.dmp_bank import DmpBank as DmpBankSystem
 
     bank, _, goals = make_banks("ijspeert", shared, 12, 3, not shared, seed=5)
     system = DmpBankSystem(bank, DT, lock_phase_when_operator_acts=True)
@@ -305,7 +305,7 @@ def test_leaf_system_follows_the_bank_through_locks_and_moving_goals(shared):
 def test_leaf_system_refuses_a_nan_goal_at_its_first_update():
     from pydrake.systems.analysis import Simulator
 
-    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
+    from pbp_drake.systems.pbp.dmp_bank import DmpBank as DmpBankSystem
 
     bank, _, goals = make_banks("ijspeert", True, 4, 3, True, seed=1)
     system = DmpBankSystem(bank, DT)
@@ -365,8 +365,8 @@ def test_the_goals_are_read_once_per_change_from_a_goals_source(monkeypatch):
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import ConstantVectorSource
 
-    from pbp_drake.systems.dmp_bank import DmpBank as DmpBankSystem
-    from pbp_drake.systems.goals_source import GoalsSource
+    from pbp_drake.systems.pbp.dmp_bank import DmpBank as DmpBankSystem
+    from pbp_drake.systems.pbp.goals_source import GoalsSource
 
     bank, _, goals = make_banks("ijspeert", True, 6, 3, True, seed=3)
     builder = DiagramBuilder()
@@ -377,9 +377,9 @@ def test_the_goals_are_read_once_per_change_from_a_goals_source(monkeypatch):
     builder.Connect(robot.get_output_port(), system.get_robot_state_input_port())
     simulator = Simulator(builder.Build())
     reads = []
-    original = DmpBank.goals_matrix
+    original = DmpBankModel.goals_matrix
     # On the class: the bank itself is immutable.
-    monkeypatch.setattr(DmpBank, "goals_matrix",
+    monkeypatch.setattr(DmpBankModel, "goals_matrix",
                         lambda self, g: (reads.append(1), original(self, g))[1])
     simulator.AdvanceTo(10 * DT)
     assert len(reads) == 1

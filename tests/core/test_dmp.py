@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from pbp_drake.core.dmp import FORMULATIONS, Dmp, DmpBank, DmpSettings, minimum_jerk
+from pbp_drake.core.dmp import FORMULATIONS, Dmp, DmpBankModel, DmpSettings, minimum_jerk
 from pbp_drake.core.toy_scene import bent_path
 
 
@@ -72,7 +72,7 @@ def test_bank_of_k_equals_k_single_dmps():
     for k in range(6):
         warped = positions * rng.uniform(0.5, 1.5, 3) + rng.uniform(-1, 1, 3)
         dmps.append(Dmp.from_demonstration(times, warped, settings))
-    bank = DmpBank.from_dmps(dmps)
+    bank = DmpBankModel.from_dmps(dmps)
     goals = rng.uniform(-1, 1, (6, 3))
     goals_dk = bank.goals_matrix(goals)
     phase, _, scaled_velocity = bank.initial_state()
@@ -97,7 +97,7 @@ def test_bank_of_k_equals_k_single_dmps():
 def test_shared_demonstration_bank_sends_one_shape_to_every_goal():
     times, positions = bent_path([0, 0], [1, 0], 0.3, 1.0)
     goals = np.array([[1.0, 0.0], [2.0, 0.0], [1.0, 1.0]])
-    bank = DmpBank.from_demonstration(times, positions, goal_count=3)
+    bank = DmpBankModel.from_demonstration(times, positions, goal_count=3)
     assert bank.shared_weights
     dt = times[1] - times[0]
     paths = bank.predict(*bank.initial_state(), bank.goals_matrix(goals), dt,
@@ -112,7 +112,7 @@ def test_shared_demonstration_bank_sends_one_shape_to_every_goal():
 
 
 def test_phase_lock_holds_the_phase_and_follows_the_robot():
-    bank = DmpBank.straight([0.0, 0.0], goal_count=2, duration=1.0)
+    bank = DmpBankModel.straight([0.0, 0.0], goal_count=2, duration=1.0)
     goals_dk = bank.goals_matrix([[1.0, 0.0], [0.0, 1.0]])
     phase, _, scaled_velocity = bank.initial_state()
     phase, _, scaled_velocity = bank.advance(phase, np.zeros((2, 1)), scaled_velocity,
@@ -127,16 +127,16 @@ def test_phase_lock_holds_the_phase_and_follows_the_robot():
 
 @pytest.mark.parametrize("goals", [[], np.zeros((0, 2))])
 def test_empty_goal_set_is_refused(goals):
-    bank = DmpBank.straight([0.0, 0.0], goal_count=1, duration=1.0)
+    bank = DmpBankModel.straight([0.0, 0.0], goal_count=1, duration=1.0)
     with pytest.raises(ValueError, match="goals is empty"):
         bank.goals_matrix(goals)
     with pytest.raises(ValueError, match="at least one goal"):
-        DmpBank.straight([0.0, 0.0], goal_count=0, duration=1.0)
+        DmpBankModel.straight([0.0, 0.0], goal_count=0, duration=1.0)
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, 1e200, -2e6])
 def test_a_goal_that_is_not_a_position_is_refused_by_number(bad):
-    bank = DmpBank.straight([0.0, 0.0], goal_count=2, duration=1.0)
+    bank = DmpBankModel.straight([0.0, 0.0], goal_count=2, duration=1.0)
     with pytest.raises(ValueError, match=r"goal 1 is \[.*\]: positions must be finite and "
                                          r"within ±1e\+06 m"):
         bank.goals_matrix([[0.5, 0.0], [bad, 0.0]])
@@ -199,7 +199,7 @@ def test_a_goal_switch_keeps_the_velocity_of_the_followed_dmp():
     30 Hz, the robot on DMP 0 for 3 s. Each DMP keeping its own velocity, selecting DMP 1
     makes the commanded velocity jump by 0.41 m/s; stepping every DMP from DMP 0's velocity
     leaves only the other attractor's pull over one step."""
-    bank = DmpBank.straight([0.0, 0.0], goal_count=2, duration=10.0)
+    bank = DmpBankModel.straight([0.0, 0.0], goal_count=2, duration=10.0)
     goals_dk = bank.goals_matrix([[2.0, 1.0], [2.0, -1.0]])
     jumps = {}
     for followed in (None, 0):

@@ -12,7 +12,7 @@ from pbp_drake.core.goal_estimation import (
     GOAL_ESTIMATION_METHODS, GoalEstimatorSettings, SelectionMemory, estimate,
     goal_probabilities, update_selection)
 from pbp_drake.core.reach_task import heading_error
-from pbp_drake.systems.goal_estimator import GoalEstimator
+from pbp_drake.systems.pbp.goal_estimator import GoalEstimator
 
 START = np.array([0.0, 0.0, 0.7])
 # Left, ahead and right of the end effector at START, which points along +x.

@@ -7,7 +7,7 @@ from scipy import integrate
 from scipy.spatial.transform import Rotation
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp import FORMULATIONS, DmpBank, DmpSettings
+from pbp_drake.core.dmp import FORMULATIONS, DmpBankModel, DmpSettings
 from pbp_drake.core.dmp.orientation import OrientationDmp
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
 
@@ -242,7 +242,7 @@ def test_phase_is_the_position_dmps_and_the_lock_holds_it():
     """The same settings and tau give the position bank's phase at every step, locks
     included; while locked, the orientation is the robot's and `eta` follows it."""
     settings, dt = DmpSettings(basis_count=30), 0.02
-    position_bank = DmpBank.straight([0.0, 0.0, 0.0], goal_count=2, duration=1.2,
+    position_bank = DmpBankModel.straight([0.0, 0.0, 0.0], goal_count=2, duration=1.2,
                                      settings=settings)
     bank = OrientationDmpBank.straight([1.0, 0, 0, 0], 2, 1.2, settings)
     goals = bank.goals_matrix([rotation_about([0, 0, 1], 1.0), rotation_about([1, 0, 0], 2)])

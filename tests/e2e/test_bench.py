@@ -21,7 +21,7 @@ from pbp_drake.bench.cases import (
     MOTION_DURATIONS, leaf_simulator, make_bank, make_case, motion_timing)
 from pbp_drake.bench.checks import CHECKS, evaluate, exit_code, format_results, summary
 from pbp_drake.bench.pinning import MARKER, THREAD_VARIABLES, blas_threads
-from pbp_drake.bench.run import _parse, plan
+from pbp_drake.bench.main import _parse, plan
 from pbp_drake.bench.timing import timed_span
 
 K10K_LEAF = ("K=10,000 goals (D=3, distinct weights): one step in the LeafSystem and a read of "

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from browser_page import NEEDS_BROWSER, free_port, open_page, running
 
-from pbp_drake.systems.keyboard_twist_operator import MODE_LABELS, ROTATE, TRANSLATE
+from pbp_drake.systems.operators.pose_keyboard_operator import MODE_LABELS, ROTATE, TRANSLATE
 
 pytestmark = NEEDS_BROWSER
 

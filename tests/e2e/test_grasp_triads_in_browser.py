@@ -12,7 +12,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.core.grasp_task import approach_direction, sample_grasp_scene
-from pbp_drake.systems.grasp_scene_visualizer import (
+from pbp_drake.systems.visualizers.grasp_scene_visualizer import (
     PATH_TRIADS, TRIAD_LENGTH, GraspSceneVisualizer)
 
 pytestmark = NEEDS_BROWSER

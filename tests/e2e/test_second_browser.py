@@ -13,7 +13,7 @@ from foreign_page import ForeignPage
 
 from pbp_drake.builder import build_diagram, run_task
 from pbp_drake.scenarios import Keyboard, load_scenario_file
-from pbp_drake.systems.keyboard_operator import LEFT_BUTTON
+from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON
 
 pytestmark = pytest.mark.slow
 

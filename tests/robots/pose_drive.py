@@ -11,7 +11,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from pbp_drake.core.quaternion import aligned, exp_map, log_map, multiply, conjugate
 from pbp_drake.robots import HsrStationConfig, hsr_initial_hand_pose, make_hsr_station
-from pbp_drake.systems.layouts import PoseState
+from pbp_drake.systems.ports import PoseState
 
 
 def turned(axis, degrees, quaternion):

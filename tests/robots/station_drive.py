@@ -15,7 +15,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from pbp_drake.robots import HsrStationConfig, hsr_initial_ee_state, make_hsr_station
 from pbp_drake.systems import SampleHold
-from pbp_drake.systems.layouts import EeState
+from pbp_drake.systems.ports import EeState
 from pbp_drake.systems.tick import decide_offset
 
 CONTROL_PERIOD = 0.03

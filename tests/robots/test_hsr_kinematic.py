@@ -16,7 +16,7 @@ from pbp_drake.robots import (
     CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, hsr_station_plant,
     make_hsr_station)
 from pbp_drake.robots.hsr_model import TORSO_TO_ARM_LIFT_RATIO
-from pbp_drake.systems.layouts import EeCommand
+from pbp_drake.systems.ports import EeCommand
 
 from test_hsr_station import POSITION_INDEX, ramp, simulate
 

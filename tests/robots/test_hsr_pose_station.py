@@ -18,7 +18,7 @@ from pbp_drake.core.grasp_task import side_grasp_orientation
 from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import HsrStationConfig, hsr_initial_hand_pose, make_hsr_station
 from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, add_hsr
-from pbp_drake.systems.layouts import PoseState
+from pbp_drake.systems.ports import PoseState
 from pose_drive import PoseWaypoints, drive, turned
 
 POSITION_TOLERANCE = 0.01  # m, after settling

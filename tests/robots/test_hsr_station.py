@@ -20,7 +20,7 @@ from pbp_drake.robots import (
     make_hsr_station)
 from pbp_drake.robots.hsr_model import (
     BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
-from pbp_drake.systems.layouts import EeCommand, EeState
+from pbp_drake.systems.ports import EeCommand, EeState
 
 EE_HEIGHT = 0.7
 BASE_RADIUS = 0.226  # the lower base's cylinder in the model

@@ -13,8 +13,8 @@ from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.robots import HsrStationConfig
 from pbp_drake.scenarios import Scenario, resolve
 from pbp_drake.systems import (
-    GamepadOperator, GoalEstimator, KeyboardOperator, ObstacleRepulsionOperator, PointRobot,
-    VirtualParticipant)
+    GamepadOperator, GoalEstimator, KeyboardOperator, ObstacleRepulsionOperator,
+    PointRobotDynamics, VirtualOperator)
 
 PERIOD = 0.03
 HSR = "robot: !Hsr {}\ntask: {}\ncontrol_period: 0.03\n"
@@ -35,7 +35,7 @@ def params_of(system):
 def test_virtual_participant_defaults_match(meshcat):
     diagram, resolved = built(HSR + "operator: !VirtualParticipant {}\n")
     from_yaml = diagram.GetSubsystemByName("operator")
-    in_python = VirtualParticipant(PERIOD, resolved.goals, nominal_speed=0.12)
+    in_python = VirtualOperator(PERIOD, resolved.goals, nominal_speed=0.12)
     assert params_of(from_yaml) == params_of(in_python)
 
 
@@ -59,7 +59,7 @@ def test_point_robot_and_repulsion_defaults_match():
     diagram, _ = built(TOY + "obstacles: [{center: [0.5, 0.0]}]\n"
                        "operator: !ObstacleRepulsion {}\n")
     robot = diagram.GetSubsystemByName("robot")
-    assert params_of(robot) == params_of(PointRobot(np.zeros(2)))
+    assert params_of(robot) == params_of(PointRobotDynamics(np.zeros(2)))
     operator = diagram.GetSubsystemByName("operator")
     in_python = ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.01)
     assert params_of(operator) == params_of(in_python)

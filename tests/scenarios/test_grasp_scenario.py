@@ -50,8 +50,8 @@ def test_another_seed_another_scene(shipped):
     assert not np.array_equal(other.layout.objects[:2], shipped.resolved.layout.objects[:2])
 
 
-@pytest.mark.parametrize("config, system", [(Keyboard, "KeyboardTwistOperator"),
-                                             (Gamepad, "GamepadTwistOperator")])
+@pytest.mark.parametrize("config, system", [(Keyboard, "PoseKeyboardOperator"),
+                                             (Gamepad, "PoseGamepadOperator")])
 def test_a_person_drives_the_grasp_from_the_page_only(shipped, meshcat, config, system):
     resolved = resolve(dataclasses.replace(shipped.scenario, operator=config()))
     with pytest.raises(ValueError, match=f"operator !{config.__name__} reads the browser: "

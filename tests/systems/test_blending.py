@@ -12,8 +12,8 @@ from pbp_drake.core.arbitration import (
     BLEND_MODES, blend, confidence_alpha, goal_confidence, validate_mode)
 from pbp_drake.scenarios import ScriptedCommands, load_scenario_file
 from pbp_drake.builder.run import simulate
-from pbp_drake.systems import Blender, PointRobot
-from pbp_drake.systems.point_robot import PointRobotParams
+from pbp_drake.systems import Blender, PointRobotDynamics
+from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 
 
 @pytest.mark.parametrize("mode", ["pbp_continuous", "pbp_alternated", "fixed_alpha",
@@ -72,7 +72,7 @@ def test_unknown_blending_mode_is_refused():
 def test_nan_or_infinite_operator_command_stops_the_simulation(bad):
     builder = DiagramBuilder()
     blender = builder.AddSystem(Blender("pbp_continuous", 2, 1, 0.01))
-    robot = builder.AddSystem(PointRobot([0.0, 0.0]))
+    robot = builder.AddSystem(PointRobotDynamics([0.0, 0.0]))
     for port, value in [(blender.get_references_input_port(), [1.0, 0.0, 0.0, 0.0]),
                         (blender.get_operator_command_input_port(), [bad, 0.0]),
                         (blender.get_operator_active_input_port(), [1.0])]:
@@ -87,7 +87,7 @@ def test_nan_or_infinite_operator_command_stops_the_simulation(bad):
 
 def test_point_robot_settles_on_a_constant_reference():
     builder = DiagramBuilder()
-    robot = builder.AddSystem(PointRobot([0.0, 0.0], PointRobotParams(time_step=0.001)))
+    robot = builder.AddSystem(PointRobotDynamics([0.0, 0.0], PointRobotParams(time_step=0.001)))
     source = builder.AddSystem(ConstantVectorSource([0.5, -0.2, 0.0, 0.0]))
     builder.Connect(source.get_output_port(), robot.get_command_input_port())
     diagram = builder.Build()

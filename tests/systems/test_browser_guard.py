@@ -11,8 +11,8 @@ import pytest
 from foreign_page import ForeignPage
 from test_browser_operators import PERIOD, Rig, gamepad_rig, set_gamepad
 
-from pbp_drake.systems.gamepad_operator import GamepadOperator
-from pbp_drake.systems.keyboard_operator import LEFT_BUTTON, KeyboardOperator
+from pbp_drake.systems.operators.gamepad_operator import GamepadOperator
+from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON, KeyboardOperator
 
 
 def port_of(meshcat):

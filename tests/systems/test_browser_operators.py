@@ -12,8 +12,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.systems.gamepad_operator import GamepadOperator, GamepadParams
-from pbp_drake.systems.keyboard_operator import (
+from pbp_drake.systems.operators.gamepad_operator import GamepadOperator, GamepadParams
+from pbp_drake.systems.operators.keyboard_operator import (
     BACK_BUTTON, FORWARD_BUTTON, KEY_BUTTONS, LEFT_BUTTON, TURN_LEFT_BUTTON,
     TURN_RIGHT_BUTTON, KeyboardOperator, KeyboardParams)
 

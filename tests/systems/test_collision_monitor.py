@@ -9,7 +9,7 @@ from pydrake.geometry import (
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import DiagramBuilder
 
-from pbp_drake.systems.collision_monitor import CollisionMonitor
+from pbp_drake.systems.tasks.collision_monitor import CollisionMonitor
 
 
 class CountingCollisionMonitor(CollisionMonitor):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
 
-from pbp_drake.systems.demonstration_player import DemonstrationPlayer
+from pbp_drake.systems.pbp.demonstration_player import DemonstrationPlayer
 
 PERIOD = 0.1
 VELOCITY = np.array([0.5, -0.2])

@@ -10,10 +10,10 @@ from bit_for_bit import assert_same_outputs
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from pbp_drake.core.dmp import DmpBank as DmpBankMath
+from pbp_drake.core.dmp import DmpBankModel as DmpBankMath
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.systems import Blender
-from pbp_drake.systems.dmp_bank import DmpBank
+from pbp_drake.systems.pbp.dmp_bank import DmpBank
 
 DT = 0.01
 GOALS = np.array([[0.6, 0.2, 0.3], [0.5, -0.4, 0.1], [-0.3, 0.7, 0.5], [0.1, 0.1, -0.6]])

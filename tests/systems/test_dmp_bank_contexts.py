@@ -10,10 +10,10 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.core.dmp import DmpBank as DmpBankMath
+from pbp_drake.core.dmp import DmpBankModel as DmpBankMath
 from pbp_drake.core.dmp import DmpSettings, fit_weights
-from pbp_drake.systems.dmp_bank import DmpBank
-from pbp_drake.systems.goals_source import GoalsSource
+from pbp_drake.systems.pbp.dmp_bank import DmpBank
+from pbp_drake.systems.pbp.goals_source import GoalsSource
 from pbp_drake.systems.tick import decide_offset
 
 DT = 0.01

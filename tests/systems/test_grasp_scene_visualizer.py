@@ -14,9 +14,9 @@ from replay_tracks import commands, recorded, value_at
 from pbp_drake.core.grasp_task import (
     approach_direction, sample_grasp_scene, side_grasp_orientation)
 from pbp_drake.core.quaternion import angle_between
-from pbp_drake.systems.grasp_scene_visualizer import (
+from pbp_drake.systems.visualizers.grasp_scene_visualizer import (
     PATH_TRIADS, TRIAD_LENGTH, GraspSceneVisualizer)
-from pbp_drake.systems.layouts import Target
+from pbp_drake.systems.ports import Target
 
 SCENE = sample_grasp_scene(3)  # four objects, one grasped from above
 STEPS = 10

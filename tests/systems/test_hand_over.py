@@ -8,11 +8,11 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, ZeroOrderHold
 
 from pbp_drake.core.arbitration import BLEND_MODES
-from pbp_drake.core.dmp import DmpBank as DmpModel
+from pbp_drake.core.dmp import DmpBankModel as DmpModel
 from pbp_drake.core.hand_over import hand_over
 from pbp_drake.systems import (
-    Blender, DmpBank, GoalsSource, HandOver, PointRobot, ScriptedOperator)
-from pbp_drake.systems.point_robot import PointRobotParams
+    Blender, DmpBank, GoalsSource, HandOver, PointRobotDynamics, ScriptedOperator)
+from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.systems.tick import decide_offset
 
 GOALS = np.array([[2.0, 1.0], [2.0, -1.0]])
@@ -68,7 +68,7 @@ def run_loop(mode, dt=0.03, continuous=True, operator=None, params=PointRobotPar
     Returns the commands (T, 2 D) and the robot's states (T, 2 D) at the ticks."""
     dimension = goals.shape[1]
     builder = DiagramBuilder()
-    robot = builder.AddSystem(PointRobot(np.zeros(dimension), params))
+    robot = builder.AddSystem(PointRobotDynamics(np.zeros(dimension), params))
     sample = builder.AddSystem(ZeroOrderHold(dt, 2 * dimension))
     builder.Connect(robot.get_state_output_port(), sample.get_input_port())
     bank = builder.AddSystem(DmpBank(DmpModel.straight(np.zeros(dimension), len(goals),

@@ -7,8 +7,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from pbp_drake.systems.heading_command import HeadingCommand
-from pbp_drake.systems.layouts import OperatorCommand
+from pbp_drake.systems.pbp.heading_command import HeadingCommand
+from pbp_drake.systems.ports import OperatorCommand
 from pbp_drake.systems.sample_hold import SampleHold
 from pbp_drake.systems.tick import decide_offset
 

@@ -14,8 +14,8 @@ from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.core.obstacle_task import ObstacleScene
-from pbp_drake.systems.layouts import EeState
-from pbp_drake.systems.moving_obstacles import MovingObstacles
+from pbp_drake.systems.ports import EeState
+from pbp_drake.systems.tasks.moving_obstacles import MovingObstacles
 
 PERIOD = 0.1
 HAND_SPEED = 0.1

@@ -11,12 +11,12 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.core.dmp import DmpBank as DmpBankMath
+from pbp_drake.core.dmp import DmpBankModel as DmpBankMath
 from pbp_drake.core.dmp import DmpSettings, fit_weights
 from pbp_drake.core.participant_params import VirtualParticipantParams
-from pbp_drake.systems import VirtualParticipant
-from pbp_drake.systems.dmp_bank import DmpBank
-from pbp_drake.systems.participant_avoidance import (
+from pbp_drake.systems import VirtualOperator
+from pbp_drake.systems.pbp.dmp_bank import DmpBank
+from pbp_drake.systems.operators.participant_avoidance import (
     is_pushing_through, robot_closes_in, start_watch, update_watch)
 
 PERIOD = 0.03
@@ -120,7 +120,7 @@ def first_push_time(params, seconds):
     params = dataclasses.replace(params, direction_noise=0.0, speed_noise=0.0,
                                  reaction_delay=0.0)
     builder = DiagramBuilder()
-    participant = builder.AddSystem(VirtualParticipant(
+    participant = builder.AddSystem(VirtualOperator(
         PERIOD, [[*TARGET, 0.7]], mode="drive", params=params, nominal_speed=0.12,
         obstacle_count=len(WALL), obstacle_radius=0.15))
     for port, value in ((participant.get_ee_state_input_port(), [*HAND, 0.7] + [0.0] * 5),

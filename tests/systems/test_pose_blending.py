@@ -11,11 +11,11 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Tr
 from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp import DmpBank as PositionModel
+from pbp_drake.core.dmp import DmpBankModel as PositionModel
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
 from pbp_drake.core.pose_arbitration import HandOverLimits
-from pbp_drake.systems.goals_source import GoalsSource
+from pbp_drake.systems.pbp.goals_source import GoalsSource
 from pbp_drake.systems import PoseBlender, PoseDmpBank, PoseHandOver
 
 DT = 0.01

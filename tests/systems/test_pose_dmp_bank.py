@@ -13,11 +13,11 @@ from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp import DmpBank as PositionModel
+from pbp_drake.core.dmp import DmpBankModel as PositionModel
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
-from pbp_drake.systems.goals_source import GoalsSource
-from pbp_drake.systems.pose_dmp_bank import PoseDmpBank
+from pbp_drake.systems.pbp.goals_source import GoalsSource
+from pbp_drake.systems.pbp.pose_dmp_bank import PoseDmpBank
 
 DT = 0.01
 K = 5

@@ -11,7 +11,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
-from pbp_drake.systems.pose_goal_estimator import PoseGoalEstimator
+from pbp_drake.systems.pbp.pose_goal_estimator import PoseGoalEstimator
 
 PERIOD = 0.03
 # Two grasps with the hand's own orientation, 0.5 m ahead: one to the left, one to the right.

@@ -13,9 +13,9 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from pbp_drake.systems.grasp_task_monitor import GraspTaskMonitor
-from pbp_drake.systems.layouts import EeState, PoseState, Target, TaskStatus
-from pbp_drake.systems.task_monitor import SUCCESS_MESSAGE, TaskMonitor
+from pbp_drake.systems.tasks.grasp_task_monitor import GraspTaskMonitor
+from pbp_drake.systems.ports import EeState, PoseState, Target, TaskStatus
+from pbp_drake.systems.tasks.task_monitor import SUCCESS_MESSAGE, TaskMonitor
 from pbp_drake.systems.tick import report_offset
 
 PERIOD = 0.1

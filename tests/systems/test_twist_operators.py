@@ -14,10 +14,10 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.core.grasp_task import side_grasp_orientation, top_grasp_orientation
-from pbp_drake.systems.gamepad_twist_operator import GamepadTwistOperator, GamepadTwistParams
-from pbp_drake.systems.keyboard_twist_operator import (
+from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator, PoseGamepadParams
+from pbp_drake.systems.operators.pose_keyboard_operator import (
     BACK_KEY, FORWARD_KEY, LEFT_KEY, MODE_LABELS, ROTATE, TRANSLATE, UP_KEY,
-    KeyboardTwistOperator, KeyboardTwistParams)
+    PoseKeyboardOperator, PoseKeyboardParams)
 
 PERIOD = 0.05
 SPEED, ROTATION_SPEED, DEAD_ZONE, HOLD_TIME = 0.2, 0.6, 0.15, 0.25
@@ -101,12 +101,12 @@ def rigs(meshcat):
 
 
 def gamepad(meshcat, allow_forward):
-    return GamepadTwistOperator(meshcat, PERIOD, allow_forward, GamepadTwistParams(
+    return PoseGamepadOperator(meshcat, PERIOD, allow_forward, PoseGamepadParams(
         speed=SPEED, rotation_speed=ROTATION_SPEED, dead_zone=DEAD_ZONE))
 
 
 def keyboard(meshcat, allow_forward):
-    return KeyboardTwistOperator(meshcat, PERIOD, allow_forward, KeyboardTwistParams(
+    return PoseKeyboardOperator(meshcat, PERIOD, allow_forward, PoseKeyboardParams(
         speed=SPEED, rotation_speed=ROTATION_SPEED, hold_time=HOLD_TIME))
 
 
@@ -284,13 +284,13 @@ def test_a_nan_hand_pose_is_refused_by_field(meshcat):
 
 
 @pytest.mark.parametrize("make, field, value", [
-    (lambda m, **f: GamepadTwistOperator(m, PERIOD, True, GamepadTwistParams(**f), 0.2),
+    (lambda m, **f: PoseGamepadOperator(m, PERIOD, True, PoseGamepadParams(**f), 0.2),
      "dead_zone", 1.0),
-    (lambda m, **f: GamepadTwistOperator(m, PERIOD, True, GamepadTwistParams(**f), 0.2),
+    (lambda m, **f: PoseGamepadOperator(m, PERIOD, True, PoseGamepadParams(**f), 0.2),
      "rotation_speed", float("nan")),
-    (lambda m, **f: KeyboardTwistOperator(m, PERIOD, True, KeyboardTwistParams(**f), 0.2),
+    (lambda m, **f: PoseKeyboardOperator(m, PERIOD, True, PoseKeyboardParams(**f), 0.2),
      "hold_time", 0.0),
-    (lambda m, **f: KeyboardTwistOperator(m, PERIOD, True, KeyboardTwistParams(**f), 0.2),
+    (lambda m, **f: PoseKeyboardOperator(m, PERIOD, True, PoseKeyboardParams(**f), 0.2),
      "speed", -1.0),
 ])
 def test_bad_params_are_refused_by_field(meshcat, make, field, value):

@@ -14,8 +14,7 @@ from pbp_drake.core.goal_estimation import GoalEstimatorSettings, goal_probabili
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_reach import assist_motion, facing
 from pbp_drake.scenarios import Scenario, resolve
-from pbp_drake.systems import VirtualParticipant
-from pbp_drake.systems import participant_params as old_participant_params
+from pbp_drake.systems import VirtualOperator
 
 PERIOD = 0.03
 SPEED = 0.12
@@ -37,7 +36,7 @@ def participant_command(params, ee_state, target, target_index, selected, object
     """The operator command of a lone participant after `ticks` control ticks with the
     given inputs held."""
     builder = DiagramBuilder()
-    participant = builder.AddSystem(VirtualParticipant(PERIOD, objects, mode="assist",
+    participant = builder.AddSystem(VirtualOperator(PERIOD, objects, mode="assist",
                                                        params=params, nominal_speed=SPEED))
     for port, value in ((participant.get_ee_state_input_port(), ee_state),
                         (participant.get_target_input_port(), [*target, target_index]),
@@ -99,7 +98,3 @@ def test_facing_a_target_behind_the_picked_object_it_goes_there_itself():
     assert velocity @ facing(sideways) <= 1e-12
     assert velocity[0] > 0.1  # toward the target, at nearly the whole speed
 
-
-def test_its_parameters_keep_their_old_import_path():
-    # They moved to pbp_drake.core (the grasp participant derives its defaults from them).
-    assert old_participant_params.VirtualParticipantParams is VirtualParticipantParams

@@ -18,9 +18,9 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import load_scenario_file
 
 from pbp_drake.scenarios import Obstacle
-from pbp_drake.systems.layouts import Target
-from pbp_drake.systems.point_scene_visualizer import PointSceneVisualizer
-from pbp_drake.systems.reach_scene_visualizer import ReachSceneVisualizer
+from pbp_drake.systems.ports import Target
+from pbp_drake.systems.visualizers.point_scene_visualizer import PointSceneVisualizer
+from pbp_drake.systems.visualizers.reach_scene_visualizer import ReachSceneVisualizer
 
 OBJECTS = np.array([[1.5, -0.4, 0.7], [1.5, 0.4, 0.7]])
 ROOTS = ["/task", "/pbp"]

@@ -38,10 +38,10 @@ from the robot's actual state when the operator lets go.
 The modules, all NumPy only (no Drake import):
 
 - `settings`: `DmpSettings`, the basis, and the memoised constants of one step;
-- `stepping`: the bank's step, vectorised over goals and dimensions (mixed into `DmpBank`);
+- `stepping`: the bank's step, vectorised over goals and dimensions (mixed into `DmpBankModel`);
 - `fitting`: `minimum_jerk`, `validate_demonstration`, `fit_weights` (one demonstration);
 - `single`: `Dmp`, one DMP with a stateful API, the readable reference;
-- `bank`: `DmpBank`, K DMPs as one immutable model, stepped by pure and in-place calls;
+- `bank`: `DmpBankModel`, K DMPs as one immutable model, stepped by pure and in-place calls;
 - `workspace`: `DmpWorkspace`, the scratch arrays a caller of the in-place step owns;
 - `orientation`: orientation DMPs on unit quaternions `(w, x, y, z)`, the position DMP on
   `e = Log(q g*)` (Koutras and Doulgeri 2020), its fit, and `OrientationDmp`, the reference;
@@ -49,7 +49,7 @@ The modules, all NumPy only (no Drake import):
 - `orientation_kernels`: its step's quaternion math into an `OrientationWorkspace`.
 """
 
-from pbp_drake.core.dmp.bank import DmpBank
+from pbp_drake.core.dmp.bank import DmpBankModel
 from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration
 from pbp_drake.core.dmp.orientation import OrientationDmp, fit_orientation_weights
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
@@ -60,7 +60,7 @@ from pbp_drake.core.dmp.single import Dmp
 from pbp_drake.core.dmp.workspace import DmpWorkspace
 
 __all__ = [
-    "FORMULATIONS", "Dmp", "DmpBank", "DmpSettings", "DmpWorkspace", "OrientationDmp",
+    "FORMULATIONS", "Dmp", "DmpBankModel", "DmpSettings", "DmpWorkspace", "OrientationDmp",
     "OrientationDmpBank", "OrientationWorkspace", "fit_orientation_weights", "fit_weights",
     "minimum_jerk", "normalized_basis", "phase_decay", "step_matrices", "transition",
     "validate_demonstration",

@@ -29,7 +29,7 @@ def _read_only(array):
     return array
 
 
-class DmpBank(BankStep):
+class DmpBankModel(BankStep):
     """K DMPs, one per goal, stepped together from one shared robot state.
 
     Vectorised over goals and dimensions; arrays are laid out `(D, K)` internally. All DMPs
@@ -101,7 +101,7 @@ class DmpBank(BankStep):
         # Immutable after construction: a bank shared by threads or Drake Contexts must not
         # change under any of them (the arrays are read-only for the same reason).
         if getattr(self, "_frozen", False):
-            raise AttributeError(f"DmpBank is immutable: cannot set {name!r}")
+            raise AttributeError(f"DmpBankModel is immutable: cannot set {name!r}")
         object.__setattr__(self, name, value)
 
     @classmethod

@@ -1,7 +1,7 @@
 """K orientation DMPs, one per goal orientation, as one immutable model stepped by a pure
 function vectorised over goals (the formulation: `pbp_drake.core.dmp.orientation`).
 
-The API is the position `DmpBank`'s, with orientations for positions, so that a 6-DoF bank
+The API is the position `DmpBankModel`'s, with orientations for positions, so that a 6-DoF bank
 can step both halves side by side: the state is `(phase (K,), orientations (4, K),
 scaled angular velocities (3, K))`, `eta = tau omega` in the world frame; goals are `(4, K)`
 (`goals_matrix` checks `(K, 4)` rows); `advance` steps from the robot's measured orientation

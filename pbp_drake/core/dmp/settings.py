@@ -26,7 +26,7 @@ MAX_BASIS_COUNT = 10_000
 class DmpSettings:
     """Gains and basis of a DMP (scenario files: the `dmp` section).
 
-    A plain dataclass, so that `yaml_load_typed` can read it; a `DmpBank` keeps its own copy.
+    A plain dataclass, so that `yaml_load_typed` can read it; a `DmpBankModel` keeps its own copy.
 
     Attributes:
         formulation: "ijspeert" or "pastor".

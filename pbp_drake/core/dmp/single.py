@@ -3,7 +3,7 @@
 `Dmp` keeps a state of its own (`phase`, `position`, `scaled_velocity`) and a stateful API
 (`reset`, `next_step`, `rollout`), as NumPy users expect of one movement primitive. That is
 safe here because a `Dmp` is one object per goal that its user steps; no Drake system holds
-one, and it is the oracle the vectorised, immutable `DmpBank` is tested against, so it stays
+one, and it is the oracle the vectorised, immutable `DmpBankModel` is tested against, so it stays
 written the plain way.
 """
 
@@ -18,7 +18,7 @@ class Dmp:
     """One DMP in D dimensions, stepped with a plain per-dimension loop.
 
     The reference implementation for a single goal: readable, and the oracle the vectorised
-    `DmpBank` is tested against.
+    `DmpBankModel` is tested against.
     """
 
     def __init__(self, weights, start, goal, duration, settings=DmpSettings(),

@@ -1,4 +1,4 @@
-"""The step of a `DmpBank`: K DMPs advanced one first-order-hold step, vectorised over (D, K).
+"""The step of a `DmpBankModel`: K DMPs advanced one first-order-hold step, vectorised over (D, K).
 
 Around its moving attractor `a` the transformation system is linear (see
 `pbp_drake.core.dmp`). Over a step the attractor goes linearly in time from `a0`, its value
@@ -81,9 +81,9 @@ def step_constants(stiffness, damping, duration, dt):
 
 
 class BankStep:
-    """The stepping half of `pbp_drake.core.dmp.DmpBank`, mixed into it.
+    """The stepping half of `pbp_drake.core.dmp.DmpBankModel`, mixed into it.
 
-    Reads the model `DmpBank.__init__` sets (`_settings`, `duration`, `starts`,
+    Reads the model `DmpBankModel.__init__` sets (`_settings`, `duration`, `starts`,
     `amplitude_scaling`, `_weights`, `shared_weights`, `_centres`, `_widths`) and the
     constants `_derive_constants` adds; writes only into arrays its callers pass.
     """

@@ -1,4 +1,4 @@
-"""Scratch memory of one caller of a `DmpBank`: what makes the bank's step allocation-free.
+"""Scratch memory of one caller of a `DmpBankModel`: what makes the bank's step allocation-free.
 
 The bank itself is an immutable model; every array a step writes to lives in a
 `DmpWorkspace` its caller owns (`bank.make_workspace()`), one per thread or per Drake

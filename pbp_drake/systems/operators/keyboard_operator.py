@@ -1,0 +1,154 @@
+"""A person at the keyboard of a Meshcat browser: arrow keys move the end effector, Q/E turn it."""
+
+import dataclasses
+
+import numpy as np
+
+from pbp_drake.core.reach_task import rotate_planar
+from pbp_drake.systems.operators.browser_guard import BrowserGuard
+from pbp_drake.systems.operators.browser_input import HeldButtons
+from pbp_drake.systems.ports import EeState, OperatorCommand
+from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
+
+FORWARD_BUTTON = "Forward (↑)"
+BACK_BUTTON = "Back (↓)"
+LEFT_BUTTON = "Left (←)"
+RIGHT_BUTTON = "Right (→)"
+TURN_LEFT_BUTTON = "Turn left (Q)"
+TURN_RIGHT_BUTTON = "Turn right (E)"
+
+#: Button name -> JavaScript `KeyboardEvent.code` that clicks it.
+KEY_BUTTONS = {
+    FORWARD_BUTTON: "ArrowUp",
+    BACK_BUTTON: "ArrowDown",
+    LEFT_BUTTON: "ArrowLeft",
+    RIGHT_BUTTON: "ArrowRight",
+    TURN_LEFT_BUTTON: "KeyQ",
+    TURN_RIGHT_BUTTON: "KeyE",
+}
+
+# What one held key adds to [forward, left, yaw] (robot frame, unit speeds).
+_KEY_AXES = {
+    FORWARD_BUTTON: (1.0, 0.0, 0.0),
+    BACK_BUTTON: (-1.0, 0.0, 0.0),
+    LEFT_BUTTON: (0.0, 1.0, 0.0),
+    RIGHT_BUTTON: (0.0, -1.0, 0.0),
+    TURN_LEFT_BUTTON: (0.0, 0.0, 1.0),
+    TURN_RIGHT_BUTTON: (0.0, 0.0, -1.0),
+}
+
+
+@dataclasses.dataclass
+class KeyboardParams:
+    """A person at the browser's keyboard (HSR tasks): arrows move the end effector at
+    `speed` (m/s; 0 takes the task's nominal speed, that of its DMPs), Q and E turn it at
+    `rotation_speed` (rad/s)."""
+
+    speed: float = 0.0
+    rotation_speed: float = 0.6
+    # A key counts as held this long (s) after its last press. The browser repeats a held
+    # key, but only after the system's repeat delay (often 0.25..0.66 s): bridge it.
+    hold_time: float = 0.6
+
+
+class KeyboardOperator(SampledOperator):
+    """Task-space velocity commands from Meshcat buttons bound to keys.
+
+    .. pydrake_system::
+
+        name: KeyboardOperator
+        input_ports:
+        - ee_state
+        output_ports:
+        - operator_command
+        - operator_active
+
+    Adds one Meshcat button per key (see `KEY_BUTTONS`): ↑/↓ forward/back along the end
+    effector's heading, ←/→ sideways (left = heading + 90 deg), Q/E turn left/right. A
+    click of a button (or a keydown of its key in the browser, auto-repeated while the key
+    is held) keeps the key held for `hold_time` seconds; a tap gives a short motion.
+    Meshcat's page clicks a button on every `keydown`, repeats included, so a held key
+    re-clicks at the OS repeat rate (~25-33 Hz) after the OS repeat delay (often 0.25-0.6 s):
+    with a `hold_time` below that delay a held key moves, pauses briefly, then moves on.
+    Translation keys combine into one direction at `speed` (m/s); Q/E give a yaw rate of
+    ±`rotation_speed` (rad/s). With `allow_forward=False` (PBP modes, where forward motion
+    comes from the DMP phase) the forward button is not added and ↑ does nothing; ↓ still
+    works.
+
+    Input `ee_state` `[p (3), v (3), heading, heading_rate]` gives the heading used to turn
+    the robot-frame keys into the world frame. Output `operator_command` is
+    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0); `operator_active` is 1 while any
+    effective key is held (even if
+    opposite keys cancel).
+
+    With `exclusive` (the default) a `BrowserGuard` (`browser_guard`) pauses the simulation
+    while more than one browser is connected to the page, and the clicks sent meanwhile
+    are dropped and every key released: no second page drives the robot.
+
+    Click counts are snapshotted at initialisation, and the last counts and click times are
+    kept in discrete state, so the system holds no state outside its Context. Meshcat must
+    be used only from the thread that created it (run the simulator there). The buttons
+    stay in Meshcat until `Delete()` is called.
+    """
+
+    # The buttons' names, for code that presses them (`Meshcat`'s injected clicks, tests).
+    FORWARD_BUTTON, BACK_BUTTON = FORWARD_BUTTON, BACK_BUTTON
+    LEFT_BUTTON, RIGHT_BUTTON = LEFT_BUTTON, RIGHT_BUTTON
+    TURN_LEFT_BUTTON, TURN_RIGHT_BUTTON = TURN_LEFT_BUTTON, TURN_RIGHT_BUTTON
+
+    def __init__(self, meshcat, control_period, allow_forward, params=KeyboardParams(),
+                 nominal_speed=None, exclusive=True):
+        super().__init__(OperatorCommand.size, control_period)
+        self.params = dataclasses.replace(params)
+        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
+        self._allow_forward = bool(allow_forward)
+        self._speed = operator_speed(params.speed, nominal_speed)
+        self._rotation_speed = float(params.rotation_speed)
+        self._keys = HeldButtons(meshcat, {name: code for name, code in KEY_BUTTONS.items()
+                                           if allow_forward or name != FORWARD_BUTTON},
+                                 params.hold_time)
+        self._axes = np.array([_KEY_AXES[name] for name in self._keys.names])
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        # Per button: the click count last seen, then the time of its last click.
+        self._keys_index = self.DeclareDiscreteState(
+            self._keys.released(np.zeros(len(self._keys))))
+        self.DeclareInitializationDiscreteUpdateEvent(self._snapshot)
+        self._declare_operator_outputs()
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def button_names(self):
+        """The names of the buttons this operator added to Meshcat."""
+        return list(self._keys.names)
+
+    def Delete(self):
+        """Removes this operator's buttons from Meshcat (they stay there otherwise)."""
+        self._keys.delete()
+
+    def _snapshot(self, context, discrete_state):
+        discrete_state.get_mutable_vector(self._keys_index).set_value(self._keys.released())
+
+    def _update(self, context, discrete_state):
+        # Meshcat is read once a tick; the key state and the command come from that read.
+        # The connections are counted after the read: a click read here came from a page
+        # connected before the count.
+        clicks = self._keys.clicks()
+        if self.browser_guard is not None and self.browser_guard.wait_while_shared():
+            keys = self._keys.released()  # what another page sent does not count
+        else:
+            keys = self._keys.step(context.get_discrete_state(self._keys_index).value(),
+                                   clicks, context.get_time())
+        discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
+        self._store_sample(discrete_state, *self._command(context, keys))
+
+    def _command(self, context, keys):
+        held = self._keys.held(keys, context.get_time())
+        forward, left, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(3)
+        local = np.array([forward, left])
+        norm = np.linalg.norm(local)
+        if norm > 0:
+            local *= self._speed / norm  # e.g. ↑ with ← goes diagonally at `speed`
+        velocity = rotate_planar(local, EeState(self._ee_state_port.Eval(context)).heading)
+        yaw_rate = self._rotation_speed * yaw
+        return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), bool(held.any())

@@ -1,0 +1,92 @@
+"""What the six-DoF browser operators share: the hand's pose in, a world-frame twist out,
+the operator frame and the forward drop of PBP modes (`core.operator_frame`)."""
+
+import math
+
+import numpy as np
+
+from pbp_drake.core.operator_frame import capped, operator_twist, without_forward_twist
+from pbp_drake.core.pose_arbitration import validate_twist
+from pbp_drake.core.quaternion import unit_quaternions
+from pbp_drake.systems.operators.browser_guard import BrowserGuard
+from pbp_drake.systems.ports import OperatorTwist, PoseState
+from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
+
+
+def check_params(params, positive=(), fraction=()):
+    """Raises ValueError naming the field of the dataclass `params` that is not finite and
+    positive (`positive` fields) or not in [0, 1) (`fraction` fields)."""
+    kind = type(params).__name__
+    for field in positive:
+        value = getattr(params, field)
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"{kind}.{field} must be finite and positive, not {value!r}")
+    for field in fraction:
+        value = getattr(params, field)
+        if not (isinstance(value, (int, float)) and 0.0 <= value < 1.0):
+            raise ValueError(f"{kind}.{field} must be in [0, 1), not {value!r}")
+
+
+class PoseOperatorBase(SampledOperator):
+    """A six-DoF operator's ports and frame; subclasses read the browser in `_update`.
+
+    .. pydrake_system::
+
+        name: PoseOperatorBase
+        input_ports:
+        - hand_state
+        output_ports:
+        - operator_twist
+        - operator_active
+
+    Input `hand_state` is the hand's `PoseState` (its orientation sets the operator frame;
+    a NaN or infinite field is refused by name). Output `operator_twist` is an
+    `OperatorTwist` `[vx, vy, vz, wx, wy, wz]` in the world frame. Unit inputs
+    `(forward, left, up)` and `(yaw, pitch, roll)`, each capped at length 1, are scaled by
+    `speed` (m/s) and `rotation_speed` (rad/s). Without `allow_forward` (PBP modes) the
+    velocity's forward part along the approach axis z_H is dropped.
+    """
+
+    def __init__(self, meshcat, control_period, allow_forward, speed, rotation_speed,
+                 exclusive):
+        super().__init__(OperatorTwist.size, control_period, command_name="operator_twist")
+        self._meshcat = meshcat
+        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
+        self._allow_forward = bool(allow_forward)
+        self._speed = speed
+        self._rotation_speed = rotation_speed
+        self._hand_state_port = self.DeclareVectorInputPort("hand_state", PoseState.size)
+
+    @staticmethod
+    def speeds(params, nominal_speed):
+        """`(speed, rotation_speed)` of `params`, checked (speed 0: `nominal_speed`)."""
+        check_params(params, positive=("rotation_speed",))
+        return operator_speed(params.speed, nominal_speed), float(params.rotation_speed)
+
+    def get_hand_state_input_port(self):
+        return self._hand_state_port
+
+    def get_operator_twist_output_port(self):
+        return self.get_operator_command_output_port()
+
+    def _validate(self, command):
+        return validate_twist(command, "operator_twist")
+
+    def _orientation(self, context):
+        state = np.asarray(self._hand_state_port.Eval(context), float)
+        bad = [name for name, value in zip(PoseState.get_fields(), state)
+               if not math.isfinite(value)]
+        if bad:
+            raise ValueError(f"hand_state {', '.join(bad)} is NaN or infinite: "
+                             f"{state.tolist()}")
+        return unit_quaternions(state[3:7], "hand_state orientation")
+
+    def _twist(self, context, linear, angular):
+        """The world twist of unit inputs (each capped at 1), forward dropped in PBP."""
+        orientation = self._orientation(context)
+        twist = operator_twist(orientation, self._speed * capped(linear),
+                               self._rotation_speed * capped(angular))
+        if not self._allow_forward:
+            twist = without_forward_twist(twist, orientation)
+        # A push wholly dropped leaves rounding residue (1e-17): zero, so it reads inactive.
+        return np.where(np.abs(twist) < 1e-12, 0.0, twist)

@@ -1,0 +1,72 @@
+"""The grasping task's virtual participant as a Drake system."""
+
+import numpy as np
+
+from pbp_drake.core.participant_grasp import GraspParticipant, ParticipantMemory
+from pbp_drake.systems.ports import OperatorTwist, PoseState, Target
+from pbp_drake.systems.operators.sampled_operator import SampledOperator
+
+
+class PoseVirtualOperator(SampledOperator):
+    """Stands in for a person in the grasping task: a thin wrapper of
+    `pbp_drake.core.participant_grasp.GraspParticipant.step`.
+
+    .. pydrake_system::
+
+        name: PoseVirtualOperator
+        input_ports:
+        - hand_pose
+        - target
+        - selected_goal
+        output_ports:
+        - operator_command
+        - operator_active
+
+    `hand_pose` is the hand's `PoseState`, `target` the task monitor's `Target` (its index
+    is the object the task wants), `selected_goal` the estimator's `[index]` (read in
+    "assist" mode only). `operator_command` is an `OperatorTwist` `[v (3), omega (3)]`,
+    world frame. It samples at the sense stage of each tick, as every `SampledOperator`;
+    what it remembers of the targets it has seen (`ParticipantMemory`) is discrete state,
+    so Contexts stay independent.
+    """
+
+    def __init__(self, participant, control_period):
+        if not isinstance(participant, GraspParticipant):
+            raise ValueError("participant must be a GraspParticipant (GraspParticipant.create)")
+        super().__init__(OperatorTwist.size, control_period)
+        self._participant = participant
+        self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
+        self._target_port = self.DeclareVectorInputPort("target", Target.size)
+        self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._memory_index = self.DeclareDiscreteState(np.array(ParticipantMemory(),
+                                                                dtype=float))
+        self._declare_operator_outputs()
+
+    @property
+    def participant(self):
+        return self._participant
+
+    def get_hand_pose_input_port(self):
+        return self._hand_port
+
+    def get_target_input_port(self):
+        return self._target_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_port
+
+    def _update(self, context, discrete_state):
+        memory = ParticipantMemory.from_array(
+            context.get_discrete_state(self._memory_index).value())
+        hand = np.asarray(self._hand_port.Eval(context), float)
+        time = context.get_time()
+        # Teleop never reads the estimate: its port may stay unconnected there.
+        selected = (self._selected_port.Eval(context)[0]
+                    if self._participant.mode == "assist" else -1)
+        twist, active, memory = self._participant.step(
+            memory, time, int(round(time / self._period)), hand[:3],
+            hand[3:7] / np.linalg.norm(hand[3:7]), int(Target(
+                self._target_port.Eval(context)).index), int(selected))
+        discrete_state.get_mutable_vector(self._memory_index).set_value(
+            np.array(memory, dtype=float))
+        self._store_sample(discrete_state, twist, active)

@@ -1,0 +1,354 @@
+"""A virtual participant for the HSR tasks: stands in for the paper's users in automated runs."""
+
+import copy
+
+import numpy as np
+
+from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
+from pbp_drake.core.participant_reach import assist_motion, drive_motion, faces_target
+from pbp_drake.core.reach_task import rotate_planar, wrap_angle
+from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
+from pbp_drake.systems.operators.participant_avoidance import (
+    WATCH_SIZE, is_pushing_through, robot_closes_in, start_watch, update_watch)
+from pbp_drake.core.participant_params import VirtualParticipantParams
+from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
+
+PARTICIPANT_MODES = ("assist", "drive")
+
+
+class VirtualOperator(SampledOperator):
+    """Sees the true target and the robot, and acts as a person would.
+
+    .. pydrake_system::
+
+        name: VirtualOperator
+        input_ports:
+        - ee_state
+        - target
+        - selected_goal
+        - obstacle_positions (optional)
+        output_ports:
+        - operator_command
+        - operator_active
+
+    `mode="assist"` (PBP and arbitration): acts only while the estimated goal
+    (`selected_goal`) is not the target, and never pushes forward, as in the paper where the
+    forward key is disabled. It turns the end effector to face the target and moves toward
+    it and away from the object picked instead, as far as the keys allow; it steps aside
+    when the two stand in line; and once it has faced the target `insist_time` to no avail,
+    it turns the target to its side and sidesteps to it (`pbp_drake.core.participant_reach`
+    says why each goal estimator can read this). It sees all the `objects` (M, 3).
+    `mode="drive"` (teleoperation): it drives the whole way, toward the target at `speed`
+    (slowing within `slow_radius`), turning to face it.
+
+    It notices a new target only `reaction_delay` seconds after it appears, and its
+    commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
+    scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
+    is reproducible and the system keeps no state outside its Context.
+
+    With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (cylinders of
+    `obstacle_radius`; their velocities
+    from the positions it remembers in discrete state) and keeps the robot's footprint (base
+    disc and arm, `footprint_clearance`) `obstacle_margin` clear of them: each tick it scores
+    a fan of velocities and yaw rates over a short horizon (progress to the target, turning
+    toward a heading whose footprint fits at the target, clearance), and in PBP it lets go
+    whenever the DMP's path (pulled back to its start-target line) looks clear for a while.
+    In the last `final_approach_radius` it no longer minds obstacles (in PBP it drives there
+    only when the robot does not close in by itself), and within `push_through_radius`, or
+    after `stall_time` without getting closer (`participant_avoidance`), it pushes on
+    through. `VirtualParticipantParams` documents each of these fields.
+
+    Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
+    `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is
+    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0).
+    """
+
+    def __init__(self, control_period, objects, mode="assist",
+                 params=VirtualParticipantParams(), nominal_speed=None, seed=0,
+                 obstacle_count=0, obstacle_radius=0.0, obstacle_margin=None,
+                 policy_adds=False):
+        if mode not in PARTICIPANT_MODES:
+            raise ValueError(f"participant mode {mode!r} is unknown; use one of "
+                             f"{PARTICIPANT_MODES}")
+        super().__init__(OperatorCommand.size, control_period)
+        self._mode = mode
+        self._objects = np.asarray(objects, dtype=float)
+        self.params = copy.deepcopy(params)
+        self._plan_times = np.array(params.plan_times, dtype=float)
+        self._speed = operator_speed(params.speed, nominal_speed)
+        self._rotation_speed = float(params.rotation_speed)
+        self._reaction_ticks = int(round(params.reaction_delay / control_period))
+        self._direction_noise = float(params.direction_noise)
+        self._speed_noise = float(params.speed_noise)
+        self._seed = int(seed)
+        self._slow_radius = float(params.slow_radius)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        self._target_port = self.DeclareVectorInputPort("target", Target.size)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        # With an additive blend (PBP-Cont) the policy keeps moving under the operator's
+        # command; the participant then asks for the motion it wants minus the policy's.
+        self._policy_adds = bool(policy_adds)
+        self._obstacles_port = None
+        if obstacle_count > 0 and not obstacle_radius > 0:
+            raise ValueError(f"obstacle_radius must be positive with obstacles, got "
+                             f"{obstacle_radius}")
+        self._obstacle_radius = float(obstacle_radius)
+        # PBP-Alt lets the DMP pull the robot back to its line after each release, so the
+        # participant keeps a wider margin there; under PBP-Cont (and in teleop) a wider one
+        # only makes it fight the policy longer.
+        if obstacle_margin is None:
+            obstacle_margin = 0.08 if mode == "assist" and not policy_adds else 0.06
+        self._obstacle_margin = float(obstacle_margin)
+        self._release_heading_gap = (params.release_heading_gap_alternated
+                                     if mode == "assist" and not policy_adds
+                                     else params.release_heading_gap)
+        self._hold_ticks = int(round(params.hold_time / control_period))
+        if obstacle_count > 0:
+            self._obstacles_port = self.DeclareVectorInputPort(
+                "obstacle_positions", 2 * int(obstacle_count))
+            # [seen (0/1), the hand's start (2), ticks it still keeps control,
+            #  the obstacles' positions at the last tick (2N), the stall watch of
+            #  `participant_avoidance` (WATCH_SIZE)].
+            self._track_index = self.DeclareDiscreteState(
+                np.zeros(4 + 2 * int(obstacle_count) + WATCH_SIZE))
+        # What the participant believes: the target index it knows and how many ticks a
+        # different target has been on screen.
+        self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        # Assisting in the reaching task: the target it counts for and how many ticks it has
+        # faced it while the estimate named another object (`insist_time`).
+        self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        self._insist_ticks = int(round(params.insist_time / control_period))
+        self._declare_operator_outputs()
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def get_target_input_port(self):
+        return self._target_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_obstacle_positions_input_port(self):
+        return self._obstacles_port
+
+    def _update(self, context, discrete_state):
+        # The belief moves first, and the command of this tick acts on the new belief.
+        known, unseen_ticks = context.get_discrete_state(self._belief_index).value()
+        shown = Target(self._target_port.Eval(context)).index
+        if known < 0:
+            known, unseen_ticks = shown, 0  # the first target is known from the start
+        elif shown != known:
+            unseen_ticks += 1
+            if unseen_ticks > self._reaction_ticks:
+                known, unseen_ticks = shown, 0
+        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
+        discrete_state.set_value(self._belief_index, [known, unseen_ticks])
+        if self._obstacles_port is not None:
+            command, active = self._avoid(context, discrete_state, int(known))
+        else:
+            command, active = self._decide(context, discrete_state, int(known))
+        self._store_sample(discrete_state, command, active)
+
+    def _noise(self, context):
+        """This tick's direction error (rad) and speed factor, drawn from `(seed, tick)`."""
+        rng = np.random.default_rng([self._seed, int(round(context.get_time() / self._period))])
+        return (rng.normal(0.0, self._direction_noise),
+                max(0.0, 1.0 + rng.normal(0.0, self._speed_noise)))
+
+    def _avoid(self, context, discrete_state, known_target):
+        """The command while obstacles are about: a local plan around them (see the class
+        docstring). Returns `(command, active)`."""
+        ee_state = EeState(self._ee_state_port.Eval(context))
+        hand = np.array([ee_state.x, ee_state.y])
+        velocity = np.array([ee_state.vx, ee_state.vy])
+        heading = ee_state.heading
+        target = Target(self._target_port.Eval(context))
+        target_xy = np.array([target.x, target.y])
+        obstacles = self._obstacles_port.Eval(context).reshape(-1, 2)
+        track = np.array(context.get_discrete_state(self._track_index).value())
+        count = len(obstacles)
+        remembered = slice(4, 4 + 2 * count)
+        watch = slice(4 + 2 * count, None)
+        if track[0] < 0.5:
+            track[0], track[1:3], track[remembered] = 1.0, hand, obstacles.reshape(-1)
+            track[watch] = start_watch(np.linalg.norm(target_xy - hand))
+        start = track[1:3]
+        obstacle_velocity = (obstacles - track[remembered].reshape(count, 2)) / self._period
+        hold = track[3]
+        track[3] = max(hold - 1.0, 0.0)
+        track[remembered] = obstacles.reshape(-1)
+        held = self._held(context)
+        was_active = held[4] > 0.5
+        last_command = held[:2] if was_active else np.zeros(2)
+
+        def finish(command, active, hold_ticks=None):
+            if hold_ticks is not None:
+                track[3] = hold_ticks
+            discrete_state.set_value(self._track_index, track)
+            return command, active
+
+        if known_target != int(target.index):
+            return finish(np.zeros(4), False)
+        offset = target_xy - hand
+        distance = np.linalg.norm(offset)
+        noise_angle, speed_scale = self._noise(context)
+        drive = self._mode == "drive"
+        params = self.params
+        track[watch] = update_watch(params, track[watch], distance, self._period)
+        pushing_through = is_pushing_through(track[watch])
+        if distance < params.final_approach_radius:
+            # The last few centimetres: straight on, whatever stands there; in PBP only
+            # when the robot does not get there by itself.
+            if not drive and robot_closes_in(params, velocity, offset, self._speed):
+                return finish(np.zeros(4), False, 0.0)
+            speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
+            step = speed * rotate_planar(offset / max(distance, 1e-9), noise_angle)
+            return finish(np.array([step[0], step[1], 0.0, 0.0]), True)
+
+        predicted = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
+                                       self._plan_times)
+        settled = predict_obstacles(obstacles, obstacle_velocity, hand, target_xy,
+                                     np.array([params.settle_time]))[0]
+        goal_heading = self._goal_heading(heading, target_xy, settled)
+        heading_gap = abs(wrap_angle(heading - goal_heading))
+        if not drive and not pushing_through:
+            # Would the policy, left alone, keep the robot clear?
+            policy_clear = footprint_clearance(
+                policy_path(hand, start, target_xy, self._speed, self._plan_times), heading,
+                predicted, self._obstacle_radius).min()
+            if was_active:
+                release = (hold <= 0 and heading_gap < self._release_heading_gap
+                           and policy_clear >= params.release_factor * self._obstacle_margin)
+            else:
+                moving_clear = footprint_clearance(
+                    hand + velocity * self._plan_times[:, None], heading, predicted,
+                    self._obstacle_radius).min()
+                release = (heading_gap < 2 * self._release_heading_gap
+                           and min(policy_clear, moving_clear) >= self._obstacle_margin)
+            if release:
+                return finish(np.zeros(4), False)
+
+        planned, yaw_rate, clear = self._plan(hand, heading, target_xy, predicted,
+                                              goal_heading, last_command)
+        if pushing_through or (clear < 0.0 and distance < params.push_through_radius):
+            # Boxed in next to the target, or no closer for a long while
+            # (`participant_avoidance`): on through, as people did.
+            planned = self._speed * min(1.0, distance / self._slow_radius) * offset / distance
+            yaw_rate = 0.0
+        command = speed_scale * rotate_planar(planned, noise_angle)
+        if self._policy_adds:
+            # The policy's own motion: what the hand does minus what was asked of it.
+            policy_velocity = velocity - last_command
+            command = command - policy_velocity
+            norm = np.linalg.norm(command)
+            limit = params.policy_compensation * self._speed
+            if norm > limit:
+                command *= limit / norm
+        hold_ticks = track[3] if was_active or drive else self._hold_ticks
+        return finish(np.array([command[0], command[1], 0.0, yaw_rate]), True, hold_ticks)
+
+    def _goal_heading(self, heading, target_xy, obstacles):
+        """The heading nearest the present one whose footprint, hand on the target, keeps
+        clear of where the obstacles will stand; the clearest one when none does."""
+        turns = np.deg2rad(np.arange(-180.0, 180.0, 15.0))
+        headings = heading + turns
+        clear = footprint_clearance(np.broadcast_to(target_xy, (len(turns), 2)), headings,
+                                    np.broadcast_to(obstacles, (len(turns),) + obstacles.shape),
+                                    self._obstacle_radius)
+        fine = clear >= self.params.goal_margin_factor * self._obstacle_margin
+        if np.any(fine):
+            return headings[fine][np.argmin(np.abs(turns[fine]))]
+        return headings[np.argmax(clear)]
+
+    def _plan(self, hand, heading, target_xy, predicted, goal_heading, last_command):
+        """The best velocity (2) and yaw rate over a short horizon, and its clearance."""
+        params, plan_times = self.params, self._plan_times
+        offset = target_xy - hand
+        distance = np.linalg.norm(offset)
+        toward = offset / max(distance, 1e-9)
+        speed = self._speed * min(1.0, max(distance, 0.02) / self._slow_radius)
+        angles = np.arctan2(toward[1], toward[0]) + np.linspace(
+            0.0, 2 * np.pi, params.plan_directions, endpoint=False)
+        directions = np.vstack([np.stack([np.cos(angles), np.sin(angles)], 1), [[0.0, 0.0]]])
+        yaw = min(self._rotation_speed, params.max_turn_rate)
+        velocities = np.repeat(speed * directions, 3, axis=0)
+        yaw_rates = np.tile([0.0, yaw, -yaw], len(directions))
+        hands = hand + velocities[:, None, :] * plan_times[None, :, None]
+        headings = heading + yaw_rates[:, None] * plan_times[None, :]
+        clear = footprint_clearance(hands, headings, predicted[None],
+                                    self._obstacle_radius).min(axis=1)
+        progress = velocities @ toward / self._speed
+        gap_now = abs(wrap_angle(heading - goal_heading))
+        gap_then = np.abs(wrap_angle(headings[:, -1] - goal_heading))
+        turning = (gap_now - gap_then) / (params.max_turn_rate * plan_times[-1])
+        last_norm = np.linalg.norm(last_command)
+        keep_on = (velocities @ last_command / (self._speed * last_norm) if last_norm > 1e-9
+                   else np.zeros(len(velocities)))
+        shortfall = np.maximum(self._obstacle_margin - clear, 0.0)
+        score = (progress + params.turn_weight * turning + params.keep_on_weight * keep_on
+                 - 20.0 * shortfall - 5.0 * (shortfall > 0))
+        best = int(np.argmax(score))
+        return velocities[best], yaw_rates[best], clear[best]
+
+    def _decide(self, context, discrete_state, known_target):
+        """The command in the reaching task (`pbp_drake.core.participant_reach`). Returns
+        `(command, active)`."""
+        ee_state = EeState(self._ee_state_port.Eval(context))
+        position, heading = position_of(ee_state), ee_state.heading
+        target = Target(self._target_port.Eval(context))
+        if known_target != int(target.index):
+            return np.zeros(4), False  # has not noticed the new target yet
+        target_position = position_of(target)
+        noise_angle, speed_scale = self._noise(context)
+        if self._mode == "assist":
+            selected = int(round(self._selected_goal_port.Eval(context)[0]))
+            insisting = self._count_insistence(context, discrete_state, known_target,
+                                               selected, position, heading, target_position)
+            if selected == known_target:
+                return np.zeros(4), False
+            velocity, yaw_rate = assist_motion(
+                self.params, self._speed, position, heading, target_position,
+                self._objects[selected], insisting)
+        else:
+            insisting = False
+            if np.linalg.norm(target_position[:2] - position[:2]) < 1e-9:
+                return np.zeros(4), False
+            velocity, yaw_rate = drive_motion(self.params, self._speed, position, heading,
+                                              target_position)
+        velocity = speed_scale * rotate_planar(velocity, noise_angle)
+        if self._mode == "assist" and insisting and self._policy_adds:
+            # Under PBP-Cont the DMP of the picked object keeps pulling the hand to it, and
+            # near it that pull matches `speed`: going to the target, the participant pushes
+            # against it as it does among obstacles (`_avoid`).
+            velocity = self._against_policy(context, ee_state, velocity)
+        return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
+
+    def _against_policy(self, context, ee_state, wanted):
+        """The command that moves the hand at `wanted` (2) under an additive blend: `wanted`
+        minus the policy's own motion (what the hand does minus what was asked of it), at
+        most `policy_compensation` times `speed`."""
+        held = self._held(context)
+        last_command = held[:2] if held[4] > 0.5 else np.zeros(2)
+        policy_velocity = np.array([ee_state.vx, ee_state.vy]) - last_command
+        command = wanted - policy_velocity
+        norm = np.linalg.norm(command)
+        limit = self.params.policy_compensation * self._speed
+        if norm > limit:
+            command *= limit / norm
+        return command
+
+    def _count_insistence(self, context, discrete_state, known_target, selected, position,
+                          heading, target_position):
+        """Whether it has faced `known_target` `insist_time` while the estimate named another
+        object; it keeps insisting on that target, once it has, until a new one appears
+        (turning back to face it would only undo what it has gained)."""
+        counted_target, ticks = context.get_discrete_state(self._insist_index).value()
+        if counted_target != known_target:
+            counted_target, ticks = known_target, 0.0
+        insisting = ticks >= self._insist_ticks
+        if (not insisting and selected != known_target
+                and faces_target(self.params, position, heading, target_position)):
+            ticks += 1.0
+        discrete_state.set_value(self._insist_index, [counted_target, ticks])
+        return insisting

@@ -1,0 +1,21 @@
+"""The PBP loop's systems: the DMP banks, the goal estimators, the blenders and the hand-over,
+in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`) and the six-DoF
+pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`, `PoseHandOver`); the goals'
+source, the heading command of the HSR tasks and the demonstration player of explicit
+arbitration."""
+
+from pbp_drake.systems.pbp.blender import Blender
+from pbp_drake.systems.pbp.demonstration_player import DemonstrationPlayer
+from pbp_drake.systems.pbp.dmp_bank import DmpBank
+from pbp_drake.systems.pbp.goal_estimator import GoalEstimator
+from pbp_drake.systems.pbp.goals_source import GoalsSource
+from pbp_drake.systems.pbp.hand_over import HandOver
+from pbp_drake.systems.pbp.heading_command import HeadingCommand
+from pbp_drake.systems.pbp.pose_blender import PoseBlender
+from pbp_drake.systems.pbp.pose_dmp_bank import PoseDmpBank
+from pbp_drake.systems.pbp.pose_goal_estimator import PoseGoalEstimator
+from pbp_drake.systems.pbp.pose_hand_over import PoseHandOver
+
+__all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource",
+           "HandOver", "HeadingCommand", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator",
+           "PoseHandOver"]

@@ -1,0 +1,290 @@
+"""The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot.
+
+The system holds the bank's immutable model (`pbp_drake.core.dmp.DmpBankModel`) and nothing
+else that a step changes: the DMPs' state is the Context's discrete state and the step's
+scratch arrays (a `DmpWorkspace`) are a cache entry, which Drake allocates once per
+Context. Two Contexts of one system, or two Simulators of one diagram, are therefore
+independent, whichever order or thread steps them.
+"""
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import LeafSystem, ValueProducer
+
+from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState, StepInputsState
+from pbp_drake.systems.ports import goal_index
+from pbp_drake.systems.tick import decide_offset
+
+
+class DmpBank(LeafSystem):
+    """Steps K DMPs (one per goal) every control period from the robot's measured state.
+
+    .. pydrake_system::
+
+        name: DmpBank
+        input_ports:
+        - robot_state
+        - goals
+        - operator_active (optional)
+        - followed_goal (optional)
+        - selected_goal (optional)
+        output_ports:
+        - references
+        - selected_reference
+        - phase
+        - predicted_paths
+
+    `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
+    `(K, D)`. Each period the bank advances every DMP one step from the robot's position
+    (keeping each DMP's own velocity; the first-order-hold step of `pbp_drake.core.dmp`). With
+    `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the phases
+    and the DMPs follow the robot until the operator lets go. With `max_speed` (m/s), each
+    DMP's own velocity is scaled down to it before every step (anti-windup: PBP-Cont gives
+    the hand-over law's speed limit, which the hand can never exceed anyway).
+
+    `followed_goal` (optional) is the index of the goal whose reference the robot followed
+    since the last update (the goal estimator's selection, read before it updates). When it
+    is connected, each update first gives every DMP the followed DMP's velocity: all DMPs
+    then step from the robot's position AND the velocity it is being driven at, so the
+    selection may move to any of them without a jump of the commanded velocity (the
+    velocities then differ by the attractors' pull over one period only, which vanishes with
+    the period). Unconnected, each DMP keeps a velocity of its own, which relaxes toward its
+    own attractor while the robot follows another.
+
+    `references` is the K next states `[positions (K*D), velocities (K*D)]`;
+    `selected_reference` the next state `[position (D), velocity (D)]` of `selected_goal`
+    alone (unconnected: the followed goal, else goal 0), what a blender reads: O(D) to
+    compute where `references` is O(K D). `phase` is the K phases; `predicted_paths`
+    (declared when `prediction_steps > 0`) is each DMP's open-loop path from its current
+    state, `(K, prediction_steps + 1, D)` flattened, for drawing, sampled every
+    `prediction_period` (default: the control period).
+    All state lives in the Context, and so does the step's scratch memory (a cache entry).
+
+    The state is one vector, in one of three layouts
+    (`pbp_drake.systems.pbp.dmp_bank_state`): every DMP's velocity and attractor terms
+    (`3 K D` numbers, which Drake copies twice an update), or, with `compact_state=True`
+    (which needs `followed_goal` connected: an update raises otherwise, since every DMP
+    then steps from one velocity), a state whatever K: `2 + 6 D` numbers for DMPs that
+    share weights and start (`bank.affine_in_goal`; a bank from one demonstration or
+    straight, as every scenario's), whose attractor terms are affine in the goal, so that
+    the outputs are computed from the goals on the port; else (distinct weights) `3 + 2 D`
+    numbers, what the last step started from, and the step's terms a cache entry computed
+    from them once per state, when first read. The compact outputs equal the per-goal
+    layout's bit for bit while the goals do not change between an update and a read (when
+    they change, the outputs and the next update read the new goals, as if the last step
+    had been taken toward them). The goals are checked
+    and laid out `(D, K)` in a cache entry, once per change. All DMPs of the system share
+    one phase: the lock is one input.
+
+    The bank updates at the decide stage of each control tick
+    (`pbp_drake.systems.tick.decide_offset`), so that it reads the robot's state sampled at
+    the tick and the operator's decision of the same tick, as Alg. 2 does. `update_offset`
+    (seconds after the tick) overrides it, for experts with their own tick order.
+    """
+
+    def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
+                 prediction_steps=0, update_offset=None, prediction_period=None,
+                 max_speed=None, compact_state=False):
+        super().__init__()
+        self._bank = bank
+        # Anti-windup: the hand-over law never lets the hand move faster than this (m/s), so
+        # a DMP must not remember a faster velocity either (see `_update`).
+        self._max_speed = None if max_speed is None else float(max_speed)
+        self._period = float(control_period)
+        # Drawing a long horizon at the control period would cost hundreds of steps a frame;
+        # the first-order-hold step stays close at coarser steps (second order in the step).
+        self._prediction_period = float(prediction_period or control_period)
+        self._lock = bool(lock_phase_when_operator_acts)
+        self._prediction_steps = int(prediction_steps)
+        if update_offset is None:
+            update_offset = decide_offset(self._period)
+        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
+            raise ValueError(
+                f"update_offset must be in [0, control_period), got {update_offset!r}")
+        k, d = bank.goal_count, bank.dimension
+        self._layout = _layout_class(compact_state, bank.affine_in_goal)(
+            bank, self._period, self._max_speed)
+        self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
+        self._goals_port = self.DeclareVectorInputPort("goals", k * d)
+        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._state_index = self.DeclareDiscreteState(self._layout.initial())
+        # The goals checked and laid out (D, K) once each time they change, not each tick.
+        self._goals_dk = self.DeclareCacheEntry(
+            "goals, validated, (D, K) contiguous",
+            ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((d, k))),
+                          calc=self._calc_goals_dk),
+            prerequisites_of_calc={self._goals_port.ticket()})
+        # Scratch of the bank's step, one workspace per Context. It is never calculated nor
+        # marked up to date (it depends on nothing and holds nothing between calls), so
+        # `_workspace` may always take it mutably; a cloned Context deep-copies it.
+        self._workspace_entry = self.DeclareCacheEntry(
+            "DmpWorkspace: scratch arrays of the bank's step",
+            ValueProducer(allocate=lambda: AbstractValue.Make(bank.make_workspace()),
+                          calc=self._never_calculated),
+            prerequisites_of_calc={self.nothing_ticket()})
+        # The step's attractor terms, in the step-inputs layout: computed from the state
+        # and the goals once per state, when first read (`StepInputsState`).
+        self._terms = None
+        if self._layout.reads == "terms":
+            self._terms = self.DeclareCacheEntry(
+                "the last step's attractor terms dp, dz (2, D, K)",
+                ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((2, d, k))),
+                              calc=self._calc_terms),
+                prerequisites_of_calc={self.xd_ticket(), self._goals_dk.ticket()})
+        # The outputs depend on the bank's own state only (and, in the compact layouts, on
+        # the goals): say so, so that Drake does not recompute them after every plant step.
+        state = {self.xd_ticket()}
+        if self._layout.reads is not None:
+            state.add(self._goals_port.ticket())
+        self._references_port = self.DeclareVectorOutputPort(
+            "references", 2 * k * d, self._calc_references, prerequisites_of_calc=state)
+        self._selected_reference_port = self.DeclareVectorOutputPort(
+            "selected_reference", 2 * d, self._calc_selected_reference,
+            prerequisites_of_calc=state | {self._selected_goal_port.ticket(),
+                                           self._followed_goal_port.ticket()})
+        self._phase_port = self.DeclareVectorOutputPort(
+            "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
+        self._predicted_paths_port = None
+        if self._prediction_steps > 0:
+            self._predicted_paths_port = self.DeclareVectorOutputPort(
+                "predicted_paths", k * (self._prediction_steps + 1) * d,
+                self._calc_predicted_paths,
+                prerequisites_of_calc={self.xd_ticket(),
+                                       self._goals_port.ticket()})
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
+
+    @staticmethod
+    def state_size(goal_count, dimension, compact_state=False, affine_in_goal=True):
+        """The length of the one state vector: `2 + D + 3 K D` per goal; compact, `2 + 6 D`
+        for a bank `affine_in_goal`, else `3 + 2 D`."""
+        return _layout_class(compact_state, affine_in_goal).size_of(goal_count, dimension)
+
+    @property
+    def bank(self):
+        return self._bank
+
+    def get_robot_state_input_port(self):
+        return self._robot_state_port
+
+    def get_goals_input_port(self):
+        return self._goals_port
+
+    def get_operator_active_input_port(self):
+        return self._operator_active_port
+
+    def get_followed_goal_input_port(self):
+        return self._followed_goal_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_references_output_port(self):
+        return self._references_port
+
+    def get_selected_reference_output_port(self):
+        return self._selected_reference_port
+
+    def get_phase_output_port(self):
+        return self._phase_port
+
+    def get_predicted_paths_output_port(self):
+        return self._predicted_paths_port
+
+    def _workspace(self, context):
+        """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""
+        return self._workspace_entry.get_mutable_cache_entry_value(
+            context).GetMutableValueOrThrow()
+
+    @staticmethod
+    def _never_calculated(context, value):
+        raise RuntimeError("the DmpBank workspace is scratch memory, never evaluated")
+
+    def _state(self, context):
+        return context.get_discrete_state(self._state_index).get_value()
+
+    def _given(self, context):
+        """What the layout `reads` besides the state: the goals `(D, K)` (the affine
+        layout), the step's terms (the step-inputs layout), or None."""
+        reads = self._layout.reads
+        if reads == "goals":
+            return self._goals_dk.Eval(context)
+        return self._terms.Eval(context) if reads == "terms" else None
+
+    def _calc_terms(self, context, value):
+        self._layout.terms_into(self._state(context), self._goals_dk.Eval(context),
+                                self._workspace(context), value.get_mutable_value())
+
+    def dmp_states(self, context):
+        """The K DMPs' state after the last update: phases (K,), positions and scaled
+        velocities (D, K), new arrays (what `references` reads out)."""
+        state = self._state(context)
+        positions, velocity = self._layout.read(state, self._given(context),
+                                                self._workspace(context))
+        return np.full(self._bank.goal_count, self._layout.phase(state)), positions, velocity
+
+    def selected_reference(self, context):
+        """`[position (D), velocity (D)]` of `selected_goal` (unconnected: the followed
+        goal, else goal 0) after the last update, a new array."""
+        k = self._bank.goal_count
+        goal = goal_index(self._selected_goal_port, context, k)
+        if goal is None:
+            goal = goal_index(self._followed_goal_port, context, k, unconnected=0)
+        position, velocity = self._layout.read(self._state(context), self._given(context),
+                                               self._workspace(context), goal)
+        return np.concatenate([position[:, 0], velocity[:, 0] / self._bank.duration])
+
+    def _update(self, context, discrete_state):
+        # Drake fills `discrete_state` with the current state; the update writes into it.
+        # Every input is evaluated before the workspace is taken: an input's evaluation may
+        # reach this system's outputs, whose calculation uses the same workspace.
+        robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
+        lock = (self._lock and self._operator_active_port.HasValue(context)
+                and self._operator_active_port.Eval(context)[0] > 0.5)
+        goals_dk = None if lock else self._goals_dk.Eval(context)
+        # The goal the robot followed since the last update (None: unconnected).
+        followed = goal_index(self._followed_goal_port, context, self._bank.goal_count)
+        if followed is None and self._layout.needs_followed_goal:
+            raise RuntimeError(
+                "DmpBank with compact_state=True steps every DMP from the followed DMP's "
+                "velocity: connect its followed_goal input port")
+        # The step-inputs layout's terms of the state being updated (the Context's), before
+        # the workspace is taken: their calculation uses it.
+        given = self._terms.Eval(context) if self._terms is not None else None
+        self._layout.update(
+            discrete_state.get_mutable_vector(self._state_index).get_mutable_value(),
+            robot_state, lock, goals_dk, followed, self._workspace(context), given)
+
+    def _calc_goals_dk(self, context, value):
+        goals = self._bank.goals_matrix(self._goals_port.Eval(context))
+        value.get_mutable_value()[...] = goals
+
+    def _calc_references(self, context, output):
+        _, positions, scaled_velocity = self.dmp_states(context)
+        d, k = self._bank.dimension, self._bank.goal_count
+        references = output.get_mutable_value().reshape(2, k, d)
+        references[0] = positions.T
+        np.divide(scaled_velocity.T, self._bank.duration, out=references[1])
+
+    def _calc_selected_reference(self, context, output):
+        output.SetFromVector(self.selected_reference(context))
+
+    def _calc_phase(self, context, output):
+        output.get_mutable_value()[:] = self._layout.phase(self._state(context))
+
+    def _calc_predicted_paths(self, context, output):
+        phase, positions, scaled_velocity = self.dmp_states(context)
+        goals = self._goals_dk.Eval(context)
+        paths = self._bank.predict(phase, positions, scaled_velocity, goals,
+                                   self._prediction_period, self._prediction_steps,
+                                   self._workspace(context))
+        output.SetFromVector(paths.reshape(-1))
+
+
+def _layout_class(compact_state, affine_in_goal):
+    """The state layout: per goal; compact, affine in the goal when the bank is, else the
+    step's inputs (`pbp_drake.systems.pbp.dmp_bank_state`)."""
+    if not compact_state:
+        return PerGoalState
+    return AffineState if affine_in_goal else StepInputsState

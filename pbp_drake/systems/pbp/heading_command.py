@@ -1,0 +1,62 @@
+"""The commanded heading of the end effector: turned by the operator alone."""
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core.hand_over import check_limit, hand_over
+from pbp_drake.systems.ports import OperatorCommand
+from pbp_drake.systems.tick import decide_offset
+
+
+class HeadingCommand(LeafSystem):
+    """Integrates the operator's yaw rate into the commanded heading.
+
+    .. pydrake_system::
+
+        name: HeadingCommand
+        input_ports:
+        - operator_command
+        output_ports:
+        - heading
+
+    `operator_command` is `OperatorCommand` (`[vx, vy, vz, yaw_rate]`); each control period
+    the heading moves by `yaw_rate * control_period`; with `max_yaw_acceleration` (rad/s^2)
+    the rate it turns at follows the operator's under the hand-over law
+    (`pbp_drake.core.hand_over`), so starting and stopping a turn is not a step. The DMPs
+    never turn the robot: in PBP the operator's turning is how it tells the goal estimator
+    where it wants to go. Like the DMP bank, it updates at the decide stage (`update_offset`
+    after the tick, by default `pbp_drake.systems.tick.decide_offset`) to use the
+    operator's command of that tick.
+    """
+
+    def __init__(self, initial_heading, control_period, max_yaw_acceleration=None,
+                 update_offset=None):
+        super().__init__()
+        self._period = float(control_period)
+        if update_offset is None:
+            update_offset = decide_offset(self._period)
+        self._max_yaw_acceleration = (np.inf if max_yaw_acceleration is None else check_limit(
+            max_yaw_acceleration, "max_yaw_acceleration", "rad/s^2"))
+        self._command_port = self.DeclareVectorInputPort("operator_command",
+                                                         OperatorCommand.size)
+        self._heading_index = self.DeclareDiscreteState(np.array([float(initial_heading)]))
+        self._yaw_rate_index = self.DeclareDiscreteState(np.zeros(1))
+        self._heading_port = self.DeclareStateOutputPort("heading", self._heading_index)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
+
+    def get_operator_command_input_port(self):
+        return self._command_port
+
+    def get_heading_output_port(self):
+        return self._heading_port
+
+    def _update(self, context, discrete_state):
+        # One pybind call a group's array (get_mutable_vector and its value: two).
+        heading = discrete_state.get_mutable_value(self._heading_index)
+        yaw_rate = discrete_state.get_mutable_value(self._yaw_rate_index)
+        wanted = OperatorCommand(self._command_port.Eval(context)).yaw_rate
+        # The hand-over law in one dimension: the turn's rate changes by at most
+        # max_yaw_acceleration * period a tick, and the heading moves at that rate.
+        heading[:], yaw_rate[:] = hand_over(yaw_rate, heading + wanted * self._period,
+                                            [wanted], self._max_yaw_acceleration, np.inf,
+                                            self._period)

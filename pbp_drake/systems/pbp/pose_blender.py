@@ -1,0 +1,91 @@
+"""Six-DoF blending as a Drake system: the operator's twist and the pose DMP's reference
+become one pose reference (`pbp_drake.core.pose_arbitration`)."""
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.arbitration import (
+    DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW)
+from pbp_drake.core.pose_arbitration import PoseReference, blend_pose, validate_pose_mode
+from pbp_drake.systems.pbp.blender import BlenderBase
+from pbp_drake.systems.ports import OperatorTwist, PoseState
+
+
+class PoseBlender(BlenderBase):
+    """Mixes the operator's twist into the policy's pose reference by one blending law.
+
+    .. pydrake_system::
+
+        name: PoseBlender
+        input_ports:
+        - robot_state
+        - policy_reference
+        - operator_twist
+        - operator_active
+        - selected_goal (optional)
+        - goal_probabilities (optional)
+        output_ports:
+        - reference
+
+    `robot_state` is the hand's `PoseState` sampled at the tick; `policy_reference` a
+    `PoseState` (pose after one period and twist: `PoseDmpBank.selected_reference`);
+    `operator_twist` an `OperatorTwist` `[vx, vy, vz, wx, wy, wz]` (world frame), refused
+    with its NaN or infinite fields named. `reference` is a `PoseState`.
+
+    Modes (`pbp_drake.core.pose_arbitration`): `pbp_continuous`, `pbp_alternated`,
+    `fixed_alpha`, `confidence_alpha`, `teleop`, `pbp_no_user`; linear parts blend as the
+    position `Blender`'s, angular velocities as world-frame vectors, orientations on SO(3)
+    (turned by `Exp(w dt)`, mixed by slerp). `confidence_alpha` reads `goal_probabilities`
+    (K) and `selected_goal` (goal 0 unconnected), as `Blender`; `fixed_alpha`'s weight is
+    a Context parameter (`set_alpha`). The mode, the ramp and the weight are `Blender`'s
+    (`BlenderBase`).
+    """
+
+    _validate_mode = staticmethod(validate_pose_mode)
+    _estimator_name = "PoseGoalEstimator"
+
+    def __init__(self, mode, goal_count, control_period, alpha=None, *,
+                 confidence_range=(DEFAULT_CONFIDENCE_LOW, DEFAULT_CONFIDENCE_HIGH),
+                 alpha_max=DEFAULT_ALPHA_MAX):
+        super().__init__(mode, goal_count, control_period, alpha, confidence_range, alpha_max)
+        self._robot_state_port = self.DeclareVectorInputPort("robot_state", PoseState.size)
+        self._policy_port = self.DeclareVectorInputPort("policy_reference", PoseState.size)
+        self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
+        self._active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._goal_probabilities_port = self.DeclareVectorInputPort("goal_probabilities",
+                                                                    self._goal_count)
+        # A function of the inputs (and alpha) alone: not redone between control ticks.
+        self._reference_port = self.DeclareVectorOutputPort(
+            "reference", PoseState.size, self._calc_reference,
+            prerequisites_of_calc={self.all_input_ports_ticket(),
+                                   self.all_parameters_ticket()})
+
+    def get_robot_state_input_port(self):
+        return self._robot_state_port
+
+    def get_policy_reference_input_port(self):
+        return self._policy_port
+
+    def get_operator_twist_input_port(self):
+        return self._twist_port
+
+    def get_operator_active_input_port(self):
+        return self._active_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_goal_probabilities_input_port(self):
+        return self._goal_probabilities_port
+
+    def get_reference_output_port(self):
+        return self._reference_port
+
+    def _calc_reference(self, context, output):
+        alpha = self.alpha(context)
+        robot = self._robot_state_port.Eval(context)
+        orientation = quaternion.unit_quaternions(robot[3:7], "robot_state orientation")
+        policy = PoseReference.from_vector(self._policy_port.Eval(context))
+        reference = blend_pose(self._mode, robot[:3], orientation, policy,
+                               self._twist_port.Eval(context),
+                               self._active_port.Eval(context)[0] > 0.5, self._period, alpha)
+        output.SetFromVector(reference.to_vector())

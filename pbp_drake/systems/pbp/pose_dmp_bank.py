@@ -1,0 +1,413 @@
+"""The six-DoF DMP bank as a Drake system: K goal poses, each a position DMP and an
+orientation DMP re-integrated every control step from the hand's measured pose.
+
+A thin LeafSystem over the NumPy banks `pbp_drake.core.dmp.DmpBankModel` (positions, D = 3) and
+`OrientationDmpBank` (unit quaternions), as `pbp_drake.systems.pbp.dmp_bank.DmpBank` is over
+the first: the DMPs' state is the Context's discrete state and the scratch arrays are a
+cache entry (one per Context), so Contexts and Simulators stay independent.
+"""
+
+import math
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import LeafSystem, ValueProducer
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one
+from pbp_drake.core.dmp.stepping import limit_speeds
+from pbp_drake.core.pose_arbitration import PoseReference
+from pbp_drake.systems.ports import GoalPose, PoseState, goal_index
+from pbp_drake.systems.pbp.pose_dmp_bank_state import (
+    AT_START, ON_ROBOT, STEPPING, PoseWorkspace, compact_inputs, hold_into, per_goal_arrays,
+    split_head, state_size, step_all)
+from pbp_drake.systems.tick import decide_offset
+
+class PoseDmpBank(LeafSystem):
+    """Steps K pose DMPs (one per goal pose) every control period from the hand's pose.
+
+    .. pydrake_system::
+
+        name: PoseDmpBank
+        input_ports:
+        - robot_state
+        - goal_poses
+        - operator_active (optional)
+        - followed_goal (optional)
+        - selected_goal (optional)
+        output_ports:
+        - references
+        - selected_reference
+        - phase
+        - predicted_poses (with prediction_steps > 0)
+
+    `robot_state` is a `PoseState` `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]`
+    (quaternion unit within `quaternion.UNIT_TOLERANCE`, angular velocity world frame);
+    `goal_poses` is K `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened (a goal that
+    is not finite, or whose quaternion is not unit, is refused naming `goal_poses`).
+
+    Each period every DMP advances one step from the measured pose: the position part as
+    `DmpBank`, the orientation part as `OrientationDmpBank` (`e = Log(q g*)`, the same
+    first-order-hold step, see docs/dmp.md). Both parts share one phase, so one lock stops
+    both: with `lock_phase_when_operator_acts` (PBP-Alt) a nonzero `operator_active`
+    freezes the phase and the DMPs follow the hand (its pose, and `tau` times its twist)
+    until the operator lets go. `followed_goal` (the goal estimator's selection before it
+    updates) makes every DMP continue from the followed DMP's linear AND angular velocity,
+    so a switch of goal keeps the commanded twist (as `DmpBank`); unconnected, each keeps
+    its own. `max_speed` (m/s) and `max_angular_speed` (rad/s) scale each DMP's own
+    velocities down to them before every step (anti-windup, as `DmpBank`'s `max_speed`;
+    give the hand-over's limits).
+
+    `references` is the K next pose references, K `PoseState` rows (pose after one step,
+    twist) flattened; `selected_reference` is the one of `selected_goal` (unconnected: the
+    followed goal, else goal 0), a `PoseState`, computed alone (what a blender needs;
+    `references` costs K exp maps). `phase` is the K (equal) phases. `predicted_poses`
+    (declared when `prediction_steps > 0`) is the selected DMP's open-loop rollout from its
+    current state, `prediction_steps + 1` `GoalPose` rows flattened, sampled every
+    `prediction_period` (default: the DMPs' duration over `prediction_steps`), for
+    drawing: it is computed only when read (a visualizer's publish), never per tick.
+
+    The state is one vector `[phase, held, p (3), q (4), eta (3), ...]`, in one of two
+    layouts (`pbp_drake.systems.pbp.pose_dmp_bank_state`). Per goal (the default), the K DMPs'
+    stepped arrays follow: the position DMPs' stepped positions relative to the measured
+    one and their stepped scaled velocities (`DmpBank`'s `p + dp + Phi01 z` and
+    `dz + Phi11 z`, summed at the step), and the orientation DMPs' stepped log coordinates
+    `(e', z')` (`log_step_into`), from which the outputs read the orientations and angular
+    velocities on demand: 12 K numbers, which Drake copies twice at each update (at
+    K = 10,000 a fifth of the step). With `compact_state=True` (which needs `followed_goal`
+    connected: an update without it raises) the state is 16 numbers whatever K, what the
+    last step started from (its phase, the measured pose, the followed DMP's velocities
+    after the speed limits), and the K stepped DMPs are a cache entry computed from it and
+    the goals, with the same call, once per state when first read: by an output, or by the
+    next update, which continues from the followed DMP's velocities. Every DMP is still
+    stepped every tick; the outputs are the per-goal layout's bit for bit while the goals
+    stay, and if the goals change between an update and a read, the read steps toward the
+    new goals (as `DmpBank`'s compact state). The bank updates at the decide stage of each
+    tick (`update_offset` overrides it).
+    """
+
+    def __init__(self, position_bank, orientation_bank, control_period,
+                 lock_phase_when_operator_acts=False, update_offset=None, max_speed=None,
+                 max_angular_speed=None, prediction_steps=0, prediction_period=None,
+                 compact_state=False):
+        super().__init__()
+        _check_banks(position_bank, orientation_bank, control_period)
+        # Anti-windup, as DmpBank's `max_speed`: the hand-over never lets the hand move or
+        # turn faster, so no DMP may remember a faster velocity (`limit_speeds`).
+        self._max_speed = None if max_speed is None else float(max_speed)
+        self._max_angular_speed = (None if max_angular_speed is None
+                                   else float(max_angular_speed))
+        self._positions, self._orientations = position_bank, orientation_bank
+        # Equal settings and durations: both parts' steps contract one basis (the position
+        # step's, passed on to the orientation step).
+        self._shared_basis = (position_bank.settings == orientation_bank.settings
+                              and position_bank.duration == orientation_bank.duration)
+        self._period = float(control_period)
+        self._lock = bool(lock_phase_when_operator_acts)
+        if update_offset is None:
+            update_offset = decide_offset(self._period)
+        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
+            raise ValueError(
+                f"update_offset must be in [0, control_period), got {update_offset!r}")
+        k = self._goal_count = position_bank.goal_count
+        self._robot_state_port = self.DeclareVectorInputPort("robot_state", PoseState.size)
+        self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
+        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._compact = bool(compact_state)
+        initial = np.zeros(self.state_size(k, self._compact))
+        phase, held, _, q, _ = split_head(initial)
+        phase[0], held[0] = 1.0, AT_START
+        q[:, 0] = quaternion.IDENTITY
+        if not self._compact:
+            per_goal_arrays(initial, k)[0][0] = position_bank.starts  # from p = 0
+        self._state_index = self.DeclareDiscreteState(initial)
+        self._goals_entry = self.DeclareCacheEntry(
+            "goal poses, validated, (7, K): positions then quaternions",
+            ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((GoalPose.size, k))),
+                          calc=self._calc_goals),
+            prerequisites_of_calc={self._goals_port.ticket()})
+        # Scratch, never calculated nor marked up to date (see DmpBank's workspace entry).
+        self._workspace_entry = self.DeclareCacheEntry(
+            "PoseWorkspace: scratch arrays of the banks' step",
+            ValueProducer(allocate=lambda: AbstractValue.Make(
+                PoseWorkspace(position_bank, orientation_bank)),
+                calc=self._never_calculated),
+            prerequisites_of_calc={self.nothing_ticket()})
+        if self._compact:
+            self._stepped_entry = self.DeclareCacheEntry(
+                "the K DMPs stepped from the compact state: [y' - p, z', e', z'] (12 K)",
+                ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(12 * k)),
+                              calc=self._calc_stepped),
+                prerequisites_of_calc={self.xd_ticket(), self._goals_entry.ticket()})
+        self._references_port = self.DeclareVectorOutputPort(
+            "references", k * PoseState.size, self._calc_references,
+            prerequisites_of_calc={self.xd_ticket(), self._goals_port.ticket()})
+        self._selected_reference_port = self.DeclareVectorOutputPort(
+            "selected_reference", PoseState.size, self._calc_selected_reference,
+            prerequisites_of_calc={self.xd_ticket(), self._goals_port.ticket(),
+                                   self._selected_goal_port.ticket(),
+                                   self._followed_goal_port.ticket()})
+        self._phase_port = self.DeclareVectorOutputPort(
+            "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
+        self._prediction_steps = int(prediction_steps)
+        self._prediction_period = float(
+            prediction_period or position_bank.duration / max(self._prediction_steps, 1))
+        self._predicted_poses_port = None
+        if self._prediction_steps > 0:
+            self._predicted_poses_port = self.DeclareVectorOutputPort(
+                "predicted_poses", (self._prediction_steps + 1) * GoalPose.size,
+                self._calc_predicted_poses,
+                prerequisites_of_calc={self.xd_ticket(), self._goals_port.ticket(),
+                                       self._selected_goal_port.ticket(),
+                                       self._followed_goal_port.ticket()})
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
+
+    @staticmethod
+    def state_size(goal_count, compact_state=False):
+        """The length of the one state vector (class docstring)."""
+        return state_size(goal_count, compact_state)
+
+    @property
+    def position_bank(self):
+        return self._positions
+
+    @property
+    def orientation_bank(self):
+        return self._orientations
+
+    def get_robot_state_input_port(self):
+        return self._robot_state_port
+
+    def get_goal_poses_input_port(self):
+        return self._goals_port
+
+    def get_operator_active_input_port(self):
+        return self._operator_active_port
+
+    def get_followed_goal_input_port(self):
+        return self._followed_goal_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_references_output_port(self):
+        return self._references_port
+
+    def get_selected_reference_output_port(self):
+        return self._selected_reference_port
+
+    def get_phase_output_port(self):
+        return self._phase_port
+
+    def get_predicted_poses_output_port(self):
+        return self._predicted_poses_port
+
+    def _stepped(self, context, vector):
+        """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K): views of
+        `vector` (the state read, or the update's copy of it) per goal; in the compact
+        layout, of the cache entry computed from the Context's state, which the update's
+        copy equals until the update writes it."""
+        if self._compact:
+            return per_goal_arrays(self._stepped_entry.Eval(context), self._goal_count)
+        return per_goal_arrays(vector, self._goal_count)
+
+    def _calc_stepped(self, context, value):
+        vector = context.get_discrete_state(self._state_index).get_value()
+        _, held, robot, q, eta = split_head(vector)
+        phase, velocity = compact_inputs(vector)
+        stepped, log_state = per_goal_arrays(value.get_mutable_value(), self._goal_count)
+        if held[0] != STEPPING:
+            hold_into(held[0], robot, velocity, self._positions.starts, stepped)
+            return
+        step_all(self._positions, self._orientations, self._shared_basis, phase, robot, q,
+                 velocity, eta, self._goals_entry.Eval(context), self._period, stepped,
+                 log_state, self._workspace(context))
+
+    def _workspace(self, context):
+        return self._workspace_entry.get_mutable_cache_entry_value(
+            context).GetMutableValueOrThrow()
+
+    @staticmethod
+    def _never_calculated(context, value):
+        raise RuntimeError("the PoseDmpBank workspace is scratch memory, never evaluated")
+
+    def _calc_goals(self, context, value):
+        rows = np.asarray(self._goals_port.Eval(context), dtype=float).reshape(
+            self._goal_count, GoalPose.size)
+        check_positions(rows[:, :3], "goal_poses position")
+        orientations = quaternion.unit_quaternions(rows[:, 3:], "goal_poses orientation")
+        goals = value.get_mutable_value()
+        goals[:3] = rows[:, :3].T
+        goals[3:] = orientations.T
+        self._workspace(context).goals_changed = True
+
+    def _robot(self, context):
+        """The measured position (3,), orientation (4,), velocity (3,) and angular velocity
+        (3,), checked."""
+        state = np.asarray(self._robot_state_port.Eval(context), dtype=float)
+        if not np.isfinite(state).all():
+            bad = [name for name, value in zip(PoseState.get_fields(), state)
+                   if not np.isfinite(value)]
+            raise ValueError(f"robot_state {', '.join(bad)} is NaN or infinite: "
+                             f"{state.tolist()}")
+        norm = math.sqrt(float(state[3:7] @ state[3:7]))
+        if abs(norm - 1.0) > quaternion.UNIT_TOLERANCE:
+            quaternion.unit_quaternions(state[3:7], "robot_state orientation")  # raises
+        # `unit_quaternions` costs 50 us a call; one quaternion is checked by hand.
+        return state[:3], state[3:7] / norm, state[7:10], state[10:13]
+
+    def _update(self, context, discrete_state):
+        positions, orientations, period = self._positions, self._orientations, self._period
+        vector = discrete_state.get_mutable_vector(self._state_index).get_mutable_value()
+        phase, held, robot, q, eta_state = split_head(vector)
+        stepping = held[0] == STEPPING
+        # Every input before the workspace (an input may reach this system's outputs).
+        position, orientation, velocity, angular_velocity = self._robot(context)
+        lock = (self._lock and self._operator_active_port.HasValue(context)
+                and self._operator_active_port.Eval(context)[0] > 0.5)
+        goals = self._goals_entry.Eval(context)
+        followed = goal_index(self._followed_goal_port, context, self._goal_count)
+        if self._compact and followed is None:
+            raise RuntimeError(
+                "PoseDmpBank with compact_state=True steps every DMP from the followed DMP's "
+                "velocities: connect its followed_goal input port")
+        # The compact state's tail: the phase and `z` the last step started from (`z`, or
+        # the held one).
+        step_phase, step_velocity = compact_inputs(vector) if self._compact else (None, None)
+        if stepping or not self._compact:
+            stepped, log_state = self._stepped(context, vector)
+            offsets, velocities = stepped
+        workspace = self._workspace(context)
+        # The DMPs' velocities at the end of the last step, which the step overwrites: the
+        # followed one's linear velocity (every DMP continues from it), else each one's,
+        # and the orientation part's eta as a column (one for all) or per DMP.
+        if followed is not None:
+            scaled_velocity = workspace.column
+            scaled_velocity[:, 0] = (velocities[:, followed] if step_velocity is None
+                                     or stepping else step_velocity[:, 0])
+        else:
+            scaled_velocity = workspace.velocities
+            np.copyto(scaled_velocity, velocities)
+        if stepping:
+            limit_speeds(scaled_velocity, self._max_speed, positions.duration)
+            if followed is not None:
+                eta = jacobian_of_one(log_state[0, :, followed],
+                                      log_state[1, :, followed])[:, np.newaxis]
+            else:
+                orientations.orientations_from_log_into(
+                    log_state[0], log_state[1], goals[3:], q,
+                    workspace.orientations, workspace.eta, workspace.orientation)
+                eta = workspace.eta
+            limit_speeds(eta, self._max_angular_speed, orientations.duration)
+        else:
+            eta = np.array(eta_state)  # the robot's (locked) or 0 (at the start), (3, 1)
+        robot[:, 0] = position
+        q[:, 0] = orientation
+        if lock:
+            # Both phases frozen: the DMPs sit at the hand's pose and follow its twist.
+            held[0] = ON_ROBOT
+            eta_state[:, 0] = angular_velocity * orientations.duration
+            if self._compact:
+                np.multiply(velocity[:, np.newaxis], positions.duration, out=step_velocity)
+            else:
+                offsets.fill(0.0)
+                np.multiply(velocity[:, np.newaxis], positions.duration, out=velocities)
+            return
+        held[0] = STEPPING
+        if self._compact:
+            # What the step starts from; the cache entry takes it (`_calc_stepped`).
+            step_phase[0] = phase[0]
+            step_velocity[...] = scaled_velocity
+            eta_state[...] = eta
+        else:
+            step_all(positions, orientations, self._shared_basis, phase, robot, q,
+                     scaled_velocity, eta, goals, period, stepped,
+                     log_state, workspace)
+        phase *= positions.decay(period)
+
+    def dmp_states(self, context):
+        """The K DMPs after the last update: phases (K,), positions (3, K), orientations
+        (4, K), and the scaled velocities `tau v` and `tau omega` (3, K), new arrays."""
+        vector = context.get_discrete_state(self._state_index).get_value()
+        phase, held, robot, q, eta_held = split_head(vector)
+        k = self._goal_count
+        (offsets, velocities), log_state = self._stepped(context, vector)
+        rotations = np.empty((4, k))
+        eta = np.empty((3, k))
+        if held[0] != STEPPING:
+            rotations[...] = self._orientations.starts if held[0] == AT_START else q
+            eta[...] = eta_held
+        else:
+            goals = self._goals_entry.Eval(context)
+            self._orientations.orientations_from_log_into(
+                log_state[0], log_state[1], goals[3:], q, rotations, eta,
+                self._workspace(context).orientation)
+        return np.full(k, phase[0]), robot + offsets, rotations, np.array(velocities), eta
+
+    def _calc_references(self, context, output):
+        _, stepped, rotations, velocity, eta = self.dmp_states(context)
+        rows = output.get_mutable_value().reshape(self._goal_count, PoseState.size)
+        rows[:, :3] = stepped.T
+        rows[:, 3:7] = rotations.T
+        rows[:, 7:10] = velocity.T / self._positions.duration
+        rows[:, 10:13] = eta.T / self._orientations.duration
+
+    def selected_reference(self, context):
+        """The `PoseReference` of `selected_goal` (unconnected: the followed goal, else 0)."""
+        k = goal_index(self._selected_goal_port, context, self._goal_count)
+        if k is None:
+            k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
+        vector = context.get_discrete_state(self._state_index).get_value()
+        _, held, robot, q, eta_held = split_head(vector)
+        (offsets, velocities), log_state = self._stepped(context, vector)
+        position = robot[:, 0] + offsets[:, k]
+        velocity = velocities[:, k] / self._positions.duration
+        tau_w = self._orientations.duration
+        if held[0] != STEPPING:
+            start = self._orientations.starts[:, k] if held[0] == AT_START else q[:, 0]
+            return PoseReference(position, np.array(start), velocity, eta_held[:, 0] / tau_w)
+        error, log_velocity = log_state[0, :, k], log_state[1, :, k]
+        goal = self._goals_entry.Eval(context)[3:, k]
+        rotation = quaternion.exp_times_aligned(error, goal, q[:, 0])
+        eta = jacobian_of_one(error, log_velocity)
+        return PoseReference(position, rotation, velocity, eta / tau_w)
+
+    def _calc_selected_reference(self, context, output):
+        output.SetFromVector(self.selected_reference(context).to_vector())
+
+    def _calc_phase(self, context, output):
+        phase = split_head(context.get_discrete_state(self._state_index).get_value())[0]
+        output.get_mutable_value()[:] = phase[0]
+
+
+    def _calc_predicted_poses(self, context, output):
+        k = goal_index(self._selected_goal_port, context, self._goal_count)
+        if k is None:
+            k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
+        phase, positions, orientations, velocity, eta = self.dmp_states(context)
+        goals = self._goals_entry.Eval(context)
+        # The banks roll out all K DMPs (their `predict` is vectorised over K); only the
+        # selected one is drawn. Read at a visualizer's rate (10 Hz), the cost is small.
+        dt, steps = self._prediction_period, self._prediction_steps
+        path = self._positions.predict(phase, positions, velocity, goals[:3], dt, steps)[k]
+        turns = self._orientations.predict(phase, orientations, eta, goals[3:], dt, steps)[k]
+        output.SetFromVector(np.hstack([path, turns]).reshape(-1))
+
+
+def _check_banks(position_bank, orientation_bank, control_period):
+    """The two banks must describe the same K goals with one phase: 3-D positions, equal
+    goal counts, and equal phase decays over the control period."""
+    if position_bank.dimension != 3:
+        raise ValueError(f"the position bank must be 3-D, got D = {position_bank.dimension}")
+    if position_bank.goal_count != orientation_bank.goal_count:
+        raise ValueError(f"the banks have {position_bank.goal_count} and "
+                         f"{orientation_bank.goal_count} goals; a pose bank needs one count")
+    period = float(control_period)
+    if not (np.isfinite(period) and period > 0.0):
+        raise ValueError(f"control_period must be positive, got {control_period!r}")
+    if position_bank.decay(period) != orientation_bank.decay(period):
+        raise ValueError("the position and orientation banks must share one phase: give them "
+                         "the same duration and alpha_x")

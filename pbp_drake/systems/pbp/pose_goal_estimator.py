@@ -1,0 +1,115 @@
+"""The ``pose`` goal estimator as a Drake system: which of K grasp poses the operator means."""
+
+import dataclasses
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core.goal_estimation import (
+    GoalEstimatorSettings, SelectionMemory, update_selection)
+from pbp_drake.core.grasp_estimation import pose_probabilities
+from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
+from pbp_drake.systems.tick import decide_offset
+
+
+class PoseGoalEstimator(LeafSystem):
+    """Estimates the intended grasp pose every control period
+    (`pbp_drake.core.grasp_estimation.pose_probabilities` and the shipped hysteresis,
+    `goal_estimation.update_selection`).
+
+    .. pydrake_system::
+
+        name: PoseGoalEstimator
+        input_ports:
+        - hand_pose
+        - goal_poses
+        - operator_twist (optional)
+        output_ports:
+        - selected_goal
+        - goal_probabilities
+
+    `hand_pose` is the hand's `PoseState` (pose and world-frame twist); `goal_poses` the K
+    `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened. `operator_twist`, when
+    connected, is the operator's command, an `OperatorTwist` `[v (3), omega (3)]` (world
+    frame): the estimator's direction of travel and turn rate are then the operator's, not
+    the hand's, and while the operator gives no input (a twist of all zeros) the selection
+    holds. Connect it whenever a policy moves the hand too: the hand's own twist is then
+    mostly the selected DMP's, and reading it as the operator's intent holds the selection
+    on whatever the robot is heading for; and with the operator idle, only the hand's
+    distances and angles to the grasps would be left to decide, which the policy's own
+    motion changes (docs/grasp_task.md). Unconnected, the hand's twist from `hand_pose`
+    is read and the selection follows it at every update. `selected_goal` is `[index]`
+    and `goal_probabilities` the K probabilities; both are read from the state, so they
+    hold between updates, as `GoalEstimator`'s.
+
+    At initialisation it selects the most probable grasp pose at once (no hysteresis);
+    each update, at the decide stage of the tick (`update_offset` overrides it), it
+    recomputes the probabilities and moves the selection with the shipped hysteresis.
+    """
+
+    def __init__(self, goal_count, settings, control_period, update_offset=None):
+        super().__init__()
+        if not isinstance(settings, GoalEstimatorSettings) or settings.method != "pose":
+            raise ValueError("settings must be a GoalEstimatorSettings with method 'pose'")
+        settings.validate()
+        if update_offset is None:
+            update_offset = decide_offset(control_period)
+        k = self._goal_count = int(goal_count)
+        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
+        self._settings = dataclasses.replace(settings)
+        self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
+        self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
+        self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
+        self._selected_index = self.DeclareDiscreteState(np.zeros(1))
+        self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
+        # [challenger, count] of the hysteresis (`SelectionMemory`); -1: none yet.
+        self._memory_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        self._selected_port = self.DeclareStateOutputPort("selected_goal",
+                                                          self._selected_index)
+        self._probabilities_port = self.DeclareStateOutputPort("goal_probabilities",
+                                                               self._probabilities_index)
+        self.DeclareInitializationDiscreteUpdateEvent(
+            lambda context, state: self._estimate(context, state, None))
+        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period), update_offset,
+                                                self._update)
+
+    def get_hand_pose_input_port(self):
+        return self._hand_port
+
+    def get_goal_poses_input_port(self):
+        return self._goals_port
+
+    def get_operator_twist_input_port(self):
+        return self._twist_port
+
+    def get_selected_goal_output_port(self):
+        return self._selected_port
+
+    def get_goal_probabilities_output_port(self):
+        return self._probabilities_port
+
+    def _update(self, context, state):
+        challenger, count = context.get_discrete_state(self._memory_index).value()
+        selected = int(context.get_discrete_state(self._selected_index).value()[0])
+        self._estimate(context, state, SelectionMemory(selected, int(challenger), int(count)))
+
+    def _estimate(self, context, state, memory):
+        hand = np.asarray(self._hand_port.Eval(context), float)
+        goals = np.asarray(self._goals_port.Eval(context), float).reshape(
+            self._goal_count, GoalPose.size)
+        operator = self._twist_port.HasValue(context)
+        twist = np.asarray(self._twist_port.Eval(context), float) if operator else hand[7:13]
+        probabilities = pose_probabilities(
+            self._settings, goals[:, :3], goals[:, 3:], hand[:3],
+            hand[3:7] / np.linalg.norm(hand[3:7]), twist[:3], twist[3:])
+        if memory is not None and operator and not twist.any():
+            # The operator gives no input: no new evidence of intent, so the selection
+            # holds (the probabilities still follow the hand).
+            memory = SelectionMemory(memory.selected)
+        else:
+            memory = update_selection(probabilities, memory, self._settings.margin,
+                                      self._settings.hold_steps)
+        state.get_mutable_vector(self._selected_index).set_value([memory.selected])
+        state.get_mutable_vector(self._probabilities_index).set_value(probabilities)
+        state.get_mutable_vector(self._memory_index).set_value(
+            [memory.challenger, memory.count])

@@ -1,0 +1,63 @@
+"""The six-DoF hand-over law as a Drake system, between the pose blender and the hand."""
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core import quaternion
+from pbp_drake.core.pose_arbitration import HandOverLimits, PoseReference, pose_hand_over
+from pbp_drake.systems.ports import PoseState
+from pbp_drake.systems.tick import report_offset
+
+
+class PoseHandOver(LeafSystem):
+    """Passes the pose reference on with its linear and angular velocities each changing at
+    most `max_acceleration * dt` and `max_angular_acceleration * dt` per tick and capped at
+    the speeds (`pbp_drake.core.pose_arbitration.pose_hand_over`).
+
+    .. pydrake_system::
+
+        name: PoseHandOver
+        input_ports:
+        - reference
+        output_ports:
+        - command
+
+    `reference` and `command` are `PoseState`s. The command is the state, held between
+    ticks; it starts at `initial_pose` `[x, y, z, qw, qx, qy, qz]` at rest, and updates at
+    the report stage of each tick, as `HandOver`.
+    """
+
+    def __init__(self, initial_pose, limits, control_period):
+        super().__init__()
+        initial_pose = np.asarray(initial_pose, dtype=float).reshape(-1)
+        if initial_pose.size != 7 or not np.isfinite(initial_pose).all():
+            raise ValueError(f"initial_pose must be 7 finite numbers [x, y, z, qw, qx, qy, qz], "
+                             f"got {initial_pose.tolist()}")
+        orientation = quaternion.unit_quaternions(initial_pose[3:], "initial_pose orientation")
+        self._limits = HandOverLimits(*limits).checked()
+        self._period = float(control_period)
+        if not (np.isfinite(self._period) and self._period > 0.0):
+            raise ValueError(f"control_period must be positive, got {control_period!r}")
+        self._reference_port = self.DeclareVectorInputPort("reference", PoseState.size)
+        initial = np.concatenate([initial_pose[:3], orientation, np.zeros(6)])
+        index = self.DeclareDiscreteState(initial)
+        self._command_port = self.DeclareStateOutputPort("command", index)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            self._period, report_offset(self._period), self._update)
+
+    @property
+    def limits(self):
+        return self._limits
+
+    def get_reference_input_port(self):
+        return self._reference_port
+
+    def get_command_output_port(self):
+        return self._command_port
+
+    def _update(self, context, discrete_state):
+        reference = PoseReference.from_vector(self._reference_port.Eval(context))
+        state = discrete_state.get_mutable_vector().get_mutable_value()
+        command = pose_hand_over(state[7:10], state[10:13], reference, self._limits,
+                                 self._period)
+        state[:] = command.to_vector()

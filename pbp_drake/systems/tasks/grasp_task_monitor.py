@@ -1,0 +1,72 @@
+"""The referee of the grasping task: targets, switches, success (a grasp pose within 3 cm
+and 10 degrees), metrics; it ends the simulation at success."""
+
+import numpy as np
+
+from pbp_drake.core.grasp_task import grasp_progress, grasp_success
+from pbp_drake.systems.ports import PoseState
+from pbp_drake.systems.tasks.task_monitor import TaskMonitorBase
+
+
+class GraspTaskMonitor(TaskMonitorBase):
+    """`TaskMonitor`'s rules (`TaskMonitorBase`) with grasp poses
+    (`pbp_drake.core.grasp_task`).
+
+    .. pydrake_system::
+
+        name: GraspTaskMonitor
+        input_ports:
+        - hand_pose
+        - operator_active
+        output_ports:
+        - target
+        - task_status
+
+    `hand_pose` is the hand's `PoseState`. At the decide stage of every tick until success:
+    count the tick (and whether the operator acted), compute `grasp_progress` toward the
+    current target's grasp pose from the hand's start pose (length per radian
+    `success_distance / success_angle`), switch to the next of `targets` once progress
+    reaches the next entry of `switch_schedule`, and declare success when the hand is
+    within `success_distance` (m) AND `success_angle` (rad) of the target's grasp pose. At
+    success it ends the simulation at the report stage, as `TaskMonitor` does.
+
+    `target` is `Target` (the target's grasp position and object index); `task_status` is
+    `TaskStatus` (collision ratio 0: the task has no obstacles). `grasp_positions` (M, 3)
+    and `grasp_orientations` (M, 4) are the objects' grasp poses; `start_pose` the hand's
+    `[p (3), q (4)]` at the start.
+    """
+
+    def __init__(self, grasp_positions, grasp_orientations, targets, switch_schedule,
+                 start_pose, success_distance, success_angle, control_period):
+        # The grasp positions are the points the task's targets stand for (`objects`).
+        super().__init__("hand_pose", PoseState.size, grasp_positions, targets,
+                         switch_schedule, control_period)
+        self._orientations = np.asarray(grasp_orientations, float)
+        start_pose = np.asarray(start_pose, float)
+        self._start_position, self._start_orientation = start_pose[:3], start_pose[3:7]
+        self._success_distance = float(success_distance)
+        self._success_angle = float(success_angle)
+        self._length_per_radian = self._success_distance / self._success_angle
+
+    def get_hand_pose_input_port(self):
+        return self._hand_port
+
+    @property
+    def grasp_orientations(self):
+        return self._orientations
+
+    def _read_hand(self, vector):
+        hand = np.asarray(vector, float)
+        return hand[:3], hand[3:7] / np.linalg.norm(hand[3:7])
+
+    def _progress(self, hand, index):
+        position, orientation = hand
+        return grasp_progress(position, orientation, self._start_position,
+                              self._start_orientation, self._objects[index],
+                              self._orientations[index], self._length_per_radian)
+
+    def _reached(self, hand, index):
+        position, orientation = hand
+        return grasp_success(position, orientation, self._objects[index],
+                             self._orientations[index], self._success_distance,
+                             self._success_angle)

@@ -1,0 +1,135 @@
+"""Draws the grasping task in Meshcat: tables, objects, each grasp pose as a triad, the
+target and the estimated goal, the hand, and the selected DMP's predicted poses."""
+
+import numpy as np
+from pydrake.geometry import Box, Cylinder, Sphere
+from pydrake.math import RigidTransform
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.systems.ports import GoalPose, PoseState, Target, goal_index
+from pbp_drake.systems.visualizers.reach_scene_visualizer import (
+    ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
+from pbp_drake.systems.visualizers.scene_drawing import PathTriads, draw_triad, pose_transform
+
+# Triads: the grasp poses' and the hand's full size, the predicted path's smaller and a
+# little transparent, so that the grasp they lead to stands out.
+TRIAD_LENGTH, TRIAD_RADIUS = 0.1, 0.005
+PATH_TRIADS, PATH_TRIAD_LENGTH, PATH_TRIAD_OPACITY = 5, 0.06, 0.7
+
+
+class GraspSceneVisualizer(LeafSystem):
+    """Publishes the grasping task's drawing to Meshcat under `/task`.
+
+    .. pydrake_system::
+
+        name: GraspSceneVisualizer
+        input_ports:
+        - target
+        - selected_goal
+        - predicted_poses (optional)
+        - hand_state (optional)
+
+    `grasps` is the task's `GraspScene` (`layout.grasps`). At each initialisation
+    (`Simulator.Initialize`, after deleting `/task`) it draws every table and object and,
+    at each object's grasp pose, a triad `/task/grasps/{k}` (`draw_triad`: x red, y green,
+    z blue, z the approach). Each publish moves the yellow ball above the `target`'s object
+    (`Target`; its index picks the object) and the blue ball above the `selected_goal`'s,
+    and the hand's triad `/task/hand` to `hand_state` (`PoseState`), with
+    `time_in_recording` so that `Meshcat.StartRecording` replays them. Each `path_period`
+    the selected DMP's predicted poses (`predicted_poses`: `prediction_steps + 1` rows of
+    `GoalPose` `[x, y, z, qw, qx, qy, qz]`, flattened) are drawn as `PATH_TRIADS` triads
+    `/task/prediction/{i}` spread along the path by arc length (`PathTriads`), also with
+    `time_in_recording`: a replay shows the path and its orientations as they were.
+    Call from the thread that made `meshcat`.
+    """
+
+    def __init__(self, meshcat, grasps, prediction_steps=0, table_size=(0.3, 0.3),
+                 object_radius=0.03, object_height=0.15, publish_period=1.0 / 30.0,
+                 path_period=0.1):
+        super().__init__()
+        self._meshcat = meshcat
+        self._grasps = grasps
+        self._table_size = tuple(float(size) for size in table_size)
+        self._object_shape = (float(object_radius), float(object_height))
+        self._prediction_steps = int(prediction_steps)
+        self._target_port = self.DeclareVectorInputPort("target", Target.size)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._predicted_poses_port = self.DeclareVectorInputPort(
+            "predicted_poses", (self._prediction_steps + 1) * GoalPose.size)
+        self._hand_state_port = self.DeclareVectorInputPort("hand_state", PoseState.size)
+        self._path = PathTriads("/task/prediction", PATH_TRIADS, PATH_TRIAD_LENGTH,
+                                TRIAD_RADIUS, PATH_TRIAD_OPACITY)
+        self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
+        if self._prediction_steps:
+            self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)
+        self.DeclareInitializationPublishEvent(self._initialise)
+
+    def get_target_input_port(self):
+        return self._target_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_predicted_poses_input_port(self):
+        return self._predicted_poses_port
+
+    def get_hand_state_input_port(self):
+        return self._hand_state_port
+
+    def _initialise(self, context):
+        self._draw_scene()
+        self._publish(context)
+        if self._prediction_steps:
+            self._publish_path(context)
+
+    def _draw_scene(self):
+        meshcat, grasps = self._meshcat, self._grasps
+        meshcat.Delete("/task")
+        radius, height = self._object_shape
+        for index, (table, centre) in enumerate(zip(grasps.tables, grasps.objects)):
+            # `tables` holds each top face's centre: the box stands on the floor below it.
+            meshcat.SetObject(f"/task/tables/{index}", Box(*self._table_size, table[2]),
+                              TABLE_COLOUR)
+            meshcat.SetTransform(f"/task/tables/{index}",
+                                 RigidTransform([table[0], table[1], table[2] / 2.0]))
+            meshcat.SetObject(f"/task/objects/{index}", Cylinder(radius, height),
+                              OBJECT_COLOUR)
+            meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(centre))
+            draw_triad(meshcat, f"/task/grasps/{index}", self._grasp_pose(index),
+                       TRIAD_LENGTH, TRIAD_RADIUS)
+        meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
+        meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
+        draw_triad(meshcat, "/task/hand", None, TRIAD_LENGTH, TRIAD_RADIUS)
+        meshcat.SetProperty("/task/hand", "visible", False)  # until a hand_state is seen
+        if self._prediction_steps:
+            self._path.draw(meshcat)
+        centre = grasps.objects.mean(axis=0)
+        # A camera behind and above the robot that sees it and every object.
+        meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
+
+    def _grasp_pose(self, index):
+        return np.concatenate([self._grasps.grasp_positions[index],
+                               self._grasps.grasp_orientations[index]])
+
+    def _publish(self, context):
+        time = context.get_time()
+        meshcat, objects = self._meshcat, self._grasps.objects
+        count = len(objects)
+        target = int(Target(self._target_port.Eval(context)).index)
+        if not 0 <= target < count:
+            raise ValueError(f"target index {target} is not one of the {count} objects")
+        meshcat.SetTransform("/task/target",
+                             RigidTransform(objects[target] + [0, 0, TARGET_LIFT]), time)
+        selected = goal_index(self._selected_goal_port, context, count)
+        meshcat.SetTransform("/task/estimated_goal",
+                             RigidTransform(objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
+        if self._hand_state_port.HasValue(context):
+            hand = self._hand_state_port.Eval(context)[:GoalPose.size]
+            meshcat.SetTransform("/task/hand", pose_transform(hand), time)
+            meshcat.SetProperty("/task/hand", "visible", True, time)
+
+    def _publish_path(self, context):
+        if not self._predicted_poses_port.HasValue(context):
+            return
+        poses = self._predicted_poses_port.Eval(context).reshape(-1, GoalPose.size)
+        self._path.show(self._meshcat, poses, context.get_time())

@@ -1,0 +1,149 @@
+"""Draws the reaching task in Meshcat: objects, the target, the estimated goal, DMP paths."""
+
+import numpy as np
+from pydrake.geometry import Box, Cylinder, Rgba, Sphere
+from pydrake.math import RigidTransform
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.systems.ports import EeState, Target, position_of
+from pbp_drake.systems.visualizers.scene_drawing import PathDots
+
+OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
+TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
+# Pure, saturated colours so that a screenshot can find them.
+TARGET_COLOUR = Rgba(1.0, 0.9, 0.0, 1.0)
+ESTIMATE_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
+ACTIVE_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
+OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
+# Dots per path (each of HSR_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
+# every path update, so their count and rate set most of its size.
+PATH_DOTS = 24
+ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008
+OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
+
+OBJECT_RADIUS = 0.03
+OBJECT_HEIGHT = 0.1
+# Markers float above the objects: the target's yellow ball, and higher the estimate's blue.
+TARGET_LIFT = 0.12
+ESTIMATE_LIFT = 0.25
+
+
+class ReachSceneVisualizer(LeafSystem):
+    """Publishes the reaching task's markers to Meshcat under `/task`.
+
+    .. pydrake_system::
+
+        name: ReachSceneVisualizer
+        input_ports:
+        - target
+        - selected_goal
+        - operator_active (optional)
+        - ee_state (optional)
+        - predicted_paths (optional)
+
+    The objects stand on small tables, drawn (after deleting `/task`) at each
+    initialisation (`Simulator.Initialize`), so a second run or a run after
+    `meshcat.Delete()` draws them again. Each publish moves the yellow ball above the
+    current `target` (`Target`, `[p (3), index]`) and the blue ball above the
+    estimated goal (`selected_goal`), with `time_in_recording` so that
+    `Meshcat.StartRecording` replays them; an orange ring around the hand shows when the
+    operator acts. Each `path_period` (default 0.1 s: paths change slowly, and a
+    replay interpolates between updates) every DMP's predicted path is drawn as faint dots
+    and the selected one's again as bold dots (`PathDots`, with `time_in_recording`, so a
+    replay shows each path where it was at that time). Call from the thread that made
+    `meshcat`.
+    """
+
+    def __init__(self, meshcat, objects, prediction_steps=0, publish_period=1.0 / 30.0,
+                 path_period=0.1):
+        super().__init__()
+        self._meshcat = meshcat
+        self._objects = np.asarray(objects, dtype=float)
+        self._prediction_steps = int(prediction_steps)
+        k = len(self._objects)
+        self._target_port = self.DeclareVectorInputPort("target", Target.size)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        self._predicted_paths_port = self.DeclareVectorInputPort(
+            "predicted_paths", max(1, k * (self._prediction_steps + 1) * 3))
+        self._other_paths = [PathDots(f"/task/predictions/{index}", PATH_DOTS,
+                                      OTHER_DOT_RADIUS, OTHER_PATH_COLOUR)
+                             for index in range(k)]
+        self._active_path = PathDots("/task/predictions/selected", PATH_DOTS,
+                                     ACTIVE_DOT_RADIUS, ACTIVE_PATH_COLOUR)
+        self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
+        if self._prediction_steps:
+            self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)
+        self.DeclareInitializationPublishEvent(self._initialise)
+
+    def get_target_input_port(self):
+        return self._target_port
+
+    def get_selected_goal_input_port(self):
+        return self._selected_goal_port
+
+    def get_operator_active_input_port(self):
+        return self._operator_active_port
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def get_predicted_paths_input_port(self):
+        return self._predicted_paths_port
+
+    def _initialise(self, context):
+        self._draw_scene()
+        self._publish(context)
+        if self._prediction_steps:
+            self._publish_paths(context)
+
+    def _draw_scene(self):
+        meshcat = self._meshcat
+        meshcat.Delete("/task")
+        for index, point in enumerate(self._objects):
+            table_height = point[2] - OBJECT_HEIGHT / 2
+            meshcat.SetObject(f"/task/tables/{index}", Box(0.3, 0.3, table_height), TABLE_COLOUR)
+            meshcat.SetTransform(f"/task/tables/{index}",
+                                 RigidTransform([point[0], point[1], table_height / 2]))
+            meshcat.SetObject(f"/task/objects/{index}",
+                              Cylinder(OBJECT_RADIUS, OBJECT_HEIGHT), OBJECT_COLOUR)
+            meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(point))
+        meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
+        meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
+        meshcat.SetObject("/task/operator", Cylinder(0.09, 0.01), OPERATOR_COLOUR)
+        meshcat.SetProperty("/task/operator", "visible", False)
+        if self._prediction_steps:
+            for dots in [*self._other_paths, self._active_path]:
+                dots.draw(meshcat)
+        centre = self._objects.mean(axis=0)
+        # A camera behind and above the robot that sees it and every object.
+        meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
+
+    def _publish(self, context):
+        time = context.get_time()
+        meshcat = self._meshcat
+        target = position_of(Target(self._target_port.Eval(context)))
+        meshcat.SetTransform("/task/target",
+                             RigidTransform(target + [0, 0, TARGET_LIFT]), time)
+        selected = int(self._selected_goal_port.Eval(context)[0])
+        meshcat.SetTransform(
+            "/task/estimated_goal",
+            RigidTransform(self._objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
+        if self._ee_state_port.HasValue(context):
+            position = position_of(EeState(self._ee_state_port.Eval(context)))
+            meshcat.SetTransform("/task/operator", RigidTransform(position), time)
+            if self._operator_active_port.HasValue(context):
+                active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
+                meshcat.SetProperty("/task/operator", "visible", active, time)
+
+    def _publish_paths(self, context):
+        if not self._predicted_paths_port.HasValue(context):
+            return
+        time = context.get_time()
+        paths = self._predicted_paths_port.Eval(context).reshape(
+            len(self._objects), self._prediction_steps + 1, 3)
+        for dots, path in zip(self._other_paths, paths):
+            dots.show(self._meshcat, path, time)
+        selected = int(self._selected_goal_port.Eval(context)[0])
+        self._active_path.show(self._meshcat, paths[selected], time)

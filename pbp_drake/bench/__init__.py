@@ -1,6 +1,6 @@
 """`pbp-drake bench`: how fast the DMP bank steps, beside the libraries people use today.
 
-Measured in one run on this machine (issue 6):
+Measured in one run, on the machine it runs on:
 
 - this machine's memory bandwidth (a NumPy copy and sum of a large array, and a sum of a
   cache-sized one), the bound it puts on streaming distinct weights;

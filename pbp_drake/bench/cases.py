@@ -27,7 +27,7 @@ BASIS = 50
 DT = 0.001  # a 1 kHz control loop
 # The LeafSystem checks time a whole movement and as long again after it: the phase goes
 # from 1 to 0.01 at tau, then to 1e-4. A step's cost moves with the phase (how many weight
-# rows matter), so the first moments alone could hide a slow stretch.
+# rows matter), so the first moments alone could hide a slow phase of the machine.
 MOTION_DURATIONS = 2.0
 
 

@@ -74,7 +74,7 @@ def closed_loop_runs(goal_counts, simulated_seconds, dynamic_goals=None, meshcat
                      progress=print):
     """The bench's closed-loop runs, each K's as one result: headless on the shipped
     robot, and on the dynamic robot at K = `dynamic_goals`, each the median of
-    `HSR_REPEATS` runs taken in rounds over all of them (so that a slow stretch of this
+    `HSR_REPEATS` runs taken in rounds over all of them (so that a slowdown of a
     shared machine, which lasts seconds, spreads over every K rather than falling on one
     K's runs; every run's factor is kept in `realtime_factors`); then, with `meshcat`,
     one run each with Meshcat publishing. In K order, headless first."""

@@ -1,4 +1,4 @@
-"""The grasping task's diagram (issue 17, docs/grasp_task.md): six-DoF PBP on the pose
+"""The grasping task's diagram (docs/tasks/grasp.md): six-DoF PBP on the pose
 station, the hand driven to a grasp pose (position and orientation).
 
     hsr_station.hand_pose ──> hand_pose_sample (SampleHold) ──> goal_estimator, dmp_bank,
@@ -51,7 +51,7 @@ from pbp_drake.systems.operators.pose_keyboard_operator import (
     PoseKeyboardOperator, PoseKeyboardParams)
 from pbp_drake.systems.ports import OperatorTwist
 
-# Issue 17: the commanded angular velocity changes by at most this much (rad/s) between two
+# The commanded angular velocity changes by at most this much (rad/s) between two
 # ticks, so a goal switch or the operator pressing never jerks the wrist.
 ANGULAR_CHANGE_PER_TICK = 0.3
 # The hand's angular speed cap (rad/s): above the participant's 0.8 rad/s with its speed
@@ -74,7 +74,7 @@ def check_grasp_buildable(scenario):
 
 def hand_over_limits(scenario):
     """The hand-over's `HandOverLimits`: the reach task's linear limits, and the angular
-    ones of issue 17."""
+    one of the grasp task (`ANGULAR_CHANGE_PER_TICK`)."""
     robot = scenario.robot
     return HandOverLimits(robot.max_hand_acceleration, robot.max_hand_speed,
                           ANGULAR_CHANGE_PER_TICK / scenario.control_period,

@@ -1,4 +1,4 @@
-"""The grasping task (issue 17): the reach task's scene with a grasp pose per object, in
+"""The grasping task: the reach task's scene with a grasp pose per object, in
 pure NumPy.
 
 Scene. 2 to 4 upright cylinders (`object_radius`, `object_height`), each standing at the

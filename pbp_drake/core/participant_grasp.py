@@ -46,7 +46,7 @@ GRASP_PARTICIPANT_MODES = ("assist", "drive")
 NO_TARGET = -1
 
 
-# The reach participant's calibrated defaults (issue 14), the one home of those this one
+# The reach participant's calibrated defaults, the one home of those this one
 # shares.
 _REACH_DEFAULTS = VirtualParticipantParams()
 # Each field shared with `VirtualParticipantParams`, by its name there.
@@ -61,7 +61,7 @@ SHARED_WITH_REACH = {
 class GraspParticipantParams:
     """How the grasping task's virtual participant behaves (module docstring). Every field
     is one it shares with the reach participant (`SHARED_WITH_REACH`) and takes its
-    calibrated default from `VirtualParticipantParams` (issue 14);
+    calibrated default from `VirtualParticipantParams`;
     `from_virtual_participant` takes them from a scenario's
     `operator: !VirtualParticipant {...}`."""
 

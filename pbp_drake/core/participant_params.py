@@ -11,7 +11,7 @@ class VirtualParticipantParams:
     """How the virtual participant behaves (see the `VirtualOperator` system). `speed` (m/s) 0 takes
     the task's nominal speed, that of its DMPs. Its noise comes from the scenario's seed.
 
-    The defaults are the reach task's calibration (issue 14): teleop only, on the tuning
+    The defaults are the reach task's calibration: teleop only, on the tuning
     seeds, to the paper's users' teleop intervention ratio (0.92 to 0.95).
     """
 

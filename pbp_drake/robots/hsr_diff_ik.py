@@ -25,8 +25,8 @@ ROTATION_WEIGHT = 0.1
 # further than the twist itself is solved again with its part along the twist weighing this
 # many times the rest, and then, if the palm still moves further along the linear twist
 # than it (turning less to move more), with that too: the hand does not run ahead of the
-# command where the limits bind (issue 17: it sped up to 0.26 m/s while the command slowed
-# to 0.15).
+# command where the limits bind (without it the palm sped up to 0.26 m/s while the command
+# slowed to 0.15).
 OVERSHOOT_WEIGHT = 10.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.

@@ -198,7 +198,7 @@ class DynamicObstacles:
 
 @dataclasses.dataclass
 class GraspTask:
-    """The grasping task (issue 17, `pbp_drake.core.grasp_task`): upright cylinders drawn
+    """The grasping task (`pbp_drake.core.grasp_task`): upright cylinders drawn
     from the seed, each on its own table in the reach task's rectangle, each with a grasp
     pose of the hand, from the side at a yaw or from above with a wrist roll; the target
     switches as in the reach task; success is the hand within `success_distance` of the

@@ -91,8 +91,8 @@ def parse_answers(text, methods):
             raise QuestionnaireError(f"--answers: unknown question {question!r}; the "
                                      f"questions: {', '.join(QUESTIONS)}")
         if colon and method not in methods:
-            raise QuestionnaireError(f"--answers: {method!r} is not a method of this "
-                                     f"session ({', '.join(methods)})")
+            raise QuestionnaireError(f"--answers: {method!r} is not one of the "
+                                     f"participant's methods ({', '.join(methods)})")
         try:
             value = int(raw.strip())
         except ValueError:

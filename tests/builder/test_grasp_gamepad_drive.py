@@ -1,4 +1,4 @@
-"""Acceptance (issue 17): an injected-message test drives the 6-axis gamepad path through a
+"""An injected-message test drives the 6-axis gamepad path through a
 whole grasp. A page on Meshcat's websocket (`foreign_page.ForeignPage`, the one page
 connected) sends the gamepad states a browser sends; a small driver reads the hand's pose
 and the target from the diagram each tick and pushes the sticks, triggers and shoulders

@@ -1,4 +1,4 @@
-"""The grasping task drawn in Meshcat by its own diagram (issue 17): a recording of a PBP-Alt
+"""The grasping task drawn in Meshcat by its own diagram: a recording of a PBP-Alt
 run with the virtual participant shows the selected DMP's predicted path ending at the
 estimated goal's grasp pose and starting at the hand, and the hand's triad where the hand
 is; without Meshcat nothing is predicted at all."""

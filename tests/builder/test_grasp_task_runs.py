@@ -1,4 +1,4 @@
-"""The grasping task end to end (issue 17): its diagram builds for every method, the virtual
+"""The grasping task end to end: its diagram builds for every method, the virtual
 participant grasps the target by teleoperation and with PBP-Alt (with less intervention),
 and the commanded angular velocity never jumps by more than 0.3 rad/s in a tick."""
 
@@ -41,7 +41,7 @@ def test_teleop_and_pbp_alternated_grasp_the_target_pbp_with_less_intervention(g
         assert distance <= 0.03 + grasp.scenario.robot.max_hand_speed * period
         assert result.angles_to_target[-1] <= 10.0 + np.degrees(MAX_HAND_ANGULAR_SPEED
                                                                  * period)
-        # The wrist did turn, and never faster than issue 17 allows from tick to tick.
+        # The wrist did turn, and never faster than the hand-over allows from tick to tick.
         commanded = result.command_angular_velocities
         steps = np.linalg.norm(np.diff(commanded, axis=0), axis=1)
         assert np.abs(commanded).max() > 0.1
@@ -51,7 +51,7 @@ def test_teleop_and_pbp_alternated_grasp_the_target_pbp_with_less_intervention(g
 
 @pytest.mark.slow
 def test_the_palm_does_not_run_ahead_of_a_slowing_command(repo):
-    """Issue 17's smooth motion: the hand within about 0.22 m/s. In this trial the operator
+    """Smooth motion: the hand within about 0.22 m/s. In this trial the operator
     presses (PBP-Alt) as the wrist starts turning; the command slows from 0.2 to 0.15 m/s
     and the diff IK, held by the base's acceleration limits, let the palm run ahead along
     the twist at up to twice its speed: 0.256 m/s measured between two ticks (0.202 after)."""

@@ -1,4 +1,4 @@
-"""The operator's console (issue 15): what the page and the terminal say about a run, and
+"""The operator's console: what the page and the terminal say about a run, and
 the controls a person uses, against a real Meshcat (clicks and slider moves injected as the
 page sends them)."""
 

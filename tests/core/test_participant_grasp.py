@@ -194,7 +194,7 @@ def test_it_takes_the_shared_fields_of_the_reach_participant():
 
 
 def test_its_shared_defaults_are_the_reach_participants():
-    # One home per default: VirtualParticipantParams' calibration (issue 14).
+    # One home per default: VirtualParticipantParams' calibration.
     grasp, reach = GraspParticipantParams(), VirtualParticipantParams()
     assert set(SHARED_WITH_REACH) == {field.name for field in dataclasses.fields(grasp)}
     for name, reach_name in SHARED_WITH_REACH.items():

@@ -1,4 +1,4 @@
-"""The operator's console in a real browser (issue 15): `pbp-drake run` an HSR keyboard
+"""The operator's console in a real browser: `pbp-drake run` an HSR keyboard
 task from a terminal (a pseudo-terminal here), open its page in headless Chromium, read the
 live status (the method, the time left, then the result) and the Stop, Restart and Next
 scene buttons in the page's controls; Next scene runs the next seed, and Stop ends it and

@@ -1,4 +1,4 @@
-"""The command line around a run (issue 15): `--version`, `--no-meshcat` (no server, no
+"""The command line around a run: `--version`, `--no-meshcat` (no server, no
 URL), the progress line, and a closed pipe (`pbp-drake report DIR | head -1`) or Ctrl-C that
 end the command quietly."""
 

@@ -1,7 +1,7 @@
 """A whole HSR run at real time with a person at the keyboard: a page with a foreign origin
 connects mid-run and presses ← for a second. The robot does not move, the run says why, and
-it takes the pause in its stride (no rush to catch up afterwards). Issue 13's acceptance
-test of exclusive control."""
+it takes the pause in its stride (no rush to catch up afterwards). The
+acceptance test of exclusive control."""
 
 import dataclasses
 import threading

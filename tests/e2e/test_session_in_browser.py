@@ -1,5 +1,5 @@
 """A keyboard participant's whole session through `pbp-drake run ... --participant`, in
-headless Chromium (issue 15's acceptance): the three methods started from the page's Start
+headless Chromium: the three methods started from the page's Start
 buttons and driven with the arrow keys, the questionnaire answered with clicks, Next clicked;
 while each method runs the page shows the live status (the method's name, the time left,
 then the result) and the Stop, Restart and Next scene buttons. The session then holds every

@@ -1,5 +1,5 @@
 """Broken scenario files end in `pbp-drake: FILE: ...` and exit 2 while loading, never in a
-traceback, and at once (issue 13)."""
+traceback, and at once."""
 
 import itertools
 import math
@@ -108,7 +108,7 @@ ALL = ("hsr_reach.yaml", "hsr_obstacles.yaml", "toy_alpha_study.yaml", "toy_alt_
 HSR = ALL[:2]
 TWO = ("hsr_reach.yaml", "toy_alpha_study.yaml")
 S, R, T = ("scenario",), ("scenario", "robot"), ("scenario", "task")
-# (file names, change, words stderr must contain): issue 13's kinds of broken file, each
+# (file names, change, words stderr must contain): the kinds of broken file, each
 # on the files it applies to...
 NAMED = [
     (TWO, _replace("\nscenario:", "\nscenario: [\n"), ["line"]),
@@ -171,7 +171,7 @@ BROKEN += GENERATED[::len(GENERATED) // (100 - len(BROKEN))][:100 - len(BROKEN)]
 
 
 def test_a_hundred_broken_files_exit_2_naming_the_field(tmp_path, run_refused):
-    """Issue 13's acceptance test: each exits 2 within 10 s, with `pbp-drake: PATH: ` and
+    """Each exits 2 within 10 s, with `pbp-drake: PATH: ` and
     the field (or the line) named, and no traceback."""
     assert len(BROKEN) == 100
     for index, (file, change, words) in enumerate(BROKEN):

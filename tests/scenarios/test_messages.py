@@ -1,4 +1,4 @@
-"""Messages that named the wrong thing (issue 13, item 9), through `pbp-drake run`: each
+"""Messages that once named the wrong thing, through `pbp-drake run`: each
 names the field and says what is wrong and what is expected."""
 
 import pathlib

@@ -1,4 +1,4 @@
-"""Random damage to every shipped scenario (issue 13): a value replaced by junk (text, NaN,
+"""Random damage to every shipped scenario: a value replaced by junk (text, NaN,
 infinities, huge, tiny, zero or negative numbers, lists of the wrong length or depth, null,
 booleans, a mapping), a key deleted or an unknown key added. Either the file loads and a
 one-second run of it stays finite, or it is refused with a ScenarioError that names a

@@ -1,4 +1,4 @@
-"""Collisions are reported only where the task measures them (issue 15): a reach study's
+"""Collisions are reported only where the task measures them: a reach study's
 results and printed table have no collision columns and no Fig. 7c, an obstacle study's
 have both, and the obstacle task's one-line result gives its collision ratio.
 

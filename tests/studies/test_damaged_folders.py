@@ -1,4 +1,4 @@
-"""Damaged study folders (issue 13): `pbp-drake report` names every damaged or foreign file
+"""Damaged study folders: `pbp-drake report` names every damaged or foreign file
 and reports the rest; a 2-D study and a method comparison refuse each other's folders."""
 
 import json

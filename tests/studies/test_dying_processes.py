@@ -1,4 +1,4 @@
-"""A study's processes die with it (issue 13): SIGKILL of the study leaves no worker, fork
+"""A study's processes die with it: SIGKILL of the study leaves no worker, fork
 server or resource tracker behind, and the same command then resumes the study. A study
 whose trials fail with an error exits non-zero."""
 

@@ -56,7 +56,7 @@ def test_fixed_answers_hold_for_every_method_unless_a_method_overrides_them():
     ("tiredness=3", "no ease for pbp_alternated"),
     ("tiredness=3,ease=four", "'four' is not a whole number"),
     ("tired=3,ease=4", "unknown question 'tired'"),
-    ("fixed_alpha:tiredness=3,ease=4", "'fixed_alpha' is not a method of this session"),
+    ("fixed_alpha:tiredness=3,ease=4", "'fixed_alpha' is not one of the participant's methods"),
 ])
 def test_bad_fixed_answers_are_named(text, message):
     with pytest.raises(QuestionnaireError, match=message.replace("(", r"\(").replace(")", r"\)")):

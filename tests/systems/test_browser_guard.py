@@ -1,5 +1,5 @@
 """Exclusive control: a second page connected to Meshcat pauses a person's operator, and
-nothing it sends moves the robot (issue 13). The second page is a raw websocket with a
+nothing it sends moves the robot. The second page is a raw websocket with a
 foreign Origin (`foreign_page.ForeignPage`), driven from a thread of its own; Meshcat is
 used only from the test's thread."""
 

@@ -1,7 +1,7 @@
 """Six-DoF PBP in a closed loop: the pose bank, the blender and the hand-over drive a hand
 that follows its command. A goal switch and the operator's presses and releases keep the
 commanded orientation continuous and change the commanded angular velocity by at most
-0.3 rad/s per tick (issue 17); the blender's modes as a user sees them."""
+0.3 rad/s per tick; the blender's modes as a user sees them."""
 
 import numpy as np
 import pytest

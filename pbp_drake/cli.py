@@ -7,9 +7,11 @@ import os
 import sys
 
 from pbp_drake import __version__
+from pbp_drake.bench.main import build_parser as build_bench_parser
 from pbp_drake.bench.main import main as bench_main
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.study import add_study_commands
+from pbp_drake.draw import build_parser as build_draw_parser
 from pbp_drake.draw import main as draw_main
 from pbp_drake.scenarios import ScenarioError
 
@@ -34,7 +36,9 @@ def main(argv=None):
         return 130
 
 
-def _main(argv):
+def build_parser():
+    """The argument parser of `pbp-drake`. `bench` and `draw` appear in it as stubs that
+    take the rest of the line: their own parsers are `tool_parsers()`."""
     parser = argparse.ArgumentParser(
         prog="pbp-drake",
         description="Policy Blending with Primitives (PBP): shared control on Drake.")
@@ -51,7 +55,16 @@ def _main(argv):
                                      "(pbp-drake draw --help)")]:
         tool = commands.add_parser(name, help=help_text, add_help=False)
         tool.add_argument("arguments", nargs=argparse.REMAINDER)
+    return parser
 
+
+def tool_parsers():
+    """The parsers of the subcommands that parse their own line: {"bench": ..., "draw": ...}."""
+    return {"bench": build_bench_parser(), "draw": build_draw_parser()}
+
+
+def _main(argv):
+    parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
     tools = {"bench": bench_main, "draw": draw_main}
     if argv and argv[0] in tools:

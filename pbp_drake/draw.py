@@ -85,7 +85,8 @@ def default_output(scenario_path):
     return pathlib.Path(scenario_path).with_suffix(".svg")
 
 
-def main(argv=None):
+def build_parser():
+    """The argument parser of `pbp-drake draw` (the CLI reference is generated from it)."""
     parser = argparse.ArgumentParser(
         prog="pbp-drake draw",
         description="Write each scenario's system diagram as SVG (needs graphviz's `dot`).")
@@ -102,6 +103,11 @@ def main(argv=None):
                         "level; 0: all)")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 if a drawing on disk is out of date")
+    return parser
+
+
+def main(argv=None):
+    parser = build_parser()
     args = parser.parse_args(argv)
     if args.output and len(args.scenarios) > 1:
         parser.error("--output takes one scenario")

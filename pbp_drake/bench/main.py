@@ -28,7 +28,8 @@ DS = (2, 3, 6)
 POSE_MAX_GOALS = 10000
 
 
-def _parse(argv):
+def build_parser():
+    """The argument parser of `pbp-drake bench` (the CLI reference is generated from it)."""
     parser = argparse.ArgumentParser(prog="pbp-drake bench",
                                      description=pbp_drake.bench.__doc__.split("\n")[0])
     parser.add_argument("--output", default="outputs/bench", help="folder for bench.json "
@@ -54,7 +55,11 @@ def _parse(argv):
                         "(0: the library's default, measured in this process)")
     parser.add_argument("--min-time", type=float, default=None,
                         help="seconds of repeats per measurement (default 0.3; --quick 0.08)")
-    return parser.parse_args(argv)
+    return parser
+
+
+def _parse(argv):
+    return build_parser().parse_args(argv)
 
 
 def plan(args):

@@ -86,7 +86,7 @@ def grasp_dmp_banks(resolved, start_pose):
     `[p, q]` to the K grasp poses, one duration (the farthest grasp at the nominal speed),
     so that they share one phase."""
     scenario = resolved.scenario
-    goals = resolved.layout.grasps.grasp_positions
+    goals = resolved.scene.grasps.grasp_positions
     distance = float(np.max(np.linalg.norm(goals - start_pose[:3], axis=1)))
     duration = (scenario.dmp_duration if scenario.dmp_duration > 0
                 else distance / resolved.nominal_speed)
@@ -100,7 +100,7 @@ def build_grasp_diagram(resolved, meshcat=None):
     check_grasp_buildable(scenario)
     period = scenario.control_period
     task = scenario.task
-    grasps = resolved.layout.grasps
+    grasps = resolved.scene.grasps
     goal_count = len(grasps.grasp_positions)
     builder = DiagramBuilder()
 

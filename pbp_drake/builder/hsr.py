@@ -31,7 +31,7 @@ def build_hsr_diagram(resolved, meshcat=None):
     scenario = resolved.scenario
     period = scenario.control_period
     task = scenario.task
-    layout = resolved.layout
+    scene = resolved.scene
     start = resolved.start
     builder = DiagramBuilder()
 
@@ -44,7 +44,7 @@ def build_hsr_diagram(resolved, meshcat=None):
     sampled = sample.get_output_port()
 
     monitor = builder.AddNamedSystem("task_monitor", TaskMonitor(
-        layout.objects, layout.targets, layout.switch_schedule, start, task.success_distance,
+        scene.objects, scene.targets, scene.switch_schedule, start, task.success_distance,
         period))
     builder.Connect(sampled, monitor.get_ee_state_input_port())
 
@@ -55,9 +55,9 @@ def build_hsr_diagram(resolved, meshcat=None):
     builder.Connect(controller.GetOutputPort("ee_command"), station.GetInputPort("ee_command"))
 
     obstacles = None
-    if layout.obstacles is not None:
+    if scene.obstacles is not None:
         obstacles = builder.AddNamedSystem("obstacles", MovingObstacles(
-            layout.obstacles, start, task.obstacle_height, task.obstacle_speed, period))
+            scene.obstacles, start, task.obstacle_height, task.obstacle_speed, period))
         builder.Connect(sampled, obstacles.get_ee_state_input_port())
         builder.Connect(obstacles.get_obstacle_positions_output_port(),
                         station.GetInputPort("obstacle_positions"))
@@ -93,7 +93,7 @@ def build_hsr_diagram(resolved, meshcat=None):
 
     if meshcat is not None:
         visualizer = builder.AddNamedSystem("task_visualizer", ReachSceneVisualizer(
-            meshcat, layout.objects, prediction_steps))
+            meshcat, scene.objects, prediction_steps))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
         builder.Connect(selected_goal, visualizer.get_selected_goal_input_port())
         builder.Connect(operator_active, visualizer.get_operator_active_input_port())

@@ -53,7 +53,7 @@ def make_hsr_operator(resolved, meshcat):
     if isinstance(config, VirtualParticipant):
         obstacles = resolved.station.obstacles
         return VirtualOperator(
-            period, resolved.layout.objects, mode="drive" if allow_forward else "assist",
+            period, resolved.scene.objects, mode="drive" if allow_forward else "assist",
             params=config, nominal_speed=speed, seed=scenario.seed,
             obstacle_count=len(obstacles),
             obstacle_radius=obstacles[0].radius if obstacles else 0.0,

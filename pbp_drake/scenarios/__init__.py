@@ -9,8 +9,8 @@ Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario
 from pbp_drake.scenarios.loading import (
     LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file)
 from pbp_drake.scenarios.resolution import (
-    BLEND_MODE_OF_METHOD, ResolvedScenario, TaskLayout, demonstration_samples,
-    parse_method_label, resolve, task_layout, with_method)
+    BLEND_MODE_OF_METHOD, ResolvedScenario, TaskScene, demonstration_samples,
+    parse_method_label, resolve, task_scene, with_method)
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, OPERATOR_NAMES, TOY_OPERATORS, AlphaStudy, AltVsCont, BentPath,
     DynamicObstacles, Gamepad, GraspTask, Hsr, Keyboard, MethodComparison, MultiGoalReach,
@@ -24,7 +24,7 @@ __all__ = [
     "Keyboard", "LoadedScenarioFile", "MethodComparison", "MultiGoalReach", "NoOperator",
     "Obstacle", "ObstacleRepulsion", "OperatorConfig", "PointRobot", "RecordedPath",
     "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile", "SceneVariant",
-    "ScriptedCommands", "SinusoidalStep", "TaskLayout", "VirtualParticipant", "check_alpha_study",
+    "ScriptedCommands", "SinusoidalStep", "TaskScene", "VirtualParticipant", "check_alpha_study",
     "check_method_comparison", "demonstration_samples", "load_scenario_file",
-    "parse_method_label", "resolve", "task_layout", "with_method",
+    "parse_method_label", "resolve", "task_scene", "with_method",
 ]

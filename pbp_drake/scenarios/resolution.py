@@ -2,7 +2,7 @@
 
 `resolve(scenario)` turns the configs of a scenario file into a `ResolvedScenario`: the
 robot's start, the goals, the demonstration's samples, the fitted DMP bank, the task's
-layout (objects, targets, obstacles, drawn from the seed), the HSR station's config and
+scene (objects, targets, obstacles, drawn from the seed), the HSR station's config and
 the blend mode. Validating is resolving: a value that cannot be used raises a
 `ScenarioError` naming its field, and nothing downstream (the builder, the studies, the
 CLI) derives any of these again.
@@ -22,7 +22,7 @@ from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
-from pbp_drake.scenarios.grasp_layout import grasp_scene
+from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, GraspTask, Hsr,
     ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands, SinusoidalStep,
@@ -44,7 +44,7 @@ BLEND_MODE_OF_METHOD = {
 
 
 @dataclasses.dataclass(frozen=True)
-class TaskLayout:
+class TaskScene:
     """What an HSR task puts in front of the robot: the goals `(K, 3)` (one DMP each; the
     grasp positions in the grasping task), the target sequence and its switch schedule, the
     obstacles (None without) and the grasping task's `GraspScene` (None in the others)."""
@@ -66,7 +66,7 @@ class ResolvedScenario:
         goals: (K, D) the goals, one DMP each.
         demonstration: (times (T,), positions (T, D)) or None.
         dmp_bank: the fitted `pbp_drake.core.dmp.DmpBankModel` (read-only by convention).
-        layout: the HSR task's `TaskLayout`, None in 2-D scenes.
+        scene: the HSR task's `TaskScene`, None in 2-D scenes.
         station: the HSR station's config (hand height and command period filled in from
             the task), None in 2-D scenes.
         initial_ee_state: (8,) the HSR hand's state at the start, None in 2-D scenes.
@@ -78,7 +78,7 @@ class ResolvedScenario:
     goals: np.ndarray
     demonstration: typing.Optional[tuple]
     dmp_bank: DmpBankModel
-    layout: typing.Optional[TaskLayout] = None
+    scene: typing.Optional[TaskScene] = None
     station: typing.Any = None
     initial_ee_state: typing.Optional[np.ndarray] = None
     nominal_speed: typing.Optional[float] = None
@@ -90,7 +90,7 @@ class ResolvedScenario:
 
     @property
     def is_hsr(self):
-        return self.layout is not None
+        return self.scene is not None
 
     def with_method(self, label):
         """This scenario run by the method `label` (see `parse_method_label`); what does not
@@ -330,14 +330,14 @@ def _resolve_hsr(scenario):
     else:
         check_reach_task(task)
     try:
-        layout = task_layout(task, scenario.seed)
+        scene = task_scene(task, scenario.seed)
     except ValueError as error:
         raise ScenarioError(f"scenario.task: {error}") from None
     # The hand starts at the task's height, the station ramps between the loop's ticks, and
     # it measures the task's cylinders against the robot.
-    cylinders = [] if layout.obstacles is None else [
+    cylinders = [] if scene.obstacles is None else [
         CylinderObstacle(radius=task.obstacle_radius, height=task.obstacle_height)
-        for _ in layout.obstacles.obstacle_starts]
+        for _ in scene.obstacles.obstacle_starts]
     station = dataclasses.replace(robot.station, ee_height=task.height,
                                   command_period=scenario.control_period, obstacles=cylinders)
     try:
@@ -345,7 +345,7 @@ def _resolve_hsr(scenario):
     except ValueError as error:
         raise ScenarioError(f"scenario.robot.station: {error}") from None
     start = initial_ee_state[:3].copy()
-    goals = np.asarray(layout.objects, float)
+    goals = np.asarray(scene.objects, float)
     nearest = float(np.min(np.linalg.norm(goals - start, axis=1)))
     if task.success_distance >= nearest:
         raise ScenarioError(
@@ -358,7 +358,7 @@ def _resolve_hsr(scenario):
     bank = DmpBankModel.straight(start, len(goals), duration, scenario.dmp)
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=bank,
-        layout=layout, station=station,
+        scene=scene, station=station,
         initial_ee_state=initial_ee_state, nominal_speed=float(robot.speed))
 
 
@@ -392,7 +392,7 @@ def _check_hand_over(scenario):
             f"rad/s, longer than scenario.duration {scenario.duration} s: raise it")
 
 
-def task_layout(task, seed):
+def task_scene(task, seed):
     """The goals, targets and obstacles of an HSR task, drawn from `seed` when asked."""
     if isinstance(task, DynamicObstacles):
         _check_region(task)
@@ -400,14 +400,14 @@ def task_layout(task, seed):
             seed, tuple(task.x_range), tuple(task.y_range), task.height,
             task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
             tuple(task.activation_range))
-        return TaskLayout(objects=obstacles.target[np.newaxis, :], targets=(0,),
+        return TaskScene(objects=obstacles.target[np.newaxis, :], targets=(0,),
                           switch_schedule=(0.0,), obstacles=obstacles)
     if isinstance(task, GraspTask):
         grasps = grasp_scene(task, seed)
-        return TaskLayout(objects=grasps.grasp_positions, targets=grasps.targets,
+        return TaskScene(objects=grasps.grasp_positions, targets=grasps.targets,
                           switch_schedule=tuple(task.switch_schedule), grasps=grasps)
     scene = _reach_scene(task, seed)
-    return TaskLayout(objects=scene.objects, targets=scene.targets,
+    return TaskScene(objects=scene.objects, targets=scene.targets,
                       switch_schedule=tuple(task.switch_schedule))
 
 

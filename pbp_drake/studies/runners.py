@@ -25,8 +25,8 @@ from pbp_drake.builder.run import run_task
 
 
 def _scene_of(resolved):
-    layout = resolved.layout
-    return (np.asarray(layout.objects, float).tolist(), [int(t) for t in layout.targets])
+    scene = resolved.scene
+    return (np.asarray(scene.objects, float).tolist(), [int(t) for t in scene.targets])
 
 
 def run_trial(scenario, method, trial, seed, output, digest, run=None):

@@ -139,7 +139,7 @@ def test_the_gamepad_drives_a_whole_grasp_through_the_page(grasp, meshcat, metho
     resolved = resolve(dataclasses.replace(grasp.scenario, method=method,
                                            operator=Gamepad()))
     diagram = build_diagram(resolved, meshcat)
-    driver = GamepadDriver(meshcat, diagram, resolved.layout.grasps,
+    driver = GamepadDriver(meshcat, diagram, resolved.scene.grasps,
                            resolved.scenario.control_period, assist=method != "teleop")
     try:
         started = time.monotonic()

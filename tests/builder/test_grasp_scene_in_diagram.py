@@ -31,7 +31,7 @@ def test_the_replay_shows_the_selected_dmps_path_to_its_grasp(grasp, meshcat):
     meshcat.PublishRecording()
     tracks = animation_tracks(meshcat.StaticHtml())
     context = simulator.get_context()
-    grasps = grasp.layout.grasps
+    grasps = grasp.scene.grasps
     # The path's last triad, at the last path publish (every 0.1 s): the DMP's rollout over
     # its duration ends at (nearly) its goal, the estimated goal's grasp pose. The estimate
     # may change from tick to tick: the one drawn is that of the tick the publish fell in,

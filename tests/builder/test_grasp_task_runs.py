@@ -32,9 +32,9 @@ def test_teleop_and_pbp_alternated_grasp_the_target_pbp_with_less_intervention(g
     alternated = run_task(grasp.with_method("pbp_alternated"))
     for result in (teleop, alternated):
         assert result.success and result.switches == 2
-        target = grasp.layout.grasps.targets[-1]
+        target = grasp.scene.grasps.targets[-1]
         distance = np.linalg.norm(result.ee_positions[-1]
-                                  - grasp.layout.grasps.grasp_positions[target])
+                                  - grasp.scene.grasps.grasp_positions[target])
         # The last row is the tick before success (3 cm and 10 degrees at the next tick):
         # one tick of motion at the hand-over's top speeds away from them.
         period = grasp.scenario.control_period

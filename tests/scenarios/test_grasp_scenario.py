@@ -30,7 +30,7 @@ def test_the_shipped_file_loads_with_its_defaults(shipped):
 
 def test_resolving_draws_the_seeds_scene_with_the_grasp_positions_as_goals(shipped):
     resolved = shipped.resolved
-    layout = resolved.layout
+    layout = resolved.scene
     expected = sample_grasp_scene(
         0, yaw_range=(-np.pi / 3, np.pi / 3), roll_range=(-np.pi / 2, np.pi / 2))
     np.testing.assert_allclose(layout.grasps.grasp_orientations,
@@ -47,7 +47,7 @@ def test_resolving_draws_the_seeds_scene_with_the_grasp_positions_as_goals(shipp
 
 def test_another_seed_another_scene(shipped):
     other = resolve(dataclasses.replace(shipped.scenario, seed=1))
-    assert not np.array_equal(other.layout.objects[:2], shipped.resolved.layout.objects[:2])
+    assert not np.array_equal(other.scene.objects[:2], shipped.resolved.scene.objects[:2])
 
 
 @pytest.mark.parametrize("config, system", [(Keyboard, "PoseKeyboardOperator"),

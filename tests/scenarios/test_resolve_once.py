@@ -8,7 +8,7 @@ import pytest
 
 import pbp_drake.core.dmp.bank as dmp_bank_module
 import pbp_drake.core.dmp.single as single_dmp_module
-import pbp_drake.scenarios.grasp_layout as grasp_layout_module
+import pbp_drake.scenarios.grasp_scene as grasp_scene_module
 import pbp_drake.scenarios.resolution as resolve_module
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import BentPath, load_scenario_file
@@ -19,7 +19,7 @@ SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.ya
 COUNTED = [(resolve_module, "bent_path"), (dmp_bank_module, "fit_weights"),
            (single_dmp_module, "fit_weights"),
            (resolve_module, "sample_reach_scene"), (resolve_module, "sample_obstacle_scene"),
-           (grasp_layout_module, "sample_grasp_scene")]
+           (grasp_scene_module, "sample_grasp_scene")]
 
 
 @pytest.fixture

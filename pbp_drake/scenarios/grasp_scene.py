@@ -1,6 +1,6 @@
 """The grasping task's scene from its config (`GraspTask`): the schema's degrees turned into
 the core's radians, the region checked, the scene drawn from the seed
-(`pbp_drake.core.grasp_task`). `resolution.task_layout` makes it a `TaskLayout`."""
+(`pbp_drake.core.grasp_task`). `resolution.task_scene` makes it a `TaskScene`."""
 
 import numpy as np
 

@@ -25,6 +25,7 @@ API_GROUPS = {
         "Dmp": "pbp_drake.core.dmp",
         "DmpBankModel": "pbp_drake.core.dmp",
         "DmpSettings": "pbp_drake.core.dmp",
+        "minimum_jerk": "pbp_drake.core.dmp",
         "OrientationDmp": "pbp_drake.core.dmp",
         "OrientationDmpBank": "pbp_drake.core.dmp",
         "GoalEstimatorSettings": "pbp_drake.core.goal_estimation",

@@ -1,6 +1,10 @@
-"""The documentation's links lead somewhere: every relative link of the README, of
-`docs/` and of the tutorials' Markdown names a file of the repository, and none leaves it
-(a reader of the checkout, or of the published repository, has nothing outside it)."""
+"""The documentation's links lead somewhere and its pages speak of the product.
+
+Every relative link of the README, of the site's pages (`docs/**/*.md`, the build and the
+generated results tables aside) and of the tutorials' Markdown names a file of the
+repository, and none leaves it (a reader of the checkout, or of the published repository,
+has nothing outside it). The README stays short, and no file of the product tells the story
+of its development (tracker numbers, what happened on which day)."""
 
 import json
 import pathlib
@@ -11,8 +15,18 @@ import pytest
 REPO = pathlib.Path(__file__).resolve().parents[1]
 # [text](target) and ![alt](target); the target ends at whitespace or the closing bracket.
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
-PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+
+
+def _site_pages():
+    for path in sorted((REPO / "docs").rglob("*.md")):
+        parts = path.relative_to(REPO / "docs").parts
+        if "_build" not in parts and "generated" not in parts:
+            yield path
+
+
+PAGES = [REPO / "README.md", *_site_pages()]
 NOTEBOOKS = sorted((REPO / "tutorials").glob("*.ipynb"))
+README_MAX_LINES = 250
 
 
 def _markdown(path):
@@ -30,10 +44,12 @@ def _relative_links(text):
 
 
 def test_the_design_and_dmp_pages_are_there():
-    assert {path.name for path in PAGES} >= {"README.md", "design.md", "dmp.md"}
+    names = {str(path.relative_to(REPO)) for path in PAGES}
+    assert names >= {"README.md", "docs/index.md", "docs/design.md", "docs/concepts/dmp.md",
+                     "docs/getting-started.md"}
 
 
-@pytest.mark.parametrize("path", PAGES + NOTEBOOKS, ids=lambda path: path.name)
+@pytest.mark.parametrize("path", PAGES + NOTEBOOKS, ids=lambda path: str(path.relative_to(REPO)))
 def test_every_relative_link_names_a_file_of_the_repository(path):
     for target in _relative_links(_markdown(path)):
         resolved = (path.parent / target).resolve()
@@ -42,7 +58,37 @@ def test_every_relative_link_names_a_file_of_the_repository(path):
 
 
 def test_the_readme_and_the_dmp_tutorial_point_to_the_pages():
-    assert "docs/dmp.md" in _relative_links((REPO / "README.md").read_text())
-    assert "docs/design.md" in _relative_links((REPO / "README.md").read_text())
+    readme = set(_relative_links((REPO / "README.md").read_text()))
+    assert {"docs/concepts/dmp.md", "docs/design.md", "docs/getting-started.md"} <= readme
     tutorial = _markdown(REPO / "tutorials" / "01_dmp_basics.ipynb")
-    assert "../docs/dmp.md" in _relative_links(tutorial)
+    assert "../docs/concepts/dmp.md" in _relative_links(tutorial)
+
+
+def test_the_readme_is_short():
+    lines = (REPO / "README.md").read_text().splitlines()
+    assert len(lines) <= README_MAX_LINES, f"README.md has {len(lines)} lines"
+
+
+# Phrases of a lab notebook, not of a product; built from pieces so that this file does not
+# match them itself.
+NOTEBOOK_PHRASES = re.compile("|".join([
+    "iss" + r"ue [0-9]", "this " + "session", "earlier " + "today", "slow " + "stretch"]),
+    re.IGNORECASE)
+
+
+def _product_files():
+    yield from (REPO / name for name in ("README.md", "CHANGELOG.md", "Makefile"))
+    yield from (path for path in sorted((REPO / "docs").rglob("*.md"))
+                if "_build" not in path.relative_to(REPO / "docs").parts)
+    yield from NOTEBOOKS
+    yield from sorted((REPO / "pbp_drake").rglob("*.py"))
+    yield from sorted((REPO / "diagrams").glob("*.yaml"))
+    yield from sorted((REPO / "tests").rglob("*.py"))
+
+
+@pytest.mark.parametrize("path", [path for path in _product_files() if path.exists()],
+                         ids=lambda path: str(path.relative_to(REPO)))
+def test_no_file_of_the_product_reads_as_a_lab_notebook(path):
+    for number, line in enumerate(path.read_text().splitlines(), start=1):
+        found = NOTEBOOK_PHRASES.search(line)
+        assert not found, f"{path.relative_to(REPO)}:{number}: {found.group(0)!r}"

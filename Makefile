@@ -5,7 +5,7 @@ PYTHON := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 DEMO_DIR := outputs/demo
 
-.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench soak clean
+.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench soak results clean
 
 $(STAMP): pyproject.toml
 	test -x $(PYTHON) || python3 -m venv $(VENV)
@@ -82,6 +82,13 @@ bench: $(VENV)/.installed-bench
 # minutes of wall time on an idle 2-core machine, 25 on a shared one).
 soak: $(STAMP)
 	$(PYTHON) -m pbp_drake.soak --minutes 60
+
+# Every study the docs quote (the list: pbp_drake/studies/results_catalogue.py), each with
+# --jobs 2 into outputs/results/NAME, and its table into docs/results/generated/NAME.md
+# (`pbp-drake report DIR --markdown FILE`, whose first line is the command that made it).
+# About 15 minutes on an idle 2-core machine; run again after an interruption, it resumes.
+results: $(STAMP)
+	$(PYTHON) -m pbp_drake.studies.results_catalogue
 
 clean:
 	rm -rf $(VENV) outputs build *.egg-info

@@ -18,6 +18,10 @@ from pbp_drake.studies.participant_report import is_participant_collection, part
 from pbp_drake.studies.questionnaire_figure import FIG8
 from pbp_drake.studies.progress import ProgressBar
 from pbp_drake.studies.report import figure_names, report, results_table
+from pbp_drake.studies.folders import TOY_STUDIES, folder_kind
+from pbp_drake.studies.results_markdown import (
+    check_markdown_path, method_comparison_markdown, read_study_json, toy_markdown,
+    write_markdown, write_toy_study)
 from pbp_drake.studies.splits import SPLITS, first_seed, split_of
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
 
@@ -58,6 +62,11 @@ def add_study_commands(commands):
                         "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
                         "Wilcoxon tests and Fig. 8 in DIR/results.md and "
                         f"DIR/{FIG8}")
+    report.add_argument("--markdown", metavar="FILE",
+                        help="also write the study's results table as a Markdown fragment "
+                        "to FILE (its folder is created), after a line naming the command "
+                        "and seeds that made the study; for a 2-D study folder, a table of "
+                        "its summary.json and the figure's path (not for a user study)")
     compare = commands.add_parser(
         "compare", help="compare two studies of the same seeds trial by trial (e.g. before "
         "and after changing a setting): per method and metric, the paired difference and "
@@ -81,6 +90,7 @@ def _study(args):
     output = pathlib.Path(args.output)
     started = time.monotonic()
     summary = run_study(scenario_file, output)
+    write_toy_study(output, summary["study"], summary["scenario"], args.scenario)
     print(f"Study {summary['study']} done in {time.monotonic() - started:.1f} s.")
     if summary["study"] == "alpha_study":
         print_alpha_study(summary)
@@ -135,7 +145,10 @@ def _method_study(args, scenario_file):
         summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
                                         seed, output, progress, jobs=args.jobs, split=split,
                                         retry_errors=args.retry_errors,
-                                        backend=args.backend, ray_address=args.ray_address)
+                                        backend=args.backend, ray_address=args.ray_address,
+                                        scenario_file=args.scenario,
+                                        split_seeds={split_name: first_seed(study, split_name)
+                                                     for split_name in SPLITS})
     except KeyboardInterrupt:
         print(f"\nInterrupted: the finished trials are in {output / 'trials'}; the same "
               "command resumes the study.", file=sys.stderr)
@@ -191,8 +204,19 @@ def _report(args):
     damaged or foreign files were skipped (what could be read is still reported and
     written); 2 (ScenarioError) when there is nothing to report. A folder that is not a
     study but holds participant folders gets the user study's report (exit 1 when damaged
-    files were skipped; 2 for a participant of another scenario or a bad answer)."""
+    files were skipped; 2 for a participant of another scenario or a bad answer).
+    `--markdown FILE` also writes the table for the docs (`studies.results_markdown`); it
+    takes a 2-D study's folder too (exit 0), not a user study's, nor a folder as FILE (2)."""
     output = pathlib.Path(args.output)
+    if args.markdown is not None:
+        check_markdown_path(args.markdown)
+        if folder_kind(output) in TOY_STUDIES:
+            write_markdown(args.markdown, toy_markdown(output))
+            print(f"  wrote {args.markdown}")
+            return 0
+        if is_participant_collection(output):
+            raise ScenarioError(f"--markdown: {output} is a user study's folder; --markdown "
+                                "takes a `pbp-drake study` folder")
     if is_participant_collection(output):
         text, damaged = participant_report(output)
         print(text, end="")
@@ -204,6 +228,10 @@ def _report(args):
         return 1 if damaged else 0
     summary = report(output)
     _print_report(summary, output)
+    if args.markdown is not None:
+        write_markdown(args.markdown,
+                       method_comparison_markdown(read_study_json(output), summary))
+        print(f"  wrote {args.markdown}")
     failed = _failed_trials(summary, output)
     if summary["damaged"]:
         print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "

@@ -22,12 +22,13 @@ BACKENDS = ("local", "ray")
 
 def run_method_comparison(scenario, methods, trials, seed, output, progress=None, jobs=1,
                           run=None, retry_errors=False, backend="local", ray_address=None,
-                          split=None):
+                          split=None, scenario_file=None, split_seeds=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     processes, writes every trial under `output/trials/`, then the summary, tables and
     figures (see `report`). Returns the summary dict. `split` labels the seeds in
     study.json and the results ("tuning", "evaluation", ...: see `studies.splits`); None
-    keeps the label the folder holds for the same seeds.
+    keeps the label the folder holds for the same seeds. `scenario_file` and `split_seeds`
+    go into study.json (see `write_study`; None keeps what the folder holds).
 
     `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
     Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "HEAD:6379", "auto",
@@ -55,6 +56,9 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     if split is None and recorded and (recorded.get("seed"), recorded.get("trials")) == (
             seed, trials) and isinstance(recorded.get("split"), str):
         split = recorded["split"]  # resuming the same seeds keeps their label
+    if recorded:
+        scenario_file = scenario_file or recorded.get("scenario_file")
+        split_seeds = split_seeds or recorded.get("split_seeds")
     keys = [(method, trial) for method in methods for trial in range(trials)]
     for leftover in [*output.glob("trials/*/*.running"), *output.glob("trials/*/.*.tmp")]:
         leftover.unlink(missing_ok=True)  # left by an interrupted study
@@ -78,7 +82,8 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
         if record is None or (retry_errors and record["error"] is not None):
             pending.append((method, trial))
     name_damaged([d._replace(problem=f"{d.problem}; runs again") for d in damaged])
-    write_study(output, scenario, digest, methods, trials, seed, split)
+    write_study(output, scenario, digest, methods, trials, seed, split, scenario_file,
+                split_seeds)
 
     started = time.monotonic()
     done = []

@@ -141,12 +141,20 @@ def write_trial_files(output, record, csv_text):
     write_atomically(json_path, json.dumps(record, indent=1) + "\n")
 
 
-def write_study(output, scenario, digest, methods, trials, seed, split=None):
+def write_study(output, scenario, digest, methods, trials, seed, split=None,
+                scenario_file=None, split_seeds=None):
     """Writes the folder's study.json: which scenario, methods, trials and seeds, and the
-    split the seeds belong to (`studies.splits`; None when not known)."""
+    split the seeds belong to (`studies.splits`; None when not known). `scenario_file` (the
+    path the study was run from) and `split_seeds` ({"tuning": first seed, "evaluation":
+    first seed}) let `report --markdown` name the command that made the study; None when not
+    known. Neither goes into the summary, which is made from the trials."""
     study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
              "split": split, "scenario_content": scenario_content(scenario)}
+    if scenario_file is not None:
+        study["scenario_file"] = str(scenario_file)
+    if split_seeds is not None:
+        study["split_seeds"] = dict(split_seeds)
     write_atomically(output / "study.json", json.dumps(study, indent=2) + "\n")
 
 

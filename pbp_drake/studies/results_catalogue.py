@@ -1,0 +1,100 @@
+"""Every study the docs quote, in one list: `make results` runs them
+(`python -m pbp_drake.studies.results_catalogue`), each into `outputs/results/NAME/` with
+`--jobs 2`, and writes its table with `pbp-drake report DIR --markdown
+docs/results/generated/NAME.md`. The first line of each generated file is the command below
+(read back from the study folder), so a table on the docs site cannot drift from what made it.
+
+A study interrupted part-way resumes from the trials on disk when this runs again.
+"""
+
+import argparse
+import pathlib
+import subprocess
+import sys
+
+REACH = ["diagrams/hsr_reach.yaml", "--methods",
+         "pbp_alternated,pbp_continuous,confidence_alpha,teleop", "--trials", "30"]
+# The obstacle task's methods are its file's (`study:` section); the generated line names them.
+OBSTACLES = ["diagrams/hsr_obstacles.yaml", "--trials", "30"]
+FIXED_ALPHAS = ",".join(f"fixed_alpha=0.{tenth}" for tenth in range(1, 10))
+PBP = "pbp_alternated,pbp_continuous"
+
+#: name -> the arguments of `pbp-drake study` (without --output and --jobs).
+STUDIES = {
+    "toy_alpha_study": ["diagrams/toy_alpha_study.yaml"],
+    "toy_alt_vs_cont": ["diagrams/toy_alt_vs_cont.yaml"],
+    "hsr_reach_evaluation": [*REACH, "--split", "evaluation"],
+    "hsr_reach_tuning": [*REACH, "--split", "tuning"],
+    "hsr_reach_teleop_calibration": ["diagrams/hsr_reach.yaml", "--methods", "teleop",
+                                     "--trials", "30", "--split", "tuning"],
+    "hsr_reach_nearest": ["diagrams/hsr_reach_nearest.yaml", "--methods", PBP,
+                          "--trials", "30", "--split", "evaluation"],
+    "hsr_reach_bayesian": ["diagrams/hsr_reach_bayesian.yaml", "--methods", PBP,
+                           "--trials", "30", "--split", "evaluation"],
+    "hsr_obstacles_evaluation": [*OBSTACLES, "--split", "evaluation"],
+    "hsr_obstacles_tuning": [*OBSTACLES, "--split", "tuning"],
+    "hsr_reach_fixed_alpha": ["diagrams/hsr_reach.yaml", "--methods", FIXED_ALPHAS,
+                              "--trials", "30", "--split", "tuning"],
+    "hsr_obstacles_fixed_alpha": ["diagrams/hsr_obstacles.yaml", "--methods", FIXED_ALPHAS,
+                                  "--trials", "30", "--split", "tuning"],
+    "hsr_grasp_evaluation": ["diagrams/hsr_grasp.yaml", "--methods",
+                             "pbp_alternated,pbp_continuous,teleop", "--trials", "30",
+                             "--split", "evaluation"],
+}
+
+
+def with_trials(arguments, trials):
+    """The arguments with `--trials` set to `trials` (for a quick check; None: unchanged)."""
+    if trials is None or "--trials" not in arguments:
+        return list(arguments)
+    arguments = list(arguments)
+    arguments[arguments.index("--trials") + 1] = str(trials)
+    return arguments
+
+
+def _pbp_drake(*arguments):
+    command = [sys.executable, "-m", "pbp_drake", *arguments]
+    print("+ pbp-drake " + " ".join(arguments), flush=True)
+    return subprocess.run(command).returncode
+
+
+def main(argv=None):
+    """Runs the studies (all, or those named) and writes their Markdown (also for a study
+    whose trials failed: its table counts them); returns 1 when any study or report failed
+    (each is named at the end), else 0."""
+    parser = argparse.ArgumentParser(prog="python -m pbp_drake.studies.results_catalogue",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("names", nargs="*", help=f"studies to run (default: all of "
+                        f"{', '.join(STUDIES)})")
+    parser.add_argument("--outputs", default="outputs/results",
+                        help="the study folders go in OUTPUTS/NAME (default outputs/results)")
+    parser.add_argument("--generated", default="docs/results/generated",
+                        help="the Markdown goes to GENERATED/NAME.md (default "
+                             "docs/results/generated)")
+    parser.add_argument("--jobs", type=int, default=2, help="processes per study (default 2)")
+    parser.add_argument("--trials", type=int,
+                        help="for a quick check only: this many trials per HSR method")
+    args = parser.parse_args(argv)
+    unknown = [name for name in args.names if name not in STUDIES]
+    if unknown:
+        parser.error(f"unknown studies {', '.join(unknown)}; known: {', '.join(STUDIES)}")
+    failed = []
+    for name in args.names or STUDIES:
+        output = pathlib.Path(args.outputs) / name
+        markdown = pathlib.Path(args.generated) / f"{name}.md"
+        studied = _pbp_drake("study", *with_trials(STUDIES[name], args.trials),
+                             "--jobs", str(args.jobs), "--output", str(output))
+        if studied != 0:
+            failed.append(f"{name}: `pbp-drake study` exited with {studied}")
+        if studied not in (0, 1):  # 1: trials failed, and its table counts them
+            continue
+        reported = _pbp_drake("report", str(output), "--markdown", str(markdown))
+        if reported != 0 and studied == 0:
+            failed.append(f"{name}: `pbp-drake report` exited with {reported}")
+    for line in failed:
+        print(f"results: {line}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

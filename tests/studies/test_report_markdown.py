@@ -1,0 +1,63 @@
+"""`pbp-drake report DIR --markdown FILE`: the study's table as a Markdown fragment for the
+docs, after the command and seeds that made it, read off the study folder."""
+
+import pytest
+
+from pbp_drake.cli import main
+from pbp_drake.studies.results_markdown import study_command
+
+
+@pytest.fixture(scope="module")
+def hsr_study(tmp_path_factory):
+    """One HSR reaching trial per method on the first evaluation seed."""
+    repo = __import__("pathlib").Path(__file__).resolve().parents[2]
+    output = tmp_path_factory.mktemp("hsr_study")
+    assert main(["study", str(repo / "diagrams/hsr_reach.yaml"), "--methods",
+                 "pbp_alternated,teleop", "--trials", "1", "--split", "evaluation",
+                 "--output", str(output)]) == 0
+    return output
+
+
+def test_the_markdown_names_the_command_and_seeds_then_the_table(hsr_study, tmp_path, capsys):
+    summary = (hsr_study / "summary.json").read_bytes()
+    markdown = tmp_path / "new" / "folder" / "hsr_reach.md"
+    assert main(["report", str(hsr_study), "--markdown", str(markdown)]) == 0
+    assert f"wrote {markdown}" in capsys.readouterr().out
+    lines = markdown.read_text().splitlines()
+    assert lines[0].startswith("`pbp-drake study ")
+    assert lines[0].endswith("diagrams/hsr_reach.yaml --methods pbp_alternated,teleop "
+                             "--trials 1 --split evaluation` — evaluation seeds 10,000 to "
+                             "10,000")
+    rows = [line for line in lines if line.startswith("| ")]
+    assert rows[0].startswith("| method | trials | success |")
+    assert [row.split(" | ")[0] for row in rows[1:]] == ["| PBP-Alt", "| Teleop"]
+    # The table is results.md's; the summary is the same bytes as the study wrote.
+    assert markdown.read_text().endswith((hsr_study / "results.md").read_text())
+    assert (hsr_study / "summary.json").read_bytes() == summary
+
+
+def test_a_2d_study_gets_its_summary_as_a_table(tmp_path, repo):
+    output = tmp_path / "alt_vs_cont"
+    assert main(["study", str(repo / "diagrams/toy_alt_vs_cont.yaml"), "--output",
+                 str(output)]) == 0
+    markdown = tmp_path / "alt_vs_cont.md"
+    assert main(["report", str(output), "--markdown", str(markdown)]) == 0
+    text = markdown.read_text()
+    assert text.startswith("`pbp-drake study ") and "toy_alt_vs_cont.yaml`" in text
+    assert "| PBP-Alt |" in text and "| PBP-Cont |" in text
+    assert f"Figure: `{output / 'fig4_alt_vs_cont.png'}`" in text
+
+
+def test_a_folder_is_refused_as_the_markdown_file(tmp_path, capsys):
+    assert main(["report", str(tmp_path), "--markdown", str(tmp_path)]) == 2
+    assert capsys.readouterr().err.startswith(f"pbp-drake: --markdown {tmp_path}: is a folder")
+
+
+def test_without_the_split_seeds_the_command_names_the_first_seed():
+    summary = {"scenario": "hsr_reach", "seed": 10005, "trials": 3, "split": "evaluation",
+               "methods": {"teleop": {}}}
+    assert study_command({"scenario_file": "diagrams/hsr_reach.yaml"}, summary) == (
+        "pbp-drake study diagrams/hsr_reach.yaml --methods teleop --trials 3 --seed 10005")
+    assert study_command({"split_seeds": {"tuning": 0, "evaluation": 10005}}, summary) == (
+        "pbp-drake study <the scenario file of hsr_reach> --methods teleop --trials 3 "
+        "--split evaluation")

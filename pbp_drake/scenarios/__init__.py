@@ -1,5 +1,5 @@
 """Scenario files: the schema (`schema`), reading them (`loading`), the checks of their text,
-shape and numbers (`checks`) and resolving them (`resolution`: everything checked and
+shape and numbers (`validation`) and resolving them (`resolution`: everything checked and
 derived once by `resolve`).
 
 Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario` ->

@@ -17,7 +17,7 @@ from pbp_drake.scenarios.resolution import (
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
     STUDY_SPLITS, ScenarioFile)
-from pbp_drake.scenarios.checks import (
+from pbp_drake.scenarios.validation import (
     check_numbers, check_seed, describe_load_error, read_scenario_text, shape_problem)
 
 

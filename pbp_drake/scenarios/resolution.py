@@ -27,7 +27,7 @@ from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, GraspTask, Hsr,
     ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands, SinusoidalStep,
     VirtualParticipant)
-from pbp_drake.scenarios.checks import (
+from pbp_drake.scenarios.validation import (
     check_bent_path, check_direction, check_dmp_duration, check_grasp_task, check_numbers,
     check_obstacle_task, check_reach_task, check_seed, check_time_steps,
     check_virtual_participant, require_finite)

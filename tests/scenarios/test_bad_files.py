@@ -10,7 +10,7 @@ import pytest
 from pydrake.common.yaml import yaml_dump, yaml_load
 
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
-from pbp_drake.scenarios.checks import check_duplicate_keys
+from pbp_drake.scenarios.validation import check_duplicate_keys
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 SHIPPED = ("hsr_reach.yaml", "toy_alt_vs_cont.yaml")

@@ -92,3 +92,12 @@ def test_no_file_of_the_product_reads_as_a_lab_notebook(path):
     for number, line in enumerate(path.read_text().splitlines(), start=1):
         found = NOTEBOOK_PHRASES.search(line)
         assert not found, f"{path.relative_to(REPO)}:{number}: {found.group(0)!r}"
+
+
+def test_the_readme_quotes_the_generated_results_table():
+    # The headline table is pasted from what `make results` wrote, never typed.
+    readme = (REPO / "README.md").read_text()
+    generated = (REPO / "docs" / "results" / "generated" / "hsr_reach_evaluation.md").read_text()
+    rows = [line for line in readme.split("## Results", 1)[1].splitlines()
+            if line.startswith("| ")]
+    assert len(rows) >= 3 and all(row in generated.splitlines() for row in rows)

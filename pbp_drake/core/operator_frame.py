@@ -6,7 +6,7 @@ The operator frame follows the hand's heading on the floor, as the person sees t
 Translations go along these three axes. Rotations are the hand's yaw about world +z (as the
 4-DoF operators' Q/E), its pitch about `left` (positive tips the approach axis down) and its
 roll about its own approach axis z_H (right-handed, the grasp task's roll rho): a side grasp
-differs by a yaw, a top grasp is a pitch down then a roll (docs/grasp_task.md).
+differs by a yaw, a top grasp is a pitch down then a roll (docs/tasks/grasp.md).
 
 The heading is the floor direction of z_H, blended towards that of x_H as z_H turns
 vertical (by the square of z_H's vertical component), with x_H signed to lean the way the

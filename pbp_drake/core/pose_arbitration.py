@@ -1,5 +1,5 @@
 """Six-DoF blending: the operator's twist and the policy's pose reference become one pose
-reference, and the six-DoF hand-over law (formulas and reasons: docs/six_dof.md).
+reference, and the six-DoF hand-over law (formulas and reasons: docs/concepts/six-dof.md).
 
 A pose reference is the pose to be at after one control period and the twist to move at:
 `PoseReference(position (3,), orientation (4,) unit (w, x, y, z), velocity (3,),

@@ -2,7 +2,7 @@
 the arithmetic the station's diff IK applies itself (`PoseCommandRamp`), and the hand's
 measured pose and twist out (`PoseStateFromPlant`).
 
-The hand frame H is `hand_palm_link` (docs/grasp_task.md): origin at the palm, +z_H the
+The hand frame H is `hand_palm_link` (docs/tasks/grasp.md): origin at the palm, +z_H the
 approach direction, +y_H the direction the fingers close along. Orientations are unit
 quaternions (w, x, y, z) mapping H to the world (`pbp_drake.core.quaternion`); angular
 velocities are world-frame.

@@ -12,7 +12,7 @@ motion, in the shape of manipulation's hardware station::
 ``make_hsr_station(config, meshcat, command="pose")`` is the six-DoF station: the same
 plant and diff IK, commanding the hand frame ``hand_palm_link`` (the grasp task's H) by a
 ``PoseState`` ``pose_command`` (``PoseCommandRamp``), with the measured ``hand_pose``
-(``PoseStateFromPlant``) as an output besides ``ee_state``; see docs/six_dof.md.
+(``PoseStateFromPlant``) as an output besides ``ee_state``; see docs/concepts/six-dof.md.
 
 Gravity is off, which stands for the ideal gravity compensation of the real robot's
 controllers; nothing else compensates it. The base and the arm are solved together by
@@ -202,7 +202,7 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     the twist to move at; a NaN field or a quaternion whose norm is off 1 by more than
     1e-6 is refused by name. ``hand_pose`` is that frame's measured ``PoseState`` (its
     quaternion signed nearer the start orientation). The diff IK is the same QP, tracking
-    the whole pose (see ``PoseCommandRamp`` and docs/six_dof.md).
+    the whole pose (see ``PoseCommandRamp`` and docs/concepts/six-dof.md).
 
     A fresh context starts at rest in the ready pose with the diff IK already there, so
     holding ``hsr_initial_ee_state(station)[:7]`` keeps the robot still.

@@ -47,7 +47,7 @@ def goal_index(port, context, goal_count, unconnected=None):
 
 
 # Six-DoF PBP (`PoseDmpBank`, `PoseBlender`, `PoseHandOver`): orientations are unit
-# quaternions (w, x, y, z), angular velocities world-frame rad/s (see docs/six_dof.md).
+# quaternions (w, x, y, z), angular velocities world-frame rad/s (see docs/concepts/six-dof.md).
 # A hand's measured pose and twist; also the layout of a pose reference or command (the
 # pose to be at after one control period, and the twist to move at).
 PoseState = _view("PoseState", ["x", "y", "z", "qw", "qx", "qy", "qz",

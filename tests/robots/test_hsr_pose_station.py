@@ -23,7 +23,7 @@ from pose_drive import PoseWaypoints, drive, turned
 
 POSITION_TOLERANCE = 0.01  # m, after settling
 ANGLE_TOLERANCE = np.radians(3.0)
-# The grasp task's success bounds (docs/grasp_task.md).
+# The grasp task's success bounds (docs/tasks/grasp.md).
 SUCCESS_DISTANCE, SUCCESS_ANGLE = 0.03, np.radians(10.0)
 
 
@@ -61,7 +61,7 @@ def plant_limits():
 
 def test_the_hand_starts_level_pointing_ahead_with_its_fingers_closing_sideways(start):
     # What a grasp convention must start from: hand_palm_link at the ready pose has its
-    # approach axis z_H along +x, x_H straight up and y_H along -y (docs/six_dof.md).
+    # approach axis z_H along +x, x_H straight up and y_H along -y (docs/concepts/six-dof.md).
     R = RotationMatrix(Quaternion(start[3:7])).matrix()  # columns x_H, y_H, z_H
     np.testing.assert_allclose(R, [[0, 0, 1], [0, -1, 0], [1, 0, 0]], atol=1e-9)
     np.testing.assert_allclose(start[:3], [0.4513, 0.078, 0.7], atol=1e-4)

@@ -49,7 +49,7 @@ class PoseDmpBank(LeafSystem):
 
     Each period every DMP advances one step from the measured pose: the position part as
     `DmpBank`, the orientation part as `OrientationDmpBank` (`e = Log(q g*)`, the same
-    first-order-hold step, see docs/dmp.md). Both parts share one phase, so one lock stops
+    first-order-hold step, see docs/concepts/dmp.md). Both parts share one phase, so one lock stops
     both: with `lock_phase_when_operator_acts` (PBP-Alt) a nonzero `operator_active`
     freezes the phase and the DMPs follow the hand (its pose, and `tau` times its twist)
     until the operator lets go. `followed_goal` (the goal estimator's selection before it

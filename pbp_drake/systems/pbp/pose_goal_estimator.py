@@ -37,7 +37,7 @@ class PoseGoalEstimator(LeafSystem):
     mostly the selected DMP's, and reading it as the operator's intent holds the selection
     on whatever the robot is heading for; and with the operator idle, only the hand's
     distances and angles to the grasps would be left to decide, which the policy's own
-    motion changes (docs/grasp_task.md). Unconnected, the hand's twist from `hand_pose`
+    motion changes (docs/tasks/grasp.md). Unconnected, the hand's twist from `hand_pose`
     is read and the selection follows it at every update. `selected_goal` is `[index]`
     and `goal_probabilities` the K probabilities; both are read from the state, so they
     hold between updates, as `GoalEstimator`'s.

@@ -90,5 +90,13 @@ soak: $(STAMP)
 results: $(STAMP)
 	$(PYTHON) -m pbp_drake.studies.results_catalogue
 
+# The documentation site (Sphinx, MyST, furo) into docs/_build/html; any warning fails.
+$(VENV)/.installed-docs: $(STAMP)
+	$(PYTHON) -m pip install --quiet -e '.[test,docs]'
+	touch $@
+
+docs: $(VENV)/.installed-docs
+	$(PYTHON) -m sphinx -W --keep-going -b html docs docs/_build/html
+
 clean:
-	rm -rf $(VENV) outputs build *.egg-info
+	rm -rf $(VENV) outputs build *.egg-info docs/_build

@@ -140,9 +140,9 @@ class TaskResult:
         collision_ratio: ratio of ticks with the robot in collision (obstacle tasks; 0 in
             tasks without obstacles). in_collision: (T,) bools, or None without obstacles.
         peak_hand_speed: m/s, the largest one-tick hand speed over the run's ticks 0..T-1,
-            max_k |ee(t_{k+1}) - ee(t_k)| / control_period, ee = `ee_positions`.
+            `max_k |ee(t_{k+1}) - ee(t_k)| / control_period`, ee = `ee_positions`.
         peak_command_acceleration: m/s^2, the largest change of the commanded velocity
-            between two ticks over the period, max_k |v(k+1) - v(k)| / control_period,
+            between two ticks over the period, `max_k |v(k+1) - v(k)| / control_period`,
             v = `commands[:, 3:6]`. Both from `SeriesPeaks`; None when unknown (fewer
             than two ticks, or a TaskResult made without them).
         angles_to_target: (T,) degrees from the hand's orientation to the current target's

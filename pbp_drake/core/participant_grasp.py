@@ -65,25 +65,25 @@ class GraspParticipantParams:
     `from_virtual_participant` takes them from a scenario's
     `operator: !VirtualParticipant {...}`."""
 
-    # Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
+    #: Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = _REACH_DEFAULTS.speed
-    # How fast it turns the hand (rad/s).
+    #: How fast it turns the hand (rad/s).
     rotation_speed: float = _REACH_DEFAULTS.rotation_speed
-    # It notices a new target this long (s) after it appears.
+    #: It notices a new target this long (s) after it appears.
     reaction_delay: float = _REACH_DEFAULTS.reaction_delay
-    # Its velocity's direction is rotated by N(0, direction_noise) rad, its twist scaled by
-    # (1 + N(0, speed_noise)).
+    #: Its velocity's direction is rotated by N(0, direction_noise) rad, its twist scaled by
+    #: (1 + N(0, speed_noise)).
     direction_noise: float = _REACH_DEFAULTS.direction_noise
     speed_noise: float = _REACH_DEFAULTS.speed_noise
-    # It slows in proportion within this distance (m) of the grasp position.
+    #: It slows in proportion within this distance (m) of the grasp position.
     slow_radius: float = _REACH_DEFAULTS.slow_radius
-    # It turns in proportion within this angle (rad) of the grasp orientation, so that it
-    # does not overshoot (the reach participant's `turn_slowdown_angle`) ...
+    #: It turns in proportion within this angle (rad) of the grasp orientation, so that it
+    #: does not overshoot (the reach participant's `turn_slowdown_angle`) ...
     slow_angle: float = _REACH_DEFAULTS.turn_slowdown_angle
-    # ... and stops turning within this angle (rad): well inside the task's 10 degrees.
+    #: ... and stops turning within this angle (rad): well inside the task's 10 degrees.
     aligned_angle: float = _REACH_DEFAULTS.aligned_angle
-    # Assisting, once it has held the target's orientation this long (s) and the estimate
-    # still names another object, it goes to the target itself (`insist_twist`).
+    #: Assisting, once it has held the target's orientation this long (s) and the estimate
+    #: still names another object, it goes to the target itself (`insist_twist`).
     insist_time: float = _REACH_DEFAULTS.insist_time
 
     @classmethod

@@ -17,83 +17,83 @@ class VirtualParticipantParams:
 
     speed: float = 0.0
     rotation_speed: float = 0.8
-    # It notices a new target this long (s) after it appears: seeing the ball move,
-    # deciding and reaching for the keys. 0.5 s is the reach calibration (teleop then rests
-    # about as long as the paper's users did); diagrams/hsr_obstacles.yaml keeps 0.3.
+    #: It notices a new target this long (s) after it appears: seeing the ball move,
+    #: deciding and reaching for the keys. 0.5 s is the reach calibration (teleop then rests
+    #: about as long as the paper's users did); diagrams/hsr_obstacles.yaml keeps 0.3.
     reaction_delay: float = 0.5
-    # Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
-    # (1 + N(0, speed_noise)).
+    #: Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
+    #: (1 + N(0, speed_noise)).
     direction_noise: float = 0.1
     speed_noise: float = 0.1
-    # Driving (teleop), it slows within this distance (m) of the target.
+    #: Driving (teleop), it slows within this distance (m) of the target.
     slow_radius: float = 0.15
-    # It counts as facing a point within this angle (rad).
+    #: It counts as facing a point within this angle (rad).
     aligned_angle: float = 0.05
-    # It turns at `rotation_speed` until the heading is this close (rad) to where it wants
-    # it, then in proportion, so that it does not overshoot.
+    #: It turns at `rotation_speed` until the heading is this close (rad) to where it wants
+    #: it, then in proportion, so that it does not overshoot.
     turn_slowdown_angle: float = 0.3
-    # Assisting, it takes the target and the object picked instead to stand in line when
-    # their directions from the hand are closer than this (rad): no sidestep toward the
-    # target separates them then, so it steps aside, at `aside_speed_fraction` of `speed`,
-    # to the side that widens the angle between them.
+    #: Assisting, it takes the target and the object picked instead to stand in line when
+    #: their directions from the hand are closer than this (rad): no sidestep toward the
+    #: target separates them then, so it steps aside, at `aside_speed_fraction` of `speed`,
+    #: to the side that widens the angle between them.
     in_line_angle: float = 0.1
     aside_speed_fraction: float = 0.5
-    # Assisting, once it has faced the target this long (s) and the estimate still names
-    # another object, it goes to the target itself: it turns the target to its side and
-    # sidesteps toward it (the forward key is disabled), until the estimate follows.
+    #: Assisting, once it has faced the target this long (s) and the estimate still names
+    #: another object, it goes to the target itself: it turns the target to its side and
+    #: sidesteps toward it (the forward key is disabled), until the estimate follows.
     insist_time: float = 1.0
-    # Once it takes control among obstacles, it keeps it at least this long (s).
+    #: Once it takes control among obstacles, it keeps it at least this long (s).
     hold_time: float = 0.5
 
     # The fields below act among obstacles (the obstacle task, `VirtualOperator._avoid`);
     # `policy_compensation` in the reaching task too.
 
-    # Within this distance (m) of the target it no longer minds obstacles and goes straight
-    # on (in PBP only when the robot does not close in by itself, `min_closing_fraction`).
+    #: Within this distance (m) of the target it no longer minds obstacles and goes straight
+    #: on (in PBP only when the robot does not close in by itself, `min_closing_fraction`).
     final_approach_radius: float = 0.08
-    # Within this distance (m) of the target it pushes on through when no way round is left.
+    #: Within this distance (m) of the target it pushes on through when no way round is left.
     push_through_radius: float = 0.3
-    # The times ahead (s) at which its local plan checks a motion: 1 to 100 positive times
-    # that increase; the last is the plan's horizon.
+    #: The times ahead (s) at which its local plan checks a motion: 1 to 100 positive times
+    #: that increase; the last is the plan's horizon.
     plan_times: list[float] = dataclasses.field(
         default_factory=lambda: [0.1, 0.3, 0.6, 1.0, 1.5])
-    # How far ahead (s) it guesses where a moving obstacle will stop (on the line from the
-    # hand to the target); it picks the heading to arrive with from that guess.
+    #: How far ahead (s) it guesses where a moving obstacle will stop (on the line from the
+    #: hand to the target); it picks the heading to arrive with from that guess.
     settle_time: float = 4.0
-    # How many directions (a count, 1 to 360) the plan tries, evenly spread round the
-    # circle from the one toward the target; each moving, turning either way, or not.
+    #: How many directions (a count, 1 to 360) the plan tries, evenly spread round the
+    #: circle from the one toward the target; each moving, turning either way, or not.
     plan_directions: int = 24
-    # The fastest it turns (rad/s) while planning among obstacles (`rotation_speed` if
-    # lower), and the turn rate its plan's turning score is measured against.
+    #: The fastest it turns (rad/s) while planning among obstacles (`rotation_speed` if
+    #: lower), and the turn rate its plan's turning score is measured against.
     max_turn_rate: float = 0.5
-    # The plan's score of a motion: progress to the target (1 at `speed`), plus
-    # `turn_weight` times how far it turns toward the heading it wants (1 at
-    # `max_turn_rate` over the horizon), plus `keep_on_weight` times how well it keeps on
-    # with its last command (1 the same direction); both weights are plain factors.
+    #: The plan's score of a motion: progress to the target (1 at `speed`), plus
+    #: `turn_weight` times how far it turns toward the heading it wants (1 at
+    #: `max_turn_rate` over the horizon), plus `keep_on_weight` times how well it keeps on
+    #: with its last command (1 the same direction); both weights are plain factors.
     turn_weight: float = 0.6
     keep_on_weight: float = 0.15
-    # In PBP, holding control, it lets go once the DMP's path is clear of the obstacles by
-    # `release_factor` times its margin (a factor) and the robot faces within
-    # `release_heading_gap` (rad) of the heading it wants; under PBP-Alt, whose DMP pulls
-    # the robot back to its line after each release, within
-    # `release_heading_gap_alternated` (rad). It keeps control `hold_time` at least. Not
-    # holding it, it stays out while the robot faces within twice that gap and the DMP's
-    # path and the hand's own keep its margin clear.
+    #: In PBP, holding control, it lets go once the DMP's path is clear of the obstacles by
+    #: `release_factor` times its margin (a factor) and the robot faces within
+    #: `release_heading_gap` (rad) of the heading it wants; under PBP-Alt, whose DMP pulls
+    #: the robot back to its line after each release, within
+    #: `release_heading_gap_alternated` (rad). It keeps control `hold_time` at least. Not
+    #: holding it, it stays out while the robot faces within twice that gap and the DMP's
+    #: path and the hand's own keep its margin clear.
     release_factor: float = 1.5
     release_heading_gap: float = 0.05
     release_heading_gap_alternated: float = 0.12
-    # The heading it wants at the target is the nearest one whose footprint keeps
-    # `goal_margin_factor` times its margin (a factor) clear of where the obstacles stop.
+    #: The heading it wants at the target is the nearest one whose footprint keeps
+    #: `goal_margin_factor` times its margin (a factor) clear of where the obstacles stop.
     goal_margin_factor: float = 1.0
-    # PBP-Cont, among obstacles and when it goes to the target itself (`insist_time`) in
-    # the reaching task: it asks for the motion it wants minus the policy's, at most this
-    # many times `speed` (a factor).
+    #: PBP-Cont, among obstacles and when it goes to the target itself (`insist_time`) in
+    #: the reaching task: it asks for the motion it wants minus the policy's, at most this
+    #: many times `speed` (a factor).
     policy_compensation: float = 3.0
-    # Its way round has stalled (`participant_avoidance`) once it has not come
-    # `progress_step` (m) closer to the target for `stall_time` (s): it then pushes on
-    # through until it arrives. 4 s is how long the moving cylinders take to settle.
+    #: Its way round has stalled (`participant_avoidance`) once it has not come
+    #: `progress_step` (m) closer to the target for `stall_time` (s): it then pushes on
+    #: through until it arrives. 4 s is how long the moving cylinders take to settle.
     progress_step: float = 0.02
     stall_time: float = 4.0
-    # In the last `final_approach_radius` (PBP) it leaves the robot alone only while the
-    # hand closes in on the target at this fraction of the nominal speed or more.
+    #: In the last `final_approach_radius` (PBP) it leaves the robot alone only while the
+    #: hand closes in on the target at this fraction of the nominal speed or more.
     min_closing_fraction: float = 0.25

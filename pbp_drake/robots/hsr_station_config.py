@@ -45,69 +45,69 @@ class HsrStationConfig:
     """
 
     plant: MultibodyPlantConfig = dataclasses.field(default_factory=_default_plant_config)
-    # How the robot moves along the diff IK's plan. "dynamic": the plant (SAP, every
-    # plant.time_step) and its stiff servos track the plan, a few hundredths of a mm
-    # behind it. "kinematic": the joints are on the plan at every instant (the servos'
-    # limit as w grows; the plant only gives the kinematics and the geometry, and its
-    # step, gains and plant settings go unused): about twice the closed loop's speed,
-    # and in the reaching and grasping tasks, which ship with it, the same study results
-    # within their trial-to-trial noise (README, "A kinematic robot"). Nothing pushes the
-    # robot in either (gravity is off, obstacles are measured).
+    #: How the robot moves along the diff IK's plan. "dynamic": the plant (SAP, every
+    #: plant.time_step) and its stiff servos track the plan, a few hundredths of a mm
+    #: behind it. "kinematic": the joints are on the plan at every instant (the servos'
+    #: limit as w grows; the plant only gives the kinematics and the geometry, and its
+    #: step, gains and plant settings go unused): about twice the closed loop's speed,
+    #: and in the reaching and grasping tasks, which ship with it, the same study results
+    #: within their trial-to-trial noise (README, "A kinematic robot"). Nothing pushes the
+    #: robot in either (gravity is off, obstacles are measured).
     motion: str = "dynamic"
-    # The whole-body differential IK's period (s), a whole multiple of plant.time_step;
-    # its QP is the station's largest cost.
+    #: The whole-body differential IK's period (s), a whole multiple of plant.time_step;
+    #: its QP is the station's largest cost.
     diff_ik_time_step: float = 0.01
-    # The period of a control loop that sends each tick the state [p, v] to reach at the
-    # next tick; the station then ramps into p at v (see EeCommandToPose). None: track p.
+    #: The period of a control loop that sends each tick the state [p, v] to reach at the
+    #: next tick; the station then ramps into p at v (see EeCommandToPose). None: track p.
     command_period: float | None = None
-    # The base's pose (x, y in m, yaw in rad) at the start; x, y within the model's 10 m.
+    #: The base's pose (x, y in m, yaw in rad) at the start; x, y within the model's 10 m.
     initial_base: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
-    # The hand's height at the start (m); it starts level, pointing along the base's +x.
+    #: The hand's height at the start (m); it starts level, pointing along the base's +x.
     ee_height: float = 0.7
-    # Base (x, y, yaw) and arm (lift, flex, roll, wrist flex, wrist roll): stiff servos,
-    # kp = I w² and kd = 2 I w (critically damped) with w = 300 rad/s on each joint's
-    # inertia I at the ready pose (34 kg for x and y, 1.0 kg·m² for yaw, 6.1 kg for the
-    # lift with the torso, 0.31, 0.013, 0.015, 0.001 kg·m² for the others). Accelerating at
-    # its limit a joint then trails the plan by a / w², at most a few hundredths of a mm
-    # at the hand, so a control loop re-integrating from the measured hand sees no lag.
-    # At w = 100, setting off at 0.08 to 0.12 m/s overshot the command by up to 13 % for
-    # a tick (8 % at 150).
+    #: Base (x, y, yaw) and arm (lift, flex, roll, wrist flex, wrist roll): stiff servos,
+    #: kp = I w² and kd = 2 I w (critically damped) with w = 300 rad/s on each joint's
+    #: inertia I at the ready pose (34 kg for x and y, 1.0 kg·m² for yaw, 6.1 kg for the
+    #: lift with the torso, 0.31, 0.013, 0.015, 0.001 kg·m² for the others). Accelerating at
+    #: its limit a joint then trails the plan by a / w², at most a few hundredths of a mm
+    #: at the hand, so a control loop re-integrating from the measured hand sees no lag.
+    #: At w = 100, setting off at 0.08 to 0.12 m/s overshot the command by up to 13 % for
+    #: a tick (8 % at 150).
     base_kp: list[float] = dataclasses.field(default_factory=lambda: [3.0e6, 3.0e6, 9.0e4])
     base_kd: list[float] = dataclasses.field(default_factory=lambda: [2.0e4, 2.0e4, 600.0])
     arm_kp: list[float] = dataclasses.field(
         default_factory=lambda: [5.5e5, 2.8e4, 1200.0, 1400.0, 90.0])
     arm_kd: list[float] = dataclasses.field(
         default_factory=lambda: [3700.0, 190.0, 7.8, 9.0, 0.6])
-    # Acceleration limits, enforced by the diff IK on its plan (the servos follow it; see
-    # WholeBodyDiffIk). Base (x, y, yaw): published (hsrb_moveit_config joint_limits.yaml)
-    # 0.05 m/s² for x and y, none for yaw. Ours, for x and y, 0.3: a departure. At 0.05
-    # the base needs 3.2 s to reach 0.16 m/s, more than the arm can cover: driven at
-    # 0.16 m/s along x the hand fell to 0.63 of it and stayed under 0.9 for 1.7 s, and
-    # told to stop, the base dragged it on by 7 cm. At 0.1 the hand followed and stopped,
-    # but turning back from 0.16 m/s along x took 2 s to get within 10 % of the command
-    # again (1.2 s at 0.2, 0.15 s at 0.3). Yaw, ours: 5 rad/s², its top speed in 0.2 s.
-    # With none, diff IK swung the base at up to 95 rad/s² to set the hand off sideways,
-    # and the hand overshot a 0.16 m/s sideways command by 18 %.
+    #: Acceleration limits, enforced by the diff IK on its plan (the servos follow it; see
+    #: WholeBodyDiffIk). Base (x, y, yaw): published (hsrb_moveit_config joint_limits.yaml)
+    #: 0.05 m/s² for x and y, none for yaw. Ours, for x and y, 0.3: a departure. At 0.05
+    #: the base needs 3.2 s to reach 0.16 m/s, more than the arm can cover: driven at
+    #: 0.16 m/s along x the hand fell to 0.63 of it and stayed under 0.9 for 1.7 s, and
+    #: told to stop, the base dragged it on by 7 cm. At 0.1 the hand followed and stopped,
+    #: but turning back from 0.16 m/s along x took 2 s to get within 10 % of the command
+    #: again (1.2 s at 0.2, 0.15 s at 0.3). Yaw, ours: 5 rad/s², its top speed in 0.2 s.
+    #: With none, diff IK swung the base at up to 95 rad/s² to set the hand off sideways,
+    #: and the hand overshot a 0.16 m/s sideways command by 18 %.
     base_acceleration_limits: list[float] = dataclasses.field(
         default_factory=lambda: [0.3, 0.3, 5.0])
-    # Arm (lift, flex, roll, wrist flex, wrist roll): none is published. Ours: the lift
-    # and the flex, which carry the arm, reach their top speed (0.2 m/s, 1.2 rad/s) in
-    # 0.2 s; the roll and the wrist joints, which carry the hand only, theirs (2.0, 1.5,
-    # 1.5 rad/s) in 0.05 s. The hand then sets off within about three control ticks.
-    # Without limits the flex and the wrist flex took up to 200 rad/s² and the lift
-    # 27 m/s²; lift and flex twice as fast made a vertical start overshoot by 17 %; roll
-    # and wrists as slow as the flex let a teleoperated hand, turning as it went, run up
-    # to 22 % over the fastest command.
+    #: Arm (lift, flex, roll, wrist flex, wrist roll): none is published. Ours: the lift
+    #: and the flex, which carry the arm, reach their top speed (0.2 m/s, 1.2 rad/s) in
+    #: 0.2 s; the roll and the wrist joints, which carry the hand only, theirs (2.0, 1.5,
+    #: 1.5 rad/s) in 0.05 s. The hand then sets off within about three control ticks.
+    #: Without limits the flex and the wrist flex took up to 200 rad/s² and the lift
+    #: 27 m/s²; lift and flex twice as fast made a vertical start overshoot by 17 %; roll
+    #: and wrists as slow as the flex let a teleoperated hand, turning as it went, run up
+    #: to 22 % over the fastest command.
     arm_acceleration_limits: list[float] = dataclasses.field(
         default_factory=lambda: [1.0, 6.0, 40.0, 30.0, 30.0])
-    # How fast the arm drifts back to the ready pose (1/s) in the joint motion the hand's
-    # leaves free; the base has no centering, so it takes over what the arm held.
+    #: How fast the arm drifts back to the ready pose (1/s) in the joint motion the hand's
+    #: leaves free; the base has no centering, so it takes over what the arm held.
     arm_centering_gain: float = 1.0
-    # Cylinders measured against the robot (not felt by it); with any, the station has
-    # the input obstacle_positions and the outputs in_collision and clearance.
+    #: Cylinders measured against the robot (not felt by it); with any, the station has
+    #: the input obstacle_positions and the outputs in_collision and clearance.
     obstacles: list[CylinderObstacle] = dataclasses.field(default_factory=list)
-    # What the station shows in Meshcat when it is given one (Drake's config; its
-    # illustration and proximity settings are used, its LCM and contact parts are not).
+    #: What the station shows in Meshcat when it is given one (Drake's config; its
+    #: illustration and proximity settings are used, its LCM and contact parts are not).
     visualization: VisualizationConfig = dataclasses.field(
         default_factory=_default_visualization)
 

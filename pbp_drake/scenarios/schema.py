@@ -72,18 +72,18 @@ class Hsr:
     whole-body differential IK; the PBP loop commands its end effector in task space."""
 
     station: HsrStationConfig = dataclasses.field(default_factory=HsrStationConfig)
-    # The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it,
-    # and operators whose speed is 0 move the hand at it.
+    #: The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it,
+    #: and operators whose speed is 0 move the hand at it.
     speed: float = 0.12
-    # The hand-over law (`pbp_drake.core.hand_over`): a goal switch, the operator pressing
-    # or releasing changes the hand's commanded velocity by at most max_hand_acceleration
-    # (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command never exceeds
-    # max_hand_speed (m/s), however far a primitive is from its attractor. 0.2 m/s is the
-    # base's published speed limit: a hand driven faster for long runs its arm out of
-    # range, and the whole-body IK then lurches.
+    #: The hand-over law (`pbp_drake.core.hand_over`): a goal switch, the operator pressing
+    #: or releasing changes the hand's commanded velocity by at most max_hand_acceleration
+    #: (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command never exceeds
+    #: max_hand_speed (m/s), however far a primitive is from its attractor. 0.2 m/s is the
+    #: base's published speed limit: a hand driven faster for long runs its arm out of
+    #: range, and the whole-body IK then lurches.
     max_hand_acceleration: float = 1.0
     max_hand_speed: float = 0.2
-    # The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
+    #: The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
     max_hand_yaw_acceleration: float = 4.0
 
 
@@ -169,8 +169,8 @@ class MultiGoalReach:
     min_separation: float = 0.2
     switch_schedule: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.3, 0.6])
     success_distance: float = 0.05
-    # Fixed objects `(M, 3)` and targets (object indices, one per schedule entry) instead of
-    # drawing them from the seed.
+    #: Fixed objects `(M, 3)` and targets (object indices, one per schedule entry) instead of
+    #: drawing them from the seed.
     objects: list[list[float]] = dataclasses.field(default_factory=list)
     targets: list[int] = dataclasses.field(default_factory=list)
 
@@ -206,32 +206,32 @@ class GraspTask:
     on the pose station (`pbp_drake.builder.grasp`) with the virtual participant."""
 
     object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
-    # The tables' centres are drawn in this rectangle (m), min_separation apart (at least
-    # the tables' diagonal, so that no two overlap).
+    #: The tables' centres are drawn in this rectangle (m), min_separation apart (at least
+    #: the tables' diagonal, so that no two overlap).
     x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
     y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
     min_separation: float = 0.45
-    # The height (m) the hand starts at (the station's ready pose), as the reach task's.
+    #: The height (m) the hand starts at (the station's ready pose), as the reach task's.
     height: float = 0.7
-    # Each table is a box table_size (x, y) m wide with its top at table_height (m).
+    #: Each table is a box table_size (x, y) m wide with its top at table_height (m).
     table_height: float = 0.6
     table_size: list[float] = dataclasses.field(default_factory=lambda: [0.3, 0.3])
-    # Each object is an upright cylinder standing at its table's centre.
+    #: Each object is an upright cylinder standing at its table's centre.
     object_radius: float = 0.03
     object_height: float = 0.15
-    # An object is grasped from above with this probability, else from the side.
+    #: An object is grasped from above with this probability, else from the side.
     top_probability: float = 0.5
-    # Side grasps approach horizontally at a yaw (degrees, counter-clockwise from the
-    # direction the robot faces) drawn here; inside [-90, 90].
+    #: Side grasps approach horizontally at a yaw (degrees, counter-clockwise from the
+    #: direction the robot faces) drawn here; inside [-90, 90].
     approach_yaw_range: list[float] = dataclasses.field(default_factory=lambda: [-60.0, 60.0])
-    # Top grasps approach straight down with a wrist roll (degrees) drawn here; inside
-    # [-180, 180].
+    #: Top grasps approach straight down with a wrist roll (degrees) drawn here; inside
+    #: [-180, 180].
     roll_range: list[float] = dataclasses.field(default_factory=lambda: [-90.0, 90.0])
-    # The palm stands this far (m) behind the point the fingers close on.
+    #: The palm stands this far (m) behind the point the fingers close on.
     grasp_depth: float = 0.08
     switch_schedule: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.3, 0.6])
     success_distance: float = 0.03
-    # Degrees.
+    #: Degrees.
     success_angle: float = 10.0
 
 
@@ -240,35 +240,35 @@ class Scenario:
     """Everything one simulation needs."""
 
     name: str = "scenario"
-    # One of METHODS.
+    #: One of METHODS.
     method: str = "pbp_alternated"
-    # The arbitration weight of `fixed_alpha`, in [0, 1].
+    #: The arbitration weight of `fixed_alpha`, in [0, 1].
     alpha: float = 0.5
     control_period: float = 0.01
-    # The time limit (s) of a run.
+    #: The time limit (s) of a run.
     duration: float = 2.0
     robot: typing.Union[PointRobot, Hsr] = dataclasses.field(default_factory=PointRobot)
-    # The robot's initial position; empty: the demonstration's start.
+    #: The robot's initial position; empty: the demonstration's start.
     start: list[float] = dataclasses.field(default_factory=list)
-    # Candidate goals, one DMP each; empty: the demonstration's goal.
+    #: Candidate goals, one DMP each; empty: the demonstration's goal.
     goals: list[list[float]] = dataclasses.field(default_factory=list)
-    # The demonstration the DMPs learn from; none: straight paths.
+    #: The demonstration the DMPs learn from; none: straight paths.
     demonstration: typing.Optional[typing.Union[BentPath, RecordedPath]] = None
     dmp: DmpSettings = dataclasses.field(default_factory=DmpSettings)
-    # The DMPs' duration tau (s); 0 takes the demonstration's duration (2-D scenes) or the
-    # farthest goal's distance over `robot.speed` (HSR).
+    #: The DMPs' duration tau (s); 0 takes the demonstration's duration (2-D scenes) or the
+    #: farthest goal's distance over `robot.speed` (HSR).
     dmp_duration: float = 0.0
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     operator: OperatorConfig = dataclasses.field(default_factory=NoOperator)
-    # HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
-    # An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,
-    # `!GraspTask {...}` the grasping task.
+    #: HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
+    #: An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,
+    #: `!GraspTask {...}` the grasping task.
     task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles, GraspTask]] = None
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
     seed: int = 0
-    # How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
-    # its target_realtime_rate).
+    #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
+    #: its target_realtime_rate).
     simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
 
 
@@ -284,17 +284,17 @@ class SceneVariant:
 class AlphaStudy:
     """Explicit arbitration over `alphas` against PBP, in each scene (Fig. 2)."""
 
-    # Where the obstacles stood when the demonstration was given (drawn in panel a).
+    #: Where the obstacles stood when the demonstration was given (drawn in panel a).
     demonstration_obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     scenes: list[SceneVariant] = dataclasses.field(default_factory=list)
     alphas: list[float] = dataclasses.field(
         default_factory=lambda: [round(0.1 * i, 1) for i in range(11)])
-    # The virtual operator's speeds (its `speed`) at which every scene runs: the summary
-    # holds each scene's results per speed. Empty (the default): only the scenario
-    # operator's own speed. The paper's Eq. 5 pushes at 1.
+    #: The virtual operator's speeds (its `speed`) at which every scene runs: the summary
+    #: holds each scene's results per speed. Empty (the default): only the scenario
+    #: operator's own speed. The paper's Eq. 5 pushes at 1.
     operator_speeds: list[float] = dataclasses.field(default_factory=list)
-    # A run reached the goal when it ends this close to it (AltVsCont's tolerance). Reported
-    # beside the collision ratio; the ideal alpha stays the paper's (no collision).
+    #: A run reached the goal when it ends this close to it (AltVsCont's tolerance). Reported
+    #: beside the collision ratio; the ideal alpha stays the paper's (no collision).
     goal_tolerance: float = 0.01
 
 
@@ -302,7 +302,7 @@ class AlphaStudy:
 class AltVsCont:
     """The same DMP and open-loop input in continuous and alternated mode (Fig. 4)."""
 
-    # Both modes must end this close to the goal.
+    #: Both modes must end this close to the goal.
     goal_tolerance: float = 0.01
 
 

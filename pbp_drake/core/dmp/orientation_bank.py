@@ -120,7 +120,7 @@ class OrientationDmpBank:
 
     @classmethod
     def from_dmps(cls, dmps):
-        """A bank of the given single `OrientationDmp`s (same duration and settings)."""
+        """A bank of the given single `OrientationDmp` objects (same duration and settings)."""
         if not dmps:
             raise ValueError("an orientation DMP bank needs at least one DMP")
         first = dmps[0]

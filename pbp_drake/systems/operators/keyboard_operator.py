@@ -46,8 +46,8 @@ class KeyboardParams:
 
     speed: float = 0.0
     rotation_speed: float = 0.6
-    # A key counts as held this long (s) after its last press. The browser repeats a held
-    # key, but only after the system's repeat delay (often 0.25..0.66 s): bridge it.
+    #: A key counts as held this long (s) after its last press. The browser repeats a held
+    #: key, but only after the system's repeat delay (often 0.25..0.66 s): bridge it.
     hold_time: float = 0.6
 
 

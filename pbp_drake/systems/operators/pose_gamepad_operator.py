@@ -44,14 +44,16 @@ class PoseGamepadOperator(PoseOperatorBase):
     In the operator frame of the hand (`core.operator_frame`: forward along the hand's
     heading, left, world up):
 
-    | control | moves |
-    |---|---|
-    | left stick up / down | forward / back |
-    | left stick left / right | left / right |
-    | right trigger (RT, button 7) / left trigger (LT, 6) | up / down |
-    | right stick left / right | yaw left / right (about world +z) |
-    | right stick up / down | pitch the approach axis down / up (about `left`) |
-    | right shoulder (RB, 5) / left shoulder (LB, 4) | roll right / left about z_H |
+    ::
+
+        | control | moves |
+        |---|---|
+        | left stick up / down | forward / back |
+        | left stick left / right | left / right |
+        | right trigger (RT, button 7) / left trigger (LT, 6) | up / down |
+        | right stick left / right | yaw left / right (about world +z) |
+        | right stick up / down | pitch the approach axis down / up (about `left`) |
+        | right shoulder (RB, 5) / left shoulder (LB, 4) | roll right / left about z_H |
 
     Each stick has a radial dead zone and each trigger a dead zone of `dead_zone`, past
     which the deflection rises continuously from 0; translation and rotation are each capped

@@ -66,12 +66,14 @@ class PoseKeyboardOperator(PoseOperatorBase):
 
     In the operator frame of the hand (`core.operator_frame`):
 
-    | key | translate mode | rotate mode |
-    |---|---|---|
-    | ↑ / ↓ | forward / back | pitch the approach axis down / up |
-    | ← / → | left / right | yaw left / right (about world +z) |
-    | PageUp / PageDown | up / down | roll right / left about z_H |
-    | R | to rotate mode | to translate mode |
+    ::
+
+        | key | translate mode | rotate mode |
+        |---|---|---|
+        | ↑ / ↓ | forward / back | pitch the approach axis down / up |
+        | ← / → | left / right | yaw left / right (about world +z) |
+        | PageUp / PageDown | up / down | roll right / left about z_H |
+        | R | to rotate mode | to translate mode |
 
     The mode button's label (`MODE_LABELS`) shows the mode; the run starts translating. A
     held R toggles once (a click within `hold_time` of the last one is the key's repeat).

@@ -1,0 +1,256 @@
+"""Our Sphinx directives: each page part that would drift from the code is generated from it.
+
+- `pydrake_system`: Drake's port block of a LeafSystem docstring, drawn as a box;
+- `cli-reference`: every `pbp-drake` subcommand from its argparse parser;
+- `scenario-reference`: every field reachable from `ScenarioFile`, from the dataclasses and
+  their `#:` doc comments;
+- `api-reference`: every name of `pbp_drake.__all__`, grouped as `pbp_drake.API_GROUPS` says.
+"""
+
+import argparse
+import dataclasses
+import importlib
+import inspect
+import typing
+
+from docutils import nodes
+from docutils.statemachine import StringList
+from sphinx.pycode import ModuleAnalyzer
+from sphinx.util.docutils import SphinxDirective
+from sphinx.util.nodes import nested_parse_with_titles
+
+
+def _parse_rst(directive, lines):
+    """Parses generated reST lines into nodes (so titles and autodoc directives work)."""
+    node = nodes.section() if False else nodes.container()
+    nested_parse_with_titles(directive.state, StringList(lines, "<generated>"), node)
+    return node.children
+
+
+# --- pydrake_system -------------------------------------------------------------------------
+
+def port_diagram(name, inputs, outputs):
+    """A box named `name` with the input ports on its left and the outputs on its right."""
+    rows = max(len(inputs), len(outputs), 1)
+    inputs = inputs + [""] * (rows - len(inputs))
+    outputs = outputs + [""] * (rows - len(outputs))
+    width = max(len(name), 6) + 4
+    left = max((len(port) for port in inputs), default=0)
+    lines = [" " * (left + 4) + "┌" + "─" * width + "┐",
+             " " * (left + 4) + "│" + name.center(width) + "│"]
+    for port_in, port_out in zip(inputs, outputs):
+        arrow_in = f"{port_in:>{left}} ──▶" if port_in else " " * (left + 4)
+        arrow_out = f"──▶ {port_out}" if port_out else ""
+        lines.append(f"{arrow_in}│{' ' * width}│{arrow_out}")
+    lines.append(" " * (left + 4) + "└" + "─" * width + "┘")
+    return "\n".join(line.rstrip() for line in lines)
+
+
+class PydrakeSystem(SphinxDirective):
+    """`.. pydrake_system::` with a YAML-like body: name, input_ports, output_ports."""
+
+    has_content = True
+
+    def run(self):
+        fields, key = {"name": "", "input_ports": [], "output_ports": []}, None
+        for line in self.content:
+            text = line.strip()
+            if text.startswith("- ") and key:
+                fields[key].append(text[2:].strip())
+            elif ":" in text:
+                key, value = (part.strip() for part in text.split(":", 1))
+                if key == "name":
+                    fields["name"] = value
+        diagram = port_diagram(fields["name"], fields["input_ports"], fields["output_ports"])
+        block = nodes.literal_block(diagram, diagram, classes=["pydrake-system"])
+        return [block]
+
+
+# --- cli-reference --------------------------------------------------------------------------
+
+def _option_lines(parser):
+    lines = []
+    for action in parser._actions:
+        if isinstance(action, (argparse._HelpAction, argparse._SubParsersAction)):
+            continue
+        name = ", ".join(action.option_strings) or action.metavar or action.dest
+        facts = []
+        if action.choices:
+            facts.append("choices: " + ", ".join(f"``{choice}``" for choice in action.choices))
+        if (action.option_strings and action.default not in (None, False, argparse.SUPPRESS)
+                and not isinstance(action, argparse._VersionAction)):
+            facts.append(f"default: ``{action.default}``")
+        help_text = (action.help or "").replace("%(prog)s", parser.prog)
+        help_text = help_text.replace("*", r"\*").replace("`", "``").replace("````", "``")
+        lines += [f"``{name}``", f"   {help_text}" + (f" ({'; '.join(facts)})" if facts else "")
+                  or "   (no help)", ""]
+    return lines
+
+
+def _command_lines(prog, parser, underline="-"):
+    usage = parser.format_usage().removeprefix("usage: ").strip()
+    lines = [prog, underline * len(prog), "", (parser.description or "").replace("`", "``"), "",
+             ".. code-block:: text", "", *("   " + line for line in usage.splitlines()), ""]
+    return lines + _option_lines(parser)
+
+
+class CliReference(SphinxDirective):
+    """The whole `pbp-drake` command line, from `pbp_drake.cli.build_parser()`."""
+
+    def run(self):
+        from pbp_drake import cli
+
+        parser, tools = cli.build_parser(), cli.tool_parsers()
+        lines = _command_lines("pbp-drake", parser)
+        subparsers = next(action for action in parser._actions
+                          if isinstance(action, argparse._SubParsersAction))
+        for name, subparser in subparsers.choices.items():
+            # bench and draw parse their own line: document their own parsers.
+            lines += _command_lines(f"pbp-drake {name}", tools.get(name, subparser))
+        return _parse_rst(self, lines)
+
+
+# --- scenario-reference ---------------------------------------------------------------------
+
+def field_docs(cls):
+    """{field name: its `#:` doc comment} of a dataclass, its bases' included."""
+    docs = {}
+    for base in reversed(cls.__mro__):
+        if not dataclasses.is_dataclass(base):
+            continue
+        analyzer = ModuleAnalyzer.for_module(base.__module__)
+        for (scope, name), lines in analyzer.find_attr_docs().items():
+            if scope == base.__qualname__:
+                docs[name] = " ".join(line.strip() for line in lines).strip()
+    return docs
+
+
+def _variants(annotation):
+    """The dataclasses a field's type names (through Optional, Union and list)."""
+    if dataclasses.is_dataclass(annotation):
+        return [annotation]
+    return [cls for arg in typing.get_args(annotation) for cls in _variants(arg)]
+
+
+def _is_ours(cls):
+    return cls.__module__.startswith("pbp_drake")
+
+
+def reachable_dataclasses(root):
+    """Our dataclasses reachable from `root`, in order of first appearance."""
+    seen, order = set(), []
+
+    def visit(cls):
+        if cls in seen or not _is_ours(cls):
+            return
+        seen.add(cls)
+        order.append(cls)
+        for field in dataclasses.fields(cls):
+            for variant in _variants(typing.get_type_hints(cls)[field.name]):
+                visit(variant)
+
+    visit(root)
+    return order
+
+
+def _type_name(annotation):
+    if isinstance(annotation, type) and not typing.get_args(annotation):
+        return annotation.__name__
+    text = str(annotation).replace("typing.", "")
+    for prefix in ("pbp_drake.", "pydrake."):
+        while prefix in text:  # module paths out: the class names are what a reader writes
+            start = text.index(prefix)
+            end = start
+            while end < len(text) and (text[end].isalnum() or text[end] in "._"):
+                end += 1
+            text = text[:start] + text[start:end].rsplit(".", 1)[-1] + text[end:]
+    return text
+
+
+def _default(field):
+    if field.default is not dataclasses.MISSING:
+        value = field.default
+    elif field.default_factory is not dataclasses.MISSING:
+        value = field.default_factory()
+    else:
+        return "required"
+    if dataclasses.is_dataclass(value):
+        return f"{type(value).__name__} defaults"
+    if type(value).__module__.startswith("pydrake"):
+        return f"Drake's {type(value).__name__} defaults"
+    return repr(value)
+
+
+def _tag_note(cls, annotation_users):
+    users = annotation_users.get(cls, [])
+    untagged = [f"``{field}: {{...}}``" for field, first in users if first]
+    tagged = [f"``{field}: !{cls.__name__} {{...}}``" for field, first in users if not first]
+    return ", ".join(tagged + untagged)
+
+
+class ScenarioReference(SphinxDirective):
+    """Every section a scenario file may hold, generated from `ScenarioFile`."""
+
+    def run(self):
+        from pbp_drake.scenarios.schema import ScenarioFile
+
+        classes = reachable_dataclasses(ScenarioFile)
+        # Where each class appears and whether it is the field's untagged (first) variant.
+        users = {}
+        for cls in classes:
+            for field in dataclasses.fields(cls):
+                variants = [v for v in _variants(typing.get_type_hints(cls)[field.name])]
+                for index, variant in enumerate(variants):
+                    users.setdefault(variant, []).append((field.name, index == 0))
+        lines = []
+        for cls in classes:
+            lines += [cls.__name__, "-" * len(cls.__name__), ""]
+            note = _tag_note(cls, users)
+            if note:
+                lines += [f"Written as {note}.", ""]
+            doc = inspect.getdoc(cls) or ""
+            lines += [line.replace("`", "``").replace("````", "``") for line in doc.splitlines()]
+            lines.append("")
+            docs, hints = field_docs(cls), typing.get_type_hints(cls)
+            for field in dataclasses.fields(cls):
+                lines += [f"``{field.name}``",
+                          f"   *{_type_name(hints[field.name])}*, default ``{_default(field)}``."
+                          f" {docs.get(field.name, '(not described)')}", ""]
+        return _parse_rst(self, [line.replace("\u00a0", " ") for line in lines])
+
+
+# --- api-reference --------------------------------------------------------------------------
+
+class ApiReference(SphinxDirective):
+    """autodoc of every public name, one section per topic of `pbp_drake.API_GROUPS`."""
+
+    def run(self):
+        import pbp_drake
+
+        grouped = {name for group in pbp_drake.API_GROUPS.values() for name in group}
+        groups = dict(pbp_drake.API_GROUPS)
+        other = [name for name in pbp_drake.__all__ if name not in grouped
+                 and name != "__version__"]
+        if other:
+            groups["Other"] = {name: "pbp_drake" for name in other}
+        lines = []
+        for title, names in groups.items():
+            lines += [title, "-" * len(title), ""]
+            for name in names:
+                value = getattr(pbp_drake, name)
+                kind = ("automodule" if inspect.ismodule(value) else
+                        "autoclass" if inspect.isclass(value) else "autofunction")
+                target = value.__name__ if kind == "automodule" else f"pbp_drake.{name}"
+                lines += [f".. {kind}:: {target}"]
+                if kind != "autofunction":
+                    lines += ["   :members:"]
+                lines.append("")
+        return _parse_rst(self, lines)
+
+
+def setup(app):
+    app.add_directive("pydrake_system", PydrakeSystem)
+    app.add_directive("cli-reference", CliReference)
+    app.add_directive("scenario-reference", ScenarioReference)
+    app.add_directive("api-reference", ApiReference)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}

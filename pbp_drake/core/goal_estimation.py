@@ -70,14 +70,23 @@ class GoalEstimatorSettings:
     the most probable goal at once.
     """
 
+    #: The score: angle (the paper's heuristic), nearest, bayesian or pose (grasping task only).
     method: str = "angle"
+    #: The scale of the angle (rad), nearest (m) and pose (rad) scores.
     temperature: float = 0.1
+    #: The rationality of bayesian (1/m).
     beta: float = 5.0
+    #: Another goal must beat the selection by more than this (a probability) to take over.
     margin: float = 0.1
+    #: How many consecutive updates (a count) another goal must beat it by `margin` to switch.
     hold_steps: int = 2
+    #: The pose score's weight of the distance (rad per m).
     distance_weight: float = 0.1
+    #: The pose score's weight of the angle to the grasp orientation (a factor).
     orientation_weight: float = 1.0
+    #: The pose score subtracts the angle the hand's turning takes off in this time (s).
     turn_horizon: float = 1.0
+    #: The direction of travel counts only while the hand moves this fast or faster (m/s).
     min_speed: float = 0.01
 
     def __post_init__(self):

@@ -15,7 +15,9 @@ class VirtualParticipantParams:
     seeds, to the paper's users' teleop intervention ratio (0.92 to 0.95).
     """
 
+    #: Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = 0.0
+    #: Its turn rate (rad/s).
     rotation_speed: float = 0.8
     #: It notices a new target this long (s) after it appears: seeing the ball move,
     #: deciding and reaching for the keys. 0.5 s is the reach calibration (teleop then rests
@@ -24,6 +26,7 @@ class VirtualParticipantParams:
     #: Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
     #: (1 + N(0, speed_noise)).
     direction_noise: float = 0.1
+    #: Its speed is scaled by (1 + N(0, speed_noise)) (a fraction).
     speed_noise: float = 0.1
     #: Driving (teleop), it slows within this distance (m) of the target.
     slow_radius: float = 0.15
@@ -37,6 +40,7 @@ class VirtualParticipantParams:
     #: target separates them then, so it steps aside, at `aside_speed_fraction` of `speed`,
     #: to the side that widens the angle between them.
     in_line_angle: float = 0.1
+    #: The speed of its sidestep out of line, as a fraction of `speed`.
     aside_speed_fraction: float = 0.5
     #: Assisting, once it has faced the target this long (s) and the estimate still names
     #: another object, it goes to the target itself: it turns the target to its side and
@@ -71,6 +75,7 @@ class VirtualParticipantParams:
     #: `max_turn_rate` over the horizon), plus `keep_on_weight` times how well it keeps on
     #: with its last command (1 the same direction); both weights are plain factors.
     turn_weight: float = 0.6
+    #: The plan's weight of keeping on with its last command (a factor).
     keep_on_weight: float = 0.15
     #: In PBP, holding control, it lets go once the DMP's path is clear of the obstacles by
     #: `release_factor` times its margin (a factor) and the robot faces within
@@ -80,7 +85,9 @@ class VirtualParticipantParams:
     #: holding it, it stays out while the robot faces within twice that gap and the DMP's
     #: path and the hand's own keep its margin clear.
     release_factor: float = 1.5
+    #: In PBP it lets go within this heading gap (rad).
     release_heading_gap: float = 0.05
+    #: The same under PBP-Alt (rad).
     release_heading_gap_alternated: float = 0.12
     #: The heading it wants at the target is the nearest one whose footprint keeps
     #: `goal_margin_factor` times its margin (a factor) clear of where the obstacles stop.
@@ -93,6 +100,7 @@ class VirtualParticipantParams:
     #: `progress_step` (m) closer to the target for `stall_time` (s): it then pushes on
     #: through until it arrives. 4 s is how long the moving cylinders take to settle.
     progress_step: float = 0.02
+    #: Not `progress_step` closer for this long (s), it has stalled and pushes on through.
     stall_time: float = 4.0
     #: In the last `final_approach_radius` (PBP) it leaves the robot alone only while the
     #: hand closes in on the target at this fraction of the nominal speed or more.

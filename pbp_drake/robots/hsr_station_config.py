@@ -11,7 +11,9 @@ from pydrake.visualization import VisualizationConfig
 class CylinderObstacle:
     """An upright cylinder the station measures the robot against (m)."""
 
+    #: The cylinder's radius (m).
     radius: float = 0.12
+    #: Its height (m).
     height: float = 1.2
 
 
@@ -44,6 +46,7 @@ class HsrStationConfig:
     published about the robot is in the model file and these comments; the rest is ours.
     """
 
+    #: Drake's MultibodyPlantConfig of the robot's plant (time step, contact model).
     plant: MultibodyPlantConfig = dataclasses.field(default_factory=_default_plant_config)
     #: How the robot moves along the diff IK's plan. "dynamic": the plant (SAP, every
     #: plant.time_step) and its stiff servos track the plan, a few hundredths of a mm
@@ -73,9 +76,12 @@ class HsrStationConfig:
     #: At w = 100, setting off at 0.08 to 0.12 m/s overshot the command by up to 13 % for
     #: a tick (8 % at 150).
     base_kp: list[float] = dataclasses.field(default_factory=lambda: [3.0e6, 3.0e6, 9.0e4])
+    #: The base's PD damping gains (x, y in N s/m, yaw in N m s/rad).
     base_kd: list[float] = dataclasses.field(default_factory=lambda: [2.0e4, 2.0e4, 600.0])
+    #: The arm's PD stiffness gains (lift in N/m, the others in N m/rad).
     arm_kp: list[float] = dataclasses.field(
         default_factory=lambda: [5.5e5, 2.8e4, 1200.0, 1400.0, 90.0])
+    #: The arm's PD damping gains (lift in N s/m, the others in N m s/rad).
     arm_kd: list[float] = dataclasses.field(
         default_factory=lambda: [3700.0, 190.0, 7.8, 9.0, 0.6])
     #: Acceleration limits, enforced by the diff IK on its plan (the servos follow it; see

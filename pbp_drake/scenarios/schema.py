@@ -58,7 +58,9 @@ METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha"
 class Obstacle:
     """A disc (sphere in 3-D) the 2-D robot must not enter."""
 
+    #: The centre (m), one coordinate per dimension.
     center: list[float] = dataclasses.field(default_factory=list)
+    #: The radius (m).
     radius: float = 0.1
 
 
@@ -71,6 +73,7 @@ class Hsr:
     """`robot: !Hsr {...}`: the simulated Toyota HSR (our primitive-shape model) under
     whole-body differential IK; the PBP loop commands its end effector in task space."""
 
+    #: What the HSR station is built from (see HsrStationConfig).
     station: HsrStationConfig = dataclasses.field(default_factory=HsrStationConfig)
     #: The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it,
     #: and operators whose speed is 0 move the hand at it.
@@ -82,6 +85,7 @@ class Hsr:
     #: base's published speed limit: a hand driven faster for long runs its arm out of
     #: range, and the whole-body IK then lurches.
     max_hand_acceleration: float = 1.0
+    #: The fastest commanded hand speed (m/s).
     max_hand_speed: float = 0.2
     #: The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
     max_hand_yaw_acceleration: float = 4.0
@@ -91,10 +95,15 @@ class Hsr:
 class BentPath:
     """A demonstration from `start` to `goal` that bows sideways by `bend` at mid-path."""
 
+    #: Where the demonstration starts (m).
     start: list[float] = dataclasses.field(default_factory=list)
+    #: Where it ends (m).
     goal: list[float] = dataclasses.field(default_factory=list)
+    #: The sideways offset at mid-path (m).
     bend: float = 0.0
+    #: Its duration (s).
     duration: float = 1.0
+    #: How many samples it has (a count).
     sample_count: int = 200
 
 
@@ -102,7 +111,9 @@ class BentPath:
 class RecordedPath:
     """A demonstration given sample by sample."""
 
+    #: The sample times (s), increasing.
     times: list[float] = dataclasses.field(default_factory=list)
+    #: The positions (m), one row per time.
     positions: list[list[float]] = dataclasses.field(default_factory=list)
 
 
@@ -120,10 +131,15 @@ class SinusoidalStep:
     """Open-loop input along `axis`: `amplitude * sin(2 pi (t - start_time) / period)` for
     `start_time <= t < start_time + duration`, then it stops at once (Fig. 4's input)."""
 
+    #: The input's direction (a vector, one entry per dimension).
     axis: list[float] = dataclasses.field(default_factory=list)
+    #: The input's amplitude (the operator command's unit, m/s).
     amplitude: float = 1.0
+    #: When the input starts (s).
     start_time: float = 0.2
+    #: How long it lasts (s).
     duration: float = 0.4
+    #: The sine's period (s).
     period: float = 1.6
 
 
@@ -131,7 +147,9 @@ class SinusoidalStep:
 class ScriptedCommands:
     """Commands `(T, D)` held from each of `times` until the next."""
 
+    #: When each command starts (s), increasing.
     times: list[float] = dataclasses.field(default_factory=list)
+    #: The commands (m/s), one row per time.
     commands: list[list[float]] = dataclasses.field(default_factory=list)
 
 
@@ -162,16 +180,24 @@ class MultiGoalReach:
     a rectangle in front of the robot at one height; the target switches to another object
     at each progress threshold of `switch_schedule` after the first (0 %)."""
 
+    #: The range [min, max] of how many objects are drawn (a count).
     object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
+    #: The objects' x range (m).
     x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    #: The objects' y range (m).
     y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    #: The objects' and the hand's height (m).
     height: float = 0.7
+    #: The least distance between two objects (m).
     min_separation: float = 0.2
+    #: The progress fractions (0 to 1) at which the target switches.
     switch_schedule: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.3, 0.6])
+    #: The hand within this distance (m) of the target is a success.
     success_distance: float = 0.05
     #: Fixed objects `(M, 3)` and targets (object indices, one per schedule entry) instead of
     #: drawing them from the seed.
     objects: list[list[float]] = dataclasses.field(default_factory=list)
+    #: The target object indices with `objects`, one per schedule entry.
     targets: list[int] = dataclasses.field(default_factory=list)
 
 
@@ -183,16 +209,27 @@ class DynamicObstacles:
     line from the hand to the target. Collisions are measured on the HSR's collision
     geometry and do not push the robot."""
 
+    #: The target's x range (m).
     x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    #: The target's y range (m).
     y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    #: The target's and the hand's height (m).
     height: float = 0.7
+    #: The hand within this distance (m) of the target is a success.
     success_distance: float = 0.05
+    #: How many cylinder obstacles (a count).
     obstacle_count: int = 3
+    #: The obstacles' radius (m).
     obstacle_radius: float = 0.12
+    #: The obstacles' height (m).
     obstacle_height: float = 1.2
+    #: The obstacles' speed once they move (m/s).
     obstacle_speed: float = 0.15
+    #: The obstacles' starting x range (m).
     obstacle_x_range: list[float] = dataclasses.field(default_factory=lambda: [0.9, 2.6])
+    #: The obstacles' starting y range (m).
     obstacle_y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.3, 1.3])
+    #: The progress fractions (0 to 1) between which each obstacle's start threshold is drawn.
     activation_range: list[float] = dataclasses.field(default_factory=lambda: [0.05, 0.5])
 
 
@@ -205,19 +242,24 @@ class GraspTask:
     target's grasp position and within `success_angle` of its grasp orientation. It runs
     on the pose station (`pbp_drake.builder.grasp`) with the virtual participant."""
 
+    #: The range [min, max] of how many objects are drawn (a count).
     object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
     #: The tables' centres are drawn in this rectangle (m), min_separation apart (at least
     #: the tables' diagonal, so that no two overlap).
     x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    #: The tables' y range (m), as `x_range`.
     y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    #: The least distance between two tables' centres (m).
     min_separation: float = 0.45
     #: The height (m) the hand starts at (the station's ready pose), as the reach task's.
     height: float = 0.7
     #: Each table is a box table_size (x, y) m wide with its top at table_height (m).
     table_height: float = 0.6
+    #: The tables' size (x, y) (m).
     table_size: list[float] = dataclasses.field(default_factory=lambda: [0.3, 0.3])
     #: Each object is an upright cylinder standing at its table's centre.
     object_radius: float = 0.03
+    #: The objects' height (m).
     object_height: float = 0.15
     #: An object is grasped from above with this probability, else from the side.
     top_probability: float = 0.5
@@ -229,7 +271,10 @@ class GraspTask:
     roll_range: list[float] = dataclasses.field(default_factory=lambda: [-90.0, 90.0])
     #: The palm stands this far (m) behind the point the fingers close on.
     grasp_depth: float = 0.08
+    #: The progress fractions (0 to 1) at which the target switches.
     switch_schedule: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.3, 0.6])
+    #: The hand within this distance (m) of the target's grasp position (and within
+    #: `success_angle`) is a success.
     success_distance: float = 0.03
     #: Degrees.
     success_angle: float = 10.0
@@ -239,14 +284,17 @@ class GraspTask:
 class Scenario:
     """Everything one simulation needs."""
 
+    #: The scenario's name (in outputs and the console).
     name: str = "scenario"
     #: One of METHODS.
     method: str = "pbp_alternated"
     #: The arbitration weight of `fixed_alpha`, in [0, 1].
     alpha: float = 0.5
+    #: The control tick's period (s).
     control_period: float = 0.01
     #: The time limit (s) of a run.
     duration: float = 2.0
+    #: The robot: the toy point robot (untagged) or `!Hsr`.
     robot: typing.Union[PointRobot, Hsr] = dataclasses.field(default_factory=PointRobot)
     #: The robot's initial position; empty: the demonstration's start.
     start: list[float] = dataclasses.field(default_factory=list)
@@ -254,18 +302,23 @@ class Scenario:
     goals: list[list[float]] = dataclasses.field(default_factory=list)
     #: The demonstration the DMPs learn from; none: straight paths.
     demonstration: typing.Optional[typing.Union[BentPath, RecordedPath]] = None
+    #: The DMPs' gains and basis (DmpSettings).
     dmp: DmpSettings = dataclasses.field(default_factory=DmpSettings)
     #: The DMPs' duration tau (s); 0 takes the demonstration's duration (2-D scenes) or the
     #: farthest goal's distance over `robot.speed` (HSR).
     dmp_duration: float = 0.0
+    #: The 2-D scenes' obstacles (discs).
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
+    #: Who drives the robot: a tagged operator variant; untagged: none.
     operator: OperatorConfig = dataclasses.field(default_factory=NoOperator)
     #: HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
     #: An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,
     #: `!GraspTask {...}` the grasping task.
     task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles, GraspTask]] = None
+    #: How the followed goal is estimated (GoalEstimatorSettings).
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
+    #: The seed of every random draw (an integer).
     seed: int = 0
     #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
     #: its target_realtime_rate).
@@ -276,7 +329,9 @@ class Scenario:
 class SceneVariant:
     """A test scene of the alpha study: the scenario with its obstacles replaced."""
 
+    #: The scene's name.
     name: str = ""
+    #: The scene's obstacles, replacing the scenario's.
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
 
 
@@ -286,7 +341,9 @@ class AlphaStudy:
 
     #: Where the obstacles stood when the demonstration was given (drawn in panel a).
     demonstration_obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
+    #: The test scenes.
     scenes: list[SceneVariant] = dataclasses.field(default_factory=list)
+    #: The fixed arbitration weights compared (each in [0, 1]).
     alphas: list[float] = dataclasses.field(
         default_factory=lambda: [round(0.1 * i, 1) for i in range(11)])
     #: The virtual operator's speeds (its `speed`) at which every scene runs: the summary
@@ -319,11 +376,16 @@ class MethodComparison:
     `pbp_drake.studies.splits`). `pbp-drake study --methods --trials --split --seed`
     override these."""
 
+    #: The methods compared (names of METHODS).
     methods: list[str] = dataclasses.field(
         default_factory=lambda: ["pbp_alternated", "pbp_continuous", "teleop"])
+    #: Trials per method (a count).
     trials: int = 10
+    #: The first seed of the tuning split.
     tuning_seed: int = 0
+    #: The first seed of the evaluation split.
     evaluation_seed: int = 10_000
+    #: Which split the trials use: tuning or evaluation.
     split: str = "evaluation"
 
 
@@ -331,5 +393,7 @@ class MethodComparison:
 class ScenarioFile:
     """The top level of a file in `diagrams/`."""
 
+    #: The scenario: everything one simulation needs.
     scenario: Scenario = dataclasses.field(default_factory=Scenario)
+    #: The study that varies it, a tagged variant; none: no study.
     study: typing.Optional[typing.Union[AlphaStudy, AltVsCont, MethodComparison]] = None

@@ -36,10 +36,15 @@ class DmpSettings:
         alpha_x: phase decay; `ln 100` makes the phase reach 0.01 at `t = tau`.
     """
 
+    #: ijspeert or pastor.
     formulation: str = "ijspeert"
+    #: The number of Gaussian basis functions, 2 to MAX_BASIS_COUNT (10,000).
     basis_count: int = 50
+    #: The damping gain (1/s).
     alpha_z: float = 25.0
+    #: The stiffness ratio; None for alpha_z / 4 (critically damped).
     beta_z: float | None = None
+    #: The phase decay; ln 100 makes the phase reach 0.01 at t = tau.
     alpha_x: float = math.log(100.0)
 
     def __post_init__(self):

@@ -22,8 +22,11 @@ class GamepadParams:
     the right stick turns it at up to `rotation_speed` (rad/s); `dead_zone` is each stick's
     radial dead zone, in [0, 1)."""
 
+    #: The left stick's top speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = 0.0
+    #: The right stick's top turn rate (rad/s).
     rotation_speed: float = 0.6
+    #: Each stick's radial dead zone, in [0, 1).
     dead_zone: float = 0.15
 
 

@@ -44,7 +44,9 @@ class KeyboardParams:
     `speed` (m/s; 0 takes the task's nominal speed, that of its DMPs), Q and E turn it at
     `rotation_speed` (rad/s)."""
 
+    #: The arrows' speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = 0.0
+    #: Q and E's turn rate (rad/s).
     rotation_speed: float = 0.6
     #: A key counts as held this long (s) after its last press. The browser repeats a held
     #: key, but only after the system's repeat delay (often 0.25..0.66 s): bridge it.

@@ -13,8 +13,11 @@ class ObstacleRepulsionParams:
     """The paper's virtual human: `speed` away from the nearest obstacle when closer than
     `distance_threshold`; along `axis` only when one is given (empty: radially)."""
 
+    #: It pushes when the robot is closer than this (m) to the nearest obstacle.
     distance_threshold: float = 0.2
+    #: How fast it pushes away (the command's unit, m/s).
     speed: float = 1.0
+    #: The direction it pushes along (a vector); empty: radially from the obstacle.
     axis: list[float] = dataclasses.field(default_factory=list)
 
 

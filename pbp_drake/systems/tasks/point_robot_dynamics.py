@@ -13,9 +13,13 @@ class PointRobotParams:
     """The point robot's dynamics: mass (kg), the tracking spring (N/m) and damper (N s/m),
     and its discrete time step (s). Scenario files give it as `robot: {...}`."""
 
+    #: The point's mass (kg).
     mass: float = 1.0
+    #: The tracking spring (N/m).
     stiffness: float = 400.0
+    #: The tracking damper (N s/m).
     damping: float = 40.0
+    #: The discrete time step (s).
     time_step: float = 0.001
 
 

@@ -88,7 +88,9 @@ def _option_lines(parser):
 
 
 def _command_lines(prog, parser, underline="-"):
-    usage = parser.format_usage().removeprefix("usage: ").strip()
+    # argparse indents the usage's later lines under "usage: ", which the page leaves out.
+    usage = "\n".join(line.removeprefix("usage: ").removeprefix(" " * len("usage: "))
+                      for line in parser.format_usage().strip().splitlines())
     lines = [prog, underline * len(prog), "", (parser.description or "").replace("`", "``"), "",
              ".. code-block:: text", "", *("   " + line for line in usage.splitlines()), ""]
     return lines + _option_lines(parser)

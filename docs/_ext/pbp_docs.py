@@ -250,7 +250,17 @@ class ApiReference(SphinxDirective):
         return _parse_rst(self, lines)
 
 
+# The pages generated from the code: re-read at every build, since Sphinx sees only
+# their Markdown (unchanged) and would keep an old page after the code changed.
+GENERATED_PAGES = ["reference/cli", "reference/scenario-files", "reference/api"]
+
+
+def _generated_pages(app, env, added, changed, removed):
+    return [page for page in GENERATED_PAGES if page in env.found_docs]
+
+
 def setup(app):
+    app.connect("env-get-outdated", _generated_pages)
     app.add_directive("pydrake_system", PydrakeSystem)
     app.add_directive("cli-reference", CliReference)
     app.add_directive("scenario-reference", ScenarioReference)

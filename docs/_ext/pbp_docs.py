@@ -22,7 +22,7 @@ from sphinx.util.nodes import nested_parse_with_titles
 
 def _parse_rst(directive, lines):
     """Parses generated reST lines into nodes (so titles and autodoc directives work)."""
-    node = nodes.section() if False else nodes.container()
+    node = nodes.container()
     nested_parse_with_titles(directive.state, StringList(lines, "<generated>"), node)
     return node.children
 
@@ -82,8 +82,9 @@ def _option_lines(parser):
             facts.append(f"default: ``{action.default}``")
         help_text = (action.help or "").replace("%(prog)s", parser.prog)
         help_text = help_text.replace("*", r"\*").replace("`", "``").replace("````", "``")
-        lines += [f"``{name}``", f"   {help_text}" + (f" ({'; '.join(facts)})" if facts else "")
-                  or "   (no help)", ""]
+        help_text = help_text or "(no help text)"
+        lines += [f"``{name}``", f"   {help_text}" + (f" ({'; '.join(facts)})" if facts else ""),
+                  ""]
     return lines
 
 

@@ -13,15 +13,15 @@ from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
 from pbp_drake.studies.trial_files import StudyError, write_atomically
 
-# The 2-D studies' study.json: which study and scenario file (their summary.json is the
-# study's result and names no file).
-TOY_STUDY_FILE = "study.json"
+# A study folder's study.json; a 2-D study's says which study and scenario file (its
+# summary.json is the study's result and names no file).
+STUDY_FILE = "study.json"
 
 
 def write_toy_study(output, kind, scenario_name, scenario_file):
     """Writes a 2-D study folder's study.json: its kind, scenario and scenario file."""
     study = {"study": kind, "scenario": scenario_name, "scenario_file": str(scenario_file)}
-    write_atomically(pathlib.Path(output) / TOY_STUDY_FILE, json.dumps(study, indent=2) + "\n")
+    write_atomically(pathlib.Path(output) / STUDY_FILE, json.dumps(study, indent=2) + "\n")
 
 
 def _scenario_file(study, summary):
@@ -121,10 +121,7 @@ def toy_markdown(output):
         summary = json.loads((output / "summary.json").read_text())
     except (OSError, ValueError) as error:
         raise StudyError(f"{output / 'summary.json'}: cannot be read ({error})") from None
-    try:
-        study = json.loads((output / TOY_STUDY_FILE).read_text())
-    except (OSError, ValueError):
-        study = {}  # written before study.json was: the command names no file
+    study = read_study_json(output)  # {} when written before study.json was
     figure = output / TOY_FIGURES[summary["study"]]
     if summary["study"] == "alpha_study":
         return alpha_study_markdown(study, summary, figure)
@@ -132,10 +129,10 @@ def toy_markdown(output):
 
 
 def read_study_json(output):
-    """A method comparison folder's study.json as a dict ({} when unreadable: the command
+    """A study folder's study.json as a dict ({} when missing or unreadable: the command
     then names no scenario file)."""
     try:
-        study = json.loads((pathlib.Path(output) / "study.json").read_text())
+        study = json.loads((pathlib.Path(output) / STUDY_FILE).read_text())
     except (OSError, ValueError):
         return {}
     return study if isinstance(study, dict) else {}

@@ -1,6 +1,7 @@
 """The documentation site builds as `make docs` builds it, with no warning, and its generated
-reference pages hold what a reader looks for; every public name imports; every field of a
-scenario file has a description (the scenario-files page prints it)."""
+reference pages hold what a reader looks for; every field of a scenario file has a
+description (the scenario-files page prints it). That every public name imports is
+tests/test_public_api.py's."""
 
 import dataclasses
 import pathlib
@@ -14,11 +15,6 @@ import pbp_drake
 REPO = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "docs" / "_ext"))
 import pbp_docs  # noqa: E402  (docs/_ext is not a package)
-
-
-@pytest.mark.parametrize("name", pbp_drake.__all__)
-def test_every_public_name_imports(name):
-    assert getattr(pbp_drake, name) is not None
 
 
 def test_every_scenario_field_has_a_description():

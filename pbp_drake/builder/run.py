@@ -17,7 +17,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorS
 
 from pbp_drake.builder.build import build_diagram
 from pbp_drake.builder.grasp import grasp_series_fields
-from pbp_drake.scenarios import ResolvedScenario, resolve
+from pbp_drake.scenarios import ResolvedScenario, counted, resolve
 from pbp_drake.systems.operators.browser_guard import reset_pacing_after_pauses
 from pbp_drake.systems.ports import TaskStatus
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
@@ -198,7 +198,8 @@ class TaskResult:
                    f"command angular change {_or_na(self.peak_command_angular_change, 3)} "
                    "rad/s per tick")
         return (f"{outcome} in {self.task_time:.2f} s, intervention ratio "
-                f"{self.intervention_ratio:.3f}{collisions}, {self.switches} target switches, "
+                f"{self.intervention_ratio:.3f}{collisions}, "
+                f"{counted(self.switches, 'target switch', 'target switches')}, "
                 f"peak hand speed {_or_na(self.peak_hand_speed, 3)} m/s, "
                 f"peak command acceleration {_or_na(self.peak_command_acceleration, 2)} m/s^2"
                 f"{turning}")

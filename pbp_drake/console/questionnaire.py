@@ -1,7 +1,7 @@
 """The pages of a user-study session in the Meshcat control panel: before each method a Start
-button that names it, after it the paper's two questions as six buttons each (0 bad .. 5
-good), then a Next button. `FixedAnswers` is the same flow without a browser, for the
-virtual operator (`--answers`).
+button that names it, after it the paper's two questions as six buttons each (0 to 5, both
+ends labelled in words: "0 = very tired", "5 = not tired at all"), then a Next button.
+`FixedAnswers` is the same flow without a browser, for the virtual operator (`--answers`).
 
 Both are driven by `studies.sessions.run_session` through three calls: `start`, `answer`,
 `next`. Meshcat's controls are polled from the thread that made the Meshcat (Drake's rule);
@@ -11,15 +11,10 @@ cannot answer another.
 
 import time
 
-from pbp_drake.studies.figures import METHOD_LABELS
-from pbp_drake.studies.questionnaire import QUESTIONS, SCALE
+from pbp_drake.console.text import method_name
+from pbp_drake.studies.questionnaire import QUESTIONS, SCALE, end_label
 
 POLL_PERIOD = 0.05  # s between looks at the buttons: a click feels immediate
-
-
-def method_name(method):
-    """The name a participant sees: the paper's (PBP-Alt, PBP-Cont, Teleop)."""
-    return METHOD_LABELS.get(method, method)
 
 
 def start_label(method, position, total, practice=False):
@@ -30,10 +25,16 @@ def start_label(method, position, total, practice=False):
 
 
 def answer_labels(question):
-    """The six buttons of a question, by label: the value first, so that a label the panel
-    cuts short still shows it."""
-    ends = {SCALE[0]: " (bad)", SCALE[-1]: " (good)"}
-    return {f"{value}{ends.get(value, '')}: {QUESTIONS[question]}": value for value in SCALE}
+    """The six buttons of a question, `{label: value}`: "0 = very tired: How tired did you
+    feel?", "1: How tired did you feel?", ... "5 = not tired at all: ...". The value first,
+    so that a label the panel cuts short still shows it; the two ends say what they mean,
+    so that nobody guesses which end is which."""
+    text = QUESTIONS[question].text
+    labels = {}
+    for value in SCALE:
+        end = end_label(question, value)
+        labels[f"{value} = {end}: {text}" if end else f"{value}: {text}"] = value
+    return labels
 
 
 def next_label(position, total):

@@ -4,20 +4,14 @@ same thing the same way."""
 
 import math
 
-#: How the page names each method (the paper's names where it has them).
-METHOD_NAMES = {
-    "pbp_alternated": "PBP-Alt",
-    "pbp_continuous": "PBP-Cont",
-    "pbp_no_user": "PBP without the user",
-    "fixed_alpha": "fixed alpha",
-    "confidence_alpha": "confidence alpha",
-    "teleop": "teleoperation",
-}
+from pbp_drake.scenarios import METHOD_NAMES, counted
 
 
 def method_name(method, alpha=None):
-    """The method as a person reads it: `method_name("pbp_alternated")` is "PBP-Alt",
-    `method_name("fixed_alpha", 0.5)` is "fixed alpha 0.50"; unknown names pass through."""
+    """The method as a person reads it, by the one table of names the results tables and
+    figures read too (`scenarios.METHOD_NAMES`): `method_name("pbp_alternated")` is
+    "PBP-Alt", `method_name("fixed_alpha", 0.5)` is "Fixed alpha 0.50"; unknown names pass
+    through."""
     name = METHOD_NAMES.get(method, method)
     if method == "fixed_alpha" and alpha is not None:
         name = f"{name} {alpha:.2f}"
@@ -36,7 +30,7 @@ def status_text(duration, now, switches=None, intervention_ratio=None):
     (0..1) are left out when None (a 2-D scene has no targets to switch)."""
     parts = [time_left(duration, now)]
     if switches is not None:
-        parts.append(f"{switches:d} target switch" + ("" if switches == 1 else "es"))
+        parts.append(counted(switches, "target switch", "target switches"))
     if intervention_ratio is not None:
         parts.append(f"intervention {100.0 * intervention_ratio:.0f} %")
     return " · ".join(parts)

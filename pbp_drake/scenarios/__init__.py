@@ -1,6 +1,7 @@
 """Scenario files: the schema (`schema`), reading them (`loading`), the checks of their text,
 shape and numbers (`validation`) and resolving them (`resolution`: everything checked and
-derived once by `resolve`).
+derived once by `resolve`), and the words a person reads about runs (`words`: each method's
+name, counts).
 
 Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario` ->
 `pbp_drake.builder.build_diagram`.
@@ -17,14 +18,15 @@ from pbp_drake.scenarios.schema import (
     NoOperator, Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot, RecordedPath, Scenario,
     ScenarioError, ScenarioFile, SceneVariant, ScriptedCommands, SinusoidalStep,
     VirtualParticipant)
+from pbp_drake.scenarios.words import METHOD_NAMES, counted
 
 __all__ = [
-    "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHODS", "OPERATOR_NAMES", "TOY_OPERATORS",
-    "AlphaStudy", "AltVsCont", "BentPath", "DynamicObstacles", "Gamepad", "GraspTask", "Hsr",
-    "Keyboard", "LoadedScenarioFile", "MethodComparison", "MultiGoalReach", "NoOperator",
-    "Obstacle", "ObstacleRepulsion", "OperatorConfig", "PointRobot", "RecordedPath",
-    "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile", "SceneVariant",
-    "ScriptedCommands", "SinusoidalStep", "TaskScene", "VirtualParticipant", "check_alpha_study",
-    "check_method_comparison", "demonstration_samples", "load_scenario_file",
-    "parse_method_label", "resolve", "task_scene", "with_method",
+    "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHOD_NAMES", "METHODS", "OPERATOR_NAMES",
+    "TOY_OPERATORS", "AlphaStudy", "AltVsCont", "BentPath", "DynamicObstacles", "Gamepad",
+    "GraspTask", "Hsr", "Keyboard", "LoadedScenarioFile", "MethodComparison", "MultiGoalReach",
+    "NoOperator", "Obstacle", "ObstacleRepulsion", "OperatorConfig", "PointRobot",
+    "RecordedPath", "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile",
+    "SceneVariant", "ScriptedCommands", "SinusoidalStep", "TaskScene", "VirtualParticipant",
+    "check_alpha_study", "check_method_comparison", "counted", "demonstration_samples",
+    "load_scenario_file", "parse_method_label", "resolve", "task_scene", "with_method",
 ]

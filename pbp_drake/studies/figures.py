@@ -12,12 +12,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
+from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
+
 
 # ---------------------------------------------------------------------------------------------
 # The method comparison (Fig. 7)
 
-METHOD_LABELS = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont",
-                 "teleop": "Teleop", "pbp_no_user": "PBP-NoUser", "fixed_alpha": "Fixed alpha"}
+# The methods' names, the one table every page and table reads (scenarios.words).
+METHOD_LABELS = METHOD_NAMES
 METHOD_COLOURS = {"pbp_alternated": "tab:orange", "pbp_continuous": "tab:blue",
                   "teleop": "tab:green", "pbp_no_user": "tab:gray", "fixed_alpha": "tab:purple"}
 

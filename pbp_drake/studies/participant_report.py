@@ -10,11 +10,10 @@ import collections
 import itertools
 import pathlib
 import statistics
-import warnings
 
-from pbp_drake.scenarios import ScenarioError
+from pbp_drake.scenarios import ScenarioError, counted
 from pbp_drake.studies.figures import METHOD_LABELS
-from pbp_drake.studies.questionnaire import QUESTIONS, read_answers
+from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, scale_text
 from pbp_drake.studies.questionnaire_figure import FIG8, answer_counts, plot_questionnaire
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, PRACTICE_FOLDER
 from pbp_drake.studies.trial_files import name_damaged, read_study, write_atomically
@@ -107,14 +106,21 @@ def measure_values(sessions, methods, measure, source):
     return values
 
 
-def wilcoxon_rows(values, methods):
+# Who counts in a pair's test, by the measure's source, as the notes say it.
+PAIRED_BY = {"trial": "ran both", "answer": "answered both"}
+
+
+def wilcoxon_rows(values, methods, source):
     """Each pair of methods' two-sided Wilcoxon signed-rank test (scipy.stats.wilcoxon,
     its defaults) over the participants with a value for both, paired by participant:
-    dicts of pair, n, statistic, p (None when scipy gives none, with `note` why)."""
+    dicts of pair, n, statistic, p. p is None where there is nothing to test, and `note`
+    says why in plain words (`source`, "trial" or "answer", names who counted) rather than
+    in SciPy's: fewer than two participants, or every difference zero."""
     # Deferred: scipy.stats takes about 0.7 s to import, which every pbp-drake command
     # would pay at start-up for the one report that uses it.
     import scipy.stats
 
+    who = PAIRED_BY[source]
     rows = []
     for first, second in itertools.combinations(methods, 2):
         paired = sorted(set(values[first]) & set(values[second]))
@@ -122,21 +128,22 @@ def wilcoxon_rows(values, methods):
         y = [values[second][p] for p in paired]
         row = {"pair": (first, second), "n": len(paired), "statistic": None, "p": None,
                "note": ""}
-        if not paired:
-            row["note"] = "no participant has both"
+        if len(paired) < 2:
+            row["note"] = (f"a test needs at least 2 participants who {who}; "
+                           f"{len(paired) or 'none'} did")
+        elif all(a == b for a, b in zip(x, y)):
+            # SciPy would warn and give p = 1 (or refuse, for older versions): no test.
+            row["note"] = (f"nothing to test: each of the {len(paired)} participants who "
+                           f"{who} has the same value for both")
         else:
             try:
-                with warnings.catch_warnings():
-                    # All differences zero: scipy warns and gives p = 1; the row says so.
-                    warnings.simplefilter("ignore", RuntimeWarning)
-                    result = scipy.stats.wilcoxon(x, y)
+                result = scipy.stats.wilcoxon(x, y)
                 row["statistic"], row["p"] = float(result.statistic), float(result.pvalue)
-                if all(a == b for a, b in zip(x, y)):
-                    row["note"] = "all differences zero"
-            except ValueError as error:
-                row["note"] = str(error)
-        if row["p"] is not None and row["p"] != row["p"]:  # NaN
-            row["p"], row["note"] = None, row["note"] or "scipy gave no p-value"
+            except ValueError as error:  # none known with two or more differing pairs
+                row["note"] = f"the test could not be made ({error})"
+        if row["p"] is not None and row["p"] != row["p"]:  # NaN: a value is not a number
+            row["statistic"] = row["p"] = None
+            row["note"] = "the test gave no p-value (a value is not a number)"
         rows.append(row)
     return rows
 
@@ -168,7 +175,7 @@ def participant_results(study_dir):
               for key, _, source in MEASURES}
     first = next(iter(sessions.values()))["study"]
     lines = [f"# User study: {first['scenario']} (scenario hash {first['scenario_hash']})", "",
-             f"{len(sessions)} participants: {', '.join(sessions)}. Practice runs "
+             f"{counted(len(sessions), 'participant')}: {', '.join(sessions)}. Practice runs "
              f"({PRACTICE_FOLDER}/ in a participant folder) are not counted.", "",
              "## Per method", "",
              "| method | participants | success | intervention ratio | task time (s) | "
@@ -182,14 +189,15 @@ def participant_results(study_dir):
             f"{_mean_std(values['task_time'][method].values())} | "
             f"{_median_mean(values['tiredness'][method].values())} | "
             f"{_median_mean(values['ease'][method].values())} |")
-    lines += ["", "Answers, counts of 0 (bad) to 5 (good) (Fig. 8, "
+    scales = "; ".join(f"{key}: {scale_text(key)}" for key in QUESTIONS)
+    lines += ["", f"Answers, the count of each value, higher is better ({scales}; Fig. 8, "
               f"{FIG8}):", "", "| method | question | 0 | 1 | 2 | 3 | 4 | 5 |",
               "|---|---|---|---|---|---|---|---|"]
     answers = {name: s["answers"] for name, s in sessions.items()}
-    for question, text in QUESTIONS.items():
+    for question, asked in QUESTIONS.items():
         counts = answer_counts(answers, methods, question)
         for method in methods:
-            lines.append(f"| {_label(method)} | {text} | "
+            lines.append(f"| {_label(method)} | {asked.text} | "
                          + " | ".join(str(c) for c in counts[method]) + " |")
     pairs = len(methods) * (len(methods) - 1) // 2
     threshold = ALPHA / max(pairs, 1)
@@ -200,8 +208,8 @@ def participant_results(study_dir):
               f"= {threshold:.4g} (the corrected p is p × {pairs}, at most 1).", "",
               "| measure | pair | n | W | p | corrected p | significant |",
               "|---|---|---|---|---|---|---|"]
-    for key, name, _ in MEASURES:
-        for row in wilcoxon_rows(values[key], methods):
+    for key, name, source in MEASURES:
+        for row in wilcoxon_rows(values[key], methods, source):
             pair = f"{_label(row['pair'][0])} vs {_label(row['pair'][1])}"
             if row["p"] is None:
                 lines.append(f"| {name} | {pair} | {row['n']} | - | n/a ({row['note']}) | "
@@ -215,13 +223,17 @@ def participant_results(study_dir):
               "(tiredness / ease) |", "|---|---|---|---|"]
     for name, session in sessions.items():
         study = session["study"]
-        given = "; ".join(f"{_label(m)} {a.get('tiredness', '-')} / {a.get('ease', '-')}"
-                          for m, a in session["answers"].items()) or "none"
+        # In the report's order of methods, whichever order the file holds them in.
+        by_method = session["answers"]
+        in_order = ([m for m in methods if m in by_method]
+                    + [m for m in by_method if m not in methods])
+        given = "; ".join(f"{_label(m)} {by_method[m].get('tiredness', '-')} / "
+                          f"{by_method[m].get('ease', '-')}" for m in in_order) or "none"
         lines.append(f"| {name} | {', '.join(_label(m) for m in study['methods'])} | "
                      f"{study['seed']} | {given} |")
     if damaged:
-        lines += ["", f"Skipped as damaged: {len(damaged)} files (named by `pbp-drake "
-                      "report`)."]
+        lines += ["", f"Skipped as damaged: {counted(len(damaged), 'file')} (named by "
+                      "`pbp-drake report`)."]
     return "\n".join(lines) + "\n", sessions, methods, damaged
 
 

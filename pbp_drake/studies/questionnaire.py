@@ -1,21 +1,42 @@
-"""The paper's questionnaire (section V-C, Fig. 8): two questions answered 0 (bad) to 5 (good)
-after each method of a session, kept in the participant folder's `questionnaire.json` as
-`{method: {"tiredness": int, "ease": int}}`.
+"""The paper's questionnaire (section V-C, Fig. 8): two questions answered on a scale of 0 to
+5 after each method of a session, higher being better (as in Fig. 8), each end of each
+question labelled in words so that a participant never has to guess which end is which.
+`QUESTIONS` is the one table of them: the page's buttons, `--answers`' messages, the report
+and the file all read it.
+
+The participant folder's `questionnaire.json` keeps the answers by method beside the
+questions as the participant saw them (their text and what 0 and 5 meant):
+
+    {"answers": {method: {"tiredness": 0-5, "ease": 0-5}, ...},
+     "questions": {"tiredness": {"question": ..., "0": ..., "5": ...}, "ease": {...}}}
 
 Each answer is written at once (atomically), so an interrupted session loses none and a
-resumed one does not ask it again; an answer on disk is never overwritten.
+resumed one does not ask it again; an answer on disk is never overwritten. A file of the
+older form, the bare `{method: {question: answer}}` without the questions, is read as it is
+and, should its session resume, kept in that form (it holds no record of the labels its
+first answers were given under, and gets none it cannot vouch for).
 """
 
 import json
 import pathlib
+import typing
 
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.studies.trial_files import write_atomically
 
+
+class Question(typing.NamedTuple):
+    """A question as the participant reads it, with what the two ends of its scale mean."""
+
+    text: str
+    lowest: str  # what 0 means
+    highest: str  # what 5 means
+
+
 # The keys of questionnaire.json and the questions as the paper asked them.
-QUESTIONS = {"tiredness": "How tired did you feel?",
-             "ease": "How easy was it to operate the robot?"}
-SCALE = range(0, 6)  # 0 (bad) .. 5 (good)
+QUESTIONS = {"tiredness": Question("How tired did you feel?", "very tired", "not tired at all"),
+             "ease": Question("How easy was it to operate the robot?", "very hard", "very easy")}
+SCALE = range(0, 6)  # 0 (the worse end) .. 5 (the better end) of every question
 QUESTIONNAIRE_FILE = "questionnaire.json"
 
 
@@ -23,56 +44,132 @@ class QuestionnaireError(ScenarioError):
     """A questionnaire answer or file that cannot be taken (exit 2, as any user error)."""
 
 
-def check_answer(value, where):
-    """`value` as an int of SCALE; raises QuestionnaireError naming `where` otherwise."""
+def end_label(question, value):
+    """What `value` means for `question` when it is an end of the scale ("very tired" for
+    tiredness 0), else None: the middle values are just numbers."""
+    asked = QUESTIONS[question]
+    return {SCALE[0]: asked.lowest, SCALE[-1]: asked.highest}.get(value)
+
+
+def scale_text(question):
+    """`question`'s scale in words: "0 = very tired to 5 = not tired at all"."""
+    return (f"{SCALE[0]} = {end_label(question, SCALE[0])} to "
+            f"{SCALE[-1]} = {end_label(question, SCALE[-1])}")
+
+
+def scales_text():
+    """Every question's scale, for help and messages that speak of them all: "0 to 5, higher
+    is better (tiredness: 0 = very tired to 5 = not tired at all; ease: ...)"."""
+    return (f"{SCALE[0]} to {SCALE[-1]}, higher is better ("
+            + "; ".join(f"{key}: {scale_text(key)}" for key in QUESTIONS) + ")")
+
+
+def recorded_questions():
+    """The questions as questionnaire.json records them beside the answers: per key, its
+    text and the labels of its two ends, by value."""
+    return {key: {"question": asked.text, str(SCALE[0]): asked.lowest,
+                  str(SCALE[-1]): asked.highest} for key, asked in QUESTIONS.items()}
+
+
+def check_answer(value, question, where):
+    """`value` as an int of SCALE; raises QuestionnaireError naming `where` and what the
+    ends of `question` mean otherwise."""
     if isinstance(value, bool) or not isinstance(value, int) or value not in SCALE:
-        raise QuestionnaireError(f"{where}: the answer {value!r} is outside 0 (bad) to 5 "
-                                 "(good); answers are whole numbers 0, 1, 2, 3, 4 or 5")
+        raise QuestionnaireError(f"{where}: the answer {value!r} is outside {SCALE[0]} to "
+                                 f"{SCALE[-1]} ({scale_text(question)}); answers are whole "
+                                 "numbers 0, 1, 2, 3, 4 or 5")
     return value
 
 
-def read_answers(folder):
-    """The answers saved in `folder`'s questionnaire.json (`{}` when there is none). Raises
-    QuestionnaireError, naming the file, when it is damaged or holds an answer outside 0-5
-    or an unknown question."""
+def _check_question(question, where):
+    if question not in QUESTIONS:
+        raise QuestionnaireError(f"{where}: unknown question {question!r}; the questions: "
+                                 f"{', '.join(QUESTIONS)}")
+
+
+def read_questionnaire(folder):
+    """`(answers, questions)` of `folder`'s questionnaire.json: the answers by method
+    (`{}` when there is no file) and the questions as recorded beside them (None for a file
+    of the older form, which did not record them). Raises QuestionnaireError, naming the
+    file, when it is damaged or holds an answer outside 0-5 or an unknown question."""
     path = pathlib.Path(folder) / QUESTIONNAIRE_FILE
     try:
-        answers = json.loads(path.read_text())
+        held = json.loads(path.read_text())
     except FileNotFoundError:
-        return {}
+        return {}, None
     except (OSError, ValueError) as error:
         raise QuestionnaireError(f"{path}: unreadable or invalid JSON ({error})") from None
-    if not isinstance(answers, dict):
-        raise QuestionnaireError(f"{path}: holds a {type(answers).__name__}, not "
-                                 "{method: {question: answer}}")
+    if not isinstance(held, dict):
+        raise QuestionnaireError(f"{path}: holds a {type(held).__name__}, not "
+                                 '{"answers": {method: {question: answer}}, "questions": ...}')
+    answers, questions = held, None
+    if "answers" in held or "questions" in held:  # the form that records the questions
+        if set(held) != {"answers", "questions"}:
+            raise QuestionnaireError(f"{path}: holds {sorted(held)}; expected exactly "
+                                     '"answers" and "questions"')
+        answers, questions = held["answers"], held["questions"]
+        if not isinstance(answers, dict):
+            raise QuestionnaireError(f'{path}: "answers" holds a {type(answers).__name__}, '
+                                     "not {method: {question: answer}}")
+        if not isinstance(questions, dict) or not all(
+                isinstance(labels, dict) and all(isinstance(text, str) for text in
+                                                 labels.values())
+                for labels in questions.values()):
+            raise QuestionnaireError(f'{path}: "questions" is not '
+                                     '{question: {"question": text, "0": label, "5": label}}')
+        for question in questions:
+            _check_question(question, f'{path}: "questions"')
     for method, entry in answers.items():
         if not isinstance(entry, dict):
             raise QuestionnaireError(f"{path}: the answers of {method!r} are not a mapping")
         for question, value in entry.items():
-            if question not in QUESTIONS:
-                raise QuestionnaireError(f"{path}: {method!r} answers an unknown question "
-                                         f"{question!r} (the questions: {list(QUESTIONS)})")
-            check_answer(value, f"{path}: {method} {question}")
-    return answers
+            _check_question(question, f"{path}: {method}")
+            check_answer(value, question, f"{path}: {method} {question}")
+    return answers, questions
+
+
+def read_answers(folder):
+    """The answers saved in `folder`'s questionnaire.json, `{method: {question: answer}}`
+    (`{}` when there is none), of either form of the file (see `read_questionnaire`)."""
+    return read_questionnaire(folder)[0]
 
 
 def save_answer(folder, method, question, value):
-    """Adds one answer to `folder`'s questionnaire.json, atomically. Raises
-    QuestionnaireError when the value is outside 0-5, or when that question of that method
-    is already answered (a saved answer is never overwritten)."""
-    check_answer(value, f"{method} {question}")
-    if question not in QUESTIONS:
-        raise QuestionnaireError(f"unknown question {question!r}; the questions: "
-                                 f"{list(QUESTIONS)}")
-    answers = read_answers(folder)
+    """Adds one answer to `folder`'s questionnaire.json, atomically, with the questions as
+    asked beside the answers. Raises QuestionnaireError when the value is outside 0-5, when
+    that question of that method is already answered (a saved answer is never overwritten),
+    or when the file records the questions worded otherwise than they are now asked (its
+    session's answers would mean two things)."""
+    _check_question(question, method)
+    check_answer(value, question, f"{method} {question}")
+    path = pathlib.Path(folder) / QUESTIONNAIRE_FILE
+    answers, questions = read_questionnaire(folder)
+    older_form = questions is None and bool(answers)
+    if questions is not None and questions != recorded_questions():
+        raise QuestionnaireError(
+            f"{path} records its questions worded otherwise ({questions}) than they are now "
+            f"asked ({recorded_questions()}): finish the session with the pbp-drake that "
+            "began it, or start the participant in a new folder")
     entry = answers.setdefault(method, {})
     if question in entry:
-        raise QuestionnaireError(f"{pathlib.Path(folder) / QUESTIONNAIRE_FILE}: {method} "
-                                 f"{question} is already answered ({entry[question]}); a saved "
-                                 "answer is not overwritten")
+        raise QuestionnaireError(f"{path}: {method} {question} is already answered "
+                                 f"({entry[question]}); a saved answer is not overwritten")
     entry[question] = value
-    write_atomically(pathlib.Path(folder) / QUESTIONNAIRE_FILE,
-                     json.dumps(answers, indent=1, sort_keys=True) + "\n")
+    write_atomically(path, (json.dumps(answers, indent=1, sort_keys=True) + "\n")
+                     if older_form else _file_text(answers))
+
+
+def _file_text(answers):
+    # One line per method and per question, in the order they were asked, so that a person
+    # reads a participant's answers at a glance.
+    def lines(mapping):
+        return ",\n".join(f"  {json.dumps(key)}: {json.dumps(value)}"
+                          for key, value in mapping.items())
+
+    in_order = {method: {q: entry[q] for q in QUESTIONS if q in entry}
+                for method, entry in answers.items()}
+    return (f'{{\n "answers": {{\n{lines(in_order)}\n }},\n'
+            f' "questions": {{\n{lines(recorded_questions())}\n }}\n}}\n')
 
 
 def parse_answers(text, methods):
@@ -87,9 +184,7 @@ def parse_answers(text, methods):
         if not equals or not question:
             raise QuestionnaireError(f"--answers: {item!r} is not [METHOD:]QUESTION=VALUE, "
                                      "e.g. tiredness=3,ease=4")
-        if question not in QUESTIONS:
-            raise QuestionnaireError(f"--answers: unknown question {question!r}; the "
-                                     f"questions: {', '.join(QUESTIONS)}")
+        _check_question(question, "--answers")
         if colon and method not in methods:
             raise QuestionnaireError(f"--answers: {method!r} is not one of the "
                                      f"participant's methods ({', '.join(methods)})")
@@ -97,8 +192,9 @@ def parse_answers(text, methods):
             value = int(raw.strip())
         except ValueError:
             raise QuestionnaireError(f"--answers: {item!r}: {raw.strip()!r} is not a whole "
-                                     "number 0 (bad) to 5 (good)") from None
-        check_answer(value, f"--answers {item}")
+                                     f"number {SCALE[0]} to {SCALE[-1]} "
+                                     f"({scale_text(question)})") from None
+        check_answer(value, question, f"--answers {item}")
         (specific.setdefault(method, {}) if colon else common)[question] = value
     answers = {}
     for method in methods:

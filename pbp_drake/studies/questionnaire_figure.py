@@ -1,5 +1,6 @@
 """The paper's Fig. 8: per method, the proportions of the 0-5 answers to each question, as
-stacked bars ((a) tiredness, (b) ease of operation), drawn with matplotlib (headless)."""
+stacked bars ((a) tiredness, (b) ease of operation), each panel saying what its scale's ends
+mean, drawn with matplotlib (headless)."""
 
 import matplotlib
 
@@ -7,7 +8,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from pbp_drake.studies.figures import METHOD_LABELS  # noqa: E402
-from pbp_drake.studies.questionnaire import QUESTIONS, SCALE  # noqa: E402
+from pbp_drake.studies.questionnaire import QUESTIONS, SCALE, scale_text  # noqa: E402
 
 FIG8 = "fig8_questionnaire.png"
 
@@ -26,26 +27,27 @@ def answer_counts(answers, methods, question):
 
 def plot_questionnaire(answers, methods, path):
     """Writes Fig. 8 to `path`: one panel per question, one bar per method, each answer's
-    share of the method's answers, 0 (bad, red) to 5 (good, green)."""
+    share of the method's answers, 0 (the worse end, red) to 5 (the better, green), the
+    panel's title saying what the ends mean for its question."""
     colours = plt.get_cmap("RdYlGn")([i / (len(SCALE) - 1) for i in range(len(SCALE))])
     figure, axes = plt.subplots(1, len(QUESTIONS), figsize=(10, 1.2 + 0.6 * len(methods)),
                                 sharey=True)
     labels = [METHOD_LABELS.get(m, m) for m in methods]
-    for panel, (axis, (question, text)) in enumerate(zip(axes, QUESTIONS.items())):
+    for panel, (axis, (question, asked)) in enumerate(zip(axes, QUESTIONS.items())):
         counts = answer_counts(answers, methods, question)
         left = [0.0] * len(methods)
         for value in SCALE:
             shares = [counts[m][value] / max(sum(counts[m]), 1) for m in methods]
             axis.barh(labels, shares, left=left, color=colours[value], edgecolor="white",
-                      label=f"{value}" + {0: " (bad)", SCALE[-1]: " (good)"}.get(value, ""))
+                      label=f"{value}")
             left = [a + b for a, b in zip(left, shares)]
         axis.set_xlim(0, 1)
         axis.set_xlabel("proportion of answers")
-        axis.set_title(f"({'ab'[panel]}) {text}")
+        axis.set_title(f"({'ab'[panel]}) {asked.text}\n{scale_text(question)}")
     axes[0].invert_yaxis()  # the first method on top, as in the tables (the axes share y)
     handles, names = axes[0].get_legend_handles_labels()
     figure.legend(handles, names, ncol=len(SCALE), loc="lower center", frameon=False,
-                  title="answer")
+                  title="answer (higher is better)")
     figure.tight_layout(rect=(0, 0.12, 1, 1))  # room for the legend below the panels
     figure.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(figure)

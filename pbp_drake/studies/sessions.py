@@ -5,7 +5,8 @@ of them), with the paper's questionnaire after each method and optional practice
 The participant folder:
 
     ID/study.json, ID/trials/<method>/seed_<seed>.*   the recorded runs (as a study's trials)
-    ID/questionnaire.json                            {method: {"tiredness": 0-5, "ease": 0-5}}
+    ID/questionnaire.json                            the answers by method, 0-5, beside the
+                                                     questions as asked (studies.questionnaire)
     ID/practice/...                                  practice runs, a study folder of their
                                                      own, never counted in the report
 

@@ -12,7 +12,9 @@ from pbp_drake.builder import build_diagram, find_system, run_task, simulate
 from pbp_drake.console import (
     ALPHA_SLIDER, CHOICE_BUTTONS, RATE_SLIDER, Console, LiveRun, Progress, behind_head_view,
     method_name, progress_text, result_text, status_text, time_left)
-from pbp_drake.scenarios import load_scenario_file, resolve, with_method
+from pbp_drake.console.questionnaire import start_label
+from pbp_drake.scenarios import METHODS, load_scenario_file, resolve, with_method
+from pbp_drake.studies.figures import METHOD_LABELS
 
 
 def click(meshcat, name):
@@ -35,8 +37,21 @@ def test_status_words():
     assert result_text(False, 9.0, stopped=True) == "stopped at 9.0 s"
     assert method_name("pbp_alternated") == "PBP-Alt"
     assert method_name("pbp_continuous") == "PBP-Cont"
-    assert method_name("fixed_alpha", 0.5) == "fixed alpha 0.50"
+    assert method_name("teleop") == "Teleop"
+    assert method_name("fixed_alpha", 0.5) == "Fixed alpha 0.50"
     assert progress_text(12.34, 60.0, 1.0) == "t = 12.3 s of 60 s, 1.00x real time"
+
+
+# The names the results tables in docs/results/generated/ print.
+NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "Teleop",
+         "pbp_no_user": "PBP-NoUser", "fixed_alpha": "Fixed alpha",
+         "confidence_alpha": "confidence_alpha"}
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_a_method_has_one_name_in_the_title_the_start_button_and_the_results(method):
+    assert method_name(method) == METHOD_LABELS[method] == NAMES[method]
+    assert start_label(method, 1, 3) == f"Start method 1 of 3: {NAMES[method]}"
 
 
 def test_the_page_shows_the_buttons_and_the_lines_in_order(meshcat):

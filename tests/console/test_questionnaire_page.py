@@ -1,6 +1,7 @@
 """A session in the Meshcat page, clicked through as a person would: the Start button names
-the method that comes, the two questions are answered with their 0-5 buttons, Next leads on,
-and the answers land in questionnaire.json. The clicks come over a raw websocket, as the page
+the method that comes, the two questions are answered with their 0-5 buttons (both ends
+saying what they mean), Next leads on, and the answers land in questionnaire.json beside the
+questions as asked. The clicks come over a raw websocket, as the page
 sends them (`foreign_page.ForeignPage`), and, in the slow test, from headless Chromium.
 
 Meshcat is made and polled on the test's thread (Drake's rule); the clicker runs on a thread
@@ -80,9 +81,27 @@ def check_session(output, seen_at_start, pressed):
     # Each method ran only after its Start button was clicked, the second only after the
     # first's questions and Next.
     assert seen_at_start == [("pbp_alternated", CLICKS[:1]), ("teleop", CLICKS[:5])]
-    assert json.loads((output / "questionnaire.json").read_text()) == ANSWERS
+    saved = json.loads((output / "questionnaire.json").read_text())
+    assert saved["answers"] == ANSWERS
+    # The file records the questions and what their ends meant, as the buttons said them.
+    assert saved["questions"] == {
+        "tiredness": {"question": "How tired did you feel?", "0": "very tired",
+                      "5": "not tired at all"},
+        "ease": {"question": "How easy was it to operate the robot?", "0": "very hard",
+                 "5": "very easy"}}
     for method in METHODS:
         assert trial_paths(output, method, 0)[0].is_file()
+
+
+def test_both_ends_of_each_question_say_what_they_mean():
+    assert list(answer_labels("tiredness")) == [
+        "0 = very tired: How tired did you feel?", "1: How tired did you feel?",
+        "2: How tired did you feel?", "3: How tired did you feel?",
+        "4: How tired did you feel?", "5 = not tired at all: How tired did you feel?"]
+    ease = answer_labels("ease")
+    assert label_of("ease", 0) == "0 = very hard: How easy was it to operate the robot?"
+    assert label_of("ease", 5) == "5 = very easy: How easy was it to operate the robot?"
+    assert list(ease.values()) == [0, 1, 2, 3, 4, 5]
 
 
 def test_a_session_is_clicked_through_in_the_page(meshcat, short_task, tmp_path):

@@ -12,7 +12,8 @@ from pbp_drake.builder.run import run_task
 from pbp_drake.cli import main
 from pbp_drake.console.questionnaire import FixedAnswers
 from pbp_drake.scenarios import load_scenario_file
-from pbp_drake.studies.questionnaire import QuestionnaireError, parse_answers, save_answer
+from pbp_drake.studies.questionnaire import (
+    QuestionnaireError, parse_answers, read_answers, save_answer)
 from pbp_drake.studies.sessions import PRACTICE_SEED_OFFSET, run_session, session_order
 from pbp_drake.studies.trial_files import trial_paths
 
@@ -51,10 +52,12 @@ def test_fixed_answers_hold_for_every_method_unless_a_method_overrides_them():
 
 
 @pytest.mark.parametrize("text, message", [
-    ("tiredness=6,ease=4", "the answer 6 is outside 0 (bad) to 5 (good)"),
-    ("tiredness=-1,ease=4", "the answer -1 is outside 0 (bad) to 5 (good)"),
+    ("tiredness=6,ease=4", "the answer 6 is outside 0 to 5 (0 = very tired to 5 = not tired "
+     "at all)"),
+    ("tiredness=3,ease=-1", "the answer -1 is outside 0 to 5 (0 = very hard to 5 = very easy)"),
     ("tiredness=3", "no ease for pbp_alternated"),
-    ("tiredness=3,ease=four", "'four' is not a whole number"),
+    ("tiredness=3,ease=four", "'four' is not a whole number 0 to 5 (0 = very hard to 5 = very "
+     "easy)"),
     ("tired=3,ease=4", "unknown question 'tired'"),
     ("fixed_alpha:tiredness=3,ease=4", "'fixed_alpha' is not one of the participant's methods"),
 ])
@@ -69,15 +72,14 @@ def test_a_saved_answer_is_never_overwritten(tmp_path):
         save_answer(tmp_path, "teleop", "tiredness", 5)
     with pytest.raises(QuestionnaireError, match="outside 0"):
         save_answer(tmp_path, "teleop", "ease", 9)
-    assert json.loads((tmp_path / "questionnaire.json").read_text()) == {
-        "teleop": {"tiredness": 2}}
+    assert read_answers(tmp_path) == {"teleop": {"tiredness": 2}}
 
 
 @pytest.mark.parametrize("argv, message", [
     (["--participant", "lab/P07", "--answers", ANSWERS], "holds a path separator"),
     (["--participant", "..", "--answers", ANSWERS], "not only dots"),
     (["--participant", "P07", "--answers", "tiredness=7,ease=4"],
-     "the answer 7 is outside 0 (bad) to 5 (good)"),
+     "the answer 7 is outside 0 to 5 (0 = very tired to 5 = not tired at all)"),
     (["--participant", "P07"], "a --headless session needs --answers"),
     (["--participant", "P07", "--answers", ANSWERS, "--operator", "keyboard"],
      "--answers stands in for a person's answers"),
@@ -154,8 +156,7 @@ def test_an_interrupted_session_resumes_where_it_stopped(short_task, tmp_path):
     assert session_files(output, order[:1]) == saved
     assert sorted(summary["methods"]) == sorted(METHODS)
     assert all(entry["trials"] == 1 for entry in summary["methods"].values())
-    assert json.loads((output / "questionnaire.json").read_text()) == parse_answers(
-        ANSWERS, METHODS)
+    assert read_answers(output) == parse_answers(ANSWERS, METHODS)
     assert sorted(p.name for p in (output / "practice" / "trials").rglob("*.json")) == practice
 
 
@@ -186,8 +187,7 @@ def test_an_unattended_session_on_the_grasping_task_and_its_report(repo, tmp_pat
         assert record["error"] is None and record["final_angle_to_target"] is not None
         # The trial's rows hold the grasping task's orientation columns.
         assert "angle_to_target" in csv_path.read_text().splitlines()[0].split(",")
-    assert json.loads((output / "questionnaire.json").read_text()) == parse_answers(
-        ANSWERS, METHODS)
+    assert read_answers(output) == parse_answers(ANSWERS, METHODS)
     capsys.readouterr()
     assert main(["report", str(study)]) == 0
     results = (study / "results.md").read_text()

@@ -1,0 +1,465 @@
+"""The run's page behind a front of our own: a token and the page's own origin, or HTTP 403.
+
+Drake's Meshcat serves its page and websocket to whoever connects, so any page or process on
+the machine could press the robot's keys. The front keeps Meshcat on a private localhost
+port and serves the public one itself: the page (Meshcat's, with our console panel injected)
+and a websocket relay to Meshcat, only to a client that presents the run's secret token (in
+the URL as `?token=T`, as Jupyter does, then in a cookie) and, for the websocket, an
+`Origin` equal to the page's own. A refused request never reaches Meshcat: no upstream
+connection is opened for it.
+
+The front never calls a Meshcat method (those belong to the thread that made the Meshcat);
+it talks to Meshcat's port over the network, from an asyncio loop on a daemon thread. Close
+the front before letting go of the Meshcat: Drake aborts the process when a Meshcat dies on
+another thread, and a Meshcat left in a reference cycle dies in whichever thread collects.
+
+- `new_token()`, `check_token(text)`: a fresh token; a `--token` checked (or ValueError).
+- `bind_page_port(port, host)`: the public port bound before anything is built (PortError).
+- `PageFront(meshcat_port, listen_socket=None, token=None, host="localhost")`: serving once
+  made; `url`, `port`, `token`; `pages()`, `show(**lines)`, `state()`, `end(text)`, `close()`.
+- `PendingMessages`, `message_key`: the relay's bounded queue toward a slow page.
+
+An example (the thread that made `meshcat`)::
+
+    listener = bind_page_port(args.port)            # PortError before anything is built
+    meshcat = Meshcat(MeshcatParams(host="localhost", port=None))
+    with PageFront(meshcat.port(), listener) as front:
+        print(f"Open {front.url}")
+        front.show(title="PBP-Alt", status="time left 41 s", time=0.0)
+        ...
+        front.end("Session complete - you can close this page")
+"""
+
+import asyncio
+import collections
+import concurrent.futures
+import email.utils
+import errno
+import hmac
+import http
+import json
+import logging
+import math
+import re
+import secrets
+import socket
+import threading
+import time
+import urllib.parse
+import urllib.request
+
+import msgpack
+from websockets.asyncio.client import connect
+from websockets.asyncio.server import serve
+from websockets.datastructures import Headers
+from websockets.exceptions import InvalidHandshake
+from websockets.http11 import Response
+
+LOG = logging.getLogger(__name__)  # websockets' connection log, every poll: INFO
+COOKIE = "pbp_drake_token"
+LINES = ("title", "status", "result", "notice")
+REFUSAL = ("This page needs the address `pbp-drake run` printed (with its ?token=...); "
+           "open that one.\n")
+_TOKEN = re.compile(r"[A-Za-z0-9_-]+")
+_PAGES = ("/", "/index.html", "/meshcat.html")
+# Small, so that a slow page's backpressure shows at once and messages wait in our queue
+# (where they coalesce) rather than in buffers (where they cannot): the websocket's, and
+# the kernel's, which on localhost grows to megabytes (seconds of poses) unless fixed.
+WRITE_LIMIT = 2**14
+SEND_BUFFER = 2**15
+
+INJECTION = """
+<style>
+#pbp-console { position: fixed; top: 56px; left: 8px; z-index: 10001; max-width: 45vw;
+  box-sizing: border-box; padding: 6px 10px; border-radius: 4px; color: #fff;
+  background: rgba(20, 22, 28, 0.85);
+  font: 15px/1.4 system-ui, sans-serif; overflow-wrap: anywhere; pointer-events: none; }
+#pbp-console > div { white-space: pre-wrap; }
+#pbp-console > div:empty { display: none; }
+#pbp-title { font-weight: bold; }
+body.pbp-ended #status-message { display: none !important; }
+</style>
+<div id="pbp-console" style="display: none"><div id="pbp-title"></div>
+<div id="pbp-status"></div><div id="pbp-result"></div><div id="pbp-notice"></div></div>
+<script>
+(function () {
+  // Our token rides along when the address has it: a cookie is per host, not per port, so
+  // another run's page on this machine may have replaced ours.
+  var token = new URLSearchParams(location.search).get("token");
+  var page = Math.random().toString(36).slice(2) + Date.now().toString(36);
+  var query = "?page=" + page + (token ? "&token=" + encodeURIComponent(token) : "");
+  var shown = {}, served = false, ended = false;
+  function show(state) {
+    shown = state;
+    ["title", "status", "result", "notice"].forEach(function (name) {
+      var line = document.getElementById("pbp-" + name), text = state[name] || "";
+      if (line.textContent !== text) line.textContent = text;
+    });
+    var status = document.getElementById("pbp-status");
+    if (state.time == null) status.removeAttribute("data-time");
+    else status.setAttribute("data-time", String(state.time));
+    var any = state.title || state.status || state.result || state.notice;
+    document.getElementById("pbp-console").style.display = any ? "" : "none";
+  }
+  function end(state) {
+    // The run is over: Meshcat's script must not retry, nor leave its yellow banner up.
+    ended = true;
+    do_reconnect = false;
+    document.body.classList.add("pbp-ended");
+    state = Object.assign({}, state);
+    if (!state.notice) state.notice = "This run has ended; you can close this page.";
+    show(state);
+  }
+  function poll() {
+    fetch("/pbp/state" + query, {cache: "no-store"})
+      .then(function (r) { if (!r.ok) throw new Error(r.status); return r.json(); })
+      .then(function (state) { served = true; if (state.ended) end(state); else show(state); })
+      .catch(function () { if (served) end(shown); })
+      .finally(function () { if (!ended) setTimeout(poll, 200); });
+  }
+  // The run's buttons on screen at 1024x640: the Scene tree folded, the control panel open.
+  try { viewer.gui.__folders["Scene"].close(); viewer.gui.open(); } catch (e) {}
+  poll();
+})();
+</script>
+"""
+
+
+def new_token():
+    """A fresh random token for a run's address (32 URL-safe characters)."""
+    return secrets.token_urlsafe(24)
+
+
+def check_token(text):
+    """`text` when it can be a run's token (16..128 of `A-Z a-z 0-9 _ -`), else ValueError:
+    a guessable or unquotable token would weaken or break the address."""
+    if not isinstance(text, str) or not 16 <= len(text) <= 128:
+        size = len(text) if isinstance(text, str) else "none"
+        raise ValueError(f"a token has 16 to 128 characters (this one has {size})")
+    if not _TOKEN.fullmatch(text):
+        raise ValueError("a token has only letters, digits, '_' and '-'")
+    return text
+
+
+class PortError(Exception):
+    """The page's port cannot be had; the message says what to do instead."""
+
+
+def bind_page_port(port, host="localhost"):
+    """A listening socket on `host:port` (port 0: a free one), bound before a run builds
+    anything, so that a taken port fails at once with a PortError that says what to do."""
+    try:
+        return socket.create_server((host, port), backlog=64)
+    except OSError as error:
+        if error.errno == errno.EADDRINUSE:
+            raise PortError(f"port {port} is in use (use --port 0 for a free one)") from None
+        if error.errno == errno.EACCES:
+            raise PortError(f"port {port} may not be bound by this process "
+                            f"(use --port 0 for a free one)") from None
+        raise
+
+
+def message_key(message):
+    """What a Meshcat message sets, when a later one of the same key replaces it (a body's
+    pose, one property, the real-time rate), else None: a barrier that must keep its place.
+    Reads only the map's small fields; a mesh's bytes are skipped, not decoded."""
+    if not isinstance(message, bytes):
+        return None
+    fields = {}
+    try:
+        unpacker = msgpack.Unpacker(raw=False)
+        unpacker.feed(message)
+        for _ in range(unpacker.read_map_header()):
+            name = unpacker.unpack()
+            if name in ("type", "path", "property"):
+                fields[name] = unpacker.unpack()
+            else:
+                unpacker.skip()
+    except (ValueError, TypeError, msgpack.UnpackException):
+        return None
+    kind, path = fields.get("type"), str(fields.get("path"))
+    if kind == "set_transform":
+        return (kind, path)
+    if kind == "set_property":
+        return (kind, path, str(fields.get("property")))
+    if kind == "realtime_rate":
+        return (kind,)
+    return None
+
+
+class PendingMessages:
+    """Meshcat's messages waiting for a slow page, bounded by what they set, not by time.
+
+    A message with a key replaces its pending predecessor of the same key (where that one
+    stood); a message without a key is a barrier: nothing moves across it. So the queue is
+    a list of segments, each the keyed messages since the last barrier and the barrier that
+    closes it; under a flood of poses of a few bodies it stays a few messages long.
+    """
+
+    def __init__(self):
+        self._segments = collections.deque([[{}, None]])  # [key -> message, barrier]
+        self._size = 0
+
+    def put(self, key, message):
+        keyed, _ = self._segments[-1]
+        if key is None:
+            self._segments[-1][1] = message
+            self._segments.append([{}, None])
+        elif key in keyed:
+            keyed[key] = message
+            return
+        else:
+            keyed[key] = message
+        self._size += 1
+
+    def pop(self):
+        """The oldest pending message; IndexError when none is."""
+        if not self._size:
+            raise IndexError("no message is pending")
+        keyed, barrier = self._segments[0]
+        self._size -= 1
+        if keyed:
+            return keyed.pop(next(iter(keyed)))
+        # An empty segment that is not the open last one ends in its barrier.
+        self._segments.popleft()
+        return barrier
+
+    def __len__(self):
+        return self._size
+
+
+def _panel_value(name, value):
+    if name != "time":
+        return None if value is None else str(value)
+    # JSON has no NaN (the page's JSON.parse would fail): a time that is not finite is none.
+    return float(value) if value is not None and math.isfinite(value) else None
+
+
+def _response(status, body, content_type, *headers):
+    status = http.HTTPStatus(status)
+    return Response(status.value, status.phrase, Headers([
+        ("Date", email.utils.formatdate(usegmt=True)), ("Connection", "close"),
+        ("Content-Length", str(len(body))), ("Content-Type", content_type), *headers]), body)
+
+
+def _fetch(url):
+    with urllib.request.urlopen(url, timeout=10.0) as reply:
+        return reply.read(), reply.headers.get("Content-Type") or "application/octet-stream"
+
+
+class PageFront:
+    """The public port of a run: Meshcat's page and websocket, to the token's holder only.
+
+    Args:
+        meshcat_port: the port of the run's Meshcat (on localhost, ideally a private one).
+        listen_socket: from `bind_page_port`; None binds a free port on `host`.
+        token: the run's token (checked by `check_token`); None draws `new_token()`.
+        host: where to bind when `listen_socket` is None, and the host of `url`.
+
+    Serving once made. The page polls `show`'s lines from `/pbp/state` (it shows them in a
+    panel at the top left), so the thread that drives the run needs no event loop.
+    """
+
+    def __init__(self, meshcat_port, listen_socket=None, token=None, host="localhost"):
+        self._token = new_token() if token is None else check_token(token)
+        self._upstream = f"localhost:{meshcat_port}"
+        self._socket = listen_socket or bind_page_port(0, host)
+        self._port = self._socket.getsockname()[1]
+        self._host = "localhost" if host in ("", "0.0.0.0", "::") else host
+        self._lock = threading.Lock()
+        self._state = dict.fromkeys((*LINES, "time"), None) | {"ended": False}
+        self._ended_pages, self._relays, self._closed = set(), 0, False
+        try:
+            self._files = self._fetch_page()
+        except (OSError, ValueError) as error:
+            self._socket.close()
+            raise ConnectionError(f"Meshcat at port {meshcat_port} did not serve its page: "
+                                  f"{error}") from error
+        self._loop = asyncio.new_event_loop()
+        self._thread = threading.Thread(target=self._loop.run_forever, daemon=True,
+                                        name=f"pbp-page-front-{self._port}")
+        self._thread.start()
+        try:
+            self._server = asyncio.run_coroutine_threadsafe(self._serve(), self._loop).result(10)
+        except BaseException:
+            self._loop.call_soon_threadsafe(self._loop.stop)
+            raise
+
+    @property
+    def url(self):
+        return f"http://{self._host}:{self._port}/?token={self._token}"
+
+    @property
+    def port(self):
+        return self._port
+
+    @property
+    def token(self):
+        return self._token
+
+    def pages(self):
+        """How many pages are relayed now (authorised websockets open to Meshcat)."""
+        return self._relays
+
+    def show(self, **lines):
+        """Sets the given lines of the page's panel (title, status, result, notice; None
+        hides one) and `time`, the simulated time the status is of; others stay."""
+        unknown = set(lines) - {*LINES, "time"}
+        if unknown:
+            raise TypeError(f"show() takes {', '.join(LINES)} and time, not "
+                            f"{', '.join(sorted(unknown))}")
+        with self._lock:
+            self._state.update({name: _panel_value(name, value) for name, value in lines.items()})
+
+    def state(self):
+        """What the page's panel shows (the lines, `time` and `ended`), a copy."""
+        with self._lock:
+            return dict(self._state)
+
+    def end(self, text=None, wait=2.0):
+        """Marks the run ended: the page shows `text` as its notice (or says the run has
+        ended), stops reconnecting and hides Meshcat's banner. Waits up to `wait` seconds
+        for every relayed page to fetch that, so none is left on the reconnect banner."""
+        with self._lock:
+            self._state.update(ended=True, notice=text)
+            self._ended_pages.clear()
+        deadline = time.monotonic() + wait
+        while time.monotonic() < deadline:
+            with self._lock:
+                if len(self._ended_pages) >= self._relays:
+                    return
+            time.sleep(0.02)
+
+    def close(self):
+        """Stops serving and closes every relay; a second call does nothing."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+        try:
+            asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(5.0)
+        except concurrent.futures.TimeoutError:
+            pass
+        self._loop.call_soon_threadsafe(self._loop.stop)
+        self._thread.join(5.0)
+        if not self._thread.is_alive():
+            self._loop.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info):
+        self.close()
+
+    def _fetch_page(self):
+        # Meshcat's page, its script (wherever the page says: Drake 1.51 serves it at a
+        # content address, not /meshcat.js) and icon, fetched once, here, off the loop.
+        html, _ = _fetch(f"http://{self._upstream}/")
+        html = html.decode()
+        script = re.search(r'<script[^>]*\bsrc="([^"]+)"', html)
+        if script is None or "</body>" not in html:
+            raise ValueError("the page has no script or no </body>")
+        source = "/" + script.group(1).lstrip("/")
+        code, code_type = _fetch(f"http://{self._upstream}{source}")
+        icon, icon_type = _fetch(f"http://{self._upstream}/favicon.ico")
+        page = html.replace("</body>", INJECTION + "</body>", 1).encode()
+        return {**{path: (page, "text/html; charset=utf-8") for path in _PAGES},
+                source: (code, code_type), "/meshcat.js": (code, code_type),
+                "/favicon.ico": (icon, icon_type)}
+
+    async def _stop(self):
+        self._server.close()  # and every connection, with its relay
+        await self._server.wait_closed()
+
+    async def _serve(self):
+        # No keepalive pings: a page busy rendering answers late, and would be dropped for
+        # being slow; a closed tab closes its socket anyway.
+        return await serve(self._relay, sock=self._socket, process_request=self._answer,
+                           write_limit=WRITE_LIMIT, compression=None, ping_interval=None,
+                           server_header=None, logger=LOG)
+
+    def _authorised(self, request, query):
+        offered = list(query.get("token", []))
+        for header in request.headers.get_all("Cookie"):
+            for pair in header.split(";"):
+                name, _, value = pair.strip().partition("=")
+                if name == COOKIE:
+                    offered.append(value)
+        token = self._token.encode()
+        return any(hmac.compare_digest(value.encode(), token) for value in offered)
+
+    async def _answer(self, connection, request):
+        """The request's response, or None to go on to the websocket (the relay)."""
+        url = urllib.parse.urlsplit(request.path)
+        query = urllib.parse.parse_qs(url.query)
+        if not self._authorised(request, query):
+            return connection.respond(403, REFUSAL)
+        if "websocket" in request.headers.get("Upgrade", "").lower():
+            origin = request.headers.get("Origin")
+            if origin is None or origin != "http://" + request.headers.get("Host", ""):
+                return connection.respond(403, "This websocket is not from the run's page.\n")
+            return None
+        response = await self._file(url.path, query)
+        if query.get("token"):
+            response.headers["Set-Cookie"] = (f"{COOKIE}={self._token}; HttpOnly; "
+                                              f"SameSite=Strict; Path=/")
+        return response
+
+    async def _file(self, path, query):
+        if path == "/pbp/state":
+            with self._lock:
+                if self._state["ended"]:
+                    self._ended_pages.update(query.get("page", ["?"]))
+                body = json.dumps(self._state).encode()
+            return _response(200, body, "application/json", ("Cache-Control", "no-store"))
+        if path not in self._files:
+            try:  # a mesh's or texture's file, at its content address
+                found = await asyncio.to_thread(_fetch, f"http://{self._upstream}{path}")
+            except (OSError, ValueError):
+                return _response(404, b"Not found\n", "text/plain; charset=utf-8")
+            if not path.startswith("/cas-v1/"):
+                return _response(200, *found, ("Cache-Control", "no-cache"))
+            self._files[path] = found
+        body, content_type = self._files[path]
+        return _response(200, body, content_type, ("Cache-Control", "no-cache"))
+
+    async def _relay(self, page):
+        """One page's relay: one websocket to Meshcat of its own, so Meshcat counts it."""
+        try:
+            meshcat = await connect(f"ws://{self._upstream}/", max_size=None,
+                                    compression=None, ping_interval=None, open_timeout=5.0,
+                                    logger=LOG)
+        except (OSError, TimeoutError, InvalidHandshake):
+            await page.close(1011, "Meshcat is not reachable")
+            return
+        page.transport.get_extra_info("socket").setsockopt(
+            socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
+        pending, ready = PendingMessages(), asyncio.Event()
+
+        async def to_meshcat():
+            async for message in page:
+                await meshcat.send(message)
+
+        async def from_meshcat():
+            async for message in meshcat:
+                pending.put(message_key(message), message)
+                ready.set()
+
+        async def to_page():
+            while True:
+                await ready.wait()
+                ready.clear()
+                while pending:
+                    await page.send(pending.pop())
+
+        self._relays += 1
+        tasks = [asyncio.create_task(job()) for job in (to_meshcat, from_meshcat, to_page)]
+        try:
+            await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
+        finally:
+            self._relays -= 1
+            for task in tasks:
+                task.cancel()
+            await asyncio.gather(*tasks, return_exceptions=True)
+            await asyncio.gather(meshcat.close(), page.close(), return_exceptions=True)
+

@@ -1,6 +1,6 @@
 """Where the page's camera looks from: `overview` (Meshcat's own camera, which the person
-can orbit) or `robot`, behind the HSR's head looking where the base faces, as the paper's
-participants saw the robot."""
+can orbit) or `robot`, above and behind the HSR's head, looking where the base faces, as
+the paper's participants saw the robot."""
 
 import numpy as np
 
@@ -8,30 +8,37 @@ from pbp_drake.robots.hsr_station import hsr_station_plant
 
 CAMERAS = ("overview", "robot")
 
-# Behind and above the head, looking down past the hand to the shelf: the view of a person
-# standing behind the robot (metres).
-BEHIND = 1.1
-ABOVE = 0.85
-AHEAD = 1.4
-TARGET_HEIGHT = 0.4
+# High above and a little behind the head, looking down past it at the hand and on to the
+# objects, as a person standing behind the robot would see them (metres). From lower and
+# further back (1.1 m behind and 0.85 m above the head) the head and torso filled the middle
+# of the view and hid the hand; from here the line of sight to the hand passes over the head
+# all through a reaching task (tests/console/test_camera.py).
+BEHIND = 0.5
+ABOVE = 1.5
+# The point looked at: ahead of the head, low, so that the view runs from the hand to the
+# far objects (the reaching task's are 1.25 m to 2.5 m ahead).
+AHEAD = 1.2
+TARGET_HEIGHT = 0.3
 
 
-def behind_head_view(head_position, yaw):
-    """`(camera, target)` in the world frame for a camera behind a head at `head_position`
-    (3) on a base facing `yaw` (rad about world z)."""
+def behind_head_view(head_position, yaw, behind=BEHIND, above=ABOVE, ahead=AHEAD,
+                     target_height=TARGET_HEIGHT):
+    """`(camera, target)` in the world frame for a camera `behind` and `above` a head at
+    `head_position` (3) on a base facing `yaw` (rad about world z), looking at the point
+    `ahead` of the head at `target_height`."""
     head = np.asarray(head_position, dtype=float)
     forward = np.array([np.cos(yaw), np.sin(yaw), 0.0])
-    camera = head - BEHIND * forward + np.array([0.0, 0.0, ABOVE])
-    target = head + AHEAD * forward
-    target[2] = TARGET_HEIGHT
+    camera = head - behind * forward + np.array([0.0, 0.0, above])
+    target = head + ahead * forward
+    target[2] = target_height
     return camera, target
 
 
 class RobotCamera:
-    """Keeps `meshcat`'s camera behind the HSR's head: `update(root_context)` reads the
-    robot's `state` off `station` (an HSR station inside the diagram whose root context is
-    given, dynamic or kinematic), places the head and the base with the station's plant
-    and sets the camera. Use from Meshcat's thread."""
+    """Keeps `meshcat`'s camera above and behind the HSR's head: `update(root_context)`
+    reads the robot's `state` off `station` (an HSR station inside the diagram whose root
+    context is given, dynamic or kinematic), places the head and the base with the
+    station's plant and sets the camera (`behind_head_view`). Use from Meshcat's thread."""
 
     def __init__(self, meshcat, station, head_body="head_link", base_body="base_link"):
         self._meshcat = meshcat

@@ -9,6 +9,7 @@ import sys
 from pbp_drake import __version__
 from pbp_drake.bench.main import build_parser as build_bench_parser
 from pbp_drake.bench.main import main as bench_main
+from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_USAGE
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.study import add_study_commands
 from pbp_drake.draw import build_parser as build_draw_parser
@@ -33,7 +34,7 @@ def main(argv=None):
     except KeyboardInterrupt:
         # Ctrl-C is how a person ends a run: a word, not a traceback (128 + SIGINT).
         print("\npbp-drake: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 def build_parser():
@@ -75,4 +76,4 @@ def _main(argv):
         return args.handler(args)
     except ScenarioError as error:
         print(f"pbp-drake: {error}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE

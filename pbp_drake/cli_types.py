@@ -4,6 +4,8 @@ and a bad one is refused by argparse (exit 2) as `argument --FLAG: what is wrong
 import argparse
 import math
 
+from pbp_drake.console.front import check_token
+
 
 def _finite(text):
     try:
@@ -48,3 +50,31 @@ def wait_seconds(text):
 def method_list(text):
     """`--methods a,b,c` as a list."""
     return [method.strip() for method in text.split(",") if method.strip()]
+
+
+def token(text):
+    """`--token`: the page's secret, as `pbp_drake.console.front.check_token` takes it."""
+    try:
+        return check_token(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+#: The exit codes of `pbp-drake`, as the CLI reference lists them.
+EXIT_SUCCESS = 0
+EXIT_FAILED = 1
+EXIT_USAGE = 2
+EXIT_STOPPED = 3
+EXIT_INTERRUPTED = 130
+EXIT_CODES = {
+    EXIT_SUCCESS: "success: the task reached its target (a session: every method's run did; "
+                  "a study: every trial ran)",
+    EXIT_FAILED: "a task failed (its time limit passed), a trial failed with an error, or "
+                 "damaged files were skipped",
+    EXIT_USAGE: "refused before anything ran: a bad flag, file or scenario, a port in use, "
+                "no browser in time for a person's run",
+    EXIT_STOPPED: "`run`: the person pressed Stop in the page (a session is resumed by the "
+                  "same command)",
+    EXIT_INTERRUPTED: "interrupted by Ctrl-C (a study or session is resumed by the same "
+                      "command)",
+}

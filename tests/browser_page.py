@@ -7,6 +7,7 @@ where chromium or Playwright is missing).
 """
 
 import contextlib
+import io
 import queue
 import re
 import shutil
@@ -15,6 +16,8 @@ import subprocess
 import threading
 import time
 
+import matplotlib.image
+import numpy as np
 import pytest
 
 CHROMIUM = shutil.which("chromium")
@@ -36,9 +39,10 @@ NEEDS_BROWSER = [
 
 
 @contextlib.contextmanager
-def open_page(url, viewport=(1280, 720), timeout_ms=20_000):
+def open_page(url, viewport=(1280, 720), timeout_ms=20_000, cpu_slowdown=None):
     """A headless Chromium page loaded from `url` (its default timeout `timeout_ms`),
-    closed with its browser on leaving."""
+    closed with its browser on leaving. `cpu_slowdown` (e.g. 10): the page's CPU throttled
+    that many times once it has loaded (Chrome DevTools' CPU throttling), a slow laptop's."""
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
                                              timeout=30_000)
@@ -46,9 +50,46 @@ def open_page(url, viewport=(1280, 720), timeout_ms=20_000):
             page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
             page.set_default_timeout(timeout_ms)
             page.goto(url, wait_until="load")
+            if cpu_slowdown is not None:
+                page.context.new_cdp_session(page).send(
+                    "Emulation.setCPUThrottlingRate", {"rate": float(cpu_slowdown)})
             yield page
         finally:
             browser.close()
+
+
+def control(page, label):
+    """The row of the page's control panel (Meshcat's dat.gui) labelled exactly `label`, a
+    regular expression."""
+    return page.locator(".dg li.cr").filter(
+        has=page.locator(".property-name", has_text=re.compile(f"^{label}$")))
+
+
+def click(page, label, timeout_ms=60_000):
+    """Clicks the control labelled exactly `label` (plain text) once the page shows it. The
+    panel may be folded: this sends the click its row would."""
+    row = control(page, re.escape(label))
+    row.wait_for(state="attached", timeout=timeout_ms)
+    row.dispatch_event("click")
+
+
+def console_line(page, name):
+    """The console panel's line `name` (title, status, result, notice): its text, as the
+    page front's panel shows it."""
+    return page.locator(f"#pbp-{name}")
+
+
+def banner_shown(page):
+    """Whether Meshcat's yellow "No connection to server" banner is on screen: its element
+    shown, or its yellow in the screenshot's top strip, where Meshcat puts it (the middle
+    half of the width, in pure yellow; the scene's yellow target is darker and lower)."""
+    if page.locator("#status-message").is_visible():
+        return True
+    image = matplotlib.image.imread(io.BytesIO(page.screenshot(type="png")), format="png")
+    height, width = image.shape[:2]
+    strip = np.round(image[:40, width // 4: 3 * width // 4, :3] * 255).astype(int)
+    yellow = (strip[..., 0] > 240) & (strip[..., 1] > 240) & (strip[..., 2] < 40)
+    return int(np.count_nonzero(yellow)) > 200
 
 
 @contextlib.contextmanager

@@ -1,7 +1,7 @@
 """Our Sphinx directives: each page part that would drift from the code is generated from it.
 
 - `pydrake_system`: Drake's port block of a LeafSystem docstring, drawn as a box;
-- `cli-reference`: every `pbp-drake` subcommand from its argparse parser;
+- `cli-reference`: every `pbp-drake` subcommand from its argparse parser, and the exit codes;
 - `scenario-reference`: every field reachable from `ScenarioFile`, from the dataclasses and
   their `#:` doc comments;
 - `api-reference`: every name of `pbp_drake.__all__`, grouped as `pbp_drake.API_GROUPS` says.
@@ -110,7 +110,17 @@ class CliReference(SphinxDirective):
         for name, subparser in subparsers.choices.items():
             # bench and draw parse their own line: document their own parsers.
             lines += _command_lines(f"pbp-drake {name}", tools.get(name, subparser))
-        return _parse_rst(self, lines)
+        return _parse_rst(self, lines + _exit_code_lines())
+
+
+def _exit_code_lines():
+    """The exit codes, from `pbp_drake.cli_types.EXIT_CODES`."""
+    from pbp_drake.cli_types import EXIT_CODES
+
+    lines = ["Exit codes", "----------", ""]
+    for code, meaning in EXIT_CODES.items():
+        lines += [f"``{code}``", f"   {meaning.replace('`', '``').replace('````', '``')}", ""]
+    return lines
 
 
 # --- scenario-reference ---------------------------------------------------------------------

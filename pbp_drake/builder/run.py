@@ -184,10 +184,10 @@ class TaskResult:
                 and len(self.angles_to_target)):
             self.final_angle_to_target = float(self.angles_to_target[-1])
 
-    def summary_line(self):
+    def summary_line(self, stopped=False):
         """One line: outcome, time, intervention ratio, the collision ratio where the task
         measures collisions (the obstacle task: `in_collision` is logged), target switches
-        and the peaks."""
+        and the peaks. `stopped`: the person ended the run before its end ("stopped at")."""
         outcome = "success" if self.success else "FAILED"
         # A reach task's collision_ratio is 0 because nothing measured it: left out.
         collisions = ("" if self.in_collision is None
@@ -197,7 +197,9 @@ class TaskResult:
                    f", final angle to target {_or_na(self.final_angle_to_target, 1)} deg, peak "
                    f"command angular change {_or_na(self.peak_command_angular_change, 3)} "
                    "rad/s per tick")
-        return (f"{outcome} in {self.task_time:.2f} s, intervention ratio "
+        ended = (f"stopped at {self.task_time:.2f} s" if stopped and not self.success
+                 else f"{outcome} in {self.task_time:.2f} s")
+        return (f"{ended}, intervention ratio "
                 f"{self.intervention_ratio:.3f}{collisions}, "
                 f"{counted(self.switches, 'target switch', 'target switches')}, "
                 f"peak hand speed {_or_na(self.peak_hand_speed, 3)} m/s, "

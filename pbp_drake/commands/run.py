@@ -1,6 +1,7 @@
 """`pbp-drake run`: one scenario in Meshcat, or a participant's session of a user study."""
 
 import dataclasses
+import logging
 import pathlib
 import sys
 import time
@@ -10,19 +11,27 @@ from pydrake.geometry import Meshcat, MeshcatParams, Rgba
 
 from pbp_drake.builder import (
     build_diagram, check_buildable, find_system, run_task, run_task_streamed, simulate)
-from pbp_drake.cli_types import port, realtime_rate, wait_seconds
+from pbp_drake.cli_types import (
+    EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS, port, realtime_rate,
+    token, wait_seconds)
 from pbp_drake.commands.run_checks import check_run_flags, is_person, session_methods
 from pbp_drake.console import (
     CAMERAS, Console, LiveRun, Progress, RobotCamera, method_name, result_text)
-from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
+from pbp_drake.console.front import PageFront, PortError, bind_page_port
+from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage, start_label
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, mark_replay)
 from pbp_drake.scenarios import (
-    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, Hsr, ScenarioError, load_scenario_file,
-    resolve)
-from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers
+    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, Hsr, ScenarioError, counted,
+    load_scenario_file, resolve)
+from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers, scales_text
 from pbp_drake.studies.sessions import run_session
+
+#: The choices in the page while a task runs, and after it has ended.
+RUN_CHOICES = ("stop", "restart", "next")
+AFTER_RUN_CHOICES = ("restart", "next", "close")
+PAGE_ENDED = "This run has ended; you can close this page."
 
 
 def add_run_command(commands):
@@ -49,12 +58,12 @@ def add_run_command(commands):
                      "counted in a report")
     run.add_argument("--answers", metavar="ANSWERS",
                      help="with --participant and --operator virtual: fixed questionnaire "
-                     "answers, 0 (bad) to 5 (good), for unattended sessions: comma-separated "
+                     f"answers, {scales_text()}, for unattended sessions: comma-separated "
                      "[METHOD:]QUESTION=VALUE (QUESTION tiredness or ease), e.g. "
                      "tiredness=3,ease=4,teleop:tiredness=1 (a person answers in the page)")
     run.add_argument("--headless", action="store_true",
-                     help="simulate as fast as possible without waiting for a browser (the "
-                     "page still shows the run) and quit at the end")
+                     help="no page: simulate as fast as possible and quit at the end "
+                     "(--record still saves a replay)")
     run.add_argument("--no-meshcat", action="store_true",
                      help="no Meshcat server and no page at all (implies --headless)")
     run.add_argument("--camera", choices=CAMERAS, default="overview",
@@ -73,7 +82,19 @@ def add_run_command(commands):
                      help="target simulated seconds per wall second, positive (default 1; "
                      "--headless runs as fast as possible)")
     run.add_argument("--port", type=port, default=0,
-                     help="Meshcat port, 0..65535 (default 0: a free one)")
+                     help="the page's port, 0..65535 (default 0: a free one); one in use "
+                     "is refused before anything is built")
+    run.add_argument("--token", type=token,
+                     help="the page's secret (16 to 128 letters, digits, '-' or '_'; default: "
+                     "a random one): only a browser that opens the printed URL, which holds "
+                     "it, gets the page and can drive")
+    run.add_argument("--start-on-connect", action="store_true",
+                     help="keyboard and gamepad runs: start the task as soon as the page "
+                     "connects, as a script wants, instead of at the page's Start button")
+    run.add_argument("--keep-page", type=wait_seconds, default=600.0, metavar="SECONDS",
+                     help="after the run, keep the page with its result served until it is "
+                     "closed, its Close button is pressed, or this many seconds pass "
+                     "(default 600)")
     run.add_argument("--wait-for-browser", type=wait_seconds, default=15.0, metavar="SECONDS",
                      help="before starting, wait this long for a browser to open the page "
                      "(default 15); a keyboard or gamepad run that no browser joins in time "
@@ -134,34 +155,66 @@ def _run(args):
         check_log_path(args.log, force=args.force)
     if args.output is not None:
         check_output_folder(args.output)
-    resolved = scenario_for_run(load_scenario_file(args.scenario), args.method, args.alpha,
-                                args.scene, args.operator, args.seed, args.duration)
-    check_buildable(resolved)  # before the page opens: what the builder cannot build yet
-    if args.camera == "robot" and not resolved.is_hsr:
-        raise ScenarioError("--camera robot follows the HSR; this scenario uses the 2-D toy "
-                            "robot")
-    check_run_flags(args, resolved)  # and the flags' combinations, before the page too
-    meshcat = None
     if args.no_meshcat:
         args.headless = True
-    else:
-        meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port or None))
-        print(f"Meshcat: {meshcat.web_url()}", flush=True)
-    if resolved.is_hsr:
-        return _run_task(args, resolved, meshcat)
-    return _run_scene(args, resolved, meshcat)
+    # The page's port before anything is built: taken or forbidden, a one-line refusal.
+    listening = None
+    if not args.headless:
+        try:
+            listening = bind_page_port(args.port)
+        except PortError as error:
+            raise ScenarioError(str(error)) from None
+    try:
+        resolved = scenario_for_run(load_scenario_file(args.scenario), args.method,
+                                    args.alpha, args.scene, args.operator, args.seed,
+                                    args.duration)
+        check_buildable(resolved)  # before the page opens: what the builder cannot build
+        if args.camera == "robot" and not resolved.is_hsr:
+            raise ScenarioError("--camera robot follows the HSR; this scenario uses the 2-D "
+                                "toy robot")
+        check_run_flags(args, resolved)  # and the flags' combinations, before the page too
+    except BaseException:
+        if listening is not None:
+            listening.close()
+        raise
+    meshcat = page = None
+    if not args.no_meshcat:
+        meshcat = _private_meshcat()
+    if listening is not None:
+        # The page people open: our front, which lets in only who holds the printed URL.
+        page = PageFront(meshcat.port(), listening, token=args.token)
+        print(f"Meshcat: {page.url}", flush=True)
+    try:
+        if resolved.is_hsr:
+            return _run_task(args, resolved, meshcat, page)
+        return _run_scene(args, resolved, meshcat, page)
+    finally:
+        if page is not None:
+            page.close()
 
 
-def _run_scene(args, resolved, meshcat):
+def _private_meshcat():
+    """Meshcat on a free localhost port that nobody is told of (the page front relays to
+    it), without Drake's line announcing its URL."""
+    drake_log = logging.getLogger("drake")
+    level = drake_log.level
+    drake_log.setLevel(logging.WARNING)
+    try:
+        return Meshcat(MeshcatParams(host="localhost", port=None))
+    finally:
+        drake_log.setLevel(level)
+
+
+def _run_scene(args, resolved, meshcat, page):
     """A 2-D scene: live in the page (its console has Stop alone) for its duration."""
     scenario = resolved.scenario
     diagram = build_diagram(resolved, meshcat)
     console = None
-    if meshcat is not None:
-        console = _console(meshcat, args, scenario, choices=("stop",))
+    if page is not None:
+        console = _console(meshcat, page, args, scenario, choices=("stop",))
         console.show_title(method_name(scenario.method, _alpha(scenario)))
-    if _interactive(args, meshcat):
-        _wait_for_browser(meshcat, args.wait_for_browser)
+        if _terminal():  # someone may be watching
+            _wait_for_browser(page, meshcat, args.wait_for_browser)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration))
@@ -173,48 +226,59 @@ def _run_scene(args, resolved, meshcat):
         positions = np.zeros((len(trajectory.positions), 3))
         positions[:, :trajectory.positions.shape[1]] = trajectory.positions[:, :3]
         meshcat.SetLine("/pbp/executed", positions.T, 2.0, Rgba(0.1, 0.3, 0.9, 1.0))
-        console.show_result(f"stopped at {trajectory.times[-1]:.1f} s" if live.choice
-                            else f"done, collision ratio {ratio:.3f}")
+    outcome = (f"stopped at {trajectory.times[-1]:.1f} s" if live.choice == "stop"
+               else f"done, collision ratio {ratio:.3f}")
     if args.record:
         _save_recording(meshcat, args.record)
-    print(f"{scenario.name} [{scenario.method}]: final position "
+    print(f"{scenario.name} [{scenario.method}]: "
+          + (f"{outcome}, " if live.choice == "stop" else "") + "final position "
           f"{np.array2string(trajectory.positions[-1], precision=3)}, collision ratio "
-          f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}")
-    if live.choice is None and _interactive(args, meshcat):
-        _wait_for_stop(console)
-    return 0
+          f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}",
+          flush=True)
+    code = EXIT_STOPPED if live.choice == "stop" else 0
+    if console is not None:
+        console.show_result(outcome)
+        if live.choice is None:
+            _keep_page(args, page, console, ("close",))
+        page.end(f"Result: {outcome}. {PAGE_ENDED}")
+    return code
 
 
-def _run_task(args, resolved, meshcat):
+def _run_task(args, resolved, meshcat, page):
     scenario = resolved.scenario
     person = is_person(scenario)
     if args.participant is not None:
-        return _run_session(args, resolved, meshcat, person)
+        return _run_session(args, resolved, meshcat, page, person)
     console = None
-    if meshcat is not None:
-        console = _console(meshcat, args, scenario)
+    if page is not None:
+        console = _console(meshcat, page, args, scenario)
     first = True
     while True:
         scenario = resolved.scenario
         diagram = build_diagram(resolved, meshcat)
-        if first and (person or _interactive(args, meshcat)):
+        if console is not None:
+            # After the operator's buttons, which the build added: the same order each run.
+            console.set_choices(RUN_CHOICES)
+        if first and page is not None and (person or _terminal()):
             # A person needs the page open before the task starts.
-            print(f"Open {meshcat.web_url()} in a browser; the task starts when it connects "
-                  f"(waiting up to {args.wait_for_browser:g} s).", flush=True)
+            print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
+                  + ("the task starts when it connects." if not _start_gate(args, person) else
+                     "the task starts when Start is pressed in the page."), flush=True)
             if person:
                 print(_controls_line(scenario), flush=True)
-            _wait_for_browser(meshcat, args.wait_for_browser, person)
+            _wait_for_browser(page, meshcat, args.wait_for_browser, person)
         first = False
-        result, live = _run_task_once(args, resolved, diagram, meshcat, console)
-        code = 0 if result.success else 1
+        result, live = _run_task_once(args, resolved, diagram, meshcat, console,
+                                      start_button="Start" if _start_gate(args, person)
+                                      else None)
+        code = _task_code(result, live)
         if console is None:
             return code
         choice = live.choice
-        if choice is None and _interactive(args, meshcat):
-            print("The page stays live: Stop (or Enter, or Ctrl-C) quits, Restart runs the "
-                  "scene again, Next scene the next seed.", flush=True)
-            choice = console.wait_for_choice(stdin=sys.stdin)
-        if choice in (None, "stop"):
+        if choice is None:
+            choice = _keep_page(args, page, console, AFTER_RUN_CHOICES)
+        if choice in (None, "stop", "close"):
+            page.end(f"Result: {_outcome(result, live)}. {PAGE_ENDED}")
             return code
         operator = diagram.GetSubsystemByName("operator")
         if hasattr(operator, "Delete"):
@@ -237,9 +301,9 @@ def _controls_line(scenario):
             "lower it; R switches to turning (arrows pitch and yaw, PageUp/PageDown roll).")
 
 
-def _run_task_once(args, resolved, diagram, meshcat, console):
+def _run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     """One run of the task in `diagram`, live in `console` and the terminal: `(TaskResult,
-    LiveRun)`."""
+    LiveRun)`. With `start_button` (a label), the task's clock starts when it is pressed."""
     scenario = resolved.scenario
     camera = None
     if args.camera == "robot":
@@ -248,7 +312,8 @@ def _run_task_once(args, resolved, diagram, meshcat, console):
         console.show_title(f"{method_name(scenario.method, _alpha(scenario))}, seed "
                            f"{scenario.seed}")
         console.clear_result()
-    live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration), camera)
+    live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration), camera,
+                   start_label=start_button, stdin=_terminal())
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     rate = 0.0 if args.headless else args.realtime_rate
@@ -260,35 +325,49 @@ def _run_task_once(args, resolved, diagram, meshcat, console):
                                         advance=live.advance))
     if args.record:
         _save_recording(meshcat, args.record)
-    outcome = result_text(result.success, result.task_time, stopped=live.choice is not None)
     if console is not None:
-        console.show_result(outcome)
+        console.show_result(_outcome(result, live))
     hand = ""
     if len(result.ee_positions):
         hand = ", hand at [" + ", ".join(f"{x:.3f}" for x in result.ee_positions[-1]) + "]"
     if args.log:
         hand = f"; per-tick rows in {args.log}"
     print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
-          f"{result.summary_line()}{hand}", flush=True)
+          f"{result.summary_line(stopped=live.choice is not None)}{hand}", flush=True)
     return result, live
 
 
-def _run_session(args, resolved, meshcat, person):
+def _outcome(result, live):
+    """The run's result in a person's words (`result_text`)."""
+    return result_text(result.success, result.task_time, stopped=live.choice is not None)
+
+
+def _task_code(result, live):
+    """The exit code of a run: stopped by the person, succeeded or failed (`EXIT_CODES`)."""
+    if live.choice == "stop":
+        return EXIT_STOPPED
+    return EXIT_SUCCESS if result.success else EXIT_FAILED
+
+
+def _run_session(args, resolved, meshcat, page, person):
     scenario = resolved.scenario
     methods, order = session_methods(args, scenario)  # checked by check_run_flags
-    page = _session_page(args, meshcat, methods)
     output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
                                                        args.participant))
     print(f"Participant {args.participant}: {', '.join(order)}, in this order"
           + (", each practised first" if args.practice else "") + f"; saved in {output}",
           flush=True)
-    if isinstance(page, MeshcatSessionPage):
-        print(f"Open {meshcat.web_url()} in a browser; the session starts when it connects "
-              f"(waiting up to {args.wait_for_browser:g} s). Start, the questions and Next "
-              "are buttons in its control panel (Open Controls).", flush=True)
-        _wait_for_browser(meshcat, args.wait_for_browser, person)
-        if meshcat.GetNumActiveConnections() == 0:
-            raise ScenarioError(f"no browser opened {meshcat.web_url()} within "
+    if args.answers is not None:
+        questions = FixedAnswers(parse_answers(args.answers, methods))
+    else:
+        questions = _StartInTheRun(MeshcatSessionPage(meshcat), args.start_on_connect)
+    if page is not None:
+        print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
+              "each method starts when its Start is pressed in the page, and the questions "
+              "and Next are buttons there too (Open Controls).", flush=True)
+        _wait_for_browser(page, meshcat, args.wait_for_browser, person)
+        if page.pages() == 0:
+            raise ScenarioError(f"no browser opened {page.url} within "
                                 f"{args.wait_for_browser:g} s (--wait-for-browser): the "
                                 "session's Start buttons and questions are in the page, so "
                                 "nothing was run or saved")
@@ -297,76 +376,134 @@ def _run_session(args, resolved, meshcat, person):
     # Stop ends it (resumable, like Ctrl-C), Restart runs the method again (the stopped run
     # is not saved), and Next scene ends this method's run as it stands (saved, not a
     # success) and goes on to its questions: the next scene of a session is the next run.
-    console = _console(meshcat, args, scenario)
+    console = None if page is None else _console(meshcat, page, args, scenario)
 
     def run_one(trial):
-        console.choice()  # clicks made between runs (on the questions) do not count
         while True:
             diagram = build_diagram(trial, meshcat)
-            result, live = _run_task_once(args, trial, diagram, meshcat, console)
+            if console is not None:
+                # After the operator's buttons; and clicks made between runs (on the
+                # questions) do not count.
+                console.set_choices(RUN_CHOICES)
+            result, live = _run_task_once(args, trial, diagram, meshcat, console,
+                                          start_button=questions.take_start_label()
+                                          if isinstance(questions, _StartInTheRun) else None)
             operator = diagram.GetSubsystemByName("operator")
             if hasattr(operator, "Delete"):
                 operator.Delete()  # the next method may want other keys
+            if console is not None:
+                console.set_choices(())  # no Stop under the questions
             if live.choice == "stop":
-                raise KeyboardInterrupt
+                raise _SessionStopped
             if live.choice != "restart":
                 return result
             print(f"Restart: {trial.scenario.method} again, seed {trial.scenario.seed} "
                   "(the stopped run is not saved).", flush=True)
 
     try:
-        summary = run_session(scenario, args.participant, methods, output, run_one, page,
-                              practice=args.practice)
-    except KeyboardInterrupt:
-        print(f"\nStopped: the methods and answers saved so far are in {output}; the "
-              "same command resumes the session.", file=sys.stderr)
-        return 130
-    finally:
-        console.close()
+        summary = run_session(scenario, args.participant, methods, output, run_one,
+                              questions, practice=args.practice)
+    except (KeyboardInterrupt, _SessionStopped) as stop:
+        stopped = isinstance(stop, _SessionStopped)
+        print(("\n" if not stopped else "") + f"{'Stopped in the page' if stopped else 'Stopped'}"
+              f": the methods and answers saved so far are in {output}; the same command "
+              "resumes the session.", file=sys.stderr)
+        if page is not None:
+            page.end(f"The session was stopped; what was saved is kept. {PAGE_ENDED}")
+        return EXIT_STOPPED if stopped else EXIT_INTERRUPTED
     failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
     print(f"Session saved in {output}, answers in {output / QUESTIONNAIRE_FILE} "
-          f"(`pbp-drake report {output.parent}` compares the participants).")
-    return 1 if failed else 0
+          f"(`pbp-drake report {output.parent}` compares the participants).", flush=True)
+    if failed:
+        print(f"pbp-drake: the run of {', '.join(failed)} did not reach its target (exit "
+              f"{EXIT_FAILED}); the session is complete and saved.", file=sys.stderr)
+    if console is not None:
+        console.show_title("Session complete - you can close this page")
+        console.show_status(f"{counted(len(order), 'method')} run and answered; thank you.")
+        console.clear_result()
+        _keep_page(args, page, console, ("close",))
+        page.end("Session complete - you can close this page")
+    return EXIT_FAILED if failed else EXIT_SUCCESS
 
 
-def _session_page(args, meshcat, methods):
-    """Where the session's Start, questions and Next are: the Meshcat page, or `--answers`
-    (the virtual operator only, which needs no browser; see check_run_flags)."""
-    if args.answers is not None:
-        return FixedAnswers(parse_answers(args.answers, methods))
-    return MeshcatSessionPage(meshcat)
+class _SessionStopped(Exception):
+    """Stop pressed in the page during a session's run: the session ends, resumable."""
 
 
-def _interactive(args, meshcat):
-    """A person may be watching: the run waits for a browser, and the page stays live after
-    the run. Not with --headless or --no-meshcat, nor without a terminal (a script's run)."""
-    return meshcat is not None and not args.headless and sys.stdin.isatty()
+class _StartInTheRun:
+    """A session's pages in Meshcat (`MeshcatSessionPage`) whose Start is pressed inside the
+    run, once the run's scene is in the page, rather than before the run is built: `start`
+    only keeps the label, which the run's `LiveRun` shows (`take_start_label`). With
+    `--start-on-connect`, Start is today's page between the runs."""
+
+    def __init__(self, pages, start_between_runs=False):
+        self._pages = pages
+        self._start_between_runs = start_between_runs
+        self._label = None
+
+    def start(self, method, position, total, practice=False):
+        if self._start_between_runs:
+            self._pages.start(method, position, total, practice)
+        else:
+            self._label = start_label(method, position, total, practice)
+
+    def take_start_label(self):
+        label, self._label = self._label, None
+        return label
+
+    def answer(self, method, question):
+        return self._pages.answer(method, question)
+
+    def next(self, position, total):
+        self._pages.next(position, total)
+
+
+def _start_gate(args, person):
+    """Whether a run's task waits for Start in the page: a person's, unless
+    --start-on-connect asks for today's start as the page connects."""
+    return person and not args.start_on_connect
+
+
+def _terminal():
+    """stdin when it is a terminal, where Enter stops a run's wait; else None."""
+    return sys.stdin if sys.stdin.isatty() else None
 
 
 def _alpha(scenario):
     return scenario.alpha if scenario.method == "fixed_alpha" else None
 
 
-def _console(meshcat, args, scenario, choices=("stop", "restart", "next")):
-    """The page's console: the choices, the alpha slider (fixed_alpha) and the real-time
-    rate slider (not when running as fast as possible)."""
-    return Console(meshcat, choices, alpha=_alpha(scenario),
-                   realtime_rate=None if args.headless else args.realtime_rate)
+def _console(meshcat, page, args, scenario, choices=RUN_CHOICES):
+    """The page's console: its lines in the front's panel, the choices, the alpha slider
+    (fixed_alpha) and the real-time rate slider."""
+    return Console(meshcat, choices, alpha=_alpha(scenario), realtime_rate=args.realtime_rate,
+                   panel=page)
 
 
-def _wait_for_stop(console):
-    print("The page stays live: Stop (or Enter, or Ctrl-C) quits.", flush=True)
-    console.wait_for_choice(stdin=sys.stdin)
+def _keep_page(args, page, console, choices):
+    """After a run, with a page open: the result stays served until the person closes the
+    page, presses one of `choices` (Close, and after a single run Restart and Next scene),
+    presses Enter in a terminal, or --keep-page seconds pass. Returns the choice, or None."""
+    if page.pages() == 0:
+        return None
+    console.set_choices(choices)
+    words = {"close": "Close", "restart": "Restart runs the scene again",
+             "next": "Next scene the next seed"}
+    print("The page shows the result: " + ", ".join(words[c] for c in choices)
+          + f"; closing the page (or Enter) ends the command, as {args.keep_page:g} s do.",
+          flush=True)
+    return console.wait_for_choice(stdin=_terminal(), timeout=args.keep_page,
+                                   until=lambda: page.pages() == 0)
 
 
-def _wait_for_browser(meshcat, seconds, person=False):
+def _wait_for_browser(page, meshcat, seconds, person=False):
     """Waits up to `seconds` for a browser on the page. A person's run (keyboard, gamepad)
     cannot go on without one: it stops with exit 2 before anything runs or is recorded."""
     deadline = time.monotonic() + seconds
-    while meshcat.GetNumActiveConnections() == 0 and time.monotonic() < deadline:
+    while page.pages() == 0 and time.monotonic() < deadline:
         time.sleep(0.05)
-    if person and meshcat.GetNumActiveConnections() == 0:
-        raise ScenarioError(f"no browser opened {meshcat.web_url()} within {seconds:g} s "
+    if person and page.pages() == 0:
+        raise ScenarioError(f"no browser opened {page.url} within {seconds:g} s "
                             "(--wait-for-browser): the keyboard and gamepad are read in the "
                             "page, so nothing was run or recorded")
 

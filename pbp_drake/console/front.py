@@ -67,6 +67,11 @@ _PAGES = ("/", "/index.html", "/meshcat.html")
 # the kernel's, which on localhost grows to megabytes (seconds of poses) unless fixed.
 WRITE_LIMIT = 2**14
 SEND_BUFFER = 2**15
+# The relay's pacing: after each batch a text frame FRAME, which our page answers with ACK
+# at its next animation frame; the next batch waits for it. So a page is sent at most one
+# batch of latest states a frame, and its main thread always has time for the panel. (A
+# client that never answers, not our page, is sent batches as fast as it reads.)
+FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
 
 INJECTION = """
 <style>
@@ -88,7 +93,12 @@ body.pbp-ended #status-message { display: none !important; }
   var token = new URLSearchParams(location.search).get("token");
   var page = Math.random().toString(36).slice(2) + Date.now().toString(36);
   var query = "?page=" + page + (token ? "&token=" + encodeURIComponent(token) : "");
-  var shown = {}, served = false, ended = false;
+  var shown = {seq: -1}, served = false, ended = false;
+  function take(state) {
+    // The newest state wins, whether it came with the scene or by a poll.
+    if (ended || state.seq < shown.seq) return;
+    if (state.ended) end(state); else show(state);
+  }
   function show(state) {
     shown = state;
     ["title", "status", "result", "notice"].forEach(function (name) {
@@ -113,16 +123,29 @@ body.pbp-ended #status-message { display: none !important; }
   function poll() {
     fetch("/pbp/state" + query, {cache: "no-store"})
       .then(function (r) { if (!r.ok) throw new Error(r.status); return r.json(); })
-      .then(function (state) { served = true; if (state.ended) end(state); else show(state); })
+      .then(function (state) { served = true; take(state); })
       .catch(function () { if (served) end(shown); })
-      .finally(function () { if (!ended) setTimeout(poll, 200); });
+      .finally(function () { if (!ended) setTimeout(poll, 1000); });
   }
+  // The relay's text frames: the panel's state, sent with the scene (a fetch's chain of
+  // tasks waits behind every frame of a slow page); and the end of a batch, answered at
+  // the next animation frame, so that the page never has more of the scene to handle
+  // than it can draw.
+  var handle_meshcat_message = handle_message;
+  handle_message = function (message) {
+    if (typeof message.data !== "string") return handle_meshcat_message(message);
+    var socket = message.target;
+    if (message.data === "FRAME_TEXT") requestAnimationFrame(function () {
+      if (socket.readyState === WebSocket.OPEN) socket.send("ACK_TEXT");
+    });
+    else if (message.data.charAt(0) === "{") { served = true; take(JSON.parse(message.data)); }
+  };
   // The run's buttons on screen at 1024x640: the Scene tree folded, the control panel open.
   try { viewer.gui.__folders["Scene"].close(); viewer.gui.open(); } catch (e) {}
   poll();
 })();
 </script>
-"""
+""".replace("FRAME_TEXT", FRAME).replace("ACK_TEXT", ACK)
 
 
 def new_token():
@@ -267,8 +290,9 @@ class PageFront:
         self._port = self._socket.getsockname()[1]
         self._host = "localhost" if host in ("", "0.0.0.0", "::") else host
         self._lock = threading.Lock()
-        self._state = dict.fromkeys((*LINES, "time"), None) | {"ended": False}
+        self._state = dict.fromkeys((*LINES, "time"), None) | {"ended": False, "seq": 0}
         self._ended_pages, self._relays, self._closed = set(), 0, False
+        self._wakers = set()  # each relay's event: the state changed, send it
         try:
             self._files = self._fetch_page()
         except (OSError, ValueError) as error:
@@ -310,6 +334,8 @@ class PageFront:
                             f"{', '.join(sorted(unknown))}")
         with self._lock:
             self._state.update({name: _panel_value(name, value) for name, value in lines.items()})
+            self._state["seq"] += 1
+        self._wake_relays()
 
     def state(self):
         """What the page's panel shows (the lines, `time` and `ended`), a copy."""
@@ -322,7 +348,9 @@ class PageFront:
         for every relayed page to fetch that, so none is left on the reconnect banner."""
         with self._lock:
             self._state.update(ended=True, notice=text)
+            self._state["seq"] += 1
             self._ended_pages.clear()
+        self._wake_relays()
         deadline = time.monotonic() + wait
         while time.monotonic() < deadline:
             with self._lock:
@@ -347,6 +375,15 @@ class PageFront:
 
     def __enter__(self):
         return self
+
+    def _wake_relays(self):
+        def wake():
+            for waker in self._wakers:
+                waker.set()
+        try:
+            self._loop.call_soon_threadsafe(wake)
+        except RuntimeError:  # the loop is closed: no relay to wake
+            pass
 
     def __exit__(self, *exc_info):
         self.close()
@@ -408,8 +445,6 @@ class PageFront:
     async def _file(self, path, query):
         if path == "/pbp/state":
             with self._lock:
-                if self._state["ended"]:
-                    self._ended_pages.update(query.get("page", ["?"]))
                 body = json.dumps(self._state).encode()
             return _response(200, body, "application/json", ("Cache-Control", "no-store"))
         if path not in self._files:
@@ -434,23 +469,52 @@ class PageFront:
             return
         page.transport.get_extra_info("socket").setsockopt(
             socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
-        pending, ready = PendingMessages(), asyncio.Event()
+        pending, ready, acked = PendingMessages(), asyncio.Event(), asyncio.Event()
+        paced = False  # until the page's first ACK: a client that never answers
+        sent_seq = -1  # the panel state this page was sent last
+        self._wakers.add(ready)
 
         async def to_meshcat():
+            nonlocal paced
             async for message in page:
-                await meshcat.send(message)
+                if message == ACK:
+                    paced = True
+                    acked.set()
+                    ready.set()
+                elif not isinstance(message, str):  # Meshcat reads msgpack, never text
+                    await meshcat.send(message)
 
         async def from_meshcat():
             async for message in meshcat:
                 pending.put(message_key(message), message)
                 ready.set()
 
+        async def send_state():
+            # The panel's state goes out whenever it changes, between batches too: it is
+            # one small message, and a slow page handles it before the next frame.
+            nonlocal sent_seq
+            with self._lock:
+                state = dict(self._state)
+            if state["seq"] != sent_seq:
+                sent_seq = state["seq"]
+                await page.send(json.dumps(state))
+                if state["ended"]:  # sent before any close: the page shows it, see `end`
+                    with self._lock:
+                        self._ended_pages.add(id(page))
+
         async def to_page():
+            acked.set()  # no batch is out yet
             while True:
                 await ready.wait()
                 ready.clear()
+                await send_state()
+                if not pending or (paced and not acked.is_set()):
+                    continue  # the scene waits for the page's answer to the last batch
                 while pending:
                     await page.send(pending.pop())
+                await send_state()
+                acked.clear()
+                await page.send(FRAME)
 
         self._relays += 1
         tasks = [asyncio.create_task(job()) for job in (to_meshcat, from_meshcat, to_page)]
@@ -458,6 +522,7 @@ class PageFront:
             await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
         finally:
             self._relays -= 1
+            self._wakers.discard(ready)
             for task in tasks:
                 task.cancel()
             await asyncio.gather(*tasks, return_exceptions=True)

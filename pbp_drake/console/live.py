@@ -68,10 +68,20 @@ class LiveRun:
     (a `RobotCamera`, or None), applies the alpha slider to the `blender` (fixed_alpha) and
     the real-time-rate slider to the simulator. A click on a choice button ends the run
     there: `advance` returns True, and `choice` holds "stop", "restart" or "next".
+
+    With `start_label`, the first `advance` first shows a Start button of that label and
+    waits for it (`Console.wait_for_start`; Enter on `stdin` or Stop: the run ends after
+    its first slice, `choice` "stop"): the simulator has then been initialized, so the scene went to
+    the page before the button did, and the page shows the button once it has handled the
+    scene. The task's clock, simulated time, starts at the press: the real-time pacing is
+    restarted there.
     """
 
-    def __init__(self, diagram, duration, console=None, progress=None, camera=None):
+    def __init__(self, diagram, duration, console=None, progress=None, camera=None,
+                 start_label=None, stdin=None):
         self._console = console
+        self._start_label = start_label
+        self._stdin = stdin
         self._progress = progress
         self._camera = camera
         self._duration = float(duration)
@@ -89,6 +99,10 @@ class LiveRun:
         task's termination event, or a choice of the person's)."""
         context = simulator.get_context()
         if self._console is not None:
+            if self._start_label is not None and not self._wait_for_start(simulator):
+                # One slice, not none: the task's logs then hold a tick to report.
+                advance_to(simulator, min(end_time, SLICE_SECONDS))
+                return True
             self._apply_sliders(simulator)
         while (now := context.get_time()) < end_time:
             step = min((math.floor(now / SLICE_SECONDS + 1e-9) + 1) * SLICE_SECONDS, end_time)
@@ -98,7 +112,7 @@ class LiveRun:
                 break
         # The last word, whatever the rate limits: the page and terminal end where the run did.
         if self._console is not None:
-            self._console.show_status(self.status(context))
+            self._console.show_status(self.status(context), context.get_time())
         if self._progress is not None:
             self._progress.show(context.get_time(), simulator.get_actual_realtime_rate(),
                                 force=True)
@@ -124,9 +138,26 @@ class LiveRun:
             return
         self.choice = self._console.choice()
         self._apply_sliders(simulator)
-        if time.monotonic() - self._last_status >= STATUS_PERIOD:
+        # A panel keeps only the latest line, which the page fetches at its own rate: every
+        # slice's. Button labels are messages the page handles in turn: a few a second.
+        if (self._console.panel is not None
+                or time.monotonic() - self._last_status >= STATUS_PERIOD):
             self._last_status = time.monotonic()
-            self._console.show_status(self.status(context))
+            self._console.show_status(self.status(context), context.get_time())
+
+    def _wait_for_start(self, simulator):
+        """Shows Start and waits for it; False when the person stopped instead."""
+        label, self._start_label = self._start_label, None
+        self._console.show_status(self.status(simulator.get_context())
+                                  + " · press Start when ready",
+                                  simulator.get_context().get_time())
+        if self._console.wait_for_start(label, stdin=self._stdin) == "stop":
+            self.choice = "stop"
+            return False
+        # The pacing counts from its last reset: without one, the run would rush through
+        # the seconds the person took to press Start.
+        simulator.ResetStatistics()
+        return True
 
     def _apply_sliders(self, simulator):
         if (alpha := self._console.alpha()) != self._alpha:

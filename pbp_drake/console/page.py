@@ -2,8 +2,11 @@
 page's control panel.
 
 Drake's Meshcat has no text primitive; what the control panel shows is the label of each
-button and slider. So a line of text is a button whose label is the text (clicking it does
-nothing), replaced (deleted and added again) when the text changes.
+button and slider. So, on a bare Meshcat, a line of text is a button whose label is the text
+(clicking it does nothing), replaced (deleted and added again) when the text changes. Behind
+the command line's page front (`pbp_drake.console.front.PageFront`) the lines go to the
+front's own panel instead, which the page fetches at a bounded rate and only the latest of:
+a slow page then never shows a stale status, however far behind it draws the scene.
 """
 
 import select
@@ -11,7 +14,8 @@ import sys
 import time
 
 #: The choices a person can make, and the label of the button that makes each.
-CHOICE_BUTTONS = {"stop": "Stop", "restart": "Restart", "next": "Next scene"}
+CHOICE_BUTTONS = {"stop": "Stop", "restart": "Restart", "next": "Next scene",
+                  "close": "Close"}
 ALPHA_SLIDER = "Alpha (user 0 .. robot 1)"
 RATE_SLIDER = "Real-time rate"
 # The slider's range: slow enough to watch a takeover, at most what a laptop keeps up with.
@@ -25,16 +29,22 @@ class Console:
 
     Args:
         meshcat: the page's Meshcat.
-        choices: which of "stop", "restart", "next" get a button (labels in
-            `CHOICE_BUTTONS`: Stop, Restart, Next scene), in this order.
+        choices: which of "stop", "restart", "next", "close" get a button (labels in
+            `CHOICE_BUTTONS`: Stop, Restart, Next scene, Close), in this order.
         alpha: with a number, an alpha slider (0..1, step 0.05) starting there; `alpha()`
             reads it.
         realtime_rate: with a positive number, a real-time-rate slider (`RATE_RANGE`,
             widened to hold the number) starting there; `realtime_rate()` reads it.
+        panel: where the lines go instead of button labels: an object with `show(**lines)`
+            taking `title`, `status`, `result` and `time` (a `PageFront`), or None.
 
     The panel then shows, top to bottom: the choice buttons, the sliders, the title line
     (`show_title`), the status line (`show_status`) and the result line (`show_result`).
     Buttons added to the page by others (the keyboard operator's) stay above.
+
+    `wait_for_start(label)` shows a Start button labelled `label` and blocks until it is
+    clicked (or Stop is); `set_choices(choices)` replaces the choice buttons (after a run:
+    Restart, Next scene, Close).
 
     Reading the person's choice:
         `choice()` returns at once: the choice whose button was clicked since the last
@@ -48,18 +58,12 @@ class Console:
     """
 
     def __init__(self, meshcat, choices=("stop", "restart", "next"), alpha=None,
-                 realtime_rate=None):
-        unknown = set(choices) - set(CHOICE_BUTTONS)
-        if unknown:
-            raise ValueError(f"unknown choices {sorted(unknown)}; choose from "
-                             f"{list(CHOICE_BUTTONS)}")
+                 realtime_rate=None, panel=None):
         self._meshcat = meshcat
-        self._choices = tuple(choices)
-        for choice in self._choices:
-            meshcat.AddButton(CHOICE_BUTTONS[choice])
-        # Clicks made before this console (a button of the same name earlier) do not count.
-        self._seen = {choice: meshcat.GetButtonClicks(CHOICE_BUTTONS[choice])
-                      for choice in self._choices}
+        self._panel = panel
+        self._choices = ()
+        self._seen = {}
+        self.set_choices(choices)
         self._sliders = []
         if alpha is not None:
             meshcat.AddSlider(ALPHA_SLIDER, 0.0, 1.0, 0.05, float(alpha))
@@ -77,13 +81,37 @@ class Console:
     def meshcat(self):
         return self._meshcat
 
+    @property
+    def panel(self):
+        """The panel the lines go to (a `PageFront`), or None: button labels."""
+        return self._panel
+
+    def set_choices(self, choices):
+        """Replaces the choice buttons by `choices` (see the class), in this order; clicks
+        made before count for none of them."""
+        unknown = set(choices) - set(CHOICE_BUTTONS)
+        if unknown:
+            raise ValueError(f"unknown choices {sorted(unknown)}; choose from "
+                             f"{list(CHOICE_BUTTONS)}")
+        for choice in self._choices:
+            self._meshcat.DeleteButton(CHOICE_BUTTONS[choice], strict=False)
+        self._choices = tuple(choices)
+        for choice in self._choices:
+            self._meshcat.AddButton(CHOICE_BUTTONS[choice])
+        # Clicks made before (a button of the same name earlier) do not count.
+        self._seen = {choice: self._meshcat.GetButtonClicks(CHOICE_BUTTONS[choice])
+                      for choice in self._choices}
+
     def show_title(self, text):
         """The first line, e.g. the method's name ("PBP-Alt")."""
         self._show("title", text)
 
-    def show_status(self, text):
-        """The live line under the title, e.g. `pbp_drake.console.text.status_text(...)`.
-        Unchanged text sends nothing to the page."""
+    def show_status(self, text, time=None):
+        """The live line under the title, e.g. `pbp_drake.console.text.status_text(...)`,
+        of simulated `time` (seconds; the panel passes it on to the page). Unchanged text
+        sends nothing to a bare Meshcat."""
+        if self._panel is not None:
+            self._panel.show(status=text, time=time)
         self._show("status", text)
 
     def show_result(self, text):
@@ -117,11 +145,37 @@ class Console:
                 return choice
         return None
 
-    def wait_for_choice(self, poll_period=0.05, stdin=None):
+    def wait_for_start(self, label, poll_period=0.05, stdin=None):
+        """Shows a Start button labelled `label` after the choices and blocks until it is
+        clicked ("start"), or until Stop is clicked, Enter is pressed on `stdin` or Ctrl-C
+        ("stop"). The button is gone on return."""
+        self._meshcat.AddButton(label)
+        try:
+            while not self._meshcat.GetButtonClicks(label):
+                if self.choice() == "stop":
+                    return "stop"
+                if stdin is not None and select.select([stdin], [], [], poll_period)[0]:
+                    stdin.readline()
+                    return "stop"
+                if stdin is None:
+                    time.sleep(poll_period)
+            return "start"
+        except KeyboardInterrupt:
+            print(file=sys.stderr)
+            return "stop"
+        finally:
+            self._meshcat.DeleteButton(label, strict=False)
+
+    def wait_for_choice(self, poll_period=0.05, stdin=None, timeout=None, until=None):
         """Blocks until a choice button is clicked and returns its choice. Ctrl-C, and a
-        line (Enter) on `stdin` when given, return "stop"."""
+        line (Enter) on `stdin` when given, return "stop". After `timeout` seconds, or as
+        soon as `until()` is true (e.g. the page was closed), returns None."""
+        deadline = None if timeout is None else time.monotonic() + timeout
         try:
             while (choice := self.choice()) is None:
+                if ((deadline is not None and time.monotonic() >= deadline)
+                        or (until is not None and until())):
+                    return None
                 if stdin is not None and select.select([stdin], [], [], poll_period)[0]:
                     stdin.readline()
                     return "stop"
@@ -140,12 +194,18 @@ class Console:
             self._meshcat.DeleteSlider(name, strict=False)
         for name in self._lines:
             self._show(name, None)
+        self._choices = ()
 
     def _slider(self, name):
         return self._meshcat.GetSliderValue(name) if name in self._sliders else None
 
     def _show(self, line, label):
         if self._lines[line] == label:
+            return
+        if self._panel is not None:
+            self._lines[line] = label
+            if line != "status":  # show_status passes the status on with its time
+                self._panel.show(**{line: label})
             return
         # The control panel lists controls in the order they were added: a changed line
         # goes back in, and so do the lines below it, to keep the order.

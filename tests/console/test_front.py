@@ -15,11 +15,12 @@ import urllib.request
 import msgpack
 import pytest
 from pydrake.geometry import Box, Rgba
-from websockets.exceptions import InvalidStatus
+from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
 from pbp_drake.console.front import (
-    PageFront, PendingMessages, PortError, bind_page_port, check_token, message_key, new_token)
+    ACK, FRAME, PageFront, PendingMessages, PortError, bind_page_port, check_token, message_key,
+    new_token)
 
 
 @pytest.fixture(autouse=True)
@@ -107,6 +108,24 @@ def test_refused_websockets_never_reach_meshcat(meshcat, front):
     assert meshcat.GetButtonClicks("Left") == 1
 
 
+def _messages(page, until, timeout=5.0):
+    """What `page` receives until `until(seen)` holds: Meshcat's messages as (type, path or
+    name), our text frames as themselves (the panel's state decoded, FRAME as is)."""
+    seen = []
+    deadline = time.monotonic() + timeout
+    while not until(seen) and time.monotonic() < deadline:
+        try:
+            raw = page.recv(timeout=max(0.01, deadline - time.monotonic()))
+        except (TimeoutError, ConnectionClosed):
+            break
+        if isinstance(raw, str):
+            seen.append(json.loads(raw) if raw.startswith("{") else raw)
+        else:
+            message = msgpack.unpackb(raw, raw=False)
+            seen.append((message.get("type"), message.get("path", message.get("name"))))
+    return seen
+
+
 def test_an_authorised_page_is_relayed_both_ways(meshcat, front):
     meshcat.AddButton("Left")
     with _websocket(front, f"?token={front.token}") as page:
@@ -114,13 +133,38 @@ def test_an_authorised_page_is_relayed_both_ways(meshcat, front):
         page.send(_press("Left"))
         assert _until(lambda: meshcat.GetButtonClicks("Left") == 1)
         meshcat.SetObject("/box", Box(0.1, 0.2, 0.3), Rgba(1, 0, 0, 1))
-        seen = []
-        deadline = time.monotonic() + 5.0
-        while ("set_object", "/box") not in seen and time.monotonic() < deadline:
-            message = msgpack.unpackb(page.recv(timeout=5.0), raw=False)
-            seen.append((message.get("type"), message.get("path", message.get("name"))))
+        seen = _messages(page, lambda seen: ("set_object", "/box") in seen)
         assert ("set_control", "Left") in seen and ("set_object", "/box") in seen
+        assert FRAME in seen  # each batch ends in one
     assert _until(lambda: meshcat.GetNumActiveConnections() == 0 and front.pages() == 0)
+
+
+def _batch_of(path):
+    """`until` for `_messages`: the batch holding `path`'s set_object, to its FRAME."""
+    def until(seen):
+        found = ("set_object", path)
+        return found in seen and FRAME in seen[seen.index(found):]
+    return until
+
+
+def test_a_paced_page_gets_the_next_batch_after_its_answer_and_the_panel_at_once(
+        meshcat, front):
+    with _websocket(front, f"?token={front.token}") as page:
+        assert _until(lambda: front.pages() == 1)
+        meshcat.SetObject("/a", Box(0.1, 0.1, 0.1), Rgba(1, 0, 0, 1))
+        assert _batch_of("/a")(_messages(page, _batch_of("/a")))
+        page.send(ACK)  # our page's answer: from now on the relay waits for each
+        meshcat.SetObject("/b", Box(0.1, 0.1, 0.1), Rgba(1, 0, 0, 1))
+        assert _batch_of("/b")(_messages(page, _batch_of("/b")))
+        # Not answered: the scene waits, but the panel's state does not.
+        meshcat.SetObject("/c", Box(0.1, 0.1, 0.1), Rgba(1, 0, 0, 1))
+        front.show(status="time left 9 s", time=51.0)
+        seen = _messages(page, lambda seen: False, timeout=1.0)
+        assert ("set_object", "/c") not in seen
+        assert any(isinstance(m, dict) and m["status"] == "time left 9 s" for m in seen)
+        page.send(ACK)
+        assert ("set_object", "/c") in _messages(
+            page, lambda seen: ("set_object", "/c") in seen)
 
 
 def test_the_cookie_alone_opens_the_websocket(meshcat, front):
@@ -135,9 +179,10 @@ def test_the_panel_state_and_the_end(front):
     front.show(result="success in 14.2 s", time=float("nan"))
     status, headers, body = _get(f"http://localhost:{front.port}/pbp/state?token={front.token}")
     assert status == 200 and headers["Cache-Control"] == "no-store"
-    assert json.loads(body) == front.state() == {
+    assert json.loads(body) == front.state()
+    assert front.state() | {"seq": None} == {
         "title": "PBP-Alt", "status": "time left 41 s", "result": "success in 14.2 s",
-        "notice": None, "time": None, "ended": False}
+        "notice": None, "time": None, "ended": False, "seq": None}
     front.show(time=4.5)
     assert json.loads(_get(front.url.replace("/?", "/pbp/state?"))[2])["time"] == 4.5
     started = time.monotonic()
@@ -149,27 +194,16 @@ def test_the_panel_state_and_the_end(front):
         front.show(colour="red")
 
 
-def test_end_waits_for_every_relayed_page_to_see_it(meshcat, front):
-    state_url = front.url.replace("/?", "/pbp/state?") + "&page=one"
-    with _websocket(front, f"?token={front.token}"):
+def test_the_end_reaches_every_relayed_page_before_the_close(meshcat, front):
+    with _websocket(front, f"?token={front.token}") as page:
         assert _until(lambda: front.pages() == 1)
-        _get(state_url)  # before the end: it does not count
-        started = time.monotonic()
-        front.end(wait=0.3)
-        assert time.monotonic() - started >= 0.3
-        done = threading.Event()
-
-        def page_polls():  # as the page's script does, every 200 ms (here 50)
-            while not done.wait(0.05):
-                _get(state_url)
-        poller = threading.Thread(target=page_polls)
-        poller.start()
         started = time.monotonic()
         front.end("Session complete - you can close this page", wait=5.0)
-        done.set()
-        poller.join()
-        assert time.monotonic() - started < 2.0
-    assert front.state()["notice"] == "Session complete - you can close this page"
+        assert time.monotonic() - started < 2.0  # sent: no need to wait out the 5 s
+        front.close()
+        ends = [m for m in _messages(page, lambda seen: False, timeout=2.0)
+                if isinstance(m, dict) and m["ended"]]
+        assert ends and ends[-1]["notice"] == "Session complete - you can close this page"
 
 
 def test_close_stops_serving_and_is_idempotent(meshcat):

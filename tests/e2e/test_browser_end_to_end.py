@@ -14,7 +14,7 @@ import time
 import matplotlib.image
 import numpy as np
 import pytest
-from browser_page import NEEDS_BROWSER, free_port, open_page, running
+from browser_page import NEEDS_BROWSER, click, free_port, open_page, running
 
 pytestmark = NEEDS_BROWSER
 
@@ -53,9 +53,10 @@ def test_holding_the_left_arrow_in_the_browser_moves_the_hand_left(repo, tmp_pat
         url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
         with open_page(url.group(1)) as page:
-            # The task starts when the page connects; the keys work once the page has
-            # the keyboard operator's buttons.
+            # The task starts at the page's Start; the keys work once the page has the
+            # keyboard operator's buttons.
             page.wait_for_selector("text=Left (←)", state="attached")
+            click(page, "Start")
             time.sleep(1.0)
             # Meshcat clicks a key's button on every keydown on `window`, and a key
             # counts as held for hold_time (0.6 s) after its last click: press it as a
@@ -73,8 +74,7 @@ def test_holding_the_left_arrow_in_the_browser_moves_the_hand_left(repo, tmp_pat
                    and time.monotonic() < deadline):
                 time.sleep(0.5)
             if process.poll() is None:  # ends the run at once, as a person would
-                page.locator(".dg li.cr").filter(has=page.locator(
-                    ".property-name", has_text=re.compile("^Stop$"))).dispatch_event("click")
+                click(page, "Stop")
         (tmp_path / "meshcat.png").write_bytes(png)
         result = output.wait_for(RESULT.pattern, timeout=DURATION + 30)
         assert result, f"no result line from pbp-drake:\n{output.text()}"

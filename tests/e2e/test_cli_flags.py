@@ -1,10 +1,13 @@
 """`pbp-drake run`'s numeric flags are checked when the line is parsed (exit 2, the flag
-named), and a keyboard or gamepad run that no browser joins stops, having run and recorded
-nothing, instead of running unattended to its time limit."""
+named), a port in use is refused in one line before anything is built, and a keyboard or
+gamepad run that no browser joins stops, having run and recorded nothing, instead of
+running unattended to its time limit."""
 
+import socket
 import time
 
 import pytest
+from browser_page import free_port
 
 from pbp_drake.cli import main
 
@@ -23,6 +26,9 @@ TASK = "diagrams/hsr_reach.yaml"
     ("--realtime-rate", "fast", "not a number"),
     ("--wait-for-browser", "nan", "finite"),
     ("--wait-for-browser", "-0.5", "0 or more"),
+    ("--keep-page", "-1", "0 or more"),
+    ("--token", "short", "16 to 128"),
+    ("--token", "a" * 15 + "/", "only letters, digits"),
 ])
 def test_a_bad_flag_value_is_refused_when_parsed(repo, capsys, flag, value, message):
     started = time.monotonic()
@@ -36,11 +42,35 @@ def test_a_bad_flag_value_is_refused_when_parsed(repo, capsys, flag, value, mess
 
 
 @pytest.mark.parametrize("argv", [
-    ["--port", "0"], ["--port", "65535"], ["--realtime-rate", "0.5"],
-    ["--wait-for-browser", "0"],
+    ["--port", "0"], ["--realtime-rate", "0.5"], ["--wait-for-browser", "0"],
+    ["--token", "a-script-chose_this-token"], ["--keep-page", "0"],
 ])
 def test_good_flag_values_pass(repo, argv):
     assert main(["run", str(repo / QUICK), "--headless", *argv]) == 0
+
+
+def test_a_page_run_takes_a_free_port_and_prints_its_tokened_url(repo, capsys):
+    port = free_port()
+    assert main(["run", str(repo / QUICK), "--port", str(port),
+                 "--token", "a-script-chose_this-token"]) == 0
+    out = capsys.readouterr().out
+    assert f"Meshcat: http://localhost:{port}/?token=a-script-chose_this-token" in out
+    assert "listening for connections" not in out  # Drake's own line, of the private port
+
+
+def test_a_port_in_use_is_refused_in_one_line_before_anything_is_built(repo, capsys):
+    with socket.socket() as taken:
+        taken.bind(("localhost", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        started = time.monotonic()
+        code = main(["run", str(repo / TASK), "--port", str(port)])
+        elapsed = time.monotonic() - started
+    captured = capsys.readouterr()
+    assert code == 2
+    assert captured.err == f"pbp-drake: port {port} is in use (use --port 0 for a free one)\n"
+    assert captured.out == ""  # no URL, no scene built, no run
+    assert elapsed < 2.0, f"took {elapsed:.1f} s"
 
 
 @pytest.mark.parametrize("operator", ["keyboard", "gamepad"])
@@ -54,7 +84,7 @@ def test_a_person_run_that_no_browser_joins_stops_and_records_nothing(repo, tmp_
     captured = capsys.readouterr()
     assert code == 2
     assert elapsed < 5.0, f"took {elapsed:.1f} s"
-    assert "the task starts when it connects (waiting up to 0.2 s)" in captured.out
+    assert "(waiting up to 0.2 s); the task starts when Start is pressed" in captured.out
     assert captured.err.startswith("pbp-drake: no browser opened http://")
     assert "within 0.2 s (--wait-for-browser)" in captured.err
     assert "nothing was run or recorded" in captured.err

@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 import pytest
-from browser_page import NEEDS_BROWSER, free_port, open_page, running
+from browser_page import NEEDS_BROWSER, click, free_port, open_page, running
 
 from pbp_drake.systems.operators.pose_keyboard_operator import MODE_LABELS, ROTATE, TRANSLATE
 
@@ -45,6 +45,7 @@ def test_the_keyboard_moves_the_grasping_hand_from_the_page(repo):
                                timeout=10), output.text()
         with open_page(url.group(1)) as page:
             page.wait_for_selector(f"text={MODE_LABELS[TRANSLATE]}", state="attached")
+            click(page, "Start")
             time.sleep(1.0)
             hold(page, "ArrowLeft", 2.0)
             pressed_while_running = process.poll() is None

@@ -3,7 +3,8 @@ headless Chromium: the three methods started from the page's Start
 buttons and driven with the arrow keys, the questionnaire answered with clicks, Next clicked;
 while each method runs the page shows the live status (the method's name, the time left,
 then the result) and the Stop, Restart and Next scene buttons. The session then holds every
-method's trial, with the keys' input in it, and `questionnaire.json` the clicked answers.
+method's trial, with the keys' input in it, and `questionnaire.json` the clicked answers;
+the page ends on "Session complete", never on Meshcat's reconnect banner.
 
 Needs Debian's `chromium` and Playwright from PyPI, as tests/e2e/test_browser_end_to_end.py.
 """
@@ -14,7 +15,8 @@ import sys
 import time
 
 import pytest
-from browser_page import NEEDS_BROWSER, free_port, open_page, running
+from browser_page import (
+    NEEDS_BROWSER, banner_shown, click, console_line, control, free_port, open_page, running)
 
 from pbp_drake.console.questionnaire import answer_labels, next_label, start_label
 from pbp_drake.console.text import method_name
@@ -28,23 +30,11 @@ pytestmark = NEEDS_BROWSER
 # runs of the suite of five).
 DURATION = 20.0
 ANSWERS = {"pbp_alternated": (4, 3), "pbp_continuous": (2, 5), "teleop": (1, 0)}
+COMPLETE = "Session complete - you can close this page"
 
 
 def label_of(question, value):
     return next(label for label, v in answer_labels(question).items() if v == value)
-
-
-def control(page, label):
-    """The row of the page's control panel (Meshcat's dat.gui) labelled exactly `label`, a
-    regular expression."""
-    return page.locator(".dg li.cr").filter(
-        has=page.locator(".property-name", has_text=re.compile(f"^{label}$")))
-
-
-def click(page, label):
-    row = control(page, re.escape(label))
-    row.wait_for(state="attached", timeout=60_000)  # until the page shows it
-    row.dispatch_event("click")  # the panel may be folded: the click its row would send
 
 
 def hold_left(page, seconds):
@@ -71,37 +61,45 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
             for position, method in enumerate(order, start=1):
                 click(page, start_label(method, position, len(order)))
                 # The keys work once the page has the keyboard operator's buttons and
-                # this method's run has started (its title shows as it starts; the
-                # buttons may be the last method's still): press at once, while it runs.
+                # this method's run has started (its title shows once its scene is in
+                # the page, with its Start): press at once, while it runs.
                 page.wait_for_selector("text=Left (←)", state="attached")
-                name = re.escape(method_name(method))
-                control(page, f"{name}, seed 0").wait_for(state="attached")
+                console_line(page, "title").filter(
+                    has_text=f"{method_name(method)}, seed 0").wait_for()
                 # Held until the status counts it: a page rendered in software may handle
                 # the keys seconds late, the later the busier the machine (at most the run).
-                status = r"time left \d+ s · \d+ target switch(es)? · intervention "
+                status = console_line(page, "status")
+                counts = r"^time left \d+ s · \d+ target switch(es)? · intervention "
                 hold_left(page, 1.5)
                 deadline = time.monotonic() + DURATION
-                while (not control(page, status + r"[1-9]\d* %").count()
+                while (not status.filter(has_text=re.compile(counts + r"[1-9]\d* %$")).count()
                        and time.monotonic() < deadline):
                     hold_left(page, 0.5)
-                control(page, status + r"\d+ %").wait_for(state="attached")
+                status.filter(has_text=re.compile(counts + r"\d+ %$")).wait_for()
                 seen[method] = {b: control(page, b).count()
                                 for b in ("Stop", "Restart", "Next scene")}
                 # A run is paced at real time when the machine keeps up; on a loaded one its
                 # 20 simulated seconds took over 50 s of wall time (a failure of the suite):
                 # wait up to four times the run, which a quiet machine never needs.
-                control(page, r"Result: (success in|failed: time limit).*").wait_for(
-                    state="attached", timeout=(4 * DURATION + 30) * 1000)
+                console_line(page, "result").filter(has_text=re.compile(
+                    r"^Result: (success in|failed: time limit)")).wait_for(
+                    timeout=(4 * DURATION + 30) * 1000)
                 tiredness, ease = ANSWERS[method]
                 click(page, label_of("tiredness", tiredness))
                 click(page, label_of("ease", ease))
                 if position < len(order):
                     click(page, next_label(position + 1, len(order)))
-        done = lines.wait_for(r"^Session saved in ", timeout=60)
-        assert done, f"the session did not end:\n{lines.text()}"
-        process.wait(timeout=30)
+            done = lines.wait_for(r"^Session saved in ", timeout=60)
+            assert done, f"the session did not end:\n{lines.text()}"
+            # The page says the session is complete, and stays so once the command ends.
+            console_line(page, "title").filter(has_text=COMPLETE).wait_for()
+            click(page, "Close")
+            process.wait(timeout=30)
+            console_line(page, "notice").filter(has_text=COMPLETE).wait_for()
+            page.wait_for_timeout(2_500)  # Meshcat's page would have shown its banner by now
+            assert not banner_shown(page)
     assert seen == {m: {"Stop": 1, "Restart": 1, "Next scene": 1} for m in order}
-    assert json.loads((output / "questionnaire.json").read_text()) == {
+    assert json.loads((output / "questionnaire.json").read_text())["answers"] == {
         method: {"tiredness": t, "ease": e} for method, (t, e) in ANSWERS.items()}
     trials = {method: json.loads((output / "trials" / method / "seed_0.json").read_text())
               for method in order}

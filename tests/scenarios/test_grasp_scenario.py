@@ -134,7 +134,7 @@ def test_run_waits_for_a_browser_and_refuses_when_none_joins(repo, capsys, opera
                  "--wait-for-browser", "0", "--port", "0"]
     assert cli.main(arguments) == 2
     captured = capsys.readouterr()
-    assert "the task starts when it connects (waiting up to 0 s)" in captured.out
+    assert "(waiting up to 0 s); the task starts when Start is pressed" in captured.out
     assert controls in captured.out
     assert captured.err.startswith("pbp-drake: no browser opened http://")
     assert "nothing was run or recorded" in captured.err

@@ -1,17 +1,17 @@
 """Exclusive control of a Meshcat page: a person's operator reads its browser only while
 exactly that one browser is connected.
 
-Drake's Meshcat accepts a websocket from any origin, so any page open in the user's browser
-(or any local program) can connect and press the operator's buttons or send a gamepad.
-The guard cannot tell the person's page from another; what it can see is the number of
+Drake's Meshcat accepts a websocket from any origin. The command line puts its page front
+(`pbp_drake.console.front.PageFront`) before it, which lets in only a browser holding the
+run's secret URL; this guard is the second line, and the only one for a diagram on a bare
+Meshcat. It cannot tell the person's page from another; what it can see is the number of
 connections. With more than one, it pauses the simulation where it stands (inside the
 operator's sampling, so no simulated time passes and the robot does not move), says so in
 the terminal and in the page, and waits until one connection is left. The operator then
 drops every input that arrived meanwhile.
 
-What it cannot stop: a page that connects while no browser is (it is then "the" browser),
-and one that connects, presses and leaves between two control ticks. See the README's
-"Who can drive" for how to protect a session on a shared machine.
+What it cannot stop alone (the front does): a page that connects while no browser is (it is
+then "the" browser), and one that connects, presses and leaves between two control ticks.
 """
 
 import sys
@@ -47,8 +47,7 @@ class BrowserGuard:
         self.pauses += 1
         notice = PAUSED_NOTICE.format(count=count)
         self._announce(f"{notice}: the robot waits, and input sent meanwhile is dropped "
-                       f"(any page or program on this machine can open "
-                       f"{self._meshcat.web_url()}).")
+                       "(every page open on this run's URL counts).")
         self._meshcat.AddButton(notice)
         while self._meshcat.GetNumActiveConnections() > 1:
             time.sleep(self._poll_period)

@@ -1,0 +1,108 @@
+"""The console's Start gate and its panel, against a real Meshcat: a run whose task waits
+for Start has simulated nothing until the press (however long the person takes), Stop at
+the gate ends it at once, the lines go to a panel (the page front's) with the simulated
+time of the status, and the choice buttons can be swapped for the ones after a run."""
+
+import threading
+import time
+
+import msgpack
+import pytest
+from foreign_page import ForeignPage
+
+from pbp_drake.builder import build_diagram, simulate
+from pbp_drake.console import Console, LiveRun
+from pbp_drake.scenarios import load_scenario_file, resolve
+
+
+def click(meshcat, name):
+    meshcat._InjectWebsocketMessage(msgpack.packb({"type": "button", "name": name}))
+
+
+class Panel:
+    """What a page front keeps: the latest of each line."""
+
+    def __init__(self):
+        self.state = {}
+
+    def show(self, **lines):
+        self.state.update(lines)
+
+
+@pytest.fixture
+def scene(repo):
+    return resolve(load_scenario_file(repo / "diagrams" / "toy_alt_vs_cont.yaml").scenario)
+
+
+def press_later(port, origin, name, delay, stop):
+    """A page that presses `name` every 20 ms from `delay` seconds on, until `stop` is set
+    (the button only counts once the console has added it)."""
+    page = ForeignPage(port, origin=origin)
+    time.sleep(delay)
+    while not stop.is_set():
+        page.press(name)
+        time.sleep(0.02)
+    page.close()
+
+
+def test_the_clock_starts_at_the_start_press(scene, meshcat):
+    diagram = build_diagram(scene)
+    panel = Panel()
+    console = Console(meshcat, choices=("stop",), panel=panel)
+    live = LiveRun(diagram, scene.scenario.duration, console, start_label="Start")
+    stop = threading.Event()
+    presser = threading.Thread(target=press_later, daemon=True, args=(
+        meshcat.port(), meshcat.web_url(), "Start", 1.0, stop))
+    started = time.monotonic()
+    presser.start()
+    try:
+        trajectory = simulate(scene, realtime_rate=0.0, diagram=diagram, advance=live.advance)
+    finally:
+        stop.set()
+        presser.join(timeout=5)
+    waited = time.monotonic() - started
+    assert waited >= 1.0
+    # The whole scene ran after the press: nothing was simulated while the page waited.
+    assert live.choice is None
+    assert trajectory.times[-1] == pytest.approx(scene.scenario.duration, abs=0.05)
+    assert "Start" not in meshcat.GetButtonNames()  # gone once pressed
+    assert panel.state["status"] == "time left 0 s"
+    assert panel.state["time"] == pytest.approx(trajectory.times[-1], abs=0.05)
+
+
+def test_stop_at_the_start_gate_ends_the_run_at_once(scene, meshcat):
+    diagram = build_diagram(scene)
+    console = Console(meshcat, choices=("stop",), panel=Panel())
+    live = LiveRun(diagram, scene.scenario.duration, console, start_label="Start")
+    click(meshcat, "Stop")  # pressed while the page waits for Start
+    trajectory = simulate(scene, realtime_rate=0.0, diagram=diagram, advance=live.advance)
+    assert live.choice == "stop"
+    assert trajectory.times[-1] < 0.1  # one slice of 0.05 s, not the 3 s of the scene
+
+
+def test_the_lines_go_to_the_panel_not_to_buttons(meshcat):
+    panel = Panel()
+    console = Console(meshcat, panel=panel)
+    console.show_title("PBP-Alt, seed 0")
+    console.show_status("time left 41 s", time=19.0)
+    console.show_result("success in 14.2 s")
+    assert panel.state == {"title": "PBP-Alt, seed 0", "status": "time left 41 s",
+                           "time": 19.0, "result": "Result: success in 14.2 s"}
+    assert sorted(meshcat.GetButtonNames()) == ["Next scene", "Restart", "Stop"]
+    console.clear_result()
+    assert panel.state["result"] is None
+
+
+def test_the_choices_after_a_run_replace_the_run_s(meshcat):
+    console = Console(meshcat)
+    click(meshcat, "Restart")
+    console.set_choices(("restart", "next", "close"))
+    assert sorted(meshcat.GetButtonNames()) == ["Close", "Next scene", "Restart"]
+    assert console.choice() is None  # the click before does not count
+    click(meshcat, "Close")
+    assert console.wait_for_choice(poll_period=0.01) == "close"
+    # Bounded: a page that is closed (or a timeout) ends the wait with no choice.
+    assert console.wait_for_choice(poll_period=0.01, until=lambda: True) is None
+    started = time.monotonic()
+    assert console.wait_for_choice(poll_period=0.01, timeout=0.2) is None
+    assert 0.2 <= time.monotonic() - started < 2.0

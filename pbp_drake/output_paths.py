@@ -1,17 +1,48 @@
 """Checks of the command line's output paths, made before anything is built or simulated:
 `run --record FILE.html`, `run --log FILE.csv`, `run --output DIR` and `study --output DIR`. A path that cannot be
-written is a user error (a ScenarioError: `pbp-drake: ...`, exit 2), not a lost run."""
+written is a user error (a ScenarioError: `pbp-drake: ...`, exit 2), not a lost run. And the
+replay a `--record` writes (`mark_replay`): marked as ours, paused at its start, with a key."""
 
+import base64
+import html as html_text
 import os
 import pathlib
+import re
 
 from pbp_drake.builder.time_series import time_series_header
 from pbp_drake.scenarios import ScenarioError
+from pbp_drake.systems.visualizers.point_scene_visualizer import LEGEND as SCENE_2D_LEGEND
 
 # Written into every replay just after its doctype: an existing file that holds it is a
 # replay of a previous `pbp-drake run --record`, and may be overwritten without --force.
 REPLAY_MARKER = "<!-- pbp-drake replay (pbp-drake run --record) -->"
 _MARKER_WINDOW = 4096  # bytes read from the top of an existing file to find the marker
+
+# Meshcat's StaticHtml makes its viewer on this line, then decodes its commands, the
+# recording (`set_animation`) last, asynchronously; loading the recording plays it at once.
+_VIEWER_LINE = re.compile(r'^[ \t]*var viewer = new MeshCat\.Viewer\(.*\);[ \t]*$', re.M)
+# Put just after that line, before any command is decoded: the animator's `load` plays the
+# recording, which makes its tracks act on the scene (StaticHtml's scene is the run's last
+# state), then it is paused and shown at 0 s, so that the replay waits for its viewer.
+PAUSED_AT_START = """
+    // pbp-drake: the replay starts paused at 0 s (Meshcat would play it once loaded).
+    (function () {
+      const animator = viewer.animator;
+      const load = animator.load.bind(animator);
+      animator.load = function (animations, options) {
+        load(animations, options);
+        animator.pause();
+        animator.seek(0);
+      };
+    })();"""
+REPLAY_HINT_ID = "pbp-replay-hint"
+LEGEND_ID = "pbp-legend"
+_REPLAY_HINT = ("The replay starts paused: Open Controls, then Animations, default, play "
+                "(or drag its time).")
+# Meshcat's commands, each a base64 msgpack payload; a payload's paths are plain bytes in it.
+_PAYLOAD = re.compile(r'fetch\("data:application/octet-binary;base64,([^"]+)"\)')
+# A 2-D scene's robot (point_scene_visualizer): the replays that get SCENE_2D_LEGEND.
+_SCENE_2D_ROBOT = b"/pbp/robot"
 
 
 class OutputPathError(ScenarioError):
@@ -19,11 +50,54 @@ class OutputPathError(ScenarioError):
 
 
 def mark_replay(html):
-    """The replay `html` (Meshcat's StaticHtml) with REPLAY_MARKER after its doctype."""
+    """The replay `html` (Meshcat's StaticHtml) as `pbp-drake run --record` saves it: with
+    REPLAY_MARKER after its doctype, so that a later run may overwrite it; starting paused
+    at 0 s (PAUSED_AT_START), because Meshcat plays a recording as soon as it loads and a
+    page that loads slowly misses a short run; with a line saying how to play it; and, for
+    a 2-D scene, a key of its colours (SCENE_2D_LEGEND), which Meshcat cannot draw in the
+    scene, having no text. A page without Meshcat's viewer line keeps its playback (and
+    gets no hint)."""
+    viewer_line = _VIEWER_LINE.search(html)
+    if viewer_line:
+        html = html[:viewer_line.end()] + PAUSED_AT_START + html[viewer_line.end():]
+    notes = []
+    if _draws(html, _SCENE_2D_ROBOT):
+        notes.append(legend_html(SCENE_2D_LEGEND))
+    if viewer_line:
+        notes.append(f'<div id="{REPLAY_HINT_ID}" style="position: fixed; right: 8px; '
+                     'bottom: 8px; padding: 2px 6px; font: 12px sans-serif; '
+                     f'background: rgba(255, 255, 255, 0.8);">{_REPLAY_HINT}</div>')
+    if notes:
+        body_end = html.rfind("</body>")
+        if body_end < 0:
+            body_end = len(html)
+        html = html[:body_end] + "\n".join(notes) + "\n" + html[body_end:]
     head, newline, rest = html.partition("\n")
     if head.lower().startswith("<!doctype") and newline:
         return f"{head}\n{REPLAY_MARKER}\n{rest}"
     return f"{REPLAY_MARKER}\n{html}"
+
+
+def legend_html(entries):
+    """A key in the page's bottom-left corner: one coloured swatch and its name for each
+    `(name, Rgba)` of `entries`."""
+    rows = "".join(
+        f'<div><span style="display: inline-block; width: 12px; height: 12px; '
+        f'margin-right: 6px; vertical-align: middle; background: {_css_colour(colour)};">'
+        f'</span>{html_text.escape(name)}</div>' for name, colour in entries)
+    return (f'<div id="{LEGEND_ID}" style="position: fixed; left: 8px; bottom: 8px; '
+            'padding: 4px 8px; font: 12px/18px sans-serif; '
+            f'background: rgba(255, 255, 255, 0.8);">{rows}</div>')
+
+
+def _css_colour(colour):
+    red, green, blue = (round(255 * value) for value in (colour.r(), colour.g(), colour.b()))
+    return f"rgba({red}, {green}, {blue}, {colour.a():g})"
+
+
+def _draws(html, path):
+    """Whether a command of the page names the Meshcat `path` (bytes)."""
+    return any(path in base64.b64decode(payload) for payload in _PAYLOAD.findall(html))
 
 
 def is_replay(path):

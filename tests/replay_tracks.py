@@ -44,6 +44,13 @@ def value_at(tracks, path, track, time):
     return values[int(np.argmin(np.abs(times - time)))]
 
 
+def held_at(tracks, path, track, time):
+    """The value of `track` of `path` at `time` as a replay shows a discrete track (e.g.
+    `.visible`): its last key at or before `time` (its first before that)."""
+    times, values = tracks[path, track]
+    return values[max(0, int(np.searchsorted(times, time + 1e-9, side="right")) - 1)]
+
+
 def recorded(meshcat, diagram, duration):
     """The animation tracks of a recording of `duration` seconds of `diagram` in `meshcat`."""
     meshcat.StartRecording(frames_per_second=30.0)

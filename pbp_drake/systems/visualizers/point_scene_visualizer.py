@@ -1,4 +1,5 @@
-"""Draws a point-robot scene in Meshcat: obstacles, goals, demonstration, robot, DMP paths."""
+"""Draws a point-robot scene in Meshcat: obstacles, goals, demonstration, robot, the path it
+has travelled, DMP paths; and `LEGEND`, what each colour means, for a replay's key."""
 
 import numpy as np
 from pydrake.geometry import Cylinder, Rgba, Sphere
@@ -6,7 +7,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.scene_framing import page_view, scene_bounds
-from pbp_drake.systems.visualizers.scene_drawing import PathDots, frame_top_down
+from pbp_drake.systems.visualizers.scene_drawing import PathDots, PathTrail, frame_top_down
 
 # Saturated colours of distinct hues, so that a screenshot tells the markers apart.
 ROBOT_COLOUR = Rgba(0.1, 0.3, 0.9, 1.0)
@@ -15,6 +16,15 @@ GOAL_COLOUR = Rgba(0.1, 0.7, 0.2, 1.0)
 START_COLOUR = Rgba(0.85, 0.1, 0.85, 1.0)
 OBSTACLE_COLOUR = Rgba(0.85, 0.15, 0.15, 0.8)
 PATH_COLOUR = Rgba(0.0, 0.65, 0.65, 1.0)
+DEMONSTRATION_COLOUR = Rgba(0.3, 0.3, 0.3, 1.0)
+# The executed path is the robot's trail, in its blue.
+EXECUTED_COLOUR = ROBOT_COLOUR
+
+# What each colour of the scene is, in the order a key lists them (`mark_replay` writes it
+# into a 2-D replay: Meshcat has no text to draw one in the scene).
+LEGEND = (("start", START_COLOUR), ("goal", GOAL_COLOUR), ("obstacle", OBSTACLE_COLOUR),
+          ("demonstration", DEMONSTRATION_COLOUR), ("robot and its executed path", ROBOT_COLOUR),
+          ("operator acting", OPERATOR_HALO), ("DMP predicted paths", PATH_COLOUR))
 
 ROBOT_RADIUS = 0.03
 GOAL_RADIUS = 0.025
@@ -22,9 +32,16 @@ GOAL_RADIUS = 0.025
 START_RADIUS = 0.05
 PATH_DOTS = 40
 PATH_DOT_RADIUS = 0.006
+# The executed path: dots closer than their diameter read as a line, thinner than the DMPs'
+# dots; 400 of them hold 1.6 m of path (a toy run's is about 1.3 m) before the trail thins
+# to every other dot.
+EXECUTED_DOTS = 400
+EXECUTED_DOT_RADIUS = 0.003
+EXECUTED_SPACING = 0.004
 # Heights (2-D scenes seen from above): the start under the obstacles, the paths over them,
-# the robot and the goals over the paths.
-START_Z, PATH_Z = -0.01, 0.008
+# the robot and the goals over the paths; the executed path over the obstacles (their top
+# at 0.005), under the predicted paths.
+START_Z, EXECUTED_Z, PATH_Z = -0.01, 0.006, 0.008
 
 
 class PointSceneVisualizer(LeafSystem):
@@ -46,11 +63,13 @@ class PointSceneVisualizer(LeafSystem):
     obstacles, the demonstration and the predicted paths of that moment, with a margin
     (`core.scene_framing`).
 
-    Each publish moves the robot and shows an orange halo while the operator acts; each
-    `path_period` (default: the publish period) spreads the dots of every DMP's predicted
-    path along it (`PathDots`). All with `time_in_recording`, so that a recording
-    (`Meshcat.StartRecording`) replays the robot and the paths together. Call from the thread
-    that made `meshcat`.
+    Each publish moves the robot, shows an orange halo while the operator acts and extends
+    the executed path, the robot's trail of blue dots under `/pbp/executed` (`PathTrail`);
+    each `path_period` (default: the publish period) spreads the dots of every DMP's
+    predicted path along it (`PathDots`). All with `time_in_recording`, so that a recording
+    (`Meshcat.StartRecording`, started before the simulator initialises) replays the robot
+    and the paths together, the executed path drawn only up to the replay's time. Call from
+    the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, start, goals, obstacles, demonstration=None,
@@ -71,6 +90,8 @@ class PointSceneVisualizer(LeafSystem):
         self._demonstration = demonstration
         self._path_dots = [PathDots(f"/pbp/predictions/{index}", PATH_DOTS, PATH_DOT_RADIUS,
                                     PATH_COLOUR) for index in range(k)]
+        self._executed = PathTrail("/pbp/executed", EXECUTED_DOTS, EXECUTED_DOT_RADIUS,
+                                   EXECUTED_COLOUR, EXECUTED_SPACING)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period or publish_period, 0.0,
@@ -119,7 +140,8 @@ class PointSceneVisualizer(LeafSystem):
             meshcat.SetTransform(f"/pbp/goals/{index}", RigidTransform(self._to_3d(goal)[0]))
         if demonstration is not None:
             meshcat.SetLine("/pbp/demonstration", self._to_3d(demonstration).T, 2.0,
-                            Rgba(0.3, 0.3, 0.3, 1.0))
+                            DEMONSTRATION_COLOUR)
+        self._executed.draw(meshcat, context.get_time())
         for dots in self._path_dots if self._prediction_steps else []:
             dots.draw(meshcat)
         meshcat.SetObject("/pbp/robot", Sphere(ROBOT_RADIUS), ROBOT_COLOUR)
@@ -145,6 +167,7 @@ class PointSceneVisualizer(LeafSystem):
         position = self._robot_state_port.Eval(context)[:d]
         self._meshcat.SetTransform(
             "/pbp/robot", RigidTransform(self._to_3d(position)[0]), time)
+        self._executed.extend(self._meshcat, self._to_3d(position, EXECUTED_Z)[0], time)
         if self._operator_active_port.HasValue(context):
             active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
             self._meshcat.SetProperty("/pbp/robot/operator", "visible", active, time)

@@ -5,7 +5,8 @@ Meshcat's recordings (`StartRecording`) keep only `SetTransform` and `SetPropert
 animation tracks of transforms, positions and visibility; `SetLine` and `SetObject` change the
 page at once and a replay shows their last geometry all along. So a path that changes over
 time is a fixed pool of small spheres (`PathDots`) whose positions are set at each publish,
-and a path of poses a pool of triads (`PathTriads`) whose transforms are.
+a path of poses a pool of triads (`PathTriads`) whose transforms are, and the path travelled
+so far a pool of dots shown one by one as it grows (`PathTrail`).
 """
 
 import numpy as np
@@ -71,6 +72,85 @@ class PathDots:
         points[:, 2] += lift
         for index, point in enumerate(points):
             meshcat.SetProperty(f"{self.root}/{index}", "position", point.tolist(), time)
+
+
+class PathTrail:
+    """The path travelled so far, drawn as it grows: up to `count` dots of `radius` under the
+    Meshcat path `root`, `spacing` apart along it, each shown once the path reaches it.
+    With `time` (`time_in_recording`), a replay at time t shows the trail up to t only:
+    every dot is hidden at the recording's start and shown when placed. (`SetLine` would
+    draw the whole path from the replay's start: a recording does not keep it.)
+
+    When every dot is placed, the trail keeps every other dot (moved down the pool, at that
+    time) and doubles its spacing, so that it still runs from the start, however long the
+    path. A replay interpolates positions between keys: before a dot moves, its old position
+    is kept again at the previous `extend`'s time, so that it jumps rather than slides.
+
+    What is drawn is kept here, not in a Drake context (as Drake's own MeshcatVisualizer
+    keeps what it has sent): `draw` starts the trail again, and one simulation at a time
+    may use it."""
+
+    def __init__(self, root, count, radius, colour, spacing):
+        self.root = root
+        self._count = max(2, int(count))
+        self._radius = float(radius)
+        self._colour = colour
+        self._first_spacing = float(spacing)
+        self._positions = [None] * self._count  # where each dot was last put
+        self._restart(None)
+
+    def _restart(self, time):
+        self._points = []  # the placed dots' positions, in order along the path
+        self._spacing = self._first_spacing
+        self._last_time = time
+
+    def draw(self, meshcat, time=None):
+        """Adds the dots, hidden, and starts the trail again. Call at the start of a
+        recording with its `time`, so that a replay hides each dot until it is placed."""
+        self._restart(time)
+        for index in range(self._count):
+            path = f"{self.root}/{index}"
+            meshcat.SetObject(path, Sphere(self._radius), self._colour)
+            meshcat.SetProperty(path, "visible", False, time)
+
+    def extend(self, meshcat, point, time=None):
+        """Extends the trail to `point` (3): dots `spacing` apart on the straight line from
+        the last dot to it (a robot goes several spacings between two publishes), all
+        shown at `time`; the first call places the first dot at `point` itself."""
+        point = np.asarray(point, dtype=float)
+        if not self._points:
+            self._place(meshcat, point, time)
+        while (gap := np.linalg.norm(point - self._points[-1])) >= self._spacing:
+            if len(self._points) == self._count:
+                self._thin(meshcat, time)
+                continue  # the spacing has doubled: measure the gap again
+            last = self._points[-1]
+            self._place(meshcat, last + (point - last) * (self._spacing / gap), time)
+        self._last_time = time
+
+    def _place(self, meshcat, point, time):
+        index = len(self._points)
+        self._points.append(point)
+        self._move(meshcat, index, point, time)
+        meshcat.SetProperty(f"{self.root}/{index}", "visible", True, time)
+
+    def _move(self, meshcat, index, point, time):
+        path = f"{self.root}/{index}"
+        previous = self._positions[index]
+        if previous is not None and time is not None and self._last_time is not None:
+            meshcat.SetProperty(path, "position", previous.tolist(), self._last_time)
+        meshcat.SetProperty(path, "position", point.tolist(), time)
+        self._positions[index] = point
+
+    def _thin(self, meshcat, time):
+        """Keeps every other dot, moved down the pool, and hides the others."""
+        kept = self._points[::2]
+        for index in range(1, len(kept)):  # the first dot stays on the start
+            self._move(meshcat, index, kept[index], time)
+        for index in range(len(kept), self._count):
+            meshcat.SetProperty(f"{self.root}/{index}", "visible", False, time)
+        self._points = kept
+        self._spacing *= 2.0
 
 
 def pose_transform(pose):

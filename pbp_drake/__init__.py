@@ -96,6 +96,7 @@ API_GROUPS = {
         "load_task_result": "pbp_drake.studies.trial_files",
         "Console": "pbp_drake.console",
         "LiveRun": "pbp_drake.console",
+        "PageFront": "pbp_drake.console",
     },
 }
 _PUBLIC = {name: module for group in API_GROUPS.values() for name, module in group.items()}

@@ -14,8 +14,12 @@ Three layers, each usable alone, and a session's pages:
   `pbp_drake.builder.run_task` (and `run_task_streamed`, `simulate`).
 - `pbp_drake.console.questionnaire`: a user-study session's pages (Start, the two
   questions, Next) and `FixedAnswers` for unattended sessions.
+- `PageFront` (`pbp_drake.console.front`): the page behind a front of our own, which lets
+  in only the holder of the run's secret URL, relays Meshcat to a slow page at the rate it
+  draws, and shows the console's lines in a panel of its own (`Console(..., panel=front)`).
 
-A minimal loop (the thread that made `meshcat`)::
+A minimal loop (the thread that made `meshcat`; with `front = PageFront(meshcat.port())`,
+open `front.url` and pass `panel=front` to the Console)::
 
     console = Console(meshcat, choices=("stop", "next"))
     console.show_title(method_name(scenario.method))
@@ -27,11 +31,12 @@ A minimal loop (the thread that made `meshcat`)::
 """
 
 from pbp_drake.console.camera import CAMERAS, RobotCamera, behind_head_view
+from pbp_drake.console.front import PageFront
 from pbp_drake.console.live import LiveRun, Progress
 from pbp_drake.console.page import ALPHA_SLIDER, CHOICE_BUTTONS, RATE_SLIDER, Console
 from pbp_drake.console.text import (
     method_name, progress_text, result_text, status_text, time_left)
 
 __all__ = ["ALPHA_SLIDER", "CAMERAS", "CHOICE_BUTTONS", "RATE_SLIDER", "Console", "LiveRun",
-           "Progress", "RobotCamera", "behind_head_view", "method_name", "progress_text",
-           "result_text", "status_text", "time_left"]
+           "PageFront", "Progress", "RobotCamera", "behind_head_view", "method_name",
+           "progress_text", "result_text", "status_text", "time_left"]

@@ -23,7 +23,7 @@ from pydrake.geometry import Meshcat, MeshcatParams
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.builder.streamed_run import run_task_streamed
-from pbp_drake.scenarios import load_scenario_file, resolve
+from pbp_drake.scenarios import counted, load_scenario_file, resolve
 
 # The repository's diagrams/ folder (this file is pbp_drake/soak.py).
 SCENARIO_FILE = pathlib.Path(__file__).resolve().parents[1] / "diagrams" / "hsr_reach.yaml"
@@ -132,7 +132,8 @@ def main(argv=None):
     peak = max(rss for _, _, rss in soak.samples)
     rows = sum(sum(1 for _ in open(path)) - 1 for path in soak.log_paths)
     failed = sum(not result.success for result in soak.results[:-1])
-    print(f"{len(soak.results)} runs ({failed} failed before the last), {rows} rows (one per "
+    print(f"{counted(len(soak.results), 'run')} ({failed} failed before the last), "
+          f"{counted(rows, 'row')} (one per "
           f"tick), {simulated:.0f} s simulated in {wall:.0f} s wall", flush=True)
     print(f"RSS at 1 min {_megabytes(first)}, at the end {_megabytes(last)}, peak "
           f"{_megabytes(peak)}: growth {soak.growth_percent:.2f} % (limit "

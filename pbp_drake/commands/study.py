@@ -11,7 +11,7 @@ from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import method_list
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
-    Hsr, MethodComparison, ScenarioError, check_method_comparison, load_scenario_file)
+    Hsr, MethodComparison, ScenarioError, check_method_comparison, counted, load_scenario_file)
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.paired import paired_comparison, paired_table
 from pbp_drake.studies.participant_report import is_participant_collection, participant_report
@@ -129,7 +129,7 @@ def _method_study(args, scenario_file):
     output = pathlib.Path(args.output)
     total = len(study.methods) * study.trials
     print(f"Study {scenario_file.scenario.name}: {', '.join(study.methods)}, "
-          f"{study.trials} trials each ({split} seeds {seed} to {seed + study.trials - 1}),"
+          f"{counted(study.trials, 'trial')} each ({split} seeds {seed} to {seed + study.trials - 1}),"
           f" {args.jobs} job{'s' if args.jobs > 1 else ''}"
           + ("" if args.backend == "local" else
              f" on Ray ({args.ray_address or 'local'})") + f", into {output}", flush=True)
@@ -154,7 +154,7 @@ def _method_study(args, scenario_file):
               "command resumes the study.", file=sys.stderr)
         return 130
     reused = total - len(runs)
-    print(f"Ran {len(runs)} trials in {time.monotonic() - started:.1f} s"
+    print(f"Ran {counted(len(runs), 'trial')} in {time.monotonic() - started:.1f} s"
           + (f"; {reused} were already on disk." if reused else "."), flush=True)
     _print_report(summary, output)
     return _failed_trials(summary, output)
@@ -177,7 +177,7 @@ def _print_report(summary, output):
     print(results_table(summary), end="")
     for method, entry in summary["methods"].items():
         if entry["errors"]:
-            print(f"  {method}: {entry['errors']} trials failed with an error (seeds "
+            print(f"  {method}: {counted(entry['errors'], 'trial')} failed with an error (seeds "
                   f"{entry['error_seeds']}); see {output / 'trials' / method}")
     for name in ("summary.json", "results.md", "trials.json", *figure_names(summary)):
         print(f"  wrote {output / name}")

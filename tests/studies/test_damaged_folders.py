@@ -100,7 +100,7 @@ def test_a_folder_with_errored_trials_reports_them_and_exits_1(tmp_path, capsys)
     assert main(["report", str(folder)]) == 1
     out, err = capsys.readouterr()
     assert "1 of 6 trials failed with an error" in err
-    assert "teleop: 1 trials failed with an error (seeds [1])" in out
+    assert "teleop: 1 trial failed with an error (seeds [1])" in out
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["methods"]["teleop"]["errors"] == 1
 

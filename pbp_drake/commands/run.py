@@ -7,7 +7,7 @@ import sys
 import time
 
 import numpy as np
-from pydrake.geometry import Meshcat, MeshcatParams, Rgba
+from pydrake.geometry import Meshcat, MeshcatParams
 
 from pbp_drake.builder import (
     build_diagram, check_buildable, find_system, run_task, run_task_streamed, simulate)
@@ -68,7 +68,8 @@ def add_run_command(commands):
                      help="no Meshcat server and no page at all (implies --headless)")
     run.add_argument("--camera", choices=CAMERAS, default="overview",
                      help="HSR tasks: the page's camera; overview (default, free to orbit) "
-                     "or robot (follows the robot from behind its head)")
+                     "or robot (follows the robot from above and behind its head, looking down past "
+                     "the hand to the targets)")
     run.add_argument("--record", metavar="FILE.html",
                      help="save a self-contained replay of the run")
     run.add_argument("--log", metavar="FILE.csv", help="HSR tasks: write the per-tick rows to "
@@ -222,10 +223,6 @@ def _run_scene(args, resolved, meshcat, page):
                           diagram=diagram, advance=live.advance)
     ratio = collision_ratio(trajectory.positions, [o.center for o in scenario.obstacles],
                             [o.radius for o in scenario.obstacles])
-    if meshcat is not None:
-        positions = np.zeros((len(trajectory.positions), 3))
-        positions[:, :trajectory.positions.shape[1]] = trajectory.positions[:, :3]
-        meshcat.SetLine("/pbp/executed", positions.T, 2.0, Rgba(0.1, 0.3, 0.9, 1.0))
     outcome = (f"stopped at {trajectory.times[-1]:.1f} s" if live.choice == "stop"
                else f"done, collision ratio {ratio:.3f}")
     if args.record:

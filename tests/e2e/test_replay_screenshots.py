@@ -218,9 +218,10 @@ def test_a_2d_replay_opens_paused_with_its_key_and_draws_the_executed_path_as_it
     replay = tmp_path / "toy_scene_1.html"
     html = record(repo, "diagrams/toy_alpha_study.yaml", replay, 2.0, "--scene", "scene_1",
                   "--method", "pbp_alternated")
-    # A line at /pbp/executed itself (the trail's dots are under it) shows whole from 0 s.
-    whole_line = any(command["type"] == "set_object" and command["path"] == "/pbp/executed"
-                     for command in commands(html))
+    # No line at /pbp/executed itself (the trail's dots are under it): one would show whole
+    # from 0 s.
+    assert not any(command["type"] == "set_object" and command["path"] == "/pbp/executed"
+                   for command in commands(html))
     with replay_page(replay) as page:
         opened = opening(page)
         # As it opened, without a seek: the robot on the start, no executed path yet.
@@ -248,9 +249,6 @@ def test_a_2d_replay_opens_paused_with_its_key_and_draws_the_executed_path_as_it
     assert columns.min() < start[0] + 40 and columns.max() > goal[0] - 40, (
         f"the executed path spans columns {columns.min()} to {columns.max()}, not the "
         f"start's {start[0]:.0f} to the goal's {goal[0]:.0f}")
-    if whole_line:
-        pytest.xfail("commands/run.py still draws the whole executed path as one line "
-                     "(SetLine('/pbp/executed') after the run), shown from 0 s: to delete")
     trail = np.count_nonzero(trail_pixels(at_start))
     assert trail < 20, f"{trail} pixels of executed path before the robot has moved"
     # Half way: drawn behind the robot only, not yet where it goes next.

@@ -68,8 +68,8 @@ def add_run_command(commands):
                      help="no Meshcat server and no page at all (implies --headless)")
     run.add_argument("--camera", choices=CAMERAS, default="overview",
                      help="HSR tasks: the page's camera; overview (default, free to orbit) "
-                     "or robot (follows the robot from above and behind its head, looking down past "
-                     "the hand to the targets)")
+                     "or robot (follows the robot from above and behind its head, looking "
+                     "down past the hand to the targets)")
     run.add_argument("--record", metavar="FILE.html",
                      help="save a self-contained replay of the run")
     run.add_argument("--log", metavar="FILE.csv", help="HSR tasks: write the per-tick rows to "

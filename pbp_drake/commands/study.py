@@ -129,7 +129,8 @@ def _method_study(args, scenario_file):
     output = pathlib.Path(args.output)
     total = len(study.methods) * study.trials
     print(f"Study {scenario_file.scenario.name}: {', '.join(study.methods)}, "
-          f"{counted(study.trials, 'trial')} each ({split} seeds {seed} to {seed + study.trials - 1}),"
+          f"{counted(study.trials, 'trial')} each ({split} seeds {seed} to "
+          f"{seed + study.trials - 1}),"
           f" {args.jobs} job{'s' if args.jobs > 1 else ''}"
           + ("" if args.backend == "local" else
              f" on Ray ({args.ray_address or 'local'})") + f", into {output}", flush=True)

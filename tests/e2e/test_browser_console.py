@@ -19,6 +19,16 @@ from pbp_drake.cli_types import EXIT_STOPPED
 pytestmark = NEEDS_BROWSER
 
 DURATION = 30.0  # the time limit: long enough that Stop, not the limit, ends seed 1
+KEYS_AND_CHOICES = {"Back (↓)", "Left (←)", "Right (→)", "Turn left (Q)", "Turn right (E)",
+                    "Real-time rate", "Stop", "Restart", "Next scene", "Start"}
+
+
+def controls_in_order(page):
+    """The labels of the run's controls (the keys, the slider, the choices) as the page
+    lists them, top to bottom."""
+    names = page.evaluate("() => Array.from(document.querySelectorAll("
+                          "'.dg li.cr .property-name')).map(e => e.textContent)")
+    return [name for name in names if name in KEYS_AND_CHOICES]
 
 
 @pytest.mark.timeout(180)
@@ -39,10 +49,19 @@ def test_stop_ends_the_run_honestly_and_the_page_keeps_the_result(repo, tmp_path
                 r"^time left \d+ s · 0 target switches · intervention 0 %$")).wait_for()
             assert all(control(page, name).count() == 1
                        for name in ("Stop", "Restart", "Next scene"))
+            # Readable at 1024 x 640: the console's lines and its buttons on screen (the
+            # scene tree folded), not below Meshcat's whole tree.
+            for element in (status, control(page, "Stop"), control(page, "Next scene")):
+                box = element.bounding_box()
+                assert box and box["y"] + box["height"] <= 640 and box["x"] >= 0, box
+            order = controls_in_order(page)
             # Next scene runs seed 1, which waits for its Start again; Stop then ends it,
             # and the command, mid-run.
             click(page, "Next scene")
             title.filter(has_text="PBP-Alt, seed 1").wait_for()
+            control(page, "Start").wait_for(state="attached")
+            # The keys come back, and everything keeps its place.
+            assert controls_in_order(page) == order + ["Start"], controls_in_order(page)
             click(page, "Start")
             status.filter(has_text=re.compile(r"^time left \d+ s")).wait_for()
             click(page, "Stop")

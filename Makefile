@@ -5,7 +5,7 @@ PYTHON := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 DEMO_DIR := outputs/demo
 
-.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench soak results clean
+.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench soak results docs clean
 
 $(STAMP): pyproject.toml
 	test -x $(PYTHON) || python3 -m venv $(VENV)

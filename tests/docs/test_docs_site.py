@@ -11,6 +11,7 @@ import sys
 import pytest
 
 import pbp_drake
+from pbp_drake.cli_types import EXIT_CODES
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "docs" / "_ext"))
@@ -57,6 +58,10 @@ def test_the_reference_pages_hold_what_a_reader_looks_for(site):
     for command in ["run", "study", "report", "compare", "bench", "draw"]:
         assert f"pbp-drake {command}" in cli
     assert "--wait-for-browser" in cli and "--depth" in cli and "--quick" in cli
+    # The exit codes, each with its meaning (a script reads them).
+    assert "Exit codes" in cli
+    for code, meaning in EXIT_CODES.items():
+        assert f"{code}{meaning.replace('`', '')[:20]}" in cli, code
     scenario = _page(out, "scenario-files")
     assert "reaction_delay" in scenario and "default 0.5" in scenario
     assert "!Hsr" in scenario

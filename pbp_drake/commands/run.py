@@ -195,13 +195,14 @@ def _run(args):
 
 
 def _private_meshcat():
-    """Meshcat on a free localhost port that nobody is told of (the page front relays to
-    it), without Drake's line announcing its URL."""
+    """Meshcat on a random free localhost port that nobody is told of (the page front
+    relays to it; Drake's `port=None` would take the first free one from 7000, easy to
+    guess), without Drake's line announcing its URL."""
     drake_log = logging.getLogger("drake")
     level = drake_log.level
     drake_log.setLevel(logging.WARNING)
     try:
-        return Meshcat(MeshcatParams(host="localhost", port=None))
+        return Meshcat(MeshcatParams(host="localhost", port=0))
     finally:
         drake_log.setLevel(level)
 
@@ -237,7 +238,7 @@ def _run_scene(args, resolved, meshcat, page):
         console.show_result(outcome)
         if live.choice is None:
             _keep_page(args, page, console, ("close",))
-        page.end(f"Result: {outcome}. {PAGE_ENDED}")
+        page.end(PAGE_ENDED)
     return code
 
 
@@ -275,7 +276,7 @@ def _run_task(args, resolved, meshcat, page):
         if choice is None:
             choice = _keep_page(args, page, console, AFTER_RUN_CHOICES)
         if choice in (None, "stop", "close"):
-            page.end(f"Result: {_outcome(result, live)}. {PAGE_ENDED}")
+            page.end(PAGE_ENDED)
             return code
         operator = diagram.GetSubsystemByName("operator")
         if hasattr(operator, "Delete"):
@@ -484,11 +485,12 @@ def _keep_page(args, page, console, choices):
     if page.pages() == 0:
         return None
     console.set_choices(choices)
-    words = {"close": "Close", "restart": "Restart runs the scene again",
-             "next": "Next scene the next seed"}
-    print("The page shows the result: " + ", ".join(words[c] for c in choices)
-          + f"; closing the page (or Enter) ends the command, as {args.keep_page:g} s do.",
-          flush=True)
+    words = {"restart": "Restart runs the scene again", "next": "Next scene the next seed"}
+    others = [words[choice] for choice in choices if choice in words]
+    print("The page keeps the result until it is closed" + (": " + ", ".join(others)
+                                                           if others else "")
+          + f"; Close, Enter or closing the page ends the command (at the latest in "
+          f"{args.keep_page:g} s).", flush=True)
     return console.wait_for_choice(stdin=_terminal(), timeout=args.keep_page,
                                    until=lambda: page.pages() == 0)
 

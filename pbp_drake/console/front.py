@@ -17,12 +17,14 @@ another thread, and a Meshcat left in a reference cycle dies in whichever thread
 - `bind_page_port(port, host)`: the public port bound before anything is built (PortError).
 - `PageFront(meshcat_port, listen_socket=None, token=None, host="localhost")`: serving once
   made; `url`, `port`, `token`; `pages()`, `show(**lines)`, `state()`, `end(text)`, `close()`.
-- `PendingMessages`, `message_key`: the relay's bounded queue toward a slow page.
+- `PendingMessages`, `message_key`: the relay's bounded queue toward a slow page, which
+  gets a batch of the latest poses and properties, ended by the text frame `FRAME`, and
+  the next batch once it has answered `ACK` at its next animation frame.
 
 An example (the thread that made `meshcat`)::
 
     listener = bind_page_port(args.port)            # PortError before anything is built
-    meshcat = Meshcat(MeshcatParams(host="localhost", port=None))
+    meshcat = Meshcat(MeshcatParams(host="localhost", port=0))
     with PageFront(meshcat.port(), listener) as front:
         print(f"Open {front.url}")
         front.show(title="PBP-Alt", status="time left 41 s", time=0.0)
@@ -279,8 +281,9 @@ class PageFront:
         token: the run's token (checked by `check_token`); None draws `new_token()`.
         host: where to bind when `listen_socket` is None, and the host of `url`.
 
-    Serving once made. The page polls `show`'s lines from `/pbp/state` (it shows them in a
-    panel at the top left), so the thread that drives the run needs no event loop.
+    Serving once made. `show`'s lines reach each page as a text frame whenever they change
+    (and by a poll of `/pbp/state` each second); the page shows the newest in a panel at the
+    top left. So the thread that drives the run needs no event loop.
     """
 
     def __init__(self, meshcat_port, listen_socket=None, token=None, host="localhost"):

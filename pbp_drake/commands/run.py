@@ -377,6 +377,9 @@ def _run_session(args, resolved, meshcat, page, person):
     console = None if page is None else _console(meshcat, page, args, scenario)
 
     def run_one(trial):
+        # Shown again after a Restart: each run of the method starts at its Start.
+        start_button = (questions.take_start_label()
+                        if isinstance(questions, _StartInTheRun) else None)
         while True:
             diagram = build_diagram(trial, meshcat)
             if console is not None:
@@ -384,8 +387,7 @@ def _run_session(args, resolved, meshcat, page, person):
                 # questions) do not count.
                 console.set_choices(RUN_CHOICES)
             result, live = _run_task_once(args, trial, diagram, meshcat, console,
-                                          start_button=questions.take_start_label()
-                                          if isinstance(questions, _StartInTheRun) else None)
+                                          start_button=start_button)
             operator = diagram.GetSubsystemByName("operator")
             if hasattr(operator, "Delete"):
                 operator.Delete()  # the next method may want other keys

@@ -20,7 +20,7 @@ pytestmark = NEEDS_BROWSER
 
 DURATION = 40.0
 TOKEN = "slow-page-test-token-0123456789"
-CPU_SLOWDOWN = 8  # with 12, Meshcat's page alone fell ~30 s behind in a 40 s run
+CPU_SLOWDOWN = 8  # at 20, Meshcat's own page fell 30 s behind in the first 40 s of a run
 MAX_LAG = 1.0  # s
 
 

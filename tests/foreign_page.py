@@ -17,13 +17,14 @@ _BINARY_FRAME, _CLOSE_FRAME = 0x82, 0x88  # FIN set
 
 
 class ForeignPage:
-    """One websocket connection to `localhost:port`, opened with `origin`."""
+    """One websocket connection to `localhost:port`, opened with `origin` at `path` (which
+    may hold a `?token=`); ConnectionError, with the status line, when it is refused."""
 
-    def __init__(self, port, origin="http://evil.example"):
+    def __init__(self, port, origin="http://evil.example", path="/"):
         self._socket = socket.create_connection(("localhost", port), timeout=5.0)
         key = base64.b64encode(os.urandom(16)).decode()
         self._socket.sendall((
-            f"GET / HTTP/1.1\r\nHost: localhost:{port}\r\nUpgrade: websocket\r\n"
+            f"GET {path} HTTP/1.1\r\nHost: localhost:{port}\r\nUpgrade: websocket\r\n"
             f"Connection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n"
             f"Sec-WebSocket-Version: 13\r\nOrigin: {origin}\r\n\r\n").encode())
         response = b""

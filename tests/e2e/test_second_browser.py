@@ -1,7 +1,8 @@
 """A whole HSR run at real time with a person at the keyboard: a page with a foreign origin
 connects mid-run and presses ← for a second. The robot does not move, the run says why, and
-it takes the pause in its stride (no rush to catch up afterwards). The
-acceptance test of exclusive control."""
+it takes the pause in its stride (no rush to catch up afterwards). And behind the page
+front, pages without the run's token or from another origin are refused (HTTP 403) and never
+reach Meshcat. The acceptance tests of exclusive control."""
 
 import dataclasses
 import threading
@@ -12,6 +13,7 @@ import pytest
 from foreign_page import ForeignPage
 
 from pbp_drake.builder import build_diagram, run_task
+from pbp_drake.console import PageFront
 from pbp_drake.scenarios import Keyboard, load_scenario_file
 from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON
 
@@ -59,3 +61,46 @@ def test_a_foreign_page_cannot_move_the_robot(repo, meshcat, capsys):
     # after it: the run lasted its duration plus the pause, rather than catching up.
     pause = attack_times[1] - attack_times[0]
     assert wall > DURATION + pause - 0.3, (wall, pause)
+
+
+def test_behind_the_front_no_page_without_the_token_and_origin_reaches_the_robot(repo,
+                                                                                  meshcat):
+    scenario = dataclasses.replace(
+        load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario,
+        method="teleop", operator=Keyboard(), duration=DURATION)
+    diagram = build_diagram(scenario, meshcat)
+    front = PageFront(meshcat.port())
+    port, own = front.port, f"http://localhost:{front.port}"
+    attempts = {"a foreign origin": (f"/?token={front.token}", "http://evil.example"),
+                "no token": ("/", own), "a wrong token": ("/?token=" + "x" * 32, own)}
+    refusals = {}
+
+    def attack():
+        # Each tries, over and over while the run goes, to connect and press the left key.
+        deadline = time.monotonic() + DURATION - 0.5
+        while time.monotonic() < deadline:
+            for name, (path, origin) in attempts.items():
+                try:
+                    page = ForeignPage(port, origin=origin, path=path)
+                except ConnectionError as error:
+                    refusals[name] = str(error)
+                    continue
+                page.press(LEFT_BUTTON)
+                page.close()
+                refusals[name] = "let in"
+            time.sleep(0.05)
+
+    attacker = threading.Thread(target=attack, daemon=True)
+    attacker.start()
+    try:
+        result = run_task(scenario, realtime_rate=1.0, diagram=diagram)
+    finally:
+        attacker.join(timeout=10.0)
+        front.close()
+    assert set(refusals) == set(attempts)
+    assert all(" 403 " in refusal for refusal in refusals.values()), refusals
+    # Nothing reached Meshcat: no connection, no key, and the hand stayed where it started.
+    assert meshcat.GetNumActiveConnections() == 0
+    assert not result.operator_active.any()
+    drift = np.linalg.norm(result.ee_positions - result.ee_positions[0], axis=1).max()
+    assert drift < 0.005, drift

@@ -71,9 +71,9 @@ class LiveRun:
 
     With `start_label`, the first `advance` first shows a Start button of that label and
     waits for it (`Console.wait_for_start`; Enter on `stdin` or Stop: the run ends after
-    its first slice, `choice` "stop"): the simulator has then been initialized, so the scene went to
-    the page before the button did, and the page shows the button once it has handled the
-    scene. The task's clock, simulated time, starts at the press: the real-time pacing is
+    its first slice, `choice` "stop"): the simulator has then been initialized, so the
+    scene went to the page before the button did, and the page shows the button once it
+    has handled the scene. The task's clock, simulated time, starts at the press: the real-time pacing is
     restarted there.
     """
 
@@ -138,8 +138,8 @@ class LiveRun:
             return
         self.choice = self._console.choice()
         self._apply_sliders(simulator)
-        # A panel keeps only the latest line, which the page fetches at its own rate: every
-        # slice's. Button labels are messages the page handles in turn: a few a second.
+        # A panel keeps only the latest line, which goes to the page as its latest state:
+        # every slice's. Button labels are messages the page handles in turn: a few a second.
         if (self._console.panel is not None
                 or time.monotonic() - self._last_status >= STATUS_PERIOD):
             self._last_status = time.monotonic()

@@ -5,8 +5,8 @@ Drake's Meshcat has no text primitive; what the control panel shows is the label
 button and slider. So, on a bare Meshcat, a line of text is a button whose label is the text
 (clicking it does nothing), replaced (deleted and added again) when the text changes. Behind
 the command line's page front (`pbp_drake.console.front.PageFront`) the lines go to the
-front's own panel instead, which the page fetches at a bounded rate and only the latest of:
-a slow page then never shows a stale status, however far behind it draws the scene.
+front's own panel instead, which goes to the page as its latest state, between the scene's
+batches: a slow page then never shows a stale status, however slowly it draws the scene.
 """
 
 import select
@@ -152,13 +152,8 @@ class Console:
         self._meshcat.AddButton(label)
         try:
             while not self._meshcat.GetButtonClicks(label):
-                if self.choice() == "stop":
+                if self.choice() == "stop" or _entered(stdin, poll_period):
                     return "stop"
-                if stdin is not None and select.select([stdin], [], [], poll_period)[0]:
-                    stdin.readline()
-                    return "stop"
-                if stdin is None:
-                    time.sleep(poll_period)
             return "start"
         except KeyboardInterrupt:
             print(file=sys.stderr)
@@ -176,11 +171,8 @@ class Console:
                 if ((deadline is not None and time.monotonic() >= deadline)
                         or (until is not None and until())):
                     return None
-                if stdin is not None and select.select([stdin], [], [], poll_period)[0]:
-                    stdin.readline()
+                if _entered(stdin, poll_period):
                     return "stop"
-                if stdin is None:
-                    time.sleep(poll_period)
             return choice
         except KeyboardInterrupt:
             print(file=sys.stderr)
@@ -218,3 +210,15 @@ class Console:
         for name in below:
             if self._lines[name] is not None:
                 self._meshcat.AddButton(self._lines[name])
+
+
+def _entered(stdin, period):
+    """Waits `period` seconds for a line (Enter) on `stdin`, or just waits without one; True
+    when a line came (and was read)."""
+    if stdin is None:
+        time.sleep(period)
+        return False
+    if select.select([stdin], [], [], period)[0]:
+        stdin.readline()
+        return True
+    return False

@@ -37,6 +37,15 @@ API_GROUPS = {
         "VirtualParticipantParams": "pbp_drake.core.participant_params",
         "GraspParticipantParams": "pbp_drake.core.participant_grasp",
     },
+    "Shared-autonomy baselines (HOP, policy blending)": {
+        "HopSettings": "pbp_drake.core.hindsight_optimization",
+        "hop_targets": "pbp_drake.core.hindsight_optimization",
+        "update_posterior": "pbp_drake.core.hindsight_optimization",
+        "assisted_command": "pbp_drake.core.hindsight_optimization",
+        **{name: "pbp_drake.systems.pbp" for name in [
+            "MaxEntGoalEstimator", "HopAssistance", "PoseMaxEntGoalEstimator",
+            "PoseHopAssistance"]},
+    },
     "The PBP loop's systems": {
         name: "pbp_drake.systems.pbp" for name in [
             "DmpBank", "GoalEstimator", "Blender", "HandOver", "GoalsSource",

@@ -17,12 +17,19 @@ station, the hand driven to a grasp pose (position and orientation).
     task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
     hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
 
+Under ``hop`` and ``policy_blending`` there is no DMP bank and no blender: the
+`goal_estimator` is HOP's posterior (`PoseMaxEntGoalEstimator`, on the operator's twist),
+and an `assistance` (`PoseHopAssistance`) adds HOP's action to the operator's twist before
+the same `hand_over`. `goal_estimator: {method: maxent_command}` puts the same posterior
+in PBP's loop in place of the `pose` estimator.
+
 `hsr_station` is `make_hsr_station(..., command="pose")`, its hand frame `hand_palm_link`;
 the DMPs start at the hand's real start pose there (`hsr_initial_hand_pose`). Loggers
 named `hand_pose_log`, `operator_active_log`, `operator_command_log`, `command_log`,
-`selected_goal_log`, `target_log`, `phase_log` record each tick (`run_task` reads them,
-`grasp_series_fields`); the task monitor ends the simulation at success. The operator is
-the grasp participant, none (PBP-NoUser), or a person in the Meshcat page: the
+`selected_goal_log`, `target_log`, `phase_log` (with DMPs) and `posterior_clipped_log`
+(with HOP's posterior) record each tick (`run_task` reads them, `grasp_series_fields`);
+the task monitor ends the simulation at success. The operator is the grasp participant,
+none (PBP-NoUser), or a person in the Meshcat page: the
 `PoseKeyboardOperator` or the `PoseGamepadOperator` (their `hand_state` is the sampled
 hand pose; they need Meshcat). With Meshcat, `task_visualizer` draws the tables, objects,
 grasp triads, target and estimate, the hand, and the selected DMP's predicted path
@@ -36,15 +43,17 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.grasp_task import approach_direction
+from pbp_drake.core.hindsight_optimization import HOP_METHODS
 from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
 from pbp_drake.core.pose_arbitration import HandOverLimits
 from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
-from pbp_drake.scenarios import Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant
+from pbp_drake.scenarios import (
+    OPERATOR_DRIVES, Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
-    PoseGoalEstimator, PoseHandOver, SampleHold)
+    PoseGoalEstimator, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
 from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator, PoseGamepadParams
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import GraspSceneVisualizer
 from pbp_drake.systems.operators.pose_keyboard_operator import (
@@ -114,39 +123,45 @@ def build_grasp_diagram(resolved, meshcat=None):
 
     poses = np.hstack([grasps.grasp_positions, grasps.grasp_orientations]).reshape(-1)
     goal_poses = builder.AddNamedSystem("goal_poses", ConstantVectorSource(poses))
-    estimator = builder.AddNamedSystem("goal_estimator", PoseGoalEstimator(
-        goal_count, scenario.goal_estimator, period))
+    estimator = builder.AddNamedSystem("goal_estimator", _estimator(scenario, goal_count))
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
 
     limits = hand_over_limits(scenario)
-    position_bank, orientation_bank = grasp_dmp_banks(resolved, start)
-    prediction_steps = GRASP_PREDICTION_SAMPLES if meshcat is not None else 0
-    # The caps are the hand-over's: no DMP winds its velocity up past what the hand may do.
-    # Every DMP continues from the followed one's velocities (connected below): the compact
-    # state, which Drake copies in 16 numbers instead of 12 K.
-    dmp_bank = builder.AddNamedSystem("dmp_bank", PoseDmpBank(
-        position_bank, orientation_bank, period,
-        lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
-        max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed,
-        prediction_steps=prediction_steps, compact_state=True))
-    builder.Connect(sampled, dmp_bank.get_robot_state_input_port())
-    builder.Connect(goal_poses.get_output_port(), dmp_bank.get_goal_poses_input_port())
-    # Read at the decide stage before the estimator updates: the goal followed last tick.
-    builder.Connect(selected, dmp_bank.get_followed_goal_input_port())
-    builder.Connect(selected, dmp_bank.get_selected_goal_input_port())
-
-    blender = builder.AddNamedSystem("blender", PoseBlender(
-        resolved.blend_mode, goal_count, period, scenario.alpha))
-    builder.Connect(sampled, blender.get_robot_state_input_port())
-    builder.Connect(dmp_bank.get_selected_reference_output_port(),
-                    blender.get_policy_reference_input_port())
-    builder.Connect(selected, blender.get_selected_goal_input_port())
+    if scenario.method in HOP_METHODS:
+        # HOP and policy blending: the operator's twist plus the assistance, no DMPs.
+        dmp_bank = None
+        prediction_steps = 0
+        policy = builder.AddNamedSystem("assistance", PoseHopAssistance(
+            scenario.method, goal_count, scenario.hop, period))
+        builder.Connect(goal_poses.get_output_port(), policy.get_goal_poses_input_port())
+    else:
+        position_bank, orientation_bank = grasp_dmp_banks(resolved, start)
+        prediction_steps = GRASP_PREDICTION_SAMPLES if meshcat is not None else 0
+        # The caps are the hand-over's: no DMP winds its velocity up past what the hand may
+        # do. Every DMP continues from the followed one's velocities (connected below): the
+        # compact state, which Drake copies in 16 numbers instead of 12 K.
+        dmp_bank = builder.AddNamedSystem("dmp_bank", PoseDmpBank(
+            position_bank, orientation_bank, period,
+            lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
+            max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed,
+            prediction_steps=prediction_steps, compact_state=True))
+        builder.Connect(sampled, dmp_bank.get_robot_state_input_port())
+        builder.Connect(goal_poses.get_output_port(), dmp_bank.get_goal_poses_input_port())
+        # Read at the decide stage before the estimator updates: the goal followed last tick.
+        builder.Connect(selected, dmp_bank.get_followed_goal_input_port())
+        builder.Connect(selected, dmp_bank.get_selected_goal_input_port())
+        policy = builder.AddNamedSystem("blender", PoseBlender(
+            resolved.blend_mode, goal_count, period, scenario.alpha))
+        builder.Connect(dmp_bank.get_selected_reference_output_port(),
+                        policy.get_policy_reference_input_port())
+        builder.Connect(selected, policy.get_selected_goal_input_port())
+    builder.Connect(sampled, policy.get_robot_state_input_port())
     builder.Connect(estimator.get_goal_probabilities_output_port(),
-                    blender.get_goal_probabilities_input_port())
+                    policy.get_goal_probabilities_input_port())
     hand_over = builder.AddNamedSystem("hand_over", PoseHandOver(start[:7], limits, period))
-    builder.Connect(blender.get_reference_output_port(), hand_over.get_reference_input_port())
+    builder.Connect(policy.get_reference_output_port(), hand_over.get_reference_input_port())
     builder.Connect(hand_over.get_command_output_port(), station.GetInputPort("pose_command"))
 
     monitor = builder.AddNamedSystem("task_monitor", GraspTaskMonitor(
@@ -165,20 +180,24 @@ def build_grasp_diagram(resolved, meshcat=None):
         builder.Connect(sampled, operator.GetInputPort("hand_state"))
     active = operator.get_operator_active_output_port()
     twist = operator.get_operator_command_output_port()
-    for port in (dmp_bank.get_operator_active_input_port(),
-                 blender.get_operator_active_input_port(),
-                 monitor.get_operator_active_input_port()):
-        builder.Connect(active, port)
-    builder.Connect(twist, blender.get_operator_twist_input_port())
+    builder.Connect(active, monitor.get_operator_active_input_port())
+    if dmp_bank is not None:
+        builder.Connect(active, dmp_bank.get_operator_active_input_port())
+        builder.Connect(active, policy.get_operator_active_input_port())
+    builder.Connect(twist, policy.get_operator_twist_input_port())
     # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
     builder.Connect(twist, estimator.get_operator_twist_input_port())
 
-    for name, port in [("hand_pose_log", hand_pose), ("operator_active_log", active),
-                       ("operator_command_log", twist),
-                       ("command_log", hand_over.get_command_output_port()),
-                       ("selected_goal_log", selected),
-                       ("target_log", monitor.get_target_output_port()),
-                       ("phase_log", dmp_bank.get_phase_output_port())]:
+    logged = [("hand_pose_log", hand_pose), ("operator_active_log", active),
+              ("operator_command_log", twist),
+              ("command_log", hand_over.get_command_output_port()),
+              ("selected_goal_log", selected),
+              ("target_log", monitor.get_target_output_port())]
+    if dmp_bank is not None:
+        logged.append(("phase_log", dmp_bank.get_phase_output_port()))
+    if estimator.HasOutputPort("posterior_clipped"):
+        logged.append(("posterior_clipped_log", estimator.GetOutputPort("posterior_clipped")))
+    for name, port in logged:
         LogVectorOutput(port, builder, period).set_name(name)
     if meshcat is not None:
         visualizer = builder.AddNamedSystem("task_visualizer", GraspSceneVisualizer(
@@ -186,13 +205,28 @@ def build_grasp_diagram(resolved, meshcat=None):
             task.object_height))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
         builder.Connect(selected, visualizer.get_selected_goal_input_port())
-        builder.Connect(dmp_bank.get_predicted_poses_output_port(),
-                        visualizer.get_predicted_poses_input_port())
+        if dmp_bank is not None:
+            builder.Connect(dmp_bank.get_predicted_poses_output_port(),
+                            visualizer.get_predicted_poses_input_port())
         # The measured pose, not the sample: the triad moves smoothly at 30 Hz.
         builder.Connect(hand_pose, visualizer.get_hand_state_input_port())
     diagram = builder.Build()
     diagram.set_name(scenario.name)
     return diagram
+
+
+def _estimator(scenario, goal_count):
+    """The goal estimator: HOP's posterior under hop and policy_blending (the most probable
+    goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
+    section's hysteresis), else the `pose` estimator."""
+    period = scenario.control_period
+    settings = scenario.goal_estimator
+    if scenario.method in HOP_METHODS:
+        return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
+    if settings.method == "maxent_command":
+        return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
+                                       settings.hold_steps)
+    return PoseGoalEstimator(goal_count, settings, period)
 
 
 def _operator(resolved, grasps, meshcat):
@@ -201,8 +235,9 @@ def _operator(resolved, grasps, meshcat):
     period = scenario.control_period
     if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
         return IdleOperator(OperatorTwist.size, period)
-    # Only teleop lets the person push along the approach axis (the paper's forward key).
-    teleop = scenario.method == "teleop"
+    # Only teleop and the baselines that add to a full command (OPERATOR_DRIVES) let the
+    # person push along the approach axis (the paper's forward key).
+    teleop = scenario.method in OPERATOR_DRIVES
     if isinstance(config, (Keyboard, Gamepad)) and meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
@@ -216,7 +251,7 @@ def _operator(resolved, grasps, meshcat):
             nominal_speed=resolved.nominal_speed)
     participant = GraspParticipant.create(
         GraspParticipantParams.from_virtual_participant(scenario.operator),
-        "drive" if scenario.method == "teleop" else "assist", resolved.nominal_speed,
+        "drive" if teleop else "assist", resolved.nominal_speed,
         grasps.grasp_positions, grasps.grasp_orientations, scenario.seed)
     return PoseVirtualOperator(participant, period)
 

@@ -9,18 +9,23 @@
 
 `hsr_station` (`pbp_drake.robots.make_hsr_station`: plant, diff IK, PD, obstacle geometry,
 collision monitor, Meshcat visualizer) and `pbp_controller`
-(`pbp_drake.builder.pbp_controller`) are Diagrams of their own. The order within a tick is
-`pbp_drake.systems.tick`'s. Loggers named `ee_state_log`, `operator_active_log`,
-`operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` and
-(with obstacles) `in_collision_log` record each tick; the task monitor ends the simulation
+(`pbp_drake.builder.pbp_controller`) are Diagrams of their own; under ``hop`` and
+``policy_blending`` the controller is `hop_controller` (`pbp_drake.builder.hop_controller`,
+no DMPs: no `phase` or `predicted_paths`, and no `operator_active` input). The order within
+a tick is `pbp_drake.systems.tick`'s. Loggers named `ee_state_log`, `operator_active_log`,
+`operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` (with
+DMPs), `posterior_clipped_log` (where the controller has HOP's posterior) and (with
+obstacles) `in_collision_log` record each tick; the task monitor ends the simulation
 at success.
 """
 
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
+from pbp_drake.builder.hop_controller import make_hop_controller
 from pbp_drake.builder.operators import make_hsr_operator
 from pbp_drake.builder.pbp_controller import HSR_PREDICTION_SAMPLES, make_pbp_controller
+from pbp_drake.core.hindsight_optimization import HOP_METHODS
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.systems import ReachSceneVisualizer, SampleHold, TaskMonitor
 from pbp_drake.systems.tasks.moving_obstacles import MovingObstacles
@@ -49,8 +54,11 @@ def build_hsr_diagram(resolved, meshcat=None):
     builder.Connect(sampled, monitor.get_ee_state_input_port())
 
     prediction_steps = HSR_PREDICTION_SAMPLES if meshcat is not None else 0
-    controller = builder.AddNamedSystem("pbp_controller",
-                                        make_pbp_controller(resolved, prediction_steps))
+    if scenario.method in HOP_METHODS:
+        controller = builder.AddNamedSystem("hop_controller", make_hop_controller(resolved))
+    else:
+        controller = builder.AddNamedSystem("pbp_controller",
+                                            make_pbp_controller(resolved, prediction_steps))
     builder.Connect(sampled, controller.GetInputPort("ee_state"))
     builder.Connect(controller.GetOutputPort("ee_command"), station.GetInputPort("ee_command"))
 
@@ -76,7 +84,8 @@ def build_hsr_diagram(resolved, meshcat=None):
     operator_active = operator.get_operator_active_output_port()
     operator_command = operator.get_operator_command_output_port()
     builder.Connect(operator_active, monitor.get_operator_active_input_port())
-    builder.Connect(operator_active, controller.GetInputPort("operator_active"))
+    if controller.HasInputPort("operator_active"):
+        builder.Connect(operator_active, controller.GetInputPort("operator_active"))
     builder.Connect(operator_command, controller.GetInputPort("operator_command"))
 
     logged = [("ee_state_log", ee_state),
@@ -84,8 +93,10 @@ def build_hsr_diagram(resolved, meshcat=None):
               ("operator_command_log", operator_command),
               ("command_log", controller.GetOutputPort("ee_command")),
               ("selected_goal_log", selected_goal),
-              ("target_log", monitor.get_target_output_port()),
-              ("phase_log", controller.GetOutputPort("phase"))]
+              ("target_log", monitor.get_target_output_port())]
+    for name in ("phase", "posterior_clipped"):
+        if controller.HasOutputPort(name):
+            logged.append((f"{name}_log", controller.GetOutputPort(name)))
     if obstacles is not None:
         logged.append(("in_collision_log", station.GetOutputPort("in_collision")))
     for name, port in logged:
@@ -98,8 +109,9 @@ def build_hsr_diagram(resolved, meshcat=None):
         builder.Connect(selected_goal, visualizer.get_selected_goal_input_port())
         builder.Connect(operator_active, visualizer.get_operator_active_input_port())
         builder.Connect(ee_state, visualizer.get_ee_state_input_port())
-        builder.Connect(controller.GetOutputPort("predicted_paths"),
-                        visualizer.get_predicted_paths_input_port())
+        if controller.HasOutputPort("predicted_paths"):
+            builder.Connect(controller.GetOutputPort("predicted_paths"),
+                            visualizer.get_predicted_paths_input_port())
 
     diagram = builder.Build()
     diagram.set_name(scenario.name)

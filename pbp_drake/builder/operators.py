@@ -4,7 +4,7 @@ at the keyboard or gamepad, or the virtual participant, on the HSR."""
 import numpy as np
 
 from pbp_drake.scenarios import (
-    Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
+    OPERATOR_DRIVES, Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
     ScriptedCommands, SinusoidalStep, VirtualParticipant)
 from pbp_drake.systems import (
     GamepadOperator, KeyboardOperator, IdleOperator, ObstacleRepulsionOperator, ScriptedOperator,
@@ -42,11 +42,14 @@ def sinusoidal_step_commands(config, control_period, duration):
 
 def make_hsr_operator(resolved, meshcat):
     """The HSR task's operator: a person at the keyboard or gamepad (they need `meshcat`),
-    or the virtual participant (which watches the task's obstacles, if any)."""
+    or the virtual participant (which watches the task's obstacles, if any). Under the
+    methods of `OPERATOR_DRIVES` (teleop, hop, policy_blending) the operator drives the
+    whole way, the forward key enabled; under PBP and arbitration it shows intent without
+    it, as the paper's users did."""
     scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
-    allow_forward = scenario.method == "teleop"
+    allow_forward = scenario.method in OPERATOR_DRIVES
     speed = resolved.nominal_speed
     if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
         return IdleOperator(OperatorCommand.size, period)

@@ -4,6 +4,7 @@ blender and the heading, between the hand's sampled state and the station's comm
     ee_state (sampled) ──> ee_state_split ──[p, v]──> dmp_bank, blender
                        └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
                                               dmp_bank (followed_goal, selected_goal)
+    operator_command ──> goal_estimator (the maxent_command estimator only)
     dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
     goals ──> dmp_bank, goal_estimator
     operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
@@ -11,6 +12,12 @@ blender and the heading, between the hand's sampled state and the station's comm
     operator_active ──> dmp_bank (PBP-Alt's phase lock), blender
     blender.command [p, v] ──> hand_over (the hand-over law: bounded acceleration)
     hand_over.command + heading_command.heading ──> ee_command (the station's input)
+
+The goal estimator is a `GoalEstimator`, or with `goal_estimator: {method: maxent_command}`
+a `MaxEntGoalEstimator` (HOP's posterior on the operator's command, with the scenario's
+`hop` settings and the `goal_estimator` section's hysteresis), which adds the output
+`posterior_clipped`. The methods ``hop`` and ``policy_blending`` have a controller of their
+own, without DMPs (`pbp_drake.builder.hop_controller`).
 
 A user with a station of their own (`pbp_drake.robots.make_hsr_station`) wires it as the
 builder does: `station.ee_state` through a `SampleHold` into `ee_state`, the operator's
@@ -22,7 +29,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from pbp_drake.systems import (
-    Blender, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand)
+    Blender, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand, MaxEntGoalEstimator)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
 # How far ahead the HSR scene draws the DMPs' paths, in samples over the DMP's duration.
@@ -45,6 +52,7 @@ def make_pbp_controller(resolved, prediction_steps=0):
         - goal_probabilities
         - phase
         - predicted_paths (with prediction_steps > 0)
+        - posterior_clipped (with the maxent_command estimator)
 
     `prediction_steps` > 0 adds `predicted_paths` (each DMP's path over its duration in
     that many samples, for drawing).
@@ -65,7 +73,10 @@ def make_pbp_controller(resolved, prediction_steps=0):
     position_velocity = split.get_output_port(0)
     goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
 
-    estimator = builder.AddNamedSystem("goal_estimator", GoalEstimator(
+    reads_command = scenario.goal_estimator.method == "maxent_command"
+    estimator = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(
+        goal_count, scenario.hop, period, scenario.goal_estimator.margin,
+        scenario.goal_estimator.hold_steps) if reads_command else GoalEstimator(
         goal_count, scenario.goal_estimator, period))
     builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
     builder.Connect(goals_source.get_output_port(), estimator.get_goals_input_port())
@@ -94,6 +105,8 @@ def make_pbp_controller(resolved, prediction_steps=0):
         EeState(resolved.initial_ee_state).heading, period,
         scenario.robot.max_hand_yaw_acceleration))
     builder.ConnectInput("operator_command", heading.get_operator_command_input_port())
+    if reads_command:
+        builder.ConnectInput("operator_command", estimator.get_operator_command_input_port())
 
     blender = builder.AddNamedSystem("blender", Blender(
         resolved.blend_mode, 3, goal_count, period, scenario.alpha))
@@ -127,6 +140,8 @@ def make_pbp_controller(resolved, prediction_steps=0):
     builder.ExportOutput(dmp_bank.get_phase_output_port(), "phase")
     if prediction_steps:
         builder.ExportOutput(dmp_bank.get_predicted_paths_output_port(), "predicted_paths")
+    if reads_command:
+        builder.ExportOutput(estimator.get_posterior_clipped_output_port(), "posterior_clipped")
     diagram = builder.Build()
     diagram.set_name("pbp_controller")
     return diagram

@@ -154,6 +154,10 @@ class TaskResult:
             velocity between two ticks (the grasping task; None in the others).
         final_angle_to_target: degrees, `angles_to_target` of the last tick (the grasping
             task; None in the others), kept when the series are not (a streamed run's).
+        posterior_clipped_ratio: ticks whose goal posterior update was clipped at the
+            scenario's `hop.max_probability` / ticks of the task, where the controller has
+            HOP's posterior (hop, policy_blending, the maxent_command estimator; None
+            elsewhere): how often the belief sat at its guard against certainty.
     """
 
     success: bool
@@ -178,6 +182,7 @@ class TaskResult:
     operator_twists: np.ndarray | None = None
     peak_command_angular_change: float | None = None
     final_angle_to_target: float | None = None
+    posterior_clipped_ratio: float | None = None
 
     def __post_init__(self):
         if (self.final_angle_to_target is None and self.angles_to_target is not None
@@ -199,12 +204,14 @@ class TaskResult:
                    "rad/s per tick")
         ended = (f"stopped at {self.task_time:.2f} s" if stopped and not self.success
                  else f"{outcome} in {self.task_time:.2f} s")
+        clipped = ("" if self.posterior_clipped_ratio is None else
+                   f", posterior at its clip {self.posterior_clipped_ratio:.3f} of the time")
         return (f"{ended}, intervention ratio "
                 f"{self.intervention_ratio:.3f}{collisions}, "
                 f"{counted(self.switches, 'target switch', 'target switches')}, "
                 f"peak hand speed {_or_na(self.peak_hand_speed, 3)} m/s, "
                 f"peak command acceleration {_or_na(self.peak_command_acceleration, 2)} m/s^2"
-                f"{turning}")
+                f"{turning}{clipped}")
 
 
 def _or_na(value, digits):
@@ -257,6 +264,8 @@ def final_status(diagram, context):
 # and those measured on the plant's state (not shifted) that make a TaskResult's series.
 DECISION_LOGS = ("command_log", "operator_active_log", "operator_command_log",
                  "selected_goal_log", "target_log")
+# The decision loggers only some controllers have (HOP's posterior), read as those above.
+OPTIONAL_DECISION_LOGS = ("posterior_clipped_log",)
 STATE_LOGS = ("ee_state_log", "in_collision_log")
 
 
@@ -271,6 +280,8 @@ def _read_result(diagram, context, status, monitor, control_period):
     series = task_series(diagram, times, state, in_collision, decisions)
     peaks = SeriesPeaks(control_period)
     peaks.add(series)
+    peaks.add_clipped(read_log(diagram, context, "posterior_clipped_log", tick_count,
+                               shift=DECISION_LOG_SHIFT)[1])
     return peaks.task_result(status, monitor, series)
 
 
@@ -296,13 +307,15 @@ class SeriesPeaks:
     max_k |ee(t_{k+1}) - ee(t_k)| / control_period (m/s, ee = `ee_positions`) and
     max_k |v(k+1) - v(k)| / control_period (m/s^2, v = `commands[:, 3:6]`), None before two
     ticks; in the grasping task also the peak command angular change (rad/s per tick) and
-    the last tick's angle to the target."""
+    the last tick's angle to the target; and, fed the `posterior_clipped_log` samples
+    (`add_clipped`), the ratio of ticks whose goal posterior was clipped."""
 
     def __init__(self, control_period):
         self._period = control_period
         self._hand, self._command, self._turning = LargestStep(), LargestStep(), LargestStep()
         self._grasp = False
         self._final_angle = None
+        self._clipped_ticks = self._posterior_ticks = None  # without a posterior
 
     def add(self, series):
         """Feeds the next ticks' series fields (a dict, see `task_series`)."""
@@ -314,11 +327,23 @@ class SeriesPeaks:
             if len(series["angles_to_target"]):
                 self._final_angle = float(series["angles_to_target"][-1])
 
+    def add_clipped(self, samples):
+        """Feeds the next ticks' `posterior_clipped_log` samples (T, 1), already shifted;
+        None (a controller without HOP's posterior) feeds nothing."""
+        if samples is None:
+            return
+        flags = np.asarray(samples, float).reshape(-1) > 0.5
+        self._clipped_ticks = (self._clipped_ticks or 0) + int(flags.sum())
+        self._posterior_ticks = (self._posterior_ticks or 0) + len(flags)
+
     def task_result(self, status, monitor, series):
         """The run's TaskResult (see `task_result`) holding `series` and the peaks fed."""
         if self._grasp:
             series = dict(series, peak_command_angular_change=self._turning.peak(1.0),
                           final_angle_to_target=self._final_angle)
+        if self._posterior_ticks:
+            series = dict(series, posterior_clipped_ratio=(
+                self._clipped_ticks / self._posterior_ticks))
         return task_result(status, monitor, series, self._hand.peak(self._period),
                            self._command.peak(self._period))
 

@@ -21,8 +21,8 @@ import numpy as np
 from pydrake.systems.primitives import VectorLogSink
 
 from pbp_drake.builder.run import (
-    DECISION_LOGS, STATE_LOGS, SeriesPeaks, advance_to, final_status, initialized_simulator,
-    state_log_name, task_series, ticks_of)
+    DECISION_LOGS, OPTIONAL_DECISION_LOGS, STATE_LOGS, SeriesPeaks, advance_to, final_status,
+    initialized_simulator, state_log_name, task_series, ticks_of)
 from pbp_drake.builder.time_series import time_series_header, time_series_rows
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
 
@@ -59,6 +59,7 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
             stream.write(time_series_rows(series))
             stream.flush()
             peaks.add(series.fields)
+            peaks.add_clipped(series.posterior_clipped)
             if after_chunk is not None:
                 after_chunk(context.get_time())
             # The task monitor ends the simulation at success (or the person, at a console).
@@ -69,11 +70,13 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
 
 
 class _Series:
-    """A TaskResult's time series fields as attributes (what `time_series_rows` reads)."""
+    """A TaskResult's time series fields as attributes (what `time_series_rows` reads), and
+    the `posterior_clipped_log` samples of the same ticks (None without HOP's posterior)."""
 
-    def __init__(self, fields):
+    def __init__(self, fields, posterior_clipped=None):
         self.__dict__.update(fields)
         self.fields = fields
+        self.posterior_clipped = posterior_clipped
 
 
 class _LogTail:
@@ -84,8 +87,11 @@ class _LogTail:
         # The hand's state: the grasping task logs its pose, the others ee_state.
         self._state_log = state_log_name(diagram)
         self._named = {name: diagram.GetSubsystemByName(name)
-                       for name in (self._state_log,) + STATE_LOGS + DECISION_LOGS
+                       for name in ((self._state_log,) + STATE_LOGS + DECISION_LOGS
+                                    + OPTIONAL_DECISION_LOGS)
                        if diagram.HasSubsystemNamed(name)}
+        self._decisions = [name for name in DECISION_LOGS + OPTIONAL_DECISION_LOGS
+                           if name in self._named]
         # Every logger, those not written too (phase_log): all are cleared.
         self._all = [system for system in diagram.GetSystems()
                      if isinstance(system, VectorLogSink)]
@@ -107,7 +113,7 @@ class _LogTail:
         for logger in self._all:
             logger.FindMutableLog(context).Clear()
         skipped = min(self._to_skip, len(self._samples[DECISION_LOGS[0]]))
-        for name in DECISION_LOGS:
+        for name in self._decisions:
             self._samples[name] = self._samples[name][skipped:]
         self._to_skip -= skipped
         return self._split(len(self._samples[DECISION_LOGS[0]]))
@@ -123,7 +129,8 @@ class _LogTail:
                                                 self._samples[name][count:].copy())
         return _Series(task_series(self._diagram, times, taken[self._state_log],
                                    taken.get("in_collision_log"),
-                                   {name: taken[name] for name in DECISION_LOGS}))
+                                   {name: taken[name] for name in DECISION_LOGS}),
+                       taken.get("posterior_clipped_log"))
 
     def empty_series(self):
         """The series fields of no ticks (what a streamed run's TaskResult holds)."""

@@ -20,6 +20,11 @@ turns the scores into probabilities that sum to 1:
   `pbp_drake.core.grasp_estimation`; `goal_probabilities` here does not compute it (it needs
   the grasp orientations and the hand's velocities), `grasp_estimation.pose_probabilities`
   does, with the same settings and the same hysteresis (`update_selection`).
+- ``maxent_command`` (every HSR task): HOP's goal posterior, which reads the operator's
+  command (Javdani et al. 2015, maximum-entropy inverse optimal control; the scenario's
+  `hop` settings, `pbp_drake.core.hindsight_optimization`); recursive, so it keeps its
+  belief in the estimator's state (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`),
+  with the same hysteresis.
 
 All of them are vectorised over K (no Python loop over goals) and computed in log space, so a
 small temperature or a large beta gives a one-hot vector rather than NaN.
@@ -41,9 +46,12 @@ from pbp_drake.core.coordinates import check_positions
 
 # The estimators that read the hand's position and heading (`goal_probabilities`) ...
 GOAL_ESTIMATION_METHODS = ("angle", "nearest", "bayesian")
-# ... and those that read its whole pose (`pbp_drake.core.grasp_estimation`).
+# ... those that read its whole pose (`pbp_drake.core.grasp_estimation`) ...
 POSE_ESTIMATION_METHODS = ("pose",)
-ESTIMATION_METHODS = GOAL_ESTIMATION_METHODS + POSE_ESTIMATION_METHODS
+# ... and those that read the operator's command (`pbp_drake.core.hindsight_optimization`).
+COMMAND_ESTIMATION_METHODS = ("maxent_command",)
+ESTIMATION_METHODS = (GOAL_ESTIMATION_METHODS + POSE_ESTIMATION_METHODS
+                      + COMMAND_ESTIMATION_METHODS)
 
 # A goal closer than this (m) to the end effector on the floor plane has no direction.
 FLOOR_EPSILON = 1e-9
@@ -57,9 +65,11 @@ class GoalEstimatorSettings:
     """How goals are scored and how sticky the selection is (scenario files: the
     `goal_estimator` section).
 
-    `method` is ``angle`` (the paper's heuristic), ``nearest``, ``bayesian`` or ``pose``
-    (grasping task only). `temperature` scales ``angle`` (rad), ``nearest`` (m) and
-    ``pose`` (rad) scores: low enough that objects a few degrees apart are told apart.
+    `method` is ``angle`` (the paper's heuristic), ``nearest``, ``bayesian``, ``pose``
+    (grasping task only) or ``maxent_command`` (HOP's posterior, on the operator's command;
+    its constants are the scenario's `hop` section). `temperature` scales ``angle`` (rad),
+    ``nearest`` (m) and ``pose`` (rad) scores: low enough that objects a few degrees apart
+    are told apart.
     `beta` (1/m) is the rationality of ``bayesian``. The ``pose`` score
     (`pbp_drake.core.grasp_estimation`) adds `distance_weight` (rad per m) times the
     distance, `orientation_weight` (a factor) times the angle to the grasp orientation, and
@@ -70,7 +80,8 @@ class GoalEstimatorSettings:
     the most probable goal at once.
     """
 
-    #: The score: angle (the paper's heuristic), nearest, bayesian or pose (grasping task only).
+    #: The score: angle (the paper's heuristic), nearest, bayesian, pose (grasping task
+    #: only) or maxent_command (HOP's posterior on the operator's command).
     method: str = "angle"
     #: The scale of the angle (rad), nearest (m) and pose (rad) scores.
     temperature: float = 0.1
@@ -221,6 +232,10 @@ def goal_probabilities(settings, goals, position, heading, start=None, path_leng
     if settings.method == "pose":
         raise ValueError("the pose goal estimator reads grasp orientations and the hand's "
                          "velocities: call pbp_drake.core.grasp_estimation.pose_probabilities")
+    if settings.method == "maxent_command":
+        raise ValueError("the maxent_command goal estimator is recursive and reads the "
+                         "operator's command: call "
+                         "pbp_drake.core.hindsight_optimization.update_posterior")
     raise ValueError(f"goal estimation method {settings.method!r} is unknown; choose one of "
                      f"{GOAL_ESTIMATION_METHODS}")
 

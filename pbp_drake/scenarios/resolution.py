@@ -32,7 +32,8 @@ from pbp_drake.scenarios.validation import (
     check_obstacle_task, check_reach_task, check_seed, check_time_steps,
     check_virtual_participant, require_finite)
 
-# How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator).
+# How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator;
+# HOP and policy blending have no blender: their assistance is `builder.hop_controller`'s).
 BLEND_MODE_OF_METHOD = {
     "pbp_alternated": "pbp_alternated",
     "pbp_continuous": "pbp_continuous",
@@ -40,6 +41,8 @@ BLEND_MODE_OF_METHOD = {
     "fixed_alpha": "fixed_alpha",
     "confidence_alpha": "confidence_alpha",
     "teleop": "teleop",
+    "hop": None,
+    "policy_blending": None,
 }
 
 
@@ -85,7 +88,8 @@ class ResolvedScenario:
 
     @property
     def blend_mode(self):
-        """The blender's mode for `scenario.method`."""
+        """The blender's mode for `scenario.method` (None for hop and policy_blending, which
+        have none)."""
         return BLEND_MODE_OF_METHOD[self.scenario.method]
 
     @property
@@ -156,6 +160,7 @@ def _check_common(scenario):
     require_finite(scenario, "scenario", ("control_period", "duration"))
     _settings_checked("scenario.dmp", scenario.dmp)
     _settings_checked("scenario.goal_estimator", scenario.goal_estimator)
+    _settings_checked("scenario.hop", scenario.hop)
     if scenario.goal_estimator.method == "pose" and not isinstance(scenario.task, GraspTask):
         raise ScenarioError("scenario.goal_estimator.method pose reads grasp orientations: "
                             "use it with task: !GraspTask {...}")
@@ -183,6 +188,9 @@ def _check_method(scenario, goal_count):
     if scenario.method == "confidence_alpha":
         raise ScenarioError("scenario.method confidence_alpha needs a goal estimator's "
                             "confidence: use it in the HSR tasks (robot: !Hsr)")
+    if scenario.method in ("hop", "policy_blending"):
+        raise ScenarioError(f"scenario.method {scenario.method} assists toward the HSR "
+                            "tasks' goals: use it in the HSR tasks (robot: !Hsr)")
     if scenario.method == "fixed_alpha" and scenario.demonstration is None:
         raise ScenarioError(
             "scenario.method fixed_alpha plays the demonstration as P: give "

@@ -25,6 +25,7 @@ from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.hindsight_optimization import HopSettings
 from pbp_drake.robots.hsr_station_config import HsrStationConfig
 from pbp_drake.systems.operators.gamepad_operator import GamepadParams
 from pbp_drake.systems.operators.keyboard_operator import KeyboardParams
@@ -51,7 +52,10 @@ class ScenarioError(ValueError):
 
 
 METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
-           "pbp_no_user")
+           "pbp_no_user", "hop", "policy_blending")
+# The methods under which the operator drives the whole way, the forward key enabled: teleop,
+# and the shared-autonomy baselines whose assistance adds to (or replaces) a full command.
+OPERATOR_DRIVES = ("teleop", "hop", "policy_blending")
 
 
 @dataclasses.dataclass
@@ -318,6 +322,9 @@ class Scenario:
     #: How the followed goal is estimated (GoalEstimatorSettings).
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
+    #: HOP's cost model, goal posterior and assistance (HopSettings), read by the hop and
+    #: policy_blending methods and the maxent_command goal estimator.
+    hop: HopSettings = dataclasses.field(default_factory=HopSettings)
     #: The seed of every random draw (an integer).
     seed: int = 0
     #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets

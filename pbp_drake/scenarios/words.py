@@ -4,7 +4,8 @@ same way: each method's one name, and a count with its noun in the right number.
 
 #: The name a person reads for each method of `schema.METHODS`: on the page's Start button
 #: and title, in the results tables and in the figures. The paper's names where it has them;
-#: confidence_alpha has none and reads as `--methods` spells it (as the results tables print it).
+#: confidence_alpha has none and reads as `--methods` spells it (as the results tables print it);
+#: hop and policy_blending are the shared-autonomy baselines' names in Javdani et al.'s papers.
 METHOD_NAMES = {
     "pbp_alternated": "PBP-Alt",
     "pbp_continuous": "PBP-Cont",
@@ -12,6 +13,8 @@ METHOD_NAMES = {
     "confidence_alpha": "confidence_alpha",
     "teleop": "Teleop",
     "pbp_no_user": "PBP-NoUser",
+    "hop": "HOP",
+    "policy_blending": "Policy blending",
 }
 
 

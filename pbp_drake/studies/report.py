@@ -6,6 +6,7 @@ import pathlib
 
 from pbp_drake.studies.figures import (
     METHOD_LABELS, plot_collision_histogram, plot_intervention, plot_task_time)
+from pbp_drake.studies.intervals import confidence_table
 from pbp_drake.studies.splits import seeds_line
 from pbp_drake.studies.summary import summarize
 from pbp_drake.studies.trial_files import (
@@ -45,14 +46,20 @@ def results_table(summary):
     """The summary as a Markdown table, one row per method: mean ± std of the intervention
     ratio and task time, and of the collision ratio with the count of collision-free trials
     where the task measures collisions; max / mean of the trials' peak hand speed and peak
-    command acceleration (see `summarize`)."""
+    command acceleration (see `summarize`); how often HOP's goal posterior sat at its clip
+    where a method records it. Below it, the 95 % confidence intervals
+    (`pbp_drake.studies.intervals`)."""
     seeds = seeds_line(summary)
     lines = [seeds, ""] if seeds else []
     collisions = summary["measures_collisions"]
+    # HOP's posterior at its clip, where a method records it (hop, policy_blending,
+    # maxent_command).
+    clipped = any("posterior_clipped_ratio" in e for e in summary["methods"].values())
     columns = ["method", "trials", "success", "intervention ratio", "task time (s)",
                *(("collision ratio", "collision-free trials") if collisions else ()),
                "peak hand speed (m/s), max / mean",
-               "peak command acceleration (m/s²), max / mean", "errors"]
+               "peak command acceleration (m/s²), max / mean",
+               *(("posterior at its clip",) if clipped else ()), "errors"]
     lines += ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for method, entry in summary["methods"].items():
         rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
@@ -63,8 +70,12 @@ def results_table(summary):
         cells = [METHOD_LABELS.get(method, method), trials, rate,
                  _cell(entry, "intervention_ratio", 3), _cell(entry, "task_time", 1),
                  *collision, _peak_cell(entry, "peak_hand_speed", 3),
-                 _peak_cell(entry, "peak_command_acceleration", 2), str(entry["errors"])]
+                 _peak_cell(entry, "peak_command_acceleration", 2),
+                 *((_cell(entry, "posterior_clipped_ratio", 3)
+                    if "posterior_clipped_ratio" in entry else "-",) if clipped else ()),
+                 str(entry["errors"])]
         lines.append("| " + " | ".join(cells) + " |")
+    lines += ["", *confidence_table(summary)]
     if summary.get("damaged"):
         lines += ["", f"Skipped as damaged or foreign: {len(summary['damaged'])} files "
                       f"({sum(e.get('damaged', 0) for e in summary['methods'].values())} "

@@ -63,6 +63,8 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
                       peak_hand_speed=json_float(result.peak_hand_speed),
                       peak_command_acceleration=json_float(result.peak_command_acceleration),
                       ticks=len(result.times))
+        if result.posterior_clipped_ratio is not None:  # HOP's posterior (trial_files)
+            record["posterior_clipped_ratio"] = json_float(result.posterior_clipped_ratio)
         if result.angles_to_target is not None:  # the grasping task's orientation
             record.update(final_angle_to_target=json_float(result.final_angle_to_target),
                           peak_command_angular_change=json_float(

@@ -152,7 +152,9 @@ def summarize(study, records, damaged=(), output=None):
     and the ideal alpha when the study sweeps fixed alphas. `damaged` (Damage tuples, see
     trial_files.read_study) gives each method's count of trials skipped as damaged (not
     counted as missing) and the summary's "damaged" list of files (paths relative to
-    `output`) and problems."""
+    `output`) and problems. A method whose trials record how often HOP's goal posterior sat
+    at its clip (hop, policy_blending, the maxent_command estimator) gets the mean and std
+    of that `posterior_clipped_ratio` too; the others have no such entry."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),
@@ -181,6 +183,9 @@ def summarize(study, records, damaged=(), output=None):
             "peak_command_acceleration": max_mean(
                 [r.get("peak_command_acceleration") for r in ran]),
         }
+        clipped = [r.get("posterior_clipped_ratio") for r in ran]
+        if any(value is not None for value in clipped):
+            entry["posterior_clipped_ratio"] = mean_std(clipped)
         if collisions:
             ratios = [r["collision_ratio"] for r in ran if r["collision_ratio"] is not None]
             entry["collision_ratio"] = {**mean_std(ratios),

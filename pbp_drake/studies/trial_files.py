@@ -31,8 +31,12 @@ TRIAL_FORMAT = 1
 # one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| / control_period, and
 # peak_command_acceleration (m/s^2), max_k |v_cmd(k+1) - v_cmd(k)| / control_period, over
 # the CSV's ee_x..ee_z and command_vx..command_vz columns (ticks 0..T-1).
+# posterior_clipped_ratio is the ratio of ticks whose goal posterior sat at its clip
+# (`TaskResult.posterior_clipped_ratio`), recorded by the methods with HOP's posterior only
+# (hop, policy_blending, the maxent_command estimator): other trials, and those written
+# before it, read it as None.
 METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio",
-           "peak_hand_speed", "peak_command_acceleration")
+           "peak_hand_speed", "peak_command_acceleration", "posterior_clipped_ratio")
 TRIAL_FIELDS = ("method", "trial", "seed", *METRICS, "error")
 
 
@@ -169,7 +173,8 @@ _REQUIRED = {"success": (bool,), "method": (str,), "seed": (int,)}
 _NUMBER = (int, float)
 _TYPES = {"scenario": (str,), "scenario_hash": (str,), "trial": (int,), "task_time": _NUMBER,
           "intervention_ratio": _NUMBER, "switches": (int,), "collision_ratio": _NUMBER,
-          "peak_hand_speed": _NUMBER, "peak_command_acceleration": _NUMBER, "ticks": (int,),
+          "peak_hand_speed": _NUMBER, "peak_command_acceleration": _NUMBER,
+          "posterior_clipped_ratio": _NUMBER, "ticks": (int,),
           "objects": (list,), "targets": (list,), "time_series": (str,), "error": (str,)}
 _INTEGER_COLUMNS = {"operator_active", "selected_goal", "target", "in_collision"}
 

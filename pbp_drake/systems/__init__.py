@@ -26,7 +26,8 @@ from pbp_drake.systems.operators import (
     VirtualOperator)
 from pbp_drake.systems.pbp import (
     Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand,
-    PoseBlender, PoseDmpBank, PoseGoalEstimator, PoseHandOver)
+    HopAssistance, MaxEntGoalEstimator, PoseBlender, PoseDmpBank, PoseGoalEstimator,
+    PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator)
 from pbp_drake.systems.sample_hold import SampleHold
 from pbp_drake.systems.tasks import (
     CollisionMonitor, CylinderObstacleGeometry, GraspTaskMonitor, MovingObstacles,
@@ -38,6 +39,8 @@ __all__ = [
     # The PBP loop.
     "Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource", "HandOver",
     "HeadingCommand", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver",
+    # The shared-autonomy baselines (HOP, policy blending) and PBP's maxent_command estimator.
+    "HopAssistance", "MaxEntGoalEstimator", "PoseHopAssistance", "PoseMaxEntGoalEstimator",
     # Operators.
     "GamepadOperator", "IdleOperator", "KeyboardOperator", "ObstacleRepulsionOperator",
     "PoseGamepadOperator", "PoseKeyboardOperator", "PoseVirtualOperator", "ScriptedOperator",

@@ -45,7 +45,8 @@ def test_status_words():
 # The names the results tables in docs/results/generated/ print.
 NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "Teleop",
          "pbp_no_user": "PBP-NoUser", "fixed_alpha": "Fixed alpha",
-         "confidence_alpha": "confidence_alpha"}
+         "confidence_alpha": "confidence_alpha", "hop": "HOP",
+         "policy_blending": "Policy blending"}
 
 
 @pytest.mark.parametrize("method", METHODS)

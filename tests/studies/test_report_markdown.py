@@ -30,7 +30,10 @@ def test_the_markdown_names_the_command_and_seeds_then_the_table(hsr_study, tmp_
                              "10,000")
     rows = [line for line in lines if line.startswith("| ")]
     assert rows[0].startswith("| method | trials | success |")
-    assert [row.split(" | ")[0] for row in rows[1:]] == ["| PBP-Alt", "| Teleop"]
+    assert [row.split(" | ")[0] for row in rows[1:3]] == ["| PBP-Alt", "| Teleop"]
+    # Below it, each method's 95 % intervals (a single trial has none for its means).
+    assert rows[3].startswith("| method | success | intervention ratio | task time (s) |")
+    assert rows[4:] == ["| PBP-Alt | [21, 100] % | - | - |", "| Teleop | [21, 100] % | - | - |"]
     # The table is results.md's; the summary is the same bytes as the study wrote.
     assert markdown.read_text().endswith((hsr_study / "results.md").read_text())
     assert (hsr_study / "summary.json").read_bytes() == summary

@@ -2,7 +2,9 @@
 in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`) and the six-DoF
 pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`, `PoseHandOver`); the goals'
 source, the heading command of the HSR tasks and the demonstration player of explicit
-arbitration."""
+arbitration; and the shared-autonomy baselines' systems: HOP's goal posterior on the
+operator's command (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`, also PBP's
+``maxent_command`` estimator) and its assistance (`HopAssistance`, `PoseHopAssistance`)."""
 
 from pbp_drake.systems.pbp.blender import Blender
 from pbp_drake.systems.pbp.demonstration_player import DemonstrationPlayer
@@ -11,11 +13,16 @@ from pbp_drake.systems.pbp.goal_estimator import GoalEstimator
 from pbp_drake.systems.pbp.goals_source import GoalsSource
 from pbp_drake.systems.pbp.hand_over import HandOver
 from pbp_drake.systems.pbp.heading_command import HeadingCommand
+from pbp_drake.systems.pbp.hop_assistance import HopAssistance
+from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator
 from pbp_drake.systems.pbp.pose_blender import PoseBlender
 from pbp_drake.systems.pbp.pose_dmp_bank import PoseDmpBank
 from pbp_drake.systems.pbp.pose_goal_estimator import PoseGoalEstimator
 from pbp_drake.systems.pbp.pose_hand_over import PoseHandOver
+from pbp_drake.systems.pbp.pose_hop_assistance import PoseHopAssistance
+from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstimator
 
 __all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource",
-           "HandOver", "HeadingCommand", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator",
-           "PoseHandOver"]
+           "HandOver", "HeadingCommand", "HopAssistance", "MaxEntGoalEstimator", "PoseBlender",
+           "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver", "PoseHopAssistance",
+           "PoseMaxEntGoalEstimator"]

@@ -1,0 +1,479 @@
+"""Shared autonomy by hindsight optimization (HOP) and the policy-blending baseline, in pure
+NumPy: the goal posterior that reads the operator's command, and the assistance it gives.
+
+Sources: S. Javdani, S. Srinivasa, J. A. Bagnell, "Shared Autonomy via Hindsight
+Optimization", RSS 2015; S. Javdani et al., "Shared autonomy via hindsight optimization for
+teleoperation and teaming", IJRR 2018; A. Dragan, S. Srinivasa, "A policy-blending
+formalism for shared control", IJRR 2013. The constants (`HopSettings`' defaults) are the
+published ones.
+
+**Targets and goals.** Goal g (one of K) has one or more targets kappa (N in all): a
+position, and in the grasping task an orientation. The reaching tasks give each goal its
+object's position as its one target; the grasping task its grasp pose.
+
+**Costs.** Per target, with the distance d = |p - p_kappa| and, with orientations, the angle
+theta from the hand's orientation to the target's (`quaternion.angle_between`), a Huber-like
+cost of constants alpha (`gain`), delta (`switch`) and c0 (`constant`), with the cost
+model's time step dt (`cost_time_step`):
+
+    step cost   c(x) = dt (alpha + c0)                        if x > delta,
+                       dt ((alpha / delta) x + c0)            otherwise;
+    value       V(x) = (alpha / (2 delta)) x^2 + c0 x          if x <= delta,
+                       (alpha + c0) x - alpha delta / 2        otherwise,
+
+so `c(x) = dt V'(x)`. A target's cost and value are the translation term's (x = d) plus
+`rotation_weight` times the rotation term's (x = theta), each with its own constants. With
+the operator's command u = (v, omega) applied for one step as direct teleoperation,
+`p' = p + v dt` and `q' = Exp(omega dt) q`, and d', theta' the distance and angle from there:
+
+    Q_kappa = c(d) + V(d')  [+ w (c(theta) + V(theta'))],    V_kappa = V(d)  [+ w V(theta)],
+    Q_g = min over g's targets of Q_kappa,                    V_g = min of V_kappa;
+
+a goal's best target is the one of least Q (a goal of one target has it alone).
+
+**The posterior** (maximum-entropy inverse optimal control, recursive), from a uniform prior:
+
+    log b_t(g) = log b_{t-1}(g) - (Q_g - V_g),   normalised by log-sum-exp;
+
+then, when the largest probability exceeds `max_probability`, it is set to `max_probability`
+and the excess is spread evenly over the K - 1 other goals (the published guard against
+certainty; one goal alone is never clipped). The clipped belief is the one carried to the
+next update. Everything stays in log space, so 10,000 goals or a goal a million metres
+away give finite, normalised probabilities.
+
+**The assistance** (QMDP's belief-weighted action):
+
+    a = -(1 / lambda) (sum_g b_g grad Q_g) / (sum_g b_g),
+
+with grad Q_g the gradient of the goal's best target's value at the operator's next pose
+(the step cost is of the present pose, which the action does not change):
+translation `V'(|r|) r / |r|`, r = p' - p_kappa (`(alpha + c0) r/|r|` far, `c0 r/|r| +
+(alpha/delta) r` near); rotation `w V'(theta') n`, n the unit axis of `Log(q' q_kappa*)`,
+along which turning the hand grows theta' at rate 1. Each goal's gradient fades in
+proportion within `translation_fade_distance` of its target (times d / 0.02 m) and, for the
+rotation, within `rotation_fade_angle` (times theta / (pi / 12)), so that the assistance
+vanishes at the target instead of chattering about it. `lambda` is `translation_divisor`
+(40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a convex blend.
+
+**Policy blending** (`blending_weights`), the predict-then-act baseline HOP's papers ran:
+while the two most probable goals differ by at most `blending_threshold` in probability
+the command is the operator's alone; beyond it, full assistance toward the most probable
+goal g*: the operator's command plus HOP's single-goal action toward g* (`a` with the
+whole belief on g*). The operator's velocity is kept, as in HOP's additive command: HOP's
+action is a correction scaled by 1/lambda to add to an operator's velocity, and on its own
+it would move the hand at most (alpha + c0)/lambda = 0.061 m/s, half our operators' speed.
+"""
+
+import dataclasses
+import math
+import typing
+
+import numpy as np
+
+from pbp_drake.core import quaternion
+
+# The methods built on this module (the scenario's `method`).
+HOP_METHODS = ("hop", "policy_blending")
+# Below this (m, rad) the hand is at a target: no direction to it.
+AT_TARGET = 1e-12
+
+
+def _is_real(value):
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, bool)
+
+
+@dataclasses.dataclass
+class HopSettings:
+    """The cost model, posterior and assistance of HOP (scenario files: the `hop` section),
+    read by the ``hop`` and ``policy_blending`` methods and the ``maxent_command`` goal
+    estimator. Each default is the published constant (Javdani et al. 2015, 2018; the
+    module docstring gives the equations). `cost_time_step` is the cost model's step, not
+    the control period: the posterior is updated once per control tick, so per second it
+    gathers `cost_time_step / control_period` times the evidence of one published step
+    (docs/concepts/hindsight-optimization.md)."""
+
+    #: The cost model's time step dt (s): a step costs dt times the cost's slope, and the
+    #: operator's command is applied for dt to find the distance after it (published: 0.1).
+    cost_time_step: float = 0.1
+    #: Translation: the Huber cost's gain alpha (per m); far from a target its value grows
+    #: by translation_gain + translation_constant per metre.
+    translation_gain: float = 2.25
+    #: Translation: the distance delta (m) within which the cost is quadratic.
+    translation_switch_distance: float = 0.07
+    #: Translation: the constant cost c0 (per m).
+    translation_constant: float = 0.2
+    #: Rotation, on the angle to a target's orientation: the gain alpha (per rad).
+    rotation_gain: float = 0.20
+    #: Rotation: the angle delta (rad) within which the cost is quadratic (pi/32).
+    rotation_switch_angle: float = math.pi / 32
+    #: Rotation: the constant cost c0 (per rad).
+    rotation_constant: float = 0.01
+    #: The rotation terms' weight against the translation's (a factor).
+    rotation_weight: float = 0.07
+    #: The translational assistance is the belief-weighted cost gradient over this
+    #: (lambda; the assistance in m/s).
+    translation_divisor: float = 40.0
+    #: The rotational assistance's lambda (the assistance in rad/s).
+    rotation_divisor: float = 0.05
+    #: Each goal's translational assistance fades in proportion within this distance (m)
+    #: of its target.
+    translation_fade_distance: float = 0.02
+    #: Each goal's rotational assistance fades in proportion within this angle (rad) of its
+    #: target's orientation (pi/12).
+    rotation_fade_angle: float = math.pi / 12
+    #: The goal posterior's largest probability is clipped at this (a probability in
+    #: (0, 1]; 1: never); the excess is spread evenly over the other goals.
+    max_probability: float = 0.99
+    #: policy_blending: the operator's command passes through while the two most probable
+    #: goals differ by at most this (a probability in [0, 1)); beyond, full assistance.
+    blending_threshold: float = 0.4
+
+    def __post_init__(self):
+        self.validate()
+
+    def validate(self):
+        """Raises ValueError naming the first field that cannot be used (a YAML loader sets
+        the fields after construction, so `resolve` calls this again)."""
+        for field in dataclasses.fields(self):
+            value = getattr(self, field.name)
+            if not _is_real(value) or not math.isfinite(value):
+                raise ValueError(f"{field.name} must be a finite number, got {value!r}")
+        for name in ("cost_time_step", "translation_gain", "translation_switch_distance",
+                     "translation_constant", "rotation_gain", "rotation_switch_angle",
+                     "rotation_constant", "rotation_weight", "translation_divisor",
+                     "rotation_divisor", "translation_fade_distance", "rotation_fade_angle"):
+            if not getattr(self, name) > 0.0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
+        if not 0.0 < self.max_probability <= 1.0:
+            raise ValueError(f"max_probability must lie in (0, 1], got "
+                             f"{self.max_probability!r}")
+        if not 0.0 <= self.blending_threshold < 1.0:
+            raise ValueError(f"blending_threshold must lie in [0, 1), got "
+                             f"{self.blending_threshold!r}")
+
+
+class HopTargets(typing.NamedTuple):
+    """The N targets of K goals: `positions` (N, 3), `orientations` (N, 4) unit quaternions
+    or None (position only), `goals` (N,) the goal index of each target, `goal_count` K."""
+
+    positions: np.ndarray
+    orientations: typing.Optional[np.ndarray]
+    goals: np.ndarray
+    goal_count: int
+
+
+def hop_targets(positions, orientations=None, goals=None, goal_count=None):
+    """Checked `HopTargets`. `goals=None`: one target per goal, target i of goal i. Raises
+    ValueError for NaN or infinite positions, orientations that are not unit quaternions,
+    a goal index out of range or a goal without a target."""
+    positions = np.array(positions, dtype=float)
+    if positions.ndim != 2 or positions.shape[1] != 3 or len(positions) == 0:
+        raise ValueError(f"target positions must be (N, 3) with N >= 1, got shape "
+                         f"{positions.shape}")
+    if not np.isfinite(positions).all():
+        raise ValueError("target positions contain NaN or infinite values")
+    if orientations is not None:
+        orientations = quaternion.unit_quaternions(orientations, "target orientations")
+        if orientations.shape != (len(positions), 4):
+            raise ValueError(f"target orientations must be (N, 4) with N = {len(positions)},"
+                             f" got shape {orientations.shape}")
+    if goals is None:
+        goals = np.arange(len(positions))
+    goals = np.asarray(goals)
+    if goals.shape != (len(positions),) or not np.issubdtype(goals.dtype, np.integer):
+        raise ValueError(f"goals must be one integer goal index per target ({len(positions)}),"
+                         f" got {goals!r}")
+    count = int(goals.max()) + 1 if goal_count is None else int(goal_count)
+    if (goals < 0).any() or (goals >= count).any():
+        raise ValueError(f"goal indices must lie in [0, {count}), got {goals.tolist()}")
+    if len(np.unique(goals)) != count:
+        raise ValueError(f"every one of the {count} goals needs a target")
+    return HopTargets(positions, orientations, goals.astype(int), count)
+
+
+# ---------------------------------------------------------------------------------------------
+# The Huber cost of one term
+
+
+def huber_value(x, gain, switch, constant):
+    """`V(x)`: `(gain / (2 switch)) x^2 + constant x` up to `switch`, then
+    `(gain + constant) x - gain switch / 2` (continuous, with a continuous slope)."""
+    x = np.asarray(x, dtype=float)
+    near = np.minimum(x, switch)  # no square of a far distance: it could overflow
+    return np.where(x <= switch, gain / (2.0 * switch) * near * near + constant * near,
+                    (gain + constant) * x - 0.5 * gain * switch)
+
+
+def huber_slope(x, gain, switch, constant):
+    """`V'(x)`: `(gain / switch) x + constant` up to `switch`, `gain + constant` beyond."""
+    x = np.asarray(x, dtype=float)
+    return np.where(x > switch, gain + constant, gain / switch * np.minimum(x, switch)
+                    + constant)
+
+
+def huber_step_cost(x, gain, switch, constant, time_step):
+    """`c(x) = time_step V'(x)`: the cost of one step of the cost model at `x`."""
+    return time_step * huber_slope(x, gain, switch, constant)
+
+
+def _translation(settings):
+    return (settings.translation_gain, settings.translation_switch_distance,
+            settings.translation_constant)
+
+
+def _rotation(settings):
+    return settings.rotation_gain, settings.rotation_switch_angle, settings.rotation_constant
+
+
+# ---------------------------------------------------------------------------------------------
+# Per target and per goal
+
+
+class TargetGeometry(typing.NamedTuple):
+    """Where the hand stands to each of N targets now and after the operator's step:
+    `distances` d (N,), `next_offsets` r = p' - p_kappa (N, 3); with orientations
+    `angles` theta (N,) and `next_rotations` Log(q' q_kappa*) (N, 3), else None."""
+
+    distances: np.ndarray
+    next_offsets: np.ndarray
+    angles: typing.Optional[np.ndarray]
+    next_rotations: typing.Optional[np.ndarray]
+
+
+def _finite_vector(value, name, size=3):
+    value = np.asarray(value, dtype=float).reshape(-1)
+    if value.size != size:
+        raise ValueError(f"{name} must have {size} entries, got {value.size}")
+    if not np.isfinite(value).all():
+        raise ValueError(f"{name} is NaN or infinite: {value.tolist()}")
+    return value
+
+
+def target_geometry(settings, targets, position, velocity, orientation=None,
+                    angular_velocity=None):
+    """The `TargetGeometry` of the hand at `position` (and `orientation`, a unit quaternion,
+    when the targets have orientations) under the operator's `velocity` (and
+    `angular_velocity`, world frame), applied for `settings.cost_time_step`."""
+    position = _finite_vector(position, "position")
+    velocity = _finite_vector(velocity, "velocity")
+    step = settings.cost_time_step
+    distances = np.linalg.norm(targets.positions - position, axis=1)
+    next_offsets = position + velocity * step - targets.positions
+    if targets.orientations is None:
+        return TargetGeometry(distances, next_offsets, None, None)
+    if orientation is None:
+        raise ValueError("the targets have orientations: the hand's orientation is needed")
+    orientation = quaternion.unit_quaternions(orientation, "orientation").reshape(4)
+    angular_velocity = _finite_vector(
+        np.zeros(3) if angular_velocity is None else angular_velocity, "angular_velocity")
+    conjugates = quaternion.conjugate(targets.orientations.T)
+    angles = np.linalg.norm(quaternion.log_map(
+        quaternion.multiply(orientation[:, np.newaxis], conjugates)), axis=0)
+    turned = quaternion.multiply(quaternion.exp_map(angular_velocity * step), orientation)
+    next_rotations = quaternion.log_map(quaternion.multiply(turned[:, np.newaxis], conjugates))
+    return TargetGeometry(distances, next_offsets, angles, next_rotations.T)
+
+
+def target_costs(settings, geometry):
+    """`(Q_kappa (N,), V_kappa (N,))` of the module docstring."""
+    step = settings.cost_time_step
+    translation = _translation(settings)
+    q_values = (huber_step_cost(geometry.distances, *translation, step)
+                + huber_value(np.linalg.norm(geometry.next_offsets, axis=1), *translation))
+    values = huber_value(geometry.distances, *translation)
+    if geometry.angles is not None:
+        rotation = _rotation(settings)
+        weight = settings.rotation_weight
+        q_values = q_values + weight * (
+            huber_step_cost(geometry.angles, *rotation, step)
+            + huber_value(np.linalg.norm(geometry.next_rotations, axis=1), *rotation))
+        values = values + weight * huber_value(geometry.angles, *rotation)
+    return q_values, values
+
+
+def goal_minimum(per_target, targets):
+    """`(minimum (K,), target (K,))`: each goal's least value over its targets and the
+    index of the target that has it (the first of equals), vectorised over targets."""
+    per_target = np.asarray(per_target, dtype=float)
+    if targets.goal_count == len(per_target) and (targets.goals == np.arange(
+            targets.goal_count)).all():
+        return per_target, np.arange(targets.goal_count)
+    order = np.lexsort((per_target, targets.goals))
+    first = np.searchsorted(targets.goals[order], np.arange(targets.goal_count))
+    best = order[first]
+    return per_target[best], best
+
+
+class GoalCosts(typing.NamedTuple):
+    """Per goal: `q_values` Q_g (K,), `values` V_g (K,), `best_targets` (K,) the target of
+    least Q, and the `geometry` (per target) they came from."""
+
+    q_values: np.ndarray
+    values: np.ndarray
+    best_targets: np.ndarray
+    geometry: TargetGeometry
+
+
+def goal_costs(settings, targets, position, velocity, orientation=None,
+               angular_velocity=None):
+    """Q_g, V_g and each goal's best target (`GoalCosts`) for the hand and the operator's
+    command (see `target_geometry`)."""
+    geometry = target_geometry(settings, targets, position, velocity, orientation,
+                               angular_velocity)
+    q_per_target, v_per_target = target_costs(settings, geometry)
+    q_values, best = goal_minimum(q_per_target, targets)
+    values, _ = goal_minimum(v_per_target, targets)
+    return GoalCosts(q_values, values, best, geometry)
+
+
+# ---------------------------------------------------------------------------------------------
+# The posterior
+
+
+def uniform_log_belief(goal_count):
+    """The uniform prior, `log(1 / K)` for each of K goals."""
+    return np.full(int(goal_count), -math.log(goal_count))
+
+
+def log_normalised(log_belief):
+    """`log_belief - logsumexp(log_belief)`: the log of probabilities that sum to 1."""
+    log_belief = np.asarray(log_belief, dtype=float)
+    largest = log_belief.max()
+    return log_belief - (largest + math.log(np.exp(log_belief - largest).sum()))
+
+
+def clip_log_belief(log_belief, max_probability):
+    """`(log_belief, clipped)`: a normalised log belief with its largest probability set to
+    `max_probability` when above it and the excess spread evenly over the other goals;
+    `clipped` says whether it was above. One goal alone is never clipped."""
+    log_belief = np.array(log_belief, dtype=float)
+    count = len(log_belief)
+    best = int(np.argmax(log_belief))
+    if count == 1 or log_belief[best] <= math.log(max_probability):
+        return log_belief, False
+    excess = math.exp(log_belief[best]) - max_probability
+    share = math.log(excess / (count - 1)) if excess > 0.0 else -math.inf
+    log_belief = np.logaddexp(log_belief, share)
+    log_belief[best] = math.log(max_probability)
+    return log_belief, True
+
+
+class PosteriorUpdate(typing.NamedTuple):
+    """One update of the goal posterior: the new `log_belief` (K,), its `probabilities`
+    (K,), whether the clip was active (`clipped`) and the `costs` it read."""
+
+    log_belief: np.ndarray
+    probabilities: np.ndarray
+    clipped: bool
+    costs: GoalCosts
+
+
+def update_posterior(settings, targets, log_belief, position, velocity, orientation=None,
+                     angular_velocity=None):
+    """`log b_t = log b_{t-1} - (Q_g - V_g)`, normalised, then clipped at
+    `settings.max_probability` (`PosteriorUpdate`). `velocity` (and `angular_velocity`) is
+    the operator's command."""
+    log_belief = np.asarray(log_belief, dtype=float)
+    if log_belief.shape != (targets.goal_count,) or not np.isfinite(log_belief).all():
+        raise ValueError(f"log_belief must be {targets.goal_count} finite numbers, got "
+                         f"{log_belief!r}")
+    costs = goal_costs(settings, targets, position, velocity, orientation, angular_velocity)
+    updated = log_normalised(log_belief - (costs.q_values - costs.values))
+    updated, clipped = clip_log_belief(updated, settings.max_probability)
+    return PosteriorUpdate(updated, np.exp(updated), clipped, costs)
+
+
+# ---------------------------------------------------------------------------------------------
+# The assistance
+
+
+def _unit_rows(vectors, lengths):
+    safe = np.where(lengths > AT_TARGET, lengths, 1.0)
+    return np.where((lengths > AT_TARGET)[:, np.newaxis], vectors / safe[:, np.newaxis], 0.0)
+
+
+def goal_gradients(settings, costs):
+    """`(translation (K, 3), rotation (K, 3) or None)`: each goal's faded gradient of its
+    best target's value at the operator's next pose (module docstring), not yet divided by
+    lambda."""
+    geometry, best = costs.geometry, costs.best_targets
+    offsets = geometry.next_offsets[best]
+    lengths = np.linalg.norm(offsets, axis=1)
+    fade = np.minimum(1.0, geometry.distances[best] / settings.translation_fade_distance)
+    translation = (huber_slope(lengths, *_translation(settings)) * fade)[:, np.newaxis] * \
+        _unit_rows(offsets, lengths)
+    if geometry.angles is None:
+        return translation, None
+    rotations = geometry.next_rotations[best]
+    angles = np.linalg.norm(rotations, axis=1)
+    fade = np.minimum(1.0, geometry.angles[best] / settings.rotation_fade_angle)
+    rotation = (settings.rotation_weight * huber_slope(angles, *_rotation(settings))
+                * fade)[:, np.newaxis] * _unit_rows(rotations, angles)
+    return translation, rotation
+
+
+def assistance_action(settings, costs, weights):
+    """`(linear (3,), angular (3,) or None)`: `-(1/lambda) (sum_g w_g grad Q_g) / sum w`,
+    the assistance for goal weights `weights` (K,) (the belief for HOP); zeros when every
+    weight is 0 (policy blending passing the operator through)."""
+    weights = np.asarray(weights, dtype=float)
+    translation, rotation = goal_gradients(settings, costs)
+    total = weights.sum()
+    if not total > 0.0:
+        return np.zeros(3), None if rotation is None else np.zeros(3)
+    linear = -(weights @ translation) / (total * settings.translation_divisor)
+    if rotation is None:
+        return linear, None
+    return linear, -(weights @ rotation) / (total * settings.rotation_divisor)
+
+
+def blending_weights(probabilities, threshold):
+    """Policy blending's goal weights: one-hot on the most probable goal when it beats the
+    second by more than `threshold`, else all 0 (the operator alone). With one goal its
+    margin is its probability, 1."""
+    probabilities = np.asarray(probabilities, dtype=float)
+    weights = np.zeros(len(probabilities))
+    best = int(np.argmax(probabilities))
+    others = np.delete(probabilities, best)
+    runner_up = others.max() if others.size else 0.0
+    if probabilities[best] - runner_up > threshold:
+        weights[best] = 1.0
+    return weights
+
+
+def assistance_weights(method, settings, probabilities):
+    """The goal weights the assistance of `method` (HOP_METHODS) uses: the belief itself
+    (``hop``) or policy blending's (``policy_blending``)."""
+    if method == "hop":
+        return np.asarray(probabilities, dtype=float)
+    if method == "policy_blending":
+        return blending_weights(probabilities, settings.blending_threshold)
+    raise ValueError(f"method {method!r} is unknown; choose one of {HOP_METHODS}")
+
+
+class AssistedCommand(typing.NamedTuple):
+    """The command of one tick: `velocity` (3,) and `angular_velocity` (3,) or None (the
+    operator's plus the assistance), and `assisting` (the weights were not all 0)."""
+
+    velocity: np.ndarray
+    angular_velocity: typing.Optional[np.ndarray]
+    assisting: bool
+
+
+def assisted_command(method, settings, targets, probabilities, position, velocity,
+                     orientation=None, angular_velocity=None):
+    """The command `u + a` of `method` for the belief `probabilities` (K,) and the
+    operator's command `u` = (`velocity`, `angular_velocity`) at the hand's pose."""
+    probabilities = np.asarray(probabilities, dtype=float)
+    if probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all():
+        raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers, "
+                         f"got {probabilities!r}")
+    weights = assistance_weights(method, settings, probabilities)
+    costs = goal_costs(settings, targets, position, velocity, orientation, angular_velocity)
+    linear, angular = assistance_action(settings, costs, weights)
+    velocity = _finite_vector(velocity, "velocity") + linear
+    if angular is not None:
+        angular = (np.zeros(3) if angular_velocity is None
+                   else _finite_vector(angular_velocity, "angular_velocity")) + angular
+    return AssistedCommand(velocity, angular, bool(weights.sum() > 0.0))

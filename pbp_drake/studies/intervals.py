@@ -1,0 +1,73 @@
+"""95 % confidence intervals of a method comparison's results, from its summary alone: the
+success rate's (Wilson's score interval) and the means' (Student's t, from the summary's
+mean and population standard deviation over the trials that ran), as a table below the
+results table (`pbp_drake.studies.report.results_table`)."""
+
+import math
+
+from pbp_drake.scenarios import METHOD_NAMES
+
+# The two-sided 95 % normal quantile of Wilson's interval.
+Z_95 = 1.959963984540054
+# The metrics whose mean gets an interval: (summary entry, column, digits).
+MEAN_METRICS = (("intervention_ratio", "intervention ratio", 3),
+                ("task_time", "task time (s)", 1),
+                ("collision_ratio", "collision ratio", 3),
+                ("posterior_clipped_ratio", "posterior at its clip", 3))
+
+
+def wilson_interval(successes, trials, z=Z_95):
+    """`(low, high)` of Wilson's score interval of a success rate, or None without trials."""
+    if trials <= 0:
+        return None
+    rate = successes / trials
+    scale = 1.0 + z * z / trials
+    centre = (rate + z * z / (2 * trials)) / scale
+    half = z * math.sqrt(rate * (1 - rate) / trials + z * z / (4 * trials * trials)) / scale
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def mean_interval(mean, population_std, count):
+    """`(low, high)` of the t interval of a mean of `count` values, from their mean and
+    population standard deviation; None for fewer than two values or no mean."""
+    if mean is None or population_std is None or count < 2:
+        return None
+    # Deferred: scipy.stats takes about 0.7 s to import, which every command would pay.
+    import scipy.stats
+    sample_std = population_std * math.sqrt(count / (count - 1))
+    half = float(scipy.stats.t.ppf(0.975, count - 1)) * sample_std / math.sqrt(count)
+    return mean - half, mean + half
+
+
+def _interval_cell(interval, digits, percent=False):
+    if interval is None:
+        return "-"
+    low, high = (100 * value for value in interval) if percent else interval
+    unit = " %" if percent else ""
+    return f"[{low:.{digits}f}, {high:.{digits}f}]{unit}"
+
+
+def confidence_table(summary):
+    """The Markdown lines of the 95 % intervals, one row per method: the success rate over
+    the trials on disk, and the mean of each metric the summary holds (collisions where the
+    task measures them, the posterior's clip where a method records it) over the trials
+    that ran."""
+    methods = summary["methods"]
+    metrics = [(key, column, digits) for key, column, digits in MEAN_METRICS
+               if any(key in entry for entry in methods.values())]
+    columns = ["method", "success", *(column for _, column, _ in metrics)]
+    lines = ["95 % confidence intervals: the success rate's (Wilson score) and each mean's "
+             "(Student's t, over the trials that ran).", "",
+             "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    for method, entry in methods.items():
+        rate = entry["success_rate"]
+        success = (None if rate is None else
+                   wilson_interval(round(rate * entry["trials"]), entry["trials"]))
+        ran = entry["trials"] - entry["errors"]
+        cells = [METHOD_NAMES.get(method, method), _interval_cell(success, 0, percent=True)]
+        for key, _, digits in metrics:
+            value = entry.get(key)
+            cells.append("-" if value is None else _interval_cell(
+                mean_interval(value["mean"], value["std"], ran), digits))
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines

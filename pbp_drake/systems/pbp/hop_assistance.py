@@ -1,0 +1,100 @@
+"""HOP's assistance as a Drake system: the operator's velocity plus the belief-weighted
+cost gradient (``hop``), or policy blending's all-or-nothing assistance
+(``policy_blending``), as the reference the hand-over passes on
+(`pbp_drake.core.hindsight_optimization.assisted_command`)."""
+
+import dataclasses
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core.hindsight_optimization import (
+    HOP_METHODS, HopSettings, assisted_command, hop_targets)
+
+
+class HopAssistanceBase(LeafSystem):
+    """What `HopAssistance` and `PoseHopAssistance` share: the method, the settings, the
+    control period and the checks of them."""
+
+    def __init__(self, method, goal_count, settings, control_period):
+        super().__init__()
+        if method not in HOP_METHODS:
+            raise ValueError(f"method {method!r} is unknown; choose one of {HOP_METHODS}")
+        if not isinstance(settings, HopSettings):
+            raise ValueError(f"settings must be a HopSettings, got {type(settings).__name__}")
+        settings.validate()
+        if not (np.isfinite(control_period) and control_period > 0.0):
+            raise ValueError(f"control_period must be positive, got {control_period!r}")
+        self._method = method
+        self._goal_count = int(goal_count)
+        self._settings = dataclasses.replace(settings)
+        self._period = float(control_period)
+
+    @property
+    def method(self):
+        return self._method
+
+    @property
+    def settings(self):
+        return self._settings
+
+
+class HopAssistance(HopAssistanceBase):
+    """The command of ``hop`` or ``policy_blending`` in the position tasks.
+
+    .. pydrake_system::
+
+        name: HopAssistance
+        input_ports:
+        - robot_state
+        - goals
+        - operator_command
+        - goal_probabilities
+        output_ports:
+        - command
+
+    `robot_state` is the hand's `[p (3), v (3)]` sampled at the tick, `goals` the K goals
+    flattened `(K, 3)`, `operator_command` the operator's velocity (3), `goal_probabilities`
+    the belief (`MaxEntGoalEstimator`'s). The velocity commanded is `u + a`
+    (`assisted_command`): `a` weighted by the belief (``hop``), or toward the most probable
+    goal alone once it leads the second by more than `settings.blending_threshold`, else 0
+    (``policy_blending``). `command` is `[p + (u + a) control_period, u + a]`, the reference
+    of one control period, as `Blender`'s, for the `HandOver`. A NaN or infinite command
+    raises.
+    """
+
+    def __init__(self, method, goal_count, settings, control_period):
+        super().__init__(method, goal_count, settings, control_period)
+        k = self._goal_count
+        self._robot_state_port = self.DeclareVectorInputPort("robot_state", 6)
+        self._goals_port = self.DeclareVectorInputPort("goals", 3 * k)
+        self._operator_command_port = self.DeclareVectorInputPort("operator_command", 3)
+        self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
+        # A function of the inputs alone: not redone between the control ticks.
+        self._command_port = self.DeclareVectorOutputPort(
+            "command", 6, self._calc_command,
+            prerequisites_of_calc={self.all_input_ports_ticket()})
+
+    def get_robot_state_input_port(self):
+        return self._robot_state_port
+
+    def get_goals_input_port(self):
+        return self._goals_port
+
+    def get_operator_command_input_port(self):
+        return self._operator_command_port
+
+    def get_goal_probabilities_input_port(self):
+        return self._probabilities_port
+
+    def get_command_output_port(self):
+        return self._command_port
+
+    def _calc_command(self, context, output):
+        position = self._robot_state_port.Eval(context)[:3]
+        targets = hop_targets(self._goals_port.Eval(context).reshape(self._goal_count, 3))
+        command = assisted_command(self._method, self._settings, targets,
+                                   self._probabilities_port.Eval(context), position,
+                                   self._operator_command_port.Eval(context))
+        output.SetFromVector(np.concatenate([position + command.velocity * self._period,
+                                             command.velocity]))

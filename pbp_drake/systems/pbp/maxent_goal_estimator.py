@@ -1,0 +1,152 @@
+"""HOP's goal posterior as a Drake system: which of K goals the operator means, read from
+the operator's command (`pbp_drake.core.hindsight_optimization`). `CommandPosteriorBase`
+holds what it shares with the six-DoF `PoseMaxEntGoalEstimator`."""
+
+import dataclasses
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from pbp_drake.core.goal_estimation import NO_CHALLENGER, SelectionMemory, update_selection
+from pbp_drake.core.hindsight_optimization import (
+    HopSettings, hop_targets, uniform_log_belief, update_posterior)
+from pbp_drake.systems.ports import EeState, OperatorCommand
+from pbp_drake.systems.tick import decide_offset
+
+
+class CommandPosteriorBase(LeafSystem):
+    """What `MaxEntGoalEstimator` and `PoseMaxEntGoalEstimator` share: the log belief, the
+    selection with the shipped hysteresis (`goal_estimation.update_selection`) and whether
+    the last update was clipped, all in the Context's discrete state; the outputs
+    `selected_goal`, `goal_probabilities` and `posterior_clipped`. A subclass declares its
+    input ports (`_declare_inputs`) and reads them (`_inputs(context) -> (targets, position,
+    velocity, orientation, angular_velocity)`)."""
+
+    def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
+                 update_offset=None):
+        super().__init__()
+        if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
+            raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
+        if not isinstance(settings, HopSettings):
+            raise ValueError(f"settings must be a HopSettings, got {type(settings).__name__}")
+        settings.validate()
+        if not (np.isfinite(control_period) and control_period > 0.0):
+            raise ValueError(f"control_period must be positive, got {control_period!r}")
+        if not 0.0 <= margin < 1.0:
+            raise ValueError(f"margin must lie in [0, 1), got {margin!r}")
+        if isinstance(hold_steps, bool) or int(hold_steps) != hold_steps or hold_steps < 1:
+            raise ValueError(f"hold_steps must be an integer >= 1, got {hold_steps!r}")
+        if update_offset is None:
+            update_offset = decide_offset(control_period)
+        k = self._goal_count = int(goal_count)
+        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
+        self._settings = dataclasses.replace(settings)
+        self._margin, self._hold_steps = float(margin), int(hold_steps)
+        self._declare_inputs(k)
+        self._log_belief_index = self.DeclareDiscreteState(uniform_log_belief(k))
+        self._selected_index = self.DeclareDiscreteState(np.zeros(1))
+        self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
+        # [challenger, count] of the hysteresis (`SelectionMemory`), and the clip's flag.
+        self._memory_index = self.DeclareDiscreteState(np.array([NO_CHALLENGER, 0.0]))
+        self._clipped_index = self.DeclareDiscreteState(np.zeros(1))
+        self._selected_port = self.DeclareStateOutputPort("selected_goal",
+                                                          self._selected_index)
+        self._probabilities_port = self.DeclareStateOutputPort("goal_probabilities",
+                                                               self._probabilities_index)
+        self._clipped_port = self.DeclareStateOutputPort("posterior_clipped",
+                                                         self._clipped_index)
+        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period), update_offset,
+                                                self._update)
+
+    @property
+    def goal_count(self):
+        return self._goal_count
+
+    @property
+    def settings(self):
+        return self._settings
+
+    @property
+    def margin(self):
+        return self._margin
+
+    @property
+    def hold_steps(self):
+        return self._hold_steps
+
+    def get_selected_goal_output_port(self):
+        return self._selected_port
+
+    def get_goal_probabilities_output_port(self):
+        return self._probabilities_port
+
+    def get_posterior_clipped_output_port(self):
+        return self._clipped_port
+
+    def _update(self, context, discrete_state):
+        state = context.get_discrete_state()
+        targets, position, velocity, orientation, angular_velocity = self._inputs(context)
+        update = update_posterior(self._settings, targets,
+                                  state.value(self._log_belief_index), position, velocity,
+                                  orientation, angular_velocity)
+        challenger, count = state.value(self._memory_index)
+        memory = update_selection(
+            update.probabilities,
+            SelectionMemory(int(state.value(self._selected_index)[0]), int(challenger),
+                            int(count)),
+            self._margin, self._hold_steps)
+        discrete_state.set_value(self._log_belief_index, update.log_belief)
+        discrete_state.set_value(self._probabilities_index, update.probabilities)
+        discrete_state.set_value(self._selected_index, [memory.selected])
+        discrete_state.set_value(self._memory_index, [memory.challenger, memory.count])
+        discrete_state.set_value(self._clipped_index, [1.0 if update.clipped else 0.0])
+
+
+class MaxEntGoalEstimator(CommandPosteriorBase):
+    """HOP's goal posterior on the hand's position and the operator's velocity command
+    (`pbp_drake.core.hindsight_optimization.update_posterior`): the ``maxent_command`` goal
+    estimator of PBP, and the belief of the ``hop`` and ``policy_blending`` methods.
+
+    .. pydrake_system::
+
+        name: MaxEntGoalEstimator
+        input_ports:
+        - ee_state
+        - goals
+        - operator_command
+        output_ports:
+        - selected_goal
+        - goal_probabilities
+        - posterior_clipped
+
+    `ee_state` is `EeState`, `goals` the K goals flattened `(K, 3)` (each goal one target),
+    `operator_command` the operator's `OperatorCommand` `[vx, vy, vz, yaw_rate]`, of which
+    the velocity is read (the hand's own velocity is mostly the robot's). The belief starts
+    uniform, and each update, at the decide stage of the tick (`update_offset` overrides
+    it), it moves by `-(Q_g - V_g)` and is clipped at `settings.max_probability`; the
+    selection is the most probable goal, moved with the hysteresis of `margin` and
+    `hold_steps` (0 and 1: at once). `goal_probabilities` (K), `selected_goal` `[index]`
+    and `posterior_clipped` (`[1]` when the last update was clipped, else `[0]`) are read
+    from the state, so they hold between updates.
+    """
+
+    def _declare_inputs(self, goal_count):
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        self._goals_port = self.DeclareVectorInputPort("goals", 3 * goal_count)
+        self._command_port = self.DeclareVectorInputPort("operator_command",
+                                                         OperatorCommand.size)
+
+    def get_ee_state_input_port(self):
+        return self._ee_state_port
+
+    def get_goals_input_port(self):
+        return self._goals_port
+
+    def get_operator_command_input_port(self):
+        return self._command_port
+
+    def _inputs(self, context):
+        targets = hop_targets(self._goals_port.Eval(context).reshape(self._goal_count, 3))
+        position = self._ee_state_port.Eval(context)[:3]
+        velocity = self._command_port.Eval(context)[:3]
+        return targets, position, velocity, None, None

@@ -1,0 +1,57 @@
+"""HOP's goal posterior on the hand's pose as a Drake system: which of K grasp poses the
+operator means, read from the operator's twist (`pbp_drake.core.hindsight_optimization`)."""
+
+import numpy as np
+
+from pbp_drake.core.hindsight_optimization import hop_targets
+from pbp_drake.systems.pbp.maxent_goal_estimator import CommandPosteriorBase
+from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
+
+
+class PoseMaxEntGoalEstimator(CommandPosteriorBase):
+    """HOP's goal posterior with position and orientation terms, on the hand's pose and the
+    operator's twist: the grasping task's ``maxent_command`` goal estimator, and the belief
+    of its ``hop`` and ``policy_blending`` methods (`MaxEntGoalEstimator` with the pose).
+
+    .. pydrake_system::
+
+        name: PoseMaxEntGoalEstimator
+        input_ports:
+        - hand_pose
+        - goal_poses
+        - operator_twist
+        output_ports:
+        - selected_goal
+        - goal_probabilities
+        - posterior_clipped
+
+    `hand_pose` is the hand's `PoseState`, `goal_poses` the K `GoalPose` rows `[x, y, z, qw,
+    qx, qy, qz]` flattened (each goal one target: its grasp pose), `operator_twist` the
+    operator's `OperatorTwist` (world frame). A goal's cost adds the translation term on
+    the distance to its grasp position and `settings.rotation_weight` times the rotation
+    term on the angle to its grasp orientation. Updates, selection and outputs are
+    `MaxEntGoalEstimator`'s.
+    """
+
+    def _declare_inputs(self, goal_count):
+        self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
+        self._goals_port = self.DeclareVectorInputPort("goal_poses",
+                                                       goal_count * GoalPose.size)
+        self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
+
+    def get_hand_pose_input_port(self):
+        return self._hand_port
+
+    def get_goal_poses_input_port(self):
+        return self._goals_port
+
+    def get_operator_twist_input_port(self):
+        return self._twist_port
+
+    def _inputs(self, context):
+        poses = self._goals_port.Eval(context).reshape(self._goal_count, GoalPose.size)
+        targets = hop_targets(poses[:, :3], poses[:, 3:])
+        hand = self._hand_port.Eval(context)
+        twist = self._twist_port.Eval(context)
+        orientation = hand[3:7] / np.linalg.norm(hand[3:7])
+        return targets, hand[:3], twist[:3], orientation, twist[3:]

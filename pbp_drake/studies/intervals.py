@@ -1,7 +1,8 @@
 """95 % confidence intervals of a method comparison's results, from its summary alone: the
 success rate's (Wilson's score interval) and the means' (Student's t, from the summary's
-mean and population standard deviation over the trials that ran), as a table below the
-results table (`pbp_drake.studies.report.results_table`)."""
+mean and population standard deviation over the trials that ran, cut to the range the
+metric can take: a ratio's [0, 1], a time's [0, inf)), as a table below the results table
+(`pbp_drake.studies.report.results_table`)."""
 
 import math
 
@@ -9,11 +10,13 @@ from pbp_drake.scenarios import METHOD_NAMES
 
 # The two-sided 95 % normal quantile of Wilson's interval.
 Z_95 = 1.959963984540054
-# The metrics whose mean gets an interval: (summary entry, column, digits).
-MEAN_METRICS = (("intervention_ratio", "intervention ratio", 3),
-                ("task_time", "task time (s)", 1),
-                ("collision_ratio", "collision ratio", 3),
-                ("posterior_clipped_ratio", "posterior at its clip", 3))
+# The metrics whose mean gets an interval: (summary entry, column, digits, the range of
+# the metric's values).
+RATIO, TIME = (0.0, 1.0), (0.0, math.inf)
+MEAN_METRICS = (("intervention_ratio", "intervention ratio", 3, RATIO),
+                ("task_time", "task time (s)", 1, TIME),
+                ("collision_ratio", "collision ratio", 3, RATIO),
+                ("posterior_clipped_ratio", "posterior at its clip", 3, RATIO))
 
 
 def wilson_interval(successes, trials, z=Z_95):
@@ -27,16 +30,17 @@ def wilson_interval(successes, trials, z=Z_95):
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
-def mean_interval(mean, population_std, count):
+def mean_interval(mean, population_std, count, within=(-math.inf, math.inf)):
     """`(low, high)` of the t interval of a mean of `count` values, from their mean and
-    population standard deviation; None for fewer than two values or no mean."""
+    population standard deviation, cut to the range `within` the values lie in; None for
+    fewer than two values or no mean."""
     if mean is None or population_std is None or count < 2:
         return None
     # Deferred: scipy.stats takes about 0.7 s to import, which every command would pay.
     import scipy.stats
     sample_std = population_std * math.sqrt(count / (count - 1))
     half = float(scipy.stats.t.ppf(0.975, count - 1)) * sample_std / math.sqrt(count)
-    return mean - half, mean + half
+    return max(within[0], mean - half), min(within[1], mean + half)
 
 
 def _interval_cell(interval, digits, percent=False):
@@ -53,11 +57,11 @@ def confidence_table(summary):
     task measures them, the posterior's clip where a method records it) over the trials
     that ran."""
     methods = summary["methods"]
-    metrics = [(key, column, digits) for key, column, digits in MEAN_METRICS
-               if any(key in entry for entry in methods.values())]
-    columns = ["method", "success", *(column for _, column, _ in metrics)]
+    metrics = [metric for metric in MEAN_METRICS
+               if any(metric[0] in entry for entry in methods.values())]
+    columns = ["method", "success", *(column for _, column, _, _ in metrics)]
     lines = ["95 % confidence intervals: the success rate's (Wilson score) and each mean's "
-             "(Student's t, over the trials that ran).", "",
+             "(Student's t over the trials that ran, within the metric's range).", "",
              "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for method, entry in methods.items():
         rate = entry["success_rate"]
@@ -65,9 +69,9 @@ def confidence_table(summary):
                    wilson_interval(round(rate * entry["trials"]), entry["trials"]))
         ran = entry["trials"] - entry["errors"]
         cells = [METHOD_NAMES.get(method, method), _interval_cell(success, 0, percent=True)]
-        for key, _, digits in metrics:
+        for key, _, digits, within in metrics:
             value = entry.get(key)
             cells.append("-" if value is None else _interval_cell(
-                mean_interval(value["mean"], value["std"], ran), digits))
+                mean_interval(value["mean"], value["std"], ran, within), digits))
         lines.append("| " + " | ".join(cells) + " |")
     return lines

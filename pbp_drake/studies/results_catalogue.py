@@ -18,6 +18,9 @@ REACH = ["diagrams/hsr_reach.yaml", "--methods",
 OBSTACLES = ["diagrams/hsr_obstacles.yaml", "--trials", "30"]
 FIXED_ALPHAS = ",".join(f"fixed_alpha=0.{tenth}" for tenth in range(1, 10))
 PBP = "pbp_alternated,pbp_continuous"
+# PBP beside the shared-autonomy baselines (docs/results/baselines.md) and teleop.
+BASELINES = ["--methods", "pbp_alternated,pbp_continuous,hop,policy_blending,teleop",
+             "--trials", "30", "--split", "evaluation"]
 
 #: name -> the arguments of `pbp-drake study` (without --output and --jobs).
 STUDIES = {
@@ -40,6 +43,11 @@ STUDIES = {
     "hsr_grasp_evaluation": ["diagrams/hsr_grasp.yaml", "--methods",
                              "pbp_alternated,pbp_continuous,teleop", "--trials", "30",
                              "--split", "evaluation"],
+    "hsr_reach_baselines": ["diagrams/hsr_reach.yaml", *BASELINES],
+    "hsr_obstacles_baselines": ["diagrams/hsr_obstacles.yaml", *BASELINES],
+    "hsr_grasp_baselines": ["diagrams/hsr_grasp.yaml", *BASELINES],
+    "hsr_reach_maxent": ["diagrams/hsr_reach_maxent.yaml", "--methods", PBP,
+                         "--trials", "30", "--split", "evaluation"],
 }
 
 

@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from pydrake.systems.analysis import Simulator
 
 from pbp_drake.builder import build_diagram, find_system, run_task
 from pbp_drake.builder.streamed_run import run_task_streamed
@@ -97,3 +98,14 @@ def test_the_grasp_task_with_hops_posterior(repo, method, estimator):
     assert result.success
     assert result.final_angle_to_target <= 10.0
     assert np.isfinite(result.posterior_clipped_ratio)
+
+
+@pytest.mark.parametrize("name", ["hsr_reach.yaml", "hsr_grasp.yaml"])
+def test_the_baselines_draw_their_scene_without_dmp_paths(repo, meshcat, name):
+    """With Meshcat the scene is drawn as under PBP, without the DMPs' predicted paths."""
+    resolved = scenario(repo, name, "hop")
+    diagram = build_diagram(resolved, meshcat)
+    assert diagram.HasSubsystemNamed("task_visualizer")
+    simulator = Simulator(diagram)
+    simulator.AdvanceTo(0.5)
+    assert meshcat.HasPath("/task/objects/0") and meshcat.HasPath("/task/target")

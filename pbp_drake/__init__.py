@@ -35,6 +35,7 @@ API_GROUPS = {
         "blend_pose": "pbp_drake.core.pose_arbitration",
         "pose_hand_over": "pbp_drake.core.pose_arbitration",
         "VirtualParticipantParams": "pbp_drake.core.participant_params",
+        "ParticipantImpairment": "pbp_drake.core.participant_impairment",
         "GraspParticipantParams": "pbp_drake.core.participant_grasp",
     },
     "Shared-autonomy baselines (HOP, policy blending)": {

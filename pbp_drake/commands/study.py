@@ -9,9 +9,11 @@ import time
 
 from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import method_list
+from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
-    Hsr, MethodComparison, ScenarioError, check_method_comparison, counted, load_scenario_file)
+    Hsr, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison, counted,
+    load_scenario_file)
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.paired import paired_comparison, paired_table
 from pbp_drake.studies.participant_report import is_participant_collection, participant_report
@@ -51,6 +53,12 @@ def add_study_commands(commands):
                        "--jobs CPUs")
     study.add_argument("--retry-errors", action="store_true",
                        help="HSR tasks: run again the trials on disk that failed with an error")
+    study.add_argument("--participant-condition", choices=tuple(PARTICIPANT_CONDITIONS),
+                       help="HSR tasks with the virtual participant: impair it, in place of "
+                       "the file's `impairment`: noisy (motor noise of 0.3 times its speed, "
+                       "held about 0.5 s), late (its commands 0.3 s late) or mistaken (one "
+                       "target in five first mistaken for another, for 1 s); recorded in "
+                       "study.json and named in the results")
 
     report = commands.add_parser(
         "report", help="rebuild the summary, table and figures of a study folder from its "
@@ -85,6 +93,10 @@ def _study(args):
     check_buildable(scenario_file.resolved)
     if isinstance(scenario_file.scenario.robot, Hsr):
         return _method_study(args, scenario_file)
+    if args.participant_condition is not None:
+        raise ScenarioError(f"--participant-condition {args.participant_condition}: "
+                            f"{args.scenario} is a 2-D study, which has no virtual "
+                            "participant; the HSR tasks' studies take it")
     if scenario_file.study is None:
         raise ScenarioError(f"{args.scenario}: has no `study:` section to run")
     output = pathlib.Path(args.output)
@@ -104,7 +116,25 @@ def _study(args):
     return 0
 
 
+def with_participant_condition(scenario, name, scenario_path):
+    """`scenario` with its virtual participant impaired as the named condition says
+    (`PARTICIPANT_CONDITIONS`, replacing the file's `impairment`); ScenarioError when its
+    operator is not the virtual participant."""
+    operator = scenario.operator
+    if not isinstance(operator, VirtualParticipant):
+        raise ScenarioError(
+            f"--participant-condition {name}: {scenario_path}'s scenario.operator is "
+            f"!{type(operator).__name__}, not the virtual participant; the condition impairs "
+            "operator: !VirtualParticipant only")
+    return dataclasses.replace(
+        scenario, operator=dataclasses.replace(operator, impairment=condition(name)))
+
+
 def _method_study(args, scenario_file):
+    scenario = scenario_file.scenario
+    if args.participant_condition is not None:
+        scenario = with_participant_condition(scenario, args.participant_condition,
+                                              args.scenario)
     study = scenario_file.study or MethodComparison()
     if not isinstance(study, MethodComparison):
         raise ScenarioError(f"{args.scenario}: HSR tasks take study: !MethodComparison")
@@ -123,14 +153,16 @@ def _method_study(args, scenario_file):
     if len(set(study.methods)) != len(study.methods):
         raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
     try:
-        check_method_comparison(study, scenario_file.scenario)
+        check_method_comparison(study, scenario)
     except ScenarioError as error:
         raise ScenarioError(f"{error} (after the command-line overrides)") from None
     output = pathlib.Path(args.output)
     total = len(study.methods) * study.trials
-    print(f"Study {scenario_file.scenario.name}: {', '.join(study.methods)}, "
+    condition_words = ("" if args.participant_condition is None else
+                       f", the {args.participant_condition} virtual participant")
+    print(f"Study {scenario.name}: {', '.join(study.methods)}, "
           f"{counted(study.trials, 'trial')} each ({split} seeds {seed} to "
-          f"{seed + study.trials - 1}),"
+          f"{seed + study.trials - 1}){condition_words},"
           f" {args.jobs} job{'s' if args.jobs > 1 else ''}"
           + ("" if args.backend == "local" else
              f" on Ray ({args.ray_address or 'local'})") + f", into {output}", flush=True)
@@ -143,13 +175,14 @@ def _method_study(args, scenario_file):
 
     started = time.monotonic()
     try:
-        summary = run_method_comparison(scenario_file.scenario, study.methods, study.trials,
+        summary = run_method_comparison(scenario, study.methods, study.trials,
                                         seed, output, progress, jobs=args.jobs, split=split,
                                         retry_errors=args.retry_errors,
                                         backend=args.backend, ray_address=args.ray_address,
                                         scenario_file=args.scenario,
                                         split_seeds={split_name: first_seed(study, split_name)
-                                                     for split_name in SPLITS})
+                                                     for split_name in SPLITS},
+                                        participant_condition=args.participant_condition)
     except KeyboardInterrupt:
         print(f"\nInterrupted: the finished trials are in {output / 'trials'}; the same "
               "command resumes the study.", file=sys.stderr)

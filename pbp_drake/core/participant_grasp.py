@@ -30,14 +30,22 @@ N(0, `direction_noise`) rad about an axis perpendicular to it, the whole twist s
 (1 + N(0, `speed_noise`)), clipped at 0. Everything is a pure function of its arguments;
 the little it remembers (`ParticipantMemory`) is passed in and returned, so a LeafSystem
 keeps it in its discrete state.
+
+Its `impairment` (`pbp_drake.core.participant_impairment`; none by default) works as the
+reach participant's: the motor noise a system passes in (`motor_noise`, on `v` and `omega`)
+is added while it acts, never forward when assisting; each time it comes to know a target
+it may first head for another object's grasp pose (position and orientation) for
+`mistake_time`; the system delays its commands by `command_delay`.
 """
 
+import copy
 import dataclasses
 import typing
 
 import numpy as np
 
 from pbp_drake.core.grasp_task import approach_direction
+from pbp_drake.core.participant_impairment import ParticipantImpairment, first_choice
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.quaternion import angle_between, conjugate, exp_map, log_map, multiply
 
@@ -54,7 +62,8 @@ SHARED_WITH_REACH = {
     "speed": "speed", "rotation_speed": "rotation_speed", "reaction_delay": "reaction_delay",
     "direction_noise": "direction_noise", "speed_noise": "speed_noise",
     "slow_radius": "slow_radius", "slow_angle": "turn_slowdown_angle",
-    "aligned_angle": "aligned_angle", "insist_time": "insist_time"}
+    "aligned_angle": "aligned_angle", "insist_time": "insist_time",
+    "impairment": "impairment"}
 
 
 @dataclasses.dataclass
@@ -85,16 +94,22 @@ class GraspParticipantParams:
     #: Assisting, once it has held the target's orientation this long (s) and the estimate
     #: still names another object, it goes to the target itself (`insist_twist`).
     insist_time: float = _REACH_DEFAULTS.insist_time
+    #: How it is impaired (`ParticipantImpairment`; the defaults: not at all).
+    impairment: ParticipantImpairment = dataclasses.field(
+        default_factory=ParticipantImpairment)
 
     @classmethod
     def from_virtual_participant(cls, params):
         """The grasp participant with the fields a `VirtualParticipantParams` shares with
         it (its `turn_slowdown_angle` is `slow_angle` here)."""
-        return cls(**{name: getattr(params, reach_name)
+        return cls(**{name: copy.deepcopy(getattr(params, reach_name))
                       for name, reach_name in SHARED_WITH_REACH.items()})
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
+        problem = self.impairment.problem()
+        if problem is not None:
+            raise ValueError(f"impairment.{problem}")
         for name in ("rotation_speed", "slow_radius", "slow_angle"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
@@ -110,19 +125,26 @@ class ParticipantMemory(typing.NamedTuple):
     """What it remembers between ticks: the target it acts on (`NO_TARGET` before the
     first is noticed), the newest target it has seen and since when (s), since when (s,
     -1: not) it has held the known target's orientation while the estimate named another
-    object, and whether it insists (`insist_twist`)."""
+    object, and whether it insists (`insist_twist`); with an impairment's mistakes, how
+    many targets it has come to know, the object it heads for instead of the known target
+    (`NO_TARGET`: none) and until when (s)."""
 
     known_target: int = NO_TARGET
     seen_target: int = NO_TARGET
     seen_since: float = 0.0
     facing_since: float = -1.0
     insisting: bool = False
+    targets_known: int = 0
+    mistaken_for: int = NO_TARGET
+    mistaken_until: float = 0.0
 
     @classmethod
     def from_array(cls, values):
         """The memory a system kept as floats (`np.array(memory, dtype=float)`)."""
-        known, seen, since, facing, insisting = values
-        return cls(int(known), int(seen), float(since), float(facing), bool(insisting))
+        (known, seen, since, facing, insisting, targets_known, mistaken_for,
+         mistaken_until) = values
+        return cls(int(known), int(seen), float(since), float(facing), bool(insisting),
+                   int(targets_known), int(mistaken_for), float(mistaken_until))
 
 
 def notice_target(memory, true_target, time, reaction_delay):
@@ -138,13 +160,41 @@ def notice_target(memory, true_target, time, reaction_delay):
     return memory
 
 
-def count_insistence(params, memory, time, orientation, target_orientation, selected):
+def choose_first(impairment, memory, known_before, time, seed, object_count):
+    """The memory after a tick that may have made a new target known (`known_before` the
+    known target before it): it may first head for another of the `object_count` objects
+    (`first_choice`, its `targets_known`-th target) until `mistake_time` has passed; then
+    it sees its mistake, and counts its patience (`insist_time`) anew."""
+    if memory.known_target != known_before and memory.known_target != NO_TARGET:
+        choice = first_choice(impairment, seed, memory.targets_known, memory.known_target,
+                              object_count)
+        return memory._replace(
+            targets_known=memory.targets_known + 1,
+            mistaken_for=NO_TARGET if choice == memory.known_target else choice,
+            mistaken_until=float(time) + impairment.mistake_time)
+    if memory.mistaken_for != NO_TARGET and time >= memory.mistaken_until - 1e-9:
+        return memory._replace(mistaken_for=NO_TARGET, facing_since=-1.0, insisting=False)
+    return memory
+
+
+def heads_for(memory, time):
+    """The object it heads for: the known target, or the one it mistook it for while its
+    mistake lasts."""
+    if memory.mistaken_for != NO_TARGET and time < memory.mistaken_until - 1e-9:
+        return memory.mistaken_for
+    return memory.known_target
+
+
+def count_insistence(params, memory, time, orientation, target_orientation, selected,
+                     target=None):
     """The memory after a tick in which the estimate names `selected`: it starts insisting
-    once it has held the known target's orientation (within twice `aligned_angle`, as noise
-    moves it) for `insist_time` while `selected` was another object."""
+    once it has held the orientation of the object it heads for (`target`, by default the
+    known target; within twice `aligned_angle`, as noise moves it) for `insist_time` while
+    `selected` was another object."""
     if memory.insisting:
         return memory
-    if selected == memory.known_target or angle_between(
+    target = memory.known_target if target is None else target
+    if selected == target or angle_between(
             orientation, target_orientation) > 2 * params.aligned_angle:
         return memory._replace(facing_since=-1.0)
     since = memory.facing_since if memory.facing_since >= 0.0 else float(time)
@@ -263,14 +313,28 @@ class GraspParticipant:
                              f"{orientations.shape}")
         return cls(params, mode, speed, positions, orientations, int(seed))
 
-    def step(self, memory, time, tick, position, orientation, true_target, selected):
+    @property
+    def motor_noise_scales(self):
+        """The standard deviation of its motor noise on each axis of its twist
+        `[v (3, m/s), omega (3, rad/s)]` (`ParticipantImpairment.command_noise`)."""
+        noise = self.params.impairment.command_noise
+        return noise * np.repeat([self.speed, self.params.rotation_speed], 3)
+
+    def step(self, memory, time, tick, position, orientation, true_target, selected,
+             motor_noise=None):
         """One tick: `(twist (6,) [v, omega], active, memory)`.
 
         `time` (s) and `tick` (an integer, the noise's draw) of this tick; the hand's
         `position` (3) and `orientation` (4, w x y z); `true_target` the object the task
-        wants; `selected` the estimator's selection (ignored in teleop)."""
+        wants; `selected` the estimator's selection (ignored in teleop); `motor_noise` (6,
+        or None) this tick's motor noise (`participant_impairment.next_motor_noise`), added
+        to its twist while it acts."""
+        known_before = memory.known_target
         memory = notice_target(memory, true_target, time, self.params.reaction_delay)
-        target = memory.known_target
+        if self.params.impairment.mistake_probability > 0.0:
+            memory = choose_first(self.params.impairment, memory, known_before, time,
+                                  self.seed, len(self.grasp_positions))
+        target = heads_for(memory, time)
         idle = np.zeros(6)
         if target == NO_TARGET:
             return idle, False, memory
@@ -278,7 +342,8 @@ class GraspParticipant:
         orientation = np.asarray(orientation, float)
         if self.mode == "assist":
             memory = count_insistence(self.params, memory, time, orientation,
-                                      self.grasp_orientations[target], int(selected))
+                                      self.grasp_orientations[target], int(selected),
+                                      target)
             if int(selected) == target:
                 return idle, False, memory
             if memory.insisting:
@@ -300,4 +365,9 @@ class GraspParticipant:
         if self.mode == "assist":
             # The noise may turn a sidestep forward; the forward key stays disabled.
             velocity = without_forward(velocity, orientation)
-        return scale * np.concatenate([velocity, angular]), True, memory
+        twist = scale * np.concatenate([velocity, angular])
+        if motor_noise is not None:
+            twist = twist + np.asarray(motor_noise, float)
+            if self.mode == "assist":
+                twist[:3] = without_forward(twist[:3], orientation)
+        return twist, True, memory

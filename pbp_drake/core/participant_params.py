@@ -5,6 +5,8 @@ participant (`pbp_drake.systems.operators.virtual_operator`) reads them, and the
 
 import dataclasses
 
+from pbp_drake.core.participant_impairment import ParticipantImpairment
+
 
 @dataclasses.dataclass
 class VirtualParticipantParams:
@@ -12,7 +14,8 @@ class VirtualParticipantParams:
     the task's nominal speed, that of its DMPs. Its noise comes from the scenario's seed.
 
     The defaults are the reach task's calibration: teleop only, on the tuning
-    seeds, to the paper's users' teleop intervention ratio (0.92 to 0.95).
+    seeds, to the paper's users' teleop intervention ratio (0.92 to 0.95). Its
+    `impairment` (none by default) makes it noisy, late or mistaken.
     """
 
     #: Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
@@ -48,6 +51,10 @@ class VirtualParticipantParams:
     insist_time: float = 1.0
     #: Once it takes control among obstacles, it keeps it at least this long (s).
     hold_time: float = 0.5
+    #: How it is impaired: motor noise, a delay of its commands, wrong first choices of
+    #: target (`ParticipantImpairment`; the defaults: not at all).
+    impairment: ParticipantImpairment = dataclasses.field(
+        default_factory=ParticipantImpairment)
 
     # The fields below act among obstacles (the obstacle task, `VirtualOperator._avoid`);
     # `policy_compensation` in the reaching task too.

@@ -501,7 +501,12 @@ MOST_PLAN_TIMES = 100
 def check_virtual_participant(operator, field="scenario.operator"):
     """The obstacle fields of `operator: !VirtualParticipant` (`VirtualParticipantParams`):
     times, rates and steps positive, distances, weights and factors not negative,
-    `plan_directions` a count and `plan_times` positive times that increase."""
+    `plan_directions` a count and `plan_times` positive times that increase; and its
+    `impairment` (`ParticipantImpairment.problem`: levels and times finite and not
+    negative, a probability in [0, 1])."""
+    problem = operator.impairment.problem()
+    if problem is not None:
+        raise ScenarioError(f"{field}.impairment.{problem}")
     require_finite(operator, field, (
         "settle_time", "max_turn_rate", "release_heading_gap", "release_heading_gap_alternated",
         "policy_compensation", "progress_step", "stall_time"))

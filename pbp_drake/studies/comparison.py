@@ -22,13 +22,16 @@ BACKENDS = ("local", "ray")
 
 def run_method_comparison(scenario, methods, trials, seed, output, progress=None, jobs=1,
                           run=None, retry_errors=False, backend="local", ray_address=None,
-                          split=None, scenario_file=None, split_seeds=None):
+                          split=None, scenario_file=None, split_seeds=None,
+                          participant_condition=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     processes, writes every trial under `output/trials/`, then the summary, tables and
     figures (see `report`). Returns the summary dict. `split` labels the seeds in
     study.json and the results ("tuning", "evaluation", ...: see `studies.splits`); None
     keeps the label the folder holds for the same seeds. `scenario_file` and `split_seeds`
-    go into study.json (see `write_study`; None keeps what the folder holds).
+    go into study.json (see `write_study`; None keeps what the folder holds), and so does
+    `participant_condition`, the name of the condition the scenario's virtual participant
+    was impaired with (`pbp-drake study --participant-condition`; None: none named).
 
     `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
     Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "HEAD:6379", "auto",
@@ -52,7 +55,7 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
         raise ScenarioError(f"trials must be at least 1, got {trials}")
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
-    recorded = check_folder(output, scenario, digest)
+    recorded = check_folder(output, scenario, digest, participant_condition)
     if split is None and recorded and (recorded.get("seed"), recorded.get("trials")) == (
             seed, trials) and isinstance(recorded.get("split"), str):
         split = recorded["split"]  # resuming the same seeds keeps their label
@@ -83,7 +86,7 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
             pending.append((method, trial))
     name_damaged([d._replace(problem=f"{d.problem}; runs again") for d in damaged])
     write_study(output, scenario, digest, methods, trials, seed, split, scenario_file,
-                split_seeds)
+                split_seeds, participant_condition)
 
     started = time.monotonic()
     done = []

@@ -9,10 +9,11 @@ from pbp_drake.studies.trial_files import Damage, StudyFolderError, name_damaged
 TOY_STUDIES = ("alpha_study", "alt_vs_cont")
 
 
-def check_folder(output, scenario, digest):
+def check_folder(output, scenario, digest, participant_condition=None):
     """Raises StudyFolderError when `output` holds a study of another scenario or kind (a 2-D
-    study's summary.json, a study.json of another kind); names a damaged study.json (it is
-    written again). Returns the folder's readable study.json as a dict, or None."""
+    study's summary.json, a study.json of another kind), saying so when it was run with
+    another `participant_condition`; names a damaged study.json (it is written again).
+    Returns the folder's readable study.json as a dict, or None."""
     kind = folder_kind(output)
     if kind is not None and kind != "method_comparison":
         raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a method "
@@ -29,10 +30,14 @@ def check_folder(output, scenario, digest):
         name_damaged([Damage(str(study_path), f"{problem}; written again")])
         return None
     if study.get("scenario_hash") != digest:
+        recorded = study.get("participant_condition")
+        condition = ("" if recorded == participant_condition else
+                     f"; it was run with --participant-condition {recorded}" if recorded else
+                     "; it was run without --participant-condition")
         raise StudyFolderError(
             f"{output} holds a study of another scenario ({study.get('scenario')!r}, hash "
-            f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}): "
-            "choose another --output folder")
+            f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}"
+            f"{condition}): choose another --output folder")
     return study
 
 

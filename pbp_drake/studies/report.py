@@ -42,15 +42,37 @@ def _count(value):
     return "-" if value is None else str(value)
 
 
+# The units of the impairment's fields in the results' words.
+_IMPAIRMENT_UNITS = {"command_noise_time": " s", "command_delay": " s", "mistake_time": " s"}
+
+
+def participant_line(summary):
+    """One line for results: how the virtual participant was impaired (its condition and
+    the fields that act), or "" when it was not."""
+    participant = summary.get("virtual_participant")
+    if not participant:
+        return ""
+    fields = ", ".join(f"{name} {value:g}{_IMPAIRMENT_UNITS.get(name, '')}"
+                       for name, value in participant["impairment"].items())
+    condition = participant["condition"]
+    head = (f"Virtual participant: the {condition} condition" if condition
+            else "Virtual participant: impaired")
+    return head + (f" ({fields})." if fields else ".")
+
+
 def results_table(summary):
     """The summary as a Markdown table, one row per method: mean ± std of the intervention
     ratio and task time, and of the collision ratio with the count of collision-free trials
     where the task measures collisions; max / mean of the trials' peak hand speed and peak
     command acceleration (see `summarize`); how often HOP's goal posterior sat at its clip
-    where a method records it. Below it, the 95 % confidence intervals
-    (`pbp_drake.studies.intervals`)."""
+    where a method records it. Above it, the seeds and, when it was impaired,
+    the virtual participant's condition (`participant_line`); below it the 95 % confidence
+    intervals (`pbp_drake.studies.intervals`)."""
     seeds = seeds_line(summary)
     lines = [seeds, ""] if seeds else []
+    participant = participant_line(summary)
+    if participant:
+        lines += [participant, ""]
     collisions = summary["measures_collisions"]
     # HOP's posterior at its clip, where a method records it (hop, policy_blending,
     # maxent_command).

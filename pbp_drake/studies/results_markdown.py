@@ -42,6 +42,9 @@ def study_command(study, summary):
         words += ["--split", split]
     else:
         words += ["--seed", str(seed)]
+    condition = study.get("participant_condition")
+    if isinstance(condition, str):
+        words += ["--participant-condition", condition]
     return " ".join(words)
 
 

@@ -4,11 +4,13 @@ The summary holds only values from the trial files, in a fixed order, rounded: i
 same bytes for any `--jobs` and either backend.
 """
 
+import dataclasses
 import math
 import pathlib
 
 import numpy as np
 
+from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.scenarios import DynamicObstacles, parse_method_label
 from pbp_drake.studies.trial_files import trial_paths
 
@@ -141,6 +143,31 @@ def measures_collisions(study, records, output=None):
     return False
 
 
+# An impairment field that matters only beside another: listed with it.
+_GOES_WITH = {"command_noise_time": "command_noise", "mistake_time": "mistake_probability"}
+
+
+def virtual_participant(study):
+    """How the study's virtual participant was impaired, from its study.json: `{"condition":
+    the name given to `--participant-condition` (None: none), "impairment": {field: value}
+    of the impairment's fields that act (those off their defaults, and the times that go
+    with them)}`; None when it was not impaired (or there is no virtual participant)."""
+    content = study.get("scenario_content")
+    operator = content.get("operator") if isinstance(content, dict) else None
+    given = operator.get("impairment") if isinstance(operator, dict) else None
+    condition = study.get("participant_condition")
+    condition = condition if isinstance(condition, str) else None
+    defaults = dataclasses.asdict(ParticipantImpairment())
+    given = given if isinstance(given, dict) else {}
+    changed = {name for name, value in given.items()
+               if name in defaults and value != defaults[name]}
+    acting = {name: given[name] for name in defaults
+              if name in changed or _GOES_WITH.get(name) in changed}
+    if not acting and condition is None:
+        return None
+    return {"condition": condition, "impairment": acting}
+
+
 def summarize(study, records, damaged=(), output=None):
     """Per method: how many trials, errors and missing; success rate over the trials on
     disk; mean and (population) std of intervention ratio and task time, and, in tasks that
@@ -159,6 +186,9 @@ def summarize(study, records, damaged=(), output=None):
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),
                "seeds": [study["seed"], study["seed"] + study["trials"] - 1]}
+    participant = virtual_participant(study)
+    if participant is not None:
+        summary["virtual_participant"] = participant
     collisions = measures_collisions(study, records, output)
     summary["measures_collisions"] = collisions
     if collisions:

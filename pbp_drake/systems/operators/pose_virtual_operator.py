@@ -3,6 +3,8 @@
 import numpy as np
 
 from pbp_drake.core.participant_grasp import GraspParticipant, ParticipantMemory
+from pbp_drake.core.participant_impairment import (
+    delay_ticks, initial_motor_noise, is_noisy, next_motor_noise)
 from pbp_drake.systems.ports import OperatorTwist, PoseState, Target
 from pbp_drake.systems.operators.sampled_operator import SampledOperator
 
@@ -27,7 +29,9 @@ class PoseVirtualOperator(SampledOperator):
     "assist" mode only). `operator_command` is an `OperatorTwist` `[v (3), omega (3)]`,
     world frame. It samples at the sense stage of each tick, as every `SampledOperator`;
     what it remembers of the targets it has seen (`ParticipantMemory`) is discrete state,
-    so Contexts stay independent.
+    so Contexts stay independent. Its parameters' `impairment` adds its motor noise (a
+    process in discrete state that runs every tick) and delays its commands by
+    `command_delay` (a queue in discrete state).
     """
 
     def __init__(self, participant, control_period):
@@ -40,7 +44,12 @@ class PoseVirtualOperator(SampledOperator):
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._memory_index = self.DeclareDiscreteState(np.array(ParticipantMemory(),
                                                                 dtype=float))
-        self._declare_operator_outputs()
+        impairment = participant.params.impairment
+        self._noisy = is_noisy(impairment)
+        if self._noisy:
+            self._noise_index = self.DeclareDiscreteState(initial_motor_noise(
+                participant.seed, participant.motor_noise_scales))
+        self._declare_operator_outputs(delay_ticks(impairment.command_delay, control_period))
 
     @property
     def participant(self):
@@ -63,10 +72,19 @@ class PoseVirtualOperator(SampledOperator):
         # Teleop never reads the estimate: its port may stay unconnected there.
         selected = (self._selected_port.Eval(context)[0]
                     if self._participant.mode == "assist" else -1)
+        tick = int(round(time / self._period))
+        noise = None
+        if self._noisy:
+            participant = self._participant
+            noise = next_motor_noise(
+                participant.params.impairment, self._period, participant.seed, tick,
+                context.get_discrete_state(self._noise_index).value(),
+                participant.motor_noise_scales)
+            discrete_state.set_value(self._noise_index, noise)
         twist, active, memory = self._participant.step(
-            memory, time, int(round(time / self._period)), hand[:3],
+            memory, time, tick, hand[:3],
             hand[3:7] / np.linalg.norm(hand[3:7]), int(Target(
-                self._target_port.Eval(context)).index), int(selected))
+                self._target_port.Eval(context)).index), int(selected), noise)
         discrete_state.get_mutable_vector(self._memory_index).set_value(
             np.array(memory, dtype=float))
         self._store_sample(discrete_state, twist, active)

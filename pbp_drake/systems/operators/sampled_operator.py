@@ -30,7 +30,9 @@ class SampledOperator(LeafSystem):
         - operator_active
 
     Subclasses implement `_sample(context) -> (command (D,), active)`, may declare input
-    ports first, and call `_declare_operator_outputs()` once. Sampling into discrete state
+    ports first, and call `_declare_operator_outputs()` once (`delay_ticks` > 0: each
+    sample reaches the outputs that many ticks after it was taken, through a queue in
+    discrete state; the virtual participant's `command_delay`). Sampling into discrete state
     keeps the operator deterministic and loggable, and its command stays constant over a
     control period as a human's keyboard read would. It samples at the sense stage of each tick
     (`pbp_drake.systems.tick`). `operator_command` is a velocity (D; a subclass may name
@@ -44,9 +46,15 @@ class SampledOperator(LeafSystem):
         self._period = float(control_period)
         self._command_name = command_name
 
-    def _declare_operator_outputs(self):
+    def _declare_operator_outputs(self, delay_ticks=0):
         d = self._dimension
         self._sample_index = self.DeclareDiscreteState(d + 1)
+        self._delay_ticks = int(delay_ticks)
+        if self._delay_ticks < 0:
+            raise ValueError(f"delay_ticks must not be negative, got {delay_ticks}")
+        if self._delay_ticks > 0:
+            # The samples taken but not yet sent, oldest first; before the start: idle.
+            self._queue_index = self.DeclareDiscreteState(self._delay_ticks * (d + 1))
         # Both outputs depend on the held sample alone (no direct feedthrough), so an
         # operator may watch systems that depend on its own output.
         held = {self.discrete_state_ticket(self._sample_index)}
@@ -67,7 +75,14 @@ class SampledOperator(LeafSystem):
         return self._active_port
 
     def _held(self, context):
+        """The sample the outputs hold: what the robot gets."""
         return context.get_discrete_state(self._sample_index).value()
+
+    def _latest(self, context):
+        """The newest sample taken (the held one unless samples are delayed)."""
+        if self._delay_ticks == 0:
+            return self._held(context)
+        return context.get_discrete_state(self._queue_index).value()[-(self._dimension + 1):]
 
     def _update(self, context, discrete_state):
         command, active = self._sample(context)
@@ -78,6 +93,10 @@ class SampledOperator(LeafSystem):
         command = self._validate(np.asarray(command, float).reshape(self._dimension))
         # DiscreteValues.set_value: one pybind call (get_mutable_vector's: two).
         sample = np.append(command, 1.0 if active else 0.0)
+        if self._delay_ticks > 0:
+            queue = np.append(discrete_state.get_vector(self._queue_index).value(), sample)
+            sample, queue = queue[:self._dimension + 1], queue[self._dimension + 1:]
+            discrete_state.set_value(self._queue_index, queue)
         discrete_state.set_value(self._sample_index, sample)
 
     def _validate(self, command):

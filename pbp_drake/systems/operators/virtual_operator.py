@@ -5,7 +5,10 @@ import copy
 import numpy as np
 
 from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
-from pbp_drake.core.participant_reach import assist_motion, drive_motion, faces_target
+from pbp_drake.core.participant_impairment import (
+    delay_ticks, first_choice, initial_motor_noise, is_noisy, next_motor_noise)
+from pbp_drake.core.participant_reach import (
+    assist_motion, drive_motion, faces_target, without_forward)
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.operators.participant_avoidance import (
@@ -46,6 +49,12 @@ class VirtualOperator(SampledOperator):
     scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
     is reproducible and the system keeps no state outside its Context.
 
+    Its `impairment` (`pbp_drake.core.participant_impairment`, none by default) adds motor
+    noise to its commands while it acts (never forward when assisting: the key stays
+    disabled), delays its commands by `command_delay` (a queue in discrete state), and
+    makes it head for a wrong object first, now and then, each time it comes to know a
+    target (the reaching task; the obstacle task has a single object).
+
     With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (cylinders of
     `obstacle_radius`; their velocities
     from the positions it remembers in discrete state) and keeps the robot's footprint (base
@@ -82,6 +91,8 @@ class VirtualOperator(SampledOperator):
         self._speed_noise = float(params.speed_noise)
         self._seed = int(seed)
         self._slow_radius = float(params.slow_radius)
+        impairment = params.impairment
+        self._impairment = impairment
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
@@ -118,7 +129,20 @@ class VirtualOperator(SampledOperator):
         # faced it while the estimate named another object (`insist_time`).
         self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
         self._insist_ticks = int(round(params.insist_time / control_period))
-        self._declare_operator_outputs()
+        # The motor noise of `impairment`, [vx, vy, yaw rate], runs every tick.
+        self._noise_scales = None
+        if is_noisy(impairment):
+            self._noise_scales = impairment.command_noise * np.array(
+                [self._speed, self._speed, self._rotation_speed])
+            self._motor_noise_index = self.DeclareDiscreteState(
+                initial_motor_noise(self._seed, self._noise_scales))
+        # Wrong first choices of target: [targets known so far, the object it heads for
+        # instead (-1: none), ticks left before it sees its mistake].
+        self._mistakes = impairment.mistake_probability > 0.0
+        if self._mistakes:
+            self._mistake_index = self.DeclareDiscreteState(np.array([0.0, -1.0, 0.0]))
+            self._mistake_ticks = delay_ticks(impairment.mistake_time, control_period)
+        self._declare_operator_outputs(delay_ticks(impairment.command_delay, control_period))
 
     def get_ee_state_input_port(self):
         return self._ee_state_port
@@ -147,8 +171,49 @@ class VirtualOperator(SampledOperator):
         if self._obstacles_port is not None:
             command, active = self._avoid(context, discrete_state, int(known))
         else:
-            command, active = self._decide(context, discrete_state, int(known))
+            heads_for = (self._heads_for(context, discrete_state, int(known))
+                         if self._mistakes else int(known))
+            command, active = self._decide(context, discrete_state, int(known), heads_for)
+        if self._noise_scales is not None:
+            command = self._add_motor_noise(context, discrete_state, command, active)
         self._store_sample(discrete_state, command, active)
+
+    def _heads_for(self, context, discrete_state, known):
+        """The object it heads for: the known target, or for `mistake_time` after it came
+        to know it, the wrong object it chose first (`first_choice`)."""
+        count, wrong, ticks_left = context.get_discrete_state(self._mistake_index).value()
+        counted_for = context.get_discrete_state(self._belief_index).value()[0]
+        if known != counted_for or count == 0:
+            # It has just come to know this target (the first one at the start).
+            choice = first_choice(self._impairment, self._seed, int(count), known,
+                                  len(self._objects))
+            count += 1
+            wrong, ticks_left = ((choice, self._mistake_ticks) if choice != known
+                                 else (-1.0, 0.0))
+        heads_for = int(wrong) if ticks_left > 0 else known
+        if ticks_left > 0:
+            ticks_left -= 1
+        discrete_state.set_value(self._mistake_index, [count, wrong, ticks_left])
+        return heads_for
+
+    def _add_motor_noise(self, context, discrete_state, command, active):
+        """The command with this tick's motor noise added while it acts (the noise runs
+        every tick, so that one seed gives the same noise under every method)."""
+        tick = int(round(context.get_time() / self._period))
+        noise = next_motor_noise(
+            self._impairment, self._period, self._seed, tick,
+            context.get_discrete_state(self._motor_noise_index).value(), self._noise_scales)
+        discrete_state.set_value(self._motor_noise_index, noise)
+        if not active:
+            return command
+        command = np.array(command, dtype=float)
+        command[:2] += noise[:2]
+        command[3] += noise[2]
+        if self._mode == "assist" and self._obstacles_port is None:
+            # The forward key stays disabled, however the hand shakes.
+            heading = EeState(self._ee_state_port.Eval(context)).heading
+            command[:2] = without_forward(command[:2], heading)
+        return command
 
     def _noise(self, context):
         """This tick's direction error (rad) and speed factor, drawn from `(seed, tick)`."""
@@ -178,9 +243,12 @@ class VirtualOperator(SampledOperator):
         hold = track[3]
         track[3] = max(hold - 1.0, 0.0)
         track[remembered] = obstacles.reshape(-1)
-        held = self._held(context)
-        was_active = held[4] > 0.5
-        last_command = held[:2] if was_active else np.zeros(2)
+        # Its own last decision (what it pressed) and what the robot got: the same unless
+        # its commands are delayed.
+        decided, sent = self._latest(context), self._held(context)
+        was_active = decided[4] > 0.5
+        last_command = decided[:2] if was_active else np.zeros(2)
+        last_sent = sent[:2] if sent[4] > 0.5 else np.zeros(2)
 
         def finish(command, active, hold_ticks=None):
             if hold_ticks is not None:
@@ -239,7 +307,7 @@ class VirtualOperator(SampledOperator):
         command = speed_scale * rotate_planar(planned, noise_angle)
         if self._policy_adds:
             # The policy's own motion: what the hand does minus what was asked of it.
-            policy_velocity = velocity - last_command
+            policy_velocity = velocity - last_sent
             command = command - policy_velocity
             norm = np.linalg.norm(command)
             limit = params.policy_compensation * self._speed
@@ -291,15 +359,18 @@ class VirtualOperator(SampledOperator):
         best = int(np.argmax(score))
         return velocities[best], yaw_rates[best], clear[best]
 
-    def _decide(self, context, discrete_state, known_target):
-        """The command in the reaching task (`pbp_drake.core.participant_reach`). Returns
-        `(command, active)`."""
+    def _decide(self, context, discrete_state, known_target, heads_for):
+        """The command in the reaching task (`pbp_drake.core.participant_reach`), toward
+        object `heads_for` (the known target, unless it has mistaken it for another).
+        Returns `(command, active)`."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         position, heading = position_of(ee_state), ee_state.heading
         target = Target(self._target_port.Eval(context))
         if known_target != int(target.index):
             return np.zeros(4), False  # has not noticed the new target yet
         target_position = position_of(target)
+        if heads_for != known_target:
+            target_position, known_target = self._objects[heads_for], heads_for
         noise_angle, speed_scale = self._noise(context)
         if self._mode == "assist":
             selected = int(round(self._selected_goal_port.Eval(context)[0]))

@@ -1,0 +1,230 @@
+"""The impaired virtual participant as a Drake system (`VirtualOperator` in the reaching
+task, `PoseVirtualOperator` in the grasping task), alone in a small diagram with its inputs
+given: the noisy one's commands carry noise of the documented spread, the same for one
+seed whatever it does; the late one sends the very commands of the unimpaired one, d
+seconds later; the mistaken one heads for another object first, then for the target."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+
+from pbp_drake.core.grasp_task import side_grasp_orientation
+from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
+from pbp_drake.core.participant_impairment import ParticipantImpairment
+from pbp_drake.core.participant_params import VirtualParticipantParams
+from pbp_drake.core.participant_reach import facing
+from pbp_drake.systems import PoseVirtualOperator, VirtualOperator
+
+PERIOD = 0.03
+SPEED = 0.12
+HAND = np.array([0.5, 0.0, 0.7])
+# Seen from the hand facing +x: one object ahead-left, one ahead-right, one far ahead.
+OBJECTS = np.array([[1.6, 0.6, 0.7], [1.6, -0.6, 0.7], [2.4, 0.0, 0.7]])
+QUIET = dict(direction_noise=0.0, speed_noise=0.0)
+
+
+def params(**impairment):
+    """The calibrated participant without its own noise, impaired as given."""
+    return VirtualParticipantParams(**QUIET, impairment=ParticipantImpairment(**impairment))
+
+
+def target_source(schedule):
+    """A source of the task monitor's `target` [p (3), index]: `schedule` is a list of
+    (time, object index), each held until the next."""
+    times = [time for time, _ in schedule] + [1e3]
+    values = np.array([[*OBJECTS[index], index] for _, index in schedule]
+                      + [[*OBJECTS[schedule[-1][1]], schedule[-1][1]]]).T
+    return TrajectorySource(PiecewisePolynomial.ZeroOrderHold(times, values))
+
+
+def reach_commands(participant_params, schedule, ticks, mode="drive", selected=0, seed=4,
+                   heading=0.0):
+    """`(commands (ticks, 4), active (ticks,))` of a lone reach participant, the hand held
+    at HAND with `heading`, the estimate naming `selected`."""
+    builder = DiagramBuilder()
+    participant = builder.AddSystem(VirtualOperator(
+        PERIOD, OBJECTS, mode=mode, params=participant_params, nominal_speed=SPEED,
+        seed=seed))
+    ee_state = [*HAND, 0.0, 0.0, 0.0, heading, 0.0]
+    for port, source in (
+            (participant.get_ee_state_input_port(),
+             ConstantVectorSource(np.array(ee_state))),
+            (participant.get_target_input_port(), target_source(schedule)),
+            (participant.get_selected_goal_input_port(),
+             ConstantVectorSource(np.array([float(selected)])))):
+        builder.Connect(builder.AddSystem(source).get_output_port(), port)
+    return _sampled(builder, participant, ticks)
+
+
+def _sampled(builder, participant, ticks):
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    context = participant.GetMyContextFromRoot(simulator.get_context())
+    commands, active = [], []
+    for tick in range(ticks):
+        simulator.AdvanceTo((tick + 0.5) * PERIOD)  # the sample of tick `tick`
+        commands.append(participant.get_operator_command_output_port().Eval(context).copy())
+        active.append(participant.get_operator_active_output_port().Eval(context)[0])
+    return np.array(commands), np.array(active) > 0.5
+
+
+def toward(command, point):
+    """The cosine between the command's floor velocity and the direction to `point` (NaN
+    for no velocity)."""
+    if not command[:2].any():
+        return np.nan
+    offset = point[:2] - HAND[:2]
+    return command[:2] @ offset / (np.linalg.norm(command[:2]) * np.linalg.norm(offset))
+
+
+# ---------------------------------------------------------------------------------------------
+# Noisy
+
+
+def test_the_noisy_participants_commands_spread_as_documented():
+    ticks = 2500
+    clean, _ = reach_commands(params(), [(0.0, 2)], ticks)
+    noisy, active = reach_commands(params(command_noise=0.3, command_noise_time=0.0),
+                                   [(0.0, 2)], ticks)
+    assert active.all()
+    noise = (noisy - clean)[:, [0, 1, 3]]
+    rotation_speed = VirtualParticipantParams().rotation_speed
+    expected = 0.3 * np.array([SPEED, SPEED, rotation_speed])
+    assert np.allclose(noise.std(axis=0), expected, rtol=0.06)
+    assert np.allclose(noise.mean(axis=0), 0.0, atol=0.1 * expected)
+    assert np.all(noisy[:, 2] == 0.0)  # the hand's height is never commanded
+
+
+def test_one_seed_gives_the_same_noise_whatever_the_participant_does():
+    impairment = dict(command_noise=0.3, command_noise_time=0.5)
+    noise = []
+    for target in (0, 1):  # two tasks: different commands, one seed
+        clean, _ = reach_commands(params(), [(0.0, target)], 150)
+        noisy, _ = reach_commands(params(**impairment), [(0.0, target)], 150)
+        noise.append(noisy - clean)
+    assert np.allclose(noise[0], noise[1], rtol=0.0, atol=1e-15)
+    assert np.abs(noise[0]).max() > 0.01
+    again, _ = reach_commands(params(**impairment), [(0.0, 1)], 150)
+    other_seed, _ = reach_commands(params(**impairment), [(0.0, 1)], 150, seed=5)
+    assert np.array_equal(again, noise[1] + reach_commands(params(), [(0.0, 1)], 150)[0])
+    assert not np.allclose(again, other_seed)
+
+
+def test_the_noisy_participant_acts_no_more_often_and_never_pushes_forward():
+    # Assisting while the estimate names the left object, the target right: it sidesteps.
+    clean, clean_active = reach_commands(params(), [(0.0, 1)], 300, mode="assist")
+    noisy, active = reach_commands(params(command_noise=0.5), [(0.0, 1)], 300,
+                                   mode="assist")
+    assert np.array_equal(active, clean_active)
+    assert not np.allclose(noisy, clean)
+    # Its heading drifts with the noise only as far as its turns take it; here it is
+    # held, and no command has a forward part along it.
+    assert np.all(noisy[:, :2] @ facing(0.0) <= 1e-12)
+    # Where it does not act, it adds nothing.
+    idle, idle_active = reach_commands(params(command_noise=0.5), [(0.0, 0)], 50,
+                                       mode="assist", selected=0)
+    assert not idle_active.any() and not idle.any()
+
+
+# ---------------------------------------------------------------------------------------------
+# Late
+
+
+def test_the_late_participant_sends_the_same_commands_the_delay_later():
+    # The target switches from the left object to the right one at 1.2 s.
+    schedule = [(0.0, 0), (1.2, 1)]
+    calibrated = VirtualParticipantParams()  # its own noise on: the same draws, later
+    late = dataclasses.replace(calibrated,
+                               impairment=ParticipantImpairment(command_delay=0.3))
+    on_time, on_time_active = reach_commands(calibrated, schedule, 150)
+    delayed, delayed_active = reach_commands(late, schedule, 150)
+    shift = 10  # 0.3 s at 30 ms
+    assert np.array_equal(delayed[shift:], on_time[:-shift])
+    assert np.array_equal(delayed_active[shift:], on_time_active[:-shift])
+    # Before its first commands arrive, the robot gets nothing.
+    assert not delayed[:shift].any() and not delayed_active[:shift].any()
+    # It reacts to the switch its reaction_delay and the delay after it.
+    turned = np.flatnonzero([toward(command, OBJECTS[1]) > 0.9 for command in delayed])
+    assert turned[0] * PERIOD == pytest.approx(1.2 + calibrated.reaction_delay + 0.3,
+                                               abs=1.5 * PERIOD)
+
+
+def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
+    orientations = np.array([side_grasp_orientation(0.4), side_grasp_orientation(-0.4)])
+    positions = OBJECTS[:2]
+
+    def twists(delay):
+        participant = GraspParticipant.create(
+            GraspParticipantParams(impairment=ParticipantImpairment(command_delay=delay)),
+            "drive", SPEED, positions, orientations, seed=2)
+        builder = DiagramBuilder()
+        system = builder.AddSystem(PoseVirtualOperator(participant, PERIOD))
+        hand = np.concatenate([HAND, side_grasp_orientation(0.0), np.zeros(6)])
+        for port, source in ((system.get_hand_pose_input_port(), ConstantVectorSource(hand)),
+                             (system.get_target_input_port(), target_source([(0.0, 0),
+                                                                             (1.0, 1)])),
+                             (system.get_selected_goal_input_port(),
+                              ConstantVectorSource(np.zeros(1)))):
+            builder.Connect(builder.AddSystem(source).get_output_port(), port)
+        return _sampled(builder, system, 120)
+
+    (on_time, on_time_active), (delayed, delayed_active) = twists(0.0), twists(0.45)
+    shift = 15
+    assert on_time_active[20:].all()
+    assert np.array_equal(delayed[shift:], on_time[:-shift])
+    assert np.array_equal(delayed_active[shift:], on_time_active[:-shift])
+    assert not delayed[:shift].any()
+
+
+# ---------------------------------------------------------------------------------------------
+# Mistaken
+
+
+def test_the_mistaken_participant_heads_for_another_object_then_for_the_target():
+    mistaken = params(mistake_probability=1.0, mistake_time=0.9)
+    commands, active = reach_commands(mistaken, [(0.0, 1)], 80)
+    assert active.all()
+    wrong_ticks = 30  # 0.9 s
+    # With the target the right object, it first heads for one of the others ...
+    first = max(range(3), key=lambda index: toward(commands[0], OBJECTS[index]))
+    assert first != 1
+    assert all(toward(command, OBJECTS[first]) > 0.999 for command in commands[:wrong_ticks])
+    # ... then sees its mistake and heads for the target.
+    assert all(toward(command, OBJECTS[1]) > 0.999 for command in commands[wrong_ticks:])
+    # The unimpaired one heads for the target from the first tick.
+    right, _ = reach_commands(params(), [(0.0, 1)], 5)
+    assert all(toward(command, OBJECTS[1]) > 0.999 for command in right)
+
+
+def test_a_mistaken_participant_assisting_leaves_the_robot_to_the_wrong_object():
+    # The estimate names the object it mistook the target for: it is content, and acts
+    # only once it sees its mistake. Which object it mistakes comes from the seed.
+    mistaken = params(mistake_probability=1.0, mistake_time=0.9)
+    commands, _ = reach_commands(mistaken, [(0.0, 1)], 2)
+    wrong = max(range(3), key=lambda index: toward(commands[0], OBJECTS[index]))
+    _, active = reach_commands(mistaken, [(0.0, 1)], 60, mode="assist", selected=wrong)
+    assert not active[:30].any()
+    assert active[30:].all()
+    _, unimpaired = reach_commands(params(), [(0.0, 1)], 5, mode="assist", selected=wrong)
+    assert unimpaired.all()
+
+
+def test_each_new_target_may_be_mistaken_again():
+    mistaken = params(mistake_probability=1.0, mistake_time=0.6)
+    commands, active = reach_commands(mistaken, [(0.0, 0), (1.5, 2)], 120)
+    wrong_ticks, switch = 20, 50  # 0.6 s; the switch at 1.5 s
+    # The first target, at once from the start ...
+    assert all(toward(command, OBJECTS[0]) < 0.99 for command in commands[:wrong_ticks])
+    assert all(toward(command, OBJECTS[0]) > 0.999 for command in commands[wrong_ticks:switch])
+    # ... and the second once it has noticed it, its reaction_delay after the switch.
+    noticed = switch + np.flatnonzero(active[switch:])[0]
+    assert (noticed - switch) * PERIOD == pytest.approx(
+        VirtualParticipantParams().reaction_delay, abs=1.5 * PERIOD)
+    after = commands[noticed:]
+    assert all(toward(command, OBJECTS[2]) < 0.99 for command in after[:wrong_ticks])
+    assert all(toward(command, OBJECTS[2]) > 0.999 for command in after[wrong_ticks:])

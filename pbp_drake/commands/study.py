@@ -15,7 +15,8 @@ from pbp_drake.scenarios import (
     Hsr, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison, counted,
     load_scenario_file)
 from pbp_drake.studies.comparison import run_method_comparison
-from pbp_drake.studies.paired import paired_comparison, paired_table
+from pbp_drake.studies.paired import (
+    PAIRED_METRICS, paired_comparison, paired_table, paired_with, paired_with_markdown)
 from pbp_drake.studies.participant_report import is_participant_collection, participant_report
 from pbp_drake.studies.questionnaire_figure import FIG8
 from pbp_drake.studies.progress import ProgressBar
@@ -70,6 +71,11 @@ def add_study_commands(commands):
                         "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
                         "Wilcoxon tests and Fig. 8 in DIR/results.md and "
                         f"DIR/{FIG8}")
+    report.add_argument("--paired-with", metavar="METHOD",
+                        help="also compare every other method of the study with METHOD "
+                        "(e.g. pbp_alternated), seed by seed: per metric the paired "
+                        "difference and its 95 %% interval, as `compare` does between two "
+                        "studies (printed, and in --markdown's file)")
     report.add_argument("--markdown", metavar="FILE",
                         help="also write the study's results table as a Markdown fragment "
                         "to FILE (its folder is created), after a line naming the command "
@@ -262,9 +268,17 @@ def _report(args):
         return 1 if damaged else 0
     summary = report(output)
     _print_report(summary, output)
+    paired = None
+    if args.paired_with is not None:
+        try:
+            rows = paired_with(output, args.paired_with, PAIRED_METRICS)
+        except ValueError as error:
+            raise ScenarioError(f"--paired-with: {error}") from None
+        paired = paired_with_markdown(rows, args.paired_with)
+        print(paired, end="")
     if args.markdown is not None:
-        write_markdown(args.markdown,
-                       method_comparison_markdown(read_study_json(output), summary))
+        write_markdown(args.markdown, method_comparison_markdown(
+            read_study_json(output), summary) + ("" if paired is None else "\n" + paired))
         print(f"  wrote {args.markdown}")
     failed = _failed_trials(summary, output)
     if summary["damaged"]:

@@ -1,4 +1,6 @@
-"""Two studies of the same seeds, compared trial by trial: `pbp-drake compare A B`.
+"""Two studies of the same seeds, compared trial by trial: `pbp-drake compare A B`; and,
+with the same statistics, one study's methods against one of them (`paired_with`:
+`pbp-drake report DIR --paired-with METHOD`).
 
 Change a setting (the robot's motion model, a time step, a gain), run the same study again
 into another folder, and ask whether any result moved by more than the trials differ among
@@ -16,6 +18,7 @@ import math
 
 import numpy as np
 
+from pbp_drake.scenarios import METHOD_NAMES
 from pbp_drake.studies.summary import measures_collisions
 from pbp_drake.studies.trial_files import read_study
 
@@ -39,6 +42,11 @@ _METRICS = (
     ("peak_command_angular_change", lambda record: record.get("peak_command_angular_change"),
      False),
 )
+
+
+# What `report --paired-with` tells of each method against the reference: the outcome, the
+# operator's input and the time (the collisions where the task measures them).
+PAIRED_METRICS = ("success", "intervention_ratio", "task_time", "collision_ratio")
 
 
 @dataclasses.dataclass
@@ -98,23 +106,46 @@ def paired_comparison(folder_a, folder_b):
                   and measures_collisions(study_b, records_b, folder_b))
     rows = []
     for method in [m for m in study_a["methods"] if m in study_b["methods"]]:
-        trials_a = _by_seed(study_a, records_a, method)
-        trials_b = _by_seed(study_b, records_b, method)
-        seeds = sorted(set(trials_a) & set(trials_b))
-        for metric, read, needs_success in _METRICS:
-            if metric in _COLLISION_METRICS and not collisions:
+        rows += _paired_rows(method, _by_seed(study_a, records_a, method),
+                             _by_seed(study_b, records_b, method), collisions)
+    return rows
+
+
+def paired_with(folder, reference, metrics=None):
+    """The `PairedRow`s of one study's every other method against its method `reference`,
+    seed by seed (A: `reference`, B: the row's method), for the `metrics` named (default:
+    every metric). Raises ValueError when the study did not run `reference`."""
+    study, records, _ = read_study(folder)
+    if reference not in study["methods"]:
+        raise ValueError(f"the study ran {', '.join(study['methods'])}, not {reference}")
+    collisions = measures_collisions(study, records, folder)
+    reference_trials = _by_seed(study, records, reference)
+    rows = []
+    for method in [m for m in study["methods"] if m != reference]:
+        rows += _paired_rows(method, reference_trials, _by_seed(study, records, method),
+                             collisions)
+    return [row for row in rows if metrics is None or row.metric in metrics]
+
+
+def _paired_rows(method, trials_a, trials_b, collisions):
+    """A row per metric of `method`'s trials B against A (`{seed: record}` each), over the
+    seeds both ran; a time only where both succeeded."""
+    seeds = sorted(set(trials_a) & set(trials_b))
+    rows = []
+    for metric, read, needs_success in _METRICS:
+        if metric in _COLLISION_METRICS and not collisions:
+            continue
+        values_a, values_b = [], []
+        for seed in seeds:
+            record_a, record_b = trials_a[seed], trials_b[seed]
+            if needs_success and not (record_a["success"] and record_b["success"]):
                 continue
-            values_a, values_b = [], []
-            for seed in seeds:
-                record_a, record_b = trials_a[seed], trials_b[seed]
-                if needs_success and not (record_a["success"] and record_b["success"]):
-                    continue
-                value_a, value_b = read(record_a), read(record_b)
-                if value_a is not None and value_b is not None:
-                    values_a.append(value_a)
-                    values_b.append(value_b)
-            if values_a:
-                rows.append(_row(metric, method, values_a, values_b))
+            value_a, value_b = read(record_a), read(record_b)
+            if value_a is not None and value_b is not None:
+                values_a.append(value_a)
+                values_b.append(value_b)
+        if values_a:
+            rows.append(_row(metric, method, values_a, values_b))
     return rows
 
 
@@ -131,3 +162,14 @@ def paired_table(rows, name_a="A", name_b="B"):
             f"{row.difference:+.3g} [{row.low:+.3g}, {row.high:+.3g}] | {row.sd_a:.3g} | "
             f"{row.se_a:.3g} | {verdict} |")
     return "\n".join(lines) + "\n"
+
+
+def paired_with_markdown(rows, reference):
+    """The rows of `paired_with` as a titled Markdown table: each method against
+    `reference`, with `reference`'s SD as the yardstick of noise (as in `compare`)."""
+    name = METHOD_NAMES.get(reference, reference)
+    rows = [dataclasses.replace(row, method=METHOD_NAMES.get(row.method, row.method))
+            for row in rows]
+    return (f"Each method against {name}, paired by seed (the method minus {name}, with "
+            f"the 95 % interval of the difference; within noise: no larger than {name}'s "
+            "trial-to-trial SD).\n\n" + paired_table(rows, name, "method"))

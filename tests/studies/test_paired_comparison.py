@@ -93,3 +93,40 @@ def test_the_command_lines_help_names_it(capsys):
         main(["--help"])
     assert exit_info.value.code == 0
     assert "compare two studies of the same seeds" in capsys.readouterr().out
+
+
+def _methods_study(folder, scenario_path, times):
+    """One finished reach study whose methods took `times[method]` (per seed) to succeed."""
+    scenario = load_scenario_file(scenario_path).scenario
+    digest = scenario_hash(scenario)
+    write_study(folder, scenario, digest, tuple(times), TRIALS, 0, "evaluation")
+    for method, method_times in times.items():
+        for trial in range(TRIALS):
+            record = trial_record(scenario.name, digest, method, trial, trial)
+            record.update(success=True, task_time=float(method_times[trial]),
+                          intervention_ratio=0.5, switches=1, collision_ratio=0.0,
+                          peak_hand_speed=0.2, peak_command_acceleration=1.0, ticks=3,
+                          objects=[[1.6, 0.0, 0.7]], targets=[0])
+            write_trial_files(folder, record, _csv())
+    return folder
+
+
+def test_report_pairs_every_method_with_one_of_its_study(tmp_path, repo, capsys):
+    # Teleop two seconds slower on every seed, HOP one faster: the seed-to-seed spread
+    # (2.0 s SD) cancels in the pairs.
+    folder = _methods_study(tmp_path / "study", repo / "diagrams" / "hsr_reach.yaml", {
+        "pbp_alternated": TASK_TIMES, "teleop": TASK_TIMES + 2.0, "hop": TASK_TIMES - 1.0})
+    markdown = tmp_path / "table.md"
+    assert main(["report", str(folder), "--paired-with", "pbp_alternated",
+                 "--markdown", str(markdown)]) == 0
+    out = capsys.readouterr().out
+    text = markdown.read_text()
+    assert "Each method against PBP-Alt, paired by seed" in out and text.count(
+        "Each method against PBP-Alt") == 1
+    assert "| task_time | Teleop | 6 | 15.83 | +2 [+2, +2] |" in text
+    assert "| task_time | HOP | 6 | 15.83 | -1 [-1, -1] |" in text
+    assert "PBP-Alt | 6" not in text.split("Each method against")[1]  # not against itself
+    # A reference the study did not run: one line, exit 2.
+    assert main(["report", str(folder), "--paired-with", "pbp_continuous"]) == 2
+    assert "--paired-with: the study ran pbp_alternated, teleop, hop, not pbp_continuous" in (
+        capsys.readouterr().err)

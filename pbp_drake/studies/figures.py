@@ -21,7 +21,9 @@ from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
 # The methods' names, the one table every page and table reads (scenarios.words).
 METHOD_LABELS = METHOD_NAMES
 METHOD_COLOURS = {"pbp_alternated": "tab:orange", "pbp_continuous": "tab:blue",
-                  "teleop": "tab:green", "pbp_no_user": "tab:gray", "fixed_alpha": "tab:purple"}
+                  "teleop": "tab:green", "pbp_no_user": "tab:gray", "fixed_alpha": "tab:purple",
+                  "confidence_alpha": "tab:cyan", "hop": "tab:red",
+                  "policy_blending": "tab:brown"}
 
 
 def _label(method, rows=None):

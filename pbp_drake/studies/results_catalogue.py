@@ -21,6 +21,11 @@ PBP = "pbp_alternated,pbp_continuous"
 # PBP beside the shared-autonomy baselines (docs/results/baselines.md) and teleop.
 BASELINES = ["--methods", "pbp_alternated,pbp_continuous,hop,policy_blending,teleop",
              "--trials", "30", "--split", "evaluation"]
+# The reaching task's methods with the virtual participant unimpaired and under each of its
+# conditions (docs/results/impaired.md).
+IMPAIRED = ["diagrams/hsr_reach.yaml", "--methods",
+            "pbp_alternated,pbp_continuous,confidence_alpha,teleop,hop,policy_blending",
+            "--trials", "30", "--split", "evaluation"]
 
 #: name -> the arguments of `pbp-drake study` (without --output and --jobs).
 STUDIES = {
@@ -48,6 +53,9 @@ STUDIES = {
     "hsr_grasp_baselines": ["diagrams/hsr_grasp.yaml", *BASELINES],
     "hsr_reach_maxent": ["diagrams/hsr_reach_maxent.yaml", "--methods", PBP,
                          "--trials", "30", "--split", "evaluation"],
+    "hsr_reach_unimpaired": IMPAIRED,
+    **{f"hsr_reach_{condition}": [*IMPAIRED, "--participant-condition", condition]
+       for condition in ("noisy", "late", "mistaken")},
 }
 
 

@@ -9,6 +9,7 @@ A study interrupted part-way resumes from the trials on disk when this runs agai
 
 import argparse
 import pathlib
+import shutil
 import subprocess
 import sys
 
@@ -59,6 +60,14 @@ STUDIES = {
 }
 
 
+#: Studies whose page compares every method with PBP-Alt seed by seed and shows the study's
+#: figures side by side (docs/results/baselines.md): their report adds `--paired-with
+#: pbp_alternated`, and the figures are copied beside the table as NAME_FIGURE.png.
+PAIRED_WITH_PBP_ALT = ("hsr_reach_baselines", "hsr_obstacles_baselines",
+                       "hsr_grasp_baselines")
+DOCS_FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png")
+
+
 def with_trials(arguments, trials):
     """The arguments with `--trials` set to `trials` (for a quick check; None: unchanged)."""
     if trials is None or "--trials" not in arguments:
@@ -104,9 +113,13 @@ def main(argv=None):
             failed.append(f"{name}: `pbp-drake study` exited with {studied}")
         if studied not in (0, 1):  # 1: trials failed, and its table counts them
             continue
-        reported = _pbp_drake("report", str(output), "--markdown", str(markdown))
+        paired = ["--paired-with", "pbp_alternated"] if name in PAIRED_WITH_PBP_ALT else []
+        reported = _pbp_drake("report", str(output), "--markdown", str(markdown), *paired)
         if reported != 0 and studied == 0:
             failed.append(f"{name}: `pbp-drake report` exited with {reported}")
+        if paired and reported == 0:
+            for figure in DOCS_FIGURES:
+                shutil.copyfile(output / figure, markdown.with_name(f"{name}_{figure}"))
     for line in failed:
         print(f"results: {line}", file=sys.stderr)
     return 1 if failed else 0

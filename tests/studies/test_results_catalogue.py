@@ -1,0 +1,25 @@
+"""`make results` (`python -m pbp_drake.studies.results_catalogue`): a study of the list run
+into its folder and its table written for the docs, here with one trial per method. The
+baselines' page gets each method paired with PBP-Alt and the study's figures beside it."""
+
+import pytest
+
+from pbp_drake.studies.results_catalogue import DOCS_FIGURES, STUDIES, main
+
+pytestmark = pytest.mark.slow
+
+
+def test_a_baselines_study_writes_its_table_paired_with_pbp_alt_and_its_figures(
+        repo, tmp_path, monkeypatch):
+    monkeypatch.chdir(repo)  # the catalogue names the scenario files from the repository
+    generated = tmp_path / "generated"
+    assert main(["hsr_reach_baselines", "--trials", "2", "--outputs", str(tmp_path / "out"),
+                 "--generated", str(generated)]) == 0
+    text = (generated / "hsr_reach_baselines.md").read_text()
+    assert text.startswith("`pbp-drake study " + " ".join(
+        STUDIES["hsr_reach_baselines"]).replace("30", "2"))
+    assert "Each method against PBP-Alt, paired by seed" in text
+    for method in ("PBP-Cont", "HOP", "Policy blending", "Teleop"):
+        assert f"| task_time | {method} | " in text or f"| success | {method} | " in text
+    for figure in DOCS_FIGURES:
+        assert (generated / f"hsr_reach_baselines_{figure}").stat().st_size > 10_000

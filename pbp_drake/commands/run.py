@@ -359,7 +359,8 @@ def _run_session(args, resolved, meshcat, page, person):
         questions = FixedAnswers(parse_answers(args.answers, methods))
     else:
         questions = _StartInTheRun(MeshcatSessionPage(meshcat), args.start_on_connect)
-    if page is not None:
+    if page is not None and isinstance(questions, _StartInTheRun):
+        # The pages are the person's: no browser, no session (`--answers` needs none).
         print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
               "each method starts when its Start is pressed in the page, and the questions "
               "and Next are buttons there too (Open Controls).", flush=True)
@@ -405,8 +406,8 @@ def _run_session(args, resolved, meshcat, page, person):
                               questions, practice=args.practice)
     except (KeyboardInterrupt, _SessionStopped) as stop:
         stopped = isinstance(stop, _SessionStopped)
-        print(("\n" if not stopped else "") + f"{'Stopped in the page' if stopped else 'Stopped'}"
-              f": the methods and answers saved so far are in {output}; the same command "
+        print(("Stopped in the page" if stopped else "\nStopped")
+              + f": the methods and answers saved so far are in {output}; the same command "
               "resumes the session.", file=sys.stderr)
         if page is not None:
             page.end(f"The session was stopped; what was saved is kept. {PAGE_ENDED}")

@@ -110,3 +110,18 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     assert main(["run", str(repo / QUICK), "--no-meshcat", *argv]) == 2
     err = capsys.readouterr().err
     assert f"{named}: user-study sessions run the HSR tasks" in err
+
+
+def test_a_session_with_fixed_answers_waits_for_no_browser(repo, tmp_path, capsys):
+    # The virtual participant and --answers need no page: the session runs at once, even
+    # with a page served and a long --wait-for-browser.
+    started = time.monotonic()
+    code = main(["run", str(repo / TASK), "--operator", "virtual", "--participant", "P01",
+                 "--methods", "teleop", "--answers", "tiredness=3,ease=4", "--duration", "20",
+                 "--realtime-rate", "20", "--wait-for-browser", "60", "--port", "0",
+                 "--output", str(tmp_path / "P01")])
+    elapsed = time.monotonic() - started
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert elapsed < 30.0, f"took {elapsed:.1f} s"
+    assert "Session saved in" in out and "Open http" not in out

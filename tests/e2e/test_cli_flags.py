@@ -51,7 +51,7 @@ def test_good_flag_values_pass(repo, argv):
 
 def test_a_page_run_takes_a_free_port_and_prints_its_tokened_url(repo, capsys):
     port = free_port()
-    assert main(["run", str(repo / QUICK), "--port", str(port),
+    assert main(["run", str(repo / QUICK), "--port", str(port), "--realtime-rate", "20",
                  "--token", "a-script-chose_this-token"]) == 0
     out = capsys.readouterr().out
     assert f"Meshcat: http://localhost:{port}/?token=a-script-chose_this-token" in out

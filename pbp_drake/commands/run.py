@@ -32,6 +32,9 @@ from pbp_drake.studies.sessions import run_session
 RUN_CHOICES = ("stop", "restart", "next")
 AFTER_RUN_CHOICES = ("restart", "next", "close")
 PAGE_ENDED = "This run has ended; you can close this page."
+# Why a keyboard or gamepad run stops when no browser opens its page.
+PERSON_NEEDS_PAGE = ("the keyboard and gamepad are read in the page, so nothing was run or "
+                     "recorded")
 
 
 def add_run_command(commands):
@@ -216,7 +219,7 @@ def _run_scene(args, resolved, meshcat, page):
         console = _console(meshcat, page, args, scenario, choices=("stop",))
         console.show_title(method_name(scenario.method, _alpha(scenario)))
         if _terminal():  # someone may be watching
-            _wait_for_browser(page, meshcat, args.wait_for_browser)
+            _wait_for_browser(page, args.wait_for_browser)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration))
@@ -264,7 +267,8 @@ def _run_task(args, resolved, meshcat, page):
                      "the task starts when Start is pressed in the page."), flush=True)
             if person:
                 print(_controls_line(scenario), flush=True)
-            _wait_for_browser(page, meshcat, args.wait_for_browser, person)
+            _wait_for_browser(page, args.wait_for_browser,
+                              PERSON_NEEDS_PAGE if person else None)
         first = False
         result, live = _run_task_once(args, resolved, diagram, meshcat, console,
                                       start_button="Start" if _start_gate(args, person)
@@ -364,12 +368,9 @@ def _run_session(args, resolved, meshcat, page, person):
         print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
               "each method starts when its Start is pressed in the page, and the questions "
               "and Next are buttons there too (Open Controls).", flush=True)
-        _wait_for_browser(page, meshcat, args.wait_for_browser, person)
-        if page.pages() == 0:
-            raise ScenarioError(f"no browser opened {page.url} within "
-                                f"{args.wait_for_browser:g} s (--wait-for-browser): the "
-                                "session's Start buttons and questions are in the page, so "
-                                "nothing was run or saved")
+        _wait_for_browser(page, args.wait_for_browser, PERSON_NEEDS_PAGE if person else
+                          "the session's Start buttons and questions are in the page, so "
+                          "nothing was run or saved")
 
     # The live status and Stop, Restart, Next scene, as in a single run. Within a session,
     # Stop ends it (resumable, like Ctrl-C), Restart runs the method again (the stopped run
@@ -498,16 +499,16 @@ def _keep_page(args, page, console, choices):
                                    until=lambda: page.pages() == 0)
 
 
-def _wait_for_browser(page, meshcat, seconds, person=False):
-    """Waits up to `seconds` for a browser on the page. A person's run (keyboard, gamepad)
-    cannot go on without one: it stops with exit 2 before anything runs or is recorded."""
+def _wait_for_browser(page, seconds, needed=None):
+    """Waits up to `seconds` for a browser on the page. A run that cannot go on without one
+    (a person's, a session's: `needed` says why) stops with exit 2 before anything runs or
+    is recorded."""
     deadline = time.monotonic() + seconds
     while page.pages() == 0 and time.monotonic() < deadline:
         time.sleep(0.05)
-    if person and page.pages() == 0:
+    if needed is not None and page.pages() == 0:
         raise ScenarioError(f"no browser opened {page.url} within {seconds:g} s "
-                            "(--wait-for-browser): the keyboard and gamepad are read in the "
-                            "page, so nothing was run or recorded")
+                            f"(--wait-for-browser): {needed}")
 
 
 def _save_recording(meshcat, path):

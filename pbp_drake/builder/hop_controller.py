@@ -17,10 +17,10 @@ position only, since the reaching tasks' goals are positions.
 """
 
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import Demultiplexer, Multiplexer
+from pydrake.systems.primitives import Demultiplexer
 
-from pbp_drake.systems import (
-    GoalsSource, HandOver, HeadingCommand, HopAssistance, MaxEntGoalEstimator)
+from pbp_drake.builder.pbp_controller import add_hand_over
+from pbp_drake.systems import GoalsSource, HeadingCommand, HopAssistance, MaxEntGoalEstimator
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
 
@@ -78,14 +78,7 @@ def make_hop_controller(resolved):
     builder.Connect(posterior.get_goal_probabilities_output_port(),
                     assistance.get_goal_probabilities_input_port())
 
-    hand_over = builder.AddNamedSystem("hand_over", HandOver(
-        resolved.start, scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
-        period))
-    builder.Connect(assistance.get_command_output_port(), hand_over.get_reference_input_port())
-    ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
-    builder.Connect(hand_over.get_command_output_port(), ee_command.get_input_port(0))
-    builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
-    builder.ExportOutput(ee_command.get_output_port(), "ee_command")
+    add_hand_over(builder, resolved, assistance.get_command_output_port(), heading)
     builder.ExportOutput(posterior.get_selected_goal_output_port(), "selected_goal")
     builder.ExportOutput(posterior.get_goal_probabilities_output_port(), "goal_probabilities")
     builder.ExportOutput(posterior.get_posterior_clipped_output_port(), "posterior_clipped")

@@ -126,15 +126,7 @@ def make_pbp_controller(resolved, prediction_steps=0):
     builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
     builder.ConnectInput("operator_active", blender.get_operator_active_input_port())
 
-    hand_over = builder.AddNamedSystem("hand_over", HandOver(
-        resolved.start, scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
-        period))
-    builder.Connect(blender.get_command_output_port(), hand_over.get_reference_input_port())
-
-    ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
-    builder.Connect(hand_over.get_command_output_port(), ee_command.get_input_port(0))
-    builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
-    builder.ExportOutput(ee_command.get_output_port(), "ee_command")
+    add_hand_over(builder, resolved, blender.get_command_output_port(), heading)
     builder.ExportOutput(estimator.get_selected_goal_output_port(), "selected_goal")
     builder.ExportOutput(estimator.get_goal_probabilities_output_port(), "goal_probabilities")
     builder.ExportOutput(dmp_bank.get_phase_output_port(), "phase")
@@ -145,3 +137,18 @@ def make_pbp_controller(resolved, prediction_steps=0):
     diagram = builder.Build()
     diagram.set_name("pbp_controller")
     return diagram
+
+
+def add_hand_over(builder, resolved, reference, heading):
+    """Adds to `builder` the hand-over every method's command goes through (`HandOver`,
+    from the `reference` [p, v] output port, within the robot's limits) and the station's
+    command, its output with `heading`'s (a `HeadingCommand`), exported as `ee_command`."""
+    scenario = resolved.scenario
+    hand_over = builder.AddNamedSystem("hand_over", HandOver(
+        resolved.start, scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
+        scenario.control_period))
+    builder.Connect(reference, hand_over.get_reference_input_port())
+    ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
+    builder.Connect(hand_over.get_command_output_port(), ee_command.get_input_port(0))
+    builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
+    builder.ExportOutput(ee_command.get_output_port(), "ee_command")

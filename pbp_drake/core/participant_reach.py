@@ -19,6 +19,15 @@ the start. `assist_motion` serves all three with one behaviour:
   object (the target is behind the picked one, say, and only forward motion would tell
   them apart), it goes to the target itself as far as the keys allow: it turns the target
   to its side and sidesteps toward it, slowing near it as when driving.
+
+With `vertical=True` (a task whose objects stand at different heights, and keys that move
+the hand up and down) the velocities are 3-vectors `(vx, vy, vz)` instead of floor
+2-vectors. Driving (`drive_motion`) it heads for the target in 3-D. Assisting
+(`assist_motion`), the DMP takes the hand to the selected goal's height by itself: the
+participant moves only on the floor, as above (vz = 0), except when insisting, when it
+also goes toward the target's height. Either way its horizontal and vertical motion
+combine into one speed, as pressed keys do, at most `speed`. With `vertical=False` (the
+default) nothing differs from the planar task.
 """
 
 import numpy as np
@@ -73,11 +82,21 @@ def faces_target(params, position, heading, target):
     return abs(heading_error(heading, position, target)) <= 2 * params.aligned_angle
 
 
-def assist_motion(params, speed, position, heading, target, picked, insisting):
+def assist_motion(params, speed, position, heading, target, picked, insisting,
+                  vertical=False):
     """The floor velocity (2, m/s) and yaw rate (rad/s) of a participant who sees the
     estimate name `picked` instead of `target` (positions, 3), the hand at `position` with
     `heading`; `insisting` once it has faced the target `insist_time` to no avail. No
-    velocity it returns points forward (`without_forward`)."""
+    velocity it returns points forward (`without_forward`).
+
+    `vertical`: the velocity is `(vx, vy, vz)` (3): vz = 0 and the floor part as without
+    it, but when `insisting` (`insisting_motion_3d`)."""
+    if vertical:
+        if insisting:
+            return insisting_motion_3d(params, speed, position, heading, target)
+        velocity, yaw_rate = assist_motion(params, speed, position, heading, target, picked,
+                                           insisting)
+        return np.array([velocity[0], velocity[1], 0.0]), yaw_rate
     offset = target[:2] - position[:2]
     distance = np.linalg.norm(offset)
     toward_target = unit(offset)
@@ -99,12 +118,56 @@ def assist_motion(params, speed, position, heading, target, picked, insisting):
     return velocity, turn_rate(params, heading_error(heading, position, target))
 
 
-def drive_motion(params, speed, position, heading, target):
+def insisting_side_heading(heading, position, target):
+    """The heading that puts the target to the side of the hand it is already nearer (the
+    shorter turn), as an insisting participant wants it."""
+    toward_target = unit(target[:2] - position[:2])
+    side = 1.0 if heading_error(heading, position, target) >= 0.0 else -1.0
+    return np.arctan2(toward_target[1], toward_target[0]) - side * np.pi / 2
+
+
+def insisting_motion_3d(params, speed, position, heading, target):
+    """`assist_motion` insisting, with vertical motion: the velocity (3) toward the target
+    in 3-D as far as the keys allow (its floor part `without_forward`), at `speed` slowing
+    within `slow_radius` of the 3-D distance, so at most `speed` in all; the yaw rate turns
+    the target to its side as without vertical motion (none with the target straight above
+    or below)."""
+    offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
+    distance = np.linalg.norm(offset)
+    toward_target = unit(offset)
+    slow = min(1.0, distance / params.slow_radius)
+    floor = without_forward(toward_target[:2], heading)
+    velocity = speed * slow * np.array([floor[0], floor[1], toward_target[2]])
+    if np.linalg.norm(offset[:2]) < 1e-9:
+        return velocity, 0.0  # straight above or below: no side to turn it to
+    wanted_heading = insisting_side_heading(heading, position, target)
+    return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
+
+
+def drive_motion(params, speed, position, heading, target, vertical=False):
     """Teleop: the floor velocity (2) toward the target at `speed`, slowing within
-    `slow_radius`, and the yaw rate that turns the hand to face it."""
+    `slow_radius`, and the yaw rate that turns the hand to face it.
+
+    `vertical`: the velocity (3) toward the target in 3-D (`drive_motion_3d`)."""
+    if vertical:
+        return drive_motion_3d(params, speed, position, heading, target)
     offset = target[:2] - position[:2]
     distance = np.linalg.norm(offset)
     if distance < 1e-9:
         return np.zeros(2), 0.0
     velocity = speed * min(1.0, distance / params.slow_radius) * offset / distance
+    return velocity, turn_rate(params, heading_error(heading, position, target))
+
+
+def drive_motion_3d(params, speed, position, heading, target):
+    """Teleop with vertical motion: the velocity (3) along the 3-D unit offset to the
+    target at `speed * min(1, d / slow_radius)` (`d` the 3-D distance), and the yaw rate
+    that turns the hand to face it (none with the target straight above or below)."""
+    offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
+    distance = np.linalg.norm(offset)
+    if distance < 1e-9:
+        return np.zeros(3), 0.0
+    velocity = speed * min(1.0, distance / params.slow_radius) * offset / distance
+    if np.linalg.norm(offset[:2]) < 1e-9:
+        return velocity, 0.0
     return velocity, turn_rate(params, heading_error(heading, position, target))

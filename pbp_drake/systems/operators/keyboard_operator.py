@@ -16,6 +16,8 @@ LEFT_BUTTON = "Left (←)"
 RIGHT_BUTTON = "Right (→)"
 TURN_LEFT_BUTTON = "Turn left (Q)"
 TURN_RIGHT_BUTTON = "Turn right (E)"
+UP_BUTTON = "Up (R)"
+DOWN_BUTTON = "Down (F)"
 
 #: Button name -> JavaScript `KeyboardEvent.code` that clicks it.
 KEY_BUTTONS = {
@@ -35,6 +37,19 @@ _KEY_AXES = {
     RIGHT_BUTTON: (0.0, -1.0, 0.0),
     TURN_LEFT_BUTTON: (0.0, 0.0, 1.0),
     TURN_RIGHT_BUTTON: (0.0, 0.0, -1.0),
+}
+
+#: The buttons `vertical=True` adds (name -> `KeyboardEvent.code`): R up, F down.
+VERTICAL_KEY_BUTTONS = {
+    UP_BUTTON: "KeyR",
+    DOWN_BUTTON: "KeyF",
+}
+
+# With vertical motion, what one held key adds to [forward, left, up, yaw].
+_VERTICAL_KEY_AXES = {
+    **{name: (forward, left, 0.0, yaw) for name, (forward, left, yaw) in _KEY_AXES.items()},
+    UP_BUTTON: (0.0, 0.0, 1.0, 0.0),
+    DOWN_BUTTON: (0.0, 0.0, -1.0, 0.0),
 }
 
 
@@ -77,9 +92,16 @@ class KeyboardOperator(SampledOperator):
     comes from the DMP phase) the forward button is not added and ↑ does nothing; ↓ still
     works.
 
+    With `vertical=True` (a task whose objects stand at different heights; off by default,
+    and off nothing here changes) two more buttons (`VERTICAL_KEY_BUTTONS`) move the hand
+    up (R) and down (F), under PBP too (they are not the forward key). The translation keys
+    then combine into one 3-D direction at `speed`: ← with R goes diagonally, up and to the
+    left, at `speed`.
+
     Input `ee_state` `[p (3), v (3), heading, heading_rate]` gives the heading used to turn
     the robot-frame keys into the world frame. Output `operator_command` is
-    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0); `operator_active` is 1 while any
+    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0 unless `vertical`);
+    `operator_active` is 1 while any
     effective key is held (even if
     opposite keys cancel).
 
@@ -97,19 +119,24 @@ class KeyboardOperator(SampledOperator):
     FORWARD_BUTTON, BACK_BUTTON = FORWARD_BUTTON, BACK_BUTTON
     LEFT_BUTTON, RIGHT_BUTTON = LEFT_BUTTON, RIGHT_BUTTON
     TURN_LEFT_BUTTON, TURN_RIGHT_BUTTON = TURN_LEFT_BUTTON, TURN_RIGHT_BUTTON
+    UP_BUTTON, DOWN_BUTTON = UP_BUTTON, DOWN_BUTTON
 
     def __init__(self, meshcat, control_period, allow_forward, params=KeyboardParams(),
-                 nominal_speed=None, exclusive=True):
+                 nominal_speed=None, exclusive=True, vertical=False):
         super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
         self.browser_guard = BrowserGuard(meshcat) if exclusive else None
         self._allow_forward = bool(allow_forward)
+        self._vertical = bool(vertical)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
-        self._keys = HeldButtons(meshcat, {name: code for name, code in KEY_BUTTONS.items()
-                                           if allow_forward or name != FORWARD_BUTTON},
-                                 params.hold_time)
-        self._axes = np.array([_KEY_AXES[name] for name in self._keys.names])
+        keys = {name: code for name, code in KEY_BUTTONS.items()
+                if allow_forward or name != FORWARD_BUTTON}
+        if self._vertical:
+            keys.update(VERTICAL_KEY_BUTTONS)
+        self._keys = HeldButtons(meshcat, keys, params.hold_time)
+        axes = _VERTICAL_KEY_AXES if self._vertical else _KEY_AXES
+        self._axes = np.array([axes[name] for name in self._keys.names])
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         # Per button: the click count last seen, then the time of its last click.
         self._keys_index = self.DeclareDiscreteState(
@@ -145,6 +172,8 @@ class KeyboardOperator(SampledOperator):
         self._store_sample(discrete_state, *self._command(context, keys))
 
     def _command(self, context, keys):
+        if self._vertical:
+            return self._vertical_command(context, keys)
         held = self._keys.held(keys, context.get_time())
         forward, left, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(3)
         local = np.array([forward, left])
@@ -154,3 +183,15 @@ class KeyboardOperator(SampledOperator):
         velocity = rotate_planar(local, EeState(self._ee_state_port.Eval(context)).heading)
         yaw_rate = self._rotation_speed * yaw
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), bool(held.any())
+
+    def _vertical_command(self, context, keys):
+        """`_command` with the up and down keys: one 3-D direction at `speed`."""
+        held = self._keys.held(keys, context.get_time())
+        forward, left, up, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(4)
+        local = np.array([forward, left, up])
+        norm = np.linalg.norm(local)
+        if norm > 0:
+            local *= self._speed / norm  # e.g. ← with R goes diagonally at `speed`
+        velocity = rotate_planar(local[:2], EeState(self._ee_state_port.Eval(context)).heading)
+        yaw_rate = self._rotation_speed * yaw
+        return np.array([velocity[0], velocity[1], local[2], yaw_rate]), bool(held.any())

@@ -44,6 +44,17 @@ class VirtualOperator(SampledOperator):
     `mode="drive"` (teleoperation): it drives the whole way, toward the target at `speed`
     (slowing within `slow_radius`), turning to face it.
 
+    `vertical=True` (a reaching task whose objects stand at different heights, the
+    operator's keys moving the hand up and down too; off by default, and off it changes
+    nothing): driving, it heads for the target in 3-D, horizontal and vertical motion
+    combined into one speed at most `speed`; assisting, it leaves the height to the DMP
+    (vz = 0) except when insisting, when it also moves toward the target's height, again
+    at most `speed` in all (`pbp_drake.core.participant_reach`). Its noise turns the
+    horizontal part only and scales vz by the same speed factor; its `impairment`'s motor
+    noise shakes vz as well (one more axis, drawn after the others: the horizontal noise is
+    that of the same seed without it). Obstacles (`obstacle_count > 0`) keep the
+    participant planar: the two are refused together.
+
     It notices a new target only `reaction_delay` seconds after it appears, and its
     commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
     scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
@@ -69,17 +80,22 @@ class VirtualOperator(SampledOperator):
 
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
     `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is
-    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0).
+    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0 unless `vertical`).
     """
 
     def __init__(self, control_period, objects, mode="assist",
                  params=VirtualParticipantParams(), nominal_speed=None, seed=0,
                  obstacle_count=0, obstacle_radius=0.0, obstacle_margin=None,
-                 policy_adds=False):
+                 policy_adds=False, vertical=False):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
+        if vertical and obstacle_count > 0:
+            raise ValueError(f"vertical=True is for the reaching task; the participant "
+                             f"avoids obstacles on the floor only (got obstacle_count "
+                             f"{obstacle_count}): use vertical=False with obstacles")
         super().__init__(OperatorCommand.size, control_period)
+        self._vertical = bool(vertical)
         self._mode = mode
         self._objects = np.asarray(objects, dtype=float)
         self.params = copy.deepcopy(params)
@@ -129,11 +145,14 @@ class VirtualOperator(SampledOperator):
         # faced it while the estimate named another object (`insist_time`).
         self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
         self._insist_ticks = int(round(params.insist_time / control_period))
-        # The motor noise of `impairment`, [vx, vy, yaw rate], runs every tick.
+        # The motor noise of `impairment`, [vx, vy, yaw rate] (and vz last when vertical:
+        # drawn after the others, it leaves theirs as they are), runs every tick.
         self._noise_scales = None
         if is_noisy(impairment):
-            self._noise_scales = impairment.command_noise * np.array(
-                [self._speed, self._speed, self._rotation_speed])
+            axes = [self._speed, self._speed, self._rotation_speed]
+            if self._vertical:
+                axes.append(self._speed)
+            self._noise_scales = impairment.command_noise * np.array(axes)
             self._motor_noise_index = self.DeclareDiscreteState(
                 initial_motor_noise(self._seed, self._noise_scales))
         # Wrong first choices of target: [targets known so far, the object it heads for
@@ -209,6 +228,8 @@ class VirtualOperator(SampledOperator):
         command = np.array(command, dtype=float)
         command[:2] += noise[:2]
         command[3] += noise[2]
+        if self._vertical:
+            command[2] += noise[3]
         if self._mode == "assist" and self._obstacles_port is None:
             # The forward key stays disabled, however the hand shakes.
             heading = EeState(self._ee_state_port.Eval(context)).heading
@@ -380,13 +401,18 @@ class VirtualOperator(SampledOperator):
                 return np.zeros(4), False
             velocity, yaw_rate = assist_motion(
                 self.params, self._speed, position, heading, target_position,
-                self._objects[selected], insisting)
+                self._objects[selected], insisting, vertical=self._vertical)
         else:
             insisting = False
-            if np.linalg.norm(target_position[:2] - position[:2]) < 1e-9:
+            reached = (np.linalg.norm(target_position - position) if self._vertical
+                       else np.linalg.norm(target_position[:2] - position[:2]))
+            if reached < 1e-9:
                 return np.zeros(4), False
             velocity, yaw_rate = drive_motion(self.params, self._speed, position, heading,
-                                              target_position)
+                                              target_position, vertical=self._vertical)
+        if self._vertical:
+            return self._vertical_command(context, ee_state, velocity, yaw_rate, noise_angle,
+                                          speed_scale, insisting), True
         velocity = speed_scale * rotate_planar(velocity, noise_angle)
         if self._mode == "assist" and insisting and self._policy_adds:
             # Under PBP-Cont the DMP of the picked object keeps pulling the hand to it, and
@@ -394,6 +420,19 @@ class VirtualOperator(SampledOperator):
             # against it as it does among obstacles (`_avoid`).
             velocity = self._against_policy(context, ee_state, velocity)
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
+
+    def _vertical_command(self, context, ee_state, velocity, yaw_rate, noise_angle,
+                          speed_scale, insisting):
+        """`_decide`'s command with vertical motion, from the velocity (3) and yaw rate of
+        `participant_reach`: the noise turns the horizontal part and scales all of it."""
+        horizontal = speed_scale * rotate_planar(velocity[:2], noise_angle)
+        vz = speed_scale * velocity[2]
+        if self._mode == "assist" and insisting and self._policy_adds:
+            # `_against_policy` stays planar: it pushes against the DMP's pull on the floor,
+            # where the participant fights the picked object's pull to its side; vz goes
+            # on as the participant wants it (the DMP's vertical pull is not compensated).
+            horizontal = self._against_policy(context, ee_state, horizontal)
+        return np.array([horizontal[0], horizontal[1], vz, yaw_rate])
 
     def _against_policy(self, context, ee_state, wanted):
         """The command that moves the hand at `wanted` (2) under an additive blend: `wanted`

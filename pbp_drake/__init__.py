@@ -81,10 +81,17 @@ API_GROUPS = {
         "hsr_initial_hand_pose": "pbp_drake.robots",
         "hsr_ready_ee_state": "pbp_drake.robots",
     },
+    "Your own arm": {
+        **{name: "pbp_drake.robots" for name in [
+            "make_arm_station", "ArmStationConfig", "arm_initial_ee_state", "arm_reach",
+            "arm_ready_ee_state", "arm_station_plant"]},
+        **{name: "pbp_drake.core.controller_config" for name in [
+            "PbpControllerConfig", "HandOverSettings"]},
+    },
     "Scenario files": {
         name: "pbp_drake.scenarios" for name in [
             "load_scenario_file", "resolve", "ResolvedScenario", "ScenarioError",
-            "ScenarioFile", "Scenario", "Hsr", "PointRobot", "MultiGoalReach",
+            "ScenarioFile", "Scenario", "Hsr", "Arm", "PointRobot", "MultiGoalReach",
             "DynamicObstacles", "GraspTask", "VirtualParticipant", "Keyboard", "Gamepad",
             "NoOperator", "ScriptedCommands", "SinusoidalStep", "ObstacleRepulsion",
             "BentPath", "RecordedPath", "Obstacle", "MethodComparison", "AlphaStudy",

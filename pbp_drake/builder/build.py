@@ -1,7 +1,7 @@
 """The one entry point from a scenario to a Drake Diagram."""
 
 from pbp_drake.builder.grasp import build_grasp_diagram, check_grasp_buildable
-from pbp_drake.builder.hsr import build_hsr_diagram
+from pbp_drake.builder.reach import build_reach_diagram
 from pbp_drake.builder.point_robot import build_point_robot_diagram
 from pbp_drake.scenarios import GraspTask, ResolvedScenario, resolve
 
@@ -14,8 +14,8 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None):
     check_buildable(resolved)
     if isinstance(resolved.scenario.task, GraspTask):
         return build_grasp_diagram(resolved, meshcat)
-    if resolved.is_hsr:
-        return build_hsr_diagram(resolved, meshcat)
+    if resolved.has_task:
+        return build_reach_diagram(resolved, meshcat)
     return build_point_robot_diagram(resolved, meshcat, prediction_steps)
 
 

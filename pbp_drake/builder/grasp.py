@@ -67,7 +67,7 @@ ANGULAR_CHANGE_PER_TICK = 0.3
 # noise (10 %), so the cap does not slow the person, only a DMP far from its goal.
 MAX_HAND_ANGULAR_SPEED = 1.0
 # How many poses ahead the page draws the selected DMP's path, over the DMPs' duration (as
-# the reach task's HSR_PREDICTION_SAMPLES).
+# the reach task's TASK_PREDICTION_SAMPLES).
 GRASP_PREDICTION_SAMPLES = 40
 _OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad)
 

@@ -1,5 +1,5 @@
 """The operator system a scenario asks for: scripted or virtual in the 2-D scenes; a person
-at the keyboard or gamepad, or the virtual participant, on the HSR."""
+at the keyboard or gamepad, or the virtual participant, in the tasks (HSR or arm)."""
 
 import numpy as np
 
@@ -51,6 +51,8 @@ def make_hsr_operator(resolved, meshcat):
     period = scenario.control_period
     allow_forward = scenario.method in OPERATOR_DRIVES
     speed = resolved.nominal_speed
+    # Objects at heights of their own (`task.z_range`): the operator moves up and down too.
+    vertical = bool(getattr(scenario.task, "z_range", None))
     if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
         return IdleOperator(OperatorCommand.size, period)
     if isinstance(config, VirtualParticipant):
@@ -60,12 +62,13 @@ def make_hsr_operator(resolved, meshcat):
             params=config, nominal_speed=speed, seed=scenario.seed,
             obstacle_count=len(obstacles),
             obstacle_radius=obstacles[0].radius if obstacles else 0.0,
-            policy_adds=scenario.method == "pbp_continuous")
+            policy_adds=scenario.method == "pbp_continuous", vertical=vertical)
     if meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
     if isinstance(config, Keyboard):
-        return KeyboardOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
+        return KeyboardOperator(meshcat, period, allow_forward, config, nominal_speed=speed,
+                                vertical=vertical)
     if isinstance(config, Gamepad):
         return GamepadOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
     raise TypeError(f"unknown operator config {type(config).__name__}")

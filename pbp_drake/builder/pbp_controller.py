@@ -1,12 +1,14 @@
-"""The PBP controller of the HSR tasks as one Diagram: goals, goal estimator, DMP bank,
-blender and the heading, between the hand's sampled state and the station's command.
+"""The shared-control controller of a task-space robot as one Diagram, built from
+parameters alone (`PbpControllerConfig`): nothing in it knows which robot it drives.
+
+Under the PBP methods and explicit arbitration (`pbp_controller`):
 
     ee_state (sampled) ──> ee_state_split ──[p, v]──> dmp_bank, blender
                        └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
                                               dmp_bank (followed_goal, selected_goal)
+    goals ──> dmp_bank, goal_estimator
     operator_command ──> goal_estimator (the maxent_command estimator only)
     dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
-    goals ──> dmp_bank, goal_estimator
     operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
                                             └─> heading_command
     operator_active ──> dmp_bank (PBP-Alt's phase lock), blender
@@ -14,102 +16,159 @@ blender and the heading, between the hand's sampled state and the station's comm
     hand_over.command + heading_command.heading ──> ee_command (the station's input)
 
 The goal estimator is a `GoalEstimator`, or with `goal_estimator: {method: maxent_command}`
-a `MaxEntGoalEstimator` (HOP's posterior on the operator's command, with the scenario's
+a `MaxEntGoalEstimator` (HOP's posterior on the operator's command, with the config's
 `hop` settings and the `goal_estimator` section's hysteresis), which adds the output
-`posterior_clipped`. The methods ``hop`` and ``policy_blending`` have a controller of their
-own, without DMPs (`pbp_drake.builder.hop_controller`).
+`posterior_clipped`.
 
-A user with a station of their own (`pbp_drake.robots.make_hsr_station`) wires it as the
-builder does: `station.ee_state` through a `SampleHold` into `ee_state`, the operator's
+Under ``hop`` and ``policy_blending`` (`hop_controller`, no DMP bank) HOP's posterior and
+its assistance take the place of the estimator, the bank and the blender:
+
+    ee_state ──> goal_estimator (MaxEntGoalEstimator) ──> assistance (goal_probabilities)
+    ee_state_split [p, v] ──> assistance;  goals ──> goal_estimator, assistance
+    operator_command ──> goal_estimator;  operator_command_split (v) ──> assistance
+    assistance.command [p, v] ──> hand_over ──> ee_command (with the heading, as PBP's)
+
+A station of any robot (`make_hsr_station`, `make_arm_station`, a user's own with the same
+ports) is wired as the task builder does: `station.ee_state` through a `SampleHold` into
+`ee_state`, a `GoalsSource` (or any source of the K goals) into `goals`, the operator's
 outputs into `operator_command` and `operator_active`, and `ee_command` back into the
 station.
 """
 
+import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
+from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.systems import (
-    Blender, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand, MaxEntGoalEstimator)
+    Blender, DmpBank, GoalEstimator, HandOver, HeadingCommand, HopAssistance,
+    MaxEntGoalEstimator)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
-# How far ahead the HSR scene draws the DMPs' paths, in samples over the DMP's duration.
-HSR_PREDICTION_SAMPLES = 40
+# How far ahead the task scenes draw the DMPs' paths, in samples over the DMP's duration.
+TASK_PREDICTION_SAMPLES = 40
 
 
-def make_pbp_controller(resolved, prediction_steps=0):
-    """The PBP controller of a resolved HSR scenario, a Diagram named `pbp_controller`.
+def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
+                        prediction_steps=0):
+    """The controller of `config.method`, a Diagram named `pbp_controller` (or
+    `hop_controller` under ``hop`` and ``policy_blending``).
+
+    Args:
+        config: the controller's parameters (validated here; ValueError names the field).
+        initial_ee_state: the hand's `EeState` (8,) where the station starts (e.g.
+            `hsr_initial_ee_state(station)`, `arm_initial_ee_state(station)`): the DMPs
+            start there, the hand-over and the heading start from it.
+        goals: (K, 3) the candidate goals at the start, one DMP each: their count sizes
+            the controller, and with `config.dmp_duration` 0 the farthest one sets the
+            DMPs' duration. The goals themselves come in on the `goals` port (K x 3,
+            row-major), so they may move.
+        prediction_steps: > 0 adds `predicted_paths` (each DMP's path over its duration
+            in that many samples, for drawing; PBP methods).
 
     .. pydrake_system::
 
         name: pbp_controller
         input_ports:
         - ee_state
+        - goals
         - operator_command
-        - operator_active
+        - operator_active (not under hop and policy_blending)
         output_ports:
         - ee_command
         - selected_goal
         - goal_probabilities
-        - phase
+        - phase (with DMPs)
         - predicted_paths (with prediction_steps > 0)
-        - posterior_clipped (with the maxent_command estimator)
+        - posterior_clipped (with HOP's posterior)
 
-    `prediction_steps` > 0 adds `predicted_paths` (each DMP's path over its duration in
-    that many samples, for drawing).
+    `ee_state` is `[p (3), v (3), heading, heading_rate]`, `operator_command`
+    `[vx, vy, vz, yaw_rate]`, `operator_active` 1 while the operator acts, `ee_command`
+    `[p (3), v (3), heading]` for the next tick. `selected_goal` is the followed goal's
+    index, `goal_probabilities` the estimator's K probabilities.
     """
-    scenario = resolved.scenario
-    period = scenario.control_period
-    goals = resolved.goals
-    goal_count = len(goals)
-    bank = resolved.dmp_bank
+    config.validate()
+    initial_ee_state = np.asarray(initial_ee_state, float).reshape(-1)
+    if initial_ee_state.size != EeState.size or not np.isfinite(initial_ee_state).all():
+        raise ValueError(f"initial_ee_state must be {EeState.size} finite numbers (an "
+                         f"EeState), got {initial_ee_state.tolist()}")
+    goals = np.asarray(goals, float)
+    if goals.ndim != 2 or goals.shape[1] != 3 or len(goals) == 0:
+        raise ValueError(f"goals must be a non-empty (K, 3) array, got shape {goals.shape}")
     builder = DiagramBuilder()
-
     # Drake's (C++) Demultiplexers: their outputs depend on every source, time included,
     # but everything downstream reads them once a tick (the DMP bank's and the estimator's
     # updates, and the blender only through the hand-over's update), so nothing recomputes
     # between ticks, and no Python call is spent on splitting.
     split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, EeState.size - 6]))
     builder.ExportInput(split.get_input_port(), "ee_state")
+    command_split = builder.AddNamedSystem("operator_command_split", Demultiplexer(
+        [3, OperatorCommand.size - 3]))
+    builder.ExportInput(command_split.get_input_port(), "operator_command")
+    start = initial_ee_state[:3]
+    if config.blend_mode is None:
+        name, estimator, reference = "hop_controller", *_add_hop_policy(
+            builder, config, len(goals), split, command_split)
+    else:
+        name, estimator, reference = "pbp_controller", *_add_pbp_policy(
+            builder, config, start, goals, split, command_split, prediction_steps)
+    heading = builder.AddNamedSystem("heading_command", HeadingCommand(
+        EeState(initial_ee_state).heading, config.control_period,
+        config.hand_over.max_hand_yaw_acceleration))
+    builder.ConnectInput("operator_command", heading.get_operator_command_input_port())
+    hand_over = builder.AddNamedSystem("hand_over", HandOver(
+        start, config.hand_over.max_hand_acceleration, config.hand_over.max_hand_speed,
+        config.control_period))
+    builder.Connect(reference, hand_over.get_reference_input_port())
+    ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
+    builder.Connect(hand_over.get_command_output_port(), ee_command.get_input_port(0))
+    builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
+    builder.ExportOutput(ee_command.get_output_port(), "ee_command")
+    builder.ExportOutput(estimator.get_selected_goal_output_port(), "selected_goal")
+    builder.ExportOutput(estimator.get_goal_probabilities_output_port(), "goal_probabilities")
+    if isinstance(estimator, MaxEntGoalEstimator):
+        builder.ExportOutput(estimator.get_posterior_clipped_output_port(), "posterior_clipped")
+    diagram = builder.Build()
+    diagram.set_name(name)
+    return diagram
+
+
+def _add_pbp_policy(builder, config, start, goals, split, command_split, prediction_steps):
+    """The goal estimator, the DMP bank and the blender; returns the estimator and the
+    blender's command [p, v]."""
+    period = config.control_period
+    goal_count = len(goals)
     position_velocity = split.get_output_port(0)
-    goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
-
-    reads_command = scenario.goal_estimator.method == "maxent_command"
+    reads_command = config.goal_estimator.method == "maxent_command"
     estimator = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(
-        goal_count, scenario.hop, period, scenario.goal_estimator.margin,
-        scenario.goal_estimator.hold_steps) if reads_command else GoalEstimator(
-        goal_count, scenario.goal_estimator, period))
+        goal_count, config.hop, period, config.goal_estimator.margin,
+        config.goal_estimator.hold_steps) if reads_command else GoalEstimator(
+        goal_count, config.goal_estimator, period))
     builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
-    builder.Connect(goals_source.get_output_port(), estimator.get_goals_input_port())
+    builder.ExportInput(estimator.get_goals_input_port(), "goals")
+    if reads_command:
+        builder.ConnectInput("operator_command", estimator.get_operator_command_input_port())
 
+    bank = config.dmp_bank(start, goals)
     dmp_bank = builder.AddNamedSystem("dmp_bank", DmpBank(
-        bank, period, lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
+        bank, period, lock_phase_when_operator_acts=config.method == "pbp_alternated",
         prediction_steps=prediction_steps,
         prediction_period=bank.duration / max(prediction_steps, 1),
         # PBP-Cont adds the operator to a DMP that keeps running: without the limit, an
         # operator holding the hand off the DMP's path winds the DMP's velocity up past the
         # hand's speed limit until it overrides them (the other modes never hold it so).
-        max_speed=(scenario.robot.max_hand_speed if resolved.blend_mode == "pbp_continuous"
+        max_speed=(config.hand_over.max_hand_speed if config.blend_mode == "pbp_continuous"
                    else None),
         # Every DMP steps from the followed one's velocity (connected below): the state is
         # then O(D) whatever K (with shared weights and start, every scenario's bank, the
         # outputs are O(D) too).
         compact_state=True))
-    builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())
+    builder.ConnectInput("goals", dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
 
-    command_split = builder.AddNamedSystem("operator_command_split", Demultiplexer(
-        [3, OperatorCommand.size - 3]))
-    builder.ExportInput(command_split.get_input_port(), "operator_command")
-    heading = builder.AddNamedSystem("heading_command", HeadingCommand(
-        EeState(resolved.initial_ee_state).heading, period,
-        scenario.robot.max_hand_yaw_acceleration))
-    builder.ConnectInput("operator_command", heading.get_operator_command_input_port())
-    if reads_command:
-        builder.ConnectInput("operator_command", estimator.get_operator_command_input_port())
-
     blender = builder.AddNamedSystem("blender", Blender(
-        resolved.blend_mode, 3, goal_count, period, scenario.alpha))
+        config.blend_mode, 3, goal_count, period, config.alpha))
     builder.Connect(position_velocity, blender.get_robot_state_input_port())
     # The blender follows the selected goal's reference alone (O(D), not all K).
     builder.Connect(dmp_bank.get_selected_reference_output_port(),
@@ -125,30 +184,30 @@ def make_pbp_controller(resolved, prediction_steps=0):
                     blender.get_goal_probabilities_input_port())
     builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
     builder.ConnectInput("operator_active", blender.get_operator_active_input_port())
-
-    add_hand_over(builder, resolved, blender.get_command_output_port(), heading)
-    builder.ExportOutput(estimator.get_selected_goal_output_port(), "selected_goal")
-    builder.ExportOutput(estimator.get_goal_probabilities_output_port(), "goal_probabilities")
     builder.ExportOutput(dmp_bank.get_phase_output_port(), "phase")
     if prediction_steps:
         builder.ExportOutput(dmp_bank.get_predicted_paths_output_port(), "predicted_paths")
-    if reads_command:
-        builder.ExportOutput(estimator.get_posterior_clipped_output_port(), "posterior_clipped")
-    diagram = builder.Build()
-    diagram.set_name("pbp_controller")
-    return diagram
+    return estimator, blender.get_command_output_port()
 
 
-def add_hand_over(builder, resolved, reference, heading):
-    """Adds to `builder` the hand-over every method's command goes through (`HandOver`,
-    from the `reference` [p, v] output port, within the robot's limits) and the station's
-    command, its output with `heading`'s (a `HeadingCommand`), exported as `ee_command`."""
-    scenario = resolved.scenario
-    hand_over = builder.AddNamedSystem("hand_over", HandOver(
-        resolved.start, scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
-        scenario.control_period))
-    builder.Connect(reference, hand_over.get_reference_input_port())
-    ee_command = builder.AddNamedSystem("ee_command", Multiplexer([6, 1]))
-    builder.Connect(hand_over.get_command_output_port(), ee_command.get_input_port(0))
-    builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
-    builder.ExportOutput(ee_command.get_output_port(), "ee_command")
+def _add_hop_policy(builder, config, goal_count, split, command_split):
+    """HOP's posterior and assistance (no DMPs); returns the posterior and the
+    assistance's command [p, v]. The operator's yaw rate turns the hand as under PBP; HOP
+    assists the position only, since the reaching tasks' goals are positions.
+    `selected_goal` is the most probable goal (no hysteresis: policy blending assists
+    toward it)."""
+    period = config.control_period
+    posterior = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(
+        goal_count, config.hop, period))
+    builder.ConnectInput("ee_state", posterior.get_ee_state_input_port())
+    builder.ExportInput(posterior.get_goals_input_port(), "goals")
+    builder.ConnectInput("operator_command", posterior.get_operator_command_input_port())
+    assistance = builder.AddNamedSystem("assistance", HopAssistance(
+        config.method, goal_count, config.hop, period))
+    builder.Connect(split.get_output_port(0), assistance.get_robot_state_input_port())
+    builder.ConnectInput("goals", assistance.get_goals_input_port())
+    builder.Connect(command_split.get_output_port(0),
+                    assistance.get_operator_command_input_port())
+    builder.Connect(posterior.get_goal_probabilities_output_port(),
+                    assistance.get_goal_probabilities_input_port())
+    return posterior, assistance.get_command_output_port()

@@ -23,7 +23,7 @@ from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, mark_replay)
 from pbp_drake.scenarios import (
-    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, Hsr, ScenarioError, counted,
+    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, ScenarioError, TASK_ROBOTS, counted,
     load_scenario_file, resolve)
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers, scales_text
 from pbp_drake.studies.sessions import run_session
@@ -120,8 +120,8 @@ def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operato
         if operator not in OPERATOR_NAMES:
             raise ScenarioError(f"--operator {operator!r} is unknown; choose one of "
                                 f"{list(OPERATOR_NAMES)}")
-        if not isinstance(scenario.robot, Hsr):
-            raise ScenarioError("--operator chooses who drives the HSR tasks; this scenario "
+        if not isinstance(scenario.robot, TASK_ROBOTS):
+            raise ScenarioError("--operator chooses who drives the tasks; this scenario "
                                 "uses the 2-D toy robot")
         if not isinstance(scenario.operator, OPERATOR_NAMES[operator]):
             scenario = dataclasses.replace(scenario, operator=OPERATOR_NAMES[operator]())
@@ -173,9 +173,9 @@ def _run(args):
                                     args.alpha, args.scene, args.operator, args.seed,
                                     args.duration)
         check_buildable(resolved)  # before the page opens: what the builder cannot build
-        if args.camera == "robot" and not resolved.is_hsr:
-            raise ScenarioError("--camera robot follows the HSR; this scenario uses the 2-D "
-                                "toy robot")
+        if args.camera == "robot" and (not resolved.has_task or resolved.is_arm):
+            raise ScenarioError("--camera robot looks from the HSR's head; this scenario "
+                                "has no HSR")
         check_run_flags(args, resolved)  # and the flags' combinations, before the page too
     except BaseException:
         if listening is not None:
@@ -189,7 +189,7 @@ def _run(args):
         page = PageFront(meshcat.port(), listening, token=args.token)
         print(f"Meshcat: {page.url}", flush=True)
     try:
-        if resolved.is_hsr:
+        if resolved.has_task:
             return _run_task(args, resolved, meshcat, page)
         return _run_scene(args, resolved, meshcat, page)
     finally:

@@ -13,7 +13,7 @@ def check_run_flags(args, resolved):
     or not with the resolved scenario. `--no-meshcat` implies `--headless`."""
     if args.no_meshcat and (args.record or args.camera == "robot"):
         raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
-    if not resolved.is_hsr:
+    if not resolved.has_task:
         _check_scene_flags(args)
         return
     person = is_person(resolved.scenario)

@@ -12,8 +12,8 @@ from pbp_drake.cli_types import method_list
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
-    Hsr, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison, counted,
-    load_scenario_file)
+    TASK_ROBOTS, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison,
+    counted, load_scenario_file)
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.paired import (
     PAIRED_METRICS, paired_comparison, paired_table, paired_with, paired_with_markdown)
@@ -97,7 +97,7 @@ def _study(args):
     check_output_folder(args.output)
     scenario_file = load_scenario_file(args.scenario)
     check_buildable(scenario_file.resolved)
-    if isinstance(scenario_file.scenario.robot, Hsr):
+    if isinstance(scenario_file.scenario.robot, TASK_ROBOTS):
         return _method_study(args, scenario_file)
     if args.participant_condition is not None:
         raise ScenarioError(f"--participant-condition {args.participant_condition}: "

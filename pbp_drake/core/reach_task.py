@@ -37,10 +37,14 @@ def check_object_count(object_count, switch_schedule):
 
 
 def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(-1.05, 1.05),
-                       height=0.7, switch_schedule=(0.0, 0.3, 0.6), min_separation=0.2):
+                       height=0.7, switch_schedule=(0.0, 0.3, 0.6), min_separation=0.2,
+                       z_range=None):
     """Draws a scene from `seed` alone (the same seed, the same scene, for every method).
 
-    Objects closer than `min_separation` are redrawn, so that each can be told apart.
+    Objects closer than `min_separation` (in the floor plane) are redrawn, so that each can
+    be told apart. With a `z_range` (low, high) each object's height is drawn in it, after
+    everything else (so the rest of the scene is the same as without); else all are at
+    `height`.
     """
     low, high = check_object_count(object_count, switch_schedule)
     rng = np.random.default_rng(seed)
@@ -60,6 +64,8 @@ def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
     for _ in switch_schedule[1:]:
         others = [i for i in range(count) if i != targets[-1]]
         targets.append(int(others[rng.integers(len(others))]))
+    if z_range:
+        objects[:, 2] = rng.uniform(*z_range, size=count)
     return ReachScene(objects=objects, targets=tuple(targets))
 
 

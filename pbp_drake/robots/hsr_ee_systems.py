@@ -168,7 +168,8 @@ class EeStateFromPlant(LeafSystem):
         - ee_state
 
     `plant_state` is `plant`'s state output; `ee_state` is `[p_WE (3), v_WE (3), heading,
-    heading_rate]` (`EeState`) of `ee_body`; heading_rate is the hand's angular velocity
+    heading_rate]` (`EeState`) of `ee_body` (a body, or any frame of the plant: an arm's
+    end-effector frame may be offset from its link); heading_rate is the hand's angular velocity
     about world z (the rate of the heading while the hand's z axis stays near the floor
     plane).
 
@@ -181,7 +182,13 @@ class EeStateFromPlant(LeafSystem):
     def __init__(self, plant, ee_body):
         super().__init__()
         self._plant = plant
+        # A body frame is read through its body, whose pose and velocity the plant caches.
+        if hasattr(ee_body, "body") and ee_body.index() == ee_body.body().body_frame().index():
+            ee_body = ee_body.body()
         self._body = ee_body
+        self._pose = getattr(ee_body, "EvalPoseInWorld", None) or ee_body.CalcPoseInWorld
+        self._velocity = (getattr(ee_body, "EvalSpatialVelocityInWorld", None)
+                          or ee_body.CalcSpatialVelocityInWorld)
         self._plant_context = plant.CreateDefaultContext()
         self._plant_state_port = self.DeclareVectorInputPort(
             "plant_state", plant.num_multibody_states())
@@ -198,8 +205,8 @@ class EeStateFromPlant(LeafSystem):
         plant_context = self._plant_context
         self._plant.SetPositionsAndVelocities(plant_context,
                                               self._plant_state_port.Eval(context))
-        X_WE = self._body.EvalPoseInWorld(plant_context)
-        V_WE = self._body.EvalSpatialVelocityInWorld(plant_context)
+        X_WE = self._pose(plant_context)
+        V_WE = self._velocity(plant_context)
         w, v = V_WE.rotational(), V_WE.translational()
         output.SetFromVector(np.concatenate(
             [X_WE.translation(), v, [heading_of(X_WE.rotation()), w[2]]]))

@@ -1,4 +1,5 @@
-"""The kinematic HSR: joints that are where the diff IK's plan is, at every instant.
+"""Kinematic robots: joints that are where the diff IK's plan is, at every instant (the
+HSR's and an arm's stations with ``motion: kinematic``).
 
 With ``HsrStationConfig.motion = "kinematic"`` the station steps no plant. The
 MultibodyPlant is finalized outside the Diagram, for its kinematics (the diff IK's and the
@@ -30,21 +31,22 @@ class KinematicJoints(LeafSystem):
 
     ``desired_state`` is ``[q_d, v_d]`` of ``motor_joints`` (in that order; the diff IK's
     plan at this instant, no look-ahead); ``state`` is ``plant``'s ``[q, v]`` with every
-    motor there and the torso where the coupler keeps it (``TORSO_TO_ARM_LIFT_RATIO``
-    times the arm lift). No state of its own: the robot is the plan.
+    motor there and each coupled joint where its coupler keeps it (``couplers``: pairs of
+    a follower joint and its leader, with the ratio; the HSR's torso follows at
+    ``TORSO_TO_ARM_LIFT_RATIO`` times the arm lift). No state of its own: the robot is the
+    plan.
     """
 
-    def __init__(self, plant, model, motor_joints):
+    def __init__(self, plant, motor_joints, couplers=()):
         super().__init__()
         self._plant = plant
         nq = plant.num_positions()
         # Where the motors' [q_d, v_d] go in [q, v], and the torso's and the lift's entries.
         self._scatter = np.array([joint.position_start() for joint in motor_joints]
                                  + [nq + joint.velocity_start() for joint in motor_joints])
-        torso = plant.GetJointByName(TORSO_JOINT_NAME, model)
-        lift = plant.GetJointByName("arm_lift_joint", model)
-        self._torso = [torso.position_start(), nq + torso.velocity_start()]
-        self._lift = [lift.position_start(), nq + lift.velocity_start()]
+        self._couplers = [([follower.position_start(), nq + follower.velocity_start()],
+                           [leader.position_start(), nq + leader.velocity_start()], ratio)
+                          for follower, leader, ratio in couplers]
         self._desired_port = self.DeclareVectorInputPort("desired_state",
                                                          2 * len(motor_joints))
         self._state_port = self.DeclareVectorOutputPort(
@@ -63,7 +65,8 @@ class KinematicJoints(LeafSystem):
     def _calc_state(self, context, output):
         state = np.zeros(output.size())
         state[self._scatter] = self._desired_port.Eval(context)
-        state[self._torso] = TORSO_TO_ARM_LIFT_RATIO * state[self._lift]
+        for follower, leader, ratio in self._couplers:
+            state[follower] = ratio * state[leader]
         output.SetFromVector(state)
 
 
@@ -76,10 +79,17 @@ def add_kinematic_plant(builder, time_step):
     return plant, scene_graph
 
 
-def add_kinematic_joints(builder, plant, model, scene_graph, motor_joints, desired_state):
+def hsr_couplers(plant, model):
+    """The HSR's coupler for `KinematicJoints`: the torso follows the arm lift."""
+    return [(plant.GetJointByName(TORSO_JOINT_NAME, model),
+             plant.GetJointByName("arm_lift_joint", model), TORSO_TO_ARM_LIFT_RATIO)]
+
+
+def add_kinematic_joints(builder, plant, scene_graph, motor_joints, desired_state,
+                         couplers=()):
     """`KinematicJoints` fed by `desired_state`, placing the plant's geometry in
     `scene_graph`; returns it (its `state` is the robot's)."""
-    joints = builder.AddNamedSystem("joints", KinematicJoints(plant, model, motor_joints))
+    joints = builder.AddNamedSystem("joints", KinematicJoints(plant, motor_joints, couplers))
     builder.Connect(desired_state, joints.get_desired_state_input_port())
     # Keeps a reference to the plant, which the Diagram does not own (pydrake keeps the
     # plant alive as long as this system).

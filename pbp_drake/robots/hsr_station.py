@@ -42,9 +42,6 @@ Example::
 """
 
 import numpy as np
-from pydrake.geometry import (
-    CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Rgba,
-    Role)
 from pydrake.math import RotationMatrix
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import PdControllerGains
@@ -52,7 +49,8 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
 from pbp_drake.robots.hsr_ee_systems import EeCommandRamp, EeStateFromPlant, heading_of
-from pbp_drake.robots.hsr_kinematic import add_kinematic_joints, add_kinematic_plant
+from pbp_drake.robots.hsr_kinematic import (
+    add_kinematic_joints, add_kinematic_plant, hsr_couplers)
 from pbp_drake.robots.hsr_model import (
     ACTUATED_JOINT_NAMES,
     ARM_JOINT_NAMES,
@@ -64,14 +62,13 @@ from pbp_drake.robots.hsr_model import (
     add_hsr,
 )
 from pbp_drake.robots.hsr_pose_systems import HAND_FRAME, PoseCommandRamp, PoseStateFromPlant
+from pbp_drake.robots.station_parts import add_meshcat_visualizers, add_obstacles
 from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
     CylinderObstacle,
     HsrStationConfig,
     validate_hsr_station_config,
 )
-from pbp_drake.systems.tasks.collision_monitor import CollisionMonitor
 from pbp_drake.systems.ports import EeState
-from pbp_drake.systems.tasks.obstacle_geometry import CylinderObstacleGeometry
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
 # the hand starts in front of the base with room to move both ways along x with the
@@ -247,8 +244,9 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(
         plant, model, q0, config, motor_joints, ramp, look_ahead, frame_name))
     if kinematic:
-        joints = add_kinematic_joints(builder, plant, model, scene_graph, motor_joints,
-                                      diff_ik.get_desired_state_output_port())
+        joints = add_kinematic_joints(builder, plant, scene_graph, motor_joints,
+                                      diff_ik.get_desired_state_output_port(),
+                                      hsr_couplers(plant, model))
         state = joints.get_state_output_port()
     else:
         state = plant.get_state_output_port()
@@ -272,9 +270,9 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
         builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
     if config.obstacles:
-        _add_obstacles(builder, plant, scene_graph, model, config.obstacles)
+        add_obstacles(builder, plant, scene_graph, model, config.obstacles)
     if meshcat is not None:
-        _add_meshcat_visualizers(builder, scene_graph, meshcat, config.visualization)
+        add_meshcat_visualizers(builder, scene_graph, meshcat, config.visualization)
     station = builder.Build()
     station.set_name("hsr_station")
     return station
@@ -291,51 +289,6 @@ def _add_hand_pose(builder, plant, model, q0, state):
                                                                        q_start))
     builder.Connect(state, hand_pose.get_plant_state_input_port())
     builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
-
-
-def _add_obstacles(builder, plant, scene_graph, model, obstacles):
-    """The cylinders, placed by the input obstacle_positions and measured against the
-    robot's collision geometry (in_collision, clearance)."""
-    geometry = builder.AddNamedSystem("obstacle_geometry", CylinderObstacleGeometry(
-        scene_graph, [(obstacle.radius, obstacle.height) for obstacle in obstacles]))
-    builder.Connect(geometry.get_geometry_pose_output_port(),
-                    scene_graph.get_source_pose_port(geometry.source_id))
-    robot_geometries = [geometry_id for body in plant.GetBodyIndices(model)
-                        for geometry_id in plant.GetCollisionGeometriesForBody(
-                            plant.get_body(body))]
-    # The obstacles are measured, not felt: keep them out of the plant's contact (which
-    # also refuses pairs of geometries it does not own, such as two obstacles meeting).
-    scene_graph.collision_filter_manager().Apply(
-        CollisionFilterDeclaration()
-        .ExcludeBetween(GeometrySet(robot_geometries), GeometrySet(geometry.geometry_ids))
-        .ExcludeWithin(GeometrySet(geometry.geometry_ids)))
-    collisions = builder.AddNamedSystem(
-        "collision_monitor", CollisionMonitor(robot_geometries, geometry.geometry_ids))
-    builder.Connect(scene_graph.get_query_output_port(),
-                    collisions.get_query_object_input_port())
-    builder.ExportInput(geometry.get_obstacle_positions_input_port(), "obstacle_positions")
-    builder.ExportOutput(collisions.get_in_collision_output_port(), "in_collision")
-    builder.ExportOutput(collisions.get_clearance_output_port(), "clearance")
-
-
-def _add_meshcat_visualizers(builder, scene_graph, meshcat, visualization):
-    """What `visualization` asks of Meshcat (Drake's `VisualizationConfig`, read here
-    without its LCM side): the illustration geometry, and the proximity geometry (hidden
-    at first) when `publish_proximity`."""
-    if visualization.publish_illustration:
-        MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(
-            role=Role.kIllustration, publish_period=visualization.publish_period,
-            default_color=visualization.default_illustration_color,
-            delete_on_initialization_event=visualization.delete_on_initialization_event,
-            enable_alpha_slider=visualization.enable_alpha_sliders))
-    if visualization.publish_proximity:
-        color = visualization.default_proximity_color
-        MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(
-            role=Role.kProximity, prefix="proximity", visible_by_default=False,
-            publish_period=visualization.publish_period,
-            default_color=Rgba(color.r(), color.g(), color.b(),
-                               visualization.initial_proximity_alpha),
-            delete_on_initialization_event=visualization.delete_on_initialization_event))
 
 
 def hsr_station_plant(station: Diagram) -> MultibodyPlant:

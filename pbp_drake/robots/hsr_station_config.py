@@ -21,14 +21,14 @@ class CylinderObstacle:
 MOTIONS = ("dynamic", "kinematic")
 
 
-def _default_plant_config():
+def default_station_plant_config():
     # SAP enforces the torso's coupler constraint and applies the motors' PD implicitly.
     # Live output ports: see validate_hsr_station_config.
     return MultibodyPlantConfig(time_step=0.005, discrete_contact_approximation="sap",
                                 use_sampled_output_ports=False)
 
 
-def _default_visualization():
+def default_station_visualization():
     # Meshcat only: the proximity shapes, contact forces and inertias are off by default
     # (each is a publisher at every frame).
     return VisualizationConfig(publish_proximity=False, publish_contacts=False,
@@ -47,7 +47,7 @@ class HsrStationConfig:
     """
 
     #: Drake's MultibodyPlantConfig of the robot's plant (time step, contact model).
-    plant: MultibodyPlantConfig = dataclasses.field(default_factory=_default_plant_config)
+    plant: MultibodyPlantConfig = dataclasses.field(default_factory=default_station_plant_config)
     #: How the robot moves along the diff IK's plan. "dynamic": the plant (SAP, every
     #: plant.time_step) and its stiff servos track the plan, a few hundredths of a mm
     #: behind it. "kinematic": the joints are on the plan at every instant (the servos'
@@ -115,7 +115,7 @@ class HsrStationConfig:
     #: What the station shows in Meshcat when it is given one (Drake's config; its
     #: illustration and proximity settings are used, its LCM and contact parts are not).
     visualization: VisualizationConfig = dataclasses.field(
-        default_factory=_default_visualization)
+        default_factory=default_station_visualization)
 
 
 def validate_hsr_station_config(config: HsrStationConfig) -> None:

@@ -13,8 +13,8 @@ from pbp_drake.scenarios.resolution import (
     BLEND_MODE_OF_METHOD, ResolvedScenario, TaskScene, demonstration_samples,
     parse_method_label, resolve, task_scene, with_method)
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, METHODS, OPERATOR_DRIVES, OPERATOR_NAMES, TOY_OPERATORS, AlphaStudy,
-    AltVsCont, BentPath, DynamicObstacles, Gamepad, GraspTask, Hsr, Keyboard, MethodComparison,
+    HSR_OPERATORS, METHODS, OPERATOR_DRIVES, OPERATOR_NAMES, TASK_ROBOTS, TOY_OPERATORS,
+    AlphaStudy, AltVsCont, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask, Hsr, Keyboard, MethodComparison,
     MultiGoalReach, NoOperator, Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot,
     RecordedPath, Scenario, ScenarioError, ScenarioFile, SceneVariant, ScriptedCommands,
     SinusoidalStep, VirtualParticipant)
@@ -22,7 +22,8 @@ from pbp_drake.scenarios.words import METHOD_NAMES, counted
 
 __all__ = [
     "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHOD_NAMES", "METHODS", "OPERATOR_DRIVES",
-    "OPERATOR_NAMES", "TOY_OPERATORS", "AlphaStudy", "AltVsCont", "BentPath",
+    "OPERATOR_NAMES", "TASK_ROBOTS", "TOY_OPERATORS", "AlphaStudy", "AltVsCont", "Arm",
+    "BentPath",
     "DynamicObstacles", "Gamepad", "GraspTask", "Hsr", "Keyboard", "LoadedScenarioFile",
     "MethodComparison", "MultiGoalReach",
     "NoOperator", "Obstacle", "ObstacleRepulsion", "OperatorConfig", "PointRobot",

@@ -15,7 +15,7 @@ from pydrake.common.yaml import yaml_load_typed
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
-    AlphaStudy, Gamepad, Hsr, Keyboard, MethodComparison, Scenario, ScenarioError,
+    AlphaStudy, Gamepad, Keyboard, MethodComparison, Scenario, ScenarioError, TASK_ROBOTS,
     STUDY_SPLITS, ScenarioFile)
 from pbp_drake.scenarios.validation import (
     check_numbers, check_seed, describe_load_error, read_scenario_text, shape_problem)
@@ -106,8 +106,9 @@ def check_operator_speeds(study, scenario):
 
 
 def check_method_comparison(study, scenario):
-    if not isinstance(scenario.robot, Hsr):
-        raise ScenarioError("study !MethodComparison runs HSR tasks: use robot: !Hsr")
+    if not isinstance(scenario.robot, TASK_ROBOTS):
+        raise ScenarioError("study !MethodComparison runs the tasks: use robot: !Hsr or "
+                            "!Arm")
     if not study.methods:
         raise ScenarioError("study.methods is empty")
     for method in study.methods:

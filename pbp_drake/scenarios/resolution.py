@@ -15,25 +15,26 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.controller_config import HandOverSettings, PbpControllerConfig
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
 from pbp_drake.core.toy_scene import bent_path
-from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
+from pbp_drake.robots import CylinderObstacle, arm_reach, arm_ready_ee_state, hsr_ready_ee_state
 from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, METHODS, TOY_OPERATORS, BentPath, DynamicObstacles, GraspTask, Hsr,
-    ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands, SinusoidalStep,
-    VirtualParticipant)
+    HSR_OPERATORS, METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles,
+    Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands,
+    SinusoidalStep, VirtualParticipant)
 from pbp_drake.scenarios.validation import (
     check_bent_path, check_direction, check_dmp_duration, check_grasp_task, check_numbers,
     check_obstacle_task, check_reach_task, check_seed, check_time_steps,
     check_virtual_participant, require_finite)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator;
-# HOP and policy blending have no blender: their assistance is `builder.hop_controller`'s).
+# HOP and policy blending have no blender: their assistance is the HOP controller's).
 BLEND_MODE_OF_METHOD = {
     "pbp_alternated": "pbp_alternated",
     "pbp_continuous": "pbp_continuous",
@@ -68,23 +69,28 @@ class ResolvedScenario:
         start: (D,) where the robot (2-D scenes) or the hand (HSR) starts.
         goals: (K, D) the goals, one DMP each.
         demonstration: (times (T,), positions (T, D)) or None.
-        dmp_bank: the fitted `pbp_drake.core.dmp.DmpBankModel` (read-only by convention).
-        scene: the HSR task's `TaskScene`, None in 2-D scenes.
-        station: the HSR station's config (hand height and command period filled in from
-            the task), None in 2-D scenes.
-        initial_ee_state: (8,) the HSR hand's state at the start, None in 2-D scenes.
-        nominal_speed: the DMPs' nominal speed (m/s) on the HSR, None in 2-D scenes.
+        dmp_bank: the 2-D scenes' fitted `pbp_drake.core.dmp.DmpBankModel` (read-only by
+            convention); None in the tasks, whose controller fits its own from
+            `controller` (`PbpControllerConfig.dmp_bank`).
+        scene: the task's `TaskScene` (HSR and arm), None in 2-D scenes.
+        station: the station's config, an `HsrStationConfig` (hand height and command
+            period filled in from the task) or an `ArmStationConfig`; None in 2-D scenes.
+        initial_ee_state: (8,) the hand's state at the start, None in 2-D scenes.
+        nominal_speed: the DMPs' nominal speed (m/s) in the tasks, None in 2-D scenes.
+        controller: the tasks' `PbpControllerConfig` (what `make_pbp_controller` builds
+            from), None in 2-D scenes.
     """
 
     scenario: Scenario
     start: np.ndarray
     goals: np.ndarray
     demonstration: typing.Optional[tuple]
-    dmp_bank: DmpBankModel
+    dmp_bank: typing.Optional[DmpBankModel]
     scene: typing.Optional[TaskScene] = None
     station: typing.Any = None
     initial_ee_state: typing.Optional[np.ndarray] = None
     nominal_speed: typing.Optional[float] = None
+    controller: typing.Optional[PbpControllerConfig] = None
 
     @property
     def blend_mode(self):
@@ -93,15 +99,22 @@ class ResolvedScenario:
         return BLEND_MODE_OF_METHOD[self.scenario.method]
 
     @property
-    def is_hsr(self):
+    def has_task(self):
+        """Whether a task robot (the HSR or an arm) runs a seeded task, not a 2-D scene."""
         return self.scene is not None
+
+    @property
+    def is_arm(self):
+        return isinstance(self.scenario.robot, Arm)
 
     def with_method(self, label):
         """This scenario run by the method `label` (see `parse_method_label`); what does not
         depend on the method (the DMPs, the scene) is kept, not derived again."""
         scenario = with_method(self.scenario, label)
         _check_method(scenario, self.goals.shape[0])
-        return dataclasses.replace(self, scenario=scenario)
+        controller = self.controller and dataclasses.replace(
+            self.controller, method=scenario.method, alpha=scenario.alpha)
+        return dataclasses.replace(self, scenario=scenario, controller=controller)
 
 
 def resolve(scenario):
@@ -110,8 +123,8 @@ def resolve(scenario):
     Raises ScenarioError naming the first field whose value cannot be used.
     """
     _check_common(scenario)
-    if isinstance(scenario.robot, Hsr):
-        return _resolve_hsr(scenario)
+    if isinstance(scenario.robot, TASK_ROBOTS):
+        return _resolve_task_robot(scenario)
     return _resolve_point_robot(scenario)
 
 
@@ -183,7 +196,7 @@ def _whole_multiple(value, step):
 
 def _check_method(scenario, goal_count):
     """What the method asks of the rest of the scenario."""
-    if isinstance(scenario.robot, Hsr):
+    if isinstance(scenario.robot, TASK_ROBOTS):
         return
     if scenario.method == "confidence_alpha":
         raise ScenarioError("scenario.method confidence_alpha needs a goal estimator's "
@@ -304,25 +317,30 @@ def _check_toy_operator(operator, dimension):
             raise ScenarioError("scenario.operator.commands contain NaN or infinite values")
 
 
-def _resolve_hsr(scenario):
+def _resolve_task_robot(scenario):
+    """The HSR's or an arm's task: the scene drawn from the seed, the station's config, the
+    hand's start and the controller's config."""
     robot = scenario.robot
+    tag = f"!{type(robot).__name__}"
     if scenario.task is None:
-        raise ScenarioError("robot !Hsr needs scenario.task, e.g. task: {object_count: [2, 4]}")
+        raise ScenarioError(f"robot {tag} needs scenario.task, e.g. task: "
+                            "{object_count: [2, 4]}")
     if not isinstance(scenario.operator, HSR_OPERATORS):
         raise ScenarioError(
             f"scenario.operator !{type(scenario.operator).__name__} drives the 2-D toy robot; "
-            f"the HSR takes one of {[c.__name__ for c in HSR_OPERATORS]}")
+            f"robot {tag} takes one of {[c.__name__ for c in HSR_OPERATORS]}")
     if scenario.demonstration is not None or scenario.goals or scenario.start:
-        raise ScenarioError("the HSR task draws its own goals (the objects) and starts "
-                            "where the robot stands: remove scenario.demonstration, goals "
-                            "and start")
+        raise ScenarioError("the task draws its own goals (the objects) and starts where "
+                            "the robot stands: remove scenario.demonstration, goals and start")
+    station_field = "scenario.robot.station" if isinstance(robot, Hsr) else "scenario.robot"
+    station = robot.station if isinstance(robot, Hsr) else robot.station_config()
     require_finite(robot, "scenario.robot", ("speed",))
     check_time_steps([
-        ("scenario.robot.station.plant.time_step", robot.station.plant.time_step),
-        ("scenario.robot.station.diff_ik_time_step", robot.station.diff_ik_time_step)])
-    if not _whole_multiple(scenario.control_period, robot.station.plant.time_step):
+        (f"{station_field}.plant.time_step", station.plant.time_step),
+        (f"{station_field}.diff_ik_time_step", station.diff_ik_time_step)])
+    if not _whole_multiple(scenario.control_period, station.plant.time_step):
         raise ScenarioError("scenario.control_period must be a whole multiple of "
-                            "scenario.robot.station.plant.time_step")
+                            f"{station_field}.plant.time_step")
     operator = scenario.operator
     require_finite(operator, "scenario.operator",
                    ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
@@ -334,24 +352,39 @@ def _resolve_hsr(scenario):
     if isinstance(task, DynamicObstacles):
         check_obstacle_task(task)
     elif isinstance(task, GraspTask):
+        if isinstance(robot, Arm):
+            raise ScenarioError("scenario.task !GraspTask runs on the HSR's pose station; "
+                                "robot !Arm takes the reaching and obstacle tasks")
         check_grasp_task(task)
     else:
         check_reach_task(task)
+        if task.z_range and isinstance(operator, Gamepad):
+            raise ScenarioError("scenario.operator !Gamepad has no up and down: a task whose "
+                                "objects stand at heights of their own (scenario.task."
+                                "z_range) takes !Keyboard or !VirtualParticipant")
+    if isinstance(robot, Arm):
+        station, initial_ee_state, reach = _arm_station(scenario, station)
+    else:
+        reach = None
     try:
-        scene = task_scene(task, scenario.seed)
+        scene = task_scene(task, scenario.seed, reach)
     except ValueError as error:
         raise ScenarioError(f"scenario.task: {error}") from None
-    # The hand starts at the task's height, the station ramps between the loop's ticks, and
-    # it measures the task's cylinders against the robot.
+    # The HSR's hand starts at the task's height; the station ramps between the loop's
+    # ticks, and it measures the task's cylinders against the robot.
     cylinders = [] if scene.obstacles is None else [
         CylinderObstacle(radius=task.obstacle_radius, height=task.obstacle_height)
         for _ in scene.obstacles.obstacle_starts]
-    station = dataclasses.replace(robot.station, ee_height=task.height,
-                                  command_period=scenario.control_period, obstacles=cylinders)
-    try:
-        initial_ee_state = hsr_ready_ee_state(station)
-    except ValueError as error:
-        raise ScenarioError(f"scenario.robot.station: {error}") from None
+    if isinstance(robot, Hsr):
+        station = dataclasses.replace(station, ee_height=task.height,
+                                      command_period=scenario.control_period,
+                                      obstacles=cylinders)
+        try:
+            initial_ee_state = hsr_ready_ee_state(station)
+        except ValueError as error:
+            raise ScenarioError(f"scenario.robot.station: {error}") from None
+    else:
+        station = dataclasses.replace(station, obstacles=cylinders)
     start = initial_ee_state[:3].copy()
     goals = np.asarray(scene.objects, float)
     nearest = float(np.min(np.linalg.norm(goals - start, axis=1)))
@@ -363,11 +396,30 @@ def _resolve_hsr(scenario):
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
     check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
                        scenario.dmp_duration > 0 else "scenario.robot.speed")
-    bank = DmpBankModel.straight(start, len(goals), duration, scenario.dmp)
+    controller = PbpControllerConfig(
+        method=scenario.method, alpha=scenario.alpha, control_period=scenario.control_period,
+        dmp=scenario.dmp, dmp_duration=float(duration), nominal_speed=float(robot.speed),
+        goal_estimator=scenario.goal_estimator, hop=scenario.hop,
+        hand_over=HandOverSettings(robot.max_hand_acceleration, robot.max_hand_speed,
+                                 robot.max_hand_yaw_acceleration))
+    # The DMPs are fitted where they run: by the controller, from `controller`.
     return ResolvedScenario(
-        scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=bank,
-        scene=scene, station=station,
-        initial_ee_state=initial_ee_state, nominal_speed=float(robot.speed))
+        scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=None,
+        scene=scene, station=station, initial_ee_state=initial_ee_state,
+        nominal_speed=float(robot.speed), controller=controller)
+
+
+def _arm_station(scenario, station):
+    """An arm's station config (ramping between the loop's ticks), the hand's start and
+    the arm's reach `(shoulder, radius)`; the arm's refusals name scenario.robot's field."""
+    station = dataclasses.replace(station, command_period=scenario.control_period)
+    try:
+        initial_ee_state = arm_ready_ee_state(station)
+        reach = arm_reach(station)
+    except ValueError as error:
+        raise ScenarioError(str(error).replace("ArmStationConfig.", "scenario.robot.")
+                            ) from None
+    return station, initial_ee_state, reach
 
 
 def _check_hand_over(scenario):
@@ -400,10 +452,12 @@ def _check_hand_over(scenario):
             f"rad/s, longer than scenario.duration {scenario.duration} s: raise it")
 
 
-def task_scene(task, seed):
-    """The goals, targets and obstacles of an HSR task, drawn from `seed` when asked."""
+def task_scene(task, seed, reach=None):
+    """The goals, targets and obstacles of a task, drawn from `seed` when asked. `reach`
+    (an arm's `(shoulder, radius)`) replaces the HSR's reach in the checks of where the
+    goals may be."""
     if isinstance(task, DynamicObstacles):
-        _check_region(task)
+        _check_region(task, reach)
         obstacles = sample_obstacle_scene(
             seed, tuple(task.x_range), tuple(task.y_range), task.height,
             task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
@@ -414,15 +468,15 @@ def task_scene(task, seed):
         grasps = grasp_scene(task, seed)
         return TaskScene(objects=grasps.grasp_positions, targets=grasps.targets,
                           switch_schedule=tuple(task.switch_schedule), grasps=grasps)
-    scene = _reach_scene(task, seed)
+    scene = _reach_scene(task, seed, reach)
     return TaskScene(objects=scene.objects, targets=scene.targets,
                       switch_schedule=tuple(task.switch_schedule))
 
 
-def _reach_scene(task, seed):
+def _reach_scene(task, seed, reach):
     """The objects and target sequence of a reaching task: given, or drawn from the seed."""
     if task.objects:
-        objects = validate_objects(task.objects, task.min_separation)
+        objects = _validate_within_reach(task.objects, task.min_separation, reach)
         targets = tuple(int(t) for t in task.targets)
         if len(task.switch_schedule) > 1 and len(objects) < 2:
             raise ValueError("target switching needs at least 2 objects: add objects or set "
@@ -439,14 +493,34 @@ def _reach_scene(task, seed):
         return ReachScene(objects=objects, targets=targets)
     if task.targets:
         raise ValueError("targets are given without objects")
-    _check_region(task)
+    _check_region(task, reach)
     return sample_reach_scene(seed, tuple(task.object_count), tuple(task.x_range),
                               tuple(task.y_range), task.height, tuple(task.switch_schedule),
-                              task.min_separation)
+                              task.min_separation, tuple(getattr(task, "z_range", ())))
 
 
-def _check_region(task):
+def _check_region(task, reach):
     """Every corner of the region the task draws its targets from must be in reach."""
     if len(task.x_range) != 2 or len(task.y_range) != 2:
         raise ValueError("x_range and y_range must be [low, high]")
-    validate_objects([[x, y, task.height] for x in task.x_range for y in task.y_range], 0.0)
+    heights = getattr(task, "z_range", None) or [task.height]
+    _validate_within_reach([[x, y, z] for x in task.x_range for y in task.y_range
+                            for z in heights], 0.0, reach)
+
+
+def _validate_within_reach(objects, min_separation, reach):
+    """`validate_objects` with the HSR's reach, or with an arm's `(shoulder, radius)`: each
+    point within radius of the shoulder, refused with the reach the arm has."""
+    if reach is None:
+        return validate_objects(objects, min_separation)
+    objects = validate_objects(objects, min_separation, reach_x=(0.0, np.inf),
+                               reach_height=(-np.inf, np.inf))
+    shoulder, radius = reach
+    distances = np.linalg.norm(objects - shoulder, axis=1)
+    farthest = int(np.argmax(distances))
+    if distances[farthest] > radius:
+        point = ", ".join(f"{value:.2f}" for value in objects[farthest])
+        raise ValueError(f"({point}) m is {distances[farthest]:.2f} m from the arm's "
+                         f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), beyond "
+                         f"its reach of {radius:.2f} m")
+    return objects

@@ -23,9 +23,11 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.visualization import VisualizationConfig
 
+from pbp_drake.core.controller_config import HandOverSettings, PbpControllerConfig
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.hindsight_optimization import HopSettings
+from pbp_drake.robots.arm_station_config import ArmStationConfig
 from pbp_drake.robots.hsr_station_config import HsrStationConfig
 from pbp_drake.systems.operators.gamepad_operator import GamepadParams
 from pbp_drake.systems.operators.keyboard_operator import KeyboardParams
@@ -81,18 +83,44 @@ class Hsr:
     station: HsrStationConfig = dataclasses.field(default_factory=HsrStationConfig)
     #: The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it,
     #: and operators whose speed is 0 move the hand at it.
-    speed: float = 0.12
+    speed: float = PbpControllerConfig.nominal_speed
     #: The hand-over law (`pbp_drake.core.hand_over`): a goal switch, the operator pressing
     #: or releasing changes the hand's commanded velocity by at most max_hand_acceleration
     #: (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command never exceeds
     #: max_hand_speed (m/s), however far a primitive is from its attractor. 0.2 m/s is the
     #: base's published speed limit: a hand driven faster for long runs its arm out of
     #: range, and the whole-body IK then lurches.
-    max_hand_acceleration: float = 1.0
+    max_hand_acceleration: float = HandOverSettings.max_hand_acceleration
     #: The fastest commanded hand speed (m/s).
-    max_hand_speed: float = 0.2
+    max_hand_speed: float = HandOverSettings.max_hand_speed
     #: The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
-    max_hand_yaw_acceleration: float = 4.0
+    max_hand_yaw_acceleration: float = HandOverSettings.max_hand_yaw_acceleration
+
+
+@dataclasses.dataclass
+class Arm(ArmStationConfig):
+    """`robot: !Arm {model_file: ..., base_frame: ..., ee_frame: ...}`: a fixed-base arm
+    from a URDF or SDFormat file (ours, `package://pbp_drake_models/arm7/pbp_arm7.urdf`,
+    or a user's own) under differential IK; every field of ArmStationConfig, and the
+    controller's speed and hand-over limits as the HSR's."""
+
+    #: The DMPs' nominal speed (m/s), as the HSR's.
+    speed: float = PbpControllerConfig.nominal_speed
+    #: The fastest change of the commanded hand velocity (m/s^2), as the HSR's.
+    max_hand_acceleration: float = HandOverSettings.max_hand_acceleration
+    #: The fastest commanded hand speed (m/s).
+    max_hand_speed: float = HandOverSettings.max_hand_speed
+    #: The same for the hand's heading (rad/s^2).
+    max_hand_yaw_acceleration: float = HandOverSettings.max_hand_yaw_acceleration
+
+    def station_config(self):
+        """Its fields of ArmStationConfig, as one."""
+        return ArmStationConfig(**{field.name: getattr(self, field.name)
+                                   for field in dataclasses.fields(ArmStationConfig)})
+
+
+# The robots that run the tasks (goals drawn from a seed, an operator, a station).
+TASK_ROBOTS = (Hsr, Arm)
 
 
 @dataclasses.dataclass
@@ -190,8 +218,12 @@ class MultiGoalReach:
     x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
     #: The objects' y range (m).
     y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
-    #: The objects' and the hand's height (m).
+    #: The objects' and the HSR hand's height (m).
     height: float = 0.7
+    #: The objects' height range [min, max] (m), drawn per object; empty: all at height.
+    #: The hand then starts where the robot's ready pose puts it, and the operators get
+    #: up and down keys.
+    z_range: list[float] = dataclasses.field(default_factory=list)
     #: The least distance between two objects (m).
     min_separation: float = 0.2
     #: The progress fractions (0 to 1) at which the target switches.
@@ -298,8 +330,8 @@ class Scenario:
     control_period: float = 0.01
     #: The time limit (s) of a run.
     duration: float = 2.0
-    #: The robot: the toy point robot (untagged) or `!Hsr`.
-    robot: typing.Union[PointRobot, Hsr] = dataclasses.field(default_factory=PointRobot)
+    #: The robot: the toy point robot (untagged), `!Hsr` or `!Arm`.
+    robot: typing.Union[PointRobot, Hsr, Arm] = dataclasses.field(default_factory=PointRobot)
     #: The robot's initial position; empty: the demonstration's start.
     start: list[float] = dataclasses.field(default_factory=list)
     #: Candidate goals, one DMP each; empty: the demonstration's goal.

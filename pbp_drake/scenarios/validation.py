@@ -415,6 +415,8 @@ def check_reach_task(task):
     require_finite(task, "scenario.task", ("success_distance", "min_separation"))
     for name in ("x_range", "y_range"):
         check_range(task, "scenario.task", name)
+    if task.z_range:
+        check_range(task, "scenario.task", "z_range")
     check_range(task, "scenario.task", "object_count")
     # Objects are placed min_separation apart in front of the robot: a few dozen fit.
     check_count(task.object_count[0], "scenario.task.object_count[0]", 1, 100)

@@ -72,10 +72,22 @@ def plain(value):
     return value
 
 
+# Fields added to the schema after studies were run, left out of the content while at their
+# defaults: the trials of a scenario that does not use them are the same as before, and its
+# study folders still resume.
+_LATER_FIELDS = {"task": {"z_range": []}}
+
+
 def scenario_content(scenario):
     """Everything in the scenario but its method and seed (a study sets those per trial),
     as plain data."""
-    return plain(dataclasses.replace(scenario, method="", seed=0))
+    content = plain(dataclasses.replace(scenario, method="", seed=0))
+    for section, fields in _LATER_FIELDS.items():
+        values = content.get(section)
+        for name, default in fields.items():
+            if isinstance(values, dict) and values.get(name, default) == default:
+                values.pop(name, None)
+    return content
 
 
 def scenario_hash(scenario):

@@ -39,9 +39,8 @@ def test_resolving_draws_the_seeds_scene_with_the_grasp_positions_as_goals(shipp
     np.testing.assert_array_equal(resolved.goals, layout.grasps.grasp_positions)
     assert layout.targets == expected.targets
     assert layout.switch_schedule == (0.0, 0.3, 0.6)
-    # One position DMP per object's grasp position (the orientation bank is the pose
-    # bank's, wired by the builder later).
-    assert resolved.dmp_bank.goal_count == len(layout.objects)
+    # One goal per object's grasp position (the builder fits the DMPs).
+    assert len(resolved.goals) == len(layout.objects)
     assert resolved.station.ee_height == 0.7
 
 

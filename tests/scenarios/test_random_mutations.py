@@ -121,7 +121,7 @@ def _first_second(resolved):
 
 def _outputs(resolved):
     """The time series of a one-second run of `resolved`."""
-    if resolved.is_hsr:
+    if resolved.has_task:
         result = run_task(_first_second(resolved))
         return [result.ee_positions, result.headings, result.commands, result.operator_commands]
     trajectory = simulate(_first_second(resolved))

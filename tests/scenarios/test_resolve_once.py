@@ -48,9 +48,9 @@ def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     build_diagram(loaded.resolved, meshcat)
     scenario = loaded.scenario
     assert work["bent_path"] == (1 if isinstance(scenario.demonstration, BentPath) else 0)
-    # The grasping task's builder fits its own position bank from the pose station's hand
-    # (hand_palm_link); the resolved one starts at the heading station's hand_ee_link.
-    assert work["fit_weights"] == (2 if path.stem == "hsr_grasp" else 1)
+    # Once, where the DMPs run: the 2-D scenes' when resolved, the tasks' in their
+    # controller (the grasping task's from the pose station's hand).
+    assert work["fit_weights"] == 1
     scenes = (work["sample_reach_scene"] + work["sample_obstacle_scene"]
               + work["sample_grasp_scene"])
     assert scenes == (1 if scenario.task is not None else 0)
@@ -58,7 +58,7 @@ def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
 
 def test_loading_the_grasping_task_draws_its_scene_once(work):
     load_scenario_file(SHIPPED[0].parent / "hsr_grasp.yaml")
-    assert work["sample_grasp_scene"] == 1 and work["fit_weights"] == 1
+    assert work["sample_grasp_scene"] == 1 and work["fit_weights"] == 0
     assert work["sample_reach_scene"] + work["sample_obstacle_scene"] == 0
 
 

@@ -15,7 +15,7 @@ TARGET_COLOUR = Rgba(1.0, 0.9, 0.0, 1.0)
 ESTIMATE_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 ACTIVE_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
-# Dots per path (each of HSR_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
+# Dots per path (each of TASK_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
 # every path update, so their count and rate set most of its size.
 PATH_DOTS = 24
 ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008

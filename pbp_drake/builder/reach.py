@@ -1,17 +1,20 @@
-"""The HSR tasks' diagram (sections IV-B.1 and IV-B.2 of the paper), a handful of blocks:
+"""The reaching and obstacle tasks' diagram (sections IV-B.1 and IV-B.2 of the paper) on
+the HSR or an arm, a handful of blocks:
 
-    hsr_station.ee_state ──> ee_state_sample (SampleHold) ──> pbp_controller, task_monitor,
-                                                               obstacles
-    hsr_station.ee_state, task_monitor.target, pbp_controller.selected_goal ──> operator
+    station.ee_state ──> ee_state_sample (SampleHold) ──> pbp_controller, task_monitor,
+                                                          obstacles
+    goals (GoalsSource, the task's objects) ──> pbp_controller
+    station.ee_state, task_monitor.target, pbp_controller.selected_goal ──> operator
     operator ──> pbp_controller (operator_command, operator_active), task_monitor
-    pbp_controller.ee_command ──> hsr_station.ee_command (whole-body differential IK)
-    obstacles.obstacle_positions ──> hsr_station;  hsr_station.in_collision ──> task_monitor
+    pbp_controller.ee_command ──> station.ee_command (differential IK)
+    obstacles.obstacle_positions ──> station;  station.in_collision ──> task_monitor
 
-`hsr_station` (`pbp_drake.robots.make_hsr_station`: plant, diff IK, PD, obstacle geometry,
-collision monitor, Meshcat visualizer) and `pbp_controller`
-(`pbp_drake.builder.pbp_controller`) are Diagrams of their own; under ``hop`` and
-``policy_blending`` the controller is `hop_controller` (`pbp_drake.builder.hop_controller`,
-no DMPs: no `phase` or `predicted_paths`, and no `operator_active` input). The order within
+The station is `hsr_station` (`pbp_drake.robots.make_hsr_station`) or `arm_station`
+(`make_arm_station`, `robot: !Arm`): plant, diff IK, obstacle geometry, collision monitor,
+Meshcat visualizer. The controller (`pbp_drake.builder.make_pbp_controller`, from the
+resolved scenario's `PbpControllerConfig`) is a Diagram of its own; under ``hop`` and
+``policy_blending`` it is `hop_controller` (no DMPs: no `phase` or `predicted_paths`, and
+no `operator_active` input). The order within
 a tick is `pbp_drake.systems.tick`'s. Loggers named `ee_state_log`, `operator_active_log`,
 `operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` (with
 DMPs), `posterior_clipped_log` (where the controller has HOP's posterior) and (with
@@ -22,17 +25,16 @@ at success.
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from pbp_drake.builder.hop_controller import make_hop_controller
 from pbp_drake.builder.operators import make_hsr_operator
-from pbp_drake.builder.pbp_controller import HSR_PREDICTION_SAMPLES, make_pbp_controller
-from pbp_drake.core.hindsight_optimization import HOP_METHODS
-from pbp_drake.robots import make_hsr_station
-from pbp_drake.systems import ReachSceneVisualizer, SampleHold, TaskMonitor
+from pbp_drake.builder.pbp_controller import TASK_PREDICTION_SAMPLES, make_pbp_controller
+from pbp_drake.robots import ArmStationConfig, make_arm_station, make_hsr_station
+from pbp_drake.systems import GoalsSource, ReachSceneVisualizer, SampleHold, TaskMonitor
 from pbp_drake.systems.tasks.moving_obstacles import MovingObstacles
 
 
-def build_hsr_diagram(resolved, meshcat=None):
-    """The Diagram of a resolved HSR scenario; with `meshcat`, drawn there too."""
+def build_reach_diagram(resolved, meshcat=None):
+    """The Diagram of a resolved reaching or obstacle task (HSR or arm); with `meshcat`,
+    drawn there too."""
     scenario = resolved.scenario
     period = scenario.control_period
     task = scenario.task
@@ -40,8 +42,10 @@ def build_hsr_diagram(resolved, meshcat=None):
     start = resolved.start
     builder = DiagramBuilder()
 
-    station = builder.AddNamedSystem("hsr_station", make_hsr_station(resolved.station,
-                                                                     meshcat))
+    station = (make_arm_station(resolved.station, meshcat)
+               if isinstance(resolved.station, ArmStationConfig)
+               else make_hsr_station(resolved.station, meshcat))
+    station = builder.AddNamedSystem(station.get_name(), station)
     ee_state = station.GetOutputPort("ee_state")
     sample = builder.AddNamedSystem("ee_state_sample",
                                     SampleHold(period, resolved.initial_ee_state))
@@ -53,12 +57,12 @@ def build_hsr_diagram(resolved, meshcat=None):
         period))
     builder.Connect(sampled, monitor.get_ee_state_input_port())
 
-    prediction_steps = HSR_PREDICTION_SAMPLES if meshcat is not None else 0
-    if scenario.method in HOP_METHODS:
-        controller = builder.AddNamedSystem("hop_controller", make_hop_controller(resolved))
-    else:
-        controller = builder.AddNamedSystem("pbp_controller",
-                                            make_pbp_controller(resolved, prediction_steps))
+    prediction_steps = TASK_PREDICTION_SAMPLES if meshcat is not None else 0
+    controller = make_pbp_controller(resolved.controller, resolved.initial_ee_state,
+                                     resolved.goals, prediction_steps)
+    controller = builder.AddNamedSystem(controller.get_name(), controller)
+    goals = builder.AddNamedSystem("goals", GoalsSource(resolved.goals))
+    builder.Connect(goals.get_output_port(), controller.GetInputPort("goals"))
     builder.Connect(sampled, controller.GetInputPort("ee_state"))
     builder.Connect(controller.GetOutputPort("ee_command"), station.GetInputPort("ee_command"))
 

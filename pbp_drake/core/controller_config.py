@@ -1,0 +1,109 @@
+"""What a shared-control controller is built from: `PbpControllerConfig`, plain dataclasses.
+
+`make_pbp_controller(PbpControllerConfig(...), initial_ee_state, goals)` builds the
+controller of any robot whose station takes an `ee_command` and gives an `ee_state` (the
+HSR's, an arm's from `make_arm_station`, a user's own). A scenario file's sections are the
+same dataclasses (``dmp``, ``goal_estimator``, ``hop``), and its robot's hand-over fields
+take their defaults from `HandOverSettings`, so a Python user and a YAML user get the same
+controller; `pbp_drake.scenarios.resolve` fills one in from a scenario
+(`ResolvedScenario.controller`).
+"""
+
+import dataclasses
+
+import numpy as np
+
+from pbp_drake.core.dmp import DmpBankModel, DmpSettings
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.hand_over import check_limit
+from pbp_drake.core.hindsight_optimization import HOP_METHODS, HopSettings
+
+# The methods a task robot's controller runs (the toy robot's demonstration player,
+# fixed_alpha with a demonstration, is the 2-D scenes' own).
+CONTROLLER_METHODS = ("pbp_alternated", "pbp_continuous", "pbp_no_user", "fixed_alpha",
+                      "confidence_alpha", "teleop") + tuple(HOP_METHODS)
+
+
+@dataclasses.dataclass
+class HandOverSettings:
+    """The hand-over law (`pbp_drake.core.hand_over`): a goal switch, or the operator
+    pressing or releasing, changes the hand's commanded velocity by at most
+    `max_hand_acceleration` (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command
+    never exceeds `max_hand_speed` (m/s), however far a primitive is from its attractor."""
+
+    #: The fastest change of the commanded hand velocity (m/s^2).
+    max_hand_acceleration: float = 1.0
+    #: The fastest commanded hand speed (m/s). 0.2 m/s is the HSR base's published limit.
+    max_hand_speed: float = 0.2
+    #: The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
+    max_hand_yaw_acceleration: float = 4.0
+
+    def validate(self):
+        """Raises ValueError naming the first limit that is not finite and positive."""
+        check_limit(self.max_hand_acceleration, "max_hand_acceleration", "m/s^2")
+        check_limit(self.max_hand_speed, "max_hand_speed", "m/s")
+        check_limit(self.max_hand_yaw_acceleration, "max_hand_yaw_acceleration", "rad/s^2")
+
+
+@dataclasses.dataclass
+class PbpControllerConfig:
+    """Everything `make_pbp_controller` builds from; one default per knob, the scenario
+    file's."""
+
+    #: One of CONTROLLER_METHODS: PBP alternated or continuous, PBP with no operator,
+    #: explicit arbitration (fixed or confidence alpha), teleop, or the HOP baselines.
+    method: str = "pbp_alternated"
+    #: The arbitration weight of fixed_alpha, in [0, 1].
+    alpha: float = 0.5
+    #: The control tick's period (s): the controller decides once a tick.
+    control_period: float = 0.01
+    #: The DMPs' gains and basis.
+    dmp: DmpSettings = dataclasses.field(default_factory=DmpSettings)
+    #: The DMPs' duration tau (s); 0: the farthest goal's distance over nominal_speed.
+    dmp_duration: float = 0.0
+    #: The DMPs' nominal speed (m/s), for their duration when dmp_duration is 0.
+    nominal_speed: float = 0.12
+    #: How the followed goal is estimated.
+    goal_estimator: GoalEstimatorSettings = dataclasses.field(
+        default_factory=GoalEstimatorSettings)
+    #: HOP's cost model, posterior and assistance (hop, policy_blending and the
+    #: maxent_command estimator).
+    hop: HopSettings = dataclasses.field(default_factory=HopSettings)
+    #: The hand-over law's limits, which every method's command goes through.
+    hand_over: HandOverSettings = dataclasses.field(default_factory=HandOverSettings)
+
+    def validate(self):
+        """Raises ValueError naming the first field that cannot be used."""
+        if self.method not in CONTROLLER_METHODS:
+            raise ValueError(f"method {self.method!r} is not one of {CONTROLLER_METHODS}")
+        if not (np.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
+            raise ValueError(f"alpha must lie in [0, 1], got {self.alpha!r}")
+        check_limit(self.control_period, "control_period", "s")
+        check_limit(self.nominal_speed, "nominal_speed", "m/s")
+        if not (np.isfinite(self.dmp_duration) and self.dmp_duration >= 0.0):
+            raise ValueError(f"dmp_duration must be finite and >= 0 (0: from "
+                             f"nominal_speed), got {self.dmp_duration!r}")
+        for name in ("dmp", "goal_estimator", "hop", "hand_over"):
+            try:
+                getattr(self, name).validate()
+            except ValueError as error:
+                raise ValueError(f"{name}.{error}") from None
+        if self.goal_estimator.method == "pose":
+            raise ValueError("goal_estimator.method pose reads grasp orientations, which a "
+                             "position controller has not")
+
+    @property
+    def blend_mode(self):
+        """The blender's mode (PBP-NoUser is PBP-Cont with no operator); None for the HOP
+        baselines, which have no blender."""
+        if self.method in HOP_METHODS:
+            return None
+        return "pbp_continuous" if self.method == "pbp_no_user" else self.method
+
+    def dmp_bank(self, start, goals):
+        """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, of
+        `dmp_duration` or the farthest goal's distance over `nominal_speed`."""
+        start, goals = np.asarray(start, float), np.asarray(goals, float)
+        duration = self.dmp_duration or float(
+            np.max(np.linalg.norm(goals - start, axis=1))) / self.nominal_speed
+        return DmpBankModel.straight(start, len(goals), duration, self.dmp)

@@ -1,0 +1,167 @@
+"""Loading a fixed-base arm from a URDF or SDFormat file into a MultibodyPlant, with the
+checks a user's own model needs: the file, the frames, the chain from the base to the
+end effector, the joints' limits, and the ready configuration.
+
+Every refusal is a one-line ValueError naming the `ArmStationConfig` field at fault.
+"""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.multibody.parsing import Parser
+
+from pbp_drake.robots.hsr_model import configure_parser
+
+# The ready configuration's ee_frame z axis must be at most this far (degrees) off the
+# floor plane: the heading is where that axis points in it.
+MAX_TILT_DEGREES = 60.0
+
+
+@dataclasses.dataclass(frozen=True)
+class ArmModel:
+    """An arm loaded into a plant by `add_arm`: its model instance, `base_frame` and
+    `ee_frame` (Drake frames), the movable `joints` of the model (in its order; each
+    gets a motor) and the `chain` of joints from the base to the end effector."""
+
+    model: object
+    base_frame: object
+    ee_frame: object
+    joints: tuple
+    chain: tuple
+
+
+def add_arm(plant, config, parser=None):
+    """Adds the arm of `config` (an `ArmStationConfig`) to `plant` (not finalized yet),
+    its base frame welded to the world at `config.base_pose`, and returns an `ArmModel`.
+    Raises ValueError naming the field for a file that is missing or does not parse, a
+    frame the model has not, an end effector that is not downstream of the base, a joint
+    without limits or of a kind the station cannot move."""
+    parser = parser or Parser(plant)
+    configure_parser(parser)
+    source = config.model_file
+    try:
+        if source.startswith("package://"):
+            models = parser.AddModels(url=source)
+        else:
+            path = Path(source)
+            if not path.is_file():
+                raise ValueError(f"ArmStationConfig.model_file: no file at {source!r} (a path "
+                                 "from the working folder, or a package:// URL)")
+            models = parser.AddModels(str(path))
+    except ValueError:
+        raise
+    except Exception as error:  # Drake's parser raises RuntimeError with the details
+        first = str(error).strip().splitlines()[0] if str(error).strip() else type(error)
+        raise ValueError(f"ArmStationConfig.model_file {source!r} does not load: {first}"
+                         ) from None
+    if len(models) != 1:
+        raise ValueError(f"ArmStationConfig.model_file {source!r} holds {len(models)} models; "
+                         "the station takes one arm")
+    (model,) = models
+    base_frame = _frame(plant, model, config, "base_frame")
+    ee_frame = _frame(plant, model, config, "ee_frame")
+    inboard = {plant.get_joint(index).child_body().index(): plant.get_joint(index)
+               for index in plant.GetJointIndices(model)}
+    base_body = base_frame.body()
+    if base_body.index() in inboard:
+        joint = inboard[base_body.index()]
+        raise ValueError(f"ArmStationConfig.base_frame {config.base_frame!r} is not the "
+                         f"model's root: it hangs from joint {joint.name()!r} of "
+                         f"{joint.parent_body().name()!r}; name the link the arm stands on")
+    chain, body = [], ee_frame.body()
+    while body.index() != base_body.index():
+        if body.index() not in inboard:
+            raise ValueError(f"ArmStationConfig.ee_frame {config.ee_frame!r} is not "
+                             f"downstream of base_frame {config.base_frame!r}: its chain "
+                             f"ends at {body.name()!r}")
+        joint = inboard[body.index()]
+        chain.append(joint)
+        body = joint.parent_body()
+    chain.reverse()
+    joints = [plant.get_joint(index) for index in plant.GetJointIndices(model)
+              if plant.get_joint(index).num_velocities() > 0]
+    for joint in joints:
+        _check_joint(joint, config)
+    if not any(joint.num_velocities() for joint in chain):
+        raise ValueError(f"ArmStationConfig.ee_frame {config.ee_frame!r} is not on the arm: "
+                         f"no joint moves it relative to base_frame {config.base_frame!r}")
+    x, y, z, yaw = config.base_pose
+    plant.WeldFrames(plant.world_frame(), base_frame,
+                     RigidTransform(RollPitchYaw(0.0, 0.0, yaw), [x, y, z]))
+    return ArmModel(model=model, base_frame=base_frame, ee_frame=ee_frame,
+                    joints=tuple(joints), chain=tuple(chain))
+
+
+def _frame(plant, model, config, field):
+    name = getattr(config, field)
+    if plant.HasFrameNamed(name, model):
+        return plant.GetFrameByName(name, model)
+    bodies = [plant.get_body(index).name() for index in plant.GetBodyIndices(model)]
+    shown = ", ".join(bodies[:12]) + (", ..." if len(bodies) > 12 else "")
+    raise ValueError(f"ArmStationConfig.{field} {name!r} is not a frame of "
+                     f"{config.model_file!r} (its links: {shown})")
+
+
+def _check_joint(joint, config):
+    """A joint the station can move: one degree of freedom with finite position and
+    velocity limits."""
+    where = f"ArmStationConfig.model_file {config.model_file!r}: joint {joint.name()!r}"
+    if joint.num_positions() != 1 or joint.num_velocities() != 1:
+        raise ValueError(f"{where} is a {joint.type_name()} joint; the station moves "
+                         "revolute and prismatic joints only")
+    for kind, lower, upper in (
+            ("position", joint.position_lower_limits(), joint.position_upper_limits()),
+            ("velocity", joint.velocity_lower_limits(), joint.velocity_upper_limits())):
+        if not (np.isfinite(lower).all() and np.isfinite(upper).all()):
+            raise ValueError(f"{where} has no {kind} limits; give them in the model (URDF "
+                             "<limit lower upper velocity>, SDFormat <limit>)")
+        if not (lower < upper).all():
+            raise ValueError(f"{where} has {kind} limits [{lower[0]}, {upper[0]}] with no "
+                             "room between them")
+
+
+def ready_positions(plant, arm, config):
+    """The plant's positions in the ready configuration: `config.initial_positions` (one
+    per movable joint of the model, in its order) or the model's defaults. Raises
+    ValueError for a wrong count, a joint outside its limits, or an ee_frame whose z axis
+    is more than MAX_TILT_DEGREES off the floor plane there."""
+    q0 = plant.GetDefaultPositions()
+    if config.initial_positions:
+        if len(config.initial_positions) != len(arm.joints):
+            names = [joint.name() for joint in arm.joints]
+            raise ValueError(f"ArmStationConfig.initial_positions has "
+                             f"{len(config.initial_positions)} entries; the arm has "
+                             f"{len(arm.joints)} joints {names}")
+        for joint, value in zip(arm.joints, config.initial_positions):
+            q0[joint.position_start()] = value
+    for joint in arm.joints:
+        value = q0[joint.position_start()]
+        lower, upper = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
+        if not lower <= value <= upper:
+            raise ValueError(f"ArmStationConfig.initial_positions: joint {joint.name()!r} at "
+                             f"{value:g} is outside its limits [{lower:g}, {upper:g}]")
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q0)
+    z_axis = arm.ee_frame.CalcPoseInWorld(context).rotation().matrix()[:, 2]
+    tilt = np.degrees(np.arcsin(np.clip(abs(z_axis[2]), 0.0, 1.0)))
+    if tilt > MAX_TILT_DEGREES:
+        raise ValueError(f"ArmStationConfig.initial_positions: ee_frame "
+                         f"{config.ee_frame!r}'s z axis is {tilt:.0f} degrees off the floor "
+                         f"plane in the ready configuration (at most {MAX_TILT_DEGREES:g}): "
+                         "the hand's heading is where that axis points")
+    return q0
+
+
+def reach_of(plant, arm, q0):
+    """`(shoulder, reach)`: the world position (3,) of the first joint that moves the end
+    effector and the farthest the end effector can be from it (m, the chain's joint
+    origins' distances summed, measured in the ready configuration `q0`)."""
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q0)
+    points = [joint.frame_on_child().CalcPoseInWorld(context).translation()
+              for joint in arm.chain if joint.num_velocities()]
+    points.append(arm.ee_frame.CalcPoseInWorld(context).translation())
+    reach = float(sum(np.linalg.norm(b - a) for a, b in zip(points, points[1:])))
+    return points[0], reach

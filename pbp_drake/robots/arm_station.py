@@ -1,0 +1,204 @@
+"""A fixed-base arm from any URDF or SDFormat file that follows an end-effector command, as
+one Diagram with the HSR station's ports: the station of a user's own robot.
+
+``make_arm_station(ArmStationConfig(model_file=..., base_frame=..., ee_frame=...))``
+returns a Diagram named ``arm_station``::
+
+    ee_command ─► WholeBodyDiffIk (its EeCommandRamp) ─► [q_d, v_d] (desired_state)
+    desired_state ─► KinematicJoints (motion: kinematic) or the plant's PD (dynamic)
+    robot state ─► EeStateFromPlant (ee_frame) ─► ee_state
+    obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
+
+The differential IK is the HSR station's (`WholeBodyDiffIk`): one least-squares QP a step
+with the model's position and velocity limits and the joints' acceleration limits (the
+model's, or `default_acceleration_limit`), the redundant motion drifting back to the ready
+configuration. What it does at limits and singularities is on docs/concepts/your-robot.md.
+Gravity is off, which stands for a real arm's gravity compensation.
+
+Example::
+
+    station = make_arm_station(ArmStationConfig(
+        model_file="package://pbp_drake_models/arm7/pbp_arm7.urdf",
+        base_frame="arm7_base", ee_frame="arm7_ee",
+        initial_positions=[0.0, 0.9, 0.0, -1.6, 0.0, 0.7, 0.0]))
+    ee_state = arm_initial_ee_state(station)   # where the hand starts
+"""
+
+import numpy as np
+from pydrake.math import RotationMatrix
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.multibody.tree import PdControllerGains
+from pydrake.systems.framework import Diagram, DiagramBuilder
+
+from pbp_drake.robots.arm_model import add_arm, reach_of, ready_positions
+from pbp_drake.robots.arm_station_config import ArmStationConfig, validate_arm_station_config
+from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
+from pbp_drake.robots.hsr_ee_systems import EeCommandRamp, EeStateFromPlant, heading_of
+from pbp_drake.robots.hsr_kinematic import add_kinematic_joints, add_kinematic_plant
+from pbp_drake.robots.station_parts import add_meshcat_visualizers, add_obstacles
+from pbp_drake.systems.ports import EeState
+
+
+def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
+    """The arm of `config`, its end-effector controller, and optionally obstacles and a
+    Meshcat visualizer, as one Diagram named ``arm_station``.
+
+    .. pydrake_system::
+
+        name: arm_station
+        input_ports:
+        - ee_command
+        - obstacle_positions (with config.obstacles)
+        output_ports:
+        - ee_state
+        - state
+        - desired_state
+        - query_object
+        - in_collision (with config.obstacles)
+        - clearance (with config.obstacles)
+
+    ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``) of ``ee_frame`` in the
+    world; ``ee_state`` ``[p (3), v (3), heading, heading_rate]`` (``EeState``); the hand's
+    orientation is its ready orientation turned about the vertical by the heading. ``state``
+    is the plant's state, ``desired_state`` the diff IK's ``[q_d, v_d]`` of every joint of
+    the model, in its order. A fresh context starts at rest in the ready configuration, so
+    holding ``arm_initial_ee_state(station)[:7]`` keeps the arm still. Raises ValueError
+    naming the config's field for a model, frame or configuration that cannot work.
+    """
+    validate_arm_station_config(config)
+    builder = DiagramBuilder()
+    kinematic = config.motion == "kinematic"
+    if kinematic:
+        plant, scene_graph = add_kinematic_plant(builder, config.plant.time_step)
+    else:
+        plant, scene_graph = AddMultibodyPlant(config.plant, builder)
+    arm = add_arm(plant, config)
+    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
+    if not kinematic:
+        _add_motors(plant, arm)
+    plant.Finalize()
+    q0 = ready_positions(plant, arm, config)
+    plant.SetDefaultPositions(q0)
+    if not kinematic:
+        _set_servo_gains(plant, arm, q0, config.servo_frequency)
+    X_WE0 = _ee_pose(plant, arm, q0)
+    # R_E0 is the hand's orientation at heading 0.
+    R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
+    ramp = EeCommandRamp(R_E0, config.command_period, lead=config.diff_ik_time_step)
+    look_ahead = 0.0 if kinematic else config.plant.time_step
+    diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, arm, q0, config, ramp,
+                                                              look_ahead))
+    if kinematic:
+        joints = add_kinematic_joints(builder, plant, scene_graph, arm.joints,
+                                      diff_ik.get_desired_state_output_port())
+        state = joints.get_state_output_port()
+    else:
+        state = plant.get_state_output_port()
+        builder.Connect(diff_ik.get_desired_state_output_port(),
+                        plant.get_desired_state_input_port(arm.model))
+    builder.Connect(state, diff_ik.get_robot_state_input_port())
+    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, arm.ee_frame))
+    builder.Connect(state, ee_state.get_plant_state_input_port())
+    builder.ExportInput(diff_ik.get_command_input_port(), ramp.port_name)
+    builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
+    builder.ExportOutput(state, "state")
+    builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
+    builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
+    if config.obstacles:
+        add_obstacles(builder, plant, scene_graph, arm.model, config.obstacles)
+    if meshcat is not None:
+        add_meshcat_visualizers(builder, scene_graph, meshcat, config.visualization)
+    station = builder.Build()
+    station.set_name("arm_station")
+    return station
+
+
+def _add_motors(plant, arm):
+    """A motor on every joint the model left without one (the plant's PD drives them)."""
+    driven = {plant.get_joint_actuator(index).joint().index()
+              for index in plant.GetJointActuatorIndices(arm.model)}
+    for joint in arm.joints:
+        if joint.index() not in driven:
+            plant.AddJointActuator(f"{joint.name()}_pbp_motor", joint)
+
+
+def _set_servo_gains(plant, arm, q0, frequency):
+    """Each motor critically damped at `frequency` on its joint's inertia at `q0` (the
+    mass matrix's diagonal): kp = I w^2, kd = 2 I w, as the HSR station's gains."""
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q0)
+    inertia = np.diag(plant.CalcMassMatrix(context))
+    for index in plant.GetJointActuatorIndices(arm.model):
+        actuator = plant.get_joint_actuator(index)
+        joint_inertia = inertia[actuator.joint().velocity_start()]
+        actuator.set_controller_gains(PdControllerGains(p=joint_inertia * frequency ** 2,
+                                                        d=2.0 * joint_inertia * frequency))
+
+
+def _ee_pose(plant, arm, q):
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q)
+    return arm.ee_frame.CalcPoseInWorld(context)
+
+
+def _make_diff_ik(plant, arm, q0, config, ramp, look_ahead):
+    """The diff IK of the end-effector frame within the model's position and velocity
+    limits, the acceleration limits the model gives (else the config's default), every
+    joint drifting back to `q0` at the config's centering gain."""
+    nv = plant.num_velocities()
+    accelerations = np.full(nv, np.inf)
+    for joint in arm.joints:
+        limit = float(min(-joint.acceleration_lower_limits()[0],
+                          joint.acceleration_upper_limits()[0]))
+        accelerations[joint.velocity_start()] = (
+            limit if np.isfinite(limit) and limit > 0 else config.default_acceleration_limit)
+    return WholeBodyDiffIk(
+        plant, arm.ee_frame, config.diff_ik_time_step, look_ahead, list(arm.joints),
+        position_limits=(plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()),
+        velocity_limits=(plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()),
+        acceleration_limits=(-accelerations, accelerations), q_nominal=q0,
+        centering_gain=np.full(plant.num_positions(), config.centering_gain),
+        command_ramp=ramp)
+
+
+def arm_model_plant(config: ArmStationConfig):
+    """`(plant, arm, q0)`: a finalized bare plant of `config`'s arm (no station), its
+    `ArmModel` and ready positions; what a scenario is resolved from before its station
+    is built. Raises ValueError as `make_arm_station` does."""
+    validate_arm_station_config(config)
+    plant = MultibodyPlant(config.plant.time_step)
+    arm = add_arm(plant, config)
+    plant.Finalize()
+    return plant, arm, ready_positions(plant, arm, config)
+
+
+def arm_ready_ee_state(config: ArmStationConfig) -> np.ndarray:
+    """The hand's ``ee_state`` (``EeState``) where a station of ``config`` starts, at rest,
+    from the model's kinematics alone. Equal to ``arm_initial_ee_state`` of that station."""
+    plant, arm, q0 = arm_model_plant(config)
+    X_WE = _ee_pose(plant, arm, q0)
+    state = EeState(np.zeros(EeState.size))
+    state.x, state.y, state.z = X_WE.translation()
+    state.heading = heading_of(X_WE.rotation())
+    return state[:]
+
+
+def arm_reach(config: ArmStationConfig):
+    """`(shoulder, reach)` of `config`'s arm: the world position of the first joint that
+    moves the end effector and the farthest (m) the end effector can be from it."""
+    plant, arm, q0 = arm_model_plant(config)
+    return reach_of(plant, arm, q0)
+
+
+def arm_initial_ee_state(station: Diagram) -> np.ndarray:
+    """The hand's ``ee_state`` (``EeState``) where ``station`` (from ``make_arm_station``)
+    starts: read off a fresh context."""
+    return np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))
+
+
+def arm_station_plant(station: Diagram) -> MultibodyPlant:
+    """The MultibodyPlant of a station from ``make_arm_station``: its subsystem ``plant``
+    (dynamic), or the kinematic joints' plant, which is outside the Diagram."""
+    if station.HasSubsystemNamed("plant"):
+        return station.GetSubsystemByName("plant")
+    return station.GetSubsystemByName("joints").plant()

@@ -62,7 +62,8 @@ def make_hsr_operator(resolved, meshcat):
             params=config, nominal_speed=speed, seed=scenario.seed,
             obstacle_count=len(obstacles),
             obstacle_radius=obstacles[0].radius if obstacles else 0.0,
-            policy_adds=scenario.method == "pbp_continuous", vertical=vertical)
+            policy_adds=scenario.method == "pbp_continuous", vertical=vertical,
+            heading_range=_heading_range(resolved))
     if meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
@@ -72,3 +73,13 @@ def make_hsr_operator(resolved, meshcat):
     if isinstance(config, Gamepad):
         return GamepadOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
     raise TypeError(f"unknown operator config {type(config).__name__}")
+
+
+def _heading_range(resolved):
+    """(low, high) of the hand's heading under the controller's `max_heading_turn` (an
+    arm's), or None (the HSR's, unbounded)."""
+    turn = resolved.controller.hand_over.max_heading_turn
+    if not np.isfinite(turn):
+        return None
+    heading = resolved.initial_ee_state[6]
+    return (heading - turn, heading + turn)

@@ -114,7 +114,8 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
             builder, config, start, goals, split, command_split, prediction_steps)
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
         EeState(initial_ee_state).heading, config.control_period,
-        config.hand_over.max_hand_yaw_acceleration))
+        config.hand_over.max_hand_yaw_acceleration,
+        max_turn=config.hand_over.max_heading_turn))
     builder.ConnectInput("operator_command", heading.get_operator_command_input_port())
     hand_over = builder.AddNamedSystem("hand_over", HandOver(
         start, config.hand_over.max_hand_acceleration, config.hand_over.max_hand_speed,

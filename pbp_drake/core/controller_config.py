@@ -37,12 +37,19 @@ class HandOverSettings:
     max_hand_speed: float = 0.2
     #: The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
     max_hand_yaw_acceleration: float = 4.0
+    #: How far (rad) the heading may turn either way from where it starts; .inf: no bound
+    #: (the HSR turns its base). An arm's wrist turns so far.
+    max_heading_turn: float = float("inf")
 
     def validate(self):
-        """Raises ValueError naming the first limit that is not finite and positive."""
+        """Raises ValueError naming the first limit that is not positive (or, but for
+        max_heading_turn, not finite)."""
         check_limit(self.max_hand_acceleration, "max_hand_acceleration", "m/s^2")
         check_limit(self.max_hand_speed, "max_hand_speed", "m/s")
         check_limit(self.max_hand_yaw_acceleration, "max_hand_yaw_acceleration", "rad/s^2")
+        if not self.max_heading_turn > 0:
+            raise ValueError(f"max_heading_turn must be positive (rad; .inf for no bound), "
+                             f"got {self.max_heading_turn!r}")
 
 
 @dataclasses.dataclass

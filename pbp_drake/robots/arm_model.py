@@ -62,21 +62,21 @@ def add_arm(plant, config, parser=None):
     (model,) = models
     base_frame = _frame(plant, model, config, "base_frame")
     ee_frame = _frame(plant, model, config, "ee_frame")
-    inboard = {plant.get_joint(index).child_body().index(): plant.get_joint(index)
+    inboard = {int(plant.get_joint(index).child_body().index()): plant.get_joint(index)
                for index in plant.GetJointIndices(model)}
     base_body = base_frame.body()
-    if base_body.index() in inboard:
-        joint = inboard[base_body.index()]
+    if int(base_body.index()) in inboard:
+        joint = inboard[int(base_body.index())]
         raise ValueError(f"ArmStationConfig.base_frame {config.base_frame!r} is not the "
                          f"model's root: it hangs from joint {joint.name()!r} of "
                          f"{joint.parent_body().name()!r}; name the link the arm stands on")
     chain, body = [], ee_frame.body()
     while body.index() != base_body.index():
-        if body.index() not in inboard:
+        if int(body.index()) not in inboard:
             raise ValueError(f"ArmStationConfig.ee_frame {config.ee_frame!r} is not "
                              f"downstream of base_frame {config.base_frame!r}: its chain "
                              f"ends at {body.name()!r}")
-        joint = inboard[body.index()]
+        joint = inboard[int(body.index())]
         chain.append(joint)
         body = joint.parent_body()
     chain.reverse()

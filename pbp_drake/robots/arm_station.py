@@ -115,10 +115,11 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
 
 def _add_motors(plant, arm):
     """A motor on every joint the model left without one (the plant's PD drives them)."""
-    driven = {plant.get_joint_actuator(index).joint().index()
-              for index in plant.GetJointActuatorIndices(arm.model)}
+    # Before Finalize, only the plant-wide list holds the model's transmissions' motors.
+    driven = {int(plant.get_joint_actuator(index).joint().index())
+              for index in plant.GetJointActuatorIndices()}
     for joint in arm.joints:
-        if joint.index() not in driven:
+        if int(joint.index()) not in driven:
             plant.AddJointActuator(f"{joint.name()}_pbp_motor", joint)
 
 

@@ -401,7 +401,8 @@ def _resolve_task_robot(scenario):
         dmp=scenario.dmp, dmp_duration=float(duration), nominal_speed=float(robot.speed),
         goal_estimator=scenario.goal_estimator, hop=scenario.hop,
         hand_over=HandOverSettings(robot.max_hand_acceleration, robot.max_hand_speed,
-                                 robot.max_hand_yaw_acceleration))
+                                   robot.max_hand_yaw_acceleration,
+                                   getattr(robot, "max_heading_turn", float("inf"))))
     # The DMPs are fitted where they run: by the controller, from `controller`.
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=None,
@@ -432,6 +433,8 @@ def _check_hand_over(scenario):
         top_speed = check_limit(robot.max_hand_speed, "scenario.robot.max_hand_speed", "m/s")
         yaw_acceleration = check_limit(robot.max_hand_yaw_acceleration,
                                        "scenario.robot.max_hand_yaw_acceleration", "rad/s^2")
+        if isinstance(robot, Arm):
+            check_limit(robot.max_heading_turn, "scenario.robot.max_heading_turn", "rad")
     except ValueError as error:
         raise ScenarioError(str(error)) from None
     speed = max(robot.speed, getattr(scenario.operator, "speed", 0.0))

@@ -112,6 +112,9 @@ class Arm(ArmStationConfig):
     max_hand_speed: float = HandOverSettings.max_hand_speed
     #: The same for the hand's heading (rad/s^2).
     max_hand_yaw_acceleration: float = HandOverSettings.max_hand_yaw_acceleration
+    #: How far (rad) the hand's heading may turn either way from its start: a wrist's
+    #: turn is bounded, and past about 90 degrees the tool points back at the arm.
+    max_heading_turn: float = 1.2
 
     def station_config(self):
         """Its fields of ArmStationConfig, as one."""

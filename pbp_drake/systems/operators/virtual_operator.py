@@ -9,7 +9,7 @@ from pbp_drake.core.participant_impairment import (
     delay_ticks, first_choice, initial_motor_noise, is_noisy, next_motor_noise)
 from pbp_drake.core.participant_reach import (
     assist_motion, drive_motion, faces_target, without_forward)
-from pbp_drake.core.reach_task import rotate_planar, wrap_angle
+from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
 from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.operators.participant_avoidance import (
     WATCH_SIZE, is_pushing_through, robot_closes_in, start_watch, update_watch)
@@ -55,6 +55,11 @@ class VirtualOperator(SampledOperator):
     that of the same seed without it). Obstacles (`obstacle_count > 0`) keep the
     participant planar: the two are refused together.
 
+    `heading_range` (low, high) is how far the hand turns (an arm's wrist; None: all the
+    way, as the HSR's base). Turned to a bound with the target still beyond it, the
+    participant counts as facing it as far as it can, so it insists after `insist_time`
+    as it would facing it (the target behind the tool, it backs to it).
+
     It notices a new target only `reaction_delay` seconds after it appears, and its
     commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
     scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
@@ -86,7 +91,7 @@ class VirtualOperator(SampledOperator):
     def __init__(self, control_period, objects, mode="assist",
                  params=VirtualParticipantParams(), nominal_speed=None, seed=0,
                  obstacle_count=0, obstacle_radius=0.0, obstacle_margin=None,
-                 policy_adds=False, vertical=False):
+                 policy_adds=False, vertical=False, heading_range=None):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
@@ -96,6 +101,8 @@ class VirtualOperator(SampledOperator):
                              f"{obstacle_count}): use vertical=False with obstacles")
         super().__init__(OperatorCommand.size, control_period)
         self._vertical = bool(vertical)
+        self._heading_range = None if heading_range is None else tuple(
+            float(bound) for bound in heading_range)
         self._mode = mode
         self._objects = np.asarray(objects, dtype=float)
         self.params = copy.deepcopy(params)
@@ -428,25 +435,39 @@ class VirtualOperator(SampledOperator):
         horizontal = speed_scale * rotate_planar(velocity[:2], noise_angle)
         vz = speed_scale * velocity[2]
         if self._mode == "assist" and insisting and self._policy_adds:
-            # `_against_policy` stays planar: it pushes against the DMP's pull on the floor,
-            # where the participant fights the picked object's pull to its side; vz goes
-            # on as the participant wants it (the DMP's vertical pull is not compensated).
-            horizontal = self._against_policy(context, ee_state, horizontal)
+            # Against the picked object's pull in 3-D: that DMP pulls the hand to its height
+            # too, and left alone it holds the hand below (or above) the target.
+            horizontal, vz = np.split(self._against_policy(
+                context, ee_state, np.array([horizontal[0], horizontal[1], vz])), [2])
+            vz = float(vz[0])
         return np.array([horizontal[0], horizontal[1], vz, yaw_rate])
 
     def _against_policy(self, context, ee_state, wanted):
-        """The command that moves the hand at `wanted` (2) under an additive blend: `wanted`
-        minus the policy's own motion (what the hand does minus what was asked of it), at
-        most `policy_compensation` times `speed`."""
+        """The command that moves the hand at `wanted` (2, on the floor; or 3) under an
+        additive blend: `wanted` minus the policy's own motion (what the hand does minus
+        what was asked of it), at most `policy_compensation` times `speed`."""
         held = self._held(context)
-        last_command = held[:2] if held[4] > 0.5 else np.zeros(2)
-        policy_velocity = np.array([ee_state.vx, ee_state.vy]) - last_command
+        size = len(wanted)
+        last_command = held[:size] if held[4] > 0.5 else np.zeros(size)
+        policy_velocity = np.array([ee_state.vx, ee_state.vy, ee_state.vz][:size]) - last_command
         command = wanted - policy_velocity
         norm = np.linalg.norm(command)
         limit = self.params.policy_compensation * self._speed
         if norm > limit:
             command *= limit / norm
         return command
+
+    def _turned_as_far_as_it_goes(self, position, heading, target_position):
+        """Whether the hand is at a bound of `heading_range` (within `aligned_angle`) with
+        the target's direction beyond it."""
+        if self._heading_range is None:
+            return False
+        low, high = self._heading_range
+        # Measured from the range's middle, so that a range across +-pi reads the same.
+        offset = float(wrap_angle(heading - 0.5 * (low + high)))
+        reach = 0.5 * (high - low) - self.params.aligned_angle
+        error = heading_error(heading, position, target_position)
+        return (offset >= reach and error > 0) or (offset <= -reach and error < 0)
 
     def _count_insistence(self, context, discrete_state, known_target, selected, position,
                           heading, target_position):
@@ -458,7 +479,8 @@ class VirtualOperator(SampledOperator):
             counted_target, ticks = known_target, 0.0
         insisting = ticks >= self._insist_ticks
         if (not insisting and selected != known_target
-                and faces_target(self.params, position, heading, target_position)):
+                and (faces_target(self.params, position, heading, target_position)
+                     or self._turned_as_far_as_it_goes(position, heading, target_position))):
             ticks += 1.0
         discrete_state.set_value(self._insist_index, [counted_target, ticks])
         return insisting

@@ -27,12 +27,20 @@ class HeadingCommand(LeafSystem):
     where it wants to go. Like the DMP bank, it updates at the decide stage (`update_offset`
     after the tick, by default `pbp_drake.systems.tick.decide_offset`) to use the
     operator's command of that tick.
+
+    With a `max_turn` (rad) the heading stays within it of `initial_heading`: an arm's wrist
+    turns so far and no further (the HSR turns its base, and has none). At the bound the
+    turn stops there, its rate set to 0.
     """
 
     def __init__(self, initial_heading, control_period, max_yaw_acceleration=None,
-                 update_offset=None):
+                 update_offset=None, max_turn=None):
         super().__init__()
         self._period = float(control_period)
+        self._turn_bounds = None
+        if max_turn is not None and np.isfinite(max_turn):
+            turn = check_limit(max_turn, "max_turn", "rad")
+            self._turn_bounds = (float(initial_heading) - turn, float(initial_heading) + turn)
         if update_offset is None:
             update_offset = decide_offset(self._period)
         self._max_yaw_acceleration = (np.inf if max_yaw_acceleration is None else check_limit(
@@ -60,3 +68,8 @@ class HeadingCommand(LeafSystem):
         heading[:], yaw_rate[:] = hand_over(yaw_rate, heading + wanted * self._period,
                                             [wanted], self._max_yaw_acceleration, np.inf,
                                             self._period)
+        if self._turn_bounds is not None:
+            low, high = self._turn_bounds
+            if not low <= heading[0] <= high:
+                heading[0] = min(max(heading[0], low), high)
+                yaw_rate[0] = 0.0

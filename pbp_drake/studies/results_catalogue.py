@@ -55,6 +55,13 @@ STUDIES = {
     "hsr_reach_maxent": ["diagrams/hsr_reach_maxent.yaml", "--methods", PBP,
                          "--trials", "30", "--split", "evaluation"],
     "hsr_reach_unimpaired": IMPAIRED,
+    # The reaching task on our 7-joint arm (docs/results/arm.md), and the same scenario on
+    # the test suite's 6-joint arm of other kinematics is the test's.
+    "arm_reach_evaluation": ["diagrams/arm_reach.yaml", "--methods",
+                             "pbp_alternated,pbp_continuous,teleop,hop,policy_blending",
+                             "--trials", "30", "--split", "evaluation"],
+    "arm_reach_teleop_calibration": ["diagrams/arm_reach.yaml", "--methods", "teleop",
+                                     "--trials", "30", "--split", "tuning"],
     **{f"hsr_reach_{condition}": [*IMPAIRED, "--participant-condition", condition]
        for condition in ("noisy", "late", "mistaken")},
 }

@@ -13,7 +13,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput
 
-from pbp_drake.robots import HsrStationConfig, hsr_initial_ee_state, make_hsr_station
+from pbp_drake.robots import HsrStationConfig, make_hsr_station
 from pbp_drake.systems import SampleHold
 from pbp_drake.systems.ports import EeState
 from pbp_drake.systems.tick import decide_offset
@@ -66,15 +66,16 @@ class Drive:
         return np.asarray(direction) @ np.diff(self.hands, axis=1) / CONTROL_PERIOD
 
 
-def drive(velocity, duration, config=None, state_period=None, turn=None):
-    """Runs a station of ``config`` (its ``command_period`` set to the tick) under the
-    driver (``velocity``, ``turn``) for ``duration`` seconds; the plant's state and the
-    desired state are logged every ``state_period`` (the plant's step when None)."""
+def drive(velocity, duration, config=None, state_period=None, turn=None, station=None):
+    """Runs a station of ``config`` (its ``command_period`` set to the tick; or `station`,
+    any station with those ports, built with that period) under the driver (``velocity``,
+    ``turn``) for ``duration`` seconds; the plant's state and the desired state are logged
+    every ``state_period`` (the plant's step when None)."""
     config = dataclasses.replace(config or HsrStationConfig(), command_period=CONTROL_PERIOD)
-    station = make_hsr_station(config)
+    station = station or make_hsr_station(config)
     builder = DiagramBuilder()
-    builder.AddNamedSystem("hsr_station", station)
-    start = hsr_initial_ee_state(station)
+    builder.AddNamedSystem(station.get_name(), station)
+    start = np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))
     sample = builder.AddNamedSystem("ee_state_sample", SampleHold(CONTROL_PERIOD, start))
     builder.Connect(station.GetOutputPort("ee_state"), sample.get_input_port())
     driver = builder.AddNamedSystem("driver", TickDriver(CONTROL_PERIOD, start, velocity, turn))

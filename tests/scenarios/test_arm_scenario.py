@@ -1,0 +1,86 @@
+"""`robot: !Arm {...}` in a scenario file: the shipped arm_reach.yaml resolves to a scene in
+the arm's region, a user's own model is a change of its names, and what cannot work is
+refused in one line naming the scenario's field."""
+
+import dataclasses
+import pathlib
+
+import numpy as np
+import pytest
+
+from pbp_drake.builder import build_diagram, run_task
+from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+ARM_REACH = REPO / "diagrams" / "arm_reach.yaml"
+ARM6 = REPO / "tests" / "robots" / "models" / "pbp_arm6_other.urdf"
+
+
+def arm_scenario(**robot_changes):
+    scenario = load_scenario_file(ARM_REACH).scenario
+    return dataclasses.replace(scenario,
+                               robot=dataclasses.replace(scenario.robot, **robot_changes))
+
+
+def other_arm():
+    """The 6-joint test arm in place of ours: model_file, frames and ready configuration."""
+    ready = ARM6.read_text().split("ready configuration: [")[1].split("]")[0]
+    return dict(model_file=str(ARM6), base_frame="arm6_base", ee_frame="arm6_tool",
+                initial_positions=[float(v) for v in ready.split(",")])
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_scene_is_drawn_in_the_arms_region(seed):
+    resolved = resolve(dataclasses.replace(arm_scenario(), seed=seed))
+    goals, task = resolved.goals, resolved.scenario.task
+    assert 2 <= len(goals) <= 4
+    for axis, (low, high) in enumerate([task.x_range, task.y_range, task.z_range]):
+        assert (goals[:, axis] >= low).all() and (goals[:, axis] <= high).all()
+    assert len(set(np.round(goals[:, 2], 6))) == len(goals)  # each at a height of its own
+    assert resolved.station.command_period == resolved.scenario.control_period
+    assert resolved.controller.hand_over.max_heading_turn == resolved.scenario.robot.max_heading_turn
+
+
+def test_the_diagram_has_the_arm_station_and_the_same_controller():
+    diagram = build_diagram(resolve(arm_scenario()))
+    assert diagram.HasSubsystemNamed("arm_station")
+    assert diagram.HasSubsystemNamed("pbp_controller")
+    assert not diagram.HasSubsystemNamed("hsr_station")
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"model_file": "models/no_such_arm.urdf"},
+     "scenario.robot.model_file: no file at 'models/no_such_arm.urdf'"),
+    ({"ee_frame": "tool0"}, "scenario.robot.ee_frame 'tool0' is not a frame of"),
+    ({"ee_frame": "arm7_base"}, "scenario.robot.ee_frame 'arm7_base' is not on the arm"),
+    ({"max_heading_turn": 0.0}, "scenario.robot.max_heading_turn must be finite and positive"),
+])
+def test_a_robot_that_cannot_work_names_the_field(changes, message):
+    with pytest.raises(ScenarioError) as error:
+        resolve(arm_scenario(**changes))
+    assert message in str(error.value) and "\n" not in str(error.value)
+
+
+def test_a_goal_region_out_of_reach_is_refused_with_the_reach_the_arm_has():
+    scenario = arm_scenario()
+    far = dataclasses.replace(scenario.task, x_range=[0.4, 1.6])
+    with pytest.raises(ScenarioError, match=r"scenario\.task: \(1\.60, .*\) m is .* m from "
+                       r"the arm's shoulder at .*, beyond its reach of \d\.\d\d m"):
+        resolve(dataclasses.replace(scenario, task=far))
+
+
+def test_the_grasping_task_is_refused_on_an_arm():
+    scenario = load_scenario_file(REPO / "diagrams" / "hsr_grasp.yaml").scenario
+    arm = arm_scenario().robot
+    with pytest.raises(ScenarioError, match="runs on the HSR's pose station"):
+        resolve(dataclasses.replace(scenario, robot=arm))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["pbp_alternated", "pbp_continuous", "teleop", "hop"])
+@pytest.mark.parametrize("arm", ["arm7", "arm6"])
+def test_the_task_runs_on_either_arm_unchanged(arm, method):
+    changes = other_arm() if arm == "arm6" else {}
+    scenario = dataclasses.replace(arm_scenario(**changes), method=method, seed=10_000)
+    result = run_task(scenario)
+    assert result.success, (arm, method, result)

@@ -63,6 +63,8 @@ def wxyz_rows(rotation):
     return np.roll(np.atleast_2d(rotation.as_quat()), 1, axis=1)
 
 
+# 2.5 s each, a twentieth of the fast suite: `make test` runs them.
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_every_dmp_converges_to_its_goal_orientation_from_any_start(formulation):
     rng = np.random.default_rng(11)

@@ -57,6 +57,7 @@ def _study(folder):
     return folder
 
 
+@pytest.mark.slow  # a whole study and its report in processes: 2.5 s
 @pytest.mark.timeout(120)
 def test_a_closed_pipe_ends_report_quietly(repo, tmp_path):
     folder = _study(tmp_path / "study")
@@ -73,6 +74,7 @@ def test_a_closed_pipe_ends_report_quietly(repo, tmp_path):
     assert process.returncode == 1
 
 
+@pytest.mark.slow  # a run in a process, interrupted: 2 s
 @pytest.mark.timeout(60)
 def test_ctrl_c_ends_a_run_without_a_traceback(repo):
     # As from a terminal: a suite started in the background (`make test &`) has SIGINT

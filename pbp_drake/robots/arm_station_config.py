@@ -6,10 +6,10 @@ import dataclasses
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlantConfig
+from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.robots.hsr_station_config import (
     MOTIONS, CylinderObstacle, default_station_plant_config, default_station_visualization)
-from pydrake.visualization import VisualizationConfig
 
 
 @dataclasses.dataclass

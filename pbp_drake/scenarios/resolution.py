@@ -350,6 +350,12 @@ def _resolve_task_robot(scenario):
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(task, DynamicObstacles):
+        if isinstance(robot, Arm):
+            # Its scene keeps obstacles 0.45 m apart and the virtual participant steers the
+            # HSR's footprint (base and arm) round them: both are the HSR's.
+            raise ScenarioError("scenario.task !DynamicObstacles is the HSR's obstacle task "
+                                "(its spacing and the participant's footprint are the "
+                                "HSR's); robot !Arm takes the reaching task")
         check_obstacle_task(task)
     elif isinstance(task, GraspTask):
         if isinstance(robot, Arm):

@@ -102,7 +102,8 @@ class Arm(ArmStationConfig):
     """`robot: !Arm {model_file: ..., base_frame: ..., ee_frame: ...}`: a fixed-base arm
     from a URDF or SDFormat file (ours, `package://pbp_drake_models/arm7/pbp_arm7.urdf`,
     or a user's own) under differential IK; every field of ArmStationConfig, and the
-    controller's speed and hand-over limits as the HSR's."""
+    controller's speed and hand-over limits as the HSR's. The task sets the station's
+    command_period (the control period) and obstacles (the obstacle task's cylinders)."""
 
     #: The DMPs' nominal speed (m/s), as the HSR's.
     speed: float = PbpControllerConfig.nominal_speed

@@ -69,10 +69,14 @@ def test_a_goal_region_out_of_reach_is_refused_with_the_reach_the_arm_has():
         resolve(dataclasses.replace(scenario, task=far))
 
 
-def test_the_grasping_task_is_refused_on_an_arm():
-    scenario = load_scenario_file(REPO / "diagrams" / "hsr_grasp.yaml").scenario
+@pytest.mark.parametrize("task, message", [
+    ("hsr_grasp", "runs on the HSR's pose station"),
+    ("hsr_obstacles", "is the HSR's obstacle task"),
+])
+def test_the_hsrs_other_tasks_are_refused_on_an_arm(task, message):
+    scenario = load_scenario_file(REPO / "diagrams" / f"{task}.yaml").scenario
     arm = arm_scenario().robot
-    with pytest.raises(ScenarioError, match="runs on the HSR's pose station"):
+    with pytest.raises(ScenarioError, match=message):
         resolve(dataclasses.replace(scenario, robot=arm))
 
 

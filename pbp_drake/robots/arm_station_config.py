@@ -9,7 +9,8 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.robots.hsr_station_config import (
-    MOTIONS, CylinderObstacle, default_station_plant_config, default_station_visualization)
+    MOTIONS, CylinderObstacle, default_station_plant_config, default_station_visualization,
+    validate_station_timing)
 
 
 @dataclasses.dataclass
@@ -71,16 +72,7 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
     time_step = config.plant.time_step
     if not time_step > 0:
         raise ValueError(f"ArmStationConfig.plant.time_step must be positive, got {time_step}")
-    if config.plant.use_sampled_output_ports:
-        raise ValueError("ArmStationConfig.plant.use_sampled_output_ports must be False, "
-                         "so that a sample at a control tick sees the robot at that tick")
-    steps = config.diff_ik_time_step / time_step
-    if not (config.diff_ik_time_step > 0 and abs(steps - round(steps)) < 1e-9):
-        raise ValueError(f"ArmStationConfig.diff_ik_time_step must be a whole multiple of "
-                         f"plant.time_step {time_step}, got {config.diff_ik_time_step}")
-    if config.command_period is not None and not config.command_period > 0:
-        raise ValueError(f"ArmStationConfig.command_period must be positive or None, got "
-                         f"{config.command_period}")
+    validate_station_timing(config, "ArmStationConfig")
     if len(config.base_pose) != 4 or not np.all(np.isfinite(config.base_pose)):
         raise ValueError(f"ArmStationConfig.base_pose must be finite [x, y, z, yaw], got "
                          f"{config.base_pose}")

@@ -130,20 +130,7 @@ def validate_hsr_station_config(config: HsrStationConfig) -> None:
     if config.plant.discrete_contact_approximation == "tamsi":
         raise ValueError("HsrStationConfig.plant.discrete_contact_approximation 'tamsi' "
                          "ignores the torso coupler; use 'sap' or 'lagged'")
-    if config.plant.use_sampled_output_ports:
-        # Sampled ports are refreshed by the plant's step, an unrestricted update, which
-        # Drake applies before the discrete updates of the same instant: a control loop
-        # sampling the robot at a tick would see the state one plant step later whenever
-        # the tick and a plant step fall on the same float time, and not otherwise.
-        raise ValueError("HsrStationConfig.plant.use_sampled_output_ports must be False, "
-                         "so that a sample at a control tick sees the robot at that tick")
-    steps = config.diff_ik_time_step / time_step
-    if not (config.diff_ik_time_step > 0 and abs(steps - round(steps)) < 1e-9):
-        raise ValueError(f"HsrStationConfig.diff_ik_time_step must be a whole multiple of "
-                         f"plant.time_step {time_step}, got {config.diff_ik_time_step}")
-    if config.command_period is not None and not config.command_period > 0:
-        raise ValueError(f"HsrStationConfig.command_period must be positive or None, got "
-                         f"{config.command_period}")
+    validate_station_timing(config, "HsrStationConfig")
     if len(config.initial_base) != 3 or not np.all(np.isfinite(config.initial_base)):
         raise ValueError(f"HsrStationConfig.initial_base must be finite [x, y, yaw], got "
                          f"{config.initial_base}")
@@ -163,3 +150,24 @@ def validate_hsr_station_config(config: HsrStationConfig) -> None:
         if not (obstacle.radius > 0 and obstacle.height > 0):
             raise ValueError(f"HsrStationConfig.obstacles[{index}] needs a positive radius "
                              f"and height, got {obstacle}")
+
+
+def validate_station_timing(config, name):
+    """The timing every station config (`name`: its class) shares: live output ports, a
+    diff IK period a whole multiple of the plant's step, a positive command period or
+    None. Raises ValueError naming the field."""
+    time_step = config.plant.time_step
+    if config.plant.use_sampled_output_ports:
+        # Sampled ports are refreshed by the plant's step, an unrestricted update, which
+        # Drake applies before the discrete updates of the same instant: a control loop
+        # sampling the robot at a tick would see the state one plant step later whenever
+        # the tick and a plant step fall on the same float time, and not otherwise.
+        raise ValueError(f"{name}.plant.use_sampled_output_ports must be False, so that a "
+                         "sample at a control tick sees the robot at that tick")
+    steps = config.diff_ik_time_step / time_step
+    if not (config.diff_ik_time_step > 0 and abs(steps - round(steps)) < 1e-9):
+        raise ValueError(f"{name}.diff_ik_time_step must be a whole multiple of "
+                         f"plant.time_step {time_step}, got {config.diff_ik_time_step}")
+    if config.command_period is not None and not config.command_period > 0:
+        raise ValueError(f"{name}.command_period must be positive or None, got "
+                         f"{config.command_period}")

@@ -19,7 +19,7 @@ YAW_RATE = 0.5
 TURN_START = 0.95
 
 
-def build(max_yaw_acceleration=None):
+def build(max_yaw_acceleration=None, max_turn=None):
     """A yaw rate that steps up at `TURN_START`, sampled at each tick like an operator."""
     builder = DiagramBuilder()
     commands = np.zeros((OperatorCommand.size, 2))
@@ -29,7 +29,8 @@ def build(max_yaw_acceleration=None):
                                           np.column_stack([commands, commands[:, 1]]))))
     operator = builder.AddSystem(SampleHold(PERIOD, np.zeros(OperatorCommand.size)))
     builder.Connect(source.get_output_port(), operator.get_input_port())
-    heading = builder.AddSystem(HeadingCommand(INITIAL_HEADING, PERIOD, max_yaw_acceleration))
+    heading = builder.AddSystem(HeadingCommand(INITIAL_HEADING, PERIOD, max_yaw_acceleration,
+                                               max_turn=max_turn))
     builder.Connect(operator.get_output_port(), heading.get_operator_command_input_port())
     return builder.Build(), heading
 
@@ -80,3 +81,21 @@ def test_with_an_acceleration_limit_the_turn_starts_as_a_ramp():
 def test_a_yaw_acceleration_limit_must_be_finite_and_positive(limit):
     with pytest.raises(ValueError, match="max_yaw_acceleration"):
         HeadingCommand(0.0, PERIOD, limit)
+
+
+def test_with_a_bounded_turn_the_heading_stops_at_the_bound_and_turns_back_at_once():
+    diagram, heading = build(max_turn=0.4)
+    simulator = Simulator(diagram)
+    # Turning at 0.5 rad/s from 1.0 s: at the bound 0.8 s later, and held there.
+    assert INITIAL_HEADING < heading_at(simulator, heading, 1.5) < INITIAL_HEADING + 0.4
+    assert heading_at(simulator, heading, 3.0) == pytest.approx(INITIAL_HEADING + 0.4)
+    assert heading_at(simulator, heading, 9.0) == pytest.approx(INITIAL_HEADING + 0.4)
+    # No turn is stored up beyond it: the rate was set to 0 at the bound.
+    context = heading.GetMyContextFromRoot(simulator.get_context())
+    assert context.get_discrete_state(1).get_value()[0] == 0.0
+
+
+@pytest.mark.parametrize("turn", [0.0, -1.0, np.nan])
+def test_a_bounded_turn_must_be_positive(turn):
+    with pytest.raises(ValueError, match="max_turn"):
+        HeadingCommand(0.0, PERIOD, max_turn=turn)

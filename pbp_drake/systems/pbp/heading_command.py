@@ -38,7 +38,7 @@ class HeadingCommand(LeafSystem):
         super().__init__()
         self._period = float(control_period)
         self._turn_bounds = None
-        if max_turn is not None and np.isfinite(max_turn):
+        if max_turn is not None and max_turn != np.inf:  # NaN is refused below
             turn = check_limit(max_turn, "max_turn", "rad")
             self._turn_bounds = (float(initial_heading) - turn, float(initial_heading) + turn)
         if update_offset is None:

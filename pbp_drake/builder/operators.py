@@ -63,7 +63,8 @@ def make_hsr_operator(resolved, meshcat):
             obstacle_count=len(obstacles),
             obstacle_radius=obstacles[0].radius if obstacles else 0.0,
             policy_adds=scenario.method == "pbp_continuous", vertical=vertical,
-            heading_range=_heading_range(resolved))
+            heading_range=_heading_range(resolved),
+            fixed_base=resolved.station.base_pose[:2] if resolved.is_arm else None)
     if meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")

@@ -1,5 +1,5 @@
-"""The reaching and obstacle tasks' diagram (sections IV-B.1 and IV-B.2 of the paper), the
-reaching task on the HSR or an arm, a handful of blocks:
+"""The reaching and obstacle tasks' diagram (sections IV-B.1 and IV-B.2 of the paper) on
+the HSR or an arm, a handful of blocks:
 
     station.ee_state ──> ee_state_sample (SampleHold) ──> pbp_controller, task_monitor,
                                                           obstacles

@@ -1,5 +1,6 @@
-"""How the virtual participant sees obstacles around the HSR, in pure NumPy: the robot's
-footprint, where moving obstacles will stop, and where the DMP will take the hand."""
+"""How the virtual participant sees obstacles around the robot, in pure NumPy: the robot's
+footprint (the HSR's, or a fixed-base arm's), where moving obstacles will stop, and where
+the DMP will take the hand."""
 
 import numpy as np
 
@@ -9,17 +10,25 @@ HAND_AHEAD_OF_BASE = 0.53
 # as a thick segment from the base to the hand (m).
 BASE_RADIUS = 0.25
 ARM_RADIUS = 0.08
+# A fixed-base arm's footprint: a thick segment from its base to the hand (m), its links
+# and the pedestal under them seen from above.
+FIXED_ARM_RADIUS = 0.06
 # How far ahead on its line the DMP aims when it pulls the hand back (m).
 POLICY_LOOKAHEAD = 0.25
 
 
-def footprint_clearance(hands, headings, obstacles, radius):
+def footprint_clearance(hands, headings, obstacles, radius, fixed_base=None):
     """The smallest gap (m) between the robot's footprint and cylinders of `radius`.
 
     `hands` (..., 2) and `headings` (...) place the footprint: a disc of `BASE_RADIUS` at
     `HAND_AHEAD_OF_BASE` behind the hand and the arm, a segment of `ARM_RADIUS` from there
-    to the hand. `obstacles` (..., N, 2) broadcast against them. Returns (...)."""
+    to the hand. With a `fixed_base` (2,), an arm's, the footprint is the segment of
+    `FIXED_ARM_RADIUS` from it to the hand, whatever the heading. `obstacles` (..., N, 2)
+    broadcast against them. Returns (...)."""
     hands = np.asarray(hands, float)
+    if fixed_base is not None:
+        return _segment_clearance(np.broadcast_to(np.asarray(fixed_base, float), hands.shape),
+                                  hands, obstacles, FIXED_ARM_RADIUS) - radius
     headings = np.broadcast_to(headings, hands.shape[:-1])
     arm = HAND_AHEAD_OF_BASE * np.stack([np.cos(headings), np.sin(headings)], axis=-1)
     bases = hands - arm
@@ -28,6 +37,17 @@ def footprint_clearance(hands, headings, obstacles, radius):
     along = np.clip((relative * arm[..., None, :]).sum(-1) / HAND_AHEAD_OF_BASE ** 2, 0.0, 1.0)
     arm_gap = np.linalg.norm(relative - along[..., None] * arm[..., None, :], axis=-1) - ARM_RADIUS
     return np.minimum(base_gap, arm_gap).min(axis=-1) - radius
+
+
+def _segment_clearance(starts, ends, obstacles, thickness):
+    """The smallest gap (m) between the segments `starts` to `ends` (..., 2) of
+    `thickness` and the points `obstacles` (..., N, 2)."""
+    segment = ends - starts
+    relative = np.asarray(obstacles, float) - starts[..., None, :]
+    length2 = np.maximum((segment ** 2).sum(-1), 1e-12)
+    along = np.clip((relative * segment[..., None, :]).sum(-1) / length2[..., None], 0.0, 1.0)
+    gaps = np.linalg.norm(relative - along[..., None] * segment[..., None, :], axis=-1)
+    return gaps.min(axis=-1) - thickness
 
 
 def predict_obstacles(obstacles, velocities, hand, target_xy, times):

@@ -350,12 +350,6 @@ def _resolve_task_robot(scenario):
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(task, DynamicObstacles):
-        if isinstance(robot, Arm):
-            # Its scene keeps obstacles 0.45 m apart and the virtual participant steers the
-            # HSR's footprint (base and arm) round them: both are the HSR's.
-            raise ScenarioError("scenario.task !DynamicObstacles is the HSR's obstacle task "
-                                "(its spacing and the participant's footprint are the "
-                                "HSR's); robot !Arm takes the reaching task")
         check_obstacle_task(task)
     elif isinstance(task, GraspTask):
         if isinstance(robot, Arm):
@@ -470,7 +464,7 @@ def task_scene(task, seed, reach=None):
         obstacles = sample_obstacle_scene(
             seed, tuple(task.x_range), tuple(task.y_range), task.height,
             task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
-            tuple(task.activation_range))
+            tuple(task.activation_range), clearance=task.obstacle_spacing)
         return TaskScene(objects=obstacles.target[np.newaxis, :], targets=(0,),
                           switch_schedule=(0.0,), obstacles=obstacles)
     if isinstance(task, GraspTask):

@@ -271,6 +271,9 @@ class DynamicObstacles:
     obstacle_y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.3, 1.3])
     #: The progress fractions (0 to 1) between which each obstacle's start threshold is drawn.
     activation_range: list[float] = dataclasses.field(default_factory=lambda: [0.05, 0.5])
+    #: Obstacles start at least this far (m) from the robot's base, the target and each
+    #: other (the HSR's scene; an arm's workspace takes less).
+    obstacle_spacing: float = 0.45
 
 
 @dataclasses.dataclass

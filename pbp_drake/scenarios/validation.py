@@ -462,7 +462,8 @@ def check_grasp_task(task):
 
 def check_obstacle_task(task):
     require_finite(task, "scenario.task",
-                   ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed"))
+                   ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed",
+                    "obstacle_spacing"))
     # Obstacles start 0.45 m from each other, the robot and the target: a few dozen fit.
     # Without any, the station has no obstacle input for the task to drive.
     check_count(task.obstacle_count, "scenario.task.obstacle_count", 1, 100,

@@ -75,7 +75,7 @@ def plain(value):
 # Fields added to the schema after studies were run, left out of the content while at their
 # defaults: the trials of a scenario that does not use them are the same as before, and its
 # study folders still resume.
-_LATER_FIELDS = {"task": {"z_range": []}}
+_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45}}
 
 
 def scenario_content(scenario):

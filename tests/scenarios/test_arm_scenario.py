@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pbp_drake.builder import build_diagram, run_task
-from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
+from pbp_drake.scenarios import DynamicObstacles, ScenarioError, load_scenario_file, resolve
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 ARM_REACH = REPO / "diagrams" / "arm_reach.yaml"
@@ -69,15 +69,41 @@ def test_a_goal_region_out_of_reach_is_refused_with_the_reach_the_arm_has():
         resolve(dataclasses.replace(scenario, task=far))
 
 
-@pytest.mark.parametrize("task, message", [
-    ("hsr_grasp", "runs on the HSR's pose station"),
-    ("hsr_obstacles", "is the HSR's obstacle task"),
-])
-def test_the_hsrs_other_tasks_are_refused_on_an_arm(task, message):
-    scenario = load_scenario_file(REPO / "diagrams" / f"{task}.yaml").scenario
-    arm = arm_scenario().robot
-    with pytest.raises(ScenarioError, match=message):
-        resolve(dataclasses.replace(scenario, robot=arm))
+def test_the_grasping_task_is_refused_on_an_arm():
+    scenario = load_scenario_file(REPO / "diagrams" / "hsr_grasp.yaml").scenario
+    with pytest.raises(ScenarioError, match="runs on the HSR's pose station"):
+        resolve(dataclasses.replace(scenario, robot=arm_scenario().robot))
+
+
+def arm_obstacle_scenario():
+    """The obstacle task in the arm's workspace: thin cylinders, closer together."""
+    scenario = arm_scenario()
+    task = DynamicObstacles(x_range=[0.5, 0.7], y_range=[-0.25, 0.25], height=0.35,
+                            success_distance=0.03, obstacle_count=2, obstacle_radius=0.03,
+                            obstacle_height=0.6, obstacle_speed=0.04,
+                            obstacle_x_range=[0.3, 0.7], obstacle_y_range=[-0.4, 0.4],
+                            obstacle_spacing=0.15)
+    return dataclasses.replace(scenario, name="arm_obstacles", task=task)
+
+
+def test_the_obstacle_task_takes_an_arm_and_measures_its_collisions():
+    resolved = resolve(arm_obstacle_scenario())
+    assert len(resolved.station.obstacles) == 2
+    diagram = build_diagram(resolved)
+    assert diagram.GetSubsystemByName("arm_station").HasOutputPort("in_collision")
+
+
+def test_the_hsr_obstacle_scene_is_out_of_the_arms_reach():
+    scenario = load_scenario_file(REPO / "diagrams" / "hsr_obstacles.yaml").scenario
+    with pytest.raises(ScenarioError, match="beyond its reach of"):
+        resolve(dataclasses.replace(scenario, robot=arm_scenario().robot))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["pbp_alternated", "teleop"])
+def test_the_obstacle_task_runs_on_the_arm(method):
+    result = run_task(dataclasses.replace(arm_obstacle_scenario(), method=method, seed=0))
+    assert result.success and result.in_collision is not None
 
 
 @pytest.mark.slow

@@ -58,7 +58,9 @@ class VirtualOperator(SampledOperator):
     `heading_range` (low, high) is how far the hand turns (an arm's wrist; None: all the
     way, as the HSR's base). Turned to a bound with the target still beyond it, the
     participant counts as facing it as far as it can, so it insists after `insist_time`
-    as it would facing it (the target behind the tool, it backs to it).
+    as it would facing it (the target behind the tool, it backs to it). `fixed_base` (x, y)
+    is a fixed-base arm's base: its footprint among obstacles is then the arm from there to
+    the hand (`footprint_clearance`), not the HSR's base and arm.
 
     It notices a new target only `reaction_delay` seconds after it appears, and its
     commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
@@ -91,7 +93,7 @@ class VirtualOperator(SampledOperator):
     def __init__(self, control_period, objects, mode="assist",
                  params=VirtualParticipantParams(), nominal_speed=None, seed=0,
                  obstacle_count=0, obstacle_radius=0.0, obstacle_margin=None,
-                 policy_adds=False, vertical=False, heading_range=None):
+                 policy_adds=False, vertical=False, heading_range=None, fixed_base=None):
         if mode not in PARTICIPANT_MODES:
             raise ValueError(f"participant mode {mode!r} is unknown; use one of "
                              f"{PARTICIPANT_MODES}")
@@ -101,6 +103,7 @@ class VirtualOperator(SampledOperator):
                              f"{obstacle_count}): use vertical=False with obstacles")
         super().__init__(OperatorCommand.size, control_period)
         self._vertical = bool(vertical)
+        self._fixed_base = None if fixed_base is None else np.asarray(fixed_base, float)[:2]
         self._heading_range = None if heading_range is None else tuple(
             float(bound) for bound in heading_range)
         self._mode = mode
@@ -312,14 +315,14 @@ class VirtualOperator(SampledOperator):
             # Would the policy, left alone, keep the robot clear?
             policy_clear = footprint_clearance(
                 policy_path(hand, start, target_xy, self._speed, self._plan_times), heading,
-                predicted, self._obstacle_radius).min()
+                predicted, self._obstacle_radius, self._fixed_base).min()
             if was_active:
                 release = (hold <= 0 and heading_gap < self._release_heading_gap
                            and policy_clear >= params.release_factor * self._obstacle_margin)
             else:
                 moving_clear = footprint_clearance(
                     hand + velocity * self._plan_times[:, None], heading, predicted,
-                    self._obstacle_radius).min()
+                    self._obstacle_radius, self._fixed_base).min()
                 release = (heading_gap < 2 * self._release_heading_gap
                            and min(policy_clear, moving_clear) >= self._obstacle_margin)
             if release:
@@ -351,7 +354,7 @@ class VirtualOperator(SampledOperator):
         headings = heading + turns
         clear = footprint_clearance(np.broadcast_to(target_xy, (len(turns), 2)), headings,
                                     np.broadcast_to(obstacles, (len(turns),) + obstacles.shape),
-                                    self._obstacle_radius)
+                                    self._obstacle_radius, self._fixed_base)
         fine = clear >= self.params.goal_margin_factor * self._obstacle_margin
         if np.any(fine):
             return headings[fine][np.argmin(np.abs(turns[fine]))]
@@ -373,7 +376,7 @@ class VirtualOperator(SampledOperator):
         hands = hand + velocities[:, None, :] * plan_times[None, :, None]
         headings = heading + yaw_rates[:, None] * plan_times[None, :]
         clear = footprint_clearance(hands, headings, predicted[None],
-                                    self._obstacle_radius).min(axis=1)
+                                    self._obstacle_radius, self._fixed_base).min(axis=1)
         progress = velocities @ toward / self._speed
         gap_now = abs(wrap_angle(heading - goal_heading))
         gap_then = np.abs(wrap_angle(headings[:, -1] - goal_heading))

@@ -55,7 +55,31 @@ def dot_source(diagram, max_depth=None, top_to_bottom=False):
         edges = []
         result.append(line)
     result.extend(sorted(edges))
-    return "\n".join(result) + "\n"
+    return _sources_beside_their_reader("\n".join(result) + "\n")
+
+
+_NODE = re.compile(r"^(s\d+) \[shape=none.*?^>\];$", re.S | re.M)
+_EDGE = re.compile(r"^(s\d+):y\d+:[a-z]+ -> (s\d+):", re.M)
+_INPUT = re.compile(r'PORT="u\d+" BORDER="1" >')
+
+
+def _sources_beside_their_reader(text):
+    """Each block without inputs whose outputs all go to one block (the task's goals into
+    the controller) drawn in that block's rank, beside it, not in a row of its own above
+    the diagram, which widened the drawing by the source's width."""
+    # Drake draws an empty grey cell where a block has no input.
+    inputless = {match.group(1) for match in _NODE.finditer(text)
+                 if not _INPUT.search(match.group(0))}
+    readers = {}
+    for source, reader in _EDGE.findall(text):
+        readers.setdefault(source, set()).add(reader)
+    pairs = sorted((node, *readers[node]) for node in inputless
+                   if len(readers.get(node, ())) == 1)
+    if not pairs:
+        return text
+    ranks = "".join(f"{{rank=same; {source}; {reader}}}\n" for source, reader in pairs)
+    return text.replace("subgraph cluster0subsystems {\n", "subgraph cluster0subsystems {\n"
+                        + ranks, 1)
 
 
 def dot_program():

@@ -172,7 +172,7 @@ def test_a_goal_moved_out_of_the_world_mid_run_stops_the_run_with_one_message(fi
     simulator = Simulator(diagram)
     simulator.Initialize()
     simulator.AdvanceTo(1.0)
-    source = diagram.GetSubsystemByName("pbp_controller").GetSubsystemByName("goals")
+    source = diagram.GetSubsystemByName("goals")  # the controller reads it on its port
     context = source.GetMyMutableContextFromRoot(simulator.get_mutable_context())
     moved = source.get_goals_output_port().Eval(context).reshape(-1, 3).copy()
     moved[1, 0] = 1e200

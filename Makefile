@@ -47,8 +47,11 @@ chromium:
 graphviz:
 	$(call debian_tool,dot,graphviz,the drawing tests)
 
+# The whole suite: everything but the browser tests in two processes, then the browser
+# tests (Chromium, real-time pages) one at a time, so that a page is never starved.
 test: $(STAMP) chromium graphviz
-	$(PYTHON) -m pytest
+	$(PYTHON) -m pytest -m "not browser" -n 2
+	$(PYTHON) -m pytest -m browser
 
 # Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run,
 # under a minute on a 2-core machine.

@@ -133,6 +133,7 @@ def test_a_session_is_clicked_through_in_the_page(meshcat, short_task, tmp_path)
 
 
 @pytest.mark.slow
+@pytest.mark.browser
 @pytest.mark.timeout(240)
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed")
 @pytest.mark.skipif(sync_playwright is None, reason="playwright is not installed")

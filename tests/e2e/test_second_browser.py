@@ -17,7 +17,8 @@ from pbp_drake.console import PageFront
 from pbp_drake.scenarios import Keyboard, load_scenario_file
 from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON
 
-pytestmark = pytest.mark.slow
+# Real-time runs a browser's clicks race against: `make test` runs them on their own.
+pytestmark = [pytest.mark.slow, pytest.mark.browser]
 
 DURATION = 3.0
 

@@ -50,13 +50,13 @@ graphviz:
 # The whole suite: everything but the browser tests in two processes, then the browser
 # tests (Chromium, real-time pages) one at a time, so that a page is never starved.
 test: $(STAMP) chromium graphviz
-	$(PYTHON) -m pytest -m "not browser" -n 2
+	$(PYTHON) -m pytest -m "not browser" -n 2 --dist worksteal
 	$(PYTHON) -m pytest -m browser
 
 # Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run,
 # under a minute on a 2-core machine.
 test-fast: $(STAMP) graphviz
-	$(PYTHON) -m pytest -m "not slow" -n 2
+	$(PYTHON) -m pytest -m "not slow" -n 2 --dist worksteal
 
 # The tutorial notebooks (tutorials/*.ipynb) in Jupyter, in the project's venv.
 $(VENV)/.installed-tutorials: $(STAMP)

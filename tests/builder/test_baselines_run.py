@@ -16,6 +16,9 @@ from pbp_drake.scenarios import load_scenario_file, resolve, with_method
 from pbp_drake.systems import (
     HopAssistance, MaxEntGoalEstimator, PoseHopAssistance, PoseMaxEntGoalEstimator)
 
+# Whole short runs of the reaching task (5 s of the fast suite): `make test` runs them.
+pytestmark = pytest.mark.slow
+
 # Tuning seeds: the evaluation seeds are for the results only.
 SEED = 3
 

@@ -102,6 +102,7 @@ def test_the_bank_converges_when_the_measured_orientation_jumps_mid_run(formulat
         assert angles(robot[:, 0], goals[:, followed]) < TENTH_OF_A_DEGREE
 
 
+@pytest.mark.slow  # an ODE solve each, 1 s: `make test` runs them
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 @pytest.mark.parametrize("case", ["demonstration_170_degrees", "straight_179_degrees"])
 def test_the_step_matches_the_continuous_equations(formulation, case):

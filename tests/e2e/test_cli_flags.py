@@ -112,6 +112,7 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     assert f"{named}: user-study sessions run the HSR tasks" in err
 
 
+@pytest.mark.slow  # a whole session of two methods: 2 s
 def test_a_session_with_fixed_answers_waits_for_no_browser(repo, tmp_path, capsys):
     # The virtual participant and --answers need no page: the session runs at once, even
     # with a page served and a long --wait-for-browser.

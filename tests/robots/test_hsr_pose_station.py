@@ -21,6 +21,9 @@ from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, add_hsr
 from pbp_drake.systems.ports import PoseState
 from pose_drive import PoseWaypoints, drive, turned
 
+# Drives of the pose station (4 s of the fast suite): `make test` runs them.
+pytestmark = pytest.mark.slow
+
 POSITION_TOLERANCE = 0.01  # m, after settling
 ANGLE_TOLERANCE = np.radians(3.0)
 # The grasp task's success bounds (docs/tasks/grasp.md).

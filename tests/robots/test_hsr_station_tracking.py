@@ -14,6 +14,9 @@ from pbp_drake.robots import HsrStationConfig
 from pbp_drake.robots.hsr_model import ACTUATED_JOINT_NAMES, add_hsr
 from station_drive import CONTROL_PERIOD, drive
 
+# Drives of the station (4 s of the fast suite): `make test` runs them.
+pytestmark = pytest.mark.slow
+
 DURATION = 5.0
 # By then the base has had time to take over from the arm (at its acceleration limit it
 # reaches 0.16 m/s in about half a second; the arm then drifts back to its ready pose).

@@ -160,14 +160,15 @@ SETTINGS = dict(derandomize=True, deadline=None, database=None,
 
 
 @pytest.mark.parametrize("name", FILES)
-@settings(max_examples=25, **SETTINGS)
+@settings(max_examples=15, **SETTINGS)
 @given(data=st.data())
 def test_damaged_shipped_files_load_and_run_or_name_a_field(name, data):
     _check_damaged(name, *data.draw(damaged(name)))
 
 
-# 100 more a file (others than the fast test's 25: derandomize seeds the draws by the test),
-# 125 a file in all (the fast test keeps to 25 as the shipped files grow in number); 200 more took about 50 s of the suite, where these take half.
+# 100 more a file (others than the fast test's 15: derandomize seeds the draws by the test),
+# 115 a file in all (the fast test keeps to 15 as the shipped files grow in number); 200
+# more took about 50 s of the suite, where these take half.
 @pytest.mark.slow
 @pytest.mark.parametrize("name", FILES)
 @settings(max_examples=100, **SETTINGS)

@@ -33,10 +33,10 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 from pbp_drake.robots.arm_model import add_arm, reach_of, ready_positions
 from pbp_drake.robots.arm_station_config import ArmStationConfig, validate_arm_station_config
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
-from pbp_drake.robots.hsr_ee_systems import EeCommandRamp, EeStateFromPlant, heading_of
+from pbp_drake.robots.hsr_ee_systems import (
+    EeCommandRamp, EeStateFromPlant, ee_state_at_rest, heading_of)
 from pbp_drake.robots.hsr_kinematic import add_kinematic_joints, add_kinematic_plant
 from pbp_drake.robots.station_parts import add_meshcat_visualizers, add_obstacles
-from pbp_drake.systems.ports import EeState
 
 
 def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
@@ -176,19 +176,20 @@ def arm_model_plant(config: ArmStationConfig):
 def arm_ready_ee_state(config: ArmStationConfig) -> np.ndarray:
     """The hand's ``ee_state`` (``EeState``) where a station of ``config`` starts, at rest,
     from the model's kinematics alone. Equal to ``arm_initial_ee_state`` of that station."""
-    plant, arm, q0 = arm_model_plant(config)
-    X_WE = _ee_pose(plant, arm, q0)
-    state = EeState(np.zeros(EeState.size))
-    state.x, state.y, state.z = X_WE.translation()
-    state.heading = heading_of(X_WE.rotation())
-    return state[:]
+    return arm_ready_ee_state_and_reach(config)[0]
 
 
 def arm_reach(config: ArmStationConfig):
     """`(shoulder, reach)` of `config`'s arm: the world position of the first joint that
     moves the end effector and the farthest (m) the end effector can be from it."""
+    return arm_ready_ee_state_and_reach(config)[1]
+
+
+def arm_ready_ee_state_and_reach(config: ArmStationConfig):
+    """`(arm_ready_ee_state, arm_reach)` of `config`, from one parse of the model: what a
+    scenario is resolved from before its station is built."""
     plant, arm, q0 = arm_model_plant(config)
-    return reach_of(plant, arm, q0)
+    return ee_state_at_rest(_ee_pose(plant, arm, q0)), reach_of(plant, arm, q0)
 
 
 def arm_initial_ee_state(station: Diagram) -> np.ndarray:

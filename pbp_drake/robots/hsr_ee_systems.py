@@ -21,6 +21,14 @@ def heading_of(R_WE: RotationMatrix) -> float:
     return float(np.arctan2(z_axis[1], z_axis[0]))
 
 
+def ee_state_at_rest(X_WE: RigidTransform) -> np.ndarray:
+    """The `EeState` (8,) of a hand at rest at `X_WE`: its position and heading."""
+    state = EeState(np.zeros(EeState.size))
+    state.x, state.y, state.z = X_WE.translation()
+    state.heading = heading_of(X_WE.rotation())
+    return state[:]
+
+
 class EeCommandToPose(LeafSystem):
     """Turns the end-effector command into the desired pose and velocity for diff IK.
 

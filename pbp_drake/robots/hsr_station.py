@@ -48,7 +48,8 @@ from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
-from pbp_drake.robots.hsr_ee_systems import EeCommandRamp, EeStateFromPlant, heading_of
+from pbp_drake.robots.hsr_ee_systems import (
+    EeCommandRamp, EeStateFromPlant, ee_state_at_rest, heading_of)
 from pbp_drake.robots.hsr_kinematic import (
     add_kinematic_joints, add_kinematic_plant, hsr_couplers)
 from pbp_drake.robots.hsr_model import (
@@ -68,7 +69,6 @@ from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
     HsrStationConfig,
     validate_hsr_station_config,
 )
-from pbp_drake.systems.ports import EeState
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
 # the hand starts in front of the base with room to move both ways along x with the
@@ -307,11 +307,7 @@ def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:
     plant = MultibodyPlant(config.plant.time_step)
     model = add_hsr(plant)
     plant.Finalize()
-    _, X_WE = _ready_pose(plant, model, config)
-    state = EeState(np.zeros(EeState.size))  # at rest
-    state.x, state.y, state.z = X_WE.translation()
-    state.heading = heading_of(X_WE.rotation())
-    return state[:]
+    return ee_state_at_rest(_ready_pose(plant, model, config)[1])
 
 
 def hsr_initial_ee_state(station: Diagram) -> np.ndarray:

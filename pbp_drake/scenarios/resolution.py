@@ -22,7 +22,8 @@ from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
 from pbp_drake.core.toy_scene import bent_path
-from pbp_drake.robots import CylinderObstacle, arm_reach, arm_ready_ee_state, hsr_ready_ee_state
+from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
+from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles,
@@ -415,8 +416,7 @@ def _arm_station(scenario, station):
     the arm's reach `(shoulder, radius)`; the arm's refusals name scenario.robot's field."""
     station = dataclasses.replace(station, command_period=scenario.control_period)
     try:
-        initial_ee_state = arm_ready_ee_state(station)
-        reach = arm_reach(station)
+        initial_ee_state, reach = arm_ready_ee_state_and_reach(station)
     except ValueError as error:
         raise ScenarioError(str(error).replace("ArmStationConfig.", "scenario.robot.")
                             ) from None

@@ -10,7 +10,7 @@ from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.robots.hsr_station_config import (
     MOTIONS, CylinderObstacle, default_station_plant_config, default_station_visualization,
-    validate_station_timing)
+    validate_station_obstacles, validate_station_timing)
 
 
 @dataclasses.dataclass
@@ -87,7 +87,4 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
     if not (np.isfinite(config.centering_gain) and config.centering_gain >= 0):
         raise ValueError(f"ArmStationConfig.centering_gain must be >= 0, got "
                          f"{config.centering_gain}")
-    for index, obstacle in enumerate(config.obstacles):
-        if not (obstacle.radius > 0 and obstacle.height > 0):
-            raise ValueError(f"ArmStationConfig.obstacles[{index}] needs a positive radius "
-                             f"and height, got {obstacle}")
+    validate_station_obstacles(config, "ArmStationConfig")

@@ -146,10 +146,16 @@ def validate_hsr_station_config(config: HsrStationConfig) -> None:
     if not config.arm_centering_gain >= 0:
         raise ValueError(f"HsrStationConfig.arm_centering_gain must be >= 0, got "
                          f"{config.arm_centering_gain}")
+    validate_station_obstacles(config, "HsrStationConfig")
+
+
+def validate_station_obstacles(config, name):
+    """Each of a station config's (`name`: its class) cylinders has a positive radius and
+    height. Raises ValueError naming the obstacle."""
     for index, obstacle in enumerate(config.obstacles):
         if not (obstacle.radius > 0 and obstacle.height > 0):
-            raise ValueError(f"HsrStationConfig.obstacles[{index}] needs a positive radius "
-                             f"and height, got {obstacle}")
+            raise ValueError(f"{name}.obstacles[{index}] needs a positive radius and height, "
+                             f"got {obstacle}")
 
 
 def validate_station_timing(config, name):

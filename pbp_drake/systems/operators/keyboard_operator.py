@@ -29,14 +29,15 @@ KEY_BUTTONS = {
     TURN_RIGHT_BUTTON: "KeyE",
 }
 
-# What one held key adds to [forward, left, yaw] (robot frame, unit speeds).
+# What one held key adds to [forward, left, up, yaw] (robot frame, unit speeds); up and
+# down only with `vertical=True`.
 _KEY_AXES = {
-    FORWARD_BUTTON: (1.0, 0.0, 0.0),
-    BACK_BUTTON: (-1.0, 0.0, 0.0),
-    LEFT_BUTTON: (0.0, 1.0, 0.0),
-    RIGHT_BUTTON: (0.0, -1.0, 0.0),
-    TURN_LEFT_BUTTON: (0.0, 0.0, 1.0),
-    TURN_RIGHT_BUTTON: (0.0, 0.0, -1.0),
+    FORWARD_BUTTON: (1.0, 0.0, 0.0, 0.0),
+    BACK_BUTTON: (-1.0, 0.0, 0.0, 0.0),
+    LEFT_BUTTON: (0.0, 1.0, 0.0, 0.0),
+    RIGHT_BUTTON: (0.0, -1.0, 0.0, 0.0),
+    TURN_LEFT_BUTTON: (0.0, 0.0, 0.0, 1.0),
+    TURN_RIGHT_BUTTON: (0.0, 0.0, 0.0, -1.0),
 }
 
 #: The buttons `vertical=True` adds (name -> `KeyboardEvent.code`): R up, F down.
@@ -44,13 +45,7 @@ VERTICAL_KEY_BUTTONS = {
     UP_BUTTON: "KeyR",
     DOWN_BUTTON: "KeyF",
 }
-
-# With vertical motion, what one held key adds to [forward, left, up, yaw].
-_VERTICAL_KEY_AXES = {
-    **{name: (forward, left, 0.0, yaw) for name, (forward, left, yaw) in _KEY_AXES.items()},
-    UP_BUTTON: (0.0, 0.0, 1.0, 0.0),
-    DOWN_BUTTON: (0.0, 0.0, -1.0, 0.0),
-}
+_KEY_AXES.update({UP_BUTTON: (0.0, 0.0, 1.0, 0.0), DOWN_BUTTON: (0.0, 0.0, -1.0, 0.0)})
 
 
 @dataclasses.dataclass
@@ -135,8 +130,7 @@ class KeyboardOperator(SampledOperator):
         if self._vertical:
             keys.update(VERTICAL_KEY_BUTTONS)
         self._keys = HeldButtons(meshcat, keys, params.hold_time)
-        axes = _VERTICAL_KEY_AXES if self._vertical else _KEY_AXES
-        self._axes = np.array([axes[name] for name in self._keys.names])
+        self._axes = np.array([_KEY_AXES[name] for name in self._keys.names])
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         # Per button: the click count last seen, then the time of its last click.
         self._keys_index = self.DeclareDiscreteState(
@@ -172,26 +166,14 @@ class KeyboardOperator(SampledOperator):
         self._store_sample(discrete_state, *self._command(context, keys))
 
     def _command(self, context, keys):
-        if self._vertical:
-            return self._vertical_command(context, keys)
-        held = self._keys.held(keys, context.get_time())
-        forward, left, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(3)
-        local = np.array([forward, left])
-        norm = np.linalg.norm(local)
-        if norm > 0:
-            local *= self._speed / norm  # e.g. ↑ with ← goes diagonally at `speed`
-        velocity = rotate_planar(local, EeState(self._ee_state_port.Eval(context)).heading)
-        yaw_rate = self._rotation_speed * yaw
-        return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), bool(held.any())
-
-    def _vertical_command(self, context, keys):
-        """`_command` with the up and down keys: one 3-D direction at `speed`."""
         held = self._keys.held(keys, context.get_time())
         forward, left, up, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(4)
+        # One direction at `speed`: e.g. ↑ with ← goes diagonally, and (vertical) ← with R
+        # up and to the left.
         local = np.array([forward, left, up])
         norm = np.linalg.norm(local)
         if norm > 0:
-            local *= self._speed / norm  # e.g. ← with R goes diagonally at `speed`
+            local *= self._speed / norm
         velocity = rotate_planar(local[:2], EeState(self._ee_state_port.Eval(context)).heading)
         yaw_rate = self._rotation_speed * yaw
         return np.array([velocity[0], velocity[1], local[2], yaw_rate]), bool(held.any())

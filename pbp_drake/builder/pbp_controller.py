@@ -9,6 +9,8 @@ Under the PBP methods and explicit arbitration (`pbp_controller`):
     goals ──> dmp_bank, goal_estimator
     operator_command ──> goal_estimator (the maxent_command estimator only)
     dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
+    goal_estimator ──> likely_goals ──> dmp_bank.predicted_goals (with prediction_steps > 0:
+                                        the paths a drawing shows)
     operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
                                             └─> heading_command
     operator_active ──> dmp_bank (PBP-Alt's phase lock), blender
@@ -41,16 +43,19 @@ from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.systems import (
-    Blender, DmpBank, GoalEstimator, HandOver, HeadingCommand, HopAssistance,
+    Blender, DmpBank, GoalEstimator, HandOver, HeadingCommand, HopAssistance, LikelyGoals,
     MaxEntGoalEstimator)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
 # How far ahead the task scenes draw the DMPs' paths, in samples over the DMP's duration.
 TASK_PREDICTION_SAMPLES = 40
+# How many goals' paths `predicted_paths` holds by default: the selected goal's and the
+# three next most probable goals'. A drawing of them costs the same whatever K.
+PREDICTED_GOALS = 4
 
 
 def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
-                        prediction_steps=0):
+                        prediction_steps=0, predicted_goal_count=PREDICTED_GOALS):
     """The controller of `config.method`, a Diagram named `pbp_controller` (or
     `hop_controller` under ``hop`` and ``policy_blending``).
 
@@ -63,8 +68,10 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
             the controller, and with `config.dmp_duration` 0 the farthest one sets the
             DMPs' duration. The goals themselves come in on the `goals` port (K x 3,
             row-major), so they may move.
-        prediction_steps: > 0 adds `predicted_paths` (each DMP's path over its duration
-            in that many samples, for drawing; PBP methods).
+        prediction_steps: > 0 adds `predicted_paths` and `predicted_goals` (PBP methods):
+            the paths of `predicted_goal_count` goals (at most K), the selected goal's
+            first and then the most probable others', over the DMPs' duration in that many
+            samples, for drawing; `predicted_goals` is their indices.
 
     .. pydrake_system::
 
@@ -80,6 +87,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         - goal_probabilities
         - phase (with DMPs)
         - predicted_paths (with prediction_steps > 0)
+        - predicted_goals (with prediction_steps > 0)
         - posterior_clipped (with HOP's posterior)
 
     `ee_state` is `[p (3), v (3), heading, heading_rate]`, `operator_command`
@@ -111,7 +119,8 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
             builder, config, len(goals), split, command_split)
     else:
         name, estimator, reference = "pbp_controller", *_add_pbp_policy(
-            builder, config, start, goals, split, command_split, prediction_steps)
+            builder, config, start, goals, split, command_split, prediction_steps,
+            min(int(predicted_goal_count), len(goals)))
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
         EeState(initial_ee_state).heading, config.control_period,
         config.hand_over.max_hand_yaw_acceleration,
@@ -134,7 +143,8 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     return diagram
 
 
-def _add_pbp_policy(builder, config, start, goals, split, command_split, prediction_steps):
+def _add_pbp_policy(builder, config, start, goals, split, command_split, prediction_steps,
+                    predicted_goal_count):
     """The goal estimator, the DMP bank and the blender; returns the estimator and the
     blender's command [p, v]."""
     period = config.control_period
@@ -163,7 +173,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         # Every DMP steps from the followed one's velocity (connected below): the state is
         # then O(D) whatever K (with shared weights and start, every scenario's bank, the
         # outputs are O(D) too).
-        compact_state=True))
+        compact_state=True, predicted_goal_count=predicted_goal_count))
     builder.ConnectInput("goals", dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
@@ -187,7 +197,16 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     builder.ConnectInput("operator_active", blender.get_operator_active_input_port())
     builder.ExportOutput(dmp_bank.get_phase_output_port(), "phase")
     if prediction_steps:
+        likely = builder.AddNamedSystem("likely_goals", LikelyGoals(
+            goal_count, predicted_goal_count))
+        builder.Connect(estimator.get_selected_goal_output_port(),
+                        likely.get_selected_goal_input_port())
+        builder.Connect(estimator.get_goal_probabilities_output_port(),
+                        likely.get_goal_probabilities_input_port())
+        builder.Connect(likely.get_goal_indices_output_port(),
+                        dmp_bank.get_predicted_goals_input_port())
         builder.ExportOutput(dmp_bank.get_predicted_paths_output_port(), "predicted_paths")
+        builder.ExportOutput(likely.get_goal_indices_output_port(), "predicted_goals")
     return estimator, blender.get_command_output_port()
 
 

@@ -26,7 +26,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from pbp_drake.builder.operators import make_hsr_operator
-from pbp_drake.builder.pbp_controller import TASK_PREDICTION_SAMPLES, make_pbp_controller
+from pbp_drake.builder.pbp_controller import (
+    PREDICTED_GOALS, TASK_PREDICTION_SAMPLES, make_pbp_controller)
 from pbp_drake.robots import ArmStationConfig, make_arm_station, make_hsr_station
 from pbp_drake.systems import GoalsSource, ReachSceneVisualizer, SampleHold, TaskMonitor
 from pbp_drake.systems.tasks.moving_obstacles import MovingObstacles
@@ -58,8 +59,9 @@ def build_reach_diagram(resolved, meshcat=None):
     builder.Connect(sampled, monitor.get_ee_state_input_port())
 
     prediction_steps = TASK_PREDICTION_SAMPLES if meshcat is not None else 0
+    path_count = min(PREDICTED_GOALS, len(resolved.goals))
     controller = make_pbp_controller(resolved.controller, resolved.initial_ee_state,
-                                     resolved.goals, prediction_steps)
+                                     resolved.goals, prediction_steps, path_count)
     controller = builder.AddNamedSystem(controller.get_name(), controller)
     goals = builder.AddNamedSystem("goals", GoalsSource(resolved.goals))
     builder.Connect(goals.get_output_port(), controller.GetInputPort("goals"))
@@ -108,7 +110,7 @@ def build_reach_diagram(resolved, meshcat=None):
 
     if meshcat is not None:
         visualizer = builder.AddNamedSystem("task_visualizer", ReachSceneVisualizer(
-            meshcat, scene.objects, prediction_steps))
+            meshcat, scene.objects, prediction_steps, path_count))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
         builder.Connect(selected_goal, visualizer.get_selected_goal_input_port())
         builder.Connect(operator_active, visualizer.get_operator_active_input_port())
@@ -116,6 +118,8 @@ def build_reach_diagram(resolved, meshcat=None):
         if controller.HasOutputPort("predicted_paths"):
             builder.Connect(controller.GetOutputPort("predicted_paths"),
                             visualizer.get_predicted_paths_input_port())
+        builder.Connect(controller.GetOutputPort("goal_probabilities"),
+                        visualizer.get_goal_probabilities_input_port())
 
     diagram = builder.Build()
     diagram.set_name(scenario.name)

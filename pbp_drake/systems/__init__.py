@@ -26,7 +26,7 @@ from pbp_drake.systems.operators import (
     VirtualOperator)
 from pbp_drake.systems.pbp import (
     Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand,
-    HopAssistance, MaxEntGoalEstimator, PoseBlender, PoseDmpBank, PoseGoalEstimator,
+    HopAssistance, LikelyGoals, MaxEntGoalEstimator, PoseBlender, PoseDmpBank, PoseGoalEstimator,
     PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator)
 from pbp_drake.systems.sample_hold import SampleHold
 from pbp_drake.systems.tasks import (
@@ -38,7 +38,7 @@ from pbp_drake.systems.visualizers import (
 __all__ = [
     # The PBP loop.
     "Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource", "HandOver",
-    "HeadingCommand", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver",
+    "HeadingCommand", "LikelyGoals", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver",
     # The shared-autonomy baselines (HOP, policy blending) and PBP's maxent_command estimator.
     "HopAssistance", "MaxEntGoalEstimator", "PoseHopAssistance", "PoseMaxEntGoalEstimator",
     # Operators.

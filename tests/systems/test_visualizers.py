@@ -21,11 +21,12 @@ from pbp_drake.scenarios import Obstacle
 from pbp_drake.systems.ports import Target
 from pbp_drake.systems.visualizers.point_scene_visualizer import PointSceneVisualizer
 from pbp_drake.systems.visualizers.reach_scene_visualizer import ReachSceneVisualizer
+from pbp_drake.systems.visualizers.scene_drawing import LIKELY_RGB, UNLIKELY_RGB, GoalCloud
 
 OBJECTS = np.array([[1.5, -0.4, 0.7], [1.5, 0.4, 0.7]])
 ROOTS = ["/task", "/pbp"]
 REACH_PATHS = ["/task/tables/0", "/task/tables/1", "/task/objects/0", "/task/objects/1",
-               "/task/target", "/task/estimated_goal", "/task/operator"]
+               "/task/goal_cloud", "/task/target", "/task/estimated_goal", "/task/operator"]
 POINT_PATHS = ["/pbp/obstacles/0", "/pbp/start", "/pbp/goals/0", "/pbp/goals/1",
                "/pbp/demonstration", "/pbp/robot", "/pbp/robot/operator"]
 
@@ -123,26 +124,84 @@ def test_a_2d_replay_shows_the_dmp_path_from_where_the_robot_is_at_each_time(rep
     assert np.max(np.abs(path_at(0.5)[:, 1])) > 0.05  # bent sideways by the push
 
 
-def test_an_hsr_replay_shows_each_dmp_path_and_the_selected_one_as_they_were(meshcat):
-    # Paths of 3 points each that slide 0.5 m along y over a second; the estimate is object 1.
-    steps, count = 2, len(OBJECTS)
-    start = np.array([[[0.5, 0.0, 0.7], *OBJECTS]] * count).reshape(count, steps + 1, 3)
-    start[:, -1] = OBJECTS  # each path ends at its object
+def test_an_hsr_replay_shows_the_selected_path_bold_and_the_likely_ones_as_they_were(meshcat):
+    # Three objects, two paths on the port (the controller's order: the selected goal's,
+    # then the likeliest other's), of 3 points each, sliding 0.5 m along y over a second.
+    objects = np.vstack([OBJECTS, [[2.0, 0.0, 0.7]]])
+    steps, count = 2, 2
+    start = np.array([[[0.5, 0.0, 0.7], objects[2], objects[2]],
+                      [[0.5, 0.0, 0.7], objects[0], objects[0]]])
     end = start + [0.0, 0.5, 0.0]
     paths = PiecewisePolynomial.FirstOrderHold(
         [0.0, 1.0], np.column_stack([start.ravel(), end.ravel()]))
     builder = DiagramBuilder()
-    visualizer = builder.AddSystem(ReachSceneVisualizer(meshcat, OBJECTS, steps))
+    visualizer = builder.AddSystem(ReachSceneVisualizer(meshcat, objects, steps, count))
     add_source(builder, np.zeros(Target.size), visualizer.get_target_input_port())
-    add_source(builder, [1.0], visualizer.get_selected_goal_input_port())
+    add_source(builder, [2.0], visualizer.get_selected_goal_input_port())
     source = builder.AddSystem(TrajectorySource(paths))
     builder.Connect(source.get_output_port(), visualizer.get_predicted_paths_input_port())
     tracks = recorded(meshcat, builder.Build(), 1.0)
     for time in [0.0, 0.5, 1.0]:
         shift = [0.0, 0.5 * time, 0.0]
-        for root, index in [("/task/predictions/0", 0), ("/task/predictions/1", 1),
-                            ("/task/predictions/selected", 1)]:
+        for root, index in [("/task/predictions/selected", 0),
+                            ("/task/predictions/likely/1", 1)]:
             first = value_at(tracks, f"{root}/0", ".position", time)
             last = value_at(tracks, f"{root}/23", ".position", time)
             np.testing.assert_allclose(first, start[index, 0] + shift, atol=1e-9)
-            np.testing.assert_allclose(last, OBJECTS[index] + shift, atol=1e-9)
+            np.testing.assert_allclose(last, start[index, -1] + shift, atol=1e-9)
+    assert not meshcat.HasPath("/task/predictions/likely/2")  # two paths, no more
+
+
+def _cloud_scene(meshcat, objects, probabilities):
+    builder = DiagramBuilder()
+    visualizer = builder.AddSystem(ReachSceneVisualizer(meshcat, objects))
+    add_source(builder, np.zeros(Target.size), visualizer.get_target_input_port())
+    add_source(builder, [0.0], visualizer.get_selected_goal_input_port())
+    source = builder.AddSystem(TrajectorySource(probabilities))
+    builder.Connect(source.get_output_port(), visualizer.get_goal_probabilities_input_port())
+    return builder.Build()
+
+
+def test_many_goals_are_one_cloud_coloured_by_probability_sent_only_when_it_changes(meshcat):
+    # 1,000 goals: no tables, one cloud; the probabilities change once, at 1 s.
+    rng = np.random.default_rng(0)
+    objects = np.column_stack([rng.uniform(1.2, 2.5, 1000), rng.uniform(-1, 1, 1000),
+                               np.full(1000, 0.7)])
+    first, second = np.full(1000, 1e-3), np.full(1000, 1e-3)
+    first[0], second[7] = 0.5, 0.5
+    probabilities = PiecewisePolynomial.ZeroOrderHold(
+        [0.0, 1.0, 2.0], np.column_stack([first, second, second]))
+    sent = []
+    original = GoalCloud.show
+
+    def spy(cloud, meshcat_, values):
+        before = cloud._sent
+        original(cloud, meshcat_, values)
+        if cloud._sent is not before:
+            sent.append(np.array(values))
+
+    GoalCloud.show = spy
+    try:
+        Simulator(_cloud_scene(meshcat, objects, probabilities)).AdvanceTo(2.0)
+    finally:
+        GoalCloud.show = original
+    assert meshcat.HasPath("/task/goal_cloud") and not meshcat.HasPath("/task/tables/0")
+    # Drawn uniform, coloured at initialisation, and again once at 1 s: three sends in
+    # 2 s, whatever the 0.25 s period would allow (nine).
+    assert len(sent) == 3
+    assert np.argmax(sent[1]) == 0 and np.argmax(sent[2]) == 7
+
+
+def test_the_cloud_colours_the_most_probable_goal_blue_and_the_unlikely_grey():
+    class Recorder:
+        def SetObject(self, path, cloud, point_size):
+            self.colours = np.array(cloud.rgbs())
+
+    recorder = Recorder()
+    cloud = GoalCloud("/cloud", np.zeros((3, 3)), 0.05)
+    cloud.show(recorder, [0.0, 0.25, 0.5])
+    np.testing.assert_array_equal(recorder.colours[:, 2], LIKELY_RGB)
+    np.testing.assert_array_equal(recorder.colours[:, 0], UNLIKELY_RGB)
+    halfway = recorder.colours[:, 1].astype(float)
+    assert (np.minimum(UNLIKELY_RGB, LIKELY_RGB) < halfway).all()
+    assert (halfway < np.maximum(UNLIKELY_RGB, LIKELY_RGB)).all()

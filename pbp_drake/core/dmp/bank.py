@@ -273,6 +273,22 @@ class DmpBankModel(BankStep):
         out_positions[...] = np.where(locked, positions, new_positions)
         out_velocity[...] = np.where(locked, held, new_velocity)
 
+    def subset(self, indices):
+        """The bank of the DMPs `indices` (M,) alone, in that order: a new immutable bank
+        with the same duration and settings and those DMPs' weights, starts and amplitude
+        scaling (what drawing a few of K DMPs' paths steps, instead of all K)."""
+        indices = np.asarray(indices).reshape(-1)
+        if (indices.size == 0 or not np.issubdtype(indices.dtype, np.integer)
+                or indices.min() < 0 or indices.max() >= self.goal_count):
+            raise ValueError(f"indices must be one or more of the bank's goal indices 0 to "
+                             f"{self.goal_count - 1}, got {indices.tolist()}")
+        starts = self.starts[:, indices].T
+        scaling = self.amplitude_scaling[:, indices].T
+        weights = (self._weights if self.shared_weights
+                   else self._weights[:, :, indices].transpose(2, 0, 1))  # (M, N, D)
+        return type(self)(weights, starts, self.duration, self._settings, scaling,
+                          goal_count=indices.size)
+
     def predict(self, phase, position, scaled_velocity, goals_dk, dt, steps, workspace=None):
         """Open-loop paths `(K, steps + 1, D)` from one state, for drawing predictions; the
         inputs are left alone. `workspace` saves allocating one (the paths are new anyway)."""

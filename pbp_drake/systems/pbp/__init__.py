@@ -1,8 +1,8 @@
 """The PBP loop's systems: the DMP banks, the goal estimators, the blenders and the hand-over,
 in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`) and the six-DoF
 pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`, `PoseHandOver`); the goals'
-source, the heading command of the HSR tasks and the demonstration player of explicit
-arbitration; and the shared-autonomy baselines' systems: HOP's goal posterior on the
+source, the heading command of the HSR tasks, the demonstration player of explicit
+arbitration and the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy baselines' systems: HOP's goal posterior on the
 operator's command (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`, also PBP's
 ``maxent_command`` estimator) and its assistance (`HopAssistance`, `PoseHopAssistance`)."""
 
@@ -14,6 +14,7 @@ from pbp_drake.systems.pbp.goals_source import GoalsSource
 from pbp_drake.systems.pbp.hand_over import HandOver
 from pbp_drake.systems.pbp.heading_command import HeadingCommand
 from pbp_drake.systems.pbp.hop_assistance import HopAssistance
+from pbp_drake.systems.pbp.likely_goals import LikelyGoals
 from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator
 from pbp_drake.systems.pbp.pose_blender import PoseBlender
 from pbp_drake.systems.pbp.pose_dmp_bank import PoseDmpBank
@@ -23,6 +24,7 @@ from pbp_drake.systems.pbp.pose_hop_assistance import PoseHopAssistance
 from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstimator
 
 __all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource",
-           "HandOver", "HeadingCommand", "HopAssistance", "MaxEntGoalEstimator", "PoseBlender",
+           "HandOver", "HeadingCommand", "HopAssistance", "LikelyGoals", "MaxEntGoalEstimator",
+           "PoseBlender",
            "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver", "PoseHopAssistance",
            "PoseMaxEntGoalEstimator"]

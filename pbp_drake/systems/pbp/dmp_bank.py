@@ -28,6 +28,7 @@ class DmpBank(LeafSystem):
         - operator_active (optional)
         - followed_goal (optional)
         - selected_goal (optional)
+        - predicted_goals (with predicted_goal_count)
         output_ports:
         - references
         - selected_reference
@@ -57,7 +58,10 @@ class DmpBank(LeafSystem):
     compute where `references` is O(K D). `phase` is the K phases; `predicted_paths`
     (declared when `prediction_steps > 0`) is each DMP's open-loop path from its current
     state, `(K, prediction_steps + 1, D)` flattened, for drawing, sampled every
-    `prediction_period` (default: the control period).
+    `prediction_period` (default: the control period). With `predicted_goal_count` M, it
+    is the paths of the M goals whose indices come in on `predicted_goals` (in that order;
+    unconnected, goals 0 to M - 1), `(M, prediction_steps + 1, D)`: a drawing of a few
+    goals' paths then costs the same whatever K.
     All state lives in the Context, and so does the step's scratch memory (a cache entry).
 
     The state is one vector, in one of three layouts
@@ -84,7 +88,7 @@ class DmpBank(LeafSystem):
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
                  prediction_steps=0, update_offset=None, prediction_period=None,
-                 max_speed=None, compact_state=False):
+                 max_speed=None, compact_state=False, predicted_goal_count=None):
         super().__init__()
         self._bank = bank
         # Anti-windup: the hand-over law never lets the hand move faster than this (m/s), so
@@ -146,13 +150,21 @@ class DmpBank(LeafSystem):
                                            self._followed_goal_port.ticket()})
         self._phase_port = self.DeclareVectorOutputPort(
             "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
-        self._predicted_paths_port = None
+        self._predicted_paths_port = self._predicted_goals_port = None
         if self._prediction_steps > 0:
+            paths = k
+            prerequisites = {self.xd_ticket(), self._goals_port.ticket()}
+            if predicted_goal_count is not None:
+                paths = int(predicted_goal_count)
+                if not 1 <= paths <= k:
+                    raise ValueError(f"predicted_goal_count must be in [1, {k}] (the goal "
+                                     f"count), got {predicted_goal_count!r}")
+                self._predicted_goals_port = self.DeclareVectorInputPort(
+                    "predicted_goals", paths)
+                prerequisites.add(self._predicted_goals_port.ticket())
             self._predicted_paths_port = self.DeclareVectorOutputPort(
-                "predicted_paths", k * (self._prediction_steps + 1) * d,
-                self._calc_predicted_paths,
-                prerequisites_of_calc={self.xd_ticket(),
-                                       self._goals_port.ticket()})
+                "predicted_paths", paths * (self._prediction_steps + 1) * d,
+                self._calc_predicted_paths, prerequisites_of_calc=prerequisites)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     @staticmethod
@@ -191,6 +203,10 @@ class DmpBank(LeafSystem):
 
     def get_predicted_paths_output_port(self):
         return self._predicted_paths_port
+
+    def get_predicted_goals_input_port(self):
+        """The goals whose paths `predicted_paths` holds (with `predicted_goal_count`)."""
+        return self._predicted_goals_port
 
     def _workspace(self, context):
         """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""
@@ -276,9 +292,16 @@ class DmpBank(LeafSystem):
     def _calc_predicted_paths(self, context, output):
         phase, positions, scaled_velocity = self.dmp_states(context)
         goals = self._goals_dk.Eval(context)
-        paths = self._bank.predict(phase, positions, scaled_velocity, goals,
-                                   self._prediction_period, self._prediction_steps,
-                                   self._workspace(context))
+        bank, workspace = self._bank, self._workspace(context)
+        if self._predicted_goals_port is not None:
+            indices = np.arange(self._predicted_goals_port.size())
+            if self._predicted_goals_port.HasValue(context):
+                indices = self._predicted_goals_port.Eval(context).astype(int)
+            bank, workspace = bank.subset(indices), None  # subset checks the indices
+            phase, positions = phase[indices], positions[:, indices]
+            scaled_velocity, goals = scaled_velocity[:, indices], goals[:, indices]
+        paths = bank.predict(phase, positions, scaled_velocity, goals,
+                             self._prediction_period, self._prediction_steps, workspace)
         output.SetFromVector(paths.reshape(-1))
 
 

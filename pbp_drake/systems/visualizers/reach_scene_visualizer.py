@@ -1,4 +1,5 @@
-"""Draws the reaching task in Meshcat: objects, the target, the estimated goal, DMP paths."""
+"""Draws the reaching task in Meshcat: objects, every goal's probability as one point cloud,
+the target, the estimated goal, and the DMP paths of the selected and the likeliest goals."""
 
 import numpy as np
 from pydrake.geometry import Box, Cylinder, Rgba, Sphere
@@ -6,7 +7,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.ports import EeState, Target, position_of
-from pbp_drake.systems.visualizers.scene_drawing import PathDots
+from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
 TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
@@ -20,6 +21,11 @@ OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
 PATH_DOTS = 24
 ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008
 OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
+# Up to this many objects are drawn as tables and cylinders; more are the goal cloud alone
+# (thousands of meshes would slow the page down, and show nothing the cloud does not).
+SOLID_OBJECTS = 100
+# The goal cloud's points float just above the objects' tops, the size of an object.
+CLOUD_LIFT, CLOUD_POINT_SIZE = 0.07, 0.05
 
 OBJECT_RADIUS = 0.03
 OBJECT_HEIGHT = 0.1
@@ -40,41 +46,59 @@ class ReachSceneVisualizer(LeafSystem):
         - operator_active (optional)
         - ee_state (optional)
         - predicted_paths (optional)
+        - goal_probabilities (optional)
 
-    The objects stand on small tables, drawn (after deleting `/task`) at each
-    initialisation (`Simulator.Initialize`), so a second run or a run after
-    `meshcat.Delete()` draws them again. Each publish moves the yellow ball above the
-    current `target` (`Target`, `[p (3), index]`) and the blue ball above the
-    estimated goal (`selected_goal`), with `time_in_recording` so that
+    What is sent does not grow with the number of objects K once the scene is drawn: at
+    each initialisation (`Simulator.Initialize`, after deleting `/task`) the objects are
+    drawn on small tables (up to `SOLID_OBJECTS` of them; more are the cloud alone), and
+    every object as one point of the goal cloud `/task/goal_cloud` (`GoalCloud`), so a
+    second run or a run after `meshcat.Delete()` draws them again. Each publish moves the
+    yellow ball above the current `target` (`Target`, `[p (3), index]`) and the blue ball
+    above the estimated goal (`selected_goal`), with `time_in_recording` so that
     `Meshcat.StartRecording` replays them; an orange ring around the hand shows when the
-    operator acts. Each `path_period` (default 0.1 s: paths change slowly, and a
-    replay interpolates between updates) every DMP's predicted path is drawn as faint dots
-    and the selected one's again as bold dots (`PathDots`, with `time_in_recording`, so a
-    replay shows each path where it was at that time). Call from the thread that made
-    `meshcat`.
+    operator acts. Each `path_period` (default 0.1 s: paths change slowly, and a replay
+    interpolates between updates) the `path_count` paths on `predicted_paths` (each
+    `prediction_steps + 1` points, the selected goal's first, as the PBP controller's
+    `predicted_paths` orders them) are drawn as dots (`PathDots`, with
+    `time_in_recording`, so a replay shows each path where it was at that time): the
+    first bold `/task/predictions/selected`, the others faint
+    `/task/predictions/likely/{i}`. Each `cloud_period` (default 0.25 s) the cloud's points
+    take the colour of their goal's probability (`goal_probabilities`, K), grey to blue,
+    sent again only when a colour changed; a recording keeps the cloud's last colours only
+    (Meshcat records transforms and properties, not objects), the paths as they went.
+    Call from the thread that made `meshcat`.
     """
 
-    def __init__(self, meshcat, objects, prediction_steps=0, publish_period=1.0 / 30.0,
-                 path_period=0.1):
+    def __init__(self, meshcat, objects, prediction_steps=0, path_count=1,
+                 publish_period=1.0 / 30.0, path_period=0.1, cloud_period=0.25):
         super().__init__()
         self._meshcat = meshcat
         self._objects = np.asarray(objects, dtype=float)
         self._prediction_steps = int(prediction_steps)
         k = len(self._objects)
+        path_count = int(path_count)
+        if not 1 <= path_count <= k:
+            raise ValueError(f"path_count must be in [1, {k}] (the object count), got "
+                             f"{path_count}")
+        self._path_count = path_count
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._predicted_paths_port = self.DeclareVectorInputPort(
-            "predicted_paths", max(1, k * (self._prediction_steps + 1) * 3))
-        self._other_paths = [PathDots(f"/task/predictions/{index}", PATH_DOTS,
-                                      OTHER_DOT_RADIUS, OTHER_PATH_COLOUR)
-                             for index in range(k)]
+            "predicted_paths", max(1, path_count * (self._prediction_steps + 1) * 3))
+        self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
         self._active_path = PathDots("/task/predictions/selected", PATH_DOTS,
                                      ACTIVE_DOT_RADIUS, ACTIVE_PATH_COLOUR)
+        self._other_paths = [PathDots(f"/task/predictions/likely/{index}", PATH_DOTS,
+                                      OTHER_DOT_RADIUS, OTHER_PATH_COLOUR)
+                             for index in range(1, path_count)]
+        self._cloud = GoalCloud("/task/goal_cloud", self._objects + [0.0, 0.0, CLOUD_LIFT],
+                                CLOUD_POINT_SIZE)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)
+        self.DeclarePeriodicPublishEvent(cloud_period, 0.0, self._publish_cloud)
         self.DeclareInitializationPublishEvent(self._initialise)
 
     def get_target_input_port(self):
@@ -92,16 +116,22 @@ class ReachSceneVisualizer(LeafSystem):
     def get_predicted_paths_input_port(self):
         return self._predicted_paths_port
 
+    def get_goal_probabilities_input_port(self):
+        return self._probabilities_port
+
     def _initialise(self, context):
         self._draw_scene()
         self._publish(context)
         if self._prediction_steps:
             self._publish_paths(context)
+        self._publish_cloud(context)
 
     def _draw_scene(self):
         meshcat = self._meshcat
         meshcat.Delete("/task")
-        for index, point in enumerate(self._objects):
+        self._cloud.draw(meshcat)
+        for index, point in enumerate(self._objects if len(self._objects) <= SOLID_OBJECTS
+                                      else ()):
             table_height = point[2] - OBJECT_HEIGHT / 2
             meshcat.SetObject(f"/task/tables/{index}", Box(0.3, 0.3, table_height), TABLE_COLOUR)
             meshcat.SetTransform(f"/task/tables/{index}",
@@ -114,7 +144,7 @@ class ReachSceneVisualizer(LeafSystem):
         meshcat.SetObject("/task/operator", Cylinder(0.09, 0.01), OPERATOR_COLOUR)
         meshcat.SetProperty("/task/operator", "visible", False)
         if self._prediction_steps:
-            for dots in [*self._other_paths, self._active_path]:
+            for dots in [self._active_path, *self._other_paths]:
                 dots.draw(meshcat)
         centre = self._objects.mean(axis=0)
         # A camera behind and above the robot that sees it and every object.
@@ -142,8 +172,10 @@ class ReachSceneVisualizer(LeafSystem):
             return
         time = context.get_time()
         paths = self._predicted_paths_port.Eval(context).reshape(
-            len(self._objects), self._prediction_steps + 1, 3)
-        for dots, path in zip(self._other_paths, paths):
+            self._path_count, self._prediction_steps + 1, 3)
+        for dots, path in zip([self._active_path, *self._other_paths], paths):
             dots.show(self._meshcat, path, time)
-        selected = int(self._selected_goal_port.Eval(context)[0])
-        self._active_path.show(self._meshcat, paths[selected], time)
+
+    def _publish_cloud(self, context):
+        if self._probabilities_port.HasValue(context):
+            self._cloud.show(self._meshcat, self._probabilities_port.Eval(context))

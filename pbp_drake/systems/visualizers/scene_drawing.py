@@ -1,5 +1,6 @@
 """Meshcat drawing shared by the scene visualizers: a top-down view framed on a 2-D scene,
-paths drawn so that a recording replays them, and axis triads for six-DoF poses.
+paths drawn so that a recording replays them, axis triads for six-DoF poses, and many
+goals as one point cloud coloured by their probabilities.
 
 Meshcat's recordings (`StartRecording`) keep only `SetTransform` and `SetProperty` calls, as
 animation tracks of transforms, positions and visibility; `SetLine` and `SetObject` change the
@@ -13,6 +14,7 @@ import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.geometry import Cylinder, Rgba, Sphere
 from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.perception import BaseField, Fields, PointCloud
 
 from pbp_drake.core.scene_framing import resample_by_arc_length
 
@@ -151,6 +153,47 @@ class PathTrail:
             meshcat.SetProperty(f"{self.root}/{index}", "visible", False, time)
         self._points = kept
         self._spacing *= 2.0
+
+
+# The goal cloud's colours: a goal of no probability grey, the most probable one blue.
+UNLIKELY_RGB = np.array([150.0, 150.0, 150.0])
+LIKELY_RGB = np.array([25.0, 75.0, 255.0])
+
+
+class GoalCloud:
+    """K goals drawn as one Meshcat point cloud at `root` (one object, whatever K), each
+    point coloured by its goal's probability relative to the most probable goal's, from
+    grey (`UNLIKELY_RGB`) to blue (`LIKELY_RGB`).
+
+    `show` sends the cloud again only when a colour changed (colours are bytes, so a
+    change too small to see sends nothing). What was sent is kept here, not in a Drake
+    context: `draw` starts again, and one simulation at a time may use it."""
+
+    def __init__(self, root, points, point_size):
+        self.root = root
+        points = np.asarray(points, dtype=float)
+        self._cloud = PointCloud(len(points), Fields(BaseField.kXYZs | BaseField.kRGBs))
+        self._cloud.mutable_xyzs()[:] = points.T
+        self._point_size = float(point_size)
+        self._sent = None  # the colours last sent, (3, K) bytes
+
+    def draw(self, meshcat):
+        """Sends the cloud with every goal equally likely (blue)."""
+        self._sent = None
+        self.show(meshcat, np.ones(self._cloud.size()))
+
+    def show(self, meshcat, probabilities):
+        """Colours the points by `probabilities` (K) and sends the cloud if a colour changed."""
+        probabilities = np.asarray(probabilities, dtype=float)
+        largest = probabilities.max()
+        share = probabilities / largest if largest > 0 else np.ones_like(probabilities)
+        colours = np.rint(UNLIKELY_RGB[:, None] + (LIKELY_RGB - UNLIKELY_RGB)[:, None]
+                          * np.clip(share, 0.0, 1.0)).astype(np.uint8)
+        if self._sent is not None and np.array_equal(colours, self._sent):
+            return
+        self._cloud.mutable_rgbs()[:] = colours
+        meshcat.SetObject(self.root, self._cloud, self._point_size)
+        self._sent = colours
 
 
 def pose_transform(pose):

@@ -210,6 +210,8 @@ def build_grasp_diagram(resolved, meshcat=None):
                             visualizer.get_predicted_poses_input_port())
         # The measured pose, not the sample: the triad moves smoothly at 30 Hz.
         builder.Connect(hand_pose, visualizer.get_hand_state_input_port())
+        builder.Connect(estimator.get_goal_probabilities_output_port(),
+                        visualizer.get_goal_probabilities_input_port())
     diagram = builder.Build()
     diagram.set_name(scenario.name)
     return diagram

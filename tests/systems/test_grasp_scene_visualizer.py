@@ -2,6 +2,8 @@
 initialisation, and a recording in which the predicted path's triads move and turn as the
 path did. (The page itself is checked in tests/e2e/test_grasp_triads_in_browser.py.)"""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from pydrake.geometry import Meshcat, MeshcatParams
@@ -15,7 +17,7 @@ from pbp_drake.core.grasp_task import (
     approach_direction, sample_grasp_scene, side_grasp_orientation)
 from pbp_drake.core.quaternion import angle_between
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import (
-    PATH_TRIADS, TRIAD_LENGTH, GraspSceneVisualizer)
+    LIKELY_TRIADS, PATH_TRIADS, TRIAD_LENGTH, GraspSceneVisualizer)
 from pbp_drake.systems.ports import Target
 
 SCENE = sample_grasp_scene(3)  # four objects, one grasped from above
@@ -122,3 +124,40 @@ def test_each_grasp_triad_stands_at_its_grasp_with_blue_along_the_approach(meshc
     # A top grasp's blue axis points straight down at its object.
     top = SCENE.approaches.index("top")
     np.testing.assert_allclose(sent[f"/task/grasps/{top}"][:3, 2], [0, 0, -1], atol=1e-9)
+
+
+def test_many_grasps_are_a_cloud_and_the_likeliest_grasps_triads_that_a_replay_keeps(meshcat):
+    # 120 grasps (the 4 of SCENE, 30 times, shifted along y): past SOLID_OBJECTS, no table,
+    # object or triad per grasp, but the goal cloud and LIKELY_TRIADS triads moved to the
+    # selected grasp (0) and the likeliest others (7 at first, then 42 from 0.5 s).
+    shifts = np.repeat(np.arange(30) * 0.01, 4)[:, None] * [0.0, 1.0, 0.0]
+    many = dataclasses.replace(
+        SCENE, objects=np.tile(SCENE.objects, (30, 1)) + shifts,
+        tables=np.tile(SCENE.tables, (30, 1)) + shifts,
+        approaches=SCENE.approaches * 30,
+        approach_angles=np.tile(SCENE.approach_angles, 30),
+        grasp_positions=np.tile(SCENE.grasp_positions, (30, 1)) + shifts,
+        grasp_orientations=np.tile(SCENE.grasp_orientations, (30, 1)))
+    count = len(many.grasp_positions)
+    before, after = np.full(count, 1e-3), np.full(count, 1e-3)
+    before[7], after[42] = 0.5, 0.5
+    builder = DiagramBuilder()
+    visualizer = builder.AddSystem(GraspSceneVisualizer(meshcat, many, STEPS))
+    target = np.zeros(Target.size)
+    target[:3], target[3] = many.objects[1], 1
+    add_source(builder, target, visualizer.get_target_input_port())
+    add_source(builder, [0.0], visualizer.get_selected_goal_input_port())
+    source = builder.AddSystem(TrajectorySource(PiecewisePolynomial.ZeroOrderHold(
+        [0.0, 0.5, 1.0], np.column_stack([before, after, after]))))
+    builder.Connect(source.get_output_port(), visualizer.get_goal_probabilities_input_port())
+    tracks = recorded(meshcat, builder.Build(), 1.0)
+    assert meshcat.HasPath("/task/goal_cloud")
+    assert not any(meshcat.HasPath(f"/task/{kind}/0") for kind in ("grasps", "tables", "objects"))
+    assert all(meshcat.HasPath(f"/task/likely_grasps/{i}") for i in range(LIKELY_TRIADS))
+    for time, likeliest in [(0.2, 7), (0.9, 42)]:
+        np.testing.assert_allclose(
+            value_at(tracks, "/task/likely_grasps/0", ".position", time),
+            many.grasp_positions[0], atol=1e-9)
+        np.testing.assert_allclose(
+            value_at(tracks, "/task/likely_grasps/1", ".position", time),
+            many.grasp_positions[likeliest], atol=1e-9)

@@ -1,4 +1,5 @@
-"""Draws the grasping task in Meshcat: tables, objects, each grasp pose as a triad, the
+"""Draws the grasping task in Meshcat: tables, objects, each grasp pose as a triad (or, for
+many, the likeliest grasps' triads), every grasp's probability as one point cloud, the
 target and the estimated goal, the hand, and the selected DMP's predicted poses."""
 
 import numpy as np
@@ -6,15 +7,21 @@ from pydrake.geometry import Box, Cylinder, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.pbp.likely_goals import likely_goal_indices
 from pbp_drake.systems.ports import GoalPose, PoseState, Target, goal_index
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
-    ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
-from pbp_drake.systems.visualizers.scene_drawing import PathTriads, draw_triad, pose_transform
+    CLOUD_POINT_SIZE, ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, SOLID_OBJECTS,
+    TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
+from pbp_drake.systems.visualizers.scene_drawing import (
+    GoalCloud, PathTriads, draw_triad, pose_transform)
 
 # Triads: the grasp poses' and the hand's full size, the predicted path's smaller and a
 # little transparent, so that the grasp they lead to stands out.
 TRIAD_LENGTH, TRIAD_RADIUS = 0.1, 0.005
 PATH_TRIADS, PATH_TRIAD_LENGTH, PATH_TRIAD_OPACITY = 5, 0.06, 0.7
+# Beyond SOLID_OBJECTS grasps, the triads of this many likeliest grasps (the selected one's
+# first) are drawn, moved to them each path period.
+LIKELY_TRIADS = 4
 
 
 class GraspSceneVisualizer(LeafSystem):
@@ -28,11 +35,18 @@ class GraspSceneVisualizer(LeafSystem):
         - selected_goal
         - predicted_poses (optional)
         - hand_state (optional)
+        - goal_probabilities (optional)
 
-    `grasps` is the task's `GraspScene` (`layout.grasps`). At each initialisation
-    (`Simulator.Initialize`, after deleting `/task`) it draws every table and object and,
-    at each object's grasp pose, a triad `/task/grasps/{k}` (`draw_triad`: x red, y green,
-    z blue, z the approach). Each publish moves the yellow ball above the `target`'s object
+    `grasps` is the task's `GraspScene` (`layout.grasps`). What is sent does not grow with
+    the number of grasps K once the scene is drawn. At each initialisation
+    (`Simulator.Initialize`, after deleting `/task`) it draws, up to `SOLID_OBJECTS`
+    grasps, every table and object and, at each object's grasp pose, a triad
+    `/task/grasps/{k}` (`draw_triad`: x red, y green, z blue, z the approach); with more,
+    `LIKELY_TRIADS` triads `/task/likely_grasps/{i}` that each path period moves to the
+    selected grasp and the likeliest others (`goal_probabilities`), with
+    `time_in_recording`. Every grasp position is also a point of the goal cloud
+    `/task/goal_cloud` (`GoalCloud`), coloured each `cloud_period` by its probability, as
+    in the reaching task. Each publish moves the yellow ball above the `target`'s object
     (`Target`; its index picks the object) and the blue ball above the `selected_goal`'s,
     and the hand's triad `/task/hand` to `hand_state` (`PoseState`), with
     `time_in_recording` so that `Meshcat.StartRecording` replays them. Each `path_period`
@@ -45,7 +59,7 @@ class GraspSceneVisualizer(LeafSystem):
 
     def __init__(self, meshcat, grasps, prediction_steps=0, table_size=(0.3, 0.3),
                  object_radius=0.03, object_height=0.15, publish_period=1.0 / 30.0,
-                 path_period=0.1):
+                 path_period=0.1, cloud_period=0.25):
         super().__init__()
         self._meshcat = meshcat
         self._grasps = grasps
@@ -57,11 +71,18 @@ class GraspSceneVisualizer(LeafSystem):
         self._predicted_poses_port = self.DeclareVectorInputPort(
             "predicted_poses", (self._prediction_steps + 1) * GoalPose.size)
         self._hand_state_port = self.DeclareVectorInputPort("hand_state", PoseState.size)
+        count = len(grasps.grasp_positions)
+        self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", count)
         self._path = PathTriads("/task/prediction", PATH_TRIADS, PATH_TRIAD_LENGTH,
                                 TRIAD_RADIUS, PATH_TRIAD_OPACITY)
+        self._solid = count <= SOLID_OBJECTS
+        self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions, CLOUD_POINT_SIZE)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)
+        if not self._solid:
+            self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_likely_grasps)
+        self.DeclarePeriodicPublishEvent(cloud_period, 0.0, self._publish_cloud)
         self.DeclareInitializationPublishEvent(self._initialise)
 
     def get_target_input_port(self):
@@ -76,17 +97,28 @@ class GraspSceneVisualizer(LeafSystem):
     def get_hand_state_input_port(self):
         return self._hand_state_port
 
+    def get_goal_probabilities_input_port(self):
+        return self._probabilities_port
+
     def _initialise(self, context):
         self._draw_scene()
         self._publish(context)
         if self._prediction_steps:
             self._publish_path(context)
+        if not self._solid:
+            self._publish_likely_grasps(context)
+        self._publish_cloud(context)
 
     def _draw_scene(self):
         meshcat, grasps = self._meshcat, self._grasps
         meshcat.Delete("/task")
         radius, height = self._object_shape
-        for index, (table, centre) in enumerate(zip(grasps.tables, grasps.objects)):
+        self._cloud.draw(meshcat)
+        for index in range(0 if self._solid else LIKELY_TRIADS):
+            draw_triad(meshcat, f"/task/likely_grasps/{index}", None, TRIAD_LENGTH,
+                       TRIAD_RADIUS, opacity=1.0 if index == 0 else 0.5)
+        solid = zip(grasps.tables, grasps.objects) if self._solid else ()
+        for index, (table, centre) in enumerate(solid):
             # `tables` holds each top face's centre: the box stands on the floor below it.
             meshcat.SetObject(f"/task/tables/{index}", Box(*self._table_size, table[2]),
                               TABLE_COLOUR)
@@ -133,3 +165,26 @@ class GraspSceneVisualizer(LeafSystem):
             return
         poses = self._predicted_poses_port.Eval(context).reshape(-1, GoalPose.size)
         self._path.show(self._meshcat, poses, context.get_time())
+
+    def _likeliest(self, context):
+        """The selected grasp and the likeliest others, `LIKELY_TRIADS` at most."""
+        count = len(self._grasps.grasp_positions)
+        selected = goal_index(self._selected_goal_port, context, count, unconnected=0)
+        if not self._probabilities_port.HasValue(context):
+            return [selected]
+        return likely_goal_indices(selected, self._probabilities_port.Eval(context),
+                                   min(LIKELY_TRIADS, count))
+
+    def _publish_likely_grasps(self, context):
+        time, likeliest = context.get_time(), self._likeliest(context)
+        for index in range(LIKELY_TRIADS):
+            path = f"/task/likely_grasps/{index}"
+            shown = index < len(likeliest)
+            if shown:
+                self._meshcat.SetTransform(
+                    path, pose_transform(self._grasp_pose(likeliest[index])), time)
+            self._meshcat.SetProperty(path, "visible", shown, time)
+
+    def _publish_cloud(self, context):
+        if self._probabilities_port.HasValue(context):
+            self._cloud.show(self._meshcat, self._probabilities_port.Eval(context))

@@ -202,7 +202,7 @@ def build_grasp_diagram(resolved, meshcat=None):
     if meshcat is not None:
         visualizer = builder.AddNamedSystem("task_visualizer", GraspSceneVisualizer(
             meshcat, grasps, prediction_steps, task.table_size, task.object_radius,
-            task.object_height))
+            task.object_height, likely_triads=1 + scenario.likely_paths))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
         builder.Connect(selected, visualizer.get_selected_goal_input_port())
         if dmp_bank is not None:

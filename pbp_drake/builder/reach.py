@@ -26,8 +26,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from pbp_drake.builder.operators import make_hsr_operator
-from pbp_drake.builder.pbp_controller import (
-    PREDICTED_GOALS, TASK_PREDICTION_SAMPLES, make_pbp_controller)
+from pbp_drake.builder.pbp_controller import TASK_PREDICTION_SAMPLES, make_pbp_controller
 from pbp_drake.robots import ArmStationConfig, make_arm_station, make_hsr_station
 from pbp_drake.systems import GoalsSource, ReachSceneVisualizer, SampleHold, TaskMonitor
 from pbp_drake.systems.tasks.moving_obstacles import MovingObstacles
@@ -59,7 +58,8 @@ def build_reach_diagram(resolved, meshcat=None):
     builder.Connect(sampled, monitor.get_ee_state_input_port())
 
     prediction_steps = TASK_PREDICTION_SAMPLES if meshcat is not None else 0
-    path_count = min(PREDICTED_GOALS, len(resolved.goals))
+    # The selected goal's path and the next most probable goals'.
+    path_count = min(1 + scenario.likely_paths, len(resolved.goals))
     controller = make_pbp_controller(resolved.controller, resolved.initial_ee_state,
                                      resolved.goals, prediction_steps, path_count)
     controller = builder.AddNamedSystem(controller.get_name(), controller)

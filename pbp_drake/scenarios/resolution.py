@@ -30,9 +30,9 @@ from pbp_drake.scenarios.schema import (
     Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands,
     SinusoidalStep, VirtualParticipant)
 from pbp_drake.scenarios.validation import (
-    check_bent_path, check_direction, check_dmp_duration, check_grasp_task, check_numbers,
-    check_obstacle_task, check_reach_task, check_seed, check_time_steps,
-    check_virtual_participant, require_finite)
+    MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
+    check_grasp_task, check_numbers, check_obstacle_task, check_reach_task, check_seed,
+    check_time_steps, check_virtual_participant, require_finite)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator;
 # HOP and policy blending have no blender: their assistance is the HOP controller's).
@@ -181,6 +181,7 @@ def _check_common(scenario):
     require_finite(scenario, "scenario", ("dmp_duration",), positive=False)
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_seed(scenario.seed)
+    check_count(scenario.likely_paths, "scenario.likely_paths", 0, MAX_LIKELY_PATHS)
 
 
 def _settings_checked(field, settings):

@@ -369,6 +369,10 @@ class Scenario:
     #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
     #: its target_realtime_rate).
     simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
+    #: HSR and arm tasks in Meshcat: how many of the next most probable goals' DMP paths the
+    #: page draws beside the selected goal's (the grasping task past 100 grasps: their
+    #: grasp triads), 0 to 20; what is drawn does not grow with the goal count.
+    likely_paths: int = 3
 
 
 @dataclasses.dataclass

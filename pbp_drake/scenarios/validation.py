@@ -319,6 +319,9 @@ SHORTEST_TIME_STEP = 1e-6
 # The longest a DMP may last (s); a far goal over a tiny robot.speed would otherwise give
 # a duration whose square overflows in the DMP's gains.
 LONGEST_DMP_DURATION = 1e6
+# The most likely goals' paths a page draws (`scenario.likely_paths`): a few are what a
+# person can follow.
+MAX_LIKELY_PATHS = 20
 # Fields where `.inf` is a documented value ("no limit"), by their path's last name.
 INFINITY_MEANS_NO_LIMIT = ("base_acceleration_limits", "arm_acceleration_limits")
 

@@ -74,8 +74,8 @@ def plain(value):
 
 # Fields added to the schema after studies were run, left out of the content while at their
 # defaults: the trials of a scenario that does not use them are the same as before, and its
-# study folders still resume.
-_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45}}
+# study folders still resume. None: the scenario's own fields.
+_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45}, None: {"likely_paths": 3}}
 
 
 def scenario_content(scenario):
@@ -83,7 +83,7 @@ def scenario_content(scenario):
     as plain data."""
     content = plain(dataclasses.replace(scenario, method="", seed=0))
     for section, fields in _LATER_FIELDS.items():
-        values = content.get(section)
+        values = content if section is None else content.get(section)
         for name, default in fields.items():
             if isinstance(values, dict) and values.get(name, default) == default:
                 values.pop(name, None)

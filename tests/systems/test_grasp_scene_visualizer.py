@@ -17,7 +17,7 @@ from pbp_drake.core.grasp_task import (
     approach_direction, sample_grasp_scene, side_grasp_orientation)
 from pbp_drake.core.quaternion import angle_between
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import (
-    LIKELY_TRIADS, PATH_TRIADS, TRIAD_LENGTH, GraspSceneVisualizer)
+    PATH_TRIADS, TRIAD_LENGTH, GraspSceneVisualizer)
 from pbp_drake.systems.ports import Target
 
 SCENE = sample_grasp_scene(3)  # four objects, one grasped from above
@@ -128,7 +128,7 @@ def test_each_grasp_triad_stands_at_its_grasp_with_blue_along_the_approach(meshc
 
 def test_many_grasps_are_a_cloud_and_the_likeliest_grasps_triads_that_a_replay_keeps(meshcat):
     # 120 grasps (the 4 of SCENE, 30 times, shifted along y): past SOLID_OBJECTS, no table,
-    # object or triad per grasp, but the goal cloud and LIKELY_TRIADS triads moved to the
+    # object or triad per grasp, but the goal cloud and three triads moved to the
     # selected grasp (0) and the likeliest others (7 at first, then 42 from 0.5 s).
     shifts = np.repeat(np.arange(30) * 0.01, 4)[:, None] * [0.0, 1.0, 0.0]
     many = dataclasses.replace(
@@ -142,7 +142,8 @@ def test_many_grasps_are_a_cloud_and_the_likeliest_grasps_triads_that_a_replay_k
     before, after = np.full(count, 1e-3), np.full(count, 1e-3)
     before[7], after[42] = 0.5, 0.5
     builder = DiagramBuilder()
-    visualizer = builder.AddSystem(GraspSceneVisualizer(meshcat, many, STEPS))
+    visualizer = builder.AddSystem(GraspSceneVisualizer(meshcat, many, STEPS,
+                                                        likely_triads=3))
     target = np.zeros(Target.size)
     target[:3], target[3] = many.objects[1], 1
     add_source(builder, target, visualizer.get_target_input_port())
@@ -153,7 +154,8 @@ def test_many_grasps_are_a_cloud_and_the_likeliest_grasps_triads_that_a_replay_k
     tracks = recorded(meshcat, builder.Build(), 1.0)
     assert meshcat.HasPath("/task/goal_cloud")
     assert not any(meshcat.HasPath(f"/task/{kind}/0") for kind in ("grasps", "tables", "objects"))
-    assert all(meshcat.HasPath(f"/task/likely_grasps/{i}") for i in range(LIKELY_TRIADS))
+    assert all(meshcat.HasPath(f"/task/likely_grasps/{i}") for i in range(3))
+    assert not meshcat.HasPath("/task/likely_grasps/3")
     for time, likeliest in [(0.2, 7), (0.9, 42)]:
         np.testing.assert_allclose(
             value_at(tracks, "/task/likely_grasps/0", ".position", time),

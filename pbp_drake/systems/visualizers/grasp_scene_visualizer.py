@@ -19,9 +19,6 @@ from pbp_drake.systems.visualizers.scene_drawing import (
 # little transparent, so that the grasp they lead to stands out.
 TRIAD_LENGTH, TRIAD_RADIUS = 0.1, 0.005
 PATH_TRIADS, PATH_TRIAD_LENGTH, PATH_TRIAD_OPACITY = 5, 0.06, 0.7
-# Beyond SOLID_OBJECTS grasps, the triads of this many likeliest grasps (the selected one's
-# first) are drawn, moved to them each path period.
-LIKELY_TRIADS = 4
 
 
 class GraspSceneVisualizer(LeafSystem):
@@ -42,7 +39,7 @@ class GraspSceneVisualizer(LeafSystem):
     (`Simulator.Initialize`, after deleting `/task`) it draws, up to `SOLID_OBJECTS`
     grasps, every table and object and, at each object's grasp pose, a triad
     `/task/grasps/{k}` (`draw_triad`: x red, y green, z blue, z the approach); with more,
-    `LIKELY_TRIADS` triads `/task/likely_grasps/{i}` that each path period moves to the
+    `likely_triads` triads `/task/likely_grasps/{i}` that each path period moves to the
     selected grasp and the likeliest others (`goal_probabilities`), with
     `time_in_recording`. Every grasp position is also a point of the goal cloud
     `/task/goal_cloud` (`GoalCloud`), coloured each `cloud_period` by its probability, as
@@ -59,7 +56,7 @@ class GraspSceneVisualizer(LeafSystem):
 
     def __init__(self, meshcat, grasps, prediction_steps=0, table_size=(0.3, 0.3),
                  object_radius=0.03, object_height=0.15, publish_period=1.0 / 30.0,
-                 path_period=0.1, cloud_period=0.25):
+                 path_period=0.1, cloud_period=0.25, likely_triads=4):
         super().__init__()
         self._meshcat = meshcat
         self._grasps = grasps
@@ -76,6 +73,7 @@ class GraspSceneVisualizer(LeafSystem):
         self._path = PathTriads("/task/prediction", PATH_TRIADS, PATH_TRIAD_LENGTH,
                                 TRIAD_RADIUS, PATH_TRIAD_OPACITY)
         self._solid = count <= SOLID_OBJECTS
+        self._likely_triads = min(int(likely_triads), count)
         self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions, CLOUD_POINT_SIZE)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
@@ -114,7 +112,7 @@ class GraspSceneVisualizer(LeafSystem):
         meshcat.Delete("/task")
         radius, height = self._object_shape
         self._cloud.draw(meshcat)
-        for index in range(0 if self._solid else LIKELY_TRIADS):
+        for index in range(0 if self._solid else self._likely_triads):
             draw_triad(meshcat, f"/task/likely_grasps/{index}", None, TRIAD_LENGTH,
                        TRIAD_RADIUS, opacity=1.0 if index == 0 else 0.5)
         solid = zip(grasps.tables, grasps.objects) if self._solid else ()
@@ -167,17 +165,17 @@ class GraspSceneVisualizer(LeafSystem):
         self._path.show(self._meshcat, poses, context.get_time())
 
     def _likeliest(self, context):
-        """The selected grasp and the likeliest others, `LIKELY_TRIADS` at most."""
+        """The selected grasp and the likeliest others, `likely_triads` at most."""
         count = len(self._grasps.grasp_positions)
         selected = goal_index(self._selected_goal_port, context, count, unconnected=0)
         if not self._probabilities_port.HasValue(context):
             return [selected]
         return likely_goal_indices(selected, self._probabilities_port.Eval(context),
-                                   min(LIKELY_TRIADS, count))
+                                   self._likely_triads)
 
     def _publish_likely_grasps(self, context):
         time, likeliest = context.get_time(), self._likeliest(context)
-        for index in range(LIKELY_TRIADS):
+        for index in range(self._likely_triads):
             path = f"/task/likely_grasps/{index}"
             shown = index < len(likeliest)
             if shown:

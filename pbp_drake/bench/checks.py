@@ -17,17 +17,26 @@ class Check:
     limit: float
     at_most: bool  # passes when value <= limit (else when value >= limit)
     unit: str
-    value: Callable  # the row of steps (or the closed-loop run) -> the measured value
+    # The row of steps, the closed-loop run (with `base_run`: the pair of runs), or the
+    # replay sizes -> the measured value
+    value: Callable
     row: tuple | None = None  # (D, K, weights) of the step row it reads
     pose: bool = False  # the row is the six-DoF pose bank's (`pbp_drake.bench.pose_cases`)
-    hsr_goals: int | None = None  # K of the headless closed-loop HSR run it reads
+    # (task, K, meshcat) of the closed-loop run it reads, on the shipped robot
+    # (`pbp_drake.bench.closed_loop`; with Meshcat, a client reading everything)
+    run: tuple | None = None
+    base_run: tuple | None = None  # ... and of the run of the same bench it compares with
+    replay: tuple = ()  # the K of the replay sizes it compares (`pbp_drake.bench.replay`)
     peers: tuple = ()  # it needs one of these peer libraries
     motion: bool = False  # it reads the row's timing over a movement (`cases.motion_timing`)
 
 
 _K10K = (3, 10000, "distinct")
-# The K of the checked closed-loop run (its dynamic robot is measured beside it).
+# The K of the checked headless closed-loop run (its dynamic robot is measured beside it).
 CHECKED_HSR_GOALS = 100
+# The K of the checked replays: each K's size over the first's.
+CHECKED_REPLAY_GOALS = (4, 1000)
+_MESHCAT = "Meshcat drawing to a client (another process) that reads everything sent"
 _OVER_A_MOVEMENT = ("one step in the LeafSystem and a read of its selected reference, median "
                     "over a movement and as long after it,")
 
@@ -39,8 +48,8 @@ def _motion(row):
 CHECKS = (
     Check(f"K=10,000 goals (D=3, distinct weights): {_OVER_A_MOVEMENT} <= 1 ms",
           1000.0, True, "us", _motion, row=_K10K, motion=True),
-    Check(f"K=10,000 goals, 6-DoF pose, distinct weights: {_OVER_A_MOVEMENT} <= 1 ms",
-          1000.0, True, "us", _motion, row=(6, 10000, "distinct"), pose=True, motion=True),
+    Check(f"K=10,000 goals, 6-DoF pose, distinct weights: {_OVER_A_MOVEMENT} <= 0.7 ms",
+          700.0, True, "us", _motion, row=(6, 10000, "distinct"), pose=True, motion=True),
     Check("K=100,000 goals sharing one demonstration (D=3, the compact state): "
           f"{_OVER_A_MOVEMENT} <= 1 ms",
           1000.0, True, "us", _motion, row=(3, 100000, "shared"), motion=True),
@@ -56,7 +65,21 @@ CHECKS = (
           lambda row: row["bank_math_us"] / row["bandwidth_bound_us"], row=_K10K),
     Check(f"HSR reaching task, K={CHECKED_HSR_GOALS} goals, headless, the shipped "
           "(kinematic) robot: closed loop >= 20x real time", 20.0, False, "x real time",
-          lambda run: run["realtime_factor"], hsr_goals=CHECKED_HSR_GOALS),
+          lambda run: run["realtime_factor"], run=("reach", CHECKED_HSR_GOALS, False)),
+    Check("HSR reaching task, headless, the shipped robot: closed loop at K=10,000 goals >= "
+          "0.5x its speed at K=4 goals (both medians of the same bench)", 0.5, False,
+          "x the K=4 speed", lambda pair: pair[0]["realtime_factor"] / pair[1]["realtime_factor"],
+          run=("reach", 10000, False), base_run=("reach", 4, False)),
+    Check(f"HSR reaching task, K=10,000 goals, {_MESHCAT}: closed loop >= 1x real time", 1.0,
+          False, "x real time", lambda run: run["realtime_factor"], run=("reach", 10000, True)),
+    Check(f"HSR reaching task, K=1,000 goals, {_MESHCAT}: closed loop >= 2x real time", 2.0,
+          False, "x real time", lambda run: run["realtime_factor"], run=("reach", 1000, True)),
+    Check(f"HSR grasping task (six-DoF), K=1,000 grasp targets, {_MESHCAT}: closed loop >= 1x "
+          "real time", 1.0, False, "x real time", lambda run: run["realtime_factor"],
+          run=("grasp", 1000, True)),
+    Check("Replay of a 5 s HSR reaching run as pbp-drake run --record saves it: K=1,000 goals "
+          "<= 3x the size of K=4's", 3.0, True, "x the K=4 replay",
+          lambda sizes: sizes[1000] / sizes[4], replay=CHECKED_REPLAY_GOALS),
 )
 
 
@@ -64,10 +87,11 @@ CHECKS = (
 MOTION_ROWS = frozenset((check.row, check.pose) for check in CHECKS if check.motion)
 
 
-def evaluate(rows, closed_loop, installed, blas=None):
+def evaluate(rows, closed_loop, installed, blas=None, replay=None):
     """Every check's result: {"check", "value", "limit", "unit", "verdict", "reason"}, the
     verdict "pass", "fail" or "skipped" (then "reason" says why). `installed` is the set of
-    peer libraries present; `blas` (from `pinning.blas_threads`) adds the pinning check."""
+    peer libraries present; `blas` (from `pinning.blas_threads`) adds the pinning check;
+    `replay` is `pbp_drake.bench.replay.replay_sizes`' result (None: not recorded)."""
     results = []
     for check in CHECKS:
         result = {"check": check.name, "value": None, "limit": check.limit,
@@ -76,7 +100,7 @@ def evaluate(rows, closed_loop, installed, blas=None):
         if check.peers and not set(check.peers) & set(installed):
             result["reason"] = f"{', '.join(check.peers)} not installed"
             continue
-        source, where = _source(check, rows, closed_loop)
+        source, where = _source(check, rows, closed_loop, replay)
         value = None if source is None else check.value(source)
         if value is None:
             result["reason"] = ("not measured: " + where if source is None else
@@ -91,7 +115,20 @@ def evaluate(rows, closed_loop, installed, blas=None):
     return results
 
 
-def _source(check, rows, closed_loop):
+def _source(check, rows, closed_loop, replay):
+    if check.replay:
+        sizes = {run["goals"]: run["bytes"] for run in (replay or {}).get("runs", ())}
+        if all(k in sizes for k in check.replay):
+            return sizes, None
+        return None, (f"no replays of K={', '.join(f'{k:,}' for k in check.replay)} "
+                      "(--hsr-goals empty or --no-meshcat)")
+    if check.base_run is not None:
+        runs = [_find_run(closed_loop, key) for key in (check.run, check.base_run)]
+        if None in runs:
+            return None, ("no " + " and ".join(_run_words(key) for key, run in
+                                               zip((check.run, check.base_run), runs)
+                                               if run is None))
+        return tuple(runs), None
     if check.row is not None:
         dimension, goals, weights = check.row
         for row in rows:
@@ -101,11 +138,23 @@ def _source(check, rows, closed_loop):
         if check.pose:
             return None, f"6-DoF pose, K={goals:,}, {weights} weights not in --goals"
         return None, f"D={dimension}, K={goals:,}, {weights} weights not in --dimensions/--goals"
+    run = _find_run(closed_loop, check.run)
+    return (run, None) if run is not None else (None, "no " + _run_words(check.run))
+
+
+def _find_run(closed_loop, key):
+    task, goals, meshcat = key
     for run in closed_loop:
-        if (run["goals"] == check.hsr_goals and not run["meshcat"]
+        if ((run.get("task", "reach"), run["goals"], run["meshcat"]) == (task, goals, meshcat)
                 and run.get("shipped_robot", True)):
-            return run, None
-    return None, f"no headless HSR run with K={check.hsr_goals} in --hsr-goals"
+            return run
+    return None
+
+
+def _run_words(key):
+    task, goals, meshcat = key
+    return (f"{'Meshcat' if meshcat else 'headless'} HSR {task} run with K={goals:,} in "
+            "--hsr-goals/--tasks" + (" (or --no-meshcat)" if meshcat else ""))
 
 
 def _blas_check(blas):

@@ -13,19 +13,25 @@ import numpy as np
 import pbp_drake.bench
 from pbp_drake.bench.cases import (
     BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_fields)
-from pbp_drake.bench.checks import CHECKED_HSR_GOALS, MOTION_ROWS, PEERS, evaluate, exit_code
-from pbp_drake.bench.closed_loop import HSR_KS, closed_loop_runs
+from pbp_drake.bench.checks import (
+    CHECKED_HSR_GOALS, CHECKED_REPLAY_GOALS, MOTION_ROWS, PEERS, evaluate, exit_code)
+from pbp_drake.bench.closed_loop import HSR_KS, TASKS, closed_loop_runs, split_run
 from pbp_drake.bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
 from pbp_drake.bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
-from pbp_drake.bench.plot import plot_control_rate
+from pbp_drake.bench.plot import plot_control_rate, plot_scaling
 from pbp_drake.bench.pose_cases import measure_pose_row
+from pbp_drake.bench.replay import REPLAY_SECONDS, replay_sizes
 from pbp_drake.bench.table import format_report, microseconds, ratio
 from pbp_drake.bench.timing import memory_bandwidth, timed
 
 KS = (1, 10, 100, 1000, 10000, 100000)
 DS = (2, 3, 6)
 POSE_MAX_GOALS = 10000
+# The reach runs whose per-tick time is split by category (headless and with Meshcat).
+SPLIT_KS = (4, 10000)
+# Wall seconds a closed-loop run with Meshcat may take before it stops (at the next slice).
+MESHCAT_WALL_CAP = 20.0
 
 
 def build_parser():
@@ -43,11 +49,24 @@ def build_parser():
     parser.add_argument("--peer-max-goals", type=int, default=1000,
                         help="largest K for the one-object-per-goal peers (default 1000)")
     parser.add_argument("--hsr-goals", type=int, nargs="*", default=list(HSR_KS),
-                        help="goal counts of the closed-loop HSR runs (none to skip)")
+                        help="goal counts K of the closed-loop HSR runs (default: "
+                        f"{' '.join(map(str, HSR_KS))}; none skips every closed-loop "
+                        "measurement: the matrix, the time split and the replays)")
+    parser.add_argument("--tasks", nargs="+", choices=TASKS, default=list(TASKS),
+                        help="the closed-loop tasks: reach (the HSR reaching task) and "
+                        "grasp (the six-DoF grasping task) (default: both)")
     parser.add_argument("--hsr-seconds", type=float, default=None,
                         help="simulated seconds per HSR run (default 5; --quick: 1)")
     parser.add_argument("--no-meshcat", action="store_true",
-                        help="skip the closed-loop runs with Meshcat publishing")
+                        help="skip the closed-loop runs with Meshcat (the matrix's, the time "
+                        "split's and the replays)")
+    parser.add_argument("--meshcat-wall-cap", type=float, default=MESHCAT_WALL_CAP,
+                        help="wall seconds after which a run with Meshcat stops, reporting "
+                        f"the simulated seconds it reached (default {MESHCAT_WALL_CAP:g})")
+    parser.add_argument("--split-goals", type=int, nargs="*", default=list(SPLIT_KS),
+                        help="K of the reach runs whose per-tick time is split by category "
+                        f"under cProfile (default: {' '.join(map(str, SPLIT_KS))}; none to "
+                        "skip)")
     parser.add_argument("--blas-threads", type=int, default=1,
                         help="BLAS threads for every backend (default 1): the bench measures "
                         "in a fresh Python process with OPENBLAS_NUM_THREADS, "
@@ -64,13 +83,24 @@ def _parse(argv):
 
 def plan(args):
     """What a run measures. `--quick` keeps every check's case (D = 3; the default goal
-    counts and HSR runs) and takes fewer repeats and a shorter HSR simulation."""
+    counts, HSR runs and replays) and takes fewer repeats and a shorter HSR simulation
+    (the replays keep their 5 s: their check compares sizes)."""
+    closed_loop = bool(args.hsr_goals)
+    meshcat = closed_loop and not args.no_meshcat
     return {"dimensions": args.dimensions or ([3] if args.quick else list(DS)),
             "goals": list(args.goals), "hsr_goals": list(args.hsr_goals),
             # The six-DoF pose bank (PoseDmpBank), up to K = 10,000 (its check's case).
             "pose_goals": [k for k in args.goals if k <= POSE_MAX_GOALS],
             "min_time": args.min_time or (0.08 if args.quick else 0.3),
-            "hsr_seconds": args.hsr_seconds or (1.0 if args.quick else 5.0)}
+            "hsr_seconds": args.hsr_seconds or (1.0 if args.quick else 5.0),
+            "tasks": [task for task in TASKS if task in args.tasks],
+            "meshcat": meshcat, "meshcat_wall_cap": args.meshcat_wall_cap,
+            # (K, with Meshcat) of the split runs: reach, headless and with Meshcat.
+            "split": [(k, with_meshcat) for k in (args.split_goals if closed_loop and
+                                                  "reach" in args.tasks else ())
+                      for with_meshcat in ((False, True) if meshcat else (False,))],
+            "replay_goals": list(CHECKED_REPLAY_GOALS) if meshcat else [],
+            "replay_seconds": REPLAY_SECONDS}
 
 
 def main(argv=None):
@@ -138,8 +168,16 @@ def _measure(args):
     rows.sort(key=lambda row: (bool(row.get("pose")), row["D"], row["K"]))
 
     closed_loop = closed_loop_runs(settings["hsr_goals"], hsr_seconds, CHECKED_HSR_GOALS,
-                                   meshcat=not args.no_meshcat,
-                                   progress=lambda text: print(text, flush=True))
+                                   meshcat=settings["meshcat"], tasks=settings["tasks"],
+                                   wall_cap=settings["meshcat_wall_cap"], progress=_progress)
+    split = []
+    for goal_count, with_meshcat in settings["split"]:
+        _progress(f"Time split (cProfile): reach, K = {goal_count}, "
+                 + ("Meshcat with a client ..." if with_meshcat else "headless ..."))
+        split.append(split_run(goal_count, hsr_seconds, with_meshcat,
+                               settings["meshcat_wall_cap"]))
+    replay = (replay_sizes(settings["replay_goals"], settings["replay_seconds"], _progress)
+              if settings["replay_goals"] else None)
 
     report = {
         "machine": {"processor": platform.processor() or platform.machine(),
@@ -147,19 +185,25 @@ def _measure(args):
                     "numpy": np.__version__, "blas": blas,
                     "load_average": os.getloadavg() if hasattr(os, "getloadavg") else None},
         "settings": {"basis_count": BASIS, "dt": DT, "min_time_s": min_time,
-                     "quick": args.quick, "hsr_seconds": hsr_seconds},
+                     "quick": args.quick, "hsr_seconds": hsr_seconds,
+                     "tasks": settings["tasks"],
+                     "meshcat_wall_cap_s": settings["meshcat_wall_cap"]},
         "memory_bandwidth": bandwidth,
         "steps": rows,
         "closed_loop": closed_loop,
+        "time_split": split,
+        "replay": replay,
     }
-    report["checks"] = evaluate(rows, closed_loop, installed, blas)
+    report["checks"] = evaluate(rows, closed_loop, installed, blas, replay)
     text = format_report(report)
     print(text)
     (output / "bench.json").write_text(json.dumps(report, indent=2))
     (output / "bench.txt").write_text(text + "\n")
-    figure = plot_control_rate(rows, output / "bench_control_rate.png")
-    print(f"Wrote {output / 'bench.json'}, {output / 'bench.txt'}"
-          + (f" and {figure}" if figure else ""))
+    figures = [plot_control_rate(rows, output / "bench_control_rate.png")]
+    if closed_loop:
+        figures.append(plot_scaling(closed_loop, output / "bench_scaling.png"))
+    print(f"Wrote {output / 'bench.json'}, {output / 'bench.txt'}, "
+          + " and ".join(str(figure) for figure in figures if figure))
     return exit_code(report["checks"])
 
 
@@ -215,6 +259,10 @@ def _measure_row(dimension, goal_count, distinct, min_time, peer_max_goals, have
     row["speedup_vs_stacked"] = ratio(row["mp_stacked_us"], row["bank_math_us"])
     row["control_rate_hz"] = 1e6 / row["leaf_us"]
     return row
+
+
+def _progress(text):
+    print(text, flush=True)
 
 
 def _print_progress(row):

@@ -1,4 +1,5 @@
-"""The bench's figure: the control rate reached (1 / step time) versus K."""
+"""The bench's figures: the control rate reached (1 / step time) versus K, and the closed
+loop's real-time factor versus K."""
 
 import matplotlib
 
@@ -39,6 +40,37 @@ def plot_control_rate(rows, path):
     axes.set_title(f"DMP bank step, D = {dimension}, N = {BASIS} basis functions")
     axes.grid(True, which="both", alpha=0.3)
     axes.legend(fontsize=8, loc="lower left")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+    return path
+
+
+def plot_scaling(closed_loop, path):
+    """The closed loop's real-time factor versus K (log x): reach and grasp, headless
+    (median) and with Meshcat and a client, on the scenario files' robots; a line at 1x."""
+    figure, axes = plt.subplots(figsize=(7.5, 5))
+    series = [("reach", False, "reaching, headless", "C0", "-o"),
+              ("reach", True, "reaching, Meshcat + client", "C0", "--s"),
+              ("grasp", False, "grasping (six-DoF), headless", "C1", "-o"),
+              ("grasp", True, "grasping (six-DoF), Meshcat + client", "C1", "--s")]
+    for task, meshcat, label, color, style in series:
+        points = sorted((run["goals"], run["realtime_factor"]) for run in closed_loop
+                        if run.get("task", "reach") == task and run["meshcat"] == meshcat
+                        and run.get("shipped_robot", True))
+        if points:
+            k, factor = zip(*points)
+            axes.plot(k, factor, style, color=color, label=label)
+    axes.axhline(1.0, color="grey", lw=0.8, ls="--")
+    axes.text(0.99, 1.03, "real time", color="grey", ha="right", va="bottom",
+              transform=axes.get_yaxis_transform())
+    axes.set_xscale("log")
+    axes.set_yscale("log")
+    axes.set_xlabel("goals K")
+    axes.set_ylabel("real-time factor (simulated s / wall s)")
+    axes.set_title("Closed loop, HSR tasks (virtual participant, PBP-Alt)")
+    axes.grid(True, which="both", alpha=0.3)
+    axes.legend(fontsize=8, loc="best")
     figure.tight_layout()
     figure.savefig(path, dpi=120)
     plt.close(figure)

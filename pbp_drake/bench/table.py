@@ -1,7 +1,9 @@
-"""The bench's report: the table of step times, the closed-loop speeds, and the checks
-(`pbp_drake.bench.checks`), each with its measured value and verdict."""
+"""The bench's report: the table of step times, the closed-loop matrix, the per-tick time
+split and the replay sizes, and the checks (`pbp_drake.bench.checks`), each with its
+measured value and verdict."""
 
 from pbp_drake.bench.checks import format_results
+from pbp_drake.bench.time_split import ORDER
 
 
 def microseconds(seconds):
@@ -95,19 +97,101 @@ def format_report(report):
                          f"{_fmt(row['leaf_slowest_us'])} us)")
     if report["closed_loop"]:
         lines.append("")
-        lines.append("Closed loop, HSR reaching task (straight-path DMPs, virtual participant, "
-                     "PBP-Alt; the robot of diagrams/hsr_reach.yaml unless named): "
-                     "simulated seconds per wall second")
-        for run in report["closed_loop"]:
-            where = ("Meshcat" if run["meshcat"] else "headless") + (
-                "" if run.get("shipped_robot", True) else f", {run['motion']} robot")
-            factors = run.get("realtime_factors", ())
-            of = (f"median of {', '.join(f'{factor:.1f}' for factor in factors)}; "
-                  if len(factors) > 1 else "")
-            lines.append(f"  K = {run['goals']:>5} {where:>8}:"
-                         f" {run['realtime_factor']:7.2f}x real time ({of}"
-                         f"{run['simulated_s']:.1f} s in {run['wall_s']:.2f} s wall; "
-                         f"built in {run['build_s']:.1f} s)")
+        lines.extend(closed_loop_lines(report["closed_loop"]))
+    if report.get("time_split"):
+        lines.append("")
+        lines.extend(split_lines(report["time_split"], report["closed_loop"]))
+    if report.get("replay"):
+        lines.append("")
+        lines.extend(replay_lines(report["replay"]))
     lines.append("")
     lines.append(format_results(report["checks"]))
     return "\n".join(lines)
+
+
+def closed_loop_lines(runs):
+    """The closed-loop matrix (task x K: headless and with Meshcat and a client), then each
+    run's details."""
+    lines = ["Closed loop, HSR tasks with K goals on a jittered grid (the target the first, no "
+             "switches; virtual participant, PBP-Alt; the robot of the scenario file unless "
+             "named): real-time factor = simulated s / wall s of AdvanceTo after Initialize "
+             "(with Meshcat, to the end of Meshcat.Flush()); headless: median of the repeats "
+             "(in rounds over every case); Meshcat: one run drawing to a client (another "
+             "process) reading everything, its bytes and messages per simulated second"]
+    header = (f"  {'task':<6} {'K':>6} {'headless':>10} {'Meshcat':>10} {'MB/sim s':>9} "
+              f"{'msgs/sim s':>11}")
+    lines += [header, "  " + "-" * (len(header) - 2)]
+    shipped = [run for run in runs if run.get("shipped_robot", True)]
+    cases = dict.fromkeys((run.get("task", "reach"), run["goals"]) for run in shipped)
+    for task, goals in cases:
+        found = {run["meshcat"]: run for run in shipped
+                 if (run.get("task", "reach"), run["goals"]) == (task, goals)}
+        headless, meshcat = found.get(False), found.get(True)
+        lines.append(
+            f"  {task:<6} {goals:>6} {_factor(headless):>10} {_factor(meshcat):>10} "
+            f"{_number(meshcat and meshcat['bytes_per_s'] / 1e6, 9, 2)} "
+            f"{_number(meshcat and meshcat['messages_per_s'], 11, 0)}")
+    lines.append("  each run:")
+    for run in runs:
+        where = ("Meshcat" if run["meshcat"] else "headless") + (
+            "" if run.get("shipped_robot", True) else f", {run['motion']} robot")
+        factors = run.get("realtime_factors", ())
+        of = (f"median of {', '.join(f'{factor:.1f}' for factor in factors)}; "
+              if len(factors) > 1 else "")
+        capped = (f"; stopped at the {run['wall_cap_s']:g} s wall cap"
+                  if run.get("capped") else "")
+        lines.append(f"  {run.get('task', 'reach'):<6} K = {run['goals']:>5} {where:>8}:"
+                     f" {run['realtime_factor']:7.2f}x real time ({of}"
+                     f"{run['simulated_s']:.2f} s in {run['wall_s']:.2f} s wall{capped}; "
+                     f"built in {run['build_s']:.1f} s)")
+    return lines
+
+
+def _number(value, width, digits):
+    return "-".rjust(width) if value is None else f"{value:,.{digits}f}".rjust(width)
+
+
+def _factor(run):
+    if run is None:
+        return "-"
+    return f"{run['realtime_factor']:.2f}x" + ("*" if run.get("capped") else "")
+
+
+def split_lines(runs, closed_loop=()):
+    """The per-tick time split of the reach runs (`pbp_drake.bench.time_split`), beside the
+    wall time per tick of the same case in the matrix (no profiler)."""
+    lines = ["Where a control tick's wall time goes, reach task, one run under cProfile: "
+             "each function's own time given to its category (code outside pbp_drake split "
+             "over its callers); ms per control tick (share). cProfile inflates the "
+             "Python-heavy parts against Drake's C++; Drake's own MeshcatVisualizer of the "
+             "robot runs in C++ and counts in rest; bank includes the DMP paths it rolls out "
+             "for the drawing (with Meshcat only)."]
+    header = (f"  {'K':>6} {'where':>8} {'ticks':>5} {'total':>6} {'matrix':>6} "
+              + " ".join(f"{name:>14}" for name in ORDER))
+    lines += [header, "  " + "-" * (len(header) - 2)]
+    for run in runs:
+        split = run["split"]
+        where = "Meshcat" if run["meshcat"] else "headless"
+        cells = " ".join(f"{split['ms_per_tick'][name]:6.3f} ({100 * split['share'][name]:3.0f}%)"
+                         .rjust(14) for name in ORDER)
+        same = [other for other in closed_loop if other.get("shipped_robot", True) and (
+            other.get("task", "reach"), other["goals"], other["meshcat"]) == (
+            "reach", run["goals"], run["meshcat"])]
+        matrix = (1e3 * same[0]["control_period_s"] / same[0]["realtime_factor"]
+                  if same else None)
+        lines.append(f"  {run['goals']:>6} {where:>8} {split['ticks']:5.0f} "
+                     f"{split['profiled_ms_per_tick']:6.2f} {_number(matrix, 6, 2)} {cells}")
+    lines.append("  total: profiled ms per tick (the categories' sum); matrix: wall ms per "
+                 "tick of the same case in the matrix above, without the profiler")
+    return lines
+
+
+def replay_lines(replay):
+    """The replay sizes (`pbp_drake.bench.replay`)."""
+    first = replay["runs"][0]
+    sizes = "; ".join(f"K = {run['goals']:,}: {run['bytes'] / 1e6:.2f} MB"
+                      + (f" ({run['bytes'] / first['bytes']:.2f}x K = {first['goals']:,})"
+                         if run is not first else "")
+                      for run in replay["runs"])
+    return [f"Replay of a {replay['simulated_s']:g} s reach run as pbp-drake run --record saves "
+            f"it (Meshcat recording at 30 frames/s, StaticHtml): {sizes}"]

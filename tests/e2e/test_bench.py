@@ -1,28 +1,38 @@
 """`pbp-drake bench` cannot lie: BLAS threads pinned in the measuring process without any
 optional package, each check named for what it measures, missing peers skipped (neither
-passed nor failed), `--quick` keeping every check, and exit code 1 when a check fails.
+passed nor failed), `--quick` keeping every check, and exit code 1 when a check fails; the
+closed loop's Meshcat client reads what Meshcat sends, and its time split sums to the total.
 
 The command-line tests run the real `python -m pbp_drake bench` with a `sitecustomize`
 that hides the `bench` extra (threadpoolctl, pydmps, movement_primitives) as in a venv
 without it, records each process's thread variables before NumPy loads, and, in the
 measuring process only, replaces the timer with a fixed time per step (so a check's verdict
-does not depend on the machine's speed)."""
+does not depend on the machine's speed; the closed-loop test also fixes each run's wall time
+from its simulated time)."""
 
+import cProfile
 import json
 import os
+import pstats
 import subprocess
 import sys
 import textwrap
 import time
 
 import pytest
+from pydrake.geometry import Box, Meshcat, MeshcatParams
+from pydrake.math import RigidTransform
 
 from pbp_drake.bench.cases import (
-    MOTION_DURATIONS, leaf_simulator, make_bank, make_case, motion_timing)
+    MOTION_DURATIONS, bank_math_step, leaf_simulator, make_bank, make_case, motion_timing)
 from pbp_drake.bench.checks import CHECKS, evaluate, exit_code, format_results, summary
+from pbp_drake.bench.closed_loop import split_run
 from pbp_drake.bench.pinning import MARKER, THREAD_VARIABLES, blas_threads
 from pbp_drake.bench.main import _parse, plan
+from pbp_drake.bench.table import format_report
+from pbp_drake.bench.time_split import BANK, DRAWING, IK, ORDER, REST, category_of, split_stats
 from pbp_drake.bench.timing import timed_span
+from pbp_drake.bench.ws_reader import MeshcatReader, send_mark
 
 K10K_LEAF = ("K=10,000 goals (D=3, distinct weights): one step in the LeafSystem and a read of "
              "its selected reference, median over "
@@ -30,6 +40,18 @@ K10K_LEAF = ("K=10,000 goals (D=3, distinct weights): one step in the LeafSystem
 
 CLOSED_LOOP = ("HSR reaching task, K=100 goals, headless, the shipped (kinematic) robot: "
                "closed loop >= 20x real time")
+_CLIENT = "Meshcat drawing to a client (another process) that reads everything sent"
+SCALING = ("HSR reaching task, headless, the shipped robot: closed loop at K=10,000 goals >= "
+           "0.5x its speed at K=4 goals (both medians of the same bench)")
+REACH_10K = f"HSR reaching task, K=10,000 goals, {_CLIENT}: closed loop >= 1x real time"
+REACH_1K = f"HSR reaching task, K=1,000 goals, {_CLIENT}: closed loop >= 2x real time"
+GRASP_1K = (f"HSR grasping task (six-DoF), K=1,000 grasp targets, {_CLIENT}: closed loop >= "
+            "1x real time")
+REPLAY = ("Replay of a 5 s HSR reaching run as pbp-drake run --record saves it: K=1,000 goals "
+          "<= 3x the size of K=4's")
+POSE_10K = ("K=10,000 goals, 6-DoF pose, distinct weights: one step in the LeafSystem and a "
+            "read of its selected reference, median over a movement and as long after it, "
+            "<= 0.7 ms")
 SITECUSTOMIZE = textwrap.dedent("""
     import json, os, sys
     for name in ("threadpoolctl", "pydmps", "movement_primitives"):
@@ -58,18 +80,42 @@ def _pose_row(goals, weights, leaf_us=500.0):
     return dict(_row(6, goals, weights, leaf_us), pose=True)
 
 
+def _run(task, goals, meshcat, factor):
+    return {"task": task, "goals": goals, "meshcat": meshcat, "realtime_factor": factor}
+
+
+def _closed_loop(headless_4=24.0, headless_10k=18.0, reach_10k=1.5, reach_1k=3.0,
+                 grasp_1k=1.5):
+    """The closed-loop runs every check reads (a dynamic robot's run beside them)."""
+    return [{"goals": 100, "meshcat": False, "realtime_factor": 24.0},
+            {"goals": 100, "meshcat": False, "realtime_factor": 11.0,
+             "motion": "dynamic", "shipped_robot": False},
+            _run("reach", 4, False, headless_4), _run("reach", 10000, False, headless_10k),
+            _run("reach", 10000, True, reach_10k), _run("reach", 1000, True, reach_1k),
+            _run("grasp", 1000, True, grasp_1k)]
+
+
+def _replay(small=2.9e6, large=3.0e6):
+    return {"simulated_s": 5.0, "runs": [{"goals": 4, "bytes": small},
+                                         {"goals": 1000, "bytes": large}]}
+
+
 def _all_cases(leaf_us=500.0):
     rows = [_row(3, goals, weights, leaf_us) for goals in (1000, 10000, 100000)
             for weights in ("distinct", "shared")]
     rows.append(_pose_row(10000, "distinct", leaf_us))
-    return rows, [{"goals": 100, "meshcat": False, "realtime_factor": 24.0},
-                  {"goals": 100, "meshcat": False, "realtime_factor": 11.0,
-                   "motion": "dynamic", "shipped_robot": False}]
+    return rows, _closed_loop()
+
+
+def _verdicts(closed_loop, replay=None, rows=None):
+    rows = rows if rows is not None else _all_cases()[0]
+    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay)
+    return {r["check"]: r["verdict"] for r in results}
 
 
 def test_the_closed_loop_check_reads_the_shipped_robot_not_the_dynamic_one():
     rows, closed_loop = _all_cases()
-    verdict = {r["check"]: r["verdict"] for r in evaluate(rows, closed_loop[1:], set())}
+    verdict = {r["check"]: r["verdict"] for r in evaluate(rows, [closed_loop[1]], set())}
     assert verdict[CLOSED_LOOP] == "skipped"  # only the dynamic robot's run: not checked
     closed_loop[0]["realtime_factor"] = 19.0
     verdict = {r["check"]: r["verdict"] for r in evaluate(rows, closed_loop, set())}
@@ -78,7 +124,7 @@ def test_the_closed_loop_check_reads_the_shipped_robot_not_the_dynamic_one():
 
 def test_every_check_passes_and_the_exit_code_is_0():
     rows, closed_loop = _all_cases()
-    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"})
+    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, _replay())
     assert [r["verdict"] for r in results] == ["pass"] * len(CHECKS)
     assert exit_code(results) == 0
 
@@ -86,7 +132,7 @@ def test_every_check_passes_and_the_exit_code_is_0():
 def test_a_slow_step_fails_its_check_and_the_exit_code_is_1():
     # The reported run: K = 10,000 took 14.3 ms.
     rows, closed_loop = _all_cases(leaf_us=14300.0)
-    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"})
+    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, _replay())
     failed = [r["check"] for r in results if r["verdict"] == "fail"]
     assert K10K_LEAF in failed
     assert exit_code(results) == 1
@@ -97,17 +143,17 @@ def test_a_slow_step_fails_its_check_and_the_exit_code_is_1():
 
 def test_missing_peers_are_skipped_neither_passed_nor_failed():
     rows, closed_loop = _all_cases()
-    results = evaluate(rows, closed_loop, installed=set())
+    results = evaluate(rows, closed_loop, installed=set(), replay=_replay())
     skipped = {r["check"]: r["reason"] for r in results if r["verdict"] == "skipped"}
     assert len(skipped) == 2
     assert set(skipped.values()) == {"pydmps, movement_primitives not installed",
                                      "movement_primitives not installed"}
     assert exit_code(results) == 0
     assert summary(results).startswith(
-        "Checks: 5 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
+        "Checks: 10 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
         " movement_primitives not installed: 1)")
     # One peer is enough for the per-goal check.
-    results = evaluate(rows, closed_loop, installed={"pydmps"})
+    results = evaluate(rows, closed_loop, installed={"pydmps"}, replay=_replay())
     assert [r["verdict"] for r in results].count("skipped") == 1
 
 
@@ -117,13 +163,57 @@ def test_quick_keeps_every_check_with_the_same_limits():
         rows = [_row(d, k, w) for d in settings["dimensions"] for k in settings["goals"]
                 for w in ("distinct", "shared")]
         rows += [_pose_row(k, w) for k in settings["pose_goals"] for w in ("distinct", "shared")]
-        closed_loop = [{"goals": k, "meshcat": False, "realtime_factor": 24.0}
-                       for k in settings["hsr_goals"]]
-        results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"})
+        closed_loop = [_run(task, k, meshcat, 24.0) for task in settings["tasks"]
+                       for k in settings["hsr_goals"]
+                       for meshcat in ((False, True) if settings["meshcat"] else (False,))]
+        replay = {"runs": [{"goals": k, "bytes": 1e6} for k in settings["replay_goals"]]}
+        results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay)
         assert [(r["check"], r["limit"], r["verdict"]) for r in results] == [
             (check.name, check.limit, "pass") for check in CHECKS]
     assert quick["min_time"] < full["min_time"]
     assert quick["hsr_seconds"] < full["hsr_seconds"]
+    # The time split runs at K = 4 and 10,000, headless and with Meshcat, quick or not.
+    assert quick["split"] == full["split"] == [(4, False), (4, True), (10000, False),
+                                               (10000, True)]
+    # No K for the closed loop: no closed-loop run at all, every such check skipped.
+    nothing = plan(_parse(["--quick", "--hsr-goals"]))
+    assert not nothing["split"] and not nothing["replay_goals"] and not nothing["meshcat"]
+
+
+def test_the_closed_loop_checks_pass_fail_and_skip():
+    assert set(_verdicts(_closed_loop(), _replay()).values()) == {"pass"}
+    # Each closed-loop check fails on its own value alone.
+    for check, closed_loop, replay in [
+            (SCALING, _closed_loop(headless_10k=11.0), _replay()),  # 0.46x the K=4 speed
+            (REACH_10K, _closed_loop(reach_10k=0.9), _replay()),
+            (REACH_1K, _closed_loop(reach_1k=1.9), _replay()),
+            (GRASP_1K, _closed_loop(grasp_1k=0.95), _replay()),
+            (REPLAY, _closed_loop(), _replay(large=3.1 * 2.9e6))]:
+        verdicts = _verdicts(closed_loop, replay)
+        assert verdicts[check] == "fail", check
+        assert [name for name, verdict in verdicts.items() if verdict == "fail"] == [check]
+    # The K=10,000 scaling is a ratio of the same bench: a slow machine slows both.
+    assert _verdicts(_closed_loop(headless_4=8.0, headless_10k=4.1))[SCALING] == "pass"
+    # A headless run does not stand for a Meshcat one, nor reach for grasp; no replay, no
+    # replay check.
+    results = evaluate([], [_run("reach", 1000, False, 30.0), _run("reach", 1000, True, 3.0),
+                            _run("reach", 4, False, 30.0)], set())
+    reasons = {r["check"]: r["reason"] for r in results if r["verdict"] == "skipped"}
+    assert reasons[GRASP_1K] == ("not measured: no Meshcat HSR grasp run with K=1,000 in "
+                                 "--hsr-goals/--tasks (or --no-meshcat)")
+    assert reasons[REACH_10K].startswith("not measured: no Meshcat HSR reach run with K=10,000")
+    assert reasons[SCALING] == ("not measured: no headless HSR reach run with K=10,000 in "
+                                "--hsr-goals/--tasks")
+    assert reasons[REPLAY].startswith("not measured: no replays of K=4, 1,000")
+    assert {r["check"]: r["verdict"] for r in results}[REACH_1K] == "pass"
+
+
+def test_the_pose_step_limit_is_0_7_ms():
+    rows, closed_loop = _all_cases()
+    rows[-1] = _pose_row(10000, "distinct", 720.0)
+    assert _verdicts(closed_loop, _replay(), rows)[POSE_10K] == "fail"
+    rows[-1] = _pose_row(10000, "distinct", 690.0)
+    assert _verdicts(closed_loop, _replay(), rows)[POSE_10K] == "pass"
 
 
 def test_no_check_is_named_after_an_issue():
@@ -178,7 +268,7 @@ def test_the_bench_command_pins_blas_and_exits_with_the_checks(
     verdict = "PASS" if code == 0 else "FAIL"
     assert f"[{verdict}] {K10K_LEAF}: " in result.stdout
     passed, failed = (4, 0) if code == 0 else (1, 3)
-    assert (f"Checks: {passed} passed, {failed} failed, 4 skipped (not measured: 2; "
+    assert (f"Checks: {passed} passed, {failed} failed, 9 skipped (not measured: 7; "
             "pydmps, movement_primitives not installed: 1; movement_primitives not "
             "installed: 1)") in result.stdout
     assert f"exit code {code}" in result.stdout
@@ -206,3 +296,117 @@ def test_the_slowest_stretch_of_a_timed_span_is_reported():
     median, slowest, repeats = timed_span(step, lambda: len(calls) >= 48, stretches=6)
     assert repeats == 48
     assert slowest >= 0.002 > median
+
+
+def test_the_websocket_reader_receives_what_meshcat_sends():
+    meshcat = Meshcat(MeshcatParams(host="localhost", port=0))
+    reader = MeshcatReader(meshcat)  # connected: Meshcat counts it
+    assert meshcat.GetNumActiveConnections() == 1
+    meshcat.SetObject("/before", Box(0.1, 0.1, 0.1))
+    send_mark(meshcat, "start")
+    for step in range(20):
+        meshcat.SetTransform("/box", RigidTransform([0.01 * step, 0.0, 0.0]))
+    meshcat.SetObject("/box/shape", Box(0.2, 0.2, 0.2))
+    send_mark(meshcat, "end")
+    totals = reader.finish(timeout=30)
+    sent, messages = reader.span("start", "end")
+    assert messages == 21  # the marks themselves are not counted
+    assert sent > 20 * 50  # each transform is a 4x4 matrix of doubles and its path
+    assert totals["bytes"] > sent and totals["messages"] > messages  # /before too
+    assert totals["closed_by"] == "done mark"
+
+
+def test_numpy_called_by_the_bank_counts_as_the_bank():
+    assert category_of(("/x/pbp_drake/core/dmp/bank.py", 1, "advance_into")) == BANK
+    assert category_of(("/x/pbp_drake/robots/box_qp.py", 1, "solve_box_qp")) == IK
+    assert category_of(("~", 0, "<built-in method pydrake.geometry.SetTransform>")) == DRAWING
+    # Shared helpers and code outside the package go to their callers.
+    assert category_of(("/x/pbp_drake/core/quaternion.py", 1, "multiply")) is None
+    assert category_of(("~", 0, "<method 'reduce' of 'numpy.ufunc' objects>")) is None
+    case = make_case(3, 1000, True)
+    step = bank_math_step(make_bank(case), case)  # a closure in pbp_drake/bench: rest
+    profile = cProfile.Profile()
+    profile.enable()
+    for _ in range(200):
+        step()
+    profile.disable()
+    stats = pstats.Stats(profile)
+    seconds = split_stats(stats)
+    assert sum(seconds.values()) == pytest.approx(stats.total_tt, rel=1e-9)
+    assert seconds[BANK] > 0.8 * stats.total_tt
+    assert set(seconds) == set(ORDER)
+
+
+def test_the_time_split_of_a_run_sums_to_its_profiled_total():
+    run = split_run(4, 0.3)
+    split = run["split"]
+    assert split["ticks"] == pytest.approx(0.3 / run["control_period_s"])
+    assert sum(split["ms_per_tick"].values()) == pytest.approx(split["profiled_ms_per_tick"])
+    assert sum(split["share"].values()) == pytest.approx(1.0)
+    assert split["ms_per_tick"][DRAWING] == 0.0  # headless
+    assert min(split["ms_per_tick"][name] for name in (BANK, IK, REST)) > 0.0
+    text = "\n".join(format_report({
+        "memory_bandwidth": {"read_gb_per_s": 10, "copy_gb_per_s": 10, "array_megabytes": 1,
+                             "cache_read_gb_per_s": 10},
+        "machine": {"blas": {"note": "BLAS"}}, "steps": [], "closed_loop": [run],
+        "time_split": [run], "replay": _replay(), "checks": []}).splitlines())
+    assert "cProfile inflates the Python-heavy parts" in text
+    assert "K = 1,000: 3.00 MB (1.03x K = 4)" in text
+
+
+# Fixes each closed-loop run's wall time to its simulated time over a real-time factor
+# (the run itself, its Meshcat and client, happen as they do): the verdicts do not depend
+# on the machine. The step timings are faked as above.
+CLOSED_LOOP_SITECUSTOMIZE = SITECUSTOMIZE + textwrap.dedent("""
+    if "%(marker)s" in os.environ:
+        import pbp_drake.bench.closed_loop as closed_loop
+        factor = float(os.environ["BENCH_TEST_REALTIME_FACTOR"])
+        real_advance = closed_loop.advance
+
+        def advance(*arguments, **options):
+            simulated, _ = real_advance(*arguments, **options)
+            return simulated, simulated / factor
+        closed_loop.advance = advance
+""") % {"marker": MARKER}
+
+
+@pytest.mark.slow  # a bench with closed-loop runs (about 30 s on a loaded 2-core machine)
+def test_the_bench_runs_the_closed_loop_matrix_split_and_replay(repo, tmp_path):
+    (tmp_path / "sitecustomize.py").write_text(CLOSED_LOOP_SITECUSTOMIZE)
+    environment = {name: value for name, value in os.environ.items()
+                   if name not in THREAD_VARIABLES and name != MARKER}
+    environment.update(
+        PYTHONPATH=os.pathsep.join([str(tmp_path), str(repo)]),
+        BENCH_TEST_RECORD=str(tmp_path / "record.jsonl"), BENCH_TEST_STEP_SECONDS="1e-9",
+        BENCH_TEST_REALTIME_FACTOR="1.5")
+    output = tmp_path / "bench"
+    result = subprocess.run(
+        [sys.executable, "-m", "pbp_drake", "bench", "--quick", "--goals", "10",
+         "--hsr-goals", "4", "100", "1000", "--split-goals", "4", "--output", str(output)],
+        capture_output=True, text=True, timeout=600, env=environment, cwd=tmp_path)
+    # At 1.5x real time: K=100 headless (>= 20x) and reach K=1,000 with Meshcat (>= 2x)
+    # fail, grasp K=1,000 with Meshcat (>= 1x) passes; K=10,000 was not run.
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert f"[FAIL] {CLOSED_LOOP}: 1.50 x real time (limit 20)" in result.stdout
+    assert f"[FAIL] {REACH_1K}: 1.50 x real time (limit 2)" in result.stdout
+    assert f"[PASS] {GRASP_1K}: 1.50 x real time (limit 1)" in result.stdout
+    assert f"[SKIP] {REACH_10K}: skipped: not measured" in result.stdout
+    assert f"[SKIP] {SCALING}: skipped: not measured" in result.stdout
+    assert f"[PASS] {REPLAY}: " in result.stdout
+    report = json.loads((output / "bench.json").read_text())
+    cases = {(run["task"], run["goals"], run["meshcat"]) for run in report["closed_loop"]
+             if run["shipped_robot"]}
+    assert cases == {(task, k, meshcat) for task in ("reach", "grasp") for k in (4, 100, 1000)
+                     for meshcat in (False, True)}
+    for run in report["closed_loop"]:
+        if run["meshcat"]:  # the client read the run's drawing
+            assert run["bytes_per_s"] > 0 and run["messages_per_s"] > 0
+    assert [(run["goals"], run["meshcat"]) for run in report["time_split"]] == [
+        (4, False), (4, True)]
+    for run in report["time_split"]:
+        split = run["split"]
+        assert sum(split["ms_per_tick"].values()) == pytest.approx(
+            split["profiled_ms_per_tick"])
+    assert report["time_split"][1]["split"]["ms_per_tick"][DRAWING] > 0.0
+    assert [run["goals"] for run in report["replay"]["runs"]] == [4, 1000]
+    assert (output / "bench_scaling.png").stat().st_size > 0

@@ -27,7 +27,7 @@ HSR_REPEATS = 5
 DYNAMIC = "dynamic"
 # A run with Meshcat advances in slices of this many simulated seconds, so that it can stop
 # at its wall-time cap.
-SLICE = 0.25
+SLICE = 0.1
 
 __all__ = ["DYNAMIC", "GRASP", "HSR_KS", "HSR_REPEATS", "REACH", "TASKS", "closed_loop_runs",
            "hsr_speed", "meshcat_speed", "new_meshcat", "split_run"]
@@ -153,9 +153,11 @@ def closed_loop_runs(goal_counts, simulated_seconds, dynamic_goals=None, meshcat
     if REACH in tasks and dynamic_goals in goal_counts:
         headless.append((REACH, dynamic_goals, DYNAMIC))
     for task, k, motion in headless:  # resolved before timing anything (once per process)
-        if k >= 10000:
-            progress(f"Resolving the {task} scene with K = {k:,} ...")
+        began = time.perf_counter()
         resolved_scene(task, k, motion)
+        if time.perf_counter() - began > 1.0:
+            progress(f"  (resolving the {task} scene with K = {k:,} took "
+                     f"{time.perf_counter() - began:.1f} s)")
     samples = {case: [] for case in headless}
     for round_ in range(HSR_REPEATS):
         progress(f"HSR closed loop, round {round_ + 1} of {HSR_REPEATS}, headless: "

@@ -70,26 +70,51 @@ def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
 
 
 def validate_objects(objects, min_separation, reach_x=(0.3, 3.5), reach_height=(0.0, 1.1)):
-    """Clear errors for objects the HSR cannot reach or that overlap."""
+    """Clear errors for objects the HSR cannot reach or that overlap (the first such object
+    named). O(K log K) time and O(K) memory, so that a scene of thousands of goals is
+    checked at once."""
     objects = np.asarray(objects, dtype=float)
     if objects.ndim != 2 or objects.shape[1] != 3 or len(objects) == 0:
         raise ValueError(f"objects must be (M, 3) with M >= 1, got shape {objects.shape}")
     if not np.isfinite(objects).all():
         raise ValueError("objects contain NaN or infinite values")
-    for index, point in enumerate(objects):
+    heights = objects[:, 2]
+    floor = np.linalg.norm(objects[:, :2], axis=1)
+    out_of_reach = ((heights < reach_height[0]) | (heights > reach_height[1])
+                    | (floor < reach_x[0]) | (floor > reach_x[1]))
+    if out_of_reach.any():
+        index = int(np.flatnonzero(out_of_reach)[0])
+        point = objects[index]
         if not (reach_height[0] <= point[2] <= reach_height[1]):
             raise ValueError(f"object {index} at height {point[2]:.2f} m is out of the "
                              f"HSR's reach (heights {reach_height[0]}..{reach_height[1]} m)")
-        if not (reach_x[0] <= np.linalg.norm(point[:2]) <= reach_x[1]):
-            raise ValueError(f"object {index} at {point.tolist()} is out of reach: keep "
-                             f"objects {reach_x[0]}..{reach_x[1]} m from the robot")
-    gaps = np.linalg.norm(objects[:, None, :] - objects[None, :, :], axis=-1)
-    gaps[np.diag_indices(len(objects))] = np.inf
-    if gaps.min() < min_separation:
-        first, second = np.unravel_index(np.argmin(gaps), gaps.shape)
-        raise ValueError(f"objects {first} and {second} overlap: {gaps.min():.3f} m apart, "
+        raise ValueError(f"object {index} at {point.tolist()} is out of reach: keep "
+                         f"objects {reach_x[0]}..{reach_x[1]} m from the robot")
+    pair = closest_pair_within(objects, min_separation)
+    if pair is not None:
+        first, second, gap = pair
+        raise ValueError(f"objects {first} and {second} overlap: {gap:.3f} m apart, "
                          f"less than {min_separation} m")
     return objects
+
+
+def closest_pair_within(points, distance):
+    """`(i, j, gap)` of the two closest of `points` `(K, D)` (i < j) if they are less than
+    `distance` apart, else None. Sorted along x, only pairs less than `distance` apart in x
+    are measured: one pass over K per neighbour in that band, not K^2 gaps."""
+    points = np.asarray(points, dtype=float)
+    order = np.argsort(points[:, 0], kind="stable")
+    ordered = points[order]
+    best = None
+    for offset in range(1, len(points)):
+        if not (ordered[offset:, 0] - ordered[:-offset, 0] < distance).any():
+            break  # sorted along x: farther neighbours are farther apart in x too
+        gaps = np.linalg.norm(ordered[offset:] - ordered[:-offset], axis=1)
+        index = int(np.argmin(gaps))
+        if gaps[index] < distance and (best is None or gaps[index] < best[2]):
+            first, second = sorted((int(order[index]), int(order[index + offset])))
+            best = (first, second, float(gaps[index]))
+    return best
 
 
 def reach_progress(position, start, target):

@@ -13,12 +13,12 @@ measures how the loop scales with K, not a task a person could do."""
 
 import dataclasses
 import functools
-import math
 from pathlib import Path
 
 import numpy as np
 
 from pbp_drake.core.grasp_task import GraspScene, grasp_pose
+from pbp_drake.core.reach_task import jittered_grid
 from pbp_drake.scenarios import load_scenario_file, resolve
 from pbp_drake.scenarios.resolution import TaskScene
 
@@ -27,21 +27,6 @@ TASKS = (REACH, GRASP)
 # The repository's diagrams/ folder (this file is pbp_drake/bench/scenes.py).
 DIAGRAMS = Path(__file__).resolve().parents[2] / "diagrams"
 SCENARIO_FILES = {REACH: DIAGRAMS / "hsr_reach.yaml", GRASP: DIAGRAMS / "hsr_grasp.yaml"}
-
-
-def jittered_grid(goal_count, x_range, y_range, rng):
-    """`(floor points (K, 2), cell size (dx, dy))`: K cells of a grid over the rectangle
-    (about square cells), drawn without repeats, each point jittered within a quarter cell
-    of its cell's centre, so two points are at least half a cell apart."""
-    (x0, x1), (y0, y1) = x_range, y_range
-    rows = max(1, int(math.ceil(math.sqrt(goal_count * (x1 - x0) / (y1 - y0)))))
-    columns = int(math.ceil(goal_count / rows))
-    dx, dy = (x1 - x0) / rows, (y1 - y0) / columns
-    cells = rng.permutation(rows * columns)[:goal_count]
-    jitter = rng.uniform(-0.25, 0.25, (goal_count, 2))
-    points = np.stack([x0 + (cells // columns + 0.5 + jitter[:, 0]) * dx,
-                       y0 + (cells % columns + 0.5 + jitter[:, 1]) * dy], axis=1)
-    return points, (dx, dy)
 
 
 def hsr_scenario(goal_count, seed=0):

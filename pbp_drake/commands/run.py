@@ -19,12 +19,13 @@ from pbp_drake.console import (
     CAMERAS, Console, LiveRun, Progress, RobotCamera, method_name, result_text)
 from pbp_drake.console.front import PageFront, PortError, bind_page_port
 from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage, start_label
+from pbp_drake.core.reach_task import sample_grid_scene
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, mark_replay)
 from pbp_drake.scenarios import (
-    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, ScenarioError, TASK_ROBOTS, counted,
-    load_scenario_file, resolve)
+    METHODS, OPERATOR_NAMES, Gamepad, GraspTask, MultiGoalReach, ScenarioError, TASK_ROBOTS,
+    counted, load_scenario_file, resolve)
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers, scales_text
 from pbp_drake.studies.sessions import run_session
 
@@ -37,6 +38,10 @@ PERSON_NEEDS_PAGE = ("the keyboard and gamepad are read in the page, so nothing 
                      "recorded")
 
 
+# The most objects `--goals` places: the loop runs live with 10,000 (docs/performance.md).
+MOST_GRID_GOALS = 100_000
+
+
 def add_run_command(commands):
     """The `run` subcommand and its arguments."""
     run = commands.add_parser("run", help="simulate one scenario in Meshcat")
@@ -47,6 +52,10 @@ def add_run_command(commands):
     run.add_argument("--operator", help="HSR tasks: who drives, one of "
                      f"{', '.join(OPERATOR_NAMES)} (keyboard and gamepad: in the browser)")
     run.add_argument("--seed", type=int, help="HSR tasks: the seed of the scene and the noise")
+    run.add_argument("--goals", type=int, metavar="K",
+                     help="reaching task: K objects (candidate goals, up to "
+                     f"{MOST_GRID_GOALS:,}), one in each cell of a grid over the task's "
+                     "region drawn from the seed, in place of the file's")
     run.add_argument("--participant", metavar="ID",
                      help="HSR tasks: a user-study session; every method of --methods once, "
                      "in an order counterbalanced across participants, saved in the study "
@@ -107,7 +116,7 @@ def add_run_command(commands):
 
 
 def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operator=None,
-                     seed=None, duration=None):
+                     seed=None, duration=None, goals=None):
     """The file's resolved scenario with the command line's overrides applied: resolved again
     only when an override changes what is derived (a method or alpha does not)."""
     scenario = scenario_file.scenario
@@ -127,6 +136,8 @@ def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operato
             scenario = dataclasses.replace(scenario, operator=OPERATOR_NAMES[operator]())
     if seed is not None:
         scenario = dataclasses.replace(scenario, seed=seed)
+    if goals is not None:
+        scenario = with_grid_goals(scenario, goals)
     if scene is not None:
         scenes = getattr(scenario_file.study, "scenes", [])
         names = [s.name for s in scenes]
@@ -151,6 +162,26 @@ def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operato
     return resolved
 
 
+def with_grid_goals(scenario, count):
+    """`scenario` (a reaching task) with `count` objects on a grid over its region
+    (`core.reach_task.sample_grid_scene`, from its seed) in place of its own."""
+    task = scenario.task
+    if type(task) is not MultiGoalReach or task.objects:
+        raise ScenarioError("--goals places the objects of a reaching task drawn from its "
+                            "seed (an untagged task without fixed objects)")
+    least = 2 if len(task.switch_schedule) > 1 else 1
+    if not least <= count <= MOST_GRID_GOALS:
+        raise ScenarioError(f"--goals {count} is out of range; expected {least} to "
+                            f"{MOST_GRID_GOALS:,}")
+    layout, separation = sample_grid_scene(
+        scenario.seed, count, task.x_range, task.y_range, task.height,
+        task.switch_schedule, task.z_range or None)
+    task = dataclasses.replace(task, objects=layout.objects.tolist(),
+                               targets=list(layout.targets),
+                               min_separation=min(task.min_separation, 0.9 * separation))
+    return dataclasses.replace(scenario, task=task)
+
+
 def _run(args):
     # The paths first: a bad one must not cost a run, let alone a person's session.
     if args.record:
@@ -171,7 +202,7 @@ def _run(args):
     try:
         resolved = scenario_for_run(load_scenario_file(args.scenario), args.method,
                                     args.alpha, args.scene, args.operator, args.seed,
-                                    args.duration)
+                                    args.duration, args.goals)
         check_buildable(resolved)  # before the page opens: what the builder cannot build
         if args.camera == "robot" and (not resolved.has_task or resolved.is_arm):
             raise ScenarioError("--camera robot looks from the HSR's head; this scenario "

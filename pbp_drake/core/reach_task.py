@@ -60,13 +60,50 @@ def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
             raise ValueError(f"cannot place {count} objects {min_separation} m apart in "
                              f"x {list(x_range)}, y {list(y_range)}")
         objects[index] = candidate
-    targets = [int(rng.integers(count))]
-    for _ in switch_schedule[1:]:
-        others = [i for i in range(count) if i != targets[-1]]
-        targets.append(int(others[rng.integers(len(others))]))
+    targets = _draw_targets(rng, count, switch_schedule)
     if z_range:
         objects[:, 2] = rng.uniform(*z_range, size=count)
-    return ReachScene(objects=objects, targets=tuple(targets))
+    return ReachScene(objects=objects, targets=targets)
+
+
+def _draw_targets(rng, count, switch_schedule):
+    """The first target, then at each switch another object than the last."""
+    targets = [int(rng.integers(count))]
+    for _ in switch_schedule[1:]:
+        other = int(rng.integers(count - 1))
+        targets.append(other + (other >= targets[-1]))
+    return tuple(targets)
+
+
+def jittered_grid(count, x_range, y_range, rng):
+    """`(floor points (K, 2), cell size (dx, dy))`: K cells of a grid over the rectangle
+    (about square cells), drawn without repeats, each point jittered within a quarter cell
+    of its cell's centre, so two points are at least half a cell apart."""
+    (x0, x1), (y0, y1) = x_range, y_range
+    rows = max(1, int(np.ceil(np.sqrt(count * (x1 - x0) / (y1 - y0)))))
+    columns = int(np.ceil(count / rows))
+    dx, dy = (x1 - x0) / rows, (y1 - y0) / columns
+    cells = rng.permutation(rows * columns)[:count]
+    jitter = rng.uniform(-0.25, 0.25, (count, 2))
+    points = np.stack([x0 + (cells // columns + 0.5 + jitter[:, 0]) * dx,
+                       y0 + (cells % columns + 0.5 + jitter[:, 1]) * dy], axis=1)
+    return points, (dx, dy)
+
+
+def sample_grid_scene(seed, count, x_range=(1.25, 2.5), y_range=(-1.05, 1.05), height=0.7,
+                      switch_schedule=(0.0, 0.3, 0.6), z_range=None):
+    """`(scene, separation)`: a scene of many objects drawn from `seed`, one in each of
+    `count` cells of a grid over the rectangle (`jittered_grid`), so that thousands are
+    placed at once, at least `separation` (half a cell) apart; the targets are drawn as in
+    `sample_reach_scene`, and with a `z_range` each object's height."""
+    check_object_count((count, count), switch_schedule)
+    rng = np.random.default_rng(seed)
+    floor, cell = jittered_grid(count, x_range, y_range, rng)
+    objects = np.column_stack([floor, np.full(count, float(height))])
+    targets = _draw_targets(rng, count, switch_schedule)
+    if z_range:
+        objects[:, 2] = rng.uniform(*z_range, size=count)
+    return ReachScene(objects=objects, targets=targets), 0.5 * min(cell)
 
 
 def validate_objects(objects, min_separation, reach_x=(0.3, 3.5), reach_height=(0.0, 1.1)):

@@ -1,0 +1,52 @@
+"""`pbp-drake run --goals K`: a reaching scene of K candidate goals on a grid over the task's
+region, from the seed; refused where it does not apply."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from pbp_drake.commands.run import MOST_GRID_GOALS, scenario_for_run, with_grid_goals
+from pbp_drake.core.reach_task import sample_grid_scene
+from pbp_drake.scenarios import ScenarioError, load_scenario_file
+
+
+def test_goals_places_k_objects_in_the_region_apart_and_the_targets_among_them(repo):
+    file = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml")
+    resolved = scenario_for_run(file, seed=3, goals=2000)
+    objects = np.asarray(resolved.goals)
+    task = file.scenario.task
+    assert objects.shape == (2000, 3)
+    assert (objects[:, 0] >= task.x_range[0]).all() and (objects[:, 0] <= task.x_range[1]).all()
+    assert (objects[:, 1] >= task.y_range[0]).all() and (objects[:, 1] <= task.y_range[1]).all()
+    targets = resolved.scene.targets
+    assert len(targets) == len(task.switch_schedule)
+    assert all(a != b for a, b in zip(targets, targets[1:]))  # each switch to another object
+    # The same seed, the same scene.
+    again = scenario_for_run(file, seed=3, goals=2000)
+    np.testing.assert_array_equal(again.goals, objects)
+
+
+def test_the_grid_keeps_objects_half_a_cell_apart():
+    scene, separation = sample_grid_scene(0, 500)
+    gaps = np.linalg.norm(scene.objects[:, None, :2] - scene.objects[None, :, :2], axis=-1)
+    gaps[np.diag_indices(500)] = np.inf
+    assert gaps.min() >= separation > 0
+
+
+@pytest.mark.parametrize("name, goals, message", [
+    ("hsr_obstacles.yaml", 10, "--goals places the objects of a reaching task"),
+    ("hsr_grasp.yaml", 10, "--goals places the objects of a reaching task"),
+    ("hsr_reach.yaml", 1, "--goals 1 is out of range; expected 2 to"),
+    ("hsr_reach.yaml", MOST_GRID_GOALS + 1, "is out of range")])
+def test_goals_is_refused_where_it_does_not_apply(repo, name, goals, message):
+    file = load_scenario_file(repo / "diagrams" / name)
+    with pytest.raises(ScenarioError, match=message):
+        scenario_for_run(file, goals=goals)
+
+
+def test_a_task_without_switches_takes_a_single_goal(repo):
+    scenario = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario
+    scenario = dataclasses.replace(scenario, task=dataclasses.replace(
+        scenario.task, switch_schedule=[0.0]))
+    assert len(with_grid_goals(scenario, 1).task.objects) == 1

@@ -13,7 +13,7 @@ from pbp_drake.systems.visualizers.reach_scene_visualizer import (
     CLOUD_POINT_SIZE, ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, SOLID_OBJECTS,
     TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
 from pbp_drake.systems.visualizers.scene_drawing import (
-    GoalCloud, PathTriads, draw_triad, pose_transform)
+    GoalCloud, PathTriads, cloud_point_size, draw_triad, pose_transform)
 
 # Triads: the grasp poses' and the hand's full size, the predicted path's smaller and a
 # little transparent, so that the grasp they lead to stands out.
@@ -74,7 +74,8 @@ class GraspSceneVisualizer(LeafSystem):
                                 TRIAD_RADIUS, PATH_TRIAD_OPACITY)
         self._solid = count <= SOLID_OBJECTS
         self._likely_triads = min(int(likely_triads), count)
-        self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions, CLOUD_POINT_SIZE)
+        self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions,
+                                cloud_point_size(grasps.grasp_positions, CLOUD_POINT_SIZE))
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)

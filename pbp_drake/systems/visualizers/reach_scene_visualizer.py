@@ -7,7 +7,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.ports import EeState, Target, position_of
-from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots
+from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots, cloud_point_size
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
 TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
@@ -24,7 +24,8 @@ OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
 # Up to this many objects are drawn as tables and cylinders; more are the goal cloud alone
 # (thousands of meshes would slow the page down, and show nothing the cloud does not).
 SOLID_OBJECTS = 100
-# The goal cloud's points float just above the objects' tops, the size of an object.
+# The goal cloud's points float just above the objects' tops, at most the size of an object
+# (smaller when many objects stand close: `cloud_point_size`).
 CLOUD_LIFT, CLOUD_POINT_SIZE = 0.07, 0.05
 
 OBJECT_RADIUS = 0.03
@@ -94,7 +95,7 @@ class ReachSceneVisualizer(LeafSystem):
                                       OTHER_DOT_RADIUS, OTHER_PATH_COLOUR)
                              for index in range(1, path_count)]
         self._cloud = GoalCloud("/task/goal_cloud", self._objects + [0.0, 0.0, CLOUD_LIFT],
-                                CLOUD_POINT_SIZE)
+                                cloud_point_size(self._objects, CLOUD_POINT_SIZE))
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)

@@ -160,6 +160,16 @@ UNLIKELY_RGB = np.array([150.0, 150.0, 150.0])
 LIKELY_RGB = np.array([25.0, 75.0, 255.0])
 
 
+def cloud_point_size(points, largest):
+    """A point size (m) for a cloud of `points` `(K, 3)`: `largest`, or for many points
+    spread over the floor 0.6 of their typical spacing (the side of the floor area per
+    point), so that neighbours stay apart; at least a fifth of `largest`."""
+    points = np.asarray(points, dtype=float)
+    extent = np.ptp(points[:, :2], axis=0)
+    spacing = np.sqrt(extent[0] * extent[1] / len(points)) if extent.all() else np.inf
+    return float(np.clip(0.6 * spacing, 0.2 * largest, largest))
+
+
 class GoalCloud:
     """K goals drawn as one Meshcat point cloud at `root` (one object, whatever K), each
     point coloured by its goal's probability relative to the most probable goal's, from

@@ -21,9 +21,10 @@ in `g` or in `e` is a product with a small matrix, the same for every goal:
   attractor's part `b` in rows the caller fills (`forcing_rows`: `b` itself, or for one
   shape shared by all goals the three rows of `-e0`).
 
-So the step is two BLAS products around 20 passes over K numbers (`sqrt`, one `arctan`,
-the rest multiplications and divisions), all in one (15, K) array and three (K,) rows
-rewritten in place: against the step through the general kernels (`orientation_kernels`:
+So the step is two BLAS products around 17 passes over K numbers (`sqrt`, one `arctan`,
+the rest multiplications and divisions; 21 when some angle is below `SERIES_BELOW`, whose
+series and `SMALLEST` guards the other goals skip), all in one (15, K) array and three (K,)
+rows rewritten in place: against the step through the general kernels (`orientation_kernels`:
 the log map, the inverse Jacobian, the transition and `b`, about 50 passes over a dozen
 arrays) it does less and touches less memory, which at large K is what the step costs
 (the arrays leave the cache between two ticks). The results equal those kernels' to
@@ -117,7 +118,7 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
     ratio, half, quadruple, p = fused[5], fused[6], fused[7], fused[8]
     np.einsum("ik,ik->k", vector, vector, out=ratio)
     np.sqrt(ratio, out=ratio)  # s = |v| = sin(t/2)
-    if w.all():
+    if np.logical_and.reduce(w):  # no w = 0 (`w.all()`, without its Python wrapper)
         # h = atan(s / w) = sign(w) t/2 (|w| = cos(t/2)): `-q g*`'s angle with `q g*`'s
         # sign, so that `h / s` is `k` and `h w / s` is `p` with no sign pass. One rounding
         # of the quotient away from `atan2`, and 3.5 times faster.
@@ -130,20 +131,20 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
         np.abs(w, out=half)
         np.arctan2(ratio, half, out=half)
         half *= ws.row
-    # k = h / s (0 for the identity, whose v is 0 anyway; SMALLEST changes no s > 1e-284).
-    ratio += SMALLEST
-    np.divide(half, ratio, out=ratio)
-    np.multiply(ratio, w, out=p)  # p = (t/2) cot(t/2) = h w / s
-    vector *= ratio  # k v = e / 2
-    # 4 c = (1 - p) / h^2, or its series where the angle is below SERIES_BELOW.
-    square, scratch = half, w
-    square *= half
-    np.less(square, _SQUARE_SERIES_BELOW, out=ws.small)
-    np.subtract(1.0, p, out=quadruple)
-    np.add(square, SMALLEST, out=scratch)
-    quadruple /= scratch
-    if ws.small.any():
-        _series_into(square, quadruple, p, scratch, ws.small)
+    # h^2, in the row `4 c` takes last: one pass tells whether any angle needs the series.
+    square = quadruple
+    np.multiply(half, half, out=square)
+    if np.minimum.reduce(square) >= _SQUARE_SERIES_BELOW:  # False if NaN: the general path
+        # Every angle at least SERIES_BELOW: then `s >= |h w|` (atan x <= x) or `|w| < 0.1`
+        # and `s > 0.99`, so `s` and `h^2` are above 1e-5, where adding SMALLEST (as the
+        # general path does) changes no bit: left out, with the series' mask and its test.
+        np.divide(half, ratio, out=ratio)  # k = h / s
+        np.multiply(ratio, w, out=p)  # p = (t/2) cot(t/2) = h w / s
+        vector *= ratio  # k v = e / 2
+        np.subtract(1.0, p, out=half)
+        np.divide(half, square, out=quadruple)  # 4 c = (1 - p) / h^2
+    else:
+        quadruple = _small_angles_into(w, vector, ratio, half, square, p, ws.small)
     # d = (4 c)(k v.eta), and c (e.eta) e = d (k v) (over k, h and 4 c, dead by then).
     along *= ratio
     along *= quadruple
@@ -172,6 +173,28 @@ def _accumulate_product(matrix, rows, out):
     result = _dgemm()(1.0, rows.T, matrix.T, beta=1.0, c=out.T, overwrite_c=True)
     if not np.may_share_memory(result, out):  # a copy would leave `out` as it was
         raise RuntimeError("BLAS dgemm did not write in place")
+
+
+def _small_angles_into(w, vector, ratio, half, square, p, small):
+    """`log_step_from_one_into`'s numbers when some angle may be below SERIES_BELOW (or
+    is 0, the identity, whose `s` is 0): `k` into `ratio`, `p`, `k v` into `vector`, and
+    `4 c` from the closed forms with SMALLEST in their denominators, then the series where
+    the angle is small. `half` holds `h` and `square` `h^2` on entry; returns the row that
+    holds `4 c` (`half`); `w` ends as scratch."""
+    # k = h / s (0 for the identity, whose v is 0 anyway; SMALLEST changes no s > 1e-284).
+    ratio += SMALLEST
+    np.divide(half, ratio, out=ratio)
+    np.multiply(ratio, w, out=p)  # p = (t/2) cot(t/2) = h w / s
+    vector *= ratio  # k v = e / 2
+    # 4 c = (1 - p) / h^2, or its series where the angle is below SERIES_BELOW.
+    quadruple, scratch = half, w
+    np.less(square, _SQUARE_SERIES_BELOW, out=small)
+    np.subtract(1.0, p, out=quadruple)
+    np.add(square, SMALLEST, out=scratch)
+    quadruple /= scratch
+    if small.any():
+        _series_into(square, quadruple, p, scratch, small)
+    return quadruple
 
 
 def _series_into(square, quadruple, p, series, small):

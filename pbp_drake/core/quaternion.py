@@ -134,8 +134,16 @@ def exp_times_aligned(rotation_vector, q, reference):
     quaternions `q`, `reference` (4,), in float arithmetic: the same operations in the
     same order, so the same numbers bit for bit, at a tenth of the time (at one quaternion
     a NumPy call costs more than the whole product). A new (4,) array."""
-    rx, ry, rz = (float(value) for value in rotation_vector)
-    qw, qx, qy, qz = (float(value) for value in q)
+    return np.array(exp_times_aligned_values([float(value) for value in rotation_vector],
+                                             [float(value) for value in q],
+                                             [float(value) for value in reference]))
+
+
+def exp_times_aligned_values(rotation_vector, q, reference):
+    """`exp_times_aligned` on plain floats: sequences of 3, 4 and 4 in, a list of 4 out
+    (for a caller that holds floats already, as Drake's pose bank reading one goal)."""
+    rx, ry, rz = rotation_vector
+    qw, qx, qy, qz = q
     angle = math.sqrt(rx * rx + ry * ry + rz * rz)
     # numpy's sinc(u) = sin(pi u) / (pi u), with u = 1e-20 at 0 (exp_map).
     u = angle / (2.0 * math.pi)
@@ -147,8 +155,8 @@ def exp_times_aligned(rotation_vector, q, reference):
                pw * qx + px * qw + py * qz - pz * qy,
                pw * qy - px * qz + py * qw + pz * qx,
                pw * qz + px * qy - py * qx + pz * qw]
-    dot = sum(value * float(other) for value, other in zip(product, reference))
-    return -np.array(product) if dot < 0.0 else np.array(product)
+    dot = sum(value * other for value, other in zip(product, reference))
+    return [-value for value in product] if dot < 0.0 else product
 
 
 def angle_between(p, q):

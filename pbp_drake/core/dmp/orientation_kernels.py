@@ -316,8 +316,14 @@ def jacobian_of_one(rotation_vector, vector):
     """`J(r) v` (3,) for ONE rotation vector and vector (3,), in float arithmetic: at one
     column a NumPy call costs more than the whole product (`np.cross` about 30 us). The
     same formulas as `jacobian_into`, with `sin` and `cos` of `t` directly."""
-    rx, ry, rz = (float(value) for value in rotation_vector)
-    vx, vy, vz = (float(value) for value in vector)
+    return np.array(jacobian_of_one_values([float(value) for value in rotation_vector],
+                                           [float(value) for value in vector]))
+
+
+def jacobian_of_one_values(rotation_vector, vector):
+    """`jacobian_of_one` on plain floats: two sequences of 3 in, a list of 3 out."""
+    rx, ry, rz = rotation_vector
+    vx, vy, vz = vector
     square = rx * rx + ry * ry + rz * rz
     angle = math.sqrt(square)
     if angle < SERIES_BELOW:
@@ -331,5 +337,4 @@ def jacobian_of_one(rotation_vector, vector):
         b = (1.0 - p) / square
     cx, cy, cz = ry * vz - rz * vy, rz * vx - rx * vz, rx * vy - ry * vx
     dot = b * (rx * vx + ry * vy + rz * vz)
-    return np.array([p * vx + a * cx + dot * rx, p * vy + a * cy + dot * ry,
-                     p * vz + a * cz + dot * rz])
+    return [p * vx + a * cx + dot * rx, p * vy + a * cy + dot * ry, p * vz + a * cz + dot * rz]

@@ -15,13 +15,13 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.coordinates import check_positions
-from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one
+from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one_values
 from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
 from pbp_drake.systems.ports import GoalPose, PoseState, goal_index
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
-    AT_START, ON_ROBOT, STEPPING, PoseWorkspace, compact_inputs, hold_into, per_goal_arrays,
-    split_head, state_size, step_all)
+    AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
+    hold_into, per_goal_arrays, split_head, state_size, step_all)
 from pbp_drake.systems.tick import decide_offset
 
 class PoseDmpBank(LeafSystem):
@@ -104,6 +104,7 @@ class PoseDmpBank(LeafSystem):
         self._shared_basis = (position_bank.settings == orientation_bank.settings
                               and position_bank.duration == orientation_bank.duration)
         self._period = float(control_period)
+        self._decay = position_bank.decay(self._period)  # the phase factor of one update
         self._lock = bool(lock_phase_when_operator_acts)
         if update_offset is None:
             update_offset = decide_offset(self._period)
@@ -138,8 +139,9 @@ class PoseDmpBank(LeafSystem):
             prerequisites_of_calc={self.nothing_ticket()})
         if self._compact:
             self._stepped_entry = self.DeclareCacheEntry(
-                "the K DMPs stepped from the compact state: [y' - p, z', e', z'] (12 K)",
-                ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(12 * k)),
+                "SteppedDmps: the K DMPs stepped from the compact state, [y' - p, z', e', z'] "
+                "(12 K)",
+                ValueProducer(allocate=lambda: AbstractValue.Make(SteppedDmps(k)),
                               calc=self._calc_stepped),
                 prerequisites_of_calc={self.xd_ticket(), self._goals_entry.ticket()})
         self._references_port = self.DeclareVectorOutputPort(
@@ -211,14 +213,26 @@ class PoseDmpBank(LeafSystem):
         layout, of the cache entry computed from the Context's state, which the update's
         copy equals until the update writes it."""
         if self._compact:
-            return per_goal_arrays(self._stepped_entry.Eval(context), self._goal_count)
+            return per_goal_arrays(self._stepped_entry.Eval(context).numbers, self._goal_count)
         return per_goal_arrays(vector, self._goal_count)
+
+    def _goal_numbers(self, context, vector, k):
+        """Goal `k`'s stepped numbers `[y' - p (3), z' (3), e' (3), z' (3)]` as 12 floats
+        (one strided read of the layout `_stepped` views), and the compact layout's
+        `SteppedDmps` they were read from (None per goal)."""
+        count = self._goal_count
+        if self._compact:
+            stepped = self._stepped_entry.Eval(context)
+            return stepped.numbers[k::count].tolist(), stepped
+        return vector[len(vector) - 12 * count + k::count].tolist(), None
 
     def _calc_stepped(self, context, value):
         vector = context.get_discrete_state(self._state_index).get_value()
         _, held, robot, q, eta = split_head(vector)
         phase, velocity = compact_inputs(vector)
-        stepped, log_state = per_goal_arrays(value.get_mutable_value(), self._goal_count)
+        result = value.get_mutable_value()
+        result.eta_goal = -1  # the numbers change below
+        stepped, log_state = per_goal_arrays(result.numbers, self._goal_count)
         if held[0] != STEPPING:
             hold_into(held[0], robot, velocity, self._positions.starts, stepped)
             return
@@ -248,11 +262,14 @@ class PoseDmpBank(LeafSystem):
         """The measured position (3,), orientation (4,), velocity (3,) and angular velocity
         (3,), checked."""
         state = np.asarray(self._robot_state_port.Eval(context), dtype=float)
-        if not np.isfinite(state).all():
+        # A sum of floats is finite unless a number is NaN or infinite (or the sum
+        # overflows, which the exact check below lets pass): a third of `np.isfinite`'s time.
+        if not math.isfinite(sum(state.tolist())):
             bad = [name for name, value in zip(PoseState.get_fields(), state)
                    if not np.isfinite(value)]
-            raise ValueError(f"robot_state {', '.join(bad)} is NaN or infinite: "
-                             f"{state.tolist()}")
+            if bad:
+                raise ValueError(f"robot_state {', '.join(bad)} is NaN or infinite: "
+                                 f"{state.tolist()}")
         norm = math.sqrt(float(state[3:7] @ state[3:7]))
         if abs(norm - 1.0) > quaternion.UNIT_TOLERANCE:
             quaternion.unit_quaternions(state[3:7], "robot_state orientation")  # raises
@@ -277,33 +294,38 @@ class PoseDmpBank(LeafSystem):
         # The compact state's tail: the phase and `z` the last step started from (`z`, or
         # the held one).
         step_phase, step_velocity = compact_inputs(vector) if self._compact else (None, None)
-        if stepping or not self._compact:
-            stepped, log_state = self._stepped(context, vector)
-            offsets, velocities = stepped
         workspace = self._workspace(context)
         # The DMPs' velocities at the end of the last step, which the step overwrites: the
         # followed one's linear velocity (every DMP continues from it), else each one's,
         # and the orientation part's eta as a column (one for all) or per DMP.
-        if followed is not None:
+        if stepping and followed is not None:
+            # The followed DMP's 12 numbers in one read, and its eta = J(e') z': the last
+            # read of the selected reference computed it when that was the same goal.
+            numbers, stepped = self._goal_numbers(context, vector, followed)
+            scaled_velocity, eta = workspace.column, workspace.eta_column
+            scaled_velocity[:, 0] = numbers[3:6]
+            eta[:, 0] = (stepped.eta if stepped is not None and stepped.eta_goal == followed
+                         else jacobian_of_one_values(numbers[6:9], numbers[9:12]))
+            limit_speeds(scaled_velocity, self._max_speed, positions.duration)
+            limit_speeds(eta, self._max_angular_speed, orientations.duration)
+        elif followed is not None:  # held: the followed DMP's `z`, or the compact one
             scaled_velocity = workspace.column
-            scaled_velocity[:, 0] = (velocities[:, followed] if step_velocity is None
-                                     or stepping else step_velocity[:, 0])
-        else:
+            scaled_velocity[:, 0] = (step_velocity[:, 0] if self._compact else
+                                     self._stepped(context, vector)[0][1][:, followed])
+            eta = np.array(eta_state)  # the robot's (locked) or 0 (at the start), (3, 1)
+        else:  # per goal, each DMP its own velocities
+            (_, velocities), log_state = self._stepped(context, vector)
             scaled_velocity = workspace.velocities
             np.copyto(scaled_velocity, velocities)
-        if stepping:
-            limit_speeds(scaled_velocity, self._max_speed, positions.duration)
-            if followed is not None:
-                eta = jacobian_of_one(log_state[0, :, followed],
-                                      log_state[1, :, followed])[:, np.newaxis]
-            else:
+            if stepping:
+                limit_speeds(scaled_velocity, self._max_speed, positions.duration)
                 orientations.orientations_from_log_into(
                     log_state[0], log_state[1], goals[3:], q,
                     workspace.orientations, workspace.eta, workspace.orientation)
                 eta = workspace.eta
-            limit_speeds(eta, self._max_angular_speed, orientations.duration)
-        else:
-            eta = np.array(eta_state)  # the robot's (locked) or 0 (at the start), (3, 1)
+                limit_speeds(eta, self._max_angular_speed, orientations.duration)
+            else:
+                eta = np.array(eta_state)
         robot[:, 0] = position
         q[:, 0] = orientation
         if lock:
@@ -313,6 +335,7 @@ class PoseDmpBank(LeafSystem):
             if self._compact:
                 np.multiply(velocity[:, np.newaxis], positions.duration, out=step_velocity)
             else:
+                offsets, velocities = self._stepped(context, vector)[0]
                 offsets.fill(0.0)
                 np.multiply(velocity[:, np.newaxis], positions.duration, out=velocities)
             return
@@ -323,10 +346,11 @@ class PoseDmpBank(LeafSystem):
             step_velocity[...] = scaled_velocity
             eta_state[...] = eta
         else:
+            stepped, log_state = self._stepped(context, vector)
             step_all(positions, orientations, self._shared_basis, phase, robot, q,
                      scaled_velocity, eta, goals, period, stepped,
                      log_state, workspace)
-        phase *= positions.decay(period)
+        phase *= self._decay
 
     def dmp_states(self, context):
         """The K DMPs after the last update: phases (K,), positions (3, K), orientations
@@ -357,26 +381,35 @@ class PoseDmpBank(LeafSystem):
 
     def selected_reference(self, context):
         """The `PoseReference` of `selected_goal` (unconnected: the followed goal, else 0)."""
+        return PoseReference.from_vector(self._selected_numbers(context))
+
+    def _selected_numbers(self, context):
+        """`selected_reference`'s 13 numbers (`PoseState`'s layout) as floats: at one goal,
+        float arithmetic on the numbers read in one go costs a fraction of NumPy calls."""
         k = goal_index(self._selected_goal_port, context, self._goal_count)
         if k is None:
             k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
         vector = context.get_discrete_state(self._state_index).get_value()
-        _, held, robot, q, eta_held = split_head(vector)
-        (offsets, velocities), log_state = self._stepped(context, vector)
-        position = robot[:, 0] + offsets[:, k]
-        velocity = velocities[:, k] / self._positions.duration
-        tau_w = self._orientations.duration
-        if held[0] != STEPPING:
-            start = self._orientations.starts[:, k] if held[0] == AT_START else q[:, 0]
-            return PoseReference(position, np.array(start), velocity, eta_held[:, 0] / tau_w)
-        error, log_velocity = log_state[0, :, k], log_state[1, :, k]
-        goal = self._goals_entry.Eval(context)[3:, k]
-        rotation = quaternion.exp_times_aligned(error, goal, q[:, 0])
-        eta = jacobian_of_one(error, log_velocity)
-        return PoseReference(position, rotation, velocity, eta / tau_w)
+        head = vector[:HEAD_SIZE].tolist()  # [phase, held, p (3), q (4), eta (3)]
+        numbers, stepped = self._goal_numbers(context, vector, k)
+        tau, tau_w = self._positions.duration, self._orientations.duration
+        position = [p + offset for p, offset in zip(head[2:5], numbers[0:3])]
+        velocity = [value / tau for value in numbers[3:6]]
+        held = head[1]
+        if held != STEPPING:
+            start = self._orientations.starts[:, k].tolist() if held == AT_START else head[5:9]
+            return position + start + velocity + [value / tau_w for value in head[9:12]]
+        goal = self._goals_entry.Eval(context)[3:, k].tolist()
+        rotation = quaternion.exp_times_aligned_values(numbers[6:9], goal, head[5:9])
+        eta = jacobian_of_one_values(numbers[6:9], numbers[9:12])
+        if stepped is not None:
+            # The next update steps every DMP from the followed one's eta: this one's, when
+            # the blender follows the goal the estimator selects (`SteppedDmps`).
+            stepped.eta_goal, stepped.eta = k, eta
+        return position + rotation + velocity + [value / tau_w for value in eta]
 
     def _calc_selected_reference(self, context, output):
-        output.SetFromVector(self.selected_reference(context).to_vector())
+        output.get_mutable_value()[:] = self._selected_numbers(context)
 
     def _calc_phase(self, context, output):
         phase = split_head(context.get_discrete_state(self._state_index).get_value())[0]

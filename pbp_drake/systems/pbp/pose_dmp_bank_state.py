@@ -49,15 +49,32 @@ def compact_inputs(vector):
     return vector[HEAD_SIZE:HEAD_SIZE + 1], vector[HEAD_SIZE + 1:HEAD_SIZE + 4].reshape(3, 1)
 
 
+class SteppedDmps:
+    """The compact layout's cache entry: the K DMPs stepped from the state (`numbers`,
+    12 K, laid out as a per-goal state's tail, `per_goal_arrays`), and `J(e') z'` of one of
+    them (`eta`, 3 floats, of goal `eta_goal`; -1: none yet): the selected reference's
+    read computes it, and the next update, which needs the followed DMP's, takes it when
+    they are the same goal (the normal case), as it takes these numbers, not computing
+    them twice. Whoever rewrites `numbers` sets `eta_goal` to -1."""
+
+    __slots__ = ("numbers", "eta_goal", "eta")
+
+    def __init__(self, goal_count):
+        self.numbers = np.zeros(12 * goal_count)
+        self.eta_goal = -1
+        self.eta = None
+
+
 class PoseWorkspace:
     """Scratch of one Context: the two banks' workspaces, a phase, the linear velocities
     the step starts from (`column`, the followed DMP's; `velocities`, every DMP's when no
-    followed goal is connected), the orientation readout's arrays (`eta` of every DMP,
-    likewise), and whether the goals were recomputed since the last step (`goals_changed`:
-    if not, the banks reuse what they derived from the goals, without comparing K goals)."""
+    followed goal is connected), the angular ones likewise (`eta_column`; `eta`, with
+    `orientations` the orientation readout's arrays), and whether the goals were
+    recomputed since the last step (`goals_changed`: if not, the banks reuse what they
+    derived from the goals, without comparing K goals)."""
 
-    __slots__ = ("position", "orientation", "phase", "column", "velocities", "orientations",
-                 "eta", "goals_changed")
+    __slots__ = ("position", "orientation", "phase", "column", "eta_column", "velocities",
+                 "orientations", "eta", "goals_changed")
 
     def __init__(self, position_bank, orientation_bank):
         k = position_bank.goal_count
@@ -65,6 +82,7 @@ class PoseWorkspace:
         self.orientation = orientation_bank.make_workspace()
         self.phase = np.empty(1)
         self.column = np.empty((3, 1))
+        self.eta_column = np.empty((3, 1))
         self.velocities = np.empty((3, k))
         self.orientations = np.empty((4, k))
         self.eta = np.empty((3, k))

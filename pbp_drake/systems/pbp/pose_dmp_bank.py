@@ -277,79 +277,98 @@ class PoseDmpBank(LeafSystem):
         return state[:3], state[3:7] / norm, state[7:10], state[10:13]
 
     def _update(self, context, discrete_state):
-        positions, orientations, period = self._positions, self._orientations, self._period
-        vector = discrete_state.get_mutable_vector(self._state_index).get_mutable_value()
-        phase, held, robot, q, eta_state = split_head(vector)
-        stepping = held[0] == STEPPING
+        vector = discrete_state.get_mutable_value(self._state_index)
         # Every input before the workspace (an input may reach this system's outputs).
-        position, orientation, velocity, angular_velocity = self._robot(context)
+        hand = self._robot(context)
         lock = (self._lock and self._operator_active_port.HasValue(context)
                 and self._operator_active_port.Eval(context)[0] > 0.5)
         goals = self._goals_entry.Eval(context)
         followed = goal_index(self._followed_goal_port, context, self._goal_count)
-        if self._compact and followed is None:
-            raise RuntimeError(
-                "PoseDmpBank with compact_state=True steps every DMP from the followed DMP's "
-                "velocities: connect its followed_goal input port")
-        # The compact state's tail: the phase and `z` the last step started from (`z`, or
-        # the held one).
-        step_phase, step_velocity = compact_inputs(vector) if self._compact else (None, None)
+        if self._compact:
+            if followed is None:
+                raise RuntimeError(
+                    "PoseDmpBank with compact_state=True steps every DMP from the followed "
+                    "DMP's velocities: connect its followed_goal input port")
+            self._update_compact(context, vector, hand, lock, followed)
+        else:
+            self._update_per_goal(context, vector, hand, lock, goals, followed)
+
+    def _update_compact(self, context, vector, hand, lock, followed):
+        """The compact state's update: what the next step starts from (the cache entry
+        takes it, `_calc_stepped`), no work of size K."""
+        phase, held, robot, q, eta = split_head(vector)
+        # The tail: the phase and `z` the last step started from.
+        step_phase, step_velocity = compact_inputs(vector)
+        position, orientation, velocity, angular_velocity = hand
+        if held[0] == STEPPING:
+            # Every DMP continues from the followed DMP's velocities at the end of the last
+            # step: its 12 numbers in one read, and its eta = J(e') z', which the last read
+            # of the selected reference computed when that was the same goal. Held, `z`
+            # and eta stay as they are.
+            numbers, stepped = self._goal_numbers(context, vector, followed)
+            step_velocity[:, 0] = numbers[3:6]
+            eta[:, 0] = (stepped.eta if stepped.eta_goal == followed
+                         else jacobian_of_one_values(numbers[6:9], numbers[9:12]))
+            limit_speeds(step_velocity, self._max_speed, self._positions.duration)
+            limit_speeds(eta, self._max_angular_speed, self._orientations.duration)
+        robot[:, 0] = position
+        q[:, 0] = orientation
+        if lock:
+            # Both phases frozen: the DMPs sit at the hand's pose and follow its twist.
+            held[0] = ON_ROBOT
+            eta[:, 0] = angular_velocity * self._orientations.duration
+            np.multiply(velocity[:, np.newaxis], self._positions.duration, out=step_velocity)
+            return
+        held[0] = STEPPING
+        step_phase[0] = phase[0]
+        phase *= self._decay
+
+    def _update_per_goal(self, context, vector, hand, lock, goals, followed):
+        """The per-goal state's update: every DMP stepped into the state."""
+        positions, orientations, period = self._positions, self._orientations, self._period
+        phase, held, robot, q, eta_state = split_head(vector)
+        stepping = held[0] == STEPPING
+        position, orientation, velocity, angular_velocity = hand
+        stepped, log_state = self._stepped(context, vector)
+        offsets, velocities = stepped
         workspace = self._workspace(context)
         # The DMPs' velocities at the end of the last step, which the step overwrites: the
         # followed one's linear velocity (every DMP continues from it), else each one's,
         # and the orientation part's eta as a column (one for all) or per DMP.
-        if stepping and followed is not None:
-            # The followed DMP's 12 numbers in one read, and its eta = J(e') z': the last
-            # read of the selected reference computed it when that was the same goal.
-            numbers, stepped = self._goal_numbers(context, vector, followed)
+        if followed is not None:
             scaled_velocity, eta = workspace.column, workspace.eta_column
-            scaled_velocity[:, 0] = numbers[3:6]
-            eta[:, 0] = (stepped.eta if stepped is not None and stepped.eta_goal == followed
-                         else jacobian_of_one_values(numbers[6:9], numbers[9:12]))
-            limit_speeds(scaled_velocity, self._max_speed, positions.duration)
-            limit_speeds(eta, self._max_angular_speed, orientations.duration)
-        elif followed is not None:  # held: the followed DMP's `z`, or the compact one
-            scaled_velocity = workspace.column
-            scaled_velocity[:, 0] = (step_velocity[:, 0] if self._compact else
-                                     self._stepped(context, vector)[0][1][:, followed])
-            eta = np.array(eta_state)  # the robot's (locked) or 0 (at the start), (3, 1)
-        else:  # per goal, each DMP its own velocities
-            (_, velocities), log_state = self._stepped(context, vector)
+            if stepping:
+                numbers = self._goal_numbers(context, vector, followed)[0]
+                scaled_velocity[:, 0] = numbers[3:6]
+                eta[:, 0] = jacobian_of_one_values(numbers[6:9], numbers[9:12])
+            else:
+                scaled_velocity[:, 0] = velocities[:, followed]
+                eta[...] = eta_state  # the robot's (locked) or 0 (at the start)
+        else:
             scaled_velocity = workspace.velocities
             np.copyto(scaled_velocity, velocities)
             if stepping:
-                limit_speeds(scaled_velocity, self._max_speed, positions.duration)
                 orientations.orientations_from_log_into(
                     log_state[0], log_state[1], goals[3:], q,
                     workspace.orientations, workspace.eta, workspace.orientation)
                 eta = workspace.eta
-                limit_speeds(eta, self._max_angular_speed, orientations.duration)
             else:
                 eta = np.array(eta_state)
+        if stepping:
+            limit_speeds(scaled_velocity, self._max_speed, positions.duration)
+            limit_speeds(eta, self._max_angular_speed, orientations.duration)
         robot[:, 0] = position
         q[:, 0] = orientation
         if lock:
             # Both phases frozen: the DMPs sit at the hand's pose and follow its twist.
             held[0] = ON_ROBOT
             eta_state[:, 0] = angular_velocity * orientations.duration
-            if self._compact:
-                np.multiply(velocity[:, np.newaxis], positions.duration, out=step_velocity)
-            else:
-                offsets, velocities = self._stepped(context, vector)[0]
-                offsets.fill(0.0)
-                np.multiply(velocity[:, np.newaxis], positions.duration, out=velocities)
+            offsets.fill(0.0)
+            np.multiply(velocity[:, np.newaxis], positions.duration, out=velocities)
             return
         held[0] = STEPPING
-        if self._compact:
-            # What the step starts from; the cache entry takes it (`_calc_stepped`).
-            step_phase[0] = phase[0]
-            step_velocity[...] = scaled_velocity
-            eta_state[...] = eta
-        else:
-            stepped, log_state = self._stepped(context, vector)
-            step_all(positions, orientations, self._shared_basis, phase, robot, q,
-                     scaled_velocity, eta, goals, period, stepped,
-                     log_state, workspace)
+        step_all(positions, orientations, self._shared_basis, phase, robot, q,
+                 scaled_velocity, eta, goals, period, stepped, log_state, workspace)
         phase *= self._decay
 
     def dmp_states(self, context):

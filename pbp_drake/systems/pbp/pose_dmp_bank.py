@@ -263,7 +263,7 @@ class PoseDmpBank(LeafSystem):
         (3,), checked."""
         state = np.asarray(self._robot_state_port.Eval(context), dtype=float)
         # A sum of floats is finite unless a number is NaN or infinite (or the sum
-        # overflows, which the exact check below lets pass): a third of `np.isfinite`'s time.
+        # overflows, which the exact check below lets pass): a fifth of `np.isfinite`'s time.
         if not math.isfinite(sum(state.tolist())):
             bad = [name for name, value in zip(PoseState.get_fields(), state)
                    if not np.isfinite(value)]

@@ -7,6 +7,8 @@ import pytest
 from pydrake.systems.analysis import Simulator
 from test_dmp_bank_compact import GOALS, DT, distinct_bank, drive, shared_bank
 
+from pbp_drake.bench.cases import make_bank
+from pbp_drake.bench.pose_cases import make_pose_case
 from pbp_drake.systems import LikelyGoals
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
 from pbp_drake.systems.pbp.likely_goals import likely_goal_indices
@@ -53,3 +55,24 @@ def test_the_chosen_goals_paths_are_the_all_goal_paths_rows(make_bank):
     chosen.get_predicted_goals_input_port().FixValue(contexts[1], [len(GOALS), 0.0])
     with pytest.raises(ValueError, match="indices must be one or more"):
         chosen.get_predicted_paths_output_port().Eval(contexts[1])
+
+
+@pytest.mark.parametrize("distinct", [False, True], ids=["shared", "distinct"])
+def test_a_pose_banks_subset_rolls_out_its_goals_as_the_whole_bank_does(distinct):
+    # The grasp drawing rolls out the selected DMP alone, from banks of its one DMP.
+    case, orientations, goals, _ = make_pose_case(300, distinct)
+    positions = make_bank(case)
+    phase, stepped, velocity = positions.initial_state()
+    turn_phase, rotations, eta = orientations.initial_state()
+    stepped, eta = stepped + 0.01, eta + 0.1
+    chosen = [123, 7]
+    whole = orientations.predict(turn_phase, rotations, eta, goals.T[3:], 0.05, 30)[chosen]
+    alone = orientations.subset(chosen).predict(
+        turn_phase[chosen], rotations[:, chosen], eta[:, chosen], goals.T[3:, chosen], 0.05, 30)
+    np.testing.assert_allclose(alone, whole, atol=1e-12)  # BLAS may sum in another order
+    whole = positions.predict(phase, stepped, velocity, goals.T[:3], 0.05, 30)[chosen]
+    alone = positions.subset(chosen).predict(
+        phase[chosen], stepped[:, chosen], velocity[:, chosen], goals.T[:3, chosen], 0.05, 30)
+    np.testing.assert_array_equal(alone, whole)
+    with pytest.raises(ValueError, match="indices must be one or more"):
+        orientations.subset([300])

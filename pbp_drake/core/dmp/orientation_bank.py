@@ -264,6 +264,21 @@ class OrientationDmpBank:
         self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
                         out_phase, out_orientations, out_velocity, workspace)
 
+    def subset(self, indices):
+        """The bank of the DMPs `indices` (M,) alone, in that order: a new immutable bank
+        with the same duration and settings and those DMPs' weights, starts and amplitude
+        scaling (as `DmpBankModel.subset`)."""
+        indices = np.asarray(indices).reshape(-1)
+        if (indices.size == 0 or not np.issubdtype(indices.dtype, np.integer)
+                or indices.min() < 0 or indices.max() >= self.goal_count):
+            raise ValueError(f"indices must be one or more of the bank's goal indices 0 to "
+                             f"{self.goal_count - 1}, got {indices.tolist()}")
+        weights = self._weights
+        if not self.shared_weights:  # (N, 3 K) back to (M, N, 3)
+            weights = weights.reshape(len(weights), AXES, -1)[:, :, indices].transpose(2, 0, 1)
+        return type(self)(weights, self.starts[:, indices].T, self.duration, self._settings,
+                          self.amplitude_scaling[:, indices].T, goal_count=indices.size)
+
     def predict(self, phase, orientation, scaled_angular_velocity, goals_4k, dt, steps,
                 workspace=None):
         """Open-loop orientations `(K, steps + 1, 4)` from one state (inputs left alone)."""

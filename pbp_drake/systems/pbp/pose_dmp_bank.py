@@ -440,12 +440,14 @@ class PoseDmpBank(LeafSystem):
         if k is None:
             k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
         phase, positions, orientations, velocity, eta = self.dmp_states(context)
-        goals = self._goals_entry.Eval(context)
-        # The banks roll out all K DMPs (their `predict` is vectorised over K); only the
-        # selected one is drawn. Read at a visualizer's rate (10 Hz), the cost is small.
+        goals = self._goals_entry.Eval(context)[:, [k]]
+        # The selected DMP alone is rolled out (banks of its one DMP): the same path as
+        # rolling out all K and picking it, at a cost that does not grow with K.
         dt, steps = self._prediction_period, self._prediction_steps
-        path = self._positions.predict(phase, positions, velocity, goals[:3], dt, steps)[k]
-        turns = self._orientations.predict(phase, orientations, eta, goals[3:], dt, steps)[k]
+        path = self._positions.subset([k]).predict(
+            phase[[k]], positions[:, [k]], velocity[:, [k]], goals[:3], dt, steps)[0]
+        turns = self._orientations.subset([k]).predict(
+            phase[[k]], orientations[:, [k]], eta[:, [k]], goals[3:], dt, steps)[0]
         output.SetFromVector(np.hstack([path, turns]).reshape(-1))
 
 

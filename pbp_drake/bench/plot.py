@@ -33,13 +33,20 @@ def plot_control_rate(rows, path):
     axes.text(1, 1100, "1 kHz", color="grey")
     axes.text(1, 33, "30 Hz (paper)", color="grey")
     axes.plot([100], [30], "k*", ms=12, label="paper, Fig. 6c: 100 DMPs at 30 Hz")
+    return _save(figure, axes, path, "goals K (one DMP each)",
+                 "control rate reached (Hz) = 1 / step time",
+                 f"DMP bank step, D = {dimension}, N = {BASIS} basis functions", "lower left")
+
+
+def _save(figure, axes, path, xlabel, ylabel, title, legend_at):
+    """Log-log axes with their labels, grid and legend, saved to `path` (returned)."""
     axes.set_xscale("log")
     axes.set_yscale("log")
-    axes.set_xlabel("goals K (one DMP each)")
-    axes.set_ylabel("control rate reached (Hz) = 1 / step time")
-    axes.set_title(f"DMP bank step, D = {dimension}, N = {BASIS} basis functions")
+    axes.set_xlabel(xlabel)
+    axes.set_ylabel(ylabel)
+    axes.set_title(title)
     axes.grid(True, which="both", alpha=0.3)
-    axes.legend(fontsize=8, loc="lower left")
+    axes.legend(fontsize=8, loc=legend_at)
     figure.tight_layout()
     figure.savefig(path, dpi=120)
     plt.close(figure)
@@ -64,14 +71,5 @@ def plot_scaling(closed_loop, path):
     axes.axhline(1.0, color="grey", lw=0.8, ls="--")
     axes.text(0.99, 1.03, "real time", color="grey", ha="right", va="bottom",
               transform=axes.get_yaxis_transform())
-    axes.set_xscale("log")
-    axes.set_yscale("log")
-    axes.set_xlabel("goals K")
-    axes.set_ylabel("real-time factor (simulated s / wall s)")
-    axes.set_title("Closed loop, HSR tasks (virtual participant, PBP-Alt)")
-    axes.grid(True, which="both", alpha=0.3)
-    axes.legend(fontsize=8, loc="best")
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
-    return path
+    return _save(figure, axes, path, "goals K", "real-time factor (simulated s / wall s)",
+                 "Closed loop, HSR tasks (virtual participant, PBP-Alt)", "best")

@@ -42,7 +42,8 @@ class GraspSceneVisualizer(LeafSystem):
     `likely_triads` triads `/task/likely_grasps/{i}` that each path period moves to the
     selected grasp and the likeliest others (`goal_probabilities`), with
     `time_in_recording`. Every grasp position is also a point of the goal cloud
-    `/task/goal_cloud` (`GoalCloud`), coloured each `cloud_period` by its probability, as
+    `/task/goal_cloud` (`GoalCloud`), coloured each `cloud_period` (or less often for
+    thousands of grasps: `GoalCloud.period`) by its probability, as
     in the reaching task. Each publish moves the yellow ball above the `target`'s object
     (`Target`; its index picks the object) and the blue ball above the `selected_goal`'s,
     and the hand's triad `/task/hand` to `hand_state` (`PoseState`), with
@@ -81,7 +82,8 @@ class GraspSceneVisualizer(LeafSystem):
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)
         if not self._solid:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_likely_grasps)
-        self.DeclarePeriodicPublishEvent(cloud_period, 0.0, self._publish_cloud)
+        self.DeclarePeriodicPublishEvent(self._cloud.period(cloud_period), 0.0,
+                                         self._publish_cloud)
         self.DeclareInitializationPublishEvent(self._initialise)
 
     def get_target_input_port(self):

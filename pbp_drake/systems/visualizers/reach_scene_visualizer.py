@@ -63,7 +63,8 @@ class ReachSceneVisualizer(LeafSystem):
     `predicted_paths` orders them) are drawn as dots (`PathDots`, with
     `time_in_recording`, so a replay shows each path where it was at that time): the
     first bold `/task/predictions/selected`, the others faint
-    `/task/predictions/likely/{i}`. Each `cloud_period` (default 0.25 s) the cloud's points
+    `/task/predictions/likely/{i}`. Each `cloud_period` (default 0.25 s; for thousands of
+    objects less often, `GoalCloud.period`) the cloud's points
     take the colour of their goal's probability (`goal_probabilities`, K), grey to blue,
     sent again only when a colour changed; a recording keeps the cloud's last colours only
     (Meshcat records transforms and properties, not objects), the paths as they went.
@@ -99,7 +100,8 @@ class ReachSceneVisualizer(LeafSystem):
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)
-        self.DeclarePeriodicPublishEvent(cloud_period, 0.0, self._publish_cloud)
+        self.DeclarePeriodicPublishEvent(self._cloud.period(cloud_period), 0.0,
+                                         self._publish_cloud)
         self.DeclareInitializationPublishEvent(self._initialise)
 
     def get_target_input_port(self):

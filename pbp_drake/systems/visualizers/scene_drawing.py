@@ -158,6 +158,10 @@ class PathTrail:
 # The goal cloud's colours: a goal of no probability grey, the most probable one blue.
 UNLIKELY_RGB = np.array([150.0, 150.0, 150.0])
 LIKELY_RGB = np.array([25.0, 75.0, 255.0])
+# A page rebuilds the whole cloud each time it is sent (Meshcat sends objects whole): at
+# most this many points a second keep a page in software rendering in step with 10,000
+# goals (sent every 0.25 s, its status fell up to 2 s behind).
+CLOUD_POINTS_PER_SECOND = 4000
 
 
 def cloud_point_size(points, largest):
@@ -186,6 +190,11 @@ class GoalCloud:
         self._cloud.mutable_xyzs()[:] = points.T
         self._point_size = float(point_size)
         self._sent = None  # the colours last sent, (3, K) bytes
+
+    def period(self, shortest):
+        """How often (s) to offer the cloud new colours: every `shortest` seconds, or less
+        often for so many points that it would exceed `CLOUD_POINTS_PER_SECOND`."""
+        return max(float(shortest), self._cloud.size() / CLOUD_POINTS_PER_SECOND)
 
     def draw(self, meshcat):
         """Sends the cloud with every goal equally likely (blue)."""

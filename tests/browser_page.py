@@ -8,6 +8,7 @@ where chromium or Playwright is missing).
 
 import contextlib
 import io
+import json
 import queue
 import re
 import shutil
@@ -15,6 +16,7 @@ import socket
 import subprocess
 import threading
 import time
+import urllib.request
 
 import matplotlib.image
 import numpy as np
@@ -112,6 +114,14 @@ def free_port():
     with socket.socket() as probe:
         probe.bind(("localhost", 0))
         return probe.getsockname()[1]
+
+
+def simulated_time(port, token):
+    """The run's simulated time, as the page front's `/pbp/state` (what the panel fetches)
+    says it now."""
+    with urllib.request.urlopen(f"http://localhost:{port}/pbp/state?token={token}",
+                                timeout=10) as response:
+        return json.loads(response.read())["time"]
 
 
 class Output:

@@ -38,7 +38,8 @@ from pbp_drake.systems.visualizers import (
 __all__ = [
     # The PBP loop.
     "Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource", "HandOver",
-    "HeadingCommand", "LikelyGoals", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver",
+    "HeadingCommand", "LikelyGoals", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator",
+    "PoseHandOver",
     # The shared-autonomy baselines (HOP, policy blending) and PBP's maxent_command estimator.
     "HopAssistance", "MaxEntGoalEstimator", "PoseHopAssistance", "PoseMaxEntGoalEstimator",
     # Operators.

@@ -2,13 +2,12 @@
 `--goals 10000` in headless Chromium keeps real time from Start on, and the page's status
 keeps up with the simulation (the page is sent what a few goals' page is sent)."""
 
-import json
 import sys
 import time
-import urllib.request
 
 import pytest
-from browser_page import NEEDS_BROWSER, click, console_line, free_port, open_page, running
+from browser_page import (
+    NEEDS_BROWSER, click, console_line, free_port, open_page, running, simulated_time)
 
 pytestmark = NEEDS_BROWSER
 
@@ -18,9 +17,7 @@ MAX_LAG = 1.0  # s
 
 
 def server_time(port):
-    with urllib.request.urlopen(f"http://localhost:{port}/pbp/state?token={TOKEN}",
-                                timeout=10) as response:
-        return json.loads(response.read())["time"]
+    return simulated_time(port, TOKEN)
 
 
 @pytest.mark.timeout(240)

@@ -7,14 +7,13 @@ just before the page's own status is read: the sum `server - page` is a lower bo
 lag at that moment, so a page that fell behind fails the test however slow the reading.
 """
 
-import json
 import re
 import sys
 import time
-import urllib.request
 
 import pytest
-from browser_page import NEEDS_BROWSER, click, console_line, free_port, open_page, running
+from browser_page import (
+    NEEDS_BROWSER, click, console_line, free_port, open_page, running, simulated_time)
 
 pytestmark = NEEDS_BROWSER
 
@@ -25,9 +24,7 @@ MAX_LAG = 1.0  # s
 
 
 def server_time(port):
-    with urllib.request.urlopen(f"http://localhost:{port}/pbp/state?token={TOKEN}",
-                                timeout=10) as response:
-        return json.loads(response.read())["time"]
+    return simulated_time(port, TOKEN)
 
 
 @pytest.mark.timeout(240)

@@ -2,9 +2,10 @@
 in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`) and the six-DoF
 pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`, `PoseHandOver`); the goals'
 source, the heading command of the HSR tasks, the demonstration player of explicit
-arbitration and the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy baselines' systems: HOP's goal posterior on the
-operator's command (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`, also PBP's
-``maxent_command`` estimator) and its assistance (`HopAssistance`, `PoseHopAssistance`)."""
+arbitration and the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy
+baselines' systems: HOP's goal posterior on the operator's command (`MaxEntGoalEstimator`,
+`PoseMaxEntGoalEstimator`, also PBP's ``maxent_command`` estimator) and its assistance
+(`HopAssistance`, `PoseHopAssistance`)."""
 
 from pbp_drake.systems.pbp.blender import Blender
 from pbp_drake.systems.pbp.demonstration_player import DemonstrationPlayer

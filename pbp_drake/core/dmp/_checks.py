@@ -23,6 +23,17 @@ def positive(value, name):
     return float(value)
 
 
+def goal_indices(indices, goal_count):
+    """`indices` as a flat integer array, refused unless one or more of `goal_count` goals'
+    indices (0 to K - 1)."""
+    indices = np.asarray(indices).reshape(-1)
+    if (indices.size == 0 or not np.issubdtype(indices.dtype, np.integer)
+            or indices.min() < 0 or indices.max() >= goal_count):
+        raise ValueError(f"indices must be one or more of the bank's goal indices 0 to "
+                         f"{goal_count - 1}, got {indices.tolist()}")
+    return indices
+
+
 def broadcast_goalwise(values, goal_count, dimension, name):
     """Per-goal rows `(K, D)` (or one row `(D,)` for all goals) as a new `(D, K)` array."""
     values = np.asarray(values, dtype=float)

@@ -13,7 +13,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
-from pbp_drake.core.dmp._checks import as_point, broadcast_goalwise, positive
+from pbp_drake.core.dmp._checks import as_point, broadcast_goalwise, goal_indices, positive
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
 from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import Dmp
@@ -277,11 +277,7 @@ class DmpBankModel(BankStep):
         """The bank of the DMPs `indices` (M,) alone, in that order: a new immutable bank
         with the same duration and settings and those DMPs' weights, starts and amplitude
         scaling (what drawing a few of K DMPs' paths steps, instead of all K)."""
-        indices = np.asarray(indices).reshape(-1)
-        if (indices.size == 0 or not np.issubdtype(indices.dtype, np.integer)
-                or indices.min() < 0 or indices.max() >= self.goal_count):
-            raise ValueError(f"indices must be one or more of the bank's goal indices 0 to "
-                             f"{self.goal_count - 1}, got {indices.tolist()}")
+        indices = goal_indices(indices, self.goal_count)
         starts = self.starts[:, indices].T
         scaling = self.amplitude_scaling[:, indices].T
         weights = (self._weights if self.shared_weights

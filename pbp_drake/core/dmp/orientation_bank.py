@@ -23,7 +23,7 @@ import functools
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp._checks import positive
+from pbp_drake.core.dmp._checks import goal_indices, positive
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
     AXES, fit_orientation_weights, straight_weights,
@@ -268,11 +268,7 @@ class OrientationDmpBank:
         """The bank of the DMPs `indices` (M,) alone, in that order: a new immutable bank
         with the same duration and settings and those DMPs' weights, starts and amplitude
         scaling (as `DmpBankModel.subset`)."""
-        indices = np.asarray(indices).reshape(-1)
-        if (indices.size == 0 or not np.issubdtype(indices.dtype, np.integer)
-                or indices.min() < 0 or indices.max() >= self.goal_count):
-            raise ValueError(f"indices must be one or more of the bank's goal indices 0 to "
-                             f"{self.goal_count - 1}, got {indices.tolist()}")
+        indices = goal_indices(indices, self.goal_count)
         weights = self._weights
         if not self.shared_weights:  # (N, 3 K) back to (M, N, 3)
             weights = weights.reshape(len(weights), AXES, -1)[:, :, indices].transpose(2, 0, 1)

@@ -49,6 +49,14 @@ class OutputPathError(ScenarioError):
     """An output path that cannot, or may not, be written."""
 
 
+def recorded_replay(meshcat):
+    """Ends `meshcat`'s recording and returns its replay page as `pbp-drake run --record`
+    saves it (`mark_replay` of Meshcat's StaticHtml with the recording published)."""
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    return mark_replay(meshcat.StaticHtml())
+
+
 def mark_replay(html):
     """The replay `html` (Meshcat's StaticHtml) as `pbp-drake run --record` saves it: with
     REPLAY_MARKER after its doctype, so that a later run may overwrite it; starting paused

@@ -1,13 +1,12 @@
 """Replay size: a reach run recorded as `pbp-drake run --record` records it (Meshcat's
-`StartRecording(frames_per_second=30)` after the build, the run, `StopRecording`,
-`PublishRecording`, and the page `mark_replay(meshcat.StaticHtml())` saved), its size in
-bytes for each K."""
+`StartRecording(frames_per_second=30)` after the build, the run, and the page
+`output_paths.recorded_replay` makes), its size in bytes for each K."""
 
 import time
 
 from pbp_drake.bench.closed_loop import build_simulator, new_meshcat
 from pbp_drake.bench.scenes import REACH
-from pbp_drake.output_paths import mark_replay
+from pbp_drake.output_paths import recorded_replay
 
 REPLAY_GOALS = (4, 1000)
 REPLAY_SECONDS = 5.0
@@ -19,9 +18,7 @@ def replay_size(goal_count, simulated_seconds=REPLAY_SECONDS, task=REACH):
     began = time.perf_counter()
     simulator, _, _ = build_simulator(task, goal_count, meshcat, start_recording=True)
     simulator.AdvanceTo(simulated_seconds)
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
-    page = mark_replay(meshcat.StaticHtml())
+    page = recorded_replay(meshcat)
     return {"task": task, "goals": goal_count, "bytes": len(page.encode()),
             "simulated_s": simulator.get_context().get_time(),
             "wall_s": time.perf_counter() - began}

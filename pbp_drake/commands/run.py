@@ -22,7 +22,7 @@ from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage, st
 from pbp_drake.core.reach_task import sample_grid_scene
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.output_paths import (
-    check_log_path, check_output_folder, check_record_path, mark_replay)
+    check_log_path, check_output_folder, check_record_path, recorded_replay)
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, GraspTask, MultiGoalReach, ScenarioError, TASK_ROBOTS,
     counted, load_scenario_file, resolve)
@@ -543,11 +543,9 @@ def _wait_for_browser(page, seconds, needed=None):
 
 
 def _save_recording(meshcat, path):
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
     record = pathlib.Path(path)
     record.parent.mkdir(parents=True, exist_ok=True)
-    record.write_text(mark_replay(meshcat.StaticHtml()))
+    record.write_text(recorded_replay(meshcat))
     print(f"Replay saved to {record}")
 
 

@@ -186,10 +186,10 @@ def test_many_goals_are_one_cloud_coloured_by_probability_sent_only_when_it_chan
     finally:
         GoalCloud.show = original
     assert meshcat.HasPath("/task/goal_cloud") and not meshcat.HasPath("/task/tables/0")
-    # Drawn uniform, coloured at initialisation, and again once at 1 s: three sends in
-    # 2 s, whatever the 0.25 s period would allow (nine).
-    assert len(sent) == 3
-    assert np.argmax(sent[1]) == 0 and np.argmax(sent[2]) == 7
+    # Drawn in its colours at initialisation, and again once at 1 s: two sends in 2 s,
+    # whatever the 0.25 s period would allow (nine).
+    assert len(sent) == 2
+    assert np.argmax(sent[0]) == 0 and np.argmax(sent[1]) == 7
 
 
 def test_the_cloud_colours_the_most_probable_goal_blue_and_the_unlikely_grey():

@@ -13,7 +13,7 @@ from pbp_drake.systems.visualizers.reach_scene_visualizer import (
     CLOUD_POINT_SIZE, ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, SOLID_OBJECTS,
     TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
 from pbp_drake.systems.visualizers.scene_drawing import (
-    GoalCloud, PathTriads, cloud_point_size, draw_triad, pose_transform)
+    GoalCloud, PathTriads, draw_triad, pose_transform)
 
 # Triads: the grasp poses' and the hand's full size, the predicted path's smaller and a
 # little transparent, so that the grasp they lead to stands out.
@@ -75,8 +75,7 @@ class GraspSceneVisualizer(LeafSystem):
                                 TRIAD_RADIUS, PATH_TRIAD_OPACITY)
         self._solid = count <= SOLID_OBJECTS
         self._likely_triads = min(int(likely_triads), count)
-        self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions,
-                                cloud_point_size(grasps.grasp_positions, CLOUD_POINT_SIZE))
+        self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions, CLOUD_POINT_SIZE)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)
@@ -114,7 +113,7 @@ class GraspSceneVisualizer(LeafSystem):
         meshcat, grasps = self._meshcat, self._grasps
         meshcat.Delete("/task")
         radius, height = self._object_shape
-        self._cloud.draw(meshcat)
+        self._cloud.restart()  # drawn by the `_publish_cloud` that follows
         for index in range(0 if self._solid else self._likely_triads):
             draw_triad(meshcat, f"/task/likely_grasps/{index}", None, TRIAD_LENGTH,
                        TRIAD_RADIUS, opacity=1.0 if index == 0 else 0.5)
@@ -187,5 +186,5 @@ class GraspSceneVisualizer(LeafSystem):
             self._meshcat.SetProperty(path, "visible", shown, time)
 
     def _publish_cloud(self, context):
-        if self._probabilities_port.HasValue(context):
-            self._cloud.show(self._meshcat, self._probabilities_port.Eval(context))
+        port = self._probabilities_port
+        self._cloud.show(self._meshcat, port.Eval(context) if port.HasValue(context) else None)

@@ -7,7 +7,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.ports import EeState, Target, position_of
-from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots, cloud_point_size
+from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
 TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
@@ -96,7 +96,7 @@ class ReachSceneVisualizer(LeafSystem):
                                       OTHER_DOT_RADIUS, OTHER_PATH_COLOUR)
                              for index in range(1, path_count)]
         self._cloud = GoalCloud("/task/goal_cloud", self._objects + [0.0, 0.0, CLOUD_LIFT],
-                                cloud_point_size(self._objects, CLOUD_POINT_SIZE))
+                                CLOUD_POINT_SIZE)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)
@@ -132,7 +132,7 @@ class ReachSceneVisualizer(LeafSystem):
     def _draw_scene(self):
         meshcat = self._meshcat
         meshcat.Delete("/task")
-        self._cloud.draw(meshcat)
+        self._cloud.restart()  # drawn by the `_publish_cloud` that follows
         for index, point in enumerate(self._objects if len(self._objects) <= SOLID_OBJECTS
                                       else ()):
             table_height = point[2] - OBJECT_HEIGHT / 2
@@ -180,5 +180,5 @@ class ReachSceneVisualizer(LeafSystem):
             dots.show(self._meshcat, path, time)
 
     def _publish_cloud(self, context):
-        if self._probabilities_port.HasValue(context):
-            self._cloud.show(self._meshcat, self._probabilities_port.Eval(context))
+        port = self._probabilities_port
+        self._cloud.show(self._meshcat, port.Eval(context) if port.HasValue(context) else None)

@@ -180,15 +180,16 @@ class GoalCloud:
     grey (`UNLIKELY_RGB`) to blue (`LIKELY_RGB`).
 
     `show` sends the cloud again only when a colour changed (colours are bytes, so a
-    change too small to see sends nothing). What was sent is kept here, not in a Drake
-    context: `draw` starts again, and one simulation at a time may use it."""
+    change too small to see sends nothing). Its points are `cloud_point_size(points,
+    largest_point_size)` wide. What was sent is kept here, not in a Drake context:
+    `restart` forgets it, and one simulation at a time may use it."""
 
-    def __init__(self, root, points, point_size):
+    def __init__(self, root, points, largest_point_size):
         self.root = root
         points = np.asarray(points, dtype=float)
         self._cloud = PointCloud(len(points), Fields(BaseField.kXYZs | BaseField.kRGBs))
         self._cloud.mutable_xyzs()[:] = points.T
-        self._point_size = float(point_size)
+        self._point_size = cloud_point_size(points, largest_point_size)
         self._sent = None  # the colours last sent, (3, K) bytes
 
     def period(self, shortest):
@@ -196,14 +197,15 @@ class GoalCloud:
         often for so many points that it would exceed `CLOUD_POINTS_PER_SECOND`."""
         return max(float(shortest), self._cloud.size() / CLOUD_POINTS_PER_SECOND)
 
-    def draw(self, meshcat):
-        """Sends the cloud with every goal equally likely (blue)."""
+    def restart(self):
+        """Forgets what was sent (the page's scene was deleted): the next `show` sends."""
         self._sent = None
-        self.show(meshcat, np.ones(self._cloud.size()))
 
-    def show(self, meshcat, probabilities):
-        """Colours the points by `probabilities` (K) and sends the cloud if a colour changed."""
-        probabilities = np.asarray(probabilities, dtype=float)
+    def show(self, meshcat, probabilities=None):
+        """Colours the points by `probabilities` (K; None: every goal equally likely, blue)
+        and sends the cloud if it was not sent since `restart` or a colour changed."""
+        probabilities = (np.ones(self._cloud.size()) if probabilities is None
+                         else np.asarray(probabilities, dtype=float))
         largest = probabilities.max()
         share = probabilities / largest if largest > 0 else np.ones_like(probabilities)
         colours = np.rint(UNLIKELY_RGB[:, None] + (LIKELY_RGB - UNLIKELY_RGB)[:, None]

@@ -49,6 +49,10 @@ class VirtualParticipantParams:
     #: another object, it goes to the target itself: it turns the target to its side and
     #: sidesteps toward it (the forward key is disabled), until the estimate follows.
     insist_time: float = 1.0
+    #: Assisting with a bounded wrist or keys that move the hand up and down, it moves the
+    #: hand to where the tool can point at the target (`reposition_motion`) at most this
+    #: long (s) for one target; still unable to, it goes to the target itself.
+    reposition_time: float = 4.0
     #: Once it takes control among obstacles, it keeps it at least this long (s).
     hold_time: float = 0.5
     #: How it is impaired: motor noise, a delay of its commands, wrong first choices of

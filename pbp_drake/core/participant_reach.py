@@ -20,6 +20,13 @@ the start. `assist_motion` serves all three with one behaviour:
   them apart), it goes to the target itself as far as the keys allow: it turns the target
   to its side and sidesteps toward it, slowing near it as when driving.
 
+Where turning cannot show the target (an arm's wrist turns the tool only so far, and a
+target behind or beside the tool, or one more above or below the hand than beside it, has
+no heading the tool can take: `can_point_at`), it first moves the hand to where it can
+(`reposition_motion`): it backs away, and moves up or down toward the target's height,
+turning the tool as far toward the target as the wrist goes. The HSR's base turns all the
+way round, so on its floor-plane tasks every target can be pointed at and nothing differs.
+
 With `vertical=True` (a task whose objects stand at different heights, and keys that move
 the hand up and down) the velocities are 3-vectors `(vx, vy, vz)` instead of floor
 2-vectors. Driving (`drive_motion`) it heads for the target in 3-D. Assisting
@@ -116,6 +123,48 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
     else:
         velocity = speed * without_forward(unit(toward_target - toward_picked), heading)
     return velocity, turn_rate(params, heading_error(heading, position, target))
+
+
+def can_point_at(params, position, target, heading_range=None, vertical=False):
+    """Whether turning the tool, within `heading_range` (low, high) (None: all the way
+    round), can point it at `target` (3) from `position` (3): the floor direction to the
+    target lies within the range (give or take `aligned_angle`), and, with `vertical`
+    motion, the target stands no more above or below the hand than beside it (straight
+    above, its floor direction is no direction at all: the least motion swings it)."""
+    offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
+    if vertical and np.linalg.norm(offset[:2]) < abs(offset[2]):
+        return False
+    if heading_range is None:
+        return True
+    low, high = heading_range
+    middle = 0.5 * (low + high)
+    bearing = wrap_angle(np.arctan2(offset[1], offset[0]) - middle)
+    return abs(float(bearing)) <= 0.5 * (high - low) + params.aligned_angle
+
+
+def reposition_motion(params, speed, position, heading, target, heading_range=None,
+                      vertical=False):
+    """The velocity (2, or 3 with `vertical`) and yaw rate that move the hand to where the
+    tool can point at `target` (`can_point_at` false): with the target's floor direction
+    beyond `heading_range`, back along the range's middle direction (never forward: the
+    tool points within a quarter turn of it); with the target more above or below than
+    beside, toward its height; both at once combined into `speed`. It turns the tool to
+    the heading in the range nearest the target's direction, to point at it once it can."""
+    offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
+    velocity = np.zeros(3)
+    wanted_heading = float(np.arctan2(offset[1], offset[0]))
+    if heading_range is not None:
+        low, high = heading_range
+        middle, half = 0.5 * (low + high), 0.5 * (high - low)
+        bearing = float(wrap_angle(wanted_heading - middle))
+        if abs(bearing) > half + params.aligned_angle:
+            velocity[:2] = -facing(middle)
+        wanted_heading = middle + float(np.clip(bearing, -half, half))
+    if vertical and np.linalg.norm(offset[:2]) < abs(offset[2]):
+        velocity[2] = np.sign(offset[2])
+    velocity = speed * unit(velocity)
+    yaw_rate = turn_rate(params, float(wrap_angle(wanted_heading - heading)))
+    return (velocity if vertical else velocity[:2]), yaw_rate
 
 
 def insisting_side_heading(heading, position, target):

@@ -505,7 +505,8 @@ MOST_PLAN_TIMES = 100
 
 
 def check_virtual_participant(operator, field="scenario.operator"):
-    """The obstacle fields of `operator: !VirtualParticipant` (`VirtualParticipantParams`):
+    """The obstacle fields and `reposition_time` of `operator: !VirtualParticipant`
+    (`VirtualParticipantParams`):
     times, rates and steps positive, distances, weights and factors not negative,
     `plan_directions` a count and `plan_times` positive times that increase; and its
     `impairment` (`ParticipantImpairment.problem`: levels and times finite and not
@@ -518,7 +519,8 @@ def check_virtual_participant(operator, field="scenario.operator"):
         "policy_compensation", "progress_step", "stall_time"))
     require_finite(operator, field, (
         "final_approach_radius", "push_through_radius", "turn_weight", "keep_on_weight",
-        "release_factor", "goal_margin_factor", "min_closing_fraction"), positive=False)
+        "release_factor", "goal_margin_factor", "min_closing_fraction", "reposition_time"),
+        positive=False)
     directions = operator.plan_directions
     if isinstance(directions, bool) or not isinstance(directions, numbers.Integral):
         raise ScenarioError(f"{field}.plan_directions {directions!r} is no count; expected "

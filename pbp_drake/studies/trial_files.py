@@ -75,7 +75,8 @@ def plain(value):
 # Fields added to the schema after studies were run, left out of the content while at their
 # defaults: the trials of a scenario that does not use them are the same as before, and its
 # study folders still resume. None: the scenario's own fields.
-_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45}, None: {"likely_paths": 3}}
+_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45},
+                 "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3}}
 
 
 def scenario_content(scenario):

@@ -8,7 +8,8 @@ from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_o
 from pbp_drake.core.participant_impairment import (
     delay_ticks, first_choice, initial_motor_noise, is_noisy, next_motor_noise)
 from pbp_drake.core.participant_reach import (
-    assist_motion, drive_motion, faces_target, without_forward)
+    assist_motion, can_point_at, drive_motion, faces_target, reposition_motion,
+    without_forward)
 from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
 from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.operators.participant_avoidance import (
@@ -56,9 +57,13 @@ class VirtualOperator(SampledOperator):
     participant planar: the two are refused together.
 
     `heading_range` (low, high) is how far the hand turns (an arm's wrist; None: all the
-    way, as the HSR's base). Turned to a bound with the target still beyond it, the
-    participant counts as facing it as far as it can, so it insists after `insist_time`
-    as it would facing it (the target behind the tool, it backs to it). `fixed_base` (x, y)
+    way, as the HSR's base). Assisting, where the tool cannot point at the target (its
+    direction beyond the range, or, with `vertical`, the target more above or below the
+    hand than beside it: `participant_reach.can_point_at`), the participant first moves the
+    hand to where it can (`participant_reach.reposition_motion`: it backs away, and moves
+    toward the target's height), for at most `reposition_time` a target, and then goes to
+    the target itself as when insisting. Under PBP-Cont it pushes against the DMP's pull
+    while it does, as when insisting. `fixed_base` (x, y)
     is a fixed-base arm's base: its footprint among obstacles is then the arm from there to
     the hand (`footprint_clearance`), not the HSR's base and arm.
 
@@ -151,10 +156,12 @@ class VirtualOperator(SampledOperator):
         # What the participant believes: the target index it knows and how many ticks a
         # different target has been on screen.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
-        # Assisting in the reaching task: the target it counts for and how many ticks it has
-        # faced it while the estimate named another object (`insist_time`).
-        self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        # Assisting in the reaching task: the target it counts for, how many ticks it has
+        # faced it while the estimate named another object (`insist_time`) and how many it
+        # has moved the hand to where the tool can point at it (`reposition_time`).
+        self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0]))
         self._insist_ticks = int(round(params.insist_time / control_period))
+        self._reposition_ticks = int(round(params.reposition_time / control_period))
         # The motor noise of `impairment`, [vx, vy, yaw rate] (and vz last when vertical:
         # drawn after the others, it leaves theirs as they are), runs every tick.
         self._noise_scales = None
@@ -405,13 +412,21 @@ class VirtualOperator(SampledOperator):
         noise_angle, speed_scale = self._noise(context)
         if self._mode == "assist":
             selected = int(round(self._selected_goal_port.Eval(context)[0]))
-            insisting = self._count_insistence(context, discrete_state, known_target,
-                                               selected, position, heading, target_position)
+            insisting, repositioning = self._count_insistence(
+                context, discrete_state, known_target, selected, position, heading,
+                target_position)
             if selected == known_target:
                 return np.zeros(4), False
-            velocity, yaw_rate = assist_motion(
-                self.params, self._speed, position, heading, target_position,
-                self._objects[selected], insisting, vertical=self._vertical)
+            if repositioning:
+                velocity, yaw_rate = reposition_motion(
+                    self.params, self._speed, position, heading, target_position,
+                    self._heading_range, vertical=self._vertical)
+            else:
+                velocity, yaw_rate = assist_motion(
+                    self.params, self._speed, position, heading, target_position,
+                    self._objects[selected], insisting, vertical=self._vertical)
+            # Going where the DMP does not, it pushes against the DMP's pull (PBP-Cont).
+            insisting = insisting or repositioning
         else:
             insisting = False
             reached = (np.linalg.norm(target_position - position) if self._vertical
@@ -460,30 +475,25 @@ class VirtualOperator(SampledOperator):
             command *= limit / norm
         return command
 
-    def _turned_as_far_as_it_goes(self, position, heading, target_position):
-        """Whether the hand is at a bound of `heading_range` (within `aligned_angle`) with
-        the target's direction beyond it."""
-        if self._heading_range is None:
-            return False
-        low, high = self._heading_range
-        # Measured from the range's middle, so that a range across +-pi reads the same.
-        offset = float(wrap_angle(heading - 0.5 * (low + high)))
-        reach = 0.5 * (high - low) - self.params.aligned_angle
-        error = heading_error(heading, position, target_position)
-        return (offset >= reach and error > 0) or (offset <= -reach and error < 0)
-
     def _count_insistence(self, context, discrete_state, known_target, selected, position,
                           heading, target_position):
-        """Whether it has faced `known_target` `insist_time` while the estimate named another
-        object; it keeps insisting on that target, once it has, until a new one appears
-        (turning back to face it would only undo what it has gained)."""
-        counted_target, ticks = context.get_discrete_state(self._insist_index).value()
+        """`(insisting, repositioning)`: whether it has faced `known_target` `insist_time`,
+        or moved the hand toward where the tool can point at it `reposition_time`, while the
+        estimate named another object; it keeps insisting on that target, once it has, until
+        a new one appears (turning back to face it would only undo what it has gained).
+        Otherwise, whether the tool cannot point at the target from where the hand is, so
+        that it moves the hand first (`participant_reach.can_point_at`)."""
+        counted_target, ticks, moved = context.get_discrete_state(self._insist_index).value()
         if counted_target != known_target:
-            counted_target, ticks = known_target, 0.0
-        insisting = ticks >= self._insist_ticks
-        if (not insisting and selected != known_target
-                and (faces_target(self.params, position, heading, target_position)
-                     or self._turned_as_far_as_it_goes(position, heading, target_position))):
-            ticks += 1.0
-        discrete_state.set_value(self._insist_index, [counted_target, ticks])
-        return insisting
+            counted_target, ticks, moved = known_target, 0.0, 0.0
+        insisting = ticks >= self._insist_ticks or moved >= self._reposition_ticks
+        repositioning = False
+        if not insisting and selected != known_target:
+            if not can_point_at(self.params, position, target_position, self._heading_range,
+                                self._vertical):
+                repositioning = True
+                moved += 1.0
+            elif faces_target(self.params, position, heading, target_position):
+                ticks += 1.0
+        discrete_state.set_value(self._insist_index, [counted_target, ticks, moved])
+        return insisting, repositioning

@@ -7,12 +7,13 @@ import dataclasses
 
 import numpy as np
 import pytest
-from pydrake.systems.analysis import Simulator
 
 from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_reach import assist_motion, drive_motion, facing
 from pbp_drake.systems import VirtualOperator
+
+import participant_harness
 
 PERIOD = 0.03
 SPEED = 0.12
@@ -124,41 +125,9 @@ def test_vertical_off_is_the_planar_motion_exactly():
 
 # The system.
 
-class Participant:
-    """A lone `VirtualOperator` whose inputs the test sets each tick."""
-
-    def __init__(self, objects, target_index, selected=0, **kwargs):
-        self.system = VirtualOperator(PERIOD, objects, nominal_speed=SPEED, seed=7, **kwargs)
-        self.simulator = Simulator(self.system)
-        self.context = self.simulator.get_mutable_context()
-        self.objects = np.asarray(objects, float)
-        self.target_index = target_index
-        self.system.get_target_input_port().FixValue(
-            self.context, [*self.objects[target_index], target_index])
-        self.system.get_selected_goal_input_port().FixValue(self.context, [selected])
-        self.move_to(START)
-        self.ticks = 0
-
-    def move_to(self, position, heading=0.0):
-        self.position, self.heading = np.asarray(position, float), float(heading)
-        self.system.get_ee_state_input_port().FixValue(
-            self.context, [*self.position, 0, 0, 0, self.heading, 0.0])
-
-    def tick(self):
-        """The command of the next control tick."""
-        self.ticks += 1
-        self.simulator.AdvanceTo((self.ticks - 0.5) * PERIOD)
-        return np.array(self.system.get_operator_command_output_port().Eval(self.context))
-
-    def follow(self, ticks):
-        """The commands of `ticks` ticks, the hand moved by each."""
-        commands = []
-        for _ in range(ticks):
-            command = self.tick()
-            commands.append(command)
-            self.move_to(self.position + PERIOD * command[:3],
-                         self.heading + PERIOD * command[3])
-        return np.array(commands)
+def Participant(objects, target_index, selected=0, **kwargs):
+    return participant_harness.Participant(objects, target_index, selected, period=PERIOD,
+                                           speed=SPEED, start=START, **kwargs)
 
 
 QUIET = dataclasses.replace(PARAMS, direction_noise=0.0, speed_noise=0.0)

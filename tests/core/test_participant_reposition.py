@@ -69,10 +69,9 @@ def test_it_moves_to_the_height_of_a_target_above_and_backs_from_one_behind_at_o
     np.testing.assert_allclose(velocity, SPEED * np.array([-1.0, 0.0, -1.0]) / np.sqrt(2))
 
 
-def Participant(objects, target_index, selected=0, **kwargs):
+def Participant(objects, target_index, selected=0, params=PARAMS, **kwargs):
     return participant_harness.Participant(objects, target_index, selected, period=PERIOD,
-                                           speed=SPEED, start=HAND, params=PARAMS,
-                                           **kwargs)
+                                           speed=SPEED, start=HAND, params=params, **kwargs)
 
 
 def test_the_participant_backs_until_the_tool_can_point_at_the_target_then_faces_it():
@@ -113,3 +112,18 @@ def test_with_the_turn_unbounded_on_the_floor_it_turns_to_face_a_target_behind()
     velocity, yaw_rate = assist_motion(PARAMS, SPEED, HAND, 0.0, BEHIND_LEFT, AHEAD,
                                        insisting=False)
     np.testing.assert_allclose(command, [*velocity, 0.0, yaw_rate])
+
+
+def test_with_no_reposition_time_it_goes_to_a_target_it_cannot_point_at_at_once():
+    params = dataclasses.replace(PARAMS, reposition_time=0.0)
+    behind = Participant([AHEAD, BEHIND_LEFT], 1, heading_range=WRIST, vertical=True,
+                         params=params)
+    insisting, yaw_rate = assist_motion(params, SPEED, HAND, 0.0, BEHIND_LEFT, AHEAD,
+                                        insisting=True, vertical=True)
+    np.testing.assert_allclose(behind.tick(), [*insisting, yaw_rate])
+    # A target it can point at it still shows by turning and sidestepping.
+    ahead = Participant([BEHIND_LEFT, AHEAD], 1, heading_range=WRIST, vertical=True,
+                        params=params)
+    showing, yaw_rate = assist_motion(params, SPEED, HAND, 0.0, AHEAD, BEHIND_LEFT,
+                                      insisting=False, vertical=True)
+    np.testing.assert_allclose(ahead.tick(), [*showing, yaw_rate])

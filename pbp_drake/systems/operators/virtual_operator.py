@@ -486,13 +486,15 @@ class VirtualOperator(SampledOperator):
         counted_target, ticks, moved = context.get_discrete_state(self._insist_index).value()
         if counted_target != known_target:
             counted_target, ticks, moved = known_target, 0.0, 0.0
-        insisting = ticks >= self._insist_ticks or moved >= self._reposition_ticks
+        insisting = ticks >= self._insist_ticks or moved > self._reposition_ticks
         repositioning = False
         if not insisting and selected != known_target:
             if not can_point_at(self.params, position, target_position, self._heading_range,
                                 self._vertical):
-                repositioning = True
                 moved += 1.0
+                # Its `reposition_time` (0: none) spent, it goes to the target itself.
+                insisting = moved > self._reposition_ticks
+                repositioning = not insisting
             elif faces_target(self.params, position, heading, target_position):
                 ticks += 1.0
         discrete_state.set_value(self._insist_index, [counted_target, ticks, moved])

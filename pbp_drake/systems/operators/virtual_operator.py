@@ -10,7 +10,7 @@ from pbp_drake.core.participant_impairment import (
 from pbp_drake.core.participant_reach import (
     assist_motion, can_point_at, drive_motion, faces_target, reposition_motion,
     without_forward)
-from pbp_drake.core.reach_task import heading_error, rotate_planar, wrap_angle
+from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.operators.participant_avoidance import (
     WATCH_SIZE, is_pushing_through, robot_closes_in, start_watch, update_watch)

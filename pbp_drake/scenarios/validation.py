@@ -505,9 +505,10 @@ MOST_PLAN_TIMES = 100
 
 
 def check_virtual_participant(operator, field="scenario.operator"):
-    """The obstacle fields and `reposition_time` of `operator: !VirtualParticipant`
-    (`VirtualParticipantParams`):
-    times, rates and steps positive, distances, weights and factors not negative,
+    """The reaching and obstacle fields of `operator: !VirtualParticipant`
+    (`VirtualParticipantParams`): what it divides by (`slow_radius`,
+    `turn_slowdown_angle`), times, rates and steps positive, other distances, angles,
+    times, weights and factors not negative,
     `plan_directions` a count and `plan_times` positive times that increase; and its
     `impairment` (`ParticipantImpairment.problem`: levels and times finite and not
     negative, a probability in [0, 1])."""
@@ -515,11 +516,12 @@ def check_virtual_participant(operator, field="scenario.operator"):
     if problem is not None:
         raise ScenarioError(f"{field}.impairment.{problem}")
     require_finite(operator, field, (
-        "settle_time", "max_turn_rate", "release_heading_gap", "release_heading_gap_alternated",
+        "slow_radius", "turn_slowdown_angle", "settle_time", "max_turn_rate", "release_heading_gap", "release_heading_gap_alternated",
         "policy_compensation", "progress_step", "stall_time"))
     require_finite(operator, field, (
         "final_approach_radius", "push_through_radius", "turn_weight", "keep_on_weight",
-        "release_factor", "goal_margin_factor", "min_closing_fraction", "reposition_time"),
+        "release_factor", "goal_margin_factor", "min_closing_fraction", "aligned_angle",
+        "in_line_angle", "aside_speed_fraction", "insist_time", "reposition_time"),
         positive=False)
     directions = operator.plan_directions
     if isinstance(directions, bool) or not isinstance(directions, numbers.Integral):

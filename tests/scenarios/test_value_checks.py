@@ -106,3 +106,24 @@ def test_the_participant_fields_are_checked_in_the_reaching_task_too(tmp_path):
                        match=r"scenario.operator.policy_compensation must be finite and "
                              r"positive, got 0.0"):
         load_scenario_file(path)
+
+
+@pytest.mark.parametrize("line, message", [
+    # Divided by: a zero turned the participant's turn rate into a ZeroDivisionError, a
+    # negative radius drove it away from the target.
+    ("turn_slowdown_angle: 0.0", "turn_slowdown_angle must be finite and positive, got 0.0"),
+    ("slow_radius: -0.15", "slow_radius must be finite and positive, got -0.15"),
+    ("insist_time: -1.0", "insist_time must be finite and not negative, got -1.0"),
+    ("reposition_time: -1.0", "reposition_time must be finite and not negative, got -1.0"),
+    ("aligned_angle: -0.05", "aligned_angle must be finite and not negative"),
+    ("aside_speed_fraction: -0.5", "aside_speed_fraction must be finite and not negative"),
+])
+def test_a_bad_reaching_participant_value_is_refused_naming_its_field(tmp_path, line,
+                                                                      message):
+    text = (DIAGRAMS / "arm_reach.yaml").read_text()
+    old = "    reaction_delay: 0.3\n"
+    assert old in text
+    path = tmp_path / "arm_reach.yaml"
+    path.write_text(text.replace(old, f"{old}    {line}\n", 1))
+    with pytest.raises(ScenarioError, match=rf"scenario.operator.{message}"):
+        load_scenario_file(path)

@@ -79,6 +79,19 @@ _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3}}
 
 
+def _may_reposition(content):
+    """Whether the scenario's virtual participant may meet a target the tool cannot point
+    at (an arm's wrist turns only so far; objects at heights of their own): its trials
+    changed when `reposition_time` came, so its older study folders must not resume."""
+    robot, task = content.get("robot"), content.get("task")
+    return ((isinstance(robot, dict) and robot.get("!type") == "Arm")
+            or (isinstance(task, dict) and bool(task.get("z_range"))))
+
+
+# Later fields that stay in the content, even at their default, where they act.
+_KEPT_WHERE = {("operator", "reposition_time"): _may_reposition}
+
+
 def scenario_content(scenario):
     """Everything in the scenario but its method and seed (a study sets those per trial),
     as plain data."""
@@ -86,6 +99,9 @@ def scenario_content(scenario):
     for section, fields in _LATER_FIELDS.items():
         values = content if section is None else content.get(section)
         for name, default in fields.items():
+            kept = _KEPT_WHERE.get((section, name))
+            if kept is not None and kept(content):
+                continue
             if isinstance(values, dict) and values.get(name, default) == default:
                 values.pop(name, None)
     return content

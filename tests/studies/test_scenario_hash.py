@@ -1,0 +1,37 @@
+"""A study folder resumes only the trials of its own scenario (`trial_files.scenario_hash`):
+a field added to the schema later leaves the hash of a scenario whose trials it does not
+change as it was, and changes the hash of one whose trials it does."""
+
+import dataclasses
+import pathlib
+
+from pbp_drake.scenarios import load_scenario_file
+from pbp_drake.studies.trial_files import scenario_content, scenario_hash
+
+DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
+
+
+def scenario(name):
+    return load_scenario_file(DIAGRAMS / name).scenario
+
+
+def with_reposition_time(scenario, seconds):
+    operator = dataclasses.replace(scenario.operator, reposition_time=seconds)
+    return dataclasses.replace(scenario, operator=operator)
+
+
+def test_the_hsr_tasks_hash_without_reposition_time_at_its_default():
+    # The HSR's base turns all the way round and its tasks are planar: the participant
+    # never repositions there, so their study folders from before the field still resume.
+    for name in ("hsr_reach.yaml", "hsr_obstacles.yaml"):
+        hsr = scenario(name)
+        assert "reposition_time" not in scenario_content(hsr)["operator"]
+        assert scenario_hash(with_reposition_time(hsr, 2.0)) != scenario_hash(hsr)
+
+
+def test_the_arm_task_hashes_reposition_time_even_at_its_default():
+    # The arm's trials changed when the participant learned to reposition: its study
+    # folders from before must be refused, not resumed with trials of the old participant.
+    arm = scenario("arm_reach.yaml")
+    assert scenario_content(arm)["operator"]["reposition_time"] == 4.0
+    assert scenario_hash(with_reposition_time(arm, 2.0)) != scenario_hash(arm)

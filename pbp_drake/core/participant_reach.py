@@ -125,21 +125,27 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
     return velocity, turn_rate(params, heading_error(heading, position, target))
 
 
+def _pointing_blocked(params, offset, heading_range, vertical):
+    """`(beyond, over)` for a target at `offset` (3) from the hand: its floor direction lies
+    beyond `heading_range` (low, high) (None: all the way round), give or take
+    `aligned_angle`; with `vertical` motion, it stands more above or below the hand than
+    beside it (straight above, its floor direction is no direction at all: the least
+    motion swings it). With either, turning the tool cannot point it at the target."""
+    over = vertical and np.linalg.norm(offset[:2]) < abs(offset[2])
+    if heading_range is None:
+        return False, over
+    low, high = heading_range
+    bearing = wrap_angle(np.arctan2(offset[1], offset[0]) - 0.5 * (low + high))
+    return abs(float(bearing)) > 0.5 * (high - low) + params.aligned_angle, over
+
+
 def can_point_at(params, position, target, heading_range=None, vertical=False):
     """Whether turning the tool, within `heading_range` (low, high) (None: all the way
     round), can point it at `target` (3) from `position` (3): the floor direction to the
     target lies within the range (give or take `aligned_angle`), and, with `vertical`
-    motion, the target stands no more above or below the hand than beside it (straight
-    above, its floor direction is no direction at all: the least motion swings it)."""
+    motion, the target stands no more above or below the hand than beside it."""
     offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
-    if vertical and np.linalg.norm(offset[:2]) < abs(offset[2]):
-        return False
-    if heading_range is None:
-        return True
-    low, high = heading_range
-    middle = 0.5 * (low + high)
-    bearing = wrap_angle(np.arctan2(offset[1], offset[0]) - middle)
-    return abs(float(bearing)) <= 0.5 * (high - low) + params.aligned_angle
+    return not any(_pointing_blocked(params, offset, heading_range, vertical))
 
 
 def reposition_motion(params, speed, position, heading, target, heading_range=None,
@@ -151,16 +157,17 @@ def reposition_motion(params, speed, position, heading, target, heading_range=No
     beside, toward its height; both at once combined into `speed`. It turns the tool to
     the heading in the range nearest the target's direction, to point at it once it can."""
     offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
+    beyond, over = _pointing_blocked(params, offset, heading_range, vertical)
     velocity = np.zeros(3)
     wanted_heading = float(np.arctan2(offset[1], offset[0]))
     if heading_range is not None:
         low, high = heading_range
         middle, half = 0.5 * (low + high), 0.5 * (high - low)
-        bearing = float(wrap_angle(wanted_heading - middle))
-        if abs(bearing) > half + params.aligned_angle:
+        if beyond:
             velocity[:2] = -facing(middle)
+        bearing = float(wrap_angle(wanted_heading - middle))
         wanted_heading = middle + float(np.clip(bearing, -half, half))
-    if vertical and np.linalg.norm(offset[:2]) < abs(offset[2]):
+    if over:
         velocity[2] = np.sign(offset[2])
     velocity = speed * unit(velocity)
     yaw_rate = turn_rate(params, float(wrap_angle(wanted_heading - heading)))

@@ -518,12 +518,13 @@ def check_virtual_participant(operator, field="scenario.operator"):
     if problem is not None:
         raise ScenarioError(f"{field}.impairment.{problem}")
     require_finite(operator, field, (
-        "slow_radius", "turn_slowdown_angle", "settle_time", "max_turn_rate", "release_heading_gap", "release_heading_gap_alternated",
-        "policy_compensation", "progress_step", "stall_time"))
+        "slow_radius", "turn_slowdown_angle", "settle_time", "max_turn_rate",
+        "release_heading_gap", "policy_compensation", "progress_step", "stall_time"))
     require_finite(operator, field, (
         "final_approach_radius", "push_through_radius", "turn_weight", "keep_on_weight",
         "release_factor", "goal_margin_factor", "min_closing_fraction", "aligned_angle",
-        "in_line_angle", "aside_speed_fraction", "insist_time", "reposition_time"),
+        "in_line_angle", "aside_speed_fraction", "insist_time", "reposition_time",
+        "serve_speed_fraction", "serve_patience", "hold_time"),
         positive=False)
     directions = operator.plan_directions
     if isinstance(directions, bool) or not isinstance(directions, numbers.Integral):

@@ -552,7 +552,7 @@ def check_pilot(operator, field="scenario.operator"):
                                 "in [0, 1]")
     if isinstance(operator, ProportionalPilotParams):
         require_finite(operator, field, ("gain",))
-        require_finite(operator, field, ("max_speed",), positive=False)
+        require_finite(operator, field, ("max_speed", "dead_zone"), positive=False)
     if isinstance(operator, ParticipantPopulationParams):
         problem = population_problem(operator)
         if problem is not None:

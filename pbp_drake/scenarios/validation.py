@@ -275,10 +275,24 @@ def _mapping_expected(schema, node, field):
     return f"{field}: got {given}; expected {expected}"
 
 
+def _unknown_tag(schema, node, field):
+    """`field: the tag !X is unknown; ...` (with did-you-mean) for a node whose tag names
+    none of the Union's members, else None."""
+    tag = node.get("_tag", "") if isinstance(node, dict) else ""
+    if not tag:
+        return None
+    tags = ["!" + getattr(member, "__name__", "") for member in _members(schema)]
+    matches = difflib.get_close_matches(tag, tags, n=1)
+    hint = f" (did you mean {matches[0]}?)" if matches else ""
+    return f"{field}: the tag {tag} is unknown; expected one of {', '.join(tags)}{hint}"
+
+
 def _first_problem(node, schema, field):
     optional = type(None) in typing.get_args(schema)
     variant = _variant(schema, node)
-    if variant is None or (node is None and optional):
+    if variant is None:
+        return _unknown_tag(schema, node, field)
+    if node is None and optional:
         return None
     types_of = _field_types(variant)
     if types_of is not None:

@@ -23,9 +23,9 @@ class VirtualParticipantParams:
     #: Its turn rate (rad/s).
     rotation_speed: float = 0.8
     #: It notices a new target this long (s) after it appears: seeing the ball move,
-    #: deciding and reaching for the keys. 0.5 s is the reach calibration (teleop then rests
-    #: about as long as the paper's users did); diagrams/hsr_obstacles.yaml keeps 0.3.
-    reaction_delay: float = 0.5
+    #: deciding and reaching for the keys. 0.3 s is the reach calibration: with
+    #: `serve_patience` after it, teleop then rests about as long as the paper's users did.
+    reaction_delay: float = 0.3
     #: Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
     #: (1 + N(0, speed_noise)).
     direction_noise: float = 0.1

@@ -17,7 +17,7 @@ station, the hand driven to a grasp pose (position and orientation).
     task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
     hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
 
-Under ``hop`` and ``policy_blending`` there is no DMP bank and no blender: the
+Under ``hop`` and ``predict_then_assist`` there is no DMP bank and no blender: the
 `goal_estimator` is HOP's posterior (`PoseMaxEntGoalEstimator`, on the operator's twist),
 and an `assistance` (`PoseHopAssistance`) adds HOP's action to the operator's twist before
 the same `hand_over`. `goal_estimator: {method: maxent_command}` puts the same posterior
@@ -130,7 +130,7 @@ def build_grasp_diagram(resolved, meshcat=None):
 
     limits = hand_over_limits(scenario)
     if scenario.method in HOP_METHODS:
-        # HOP and policy blending: the operator's twist plus the assistance, no DMPs.
+        # HOP and predict-then-assist: the operator's twist plus the assistance, no DMPs.
         dmp_bank = None
         prediction_steps = 0
         policy = builder.AddNamedSystem("assistance", PoseHopAssistance(
@@ -218,7 +218,7 @@ def build_grasp_diagram(resolved, meshcat=None):
 
 
 def _estimator(scenario, goal_count):
-    """The goal estimator: HOP's posterior under hop and policy_blending (the most probable
+    """The goal estimator: HOP's posterior under hop and predict_then_assist (the most probable
     goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
     section's hysteresis), else the `pose` estimator."""
     period = scenario.control_period

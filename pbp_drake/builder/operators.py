@@ -43,7 +43,7 @@ def sinusoidal_step_commands(config, control_period, duration):
 def make_hsr_operator(resolved, meshcat):
     """The HSR task's operator: a person at the keyboard or gamepad (they need `meshcat`),
     or the virtual participant (which watches the task's obstacles, if any). Under the
-    methods of `OPERATOR_DRIVES` (teleop, hop, policy_blending) the operator drives the
+    methods of `OPERATOR_DRIVES` (teleop, hop, predict_then_assist) the operator drives the
     whole way, the forward key enabled; under PBP and arbitration it shows intent without
     it, as the paper's users did."""
     scenario = resolved.scenario

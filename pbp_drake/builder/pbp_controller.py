@@ -22,7 +22,7 @@ a `MaxEntGoalEstimator` (HOP's posterior on the operator's command, with the con
 `hop` settings and the `goal_estimator` section's hysteresis), which adds the output
 `posterior_clipped`.
 
-Under ``hop`` and ``policy_blending`` (`hop_controller`, no DMP bank) HOP's posterior and
+Under ``hop`` and ``predict_then_assist`` (`hop_controller`, no DMP bank) HOP's posterior and
 its assistance take the place of the estimator, the bank and the blender:
 
     ee_state ──> goal_estimator (MaxEntGoalEstimator) ──> assistance (goal_probabilities)
@@ -57,7 +57,7 @@ PREDICTED_GOALS = 4
 def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
                         prediction_steps=0, predicted_goal_count=PREDICTED_GOALS):
     """The controller of `config.method`, a Diagram named `pbp_controller` (or
-    `hop_controller` under ``hop`` and ``policy_blending``).
+    `hop_controller` under ``hop`` and ``predict_then_assist``).
 
     Args:
         config: the controller's parameters (validated here; ValueError names the field).
@@ -80,7 +80,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         - ee_state
         - goals
         - operator_command
-        - operator_active (not under hop and policy_blending)
+        - operator_active (not under hop and predict_then_assist)
         output_ports:
         - ee_command
         - selected_goal
@@ -214,7 +214,7 @@ def _add_hop_policy(builder, config, goal_count, split, command_split):
     """HOP's posterior and assistance (no DMPs); returns the posterior and the
     assistance's command [p, v]. The operator's yaw rate turns the hand as under PBP; HOP
     assists the position only, since the reaching tasks' goals are positions.
-    `selected_goal` is the most probable goal (no hysteresis: policy blending assists
+    `selected_goal` is the most probable goal (no hysteresis: predict-then-assist assists
     toward it)."""
     period = config.control_period
     posterior = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(

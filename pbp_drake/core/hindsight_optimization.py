@@ -1,5 +1,5 @@
-"""Shared autonomy by hindsight optimization (HOP) and the policy-blending baseline, in pure
-NumPy: the goal posterior that reads the operator's command, and the assistance it gives.
+"""Shared autonomy by hindsight optimization (HOP) and its predict-then-assist variant, in
+pure NumPy: the goal posterior that reads the operator's command, and the assistance it gives.
 
 Sources: S. Javdani, S. Srinivasa, J. A. Bagnell, "Shared Autonomy via Hindsight
 Optimization", RSS 2015; S. Javdani et al., "Shared autonomy via hindsight optimization for
@@ -55,7 +55,10 @@ rotation, within `rotation_fade_angle` (times theta / (pi / 12)), so that the as
 vanishes at the target instead of chattering about it. `lambda` is `translation_divisor`
 (40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a convex blend.
 
-**Policy blending** (`blending_weights`), the predict-then-act baseline HOP's papers ran:
+**Predict-then-assist** (`blending_weights`), the predict-then-act variant of HOP's public
+code (HOP's papers call their predict-then-act baseline policy blending, after Dragan and
+Srinivasa; this is not their arbitration `(1 - alpha) U + alpha P`, which is the
+``confidence_alpha`` method of `pbp_drake.core.arbitration`):
 while the two most probable goals differ by at most `blending_threshold` in probability
 the command is the operator's alone; beyond it, full assistance toward the most probable
 goal g*: the operator's command plus HOP's single-goal action toward g* (`a` with the
@@ -73,7 +76,7 @@ import numpy as np
 from pbp_drake.core import quaternion
 
 # The methods built on this module (the scenario's `method`).
-HOP_METHODS = ("hop", "policy_blending")
+HOP_METHODS = ("hop", "predict_then_assist")
 # Below this (m, rad) the hand is at a target: no direction to it.
 AT_TARGET = 1e-12
 
@@ -86,7 +89,7 @@ def _is_real(value):
 @dataclasses.dataclass
 class HopSettings:
     """The cost model, posterior and assistance of HOP (scenario files: the `hop` section),
-    read by the ``hop`` and ``policy_blending`` methods and the ``maxent_command`` goal
+    read by the ``hop`` and ``predict_then_assist`` methods and the ``maxent_command`` goal
     estimator. Each default is the published constant (Javdani et al. 2015, 2018; the
     module docstring gives the equations). `cost_time_step` is the cost model's step, not
     the control period: the posterior is updated once per control tick, so per second it
@@ -125,7 +128,7 @@ class HopSettings:
     #: The goal posterior's largest probability is clipped at this (a probability in
     #: (0, 1]; 1: never); the excess is spread evenly over the other goals.
     max_probability: float = 0.99
-    #: policy_blending: the operator's command passes through while the two most probable
+    #: predict_then_assist: the operator's command passes through while the two most probable
     #: goals differ by at most this (a probability in [0, 1)); beyond, full assistance.
     blending_threshold: float = 0.4
 
@@ -416,7 +419,7 @@ def goal_gradients(settings, costs):
 def assistance_action(settings, costs, weights):
     """`(linear (3,), angular (3,) or None)`: `-(1/lambda) (sum_g w_g grad Q_g) / sum w`,
     the assistance for goal weights `weights` (K,) (the belief for HOP); zeros when every
-    weight is 0 (policy blending passing the operator through)."""
+    weight is 0 (predict-then-assist passing the operator through)."""
     weights = np.asarray(weights, dtype=float)
     translation, rotation = goal_gradients(settings, costs)
     total = weights.sum()
@@ -429,7 +432,7 @@ def assistance_action(settings, costs, weights):
 
 
 def blending_weights(probabilities, threshold):
-    """Policy blending's goal weights: one-hot on the most probable goal when it beats the
+    """Predict-then-assist's goal weights: one-hot on the most probable goal when it beats the
     second by more than `threshold`, else all 0 (the operator alone). With one goal its
     margin is its probability, 1."""
     probabilities = np.asarray(probabilities, dtype=float)
@@ -444,10 +447,10 @@ def blending_weights(probabilities, threshold):
 
 def assistance_weights(method, settings, probabilities):
     """The goal weights the assistance of `method` (HOP_METHODS) uses: the belief itself
-    (``hop``) or policy blending's (``policy_blending``)."""
+    (``hop``) or predict-then-assist's (``predict_then_assist``)."""
     if method == "hop":
         return np.asarray(probabilities, dtype=float)
-    if method == "policy_blending":
+    if method == "predict_then_assist":
         return blending_weights(probabilities, settings.blending_threshold)
     raise ValueError(f"method {method!r} is unknown; choose one of {HOP_METHODS}")
 

@@ -54,10 +54,17 @@ class ScenarioError(ValueError):
 
 
 METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
-           "pbp_no_user", "hop", "policy_blending")
+           "pbp_no_user", "hop", "predict_then_assist")
+#: Old method name -> (its name now, why): a scenario, `--method` or `--methods` naming the
+#: old one is refused with a message naming the new one (`resolution.renamed_method`).
+RENAMED_METHODS = {
+    "policy_blending": ("predict_then_assist", "HOP's action added once the two most "
+                        "probable goals differ by hop.blending_threshold; Dragan and "
+                        "Srinivasa's arbitration is confidence_alpha"),
+}
 # The methods under which the operator drives the whole way, the forward key enabled: teleop,
 # and the shared-autonomy baselines whose assistance adds to (or replaces) a full command.
-OPERATOR_DRIVES = ("teleop", "hop", "policy_blending")
+OPERATOR_DRIVES = ("teleop", "hop", "predict_then_assist")
 
 
 @dataclasses.dataclass
@@ -362,7 +369,7 @@ class Scenario:
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
     #: HOP's cost model, goal posterior and assistance (HopSettings), read by the hop and
-    #: policy_blending methods and the maxent_command goal estimator.
+    #: predict_then_assist methods and the maxent_command goal estimator.
     hop: HopSettings = dataclasses.field(default_factory=HopSettings)
     #: The seed of every random draw (an integer).
     seed: int = 0

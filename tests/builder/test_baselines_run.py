@@ -1,5 +1,5 @@
-"""The shared-autonomy baselines end to end with the virtual participant: HOP and policy
-blending reach the target on the reaching task without any DMP; PBP with the
+"""The shared-autonomy baselines end to end with the virtual participant: HOP and
+predict-then-assist reach the target on the reaching task without any DMP; PBP with the
 ``maxent_command`` estimator picks its DMP from the operator's commands; the posterior's
 clip ratio reaches the TaskResult, a streamed run and a study's trial file. A reaching run
 takes under a second; the obstacle and grasping tasks' runs are marked slow."""
@@ -31,7 +31,7 @@ def scenario(repo, name, method, estimator=None):
     return resolve(dataclasses.replace(with_method(loaded, method), seed=SEED))
 
 
-@pytest.mark.parametrize("method", ["hop", "policy_blending"])
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
 def test_the_baselines_reach_the_target_without_dmps(repo, method):
     resolved = scenario(repo, "hsr_reach.yaml", method)
     diagram = build_diagram(resolved)
@@ -80,7 +80,7 @@ def test_a_streamed_run_records_the_same_clip_ratio(repo, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("method", ["hop", "policy_blending"])
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
 def test_the_baselines_do_the_obstacle_task(repo, method):
     result = run_task(scenario(repo, "hsr_obstacles.yaml", method))
     assert result.success
@@ -89,7 +89,7 @@ def test_the_baselines_do_the_obstacle_task(repo, method):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("method, estimator", [("hop", None), ("policy_blending", None),
+@pytest.mark.parametrize("method, estimator", [("hop", None), ("predict_then_assist", None),
                                                ("pbp_alternated", "maxent_command")])
 def test_the_grasp_task_with_hops_posterior(repo, method, estimator):
     resolved = scenario(repo, "hsr_grasp.yaml", method, estimator)

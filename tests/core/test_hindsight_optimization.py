@@ -1,4 +1,4 @@
-"""HOP's goal posterior and assistance, and policy blending, against the equations of
+"""HOP's goal posterior and assistance, and predict-then-assist, against the equations of
 Javdani et al. (2015, 2018) written out here goal by goal and target by target with plain
 floats and SciPy's rotations: an oracle that shares no code with
 `pbp_drake.core.hindsight_optimization`."""
@@ -253,21 +253,21 @@ def test_with_one_goal_near_the_assistance_is_the_quadratic_slope_and_fades():
     np.testing.assert_array_equal(at_goal.velocity, np.zeros(3))
 
 
-def test_policy_blending_passes_the_operator_through_below_the_threshold():
+def test_predict_then_assist_passes_the_operator_through_below_the_threshold():
     targets = hop_targets([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [0.0, 1.5, 0.7]])
     position, velocity = np.array([0.0, 0.0, 0.7]), np.array([0.1, 0.02, 0.0])
     for belief in ([0.5, 0.3, 0.2], [0.65, 0.25, 0.1], [0.34, 0.33, 0.33]):
-        command = assisted_command("policy_blending", SETTINGS, targets, belief, position,
+        command = assisted_command("predict_then_assist", SETTINGS, targets, belief, position,
                                    velocity)
         np.testing.assert_array_equal(command.velocity, velocity)
         assert not command.assisting
 
 
-def test_policy_blending_assists_fully_toward_the_most_probable_goal_above_it():
+def test_predict_then_assist_assists_fully_toward_the_most_probable_goal_above_it():
     targets = hop_targets([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [0.0, 1.5, 0.7]])
     position, velocity = np.array([0.0, 0.0, 0.7]), np.array([0.1, 0.02, 0.0])
     belief = [0.1, 0.8, 0.1]
-    blended = assisted_command("policy_blending", SETTINGS, targets, belief, position,
+    blended = assisted_command("predict_then_assist", SETTINGS, targets, belief, position,
                                velocity)
     certain = assisted_command("hop", SETTINGS, targets, [0.0, 1.0, 0.0], position,
                                velocity)

@@ -8,6 +8,7 @@ import textwrap
 
 import pytest
 
+from pbp_drake import cli
 from pbp_drake.builder import build_diagram, find_system
 from pbp_drake.core.hindsight_optimization import HopSettings
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
@@ -48,7 +49,7 @@ def test_a_file_without_the_section_builds_the_defaults_and_a_value_reaches_the_
     assert find_system(diagram, "goal_estimator").settings == HopSettings()
     assert find_system(diagram, "assistance").settings == HopSettings()
     changed = load_scenario_file(scenario_file(
-        tmp_path, "method: policy_blending\nhop: {max_probability: 0.95, "
+        tmp_path, "method: predict_then_assist\nhop: {max_probability: 0.95, "
                   "blending_threshold: 0.2}\n")).resolved
     diagram = build_diagram(changed)
     assert find_system(diagram, "goal_estimator").settings.max_probability == 0.95
@@ -89,3 +90,27 @@ def test_the_maxent_command_estimator_builds_in_pbps_loop(tmp_path):
     assert (type(estimator).__name__, estimator.margin, estimator.hold_steps) == (
         "MaxEntGoalEstimator", 0.2, 3)
     assert estimator.settings.cost_time_step == 0.05
+
+
+OLD_NAME = "method 'policy_blending' is now called 'predict_then_assist'"
+
+
+def test_the_old_name_of_predict_then_assist_is_refused_in_a_file(tmp_path, run_refused):
+    code, err, _ = run_refused(scenario_file(tmp_path, "method: policy_blending\n"))
+    assert code == 2 and "Traceback" not in err
+    assert f"scenario.{OLD_NAME}" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("arguments", [
+    ["run", "{file}", "--headless", "--method", "policy_blending"],
+    ["study", "{file}", "--methods", "hop,policy_blending", "--trials", "1",
+     "--output", "{output}"],
+])
+def test_the_old_name_is_refused_on_the_command_line_and_nothing_is_written(
+        tmp_path, run_refused, capsys, arguments):
+    path = scenario_file(tmp_path, "method: hop\n")
+    output = tmp_path / "study"
+    code = cli.main([argument.format(file=path, output=output) for argument in arguments])
+    err = capsys.readouterr().err
+    assert code == 2 and OLD_NAME in err and len(err.strip().splitlines()) == 1
+    assert not output.exists()

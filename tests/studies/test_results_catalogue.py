@@ -19,7 +19,7 @@ def test_a_baselines_study_writes_its_table_paired_with_pbp_alt_and_its_figures(
     assert text.startswith("`pbp-drake study " + " ".join(
         STUDIES["hsr_reach_baselines"]).replace("30", "2"))
     assert "Each method against PBP-Alt, paired by seed" in text
-    for method in ("PBP-Cont", "HOP", "Policy blending", "Teleop"):
+    for method in ("PBP-Cont", "HOP", "Predict-then-assist", "confidence_alpha", "Teleop"):
         assert f"| task_time | {method} | " in text or f"| success | {method} | " in text
     for figure in DOCS_FIGURES:
         assert (generated / f"hsr_reach_baselines_{figure}").stat().st_size > 10_000

@@ -105,7 +105,7 @@ class CommandPosteriorBase(LeafSystem):
 class MaxEntGoalEstimator(CommandPosteriorBase):
     """HOP's goal posterior on the hand's position and the operator's velocity command
     (`pbp_drake.core.hindsight_optimization.update_posterior`): the ``maxent_command`` goal
-    estimator of PBP, and the belief of the ``hop`` and ``policy_blending`` methods.
+    estimator of PBP, and the belief of the ``hop`` and ``predict_then_assist`` methods.
 
     .. pydrake_system::
 

@@ -11,7 +11,7 @@ from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
 class PoseMaxEntGoalEstimator(CommandPosteriorBase):
     """HOP's goal posterior with position and orientation terms, on the hand's pose and the
     operator's twist: the grasping task's ``maxent_command`` goal estimator, and the belief
-    of its ``hop`` and ``policy_blending`` methods (`MaxEntGoalEstimator` with the pose).
+    of its ``hop`` and ``predict_then_assist`` methods (`MaxEntGoalEstimator` with the pose).
 
     .. pydrake_system::
 

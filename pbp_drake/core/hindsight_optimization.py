@@ -50,9 +50,10 @@ with grad Q_g the gradient of the goal's best target's value at the operator's n
 translation `V'(|r|) r / |r|`, r = p' - p_kappa (`(alpha + c0) r/|r|` far, `c0 r/|r| +
 (alpha/delta) r` near); rotation `w V'(theta') n`, n the unit axis of `Log(q' q_kappa*)`,
 along which turning the hand grows theta' at rate 1. Each goal's gradient fades in
-proportion within `translation_fade_distance` of its target (times d / 0.02 m) and, for the
-rotation, within `rotation_fade_angle` (times theta / (pi / 12)), so that the assistance
-vanishes at the target instead of chattering about it. `lambda` is `translation_divisor`
+proportion within `translation_fade_distance` of its target (times d' / 0.02 m) and, for
+the rotation, within `rotation_fade_angle` (times theta' / (pi / 12)), on the distance and
+angle after the operator's step, the pose the gradient is taken at, so that the assistance
+vanishes where the operator's step reaches the target instead of chattering about it. `lambda` is `translation_divisor`
 (40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a convex blend.
 
 **Predict-then-assist** (`blending_weights`), the predict-then-act variant of HOP's public
@@ -397,20 +398,21 @@ def _unit_rows(vectors, lengths):
 
 
 def goal_gradients(settings, costs):
-    """`(translation (K, 3), rotation (K, 3) or None)`: each goal's faded gradient of its
-    best target's value at the operator's next pose (module docstring), not yet divided by
-    lambda."""
+    """`(translation (K, 3), rotation (K, 3) or None)`: each goal's gradient of its best
+    target's value at the operator's next pose, faded on the distance and angle from that
+    pose (module docstring), not yet divided by lambda."""
     geometry, best = costs.geometry, costs.best_targets
     offsets = geometry.next_offsets[best]
     lengths = np.linalg.norm(offsets, axis=1)
-    fade = np.minimum(1.0, geometry.distances[best] / settings.translation_fade_distance)
+    # Faded on the distance after the operator's step, where the gradient is taken.
+    fade = np.minimum(1.0, lengths / settings.translation_fade_distance)
     translation = (huber_slope(lengths, *_translation(settings)) * fade)[:, np.newaxis] * \
         _unit_rows(offsets, lengths)
     if geometry.angles is None:
         return translation, None
     rotations = geometry.next_rotations[best]
     angles = np.linalg.norm(rotations, axis=1)
-    fade = np.minimum(1.0, geometry.angles[best] / settings.rotation_fade_angle)
+    fade = np.minimum(1.0, angles / settings.rotation_fade_angle)
     rotation = (settings.rotation_weight * huber_slope(angles, *_rotation(settings))
                 * fade)[:, np.newaxis] * _unit_rows(rotations, angles)
     return translation, rotation

@@ -53,7 +53,9 @@ along which turning the hand grows theta' at rate 1. Each goal's gradient fades 
 proportion within `translation_fade_distance` of its target (times d' / 0.02 m) and, for
 the rotation, within `rotation_fade_angle` (times theta' / (pi / 12)), on the distance and
 angle after the operator's step, the pose the gradient is taken at, so that the assistance
-vanishes where the operator's step reaches the target instead of chattering about it. `lambda` is `translation_divisor`
+vanishes where the operator's step reaches the target instead of chattering about it.
+With `assistance` False the command is `u` alone, exactly teleop's (the posterior still
+runs): a control condition with the baselines' estimator and no help. `lambda` is `translation_divisor`
 (40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a convex blend.
 
 **Predict-then-assist** (`blending_weights`), the predict-then-act variant of HOP's public
@@ -132,6 +134,9 @@ class HopSettings:
     #: predict_then_assist: the operator's command passes through while the two most probable
     #: goals differ by at most this (a probability in [0, 1)); beyond, full assistance.
     blending_threshold: float = 0.4
+    #: False: the robot adds nothing: HOP's and predict_then_assist's command is the
+    #: operator's alone (exactly teleop's); the posterior still runs.
+    assistance: bool = True
 
     def __post_init__(self):
         self.validate()
@@ -139,8 +144,12 @@ class HopSettings:
     def validate(self):
         """Raises ValueError naming the first field that cannot be used (a YAML loader sets
         the fields after construction, so `resolve` calls this again)."""
+        if not isinstance(self.assistance, bool):
+            raise ValueError(f"assistance must be true or false, got {self.assistance!r}")
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
+            if field.name == "assistance":
+                continue
             if not _is_real(value) or not math.isfinite(value):
                 raise ValueError(f"{field.name} must be a finite number, got {value!r}")
         for name in ("cost_time_step", "translation_gain", "translation_switch_distance",
@@ -469,11 +478,19 @@ class AssistedCommand(typing.NamedTuple):
 def assisted_command(method, settings, targets, probabilities, position, velocity,
                      orientation=None, angular_velocity=None):
     """The command `u + a` of `method` for the belief `probabilities` (K,) and the
-    operator's command `u` = (`velocity`, `angular_velocity`) at the hand's pose."""
+    operator's command `u` = (`velocity`, `angular_velocity`) at the hand's pose; `u`
+    alone when `settings.assistance` is False."""
     probabilities = np.asarray(probabilities, dtype=float)
     if probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all():
         raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers, "
                          f"got {probabilities!r}")
+    if not settings.assistance:
+        # The operator's command untouched (not plus a zero action, which would turn a -0.0
+        # into 0.0): bit for bit the command teleop passes on.
+        angular = None if targets.orientations is None else (
+            np.zeros(3) if angular_velocity is None
+            else _finite_vector(angular_velocity, "angular_velocity"))
+        return AssistedCommand(_finite_vector(velocity, "velocity"), angular, False)
     weights = assistance_weights(method, settings, probabilities)
     costs = goal_costs(settings, targets, position, velocity, orientation, angular_velocity)
     linear, angular = assistance_action(settings, costs, weights)

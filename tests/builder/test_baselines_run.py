@@ -23,8 +23,10 @@ pytestmark = pytest.mark.slow
 SEED = 3
 
 
-def scenario(repo, name, method, estimator=None):
+def scenario(repo, name, method, estimator=None, **hop):
     loaded = load_scenario_file(repo / "diagrams" / name).scenario
+    if hop:
+        loaded = dataclasses.replace(loaded, hop=dataclasses.replace(loaded.hop, **hop))
     if estimator is not None:
         loaded = dataclasses.replace(loaded, goal_estimator=dataclasses.replace(
             loaded.goal_estimator, method=estimator))
@@ -112,3 +114,19 @@ def test_the_baselines_draw_their_scene_without_dmp_paths(repo, meshcat, name):
     simulator = Simulator(diagram)
     simulator.AdvanceTo(0.5)
     assert meshcat.HasPath("/task/objects/0") and meshcat.HasPath("/task/target")
+
+
+@pytest.mark.parametrize("name", ["hsr_reach.yaml", "hsr_grasp.yaml"])
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
+def test_with_its_assistance_off_a_baseline_commands_what_teleop_commands(repo, name, method):
+    """`hop: {assistance: false}`: the robot adds nothing, so the same participant on the
+    same seed moves the hand exactly as under teleop, tick for tick (the pose too in the
+    grasping task); the posterior still runs."""
+    teleop = run_task(scenario(repo, name, "teleop"))
+    off = run_task(scenario(repo, name, method, assistance=False))
+    for series in ("ee_positions", "headings", "commands", "operator_active",
+                   "operator_commands", "command_angular_velocities", "angles_to_target"):
+        np.testing.assert_array_equal(getattr(off, series), getattr(teleop, series),
+                                      err_msg=series)
+    assert (off.success, off.task_time) == (teleop.success, teleop.task_time)
+    assert off.posterior_clipped_ratio is not None

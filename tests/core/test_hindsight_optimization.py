@@ -282,6 +282,24 @@ def test_the_rotation_fade_reads_the_angle_after_the_operators_step():
     np.testing.assert_array_equal(command.velocity, np.zeros(3))
 
 
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
+def test_with_the_assistance_off_the_command_is_the_operators_alone(method):
+    """Certain of a goal 1 m away, the robot still adds nothing: the operator's command
+    comes back as it went in, signed zeros included."""
+    off = HopSettings(assistance=False)
+    targets = hop_targets([[1.0, 0.0, 0.7], [0.0, 1.0, 0.7]], [[1.0, 0, 0, 0]] * 2)
+    velocity, angular = np.array([-0.0, 0.1, 0.0]), np.array([0.0, -0.0, 0.3])
+    command = assisted_command(method, off, targets, [0.99, 0.01], [0.0, 0.0, 0.7],
+                               velocity, [1.0, 0.0, 0.0, 0.0], angular)
+    assert not command.assisting
+    for got, sent in ((command.velocity, velocity), (command.angular_velocity, angular)):
+        np.testing.assert_array_equal(got, sent)
+        np.testing.assert_array_equal(np.signbit(got), np.signbit(sent))
+    on = assisted_command(method, SETTINGS, targets, [0.99, 0.01], [0.0, 0.0, 0.7],
+                          velocity, [1.0, 0.0, 0.0, 0.0], angular)
+    assert on.assisting and on.velocity[0] > 0.05
+
+
 def test_predict_then_assist_passes_the_operator_through_below_the_threshold():
     targets = hop_targets([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [0.0, 1.5, 0.7]])
     position, velocity = np.array([0.0, 0.0, 0.7]), np.array([0.1, 0.02, 0.0])

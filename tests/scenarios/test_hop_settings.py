@@ -40,6 +40,7 @@ def test_the_defaults_are_the_published_constants():
         0.02, math.pi / 12)
     assert (settings.cost_time_step, settings.max_probability,
             settings.blending_threshold) == (0.1, 0.99, 0.4)
+    assert settings.assistance is True
 
 
 def test_a_file_without_the_section_builds_the_defaults_and_a_value_reaches_the_systems(
@@ -64,6 +65,8 @@ def test_a_file_without_the_section_builds_the_defaults_and_a_value_reaches_the_
     ("hop: {rotation_weight: -0.07}", "scenario.hop: rotation_weight must be positive"),
     ("hop: {cost_time_step: .nan}", "scenario.hop.cost_time_step: NaN is not a number"),
     ("hop: {translation_gain: .inf}", "scenario.hop.translation_gain: inf is infinite"),
+    ("hop: {assistance: 1}", "scenario.hop.assistance: got 1; expected true or false"),
+    ("hop: {assistance: 0.5}", "scenario.hop.assistance: got 0.5; expected true or false"),
     ("hop: {max_probabilty: 0.9}", "scenario.hop: unknown key 'max_probabilty' (did you "
                                    "mean 'max_probability'?)"),
 ])
@@ -71,6 +74,11 @@ def test_bad_values_are_refused_naming_the_field(tmp_path, extra, message):
     with pytest.raises(ScenarioError) as raised:
         load_scenario_file(scenario_file(tmp_path, f"method: hop\n{extra}\n"))
     assert message in str(raised.value)
+
+
+def test_assistance_is_true_or_false_from_python_too():
+    with pytest.raises(ValueError, match="assistance must be true or false, got 0"):
+        HopSettings(assistance=0)
 
 
 def test_the_baselines_are_refused_on_the_2d_robot(tmp_path):

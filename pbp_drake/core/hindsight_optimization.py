@@ -95,9 +95,10 @@ class HopSettings:
     read by the ``hop`` and ``predict_then_assist`` methods and the ``maxent_command`` goal
     estimator. Each default is the published constant (Javdani et al. 2015, 2018; the
     module docstring gives the equations). `cost_time_step` is the cost model's step, not
-    the control period: the posterior is updated once per control tick, so per second it
-    gathers `cost_time_step / control_period` times the evidence of one published step
-    (docs/concepts/hindsight-optimization.md)."""
+    the control period: the posterior is updated once per control tick, and far from the
+    targets a tick's evidence between two goals is proportional to the operator's speed
+    times `cost_time_step`, so per second it gathers in proportion to
+    `speed * cost_time_step / control_period` (docs/concepts/hindsight-optimization.md)."""
 
     #: The cost model's time step dt (s): a step costs dt times the cost's slope, and the
     #: operator's command is applied for dt to find the distance after it (published: 0.1).

@@ -123,7 +123,7 @@ def build_grasp_diagram(resolved, meshcat=None):
 
     poses = np.hstack([grasps.grasp_positions, grasps.grasp_orientations]).reshape(-1)
     goal_poses = builder.AddNamedSystem("goal_poses", ConstantVectorSource(poses))
-    estimator = builder.AddNamedSystem("goal_estimator", _estimator(scenario, goal_count))
+    estimator = builder.AddNamedSystem("goal_estimator", _estimator(resolved, goal_count))
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
@@ -184,6 +184,8 @@ def build_grasp_diagram(resolved, meshcat=None):
     if dmp_bank is not None:
         builder.Connect(active, dmp_bank.get_operator_active_input_port())
         builder.Connect(active, policy.get_operator_active_input_port())
+    if getattr(estimator, "operator_speed", None) is not None:
+        builder.Connect(active, estimator.get_operator_active_input_port())
     builder.Connect(twist, policy.get_operator_twist_input_port())
     # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
     builder.Connect(twist, estimator.get_operator_twist_input_port())
@@ -217,17 +219,19 @@ def build_grasp_diagram(resolved, meshcat=None):
     return diagram
 
 
-def _estimator(scenario, goal_count):
+def _estimator(resolved, goal_count):
     """The goal estimator: HOP's posterior under hop and predict_then_assist (the most probable
     goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
-    section's hysteresis), else the `pose` estimator."""
+    section's hysteresis and the likelihood of PBP's operator), else the `pose` estimator."""
+    scenario = resolved.scenario
     period = scenario.control_period
     settings = scenario.goal_estimator
     if scenario.method in HOP_METHODS:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
     if settings.method == "maxent_command":
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
-                                       settings.hold_steps)
+                                       settings.hold_steps,
+                                       operator_speed=resolved.nominal_speed)
     return PoseGoalEstimator(goal_count, settings, period)
 
 

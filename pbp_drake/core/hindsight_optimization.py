@@ -289,20 +289,29 @@ def target_geometry(settings, targets, position, velocity, orientation=None,
     return TargetGeometry(distances, next_offsets, angles, next_rotations.T)
 
 
-def target_costs(settings, geometry):
-    """`(Q_kappa (N,), V_kappa (N,))` of the module docstring."""
-    step = settings.cost_time_step
+def target_values(settings, geometry):
+    """`(V_kappa now (N,), V_kappa after the operator's step (N,))`: each target's value at
+    the hand's pose and at its next pose (`p'`, `q'`), translation plus weighted rotation."""
     translation = _translation(settings)
-    q_values = (huber_step_cost(geometry.distances, *translation, step)
-                + huber_value(np.linalg.norm(geometry.next_offsets, axis=1), *translation))
-    values = huber_value(geometry.distances, *translation)
+    now = huber_value(geometry.distances, *translation)
+    after = huber_value(np.linalg.norm(geometry.next_offsets, axis=1), *translation)
     if geometry.angles is not None:
         rotation = _rotation(settings)
         weight = settings.rotation_weight
-        q_values = q_values + weight * (
-            huber_step_cost(geometry.angles, *rotation, step)
-            + huber_value(np.linalg.norm(geometry.next_rotations, axis=1), *rotation))
-        values = values + weight * huber_value(geometry.angles, *rotation)
+        now = now + weight * huber_value(geometry.angles, *rotation)
+        after = after + weight * huber_value(np.linalg.norm(geometry.next_rotations, axis=1),
+                                             *rotation)
+    return now, after
+
+
+def target_costs(settings, geometry):
+    """`(Q_kappa (N,), V_kappa (N,))` of the module docstring."""
+    step = settings.cost_time_step
+    values, after = target_values(settings, geometry)
+    q_values = huber_step_cost(geometry.distances, *_translation(settings), step) + after
+    if geometry.angles is not None:
+        q_values = q_values + settings.rotation_weight * huber_step_cost(
+            geometry.angles, *_rotation(settings), step)
     return q_values, values
 
 

@@ -38,7 +38,7 @@ API_GROUPS = {
         "ParticipantImpairment": "pbp_drake.core.participant_impairment",
         "GraspParticipantParams": "pbp_drake.core.participant_grasp",
     },
-    "Shared-autonomy baselines (HOP, policy blending)": {
+    "Shared-autonomy baselines (HOP, predict-then-assist)": {
         "HopSettings": "pbp_drake.core.hindsight_optimization",
         "hop_targets": "pbp_drake.core.hindsight_optimization",
         "update_posterior": "pbp_drake.core.hindsight_optimization",
@@ -95,7 +95,8 @@ API_GROUPS = {
             "DynamicObstacles", "GraspTask", "VirtualParticipant", "Keyboard", "Gamepad",
             "NoOperator", "ScriptedCommands", "SinusoidalStep", "ObstacleRepulsion",
             "BentPath", "RecordedPath", "Obstacle", "MethodComparison", "AlphaStudy",
-            "AltVsCont", "SceneVariant"]},
+            "AltVsCont", "SceneVariant", "NoisyPilot", "LaggyPilot", "ProportionalPilot",
+            "ParticipantPopulation", "PILOT_NAMES", "with_pilot"]},
     "Building and running": {
         name: "pbp_drake.builder" for name in [
             "build_diagram", "make_pbp_controller", "find_system", "simulate", "run_task",

@@ -17,7 +17,7 @@ station, the hand driven to a grasp pose (position and orientation).
     task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
     hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
 
-Under ``hop`` and ``policy_blending`` there is no DMP bank and no blender: the
+Under ``hop`` and ``predict_then_assist`` there is no DMP bank and no blender: the
 `goal_estimator` is HOP's posterior (`PoseMaxEntGoalEstimator`, on the operator's twist),
 and an `assistance` (`PoseHopAssistance`) adds HOP's action to the operator's twist before
 the same `hand_over`. `goal_estimator: {method: maxent_command}` puts the same posterior
@@ -41,6 +41,8 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
+from pbp_drake.builder.operators import shown_intent_and_keys
+from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.hindsight_optimization import HOP_METHODS
@@ -50,12 +52,14 @@ from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
 from pbp_drake.scenarios import (
-    OPERATOR_DRIVES, Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant)
+    PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant,
+    forward_key_enabled)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
     PoseGoalEstimator, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
 from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator, PoseGamepadParams
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import GraspSceneVisualizer
+from pbp_drake.systems.operators.pilot_filters import GraspKeys
 from pbp_drake.systems.operators.pose_keyboard_operator import (
     PoseKeyboardOperator, PoseKeyboardParams)
 from pbp_drake.systems.ports import OperatorTwist
@@ -69,7 +73,7 @@ MAX_HAND_ANGULAR_SPEED = 1.0
 # How many poses ahead the page draws the selected DMP's path, over the DMPs' duration (as
 # the reach task's TASK_PREDICTION_SAMPLES).
 GRASP_PREDICTION_SAMPLES = 40
-_OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad)
+_OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad, *PILOT_CONFIGS)
 
 
 def check_grasp_buildable(scenario):
@@ -123,14 +127,15 @@ def build_grasp_diagram(resolved, meshcat=None):
 
     poses = np.hstack([grasps.grasp_positions, grasps.grasp_orientations]).reshape(-1)
     goal_poses = builder.AddNamedSystem("goal_poses", ConstantVectorSource(poses))
-    estimator = builder.AddNamedSystem("goal_estimator", _estimator(scenario, goal_count))
+    estimator = builder.AddNamedSystem("goal_estimator", _estimator(resolved, goal_count))
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
+    shown, keys = shown_intent_and_keys(builder, scenario, selected)
 
     limits = hand_over_limits(scenario)
     if scenario.method in HOP_METHODS:
-        # HOP and policy blending: the operator's twist plus the assistance, no DMPs.
+        # HOP and predict-then-assist: the operator's twist plus the assistance, no DMPs.
         dmp_bank = None
         prediction_steps = 0
         policy = builder.AddNamedSystem("assistance", PoseHopAssistance(
@@ -174,7 +179,8 @@ def build_grasp_diagram(resolved, meshcat=None):
     if operator.HasInputPort("hand_pose"):
         builder.Connect(sampled, operator.GetInputPort("hand_pose"))
         builder.Connect(monitor.get_target_output_port(), operator.GetInputPort("target"))
-        builder.Connect(selected, operator.GetInputPort("selected_goal"))
+        builder.Connect(shown, operator.GetInputPort("selected_goal"))
+        builder.Connect(keys, operator.GetInputPort("forward_key"))
     if operator.HasInputPort("hand_state"):
         # The sampled pose: the person's frame is the hand's as the tick saw it.
         builder.Connect(sampled, operator.GetInputPort("hand_state"))
@@ -184,6 +190,8 @@ def build_grasp_diagram(resolved, meshcat=None):
     if dmp_bank is not None:
         builder.Connect(active, dmp_bank.get_operator_active_input_port())
         builder.Connect(active, policy.get_operator_active_input_port())
+    if getattr(estimator, "operator_speed", None) is not None:
+        builder.Connect(active, estimator.get_operator_active_input_port())
     builder.Connect(twist, policy.get_operator_twist_input_port())
     # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
     builder.Connect(twist, estimator.get_operator_twist_input_port())
@@ -191,7 +199,7 @@ def build_grasp_diagram(resolved, meshcat=None):
     logged = [("hand_pose_log", hand_pose), ("operator_active_log", active),
               ("operator_command_log", twist),
               ("command_log", hand_over.get_command_output_port()),
-              ("selected_goal_log", selected),
+              ("selected_goal_log", shown),
               ("target_log", monitor.get_target_output_port())]
     if dmp_bank is not None:
         logged.append(("phase_log", dmp_bank.get_phase_output_port()))
@@ -217,17 +225,19 @@ def build_grasp_diagram(resolved, meshcat=None):
     return diagram
 
 
-def _estimator(scenario, goal_count):
-    """The goal estimator: HOP's posterior under hop and policy_blending (the most probable
+def _estimator(resolved, goal_count):
+    """The goal estimator: HOP's posterior under hop and predict_then_assist (the most probable
     goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
-    section's hysteresis), else the `pose` estimator."""
+    section's hysteresis and the likelihood of PBP's operator), else the `pose` estimator."""
+    scenario = resolved.scenario
     period = scenario.control_period
     settings = scenario.goal_estimator
     if scenario.method in HOP_METHODS:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
     if settings.method == "maxent_command":
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
-                                       settings.hold_steps)
+                                       settings.hold_steps,
+                                       operator_speed=resolved.nominal_speed)
     return PoseGoalEstimator(goal_count, settings, period)
 
 
@@ -237,9 +247,9 @@ def _operator(resolved, grasps, meshcat):
     period = scenario.control_period
     if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
         return IdleOperator(OperatorTwist.size, period)
-    # Only teleop and the baselines that add to a full command (OPERATOR_DRIVES) let the
-    # person push along the approach axis (the paper's forward key).
-    teleop = scenario.method in OPERATOR_DRIVES
+    # Only teleop and the baselines that add to a full command let the person push along
+    # the approach axis (the paper's forward key).
+    teleop = forward_key_enabled(scenario)
     if isinstance(config, (Keyboard, Gamepad)) and meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
@@ -251,9 +261,12 @@ def _operator(resolved, grasps, meshcat):
         return PoseGamepadOperator(meshcat, period, teleop, PoseGamepadParams(
             config.speed, config.rotation_speed, config.dead_zone),
             nominal_speed=resolved.nominal_speed)
+    if isinstance(config, PILOT_CONFIGS):  # a surrogate pilot (`scenarios.pilots`)
+        return make_pilot(resolved, lambda participant: _operator(participant, grasps, meshcat),
+                          GraspKeys)
     participant = GraspParticipant.create(
         GraspParticipantParams.from_virtual_participant(scenario.operator),
-        "drive" if teleop else "assist", resolved.nominal_speed,
+        resolved.nominal_speed,
         grasps.grasp_positions, grasps.grasp_orientations, scenario.seed)
     return PoseVirtualOperator(participant, period)
 

@@ -157,7 +157,7 @@ class TaskResult:
             task; None in the others), kept when the series are not (a streamed run's).
         posterior_clipped_ratio: ticks whose goal posterior update was clipped at the
             scenario's `hop.max_probability` / ticks of the task, where the controller has
-            HOP's posterior (hop, policy_blending, the maxent_command estimator; None
+            HOP's posterior (hop, predict_then_assist, the maxent_command estimator; None
             elsewhere): how often the belief sat at its guard against certainty.
         input_integral, turn_input_integral, idle_ratio, agreement, prediction_accuracy,
             time_to_prediction, mean_time_to_prediction, unpredicted_switches: how the

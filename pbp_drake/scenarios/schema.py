@@ -34,6 +34,9 @@ from pbp_drake.systems.operators.keyboard_operator import KeyboardParams
 from pbp_drake.systems.operators.obstacle_repulsion_operator import ObstacleRepulsionParams
 from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.core.participant_params import VirtualParticipantParams
+from pbp_drake.core.pilot_population import ParticipantPopulationParams
+from pbp_drake.core.surrogate_pilots import (
+    LaggyPilotParams, NoisyPilotParams, ProportionalPilotParams)
 
 def _config_from_yaml(config_type, text):
     return yaml_load_typed(schema=config_type, data=text)
@@ -54,10 +57,34 @@ class ScenarioError(ValueError):
 
 
 METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
-           "pbp_no_user", "hop", "policy_blending")
-# The methods under which the operator drives the whole way, the forward key enabled: teleop,
-# and the shared-autonomy baselines whose assistance adds to (or replaces) a full command.
-OPERATOR_DRIVES = ("teleop", "hop", "policy_blending")
+           "pbp_no_user", "hop", "predict_then_assist")
+#: Old method name -> (its name now, why): a scenario, `--method` or `--methods` naming the
+#: old one is refused with a message naming the new one (`resolution.renamed_method`).
+RENAMED_METHODS = {
+    "policy_blending": ("predict_then_assist", "HOP's action added once the two most "
+                        "probable goals differ by hop.blending_threshold; Dragan and "
+                        "Srinivasa's arbitration is confidence_alpha"),
+}
+# The methods whose keys include forward: teleop, and the shared-autonomy baselines whose
+# assistance adds to a full command. The paper disables it under PBP and arbitration, whose
+# operator shows the goal and lets the robot bring the hand there.
+FORWARD_KEY_METHODS = ("teleop", "hop", "predict_then_assist")
+
+
+def forward_key_enabled(scenario):
+    """Whether the scenario's method enables the forward key (a person's keys, and the
+    virtual participant's `forward_key` input)."""
+    return scenario.method in FORWARD_KEY_METHODS
+
+
+def shows_intent(scenario):
+    """Whether the page shows the robot's intent (the blue ball over the object it means):
+    not under teleop, whose robot never moves by itself, nor under HOP with its assistance
+    off (`hop: {assistance: false}`), whose robot adds nothing."""
+    if scenario.method == "teleop":
+        return False
+    return not (scenario.method in ("hop", "predict_then_assist")
+                and not getattr(scenario.hop, "assistance", True))
 
 
 @dataclasses.dataclass
@@ -201,9 +228,32 @@ class VirtualParticipant(VirtualParticipantParams):
     """`operator: !VirtualParticipant {...}`: the stand-in for the paper's participants."""
 
 
+# The field's surrogate pilots (`pbp_drake.scenarios.pilots` is their registry; each
+# `participant:` is an untagged `VirtualParticipantParams` mapping).
+class NoisyPilot(NoisyPilotParams):
+    """`operator: !NoisyPilot {eps: 0.3, participant: {...}}`: the virtual participant
+    whose output is, each tick with probability eps, a random key state."""
+
+
+class LaggyPilot(LaggyPilotParams):
+    """`operator: !LaggyPilot {p: 0.85, participant: {...}}`: the virtual participant
+    that repeats its previous output with probability p (per 1/50 s)."""
+
+
+class ProportionalPilot(ProportionalPilotParams):
+    """`operator: !ProportionalPilot {gain: 10, max_speed: 0}`: HOP's simulated user."""
+
+
+class ParticipantPopulation(ParticipantPopulationParams):
+    """`operator: !ParticipantPopulation {...}`: each trial's participant drawn from its
+    seed over ranges of conformance, proficiency, aggressiveness and speed."""
+
+
+PILOT_CONFIGS = (NoisyPilot, LaggyPilot, ProportionalPilot, ParticipantPopulation)
 OperatorConfig = typing.Union[NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands,
-                              Keyboard, Gamepad, VirtualParticipant]
-HSR_OPERATORS = (NoOperator, Keyboard, Gamepad, VirtualParticipant)
+                              Keyboard, Gamepad, VirtualParticipant, NoisyPilot, LaggyPilot,
+                              ProportionalPilot, ParticipantPopulation]
+HSR_OPERATORS = (NoOperator, Keyboard, Gamepad, VirtualParticipant, *PILOT_CONFIGS)
 TOY_OPERATORS = (NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands)
 # The names `pbp-drake run --operator` takes for the HSR tasks.
 OPERATOR_NAMES = {"keyboard": Keyboard, "gamepad": Gamepad, "virtual": VirtualParticipant,
@@ -362,7 +412,7 @@ class Scenario:
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
     #: HOP's cost model, goal posterior and assistance (HopSettings), read by the hop and
-    #: policy_blending methods and the maxent_command goal estimator.
+    #: predict_then_assist methods and the maxent_command goal estimator.
     hop: HopSettings = dataclasses.field(default_factory=HopSettings)
     #: The seed of every random draw (an integer).
     seed: int = 0

@@ -2,8 +2,8 @@
 participant (PBP-Alt and teleop, two tuning seeds) and a few seconds of the grasping task.
 Each trial file holds every metric within its range and in step with its own time series
 (the idle ratio with the intervention ratio, the prediction accuracy and the turning input
-with the CSV's rows); the summary gives each a mean inside its 95 % interval, and the
-results table shows them."""
+with the CSV's rows); teleop, which shows no goal, has no prediction metrics. The summary
+gives each a mean inside its 95 % interval, and the results table shows them."""
 
 import dataclasses
 import json
@@ -69,8 +69,13 @@ def test_each_reach_trial_holds_every_metric_in_its_range(reach_study, method):
         assert record["success"]
         _check_operator_metrics(record, series)
         if method == "teleop":
-            # Under teleop the hand goes where the participant pushes it.
+            # Under teleop the hand goes where the participant pushes it, and no goal is
+            # shown (every tick's selected_goal -1): no prediction metrics.
             assert record["agreement"] > 0.9
+            assert np.all(series["selected_goal"] == -1)
+            assert all(record[name] is None for name in (
+                "prediction_accuracy", "time_to_prediction", "mean_time_to_prediction",
+                "unpredicted_switches"))
         else:
             _check_prediction_metrics(record, series)
 
@@ -84,6 +89,8 @@ def test_the_summary_and_the_results_give_each_metric_with_its_interval(reach_st
             assert value["count"] == 2
             low, high = value["interval"]
             assert low <= value["mean"] <= high, (method, name)
+    teleop = summary["methods"]["teleop"]["prediction_accuracy"]
+    assert teleop["count"] == 0 and teleop["interval"] is None
     latency = summary["methods"]["pbp_alternated"]["time_to_prediction"]
     assert latency["switches"] == sum(
         _trial(reach_study, "pbp_alternated", seed)[0]["switches"] + 1 for seed in (0, 1))

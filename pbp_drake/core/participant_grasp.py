@@ -352,6 +352,10 @@ class GraspParticipant:
         if self.params.impairment.mistake_probability > 0.0:
             memory = choose_first(self.params.impairment, memory, known_before, time,
                                   self.seed, len(self.grasp_positions))
+        if memory.known_target != known_before:
+            # A target it has just come to know: it watches the robot afresh, as the reach
+            # participant does.
+            serving = ServingMemory()
         target = heads_for(memory, time)
         idle = np.zeros(6)
         if target == NO_TARGET:

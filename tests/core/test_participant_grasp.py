@@ -243,8 +243,8 @@ def test_only_its_turn_tells_two_grasps_at_one_place_apart_in_the_loop():
 
 
 def test_its_noise_comes_from_the_seed_and_the_tick():
-    # Object 0 seen since the start: noticed by 1.0 s; under teleop, it has taken over.
-    seen = notice_target(ParticipantMemory(), 0, 0.0, 0.5)
+    # Object 0 known from the start; under teleop, it has taken over.
+    seen = notice_target(ParticipantMemory(), 0, 0.0, 0.0)
     driving = ServingMemory(acting=True, took_over=True, hold_ticks=10)
     scene = sample_grasp_scene(2)
     commands = {}

@@ -202,12 +202,17 @@ def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
 
     (on_time, on_time_active), (delayed, delayed_active) = twists(0.0), twists(0.45)
     shift = 15
-    # Under teleop it takes over once it has noticed the target and watched the still hand
-    # for its patience, and keeps on.
+    # Under teleop it takes over once it has noticed a target and watched the still hand
+    # for its patience, and keeps on until it notices the next (at 1 s), when it watches
+    # afresh.
     defaults = GraspParticipantParams()
-    acts = (int(np.ceil(defaults.reaction_delay / PERIOD - 1e-9))
-            + round(defaults.serve_patience / PERIOD))
-    assert not on_time_active[:acts].any() and on_time_active[acts:].all()
+    reacts = int(np.ceil(defaults.reaction_delay / PERIOD - 1e-9))
+    patience = round(defaults.serve_patience / PERIOD)
+    noticed = int(np.ceil((1.0 + defaults.reaction_delay) / PERIOD - 1e-9))
+    assert not on_time_active[:reacts + patience].any()
+    assert on_time_active[reacts + patience:noticed].all()
+    assert not on_time_active[noticed:noticed + patience].any()
+    assert on_time_active[noticed + patience + 1:].all()
     assert np.array_equal(delayed[shift:], on_time[:-shift])
     assert np.array_equal(delayed_active[shift:], on_time_active[:-shift])
     assert not delayed[:shift].any()

@@ -112,6 +112,8 @@ API_GROUPS = {
         "run_method_comparison": "pbp_drake.studies.comparison",
         "report": "pbp_drake.studies.report",
         "load_task_result": "pbp_drake.studies.trial_files",
+        "interaction_metrics": "pbp_drake.core.interaction_metrics",
+        "InteractionMetrics": "pbp_drake.core.interaction_metrics",
         "Console": "pbp_drake.console",
         "LiveRun": "pbp_drake.console",
         "PageFront": "pbp_drake.console",

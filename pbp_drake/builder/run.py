@@ -17,6 +17,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorS
 
 from pbp_drake.builder.build import build_diagram
 from pbp_drake.builder.grasp import grasp_series_fields
+from pbp_drake.core.interaction_metrics import InteractionMeter, idle_ratio
 from pbp_drake.scenarios import ResolvedScenario, counted, resolve
 from pbp_drake.systems.operators.browser_guard import reset_pacing_after_pauses
 from pbp_drake.systems.ports import TaskStatus
@@ -158,6 +159,15 @@ class TaskResult:
             scenario's `hop.max_probability` / ticks of the task, where the controller has
             HOP's posterior (hop, predict_then_assist, the maxent_command estimator; None
             elsewhere): how often the belief sat at its guard against certainty.
+        input_integral, turn_input_integral, idle_ratio, agreement, prediction_accuracy,
+            time_to_prediction, mean_time_to_prediction, unpredicted_switches: how the
+            operator and the method worked together (`pbp_drake.core.interaction_metrics`,
+            over the series' ticks; `idle_ratio` is `1 - intervention_ratio`, on the task
+            monitor's ticks). The operator's command is `operator_commands[:, :3]`, its
+            turning the yaw rate (the reaching tasks) or the angular velocity of
+            `operator_twists` (the grasping task); the named goal `selected_goals`, -1
+            where the method names none. None when unknown (a TaskResult made without
+            them).
     """
 
     success: bool
@@ -183,6 +193,14 @@ class TaskResult:
     peak_command_angular_change: float | None = None
     final_angle_to_target: float | None = None
     posterior_clipped_ratio: float | None = None
+    input_integral: float | None = None
+    turn_input_integral: float | None = None
+    idle_ratio: float | None = None
+    agreement: float | None = None
+    prediction_accuracy: float | None = None
+    time_to_prediction: list | None = None
+    mean_time_to_prediction: float | None = None
+    unpredicted_switches: int | None = None
 
     def __post_init__(self):
         if (self.final_angle_to_target is None and self.angles_to_target is not None
@@ -191,8 +209,9 @@ class TaskResult:
 
     def summary_line(self, stopped=False):
         """One line: outcome, time, intervention ratio, the collision ratio where the task
-        measures collisions (the obstacle task: `in_collision` is logged), target switches
-        and the peaks. `stopped`: the person ended the run before its end ("stopped at")."""
+        measures collisions (the obstacle task: `in_collision` is logged), target switches,
+        the peaks and, where measured, the interaction metrics. `stopped`: the person ended
+        the run before its end ("stopped at")."""
         outcome = "success" if self.success else "FAILED"
         # A reach task's collision_ratio is 0 because nothing measured it: left out.
         collisions = ("" if self.in_collision is None
@@ -211,7 +230,21 @@ class TaskResult:
                 f"{counted(self.switches, 'target switch', 'target switches')}, "
                 f"peak hand speed {_or_na(self.peak_hand_speed, 3)} m/s, "
                 f"peak command acceleration {_or_na(self.peak_command_acceleration, 2)} m/s^2"
-                f"{turning}{clipped}")
+                f"{turning}{clipped}{self._interaction_text()}")
+
+    def _interaction_text(self):
+        """The interaction metrics' part of `summary_line` ("" when not measured)."""
+        if self.input_integral is None:
+            return ""
+        text = (f", input {self.input_integral:.3f} m and {self.turn_input_integral:.3f} rad, "
+                f"idle ratio {_or_na(self.idle_ratio, 3)}, "
+                f"agreement {_or_na(self.agreement, 3)}")
+        if self.prediction_accuracy is None:
+            return text + ", no goal named"
+        never = self.unpredicted_switches or 0
+        return (text + f", prediction accuracy {self.prediction_accuracy:.3f}, "
+                f"time to prediction {_or_na(self.mean_time_to_prediction, 2)} s"
+                + (f" ({counted(never, 'switch', 'switches')} never named)" if never else ""))
 
 
 def _or_na(value, digits):
@@ -307,11 +340,13 @@ class SeriesPeaks:
     max_k |ee(t_{k+1}) - ee(t_k)| / control_period (m/s, ee = `ee_positions`) and
     max_k |v(k+1) - v(k)| / control_period (m/s^2, v = `commands[:, 3:6]`), None before two
     ticks; in the grasping task also the peak command angular change (rad/s per tick) and
-    the last tick's angle to the target; and, fed the `posterior_clipped_log` samples
-    (`add_clipped`), the ratio of ticks whose goal posterior was clipped."""
+    the last tick's angle to the target; the interaction metrics (`InteractionMeter`);
+    and, fed the `posterior_clipped_log` samples (`add_clipped`), the ratio of ticks whose
+    goal posterior was clipped."""
 
     def __init__(self, control_period):
         self._period = control_period
+        self._interaction = InteractionMeter(control_period)
         self._hand, self._command, self._turning = LargestStep(), LargestStep(), LargestStep()
         self._grasp = False
         self._final_angle = None
@@ -321,6 +356,12 @@ class SeriesPeaks:
         """Feeds the next ticks' series fields (a dict, see `task_series`)."""
         self._hand.add(series["ee_positions"])
         self._command.add(series["commands"][:, 3:6])
+        commands, twists = series["operator_commands"], series.get("operator_twists")
+        self._interaction.add(
+            series["times"], commands[:, :3],
+            commands[:, 3] if twists is None else np.asarray(twists)[:, 3:6],
+            series["operator_active"], series["ee_positions"], series["selected_goals"],
+            series["targets"])
         if series.get("angles_to_target") is not None:
             self._grasp = True
             self._turning.add(series["command_angular_velocities"])
@@ -344,6 +385,7 @@ class SeriesPeaks:
         if self._posterior_ticks:
             series = dict(series, posterior_clipped_ratio=(
                 self._clipped_ticks / self._posterior_ticks))
+        series = dict(series, **self._interaction.metrics().fields())
         return task_result(status, monitor, series, self._hand.peak(self._period),
                            self._command.peak(self._period))
 
@@ -376,4 +418,5 @@ def task_result(status, monitor, series, peak_hand_speed, peak_command_accelerat
         collision_ratio=float(status.collision_ratio),
         peak_hand_speed=peak_hand_speed,
         peak_command_acceleration=peak_command_acceleration,
+        idle_ratio=idle_ratio(status.intervention_ratio),
         **series)

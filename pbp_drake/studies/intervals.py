@@ -1,8 +1,10 @@
 """95 % confidence intervals of a method comparison's results, from its summary alone: the
 success rate's (Wilson's score interval) and the means' (Student's t, from the summary's
 mean and population standard deviation over the trials that ran, cut to the range the
-metric can take: a ratio's [0, 1], a time's [0, inf)), as a table below the results table
-(`pbp_drake.studies.report.results_table`)."""
+metric can take: a ratio's [0, 1], a time's [0, inf), a cosine's [-1, 1]), as a table below
+the results table (`pbp_drake.studies.report.results_table`). The interaction metrics'
+intervals are in the summary too (`pbp_drake.studies.summary`), over the trials that have a
+value (a method that names no goal has no prediction accuracy)."""
 
 import math
 
@@ -12,11 +14,20 @@ from pbp_drake.scenarios import METHOD_NAMES
 Z_95 = 1.959963984540054
 # The metrics whose mean gets an interval: (summary entry, column, digits, the range of
 # the metric's values).
-RATIO, TIME = (0.0, 1.0), (0.0, math.inf)
+RATIO, TIME, COSINE = (0.0, 1.0), (0.0, math.inf), (-1.0, 1.0)
+# The interaction metrics of `pbp_drake.core.interaction_metrics`, as the summary gives them
+# (`time_to_prediction`: the mean of each trial's mean over its switches).
+INTERACTION_MEANS = (("input_integral", "input (m)", 3, TIME),
+                     ("turn_input_integral", "turning input (rad)", 2, TIME),
+                     ("idle_ratio", "idle ratio", 3, RATIO),
+                     ("agreement", "agreement", 3, COSINE),
+                     ("prediction_accuracy", "prediction accuracy", 3, RATIO),
+                     ("time_to_prediction", "time to prediction (s)", 2, TIME))
 MEAN_METRICS = (("intervention_ratio", "intervention ratio", 3, RATIO),
                 ("task_time", "task time (s)", 1, TIME),
                 ("collision_ratio", "collision ratio", 3, RATIO),
-                ("posterior_clipped_ratio", "posterior at its clip", 3, RATIO))
+                ("posterior_clipped_ratio", "posterior at its clip", 3, RATIO),
+                *INTERACTION_MEANS)
 
 
 def wilson_interval(successes, trials, z=Z_95):
@@ -54,8 +65,9 @@ def _interval_cell(interval, digits, percent=False):
 def confidence_table(summary):
     """The Markdown lines of the 95 % intervals, one row per method: the success rate over
     the trials on disk, and the mean of each metric the summary holds (collisions where the
-    task measures them, the posterior's clip where a method records it) over the trials
-    that ran."""
+    task measures them, the posterior's clip where a method records it, the interaction
+    metrics where the trials record them) over the trials that ran (those with a value,
+    for a metric whose entry counts them)."""
     methods = summary["methods"]
     metrics = [metric for metric in MEAN_METRICS
                if any(metric[0] in entry for entry in methods.values())]
@@ -71,7 +83,7 @@ def confidence_table(summary):
         cells = [METHOD_NAMES.get(method, method), _interval_cell(success, 0, percent=True)]
         for key, _, digits, within in metrics:
             value = entry.get(key)
-            cells.append("-" if value is None else _interval_cell(
-                mean_interval(value["mean"], value["std"], ran, within), digits))
+            cells.append("-" if value is None else _interval_cell(mean_interval(
+                value["mean"], value["std"], value.get("count", ran), within), digits))
         lines.append("| " + " | ".join(cells) + " |")
     return lines

@@ -6,7 +6,7 @@ import pathlib
 
 from pbp_drake.studies.figures import (
     METHOD_LABELS, plot_collision_histogram, plot_intervention, plot_task_time)
-from pbp_drake.studies.intervals import confidence_table
+from pbp_drake.studies.intervals import INTERACTION_MEANS, confidence_table
 from pbp_drake.studies.splits import seeds_line
 from pbp_drake.studies.summary import summarize
 from pbp_drake.studies.trial_files import (
@@ -42,6 +42,30 @@ def _count(value):
     return "-" if value is None else str(value)
 
 
+def interaction_table(summary):
+    """The Markdown lines of the interaction metrics, one row per method: mean ± std of each
+    (`INTERACTION_MEANS`) over the trials with a value, and the switches never named of
+    all the switches; "-" where a method has none (no goal named, or trials written before
+    the metric). No lines when no method has any."""
+    methods = summary["methods"]
+    if not any(name in entry for entry in methods.values() for name, *_ in INTERACTION_MEANS):
+        return []
+    columns = ["method", *(column for _, column, _, _ in INTERACTION_MEANS),
+               "switches never named"]
+    lines = ["How the operator and the method worked together (mean ± std over the trials "
+             "with a value; see the docs' study page for each definition).", "",
+             "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    for method, entry in methods.items():
+        cells = [METHOD_LABELS.get(method, method)]
+        for name, _, digits, _ in INTERACTION_MEANS:
+            cells.append(_cell(entry, name, digits) if name in entry else "-")
+        latency = entry.get("time_to_prediction") or {}
+        switches = latency.get("switches")
+        cells.append(f"{latency['unpredicted_switches']} of {switches}" if switches else "-")
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
 # The units of the impairment's fields in the results' words.
 _IMPAIRMENT_UNITS = {"command_noise_time": " s", "command_delay": " s", "mistake_time": " s"}
 
@@ -66,8 +90,9 @@ def results_table(summary):
     where the task measures collisions; max / mean of the trials' peak hand speed and peak
     command acceleration (see `summarize`); how often HOP's goal posterior sat at its clip
     where a method records it. Above it, the seeds and, when it was impaired,
-    the virtual participant's condition (`participant_line`); below it the 95 % confidence
-    intervals (`pbp_drake.studies.intervals`)."""
+    the virtual participant's condition (`participant_line`); below it the interaction
+    metrics (`interaction_table`) and the 95 % confidence intervals
+    (`pbp_drake.studies.intervals`)."""
     seeds = seeds_line(summary)
     lines = [seeds, ""] if seeds else []
     participant = participant_line(summary)
@@ -97,6 +122,9 @@ def results_table(summary):
                     if "posterior_clipped_ratio" in entry else "-",) if clipped else ()),
                  str(entry["errors"])]
         lines.append("| " + " | ".join(cells) + " |")
+    interaction = interaction_table(summary)
+    if interaction:
+        lines += ["", *interaction]
     lines += ["", *confidence_table(summary)]
     if summary.get("damaged"):
         lines += ["", f"Skipped as damaged or foreign: {len(summary['damaged'])} files "

@@ -20,7 +20,7 @@ import numpy as np
 
 from pbp_drake.scenarios import resolve, with_method
 from pbp_drake.studies.trial_files import (
-    StudyError, json_float, running_marker, trial_record, write_trial)
+    StudyError, interaction_fields, json_float, running_marker, trial_record, write_trial)
 from pbp_drake.builder.run import run_task
 
 
@@ -62,7 +62,7 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
                       collision_ratio=json_float(result.collision_ratio),
                       peak_hand_speed=json_float(result.peak_hand_speed),
                       peak_command_acceleration=json_float(result.peak_command_acceleration),
-                      ticks=len(result.times))
+                      ticks=len(result.times), **interaction_fields(result))
         if result.posterior_clipped_ratio is not None:  # HOP's posterior (trial_files)
             record["posterior_clipped_ratio"] = json_float(result.posterior_clipped_ratio)
         if result.angles_to_target is not None:  # the grasping task's orientation

@@ -12,6 +12,7 @@ import numpy as np
 
 from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.scenarios import DynamicObstacles, parse_method_label
+from pbp_drake.studies.intervals import INTERACTION_MEANS, mean_interval
 from pbp_drake.studies.trial_files import trial_paths
 
 # Collision-ratio histogram: 20 bins of 0.05 over [0, 1] (the last bin includes 1).
@@ -103,6 +104,41 @@ def max_mean(values):
     return {"max": _round(max(values)), "mean": _round(math.fsum(values) / len(values))}
 
 
+def mean_with_interval(values, within):
+    """`{"mean", "std", "count", "interval"}` of the finite values: their mean and population
+    std (`mean_std`), how many, and the 95 % t interval of the mean cut to `within`
+    (`pbp_drake.studies.intervals.mean_interval`; None for fewer than two), rounded."""
+    values = [v for v in values if v is not None and math.isfinite(v)]
+    entry = {**mean_std(values), "count": len(values)}
+    interval = mean_interval(entry["mean"], entry["std"], len(values), within)
+    entry["interval"] = None if interval is None else [_round(v) for v in interval]
+    return entry
+
+
+# What each interaction metric's summary entry is made of: a trial's field.
+_TRIAL_VALUE = {"time_to_prediction": "mean_time_to_prediction"}
+
+
+def interaction_entries(ran):
+    """The interaction metrics' entries of a method's summary, from the records of its
+    trials that ran (`INTERACTION_MEANS`, each `mean_with_interval`): `time_to_prediction`
+    is over each trial's mean over its switches, with the study's count of `switches` and
+    of those never named (`unpredicted_switches`). A metric no record holds (trials written
+    before it) has no entry."""
+    entries = {}
+    for name, _, _, within in INTERACTION_MEANS:
+        field = _TRIAL_VALUE.get(name, name)
+        if any(field in record for record in ran):
+            entries[name] = mean_with_interval([r.get(field) for r in ran], within)
+    if "time_to_prediction" in entries:
+        lists = [r.get("time_to_prediction") for r in ran]
+        lists = [latencies for latencies in lists if latencies is not None]
+        entries["time_to_prediction"].update(
+            switches=sum(len(latencies) for latencies in lists),
+            unpredicted_switches=sum(t is None for latencies in lists for t in latencies))
+    return entries
+
+
 def collision_histogram(ratios):
     """Counts of collision ratios in the bins of HISTOGRAM_EDGES (the last includes 1)."""
     counts = [0] * (len(HISTOGRAM_EDGES) - 1)
@@ -180,8 +216,11 @@ def summarize(study, records, damaged=(), output=None):
     trial_files.read_study) gives each method's count of trials skipped as damaged (not
     counted as missing) and the summary's "damaged" list of files (paths relative to
     `output`) and problems. A method whose trials record how often HOP's goal posterior sat
-    at its clip (hop, predict_then_assist, the maxent_command estimator) gets the mean and std
-    of that `posterior_clipped_ratio` too; the others have no such entry."""
+    at its clip (hop, predict_then_assist, the maxent_command estimator) gets the mean and
+    std of that `posterior_clipped_ratio` too; the others have no such entry. The
+    interaction metrics (input, turning input, idle ratio, agreement, prediction accuracy,
+    time to prediction) get their mean, std, count and 95 % interval
+    (`interaction_entries`)."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),
@@ -213,6 +252,7 @@ def summarize(study, records, damaged=(), output=None):
             "peak_command_acceleration": max_mean(
                 [r.get("peak_command_acceleration") for r in ran]),
         }
+        entry.update(interaction_entries(ran))
         clipped = [r.get("posterior_clipped_ratio") for r in ran]
         if any(value is not None for value in clipped):
             entry["posterior_clipped_ratio"] = mean_std(clipped)

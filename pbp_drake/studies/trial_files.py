@@ -35,8 +35,14 @@ TRIAL_FORMAT = 1
 # (`TaskResult.posterior_clipped_ratio`), recorded by the methods with HOP's posterior only
 # (hop, predict_then_assist, the maxent_command estimator): other trials, and those written
 # before it, read it as None.
+# The interaction metrics (`pbp_drake.core.interaction_metrics`, `INTERACTION_METRICS`) are
+# in every trial run since they came; those written before read them as None.
+INTERACTION_METRICS = ("input_integral", "turn_input_integral", "idle_ratio", "agreement",
+                       "prediction_accuracy", "time_to_prediction", "mean_time_to_prediction",
+                       "unpredicted_switches")
 METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio",
-           "peak_hand_speed", "peak_command_acceleration", "posterior_clipped_ratio")
+           "peak_hand_speed", "peak_command_acceleration", "posterior_clipped_ratio",
+           *INTERACTION_METRICS)
 TRIAL_FIELDS = ("method", "trial", "seed", *METRICS, "error")
 
 
@@ -156,8 +162,26 @@ def trial_record(scenario_name, digest, method, trial, seed):
             "method": method, "trial": trial, "seed": seed, "success": False,
             "task_time": None, "intervention_ratio": None, "switches": None,
             "collision_ratio": None, "peak_hand_speed": None,
-            "peak_command_acceleration": None, "ticks": 0, "objects": None, "targets": None,
-            "time_series": None, "error": None, "drake_warnings": 0, "wall_time": None}
+            "peak_command_acceleration": None,
+            **dict.fromkeys(INTERACTION_METRICS), "ticks": 0, "objects": None,
+            "targets": None, "time_series": None, "error": None, "drake_warnings": 0,
+            "wall_time": None}
+
+
+def interaction_fields(result):
+    """The interaction metrics of a TaskResult as a trial record's fields: JSON numbers
+    (None for NaN), a list for `time_to_prediction`, an int for `unpredicted_switches`."""
+    fields = {}
+    for name in INTERACTION_METRICS:
+        value = getattr(result, name)
+        if name == "time_to_prediction":
+            value = None if value is None else [json_float(t) for t in value]
+        elif name == "unpredicted_switches":
+            value = None if value is None else int(value)
+        else:
+            value = json_float(value)
+        fields[name] = value
+    return fields
 
 
 def write_trial(output, record, result=None):
@@ -208,6 +232,8 @@ _TYPES = {"scenario": (str,), "scenario_hash": (str,), "trial": (int,), "task_ti
           "intervention_ratio": _NUMBER, "switches": (int,), "collision_ratio": _NUMBER,
           "peak_hand_speed": _NUMBER, "peak_command_acceleration": _NUMBER,
           "posterior_clipped_ratio": _NUMBER, "ticks": (int,),
+          **dict.fromkeys(INTERACTION_METRICS, _NUMBER), "time_to_prediction": (list,),
+          "unpredicted_switches": (int,),
           "objects": (list,), "targets": (list,), "time_series": (str,), "error": (str,)}
 _INTEGER_COLUMNS = {"operator_active", "selected_goal", "target", "in_collision"}
 
@@ -304,7 +330,8 @@ def load_task_result(output, method, seed):
         collision_ratio=record["collision_ratio"], in_collision=in_collision,
         peak_hand_speed=record.get("peak_hand_speed"),
         peak_command_acceleration=record.get("peak_command_acceleration"),
-        peak_command_angular_change=record.get("peak_command_angular_change"), **grasp)
+        peak_command_angular_change=record.get("peak_command_angular_change"),
+        **{name: record.get(name) for name in INTERACTION_METRICS}, **grasp)
 
 
 def read_trial(output, method, seed, digest=None, damaged=None, key=None):

@@ -200,6 +200,10 @@ def test_run_with_the_virtual_participant_prints_one_result_line(tmp_path, capsy
     # The same seeded run as pbp_run: the line gives its peaks.
     assert (f", peak hand speed {pbp_run.peak_hand_speed:.3f} m/s, peak command "
             f"acceleration {pbp_run.peak_command_acceleration:.2f} m/s^2") in out
+    # And how the participant and PBP worked together.
+    assert (f", input {pbp_run.input_integral:.3f} m and {pbp_run.turn_input_integral:.3f} "
+            f"rad, idle ratio {pbp_run.idle_ratio:.3f}, agreement {pbp_run.agreement:.3f}, "
+            f"prediction accuracy {pbp_run.prediction_accuracy:.3f}") in out
     assert record.stat().st_size > 10_000
 
 

@@ -1,7 +1,7 @@
 """An HSR task streamed to a CSV file gives the run `run_task` gives: the same metrics and
-peaks, and the file holds the rows `run_task`'s series would (its loggers emptied as it
-goes), the grasping task's too (the rows of a study's trial CSV). The soak keeps memory
-flat over several minutes of runs."""
+peaks (the interaction metrics up to their sums' rounding), and the file holds the rows
+`run_task`'s series would (its loggers emptied as it goes), the grasping task's too (the
+rows of a study's trial CSV). The soak keeps memory flat over several minutes of runs."""
 
 import dataclasses
 
@@ -45,6 +45,13 @@ def test_a_streamed_run_matches_the_in_memory_run(repo, tmp_path, file_name, dur
     for metric in METRICS:
         assert getattr(streamed, metric) == getattr(in_memory, metric), metric
     assert streamed.peak_hand_speed is not None
+    # The interaction metrics, summed chunk by chunk: the same up to the sums' rounding.
+    for metric in ("input_integral", "turn_input_integral", "idle_ratio", "agreement",
+                   "prediction_accuracy", "mean_time_to_prediction"):
+        assert getattr(streamed, metric) == pytest.approx(getattr(in_memory, metric),
+                                                          rel=1e-12, abs=1e-15), metric
+    assert streamed.time_to_prediction == in_memory.time_to_prediction
+    assert streamed.unpredicted_switches == in_memory.unpredicted_switches
     # Row for row what a study would write for the in-memory run, and readable as a trial's.
     assert log.read_text() == time_series_csv(in_memory)
     assert len(read_time_series(log, len(in_memory.times))["time"]) == len(in_memory.times)

@@ -31,9 +31,14 @@ def test_the_markdown_names_the_command_and_seeds_then_the_table(hsr_study, tmp_
     rows = [line for line in lines if line.startswith("| ")]
     assert rows[0].startswith("| method | trials | success |")
     assert [row.split(" | ")[0] for row in rows[1:3]] == ["| PBP-Alt", "| Teleop"]
-    # Below it, each method's 95 % intervals (a single trial has none for its means).
-    assert rows[3].startswith("| method | success | intervention ratio | task time (s) |")
-    assert rows[4:] == ["| PBP-Alt | [21, 100] % | - | - |", "| Teleop | [21, 100] % | - | - |"]
+    # Below it, the interaction metrics, then each method's 95 % intervals (a single trial
+    # has none for its means).
+    assert rows[3].startswith("| method | input (m) | turning input (rad) | idle ratio |")
+    assert [row.split(" | ")[0] for row in rows[4:6]] == ["| PBP-Alt", "| Teleop"]
+    assert rows[6].startswith("| method | success | intervention ratio | task time (s) |")
+    no_interval = " | -" * 8 + " |"
+    assert rows[7:] == ["| PBP-Alt | [21, 100] %" + no_interval,
+                        "| Teleop | [21, 100] %" + no_interval]
     # The table is results.md's; the summary is the same bytes as the study wrote.
     assert markdown.read_text().endswith((hsr_study / "results.md").read_text())
     assert (hsr_study / "summary.json").read_bytes() == summary

@@ -1,0 +1,198 @@
+"""How an operator and a shared-control method worked together over one task, from the
+task's per-tick series (`InteractionMetrics` defines each metric): how much the operator
+gave, how well the hand did what it asked, how early and how often the method named the
+target. With the task monitor's `intervention_ratio`, `idle_ratio` is its complement on the
+same ticks.
+
+`InteractionMeter` takes the series whole or chunk by chunk (a streamed run);
+`interaction_metrics` is the same on whole arrays. The series are those of a task's time
+series, one row per control tick k, the command of tick k held until tick k + 1: `times`
+(T,) s; the operator's commanded translational velocity (T, 3) m/s, world frame, and its
+turning, (T,) rad/s (a yaw rate) or (T, 3) (an angular velocity); whether it acted (T,)
+bools; the hand's position (T, 3) m; the goal the method names (T,) object indices, -1 on
+a tick where it names none; the current target (T,) object indices.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+# Below this speed (m/s) a command or the hand's motion has no direction to compare.
+STILL_SPEED = 1e-3
+
+
+def idle_ratio(intervention_ratio):
+    """The share of the task's ticks with no operator input, counted on the ticks the task
+    monitor counts for `intervention_ratio` (every control tick from the first to the one
+    that ended the task): `1 - intervention_ratio`, None when that is None."""
+    return None if intervention_ratio is None else 1.0 - float(intervention_ratio)
+
+
+@dataclasses.dataclass(frozen=True)
+class InteractionMetrics:
+    """The interaction metrics of one task.
+
+    - `input_integral` (m): the integral over the task of the operator's translational
+      command's norm while it acts, `sum_k active_k |v_k| control_period`;
+      `turn_input_integral` (rad) the same of its turning (the yaw rate's magnitude, or the
+      angular velocity's norm).
+    - `agreement`: over the ticks the operator acts, the mean cosine between its commanded
+      translational velocity `v_k` and the hand's executed one over that tick,
+      `(p_{k+1} - p_k) / control_period`: 1 when the hand goes where it pushes, -1 when
+      the opposite way. Ticks where either is slower than `STILL_SPEED`, and the last
+      tick (whose motion is not in the series), are left out; None when none is left.
+    - `prediction_accuracy`: the share of the ticks whose named goal is the current target
+      (a tick naming none counts as not naming it); None when no tick names a goal (a
+      method that shows no intent).
+    - `time_to_prediction` (s): for each target switch in order, the first target at the
+      first tick included (a switch: a tick whose target differs from the tick before's),
+      the time from the switch's tick to the first tick from which the named goal is the
+      new target on every tick up to the next switch or the end; None for a switch never
+      so named. None as a whole when no tick names a goal. `mean_time_to_prediction` is
+      its mean over the switches that got one, `unpredicted_switches` the count of the
+      others.
+    """
+
+    input_integral: float
+    turn_input_integral: float
+    agreement: float | None
+    prediction_accuracy: float | None
+    time_to_prediction: tuple | None
+
+    @property
+    def mean_time_to_prediction(self):
+        """The mean of `time_to_prediction` over the switches that got one, or None."""
+        named = [t for t in self.time_to_prediction or () if t is not None]
+        return math.fsum(named) / len(named) if named else None
+
+    @property
+    def unpredicted_switches(self):
+        """How many switches the method never named, or None where no tick names a goal."""
+        if self.time_to_prediction is None:
+            return None
+        return sum(t is None for t in self.time_to_prediction)
+
+    def fields(self):
+        """The metrics by name, the derived two included, as plain Python values (a list
+        for `time_to_prediction`)."""
+        latencies = self.time_to_prediction
+        return {"input_integral": self.input_integral,
+                "turn_input_integral": self.turn_input_integral,
+                "agreement": self.agreement,
+                "prediction_accuracy": self.prediction_accuracy,
+                "time_to_prediction": None if latencies is None else list(latencies),
+                "mean_time_to_prediction": self.mean_time_to_prediction,
+                "unpredicted_switches": self.unpredicted_switches}
+
+
+class InteractionMeter:
+    """`InteractionMetrics` of a series fed whole or in consecutive chunks (`add`): what
+    crosses a chunk boundary (the last tick's hand position and command, the current
+    switch and how long its target has been named) is carried over."""
+
+    def __init__(self, control_period, still_speed=STILL_SPEED):
+        self._period = float(control_period)
+        self._still = float(still_speed)
+        self._input = self._turn = 0.0
+        self._cosines, self._cosine_count = 0.0, 0
+        self._last = None  # (position, velocity command, active) of the last tick fed
+        self._ticks = self._named_ticks = 0
+        self._shown = False
+        self._target = None
+        self._switch_time = None
+        self._named_since = None  # when the target began to be named without a break
+        self._latencies = []
+
+    def add(self, times, operator_velocity, operator_turn, operator_active, hand_positions,
+            predicted_goals, targets):
+        """Feeds the next ticks' series (as `interaction_metrics` takes them)."""
+        times = np.asarray(times, float).reshape(-1)
+        if len(times) == 0:
+            return
+        velocity = np.asarray(operator_velocity, float).reshape(len(times), -1)
+        turn = np.asarray(operator_turn, float)
+        turn = np.abs(turn) if turn.ndim == 1 else np.linalg.norm(turn, axis=1)
+        active = np.asarray(operator_active, bool).reshape(-1)
+        positions = np.asarray(hand_positions, float).reshape(len(times), -1)
+        speeds = np.linalg.norm(velocity, axis=1)
+        self._input += float(speeds[active].sum()) * self._period
+        self._turn += float(turn[active].sum()) * self._period
+        self._add_agreement(velocity, active, positions)
+        self._add_predictions(times, np.asarray(predicted_goals, int).reshape(-1),
+                              np.asarray(targets, int).reshape(-1))
+
+    def _add_agreement(self, velocity, active, positions):
+        if self._last is not None:
+            position, command, acting = self._last
+            positions = np.vstack([position, positions])
+            velocity = np.vstack([command, velocity])
+            active = np.concatenate([[acting], active])
+        self._last = (positions[-1].copy(), velocity[-1].copy(), bool(active[-1]))
+        # Tick k's command against the hand's motion from t_k to t_{k+1}.
+        hand = np.diff(positions, axis=0) / self._period
+        command = velocity[:-1]
+        hand_speed = np.linalg.norm(hand, axis=1)
+        command_speed = np.linalg.norm(command, axis=1)
+        used = active[:-1] & (hand_speed >= self._still) & (command_speed >= self._still)
+        cosines = (np.einsum("ij,ij->i", command[used], hand[used])
+                   / (command_speed[used] * hand_speed[used]))
+        self._cosines += math.fsum(cosines)
+        self._cosine_count += int(used.sum())
+
+    def _add_predictions(self, times, predicted, targets):
+        named = predicted == targets
+        self._ticks += len(times)
+        self._named_ticks += int(named.sum())
+        self._shown = self._shown or bool(np.any(predicted >= 0))
+        before = np.concatenate([[-1 if self._target is None else self._target], targets[:-1]])
+        switches = np.flatnonzero(targets != before)
+        if self._target is None:
+            switches = np.union1d([0], switches)
+        starts = set(switches.tolist())
+        bounds = sorted(starts | {0, len(times)})
+        for begin, end in zip(bounds, bounds[1:]):
+            if begin in starts:
+                self._close_switch()
+                self._target, self._switch_time, self._named_since = (
+                    int(targets[begin]), float(times[begin]), None)
+            missed = np.flatnonzero(~named[begin:end])
+            if len(missed) == 0:
+                if self._named_since is None:
+                    self._named_since = float(times[begin])
+            else:
+                after = begin + int(missed[-1]) + 1
+                self._named_since = float(times[after]) if after < end else None
+
+    def _close_switch(self):
+        if self._switch_time is not None:
+            self._latencies.append(self._latency())
+
+    def _latency(self):
+        return None if self._named_since is None else self._named_since - self._switch_time
+
+    def metrics(self):
+        """The `InteractionMetrics` of every tick fed so far."""
+        latencies = None
+        if self._shown:
+            latencies = tuple(self._latencies) + (
+                (self._latency(),) if self._switch_time is not None else ())
+        return InteractionMetrics(
+            input_integral=self._input, turn_input_integral=self._turn,
+            agreement=(self._cosines / self._cosine_count if self._cosine_count else None),
+            prediction_accuracy=(self._named_ticks / self._ticks
+                                 if self._shown and self._ticks else None),
+            time_to_prediction=latencies)
+
+
+def interaction_metrics(times, control_period, operator_velocity, operator_turn,
+                        operator_active, hand_positions, predicted_goals, targets,
+                        still_speed=STILL_SPEED):
+    """The `InteractionMetrics` of one task's whole series: `times` (T,) s, the operator's
+    translational command (T, 3) m/s and turning (T,) or (T, 3) rad/s, whether it acted
+    (T,), the hand's positions (T, 3) m, the named goal (T,) (-1: none) and the target
+    (T,), one row per control tick of `control_period` s."""
+    meter = InteractionMeter(control_period, still_speed)
+    meter.add(times, operator_velocity, operator_turn, operator_active, hand_positions,
+              predicted_goals, targets)
+    return meter.metrics()

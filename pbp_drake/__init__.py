@@ -96,7 +96,7 @@ API_GROUPS = {
             "NoOperator", "ScriptedCommands", "SinusoidalStep", "ObstacleRepulsion",
             "BentPath", "RecordedPath", "Obstacle", "MethodComparison", "AlphaStudy",
             "AltVsCont", "SceneVariant", "NoisyPilot", "LaggyPilot", "ProportionalPilot",
-            "ParticipantPopulation", "PILOT_NAMES", "with_pilot"]},
+            "ParticipantPopulation", "with_pilot"]},
     "Building and running": {
         name: "pbp_drake.builder" for name in [
             "build_diagram", "make_pbp_controller", "find_system", "simulate", "run_task",

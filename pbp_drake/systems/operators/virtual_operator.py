@@ -230,6 +230,7 @@ class VirtualOperator(SampledOperator):
     def _update(self, context, discrete_state):
         # The belief moves first, and the command of this tick acts on the new belief.
         known, unseen_ticks = context.get_discrete_state(self._belief_index).value()
+        known_before = known
         shown = Target(self._target_port.Eval(context)).index
         if known < 0:
             known, unseen_ticks = shown, 0  # the first target is known from the start
@@ -240,13 +241,17 @@ class VirtualOperator(SampledOperator):
         # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
         discrete_state.set_value(self._belief_index, [known, unseen_ticks])
         own_motion = self._perceive(context, discrete_state)
+        # A target it has just come to know: it watches the robot afresh.
+        serving = (ServingMemory() if known != known_before else ServingMemory.from_vector(
+            context.get_discrete_state(self._serving_index).value()))
         if self._obstacles_port is not None:
-            command, active = self._avoid(context, discrete_state, int(known), own_motion)
+            command, active = self._avoid(context, discrete_state, int(known), own_motion,
+                                          serving)
         else:
             heads_for = (self._heads_for(context, discrete_state, int(known))
                          if self._mistakes else int(known))
             command, active = self._decide(context, discrete_state, int(known), heads_for,
-                                           own_motion)
+                                           own_motion, serving)
         if self._noise_scales is not None:
             command = self._add_motor_noise(context, discrete_state, command, active)
         self._store_sample(discrete_state, command, active)
@@ -296,10 +301,10 @@ class VirtualOperator(SampledOperator):
         return (rng.normal(0.0, self._direction_noise),
                 max(0.0, 1.0 + rng.normal(0.0, self._speed_noise)))
 
-    def _avoid(self, context, discrete_state, known_target, own_motion):
+    def _avoid(self, context, discrete_state, known_target, own_motion, serving):
         """The command while obstacles are about: a local plan around them (see the class
-        docstring), `own_motion` the robot's own motion as it perceives it. Returns
-        `(command, active)`."""
+        docstring), `own_motion` the robot's own motion as it perceives it and `serving`
+        its `ServingMemory`. Returns `(command, active)`."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         hand = np.array([ee_state.x, ee_state.y])
         velocity = np.array([ee_state.vx, ee_state.vy])
@@ -345,7 +350,7 @@ class VirtualOperator(SampledOperator):
         pushing_through = is_pushing_through(track[watch])
         if not shows:
             act, memory = serving_step(
-                params, self._speed, self._period, self._serving(context), NO_INTENT,
+                params, self._speed, self._period, serving, NO_INTENT,
                 known_target, offset, velocity, own_motion[:2])
             discrete_state.set_value(self._serving_index, memory.as_vector())
             if not act:
@@ -444,15 +449,11 @@ class VirtualOperator(SampledOperator):
         best = int(np.argmax(score))
         return velocities[best], yaw_rates[best], clear[best]
 
-    def _serving(self, context):
-        return ServingMemory.from_vector(
-            context.get_discrete_state(self._serving_index).value())
-
-    def _decide(self, context, discrete_state, known_target, heads_for, own_motion):
+    def _decide(self, context, discrete_state, known_target, heads_for, own_motion, serving):
         """The command in the reaching task, toward object `heads_for` (the known target,
         unless it has mistaken it for another): whether to act by the one rule of
         `participant_serving`, and what to press with the keys it has
-        (`participant_reach`). Returns `(command, active)`."""
+        (`participant_reach`); `serving` its `ServingMemory`. Returns `(command, active)`."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         position, heading = position_of(ee_state), ee_state.heading
         target = Target(self._target_port.Eval(context))
@@ -474,7 +475,7 @@ class VirtualOperator(SampledOperator):
         axes = 3 if self._vertical else 2
         velocity_now = np.array([ee_state.vx, ee_state.vy, ee_state.vz])[:axes]
         act, memory = serving_step(
-            self.params, self._speed, self._period, self._serving(context), shown,
+            self.params, self._speed, self._period, serving, shown,
             known_target, (target_position - position)[:axes], velocity_now,
             own_motion[:axes])
         discrete_state.set_value(self._serving_index, memory.as_vector())

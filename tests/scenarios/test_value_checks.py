@@ -117,11 +117,14 @@ def test_the_participant_fields_are_checked_in_the_reaching_task_too(tmp_path):
     ("reposition_time: -1.0", "reposition_time must be finite and not negative, got -1.0"),
     ("aligned_angle: -0.05", "aligned_angle must be finite and not negative"),
     ("aside_speed_fraction: -0.5", "aside_speed_fraction must be finite and not negative"),
+    ("serve_speed_fraction: -0.5", "serve_speed_fraction must be finite and not negative"),
+    ("serve_patience: .nan", "serve_patience: NaN is not a number here"),
+    ("hold_time: -0.5", "hold_time must be finite and not negative"),
 ])
 def test_a_bad_reaching_participant_value_is_refused_naming_its_field(tmp_path, line,
                                                                       message):
     text = (DIAGRAMS / "arm_reach.yaml").read_text()
-    old = "    reaction_delay: 0.3\n"
+    old = "    reaction_delay: 0.0\n"
     assert old in text
     path = tmp_path / "arm_reach.yaml"
     path.write_text(text.replace(old, f"{old}    {line}\n", 1))

@@ -17,8 +17,10 @@ from pbp_drake.scenarios.schema import (
     AlphaStudy, AltVsCont, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask, Hsr, Keyboard, MethodComparison,
     MultiGoalReach, NoOperator, Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot,
     RecordedPath, Scenario, ScenarioError, ScenarioFile, SceneVariant, ScriptedCommands,
-    SinusoidalStep, VirtualParticipant)
+    SinusoidalStep, VirtualParticipant, NoisyPilot, LaggyPilot, ProportionalPilot,
+    ParticipantPopulation, PILOT_CONFIGS)
 from pbp_drake.scenarios.words import METHOD_NAMES, counted
+from pbp_drake.scenarios.pilots import PILOT_NAMES, PILOTS, check_pilot_name, with_pilot
 
 __all__ = [
     "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHOD_NAMES", "METHODS", "OPERATOR_DRIVES",
@@ -29,6 +31,8 @@ __all__ = [
     "NoOperator", "Obstacle", "ObstacleRepulsion", "OperatorConfig", "PointRobot",
     "RecordedPath", "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile",
     "SceneVariant", "ScriptedCommands", "SinusoidalStep", "TaskScene", "VirtualParticipant",
+    "NoisyPilot", "LaggyPilot", "ProportionalPilot", "ParticipantPopulation", "PILOT_CONFIGS",
+    "PILOT_NAMES", "PILOTS", "check_pilot_name", "with_pilot",
     "check_alpha_study", "check_method_comparison", "counted", "demonstration_samples",
     "load_scenario_file", "parse_method_label", "resolve", "task_scene", "with_method",
 ]

@@ -34,6 +34,9 @@ from pbp_drake.systems.operators.keyboard_operator import KeyboardParams
 from pbp_drake.systems.operators.obstacle_repulsion_operator import ObstacleRepulsionParams
 from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.core.participant_params import VirtualParticipantParams
+from pbp_drake.core.pilot_population import ParticipantPopulationParams
+from pbp_drake.core.surrogate_pilots import (
+    LaggyPilotParams, NoisyPilotParams, ProportionalPilotParams)
 
 def _config_from_yaml(config_type, text):
     return yaml_load_typed(schema=config_type, data=text)
@@ -201,9 +204,32 @@ class VirtualParticipant(VirtualParticipantParams):
     """`operator: !VirtualParticipant {...}`: the stand-in for the paper's participants."""
 
 
+# The field's surrogate pilots (`pbp_drake.scenarios.pilots` is their registry; each
+# `participant:` is an untagged `VirtualParticipantParams` mapping).
+class NoisyPilot(NoisyPilotParams):
+    """`operator: !NoisyPilot {eps: 0.3, participant: {...}}`: the virtual participant
+    whose output is, each tick with probability eps, a random key state."""
+
+
+class LaggyPilot(LaggyPilotParams):
+    """`operator: !LaggyPilot {p: 0.85, participant: {...}}`: the virtual participant
+    that repeats its previous output with probability p (per 1/50 s)."""
+
+
+class ProportionalPilot(ProportionalPilotParams):
+    """`operator: !ProportionalPilot {gain: 10, max_speed: 0}`: HOP's simulated user."""
+
+
+class ParticipantPopulation(ParticipantPopulationParams):
+    """`operator: !ParticipantPopulation {...}`: each trial's participant drawn from its
+    seed over ranges of conformance, proficiency, aggressiveness and speed."""
+
+
+PILOT_CONFIGS = (NoisyPilot, LaggyPilot, ProportionalPilot, ParticipantPopulation)
 OperatorConfig = typing.Union[NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands,
-                              Keyboard, Gamepad, VirtualParticipant]
-HSR_OPERATORS = (NoOperator, Keyboard, Gamepad, VirtualParticipant)
+                              Keyboard, Gamepad, VirtualParticipant, NoisyPilot, LaggyPilot,
+                              ProportionalPilot, ParticipantPopulation]
+HSR_OPERATORS = (NoOperator, Keyboard, Gamepad, VirtualParticipant, *PILOT_CONFIGS)
 TOY_OPERATORS = (NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands)
 # The names `pbp-drake run --operator` takes for the HSR tasks.
 OPERATOR_NAMES = {"keyboard": Keyboard, "gamepad": Gamepad, "virtual": VirtualParticipant,

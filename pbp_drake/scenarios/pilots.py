@@ -1,0 +1,87 @@
+"""The registry of surrogate pilots: the operators a study runs every method under
+(`pbp-drake study --pilots ...`), by name.
+
+``attentive`` is the scenario's own virtual participant; the others are the field's
+surrogate pilots (docs/concepts/pilots.md), each a tagged operator config of the schema
+(`NoisyPilot`, `LaggyPilot`, `ProportionalPilot`, `ParticipantPopulation`). A pilot is its
+module (its math in `pbp_drake.core`, its system in `pbp_drake.systems.operators`) and one
+entry in `PILOTS`: its tag, and how its defaults follow from the scenario's participant.
+`with_pilot(scenario, name)` is what a study calls for each name.
+"""
+
+import copy
+import dataclasses
+
+from pbp_drake.core.participant_params import VirtualParticipantParams
+from pbp_drake.scenarios.resolution import close_match
+from pbp_drake.scenarios.schema import (
+    LaggyPilot, NoisyPilot, ParticipantPopulation, ProportionalPilot, ScenarioError,
+    VirtualParticipant)
+
+#: The scenario's own participant, unchanged.
+ATTENTIVE = "attentive"
+
+
+@dataclasses.dataclass(frozen=True)
+class Pilot:
+    """One registry entry: the pilot's tag (schema class) and its config with its defaults,
+    based on the scenario's participant (`VirtualParticipantParams`)."""
+
+    tag: type
+    from_participant: object
+
+
+PILOTS = {
+    "noisy": Pilot(NoisyPilot, lambda participant: NoisyPilot(participant=participant)),
+    "laggy": Pilot(LaggyPilot, lambda participant: LaggyPilot(participant=participant)),
+    # HOP's user moves at the participant's speed (0: the task's operator speed).
+    "proportional": Pilot(ProportionalPilot,
+                          lambda participant: ProportionalPilot(max_speed=participant.speed)),
+    "population": Pilot(ParticipantPopulation,
+                        lambda participant: ParticipantPopulation(participant=participant)),
+}
+#: The names `pbp-drake study --pilots` takes, `attentive` first.
+PILOT_NAMES = (ATTENTIVE, *PILOTS)
+
+
+def participant_params(participant):
+    """A plain `VirtualParticipantParams` copy of `participant` (a `!VirtualParticipant`
+    config or the params themselves): what a pilot's `participant:` field holds."""
+    return VirtualParticipantParams(**{
+        field.name: copy.deepcopy(getattr(participant, field.name))
+        for field in dataclasses.fields(VirtualParticipantParams)})
+
+
+def check_pilot_name(name, field="pilot"):
+    """Raises ScenarioError unless `name` is one of PILOT_NAMES (with did-you-mean)."""
+    if name not in PILOT_NAMES:
+        raise ScenarioError(f"{field} {name!r} is unknown; choose one of "
+                            f"{', '.join(PILOT_NAMES)}{close_match(str(name), PILOT_NAMES)}")
+
+
+def with_pilot(scenario, name):
+    """A copy of `scenario` whose operator is the pilot `name` with its defaults, based on
+    the scenario's own `!VirtualParticipant` params; `attentive` returns `scenario`
+    itself. Raises ScenarioError for an unknown name (did-you-mean) or a scenario whose
+    operator is not the virtual participant."""
+    check_pilot_name(name)
+    if name == ATTENTIVE:
+        return scenario
+    operator = scenario.operator
+    if not isinstance(operator, VirtualParticipant):
+        raise ScenarioError(
+            f"pilot {name!r} stands in for the virtual participant: scenario.operator is "
+            f"!{type(operator).__name__}; expected !VirtualParticipant")
+    config = PILOTS[name].from_participant(participant_params(operator))
+    return dataclasses.replace(scenario, operator=config)
+
+
+def pilot_name(config):
+    """The registry name of an operator config (`attentive` for the participant), or
+    None for an operator that is neither."""
+    if isinstance(config, VirtualParticipant):
+        return ATTENTIVE
+    for name, pilot in PILOTS.items():
+        if isinstance(config, pilot.tag):
+            return name
+    return None

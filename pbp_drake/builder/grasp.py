@@ -41,6 +41,7 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
+from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.hindsight_optimization import HOP_METHODS
@@ -50,12 +51,14 @@ from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
 from pbp_drake.scenarios import (
-    OPERATOR_DRIVES, Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant)
+    OPERATOR_DRIVES, PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ScenarioError,
+    VirtualParticipant)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
     PoseGoalEstimator, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
 from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator, PoseGamepadParams
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import GraspSceneVisualizer
+from pbp_drake.systems.operators.pilot_filters import GraspKeys
 from pbp_drake.systems.operators.pose_keyboard_operator import (
     PoseKeyboardOperator, PoseKeyboardParams)
 from pbp_drake.systems.ports import OperatorTwist
@@ -69,7 +72,7 @@ MAX_HAND_ANGULAR_SPEED = 1.0
 # How many poses ahead the page draws the selected DMP's path, over the DMPs' duration (as
 # the reach task's TASK_PREDICTION_SAMPLES).
 GRASP_PREDICTION_SAMPLES = 40
-_OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad)
+_OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad, *PILOT_CONFIGS)
 
 
 def check_grasp_buildable(scenario):
@@ -251,6 +254,9 @@ def _operator(resolved, grasps, meshcat):
         return PoseGamepadOperator(meshcat, period, teleop, PoseGamepadParams(
             config.speed, config.rotation_speed, config.dead_zone),
             nominal_speed=resolved.nominal_speed)
+    if isinstance(config, PILOT_CONFIGS):  # a surrogate pilot (`scenarios.pilots`)
+        return make_pilot(resolved, lambda participant: _operator(participant, grasps, meshcat),
+                          GraspKeys)
     participant = GraspParticipant.create(
         GraspParticipantParams.from_virtual_participant(scenario.operator),
         "drive" if teleop else "assist", resolved.nominal_speed,

@@ -3,12 +3,14 @@ at the keyboard or gamepad, or the virtual participant, in the tasks (HSR or arm
 
 import numpy as np
 
+from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.scenarios import (
-    OPERATOR_DRIVES, Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
+    PILOT_CONFIGS, OPERATOR_DRIVES, Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
     ScriptedCommands, SinusoidalStep, VirtualParticipant)
 from pbp_drake.systems import (
     GamepadOperator, KeyboardOperator, IdleOperator, ObstacleRepulsionOperator, ScriptedOperator,
     VirtualOperator)
+from pbp_drake.systems.operators.pilot_filters import ReachKeys
 from pbp_drake.systems.ports import OperatorCommand
 
 
@@ -55,6 +57,10 @@ def make_hsr_operator(resolved, meshcat):
     vertical = bool(getattr(scenario.task, "z_range", None))
     if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
         return IdleOperator(OperatorCommand.size, period)
+    if isinstance(config, PILOT_CONFIGS):  # a surrogate pilot (`scenarios.pilots`)
+        return make_pilot(resolved, lambda participant: make_hsr_operator(participant, meshcat),
+                          lambda speed, rotation: ReachKeys(speed, rotation, vertical),
+                          len(resolved.station.obstacles))
     if isinstance(config, VirtualParticipant):
         obstacles = resolved.station.obstacles
         return VirtualOperator(

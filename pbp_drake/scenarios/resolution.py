@@ -28,11 +28,12 @@ from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles,
     Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands,
-    SinusoidalStep, VirtualParticipant)
+    PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
+    VirtualParticipant)
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
     check_grasp_task, check_numbers, check_obstacle_task, check_reach_task, check_seed,
-    check_time_steps, check_virtual_participant, require_finite)
+    check_pilot, check_time_steps, check_virtual_participant, require_finite)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator;
 # HOP and policy blending have no blender: their assistance is the HOP controller's).
@@ -344,9 +345,12 @@ def _resolve_task_robot(scenario):
         raise ScenarioError("scenario.control_period must be a whole multiple of "
                             f"{station_field}.plant.time_step")
     operator = scenario.operator
-    require_finite(operator, "scenario.operator",
-                   ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
-                    "direction_noise", "speed_noise"), positive=False)
+    if isinstance(operator, PILOT_CONFIGS):
+        check_pilot(operator)  # its participant's fields too; a population's are ranges
+    else:
+        require_finite(operator, "scenario.operator",
+                       ("speed", "rotation_speed", "hold_time", "dead_zone", "reaction_delay",
+                        "direction_noise", "speed_noise"), positive=False)
     if isinstance(operator, VirtualParticipant):
         check_virtual_participant(operator)
     _check_hand_over(scenario)
@@ -438,7 +442,8 @@ def _check_hand_over(scenario):
             check_limit(robot.max_heading_turn, "scenario.robot.max_heading_turn", "rad")
     except ValueError as error:
         raise ScenarioError(str(error)) from None
-    speed = max(robot.speed, getattr(scenario.operator, "speed", 0.0))
+    operator_speed, turn = _operator_top_speeds(scenario)
+    speed = max(robot.speed, operator_speed)
     if speed > top_speed:
         raise ScenarioError(
             f"scenario.robot.max_hand_speed {top_speed} m/s is below the task's speed "
@@ -448,12 +453,25 @@ def _check_hand_over(scenario):
             f"scenario.robot.max_hand_acceleration {acceleration} m/s^2 takes "
             f"{speed / acceleration:.1f} s to reach the task's speed {speed} m/s, longer "
             f"than scenario.duration {scenario.duration} s: raise it")
-    turn = getattr(scenario.operator, "rotation_speed", 0.0)
     if turn / yaw_acceleration > scenario.duration:
         raise ScenarioError(
             f"scenario.robot.max_hand_yaw_acceleration {yaw_acceleration} rad/s^2 takes "
             f"{turn / yaw_acceleration:.1f} s to reach the operator's rotation_speed {turn} "
             f"rad/s, longer than scenario.duration {scenario.duration} s: raise it")
+
+
+def _operator_top_speeds(scenario):
+    """`(m/s, rad/s)`: the fastest the scenario's operator moves and turns the hand (a
+    speed of 0 is the robot's): a pilot's participant's, the population's fastest draw,
+    HOP's simulated user's clip."""
+    operator = scenario.operator
+    if isinstance(operator, ProportionalPilot):
+        return operator.max_speed, 0.0
+    if isinstance(operator, ParticipantPopulation):
+        speed = operator.participant.speed or scenario.robot.speed
+        return speed * max(operator.speed_factor), max(operator.rotation_speed)
+    participant = getattr(operator, "participant", operator)
+    return getattr(participant, "speed", 0.0), getattr(participant, "rotation_speed", 0.0)
 
 
 def task_scene(task, seed, reach=None):

@@ -23,6 +23,8 @@ import typing
 import numpy as np
 from pydrake.common.yaml import yaml_load
 
+from pbp_drake.core.pilot_population import ParticipantPopulationParams, population_problem
+from pbp_drake.core.surrogate_pilots import ProportionalPilotParams
 from pbp_drake.scenarios.schema import ScenarioError
 
 
@@ -535,3 +537,28 @@ def check_virtual_participant(operator, field="scenario.operator"):
         raise ScenarioError(f"{field}.plan_times {operator.plan_times} must be 1 to "
                             f"{MOST_PLAN_TIMES} positive times (s) that increase strictly, "
                             "e.g. [0.1, 0.3, 0.6, 1.0, 1.5]")
+
+
+def check_pilot(operator, field="scenario.operator"):
+    """A surrogate pilot's fields (`pbp_drake.scenarios.pilots`): eps and p probabilities in
+    [0, 1]; the proportional pilot's gain positive and max_speed not negative (0: the
+    task's operator speed); the population's ranges `[low, high]` finite, low <= high;
+    and the base participant's fields (`check_virtual_participant`)."""
+    for name in ("eps", "p"):
+        value = getattr(operator, name, None)
+        if value is not None and not (np.isfinite(value) and 0.0 <= value <= 1.0):
+            raise ScenarioError(f"{field}.{name} {value} is no probability; expected a number "
+                                "in [0, 1]")
+    if isinstance(operator, ProportionalPilotParams):
+        require_finite(operator, field, ("gain",))
+        require_finite(operator, field, ("max_speed",), positive=False)
+    if isinstance(operator, ParticipantPopulationParams):
+        problem = population_problem(operator)
+        if problem is not None:
+            raise ScenarioError(f"{field}.{problem}")
+    participant = getattr(operator, "participant", None)
+    if participant is not None:
+        require_finite(participant, f"{field}.participant",
+                       ("speed", "rotation_speed", "reaction_delay", "direction_noise",
+                        "speed_noise"), positive=False)
+        check_virtual_participant(participant, f"{field}.participant")

@@ -6,6 +6,9 @@ three stages, in this order:
 
 1. **sense** at `t_k` (offset `SENSE_OFFSET`): the robot's state is sampled (`SampleHold`)
    and the operator decides (it reads the robot's state and Meshcat's input).
+   A surrogate pilot's corruption of the operator's decision (`pilot_filters`) samples
+   that decision half-way to the decide stage (`pilot_offset`): the robot reads the
+   corrupted decision of the same tick, not one a tick late.
 2. **decide** at `t_k + decide_offset(period)`: the DMP bank, the goal estimator, the heading,
    the task monitor and the moving obstacles update from the state sampled at `t_k` and the
    operator's decision of the same tick (as the paper's Alg. 2 reads them). The blender's
@@ -40,6 +43,12 @@ DECISION_LOG_SHIFT = 1
 def decide_offset(control_period):
     """The offset (s) after each tick at which the decide stage updates."""
     return float(control_period) * DECIDE_FRACTION
+
+
+def pilot_offset(control_period):
+    """The offset (s) after each tick at which a pilot's filter samples the operator's
+    decision of the tick: after the sense stage, before the decide stage."""
+    return 0.5 * decide_offset(control_period)
 
 
 def report_offset(control_period, update_offset=None):

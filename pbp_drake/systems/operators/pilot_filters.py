@@ -1,0 +1,292 @@
+"""The field's surrogate pilots as Drake systems: thin wrappers of
+`pbp_drake.core.surrogate_pilots`.
+
+A corrupted pilot (noisy, laggy) is a `PilotOperator`: the base participant and a filter
+(`NoisyFilter`, `LaggyFilter`) between its outputs and the controller, in one Diagram with
+exactly the participant's ports, so that the builders connect it as they connect the
+participant. HOP's simulated user is a `ProportionalOperator` with the same ports. Each
+task's keys (`ReachKeys`, `GraspKeys`) say how a key state or a velocity becomes its
+command: the reaching and obstacle tasks' `[vx, vy, vz, yaw_rate]` or the grasping task's
+twist `[v (3), omega (3)]`. The keys the method enables come in through the `forward_key`
+port (1: forward enabled, 0: not), so a pilot is built from the same arguments under every
+method; its draws come from `(seed, tick)` alone.
+"""
+
+import numpy as np
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+
+from pbp_drake.core.surrogate_pilots import (
+    GRASP_AXES, REACH_AXES, REACH_VERTICAL_AXES, grasp_key_command,
+    grasp_proportional_command, lag_per_tick, laggy_draw, noisy_draw, reach_key_command,
+    reach_proportional_command)
+from pbp_drake.systems.operators.sampled_operator import SampledOperator
+from pbp_drake.systems.ports import (
+    EeState, OperatorCommand, OperatorTwist, PoseState, Target, position_of)
+from pbp_drake.systems.tick import pilot_offset
+
+#: The port that says whether the method enables the forward key (size 1).
+FORWARD_KEY = "forward_key"
+
+
+def _forward_enabled(port, context):
+    return bool(port.Eval(context)[0] > 0.5)
+
+
+class ReachKeys:
+    """The reaching and obstacle tasks' keys: forward/back, left/right, (up/down with
+    `vertical`,) turn left/right, at `speed` (m/s) and `rotation_speed` (rad/s); the hand
+    is read from `ee_state`."""
+
+    hand_port = "ee_state"
+    hand_size = EeState.size
+    command_size = OperatorCommand.size
+    # The keyboard has no forward button where the forward key is disabled.
+    forward_is_a_button = True
+
+    def __init__(self, speed, rotation_speed, vertical=False):
+        self.speed, self.rotation_speed = float(speed), float(rotation_speed)
+        self.vertical = bool(vertical)
+        self.axes = REACH_VERTICAL_AXES if self.vertical else REACH_AXES
+
+    def key_command(self, keys, hand, forward_enabled):
+        """`(command, active)` of a key state (its forward axis already limited to the
+        enabled states by `key_state`)."""
+        return reach_key_command(keys, EeState(hand).heading, self.speed, self.rotation_speed)
+
+    def proportional_command(self, params, hand, target, max_speed, forward_enabled):
+        ee_state = EeState(hand)
+        return reach_proportional_command(
+            params, position_of(ee_state), ee_state.heading, position_of(Target(target)),
+            max_speed, self.vertical, forward_enabled)
+
+
+class GraspKeys:
+    """The grasping task's keys: forward/back, left/right, up/down, yaw, pitch, roll, at
+    `speed` (m/s) and `rotation_speed` (rad/s); the hand is read from `hand_pose`."""
+
+    hand_port = "hand_pose"
+    hand_size = PoseState.size
+    command_size = OperatorTwist.size
+    axes = GRASP_AXES
+    # Its ↑ stays (it tips the hand in rotate mode); the twist loses its forward part.
+    forward_is_a_button = False
+
+    def __init__(self, speed, rotation_speed):
+        self.speed, self.rotation_speed = float(speed), float(rotation_speed)
+
+    @staticmethod
+    def _orientation(hand):
+        quaternion = np.asarray(hand, float)[3:7]
+        return quaternion / np.linalg.norm(quaternion)
+
+    def key_command(self, keys, hand, forward_enabled):
+        return grasp_key_command(keys, self._orientation(hand), self.speed,
+                                 self.rotation_speed, forward_enabled)
+
+    def proportional_command(self, params, hand, target, max_speed, forward_enabled):
+        return grasp_proportional_command(
+            params, np.asarray(hand, float)[:3], self._orientation(hand),
+            position_of(Target(target)), max_speed, forward_enabled)
+
+
+class PilotFilter(LeafSystem):
+    """Base of the filters between a base pilot's outputs and the controller.
+
+    .. pydrake_system::
+
+        name: PilotFilter
+        input_ports:
+        - base_command
+        - base_active
+        - ee_state (or hand_pose)
+        - forward_key
+        output_ports:
+        - operator_command
+        - operator_active
+
+    Each tick, at `pbp_drake.systems.tick.pilot_offset` (after the base pilot's sense
+    stage, before the controller's decide stage), it samples the base pilot's output and
+    holds what `_filter` makes of it; its outputs depend on that held sample alone, as a
+    `SampledOperator`'s. Subclasses implement
+    `_filter(context, tick, command, active, previous) -> (command, active)`, `previous`
+    being its own last output (None at the first tick).
+    """
+
+    def __init__(self, keys, control_period, seed):
+        super().__init__()
+        self.keys = keys
+        self._period = float(control_period)
+        self._seed = int(seed)
+        size = keys.command_size
+        self._size = size
+        self._base_command_port = self.DeclareVectorInputPort("base_command", size)
+        self._base_active_port = self.DeclareVectorInputPort("base_active", 1)
+        self._hand_port = self.DeclareVectorInputPort(keys.hand_port, keys.hand_size)
+        self._forward_port = self.DeclareVectorInputPort(FORWARD_KEY, 1)
+        # [command (size), active, whether a sample has been taken].
+        self._sample_index = self.DeclareDiscreteState(size + 2)
+        held = {self.discrete_state_ticket(self._sample_index)}
+        self._command_port = self.DeclareVectorOutputPort(
+            "operator_command", size,
+            lambda context, output: output.SetFromVector(self._held(context)[:size]),
+            prerequisites_of_calc=held)
+        self._active_port = self.DeclareVectorOutputPort(
+            "operator_active", 1,
+            lambda context, output: output.SetFromVector(self._held(context)[size:size + 1]),
+            prerequisites_of_calc=held)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, pilot_offset(self._period),
+                                                self._update)
+
+    def get_operator_command_output_port(self):
+        return self._command_port
+
+    def get_operator_active_output_port(self):
+        return self._active_port
+
+    def _held(self, context):
+        return context.get_discrete_state(self._sample_index).value()
+
+    def _update(self, context, discrete_state):
+        tick = int(round(context.get_time() / self._period))
+        held = self._held(context)
+        previous = (held[:self._size], bool(held[self._size] > 0.5)) if held[-1] > 0.5 else None
+        command, active = self._filter(
+            context, tick, np.array(self._base_command_port.Eval(context), float),
+            bool(self._base_active_port.Eval(context)[0] > 0.5), previous)
+        discrete_state.set_value(self._sample_index,
+                                 np.concatenate([command, [float(active), 1.0]]))
+
+    def _hand(self, context):
+        return self._hand_port.Eval(context)
+
+    def _forward_enabled(self, context):
+        return _forward_enabled(self._forward_port, context)
+
+    def _filter(self, context, tick, command, active, previous):
+        raise NotImplementedError
+
+
+class NoisyFilter(PilotFilter):
+    """The noisy pilot's filter: each tick, with probability `eps`, the base pilot's output
+    is replaced by a uniformly random state of the enabled keys (`noisy_draw`), active
+    when an effective key is pressed (`PilotFilter` shows its ports)."""
+
+    def __init__(self, keys, control_period, seed, eps):
+        super().__init__(keys, control_period, seed)
+        self.eps = float(eps)
+
+    def _filter(self, context, tick, command, active, previous):
+        forward = self._forward_enabled(context)
+        corrupted, key_state = noisy_draw(self._seed, tick, self.eps, len(self.keys.axes),
+                                          forward or not self.keys.forward_is_a_button)
+        if not corrupted:
+            return command, active
+        return self.keys.key_command(key_state, self._hand(context), forward)
+
+
+class LaggyFilter(PilotFilter):
+    """The laggy pilot's filter: each tick, with probability `p_tick` (the sources' `p` at
+    our tick, `lag_per_tick`), it repeats its previous output instead of the base pilot's
+    (`PilotFilter` shows its ports). The first tick passes the base pilot's output."""
+
+    def __init__(self, keys, control_period, seed, p):
+        super().__init__(keys, control_period, seed)
+        self.p_tick = lag_per_tick(p, control_period)
+
+    def _filter(self, context, tick, command, active, previous):
+        if laggy_draw(self._seed, tick, self.p_tick) and previous is not None:
+            return previous
+        return command, active
+
+
+class PilotOperator(Diagram):
+    """A base pilot and its filter, with exactly the base pilot's ports.
+
+    .. pydrake_system::
+
+        name: PilotOperator
+        input_ports:
+        - ee_state (or hand_pose)
+        - target
+        - selected_goal
+        - forward_key
+        - obstacle_positions (optional)
+        output_ports:
+        - operator_command
+        - operator_active
+
+    Every input port of the base pilot (`base`, a participant system) and of the `filter`
+    is exported once under its name (the hand's state and `forward_key` feed both); the
+    outputs are the filter's.
+    """
+
+    def __init__(self, base, pilot_filter):
+        super().__init__()
+        builder = DiagramBuilder()
+        base = builder.AddNamedSystem("participant", base)
+        pilot_filter = builder.AddNamedSystem("pilot_filter", pilot_filter)
+        builder.Connect(base.get_operator_command_output_port(),
+                        pilot_filter.GetInputPort("base_command"))
+        builder.Connect(base.get_operator_active_output_port(),
+                        pilot_filter.GetInputPort("base_active"))
+        exported = {}
+        for system in (base, pilot_filter):
+            for index in range(system.num_input_ports()):
+                port = system.get_input_port(index)
+                name = port.get_name()
+                if name in ("base_command", "base_active"):
+                    continue
+                if name in exported:
+                    builder.ConnectInput(exported[name], port)
+                else:
+                    exported[name] = builder.ExportInput(port, name)
+        builder.ExportOutput(pilot_filter.get_operator_command_output_port(), "operator_command")
+        builder.ExportOutput(pilot_filter.get_operator_active_output_port(), "operator_active")
+        builder.BuildInto(self)
+
+    def get_operator_command_output_port(self):
+        return self.GetOutputPort("operator_command")
+
+    def get_operator_active_output_port(self):
+        return self.GetOutputPort("operator_active")
+
+
+class ProportionalOperator(SampledOperator):
+    """HOP's simulated user: `u = gain (p_target - p_hand)`, its norm clipped to
+    `max_speed` (m/s), translation only (`core.surrogate_pilots.proportional_velocity`).
+
+    .. pydrake_system::
+
+        name: ProportionalOperator
+        input_ports:
+        - ee_state (or hand_pose)
+        - target
+        - selected_goal
+        - forward_key
+        - obstacle_positions (optional)
+        output_ports:
+        - operator_command
+        - operator_active
+
+    It has the participant's ports but reads only the hand, the target and `forward_key`
+    (with the forward key disabled, the command's forward part is removed): it is blind to
+    the robot's intent (`selected_goal`) and to obstacles. It acts whenever its command is
+    not zero, i.e. everywhere but on the target. `keys` is the task's `ReachKeys` or
+    `GraspKeys`; it samples at the sense stage as every `SampledOperator`.
+    """
+
+    def __init__(self, keys, control_period, params, max_speed, obstacle_count=0):
+        super().__init__(keys.command_size, control_period)
+        self.keys, self.params, self.max_speed = keys, params, float(max_speed)
+        self._hand_port = self.DeclareVectorInputPort(keys.hand_port, keys.hand_size)
+        self._target_port = self.DeclareVectorInputPort("target", Target.size)
+        self.DeclareVectorInputPort("selected_goal", 1)
+        self._forward_port = self.DeclareVectorInputPort(FORWARD_KEY, 1)
+        if obstacle_count > 0:
+            self.DeclareVectorInputPort("obstacle_positions", 2 * int(obstacle_count))
+        self._declare_operator_outputs()
+
+    def _sample(self, context):
+        return self.keys.proportional_command(
+            self.params, self._hand_port.Eval(context), self._target_port.Eval(context),
+            self.max_speed, _forward_enabled(self._forward_port, context))

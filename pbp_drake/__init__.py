@@ -109,7 +109,9 @@ API_GROUPS = {
     },
     "Studies and the console": {
         "run_method_comparison": "pbp_drake.studies.comparison",
+        "run_method_matrix": "pbp_drake.studies.comparison",
         "report": "pbp_drake.studies.report",
+        "report_matrix": "pbp_drake.studies.matrix_report",
         "load_task_result": "pbp_drake.studies.trial_files",
         "Console": "pbp_drake.console",
         "LiveRun": "pbp_drake.console",

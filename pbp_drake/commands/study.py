@@ -14,8 +14,8 @@ from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
     TASK_ROBOTS, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison,
     counted, load_scenario_file)
-from pbp_drake.studies.comparison import run_method_comparison
-from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder, run_method_matrix
+from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
+from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
 from pbp_drake.studies.paired import (
     PAIRED_METRICS, paired_comparison, paired_table, paired_with, paired_with_markdown)

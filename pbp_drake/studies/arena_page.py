@@ -44,13 +44,26 @@ class Claim:
 
     def rule(self):
         """The rule in words, from its fields."""
-        side = "below" if self.below else "above"
+        label = _LABELS[self.metric]
         if self.factor is not None:
-            bound = "teleop's" if self.factor == 1 else f"{self.factor:g} times teleop's"
-            return (f"the interval of the method's mean {self.metric.replace('_', ' ')} lies "
-                    f"wholly {side} {bound} interval (scaled)")
-        return (f"the Wilson interval of the method's {self.metric.replace('_', ' ')} lies "
-                f"wholly {side} {self.bar:.0%}")
+            times = "" if self.factor == 1 else f"{self.factor:g} x "
+            ends = ("upper", "lower") if self.below else ("lower", "upper")
+            side, other = ("below", "at or above") if self.below else ("above", "at or below")
+            return (f"holds when the {ends[0]} end of the interval of its mean {label} is "
+                    f"{side} {times}the {ends[1]} end of teleop's; does not hold when its "
+                    f"{ends[1]} end is {other} {times}the {ends[0]} end of teleop's")
+        bar = f"{100 * self.bar:g} %"
+        if self.below:
+            return (f"holds when the upper end of the Wilson interval of its {label} is below "
+                    f"{bar}; does not hold when its lower end is at or above {bar}")
+        return (f"holds when the lower end of the Wilson interval of its {label} is at or "
+                f"above {bar}; does not hold when its upper end is below {bar}")
+
+
+# The metrics' names in the rules.
+_LABELS = {"intervention_ratio": "intervention ratio", "task_time": "task time",
+           "success_rate": "success rate",
+           "collision_free": "share of trials without a collision"}
 
 
 def _obstacles(summary):
@@ -69,7 +82,7 @@ CLAIMS = (
           "Section IV, obstacles: about 20 % less cut than in reaching",
           "intervention_ratio", below=True, factor=0.6, where=_obstacles),
     Claim("takes at most 1.2 times teleop's task time",
-          "Section IV: task times not longer than teleop's (here with 20 % of slack)",
+          "Section IV: task times not longer than teleop's; 20 % of slack here",
           "task_time", below=True, factor=1.2),
     Claim("succeeds in at least 95 % of trials",
           "Section IV: the users reached their targets", "success_rate", below=False,
@@ -120,7 +133,8 @@ def verdict(claim, entry, teleop):
             return UNDECIDED, "no trials"
         low, high = interval
         bound_low = bound_high = claim.bar
-        evidence = f"{mean:.0%} [{low:.0%}, {high:.0%}] against {claim.bar:.0%}"
+        evidence = (f"{100 * mean:.0f} [{100 * low:.0f}, {100 * high:.0f}] % against "
+                    f"{100 * claim.bar:g} %")
     if claim.below:
         wanted, opposite = high < bound_low, low >= bound_high
     else:

@@ -4,7 +4,7 @@
 same scenario), runs them in local processes (`--jobs`) or as Ray tasks (`--backend ray`),
 then rebuilds the summary, tables and figures from the files (`report`). A matrix of
 methods and pilots (`studies.matrix`) prepares one such folder per pilot and runs all their
-trials together (`run_trials`).
+trials together (`run_trials`): `run_method_matrix`.
 """
 
 import dataclasses
@@ -19,6 +19,10 @@ from pbp_drake.studies.runners import failed_record, run_locally
 from pbp_drake.studies.trial_files import (
     StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, write_study)
 from pbp_drake.studies.folders import check_folder
+from pbp_drake.studies.matrix import (
+    check_matrix_folder, check_pilots, pilot_folder, write_matrix_study)
+from pbp_drake.studies.matrix_report import report_matrix
+from pbp_drake.scenarios.pilots import with_pilot
 
 BACKENDS = ("local", "ray")
 
@@ -155,3 +159,41 @@ def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_ad
             run_on_ray(pending, jobs, ray_address, submit_args, on_done, on_error)
     else:
         run_locally(pending, jobs, submit_args, on_done, on_error)
+
+
+def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=None, jobs=1,
+                      run=None, retry_errors=False, backend="local", ray_address=None,
+                      split=None, scenario_file=None, split_seeds=None):
+    """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with every method under every
+    pilot (`scenarios.pilots`: `with_pilot(scenario, name)`), all in one pool of `jobs`
+    processes or Ray tasks, each pilot's trials into `output/pilots/NAME/`; then writes the
+    matrix's summary, table and figure (`matrix_report.report_matrix`) and returns the
+    summary. The arguments are `run_method_comparison`'s, plus the pilots' names; trials on
+    disk for the same scenario and pilot are not run again."""
+    check_pilots(pilots, "pilots")
+    check_run_options(jobs, backend, ray_address, run)
+    if trials < 1:
+        raise ScenarioError(f"trials must be at least 1, got {trials}")
+    pilot_scenarios = {pilot: with_pilot(scenario, pilot) for pilot in pilots}
+    output = pathlib.Path(output)
+    digest = scenario_hash(scenario)
+    recorded = check_matrix_folder(output, scenario, digest)
+    if recorded:
+        scenario_file = scenario_file or recorded.get("scenario_file")
+        split_seeds = split_seeds or recorded.get("split_seeds")
+        if split is None and (recorded.get("seed"), recorded.get("trials")) == (seed, trials):
+            split = recorded.get("split")
+    # Every pilot's folder is checked before any is written: a refused one stops the matrix
+    # with nothing changed.
+    for pilot, pilot_scenario in pilot_scenarios.items():
+        folder = pilot_folder(output, pilot)
+        if folder.is_dir():
+            check_folder(folder, pilot_scenario, scenario_hash(pilot_scenario))
+    write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split,
+                       scenario_file, split_seeds)
+    folders = [prepare_folder(pilot_scenario, methods, trials, seed,
+                              pilot_folder(output, pilot), retry_errors, split, scenario_file,
+                              split_seeds)
+               for pilot, pilot_scenario in pilot_scenarios.items()]
+    run_trials(folders, jobs, progress, run, backend, ray_address)
+    return report_matrix(output)

@@ -1,5 +1,6 @@
-"""Every method under every pilot, in one folder: `pbp-drake study FILE --methods ...
---pilots attentive,noisy,...`.
+"""The folder of every method under every pilot (`pbp-drake study FILE --methods ...
+--pilots attentive,noisy,...`, run by `comparison.run_method_matrix`): its layout, its
+study.json, and its summary read from the pilots' trial files.
 
 A matrix folder `DIR` holds one method comparison per pilot, each a whole study folder of
 its own (its study.json, hash and trials: `pbp-drake report DIR/pilots/NAME` reports one
@@ -21,12 +22,11 @@ import json
 import pathlib
 
 from pbp_drake.scenarios import ScenarioError
-from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name, with_pilot
-from pbp_drake.studies.comparison import check_run_options, prepare_folder, run_trials
-from pbp_drake.studies.folders import check_folder, folder_kind
+from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name
+from pbp_drake.studies.folders import folder_kind
 from pbp_drake.studies.summary import summarize
 from pbp_drake.studies.trial_files import (
-    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study, scenario_hash, write_atomically)
+    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study, write_atomically)
 
 MATRIX = "method_matrix"
 PILOTS_FOLDER = "pilots"
@@ -70,45 +70,6 @@ def check_matrix_folder(output, scenario, digest):
             f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}): "
             "choose another --output folder")
     return study
-
-
-def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=None, jobs=1,
-                      run=None, retry_errors=False, backend="local", ray_address=None,
-                      split=None, scenario_file=None, split_seeds=None):
-    """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with every method under every
-    pilot (`scenarios.pilots`: `with_pilot(scenario, name)`), all in one pool of `jobs`
-    processes or Ray tasks, each pilot's trials into `output/pilots/NAME/`; then writes the
-    matrix's summary, table and figure (`matrix_report.report_matrix`) and returns the
-    summary. The arguments are `run_method_comparison`'s, plus the pilots' names; trials on
-    disk for the same scenario and pilot are not run again."""
-    check_pilots(pilots, "pilots")
-    check_run_options(jobs, backend, ray_address, run)
-    if trials < 1:
-        raise ScenarioError(f"trials must be at least 1, got {trials}")
-    pilot_scenarios = {pilot: with_pilot(scenario, pilot) for pilot in pilots}
-    output = pathlib.Path(output)
-    digest = scenario_hash(scenario)
-    recorded = check_matrix_folder(output, scenario, digest)
-    if recorded:
-        scenario_file = scenario_file or recorded.get("scenario_file")
-        split_seeds = split_seeds or recorded.get("split_seeds")
-        if split is None and (recorded.get("seed"), recorded.get("trials")) == (seed, trials):
-            split = recorded.get("split")
-    # Every pilot's folder is checked before any is written: a refused one stops the matrix
-    # with nothing changed.
-    for pilot, pilot_scenario in pilot_scenarios.items():
-        folder = pilot_folder(output, pilot)
-        if folder.is_dir():
-            check_folder(folder, pilot_scenario, scenario_hash(pilot_scenario))
-    write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split,
-                       scenario_file, split_seeds)
-    folders = [prepare_folder(pilot_scenario, methods, trials, seed,
-                              pilot_folder(output, pilot), retry_errors, split, scenario_file,
-                              split_seeds)
-               for pilot, pilot_scenario in pilot_scenarios.items()]
-    run_trials(folders, jobs, progress, run, backend, ray_address)
-    from pbp_drake.studies.matrix_report import report_matrix  # matplotlib: not in workers
-    return report_matrix(output)
 
 
 def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split=None,

@@ -19,6 +19,8 @@ import pytest
 import scipy.stats
 
 from pbp_drake.cli import main
+from pbp_drake.scenarios import load_scenario_file
+from pbp_drake.studies.trial_files import scenario_hash
 from pbp_drake.studies.matrix import pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE
 
@@ -96,6 +98,26 @@ def test_a_matrix_is_never_mixed_with_a_study_or_another_scenario(task_file, tmp
     assert main(study_args(task_file, matrix)) == 2  # a study without --pilots, into a matrix
     assert "method_matrix" in capsys.readouterr().err
     assert sorted(p.name for p in matrix.iterdir()) == ["study.json"]
+
+
+def test_a_pilot_folder_of_another_pilot_is_refused_before_anything_is_written(
+        task_file, tmp_path, capsys):
+    # The matrix's scenario, but its laggy folder holds a study of another scenario (as
+    # after a change to the pilot): refused, and not one file written.
+    digest = scenario_hash(load_scenario_file(task_file).scenario)
+    matrix = tmp_path / "matrix"
+    laggy = pilot_folder(matrix, "laggy")
+    laggy.mkdir(parents=True)
+    (matrix / "study.json").write_text(json.dumps({
+        "study": "method_matrix", "scenario": "two_random_objects", "scenario_hash": digest,
+        "pilots": PILOTS, "methods": METHODS, "trials": TRIALS, "seed": SEED}))
+    (laggy / "study.json").write_text(json.dumps({
+        "study": "method_comparison", "scenario": "two_random_objects",
+        "scenario_hash": "0" * 16, "methods": METHODS, "trials": TRIALS, "seed": SEED}))
+    before = {path: path.read_bytes() for path in matrix.rglob("*") if path.is_file()}
+    assert main(matrix_args(task_file, matrix)) == 2
+    assert f"{laggy} holds a study of another scenario" in capsys.readouterr().err
+    assert {path: path.read_bytes() for path in matrix.rglob("*") if path.is_file()} == before
 
 
 # ---------------------------------------------------------------------------------------------

@@ -95,7 +95,8 @@ API_GROUPS = {
             "DynamicObstacles", "GraspTask", "VirtualParticipant", "Keyboard", "Gamepad",
             "NoOperator", "ScriptedCommands", "SinusoidalStep", "ObstacleRepulsion",
             "BentPath", "RecordedPath", "Obstacle", "MethodComparison", "AlphaStudy",
-            "AltVsCont", "SceneVariant"]},
+            "AltVsCont", "SceneVariant", "NoisyPilot", "LaggyPilot", "ProportionalPilot",
+            "ParticipantPopulation", "PILOT_NAMES", "with_pilot"]},
     "Building and running": {
         name: "pbp_drake.builder" for name in [
             "build_diagram", "make_pbp_controller", "find_system", "simulate", "run_task",

@@ -41,6 +41,7 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
+from pbp_drake.builder.operators import shown_intent_and_keys
 from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.grasp_task import approach_direction
@@ -51,8 +52,8 @@ from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
 from pbp_drake.scenarios import (
-    OPERATOR_DRIVES, PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ScenarioError,
-    VirtualParticipant)
+    PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant,
+    forward_key_enabled)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
     PoseGoalEstimator, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
@@ -130,6 +131,7 @@ def build_grasp_diagram(resolved, meshcat=None):
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
+    shown, keys = shown_intent_and_keys(builder, scenario, selected)
 
     limits = hand_over_limits(scenario)
     if scenario.method in HOP_METHODS:
@@ -177,7 +179,8 @@ def build_grasp_diagram(resolved, meshcat=None):
     if operator.HasInputPort("hand_pose"):
         builder.Connect(sampled, operator.GetInputPort("hand_pose"))
         builder.Connect(monitor.get_target_output_port(), operator.GetInputPort("target"))
-        builder.Connect(selected, operator.GetInputPort("selected_goal"))
+        builder.Connect(shown, operator.GetInputPort("selected_goal"))
+        builder.Connect(keys, operator.GetInputPort("forward_key"))
     if operator.HasInputPort("hand_state"):
         # The sampled pose: the person's frame is the hand's as the tick saw it.
         builder.Connect(sampled, operator.GetInputPort("hand_state"))
@@ -194,7 +197,7 @@ def build_grasp_diagram(resolved, meshcat=None):
     logged = [("hand_pose_log", hand_pose), ("operator_active_log", active),
               ("operator_command_log", twist),
               ("command_log", hand_over.get_command_output_port()),
-              ("selected_goal_log", selected),
+              ("selected_goal_log", shown),
               ("target_log", monitor.get_target_output_port())]
     if dmp_bank is not None:
         logged.append(("phase_log", dmp_bank.get_phase_output_port()))
@@ -240,9 +243,9 @@ def _operator(resolved, grasps, meshcat):
     period = scenario.control_period
     if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
         return IdleOperator(OperatorTwist.size, period)
-    # Only teleop and the baselines that add to a full command (OPERATOR_DRIVES) let the
-    # person push along the approach axis (the paper's forward key).
-    teleop = scenario.method in OPERATOR_DRIVES
+    # Only teleop and the baselines that add to a full command let the person push along
+    # the approach axis (the paper's forward key).
+    teleop = forward_key_enabled(scenario)
     if isinstance(config, (Keyboard, Gamepad)) and meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
@@ -259,7 +262,7 @@ def _operator(resolved, grasps, meshcat):
                           GraspKeys)
     participant = GraspParticipant.create(
         GraspParticipantParams.from_virtual_participant(scenario.operator),
-        "drive" if teleop else "assist", resolved.nominal_speed,
+        resolved.nominal_speed,
         grasps.grasp_positions, grasps.grasp_orientations, scenario.seed)
     return PoseVirtualOperator(participant, period)
 

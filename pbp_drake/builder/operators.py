@@ -2,11 +2,13 @@
 at the keyboard or gamepad, or the virtual participant, in the tasks (HSR or arm)."""
 
 import numpy as np
+from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.scenarios import (
-    PILOT_CONFIGS, OPERATOR_DRIVES, Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
-    ScriptedCommands, SinusoidalStep, VirtualParticipant)
+    PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
+    ScriptedCommands, SinusoidalStep, VirtualParticipant, forward_key_enabled, shows_intent)
+from pbp_drake.core.participant_serving import NO_INTENT
 from pbp_drake.systems import (
     GamepadOperator, KeyboardOperator, IdleOperator, ObstacleRepulsionOperator, ScriptedOperator,
     VirtualOperator)
@@ -44,14 +46,14 @@ def sinusoidal_step_commands(config, control_period, duration):
 
 def make_hsr_operator(resolved, meshcat):
     """The HSR task's operator: a person at the keyboard or gamepad (they need `meshcat`),
-    or the virtual participant (which watches the task's obstacles, if any). Under the
-    methods of `OPERATOR_DRIVES` (teleop, hop, policy_blending) the operator drives the
-    whole way, the forward key enabled; under PBP and arbitration it shows intent without
-    it, as the paper's users did."""
+    or the virtual participant (which watches the task's obstacles, if any). The keys are
+    the method's (`forward_key_enabled`: the paper disables forward under PBP and
+    arbitration); the virtual participant is built from the same arguments under every
+    method and reads the keys from its `forward_key` input, as a person sees them."""
     scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
-    allow_forward = scenario.method in OPERATOR_DRIVES
+    allow_forward = forward_key_enabled(scenario)
     speed = resolved.nominal_speed
     # Objects at heights of their own (`task.z_range`): the operator moves up and down too.
     vertical = bool(getattr(scenario.task, "z_range", None))
@@ -62,15 +64,7 @@ def make_hsr_operator(resolved, meshcat):
                           lambda speed, rotation: ReachKeys(speed, rotation, vertical),
                           len(resolved.station.obstacles))
     if isinstance(config, VirtualParticipant):
-        obstacles = resolved.station.obstacles
-        return VirtualOperator(
-            period, resolved.scene.objects, mode="drive" if allow_forward else "assist",
-            params=config, nominal_speed=speed, seed=scenario.seed,
-            obstacle_count=len(obstacles),
-            obstacle_radius=obstacles[0].radius if obstacles else 0.0,
-            policy_adds=scenario.method == "pbp_continuous", vertical=vertical,
-            heading_range=_heading_range(resolved),
-            fixed_base=resolved.station.base_pose[:2] if resolved.is_arm else None)
+        return VirtualOperator(period, resolved.scene.objects, **participant_arguments(resolved))
     if meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
@@ -82,6 +76,20 @@ def make_hsr_operator(resolved, meshcat):
     raise TypeError(f"unknown operator config {type(config).__name__}")
 
 
+def participant_arguments(resolved):
+    """The virtual participant's arguments beyond the control period and the objects: the
+    same under every method (nothing here reads `scenario.method`)."""
+    scenario = resolved.scenario
+    obstacles = resolved.station.obstacles
+    return dict(
+        params=scenario.operator, nominal_speed=resolved.nominal_speed, seed=scenario.seed,
+        obstacle_count=len(obstacles),
+        obstacle_radius=obstacles[0].radius if obstacles else 0.0,
+        vertical=bool(getattr(scenario.task, "z_range", None)),
+        heading_range=_heading_range(resolved),
+        fixed_base=resolved.station.base_pose[:2] if resolved.is_arm else None)
+
+
 def _heading_range(resolved):
     """(low, high) of the hand's heading under the controller's `max_heading_turn` (an
     arm's), or None (the HSR's, unbounded)."""
@@ -90,3 +98,17 @@ def _heading_range(resolved):
         return None
     heading = resolved.initial_ee_state[6]
     return (heading - turn, heading + turn)
+
+
+def shown_intent_and_keys(builder, scenario, selected_goal):
+    """`(shown_goal, forward_key)` output ports: the robot's intent as the page shows it
+    (the estimator's `selected_goal` port, or `NO_INTENT` where the method shows none:
+    `shows_intent`) and whether the forward key works (`forward_key_enabled`). The page,
+    the logs and the operator all get these, so the virtual participant sees what a
+    person does."""
+    if not shows_intent(scenario):
+        selected_goal = builder.AddNamedSystem(
+            "no_intent_shown", ConstantVectorSource([float(NO_INTENT)])).get_output_port()
+    keys = builder.AddNamedSystem("keys", ConstantVectorSource(
+        [1.0 if forward_key_enabled(scenario) else 0.0]))
+    return selected_goal, keys.get_output_port()

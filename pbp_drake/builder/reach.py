@@ -25,7 +25,7 @@ at success.
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
-from pbp_drake.builder.operators import make_hsr_operator
+from pbp_drake.builder.operators import make_hsr_operator, shown_intent_and_keys
 from pbp_drake.builder.pbp_controller import TASK_PREDICTION_SAMPLES, make_pbp_controller
 from pbp_drake.robots import ArmStationConfig, make_arm_station, make_hsr_station
 from pbp_drake.systems import GoalsSource, ReachSceneVisualizer, SampleHold, TaskMonitor
@@ -79,10 +79,12 @@ def build_reach_diagram(resolved, meshcat=None):
                         monitor.get_in_collision_input_port())
 
     operator = builder.AddNamedSystem("operator", make_hsr_operator(resolved, meshcat))
-    selected_goal = controller.GetOutputPort("selected_goal")
+    selected_goal, keys = shown_intent_and_keys(
+        builder, scenario, controller.GetOutputPort("selected_goal"))
     for port_name, source in [("ee_state", ee_state),
                               ("target", monitor.get_target_output_port()),
                               ("selected_goal", selected_goal),
+                              ("forward_key", keys),
                               ("obstacle_positions", obstacles and
                                obstacles.get_floor_positions_output_port())]:
         if operator.HasInputPort(port_name) and source is not None:
@@ -124,3 +126,4 @@ def build_reach_diagram(resolved, meshcat=None):
     diagram = builder.Build()
     diagram.set_name(scenario.name)
     return diagram
+

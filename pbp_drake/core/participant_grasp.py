@@ -5,19 +5,28 @@ It sees the true target (an object index) and notices a new one only `reaction_d
 seconds after it appears (`notice_target`). It commands a twist `[v (3), omega (3)]`, both
 in the world frame (m/s, rad/s):
 
-- teleop (`mode="drive"`): the whole twist, `v` toward the target's grasp position at
-  `speed` (slowing in proportion within `slow_radius`), `omega` about the axis of
-  `Log(q_target q*)` at `rotation_speed` (in proportion within `slow_angle`; none within
-  `aligned_angle`), so that both errors shrink together to the grasp pose.
-- PBP and arbitration (`mode="assist"`): nothing while the estimate names the target.
-  While it names another object ("picked"), it turns the hand toward the target's grasp
+It is never told the method. Whether it acts is the reach participant's one rule
+(`pbp_drake.core.participant_serving`): it acts while the robot's shown intent names
+another object, or while the hand does not close in on the target's grasp position at
+`serve_speed_fraction` of its own preferred speed for `serve_patience`, and lets go while
+the robot serves the target. What it presses is the keys' (`forward_key`, the method's):
+
+- with the forward key (teleop, and the baselines that add to a full command): the whole
+  twist, `v` toward the target's grasp position at `speed` (slowing in proportion within
+  `slow_radius`), `omega` about the axis of `Log(q_target q*)` at `rotation_speed` (in
+  proportion within `slow_angle`; none within `aligned_angle`), so that both errors shrink
+  together to the grasp pose.
+- without it (the paper's PBP), while the shown intent names another object ("picked"),
+  it turns the hand toward the target's grasp
   orientation as when driving (what the ``pose`` estimator's orientation term reads) and
   moves along `u_target - u_picked` (the unit directions from the hand to the two grasp
   positions): the direction in which the distance to the target shrinks fastest against
   the distance to the picked one, i.e. sideways or backward, away from the picked object.
   Any forward part along the hand's approach axis z_H is removed (`without_forward`), as
   with the paper's disabled forward key. Two grasps at one place differ only in
-  orientation: it then only turns.
+  orientation: it then only turns. With the intent on the target (or none shown) but the
+  robot too slow, it presses what is left of driving there without the forward key, and
+  waits when that is little.
 - Once it has held the target's grasp orientation (within twice `aligned_angle`) for
   `insist_time` while the estimate still names another object, it goes to the target
   itself as far as the keys allow, as the reach participant does (`insist_twist`): along
@@ -47,9 +56,9 @@ import numpy as np
 from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.participant_impairment import ParticipantImpairment, first_choice
 from pbp_drake.core.participant_params import VirtualParticipantParams
+from pbp_drake.core.participant_serving import NO_INTENT, ServingMemory, serving_step
 from pbp_drake.core.quaternion import angle_between, conjugate, exp_map, log_map, multiply
 
-GRASP_PARTICIPANT_MODES = ("assist", "drive")
 # `ParticipantMemory.known_target` before it has noticed any target.
 NO_TARGET = -1
 
@@ -63,7 +72,8 @@ SHARED_WITH_REACH = {
     "direction_noise": "direction_noise", "speed_noise": "speed_noise",
     "slow_radius": "slow_radius", "slow_angle": "turn_slowdown_angle",
     "aligned_angle": "aligned_angle", "insist_time": "insist_time",
-    "impairment": "impairment"}
+    "hold_time": "hold_time", "serve_speed_fraction": "serve_speed_fraction",
+    "serve_patience": "serve_patience", "impairment": "impairment"}
 
 
 @dataclasses.dataclass
@@ -94,6 +104,14 @@ class GraspParticipantParams:
     #: Assisting, once it has held the target's orientation this long (s) and the estimate
     #: still names another object, it goes to the target itself (`insist_twist`).
     insist_time: float = _REACH_DEFAULTS.insist_time
+    #: Having taken over from a robot that did not serve its target, it keeps control at
+    #: least this long (s).
+    hold_time: float = _REACH_DEFAULTS.hold_time
+    #: It lets the robot go while the hand closes in on the grasp position at this fraction
+    #: of its own preferred speed there or more (`participant_serving`).
+    serve_speed_fraction: float = _REACH_DEFAULTS.serve_speed_fraction
+    #: It watches a robot that does not serve its target this long (s) before it takes over.
+    serve_patience: float = _REACH_DEFAULTS.serve_patience
     #: How it is impaired (`ParticipantImpairment`; the defaults: not at all).
     impairment: ParticipantImpairment = dataclasses.field(
         default_factory=ParticipantImpairment)
@@ -115,7 +133,8 @@ class GraspParticipantParams:
             if not (np.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be finite and positive, got {value!r}")
         for name in ("speed", "reaction_delay", "direction_noise", "speed_noise",
-                     "aligned_angle", "insist_time"):
+                     "aligned_angle", "insist_time", "hold_time", "serve_speed_fraction",
+                     "serve_patience"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be finite and not negative, got {value!r}")
@@ -273,33 +292,28 @@ def command_noise(params, seed, tick, velocity):
 
 @dataclasses.dataclass(frozen=True)
 class GraspParticipant:
-    """The participant of one run: its parameters, mode, speed and seed, and the grasp poses
-    of the scene's objects. `step` is a pure function of its arguments.
+    """The participant of one run: its parameters, speed and seed, and the grasp poses of
+    the scene's objects; the same under every method. `step` is a pure function of its
+    arguments.
 
     Attributes:
         params: `GraspParticipantParams`.
-        mode: "drive" (teleop) or "assist" (PBP, arbitration).
         speed: its linear speed (m/s): `params.speed`, or the nominal speed if that is 0.
         grasp_positions: (M, 3), grasp_orientations: (M, 4) the objects' grasp poses.
         seed: the run's seed (noise per tick from `(seed, tick)`).
     """
 
     params: GraspParticipantParams
-    mode: str
     speed: float
     grasp_positions: np.ndarray
     grasp_orientations: np.ndarray
     seed: int = 0
 
     @classmethod
-    def create(cls, params, mode, nominal_speed, grasp_positions, grasp_orientations,
-               seed=0):
+    def create(cls, params, nominal_speed, grasp_positions, grasp_orientations, seed=0):
         """Checks the arguments (errors name them) and takes the nominal speed when
         `params.speed` is 0."""
         params.validate()
-        if mode not in GRASP_PARTICIPANT_MODES:
-            raise ValueError(f"participant mode {mode!r} is unknown; use one of "
-                             f"{GRASP_PARTICIPANT_MODES}")
         speed = float(params.speed) if params.speed > 0 else float(nominal_speed)
         if not (np.isfinite(speed) and speed > 0):
             raise ValueError(f"nominal_speed must be finite and positive when params.speed "
@@ -311,7 +325,7 @@ class GraspParticipant:
             raise ValueError(f"grasp_positions must be (M, 3) with M >= 1 and "
                              f"grasp_orientations (M, 4), got shapes {positions.shape} and "
                              f"{orientations.shape}")
-        return cls(params, mode, speed, positions, orientations, int(seed))
+        return cls(params, speed, positions, orientations, int(seed))
 
     @property
     def motor_noise_scales(self):
@@ -320,14 +334,18 @@ class GraspParticipant:
         noise = self.params.impairment.command_noise
         return noise * np.repeat([self.speed, self.params.rotation_speed], 3)
 
-    def step(self, memory, time, tick, position, orientation, true_target, selected,
-             motor_noise=None):
-        """One tick: `(twist (6,) [v, omega], active, memory)`.
+    def step(self, memory, serving, time, tick, position, orientation, velocity, own_motion,
+             true_target, shown, forward_key, period, motor_noise=None):
+        """One tick: `(twist (6,) [v, omega], active, memory, serving)`.
 
-        `time` (s) and `tick` (an integer, the noise's draw) of this tick; the hand's
-        `position` (3) and `orientation` (4, w x y z); `true_target` the object the task
-        wants; `selected` the estimator's selection (ignored in teleop); `motor_noise` (6,
-        or None) this tick's motor noise (`participant_impairment.next_motor_noise`), added
+        `memory` (`ParticipantMemory`) and `serving` (`participant_serving.ServingMemory`)
+        what it remembers; `time` (s) and `tick` (an integer, the noise's draw) of this
+        tick, `period` the control period (s); the hand's `position` (3), `orientation` (4,
+        w x y z) and `velocity` (3), and the robot's own motion as it perceives it
+        (`own_motion` (3), `participant_serving.update_own_motion`); `true_target` the
+        object the task wants; `shown` the robot's shown intent (`NO_INTENT`: none);
+        `forward_key` whether the method enables the forward key; `motor_noise` (6, or
+        None) this tick's motor noise (`participant_impairment.next_motor_noise`), added
         to its twist while it acts."""
         known_before = memory.known_target
         memory = notice_target(memory, true_target, time, self.params.reaction_delay)
@@ -337,15 +355,19 @@ class GraspParticipant:
         target = heads_for(memory, time)
         idle = np.zeros(6)
         if target == NO_TARGET:
-            return idle, False, memory
+            return idle, False, memory, ServingMemory()
         position = np.asarray(position, float)
         orientation = np.asarray(orientation, float)
-        if self.mode == "assist":
+        shown = int(shown) if int(shown) >= 0 else NO_INTENT
+        if not forward_key:
             memory = count_insistence(self.params, memory, time, orientation,
-                                      self.grasp_orientations[target], int(selected),
-                                      target)
-            if int(selected) == target:
-                return idle, False, memory
+                                      self.grasp_orientations[target], shown, target)
+        act, serving = serving_step(
+            self.params, self.speed, period, serving, shown, target,
+            self.grasp_positions[target] - position, velocity, own_motion)
+        if not act:
+            return idle, False, memory, serving
+        if not forward_key and shown not in (NO_INTENT, target):
             if memory.insisting:
                 velocity, angular = insist_twist(
                     self.params, self.speed, position, orientation,
@@ -354,20 +376,27 @@ class GraspParticipant:
                 velocity, angular = assist_twist(
                     self.params, self.speed, position, orientation,
                     self.grasp_positions[target], self.grasp_orientations[target],
-                    self.grasp_positions[int(selected)])
+                    self.grasp_positions[shown])
         else:
             velocity, angular = drive_twist(
                 self.params, self.speed, position, orientation, self.grasp_positions[target],
                 self.grasp_orientations[target])
+            if not forward_key:
+                # What is left of driving there without the forward key; when that is
+                # little (the grasp ahead), no key helps and it waits.
+                wanted = float(np.linalg.norm(velocity))
+                velocity = without_forward(velocity, orientation)
+                if np.linalg.norm(velocity) < self.params.serve_speed_fraction * wanted:
+                    return idle, False, memory, ServingMemory()
         if not (velocity.any() or angular.any()):
-            return idle, False, memory
+            return idle, False, memory, serving
         velocity, scale = command_noise(self.params, self.seed, tick, velocity)
-        if self.mode == "assist":
+        if not forward_key:
             # The noise may turn a sidestep forward; the forward key stays disabled.
             velocity = without_forward(velocity, orientation)
         twist = scale * np.concatenate([velocity, angular])
         if motor_noise is not None:
             twist = twist + np.asarray(motor_noise, float)
-            if self.mode == "assist":
+            if not forward_key:
                 twist[:3] = without_forward(twist[:3], orientation)
-        return twist, True, memory
+        return twist, True, memory, serving

@@ -23,9 +23,9 @@ class VirtualParticipantParams:
     #: Its turn rate (rad/s).
     rotation_speed: float = 0.8
     #: It notices a new target this long (s) after it appears: seeing the ball move,
-    #: deciding and reaching for the keys. 0.5 s is the reach calibration (teleop then rests
-    #: about as long as the paper's users did); diagrams/hsr_obstacles.yaml keeps 0.3.
-    reaction_delay: float = 0.5
+    #: deciding and reaching for the keys. 0.3 s is the reach calibration: with
+    #: `serve_patience` after it, teleop then rests about as long as the paper's users did.
+    reaction_delay: float = 0.3
     #: Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
     #: (1 + N(0, speed_noise)).
     direction_noise: float = 0.1
@@ -53,8 +53,17 @@ class VirtualParticipantParams:
     #: hand to where the tool can point at the target (`reposition_motion`) at most this
     #: long (s) for one target; still unable to, it goes to the target itself.
     reposition_time: float = 4.0
-    #: Once it takes control among obstacles, it keeps it at least this long (s).
+    #: Once it takes control (among obstacles, or because the robot's motion did not serve
+    #: its target), it keeps it at least this long (s).
     hold_time: float = 0.5
+    #: It lets the robot go while the hand closes in on its target at this fraction of its
+    #: own preferred speed there or more (`pbp_drake.core.participant_serving`): the same
+    #: rule under every method, set before any method ran, never tuned on one.
+    serve_speed_fraction: float = 0.5
+    #: It watches the robot this long (s) before it takes over from a robot that does not
+    #: serve its target (about a simple reaction time, 0.24 s in the Model Human
+    #: Processor), and its sense of the robot's own motion averages over as long.
+    serve_patience: float = 0.25
     #: How it is impaired: motor noise, a delay of its commands, wrong first choices of
     #: target (`ParticipantImpairment`; the defaults: not at all).
     impairment: ParticipantImpairment = dataclasses.field(
@@ -88,24 +97,22 @@ class VirtualParticipantParams:
     turn_weight: float = 0.6
     #: The plan's weight of keeping on with its last command (a factor).
     keep_on_weight: float = 0.15
-    #: In PBP, holding control, it lets go once the DMP's path is clear of the obstacles by
+    #: Where the robot shows its intent, holding control it lets go once the robot's path
+    #: (the straight line the shown path pulls back to) is clear of the obstacles by
     #: `release_factor` times its margin (a factor) and the robot faces within
-    #: `release_heading_gap` (rad) of the heading it wants; under PBP-Alt, whose DMP pulls
-    #: the robot back to its line after each release, within
-    #: `release_heading_gap_alternated` (rad). It keeps control `hold_time` at least. Not
-    #: holding it, it stays out while the robot faces within twice that gap and the DMP's
-    #: path and the hand's own keep its margin clear.
+    #: `release_heading_gap` (rad) of the heading it wants. It keeps control `hold_time` at
+    #: least. Not holding it, it stays out while the robot faces within twice that gap and
+    #: the robot's path and the hand's own keep its margin clear.
     release_factor: float = 1.5
-    #: In PBP it lets go within this heading gap (rad).
+    #: It lets go within this heading gap (rad).
     release_heading_gap: float = 0.05
-    #: The same under PBP-Alt (rad).
-    release_heading_gap_alternated: float = 0.12
     #: The heading it wants at the target is the nearest one whose footprint keeps
     #: `goal_margin_factor` times its margin (a factor) clear of where the obstacles stop.
     goal_margin_factor: float = 1.0
-    #: PBP-Cont, among obstacles and when it goes to the target itself (`insist_time`) in
-    #: the reaching task: it asks for the motion it wants minus the policy's, at most this
-    #: many times `speed` (a factor).
+    #: Where it sees the robot pull by itself (`participant_serving.robot_pulls`: PBP-Cont's
+    #: DMP), among obstacles and when it goes to the target itself in the reaching task it
+    #: asks for the motion it wants minus the robot's own, at most this many times `speed`
+    #: (a factor).
     policy_compensation: float = 3.0
     #: Its way round has stalled (`participant_avoidance`) once it has not come
     #: `progress_step` (m) closer to the target for `stall_time` (s): it then pushes on

@@ -56,7 +56,7 @@ class ParticipantPopulationParams:
     #: Proficiency: its speed noise (a fraction).
     speed_noise: list[float] = dataclasses.field(default_factory=lambda: [0.05, 0.2])
     #: Proficiency: how long (s) it takes to notice a new target.
-    reaction_delay: list[float] = dataclasses.field(default_factory=lambda: [0.3, 0.8])
+    reaction_delay: list[float] = dataclasses.field(default_factory=lambda: [0.2, 0.6])
     #: Aggressiveness: how long (s) it faces the target before it goes there itself.
     insist_time: list[float] = dataclasses.field(default_factory=lambda: [0.5, 2.0])
     #: Aggressiveness: its turn rate (rad/s).

@@ -89,6 +89,9 @@ class ProportionalPilotParams:
     #: The clip (m/s) of the command's norm; 0 takes the task's operator speed (the
     #: source's 0.25 m/s was its robot's operator speed).
     max_speed: float = 0.0
+    #: A command (after the keys) no faster than this (m/s) presses no key: it is then
+    #: zero and inactive. 0, the source's: it acts everywhere but on the target.
+    dead_zone: float = 0.0
 
 
 def lag_per_tick(p, control_period):
@@ -182,8 +185,7 @@ def reach_proportional_command(params, hand, heading, goal, max_speed, vertical,
     velocity[:size] = proportional_velocity(params, hand[:size], goal[:size], max_speed)
     if not forward_enabled:
         velocity[:2] = without_forward(velocity[:2], heading)
-    command = np.array([velocity[0], velocity[1], velocity[2], 0.0])
-    return command, bool(np.linalg.norm(command) > 0)
+    return _pressed(np.array([velocity[0], velocity[1], velocity[2], 0.0]), params.dead_zone)
 
 
 def grasp_proportional_command(params, hand, orientation, goal, max_speed, forward_enabled):
@@ -194,5 +196,12 @@ def grasp_proportional_command(params, hand, orientation, goal, max_speed, forwa
                             np.zeros(3)])
     if not forward_enabled:
         twist = without_forward_twist(twist, orientation)
-    return twist, bool(np.linalg.norm(twist) > 0)
+    return _pressed(twist, params.dead_zone)
+
+
+def _pressed(command, dead_zone):
+    """`(command, active)`: a command no faster than `dead_zone` presses no key."""
+    if np.linalg.norm(command) <= dead_zone:
+        return np.zeros_like(command), False
+    return command, True
 

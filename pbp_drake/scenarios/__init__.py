@@ -13,17 +13,17 @@ from pbp_drake.scenarios.resolution import (
     BLEND_MODE_OF_METHOD, ResolvedScenario, TaskScene, demonstration_samples,
     parse_method_label, resolve, task_scene, with_method)
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, METHODS, OPERATOR_DRIVES, OPERATOR_NAMES, TASK_ROBOTS, TOY_OPERATORS,
+    HSR_OPERATORS, METHODS, FORWARD_KEY_METHODS, OPERATOR_NAMES, TASK_ROBOTS, TOY_OPERATORS,
     AlphaStudy, AltVsCont, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask, Hsr, Keyboard, MethodComparison,
     MultiGoalReach, NoOperator, Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot,
     RecordedPath, Scenario, ScenarioError, ScenarioFile, SceneVariant, ScriptedCommands,
-    SinusoidalStep, VirtualParticipant, NoisyPilot, LaggyPilot, ProportionalPilot,
-    ParticipantPopulation, PILOT_CONFIGS)
+    SinusoidalStep, VirtualParticipant, forward_key_enabled, shows_intent, NoisyPilot,
+    LaggyPilot, ProportionalPilot, ParticipantPopulation, PILOT_CONFIGS)
 from pbp_drake.scenarios.words import METHOD_NAMES, counted
 from pbp_drake.scenarios.pilots import PILOT_NAMES, PILOTS, check_pilot_name, with_pilot
 
 __all__ = [
-    "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHOD_NAMES", "METHODS", "OPERATOR_DRIVES",
+    "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHOD_NAMES", "METHODS", "FORWARD_KEY_METHODS",
     "OPERATOR_NAMES", "TASK_ROBOTS", "TOY_OPERATORS", "AlphaStudy", "AltVsCont", "Arm",
     "BentPath",
     "DynamicObstacles", "Gamepad", "GraspTask", "Hsr", "Keyboard", "LoadedScenarioFile",
@@ -34,5 +34,5 @@ __all__ = [
     "NoisyPilot", "LaggyPilot", "ProportionalPilot", "ParticipantPopulation", "PILOT_CONFIGS",
     "PILOT_NAMES", "PILOTS", "check_pilot_name", "with_pilot",
     "check_alpha_study", "check_method_comparison", "counted", "demonstration_samples",
-    "load_scenario_file", "parse_method_label", "resolve", "task_scene", "with_method",
+    "forward_key_enabled", "load_scenario_file", "parse_method_label", "resolve", "shows_intent", "task_scene", "with_method",
 ]

@@ -58,9 +58,26 @@ class ScenarioError(ValueError):
 
 METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
            "pbp_no_user", "hop", "policy_blending")
-# The methods under which the operator drives the whole way, the forward key enabled: teleop,
-# and the shared-autonomy baselines whose assistance adds to (or replaces) a full command.
-OPERATOR_DRIVES = ("teleop", "hop", "policy_blending")
+# The methods whose keys include forward: teleop, and the shared-autonomy baselines whose
+# assistance adds to a full command. The paper disables it under PBP and arbitration, whose
+# operator shows the goal and lets the robot bring the hand there.
+FORWARD_KEY_METHODS = ("teleop", "hop", "policy_blending")
+
+
+def forward_key_enabled(scenario):
+    """Whether the scenario's method enables the forward key (a person's keys, and the
+    virtual participant's `forward_key` input)."""
+    return scenario.method in FORWARD_KEY_METHODS
+
+
+def shows_intent(scenario):
+    """Whether the page shows the robot's intent (the blue ball over the object it means):
+    not under teleop, whose robot never moves by itself, nor under HOP with its assistance
+    off (`hop: {assistance: false}`), whose robot adds nothing."""
+    if scenario.method == "teleop":
+        return False
+    return not (scenario.method in ("hop", "policy_blending")
+                and not getattr(scenario.hop, "assistance", True))
 
 
 @dataclasses.dataclass

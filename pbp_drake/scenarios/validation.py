@@ -275,10 +275,24 @@ def _mapping_expected(schema, node, field):
     return f"{field}: got {given}; expected {expected}"
 
 
+def _unknown_tag(schema, node, field):
+    """`field: the tag !X is unknown; ...` (with did-you-mean) for a node whose tag names
+    none of the Union's members, else None."""
+    tag = node.get("_tag", "") if isinstance(node, dict) else ""
+    if not tag:
+        return None
+    tags = ["!" + getattr(member, "__name__", "") for member in _members(schema)]
+    matches = difflib.get_close_matches(tag, tags, n=1)
+    hint = f" (did you mean {matches[0]}?)" if matches else ""
+    return f"{field}: the tag {tag} is unknown; expected one of {', '.join(tags)}{hint}"
+
+
 def _first_problem(node, schema, field):
     optional = type(None) in typing.get_args(schema)
     variant = _variant(schema, node)
-    if variant is None or (node is None and optional):
+    if variant is None:
+        return _unknown_tag(schema, node, field)
+    if node is None and optional:
         return None
     types_of = _field_types(variant)
     if types_of is not None:
@@ -518,12 +532,13 @@ def check_virtual_participant(operator, field="scenario.operator"):
     if problem is not None:
         raise ScenarioError(f"{field}.impairment.{problem}")
     require_finite(operator, field, (
-        "slow_radius", "turn_slowdown_angle", "settle_time", "max_turn_rate", "release_heading_gap", "release_heading_gap_alternated",
-        "policy_compensation", "progress_step", "stall_time"))
+        "slow_radius", "turn_slowdown_angle", "settle_time", "max_turn_rate",
+        "release_heading_gap", "policy_compensation", "progress_step", "stall_time"))
     require_finite(operator, field, (
         "final_approach_radius", "push_through_radius", "turn_weight", "keep_on_weight",
         "release_factor", "goal_margin_factor", "min_closing_fraction", "aligned_angle",
-        "in_line_angle", "aside_speed_fraction", "insist_time", "reposition_time"),
+        "in_line_angle", "aside_speed_fraction", "insist_time", "reposition_time",
+        "serve_speed_fraction", "serve_patience", "hold_time"),
         positive=False)
     directions = operator.plan_directions
     if isinstance(directions, bool) or not isinstance(directions, numbers.Integral):
@@ -551,7 +566,7 @@ def check_pilot(operator, field="scenario.operator"):
                                 "in [0, 1]")
     if isinstance(operator, ProportionalPilotParams):
         require_finite(operator, field, ("gain",))
-        require_finite(operator, field, ("max_speed",), positive=False)
+        require_finite(operator, field, ("max_speed", "dead_zone"), positive=False)
     if isinstance(operator, ParticipantPopulationParams):
         problem = population_problem(operator)
         if problem is not None:

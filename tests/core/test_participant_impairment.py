@@ -16,6 +16,7 @@ from pbp_drake.core.participant_grasp import (
 from pbp_drake.core.participant_impairment import (
     PARTICIPANT_CONDITIONS, ParticipantImpairment, condition, delay_ticks, first_choice,
     initial_motor_noise, next_motor_noise)
+from pbp_drake.core.participant_serving import NO_INTENT, ServingMemory, update_own_motion
 
 PERIOD = 0.03
 SCALES = np.array([0.036, 0.036, 0.24])  # 0.3 times a speed of 0.12 m/s and 0.8 rad/s
@@ -155,16 +156,21 @@ def grasp_scene():
     return positions, orientations
 
 
-def grasp_twists(impairment, mode="drive", seconds=2.5, selected=-1, noise=None):
+def grasp_twists(impairment, forward_key=True, seconds=2.5, selected=NO_INTENT, noise=None):
+    """The twists toward object 1 of a participant whose hand stays where it is (as under
+    teleop by default: the forward key enabled, no intent shown)."""
     positions, orientations = grasp_scene()
-    participant = GraspParticipant.create(
-        GraspParticipantParams(direction_noise=0.0, speed_noise=0.0, impairment=impairment),
-        mode, 0.12, positions, orientations, seed=3)
-    memory, twists = ParticipantMemory(), []
+    params = GraspParticipantParams(direction_noise=0.0, speed_noise=0.0,
+                                    impairment=impairment)
+    participant = GraspParticipant.create(params, 0.12, positions, orientations, seed=3)
+    memory, serving, own_motion, twists = ParticipantMemory(), ServingMemory(), np.zeros(3), []
     hand, level = np.array([0.5, 0.0, 0.7]), side_grasp_orientation(0.0)
     for tick in range(int(round(seconds / PERIOD))):
-        twist, _, memory = participant.step(memory, tick * PERIOD, tick, hand, level, 1,
-                                            selected, None if noise is None else noise[tick])
+        twist, active, memory, serving = participant.step(
+            memory, serving, tick * PERIOD, tick, hand, level, np.zeros(3), own_motion, 1,
+            selected, forward_key, PERIOD, None if noise is None else noise[tick])
+        own_motion = update_own_motion(params, PERIOD, own_motion, np.zeros(3),
+                                       twist[:3] if active else np.zeros(3))
         twists.append(twist)
     return np.array(twists), hand, level
 
@@ -174,8 +180,10 @@ def test_the_mistaken_grasp_participant_heads_for_the_other_grasp_pose_then_the_
     twists, hand, level = grasp_twists(
         ParticipantImpairment(mistake_probability=1.0, mistake_time=0.9))
     # It notices the target (object 1) after its reaction_delay, 0.5 s, then heads for
-    # object 0's grasp pose, position and orientation, for 0.9 s.
-    noticed, corrected = int(round(0.5 / PERIOD)), int(round(1.4 / PERIOD))
+    # object 0's grasp pose, position and orientation, for 0.9 s; the hand still, it takes
+    # over once it has watched it `serve_patience`.
+    patience = round(GraspParticipantParams().serve_patience / PERIOD)
+    noticed, corrected = int(round(0.5 / PERIOD)) + patience, int(round(1.4 / PERIOD))
     assert not twists[:noticed].any()
 
     def heads_for(twist, index):
@@ -199,7 +207,7 @@ def test_the_noisy_grasp_participant_adds_its_noise_while_it_acts_and_never_forw
     assert np.allclose(noisy[acting], clean[acting] + noise[acting])
     assert not noisy[~acting].any()
     # Assisting (the estimate names object 0), the forward key stays disabled.
-    assisted, _, _ = grasp_twists(ParticipantImpairment(command_noise=0.3), mode="assist",
-                                  selected=0, noise=noise)
+    assisted, _, _ = grasp_twists(ParticipantImpairment(command_noise=0.3),
+                                  forward_key=False, selected=0, noise=noise)
     assert assisted.any()
     assert np.all(assisted[:, :3] @ approach_direction(level) <= 1e-12)

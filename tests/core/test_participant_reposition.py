@@ -94,15 +94,24 @@ def test_the_participant_backs_until_the_tool_can_point_at_the_target_then_faces
 
 def test_unable_to_move_to_where_it_can_point_it_goes_to_the_target_itself():
     # The hand held where it is (the arm at a limit, say): after `reposition_time` of
-    # backing in vain it insists, moving toward the target as far as the keys allow.
+    # backing in vain it insists, moving toward the target as far as the keys allow. The
+    # hand that does not follow its keys reads as the robot pulling against them, so it
+    # pushes against that pull (`policy_compensation`): harder, in the same direction.
     participant = Participant([AHEAD, BEHIND_LEFT], 1, heading_range=WRIST, vertical=True)
     ticks = round(PARAMS.reposition_time / PERIOD)
     commands = np.array([participant.tick() for _ in range(ticks + 1)])
     backing, _ = reposition_motion(PARAMS, SPEED, HAND, 0.0, BEHIND_LEFT, WRIST, True)
-    np.testing.assert_allclose(commands[:ticks, :3], np.tile(backing, (ticks, 1)))
+    np.testing.assert_allclose(commands[0, :3], backing)
+    limit = PARAMS.policy_compensation * SPEED
+    speeds = np.linalg.norm(commands[:ticks, :3], axis=1)
+    np.testing.assert_allclose(commands[:ticks, :3], speeds[:, None] * backing / SPEED)
+    assert speeds.max() <= limit * (1 + 1e-12)
     insisting, yaw_rate = assist_motion(PARAMS, SPEED, HAND, 0.0, BEHIND_LEFT, AHEAD,
                                         insisting=True, vertical=True)
-    np.testing.assert_allclose(commands[ticks], [*insisting, yaw_rate])
+    # What it wants minus the robot's own motion (the hand still: minus what it sent).
+    pushed = insisting + commands[ticks - 1, :3]
+    pushed *= min(1.0, limit / np.linalg.norm(pushed))
+    np.testing.assert_allclose(commands[ticks], [*pushed, yaw_rate])
     assert not np.allclose(insisting, backing)
 
 

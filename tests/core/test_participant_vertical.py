@@ -11,6 +11,7 @@ import pytest
 from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_reach import assist_motion, drive_motion, facing
+from pbp_drake.core.participant_serving import NO_INTENT
 from pbp_drake.systems import VirtualOperator
 
 import participant_harness
@@ -132,12 +133,22 @@ def Participant(objects, target_index, selected=0, **kwargs):
 
 QUIET = dataclasses.replace(PARAMS, direction_noise=0.0, speed_noise=0.0)
 OBJECTS = np.array([PICKED, TARGET, ABOVE, BELOW])
+# The ticks a participant watches a robot that does not serve its target before it acts.
+PATIENCE_TICKS = round(PARAMS.serve_patience / PERIOD)
+
+
+def TeleopParticipant(objects, target_index, **kwargs):
+    """A participant as under teleop (the forward key enabled, no intent shown), past the
+    `serve_patience` it watches the still hand before it takes over."""
+    participant = Participant(objects, target_index, NO_INTENT, forward_key=True, **kwargs)
+    waiting = np.array([participant.tick() for _ in range(PATIENCE_TICKS)])
+    assert not waiting.any()
+    return participant
 
 
 @pytest.mark.parametrize("target_index", [2, 3])
 def test_a_teleop_participant_drives_the_hand_to_a_target_above_or_below(target_index):
-    participant = Participant(OBJECTS, target_index, mode="drive", params=QUIET,
-                              vertical=True)
+    participant = TeleopParticipant(OBJECTS, target_index, params=QUIET, vertical=True)
     commands = participant.follow(400)
     target = OBJECTS[target_index]
     assert np.sign(commands[0, 2]) == np.sign(target[2] - START[2])
@@ -161,13 +172,13 @@ def test_its_noise_turns_the_floor_part_and_scales_vz():
     # Noisy (the calibrated noise) toward a target at the hand's height, with and without
     # vertical motion: the same floor command; toward one above, the same speed factor.
     level = np.array([[1.2, 0.4, START[2]], [1.2, 0.4, START[2] + 0.3]])
-    planar = Participant(level, 0, mode="drive", params=PARAMS)
-    vertical = Participant(level, 0, mode="drive", params=PARAMS, vertical=True)
+    planar = TeleopParticipant(level, 0, params=PARAMS)
+    vertical = TeleopParticipant(level, 0, params=PARAMS, vertical=True)
     for _ in range(5):
         expected, got = planar.tick(), vertical.tick()
         np.testing.assert_allclose(got, expected, atol=1e-15)
-    above = Participant(level, 1, mode="drive", params=PARAMS, vertical=True)
-    quiet = Participant(level, 1, mode="drive", params=QUIET, vertical=True)
+    above = TeleopParticipant(level, 1, params=PARAMS, vertical=True)
+    quiet = TeleopParticipant(level, 1, params=QUIET, vertical=True)
     noisy, exact = above.tick(), quiet.tick()
     factor = np.linalg.norm(noisy[:2]) / np.linalg.norm(exact[:2])
     assert factor != 1.0
@@ -178,24 +189,24 @@ def test_its_motor_noise_shakes_vz_and_keeps_the_rest_as_without_it():
     shaky = dataclasses.replace(
         PARAMS, impairment=ParticipantImpairment(command_noise=0.3))
     level = np.array([[1.2, 0.4, START[2]]])
-    planar = Participant(level, 0, mode="drive", params=shaky)
-    vertical = Participant(level, 0, mode="drive", params=shaky, vertical=True)
+    planar = TeleopParticipant(level, 0, params=shaky)
+    vertical = TeleopParticipant(level, 0, params=shaky, vertical=True)
     commands = np.array([(planar.tick(), vertical.tick()) for _ in range(5)])
     np.testing.assert_allclose(commands[:, 1, [0, 1, 3]], commands[:, 0, [0, 1, 3]],
                                atol=1e-15)
     assert np.all(commands[:, 0, 2] == 0.0) and np.all(commands[:, 1, 2] != 0.0)
 
 
-@pytest.mark.parametrize("mode", ["drive", "assist"])
-def test_vertical_off_sends_the_same_commands_as_before(mode):
+@pytest.mark.parametrize("forward_key", [True, False])
+def test_vertical_off_sends_the_same_commands_as_before(forward_key):
     # The keyword omitted (as every existing scenario builds it) and vertical=False: the
     # same commands bit for bit, and vz = 0, with the calibrated noise and an impairment.
     params = dataclasses.replace(PARAMS, impairment=ParticipantImpairment(
         command_noise=0.3, command_delay=0.06, mistake_probability=0.5))
     runs = []
     for kwargs in ({}, {"vertical": False}):
-        participant = Participant(OBJECTS, 2, selected=0, mode=mode, params=params,
-                                  **kwargs)
+        participant = Participant(OBJECTS, 2, selected=0, forward_key=forward_key,
+                                  params=params, **kwargs)
         runs.append(participant.follow(60))
     assert np.array_equal(runs[0], runs[1])
     assert np.all(runs[0][:, 2] == 0.0) and np.any(runs[0][:, :2] != 0.0)
@@ -203,5 +214,5 @@ def test_vertical_off_sends_the_same_commands_as_before(mode):
 
 def test_vertical_motion_with_obstacles_is_refused():
     with pytest.raises(ValueError, match="vertical=True.*obstacle"):
-        VirtualOperator(PERIOD, OBJECTS[:1], mode="drive", nominal_speed=SPEED,
+        VirtualOperator(PERIOD, OBJECTS[:1], nominal_speed=SPEED,
                         obstacle_count=2, obstacle_radius=0.1, vertical=True)

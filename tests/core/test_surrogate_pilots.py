@@ -199,3 +199,16 @@ def test_a_population_range_that_cannot_be_used_is_named(field, value, words):
     problem = population_problem(dataclasses.replace(POPULATION, **{field: value}))
     assert problem is not None and words in problem
     assert population_problem(POPULATION) is None
+
+
+def test_a_dead_zone_presses_no_key_for_a_slow_command():
+    slow = dataclasses.replace(PROPORTIONAL, dead_zone=0.05)
+    hand = np.array([1.0, 0.0, 0.7])
+    # 10 /s times 4 mm: 0.04 m/s, inside the dead zone; 6 mm: 0.06 m/s, outside.
+    command, active = reach_proportional_command(slow, hand, 0.0, hand + [0.0, 0.004, 0.0],
+                                                 0.25, vertical=False, forward_enabled=True)
+    assert not active and not np.any(command)
+    command, active = reach_proportional_command(slow, hand, 0.0, hand + [0.0, 0.006, 0.0],
+                                                 0.25, vertical=False, forward_enabled=True)
+    assert active
+    np.testing.assert_allclose(command, [0.0, 0.06, 0.0, 0.0], atol=1e-15)

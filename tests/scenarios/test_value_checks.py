@@ -66,8 +66,8 @@ def test_values_that_broke_a_computation_are_refused(tmp_path, file, old, new, m
     # Divided by in the plan's turning score.
     ("max_turn_rate: 0.5", "max_turn_rate: 0.0",
      r"scenario.operator.max_turn_rate must be finite and positive, got 0.0"),
-    ("release_heading_gap_alternated: 0.12", "release_heading_gap_alternated: -0.1",
-     r"scenario.operator.release_heading_gap_alternated must be finite and positive"),
+    ("release_heading_gap: 0.05", "release_heading_gap: -0.1",
+     r"scenario.operator.release_heading_gap must be finite and positive"),
     ("policy_compensation: 3.0", "policy_compensation: 0.0",
      r"scenario.operator.policy_compensation must be finite and positive"),
     ("turn_weight: 0.6", "turn_weight: -0.6",

@@ -18,6 +18,7 @@ from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantP
 from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_reach import facing
+from pbp_drake.core.participant_serving import NO_INTENT
 from pbp_drake.systems import PoseVirtualOperator, VirtualOperator
 
 PERIOD = 0.03
@@ -26,6 +27,8 @@ HAND = np.array([0.5, 0.0, 0.7])
 # Seen from the hand facing +x: one object ahead-left, one ahead-right, one far ahead.
 OBJECTS = np.array([[1.6, 0.6, 0.7], [1.6, -0.6, 0.7], [2.4, 0.0, 0.7]])
 QUIET = dict(direction_noise=0.0, speed_noise=0.0)
+# The ticks it watches a robot that does not serve its target before it takes over.
+PATIENCE = round(VirtualParticipantParams().serve_patience / PERIOD)
 
 
 def params(**impairment):
@@ -42,21 +45,33 @@ def target_source(schedule):
     return TrajectorySource(PiecewisePolynomial.ZeroOrderHold(times, values))
 
 
-def reach_commands(participant_params, schedule, ticks, mode="drive", selected=0, seed=4,
-                   heading=0.0):
+def hand_source(heading, velocity, seconds):
+    """A source of `ee_state`: the hand from HAND at `velocity` (3; zero: held there),
+    facing `heading`."""
+    velocity = np.asarray(velocity, float)
+    if not velocity.any():
+        return ConstantVectorSource(np.array([*HAND, 0.0, 0.0, 0.0, heading, 0.0]))
+    values = np.array([[*(HAND + time * velocity), *velocity, heading, 0.0]
+                       for time in (0.0, seconds)]).T
+    return TrajectorySource(PiecewisePolynomial.FirstOrderHold([0.0, seconds], values))
+
+
+def reach_commands(participant_params, schedule, ticks, forward_key=True, selected=NO_INTENT,
+                   seed=4, heading=0.0, hand_velocity=(0.0, 0.0, 0.0)):
     """`(commands (ticks, 4), active (ticks,))` of a lone reach participant, the hand held
-    at HAND with `heading`, the estimate naming `selected`."""
+    at HAND with `heading` (or moving from there at `hand_velocity`), the robot showing
+    `selected` (by default none, and the forward key enabled: as under teleop)."""
     builder = DiagramBuilder()
     participant = builder.AddSystem(VirtualOperator(
-        PERIOD, OBJECTS, mode=mode, params=participant_params, nominal_speed=SPEED,
-        seed=seed))
-    ee_state = [*HAND, 0.0, 0.0, 0.0, heading, 0.0]
+        PERIOD, OBJECTS, params=participant_params, nominal_speed=SPEED, seed=seed))
     for port, source in (
             (participant.get_ee_state_input_port(),
-             ConstantVectorSource(np.array(ee_state))),
+             hand_source(heading, hand_velocity, ticks * PERIOD + 1.0)),
             (participant.get_target_input_port(), target_source(schedule)),
             (participant.get_selected_goal_input_port(),
-             ConstantVectorSource(np.array([float(selected)])))):
+             ConstantVectorSource(np.array([float(selected)]))),
+            (participant.get_forward_key_input_port(),
+             ConstantVectorSource(np.array([1.0 if forward_key else 0.0])))):
         builder.Connect(builder.AddSystem(source).get_output_port(), port)
     return _sampled(builder, participant, ticks)
 
@@ -91,8 +106,10 @@ def test_the_noisy_participants_commands_spread_as_documented():
     clean, _ = reach_commands(params(), [(0.0, 2)], ticks)
     noisy, active = reach_commands(params(command_noise=0.3, command_noise_time=0.0),
                                    [(0.0, 2)], ticks)
-    assert active.all()
-    noise = (noisy - clean)[:, [0, 1, 3]]
+    # Teleop's robot does not move the hand: it takes over after its patience, for good.
+    assert not active[:PATIENCE].any() and active[PATIENCE:].all()
+    assert not noisy[:PATIENCE].any()
+    noise = (noisy - clean)[PATIENCE:, [0, 1, 3]]
     rotation_speed = VirtualParticipantParams().rotation_speed
     expected = 0.3 * np.array([SPEED, SPEED, rotation_speed])
     assert np.allclose(noise.std(axis=0), expected, rtol=0.06)
@@ -109,6 +126,7 @@ def test_one_seed_gives_the_same_noise_whatever_the_participant_does():
         noise.append(noisy - clean)
     assert np.allclose(noise[0], noise[1], rtol=0.0, atol=1e-15)
     assert np.abs(noise[0]).max() > 0.01
+    assert not noise[0][:PATIENCE].any()  # nothing added before it acts
     again, _ = reach_commands(params(**impairment), [(0.0, 1)], 150)
     other_seed, _ = reach_commands(params(**impairment), [(0.0, 1)], 150, seed=5)
     assert np.array_equal(again, noise[1] + reach_commands(params(), [(0.0, 1)], 150)[0])
@@ -116,18 +134,24 @@ def test_one_seed_gives_the_same_noise_whatever_the_participant_does():
 
 
 def test_the_noisy_participant_acts_no_more_often_and_never_pushes_forward():
-    # Assisting while the estimate names the left object, the target right: it sidesteps.
-    clean, clean_active = reach_commands(params(), [(0.0, 1)], 300, mode="assist")
+    # Without the forward key, the robot showing the left object, the target right: it
+    # sidesteps.
+    clean, clean_active = reach_commands(params(), [(0.0, 1)], 300, forward_key=False,
+                                         selected=0)
     noisy, active = reach_commands(params(command_noise=0.5), [(0.0, 1)], 300,
-                                   mode="assist")
+                                   forward_key=False, selected=0)
+    assert active.all()
     assert np.array_equal(active, clean_active)
     assert not np.allclose(noisy, clean)
     # Its heading drifts with the noise only as far as its turns take it; here it is
     # held, and no command has a forward part along it.
     assert np.all(noisy[:, :2] @ facing(0.0) <= 1e-12)
-    # Where it does not act, it adds nothing.
+    # Where it does not act (the robot shows the target and brings the hand there), it
+    # adds nothing.
+    offset = OBJECTS[0] - HAND
     idle, idle_active = reach_commands(params(command_noise=0.5), [(0.0, 0)], 50,
-                                       mode="assist", selected=0)
+                                       forward_key=False, selected=0,
+                                       hand_velocity=SPEED * offset / np.linalg.norm(offset))
     assert not idle_active.any() and not idle.any()
 
 
@@ -148,10 +172,11 @@ def test_the_late_participant_sends_the_same_commands_the_delay_later():
     assert np.array_equal(delayed_active[shift:], on_time_active[:-shift])
     # Before its first commands arrive, the robot gets nothing.
     assert not delayed[:shift].any() and not delayed_active[:shift].any()
-    # It reacts to the switch its reaction_delay and the delay after it.
+    # It reacts to the switch its reaction_delay, its patience with the still hand and the
+    # delay after it.
     turned = np.flatnonzero([toward(command, OBJECTS[1]) > 0.9 for command in delayed])
-    assert turned[0] * PERIOD == pytest.approx(1.2 + calibrated.reaction_delay + 0.3,
-                                               abs=1.5 * PERIOD)
+    assert turned[0] * PERIOD == pytest.approx(
+        1.2 + calibrated.reaction_delay + calibrated.serve_patience + 0.3, abs=1.5 * PERIOD)
 
 
 def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
@@ -161,7 +186,7 @@ def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
     def twists(delay):
         participant = GraspParticipant.create(
             GraspParticipantParams(impairment=ParticipantImpairment(command_delay=delay)),
-            "drive", SPEED, positions, orientations, seed=2)
+            SPEED, positions, orientations, seed=2)
         builder = DiagramBuilder()
         system = builder.AddSystem(PoseVirtualOperator(participant, PERIOD))
         hand = np.concatenate([HAND, side_grasp_orientation(0.0), np.zeros(6)])
@@ -169,13 +194,18 @@ def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
                              (system.get_target_input_port(), target_source([(0.0, 0),
                                                                              (1.0, 1)])),
                              (system.get_selected_goal_input_port(),
-                              ConstantVectorSource(np.zeros(1)))):
+                              ConstantVectorSource(np.array([float(NO_INTENT)]))),
+                             (system.get_forward_key_input_port(),
+                              ConstantVectorSource(np.ones(1)))):
             builder.Connect(builder.AddSystem(source).get_output_port(), port)
         return _sampled(builder, system, 120)
 
     (on_time, on_time_active), (delayed, delayed_active) = twists(0.0), twists(0.45)
     shift = 15
-    assert on_time_active[20:].all()
+    # Under teleop it takes over once it has noticed the target and watched the still hand
+    # for its patience (0.5 + 0.25 s), and keeps on.
+    acts = round(0.75 / PERIOD)
+    assert not on_time_active[:acts].any() and on_time_active[acts:].all()
     assert np.array_equal(delayed[shift:], on_time[:-shift])
     assert np.array_equal(delayed_active[shift:], on_time_active[:-shift])
     assert not delayed[:shift].any()
@@ -188,29 +218,36 @@ def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
 def test_the_mistaken_participant_heads_for_another_object_then_for_the_target():
     mistaken = params(mistake_probability=1.0, mistake_time=0.9)
     commands, active = reach_commands(mistaken, [(0.0, 1)], 80)
-    assert active.all()
+    # Teleop's still hand: it takes over after its patience.
+    assert not active[:PATIENCE].any() and active[PATIENCE:].all()
     wrong_ticks = 30  # 0.9 s
     # With the target the right object, it first heads for one of the others ...
-    first = max(range(3), key=lambda index: toward(commands[0], OBJECTS[index]))
+    first = max(range(3), key=lambda index: toward(commands[PATIENCE], OBJECTS[index]))
     assert first != 1
-    assert all(toward(command, OBJECTS[first]) > 0.999 for command in commands[:wrong_ticks])
+    assert all(toward(command, OBJECTS[first]) > 0.999
+               for command in commands[PATIENCE:wrong_ticks])
     # ... then sees its mistake and heads for the target.
     assert all(toward(command, OBJECTS[1]) > 0.999 for command in commands[wrong_ticks:])
-    # The unimpaired one heads for the target from the first tick.
-    right, _ = reach_commands(params(), [(0.0, 1)], 5)
-    assert all(toward(command, OBJECTS[1]) > 0.999 for command in right)
+    # The unimpaired one heads for the target from the first tick it acts.
+    right, _ = reach_commands(params(), [(0.0, 1)], PATIENCE + 5)
+    assert all(toward(command, OBJECTS[1]) > 0.999 for command in right[PATIENCE:])
 
 
 def test_a_mistaken_participant_assisting_leaves_the_robot_to_the_wrong_object():
-    # The estimate names the object it mistook the target for: it is content, and acts
-    # only once it sees its mistake. Which object it mistakes comes from the seed.
+    # The robot shows the object it mistook the target for and brings the hand there: it is
+    # content, and acts only once it sees its mistake. Which object it mistakes comes from
+    # the seed.
     mistaken = params(mistake_probability=1.0, mistake_time=0.9)
-    commands, _ = reach_commands(mistaken, [(0.0, 1)], 2)
-    wrong = max(range(3), key=lambda index: toward(commands[0], OBJECTS[index]))
-    _, active = reach_commands(mistaken, [(0.0, 1)], 60, mode="assist", selected=wrong)
+    commands, _ = reach_commands(mistaken, [(0.0, 1)], PATIENCE + 1)
+    wrong = max(range(3), key=lambda index: toward(commands[PATIENCE], OBJECTS[index]))
+    offset = OBJECTS[wrong] - HAND
+    robot = SPEED * offset / np.linalg.norm(offset)
+    _, active = reach_commands(mistaken, [(0.0, 1)], 60, forward_key=False, selected=wrong,
+                               hand_velocity=robot)
     assert not active[:30].any()
     assert active[30:].all()
-    _, unimpaired = reach_commands(params(), [(0.0, 1)], 5, mode="assist", selected=wrong)
+    _, unimpaired = reach_commands(params(), [(0.0, 1)], 5, forward_key=False,
+                                   selected=wrong, hand_velocity=robot)
     assert unimpaired.all()
 
 
@@ -218,13 +255,19 @@ def test_each_new_target_may_be_mistaken_again():
     mistaken = params(mistake_probability=1.0, mistake_time=0.6)
     commands, active = reach_commands(mistaken, [(0.0, 0), (1.5, 2)], 120)
     wrong_ticks, switch = 20, 50  # 0.6 s; the switch at 1.5 s
-    # The first target, at once from the start ...
-    assert all(toward(command, OBJECTS[0]) < 0.99 for command in commands[:wrong_ticks])
+    # The first target, known from the start (acting once its patience with teleop's
+    # still hand has passed) ...
+    assert all(toward(command, OBJECTS[0]) < 0.99
+               for command in commands[PATIENCE:wrong_ticks])
     assert all(toward(command, OBJECTS[0]) > 0.999 for command in commands[wrong_ticks:switch])
-    # ... and the second once it has noticed it, its reaction_delay after the switch.
-    noticed = switch + np.flatnonzero(active[switch:])[0]
-    assert (noticed - switch) * PERIOD == pytest.approx(
-        VirtualParticipantParams().reaction_delay, abs=1.5 * PERIOD)
-    after = commands[noticed:]
-    assert all(toward(command, OBJECTS[2]) < 0.99 for command in after[:wrong_ticks])
-    assert all(toward(command, OBJECTS[2]) > 0.999 for command in after[wrong_ticks:])
+    # ... and the second once it has noticed it, its reaction_delay after the switch (and
+    # acts its patience later).
+    acting = switch + np.flatnonzero(active[switch:])[0]
+    defaults = VirtualParticipantParams()
+    assert (acting - switch) * PERIOD == pytest.approx(
+        defaults.reaction_delay + defaults.serve_patience, abs=1.5 * PERIOD)
+    after = commands[acting:]
+    assert all(toward(command, OBJECTS[2]) < 0.99
+               for command in after[:wrong_ticks - PATIENCE])
+    assert all(toward(command, OBJECTS[2]) > 0.999
+               for command in after[wrong_ticks - PATIENCE:])

@@ -34,13 +34,14 @@ def target_probability(settings, goals, position, heading):
 def participant_command(params, ee_state, target, target_index, selected, objects,
                         ticks=1):
     """The operator command of a lone participant after `ticks` control ticks with the
-    given inputs held."""
+    given inputs held, the robot showing `selected` and the forward key disabled (PBP)."""
     builder = DiagramBuilder()
-    participant = builder.AddSystem(VirtualOperator(PERIOD, objects, mode="assist",
-                                                       params=params, nominal_speed=SPEED))
+    participant = builder.AddSystem(VirtualOperator(PERIOD, objects, params=params,
+                                                    nominal_speed=SPEED))
     for port, value in ((participant.get_ee_state_input_port(), ee_state),
                         (participant.get_target_input_port(), [*target, target_index]),
-                        (participant.get_selected_goal_input_port(), [selected])):
+                        (participant.get_selected_goal_input_port(), [selected]),
+                        (participant.get_forward_key_input_port(), [0.0])):
         source = builder.AddSystem(ConstantVectorSource(np.asarray(value, dtype=float)))
         builder.Connect(source.get_output_port(), port)
     diagram = builder.Build()

@@ -5,6 +5,8 @@ import numpy as np
 from pbp_drake.core.participant_grasp import GraspParticipant, ParticipantMemory
 from pbp_drake.core.participant_impairment import (
     delay_ticks, initial_motor_noise, is_noisy, next_motor_noise)
+from pbp_drake.core.participant_serving import (
+    SERVING_MEMORY_SIZE, ServingMemory, update_own_motion)
 from pbp_drake.systems.ports import OperatorTwist, PoseState, Target
 from pbp_drake.systems.operators.sampled_operator import SampledOperator
 
@@ -20,13 +22,15 @@ class PoseVirtualOperator(SampledOperator):
         - hand_pose
         - target
         - selected_goal
+        - forward_key
         output_ports:
         - operator_command
         - operator_active
 
     `hand_pose` is the hand's `PoseState`, `target` the task monitor's `Target` (its index
-    is the object the task wants), `selected_goal` the estimator's `[index]` (read in
-    "assist" mode only). `operator_command` is an `OperatorTwist` `[v (3), omega (3)]`,
+    is the object the task wants), `selected_goal` the robot's shown intent `[index]` (-1:
+    the method shows none), `forward_key` `[1 or 0]` whether the method enables the forward
+    key; it is built from the same arguments under every method. `operator_command` is an `OperatorTwist` `[v (3), omega (3)]`,
     world frame. It samples at the sense stage of each tick, as every `SampledOperator`;
     what it remembers of the targets it has seen (`ParticipantMemory`) is discrete state,
     so Contexts stay independent. Its parameters' `impairment` adds its motor noise (a
@@ -42,6 +46,11 @@ class PoseVirtualOperator(SampledOperator):
         self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._forward_key_port = self.DeclareVectorInputPort("forward_key", 1)
+        # `participant_serving`: whether the robot serves its target, and its sense of the
+        # robot's own motion (3).
+        self._serving_index = self.DeclareDiscreteState(np.zeros(SERVING_MEMORY_SIZE))
+        self._own_motion_index = self.DeclareDiscreteState(np.zeros(3))
         self._memory_index = self.DeclareDiscreteState(np.array(ParticipantMemory(),
                                                                 dtype=float))
         impairment = participant.params.impairment
@@ -64,27 +73,38 @@ class PoseVirtualOperator(SampledOperator):
     def get_selected_goal_input_port(self):
         return self._selected_port
 
+    def get_forward_key_input_port(self):
+        return self._forward_key_port
+
     def _update(self, context, discrete_state):
         memory = ParticipantMemory.from_array(
             context.get_discrete_state(self._memory_index).value())
         hand = np.asarray(self._hand_port.Eval(context), float)
         time = context.get_time()
-        # Teleop never reads the estimate: its port may stay unconnected there.
-        selected = (self._selected_port.Eval(context)[0]
-                    if self._participant.mode == "assist" else -1)
+        participant = self._participant
+        velocity = hand[7:10]
+        sent = self._held(context)
+        own_motion = update_own_motion(
+            participant.params, self._period,
+            context.get_discrete_state(self._own_motion_index).value(), velocity,
+            sent[:3] if sent[6] > 0.5 else np.zeros(3))
+        discrete_state.set_value(self._own_motion_index, own_motion)
+        serving = ServingMemory.from_vector(
+            context.get_discrete_state(self._serving_index).value())
         tick = int(round(time / self._period))
         noise = None
         if self._noisy:
-            participant = self._participant
             noise = next_motor_noise(
                 participant.params.impairment, self._period, participant.seed, tick,
                 context.get_discrete_state(self._noise_index).value(),
                 participant.motor_noise_scales)
             discrete_state.set_value(self._noise_index, noise)
-        twist, active, memory = self._participant.step(
-            memory, time, tick, hand[:3],
-            hand[3:7] / np.linalg.norm(hand[3:7]), int(Target(
-                self._target_port.Eval(context)).index), int(selected), noise)
+        twist, active, memory, serving = participant.step(
+            memory, serving, time, tick, hand[:3], hand[3:7] / np.linalg.norm(hand[3:7]),
+            velocity, own_motion, int(Target(self._target_port.Eval(context)).index),
+            int(round(self._selected_port.Eval(context)[0])),
+            self._forward_key_port.Eval(context)[0] > 0.5, self._period, noise)
+        discrete_state.set_value(self._serving_index, serving.as_vector())
         discrete_state.get_mutable_vector(self._memory_index).set_value(
             np.array(memory, dtype=float))
         self._store_sample(discrete_state, twist, active)

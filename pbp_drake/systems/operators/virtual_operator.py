@@ -10,14 +10,15 @@ from pbp_drake.core.participant_impairment import (
 from pbp_drake.core.participant_reach import (
     assist_motion, can_point_at, drive_motion, faces_target, reposition_motion,
     without_forward)
+from pbp_drake.core.participant_serving import (
+    NO_INTENT, SERVING_MEMORY_SIZE, ServingMemory, robot_pulls, serving_step,
+    update_own_motion)
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
 from pbp_drake.systems.operators.participant_avoidance import (
     WATCH_SIZE, is_pushing_through, robot_closes_in, start_watch, update_watch)
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
-
-PARTICIPANT_MODES = ("assist", "drive")
 
 
 class VirtualOperator(SampledOperator):
@@ -30,26 +31,41 @@ class VirtualOperator(SampledOperator):
         - ee_state
         - target
         - selected_goal
+        - forward_key
         - obstacle_positions (optional)
         output_ports:
         - operator_command
         - operator_active
 
-    `mode="assist"` (PBP and arbitration): acts only while the estimated goal
-    (`selected_goal`) is not the target, and never pushes forward, as in the paper where the
-    forward key is disabled. It turns the end effector to face the target and moves toward
-    it and away from the object picked instead, as far as the keys allow; it steps aside
-    when the two stand in line; and once it has faced the target `insist_time` to no avail,
-    it turns the target to its side and sidesteps to it (`pbp_drake.core.participant_reach`
-    says why each goal estimator can read this). It sees all the `objects` (M, 3).
-    `mode="drive"` (teleoperation): it drives the whole way, toward the target at `speed`
-    (slowing within `slow_radius`), turning to face it.
+    It is built from the same arguments under every method and is never told the method.
+    It sees what a person at the page sees: the scene (`objects` (M, 3)) and its target
+    (`target`), the hand (`ee_state`), the robot's shown intent (`selected_goal`, the blue
+    ball; -1 where the method shows none) and which keys work (`forward_key`: 1 when the
+    forward key is enabled, 0 when not, as the paper disables it under PBP). Whether it acts
+    is one rule under every method (`pbp_drake.core.participant_serving`): it lets the robot
+    go while its motion serves the target and acts while it does not (the shown intent on
+    another object, or the hand not closing in at `serve_speed_fraction` of its own
+    preferred speed for `serve_patience`); teleop's robot never moves by itself, so there it
+    always acts.
+
+    What it presses is the keys': with the forward key it drives toward the target at
+    `speed` (slowing within `slow_radius`), turning to face it. Without it, while the
+    robot means another object, it shows the target: it turns the end effector to face it
+    and moves toward it and away from the object picked instead, as far as the keys allow;
+    it steps aside when the two stand in line; and once it has faced the target
+    `insist_time` to no avail, it turns the target to its side and sidesteps to it
+    (`pbp_drake.core.participant_reach` says why each goal estimator can read this).
+    Without it and with the robot's intent on the target (or none shown) but too slow, it
+    presses what is left of driving there, and waits when that is little. Going to the
+    target itself where it sees the robot pull by itself (`participant_serving.robot_pulls`:
+    PBP-Cont's DMP), it pushes against that pull, at most `policy_compensation` times
+    `speed`.
 
     `vertical=True` (a reaching task whose objects stand at different heights, the
     operator's keys moving the hand up and down too; off by default, and off it changes
     nothing): driving, it heads for the target in 3-D, horizontal and vertical motion
-    combined into one speed at most `speed`; assisting, it leaves the height to the DMP
-    (vz = 0) except when insisting, when it also moves toward the target's height, again
+    combined into one speed at most `speed`; showing the target, it leaves the height to
+    the DMP (vz = 0) except when insisting, when it also moves toward the target's height, again
     at most `speed` in all (`pbp_drake.core.participant_reach`). Its noise turns the
     horizontal part only and scales vz by the same speed factor; its `impairment`'s motor
     noise shakes vz as well (one more axis, drawn after the others: the horizontal noise is
@@ -57,13 +73,13 @@ class VirtualOperator(SampledOperator):
     participant planar: the two are refused together.
 
     `heading_range` (low, high) is how far the hand turns (an arm's wrist; None: all the
-    way, as the HSR's base). Assisting, where the tool cannot point at the target (its
+    way, as the HSR's base). Showing the target, where the tool cannot point at the target (its
     direction beyond the range, or, with `vertical`, the target more above or below the
     hand than beside it: `participant_reach.can_point_at`), the participant first moves the
     hand to where it can (`participant_reach.reposition_motion`: it backs away, and moves
     toward the target's height), for at most `reposition_time` a target, and then goes to
-    the target itself as when insisting. Under PBP-Cont it pushes against the DMP's pull
-    while it does, as when insisting. `fixed_base` (x, y)
+    the target itself as when insisting. It pushes against a pull it sees while it does,
+    as when insisting. `fixed_base` (x, y)
     is a fixed-base arm's base: its footprint among obstacles is then the arm from there to
     the hand (`footprint_clearance`), not the HSR's base and arm.
 
@@ -73,8 +89,7 @@ class VirtualOperator(SampledOperator):
     is reproducible and the system keeps no state outside its Context.
 
     Its `impairment` (`pbp_drake.core.participant_impairment`, none by default) adds motor
-    noise to its commands while it acts (never forward when assisting: the key stays
-    disabled), delays its commands by `command_delay` (a queue in discrete state), and
+    noise to its commands while it acts (never forward where the key is disabled), delays its commands by `command_delay` (a queue in discrete state), and
     makes it head for a wrong object first, now and then, each time it comes to know a
     target (the reaching task; the obstacle task has a single object).
 
@@ -83,25 +98,24 @@ class VirtualOperator(SampledOperator):
     from the positions it remembers in discrete state) and keeps the robot's footprint (base
     disc and arm, `footprint_clearance`) `obstacle_margin` clear of them: each tick it scores
     a fan of velocities and yaw rates over a short horizon (progress to the target, turning
-    toward a heading whose footprint fits at the target, clearance), and in PBP it lets go
-    whenever the DMP's path (pulled back to its start-target line) looks clear for a while.
-    In the last `final_approach_radius` it no longer minds obstacles (in PBP it drives there
-    only when the robot does not close in by itself), and within `push_through_radius`, or
+    toward a heading whose footprint fits at the target, clearance). Where the robot shows
+    its intent, it lets go whenever the robot's path (pulled back to its start-target line,
+    as PBP's drawn DMP path is) looks clear for a while; where it shows none, by the rule
+    above. In the last `final_approach_radius` it no longer minds obstacles (where the
+    robot shows its intent it drives there only when the robot does not close in by
+    itself), and within `push_through_radius`, or
     after `stall_time` without getting closer (`participant_avoidance`), it pushes on
     through. `VirtualParticipantParams` documents each of these fields.
 
     Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
-    `selected_goal` `[index]`, `obstacle_positions` (optional). Output `operator_command` is
+    `selected_goal` `[index]` (-1: none shown), `forward_key` `[1 or 0]`,
+    `obstacle_positions` (optional). Output `operator_command` is
     `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0 unless `vertical`).
     """
 
-    def __init__(self, control_period, objects, mode="assist",
-                 params=VirtualParticipantParams(), nominal_speed=None, seed=0,
-                 obstacle_count=0, obstacle_radius=0.0, obstacle_margin=None,
-                 policy_adds=False, vertical=False, heading_range=None, fixed_base=None):
-        if mode not in PARTICIPANT_MODES:
-            raise ValueError(f"participant mode {mode!r} is unknown; use one of "
-                             f"{PARTICIPANT_MODES}")
+    def __init__(self, control_period, objects, params=VirtualParticipantParams(),
+                 nominal_speed=None, seed=0, obstacle_count=0, obstacle_radius=0.0,
+                 obstacle_margin=0.06, vertical=False, heading_range=None, fixed_base=None):
         if vertical and obstacle_count > 0:
             raise ValueError(f"vertical=True is for the reaching task; the participant "
                              f"avoids obstacles on the floor only (got obstacle_count "
@@ -111,7 +125,6 @@ class VirtualOperator(SampledOperator):
         self._fixed_base = None if fixed_base is None else np.asarray(fixed_base, float)[:2]
         self._heading_range = None if heading_range is None else tuple(
             float(bound) for bound in heading_range)
-        self._mode = mode
         self._objects = np.asarray(objects, dtype=float)
         self.params = copy.deepcopy(params)
         self._plan_times = np.array(params.plan_times, dtype=float)
@@ -127,23 +140,16 @@ class VirtualOperator(SampledOperator):
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
-        # With an additive blend (PBP-Cont) the policy keeps moving under the operator's
-        # command; the participant then asks for the motion it wants minus the policy's.
-        self._policy_adds = bool(policy_adds)
+        # Which keys work is the method's (the paper disables forward under PBP): the
+        # participant sees it on the page as a person does, not in its arguments.
+        self._forward_key_port = self.DeclareVectorInputPort("forward_key", 1)
         self._obstacles_port = None
         if obstacle_count > 0 and not obstacle_radius > 0:
             raise ValueError(f"obstacle_radius must be positive with obstacles, got "
                              f"{obstacle_radius}")
         self._obstacle_radius = float(obstacle_radius)
-        # PBP-Alt lets the DMP pull the robot back to its line after each release, so the
-        # participant keeps a wider margin there; under PBP-Cont (and in teleop) a wider one
-        # only makes it fight the policy longer.
-        if obstacle_margin is None:
-            obstacle_margin = 0.08 if mode == "assist" and not policy_adds else 0.06
         self._obstacle_margin = float(obstacle_margin)
-        self._release_heading_gap = (params.release_heading_gap_alternated
-                                     if mode == "assist" and not policy_adds
-                                     else params.release_heading_gap)
+        self._release_heading_gap = params.release_heading_gap
         self._hold_ticks = int(round(params.hold_time / control_period))
         if obstacle_count > 0:
             self._obstacles_port = self.DeclareVectorInputPort(
@@ -156,6 +162,10 @@ class VirtualOperator(SampledOperator):
         # What the participant believes: the target index it knows and how many ticks a
         # different target has been on screen.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
+        # Whether the robot serves its target (`participant_serving.ServingMemory`), and
+        # its sense of the robot's own motion (3: what the hand does beyond its keys).
+        self._serving_index = self.DeclareDiscreteState(np.zeros(SERVING_MEMORY_SIZE))
+        self._own_motion_index = self.DeclareDiscreteState(np.zeros(3))
         # Assisting in the reaching task: the target it counts for, how many ticks it has
         # faced it while the estimate named another object (`insist_time`) and how many it
         # has moved the hand to where the tool can point at it (`reposition_time`).
@@ -189,8 +199,33 @@ class VirtualOperator(SampledOperator):
     def get_selected_goal_input_port(self):
         return self._selected_goal_port
 
+    def get_forward_key_input_port(self):
+        return self._forward_key_port
+
     def get_obstacle_positions_input_port(self):
         return self._obstacles_port
+
+    def _forward_key(self, context):
+        """Whether the method enables the forward key."""
+        return self._forward_key_port.Eval(context)[0] > 0.5
+
+    def _shown_goal(self, context):
+        """The object the robot shows it means (`NO_INTENT`: the method shows none)."""
+        shown = int(round(self._selected_goal_port.Eval(context)[0]))
+        return shown if shown >= 0 else NO_INTENT
+
+    def _perceive(self, context, discrete_state):
+        """The robot's own motion as it perceives it after this tick (3), updated from the
+        hand's velocity and the command it sent."""
+        ee_state = EeState(self._ee_state_port.Eval(context))
+        sent = self._held(context)
+        sent_velocity = sent[:3] if sent[4] > 0.5 else np.zeros(3)
+        own = update_own_motion(
+            self.params, self._period,
+            context.get_discrete_state(self._own_motion_index).value(),
+            np.array([ee_state.vx, ee_state.vy, ee_state.vz]), sent_velocity)
+        discrete_state.set_value(self._own_motion_index, own)
+        return own
 
     def _update(self, context, discrete_state):
         # The belief moves first, and the command of this tick acts on the new belief.
@@ -204,12 +239,14 @@ class VirtualOperator(SampledOperator):
                 known, unseen_ticks = shown, 0
         # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
         discrete_state.set_value(self._belief_index, [known, unseen_ticks])
+        own_motion = self._perceive(context, discrete_state)
         if self._obstacles_port is not None:
-            command, active = self._avoid(context, discrete_state, int(known))
+            command, active = self._avoid(context, discrete_state, int(known), own_motion)
         else:
             heads_for = (self._heads_for(context, discrete_state, int(known))
                          if self._mistakes else int(known))
-            command, active = self._decide(context, discrete_state, int(known), heads_for)
+            command, active = self._decide(context, discrete_state, int(known), heads_for,
+                                           own_motion)
         if self._noise_scales is not None:
             command = self._add_motor_noise(context, discrete_state, command, active)
         self._store_sample(discrete_state, command, active)
@@ -247,7 +284,7 @@ class VirtualOperator(SampledOperator):
         command[3] += noise[2]
         if self._vertical:
             command[2] += noise[3]
-        if self._mode == "assist" and self._obstacles_port is None:
+        if not self._forward_key(context) and self._obstacles_port is None:
             # The forward key stays disabled, however the hand shakes.
             heading = EeState(self._ee_state_port.Eval(context)).heading
             command[:2] = without_forward(command[:2], heading)
@@ -259,9 +296,10 @@ class VirtualOperator(SampledOperator):
         return (rng.normal(0.0, self._direction_noise),
                 max(0.0, 1.0 + rng.normal(0.0, self._speed_noise)))
 
-    def _avoid(self, context, discrete_state, known_target):
+    def _avoid(self, context, discrete_state, known_target, own_motion):
         """The command while obstacles are about: a local plan around them (see the class
-        docstring). Returns `(command, active)`."""
+        docstring), `own_motion` the robot's own motion as it perceives it. Returns
+        `(command, active)`."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         hand = np.array([ee_state.x, ee_state.y])
         velocity = np.array([ee_state.vx, ee_state.vy])
@@ -299,14 +337,23 @@ class VirtualOperator(SampledOperator):
         offset = target_xy - hand
         distance = np.linalg.norm(offset)
         noise_angle, speed_scale = self._noise(context)
-        drive = self._mode == "drive"
+        # Where the robot shows its intent (the ball on the object, its path), the
+        # participant judges the path it shows; where it shows none, the motion it sees.
+        shows = self._shown_goal(context) != NO_INTENT
         params = self.params
         track[watch] = update_watch(params, track[watch], distance, self._period)
         pushing_through = is_pushing_through(track[watch])
+        if not shows:
+            act, memory = serving_step(
+                params, self._speed, self._period, self._serving(context), NO_INTENT,
+                known_target, offset, velocity, own_motion[:2])
+            discrete_state.set_value(self._serving_index, memory.as_vector())
+            if not act:
+                return finish(np.zeros(4), False)
         if distance < params.final_approach_radius:
-            # The last few centimetres: straight on, whatever stands there; in PBP only
-            # when the robot does not get there by itself.
-            if not drive and robot_closes_in(params, velocity, offset, self._speed):
+            # The last few centimetres: straight on, whatever stands there; where the robot
+            # shows its intent, only when it does not get there by itself.
+            if shows and robot_closes_in(params, velocity, offset, self._speed):
                 return finish(np.zeros(4), False, 0.0)
             speed = self._speed * speed_scale * min(1.0, distance / self._slow_radius)
             step = speed * rotate_planar(offset / max(distance, 1e-9), noise_angle)
@@ -318,8 +365,8 @@ class VirtualOperator(SampledOperator):
                                      np.array([params.settle_time]))[0]
         goal_heading = self._goal_heading(heading, target_xy, settled)
         heading_gap = abs(wrap_angle(heading - goal_heading))
-        if not drive and not pushing_through:
-            # Would the policy, left alone, keep the robot clear?
+        if shows and not pushing_through:
+            # Would the robot, left alone on the path it shows, keep clear?
             policy_clear = footprint_clearance(
                 policy_path(hand, start, target_xy, self._speed, self._plan_times), heading,
                 predicted, self._obstacle_radius, self._fixed_base).min()
@@ -343,15 +390,15 @@ class VirtualOperator(SampledOperator):
             planned = self._speed * min(1.0, distance / self._slow_radius) * offset / distance
             yaw_rate = 0.0
         command = speed_scale * rotate_planar(planned, noise_angle)
-        if self._policy_adds:
-            # The policy's own motion: what the hand does minus what was asked of it.
+        if robot_pulls(params, self._speed, own_motion):
+            # The robot's own motion: what the hand does minus what was asked of it.
             policy_velocity = velocity - last_sent
             command = command - policy_velocity
             norm = np.linalg.norm(command)
             limit = params.policy_compensation * self._speed
             if norm > limit:
                 command *= limit / norm
-        hold_ticks = track[3] if was_active or drive else self._hold_ticks
+        hold_ticks = track[3] if was_active or not shows else self._hold_ticks
         return finish(np.array([command[0], command[1], 0.0, yaw_rate]), True, hold_ticks)
 
     def _goal_heading(self, heading, target_xy, obstacles):
@@ -397,26 +444,44 @@ class VirtualOperator(SampledOperator):
         best = int(np.argmax(score))
         return velocities[best], yaw_rates[best], clear[best]
 
-    def _decide(self, context, discrete_state, known_target, heads_for):
-        """The command in the reaching task (`pbp_drake.core.participant_reach`), toward
-        object `heads_for` (the known target, unless it has mistaken it for another).
-        Returns `(command, active)`."""
+    def _serving(self, context):
+        return ServingMemory.from_vector(
+            context.get_discrete_state(self._serving_index).value())
+
+    def _decide(self, context, discrete_state, known_target, heads_for, own_motion):
+        """The command in the reaching task, toward object `heads_for` (the known target,
+        unless it has mistaken it for another): whether to act by the one rule of
+        `participant_serving`, and what to press with the keys it has
+        (`participant_reach`). Returns `(command, active)`."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         position, heading = position_of(ee_state), ee_state.heading
         target = Target(self._target_port.Eval(context))
         if known_target != int(target.index):
-            return np.zeros(4), False  # has not noticed the new target yet
+            # It has not noticed the new target yet: it watches afresh once it has.
+            discrete_state.set_value(self._serving_index, ServingMemory().as_vector())
+            return np.zeros(4), False
         target_position = position_of(target)
         if heads_for != known_target:
             target_position, known_target = self._objects[heads_for], heads_for
         noise_angle, speed_scale = self._noise(context)
-        if self._mode == "assist":
-            selected = int(round(self._selected_goal_port.Eval(context)[0]))
+        shown = self._shown_goal(context)
+        forward = self._forward_key(context)
+        insisting = repositioning = False
+        if not forward:
             insisting, repositioning = self._count_insistence(
-                context, discrete_state, known_target, selected, position, heading,
+                context, discrete_state, known_target, shown, position, heading,
                 target_position)
-            if selected == known_target:
-                return np.zeros(4), False
+        axes = 3 if self._vertical else 2
+        velocity_now = np.array([ee_state.vx, ee_state.vy, ee_state.vz])[:axes]
+        act, memory = serving_step(
+            self.params, self._speed, self._period, self._serving(context), shown,
+            known_target, (target_position - position)[:axes], velocity_now,
+            own_motion[:axes])
+        discrete_state.set_value(self._serving_index, memory.as_vector())
+        if not act or np.linalg.norm((target_position - position)[:axes]) < 1e-9:
+            return np.zeros(4), False
+        if not forward and shown not in (NO_INTENT, known_target):
+            # No forward key, and the robot means another object: it shows the target.
             if repositioning:
                 velocity, yaw_rate = reposition_motion(
                     self.params, self._speed, position, heading, target_position,
@@ -424,35 +489,38 @@ class VirtualOperator(SampledOperator):
             else:
                 velocity, yaw_rate = assist_motion(
                     self.params, self._speed, position, heading, target_position,
-                    self._objects[selected], insisting, vertical=self._vertical)
-            # Going where the DMP does not, it pushes against the DMP's pull (PBP-Cont).
-            insisting = insisting or repositioning
+                    self._objects[shown], insisting, vertical=self._vertical)
         else:
-            insisting = False
-            reached = (np.linalg.norm(target_position - position) if self._vertical
-                       else np.linalg.norm(target_position[:2] - position[:2]))
-            if reached < 1e-9:
-                return np.zeros(4), False
             velocity, yaw_rate = drive_motion(self.params, self._speed, position, heading,
                                               target_position, vertical=self._vertical)
+            if not forward:
+                # Without the forward key, what is left of driving there; when that is
+                # little (the target ahead), no key helps and it waits.
+                wanted = np.linalg.norm(velocity)
+                velocity = np.array(velocity, float)
+                velocity[:2] = without_forward(velocity[:2], heading)
+                if np.linalg.norm(velocity) < self.params.serve_speed_fraction * wanted:
+                    discrete_state.set_value(self._serving_index, ServingMemory().as_vector())
+                    return np.zeros(4), False
+        # Going to the target where the robot does not, it pushes against the pull it sees
+        # (PBP-Cont's DMP of the picked object keeps pulling the hand there).
+        against = (insisting or repositioning) and robot_pulls(self.params, self._speed,
+                                                               own_motion)
         if self._vertical:
             return self._vertical_command(context, ee_state, velocity, yaw_rate, noise_angle,
-                                          speed_scale, insisting), True
+                                          speed_scale, against), True
         velocity = speed_scale * rotate_planar(velocity, noise_angle)
-        if self._mode == "assist" and insisting and self._policy_adds:
-            # Under PBP-Cont the DMP of the picked object keeps pulling the hand to it, and
-            # near it that pull matches `speed`: going to the target, the participant pushes
-            # against it as it does among obstacles (`_avoid`).
+        if against:
             velocity = self._against_policy(context, ee_state, velocity)
         return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
 
     def _vertical_command(self, context, ee_state, velocity, yaw_rate, noise_angle,
-                          speed_scale, insisting):
+                          speed_scale, against):
         """`_decide`'s command with vertical motion, from the velocity (3) and yaw rate of
         `participant_reach`: the noise turns the horizontal part and scales all of it."""
         horizontal = speed_scale * rotate_planar(velocity[:2], noise_angle)
         vz = speed_scale * velocity[2]
-        if self._mode == "assist" and insisting and self._policy_adds:
+        if against:
             # Against the picked object's pull in 3-D: that DMP pulls the hand to its height
             # too, and left alone it holds the hand below (or above) the target.
             horizontal, vz = np.split(self._against_policy(

@@ -160,9 +160,12 @@ class ReachSceneVisualizer(LeafSystem):
         meshcat.SetTransform("/task/target",
                              RigidTransform(target + [0, 0, TARGET_LIFT]), time)
         selected = int(self._selected_goal_port.Eval(context)[0])
-        meshcat.SetTransform(
-            "/task/estimated_goal",
-            RigidTransform(self._objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
+        # -1: the method shows no intent (teleop), and the page no blue ball.
+        meshcat.SetProperty("/task/estimated_goal", "visible", selected >= 0, time)
+        if selected >= 0:
+            meshcat.SetTransform(
+                "/task/estimated_goal",
+                RigidTransform(self._objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
         if self._ee_state_port.HasValue(context):
             position = position_of(EeState(self._ee_state_port.Eval(context)))
             meshcat.SetTransform("/task/operator", RigidTransform(position), time)

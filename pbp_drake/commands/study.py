@@ -75,7 +75,10 @@ def add_study_commands(commands):
         "trial files, without simulating; damaged or foreign files are named on stderr and "
         "skipped (exit 1 when there were any, or when trials failed with an error or did not "
         "run, as `study` does; 2 when there is nothing to report)")
-    report.add_argument("output", help="the --output folder of `pbp-drake study`, or a user "
+    report.add_argument("output", help="the --output folder of `pbp-drake study` (of a "
+                        "matrix, with --pilots: its method x pilot tables with 95 %% "
+                        "intervals, every method paired with PBP-Alt per pilot, and "
+                        f"{MATRIX_FIGURE}, a panel per pilot), or a user "
                         "study's folder of participant folders (`pbp-drake run --participant "
                         "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
                         "Wilcoxon tests and Fig. 8 in DIR/results.md and "
@@ -84,7 +87,8 @@ def add_study_commands(commands):
                         help="also compare every other method of the study with METHOD "
                         "(e.g. pbp_alternated), seed by seed: per metric the paired "
                         "difference and its 95 %% interval, as `compare` does between two "
-                        "studies (printed, and in --markdown's file)")
+                        "studies (printed, and in --markdown's file); for a matrix, the "
+                        "method every other is paired with (default pbp_alternated)")
     report.add_argument("--markdown", metavar="FILE",
                         help="also write the study's results table as a Markdown fragment "
                         "to FILE (its folder is created), after a line naming the command "

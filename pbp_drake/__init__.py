@@ -38,7 +38,7 @@ API_GROUPS = {
         "ParticipantImpairment": "pbp_drake.core.participant_impairment",
         "GraspParticipantParams": "pbp_drake.core.participant_grasp",
     },
-    "Shared-autonomy baselines (HOP, policy blending)": {
+    "Shared-autonomy baselines (HOP, predict-then-assist)": {
         "HopSettings": "pbp_drake.core.hindsight_optimization",
         "hop_targets": "pbp_drake.core.hindsight_optimization",
         "update_posterior": "pbp_drake.core.hindsight_optimization",

@@ -17,7 +17,7 @@ station, the hand driven to a grasp pose (position and orientation).
     task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
     hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
 
-Under ``hop`` and ``policy_blending`` there is no DMP bank and no blender: the
+Under ``hop`` and ``predict_then_assist`` there is no DMP bank and no blender: the
 `goal_estimator` is HOP's posterior (`PoseMaxEntGoalEstimator`, on the operator's twist),
 and an `assistance` (`PoseHopAssistance`) adds HOP's action to the operator's twist before
 the same `hand_over`. `goal_estimator: {method: maxent_command}` puts the same posterior
@@ -127,7 +127,7 @@ def build_grasp_diagram(resolved, meshcat=None):
 
     poses = np.hstack([grasps.grasp_positions, grasps.grasp_orientations]).reshape(-1)
     goal_poses = builder.AddNamedSystem("goal_poses", ConstantVectorSource(poses))
-    estimator = builder.AddNamedSystem("goal_estimator", _estimator(scenario, goal_count))
+    estimator = builder.AddNamedSystem("goal_estimator", _estimator(resolved, goal_count))
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
@@ -135,7 +135,7 @@ def build_grasp_diagram(resolved, meshcat=None):
 
     limits = hand_over_limits(scenario)
     if scenario.method in HOP_METHODS:
-        # HOP and policy blending: the operator's twist plus the assistance, no DMPs.
+        # HOP and predict-then-assist: the operator's twist plus the assistance, no DMPs.
         dmp_bank = None
         prediction_steps = 0
         policy = builder.AddNamedSystem("assistance", PoseHopAssistance(
@@ -190,6 +190,8 @@ def build_grasp_diagram(resolved, meshcat=None):
     if dmp_bank is not None:
         builder.Connect(active, dmp_bank.get_operator_active_input_port())
         builder.Connect(active, policy.get_operator_active_input_port())
+    if getattr(estimator, "operator_speed", None) is not None:
+        builder.Connect(active, estimator.get_operator_active_input_port())
     builder.Connect(twist, policy.get_operator_twist_input_port())
     # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
     builder.Connect(twist, estimator.get_operator_twist_input_port())
@@ -223,17 +225,19 @@ def build_grasp_diagram(resolved, meshcat=None):
     return diagram
 
 
-def _estimator(scenario, goal_count):
-    """The goal estimator: HOP's posterior under hop and policy_blending (the most probable
+def _estimator(resolved, goal_count):
+    """The goal estimator: HOP's posterior under hop and predict_then_assist (the most probable
     goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
-    section's hysteresis), else the `pose` estimator."""
+    section's hysteresis and the likelihood of PBP's operator), else the `pose` estimator."""
+    scenario = resolved.scenario
     period = scenario.control_period
     settings = scenario.goal_estimator
     if scenario.method in HOP_METHODS:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
     if settings.method == "maxent_command":
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
-                                       settings.hold_steps)
+                                       settings.hold_steps,
+                                       operator_speed=resolved.nominal_speed)
     return PoseGoalEstimator(goal_count, settings, period)
 
 

@@ -7,7 +7,7 @@ Under the PBP methods and explicit arbitration (`pbp_controller`):
                        └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
                                               dmp_bank (followed_goal, selected_goal)
     goals ──> dmp_bank, goal_estimator
-    operator_command ──> goal_estimator (the maxent_command estimator only)
+    operator_command, operator_active ──> goal_estimator (the maxent_command estimator only)
     dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
     goal_estimator ──> likely_goals ──> dmp_bank.predicted_goals (with prediction_steps > 0:
                                         the paths a drawing shows)
@@ -18,11 +18,11 @@ Under the PBP methods and explicit arbitration (`pbp_controller`):
     hand_over.command + heading_command.heading ──> ee_command (the station's input)
 
 The goal estimator is a `GoalEstimator`, or with `goal_estimator: {method: maxent_command}`
-a `MaxEntGoalEstimator` (HOP's posterior on the operator's command, with the config's
-`hop` settings and the `goal_estimator` section's hysteresis), which adds the output
-`posterior_clipped`.
+a `MaxEntGoalEstimator` (HOP's posterior with the likelihood of PBP's operator,
+`pbp_drake.core.maxent_command`, with the config's `hop` settings, `nominal_speed` and the
+`goal_estimator` section's hysteresis), which adds the output `posterior_clipped`.
 
-Under ``hop`` and ``policy_blending`` (`hop_controller`, no DMP bank) HOP's posterior and
+Under ``hop`` and ``predict_then_assist`` (`hop_controller`, no DMP bank) HOP's posterior and
 its assistance take the place of the estimator, the bank and the blender:
 
     ee_state ──> goal_estimator (MaxEntGoalEstimator) ──> assistance (goal_probabilities)
@@ -57,7 +57,7 @@ PREDICTED_GOALS = 4
 def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
                         prediction_steps=0, predicted_goal_count=PREDICTED_GOALS):
     """The controller of `config.method`, a Diagram named `pbp_controller` (or
-    `hop_controller` under ``hop`` and ``policy_blending``).
+    `hop_controller` under ``hop`` and ``predict_then_assist``).
 
     Args:
         config: the controller's parameters (validated here; ValueError names the field).
@@ -80,7 +80,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         - ee_state
         - goals
         - operator_command
-        - operator_active (not under hop and policy_blending)
+        - operator_active (not under hop and predict_then_assist)
         output_ports:
         - ee_command
         - selected_goal
@@ -151,10 +151,12 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     goal_count = len(goals)
     position_velocity = split.get_output_port(0)
     reads_command = config.goal_estimator.method == "maxent_command"
+    # maxent_command: HOP's posterior with the likelihood of PBP's operator (corrections,
+    # turns, and silences read as letting the robot go on), at the operators' speed.
     estimator = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(
         goal_count, config.hop, period, config.goal_estimator.margin,
-        config.goal_estimator.hold_steps) if reads_command else GoalEstimator(
-        goal_count, config.goal_estimator, period))
+        config.goal_estimator.hold_steps, operator_speed=config.nominal_speed)
+        if reads_command else GoalEstimator(goal_count, config.goal_estimator, period))
     builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
     builder.ExportInput(estimator.get_goals_input_port(), "goals")
     if reads_command:
@@ -177,6 +179,8 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     builder.ConnectInput("goals", dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
+    if reads_command:
+        builder.ConnectInput("operator_active", estimator.get_operator_active_input_port())
 
     blender = builder.AddNamedSystem("blender", Blender(
         config.blend_mode, 3, goal_count, period, config.alpha))
@@ -214,7 +218,7 @@ def _add_hop_policy(builder, config, goal_count, split, command_split):
     """HOP's posterior and assistance (no DMPs); returns the posterior and the
     assistance's command [p, v]. The operator's yaw rate turns the hand as under PBP; HOP
     assists the position only, since the reaching tasks' goals are positions.
-    `selected_goal` is the most probable goal (no hysteresis: policy blending assists
+    `selected_goal` is the most probable goal (no hysteresis: predict-then-assist assists
     toward it)."""
     period = config.control_period
     posterior = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(

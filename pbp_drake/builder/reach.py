@@ -13,7 +13,7 @@ The station is `hsr_station` (`pbp_drake.robots.make_hsr_station`) or `arm_stati
 (`make_arm_station`, `robot: !Arm`): plant, diff IK, obstacle geometry, collision monitor,
 Meshcat visualizer. The controller (`pbp_drake.builder.make_pbp_controller`, from the
 resolved scenario's `PbpControllerConfig`) is a Diagram of its own; under ``hop`` and
-``policy_blending`` it is `hop_controller` (no DMPs: no `phase` or `predicted_paths`, and
+``predict_then_assist`` it is `hop_controller` (no DMPs: no `phase` or `predicted_paths`, and
 no `operator_active` input). The order within
 a tick is `pbp_drake.systems.tick`'s. Loggers named `ee_state_log`, `operator_active_log`,
 `operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` (with

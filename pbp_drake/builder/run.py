@@ -156,7 +156,7 @@ class TaskResult:
             task; None in the others), kept when the series are not (a streamed run's).
         posterior_clipped_ratio: ticks whose goal posterior update was clipped at the
             scenario's `hop.max_probability` / ticks of the task, where the controller has
-            HOP's posterior (hop, policy_blending, the maxent_command estimator; None
+            HOP's posterior (hop, predict_then_assist, the maxent_command estimator; None
             elsewhere): how often the belief sat at its guard against certainty.
     """
 

@@ -73,7 +73,7 @@ class PbpControllerConfig:
     #: How the followed goal is estimated.
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
-    #: HOP's cost model, posterior and assistance (hop, policy_blending and the
+    #: HOP's cost model, posterior and assistance (hop, predict_then_assist and the
     #: maxent_command estimator).
     hop: HopSettings = dataclasses.field(default_factory=HopSettings)
     #: The hand-over law's limits, which every method's command goes through.

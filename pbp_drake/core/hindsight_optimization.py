@@ -1,5 +1,5 @@
-"""Shared autonomy by hindsight optimization (HOP) and the policy-blending baseline, in pure
-NumPy: the goal posterior that reads the operator's command, and the assistance it gives.
+"""Shared autonomy by hindsight optimization (HOP) and its predict-then-assist variant, in
+pure NumPy: the goal posterior that reads the operator's command, and the assistance it gives.
 
 Sources: S. Javdani, S. Srinivasa, J. A. Bagnell, "Shared Autonomy via Hindsight
 Optimization", RSS 2015; S. Javdani et al., "Shared autonomy via hindsight optimization for
@@ -50,12 +50,18 @@ with grad Q_g the gradient of the goal's best target's value at the operator's n
 translation `V'(|r|) r / |r|`, r = p' - p_kappa (`(alpha + c0) r/|r|` far, `c0 r/|r| +
 (alpha/delta) r` near); rotation `w V'(theta') n`, n the unit axis of `Log(q' q_kappa*)`,
 along which turning the hand grows theta' at rate 1. Each goal's gradient fades in
-proportion within `translation_fade_distance` of its target (times d / 0.02 m) and, for the
-rotation, within `rotation_fade_angle` (times theta / (pi / 12)), so that the assistance
-vanishes at the target instead of chattering about it. `lambda` is `translation_divisor`
+proportion within `translation_fade_distance` of its target (times d' / 0.02 m) and, for
+the rotation, within `rotation_fade_angle` (times theta' / (pi / 12)), on the distance and
+angle after the operator's step, the pose the gradient is taken at, so that the assistance
+vanishes where the operator's step reaches the target instead of chattering about it.
+With `assistance` False the command is `u` alone, exactly teleop's (the posterior still
+runs): a control condition with the baselines' estimator and no help. `lambda` is `translation_divisor`
 (40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a convex blend.
 
-**Policy blending** (`blending_weights`), the predict-then-act baseline HOP's papers ran:
+**Predict-then-assist** (`blending_weights`), the predict-then-act variant of HOP's public
+code (HOP's papers call their predict-then-act baseline policy blending, after Dragan and
+Srinivasa; this is not their arbitration `(1 - alpha) U + alpha P`, which is the
+``confidence_alpha`` method of `pbp_drake.core.arbitration`):
 while the two most probable goals differ by at most `blending_threshold` in probability
 the command is the operator's alone; beyond it, full assistance toward the most probable
 goal g*: the operator's command plus HOP's single-goal action toward g* (`a` with the
@@ -73,7 +79,7 @@ import numpy as np
 from pbp_drake.core import quaternion
 
 # The methods built on this module (the scenario's `method`).
-HOP_METHODS = ("hop", "policy_blending")
+HOP_METHODS = ("hop", "predict_then_assist")
 # Below this (m, rad) the hand is at a target: no direction to it.
 AT_TARGET = 1e-12
 
@@ -86,12 +92,13 @@ def _is_real(value):
 @dataclasses.dataclass
 class HopSettings:
     """The cost model, posterior and assistance of HOP (scenario files: the `hop` section),
-    read by the ``hop`` and ``policy_blending`` methods and the ``maxent_command`` goal
+    read by the ``hop`` and ``predict_then_assist`` methods and the ``maxent_command`` goal
     estimator. Each default is the published constant (Javdani et al. 2015, 2018; the
     module docstring gives the equations). `cost_time_step` is the cost model's step, not
-    the control period: the posterior is updated once per control tick, so per second it
-    gathers `cost_time_step / control_period` times the evidence of one published step
-    (docs/concepts/hindsight-optimization.md)."""
+    the control period: the posterior is updated once per control tick, and far from the
+    targets a tick's evidence between two goals is proportional to the operator's speed
+    times `cost_time_step`, so per second it gathers in proportion to
+    `speed * cost_time_step / control_period` (docs/concepts/hindsight-optimization.md)."""
 
     #: The cost model's time step dt (s): a step costs dt times the cost's slope, and the
     #: operator's command is applied for dt to find the distance after it (published: 0.1).
@@ -125,9 +132,12 @@ class HopSettings:
     #: The goal posterior's largest probability is clipped at this (a probability in
     #: (0, 1]; 1: never); the excess is spread evenly over the other goals.
     max_probability: float = 0.99
-    #: policy_blending: the operator's command passes through while the two most probable
+    #: predict_then_assist: the operator's command passes through while the two most probable
     #: goals differ by at most this (a probability in [0, 1)); beyond, full assistance.
     blending_threshold: float = 0.4
+    #: False: the robot adds nothing: HOP's and predict_then_assist's command is the
+    #: operator's alone (exactly teleop's); the posterior still runs.
+    assistance: bool = True
 
     def __post_init__(self):
         self.validate()
@@ -135,8 +145,12 @@ class HopSettings:
     def validate(self):
         """Raises ValueError naming the first field that cannot be used (a YAML loader sets
         the fields after construction, so `resolve` calls this again)."""
+        if not isinstance(self.assistance, bool):
+            raise ValueError(f"assistance must be true or false, got {self.assistance!r}")
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
+            if field.name == "assistance":
+                continue
             if not _is_real(value) or not math.isfinite(value):
                 raise ValueError(f"{field.name} must be a finite number, got {value!r}")
         for name in ("cost_time_step", "translation_gain", "translation_switch_distance",
@@ -275,20 +289,29 @@ def target_geometry(settings, targets, position, velocity, orientation=None,
     return TargetGeometry(distances, next_offsets, angles, next_rotations.T)
 
 
-def target_costs(settings, geometry):
-    """`(Q_kappa (N,), V_kappa (N,))` of the module docstring."""
-    step = settings.cost_time_step
+def target_values(settings, geometry):
+    """`(V_kappa now (N,), V_kappa after the operator's step (N,))`: each target's value at
+    the hand's pose and at its next pose (`p'`, `q'`), translation plus weighted rotation."""
     translation = _translation(settings)
-    q_values = (huber_step_cost(geometry.distances, *translation, step)
-                + huber_value(np.linalg.norm(geometry.next_offsets, axis=1), *translation))
-    values = huber_value(geometry.distances, *translation)
+    now = huber_value(geometry.distances, *translation)
+    after = huber_value(np.linalg.norm(geometry.next_offsets, axis=1), *translation)
     if geometry.angles is not None:
         rotation = _rotation(settings)
         weight = settings.rotation_weight
-        q_values = q_values + weight * (
-            huber_step_cost(geometry.angles, *rotation, step)
-            + huber_value(np.linalg.norm(geometry.next_rotations, axis=1), *rotation))
-        values = values + weight * huber_value(geometry.angles, *rotation)
+        now = now + weight * huber_value(geometry.angles, *rotation)
+        after = after + weight * huber_value(np.linalg.norm(geometry.next_rotations, axis=1),
+                                             *rotation)
+    return now, after
+
+
+def target_costs(settings, geometry):
+    """`(Q_kappa (N,), V_kappa (N,))` of the module docstring."""
+    step = settings.cost_time_step
+    values, after = target_values(settings, geometry)
+    q_values = huber_step_cost(geometry.distances, *_translation(settings), step) + after
+    if geometry.angles is not None:
+        q_values = q_values + settings.rotation_weight * huber_step_cost(
+            geometry.angles, *_rotation(settings), step)
     return q_values, values
 
 
@@ -394,20 +417,21 @@ def _unit_rows(vectors, lengths):
 
 
 def goal_gradients(settings, costs):
-    """`(translation (K, 3), rotation (K, 3) or None)`: each goal's faded gradient of its
-    best target's value at the operator's next pose (module docstring), not yet divided by
-    lambda."""
+    """`(translation (K, 3), rotation (K, 3) or None)`: each goal's gradient of its best
+    target's value at the operator's next pose, faded on the distance and angle from that
+    pose (module docstring), not yet divided by lambda."""
     geometry, best = costs.geometry, costs.best_targets
     offsets = geometry.next_offsets[best]
     lengths = np.linalg.norm(offsets, axis=1)
-    fade = np.minimum(1.0, geometry.distances[best] / settings.translation_fade_distance)
+    # Faded on the distance after the operator's step, where the gradient is taken.
+    fade = np.minimum(1.0, lengths / settings.translation_fade_distance)
     translation = (huber_slope(lengths, *_translation(settings)) * fade)[:, np.newaxis] * \
         _unit_rows(offsets, lengths)
     if geometry.angles is None:
         return translation, None
     rotations = geometry.next_rotations[best]
     angles = np.linalg.norm(rotations, axis=1)
-    fade = np.minimum(1.0, geometry.angles[best] / settings.rotation_fade_angle)
+    fade = np.minimum(1.0, angles / settings.rotation_fade_angle)
     rotation = (settings.rotation_weight * huber_slope(angles, *_rotation(settings))
                 * fade)[:, np.newaxis] * _unit_rows(rotations, angles)
     return translation, rotation
@@ -416,7 +440,7 @@ def goal_gradients(settings, costs):
 def assistance_action(settings, costs, weights):
     """`(linear (3,), angular (3,) or None)`: `-(1/lambda) (sum_g w_g grad Q_g) / sum w`,
     the assistance for goal weights `weights` (K,) (the belief for HOP); zeros when every
-    weight is 0 (policy blending passing the operator through)."""
+    weight is 0 (predict-then-assist passing the operator through)."""
     weights = np.asarray(weights, dtype=float)
     translation, rotation = goal_gradients(settings, costs)
     total = weights.sum()
@@ -429,7 +453,7 @@ def assistance_action(settings, costs, weights):
 
 
 def blending_weights(probabilities, threshold):
-    """Policy blending's goal weights: one-hot on the most probable goal when it beats the
+    """Predict-then-assist's goal weights: one-hot on the most probable goal when it beats the
     second by more than `threshold`, else all 0 (the operator alone). With one goal its
     margin is its probability, 1."""
     probabilities = np.asarray(probabilities, dtype=float)
@@ -444,10 +468,10 @@ def blending_weights(probabilities, threshold):
 
 def assistance_weights(method, settings, probabilities):
     """The goal weights the assistance of `method` (HOP_METHODS) uses: the belief itself
-    (``hop``) or policy blending's (``policy_blending``)."""
+    (``hop``) or predict-then-assist's (``predict_then_assist``)."""
     if method == "hop":
         return np.asarray(probabilities, dtype=float)
-    if method == "policy_blending":
+    if method == "predict_then_assist":
         return blending_weights(probabilities, settings.blending_threshold)
     raise ValueError(f"method {method!r} is unknown; choose one of {HOP_METHODS}")
 
@@ -464,11 +488,19 @@ class AssistedCommand(typing.NamedTuple):
 def assisted_command(method, settings, targets, probabilities, position, velocity,
                      orientation=None, angular_velocity=None):
     """The command `u + a` of `method` for the belief `probabilities` (K,) and the
-    operator's command `u` = (`velocity`, `angular_velocity`) at the hand's pose."""
+    operator's command `u` = (`velocity`, `angular_velocity`) at the hand's pose; `u`
+    alone when `settings.assistance` is False."""
     probabilities = np.asarray(probabilities, dtype=float)
     if probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all():
         raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers, "
                          f"got {probabilities!r}")
+    if not settings.assistance:
+        # The operator's command untouched (not plus a zero action, which would turn a -0.0
+        # into 0.0): bit for bit the command teleop passes on.
+        angular = None if targets.orientations is None else (
+            np.zeros(3) if angular_velocity is None
+            else _finite_vector(angular_velocity, "angular_velocity"))
+        return AssistedCommand(_finite_vector(velocity, "velocity"), angular, False)
     weights = assistance_weights(method, settings, probabilities)
     costs = goal_costs(settings, targets, position, velocity, orientation, angular_velocity)
     linear, angular = assistance_action(settings, costs, weights)

@@ -26,9 +26,9 @@ from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles,
-    Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands,
-    PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
+    HSR_OPERATORS, METHODS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
+    DynamicObstacles, Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError,
+    ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
     VirtualParticipant)
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
@@ -36,7 +36,7 @@ from pbp_drake.scenarios.validation import (
     check_pilot, check_time_steps, check_virtual_participant, require_finite)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator;
-# HOP and policy blending have no blender: their assistance is the HOP controller's).
+# HOP and predict-then-assist have no blender: their assistance is the HOP controller's).
 BLEND_MODE_OF_METHOD = {
     "pbp_alternated": "pbp_alternated",
     "pbp_continuous": "pbp_continuous",
@@ -45,7 +45,7 @@ BLEND_MODE_OF_METHOD = {
     "confidence_alpha": "confidence_alpha",
     "teleop": "teleop",
     "hop": None,
-    "policy_blending": None,
+    "predict_then_assist": None,
 }
 
 
@@ -96,7 +96,7 @@ class ResolvedScenario:
 
     @property
     def blend_mode(self):
-        """The blender's mode for `scenario.method` (None for hop and policy_blending, which
+        """The blender's mode for `scenario.method` (None for hop and predict_then_assist, which
         have none)."""
         return BLEND_MODE_OF_METHOD[self.scenario.method]
 
@@ -134,6 +134,7 @@ def parse_method_label(label):
     """`(name, alpha)` of a method label: a name of METHODS (alpha None), or `fixed_alpha=A`
     for explicit arbitration with weight A (so that one study can sweep alpha)."""
     name, _, alpha = label.partition("=")
+    renamed_method(name)
     if name not in METHODS:
         raise ScenarioError(f"method {label!r} is unknown; choose from {METHODS} or "
                             f"fixed_alpha=A{close_match(name, METHODS)}")
@@ -158,6 +159,14 @@ def with_method(scenario, label):
     return dataclasses.replace(scenario, method=name, alpha=alpha)
 
 
+def renamed_method(name, field="method"):
+    """Raises ScenarioError when `name` is a method's old name (`RENAMED_METHODS`), naming
+    the new one."""
+    if name in RENAMED_METHODS:
+        new, why = RENAMED_METHODS[name]
+        raise ScenarioError(f"{field} {name!r} is now called {new!r} ({why})")
+
+
 def close_match(name, choices):
     """` (did you mean 'x'?)` when one of `choices` is close to `name`, else ``."""
     matches = difflib.get_close_matches(name, list(choices), n=1)
@@ -166,6 +175,7 @@ def close_match(name, choices):
 
 def _check_common(scenario):
     check_numbers(scenario)
+    renamed_method(scenario.method, "scenario.method")
     if scenario.method not in METHODS:
         raise ScenarioError(
             f"scenario.method {scenario.method!r} is unknown; choose one of {METHODS}"
@@ -204,7 +214,7 @@ def _check_method(scenario, goal_count):
     if scenario.method == "confidence_alpha":
         raise ScenarioError("scenario.method confidence_alpha needs a goal estimator's "
                             "confidence: use it in the HSR tasks (robot: !Hsr)")
-    if scenario.method in ("hop", "policy_blending"):
+    if scenario.method in ("hop", "predict_then_assist"):
         raise ScenarioError(f"scenario.method {scenario.method} assists toward the HSR "
                             "tasks' goals: use it in the HSR tasks (robot: !Hsr)")
     if scenario.method == "fixed_alpha" and scenario.demonstration is None:

@@ -57,11 +57,18 @@ class ScenarioError(ValueError):
 
 
 METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
-           "pbp_no_user", "hop", "policy_blending")
+           "pbp_no_user", "hop", "predict_then_assist")
+#: Old method name -> (its name now, why): a scenario, `--method` or `--methods` naming the
+#: old one is refused with a message naming the new one (`resolution.renamed_method`).
+RENAMED_METHODS = {
+    "policy_blending": ("predict_then_assist", "HOP's action added once the two most "
+                        "probable goals differ by hop.blending_threshold; Dragan and "
+                        "Srinivasa's arbitration is confidence_alpha"),
+}
 # The methods whose keys include forward: teleop, and the shared-autonomy baselines whose
 # assistance adds to a full command. The paper disables it under PBP and arbitration, whose
 # operator shows the goal and lets the robot bring the hand there.
-FORWARD_KEY_METHODS = ("teleop", "hop", "policy_blending")
+FORWARD_KEY_METHODS = ("teleop", "hop", "predict_then_assist")
 
 
 def forward_key_enabled(scenario):
@@ -76,7 +83,7 @@ def shows_intent(scenario):
     off (`hop: {assistance: false}`), whose robot adds nothing."""
     if scenario.method == "teleop":
         return False
-    return not (scenario.method in ("hop", "policy_blending")
+    return not (scenario.method in ("hop", "predict_then_assist")
                 and not getattr(scenario.hop, "assistance", True))
 
 
@@ -405,7 +412,7 @@ class Scenario:
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
     #: HOP's cost model, goal posterior and assistance (HopSettings), read by the hop and
-    #: policy_blending methods and the maxent_command goal estimator.
+    #: predict_then_assist methods and the maxent_command goal estimator.
     hop: HopSettings = dataclasses.field(default_factory=HopSettings)
     #: The seed of every random draw (an integer).
     seed: int = 0

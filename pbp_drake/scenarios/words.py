@@ -5,7 +5,7 @@ same way: each method's one name, and a count with its noun in the right number.
 #: The name a person reads for each method of `schema.METHODS`: on the page's Start button
 #: and title, in the results tables and in the figures. The paper's names where it has them;
 #: confidence_alpha has none and reads as `--methods` spells it (as the results tables print it);
-#: hop and policy_blending are the shared-autonomy baselines' names in Javdani et al.'s papers.
+#: hop and predict_then_assist are the shared-autonomy baselines' names in Javdani et al.'s papers.
 METHOD_NAMES = {
     "pbp_alternated": "PBP-Alt",
     "pbp_continuous": "PBP-Cont",
@@ -14,7 +14,7 @@ METHOD_NAMES = {
     "teleop": "Teleop",
     "pbp_no_user": "PBP-NoUser",
     "hop": "HOP",
-    "policy_blending": "Policy blending",
+    "predict_then_assist": "Predict-then-assist",
 }
 
 

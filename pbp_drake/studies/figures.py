@@ -24,7 +24,7 @@ METHOD_LABELS = METHOD_NAMES
 METHOD_COLOURS = {"pbp_alternated": "tab:orange", "pbp_continuous": "tab:blue",
                   "teleop": "tab:green", "pbp_no_user": "tab:gray", "fixed_alpha": "tab:purple",
                   "confidence_alpha": "tab:cyan", "hop": "tab:red",
-                  "policy_blending": "tab:brown"}
+                  "predict_then_assist": "tab:brown"}
 
 
 def _label(method, rows=None):

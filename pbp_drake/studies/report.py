@@ -74,7 +74,7 @@ def results_table(summary):
     if participant:
         lines += [participant, ""]
     collisions = summary["measures_collisions"]
-    # HOP's posterior at its clip, where a method records it (hop, policy_blending,
+    # HOP's posterior at its clip, where a method records it (hop, predict_then_assist,
     # maxent_command).
     clipped = any("posterior_clipped_ratio" in e for e in summary["methods"].values())
     columns = ["method", "trials", "success", "intervention ratio", "task time (s)",

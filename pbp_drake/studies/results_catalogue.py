@@ -24,13 +24,15 @@ REACH = ["diagrams/hsr_reach.yaml", "--methods",
 OBSTACLES = ["diagrams/hsr_obstacles.yaml", "--trials", "30"]
 FIXED_ALPHAS = ",".join(f"fixed_alpha=0.{tenth}" for tenth in range(1, 10))
 PBP = "pbp_alternated,pbp_continuous"
-# PBP beside the shared-autonomy baselines (docs/results/baselines.md) and teleop.
-BASELINES = ["--methods", "pbp_alternated,pbp_continuous,hop,policy_blending,teleop",
+# PBP beside the shared-autonomy baselines (docs/results/baselines.md) and teleop: HOP, its
+# predict-then-assist variant and Dragan and Srinivasa's arbitration (confidence_alpha).
+BASELINE_METHODS = "hop,predict_then_assist,confidence_alpha"
+BASELINES = ["--methods", f"pbp_alternated,pbp_continuous,{BASELINE_METHODS},teleop",
              "--trials", "30", "--split", "evaluation"]
 # The reaching task's methods with the virtual participant unimpaired and under each of its
 # conditions (docs/results/impaired.md).
 IMPAIRED = ["diagrams/hsr_reach.yaml", "--methods",
-            "pbp_alternated,pbp_continuous,confidence_alpha,teleop,hop,policy_blending",
+            f"pbp_alternated,pbp_continuous,{BASELINE_METHODS},teleop",
             "--trials", "30", "--split", "evaluation"]
 
 # Every method under every pilot of the registry (`scenarios.pilots`), on the evaluation
@@ -72,7 +74,7 @@ STUDIES = {
     # The reaching task on our 7-joint arm (docs/results/arm.md), and the same scenario on
     # the test suite's 6-joint arm of other kinematics is the test's.
     "arm_reach_evaluation": ["diagrams/arm_reach.yaml", "--methods",
-                             "pbp_alternated,pbp_continuous,teleop,hop,policy_blending",
+                             f"pbp_alternated,pbp_continuous,{BASELINE_METHODS},teleop",
                              "--trials", "30", "--split", "evaluation"],
     "arm_reach_teleop_calibration": ["diagrams/arm_reach.yaml", "--methods", "teleop",
                                      "--trials", "30", "--split", "tuning"],

@@ -180,7 +180,7 @@ def summarize(study, records, damaged=(), output=None):
     trial_files.read_study) gives each method's count of trials skipped as damaged (not
     counted as missing) and the summary's "damaged" list of files (paths relative to
     `output`) and problems. A method whose trials record how often HOP's goal posterior sat
-    at its clip (hop, policy_blending, the maxent_command estimator) gets the mean and std
+    at its clip (hop, predict_then_assist, the maxent_command estimator) gets the mean and std
     of that `posterior_clipped_ratio` too; the others have no such entry."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],

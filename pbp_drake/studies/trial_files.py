@@ -33,7 +33,7 @@ TRIAL_FORMAT = 1
 # the CSV's ee_x..ee_z and command_vx..command_vz columns (ticks 0..T-1).
 # posterior_clipped_ratio is the ratio of ticks whose goal posterior sat at its clip
 # (`TaskResult.posterior_clipped_ratio`), recorded by the methods with HOP's posterior only
-# (hop, policy_blending, the maxent_command estimator): other trials, and those written
+# (hop, predict_then_assist, the maxent_command estimator): other trials, and those written
 # before it, read it as None.
 METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio",
            "peak_hand_speed", "peak_command_acceleration", "posterior_clipped_ratio")

@@ -40,7 +40,7 @@ __all__ = [
     "Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource", "HandOver",
     "HeadingCommand", "LikelyGoals", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator",
     "PoseHandOver",
-    # The shared-autonomy baselines (HOP, policy blending) and PBP's maxent_command estimator.
+    # The shared-autonomy baselines (HOP, predict-then-assist) and PBP's maxent_command estimator.
     "HopAssistance", "MaxEntGoalEstimator", "PoseHopAssistance", "PoseMaxEntGoalEstimator",
     # Operators.
     "GamepadOperator", "IdleOperator", "KeyboardOperator", "ObstacleRepulsionOperator",

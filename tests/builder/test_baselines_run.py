@@ -1,5 +1,5 @@
-"""The shared-autonomy baselines end to end with the virtual participant: HOP and policy
-blending reach the target on the reaching task without any DMP; PBP with the
+"""The shared-autonomy baselines end to end with the virtual participant: HOP and
+predict-then-assist reach the target on the reaching task without any DMP; PBP with the
 ``maxent_command`` estimator picks its DMP from the operator's commands; the posterior's
 clip ratio reaches the TaskResult, a streamed run and a study's trial file. A reaching run
 takes under a second; the obstacle and grasping tasks' runs are marked slow."""
@@ -23,15 +23,17 @@ pytestmark = pytest.mark.slow
 SEED = 3
 
 
-def scenario(repo, name, method, estimator=None):
+def scenario(repo, name, method, estimator=None, **hop):
     loaded = load_scenario_file(repo / "diagrams" / name).scenario
+    if hop:
+        loaded = dataclasses.replace(loaded, hop=dataclasses.replace(loaded.hop, **hop))
     if estimator is not None:
         loaded = dataclasses.replace(loaded, goal_estimator=dataclasses.replace(
             loaded.goal_estimator, method=estimator))
     return resolve(dataclasses.replace(with_method(loaded, method), seed=SEED))
 
 
-@pytest.mark.parametrize("method", ["hop", "policy_blending"])
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
 def test_the_baselines_reach_the_target_without_dmps(repo, method):
     resolved = scenario(repo, "hsr_reach.yaml", method)
     diagram = build_diagram(resolved)
@@ -80,7 +82,7 @@ def test_a_streamed_run_records_the_same_clip_ratio(repo, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("method", ["hop", "policy_blending"])
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
 def test_the_baselines_do_the_obstacle_task(repo, method):
     result = run_task(scenario(repo, "hsr_obstacles.yaml", method))
     assert result.success
@@ -89,7 +91,7 @@ def test_the_baselines_do_the_obstacle_task(repo, method):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("method, estimator", [("hop", None), ("policy_blending", None),
+@pytest.mark.parametrize("method, estimator", [("hop", None), ("predict_then_assist", None),
                                                ("pbp_alternated", "maxent_command")])
 def test_the_grasp_task_with_hops_posterior(repo, method, estimator):
     resolved = scenario(repo, "hsr_grasp.yaml", method, estimator)
@@ -112,3 +114,19 @@ def test_the_baselines_draw_their_scene_without_dmp_paths(repo, meshcat, name):
     simulator = Simulator(diagram)
     simulator.AdvanceTo(0.5)
     assert meshcat.HasPath("/task/objects/0") and meshcat.HasPath("/task/target")
+
+
+@pytest.mark.parametrize("name", ["hsr_reach.yaml", "hsr_grasp.yaml"])
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
+def test_with_its_assistance_off_a_baseline_commands_what_teleop_commands(repo, name, method):
+    """`hop: {assistance: false}`: the robot adds nothing, so the same participant on the
+    same seed moves the hand exactly as under teleop, tick for tick (the pose too in the
+    grasping task); the posterior still runs."""
+    teleop = run_task(scenario(repo, name, "teleop"))
+    off = run_task(scenario(repo, name, method, assistance=False))
+    for series in ("ee_positions", "headings", "commands", "operator_active",
+                   "operator_commands", "command_angular_velocities", "angles_to_target"):
+        np.testing.assert_array_equal(getattr(off, series), getattr(teleop, series),
+                                      err_msg=series)
+    assert (off.success, off.task_time) == (teleop.success, teleop.task_time)
+    assert off.posterior_clipped_ratio is not None

@@ -46,7 +46,7 @@ def test_status_words():
 NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "Teleop",
          "pbp_no_user": "PBP-NoUser", "fixed_alpha": "Fixed alpha",
          "confidence_alpha": "confidence_alpha", "hop": "HOP",
-         "policy_blending": "Policy blending"}
+         "predict_then_assist": "Predict-then-assist"}
 
 
 @pytest.mark.parametrize("method", METHODS)

@@ -1,4 +1,4 @@
-"""HOP's goal posterior and assistance, and policy blending, against the equations of
+"""HOP's goal posterior and assistance, and predict-then-assist, against the equations of
 Javdani et al. (2015, 2018) written out here goal by goal and target by target with plain
 floats and SciPy's rotations: an oracle that shares no code with
 `pbp_drake.core.hindsight_optimization`."""
@@ -89,11 +89,11 @@ def oracle_action(weights, state, goals):
         length = math.hypot(*r)
         if length > 0:
             gradient = slope(length, *TRANSLATION) * np.array(r) / length
-            linear += weight * gradient * min(1.0, d / 0.02)
+            linear += weight * gradient * min(1.0, length / 0.02)
         if theta is not None:
             angle = float(np.linalg.norm(rotation_vector))
             gradient = ROTATION_WEIGHT * slope(angle, *ROTATION) * rotation_vector / angle
-            angular += weight * gradient * min(1.0, theta / (math.pi / 12))
+            angular += weight * gradient * min(1.0, angle / (math.pi / 12))
     return -linear / (sum(weights) * 40.0), -angular / (sum(weights) * 0.05)
 
 
@@ -253,21 +253,68 @@ def test_with_one_goal_near_the_assistance_is_the_quadratic_slope_and_fades():
     np.testing.assert_array_equal(at_goal.velocity, np.zeros(3))
 
 
-def test_policy_blending_passes_the_operator_through_below_the_threshold():
+def test_the_fade_reads_the_distance_after_the_operators_step():
+    """5 cm short, the operator's step (0.4 m/s for 0.1 s) ends 1 cm short: the action is
+    faded by 0.01 / 0.02 = 0.5, not by the present 0.05 / 0.02 (no fade). 1 cm short, a step
+    of 0.3 m/s ends 2 cm past: no fade, and the action pulls back."""
+    goal = np.array([1.0, 0.0, 0.7])
+    targets = hop_targets([goal])
+    slope_at = {0.01: 0.2 + 2.25 / 0.07 * 0.01, 0.02: 0.2 + 2.25 / 0.07 * 0.02}
+    for short, speed, after, fade in ((0.05, 0.4, -0.01, 0.5), (0.01, 0.3, 0.02, 1.0)):
+        command = assisted_command("hop", SETTINGS, targets, [1.0], goal - [short, 0, 0],
+                                   [speed, 0.0, 0.0])
+        action = -math.copysign(1.0, after) * slope_at[abs(after)] * fade / 40.0
+        np.testing.assert_allclose(command.velocity, [speed + action, 0.0, 0.0],
+                                   rtol=0, atol=1e-15)
+
+
+def test_the_rotation_fade_reads_the_angle_after_the_operators_step():
+    """pi/8 about z from the grasp, turning back pi/12 in the step: theta' = pi/24, beyond
+    the quadratic zone (pi/32), so the slope is 0.2 + 0.01, faded by (pi/24) / (pi/12)."""
+    hand = [math.cos(math.pi / 16), 0.0, 0.0, math.sin(math.pi / 16)]  # pi/8 about z
+    turn = [0.0, 0.0, -(math.pi / 12) / DT]
+    targets = hop_targets([[1.0, 0.0, 0.7]], [[1.0, 0.0, 0.0, 0.0]])
+    command = assisted_command("hop", SETTINGS, targets, [1.0], [1.0, 0.0, 0.7],
+                               np.zeros(3), hand, turn)
+    action = -ROTATION_WEIGHT * (0.2 + 0.01) * 0.5 / 0.05
+    np.testing.assert_allclose(command.angular_velocity, [0.0, 0.0, turn[2] + action],
+                               rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(command.velocity, np.zeros(3))
+
+
+@pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
+def test_with_the_assistance_off_the_command_is_the_operators_alone(method):
+    """Certain of a goal 1 m away, the robot still adds nothing: the operator's command
+    comes back as it went in, signed zeros included."""
+    off = HopSettings(assistance=False)
+    targets = hop_targets([[1.0, 0.0, 0.7], [0.0, 1.0, 0.7]], [[1.0, 0, 0, 0]] * 2)
+    velocity, angular = np.array([-0.0, 0.1, 0.0]), np.array([0.0, -0.0, 0.3])
+    command = assisted_command(method, off, targets, [0.99, 0.01], [0.0, 0.0, 0.7],
+                               velocity, [1.0, 0.0, 0.0, 0.0], angular)
+    assert not command.assisting
+    for got, sent in ((command.velocity, velocity), (command.angular_velocity, angular)):
+        np.testing.assert_array_equal(got, sent)
+        np.testing.assert_array_equal(np.signbit(got), np.signbit(sent))
+    on = assisted_command(method, SETTINGS, targets, [0.99, 0.01], [0.0, 0.0, 0.7],
+                          velocity, [1.0, 0.0, 0.0, 0.0], angular)
+    assert on.assisting and on.velocity[0] > 0.05
+
+
+def test_predict_then_assist_passes_the_operator_through_below_the_threshold():
     targets = hop_targets([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [0.0, 1.5, 0.7]])
     position, velocity = np.array([0.0, 0.0, 0.7]), np.array([0.1, 0.02, 0.0])
     for belief in ([0.5, 0.3, 0.2], [0.65, 0.25, 0.1], [0.34, 0.33, 0.33]):
-        command = assisted_command("policy_blending", SETTINGS, targets, belief, position,
+        command = assisted_command("predict_then_assist", SETTINGS, targets, belief, position,
                                    velocity)
         np.testing.assert_array_equal(command.velocity, velocity)
         assert not command.assisting
 
 
-def test_policy_blending_assists_fully_toward_the_most_probable_goal_above_it():
+def test_predict_then_assist_assists_fully_toward_the_most_probable_goal_above_it():
     targets = hop_targets([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [0.0, 1.5, 0.7]])
     position, velocity = np.array([0.0, 0.0, 0.7]), np.array([0.1, 0.02, 0.0])
     belief = [0.1, 0.8, 0.1]
-    blended = assisted_command("policy_blending", SETTINGS, targets, belief, position,
+    blended = assisted_command("predict_then_assist", SETTINGS, targets, belief, position,
                                velocity)
     certain = assisted_command("hop", SETTINGS, targets, [0.0, 1.0, 0.0], position,
                                velocity)

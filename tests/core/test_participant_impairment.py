@@ -179,11 +179,13 @@ def test_the_mistaken_grasp_participant_heads_for_the_other_grasp_pose_then_the_
     positions, orientations = grasp_scene()
     twists, hand, level = grasp_twists(
         ParticipantImpairment(mistake_probability=1.0, mistake_time=0.9))
-    # It notices the target (object 1) after its reaction_delay, 0.5 s, then heads for
-    # object 0's grasp pose, position and orientation, for 0.9 s; the hand still, it takes
-    # over once it has watched it `serve_patience`.
-    patience = round(GraspParticipantParams().serve_patience / PERIOD)
-    noticed, corrected = int(round(0.5 / PERIOD)) + patience, int(round(1.4 / PERIOD))
+    # It notices the target (object 1) after its reaction_delay, then heads for object 0's
+    # grasp pose, position and orientation, for 0.9 s; the hand still, it takes over once
+    # it has watched it `serve_patience`.
+    defaults = GraspParticipantParams()
+    patience = round(defaults.serve_patience / PERIOD)
+    known = int(np.ceil(defaults.reaction_delay / PERIOD - 1e-9))
+    noticed, corrected = known + patience, known + int(round(0.9 / PERIOD))
     assert not twists[:noticed].any()
 
     def heads_for(twist, index):

@@ -19,7 +19,18 @@ def test_a_baselines_study_writes_its_table_paired_with_pbp_alt_and_its_figures(
     assert text.startswith("`pbp-drake study " + " ".join(
         STUDIES["hsr_reach_baselines"]).replace("30", "2"))
     assert "Each method against PBP-Alt, paired by seed" in text
-    for method in ("PBP-Cont", "HOP", "Policy blending", "Teleop"):
+    for method in ("PBP-Cont", "HOP", "Predict-then-assist", "confidence_alpha", "Teleop"):
         assert f"| task_time | {method} | " in text or f"| success | {method} | " in text
     for figure in DOCS_FIGURES:
         assert (generated / f"hsr_reach_baselines_{figure}").stat().st_size > 10_000
+
+
+def test_every_baselines_study_has_dragan_and_srinivasas_arbitration():
+    """Wherever HOP is compared, confidence_alpha ((1 - alpha) U + alpha P) is too."""
+    with_hop = {name: arguments[arguments.index("--methods") + 1].split(",")
+                for name, arguments in STUDIES.items()
+                if "--methods" in arguments and "hop" in arguments[
+                    arguments.index("--methods") + 1].split(",")}
+    assert {"hsr_reach_baselines", "hsr_grasp_baselines", "arm_reach_evaluation"} <= set(
+        with_hop)
+    assert all("confidence_alpha" in methods for methods in with_hop.values())

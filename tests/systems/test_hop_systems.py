@@ -1,7 +1,7 @@
 """HOP's systems in small diagrams: the goal posterior (`MaxEntGoalEstimator`,
 `PoseMaxEntGoalEstimator`) keeps the core's recursive belief tick by tick, in the Context
 alone; the assistance (`HopAssistance`, `PoseHopAssistance`) sends the operator's command
-plus HOP's action, and policy blending the operator's alone until it is confident."""
+plus HOP's action, and predict-then-assist the operator's alone until it is confident."""
 
 import numpy as np
 import pytest
@@ -139,10 +139,10 @@ def test_hop_sends_the_operator_plus_the_assistance_as_a_one_tick_reference():
     assert np.linalg.norm(command[3:]) > np.linalg.norm(TOWARD_FIRST)
 
 
-def test_policy_blending_is_the_operator_until_confident():
-    unsure = assistance_output("policy_blending", [0.5, 0.3, 0.2], TOWARD_FIRST)
+def test_predict_then_assist_is_the_operator_until_confident():
+    unsure = assistance_output("predict_then_assist", [0.5, 0.3, 0.2], TOWARD_FIRST)
     np.testing.assert_array_equal(unsure[3:], TOWARD_FIRST)
-    sure = assistance_output("policy_blending", [0.9, 0.05, 0.05], TOWARD_FIRST)
+    sure = assistance_output("predict_then_assist", [0.9, 0.05, 0.05], TOWARD_FIRST)
     certain = assistance_output("hop", [1.0, 0.0, 0.0], TOWARD_FIRST)
     np.testing.assert_array_equal(sure, certain)
 

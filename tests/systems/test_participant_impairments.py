@@ -203,8 +203,10 @@ def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
     (on_time, on_time_active), (delayed, delayed_active) = twists(0.0), twists(0.45)
     shift = 15
     # Under teleop it takes over once it has noticed the target and watched the still hand
-    # for its patience (0.5 + 0.25 s), and keeps on.
-    acts = round(0.75 / PERIOD)
+    # for its patience, and keeps on.
+    defaults = GraspParticipantParams()
+    acts = (int(np.ceil(defaults.reaction_delay / PERIOD - 1e-9))
+            + round(defaults.serve_patience / PERIOD))
     assert not on_time_active[:acts].any() and on_time_active[acts:].all()
     assert np.array_equal(delayed[shift:], on_time[:-shift])
     assert np.array_equal(delayed_active[shift:], on_time_active[:-shift])

@@ -1,6 +1,6 @@
 """HOP's assistance as a Drake system: the operator's velocity plus the belief-weighted
-cost gradient (``hop``), or policy blending's all-or-nothing assistance
-(``policy_blending``), as the reference the hand-over passes on
+cost gradient (``hop``), or predict-then-assist's all-or-nothing assistance
+(``predict_then_assist``), as the reference the hand-over passes on
 (`pbp_drake.core.hindsight_optimization.assisted_command`)."""
 
 import dataclasses
@@ -40,7 +40,7 @@ class HopAssistanceBase(LeafSystem):
 
 
 class HopAssistance(HopAssistanceBase):
-    """The command of ``hop`` or ``policy_blending`` in the position tasks.
+    """The command of ``hop`` or ``predict_then_assist`` in the position tasks.
 
     .. pydrake_system::
 
@@ -58,7 +58,7 @@ class HopAssistance(HopAssistanceBase):
     the belief (`MaxEntGoalEstimator`'s). The velocity commanded is `u + a`
     (`assisted_command`): `a` weighted by the belief (``hop``), or toward the most probable
     goal alone once it leads the second by more than `settings.blending_threshold`, else 0
-    (``policy_blending``). `command` is `[p + (u + a) control_period, u + a]`, the reference
+    (``predict_then_assist``). `command` is `[p + (u + a) control_period, u + a]`, the reference
     of one control period, as `Blender`'s, for the `HandOver`. A NaN or infinite command
     raises.
     """

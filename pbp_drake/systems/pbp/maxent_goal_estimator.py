@@ -1,8 +1,11 @@
 """HOP's goal posterior as a Drake system: which of K goals the operator means, read from
-the operator's command (`pbp_drake.core.hindsight_optimization`). `CommandPosteriorBase`
-holds what it shares with the six-DoF `PoseMaxEntGoalEstimator`."""
+the operator's command (`pbp_drake.core.hindsight_optimization`), or with an
+`operator_speed` from PBP's operator's corrections, turns and silences
+(`pbp_drake.core.maxent_command`). `CommandPosteriorBase` holds what it shares with the
+six-DoF `PoseMaxEntGoalEstimator`."""
 
 import dataclasses
+import typing
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
@@ -10,8 +13,28 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.goal_estimation import NO_CHALLENGER, SelectionMemory, update_selection
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, hop_targets, uniform_log_belief, update_posterior)
+from pbp_drake.core.maxent_command import intent_evidence, update_intent_posterior
 from pbp_drake.systems.ports import EeState, OperatorCommand
 from pbp_drake.systems.tick import decide_offset
+
+
+class PosteriorInputs(typing.NamedTuple):
+    """What an update reads: the `targets`, the hand's `position`, the operator's
+    `command` velocity, the hand's executed `hand_velocity`; with orientations the hand's
+    `orientation`, the operator's `command_angular_velocity` and the hand's
+    `hand_angular_velocity`; without, the hand's `heading` and the operator's `yaw_rate`;
+    and whether the operator `active`ly commands."""
+
+    targets: typing.Any
+    position: np.ndarray
+    command: np.ndarray
+    hand_velocity: np.ndarray
+    orientation: typing.Optional[np.ndarray] = None
+    command_angular_velocity: typing.Optional[np.ndarray] = None
+    hand_angular_velocity: typing.Optional[np.ndarray] = None
+    heading: typing.Optional[float] = None
+    yaw_rate: float = 0.0
+    active: bool = True
 
 
 class CommandPosteriorBase(LeafSystem):
@@ -19,12 +42,22 @@ class CommandPosteriorBase(LeafSystem):
     selection with the shipped hysteresis (`goal_estimation.update_selection`) and whether
     the last update was clipped, all in the Context's discrete state; the outputs
     `selected_goal`, `goal_probabilities` and `posterior_clipped`. A subclass declares its
-    input ports (`_declare_inputs`) and reads them (`_inputs(context) -> (targets, position,
-    velocity, orientation, angular_velocity)`)."""
+    input ports (`_declare_inputs`, with `operator_active` among them) and reads them
+    (`_inputs(context) -> PosteriorInputs`).
+
+    `operator_speed` None: HOP's published update, on the operator's command alone (the
+    ``hop`` and ``predict_then_assist`` methods). A speed (m/s, the operators' speed, the
+    task's nominal speed): the ``maxent_command`` likelihood for PBP's operator
+    (`pbp_drake.core.maxent_command`), which reads `operator_active`: the operator's
+    command while it acts, the hand's executed motion while it is silent, and its turns."""
 
     def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
-                 update_offset=None):
+                 update_offset=None, operator_speed=None):
         super().__init__()
+        if operator_speed is not None and not (np.isfinite(operator_speed)
+                                               and operator_speed > 0.0):
+            raise ValueError(f"operator_speed must be positive, got {operator_speed!r}")
+        self._operator_speed = None if operator_speed is None else float(operator_speed)
         if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
             raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
         if not isinstance(settings, HopSettings):
@@ -67,6 +100,14 @@ class CommandPosteriorBase(LeafSystem):
         return self._settings
 
     @property
+    def operator_speed(self):
+        """None: HOP's published likelihood; else the PBP operator's, at this speed."""
+        return self._operator_speed
+
+    def get_operator_active_input_port(self):
+        return self._active_port
+
+    @property
     def margin(self):
         return self._margin
 
@@ -85,10 +126,22 @@ class CommandPosteriorBase(LeafSystem):
 
     def _update(self, context, discrete_state):
         state = context.get_discrete_state()
-        targets, position, velocity, orientation, angular_velocity = self._inputs(context)
-        update = update_posterior(self._settings, targets,
-                                  state.value(self._log_belief_index), position, velocity,
-                                  orientation, angular_velocity)
+        read = self._inputs(context)
+        log_belief = state.value(self._log_belief_index)
+        if self._operator_speed is None:
+            update = update_posterior(self._settings, read.targets, log_belief, read.position,
+                                      read.command, read.orientation,
+                                      read.command_angular_velocity)
+        else:
+            # Silent, the operator lets the robot go on: its motion is the implicit command.
+            active = self._active_port.Eval(context)[0] > 0.5
+            evidence = intent_evidence(
+                self._settings, read.targets, read.position,
+                read.command if active else read.hand_velocity, self._operator_speed,
+                read.heading, read.yaw_rate if active else 0.0, read.orientation,
+                read.command_angular_velocity if active else read.hand_angular_velocity)
+            update = update_intent_posterior(self._settings, read.targets, log_belief,
+                                             evidence)
         challenger, count = state.value(self._memory_index)
         memory = update_selection(
             update.probabilities,
@@ -105,7 +158,7 @@ class CommandPosteriorBase(LeafSystem):
 class MaxEntGoalEstimator(CommandPosteriorBase):
     """HOP's goal posterior on the hand's position and the operator's velocity command
     (`pbp_drake.core.hindsight_optimization.update_posterior`): the ``maxent_command`` goal
-    estimator of PBP, and the belief of the ``hop`` and ``policy_blending`` methods.
+    estimator of PBP, and the belief of the ``hop`` and ``predict_then_assist`` methods.
 
     .. pydrake_system::
 
@@ -114,6 +167,7 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
         - ee_state
         - goals
         - operator_command
+        - operator_active (read with operator_speed)
         output_ports:
         - selected_goal
         - goal_probabilities
@@ -123,7 +177,10 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
     `operator_command` the operator's `OperatorCommand` `[vx, vy, vz, yaw_rate]`, of which
     the velocity is read (the hand's own velocity is mostly the robot's). The belief starts
     uniform, and each update, at the decide stage of the tick (`update_offset` overrides
-    it), it moves by `-(Q_g - V_g)` and is clipped at `settings.max_probability`; the
+    it), it moves by `-(Q_g - V_g)` (with `operator_speed`: by the evidence of
+    `pbp_drake.core.maxent_command`, which also reads `operator_active` (1 while the
+    operator acts), the hand's velocity and heading in `ee_state` and the yaw rate) and
+    is clipped at `settings.max_probability`; the
     selection is the most probable goal, moved with the hysteresis of `margin` and
     `hold_steps` (0 and 1: at once). `goal_probabilities` (K), `selected_goal` `[index]`
     and `posterior_clipped` (`[1]` when the last update was clipped, else `[0]`) are read
@@ -135,6 +192,7 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
         self._goals_port = self.DeclareVectorInputPort("goals", 3 * goal_count)
         self._command_port = self.DeclareVectorInputPort("operator_command",
                                                          OperatorCommand.size)
+        self._active_port = self.DeclareVectorInputPort("operator_active", 1)
 
     def get_ee_state_input_port(self):
         return self._ee_state_port
@@ -147,6 +205,8 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
 
     def _inputs(self, context):
         targets = hop_targets(self._goals_port.Eval(context).reshape(self._goal_count, 3))
-        position = self._ee_state_port.Eval(context)[:3]
-        velocity = self._command_port.Eval(context)[:3]
-        return targets, position, velocity, None, None
+        hand = self._ee_state_port.Eval(context)
+        command = self._command_port.Eval(context)
+        return PosteriorInputs(targets, hand[:3], command[:3], hand[3:6],
+                               heading=float(EeState(hand).heading),
+                               yaw_rate=float(OperatorCommand(command).yaw_rate))

@@ -1,5 +1,5 @@
 """HOP's assistance on the hand's pose as a Drake system: the grasping task's ``hop`` and
-``policy_blending`` commands, position and orientation
+``predict_then_assist`` commands, position and orientation
 (`pbp_drake.core.hindsight_optimization.assisted_command`)."""
 
 import numpy as np
@@ -12,7 +12,7 @@ from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
 
 
 class PoseHopAssistance(HopAssistanceBase):
-    """The six-DoF command of ``hop`` or ``policy_blending`` (`HopAssistance` with the
+    """The six-DoF command of ``hop`` or ``predict_then_assist`` (`HopAssistance` with the
     pose).
 
     .. pydrake_system::

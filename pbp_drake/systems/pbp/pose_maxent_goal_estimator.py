@@ -4,14 +4,14 @@ operator means, read from the operator's twist (`pbp_drake.core.hindsight_optimi
 import numpy as np
 
 from pbp_drake.core.hindsight_optimization import hop_targets
-from pbp_drake.systems.pbp.maxent_goal_estimator import CommandPosteriorBase
+from pbp_drake.systems.pbp.maxent_goal_estimator import CommandPosteriorBase, PosteriorInputs
 from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
 
 
 class PoseMaxEntGoalEstimator(CommandPosteriorBase):
     """HOP's goal posterior with position and orientation terms, on the hand's pose and the
     operator's twist: the grasping task's ``maxent_command`` goal estimator, and the belief
-    of its ``hop`` and ``policy_blending`` methods (`MaxEntGoalEstimator` with the pose).
+    of its ``hop`` and ``predict_then_assist`` methods (`MaxEntGoalEstimator` with the pose).
 
     .. pydrake_system::
 
@@ -20,6 +20,7 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
         - hand_pose
         - goal_poses
         - operator_twist
+        - operator_active (read with operator_speed)
         output_ports:
         - selected_goal
         - goal_probabilities
@@ -30,7 +31,8 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
     operator's `OperatorTwist` (world frame). A goal's cost adds the translation term on
     the distance to its grasp position and `settings.rotation_weight` times the rotation
     term on the angle to its grasp orientation. Updates, selection and outputs are
-    `MaxEntGoalEstimator`'s.
+    `MaxEntGoalEstimator`'s; with `operator_speed`, the silent operator's implicit twist is
+    the hand's (`hand_pose`'s velocities), and turns count through the rotation term.
     """
 
     def _declare_inputs(self, goal_count):
@@ -38,6 +40,7 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
         self._goals_port = self.DeclareVectorInputPort("goal_poses",
                                                        goal_count * GoalPose.size)
         self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
+        self._active_port = self.DeclareVectorInputPort("operator_active", 1)
 
     def get_hand_pose_input_port(self):
         return self._hand_port
@@ -54,4 +57,5 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
         hand = self._hand_port.Eval(context)
         twist = self._twist_port.Eval(context)
         orientation = hand[3:7] / np.linalg.norm(hand[3:7])
-        return targets, hand[:3], twist[:3], orientation, twist[3:]
+        return PosteriorInputs(targets, hand[:3], twist[:3], hand[7:10], orientation,
+                               twist[3:], hand[10:13])

@@ -1,0 +1,130 @@
+"""The ``maxent_command`` goal estimator's likelihood, in pure NumPy: HOP's maximum-entropy
+goal posterior (`pbp_drake.core.hindsight_optimization`) made for PBP's operator, who
+corrects, turns the hand to point at a goal, and otherwise lets the robot go on.
+
+HOP's published update, `log b(g) -= Q_g - V_g`, reads only the operator's command as
+direct teleoperation. Under PBP that misreads the operator three ways: a silent operator
+gives no evidence, though letting the robot go on toward the goal it follows says that goal
+is right; the step cost `c(x)`, which is the same whatever the operator does, hands a goal
+the hand passes within `delta` (7 cm) up to `alpha dt = 0.225` nats a tick over the far
+goals; and turning the hand, the paper's sign of intent, is not read at all. Here,
+every control tick, each goal g gains
+
+    l_g = l_move_g + l_turn_g,   then normalised and clipped as HOP's posterior,
+
+- **moves** (corrections and silences): `l_move_g = V_g(x) - V_g(x + w dt)`, the drop of
+  goal g's value (`hindsight_optimization.target_values`, translation plus, with
+  orientations, the weighted rotation term) over one step of the cost model `dt` under the
+  implicit command `w`: the operator's command `u` while the operator acts (a
+  correction), the hand's own executed velocity (and angular velocity) while the operator
+  is silent (letting the robot go on is evidence for the goal it is going to). HOP's step
+  cost `c(x)` is left out: it does not depend on the command, so it is no evidence of the
+  goal. The value's slope is at most `alpha + c0` (the translation's, and `w (alpha_r +
+  c0_r)` the rotation's), so a tick moves no goal by more than
+  `(alpha + c0) |w| dt` (plus the rotation's share): passing near a goal earns at most
+  what moving straight at a far one does, whatever the distance.
+- **turns** (the position tasks, whose goals have no orientation): with the hand's heading
+  `psi` and each goal's floor bearing `beta_g` from the hand, the heading error
+  `e_g = wrap(beta_g - psi)` and after the operator's turn `e'_g = wrap(e_g - r dt)`, `r`
+  the operator's commanded yaw rate,
+
+      l_turn_g = (alpha + c0) s dt (|e_g| - |e'_g|) / |r dt|     (0 while r = 0),
+
+  between `+(alpha + c0) s dt` for a turn wholly toward g and `-(alpha + c0) s dt` for one
+  wholly away: a tick of turning toward a goal is worth a tick of moving straight at it
+  at the operator's speed `s` (the task's nominal speed). A goal straight above or below
+  the hand has no bearing and gains nothing from turns.
+
+The constants are HOP's published ones (the scenario's `hop` section) and `s`, the speed
+the operators move at; none is fitted. The telescoped moves are HOP's progress term,
+`V_g(x_0) - V_g(x_t)`, along the path the hand actually took under the operator's
+corrections and the robot's own motion.
+"""
+
+import math
+import typing
+
+import numpy as np
+
+from pbp_drake.core.hindsight_optimization import (
+    PosteriorUpdate, clip_log_belief, goal_minimum, log_normalised, target_geometry,
+    target_values)
+
+# A goal closer than this (m) to the hand on the floor plane has no bearing.
+NO_BEARING = 1e-9
+
+
+class IntentEvidence(typing.NamedTuple):
+    """One tick's evidence per goal: `moves` (K,) and `turns` (K,) (zeros without a turn
+    or with orientations), in nats."""
+
+    moves: np.ndarray
+    turns: np.ndarray
+
+    @property
+    def total(self):
+        return self.moves + self.turns
+
+
+def move_evidence(settings, targets, position, velocity, orientation=None,
+                  angular_velocity=None):
+    """`V_g(x) - V_g(x + w dt)` (K,): each goal's value dropped by one step of the cost
+    model under the implicit command `w` = (`velocity`, `angular_velocity`)."""
+    now, after = target_values(settings, target_geometry(
+        settings, targets, position, velocity, orientation, angular_velocity))
+    return goal_minimum(now, targets)[0] - goal_minimum(after, targets)[0]
+
+
+def turn_evidence(settings, targets, position, heading, yaw_rate, speed):
+    """`(alpha + c0) s dt (|e_g| - |e'_g|) / |r dt|` (K,), the module docstring's turns,
+    for the hand's `heading` (rad), the operator's `yaw_rate` r (rad/s) and the operators'
+    `speed` s (m/s); zeros while r is 0."""
+    position = np.asarray(position, dtype=float).reshape(-1)
+    if position.shape != (3,) or not np.isfinite(position).all():
+        raise ValueError(f"position must be 3 finite numbers, got {position.tolist()}")
+    if not (math.isfinite(heading) and math.isfinite(yaw_rate)):
+        raise ValueError(f"heading and yaw_rate must be finite, got {heading!r}, {yaw_rate!r}")
+    if not (math.isfinite(speed) and speed > 0.0):
+        raise ValueError(f"speed must be positive, got {speed!r}")
+    turn = yaw_rate * settings.cost_time_step
+    if turn == 0.0:
+        return np.zeros(targets.goal_count)
+    floor = targets.positions[:, :2] - position[:2]
+    has_bearing = np.hypot(floor[:, 0], floor[:, 1]) > NO_BEARING
+    error = _wrapped(np.arctan2(floor[:, 1], floor[:, 0]) - heading)
+    after = _wrapped(error - turn)
+    per_target = np.where(has_bearing, (np.abs(error) - np.abs(after)) / abs(turn), 0.0)
+    scale = (settings.translation_gain + settings.translation_constant) * speed * \
+        settings.cost_time_step
+    # A goal's turn evidence is its best target's (each goal has one in the position tasks).
+    return -scale * goal_minimum(-per_target, targets)[0]
+
+
+def _wrapped(angles):
+    return (np.asarray(angles) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def intent_evidence(settings, targets, position, move_velocity, speed, heading=None,
+                    yaw_rate=0.0, orientation=None, move_angular_velocity=None):
+    """One tick's `IntentEvidence`: the moves under the implicit command (`move_velocity`,
+    and with orientations `move_angular_velocity`; the caller passes the operator's command
+    while the operator acts, the hand's executed velocity while silent) and, for targets
+    without orientations and a `heading`, the turns of the operator's `yaw_rate`."""
+    moves = move_evidence(settings, targets, position, move_velocity, orientation,
+                          move_angular_velocity)
+    if targets.orientations is not None or heading is None:
+        return IntentEvidence(moves, np.zeros(targets.goal_count))
+    return IntentEvidence(moves, turn_evidence(settings, targets, position, heading,
+                                               yaw_rate, speed))
+
+
+def update_intent_posterior(settings, targets, log_belief, evidence):
+    """`log b_t = log b_{t-1} + l`, normalised, then clipped at `settings.max_probability`
+    (a `PosteriorUpdate`, whose `costs` is None)."""
+    log_belief = np.asarray(log_belief, dtype=float)
+    if log_belief.shape != (targets.goal_count,) or not np.isfinite(log_belief).all():
+        raise ValueError(f"log_belief must be {targets.goal_count} finite numbers, got "
+                         f"{log_belief!r}")
+    updated, clipped = clip_log_belief(log_normalised(log_belief + evidence.total),
+                                       settings.max_probability)
+    return PosteriorUpdate(updated, np.exp(updated), clipped, None)

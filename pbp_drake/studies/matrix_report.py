@@ -59,14 +59,19 @@ def _finite_count(records, method, key):
 
 
 def metric_interval(entry, key, count):
-    """`(mean, low, high)` of a method entry's metric: the mean's 95 % t interval over
-    `count` values, cut to the metric's range where it is known; low and high None with
-    fewer than two values, all None without a mean."""
+    """`(mean, low, high)` of a method entry's metric: the interval the entry holds, if it
+    holds one, else the mean's 95 % t interval over its `count` values (the entry's own
+    count where it has one), cut to the metric's range where it is known; low and high None
+    with fewer than two values, all None without a mean."""
     value = entry.get(key)
     if not isinstance(value, dict) or value.get("mean") is None:
         return None, None, None
-    within = _KNOWN[key][2] if key in _KNOWN else (-math.inf, math.inf)
-    interval = mean_interval(value["mean"], value["std"], count, within)
+    if "interval" in value:
+        interval = value["interval"]
+    else:
+        within = _KNOWN[key][2] if key in _KNOWN else (-math.inf, math.inf)
+        interval = mean_interval(value["mean"], value["std"], value.get("count", count),
+                                 within)
     return (value["mean"], *(interval or (None, None)))
 
 

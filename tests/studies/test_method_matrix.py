@@ -15,10 +15,13 @@ import textwrap
 import time
 import importlib.util
 
+import numpy as np
 import pytest
 import scipy.stats
 
+from pbp_drake.builder.run import TaskResult
 from pbp_drake.cli import main
+from pbp_drake.studies.comparison import run_method_matrix
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.studies.trial_files import scenario_hash
 from pbp_drake.studies.matrix import pilot_folder
@@ -118,6 +121,37 @@ def test_a_pilot_folder_of_another_pilot_is_refused_before_anything_is_written(
     assert main(matrix_args(task_file, matrix)) == 2
     assert f"{laggy} holds a study of another scenario" in capsys.readouterr().err
     assert {path: path.read_bytes() for path in matrix.rglob("*") if path.is_file()} == before
+
+
+def process_run(resolved):
+    """A trial's result without a simulation, its task time the id of the process that
+    ran it (a little later, so that both workers take trials)."""
+    time.sleep(0.2)
+    ticks = 3
+    return TaskResult(
+        success=True, task_time=float(os.getpid()), intervention_ratio=0.5, switches=0,
+        times=0.03 * np.arange(ticks), ee_positions=np.zeros((ticks, 3)),
+        headings=np.zeros(ticks), commands=np.zeros((ticks, 7)),
+        operator_active=np.zeros(ticks, bool), operator_commands=np.zeros((ticks, 4)),
+        selected_goals=np.zeros(ticks, int), targets=np.zeros(ticks, int),
+        objects=np.zeros((2, 3)), collision_ratio=0.0, in_collision=np.zeros(ticks, bool))
+
+
+def test_every_pilots_trials_run_in_one_pool_of_workers(task_file, tmp_path):
+    # Three pilots' trials on --jobs 2: two worker processes in all, each taking trials of
+    # more than one pilot (pilot by pilot, each pilot would have had workers of its own).
+    scenario = load_scenario_file(task_file).scenario
+    pilots = ["attentive", "noisy", "laggy"]
+    run_method_matrix(scenario, ["teleop"], pilots, 2, SEED, tmp_path, jobs=2,
+                      run=process_run)
+    ran_by = {}
+    for pilot in pilots:
+        for seed in (SEED, SEED + 1):
+            record = json.loads((pilot_folder(tmp_path, pilot) / "trials" / "teleop"
+                                 / f"seed_{seed}.json").read_text())
+            ran_by.setdefault(int(record["task_time"]), set()).add(pilot)
+    assert len(ran_by) <= 2 and os.getpid() not in ran_by
+    assert max(len(taken) for taken in ran_by.values()) >= 2
 
 
 # ---------------------------------------------------------------------------------------------

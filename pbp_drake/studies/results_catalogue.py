@@ -38,7 +38,7 @@ IMPAIRED = ["diagrams/hsr_reach.yaml", "--methods",
 # Every method under every pilot of the registry (`scenarios.pilots`), on the evaluation
 # seeds; its tasks: name -> (scenario file, the arena page's title of it).
 ARENA = ["--methods", "pbp_alternated,pbp_continuous,hop,confidence_alpha,teleop",
-         "--pilots", ",".join(PILOT_NAMES), "--trials", "30", "--split", "evaluation"]
+         "--trials", "30", "--split", "evaluation", "--pilots", ",".join(PILOT_NAMES)]
 ARENA_TASKS = {"hsr_reach_arena": ("diagrams/hsr_reach.yaml", "Reaching"),
                "hsr_obstacles_arena": ("diagrams/hsr_obstacles.yaml", "Obstacles"),
                "hsr_grasp_arena": ("diagrams/hsr_grasp.yaml", "Grasping"),

@@ -3,7 +3,8 @@ matrices' summary.json: per task and pilot, which of the paper's claims about PB
 
 Each claim is a rule on 95 % intervals (`CLAIMS`), evaluated for every PBP method of the
 matrix, never a sentence typed by hand. A claim that compares with teleop compares the two
-means' t intervals (`intervals.mean_interval`, over the trials that ran); a claim on a
+means' t intervals (`intervals.mean_interval`, over the trials that ran, within the
+metric's range); a claim on a
 rate compares its Wilson interval with the bar. The verdict is *holds* when the whole
 interval is on the claim's side, *does not hold* when it is wholly on the other side, and
 *undecided* when the interval straddles the bar (too few trials to tell, or a difference
@@ -17,7 +18,7 @@ import pathlib
 
 from pbp_drake.scenarios import METHOD_NAMES
 from pbp_drake.studies.intervals import mean_interval, wilson_interval
-from pbp_drake.studies.matrix_report import FIGURE, matrix_command
+from pbp_drake.studies.matrix_report import FIGURE, matrix_command, metric_range
 from pbp_drake.studies.trial_files import write_atomically
 
 HOLDS, FAILS, UNDECIDED = "holds", "does not hold", "undecided"
@@ -98,8 +99,10 @@ def _ran(entry):
 
 
 def _mean_interval(entry, metric):
+    """The mean and its t interval over the trials that ran, within the metric's range."""
     value = entry.get(metric) or {}
-    return value.get("mean"), mean_interval(value.get("mean"), value.get("std"), _ran(entry))
+    return value.get("mean"), mean_interval(value.get("mean"), value.get("std"), _ran(entry),
+                                            metric_range(metric))
 
 
 def _rate_interval(entry, metric):

@@ -43,6 +43,12 @@ def mean_metrics(summary):
     return names
 
 
+def metric_range(key):
+    """The range a metric's values lie in (its interval is cut to it): the studies' own
+    where the metric is known, else the whole line."""
+    return _KNOWN[key][2] if key in _KNOWN else (-math.inf, math.inf)
+
+
 def metric_label(key):
     """A metric's name in the tables."""
     return _KNOWN[key][0] if key in _KNOWN else key.replace("_", " ")
@@ -69,9 +75,8 @@ def metric_interval(entry, key, count):
     if "interval" in value:
         interval = value["interval"]
     else:
-        within = _KNOWN[key][2] if key in _KNOWN else (-math.inf, math.inf)
         interval = mean_interval(value["mean"], value["std"], value.get("count", count),
-                                 within)
+                                 metric_range(key))
     return (value["mean"], *(interval or (None, None)))
 
 

@@ -110,7 +110,9 @@ API_GROUPS = {
     },
     "Studies and the console": {
         "run_method_comparison": "pbp_drake.studies.comparison",
+        "run_method_matrix": "pbp_drake.studies.comparison",
         "report": "pbp_drake.studies.report",
+        "report_matrix": "pbp_drake.studies.matrix_report",
         "load_task_result": "pbp_drake.studies.trial_files",
         "interaction_metrics": "pbp_drake.core.interaction_metrics",
         "InteractionMetrics": "pbp_drake.core.interaction_metrics",

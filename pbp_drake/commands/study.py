@@ -14,7 +14,9 @@ from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
     TASK_ROBOTS, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison,
     counted, load_scenario_file)
-from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
+from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
+from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
 from pbp_drake.studies.paired import (
     PAIRED_METRICS, paired_comparison, paired_table, paired_with, paired_with_markdown)
 from pbp_drake.studies.participant_report import is_participant_collection, participant_report
@@ -26,6 +28,7 @@ from pbp_drake.studies.results_markdown import (
     check_markdown_path, method_comparison_markdown, read_study_json, toy_markdown,
     write_markdown, write_toy_study)
 from pbp_drake.studies.splits import SPLITS, first_seed, split_of
+from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
 
 
@@ -36,6 +39,12 @@ def add_study_commands(commands):
     study.add_argument("--output", required=True, help="folder for summary.json and figures")
     study.add_argument("--methods", help="comma-separated methods to compare (HSR tasks)")
     study.add_argument("--trials", type=int, help="seeded scenes per method (HSR tasks)")
+    study.add_argument("--pilots", type=method_list, metavar="P1,P2,...",
+                       help="HSR tasks: run every method under each of these operators, "
+                       f"of {', '.join(PILOT_NAMES)} ({ATTENTIVE}: the scenario's own virtual "
+                       "participant), on the same seeds, into one folder (a subfolder per "
+                       "pilot under OUTPUT/pilots); its summary.json holds "
+                       "\"pilots\": {NAME: {\"methods\": ...}}")
     study.add_argument("--split", choices=SPLITS,
                        help="HSR tasks: run the study's tuning or evaluation seeds (default: "
                             "the study's `split`)")
@@ -66,7 +75,10 @@ def add_study_commands(commands):
         "trial files, without simulating; damaged or foreign files are named on stderr and "
         "skipped (exit 1 when there were any, or when trials failed with an error or did not "
         "run, as `study` does; 2 when there is nothing to report)")
-    report.add_argument("output", help="the --output folder of `pbp-drake study`, or a user "
+    report.add_argument("output", help="the --output folder of `pbp-drake study` (of a "
+                        "matrix, with --pilots: its method x pilot tables with 95 %% "
+                        "intervals, every method paired with PBP-Alt per pilot, and "
+                        f"{MATRIX_FIGURE}, a panel per pilot), or a user "
                         "study's folder of participant folders (`pbp-drake run --participant "
                         "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
                         "Wilcoxon tests and Fig. 8 in DIR/results.md and "
@@ -75,7 +87,8 @@ def add_study_commands(commands):
                         help="also compare every other method of the study with METHOD "
                         "(e.g. pbp_alternated), seed by seed: per metric the paired "
                         "difference and its 95 %% interval, as `compare` does between two "
-                        "studies (printed, and in --markdown's file)")
+                        "studies (printed, and in --markdown's file); for a matrix, the "
+                        "method every other is paired with (default pbp_alternated)")
     report.add_argument("--markdown", metavar="FILE",
                         help="also write the study's results table as a Markdown fragment "
                         "to FILE (its folder is created), after a line naming the command "
@@ -99,6 +112,9 @@ def _study(args):
     check_buildable(scenario_file.resolved)
     if isinstance(scenario_file.scenario.robot, TASK_ROBOTS):
         return _method_study(args, scenario_file)
+    if args.pilots is not None:
+        raise ScenarioError(f"--pilots: {args.scenario} is a 2-D study, which has no "
+                            "virtual participant; the HSR tasks' studies take it")
     if args.participant_condition is not None:
         raise ScenarioError(f"--participant-condition {args.participant_condition}: "
                             f"{args.scenario} is a 2-D study, which has no virtual "
@@ -138,6 +154,12 @@ def with_participant_condition(scenario, name, scenario_path):
 
 def _method_study(args, scenario_file):
     scenario = scenario_file.scenario
+    if args.pilots is not None:
+        check_pilots(args.pilots)
+        if args.participant_condition is not None:
+            raise ScenarioError("--participant-condition and --pilots: give one (the "
+                                "condition impairs the scenario's own participant; "
+                                "--pilots replaces it)")
     if args.participant_condition is not None:
         scenario = with_participant_condition(scenario, args.participant_condition,
                                               args.scenario)
@@ -163,9 +185,15 @@ def _method_study(args, scenario_file):
     except ScenarioError as error:
         raise ScenarioError(f"{error} (after the command-line overrides)") from None
     output = pathlib.Path(args.output)
-    total = len(study.methods) * study.trials
+    pilots = args.pilots or []
+    if pilots:
+        for pilot in pilots:  # a pilot the scenario cannot take stops here, nothing written
+            with_pilot(scenario, pilot)
+    total = len(study.methods) * study.trials * max(1, len(pilots))
     condition_words = ("" if args.participant_condition is None else
                        f", the {args.participant_condition} virtual participant")
+    if pilots:
+        condition_words = f", under the pilots {', '.join(pilots)}"
     print(f"Study {scenario.name}: {', '.join(study.methods)}, "
           f"{counted(study.trials, 'trial')} each ({split} seeds {seed} to "
           f"{seed + study.trials - 1}){condition_words},"
@@ -180,15 +208,19 @@ def _method_study(args, scenario_file):
         bar(done, total_now, record, elapsed)
 
     started = time.monotonic()
+    options = dict(jobs=args.jobs, split=split, retry_errors=args.retry_errors,
+                   backend=args.backend, ray_address=args.ray_address,
+                   scenario_file=args.scenario,
+                   split_seeds={split_name: first_seed(study, split_name)
+                                for split_name in SPLITS})
     try:
-        summary = run_method_comparison(scenario, study.methods, study.trials,
-                                        seed, output, progress, jobs=args.jobs, split=split,
-                                        retry_errors=args.retry_errors,
-                                        backend=args.backend, ray_address=args.ray_address,
-                                        scenario_file=args.scenario,
-                                        split_seeds={split_name: first_seed(study, split_name)
-                                                     for split_name in SPLITS},
-                                        participant_condition=args.participant_condition)
+        if pilots:
+            summary = run_method_matrix(scenario, study.methods, pilots, study.trials, seed,
+                                        output, progress, **options)
+        else:
+            summary = run_method_comparison(
+                scenario, study.methods, study.trials, seed, output, progress,
+                participant_condition=args.participant_condition, **options)
     except KeyboardInterrupt:
         print(f"\nInterrupted: the finished trials are in {output / 'trials'}; the same "
               "command resumes the study.", file=sys.stderr)
@@ -196,21 +228,39 @@ def _method_study(args, scenario_file):
     reused = total - len(runs)
     print(f"Ran {counted(len(runs), 'trial')} in {time.monotonic() - started:.1f} s"
           + (f"; {reused} were already on disk." if reused else "."), flush=True)
+    if pilots:
+        _print_matrix_report(summary, output)
+        return _failed_matrix_trials(summary, output)
     _print_report(summary, output)
     return _failed_trials(summary, output)
 
 
-def _failed_trials(summary, output):
+def _failed_trials(summary, output, where=None):
     """1, with a line on stderr, when trials recorded an error or did not run (a trial
     that ran but missed its target is a result, not an error); else 0."""
     errors = sum(entry["errors"] for entry in summary["methods"].values())
     missing = sum(entry["missing"] for entry in summary["methods"].values())
     if not errors and not missing:
         return 0
-    print(f"{errors} of {summary['trials'] * len(summary['methods'])} trials failed with an "
+    print(f"{errors} of {summary['trials'] * len(summary['methods'])} trials"
+          + ("" if where is None else f" {where}") + " failed with an "
           f"error (in the `error` field of their {output / 'trials'}/METHOD/seed_SEED.json)"
           + (f" and {missing} did not run" if missing else "") + ".", file=sys.stderr)
     return 1
+
+
+def _failed_matrix_trials(summary, output):
+    """`_failed_trials` of each pilot of a matrix: 1 when any pilot's are."""
+    failed = [_failed_trials({**summary, **pilot}, pilot_folder(output, name),
+                             f"under the pilot {name}")
+              for name, pilot in summary["pilots"].items()]
+    return max(failed)
+
+
+def _print_matrix_report(summary, output):
+    print((output / "results.md").read_text(), end="")
+    for name in ("summary.json", "results.md", "trials.json", MATRIX_FIGURE):
+        print(f"  wrote {output / name}")
 
 
 def _print_report(summary, output):
@@ -266,6 +316,8 @@ def _report(args):
             print(f"pbp-drake: {damaged} damaged files skipped (listed above)",
                   file=sys.stderr)
         return 1 if damaged else 0
+    if folder_kind(output) == MATRIX:
+        return _report_matrix(args, output)
     summary = report(output)
     _print_report(summary, output)
     paired = None
@@ -281,6 +333,24 @@ def _report(args):
             read_study_json(output), summary) + ("" if paired is None else "\n" + paired))
         print(f"  wrote {args.markdown}")
     failed = _failed_trials(summary, output)
+    if summary["damaged"]:
+        print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
+              f"(listed above and in {output / 'summary.json'})", file=sys.stderr)
+        return 1
+    return failed
+
+
+def _report_matrix(args, output):
+    """`report` of a matrix folder: its tables (every method paired with --paired-with,
+    default PBP-Alt), figure and, with --markdown, the tables after the command."""
+    try:
+        summary = report_matrix(output, args.paired_with, args.markdown)
+    except ValueError as error:
+        raise ScenarioError(f"--paired-with: {error}") from None
+    _print_matrix_report(summary, output)
+    if args.markdown is not None:
+        print(f"  wrote {args.markdown}")
+    failed = _failed_matrix_trials(summary, output)
     if summary["damaged"]:
         print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
               f"(listed above and in {output / 'summary.json'})", file=sys.stderr)

@@ -17,7 +17,12 @@ One job per module:
   study), so neither is written into the other's folder;
 - `runners`: one trial (run, or computed without the disk) and the local process pool;
 - `ray_backend`: the same trials as Ray tasks (Ray is imported only when asked for);
-- `comparison`: `run_method_comparison`, which trials to run, where, then the report;
+- `comparison`: `run_method_comparison` and `run_method_matrix`, which trials to run,
+  where, then the report;
+- `matrix`: the folder of every method under every pilot (`comparison.run_method_matrix`
+  runs it, all pilots' trials in one pool): a study folder per pilot, its summary;
+- `matrix_report`: a matrix folder's summary, method x pilot tables and figure;
+- `arena_page`: the paper's claims as rules on intervals, per task and pilot, as a page;
 - `summary`: the summary of a study folder and the one definition of the ideal alpha;
 - `report`: `report(DIR)`, the summary, `results.md`, `trials.json` and the figures;
 - `progress`: the text progress bar;

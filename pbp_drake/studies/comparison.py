@@ -2,9 +2,12 @@
 
 `run_method_comparison` decides which trials still have to run (those not on disk for the
 same scenario), runs them in local processes (`--jobs`) or as Ray tasks (`--backend ray`),
-then rebuilds the summary, tables and figures from the files (`report`).
+then rebuilds the summary, tables and figures from the files (`report`). A matrix of
+methods and pilots (`studies.matrix`) prepares one such folder per pilot and runs all their
+trials together (`run_trials`): `run_method_matrix`.
 """
 
+import dataclasses
 import pathlib
 import pickle
 import time
@@ -16,6 +19,10 @@ from pbp_drake.studies.runners import failed_record, run_locally
 from pbp_drake.studies.trial_files import (
     StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, write_study)
 from pbp_drake.studies.folders import check_folder
+from pbp_drake.studies.matrix import (
+    check_matrix_folder, check_pilots, pilot_folder, write_matrix_study)
+from pbp_drake.studies.matrix_report import report_matrix
+from pbp_drake.scenarios.pilots import with_pilot
 
 BACKENDS = ("local", "ray")
 
@@ -45,14 +52,51 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     after each trial run now. `run(scenario) -> TaskResult` replaces `run_task` (it must be
     picklable when `jobs > 1`).
     """
+    check_run_options(jobs, backend, ray_address, run)
+    if trials < 1:
+        raise ScenarioError(f"trials must be at least 1, got {trials}")
+    folder = prepare_folder(scenario, methods, trials, seed, output, retry_errors, split,
+                            scenario_file, split_seeds, participant_condition)
+    run_trials([folder], jobs, progress, run, backend, ray_address)
+    return report(output)
+
+
+@dataclasses.dataclass
+class StudyFolder:
+    """One method comparison's folder, ready to run (`prepare_folder`): its scenario and
+    hash, its first seed and the (method, trial) keys of the trials still to run."""
+
+    scenario: object
+    digest: str
+    output: pathlib.Path
+    seed: int
+    pending: list
+
+
+def check_run_options(jobs, backend, ray_address, run):
+    """Raises ScenarioError for a bad number of jobs, backend or `run` (before any folder
+    is touched); imports Ray when it is asked for, so that its absence stops here too."""
     if not isinstance(jobs, int) or jobs < 1:
         raise ScenarioError(f"jobs must be a positive number of processes, got {jobs}")
     if backend not in BACKENDS:
         raise ScenarioError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
     if ray_address is not None and backend != "ray":
         raise ScenarioError("ray_address needs backend='ray'")
-    if trials < 1:
-        raise ScenarioError(f"trials must be at least 1, got {trials}")
+    if backend == "ray":
+        import_ray()  # fail before touching the folder when Ray is missing
+    if backend == "local" and jobs > 1 and run is not None:
+        try:
+            pickle.dumps(run)
+        except Exception as error:
+            raise ScenarioError(f"run={run!r} cannot be sent to worker processes ({error}): "
+                                "use a module-level function, or jobs=1") from None
+
+
+def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, split=None,
+                   scenario_file=None, split_seeds=None, participant_condition=None):
+    """Checks `output` (StudyFolderError when it holds another scenario's study), removes
+    what an interrupted study left, names the damaged trial files, writes study.json and
+    returns the StudyFolder with the trials still to run (see `run_method_comparison`)."""
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
     recorded = check_folder(output, scenario, digest, participant_condition)
@@ -62,32 +106,33 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     if recorded:
         scenario_file = scenario_file or recorded.get("scenario_file")
         split_seeds = split_seeds or recorded.get("split_seeds")
-    keys = [(method, trial) for method in methods for trial in range(trials)]
     for leftover in [*output.glob("trials/*/*.running"), *output.glob("trials/*/.*.tmp")]:
         leftover.unlink(missing_ok=True)  # left by an interrupted study
-    if backend == "ray":
-        import_ray()  # fail before touching the folder when Ray is missing
-    if backend == "local" and jobs > 1 and run is not None:
-        try:
-            pickle.dumps(run)
-        except Exception as error:
-            raise ScenarioError(f"run={run!r} cannot be sent to worker processes ({error}): "
-                                "use a module-level function, or jobs=1") from None
     pending, damaged = [], []
-    for method, trial in keys:
-        # A damaged trial file is not a finished trial: it is named, and runs again. A trial
-        # of another scenario refuses the folder (StudyFolderError).
-        before = len(damaged)
-        record = read_trial(output, method, seed + trial, digest, damaged, (method, trial))
-        if len(damaged) > before and "another scenario" in damaged[-1].problem:
-            raise StudyFolderError(f"{damaged[-1].path} is {damaged[-1].problem}: choose "
-                                   "another --output folder")
-        if record is None or (retry_errors and record["error"] is not None):
-            pending.append((method, trial))
+    for method in methods:
+        for trial in range(trials):
+            # A damaged trial file is not a finished trial: it is named, and runs again. A
+            # trial of another scenario refuses the folder (StudyFolderError).
+            before = len(damaged)
+            record = read_trial(output, method, seed + trial, digest, damaged,
+                                (method, trial))
+            if len(damaged) > before and "another scenario" in damaged[-1].problem:
+                raise StudyFolderError(f"{damaged[-1].path} is {damaged[-1].problem}: "
+                                       "choose another --output folder")
+            if record is None or (retry_errors and record["error"] is not None):
+                pending.append((method, trial))
     name_damaged([d._replace(problem=f"{d.problem}; runs again") for d in damaged])
     write_study(output, scenario, digest, methods, trials, seed, split, scenario_file,
                 split_seeds, participant_condition)
+    return StudyFolder(scenario, digest, output, seed, pending)
 
+
+def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_address=None):
+    """Runs the pending trials of every StudyFolder in one pool of `jobs` local processes,
+    or as Ray tasks, so that no worker waits for another folder's last trial; each trial's
+    files go to its folder. `progress(done, total, record, elapsed)` after each trial."""
+    pending = [(index, method, trial) for index, folder in enumerate(folders)
+               for method, trial in folder.pending]
     started = time.monotonic()
     done = []
 
@@ -97,18 +142,58 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
             progress(len(done), len(pending), record, time.monotonic() - started)
 
     def submit_args(key):
-        method, trial = key
-        return (scenario, method, trial, seed + trial, output, digest, run)
+        index, method, trial = key
+        folder = folders[index]
+        return (folder.scenario, method, trial, folder.seed + trial, folder.output,
+                folder.digest, run)
 
     def on_error(key, error):
-        method, trial = key
-        running_marker(output, method, seed + trial).unlink(missing_ok=True)
-        on_done(key, failed_record(scenario, digest, method, trial, seed + trial, error,
-                                   output))
+        index, method, trial = key
+        folder = folders[index]
+        running_marker(folder.output, method, folder.seed + trial).unlink(missing_ok=True)
+        on_done(key, failed_record(folder.scenario, folder.digest, method, trial,
+                                   folder.seed + trial, error, folder.output))
 
     if backend == "ray":
         if pending:
-            run_on_ray(pending, jobs, ray_address, submit_args, output, on_done, on_error)
+            run_on_ray(pending, jobs, ray_address, submit_args, on_done, on_error)
     else:
-        run_locally(pending, jobs, output, seed, submit_args, on_done, on_error)
-    return report(output)
+        run_locally(pending, jobs, submit_args, on_done, on_error)
+
+
+def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=None, jobs=1,
+                      run=None, retry_errors=False, backend="local", ray_address=None,
+                      split=None, scenario_file=None, split_seeds=None):
+    """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with every method under every
+    pilot (`scenarios.pilots`: `with_pilot(scenario, name)`), all in one pool of `jobs`
+    processes or Ray tasks, each pilot's trials into `output/pilots/NAME/`; then writes the
+    matrix's summary, table and figure (`matrix_report.report_matrix`) and returns the
+    summary. The arguments are `run_method_comparison`'s, plus the pilots' names; trials on
+    disk for the same scenario and pilot are not run again."""
+    check_pilots(pilots, "pilots")
+    check_run_options(jobs, backend, ray_address, run)
+    if trials < 1:
+        raise ScenarioError(f"trials must be at least 1, got {trials}")
+    pilot_scenarios = {pilot: with_pilot(scenario, pilot) for pilot in pilots}
+    output = pathlib.Path(output)
+    digest = scenario_hash(scenario)
+    recorded = check_matrix_folder(output, scenario, digest)
+    if recorded:
+        scenario_file = scenario_file or recorded.get("scenario_file")
+        split_seeds = split_seeds or recorded.get("split_seeds")
+        if split is None and (recorded.get("seed"), recorded.get("trials")) == (seed, trials):
+            split = recorded.get("split")
+    # Every pilot's folder is checked before any is written: a refused one stops the matrix
+    # with nothing changed.
+    for pilot, pilot_scenario in pilot_scenarios.items():
+        folder = pilot_folder(output, pilot)
+        if folder.is_dir():
+            check_folder(folder, pilot_scenario, scenario_hash(pilot_scenario))
+    write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split,
+                       scenario_file, split_seeds)
+    folders = [prepare_folder(pilot_scenario, methods, trials, seed,
+                              pilot_folder(output, pilot), retry_errors, split, scenario_file,
+                              split_seeds)
+               for pilot, pilot_scenario in pilot_scenarios.items()]
+    run_trials(folders, jobs, progress, run, backend, ray_address)
+    return report_matrix(output)

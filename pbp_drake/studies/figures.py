@@ -2,8 +2,9 @@
 study, with its final distances and operator speeds) and Fig. 4 (Alt vs Cont), and the
 method comparison's Fig. 7: (a) box plots of the intervention ratio, (b) of the task time,
 (c) the histogram of per-trial collision ratios, drawn only for tasks that measure
-collisions (the obstacle task; see `studies.report.figure_names`).
-Fig. 7 reads trial records (dicts from the trial files), never a simulation."""
+collisions (the obstacle task; see `studies.report.figure_names`); and a matrix of methods
+and pilots in one figure (`plot_pilot_panels`). They read trial records (dicts from the
+trial files) or summaries, never a simulation."""
 
 import matplotlib
 
@@ -97,6 +98,45 @@ def plot_collision_histogram(summary, path):
     axis.grid(axis="y", alpha=0.3)
     figure.tight_layout()
     figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def _error_bar(axis, x, interval, **style):
+    mean, low, high = interval
+    if mean is None:
+        return
+    error = None if low is None else [[mean - low], [high - mean]]
+    axis.errorbar([x], [mean], yerr=error, capsize=3, **style)
+
+
+def plot_pilot_panels(panels, path):
+    """A matrix of methods and pilots in one figure, a panel per pilot: each method's mean
+    intervention ratio (circles, left axis) and task time (squares, right axis) with their
+    95 % intervals. `panels`: `{pilot: [(method, (mean, low, high) of the intervention
+    ratio, the same of the task time)]}` (low and high None: no interval)."""
+    count = len(panels)
+    figure, axes = plt.subplots(1, count, figsize=(1.2 + 3.4 * count, 3.8), squeeze=False)
+    times = [t[0] for rows in panels.values() for _, _, t in rows if t[0] is not None]
+    highs = [t[2] for rows in panels.values() for _, _, t in rows if t[2] is not None]
+    time_top = 1.1 * max(times + highs) if times else 1.0
+    for axis, (pilot, rows) in zip(axes[0], panels.items()):
+        time_axis = axis.twinx()
+        for index, (method, ratio, time) in enumerate(rows):
+            colour = METHOD_COLOURS.get(method, "0.4")
+            _error_bar(axis, index - 0.12, ratio, fmt="o", color=colour)
+            _error_bar(time_axis, index + 0.12, time, fmt="s", color=colour, mfc="white")
+        axis.set_xticks(range(len(rows)), [_label(method) for method, _, _ in rows],
+                        rotation=30, ha="right", fontsize=8)
+        axis.set_xlim(-0.5, len(rows) - 0.5)
+        axis.set_ylim(-0.02, 1.05)
+        axis.set_ylabel("intervention ratio (circles)")
+        time_axis.set_ylim(0, time_top)
+        time_axis.set_ylabel("task time, s (squares)")
+        axis.set_title(f"pilot: {pilot}")
+        axis.grid(axis="y", alpha=0.3)
+    figure.suptitle("Every method under every pilot: means and 95 % intervals", fontsize=10)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
     plt.close(figure)
 
 

@@ -116,23 +116,46 @@ def paired_with(folder, reference, metrics=None):
     seed by seed (A: `reference`, B: the row's method), for the `metrics` named (default:
     every metric). Raises ValueError when the study did not run `reference`."""
     study, records, _ = read_study(folder)
+    return paired_rows_with(study, records, reference,
+                            measures_collisions(study, records, folder), metrics)
+
+
+def paired_rows_with(study, records, reference, collisions, metrics=None):
+    """`paired_with` of a study already read (`read_study`'s study and records;
+    `collisions`: whether its task measures them). A metric of `metrics` that is not one
+    of the known ones is read as the trial records' field of that name (how a trial metric
+    added later is paired without naming it here)."""
     if reference not in study["methods"]:
         raise ValueError(f"the study ran {', '.join(study['methods'])}, not {reference}")
-    collisions = measures_collisions(study, records, folder)
     reference_trials = _by_seed(study, records, reference)
+    known = {name for name, _, _ in _METRICS}
+    fields = tuple(name for name in metrics or () if name not in known)
     rows = []
     for method in [m for m in study["methods"] if m != reference]:
         rows += _paired_rows(method, reference_trials, _by_seed(study, records, method),
-                             collisions)
+                             collisions, fields)
     return [row for row in rows if metrics is None or row.metric in metrics]
 
 
-def _paired_rows(method, trials_a, trials_b, collisions):
+def _record_field(name):
+    """A reader of the records' field `name`: its number, None when it holds none (or not a
+    finite number, e.g. a list of values)."""
+    def read(record):
+        value = record.get(name)
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        return value if number and math.isfinite(value) else None
+    return read
+
+
+def _paired_rows(method, trials_a, trials_b, collisions, fields=()):
     """A row per metric of `method`'s trials B against A (`{seed: record}` each), over the
-    seeds both ran; a time only where both succeeded."""
+    seeds both ran; a time only where both succeeded. `fields`: more metrics, each read
+    as the records' field of its name."""
     seeds = sorted(set(trials_a) & set(trials_b))
     rows = []
-    for metric, read, needs_success in _METRICS:
+    for metric, read, needs_success in (*_METRICS,
+                                        *((name, _record_field(name), False)
+                                          for name in fields)):
         if metric in _COLLISION_METRICS and not collisions:
             continue
         values_a, values_b = [], []
@@ -154,7 +177,9 @@ def paired_table(rows, name_a="A", name_b="B"):
     lines = [f"| metric | method | pairs | {name_a} | {name_b} - {name_a} [95 % CI] | "
              f"SD of {name_a} | SE of {name_a} | within noise |",
              "|---|---|---|---|---|---|---|---|"]
-    for row in sorted(rows, key=lambda row: [m for m, _, _ in _METRICS].index(row.metric)):
+    order = [m for m, _, _ in _METRICS]
+    for row in sorted(rows, key=lambda row: (order.index(row.metric) if row.metric in order
+                                             else len(order))):
         verdict = ("yes (within SE too)" if row.within_se else "yes" if row.within_sd
                    else "**no**")
         lines.append(

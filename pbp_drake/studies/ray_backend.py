@@ -129,25 +129,31 @@ def _ray_error_text(ray, error):
     return f"{type(error).__name__}: {error}"
 
 
-def run_on_ray(pending, jobs, address, submit_args, output, on_done, on_error):
+def run_on_ray(pending, jobs, address, submit_args, on_done, on_error):
     """Runs `pending` trial keys as Ray tasks, at most `jobs` at once, and writes each
-    trial's files here as its task finishes; a task that fails is recorded as failed."""
+    trial's files here, into the folder `submit_args(key)` names, as its task finishes; a
+    task that fails is recorded as failed. Each distinct scenario (a matrix has one per
+    pilot) is sent to Ray once."""
     session = _RaySession(jobs, address)
     ray = session.ray
     running = {}
     try:
         task = ray.remote(num_cpus=1, max_retries=RAY_MAX_RETRIES)(_ray_trial)
-        scenario, *_, digest, run = submit_args(pending[0])
-        scenario_ref, run_ref = ray.put(scenario), ray.put(run)
+        run_ref = ray.put(submit_args(pending[0])[-1])
+        scenario_refs = {}  # id(scenario) -> its object ref
         queue = list(pending)
         while queue or running:
             while queue and len(running) < jobs:
                 key = queue.pop(0)
-                _, method, trial, seed, *_ = submit_args(key)
-                running[task.remote(scenario_ref, method, trial, seed, digest, run_ref)] = key
+                scenario, method, trial, seed, output, digest, _ = submit_args(key)
+                if id(scenario) not in scenario_refs:
+                    scenario_refs[id(scenario)] = ray.put(scenario)
+                ref = task.remote(scenario_refs[id(scenario)], method, trial, seed, digest,
+                                  run_ref)
+                running[ref] = key, output
             ready, _ = ray.wait(list(running), num_returns=1)
             for ref in ready:
-                key = running.pop(ref)
+                key, output = running.pop(ref)
                 try:
                     record, csv_text = ray.get(ref)
                 except Exception as error:  # the task failed: record it, go on

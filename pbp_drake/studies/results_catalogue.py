@@ -3,6 +3,8 @@
 `--jobs 2`, and writes its table with `pbp-drake report DIR --markdown
 docs/results/generated/NAME.md`. The first line of each generated file is the command below
 (read back from the study folder), so a table on the docs site cannot drift from what made it.
+The matrices of every method under every pilot (`ARENA_STUDIES`) also make the arena page,
+docs/results/arena.md (`studies.arena_page`), from their summaries.
 
 A study interrupted part-way resumes from the trials on disk when this runs again.
 """
@@ -12,6 +14,9 @@ import pathlib
 import shutil
 import subprocess
 import sys
+
+from pbp_drake.scenarios.pilots import PILOT_NAMES
+from pbp_drake.studies.arena_page import write_arena_page
 
 REACH = ["diagrams/hsr_reach.yaml", "--methods",
          "pbp_alternated,pbp_continuous,confidence_alpha,teleop", "--trials", "30"]
@@ -29,6 +34,15 @@ BASELINES = ["--methods", f"pbp_alternated,pbp_continuous,{BASELINE_METHODS},tel
 IMPAIRED = ["diagrams/hsr_reach.yaml", "--methods",
             f"pbp_alternated,pbp_continuous,{BASELINE_METHODS},teleop",
             "--trials", "30", "--split", "evaluation"]
+
+# Every method under every pilot of the registry (`scenarios.pilots`), on the evaluation
+# seeds; its tasks: name -> (scenario file, the arena page's title of it).
+ARENA = ["--methods", "pbp_alternated,pbp_continuous,hop,confidence_alpha,teleop",
+         "--trials", "30", "--split", "evaluation", "--pilots", ",".join(PILOT_NAMES)]
+ARENA_TASKS = {"hsr_reach_arena": ("diagrams/hsr_reach.yaml", "Reaching"),
+               "hsr_obstacles_arena": ("diagrams/hsr_obstacles.yaml", "Obstacles"),
+               "hsr_grasp_arena": ("diagrams/hsr_grasp.yaml", "Grasping"),
+               "arm_reach_arena": ("diagrams/arm_reach.yaml", "Reaching with the arm")}
 
 #: name -> the arguments of `pbp-drake study` (without --output and --jobs).
 STUDIES = {
@@ -66,7 +80,12 @@ STUDIES = {
                                      "--trials", "30", "--split", "tuning"],
     **{f"hsr_reach_{condition}": [*IMPAIRED, "--participant-condition", condition]
        for condition in ("noisy", "late", "mistaken")},
+    # Every method under every pilot (docs/results/arena.md).
+    **{name: [scenario, *ARENA] for name, (scenario, _) in ARENA_TASKS.items()},
 }
+
+#: The matrices of the arena page: name -> the page's title of the task.
+ARENA_STUDIES = {name: title for name, (_, title) in ARENA_TASKS.items()}
 
 
 #: Studies whose page compares every method with PBP-Alt seed by seed and shows the study's
@@ -75,6 +94,8 @@ STUDIES = {
 PAIRED_WITH_PBP_ALT = ("hsr_reach_baselines", "hsr_obstacles_baselines",
                        "hsr_grasp_baselines")
 DOCS_FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png")
+# A matrix's one figure (`studies.matrix_report`), copied beside its table as NAME_pilots.png.
+MATRIX_FIGURE = "pilots.png"
 
 
 def with_trials(arguments, trials):
@@ -105,6 +126,9 @@ def main(argv=None):
     parser.add_argument("--generated", default="docs/results/generated",
                         help="the Markdown goes to GENERATED/NAME.md (default "
                              "docs/results/generated)")
+    parser.add_argument("--arena", default="docs/results/arena.md",
+                        help="the page of the matrices' claims, written when one of "
+                             f"{', '.join(ARENA_STUDIES)} runs (default docs/results/arena.md)")
     parser.add_argument("--jobs", type=int, default=2, help="processes per study (default 2)")
     parser.add_argument("--trials", type=int,
                         help="for a quick check only: this many trials per HSR method")
@@ -129,6 +153,12 @@ def main(argv=None):
         if paired and reported == 0:
             for figure in DOCS_FIGURES:
                 shutil.copyfile(output / figure, markdown.with_name(f"{name}_{figure}"))
+        if name in ARENA_STUDIES and reported in (0, 1):
+            shutil.copyfile(output / MATRIX_FIGURE,
+                            markdown.with_name(f"{name}_{MATRIX_FIGURE}"))
+    if any(name in ARENA_STUDIES for name in args.names or STUDIES):
+        write_arena_page(ARENA_STUDIES, args.outputs, args.generated, args.arena)
+        print(f"  wrote {args.arena}")
     for line in failed:
         print(f"results: {line}", file=sys.stderr)
     return 1 if failed else 0

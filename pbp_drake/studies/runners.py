@@ -112,9 +112,16 @@ def failed_record(scenario, digest, method, trial, seed, error, output):
 # Local processes
 
 
-def run_locally(pending, jobs, output, seed, submit_args, on_done, on_error):
-    """Runs `pending` (method, trial) keys here (`jobs == 1`) or in a pool of `jobs`
-    processes; `submit_args(key)` gives `run_trial`'s arguments."""
+def trial_marker(arguments):
+    """The running marker of the trial that `run_trial(*arguments)` runs."""
+    scenario, method, trial, seed, output, *_ = arguments
+    return running_marker(output, method, seed)
+
+
+def run_locally(pending, jobs, submit_args, on_done, on_error):
+    """Runs the `pending` trial keys here (`jobs == 1`) or in one pool of `jobs` processes,
+    whatever folder each trial goes to; `submit_args(key)` gives `run_trial`'s
+    arguments."""
     if jobs == 1:
         for key in pending:
             on_done(key, run_trial(*submit_args(key)))
@@ -127,12 +134,12 @@ def run_locally(pending, jobs, output, seed, submit_args, on_done, on_error):
         unfinished = _run_in_pool(queue, min(jobs, len(queue)), submit_args, on_done,
                                   on_error)
         started_keys = [key for key, _ in unfinished
-                        if running_marker(output, key[0], seed + key[1]).exists()]
+                        if trial_marker(submit_args(key)).exists()]
         if unfinished and not started_keys:
             started_keys = [key for key, _ in unfinished]  # died before any trial began
         queue = [key for key, _ in unfinished if key not in started_keys]
         for key in started_keys:
-            marker = running_marker(output, key[0], seed + key[1])
+            marker = trial_marker(submit_args(key))
             marker.unlink(missing_ok=True)
             for _, error in _run_in_pool([key], 1, submit_args, on_done, on_error):
                 if not marker.exists():

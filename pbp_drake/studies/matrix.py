@@ -1,0 +1,134 @@
+"""The folder of every method under every pilot (`pbp-drake study FILE --methods ...
+--pilots attentive,noisy,...`, run by `comparison.run_method_matrix`): its layout, its
+study.json, and its summary read from the pilots' trial files.
+
+A matrix folder `DIR` holds one method comparison per pilot, each a whole study folder of
+its own (its study.json, hash and trials: `pbp-drake report DIR/pilots/NAME` reports one
+pilot alone):
+
+    DIR/study.json              the matrix: scenario and hash, methods, pilots, trials, seeds
+    DIR/pilots/<pilot>/...      the study of every method under that pilot
+    DIR/summary.json, DIR/results.md, DIR/trials.json, DIR/pilots.png
+                                rebuilt from the files above (`studies.matrix_report`)
+
+Trial i of every method under every pilot runs seed `seed + i` (the pilots draw their own
+randomness from it), so every comparison is paired. The trials of all pilots run in one
+pool (`comparison.run_trials`): no worker waits for a pilot's last trial. Each pilot's
+folder checks its own scenario's hash (the pilot is part of it), and study.json the
+scenario's: a matrix folder resumes only the same scenario, pilot by pilot.
+"""
+
+import json
+import pathlib
+
+from pbp_drake.scenarios import ScenarioError
+from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name
+from pbp_drake.studies.folders import folder_kind
+from pbp_drake.studies.summary import summarize
+from pbp_drake.studies.trial_files import (
+    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study, write_atomically)
+
+MATRIX = "method_matrix"
+PILOTS_FOLDER = "pilots"
+# Summary fields every pilot's study shares with the matrix: said once, at its top.
+_SHARED = ("study", "scenario", "trials", "seed", "split", "seeds", "measures_collisions",
+           "collision_histogram_edges")
+
+
+def pilot_folder(output, pilot):
+    """The study folder of one pilot in a matrix folder."""
+    return pathlib.Path(output) / PILOTS_FOLDER / pilot
+
+
+def check_pilots(pilots, option="--pilots"):
+    """Raises ScenarioError for an unknown pilot (with did-you-mean), a pilot named twice
+    or no pilot at all."""
+    if not pilots:
+        raise ScenarioError(f"{option}: name at least one of {', '.join(PILOT_NAMES)}")
+    for pilot in pilots:
+        check_pilot_name(pilot, option)
+    if len(set(pilots)) != len(pilots):
+        raise ScenarioError(f"{option} {','.join(pilots)} names a pilot twice")
+
+
+def check_matrix_folder(output, scenario, digest):
+    """Raises StudyFolderError when `output` holds another kind of study, or a matrix of
+    another scenario. Returns its readable study.json as a dict, or None."""
+    kind = folder_kind(output)
+    if kind is not None and kind != MATRIX:
+        raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a matrix of "
+                               "methods and pilots: choose another --output folder")
+    try:
+        study = json.loads((pathlib.Path(output) / "study.json").read_text())
+    except (OSError, ValueError):
+        return None  # none yet, or damaged: written again
+    if not isinstance(study, dict):
+        return None
+    if study.get("scenario_hash") != digest:
+        raise StudyFolderError(
+            f"{output} holds a matrix of another scenario ({study.get('scenario')!r}, hash "
+            f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}): "
+            "choose another --output folder")
+    return study
+
+
+def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split=None,
+                       scenario_file=None, split_seeds=None):
+    """Writes a matrix folder's study.json (each pilot's folder has its own)."""
+    study = {"study": MATRIX, "format": TRIAL_FORMAT, "scenario": scenario.name,
+             "scenario_hash": digest, "methods": list(methods), "pilots": list(pilots),
+             "trials": trials, "seed": seed, "split": split}
+    if scenario_file is not None:
+        study["scenario_file"] = str(scenario_file)
+    if split_seeds is not None:
+        study["split_seeds"] = dict(split_seeds)
+    write_atomically(pathlib.Path(output) / "study.json", json.dumps(study, indent=2) + "\n")
+
+
+def read_matrix_study(output):
+    """A matrix folder's study.json. Raises StudyFolderError when it is missing, damaged or
+    not a matrix's."""
+    path = pathlib.Path(output) / "study.json"
+    try:
+        study = json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        raise StudyFolderError(f"{path}: cannot be read as a matrix's study ({error})") from None
+    pilots = study.get("pilots") if isinstance(study, dict) else None
+    if (not isinstance(study, dict) or study.get("study") != MATRIX
+            or not isinstance(pilots, list) or not all(isinstance(p, str) for p in pilots)):
+        raise StudyFolderError(f"{path}: not the study.json of a matrix of methods and pilots")
+    return study
+
+
+def read_matrix(output):
+    """The matrix's study.json and, per pilot in its order, `(study, records, damaged)` of
+    that pilot's folder (`trial_files.read_study`; damaged files are named on stderr)."""
+    study = read_matrix_study(output)
+    pilots = {}
+    for pilot in study["pilots"]:
+        pilots[pilot] = read_study(pilot_folder(output, pilot))
+        name_damaged(pilots[pilot][2])
+    return study, pilots
+
+
+def summarize_matrix(study, pilots, output):
+    """The matrix's summary: the fields every pilot's study shares (scenario, trials,
+    seeds, split, whether collisions are measured), then `"pilots": {NAME: that pilot's
+    summary without them}` (its `methods` as in a study's summary.json, whatever their
+    entries hold), and every damaged file, relative to `output`."""
+    summary = {"study": MATRIX, "scenario": study["scenario"],
+               "scenario_hash": study["scenario_hash"]}
+    damaged = []
+    for pilot, (pilot_study, records, broken) in pilots.items():
+        folder = pilot_folder(output, pilot)
+        pilot_summary = summarize(pilot_study, records, broken, folder)
+        if "trials" not in summary:
+            summary.update({key: pilot_summary[key] for key in _SHARED[2:]
+                            if key in pilot_summary})
+        summary.setdefault("pilots", {})[pilot] = {
+            key: value for key, value in pilot_summary.items()
+            if key not in _SHARED and key != "damaged"}
+        damaged += [{**item, "file": f"{PILOTS_FOLDER}/{pilot}/{item['file']}"}
+                    for item in pilot_summary["damaged"]]
+    summary["damaged"] = damaged
+    return summary

@@ -76,6 +76,12 @@ STUDIES = {
     "arm_reach_evaluation": ["diagrams/arm_reach.yaml", "--methods",
                              f"pbp_alternated,pbp_continuous,{BASELINE_METHODS},teleop",
                              "--trials", "30", "--split", "evaluation"],
+    # The same with a participant that never moves the hand to where the tool can point
+    # (docs/results/arm.md shows both).
+    "arm_reach_without_repositioning": [
+        "diagrams/arm_reach_without_repositioning.yaml", "--methods",
+        f"pbp_alternated,pbp_continuous,{BASELINE_METHODS},teleop", "--trials", "30",
+        "--split", "evaluation"],
     "arm_reach_teleop_calibration": ["diagrams/arm_reach.yaml", "--methods", "teleop",
                                      "--trials", "30", "--split", "tuning"],
     **{f"hsr_reach_{condition}": [*IMPAIRED, "--participant-condition", condition]

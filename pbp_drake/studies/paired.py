@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from pbp_drake.scenarios import METHOD_NAMES
-from pbp_drake.studies.summary import measures_collisions
+from pbp_drake.studies.summary import TRIAL_VALUE, measures_collisions
 from pbp_drake.studies.trial_files import read_study
 
 # Metrics that only a task with obstacles measures.
@@ -123,8 +123,9 @@ def paired_with(folder, reference, metrics=None):
 def paired_rows_with(study, records, reference, collisions, metrics=None):
     """`paired_with` of a study already read (`read_study`'s study and records;
     `collisions`: whether its task measures them). A metric of `metrics` that is not one
-    of the known ones is read as the trial records' field of that name (how a trial metric
-    added later is paired without naming it here)."""
+    of the known ones is read as the trial records' field of that name, or of the name
+    `summary.TRIAL_VALUE` gives it (how a trial metric added later is paired without
+    naming it here)."""
     if reference not in study["methods"]:
         raise ValueError(f"the study ran {', '.join(study['methods'])}, not {reference}")
     reference_trials = _by_seed(study, records, reference)
@@ -154,8 +155,8 @@ def _paired_rows(method, trials_a, trials_b, collisions, fields=()):
     seeds = sorted(set(trials_a) & set(trials_b))
     rows = []
     for metric, read, needs_success in (*_METRICS,
-                                        *((name, _record_field(name), False)
-                                          for name in fields)):
+                                        *((name, _record_field(TRIAL_VALUE.get(name, name)),
+                                           False) for name in fields)):
         if metric in _COLLISION_METRICS and not collisions:
             continue
         values_a, values_b = [], []

@@ -115,8 +115,9 @@ def mean_with_interval(values, within):
     return entry
 
 
-# What each interaction metric's summary entry is made of: a trial's field.
-_TRIAL_VALUE = {"time_to_prediction": "mean_time_to_prediction"}
+#: The trial field a summary entry is the mean of, where the two names differ (a trial's
+#: `time_to_prediction` lists one latency per switch; its mean is the value summarized).
+TRIAL_VALUE = {"time_to_prediction": "mean_time_to_prediction"}
 
 
 def interaction_entries(ran):
@@ -127,7 +128,7 @@ def interaction_entries(ran):
     before it) has no entry."""
     entries = {}
     for name, _, _, within in INTERACTION_MEANS:
-        field = _TRIAL_VALUE.get(name, name)
+        field = TRIAL_VALUE.get(name, name)
         if any(field in record for record in ran):
             entries[name] = mean_with_interval([r.get(field) for r in ran], within)
     if "time_to_prediction" in entries:

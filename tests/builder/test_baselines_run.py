@@ -43,8 +43,9 @@ def test_the_baselines_reach_the_target_without_dmps(repo, method):
         find_system(diagram, "dmp_bank")
     result = run_task(resolved, diagram=diagram)
     assert result.success and result.switches == 2
-    # The participant drives the whole way, the forward key enabled, as in teleop.
-    assert result.intervention_ratio > 0.8
+    # The keys are teleop's; the participant presses where the robot does not serve its
+    # target and lets it go where it does, so it acts on some ticks, not all.
+    assert 0.0 < result.intervention_ratio < 1.0
     # The estimate the trial CSV records ends on the final target.
     assert result.selected_goals[-1] == result.targets[-1]
     assert 0.0 <= result.posterior_clipped_ratio <= 1.0

@@ -14,6 +14,7 @@ controller as one block each), top to bottom, so that it reads at a page's width
 """
 
 import argparse
+import itertools
 import pathlib
 import re
 import shutil
@@ -101,7 +102,30 @@ def render_svg(source):
 def scenario_svg(scenario, max_depth=1):
     """The SVG bytes of the diagram `build_diagram(scenario)` builds, as `pbp-drake draw`
     draws it (`max_depth` levels, None for all; top to bottom)."""
-    return render_svg(dot_source(build_diagram(scenario), max_depth, top_to_bottom=True))
+    return _narrowest(dot_source(build_diagram(scenario), max_depth, top_to_bottom=True))
+
+
+_RANK = re.compile(r"^\{rank=same; s\d+; s\d+\}\n", re.M)
+_WIDTH = re.compile(rb'<svg width="([\d.]+)pt"')
+
+
+def _narrowest(source):
+    """`render_svg(source)` with the set of source-beside-its-reader ranks
+    (`_sources_beside_their_reader`, a handful) that draws narrowest: a row already full
+    (the operator's, beside the station) only grows with a source in it. Ties keep more
+    ranks."""
+    ranks = _RANK.findall(source)
+    best = None
+    for dropped in range(len(ranks) + 1):
+        for subset in itertools.combinations(ranks, dropped):
+            trial = source
+            for rank in subset:
+                trial = trial.replace(rank, "", 1)
+            svg = render_svg(trial)
+            width = float(_WIDTH.search(svg).group(1))
+            if best is None or width < best[0]:
+                best = (width, svg)
+    return best[1]
 
 
 def default_output(scenario_path):
@@ -151,7 +175,7 @@ def main(argv=None):
             data = source.encode()
         else:
             try:
-                data = render_svg(source)
+                data = _narrowest(source)
             except RuntimeError as error:
                 print(f"pbp-drake draw: {error}", file=sys.stderr)
                 return 2

@@ -123,6 +123,8 @@ class ReachSceneVisualizer(LeafSystem):
         return self._probabilities_port
 
     def _initialise(self, context):
+        # Whether the blue ball is drawn: a method that shows no intent (teleop) sends -1.
+        self._ball_shown = True
         self._draw_scene()
         self._publish(context)
         if self._prediction_steps:
@@ -160,8 +162,11 @@ class ReachSceneVisualizer(LeafSystem):
         meshcat.SetTransform("/task/target",
                              RigidTransform(target + [0, 0, TARGET_LIFT]), time)
         selected = int(self._selected_goal_port.Eval(context)[0])
-        # -1: the method shows no intent (teleop), and the page no blue ball.
-        meshcat.SetProperty("/task/estimated_goal", "visible", selected >= 0, time)
+        if (selected >= 0) != self._ball_shown:
+            # -1: the method shows no intent (teleop), and the page no blue ball; sent only
+            # when that changes, so that a page's messages do not grow.
+            self._ball_shown = selected >= 0
+            meshcat.SetProperty("/task/estimated_goal", "visible", self._ball_shown, time)
         if selected >= 0:
             meshcat.SetTransform(
                 "/task/estimated_goal",

@@ -332,12 +332,7 @@ def _report(args):
         write_markdown(args.markdown, method_comparison_markdown(
             read_study_json(output), summary) + ("" if paired is None else "\n" + paired))
         print(f"  wrote {args.markdown}")
-    failed = _failed_trials(summary, output)
-    if summary["damaged"]:
-        print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
-              f"(listed above and in {output / 'summary.json'})", file=sys.stderr)
-        return 1
-    return failed
+    return _report_status(summary, output, _failed_trials(summary, output))
 
 
 def _report_matrix(args, output):
@@ -350,7 +345,12 @@ def _report_matrix(args, output):
     _print_matrix_report(summary, output)
     if args.markdown is not None:
         print(f"  wrote {args.markdown}")
-    failed = _failed_matrix_trials(summary, output)
+    return _report_status(summary, output, _failed_matrix_trials(summary, output))
+
+
+def _report_status(summary, output, failed):
+    """`report`'s exit code: 1 with a line on stderr when files were damaged or foreign,
+    else `failed` (the failed trials' code)."""
     if summary["damaged"]:
         print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
               f"(listed above and in {output / 'summary.json'})", file=sys.stderr)

@@ -32,9 +32,10 @@ import numpy as np
 
 from pbp_drake.robots.hsr_model import PACKAGE_NAME, models_dir
 
-# Our arm's file is 20 KB and a model of a few hundred links a few MB: a larger file is
-# not a robot, and reading it would take the time and memory the checks are to spare.
-MAX_MODEL_FILE_BYTES = 20_000_000
+# Our arm's file is 20 KB, and a robot of a few hundred links well under 1 MB. The checks
+# are pure Python: a file of 2 MB (8,000 links) takes them 1.7 s on a loaded machine, the
+# most the 2 s they are promised in leaves.
+MAX_MODEL_FILE_BYTES = 2_000_000
 # Drake downloads this package's files on first use: a model that needs it needs the
 # network, which a run must not.
 NETWORK_PACKAGES = ("drake_models",)
@@ -44,6 +45,9 @@ FORBIDDEN_NAME_CATEGORIES = ("Cc", "Cf", "Zl", "Zp")
 # Characters XML 1.0 does not allow (a parser stops at them) are read as these private-use
 # stand-ins, so that the name holding one can be named (`_readable_xml`).
 _STAND_IN = 0x10FF00
+_STAND_INS = re.compile("[\U0010ff00-\U0010ff1f]")
+# A name of printable ASCII needs no closer look.
+_PLAIN_NAME = re.compile(r"[ -~]*")
 # Joint types that move nothing (URDF and SDFormat spell them alike).
 FIXED_JOINT_TYPES = ("fixed",)
 # The tolerance (relative to the largest moment) of the inertia checks: the values are
@@ -59,19 +63,19 @@ def printable(name):
 def original_text(text):
     """`text` read from the file with the stand-ins of `_readable_xml` turned back into the
     characters the file holds."""
+    if not _STAND_INS.search(text):
+        return text
     return "".join(chr(ord(c) - _STAND_IN) if _STAND_IN <= ord(c) < _STAND_IN + 0x20 else c
                    for c in text)
 
 
-@dataclasses.dataclass
 class XmlElement:
     """One element of the file: its tag, attributes, text, children and line."""
 
-    tag: str
-    attrib: dict
-    line: int
-    children: list = dataclasses.field(default_factory=list)
-    text: str = ""
+    __slots__ = ("tag", "attrib", "line", "children", "text")
+
+    def __init__(self, tag, attrib, line):
+        self.tag, self.attrib, self.line, self.children, self.text = tag, attrib, line, [], ""
 
     def find_all(self, tag):
         return [child for child in self.children if child.tag == tag]
@@ -187,6 +191,7 @@ def _parse(data, source, field):
         raise refuse(None, "the file", f"byte {error.start} is not UTF-8; a model file "
                      "is UTF-8 text") from None
     parser = xml.parsers.expat.ParserCreate()
+    parser.buffer_text = True
     stack, roots = [], []
 
     def start(tag, attrib):
@@ -227,6 +232,8 @@ _MARKUP = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>"
                      r"|<[^!?/<>\"'][^<>\"']*(?:(?:\"[^\"]*\"|'[^']*')[^<>\"']*)*>", re.DOTALL)
 _QUOTED = re.compile(r"\"[^\"]*\"|'[^']*'")
 _LINE_BREAKS = re.compile("[\t\n\r]")
+# A quoted value holding a raw line break or tab: only then are the tags looked into.
+_BROKEN_VALUE = re.compile("=\\s*(?:\"[^\"<]*[\t\n\r][^\"<]*\"|'[^'<]*[\t\n\r][^'<]*')")
 
 
 def _stand_in(match):
@@ -251,7 +258,7 @@ def _readable_xml(text):
                            markup)
 
     text = _FORBIDDEN_IN_XML.sub(_stand_in, _CHARACTER_REFERENCE.sub(reference, text))
-    return _MARKUP.sub(tag, text)
+    return _MARKUP.sub(tag, text) if _BROKEN_VALUE.search(text) else text
 
 
 # Attributes whose value is a name, or names a link (URDF's <parent link>, <child link>).
@@ -272,6 +279,8 @@ def _check_names(document, refuse):
 
 
 def _check_name(name, element, what, refuse):
+    if _PLAIN_NAME.fullmatch(name):
+        return
     for char in original_text(name):
         if unicodedata.category(char) in FORBIDDEN_NAME_CATEGORIES:
             kind = ("a control character" if unicodedata.category(char) == "Cc"
@@ -390,12 +399,12 @@ def _inertial(model, link, refuse):
     inertial = link.find("inertial")
     if model.kind == "urdf":
         if inertial is None:
-            return 0.0, np.zeros((3, 3))
+            return 0.0, ((0.0,) * 3,) * 3
         mass_element, tensor = inertial.find("mass"), inertial.find("inertia")
         mass = _number(mass_element, "value", 0.0, refuse, f"link {name} <mass value>")
     else:
         if inertial is None:
-            return 1.0, np.eye(3)
+            return 1.0, ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
         tensor, mass_element = inertial.find("inertia"), inertial.find("mass") or inertial
         mass = _number(inertial, "mass", 1.0, refuse, f"link {name} <inertial><mass>")
     if mass < 0:
@@ -405,10 +414,9 @@ def _inertial(model, link, refuse):
     moments = {key: _number(tensor, key, diagonal if key in ("ixx", "iyy", "izz") else 0.0,
                             refuse, f"link {name} <inertia {key}>")
                for key in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
-    matrix = np.array([[moments["ixx"], moments["ixy"], moments["ixz"]],
-                       [moments["ixy"], moments["iyy"], moments["iyz"]],
-                       [moments["ixz"], moments["iyz"], moments["izz"]]])
-    return mass, matrix
+    return mass, ((moments["ixx"], moments["ixy"], moments["ixz"]),
+                  (moments["ixy"], moments["iyy"], moments["iyz"]),
+                  (moments["ixz"], moments["iyz"], moments["izz"]))
 
 
 def _check_inertias(model, links, joints, motion, refuse):
@@ -418,8 +426,8 @@ def _check_inertias(model, links, joints, motion, refuse):
     if motion != "dynamic":
         return
     for name, (mass, inertia) in inertials.items():
-        moments = np.linalg.eigvalsh(inertia)
-        slack = INERTIA_TOLERANCE * max(float(np.max(np.abs(moments))), 1e-12)
+        moments = _principal_moments(inertia)
+        slack = INERTIA_TOLERANCE * max(abs(moments[0]), abs(moments[2]), 1e-12)
         link = links[name]
         element = link.find("inertial") or link
         what = f"link {printable(name)} <inertial><inertia>"
@@ -451,10 +459,19 @@ def _check_inertias(model, links, joints, motion, refuse):
                          "needs mass on what a joint moves (or use motion: kinematic)")
 
 
+def _principal_moments(inertia):
+    """The principal moments of a 3x3 inertia, smallest first (most files give a diagonal
+    one: read without numpy's overhead, which counts over thousands of links)."""
+    (ixx, ixy, ixz), (_, iyy, iyz), (_, _, izz) = inertia
+    if ixy == ixz == iyz == 0:
+        return sorted((ixx, iyy, izz))
+    return [float(moment) for moment in np.linalg.eigvalsh(np.array(inertia))]
+
+
 def _moved_mass(links, children, inertials):
     """{link: the mass of it and of everything hanging from it}, leaves first."""
-    order, stack = [], [name for name in links if not any(
-        name in hanging for hanging in children.values())]
+    hanging = {child for below in children.values() for child in below}
+    order, stack = [], [name for name in links if name not in hanging]
     while stack:
         order.append(stack.pop())
         stack.extend(children.get(order[-1], ()))

@@ -13,6 +13,7 @@ import pytest
 
 from pbp_drake.cli import main
 from pbp_drake.robots.hsr_model import models_dir
+from pbp_drake.robots.model_checks import MAX_MODEL_FILE_BYTES
 from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
@@ -256,3 +257,13 @@ def test_a_doctype_is_refused_before_any_entity_is_expanded(tmp_path):
         '<robot name="pbp_arm7"', '<robot name="&i;"'))
     message = refusal(scenario_of(model))
     assert "does not load: line 2: a DOCTYPE (entity declarations)" in message, message
+
+
+def test_a_file_larger_than_a_model_is_refused_unread(tmp_path):
+    model = tmp_path / "huge.urdf"
+    text = ARM7.read_text()
+    padding = "<!-- " + "x" * MAX_MODEL_FILE_BYTES + " -->\n"
+    model.write_text(text.replace("<robot ", padding + "<robot ", 1))
+    message = refusal(scenario_of(model))
+    assert (f"the file: {model.stat().st_size:,} bytes is larger than a model file may be "
+            f"({MAX_MODEL_FILE_BYTES:,} bytes)" in message), message

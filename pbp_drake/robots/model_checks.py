@@ -29,6 +29,7 @@ import xml.parsers.expat
 from pathlib import Path
 
 import numpy as np
+from pydrake.multibody.parsing import PackageMap
 
 from pbp_drake.robots.hsr_model import PACKAGE_NAME, models_dir
 
@@ -148,11 +149,15 @@ def _url_path(uri, folder, refuse):
     if package == PACKAGE_NAME:
         return models_dir() / PACKAGE_NAME / inside
     if package == "drake":
-        from pydrake.multibody.parsing import PackageMap  # Drake's own files, local
         return Path(PackageMap().GetPath("drake")) / inside
     raise refuse(f"{printable(uri)} is in package {printable(package)}, which the station "
                  f"does not know (it knows {PACKAGE_NAME}, ours in models/, and drake); name "
                  "the file by a path relative to the model")
+
+
+# The files checked last, by (path, modification time, size, motion): a scenario's model is
+# checked where it is resolved, where the scene is placed, and where its station is built.
+_CHECKED = {}
 
 
 def check_model_file(source, motion, field="ArmStationConfig.model_file"):
@@ -161,7 +166,11 @@ def check_model_file(source, motion, field="ArmStationConfig.model_file"):
     ValueError naming `field`, the file, the element and its field."""
     path = model_file_path(source, field)
     refuse = _Refusal(field, source)
-    size = path.stat().st_size
+    status = path.stat()
+    size = status.st_size
+    key = (str(path.resolve()), status.st_mtime_ns, size, motion)
+    if key in _CHECKED:
+        return _CHECKED[key]
     if size > MAX_MODEL_FILE_BYTES:
         raise refuse(None, "the file", f"{size:,} bytes is larger than a model file may be "
                      f"({MAX_MODEL_FILE_BYTES:,} bytes)")
@@ -178,6 +187,9 @@ def check_model_file(source, motion, field="ArmStationConfig.model_file"):
     _check_tree(links, joints, refuse)
     _check_files(document, model, refuse)
     _check_inertias(model, links, joints, motion, refuse)
+    if len(_CHECKED) >= 8:
+        _CHECKED.pop(next(iter(_CHECKED)))
+    _CHECKED[key] = model
     return model
 
 

@@ -12,6 +12,7 @@ import time
 import pytest
 
 from pbp_drake.cli import main
+from pbp_drake.robots import ArmStationConfig, make_arm_station
 from pbp_drake.robots.hsr_model import models_dir
 from pbp_drake.robots.model_checks import MAX_MODEL_FILE_BYTES
 from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
@@ -267,3 +268,41 @@ def test_a_file_larger_than_a_model_is_refused_unread(tmp_path):
     message = refusal(scenario_of(model))
     assert (f"the file: {model.stat().st_size:,} bytes is larger than a model file may be "
             f"({MAX_MODEL_FILE_BYTES:,} bytes)" in message), message
+
+
+SDF_ARM = """<?xml version="1.0"?>
+<sdf version="1.7">
+  <model name="two_joints">
+    <link name="base">
+      <collision name="post"><pose>0 0 0.1 0 0 0</pose>
+        <geometry><cylinder><radius>0.05</radius><length>0.2</length></cylinder></geometry>
+      </collision>
+    </link>
+    <link name="upper"><pose>0 0 0.2 0 0 0</pose></link>
+    <link name="lower"><pose>0 0 0.5 0 0 0</pose></link>
+    <frame name="tool" attached_to="lower"><pose relative_to="lower">0 0 0.1 0 1.5708 0</pose></frame>
+    <joint name="shoulder" type="revolute"><parent>base</parent><child>upper</child>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit></axis>
+    </joint>
+    <joint name="elbow" type="revolute"><parent>upper</parent><child>lower</child>
+      <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit></axis>
+    </joint>
+  </model>
+</sdf>
+"""
+
+
+def test_an_sdformat_model_is_checked_alike(tmp_path):
+    good, looped = tmp_path / "arm.sdf", tmp_path / "looped.sdf"
+    good.write_text(SDF_ARM)
+    looped.write_text(SDF_ARM.replace("<parent>base</parent>", "<parent>lower</parent>"))
+    config = ArmStationConfig(model_file=str(good), base_frame="base", ee_frame="tool")
+    make_arm_station(config)
+    started = time.monotonic()
+    with pytest.raises(ValueError) as error:
+        make_arm_station(dataclasses.replace(config, model_file=str(looped)))
+    assert time.monotonic() - started < TIME_BOUND
+    elbow = SDF_ARM[:SDF_ARM.index('<joint name="elbow"')].count("\n") + 1
+    assert (f"ArmStationConfig.model_file '{looped}': line {elbow}, joint 'elbow' <parent>: link "
+            "'upper' closes a loop of joints ('upper' -> 'lower' -> 'upper')"
+            in str(error.value)), error.value

@@ -14,7 +14,7 @@ from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.parsing import Parser
 
 from pbp_drake.robots.hsr_model import configure_parser
-from pbp_drake.robots.model_checks import check_model_file, printable
+from pbp_drake.robots.model_checks import check_model_file, escaped, printable
 
 # The ready configuration's ee_frame z axis must be at most this far (degrees) off the
 # floor plane: the heading is where that axis points in it.
@@ -52,7 +52,7 @@ def add_arm(plant, config, parser=None):
     except Exception as error:  # Drake's parser raises RuntimeError with the details
         first = str(error).strip().splitlines()[0] if str(error).strip() else type(error)
         raise ValueError(f"ArmStationConfig.model_file {printable(source)} does not load: "
-                         f"{first}") from None
+                         f"{escaped(str(first))}") from None
     if len(models) != 1:
         raise ValueError(f"ArmStationConfig.model_file {source!r} holds {len(models)} models; "
                          "the station takes one arm")

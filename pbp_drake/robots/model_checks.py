@@ -61,6 +61,13 @@ def printable(name):
     return repr(original_text(name))
 
 
+def escaped(text):
+    """`text` unquoted, with each character a terminal would act on escaped as in `repr`
+    (for messages that quote what another reader, Drake's, says about the file)."""
+    return "".join(char if char.isprintable() else repr(char)[1:-1]
+                   for char in original_text(text))
+
+
 def original_text(text):
     """`text` read from the file with the stand-ins of `_readable_xml` turned back into the
     characters the file holds."""

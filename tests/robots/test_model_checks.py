@@ -15,7 +15,7 @@ from pbp_drake.cli import main
 from pbp_drake.robots import ArmStationConfig, make_arm_station
 from pbp_drake.robots.hsr_model import models_dir
 from pbp_drake.robots.model_checks import MAX_MODEL_FILE_BYTES
-from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
+from pbp_drake.scenarios import DynamicObstacles, ScenarioError, load_scenario_file, resolve
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 ARM_REACH = REPO / "diagrams" / "arm_reach.yaml"
@@ -306,3 +306,27 @@ def test_an_sdformat_model_is_checked_alike(tmp_path):
     assert (f"ArmStationConfig.model_file '{looped}': line {elbow}, joint 'elbow' <parent>: link "
             "'upper' closes a loop of joints ('upper' -> 'lower' -> 'upper')"
             in str(error.value)), error.value
+
+
+def test_an_obstacle_drawn_into_the_pedestal_is_refused_naming_its_seed():
+    scenario = scenario_of(ARM7)
+    # Obstacles drawn around the base, kept only 0.01 m from its centre.
+    task = DynamicObstacles(x_range=[0.5, 0.7], y_range=[-0.25, 0.25], height=0.35,
+                            success_distance=0.03, obstacle_count=1, obstacle_radius=0.03,
+                            obstacle_height=0.6, obstacle_speed=0.04,
+                            obstacle_x_range=[-0.05, 0.05], obstacle_y_range=[-0.05, 0.05],
+                            obstacle_spacing=0.01)
+    message = refusal(dataclasses.replace(scenario, task=task, seed=3))
+    assert ("scenario.task's obstacle 0 (drawn with seed 3 at (" in message
+            and "obstacle_radius 0.03 m) reaches into the robot's own geometry: link "
+            "'arm7_base' <collision 'foot'> (a cylinder of radius 0.12 m, length 0.02 m)"
+            in message), message
+
+
+def test_what_drake_says_of_the_file_is_shown_escaped(tmp_path):
+    # Not a name: Drake's parser refuses the joint type, quoting it.
+    model = arm7_with(tmp_path, '<joint name="arm7_joint4" type="revolute">',
+                      '<joint name="arm7_joint4" type="revolute&#27;[2J">')
+    message = refusal(scenario_of(model))
+    assert "does not load: " in message and "\x1b" not in message, message
+    assert r"revolute\x1b[2J" in message, message

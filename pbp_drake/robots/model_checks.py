@@ -13,8 +13,10 @@ DOCTYPE) and refuses, naming the file, the element and its field:
   ``motion: dynamic`` also inertias that are not physical (a negative principal moment, or
   one larger than the other two together) and joints that move no mass at all.
 
-`base_shapes` and `first_overlap` find the scene's objects inside the geometry the
-model fixes to its base (the pedestal), posed where the base stands.
+What needs more than the file is checked elsewhere: the scene's objects inside the
+geometry the model fixes to its base (`pbp_drake.robots.model_geometry`), and, for dynamic
+motion, a mass matrix that is singular in the ready configuration
+(`pbp_drake.robots.arm_model`).
 
 Names are shown through `printable`, which escapes what a terminal would act on. Every
 refusal is one line: a ValueError whose message starts with the config's field and the
@@ -288,11 +290,11 @@ NAME_ELEMENTS = ("parent", "child", "attached_to")
 
 def _check_names(document, refuse):
     for element in document.walk():
-        owner = _describe(element)
+        owner = f"{_describe(element)} " if "name" in element.attrib else ""
         for attribute in NAME_ATTRIBUTES:
             if attribute in element.attrib:
-                _check_name(element.attrib[attribute], element, f"{owner} <{element.tag} "
-                            f"{attribute}>", refuse)
+                _check_name(element.attrib[attribute], element,
+                            f"{owner}<{element.tag} {attribute}>", refuse)
         if element.tag in NAME_ELEMENTS and element.text.strip():
             _check_name(element.text.strip(), element, f"<{element.tag}>", refuse)
 
@@ -374,7 +376,8 @@ def _check_tree(links, joints, refuse):
 
 
 def _check_files(document, model, refuse):
-    """Every mesh and texture the model reads is on disk (Drake reads them at build)."""
+    """Every mesh and texture the model reads (URDF's `filename`, SDFormat's `<uri>`) is
+    on disk, not behind the network (Drake reads them when the station is built)."""
     folder = model.path.parent
     for element in document.walk():
         if model.kind == "urdf":
@@ -386,10 +389,11 @@ def _check_files(document, model, refuse):
         if uri is None:
             continue
         path = _url_path(uri, folder, lambda why: refuse(element, what, why))
-        if not path.is_file():
+        # An SDFormat <include> names a model's folder.
+        if not (path.is_file() or (model.kind == "sdf" and path.is_dir())):
             raise refuse(element, what, f"{printable(uri)} is missing (no file at "
-                         f"{printable(str(path))}); meshes are read from disk when the "
-                         "station is built")
+                         f"{printable(str(path))}); the meshes and textures a model names "
+                         "are read from disk when the station is built")
 
 
 def _number(element, attribute, default, refuse, what):

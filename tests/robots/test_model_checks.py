@@ -15,6 +15,7 @@ from pbp_drake.cli import main
 from pbp_drake.robots import ArmStationConfig, make_arm_station
 from pbp_drake.robots.hsr_model import models_dir
 from pbp_drake.robots.model_checks import MAX_MODEL_FILE_BYTES
+from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.scenarios import DynamicObstacles, ScenarioError, load_scenario_file, resolve
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
@@ -330,3 +331,28 @@ def test_what_drake_says_of_the_file_is_shown_escaped(tmp_path):
     message = refusal(scenario_of(model))
     assert "does not load: " in message and "\x1b" not in message, message
     assert r"revolute\x1b[2J" in message, message
+
+
+BOX_BASE = """<?xml version="1.0"?>
+<robot name="box_base">
+  <link name="base">
+    <collision name="block"><origin xyz="0 0 0" rpy="0 0 {yaw}"/>
+      <geometry><box size="0.2 0.2 0.2"/></geometry></collision>
+  </link>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("box_yaw, base_yaw", [(0.785398, 0.0), (0.0, 0.785398)],
+                         ids=["box turned", "base turned"])
+def test_a_turned_base_is_measured_as_turned(tmp_path, box_yaw, base_yaw):
+    # A 0.2 m cube turned 45 degrees about z: its corners reach 0.141 m along x, while
+    # (0.1, 0.1) is 0.141 m from its centre along a face's normal, outside its 0.1 m.
+    model = tmp_path / "box.urdf"
+    model.write_text(BOX_BASE.format(yaw=box_yaw))
+    config = ArmStationConfig(model_file=str(model), base_frame="base", ee_frame="base",
+                              base_pose=[0.0, 0.0, 0.0, base_yaw])
+    check_clear_of_base(config, [("outside", [0.1, 0.1, 0.0], [0.1, 0.1, 0.0])])
+    with pytest.raises(ValueError, match=r"^inside is inside the robot's own geometry: link "
+                       r"'base' <collision 'block'> \(a box of sides 0.2 x 0.2 x 0.2 m\)"):
+        check_clear_of_base(config, [("inside", [0.13, 0.0, 0.0], [0.13, 0.0, 0.0])])

@@ -197,7 +197,7 @@ def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
             processes = list((getattr(pool, "_processes", None) or {}).values())
             pool.shutdown(wait=False, cancel_futures=True)
             for process in processes:
-                process.kill()  # they ignore SIGTERM (see _start_worker)
+                process.kill()
             for process in processes:
                 process.join()  # none writes after this: what they left can be removed
             raise
@@ -205,14 +205,12 @@ def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
 
 
 def _start_worker(study_pid):
-    """Workers leave Ctrl-C and SIGTERM (which may be sent to the whole process group) to
-    the study's process, which stops them; and they end when
+    """Workers leave Ctrl-C to the study's process, which stops them; and they end when
     that process ends, however it ends (even SIGKILL), so that none goes on writing trials.
     Under forkserver a worker's parent is the fork server, which lives as long as a worker
     holds its pipe: so each worker watches the study's process itself. When the workers
     are gone, the fork server and the resource tracker see their pipes close and exit."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     threading.Thread(target=_exit_with, args=(study_pid,), name="exit-with-study",
                      daemon=True).start()
 

@@ -22,7 +22,7 @@ import pytest
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.cli import main
 from pbp_drake.studies.atomic_files import WriteFailed
-from pbp_drake.studies.comparison import run_method_comparison
+from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.folders import LOCK_FILE, FolderLocked
 from pbp_drake.scenarios import load_scenario_file
 
@@ -147,6 +147,23 @@ def test_a_full_disk_stops_the_study_and_freed_it_ends_as_an_uninterrupted_one(
     assert summary["methods"]["teleop"]["errors"] == 0
     assert (folder / "summary.json").read_bytes() == (whole / "summary.json").read_bytes()
     assert _leftovers(folder) == []
+
+
+def test_a_full_disk_stops_a_matrix_and_freed_it_ends_as_an_uninterrupted_one(
+        scenario, tmp_path, small_disk):
+    pilots = ["attentive", "noisy"]
+    whole = tmp_path / "whole"
+    run_method_matrix(scenario, METHODS, pilots, 3, 5, whole, run=fake_run)
+    disk = small_disk(20 * PAGE)
+    folder = disk / "matrix"
+    with pytest.raises(WriteFailed, match="no space left on device"):
+        run_method_matrix(scenario, METHODS, pilots, 3, 5, folder, run=fake_run)
+    written = [r for pilot in pilots for r in _trial_records(folder / "pilots" / pilot)]
+    assert 0 < len(written) < 12 and all(record["error"] is None for record in written)
+    assert _leftovers(folder) == []
+    _resize(disk, "8m")
+    run_method_matrix(scenario, METHODS, pilots, 3, 5, folder, run=fake_run)
+    assert (folder / "summary.json").read_bytes() == (whole / "summary.json").read_bytes()
 
 
 def test_report_on_a_full_disk_says_so_in_one_line_and_leaves_nothing_half_written(

@@ -7,6 +7,7 @@ import fcntl
 import json
 import os
 import pathlib
+import sys
 
 from pbp_drake.studies.atomic_files import write_failed
 from pbp_drake.studies.trial_files import Damage, StudyFolderError, name_damaged
@@ -77,7 +78,8 @@ def study_lock(output):
     """Holds `output`'s lock (an flock on its LOCK_FILE, which holds the holder's process
     id) while the block runs: a study writes the folder alone. Raises FolderLocked, naming
     the process that holds it, when another does. The lock ends with the process however
-    it ends (kill -9 too): the file may stay, unlocked."""
+    it ends (kill -9 too): the file may stay, unlocked. On a file system without locks
+    (flock fails otherwise) the block runs unlocked, after a line on stderr saying so."""
     output = pathlib.Path(output)
     path = output / LOCK_FILE
     try:
@@ -93,6 +95,11 @@ def study_lock(output):
                 f"{output} is being written by another study ({_holder(descriptor, path)}): "
                 "wait for it to end, or stop it, and run this command again; give another "
                 "--output to run both at once") from None
+        except OSError as error:
+            print(f"pbp-drake: cannot lock {path} ({error.strerror}): run one study at a "
+                  "time on this folder", file=sys.stderr, flush=True)
+            yield
+            return
         try:
             os.ftruncate(descriptor, 0)
             os.pwrite(descriptor, f"{os.getpid()}\n".encode(), 0)

@@ -188,6 +188,21 @@ def test_report_on_a_full_disk_says_so_in_one_line_and_leaves_nothing_half_writt
     assert (folder / "summary.json").read_bytes() == expected
 
 
+def test_report_on_a_read_only_disk_names_the_file_and_what_to_do(scenario, small_disk,
+                                                                  capsys):
+    disk = small_disk("1m")
+    folder = disk / "study"
+    run_method_comparison(scenario, METHODS, 2, 5, folder, run=fake_run)
+    before = {path: path.read_bytes() for path in folder.rglob("*") if path.is_file()}
+    capsys.readouterr()
+    subprocess.run(["mount", "-o", "remount,ro", str(disk)], check=True)
+    assert main(["report", str(folder)]) == 4
+    assert capsys.readouterr().err.splitlines() == [
+        f"pbp-drake: cannot write {folder / 'summary.json'}: read-only file system; nothing "
+        "is left half-written: make the file system writable, then the same command resumes."]
+    assert {path: path.read_bytes() for path in folder.rglob("*") if path.is_file()} == before
+
+
 def _hold_lock(folder, write_pid=True):
     """A process holding `folder`'s study lock (as `study_lock`, or a bare flock that
     writes no process id) until it is killed; returns it once it holds the lock."""

@@ -65,7 +65,9 @@ EXIT_SUCCESS = 0
 EXIT_FAILED = 1
 EXIT_USAGE = 2
 EXIT_STOPPED = 3
+EXIT_WRITE_FAILED = 4
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
 EXIT_CODES = {
     EXIT_SUCCESS: "success: the task reached its target (a session: every method's run did; "
                   "a study: every trial ran)",
@@ -75,6 +77,11 @@ EXIT_CODES = {
                 "no browser in time for a person's run",
     EXIT_STOPPED: "`run`: the person pressed Stop in the page (a session is resumed by the "
                   "same command)",
+    EXIT_WRITE_FAILED: "`study`, `report`: a file could not be written (no space left, a "
+                       "quota, a read-only or failing disk), said in one line; nothing "
+                       "half-written is left, and the same command resumes",
     EXIT_INTERRUPTED: "interrupted by Ctrl-C (a study or session is resumed by the same "
                       "command)",
+    EXIT_TERMINATED: "`study`, `report`: ended by SIGTERM, as by Ctrl-C (a study is resumed "
+                     "by the same command)",
 }

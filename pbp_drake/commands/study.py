@@ -1,19 +1,26 @@
 """`pbp-drake study` (a scenario file's study), `pbp-drake report` (a study folder's
 tables and figures, rebuilt from its trial files) and `pbp-drake compare` (two studies of
-the same seeds, trial by trial)."""
+the same seeds, trial by trial).
+
+`study` and `report` take SIGTERM as Ctrl-C, and say a file that cannot be written (a full
+disk) in one line, exit 4: nothing is left half-written, and the same command resumes."""
 
 import dataclasses
+import functools
 import pathlib
 import sys
 import time
 
 from pbp_drake.builder import check_buildable
-from pbp_drake.cli_types import method_list
+from pbp_drake.cli_types import (
+    EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_WRITE_FAILED, method_list)
+from pbp_drake.commands.signals import Terminated, sigterm_as_interrupt
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
     TASK_ROBOTS, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison,
     counted, load_scenario_file)
+from pbp_drake.studies.atomic_files import is_disk_failure, write_failed
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
@@ -101,9 +108,34 @@ def add_study_commands(commands):
         "metric moved by more than that noise")
     compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
     compare.add_argument("second", help="another, of the same seeds (B)")
-    study.set_defaults(handler=_study)
-    report.set_defaults(handler=_report)
+    study.set_defaults(handler=_stopping_cleanly(_study))
+    report.set_defaults(handler=_stopping_cleanly(_report))
     compare.set_defaults(handler=_compare)
+
+
+def _stopping_cleanly(command):
+    """`command(args)` that takes SIGTERM as Ctrl-C (`commands.signals`), and says a file
+    that could not be written in one line, exit 4 (the disk failed, not the study: nothing
+    is half-written, and the same command resumes)."""
+
+    @functools.wraps(command)
+    def stopping_cleanly(args):
+        with sigterm_as_interrupt():
+            try:
+                return command(args)
+            except Terminated:
+                print("\npbp-drake: terminated (SIGTERM)", file=sys.stderr)
+                return EXIT_TERMINATED
+            except OSError as error:
+                if not is_disk_failure(error):
+                    raise
+                error = write_failed(error, error.filename)
+                on_a_bar = "\n" if sys.stderr.isatty() else ""  # the progress bar's line
+                print(f"{on_a_bar}pbp-drake: {error}; nothing is left half-written: "
+                      f"{error.remedy}, then the same command resumes.", file=sys.stderr)
+                return EXIT_WRITE_FAILED
+
+    return stopping_cleanly
 
 
 def _study(args):
@@ -221,10 +253,12 @@ def _method_study(args, scenario_file):
             summary = run_method_comparison(
                 scenario, study.methods, study.trials, seed, output, progress,
                 participant_condition=args.participant_condition, **options)
-    except KeyboardInterrupt:
-        print(f"\nInterrupted: the finished trials are in {output / 'trials'}; the same "
-              "command resumes the study.", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as stop:
+        terminated = isinstance(stop, Terminated)
+        trials = output / "pilots" / "*" / "trials" if pilots else output / "trials"
+        print(f"\n{'Terminated (SIGTERM)' if terminated else 'Interrupted'}: the finished "
+              f"trials are in {trials}; the same command resumes the study.", file=sys.stderr)
+        return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
     reused = total - len(runs)
     print(f"Ran {counted(len(runs), 'trial')} in {time.monotonic() - started:.1f} s"
           + (f"; {reused} were already on disk." if reused else "."), flush=True)

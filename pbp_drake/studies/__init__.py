@@ -8,13 +8,17 @@ A study folder `DIR` holds everything needed to rebuild its tables and figures:
     DIR/trials/<method>/seed_<seed>.csv   its time series, one row per control tick
     DIR/summary.json, DIR/results.md, DIR/trials.json, DIR/fig7*.png
                                           rebuilt from the files above by `report`
+    DIR/.study.lock                       flock'd while a study writes the folder
 
 One job per module:
 
-- `trial_files`: the trial and study files (format, paths, atomic writes, CSV time series,
-  reading back) and the scenario hash that keeps different scenarios apart;
+- `trial_files`: the trial and study files (format, paths, CSV time series, reading back)
+  and the scenario hash that keeps different scenarios apart;
+- `atomic_files`: every file written whole or not at all, and a disk that fails said as
+  `WriteFailed` (never a trial's result);
 - `folders`: which kind of study an output folder holds (a method comparison or a 2-D
-  study), so neither is written into the other's folder;
+  study), so neither is written into the other's folder, and its lock (one study at a
+  time);
 - `runners`: one trial (run, or computed without the disk) and the local process pool;
 - `ray_backend`: the same trials as Ray tasks (Ray is imported only when asked for);
 - `comparison`: `run_method_comparison` and `run_method_matrix`, which trials to run,

@@ -19,7 +19,7 @@ import pathlib
 from pbp_drake.scenarios import METHOD_NAMES
 from pbp_drake.studies.intervals import mean_interval, wilson_interval
 from pbp_drake.studies.matrix_report import FIGURE, matrix_command, metric_range
-from pbp_drake.studies.trial_files import write_atomically
+from pbp_drake.studies.atomic_files import write_atomically
 
 HOLDS, FAILS, UNDECIDED = "holds", "does not hold", "undecided"
 TELEOP = "teleop"

@@ -2,23 +2,26 @@
 
 `run_method_comparison` decides which trials still have to run (those not on disk for the
 same scenario), runs them in local processes (`--jobs`) or as Ray tasks (`--backend ray`),
-then rebuilds the summary, tables and figures from the files (`report`). A matrix of
+then rebuilds the summary, tables and figures from the files (`report`), holding the
+folder's lock (`folders.study_lock`) all along: one study at a time writes it. A matrix of
 methods and pilots (`studies.matrix`) prepares one such folder per pilot and runs all their
 trials together (`run_trials`): `run_method_matrix`.
 """
 
+import contextlib
 import dataclasses
 import pathlib
 import pickle
 import time
 
 from pbp_drake.scenarios import ScenarioError
+from pbp_drake.studies.atomic_files import remove_leftovers
 from pbp_drake.studies.ray_backend import import_ray, run_on_ray
 from pbp_drake.studies.report import report
 from pbp_drake.studies.runners import failed_record, run_locally
 from pbp_drake.studies.trial_files import (
     StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, write_study)
-from pbp_drake.studies.folders import check_folder
+from pbp_drake.studies.folders import check_folder, study_lock
 from pbp_drake.studies.matrix import (
     check_matrix_folder, check_pilots, pilot_folder, write_matrix_study)
 from pbp_drake.studies.matrix_report import report_matrix
@@ -48,17 +51,25 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except
     those that failed with an error). A trial that raises, or whose worker process dies, is
-    recorded as failed with its error. `progress(done, total, record, elapsed)` is called
+    recorded as failed with its error. A file that cannot be written stops the study with
+    `atomic_files.WriteFailed` (an OSError), nothing half-written left; another process
+    writing `output` refuses it with `folders.FolderLocked`, before anything is written.
+    `progress(done, total, record, elapsed)` is called
     after each trial run now. `run(scenario) -> TaskResult` replaces `run_task` (it must be
     picklable when `jobs > 1`).
     """
     check_run_options(jobs, backend, ray_address, run)
     if trials < 1:
         raise ScenarioError(f"trials must be at least 1, got {trials}")
-    folder = prepare_folder(scenario, methods, trials, seed, output, retry_errors, split,
-                            scenario_file, split_seeds, participant_condition)
-    run_trials([folder], jobs, progress, run, backend, ray_address)
-    return report(output)
+    output = pathlib.Path(output)
+    # Checked before the lock, so that a refused folder is not written at all; and again
+    # under it (prepare_folder).
+    check_folder(output, scenario, scenario_hash(scenario), participant_condition)
+    with study_lock(output):
+        folder = prepare_folder(scenario, methods, trials, seed, output, retry_errors, split,
+                                scenario_file, split_seeds, participant_condition)
+        run_trials([folder], jobs, progress, run, backend, ray_address)
+        return report(output)
 
 
 @dataclasses.dataclass
@@ -96,18 +107,19 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
                    scenario_file=None, split_seeds=None, participant_condition=None):
     """Checks `output` (StudyFolderError when it holds another scenario's study), removes
     what an interrupted study left, names the damaged trial files, writes study.json and
-    returns the StudyFolder with the trials still to run (see `run_method_comparison`)."""
+    returns the StudyFolder with the trials still to run (see `run_method_comparison`).
+    The caller holds the folder's lock (`folders.study_lock`) and has checked it once
+    (`check_folder`, which named a damaged study.json)."""
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
-    recorded = check_folder(output, scenario, digest, participant_condition)
+    recorded = check_folder(output, scenario, digest, participant_condition, quiet=True)
     if split is None and recorded and (recorded.get("seed"), recorded.get("trials")) == (
             seed, trials) and isinstance(recorded.get("split"), str):
         split = recorded["split"]  # resuming the same seeds keeps their label
     if recorded:
         scenario_file = scenario_file or recorded.get("scenario_file")
         split_seeds = split_seeds or recorded.get("split_seeds")
-    for leftover in [*output.glob("trials/*/*.running"), *output.glob("trials/*/.*.tmp")]:
-        leftover.unlink(missing_ok=True)  # left by an interrupted study
+    remove_leftovers(output)  # of an interrupted study
     pending, damaged = [], []
     for method in methods:
         for trial in range(trials):
@@ -130,7 +142,9 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
 def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_address=None):
     """Runs the pending trials of every StudyFolder in one pool of `jobs` local processes,
     or as Ray tasks, so that no worker waits for another folder's last trial; each trial's
-    files go to its folder. `progress(done, total, record, elapsed)` after each trial."""
+    files go to its folder. `progress(done, total, record, elapsed)` after each trial.
+    Stopped (Ctrl-C, SIGTERM, a file that cannot be written), it removes what the trials
+    that were running left (temporary files, running markers) before it raises."""
     pending = [(index, method, trial) for index, folder in enumerate(folders)
                for method, trial in folder.pending]
     started = time.monotonic()
@@ -154,11 +168,16 @@ def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_ad
         on_done(key, failed_record(folder.scenario, folder.digest, method, trial,
                                    folder.seed + trial, error, folder.output))
 
-    if backend == "ray":
-        if pending:
-            run_on_ray(pending, jobs, ray_address, submit_args, on_done, on_error)
-    else:
-        run_locally(pending, jobs, submit_args, on_done, on_error)
+    try:
+        if backend == "ray":
+            if pending:
+                run_on_ray(pending, jobs, ray_address, submit_args, on_done, on_error)
+        else:
+            run_locally(pending, jobs, submit_args, on_done, on_error)
+    except BaseException:
+        for folder in folders:
+            remove_leftovers(folder.output)
+        raise
 
 
 def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=None, jobs=1,
@@ -186,14 +205,17 @@ def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=
     # Every pilot's folder is checked before any is written: a refused one stops the matrix
     # with nothing changed.
     for pilot, pilot_scenario in pilot_scenarios.items():
-        folder = pilot_folder(output, pilot)
-        if folder.is_dir():
-            check_folder(folder, pilot_scenario, scenario_hash(pilot_scenario))
-    write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split,
-                       scenario_file, split_seeds)
-    folders = [prepare_folder(pilot_scenario, methods, trials, seed,
-                              pilot_folder(output, pilot), retry_errors, split, scenario_file,
-                              split_seeds)
-               for pilot, pilot_scenario in pilot_scenarios.items()]
-    run_trials(folders, jobs, progress, run, backend, ray_address)
-    return report_matrix(output)
+        check_folder(pilot_folder(output, pilot), pilot_scenario, scenario_hash(pilot_scenario))
+    with contextlib.ExitStack() as locks:
+        # The matrix's folder, and each pilot's (a study folder of its own).
+        for folder in [output, *(pilot_folder(output, pilot) for pilot in pilots)]:
+            locks.enter_context(study_lock(folder))
+        remove_leftovers(output)  # of an interrupted report
+        write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split,
+                           scenario_file, split_seeds)
+        folders = [prepare_folder(pilot_scenario, methods, trials, seed,
+                                  pilot_folder(output, pilot), retry_errors, split,
+                                  scenario_file, split_seeds)
+                   for pilot, pilot_scenario in pilot_scenarios.items()]
+        run_trials(folders, jobs, progress, run, backend, ray_address)
+        return report_matrix(output)

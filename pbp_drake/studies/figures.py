@@ -14,6 +14,7 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
 from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
+from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
 
 
 # ---------------------------------------------------------------------------------------------
@@ -60,7 +61,7 @@ def _box_plot(records, methods, field, ylabel, title, path, ylim=None):
     if ylim is not None:
         axis.set_ylim(*ylim)
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
+    save_figure(figure, path, dpi=120)
     plt.close(figure)
 
 
@@ -97,7 +98,7 @@ def plot_collision_histogram(summary, path):
     axis.legend(fontsize=8)
     axis.grid(axis="y", alpha=0.3)
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
+    save_figure(figure, path, dpi=120)
     plt.close(figure)
 
 
@@ -136,7 +137,7 @@ def plot_pilot_panels(panels, path):
         axis.grid(axis="y", alpha=0.3)
     figure.suptitle("Every method under every pilot: means and 95 % intervals", fontsize=10)
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
+    save_figure(figure, path, dpi=110)
     plt.close(figure)
 
 
@@ -258,7 +259,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
         target.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.12))
     figure.tight_layout()
     # "tight" keeps the legends under the PBP panels in the image.
-    figure.savefig(path, dpi=110, bbox_inches="tight")
+    save_figure(figure, path, dpi=110, bbox_inches="tight")
     plt.close(figure)
 
 
@@ -295,5 +296,5 @@ def plot_alt_vs_cont(resolved, summary, path):
     input_axes.set_title("phase against time")
     input_axes.legend(fontsize=8)
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
+    save_figure(figure, path, dpi=110)
     plt.close(figure)

@@ -1,19 +1,26 @@
 """Which study an output folder holds: a method comparison (study.json, trials/) or a 2-D
-study (its summary.json), so that one kind is never written into the other's folder."""
+study (its summary.json), so that one kind is never written into the other's folder; and
+its lock, so that one study at a time writes it."""
 
+import contextlib
+import fcntl
 import json
+import os
 import pathlib
+import sys
 
+from pbp_drake.studies.atomic_files import write_failed
 from pbp_drake.studies.trial_files import Damage, StudyFolderError, name_damaged
 
 TOY_STUDIES = ("alpha_study", "alt_vs_cont")
 
 
-def check_folder(output, scenario, digest, participant_condition=None):
+def check_folder(output, scenario, digest, participant_condition=None, quiet=False):
     """Raises StudyFolderError when `output` holds a study of another scenario or kind (a 2-D
     study's summary.json, a study.json of another kind), saying so when it was run with
-    another `participant_condition`; names a damaged study.json (it is written again).
-    Returns the folder's readable study.json as a dict, or None."""
+    another `participant_condition`; names a damaged study.json (it is written again;
+    `quiet`: not named, when it has been already). Returns the folder's readable study.json
+    as a dict, or None."""
     kind = folder_kind(output)
     if kind is not None and kind != "method_comparison":
         raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a method "
@@ -27,7 +34,8 @@ def check_folder(output, scenario, digest, participant_condition=None):
     except ValueError as error:
         problem = f"truncated or invalid JSON ({error})"
     if problem is not None:
-        name_damaged([Damage(str(study_path), f"{problem}; written again")])
+        if not quiet:
+            name_damaged([Damage(str(study_path), f"{problem}; written again")])
         return None
     if study.get("scenario_hash") != digest:
         recorded = study.get("participant_condition")
@@ -53,3 +61,70 @@ def folder_kind(output):
         if isinstance(data, dict) and isinstance(data.get("study"), str):
             return data["study"]
     return "method_comparison" if (output / "trials").is_dir() else None
+
+
+# ---------------------------------------------------------------------------------------------
+# The lock
+
+LOCK_FILE = ".study.lock"
+
+
+class FolderLocked(StudyFolderError):
+    """Another process holds the study folder's lock: it is writing the folder."""
+
+
+@contextlib.contextmanager
+def study_lock(output):
+    """Holds `output`'s lock (an flock on its LOCK_FILE, which holds the holder's process
+    id) while the block runs: a study writes the folder alone. Raises FolderLocked, naming
+    the process that holds it, when another does. The lock ends with the process however
+    it ends (kill -9 too): the file may stay, unlocked. On a file system without locks
+    (flock fails otherwise) the block runs unlocked, after a line on stderr saying so."""
+    output = pathlib.Path(output)
+    path = output / LOCK_FILE
+    try:
+        output.mkdir(parents=True, exist_ok=True)
+        descriptor = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    except OSError as error:
+        raise write_failed(error, path) from error
+    try:
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise FolderLocked(
+                f"{output} is being written by another study ({_holder(descriptor, path)}): "
+                "wait for it to end, or stop it, and run this command again; give another "
+                "--output to run both at once") from None
+        except OSError as error:
+            print(f"pbp-drake: cannot lock {path} ({error.strerror}): run one study at a "
+                  "time on this folder", file=sys.stderr, flush=True)
+            yield
+            return
+        try:
+            os.ftruncate(descriptor, 0)
+            os.pwrite(descriptor, f"{os.getpid()}\n".encode(), 0)
+        except OSError:
+            pass  # a full disk: the holder is then found through /proc/locks
+        yield
+    finally:
+        os.close(descriptor)
+
+
+def _holder(descriptor, path):
+    """The lock holder's words: "process PID", from the lock file, else from the kernel's
+    table of locks (/proc/locks, by the file's inode)."""
+    text = os.pread(descriptor, 32, 0).decode(errors="replace").strip()
+    if text.isdigit():
+        return f"process {text}"
+    inode = os.fstat(descriptor).st_ino
+    try:
+        lines = pathlib.Path("/proc/locks").read_text().splitlines()
+    except OSError:
+        lines = []
+    for line in lines:
+        fields = line.split()
+        # `1: FLOCK  ADVISORY  WRITE 1234 00:2a:5678 0 EOF`: the pid, then MAJOR:MINOR:INODE.
+        if len(fields) > 5 and fields[1] == "FLOCK" and fields[5].rsplit(":", 1)[-1] == str(
+                inode) and fields[4].isdigit():
+            return f"process {fields[4]}"
+    return f"its process id is not in {path}"

@@ -25,8 +25,9 @@ from pbp_drake.scenarios import ScenarioError
 from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name
 from pbp_drake.studies.folders import folder_kind
 from pbp_drake.studies.summary import summarize
+from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.trial_files import (
-    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study, write_atomically)
+    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study)
 
 MATRIX = "method_matrix"
 PILOTS_FOLDER = "pilots"

@@ -20,7 +20,8 @@ from pbp_drake.studies.matrix import read_matrix, summarize_matrix
 from pbp_drake.studies.paired import paired_rows_with
 from pbp_drake.studies.results_markdown import study_command, write_markdown
 from pbp_drake.studies.splits import seeds_line
-from pbp_drake.studies.trial_files import TRIAL_FIELDS, write_atomically
+from pbp_drake.studies.atomic_files import write_atomically
+from pbp_drake.studies.trial_files import TRIAL_FIELDS
 
 FIGURE = "pilots.png"
 #: The method every other is paired with, pilot by pilot, when the matrix ran it.

@@ -16,7 +16,8 @@ from pbp_drake.studies.figures import METHOD_LABELS
 from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, scale_text
 from pbp_drake.studies.questionnaire_figure import FIG8, answer_counts, plot_questionnaire
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, PRACTICE_FOLDER
-from pbp_drake.studies.trial_files import name_damaged, read_study, write_atomically
+from pbp_drake.studies.atomic_files import write_atomically
+from pbp_drake.studies.trial_files import name_damaged, read_study
 
 ALPHA = 0.05  # the family-wise level; each measure's pairs are Bonferroni-corrected
 # The measures tested, in the paper's order: (key, name in the tables, source).

@@ -22,7 +22,7 @@ import pathlib
 import typing
 
 from pbp_drake.scenarios import ScenarioError
-from pbp_drake.studies.trial_files import write_atomically
+from pbp_drake.studies.atomic_files import write_atomically
 
 
 class Question(typing.NamedTuple):

@@ -7,6 +7,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
 from pbp_drake.studies.figures import METHOD_LABELS  # noqa: E402
 from pbp_drake.studies.questionnaire import QUESTIONS, SCALE, scale_text  # noqa: E402
 
@@ -49,5 +50,5 @@ def plot_questionnaire(answers, methods, path):
     figure.legend(handles, names, ncol=len(SCALE), loc="lower center", frameon=False,
                   title="answer (higher is better)")
     figure.tight_layout(rect=(0, 0.12, 1, 1))  # room for the legend below the panels
-    figure.savefig(path, dpi=120, bbox_inches="tight")
+    save_figure(figure, path, dpi=120, bbox_inches="tight")
     plt.close(figure)

@@ -13,6 +13,7 @@ import pathlib
 import socket
 import sys
 
+from pbp_drake.studies.atomic_files import WriteFailed
 from pbp_drake.studies.runners import compute_trial
 from pbp_drake.studies.trial_files import StudyError, time_series_csv, write_trial_files
 
@@ -157,6 +158,9 @@ def run_on_ray(pending, jobs, address, submit_args, on_done, on_error):
                 try:
                     record, csv_text = ray.get(ref)
                 except Exception as error:  # the task failed: record it, go on
+                    cause = getattr(error, "cause", None)
+                    if isinstance(cause, WriteFailed):
+                        raise cause from None  # the disk, not the trial: the study stops
                     on_error(key, _ray_error_text(ray, error))
                 else:
                     write_trial_files(output, record, csv_text)

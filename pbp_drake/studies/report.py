@@ -9,8 +9,8 @@ from pbp_drake.studies.figures import (
 from pbp_drake.studies.intervals import INTERACTION_MEANS, confidence_table
 from pbp_drake.studies.splits import seeds_line
 from pbp_drake.studies.summary import summarize
-from pbp_drake.studies.trial_files import (
-    TRIAL_FIELDS, name_damaged, read_study, write_atomically)
+from pbp_drake.studies.atomic_files import write_atomically
+from pbp_drake.studies.trial_files import TRIAL_FIELDS, name_damaged, read_study
 
 BOX_FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png")
 # Drawn only for tasks that measure collisions (summary["measures_collisions"]).

@@ -11,7 +11,8 @@ import pathlib
 from pbp_drake.studies.report import results_table
 from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
-from pbp_drake.studies.trial_files import StudyError, write_atomically
+from pbp_drake.studies.atomic_files import is_disk_failure, write_atomically
+from pbp_drake.studies.trial_files import StudyError
 
 # A study folder's study.json; a 2-D study's says which study and scenario file (its
 # summary.json is the study's result and names no file).
@@ -155,4 +156,6 @@ def write_markdown(path, text):
     try:
         write_atomically(path, text)
     except OSError as error:
+        if is_disk_failure(error):
+            raise  # the disk's failure, not the path's: said as any write's (WriteFailed)
         raise StudyError(f"--markdown {path}: cannot be written ({error.strerror})") from None

@@ -3,7 +3,9 @@
 
 Trial i of every method uses seed `seed + i`: the same scene and participant noise. A trial
 that raises is recorded as failed with its error; one whose worker process dies runs again
-alone, so that only a trial that kills its own process is recorded as failed.
+alone, so that only a trial that kills its own process is recorded as failed. A disk that
+fails (`atomic_files.WriteFailed`) is never a trial's result: it stops the study, as
+Ctrl-C does, and the trial runs again when the same command resumes the study.
 """
 
 import concurrent.futures
@@ -19,6 +21,8 @@ import time
 import numpy as np
 
 from pbp_drake.scenarios import resolve, with_method
+from pbp_drake.studies.atomic_files import (
+    WriteFailed, is_disk_failure, write_atomically, write_failed)
 from pbp_drake.studies.trial_files import (
     StudyError, interaction_fields, json_float, running_marker, trial_record, write_trial)
 from pbp_drake.builder.run import run_task
@@ -33,18 +37,20 @@ def run_trial(scenario, method, trial, seed, output, digest, run=None):
     """Runs one trial and writes its files; a trial that raises is written as failed with
     its error. Returns its record. This is what a worker process runs."""
     marker = running_marker(output, method, seed)
-    marker.parent.mkdir(parents=True, exist_ok=True)
-    marker.write_text(f"{os.getpid()}\n")
-    record, result = compute_trial(scenario, method, trial, seed, digest, run)
-    write_trial(output, record, result)
-    marker.unlink(missing_ok=True)
+    write_atomically(marker, f"{os.getpid()}\n")
+    try:
+        record, result = compute_trial(scenario, method, trial, seed, digest, run)
+        write_trial(output, record, result)
+    finally:  # not when the process dies: then the marker tells that the trial had begun
+        marker.unlink(missing_ok=True)
     return record
 
 
 def compute_trial(scenario, method, trial, seed, digest, run=None):
     """Runs one trial without touching the disk: its record and TaskResult (None when it
     raised: the record then holds the error). `run(resolved_scenario)` defaults to
-    `run_task`."""
+    `run_task`. A disk that fails under the trial raises WriteFailed: not the trial's
+    result."""
     if run is None:
         run = run_task
     started = time.monotonic()
@@ -69,6 +75,11 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
             record.update(final_angle_to_target=json_float(result.final_angle_to_target),
                           peak_command_angular_change=json_float(
                               result.peak_command_angular_change))
+    except OSError as error:
+        if is_disk_failure(error):
+            raise write_failed(error, error.filename) from error
+        result = None
+        record.update(success=False, error=f"{type(error).__name__}: {error}")
     except Exception as error:  # a broken trial must not lose the study
         result = None
         record.update(success=False, error=f"{type(error).__name__}: {error}")
@@ -176,15 +187,19 @@ def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
                     record = future.result()
                 except concurrent.futures.process.BrokenProcessPool as error:
                     unfinished.append((key, f"{type(error).__name__}: {error}"))
-                except Exception as error:  # e.g. the worker could not write the files
+                except WriteFailed:
+                    raise  # the disk, not the trial: the study stops (below)
+                except Exception as error:  # e.g. its result could not be sent back
                     on_error(key, f"{type(error).__name__}: {error}")
                 else:
                     on_done(key, record)
-        except BaseException:  # Ctrl-C: stop now; the trials on disk are whole
+        except BaseException:  # Ctrl-C, SIGTERM, a full disk: stop now
             processes = list((getattr(pool, "_processes", None) or {}).values())
             pool.shutdown(wait=False, cancel_futures=True)
             for process in processes:
-                process.terminate()
+                process.kill()
+            for process in processes:
+                process.join()  # none writes after this: what they left can be removed
             raise
     return unfinished
 

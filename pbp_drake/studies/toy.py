@@ -14,8 +14,9 @@ import numpy as np
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolve
 from pbp_drake.builder.run import simulate
+from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.figures import plot_alpha_study, plot_alt_vs_cont
-from pbp_drake.studies.folders import folder_kind
+from pbp_drake.studies.folders import folder_kind, study_lock
 from pbp_drake.studies.trial_files import StudyFolderError
 from pbp_drake.studies.summary import collision_free, ideal_alpha
 
@@ -27,7 +28,8 @@ TOY_FIGURES = {"alpha_study": "fig2_alpha_study.png", "alt_vs_cont": "fig4_alt_v
 def run_study(scenario_file, output_dir):
     """Runs the study a scenario file describes; returns its summary. Raises
     StudyFolderError when `output_dir` holds a study of another kind (a method comparison,
-    or the other 2-D study), whose summary.json it would overwrite."""
+    or the other 2-D study), whose summary.json it would overwrite; FolderLocked when
+    another study is writing it (`folders.study_lock`)."""
     output_dir = pathlib.Path(output_dir)
     if isinstance(scenario_file.study, AlphaStudy):
         kind, run = "alpha_study", run_alpha_study
@@ -39,8 +41,8 @@ def run_study(scenario_file, output_dir):
     if held is not None and held != kind:
         raise StudyFolderError(f"{output_dir} holds a study of kind {held!r}, not a 2-D "
                                f"{kind}: choose another --output folder")
-    output_dir.mkdir(parents=True, exist_ok=True)
-    return run(scenario_file.resolved, scenario_file.study, output_dir)
+    with study_lock(output_dir):
+        return run(scenario_file.resolved, scenario_file.study, output_dir)
 
 
 def scene_scenario(scenario, scene):
@@ -216,4 +218,4 @@ def _write_json(path, data):
             return [clean(item) for item in value]
         return value
 
-    path.write_text(json.dumps(clean(data), indent=1) + "\n")
+    write_atomically(path, json.dumps(clean(data), indent=1) + "\n")

@@ -1,8 +1,9 @@
-"""The files of a study folder: the trial record format, its paths, atomic writes, the
-per-tick CSV time series, reading trials and studies back, and the scenario hash.
+"""The files of a study folder: the trial record format, its paths, the per-tick CSV time
+series, reading trials and studies back, and the scenario hash.
 
-Each trial file is written atomically (a temporary file, then a rename), so an interrupted
-study leaves only whole trials, and running the same study again runs only the missing ones.
+Each trial file is written atomically (`studies.atomic_files`: a temporary file, then a
+rename), so an interrupted study, or one whose disk filled, leaves only whole trials, and
+running the same study again runs only the missing ones.
 """
 
 import collections
@@ -11,7 +12,6 @@ import dataclasses
 import hashlib
 import json
 import math
-import os
 import pathlib
 import sys
 
@@ -19,6 +19,7 @@ import numpy as np
 from pydrake.common.yaml import yaml_dump_typed, yaml_load
 
 from pbp_drake.scenarios import ScenarioError
+from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.builder.time_series import time_series_columns, time_series_csv
 
@@ -135,17 +136,6 @@ def running_marker(output, method, seed):
     """Present while a process runs the trial: after a worker dies, it tells the trials
     that had started from those that had not."""
     return trial_paths(output, method, seed)[0].with_suffix(".running")
-
-
-def write_atomically(path, text):
-    """Writes `text` to a temporary file beside `path`, then renames it to `path`."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(temporary, "w", newline="") as stream:
-        stream.write(text)
-        stream.flush()
-        os.fsync(stream.fileno())
-    os.replace(temporary, path)
 
 
 def json_float(value):

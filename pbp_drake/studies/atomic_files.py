@@ -1,0 +1,123 @@
+"""Writing a study's files whole or not at all, and saying so in one line when the disk
+fails.
+
+Each file is written to a temporary file beside it (`.NAME.PID.tmp`), flushed to the disk,
+then renamed over its name. A write that fails (no space left, a quota, a read-only or
+failing disk) removes its temporary file and raises WriteFailed naming the file: the
+study stops there with nothing half-written, and the failure is never taken for a trial's
+own result, so that the same command, once the disk can take the files, runs what is
+missing and ends as if it had never stopped.
+"""
+
+import contextlib
+import errno
+import os
+import pathlib
+
+# The errors that mean the disk, not the study, failed; what the person can do about each.
+DISK_ERRORS = {
+    errno.ENOSPC: "free some space",
+    errno.EDQUOT: "free some space or raise the disk quota",
+    errno.EFBIG: "free some space or raise the file size limit",
+    errno.EROFS: "make the file system writable",
+    errno.EIO: "check the disk",
+}
+
+
+class WriteFailed(OSError):
+    """A file could not be written (its `filename`, the `errno` and `strerror` of the
+    failure, as OSError's). Nothing half-written is left behind it."""
+
+    def __str__(self):
+        reason = (self.strerror or "failed").rstrip(".")
+        where = "a file" if self.filename is None else self.filename
+        return f"cannot write {where}: {reason[:1].lower()}{reason[1:]}"
+
+    @property
+    def remedy(self):
+        """What the person can do before running the same command again."""
+        return DISK_ERRORS.get(self.errno, "make the folder writable")
+
+
+def write_failed(error, path):
+    """`error`, an OSError met while writing `path`, as a WriteFailed naming `path`."""
+    if isinstance(error, WriteFailed):
+        return error
+    return WriteFailed(error.errno, error.strerror or str(error),
+                       None if path is None else str(path))
+
+
+def is_disk_failure(error):
+    """Whether `error` says the disk failed (see DISK_ERRORS), not the code that met it."""
+    return isinstance(error, WriteFailed) or (isinstance(error, OSError)
+                                              and error.errno in DISK_ERRORS)
+
+
+def temporary_path(path):
+    """The temporary file this process writes `path` through."""
+    return path.with_name(f".{path.name}.{os.getpid()}.tmp")
+
+
+@contextlib.contextmanager
+def writing(path):
+    """Yields the temporary path to write `path` through; when the block ends without an
+    error, flushes it to the disk and renames it to `path`. Any error removes it; an
+    OSError is raised as WriteFailed naming `path`."""
+    path = pathlib.Path(path)
+    temporary = temporary_path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        yield temporary
+        descriptor = os.open(temporary, os.O_RDONLY)
+        try:
+            os.fsync(descriptor)
+        finally:
+            os.close(descriptor)
+        os.replace(temporary, path)
+    except BaseException as error:
+        with contextlib.suppress(OSError):
+            temporary.unlink(missing_ok=True)
+        if isinstance(error, OSError):
+            raise write_failed(error, path) from error
+        raise
+
+
+def write_atomically(path, text):
+    """Writes `text` to `path` whole or not at all (see `writing`)."""
+    with writing(path) as temporary, open(temporary, "w", newline="") as stream:
+        stream.write(text)
+
+
+def save_figure(figure, path, **options):
+    """`figure.savefig(path, **options)` whole or not at all (see `writing`), in the format
+    `path`'s suffix names."""
+    path = pathlib.Path(path)
+    with writing(path) as temporary:
+        figure.savefig(temporary, format=path.suffix.lstrip("."), **options)
+
+
+def remove_leftovers(folder):
+    """Removes what a stopped study left in `folder`: the temporary files and running
+    markers of its trials (only the study that holds the folder's lock writes there), and
+    the temporary files beside its summary whose process has ended (a `report` may be
+    writing its own)."""
+    folder = pathlib.Path(folder)
+    leftovers = [*folder.glob("trials/*/*.running"), *folder.glob("trials/*/.*.tmp"),
+                 *(path for path in folder.glob(".*.tmp") if not _writer_alive(path))]
+    for leftover in leftovers:
+        with contextlib.suppress(OSError):
+            leftover.unlink(missing_ok=True)
+
+
+def _writer_alive(temporary):
+    """Whether the process that writes `temporary` (its name's PID) still runs."""
+    pid = temporary.name.rsplit(".", 2)[-2]
+    if not pid.isdigit() or int(pid) == os.getpid():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

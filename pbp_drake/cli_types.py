@@ -77,9 +77,9 @@ EXIT_CODES = {
                 "no browser in time for a person's run",
     EXIT_STOPPED: "`run`: the person pressed Stop in the page (a session is resumed by the "
                   "same command)",
-    EXIT_WRITE_FAILED: "`study`, `report`: a file could not be written (no space left, a "
-                       "quota, a read-only or failing disk), said in one line; nothing "
-                       "half-written is left, and the same command resumes",
+    EXIT_WRITE_FAILED: "a file could not be written (no space left, a quota, a read-only or "
+                       "failing disk), said in one line; nothing half-written is left, and "
+                       "the same command resumes a study or session",
     EXIT_INTERRUPTED: "interrupted by Ctrl-C (a study or session is resumed by the same "
                       "command)",
     EXIT_TERMINATED: "`study`, `report`: ended by SIGTERM, as by Ctrl-C (a study is resumed "

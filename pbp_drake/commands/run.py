@@ -1,6 +1,7 @@
 """`pbp-drake run`: one scenario in Meshcat, or a participant's session of a user study."""
 
 import dataclasses
+import functools
 import logging
 import pathlib
 import sys
@@ -12,8 +13,8 @@ from pydrake.geometry import Meshcat, MeshcatParams
 from pbp_drake.builder import (
     build_diagram, check_buildable, find_system, run_task, run_task_streamed, simulate)
 from pbp_drake.cli_types import (
-    EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS, port, realtime_rate,
-    token, wait_seconds)
+    EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS, EXIT_WRITE_FAILED, port,
+    realtime_rate, token, wait_seconds)
 from pbp_drake.commands.run_checks import check_run_flags, is_person, session_methods
 from pbp_drake.console import (
     CAMERAS, Console, LiveRun, Progress, RobotCamera, method_name, result_text)
@@ -27,6 +28,8 @@ from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, GraspTask, MultiGoalReach, ScenarioError, TASK_ROBOTS,
     counted, load_scenario_file, resolve)
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers, scales_text
+from pbp_drake.studies.atomic_files import (
+    is_disk_failure, write_atomically, write_failure_line)
 from pbp_drake.studies.sessions import run_session
 
 #: The choices in the page while a task runs, and after it has ended.
@@ -112,7 +115,7 @@ def add_run_command(commands):
                      help="before starting, wait this long for a browser to open the page "
                      "(default 15); a keyboard or gamepad run that no browser joins in time "
                      "stops with exit 2, having run and recorded nothing")
-    run.set_defaults(handler=_run)
+    run.set_defaults(handler=_saying_write_failures(_run))
 
 
 def scenario_for_run(scenario_file, method=None, alpha=None, scene=None, operator=None,
@@ -542,10 +545,26 @@ def _wait_for_browser(page, seconds, needed=None):
                             f"(--wait-for-browser): {needed}")
 
 
+def _saying_write_failures(command):
+    """`command(args)` that says a file it could not write (a full disk) in one line, exit
+    4, instead of a traceback: replays and sessions are written whole or not at all."""
+
+    @functools.wraps(command)
+    def saying_write_failures(args):
+        try:
+            return command(args)
+        except OSError as error:
+            if not is_disk_failure(error):
+                raise
+            print(write_failure_line(error, "run the same command again"), file=sys.stderr)
+            return EXIT_WRITE_FAILED
+
+    return saying_write_failures
+
+
 def _save_recording(meshcat, path):
     record = pathlib.Path(path)
-    record.parent.mkdir(parents=True, exist_ok=True)
-    record.write_text(recorded_replay(meshcat))
+    write_atomically(record, recorded_replay(meshcat))
     print(f"Replay saved to {record}")
 
 

@@ -20,7 +20,7 @@ from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
     TASK_ROBOTS, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison,
     counted, load_scenario_file)
-from pbp_drake.studies.atomic_files import is_disk_failure, write_failed
+from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
@@ -129,10 +129,8 @@ def _stopping_cleanly(command):
             except OSError as error:
                 if not is_disk_failure(error):
                     raise
-                error = write_failed(error, error.filename)
                 on_a_bar = "\n" if sys.stderr.isatty() else ""  # the progress bar's line
-                print(f"{on_a_bar}pbp-drake: {error}; nothing is left half-written: "
-                      f"{error.remedy}, then the same command resumes.", file=sys.stderr)
+                print(on_a_bar + write_failure_line(error), file=sys.stderr)
                 return EXIT_WRITE_FAILED
 
     return stopping_cleanly

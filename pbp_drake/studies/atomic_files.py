@@ -47,6 +47,13 @@ def write_failed(error, path):
                        None if path is None else str(path))
 
 
+def write_failure_line(error, then="the same command resumes"):
+    """The one line a command prints for `error`, a disk failure (`is_disk_failure`): the
+    file, the reason, and what to do, `then` what the same command does."""
+    error = write_failed(error, error.filename)
+    return f"pbp-drake: {error}; nothing is left half-written: {error.remedy}, then {then}."
+
+
 def is_disk_failure(error):
     """Whether `error` says the disk failed (see DISK_ERRORS), not the code that met it."""
     return isinstance(error, WriteFailed) or (isinstance(error, OSError)

@@ -371,3 +371,18 @@ def test_a_second_study_on_a_folder_being_written_is_refused_with_the_first_ones
                              text=True)
     assert resumed.returncode == 0, resumed.stderr
     assert (folder / "summary.json").read_bytes() == (uninterrupted / "summary.json").read_bytes()
+
+
+@pytest.mark.slow
+def test_a_replay_on_a_full_disk_is_one_line_and_no_half_written_file(small_disk, capsys):
+    disk = small_disk("1m")
+    record = disk / "replay.html"
+    _fill(disk)
+    capsys.readouterr()
+    assert main(["run", str(ROOT / "diagrams" / "toy_alpha_study.yaml"), "--scene",
+                 "scene_1", "--method", "pbp_alternated", "--headless", "--record",
+                 str(record)]) == 4
+    assert capsys.readouterr().err.splitlines() == [
+        f"pbp-drake: cannot write {record}: no space left on device; nothing is left "
+        "half-written: free some space, then run the same command again."]
+    assert not record.exists() and _leftovers(disk) == []

@@ -18,7 +18,8 @@ import yaml
 from pydrake.common import yaml as drake_yaml
 from pydrake.common.yaml import yaml_load_typed
 from yaml.events import (
-    AliasEvent, CollectionEndEvent, CollectionStartEvent, MappingStartEvent, ScalarEvent)
+    AliasEvent, MappingEndEvent, MappingStartEvent, ScalarEvent, SequenceEndEvent,
+    SequenceStartEvent)
 
 from pbp_drake.scenarios.schema import ScenarioError
 
@@ -80,16 +81,44 @@ def check_goal_counts(scenario):
 class _OpenNode:
     """A sequence or mapping whose events are being read."""
 
-    __slots__ = ("field", "anchor", "mapping", "values", "items", "key", "expect_key")
+    __slots__ = ("field", "anchor", "mapping", "goals", "values", "items", "key", "expect_key")
 
     def __init__(self, field, event):
         self.field = field
         self.anchor = event.anchor
         self.mapping = isinstance(event, MappingStartEvent)
+        self.goals = field in GOAL_LISTS
         self.values = 1  # itself and, as they end, everything in it (aliases expanded)
         self.items = 0
         self.key = None
         self.expect_key = True
+
+    def add(self, event, values):
+        """Counts a node of `values` values that `event` starts in this one; returns the
+        new node's field (`scenario.task.objects`, `scenario.goals[3]`), None for a
+        mapping's key or in one."""
+        self.values += values
+        if self.mapping:
+            self.expect_key = not self.expect_key
+            if not self.expect_key:
+                self.key = event.value if type(event) is ScalarEvent else None
+                return None
+            if self.field is None or self.key is None:
+                return None
+            return f"{self.field}.{self.key}" if self.field else str(self.key)
+        self.items += 1
+        if self.goals and self.items > MAX_GOALS:
+            raise ScenarioError(goal_count_problem(self.field, self.items,
+                                                   event.start_mark.line + 1))
+        return None if self.field is None else f"{self.field}[{self.items - 1}]"
+
+
+class _Document(_OpenNode):
+    """What holds the document's root node (of field ``)."""
+
+    def add(self, event, values):
+        self.values += values
+        return ""
 
 
 def check_yaml_bounds(text):
@@ -98,32 +127,30 @@ def check_yaml_bounds(text):
     holds more than MAX_GOALS goals in a list of GOAL_LISTS. Reads the events only; a text
     that does not parse is left to the loader, which says where."""
     anchored = {}  # anchor: (values, items) of the node it names, once that node has ended
-    open_nodes = []
+    open_nodes = [_Document(None, SequenceStartEvent(None, None, True))]
     aliased = 0
+    loader = _BASE_LOADER(text)
     try:
-        for event in yaml.parse(text, Loader=_BASE_LOADER):
-            if isinstance(event, CollectionEndEvent):
+        while loader.check_event():
+            event = loader.get_event()
+            kind = type(event)
+            if kind is ScalarEvent:  # most events: kept short
+                open_nodes[-1].add(event, 1)
+                if event.anchor is not None:
+                    anchored[event.anchor] = (1, 0)
+            elif kind in (SequenceStartEvent, MappingStartEvent):
+                open_nodes.append(_OpenNode(open_nodes[-1].add(event, 0), event))
+            elif kind in (SequenceEndEvent, MappingEndEvent):
                 node = open_nodes.pop()
+                open_nodes[-1].values += node.values
                 if node.anchor is not None:
                     anchored[node.anchor] = (node.values, node.items)
-                if open_nodes:
-                    open_nodes[-1].values += node.values
-                continue
-            if not isinstance(event, (AliasEvent, ScalarEvent, CollectionStartEvent)):
-                continue  # the stream's and the document's start and end
-            field = _field_of(open_nodes, event)
-            if isinstance(event, CollectionStartEvent):
-                open_nodes.append(_OpenNode(field, event))
-                continue
-            if isinstance(event, ScalarEvent):
-                values, items = 1, 0
-                if event.anchor is not None:
-                    anchored[event.anchor] = (values, items)
-            else:
+            elif kind is AliasEvent:
+                values, items = anchored.get(event.anchor, (0, 0))
+                field = open_nodes[-1].add(event, values)
                 if event.anchor not in anchored:
                     _check_alias_target(event, open_nodes, field)
                     continue  # undefined: the loader says so
-                values, items = anchored[event.anchor]
                 aliased += values
                 if aliased > MOST_ALIASED_VALUES:
                     raise ScenarioError(
@@ -131,36 +158,13 @@ def check_yaml_bounds(text):
                         f"file's aliases repeat more than {MOST_ALIASED_VALUES:,} values "
                         f"(*{event.anchor} here repeats {values:,}); a scenario file's "
                         f"aliases may repeat at most {MOST_ALIASED_VALUES:,}")
-                if field in GOAL_LISTS:
-                    problem = goal_count_problem(field, items, event.start_mark.line + 1)
-                    if problem:
-                        raise ScenarioError(problem)
-            if open_nodes:
-                open_nodes[-1].values += values
+                if field in GOAL_LISTS and items > MAX_GOALS:
+                    raise ScenarioError(goal_count_problem(field, items,
+                                                           event.start_mark.line + 1))
     except yaml.YAMLError:
         return
-
-
-def _field_of(open_nodes, event):
-    """The field path (`scenario.task.objects`, list items as `[]`) of the node `event`
-    starts, None for a mapping's key; counts the items of a list of GOAL_LISTS."""
-    if not open_nodes:
-        return ""
-    parent = open_nodes[-1]
-    if parent.mapping:
-        parent.expect_key = not parent.expect_key
-        if not parent.expect_key:  # this node is a key
-            parent.key = event.value if isinstance(event, ScalarEvent) else None
-            return None
-        if parent.field is None or parent.key is None:
-            return None
-        return f"{parent.field}.{parent.key}" if parent.field else str(parent.key)
-    parent.items += 1
-    if parent.field in GOAL_LISTS:
-        problem = goal_count_problem(parent.field, parent.items, event.start_mark.line + 1)
-        if problem:
-            raise ScenarioError(problem)
-    return None if parent.field is None else f"{parent.field}[]"
+    finally:
+        loader.dispose()
 
 
 def _check_alias_target(event, open_nodes, field):
@@ -168,7 +172,8 @@ def _check_alias_target(event, open_nodes, field):
     if any(node.anchor == event.anchor for node in open_nodes):
         raise ScenarioError(f"{field or 'the file'}, line {event.start_mark.line + 1}: the "
                             f"alias *{event.anchor} stands inside the node it names (a "
-                            "cycle); a scenario file's aliases name nodes before them")
+                            "cycle); a scenario file's aliases name nodes that end before "
+                            "them")
 
 
 class _TaggedLoader(_BASE_LOADER):

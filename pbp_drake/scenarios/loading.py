@@ -19,7 +19,8 @@ from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Keyboard, MethodComparison, Scenario, ScenarioError, TASK_ROBOTS,
     STUDY_SPLITS, ScenarioFile)
 from pbp_drake.scenarios.validation import (
-    check_numbers, check_seed, describe_load_error, read_scenario_text, shape_problem)
+    check_duplicate_keys, check_numbers, check_seed, describe_load_error,
+    read_scenario_text, shape_problem)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -40,8 +41,10 @@ def load_scenario_file(path):
         raise ScenarioError(f"{path}: no such scenario file")
     try:
         text = read_scenario_text(path)
-        # Before any value is made: a few lines of aliases can stand for billions.
+        # Before any value is made (a few lines of aliases can stand for billions), and
+        # before the slower walk of the text for duplicate keys.
         check_yaml_bounds(text)
+        check_duplicate_keys(text)
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from None
     try:

@@ -38,8 +38,8 @@ _MERGE_FRAME = "_merge_yaml_dict_item_into_target"
 
 def read_scenario_text(path):
     """The file's text; raises ScenarioError (without the file's name) for a file over
-    MOST_FILE_BYTES, a binary or non-UTF-8 file, a tab in the indentation or a duplicate
-    key."""
+    MOST_FILE_BYTES, a binary or non-UTF-8 file, a tab in the indentation or no scenario
+    at all (then `check_duplicate_keys`)."""
     data = read_bounded(path)
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise ScenarioError("the file is UTF-16 encoded; save it as UTF-8 text")
@@ -60,7 +60,6 @@ def read_scenario_text(path):
         # Drake's loader reads an empty document as None and fails with a TypeError.
         raise ScenarioError("the file is empty; expected a scenario file starting with "
                             "`scenario:`")
-    check_duplicate_keys(text)
     return text
 
 

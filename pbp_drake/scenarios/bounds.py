@@ -40,8 +40,6 @@ GOAL_LISTS = {"scenario.goals": "goals", "scenario.task.objects": "objects"}
 
 # PyYAML's C loader where PyYAML was built with libyaml, else its Python one.
 _BASE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-#: Whether scenario files are parsed by libyaml (PyYAML's C loader).
-C_LOADER = _BASE_LOADER is not yaml.SafeLoader
 
 
 def read_bounded(path):

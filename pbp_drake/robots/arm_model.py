@@ -1,6 +1,7 @@
 """Loading a fixed-base arm from a URDF or SDFormat file into a MultibodyPlant, with the
-checks a user's own model needs: the file, the frames, the chain from the base to the
-end effector, the joints' limits, and the ready configuration.
+checks a user's own model needs: the file (`pbp_drake.robots.model_checks`, before Drake
+reads it), the frames, the chain from the base to the end effector, the joints' limits,
+the ready configuration and, for dynamic motion, its mass matrix there.
 
 Every refusal is a one-line ValueError naming the `ArmStationConfig` field at fault.
 """
@@ -13,6 +14,7 @@ from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.parsing import Parser
 
 from pbp_drake.robots.hsr_model import configure_parser
+from pbp_drake.robots.model_checks import check_model_file, escaped, printable
 
 # The ready configuration's ee_frame z axis must be at most this far (degrees) off the
 # floor plane: the heading is where that axis points in it.
@@ -38,24 +40,19 @@ def add_arm(plant, config, parser=None):
     Raises ValueError naming the field for a file that is missing or does not parse, a
     frame the model has not, an end effector that is not downstream of the base, a joint
     without limits or of a kind the station cannot move."""
+    check_model_file(config.model_file, config.motion)
     parser = parser or Parser(plant)
     configure_parser(parser)
     source = config.model_file
     try:
-        if source.startswith("package://"):
+        if "://" in source:
             models = parser.AddModels(url=source)
         else:
-            path = Path(source)
-            if not path.is_file():
-                raise ValueError(f"ArmStationConfig.model_file: no file at {source!r} (a path "
-                                 "from the working folder, or a package:// URL)")
-            models = parser.AddModels(str(path))
-    except ValueError:
-        raise
+            models = parser.AddModels(str(Path(source)))
     except Exception as error:  # Drake's parser raises RuntimeError with the details
         first = str(error).strip().splitlines()[0] if str(error).strip() else type(error)
-        raise ValueError(f"ArmStationConfig.model_file {source!r} does not load: {first}"
-                         ) from None
+        raise ValueError(f"ArmStationConfig.model_file {printable(source)} does not load: "
+                         f"{escaped(str(first))}") from None
     if len(models) != 1:
         raise ValueError(f"ArmStationConfig.model_file {source!r} holds {len(models)} models; "
                          "the station takes one arm")
@@ -72,7 +69,7 @@ def add_arm(plant, config, parser=None):
                          f"{joint.parent_body().name()!r}; name the link the arm stands on")
     chain, body = [], ee_frame.body()
     while body.index() != base_body.index():
-        if int(body.index()) not in inboard:
+        if int(body.index()) not in inboard or len(chain) > len(inboard):
             raise ValueError(f"ArmStationConfig.ee_frame {config.ee_frame!r} is not "
                              f"downstream of base_frame {config.base_frame!r}: its chain "
                              f"ends at {body.name()!r}")
@@ -144,6 +141,8 @@ def ready_positions(plant, arm, config):
                              f"{value:g} is outside its limits [{lower:g}, {upper:g}]")
     context = plant.CreateDefaultContext()
     plant.SetPositions(context, q0)
+    if config.motion == "dynamic":
+        _check_mass_matrix(plant, arm, context, config)
     z_axis = arm.ee_frame.CalcPoseInWorld(context).rotation().matrix()[:, 2]
     tilt = np.degrees(np.arcsin(np.clip(abs(z_axis[2]), 0.0, 1.0)))
     if tilt > MAX_TILT_DEGREES:
@@ -152,6 +151,28 @@ def ready_positions(plant, arm, config):
                          f"plane in the ready configuration (at most {MAX_TILT_DEGREES:g}): "
                          "the hand's heading is where that axis points")
     return q0
+
+
+# The mass matrix is singular (a joint whose motion moves no inertia) when its smallest
+# eigenvalue is this small against its largest: Drake's dynamics then fail mid-run.
+SINGULAR_MASS_MATRIX = 1e-10
+
+
+def _check_mass_matrix(plant, arm, context, config):
+    """Dynamic motion steps the plant: its mass matrix must be positive-definite (the file's
+    checks refuse a joint that moves no mass; this one, a joint that turns no inertia)."""
+    mass_matrix = plant.CalcMassMatrix(context)
+    moments, directions = np.linalg.eigh(mass_matrix)
+    if moments[0] > SINGULAR_MASS_MATRIX * max(moments[-1], 1e-300):
+        return
+    velocity = int(np.argmax(np.abs(directions[:, 0])))
+    joint = next(joint for joint in arm.joints if joint.velocity_start() == velocity)
+    raise ValueError(f"ArmStationConfig.model_file {printable(config.model_file)}: joint "
+                     f"{printable(joint.name())} moves no inertia about its axis (the mass "
+                     f"matrix is singular in the ready configuration): link "
+                     f"{printable(joint.child_body().name())} and what hangs from it need "
+                     "mass and inertia <inertial> that the joint turns; motion: dynamic "
+                     "needs them (or use motion: kinematic)")
 
 
 def reach_of(plant, arm, q0):

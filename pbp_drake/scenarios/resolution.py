@@ -24,11 +24,13 @@ from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_o
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
+from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.scenarios.bounds import check_goal_counts
 from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
-    DynamicObstacles, Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError,
+    DynamicObstacles, Gamepad, GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, Scenario,
+    ScenarioError,
     ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
     VirtualParticipant)
 from pbp_drake.scenarios.validation import (
@@ -386,8 +388,12 @@ def _resolve_task_robot(scenario):
         reach = None
     try:
         scene = task_scene(task, scenario.seed, reach)
+        if isinstance(robot, Arm):
+            check_clear_of_base(station, _scene_boxes(task, scene, scenario.seed),
+                                "scenario.robot.model_file")
     except ValueError as error:
-        raise ScenarioError(f"scenario.task: {error}") from None
+        raise ScenarioError(f"scenario.task: {error}".replace("scenario.task: scenario.",
+                                                              "scenario.")) from None
     # The HSR's hand starts at the task's height; the station ramps between the loop's
     # ticks, and it measures the task's cylinders against the robot.
     cylinders = [] if scene.obstacles is None else [
@@ -438,6 +444,26 @@ def _arm_station(scenario, station):
         raise ScenarioError(str(error).replace("ArmStationConfig.", "scenario.robot.")
                             ) from None
     return station, initial_ee_state, reach
+
+
+def _scene_boxes(task, scene, seed):
+    """`(what, lower, upper)` of what the task places: given objects as points, the
+    region objects are drawn from, and the obstacles drawn from `seed` (cylinders on the
+    floor) as their boxes."""
+    if isinstance(task, MultiGoalReach) and task.objects:
+        return [(f"scenario.task.objects[{index}] ({', '.join(f'{v:.2f}' for v in point)}) m",
+                 point, point) for index, point in enumerate(scene.objects)]
+    heights = getattr(task, "z_range", None) or [task.height, task.height]
+    names = "z_range" if getattr(task, "z_range", None) else "height"
+    boxes = [(f"scenario.task.x_range, y_range and {names} (where the objects are drawn)",
+              [task.x_range[0], task.y_range[0], heights[0]],
+              [task.x_range[1], task.y_range[1], heights[1]])]
+    for index, (x, y) in enumerate(getattr(scene.obstacles, "obstacle_starts", [])):
+        radius = task.obstacle_radius
+        boxes.append((f"scenario.task's obstacle {index} (drawn with seed {seed} at ({x:.2f}, "
+                      f"{y:.2f}) m, obstacle_radius {radius:g} m)", [x - radius, y - radius, 0.0],
+                      [x + radius, y + radius, task.obstacle_height]))
+    return boxes
 
 
 def _check_hand_over(scenario):

@@ -27,6 +27,7 @@ from pbp_drake.output_paths import (
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, Gamepad, GraspTask, MultiGoalReach, ScenarioError, TASK_ROBOTS,
     counted, load_scenario_file, resolve)
+from pbp_drake.scenarios.bounds import MAX_GOALS
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers, scales_text
 from pbp_drake.studies.atomic_files import (
     is_disk_failure, write_atomically, write_failure_line)
@@ -41,8 +42,8 @@ PERSON_NEEDS_PAGE = ("the keyboard and gamepad are read in the page, so nothing 
                      "recorded")
 
 
-# The most objects `--goals` places: the loop runs live with 10,000 (docs/performance.md).
-MOST_GRID_GOALS = 100_000
+# The most objects `--goals` places: as many as a scenario file may hold.
+MOST_GRID_GOALS = MAX_GOALS
 
 
 def add_run_command(commands):

@@ -1,4 +1,5 @@
-"""Reading a scenario file: parsed by `yaml_load_typed`, then resolved (which checks it).
+"""Reading a scenario file: its size and YAML bounded (`bounds`), parsed once by PyYAML's C
+loader, read into the schema by Drake's typed loader, then resolved (which checks it).
 
 Unknown or misspelled keys are errors that name the key (with a suggestion); values are
 checked by `resolve`, and a study section by the checks here.
@@ -10,15 +11,16 @@ import re
 import typing
 
 import numpy as np
-from pydrake.common.yaml import yaml_load_typed
 
+from pbp_drake.scenarios.bounds import check_yaml_bounds, load_document, load_typed
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
     AlphaStudy, Gamepad, Keyboard, MethodComparison, Scenario, ScenarioError, TASK_ROBOTS,
     STUDY_SPLITS, ScenarioFile)
 from pbp_drake.scenarios.validation import (
-    check_numbers, check_seed, describe_load_error, read_scenario_text, shape_problem)
+    check_duplicate_keys, check_numbers, check_seed, describe_load_error,
+    read_scenario_text, shape_problem)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -39,14 +41,22 @@ def load_scenario_file(path):
         raise ScenarioError(f"{path}: no such scenario file")
     try:
         text = read_scenario_text(path)
+        # Before any value is made (a few lines of aliases can stand for billions), and
+        # before the slower walk of the text for duplicate keys.
+        check_yaml_bounds(text)
+        check_duplicate_keys(text)
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from None
-    # Before the loader: it accepts some of these and misreports the others.
-    problem = shape_problem(text, ScenarioFile)
+    try:
+        document = load_document(text)
+    except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
+        raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
+    # Before the typed loader: it accepts some of these and misreports the others.
+    problem = shape_problem(document, ScenarioFile)
     if problem:
         raise ScenarioError(f"{path}: {problem}")
     try:
-        loaded = yaml_load_typed(schema=ScenarioFile, data=text)
+        loaded = load_typed(ScenarioFile, document, text)
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
         raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
     try:

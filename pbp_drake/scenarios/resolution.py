@@ -25,6 +25,7 @@ from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.model_geometry import check_clear_of_base
+from pbp_drake.scenarios.bounds import check_goal_counts
 from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
@@ -176,6 +177,7 @@ def close_match(name, choices):
 
 
 def _check_common(scenario):
+    check_goal_counts(scenario)  # first: every check after it walks the goals
     check_numbers(scenario)
     renamed_method(scenario.method, "scenario.method")
     if scenario.method not in METHODS:

@@ -21,10 +21,10 @@ import types
 import typing
 
 import numpy as np
-from pydrake.common.yaml import yaml_load
 
 from pbp_drake.core.pilot_population import ParticipantPopulationParams, population_problem
 from pbp_drake.core.surrogate_pilots import ProportionalPilotParams
+from pbp_drake.scenarios.bounds import read_bounded
 from pbp_drake.scenarios.schema import ScenarioError
 
 
@@ -37,9 +37,10 @@ _MERGE_FRAME = "_merge_yaml_dict_item_into_target"
 
 
 def read_scenario_text(path):
-    """The file's text; raises ScenarioError (without the file's name) for a binary or
-    non-UTF-8 file, a tab in the indentation or a duplicate key."""
-    data = path.read_bytes()
+    """The file's text; raises ScenarioError (without the file's name) for a file over
+    MOST_FILE_BYTES, a binary or non-UTF-8 file, a tab in the indentation or no scenario
+    at all (then `check_duplicate_keys`)."""
+    data = read_bounded(path)
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise ScenarioError("the file is UTF-16 encoded; save it as UTF-8 text")
     if b"\0" in data:
@@ -59,7 +60,6 @@ def read_scenario_text(path):
         # Drake's loader reads an empty document as None and fails with a TypeError.
         raise ScenarioError("the file is empty; expected a scenario file starting with "
                             "`scenario:`")
-    check_duplicate_keys(text)
     return text
 
 
@@ -218,14 +218,10 @@ def _describe_schema(schema):
 # 2. The file's mappings walked next to its schema, for what Drake's loader misreports.
 
 
-def shape_problem(text, schema):
+def shape_problem(data, schema):
     """`field.path: what is wrong; expected ...` for the first unknown key, or value that
-    is not a mapping where the schema has one, of the YAML `text` read as `schema`; None
-    when there is none (or the text does not parse: the loader reports that)."""
-    try:
-        data = yaml_load(data=text, private=True)
-    except Exception:  # noqa: BLE001 - Drake's loader reports what does not parse
-        return None
+    is not a mapping where the schema has one, of the YAML document `data` (as
+    `bounds.load_document` reads it) read as `schema`; None when there is none."""
     if not isinstance(data, dict):
         return None
     return _first_problem(data, schema, "")

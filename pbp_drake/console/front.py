@@ -35,20 +35,22 @@ An example (the thread that made `meshcat`)::
 import asyncio
 import collections
 import concurrent.futures
+import contextlib
 import email.utils
 import errno
 import hmac
 import http
+import http.client
 import json
 import logging
 import math
 import re
 import secrets
 import socket
+import sys
 import threading
 import time
 import urllib.parse
-import urllib.request
 
 import msgpack
 from websockets.asyncio.client import connect
@@ -56,6 +58,10 @@ from websockets.asyncio.server import serve
 from websockets.datastructures import Headers
 from websockets.exceptions import InvalidHandshake
 from websockets.http11 import Response
+
+from pbp_drake.console.meshcat_door import MeshcatDoor
+from pbp_drake.console.page_messages import MAX_MESSAGE, BadMessage, read_page_message
+from pbp_drake.systems.operators.browser_guard import register_front, unregister_front
 
 LOG = logging.getLogger(__name__)  # websockets' connection log, every poll: INFO
 COOKIE = "pbp_drake_token"
@@ -74,6 +80,13 @@ SEND_BUFFER = 2**15
 # batch of latest states a frame, and its main thread always has time for the panel. (A
 # client that never answers, not our page, is sent batches as fast as it reads.)
 FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
+# A page's bad frame: its websocket is closed with this code (policy violation) and a reason.
+BAD_FRAME_CLOSE = 1008
+# Accept errors (out of file descriptors) closer together than this are one burst: one line.
+ACCEPT_BURST = 10.0
+# A connection to Meshcat the front closed still counts as its own this long: Meshcat
+# counts it until it has read the close.
+CLOSING_GRACE = 1.0
 
 INJECTION = """
 <style>
@@ -267,9 +280,8 @@ def _response(status, body, content_type, *headers):
         ("Content-Length", str(len(body))), ("Content-Type", content_type), *headers]), body)
 
 
-def _fetch(url):
-    with urllib.request.urlopen(url, timeout=10.0) as reply:
-        return reply.read(), reply.headers.get("Content-Type") or "application/octet-stream"
+def _warn(message):
+    print(f"pbp-drake: {message}", file=sys.stderr, flush=True)
 
 
 class PageFront:
@@ -288,21 +300,30 @@ class PageFront:
 
     def __init__(self, meshcat_port, listen_socket=None, token=None, host="localhost"):
         self._token = new_token() if token is None else check_token(token)
-        self._upstream = f"localhost:{meshcat_port}"
+        self._meshcat_port = meshcat_port
         self._socket = listen_socket or bind_page_port(0, host)
         self._port = self._socket.getsockname()[1]
         self._host = "localhost" if host in ("", "0.0.0.0", "::") else host
         self._lock = threading.Lock()
         self._state = dict.fromkeys((*LINES, "time"), None) | {"ended": False, "seq": 0}
         self._ended_pages, self._relays, self._closed = set(), 0, False
+        self._upstreams, self._closed_upstreams = 0, collections.deque()  # close times
+        self._accept_errors = None  # the last accept error's time, in a burst
         self._wakers = set()  # each relay's event: the state changed, send it
+        self._door = MeshcatDoor(meshcat_port)
+        if not self._door.shut:
+            _warn(f"Meshcat's port stays open to other programs on this machine "
+                  f"({self._door.reason}): what a connection the page front did not open "
+                  "sends is ignored while it stays")
         try:
             self._files = self._fetch_page()
-        except (OSError, ValueError) as error:
+        except (OSError, ValueError, http.client.HTTPException) as error:
             self._socket.close()
+            self._door.close()
             raise ConnectionError(f"Meshcat at port {meshcat_port} did not serve its page: "
                                   f"{error}") from error
         self._loop = asyncio.new_event_loop()
+        self._loop.set_exception_handler(self._loop_error)
         self._thread = threading.Thread(target=self._loop.run_forever, daemon=True,
                                         name=f"pbp-page-front-{self._port}")
         self._thread.start()
@@ -310,7 +331,9 @@ class PageFront:
             self._server = asyncio.run_coroutine_threadsafe(self._serve(), self._loop).result(10)
         except BaseException:
             self._loop.call_soon_threadsafe(self._loop.stop)
+            self._door.close()
             raise
+        register_front(meshcat_port, self)
 
     @property
     def url(self):
@@ -325,8 +348,23 @@ class PageFront:
         return self._token
 
     def pages(self):
-        """How many pages are relayed now (authorised websockets open to Meshcat)."""
+        """How many pages are relayed now (admitted websockets with their own connection
+        to Meshcat): what `BrowserGuard` counts behind the front."""
         return self._relays
+
+    def own_connections(self):
+        """How many connections to Meshcat are the front's: open, opening, or closed less
+        than `CLOSING_GRACE` seconds ago (Meshcat may not have read the close yet)."""
+        with self._lock:
+            now = time.monotonic()
+            while self._closed_upstreams and self._closed_upstreams[0] < now - CLOSING_GRACE:
+                self._closed_upstreams.popleft()
+            return self._upstreams + len(self._closed_upstreams)
+
+    @property
+    def door_shut(self):
+        """Whether Meshcat's port is shut to all but the front (see `meshcat_door`)."""
+        return self._door.shut
 
     def show(self, **lines):
         """Sets the given lines of the page's panel (title, status, result, notice; None
@@ -367,6 +405,7 @@ class PageFront:
             if self._closed:
                 return
             self._closed = True
+        unregister_front(self._meshcat_port, self)
         try:
             asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(5.0)
         except concurrent.futures.TimeoutError:
@@ -375,6 +414,7 @@ class PageFront:
         self._thread.join(5.0)
         if not self._thread.is_alive():
             self._loop.close()
+        self._door.close()
 
     def __enter__(self):
         return self
@@ -394,14 +434,14 @@ class PageFront:
     def _fetch_page(self):
         # Meshcat's page, its script (wherever the page says: Drake 1.51 serves it at a
         # content address, not /meshcat.js) and icon, fetched once, here, off the loop.
-        html, _ = _fetch(f"http://{self._upstream}/")
+        html, _ = self._door.get("/")
         html = html.decode()
         script = re.search(r'<script[^>]*\bsrc="([^"]+)"', html)
         if script is None or "</body>" not in html:
             raise ValueError("the page has no script or no </body>")
         source = "/" + script.group(1).lstrip("/")
-        code, code_type = _fetch(f"http://{self._upstream}{source}")
-        icon, icon_type = _fetch(f"http://{self._upstream}/favicon.ico")
+        code, code_type = self._door.get(source)
+        icon, icon_type = self._door.get("/favicon.ico")
         page = html.replace("</body>", INJECTION + "</body>", 1).encode()
         return {**{path: (page, "text/html; charset=utf-8") for path in _PAGES},
                 source: (code, code_type), "/meshcat.js": (code, code_type),
@@ -416,7 +456,21 @@ class PageFront:
         # being slow; a closed tab closes its socket anyway.
         return await serve(self._relay, sock=self._socket, process_request=self._answer,
                            write_limit=WRITE_LIMIT, compression=None, ping_interval=None,
-                           server_header=None, logger=LOG)
+                           max_size=MAX_MESSAGE, server_header=None, logger=LOG)
+
+    def _loop_error(self, loop, context):
+        """asyncio's errors: an accept that failed (out of file descriptors: asyncio
+        retries each second) is one line per burst, not a traceback each time."""
+        error = context.get("exception")
+        if not context.get("message", "").startswith("socket.accept() out of system"):
+            loop.default_exception_handler(context)
+            return
+        now = time.monotonic()
+        if self._accept_errors is None or now - self._accept_errors > ACCEPT_BURST:
+            why = error.strerror if isinstance(error, OSError) and error.strerror else error
+            _warn(f"the page's port cannot accept connections for now ({why}); "
+                  "it retries each second, and the run goes on")
+        self._accept_errors = now
 
     def _authorised(self, request, query):
         offered = list(query.get("token", []))
@@ -430,6 +484,8 @@ class PageFront:
 
     async def _answer(self, connection, request):
         """The request's response, or None to go on to the websocket (the relay)."""
+        if not request.path.startswith("/"):  # `GET etc/passwd`, `GET ?token=T`
+            return connection.respond(400, "A request's target starts with '/'.\n")
         url = urllib.parse.urlsplit(request.path)
         query = urllib.parse.parse_qs(url.query)
         if not self._authorised(request, query):
@@ -452,8 +508,8 @@ class PageFront:
             return _response(200, body, "application/json", ("Cache-Control", "no-store"))
         if path not in self._files:
             try:  # a mesh's or texture's file, at its content address
-                found = await asyncio.to_thread(_fetch, f"http://{self._upstream}{path}")
-            except (OSError, ValueError):
+                found = await asyncio.to_thread(self._door.get, path)
+            except (OSError, ValueError, http.client.HTTPException):
                 return _response(404, b"Not found\n", "text/plain; charset=utf-8")
             if not path.startswith("/cas-v1/"):
                 return _response(200, *found, ("Cache-Control", "no-cache"))
@@ -462,16 +518,36 @@ class PageFront:
         return _response(200, body, content_type, ("Cache-Control", "no-cache"))
 
     async def _relay(self, page):
-        """One page's relay: one websocket to Meshcat of its own, so Meshcat counts it."""
+        """One page's relay: a connection to Meshcat of its own (through the door), closed
+        when the page goes or Meshcat does, whichever goes first, whenever it goes."""
+        with self._lock:
+            self._upstreams += 1
+        sock = meshcat = port = None
         try:
-            meshcat = await connect(f"ws://{self._upstream}/", max_size=None,
-                                    compression=None, ping_interval=None, open_timeout=5.0,
-                                    logger=LOG)
+            sock = await asyncio.to_thread(self._door.connect, 5.0)
+            port = sock.getsockname()[1]
+            meshcat = await connect(f"ws://localhost:{self._meshcat_port}/", sock=sock,
+                                    max_size=None, compression=None, ping_interval=None,
+                                    open_timeout=5.0, logger=LOG)
         except (OSError, TimeoutError, InvalidHandshake):
             await page.close(1011, "Meshcat is not reachable")
-            return
-        page.transport.get_extra_info("socket").setsockopt(
-            socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
+        else:
+            await self._relay_between(page, meshcat)
+        finally:
+            if port is not None:
+                self._door.forget(port)  # first: no other socket may take it meanwhile
+            if meshcat is not None:
+                await asyncio.gather(meshcat.close(), return_exceptions=True)
+            if sock is not None:
+                sock.close()  # did the websocket not start, it is still ours
+            with self._lock:
+                self._upstreams -= 1
+                self._closed_upstreams.append(time.monotonic())
+
+    async def _relay_between(self, page, meshcat):
+        with contextlib.suppress(OSError, AttributeError):  # None, or closed: page gone
+            page.transport.get_extra_info("socket").setsockopt(
+                socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
         pending, ready, acked = PendingMessages(), asyncio.Event(), asyncio.Event()
         paced = False  # until the page's first ACK: a client that never answers
         sent_seq = -1  # the panel state this page was sent last
@@ -484,8 +560,13 @@ class PageFront:
                     paced = True
                     acked.set()
                     ready.set()
-                elif not isinstance(message, str):  # Meshcat reads msgpack, never text
-                    await meshcat.send(message)
+                    continue
+                try:  # only what Meshcat's page sends, freshly encoded: Meshcat's parser
+                    message = read_page_message(message)  # dies on bytes it cannot read
+                except BadMessage as error:
+                    await page.close(BAD_FRAME_CLOSE, f"bad message: {error}"[:120])
+                    return
+                await meshcat.send(message)
 
         async def from_meshcat():
             async for message in meshcat:
@@ -529,5 +610,5 @@ class PageFront:
             for task in tasks:
                 task.cancel()
             await asyncio.gather(*tasks, return_exceptions=True)
-            await asyncio.gather(meshcat.close(), page.close(), return_exceptions=True)
+            await asyncio.gather(page.close(), return_exceptions=True)
 

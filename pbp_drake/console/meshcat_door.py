@@ -156,9 +156,14 @@ def _listeners(port):
     found = []
     for name in os.listdir("/proc/self/fd"):
         try:
-            sock = socket.socket(fileno=os.dup(int(name)))
-        except (OSError, ValueError):
-            continue  # not a socket, or closed meanwhile
+            duplicate = os.dup(int(name))
+        except OSError:
+            continue  # closed meanwhile
+        try:
+            sock = socket.socket(fileno=duplicate)
+        except OSError:
+            os.close(duplicate)  # not a socket
+            continue
         try:
             if (sock.type == socket.SOCK_STREAM
                     and sock.family in (socket.AF_INET, socket.AF_INET6)

@@ -8,6 +8,8 @@ Meshcat is used only from the test's thread; the clients are plain sockets and w
 
 import gc
 import socket
+import subprocess
+import sys
 import threading
 import time
 
@@ -197,3 +199,44 @@ def test_two_admitted_pages_still_pause(meshcat, front):
             assert guard.wait_while_shared() and guard.pauses == 1
             assert announced[0].startswith("Paused: 2 browsers are connected")
             closer.join()
+
+
+# Out of file descriptors: the front's accepts fail while clients of this same process hold
+# every descriptor; asyncio retries each second. Then the clients go and the page is served.
+OUT_OF_DESCRIPTORS = """
+import os, resource, socket, sys, time, urllib.request
+from pydrake.geometry import Meshcat, MeshcatParams
+from pbp_drake.console.front import PageFront
+meshcat = Meshcat(MeshcatParams(host="localhost", port=0))
+front = PageFront(meshcat.port())
+open_now = len(os.listdir("/proc/self/fd"))
+resource.setrlimit(resource.RLIMIT_NOFILE,
+                   (open_now + 40, resource.getrlimit(resource.RLIMIT_NOFILE)[1]))
+held = []
+try:
+    while True:
+        held.append(socket.create_connection(("localhost", front.port), timeout=5))
+except OSError:
+    pass
+failures, deadline = set(), time.monotonic() + 20
+while len(failures) < 3 and time.monotonic() < deadline:  # three accepts refused
+    if front._accept_errors is not None:
+        failures.add(front._accept_errors)
+    time.sleep(0.05)
+for client in held:
+    client.close()
+url = f"http://localhost:{front.port}/pbp/state?token={front.token}"
+with urllib.request.urlopen(url, timeout=10) as reply:
+    print("refused", len(failures), "then served", reply.status)
+front.close()
+"""
+
+
+@pytest.mark.slow  # a Meshcat in a process, out of descriptors for three seconds
+@pytest.mark.timeout(90)
+def test_out_of_descriptors_is_one_line_and_the_page_is_served_after(repo):
+    done = subprocess.run([sys.executable, "-c", OUT_OF_DESCRIPTORS], cwd=repo, timeout=80,
+                          capture_output=True, text=True)
+    assert done.stdout.strip() == "refused 3 then served 200", done.stderr
+    assert done.stderr.count("the page's port cannot accept connections") == 1, done.stderr
+    assert "Traceback" not in done.stderr, done.stderr

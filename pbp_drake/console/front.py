@@ -6,7 +6,19 @@ port and serves the public one itself: the page (Meshcat's, with our console pan
 and a websocket relay to Meshcat, only to a client that presents the run's secret token (in
 the URL as `?token=T`, as Jupyter does, then in a cookie) and, for the websocket, an
 `Origin` equal to the page's own. A refused request never reaches Meshcat: no upstream
-connection is opened for it.
+connection is opened for it; a request target not starting with `/` gets 400.
+
+The front is the only door. Meshcat's own port is shut to every connection but the
+front's (`meshcat_door`: a socket filter on Meshcat's listening socket, Linux), so no other
+program or page reaches it; where that cannot be done, the front says so in one line and
+`BrowserGuard` ignores what arrives while a connection the front did not open is there. A
+page's frames reach Meshcat only as a fresh encoding of one of the messages Meshcat's page
+sends (`page_messages`; Meshcat's parser takes the process down on a frame that is not
+msgpack); any other frame closes that page's websocket with code `BAD_FRAME_CLOSE` and the
+reason, a frame over `MAX_MESSAGE` bytes with 1009. A page's connection to Meshcat is closed
+when the page goes, whichever goes first; `pages()` counts the pages admitted, which is
+what the guard's two-page pause counts (`register_front`). Accept errors (out of file
+descriptors) print one line a burst.
 
 The front never calls a Meshcat method (those belong to the thread that made the Meshcat);
 it talks to Meshcat's port over the network, from an asyncio loop on a daemon thread. Close
@@ -16,9 +28,10 @@ another thread, and a Meshcat left in a reference cycle dies in whichever thread
 - `new_token()`, `check_token(text)`: a fresh token; a `--token` checked (or ValueError).
 - `bind_page_port(port, host)`: the public port bound before anything is built (PortError).
 - `PageFront(meshcat_port, listen_socket=None, token=None, host="localhost")`: serving once
-  made; `url`, `port`, `token`; `pages()`, `show(**lines)`, `state()`, `end(text)`, `close()`.
-- `PendingMessages`, `message_key`: the relay's bounded queue toward a slow page, which
-  gets a batch of the latest poses and properties, ended by the text frame `FRAME`, and
+  made; `url`, `port`, `token`, `door_shut`; `pages()`, `own_connections()`,
+  `show(**lines)`, `state()`, `end(text)`, `close()`.
+- `PendingMessages`, `message_key` (from `pending_messages`): the relay's bounded queue
+  toward a slow page, which gets a batch of the latest poses and properties, ended by the text frame `FRAME`, and
   the next batch once it has answered `ACK` at its next animation frame.
 
 An example (the thread that made `meshcat`)::
@@ -52,7 +65,6 @@ import threading
 import time
 import urllib.parse
 
-import msgpack
 from websockets.asyncio.client import connect
 from websockets.asyncio.server import serve
 from websockets.datastructures import Headers
@@ -61,6 +73,7 @@ from websockets.http11 import Response
 
 from pbp_drake.console.meshcat_door import MeshcatDoor
 from pbp_drake.console.page_messages import MAX_MESSAGE, BadMessage, read_page_message
+from pbp_drake.console.pending_messages import PendingMessages, message_key
 from pbp_drake.systems.operators.browser_guard import register_front, unregister_front
 
 LOG = logging.getLogger(__name__)  # websockets' connection log, every poll: INFO
@@ -195,75 +208,6 @@ def bind_page_port(port, host="localhost"):
             raise PortError(f"port {port} may not be bound by this process "
                             f"(use --port 0 for a free one)") from None
         raise
-
-
-def message_key(message):
-    """What a Meshcat message sets, when a later one of the same key replaces it (a body's
-    pose, one property, the real-time rate), else None: a barrier that must keep its place.
-    Reads only the map's small fields; a mesh's bytes are skipped, not decoded."""
-    if not isinstance(message, bytes):
-        return None
-    fields = {}
-    try:
-        unpacker = msgpack.Unpacker(raw=False)
-        unpacker.feed(message)
-        for _ in range(unpacker.read_map_header()):
-            name = unpacker.unpack()
-            if name in ("type", "path", "property"):
-                fields[name] = unpacker.unpack()
-            else:
-                unpacker.skip()
-    except (ValueError, TypeError, msgpack.UnpackException):
-        return None
-    kind, path = fields.get("type"), str(fields.get("path"))
-    if kind == "set_transform":
-        return (kind, path)
-    if kind == "set_property":
-        return (kind, path, str(fields.get("property")))
-    if kind == "realtime_rate":
-        return (kind,)
-    return None
-
-
-class PendingMessages:
-    """Meshcat's messages waiting for a slow page, bounded by what they set, not by time.
-
-    A message with a key replaces its pending predecessor of the same key (where that one
-    stood); a message without a key is a barrier: nothing moves across it. So the queue is
-    a list of segments, each the keyed messages since the last barrier and the barrier that
-    closes it; under a flood of poses of a few bodies it stays a few messages long.
-    """
-
-    def __init__(self):
-        self._segments = collections.deque([[{}, None]])  # [key -> message, barrier]
-        self._size = 0
-
-    def put(self, key, message):
-        keyed, _ = self._segments[-1]
-        if key is None:
-            self._segments[-1][1] = message
-            self._segments.append([{}, None])
-        elif key in keyed:
-            keyed[key] = message
-            return
-        else:
-            keyed[key] = message
-        self._size += 1
-
-    def pop(self):
-        """The oldest pending message; IndexError when none is."""
-        if not self._size:
-            raise IndexError("no message is pending")
-        keyed, barrier = self._segments[0]
-        self._size -= 1
-        if keyed:
-            return keyed.pop(next(iter(keyed)))
-        # An empty segment that is not the open last one ends in its barrier.
-        self._segments.popleft()
-        return barrier
-
-    def __len__(self):
-        return self._size
 
 
 def _panel_value(name, value):

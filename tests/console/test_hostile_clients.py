@@ -101,7 +101,7 @@ def test_unknown_messages_and_oversized_frames_close_their_page(meshcat, front):
                 hostile.send(frame)
                 assert _closed(hostile)[0] == expected
         _press(person, meshcat)
-        assert meshcat.GetNumActiveConnections() == 1
+        assert _until(lambda: front.pages() == 1 and meshcat.GetNumActiveConnections() == 1)
 
 
 def test_meshcats_port_lets_in_nobody_but_the_front(meshcat, front):

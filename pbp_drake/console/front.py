@@ -406,6 +406,9 @@ class PageFront:
         """asyncio's errors: an accept that failed (out of file descriptors: asyncio
         retries each second) is one line per burst, not a traceback each time."""
         error = context.get("exception")
+        if self._closed and isinstance(error, ValueError) and "_start_serving" in repr(
+                context.get("handle")):
+            return  # asyncio's retry of such an accept, after the port was closed
         if not context.get("message", "").startswith("socket.accept() out of system"):
             loop.default_exception_handler(context)
             return

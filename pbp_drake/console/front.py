@@ -511,6 +511,7 @@ class PageFront:
                 try:  # only what Meshcat's page sends, freshly encoded: Meshcat's parser
                     message = read_page_message(message)  # dies on bytes it cannot read
                 except BadMessage as error:
+                    _warn(f"a page's connection was closed: it sent a bad message ({error})")
                     await page.close(BAD_FRAME_CLOSE, f"bad message: {error}"[:120])
                     return
                 await meshcat.send(message)

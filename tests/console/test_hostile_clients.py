@@ -136,11 +136,22 @@ def _handshake(front, read_answer):
 
 def test_pages_that_close_as_they_connect_leave_no_connection_to_meshcat(
         meshcat, front, caplog):
-    with _page(front) as person:
+    announced = []
+    guard = BrowserGuard(meshcat, announce=announced.append)
+
+    def quick_pages():
         for i in range(20):
             _handshake(front, read_answer=i % 2 == 0)
             with _page(front):
                 pass
+
+    with _page(front) as person:
+        assert _until(lambda: front.pages() == 1)
+        closer = threading.Thread(target=quick_pages)
+        closer.start()
+        while closer.is_alive():  # the operator's ticks meanwhile: never a pause
+            guard.wait_while_shared()
+        assert guard.pauses == 0 and not announced, announced
         assert _until(lambda: front.pages() == 1 and meshcat.GetNumActiveConnections() == 1)
         _press(person, meshcat)
     assert _until(lambda: front.pages() == 0 and meshcat.GetNumActiveConnections() == 0)

@@ -47,12 +47,15 @@ class BrowserGuard:
     """Waits while more than one browser is connected to `meshcat`.
 
     `wait_while_shared()` is called by an operator each time it reads its browser: it
-    returns at once (False) with at most one connection; otherwise it announces the pause
-    (`announce`, the terminal by default, and a button in the page carrying the notice),
-    polls every `poll_period` seconds until at most one connection is left, announces the
-    end of the pause, calls `after_pause` if set (see `reset_pacing_after_pauses`) and
-    returns True: the caller must then drop what the browser sent meanwhile.
-    `pauses` counts the pauses so far. Use from the thread that created Meshcat.
+    returns at once (False) with at most one page (the front's admitted pages, else
+    Meshcat's connections); with more it waits up to `settle` seconds for them to go (True:
+    a page that closed as it connected), else announces the pause (`announce`, the
+    terminal by default, and a button in the page carrying the notice), polls every
+    `poll_period` seconds until at most one is left, announces the end of the pause, calls
+    `after_pause` if set (see `reset_pacing_after_pauses`) and returns True: the caller
+    must then drop what the browser sent meanwhile. While a connection the front did not
+    open is there, it returns True at once (announced once). `pauses` counts the pauses
+    so far. Use from the thread that created Meshcat.
     """
 
     def __init__(self, meshcat, poll_period=0.05, announce=None, settle=0.2):
@@ -92,6 +95,8 @@ class BrowserGuard:
         while time.monotonic() < settled:  # a page closed as it connected: no pause
             time.sleep(min(self._poll_period, self._settle))
             if self._pages()[0] <= 1:
+                if self.after_pause is not None:
+                    self.after_pause()  # the settling's wall time is not to be caught up
                 return True
         self.pauses += 1
         notice = PAUSED_NOTICE.format(count=count)

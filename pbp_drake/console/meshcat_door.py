@@ -56,7 +56,7 @@ class MeshcatDoor:
     def __init__(self, port):
         self.port = int(port)
         self._lock = threading.Lock()
-        self._admitted = set()
+        self._admitted, self._closed = set(), False
         self._listeners, self.reason = _listeners(self.port)
         self._address = ("localhost", self.port)
         if self._listeners:
@@ -79,14 +79,20 @@ class MeshcatDoor:
         return bool(self._listeners)
 
     def connect(self, timeout=5.0):
-        """A blocking socket connected to Meshcat (through the door when it is shut)."""
-        family = self._listeners[0].family if self.shut else socket.AF_INET
-        if not self.shut:
+        """A blocking socket connected to Meshcat (through the door when it is shut);
+        OSError once the door is closed."""
+        with self._lock:
+            if self._closed:
+                raise OSError(errno.ECONNREFUSED, "the door to Meshcat is closed")
+            family = self._listeners[0].family if self._listeners else None
+        if family is None:
             return socket.create_connection(self._address, timeout=timeout)
         sock = socket.socket(family, socket.SOCK_STREAM)
         try:
             sock.bind((self._address[0], 0))
             with self._lock:
+                if self._closed:
+                    raise OSError(errno.ECONNREFUSED, "the door to Meshcat is closed")
                 if len(self._admitted) >= MAX_OPEN:
                     raise OSError(errno.EMFILE, f"{MAX_OPEN} connections to Meshcat are open")
                 self._admitted.add(sock.getsockname()[1])
@@ -132,13 +138,15 @@ class MeshcatDoor:
     def close(self):
         """Lets go of the listener, leaving the door shut to everyone."""
         with self._lock:
+            self._closed = True
             self._admitted.clear()
-            if self._listeners:
-                with contextlib.suppress(OSError):
-                    self._refilter()
+            with contextlib.suppress(OSError):
+                self._refilter()
             self._close_listeners(self.reason)
 
     def _refilter(self):
+        if not self._listeners:
+            return  # open, or let go of
         program = _program(self._listeners[0].family, self._address[0], self._admitted)
         for listener in self._listeners:
             _attach(listener, program)

@@ -6,7 +6,19 @@ port and serves the public one itself: the page (Meshcat's, with our console pan
 and a websocket relay to Meshcat, only to a client that presents the run's secret token (in
 the URL as `?token=T`, as Jupyter does, then in a cookie) and, for the websocket, an
 `Origin` equal to the page's own. A refused request never reaches Meshcat: no upstream
-connection is opened for it.
+connection is opened for it; a request target not starting with `/` gets 400.
+
+The front is the only door. Meshcat's own port is shut to every connection but the
+front's (`meshcat_door`: a socket filter on Meshcat's listening socket, Linux), so no other
+program or page reaches it; where that cannot be done, the front says so in one line and
+`BrowserGuard` ignores what arrives while a connection the front did not open is there. A
+page's frames reach Meshcat only as a fresh encoding of one of the messages Meshcat's page
+sends (`page_messages`; Meshcat's parser takes the process down on a frame that is not
+msgpack); any other frame closes that page's websocket with code `BAD_FRAME_CLOSE` and the
+reason, a frame over `MAX_MESSAGE` bytes with 1009. A page's connection to Meshcat is closed
+when the page goes, whichever goes first; `pages()` counts the pages admitted, which is
+what the guard's two-page pause counts (`register_front`). Accept errors (out of file
+descriptors) print one line a burst.
 
 The front never calls a Meshcat method (those belong to the thread that made the Meshcat);
 it talks to Meshcat's port over the network, from an asyncio loop on a daemon thread. Close
@@ -16,9 +28,10 @@ another thread, and a Meshcat left in a reference cycle dies in whichever thread
 - `new_token()`, `check_token(text)`: a fresh token; a `--token` checked (or ValueError).
 - `bind_page_port(port, host)`: the public port bound before anything is built (PortError).
 - `PageFront(meshcat_port, listen_socket=None, token=None, host="localhost")`: serving once
-  made; `url`, `port`, `token`; `pages()`, `show(**lines)`, `state()`, `end(text)`, `close()`.
-- `PendingMessages`, `message_key`: the relay's bounded queue toward a slow page, which
-  gets a batch of the latest poses and properties, ended by the text frame `FRAME`, and
+  made; `url`, `port`, `token`, `door_shut`; `pages()`, `own_connections()`,
+  `show(**lines)`, `state()`, `end(text)`, `close()`.
+- `PendingMessages`, `message_key` (from `pending_messages`): the relay's bounded queue
+  toward a slow page, which gets a batch of the latest poses and properties, ended by the text frame `FRAME`, and
   the next batch once it has answered `ACK` at its next animation frame.
 
 An example (the thread that made `meshcat`)::
@@ -35,27 +48,33 @@ An example (the thread that made `meshcat`)::
 import asyncio
 import collections
 import concurrent.futures
+import contextlib
 import email.utils
 import errno
 import hmac
 import http
+import http.client
 import json
 import logging
 import math
 import re
 import secrets
 import socket
+import sys
 import threading
 import time
 import urllib.parse
-import urllib.request
 
-import msgpack
 from websockets.asyncio.client import connect
 from websockets.asyncio.server import serve
 from websockets.datastructures import Headers
 from websockets.exceptions import InvalidHandshake
 from websockets.http11 import Response
+
+from pbp_drake.console.meshcat_door import MeshcatDoor
+from pbp_drake.console.page_messages import MAX_MESSAGE, BadMessage, read_page_message
+from pbp_drake.console.pending_messages import PendingMessages, message_key
+from pbp_drake.systems.operators.browser_guard import register_front, unregister_front
 
 LOG = logging.getLogger(__name__)  # websockets' connection log, every poll: INFO
 COOKIE = "pbp_drake_token"
@@ -74,6 +93,13 @@ SEND_BUFFER = 2**15
 # batch of latest states a frame, and its main thread always has time for the panel. (A
 # client that never answers, not our page, is sent batches as fast as it reads.)
 FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
+# A page's bad frame: its websocket is closed with this code (policy violation) and a reason.
+BAD_FRAME_CLOSE = 1008
+# Accept errors (out of file descriptors) closer together than this are one burst: one line.
+ACCEPT_BURST = 10.0
+# A connection to Meshcat the front closed still counts as its own this long: Meshcat
+# counts it until it has read the close.
+CLOSING_GRACE = 1.0
 
 INJECTION = """
 <style>
@@ -184,75 +210,6 @@ def bind_page_port(port, host="localhost"):
         raise
 
 
-def message_key(message):
-    """What a Meshcat message sets, when a later one of the same key replaces it (a body's
-    pose, one property, the real-time rate), else None: a barrier that must keep its place.
-    Reads only the map's small fields; a mesh's bytes are skipped, not decoded."""
-    if not isinstance(message, bytes):
-        return None
-    fields = {}
-    try:
-        unpacker = msgpack.Unpacker(raw=False)
-        unpacker.feed(message)
-        for _ in range(unpacker.read_map_header()):
-            name = unpacker.unpack()
-            if name in ("type", "path", "property"):
-                fields[name] = unpacker.unpack()
-            else:
-                unpacker.skip()
-    except (ValueError, TypeError, msgpack.UnpackException):
-        return None
-    kind, path = fields.get("type"), str(fields.get("path"))
-    if kind == "set_transform":
-        return (kind, path)
-    if kind == "set_property":
-        return (kind, path, str(fields.get("property")))
-    if kind == "realtime_rate":
-        return (kind,)
-    return None
-
-
-class PendingMessages:
-    """Meshcat's messages waiting for a slow page, bounded by what they set, not by time.
-
-    A message with a key replaces its pending predecessor of the same key (where that one
-    stood); a message without a key is a barrier: nothing moves across it. So the queue is
-    a list of segments, each the keyed messages since the last barrier and the barrier that
-    closes it; under a flood of poses of a few bodies it stays a few messages long.
-    """
-
-    def __init__(self):
-        self._segments = collections.deque([[{}, None]])  # [key -> message, barrier]
-        self._size = 0
-
-    def put(self, key, message):
-        keyed, _ = self._segments[-1]
-        if key is None:
-            self._segments[-1][1] = message
-            self._segments.append([{}, None])
-        elif key in keyed:
-            keyed[key] = message
-            return
-        else:
-            keyed[key] = message
-        self._size += 1
-
-    def pop(self):
-        """The oldest pending message; IndexError when none is."""
-        if not self._size:
-            raise IndexError("no message is pending")
-        keyed, barrier = self._segments[0]
-        self._size -= 1
-        if keyed:
-            return keyed.pop(next(iter(keyed)))
-        # An empty segment that is not the open last one ends in its barrier.
-        self._segments.popleft()
-        return barrier
-
-    def __len__(self):
-        return self._size
-
-
 def _panel_value(name, value):
     if name != "time":
         return None if value is None else str(value)
@@ -267,9 +224,8 @@ def _response(status, body, content_type, *headers):
         ("Content-Length", str(len(body))), ("Content-Type", content_type), *headers]), body)
 
 
-def _fetch(url):
-    with urllib.request.urlopen(url, timeout=10.0) as reply:
-        return reply.read(), reply.headers.get("Content-Type") or "application/octet-stream"
+def _warn(message):
+    print(f"pbp-drake: {message}", file=sys.stderr, flush=True)
 
 
 class PageFront:
@@ -288,21 +244,30 @@ class PageFront:
 
     def __init__(self, meshcat_port, listen_socket=None, token=None, host="localhost"):
         self._token = new_token() if token is None else check_token(token)
-        self._upstream = f"localhost:{meshcat_port}"
+        self._meshcat_port = meshcat_port
         self._socket = listen_socket or bind_page_port(0, host)
         self._port = self._socket.getsockname()[1]
         self._host = "localhost" if host in ("", "0.0.0.0", "::") else host
         self._lock = threading.Lock()
         self._state = dict.fromkeys((*LINES, "time"), None) | {"ended": False, "seq": 0}
         self._ended_pages, self._relays, self._closed = set(), 0, False
+        self._upstreams, self._closed_upstreams = 0, collections.deque()  # close times
+        self._accept_errors = None  # the last accept error's time, in a burst
         self._wakers = set()  # each relay's event: the state changed, send it
+        self._door = MeshcatDoor(meshcat_port)
+        if not self._door.shut:
+            _warn(f"Meshcat's port stays open to other programs on this machine "
+                  f"({self._door.reason}): what a connection the page front did not open "
+                  "sends is ignored while it stays")
         try:
             self._files = self._fetch_page()
-        except (OSError, ValueError) as error:
+        except (OSError, ValueError, http.client.HTTPException) as error:
             self._socket.close()
+            self._door.close()
             raise ConnectionError(f"Meshcat at port {meshcat_port} did not serve its page: "
                                   f"{error}") from error
         self._loop = asyncio.new_event_loop()
+        self._loop.set_exception_handler(self._loop_error)
         self._thread = threading.Thread(target=self._loop.run_forever, daemon=True,
                                         name=f"pbp-page-front-{self._port}")
         self._thread.start()
@@ -310,7 +275,9 @@ class PageFront:
             self._server = asyncio.run_coroutine_threadsafe(self._serve(), self._loop).result(10)
         except BaseException:
             self._loop.call_soon_threadsafe(self._loop.stop)
+            self._door.close()
             raise
+        register_front(meshcat_port, self)
 
     @property
     def url(self):
@@ -325,8 +292,23 @@ class PageFront:
         return self._token
 
     def pages(self):
-        """How many pages are relayed now (authorised websockets open to Meshcat)."""
+        """How many pages are relayed now (admitted websockets with their own connection
+        to Meshcat): what `BrowserGuard` counts behind the front."""
         return self._relays
+
+    def own_connections(self):
+        """How many connections to Meshcat are the front's: open, opening, or closed less
+        than `CLOSING_GRACE` seconds ago (Meshcat may not have read the close yet)."""
+        with self._lock:
+            now = time.monotonic()
+            while self._closed_upstreams and self._closed_upstreams[0] < now - CLOSING_GRACE:
+                self._closed_upstreams.popleft()
+            return self._upstreams + len(self._closed_upstreams)
+
+    @property
+    def door_shut(self):
+        """Whether Meshcat's port is shut to all but the front (see `meshcat_door`)."""
+        return self._door.shut
 
     def show(self, **lines):
         """Sets the given lines of the page's panel (title, status, result, notice; None
@@ -367,6 +349,7 @@ class PageFront:
             if self._closed:
                 return
             self._closed = True
+        unregister_front(self._meshcat_port, self)
         try:
             asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(5.0)
         except concurrent.futures.TimeoutError:
@@ -375,6 +358,7 @@ class PageFront:
         self._thread.join(5.0)
         if not self._thread.is_alive():
             self._loop.close()
+        self._door.close()
 
     def __enter__(self):
         return self
@@ -394,14 +378,14 @@ class PageFront:
     def _fetch_page(self):
         # Meshcat's page, its script (wherever the page says: Drake 1.51 serves it at a
         # content address, not /meshcat.js) and icon, fetched once, here, off the loop.
-        html, _ = _fetch(f"http://{self._upstream}/")
+        html, _ = self._door.get("/")
         html = html.decode()
         script = re.search(r'<script[^>]*\bsrc="([^"]+)"', html)
         if script is None or "</body>" not in html:
             raise ValueError("the page has no script or no </body>")
         source = "/" + script.group(1).lstrip("/")
-        code, code_type = _fetch(f"http://{self._upstream}{source}")
-        icon, icon_type = _fetch(f"http://{self._upstream}/favicon.ico")
+        code, code_type = self._door.get(source)
+        icon, icon_type = self._door.get("/favicon.ico")
         page = html.replace("</body>", INJECTION + "</body>", 1).encode()
         return {**{path: (page, "text/html; charset=utf-8") for path in _PAGES},
                 source: (code, code_type), "/meshcat.js": (code, code_type),
@@ -416,7 +400,24 @@ class PageFront:
         # being slow; a closed tab closes its socket anyway.
         return await serve(self._relay, sock=self._socket, process_request=self._answer,
                            write_limit=WRITE_LIMIT, compression=None, ping_interval=None,
-                           server_header=None, logger=LOG)
+                           max_size=MAX_MESSAGE, server_header=None, logger=LOG)
+
+    def _loop_error(self, loop, context):
+        """asyncio's errors: an accept that failed (out of file descriptors: asyncio
+        retries each second) is one line per burst, not a traceback each time."""
+        error = context.get("exception")
+        if self._closed and isinstance(error, ValueError) and "_start_serving" in repr(
+                context.get("handle")):
+            return  # asyncio's retry of such an accept, after the port was closed
+        if not context.get("message", "").startswith("socket.accept() out of system"):
+            loop.default_exception_handler(context)
+            return
+        now = time.monotonic()
+        if self._accept_errors is None or now - self._accept_errors > ACCEPT_BURST:
+            why = error.strerror if isinstance(error, OSError) and error.strerror else error
+            _warn(f"the page's port cannot accept connections for now ({why}); "
+                  "it retries each second, and the run goes on")
+        self._accept_errors = now
 
     def _authorised(self, request, query):
         offered = list(query.get("token", []))
@@ -430,6 +431,8 @@ class PageFront:
 
     async def _answer(self, connection, request):
         """The request's response, or None to go on to the websocket (the relay)."""
+        if not request.path.startswith("/"):  # `GET etc/passwd`, `GET ?token=T`
+            return connection.respond(400, "A request's target starts with '/'.\n")
         url = urllib.parse.urlsplit(request.path)
         query = urllib.parse.parse_qs(url.query)
         if not self._authorised(request, query):
@@ -452,8 +455,8 @@ class PageFront:
             return _response(200, body, "application/json", ("Cache-Control", "no-store"))
         if path not in self._files:
             try:  # a mesh's or texture's file, at its content address
-                found = await asyncio.to_thread(_fetch, f"http://{self._upstream}{path}")
-            except (OSError, ValueError):
+                found = await asyncio.to_thread(self._door.get, path)
+            except (OSError, ValueError, http.client.HTTPException):
                 return _response(404, b"Not found\n", "text/plain; charset=utf-8")
             if not path.startswith("/cas-v1/"):
                 return _response(200, *found, ("Cache-Control", "no-cache"))
@@ -462,16 +465,36 @@ class PageFront:
         return _response(200, body, content_type, ("Cache-Control", "no-cache"))
 
     async def _relay(self, page):
-        """One page's relay: one websocket to Meshcat of its own, so Meshcat counts it."""
+        """One page's relay: a connection to Meshcat of its own (through the door), closed
+        when the page goes or Meshcat does, whichever goes first, whenever it goes."""
+        with self._lock:
+            self._upstreams += 1
+        sock = meshcat = port = None
         try:
-            meshcat = await connect(f"ws://{self._upstream}/", max_size=None,
-                                    compression=None, ping_interval=None, open_timeout=5.0,
-                                    logger=LOG)
+            sock = await asyncio.to_thread(self._door.connect, 5.0)
+            port = sock.getsockname()[1]
+            meshcat = await connect(f"ws://localhost:{self._meshcat_port}/", sock=sock,
+                                    max_size=None, compression=None, ping_interval=None,
+                                    open_timeout=5.0, logger=LOG)
         except (OSError, TimeoutError, InvalidHandshake):
             await page.close(1011, "Meshcat is not reachable")
-            return
-        page.transport.get_extra_info("socket").setsockopt(
-            socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
+        else:
+            await self._relay_between(page, meshcat)
+        finally:
+            if port is not None:
+                self._door.forget(port)  # first: no other socket may take it meanwhile
+            if meshcat is not None:
+                await asyncio.gather(meshcat.close(), return_exceptions=True)
+            if sock is not None:
+                sock.close()  # did the websocket not start, it is still ours
+            with self._lock:
+                self._upstreams -= 1
+                self._closed_upstreams.append(time.monotonic())
+
+    async def _relay_between(self, page, meshcat):
+        with contextlib.suppress(OSError, AttributeError):  # None, or closed: page gone
+            page.transport.get_extra_info("socket").setsockopt(
+                socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
         pending, ready, acked = PendingMessages(), asyncio.Event(), asyncio.Event()
         paced = False  # until the page's first ACK: a client that never answers
         sent_seq = -1  # the panel state this page was sent last
@@ -484,8 +507,14 @@ class PageFront:
                     paced = True
                     acked.set()
                     ready.set()
-                elif not isinstance(message, str):  # Meshcat reads msgpack, never text
-                    await meshcat.send(message)
+                    continue
+                try:  # only what Meshcat's page sends, freshly encoded: Meshcat's parser
+                    message = read_page_message(message)  # dies on bytes it cannot read
+                except BadMessage as error:
+                    _warn(f"a page's connection was closed: it sent a bad message ({error})")
+                    await page.close(BAD_FRAME_CLOSE, f"bad message: {error}"[:120])
+                    return
+                await meshcat.send(message)
 
         async def from_meshcat():
             async for message in meshcat:
@@ -529,5 +558,5 @@ class PageFront:
             for task in tasks:
                 task.cancel()
             await asyncio.gather(*tasks, return_exceptions=True)
-            await asyncio.gather(meshcat.close(), page.close(), return_exceptions=True)
+            await asyncio.gather(page.close(), return_exceptions=True)
 

@@ -3,12 +3,20 @@ exactly that one browser is connected.
 
 Drake's Meshcat accepts a websocket from any origin. The command line puts its page front
 (`pbp_drake.console.front.PageFront`) before it, which lets in only a browser holding the
-run's secret URL; this guard is the second line, and the only one for a diagram on a bare
-Meshcat. It cannot tell the person's page from another; what it can see is the number of
-connections. With more than one, it pauses the simulation where it stands (inside the
-operator's sampling, so no simulated time passes and the robot does not move), says so in
-the terminal and in the page, and waits until one connection is left. The operator then
-drops every input that arrived meanwhile.
+run's secret URL and shuts Meshcat's own port to everyone else; this guard is the second
+line, and the only one for a diagram on a bare Meshcat. It cannot tell the person's page
+from another; what it can see is how many there are: the pages the front admitted when a
+front serves this Meshcat (it says so with `register_front`), else Meshcat's connections.
+With more than one, it pauses the simulation where it stands (inside the operator's
+sampling, so no simulated time passes and the robot does not move), says so in the terminal
+and in the page, and waits until one is left. The operator then drops every input that
+arrived meanwhile. A page that leaves within `settle` seconds (one closed right after it
+connected) costs the input of that tick, not a pause.
+
+Behind a front, a connection to Meshcat that the front did not open (possible only where
+the front could not shut Meshcat's port, see `pbp_drake.console.meshcat_door`) is an
+intruder: while one is connected every click and key is dropped (Meshcat does not say whose
+they are, so the person's too), the run is not paused for it, and one line says so.
 
 What it cannot stop alone (the front does): a page that connects while no browser is (it is
 then "the" browser), and one that connects, presses and leaves between two control ticks.
@@ -20,36 +28,82 @@ import time
 #: The label of the notice added to the page's controls while the run is paused.
 PAUSED_NOTICE = "Paused: {count} browsers are connected. Close all pages but one"
 
+# Meshcat's port -> the page front before it: its `pages()` (the pages it admitted) and
+# `own_connections()` (its connections to Meshcat, which it counts against Meshcat's).
+_FRONTS = {}
+
+
+def register_front(meshcat_port, front):
+    """Tells the guards of the Meshcat on `meshcat_port` that `front` serves its pages."""
+    _FRONTS[meshcat_port] = front
+
+
+def unregister_front(meshcat_port, front):
+    if _FRONTS.get(meshcat_port) is front:
+        del _FRONTS[meshcat_port]
+
 
 class BrowserGuard:
     """Waits while more than one browser is connected to `meshcat`.
 
     `wait_while_shared()` is called by an operator each time it reads its browser: it
-    returns at once (False) with at most one connection; otherwise it announces the pause
-    (`announce`, the terminal by default, and a button in the page carrying the notice),
-    polls every `poll_period` seconds until at most one connection is left, announces the
-    end of the pause, calls `after_pause` if set (see `reset_pacing_after_pauses`) and
-    returns True: the caller must then drop what the browser sent meanwhile.
-    `pauses` counts the pauses so far. Use from the thread that created Meshcat.
+    returns at once (False) with at most one page (the front's admitted pages, else
+    Meshcat's connections); with more it waits up to `settle` seconds for them to go (True:
+    a page that closed as it connected), else announces the pause (`announce`, the
+    terminal by default, and a button in the page carrying the notice), polls every
+    `poll_period` seconds until at most one is left, announces the end of the pause, calls
+    `after_pause` if set (see `reset_pacing_after_pauses`) and returns True: the caller
+    must then drop what the browser sent meanwhile. While a connection the front did not
+    open is there, it returns True at once (announced once). `pauses` counts the pauses
+    so far. Use from the thread that created Meshcat.
     """
 
-    def __init__(self, meshcat, poll_period=0.05, announce=None):
+    def __init__(self, meshcat, poll_period=0.05, announce=None, settle=0.2):
         self._meshcat = meshcat
         self._poll_period = float(poll_period)
+        self._settle = float(settle)
         self._announce = announce or _to_stderr
+        self._intruded = False
         self.after_pause = None
         self.pauses = 0
 
+    def _pages(self):
+        """(pages, intruders): the front's admitted pages and the connections to Meshcat
+        that are not the front's; without a front, Meshcat's connections and none."""
+        connections = self._meshcat.GetNumActiveConnections()
+        front = _FRONTS.get(self._meshcat.port())
+        if front is None:
+            return connections, 0
+        return front.pages(), max(0, connections - front.own_connections())
+
     def wait_while_shared(self):
-        count = self._meshcat.GetNumActiveConnections()
+        count, intruders = self._pages()
+        if intruders:
+            if not self._intruded:
+                self._announce("A connection to Meshcat that the page front did not open: "
+                               "every click and key is ignored while it stays; the run "
+                               "goes on.")
+            self._intruded = True
+            return True
+        if self._intruded:
+            self._announce("The connection the page front did not open is gone: the "
+                           "page's clicks and keys count again.")
+            self._intruded = False
         if count <= 1:
             return False
+        settled = time.monotonic() + self._settle
+        while time.monotonic() < settled:  # a page closed as it connected: no pause
+            time.sleep(min(self._poll_period, self._settle))
+            if self._pages()[0] <= 1:
+                if self.after_pause is not None:
+                    self.after_pause()  # the settling's wall time is not to be caught up
+                return True
         self.pauses += 1
         notice = PAUSED_NOTICE.format(count=count)
         self._announce(f"{notice}: the robot waits, and input sent meanwhile is dropped "
                        "(every page open on this run's URL counts).")
         self._meshcat.AddButton(notice)
-        while self._meshcat.GetNumActiveConnections() > 1:
+        while self._pages()[0] > 1:
             time.sleep(self._poll_period)
         self._meshcat.DeleteButton(notice, strict=False)
         self._announce("One browser is connected again: the robot goes on.")

@@ -1,0 +1,81 @@
+"""The relay's queue toward a slow page: Meshcat's messages waiting, bounded by what they
+set, not by time (see `pbp_drake.console.front`, which re-exports both names).
+
+- `message_key(message)`: what a message sets (a body's pose, one property, the real-time
+  rate), or None for a barrier.
+- `PendingMessages`: the queue, where a keyed message replaces its pending predecessor of
+  the same key and nothing moves across a barrier.
+"""
+
+import collections
+
+import msgpack
+
+
+def message_key(message):
+    """What a Meshcat message sets, when a later one of the same key replaces it (a body's
+    pose, one property, the real-time rate), else None: a barrier that must keep its place.
+    Reads only the map's small fields; a mesh's bytes are skipped, not decoded."""
+    if not isinstance(message, bytes):
+        return None
+    fields = {}
+    try:
+        unpacker = msgpack.Unpacker(raw=False)
+        unpacker.feed(message)
+        for _ in range(unpacker.read_map_header()):
+            name = unpacker.unpack()
+            if name in ("type", "path", "property"):
+                fields[name] = unpacker.unpack()
+            else:
+                unpacker.skip()
+    except (ValueError, TypeError, msgpack.UnpackException):
+        return None
+    kind, path = fields.get("type"), str(fields.get("path"))
+    if kind == "set_transform":
+        return (kind, path)
+    if kind == "set_property":
+        return (kind, path, str(fields.get("property")))
+    if kind == "realtime_rate":
+        return (kind,)
+    return None
+
+
+class PendingMessages:
+    """Meshcat's messages waiting for a slow page, bounded by what they set, not by time.
+
+    A message with a key replaces its pending predecessor of the same key (where that one
+    stood); a message without a key is a barrier: nothing moves across it. So the queue is
+    a list of segments, each the keyed messages since the last barrier and the barrier that
+    closes it; under a flood of poses of a few bodies it stays a few messages long.
+    """
+
+    def __init__(self):
+        self._segments = collections.deque([[{}, None]])  # [key -> message, barrier]
+        self._size = 0
+
+    def put(self, key, message):
+        keyed, _ = self._segments[-1]
+        if key is None:
+            self._segments[-1][1] = message
+            self._segments.append([{}, None])
+        elif key in keyed:
+            keyed[key] = message
+            return
+        else:
+            keyed[key] = message
+        self._size += 1
+
+    def pop(self):
+        """The oldest pending message; IndexError when none is."""
+        if not self._size:
+            raise IndexError("no message is pending")
+        keyed, barrier = self._segments[0]
+        self._size -= 1
+        if keyed:
+            return keyed.pop(next(iter(keyed)))
+        # An empty segment that is not the open last one ends in its barrier.
+        self._segments.popleft()
+        return barrier
+
+    def __len__(self):
+        return self._size

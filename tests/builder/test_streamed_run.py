@@ -70,7 +70,7 @@ def test_a_streamed_run_matches_the_in_memory_run(repo, tmp_path, file_name, dur
 
 # Three simulated minutes (about 30 s): the first the baseline, two more of runs against it
 # (`make soak` runs sixty).
-SOAK_MINUTES = 3
+SOAK_MINUTES = 2
 
 
 def test_a_short_soak_keeps_memory_flat_and_logs_every_tick(tmp_path):

@@ -97,11 +97,11 @@ def test_the_catalogues_matrix_writes_its_table_figure_and_the_page(repo, tmp_pa
     monkeypatch.chdir(repo)  # the catalogue names the scenario files from the repository
     generated, page = tmp_path / "generated", tmp_path / "arena.md"
     name = "hsr_reach_arena"
-    assert main([name, "--trials", "2", "--outputs", str(tmp_path / "out"),
+    assert main([name, "--trials", "1", "--outputs", str(tmp_path / "out"),
                  "--generated", str(generated), "--arena", str(page)]) == 0
     text = (generated / f"{name}.md").read_text()
     assert text.startswith("`pbp-drake study " + " ".join(STUDIES[name]).replace(
-        "--trials 30", "--trials 2"))
+        "--trials 30", "--trials 1"))
     assert (generated / f"{name}_pilots.png").stat().st_size > 10_000
     summary = json.loads((tmp_path / "out" / name / "summary.json").read_text())
     written = page.read_text()

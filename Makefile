@@ -54,7 +54,7 @@ test: $(STAMP) chromium graphviz
 	$(PYTHON) -m pytest -m browser
 
 # Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run,
-# under a minute on a 2-core machine.
+# two and a half minutes on a 2-core machine (the README says when it was timed).
 test-fast: $(STAMP) graphviz
 	$(PYTHON) -m pytest -m "not slow" -n 2 --dist worksteal
 

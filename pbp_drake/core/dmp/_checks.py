@@ -4,6 +4,14 @@ check of the package does."""
 import numpy as np
 
 
+def read_only(array, dtype=None):
+    """A private read-only C-order copy of `array`: a bank's model must not change under
+    its users (threads, Drake Contexts), nor may it change an array its caller still holds."""
+    array = np.array(array, dtype=dtype, order="C")
+    array.setflags(write=False)
+    return array
+
+
 def as_point(value, name, dimension=None):
     """`value` as a new finite float vector `(D,)`; refuses empty, wrong-sized or NaN input."""
     point = np.array(value, dtype=float).reshape(-1)
@@ -32,6 +40,16 @@ def goal_indices(indices, goal_count):
         raise ValueError(f"indices must be one or more of the bank's goal indices 0 to "
                          f"{goal_count - 1}, got {indices.tolist()}")
     return indices
+
+
+def followed_velocity(velocity, followed, goal_count):
+    """`velocity` (D, K), or with `followed` a goal index, that goal's column for every goal
+    (PBP's goal switch: every DMP steps from the velocity the robot followed)."""
+    if followed is None:
+        return velocity
+    if not 0 <= int(followed) < goal_count:
+        raise ValueError(f"followed {followed} is not one of the {goal_count} goals")
+    return np.repeat(velocity[:, [int(followed)]], goal_count, axis=1)
 
 
 def broadcast_goalwise(values, goal_count, dimension, name):

@@ -13,20 +13,13 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
-from pbp_drake.core.dmp._checks import as_point, broadcast_goalwise, goal_indices, positive
+from pbp_drake.core.dmp._checks import (
+    as_point, broadcast_goalwise, followed_velocity, goal_indices, positive, read_only)
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
 from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import Dmp
 from pbp_drake.core.dmp.stepping import BankStep
 from pbp_drake.core.dmp.workspace import DmpWorkspace
-
-
-def _read_only(array):
-    """A private read-only copy of `array`: the bank's model must not change under it, nor
-    may it change an array its caller still holds."""
-    array = np.array(array, order="C")
-    array.setflags(write=False)
-    return array
 
 
 class DmpBankModel(BankStep):
@@ -70,13 +63,13 @@ class DmpBankModel(BankStep):
             self.shared_weights = True
             if goal_count is None:
                 goal_count = 1 if np.ndim(starts) == 1 else np.shape(starts)[0]
-            self._weights = _read_only(weights)
+            self._weights = read_only(weights)
             dimension = weights.shape[1]
         elif weights.ndim == 3:
             self.shared_weights = False
             goal_count = weights.shape[0]
             dimension = weights.shape[2]
-            self._weights = _read_only(weights.transpose(1, 2, 0))  # (N, D, K)
+            self._weights = read_only(weights.transpose(1, 2, 0))  # (N, D, K)
         else:
             raise ValueError(f"weights must be (N, D) or (K, N, D), got shape {weights.shape}")
         if weights.shape[-2] != settings.basis_count:
@@ -88,12 +81,12 @@ class DmpBankModel(BankStep):
             raise ValueError("a DMP bank needs at least one goal")
         self.goal_count = goal_count
         self.dimension = dimension
-        self.starts = _read_only(broadcast_goalwise(starts, goal_count, dimension, "starts"))
+        self.starts = read_only(broadcast_goalwise(starts, goal_count, dimension, "starts"))
         scaling = np.ones((goal_count, dimension), bool) if amplitude_scaling is None else (
             np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, dimension)))
-        self.amplitude_scaling = _read_only(scaling.T)  # (D, K)
+        self.amplitude_scaling = read_only(scaling.T)  # (D, K)
         centres, widths = settings.basis()
-        self._centres, self._widths = _read_only(centres), _read_only(widths)
+        self._centres, self._widths = read_only(centres), read_only(widths)
         self._derive_constants()
         self._frozen = True
 
@@ -199,13 +192,8 @@ class DmpBankModel(BankStep):
             (phase, positions, scaled_velocity) after the step, new arrays.
         """
         phase = np.asarray(phase, dtype=float)
-        scaled_velocity = np.asarray(scaled_velocity, dtype=float)
-        if followed is not None:
-            if not 0 <= int(followed) < self.goal_count:
-                raise ValueError(f"followed {followed} is not one of the {self.goal_count} "
-                                 "goals")
-            scaled_velocity = np.repeat(scaled_velocity[:, [int(followed)]], self.goal_count,
-                                        axis=1)
+        scaled_velocity = followed_velocity(np.asarray(scaled_velocity, dtype=float), followed,
+                                            self.goal_count)
         new_phase = np.empty(phase.shape)
         new_positions = np.empty(scaled_velocity.shape)
         new_velocity = np.empty(scaled_velocity.shape)

@@ -25,19 +25,19 @@ import numpy as np
 
 # The most the left-out rows may add, over the largest row's bound (or absolutely), per row.
 _RELATIVE_PER_ROW = 2.0 ** -53
+# The product runs in blocks of columns holding about this many bytes of weights (they fit
+# the L2 cache): OpenBLAS's one long two-row dgemm took up to twice a one-row dgemv; in
+# blocks it takes what the dgemv takes.
+BLOCK_BYTES = 800_000
 
 
 class WeightRows:
     """Distinct weights `(N, M)` (read-only, C order) prepared for `contract_into`: each
-    row's largest magnitude, and column blocks that fit the L2 cache.
-
-    `block_bytes`: OpenBLAS's one long two-row dgemm took up to twice a one-row dgemv on
-    this project's machines; in column blocks of about this many bytes it takes what the
-    dgemv takes (`pbp_drake.core.dmp.stepping._BLOCK_BYTES`)."""
+    row's largest magnitude, and column blocks of about `block_bytes` (`BLOCK_BYTES`)."""
 
     __slots__ = ("weights", "row_bounds", "block_bytes")
 
-    def __init__(self, weights, block_bytes):
+    def __init__(self, weights, block_bytes=BLOCK_BYTES):
         self.weights = weights
         bounds = np.abs(weights).max(axis=1)
         bounds.setflags(write=False)

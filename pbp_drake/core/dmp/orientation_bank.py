@@ -23,7 +23,7 @@ import functools
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp._checks import goal_indices, positive
+from pbp_drake.core.dmp._checks import followed_velocity, goal_indices, positive, read_only
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
     AXES, fit_orientation_weights, straight_weights,
@@ -34,14 +34,7 @@ from pbp_drake.core.dmp.orientation_kernels import (
 from pbp_drake.core.dmp.orientation_log_step import (
     IDENTITY6, forcing_rows, log_step_from_one_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis, phase_decay
-from pbp_drake.core.dmp.stepping import _BLOCK_BYTES, step_constants
-
-
-def _read_only(array):
-    """A private read-only copy: the model must not change under its users."""
-    array = np.array(array, dtype=float, order="C")
-    array.setflags(write=False)
-    return array
+from pbp_drake.core.dmp.stepping import step_constants
 
 
 @functools.lru_cache(maxsize=64)
@@ -75,12 +68,12 @@ class OrientationDmpBank:
             self.shared_weights = True
             if goal_count is None:
                 goal_count = 1 if starts.ndim == 1 else starts.shape[0]
-            self._weights = _read_only(weights)  # (N, 3)
+            self._weights = read_only(weights)  # (N, 3)
         elif weights.ndim == 3:
             self.shared_weights = False
             goal_count = weights.shape[0]
             # (N, 3 K): the step contracts it with the basis in one product.
-            self._weights = _read_only(weights.transpose(1, 2, 0).reshape(weights.shape[1], -1))
+            self._weights = read_only(weights.transpose(1, 2, 0).reshape(weights.shape[1], -1))
         else:
             raise ValueError(f"weights must be (N, 3) or (K, N, 3), got shape {weights.shape}")
         if weights.shape[-2:] != (settings.basis_count, AXES):
@@ -94,22 +87,18 @@ class OrientationDmpBank:
             starts = np.broadcast_to(starts, (goal_count, 4))
         if starts.shape != (goal_count, 4):
             raise ValueError(f"starts must be ({goal_count}, 4) or (4,), got {starts.shape}")
-        self.starts = _read_only(starts.T)  # (4, K)
+        self.starts = read_only(starts.T)  # (4, K)
         scaling = (np.ones((goal_count, AXES), bool) if amplitude_scaling is None else
                    np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, AXES)))
-        self.amplitude_scaling = np.array(scaling.T)  # (3, K)
-        self.amplitude_scaling.setflags(write=False)
+        self.amplitude_scaling = read_only(scaling.T)  # (3, K)
         self._all_scaled = bool(scaling.all())
-        # Distinct weights `(N, 3 K)`: contracted over the basis rows that matter, in
-        # column blocks that fit the L2 cache, as the position bank.
-        self._weight_rows = (None if self.shared_weights else
-                             WeightRows(self._weights, _BLOCK_BYTES))
+        self._weight_rows = None if self.shared_weights else WeightRows(self._weights)
         self._ijspeert = settings.formulation == "ijspeert"
         # One start for all: `q0 g*` is then one 4x4 product (`error_quaternions_into`).
-        self._uniform_start = (_read_only(self.starts[:, :1])
+        self._uniform_start = (read_only(self.starts[:, :1])
                                if (self.starts == self.starts[:, :1]).all() else None)
         centres, widths = settings.basis()
-        self._centres, self._widths = _read_only(centres), _read_only(widths)
+        self._centres, self._widths = read_only(centres), read_only(widths)
         self._frozen = True
 
     def __setattr__(self, name, value):
@@ -209,12 +198,8 @@ class OrientationDmpBank:
             (phase (K,), orientations (4, K), scaled angular velocity (3, K)).
         """
         phase = np.asarray(phase, dtype=float)
-        velocity = np.asarray(scaled_angular_velocity, dtype=float)
-        if followed is not None:
-            if not 0 <= int(followed) < self.goal_count:
-                raise ValueError(f"followed {followed} is not one of the {self.goal_count} "
-                                 "goals")
-            velocity = np.repeat(velocity[:, [int(followed)]], self.goal_count, axis=1)
+        velocity = followed_velocity(np.asarray(scaled_angular_velocity, dtype=float),
+                                     followed, self.goal_count)
         new_state = (np.empty(phase.shape), np.empty((4, self.goal_count)),
                      np.empty((AXES, self.goal_count)))
         self.advance_into(phase, orientations, velocity, goals_4k, dt, *new_state,

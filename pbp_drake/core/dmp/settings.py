@@ -2,10 +2,9 @@
 
 The step constants (the 2x2 matrices `Phi` and `Gamma` of the first-order-hold step, see
 `pbp_drake.core.dmp`, and the phase decay) depend on the settings, the duration and the step
-only, so they are pure functions here rather than state of any DMP object: `step_matrices`
-is memoised with `functools.lru_cache` (thread-safe in CPython: two threads missing together
-both compute the same value, and the cache's own bookkeeping is locked), and it returns
-read-only arrays, so the arrays every caller shares cannot be changed by any of them.
+only, so they are pure functions here, not state of a DMP: `step_matrices` is memoised
+(`functools.lru_cache`, thread-safe in CPython) and returns read-only arrays, which every
+caller shares.
 """
 
 import dataclasses
@@ -27,13 +26,6 @@ class DmpSettings:
     """Gains and basis of a DMP (scenario files: the `dmp` section).
 
     A plain dataclass, so that `yaml_load_typed` can read it; a `DmpBankModel` keeps its own copy.
-
-    Attributes:
-        formulation: "ijspeert" or "pastor".
-        basis_count: number of Gaussian basis functions, 2 to `MAX_BASIS_COUNT` (10,000).
-        alpha_z: damping gain; `beta_z` defaults to `alpha_z / 4` (critically damped).
-        beta_z: stiffness ratio, `None` for `alpha_z / 4`.
-        alpha_x: phase decay; `ln 100` makes the phase reach 0.01 at `t = tau`.
     """
 
     #: ijspeert or pastor.

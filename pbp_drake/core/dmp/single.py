@@ -1,10 +1,9 @@
 """One DMP, stepped with a plain per-dimension loop: the readable reference.
 
 `Dmp` keeps a state of its own (`phase`, `position`, `scaled_velocity`) and a stateful API
-(`reset`, `next_step`, `rollout`), as NumPy users expect of one movement primitive. That is
-safe here because a `Dmp` is one object per goal that its user steps; no Drake system holds
-one, and it is the oracle the vectorised, immutable `DmpBankModel` is tested against, so it stays
-written the plain way.
+(`reset`, `next_step`, `rollout`), as NumPy users expect of one movement primitive: no Drake
+system holds one, and it is the oracle the vectorised, immutable `DmpBankModel` is tested
+against.
 """
 
 import numpy as np
@@ -15,11 +14,7 @@ from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, step_matrices
 
 
 class Dmp:
-    """One DMP in D dimensions, stepped with a plain per-dimension loop.
-
-    The reference implementation for a single goal: readable, and the oracle the vectorised
-    `DmpBankModel` is tested against.
-    """
+    """One DMP in D dimensions, stepped with a plain per-dimension loop."""
 
     def __init__(self, weights, start, goal, duration, settings=DmpSettings(),
                  amplitude_scaling=None):

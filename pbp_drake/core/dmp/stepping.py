@@ -34,16 +34,12 @@ from typing import NamedTuple
 
 import numpy as np
 
+from pbp_drake.core.dmp._checks import read_only
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.settings import normalized_basis, phase_decay, step_matrices
 
 _IDENTITY = np.eye(2)
 _IDENTITY.setflags(write=False)
-# Distinct weights: the (2, N) x (N, D*K) product runs in blocks of columns that fit the L2
-# cache (about this many bytes of weights each). OpenBLAS's one long two-row dgemm took up
-# to twice a one-row dgemv here; in blocks it takes what the dgemv takes (the weights are
-# read once: the step's second phase costs no memory traffic).
-_BLOCK_BYTES = 800_000
 
 
 class StepConstants(NamedTuple):
@@ -90,12 +86,7 @@ class BankStep:
 
     def _derive_constants(self):
         """Per-bank constants of the step, computed once (read-only)."""
-        def frozen(array):
-            array = np.array(array, dtype=float)
-            array.setflags(write=False)
-            return array
-
-        self._negative_widths = frozen(-self._widths)
+        self._negative_widths = read_only(-self._widths, float)
         self._ijspeert = self._settings.formulation == "ijspeert"
         self._stiffness = self._settings.stiffness
         self._damping = self._settings.damping
@@ -108,17 +99,15 @@ class BankStep:
         self._affine_in_goal = (
             self.shared_weights and bool((scaling.all(axis=1) | ~scaling.any(axis=1)).all())
             and bool((starts == starts[:, :1]).all()))
-        self._uniform_start = frozen(starts[:, :1])
-        # Distinct weights `(N, D*K)`: contracted over the basis rows that matter at the
-        # step's phase, in column blocks (`pbp_drake.core.dmp.contraction`).
+        self._uniform_start = read_only(starts[:, :1], float)
         self._weight_rows = (None if self.shared_weights else WeightRows(
-            self._weights.reshape(self._settings.basis_count, -1), _BLOCK_BYTES))
+            self._weights.reshape(self._settings.basis_count, -1)))
         # b = S (sigma g + rho) for Ijspeert (S the shape; sigma 1 where scaled, and
         # rho = 1 - sigma (1 + y0)); b = S - lambda (g - y0) for Pastor.
         sigma = scaling[:, :1].astype(float)
-        self._goal_weight = frozen(sigma if self._ijspeert else np.zeros_like(sigma))
-        self._shape_weight = frozen(
-            1.0 - sigma * (1.0 + starts[:, :1]) if self._ijspeert else np.ones_like(sigma))
+        self._goal_weight = read_only(sigma if self._ijspeert else np.zeros_like(sigma), float)
+        self._shape_weight = read_only(
+            1.0 - sigma * (1.0 + starts[:, :1]) if self._ijspeert else np.ones_like(sigma), float)
 
     def step_constants(self, dt):
         """The `StepConstants` of one step of `dt` (memoised)."""

@@ -2,10 +2,9 @@
 origin on every axis.
 
 The bound is far beyond any scene a robot works in, so it refuses only data errors (a wrong
-unit, a corrupted value). Past about 1e154 a squared distance overflows to infinity: a goal
-moved to 1e200 used to reach the whole-body QP as infinite costs, where OSQP and the
-differential IK warned at every tick and the run went on. Refused here, it stops with one
-message naming the goal.
+unit, a corrupted value): past about 1e154 a squared distance overflows to infinity, which
+the whole-body QP and the differential IK would meet at every tick. Refused here, the run
+stops with one message naming the position.
 """
 
 import math

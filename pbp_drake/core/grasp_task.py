@@ -46,7 +46,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.quaternion import angle_between, exp_map, multiply, unit_quaternions
-from pbp_drake.core.reach_task import check_object_count
+from pbp_drake.core.reach_task import check_object_count, spread_points
 
 APPROACHES = ("side", "top")
 # The region the shipped tasks draw from and the HSR reaches (`reach_task.validate_objects`).
@@ -137,17 +137,7 @@ def sample_grasp_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
                          f"{list(table_size)} m wide")
     rng = np.random.default_rng(seed)
     count = int(rng.integers(low, high + 1))
-    floor = np.empty((count, 2))
-    for index in range(count):
-        for _ in range(1000):
-            candidate = np.array([rng.uniform(*x_range), rng.uniform(*y_range)])
-            if index == 0 or np.min(np.linalg.norm(floor[:index] - candidate, axis=1)) \
-                    >= min_separation:
-                break
-        else:
-            raise ValueError(f"cannot place {count} tables {min_separation} m apart in "
-                             f"x {list(x_range)}, y {list(y_range)}")
-        floor[index] = candidate
+    floor = spread_points(rng, count, x_range, y_range, min_separation, "tables")
     approaches = tuple("top" if rng.uniform() < top_probability else "side"
                        for _ in range(count))
     angles = np.array([rng.uniform(*(roll_range if approach == "top" else yaw_range))

@@ -423,7 +423,6 @@ def goal_gradients(settings, costs):
     geometry, best = costs.geometry, costs.best_targets
     offsets = geometry.next_offsets[best]
     lengths = np.linalg.norm(offsets, axis=1)
-    # Faded on the distance after the operator's step, where the gradient is taken.
     fade = np.minimum(1.0, lengths / settings.translation_fade_distance)
     translation = (huber_slope(lengths, *_translation(settings)) * fade)[:, np.newaxis] * \
         _unit_rows(offsets, lengths)

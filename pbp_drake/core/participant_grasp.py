@@ -3,13 +3,12 @@ honest rules (`pbp_drake.core.participant_reach`) with the hand's orientation.
 
 It sees the true target (an object index) and notices a new one only `reaction_delay`
 seconds after it appears (`notice_target`). It commands a twist `[v (3), omega (3)]`, both
-in the world frame (m/s, rad/s):
-
-It is never told the method. Whether it acts is the reach participant's one rule
-(`pbp_drake.core.participant_serving`): it acts while the robot's shown intent names
-another object, or while the hand does not close in on the target's grasp position at
-`serve_speed_fraction` of its own preferred speed for `serve_patience`, and lets go while
-the robot serves the target. What it presses is the keys' (`forward_key`, the method's):
+in the world frame (m/s, rad/s). It is never told the method. Whether it acts is the
+reach participant's one rule (`pbp_drake.core.participant_serving`): it acts while the
+robot's shown intent names another object, or while the hand does not close in on the
+target's grasp position at `serve_speed_fraction` of its own preferred speed for
+`serve_patience`, and lets go while the robot serves the target. What it presses is the
+keys' (`forward_key`, the method's):
 
 - with the forward key (teleop, and the baselines that add to a full command): the whole
   twist, `v` toward the target's grasp position at `speed` (slowing in proportion within
@@ -56,6 +55,7 @@ import numpy as np
 from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.participant_impairment import ParticipantImpairment, first_choice
 from pbp_drake.core.participant_params import VirtualParticipantParams
+from pbp_drake.core.participant_reach import unit
 from pbp_drake.core.participant_serving import NO_INTENT, ServingMemory, serving_step
 from pbp_drake.core.quaternion import angle_between, conjugate, exp_map, log_map, multiply
 
@@ -63,8 +63,7 @@ from pbp_drake.core.quaternion import angle_between, conjugate, exp_map, log_map
 NO_TARGET = -1
 
 
-# The reach participant's calibrated defaults, the one home of those this one
-# shares.
+# The reach participant's calibrated defaults, the one home of those this one shares.
 _REACH_DEFAULTS = VirtualParticipantParams()
 # Each field shared with `VirtualParticipantParams`, by its name there.
 SHARED_WITH_REACH = {
@@ -221,12 +220,6 @@ def count_insistence(params, memory, time, orientation, target_orientation, sele
                            insisting=time - since >= params.insist_time - 1e-9)
 
 
-def unit(vector):
-    """`vector` scaled to length 1 (zero stays zero)."""
-    norm = np.linalg.norm(vector)
-    return vector / norm if norm > 1e-9 else np.zeros_like(vector)
-
-
 def without_forward(velocity, orientation):
     """`velocity` (3) with its component along the approach axis removed when that
     component points forward: what the keys allow with the forward key disabled."""
@@ -284,9 +277,8 @@ def command_noise(params, seed, tick, velocity):
     axis = unit(np.cross(velocity, rng.normal(size=3)))
     if not axis.any():
         return velocity, scale
-    w, x, y, z = exp_map(angle * axis)
-    turned = multiply(multiply(np.array([w, x, y, z]), np.concatenate([[0.0], velocity])),
-                      conjugate(np.array([w, x, y, z])))[1:]
+    turn = exp_map(angle * axis)
+    turned = multiply(multiply(turn, np.concatenate([[0.0], velocity])), conjugate(turn))[1:]
     return turned, scale
 
 

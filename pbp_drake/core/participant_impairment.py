@@ -4,7 +4,7 @@ mistaken. `ParticipantImpairment` is the scenario's `operator: !VirtualParticipa
 --participant-condition` applies.
 
 The calibrated participant (`VirtualParticipantParams`) has none of them: the defaults
-leave every run as it was. Everything random here is drawn from the run's seed, never from
+change nothing. Everything random here is drawn from the run's seed, never from
 what the robot does, so one seed gives the same noise and the same mistakes under every
 method:
 

@@ -10,8 +10,8 @@ from pbp_drake.core.participant_impairment import ParticipantImpairment
 
 @dataclasses.dataclass
 class VirtualParticipantParams:
-    """How the virtual participant behaves (see the `VirtualOperator` system). `speed` (m/s) 0 takes
-    the task's nominal speed, that of its DMPs. Its noise comes from the scenario's seed.
+    """How the virtual participant behaves (see the `VirtualOperator` system). Its noise comes
+    from the scenario's seed.
 
     The defaults are the reach task's calibration: teleop only, on the tuning
     seeds, to the paper's users' teleop intervention ratio (0.92 to 0.95). Its
@@ -26,8 +26,7 @@ class VirtualParticipantParams:
     #: deciding and reaching for the keys. 0.3 s is the reach calibration: with
     #: `serve_patience` after it, teleop then rests about as long as the paper's users did.
     reaction_delay: float = 0.3
-    #: Its direction is rotated by N(0, direction_noise) rad, its speed scaled by
-    #: (1 + N(0, speed_noise)).
+    #: Its direction is rotated by N(0, direction_noise) rad.
     direction_noise: float = 0.1
     #: Its speed is scaled by (1 + N(0, speed_noise)) (a fraction).
     speed_noise: float = 0.1

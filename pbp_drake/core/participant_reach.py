@@ -14,7 +14,7 @@ the start. `assist_motion` serves all three with one behaviour:
   is what ``nearest`` and ``bayesian`` compare. Facing the target, it is a sidestep away
   from the picked object.
 - when the two stand in line (no sidestep separates them), it steps aside to widen the
-  angle between them, as before.
+  angle between them.
 - when it has faced the target for `insist_time` and the estimate still names another
   object (the target is behind the picked one, say, and only forward motion would tell
   them apart), it goes to the target itself as far as the keys allow: it turns the target
@@ -109,9 +109,7 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
     toward_target = unit(offset)
     toward_picked = unit(picked[:2] - position[:2])
     if insisting:
-        # The target to the side it is already nearer, so the turn is the shorter one.
-        side = 1.0 if heading_error(heading, position, target) >= 0.0 else -1.0
-        wanted_heading = np.arctan2(toward_target[1], toward_target[0]) - side * np.pi / 2
+        wanted_heading = insisting_side_heading(heading, position, target)
         slow = min(1.0, distance / params.slow_radius)
         velocity = speed * slow * without_forward(toward_target, heading)
         return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))

@@ -49,21 +49,29 @@ def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
     low, high = check_object_count(object_count, switch_schedule)
     rng = np.random.default_rng(seed)
     count = int(rng.integers(low, high + 1))
-    objects = np.empty((count, 3))
-    for index in range(count):
-        for _ in range(1000):
-            candidate = [rng.uniform(*x_range), rng.uniform(*y_range), height]
-            if index == 0 or np.min(np.linalg.norm(
-                    objects[:index, :2] - candidate[:2], axis=1)) >= min_separation:
-                break
-        else:
-            raise ValueError(f"cannot place {count} objects {min_separation} m apart in "
-                             f"x {list(x_range)}, y {list(y_range)}")
-        objects[index] = candidate
+    floor = spread_points(rng, count, x_range, y_range, min_separation, "objects")
+    objects = np.column_stack([floor, np.full(count, float(height))])
     targets = _draw_targets(rng, count, switch_schedule)
     if z_range:
         objects[:, 2] = rng.uniform(*z_range, size=count)
     return ReachScene(objects=objects, targets=targets)
+
+
+def spread_points(rng, count, x_range, y_range, min_separation, what):
+    """`count` floor points `(count, 2)` drawn uniformly in the rectangle, each redrawn (up
+    to 1000 times) until it is `min_separation` from those before it."""
+    points = np.empty((count, 2))
+    for index in range(count):
+        for _ in range(1000):
+            candidate = np.array([rng.uniform(*x_range), rng.uniform(*y_range)])
+            if index == 0 or np.min(np.linalg.norm(points[:index] - candidate,
+                                                   axis=1)) >= min_separation:
+                break
+        else:
+            raise ValueError(f"cannot place {count} {what} {min_separation} m apart in "
+                             f"x {list(x_range)}, y {list(y_range)}")
+        points[index] = candidate
+    return points
 
 
 def _draw_targets(rng, count, switch_schedule):

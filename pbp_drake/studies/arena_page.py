@@ -4,11 +4,10 @@ matrices' summary.json: per task and pilot, which of the paper's claims about PB
 Each claim is a rule on 95 % intervals (`CLAIMS`), evaluated for every PBP method of the
 matrix, never a sentence typed by hand. A claim that compares with teleop compares the two
 means' t intervals (`intervals.mean_interval`, over the trials that ran, within the
-metric's range); a claim on a
-rate compares its Wilson interval with the bar. The verdict is *holds* when the whole
-interval is on the claim's side, *does not hold* when it is wholly on the other side, and
-*undecided* when the interval straddles the bar (too few trials to tell, or a difference
-too small for them).
+metric's range); a claim on a rate compares its Wilson interval with the bar. The verdict
+is *holds* when the whole interval is on the claim's side, *does not hold* when it is
+wholly on the other side, and *undecided* when the interval straddles the bar (too few
+trials to tell, or a difference too small for them).
 """
 
 import dataclasses

@@ -54,13 +54,10 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     recorded as failed with its error. A file that cannot be written stops the study with
     `atomic_files.WriteFailed` (an OSError), nothing half-written left; another process
     writing `output` refuses it with `folders.FolderLocked`, before anything is written.
-    `progress(done, total, record, elapsed)` is called
-    after each trial run now. `run(scenario) -> TaskResult` replaces `run_task` (it must be
-    picklable when `jobs > 1`).
+    `progress(done, total, record, elapsed)` is called after each trial.
+    `run(scenario) -> TaskResult` replaces `run_task` (picklable when `jobs > 1`).
     """
-    check_run_options(jobs, backend, ray_address, run)
-    if trials < 1:
-        raise ScenarioError(f"trials must be at least 1, got {trials}")
+    check_run_options(trials, jobs, backend, ray_address, run)
     output = pathlib.Path(output)
     # Checked before the lock, so that a refused folder is not written at all; and again
     # under it (prepare_folder).
@@ -84,9 +81,11 @@ class StudyFolder:
     pending: list
 
 
-def check_run_options(jobs, backend, ray_address, run):
-    """Raises ScenarioError for a bad number of jobs, backend or `run` (before any folder
-    is touched); imports Ray when it is asked for, so that its absence stops here too."""
+def check_run_options(trials, jobs, backend, ray_address, run):
+    """Raises ScenarioError for a bad number of trials or jobs, backend or `run` (before any
+    folder is touched); imports Ray when it is asked for, so that its absence stops here too."""
+    if trials < 1:
+        raise ScenarioError(f"trials must be at least 1, got {trials}")
     if not isinstance(jobs, int) or jobs < 1:
         raise ScenarioError(f"jobs must be a positive number of processes, got {jobs}")
     if backend not in BACKENDS:
@@ -190,9 +189,7 @@ def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=
     summary. The arguments are `run_method_comparison`'s, plus the pilots' names; trials on
     disk for the same scenario and pilot are not run again."""
     check_pilots(pilots, "pilots")
-    check_run_options(jobs, backend, ray_address, run)
-    if trials < 1:
-        raise ScenarioError(f"trials must be at least 1, got {trials}")
+    check_run_options(trials, jobs, backend, ray_address, run)
     pilot_scenarios = {pilot: with_pilot(scenario, pilot) for pilot in pilots}
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)

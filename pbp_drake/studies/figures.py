@@ -28,6 +28,12 @@ METHOD_COLOURS = {"pbp_alternated": "tab:orange", "pbp_continuous": "tab:blue",
                   "predict_then_assist": "tab:brown"}
 
 
+def _save(figure, path, **options):
+    figure.tight_layout()
+    save_figure(figure, path, **options)
+    plt.close(figure)
+
+
 def _label(method, rows=None):
     label = METHOD_LABELS.get(method, method)
     if rows:
@@ -60,9 +66,7 @@ def _box_plot(records, methods, field, ylabel, title, path, ylim=None):
     axis.grid(axis="y", alpha=0.3)
     if ylim is not None:
         axis.set_ylim(*ylim)
-    figure.tight_layout()
-    save_figure(figure, path, dpi=120)
-    plt.close(figure)
+    _save(figure, path, dpi=120)
 
 
 def plot_intervention(records, methods, path):
@@ -97,9 +101,7 @@ def plot_collision_histogram(summary, path):
     axis.yaxis.get_major_locator().set_params(integer=True)
     axis.legend(fontsize=8)
     axis.grid(axis="y", alpha=0.3)
-    figure.tight_layout()
-    save_figure(figure, path, dpi=120)
-    plt.close(figure)
+    _save(figure, path, dpi=120)
 
 
 def _error_bar(axis, x, interval, **style):
@@ -136,9 +138,7 @@ def plot_pilot_panels(panels, path):
         axis.set_title(f"pilot: {pilot}")
         axis.grid(axis="y", alpha=0.3)
     figure.suptitle("Every method under every pilot: means and 95 % intervals", fontsize=10)
-    figure.tight_layout()
-    save_figure(figure, path, dpi=110)
-    plt.close(figure)
+    _save(figure, path, dpi=110)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -257,10 +257,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
     for letter, speed, target in zip("efghij", speeds, pbp_axes):
         target.set_title(f"({letter}) PBP (no alpha), operator speed {speed}")
         target.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.12))
-    figure.tight_layout()
-    # "tight" keeps the legends under the PBP panels in the image.
-    save_figure(figure, path, dpi=110, bbox_inches="tight")
-    plt.close(figure)
+    _save(figure, path, dpi=110, bbox_inches="tight")  # the legends under the PBP panels
 
 
 def plot_alt_vs_cont(resolved, summary, path):
@@ -295,6 +292,4 @@ def plot_alt_vs_cont(resolved, summary, path):
     input_axes.set_ylabel("phase")
     input_axes.set_title("phase against time")
     input_axes.legend(fontsize=8)
-    figure.tight_layout()
-    save_figure(figure, path, dpi=110)
-    plt.close(figure)
+    _save(figure, path, dpi=110)

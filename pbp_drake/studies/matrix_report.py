@@ -18,10 +18,10 @@ from pbp_drake.studies.figures import plot_pilot_panels
 from pbp_drake.studies.intervals import MEAN_METRICS, mean_interval, wilson_interval
 from pbp_drake.studies.matrix import read_matrix, summarize_matrix
 from pbp_drake.studies.paired import paired_rows_with
+from pbp_drake.studies.report import flat_trials
 from pbp_drake.studies.results_markdown import study_command, write_markdown
 from pbp_drake.studies.splits import seeds_line
 from pbp_drake.studies.atomic_files import write_atomically
-from pbp_drake.studies.trial_files import TRIAL_FIELDS
 
 FIGURE = "pilots.png"
 #: The method every other is paired with, pilot by pilot, when the matrix ran it.
@@ -183,15 +183,8 @@ def matrix_command(study, summary):
 
 
 def _flat_trials(pilots):
-    rows = []
-    for pilot, (study, records, _) in pilots.items():
-        for method in study["methods"]:
-            for trial in range(study["trials"]):
-                record = records[(method, trial)]
-                if record is not None:
-                    rows.append({"pilot": pilot,
-                                 **{field: record.get(field) for field in TRIAL_FIELDS}})
-    return rows
+    return [{"pilot": pilot, **row} for pilot, (study, records, _) in pilots.items()
+            for row in flat_trials(study, records)]
 
 
 def report_matrix(output, reference=None, markdown=None):

@@ -24,8 +24,8 @@ from pbp_drake.studies.trial_files import read_study
 
 # Metrics that only a task with obstacles measures.
 _COLLISION_METRICS = ("collision_ratio", "collision_free")
-# (name in the table, how a trial's value is read (None: not recorded, as in trials written
-# before the field existed), whether both trials must have succeeded)
+# (name in the table, how a trial's value is read (None: not recorded), whether both trials
+# must have succeeded)
 _METRICS = (
     ("success", lambda record: float(bool(record["success"])), False),
     ("intervention_ratio", lambda record: record.get("intervention_ratio"), False),

@@ -117,8 +117,7 @@ def wilcoxon_rows(values, methods, source):
     dicts of pair, n, statistic, p. p is None where there is nothing to test, and `note`
     says why in plain words (`source`, "trial" or "answer", names who counted) rather than
     in SciPy's: fewer than two participants, or every difference zero."""
-    # Deferred: scipy.stats takes about 0.7 s to import, which every pbp-drake command
-    # would pay at start-up for the one report that uses it.
+    # Deferred: scipy.stats takes about 0.7 s to import, which every command would pay.
     import scipy.stats
 
     who = PAIRED_BY[source]

@@ -3,7 +3,7 @@
 The tasks only compute; the process that runs the study writes every trial file (a
 cluster's nodes may not see the folder), so the folder is the same as with local processes,
 but for where each trial ran: its `host` and `ray_node` (the Ray node's id), which only Ray
-trials record (informational: no reader needs them, so older folders read the same).
+trials record (no reader needs them).
 Ray is imported only when this backend is asked for: it is an optional, heavy dependency
 (`pip install 'pbp_drake[ray]'`), and the local backend must never load it.
 """

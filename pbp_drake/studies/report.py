@@ -31,7 +31,7 @@ def _cell(entry, field, digits):
 
 
 def _peak_cell(entry, field, digits):
-    """`max / mean` of a per-trial peak; n/a when no trial recorded it (older trials)."""
+    """`max / mean` of a per-trial peak; n/a when no trial recorded it."""
     value = entry[field]
     if value["max"] is None:
         return "n/a"
@@ -45,8 +45,7 @@ def _count(value):
 def interaction_table(summary):
     """The Markdown lines of the interaction metrics, one row per method: mean ± std of each
     (`INTERACTION_MEANS`) over the trials with a value, and the switches never named of
-    all the switches; "-" where a method has none (no goal named, or trials written before
-    the metric). No lines when no method has any."""
+    all the switches; "-" where a method has none. No lines when no method has any."""
     methods = summary["methods"]
     if not any(name in entry for entry in methods.values() for name, *_ in INTERACTION_MEANS):
         return []
@@ -99,8 +98,6 @@ def results_table(summary):
     if participant:
         lines += [participant, ""]
     collisions = summary["measures_collisions"]
-    # HOP's posterior at its clip, where a method records it (hop, predict_then_assist,
-    # maxent_command).
     clipped = any("posterior_clipped_ratio" in e for e in summary["methods"].values())
     columns = ["method", "trials", "success", "intervention ratio", "task time (s)",
                *(("collision ratio", "collision-free trials") if collisions else ()),
@@ -138,13 +135,13 @@ def results_table(summary):
     return "\n".join(lines) + "\n"
 
 
-def _flat_trials(study, records):
+def flat_trials(study, records):
+    """trials.json's rows: each trial on disk, its `TRIAL_FIELDS` (None where it has none)."""
     rows = []
     for method in study["methods"]:
         for trial in range(study["trials"]):
             record = records[(method, trial)]
             if record is not None:
-                # Trials written before a field existed lack it: None.
                 rows.append({field: record.get(field) for field in TRIAL_FIELDS})
     return rows
 
@@ -163,7 +160,7 @@ def report(output):
     write_atomically(output / "summary.json", json.dumps(summary, indent=2) + "\n")
     write_atomically(output / "results.md", results_table(summary))
     write_atomically(output / "trials.json",
-                     json.dumps(_flat_trials(study, records), indent=1) + "\n")
+                     json.dumps(flat_trials(study, records), indent=1) + "\n")
     rows = [r for r in records.values() if r is not None]
     methods = study["methods"]
     plot_intervention(rows, methods, output / BOX_FIGURES[0])
@@ -171,7 +168,6 @@ def report(output):
     if summary["measures_collisions"]:
         plot_collision_histogram(summary, output / COLLISION_FIGURE)
     else:
-        # A Fig. 7c an older version drew for this task (all zeros: nothing was measured)
-        # would stand beside the new figures as if it were a result.
+        # A Fig. 7c left in the folder (all zeros: nothing measured) would read as a result.
         (output / COLLISION_FIGURE).unlink(missing_ok=True)
     return summary

@@ -17,6 +17,8 @@ import sys
 
 from pbp_drake.scenarios.pilots import PILOT_NAMES
 from pbp_drake.studies.arena_page import write_arena_page
+from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE
+from pbp_drake.studies.report import BOX_FIGURES as DOCS_FIGURES
 
 REACH = ["diagrams/hsr_reach.yaml", "--methods",
          "pbp_alternated,pbp_continuous,confidence_alpha,teleop", "--trials", "30"]
@@ -102,9 +104,6 @@ ARENA_STUDIES = {name: title for name, (_, title, _) in ARENA_TASKS.items()}
 #: pbp_alternated`, and the figures are copied beside the table as NAME_FIGURE.png.
 PAIRED_WITH_PBP_ALT = ("hsr_reach_baselines", "hsr_obstacles_baselines",
                        "hsr_grasp_baselines")
-DOCS_FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png")
-# A matrix's one figure (`studies.matrix_report`), copied beside its table as NAME_pilots.png.
-MATRIX_FIGURE = "pilots.png"
 
 
 def with_trials(arguments, trials):
@@ -163,8 +162,8 @@ def main(argv=None):
             for figure in DOCS_FIGURES:
                 shutil.copyfile(output / figure, markdown.with_name(f"{name}_{figure}"))
         if name in ARENA_STUDIES and reported in (0, 1):
-            shutil.copyfile(output / MATRIX_FIGURE,
-                            markdown.with_name(f"{name}_{MATRIX_FIGURE}"))
+            # A matrix's one figure, copied beside its table as NAME_pilots.png.
+            shutil.copyfile(output / MATRIX_FIGURE, markdown.with_name(f"{name}_{MATRIX_FIGURE}"))
     if any(name in ARENA_STUDIES for name in args.names or STUDIES):
         write_arena_page(ARENA_STUDIES, args.outputs, args.generated, args.arena)
         print(f"  wrote {args.arena}")

@@ -125,7 +125,7 @@ def toy_markdown(output):
         summary = json.loads((output / "summary.json").read_text())
     except (OSError, ValueError) as error:
         raise StudyError(f"{output / 'summary.json'}: cannot be read ({error})") from None
-    study = read_study_json(output)  # {} when written before study.json was
+    study = read_study_json(output)  # {} when the folder has none
     figure = output / TOY_FIGURES[summary["study"]]
     if summary["study"] == "alpha_study":
         return alpha_study_markdown(study, summary, figure)

@@ -96,8 +96,7 @@ def mean_std(values):
 
 
 def max_mean(values):
-    """`{"max", "mean"}` of the finite values, rounded; None for none (e.g. trials written
-    before the value was recorded)."""
+    """`{"max", "mean"}` of the finite values, rounded; None for none."""
     values = [v for v in values if v is not None and math.isfinite(v)]
     if not values:
         return {"max": None, "mean": None}
@@ -124,8 +123,7 @@ def interaction_entries(ran):
     """The interaction metrics' entries of a method's summary, from the records of its
     trials that ran (`INTERACTION_MEANS`, each `mean_with_interval`): `time_to_prediction`
     is over each trial's mean over its switches, with the study's count of `switches` and
-    of those never named (`unpredicted_switches`). A metric no record holds (trials written
-    before it) has no entry."""
+    of those never named (`unpredicted_switches`). A metric no record holds has no entry."""
     entries = {}
     for name, _, _, within in INTERACTION_MEANS:
         field = TRIAL_VALUE.get(name, name)
@@ -160,9 +158,8 @@ def measures_collisions(study, records, output=None):
     """Whether the study's task measures collisions: the obstacle task does, reaching does
     not (its trials record a collision ratio of 0 that means "not measured", not "none").
 
-    Read off the scenario study.json holds; a study without it (inferred from the trial
-    files, or written by an older version) is judged by its trials' CSV files, whose
-    `in_collision` column only a task that measures collisions writes."""
+    Read off the scenario study.json holds; a study without it is judged by its trials' CSV
+    files, whose `in_collision` column only a task that measures collisions writes."""
     content = study.get("scenario_content")
     if isinstance(content, dict):
         task = content.get("task")
@@ -206,22 +203,15 @@ def virtual_participant(study):
 
 
 def summarize(study, records, damaged=(), output=None):
-    """Per method: how many trials, errors and missing; success rate over the trials on
-    disk; mean and (population) std of intervention ratio and task time, and, in tasks that
-    measure collisions (`measures_collisions`, also in the summary), the mean, std and
-    histogram of the collision ratio and the count of collision-free trials; the max and mean of each trial's
-    peak_hand_speed (m/s, the largest one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| /
-    control_period) and peak_command_acceleration (m/s^2, max_k |v_cmd(k+1) - v_cmd(k)| /
-    control_period), over the trials that ran without error (those that recorded them);
-    and the ideal alpha when the study sweeps fixed alphas. `damaged` (Damage tuples, see
-    trial_files.read_study) gives each method's count of trials skipped as damaged (not
-    counted as missing) and the summary's "damaged" list of files (paths relative to
-    `output`) and problems. A method whose trials record how often HOP's goal posterior sat
-    at its clip (hop, predict_then_assist, the maxent_command estimator) gets the mean and
-    std of that `posterior_clipped_ratio` too; the others have no such entry. The
-    interaction metrics (input, turning input, idle ratio, agreement, prediction accuracy,
-    time to prediction) get their mean, std, count and 95 % interval
-    (`interaction_entries`)."""
+    """Per method: how many trials, errors, missing and damaged; the success rate over the
+    trials on disk; over the trials that ran without error, the mean and (population) std of
+    intervention ratio and task time, the max and mean of the peak hand speed and peak
+    command acceleration (`pbp_drake.builder.run.SeriesPeaks`), the `posterior_clipped_ratio`
+    where the trials record it, the interaction metrics (`interaction_entries`) and, where
+    the task measures collisions (`measures_collisions`), the collision ratio's mean, std
+    and histogram and the count of collision-free trials; and the ideal alpha when the study
+    sweeps fixed alphas. `damaged` (Damage tuples, see `trial_files.read_study`) becomes the
+    summary's "damaged" list (paths relative to `output`)."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),

@@ -114,7 +114,8 @@ def run_alpha_study(resolved, study, output_dir):
                                         "reaching the goal is reported, not judged",
                "scenes": scenes}
     _write_json(output_dir / "summary.json", summary)
-    plot_alpha_study(resolved, study, summary, trajectories, output_dir / "fig2_alpha_study.png")
+    plot_alpha_study(resolved, study, summary, trajectories,
+                     output_dir / TOY_FIGURES["alpha_study"])
     return summary
 
 
@@ -204,7 +205,7 @@ def run_alt_vs_cont(resolved, study, output_dir):
         "both_reach_goal": all(m["final_error"] <= study.goal_tolerance for m in modes.values()),
     }
     _write_json(output_dir / "summary.json", summary)
-    plot_alt_vs_cont(resolved, summary, output_dir / "fig4_alt_vs_cont.png")
+    plot_alt_vs_cont(resolved, summary, output_dir / TOY_FIGURES["alt_vs_cont"])
     return summary
 
 

@@ -23,21 +23,12 @@ from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.builder.time_series import time_series_columns, time_series_csv
 
-# A trial file of another format counts as not on disk (it runs again). Fields added since
-# (peak_hand_speed, peak_command_acceleration) are read as None when a file lacks them, so
-# they did not change the format: older trials still count and report them as n/a.
+# A trial file of another format counts as not on disk (it runs again); a metric a file
+# lacks reads as None (reported n/a), so a new metric does not change the format.
 TRIAL_FORMAT = 1
-# The metrics of a trial, in the order of the trial files and of trials.json. The peaks are
-# TaskResult's (see pbp_drake.builder.run.SeriesPeaks): peak_hand_speed (m/s), the largest
-# one-tick hand speed, max_k |ee(t_{k+1}) - ee(t_k)| / control_period, and
-# peak_command_acceleration (m/s^2), max_k |v_cmd(k+1) - v_cmd(k)| / control_period, over
-# the CSV's ee_x..ee_z and command_vx..command_vz columns (ticks 0..T-1).
-# posterior_clipped_ratio is the ratio of ticks whose goal posterior sat at its clip
-# (`TaskResult.posterior_clipped_ratio`), recorded by the methods with HOP's posterior only
-# (hop, predict_then_assist, the maxent_command estimator): other trials, and those written
-# before it, read it as None.
-# The interaction metrics (`pbp_drake.core.interaction_metrics`, `INTERACTION_METRICS`) are
-# in every trial run since they came; those written before read them as None.
+# The metrics of a trial, in the order of the trial files and of trials.json: the peaks
+# (`pbp_drake.builder.run.SeriesPeaks`), `posterior_clipped_ratio` (only the methods with
+# HOP's posterior record it) and the interaction metrics (`pbp_drake.core.interaction_metrics`).
 INTERACTION_METRICS = ("input_integral", "turn_input_integral", "idle_ratio", "agreement",
                        "prediction_accuracy", "time_to_prediction", "mean_time_to_prediction",
                        "unpredicted_switches")
@@ -79,17 +70,17 @@ def plain(value):
     return value
 
 
-# Fields added to the schema after studies were run, left out of the content while at their
-# defaults: the trials of a scenario that does not use them are the same as before, and its
-# study folders still resume. None: the scenario's own fields.
+# Fields left out of the content while at their defaults, so that a scenario that does not
+# use them keeps the hash of study folders written before they existed (and these resume).
+# None: the scenario's own fields.
 _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3}}
 
 
 def _may_reposition(content):
     """Whether the scenario's virtual participant may meet a target the tool cannot point
-    at (an arm's wrist turns only so far; objects at heights of their own): its trials
-    changed when `reposition_time` came, so its older study folders must not resume."""
+    at (an arm's wrist turns only so far; objects at heights of their own): `reposition_time`
+    acts on its trials, so it stays in the hash."""
     robot, task = content.get("robot"), content.get("task")
     return ((isinstance(robot, dict) and robot.get("!type") == "Arm")
             or (isinstance(task, dict) and bool(task.get("z_range"))))

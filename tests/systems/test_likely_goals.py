@@ -7,8 +7,8 @@ import pytest
 from pydrake.systems.analysis import Simulator
 from test_dmp_bank_compact import GOALS, DT, distinct_bank, drive, shared_bank
 
-from pbp_drake.bench.cases import make_bank
-from pbp_drake.bench.pose_cases import make_pose_case
+from pbp_drake_bench.cases import make_bank
+from pbp_drake_bench.pose_cases import make_pose_case
 from pbp_drake.systems import LikelyGoals
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
 from pbp_drake.systems.pbp.likely_goals import likely_goal_indices

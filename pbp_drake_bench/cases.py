@@ -16,8 +16,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.bench.table import microseconds
-from pbp_drake.bench.timing import timed_span
+from pbp_drake_bench.table import microseconds
+from pbp_drake_bench.timing import timed_span
 from pbp_drake.core.dmp import DmpBankModel, DmpSettings, fit_weights, minimum_jerk
 from pbp_drake.systems.pbp.dmp_bank import DmpBank as DmpBankSystem
 from pbp_drake.systems.pbp.goals_source import GoalsSource

@@ -39,8 +39,8 @@ def format_report(report):
                  "N = 50, dt = 1 ms.")
     lines.append("math: DmpBank.advance_into; leaf: the DmpBank LeafSystem per 1 ms period "
                  "in a Simulator (includes Drake), wired as the builder wires it (followed "
-                 "and selected goal connected, the compact state: affine in the goal with "
-                 "shared weights, the step's inputs with distinct ones; the selected "
+                 "and selected goal connected; the compact state with shared weights, the "
+                 "per-goal state with distinct ones; the selected "
                  "reference read every period); drake: a LeafSystem with the same ports "
                  "and state and an empty update;")
     lines.append("bound: weight bytes / measured read bandwidth (cache-sized bound in "

@@ -12,11 +12,11 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
-from pbp_drake.systems.ports import goal_index
+from pbp_drake.systems.ports import PortGetters, goal_index
 from pbp_drake.systems.tick import decide_offset
 
 
-class DmpBank(LeafSystem):
+class DmpBank(PortGetters, LeafSystem):
     """Steps K DMPs (one per goal) every control period from the robot's measured state.
 
     .. pydrake_system::
@@ -170,37 +170,6 @@ class DmpBank(LeafSystem):
     @property
     def bank(self):
         return self._bank
-
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_goals_input_port(self):
-        return self._goals_port
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_followed_goal_input_port(self):
-        return self._followed_goal_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_references_output_port(self):
-        return self._references_port
-
-    def get_selected_reference_output_port(self):
-        return self._selected_reference_port
-
-    def get_phase_output_port(self):
-        return self._phase_port
-
-    def get_predicted_paths_output_port(self):
-        return self._predicted_paths_port
-
-    def get_predicted_goals_input_port(self):
-        """The goals whose paths `predicted_paths` holds (with `predicted_goal_count`)."""
-        return self._predicted_goals_port
 
     def _workspace(self, context):
         """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""

@@ -6,7 +6,7 @@ from pydrake.geometry import Box, Cylinder, Rgba, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.systems.ports import EeState, Target, position_of
+from pbp_drake.systems.ports import EeState, PortGetters, Target, position_of
 from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
@@ -35,7 +35,7 @@ TARGET_LIFT = 0.12
 ESTIMATE_LIFT = 0.25
 
 
-class ReachSceneVisualizer(LeafSystem):
+class ReachSceneVisualizer(PortGetters, LeafSystem):
     """Publishes the reaching task's markers to Meshcat under `/task`.
 
     .. pydrake_system::
@@ -103,24 +103,6 @@ class ReachSceneVisualizer(LeafSystem):
         self.DeclarePeriodicPublishEvent(self._cloud.period(cloud_period), 0.0,
                                          self._publish_cloud)
         self.DeclareInitializationPublishEvent(self._initialise)
-
-    def get_target_input_port(self):
-        return self._target_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
-    def get_predicted_paths_input_port(self):
-        return self._predicted_paths_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._probabilities_port
 
     def _initialise(self, context):
         # Whether the blue ball is drawn: a method that shows no intent (teleop) sends -1.

@@ -6,6 +6,7 @@ from pydrake.geometry import Box, Cylinder, Rgba, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.core.scene_framing import workspace_view
 from pbp_drake.systems.ports import EeState, PortGetters, Target, position_of
 from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots
 
@@ -68,14 +69,19 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
     take the colour of their goal's probability (`goal_probabilities`, K), grey to blue,
     sent again only when a colour changed; a recording keeps the cloud's last colours only
     (Meshcat records transforms and properties, not objects), the paths as they went.
-    Call from the thread that made `meshcat`.
+    The drawing sets Meshcat's camera (`camera`, `(position, target)`): behind and above
+    the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base, start and
+    objects), framed on it (`workspace_view`). Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, objects, prediction_steps=0, path_count=1,
-                 publish_period=1.0 / 30.0, path_period=0.1, cloud_period=0.25):
+                 publish_period=1.0 / 30.0, path_period=0.1, cloud_period=0.25,
+                 workspace=None):
         super().__init__()
         self._meshcat = meshcat
         self._objects = np.asarray(objects, dtype=float)
+        self.camera = (_behind_the_hsr(self._objects) if workspace is None
+                       else workspace_view(workspace))
         self._prediction_steps = int(prediction_steps)
         k = len(self._objects)
         path_count = int(path_count)
@@ -133,9 +139,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         if self._prediction_steps:
             for dots in [self._active_path, *self._other_paths]:
                 dots.draw(meshcat)
-        centre = self._objects.mean(axis=0)
-        # A camera behind and above the robot that sees it and every object.
-        meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
+        meshcat.SetCameraPose(*self.camera)
 
     def _publish(self, context):
         time = context.get_time()
@@ -172,3 +176,8 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
     def _publish_cloud(self, context):
         port = self._probabilities_port
         self._cloud.show(self._meshcat, port.Eval(context) if port.HasValue(context) else None)
+
+
+def _behind_the_hsr(objects):
+    """A camera behind and above the HSR that sees it and every object of the task."""
+    return np.array([-1.6, -1.2, 2.6]), np.array([0.55 * objects.mean(axis=0)[0], 0.0, 0.4])

@@ -197,7 +197,7 @@ class EeStateFromPlant(PortGetters, LeafSystem):
         self._plant_context = plant.CreateDefaultContext()
         self._plant_state_port = self.DeclareVectorInputPort(
             "plant_state", plant.num_multibody_states())
-        self._state_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "ee_state", EeState.size, self._calc_state)
 
     def _calc_state(self, context, output):

@@ -50,7 +50,7 @@ class KinematicJoints(PortGetters, LeafSystem):
                           for follower, leader, ratio in couplers]
         self._desired_port = self.DeclareVectorInputPort("desired_state",
                                                          2 * len(motor_joints))
-        self._state_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "state", plant.num_multibody_states(), self._calc_state)
 
     def plant(self):

@@ -135,7 +135,7 @@ class PoseStateFromPlant(PortGetters, LeafSystem):
         self._plant_context = plant.CreateDefaultContext()
         self._plant_state_port = self.DeclareVectorInputPort(
             "plant_state", plant.num_multibody_states())
-        self._pose_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "hand_pose", PoseState.size, self._calc_pose)
 
     def _calc_pose(self, context, output):

@@ -126,11 +126,11 @@ class PilotFilter(PortGetters, LeafSystem):
         # [command (size), active, whether a sample has been taken].
         self._sample_index = self.DeclareDiscreteState(size + 2)
         held = {self.discrete_state_ticket(self._sample_index)}
-        self._command_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "operator_command", size,
             lambda context, output: output.SetFromVector(self._held(context)[:size]),
             prerequisites_of_calc=held)
-        self._active_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "operator_active", 1,
             lambda context, output: output.SetFromVector(self._held(context)[size:size + 1]),
             prerequisites_of_calc=held)

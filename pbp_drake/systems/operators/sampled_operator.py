@@ -63,7 +63,7 @@ class SampledOperator(PortGetters, LeafSystem):
             self._command_name, d,
             lambda context, output: output.SetFromVector(self._held(context)[:d]),
             prerequisites_of_calc=held)
-        self._active_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "operator_active", 1,
             lambda context, output: output.SetFromVector(self._held(context)[d:]),
             prerequisites_of_calc=held)

@@ -35,7 +35,7 @@ class CollisionMonitor(PortGetters, LeafSystem):
             raise ValueError("CollisionMonitor needs robot and obstacle geometries")
         self._query_port = self.DeclareAbstractInputPort(
             "query_object", AbstractValue.Make(QueryObject()))
-        self._collision_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "in_collision", 1, self._calc_in_collision)
         self._clearance_port = self.DeclareVectorOutputPort(
             "clearance", 1, self._calc_clearance)

@@ -46,10 +46,10 @@ class MovingObstacles(PortGetters, LeafSystem):
         self._positions_index = self.DeclareDiscreteState(scene.obstacle_starts.reshape(-1))
         self._intercepts_index = self.DeclareDiscreteState(scene.obstacle_starts.reshape(-1))
         self._active_index = self.DeclareDiscreteState(np.zeros(count))
-        self._centres_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "obstacle_positions", 3 * count, self._calc_centres,
             prerequisites_of_calc={self.discrete_state_ticket(self._positions_index)})
-        self._floor_port = self.DeclareStateOutputPort("floor_positions", self._positions_index)
+        self.DeclareStateOutputPort("floor_positions", self._positions_index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     def _calc_centres(self, context, output):

@@ -47,7 +47,7 @@ class CylinderObstacleGeometry(PortGetters, LeafSystem):
             self.geometry_ids.append(geometry)
         self._positions_port = self.DeclareVectorInputPort(
             "obstacle_positions", 3 * len(self._frame_ids))
-        self._pose_port = self.DeclareAbstractOutputPort(
+        self.DeclareAbstractOutputPort(
             "geometry_pose", lambda: AbstractValue.Make(FramePoseVector()), self._calc_poses)
 
     def _calc_poses(self, context, output):

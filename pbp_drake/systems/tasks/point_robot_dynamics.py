@@ -52,7 +52,7 @@ class PointRobotDynamics(PortGetters, LeafSystem):
         self._command_port = self.DeclareVectorInputPort("command", 2 * self._dimension)
         state_index = self.DeclareDiscreteState(
             np.concatenate([initial_position, np.zeros(self._dimension)]))
-        self._state_port = self.DeclareStateOutputPort("state", state_index)
+        self.DeclareStateOutputPort("state", state_index)
         self.DeclarePeriodicDiscreteUpdateEvent(time_step, time_step / 2, self._step)
 
     def _step(self, context, discrete_state):

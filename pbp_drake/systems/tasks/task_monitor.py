@@ -90,10 +90,10 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         self._counts_index = self.DeclareDiscreteState(_COUNTS_SIZE)
         # [progress, task time]: the status's real-valued entries.
         self._measures_index = self.DeclareDiscreteState(2)
-        self._target_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "target", Target.size, self._calc_target,
             prerequisites_of_calc={self.discrete_state_ticket(self._counts_index)})
-        self._status_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "task_status", TaskStatus.size, self._calc_status,
             prerequisites_of_calc={self.all_state_ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(period, update_offset, self._update)

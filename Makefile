@@ -78,13 +78,13 @@ $(VENV)/.installed-bench: $(STAMP)
 	touch $@
 
 bench: $(VENV)/.installed-bench
-	$(VENV)/bin/python -m pbp_drake.bench
+	$(VENV)/bin/python -m pbp_drake_bench
 
 # An hour of simulated time of the HSR reaching task with Meshcat on, runs back to back in
 # one process; fails when memory grows 10 % or more after the first minute (about 15
 # minutes of wall time on an idle 2-core machine, 25 on a shared one).
 soak: $(STAMP)
-	$(PYTHON) -m pbp_drake.soak --minutes 60
+	$(PYTHON) -m pbp_drake_bench.soak --minutes 60
 
 # Every study the docs quote (the list: pbp_drake/studies/results_catalogue.py), each with
 # --jobs 2 into outputs/results/NAME, and its table into docs/results/generated/NAME.md

@@ -13,6 +13,9 @@ extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "pbp_d
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 exclude_patterns = ["_build", "_ext", "Thumbs.db", ".DS_Store"]
 myst_enable_extensions = ["colon_fence", "deflist"]
+# `[text](page.md#a-heading)` links to a heading by its GitHub-style anchor, on the site as on
+# GitHub (tests/test_documentation_links.py checks that each names a heading).
+myst_heading_anchors = 6
 # Our docstrings write names in single backticks: they render as code.
 default_role = "code"
 napoleon_google_docstring = True

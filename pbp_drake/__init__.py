@@ -10,8 +10,9 @@ API reference is generated from it); the subpackages hold the rest:
 - `pbp_drake.robots`: the HSR model and its station;
 - `pbp_drake.scenarios`: scenario files (schema, loading, checks, `resolve`);
 - `pbp_drake.builder`: a resolved scenario to a Diagram, and runs;
-- `pbp_drake.studies`, `pbp_drake.console`, `pbp_drake.bench`: studies, the operator's
-  page, the bench.
+- `pbp_drake.studies`, `pbp_drake.console`: studies, the operator's page.
+
+The bench and the soak test are the package `pbp_drake_bench`, beside this one.
 """
 
 import importlib

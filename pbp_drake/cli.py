@@ -1,14 +1,12 @@
 """The `pbp-drake` command line: `run` one scenario in Meshcat, `study` a scenario file,
 `report` a study folder, `bench` the DMP bank, `draw` a system diagram. Each subcommand lives
-in `pbp_drake.commands`."""
+in `pbp_drake.commands`, but `bench`: the package `pbp_drake_bench`, beside `pbp_drake`."""
 
 import argparse
 import os
 import sys
 
 from pbp_drake import __version__
-from pbp_drake.bench.main import build_parser as build_bench_parser
-from pbp_drake.bench.main import main as bench_main
 from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_USAGE
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.study import add_study_commands
@@ -61,16 +59,19 @@ def build_parser():
 
 def tool_parsers():
     """The parsers of the subcommands that parse their own line: {"bench": ..., "draw": ...}."""
+    from pbp_drake_bench.main import build_parser as build_bench_parser  # the harness: on use
     return {"bench": build_bench_parser(), "draw": build_draw_parser()}
 
 
 def _main(argv):
     parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
-    tools = {"bench": bench_main, "draw": draw_main}
-    if argv and argv[0] in tools:
-        # Before argparse, which would take their options (e.g. --help) for its own.
-        return tools[argv[0]](argv[1:])
+    # Before argparse, which would take their options (e.g. --help) for its own.
+    if argv and argv[0] == "bench":
+        from pbp_drake_bench.main import main as bench_main  # the harness: on use
+        return bench_main(argv[1:])
+    if argv and argv[0] == "draw":
+        return draw_main(argv[1:])
     args = parser.parse_args(argv)
     try:
         return args.handler(args)

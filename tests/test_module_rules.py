@@ -1,29 +1,38 @@
 """Rules every module of `pbp_drake` keeps: modules grouped by topic, one over 600 lines
 saying in its docstring why it is one module; imports at the top (except heavy optional
 packages deferred on purpose) and pointing one way, from the tools down to the math; no two
-modules sharing a file name but those the design page names as one concept in two layers."""
+modules sharing a file name but those the design page names as one concept in two layers.
+The harness beside it, `pbp_drake_bench`, keeps the first two; the library never imports it
+but where `pbp-drake bench` hands over to it."""
 
 import ast
 import collections
 import pathlib
+import subprocess
+import sys
 
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "pbp_drake"
 MODULES = sorted(path for path in PACKAGE.rglob("*.py") if "_models" not in path.parts)
+BENCH = REPO / "pbp_drake_bench"
+BENCH_MODULES = sorted(BENCH.glob("*.py"))
 # Imports a module may defer into a function: heavy optional packages, on purpose.
 # scipy.stats: a dependency, but 0.7 s to import; only a user study's report needs it.
 # scipy.linalg.blas: 0.2 s to import; only the six-DoF bank's fused step needs its dgemm.
 DEFERRED_IMPORTS = {"ray", "pydmps", "movement_primitives.dmp", "threadpoolctl", "scipy.stats",
                     "scipy.linalg.blas"}
+# The harness, imported by `pbp-drake bench` alone (cli.py), when run.
+HARNESS = "pbp_drake_bench.main"
 
 
 def test_the_package_has_modules():
     assert len(MODULES) > 40
 
 
-@pytest.mark.parametrize("path", MODULES, ids=lambda path: str(path.relative_to(PACKAGE)))
+@pytest.mark.parametrize("path", MODULES + BENCH_MODULES,
+                         ids=lambda path: str(path.relative_to(REPO)))
 def test_a_long_module_says_why_and_imports_are_at_the_top(path):
     text = path.read_text()
     tree = ast.parse(text)
@@ -35,13 +44,14 @@ def test_a_long_module_says_why_and_imports_are_at_the_top(path):
         if isinstance(node, (ast.Import, ast.ImportFrom)) and id(node) not in top:
             modules = ([node.module] if isinstance(node, ast.ImportFrom)
                        else [alias.name for alias in node.names])
-            assert set(modules) <= DEFERRED_IMPORTS, (
+            allowed = DEFERRED_IMPORTS | ({HARNESS} if path == PACKAGE / "cli.py" else set())
+            assert set(modules) <= allowed, (
                 f"{path.name}:{node.lineno} imports {modules} inside a function")
 
 
 # The layers, from the math up: a module imports only from its own layer and those below.
 LAYERS = [{"core"}, {"systems"}, {"robots"}, {"scenarios"}, {"builder"}, {"studies"},
-          {"console"}, {"bench", "draw", "output_paths", "soak", "cli_types"}, {"commands"},
+          {"console"}, {"draw", "output_paths", "cli_types"}, {"commands"},
           {"cli"}, {"__main__", "__init__"}]
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
@@ -90,3 +100,24 @@ def test_modules_share_a_file_name_only_as_one_concept_in_different_layers():
                 assert str(path.relative_to(PACKAGE)) in design, (
                     f"docs/design.md does not say which {name} is which "
                     f"({path.relative_to(PACKAGE)})")
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda path: str(path.relative_to(PACKAGE)))
+def test_the_library_does_not_import_the_harness_at_the_top(path):
+    tree = ast.parse(path.read_text())
+    for node in tree.body:
+        names = ([node.module or ""] if isinstance(node, ast.ImportFrom)
+                 else [a.name for a in node.names] if isinstance(node, ast.Import) else [])
+        assert not any(name.split(".")[0] == BENCH.name for name in names), (
+            f"{path.relative_to(PACKAGE)}:{node.lineno} imports the harness")
+
+
+def test_the_harness_imports_the_library_not_the_other_way():
+    # Loading the command line and every topic leaves the harness unloaded.
+    code = ("import sys, pbp_drake, pbp_drake.cli, pbp_drake.builder, pbp_drake.studies; "
+            "print(sorted(name for name in sys.modules if name.startswith('pbp_drake_bench')))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            cwd=REPO, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
+    assert BENCH_MODULES, "the harness package is missing"

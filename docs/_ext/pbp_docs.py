@@ -4,13 +4,15 @@
 - `cli-reference`: every `pbp-drake` subcommand from its argparse parser, and the exit codes;
 - `scenario-reference`: every field reachable from `ScenarioFile`, from the dataclasses and
   their `#:` doc comments;
-- `api-reference`: every name of `pbp_drake.__all__`, grouped as `pbp_drake.API_GROUPS` says.
+- `api-reference`: a table of every name of `pbp_drake.__all__` (its topic from
+  `pbp_drake.API_GROUPS`), each name's own page generated under `reference/api/`.
 """
 
 import argparse
 import dataclasses
 import importlib
 import inspect
+import pathlib
 import typing
 
 from docutils import nodes
@@ -234,31 +236,85 @@ class ScenarioReference(SphinxDirective):
 
 # --- api-reference --------------------------------------------------------------------------
 
+# The folder, under the source folder, of the one page per public name (written at each
+# build by `_write_api_pages`, not kept in git).
+API_FOLDER = "reference/api"
+
+
+def api_groups():
+    """{topic: [public name, ...]} of `pbp_drake.API_GROUPS`, any name it misses under
+    "Other"."""
+    import pbp_drake
+
+    groups = {title: list(names) for title, names in pbp_drake.API_GROUPS.items()}
+    grouped = {name for names in groups.values() for name in names}
+    other = [name for name in pbp_drake.__all__ if name not in grouped and name != "__version__"]
+    if other:
+        groups["Other"] = other
+    return groups
+
+
+def summary(value):
+    """The first sentence of `value`'s docstring, on one line ("" without one)."""
+    paragraph = " ".join((inspect.getdoc(value) or "").split("\n\n", 1)[0].split())
+    at = 0
+    while True:
+        at = paragraph.find(". ", at) + 1
+        if at == 0:
+            return paragraph
+        before = paragraph[:at]
+        # Not inside `code`, nor an abbreviation.
+        if before.count("`") % 2 == 0 and not before.endswith(("e.g.", "i.e.", "vs.")):
+            return before
+
+
+def _api_page(name, topic):
+    import pbp_drake
+
+    value = getattr(pbp_drake, name)
+    if inspect.ismodule(value):
+        directive = [f".. automodule:: {value.__name__}", "   :members:"]
+    elif inspect.isclass(value):
+        directive = [f".. autoclass:: pbp_drake.{name}", "   :members:"]
+    else:
+        directive = [f".. autofunction:: pbp_drake.{name}"]
+    return "\n".join([name, "=" * len(name), "", f"*{topic}* (:doc:`every public name <../api>`)",
+                       "", *directive, ""])
+
+
+def _write_api_pages(app):
+    """One page per public name under `API_FOLDER`, rewritten only when it changes."""
+    folder = pathlib.Path(app.srcdir) / API_FOLDER
+    folder.mkdir(exist_ok=True)
+    pages = {f"{name}.rst": _api_page(name, topic)
+             for topic, names in api_groups().items() for name in names}
+    for stale in folder.glob("*.rst"):
+        if stale.name not in pages:
+            stale.unlink()
+    for file_name, text in pages.items():
+        path = folder / file_name
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+
+
 class ApiReference(SphinxDirective):
-    """autodoc of every public name, one section per topic of `pbp_drake.API_GROUPS`."""
+    """Every public name, one section per topic of `pbp_drake.API_GROUPS`: a table of each
+    name (a link to its page) and its docstring's first sentence; the pages themselves in a
+    hidden toctree."""
 
     def run(self):
         import pbp_drake
 
-        grouped = {name for group in pbp_drake.API_GROUPS.values() for name in group}
-        groups = dict(pbp_drake.API_GROUPS)
-        other = [name for name in pbp_drake.__all__ if name not in grouped
-                 and name != "__version__"]
-        if other:
-            groups["Other"] = {name: "pbp_drake" for name in other}
-        lines = []
-        for title, names in groups.items():
-            lines += [title, "-" * len(title), ""]
+        folder = API_FOLDER.rsplit("/", 1)[1]
+        lines, entries = [], []
+        for topic, names in api_groups().items():
+            lines += [topic, "-" * len(topic), "", ".. list-table::", "   :widths: 30 70", ""]
             for name in names:
-                value = getattr(pbp_drake, name)
-                kind = ("automodule" if inspect.ismodule(value) else
-                        "autoclass" if inspect.isclass(value) else "autofunction")
-                target = value.__name__ if kind == "automodule" else f"pbp_drake.{name}"
-                lines += [f".. {kind}:: {target}"]
-                if kind != "autofunction":
-                    lines += ["   :members:"]
-                lines.append("")
-        return _parse_rst(self, lines)
+                lines += [f"   * - :doc:`{name} <{folder}/{name}>`",
+                          f"     - {summary(getattr(pbp_drake, name)) or ' '}"]
+                entries.append(f"   {folder}/{name}")
+            lines.append("")
+        return _parse_rst(self, lines + [".. toctree::", "   :hidden:", "", *entries, ""])
 
 
 # The pages generated from the code: re-read at every build, since Sphinx sees only
@@ -267,10 +323,12 @@ GENERATED_PAGES = ["reference/cli", "reference/scenario-files", "reference/api"]
 
 
 def _generated_pages(app, env, added, changed, removed):
-    return [page for page in GENERATED_PAGES if page in env.found_docs]
+    return [page for page in env.found_docs
+            if page in GENERATED_PAGES or page.startswith(API_FOLDER + "/")]
 
 
 def setup(app):
+    app.connect("builder-inited", _write_api_pages)
     app.connect("env-get-outdated", _generated_pages)
     app.add_directive("pydrake_system", PydrakeSystem)
     app.add_directive("cli-reference", CliReference)

@@ -22,6 +22,7 @@ obstacles) `in_collision_log` record each tick; the task monitor ends the simula
 at success.
 """
 
+import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
@@ -111,8 +112,11 @@ def build_reach_diagram(resolved, meshcat=None):
         LogVectorOutput(port, builder, period).set_name(name)
 
     if meshcat is not None:
+        # An arm's workspace is a fraction of the HSR's: the camera frames it.
+        workspace = (np.vstack([resolved.station.base_pose[:3], scene.objects, start])
+                     if isinstance(resolved.station, ArmStationConfig) else None)
         visualizer = builder.AddNamedSystem("task_visualizer", ReachSceneVisualizer(
-            meshcat, scene.objects, prediction_steps, path_count))
+            meshcat, scene.objects, prediction_steps, path_count, workspace=workspace))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
         builder.Connect(selected_goal, visualizer.get_selected_goal_input_port())
         builder.Connect(operator_active, visualizer.get_operator_active_input_port())

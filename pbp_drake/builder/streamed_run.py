@@ -1,5 +1,5 @@
 """Running an HSR task with its per-tick rows streamed to a CSV file (`run_task_streamed`),
-for runs too long to keep their time series in memory (`pbp_drake.soak` runs one for an
+for runs too long to keep their time series in memory (`pbp_drake_bench.soak` runs one for an
 hour of simulated time).
 
 The simulator advances in chunks of simulated time. After each chunk the rows of the ticks

@@ -1,5 +1,6 @@
-"""Where a 2-D scene is and how to frame it on a page, and paths resampled to a fixed count of
-points (for drawing them with a fixed set of Meshcat objects).
+"""Where a 2-D scene is and how to frame it on a page, a perspective camera framed on a 3-D
+workspace (`workspace_view`), and paths resampled to a fixed count of points (for drawing them
+with a fixed set of Meshcat objects).
 
 Meshcat's page keeps an orthographic camera's `left`, `top` and `bottom` and fits `right` to
 the page's aspect (`right = left + width * (top - bottom) / height`). So a view cannot be
@@ -44,6 +45,29 @@ def page_view(low, high, centred_aspect=CENTRED_ASPECT, narrowest_aspect=NARROWE
     half_width = centred_aspect * height / 2.0
     return (centre[0] - half_width, centre[0] + half_width,
             centre[1] - height / 2.0, centre[1] + height / 2.0)
+
+
+# Meshcat's perspective camera: 75 degrees of vertical field of view (three.js, as Meshcat
+# sets it up), on a page at least as wide as it is tall.
+MESHCAT_FIELD_OF_VIEW = np.radians(75.0)
+# From the workspace's centre toward the camera: behind the robot (-x), to its right (-y)
+# and above, the direction of the HSR's default view.
+VIEW_DIRECTION = (-0.57, -0.43, 0.70)
+WORKSPACE_FILL = 0.6  # the share of the view's height the workspace spans
+
+
+def workspace_view(points, fill=WORKSPACE_FILL, direction=VIEW_DIRECTION,
+                   field_of_view=MESHCAT_FIELD_OF_VIEW, min_radius=0.1):
+    """`(camera, target)` (world frame) of a perspective camera looking at the centre of the
+    box around `points` `(N, 3)` from `direction`, at the distance at which the ball around
+    them (radius at least `min_radius`) spans `fill` of the vertical `field_of_view`."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    centre = (points.min(axis=0) + points.max(axis=0)) / 2.0
+    radius = max(min_radius, float(np.max(np.linalg.norm(points - centre, axis=1))))
+    # Seen from d away, the ball's half angle is asin(radius / d).
+    distance = radius / np.sin(fill * field_of_view / 2.0)
+    direction = np.asarray(direction, dtype=float)
+    return centre + distance * direction / np.linalg.norm(direction), centre
 
 
 def resample_by_arc_length(path, count):

@@ -10,6 +10,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.robots.box_qp import solve_box_qp
+from pbp_drake.systems.ports import PortGetters
 
 # How much more a unit of the hand's velocity error (m/s) weighs than a unit of the joints'
 # drift toward their nominal positions (m/s, rad/s): the drift takes what the hand's motion
@@ -33,7 +34,7 @@ OVERSHOOT_WEIGHT = 10.0
 CATCH_UP_STEPS = 3
 
 
-class WholeBodyDiffIk(LeafSystem):
+class WholeBodyDiffIk(PortGetters, LeafSystem):
     """Plans the robot's joint motion toward a desired end-effector pose, one step of
     differential IK at a time, and tells the plant's PD where to be.
 
@@ -150,24 +151,9 @@ class WholeBodyDiffIk(LeafSystem):
             "desired_state", 2 * len(motor_joints), self._calc_desired_state,
             {self.time_ticket(), self.xd_ticket()})
 
-    def get_X_WE_desired_input_port(self):
-        return self._pose_port
-
-    def get_V_WE_desired_input_port(self):
-        return self._twist_port
-
-    def get_ee_command_input_port(self):
-        return self._command_port
-
     def get_command_input_port(self):
         """The command port of a diff IK with a ramp, whichever command it reads."""
         return self._command_port
-
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_desired_state_output_port(self):
-        return self._desired_port
 
     def _start(self, context, discrete_state):
         q = self._robot_state_port.Eval(context)[:self._nq]

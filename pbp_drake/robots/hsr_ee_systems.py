@@ -8,7 +8,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.systems.ports import EeCommand, EeState
+from pbp_drake.systems.ports import EeCommand, EeState, PortGetters
 from pbp_drake.systems.tick import decide_offset
 
 # EeCommand's entries, by index.
@@ -29,7 +29,7 @@ def ee_state_at_rest(X_WE: RigidTransform) -> np.ndarray:
     return state[:]
 
 
-class EeCommandToPose(LeafSystem):
+class EeCommandToPose(PortGetters, LeafSystem):
     """Turns the end-effector command into the desired pose and velocity for diff IK.
 
     .. pydrake_system::
@@ -69,9 +69,6 @@ class EeCommandToPose(LeafSystem):
             "X_WE_desired", lambda: AbstractValue.Make(RigidTransform()), self._calc_pose)
         self._velocity_port = self.DeclareVectorOutputPort(
             "V_WE_desired", 6, self._calc_velocity)
-
-    def get_ee_command_input_port(self):
-        return self._command_port
 
     def get_pose_output_port(self):
         return self._pose_port
@@ -164,7 +161,7 @@ class EeCommandRamp:
         return R, position, [0.0, 0.0, rate, *command[_VELOCITY]]
 
 
-class EeStateFromPlant(LeafSystem):
+class EeStateFromPlant(PortGetters, LeafSystem):
     """Reads the end effector's position, velocity and heading off the plant's state.
 
     .. pydrake_system::
@@ -200,14 +197,8 @@ class EeStateFromPlant(LeafSystem):
         self._plant_context = plant.CreateDefaultContext()
         self._plant_state_port = self.DeclareVectorInputPort(
             "plant_state", plant.num_multibody_states())
-        self._state_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "ee_state", EeState.size, self._calc_state)
-
-    def get_plant_state_input_port(self):
-        return self._plant_state_port
-
-    def get_ee_state_output_port(self):
-        return self._state_port
 
     def _calc_state(self, context, output):
         plant_context = self._plant_context

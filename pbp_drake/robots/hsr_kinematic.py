@@ -16,9 +16,10 @@ from pydrake.systems.framework import LeafSystem
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO
+from pbp_drake.systems.ports import PortGetters
 
 
-class KinematicJoints(LeafSystem):
+class KinematicJoints(PortGetters, LeafSystem):
     """The plant's state, read off the diff IK's ``desired_state`` with no dynamics.
 
     .. pydrake_system::
@@ -49,18 +50,12 @@ class KinematicJoints(LeafSystem):
                           for follower, leader, ratio in couplers]
         self._desired_port = self.DeclareVectorInputPort("desired_state",
                                                          2 * len(motor_joints))
-        self._state_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "state", plant.num_multibody_states(), self._calc_state)
 
     def plant(self):
         """The MultibodyPlant (outside any Diagram) whose state this system outputs."""
         return self._plant
-
-    def get_desired_state_input_port(self):
-        return self._desired_port
-
-    def get_state_output_port(self):
-        return self._state_port
 
     def _calc_state(self, context, output):
         state = np.zeros(output.size())

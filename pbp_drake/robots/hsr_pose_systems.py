@@ -14,7 +14,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.quaternion import UNIT_TOLERANCE, aligned, exp_map, multiply
-from pbp_drake.systems.ports import PoseState
+from pbp_drake.systems.ports import PortGetters, PoseState
 
 # The frame the pose station commands and measures: the grasp task's hand frame H.
 HAND_FRAME = "hand_palm_link"
@@ -105,7 +105,7 @@ class PoseCommandRamp:
                 command[_POSITION] + command[_VELOCITY] * ahead)
 
 
-class PoseStateFromPlant(LeafSystem):
+class PoseStateFromPlant(PortGetters, LeafSystem):
     """Reads the hand's pose and twist off the plant's state.
 
     .. pydrake_system::
@@ -135,14 +135,8 @@ class PoseStateFromPlant(LeafSystem):
         self._plant_context = plant.CreateDefaultContext()
         self._plant_state_port = self.DeclareVectorInputPort(
             "plant_state", plant.num_multibody_states())
-        self._pose_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "hand_pose", PoseState.size, self._calc_pose)
-
-    def get_plant_state_input_port(self):
-        return self._plant_state_port
-
-    def get_hand_pose_output_port(self):
-        return self._pose_port
 
     def _calc_pose(self, context, output):
         plant_context = self._plant_context

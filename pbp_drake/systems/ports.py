@@ -3,8 +3,11 @@
 Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
 ``EeState.size`` is its length. Every system that declares such a port takes its size here.
 `position_of` reads the `[x, y, z]` of any view that has those fields (the pose views too);
-`goal_index` reads a goal index port (`selected_goal`, `followed_goal`).
+`goal_index` reads a goal index port (`selected_goal`, `followed_goal`). `PortGetters` gives
+a system `get_NAME_input_port()` and `get_NAME_output_port()` for every port it declares.
 """
+
+import re
 
 import numpy as np
 from pydrake.common.containers import namedview
@@ -56,3 +59,31 @@ PoseState = _view("PoseState", ["x", "y", "z", "qw", "qx", "qy", "qz",
 GoalPose = _view("GoalPose", ["x", "y", "z", "qw", "qx", "qy", "qz"])
 # An operator's six-DoF command: a world-frame linear and angular velocity.
 OperatorTwist = _view("OperatorTwist", ["vx", "vy", "vz", "wx", "wy", "wz"])
+
+
+_GETTER = re.compile(r"get_(\w+)_(input|output)_port")
+
+
+class PortGetters:
+    """`get_NAME_input_port()` and `get_NAME_output_port()` for every port NAME the system
+    declares, as Drake's C++ systems have: `GetInputPort(NAME)`, `GetOutputPort(NAME)`. A
+    mixin before `LeafSystem` or `Diagram`; the ports are those of the system's
+    `.. pydrake_system::` diagram, and `dir()` lists their getters."""
+
+    def __getattr__(self, attribute):
+        match = _GETTER.fullmatch(attribute)
+        if match is not None:
+            name, kind = match.groups()
+            if kind == "input" and self.HasInputPort(name):
+                port = self.GetInputPort(name)
+                return lambda: port
+            if kind == "output" and self.HasOutputPort(name):
+                port = self.GetOutputPort(name)
+                return lambda: port
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {attribute!r}")
+
+    def __dir__(self):
+        inputs = (self.get_input_port(i).get_name() for i in range(self.num_input_ports()))
+        outputs = (self.get_output_port(i).get_name() for i in range(self.num_output_ports()))
+        return [*super().__dir__(), *(f"get_{name}_input_port" for name in inputs),
+                *(f"get_{name}_output_port" for name in outputs)]

@@ -3,10 +3,11 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.ports import PortGetters
 from pbp_drake.systems.tick import SENSE_OFFSET
 
 
-class SampleHold(LeafSystem):
+class SampleHold(PortGetters, LeafSystem):
     """Samples its input at each control tick and holds it; starts at `initial_value`.
 
     .. pydrake_system::

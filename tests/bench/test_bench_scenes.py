@@ -1,4 +1,4 @@
-"""The closed-loop bench's scenes (`pbp_drake.bench.scenes`): K objects on a jittered grid,
+"""The closed-loop bench's scenes (`pbp_drake_bench.scenes`): K objects on a jittered grid,
 the target the first, no switches; the grasp scene's poses drawn by the core's own
 functions; both built by the normal builder and run to their target by the virtual
 participant."""
@@ -6,7 +6,7 @@ participant."""
 import numpy as np
 import pytest
 
-from pbp_drake.bench.scenes import GRASP, REACH, grasp_resolved, resolved_scene
+from pbp_drake_bench.scenes import GRASP, REACH, grasp_resolved, resolved_scene
 from pbp_drake.builder.run import run_task
 from pbp_drake.core.grasp_task import grasp_pose
 

@@ -61,6 +61,5 @@ def test_the_replay_shows_the_selected_dmps_path_to_its_grasp(grasp, meshcat):
 
 def test_without_meshcat_the_pose_bank_predicts_nothing(grasp):
     bank = build_diagram(grasp).GetSubsystemByName("dmp_bank")
-    assert bank.get_predicted_poses_output_port() is None
     assert not bank.HasOutputPort("predicted_poses")
     assert GRASP_PREDICTION_SAMPLES > 0

@@ -12,7 +12,7 @@ from pbp_drake.builder import run_task, run_task_streamed
 from pbp_drake.builder.time_series import time_series_csv
 from pbp_drake.cli import main
 from pbp_drake.scenarios import load_scenario_file, resolve
-from pbp_drake.soak import run_soak
+from pbp_drake_bench.soak import run_soak
 from pbp_drake.studies.runners import run_trial
 from pbp_drake.studies.trial_files import load_task_result, read_time_series, trial_paths
 

@@ -65,7 +65,14 @@ def test_the_reference_pages_hold_what_a_reader_looks_for(site):
     scenario = _page(out, "scenario-files")
     assert "reaction_delay" in scenario and "default 0.5" in scenario
     assert "!Hsr" in scenario
+    # The API page is a table a person scans: every name, linked to its own page, which
+    # holds the docstrings (a system's port diagram among them).
     api = _page(out, "api")
+    html = (out / "reference" / "api.html").read_text()
     for name in pbp_drake.__all__:
-        assert name in api or name == "__version__", name
-    assert "robot_state ──▶" in api  # Blender's and the banks' port diagrams
+        if name != "__version__":
+            assert name in api and f'href="api/{name}.html"' in html, name
+            assert (out / "reference" / "api" / f"{name}.html").exists(), name
+    assert "robot_state ──▶" not in api
+    assert "robot_state ──▶" in _page(out, "api/Blender")
+    assert len(api.split()) < 4000, "the API page holds more than its table"

@@ -23,16 +23,16 @@ import pytest
 from pydrake.geometry import Box, Meshcat, MeshcatParams
 from pydrake.math import RigidTransform
 
-from pbp_drake.bench.cases import (
+from pbp_drake_bench.cases import (
     MOTION_DURATIONS, bank_math_step, leaf_simulator, make_bank, make_case, motion_timing)
-from pbp_drake.bench.checks import CHECKS, evaluate, exit_code, format_results, summary
-from pbp_drake.bench.closed_loop import split_run
-from pbp_drake.bench.pinning import MARKER, THREAD_VARIABLES, blas_threads
-from pbp_drake.bench.main import _parse, plan
-from pbp_drake.bench.table import format_report
-from pbp_drake.bench.time_split import BANK, DRAWING, IK, ORDER, REST, category_of, split_stats
-from pbp_drake.bench.timing import timed_span
-from pbp_drake.bench.ws_reader import MeshcatReader, send_mark
+from pbp_drake_bench.checks import CHECKS, evaluate, exit_code, format_results, summary
+from pbp_drake_bench.closed_loop import split_run
+from pbp_drake_bench.pinning import MARKER, THREAD_VARIABLES, blas_threads
+from pbp_drake_bench.main import _parse, plan
+from pbp_drake_bench.table import format_report
+from pbp_drake_bench.time_split import BANK, DRAWING, IK, ORDER, REST, category_of, split_stats
+from pbp_drake_bench.timing import timed_span
+from pbp_drake_bench.ws_reader import MeshcatReader, send_mark
 
 K10K_LEAF = ("K=10,000 goals (D=3, distinct weights): one step in the LeafSystem and a read of "
              "its selected reference, median over "
@@ -62,7 +62,7 @@ SITECUSTOMIZE = textwrap.dedent("""
             "numpy_loaded": "numpy" in sys.modules,
             "variables": {name: os.environ.get(name) for name in %(variables)r}}) + "\\n")
     if "%(marker)s" in os.environ:
-        import pbp_drake.bench.timing as timing
+        import pbp_drake_bench.timing as timing
         seconds = float(os.environ["BENCH_TEST_STEP_SECONDS"])
         timing.timed = lambda step, min_time, **options: (seconds, seconds, 3)
         timing.timed_span = lambda step, done, **options: (seconds, seconds, 3)
@@ -324,7 +324,7 @@ def test_numpy_called_by_the_bank_counts_as_the_bank():
     assert category_of(("/x/pbp_drake/core/quaternion.py", 1, "multiply")) is None
     assert category_of(("~", 0, "<method 'reduce' of 'numpy.ufunc' objects>")) is None
     case = make_case(3, 1000, True)
-    step = bank_math_step(make_bank(case), case)  # a closure in pbp_drake/bench: rest
+    step = bank_math_step(make_bank(case), case)  # a closure in pbp_drake_bench: rest
     profile = cProfile.Profile()
     profile.enable()
     for _ in range(200):
@@ -359,7 +359,7 @@ def test_the_time_split_of_a_run_sums_to_its_profiled_total():
 # on the machine. The step timings are faked as above.
 CLOSED_LOOP_SITECUSTOMIZE = SITECUSTOMIZE + textwrap.dedent("""
     if "%(marker)s" in os.environ:
-        import pbp_drake.bench.closed_loop as closed_loop
+        import pbp_drake_bench.closed_loop as closed_loop
         factor = float(os.environ["BENCH_TEST_REALTIME_FACTOR"])
         real_advance = closed_loop.advance
 

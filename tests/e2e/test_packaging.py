@@ -153,7 +153,7 @@ def test_importing_the_package_does_not_import_drake():
 
 
 def test_the_bench_runs_as_a_module_and_as_a_command():
-    by_module = subprocess.run([sys.executable, "-m", "pbp_drake.bench", "--help"],
+    by_module = subprocess.run([sys.executable, "-m", "pbp_drake_bench", "--help"],
                                capture_output=True, text=True, timeout=120)
     by_command = subprocess.run([sys.executable, "-m", "pbp_drake", "bench", "--help"],
                                 capture_output=True, text=True, timeout=120)

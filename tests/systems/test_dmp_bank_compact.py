@@ -1,8 +1,7 @@
-"""The DmpBank system's compact state (`compact_state=True`): for DMPs that step from the
-followed DMP's velocity, a state whatever K (`2 + 6 D` numbers when they share weights and
-start, `3 + 2 D` with distinct weights, the step's terms then a cache entry), whose outputs
-are the per-goal state's bit for bit; and `selected_reference`, the selected goal's
-reference alone, which the blender can follow instead of all K."""
+"""The DmpBank system's compact state (`compact_state=True`): for DMPs that share weights and
+start and step from the followed DMP's velocity, a state whatever K (`2 + 6 D` numbers),
+whose outputs are the per-goal state's bit for bit; and `selected_reference`, the selected
+goal's reference alone, which the blender can follow instead of all K."""
 
 import numpy as np
 import pytest
@@ -50,12 +49,9 @@ def outputs(system, context):
 
 @pytest.mark.parametrize("formulation", ["ijspeert", "pastor"])
 @pytest.mark.parametrize("max_speed", [None, 0.3])
-@pytest.mark.parametrize("make_bank", [shared_bank, distinct_bank],
-                         ids=["shared", "distinct"])
 def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(formulation,
-                                                                          max_speed, make_bank):
-    """Shared weights take the affine layout, distinct ones the step-inputs layout."""
-    bank = make_bank(formulation)
+                                                                          max_speed):
+    bank = shared_bank(formulation)
     runs = []
     for compact in (False, True):
         system = DmpBank(bank, DT, lock_phase_when_operator_acts=True, prediction_steps=3,
@@ -83,16 +79,15 @@ def test_the_compact_state_does_not_grow_with_the_goals():
     assert DmpBank.state_size(100_000, 3) == 2 + 3 + 9 * 100_000
 
 
-def test_the_compact_state_of_distinct_weights_keeps_the_steps_inputs():
-    bank = distinct_bank()
-    system = DmpBank(bank, DT, compact_state=True)
-    assert system.CreateDefaultContext().get_discrete_state_vector().size() == 3 + 2 * 3
-    assert DmpBank.state_size(100_000, 3, compact_state=True, affine_in_goal=False) == 9
+def test_the_compact_state_refuses_distinct_weights():
+    with pytest.raises(ValueError, match="share weights and start"):
+        DmpBank(distinct_bank(), DT, compact_state=True)
+    system = DmpBank(distinct_bank(), DT)
+    assert system.CreateDefaultContext().get_discrete_state_vector().size() == 2 + 3 + 9 * 4
 
 
-@pytest.mark.parametrize("make_bank", [shared_bank, distinct_bank], ids=["shared", "distinct"])
-def test_the_compact_state_needs_the_followed_goal_connected(make_bank):
-    system = DmpBank(make_bank(), DT, compact_state=True)
+def test_the_compact_state_needs_the_followed_goal_connected():
+    system = DmpBank(shared_bank(), DT, compact_state=True)
     simulator = Simulator(system)
     context = simulator.get_mutable_context()
     system.get_robot_state_input_port().FixValue(context, np.zeros(6))

@@ -7,11 +7,11 @@ import pytest
 from pydrake.systems.analysis import Simulator
 from test_dmp_bank_compact import GOALS, DT, distinct_bank, drive, shared_bank
 
-from pbp_drake.bench.cases import make_bank
-from pbp_drake.bench.pose_cases import make_pose_case
 from pbp_drake.systems import LikelyGoals
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
 from pbp_drake.systems.pbp.likely_goals import likely_goal_indices
+from pbp_drake_bench.cases import make_bank
+from pbp_drake_bench.pose_cases import make_pose_case
 
 
 @pytest.mark.parametrize("selected, count, expected", [
@@ -38,8 +38,9 @@ def test_the_system_reads_its_ports_and_refuses_more_goals_than_there_are():
 @pytest.mark.parametrize("make_bank", [shared_bank, distinct_bank], ids=["shared", "distinct"])
 def test_the_chosen_goals_paths_are_the_all_goal_paths_rows(make_bank):
     bank = make_bank()
-    every = DmpBank(bank, DT, prediction_steps=5, compact_state=True)
-    chosen = DmpBank(bank, DT, prediction_steps=5, compact_state=True, predicted_goal_count=2)
+    compact = bank.affine_in_goal  # the compact state takes shared weights only
+    every = DmpBank(bank, DT, prediction_steps=5, compact_state=compact)
+    chosen = DmpBank(bank, DT, prediction_steps=5, compact_state=compact, predicted_goal_count=2)
     contexts = []
     for system in (every, chosen):
         simulator = Simulator(system)

@@ -187,7 +187,7 @@ class DmpBankModel(BankStep):
             followed: None, or the index of the DMP the robot followed until now: every DMP
                 then steps from that DMP's velocity, so that the robot may switch to any of
                 them without a jump of its commanded velocity (PBP's goal switch; see the
-                hand-over law in the README). None: each DMP keeps its own.
+                hand-over law, docs/concepts/hand-over.md). None: each DMP keeps its own.
         Returns:
             (phase, positions, scaled_velocity) after the step, new arrays.
         """

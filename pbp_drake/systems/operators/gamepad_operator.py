@@ -81,9 +81,6 @@ class GamepadOperator(SampledOperator):
         self._stale_index = self.DeclareDiscreteState(np.full(_STICK_AXES, np.nan))
         self._declare_operator_outputs()
 
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
     def _update(self, context, discrete_state):
         # Read before the connections are counted (see KeyboardOperator._update).
         gamepad = self._meshcat.GetGamepad()

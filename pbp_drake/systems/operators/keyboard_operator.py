@@ -138,9 +138,6 @@ class KeyboardOperator(SampledOperator):
         self.DeclareInitializationDiscreteUpdateEvent(self._snapshot)
         self._declare_operator_outputs()
 
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
     def button_names(self):
         """The names of the buttons this operator added to Meshcat."""
         return list(self._keys.names)

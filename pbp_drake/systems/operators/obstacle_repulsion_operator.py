@@ -51,9 +51,6 @@ class ObstacleRepulsionOperator(SampledOperator):
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * dimension)
         self._declare_operator_outputs()
 
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
     def _sample(self, context):
         position = self._robot_state_port.Eval(context)[:self._dimension]
         return repulsion_command(position, self._centres, self._radii, self._threshold,

@@ -21,7 +21,7 @@ from pbp_drake.core.surrogate_pilots import (
     reach_proportional_command)
 from pbp_drake.systems.operators.sampled_operator import SampledOperator
 from pbp_drake.systems.ports import (
-    EeState, OperatorCommand, OperatorTwist, PoseState, Target, position_of)
+    EeState, OperatorCommand, OperatorTwist, PortGetters, PoseState, Target, position_of)
 from pbp_drake.systems.tick import pilot_offset
 
 #: The port that says whether the method enables the forward key (size 1).
@@ -89,7 +89,7 @@ class GraspKeys:
             position_of(Target(target)), max_speed, forward_enabled)
 
 
-class PilotFilter(LeafSystem):
+class PilotFilter(PortGetters, LeafSystem):
     """Base of the filters between a base pilot's outputs and the controller.
 
     .. pydrake_system::
@@ -126,22 +126,16 @@ class PilotFilter(LeafSystem):
         # [command (size), active, whether a sample has been taken].
         self._sample_index = self.DeclareDiscreteState(size + 2)
         held = {self.discrete_state_ticket(self._sample_index)}
-        self._command_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "operator_command", size,
             lambda context, output: output.SetFromVector(self._held(context)[:size]),
             prerequisites_of_calc=held)
-        self._active_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "operator_active", 1,
             lambda context, output: output.SetFromVector(self._held(context)[size:size + 1]),
             prerequisites_of_calc=held)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, pilot_offset(self._period),
                                                 self._update)
-
-    def get_operator_command_output_port(self):
-        return self._command_port
-
-    def get_operator_active_output_port(self):
-        return self._active_port
 
     def _held(self, context):
         return context.get_discrete_state(self._sample_index).value()
@@ -199,7 +193,7 @@ class LaggyFilter(PilotFilter):
         return command, active
 
 
-class PilotOperator(Diagram):
+class PilotOperator(PortGetters, Diagram):
     """A base pilot and its filter, with exactly the base pilot's ports.
 
     .. pydrake_system::
@@ -243,12 +237,6 @@ class PilotOperator(Diagram):
         builder.ExportOutput(pilot_filter.get_operator_command_output_port(), "operator_command")
         builder.ExportOutput(pilot_filter.get_operator_active_output_port(), "operator_active")
         builder.BuildInto(self)
-
-    def get_operator_command_output_port(self):
-        return self.GetOutputPort("operator_command")
-
-    def get_operator_active_output_port(self):
-        return self.GetOutputPort("operator_active")
 
 
 class ProportionalOperator(SampledOperator):

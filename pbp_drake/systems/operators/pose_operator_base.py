@@ -63,9 +63,6 @@ class PoseOperatorBase(SampledOperator):
         check_params(params, positive=("rotation_speed",))
         return operator_speed(params.speed, nominal_speed), float(params.rotation_speed)
 
-    def get_hand_state_input_port(self):
-        return self._hand_state_port
-
     def get_operator_twist_output_port(self):
         return self.get_operator_command_output_port()
 

@@ -64,18 +64,6 @@ class PoseVirtualOperator(SampledOperator):
     def participant(self):
         return self._participant
 
-    def get_hand_pose_input_port(self):
-        return self._hand_port
-
-    def get_target_input_port(self):
-        return self._target_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_port
-
-    def get_forward_key_input_port(self):
-        return self._forward_key_port
-
     def _update(self, context, discrete_state):
         memory = ParticipantMemory.from_array(
             context.get_discrete_state(self._memory_index).value())

@@ -6,6 +6,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.arbitration import validate_command
+from pbp_drake.systems.ports import PortGetters
 from pbp_drake.systems.tick import SENSE_OFFSET
 
 
@@ -19,7 +20,7 @@ def operator_speed(speed, nominal_speed):
     return float(chosen)
 
 
-class SampledOperator(LeafSystem):
+class SampledOperator(PortGetters, LeafSystem):
     """An operator whose command is sampled at the control ticks and held in between.
 
     .. pydrake_system::
@@ -62,7 +63,7 @@ class SampledOperator(LeafSystem):
             self._command_name, d,
             lambda context, output: output.SetFromVector(self._held(context)[:d]),
             prerequisites_of_calc=held)
-        self._active_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "operator_active", 1,
             lambda context, output: output.SetFromVector(self._held(context)[d:]),
             prerequisites_of_calc=held)
@@ -70,9 +71,6 @@ class SampledOperator(LeafSystem):
 
     def get_operator_command_output_port(self):
         return self._command_port
-
-    def get_operator_active_output_port(self):
-        return self._active_port
 
     def _held(self, context):
         """The sample the outputs hold: what the robot gets."""

@@ -190,21 +190,6 @@ class VirtualOperator(SampledOperator):
             self._mistake_ticks = delay_ticks(impairment.mistake_time, control_period)
         self._declare_operator_outputs(delay_ticks(impairment.command_delay, control_period))
 
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
-    def get_target_input_port(self):
-        return self._target_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_forward_key_input_port(self):
-        return self._forward_key_port
-
-    def get_obstacle_positions_input_port(self):
-        return self._obstacles_port
-
     def _forward_key(self, context):
         """Whether the method enables the forward key."""
         return self._forward_key_port.Eval(context)[0] > 0.5

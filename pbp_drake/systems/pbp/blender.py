@@ -8,10 +8,10 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 from pbp_drake.core.arbitration import (
     DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW, blend, confidence_alpha,
     validate_confidence_ramp, validate_mode)
-from pbp_drake.systems.ports import goal_index
+from pbp_drake.systems.ports import PortGetters, goal_index
 
 
-class BlenderBase(LeafSystem):
+class BlenderBase(PortGetters, LeafSystem):
     """What `Blender` and `PoseBlender` share: the blending mode, the ramp of
     `confidence_alpha` (`confidence_range`, `alpha_max`, checked here) and the weight of
     `fixed_alpha`, a numeric parameter of the Context (its default the constructor's
@@ -144,30 +144,6 @@ class Blender(BlenderBase):
             "command", 2 * d, self._calc_command,
             prerequisites_of_calc={self.all_input_ports_ticket(),
                                    self.all_parameters_ticket()})
-
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_references_input_port(self):
-        return self._references_port
-
-    def get_policy_reference_input_port(self):
-        return self._policy_reference_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_operator_command_input_port(self):
-        return self._operator_command_port
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._goal_probabilities_port
-
-    def get_command_output_port(self):
-        return self._command_port
 
     def _calc_command(self, context, output):
         d, k = self._dimension, self._goal_count

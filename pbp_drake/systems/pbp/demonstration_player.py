@@ -4,9 +4,10 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.dmp import validate_demonstration
+from pbp_drake.systems.ports import PortGetters
 
 
-class DemonstrationPlayer(LeafSystem):
+class DemonstrationPlayer(PortGetters, LeafSystem):
     """Outputs the demonstration's next state at every control tick, whatever the robot does.
 
     .. pydrake_system::
@@ -33,9 +34,6 @@ class DemonstrationPlayer(LeafSystem):
         self._references_port = self.DeclareStateOutputPort("references", index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
         self._dimension = d
-
-    def get_references_output_port(self):
-        return self._references_port
 
     def _sample(self, time):
         position = [np.interp(time, self._times, column) for column in self._positions.T]

@@ -11,12 +11,12 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
-from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState, StepInputsState
-from pbp_drake.systems.ports import goal_index
+from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
+from pbp_drake.systems.ports import PortGetters, goal_index
 from pbp_drake.systems.tick import decide_offset
 
 
-class DmpBank(LeafSystem):
+class DmpBank(PortGetters, LeafSystem):
     """Steps K DMPs (one per goal) every control period from the robot's measured state.
 
     .. pydrake_system::
@@ -64,16 +64,15 @@ class DmpBank(LeafSystem):
     goals' paths then costs the same whatever K.
     All state lives in the Context, and so does the step's scratch memory (a cache entry).
 
-    The state is one vector, in one of three layouts
+    The state is one vector, in one of two layouts
     (`pbp_drake.systems.pbp.dmp_bank_state`): every DMP's velocity and attractor terms
     (`3 K D` numbers, which Drake copies twice an update), or, with `compact_state=True`
     (which needs `followed_goal` connected: an update raises otherwise, since every DMP
-    then steps from one velocity), a state whatever K: `2 + 6 D` numbers for DMPs that
-    share weights and start (`bank.affine_in_goal`; a bank from one demonstration or
-    straight, as every scenario's), whose attractor terms are affine in the goal, so that
-    the outputs are computed from the goals on the port; else (distinct weights) `3 + 2 D`
-    numbers, what the last step started from, and the step's terms a cache entry computed
-    from them once per state, when first read. The compact outputs equal the per-goal
+    then steps from one velocity), `2 + 6 D` numbers whatever K, for DMPs that share
+    weights and start (`bank.affine_in_goal`; a bank from one demonstration or straight,
+    as every scenario's; any other bank is refused), whose attractor terms are affine in
+    the goal, so that the outputs are computed from the goals on the port. The compact
+    outputs equal the per-goal
     layout's bit for bit while the goals do not change between an update and a read (when
     they change, the outputs and the next update read the new goals, as if the last step
     had been taken toward them). The goals are checked
@@ -106,7 +105,12 @@ class DmpBank(LeafSystem):
             raise ValueError(
                 f"update_offset must be in [0, control_period), got {update_offset!r}")
         k, d = bank.goal_count, bank.dimension
-        self._layout = _layout_class(compact_state, bank.affine_in_goal)(
+        if compact_state and not bank.affine_in_goal:
+            raise ValueError(
+                "compact_state=True needs DMPs that share weights and start (a bank whose "
+                "attractor terms are affine in the goal); this bank's are not: use the "
+                "per-goal state (compact_state=False)")
+        self._layout = (AffineState if compact_state else PerGoalState)(
             bank, self._period, self._max_speed)
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._goals_port = self.DeclareVectorInputPort("goals", k * d)
@@ -128,16 +132,7 @@ class DmpBank(LeafSystem):
             ValueProducer(allocate=lambda: AbstractValue.Make(bank.make_workspace()),
                           calc=self._never_calculated),
             prerequisites_of_calc={self.nothing_ticket()})
-        # The step's attractor terms, in the step-inputs layout: computed from the state
-        # and the goals once per state, when first read (`StepInputsState`).
-        self._terms = None
-        if self._layout.reads == "terms":
-            self._terms = self.DeclareCacheEntry(
-                "the last step's attractor terms dp, dz (2, D, K)",
-                ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((2, d, k))),
-                              calc=self._calc_terms),
-                prerequisites_of_calc={self.xd_ticket(), self._goals_dk.ticket()})
-        # The outputs depend on the bank's own state only (and, in the compact layouts, on
+        # The outputs depend on the bank's own state only (and, in the compact layout, on
         # the goals): say so, so that Drake does not recompute them after every plant step.
         state = {self.xd_ticket()}
         if self._layout.reads is not None:
@@ -168,45 +163,13 @@ class DmpBank(LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
 
     @staticmethod
-    def state_size(goal_count, dimension, compact_state=False, affine_in_goal=True):
-        """The length of the one state vector: `2 + D + 3 K D` per goal; compact, `2 + 6 D`
-        for a bank `affine_in_goal`, else `3 + 2 D`."""
-        return _layout_class(compact_state, affine_in_goal).size_of(goal_count, dimension)
+    def state_size(goal_count, dimension, compact_state=False):
+        """The length of the one state vector: `2 + D + 3 K D` per goal; compact, `2 + 6 D`."""
+        return (AffineState if compact_state else PerGoalState).size_of(goal_count, dimension)
 
     @property
     def bank(self):
         return self._bank
-
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_goals_input_port(self):
-        return self._goals_port
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_followed_goal_input_port(self):
-        return self._followed_goal_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_references_output_port(self):
-        return self._references_port
-
-    def get_selected_reference_output_port(self):
-        return self._selected_reference_port
-
-    def get_phase_output_port(self):
-        return self._phase_port
-
-    def get_predicted_paths_output_port(self):
-        return self._predicted_paths_port
-
-    def get_predicted_goals_input_port(self):
-        """The goals whose paths `predicted_paths` holds (with `predicted_goal_count`)."""
-        return self._predicted_goals_port
 
     def _workspace(self, context):
         """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""
@@ -221,16 +184,9 @@ class DmpBank(LeafSystem):
         return context.get_discrete_state(self._state_index).get_value()
 
     def _given(self, context):
-        """What the layout `reads` besides the state: the goals `(D, K)` (the affine
-        layout), the step's terms (the step-inputs layout), or None."""
-        reads = self._layout.reads
-        if reads == "goals":
-            return self._goals_dk.Eval(context)
-        return self._terms.Eval(context) if reads == "terms" else None
-
-    def _calc_terms(self, context, value):
-        self._layout.terms_into(self._state(context), self._goals_dk.Eval(context),
-                                self._workspace(context), value.get_mutable_value())
+        """What the layout `reads` besides the state: the goals `(D, K)` (the compact
+        layout), or None."""
+        return self._goals_dk.Eval(context) if self._layout.reads == "goals" else None
 
     def dmp_states(self, context):
         """The K DMPs' state after the last update: phases (K,), positions and scaled
@@ -265,12 +221,9 @@ class DmpBank(LeafSystem):
             raise RuntimeError(
                 "DmpBank with compact_state=True steps every DMP from the followed DMP's "
                 "velocity: connect its followed_goal input port")
-        # The step-inputs layout's terms of the state being updated (the Context's), before
-        # the workspace is taken: their calculation uses it.
-        given = self._terms.Eval(context) if self._terms is not None else None
         self._layout.update(
             discrete_state.get_mutable_vector(self._state_index).get_mutable_value(),
-            robot_state, lock, goals_dk, followed, self._workspace(context), given)
+            robot_state, lock, goals_dk, followed, self._workspace(context))
 
     def _calc_goals_dk(self, context, value):
         goals = self._bank.goals_matrix(self._goals_port.Eval(context))
@@ -304,10 +257,3 @@ class DmpBank(LeafSystem):
                              self._prediction_period, self._prediction_steps, workspace)
         output.SetFromVector(paths.reshape(-1))
 
-
-def _layout_class(compact_state, affine_in_goal):
-    """The state layout: per goal; compact, affine in the goal when the bank is, else the
-    step's inputs (`pbp_drake.systems.pbp.dmp_bank_state`)."""
-    if not compact_state:
-        return PerGoalState
-    return AffineState if affine_in_goal else StepInputsState

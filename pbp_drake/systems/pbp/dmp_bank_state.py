@@ -1,4 +1,4 @@
-"""The three state layouts of Drake's `DmpBank` system: what its discrete state holds, how an
+"""The two state layouts of Drake's `DmpBank` system: what its discrete state holds, how an
 update writes it, and how the DMPs' stepped states are read out of it.
 
 PBP steps every DMP from the robot's position `p`, and the step is affine in the DMP's own
@@ -20,14 +20,6 @@ PBP-Alt locks the phases) the DMPs sit at `p + dp` with velocity `z`.
   per-goal layout's, bit for bit (the same operations in the same order); when they
   change, the read-out and the next update read the new goals, as if the last step had
   been taken toward them.
-- `StepInputsState`, `[phase, held, p (D), z (D), the last step's phase]`: any bank
-  (distinct weights too) whose DMPs all step from the followed DMP's velocity. The step's
-  attractor terms are then a function of what it started from and the goals, so they are
-  not state but a cache entry the system computes from it (`terms_into`, the per-goal
-  update's call) once per state, when first read: by a read-out, or by the next update,
-  which takes the followed DMP's `dz` from them. `3 + 2 D` numbers whatever K; every
-  read-out is the per-goal layout's bit for bit while the goals stay (and steps toward
-  new goals as the affine layout does).
 """
 
 import numpy as np
@@ -51,13 +43,6 @@ class _Layout:
 
     def phase(self, vector):
         return vector[0]
-
-    def _one_velocity_head(self, vector):
-        """Views of the compact layouts' first numbers: phase (1,), held (1,), p (D, 1)
-        and the one velocity z (D, 1)."""
-        d = self._bank.dimension
-        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
-                vector[2 + d:2 + 2 * d].reshape(d, 1))
 
 
 class PerGoalState(_Layout):
@@ -84,9 +69,8 @@ class PerGoalState(_Layout):
         """The DMPs sit at their starts (p = 0, dp = starts), at rest."""
         self._split(vector)[4][...] = self._bank.starts
 
-    def update(self, vector, robot_state, lock, goals_dk, followed, workspace, given=None):
-        """One update, in place (`goals_dk` may be None when `lock`; `given`, what the
-        layout `reads` besides the state, unused here)."""
+    def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
+        """One update, in place (`goals_dk` may be None when `lock`)."""
         bank, period = self._bank, self._period
         d = bank.dimension
         phase, held, robot, z, dp, dz = self._split(vector)
@@ -143,7 +127,8 @@ class AffineState(_Layout):
     def _split(self, vector):
         """Views: phase (1,), held (1,), p (D, 1), z (D, 1), alpha and beta (2, D, 1)."""
         d = self._bank.dimension
-        return (*self._one_velocity_head(vector),
+        return (vector[0:1], vector[1:2], vector[2:2 + d].reshape(d, 1),
+                vector[2 + d:2 + 2 * d].reshape(d, 1),
                 vector[2 + 2 * d:2 + 4 * d].reshape(2, d, 1),
                 vector[2 + 4 * d:2 + 6 * d].reshape(2, d, 1))
 
@@ -151,7 +136,7 @@ class AffineState(_Layout):
         """At rest at the (one) start: dp = 0 g + start."""
         self._split(vector)[5][0] = self._bank.starts[:, :1]
 
-    def update(self, vector, robot_state, lock, goals_dk, followed, workspace, given=None):
+    def update(self, vector, robot_state, lock, goals_dk, followed, workspace):
         """One update, in place: the per-goal layout's arithmetic on the followed DMP."""
         bank, period = self._bank, self._period
         d = bank.dimension
@@ -195,74 +180,3 @@ class AffineState(_Layout):
         # dz + Phi11 z, summed as the per-goal layout sums Phi11 z + dz.
         velocity += z * self._bank.step_constants(self._period).velocity_velocity
         return positions, velocity
-
-
-# `held` in the step-inputs layout: 1 on the robot (as the others), 2 at the start (its
-# attractor terms, not kept, are then the starts).
-_AT_START = 2.0
-
-
-class StepInputsState(_Layout):
-    """What the last step started from in the state; its attractor terms a cache entry
-    (see the module docstring)."""
-
-    def __init__(self, bank, period, max_speed):
-        super().__init__(bank, period, max_speed)
-        self.needs_followed_goal = True
-        self.reads = "terms"  # the read-out and the update read the step's terms
-
-    @staticmethod
-    def size_of(goal_count, dimension):
-        return 3 + 2 * dimension  # whatever K
-
-    def _split(self, vector):
-        """Views: phase (1,), held (1,), p (D, 1), z (D, 1), the last step's phase (1,)."""
-        d = self._bank.dimension
-        return (*self._one_velocity_head(vector), vector[2 + 2 * d:3 + 2 * d])
-
-    def _at_start(self, vector):
-        """At rest at the starts (p = 0; the terms then give dp = the starts)."""
-        vector[1] = _AT_START
-
-    def terms_into(self, vector, goals_dk, workspace, terms):
-        """The last step's attractor terms `dp`, `dz` into `terms` (2, D, K), with the
-        per-goal layout's update's call; while held, `dp` is the starts (at the start) or
-        0 (on the robot), as that layout keeps it."""
-        _, held, robot, _, step_phase = self._split(vector)
-        dp, dz = terms
-        if held[0]:
-            dp[...] = self._bank.starts if held[0] == _AT_START else 0.0
-            dz.fill(0.0)  # not read while held
-            return
-        self._bank.attractor_terms_into(step_phase, robot, goals_dk, self._period, dp, dz,
-                                        workspace)
-
-    def update(self, vector, robot_state, lock, goals_dk, followed, workspace, given=None):
-        """One update, in place: the per-goal layout's arithmetic on the followed DMP,
-        whose `dz` comes from `given`, the terms of the state being updated."""
-        bank, period = self._bank, self._period
-        d = bank.dimension
-        phase, held, robot, z, step_phase = self._split(vector)
-        if not held[0]:
-            bank.stepped_velocity_into(given[1][:, followed:followed + 1], z, period, z)
-            limit_speeds(z, self._max_speed, bank.duration)
-        robot[:, 0] = robot_state[:d]
-        if lock:
-            # Phases frozen: the DMPs stay at the robot's position and follow its velocity.
-            held[0] = 1.0
-            np.multiply(robot_state[d:, np.newaxis], bank.duration, out=z)
-            return
-        held[0] = 0.0
-        step_phase[0] = phase[0]
-        phase *= bank.decay(period)
-
-    def read(self, vector, given, workspace, goal=None):
-        """As `PerGoalState.read`, from the terms `given` (2, D, K) of this state."""
-        _, held, robot, z, _ = self._split(vector)
-        dp, dz = given if goal is None else given[:, :, goal:goal + 1]
-        positions = np.add(robot, dp)
-        if held[0]:
-            return positions, np.repeat(z, dp.shape[1], axis=1)
-        positions += z * self._bank.step_constants(self._period).position_velocity
-        return positions, self._bank.stepped_velocity_into(dz, z, self._period,
-                                                           np.empty(dz.shape))

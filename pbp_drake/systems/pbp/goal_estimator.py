@@ -8,7 +8,7 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.goal_estimation import (
     NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate)
-from pbp_drake.systems.ports import EeState, position_of
+from pbp_drake.systems.ports import EeState, PortGetters, position_of
 from pbp_drake.systems.tick import decide_offset
 
 # Layout of the `memory` discrete state group.
@@ -16,7 +16,7 @@ CHALLENGER, COUNT, START, PATH_LENGTH, LAST_POSITION, INITIALISED = 0, 1, 2, 5, 
 MEMORY_SIZE = 10
 
 
-class GoalEstimator(LeafSystem):
+class GoalEstimator(PortGetters, LeafSystem):
     """Estimates the intended goal every control period (`pbp_drake.core.goal_estimation`).
 
     .. pydrake_system::
@@ -84,18 +84,6 @@ class GoalEstimator(LeafSystem):
     @property
     def settings(self):
         return self._settings
-
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
-    def get_goals_input_port(self):
-        return self._goals_port
-
-    def get_selected_goal_output_port(self):
-        return self._selected_goal_port
-
-    def get_goal_probabilities_output_port(self):
-        return self._probabilities_port
 
     def _inputs(self, context):
         ee_state = EeState(self._ee_state_port.Eval(context))

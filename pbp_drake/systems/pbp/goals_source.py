@@ -4,9 +4,10 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem, NumericParameterIndex
 
 from pbp_drake.core.coordinates import check_positions
+from pbp_drake.systems.ports import PortGetters
 
 
-class GoalsSource(LeafSystem):
+class GoalsSource(PortGetters, LeafSystem):
     """Outputs K goals `(K, D)` flattened row-major, kept in a numeric parameter.
 
     .. pydrake_system::
@@ -33,9 +34,6 @@ class GoalsSource(LeafSystem):
             "goals", goals.size,
             lambda context, output: output.SetFrom(context.get_numeric_parameter(self._index)),
             prerequisites_of_calc={self.numeric_parameter_ticket(NumericParameterIndex(self._index))})
-
-    def get_goals_output_port(self):
-        return self._goals_port
 
     def set_goals(self, context, goals):
         """Sets the goals `(K, D)` (the same K and D, finite and within

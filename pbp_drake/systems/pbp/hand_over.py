@@ -4,10 +4,11 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.hand_over import check_limit, hand_over
+from pbp_drake.systems.ports import PortGetters
 from pbp_drake.systems.tick import report_offset
 
 
-class HandOver(LeafSystem):
+class HandOver(PortGetters, LeafSystem):
     """Passes the blender's reference on with its velocity changing at most
     `max_acceleration * control_period` per tick and its speed at most `max_speed`
     (`pbp_drake.core.hand_over`).
@@ -54,12 +55,6 @@ class HandOver(LeafSystem):
     @property
     def max_speed(self):
         return self._max_speed
-
-    def get_reference_input_port(self):
-        return self._reference_port
-
-    def get_command_output_port(self):
-        return self._command_port
 
     def _update(self, context, discrete_state):
         d = self._dimension

@@ -4,11 +4,11 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.hand_over import check_limit, hand_over
-from pbp_drake.systems.ports import OperatorCommand
+from pbp_drake.systems.ports import OperatorCommand, PortGetters
 from pbp_drake.systems.tick import decide_offset
 
 
-class HeadingCommand(LeafSystem):
+class HeadingCommand(PortGetters, LeafSystem):
     """Integrates the operator's yaw rate into the commanded heading.
 
     .. pydrake_system::
@@ -51,12 +51,6 @@ class HeadingCommand(LeafSystem):
         self._yaw_rate_index = self.DeclareDiscreteState(np.zeros(1))
         self._heading_port = self.DeclareStateOutputPort("heading", self._heading_index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
-
-    def get_operator_command_input_port(self):
-        return self._command_port
-
-    def get_heading_output_port(self):
-        return self._heading_port
 
     def _update(self, context, discrete_state):
         # One pybind call a group's array (get_mutable_vector and its value: two).

@@ -10,9 +10,10 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.hindsight_optimization import (
     HOP_METHODS, HopSettings, assisted_command, hop_targets)
+from pbp_drake.systems.ports import PortGetters
 
 
-class HopAssistanceBase(LeafSystem):
+class HopAssistanceBase(PortGetters, LeafSystem):
     """What `HopAssistance` and `PoseHopAssistance` share: the method, the settings, the
     control period and the checks of them."""
 
@@ -74,21 +75,6 @@ class HopAssistance(HopAssistanceBase):
         self._command_port = self.DeclareVectorOutputPort(
             "command", 6, self._calc_command,
             prerequisites_of_calc={self.all_input_ports_ticket()})
-
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_goals_input_port(self):
-        return self._goals_port
-
-    def get_operator_command_input_port(self):
-        return self._operator_command_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._probabilities_port
-
-    def get_command_output_port(self):
-        return self._command_port
 
     def _calc_command(self, context, output):
         position = self._robot_state_port.Eval(context)[:3]

@@ -3,7 +3,7 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.systems.ports import goal_index
+from pbp_drake.systems.ports import PortGetters, goal_index
 
 
 def likely_goal_indices(selected, probabilities, count):
@@ -21,7 +21,7 @@ def likely_goal_indices(selected, probabilities, count):
     return np.concatenate([[selected], top[top != selected][:others]])
 
 
-class LikelyGoals(LeafSystem):
+class LikelyGoals(PortGetters, LeafSystem):
     """The indices of the goals worth drawing: `selected_goal` first, then the `count - 1`
     most probable others (`goal_probabilities`), so that a drawing of their paths costs the
     same whatever the goal count K.
@@ -48,15 +48,6 @@ class LikelyGoals(LeafSystem):
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", goal_count)
         self._indices_port = self.DeclareVectorOutputPort("goal_indices", count, self._calc)
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._probabilities_port
-
-    def get_goal_indices_output_port(self):
-        return self._indices_port
 
     def _calc(self, context, output):
         selected = goal_index(self._selected_goal_port, context, self._goal_count,

@@ -14,7 +14,7 @@ from pbp_drake.core.goal_estimation import NO_CHALLENGER, SelectionMemory, updat
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, hop_targets, uniform_log_belief, update_posterior)
 from pbp_drake.core.maxent_command import intent_evidence, update_intent_posterior
-from pbp_drake.systems.ports import EeState, OperatorCommand
+from pbp_drake.systems.ports import EeState, OperatorCommand, PortGetters
 from pbp_drake.systems.tick import decide_offset
 
 
@@ -37,7 +37,7 @@ class PosteriorInputs(typing.NamedTuple):
     active: bool = True
 
 
-class CommandPosteriorBase(LeafSystem):
+class CommandPosteriorBase(PortGetters, LeafSystem):
     """What `MaxEntGoalEstimator` and `PoseMaxEntGoalEstimator` share: the log belief, the
     selection with the shipped hysteresis (`goal_estimation.update_selection`) and whether
     the last update was clipped, all in the Context's discrete state; the outputs
@@ -104,9 +104,6 @@ class CommandPosteriorBase(LeafSystem):
         """None: HOP's published likelihood; else the PBP operator's, at this speed."""
         return self._operator_speed
 
-    def get_operator_active_input_port(self):
-        return self._active_port
-
     @property
     def margin(self):
         return self._margin
@@ -114,15 +111,6 @@ class CommandPosteriorBase(LeafSystem):
     @property
     def hold_steps(self):
         return self._hold_steps
-
-    def get_selected_goal_output_port(self):
-        return self._selected_port
-
-    def get_goal_probabilities_output_port(self):
-        return self._probabilities_port
-
-    def get_posterior_clipped_output_port(self):
-        return self._clipped_port
 
     def _update(self, context, discrete_state):
         state = context.get_discrete_state()
@@ -193,15 +181,6 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
         self._command_port = self.DeclareVectorInputPort("operator_command",
                                                          OperatorCommand.size)
         self._active_port = self.DeclareVectorInputPort("operator_active", 1)
-
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
-    def get_goals_input_port(self):
-        return self._goals_port
-
-    def get_operator_command_input_port(self):
-        return self._command_port
 
     def _inputs(self, context):
         targets = hop_targets(self._goals_port.Eval(context).reshape(self._goal_count, 3))

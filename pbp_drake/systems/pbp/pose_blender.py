@@ -59,27 +59,6 @@ class PoseBlender(BlenderBase):
             prerequisites_of_calc={self.all_input_ports_ticket(),
                                    self.all_parameters_ticket()})
 
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_policy_reference_input_port(self):
-        return self._policy_port
-
-    def get_operator_twist_input_port(self):
-        return self._twist_port
-
-    def get_operator_active_input_port(self):
-        return self._active_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._goal_probabilities_port
-
-    def get_reference_output_port(self):
-        return self._reference_port
-
     def _calc_reference(self, context, output):
         alpha = self.alpha(context)
         robot = self._robot_state_port.Eval(context)

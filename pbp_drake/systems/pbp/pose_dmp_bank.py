@@ -18,13 +18,13 @@ from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one_values
 from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
-from pbp_drake.systems.ports import GoalPose, PoseState, goal_index
+from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, goal_index
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
     AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
     hold_into, per_goal_arrays, split_head, state_size, step_all)
 from pbp_drake.systems.tick import decide_offset
 
-class PoseDmpBank(LeafSystem):
+class PoseDmpBank(PortGetters, LeafSystem):
     """Steps K pose DMPs (one per goal pose) every control period from the hand's pose.
 
     .. pydrake_system::
@@ -179,33 +179,6 @@ class PoseDmpBank(LeafSystem):
     @property
     def orientation_bank(self):
         return self._orientations
-
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_goal_poses_input_port(self):
-        return self._goals_port
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_followed_goal_input_port(self):
-        return self._followed_goal_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_references_output_port(self):
-        return self._references_port
-
-    def get_selected_reference_output_port(self):
-        return self._selected_reference_port
-
-    def get_phase_output_port(self):
-        return self._phase_port
-
-    def get_predicted_poses_output_port(self):
-        return self._predicted_poses_port
 
     def _stepped(self, context, vector):
         """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K): views of

@@ -8,11 +8,11 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.goal_estimation import (
     GoalEstimatorSettings, SelectionMemory, update_selection)
 from pbp_drake.core.grasp_estimation import pose_probabilities
-from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
+from pbp_drake.systems.ports import GoalPose, OperatorTwist, PortGetters, PoseState
 from pbp_drake.systems.tick import decide_offset
 
 
-class PoseGoalEstimator(LeafSystem):
+class PoseGoalEstimator(PortGetters, LeafSystem):
     """Estimates the intended grasp pose every control period
     (`pbp_drake.core.grasp_estimation.pose_probabilities` and the shipped hysteresis,
     `goal_estimation.update_selection`).
@@ -72,21 +72,6 @@ class PoseGoalEstimator(LeafSystem):
             lambda context, state: self._estimate(context, state, None))
         self.DeclarePeriodicDiscreteUpdateEvent(float(control_period), update_offset,
                                                 self._update)
-
-    def get_hand_pose_input_port(self):
-        return self._hand_port
-
-    def get_goal_poses_input_port(self):
-        return self._goals_port
-
-    def get_operator_twist_input_port(self):
-        return self._twist_port
-
-    def get_selected_goal_output_port(self):
-        return self._selected_port
-
-    def get_goal_probabilities_output_port(self):
-        return self._probabilities_port
 
     def _update(self, context, state):
         challenger, count = context.get_discrete_state(self._memory_index).value()

@@ -5,11 +5,11 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.pose_arbitration import HandOverLimits, PoseReference, pose_hand_over
-from pbp_drake.systems.ports import PoseState
+from pbp_drake.systems.ports import PortGetters, PoseState
 from pbp_drake.systems.tick import report_offset
 
 
-class PoseHandOver(LeafSystem):
+class PoseHandOver(PortGetters, LeafSystem):
     """Passes the pose reference on with its linear and angular velocities each changing at
     most `max_acceleration * dt` and `max_angular_acceleration * dt` per tick and capped at
     the speeds (`pbp_drake.core.pose_arbitration.pose_hand_over`).
@@ -48,12 +48,6 @@ class PoseHandOver(LeafSystem):
     @property
     def limits(self):
         return self._limits
-
-    def get_reference_input_port(self):
-        return self._reference_port
-
-    def get_command_output_port(self):
-        return self._command_port
 
     def _update(self, context, discrete_state):
         reference = PoseReference.from_vector(self._reference_port.Eval(context))

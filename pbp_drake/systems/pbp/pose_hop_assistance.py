@@ -46,21 +46,6 @@ class PoseHopAssistance(HopAssistanceBase):
             "reference", PoseState.size, self._calc_reference,
             prerequisites_of_calc={self.all_input_ports_ticket()})
 
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_goal_poses_input_port(self):
-        return self._goals_port
-
-    def get_operator_twist_input_port(self):
-        return self._twist_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._probabilities_port
-
-    def get_reference_output_port(self):
-        return self._reference_port
-
     def _calc_reference(self, context, output):
         robot = self._robot_state_port.Eval(context)
         orientation = quaternion.unit_quaternions(robot[3:7], "robot_state orientation")

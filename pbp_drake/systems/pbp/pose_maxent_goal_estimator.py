@@ -42,15 +42,6 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
         self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
         self._active_port = self.DeclareVectorInputPort("operator_active", 1)
 
-    def get_hand_pose_input_port(self):
-        return self._hand_port
-
-    def get_goal_poses_input_port(self):
-        return self._goals_port
-
-    def get_operator_twist_input_port(self):
-        return self._twist_port
-
     def _inputs(self, context):
         poses = self._goals_port.Eval(context).reshape(self._goal_count, GoalPose.size)
         targets = hop_targets(poses[:, :3], poses[:, 3:])

@@ -4,8 +4,10 @@ from pydrake.common.value import AbstractValue
 from pydrake.geometry import QueryObject
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.ports import PortGetters
 
-class CollisionMonitor(LeafSystem):
+
+class CollisionMonitor(PortGetters, LeafSystem):
     """Reports the robot's clearance to the obstacles and whether it touches one.
 
     .. pydrake_system::
@@ -33,19 +35,10 @@ class CollisionMonitor(LeafSystem):
             raise ValueError("CollisionMonitor needs robot and obstacle geometries")
         self._query_port = self.DeclareAbstractInputPort(
             "query_object", AbstractValue.Make(QueryObject()))
-        self._collision_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "in_collision", 1, self._calc_in_collision)
         self._clearance_port = self.DeclareVectorOutputPort(
             "clearance", 1, self._calc_clearance)
-
-    def get_query_object_input_port(self):
-        return self._query_port
-
-    def get_in_collision_output_port(self):
-        return self._collision_port
-
-    def get_clearance_output_port(self):
-        return self._clearance_port
 
     def _calc_clearance(self, context, output):
         query = self._query_port.Eval(context)

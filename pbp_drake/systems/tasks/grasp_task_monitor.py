@@ -48,9 +48,6 @@ class GraspTaskMonitor(TaskMonitorBase):
         self._success_angle = float(success_angle)
         self._length_per_radian = self._success_distance / self._success_angle
 
-    def get_hand_pose_input_port(self):
-        return self._hand_port
-
     @property
     def grasp_orientations(self):
         return self._orientations

@@ -5,11 +5,11 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.obstacle_task import step_obstacles
 from pbp_drake.core.reach_task import reach_progress
-from pbp_drake.systems.ports import EeState
+from pbp_drake.systems.ports import EeState, PortGetters
 from pbp_drake.systems.tick import decide_offset
 
 
-class MovingObstacles(LeafSystem):
+class MovingObstacles(PortGetters, LeafSystem):
     """The behaviour of the dynamic-obstacle task's obstacles: where they are.
 
     .. pydrake_system::
@@ -46,20 +46,11 @@ class MovingObstacles(LeafSystem):
         self._positions_index = self.DeclareDiscreteState(scene.obstacle_starts.reshape(-1))
         self._intercepts_index = self.DeclareDiscreteState(scene.obstacle_starts.reshape(-1))
         self._active_index = self.DeclareDiscreteState(np.zeros(count))
-        self._centres_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "obstacle_positions", 3 * count, self._calc_centres,
             prerequisites_of_calc={self.discrete_state_ticket(self._positions_index)})
-        self._floor_port = self.DeclareStateOutputPort("floor_positions", self._positions_index)
+        self.DeclareStateOutputPort("floor_positions", self._positions_index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
-
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
-    def get_obstacle_positions_output_port(self):
-        return self._centres_port
-
-    def get_floor_positions_output_port(self):
-        return self._floor_port
 
     def _calc_centres(self, context, output):
         floor = context.get_discrete_state(self._positions_index).value().reshape(-1, 2)

@@ -8,10 +8,12 @@ from pydrake.geometry import (
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.systems.ports import PortGetters
+
 OBSTACLE_RGBA = [0.85, 0.15, 0.15, 1.0]
 
 
-class CylinderObstacleGeometry(LeafSystem):
+class CylinderObstacleGeometry(PortGetters, LeafSystem):
     """Upright cylinders registered with a SceneGraph, where `obstacle_positions` puts them.
 
     .. pydrake_system::
@@ -45,14 +47,8 @@ class CylinderObstacleGeometry(LeafSystem):
             self.geometry_ids.append(geometry)
         self._positions_port = self.DeclareVectorInputPort(
             "obstacle_positions", 3 * len(self._frame_ids))
-        self._pose_port = self.DeclareAbstractOutputPort(
+        self.DeclareAbstractOutputPort(
             "geometry_pose", lambda: AbstractValue.Make(FramePoseVector()), self._calc_poses)
-
-    def get_obstacle_positions_input_port(self):
-        return self._positions_port
-
-    def get_geometry_pose_output_port(self):
-        return self._pose_port
 
     def _calc_poses(self, context, output):
         centres = np.reshape(self._positions_port.Eval(context), (-1, 3))

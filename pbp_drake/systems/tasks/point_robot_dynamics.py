@@ -6,6 +6,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.point_robot import MassSpringDamper
+from pbp_drake.systems.ports import PortGetters
 
 
 @dataclasses.dataclass
@@ -23,7 +24,7 @@ class PointRobotParams:
     time_step: float = 0.001
 
 
-class PointRobotDynamics(LeafSystem):
+class PointRobotDynamics(PortGetters, LeafSystem):
     """A point mass-spring-damper tracking a commanded position and velocity.
 
     .. pydrake_system::
@@ -51,14 +52,8 @@ class PointRobotDynamics(LeafSystem):
         self._command_port = self.DeclareVectorInputPort("command", 2 * self._dimension)
         state_index = self.DeclareDiscreteState(
             np.concatenate([initial_position, np.zeros(self._dimension)]))
-        self._state_port = self.DeclareStateOutputPort("state", state_index)
+        self.DeclareStateOutputPort("state", state_index)
         self.DeclarePeriodicDiscreteUpdateEvent(time_step, time_step / 2, self._step)
-
-    def get_command_input_port(self):
-        return self._command_port
-
-    def get_state_output_port(self):
-        return self._state_port
 
     def _step(self, context, discrete_state):
         d = self._dimension

@@ -9,7 +9,7 @@ from pydrake.systems.framework import EventStatus, LeafSystem
 
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.reach_task import reach_progress
-from pbp_drake.systems.ports import EeState, Target, TaskStatus, position_of
+from pbp_drake.systems.ports import EeState, PortGetters, Target, TaskStatus, position_of
 from pbp_drake.systems.tick import decide_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
@@ -37,7 +37,7 @@ _COUNTS_SIZE = len(dataclasses.fields(TaskCounts))
 _STAGE, _SUCCESS = 0, 4  # where TaskCounts' stage and success sit in the counts vector
 
 
-class TaskMonitorBase(LeafSystem):
+class TaskMonitorBase(PortGetters, LeafSystem):
     """What the reaching and the grasping task's referees (`TaskMonitor`,
     `GraspTaskMonitor`) share, so that their rules stay in step.
 
@@ -90,23 +90,14 @@ class TaskMonitorBase(LeafSystem):
         self._counts_index = self.DeclareDiscreteState(_COUNTS_SIZE)
         # [progress, task time]: the status's real-valued entries.
         self._measures_index = self.DeclareDiscreteState(2)
-        self._target_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "target", Target.size, self._calc_target,
             prerequisites_of_calc={self.discrete_state_ticket(self._counts_index)})
-        self._status_port = self.DeclareVectorOutputPort(
+        self.DeclareVectorOutputPort(
             "task_status", TaskStatus.size, self._calc_status,
             prerequisites_of_calc={self.all_state_ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(period, update_offset, self._update)
         self.DeclarePeriodicPublishEvent(period, end_offset, self._end_at_success)
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_target_output_port(self):
-        return self._target_port
-
-    def get_task_status_output_port(self):
-        return self._status_port
 
     @property
     def objects(self):
@@ -219,9 +210,6 @@ class TaskMonitor(TaskMonitorBase):
 
     def get_ee_state_input_port(self):
         return self._hand_port
-
-    def get_in_collision_input_port(self):
-        return self._in_collision_port
 
     def _read_hand(self, vector):
         return position_of(EeState(vector))

@@ -8,7 +8,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.pbp.likely_goals import likely_goal_indices
-from pbp_drake.systems.ports import GoalPose, PoseState, Target, goal_index
+from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, Target, goal_index
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
     CLOUD_POINT_SIZE, ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, SOLID_OBJECTS,
     TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
@@ -21,7 +21,7 @@ TRIAD_LENGTH, TRIAD_RADIUS = 0.1, 0.005
 PATH_TRIADS, PATH_TRIAD_LENGTH, PATH_TRIAD_OPACITY = 5, 0.06, 0.7
 
 
-class GraspSceneVisualizer(LeafSystem):
+class GraspSceneVisualizer(PortGetters, LeafSystem):
     """Publishes the grasping task's drawing to Meshcat under `/task`.
 
     .. pydrake_system::
@@ -84,21 +84,6 @@ class GraspSceneVisualizer(LeafSystem):
         self.DeclarePeriodicPublishEvent(self._cloud.period(cloud_period), 0.0,
                                          self._publish_cloud)
         self.DeclareInitializationPublishEvent(self._initialise)
-
-    def get_target_input_port(self):
-        return self._target_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_predicted_poses_input_port(self):
-        return self._predicted_poses_port
-
-    def get_hand_state_input_port(self):
-        return self._hand_state_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._probabilities_port
 
     def _initialise(self, context):
         self._draw_scene()

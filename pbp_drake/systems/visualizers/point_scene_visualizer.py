@@ -7,6 +7,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.scene_framing import page_view, scene_bounds
+from pbp_drake.systems.ports import PortGetters
 from pbp_drake.systems.visualizers.scene_drawing import PathDots, PathTrail, frame_top_down
 
 # Saturated colours of distinct hues, so that a screenshot tells the markers apart.
@@ -44,7 +45,7 @@ EXECUTED_SPACING = 0.004
 START_Z, EXECUTED_Z, PATH_Z = -0.01, 0.006, 0.008
 
 
-class PointSceneVisualizer(LeafSystem):
+class PointSceneVisualizer(PortGetters, LeafSystem):
     """Publishes the robot and the DMPs' predicted paths to Meshcat; a planar scene is seen
     from above, framed on the whole scene.
 
@@ -97,15 +98,6 @@ class PointSceneVisualizer(LeafSystem):
             self.DeclarePeriodicPublishEvent(path_period or publish_period, 0.0,
                                              self._publish_paths)
         self.DeclareInitializationPublishEvent(self._draw_scene)
-
-    def get_robot_state_input_port(self):
-        return self._robot_state_port
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_predicted_paths_input_port(self):
-        return self._predicted_paths_port
 
     def _to_3d(self, points, z=0.0):
         points = np.atleast_2d(points)

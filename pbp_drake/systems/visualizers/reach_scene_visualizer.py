@@ -6,7 +6,8 @@ from pydrake.geometry import Box, Cylinder, Rgba, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.systems.ports import EeState, Target, position_of
+from pbp_drake.core.scene_framing import workspace_view
+from pbp_drake.systems.ports import EeState, PortGetters, Target, position_of
 from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
@@ -35,7 +36,7 @@ TARGET_LIFT = 0.12
 ESTIMATE_LIFT = 0.25
 
 
-class ReachSceneVisualizer(LeafSystem):
+class ReachSceneVisualizer(PortGetters, LeafSystem):
     """Publishes the reaching task's markers to Meshcat under `/task`.
 
     .. pydrake_system::
@@ -68,14 +69,19 @@ class ReachSceneVisualizer(LeafSystem):
     take the colour of their goal's probability (`goal_probabilities`, K), grey to blue,
     sent again only when a colour changed; a recording keeps the cloud's last colours only
     (Meshcat records transforms and properties, not objects), the paths as they went.
-    Call from the thread that made `meshcat`.
+    The drawing sets Meshcat's camera (`camera`, `(position, target)`): behind and above
+    the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base, start and
+    objects), framed on it (`workspace_view`). Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, objects, prediction_steps=0, path_count=1,
-                 publish_period=1.0 / 30.0, path_period=0.1, cloud_period=0.25):
+                 publish_period=1.0 / 30.0, path_period=0.1, cloud_period=0.25,
+                 workspace=None):
         super().__init__()
         self._meshcat = meshcat
         self._objects = np.asarray(objects, dtype=float)
+        self.camera = (_behind_the_hsr(self._objects) if workspace is None
+                       else workspace_view(workspace))
         self._prediction_steps = int(prediction_steps)
         k = len(self._objects)
         path_count = int(path_count)
@@ -103,24 +109,6 @@ class ReachSceneVisualizer(LeafSystem):
         self.DeclarePeriodicPublishEvent(self._cloud.period(cloud_period), 0.0,
                                          self._publish_cloud)
         self.DeclareInitializationPublishEvent(self._initialise)
-
-    def get_target_input_port(self):
-        return self._target_port
-
-    def get_selected_goal_input_port(self):
-        return self._selected_goal_port
-
-    def get_operator_active_input_port(self):
-        return self._operator_active_port
-
-    def get_ee_state_input_port(self):
-        return self._ee_state_port
-
-    def get_predicted_paths_input_port(self):
-        return self._predicted_paths_port
-
-    def get_goal_probabilities_input_port(self):
-        return self._probabilities_port
 
     def _initialise(self, context):
         # Whether the blue ball is drawn: a method that shows no intent (teleop) sends -1.
@@ -151,9 +139,7 @@ class ReachSceneVisualizer(LeafSystem):
         if self._prediction_steps:
             for dots in [self._active_path, *self._other_paths]:
                 dots.draw(meshcat)
-        centre = self._objects.mean(axis=0)
-        # A camera behind and above the robot that sees it and every object.
-        meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
+        meshcat.SetCameraPose(*self.camera)
 
     def _publish(self, context):
         time = context.get_time()
@@ -190,3 +176,8 @@ class ReachSceneVisualizer(LeafSystem):
     def _publish_cloud(self, context):
         port = self._probabilities_port
         self._cloud.show(self._meshcat, port.Eval(context) if port.HasValue(context) else None)
+
+
+def _behind_the_hsr(objects):
+    """A camera behind and above the HSR that sees it and every object of the task."""
+    return np.array([-1.6, -1.2, 2.6]), np.array([0.55 * objects.mean(axis=0)[0], 0.0, 0.4])

@@ -1,12 +1,12 @@
 """How long one step of an `OrientationDmpBank` takes: a helper, not a test.
 
-`python -m pbp_drake.bench.orientation_step [K ...]` prints, for K DMPs stepped from one
+`python -m pbp_drake_bench.orientation_step [K ...]` prints, for K DMPs stepped from one
 measured orientation with equal phases (the normal case), the median wall time and the mean
 CPU time of one in-place step (`advance_into` with one workspace), for straight DMPs (one
 shared shape) and for distinct weights per goal. Run it with OPENBLAS_NUM_THREADS=1 (and
 the other thread variables) as the bench measures; it prints what the BLAS library reports.
 On a machine shared with other work the CPU time is the steadier. `pbp-drake bench` times
-the bank inside the six-DoF LeafSystem (`pbp_drake.bench.pose_cases`).
+the bank inside the six-DoF LeafSystem (`pbp_drake_bench.pose_cases`).
 """
 
 import sys
@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from pbp_drake.bench.pinning import blas_threads
+from pbp_drake_bench.pinning import blas_threads
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
 from pbp_drake.core.dmp.settings import DmpSettings

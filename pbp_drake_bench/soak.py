@@ -1,4 +1,4 @@
-"""`python -m pbp_drake.soak`: a soak test of the HSR reaching task. One process, one
+"""`python -m pbp_drake_bench.soak`: a soak test of the HSR reaching task. One process, one
 Meshcat and one diagram run the task of `diagrams/hsr_reach.yaml` (virtual participant,
 seed 0) back to back, each run to success on a fresh Simulator, as fast as possible, for an
 hour of simulated time in all (`--minutes`), every run's per-tick rows streamed to a CSV
@@ -25,7 +25,7 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.builder.streamed_run import run_task_streamed
 from pbp_drake.scenarios import counted, load_scenario_file, resolve
 
-# The repository's diagrams/ folder (this file is pbp_drake/soak.py).
+# The repository's diagrams/ folder (this file is pbp_drake_bench/soak.py).
 SCENARIO_FILE = pathlib.Path(__file__).resolve().parents[1] / "diagrams" / "hsr_reach.yaml"
 DEFAULT_LOG_DIR = pathlib.Path("outputs", "soak")
 GROWTH_LIMIT_PERCENT = 10.0
@@ -107,7 +107,7 @@ def _megabytes(rss):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m pbp_drake.soak",
+    parser = argparse.ArgumentParser(prog="python -m pbp_drake_bench.soak",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("--minutes", type=int, default=60,
                         help="simulated minutes, at least 2 (default 60)")

@@ -4,8 +4,8 @@
 
 import time
 
-from pbp_drake.bench.closed_loop import build_simulator, new_meshcat
-from pbp_drake.bench.scenes import REACH
+from pbp_drake_bench.closed_loop import build_simulator, new_meshcat
+from pbp_drake_bench.scenes import REACH
 from pbp_drake.output_paths import recorded_replay
 
 REPLAY_GOALS = (4, 1000)

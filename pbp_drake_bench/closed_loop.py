@@ -15,9 +15,9 @@ import numpy as np
 from pydrake.geometry import Meshcat, MeshcatParams
 from pydrake.systems.analysis import Simulator
 
-from pbp_drake.bench.scenes import GRASP, REACH, TASKS, resolved_scene
-from pbp_drake.bench.time_split import profiled_advance, split_row
-from pbp_drake.bench.ws_reader import MeshcatReader, send_mark
+from pbp_drake_bench.scenes import GRASP, REACH, TASKS, resolved_scene
+from pbp_drake_bench.time_split import profiled_advance, split_row
+from pbp_drake_bench.ws_reader import MeshcatReader, send_mark
 from pbp_drake.builder import build_diagram
 
 HSR_KS = (4, 100, 1000, 10000)

@@ -45,10 +45,11 @@ CATEGORIES = {
     "systems/operators/": OPERATOR, "core/participant_": OPERATOR,
     "core/operator_frame.py": OPERATOR,
     "systems/tasks/": REST, "systems/tick.py": REST, "systems/sample_hold.py": REST,
-    "builder/": REST, "bench/": REST, "console/": REST, "scenarios/": REST,
+    "builder/": REST, "console/": REST, "scenarios/": REST,
     "core/": SHARED, "systems/": SHARED,
 }
 _PACKAGE = "/pbp_drake/"
+_BENCH = "/pbp_drake_bench/"  # the bench's own code: rest
 _MESHCAT_METHODS = frozenset(name for name in dir(Meshcat) if not name.startswith("__"))
 
 
@@ -62,6 +63,8 @@ def category_of(function):
         matches = [prefix for prefix in CATEGORIES if relative.startswith(prefix)]
         category = CATEGORIES[max(matches, key=len)] if matches else REST
         return None if category == SHARED else category
+    if _BENCH in path.replace("\\", "/"):
+        return REST
     if name.startswith("<built-in method pydrake.geometry.") and (
             name[len("<built-in method pydrake.geometry."):-1] in _MESHCAT_METHODS):
         return DRAWING

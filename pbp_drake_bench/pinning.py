@@ -22,11 +22,11 @@ THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"
                     "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
 # Set in the measuring process's environment, to the threads asked for, by its parent.
 MARKER = "PBP_DRAKE_BENCH_BLAS_THREADS"
-# The folder holding the `pbp_drake` package this file belongs to: the child imports the
-# same code, whatever its working directory holds.
-PACKAGE_ROOT = str(Path(__file__).resolve().parents[2])
+# The folder holding the `pbp_drake_bench` package this file belongs to: the child imports
+# the same code, whatever its working directory holds.
+PACKAGE_ROOT = str(Path(__file__).resolve().parents[1])
 _CHILD = ("import sys; sys.path[0] = sys.argv.pop(1); "
-          "from pbp_drake.bench.main import main; sys.exit(main(sys.argv[1:]))")
+          "from pbp_drake_bench.main import main; sys.exit(main(sys.argv[1:]))")
 # OpenBLAS's thread-count getter under the names its builds export (NumPy's wheels bundle
 # scipy-openblas, whose symbols carry a prefix and a 64-bit-integer suffix).
 _OPENBLAS_GETTERS = ("openblas_get_num_threads", "openblas_get_num_threads64_",

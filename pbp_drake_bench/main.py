@@ -1,4 +1,4 @@
-"""`pbp-drake bench` (`python -m pbp_drake.bench`): its command line, one row of step
+"""`pbp-drake bench` (`python -m pbp_drake_bench`): its command line, one row of step
 timings per (D, K, weights), the closed-loop runs, and the files it writes."""
 
 import argparse
@@ -10,20 +10,20 @@ from pathlib import Path
 
 import numpy as np
 
-import pbp_drake.bench
-from pbp_drake.bench.cases import (
+import pbp_drake_bench
+from pbp_drake_bench.cases import (
     BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_fields)
-from pbp_drake.bench.checks import (
+from pbp_drake_bench.checks import (
     CHECKED_HSR_GOALS, CHECKED_REPLAY_GOALS, MOTION_ROWS, PEERS, evaluate, exit_code)
-from pbp_drake.bench.closed_loop import HSR_KS, TASKS, closed_loop_runs, split_run
-from pbp_drake.bench.peers import (
+from pbp_drake_bench.closed_loop import HSR_KS, TASKS, closed_loop_runs, split_run
+from pbp_drake_bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
-from pbp_drake.bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
-from pbp_drake.bench.plot import plot_control_rate, plot_scaling
-from pbp_drake.bench.pose_cases import measure_pose_row
-from pbp_drake.bench.replay import REPLAY_SECONDS, replay_sizes
-from pbp_drake.bench.table import format_report, microseconds, ratio
-from pbp_drake.bench.timing import memory_bandwidth, timed
+from pbp_drake_bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
+from pbp_drake_bench.plot import plot_control_rate, plot_scaling
+from pbp_drake_bench.pose_cases import measure_pose_row
+from pbp_drake_bench.replay import REPLAY_SECONDS, replay_sizes
+from pbp_drake_bench.table import format_report, microseconds, ratio
+from pbp_drake_bench.timing import memory_bandwidth, timed
 
 KS = (1, 10, 100, 1000, 10000, 100000)
 DS = (2, 3, 6)
@@ -37,7 +37,7 @@ MESHCAT_WALL_CAP = 20.0
 def build_parser():
     """The argument parser of `pbp-drake bench` (the CLI reference is generated from it)."""
     parser = argparse.ArgumentParser(prog="pbp-drake bench",
-                                     description=pbp_drake.bench.__doc__.split("\n")[0])
+                                     description=pbp_drake_bench.__doc__.split("\n")[0])
     parser.add_argument("--output", default="outputs/bench", help="folder for bench.json "
                         "and bench_control_rate.png (default: outputs/bench)")
     parser.add_argument("--quick", action="store_true",
@@ -110,7 +110,7 @@ def main(argv=None):
     if args.blas_threads > 0 and not in_measuring_process():
         # NumPy is loaded in this process already (pbp_drake.cli and this module import
         # it), too late for the thread variables: measure in a fresh process pinned from
-        # its start (pbp_drake.bench.pinning).
+        # its start (pbp_drake_bench.pinning).
         return measure_in_fresh_process(argv, args.blas_threads)
     return _measure(args)
 

@@ -6,7 +6,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from pbp_drake.bench.cases import BASIS  # noqa: E402
+from pbp_drake_bench.cases import BASIS  # noqa: E402
 
 
 def plot_control_rate(rows, path):

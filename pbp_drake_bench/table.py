@@ -1,9 +1,9 @@
 """The bench's report: the table of step times, the closed-loop matrix, the per-tick time
-split and the replay sizes, and the checks (`pbp_drake.bench.checks`), each with its
+split and the replay sizes, and the checks (`pbp_drake_bench.checks`), each with its
 measured value and verdict."""
 
-from pbp_drake.bench.checks import format_results
-from pbp_drake.bench.time_split import ORDER
+from pbp_drake_bench.checks import format_results
+from pbp_drake_bench.time_split import ORDER
 
 
 def microseconds(seconds):
@@ -39,8 +39,8 @@ def format_report(report):
                  "N = 50, dt = 1 ms.")
     lines.append("math: DmpBank.advance_into; leaf: the DmpBank LeafSystem per 1 ms period "
                  "in a Simulator (includes Drake), wired as the builder wires it (followed "
-                 "and selected goal connected, the compact state: affine in the goal with "
-                 "shared weights, the step's inputs with distinct ones; the selected "
+                 "and selected goal connected; the compact state with shared weights, the "
+                 "per-goal state with distinct ones; the selected "
                  "reference read every period); drake: a LeafSystem with the same ports "
                  "and state and an empty update;")
     lines.append("bound: weight bytes / measured read bandwidth (cache-sized bound in "
@@ -158,7 +158,7 @@ def _factor(run):
 
 
 def split_lines(runs, closed_loop=()):
-    """The per-tick time split of the reach runs (`pbp_drake.bench.time_split`), beside the
+    """The per-tick time split of the reach runs (`pbp_drake_bench.time_split`), beside the
     wall time per tick of the same case in the matrix (no profiler)."""
     lines = ["Where a control tick's wall time goes, reach task, one run under cProfile: "
              "each function's own time given to its category (code outside pbp_drake split "
@@ -187,7 +187,7 @@ def split_lines(runs, closed_loop=()):
 
 
 def replay_lines(replay):
-    """The replay sizes (`pbp_drake.bench.replay`)."""
+    """The replay sizes (`pbp_drake_bench.replay`)."""
     first = replay["runs"][0]
     sizes = "; ".join(f"K = {run['goals']:,}: {run['bytes'] / 1e6:.2f} MB"
                       + (f" ({run['bytes'] / first['bytes']:.2f}x K = {first['goals']:,})"

@@ -10,7 +10,7 @@ import importlib
 
 import numpy as np
 
-from pbp_drake.bench.cases import BASIS, DT
+from pbp_drake_bench.cases import BASIS, DT
 from pbp_drake.core.dmp import DmpSettings
 
 

@@ -3,7 +3,7 @@ fail, or skipped with the reason: a peer library not installed, or a case this r
 measure), the summary line, and the exit code (1 when any check fails).
 
 `--quick` runs the same checks with the same limits at fewer repeats: every check's case is
-in the quick run (see `pbp_drake.bench.main.plan`)."""
+in the quick run (see `pbp_drake_bench.main.plan`)."""
 
 import dataclasses
 from collections.abc import Callable
@@ -21,12 +21,12 @@ class Check:
     # replay sizes -> the measured value
     value: Callable
     row: tuple | None = None  # (D, K, weights) of the step row it reads
-    pose: bool = False  # the row is the six-DoF pose bank's (`pbp_drake.bench.pose_cases`)
+    pose: bool = False  # the row is the six-DoF pose bank's (`pbp_drake_bench.pose_cases`)
     # (task, K, meshcat) of the closed-loop run it reads, on the shipped robot
-    # (`pbp_drake.bench.closed_loop`; with Meshcat, a client reading everything)
+    # (`pbp_drake_bench.closed_loop`; with Meshcat, a client reading everything)
     run: tuple | None = None
     base_run: tuple | None = None  # ... and of the run of the same bench it compares with
-    replay: tuple = ()  # the K of the replay sizes it compares (`pbp_drake.bench.replay`)
+    replay: tuple = ()  # the K of the replay sizes it compares (`pbp_drake_bench.replay`)
     peers: tuple = ()  # it needs one of these peer libraries
     motion: bool = False  # it reads the row's timing over a movement (`cases.motion_timing`)
 
@@ -91,7 +91,7 @@ def evaluate(rows, closed_loop, installed, blas=None, replay=None):
     """Every check's result: {"check", "value", "limit", "unit", "verdict", "reason"}, the
     verdict "pass", "fail" or "skipped" (then "reason" says why). `installed` is the set of
     peer libraries present; `blas` (from `pinning.blas_threads`) adds the pinning check;
-    `replay` is `pbp_drake.bench.replay.replay_sizes`' result (None: not recorded)."""
+    `replay` is `pbp_drake_bench.replay.replay_sizes`' result (None: not recorded)."""
     results = []
     for check in CHECKS:
         result = {"check": check.name, "value": None, "limit": check.limit,

@@ -6,7 +6,7 @@ The LeafSystem is wired as the grasp builder wires it: `followed_goal` connected
 continues from the followed DMP's velocities) and the compact state (16 numbers; the K
 stepped DMPs a cache entry computed once per tick, `PoseDmpBank`), and its
 `selected_reference` read at every period, as the pose blender reads it
-(`pbp_drake.bench.cases.ReferenceReader`). The row also times it with the per-goal state
+(`pbp_drake_bench.cases.ReferenceReader`). The row also times it with the per-goal state
 (`leaf_per_goal_us`: 12 K numbers, which Drake copies twice per update) and with
 `followed_goal` unconnected (`leaf_own_us`: the per-goal state, each DMP keeps its own
 velocities, and every update reads all K angular velocities back)."""
@@ -16,11 +16,11 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.bench.cases import (
+from pbp_drake_bench.cases import (
     BASIS, DT, connect_reader, leaf_step, make_bank, make_case, motion_fields)
-from pbp_drake.bench.checks import MOTION_ROWS
-from pbp_drake.bench.table import microseconds
-from pbp_drake.bench.timing import timed
+from pbp_drake_bench.checks import MOTION_ROWS
+from pbp_drake_bench.table import microseconds
+from pbp_drake_bench.timing import timed
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank

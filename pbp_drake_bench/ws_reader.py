@@ -1,5 +1,5 @@
 """A Meshcat client that reads everything sent, for the bench's runs with a client connected:
-`python pbp_drake/bench/ws_reader.py ws://localhost:PORT` (this file as a script, which
+`python pbp_drake_bench/ws_reader.py ws://localhost:PORT` (this file as a script, which
 imports websockets alone) connects to a Meshcat's websocket,
 reads every message, counting messages and bytes, until the connection closes (or a DONE
 mark arrives, or SIGTERM), and then prints its totals to stdout as one JSON line.

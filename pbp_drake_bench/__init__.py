@@ -36,5 +36,5 @@ Modules: `pinning` (the fresh, pinned process), `timing` (the timer, memory band
 speed, headless and with Meshcat), `ws_reader` (the Meshcat client that counts what it
 reads), `time_split` (a tick's time by category, from cProfile), `replay` (the recorded
 replay's size), `checks` (the checks, their verdicts and the exit code), `table` (the
-report), `plot` (the figures), `main` (the command line; `python -m pbp_drake.bench`).
+report), `plot` (the figures), `main` (the command line; `python -m pbp_drake_bench`).
 """

@@ -24,8 +24,8 @@ from pbp_drake.scenarios.resolution import TaskScene
 
 REACH, GRASP = "reach", "grasp"
 TASKS = (REACH, GRASP)
-# The repository's diagrams/ folder (this file is pbp_drake/bench/scenes.py).
-DIAGRAMS = Path(__file__).resolve().parents[2] / "diagrams"
+# The repository's diagrams/ folder (this file is pbp_drake_bench/scenes.py).
+DIAGRAMS = Path(__file__).resolve().parents[1] / "diagrams"
 SCENARIO_FILES = {REACH: DIAGRAMS / "hsr_reach.yaml", GRASP: DIAGRAMS / "hsr_grasp.yaml"}
 
 

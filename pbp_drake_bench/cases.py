@@ -3,8 +3,8 @@ times (the bank math alone, the bank inside its LeafSystem, and a LeafSystem wit
 ports and state whose update does nothing: Drake's own cost).
 
 The LeafSystem is wired as the builder wires it: its `followed_goal` and `selected_goal`
-connected, the compact state (`DmpBank(compact_state=True)`: affine in the goal with
-shared weights, the step's inputs with distinct ones), and a reader that evaluates its
+connected, the compact state with shared weights (`DmpBank(compact_state=True)`, as every
+scenario's bank) and the per-goal state with distinct ones, and a reader that evaluates its
 `selected_reference` at every period, as the blender does: a step's time is its update
 and that read. (A bank could otherwise look fast by leaving its work to an output no
 timing reads.)"""
@@ -16,8 +16,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
-from pbp_drake.bench.table import microseconds
-from pbp_drake.bench.timing import timed_span
+from pbp_drake_bench.table import microseconds
+from pbp_drake_bench.timing import timed_span
 from pbp_drake.core.dmp import DmpBankModel, DmpSettings, fit_weights, minimum_jerk
 from pbp_drake.systems.pbp.dmp_bank import DmpBank as DmpBankSystem
 from pbp_drake.systems.pbp.goals_source import GoalsSource
@@ -78,11 +78,11 @@ def bank_math_step(bank, case):
 
 
 class NullBank(LeafSystem):
-    """A LeafSystem with the DmpBankModel system's ports and compact state (of a bank
-    `affine_in_goal` or not) and an update that does nothing: Drake's own cost of one
-    periodic discrete update (and of the read)."""
+    """A LeafSystem with the DmpBankModel system's ports and state (compact or per goal)
+    and an update that does nothing: Drake's own cost of one periodic discrete update (and
+    of the read)."""
 
-    def __init__(self, goal_count, dimension, affine_in_goal):
+    def __init__(self, goal_count, dimension, compact):
         super().__init__()
         k, d = goal_count, dimension
         self.DeclareVectorInputPort("robot_state", 2 * d)
@@ -90,7 +90,7 @@ class NullBank(LeafSystem):
         self.DeclareVectorInputPort("operator_active", 1)
         self.DeclareVectorInputPort("followed_goal", 1)
         self.DeclareVectorInputPort("selected_goal", 1)
-        size = DmpBankSystem.state_size(k, d, compact_state=True, affine_in_goal=affine_in_goal)
+        size = DmpBankSystem.state_size(k, d, compact_state=compact)
         self.DeclareDiscreteState(np.zeros(size))
         self.DeclareVectorOutputPort("selected_reference", 2 * d, self._calc_reference,
                                      prerequisites_of_calc={self.xd_ticket()})
@@ -128,13 +128,13 @@ def leaf_simulator(case, bank=None, read="selected_reference"):
     all K, for the report: the null system has none)."""
     builder = DiagramBuilder()
     d = case.dimension
-    # The compact state, as the builder's: a case's shared weights come with one start
-    # (`make_bank`), so its DMPs are affine in the goal; distinct ones keep the step's
-    # inputs.
+    # The compact state, as the builder's, for shared weights (they come with one start,
+    # `make_bank`, so the DMPs are affine in the goal); distinct ones keep the per-goal one.
+    compact = case.weights is None
     if bank is None:
-        system = builder.AddSystem(NullBank(case.goal_count, d, case.weights is None))
+        system = builder.AddSystem(NullBank(case.goal_count, d, compact))
     else:
-        system = builder.AddSystem(DmpBankSystem(bank, DT, compact_state=True))
+        system = builder.AddSystem(DmpBankSystem(bank, DT, compact_state=compact))
     robot = builder.AddSystem(ConstantVectorSource(np.concatenate([case.robot, np.zeros(d)])))
     # Our goals source, as the builder uses: Drake's ConstantVectorSource would make the
     # bank re-read its goals at every update.

@@ -54,8 +54,9 @@ class HsrStationConfig:
     #: limit as w grows; the plant only gives the kinematics and the geometry, and its
     #: step, gains and plant settings go unused): about twice the closed loop's speed,
     #: and in the reaching and grasping tasks, which ship with it, the same study results
-    #: within their trial-to-trial noise (README, "A kinematic robot"). Nothing pushes the
-    #: robot in either (gravity is off, obstacles are measured).
+    #: within their trial-to-trial noise (docs/tasks/hsr-station.md, "A kinematic
+    #: robot"). Nothing pushes the robot in either (gravity is off, obstacles are
+    #: measured).
     motion: str = "dynamic"
     #: The whole-body differential IK's period (s), a whole multiple of plant.time_step;
     #: its QP is the station's largest cost.

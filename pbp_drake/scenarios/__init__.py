@@ -8,7 +8,8 @@ Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario
 """
 
 from pbp_drake.scenarios.loading import (
-    LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file)
+    LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file,
+    load_scenario_text)
 from pbp_drake.scenarios.resolution import (
     BLEND_MODE_OF_METHOD, ResolvedScenario, TaskScene, demonstration_samples,
     parse_method_label, resolve, task_scene, with_method)
@@ -34,5 +35,5 @@ __all__ = [
     "NoisyPilot", "LaggyPilot", "ProportionalPilot", "ParticipantPopulation", "PILOT_CONFIGS",
     "PILOT_NAMES", "PILOTS", "check_pilot_name", "with_pilot",
     "check_alpha_study", "check_method_comparison", "counted", "demonstration_samples",
-    "forward_key_enabled", "load_scenario_file", "parse_method_label", "resolve", "shows_intent", "task_scene", "with_method",
+    "forward_key_enabled", "load_scenario_file", "load_scenario_text", "parse_method_label", "resolve", "shows_intent", "task_scene", "with_method",
 ]

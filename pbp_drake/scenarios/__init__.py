@@ -1,7 +1,7 @@
-"""Scenario files: the schema (`schema`), reading them (`loading`), the checks of their text,
-shape and numbers (`validation`) and resolving them (`resolution`: everything checked and
-derived once by `resolve`), and the words a person reads about runs (`words`: each method's
-name, counts).
+"""Scenario files: the schema (`schema`), reading them (`loading`, within the bounds of
+`bounds`), the checks of their numbers (`validation`), resolving them (`resolution`:
+everything checked and derived once by `resolve`; the tasks' scenes in `task_scenes`), the
+surrogate pilots (`pilots`) and the words a person reads about runs (`words`).
 
 Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario` ->
 `pbp_drake.builder.build_diagram`.

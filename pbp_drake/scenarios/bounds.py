@@ -181,7 +181,7 @@ class _TaggedLoader(_BASE_LOADER):
 
     def construct_mapping(self, node, deep=False):
         first_lines = {}
-        for key_node, _ in node.value:
+        for key_node, _ in node.value if isinstance(node, yaml.MappingNode) else ():
             if key_node.tag == "tag:yaml.org,2002:merge" or not isinstance(key_node.value, str):
                 continue
             line = key_node.start_mark.line + 1

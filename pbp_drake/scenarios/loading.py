@@ -9,6 +9,7 @@ document before it is read (`pbp-drake run --set FIELD=VALUE`).
 """
 
 import dataclasses
+import difflib
 import os
 import pathlib
 import types
@@ -204,8 +205,9 @@ def _first_problem(node, schema, field, is_range=False):
     variant = next((m for m, n in zip(members, names) if tag == "!" + n), None)
     if tag and variant is None:
         tags = ["!" + name for name in names]
-        return (f"{field}: the tag {tag} is unknown; expected one of {', '.join(tags)}"
-                f"{close_match(tag, tags)}")
+        matches = difflib.get_close_matches(tag, tags, n=1)
+        hint = f" (did you mean {matches[0]}?)" if matches else ""
+        return f"{field}: the tag {tag} is unknown; expected one of {', '.join(tags)}{hint}"
     variant = variant or members[0]
     types_of = _field_types(variant)
     where = field or "the file's top level"

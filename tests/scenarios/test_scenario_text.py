@@ -44,7 +44,7 @@ def test_one_number_for_a_range_is_exactly_that_number():
                                           "a number"]),
     ("scenario: {task: {switch_schedule: 0.0}}", ["scenario.task.switch_schedule", "a list"]),
     ("scenario: {seed: 1.5}", ["scenario.seed", "an integer"]),
-    ("scenario: {robot: !Hsrr {}}", ["scenario.robot", "!Hsrr", "did you mean '!Hsr'"]),
+    ("scenario: {robot: !Hsrr {}}", ["scenario.robot", "!Hsrr", "did you mean !Hsr?"]),
     ("scenario: [", ["reach: the override 'scenario: ['", "YAML syntax error"]),
 ])
 def test_a_bad_overlay_names_its_field(overlay, words):

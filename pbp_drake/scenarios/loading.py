@@ -240,9 +240,19 @@ def _first_problem(node, schema, field, is_range=False):
                                   for index, item in enumerate(node))), None)
     if variant in _KINDS:
         words, kinds = _KINDS[variant]
+        if variant is float and isinstance(node, str) and _reads_as_float(node):
+            return None  # as Drake's loader reads it: YAML 1.1 takes 1.0e9 for a string
         if isinstance(node, bool) != (variant is bool) or not isinstance(node, kinds):
             return f"{field}: got {_given(node)}; expected {words}"
     return None
+
+
+def _reads_as_float(text):
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 # ---------------------------------------------------------------------------------------------

@@ -2,11 +2,11 @@
 
 `make_pbp_controller(PbpControllerConfig(...), initial_ee_state, goals)` builds the
 controller of any robot whose station takes an `ee_command` and gives an `ee_state` (the
-HSR's, an arm's from `make_arm_station`, a user's own). A scenario file's sections are the
-same dataclasses (``dmp``, ``goal_estimator``, ``hop``), and its robot's hand-over fields
-take their defaults from `HandOverSettings`, so a Python user and a YAML user get the same
-controller; `pbp_drake.scenarios.resolve` fills one in from a scenario
-(`ResolvedScenario.controller`).
+HSR's, an arm's from `make_arm_station`, a user's own). A scenario is a `ControlSettings` (its
+``method``, ``alpha``, ``control_period``, ``dmp``, ``dmp_duration``, ``goal_estimator``,
+``hop``) and its robot section a `HandLimits` with a nominal ``speed``, so a Python user and
+a YAML user get the same controller; `pbp_drake.scenarios.resolve` makes one from a
+scenario (`ResolvedScenario.controller`).
 """
 
 import dataclasses
@@ -25,37 +25,48 @@ CONTROLLER_METHODS = ("pbp_alternated", "pbp_continuous", "pbp_no_user", "fixed_
 
 
 @dataclasses.dataclass
-class HandOverSettings:
-    """The hand-over law (`pbp_drake.core.hand_over`): a goal switch, or the operator
-    pressing or releasing, changes the hand's commanded velocity by at most
+class HandLimits:
+    """The hand-over law's limits (`pbp_drake.core.hand_over`): a goal switch, or the
+    operator pressing or releasing, changes the hand's commanded velocity by at most
     `max_hand_acceleration` (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command
-    never exceeds `max_hand_speed` (m/s), however far a primitive is from its attractor."""
+    never exceeds `max_hand_speed` (m/s), however far a primitive is from its attractor.
+    A scenario's robot section holds them (`robot: !Hsr {max_hand_speed: ...}`)."""
 
     #: The fastest change of the commanded hand velocity (m/s^2).
     max_hand_acceleration: float = 1.0
-    #: The fastest commanded hand speed (m/s). 0.2 m/s is the HSR base's published limit.
+    #: The fastest commanded hand speed (m/s). 0.2 m/s is the HSR base's published limit:
+    #: a hand driven faster for long runs its arm out of range.
     max_hand_speed: float = 0.2
     #: The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
     max_hand_yaw_acceleration: float = 4.0
+
+    def validate(self):
+        """Raises ValueError naming the first limit that is not finite and positive."""
+        check_limit(self.max_hand_acceleration, "max_hand_acceleration", "m/s^2")
+        check_limit(self.max_hand_speed, "max_hand_speed", "m/s")
+        check_limit(self.max_hand_yaw_acceleration, "max_hand_yaw_acceleration", "rad/s^2")
+
+
+@dataclasses.dataclass
+class HandOverSettings(HandLimits):
+    """`HandLimits` and how far the hand's heading may turn."""
+
     #: How far (rad) the heading may turn either way from where it starts; .inf: no bound
     #: (the HSR turns its base). An arm's wrist turns so far.
     max_heading_turn: float = float("inf")
 
     def validate(self):
-        """Raises ValueError naming the first limit that is not positive (or, but for
-        max_heading_turn, not finite)."""
-        check_limit(self.max_hand_acceleration, "max_hand_acceleration", "m/s^2")
-        check_limit(self.max_hand_speed, "max_hand_speed", "m/s")
-        check_limit(self.max_hand_yaw_acceleration, "max_hand_yaw_acceleration", "rad/s^2")
+        """Raises ValueError naming the first limit that cannot be used."""
+        super().validate()
         if not self.max_heading_turn > 0:
-            raise ValueError(f"max_heading_turn must be positive (rad; .inf for no bound), "
-                             f"got {self.max_heading_turn!r}")
+            raise ValueError(f"max_heading_turn must be finite and positive (rad; .inf for "
+                             f"no bound), got {self.max_heading_turn!r}")
 
 
 @dataclasses.dataclass
-class PbpControllerConfig:
-    """Everything `make_pbp_controller` builds from; one default per knob, the scenario
-    file's."""
+class ControlSettings:
+    """What the controller runs and how often: the fields a scenario file's `scenario:`
+    shares with `PbpControllerConfig` (both are one)."""
 
     #: One of CONTROLLER_METHODS: PBP alternated or continuous, PBP with no operator,
     #: explicit arbitration (fixed or confidence alpha), teleop, or the HOP baselines.
@@ -66,16 +77,44 @@ class PbpControllerConfig:
     control_period: float = 0.01
     #: The DMPs' gains and basis.
     dmp: DmpSettings = dataclasses.field(default_factory=DmpSettings)
-    #: The DMPs' duration tau (s); 0: the farthest goal's distance over nominal_speed.
+    #: The DMPs' duration tau (s); 0: from the demonstration (2-D scenes) or the farthest
+    #: goal's distance over the nominal speed (the robot's `speed`).
     dmp_duration: float = 0.0
-    #: The DMPs' nominal speed (m/s), for their duration when dmp_duration is 0.
-    nominal_speed: float = 0.12
     #: How the followed goal is estimated.
     goal_estimator: GoalEstimatorSettings = dataclasses.field(
         default_factory=GoalEstimatorSettings)
     #: HOP's cost model, posterior and assistance (hop, predict_then_assist and the
     #: maxent_command estimator).
     hop: HopSettings = dataclasses.field(default_factory=HopSettings)
+
+    def control_settings(self):
+        """Its `ControlSettings` fields, by name."""
+        return {field.name: getattr(self, field.name)
+                for field in dataclasses.fields(ControlSettings)}
+
+    def validate_settings(self):
+        """Raises ValueError naming the first of its numbers or settings that cannot be
+        used (its method is checked by its user, who knows the methods it runs)."""
+        if not (np.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
+            raise ValueError(f"alpha must lie in [0, 1], got {self.alpha!r}")
+        check_limit(self.control_period, "control_period", "s")
+        if not (np.isfinite(self.dmp_duration) and self.dmp_duration >= 0.0):
+            raise ValueError(f"dmp_duration must be finite and not negative (0: derived), "
+                             f"got {self.dmp_duration!r}")
+        for name in ("dmp", "goal_estimator", "hop"):
+            try:
+                getattr(self, name).validate()
+            except ValueError as error:
+                raise ValueError(f"{name}: {error}") from None
+
+
+@dataclasses.dataclass
+class PbpControllerConfig(ControlSettings):
+    """Everything `make_pbp_controller` builds from; one default per knob, the scenario
+    file's."""
+
+    #: The DMPs' nominal speed (m/s), for their duration when dmp_duration is 0.
+    nominal_speed: float = 0.12
     #: The hand-over law's limits, which every method's command goes through.
     hand_over: HandOverSettings = dataclasses.field(default_factory=HandOverSettings)
 
@@ -83,18 +122,12 @@ class PbpControllerConfig:
         """Raises ValueError naming the first field that cannot be used."""
         if self.method not in CONTROLLER_METHODS:
             raise ValueError(f"method {self.method!r} is not one of {CONTROLLER_METHODS}")
-        if not (np.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
-            raise ValueError(f"alpha must lie in [0, 1], got {self.alpha!r}")
-        check_limit(self.control_period, "control_period", "s")
+        self.validate_settings()
         check_limit(self.nominal_speed, "nominal_speed", "m/s")
-        if not (np.isfinite(self.dmp_duration) and self.dmp_duration >= 0.0):
-            raise ValueError(f"dmp_duration must be finite and >= 0 (0: from "
-                             f"nominal_speed), got {self.dmp_duration!r}")
-        for name in ("dmp", "goal_estimator", "hop", "hand_over"):
-            try:
-                getattr(self, name).validate()
-            except ValueError as error:
-                raise ValueError(f"{name}.{error}") from None
+        try:
+            self.hand_over.validate()
+        except ValueError as error:
+            raise ValueError(f"hand_over.{error}") from None
         if self.goal_estimator.method == "pose":
             raise ValueError("goal_estimator.method pose reads grasp orientations, which a "
                              "position controller has not")

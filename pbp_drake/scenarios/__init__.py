@@ -1,38 +1,38 @@
-"""Scenario files: the schema (`schema`), reading them (`loading`), the checks of their text,
-shape and numbers (`validation`) and resolving them (`resolution`: everything checked and
-derived once by `resolve`), and the words a person reads about runs (`words`: each method's
-name, counts).
+"""Scenario files: the schema (`schema`), reading them (`loading`, within the bounds of
+`bounds`), the checks of their numbers (`validation`), resolving them (`resolution`:
+everything checked and derived once by `resolve`; the tasks' scenes in `task_scenes`), the
+surrogate pilots (`pilots`) and the words a person reads about runs (`words`).
 
 Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario` ->
 `pbp_drake.builder.build_diagram`.
 """
 
 from pbp_drake.scenarios.loading import (
-    LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file)
+    LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file,
+    load_scenario_text)
 from pbp_drake.scenarios.resolution import (
     BLEND_MODE_OF_METHOD, ResolvedScenario, TaskScene, demonstration_samples,
     parse_method_label, resolve, task_scene, with_method)
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, METHODS, FORWARD_KEY_METHODS, OPERATOR_NAMES, TASK_ROBOTS, TOY_OPERATORS,
-    AlphaStudy, AltVsCont, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask, Hsr, Keyboard, MethodComparison,
-    MultiGoalReach, NoOperator, Obstacle, ObstacleRepulsion, OperatorConfig, PointRobot,
-    RecordedPath, Scenario, ScenarioError, ScenarioFile, SceneVariant, ScriptedCommands,
-    SinusoidalStep, VirtualParticipant, forward_key_enabled, shows_intent, NoisyPilot,
-    LaggyPilot, ProportionalPilot, ParticipantPopulation, PILOT_CONFIGS)
+    FORWARD_KEY_METHODS, HSR_OPERATORS, METHODS, OPERATOR_NAMES, PILOT_CONFIGS, TASK_ROBOTS,
+    TOY_OPERATORS, AlphaStudy, AltVsCont, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask,
+    Hsr, Keyboard, LaggyPilot, MethodComparison, MultiGoalReach, NoisyPilot, NoOperator,
+    Obstacle, ObstacleRepulsion, OperatorConfig, ParticipantPopulation, PointRobot,
+    ProportionalPilot, RecordedPath, Scenario, ScenarioError, ScenarioFile, SceneVariant,
+    ScriptedCommands, SinusoidalStep, VirtualParticipant, forward_key_enabled, shows_intent)
 from pbp_drake.scenarios.words import METHOD_NAMES, counted
 from pbp_drake.scenarios.pilots import PILOT_NAMES, PILOTS, check_pilot_name, with_pilot
 
 __all__ = [
-    "BLEND_MODE_OF_METHOD", "HSR_OPERATORS", "METHOD_NAMES", "METHODS", "FORWARD_KEY_METHODS",
-    "OPERATOR_NAMES", "TASK_ROBOTS", "TOY_OPERATORS", "AlphaStudy", "AltVsCont", "Arm",
-    "BentPath",
-    "DynamicObstacles", "Gamepad", "GraspTask", "Hsr", "Keyboard", "LoadedScenarioFile",
-    "MethodComparison", "MultiGoalReach",
-    "NoOperator", "Obstacle", "ObstacleRepulsion", "OperatorConfig", "PointRobot",
+    "BLEND_MODE_OF_METHOD", "FORWARD_KEY_METHODS", "HSR_OPERATORS", "METHOD_NAMES", "METHODS",
+    "OPERATOR_NAMES", "PILOT_CONFIGS", "PILOT_NAMES", "PILOTS", "TASK_ROBOTS", "TOY_OPERATORS",
+    "AlphaStudy", "AltVsCont", "Arm", "BentPath", "DynamicObstacles", "Gamepad", "GraspTask",
+    "Hsr", "Keyboard", "LaggyPilot", "LoadedScenarioFile", "MethodComparison",
+    "MultiGoalReach", "NoisyPilot", "NoOperator", "Obstacle", "ObstacleRepulsion",
+    "OperatorConfig", "ParticipantPopulation", "PointRobot", "ProportionalPilot",
     "RecordedPath", "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile",
     "SceneVariant", "ScriptedCommands", "SinusoidalStep", "TaskScene", "VirtualParticipant",
-    "NoisyPilot", "LaggyPilot", "ProportionalPilot", "ParticipantPopulation", "PILOT_CONFIGS",
-    "PILOT_NAMES", "PILOTS", "check_pilot_name", "with_pilot",
-    "check_alpha_study", "check_method_comparison", "counted", "demonstration_samples",
-    "forward_key_enabled", "load_scenario_file", "parse_method_label", "resolve", "shows_intent", "task_scene", "with_method",
+    "check_alpha_study", "check_method_comparison", "check_pilot_name", "counted",
+    "demonstration_samples", "forward_key_enabled", "load_scenario_file", "load_scenario_text",
+    "parse_method_label", "resolve", "shows_intent", "task_scene", "with_method", "with_pilot",
 ]

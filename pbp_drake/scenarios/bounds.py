@@ -176,7 +176,21 @@ def _check_alias_target(event, open_nodes, field):
 
 class _TaggedLoader(_BASE_LOADER):
     """Drake's reading of YAML (`pydrake.common.yaml.yaml_load_data`: a tagged node is its
-    mapping with the tag as a `_tag` key) on PyYAML's C loader."""
+    mapping with the tag as a `_tag` key) on PyYAML's C loader, refusing a key given twice
+    in one mapping (PyYAML keeps the last)."""
+
+    def construct_mapping(self, node, deep=False):
+        first_lines = {}
+        for key_node, _ in node.value if isinstance(node, yaml.MappingNode) else ():
+            if key_node.tag == "tag:yaml.org,2002:merge" or not isinstance(key_node.value, str):
+                continue
+            line = key_node.start_mark.line + 1
+            if key_node.value in first_lines:
+                raise ScenarioError(
+                    f"line {line}: duplicate key {key_node.value!r} (first on line "
+                    f"{first_lines[key_node.value]}); each key may appear once in a mapping")
+            first_lines[key_node.value] = line
+        return super().construct_mapping(node, deep)
 
 
 def _tagged_mapping(loader, tag, node):
@@ -190,20 +204,31 @@ _TaggedLoader.add_multi_constructor("", _tagged_mapping)
 
 def load_document(text):
     """The YAML `text` as Drake's loader reads it, root keys starting with `_` kept; raises
-    what PyYAML raises for text that does not parse."""
+    ScenarioError for a key given twice in a mapping, what PyYAML raises for text that
+    does not parse."""
     return yaml.load(text, Loader=_TaggedLoader)
 
 
-def load_typed(schema, document, text):
+class _TaggedDumper(yaml.SafeDumper):
+    """Writes a document of `load_document` back as YAML, its `_tag` keys as tags."""
+
+
+def _tagged_representation(dumper, data):
+    items = {key: value for key, value in data.items() if key != "_tag"}
+    return dumper.represent_mapping(data.get("_tag", "tag:yaml.org,2002:map"), items)
+
+
+_TaggedDumper.add_representer(dict, _tagged_representation)
+
+
+def load_typed(schema, document):
     """`schema` read from `document` (of `load_document`) by Drake's typed loader, as
-    `yaml_load_typed(schema=schema, data=text)` reads it but without parsing `text` again;
-    by `yaml_load_typed` itself where this Drake lacks the pieces it is made of."""
+    `yaml_load_typed(schema=schema, data=...)` reads its text but without parsing it again
+    (by `yaml_load_typed` itself where this Drake lacks the pieces it is made of)."""
     merge = getattr(drake_yaml, "_merge_yaml_dict_into_target", None)
     options = getattr(drake_yaml, "_LoadYamlOptions", None)
     if merge is None or options is None:
-        return yaml_load_typed(schema=schema, data=text)
-    if not isinstance(document, dict):
-        raise RuntimeError(f"YAML root was a {type(document)} but should have been a dict")
+        return yaml_load_typed(schema=schema, data=yaml.dump(document, Dumper=_TaggedDumper))
     # As yaml_load_typed: root keys starting with `_` are private (anchors' templates).
     document = {key: value for key, value in document.items()
                 if not (isinstance(key, str) and key.startswith("_"))}

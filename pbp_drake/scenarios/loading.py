@@ -1,75 +1,262 @@
-"""Reading a scenario file: its size and YAML bounded (`bounds`), parsed once by PyYAML's C
-loader, read into the schema by Drake's typed loader, then resolved (which checks it).
+"""Reading a scenario: its text within bounds (`bounds`), its YAML document walked next to
+the schema (unknown keys and tags, values of the wrong kind, each named by its field), read
+into the schema by Drake's typed loader, then resolved (`resolve`, which checks the values)
+and its study checked.
 
-Unknown or misspelled keys are errors that name the key (with a suggestion); values are
-checked by `resolve`, and a study section by the checks here.
+`load_scenario_file(path)` reads a file; `load_scenario_text(text, origin)` the same from
+YAML text (`pbp-drake run --scenario-text`), and both take YAML overlays merged into the
+document before it is read (`pbp-drake run --set FIELD=VALUE`).
 """
 
 import dataclasses
+import difflib
+import os
 import pathlib
-import re
+import types
 import typing
 
 import numpy as np
 
-from pbp_drake.scenarios.bounds import check_yaml_bounds, load_document, load_typed
+from pbp_drake.scenarios.bounds import (
+    check_yaml_bounds, load_document, load_typed, read_bounded)
 from pbp_drake.scenarios.resolution import (
-    ResolvedScenario, check_obstacles, resolve, with_method)
+    ResolvedScenario, check_obstacles, close_match, resolve, with_method)
 from pbp_drake.scenarios.schema import (
-    AlphaStudy, Gamepad, Keyboard, MethodComparison, Scenario, ScenarioError, TASK_ROBOTS,
-    STUDY_SPLITS, ScenarioFile)
-from pbp_drake.scenarios.validation import (
-    check_duplicate_keys, check_numbers, check_seed, describe_load_error,
-    read_scenario_text, shape_problem)
+    RANGE, STUDY_SPLITS, AlphaStudy, Arm, Gamepad, Keyboard, MethodComparison, Scenario,
+    ScenarioError, ScenarioFile, TASK_ROBOTS)
+from pbp_drake.scenarios.validation import check_numbers, check_seed
 
 
 @dataclasses.dataclass(frozen=True)
 class LoadedScenarioFile:
-    """A scenario file read and resolved: its `scenario` and `study` configs as written, and
-    `resolved`, the scenario with everything derived (see `resolve`)."""
+    """A scenario read and resolved: its `scenario` and `study` configs as written, and
+    `resolved`, the scenario with everything derived (see `resolve`). `path` is the file
+    read, None for a scenario given as text."""
 
-    path: pathlib.Path
+    path: typing.Optional[pathlib.Path]
     scenario: Scenario
     study: typing.Any
     resolved: ResolvedScenario
 
 
-def load_scenario_file(path):
-    """Reads, checks and resolves a scenario file; errors name the file and the field."""
+def load_scenario_file(path, overlays=()):
+    """Reads, checks and resolves a scenario file (see `load_scenario_text`); errors name
+    the file and the field. A relative `robot: !Arm {model_file: ...}` is read from the
+    file's folder."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
     try:
-        text = read_scenario_text(path)
-        # Before any value is made (a few lines of aliases can stand for billions), and
-        # before the slower walk of the text for duplicate keys.
-        check_yaml_bounds(text)
-        check_duplicate_keys(text)
+        text = decode_scenario_bytes(read_bounded(path))
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from None
+    return dataclasses.replace(
+        load_scenario_text(text, str(path), path.parent, overlays), path=path)
+
+
+def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
+    """Reads, checks and resolves the YAML `text` of a scenario file; each of `overlays`
+    (YAML text of a mapping, e.g. ``scenario: {task: {object_count: 5}}``) is merged into
+    the document first, a mapping into a mapping key by key (a tagged one replaces a node
+    of another tag). Raises ScenarioError as `ORIGIN: field.path: what is wrong` (or `line
+    L`). A relative arm `model_file` is read from `folder` (default: the working folder)."""
     try:
-        document = load_document(text)
+        document = _document(text)
+        for overlay in overlays:
+            try:
+                document = _merged(document, _document(overlay, "the override"))
+            except ScenarioError as error:
+                raise ScenarioError(f"the override {overlay.strip()!r}: {error}") from None
+        problem = _first_problem(document, ScenarioFile, "")
+        if problem:
+            raise ScenarioError(problem)
+        loaded = load_typed(ScenarioFile, document)
+    except ScenarioError as error:
+        raise ScenarioError(f"{origin}: {error}") from None
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
-        raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
-    # Before the typed loader: it accepts some of these and misreports the others.
-    problem = shape_problem(document, ScenarioFile)
-    if problem:
-        raise ScenarioError(f"{path}: {problem}")
+        raise ScenarioError(f"{origin}: {type(error).__name__}: {error}") from None
+    scenario = _model_file_from(loaded.scenario, folder)
     try:
-        loaded = load_typed(ScenarioFile, document, text)
-    except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
-        raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
-    try:
-        resolved = resolve(loaded.scenario)
+        resolved = resolve(scenario)
         check_numbers(loaded.study, "study")
         if isinstance(loaded.study, AlphaStudy):
-            check_alpha_study(loaded.study, loaded.scenario, resolved.start.size)
+            check_alpha_study(loaded.study, scenario, resolved.start.size)
         if isinstance(loaded.study, MethodComparison):
-            check_method_comparison(loaded.study, loaded.scenario)
+            check_method_comparison(loaded.study, scenario)
     except ScenarioError as error:
-        raise ScenarioError(f"{path}: {error}") from None
-    return LoadedScenarioFile(path=path, scenario=loaded.scenario, study=loaded.study,
+        raise ScenarioError(f"{origin}: {error}") from None
+    return LoadedScenarioFile(path=None, scenario=scenario, study=loaded.study,
                               resolved=resolved)
+
+
+def decode_scenario_bytes(data):
+    """The text of a scenario file's bytes; ScenarioError for UTF-16, a binary file or bytes
+    that are not UTF-8."""
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise ScenarioError("the file is UTF-16 encoded; save it as UTF-8 text")
+    if b"\0" in data:
+        raise ScenarioError("a binary file (it holds NUL bytes), not a YAML scenario file; "
+                            "expected UTF-8 text")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise ScenarioError(f"byte {error.start} is not UTF-8 (a binary file?); expected "
+                            "UTF-8 text") from None
+
+
+def _document(text, what="the file"):
+    """The YAML document of `text`, its size and aliases bounded; a mapping."""
+    for number, line in enumerate(text.splitlines(), 1):
+        if "\t" in line[:len(line) - len(line.lstrip(" \t"))] and line.strip():
+            raise ScenarioError(f"line {number}: a tab in the indentation; YAML indents with "
+                                "spaces only")
+    if all(not line.strip() or line.lstrip().startswith("#") for line in text.splitlines()):
+        raise ScenarioError(f"{what} is empty; expected a scenario file starting with "
+                            "`scenario:`")
+    # Before any value is made: a few lines of aliases can stand for billions.
+    check_yaml_bounds(text)
+    try:
+        document = load_document(text)
+    except ScenarioError:
+        raise
+    except Exception as error:  # noqa: BLE001 - PyYAML's errors for text that does not parse
+        raise ScenarioError(_syntax_error(error)) from None
+    if not isinstance(document, dict):
+        raise ScenarioError(f"{what}'s top level holds {_given(document)}; expected a "
+                            "mapping with `scenario:` (and optionally `study:`)")
+    return document
+
+
+def _syntax_error(error):
+    mark = getattr(error, "problem_mark", None)
+    if mark is None:
+        return f"YAML error: {error}"
+    context, context_mark = getattr(error, "context", None), getattr(error, "context_mark", None)
+    where = (f" ({context} at line {context_mark.line + 1}, column {context_mark.column + 1})"
+             if context and context_mark else "")
+    return (f"line {mark.line + 1}, column {mark.column + 1}: YAML syntax error: "
+            f"{getattr(error, 'problem', None) or error}{where}")
+
+
+def _merged(base, overlay):
+    """`overlay` merged into `base` (documents of `load_document`)."""
+    if not (isinstance(base, dict) and isinstance(overlay, dict)) or (
+            "_tag" in overlay and overlay["_tag"] != base.get("_tag")):
+        return overlay
+    merged = dict(base)
+    for key, value in overlay.items():
+        merged[key] = _merged(base[key], value) if key in base else value
+    return merged
+
+
+def _model_file_from(scenario, folder):
+    """`scenario` with a relative arm model file made a path from `folder`."""
+    robot = scenario.robot
+    if (not isinstance(robot, Arm) or not robot.model_file or "://" in robot.model_file
+            or os.path.isabs(robot.model_file)):
+        return scenario
+    model_file = os.path.join(os.path.abspath(folder or os.curdir), robot.model_file)
+    return dataclasses.replace(scenario, robot=dataclasses.replace(robot, model_file=model_file))
+
+
+# ---------------------------------------------------------------------------------------------
+# The document walked next to the schema: what Drake's loader refuses without naming the
+# field (or accepts), said with the field's path.
+
+
+_KINDS = {float: ("a number", (int, float)), int: ("an integer", (int,)),
+          str: ("a string", (str,)), bool: ("true or false", (bool,))}
+
+
+def _field_types(schema):
+    """{name: (type, is a range)} of a dataclass or a Drake config struct; None for others."""
+    if dataclasses.is_dataclass(schema):
+        hints = typing.get_type_hints(schema)
+        return {field.name: (hints[field.name], field.metadata.get(RANGE, False))
+                for field in dataclasses.fields(schema)}
+    fields = getattr(schema, "__fields__", None)
+    if fields is not None and isinstance(schema, type):
+        return {field.name: (field.type, False) for field in fields}
+    return None
+
+
+def _members(schema):
+    """The types a Union (or Optional) field can hold, without None; [schema] otherwise."""
+    if typing.get_origin(schema) not in (typing.Union, types.UnionType):
+        return [schema]
+    return [member for member in typing.get_args(schema) if member is not type(None)]
+
+
+def _given(node):
+    if node is None:
+        return "nothing (an empty value)"
+    return f"a list {node!r}" if isinstance(node, list) else repr(node)
+
+
+def _first_problem(node, schema, field, is_range=False):
+    """`field.path: what is wrong; expected ...` of the first node of `node` that `schema`
+    cannot hold, None when there is none. A range field given one number is made the
+    range [number, number] in place."""
+    members = _members(schema)
+    if node is None and type(None) in typing.get_args(schema):
+        return None
+    tag = node.get("_tag", "") if isinstance(node, dict) else ""
+    names = [getattr(member, "__name__", str(member)) for member in members]
+    variant = next((m for m, n in zip(members, names) if tag == "!" + n), None)
+    if tag and variant is None:
+        tags = ["!" + name for name in names]
+        matches = difflib.get_close_matches(tag, tags, n=1)
+        hint = f" (did you mean {matches[0]}?)" if matches else ""
+        return f"{field}: the tag {tag} is unknown; expected one of {', '.join(tags)}{hint}"
+    variant = variant or members[0]
+    types_of = _field_types(variant)
+    where = field or "the file's top level"
+    if types_of is not None:
+        if not isinstance(node, dict):
+            expected = (f"a mapping of the fields of {names[0]}" if len(names) == 1 else
+                        f"a mapping, tagged with one of {', '.join('!' + n for n in names)} "
+                        f"(untagged: {names[0]})")
+            return f"{where}: got {_given(node)}; expected {expected}"
+        for key, value in node.items():
+            if key == "_tag" or (not field and str(key).startswith("_")):
+                continue  # the top level's private keys hold anchors' templates
+            if key not in types_of:
+                return (f"{where}: unknown key {key!r}{close_match(str(key), types_of)}; "
+                        f"expected one of {', '.join(sorted(types_of))}")
+            value_type, is_range = types_of[key]
+            if is_range and isinstance(value, (int, float)) and not isinstance(value, bool):
+                node[key] = value = [value, value]
+            found = _first_problem(value, value_type, f"{field}.{key}" if field else str(key),
+                                   is_range)
+            if found:
+                return found
+        return None
+    if typing.get_origin(variant) is list:
+        if not isinstance(node, list):
+            single = " (or one number: exactly it)" if is_range else ""
+            return f"{field}: got {_given(node)}; expected a list{single}"
+        item_type = typing.get_args(variant)[0]
+        return next(filter(None, (_first_problem(item, item_type, f"{field}[{index}]")
+                                  for index, item in enumerate(node))), None)
+    if variant in _KINDS:
+        words, kinds = _KINDS[variant]
+        if variant is float and isinstance(node, str) and _reads_as_float(node):
+            return None  # as Drake's loader reads it: YAML 1.1 takes 1.0e9 for a string
+        if isinstance(node, bool) != (variant is bool) or not isinstance(node, kinds):
+            return f"{field}: got {_given(node)}; expected {words}"
+    return None
+
+
+def _reads_as_float(text):
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+# ---------------------------------------------------------------------------------------------
+# The study sections.
 
 
 def check_alpha_study(study, scenario, dimension):
@@ -139,15 +326,3 @@ def check_method_comparison(study, scenario):
                             f"{', '.join(STUDY_SPLITS)}")
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
-
-
-def _load_error_message(error):
-    """A root that is not a mapping, said plainly; everything else names its field by
-    `describe_load_error`."""
-    root = re.match(r"YAML root was a <class '(\w+)'>", str(error))
-    if root:
-        found = {"NoneType": "nothing", "str": "a string", "list": "a list", "int": "a number",
-                 "float": "a number", "bool": "true or false"}.get(root[1], root[1])
-        return (f"the file's top level holds {found}; expected a mapping with `scenario:` "
-                "(and optionally `study:`)")
-    return describe_load_error(error)

@@ -15,28 +15,24 @@ import typing
 
 import numpy as np
 
-from pbp_drake.core.controller_config import HandOverSettings, PbpControllerConfig
+from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
-from pbp_drake.core.hand_over import check_limit
-from pbp_drake.core.obstacle_task import sample_obstacle_scene
-from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.scenarios.bounds import check_goal_counts
-from pbp_drake.scenarios.grasp_scene import grasp_scene
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, METHODS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
-    DynamicObstacles, Gamepad, GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, Scenario,
-    ScenarioError,
+    DynamicObstacles, Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError,
     ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
     VirtualParticipant)
+from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
     check_grasp_task, check_numbers, check_obstacle_task, check_reach_task, check_seed,
-    check_pilot, check_time_steps, check_virtual_participant, require_finite)
+    check_pilot, check_time_steps, check_virtual_participant, require_finite, whole_steps)
 
 # How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator;
 # HOP and predict-then-assist have no blender: their assistance is the HOP controller's).
@@ -50,19 +46,6 @@ BLEND_MODE_OF_METHOD = {
     "hop": None,
     "predict_then_assist": None,
 }
-
-
-@dataclasses.dataclass(frozen=True)
-class TaskScene:
-    """What an HSR task puts in front of the robot: the goals `(K, 3)` (one DMP each; the
-    grasp positions in the grasping task), the target sequence and its switch schedule, the
-    obstacles (None without) and the grasping task's `GraspScene` (None in the others)."""
-
-    objects: np.ndarray
-    targets: tuple
-    switch_schedule: tuple
-    obstacles: typing.Any = None
-    grasps: typing.Any = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -184,31 +167,29 @@ def _check_common(scenario):
         raise ScenarioError(
             f"scenario.method {scenario.method!r} is unknown; choose one of {METHODS}"
             f"{close_match(scenario.method, METHODS)}")
-    if not (np.isfinite(scenario.alpha) and 0.0 <= scenario.alpha <= 1.0):
-        raise ScenarioError(f"scenario.alpha = {scenario.alpha} is outside [0, 1]")
-    require_finite(scenario, "scenario", ("control_period", "duration"))
-    _settings_checked("scenario.dmp", scenario.dmp)
-    _settings_checked("scenario.goal_estimator", scenario.goal_estimator)
-    _settings_checked("scenario.hop", scenario.hop)
+    _checked("scenario.", scenario.validate_settings)
+    require_finite(scenario, "scenario", ("duration",))
     if scenario.goal_estimator.method == "pose" and not isinstance(scenario.task, GraspTask):
         raise ScenarioError("scenario.goal_estimator.method pose reads grasp orientations: "
                             "use it with task: !GraspTask {...}")
-    require_finite(scenario, "scenario", ("dmp_duration",), positive=False)
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_seed(scenario.seed)
     check_count(scenario.likely_paths, "scenario.likely_paths", 0, MAX_LIKELY_PATHS)
 
 
-def _settings_checked(field, settings):
+def _checked(prefix, validate):
+    """Calls `validate`; its ValueError becomes a ScenarioError, `prefix` before it."""
     try:
-        settings.validate()
+        validate()
     except ValueError as error:
-        raise ScenarioError(f"{field}: {error}") from None
+        raise ScenarioError(f"{prefix}{error}") from None
 
 
-def _whole_multiple(value, step):
-    ratio = value / step
-    return round(ratio) >= 1 and abs(ratio - round(ratio)) < 1e-9
+def _with_period(scenario, period):
+    """`scenario` run at `period` (itself when that is its control period)."""
+    if period == scenario.control_period:
+        return scenario
+    return dataclasses.replace(scenario, control_period=period)
 
 
 def _check_method(scenario, goal_count):
@@ -248,9 +229,9 @@ def _check_point_robot(robot):
 
 def _resolve_point_robot(scenario):
     _check_point_robot(scenario.robot)
-    if not _whole_multiple(scenario.control_period, scenario.robot.time_step):
-        raise ScenarioError(
-            "scenario.control_period must be a whole multiple of scenario.robot.time_step")
+    scenario = _with_period(scenario, whole_steps(
+        scenario.control_period, scenario.robot.time_step, "scenario.control_period",
+        "scenario.robot.time_step"))
     if scenario.task is not None or not isinstance(scenario.operator, TOY_OPERATORS):
         raise ScenarioError(
             f"scenario.task and operator !{type(scenario.operator).__name__} need "
@@ -355,9 +336,13 @@ def _resolve_task_robot(scenario):
     check_time_steps([
         (f"{station_field}.plant.time_step", station.plant.time_step),
         (f"{station_field}.diff_ik_time_step", station.diff_ik_time_step)])
-    if not _whole_multiple(scenario.control_period, station.plant.time_step):
-        raise ScenarioError("scenario.control_period must be a whole multiple of "
-                            f"{station_field}.plant.time_step")
+    step, step_field = station.plant.time_step, f"{station_field}.plant.time_step"
+    scenario = _with_period(scenario, whole_steps(
+        scenario.control_period, step, "scenario.control_period", step_field,
+        [station.diff_ik_time_step]))
+    station = dataclasses.replace(station, diff_ik_time_step=whole_steps(
+        station.diff_ik_time_step, step, f"{station_field}.diff_ik_time_step", step_field,
+        [scenario.control_period]))
     operator = scenario.operator
     if isinstance(operator, PILOT_CONFIGS):
         check_pilot(operator)  # its participant's fields too; a population's are ranges
@@ -389,7 +374,7 @@ def _resolve_task_robot(scenario):
     try:
         scene = task_scene(task, scenario.seed, reach)
         if isinstance(robot, Arm):
-            check_clear_of_base(station, _scene_boxes(task, scene, scenario.seed),
+            check_clear_of_base(station, scene_boxes(task, scene, scenario.seed),
                                 "scenario.robot.model_file")
     except ValueError as error:
         raise ScenarioError(f"scenario.task: {error}".replace("scenario.task: scenario.",
@@ -420,13 +405,9 @@ def _resolve_task_robot(scenario):
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
     check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
                        scenario.dmp_duration > 0 else "scenario.robot.speed")
-    controller = PbpControllerConfig(
-        method=scenario.method, alpha=scenario.alpha, control_period=scenario.control_period,
-        dmp=scenario.dmp, dmp_duration=float(duration), nominal_speed=float(robot.speed),
-        goal_estimator=scenario.goal_estimator, hop=scenario.hop,
-        hand_over=HandOverSettings(robot.max_hand_acceleration, robot.max_hand_speed,
-                                   robot.max_hand_yaw_acceleration,
-                                   getattr(robot, "max_heading_turn", float("inf"))))
+    controller = PbpControllerConfig(**{
+        **scenario.control_settings(), "dmp_duration": float(duration),
+        "nominal_speed": float(robot.speed), "hand_over": robot.hand_over()})
     # The DMPs are fitted where they run: by the controller, from `controller`.
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=None,
@@ -446,40 +427,13 @@ def _arm_station(scenario, station):
     return station, initial_ee_state, reach
 
 
-def _scene_boxes(task, scene, seed):
-    """`(what, lower, upper)` of what the task places: given objects as points, the
-    region objects are drawn from, and the obstacles drawn from `seed` (cylinders on the
-    floor) as their boxes."""
-    if isinstance(task, MultiGoalReach) and task.objects:
-        return [(f"scenario.task.objects[{index}] ({', '.join(f'{v:.2f}' for v in point)}) m",
-                 point, point) for index, point in enumerate(scene.objects)]
-    heights = getattr(task, "z_range", None) or [task.height, task.height]
-    names = "z_range" if getattr(task, "z_range", None) else "height"
-    boxes = [(f"scenario.task.x_range, y_range and {names} (where the objects are drawn)",
-              [task.x_range[0], task.y_range[0], heights[0]],
-              [task.x_range[1], task.y_range[1], heights[1]])]
-    for index, (x, y) in enumerate(getattr(scene.obstacles, "obstacle_starts", [])):
-        radius = task.obstacle_radius
-        boxes.append((f"scenario.task's obstacle {index} (drawn with seed {seed} at ({x:.2f}, "
-                      f"{y:.2f}) m, obstacle_radius {radius:g} m)", [x - radius, y - radius, 0.0],
-                      [x + radius, y + radius, task.obstacle_height]))
-    return boxes
-
-
 def _check_hand_over(scenario):
     """The hand-over's limits must let the hand reach the task's speeds (the DMPs' and the
     operator's) within the time limit."""
     robot = scenario.robot
-    try:
-        acceleration = check_limit(robot.max_hand_acceleration,
-                                   "scenario.robot.max_hand_acceleration", "m/s^2")
-        top_speed = check_limit(robot.max_hand_speed, "scenario.robot.max_hand_speed", "m/s")
-        yaw_acceleration = check_limit(robot.max_hand_yaw_acceleration,
-                                       "scenario.robot.max_hand_yaw_acceleration", "rad/s^2")
-        if isinstance(robot, Arm):
-            check_limit(robot.max_heading_turn, "scenario.robot.max_heading_turn", "rad")
-    except ValueError as error:
-        raise ScenarioError(str(error)) from None
+    _checked("scenario.robot.", robot.hand_over().validate)
+    acceleration, top_speed = robot.max_hand_acceleration, robot.max_hand_speed
+    yaw_acceleration = robot.max_hand_yaw_acceleration
     operator_speed, turn = _operator_top_speeds(scenario)
     speed = max(robot.speed, operator_speed)
     if speed > top_speed:
@@ -510,77 +464,3 @@ def _operator_top_speeds(scenario):
         return speed * max(operator.speed_factor), max(operator.rotation_speed)
     participant = getattr(operator, "participant", operator)
     return getattr(participant, "speed", 0.0), getattr(participant, "rotation_speed", 0.0)
-
-
-def task_scene(task, seed, reach=None):
-    """The goals, targets and obstacles of a task, drawn from `seed` when asked. `reach`
-    (an arm's `(shoulder, radius)`) replaces the HSR's reach in the checks of where the
-    goals may be."""
-    if isinstance(task, DynamicObstacles):
-        _check_region(task, reach)
-        obstacles = sample_obstacle_scene(
-            seed, tuple(task.x_range), tuple(task.y_range), task.height,
-            task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
-            tuple(task.activation_range), clearance=task.obstacle_spacing)
-        return TaskScene(objects=obstacles.target[np.newaxis, :], targets=(0,),
-                          switch_schedule=(0.0,), obstacles=obstacles)
-    if isinstance(task, GraspTask):
-        grasps = grasp_scene(task, seed)
-        return TaskScene(objects=grasps.grasp_positions, targets=grasps.targets,
-                          switch_schedule=tuple(task.switch_schedule), grasps=grasps)
-    scene = _reach_scene(task, seed, reach)
-    return TaskScene(objects=scene.objects, targets=scene.targets,
-                      switch_schedule=tuple(task.switch_schedule))
-
-
-def _reach_scene(task, seed, reach):
-    """The objects and target sequence of a reaching task: given, or drawn from the seed."""
-    if task.objects:
-        objects = _validate_within_reach(task.objects, task.min_separation, reach)
-        targets = tuple(int(t) for t in task.targets)
-        if len(task.switch_schedule) > 1 and len(objects) < 2:
-            raise ValueError("target switching needs at least 2 objects: add objects or set "
-                             "switch_schedule to [0.0]")
-        if len(targets) != len(task.switch_schedule):
-            raise ValueError(f"targets {list(targets)} needs one object index per entry of "
-                             f"switch_schedule {task.switch_schedule}")
-        if any(not 0 <= t < len(objects) for t in targets):
-            raise ValueError(f"targets {list(targets)} name objects that do not exist "
-                             f"({len(objects)} objects)")
-        if any(a == b for a, b in zip(targets, targets[1:])):
-            raise ValueError(f"targets {list(targets)}: each switch must go to a different "
-                             "object")
-        return ReachScene(objects=objects, targets=targets)
-    if task.targets:
-        raise ValueError("targets are given without objects")
-    _check_region(task, reach)
-    return sample_reach_scene(seed, tuple(task.object_count), tuple(task.x_range),
-                              tuple(task.y_range), task.height, tuple(task.switch_schedule),
-                              task.min_separation, tuple(getattr(task, "z_range", ())))
-
-
-def _check_region(task, reach):
-    """Every corner of the region the task draws its targets from must be in reach."""
-    if len(task.x_range) != 2 or len(task.y_range) != 2:
-        raise ValueError("x_range and y_range must be [low, high]")
-    heights = getattr(task, "z_range", None) or [task.height]
-    _validate_within_reach([[x, y, z] for x in task.x_range for y in task.y_range
-                            for z in heights], 0.0, reach)
-
-
-def _validate_within_reach(objects, min_separation, reach):
-    """`validate_objects` with the HSR's reach, or with an arm's `(shoulder, radius)`: each
-    point within radius of the shoulder, refused with the reach the arm has."""
-    if reach is None:
-        return validate_objects(objects, min_separation)
-    objects = validate_objects(objects, min_separation, reach_x=(0.0, np.inf),
-                               reach_height=(-np.inf, np.inf))
-    shoulder, radius = reach
-    distances = np.linalg.norm(objects - shoulder, axis=1)
-    farthest = int(np.argmax(distances))
-    if distances[farthest] > radius:
-        point = ", ".join(f"{value:.2f}" for value in objects[farthest])
-        raise ValueError(f"({point}) m is {distances[farthest]:.2f} m from the arm's "
-                         f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), beyond "
-                         f"its reach of {radius:.2f} m")
-    return objects

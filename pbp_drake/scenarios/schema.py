@@ -16,6 +16,7 @@ station). `pbp_drake.scenarios.resolve` checks and derives everything else.
 
 import copyreg
 import dataclasses
+import math
 import typing
 
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
@@ -23,10 +24,8 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.visualization import VisualizationConfig
 
-from pbp_drake.core.controller_config import HandOverSettings, PbpControllerConfig
-from pbp_drake.core.dmp import DmpSettings
-from pbp_drake.core.goal_estimation import GoalEstimatorSettings
-from pbp_drake.core.hindsight_optimization import HopSettings
+from pbp_drake.core.controller_config import (
+    ControlSettings, HandLimits, HandOverSettings, PbpControllerConfig)
 from pbp_drake.robots.arm_station_config import ArmStationConfig
 from pbp_drake.robots.hsr_station_config import HsrStationConfig
 from pbp_drake.systems.operators.gamepad_operator import GamepadParams
@@ -50,6 +49,15 @@ def _reduce_config(config):
 # they travel as their YAML.
 for _config_type in (MultibodyPlantConfig, SimulatorConfig, VisualizationConfig):
     copyreg.pickle(_config_type, _reduce_config)
+
+
+#: The metadata key of a `[low, high]` field: one number there is the range [n, n].
+RANGE = "range"
+
+
+def range_field(*low_high):
+    """A `[low, high]` field (empty: none) that also takes one number, exactly it."""
+    return dataclasses.field(default_factory=lambda: list(low_high), metadata={RANGE: True})
 
 
 class ScenarioError(ValueError):
@@ -102,44 +110,39 @@ class PointRobot(PointRobotParams):
 
 
 @dataclasses.dataclass
-class Hsr:
+class TaskRobot(HandLimits):
+    """What the HSR and an arm share: the hand-over law's limits (`HandLimits`) and the
+    DMPs' nominal speed; the controller takes them (`PbpControllerConfig.nominal_speed`,
+    `hand_over`)."""
+
+    #: The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over
+    #: it, and operators whose speed is 0 move the hand at it.
+    speed: float = PbpControllerConfig.nominal_speed
+
+    def hand_over(self):
+        """The controller's `HandOverSettings`: these limits, and the heading's bound where
+        the robot has one."""
+        return HandOverSettings(**{field.name: getattr(self, field.name, math.inf)
+                                   for field in dataclasses.fields(HandOverSettings)})
+
+
+@dataclasses.dataclass
+class Hsr(TaskRobot):
     """`robot: !Hsr {...}`: the simulated Toyota HSR (our primitive-shape model) under
     whole-body differential IK; the PBP loop commands its end effector in task space."""
 
     #: What the HSR station is built from (see HsrStationConfig).
     station: HsrStationConfig = dataclasses.field(default_factory=HsrStationConfig)
-    #: The DMPs' nominal speed (m/s): their duration is the farthest goal's distance over it,
-    #: and operators whose speed is 0 move the hand at it.
-    speed: float = PbpControllerConfig.nominal_speed
-    #: The hand-over law (`pbp_drake.core.hand_over`): a goal switch, the operator pressing
-    #: or releasing changes the hand's commanded velocity by at most max_hand_acceleration
-    #: (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command never exceeds
-    #: max_hand_speed (m/s), however far a primitive is from its attractor. 0.2 m/s is the
-    #: base's published speed limit: a hand driven faster for long runs its arm out of
-    #: range, and the whole-body IK then lurches.
-    max_hand_acceleration: float = HandOverSettings.max_hand_acceleration
-    #: The fastest commanded hand speed (m/s).
-    max_hand_speed: float = HandOverSettings.max_hand_speed
-    #: The same for the hand's heading (rad/s^2): the operator starting or stopping a turn.
-    max_hand_yaw_acceleration: float = HandOverSettings.max_hand_yaw_acceleration
 
 
 @dataclasses.dataclass
-class Arm(ArmStationConfig):
+class Arm(ArmStationConfig, TaskRobot):
     """`robot: !Arm {model_file: ..., base_frame: ..., ee_frame: ...}`: a fixed-base arm
     from a URDF or SDFormat file (ours, `package://pbp_drake_models/arm7/pbp_arm7.urdf`,
     or a user's own) under differential IK; every field of ArmStationConfig, and the
-    controller's speed and hand-over limits as the HSR's. The task sets the station's
-    command_period (the control period) and obstacles (the obstacle task's cylinders)."""
+    HSR's speed and hand-over limits. The task sets the station's command_period (the
+    control period) and obstacles (the obstacle task's cylinders)."""
 
-    #: The DMPs' nominal speed (m/s), as the HSR's.
-    speed: float = PbpControllerConfig.nominal_speed
-    #: The fastest change of the commanded hand velocity (m/s^2), as the HSR's.
-    max_hand_acceleration: float = HandOverSettings.max_hand_acceleration
-    #: The fastest commanded hand speed (m/s).
-    max_hand_speed: float = HandOverSettings.max_hand_speed
-    #: The same for the hand's heading (rad/s^2).
-    max_hand_yaw_acceleration: float = HandOverSettings.max_hand_yaw_acceleration
     #: How far (rad) the hand's heading may turn either way from its start: a wrist's
     #: turn is bounded, and past about 90 degrees the tool points back at the arm.
     max_heading_turn: float = 1.2
@@ -266,18 +269,19 @@ class MultiGoalReach:
     a rectangle in front of the robot at one height; the target switches to another object
     at each progress threshold of `switch_schedule` after the first (0 %)."""
 
-    #: The range [min, max] of how many objects are drawn (a count).
-    object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
+    #: The range [min, max] of how many objects are drawn (a count); one number: exactly
+    #: that many.
+    object_count: list[int] = range_field(2, 4)
     #: The objects' x range (m).
-    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    x_range: list[float] = range_field(1.25, 2.5)
     #: The objects' y range (m).
-    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    y_range: list[float] = range_field(-1.05, 1.05)
     #: The objects' and the HSR hand's height (m).
     height: float = 0.7
     #: The objects' height range [min, max] (m), drawn per object; empty: all at height.
     #: The hand then starts where the robot's ready pose puts it, and the operators get
     #: up and down keys.
-    z_range: list[float] = dataclasses.field(default_factory=list)
+    z_range: list[float] = range_field()
     #: The least distance between two objects (m).
     min_separation: float = 0.2
     #: The progress fractions (0 to 1) at which the target switches.
@@ -300,9 +304,9 @@ class DynamicObstacles:
     geometry and do not push the robot."""
 
     #: The target's x range (m).
-    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    x_range: list[float] = range_field(1.25, 2.5)
     #: The target's y range (m).
-    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    y_range: list[float] = range_field(-1.05, 1.05)
     #: The target's and the hand's height (m).
     height: float = 0.7
     #: The hand within this distance (m) of the target is a success.
@@ -316,11 +320,11 @@ class DynamicObstacles:
     #: The obstacles' speed once they move (m/s).
     obstacle_speed: float = 0.15
     #: The obstacles' starting x range (m).
-    obstacle_x_range: list[float] = dataclasses.field(default_factory=lambda: [0.9, 2.6])
+    obstacle_x_range: list[float] = range_field(0.9, 2.6)
     #: The obstacles' starting y range (m).
-    obstacle_y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.3, 1.3])
+    obstacle_y_range: list[float] = range_field(-1.3, 1.3)
     #: The progress fractions (0 to 1) between which each obstacle's start threshold is drawn.
-    activation_range: list[float] = dataclasses.field(default_factory=lambda: [0.05, 0.5])
+    activation_range: list[float] = range_field(0.05, 0.5)
     #: Obstacles start at least this far (m) from the robot's base, the target and each
     #: other (the HSR's scene; an arm's workspace takes less).
     obstacle_spacing: float = 0.45
@@ -335,13 +339,14 @@ class GraspTask:
     target's grasp position and within `success_angle` of its grasp orientation. It runs
     on the pose station (`pbp_drake.builder.grasp`) with the virtual participant."""
 
-    #: The range [min, max] of how many objects are drawn (a count).
-    object_count: list[int] = dataclasses.field(default_factory=lambda: [2, 4])
+    #: The range [min, max] of how many objects are drawn (a count); one number: exactly
+    #: that many.
+    object_count: list[int] = range_field(2, 4)
     #: The tables' centres are drawn in this rectangle (m), min_separation apart (at least
     #: the tables' diagonal, so that no two overlap).
-    x_range: list[float] = dataclasses.field(default_factory=lambda: [1.25, 2.5])
+    x_range: list[float] = range_field(1.25, 2.5)
     #: The tables' y range (m), as `x_range`.
-    y_range: list[float] = dataclasses.field(default_factory=lambda: [-1.05, 1.05])
+    y_range: list[float] = range_field(-1.05, 1.05)
     #: The least distance between two tables' centres (m).
     min_separation: float = 0.45
     #: The height (m) the hand starts at (the station's ready pose), as the reach task's.
@@ -358,10 +363,10 @@ class GraspTask:
     top_probability: float = 0.5
     #: Side grasps approach horizontally at a yaw (degrees, counter-clockwise from the
     #: direction the robot faces) drawn here; inside [-90, 90].
-    approach_yaw_range: list[float] = dataclasses.field(default_factory=lambda: [-60.0, 60.0])
+    approach_yaw_range: list[float] = range_field(-60.0, 60.0)
     #: Top grasps approach straight down with a wrist roll (degrees) drawn here; inside
     #: [-180, 180].
-    roll_range: list[float] = dataclasses.field(default_factory=lambda: [-90.0, 90.0])
+    roll_range: list[float] = range_field(-90.0, 90.0)
     #: The palm stands this far (m) behind the point the fingers close on.
     grasp_depth: float = 0.08
     #: The progress fractions (0 to 1) at which the target switches.
@@ -374,17 +379,12 @@ class GraspTask:
 
 
 @dataclasses.dataclass
-class Scenario:
-    """Everything one simulation needs."""
+class Scenario(ControlSettings):
+    """Everything one simulation needs: the controller's settings (`ControlSettings`:
+    method, alpha, control_period, dmp, dmp_duration, goal_estimator, hop) and the rest."""
 
     #: The scenario's name (in outputs and the console).
     name: str = "scenario"
-    #: One of METHODS.
-    method: str = "pbp_alternated"
-    #: The arbitration weight of `fixed_alpha`, in [0, 1].
-    alpha: float = 0.5
-    #: The control tick's period (s).
-    control_period: float = 0.01
     #: The time limit (s) of a run.
     duration: float = 2.0
     #: The robot: the toy point robot (untagged), `!Hsr` or `!Arm`.
@@ -395,11 +395,6 @@ class Scenario:
     goals: list[list[float]] = dataclasses.field(default_factory=list)
     #: The demonstration the DMPs learn from; none: straight paths.
     demonstration: typing.Optional[typing.Union[BentPath, RecordedPath]] = None
-    #: The DMPs' gains and basis (DmpSettings).
-    dmp: DmpSettings = dataclasses.field(default_factory=DmpSettings)
-    #: The DMPs' duration tau (s); 0 takes the demonstration's duration (2-D scenes) or the
-    #: farthest goal's distance over `robot.speed` (HSR).
-    dmp_duration: float = 0.0
     #: The 2-D scenes' obstacles (discs).
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     #: Who drives the robot: a tagged operator variant; untagged: none.
@@ -408,12 +403,6 @@ class Scenario:
     #: An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,
     #: `!GraspTask {...}` the grasping task.
     task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles, GraspTask]] = None
-    #: How the followed goal is estimated (GoalEstimatorSettings).
-    goal_estimator: GoalEstimatorSettings = dataclasses.field(
-        default_factory=GoalEstimatorSettings)
-    #: HOP's cost model, goal posterior and assistance (HopSettings), read by the hop and
-    #: predict_then_assist methods and the maxent_command goal estimator.
-    hop: HopSettings = dataclasses.field(default_factory=HopSettings)
     #: The seed of every random draw (an integer).
     seed: int = 0
     #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets

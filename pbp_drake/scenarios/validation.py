@@ -1,325 +1,18 @@
-"""The checks of a scenario file, in the order loading meets them:
-
-1. its text, before and around Drake's YAML loader (`read_scenario_text`,
-   `describe_load_error`), so that every broken file ends in a message that names the file
-   and the line or the field;
-2. its mappings walked next to the schema (`shape_problem`), for what Drake's loader
-   misreports;
-3. its numbers, before anything is computed from them (`check_numbers`,
-   `check_time_steps`, the seed, the tasks' ranges and counts).
-
-Each raises (or returns the words of) a ScenarioError as `field.path: what is wrong, what is
-expected`.
+"""The checks of a scenario's numbers, before anything is computed from them: every number
+finite and of a sane size (`check_numbers`), time steps, the seed, the tasks' ranges and
+counts, the operators' fields. Each raises a ScenarioError as `field.path: what is wrong,
+what is expected`.
 """
 
 import dataclasses
-import difflib
 import math
 import numbers
-import re
-import types
-import typing
 
 import numpy as np
 
 from pbp_drake.core.pilot_population import ParticipantPopulationParams, population_problem
 from pbp_drake.core.surrogate_pilots import ProportionalPilotParams
-from pbp_drake.scenarios.bounds import read_bounded
 from pbp_drake.scenarios.schema import ScenarioError
-
-
-# ---------------------------------------------------------------------------------------------
-# 1. The file's text, before and around Drake's YAML loader.
-
-
-_BLOCK_KEY = re.compile(r"^( *)((?:- +)*)([A-Za-z_][\w.-]*|\"[^\"]*\"|'[^']*') *:(?: |$)")
-_MERGE_FRAME = "_merge_yaml_dict_item_into_target"
-
-
-def read_scenario_text(path):
-    """The file's text; raises ScenarioError (without the file's name) for a file over
-    MOST_FILE_BYTES, a binary or non-UTF-8 file, a tab in the indentation or no scenario
-    at all (then `check_duplicate_keys`)."""
-    data = read_bounded(path)
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise ScenarioError("the file is UTF-16 encoded; save it as UTF-8 text")
-    if b"\0" in data:
-        raise ScenarioError("a binary file (it holds NUL bytes), not a YAML scenario file; "
-                            "expected UTF-8 text")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise ScenarioError(f"byte {error.start} is not UTF-8 (a binary file?); expected "
-                            "UTF-8 text") from None
-    for number, line in enumerate(text.splitlines(), 1):
-        indent = line[:len(line) - len(line.lstrip(" \t"))]
-        if "\t" in indent and line.strip():
-            raise ScenarioError(f"line {number}: a tab in the indentation; YAML indents with "
-                                "spaces only")
-    if all(not line.strip() or line.lstrip().startswith("#") for line in text.splitlines()):
-        # Drake's loader reads an empty document as None and fails with a TypeError.
-        raise ScenarioError("the file is empty; expected a scenario file starting with "
-                            "`scenario:`")
-    return text
-
-
-def check_duplicate_keys(text):
-    """Raises ScenarioError naming the line of the second of two equal keys of one mapping,
-    in block mappings (by indentation) and in flow mappings `{a: 1, a: 2}`."""
-    _check_flow_keys(text)
-    stack = []  # (column, {key: line}) of the open block mappings, innermost last
-    block_scalar = None  # the indentation a `|` or `>` scalar's lines must exceed
-    flow_depths = _flow_depth_by_line(text)
-    for number, line in enumerate(text.splitlines(), 1):
-        stripped = line.strip()
-        column = len(line) - len(line.lstrip(" "))
-        if block_scalar is not None:
-            if not stripped or column > block_scalar:
-                continue
-            block_scalar = None
-        if not stripped or stripped.startswith("#") or flow_depths[number] > 0:
-            continue
-        match = _BLOCK_KEY.match(line)
-        if not match:
-            continue
-        key_column = match.start(3)
-        key = match.group(3).strip("\"'")
-        new_item = bool(match.group(2))
-        while stack and (stack[-1][0] > key_column
-                         or (new_item and stack[-1][0] == key_column)):
-            stack.pop()
-        if not stack or stack[-1][0] < key_column:
-            stack.append((key_column, {}))
-        keys = stack[-1][1]
-        if key in keys:
-            raise ScenarioError(f"line {number}: duplicate key {key!r} (first on line "
-                                f"{keys[key]}); each key may appear once in a mapping")
-        keys[key] = number
-        rest = line[match.end():].split(" #")[0].strip()
-        if re.fullmatch(r"[|>][-+0-9]*", rest):
-            block_scalar = key_column if new_item else column
-
-
-def _flow_depth_by_line(text):
-    """For each line (1-based), the number of `{`/`[` open at its start."""
-    depths, depth, quote = [0, 0], 0, None
-    for line in text.splitlines():
-        depths.append(depth)
-        index = 0
-        while index < len(line):
-            char = line[index]
-            if quote:
-                if char == quote:
-                    quote = None
-            elif char in "\"'" and (index == 0 or line[index - 1] in " ,[{:"):
-                quote = char
-            elif char == "#" and (index == 0 or line[index - 1] in " \t"):
-                break
-            elif char in "[{":
-                depth += 1
-            elif char in "]}":
-                depth = max(depth - 1, 0)
-            index += 1
-    return depths
-
-
-def _check_flow_keys(text):
-    """Duplicate keys inside `{...}`: a key is what stands between `{` or `,` and `: `."""
-    stack = []  # per open bracket: None for `[`, {key: line} for `{`
-    entry = None  # (start line, characters) of the entry being read in the innermost `{`
-    quote = None
-    for number, line in enumerate(text.splitlines(), 1):
-        for index, char in enumerate(line):
-            if quote:
-                if char == quote:
-                    quote = None
-                if entry is not None:
-                    entry[1].append(char)
-                continue
-            if char == "#" and (index == 0 or line[index - 1] in " \t"):
-                break
-            if char in "\"'" and (index == 0 or line[index - 1] in " ,[{:"):
-                quote = char
-            if char in "[{":
-                stack.append({} if char == "{" else None)
-                entry = [None, []] if char == "{" else None
-            elif char in "]}":
-                if stack:
-                    stack.pop()
-                entry = None
-            elif char == "," and stack and stack[-1] is not None:
-                entry = [None, []]
-            elif (char == ":" and entry is not None and stack and stack[-1] is not None
-                  and line[index + 1:index + 2] in ("", " ", ",", "}")):
-                key = "".join(entry[1]).strip().strip("\"'")
-                keys = stack[-1]
-                where = entry[0] or number
-                if key in keys:
-                    raise ScenarioError(f"line {where}: duplicate key {key!r} (first on line "
-                                        f"{keys[key]}); each key may appear once in a mapping")
-                keys[key] = where
-                entry = None
-            elif entry is not None:
-                if entry[0] is None and not char.isspace():
-                    entry[0] = number
-                entry[1].append(char)
-        if entry is not None:
-            entry[1].append(" ")
-
-
-def describe_load_error(error):
-    """What `yaml_load_typed` raised, as `line L, column C: ...` (a YAML syntax error) or
-    `field.path: what is wrong; expected ...` (a value of the wrong type)."""
-    mark = getattr(error, "problem_mark", None)
-    if mark is not None:
-        problem = getattr(error, "problem", None) or str(error)
-        context = getattr(error, "context", None)
-        context_mark = getattr(error, "context_mark", None)
-        where = (f" ({context} at line {context_mark.line + 1}, column "
-                 f"{context_mark.column + 1})" if context and context_mark else "")
-        return (f"line {mark.line + 1}, column {mark.column + 1}: YAML syntax error: "
-                f"{problem}{where}")
-    names, frame = [], None
-    traceback = error.__traceback__
-    while traceback is not None:
-        if traceback.tb_frame.f_code.co_name == _MERGE_FRAME:
-            frame = traceback.tb_frame.f_locals
-            if not names or names[-1] != str(frame.get("name")):  # a Union: one field twice
-                names.append(str(frame.get("name")))
-        traceback = traceback.tb_next
-    if frame is None:
-        return f"{type(error).__name__}: {error}"
-    value = frame.get("yaml_value")
-    given = "nothing (an empty value)" if value is None else f"{value!r}"
-    return (f"{'.'.join(names)}: got {given}; expected "
-            f"{_describe_schema(frame.get('value_schema'))}")
-
-
-def _describe_schema(schema):
-    optional = typing.get_args(schema) if typing.get_origin(schema) is typing.Union else ()
-    inner = [arg for arg in optional if arg is not type(None)]
-    if len(inner) == 1:
-        schema = inner[0]
-    names = {float: "a number", int: "an integer", str: "a string", bool: "true or false"}
-    if schema in names:
-        return names[schema]
-    origin = typing.get_origin(schema)
-    if origin in (list, tuple, typing.List):
-        args = typing.get_args(schema)
-        return f"a list, each item {_describe_schema(args[0])}" if args else "a list"
-    if origin is dict:
-        return "a mapping"
-    if dataclasses.is_dataclass(schema):
-        return f"a mapping of the fields of {schema.__name__}"
-    return f"a value of type {schema}"
-
-
-# ---------------------------------------------------------------------------------------------
-# 2. The file's mappings walked next to its schema, for what Drake's loader misreports.
-
-
-def shape_problem(data, schema):
-    """`field.path: what is wrong; expected ...` for the first unknown key, or value that
-    is not a mapping where the schema has one, of the YAML document `data` (as
-    `bounds.load_document` reads it) read as `schema`; None when there is none."""
-    if not isinstance(data, dict):
-        return None
-    return _first_problem(data, schema, "")
-
-
-def _field_types(schema):
-    """{name: type} of a dataclass or of a Drake config struct, None for anything else."""
-    if dataclasses.is_dataclass(schema):
-        try:
-            hints = typing.get_type_hints(schema)
-        except Exception:  # noqa: BLE001 - an annotation that does not resolve: as written
-            hints = {}
-        return {field.name: hints.get(field.name, field.type)
-                for field in dataclasses.fields(schema)}
-    fields = getattr(schema, "__fields__", None)
-    if fields is not None and isinstance(schema, type):
-        return {field.name: field.type for field in fields}
-    return None
-
-
-def _members(schema):
-    """The types a Union (or Optional) field can hold, without None; [schema] otherwise."""
-    if typing.get_origin(schema) not in (typing.Union, types.UnionType):
-        return [schema]
-    return [member for member in typing.get_args(schema) if member is not type(None)]
-
-
-def _variant(schema, node):
-    """The schema a node is read as: a Union's member chosen by the node's tag (the first
-    member when untagged, as Drake's loader does); None for an unknown tag."""
-    members = _members(schema)
-    tag = node.get("_tag", "").lstrip("!") if isinstance(node, dict) else ""
-    for member in members:
-        if tag and getattr(member, "__name__", "") == tag:
-            return member
-    return members[0] if members and not tag else None
-
-
-def _mapping_expected(schema, node, field):
-    names = [member.__name__ for member in _members(schema)]
-    if len(names) == 1:
-        expected = f"a mapping of the fields of {names[0]}"
-    else:
-        expected = (f"a mapping, tagged with one of {', '.join('!' + n for n in names)} "
-                    f"(untagged: {names[0]})")
-    given = "nothing (an empty value)" if node is None else f"{node!r}"
-    return f"{field}: got {given}; expected {expected}"
-
-
-def _unknown_tag(schema, node, field):
-    """`field: the tag !X is unknown; ...` (with did-you-mean) for a node whose tag names
-    none of the Union's members, else None."""
-    tag = node.get("_tag", "") if isinstance(node, dict) else ""
-    if not tag:
-        return None
-    tags = ["!" + getattr(member, "__name__", "") for member in _members(schema)]
-    matches = difflib.get_close_matches(tag, tags, n=1)
-    hint = f" (did you mean {matches[0]}?)" if matches else ""
-    return f"{field}: the tag {tag} is unknown; expected one of {', '.join(tags)}{hint}"
-
-
-def _first_problem(node, schema, field):
-    optional = type(None) in typing.get_args(schema)
-    variant = _variant(schema, node)
-    if variant is None:
-        return _unknown_tag(schema, node, field)
-    if node is None and optional:
-        return None
-    types_of = _field_types(variant)
-    if types_of is not None:
-        if not isinstance(node, dict):
-            return _mapping_expected(schema, node, field or "the file's top level")
-        for key, value in node.items():
-            if key == "_tag":
-                continue
-            if key not in types_of:
-                return _unknown_key(field, key, list(types_of))
-            found = _first_problem(value, types_of[key], f"{field}.{key}" if field else key)
-            if found:
-                return found
-    elif isinstance(node, list) and typing.get_origin(variant) is list:
-        for index, item in enumerate(node):
-            found = _first_problem(item, typing.get_args(variant)[0], f"{field}[{index}]")
-            if found:
-                return found
-    return None
-
-
-def _unknown_key(field, key, known):
-    matches = difflib.get_close_matches(key, [name for name in known if name != key], n=1)
-    suggestion = f" (did you mean {matches[0]!r}?)" if matches else ""
-    where = field or "the file's top level"
-    return (f"{where}: unknown key {key!r}{suggestion}; expected one of "
-            f"{', '.join(sorted(known))}")
-
-
-# ---------------------------------------------------------------------------------------------
-# 3. The numbers, before anything is computed from them.
 
 
 # No length, time, gain or speed of a scenario comes near this; beyond it a norm or a
@@ -573,3 +266,35 @@ def check_pilot(operator, field="scenario.operator"):
                        ("speed", "rotation_speed", "reaction_delay", "direction_noise",
                         "speed_noise"), positive=False)
         check_virtual_participant(participant, f"{field}.participant")
+
+
+#: A period within this fraction of a whole multiple of its time step runs at that
+#: multiple: the paper's 30 Hz, 0.0333 s, is 10 plant steps of 0.0033333 s.
+PERIOD_TOLERANCE = 0.002
+#: The most time steps a suggested step puts in the control period.
+MOST_STEPS_SUGGESTED = 100
+
+
+def whole_steps(period, step, field, step_field, others=()):
+    """`period` (s) as a whole multiple of `step`: itself when it is one, the nearest one
+    within PERIOD_TOLERANCE, else ScenarioError with both values and a step dividing
+    `period` (and each of `others`, the periods that share the step)."""
+    count = _steps(period, step)
+    if count is not None:
+        return period if _steps(period, step, 1e-9) else count * step
+    nearest = sorted({max(1, math.floor(period / step)), max(1, math.ceil(period / step))})
+    divisors = (period / count for count in range(nearest[0], MOST_STEPS_SUGGESTED + 1))
+    divisor = next((divisor for divisor in divisors if divisor <= step and all(
+        _steps(other, divisor) is not None for other in others)), None)
+    hint = (f", or a {step_field} of {divisor:.5g} s ({round(period / divisor)} steps)"
+            if divisor else "")
+    raise ScenarioError(
+        f"{field} {period:g} s is {period / step:.4g} steps of {step_field} {step:g} s; "
+        f"expected a whole multiple of it (within {PERIOD_TOLERANCE:.1%}): "
+        f"{' or '.join(f'{count * step:g} s' for count in nearest)}{hint}")
+
+
+def _steps(period, step, tolerance=PERIOD_TOLERANCE):
+    """How many `step`s make `period` within `tolerance` of it; None if no whole number."""
+    count = round(period / step)
+    return count if count >= 1 and abs(period - count * step) <= tolerance * period else None

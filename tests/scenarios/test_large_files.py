@@ -162,10 +162,10 @@ def test_ten_thousand_goals_at_full_precision_load_within_the_cap(tmp_path):
 def test_the_c_loader_reads_every_shipped_file_as_drake_does(path, monkeypatch):
     text = path.read_text()
     drake = yaml_dump_typed(yaml_load_typed(schema=ScenarioFile, data=text))
-    assert yaml_dump_typed(load_typed(ScenarioFile, load_document(text), text)) == drake
+    assert yaml_dump_typed(load_typed(ScenarioFile, load_document(text))) == drake
     # A Drake without the typed loader's pieces: its own yaml_load_typed, the same file.
     monkeypatch.setattr(bounds, "drake_yaml", types.SimpleNamespace())
-    assert yaml_dump_typed(load_typed(ScenarioFile, load_document(text), text)) == drake
+    assert yaml_dump_typed(load_typed(ScenarioFile, load_document(text))) == drake
 
 
 # The memory a refusal may take beyond the imports, and all told: a few hundred MB at most

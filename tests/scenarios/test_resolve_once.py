@@ -8,8 +8,8 @@ import pytest
 
 import pbp_drake.core.dmp.bank as dmp_bank_module
 import pbp_drake.core.dmp.single as single_dmp_module
-import pbp_drake.scenarios.grasp_scene as grasp_scene_module
 import pbp_drake.scenarios.resolution as resolve_module
+import pbp_drake.scenarios.task_scenes as task_scenes_module
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import BentPath, load_scenario_file
 from pbp_drake.studies.runners import compute_trial
@@ -18,8 +18,9 @@ SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.ya
 # Where each piece of work is done, by the name the caller looks it up under.
 COUNTED = [(resolve_module, "bent_path"), (dmp_bank_module, "fit_weights"),
            (single_dmp_module, "fit_weights"),
-           (resolve_module, "sample_reach_scene"), (resolve_module, "sample_obstacle_scene"),
-           (grasp_scene_module, "sample_grasp_scene")]
+           (task_scenes_module, "sample_reach_scene"),
+           (task_scenes_module, "sample_obstacle_scene"),
+           (task_scenes_module, "sample_grasp_scene")]
 
 
 @pytest.fixture

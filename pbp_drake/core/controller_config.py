@@ -14,14 +14,10 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.dmp import DmpBankModel, DmpSettings
-from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.goal_estimation import READS_POSE, GoalEstimatorSettings, estimator_entry
 from pbp_drake.core.hand_over import check_limit
-from pbp_drake.core.hindsight_optimization import HOP_METHODS, HopSettings
-
-# The methods a task robot's controller runs (the toy robot's demonstration player,
-# fixed_alpha with a demonstration, is the 2-D scenes' own).
-CONTROLLER_METHODS = ("pbp_alternated", "pbp_continuous", "pbp_no_user", "fixed_alpha",
-                      "confidence_alpha", "teleop") + tuple(HOP_METHODS)
+from pbp_drake.core.hindsight_optimization import HopSettings
+from pbp_drake.core.methods import method_entry
 
 
 @dataclasses.dataclass
@@ -57,8 +53,9 @@ class PbpControllerConfig:
     """Everything `make_pbp_controller` builds from; one default per knob, the scenario
     file's."""
 
-    #: One of CONTROLLER_METHODS: PBP alternated or continuous, PBP with no operator,
-    #: explicit arbitration (fixed or confidence alpha), teleop, or the HOP baselines.
+    #: A method of the registry (`pbp_drake.core.methods.METHODS`): PBP alternated or
+    #: continuous, PBP with no operator, explicit arbitration (fixed or confidence alpha),
+    #: teleop, or the HOP baselines.
     method: str = "pbp_alternated"
     #: The arbitration weight of fixed_alpha, in [0, 1].
     alpha: float = 0.5
@@ -81,8 +78,7 @@ class PbpControllerConfig:
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
-        if self.method not in CONTROLLER_METHODS:
-            raise ValueError(f"method {self.method!r} is not one of {CONTROLLER_METHODS}")
+        method_entry(self.method)
         if not (np.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
             raise ValueError(f"alpha must lie in [0, 1], got {self.alpha!r}")
         check_limit(self.control_period, "control_period", "s")
@@ -95,17 +91,15 @@ class PbpControllerConfig:
                 getattr(self, name).validate()
             except ValueError as error:
                 raise ValueError(f"{name}.{error}") from None
-        if self.goal_estimator.method == "pose":
-            raise ValueError("goal_estimator.method pose reads grasp orientations, which a "
-                             "position controller has not")
+        if estimator_entry(self.goal_estimator.method).reads == READS_POSE:
+            raise ValueError(f"goal_estimator.method {self.goal_estimator.method} reads grasp "
+                             f"orientations, which a position controller has not")
 
     @property
     def blend_mode(self):
-        """The blender's mode (PBP-NoUser is PBP-Cont with no operator); None for the HOP
-        baselines, which have no blender."""
-        if self.method in HOP_METHODS:
-            return None
-        return "pbp_continuous" if self.method == "pbp_no_user" else self.method
+        """The blender's mode (`Method.blend_mode`); None for the HOP baselines, which have
+        no blender."""
+        return method_entry(self.method).blend_mode
 
     def dmp_bank(self, start, goals):
         """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, of

@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
-from pbp_drake.core.methods import method_colour  # noqa: E402
+from pbp_drake.core.methods import method_colour, methods_of  # noqa: E402
 from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
 from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
 
@@ -240,7 +240,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
         results = summary["scenes"][index]["by_operator_speed"]
         for speed, target in zip(speeds, pbp_axes):
             outcomes = results[speed]
-            for method, style in (("pbp_alternated", "-"), ("pbp_continuous", "--")):
+            for method, style in zip(methods_of("pbp"), ("-", "--")):
                 positions = trajectories[(scene.name, speed, method)]
                 target.plot(positions[:, 0], positions[:, 1], style, color=colour, lw=1.5,
                             label=f"{scene.name} {METHOD_LABELS[method]}: "

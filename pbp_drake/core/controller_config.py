@@ -17,7 +17,7 @@ from pbp_drake.core.dmp import DmpBankModel, DmpSettings
 from pbp_drake.core.goal_estimation import READS_POSE, GoalEstimatorSettings, estimator_entry
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.hindsight_optimization import HopSettings
-from pbp_drake.core.methods import method_entry
+from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_names
 
 
 @dataclasses.dataclass
@@ -78,7 +78,9 @@ class PbpControllerConfig:
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
-        method_entry(self.method)
+        if self.method not in METHODS:
+            raise ValueError(f"method {self.method!r} is not one of {method_names()}"
+                             f"{did_you_mean(self.method, METHODS)}")
         if not (np.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
             raise ValueError(f"alpha must lie in [0, 1], got {self.alpha!r}")
         check_limit(self.control_period, "control_period", "s")

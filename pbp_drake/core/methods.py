@@ -20,7 +20,6 @@ from pbp_drake.core.hindsight_optimization import ASSISTANCE_WEIGHTS
 BLENDED = "blended"
 #: ... or HOP's posterior and its assistance, added to the operator's command.
 ASSISTED = "assisted"
-POLICIES = (BLENDED, ASSISTED)
 
 
 def _always(settings):
@@ -81,8 +80,8 @@ class Method:
 
     @property
     def policy(self):
-        """What the builder builds for it (`POLICIES`): the DMPs and a blender, or HOP's
-        assistance."""
+        """What the builder builds for it: the DMPs and a blender (`BLENDED`), or HOP's
+        assistance (`ASSISTED`)."""
         return BLENDED if self.assistance is None else ASSISTED
 
     @property
@@ -143,11 +142,6 @@ def method_entry(name, field="method"):
         raise ValueError(f"{field} {name!r} is unknown; choose one of {method_names()}"
                          f"{did_you_mean(name, METHODS)}")
     return METHODS[name]
-
-
-def method_label(name):
-    """What a person reads for the method `name`; an unknown name reads as itself."""
-    return METHODS[name].label if name in METHODS else name
 
 
 def method_colour(name, default=None):

@@ -40,6 +40,7 @@ from pbp_drake.scenarios.validation import (
     check_grasp_task, check_numbers, check_obstacle_task, check_reach_task, check_seed,
     check_pilot, check_time_steps, check_virtual_participant, require_finite)
 
+
 @dataclasses.dataclass(frozen=True)
 class TaskScene:
     """What an HSR task puts in front of the robot: the goals `(K, 3)` (one DMP each; the

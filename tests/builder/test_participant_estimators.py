@@ -56,7 +56,7 @@ def test_every_estimator_follows_the_participant_to_the_target(task, method, est
 def test_on_the_arm_the_participant_gets_there_under_pbp_alt(estimator):
     """The arm's wrist turns 1.2 rad either way: insisting, the participant turns the
     target to the side the wrist reaches and sidesteps onto it (evaluation seed 10,000,
-    which it once spent pushing against the wrist's bound until the time ran out)."""
+    where the shorter turn's side lies beyond the wrist's bound, the target ahead)."""
     scenario = load_scenario_file(
         pathlib.Path(__file__).resolve().parents[2] / "diagrams/arm_reach.yaml").scenario
     scenario = dataclasses.replace(scenario, method="pbp_alternated", seed=10_000,

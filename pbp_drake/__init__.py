@@ -39,6 +39,12 @@ API_GROUPS = {
         "ParticipantImpairment": "pbp_drake.core.participant_impairment",
         "GraspParticipantParams": "pbp_drake.core.participant_grasp",
     },
+    "Methods and goal estimators (registries)": {
+        "Method": "pbp_drake.core.methods",
+        "register_method": "pbp_drake.core.methods",
+        "Estimator": "pbp_drake.core.goal_estimation",
+        "register_estimator": "pbp_drake.core.goal_estimation",
+    },
     "Shared-autonomy baselines (HOP, predict-then-assist)": {
         "HopSettings": "pbp_drake.core.hindsight_optimization",
         "hop_targets": "pbp_drake.core.hindsight_optimization",

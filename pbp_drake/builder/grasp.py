@@ -45,7 +45,8 @@ from pbp_drake.builder.operators import shown_intent_and_keys
 from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.grasp_task import approach_direction
-from pbp_drake.core.hindsight_optimization import HOP_METHODS
+from pbp_drake.core.goal_estimation import READS_COMMAND, estimator_entry
+from pbp_drake.core.methods import ASSISTED, METHODS
 from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
 from pbp_drake.core.pose_arbitration import HandOverLimits
 from pbp_drake.core.quaternion import angle_between
@@ -134,12 +135,13 @@ def build_grasp_diagram(resolved, meshcat=None):
     shown, keys = shown_intent_and_keys(builder, scenario, selected)
 
     limits = hand_over_limits(scenario)
-    if scenario.method in HOP_METHODS:
+    method = METHODS[scenario.method]
+    if method.policy == ASSISTED:
         # HOP and predict-then-assist: the operator's twist plus the assistance, no DMPs.
         dmp_bank = None
         prediction_steps = 0
         policy = builder.AddNamedSystem("assistance", PoseHopAssistance(
-            scenario.method, goal_count, scenario.hop, period))
+            method.assistance, goal_count, scenario.hop, period))
         builder.Connect(goal_poses.get_output_port(), policy.get_goal_poses_input_port())
     else:
         position_bank, orientation_bank = grasp_dmp_banks(resolved, start)
@@ -149,7 +151,7 @@ def build_grasp_diagram(resolved, meshcat=None):
         # compact state, which Drake copies in 16 numbers instead of 12 K.
         dmp_bank = builder.AddNamedSystem("dmp_bank", PoseDmpBank(
             position_bank, orientation_bank, period,
-            lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
+            lock_phase_when_operator_acts=method.lock_phase,
             max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed,
             prediction_steps=prediction_steps, compact_state=True))
         builder.Connect(sampled, dmp_bank.get_robot_state_input_port())
@@ -232,9 +234,9 @@ def _estimator(resolved, goal_count):
     scenario = resolved.scenario
     period = scenario.control_period
     settings = scenario.goal_estimator
-    if scenario.method in HOP_METHODS:
+    if METHODS[scenario.method].policy == ASSISTED:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
-    if settings.method == "maxent_command":
+    if estimator_entry(settings.method).reads == READS_COMMAND:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
                                        settings.hold_steps,
                                        operator_speed=resolved.nominal_speed)
@@ -245,7 +247,7 @@ def _operator(resolved, grasps, meshcat):
     scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
-    if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
+    if not METHODS[scenario.method].operated or isinstance(config, NoOperator):
         return IdleOperator(OperatorTwist.size, period)
     # Only teleop and the baselines that add to a full command let the person push along
     # the approach axis (the paper's forward key).

@@ -8,6 +8,7 @@ from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.scenarios import (
     PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ObstacleRepulsion, ScenarioError,
     ScriptedCommands, SinusoidalStep, VirtualParticipant, forward_key_enabled, shows_intent)
+from pbp_drake.core.methods import METHODS
 from pbp_drake.core.participant_serving import NO_INTENT
 from pbp_drake.systems import (
     GamepadOperator, KeyboardOperator, IdleOperator, ObstacleRepulsionOperator, ScriptedOperator,
@@ -17,10 +18,10 @@ from pbp_drake.systems.ports import OperatorCommand
 
 
 def make_operator(scenario, dimension):
-    """The operator of a 2-D scene (none at all for PBP-NoUser)."""
+    """The operator of a 2-D scene (none at all under a method no operator drives)."""
     config = scenario.operator
     period = scenario.control_period
-    if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
+    if not METHODS[scenario.method].operated or isinstance(config, NoOperator):
         return IdleOperator(dimension, period)
     if isinstance(config, ObstacleRepulsion):
         return ObstacleRepulsionOperator(
@@ -57,7 +58,7 @@ def make_hsr_operator(resolved, meshcat):
     speed = resolved.nominal_speed
     # Objects at heights of their own (`task.z_range`): the operator moves up and down too.
     vertical = bool(getattr(scenario.task, "z_range", None))
-    if scenario.method == "pbp_no_user" or isinstance(config, NoOperator):
+    if not METHODS[scenario.method].operated or isinstance(config, NoOperator):
         return IdleOperator(OperatorCommand.size, period)
     if isinstance(config, PILOT_CONFIGS):  # a surrogate pilot (`scenarios.pilots`)
         return make_pilot(resolved, lambda participant: make_hsr_operator(participant, meshcat),

@@ -41,7 +41,10 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
+from pbp_drake.core.arbitration import BLEND_LAWS
 from pbp_drake.core.controller_config import PbpControllerConfig
+from pbp_drake.core.goal_estimation import READS_COMMAND, estimator_entry
+from pbp_drake.core.methods import ASSISTED, BLENDED, METHODS
 from pbp_drake.systems import (
     Blender, DmpBank, GoalEstimator, HandOver, HeadingCommand, HopAssistance, LikelyGoals,
     MaxEntGoalEstimator)
@@ -114,13 +117,10 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         [3, OperatorCommand.size - 3]))
     builder.ExportInput(command_split.get_input_port(), "operator_command")
     start = initial_ee_state[:3]
-    if config.blend_mode is None:
-        name, estimator, reference = "hop_controller", *_add_hop_policy(
-            builder, config, len(goals), split, command_split)
-    else:
-        name, estimator, reference = "pbp_controller", *_add_pbp_policy(
-            builder, config, start, goals, split, command_split, prediction_steps,
-            min(int(predicted_goal_count), len(goals)))
+    name, add_policy = _POLICIES[METHODS[config.method].policy]
+    estimator, reference = add_policy(builder, config, start, goals, split, command_split,
+                                      prediction_steps,
+                                      min(int(predicted_goal_count), len(goals)))
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
         EeState(initial_ee_state).heading, config.control_period,
         config.hand_over.max_hand_yaw_acceleration,
@@ -150,7 +150,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     period = config.control_period
     goal_count = len(goals)
     position_velocity = split.get_output_port(0)
-    reads_command = config.goal_estimator.method == "maxent_command"
+    reads_command = estimator_entry(config.goal_estimator.method).reads == READS_COMMAND
     # maxent_command: HOP's posterior with the likelihood of PBP's operator (corrections,
     # turns, and silences read as letting the robot go on), at the operators' speed.
     estimator = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(
@@ -164,14 +164,14 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
 
     bank = config.dmp_bank(start, goals)
     dmp_bank = builder.AddNamedSystem("dmp_bank", DmpBank(
-        bank, period, lock_phase_when_operator_acts=config.method == "pbp_alternated",
+        bank, period, lock_phase_when_operator_acts=METHODS[config.method].lock_phase,
         prediction_steps=prediction_steps,
         prediction_period=bank.duration / max(prediction_steps, 1),
         # PBP-Cont adds the operator to a DMP that keeps running: without the limit, an
         # operator holding the hand off the DMP's path winds the DMP's velocity up past the
         # hand's speed limit until it overrides them (the other modes never hold it so).
-        max_speed=(config.hand_over.max_hand_speed if config.blend_mode == "pbp_continuous"
-                   else None),
+        max_speed=(config.hand_over.max_hand_speed
+                   if BLEND_LAWS[config.blend_mode].adds_to_policy else None),
         # Every DMP steps from the followed one's velocity (connected below): the state is
         # then O(D) whatever K (with shared weights and start, every scenario's bank, the
         # outputs are O(D) too).
@@ -214,20 +214,22 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     return estimator, blender.get_command_output_port()
 
 
-def _add_hop_policy(builder, config, goal_count, split, command_split):
-    """HOP's posterior and assistance (no DMPs); returns the posterior and the
-    assistance's command [p, v]. The operator's yaw rate turns the hand as under PBP; HOP
+def _add_hop_policy(builder, config, start, goals, split, command_split, prediction_steps,
+                    predicted_goal_count):
+    """HOP's posterior and assistance (no DMPs, nothing predicted); returns the posterior
+    and the assistance's command [p, v]. The operator's yaw rate turns the hand as under PBP; HOP
     assists the position only, since the reaching tasks' goals are positions.
     `selected_goal` is the most probable goal (no hysteresis: predict-then-assist assists
     toward it)."""
     period = config.control_period
+    goal_count = len(goals)
     posterior = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(
         goal_count, config.hop, period))
     builder.ConnectInput("ee_state", posterior.get_ee_state_input_port())
     builder.ExportInput(posterior.get_goals_input_port(), "goals")
     builder.ConnectInput("operator_command", posterior.get_operator_command_input_port())
     assistance = builder.AddNamedSystem("assistance", HopAssistance(
-        config.method, goal_count, config.hop, period))
+        METHODS[config.method].assistance, goal_count, config.hop, period))
     builder.Connect(split.get_output_port(0), assistance.get_robot_state_input_port())
     builder.ConnectInput("goals", assistance.get_goals_input_port())
     builder.Connect(command_split.get_output_port(0),
@@ -235,3 +237,8 @@ def _add_hop_policy(builder, config, goal_count, split, command_split):
     builder.Connect(posterior.get_goal_probabilities_output_port(),
                     assistance.get_goal_probabilities_input_port())
     return posterior, assistance.get_command_output_port()
+
+
+#: The Diagram's name and what adds its policy, by `Method.policy`.
+_POLICIES = {BLENDED: ("pbp_controller", _add_pbp_policy),
+             ASSISTED: ("hop_controller", _add_hop_policy)}

@@ -16,6 +16,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, ZeroOrderHold
 
 from pbp_drake.builder.operators import make_operator
+from pbp_drake.core.methods import METHODS
 from pbp_drake.systems import Blender, DemonstrationPlayer, DmpBank, GoalsSource, PointRobotDynamics
 from pbp_drake.systems.visualizers.point_scene_visualizer import PointSceneVisualizer
 
@@ -45,7 +46,8 @@ def build_point_robot_diagram(resolved, meshcat=None, prediction_steps=None):
     blender = builder.AddNamedSystem("blender", Blender(
         resolved.blend_mode, dimension, goal_count, period, scenario.alpha))
     dmp_bank = None
-    if scenario.method == "fixed_alpha":
+    method = METHODS[scenario.method]
+    if method.plays_demonstration:
         times, positions = resolved.demonstration
         policy = builder.AddNamedSystem(
             "demonstration_player", DemonstrationPlayer(times, positions, period))
@@ -56,7 +58,7 @@ def build_point_robot_diagram(resolved, meshcat=None, prediction_steps=None):
                 resolved.dmp_bank.duration / period))
         dmp_bank = policy = builder.AddNamedSystem("dmp_bank", DmpBank(
             resolved.dmp_bank, period,
-            lock_phase_when_operator_acts=scenario.method == "pbp_alternated",
+            lock_phase_when_operator_acts=method.lock_phase,
             prediction_steps=prediction_steps))
         goals_source = builder.AddNamedSystem("goals", GoalsSource(goals))
         builder.Connect(goals_source.get_output_port(), dmp_bank.get_goals_input_port())

@@ -37,10 +37,14 @@ to `alpha` by the "timid/aggressive" linear ramp
 so the robot does not assist below `low`, reaches `alpha_max` at `high` and above.
 """
 
+import typing
+
 import numpy as np
 
-BLEND_MODES = ("pbp_continuous", "pbp_alternated", "fixed_alpha", "teleop",
-               "confidence_alpha")
+#: `BlendLaw.weight` of a law whose weight alpha is the method's own (`scenario.alpha`) ...
+FIXED_WEIGHT = "fixed"
+#: ... and of one whose alpha is the goal confidence's ramp, every control period.
+CONFIDENCE_WEIGHT = "confidence"
 
 # Defaults of the confidence -> alpha ramp of ``confidence_alpha``.
 DEFAULT_CONFIDENCE_LOW = 0.0
@@ -48,12 +52,73 @@ DEFAULT_CONFIDENCE_HIGH = 1.0
 DEFAULT_ALPHA_MAX = 1.0
 
 
+class BlendLaw(typing.NamedTuple):
+    """One blending law: `law(policy_position, policy_velocity, command, operator_position,
+    active, dt, alpha)` -> (position, velocity), with `operator_position` the operator's
+    `U = y + u dt`; what its weight alpha is
+    (`FIXED_WEIGHT`, `CONFIDENCE_WEIGHT` or None: no weight); and whether the operator's
+    command adds to a policy that keeps running (the DMPs' speed is then capped)."""
+
+    law: typing.Callable
+    weight: typing.Optional[str] = None
+    adds_to_policy: bool = False
+
+
+def _continuous(policy_position, policy_velocity, command, operator_position, active, dt,
+                alpha):
+    return policy_position + command * dt, policy_velocity + command
+
+
+def _alternated(policy_position, policy_velocity, command, operator_position, active, dt,
+                alpha):
+    if active:
+        return operator_position, command
+    return policy_position, policy_velocity
+
+
+def _teleop(policy_position, policy_velocity, command, operator_position, active, dt, alpha):
+    return operator_position, command
+
+
+def _weighted(policy_position, policy_velocity, command, operator_position, active, dt,
+              alpha):
+    if not active:
+        return policy_position, policy_velocity
+    return ((1.0 - alpha) * operator_position + alpha * policy_position,
+            (1.0 - alpha) * command + alpha * policy_velocity)
+
+
+#: The blending laws by mode name (the module docstring); a method names its law
+#: (`pbp_drake.core.methods.Method.blend_mode`).
+BLEND_LAWS = {
+    "pbp_continuous": BlendLaw(_continuous, adds_to_policy=True),
+    "pbp_alternated": BlendLaw(_alternated),
+    "fixed_alpha": BlendLaw(_weighted, FIXED_WEIGHT),
+    "teleop": BlendLaw(_teleop),
+    "confidence_alpha": BlendLaw(_weighted, CONFIDENCE_WEIGHT),
+}
+BLEND_MODES = tuple(BLEND_LAWS)
+
+
+def blend_law(mode, laws=None):
+    """The `BlendLaw` of `mode` in `laws` (default `BLEND_LAWS`); ValueError naming the
+    modes for an unknown one."""
+    laws = BLEND_LAWS if laws is None else laws
+    if mode not in laws:
+        raise ValueError(f"blending mode {mode!r} is unknown; choose one of {tuple(laws)}")
+    return laws[mode]
+
+
+def check_alpha(mode, alpha):
+    """Raises ValueError unless `alpha` is a finite number in [0, 1]."""
+    if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
+        raise ValueError(f"alpha must lie in [0, 1] for {mode}, got {alpha}")
+
+
 def validate_mode(mode, alpha=None):
-    if mode not in BLEND_MODES:
-        raise ValueError(f"blending mode {mode!r} is unknown; choose one of {BLEND_MODES}")
-    if mode == "fixed_alpha":
-        if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
-            raise ValueError(f"alpha must lie in [0, 1] for fixed_alpha, got {alpha}")
+    """Raises ValueError for an unknown mode, or a fixed-weight one without alpha in [0, 1]."""
+    if blend_law(mode).weight == FIXED_WEIGHT:
+        check_alpha(mode, alpha)
 
 
 def validate_confidence_ramp(low=DEFAULT_CONFIDENCE_LOW, high=DEFAULT_CONFIDENCE_HIGH,
@@ -128,16 +193,8 @@ def blend(mode, robot_position, policy_position, policy_velocity, command, activ
     each control period); the other modes ignore it.
     """
     command = validate_command(command)
-    operator_position = robot_position + command * dt
-    if mode == "pbp_continuous":
-        return policy_position + command * dt, policy_velocity + command
-    if mode == "teleop" or (mode == "pbp_alternated" and active):
-        return operator_position, command
-    if mode == "pbp_alternated" or not active:
-        return policy_position, policy_velocity
-    if mode in ("fixed_alpha", "confidence_alpha"):
-        if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
-            raise ValueError(f"alpha must lie in [0, 1] for {mode}, got {alpha}")
-        return ((1.0 - alpha) * operator_position + alpha * policy_position,
-                (1.0 - alpha) * command + alpha * policy_velocity)
-    raise ValueError(f"blending mode {mode!r} is unknown; choose one of {BLEND_MODES}")
+    law = blend_law(mode)
+    if law.weight is not None and active:
+        check_alpha(mode, alpha)
+    return law.law(policy_position, policy_velocity, command, robot_position + command * dt,
+                   active, dt, alpha)

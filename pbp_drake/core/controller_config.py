@@ -14,14 +14,10 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.dmp import DmpBankModel, DmpSettings
-from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.goal_estimation import READS_POSE, GoalEstimatorSettings, estimator_entry
 from pbp_drake.core.hand_over import check_limit
-from pbp_drake.core.hindsight_optimization import HOP_METHODS, HopSettings
-
-# The methods a task robot's controller runs (the toy robot's demonstration player,
-# fixed_alpha with a demonstration, is the 2-D scenes' own).
-CONTROLLER_METHODS = ("pbp_alternated", "pbp_continuous", "pbp_no_user", "fixed_alpha",
-                      "confidence_alpha", "teleop") + tuple(HOP_METHODS)
+from pbp_drake.core.hindsight_optimization import HopSettings
+from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_names
 
 
 @dataclasses.dataclass
@@ -68,8 +64,9 @@ class ControlSettings:
     """What the controller runs and how often: the fields a scenario file's `scenario:`
     shares with `PbpControllerConfig` (both are one)."""
 
-    #: One of CONTROLLER_METHODS: PBP alternated or continuous, PBP with no operator,
-    #: explicit arbitration (fixed or confidence alpha), teleop, or the HOP baselines.
+    #: A method of the registry (`pbp_drake.core.methods.METHODS`): PBP alternated or
+    #: continuous, PBP with no operator, explicit arbitration (fixed or confidence alpha),
+    #: teleop, or the HOP baselines.
     method: str = "pbp_alternated"
     #: The arbitration weight of fixed_alpha, in [0, 1].
     alpha: float = 0.5
@@ -120,25 +117,24 @@ class PbpControllerConfig(ControlSettings):
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
-        if self.method not in CONTROLLER_METHODS:
-            raise ValueError(f"method {self.method!r} is not one of {CONTROLLER_METHODS}")
+        if self.method not in METHODS:
+            raise ValueError(f"method {self.method!r} is not one of {method_names()}"
+                             f"{did_you_mean(self.method, METHODS)}")
         self.validate_settings()
         check_limit(self.nominal_speed, "nominal_speed", "m/s")
         try:
             self.hand_over.validate()
         except ValueError as error:
             raise ValueError(f"hand_over.{error}") from None
-        if self.goal_estimator.method == "pose":
-            raise ValueError("goal_estimator.method pose reads grasp orientations, which a "
-                             "position controller has not")
+        if estimator_entry(self.goal_estimator.method).reads == READS_POSE:
+            raise ValueError(f"goal_estimator.method {self.goal_estimator.method} reads grasp "
+                             f"orientations, which a position controller has not")
 
     @property
     def blend_mode(self):
-        """The blender's mode (PBP-NoUser is PBP-Cont with no operator); None for the HOP
-        baselines, which have no blender."""
-        if self.method in HOP_METHODS:
-            return None
-        return "pbp_continuous" if self.method == "pbp_no_user" else self.method
+        """The blender's mode (`Method.blend_mode`); None for the HOP baselines, which have
+        no blender."""
+        return method_entry(self.method).blend_mode
 
     def dmp_bank(self, start, goals):
         """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, of

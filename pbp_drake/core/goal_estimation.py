@@ -16,15 +16,17 @@ turns the scores into probabilities that sum to 1:
   goal, so it cancels in the normalised posterior: it is kept in `bayesian_log_posterior`
   for the formula's sake and does not change the probabilities.
 
-- ``pose`` (the grasping task): reads position and orientation, see
-  `pbp_drake.core.grasp_estimation`; `goal_probabilities` here does not compute it (it needs
-  the grasp orientations and the hand's velocities), `grasp_estimation.pose_probabilities`
-  does, with the same settings and the same hysteresis (`update_selection`).
-- ``maxent_command`` (every HSR task): HOP's goal posterior, which reads the operator's
-  command (Javdani et al. 2015, maximum-entropy inverse optimal control; the scenario's
-  `hop` settings, `pbp_drake.core.hindsight_optimization`); recursive, so it keeps its
-  belief in the estimator's state (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`),
-  with the same hysteresis.
+- ``pose`` (the grasping task): reads position and orientation
+  (`pbp_drake.core.grasp_estimation.pose_probabilities`, the `PoseGoalEstimator` system).
+- ``maxent_command`` (every task): HOP's goal posterior, which reads the operator's
+  command (Javdani et al. 2015; the scenario's `hop` settings,
+  `pbp_drake.core.maxent_command`); recursive, so it keeps its belief in the estimator's
+  state (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`).
+
+`ESTIMATORS` is the registry the scenario's `goal_estimator: {method: NAME}` is read
+through: each `Estimator` says what it reads (which picks its system) and, for those that
+read the hand's position, its probabilities function. A new estimator is its function and
+one entry (`register_estimator`); no layer compares an estimator's name.
 
 All of them are vectorised over K (no Python loop over goals) and computed in log space, so a
 small temperature or a large beta gives a one-hot vector rather than NaN.
@@ -43,15 +45,14 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.methods import did_you_mean
 
-# The estimators that read the hand's position and heading (`goal_probabilities`) ...
-GOAL_ESTIMATION_METHODS = ("angle", "nearest", "bayesian")
-# ... those that read its whole pose (`pbp_drake.core.grasp_estimation`) ...
-POSE_ESTIMATION_METHODS = ("pose",)
-# ... and those that read the operator's command (`pbp_drake.core.hindsight_optimization`).
-COMMAND_ESTIMATION_METHODS = ("maxent_command",)
-ESTIMATION_METHODS = (GOAL_ESTIMATION_METHODS + POSE_ESTIMATION_METHODS
-                      + COMMAND_ESTIMATION_METHODS)
+#: `Estimator.reads`: the hand's position and heading (`GoalEstimator`, any task) ...
+READS_POSITION = "position"
+#: ... the hand's pose and the operator's twist (`PoseGoalEstimator`, the grasping task) ...
+READS_POSE = "pose"
+#: ... or the operator's command, recursively (`MaxEntGoalEstimator`, every task).
+READS_COMMAND = "command"
 
 # A goal closer than this (m) to the end effector on the floor plane has no direction.
 FLOOR_EPSILON = 1e-9
@@ -106,9 +107,7 @@ class GoalEstimatorSettings:
     def validate(self):
         """Raises ValueError naming the first field that cannot be used (a YAML loader sets
         the fields after construction, so `resolve` calls this again)."""
-        if self.method not in ESTIMATION_METHODS:
-            raise ValueError(f"goal estimation method {self.method!r} is unknown; choose one "
-                             f"of {ESTIMATION_METHODS}")
+        estimator_entry(self.method)
         for name in ("temperature", "beta"):
             value = getattr(self, name)
             if not _is_real(value) or not math.isfinite(value) or value <= 0.0:
@@ -220,32 +219,85 @@ def bayesian_probabilities(goals, position, start, path_length, beta):
     return weights / weights.sum()
 
 
+class Estimator(typing.NamedTuple):
+    """One registry entry: the name `goal_estimator.method` spells, what it reads (`READS_*`,
+    which picks its system), and for one that reads the position its function
+    `probabilities(settings, goals (K, 3), position (3), heading, start (3), path_length)`
+    -> K probabilities (the start and the path length since it: the system tracks them);
+    for the others, the function that computes them (`computed_by`, for messages)."""
+
+    name: str
+    reads: str
+    probabilities: typing.Optional[typing.Callable] = None
+    computed_by: str = ""
+
+
+def _angle(settings, goals, position, heading, start, path_length):
+    heading = _validate_scalar(heading, "heading")
+    return angle_probabilities(goals, position, heading, settings.temperature)
+
+
+def _nearest(settings, goals, position, heading, start, path_length):
+    return nearest_probabilities(goals, position, settings.temperature)
+
+
+def _bayesian(settings, goals, position, heading, start, path_length):
+    if start is None:
+        raise ValueError("the bayesian goal estimator needs start (the end effector's "
+                         "position when estimation began)")
+    start = validate_point(start, "start")
+    path_length = _validate_scalar(path_length, "path_length", minimum=0.0)
+    return bayesian_probabilities(goals, position, start, path_length, settings.beta)
+
+
+ESTIMATORS = {estimator.name: estimator for estimator in (
+    Estimator("angle", READS_POSITION, _angle),
+    Estimator("nearest", READS_POSITION, _nearest),
+    Estimator("bayesian", READS_POSITION, _bayesian),
+    Estimator("pose", READS_POSE,
+              computed_by="pbp_drake.core.grasp_estimation.pose_probabilities"),
+    Estimator("maxent_command", READS_COMMAND,
+              computed_by="pbp_drake.core.hindsight_optimization.update_posterior"),
+)}
+#: The shipped estimators that read the hand's position (`goal_probabilities`).
+GOAL_ESTIMATION_METHODS = tuple(name for name, estimator in ESTIMATORS.items()
+                                if estimator.reads == READS_POSITION)
+
+
+def register_estimator(estimator):
+    """Adds `estimator` (an `Estimator`) to `ESTIMATORS`; ValueError if its name is taken,
+    or it reads the position without a probabilities function."""
+    if estimator.name in ESTIMATORS:
+        raise ValueError(f"goal estimator {estimator.name!r} is already registered")
+    if estimator.reads not in (READS_POSITION, READS_POSE, READS_COMMAND):
+        raise ValueError(f"goal estimator {estimator.name!r}: reads {estimator.reads!r} is "
+                         f"not one of {(READS_POSITION, READS_POSE, READS_COMMAND)}")
+    if (estimator.reads == READS_POSITION) != (estimator.probabilities is not None):
+        raise ValueError(f"goal estimator {estimator.name!r}: a probabilities function is "
+                         f"for (and needed by) an estimator that reads the position")
+    ESTIMATORS[estimator.name] = estimator
+    return estimator
+
+
+def estimator_entry(name):
+    """The `Estimator` called `name`; ValueError naming the choices and the nearest one."""
+    if name not in ESTIMATORS:
+        raise ValueError(f"goal estimation method {name!r} is unknown; choose one of "
+                         f"{tuple(ESTIMATORS)}{did_you_mean(name, ESTIMATORS)}")
+    return ESTIMATORS[name]
+
+
 def goal_probabilities(settings, goals, position, heading, start=None, path_length=0.0):
-    """The K probabilities of `settings.method`; `start` and `path_length` (the length of the
-    path from `start` to `position`) are needed by ``bayesian`` only."""
+    """The K probabilities of `settings.method`, an estimator that reads the hand's
+    position; `start` and `path_length` (the length of the path from `start` to
+    `position`) are read by ``bayesian``."""
     goals = validate_goals(goals)
     position = validate_point(position, "position")
-    if settings.method == "angle":
-        heading = _validate_scalar(heading, "heading")
-        return angle_probabilities(goals, position, heading, settings.temperature)
-    if settings.method == "nearest":
-        return nearest_probabilities(goals, position, settings.temperature)
-    if settings.method == "bayesian":
-        if start is None:
-            raise ValueError("the bayesian goal estimator needs start (the end effector's "
-                             "position when estimation began)")
-        start = validate_point(start, "start")
-        path_length = _validate_scalar(path_length, "path_length", minimum=0.0)
-        return bayesian_probabilities(goals, position, start, path_length, settings.beta)
-    if settings.method == "pose":
-        raise ValueError("the pose goal estimator reads grasp orientations and the hand's "
-                         "velocities: call pbp_drake.core.grasp_estimation.pose_probabilities")
-    if settings.method == "maxent_command":
-        raise ValueError("the maxent_command goal estimator is recursive and reads the "
-                         "operator's command: call "
-                         "pbp_drake.core.hindsight_optimization.update_posterior")
-    raise ValueError(f"goal estimation method {settings.method!r} is unknown; choose one of "
-                     f"{GOAL_ESTIMATION_METHODS}")
+    estimator = estimator_entry(settings.method)
+    if estimator.probabilities is None:
+        raise ValueError(f"the {estimator.name} goal estimator reads more than the hand's "
+                         f"position: call {estimator.computed_by}")
+    return estimator.probabilities(settings, goals, position, heading, start, path_length)
 
 
 def update_selection(probabilities, memory, margin, hold_steps):

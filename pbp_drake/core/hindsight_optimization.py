@@ -78,8 +78,6 @@ import numpy as np
 
 from pbp_drake.core import quaternion
 
-# The methods built on this module (the scenario's `method`).
-HOP_METHODS = ("hop", "predict_then_assist")
 # Below this (m, rad) the hand is at a target: no direction to it.
 AT_TARGET = 1e-12
 
@@ -465,14 +463,31 @@ def blending_weights(probabilities, threshold):
     return weights
 
 
+def _belief_weights(settings, probabilities):
+    return np.asarray(probabilities, dtype=float)
+
+
+def _predict_then_assist_weights(settings, probabilities):
+    return blending_weights(probabilities, settings.blending_threshold)
+
+
+#: The goal weights of each assistance by name (`pbp_drake.core.methods.Method.assistance`):
+#: the belief itself (``hop``) or predict-then-assist's (``predict_then_assist``).
+ASSISTANCE_WEIGHTS = {"hop": _belief_weights, "predict_then_assist": _predict_then_assist_weights}
+#: The assistance names, which are the methods built on this module.
+HOP_METHODS = tuple(ASSISTANCE_WEIGHTS)
+
+
+def check_assistance(name):
+    """Raises ValueError unless `name` is one of `ASSISTANCE_WEIGHTS`."""
+    if name not in ASSISTANCE_WEIGHTS:
+        raise ValueError(f"method {name!r} is unknown; choose one of {HOP_METHODS}")
+
+
 def assistance_weights(method, settings, probabilities):
-    """The goal weights the assistance of `method` (HOP_METHODS) uses: the belief itself
-    (``hop``) or predict-then-assist's (``predict_then_assist``)."""
-    if method == "hop":
-        return np.asarray(probabilities, dtype=float)
-    if method == "predict_then_assist":
-        return blending_weights(probabilities, settings.blending_threshold)
-    raise ValueError(f"method {method!r} is unknown; choose one of {HOP_METHODS}")
+    """The goal weights the assistance `method` (`ASSISTANCE_WEIGHTS`) uses."""
+    check_assistance(method)
+    return ASSISTANCE_WEIGHTS[method](settings, probabilities)
 
 
 class AssistedCommand(typing.NamedTuple):

@@ -90,17 +90,20 @@ def faces_target(params, position, heading, target):
 
 
 def assist_motion(params, speed, position, heading, target, picked, insisting,
-                  vertical=False):
+                  vertical=False, heading_range=None):
     """The floor velocity (2, m/s) and yaw rate (rad/s) of a participant who sees the
     estimate name `picked` instead of `target` (positions, 3), the hand at `position` with
     `heading`; `insisting` once it has faced the target `insist_time` to no avail. No
     velocity it returns points forward (`without_forward`).
 
     `vertical`: the velocity is `(vx, vy, vz)` (3): vz = 0 and the floor part as without
-    it, but when `insisting` (`insisting_motion_3d`)."""
+    it, but when `insisting` (`insisting_motion_3d`). `heading_range` (low, high), an
+    arm's wrist (None: all the way round), bounds the heading an insisting participant
+    turns to (`insisting_side_heading`)."""
     if vertical:
         if insisting:
-            return insisting_motion_3d(params, speed, position, heading, target)
+            return insisting_motion_3d(params, speed, position, heading, target,
+                                       heading_range)
         velocity, yaw_rate = assist_motion(params, speed, position, heading, target, picked,
                                            insisting)
         return np.array([velocity[0], velocity[1], 0.0]), yaw_rate
@@ -109,7 +112,7 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
     toward_target = unit(offset)
     toward_picked = unit(picked[:2] - position[:2])
     if insisting:
-        wanted_heading = insisting_side_heading(heading, position, target)
+        wanted_heading = insisting_side_heading(heading, position, target, heading_range)
         slow = min(1.0, distance / params.slow_radius)
         velocity = speed * slow * without_forward(toward_target, heading)
         return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
@@ -172,15 +175,26 @@ def reposition_motion(params, speed, position, heading, target, heading_range=No
     return (velocity if vertical else velocity[:2]), yaw_rate
 
 
-def insisting_side_heading(heading, position, target):
+def insisting_side_heading(heading, position, target, heading_range=None):
     """The heading that puts the target to the side of the hand it is already nearer (the
-    shorter turn), as an insisting participant wants it."""
+    shorter turn), as an insisting participant wants it; the other side when that heading
+    lies beyond `heading_range` (low, high) and the other's does not (an arm's wrist,
+    which cannot turn a target ahead to its near side, but can to its far one)."""
     toward_target = unit(target[:2] - position[:2])
     side = 1.0 if heading_error(heading, position, target) >= 0.0 else -1.0
-    return np.arctan2(toward_target[1], toward_target[0]) - side * np.pi / 2
+    bearing = np.arctan2(toward_target[1], toward_target[0])
+    wanted = bearing - side * np.pi / 2
+    if heading_range is not None:
+        low, high = heading_range
+        middle, half = 0.5 * (low + high), 0.5 * (high - low)
+        other = bearing + side * np.pi / 2
+        if (abs(wrap_angle(wanted - middle)) > half
+                and abs(wrap_angle(other - middle)) <= half):
+            return other
+    return wanted
 
 
-def insisting_motion_3d(params, speed, position, heading, target):
+def insisting_motion_3d(params, speed, position, heading, target, heading_range=None):
     """`assist_motion` insisting, with vertical motion: the velocity (3) toward the target
     in 3-D as far as the keys allow (its floor part `without_forward`), at `speed` slowing
     within `slow_radius` of the 3-D distance, so at most `speed` in all; the yaw rate turns
@@ -194,7 +208,7 @@ def insisting_motion_3d(params, speed, position, heading, target):
     velocity = speed * slow * np.array([floor[0], floor[1], toward_target[2]])
     if np.linalg.norm(offset[:2]) < 1e-9:
         return velocity, 0.0  # straight above or below: no side to turn it to
-    wanted_heading = insisting_side_heading(heading, position, target)
+    wanted_heading = insisting_side_heading(heading, position, target, heading_range)
     return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
 
 

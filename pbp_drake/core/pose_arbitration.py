@@ -29,10 +29,10 @@ from typing import NamedTuple
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.arbitration import BLEND_MODES
+from pbp_drake.core.arbitration import (
+    BLEND_LAWS, FIXED_WEIGHT, BlendLaw, blend_law, check_alpha)
 from pbp_drake.core.hand_over import check_limit, limited_velocity
 
-POSE_BLEND_MODES = BLEND_MODES + ("pbp_no_user",)
 TWIST_FIELDS = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 
@@ -77,11 +77,8 @@ class HandOverLimits(NamedTuple):
 
 def validate_pose_mode(mode, alpha=None):
     """Raises ValueError for an unknown mode, or a `fixed_alpha` without alpha in [0, 1]."""
-    if mode not in POSE_BLEND_MODES:
-        raise ValueError(f"blending mode {mode!r} is unknown; choose one of {POSE_BLEND_MODES}")
-    if mode == "fixed_alpha" and (alpha is None or not np.isfinite(alpha)
-                                  or not 0.0 <= alpha <= 1.0):
-        raise ValueError(f"alpha must lie in [0, 1] for fixed_alpha, got {alpha}")
+    if blend_law(mode, POSE_BLEND_LAWS).weight == FIXED_WEIGHT:
+        check_alpha(mode, alpha)
 
 
 def validate_twist(twist, name="operator_twist"):
@@ -118,25 +115,60 @@ def blend_pose(mode, robot_position, robot_orientation, policy, twist, active, d
     policy = PoseReference(*(np.asarray(part, dtype=float) for part in policy))
     policy = policy._replace(orientation=quaternion.aligned(policy.orientation,
                                                             robot_orientation))
-    if mode == "pbp_continuous":
-        return PoseReference(policy.position + linear * dt,
-                             turned(policy.orientation, angular, dt),
-                             policy.velocity + linear, policy.angular_velocity + angular)
-    operator = PoseReference(np.asarray(robot_position, dtype=float) + linear * dt,
-                             turned(robot_orientation, angular, dt), linear, angular)
-    if mode == "teleop" or (mode == "pbp_alternated" and active):
-        return operator
-    if mode in ("pbp_alternated", "pbp_no_user") or not active:
+    law = blend_law(mode, POSE_BLEND_LAWS)
+    if law.weight is not None and active:
+        check_alpha(mode, alpha)
+    return law.law(policy, robot_position, robot_orientation, linear, angular, active, dt,
+                   alpha)
+
+
+def _operator_pose(robot_position, robot_orientation, linear, angular, dt):
+    """`U`: where the operator alone takes the hand in one period, at its twist."""
+    return PoseReference(np.asarray(robot_position, dtype=float) + linear * dt,
+                         turned(robot_orientation, angular, dt), linear, angular)
+
+
+def _continuous(policy, robot_position, robot_orientation, linear, angular, active, dt,
+                alpha):
+    return PoseReference(policy.position + linear * dt, turned(policy.orientation, angular, dt),
+                         policy.velocity + linear, policy.angular_velocity + angular)
+
+
+def _alternated(policy, robot_position, robot_orientation, linear, angular, active, dt,
+                alpha):
+    if active:
+        return _operator_pose(robot_position, robot_orientation, linear, angular, dt)
+    return policy
+
+
+def _teleop(policy, robot_position, robot_orientation, linear, angular, active, dt, alpha):
+    return _operator_pose(robot_position, robot_orientation, linear, angular, dt)
+
+
+def _policy_alone(policy, robot_position, robot_orientation, linear, angular, active, dt,
+                  alpha):
+    return policy
+
+
+def _weighted(policy, robot_position, robot_orientation, linear, angular, active, dt, alpha):
+    if not active:
         return policy
-    if mode in ("fixed_alpha", "confidence_alpha"):
-        if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
-            raise ValueError(f"alpha must lie in [0, 1] for {mode}, got {alpha}")
-        return PoseReference(
-            (1.0 - alpha) * operator.position + alpha * policy.position,
-            quaternion.slerp(operator.orientation, policy.orientation, alpha),
-            (1.0 - alpha) * operator.velocity + alpha * policy.velocity,
-            (1.0 - alpha) * operator.angular_velocity + alpha * policy.angular_velocity)
-    raise ValueError(f"blending mode {mode!r} is unknown; choose one of {POSE_BLEND_MODES}")
+    operator = _operator_pose(robot_position, robot_orientation, linear, angular, dt)
+    return PoseReference(
+        (1.0 - alpha) * operator.position + alpha * policy.position,
+        quaternion.slerp(operator.orientation, policy.orientation, alpha),
+        (1.0 - alpha) * operator.velocity + alpha * policy.velocity,
+        (1.0 - alpha) * operator.angular_velocity + alpha * policy.angular_velocity)
+
+
+#: The six-DoF laws by mode: each position law of `BLEND_LAWS` (its weight and
+#: `adds_to_policy` kept), and ``pbp_no_user``, the policy alone.
+_POSE_LAWS = {"pbp_continuous": _continuous, "pbp_alternated": _alternated,
+              "fixed_alpha": _weighted, "teleop": _teleop, "confidence_alpha": _weighted}
+POSE_BLEND_LAWS = {**{mode: law._replace(law=_POSE_LAWS[mode])
+                      for mode, law in BLEND_LAWS.items()},
+                   "pbp_no_user": BlendLaw(_policy_alone)}
+POSE_BLEND_MODES = tuple(POSE_BLEND_LAWS)
 
 
 def pose_hand_over(previous_velocity, previous_angular_velocity, reference, limits, dt):

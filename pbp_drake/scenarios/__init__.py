@@ -10,11 +10,12 @@ Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario
 from pbp_drake.scenarios.loading import (
     LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file,
     load_scenario_text)
+from pbp_drake.core.methods import METHODS
 from pbp_drake.scenarios.resolution import (
-    BLEND_MODE_OF_METHOD, ResolvedScenario, TaskScene, demonstration_samples,
+    ResolvedScenario, TaskScene, demonstration_samples,
     parse_method_label, resolve, task_scene, with_method)
 from pbp_drake.scenarios.schema import (
-    FORWARD_KEY_METHODS, HSR_OPERATORS, METHODS, OPERATOR_NAMES, PILOT_CONFIGS, TASK_ROBOTS,
+    HSR_OPERATORS, OPERATOR_NAMES, PILOT_CONFIGS, TASK_ROBOTS,
     TOY_OPERATORS, AlphaStudy, AltVsCont, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask,
     Hsr, Keyboard, LaggyPilot, MethodComparison, MultiGoalReach, NoisyPilot, NoOperator,
     Obstacle, ObstacleRepulsion, OperatorConfig, ParticipantPopulation, PointRobot,
@@ -24,7 +25,7 @@ from pbp_drake.scenarios.words import METHOD_NAMES, counted
 from pbp_drake.scenarios.pilots import PILOT_NAMES, PILOTS, check_pilot_name, with_pilot
 
 __all__ = [
-    "BLEND_MODE_OF_METHOD", "FORWARD_KEY_METHODS", "HSR_OPERATORS", "METHOD_NAMES", "METHODS",
+    "HSR_OPERATORS", "METHOD_NAMES", "METHODS",
     "OPERATOR_NAMES", "PILOT_CONFIGS", "PILOT_NAMES", "PILOTS", "TASK_ROBOTS", "TOY_OPERATORS",
     "AlphaStudy", "AltVsCont", "Arm", "BentPath", "DynamicObstacles", "Gamepad", "GraspTask",
     "Hsr", "Keyboard", "LaggyPilot", "LoadedScenarioFile", "MethodComparison",

@@ -18,13 +18,15 @@ import numpy as np
 from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
+from pbp_drake.core.goal_estimation import READS_POSE, estimator_entry
+from pbp_drake.core.methods import METHODS, method_entry, method_names
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.scenarios.bounds import check_goal_counts
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, METHODS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
+    HSR_OPERATORS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
     DynamicObstacles, Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError,
     ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
     VirtualParticipant)
@@ -33,19 +35,6 @@ from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
     check_grasp_task, check_numbers, check_obstacle_task, check_reach_task, check_seed,
     check_pilot, check_time_steps, check_virtual_participant, require_finite, whole_steps)
-
-# How the scenario's method maps onto the blender (PBP-NoUser is PBP-Cont with no operator;
-# HOP and predict-then-assist have no blender: their assistance is the HOP controller's).
-BLEND_MODE_OF_METHOD = {
-    "pbp_alternated": "pbp_alternated",
-    "pbp_continuous": "pbp_continuous",
-    "pbp_no_user": "pbp_continuous",
-    "fixed_alpha": "fixed_alpha",
-    "confidence_alpha": "confidence_alpha",
-    "teleop": "teleop",
-    "hop": None,
-    "predict_then_assist": None,
-}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -82,9 +71,9 @@ class ResolvedScenario:
 
     @property
     def blend_mode(self):
-        """The blender's mode for `scenario.method` (None for hop and predict_then_assist, which
-        have none)."""
-        return BLEND_MODE_OF_METHOD[self.scenario.method]
+        """The blender's mode of `scenario.method` (None for a method with no blender: HOP's
+        assistance)."""
+        return METHODS[self.scenario.method].blend_mode
 
     @property
     def has_task(self):
@@ -117,17 +106,19 @@ def resolve(scenario):
 
 
 def parse_method_label(label):
-    """`(name, alpha)` of a method label: a name of METHODS (alpha None), or `fixed_alpha=A`
-    for explicit arbitration with weight A (so that one study can sweep alpha)."""
+    """`(name, alpha)` of a method label: a name of the methods registry (alpha None), or
+    `fixed_alpha=A` for explicit arbitration with weight A (so that one study can sweep
+    alpha)."""
     name, _, alpha = label.partition("=")
     renamed_method(name)
+    weighted = " or ".join(f"{m}=A" for m, method in METHODS.items() if method.takes_weight)
     if name not in METHODS:
-        raise ScenarioError(f"method {label!r} is unknown; choose from {METHODS} or "
-                            f"fixed_alpha=A{close_match(name, METHODS)}")
+        raise ScenarioError(f"method {label!r} is unknown; choose from {method_names()} or "
+                            f"{weighted}{close_match(name, METHODS)}")
     if not alpha:
         return name, None
-    if name != "fixed_alpha":
-        raise ScenarioError(f"method {label!r}: only fixed_alpha takes a weight (=A)")
+    if not METHODS[name].takes_weight:
+        raise ScenarioError(f"method {label!r}: only {weighted} takes a weight")
     try:
         value = float(alpha)
     except ValueError:
@@ -163,15 +154,16 @@ def _check_common(scenario):
     check_goal_counts(scenario)  # first: every check after it walks the goals
     check_numbers(scenario)
     renamed_method(scenario.method, "scenario.method")
-    if scenario.method not in METHODS:
-        raise ScenarioError(
-            f"scenario.method {scenario.method!r} is unknown; choose one of {METHODS}"
-            f"{close_match(scenario.method, METHODS)}")
+    try:
+        method_entry(scenario.method, "scenario.method")
+    except ValueError as error:
+        raise ScenarioError(str(error)) from None
     _checked("scenario.", scenario.validate_settings)
     require_finite(scenario, "scenario", ("duration",))
-    if scenario.goal_estimator.method == "pose" and not isinstance(scenario.task, GraspTask):
-        raise ScenarioError("scenario.goal_estimator.method pose reads grasp orientations: "
-                            "use it with task: !GraspTask {...}")
+    if (estimator_entry(scenario.goal_estimator.method).reads == READS_POSE
+            and not isinstance(scenario.task, GraspTask)):
+        raise ScenarioError(f"scenario.goal_estimator.method {scenario.goal_estimator.method} "
+                            f"reads grasp orientations: use it with task: !GraspTask {{...}}")
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_seed(scenario.seed)
     check_count(scenario.likely_paths, "scenario.likely_paths", 0, MAX_LIKELY_PATHS)
@@ -196,18 +188,16 @@ def _check_method(scenario, goal_count):
     """What the method asks of the rest of the scenario."""
     if isinstance(scenario.robot, TASK_ROBOTS):
         return
-    if scenario.method == "confidence_alpha":
-        raise ScenarioError("scenario.method confidence_alpha needs a goal estimator's "
-                            "confidence: use it in the HSR tasks (robot: !Hsr)")
-    if scenario.method in ("hop", "predict_then_assist"):
-        raise ScenarioError(f"scenario.method {scenario.method} assists toward the HSR "
-                            "tasks' goals: use it in the HSR tasks (robot: !Hsr)")
-    if scenario.method == "fixed_alpha" and scenario.demonstration is None:
+    method = METHODS[scenario.method]
+    if method.task_only:
+        raise ScenarioError(f"scenario.method {method.name} {method.task_only}: use it in the "
+                            "HSR tasks (robot: !Hsr)")
+    if method.plays_demonstration and scenario.demonstration is None:
         raise ScenarioError(
-            "scenario.method fixed_alpha plays the demonstration as P: give "
+            f"scenario.method {method.name} plays the demonstration as P: give "
             "scenario.demonstration")
-    if scenario.method == "fixed_alpha" and goal_count != 1:
-        raise ScenarioError("scenario.method fixed_alpha takes exactly one goal here")
+    if method.plays_demonstration and goal_count != 1:
+        raise ScenarioError(f"scenario.method {method.name} takes exactly one goal here")
 
 
 def demonstration_samples(demonstration):

@@ -26,6 +26,7 @@ from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.core.controller_config import (
     ControlSettings, HandLimits, HandOverSettings, PbpControllerConfig)
+from pbp_drake.core.methods import forward_key_enabled, shows_intent  # noqa: F401 (public)
 from pbp_drake.robots.arm_station_config import ArmStationConfig
 from pbp_drake.robots.hsr_station_config import HsrStationConfig
 from pbp_drake.systems.operators.gamepad_operator import GamepadParams
@@ -64,8 +65,6 @@ class ScenarioError(ValueError):
     """A scenario file or value that cannot be used; the message names the field."""
 
 
-METHODS = ("pbp_alternated", "pbp_continuous", "fixed_alpha", "confidence_alpha", "teleop",
-           "pbp_no_user", "hop", "predict_then_assist")
 #: Old method name -> (its name now, why): a scenario, `--method` or `--methods` naming the
 #: old one is refused with a message naming the new one (`resolution.renamed_method`).
 RENAMED_METHODS = {
@@ -73,26 +72,6 @@ RENAMED_METHODS = {
                         "probable goals differ by hop.blending_threshold; Dragan and "
                         "Srinivasa's arbitration is confidence_alpha"),
 }
-# The methods whose keys include forward: teleop, and the shared-autonomy baselines whose
-# assistance adds to a full command. The paper disables it under PBP and arbitration, whose
-# operator shows the goal and lets the robot bring the hand there.
-FORWARD_KEY_METHODS = ("teleop", "hop", "predict_then_assist")
-
-
-def forward_key_enabled(scenario):
-    """Whether the scenario's method enables the forward key (a person's keys, and the
-    virtual participant's `forward_key` input)."""
-    return scenario.method in FORWARD_KEY_METHODS
-
-
-def shows_intent(scenario):
-    """Whether the page shows the robot's intent (the blue ball over the object it means):
-    not under teleop, whose robot never moves by itself, nor under HOP with its assistance
-    off (`hop: {assistance: false}`), whose robot adds nothing."""
-    if scenario.method == "teleop":
-        return False
-    return not (scenario.method in ("hop", "predict_then_assist")
-                and not getattr(scenario.hop, "assistance", True))
 
 
 @dataclasses.dataclass
@@ -465,7 +444,7 @@ class MethodComparison:
     `pbp_drake.studies.splits`). `pbp-drake study --methods --trials --split --seed`
     override these."""
 
-    #: The methods compared (names of METHODS).
+    #: The methods compared (names of the methods registry).
     methods: list[str] = dataclasses.field(
         default_factory=lambda: ["pbp_alternated", "pbp_continuous", "teleop"])
     #: Trials per method (a count).

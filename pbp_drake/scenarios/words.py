@@ -2,20 +2,28 @@
 (a run's result line, the studies' tables and figures, the console's page) says them the
 same way: each method's one name, and a count with its noun in the right number."""
 
-#: The name a person reads for each method of `schema.METHODS`: on the page's Start button
-#: and title, in the results tables and in the figures. The paper's names where it has them;
-#: confidence_alpha has none and reads as `--methods` spells it (as the results tables print it);
-#: hop and predict_then_assist are the shared-autonomy baselines' names in Javdani et al.'s papers.
-METHOD_NAMES = {
-    "pbp_alternated": "PBP-Alt",
-    "pbp_continuous": "PBP-Cont",
-    "fixed_alpha": "Fixed alpha",
-    "confidence_alpha": "confidence_alpha",
-    "teleop": "Teleop",
-    "pbp_no_user": "PBP-NoUser",
-    "hop": "HOP",
-    "predict_then_assist": "Predict-then-assist",
-}
+import collections.abc
+
+from pbp_drake.core.methods import METHODS
+
+
+class _MethodNames(collections.abc.Mapping):
+    """Method name -> the name a person reads (`Method.label`), read live from the methods
+    registry, so a method registered later has its name here too."""
+
+    def __getitem__(self, name):
+        return METHODS[name].label
+
+    def __iter__(self):
+        return iter(METHODS)
+
+    def __len__(self):
+        return len(METHODS)
+
+
+#: The name a person reads for each method: on the page's Start button and title, in the
+#: results tables and in the figures (`pbp_drake.core.methods.Method.label`).
+METHOD_NAMES = _MethodNames()
 
 
 def counted(count, noun, plural=None):

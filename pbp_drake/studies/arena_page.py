@@ -15,15 +15,16 @@ import json
 import os
 import pathlib
 
+from pbp_drake.core.methods import methods_of
 from pbp_drake.scenarios import METHOD_NAMES
 from pbp_drake.studies.intervals import mean_interval, wilson_interval
 from pbp_drake.studies.matrix_report import FIGURE, matrix_command, metric_range
 from pbp_drake.studies.atomic_files import write_atomically
 
 HOLDS, FAILS, UNDECIDED = "holds", "does not hold", "undecided"
-TELEOP = "teleop"
+TELEOP = methods_of("teleop")[0]
 #: The methods whose claims the page checks: the paper's PBP, both modes.
-PBP_METHODS = ("pbp_alternated", "pbp_continuous")
+PBP_METHODS = methods_of("pbp")
 
 
 @dataclasses.dataclass(frozen=True)

@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
+from pbp_drake.core.methods import method_colour, methods_of  # noqa: E402
 from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
 from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
 
@@ -20,12 +21,8 @@ from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
 # ---------------------------------------------------------------------------------------------
 # The method comparison (Fig. 7)
 
-# The methods' names, the one table every page and table reads (scenarios.words).
+# The methods' names, the one table every page and table reads (the methods registry).
 METHOD_LABELS = METHOD_NAMES
-METHOD_COLOURS = {"pbp_alternated": "tab:orange", "pbp_continuous": "tab:blue",
-                  "teleop": "tab:green", "pbp_no_user": "tab:gray", "fixed_alpha": "tab:purple",
-                  "confidence_alpha": "tab:cyan", "hop": "tab:red",
-                  "predict_then_assist": "tab:brown"}
 
 
 def _save(figure, path, **options):
@@ -54,7 +51,7 @@ def _box_plot(records, methods, field, ylabel, title, path, ylim=None):
     # A method with no finished trial gets an empty box (matplotlib needs one value: NaN).
     boxes = axis.boxplot([d if d else [np.nan] for d in data], patch_artist=True)
     for patch, method in zip(boxes["boxes"], methods):
-        patch.set_facecolor(METHOD_COLOURS.get(method, "0.8"))
+        patch.set_facecolor(method_colour(method, "0.8"))
         patch.set_alpha(0.6)
     for index, values in enumerate(data, start=1):
         jitter = np.linspace(-0.12, 0.12, len(values)) if len(values) > 1 else np.zeros(
@@ -93,7 +90,7 @@ def plot_collision_histogram(summary, path):
         label = METHOD_LABELS.get(method, method) + (
             f" (mean {mean:.3f})" if mean is not None else " (no trials)")
         axis.bar(edges[:-1] + (index + 0.5) * width, entry["histogram"], width=width,
-                 align="edge", color=METHOD_COLOURS.get(method), label=label, alpha=0.85)
+                 align="edge", color=method_colour(method), label=label, alpha=0.85)
     axis.set_xlim(edges[0], edges[-1])
     axis.set_xlabel("collision ratio (ticks in collision / ticks)")
     axis.set_ylabel("trials")
@@ -125,7 +122,7 @@ def plot_pilot_panels(panels, path):
     for axis, (pilot, rows) in zip(axes[0], panels.items()):
         time_axis = axis.twinx()
         for index, (method, ratio, time) in enumerate(rows):
-            colour = METHOD_COLOURS.get(method, "0.4")
+            colour = method_colour(method, "0.4")
             _error_bar(axis, index - 0.12, ratio, fmt="o", color=colour)
             _error_bar(time_axis, index + 0.12, time, fmt="s", color=colour, mfc="white")
         axis.set_xticks(range(len(rows)), [_label(method) for method, _, _ in rows],
@@ -243,7 +240,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
         results = summary["scenes"][index]["by_operator_speed"]
         for speed, target in zip(speeds, pbp_axes):
             outcomes = results[speed]
-            for method, style in (("pbp_alternated", "-"), ("pbp_continuous", "--")):
+            for method, style in zip(methods_of("pbp"), ("-", "--")):
                 positions = trajectories[(scene.name, speed, method)]
                 target.plot(positions[:, 0], positions[:, 1], style, color=colour, lw=1.5,
                             label=f"{scene.name} {METHOD_LABELS[method]}: "
@@ -263,17 +260,16 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
 def plot_alt_vs_cont(resolved, summary, path):
     """Fig. 4: the two modes' paths, their y against the phase, and the input."""
     figure, (path_axes, phase_axes, input_axes) = plt.subplots(1, 3, figsize=(14, 4))
-    labels = {"pbp_continuous": "PBP-Cont", "pbp_alternated": "PBP-Alt"}
-    colours = {"pbp_continuous": "tab:blue", "pbp_alternated": "tab:orange"}
     for method, mode in summary["modes"].items():
+        label, colour = METHOD_LABELS[method], method_colour(method)
         positions = np.asarray(mode["positions"])
         phase = np.asarray(mode["phase"])
         active = np.asarray(mode["operator_active"], bool)
-        path_axes.plot(positions[:, 0], positions[:, 1], color=colours[method],
-                       label=f"{labels[method]} (final error {mode['final_error'] * 100:.2f} cm)")
-        phase_axes.plot(phase, positions[:, 1], color=colours[method], label=labels[method])
-        phase_axes.plot(phase[active], positions[active, 1], ".", color=colours[method], ms=3)
-        input_axes.plot(mode["times"], phase, color=colours[method], label=labels[method])
+        path_axes.plot(positions[:, 0], positions[:, 1], color=colour,
+                       label=f"{label} (final error {mode['final_error'] * 100:.2f} cm)")
+        phase_axes.plot(phase, positions[:, 1], color=colour, label=label)
+        phase_axes.plot(phase[active], positions[active, 1], ".", color=colour, ms=3)
+        input_axes.plot(mode["times"], phase, color=colour, label=label)
     goal = summary["goal"]
     path_axes.plot(*goal[:2], "k*", ms=10)
     path_axes.set_xlabel("x")

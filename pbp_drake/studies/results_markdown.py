@@ -8,6 +8,7 @@ table on the docs site cannot name seeds or methods other than those it was made
 import json
 import pathlib
 
+from pbp_drake.scenarios import METHOD_NAMES
 from pbp_drake.studies.report import results_table
 from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
@@ -104,9 +105,8 @@ def alt_vs_cont_markdown(study, summary, figure):
     columns = ["method", "final error (cm)", "input stopped at (s)",
                "phase constant while the operator acts", "phase strictly increasing"]
     lines += ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    labels = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont"}
     for method, mode in summary["modes"].items():
-        cells = [labels.get(method, method), f"{100 * mode['final_error']:.2f}",
+        cells = [METHOD_NAMES.get(method, method), f"{100 * mode['final_error']:.2f}",
                  f"{mode['input_stopped_at']:.2f}",
                  "yes" if mode["phase_constant_while_operator_acts"] else "no",
                  "yes" if mode["phase_strictly_increasing"] else "no"]

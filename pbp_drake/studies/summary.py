@@ -65,8 +65,8 @@ def arbitration(methods):
     entries of a summary's methods (None when it has none)."""
     swept = []
     for label, entry in methods.items():
-        name, alpha = parse_method_label(label)
-        if name == "fixed_alpha" and alpha is not None:
+        _, alpha = parse_method_label(label)
+        if alpha is not None:  # a method with its weight, `fixed_alpha=A`
             swept.append((alpha, entry))
     if not swept:
         return None

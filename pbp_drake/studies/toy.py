@@ -11,6 +11,7 @@ import pathlib
 
 import numpy as np
 
+from pbp_drake.core.methods import methods_of
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolve
 from pbp_drake.builder.run import simulate
@@ -56,7 +57,8 @@ def _ratio(trajectory, obstacles):
                            [o.radius for o in obstacles])
 
 
-PBP_METHODS = ("pbp_alternated", "pbp_continuous")
+#: The paper's two PBP modes, which the alpha study runs beside every fixed alpha.
+PBP_METHODS = methods_of("pbp")
 
 
 def operator_speeds(scenario, study):

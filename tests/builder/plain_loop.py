@@ -12,7 +12,7 @@ from pbp_drake.core.dmp import DmpBankModel
 from pbp_drake.core.point_robot import MassSpringDamper
 from pbp_drake.core.toy_scene import repulsion_command
 from pbp_drake.scenarios import (
-    BLEND_MODE_OF_METHOD, NoOperator, ObstacleRepulsion, SinusoidalStep, demonstration_samples)
+    METHODS, NoOperator, ObstacleRepulsion, SinusoidalStep, demonstration_samples)
 
 
 def plain_loop(scenario):
@@ -26,7 +26,7 @@ def plain_loop(scenario):
                              scenario.robot.damping, scenario.robot.time_step)
     plant_steps = int(round(period / scenario.robot.time_step))
     ticks = int(round(scenario.duration / period))
-    mode = BLEND_MODE_OF_METHOD[scenario.method]
+    mode = METHODS[scenario.method].blend_mode
     settings = scenario.dmp
     if demo is not None:
         bank = DmpBankModel.from_demonstration(times, demo, len(goals), settings, start,

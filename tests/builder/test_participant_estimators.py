@@ -2,6 +2,7 @@
 reaching tasks under PBP-Alt and PBP-Cont with ``angle``, ``nearest`` and ``bayesian``."""
 
 import dataclasses
+import pathlib
 import textwrap
 
 import numpy as np
@@ -49,3 +50,17 @@ def test_every_estimator_follows_the_participant_to_the_target(task, method, est
     assert np.linalg.norm(result.ee_positions[-1] - result.objects[2]) < 0.06
     # It never did the whole task alone: the DMPs moved the hand part of the way.
     assert result.intervention_ratio < 0.95
+
+
+@pytest.mark.parametrize("estimator", ["nearest", "bayesian"])
+def test_on_the_arm_the_participant_gets_there_under_pbp_alt(estimator):
+    """The arm's wrist turns 1.2 rad either way: insisting, the participant turns the
+    target to the side the wrist reaches and sidesteps onto it (evaluation seed 10,000,
+    where the shorter turn's side lies beyond the wrist's bound, the target ahead)."""
+    scenario = load_scenario_file(
+        pathlib.Path(__file__).resolve().parents[2] / "diagrams/arm_reach.yaml").scenario
+    scenario = dataclasses.replace(scenario, method="pbp_alternated", seed=10_000,
+                                   goal_estimator=GoalEstimatorSettings(method=estimator))
+    result = run_task(scenario)
+    assert result.success, estimator
+    assert result.switches == 2

@@ -136,3 +136,25 @@ def test_with_no_reposition_time_it_goes_to_a_target_it_cannot_point_at_at_once(
     showing, yaw_rate = assist_motion(params, SPEED, HAND, 0.0, AHEAD, BEHIND_LEFT,
                                       insisting=False, vertical=True)
     np.testing.assert_allclose(ahead.tick(), [*showing, yaw_rate])
+
+
+def test_insisting_at_the_wrists_bound_it_turns_the_target_to_the_side_the_wrist_reaches():
+    # The hand turned to the wrist's bound, the target straight ahead: the near side's
+    # heading (a quarter turn further) is beyond the bound, where an arm's participant
+    # once pushed for ever while no key moved the hand; the far side's is within it.
+    heading = WRIST[0]
+    target = HAND + 0.2 * np.array([np.cos(heading), np.sin(heading), 0.0])
+    for vertical in (False, True):
+        velocity, yaw_rate = assist_motion(PARAMS, SPEED, HAND, heading, target, AHEAD,
+                                           insisting=True, vertical=vertical,
+                                           heading_range=WRIST)
+        assert yaw_rate > 0.0
+        _, unbounded = assist_motion(PARAMS, SPEED, HAND, heading, target, AHEAD,
+                                     insisting=True, vertical=vertical)
+        assert unbounded < 0.0  # the HSR's base turns the near way, as before
+    # Once turned there, the target is to its side: the sidestep reaches it at full speed.
+    turned = heading + np.pi / 2
+    velocity, yaw_rate = assist_motion(PARAMS, SPEED, HAND, turned, target, AHEAD,
+                                       insisting=True, vertical=True, heading_range=WRIST)
+    assert yaw_rate == pytest.approx(0.0, abs=1e-9)
+    np.testing.assert_allclose(velocity, SPEED * (target - HAND) / 0.2, atol=1e-12)

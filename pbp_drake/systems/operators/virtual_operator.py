@@ -475,7 +475,8 @@ class VirtualOperator(SampledOperator):
             else:
                 velocity, yaw_rate = assist_motion(
                     self.params, self._speed, position, heading, target_position,
-                    self._objects[shown], insisting, vertical=self._vertical)
+                    self._objects[shown], insisting, vertical=self._vertical,
+                    heading_range=self._heading_range)
         else:
             velocity, yaw_rate = drive_motion(self.params, self._speed, position, heading,
                                               target_position, vertical=self._vertical)

@@ -6,8 +6,9 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from pbp_drake.core.arbitration import (
-    DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW, blend, confidence_alpha,
-    validate_confidence_ramp, validate_mode)
+    BLEND_LAWS, CONFIDENCE_WEIGHT, DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH,
+    DEFAULT_CONFIDENCE_LOW, FIXED_WEIGHT, blend, confidence_alpha, validate_confidence_ramp,
+    validate_mode)
 from pbp_drake.systems.ports import PortGetters, goal_index
 
 
@@ -19,11 +20,13 @@ class BlenderBase(PortGetters, LeafSystem):
 
     A subclass declares its ports, among them `selected_goal` and `goal_probabilities` as
     `_selected_goal_port` and `_goal_probabilities_port`, which `alpha` reads; it names the
-    check of its modes (`_validate_mode`) and the goal estimator whose `goal_probabilities`
-    output feeds it (`_estimator_name`).
+    check of its modes (`_validate_mode`), their laws (`_laws`, whose weight says where
+    alpha comes from) and the goal estimator whose `goal_probabilities` output feeds it
+    (`_estimator_name`).
     """
 
     _validate_mode = staticmethod(validate_mode)
+    _laws = BLEND_LAWS
     _estimator_name = "GoalEstimator"
 
     def __init__(self, mode, goal_count, control_period, alpha, confidence_range, alpha_max):
@@ -36,6 +39,7 @@ class BlenderBase(PortGetters, LeafSystem):
                              f"confidence_high), got {confidence_range!r}") from None
         validate_confidence_ramp(low, high, alpha_max)
         self._mode = mode
+        self._weight = self._laws[mode].weight
         self._confidence_range = (float(low), float(high))
         self._alpha_max = float(alpha_max)
         self._goal_count = int(goal_count)
@@ -43,7 +47,7 @@ class BlenderBase(PortGetters, LeafSystem):
         # A Context parameter, not a Python attribute: a live change (set_alpha) then
         # belongs to one Context and invalidates the cached output.
         self._alpha_index = (self.DeclareNumericParameter(BasicVector([float(alpha)]))
-                             if mode == "fixed_alpha" else None)
+                             if self._weight == FIXED_WEIGHT else None)
 
     @property
     def mode(self):
@@ -62,7 +66,7 @@ class BlenderBase(PortGetters, LeafSystem):
         the goal confidence for `confidence_alpha`, None for the other modes."""
         if self._alpha_index is not None:
             return float(context.get_numeric_parameter(self._alpha_index)[0])
-        if self._mode != "confidence_alpha":
+        if self._weight != CONFIDENCE_WEIGHT:
             return None
         if not self._goal_probabilities_port.HasValue(context):
             raise RuntimeError(

@@ -9,7 +9,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.hindsight_optimization import (
-    HOP_METHODS, HopSettings, assisted_command, hop_targets)
+    HopSettings, assisted_command, check_assistance, hop_targets)
 from pbp_drake.systems.ports import PortGetters
 
 
@@ -19,8 +19,7 @@ class HopAssistanceBase(PortGetters, LeafSystem):
 
     def __init__(self, method, goal_count, settings, control_period):
         super().__init__()
-        if method not in HOP_METHODS:
-            raise ValueError(f"method {method!r} is unknown; choose one of {HOP_METHODS}")
+        check_assistance(method)
         if not isinstance(settings, HopSettings):
             raise ValueError(f"settings must be a HopSettings, got {type(settings).__name__}")
         settings.validate()

@@ -75,7 +75,7 @@ class Console:
             meshcat.AddSlider(RATE_SLIDER, min(low, rate), max(high, rate), step, rate)
             self._sliders.append(RATE_SLIDER)
         # Line name -> the label shown now, in the order the lines are shown.
-        self._lines = {"title": None, "status": None, "result": None}
+        self._lines = {"title": None, "status": None, "result": None, "notice": None}
 
     @property
     def meshcat(self):
@@ -121,6 +121,19 @@ class Console:
 
     def clear_result(self):
         self._show("result", None)
+
+    def show_notice(self, text):
+        """A line under the result for what the person must know (no gamepad); None
+        hides it."""
+        self._show("notice", text)
+
+    def remove_controls(self):
+        """Removes the choice buttons and the sliders, keeping the lines: the run's page
+        once nothing answers them."""
+        self.set_choices(())
+        for name in self._sliders:
+            self._meshcat.DeleteSlider(name, strict=False)
+        self._sliders = []
 
     def lines(self):
         """The labels of the shown lines, top to bottom (what the page shows)."""
@@ -179,14 +192,10 @@ class Console:
             return "stop"
 
     def close(self):
-        """Removes every button and slider this console added."""
-        for choice in self._choices:
-            self._meshcat.DeleteButton(CHOICE_BUTTONS[choice], strict=False)
-        for name in self._sliders:
-            self._meshcat.DeleteSlider(name, strict=False)
+        """Removes every button and slider this console added, and its lines."""
+        self.remove_controls()
         for name in self._lines:
             self._show(name, None)
-        self._choices = ()
 
     def _slider(self, name):
         return self._meshcat.GetSliderValue(name) if name in self._sliders else None

@@ -13,10 +13,11 @@ import typing
 import numpy as np
 
 from pbp_drake.scenarios.bounds import check_yaml_bounds, load_document, load_typed
+from pbp_drake.scenarios.overrides import document_text
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
-    AlphaStudy, Gamepad, Keyboard, MethodComparison, Scenario, ScenarioError, TASK_ROBOTS,
+    AlphaStudy, MethodComparison, Scenario, ScenarioError, TASK_ROBOTS,
     STUDY_SPLITS, ScenarioFile)
 from pbp_drake.scenarios.validation import (
     check_duplicate_keys, check_numbers, check_seed, describe_load_error,
@@ -34,13 +35,24 @@ class LoadedScenarioFile:
     resolved: ResolvedScenario
 
 
-def load_scenario_file(path):
-    """Reads, checks and resolves a scenario file; errors name the file and the field."""
+def load_scenario_file(path, overrides=None):
+    """Reads, checks and resolves a scenario file; errors name the file and the field.
+    `overrides` (`overrides.ScenarioOverrides`: the command line's `--set` and
+    `--scenario-text`) are merged onto the file's document before it is read, and checked
+    as the file is; errors then name the file and the overrides."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
     try:
         text = read_scenario_text(path)
+    except ScenarioError as error:
+        raise ScenarioError(f"{path}: {error}") from None
+    return load_scenario_text(text, path, overrides)
+
+
+def load_scenario_text(text, path, overrides=None):
+    """`load_scenario_file` of a scenario file's `text`, named `path` in its errors."""
+    try:
         # Before any value is made (a few lines of aliases can stand for billions), and
         # before the slower walk of the text for duplicate keys.
         check_yaml_bounds(text)
@@ -51,14 +63,19 @@ def load_scenario_file(path):
         document = load_document(text)
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
         raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
+    origin = path
+    if overrides:
+        document = overrides.apply(document)
+        text = document_text(document)
+        origin = f"{path} with {overrides.words()}"
     # Before the typed loader: it accepts some of these and misreports the others.
     problem = shape_problem(document, ScenarioFile)
     if problem:
-        raise ScenarioError(f"{path}: {problem}")
+        raise ScenarioError(f"{origin}: {problem}")
     try:
         loaded = load_typed(ScenarioFile, document, text)
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
-        raise ScenarioError(f"{path}: {_load_error_message(error)}") from None
+        raise ScenarioError(f"{origin}: {_load_error_message(error)}") from None
     try:
         resolved = resolve(loaded.scenario)
         check_numbers(loaded.study, "study")
@@ -67,7 +84,7 @@ def load_scenario_file(path):
         if isinstance(loaded.study, MethodComparison):
             check_method_comparison(loaded.study, loaded.scenario)
     except ScenarioError as error:
-        raise ScenarioError(f"{path}: {error}") from None
+        raise ScenarioError(f"{origin}: {error}") from None
     return LoadedScenarioFile(path=path, scenario=loaded.scenario, study=loaded.study,
                               resolved=resolved)
 
@@ -116,6 +133,8 @@ def check_operator_speeds(study, scenario):
 
 
 def check_method_comparison(study, scenario):
+    """The method comparison's methods, trials and seeds, for `scenario` (a person's
+    operator is refused by `pbp-drake study`, not here: `run` takes the file with one)."""
     if not isinstance(scenario.robot, TASK_ROBOTS):
         raise ScenarioError("study !MethodComparison runs the tasks: use robot: !Hsr or "
                             "!Arm")
@@ -137,8 +156,6 @@ def check_method_comparison(study, scenario):
     if study.split not in STUDY_SPLITS:
         raise ScenarioError(f"study.split {study.split!r} is unknown; expected one of "
                             f"{', '.join(STUDY_SPLITS)}")
-    if isinstance(scenario.operator, (Keyboard, Gamepad)):
-        raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")
 
 
 def _load_error_message(error):

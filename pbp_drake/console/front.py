@@ -144,6 +144,12 @@ body.pbp-ended #status-message { display: none !important; }
     ended = true;
     do_reconnect = false;
     document.body.classList.add("pbp-ended");
+    // Nothing answers the run's buttons and sliders any more (the keys' included).
+    try {
+      Object.keys(viewer.gui_controllers).forEach(function (name) {
+        viewer.delete_control(name);
+      });
+    } catch (e) {}
     state = Object.assign({}, state);
     if (!state.notice) state.notice = "This run has ended; you can close this page.";
     show(state);
@@ -394,6 +400,13 @@ class PageFront:
     async def _stop(self):
         self._server.close()  # and every connection, with its relay
         await self._server.wait_closed()
+        # What is still running (a relay's last close, a file being read) ends here, on the
+        # running loop: a task left pending would be destroyed with the loop, its cleanup
+        # then failing with "no running event loop".
+        others = [task for task in asyncio.all_tasks() if task is not asyncio.current_task()]
+        for task in others:
+            task.cancel()
+        await asyncio.gather(*others, return_exceptions=True)
 
     async def _serve(self):
         # No keepalive pings: a page busy rendering answers late, and would be dropped for

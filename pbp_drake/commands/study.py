@@ -89,7 +89,7 @@ def add_study_commands(commands):
                         "matrix, with --pilots: its method x pilot tables with 95 %% "
                         "intervals, every method paired with PBP-Alt per pilot, and "
                         f"{MATRIX_FIGURE}, a panel per pilot), or a user "
-                        "study's folder of participant folders (`pbp-drake run --participant "
+                        "study's folder of participant folders (`pbp-drake session --participant "
                         "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
                         "Wilcoxon tests and Fig. 8 in DIR/results.md and "
                         f"DIR/{FIG8}")

@@ -39,7 +39,8 @@ class Console:
             taking `title`, `status`, `result` and `time` (a `PageFront`), or None.
 
     The panel then shows, top to bottom: the choice buttons, the sliders, the title line
-    (`show_title`), the status line (`show_status`) and the result line (`show_result`).
+    (`show_title`), the status line (`show_status`), the result line (`show_result`) and
+    the notice (`show_notice`).
     Buttons added to the page by others (the keyboard operator's) stay above.
 
     `wait_for_start(label)` shows a Start button labelled `label` and blocks until it is
@@ -52,9 +53,9 @@ class Console:
         once. `wait_for_choice()` blocks until a button is clicked (or Enter is pressed in
         a terminal, or Ctrl-C: both "stop").
 
-    `close()` removes every control this console added; a session that keeps one page for
-    many runs makes one Console and calls `show_title` / `show_status` / `clear_result`
-    between runs instead.
+    `close()` removes every control this console added, `remove_controls()` its buttons
+    and sliders only; a session that keeps one page for many runs makes one Console and
+    calls `show_title` / `show_status` / `clear_result` between runs instead.
     """
 
     def __init__(self, meshcat, choices=("stop", "restart", "next"), alpha=None,

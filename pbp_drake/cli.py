@@ -1,6 +1,7 @@
-"""The `pbp-drake` command line: `run` one scenario in Meshcat, `study` a scenario file,
-`report` a study folder, `bench` the DMP bank, `draw` a system diagram. Each subcommand lives
-in `pbp_drake.commands`, but `bench`: the package `pbp_drake_bench`, beside `pbp_drake`."""
+"""The `pbp-drake` command line: `run` one scenario in Meshcat, `session` a participant's
+session of a user study, `study` a scenario file, `report` a study folder, `compare` two,
+`bench` the DMP bank, `draw` a system diagram. Each subcommand lives in
+`pbp_drake.commands`, but `bench`: the package `pbp_drake_bench`, beside `pbp_drake`."""
 
 import argparse
 import os

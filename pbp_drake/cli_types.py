@@ -1,4 +1,4 @@
-"""Argument types of `pbp-drake run`: each flag's value is checked when the line is parsed,
+"""Argument types of `pbp-drake run` and `session`: each flag's value is checked when the line is parsed,
 and a bad one is refused by argparse (exit 2) as `argument --FLAG: what is wrong`."""
 
 import argparse
@@ -75,8 +75,8 @@ EXIT_CODES = {
                  "damaged files were skipped",
     EXIT_USAGE: "refused before anything ran: a bad flag, file or scenario, a port in use, "
                 "no browser in time for a person's run",
-    EXIT_STOPPED: "`run`: the person pressed Stop in the page (a session is resumed by the "
-                  "same command)",
+    EXIT_STOPPED: "`run`, `session`: the person pressed Stop in the page (a session is "
+                  "resumed by the same command)",
     EXIT_WRITE_FAILED: "a file could not be written (no space left, a quota, a read-only or "
                        "failing disk), said in one line; nothing half-written is left, and "
                        "the same command resumes a study or session",

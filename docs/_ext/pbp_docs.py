@@ -73,7 +73,8 @@ class PydrakeSystem(SphinxDirective):
 def _option_lines(parser):
     lines = []
     for action in parser._actions:
-        if isinstance(action, (argparse._HelpAction, argparse._SubParsersAction)):
+        if (isinstance(action, (argparse._HelpAction, argparse._SubParsersAction))
+                or action.help == argparse.SUPPRESS):  # an alias kept out of the help
             continue
         name = ", ".join(action.option_strings) or action.metavar or action.dest
         facts = []

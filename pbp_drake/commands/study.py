@@ -14,12 +14,13 @@ import time
 from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import (
     EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_WRITE_FAILED, method_list)
+from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
 from pbp_drake.commands.signals import Terminated, sigterm_as_interrupt
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.scenarios import (
-    TASK_ROBOTS, MethodComparison, ScenarioError, VirtualParticipant, check_method_comparison,
-    counted, load_scenario_file)
+    TASK_ROBOTS, Gamepad, Keyboard, MethodComparison, ScenarioError, VirtualParticipant,
+    check_method_comparison, counted, load_scenario_file)
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
@@ -43,7 +44,9 @@ def add_study_commands(commands):
     """The `study` and `report` subcommands and their arguments."""
     study = commands.add_parser("study", help="run the study a scenario file describes")
     study.add_argument("scenario", help="a scenario file with a `study:` section")
-    study.add_argument("--output", required=True, help="folder for summary.json and figures")
+    study.add_argument("--output", help="folder for summary.json and figures (default: "
+                       "outputs/SCENARIO-METHODS, e.g. outputs/hsr_reach-pbp_alternated-teleop; "
+                       "a 2-D study's outputs/SCENARIO)")
     study.add_argument("--methods", help="comma-separated methods to compare (HSR tasks)")
     study.add_argument("--trials", type=int, help="seeded scenes per method (HSR tasks)")
     study.add_argument("--pilots", type=method_list, metavar="P1,P2,...",
@@ -86,7 +89,7 @@ def add_study_commands(commands):
                         "matrix, with --pilots: its method x pilot tables with 95 %% "
                         "intervals, every method paired with PBP-Alt per pilot, and "
                         f"{MATRIX_FIGURE}, a panel per pilot), or a user "
-                        "study's folder of participant folders (`pbp-drake run --participant "
+                        "study's folder of participant folders (`pbp-drake session --participant "
                         "ID --output DIR/ID`): then per-method metrics and answers, pairwise "
                         "Wilcoxon tests and Fig. 8 in DIR/results.md and "
                         f"DIR/{FIG8}")
@@ -108,6 +111,7 @@ def add_study_commands(commands):
         "metric moved by more than that noise")
     compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
     compare.add_argument("second", help="another, of the same seeds (B)")
+    add_override_flags(study)
     study.set_defaults(handler=_stopping_cleanly(_study))
     report.set_defaults(handler=_stopping_cleanly(_report))
     compare.set_defaults(handler=_compare)
@@ -137,11 +141,14 @@ def _stopping_cleanly(command):
 
 
 def _study(args):
+    overrides = scenario_overrides(args)
+    scenario_file = load_scenario_file(args.scenario, overrides)
+    if args.output is None:
+        args.output = str(default_output(args.scenario, scenario_file, args.methods))
     check_output_folder(args.output)
-    scenario_file = load_scenario_file(args.scenario)
     check_buildable(scenario_file.resolved)
     if isinstance(scenario_file.scenario.robot, TASK_ROBOTS):
-        return _method_study(args, scenario_file)
+        return _method_study(args, scenario_file, overrides)
     if args.pilots is not None:
         raise ScenarioError(f"--pilots: {args.scenario} is a 2-D study, which has no "
                             "virtual participant; the HSR tasks' studies take it")
@@ -154,7 +161,8 @@ def _study(args):
     output = pathlib.Path(args.output)
     started = time.monotonic()
     summary = run_study(scenario_file, output)
-    write_toy_study(output, summary["study"], summary["scenario"], args.scenario)
+    write_toy_study(output, summary["study"], summary["scenario"], args.scenario,
+                    overrides.record() if overrides else None)
     print(f"Study {summary['study']} done in {time.monotonic() - started:.1f} s.")
     if summary["study"] == "alpha_study":
         print_alpha_study(summary)
@@ -166,6 +174,16 @@ def _study(args):
     for name in ("summary.json", TOY_FIGURES[summary["study"]]):
         print(f"  wrote {output / name}")
     return 0
+
+
+def default_output(scenario_path, scenario_file, methods=None):
+    """`outputs/<the file's stem>-<the methods, by '-'>` (`methods`: `--methods`' text, or
+    None for the file's study's); a 2-D study's `outputs/<stem>`."""
+    stem = pathlib.Path(scenario_path).stem
+    if not isinstance(scenario_file.study, MethodComparison) and methods is None:
+        return pathlib.Path("outputs", stem)
+    methods = method_list(methods) if methods else scenario_file.study.methods
+    return pathlib.Path("outputs", "-".join([stem, *methods]))
 
 
 def with_participant_condition(scenario, name, scenario_path):
@@ -182,7 +200,7 @@ def with_participant_condition(scenario, name, scenario_path):
         scenario, operator=dataclasses.replace(operator, impairment=condition(name)))
 
 
-def _method_study(args, scenario_file):
+def _method_study(args, scenario_file, overrides):
     scenario = scenario_file.scenario
     if args.pilots is not None:
         check_pilots(args.pilots)
@@ -196,6 +214,9 @@ def _method_study(args, scenario_file):
     study = scenario_file.study or MethodComparison()
     if not isinstance(study, MethodComparison):
         raise ScenarioError(f"{args.scenario}: HSR tasks take study: !MethodComparison")
+    if isinstance(scenario.operator, (Keyboard, Gamepad)):
+        raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {} "
+                            "(--set 'operator=!VirtualParticipant {}')")
     if args.methods is not None:
         study = dataclasses.replace(study, methods=method_list(args.methods))
     if args.trials is not None:
@@ -241,6 +262,7 @@ def _method_study(args, scenario_file):
     options = dict(jobs=args.jobs, split=split, retry_errors=args.retry_errors,
                    backend=args.backend, ray_address=args.ray_address,
                    scenario_file=args.scenario,
+                   overrides=overrides.record() if overrides else None,
                    split_seeds={split_name: first_seed(study, split_name)
                                 for split_name in SPLITS})
     try:

@@ -6,8 +6,9 @@ Three layers, each usable alone, and a session's pages:
   `status_text` "time left 41 s · 2 target switches · intervention 31 %", `result_text`
   "success in 14.2 s" / "failed: time limit" / "stopped at 9.0 s", `progress_text`).
 - `Console` (`pbp_drake.console.page`): the page's controls. Choice buttons (Stop,
-  Restart, Next scene), optional alpha and real-time-rate sliders, and three lines of
-  text (title, status, result) shown as button labels, since Meshcat has no text.
+  Restart, Next scene), optional alpha and real-time-rate sliders, and four lines of
+  text (title, status, result, notice) in the page front's panel, or shown as button
+  labels on a bare Meshcat, which has no text.
   `choice()` polls, `wait_for_choice()` blocks.
 - `LiveRun` (`pbp_drake.console.live`): a running simulation feeding a Console, a
   `RobotCamera` and the terminal's `Progress`; its `advance` is the `advance` argument of

@@ -100,6 +100,10 @@ ACCEPT_BURST = 10.0
 # A connection to Meshcat the front closed still counts as its own this long: Meshcat
 # counts it until it has read the close.
 CLOSING_GRACE = 1.0
+# How long a closing connection waits for the other side's close (websockets' default, 10 s,
+# outlasts a command's end: a busy page answers late). The front's own close waits for its
+# connections this long, twice (the page's side, then Meshcat's), and then cancels them.
+CLOSE_TIMEOUT = 1.0
 
 INJECTION = """
 <style>
@@ -144,6 +148,12 @@ body.pbp-ended #status-message { display: none !important; }
     ended = true;
     do_reconnect = false;
     document.body.classList.add("pbp-ended");
+    // Nothing answers the run's buttons and sliders any more (the keys' included).
+    try {
+      Object.keys(viewer.gui_controllers).forEach(function (name) {
+        viewer.delete_control(name);
+      });
+    } catch (e) {}
     state = Object.assign({}, state);
     if (!state.notice) state.notice = "This run has ended; you can close this page.";
     show(state);
@@ -351,7 +361,8 @@ class PageFront:
             self._closed = True
         unregister_front(self._meshcat_port, self)
         try:
-            asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(5.0)
+            asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(
+                4 * CLOSE_TIMEOUT + 5.0)
         except concurrent.futures.TimeoutError:
             pass
         self._loop.call_soon_threadsafe(self._loop.stop)
@@ -393,14 +404,24 @@ class PageFront:
 
     async def _stop(self):
         self._server.close()  # and every connection, with its relay
-        await self._server.wait_closed()
+        with contextlib.suppress(TimeoutError):
+            await asyncio.wait_for(self._server.wait_closed(), 2 * CLOSE_TIMEOUT)
+        # What still runs (a relay's last close, a file being read) ends here, on the
+        # running loop: a task left pending would be destroyed with the loop, its cleanup
+        # then failing with "no running event loop".
+        others = [task for task in asyncio.all_tasks() if task is not asyncio.current_task()]
+        for task in others:
+            task.cancel()
+        await asyncio.gather(*others, return_exceptions=True)
+        await asyncio.get_running_loop().shutdown_asyncgens()
 
     async def _serve(self):
         # No keepalive pings: a page busy rendering answers late, and would be dropped for
         # being slow; a closed tab closes its socket anyway.
         return await serve(self._relay, sock=self._socket, process_request=self._answer,
                            write_limit=WRITE_LIMIT, compression=None, ping_interval=None,
-                           max_size=MAX_MESSAGE, server_header=None, logger=LOG)
+                           max_size=MAX_MESSAGE, server_header=None,
+                           close_timeout=CLOSE_TIMEOUT, logger=LOG)
 
     def _loop_error(self, loop, context):
         """asyncio's errors: an accept that failed (out of file descriptors: asyncio
@@ -475,7 +496,8 @@ class PageFront:
             port = sock.getsockname()[1]
             meshcat = await connect(f"ws://localhost:{self._meshcat_port}/", sock=sock,
                                     max_size=None, compression=None, ping_interval=None,
-                                    open_timeout=5.0, logger=LOG)
+                                    open_timeout=5.0, close_timeout=CLOSE_TIMEOUT,
+                                    logger=LOG)
         except (OSError, TimeoutError, InvalidHandshake):
             await page.close(1011, "Meshcat is not reachable")
         else:

@@ -21,6 +21,10 @@ from pbp_drake.systems.ports import TaskStatus
 SLICE_SECONDS = 0.05
 # Wall seconds between two status lines: the page redraws its panel at each.
 STATUS_PERIOD = 0.25
+#: What the page and the terminal say while a gamepad run's page has seen no pad.
+NO_GAMEPAD = ("No gamepad in the page: connect one and press any of its buttons (a browser "
+              "shows a pad to the page only after a press); until then it drives nothing.")
+GAMEPAD_FOUND = "Gamepad found: it drives now."
 
 
 class Progress:
@@ -73,13 +77,18 @@ class LiveRun:
     waits for it (`Console.wait_for_start`; Enter on `stdin` or Stop: the run ends after
     its first slice, `choice` "stop"): the simulator has then been initialized, so the
     scene went to the page before the button did, and the page shows the button once it
-    has handled the scene. The task's clock, simulated time, starts at the press: the real-time pacing is
-    restarted there.
+    has handled the scene. The task's clock, simulated time, starts at the press: the
+    real-time pacing is restarted there.
+
+    With `gamepad`, a page that has seen no gamepad is told so (`NO_GAMEPAD`, in the
+    console's notice line and on stderr), and told again when one appears.
     """
 
     def __init__(self, diagram, duration, console=None, progress=None, camera=None,
-                 start_label=None, stdin=None):
+                 start_label=None, stdin=None, gamepad=False):
         self._console = console
+        self._gamepad = gamepad
+        self._pad_seen = None  # not looked yet
         self._start_label = start_label
         self._stdin = stdin
         self._progress = progress
@@ -99,6 +108,7 @@ class LiveRun:
         task's termination event, or a choice of the person's)."""
         context = simulator.get_context()
         if self._console is not None:
+            self._check_gamepad()
             if self._start_label is not None and not self._wait_for_start(simulator):
                 # One slice, not none: the task's logs then hold a tick to report.
                 advance_to(simulator, min(end_time, SLICE_SECONDS))
@@ -138,6 +148,7 @@ class LiveRun:
             return
         self.choice = self._console.choice()
         self._apply_sliders(simulator)
+        self._check_gamepad()
         # A panel keeps only the latest line, which goes to the page as its latest state:
         # every slice's. Button labels are messages the page handles in turn: a few a second.
         if (self._console.panel is not None
@@ -158,6 +169,19 @@ class LiveRun:
         # the seconds the person took to press Start.
         simulator.ResetStatistics()
         return True
+
+    def _check_gamepad(self):
+        """Says, in the page and on stderr, when a gamepad run's page has no pad, or has
+        one again."""
+        if not self._gamepad:
+            return
+        seen = self._console.meshcat.GetGamepad().index is not None
+        if seen == self._pad_seen:
+            return
+        if self._pad_seen is not None or not seen:  # at the start, only a missing pad is news
+            print(GAMEPAD_FOUND if seen else NO_GAMEPAD, file=sys.stderr, flush=True)
+        self._pad_seen = seen
+        self._console.show_notice(None if seen else NO_GAMEPAD)
 
     def _apply_sliders(self, simulator):
         if (alpha := self._console.alpha()) != self._alpha:

@@ -39,7 +39,8 @@ class Console:
             taking `title`, `status`, `result` and `time` (a `PageFront`), or None.
 
     The panel then shows, top to bottom: the choice buttons, the sliders, the title line
-    (`show_title`), the status line (`show_status`) and the result line (`show_result`).
+    (`show_title`), the status line (`show_status`), the result line (`show_result`) and
+    the notice (`show_notice`).
     Buttons added to the page by others (the keyboard operator's) stay above.
 
     `wait_for_start(label)` shows a Start button labelled `label` and blocks until it is
@@ -52,9 +53,9 @@ class Console:
         once. `wait_for_choice()` blocks until a button is clicked (or Enter is pressed in
         a terminal, or Ctrl-C: both "stop").
 
-    `close()` removes every control this console added; a session that keeps one page for
-    many runs makes one Console and calls `show_title` / `show_status` / `clear_result`
-    between runs instead.
+    `close()` removes every control this console added, `remove_controls()` its buttons
+    and sliders only; a session that keeps one page for many runs makes one Console and
+    calls `show_title` / `show_status` / `clear_result` between runs instead.
     """
 
     def __init__(self, meshcat, choices=("stop", "restart", "next"), alpha=None,
@@ -75,7 +76,7 @@ class Console:
             meshcat.AddSlider(RATE_SLIDER, min(low, rate), max(high, rate), step, rate)
             self._sliders.append(RATE_SLIDER)
         # Line name -> the label shown now, in the order the lines are shown.
-        self._lines = {"title": None, "status": None, "result": None}
+        self._lines = {"title": None, "status": None, "result": None, "notice": None}
 
     @property
     def meshcat(self):
@@ -121,6 +122,19 @@ class Console:
 
     def clear_result(self):
         self._show("result", None)
+
+    def show_notice(self, text):
+        """A line under the result for what the person must know (no gamepad); None
+        hides it."""
+        self._show("notice", text)
+
+    def remove_controls(self):
+        """Removes the choice buttons and the sliders, keeping the lines: the run's page
+        once nothing answers them."""
+        self.set_choices(())
+        for name in self._sliders:
+            self._meshcat.DeleteSlider(name, strict=False)
+        self._sliders = []
 
     def lines(self):
         """The labels of the shown lines, top to bottom (what the page shows)."""
@@ -179,14 +193,10 @@ class Console:
             return "stop"
 
     def close(self):
-        """Removes every button and slider this console added."""
-        for choice in self._choices:
-            self._meshcat.DeleteButton(CHOICE_BUTTONS[choice], strict=False)
-        for name in self._sliders:
-            self._meshcat.DeleteSlider(name, strict=False)
+        """Removes every button and slider this console added, and its lines."""
+        self.remove_controls()
         for name in self._lines:
             self._show(name, None)
-        self._choices = ()
 
     def _slider(self, name):
         return self._meshcat.GetSliderValue(name) if name in self._sliders else None

@@ -4,7 +4,7 @@ same thing the same way."""
 
 import math
 
-from pbp_drake.scenarios import METHOD_NAMES, counted
+from pbp_drake.scenarios import METHOD_NAMES, METHODS, counted
 
 
 def method_name(method, alpha=None):
@@ -13,7 +13,7 @@ def method_name(method, alpha=None):
     "PBP-Alt", `method_name("fixed_alpha", 0.5)` is "Fixed alpha 0.50"; unknown names pass
     through."""
     name = METHOD_NAMES.get(method, method)
-    if method == "fixed_alpha" and alpha is not None:
+    if alpha is not None and method in METHODS and METHODS[method].takes_weight:
         name = f"{name} {alpha:.2f}"
     return name
 
@@ -36,14 +36,42 @@ def status_text(duration, now, switches=None, intervention_ratio=None):
     return " · ".join(parts)
 
 
-def result_text(success, task_time, stopped=False):
-    """A task's outcome: "success in 14.2 s", "failed: time limit", or, when the person
-    ended the run before either (Stop, Restart, Next scene), "stopped at 9.0 s"."""
+def result_text(success, task_time, stopped=False, why=None):
+    """A task's outcome: "success in 14.2 s", "failed: time limit" (then `why`, from
+    `failure_text`, when known), or, when the person ended the run before either (Stop,
+    Restart, Next scene), "stopped at 9.0 s"."""
     if success:
         return f"success in {task_time:.1f} s"
     if stopped:
         return f"stopped at {task_time:.1f} s"
-    return "failed: time limit"
+    return "failed: time limit" + ("" if why is None else f"; {why}")
+
+
+def failure_text(target, target_count, distance, success_distance=None):
+    """Where a failed run ended: "the target was object 2 of 3, the hand 0.213 m from it
+    (success within 0.050 m)"; `target` counts from 0, `success_distance` None leaves the
+    bracket out."""
+    within = "" if success_distance is None else f" (success within {success_distance:.3f} m)"
+    return (f"the target was object {target + 1} of {target_count}, the hand "
+            f"{distance:.3f} m from it{within}")
+
+
+def controls_text(grasping, gamepad, forward, vertical):
+    """What a person's keys or gamepad do in a task: `grasping` (six degrees of freedom),
+    `gamepad` (else the keys), `forward` (the method lets the person push forward: the
+    forward key, the stick's forward), `vertical` (the keys raise and lower the hand: a
+    reaching task whose objects stand at heights of their own)."""
+    limit = "" if forward else " (not forward: the primitive drives it)"
+    if gamepad and grasping:
+        return (f"Gamepad: left stick moves the hand{limit}, triggers raise (RT) and lower "
+                "(LT) it; right stick yaws and pitches, shoulders roll.")
+    if gamepad:
+        return f"Gamepad: left stick moves the hand{limit}, right stick turns it."
+    if grasping:
+        return (f"Keys: arrows move the hand{limit}, PageUp/PageDown raise and lower it; R "
+                "switches to turning (arrows pitch and yaw, PageUp/PageDown roll).")
+    return (f"Keys: arrows move the hand{limit}, Q and E turn it"
+            + (", R raises it and F lowers it." if vertical else "."))
 
 
 def progress_text(now, duration, realtime_factor):

@@ -19,10 +19,11 @@ import numpy as np
 
 from pbp_drake.scenarios.bounds import (
     check_yaml_bounds, load_document, load_typed, read_bounded)
+from pbp_drake.scenarios.overrides import merged
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, close_match, resolve, with_method)
 from pbp_drake.scenarios.schema import (
-    RANGE, STUDY_SPLITS, AlphaStudy, Arm, Gamepad, Keyboard, MethodComparison, Scenario,
+    RANGE, STUDY_SPLITS, AlphaStudy, Arm, MethodComparison, Scenario,
     ScenarioError, ScenarioFile, TASK_ROBOTS)
 from pbp_drake.scenarios.validation import check_numbers, check_seed
 
@@ -39,10 +40,12 @@ class LoadedScenarioFile:
     resolved: ResolvedScenario
 
 
-def load_scenario_file(path, overlays=()):
+def load_scenario_file(path, overrides=None):
     """Reads, checks and resolves a scenario file (see `load_scenario_text`); errors name
-    the file and the field. A relative `robot: !Arm {model_file: ...}` is read from the
-    file's folder."""
+    the file and the field. `overrides` (`overrides.ScenarioOverrides`: the command line's
+    `--set` and `--scenario-text`) are merged onto the file's document first and checked as
+    the file is; errors then name the file and the overrides. A relative `robot: !Arm
+    {model_file: ...}` is read from the file's folder."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
@@ -50,21 +53,28 @@ def load_scenario_file(path, overlays=()):
         text = decode_scenario_bytes(read_bounded(path))
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from None
+    origin, overlays = str(path), ()
+    if overrides:
+        origin, overlays = f"{path} with {overrides.words()}", (overrides.overlay(),)
     return dataclasses.replace(
-        load_scenario_text(text, str(path), path.parent, overlays), path=path)
+        load_scenario_text(text, origin, path.parent, overlays), path=path)
 
 
 def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
     """Reads, checks and resolves the YAML `text` of a scenario file; each of `overlays`
-    (YAML text of a mapping, e.g. ``scenario: {task: {object_count: 5}}``) is merged into
+    (YAML text of a mapping, e.g. ``scenario: {task: {object_count: 5}}``, or such a
+    mapping as `bounds.load_document` reads it) is merged into
     the document first, a mapping into a mapping key by key (a tagged one replaces a node
     of another tag). Raises ScenarioError as `ORIGIN: field.path: what is wrong` (or `line
     L`). A relative arm `model_file` is read from `folder` (default: the working folder)."""
     try:
         document = _document(text)
         for overlay in overlays:
+            if isinstance(overlay, dict):
+                document = merged(document, overlay)
+                continue
             try:
-                document = _merged(document, _document(overlay, "the override"))
+                document = merged(document, _document(overlay, "the override"))
             except ScenarioError as error:
                 raise ScenarioError(f"the override {overlay.strip()!r}: {error}") from None
         problem = _first_problem(document, ScenarioFile, "")
@@ -136,17 +146,6 @@ def _syntax_error(error):
              if context and context_mark else "")
     return (f"line {mark.line + 1}, column {mark.column + 1}: YAML syntax error: "
             f"{getattr(error, 'problem', None) or error}{where}")
-
-
-def _merged(base, overlay):
-    """`overlay` merged into `base` (documents of `load_document`)."""
-    if not (isinstance(base, dict) and isinstance(overlay, dict)) or (
-            "_tag" in overlay and overlay["_tag"] != base.get("_tag")):
-        return overlay
-    merged = dict(base)
-    for key, value in overlay.items():
-        merged[key] = _merged(base[key], value) if key in base else value
-    return merged
 
 
 def _model_file_from(scenario, folder):
@@ -324,5 +323,3 @@ def check_method_comparison(study, scenario):
     if study.split not in STUDY_SPLITS:
         raise ScenarioError(f"study.split {study.split!r} is unknown; expected one of "
                             f"{', '.join(STUDY_SPLITS)}")
-    if isinstance(scenario.operator, (Keyboard, Gamepad)):
-        raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {}")

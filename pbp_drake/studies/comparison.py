@@ -33,7 +33,7 @@ BACKENDS = ("local", "ray")
 def run_method_comparison(scenario, methods, trials, seed, output, progress=None, jobs=1,
                           run=None, retry_errors=False, backend="local", ray_address=None,
                           split=None, scenario_file=None, split_seeds=None,
-                          participant_condition=None):
+                          participant_condition=None, overrides=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     processes, writes every trial under `output/trials/`, then the summary, tables and
     figures (see `report`). Returns the summary dict. `split` labels the seeds in
@@ -41,7 +41,8 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     keeps the label the folder holds for the same seeds. `scenario_file` and `split_seeds`
     go into study.json (see `write_study`; None keeps what the folder holds), and so does
     `participant_condition`, the name of the condition the scenario's virtual participant
-    was impaired with (`pbp-drake study --participant-condition`; None: none named).
+    was impaired with (`pbp-drake study --participant-condition`; None: none named), and
+    `overrides`, the command line's changes to the file's fields (None: none).
 
     `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
     Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "HEAD:6379", "auto",
@@ -64,7 +65,7 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     check_folder(output, scenario, scenario_hash(scenario), participant_condition)
     with study_lock(output):
         folder = prepare_folder(scenario, methods, trials, seed, output, retry_errors, split,
-                                scenario_file, split_seeds, participant_condition)
+                                scenario_file, split_seeds, participant_condition, overrides)
         run_trials([folder], jobs, progress, run, backend, ray_address)
         return report(output)
 
@@ -103,7 +104,8 @@ def check_run_options(trials, jobs, backend, ray_address, run):
 
 
 def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, split=None,
-                   scenario_file=None, split_seeds=None, participant_condition=None):
+                   scenario_file=None, split_seeds=None, participant_condition=None,
+                   overrides=None):
     """Checks `output` (StudyFolderError when it holds another scenario's study), removes
     what an interrupted study left, names the damaged trial files, writes study.json and
     returns the StudyFolder with the trials still to run (see `run_method_comparison`).
@@ -134,7 +136,7 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
                 pending.append((method, trial))
     name_damaged([d._replace(problem=f"{d.problem}; runs again") for d in damaged])
     write_study(output, scenario, digest, methods, trials, seed, split, scenario_file,
-                split_seeds, participant_condition)
+                split_seeds, participant_condition, overrides)
     return StudyFolder(scenario, digest, output, seed, pending)
 
 
@@ -181,7 +183,7 @@ def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_ad
 
 def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=None, jobs=1,
                       run=None, retry_errors=False, backend="local", ray_address=None,
-                      split=None, scenario_file=None, split_seeds=None):
+                      split=None, scenario_file=None, split_seeds=None, overrides=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with every method under every
     pilot (`scenarios.pilots`: `with_pilot(scenario, name)`), all in one pool of `jobs`
     processes or Ray tasks, each pilot's trials into `output/pilots/NAME/`; then writes the
@@ -209,10 +211,10 @@ def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=
             locks.enter_context(study_lock(folder))
         remove_leftovers(output)  # of an interrupted report
         write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split,
-                           scenario_file, split_seeds)
+                           scenario_file, split_seeds, overrides)
         folders = [prepare_folder(pilot_scenario, methods, trials, seed,
                                   pilot_folder(output, pilot), retry_errors, split,
-                                  scenario_file, split_seeds)
+                                  scenario_file, split_seeds, overrides=overrides)
                    for pilot, pilot_scenario in pilot_scenarios.items()]
         run_trials(folders, jobs, progress, run, backend, ray_address)
         return report_matrix(output)

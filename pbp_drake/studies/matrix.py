@@ -74,7 +74,7 @@ def check_matrix_folder(output, scenario, digest):
 
 
 def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split=None,
-                       scenario_file=None, split_seeds=None):
+                       scenario_file=None, split_seeds=None, overrides=None):
     """Writes a matrix folder's study.json (each pilot's folder has its own)."""
     study = {"study": MATRIX, "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "pilots": list(pilots),
@@ -83,6 +83,8 @@ def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, 
         study["scenario_file"] = str(scenario_file)
     if split_seeds is not None:
         study["split_seeds"] = dict(split_seeds)
+    if overrides is not None:
+        study["overrides"] = overrides
     write_atomically(pathlib.Path(output) / "study.json", json.dumps(study, indent=2) + "\n")
 
 

@@ -1,5 +1,5 @@
 """`pbp-drake report STUDY_DIR` for a user study: STUDY_DIR holds one folder per participant
-(`pbp-drake run ... --participant ID`). Per method, the metrics of the recorded runs
+(`pbp-drake session ... --participant ID`). Per method, the metrics of the recorded runs
 (intervention ratio, task time, success) and the questionnaire's answers; pairwise Wilcoxon
 signed-rank tests with Bonferroni correction on intervention, task time, tiredness and ease,
 as the paper reports them (section V-C); Fig. 8 (`fig8_questionnaire.png`); all in
@@ -54,7 +54,7 @@ def read_participants(study_dir):
     if not folders:
         raise ScenarioError(f"{study_dir} has no study.json and no trial files of a "
                             "`pbp-drake study`, and no participant folders (ID/study.json, "
-                            "written by `pbp-drake run SCENARIO --participant ID --output "
+                            "written by `pbp-drake session SCENARIO --participant ID --output "
                             f"{study_dir}/ID`): nothing to report")
     sessions, damaged = {}, []
     for folder in folders:

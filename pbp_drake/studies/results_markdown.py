@@ -8,7 +8,8 @@ table on the docs site cannot name seeds or methods other than those it was made
 import json
 import pathlib
 
-from pbp_drake.scenarios import METHOD_NAMES
+from pbp_drake.scenarios import METHOD_NAMES, ScenarioError
+from pbp_drake.scenarios.overrides import ScenarioOverrides
 from pbp_drake.studies.report import results_table
 from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
@@ -20,9 +21,12 @@ from pbp_drake.studies.trial_files import StudyError
 STUDY_FILE = "study.json"
 
 
-def write_toy_study(output, kind, scenario_name, scenario_file):
-    """Writes a 2-D study folder's study.json: its kind, scenario and scenario file."""
+def write_toy_study(output, kind, scenario_name, scenario_file, overrides=None):
+    """Writes a 2-D study folder's study.json: its kind, scenario and scenario file, and
+    the command line's `overrides` of its fields (`ScenarioOverrides.record()`) if any."""
     study = {"study": kind, "scenario": scenario_name, "scenario_file": str(scenario_file)}
+    if overrides is not None:
+        study["overrides"] = overrides
     write_atomically(pathlib.Path(output) / STUDY_FILE, json.dumps(study, indent=2) + "\n")
 
 
@@ -47,7 +51,23 @@ def study_command(study, summary):
     condition = study.get("participant_condition")
     if isinstance(condition, str):
         words += ["--participant-condition", condition]
-    return " ".join(words)
+    return " ".join(words + _override_words(study))
+
+
+def _override_words(study):
+    """The recorded `--scenario-text` and `--set` flags, as typed ([] for none)."""
+    recorded = study.get("overrides") if isinstance(study, dict) else None
+    if not isinstance(recorded, dict):
+        return []
+    settings = recorded.get("set") or []
+    text = recorded.get("scenario_text")
+    if not all(isinstance(setting, str) for setting in settings) or not isinstance(
+            text, (str, type(None))):
+        return []
+    try:
+        return [ScenarioOverrides(tuple(settings), text).words()]
+    except ScenarioError:  # a study.json edited by hand: the command without them
+        return []
 
 
 def _seeds_text(summary):
@@ -65,7 +85,8 @@ def method_comparison_markdown(study, summary):
 
 
 def _toy_command(study, summary):
-    return f"pbp-drake study {_scenario_file(study, summary)}"
+    return " ".join([f"pbp-drake study {_scenario_file(study, summary)}",
+                     *_override_words(study)])
 
 
 def _outcome_cell(outcome):

@@ -180,14 +180,16 @@ def write_trial_files(output, record, csv_text):
 
 
 def write_study(output, scenario, digest, methods, trials, seed, split=None,
-                scenario_file=None, split_seeds=None, participant_condition=None):
+                scenario_file=None, split_seeds=None, participant_condition=None,
+                overrides=None):
     """Writes the folder's study.json: which scenario, methods, trials and seeds, and the
     split the seeds belong to (`studies.splits`; None when not known). `scenario_file` (the
     path the study was run from) and `split_seeds` ({"tuning": first seed, "evaluation":
     first seed}) let `report --markdown` name the command that made the study; None when not
     known. Neither goes into the summary, which is made from the trials.
     `participant_condition` (`pbp-drake study --participant-condition`; None: none) is
-    recorded when given, and the results name it."""
+    recorded when given, and the results name it; so are `overrides`, the command line's
+    changes to the file's fields (`ScenarioOverrides.record()`)."""
     study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
              "split": split, "scenario_content": scenario_content(scenario)}
@@ -197,6 +199,8 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
         study["split_seeds"] = dict(split_seeds)
     if participant_condition is not None:
         study["participant_condition"] = str(participant_condition)
+    if overrides is not None:
+        study["overrides"] = overrides
     write_atomically(output / "study.json", json.dumps(study, indent=2) + "\n")
 
 

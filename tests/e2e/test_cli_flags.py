@@ -92,9 +92,11 @@ def test_a_person_run_that_no_browser_joins_stops_and_records_nothing(repo, tmp_
     assert not record.exists()
 
 
-def test_a_session_that_no_browser_joins_stops_and_saves_nothing(repo, tmp_path, capsys):
+@pytest.mark.parametrize("command", [["session"], ["run"]])  # `run --participant`: its alias
+def test_a_session_that_no_browser_joins_stops_and_saves_nothing(repo, tmp_path, capsys,
+                                                                 command):
     output = tmp_path / "P1"
-    code = main(["run", str(repo / TASK), "--operator", "keyboard", "--participant", "P1",
+    code = main([*command, str(repo / TASK), "--operator", "keyboard", "--participant", "P1",
                  "--output", str(output), "--wait-for-browser", "0.2"])
     err = capsys.readouterr().err
     assert code == 2
@@ -112,12 +114,24 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     assert f"{named}: user-study sessions run the HSR tasks" in err
 
 
+def test_a_session_is_its_own_command_and_run_keeps_to_one_run(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["session", TASK])
+    assert exit_info.value.code == 2
+    assert "the following arguments are required: --participant" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    run_help = capsys.readouterr().out
+    assert "--participant" not in run_help and "--answers" not in run_help
+    assert "--set FIELD=VALUE" in run_help and "the page:" in run_help
+
+
 @pytest.mark.slow  # a whole session of two methods: 2 s
 def test_a_session_with_fixed_answers_waits_for_no_browser(repo, tmp_path, capsys):
     # The virtual participant and --answers need no page: the session runs at once, even
     # with a page served and a long --wait-for-browser.
     started = time.monotonic()
-    code = main(["run", str(repo / TASK), "--operator", "virtual", "--participant", "P01",
+    code = main(["session", str(repo / TASK), "--operator", "virtual", "--participant", "P01",
                  "--methods", "teleop", "--answers", "tiredness=3,ease=4", "--duration", "20",
                  "--realtime-rate", "20", "--wait-for-browser", "60", "--port", "0",
                  "--output", str(tmp_path / "P01")])

@@ -6,14 +6,22 @@ import dataclasses
 import numpy as np
 import pytest
 
-from pbp_drake.commands.run import MOST_GRID_GOALS, scenario_for_run, with_grid_goals
+from pbp_drake.cli import build_parser
+from pbp_drake.commands.run import scenario_for_run, with_grid_goals
 from pbp_drake.core.reach_task import sample_grid_scene
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.scenarios.bounds import MAX_GOALS
+
+
+def run_scenario(path, *flags):
+    """The resolved scenario `pbp-drake run PATH FLAGS...` runs."""
+    return scenario_for_run(build_parser().parse_args(["run", str(path), *flags]))
 
 
 def test_goals_places_k_objects_in_the_region_apart_and_the_targets_among_them(repo):
-    file = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml")
-    resolved = scenario_for_run(file, seed=3, goals=2000)
+    path = repo / "diagrams" / "hsr_reach.yaml"
+    file = load_scenario_file(path)
+    resolved = run_scenario(path, "--seed", "3", "--goals", "2000")
     objects = np.asarray(resolved.goals)
     task = file.scenario.task
     assert objects.shape == (2000, 3)
@@ -23,7 +31,7 @@ def test_goals_places_k_objects_in_the_region_apart_and_the_targets_among_them(r
     assert len(targets) == len(task.switch_schedule)
     assert all(a != b for a, b in zip(targets, targets[1:]))  # each switch to another object
     # The same seed, the same scene.
-    again = scenario_for_run(file, seed=3, goals=2000)
+    again = run_scenario(path, "--seed", "3", "--goals", "2000")
     np.testing.assert_array_equal(again.goals, objects)
 
 
@@ -38,11 +46,10 @@ def test_the_grid_keeps_objects_half_a_cell_apart():
     ("hsr_obstacles.yaml", 10, "--goals places the objects of a reaching task"),
     ("hsr_grasp.yaml", 10, "--goals places the objects of a reaching task"),
     ("hsr_reach.yaml", 1, "--goals 1 is out of range; expected 2 to"),
-    ("hsr_reach.yaml", MOST_GRID_GOALS + 1, "is out of range")])
+    ("hsr_reach.yaml", MAX_GOALS + 1, "is out of range")])
 def test_goals_is_refused_where_it_does_not_apply(repo, name, goals, message):
-    file = load_scenario_file(repo / "diagrams" / name)
     with pytest.raises(ScenarioError, match=message):
-        scenario_for_run(file, goals=goals)
+        run_scenario(repo / "diagrams" / name, "--goals", str(goals))
 
 
 def test_a_task_without_switches_takes_a_single_goal(repo):

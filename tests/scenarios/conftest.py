@@ -3,7 +3,7 @@ import time
 import pytest
 
 from pbp_drake import cli
-from pbp_drake.commands import run as run_command
+from pbp_drake.commands import run_page
 
 
 @pytest.fixture
@@ -14,7 +14,7 @@ def run_refused(monkeypatch, capsys):
     def no_simulation(*args, **kwargs):
         raise AssertionError("the file was accepted and a simulation started")
 
-    monkeypatch.setattr(run_command, "Meshcat", no_simulation)
+    monkeypatch.setattr(run_page, "Meshcat", no_simulation)
 
     def run(path):
         capsys.readouterr()

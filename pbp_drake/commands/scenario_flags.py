@@ -1,0 +1,64 @@
+"""The flags that change a scenario file's fields, shared by `run`, `session` and `study`:
+`--set FIELD=VALUE` and `--scenario-text YAML` (`scenarios.overrides`), and the shorthands
+`--method`, `--alpha`, `--operator`, `--seed` and `--duration`, each one `--set`."""
+
+from pbp_drake.scenarios import METHODS, OPERATOR_NAMES, ScenarioError, parse_method_label
+from pbp_drake.scenarios.overrides import ScenarioOverrides
+
+
+def add_override_flags(parser):
+    """`--set` and `--scenario-text`."""
+    group = parser.add_argument_group(
+        "scenario fields", "change the file's fields as the file would: FIELD is a dotted "
+        "path under `scenario:` (`study.FIELD` under `study:`), VALUE read as YAML")
+    group.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
+                       dest="settings", help="e.g. --set goal_estimator.method=nearest "
+                       "--set control_period=0.02 (repeatable; applied after the text)")
+    group.add_argument("--scenario-text", metavar="YAML",
+                       help="a mapping of fields merged onto the file, e.g. "
+                       "'{seed: 3, goal_estimator: {method: nearest}}'")
+    return group
+
+
+def add_shorthand_flags(group):
+    """`--method`, `--operator`, `--seed`, `--duration` and `--alpha`, in `group`."""
+    group.add_argument("--method", help=f"--set method=METHOD: {', '.join(METHODS)} "
+                       "(fixed_alpha=A sets alpha too)")
+    group.add_argument("--operator", help="--set operator=...: who drives a task, one of "
+                       f"{', '.join(OPERATOR_NAMES)} (keyboard and gamepad: in the browser)")
+    group.add_argument("--seed", type=int, help="--set seed=N: the scene's and the noise's seed")
+    group.add_argument("--duration", type=float, metavar="SECONDS",
+                       help="--set duration=SECONDS (for a task, its time limit)")
+    group.add_argument("--alpha", type=float, help="--set alpha=A (fixed_alpha's weight)")
+
+
+def scenario_overrides(args):
+    """The overrides of the parsed `args`: the text, the shorthands, then each `--set`."""
+    shorthands = _shorthand_settings(args)
+    return ScenarioOverrides(
+        tuple(setting for setting, _ in shorthands) + tuple(args.settings),
+        args.scenario_text, tuple(typed for _, typed in shorthands))
+
+
+def _shorthand_settings(args):
+    """[(FIELD=VALUE, the flag as typed)] of the shorthands given."""
+    settings = []
+    method = getattr(args, "method", None)
+    if method is not None:
+        name, alpha = parse_method_label(method)
+        settings.append((f"method={name}", f"--method {method}"))
+        if alpha is not None:
+            settings.append((f"alpha={alpha!r}", f"--method {method}"))
+    operator = getattr(args, "operator", None)
+    if operator is not None:
+        if operator not in OPERATOR_NAMES:
+            raise ScenarioError(f"--operator {operator!r} is unknown; choose one of "
+                                f"{list(OPERATOR_NAMES)}")
+        # A tag: the file's operator of the same kind keeps its settings (`merged`).
+        settings.append((f"operator=!{OPERATOR_NAMES[operator].__name__} {{}}",
+                         f"--operator {operator}"))
+    for flag in ("seed", "duration", "alpha"):
+        value = getattr(args, flag, None)
+        if value is not None:
+            settings.append((f"{flag}={value!r}", f"--{flag} {value:g}"))
+    return settings

@@ -1,0 +1,180 @@
+"""The runs of `pbp-drake run`: a task, live in the page and the terminal, run again on
+Restart and on the next seed on Next scene; a 2-D scene, run once."""
+
+import dataclasses
+import pathlib
+
+import numpy as np
+
+from pbp_drake.builder import build_diagram, find_system, run_task, run_task_streamed, simulate
+from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS
+from pbp_drake.commands.run_checks import is_person
+from pbp_drake.commands.run_page import (
+    AFTER_RUN_CHOICES, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
+    save_recording, terminal, wait_for_browser)
+from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, result_text
+from pbp_drake.console.text import controls_text, failure_text
+from pbp_drake.core.toy_scene import collision_ratio
+from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, forward_key_enabled, resolve
+
+
+def run_scene(args, resolved, meshcat, page):
+    """A 2-D scene: live in the page (its console has Stop alone) for its duration."""
+    scenario = resolved.scenario
+    diagram = build_diagram(resolved, meshcat)
+    console = None
+    if page is not None:
+        console = page_console(meshcat, page, args, alpha_of(scenario), choices=("stop",))
+        console.show_title(method_name(scenario.method, alpha_of(scenario)))
+        if terminal():  # someone may be watching
+            wait_for_browser(page, args.wait_for_browser)
+    if args.record:
+        meshcat.StartRecording(frames_per_second=30.0)
+    live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration))
+    trajectory = simulate(resolved, realtime_rate=0.0 if args.headless else args.realtime_rate,
+                          diagram=diagram, advance=live.advance)
+    ratio = collision_ratio(trajectory.positions, [o.center for o in scenario.obstacles],
+                            [o.radius for o in scenario.obstacles])
+    outcome = (f"stopped at {trajectory.times[-1]:.1f} s" if live.choice == "stop"
+               else f"done, collision ratio {ratio:.3f}")
+    if args.record:
+        save_recording(meshcat, args.record)
+    print(f"{scenario.name} [{scenario.method}]: "
+          + (f"{outcome}, " if live.choice == "stop" else "") + "final position "
+          f"{np.array2string(trajectory.positions[-1], precision=3)}, collision ratio "
+          f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}",
+          flush=True)
+    if console is not None:
+        console.show_result(outcome)
+        if live.choice is None:
+            keep_page(args, page, console, ("close",))
+        end_page(page, console)
+    return EXIT_STOPPED if live.choice == "stop" else EXIT_SUCCESS
+
+
+def run_task_loop(args, resolved, meshcat, page):
+    """A task, run until the person is done: Restart runs it again, Next scene on the next
+    seed; the exit code of the last run."""
+    person = is_person(resolved.scenario)
+    console = None
+    if page is not None:
+        console = page_console(meshcat, page, args, alpha_of(resolved.scenario))
+    first = True
+    while True:
+        scenario = resolved.scenario
+        diagram = build_diagram(resolved, meshcat)
+        if console is not None:
+            # After the operator's buttons, which the build added: the same order each run.
+            console.set_choices(RUN_CHOICES)
+        if first and page is not None and (person or terminal()):
+            # A person needs the page open before the task starts.
+            print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
+                  + ("the task starts when it connects." if not start_gate(args, person) else
+                     "the task starts when Start is pressed in the page."), flush=True)
+            if person:
+                print(controls_line(scenario), flush=True)
+            wait_for_browser(page, args.wait_for_browser, PERSON_NEEDS_PAGE if person else None)
+        first = False
+        result, live = run_task_once(args, resolved, diagram, meshcat, console,
+                                     start_button="Start" if start_gate(args, person) else None)
+        code = task_code(result, live)
+        if console is None:
+            return code
+        choice = live.choice
+        if choice is None:
+            choice = keep_page(args, page, console, AFTER_RUN_CHOICES)
+        delete_operator(diagram)
+        if choice in (None, "stop", "close"):
+            end_page(page, console)
+            return code
+        if choice == "next":
+            resolved = resolve(dataclasses.replace(scenario, seed=scenario.seed + 1))
+        print(f"{'Restart' if choice == 'restart' else 'Next scene'}: seed "
+              f"{resolved.scenario.seed}.", flush=True)
+
+
+def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
+    """One run of the task in `diagram`, live in `console` and the terminal: `(TaskResult,
+    LiveRun)`. With `start_button` (a label), the task's clock starts when it is pressed."""
+    scenario = resolved.scenario
+    camera = None
+    if args.camera == "robot":
+        camera = RobotCamera(meshcat, find_system(diagram, "hsr_station"))
+    if console is not None:
+        console.show_title(f"{method_name(scenario.method, alpha_of(scenario))}, seed "
+                           f"{scenario.seed}")
+        console.clear_result()
+    live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration), camera,
+                   start_label=start_button, stdin=terminal(),
+                   gamepad=isinstance(scenario.operator, Gamepad))
+    if args.record:
+        meshcat.StartRecording(frames_per_second=30.0)
+    rate = 0.0 if args.headless else args.realtime_rate
+    if args.log:  # its folder may be made (check_log_path)
+        pathlib.Path(args.log).parent.mkdir(parents=True, exist_ok=True)
+    result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram,
+                                advance=live.advance)
+              if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram,
+                                        advance=live.advance))
+    if args.record:
+        save_recording(meshcat, args.record)
+    stopped = live.choice is not None
+    why = None if result.success or stopped else why_failed(result, scenario)
+    if console is not None:
+        console.show_result(result_text(result.success, result.task_time, stopped, why))
+    hand = ""
+    if len(result.ee_positions):
+        hand = ", hand at [" + ", ".join(f"{x:.3f}" for x in result.ee_positions[-1]) + "]"
+    if args.log:
+        hand = f"; per-tick rows in {args.log}"
+    print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
+          f"{result.summary_line(stopped=stopped)}{hand}", flush=True)
+    if why is not None:
+        print(f"  the time limit ({scenario.duration:g} s) passed: {why}", flush=True)
+    return result, live
+
+
+def why_failed(result, scenario):
+    """Where a failed run's hand ended against its target (`failure_text`), or None when
+    the result holds no series (a run streamed to --log)."""
+    if not len(result.ee_positions) or not len(result.targets):
+        return None
+    target = int(result.targets[-1])
+    distance = float(np.linalg.norm(result.ee_positions[-1] - result.objects[target]))
+    # The grasping task's success is a grasp pose, not a distance to the object's centre.
+    grasping = isinstance(scenario.task, GraspTask)
+    return failure_text(target, len(result.objects), distance,
+                        None if grasping else scenario.task.success_distance)
+
+
+def controls_line(scenario):
+    """What the person's keys or gamepad do in `scenario`'s task (`controls_text`)."""
+    return controls_text(grasping=isinstance(scenario.task, GraspTask),
+                         gamepad=isinstance(scenario.operator, Gamepad),
+                         forward=forward_key_enabled(scenario),
+                         vertical=bool(getattr(scenario.task, "z_range", None)))
+
+
+def task_code(result, live):
+    """The exit code of a run: stopped by the person, succeeded or failed (`EXIT_CODES`)."""
+    if live.choice == "stop":
+        return EXIT_STOPPED
+    return EXIT_SUCCESS if result.success else EXIT_FAILED
+
+
+def delete_operator(diagram):
+    """Removes the operator's buttons from the page: the next build adds its own."""
+    operator = diagram.GetSubsystemByName("operator")
+    if hasattr(operator, "Delete"):
+        operator.Delete()
+
+
+def start_gate(args, person):
+    """Whether a run's task waits for Start in the page: a person's, unless
+    --start-on-connect asks for the start as the page connects."""
+    return person and not args.start_on_connect
+
+
+def alpha_of(scenario):
+    """fixed_alpha's weight, for the page's slider; None under another method."""
+    return scenario.alpha if METHODS[scenario.method].takes_weight else None

@@ -125,8 +125,10 @@ def test_a_yaml_typo_in_the_task_names_the_key(shipped, tmp_path):
 
 
 @pytest.mark.parametrize("operator, controls", [
-    ("keyboard", "Keys: arrows move the hand (forward only in teleop), PageUp/PageDown"),
-    ("gamepad", "Gamepad: left stick moves the hand (forward only in teleop), triggers")])
+    ("keyboard", "Keys: arrows move the hand (not forward: the primitive drives it), "
+                 "PageUp/PageDown"),
+    ("gamepad", "Gamepad: left stick moves the hand (not forward: the primitive drives it), "
+                "triggers")])
 def test_run_waits_for_a_browser_and_refuses_when_none_joins(repo, capsys, operator,
                                                              controls):
     arguments = ["run", str(repo / "diagrams" / "hsr_grasp.yaml"), "--operator", operator,

@@ -1,5 +1,5 @@
-"""Argument types of `pbp-drake run` and `session`: each flag's value is checked when the line is parsed,
-and a bad one is refused by argparse (exit 2) as `argument --FLAG: what is wrong`."""
+"""Argument types of `pbp-drake run` and `session`: each flag's value is checked when the line is
+parsed, and a bad one is refused by argparse (exit 2) as `argument --FLAG: what is wrong`."""
 
 import argparse
 import math

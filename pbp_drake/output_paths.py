@@ -1,7 +1,8 @@
 """Checks of the command line's output paths, made before anything is built or simulated:
-`run --record FILE.html`, `run --log FILE.csv`, `run --output DIR` and `study --output DIR`. A path that cannot be
-written is a user error (a ScenarioError: `pbp-drake: ...`, exit 2), not a lost run. And the
-replay a `--record` writes (`mark_replay`): marked as ours, paused at its start, with a key."""
+`run --record FILE.html`, `run --log FILE.csv`, `run --output DIR` and `study --output DIR`. A path
+that cannot be written is a user error (a ScenarioError: `pbp-drake: ...`, exit 2), not a lost run.
+And the replay a `--record` writes (`mark_replay`): marked as ours, paused at its start, with a
+key."""
 
 import base64
 import html as html_text

@@ -45,7 +45,7 @@ def memory_bandwidth(megabytes=400, cache_megabytes=12, repeats=5):
     np.copyto(b, a)
     sum_time = min(_clock(a.sum) for _ in range(repeats))
     copy_time = min(_clock(lambda: np.copyto(b, a)) for _ in range(repeats))
-    del a, b
+    a = b = None  # the arrays go before the next case is measured
     small = np.ones(int(cache_megabytes * 1e6 / 8))
     cache_time = timed(small.sum, 0.2, max_repeats=200)[1]
     return {

@@ -94,8 +94,8 @@ def read_log(diagram, context, name, tick_count, shift=0):
 
     Drake dispatches the publish events of an instant (the loggers) before its discrete
     updates, so a logger at `t_k` sees the plant's state at `t_k` but the decisions of tick
-    k - 1 (operator, blender, estimator): read those with `shift=DECISION_LOG_SHIFT` (one sample later), from
-    a simulation run one tick past the last tick read.
+    k - 1 (operator, blender, estimator): read those with `shift=DECISION_LOG_SHIFT` (one sample
+    later), from a simulation run one tick past the last tick read.
     """
     if not diagram.HasSubsystemNamed(name):
         return None, None

@@ -34,8 +34,8 @@ def time_series_rows(series):
     TaskResult, or any object with its time series attributes (`times`, `ee_positions`,
     `headings`, `commands`, `operator_active`, `operator_commands`, `selected_goals`,
     `targets`, `in_collision`; the grasping task's `angles_to_target`,
-    `command_angular_velocities` and `operator_twists` too). Floats are written in their shortest exact form, so reading
-    them back gives the same numbers."""
+    `command_angular_velocities` and `operator_twists` too). Floats are written in their shortest
+    exact form, so reading them back gives the same numbers."""
     has_collision = series.in_collision is not None
     has_grasp = _has_grasp(series)
     # Python lists once, not a numpy scalar per cell: the same numbers (repr of the same

@@ -61,7 +61,8 @@ def add_run_command(commands):
                         "in the browser), virtual (with --answers)")
     fields.add_argument("--duration", type=float, metavar="SECONDS",
                         help="--set duration=SECONDS: each run's time limit")
-    fields.add_argument("--seed", type=int, help="--set seed=N: the scene of every run (practice: the next scenes)")
+    fields.add_argument("--seed", type=int,
+                        help="--set seed=N: the scene of every run (practice: the next scenes)")
     _add_common_flags(session)
     add_page_flags(session)
     session.set_defaults(handler=_saying_write_failures(_run), method=None, alpha=None,

@@ -31,8 +31,8 @@ another thread, and a Meshcat left in a reference cycle dies in whichever thread
   made; `url`, `port`, `token`, `door_shut`; `pages()`, `own_connections()`,
   `show(**lines)`, `state()`, `end(text)`, `close()`.
 - `PendingMessages`, `message_key` (from `pending_messages`): the relay's bounded queue
-  toward a slow page, which gets a batch of the latest poses and properties, ended by the text frame `FRAME`, and
-  the next batch once it has answered `ACK` at its next animation frame.
+  toward a slow page, which gets a batch of the latest poses and properties, ended by the text frame
+  `FRAME`, and the next batch once it has answered `ACK` at its next animation frame.
 
 An example (the thread that made `meshcat`)::
 

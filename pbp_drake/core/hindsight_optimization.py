@@ -55,8 +55,9 @@ the rotation, within `rotation_fade_angle` (times theta' / (pi / 12)), on the di
 angle after the operator's step, the pose the gradient is taken at, so that the assistance
 vanishes where the operator's step reaches the target instead of chattering about it.
 With `assistance` False the command is `u` alone, exactly teleop's (the posterior still
-runs): a control condition with the baselines' estimator and no help. `lambda` is `translation_divisor`
-(40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a convex blend.
+runs): a control condition with the baselines' estimator and no help. `lambda` is
+`translation_divisor` (40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a
+convex blend.
 
 **Predict-then-assist** (`blending_weights`), the predict-then-act variant of HOP's public
 code (HOP's papers call their predict-then-act baseline policy blending, after Dragan and

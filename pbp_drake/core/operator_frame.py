@@ -11,9 +11,9 @@ differs by a yaw, a top grasp is a pitch down then a roll (docs/tasks/grasp.md).
 The heading is the floor direction of z_H, blended towards that of x_H as z_H turns
 vertical (by the square of z_H's vertical component), with x_H signed to lean the way the
 hand was pitched: +x_H for a hand pointing down, -x_H for one pointing up (the HSR's start
-hand has x_H up: pitched down, x_H turns ahead). For a side grasp it is the approach's floor angle (the station's `heading`);
-it stays defined, and continuous, through a pitch straight down or up, where the ready
-hand pitched by +-90 degrees keeps world +x as forward.
+hand has x_H up: pitched down, x_H turns ahead). For a side grasp it is the approach's floor angle
+(the station's `heading`); it stays defined, and continuous, through a pitch straight down or up,
+where the ready hand pitched by +-90 degrees keeps world +x as forward.
 """
 
 import numpy as np

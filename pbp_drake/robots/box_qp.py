@@ -33,8 +33,8 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     same numbers, bit for bit (checked on 23,822 QPs of reach, obstacle and grasp
     trials). It solves about as many systems as the primal method, which moves one bound
     at a time (2.8 a QP against 2.3 on those), but each iteration is a solve, a product
-    and tests on Python lists, where the primal's step, clip and copies are numpy calls. Such a method can
-    cycle on some problems: after ``2 n + 2`` iterations it hands over to the primal
+    and tests on Python lists, where the primal's step, clip and copies are numpy calls. Such a
+    method can cycle on some problems: after ``2 n + 2`` iterations it hands over to the primal
     method, which always ends.
     """
     n = g.size

@@ -18,8 +18,8 @@ three stages, in this order:
    publish events that must see the decisions of tick k, such as the task monitor ending
    the simulation at success, and the hand-over (`HandOver`), whose state is the command
    the robot follows: it reads the blender's reference of tick k there, and no plant step
-   lies between the tick and its report stage. A publish at the decide instant itself would run before that
-   instant's updates (Drake publishes at the end of the step that reaches an instant and
+   lies between the tick and its report stage. A publish at the decide instant itself would run
+   before that instant's updates (Drake publishes at the end of the step that reaches an instant and
    updates at the start of the next one).
 
 The decide stage sits a millionth of the control period after the tick: long before any

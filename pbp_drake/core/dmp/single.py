@@ -56,7 +56,8 @@ class Dmp:
             weights = np.zeros((settings.basis_count, start.size))
             return cls(weights, start, goal, duration, settings)
         if profile != "minimum_jerk":
-            raise ValueError(f"profile {profile!r} is unknown; use 'minimum_jerk' or 'zero_forcing'")
+            raise ValueError(
+                f"profile {profile!r} is unknown; use 'minimum_jerk' or 'zero_forcing'")
         # Fit in each dimension on a unit reach so that dimensions with g = y0 still get the
         # straight-path shape; the Ijspeert (g - y0) factor then scales it to any goal.
         times, unit = minimum_jerk(np.zeros(1), np.ones(1), duration)
@@ -69,7 +70,8 @@ class Dmp:
         self.phase = 1.0
         self.position = self.start.copy() if position is None else as_point(position, "position")
         self.scaled_velocity = (
-            np.zeros(self.start.size) if scaled_velocity is None else np.array(scaled_velocity, float)
+            np.zeros(self.start.size) if scaled_velocity is None
+            else np.array(scaled_velocity, float)
         )
 
     def attractor(self, phase, goal):

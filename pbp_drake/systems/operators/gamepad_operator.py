@@ -6,7 +6,8 @@ import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
 from pbp_drake.systems.operators.browser_guard import BrowserGuard
-from pbp_drake.systems.operators.browser_input import apply_dead_zone, fresh_after_pause, gamepad_values
+from pbp_drake.systems.operators.browser_input import (
+    apply_dead_zone, fresh_after_pause, gamepad_values)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 

@@ -5,7 +5,8 @@ import dataclasses
 
 import numpy as np
 
-from pbp_drake.systems.operators.browser_input import apply_dead_zone, fresh_after_pause, gamepad_values
+from pbp_drake.systems.operators.browser_input import (
+    apply_dead_zone, fresh_after_pause, gamepad_values)
 from pbp_drake.systems.ports import OperatorTwist
 from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase, check_params
 

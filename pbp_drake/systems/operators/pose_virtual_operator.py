@@ -30,11 +30,11 @@ class PoseVirtualOperator(SampledOperator):
     `hand_pose` is the hand's `PoseState`, `target` the task monitor's `Target` (its index
     is the object the task wants), `selected_goal` the robot's shown intent `[index]` (-1:
     the method shows none), `forward_key` `[1 or 0]` whether the method enables the forward
-    key; it is built from the same arguments under every method. `operator_command` is an `OperatorTwist` `[v (3), omega (3)]`,
-    world frame. It samples at the sense stage of each tick, as every `SampledOperator`;
-    what it remembers of the targets it has seen (`ParticipantMemory`) is discrete state,
-    so Contexts stay independent. Its parameters' `impairment` adds its motor noise (a
-    process in discrete state that runs every tick) and delays its commands by
+    key; it is built from the same arguments under every method. `operator_command` is an
+    `OperatorTwist` `[v (3), omega (3)]`, world frame. It samples at the sense stage of each tick,
+    as every `SampledOperator`; what it remembers of the targets it has seen (`ParticipantMemory`)
+    is discrete state, so Contexts stay independent. Its parameters' `impairment` adds its motor
+    noise (a process in discrete state that runs every tick) and delays its commands by
     `command_delay` (a queue in discrete state).
     """
 

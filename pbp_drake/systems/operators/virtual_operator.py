@@ -89,9 +89,10 @@ class VirtualOperator(SampledOperator):
     is reproducible and the system keeps no state outside its Context.
 
     Its `impairment` (`pbp_drake.core.participant_impairment`, none by default) adds motor
-    noise to its commands while it acts (never forward where the key is disabled), delays its commands by `command_delay` (a queue in discrete state), and
-    makes it head for a wrong object first, now and then, each time it comes to know a
-    target (the reaching task; the obstacle task has a single object).
+    noise to its commands while it acts (never forward where the key is disabled), delays its
+    commands by `command_delay` (a queue in discrete state), and makes it head for a wrong object
+    first, now and then, each time it comes to know a target (the reaching task; the obstacle task
+    has a single object).
 
     With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (cylinders of
     `obstacle_radius`; their velocities

@@ -2,7 +2,6 @@
 ``predict_then_assist`` commands, position and orientation
 (`pbp_drake.core.hindsight_optimization.assisted_command`)."""
 
-import numpy as np
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.hindsight_optimization import assisted_command, hop_targets

@@ -197,8 +197,9 @@ class TaskMonitor(TaskMonitorBase):
 
     `target` is `Target` (`[position (3), object index]`); `task_status` is `TaskStatus`
     (`[progress, stage (number of switches so far), success (0/1), task time (s, the time
-    of the last tick counted: at success, the tick that reached the target), intervention ratio (steps with operator input / steps of the task), steps,
-    collision ratio (steps with `in_collision` / steps; 0 when unconnected)]`).
+    of the last tick counted: at success, the tick that reached the target), intervention ratio
+    (steps with operator input / steps of the task), steps, collision ratio (steps with
+    `in_collision` / steps; 0 when unconnected)]`).
     """
 
     def __init__(self, objects, targets, switch_schedule, start, success_distance,

@@ -1,17 +1,36 @@
 # `make demo` and `make test` are all a fresh clone needs: each creates .venv from
 # pyproject.toml when it is missing (or older than pyproject.toml), then runs.
+# .venv holds the oldest Drake pyproject.toml allows (.ci/oldest.txt pins it) on `python3`
+# (3.11 on CI); `make test-newest` tests the newest Drake pip gives on Python 3.12, in
+# .venv-newest.
 VENV := .venv
 PYTHON := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+OLDEST := .ci/oldest.txt
+NEWEST_VENV := .venv-newest
+NEWEST_STAMP := $(NEWEST_VENV)/.installed
+# pyenv's 3.12 when there is one (its shim answers only where pyenv selects it), else the
+# system's (Ubuntu 24.04's python3.12).
+PYTHON312 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.12*/bin/python3.12) python3.12)
 DEMO_DIR := outputs/demo
 
-.PHONY: demo test test-fast chromium graphviz tutorials diagrams bench soak results docs clean
+.PHONY: demo lint test test-newest test-fast chromium graphviz tutorials diagrams bench soak \
+	results docs clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml $(OLDEST)
 	test -x $(PYTHON) || python3 -m venv $(VENV)
 	$(PYTHON) -m pip install --quiet --upgrade pip
-	$(PYTHON) -m pip install --quiet -e '.[test]'
+	$(PYTHON) -m pip install --quiet --constraint $(OLDEST) -e '.[test]'
 	touch $(STAMP)
+
+# The newest of everything pip gives Python 3.12 (`--upgrade-strategy eager`), made afresh
+# when pyproject.toml changes (`rm -r .venv-newest` to take a later Drake).
+$(NEWEST_STAMP): pyproject.toml
+	test -x $(NEWEST_VENV)/bin/python || $(PYTHON312) -m venv $(NEWEST_VENV)
+	$(NEWEST_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(NEWEST_VENV)/bin/python -m pip install --quiet --upgrade --upgrade-strategy eager \
+		-e '.[test]'
+	touch $(NEWEST_STAMP)
 
 # The HSR reaching task with PBP-Alt and the virtual participant, then the 2-D alpha study.
 demo: $(STAMP)
@@ -47,11 +66,20 @@ chromium:
 graphviz:
 	$(call debian_tool,dot,graphviz,the drawing tests)
 
-# The whole suite: everything but the browser tests in two processes, then the browser
-# tests (Chromium, real-time pages) one at a time, so that a page is never starved.
-test: $(STAMP) chromium graphviz
+# Ruff's checks ([tool.ruff] in pyproject.toml) on the package, tests, docs and notebooks.
+lint: $(STAMP)
+	$(PYTHON) -m ruff check .
+
+# The whole suite after the lint: everything but the browser tests in two processes, then
+# the browser tests (Chromium, real-time pages) one at a time, so that a page is never starved.
+test: lint chromium graphviz
 	$(PYTHON) -m pytest -m "not browser" -n 2 --dist worksteal
 	$(PYTHON) -m pytest -m browser
+
+# The suite but the browser tests on Python 3.12 with the newest Drake and NumPy (.ci/run
+# runs it after `make test`): what a user of a newer Python gets from pip.
+test-newest: $(NEWEST_STAMP) graphviz
+	$(NEWEST_VENV)/bin/python -m pytest -m "not browser" -n 2 --dist worksteal
 
 # Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run,
 # two and a half minutes on a 2-core machine (the README says when it was timed).
@@ -102,4 +130,4 @@ docs: $(VENV)/.installed-docs
 	$(PYTHON) -m sphinx -W --keep-going -b html docs docs/_build/html
 
 clean:
-	rm -rf $(VENV) outputs build *.egg-info docs/_build
+	rm -rf $(VENV) $(NEWEST_VENV) outputs build *.egg-info docs/_build

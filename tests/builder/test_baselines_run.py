@@ -5,6 +5,7 @@ clip ratio reaches the TaskResult, a streamed run and a study's trial file. A re
 takes under a second; the obstacle and grasping tasks' runs are marked slow."""
 
 import dataclasses
+import functools
 
 import numpy as np
 import pytest
@@ -33,6 +34,13 @@ def scenario(repo, name, method, estimator=None, **hop):
     return resolve(dataclasses.replace(with_method(loaded, method), seed=SEED))
 
 
+@functools.cache
+def teleop_run(repo, name):
+    """Teleop's run of scene `name` on SEED, simulated once for the tests that compare with
+    it (a run is deterministic)."""
+    return run_task(scenario(repo, name, "teleop"))
+
+
 @pytest.mark.parametrize("method", ["hop", "predict_then_assist"])
 def test_the_baselines_reach_the_target_without_dmps(repo, method):
     resolved = scenario(repo, "hsr_reach.yaml", method)
@@ -55,7 +63,7 @@ def test_hop_is_faster_than_teleop_with_the_same_participant(repo):
     """HOP adds its action to the operator's command: the same participant, the same
     scene, less time."""
     hop = run_task(scenario(repo, "hsr_reach.yaml", "hop"))
-    teleop = run_task(scenario(repo, "hsr_reach.yaml", "teleop"))
+    teleop = teleop_run(repo, "hsr_reach.yaml")
     assert hop.task_time < teleop.task_time
     assert teleop.posterior_clipped_ratio is None
 
@@ -123,7 +131,7 @@ def test_with_its_assistance_off_a_baseline_commands_what_teleop_commands(repo, 
     """`hop: {assistance: false}`: the robot adds nothing, so the same participant on the
     same seed moves the hand exactly as under teleop, tick for tick (the pose too in the
     grasping task); the posterior still runs."""
-    teleop = run_task(scenario(repo, name, "teleop"))
+    teleop = teleop_run(repo, name)
     off = run_task(scenario(repo, name, method, assistance=False))
     for series in ("ee_positions", "headings", "commands", "operator_active",
                    "operator_commands", "command_angular_velocities", "angles_to_target"):

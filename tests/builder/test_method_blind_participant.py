@@ -7,9 +7,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-from pydrake.systems.analysis import Simulator
 
-from pbp_drake.builder import build_diagram, find_system, run_task
+from pbp_drake.builder import build_diagram, find_system
 from pbp_drake.builder.grasp import _operator as grasp_operator
 from pbp_drake.builder.operators import participant_arguments
 from pbp_drake.scenarios import METHODS, load_scenario_file, resolve

@@ -7,7 +7,6 @@ Meshcat is used only from the test's thread; the clients are plain sockets and w
 import gc
 import json
 import socket
-import threading
 import time
 import urllib.error
 import urllib.request

@@ -15,7 +15,6 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Ze
 from pbp_drake.core.grasp_task import approach_direction, grasp_success, sample_grasp_scene
 from pbp_drake.core.quaternion import angle_between, exp_map, multiply
 from pbp_drake.core.grasp_task import side_grasp_orientation
-from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import HsrStationConfig, hsr_initial_hand_pose, make_hsr_station
 from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, add_hsr
 from pbp_drake.systems.ports import PoseState

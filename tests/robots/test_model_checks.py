@@ -126,7 +126,8 @@ def test_a_link_with_two_parents_is_refused(tmp_path):
                       '<parent link="arm7_link6"/>\n    <child link="arm7_link5"/>')
     message = refusal(scenario_of(model))
     assert (f"joint 'arm7_joint7' <child>: link 'arm7_link5' already hangs from joint "
-            f"'arm7_joint5' (line {line_of(JOINT5)}); a link hangs from one joint" in message), message
+            f"'arm7_joint5' (line {line_of(JOINT5)}); a link hangs from one joint"
+            in message), message
 
 
 @pytest.mark.parametrize("uri, why", [
@@ -281,12 +282,15 @@ SDF_ARM = """<?xml version="1.0"?>
     </link>
     <link name="upper"><pose>0 0 0.2 0 0 0</pose></link>
     <link name="lower"><pose>0 0 0.5 0 0 0</pose></link>
-    <frame name="tool" attached_to="lower"><pose relative_to="lower">0 0 0.1 0 1.5708 0</pose></frame>
+    <frame name="tool" attached_to="lower">
+      <pose relative_to="lower">0 0 0.1 0 1.5708 0</pose></frame>
     <joint name="shoulder" type="revolute"><parent>base</parent><child>upper</child>
-      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit></axis>
+      <axis><xyz>0 0 1</xyz>
+        <limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit></axis>
     </joint>
     <joint name="elbow" type="revolute"><parent>upper</parent><child>lower</child>
-      <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit></axis>
+      <axis><xyz>0 1 0</xyz>
+        <limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit></axis>
     </joint>
   </model>
 </sdf>

@@ -38,7 +38,8 @@ def test_the_scene_is_drawn_in_the_arms_region(seed):
         assert (goals[:, axis] >= low).all() and (goals[:, axis] <= high).all()
     assert len(set(np.round(goals[:, 2], 6))) == len(goals)  # each at a height of its own
     assert resolved.station.command_period == resolved.scenario.control_period
-    assert resolved.controller.hand_over.max_heading_turn == resolved.scenario.robot.max_heading_turn
+    hand_over = resolved.controller.hand_over
+    assert hand_over.max_heading_turn == resolved.scenario.robot.max_heading_turn
 
 
 def test_the_diagram_has_the_arm_station_and_the_same_controller():

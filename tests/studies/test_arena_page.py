@@ -1,6 +1,7 @@
 """The arena page's claims: each a rule on 95 % intervals, checked here on summaries whose
 intervals are computed by hand from their definitions; and `make results`' matrix entry
-run on a tiny study, writing its table, figure and the page."""
+run on a tiny study (two methods, two pilots, a trial each), writing its table, figure and the
+page."""
 
 import json
 import math
@@ -97,6 +98,14 @@ def test_the_catalogues_matrix_writes_its_table_figure_and_the_page(repo, tmp_pa
     monkeypatch.chdir(repo)  # the catalogue names the scenario files from the repository
     generated, page = tmp_path / "generated", tmp_path / "arena.md"
     name = "hsr_reach_arena"
+    # The catalogue's entry with two of its methods under two of its pilots (4 trials, not
+    # 25): the page's claims compare PBP-Alt with teleop, and a second pilot makes a matrix.
+    arguments = list(STUDIES[name])
+    methods, pilots = (arguments.index(flag) + 1 for flag in ("--methods", "--pilots"))
+    assert {"pbp_alternated", "teleop"} <= set(arguments[methods].split(","))
+    arguments[methods] = "pbp_alternated,teleop"
+    arguments[pilots] = ",".join(arguments[pilots].split(",")[:2])
+    monkeypatch.setitem(STUDIES, name, arguments)
     assert main([name, "--trials", "1", "--outputs", str(tmp_path / "out"),
                  "--generated", str(generated), "--arena", str(page)]) == 0
     text = (generated / f"{name}.md").read_text()
@@ -106,6 +115,7 @@ def test_the_catalogues_matrix_writes_its_table_figure_and_the_page(repo, tmp_pa
     summary = json.loads((tmp_path / "out" / name / "summary.json").read_text())
     written = page.read_text()
     assert written.count("Not run yet") == len(ARENA_STUDIES) - 1
+    assert len(summary["pilots"]) == 2
     for pilot in summary["pilots"]:
         assert f"### Pilot: {pilot}" in written
     assert f"```{{include}} generated/{name}.md" in written

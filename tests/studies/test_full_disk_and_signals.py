@@ -27,12 +27,15 @@ from pbp_drake.studies.folders import LOCK_FILE, FolderLocked
 from pbp_drake.scenarios import load_scenario_file
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+# 6 s of simulated time: each trial ends at its time limit, before the target (about 17 s
+# in these scenes), a third of a whole task; what the tests here prove (the files, their
+# bytes, resuming, the processes) holds of any trial.
 TASK = """
 scenario:
   name: two_random_objects
   method: teleop
   control_period: 0.03
-  duration: 30.0
+  duration: 6.0
   robot: !Hsr {}
   task:
     object_count: [2, 2]
@@ -360,12 +363,14 @@ def test_a_second_study_on_a_folder_being_written_is_refused_with_the_first_ones
     first = subprocess.Popen(study_command(task_file, folder, jobs=1), env=ENV,
                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     _wait_for(lambda: list((folder / "trials").glob("*/*.running")), first, "a trial running")
+    # Stopped (SIGSTOP), the first study holds its folder however short its trials are.
+    first.send_signal(signal.SIGSTOP)
     second = subprocess.run(study_command(task_file, folder), env=ENV, capture_output=True,
                             text=True)
     assert second.returncode == 2
     assert (f"pbp-drake: {folder} is being written by another study (process {first.pid})"
             in second.stderr)
-    first.kill()  # kill -9: its lock goes with it
+    first.kill()  # kill -9 (a stopped process too): its lock goes with it
     first.wait()
     resumed = subprocess.run(study_command(task_file, folder), env=ENV, capture_output=True,
                              text=True)

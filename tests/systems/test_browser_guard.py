@@ -6,12 +6,9 @@ used only from the test's thread."""
 import threading
 import time
 
-import numpy as np
-import pytest
 from foreign_page import ForeignPage
 from test_browser_operators import PERIOD, Rig, gamepad_rig, set_gamepad
 
-from pbp_drake.systems.operators.gamepad_operator import GamepadOperator
 from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON, KeyboardOperator
 
 

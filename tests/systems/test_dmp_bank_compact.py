@@ -11,6 +11,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from pbp_drake.core.dmp import DmpBankModel as DmpBankMath
 from pbp_drake.core.dmp import DmpSettings
+from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.systems import Blender
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
 
@@ -69,6 +70,22 @@ def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(formula
                         ("references", "selected_reference", "phase", "paths"))
     # The run did move, lock and unlock.
     assert not np.array_equal(per_goal[3][0], per_goal[30][0])
+
+
+def test_one_velocity_is_limited_as_each_column_of_many_bit_for_bit():
+    """The compact layouts limit the followed DMP's velocity alone, the per-goal layout every
+    column: the same scale to the last bit, on any Python and NumPy (the one column's sum of
+    squares once differed from NumPy's norm in one column of ten on Python 3.12)."""
+    rng = np.random.default_rng(12)
+    for _ in range(2000):
+        column = rng.normal(0.0, 1.0, (3, 1)) * 10.0 ** rng.uniform(-2, 1)
+        one, many = column.copy(), np.repeat(column, 4, axis=1)
+        limit_speeds(one, 0.3, 1.2)
+        limit_speeds(many, 0.3, 1.2)
+        for k in range(4):
+            assert np.array_equal(one[:, 0], many[:, k])
+        # The limit itself, from its definition (a speed of |tau v| / tau at most 0.3).
+        assert np.linalg.norm(one) / 1.2 <= 0.3 * (1 + 1e-12)
 
 
 def test_the_compact_state_does_not_grow_with_the_goals():

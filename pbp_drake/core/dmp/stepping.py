@@ -386,9 +386,12 @@ def limit_speeds(scaled_velocities, max_speed, duration):
         return
     if scaled_velocities.shape[1] == 1:
         # One column (every tick with a followed goal): plain floats, a fifth of the time,
-        # summed in the order NumPy's norm sums a short column.
-        column = scaled_velocities[:, 0].tolist()
-        speed = math.sqrt(sum(value * value for value in column)) / duration
+        # summed one after another as NumPy's norm sums a short column (not with `sum`,
+        # which compensates its rounding from Python 3.12 on).
+        squares = 0.0
+        for value in scaled_velocities[:, 0].tolist():
+            squares += value * value
+        speed = math.sqrt(squares) / duration
         if speed > max_speed:
             scaled_velocities *= max_speed / speed
         return

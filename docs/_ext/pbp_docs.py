@@ -10,7 +10,6 @@
 
 import argparse
 import dataclasses
-import importlib
 import inspect
 import pathlib
 import typing

@@ -32,9 +32,10 @@ def add_shorthand_flags(group):
     group.add_argument("--alpha", type=float, help="--set alpha=A (fixed_alpha's weight)")
 
 
-def scenario_overrides(args):
-    """The overrides of the parsed `args`: the text, the shorthands, then each `--set`."""
-    shorthands = _shorthand_settings(args)
+def scenario_overrides(args, shorthands=True):
+    """The overrides of the parsed `args`: the text, the shorthands (where the command has
+    them: `study`'s `--seed` is its first scene's, not a field), then each `--set`."""
+    shorthands = _shorthand_settings(args) if shorthands else []
     return ScenarioOverrides(
         tuple(setting for setting, _ in shorthands) + tuple(args.settings),
         args.scenario_text, tuple(typed for _, typed in shorthands))

@@ -141,7 +141,7 @@ def _stopping_cleanly(command):
 
 
 def _study(args):
-    overrides = scenario_overrides(args)
+    overrides = scenario_overrides(args, shorthands=False)
     scenario_file = load_scenario_file(args.scenario, overrides)
     if args.output is None:
         args.output = str(default_output(args.scenario, scenario_file, args.methods))

@@ -41,7 +41,7 @@ def test_the_keyboard_moves_the_grasping_hand_from_the_page(repo):
     with running(command, cwd=repo) as (process, output):
         url = output.wait_for(r"^Meshcat: (http://\S+)", timeout=60)
         assert url, f"no Meshcat URL from pbp-drake:\n{output.text()}"
-        assert output.wait_for(r"^Keys: arrows move the hand .*R switches to turning",
+        assert output.wait_for(r"^Keys: arrows move the hand\b.*R switches to turning",
                                timeout=10), output.text()
         with open_page(url.group(1)) as page:
             page.wait_for_selector(f"text={MODE_LABELS[TRANSLATE]}", state="attached")

@@ -81,8 +81,7 @@ test: lint chromium graphviz
 test-newest: $(NEWEST_STAMP) graphviz
 	$(NEWEST_VENV)/bin/python -m pytest -m "not browser" -n 2 --dist worksteal
 
-# Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run,
-# two and a half minutes on a 2-core machine (the README says when it was timed).
+# Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run.
 test-fast: $(STAMP) graphviz
 	$(PYTHON) -m pytest -m "not slow" -n 2 --dist worksteal
 

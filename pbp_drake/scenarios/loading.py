@@ -17,11 +17,12 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.methods import did_you_mean
 from pbp_drake.scenarios.bounds import (
     check_yaml_bounds, load_document, load_typed, read_bounded)
 from pbp_drake.scenarios.overrides import merged
 from pbp_drake.scenarios.resolution import (
-    ResolvedScenario, check_obstacles, close_match, resolve, with_method)
+    ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
     RANGE, STUDY_SPLITS, AlphaStudy, Arm, MethodComparison, Scenario,
     ScenarioError, ScenarioFile, TASK_ROBOTS)
@@ -220,7 +221,7 @@ def _first_problem(node, schema, field, is_range=False):
             if key == "_tag" or (not field and str(key).startswith("_")):
                 continue  # the top level's private keys hold anchors' templates
             if key not in types_of:
-                return (f"{where}: unknown key {key!r}{close_match(str(key), types_of)}; "
+                return (f"{where}: unknown key {key!r}{did_you_mean(key, types_of)}; "
                         f"expected one of {', '.join(sorted(types_of))}")
             value_type, is_range = types_of[key]
             if is_range and isinstance(value, (int, float)) and not isinstance(value, bool):

@@ -13,7 +13,7 @@ import copy
 import dataclasses
 
 from pbp_drake.core.participant_params import VirtualParticipantParams
-from pbp_drake.scenarios.resolution import close_match
+from pbp_drake.core.methods import did_you_mean
 from pbp_drake.scenarios.schema import (
     LaggyPilot, NoisyPilot, ParticipantPopulation, ProportionalPilot, ScenarioError,
     VirtualParticipant)
@@ -56,7 +56,7 @@ def check_pilot_name(name, field="pilot"):
     """Raises ScenarioError unless `name` is one of PILOT_NAMES (with did-you-mean)."""
     if name not in PILOT_NAMES:
         raise ScenarioError(f"{field} {name!r} is unknown; choose one of "
-                            f"{', '.join(PILOT_NAMES)}{close_match(str(name), PILOT_NAMES)}")
+                            f"{', '.join(PILOT_NAMES)}{did_you_mean(name, PILOT_NAMES)}")
 
 
 def with_pilot(scenario, name):

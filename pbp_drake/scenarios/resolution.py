@@ -9,7 +9,6 @@ CLI) derives any of these again.
 """
 
 import dataclasses
-import difflib
 import math
 import typing
 
@@ -19,7 +18,7 @@ from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
 from pbp_drake.core.goal_estimation import READS_POSE, estimator_entry
-from pbp_drake.core.methods import METHODS, method_entry, method_names
+from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_names
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
@@ -114,7 +113,7 @@ def parse_method_label(label):
     weighted = " or ".join(f"{m}=A" for m, method in METHODS.items() if method.takes_weight)
     if name not in METHODS:
         raise ScenarioError(f"method {label!r} is unknown; choose from {method_names()} or "
-                            f"{weighted}{close_match(name, METHODS)}")
+                            f"{weighted}{did_you_mean(name, METHODS)}")
     if not alpha:
         return name, None
     if not METHODS[name].takes_weight:
@@ -142,12 +141,6 @@ def renamed_method(name, field="method"):
     if name in RENAMED_METHODS:
         new, why = RENAMED_METHODS[name]
         raise ScenarioError(f"{field} {name!r} is now called {new!r} ({why})")
-
-
-def close_match(name, choices):
-    """` (did you mean 'x'?)` when one of `choices` is close to `name`, else ``."""
-    matches = difflib.get_close_matches(name, list(choices), n=1)
-    return f" (did you mean {matches[0]!r}?)" if matches else ""
 
 
 def _check_common(scenario):

@@ -3,13 +3,18 @@
 Driven as the PBP loop drives it (``station_drive``): every 0.03 s the hand's position y is
 sampled at the tick and the command is ``[y + v dt, v, heading0]``, re-integrated from the
 measured hand, so any lag of the robot behind its command slows the hand. Each drive sets
-off from rest at a constant ``v``.
+off from rest at a constant ``v``. Each drive runs on the station's defaults and on the
+station of the reaching scenes (``diagrams/hsr_reach.yaml``: kinematic joints, one diff IK
+step a control tick).
 """
+
+import pathlib
 
 import numpy as np
 import pytest
 from pydrake.multibody.plant import MultibodyPlant
 
+from pbp_drake import load_scenario_file
 from pbp_drake.robots import HsrStationConfig
 from pbp_drake.robots.hsr_model import ACTUATED_JOINT_NAMES, add_hsr
 from station_drive import CONTROL_PERIOD, drive
@@ -50,15 +55,33 @@ def motor_limits(config):
     return velocities, accelerations, rows
 
 
-@pytest.fixture(scope="module", params=list(CASES))
+def reach_scenes_station():
+    """The station config of the reaching scenes, as their file states it."""
+    repo = pathlib.Path(__file__).resolve().parents[2]
+    return load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").resolved.station
+
+
+STATIONS = {"default": HsrStationConfig, "reach-scenes": reach_scenes_station}
+# The most the hand's speed over a tick may exceed the command's, setting off from rest:
+# the plan's velocity is constant over a diff IK step, so with one step a tick nothing
+# averages the arm's catch-up behind the base's acceleration limit out of a tick (measured:
+# 1.1 % at 0.01 s, 12.2 % at 0.03 s, diagonally at 0.12 m/s).
+OVERSHOOT = {0.01: 1.1, 0.03: 1.15}
+
+
+@pytest.fixture(scope="module", params=[(station, case) for station in STATIONS
+                                        for case in CASES],
+                ids=lambda param: "-".join(param))
 def case(request):
-    direction, speed = CASES[request.param]
+    station, name = request.param
+    direction, speed = CASES[name]
     direction = np.asarray(direction, float)
-    return direction, speed, drive(lambda t: speed * direction, DURATION)
+    config = STATIONS[station]()
+    return direction, speed, drive(lambda t: speed * direction, DURATION, config), config
 
 
 def test_hand_moves_at_the_commanded_speed_once_settled(case):
-    direction, speed, result = case
+    direction, speed, result, config = case
     speeds = result.speeds(direction) / speed
     settled = speeds[result.tick_times[1:] > SETTLE]
     # Every tick within 10 % of the command: no lag, no jitter.
@@ -67,15 +90,15 @@ def test_hand_moves_at_the_commanded_speed_once_settled(case):
 
 
 def test_hand_never_overshoots_the_commanded_speed(case):
-    direction, speed, result = case
+    direction, speed, result, config = case
     speeds = result.speeds(direction) / speed
-    assert speeds.max() < 1.1
+    assert speeds.max() < OVERSHOOT[config.diff_ik_time_step]
     # Setting off from rest it reaches the command within a few ticks.
     assert np.argmax(speeds > 0.9) * CONTROL_PERIOD < 0.15
 
 
 def test_hand_keeps_to_the_commanded_direction(case):
-    direction, speed, result = case
+    direction, speed, result, config = case
     steps = np.diff(result.hands, axis=1)
     across = steps - np.outer(direction, direction @ steps)
     assert np.linalg.norm(across, axis=0).max() / CONTROL_PERIOD < 0.1 * speed
@@ -85,14 +108,13 @@ def test_each_command_starts_from_the_hand_at_its_tick(case):
     # The sample at a tick is the robot at that tick, never one plant step later (the
     # plant's live output ports): the command decided at tick k, logged at tick k + 1,
     # is the hand at tick k plus v dt.
-    direction, speed, result = case
+    direction, speed, result, config = case
     commanded_start = result.commands[:3, 1:] - speed * CONTROL_PERIOD * direction[:, None]
     np.testing.assert_allclose(commanded_start, result.hands[:, :-1], atol=1e-12)
 
 
 def test_joints_keep_within_their_velocity_and_acceleration_limits(case):
-    direction, speed, result = case
-    config = HsrStationConfig()
+    direction, speed, result, config = case
     velocity_limits, acceleration_limits, rows = motor_limits(config)
     # The plan (desired_state's velocities, in motor order) keeps the limits exactly: its
     # velocity changes once a diff IK step, by at most the limit times the step.
@@ -111,7 +133,7 @@ def test_joints_keep_within_their_velocity_and_acceleration_limits(case):
     stride = round(CONTROL_PERIOD / config.plant.time_step)
     tick_accelerations = np.abs(np.diff(velocities[:, ::stride], axis=1)) / CONTROL_PERIOD
     bound = (CONTROL_PERIOD + config.diff_ik_time_step) / CONTROL_PERIOD
-    assert np.all(tick_accelerations.max(axis=1) <= bound * acceleration_limits)
+    assert np.all(tick_accelerations.max(axis=1) <= bound * acceleration_limits + 1e-9)
 
 
 def test_hand_keeps_its_speed_while_its_heading_turns():

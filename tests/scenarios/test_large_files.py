@@ -34,6 +34,11 @@ def _toy_goals(goals):
     return TOY.replace(TOY_GOALS, f"goals: {goals}")
 
 
+def _line_of(anchor, text):
+    """The line number of `anchor` in `text` (where _reach_objects puts the objects)."""
+    return text[:text.index(anchor)].count("\n") + 1
+
+
 def _reach_objects(objects):
     anchor = "    switch_schedule:"
     assert anchor in REACH
@@ -78,7 +83,8 @@ CASES = {
     # Under 1 MiB, written tight: the count refuses them, before they are read.
     "objects_over_the_cap": (lambda: _reach_objects(
         "[" + ",".join(["[2,0,0.7]"] * (MAX_GOALS + 1)) + "]"),
-        ["scenario.task.objects", "line 27", f"more than {MAX_GOALS:,} objects"], 30.0),
+        ["scenario.task.objects", f"line {_line_of('    switch_schedule:', REACH)}",
+         f"more than {MAX_GOALS:,} objects"], 30.0),
     "goals_over_the_cap": (lambda: _toy_goals("[" + ",".join(["[1,0]"] * (MAX_GOALS + 1)) + "]"),
                            ["scenario.goals", "line 11", f"more than {MAX_GOALS:,} goals"],
                            30.0),

@@ -61,7 +61,7 @@ def test_a_period_off_the_plant_step_says_the_values():
     assert "scenario.control_period 0.0333 s is 6.66 steps of" in message
     assert "plant.time_step 0.005 s" in message
     assert "0.03 s or 0.035 s" in message
-    # 0.0333 s is ten steps of 0.00333 s (the diff IK's 0.01 s three of them).
+    # 0.0333 s is ten steps of 0.00333 s (the diff IK's 0.03 s nine of them).
     assert "plant.time_step of 0.00333 s (10 steps)" in message
 
 
@@ -73,7 +73,7 @@ def test_30_hz_runs_at_ten_plant_steps_of_a_third_of_a_millisecond():
     # Within 0.2 % of ten steps: the controller and the station tick at exactly ten.
     assert resolved.controller.control_period == pytest.approx(10 * 0.0033333, abs=1e-15)
     assert resolved.station.command_period == resolved.controller.control_period
-    assert resolved.station.diff_ik_time_step == pytest.approx(3 * 0.0033333, abs=1e-15)
+    assert resolved.station.diff_ik_time_step == pytest.approx(9 * 0.0033333, abs=1e-15)
     # The toy robot's step too.
     toy = load_scenario_text(TOY, "toy", overlays=[
         "scenario: {control_period: 0.0333, robot: {time_step: 0.0033333}}"])
@@ -83,7 +83,7 @@ def test_30_hz_runs_at_ten_plant_steps_of_a_third_of_a_millisecond():
 def test_a_shipped_period_is_kept_to_the_bit():
     loaded = load_scenario_text(REACH, "reach")
     assert loaded.resolved.controller.control_period == 0.03
-    assert loaded.resolved.station.diff_ik_time_step == 0.01
+    assert loaded.resolved.station.diff_ik_time_step == 0.03
 
 
 def test_a_relative_model_file_is_read_beside_the_scenario_file(tmp_path, monkeypatch):

@@ -31,6 +31,7 @@ def test_the_package_has_modules():
     assert len(MODULES) > 40
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", MODULES + BENCH_MODULES,
                          ids=lambda path: str(path.relative_to(REPO)))
 def test_a_long_module_says_why_and_imports_are_at_the_top(path):
@@ -102,6 +103,7 @@ def test_modules_share_a_file_name_only_as_one_concept_in_different_layers():
                     f"({path.relative_to(PACKAGE)})")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", MODULES, ids=lambda path: str(path.relative_to(PACKAGE)))
 def test_the_library_does_not_import_the_harness_at_the_top(path):
     tree = ast.parse(path.read_text())
@@ -112,6 +114,7 @@ def test_the_library_does_not_import_the_harness_at_the_top(path):
             f"{path.relative_to(PACKAGE)}:{node.lineno} imports the harness")
 
 
+@pytest.mark.slow
 def test_the_harness_imports_the_library_not_the_other_way():
     # Loading the command line and every topic leaves the harness unloaded.
     code = ("import sys, pbp_drake, pbp_drake.cli, pbp_drake.builder, pbp_drake.studies; "

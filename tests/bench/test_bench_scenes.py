@@ -11,6 +11,7 @@ from pbp_drake.builder.run import run_task
 from pbp_drake.core.grasp_task import grasp_pose
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", [REACH, GRASP])
 def test_a_scene_has_k_goals_in_the_task_region_and_targets_the_first(task):
     resolved = resolved_scene(task, 1000)
@@ -45,6 +46,7 @@ def test_the_grasp_poses_are_the_cores_and_the_dmps_last_to_the_farthest():
     assert resolved.controller.dmp_duration == pytest.approx(farthest / resolved.nominal_speed)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", [REACH, GRASP])
 def test_the_virtual_participant_reaches_the_target(task):
     result = run_task(resolved_scene(task, 4))

@@ -52,6 +52,7 @@ def closed_loop(config, goals, operator=None):
     return builder.Build(), source, log, start
 
 
+@pytest.mark.slow
 def test_pbp_takes_the_hand_to_the_goal_the_estimator_picks():
     goals = np.array([[0.55, 0.15, 0.30], [0.55, -0.25, 0.45]])
     config = PbpControllerConfig(method="pbp_no_user", control_period=PERIOD)
@@ -66,6 +67,7 @@ def test_pbp_takes_the_hand_to_the_goal_the_estimator_picks():
     assert speeds.max() <= config.hand_over.max_hand_speed + 0.01
 
 
+@pytest.mark.slow
 def test_a_goal_that_moves_on_the_goals_port_is_followed():
     goals = np.array([[0.55, 0.0, 0.35]])
     config = PbpControllerConfig(method="pbp_no_user", control_period=PERIOD,
@@ -80,6 +82,7 @@ def test_a_goal_that_moves_on_the_goals_port_is_followed():
     assert np.linalg.norm(hand - moved[0]) < 0.01
 
 
+@pytest.mark.slow
 def test_teleop_moves_the_hand_at_the_operators_command():
     goals = np.array([[0.55, 0.0, 0.35]])
     config = PbpControllerConfig(method="teleop", control_period=PERIOD)

@@ -10,6 +10,7 @@ from pbp_drake.builder.run import simulate
 from plain_loop import plain_loop
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["pbp_alternated", "pbp_continuous", "fixed_alpha",
                                     "teleop", "pbp_no_user"])
 def test_alpha_study_scene_matches_the_plain_loop(repo, method):
@@ -21,6 +22,7 @@ def test_alpha_study_scene_matches_the_plain_loop(repo, method):
     np.testing.assert_allclose(trajectory.positions, expected, rtol=0, atol=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["pbp_alternated", "pbp_continuous"])
 def test_alt_vs_cont_scenario_matches_the_plain_loop(repo, method):
     scenario = load_scenario_file(repo / "diagrams/toy_alt_vs_cont.yaml").scenario

@@ -22,6 +22,7 @@ def grasp(repo):
     return load_scenario_file(repo / "diagrams" / "hsr_grasp.yaml").resolved
 
 
+@pytest.mark.slow
 def test_the_replay_shows_the_selected_dmps_path_to_its_grasp(grasp, meshcat):
     diagram = build_diagram(grasp, meshcat)
     meshcat.StartRecording(frames_per_second=30.0)

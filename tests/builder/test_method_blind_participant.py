@@ -30,6 +30,7 @@ def same(a, b):
     return a == b
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", ["hsr_reach.yaml", "hsr_obstacles.yaml", "arm_reach.yaml"])
 def test_the_participant_is_built_alike_under_every_method(repo, task):
     first = participant_arguments(resolved(repo, task, DRIVEN[0]))
@@ -40,6 +41,7 @@ def test_the_participant_is_built_alike_under_every_method(repo, task):
             assert same(value, first[name]), (method, name)
 
 
+@pytest.mark.slow
 def test_the_grasp_participant_is_built_alike_under_every_method(repo):
     participants = []
     for method in DRIVEN:
@@ -61,6 +63,7 @@ def participant_inputs(run):
             operator.GetInputPort("selected_goal").Eval(context)[0])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", ["hsr_reach.yaml", "hsr_grasp.yaml"])
 def test_the_keys_and_the_shown_intent_reach_it_through_its_ports(repo, task):
     assert participant_inputs(resolved(repo, task, "teleop")) == (1.0, -1.0)

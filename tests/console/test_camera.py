@@ -149,6 +149,7 @@ def hidden_or_off_the_page(points, camera, target, head_sphere):
                     and sight_clears(point, camera, head_sphere))]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_the_robot_camera_sees_the_hand_and_the_target_over_the_head_all_through_a_task(
         repo, seed):

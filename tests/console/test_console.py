@@ -120,6 +120,7 @@ def test_stop_ends_a_run_where_it_stands(repo, meshcat):
     assert stream.getvalue().startswith("t = 0.") and stream.getvalue().count("\n") == 1
 
 
+@pytest.mark.slow
 def test_the_alpha_slider_changes_the_blend_during_the_run(repo, meshcat):
     scenario = with_method(load_scenario_file(repo / "diagrams" / "toy_alpha_study.yaml")
                            .scenario, "fixed_alpha=0.2")
@@ -138,6 +139,7 @@ def test_the_alpha_slider_changes_the_blend_during_the_run(repo, meshcat):
     assert not np.allclose(commands[0.2], commands[0.9])
 
 
+@pytest.mark.slow
 def test_the_hsr_status_counts_what_the_task_monitor_counts(repo, meshcat):
     resolved = resolve(load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario)
     diagram = build_diagram(resolved)

@@ -65,6 +65,7 @@ def _press(button):
     return msgpack.packb({"type": "button", "name": button})
 
 
+@pytest.mark.slow
 def test_http_needs_the_token_then_the_cookie(front):
     base = f"http://localhost:{front.port}/"
     assert _get(base)[0] == 403
@@ -82,6 +83,7 @@ def test_http_needs_the_token_then_the_cookie(front):
     assert _get(base + "favicon.ico", cookie="pbp_drake_token=" + "x" * 32)[0] == 403
 
 
+@pytest.mark.slow
 def test_refused_websockets_never_reach_meshcat(meshcat, front):
     meshcat.AddButton("Left")
     for query, origin in [(f"?token={front.token}", "http://evil.example"), ("", None),
@@ -125,6 +127,7 @@ def _messages(page, until, timeout=5.0):
     return seen
 
 
+@pytest.mark.slow
 def test_an_authorised_page_is_relayed_both_ways(meshcat, front):
     meshcat.AddButton("Left")
     with _websocket(front, f"?token={front.token}") as page:
@@ -146,6 +149,7 @@ def _batch_of(path):
     return until
 
 
+@pytest.mark.slow
 def test_a_paced_page_gets_the_next_batch_after_its_answer_and_the_panel_at_once(
         meshcat, front):
     with _websocket(front, f"?token={front.token}") as page:
@@ -166,6 +170,7 @@ def test_a_paced_page_gets_the_next_batch_after_its_answer_and_the_panel_at_once
             page, lambda seen: ("set_object", "/c") in seen)
 
 
+@pytest.mark.slow
 def test_the_cookie_alone_opens_the_websocket(meshcat, front):
     cookie = {"Cookie": f"other=1; pbp_drake_token={front.token}"}
     with connect(f"ws://localhost:{front.port}/", origin=f"http://localhost:{front.port}",
@@ -173,6 +178,7 @@ def test_the_cookie_alone_opens_the_websocket(meshcat, front):
         assert _until(lambda: meshcat.GetNumActiveConnections() == 1)
 
 
+@pytest.mark.slow
 def test_the_panel_state_and_the_end(front):
     front.show(title="PBP-Alt", status="time left 41 s", time=3.25)
     front.show(result="success in 14.2 s", time=float("nan"))
@@ -193,6 +199,7 @@ def test_the_panel_state_and_the_end(front):
         front.show(colour="red")
 
 
+@pytest.mark.slow
 def test_the_end_reaches_every_relayed_page_before_the_close(meshcat, front):
     with _websocket(front, f"?token={front.token}") as page:
         assert _until(lambda: front.pages() == 1)
@@ -205,6 +212,7 @@ def test_the_end_reaches_every_relayed_page_before_the_close(meshcat, front):
         assert ends and ends[-1]["notice"] == "Session complete - you can close this page"
 
 
+@pytest.mark.slow
 def test_close_stops_serving_and_is_idempotent(meshcat):
     front = PageFront(meshcat.port())
     port = front.port
@@ -214,6 +222,7 @@ def test_close_stops_serving_and_is_idempotent(meshcat):
         socket.create_connection(("localhost", port), timeout=1.0).close()
 
 
+@pytest.mark.slow
 def test_a_taken_port_says_what_to_do():
     taken = bind_page_port(0)
     port = taken.getsockname()[1]
@@ -223,6 +232,7 @@ def test_a_taken_port_says_what_to_do():
     taken.close()
 
 
+@pytest.mark.slow
 def test_tokens():
     token = new_token()
     assert check_token(token) == token and len(token) == 32
@@ -243,6 +253,7 @@ def _drain(queue):
     return messages
 
 
+@pytest.mark.slow
 def test_message_keys():
     assert message_key(_transform("/a", 0)) == ("set_transform", "/a")
     assert message_key(msgpack.packb({"property": "visible", "type": "set_property",
@@ -257,6 +268,7 @@ def test_message_keys():
     assert message_key(msgpack.packb([1, 2])) is None
 
 
+@pytest.mark.slow
 def test_the_queue_keeps_the_latest_of_a_key_and_the_order_across_barriers():
     queue = PendingMessages()
     for message in [_transform("/a", 1), _transform("/b", 1), _transform("/a", 2),
@@ -271,6 +283,7 @@ def test_the_queue_keeps_the_latest_of_a_key_and_the_order_across_barriers():
         queue.pop()
 
 
+@pytest.mark.slow
 def test_the_queue_stays_bounded_under_a_flood():
     queue = PendingMessages()
     paths = ["/robot/base", "/robot/arm", "/robot/hand"]

@@ -78,6 +78,7 @@ def _closed(page, seconds=5.0):
     return page.protocol.close_rcvd.code, page.protocol.close_rcvd.reason
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("frame", DEADLY.values(), ids=DEADLY.keys())
 def test_a_deadly_frame_closes_its_page_with_a_reason_and_the_person_drives_on(
         meshcat, front, frame):
@@ -92,6 +93,7 @@ def test_a_deadly_frame_closes_its_page_with_a_reason_and_the_person_drives_on(
         _press(person, meshcat)
 
 
+@pytest.mark.slow
 def test_unknown_messages_and_oversized_frames_close_their_page(meshcat, front):
     with _page(front) as person:
         for frame, expected in [(msgpack.packb({"type": "set_transform", "path": "/"}),
@@ -104,6 +106,7 @@ def test_unknown_messages_and_oversized_frames_close_their_page(meshcat, front):
         assert _until(lambda: front.pages() == 1 and meshcat.GetNumActiveConnections() == 1)
 
 
+@pytest.mark.slow
 def test_meshcats_port_lets_in_nobody_but_the_front(meshcat, front):
     assert front.door_shut
     with _page(front) as person:
@@ -134,6 +137,7 @@ def _handshake(front, read_answer):
     raw.close()
 
 
+@pytest.mark.slow
 def test_pages_that_close_as_they_connect_leave_no_connection_to_meshcat(
         meshcat, front, caplog):
     announced = []
@@ -158,6 +162,7 @@ def test_pages_that_close_as_they_connect_leave_no_connection_to_meshcat(
     assert not [r for r in caplog.records if r.levelname in ("ERROR", "CRITICAL")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", ["etc/passwd", "?token={token}", "*",
                                     "http://localhost:{port}/?token={token}"])
 def test_a_target_without_a_leading_slash_gets_400(front, target):
@@ -172,6 +177,7 @@ def test_a_target_without_a_leading_slash_gets_400(front, target):
     assert answer.startswith(b"HTTP/1.1 400 ") and b"MeshCat" not in answer
 
 
+@pytest.mark.slow
 def test_where_the_door_stays_open_an_intruder_is_ignored_not_obeyed(meshcat, monkeypatch,
                                                                      capsys):
     monkeypatch.setattr(meshcat_door, "_listeners", lambda port: ([], "no filter here"))
@@ -195,6 +201,7 @@ def test_where_the_door_stays_open_an_intruder_is_ignored_not_obeyed(meshcat, mo
         assert "count again" in announced[-1]
 
 
+@pytest.mark.slow
 def test_two_admitted_pages_still_pause(meshcat, front):
     announced = []
     guard = BrowserGuard(meshcat, announce=announced.append, poll_period=0.01)

@@ -31,6 +31,7 @@ def _no_answer(family, address, port, source=None):
     return False
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("host, family, address", [
     ("localhost", socket.AF_INET, "127.0.0.1"), ("::1", socket.AF_INET6, "::1")])
 def test_a_shut_door_answers_its_own_sockets_alone(host, family, address):
@@ -51,6 +52,7 @@ def test_a_shut_door_answers_its_own_sockets_alone(host, family, address):
     assert _no_answer(family, address, meshcat.port())  # shut still, to everyone
 
 
+@pytest.mark.slow
 def test_a_meshcat_of_another_process_leaves_the_door_open_saying_why():
     with socket.create_server(("localhost", 0)) as elsewhere:
         # Not listening in this process under that port: a port nobody here listens on.

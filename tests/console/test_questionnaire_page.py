@@ -104,6 +104,7 @@ def test_both_ends_of_each_question_say_what_they_mean():
     assert list(ease.values()) == [0, 1, 2, 3, 4, 5]
 
 
+@pytest.mark.slow
 def test_a_session_is_clicked_through_in_the_page(meshcat, short_task, tmp_path):
     port = meshcat.port()
 

@@ -5,6 +5,7 @@ a key of its colours; the recording itself unchanged. (tests/e2e/test_replay_scr
 opens such pages in a browser.)"""
 
 import numpy as np
+import pytest
 from pydrake.geometry import Rgba, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.analysis import Simulator
@@ -53,6 +54,7 @@ def draw_a_task_target(meshcat):
         meshcat.SetTransform("/task/target", RigidTransform([time, 0.0, 0.8]), time)
 
 
+@pytest.mark.slow
 def test_a_2d_replay_opens_paused_with_a_key_of_the_scene_colours(meshcat, tmp_path):
     html = static_html(meshcat, run_a_2d_scene)
     replay = mark_replay(html)
@@ -74,6 +76,7 @@ def test_a_2d_replay_opens_paused_with_a_key_of_the_scene_colours(meshcat, tmp_p
     assert is_replay(tmp_path / "replay.html")
 
 
+@pytest.mark.slow
 def test_a_task_replay_opens_paused_without_the_2d_key(meshcat):
     html = static_html(meshcat, draw_a_task_target)
     replay = mark_replay(html)
@@ -92,6 +95,7 @@ def colour_bytes(colour):
     return np.array([colour.r(), colour.g(), colour.b()]) * 255, colour.a()
 
 
+@pytest.mark.slow
 def test_the_key_lists_every_colour_the_2d_scene_draws_and_no_other(meshcat):
     drawn = []
     for command in commands(static_html(meshcat, run_a_2d_scene)):

@@ -63,6 +63,7 @@ def test_a_failed_run_says_which_target_and_how_far(repo):
     assert failure_text(0, 4, 1.25) == "the target was object 1 of 4, the hand 1.250 m from it"
 
 
+@pytest.mark.slow
 def test_a_gamepad_run_without_a_pad_says_so_until_one_comes(repo, meshcat, capsys):
     toy = load_scenario_file(repo / "diagrams" / "toy_alt_vs_cont.yaml").resolved
     console = Console(meshcat, choices=("stop",))
@@ -80,6 +81,7 @@ def test_a_gamepad_run_without_a_pad_says_so_until_one_comes(repo, meshcat, caps
     assert capsys.readouterr().err == ""  # a pad there at the start is no news
 
 
+@pytest.mark.slow
 def test_a_pad_that_comes_during_the_run_is_greeted(repo, meshcat, capsys):
     toy = load_scenario_file(repo / "diagrams" / "toy_alt_vs_cont.yaml").resolved
     console = Console(meshcat, choices=("stop",))

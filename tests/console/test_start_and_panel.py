@@ -45,6 +45,7 @@ def press_later(port, origin, name, delay, stop):
     page.close()
 
 
+@pytest.mark.slow
 def test_the_clock_starts_at_the_start_press(scene, meshcat):
     diagram = build_diagram(scene)
     panel = Panel()

@@ -88,6 +88,7 @@ def one_by_one(step, k):
     return (np.arange(k) % 3 == step % 3) if 10 <= step < 25 else None
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
 @pytest.mark.parametrize("goal_count", [5, 70])
@@ -120,6 +121,7 @@ def test_a_position_per_goal_steps_as_the_per_goal_loop(formulation, shared, uni
                                        rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_many_distinct_goals_step_as_the_per_goal_loop():
     """Many distinct weights, contracted over the basis rows that matter at each phase
     (`pbp_drake.core.dmp.contraction`, its blocks tested in tests/core/test_contraction.py);
@@ -241,6 +243,7 @@ def test_the_bank_model_is_immutable_and_untouched_by_steps(formulation, shared)
     np.testing.assert_array_equal(other._weights, 1.0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
 def test_leaf_system_equals_the_per_goal_loop(shared):
     from pydrake.systems.analysis import Simulator
@@ -330,6 +333,7 @@ def pydmps_path(dmp_parameters, dt, duration, y_start, yd_start):
     return np.array([other.step()[0].copy() for _ in range(int(round(duration / dt)))])
 
 
+@pytest.mark.slow
 def test_pydmps_agrees_with_the_ijspeert_form():
     """pydmps integrates `ydd = alpha_z (beta_z (g - y) - yd) + x (g - y0) psi.w / sum psi`
     (tau = 1) with explicit Euler on the phase and semi-implicit Euler on (y, yd); ours steps

@@ -42,6 +42,7 @@ def all_kinds_of_dmp(formulation, start, goal):
             Dmp.straight(start, goal, 0.7, settings, profile="zero_forcing")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_every_dmp_converges_to_its_goal_from_any_start(formulation):
     rng = np.random.default_rng(7)
@@ -64,6 +65,7 @@ def test_straight_dmp_moves_on_the_line_and_arrives_on_time():
     assert np.abs(path - expected).max() < 0.05
 
 
+@pytest.mark.slow
 def test_bank_of_k_equals_k_single_dmps():
     rng = np.random.default_rng(3)
     settings = DmpSettings(basis_count=30)
@@ -94,6 +96,7 @@ def test_bank_of_k_equals_k_single_dmps():
         robot_position = 0.7 * robot_position + 0.3 * bank_positions[0]
 
 
+@pytest.mark.slow
 def test_shared_demonstration_bank_sends_one_shape_to_every_goal():
     times, positions = bent_path([0, 0], [1, 0], 0.3, 1.0)
     goals = np.array([[1.0, 0.0], [2.0, 0.0], [1.0, 1.0]])
@@ -157,6 +160,7 @@ def test_unknown_formulation_is_refused():
         DmpSettings(formulation="ijsperet")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_the_step_is_second_order_against_the_continuous_ode(formulation):
     """The step against SciPy's `solve_ivp` (DOP853, rtol = atol = 1e-12) on the continuous

@@ -152,6 +152,7 @@ def loop_probabilities(settings, goals, position, heading, start, path_length):
     return np.array([weight / total for weight in weights])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", GOAL_ESTIMATION_METHODS)
 def test_vectorised_equals_a_loop_over_ten_thousand_goals(method):
     rng = np.random.default_rng(2)

@@ -151,6 +151,7 @@ def test_posterior_and_action_agree_with_the_equations(seed, with_orientations):
         assert command.angular_velocity is None
 
 
+@pytest.mark.slow
 def test_recursive_updates_agree_with_the_equations():
     """Fifty updates along a path, each from the last one's clipped belief."""
     rng = np.random.default_rng(7)

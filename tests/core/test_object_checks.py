@@ -7,6 +7,7 @@ import pytest
 from pbp_drake.core.reach_task import closest_pair_within, validate_objects
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("count, distance", [(2, 0.9), (5, 0.4), (60, 0.05), (400, 0.01)])
 def test_the_closest_pair_is_the_one_all_gaps_give(count, distance):
     rng = np.random.default_rng(count)

@@ -34,6 +34,7 @@ def test_a_side_grasp_faces_its_yaw_and_a_top_grasp_turns_with_its_roll():
     np.testing.assert_allclose(forward, [np.cos(yaw), -np.sin(yaw), 0], atol=1e-12)
 
 
+@pytest.mark.slow
 def test_the_frame_turns_continuously_while_the_hand_pitches_and_rolls():
     previous = None
     for step in np.linspace(0.0, 1.0, 2001):

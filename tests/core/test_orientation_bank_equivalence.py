@@ -59,6 +59,7 @@ def one_by_one(step, k):
     return (np.arange(k) % 3 == step % 3) if 5 <= step < 15 else None
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
 @pytest.mark.parametrize("uniform_start", [True, False], ids=["one_start", "many_starts"])
@@ -90,6 +91,7 @@ def test_bank_of_k_equals_k_single_dmps(formulation, shared, uniform_start, lock
             robot = random_rows(1, rng).T
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
 def test_an_orientation_per_dmp_steps_as_the_per_goal_loop(formulation, shared):
@@ -108,6 +110,7 @@ def test_an_orientation_per_dmp_steps_as_the_per_goal_loop(formulation, shared):
                                        rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_from_dmps_and_predict_match_the_single_rollouts():
     bank, dmps, goals = make_banks("ijspeert", False, 4, False, seed=25)
     rebuilt = OrientationDmpBank.from_dmps(dmps)

@@ -79,6 +79,7 @@ def test_every_dmp_converges_to_its_goal_orientation_from_any_start(formulation)
             assert angles(path[-1], goal) < TENTH_OF_A_DEGREE
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_the_bank_converges_when_the_measured_orientation_jumps_mid_run(formulation):
     """PBP: every step from the robot's orientation, which tracks the DMP it follows with a
@@ -176,6 +177,7 @@ def test_the_step_matches_the_continuous_equations(formulation, case):
     assert errors[30] / errors[100] > 6  # second order: (100 / 30)^2 = 11
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 @pytest.mark.parametrize("total_degrees", [60, 120, 170])
 def test_a_learned_dmp_reproduces_its_demonstration(formulation, total_degrees):
@@ -193,6 +195,7 @@ def test_a_learned_dmp_reproduces_its_demonstration(formulation, total_degrees):
     assert angles(paths[0], demo).max() < 0.01 * np.radians(total_degrees)
 
 
+@pytest.mark.slow
 def test_a_straight_dmp_turns_along_the_slerp_arc():
     start, goal = rotation_about([1, 1, 0], 0.2), rotation_about([0, -1, 2], 2.5)
     for formulation in FORMULATIONS:
@@ -211,6 +214,7 @@ def flip_signs(rows, rng):
     return rows * rng.choice([-1.0, 1.0], size=(len(rows), 1))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_antipodal_quaternions_give_the_same_motion(formulation):
     """`-q` for the goal, the start, the demonstration's samples and the measured

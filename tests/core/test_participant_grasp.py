@@ -63,6 +63,7 @@ def drive(scene, target, seed, seconds=60.0):
     return None, first_active
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(8))
 def test_driving_it_reaches_the_targets_grasp_pose(seed):
     scene = sample_grasp_scene(seed)
@@ -149,6 +150,7 @@ def test_with_the_forward_key_it_drives_at_once_to_the_target_the_robot_does_not
         scene.grasp_orientations[target])))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(12))
 def test_assisting_while_wrong_it_turns_toward_the_target_and_never_pushes_forward(seed):
     scene = sample_grasp_scene(seed)
@@ -223,6 +225,7 @@ def blend_loop(positions, orientations, target, start_picked, seconds=30.0, seed
     return np.array(selections), np.array(activity)
 
 
+@pytest.mark.slow
 def test_in_a_blend_loop_it_brings_the_estimate_round_and_then_lets_go():
     positions = np.array([[1.6, 0.5, 0.675], [1.6, -0.5, 0.675]])
     orientations = np.array([side_grasp_orientation(0.4), side_grasp_orientation(-0.4)])
@@ -233,6 +236,7 @@ def test_in_a_blend_loop_it_brings_the_estimate_round_and_then_lets_go():
     assert not activity[first_right + 1:].any()
 
 
+@pytest.mark.slow
 def test_only_its_turn_tells_two_grasps_at_one_place_apart_in_the_loop():
     place = np.array([1.6, 0.0, 0.83])
     positions = np.array([place, place])

@@ -31,6 +31,7 @@ def noise_series(impairment, seed, ticks, scales=SCALES):
     return np.array(series)
 
 
+@pytest.mark.slow
 def test_white_motor_noise_has_the_documented_spread_and_no_memory():
     series = noise_series(ParticipantImpairment(command_noise=0.3, command_noise_time=0.0),
                           seed=3, ticks=6000)
@@ -40,6 +41,7 @@ def test_white_motor_noise_has_the_documented_spread_and_no_memory():
     assert np.all(np.abs(lag_one) < 0.05)
 
 
+@pytest.mark.slow
 def test_correlated_motor_noise_keeps_its_spread_and_lasts_its_correlation_time():
     impairment = ParticipantImpairment(command_noise=0.3, command_noise_time=0.6)
     series = noise_series(impairment, seed=11, ticks=20000)
@@ -64,6 +66,7 @@ def test_motor_noise_is_a_function_of_the_seed_and_tick_alone():
     assert np.allclose(quiet, first / 3)
 
 
+@pytest.mark.slow
 def test_the_mistaken_participant_errs_at_its_rate_and_never_names_the_target():
     impairment = ParticipantImpairment(mistake_probability=0.2)
     choices = np.array([[first_choice(impairment, seed, number, 1, 4) for number in range(3)]
@@ -129,6 +132,7 @@ def test_the_defaults_and_the_conditions_are_usable_and_each_one_impairment():
         condition("sleepy")
 
 
+@pytest.mark.slow
 def test_the_motor_noise_draws_apart_from_the_calibrated_participants_noise():
     # The calibrated participant draws its direction and speed noise from (seed, tick); no
     # tick of the motor noise may repeat one of those draws (NumPy's seeds ignore trailing
@@ -175,6 +179,7 @@ def grasp_twists(impairment, forward_key=True, seconds=2.5, selected=NO_INTENT, 
     return np.array(twists), hand, level
 
 
+@pytest.mark.slow
 def test_the_mistaken_grasp_participant_heads_for_the_other_grasp_pose_then_the_target():
     positions, orientations = grasp_scene()
     twists, hand, level = grasp_twists(
@@ -200,6 +205,7 @@ def test_the_mistaken_grasp_participant_heads_for_the_other_grasp_pose_then_the_
     assert all(heads_for(twist, 1) for twist in unimpaired[noticed:])
 
 
+@pytest.mark.slow
 def test_the_noisy_grasp_participant_adds_its_noise_while_it_acts_and_never_forward():
     ticks = int(round(2.5 / PERIOD))
     noise = np.random.default_rng(0).normal(0.0, 0.05, (ticks, 6))

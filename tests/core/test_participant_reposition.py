@@ -92,6 +92,7 @@ def test_the_participant_backs_until_the_tool_can_point_at_the_target_then_faces
         assert facing_ticks * PERIOD < 2.0
 
 
+@pytest.mark.slow
 def test_unable_to_move_to_where_it_can_point_it_goes_to_the_target_itself():
     # The hand held where it is (the arm at a limit, say): after `reposition_time` of
     # backing in vain it insists, moving toward the target as far as the keys allow. The

@@ -146,6 +146,7 @@ def TeleopParticipant(objects, target_index, **kwargs):
     return participant
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target_index", [2, 3])
 def test_a_teleop_participant_drives_the_hand_to_a_target_above_or_below(target_index):
     participant = TeleopParticipant(OBJECTS, target_index, params=QUIET, vertical=True)

@@ -106,6 +106,7 @@ def test_unknown_modes_and_bad_alphas_are_refused():
 LIMITS = HandOverLimits(2.0, 0.5, 0.3 / DT, 1.5)
 
 
+@pytest.mark.slow
 def test_the_hand_over_bounds_the_change_of_angular_velocity_per_tick():
     rng = np.random.default_rng(2)
     velocity, angular = np.zeros(3), np.zeros(3)

@@ -29,6 +29,7 @@ def random_rotation_vectors(rng, count, largest=np.pi):
     return axes * angles
 
 
+@pytest.mark.slow
 def test_product_log_exp_and_slerp_match_scipy():
     first, second = Rotation.random(50, random_state=1), Rotation.random(50, random_state=2)
     product = quaternion.multiply(wxyz(first), wxyz(second))
@@ -118,6 +119,7 @@ def test_unit_quaternions_are_normalised_within_the_tolerance_and_bad_ones_named
         quaternion.unit_quaternions([1.0, 0, 0], "start")
 
 
+@pytest.mark.slow
 def test_exp_times_aligned_is_the_vectorised_composition_bit_for_bit():
     rng = np.random.default_rng(7)
     cases = [(np.zeros(3), quaternion.IDENTITY, quaternion.IDENTITY)]  # angle 0: sinc's 1e-20

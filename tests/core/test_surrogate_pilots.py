@@ -28,12 +28,14 @@ def within_binomial(count, trials, probability, sigmas=5.0):
     return abs(count - trials * probability) <= sigmas * spread
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("eps", [0.3, 0.6])
 def test_the_noisy_pilot_corrupts_a_share_eps_of_the_ticks(eps):
     corrupted = sum(noisy_draw(7, tick, eps, 3, True)[0] for tick in range(TICKS))
     assert within_binomial(corrupted, TICKS, eps)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("forward_enabled, states", [(True, (-1.0, 0.0, 1.0)),
                                                      (False, (-1.0, 0.0))])
 def test_corrupted_keys_are_uniform_over_the_enabled_states(forward_enabled, states):
@@ -103,6 +105,7 @@ def test_the_lag_is_converted_from_50_hz_to_our_tick(p, period, expected):
     assert lag_per_tick(p, period) ** (1.0 / period) == pytest.approx(p ** 50, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_the_laggy_pilot_repeats_a_share_p_of_the_ticks():
     p_tick = lag_per_tick(0.85, 0.03)
     repeated = sum(laggy_draw(5, tick, p_tick) for tick in range(TICKS))
@@ -170,6 +173,7 @@ def test_the_population_draws_within_its_ranges_and_by_its_levels():
             assert values[name] == pytest.approx(low + level * (high - low))
 
 
+@pytest.mark.slow
 def test_the_levels_are_uniform_over_seeds():
     levels = np.array([list(population_levels(seed).values()) for seed in range(4000)])
     for column in levels.T:

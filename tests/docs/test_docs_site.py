@@ -18,6 +18,7 @@ sys.path.insert(0, str(REPO / "docs" / "_ext"))
 import pbp_docs  # noqa: E402  (docs/_ext is not a package)
 
 
+@pytest.mark.slow
 def test_every_scenario_field_has_a_description():
     from pbp_drake.scenarios.schema import ScenarioFile
 

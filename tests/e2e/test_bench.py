@@ -274,6 +274,7 @@ def test_the_bench_command_pins_blas_and_exits_with_the_checks(
     assert f"exit code {code}" in result.stdout
 
 
+@pytest.mark.slow
 def test_the_movement_timing_runs_a_fresh_simulator_over_two_durations():
     # The LeafSystem checks read a run from phase 1 to 1e-4 (0 to 2 tau), not its first
     # moments: the step's cost moves with the phase.
@@ -298,6 +299,7 @@ def test_the_slowest_stretch_of_a_timed_span_is_reported():
     assert slowest >= 0.002 > median
 
 
+@pytest.mark.slow
 def test_the_websocket_reader_receives_what_meshcat_sends():
     meshcat = Meshcat(MeshcatParams(host="localhost", port=0))
     reader = MeshcatReader(meshcat)  # connected: Meshcat counts it

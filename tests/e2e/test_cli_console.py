@@ -24,6 +24,7 @@ def test_version(capsys):
     assert capsys.readouterr().out == f"pbp-drake {__version__}\n"
 
 
+@pytest.mark.slow
 def test_no_meshcat_runs_without_a_server(repo, capsys):
     assert main(["run", str(repo / QUICK), "--no-meshcat"]) == 0
     out = capsys.readouterr().out

@@ -41,6 +41,7 @@ def test_a_bad_flag_value_is_refused_when_parsed(repo, capsys, flag, value, mess
     assert "Traceback" not in err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [
     ["--port", "0"], ["--realtime-rate", "0.5"], ["--wait-for-browser", "0"],
     ["--token", "a-script-chose_this-token"], ["--keep-page", "0"],
@@ -49,6 +50,7 @@ def test_good_flag_values_pass(repo, argv):
     assert main(["run", str(repo / QUICK), "--headless", *argv]) == 0
 
 
+@pytest.mark.slow
 def test_a_page_run_takes_a_free_port_and_prints_its_tokened_url(repo, capsys):
     port = free_port()
     assert main(["run", str(repo / QUICK), "--port", str(port), "--realtime-rate", "20",
@@ -73,6 +75,7 @@ def test_a_port_in_use_is_refused_in_one_line_before_anything_is_built(repo, cap
     assert elapsed < 2.0, f"took {elapsed:.1f} s"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("operator", ["keyboard", "gamepad"])
 def test_a_person_run_that_no_browser_joins_stops_and_records_nothing(repo, tmp_path, capsys,
                                                                        operator):
@@ -92,6 +95,7 @@ def test_a_person_run_that_no_browser_joins_stops_and_records_nothing(repo, tmp_
     assert not record.exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", [["session"], ["run"]])  # `run --participant`: its alias
 def test_a_session_that_no_browser_joins_stops_and_saves_nothing(repo, tmp_path, capsys,
                                                                  command):

@@ -43,6 +43,7 @@ def test_record_under_a_file_is_refused(tmp_path, repo, capsys):
     assert blocker.read_text() == "not a folder"
 
 
+@pytest.mark.slow
 def test_record_over_a_file_that_is_not_a_replay_needs_force(tmp_path, repo, capsys):
     record = tmp_path / "thesis.html"
     record.write_text("<html>three years of work</html>")
@@ -58,6 +59,7 @@ def test_record_over_a_file_that_is_not_a_replay_needs_force(tmp_path, repo, cap
     assert f"Replay saved to {record}" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_record_writes_a_replay_and_overwrites_its_own(tmp_path, repo, capsys):
     record = tmp_path / "new" / "folder" / "replay.html"
     assert main(["run", str(repo / QUICK), "--headless", "--record", str(record)]) == 0

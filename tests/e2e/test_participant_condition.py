@@ -44,6 +44,7 @@ def test_a_two_d_study_refuses_it(repo, tmp_path, capsys):
     assert not (tmp_path / "out" / "summary.json").exists()
 
 
+@pytest.mark.slow
 def test_the_condition_runs_is_recorded_and_named_in_the_results(repo, tmp_path, capsys):
     plain, late = tmp_path / "plain", tmp_path / "late"
     common = ["--methods", "teleop", "--trials", "1", "--split", "tuning"]

@@ -46,6 +46,7 @@ def arm(request):
     return dataclasses.replace(ARMS[request.param](), command_period=CONTROL_PERIOD)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("motion", ["kinematic", "dynamic"])
 def test_holding_the_start_keeps_the_arm_still(arm, motion):
     station = make_arm_station(dataclasses.replace(arm, motion=motion))
@@ -62,6 +63,7 @@ def test_holding_the_start_keeps_the_arm_still(arm, motion):
     assert np.abs(hands[:3] - start[:3, None]).max() < 1e-5
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("direction", [(1, 0, 0), (0, 1, 0), (0, 0, 1), (0.6, -0.6, -0.5)])
 def test_the_hand_moves_at_the_commanded_velocity_within_the_joint_limits(arm, direction):
     unit = np.asarray(direction, float) / np.linalg.norm(direction)
@@ -80,6 +82,7 @@ def test_the_hand_moves_at_the_commanded_velocity_within_the_joint_limits(arm, d
     assert (np.abs(v) <= plant.GetVelocityUpperLimits()[:, None] + 1e-9).all()
 
 
+@pytest.mark.slow
 def test_the_heading_turns_the_tool_about_the_vertical(arm):
     result = drive(lambda time: np.zeros(3), 1.5, station=make_arm_station(arm),
                    turn=lambda time: 0.5 * min(time, 1.0))

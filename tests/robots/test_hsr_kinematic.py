@@ -20,6 +20,9 @@ from pbp_drake.systems.ports import EeCommand
 
 from test_hsr_station import POSITION_INDEX, ramp, simulate
 
+# Its tests share fixtures that take seconds to make: `make test-fast` leaves it out.
+pytestmark = pytest.mark.slow
+
 KINEMATIC = HsrStationConfig(motion="kinematic")
 
 

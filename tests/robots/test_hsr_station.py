@@ -173,6 +173,7 @@ def test_rejects_an_unreachable_start_height():
         make_hsr_station(HsrStationConfig(ee_height=2.0))
 
 
+@pytest.mark.slow
 def test_holding_the_initial_command_keeps_still(start):
     ee_log, state_log = simulate([(0.0, start), (2.0, start)], 2.0)
     drift = np.linalg.norm(ee_log.data()[:3] - start[:3, None], axis=0)
@@ -181,6 +182,7 @@ def test_holding_the_initial_command_keeps_still(start):
     assert np.abs(positions - positions[:, :1]).max() < 1e-3
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("axis", [0, 1], ids=["forward", "sideways"])
 def test_position_ramp_is_tracked_and_moves_the_base(start, axis):
     delta = np.zeros(7)
@@ -213,6 +215,7 @@ def test_position_ramp_is_tracked_and_moves_the_base(start, axis):
     np.testing.assert_allclose(torso, TORSO_TO_ARM_LIFT_RATIO * lift, atol=1e-4)
 
 
+@pytest.mark.slow
 def test_base_is_driven_within_its_velocity_limits(start):
     # A far, fast command: diff IK asks the base for its full speed (the model file's
     # limits), and the plant's PD on the base motors follows it.
@@ -231,6 +234,7 @@ def test_base_is_driven_within_its_velocity_limits(start):
     assert base_velocities[0, -1] == pytest.approx(BASE_SPEED_LIMITS[0], rel=0.01)
 
 
+@pytest.mark.slow
 def test_heading_ramp_turns_the_hand_and_the_base_follows(start):
     turned = start.copy()
     turned[6] = 0.5
@@ -244,6 +248,7 @@ def test_heading_ramp_turns_the_hand_and_the_base_follows(start):
     assert state_log.data()[BASE[2], -1] > 0.35
 
 
+@pytest.mark.slow
 def test_reaches_a_point_in_the_object_region(start):
     target = np.array([2.0, 0.8, EE_HEIGHT])
     delta = np.zeros(7)
@@ -255,6 +260,7 @@ def test_reaches_a_point_in_the_object_region(start):
     assert np.abs(p[2] - EE_HEIGHT).max() < 0.02
 
 
+@pytest.mark.slow
 def test_coarser_diff_ik_period_still_tracks(start):
     delta = np.zeros(7)
     delta[1] = 0.3
@@ -292,6 +298,7 @@ def test_obstacles_are_measured_against_the_robot():
     assert station.GetOutputPort("in_collision").Eval(context)[0] == 1.0
 
 
+@pytest.mark.slow
 def test_obstacles_do_not_push_the_robot(start):
     station, _ = obstacle_station_context([[0.0, 0.0, 0.0]] * 2)
     builder = DiagramBuilder()

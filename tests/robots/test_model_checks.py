@@ -79,6 +79,7 @@ def test_our_arms_pass_in_either_motion(model_file, motion):
 JOINT1_PARENT = '<parent link="arm7_base"/>\n    <child link="arm7_link1"/>'
 
 
+@pytest.mark.slow
 def test_a_joint_cycle_is_refused_by_the_cli_with_exit_2_and_no_hang(tmp_path):
     # The shoulder hangs from the upper arm, which hangs from the shoulder: the chain walk
     # from the hand to the base used to loop forever, growing.

@@ -172,6 +172,7 @@ GENERATED = list(_generated())
 BROKEN += GENERATED[::len(GENERATED) // (100 - len(BROKEN))][:100 - len(BROKEN)]
 
 
+@pytest.mark.slow
 def test_a_hundred_broken_files_exit_2_naming_the_field(tmp_path, run_refused):
     """Each exits 2 within 10 s, with `pbp-drake: PATH: ` and
     the field (or the line) named, and no traceback."""

@@ -104,6 +104,7 @@ def _write(tmp_path, name):
     return path
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", CASES)
 def test_a_large_or_aliased_file_is_refused_in_seconds_naming_the_field(
         name, tmp_path, run_refused):
@@ -153,6 +154,7 @@ def test_a_scenario_built_in_python_is_held_to_the_goal_cap():
         resolve(crowded)
 
 
+@pytest.mark.slow
 def test_ten_thousand_goals_at_full_precision_load_within_the_cap(tmp_path):
     file = load_scenario_file(DIAGRAMS / "hsr_reach.yaml")
     scenario = with_grid_goals(file.scenario, 10_000)

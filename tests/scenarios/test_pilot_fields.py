@@ -93,6 +93,7 @@ def test_a_scenario_without_the_participant_has_no_pilots(repo):
         with_pilot(type(scenario)(**{**vars(scenario), "operator": keyboard}), "noisy")
 
 
+@pytest.mark.slow
 def test_the_tags_fields_reach_the_systems(repo, tmp_path):
     noisy = build_diagram(load_scenario_file(with_operator(
         repo, tmp_path, "!NoisyPilot {eps: 0.2, participant: {speed: 0.07}}")).resolved)

@@ -51,6 +51,7 @@ def _header(results):
     return next(line for line in results.splitlines() if line.startswith("| method"))
 
 
+@pytest.mark.slow
 def test_a_reach_study_reports_no_collisions(tmp_path, repo, capsys):
     folder = _study(tmp_path, repo / "diagrams" / "hsr_reach.yaml")
     assert main(["report", str(folder)]) == 0
@@ -68,6 +69,7 @@ def test_a_reach_study_reports_no_collisions(tmp_path, repo, capsys):
     assert all("collision_ratio" not in entry for entry in summary["methods"].values())
 
 
+@pytest.mark.slow
 def test_an_obstacle_study_reports_its_collisions(tmp_path, repo, capsys):
     folder = _study(tmp_path, repo / "diagrams" / "hsr_obstacles.yaml")
     assert main(["report", str(folder)]) == 0
@@ -85,6 +87,7 @@ def test_an_obstacle_study_reports_its_collisions(tmp_path, repo, capsys):
     assert summary["methods"]["teleop"]["collision_free_trials"] == 1
 
 
+@pytest.mark.slow
 def test_a_stale_collision_figure_is_neither_kept_nor_claimed(tmp_path, repo, capsys):
     folder = _study(tmp_path, repo / "diagrams" / "hsr_reach.yaml")
     # An older version drew Fig. 7c for reaching too.
@@ -94,6 +97,7 @@ def test_a_stale_collision_figure_is_neither_kept_nor_claimed(tmp_path, repo, ca
     assert not (folder / "fig7c_collisions.png").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task, measured", [("hsr_reach", False), ("hsr_obstacles", True)])
 def test_a_folder_without_study_json_is_judged_by_its_time_series(tmp_path, repo, capsys,
                                                                  task, measured):

@@ -34,6 +34,7 @@ def _study(folder, trials=2):
     return folder
 
 
+@pytest.mark.slow
 def test_a_clean_folder_reports_without_complaint(tmp_path, capsys):
     assert main(["report", str(_study(tmp_path))]) == 0
     assert "damaged" not in capsys.readouterr().err
@@ -42,6 +43,7 @@ def test_a_clean_folder_reports_without_complaint(tmp_path, capsys):
     assert summary["methods"]["teleop"]["trials"] == 2
 
 
+@pytest.mark.slow
 def test_report_names_each_damaged_file_and_reports_the_rest(tmp_path, capsys):
     folder = _study(tmp_path, trials=3)
     truncated = trial_paths(folder, "teleop", 0)[0]
@@ -89,6 +91,7 @@ def test_a_malformed_csv_is_named(tmp_path, text, problem):
     assert [(d.key, problem in d.problem) for d in damaged] == [(("teleop", 0), True)]
 
 
+@pytest.mark.slow
 def test_a_folder_with_errored_trials_reports_them_and_exits_1(tmp_path, capsys):
     folder = _study(tmp_path, trials=3)
     record = trial_record("fake", "abc", "teleop", 1, 1)
@@ -105,6 +108,7 @@ def test_a_folder_with_errored_trials_reports_them_and_exits_1(tmp_path, capsys)
     assert summary["methods"]["teleop"]["errors"] == 1
 
 
+@pytest.mark.slow
 def test_a_folder_with_trials_that_did_not_run_exits_1(tmp_path, capsys):
     folder = _study(tmp_path, trials=3)
     for path in trial_paths(folder, "pbp_alternated", 2):

@@ -124,6 +124,7 @@ def _trial_records(folder):
     return [json.loads(p.read_text()) for p in (folder / "trials").glob("*/seed_*.json")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("jobs", [1, 2])
 def test_a_full_disk_stops_the_study_and_freed_it_ends_as_an_uninterrupted_one(
         scenario, tmp_path, small_disk, jobs):
@@ -152,6 +153,7 @@ def test_a_full_disk_stops_the_study_and_freed_it_ends_as_an_uninterrupted_one(
     assert _leftovers(folder) == []
 
 
+@pytest.mark.slow
 def test_a_full_disk_stops_a_matrix_and_freed_it_ends_as_an_uninterrupted_one(
         scenario, tmp_path, small_disk):
     pilots = ["attentive", "noisy"]
@@ -169,6 +171,7 @@ def test_a_full_disk_stops_a_matrix_and_freed_it_ends_as_an_uninterrupted_one(
     assert (folder / "summary.json").read_bytes() == (whole / "summary.json").read_bytes()
 
 
+@pytest.mark.slow
 def test_report_on_a_full_disk_says_so_in_one_line_and_leaves_nothing_half_written(
         scenario, tmp_path, small_disk, capsys):
     disk = small_disk("1m")
@@ -191,6 +194,7 @@ def test_report_on_a_full_disk_says_so_in_one_line_and_leaves_nothing_half_writt
     assert (folder / "summary.json").read_bytes() == expected
 
 
+@pytest.mark.slow
 def test_report_on_a_read_only_disk_names_the_file_and_what_to_do(scenario, small_disk,
                                                                   capsys):
     disk = small_disk("1m")
@@ -225,6 +229,7 @@ def _hold_lock(folder, write_pid=True):
     return holder
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("write_pid", [True, False], ids=["pid in the file", "in /proc/locks"])
 def test_a_locked_folder_is_refused_naming_the_holder_and_freed_when_it_dies(
         scenario, tmp_path, write_pid):
@@ -242,6 +247,7 @@ def test_a_locked_folder_is_refused_naming_the_holder_and_freed_when_it_dies(
     assert summary["methods"]["teleop"]["trials"] == 2
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pilots", [None, "attentive,noisy"])
 def test_the_command_refuses_a_locked_folder_with_exit_2(task_file, tmp_path, capsys, pilots):
     folder = tmp_path / "study"

@@ -18,6 +18,9 @@ from pbp_drake.studies.trial_files import (
     INTERACTION_METRICS, scenario_hash, time_series_columns, trial_record, write_study,
     write_trial_files)
 
+# Its tests share fixtures that take seconds to make: `make test-fast` leaves it out.
+pytestmark = pytest.mark.slow
+
 METHODS = ("pbp_alternated", "teleop", "hop")
 # Per trial of PBP-Alt: input (m), agreement, each switch's time to prediction (s).
 INPUT = (0.2, 0.4, 0.6)

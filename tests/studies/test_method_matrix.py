@@ -140,6 +140,7 @@ def process_run(resolved):
         objects=np.zeros((2, 3)), collision_ratio=0.0, in_collision=np.zeros(ticks, bool))
 
 
+@pytest.mark.slow
 def test_every_pilots_trials_run_in_one_pool_of_workers(task_file, tmp_path):
     # Three pilots' trials on --jobs 2: two worker processes in all, each taking trials of
     # more than one pilot (pilot by pilot, each pilot would have had workers of its own).

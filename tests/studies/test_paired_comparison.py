@@ -47,6 +47,7 @@ def _row(rows, metric, method="teleop"):
     return row
 
 
+@pytest.mark.slow
 def test_pairs_the_trials_by_seed_against_the_first_studys_noise(tmp_path, repo):
     scenario = repo / "diagrams" / "hsr_reach.yaml"
     a = _study(tmp_path / "a", scenario)
@@ -67,6 +68,7 @@ def test_pairs_the_trials_by_seed_against_the_first_studys_noise(tmp_path, repo)
     assert not [r for r in rows if r.metric.startswith("collision")]
 
 
+@pytest.mark.slow
 def test_exit_code_says_whether_a_metric_moved_beyond_its_noise(tmp_path, repo, capsys):
     scenario = repo / "diagrams" / "hsr_reach.yaml"
     a = _study(tmp_path / "a", scenario)
@@ -111,6 +113,7 @@ def _methods_study(folder, scenario_path, times):
     return folder
 
 
+@pytest.mark.slow
 def test_report_pairs_every_method_with_one_of_its_study(tmp_path, repo, capsys):
     # Teleop two seconds slower on every seed, HOP one faster: the seed-to-seed spread
     # (2.0 s SD) cancels in the pairs.

@@ -10,6 +10,9 @@ import pytest
 
 from pbp_drake.cli import main
 
+# Its tests share fixtures that take seconds to make: `make test-fast` leaves it out.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def baseline_study(tmp_path_factory, repo):

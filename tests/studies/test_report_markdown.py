@@ -6,6 +6,9 @@ import pytest
 from pbp_drake.cli import main
 from pbp_drake.studies.results_markdown import study_command
 
+# Its tests share fixtures that take seconds to make: `make test-fast` leaves it out.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def hsr_study(tmp_path_factory):

@@ -10,6 +10,9 @@ from pbp_drake.scenarios.loading import check_operator_speeds
 from pbp_drake.scenarios.schema import ScenarioError
 from pbp_drake.studies.toy import run_alpha_study
 
+# Its tests share fixtures that take seconds to make: `make test-fast` leaves it out.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def inside_the_bow(repo, tmp_path_factory):

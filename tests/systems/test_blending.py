@@ -28,6 +28,7 @@ def test_blending_with_no_input_is_the_bare_policy(mode):
         np.testing.assert_array_equal(velocity, policy_velocity)
 
 
+@pytest.mark.slow
 def test_pbp_with_a_silent_operator_runs_the_bare_dmp(repo):
     """Closed loop: an operator that never acts leaves PBP-Alt and PBP-Cont equal to the DMP
     alone (PBP-NoUser)."""
@@ -98,6 +99,7 @@ def test_point_robot_settles_on_a_constant_reference():
     np.testing.assert_allclose(state, [0.5, -0.2, 0.0, 0.0], atol=1e-4)
 
 
+@pytest.mark.slow
 def test_simulations_are_restartable_and_contexts_independent(repo):
     from pbp_drake.builder import build_diagram
     from pbp_drake.builder.run import read_trajectory

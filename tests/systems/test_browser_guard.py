@@ -6,6 +6,8 @@ used only from the test's thread."""
 import threading
 import time
 
+import pytest
+
 from foreign_page import ForeignPage
 from test_browser_operators import PERIOD, Rig, gamepad_rig, set_gamepad
 
@@ -56,6 +58,7 @@ def keyboard(meshcat, exclusive):
                                 exclusive=exclusive))
 
 
+@pytest.mark.slow
 def test_a_second_page_pauses_the_keyboard_and_its_presses_are_dropped(meshcat, capsys):
     person = ForeignPage(port_of(meshcat), origin=meshcat.web_url())
     rig = keyboard(meshcat, exclusive=True)
@@ -69,6 +72,7 @@ def test_a_second_page_pauses_the_keyboard_and_its_presses_are_dropped(meshcat, 
     assert "the robot goes on" in err
 
 
+@pytest.mark.slow
 def test_without_exclusive_control_the_second_page_drives(meshcat):
     person = ForeignPage(port_of(meshcat), origin=meshcat.web_url())
     rig = keyboard(meshcat, exclusive=False)
@@ -78,6 +82,7 @@ def test_without_exclusive_control_the_second_page_drives(meshcat):
         person.close()
 
 
+@pytest.mark.slow
 def test_the_pause_is_shown_in_the_page(meshcat):
     person = ForeignPage(port_of(meshcat), origin=meshcat.web_url())
     rig = keyboard(meshcat, exclusive=True)
@@ -92,6 +97,7 @@ def test_the_pause_is_shown_in_the_page(meshcat):
     assert not any(name.startswith("Paused") for name in meshcat.GetButtonNames())
 
 
+@pytest.mark.slow
 def test_a_gamepad_state_left_by_a_second_page_is_ignored_until_the_sticks_move(meshcat):
     person = ForeignPage(port_of(meshcat), origin=meshcat.web_url())
     rig = gamepad_rig(meshcat, allow_forward=True)

@@ -72,6 +72,7 @@ def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(formula
     assert not np.array_equal(per_goal[3][0], per_goal[30][0])
 
 
+@pytest.mark.slow
 def test_one_velocity_is_limited_as_each_column_of_many_bit_for_bit():
     """The compact layouts limit the followed DMP's velocity alone, the per-goal layout every
     column: the same scale to the last bit, on any Python and NumPy (the one column's sum of

@@ -77,6 +77,7 @@ def assert_same_runs(ours, alone):
             np.testing.assert_array_equal(a, b, err_msg=f"step {step}")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
 def test_two_contexts_of_one_system_stepped_alternately_equal_each_alone(shared):
     bank = make_bank(shared)
@@ -126,6 +127,7 @@ def run_diagram(simulator, system, goals_source, seed, steps):
         yield outputs(system, system.GetMyContextFromRoot(root))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shared", [True, False], ids=["shared", "distinct"])
 def test_two_simulators_of_one_diagram_stepped_alternately_equal_each_alone(shared):
     diagram, system, goals_source = bank_diagram(make_bank(shared, goal_count=6))
@@ -141,6 +143,7 @@ def test_two_simulators_of_one_diagram_stepped_alternately_equal_each_alone(shar
         assert_same_runs(run, expected)
 
 
+@pytest.mark.slow
 def test_two_threads_stepping_one_bank_equal_each_alone():
     """Large enough that NumPy releases the GIL inside a step, so the threads interleave
     within steps: a workspace shared between the contexts would mix their numbers."""

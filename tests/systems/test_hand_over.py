@@ -115,6 +115,7 @@ def largest_velocity_change(commands):
     return np.linalg.norm(np.diff(commands[:, dimension:], axis=0), axis=1).max()
 
 
+@pytest.mark.slow
 def test_minimal_reproduction_the_switch_keeps_the_dmps_velocity():
     """Two straight DMPs to (2, 1) and (2, -1), tau 10 s, 30 Hz, the robot on DMP 0 for 3 s:
     selecting DMP 1 used to make the command jump by 0.41 m/s in one tick."""
@@ -133,6 +134,7 @@ def test_minimal_reproduction_the_switch_keeps_the_dmps_velocity():
     assert jumps[0.015, True] < 0.6 * jumps[0.03, True]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mode", BLEND_MODES)
 def test_switch_press_and_release_change_the_command_by_at_most_the_limit(mode):
     """A forced switch at 3 s, a press at 5 s (0.15 m/s sideways) and a release at 6 s."""
@@ -145,6 +147,7 @@ def test_switch_press_and_release_change_the_command_by_at_most_the_limit(mode):
     assert largest_velocity_change(commands) > 0.1
 
 
+@pytest.mark.slow
 def test_pbp_does_not_stall_behind_a_lagging_robot():
     """The re-integration trap (each step resetting the DMP to the robot's measured velocity
     stalls it behind a lagging tracker): a soft robot, no operator, a 1 m reach of 1 s at

@@ -66,6 +66,7 @@ def test_the_estimator_keeps_the_cores_recursive_belief_tick_by_tick():
     assert outputs(estimator, simulator)[0] == 0
 
 
+@pytest.mark.slow
 def test_commanding_a_goal_long_enough_sits_at_the_clip():
     diagram, estimator = estimator_diagram(np.append(TOWARD_FIRST, 0.0))
     simulator = Simulator(diagram)
@@ -91,6 +92,7 @@ def test_two_contexts_and_a_restart_give_the_same_belief():
     np.testing.assert_array_equal(outputs(estimator, first)[1], beliefs)
 
 
+@pytest.mark.slow
 def test_the_selection_moves_only_after_the_hysteresis():
     """The operator turns from the first goal to the second after 3 s: with margin 0.1 and
     10 held updates the selection moves later than with none."""

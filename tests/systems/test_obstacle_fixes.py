@@ -53,10 +53,12 @@ def peak_reference_speed_while_held(max_speed):
     return peak
 
 
+@pytest.mark.slow
 def test_a_held_dmp_winds_up_past_the_hand_speed_limit_without_the_limit():
     assert peak_reference_speed_while_held(None) > 2 * HAND_SPEED_LIMIT
 
 
+@pytest.mark.slow
 def test_a_held_dmp_stays_near_the_hand_speed_limit_with_it():
     # One step of the attractor on top of the limited velocity exceeds it a little (the
     # hand-over law caps that); without the limit this DMP reaches 0.79 m/s.
@@ -149,12 +151,14 @@ def first_push_time(params, seconds):
     return None
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("stall_time", [2.0, 4.0])
 def test_the_stall_time_is_how_long_a_parked_participant_waits_before_pushing(stall_time):
     pushed = first_push_time(dataclasses.replace(PARAMS, stall_time=stall_time), 7.0)
     assert pushed is not None and stall_time - 0.1 <= pushed <= stall_time + 0.1
 
 
+@pytest.mark.slow
 def test_a_longer_stall_time_delays_the_push_through():
     assert first_push_time(PARAMS, 5.0) is not None
     assert first_push_time(dataclasses.replace(PARAMS, stall_time=8.0), 5.0) is None

@@ -101,6 +101,7 @@ def toward(command, point):
 # Noisy
 
 
+@pytest.mark.slow
 def test_the_noisy_participants_commands_spread_as_documented():
     ticks = 2500
     clean, _ = reach_commands(params(), [(0.0, 2)], ticks)
@@ -117,6 +118,7 @@ def test_the_noisy_participants_commands_spread_as_documented():
     assert np.all(noisy[:, 2] == 0.0)  # the hand's height is never commanded
 
 
+@pytest.mark.slow
 def test_one_seed_gives_the_same_noise_whatever_the_participant_does():
     impairment = dict(command_noise=0.3, command_noise_time=0.5)
     noise = []
@@ -133,6 +135,7 @@ def test_one_seed_gives_the_same_noise_whatever_the_participant_does():
     assert not np.allclose(again, other_seed)
 
 
+@pytest.mark.slow
 def test_the_noisy_participant_acts_no_more_often_and_never_pushes_forward():
     # Without the forward key, the robot showing the left object, the target right: it
     # sidesteps.
@@ -159,6 +162,7 @@ def test_the_noisy_participant_acts_no_more_often_and_never_pushes_forward():
 # Late
 
 
+@pytest.mark.slow
 def test_the_late_participant_sends_the_same_commands_the_delay_later():
     # The target switches from the left object to the right one at 1.2 s.
     schedule = [(0.0, 0), (1.2, 1)]
@@ -179,6 +183,7 @@ def test_the_late_participant_sends_the_same_commands_the_delay_later():
         1.2 + calibrated.reaction_delay + calibrated.serve_patience + 0.3, abs=1.5 * PERIOD)
 
 
+@pytest.mark.slow
 def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
     orientations = np.array([side_grasp_orientation(0.4), side_grasp_orientation(-0.4)])
     positions = OBJECTS[:2]

@@ -49,12 +49,14 @@ def replay(meshcat):
     return recorded(meshcat, builder.Build(), DURATION)
 
 
+@pytest.mark.slow
 def test_a_2d_replay_shows_no_executed_path_before_the_robot_moves(replay):
     dots = shown_dots(replay, "/pbp/executed", EXECUTED_DOTS, 0.0)
     assert len(dots) <= 1  # at most one, on the start, under the robot
     np.testing.assert_allclose(dots[:, :2], np.zeros((len(dots), 2)), atol=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("time", [0.3, 0.6, 1.0])
 def test_a_2d_replay_shows_the_executed_path_from_the_start_up_to_the_robot(replay, time):
     dots = shown_dots(replay, "/pbp/executed", EXECUTED_DOTS, time)

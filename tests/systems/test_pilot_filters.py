@@ -66,6 +66,7 @@ def filter_outputs(pilot_filter, ticks, forward_key, base_commands=None):
 KEYS = ReachKeys(0.1, 0.8)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("forward_key", [1.0, 0.0])
 def test_the_noisy_filter_replaces_exactly_the_drawn_ticks_with_their_keys(forward_key):
     ticks = 600
@@ -86,6 +87,7 @@ def test_the_noisy_filter_replaces_exactly_the_drawn_ticks_with_their_keys(forwa
         ticks * 0.21)
 
 
+@pytest.mark.slow
 def test_the_noisy_filter_corrupts_the_same_ticks_whatever_the_keys():
     with_forward, _ = filter_outputs(NoisyFilter(KEYS, PERIOD, SEED, 0.3), 300, 1.0)
     without, _ = filter_outputs(NoisyFilter(KEYS, PERIOD, SEED, 0.3), 300, 0.0)
@@ -100,6 +102,7 @@ def test_the_noisy_filter_corrupts_the_same_ticks_whatever_the_keys():
     assert np.any(with_forward[np.array(changed), :2] @ forward > 0.05)
 
 
+@pytest.mark.slow
 def test_the_laggy_filter_repeats_its_last_output_on_the_drawn_ticks():
     ticks = 1500
     base = np.outer(np.arange(ticks), [1e-3, 0.0, 0.0, 0.0])  # every tick a new command
@@ -148,6 +151,7 @@ def _ports(system):
     return inputs, outputs
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", TASKS)
 def test_every_pilot_has_the_participants_ports(resolved, task):
     participant = _ports(_operator(resolved[task, "attentive"], "pbp_alternated"))
@@ -205,6 +209,7 @@ def _grasp_start(resolved_scenario):
         diagram.CreateDefaultContext())).copy()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", TASKS)
 @pytest.mark.parametrize("pilot", PILOT_NAMES)
 def test_every_pilot_is_built_from_the_same_arguments_under_every_method(resolved, task,
@@ -222,6 +227,7 @@ def test_every_pilot_is_built_from_the_same_arguments_under_every_method(resolve
         np.testing.assert_array_equal(active, reference[1], err_msg=method)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("task", TASKS)
 @pytest.mark.parametrize("pilot", ["noisy", "laggy"])
 def test_one_seed_draws_the_same_under_pbp_alternated_and_hop(resolved, task, pilot):

@@ -60,6 +60,7 @@ def _declared_names(cls):
     return names
 
 
+@pytest.mark.slow
 def test_no_module_writes_a_getter_the_ports_give():
     written = []
     for path in sorted(PACKAGE.rglob("*.py")):

@@ -87,6 +87,7 @@ def assert_continuous(commands):
     return steps
 
 
+@pytest.mark.slow
 def test_a_goal_switch_keeps_orientation_and_angular_velocity_continuous():
     commands = closed_loop("pbp_continuous", 1.2, switch_at=0.405)
     steps = assert_continuous(commands)
@@ -101,6 +102,7 @@ def test_a_goal_switch_keeps_orientation_and_angular_velocity_continuous():
             < quaternion.angle_between(final, GOALS[0, 3:]))
 
 
+@pytest.mark.slow
 def test_presses_and_releases_keep_the_angular_velocity_continuous():
     presses = ([0.0, 0.3, 0.6], np.array([[0.0], [1.0], [0.0]]))
     twist = np.array([0.0, 0.0, 0.0, 1.5, 0.0, -1.0])  # the operator turns the hand fast

@@ -259,6 +259,7 @@ def outputs(system, context):
     return [port.Eval(context).copy() for port in ports]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("limits", [(None, None), (0.2, 0.5)], ids=["free", "speed limits"])
 def test_the_compact_state_gives_the_per_goal_states_outputs_bit_for_bit(limits):
     positions, orientations, goals = make_banks()

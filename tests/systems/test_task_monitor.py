@@ -139,6 +139,7 @@ def test_an_update_offset_past_the_period_is_refused():
 
 
 
+@pytest.mark.slow
 def test_the_grasp_monitor_keeps_the_same_rules():
     # The hand slides as above, already at the grasp orientation: the same ticks switch and
     # succeed, with no collision port.

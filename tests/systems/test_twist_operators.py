@@ -237,6 +237,7 @@ def drive_through(rig, attack, after=0.3):
     return active
 
 
+@pytest.mark.slow
 def test_a_second_page_cannot_drive_the_six_dof_keyboard(meshcat, rigs):
     rig = rigs(keyboard(meshcat, allow_forward=True))
     presses = [{"type": "button", "name": name}
@@ -248,6 +249,7 @@ def test_a_second_page_cannot_drive_the_six_dof_keyboard(meshcat, rigs):
     np.testing.assert_allclose(rig.twist(), twist(SPEED * LEFT), atol=1e-12)
 
 
+@pytest.mark.slow
 def test_a_second_pages_gamepad_is_ignored_until_the_controls_move(meshcat, rigs):
     rig = rigs(gamepad(meshcat, allow_forward=True))
     values = [0.0] * 17

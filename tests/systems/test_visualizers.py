@@ -105,6 +105,7 @@ def test_the_scene_comes_back_after_a_delete_and_in_a_second_run(meshcat, make, 
 
 
 
+@pytest.mark.slow
 def test_a_2d_replay_shows_the_dmp_path_from_where_the_robot_is_at_each_time(repo, meshcat):
     # Fig. 4's scene: pushed sideways from 0.2 s to 0.6 s, the DMP's path bends; then it
     # comes back straight to the goal.

@@ -8,6 +8,7 @@ station of the reaching scenes (``diagrams/hsr_reach.yaml``: kinematic joints, o
 step a control tick).
 """
 
+import functools
 import pathlib
 
 import numpy as np
@@ -55,8 +56,9 @@ def motor_limits(config):
     return velocities, accelerations, rows
 
 
+@functools.cache
 def reach_scenes_station():
-    """The station config of the reaching scenes, as their file states it."""
+    """The station config of the reaching scenes, as their file states it (read once)."""
     repo = pathlib.Path(__file__).resolve().parents[2]
     return load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").resolved.station
 

@@ -34,15 +34,14 @@ def _toy_goals(goals):
     return TOY.replace(TOY_GOALS, f"goals: {goals}")
 
 
-def _line_of(anchor, text):
-    """The line number of `anchor` in `text` (where _reach_objects puts the objects)."""
-    return text[:text.index(anchor)].count("\n") + 1
+# _reach_objects puts the objects on this line's place, so the loader names its number.
+OBJECTS_ANCHOR = "    switch_schedule:"
+OBJECTS_LINE = REACH[:REACH.index(OBJECTS_ANCHOR)].count("\n") + 1
 
 
 def _reach_objects(objects):
-    anchor = "    switch_schedule:"
-    assert anchor in REACH
-    return REACH.replace(anchor, f"    objects: {objects}\n    targets: [0, 1, 2]\n{anchor}")
+    return REACH.replace(OBJECTS_ANCHOR,
+                         f"    objects: {objects}\n    targets: [0, 1, 2]\n{OBJECTS_ANCHOR}")
 
 
 def _laughs(levels=9, width=9):
@@ -83,7 +82,7 @@ CASES = {
     # Under 1 MiB, written tight: the count refuses them, before they are read.
     "objects_over_the_cap": (lambda: _reach_objects(
         "[" + ",".join(["[2,0,0.7]"] * (MAX_GOALS + 1)) + "]"),
-        ["scenario.task.objects", f"line {_line_of('    switch_schedule:', REACH)}",
+        ["scenario.task.objects", f"line {OBJECTS_LINE}",
          f"more than {MAX_GOALS:,} objects"], 30.0),
     "goals_over_the_cap": (lambda: _toy_goals("[" + ",".join(["[1,0]"] * (MAX_GOALS + 1)) + "]"),
                            ["scenario.goals", "line 11", f"more than {MAX_GOALS:,} goals"],

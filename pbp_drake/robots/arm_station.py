@@ -84,7 +84,7 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
     X_WE0 = _ee_pose(plant, arm, q0)
     # R_E0 is the hand's orientation at heading 0.
     R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
-    ramp = EeCommandRamp(R_E0, config.command_period, lead=config.diff_ik_time_step)
+    ramp = EeCommandRamp(R_E0, config.control_period, lead=config.diff_ik_time_step)
     look_ahead = 0.0 if kinematic else config.plant.time_step
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, arm, q0, config, ramp,
                                                               look_ahead))

@@ -43,7 +43,7 @@ class ArmStationConfig:
     diff_ik_time_step: float = 0.01
     #: The period of a control loop that sends each tick the state [p, v] to reach at the
     #: next tick; the station then ramps into p at v (see EeCommandToPose). None: track p.
-    command_period: float | None = None
+    control_period: float | None = None
     #: Each joint's acceleration limit (rad/s^2 or m/s^2) where the model gives none.
     default_acceleration_limit: float = 10.0
     #: How fast the arm drifts back to its ready configuration (1/s) in the joint motion

@@ -46,7 +46,7 @@ class EeCommandToPose(PortGetters, LeafSystem):
     `R_E0` the hand pointing along world +x; `V_WE_desired` is the hand's spatial velocity
     `[w (3), v (3)]` in the world frame along the way.
 
-    With a `command_period` (a control loop that sends, at each tick, the state to be in at
+    With a `control_period` (a control loop that sends, at each tick, the state to be in at
     the next tick) both ramp: the position into `p` at `v`, `p - v (t_next - t - lead)`,
     and the heading into the command's from the last tick's command, at a constant rate.
     Stepping to `p` and the heading once a tick would leave the robot behind by most of a
@@ -54,15 +54,15 @@ class EeCommandToPose(PortGetters, LeafSystem):
     slow), and would ask the robot for the whole turn at once. The last tick's heading is
     sampled just after each tick, before a controller that decides at the PBP loop's
     decide stage (`pbp_drake.systems.tick`) changes the command. Without a
-    `command_period`, the position is `p + v lead` and the heading the command's.
+    `control_period`, the position is `p + v lead` and the heading the command's.
 
     `lead` is how far ahead the reader wants the pose: the station's diff IK reads it as
     the pose to have at the end of its step, so it is the diff IK's period there.
     """
 
-    def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
+    def __init__(self, R_E0: RotationMatrix, control_period=None, lead=0.0):
         super().__init__()
-        self._ramp = EeCommandRamp(R_E0, command_period, lead)
+        self._ramp = EeCommandRamp(R_E0, control_period, lead)
         self._command_port = self.DeclareVectorInputPort("ee_command", EeCommand.size)
         self._last_heading = self._ramp.declare_heading_sample(self, self._command_port)
         self._pose_port = self.DeclareAbstractOutputPort(
@@ -97,9 +97,9 @@ class EeCommandRamp:
     port_name = "ee_command"
     command_size = EeCommand.size
 
-    def __init__(self, R_E0: RotationMatrix, command_period=None, lead=0.0):
+    def __init__(self, R_E0: RotationMatrix, control_period=None, lead=0.0):
         self.R_E0 = RotationMatrix(R_E0)
-        self.period = command_period
+        self.period = control_period
         self.lead = float(lead)
 
     def declare_heading_sample(self, system, command_port):

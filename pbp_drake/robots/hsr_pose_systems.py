@@ -51,7 +51,7 @@ class PoseCommandRamp:
     `X_WE_desired` at time t is the command carried along its own twist for `ahead`
     seconds, `(Exp(w ahead) q, p + v ahead)`; `V_WE_desired` is `[w, v]`. `ahead` is `lead`
     (the diff IK's period: it reads the pose as the one to have at the end of its step),
-    less, with a `command_period`, the time left to the next tick: a control loop sends at
+    less, with a `control_period`, the time left to the next tick: a control loop sends at
     each tick the state to be in at the next tick (as `PoseHandOver` does), so between
     ticks the hand ramps into it along the command's twist instead of stepping to it once
     a tick (which would leave the hand behind by most of a tick's travel and turn).
@@ -65,8 +65,8 @@ class PoseCommandRamp:
     port_name = "pose_command"
     command_size = PoseState.size
 
-    def __init__(self, command_period=None, lead=0.0):
-        self.period = command_period
+    def __init__(self, control_period=None, lead=0.0):
+        self.period = control_period
         self.lead = float(lead)
 
     def declare_heading_sample(self, system, command_port):

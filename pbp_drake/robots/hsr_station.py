@@ -195,7 +195,7 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     The obstacles do not push the robot (their contact with it is filtered out).
 
     ``pose_command`` is ``[p (3), q (4), v (3), w (3)]`` (``PoseState``, world frame) of
-    ``hand_palm_link``: the pose to be at (at the next tick with ``command_period``) and
+    ``hand_palm_link``: the pose to be at (at the next tick with ``control_period``) and
     the twist to move at; a NaN field or a quaternion whose norm is off 1 by more than
     1e-6 is refused by name. ``hand_pose`` is that frame's measured ``PoseState`` (its
     quaternion signed nearer the start orientation). The diff IK is the same QP, tracking
@@ -230,10 +230,10 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
 
     # The diff IK reads the command's pose as the one to have at the end of its step.
-    ramp = EeCommandRamp(R_E0, config.command_period, lead=config.diff_ik_time_step)
+    ramp = EeCommandRamp(R_E0, config.control_period, lead=config.diff_ik_time_step)
     frame_name = END_EFFECTOR_FRAME
     if command == "pose":
-        ramp = PoseCommandRamp(config.command_period, lead=config.diff_ik_time_step)
+        ramp = PoseCommandRamp(config.control_period, lead=config.diff_ik_time_step)
         frame_name = HAND_FRAME
     # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()

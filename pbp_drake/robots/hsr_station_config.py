@@ -62,7 +62,7 @@ class HsrStationConfig:
     diff_ik_time_step: float = 0.01
     #: The period of a control loop that sends each tick the state [p, v] to reach at the
     #: next tick; the station then ramps into p at v (see EeCommandToPose). None: track p.
-    command_period: float | None = None
+    control_period: float | None = None
     #: The base's pose (x, y in m, yaw in rad) at the start; x, y within the model's 10 m.
     initial_base: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
     #: The hand's height at the start (m); it starts level, pointing along the base's +x.
@@ -174,6 +174,6 @@ def validate_station_timing(config, name):
     if not (config.diff_ik_time_step > 0 and abs(steps - round(steps)) < 1e-9):
         raise ValueError(f"{name}.diff_ik_time_step must be a whole multiple of "
                          f"plant.time_step {time_step}, got {config.diff_ik_time_step}")
-    if config.command_period is not None and not config.command_period > 0:
-        raise ValueError(f"{name}.command_period must be positive or None, got "
-                         f"{config.command_period}")
+    if config.control_period is not None and not config.control_period > 0:
+        raise ValueError(f"{name}.control_period must be positive or None, got "
+                         f"{config.control_period}")

@@ -315,6 +315,7 @@ def _resolve_task_robot(scenario):
                             "the robot stands: remove scenario.demonstration, goals and start")
     station_field = "scenario.robot.station" if isinstance(robot, Hsr) else "scenario.robot"
     station = robot.station if isinstance(robot, Hsr) else robot.station_config()
+    _refuse_what_the_task_sets(station, station_field)
     require_finite(robot, "scenario.robot", ("speed",))
     check_time_steps([
         (f"{station_field}.plant.time_step", station.plant.time_step),
@@ -369,7 +370,7 @@ def _resolve_task_robot(scenario):
         for _ in scene.obstacles.obstacle_starts]
     if isinstance(robot, Hsr):
         station = dataclasses.replace(station, ee_height=task.height,
-                                      command_period=scenario.control_period,
+                                      control_period=scenario.control_period,
                                       obstacles=cylinders)
         try:
             initial_ee_state = hsr_ready_ee_state(station)
@@ -398,10 +399,26 @@ def _resolve_task_robot(scenario):
         nominal_speed=float(robot.speed), controller=controller)
 
 
+#: The station's fields a task sets, each from its one home in the scenario.
+_SET_BY_THE_TASK = {"control_period": "scenario.control_period",
+                    "ee_height": "scenario.task.height",
+                    "obstacles": "scenario.task (the obstacle task's cylinders)"}
+
+
+def _refuse_what_the_task_sets(station, station_field):
+    """A station field the task sets, given in the file, would be overwritten unseen: it is
+    refused, naming where the value belongs."""
+    defaults = type(station)()
+    for name, home in _SET_BY_THE_TASK.items():
+        if hasattr(station, name) and getattr(station, name) != getattr(defaults, name):
+            raise ScenarioError(f"{station_field}.{name} is set by the task from {home}; "
+                                "give it there")
+
+
 def _arm_station(scenario, station):
     """An arm's station config (ramping between the loop's ticks), the hand's start and
     the arm's reach `(shoulder, radius)`; the arm's refusals name scenario.robot's field."""
-    station = dataclasses.replace(station, command_period=scenario.control_period)
+    station = dataclasses.replace(station, control_period=scenario.control_period)
     try:
         initial_ee_state, reach = arm_ready_ee_state_and_reach(station)
     except ValueError as error:

@@ -119,7 +119,7 @@ class Arm(ArmStationConfig, TaskRobot):
     """`robot: !Arm {model_file: ..., base_frame: ..., ee_frame: ...}`: a fixed-base arm
     from a URDF or SDFormat file (ours, `package://pbp_drake_models/arm7/pbp_arm7.urdf`,
     or a user's own) under differential IK; every field of ArmStationConfig, and the
-    HSR's speed and hand-over limits. The task sets the station's command_period (the
+    HSR's speed and hand-over limits. The task sets the station's control_period (the
     control period) and obstacles (the obstacle task's cylinders)."""
 
     #: How far (rad) the hand's heading may turn either way from its start: a wrist's

@@ -23,7 +23,7 @@ PERIOD = 0.03
 
 def arm_config():
     robot = load_scenario_file(REPO / "diagrams" / "arm_reach.yaml").scenario.robot
-    return dataclasses.replace(robot.station_config(), command_period=PERIOD)
+    return dataclasses.replace(robot.station_config(), control_period=PERIOD)
 
 
 def closed_loop(config, goals, operator=None):

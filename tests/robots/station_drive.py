@@ -67,11 +67,11 @@ class Drive:
 
 
 def drive(velocity, duration, config=None, state_period=None, turn=None, station=None):
-    """Runs a station of ``config`` (its ``command_period`` set to the tick; or `station`,
+    """Runs a station of ``config`` (its ``control_period`` set to the tick; or `station`,
     any station with those ports, built with that period) under the driver (``velocity``,
     ``turn``) for ``duration`` seconds; the plant's state and the desired state are logged
     every ``state_period`` (the plant's step when None)."""
-    config = dataclasses.replace(config or HsrStationConfig(), command_period=CONTROL_PERIOD)
+    config = dataclasses.replace(config or HsrStationConfig(), control_period=CONTROL_PERIOD)
     station = station or make_hsr_station(config)
     builder = DiagramBuilder()
     builder.AddNamedSystem(station.get_name(), station)

@@ -43,7 +43,7 @@ ARMS = {"arm7": shipped_arm, "arm6": other_arm}
 
 @pytest.fixture(params=sorted(ARMS))
 def arm(request):
-    return dataclasses.replace(ARMS[request.param](), command_period=CONTROL_PERIOD)
+    return dataclasses.replace(ARMS[request.param](), control_period=CONTROL_PERIOD)
 
 
 @pytest.mark.slow

@@ -49,10 +49,10 @@ def test_box_qp_without_active_bounds_is_the_unconstrained_minimum():
     np.testing.assert_array_equal(hold, [0.0, 0.0])
 
 
-def command_to_pose(command, time, command_period, lead, last_heading=None):
+def command_to_pose(command, time, control_period, lead, last_heading=None):
     """The pose and velocity EeCommandToPose outputs at ``time`` for ``command``, the
     last tick's command having had ``last_heading`` (the command's when None)."""
-    system = EeCommandToPose(RotationMatrix(), command_period, lead)
+    system = EeCommandToPose(RotationMatrix(), control_period, lead)
     context = system.CreateDefaultContext()
     context.SetTime(time)
     system.get_ee_command_input_port().FixValue(context, command)

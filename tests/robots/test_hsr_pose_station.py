@@ -177,7 +177,7 @@ def test_a_control_loop_ticking_the_next_pose_finds_the_hand_there_at_each_tick(
     # twist to move at. The station ramps into it between ticks, so at every tick the hand
     # is where the command of the tick before put it, turning and moving at once.
     period = 0.03
-    station = make_hsr_station(HsrStationConfig(command_period=period), command="pose")
+    station = make_hsr_station(HsrStationConfig(control_period=period), command="pose")
     p, q = start[:3], start[3:7]
     segments = [(0.5, 2.0, p + [0.1, 0.1, 0.05], turned([0, 0, 1], 45, q)),
                 (3.5, 2.5, p, turned([0, 1, 0], 90, q))]

@@ -98,11 +98,11 @@ def test_is_one_diagram_with_named_ports(station):
 
 
 def test_config_round_trips_through_yaml():
-    config = HsrStationConfig(diff_ik_time_step=0.02, command_period=1 / 30,
+    config = HsrStationConfig(diff_ik_time_step=0.02, control_period=1 / 30,
                               obstacles=[CylinderObstacle(radius=0.1, height=1.0)])
     loaded = yaml_load_typed(schema=HsrStationConfig, data=yaml_dump_typed(config))
     assert loaded.obstacles == config.obstacles
-    assert loaded.command_period == config.command_period
+    assert loaded.control_period == config.control_period
     partial = yaml_load_typed(schema=HsrStationConfig, data="plant: {time_step: 0.002}")
     assert partial.plant.time_step == 0.002
     assert partial.plant.discrete_contact_approximation == "sap"  # the defaults are kept
@@ -114,7 +114,7 @@ def test_config_round_trips_through_yaml():
 
 @pytest.mark.parametrize("field, value, message", [
     ("diff_ik_time_step", 0.0125, "diff_ik_time_step must be a whole multiple"),
-    ("command_period", -0.1, "command_period"),
+    ("control_period", -0.1, "control_period"),
     ("initial_base", [0.0, 0.0], "initial_base"),
     ("base_kp", [1.0, 1.0], "base_kp"),
     ("base_acceleration_limits", [0.3, 0.3], r"HsrStationConfig\.base_acceleration_limits"),

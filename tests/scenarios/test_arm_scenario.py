@@ -37,7 +37,7 @@ def test_the_scene_is_drawn_in_the_arms_region(seed):
     for axis, (low, high) in enumerate([task.x_range, task.y_range, task.z_range]):
         assert (goals[:, axis] >= low).all() and (goals[:, axis] <= high).all()
     assert len(set(np.round(goals[:, 2], 6))) == len(goals)  # each at a height of its own
-    assert resolved.station.command_period == resolved.scenario.control_period
+    assert resolved.station.control_period == resolved.scenario.control_period
     hand_over = resolved.controller.hand_over
     assert hand_over.max_heading_turn == resolved.scenario.robot.max_heading_turn
 

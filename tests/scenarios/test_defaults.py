@@ -75,6 +75,6 @@ def test_changed_yaml_value_reaches_the_system():
 def test_hsr_station_defaults_match():
     _, resolved = built(HSR)
     # The task sets the hand's start height, the loop's period and the obstacles.
-    derived = {"ee_height": 0.7, "command_period": PERIOD, "obstacles": []}
+    derived = {"ee_height": 0.7, "control_period": PERIOD, "obstacles": []}
     in_python = dataclasses.replace(HsrStationConfig(), **derived)
     assert yaml_dump_typed(resolved.station) == yaml_dump_typed(in_python)

@@ -54,6 +54,24 @@ def test_a_bad_overlay_names_its_field(overlay, words):
         assert word in str(error.value)
 
 
+ARM = (REPO / "diagrams" / "arm_reach.yaml").read_text()
+
+
+@pytest.mark.parametrize("text, overlay, words", [
+    (REACH, "scenario: {robot: {station: {control_period: 0.05}}}",
+     "scenario.robot.station.control_period is set by the task from scenario.control_period"),
+    (REACH, "scenario: {robot: {station: {ee_height: 0.9}}}",
+     "scenario.robot.station.ee_height is set by the task from scenario.task.height"),
+    (ARM, "scenario: {robot: {control_period: 0.05}}",
+     "scenario.robot.control_period is set by the task from scenario.control_period"),
+])
+def test_a_station_field_the_task_sets_is_refused_naming_its_home(text, overlay, words):
+    """Given in the robot's section, the value would be overwritten by the task's unseen."""
+    with pytest.raises(ScenarioError, match=words) as error:
+        load_scenario_text(text, "scene", folder=REPO / "diagrams", overlays=[overlay])
+    assert "\n" not in str(error.value)
+
+
 def test_a_period_off_the_plant_step_says_the_values():
     with pytest.raises(ScenarioError) as error:
         load_scenario_text(REACH, "reach", overlays=["scenario: {control_period: 0.0333}"])
@@ -72,7 +90,7 @@ def test_30_hz_runs_at_ten_plant_steps_of_a_third_of_a_millisecond():
     resolved = loaded.resolved
     # Within 0.2 % of ten steps: the controller and the station tick at exactly ten.
     assert resolved.controller.control_period == pytest.approx(10 * 0.0033333, abs=1e-15)
-    assert resolved.station.command_period == resolved.controller.control_period
+    assert resolved.station.control_period == resolved.controller.control_period
     assert resolved.station.diff_ik_time_step == pytest.approx(9 * 0.0033333, abs=1e-15)
     # The toy robot's step too.
     toy = load_scenario_text(TOY, "toy", overlays=[

@@ -11,16 +11,14 @@ from pbp_drake.cli_types import EXIT_WRITE_FAILED, realtime_rate
 from pbp_drake.commands.run_checks import check_run_flags, is_person
 from pbp_drake.commands.run_page import add_page_flags, open_page
 from pbp_drake.commands.scenario_flags import (
-    add_override_flags, add_shorthand_flags, scenario_overrides)
+    add_goals_flag, add_override_flags, add_shorthand_flags, scenario_overrides)
 from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
 from pbp_drake.console import CAMERAS
 from pbp_drake.console.front import PortError, bind_page_port
-from pbp_drake.core.reach_task import sample_grid_scene
 from pbp_drake.output_paths import check_log_path, check_output_folder, check_record_path
 from pbp_drake.scenarios import (
-    METHODS, MultiGoalReach, ScenarioError, load_scenario_file, resolve)
-from pbp_drake.scenarios.bounds import MAX_GOALS
+    METHODS, ScenarioError, load_scenario_file, resolve)
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 
 
@@ -30,10 +28,7 @@ def add_run_command(commands):
     run.add_argument("scenario", help="a scenario file, e.g. diagrams/hsr_reach.yaml")
     fields = add_override_flags(run)
     add_shorthand_flags(fields)
-    fields.add_argument("--goals", type=int, metavar="K",
-                        help="reaching task: K objects (candidate goals, up to "
-                        f"{MAX_GOALS:,}), one in each cell of a grid over the task's region "
-                        "drawn from the seed, in place of the file's")
+    add_goals_flag(fields)
     fields.add_argument("--scene", help="use the obstacles of this scene of the file's study")
     _add_common_flags(run)
     run.add_argument("--no-meshcat", action="store_true",
@@ -85,8 +80,8 @@ def _add_common_flags(parser):
 
 def scenario_for_run(args):
     """The scenario file of `args` with the command line's overrides, resolved: its fields
-    (`--set`, `--scenario-text` and their shorthands) as the file's, then `--goals` and
-    `--scene`, which place objects and obstacles."""
+    (`--set`, `--scenario-text` and their shorthands, `--goals` one of them) as the file's,
+    then `--scene`, which places the obstacles of a scene of the file's study."""
     scenario_file = load_scenario_file(args.scenario, scenario_overrides(args))
     scenario = scenario_file.scenario
     if args.alpha is not None and not METHODS[scenario.method].takes_weight:
@@ -96,43 +91,20 @@ def scenario_for_run(args):
     if args.operator is not None and scenario.task is None:
         raise ScenarioError("--operator chooses who drives the tasks; this scenario uses "
                             "the 2-D toy robot")
-    if args.goals is None and args.scene is None:
+    if args.scene is None:
         return scenario_file.resolved
-    if args.goals is not None:
-        scenario = with_grid_goals(scenario, args.goals)
-    if args.scene is not None:
-        scenes = getattr(scenario_file.study, "scenes", [])
-        names = [scene.name for scene in scenes]
-        if args.scene not in names:
-            raise ScenarioError(f"--scene {args.scene!r} is not in this file's study; "
-                                f"scenes: {names}")
-        chosen = scenes[names.index(args.scene)]
-        scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{args.scene}",
-                                       obstacles=list(chosen.obstacles))
+    scenes = getattr(scenario_file.study, "scenes", [])
+    names = [scene.name for scene in scenes]
+    if args.scene not in names:
+        raise ScenarioError(f"--scene {args.scene!r} is not in this file's study; "
+                            f"scenes: {names}")
+    chosen = scenes[names.index(args.scene)]
+    scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{args.scene}",
+                                   obstacles=list(chosen.obstacles))
     try:
         return resolve(scenario)
     except ScenarioError as error:
-        raise ScenarioError(f"{error} (after --goals or --scene)") from None
-
-
-def with_grid_goals(scenario, count):
-    """`scenario` (a reaching task) with `count` objects on a grid over its region
-    (`core.reach_task.sample_grid_scene`, from its seed) in place of its own."""
-    task = scenario.task
-    if type(task) is not MultiGoalReach or task.objects:
-        raise ScenarioError("--goals places the objects of a reaching task drawn from its "
-                            "seed (an untagged task without fixed objects)")
-    least = 2 if len(task.switch_schedule) > 1 else 1
-    if not least <= count <= MAX_GOALS:
-        raise ScenarioError(f"--goals {count} is out of range; expected {least} to "
-                            f"{MAX_GOALS:,}")
-    layout, separation = sample_grid_scene(
-        scenario.seed, count, task.x_range, task.y_range, task.height,
-        task.switch_schedule, task.z_range or None)
-    task = dataclasses.replace(task, objects=layout.objects.tolist(),
-                               targets=list(layout.targets),
-                               min_separation=min(task.min_separation, 0.9 * separation))
-    return dataclasses.replace(scenario, task=task)
+        raise ScenarioError(f"{error} (after --scene)") from None
 
 
 def _run(args):

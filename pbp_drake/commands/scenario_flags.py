@@ -1,8 +1,10 @@
 """The flags that change a scenario file's fields, shared by `run`, `session` and `study`:
 `--set FIELD=VALUE` and `--scenario-text YAML` (`scenarios.overrides`), and the shorthands
-`--method`, `--alpha`, `--operator`, `--seed` and `--duration`, each one `--set`."""
+`--method`, `--alpha`, `--operator`, `--seed`, `--duration` and `--goals`, each one
+`--set`."""
 
 from pbp_drake.scenarios import METHODS, OPERATOR_NAMES, ScenarioError, parse_method_label
+from pbp_drake.scenarios.bounds import MAX_GOALS
 from pbp_drake.scenarios.overrides import ScenarioOverrides
 
 
@@ -32,10 +34,22 @@ def add_shorthand_flags(group):
     group.add_argument("--alpha", type=float, help="--set alpha=A (fixed_alpha's weight)")
 
 
+def add_goals_flag(group):
+    """`--goals K`, in `group`."""
+    group.add_argument("--goals", type=int, metavar="K",
+                       help="--set task.grid_objects=K: a reaching task's K objects "
+                       f"(candidate goals, up to {MAX_GOALS:,}), one in each cell of a grid "
+                       "over its region, drawn from each scene's seed")
+
+
 def scenario_overrides(args, shorthands=True):
     """The overrides of the parsed `args`: the text, the shorthands (where the command has
-    them: `study`'s `--seed` is its first scene's, not a field), then each `--set`."""
+    them: `study`'s `--seed` is its first scene's, not a field), `--goals`, then each
+    `--set`."""
     shorthands = _shorthand_settings(args) if shorthands else []
+    goals = getattr(args, "goals", None)
+    if goals is not None:
+        shorthands.append((f"task.grid_objects={goals}", f"--goals {goals}"))
     return ScenarioOverrides(
         tuple(setting for setting, _ in shorthands) + tuple(args.settings),
         args.scenario_text, tuple(typed for _, typed in shorthands))

@@ -14,7 +14,8 @@ import time
 from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import (
     EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_WRITE_FAILED, method_list)
-from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
+from pbp_drake.commands.scenario_flags import (
+    add_goals_flag, add_override_flags, scenario_overrides)
 from pbp_drake.commands.signals import Terminated, sigterm_as_interrupt
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
@@ -111,7 +112,7 @@ def add_study_commands(commands):
         "metric moved by more than that noise")
     compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
     compare.add_argument("second", help="another, of the same seeds (B)")
-    add_override_flags(study)
+    add_goals_flag(add_override_flags(study))
     study.set_defaults(handler=_stopping_cleanly(_study))
     report.set_defaults(handler=_stopping_cleanly(_report))
     compare.set_defaults(handler=_compare)

@@ -251,6 +251,10 @@ class MultiGoalReach:
     #: The range [min, max] of how many objects are drawn (a count); one number: exactly
     #: that many.
     object_count: list[int] = range_field(2, 4)
+    #: K > 0: K objects instead, one in each cell of a K-cell grid over the region, drawn
+    #: from the seed (thousands are placed at once; `pbp-drake run` and `study` --goals K);
+    #: 0: object_count objects drawn min_separation apart.
+    grid_objects: int = 0
     #: The objects' x range (m).
     x_range: list[float] = range_field(1.25, 2.5)
     #: The objects' y range (m).

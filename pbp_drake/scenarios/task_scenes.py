@@ -10,7 +10,8 @@ import numpy as np
 
 from pbp_drake.core.grasp_task import sample_grasp_scene
 from pbp_drake.core.obstacle_task import sample_obstacle_scene
-from pbp_drake.core.reach_task import ReachScene, sample_reach_scene, validate_objects
+from pbp_drake.core.reach_task import (
+    ReachScene, sample_grid_scene, sample_reach_scene, validate_objects)
 from pbp_drake.scenarios.schema import DynamicObstacles, GraspTask, MultiGoalReach
 
 
@@ -69,6 +70,10 @@ def _reach_scene(task, seed, reach):
     if task.targets:
         raise ValueError("targets are given without objects")
     _check_region(task, reach)
+    if task.grid_objects:
+        scene, _ = sample_grid_scene(seed, task.grid_objects, task.x_range, task.y_range,
+                                     task.height, task.switch_schedule, task.z_range or None)
+        return scene
     return sample_reach_scene(seed, tuple(task.object_count), tuple(task.x_range),
                               tuple(task.y_range), task.height, tuple(task.switch_schedule),
                               task.min_separation, tuple(getattr(task, "z_range", ())))

@@ -12,6 +12,7 @@ import numpy as np
 
 from pbp_drake.core.pilot_population import ParticipantPopulationParams, population_problem
 from pbp_drake.core.surrogate_pilots import ProportionalPilotParams
+from pbp_drake.scenarios.bounds import MAX_GOALS
 from pbp_drake.scenarios.schema import ScenarioError
 
 
@@ -130,6 +131,14 @@ def check_reach_task(task):
     check_count(task.object_count[0], "scenario.task.object_count[0]", 1, 100)
     check_count(task.object_count[1], "scenario.task.object_count[1]", 1, 100)
     check_switch_schedule(task)
+    if task.grid_objects:
+        if task.objects:
+            raise ScenarioError("scenario.task.grid_objects places objects on a grid; "
+                                "scenario.task.objects are given: remove one")
+        check_count(task.grid_objects, "scenario.task.grid_objects",
+                    2 if len(task.switch_schedule) > 1 else 1, MAX_GOALS,
+                    " (a target switch needs 2 objects)" if len(task.switch_schedule) > 1
+                    else "")
 
 
 def check_switch_schedule(task):

@@ -73,8 +73,11 @@ def plain(value):
 # Fields left out of the content while at their defaults, so that a scenario that does not
 # use them keeps the hash of study folders written before they existed (and these resume).
 # None: the scenario's own fields.
-_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45},
+_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects": 0},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3}}
+# A station's field renamed since folders were written: hashed under its old name, so that
+# those folders keep their hash (an arm's station fields are the robot's own).
+_HASHED_AS = {"control_period": "command_period"}
 
 
 def _may_reposition(content):
@@ -102,6 +105,13 @@ def scenario_content(scenario):
                 continue
             if isinstance(values, dict) and values.get(name, default) == default:
                 values.pop(name, None)
+    robot = content.get("robot")
+    station = robot.get("station") if isinstance(robot, dict) else None
+    for section in (robot, station):
+        if isinstance(section, dict):
+            for name, old_name in _HASHED_AS.items():
+                if name in section:
+                    section[old_name] = section.pop(name)
     return content
 
 

@@ -1,5 +1,5 @@
-"""`pbp-drake run --goals K`: a reaching scene of K candidate goals on a grid over the task's
-region, from the seed; refused where it does not apply."""
+"""`pbp-drake run --goals K` (`task.grid_objects`): a reaching scene of K candidate goals on a
+grid over the task's region, from the seed; refused where it does not apply."""
 
 import dataclasses
 
@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from pbp_drake.cli import build_parser
-from pbp_drake.commands.run import scenario_for_run, with_grid_goals
+from pbp_drake.commands.run import scenario_for_run
 from pbp_drake.core.reach_task import sample_grid_scene
-from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
 from pbp_drake.scenarios.bounds import MAX_GOALS
 
 
@@ -43,17 +43,35 @@ def test_the_grid_keeps_objects_half_a_cell_apart():
 
 
 @pytest.mark.parametrize("name, goals, message", [
-    ("hsr_obstacles.yaml", 10, "--goals places the objects of a reaching task"),
-    ("hsr_grasp.yaml", 10, "--goals places the objects of a reaching task"),
-    ("hsr_reach.yaml", 1, "--goals 1 is out of range; expected 2 to"),
-    ("hsr_reach.yaml", MAX_GOALS + 1, "is out of range")])
+    ("hsr_obstacles.yaml", 10, "with --goals 10: scenario.task: unknown key 'grid_objects'"),
+    ("hsr_grasp.yaml", 10, "with --goals 10: scenario.task: unknown key 'grid_objects'"),
+    ("hsr_reach.yaml", 1, "scenario.task.grid_objects 1 is out of range; expected 2 to"),
+    ("hsr_reach.yaml", MAX_GOALS + 1, "is out of range"),
+    ("hsr_reach.yaml", -5, "scenario.task.grid_objects -5 is out of range")])
 def test_goals_is_refused_where_it_does_not_apply(repo, name, goals, message):
     with pytest.raises(ScenarioError, match=message):
         run_scenario(repo / "diagrams" / name, "--goals", str(goals))
 
 
+def test_a_grid_and_given_objects_are_refused_together(repo):
+    scenario = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario
+    scenario = dataclasses.replace(scenario, task=dataclasses.replace(
+        scenario.task, grid_objects=10, objects=[[1.5, 0.0, 0.7], [2.0, 0.0, 0.7]],
+        targets=[0, 1, 0]))
+    with pytest.raises(ScenarioError, match="grid_objects places objects on a grid; "
+                       "scenario.task.objects are given"):
+        resolve(scenario)
+
+
 def test_a_task_without_switches_takes_a_single_goal(repo):
     scenario = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario
     scenario = dataclasses.replace(scenario, task=dataclasses.replace(
-        scenario.task, switch_schedule=[0.0]))
-    assert len(with_grid_goals(scenario, 1).task.objects) == 1
+        scenario.task, switch_schedule=[0.0], grid_objects=1))
+    assert resolve(scenario).goals.shape == (1, 3)
+
+
+def test_each_seed_draws_its_own_grid(repo):
+    """A study's trials (one seed each) each get their jittered grid and targets."""
+    path = repo / "diagrams" / "hsr_reach.yaml"
+    first, second = (run_scenario(path, "--seed", seed, "--goals", "100") for seed in "12")
+    assert not np.array_equal(first.goals, second.goals)

@@ -17,7 +17,7 @@ import types
 import pytest
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
-from pbp_drake.commands.run import with_grid_goals
+from pbp_drake.core.reach_task import sample_grid_scene
 from pbp_drake.scenarios import ScenarioError, ScenarioFile, load_scenario_file, resolve
 from pbp_drake.scenarios import bounds
 from pbp_drake.scenarios.bounds import (
@@ -156,7 +156,12 @@ def test_a_scenario_built_in_python_is_held_to_the_goal_cap():
 @pytest.mark.slow
 def test_ten_thousand_goals_at_full_precision_load_within_the_cap(tmp_path):
     file = load_scenario_file(DIAGRAMS / "hsr_reach.yaml")
-    scenario = with_grid_goals(file.scenario, 10_000)
+    task = file.scenario.task
+    scene, separation = sample_grid_scene(0, 10_000, task.x_range, task.y_range, task.height,
+                                          task.switch_schedule)
+    scenario = dataclasses.replace(file.scenario, task=dataclasses.replace(
+        task, objects=scene.objects.tolist(), targets=list(scene.targets),
+        min_separation=0.9 * separation))
     path = tmp_path / "ten_thousand.yaml"
     path.write_text(yaml_dump_typed(ScenarioFile(scenario=scenario, study=file.study)))
     assert path.stat().st_size < MOST_FILE_BYTES / 1.5  # room to spare

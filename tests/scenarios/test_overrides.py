@@ -110,3 +110,16 @@ def test_a_study_records_its_overrides_and_report_names_them(repo, tmp_path, cap
     assert main(["report", str(output), "--markdown", str(markdown)]) == 0
     assert ("--set 'task.object_count=[2, 2]' --set goal_estimator.method=nearest"
             in markdown.read_text())
+
+
+@pytest.mark.slow  # two trials of the reaching task: a few seconds
+def test_a_study_of_many_goals_draws_each_trials_grid_from_its_seed(repo, tmp_path):
+    output = tmp_path / "study"
+    assert main(["study", str(repo / TASK), "--goals", "30", "--methods", "teleop",
+                 "--trials", "2", "--output", str(output)]) == 0
+    study = json.loads((output / "study.json").read_text())
+    assert study["overrides"]["set"] == ["task.grid_objects=30"]
+    trials = [json.loads((output / "trials" / "teleop" / f"seed_{seed}.json").read_text())
+              for seed in (10_000, 10_001)]
+    assert [len(trial["objects"]) for trial in trials] == [30, 30]
+    assert trials[0]["objects"] != trials[1]["objects"]  # each trial's grid from its seed

@@ -35,3 +35,21 @@ def test_the_arm_task_hashes_reposition_time_even_at_its_default():
     arm = scenario("arm_reach.yaml")
     assert scenario_content(arm)["operator"]["reposition_time"] == 4.0
     assert scenario_hash(with_reposition_time(arm, 2.0)) != scenario_hash(arm)
+
+
+def test_a_renamed_station_field_keeps_the_name_folders_were_written_with():
+    # `command_period` became `control_period`: the hash reads it under its old name.
+    for name, section in (("hsr_reach.yaml", ("robot", "station")),
+                          ("arm_reach.yaml", ("robot",))):
+        content = scenario_content(scenario(name))
+        for key in section:
+            content = content[key]
+        assert "command_period" in content and "control_period" not in content
+
+
+def test_a_grid_of_objects_changes_the_hash_and_none_leaves_it():
+    reach = scenario("hsr_reach.yaml")
+    assert "grid_objects" not in scenario_content(reach)["task"]
+    grid = dataclasses.replace(reach, task=dataclasses.replace(reach.task, grid_objects=100))
+    assert scenario_content(grid)["task"]["grid_objects"] == 100
+    assert scenario_hash(grid) != scenario_hash(reach)

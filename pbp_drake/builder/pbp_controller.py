@@ -48,6 +48,7 @@ from pbp_drake.core.methods import ASSISTED, BLENDED, METHODS
 from pbp_drake.systems import (
     Blender, DmpBank, GoalEstimator, HandOver, HeadingCommand, HopAssistance, LikelyGoals,
     MaxEntGoalEstimator)
+from pbp_drake.systems.pbp.goal_grouping import GoalGrouping
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
 # How far ahead the task scenes draw the DMPs' paths, in samples over the DMP's duration.
@@ -118,9 +119,9 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     builder.ExportInput(command_split.get_input_port(), "operator_command")
     start = initial_ee_state[:3]
     name, add_policy = _POLICIES[METHODS[config.method].policy]
-    estimator, reference = add_policy(builder, config, start, goals, split, command_split,
-                                      prediction_steps,
-                                      min(int(predicted_goal_count), len(goals)))
+    estimator, reference, shown = add_policy(
+        builder, config, start, goals, split, command_split, prediction_steps,
+        min(int(predicted_goal_count), len(goals)))
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
         EeState(initial_ee_state).heading, config.control_period,
         config.hand_over.max_hand_yaw_acceleration,
@@ -134,7 +135,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     builder.Connect(hand_over.get_command_output_port(), ee_command.get_input_port(0))
     builder.Connect(heading.get_heading_output_port(), ee_command.get_input_port(1))
     builder.ExportOutput(ee_command.get_output_port(), "ee_command")
-    builder.ExportOutput(estimator.get_selected_goal_output_port(), "selected_goal")
+    builder.ExportOutput(shown, "selected_goal")
     builder.ExportOutput(estimator.get_goal_probabilities_output_port(), "goal_probabilities")
     if isinstance(estimator, MaxEntGoalEstimator):
         builder.ExportOutput(estimator.get_posterior_clipped_output_port(), "posterior_clipped")
@@ -176,7 +177,22 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         # then O(D) whatever K (with shared weights and start, every scenario's bank, the
         # outputs are O(D) too).
         compact_state=True, predicted_goal_count=predicted_goal_count))
-    builder.ConnectInput("goals", dmp_bank.get_goals_input_port())
+    settings = config.goal_estimator
+    shown = estimator.get_selected_goal_output_port()
+    if settings.group_mass > 0.0:
+        grouping = builder.AddNamedSystem("goal_grouping", GoalGrouping(
+            goal_count, settings.group_mass, settings.commit_radius,
+            settings.commit_probability))
+        builder.ConnectInput("goals", grouping.get_goals_input_port())
+        builder.Connect(estimator.get_goal_probabilities_output_port(),
+                        grouping.get_goal_probabilities_input_port())
+        builder.Connect(estimator.get_selected_goal_output_port(),
+                        grouping.get_selected_goal_input_port())
+        builder.Connect(grouping.get_followed_goals_output_port(),
+                        dmp_bank.get_goals_input_port())
+        shown = grouping.get_shown_goal_output_port()
+    else:
+        builder.ConnectInput("goals", dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
     if reads_command:
@@ -211,7 +227,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
                         dmp_bank.get_predicted_goals_input_port())
         builder.ExportOutput(dmp_bank.get_predicted_paths_output_port(), "predicted_paths")
         builder.ExportOutput(likely.get_goal_indices_output_port(), "predicted_goals")
-    return estimator, blender.get_command_output_port()
+    return estimator, blender.get_command_output_port(), shown
 
 
 def _add_hop_policy(builder, config, start, goals, split, command_split, prediction_steps,
@@ -236,7 +252,8 @@ def _add_hop_policy(builder, config, start, goals, split, command_split, predict
                     assistance.get_operator_command_input_port())
     builder.Connect(posterior.get_goal_probabilities_output_port(),
                     assistance.get_goal_probabilities_input_port())
-    return posterior, assistance.get_command_output_port()
+    return posterior, assistance.get_command_output_port(), \
+        posterior.get_selected_goal_output_port()
 
 
 #: The Diagram's name and what adds its policy, by `Method.policy`.

@@ -100,6 +100,14 @@ class GoalEstimatorSettings:
     turn_horizon: float = 1.0
     #: The direction of travel counts only while the hand moves this fast or faster (m/s).
     min_speed: float = 0.01
+    #: PBP's goal groups (`pbp_drake.core.goal_groups`): the probability mass of the group
+    #: the robot heads for until it commits to a goal; 0 (the paper's): no groups, the
+    #: robot follows the selected goal from the start.
+    group_mass: float = 0.0
+    #: The robot commits once the group's goals lie this close (m) to their point.
+    commit_radius: float = 0.05
+    #: ... or once the most probable goal holds this probability.
+    commit_probability: float = 0.5
 
     def __post_init__(self):
         self.validate()

@@ -1,0 +1,68 @@
+"""Goals that cannot be told apart act as one, in pure NumPy.
+
+With many candidate goals a goal estimator's probabilities spread over the goals near
+where the operator points; following the single most probable of them takes the robot to
+a neighbour of the intended goal about as often as to the goal, and the operator spends
+the run correcting it. Here the robot follows the group instead, coarse to fine:
+
+- **The group** is the smallest set of the most probable goals that holds `group_mass` of
+  the probability (a credible set; O(K log K), a sort of the probabilities).
+- **Its point** is the group's probability-weighted mean goal: the DMP of the selected goal
+  is steered to it, so the robot heads into the region the operator means.
+- **Commitment.** The robot commits to the most probable goal (and shows it) once the
+  group is one goal, or its goals lie within `commit_radius` of their point (they act as
+  one), or the most probable goal holds `commit_probability`. Until then it shows no goal:
+  `NO_GOAL` is the shown index.
+
+As the hand nears the group, goals off its heading fall out of it and the group narrows to
+the goal meant; a goal that stays ambiguous (two goals in line) is decided by the
+operator's correction, as with a single goal.
+"""
+
+import math
+import typing
+
+import numpy as np
+
+#: The shown goal while the robot follows a group and has not committed.
+NO_GOAL = -1
+
+
+class GroupTarget(typing.NamedTuple):
+    """What `group_target` returns: the point the robot heads for (3), the index shown
+    (`NO_GOAL` while uncommitted) and the group's size."""
+
+    point: np.ndarray
+    shown: int
+    size: int
+
+
+def check_grouping(group_mass, commit_radius, commit_probability):
+    """ValueError naming the first setting out of its range."""
+    if not (isinstance(group_mass, (int, float)) and 0.0 <= group_mass < 1.0):
+        raise ValueError(f"group_mass must lie in [0, 1) (0: no groups), got {group_mass!r}")
+    if not (isinstance(commit_radius, (int, float)) and math.isfinite(commit_radius)
+            and commit_radius > 0.0):
+        raise ValueError(f"commit_radius must be a positive finite distance (m), got "
+                         f"{commit_radius!r}")
+    if not (isinstance(commit_probability, (int, float)) and 0.0 < commit_probability <= 1.0):
+        raise ValueError(f"commit_probability must lie in (0, 1], got {commit_probability!r}")
+
+
+def group_target(goals, probabilities, selected, group_mass, commit_radius,
+                 commit_probability):
+    """The `GroupTarget` of `goals` (K, 3) under `probabilities` (K), the estimator's
+    `selected` goal committed to when the group allows (module docstring)."""
+    best = int(np.argmax(probabilities))
+    if probabilities[best] >= commit_probability:
+        return GroupTarget(goals[selected].copy(), selected, 1)
+    order = np.argsort(-probabilities, kind="stable")
+    mass = np.cumsum(probabilities[order])
+    size = int(np.searchsorted(mass, group_mass * mass[-1])) + 1
+    members = order[:size]
+    weights = probabilities[members]
+    point = weights @ goals[members] / weights.sum()
+    spread = float(np.max(np.linalg.norm(goals[members] - point, axis=1)))
+    if size == 1 or spread <= commit_radius:
+        return GroupTarget(goals[selected].copy(), selected, size)
+    return GroupTarget(point, NO_GOAL, size)

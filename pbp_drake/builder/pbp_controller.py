@@ -17,6 +17,14 @@ Under the PBP methods and explicit arbitration (`pbp_controller`):
     blender.command [p, v] ──> hand_over (the hand-over law: bounded acceleration)
     hand_over.command + heading_command.heading ──> ee_command (the station's input)
 
+With `goal_estimator: {group_mass: M}` (M > 0) a `GoalGrouping` stands between the goals
+and the DMP bank: it moves the selected goal's row to the point of the group of goals the
+estimate cannot yet tell apart (`pbp_drake.core.goal_groups`), and the controller's
+`selected_goal` is its `shown_goal` (-1 until the robot commits to a goal):
+
+    goals, goal_estimator (goal_probabilities, selected_goal) ──> goal_grouping
+    goal_grouping.followed_goals ──> dmp_bank.goals;  goal_grouping.shown_goal ──> selected_goal
+
 The goal estimator is a `GoalEstimator`, or with `goal_estimator: {method: maxent_command}`
 a `MaxEntGoalEstimator` (HOP's posterior with the likelihood of PBP's operator,
 `pbp_drake.core.maxent_command`, with the config's `hop` settings, `nominal_speed` and the
@@ -97,7 +105,8 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     `ee_state` is `[p (3), v (3), heading, heading_rate]`, `operator_command`
     `[vx, vy, vz, yaw_rate]`, `operator_active` 1 while the operator acts, `ee_command`
     `[p (3), v (3), heading]` for the next tick. `selected_goal` is the followed goal's
-    index, `goal_probabilities` the estimator's K probabilities.
+    index (with goal groups, -1 until the robot commits to one), `goal_probabilities` the
+    estimator's K probabilities.
     """
     config.validate()
     initial_ee_state = np.asarray(initial_ee_state, float).reshape(-1)

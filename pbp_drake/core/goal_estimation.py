@@ -45,6 +45,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.goal_groups import check_grouping
 from pbp_drake.core.methods import did_you_mean
 
 #: `Estimator.reads`: the hand's position and heading (`GoalEstimator`, any task) ...
@@ -107,7 +108,7 @@ class GoalEstimatorSettings:
     #: The robot commits once the group's goals lie this close (m) to their point.
     commit_radius: float = 0.05
     #: ... or once the most probable goal holds this probability.
-    commit_probability: float = 0.5
+    commit_probability: float = 0.8
 
     def __post_init__(self):
         self.validate()
@@ -129,6 +130,7 @@ class GoalEstimatorSettings:
         if (isinstance(self.hold_steps, bool) or not isinstance(self.hold_steps, (int, np.integer))
                 or self.hold_steps < 1):
             raise ValueError(f"hold_steps must be an integer >= 1, got {self.hold_steps!r}")
+        check_grouping(self.group_mass, self.commit_radius, self.commit_probability)
 
 
 class SelectionMemory(typing.NamedTuple):

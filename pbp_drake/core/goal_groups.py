@@ -6,7 +6,7 @@ a neighbour of the intended goal about as often as to the goal, and the operator
 the run correcting it. Here the robot follows the group instead, coarse to fine:
 
 - **The group** is the smallest set of the most probable goals that holds `group_mass` of
-  the probability (a credible set; O(K log K), a sort of the probabilities).
+  the probability (a credible set; O(K) partitions and a sort of the group's members).
 - **Its point** is the group's probability-weighted mean goal: the DMP of the selected goal
   is steered to it, so the robot heads into the region the operator means.
 - **Commitment.** The robot commits to the most probable goal (and shows it) once the
@@ -37,16 +37,36 @@ class GroupTarget(typing.NamedTuple):
     size: int
 
 
+def _is_number(value):
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, bool)
+
+
 def check_grouping(group_mass, commit_radius, commit_probability):
-    """ValueError naming the first setting out of its range."""
-    if not (isinstance(group_mass, (int, float)) and 0.0 <= group_mass < 1.0):
+    """ValueError naming the first setting out of its range (NaN included)."""
+    if not (_is_number(group_mass) and 0.0 <= group_mass < 1.0):
         raise ValueError(f"group_mass must lie in [0, 1) (0: no groups), got {group_mass!r}")
-    if not (isinstance(commit_radius, (int, float)) and math.isfinite(commit_radius)
+    if not (_is_number(commit_radius) and math.isfinite(commit_radius)
             and commit_radius > 0.0):
         raise ValueError(f"commit_radius must be a positive finite distance (m), got "
                          f"{commit_radius!r}")
-    if not (isinstance(commit_probability, (int, float)) and 0.0 < commit_probability <= 1.0):
+    if not (_is_number(commit_probability) and 0.0 < commit_probability <= 1.0):
         raise ValueError(f"commit_probability must lie in (0, 1], got {commit_probability!r}")
+
+
+def _most_probable(probabilities, mass):
+    """The fewest most probable goals that hold `mass`, most probable first: the top m
+    found by partition (O(K)), m growing fourfold until they hold it, then sorted."""
+    count = len(probabilities)
+    m = min(count, 64)
+    while True:
+        top = (np.arange(count) if m == count else
+               np.argpartition(-probabilities, m - 1)[:m])
+        top = top[np.argsort(-probabilities[top], kind="stable")]
+        held = np.cumsum(probabilities[top])
+        if held[-1] >= mass or m == count:
+            return top[:int(np.searchsorted(held, mass)) + 1]
+        m = min(count, 4 * m)
 
 
 def group_target(goals, probabilities, selected, group_mass, commit_radius,
@@ -56,10 +76,8 @@ def group_target(goals, probabilities, selected, group_mass, commit_radius,
     best = int(np.argmax(probabilities))
     if probabilities[best] >= commit_probability:
         return GroupTarget(goals[selected].copy(), selected, 1)
-    order = np.argsort(-probabilities, kind="stable")
-    mass = np.cumsum(probabilities[order])
-    size = int(np.searchsorted(mass, group_mass * mass[-1])) + 1
-    members = order[:size]
+    members = _most_probable(probabilities, group_mass * float(probabilities.sum()))
+    size = len(members)
     weights = probabilities[members]
     point = weights @ goals[members] / weights.sum()
     spread = float(np.max(np.linalg.norm(goals[members] - point, axis=1)))

@@ -99,6 +99,11 @@ def resolve(scenario):
     Raises ScenarioError naming the first field whose value cannot be used.
     """
     _check_common(scenario)
+    if scenario.goal_estimator.group_mass > 0.0 and (
+            not isinstance(scenario.robot, TASK_ROBOTS) or isinstance(scenario.task, GraspTask)):
+        raise ScenarioError("scenario.goal_estimator.group_mass: goal groups steer the "
+                            "position DMPs of the reaching and obstacle tasks (HSR and arm); "
+                            "this scenario's robot or task has none: set it to 0")
     if isinstance(scenario.robot, TASK_ROBOTS):
         return _resolve_task_robot(scenario)
     return _resolve_point_robot(scenario)

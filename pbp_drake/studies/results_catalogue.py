@@ -48,6 +48,12 @@ ARENA_TASKS = {"hsr_reach_arena": ("diagrams/hsr_reach.yaml", "Reaching", 30),
                "hsr_grasp_arena": ("diagrams/hsr_grasp.yaml", "Grasping", 10),
                "arm_reach_arena": ("diagrams/arm_reach.yaml", "Reaching with the arm", 10)}
 
+# The reaching task with K candidate goals on a grid (docs/results/many-goals.md): PBP-Alt
+# following one goal at a time (the paper's) beside teleop, and PBP-Alt with goal groups.
+MANY_GOALS = (4, 100, 1000)
+GROUPS = ["--set", "goal_estimator.group_mass=0.9"]
+EVALUATION_30 = ["--trials", "30", "--split", "evaluation"]
+
 #: name -> the arguments of `pbp-drake study` (without --output and --jobs).
 STUDIES = {
     "toy_alpha_study": ["diagrams/toy_alpha_study.yaml"],
@@ -90,6 +96,15 @@ STUDIES = {
                                      "--trials", "30", "--split", "tuning"],
     **{f"hsr_reach_{condition}": [*IMPAIRED, "--participant-condition", condition]
        for condition in ("noisy", "late", "mistaken")},
+    **{f"hsr_reach_goals_{goals}": ["diagrams/hsr_reach.yaml", "--goals", str(goals),
+                                     "--methods", "pbp_alternated,teleop", *EVALUATION_30]
+       for goals in MANY_GOALS},
+    **{f"hsr_reach_goals_{goals}_groups": ["diagrams/hsr_reach.yaml", "--goals", str(goals),
+                                            *GROUPS, "--methods", "pbp_alternated",
+                                            *EVALUATION_30] for goals in MANY_GOALS},
+    "hsr_reach_goals_100_groups_pilots": [
+        "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, "--methods",
+        "pbp_alternated,teleop", *EVALUATION_30, "--pilots", ",".join(PILOT_NAMES)],
     # Every method under every pilot (docs/results/arena.md).
     **{name: [scenario, *ARENA[:2], "--trials", str(trials), *ARENA[2:]]
        for name, (scenario, _, trials) in ARENA_TASKS.items()},

@@ -74,7 +74,9 @@ def plain(value):
 # use them keeps the hash of study folders written before they existed (and these resume).
 # None: the scenario's own fields.
 _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects": 0},
-                 "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3}}
+                 "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3},
+                 "goal_estimator": {"group_mass": 0.0, "commit_radius": 0.05,
+                                    "commit_probability": 0.8}}
 # A station's field renamed since folders were written: hashed under its old name, so that
 # those folders keep their hash (an arm's station fields are the robot's own).
 _HASHED_AS = {"control_period": "command_period"}

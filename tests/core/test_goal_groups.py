@@ -1,0 +1,92 @@
+"""Goals the estimate cannot tell apart act as one (`core.goal_groups`, `GoalGrouping`): the
+robot heads for their probability-weighted point and commits to a goal, and shows it, only
+once the group allows."""
+
+import numpy as np
+import pytest
+
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.goal_groups import NO_GOAL, check_grouping, group_target
+from pbp_drake.systems.pbp.goal_grouping import GoalGrouping
+
+SETTINGS = dict(group_mass=0.9, commit_radius=0.05, commit_probability=0.5)  # 0.8 by default
+
+
+def target(goals, probabilities, selected=None):
+    probabilities = np.asarray(probabilities, float)
+    selected = int(np.argmax(probabilities)) if selected is None else selected
+    return group_target(np.asarray(goals, float), probabilities, selected, **SETTINGS)
+
+
+def test_two_goals_equally_likely_are_headed_for_between_and_neither_is_shown():
+    result = target([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [3.0, 0.0, 0.7]], [0.48, 0.48, 0.04])
+    np.testing.assert_allclose(result.point, [1.0, 0.0, 0.7])
+    assert result.shown == NO_GOAL and result.size == 2
+
+
+def test_the_point_weighs_each_goal_by_its_probability():
+    goals = [[1.0, 0.0, 0.7], [2.0, 0.0, 0.7], [2.0, 1.0, 0.7], [1.0, -1.0, 0.7]]
+    result = target(goals, [0.45, 0.35, 0.15, 0.05])
+    # The group holds 0.95 of the mass (0.8 is short of 0.9): its three likely goals.
+    assert result.size == 3
+    np.testing.assert_allclose(result.point, np.array([0.45, 0.35, 0.15]) @ np.array(
+        goals[:3]) / 0.95)
+
+
+def test_a_likely_goal_is_committed_to_and_shown():
+    goals = [[1.0, 0.5, 0.7], [1.0, -0.5, 0.7]]
+    result = target(goals, [0.6, 0.4])
+    assert result.shown == 0 and result.size == 1
+    np.testing.assert_array_equal(result.point, goals[0])
+
+
+def test_goals_closer_than_the_commit_radius_act_as_one():
+    goals = [[1.5, 0.0, 0.7], [1.5, 0.03, 0.7], [1.5, -0.03, 0.7]]
+    result = target(goals, [0.34, 0.33, 0.33], selected=1)
+    assert result.shown == 1  # the estimator's selection, with its hysteresis
+    np.testing.assert_array_equal(result.point, goals[1])
+
+
+def test_ten_thousand_goals_group_to_the_likely_ones():
+    rng = np.random.default_rng(0)
+    goals = np.column_stack([rng.uniform(1.25, 2.5, 10_000), rng.uniform(-1, 1, 10_000),
+                             np.full(10_000, 0.7)])
+    logits = -np.abs(goals[:, 1] - 0.2) / 0.01  # the goals near y = 0.2 are likely
+    probabilities = np.exp(logits - logits.max())
+    probabilities /= probabilities.sum()
+    result = target(goals, probabilities)
+    assert result.shown == NO_GOAL and 1 < result.size < 1_000
+    assert abs(result.point[1] - 0.2) < 0.02
+
+
+@pytest.mark.parametrize("settings, message", [
+    (dict(group_mass=1.0), "group_mass must lie in"),
+    (dict(group_mass=float("nan")), "group_mass must lie in"),
+    (dict(group_mass=-0.1), "group_mass must lie in"),
+    (dict(commit_radius=0.0), "commit_radius must be a positive finite distance"),
+    (dict(commit_radius=float("inf")), "commit_radius must be a positive finite distance"),
+    (dict(commit_probability=0.0), "commit_probability must lie in"),
+    (dict(commit_probability=True), "commit_probability must lie in"),
+])
+def test_a_setting_out_of_range_is_refused_naming_it(settings, message):
+    with pytest.raises(ValueError, match=message):
+        check_grouping(**{**SETTINGS, **settings})
+    with pytest.raises(ValueError, match=message):
+        GoalEstimatorSettings(**{**SETTINGS, **settings})
+
+
+def test_the_system_moves_the_selected_goals_row_and_shows_none_until_committed():
+    goals = np.array([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [3.0, 0.0, 0.7]])
+    system = GoalGrouping(3, **SETTINGS)
+    context = system.CreateDefaultContext()
+    system.get_goals_input_port().FixValue(context, goals.reshape(-1))
+    system.get_goal_probabilities_input_port().FixValue(context, [0.48, 0.48, 0.04])
+    system.get_selected_goal_input_port().FixValue(context, [1.0])
+    followed = system.get_followed_goals_output_port().Eval(context).reshape(3, 3)
+    np.testing.assert_allclose(followed[1], [1.0, 0.0, 0.7])
+    np.testing.assert_array_equal(followed[[0, 2]], goals[[0, 2]])
+    assert system.get_shown_goal_output_port().Eval(context)[0] == NO_GOAL
+    system.get_goal_probabilities_input_port().FixValue(context, [0.2, 0.7, 0.1])
+    np.testing.assert_array_equal(
+        system.get_followed_goals_output_port().Eval(context).reshape(3, 3), goals)
+    assert system.get_shown_goal_output_port().Eval(context)[0] == 1

@@ -9,10 +9,10 @@ the run correcting it. Here the robot follows the group instead, coarse to fine:
   the probability (a credible set; O(K) partitions and a sort of the group's members).
 - **Its point** is the group's probability-weighted mean goal: the DMP of the selected goal
   is steered to it, so the robot heads into the region the operator means.
-- **Commitment.** The robot commits to the most probable goal (and shows it) once the
-  group is one goal, or its goals lie within `commit_radius` of their point (they act as
-  one), or the most probable goal holds `commit_probability`. Until then it shows no goal:
-  `NO_GOAL` is the shown index.
+- **Commitment.** The robot commits to the estimator's selected goal (its hysteresis
+  kept) and shows it once the group is one goal, or its goals lie within `commit_radius`
+  of their point (they act as one), or the most probable goal holds `commit_probability`.
+  Until then it shows no goal: `NO_GOAL` is the shown index.
 
 As the hand nears the group, goals off its heading fall out of it and the group narrows to
 the goal meant; a goal that stays ambiguous (two goals in line) is decided by the

@@ -120,7 +120,7 @@ class Arm(ArmStationConfig, TaskRobot):
     from a URDF or SDFormat file (ours, `package://pbp_drake_models/arm7/pbp_arm7.urdf`,
     or a user's own) under differential IK; every field of ArmStationConfig, and the
     HSR's speed and hand-over limits. The task sets the station's control_period (the
-    control period) and obstacles (the obstacle task's cylinders)."""
+    scenario's) and obstacles (the obstacle task's cylinders); the file leaves them out."""
 
     #: How far (rad) the hand's heading may turn either way from its start: a wrist's
     #: turn is bounded, and past about 90 degrees the tool points back at the arm.

@@ -49,7 +49,8 @@ ARENA_TASKS = {"hsr_reach_arena": ("diagrams/hsr_reach.yaml", "Reaching", 30),
                "arm_reach_arena": ("diagrams/arm_reach.yaml", "Reaching with the arm", 10)}
 
 # The reaching task with K candidate goals on a grid (docs/results/many-goals.md): PBP-Alt
-# following one goal at a time (the paper's) beside teleop, and PBP-Alt with goal groups.
+# following one goal at a time (the paper's) beside teleop, and PBP-Alt with goal groups;
+# on the HSR at K = 4, 100 and 1,000, and on the arm at K = 100.
 MANY_GOALS = (4, 100, 1000)
 GROUPS = ["--set", "goal_estimator.group_mass=0.9"]
 EVALUATION_30 = ["--trials", "30", "--split", "evaluation"]
@@ -102,6 +103,10 @@ STUDIES = {
     **{f"hsr_reach_goals_{goals}_groups": ["diagrams/hsr_reach.yaml", "--goals", str(goals),
                                             *GROUPS, "--methods", "pbp_alternated",
                                             *EVALUATION_30] for goals in MANY_GOALS},
+    "arm_reach_goals_100": ["diagrams/arm_reach.yaml", "--goals", "100", "--methods",
+                            "pbp_alternated,teleop", *EVALUATION_30],
+    "arm_reach_goals_100_groups": ["diagrams/arm_reach.yaml", "--goals", "100", *GROUPS,
+                                   "--methods", "pbp_alternated", *EVALUATION_30],
     "hsr_reach_goals_100_groups_pilots": [
         "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, "--methods",
         "pbp_alternated,teleop", *EVALUATION_30, "--pilots", ",".join(PILOT_NAMES)],

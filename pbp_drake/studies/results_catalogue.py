@@ -107,6 +107,10 @@ STUDIES = {
                             "pbp_alternated,teleop", *EVALUATION_30],
     "arm_reach_goals_100_groups": ["diagrams/arm_reach.yaml", "--goals", "100", *GROUPS,
                                    "--methods", "pbp_alternated", *EVALUATION_30],
+    # A participant that first heads for a wrong object, now and then (impaired.md).
+    "hsr_reach_goals_100_groups_mistaken": [
+        "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, "--methods",
+        "pbp_alternated,teleop", *EVALUATION_30, "--participant-condition", "mistaken"],
     "hsr_reach_goals_100_groups_pilots": [
         "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, "--methods",
         "pbp_alternated,teleop", *EVALUATION_30, "--pilots", ",".join(PILOT_NAMES)],

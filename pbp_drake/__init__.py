@@ -56,7 +56,7 @@ API_GROUPS = {
     },
     "The PBP loop's systems": {
         name: "pbp_drake.systems.pbp" for name in [
-            "DmpBank", "GoalEstimator", "Blender", "HandOver", "GoalsSource",
+            "DmpBank", "GoalEstimator", "GoalGrouping", "Blender", "HandOver", "GoalsSource",
             "HeadingCommand", "DemonstrationPlayer"]},
     "Six-DoF PBP systems": {
         name: "pbp_drake.systems.pbp" for name in [

@@ -54,9 +54,8 @@ from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.core.goal_estimation import READS_COMMAND, estimator_entry
 from pbp_drake.core.methods import ASSISTED, BLENDED, METHODS
 from pbp_drake.systems import (
-    Blender, DmpBank, GoalEstimator, HandOver, HeadingCommand, HopAssistance, LikelyGoals,
-    MaxEntGoalEstimator)
-from pbp_drake.systems.pbp.goal_grouping import GoalGrouping
+    Blender, DmpBank, GoalEstimator, GoalGrouping, HandOver, HeadingCommand, HopAssistance,
+    LikelyGoals, MaxEntGoalEstimator)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
 # How far ahead the task scenes draw the DMPs' paths, in samples over the DMP's duration.

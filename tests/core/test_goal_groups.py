@@ -7,7 +7,7 @@ import pytest
 
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.goal_groups import NO_GOAL, check_grouping, group_target
-from pbp_drake.systems.pbp.goal_grouping import GoalGrouping
+from pbp_drake import GoalGrouping
 
 SETTINGS = dict(group_mass=0.9, commit_radius=0.05, commit_probability=0.5)  # 0.8 by default
 

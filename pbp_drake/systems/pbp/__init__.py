@@ -1,5 +1,6 @@
 """The PBP loop's systems: the DMP banks, the goal estimators, the blenders and the hand-over,
-in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`) and the six-DoF
+in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`, and `GoalGrouping`
+for scenes of many goals) and the six-DoF
 pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`, `PoseHandOver`); the goals'
 source, the heading command of the HSR tasks, the demonstration player of explicit
 arbitration and the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy
@@ -11,6 +12,7 @@ from pbp_drake.systems.pbp.blender import Blender
 from pbp_drake.systems.pbp.demonstration_player import DemonstrationPlayer
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
 from pbp_drake.systems.pbp.goal_estimator import GoalEstimator
+from pbp_drake.systems.pbp.goal_grouping import GoalGrouping
 from pbp_drake.systems.pbp.goals_source import GoalsSource
 from pbp_drake.systems.pbp.hand_over import HandOver
 from pbp_drake.systems.pbp.heading_command import HeadingCommand
@@ -24,7 +26,8 @@ from pbp_drake.systems.pbp.pose_hand_over import PoseHandOver
 from pbp_drake.systems.pbp.pose_hop_assistance import PoseHopAssistance
 from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstimator
 
-__all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalsSource",
+__all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalGrouping",
+           "GoalsSource",
            "HandOver", "HeadingCommand", "HopAssistance", "LikelyGoals", "MaxEntGoalEstimator",
            "PoseBlender",
            "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver", "PoseHopAssistance",

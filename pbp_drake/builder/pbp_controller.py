@@ -188,9 +188,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     settings = config.goal_estimator
     shown = estimator.get_selected_goal_output_port()
     if settings.group_mass > 0.0:
-        grouping = builder.AddNamedSystem("goal_grouping", GoalGrouping(
-            goal_count, settings.group_mass, settings.commit_radius,
-            settings.commit_probability))
+        grouping = builder.AddNamedSystem("goal_grouping", GoalGrouping(goal_count, settings))
         builder.ConnectInput("goals", grouping.get_goals_input_port())
         builder.Connect(estimator.get_goal_probabilities_output_port(),
                         grouping.get_goal_probabilities_input_port())

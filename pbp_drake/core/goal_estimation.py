@@ -45,7 +45,6 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
-from pbp_drake.core.goal_groups import check_grouping
 from pbp_drake.core.methods import did_you_mean
 
 #: `Estimator.reads`: the hand's position and heading (`GoalEstimator`, any task) ...
@@ -130,7 +129,16 @@ class GoalEstimatorSettings:
         if (isinstance(self.hold_steps, bool) or not isinstance(self.hold_steps, (int, np.integer))
                 or self.hold_steps < 1):
             raise ValueError(f"hold_steps must be an integer >= 1, got {self.hold_steps!r}")
-        check_grouping(self.group_mass, self.commit_radius, self.commit_probability)
+        if not (_is_real(self.group_mass) and 0.0 <= self.group_mass < 1.0):
+            raise ValueError(f"group_mass must lie in [0, 1) (0: no groups), got "
+                             f"{self.group_mass!r}")
+        if not (_is_real(self.commit_radius) and math.isfinite(self.commit_radius)
+                and self.commit_radius > 0.0):
+            raise ValueError(f"commit_radius must be a positive finite distance (m), got "
+                             f"{self.commit_radius!r}")
+        if not (_is_real(self.commit_probability) and 0.0 < self.commit_probability <= 1.0):
+            raise ValueError(f"commit_probability must lie in (0, 1], got "
+                             f"{self.commit_probability!r}")
 
 
 class SelectionMemory(typing.NamedTuple):

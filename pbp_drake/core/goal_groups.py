@@ -19,7 +19,6 @@ the goal meant; a goal that stays ambiguous (two goals in line) is decided by th
 operator's correction, as with a single goal.
 """
 
-import math
 import typing
 
 import numpy as np
@@ -35,23 +34,6 @@ class GroupTarget(typing.NamedTuple):
     point: np.ndarray
     shown: int
     size: int
-
-
-def _is_number(value):
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, bool)
-
-
-def check_grouping(group_mass, commit_radius, commit_probability):
-    """ValueError naming the first setting out of its range (NaN included)."""
-    if not (_is_number(group_mass) and 0.0 <= group_mass < 1.0):
-        raise ValueError(f"group_mass must lie in [0, 1) (0: no groups), got {group_mass!r}")
-    if not (_is_number(commit_radius) and math.isfinite(commit_radius)
-            and commit_radius > 0.0):
-        raise ValueError(f"commit_radius must be a positive finite distance (m), got "
-                         f"{commit_radius!r}")
-    if not (_is_number(commit_probability) and 0.0 < commit_probability <= 1.0):
-        raise ValueError(f"commit_probability must lie in (0, 1], got {commit_probability!r}")
 
 
 def _most_probable(probabilities, mass):

@@ -38,6 +38,13 @@ def position_of(view):
     return np.array([view.x, view.y, view.z])
 
 
+def checked_goal_count(goal_count):
+    """`goal_count` as an int; ValueError unless it is an integer >= 1."""
+    if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
+        raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
+    return int(goal_count)
+
+
 def goal_index(port, context, goal_count, unconnected=None):
     """The goal index `[k]` on `port` as an int, checked to be one of `goal_count` goals;
     `unconnected` when nothing is connected to the port."""

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
-from pbp_drake.core.goal_groups import NO_GOAL, check_grouping, group_target
+from pbp_drake.core.goal_groups import NO_GOAL, group_target
 from pbp_drake import GoalGrouping
 
 SETTINGS = dict(group_mass=0.9, commit_radius=0.05, commit_probability=0.5)  # 0.8 by default
@@ -70,14 +70,18 @@ def test_ten_thousand_goals_group_to_the_likely_ones():
 ])
 def test_a_setting_out_of_range_is_refused_naming_it(settings, message):
     with pytest.raises(ValueError, match=message):
-        check_grouping(**{**SETTINGS, **settings})
-    with pytest.raises(ValueError, match=message):
         GoalEstimatorSettings(**{**SETTINGS, **settings})
+    # Set after construction (as a YAML loader does), the system refuses it too.
+    changed = GoalEstimatorSettings(**SETTINGS)
+    for name, value in settings.items():
+        setattr(changed, name, value)
+    with pytest.raises(ValueError, match=message):
+        GoalGrouping(3, changed)
 
 
 def test_the_system_moves_the_selected_goals_row_and_shows_none_until_committed():
     goals = np.array([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [3.0, 0.0, 0.7]])
-    system = GoalGrouping(3, **SETTINGS)
+    system = GoalGrouping(3, GoalEstimatorSettings(**SETTINGS))
     context = system.CreateDefaultContext()
     system.get_goals_input_port().FixValue(context, goals.reshape(-1))
     system.get_goal_probabilities_input_port().FixValue(context, [0.48, 0.48, 0.04])

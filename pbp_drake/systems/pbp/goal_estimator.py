@@ -8,7 +8,7 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.goal_estimation import (
     NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate)
-from pbp_drake.systems.ports import EeState, PortGetters, position_of
+from pbp_drake.systems.ports import EeState, PortGetters, checked_goal_count, position_of
 from pbp_drake.systems.tick import decide_offset
 
 # Layout of the `memory` discrete state group.
@@ -46,8 +46,7 @@ class GoalEstimator(PortGetters, LeafSystem):
 
     def __init__(self, goal_count, settings, control_period, update_offset=None):
         super().__init__()
-        if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
-            raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
+        goal_count = checked_goal_count(goal_count)
         if not isinstance(settings, GoalEstimatorSettings):
             raise ValueError(f"settings must be a GoalEstimatorSettings, got "
                              f"{type(settings).__name__}")

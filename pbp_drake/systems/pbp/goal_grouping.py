@@ -4,8 +4,9 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
-from pbp_drake.core.goal_groups import check_grouping, group_target
-from pbp_drake.systems.ports import PortGetters, goal_index
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.goal_groups import group_target
+from pbp_drake.systems.ports import PortGetters, checked_goal_count, goal_index
 
 
 class GoalGrouping(PortGetters, LeafSystem):
@@ -23,20 +24,24 @@ class GoalGrouping(PortGetters, LeafSystem):
         - followed_goals
         - shown_goal
 
-    `goals` is the K goals `(K, 3)` row-major; `goal_probabilities` and `selected_goal` are
-    the estimator's. `followed_goals` is `goals` with the selected goal's row moved to the
-    group's point while the robot has not committed (what the DMP bank steers to);
-    `shown_goal` is `[index]`, the selected goal once committed, else `NO_GOAL` (-1). Both
-    come from one computation a change of the inputs (the estimator's state: once a tick).
+    `settings` is the estimator's (`GoalEstimatorSettings`: `group_mass`, `commit_radius`,
+    `commit_probability`). `goals` is the K goals `(K, 3)` row-major; `goal_probabilities`
+    and `selected_goal` are the estimator's. `followed_goals` is `goals` with the selected
+    goal's row moved to the group's point while the robot has not committed (what the DMP
+    bank steers to); `shown_goal` is `[index]`, the selected goal once committed, else
+    `NO_GOAL` (-1). Both come from one computation a change of the inputs (the estimator's
+    state: once a tick).
     """
 
-    def __init__(self, goal_count, group_mass, commit_radius, commit_probability):
+    def __init__(self, goal_count, settings):
         super().__init__()
-        if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
-            raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
-        check_grouping(group_mass, commit_radius, commit_probability)
-        self._goal_count = k = int(goal_count)
-        self._settings = (float(group_mass), float(commit_radius), float(commit_probability))
+        self._goal_count = k = checked_goal_count(goal_count)
+        if not isinstance(settings, GoalEstimatorSettings):
+            raise ValueError(f"settings must be a GoalEstimatorSettings, got "
+                             f"{type(settings).__name__}")
+        settings.validate()  # a plain dataclass: its fields may have changed since
+        self._settings = (float(settings.group_mass), float(settings.commit_radius),
+                          float(settings.commit_probability))
         self._goals_port = self.DeclareVectorInputPort("goals", 3 * k)
         self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)

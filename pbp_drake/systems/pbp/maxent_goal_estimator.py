@@ -14,7 +14,7 @@ from pbp_drake.core.goal_estimation import NO_CHALLENGER, SelectionMemory, updat
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, hop_targets, uniform_log_belief, update_posterior)
 from pbp_drake.core.maxent_command import intent_evidence, update_intent_posterior
-from pbp_drake.systems.ports import EeState, OperatorCommand, PortGetters
+from pbp_drake.systems.ports import EeState, OperatorCommand, PortGetters, checked_goal_count
 from pbp_drake.systems.tick import decide_offset
 
 
@@ -58,8 +58,7 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
                                                and operator_speed > 0.0):
             raise ValueError(f"operator_speed must be positive, got {operator_speed!r}")
         self._operator_speed = None if operator_speed is None else float(operator_speed)
-        if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
-            raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
+        goal_count = checked_goal_count(goal_count)
         if not isinstance(settings, HopSettings):
             raise ValueError(f"settings must be a HopSettings, got {type(settings).__name__}")
         settings.validate()

@@ -135,10 +135,9 @@ def check_reach_task(task):
         if task.objects:
             raise ScenarioError("scenario.task.grid_objects places objects on a grid; "
                                 "scenario.task.objects are given: remove one")
-        check_count(task.grid_objects, "scenario.task.grid_objects",
-                    2 if len(task.switch_schedule) > 1 else 1, MAX_GOALS,
-                    " (a target switch needs 2 objects)" if len(task.switch_schedule) > 1
-                    else "")
+        switches = len(task.switch_schedule) > 1
+        check_count(task.grid_objects, "scenario.task.grid_objects", 2 if switches else 1,
+                    MAX_GOALS, " (a target switch needs 2 objects)" if switches else "")
 
 
 def check_switch_schedule(task):

@@ -17,10 +17,10 @@ pytestmark = pytest.mark.slow  # four reaching trials of about 2 s each
 REACH = pathlib.Path(__file__).resolve().parents[2] / "diagrams" / "hsr_reach.yaml"
 
 
-def grid_scene(seed, group_mass, goals=100, file=REACH):
-    scenario = load_scenario_file(file).scenario
+def grid_scene(seed, group_mass):
+    scenario = load_scenario_file(REACH).scenario
     return resolve(dataclasses.replace(
-        scenario, seed=seed, task=dataclasses.replace(scenario.task, grid_objects=goals),
+        scenario, seed=seed, task=dataclasses.replace(scenario.task, grid_objects=100),
         goal_estimator=dataclasses.replace(scenario.goal_estimator, group_mass=group_mass)))
 
 

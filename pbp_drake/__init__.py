@@ -44,6 +44,7 @@ API_GROUPS = {
         "register_method": "pbp_drake.core.methods",
         "Estimator": "pbp_drake.core.goal_estimation",
         "register_estimator": "pbp_drake.core.goal_estimation",
+        "IntentFilterSettings": "pbp_drake.core.intent_filter",
     },
     "Shared-autonomy baselines (HOP, predict-then-assist)": {
         "HopSettings": "pbp_drake.core.hindsight_optimization",
@@ -56,7 +57,8 @@ API_GROUPS = {
     },
     "The PBP loop's systems": {
         name: "pbp_drake.systems.pbp" for name in [
-            "DmpBank", "GoalEstimator", "GoalGrouping", "Blender", "HandOver", "GoalsSource",
+            "DmpBank", "GoalEstimator", "GoalGrouping", "IntentFilterGoalEstimator", "Blender",
+            "HandOver", "GoalsSource",
             "HeadingCommand", "DemonstrationPlayer"]},
     "Six-DoF PBP systems": {
         name: "pbp_drake.systems.pbp" for name in [

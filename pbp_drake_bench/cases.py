@@ -107,18 +107,18 @@ class ReferenceReader(LeafSystem):
     """Evaluates its input once a period, after the bank's update (at the report stage of
     `pbp_drake.systems.tick`, as the hand-over reads the blender): a consumer's read."""
 
-    def __init__(self, size):
+    def __init__(self, size, period=DT):
         super().__init__()
         self._port = self.DeclareVectorInputPort("reference", size)
-        self.DeclarePeriodicPublishEvent(DT, report_offset(DT), self._read)
+        self.DeclarePeriodicPublishEvent(period, report_offset(period), self._read)
 
     def _read(self, context):
         self._port.EvalAbstract(context)
 
 
-def connect_reader(builder, port):
-    """A `ReferenceReader` of `port` in `builder`."""
-    reader = builder.AddSystem(ReferenceReader(port.size()))
+def connect_reader(builder, port, period=DT):
+    """A `ReferenceReader` of `port` in `builder`, reading every `period`."""
+    reader = builder.AddSystem(ReferenceReader(port.size(), period))
     builder.Connect(port, reader.get_input_port())
 
 

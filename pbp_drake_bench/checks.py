@@ -9,6 +9,9 @@ import dataclasses
 from collections.abc import Callable
 
 PEERS = ("pydmps", "movement_primitives")
+# The K of the goal estimators' steps (`pbp_drake_bench.estimators`; not imported: it
+# imports Drake's systems, and this module is read by the CLI's reference).
+ESTIMATOR_GOALS = 10_000
 
 
 @dataclasses.dataclass(frozen=True)
@@ -27,6 +30,7 @@ class Check:
     run: tuple | None = None
     base_run: tuple | None = None  # ... and of the run of the same bench it compares with
     replay: tuple = ()  # the K of the replay sizes it compares (`pbp_drake_bench.replay`)
+    estimator: str = ""  # the row of the goal estimators' steps it reads (`.estimators`)
     peers: tuple = ()  # it needs one of these peer libraries
     motion: bool = False  # it reads the row's timing over a movement (`cases.motion_timing`)
 
@@ -77,6 +81,9 @@ CHECKS = (
     Check(f"HSR grasping task (six-DoF), K=1,000 grasp targets, {_MESHCAT}: closed loop >= 1x "
           "real time", 1.0, False, "x real time", lambda run: run["realtime_factor"],
           run=("grasp", 1000, True)),
+    Check(f"K={ESTIMATOR_GOALS:,} goals: the intent_filter estimator with goal groups, a "
+          "control period's step <= 2x the angle estimator's (same run)", 2.0, True,
+          "x angle", lambda row: row["vs_angle"], estimator="intent_filter + groups"),
     Check("Replay of a 5 s HSR reaching run as pbp-drake run --record saves it: K=1,000 goals "
           "<= 3x the size of K=4's", 3.0, True, "x the K=4 replay",
           lambda sizes: sizes[1000] / sizes[4], replay=CHECKED_REPLAY_GOALS),
@@ -87,11 +94,12 @@ CHECKS = (
 MOTION_ROWS = frozenset((check.row, check.pose) for check in CHECKS if check.motion)
 
 
-def evaluate(rows, closed_loop, installed, blas=None, replay=None):
+def evaluate(rows, closed_loop, installed, blas=None, replay=None, estimators=None):
     """Every check's result: {"check", "value", "limit", "unit", "verdict", "reason"}, the
     verdict "pass", "fail" or "skipped" (then "reason" says why). `installed` is the set of
     peer libraries present; `blas` (from `pinning.blas_threads`) adds the pinning check;
-    `replay` is `pbp_drake_bench.replay.replay_sizes`' result (None: not recorded)."""
+    `replay` is `pbp_drake_bench.replay.replay_sizes`' result (None: not recorded);
+    `estimators` `pbp_drake_bench.estimators.estimator_steps`' (None: not measured)."""
     results = []
     for check in CHECKS:
         result = {"check": check.name, "value": None, "limit": check.limit,
@@ -100,7 +108,7 @@ def evaluate(rows, closed_loop, installed, blas=None, replay=None):
         if check.peers and not set(check.peers) & set(installed):
             result["reason"] = f"{', '.join(check.peers)} not installed"
             continue
-        source, where = _source(check, rows, closed_loop, replay)
+        source, where = _source(check, rows, closed_loop, replay, estimators)
         value = None if source is None else check.value(source)
         if value is None:
             result["reason"] = ("not measured: " + where if source is None else
@@ -115,7 +123,11 @@ def evaluate(rows, closed_loop, installed, blas=None, replay=None):
     return results
 
 
-def _source(check, rows, closed_loop, replay):
+def _source(check, rows, closed_loop, replay, estimators=None):
+    if check.estimator:
+        found = [row for row in (estimators or {}).get("rows", ())
+                 if row["estimator"] == check.estimator]
+        return (found[0], None) if found else (None, "no goal estimator steps (--no-estimators)")
     if check.replay:
         sizes = {run["goals"]: run["bytes"] for run in (replay or {}).get("runs", ())}
         if all(k in sizes for k in check.replay):

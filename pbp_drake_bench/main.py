@@ -16,6 +16,7 @@ from pbp_drake_bench.cases import (
 from pbp_drake_bench.checks import (
     CHECKED_HSR_GOALS, CHECKED_REPLAY_GOALS, MOTION_ROWS, PEERS, evaluate, exit_code)
 from pbp_drake_bench.closed_loop import HSR_KS, TASKS, closed_loop_runs, split_run
+from pbp_drake_bench.estimators import estimator_steps
 from pbp_drake_bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
 from pbp_drake_bench.pinning import blas_threads, in_measuring_process, measure_in_fresh_process
@@ -67,6 +68,8 @@ def build_parser():
                         help="K of the reach runs whose per-tick time is split by category "
                         f"under cProfile (default: {' '.join(map(str, SPLIT_KS))}; none to "
                         "skip)")
+    parser.add_argument("--no-estimators", action="store_true",
+                        help="skip the goal estimators' step at K = 10,000 (and its check)")
     parser.add_argument("--blas-threads", type=int, default=1,
                         help="BLAS threads for every backend (default 1): the bench measures "
                         "in a fresh Python process with OPENBLAS_NUM_THREADS, "
@@ -100,6 +103,7 @@ def plan(args):
                                                   "reach" in args.tasks else ())
                       for with_meshcat in ((False, True) if meshcat else (False,))],
             "replay_goals": list(CHECKED_REPLAY_GOALS) if meshcat else [],
+            "estimators": not args.no_estimators,
             "replay_seconds": REPLAY_SECONDS}
 
 
@@ -179,6 +183,9 @@ def _measure(args):
     replay = (replay_sizes(settings["replay_goals"], settings["replay_seconds"], _progress)
               if settings["replay_goals"] else None)
 
+    estimators = (estimator_steps(min_time, progress=_progress) if settings["estimators"]
+                  else None)
+
     report = {
         "machine": {"processor": platform.processor() or platform.machine(),
                     "cpus": os.cpu_count(), "python": platform.python_version(),
@@ -193,8 +200,9 @@ def _measure(args):
         "closed_loop": closed_loop,
         "time_split": split,
         "replay": replay,
+        "estimators": estimators,
     }
-    report["checks"] = evaluate(rows, closed_loop, installed, blas, replay)
+    report["checks"] = evaluate(rows, closed_loop, installed, blas, replay, estimators)
     text = format_report(report)
     print(text)
     (output / "bench.json").write_text(json.dumps(report, indent=2))

@@ -104,6 +104,9 @@ def format_report(report):
     if report.get("replay"):
         lines.append("")
         lines.extend(replay_lines(report["replay"]))
+    if report.get("estimators"):
+        lines.append("")
+        lines.extend(format_estimators(report["estimators"]))
     lines.append("")
     lines.append(format_results(report["checks"]))
     return "\n".join(lines)
@@ -195,3 +198,13 @@ def replay_lines(replay):
                       for run in replay["runs"])
     return [f"Replay of a {replay['simulated_s']:g} s reach run as pbp-drake run --record saves "
             f"it (Meshcat recording at 30 frames/s, StaticHtml): {sizes}"]
+
+
+def format_estimators(estimators):
+    """The report's lines of the estimator steps."""
+    lines = [f"Goal estimator step, K = {estimators['goals']:,} goals (a control period's "
+             "update and the outputs' read, median; x the angle estimator's):"]
+    for row in estimators["rows"]:
+        lines.append(f"  {row['estimator']:<24} {row['step_us']:9.0f} us  "
+                     f"{row['vs_angle']:5.2f}x")
+    return lines

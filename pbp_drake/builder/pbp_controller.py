@@ -7,7 +7,7 @@ Under the PBP methods and explicit arbitration (`pbp_controller`):
                        └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
                                               dmp_bank (followed_goal, selected_goal)
     goals ──> dmp_bank, goal_estimator
-    operator_command, operator_active ──> goal_estimator (the maxent_command estimator only)
+    operator_command, operator_active ──> goal_estimator (maxent_command and intent_filter)
     dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
     goal_estimator ──> likely_goals ──> dmp_bank.predicted_goals (with prediction_steps > 0:
                                         the paths a drawing shows)
@@ -22,13 +22,15 @@ and the DMP bank: it moves the selected goal's row to the point of the group of 
 estimate cannot yet tell apart (`pbp_drake.core.goal_groups`), and the controller's
 `selected_goal` is its `shown_goal` (-1 until the robot commits to a goal):
 
-    goals, goal_estimator (goal_probabilities, selected_goal) ──> goal_grouping
+    goals, ee_state, goal_estimator (goal_probabilities, selected_goal) ──> goal_grouping
     goal_grouping.followed_goals ──> dmp_bank.goals;  goal_grouping.shown_goal ──> selected_goal
 
 The goal estimator is a `GoalEstimator`, or with `goal_estimator: {method: maxent_command}`
 a `MaxEntGoalEstimator` (HOP's posterior with the likelihood of PBP's operator,
 `pbp_drake.core.maxent_command`, with the config's `hop` settings, `nominal_speed` and the
-`goal_estimator` section's hysteresis), which adds the output `posterior_clipped`.
+`goal_estimator` section's hysteresis), or with `{method: intent_filter}` an
+`IntentFilterGoalEstimator` (the section's `intent_filter` settings and hysteresis); those
+two add the output `posterior_clipped`.
 
 Under ``hop`` and ``predict_then_assist`` (`hop_controller`, no DMP bank) HOP's posterior and
 its assistance take the place of the estimator, the bank and the blender:
@@ -51,11 +53,11 @@ from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from pbp_drake.core.arbitration import BLEND_LAWS
 from pbp_drake.core.controller_config import PbpControllerConfig
-from pbp_drake.core.goal_estimation import READS_COMMAND, estimator_entry
+from pbp_drake.core.goal_estimation import READS_COMMAND, READS_INTENT, estimator_entry
 from pbp_drake.core.methods import ASSISTED, BLENDED, METHODS
 from pbp_drake.systems import (
     Blender, DmpBank, GoalEstimator, GoalGrouping, HandOver, HeadingCommand, HopAssistance,
-    LikelyGoals, MaxEntGoalEstimator)
+    IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
 # How far ahead the task scenes draw the DMPs' paths, in samples over the DMP's duration.
@@ -145,11 +147,27 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     builder.ExportOutput(ee_command.get_output_port(), "ee_command")
     builder.ExportOutput(shown, "selected_goal")
     builder.ExportOutput(estimator.get_goal_probabilities_output_port(), "goal_probabilities")
-    if isinstance(estimator, MaxEntGoalEstimator):
+    if isinstance(estimator, MaxEntGoalEstimator):  # the intent filter's class too
         builder.ExportOutput(estimator.get_posterior_clipped_output_port(), "posterior_clipped")
     diagram = builder.Build()
     diagram.set_name(name)
     return diagram
+
+
+def make_goal_estimator(config: PbpControllerConfig, goal_count):
+    """The PBP methods' goal estimator of `config.goal_estimator.method` for `goal_count`
+    goals: a `GoalEstimator`, an `IntentFilterGoalEstimator` (``intent_filter``) or a
+    `MaxEntGoalEstimator` (``maxent_command``: HOP's posterior with the likelihood of PBP's
+    operator, at the operators' speed `config.nominal_speed`)."""
+    settings, period = config.goal_estimator, config.control_period
+    reads = estimator_entry(settings.method).reads
+    if reads == READS_INTENT:
+        return IntentFilterGoalEstimator(goal_count, settings.intent_filter, period,
+                                         settings.margin, settings.hold_steps)
+    if reads == READS_COMMAND:
+        return MaxEntGoalEstimator(goal_count, config.hop, period, settings.margin,
+                                   settings.hold_steps, operator_speed=config.nominal_speed)
+    return GoalEstimator(goal_count, settings, period)
 
 
 def _add_pbp_policy(builder, config, start, goals, split, command_split, prediction_steps,
@@ -159,13 +177,10 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     period = config.control_period
     goal_count = len(goals)
     position_velocity = split.get_output_port(0)
-    reads_command = estimator_entry(config.goal_estimator.method).reads == READS_COMMAND
-    # maxent_command: HOP's posterior with the likelihood of PBP's operator (corrections,
-    # turns, and silences read as letting the robot go on), at the operators' speed.
-    estimator = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(
-        goal_count, config.hop, period, config.goal_estimator.margin,
-        config.goal_estimator.hold_steps, operator_speed=config.nominal_speed)
-        if reads_command else GoalEstimator(goal_count, config.goal_estimator, period))
+    settings = config.goal_estimator
+    reads_command = estimator_entry(settings.method).reads in (READS_COMMAND, READS_INTENT)
+    estimator = builder.AddNamedSystem("goal_estimator", make_goal_estimator(config,
+                                                                             goal_count))
     builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
     builder.ExportInput(estimator.get_goals_input_port(), "goals")
     if reads_command:
@@ -185,11 +200,12 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         # then O(D) whatever K (with shared weights and start, every scenario's bank, the
         # outputs are O(D) too).
         compact_state=True, predicted_goal_count=predicted_goal_count))
-    settings = config.goal_estimator
     shown = estimator.get_selected_goal_output_port()
     if settings.group_mass > 0.0:
-        grouping = builder.AddNamedSystem("goal_grouping", GoalGrouping(goal_count, settings))
+        grouping = builder.AddNamedSystem("goal_grouping", GoalGrouping(goal_count, settings,
+                                                                        period))
         builder.ConnectInput("goals", grouping.get_goals_input_port())
+        builder.ConnectInput("ee_state", grouping.get_ee_state_input_port())
         builder.Connect(estimator.get_goal_probabilities_output_port(),
                         grouping.get_goal_probabilities_input_port())
         builder.Connect(estimator.get_selected_goal_output_port(),

@@ -110,7 +110,8 @@ class PbpControllerConfig(ControlSettings):
     """Everything `make_pbp_controller` builds from; one default per knob, the scenario
     file's."""
 
-    #: The DMPs' nominal speed (m/s), for their duration when dmp_duration is 0.
+    #: The DMPs' nominal speed (m/s), for their duration when dmp_duration is 0
+    #: (`nominal_duration`).
     nominal_speed: float = 0.12
     #: The hand-over law's limits, which every method's command goes through.
     hand_over: HandOverSettings = dataclasses.field(default_factory=HandOverSettings)
@@ -138,8 +139,19 @@ class PbpControllerConfig(ControlSettings):
 
     def dmp_bank(self, start, goals):
         """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, of
-        `dmp_duration` or the farthest goal's distance over `nominal_speed`."""
+        `dmp_duration` or `nominal_duration`."""
         start, goals = np.asarray(start, float), np.asarray(goals, float)
-        duration = self.dmp_duration or float(
-            np.max(np.linalg.norm(goals - start, axis=1))) / self.nominal_speed
+        duration = self.dmp_duration or nominal_duration(
+            start, goals, self.nominal_speed, self.goal_estimator.group_mass > 0.0)
         return DmpBankModel.straight(start, len(goals), duration, self.dmp)
+
+
+def nominal_duration(start, goals, speed, grouped):
+    """The DMPs' duration (s) when none is given: the farthest goal's distance from `start`
+    over `speed` (all DMPs share one phase, so the farthest goal is reached at the nominal
+    speed and the nearer ones slower); with goal groups (`grouped`), the median goal's.
+    Hundreds of goals spread over a table put the farthest well beyond the typical one,
+    and the robot, heading first into the region the operator means, would cross it at
+    the farthest goal's pace (the hand-over's speed limit bounds the faster DMPs)."""
+    distances = np.linalg.norm(np.asarray(goals, float) - np.asarray(start, float), axis=1)
+    return float(np.median(distances) if grouped else np.max(distances)) / speed

@@ -22,6 +22,10 @@ turns the scores into probabilities that sum to 1:
   command (Javdani et al. 2015; the scenario's `hop` settings,
   `pbp_drake.core.maxent_command`); recursive, so it keeps its belief in the estimator's
   state (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`).
+- ``intent_filter`` (the position tasks): a recursive posterior on the operator's motions,
+  silences and turns and the hand's heading, with a hazard against runaway confidence
+  (`pbp_drake.core.intent_filter`, the section's `intent_filter` settings;
+  `IntentFilterGoalEstimator`).
 
 `ESTIMATORS` is the registry the scenario's `goal_estimator: {method: NAME}` is read
 through: each `Estimator` says what it reads (which picks its system) and, for those that
@@ -45,14 +49,21 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.core.methods import did_you_mean
 
 #: `Estimator.reads`: the hand's position and heading (`GoalEstimator`, any task) ...
 READS_POSITION = "position"
 #: ... the hand's pose and the operator's twist (`PoseGoalEstimator`, the grasping task) ...
 READS_POSE = "pose"
-#: ... or the operator's command, recursively (`MaxEntGoalEstimator`, every task).
+#: ... or the operator's command, recursively (`MaxEntGoalEstimator`, every task) ...
 READS_COMMAND = "command"
+#: ... or the operator's motions, silences and turns and the hand's heading, recursively
+#: with a hazard (`IntentFilterGoalEstimator`, the position tasks).
+READS_INTENT = "intent"
+
+#: What an estimator may read.
+READS = (READS_POSITION, READS_POSE, READS_COMMAND, READS_INTENT)
 
 # A goal closer than this (m) to the end effector on the floor plane has no direction.
 FLOOR_EPSILON = 1e-9
@@ -82,7 +93,8 @@ class GoalEstimatorSettings:
     """
 
     #: The score: angle (the paper's heuristic), nearest, bayesian, pose (grasping task
-    #: only) or maxent_command (HOP's posterior on the operator's command).
+    #: only), maxent_command (HOP's posterior on the operator's command) or intent_filter
+    #: (the position tasks).
     method: str = "angle"
     #: The scale of the angle (rad), nearest (m) and pose (rad) scores.
     temperature: float = 0.1
@@ -108,6 +120,9 @@ class GoalEstimatorSettings:
     commit_radius: float = 0.05
     #: ... or once the most probable goal holds this probability.
     commit_probability: float = 0.8
+    #: The intent_filter estimator's operator model (`pbp_drake.core.intent_filter`).
+    intent_filter: IntentFilterSettings = dataclasses.field(
+        default_factory=IntentFilterSettings)
 
     def __post_init__(self):
         self.validate()
@@ -139,6 +154,10 @@ class GoalEstimatorSettings:
         if not (_is_real(self.commit_probability) and 0.0 < self.commit_probability <= 1.0):
             raise ValueError(f"commit_probability must lie in (0, 1], got "
                              f"{self.commit_probability!r}")
+        if not isinstance(self.intent_filter, IntentFilterSettings):
+            raise ValueError(f"intent_filter must be an IntentFilterSettings, got "
+                             f"{type(self.intent_filter).__name__}")
+        self.intent_filter.validate()
 
 
 class SelectionMemory(typing.NamedTuple):
@@ -276,6 +295,8 @@ ESTIMATORS = {estimator.name: estimator for estimator in (
               computed_by="pbp_drake.core.grasp_estimation.pose_probabilities"),
     Estimator("maxent_command", READS_COMMAND,
               computed_by="pbp_drake.core.hindsight_optimization.update_posterior"),
+    Estimator("intent_filter", READS_INTENT,
+              computed_by="pbp_drake.core.intent_filter.filter_step"),
 )}
 #: The shipped estimators that read the hand's position (`goal_probabilities`).
 GOAL_ESTIMATION_METHODS = tuple(name for name, estimator in ESTIMATORS.items()
@@ -287,9 +308,9 @@ def register_estimator(estimator):
     or it reads the position without a probabilities function."""
     if estimator.name in ESTIMATORS:
         raise ValueError(f"goal estimator {estimator.name!r} is already registered")
-    if estimator.reads not in (READS_POSITION, READS_POSE, READS_COMMAND):
+    if estimator.reads not in READS:
         raise ValueError(f"goal estimator {estimator.name!r}: reads {estimator.reads!r} is "
-                         f"not one of {(READS_POSITION, READS_POSE, READS_COMMAND)}")
+                         f"not one of {READS}")
     if (estimator.reads == READS_POSITION) != (estimator.probabilities is not None):
         raise ValueError(f"goal estimator {estimator.name!r}: a probabilities function is "
                          f"for (and needed by) an estimator that reads the position")

@@ -11,8 +11,12 @@ the run correcting it. Here the robot follows the group instead, coarse to fine:
   is steered to it, so the robot heads into the region the operator means.
 - **Commitment.** The robot commits to the estimator's selected goal (its hysteresis
   kept) and shows it once the group is one goal, or its goals lie within `commit_radius`
-  of their point (they act as one), or the most probable goal holds `commit_probability`.
-  Until then it shows no goal: `NO_GOAL` is the shown index.
+  of their point (they act as one), or the most probable goal holds `commit_probability`,
+  or the hand has reached the group's point (within `commit_radius`: heading into the
+  region is done, and the best guess is shown for the operator to confirm or correct).
+  Until then it shows no goal: `NO_GOAL` is the shown index. A commitment holds while the
+  estimator selects the same goal (`committed`), so that the robot leaving the group's
+  point for the goal does not undo it.
 
 As the hand nears the group, goals off its heading fall out of it and the group narrows to
 the goal meant; a goal that stays ambiguous (two goals in line) is decided by the
@@ -52,17 +56,20 @@ def _most_probable(probabilities, mass):
 
 
 def group_target(goals, probabilities, selected, group_mass, commit_radius,
-                 commit_probability):
+                 commit_probability, hand=None, committed=NO_GOAL):
     """The `GroupTarget` of `goals` (K, 3) under `probabilities` (K), the estimator's
-    `selected` goal committed to when the group allows (module docstring)."""
+    `selected` goal committed to when the group allows (module docstring): `hand` (3) is
+    the hand's position (None: not read), `committed` the goal committed to before
+    (`NO_GOAL`: none)."""
     best = int(np.argmax(probabilities))
-    if probabilities[best] >= commit_probability:
+    if probabilities[best] >= commit_probability or committed == selected:
         return GroupTarget(goals[selected].copy(), selected, 1)
     members = _most_probable(probabilities, group_mass * float(probabilities.sum()))
     size = len(members)
     weights = probabilities[members]
     point = weights @ goals[members] / weights.sum()
     spread = float(np.max(np.linalg.norm(goals[members] - point, axis=1)))
-    if size == 1 or spread <= commit_radius:
+    arrived = hand is not None and float(np.linalg.norm(hand - point)) <= commit_radius
+    if size == 1 or spread <= commit_radius or arrived:
         return GroupTarget(goals[selected].copy(), selected, size)
     return GroupTarget(point, NO_GOAL, size)

@@ -14,10 +14,10 @@ import typing
 
 import numpy as np
 
-from pbp_drake.core.controller_config import PbpControllerConfig
+from pbp_drake.core.controller_config import PbpControllerConfig, nominal_duration
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
-from pbp_drake.core.goal_estimation import READS_POSE, estimator_entry
+from pbp_drake.core.goal_estimation import READS_INTENT, READS_POSE, estimator_entry
 from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_names
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
@@ -104,6 +104,12 @@ def resolve(scenario):
         raise ScenarioError("scenario.goal_estimator.group_mass: goal groups steer the "
                             "position DMPs of the reaching and obstacle tasks (HSR and arm); "
                             "this scenario's robot or task has none: set it to 0")
+    if estimator_entry(scenario.goal_estimator.method).reads == READS_INTENT and (
+            not isinstance(scenario.robot, TASK_ROBOTS) or isinstance(scenario.task, GraspTask)):
+        raise ScenarioError("scenario.goal_estimator.method intent_filter reads the hand's "
+                            "position and heading in the reaching and obstacle tasks (HSR and "
+                            "arm); this scenario's robot or task has none: use pose or "
+                            "maxent_command on the grasping task, angle in the 2-D scenes")
     if isinstance(scenario.robot, TASK_ROBOTS):
         return _resolve_task_robot(scenario)
     return _resolve_point_robot(scenario)
@@ -390,8 +396,8 @@ def _resolve_task_robot(scenario):
         raise ScenarioError(
             f"scenario.task.success_distance {task.success_distance} m reaches the nearest "
             f"object ({nearest:.2f} m from the hand's start): the task would succeed at once")
-    distance = np.max(np.linalg.norm(goals - start, axis=1))
-    duration = scenario.dmp_duration if scenario.dmp_duration > 0 else distance / robot.speed
+    duration = scenario.dmp_duration if scenario.dmp_duration > 0 else nominal_duration(
+        start, goals, robot.speed, scenario.goal_estimator.group_mass > 0.0)
     check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
                        scenario.dmp_duration > 0 else "scenario.robot.speed")
     controller = PbpControllerConfig(**{

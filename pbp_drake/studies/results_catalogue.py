@@ -53,6 +53,8 @@ ARENA_TASKS = {"hsr_reach_arena": ("diagrams/hsr_reach.yaml", "Reaching", 30),
 # on the HSR at K = 4, 100 and 1,000, and on the arm at K = 100.
 MANY_GOALS = (4, 100, 1000)
 GROUPS = ["--set", "goal_estimator.group_mass=0.9"]
+# The shipped estimators beside `angle` that read the hand in the reaching task.
+OTHER_ESTIMATORS = ("nearest", "bayesian", "maxent_command", "intent_filter")
 EVALUATION_30 = ["--trials", "30", "--split", "evaluation"]
 
 #: name -> the arguments of `pbp-drake study` (without --output and --jobs).
@@ -103,10 +105,20 @@ STUDIES = {
     **{f"hsr_reach_goals_{goals}_groups": ["diagrams/hsr_reach.yaml", "--goals", str(goals),
                                             *GROUPS, "--methods", "pbp_alternated",
                                             *EVALUATION_30] for goals in MANY_GOALS},
+    # The same with each of the other estimators (docs/results/many-goals.md).
+    **{f"hsr_reach_goals_{goals}_groups_{estimator}": [
+        "diagrams/hsr_reach.yaml", "--goals", str(goals), *GROUPS, "--set",
+        f"goal_estimator.method={estimator}", "--methods", "pbp_alternated", *EVALUATION_30]
+       for estimator in OTHER_ESTIMATORS for goals in MANY_GOALS},
     "arm_reach_goals_100": ["diagrams/arm_reach.yaml", "--goals", "100", "--methods",
                             "pbp_alternated,teleop", *EVALUATION_30],
     "arm_reach_goals_100_groups": ["diagrams/arm_reach.yaml", "--goals", "100", *GROUPS,
                                    "--methods", "pbp_alternated", *EVALUATION_30],
+    # What the intent filter's operator model is fitted on (`studies.intent_fit`): teleop
+    # under every pilot, on tuning seeds, at K = 4 and 100.
+    **{f"hsr_reach_goals_{goals}_teleop_tuning": [
+        "diagrams/hsr_reach.yaml", "--goals", str(goals), "--methods", "teleop", "--trials",
+        "16", "--split", "tuning", "--pilots", ",".join(PILOT_NAMES)] for goals in (4, 100)},
     # A participant that first heads for a wrong object, now and then (impaired.md).
     "hsr_reach_goals_100_groups_mistaken": [
         "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, "--methods",

@@ -18,6 +18,7 @@ import sys
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed, yaml_load
 
+from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.builder.run import TaskResult
@@ -76,7 +77,8 @@ def plain(value):
 _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects": 0},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3},
                  "goal_estimator": {"group_mass": 0.0, "commit_radius": 0.05,
-                                    "commit_probability": 0.8}}
+                                    "commit_probability": 0.8,
+                                    "intent_filter": plain(IntentFilterSettings())}}
 # A station's field renamed since folders were written: hashed under its old name, so that
 # those folders keep their hash (an arm's station fields are the robot's own).
 _HASHED_AS = {"control_period": "command_period"}

@@ -26,7 +26,8 @@ from pbp_drake.systems.operators import (
     VirtualOperator)
 from pbp_drake.systems.pbp import (
     Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalGrouping, GoalsSource, HandOver,
-    HeadingCommand, HopAssistance, LikelyGoals, MaxEntGoalEstimator, PoseBlender, PoseDmpBank,
+    HeadingCommand, HopAssistance, IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator,
+    PoseBlender, PoseDmpBank,
     PoseGoalEstimator, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator)
 from pbp_drake.systems.sample_hold import SampleHold
 from pbp_drake.systems.tasks import (
@@ -38,8 +39,8 @@ from pbp_drake.systems.visualizers import (
 __all__ = [
     # The PBP loop.
     "Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalGrouping", "GoalsSource",
-    "HandOver", "HeadingCommand", "LikelyGoals", "PoseBlender", "PoseDmpBank", "PoseGoalEstimator",
-    "PoseHandOver",
+    "HandOver", "HeadingCommand", "IntentFilterGoalEstimator", "LikelyGoals", "PoseBlender",
+    "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver",
     # The shared-autonomy baselines (HOP, predict-then-assist) and PBP's maxent_command estimator.
     "HopAssistance", "MaxEntGoalEstimator", "PoseHopAssistance", "PoseMaxEntGoalEstimator",
     # Operators.

@@ -1,6 +1,7 @@
 """Goals the estimate cannot tell apart act as one (`core.goal_groups`, `GoalGrouping`): the
 robot heads for their probability-weighted point and commits to a goal, and shows it, only
-once the group allows."""
+once the group allows or the hand has reached the point, and keeps the commitment while the
+estimator selects that goal."""
 
 import numpy as np
 import pytest
@@ -76,13 +77,58 @@ def test_a_setting_out_of_range_is_refused_naming_it(settings, message):
     for name, value in settings.items():
         setattr(changed, name, value)
     with pytest.raises(ValueError, match=message):
-        GoalGrouping(3, changed)
+        GoalGrouping(3, changed, 0.03)
+
+
+def test_the_hand_at_the_groups_point_commits_to_the_selected_goal():
+    goals = [[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [3.0, 0.0, 0.7]]
+    away = group_target(np.asarray(goals), np.array([0.48, 0.48, 0.04]), 1, **SETTINGS,
+                        hand=np.array([0.5, 0.0, 0.7]))
+    assert away.shown == NO_GOAL
+    there = group_target(np.asarray(goals), np.array([0.48, 0.48, 0.04]), 1, **SETTINGS,
+                         hand=np.array([1.0, 0.04, 0.7]))
+    assert there.shown == 1
+    np.testing.assert_array_equal(there.point, goals[1])
+
+
+def test_a_commitment_holds_while_the_same_goal_is_selected():
+    goals = np.array([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [3.0, 0.0, 0.7]])
+    probabilities = np.array([0.48, 0.48, 0.04])
+    held = group_target(goals, probabilities, 1, **SETTINGS, committed=1)
+    assert held.shown == 1
+    # Another goal selected: the commitment is gone, the group is followed again.
+    assert group_target(goals, probabilities, 0, **SETTINGS, committed=1).shown == NO_GOAL
+
+
+def fixed_grouping(goals, probabilities, selected, hand):
+    system = GoalGrouping(len(goals), GoalEstimatorSettings(**SETTINGS), 0.03)
+    context = system.CreateDefaultContext()
+    system.get_goals_input_port().FixValue(context, np.asarray(goals, float).reshape(-1))
+    system.get_goal_probabilities_input_port().FixValue(context, probabilities)
+    system.get_selected_goal_input_port().FixValue(context, [float(selected)])
+    system.get_ee_state_input_port().FixValue(context, np.concatenate([hand, np.zeros(5)]))
+    return system, context
+
+
+def test_the_system_keeps_its_commitment_when_the_hand_leaves_the_groups_point():
+    goals = [[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [3.0, 0.0, 0.7]]
+    system, context = fixed_grouping(goals, [0.48, 0.48, 0.04], 1, [1.0, 0.0, 0.7])
+    assert system.get_shown_goal_output_port().Eval(context)[0] == 1
+    # The tick's update keeps the commitment in the state ...
+    context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context).value())
+    # ... so the hand heading on to the goal, away from the point, still shows it.
+    system.get_ee_state_input_port().FixValue(context, np.array([1.0, -0.3, 0.7, 0, 0, 0, 0,
+                                                                 0]))
+    assert system.get_shown_goal_output_port().Eval(context)[0] == 1
+    np.testing.assert_array_equal(
+        system.get_followed_goals_output_port().Eval(context).reshape(3, 3)[1], goals[1])
 
 
 def test_the_system_moves_the_selected_goals_row_and_shows_none_until_committed():
     goals = np.array([[1.0, 0.5, 0.7], [1.0, -0.5, 0.7], [3.0, 0.0, 0.7]])
-    system = GoalGrouping(3, GoalEstimatorSettings(**SETTINGS))
+    system = GoalGrouping(3, GoalEstimatorSettings(**SETTINGS), 0.03)
     context = system.CreateDefaultContext()
+    system.get_ee_state_input_port().FixValue(context, np.zeros(8))
     system.get_goals_input_port().FixValue(context, goals.reshape(-1))
     system.get_goal_probabilities_input_port().FixValue(context, [0.48, 0.48, 0.04])
     system.get_selected_goal_input_port().FixValue(context, [1.0])

@@ -27,9 +27,10 @@ from pbp_drake_bench.cases import (
     MOTION_DURATIONS, bank_math_step, leaf_simulator, make_bank, make_case, motion_timing)
 from pbp_drake_bench.checks import CHECKS, evaluate, exit_code, format_results, summary
 from pbp_drake_bench.closed_loop import split_run
+from pbp_drake_bench.estimators import estimator_steps
 from pbp_drake_bench.pinning import MARKER, THREAD_VARIABLES, blas_threads
 from pbp_drake_bench.main import _parse, plan
-from pbp_drake_bench.table import format_report
+from pbp_drake_bench.table import format_estimators, format_report
 from pbp_drake_bench.time_split import BANK, DRAWING, IK, ORDER, REST, category_of, split_stats
 from pbp_drake_bench.timing import timed_span
 from pbp_drake_bench.ws_reader import MeshcatReader, send_mark
@@ -100,6 +101,17 @@ def _replay(small=2.9e6, large=3.0e6):
                                          {"goals": 1000, "bytes": large}]}
 
 
+ESTIMATOR = ("K=10,000 goals: the intent_filter estimator with goal groups, a control "
+             "period's step <= 2x the angle estimator's (same run)")
+
+
+def _estimators(ratio=1.7):
+    return {"goals": 10000, "period_s": 0.03, "rows": [
+        {"estimator": "angle", "groups": False, "step_us": 1000.0, "vs_angle": 1.0},
+        {"estimator": "intent_filter + groups", "groups": True, "step_us": 1000.0 * ratio,
+         "vs_angle": ratio}]}
+
+
 def _all_cases(leaf_us=500.0):
     rows = [_row(3, goals, weights, leaf_us) for goals in (1000, 10000, 100000)
             for weights in ("distinct", "shared")]
@@ -107,9 +119,10 @@ def _all_cases(leaf_us=500.0):
     return rows, _closed_loop()
 
 
-def _verdicts(closed_loop, replay=None, rows=None):
+def _verdicts(closed_loop, replay=None, rows=None, estimators=None):
     rows = rows if rows is not None else _all_cases()[0]
-    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay)
+    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay,
+                       estimators if estimators is not None else _estimators())
     return {r["check"]: r["verdict"] for r in results}
 
 
@@ -124,7 +137,8 @@ def test_the_closed_loop_check_reads_the_shipped_robot_not_the_dynamic_one():
 
 def test_every_check_passes_and_the_exit_code_is_0():
     rows, closed_loop = _all_cases()
-    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, _replay())
+    results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, _replay(),
+                       _estimators())
     assert [r["verdict"] for r in results] == ["pass"] * len(CHECKS)
     assert exit_code(results) == 0
 
@@ -143,17 +157,19 @@ def test_a_slow_step_fails_its_check_and_the_exit_code_is_1():
 
 def test_missing_peers_are_skipped_neither_passed_nor_failed():
     rows, closed_loop = _all_cases()
-    results = evaluate(rows, closed_loop, installed=set(), replay=_replay())
+    results = evaluate(rows, closed_loop, installed=set(), replay=_replay(),
+                       estimators=_estimators())
     skipped = {r["check"]: r["reason"] for r in results if r["verdict"] == "skipped"}
     assert len(skipped) == 2
     assert set(skipped.values()) == {"pydmps, movement_primitives not installed",
                                      "movement_primitives not installed"}
     assert exit_code(results) == 0
     assert summary(results).startswith(
-        "Checks: 10 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
+        "Checks: 11 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
         " movement_primitives not installed: 1)")
     # One peer is enough for the per-goal check.
-    results = evaluate(rows, closed_loop, installed={"pydmps"}, replay=_replay())
+    results = evaluate(rows, closed_loop, installed={"pydmps"}, replay=_replay(),
+                       estimators=_estimators())
     assert [r["verdict"] for r in results].count("skipped") == 1
 
 
@@ -167,7 +183,8 @@ def test_quick_keeps_every_check_with_the_same_limits():
                        for k in settings["hsr_goals"]
                        for meshcat in ((False, True) if settings["meshcat"] else (False,))]
         replay = {"runs": [{"goals": k, "bytes": 1e6} for k in settings["replay_goals"]]}
-        results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay)
+        results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay,
+                           _estimators() if settings["estimators"] else None)
         assert [(r["check"], r["limit"], r["verdict"]) for r in results] == [
             (check.name, check.limit, "pass") for check in CHECKS]
     assert quick["min_time"] < full["min_time"]
@@ -206,6 +223,29 @@ def test_the_closed_loop_checks_pass_fail_and_skip():
                                 "--hsr-goals/--tasks")
     assert reasons[REPLAY].startswith("not measured: no replays of K=4, 1,000")
     assert {r["check"]: r["verdict"] for r in results}[REACH_1K] == "pass"
+
+
+def test_the_intent_filters_step_is_checked_against_the_angle_estimators_of_the_same_run():
+    rows, closed_loop = _all_cases()
+    assert _verdicts(closed_loop, _replay(), rows, _estimators(1.9))[ESTIMATOR] == "pass"
+    assert _verdicts(closed_loop, _replay(), rows, _estimators(2.1))[ESTIMATOR] == "fail"
+    skipped = evaluate(rows, closed_loop, set(), None, _replay())
+    assert {r["check"]: r["reason"] for r in skipped}[ESTIMATOR] == (
+        "not measured: no goal estimator steps (--no-estimators)")
+
+
+@pytest.mark.slow
+def test_every_estimator_steps_in_its_own_simulator_at_k_goals():
+    """The bench's estimator rows, at a small K: every shipped estimator that reads the hand
+    (and the operator), with and without goal groups, against the angle estimator."""
+    estimators = estimator_steps(0.01, goal_count=100)
+    rows = {row["estimator"]: row for row in estimators["rows"]}
+    assert set(rows) == {"angle", "angle + groups", "nearest", "bayesian", "maxent_command",
+                         "intent_filter", "intent_filter + groups"}
+    assert rows["angle"]["vs_angle"] == 1.0
+    assert all(row["step_us"] > 0.0 for row in rows.values())
+    text = "\n".join(format_estimators(estimators))
+    assert "intent_filter + groups" in text and "K = 100 goals" in text
 
 
 def test_the_pose_step_limit_is_0_7_ms():

@@ -1,6 +1,6 @@
 """HOP's systems in small diagrams: the goal posterior (`MaxEntGoalEstimator`,
-`PoseMaxEntGoalEstimator`) keeps the core's recursive belief tick by tick, in the Context
-alone; the assistance (`HopAssistance`, `PoseHopAssistance`) sends the operator's command
+`PoseMaxEntGoalEstimator`) and the intent filter (`IntentFilterGoalEstimator`) keep the
+core's recursive belief tick by tick, in the Context alone; the assistance (`HopAssistance`, `PoseHopAssistance`) sends the operator's command
 plus HOP's action, and predict-then-assist the operator's alone until it is confident."""
 
 import numpy as np
@@ -14,8 +14,10 @@ from pbp_drake.core import quaternion
 from pbp_drake.core.grasp_task import side_grasp_orientation
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, assisted_command, hop_targets, uniform_log_belief, update_posterior)
+from pbp_drake.core.intent_filter import IntentFilterSettings, filter_step, intent_features
 from pbp_drake.systems import (
-    HopAssistance, MaxEntGoalEstimator, PoseHopAssistance, PoseMaxEntGoalEstimator)
+    HopAssistance, IntentFilterGoalEstimator, MaxEntGoalEstimator, PoseHopAssistance,
+    PoseMaxEntGoalEstimator)
 
 PERIOD = 0.03
 SETTINGS = HopSettings()
@@ -64,6 +66,43 @@ def test_the_estimator_keeps_the_cores_recursive_belief_tick_by_tick():
         np.testing.assert_allclose(outputs(estimator, simulator)[1], np.exp(log_belief),
                                    rtol=0, atol=1e-14)
     assert outputs(estimator, simulator)[0] == 0
+
+
+@pytest.mark.parametrize("active", [1.0, 0.0])
+def test_the_intent_filter_keeps_the_cores_belief_tick_by_tick(active):
+    """`IntentFilterGoalEstimator` (the ``intent_filter`` estimator): the core's filter on
+    the operator's command and yaw rate while it acts, and on the hand's own velocity (no
+    turn) while it is silent, the hand's heading both ways."""
+    settings = IntentFilterSettings(silence_rate=20.0)  # a silence read too
+    hand_velocity = np.array([0.0, 0.1, 0.0])  # toward the third goal
+    heading = 0.3
+    builder = DiagramBuilder()
+    estimator = builder.AddSystem(IntentFilterGoalEstimator(len(GOALS), settings, PERIOD))
+    builder.Connect(constant(builder, np.concatenate([HAND, hand_velocity, [heading, 0.0]])),
+                    estimator.get_ee_state_input_port())
+    builder.Connect(constant(builder, GOALS.reshape(-1)), estimator.get_goals_input_port())
+    builder.Connect(constant(builder, np.append(TOWARD_FIRST, 0.4)),
+                    estimator.get_operator_command_input_port())
+    builder.Connect(constant(builder, [active]), estimator.get_operator_active_input_port())
+    simulator = Simulator(builder.Build())
+    simulator.Initialize()
+    log_belief = uniform_log_belief(3)
+    motion, yaw_rate = (TOWARD_FIRST, 0.4) if active else (hand_velocity, 0.0)
+    for tick in range(40):
+        simulator.AdvanceTo(tick * PERIOD + 1e-4)
+        update = filter_step(settings, log_belief, intent_features(
+            GOALS, HAND, motion, heading, yaw_rate, PERIOD, settings.min_speed, bool(active)),
+            PERIOD)
+        log_belief = update.log_belief
+        np.testing.assert_allclose(outputs(estimator, simulator)[1], update.probabilities,
+                                   rtol=0, atol=1e-14)
+    assert outputs(estimator, simulator)[0] == (0 if active else 2)
+
+
+def test_the_intent_filter_takes_its_own_settings():
+    with pytest.raises(ValueError, match="settings must be IntentFilterSettings, got "
+                                         "HopSettings"):
+        IntentFilterGoalEstimator(len(GOALS), SETTINGS, PERIOD)
 
 
 @pytest.mark.slow

@@ -1,6 +1,7 @@
 """The PBP loop's systems: the DMP banks, the goal estimators, the blenders and the hand-over,
-in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`, and `GoalGrouping`
-for scenes of many goals) and the six-DoF
+in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`, and for scenes of
+many goals `GoalGrouping` and the ``intent_filter`` estimator, `IntentFilterGoalEstimator`)
+and the six-DoF
 pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`, `PoseHandOver`); the goals'
 source, the heading command of the HSR tasks, the demonstration player of explicit
 arbitration and the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy
@@ -18,6 +19,7 @@ from pbp_drake.systems.pbp.hand_over import HandOver
 from pbp_drake.systems.pbp.heading_command import HeadingCommand
 from pbp_drake.systems.pbp.hop_assistance import HopAssistance
 from pbp_drake.systems.pbp.likely_goals import LikelyGoals
+from pbp_drake.systems.pbp.intent_filter_estimator import IntentFilterGoalEstimator
 from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator
 from pbp_drake.systems.pbp.pose_blender import PoseBlender
 from pbp_drake.systems.pbp.pose_dmp_bank import PoseDmpBank
@@ -28,7 +30,8 @@ from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstim
 
 __all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalGrouping",
            "GoalsSource",
-           "HandOver", "HeadingCommand", "HopAssistance", "LikelyGoals", "MaxEntGoalEstimator",
+           "HandOver", "HeadingCommand", "HopAssistance", "IntentFilterGoalEstimator",
+           "LikelyGoals", "MaxEntGoalEstimator",
            "PoseBlender",
            "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver", "PoseHopAssistance",
            "PoseMaxEntGoalEstimator"]

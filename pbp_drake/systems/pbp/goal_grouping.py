@@ -5,8 +5,9 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
-from pbp_drake.core.goal_groups import group_target
-from pbp_drake.systems.ports import PortGetters, checked_goal_count, goal_index
+from pbp_drake.core.goal_groups import NO_GOAL, group_target
+from pbp_drake.systems.ports import EeState, PortGetters, checked_goal_count, goal_index
+from pbp_drake.systems.tick import decide_offset
 
 
 class GoalGrouping(PortGetters, LeafSystem):
@@ -20,20 +21,24 @@ class GoalGrouping(PortGetters, LeafSystem):
         - goals
         - goal_probabilities
         - selected_goal
+        - ee_state
         output_ports:
         - followed_goals
         - shown_goal
 
     `settings` is the estimator's (`GoalEstimatorSettings`: `group_mass`, `commit_radius`,
     `commit_probability`). `goals` is the K goals `(K, 3)` row-major; `goal_probabilities`
-    and `selected_goal` are the estimator's. `followed_goals` is `goals` with the selected
-    goal's row moved to the group's point while the robot has not committed (what the DMP
-    bank steers to); `shown_goal` is `[index]`, the selected goal once committed, else
-    `NO_GOAL` (-1). Both come from one computation a change of the inputs (the estimator's
-    state: once a tick).
+    and `selected_goal` are the estimator's; `ee_state` the hand's `EeState` (its position
+    is read: the robot commits once the hand reaches the group's point). `followed_goals`
+    is `goals` with the selected goal's row moved to the group's point while the robot has
+    not committed (what the DMP bank steers to); `shown_goal` is `[index]`, the selected
+    goal once committed, else `NO_GOAL` (-1). Both come from one computation a change of
+    the inputs. The goal committed to is kept in the Context's state, updated every
+    `control_period` at the decide stage of the tick: a commitment holds while the
+    estimator selects the same goal.
     """
 
-    def __init__(self, goal_count, settings):
+    def __init__(self, goal_count, settings, control_period):
         super().__init__()
         self._goal_count = k = checked_goal_count(goal_count)
         if not isinstance(settings, GoalEstimatorSettings):
@@ -45,12 +50,18 @@ class GoalGrouping(PortGetters, LeafSystem):
         self._goals_port = self.DeclareVectorInputPort("goals", 3 * k)
         self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        if not (np.isfinite(control_period) and control_period > 0.0):
+            raise ValueError(f"control_period must be positive, got {control_period!r}")
+        self._committed_index = self.DeclareDiscreteState(np.array([float(NO_GOAL)]))
+        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period),
+                                                decide_offset(control_period), self._commit)
         # [followed goals (3 K), shown index]: computed once for both outputs.
         self._target = self.DeclareCacheEntry(
             "followed goals and the shown goal",
             ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(3 * k + 1)),
                           calc=self._calc_target),
-            prerequisites_of_calc={self.all_input_ports_ticket()})
+            prerequisites_of_calc={self.all_input_ports_ticket(), self.xd_ticket()})
         self.DeclareVectorOutputPort(
             "followed_goals", 3 * k,
             lambda context, output: output.SetFromVector(self._target.Eval(context)[:-1]),
@@ -60,11 +71,16 @@ class GoalGrouping(PortGetters, LeafSystem):
             lambda context, output: output.SetAtIndex(0, self._target.Eval(context)[-1]),
             prerequisites_of_calc={self._target.ticket()})
 
+    def _commit(self, context, discrete_state):
+        discrete_state.set_value(self._committed_index, [self._target.Eval(context)[-1]])
+
     def _calc_target(self, context, value):
         goals = self._goals_port.Eval(context).reshape(self._goal_count, 3)
         selected = goal_index(self._selected_port, context, self._goal_count)
-        target = group_target(goals, self._probabilities_port.Eval(context), selected,
-                              *self._settings)
+        target = group_target(
+            goals, self._probabilities_port.Eval(context), selected, *self._settings,
+            hand=self._ee_state_port.Eval(context)[:3],
+            committed=int(context.get_discrete_state(self._committed_index).value()[0]))
         result = value.get_mutable_value()
         result[:-1] = goals.reshape(-1)
         result[3 * selected:3 * selected + 3] = target.point

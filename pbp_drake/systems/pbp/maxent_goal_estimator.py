@@ -59,8 +59,9 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
             raise ValueError(f"operator_speed must be positive, got {operator_speed!r}")
         self._operator_speed = None if operator_speed is None else float(operator_speed)
         goal_count = checked_goal_count(goal_count)
-        if not isinstance(settings, HopSettings):
-            raise ValueError(f"settings must be a HopSettings, got {type(settings).__name__}")
+        if not isinstance(settings, self._SETTINGS):
+            raise ValueError(f"settings must be {self._SETTINGS.__name__}, got "
+                             f"{type(settings).__name__}")
         settings.validate()
         if not (np.isfinite(control_period) and control_period > 0.0):
             raise ValueError(f"control_period must be positive, got {control_period!r}")
@@ -70,6 +71,7 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
             raise ValueError(f"hold_steps must be an integer >= 1, got {hold_steps!r}")
         if update_offset is None:
             update_offset = decide_offset(control_period)
+        self._period = float(control_period)
         k = self._goal_count = int(goal_count)
         # A copy: the settings are a plain (mutable) dataclass the caller may change later.
         self._settings = dataclasses.replace(settings)
@@ -111,10 +113,27 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
     def hold_steps(self):
         return self._hold_steps
 
+    #: The type of the posterior's settings.
+    _SETTINGS = HopSettings
+
     def _update(self, context, discrete_state):
         state = context.get_discrete_state()
         read = self._inputs(context)
-        log_belief = state.value(self._log_belief_index)
+        update = self._posterior(context, read, state.value(self._log_belief_index))
+        challenger, count = state.value(self._memory_index)
+        memory = update_selection(
+            update.probabilities,
+            SelectionMemory(int(state.value(self._selected_index)[0]), int(challenger),
+                            int(count)),
+            self._margin, self._hold_steps)
+        discrete_state.set_value(self._log_belief_index, update.log_belief)
+        discrete_state.set_value(self._probabilities_index, update.probabilities)
+        discrete_state.set_value(self._selected_index, [memory.selected])
+        discrete_state.set_value(self._memory_index, [memory.challenger, memory.count])
+        discrete_state.set_value(self._clipped_index, [1.0 if update.clipped else 0.0])
+
+    def _posterior(self, context, read, log_belief):
+        """This tick's update of the belief (with `log_belief`, `probabilities`, `clipped`)."""
         if self._operator_speed is None:
             update = update_posterior(self._settings, read.targets, log_belief, read.position,
                                       read.command, read.orientation,
@@ -129,17 +148,7 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
                 read.command_angular_velocity if active else read.hand_angular_velocity)
             update = update_intent_posterior(self._settings, read.targets, log_belief,
                                              evidence)
-        challenger, count = state.value(self._memory_index)
-        memory = update_selection(
-            update.probabilities,
-            SelectionMemory(int(state.value(self._selected_index)[0]), int(challenger),
-                            int(count)),
-            self._margin, self._hold_steps)
-        discrete_state.set_value(self._log_belief_index, update.log_belief)
-        discrete_state.set_value(self._probabilities_index, update.probabilities)
-        discrete_state.set_value(self._selected_index, [memory.selected])
-        discrete_state.set_value(self._memory_index, [memory.challenger, memory.count])
-        discrete_state.set_value(self._clipped_index, [1.0 if update.clipped else 0.0])
+        return update
 
 
 class MaxEntGoalEstimator(CommandPosteriorBase):

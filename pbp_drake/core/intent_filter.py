@@ -1,0 +1,217 @@
+"""The ``intent_filter`` goal estimator, in pure NumPy: a recursive Bayesian posterior over
+the K goals on what the operator does, with a hazard that keeps it from becoming certain for
+good, and the hand's present heading read on top.
+
+The operator is a hidden Markov chain over the goals: each tick of `dt` seconds it keeps its
+goal, or with probability `h = 1 - exp(-switch_rate dt)` picks one anew (uniformly). Its
+evidence, read every tick from the hand's position `p`, the hand's heading `psi` (rad, on
+the floor plane) and the operator's inputs:
+
+- **motion** `w`: the operator's command while it acts (a correction, or teleoperation), and
+  the hand's own executed velocity while it is silent (letting the robot go on is evidence
+  for the goal the robot is going to, weighed by `silence_rate`). Its feature is `m_g = 1 -
+  2 a_g / pi`, `a_g` the angle between `w` and the direction `g - p` (1 straight at g, 0
+  across, -1 away); 0 while `|w| < min_speed` (no direction), or within `min_speed dt` of
+  g. Linear in the angle, not its cosine: goals a few degrees apart differ as much near
+  the direction of motion as anywhere (a cosine is flat there).
+- **turns**: with the operator's yaw rate `r` (while it acts) the bearing error `e_g =
+  wrap(beta_g - psi)` (`beta_g` the floor bearing of g from `p`) becomes `e'_g = wrap(e_g -
+  r dt)`, and `t_g = (|e_g| - |e'_g|) / |r dt|` lies between +1 (a turn wholly toward g)
+  and -1 (wholly away); 0 while `r = 0`.
+- **heading** (where the hand points now): `h_g = 1 - 2 |e_g| / pi` (1 for a goal straight
+  above or below the hand, which it is already at).
+
+Motions and turns are events: each tick's adds to the belief, at a rate (nats per second,
+so that the evidence does not depend on the control rate). The heading is a state that
+persists, and seeing it again every tick is no new evidence: it is read once, as the
+present observation, on top of the recursive belief and not into it:
+
+    log b_t(g) = log((1 - h) b_{t-1}(g) + h / K) + dt (move_rate m_g + turn_rate t_g)
+                 (silent: + dt silence_rate m_g)
+    log P_t(g) = log b_t(g) + heading_weight h_g,
+
+each normalised and its largest probability clipped at `max_probability` with the excess
+spread over the others (as HOP's posterior). `b` is the estimator's state, `P` its
+probabilities. The hazard is the floor against runaway confidence: after the prediction no
+goal is below `h / K`, so a belief built over any time is overturned by a bounded time of
+evidence against it (`pbp_drake.studies.runaway` measures it).
+
+The rates, the heading's weight and the switch rate are the operator model's parameters,
+fitted on the tuning seeds of teleop under the arena's pilots (never on PBP's trials) by
+`python -m pbp_drake.studies.intent_fit`, which maximises the mean log probability the
+filter gives the participant's own target, tick by tick; the shipped defaults are its
+output. `silence_rate` is not fitted (under teleop a silence leaves the hand still) and is
+0 by default: a silence is no evidence, and the belief drifts back toward uniform at the
+switch rate while the present heading carries the estimate. Vectorised over K (no Python
+loop over goals), in log space.
+"""
+
+import dataclasses
+import math
+import typing
+
+import numpy as np
+
+
+# A goal closer than this (m) to the hand on the floor plane has no bearing.
+NO_BEARING = 1e-9
+
+
+@dataclasses.dataclass
+class IntentFilterSettings:
+    """The ``intent_filter`` estimator's operator model (scenario files: the
+    `goal_estimator` section's `intent_filter`). The rates are nats per second of evidence
+    for a goal the feature points straight at (1) over one it points across (0), and as
+    much against one it points away from (-1); all but `silence_rate`, `max_probability`
+    and `min_speed` are `pbp_drake.studies.intent_fit`'s fit."""
+
+    #: The weight of the operator's command (nats/s) while it acts.
+    move_rate: float = 128.0
+    #: The weight of where the hand points now (nats, not per second: an observation of
+    #: the hand's present heading, which persists, is not new evidence every tick).
+    heading_weight: float = 4.0
+    #: The turn's weight (nats/s): turning the hand toward a goal.
+    turn_rate: float = 8.0
+    #: The weight (nats/s) of the robot's motion while the operator is silent (0: a silence
+    #: is no evidence).
+    silence_rate: float = 0.0
+    #: How often the operator changes its goal (1/s): the filter's hazard.
+    switch_rate: float = 1.0
+    #: No goal's probability goes above this (the clip against certainty).
+    max_probability: float = 0.99
+    #: A motion slower than this (m/s) has no direction.
+    min_speed: float = 0.01
+
+    def validate(self):
+        """Raises ValueError naming the first field that cannot be used."""
+        for name in ("move_rate", "heading_weight", "turn_rate", "silence_rate",
+                     "switch_rate", "min_speed"):
+            value = getattr(self, name)
+            if not _is_real(value) or not math.isfinite(value) or value < 0.0:
+                raise ValueError(f"intent_filter.{name} must be a finite number >= 0, got "
+                                 f"{value!r}")
+        if not (_is_real(self.max_probability) and 0.0 < self.max_probability <= 1.0):
+            raise ValueError(f"intent_filter.max_probability must lie in (0, 1], got "
+                             f"{self.max_probability!r}")
+
+
+def _is_real(value):
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, bool)
+
+
+class IntentFeatures(typing.NamedTuple):
+    """One tick's features per goal, each (K,) in [-1, 1]: `moves`, `headings`, `turns`;
+    and whether the operator `acts` (else the moves are the robot's)."""
+
+    moves: np.ndarray
+    headings: np.ndarray
+    turns: np.ndarray
+    acts: bool = True
+
+
+class FilterUpdate(typing.NamedTuple):
+    """One update: the new recursive `log_belief` (K,) (the state), the `probabilities`
+    (K,) with the present heading read, and whether their clip was active (`clipped`)."""
+
+    log_belief: np.ndarray
+    probabilities: np.ndarray
+    clipped: bool
+
+
+def intent_features(goals, position, motion, heading, yaw_rate, period, min_speed, acts=True):
+    """The `IntentFeatures` of the K `goals` (K, 3) for the hand at `position` (3) heading
+    `heading` (rad), the `motion` (3, m/s: the operator's command when it `acts`, else the
+    hand's own velocity) and the operator's `yaw_rate` (rad/s) over one `period` (s)."""
+    offsets = goals - position
+    distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+    speed = float(np.linalg.norm(motion))
+    if speed >= min_speed:
+        reach = np.maximum(distances, min_speed * period)
+        moves = _straightness(np.arccos(np.clip((offsets @ motion) / (reach * speed),
+                                                -1.0, 1.0)))
+        moves[distances < min_speed * period] = 0.0
+    else:
+        moves = np.zeros(len(goals))
+    has_bearing = np.hypot(offsets[:, 0], offsets[:, 1]) > NO_BEARING
+    error = _wrapped(np.arctan2(offsets[:, 1], offsets[:, 0]) - heading)
+    headings = np.where(has_bearing, _straightness(np.abs(error)), 1.0)
+    turn = yaw_rate * period
+    if turn == 0.0:
+        turns = np.zeros(len(goals))
+    else:
+        turns = np.where(has_bearing, (np.abs(error) - np.abs(_wrapped(error - turn)))
+                         / abs(turn), 0.0)
+    return IntentFeatures(moves, headings, turns, bool(acts))
+
+
+def _straightness(angles):
+    """`1 - 2 angle / pi`: 1 straight at a goal, 0 across, -1 straight away."""
+    return 1.0 - (2.0 / math.pi) * angles
+
+
+def _wrapped(angles):
+    return (np.asarray(angles) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def switch_probability(settings, period):
+    """`h = 1 - exp(-switch_rate dt)`: the chance the operator picks its goal anew in a tick."""
+    return -math.expm1(-settings.switch_rate * period)
+
+
+def filter_step(settings, log_belief, features, period):
+    """One tick of the filter (the module docstring's update): the `FilterUpdate` from the
+    last recursive `log_belief` (K,) and this tick's `IntentFeatures`."""
+    weights = np.array([[settings.move_rate, settings.turn_rate, settings.silence_rate,
+                         settings.heading_weight]])
+    update = filter_update(np.asarray(log_belief, dtype=float)[np.newaxis], features,
+                           weights, np.array([switch_probability(settings, period)]),
+                           settings.max_probability, period)
+    return FilterUpdate(update.log_belief[0], update.probabilities[0],
+                        bool(update.clipped[0]))
+
+
+def filter_update(log_beliefs, features, weights, hazards, max_probability, period):
+    """`filter_step` for B operator models at once (the fit's sweep): `log_beliefs` (B, K)
+    the recursive beliefs, `weights` (B, 4) the move, turn and silence rates and the
+    heading's weight, `hazards` (B,) the switch probabilities. Returns a `FilterUpdate`
+    of (B, K) arrays (`clipped` (B,))."""
+    count = log_beliefs.shape[1]
+    hazards = hazards[:, np.newaxis]
+    with np.errstate(divide="ignore"):
+        predicted = np.logaddexp(log_beliefs + np.log1p(-hazards), np.log(hazards / count))
+    if features.acts:
+        evidence = weights[:, 0:1] * features.moves + weights[:, 1:2] * features.turns
+    else:  # silent: the robot's motion at the silence's rate
+        evidence = weights[:, 2:3] * features.moves
+    recursive, _ = clip_log_beliefs(_normalised(predicted + period * evidence),
+                                    max_probability)
+    pointed, clipped = clip_log_beliefs(
+        _normalised(recursive + weights[:, 3:4] * features.headings), max_probability)
+    return FilterUpdate(recursive, np.exp(pointed), clipped)
+
+
+def _normalised(log_beliefs):
+    largest = log_beliefs.max(axis=1, keepdims=True)
+    return log_beliefs - (largest + np.log(np.exp(log_beliefs - largest).sum(axis=1,
+                                                                           keepdims=True)))
+
+
+def clip_log_beliefs(log_beliefs, max_probability):
+    """`hindsight_optimization.clip_log_belief` row by row of (B, K) normalised log
+    beliefs: each row's largest probability set to `max_probability` when above it, the
+    excess spread evenly over the row's other goals. Returns the rows and which were
+    clipped (B,); one goal alone is never clipped."""
+    rows, count = log_beliefs.shape
+    best = np.argmax(log_beliefs, axis=1)
+    top = log_beliefs[np.arange(rows), best]
+    clipped = (top > math.log(max_probability)) & (count > 1)
+    if not clipped.any():
+        return log_beliefs, clipped
+    log_beliefs = log_beliefs.copy()
+    excess = np.exp(top[clipped]) - max_probability
+    with np.errstate(divide="ignore"):
+        share = np.log(excess / (count - 1))[:, np.newaxis]
+    log_beliefs[clipped] = np.logaddexp(log_beliefs[clipped], share)
+    log_beliefs[np.flatnonzero(clipped), best[clipped]] = math.log(max_probability)
+    return log_beliefs, clipped

@@ -1,0 +1,180 @@
+"""Fits the ``intent_filter`` estimator's operator model (`pbp_drake.core.intent_filter`) on
+recorded trials: `python -m pbp_drake.studies.intent_fit FOLDER...`.
+
+The folders are study folders (`pbp-drake study`, pilots' sub-folders included); the fit
+reads only their teleop trials, whose every motion is the operator's own. It replays the
+filter over each trial, tick by tick, on the recorded hand position, heading and operator
+inputs, and scores a model by the mean, over trials, of the mean log probability it gives the
+target the participant was heading for at each tick (a proper score: it rewards a calibrated
+belief, neither a timid nor an overconfident one). The move and turn rates, the heading's
+weight and the switch rate are fitted over fixed grids (`GRIDS`) by coordinate ascent, one
+parameter's grid at a time in one batched replay, until a round changes nothing. Not fitted:
+`silence_rate` (under teleop a silence leaves the hand still, so teleop cannot show what a
+silence says while the robot moves), the clip (`max_probability`, HOP's published 0.99)
+and the slowest motion.
+
+Each source is fitted alone (the filter reading that source only; the motion and the turns
+with a switch rate of their own), and then the switch rate with all three. Fitted jointly,
+the heading would get no weight: under teleop the operator's motion says nearly all its
+heading says. Under PBP the operator is silent most of the time, and the hand's heading (set
+by its turns) is then the evidence left, so its weight has to be what the heading alone
+tells of the target.
+
+`make results` runs the tuning studies it is fitted on (`hsr_reach_goals_4_teleop_tuning`,
+`hsr_reach_goals_100_teleop_tuning`: teleop under every pilot, tuning seeds), and the
+shipped defaults of `IntentFilterSettings` are this command's output on them.
+"""
+
+import argparse
+import dataclasses
+import pathlib
+import sys
+import typing
+
+import numpy as np
+
+from pbp_drake.core.intent_filter import (
+    IntentFeatures, IntentFilterSettings, filter_update, intent_features)
+from pbp_drake.studies.trial_files import load_task_result
+
+#: The values each fitted parameter is chosen from.
+GRIDS = {"move_rate": (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0),
+         "heading_weight": (0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 16.0),
+         "turn_rate": (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0),
+         "switch_rate": (0.003, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0)}
+FITTED = tuple(GRIDS)
+# The evidence sources, each fitted alone.
+SOURCES = ("move_rate", "heading_weight", "turn_rate")
+# The method whose trials are read: the operator's own motions alone.
+TELEOP = "teleop"
+MAX_ROUNDS = 6
+
+
+class Replay(typing.NamedTuple):
+    """One trial ready to replay: its features (each (T, K); `acts` (T,)), the target
+    index at each tick (T,), and the control period."""
+
+    features: IntentFeatures
+    targets: np.ndarray
+    period: float
+
+
+def teleop_trials(folders):
+    """The (output folder, seed) of every teleop trial under `folders` (pilots included)."""
+    found = []
+    for folder in folders:
+        folder = pathlib.Path(folder)
+        if not folder.is_dir():
+            raise ValueError(f"{folder}: no such folder")
+        for record in sorted(folder.glob(f"**/trials/{TELEOP}/seed_*.json")):
+            found.append((record.parents[2], int(record.stem.removeprefix("seed_"))))
+    if not found:
+        raise ValueError(f"no teleop trials under {', '.join(map(str, folders))} (a study "
+                         "folder of `pbp-drake study --methods teleop`)")
+    return found
+
+
+def replay_of(result, min_speed):
+    """A `Replay` of a trial's `TaskResult`: the motion is the operator's command while it
+    acts and the hand's own velocity (from its positions) while it is silent."""
+    times, positions = result.times, result.ee_positions
+    period = float(np.median(np.diff(times)))
+    hand_velocities = np.vstack([np.zeros(3), np.diff(positions, axis=0) / period])
+    commands = result.operator_commands
+    ticks = []
+    for tick in range(len(times)):
+        active = bool(result.operator_active[tick])
+        motion = commands[tick, :3] if active else hand_velocities[tick]
+        ticks.append(intent_features(result.objects, positions[tick], motion,
+                                     float(result.headings[tick]),
+                                     float(commands[tick, 3]) if active else 0.0, period,
+                                     min_speed, active))
+    return Replay(IntentFeatures(*(np.array(values) for values in zip(*ticks))),
+                  np.asarray(result.targets, dtype=int), period)
+
+
+def scores(replays, models):
+    """The score of each of `models` (a list of `IntentFilterSettings`): the mean over
+    trials of the mean log probability of the participant's target, in nats."""
+    weights = np.array([[m.move_rate, m.turn_rate, m.silence_rate, m.heading_weight]
+                        for m in models])
+    totals = np.zeros(len(models))
+    for replay in replays:
+        count = replay.features.moves.shape[1]
+        hazards = np.array([-np.expm1(-m.switch_rate * replay.period) for m in models])
+        log_beliefs = np.full((len(models), count), -np.log(count))
+        score, ticks = np.zeros(len(models)), 0
+        for tick, target in enumerate(replay.targets):
+            features = IntentFeatures(*(values[tick] for values in replay.features))
+            update = filter_update(log_beliefs, features, weights, hazards,
+                                   models[0].max_probability, replay.period)
+            log_beliefs = update.log_belief
+            if 0 <= target < count:
+                score += np.log(update.probabilities[:, target])
+                ticks += 1
+        totals += score / max(ticks, 1)
+    return totals / len(replays)
+
+
+def ascend(replays, start, names, log=None, label=""):
+    """`(settings, score)`: coordinate ascent from `start` over the `GRIDS` of `names`, one
+    parameter's grid at a time in one batched replay, until a round changes nothing."""
+    best = dataclasses.replace(start)
+    best_score = float(scores(replays, [best])[0])
+    for round_number in range(1, MAX_ROUNDS + 1):
+        changed = False
+        for name in names:
+            models = [dataclasses.replace(best, **{name: value}) for value in GRIDS[name]]
+            values = scores(replays, models)
+            index = int(np.argmax(values))
+            if log:
+                print(f"{label}round {round_number} {name}: " + ", ".join(
+                    f"{value:g}: {score:.4f}" for value, score in zip(GRIDS[name], values)),
+                    file=log)
+            if values[index] > best_score + 1e-12:
+                best, best_score, changed = models[index], float(values[index]), True
+        if not changed:
+            break
+    return best, best_score
+
+
+def fit(replays, log=None):
+    """`(settings, score)`: each source fitted alone (`SOURCES`: the filter reading that
+    source only; the motion and the turns each with a switch rate of its own), then the
+    switch rate with all of them."""
+    fitted = {}
+    for source in SOURCES:
+        alone = dataclasses.replace(IntentFilterSettings(), **{name: 0.0 for name in SOURCES})
+        names = (source,) if source == "heading_weight" else (source, "switch_rate")
+        settings, _ = ascend(replays, alone, names, log, f"{source} alone: ")
+        fitted[source] = getattr(settings, source)
+    return ascend(replays, dataclasses.replace(IntentFilterSettings(), **fitted),
+                  ("switch_rate",), log, "all: ")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m pbp_drake.studies.intent_fit",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("folders", nargs="+", help="study folders whose teleop trials the "
+                        "model is fitted on")
+    args = parser.parse_args(argv)
+    defaults = IntentFilterSettings()
+    try:
+        trials = teleop_trials(args.folders)
+        replays = [replay_of(load_task_result(output, TELEOP, seed), defaults.min_speed)
+                   for output, seed in trials]
+    except ValueError as error:
+        print(f"intent_fit: {error}", file=sys.stderr)
+        return 2
+    print(f"{len(replays)} teleop trials, {sum(len(r.targets) for r in replays)} ticks")
+    fitted, score = fit(replays, log=sys.stdout)
+    uniform = float(np.mean([-np.log(r.features.moves.shape[1]) for r in replays]))
+    print(f"mean log probability of the target: {score:.4f} nats (uniform: {uniform:.4f}; "
+          f"the shipped defaults: {float(scores(replays, [defaults])[0]):.4f})")
+    print("intent_filter: {" + ", ".join(f"{name}: {getattr(fitted, name):g}"
+                                        for name in FITTED) + "}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

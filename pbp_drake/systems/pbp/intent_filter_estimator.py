@@ -1,0 +1,61 @@
+"""The ``intent_filter`` goal estimator as a Drake system (`pbp_drake.core.intent_filter`):
+a recursive posterior over the K goals on the operator's motions, headings, turns and
+silences, with a hazard against runaway confidence."""
+
+import numpy as np
+
+from pbp_drake.core.intent_filter import IntentFilterSettings, filter_step, intent_features
+from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator, PosteriorInputs
+from pbp_drake.systems.ports import EeState, OperatorCommand
+
+
+class IntentFilterGoalEstimator(MaxEntGoalEstimator):
+    """The intent filter on the hand's position and heading and the operator's command.
+
+    .. pydrake_system::
+
+        name: IntentFilterGoalEstimator
+        input_ports:
+        - ee_state
+        - goals
+        - operator_command
+        - operator_active
+        output_ports:
+        - selected_goal
+        - goal_probabilities
+        - posterior_clipped
+
+    The ports are `MaxEntGoalEstimator`'s: `ee_state` an `EeState`, `goals` the K goals
+    flattened `(K, 3)`, `operator_command` `[vx, vy, vz, yaw_rate]`, `operator_active` 1
+    while the operator acts. Each update (the decide stage of the tick) reads the
+    operator's command as the motion while it acts, the hand's executed velocity while it
+    is silent, the yaw rate while it acts, and the hand's heading; the belief starts
+    uniform. `settings` is an `IntentFilterSettings`; `margin` and `hold_steps` are the
+    selection's hysteresis (the `goal_estimator` section's). `posterior_clipped` is `[1]`
+    when the last update hit `settings.max_probability`.
+    """
+
+    _SETTINGS = IntentFilterSettings
+
+    def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
+                 update_offset=None):
+        super().__init__(goal_count, settings, control_period, margin, hold_steps,
+                         update_offset)
+
+    def _inputs(self, context):
+        hand = self._ee_state_port.Eval(context)
+        command = self._command_port.Eval(context)
+        goals = self._goals_port.Eval(context).reshape(self._goal_count, 3)
+        return PosteriorInputs(goals, hand[:3], command[:3], hand[3:6],
+                               heading=float(EeState(hand).heading),
+                               yaw_rate=float(OperatorCommand(command).yaw_rate))
+
+    def _posterior(self, context, read, log_belief):
+        if not np.isfinite(read.targets).all():
+            raise ValueError("goals contain NaN or infinite values")
+        active = self._active_port.Eval(context)[0] > 0.5
+        features = intent_features(
+            read.targets, read.position, read.command if active else read.hand_velocity,
+            read.heading, read.yaw_rate if active else 0.0, self._period,
+            self._settings.min_speed, active)
+        return filter_step(self._settings, log_belief, features, self._period)

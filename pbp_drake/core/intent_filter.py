@@ -76,7 +76,7 @@ class IntentFilterSettings:
     #: is no evidence).
     silence_rate: float = 0.0
     #: How often the operator changes its goal (1/s): the filter's hazard.
-    switch_rate: float = 1.0
+    switch_rate: float = 3.0
     #: No goal's probability goes above this (the clip against certainty).
     max_probability: float = 0.99
     #: A motion slower than this (m/s) has no direction.

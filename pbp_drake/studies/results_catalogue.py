@@ -4,7 +4,8 @@
 docs/results/generated/NAME.md`. The first line of each generated file is the command below
 (read back from the study folder), so a table on the docs site cannot drift from what made it.
 The matrices of every method under every pilot (`ARENA_STUDIES`) also make the arena page,
-docs/results/arena.md (`studies.arena_page`), from their summaries.
+docs/results/arena.md (`studies.arena_page`), from their summaries, and the many-goals
+studies the K sweep's figure (`studies.many_goals_figure`).
 
 A study interrupted part-way resumes from the trials on disk when this runs again.
 """
@@ -17,6 +18,8 @@ import sys
 
 from pbp_drake.scenarios.pilots import PILOT_NAMES
 from pbp_drake.studies.arena_page import write_arena_page
+from pbp_drake.studies.many_goals_figure import ESTIMATORS, GOAL_COUNTS, plot_many_goals
+from pbp_drake.studies.many_goals_figure import FIGURE as MANY_GOALS_FIGURE
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE
 from pbp_drake.studies.report import BOX_FIGURES as DOCS_FIGURES
 
@@ -51,10 +54,10 @@ ARENA_TASKS = {"hsr_reach_arena": ("diagrams/hsr_reach.yaml", "Reaching", 30),
 # The reaching task with K candidate goals on a grid (docs/results/many-goals.md): PBP-Alt
 # following one goal at a time (the paper's) beside teleop, and PBP-Alt with goal groups;
 # on the HSR at K = 4, 100 and 1,000, and on the arm at K = 100.
-MANY_GOALS = (4, 100, 1000)
+MANY_GOALS = GOAL_COUNTS
 GROUPS = ["--set", "goal_estimator.group_mass=0.9"]
 # The shipped estimators beside `angle` that read the hand in the reaching task.
-OTHER_ESTIMATORS = ("nearest", "bayesian", "maxent_command", "intent_filter")
+OTHER_ESTIMATORS = tuple(estimator for estimator in ESTIMATORS if estimator != "angle")
 EVALUATION_30 = ["--trials", "30", "--split", "evaluation"]
 
 #: name -> the arguments of `pbp-drake study` (without --output and --jobs).
@@ -203,6 +206,10 @@ def main(argv=None):
     if any(name in ARENA_STUDIES for name in args.names or STUDIES):
         write_arena_page(ARENA_STUDIES, args.outputs, args.generated, args.arena)
         print(f"  wrote {args.arena}")
+    if any(name.startswith("hsr_reach_goals_") for name in args.names or STUDIES):
+        figure = pathlib.Path(args.generated) / MANY_GOALS_FIGURE
+        if plot_many_goals(args.outputs, figure):
+            print(f"  wrote {figure}")
     for line in failed:
         print(f"results: {line}", file=sys.stderr)
     return 1 if failed else 0

@@ -1,0 +1,105 @@
+"""The K sweep's figure (docs/results/many-goals.md): PBP-Alt's intervention ratio and task
+time over teleop's against the number of goals K, following one goal (the paper's) and with
+goal groups under each estimator, from the summaries of the catalogue's many-goals studies
+(`results_catalogue.MANY_GOALS`). `make results` draws it after those studies; drawn alone:
+`python -m pbp_drake.studies.many_goals_figure [--outputs DIR] [--figure PNG]`.
+"""
+
+import argparse
+import json
+import pathlib
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+#: The figure's file name beside the generated tables.
+FIGURE = "many_goals.png"
+GOAL_COUNTS = (4, 100, 1000)
+ESTIMATORS = ("angle", "nearest", "bayesian", "maxent_command", "intent_filter")
+
+
+def study_name(goals, estimator=None):
+    """The catalogue's study of K `goals`: following one goal (`estimator` None, with
+    teleop), or with goal groups under `estimator`."""
+    if estimator is None:
+        return f"hsr_reach_goals_{goals}"
+    return f"hsr_reach_goals_{goals}_groups" + ("" if estimator == "angle" else f"_{estimator}")
+
+
+def _method(outputs, name, method):
+    path = pathlib.Path(outputs) / name / "summary.json"
+    if not path.is_file():
+        return None
+    return json.loads(path.read_text())["methods"].get(method)
+
+
+def sweep(outputs):
+    """{label: [(K, intervention ratio, task time / teleop's)]} of every line that has its
+    studies on disk (teleop's own line at time ratio 1)."""
+    lines = {}
+    for label, estimator in [("PBP-Alt, one goal (angle)", None),
+                             *((f"PBP-Alt, groups, {e}", e) for e in ESTIMATORS)]:
+        points = []
+        for goals in GOAL_COUNTS:
+            teleop = _method(outputs, study_name(goals), "teleop")
+            pbp = _method(outputs, study_name(goals, estimator), "pbp_alternated")
+            if teleop and pbp:
+                points.append((goals, pbp["intervention_ratio"]["mean"],
+                               pbp["task_time"]["mean"] / teleop["task_time"]["mean"]))
+        if points:
+            lines[label] = points
+    teleop = [(goals, method["intervention_ratio"]["mean"], 1.0) for goals in GOAL_COUNTS
+              if (method := _method(outputs, study_name(goals), "teleop"))]
+    if teleop:
+        lines["teleop"] = teleop
+    return lines
+
+
+def plot_many_goals(outputs, figure):
+    """Draws the sweep into `figure`; returns False (and draws nothing) with no study on
+    disk."""
+    lines = sweep(outputs)
+    if not lines:
+        return False
+    fig, (intervention, time) = plt.subplots(1, 2, figsize=(10, 4))
+    for label, points in lines.items():
+        goals, ratio, time_ratio = zip(*points)
+        style = dict(marker="o", label=label, linestyle="--" if "teleop" in label or
+                     "one goal" in label else "-")
+        intervention.plot(goals, ratio, **style)
+        time.plot(goals, time_ratio, **style)
+    for axes, title in ((intervention, "intervention ratio"),
+                        (time, "task time / teleop's")):
+        axes.set_xscale("log")
+        axes.set_xticks(GOAL_COUNTS, [f"{k:,}" for k in GOAL_COUNTS])
+        axes.set_xlabel("goals K")
+        axes.set_title(title)
+        axes.grid(alpha=0.3)
+    intervention.set_ylim(0.0, 1.05)
+    time.legend(fontsize=7, loc="upper left")
+    fig.suptitle("Reaching with K goals on a grid, evaluation seeds (means over 30 trials)")
+    fig.tight_layout()
+    pathlib.Path(figure).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(figure, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m pbp_drake.studies.many_goals_figure",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("--outputs", default="outputs/results",
+                        help="the catalogue's study folders (default outputs/results)")
+    parser.add_argument("--figure", default=f"docs/results/generated/{FIGURE}",
+                        help=f"the figure to write (default docs/results/generated/{FIGURE})")
+    args = parser.parse_args(argv)
+    if not plot_many_goals(args.outputs, args.figure):
+        parser.error(f"no many-goals study under {args.outputs} (make results runs them)")
+    print(f"  wrote {args.figure}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -81,9 +81,9 @@ CHECKS = (
     Check(f"HSR grasping task (six-DoF), K=1,000 grasp targets, {_MESHCAT}: closed loop >= 1x "
           "real time", 1.0, False, "x real time", lambda run: run["realtime_factor"],
           run=("grasp", 1000, True)),
-    Check(f"K={ESTIMATOR_GOALS:,} goals: the intent_filter estimator with goal groups, a "
-          "control period's step <= 2x the angle estimator's (same run)", 2.0, True,
-          "x angle", lambda row: row["vs_angle"], estimator="intent_filter + groups"),
+    Check(f"K={ESTIMATOR_GOALS:,} goals: the intent_filter estimator, a control period's "
+          "step <= 2x the angle estimator's (same run)", 2.0, True,
+          "x angle", lambda row: row["vs_angle"], estimator="intent_filter"),
     Check("Replay of a 5 s HSR reaching run as pbp-drake run --record saves it: K=1,000 goals "
           "<= 3x the size of K=4's", 3.0, True, "x the K=4 replay",
           lambda sizes: sizes[1000] / sizes[4], replay=CHECKED_REPLAY_GOALS),

@@ -1,5 +1,6 @@
-"""The positions the toolbox accepts: finite, and within `MAX_COORDINATE` metres of the
-origin on every axis.
+"""The numbers and positions the toolbox accepts: a real number is an int or a float (NumPy's
+too), never a bool; a position is finite, and within `MAX_COORDINATE` metres of the origin
+on every axis.
 
 The bound is far beyond any scene a robot works in, so it refuses only data errors (a wrong
 unit, a corrupted value): past about 1e154 a squared distance overflows to infinity, which
@@ -12,6 +13,12 @@ import math
 import numpy as np
 
 MAX_COORDINATE = 1e6  # metres
+
+
+def is_real(value):
+    """Whether `value` is a real number: an int or a float, NumPy's too, but not a bool."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, bool)
 
 
 def vector_length(vector):

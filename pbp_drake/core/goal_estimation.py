@@ -48,7 +48,7 @@ import typing
 
 import numpy as np
 
-from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.coordinates import check_positions, is_real
 from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.core.methods import did_you_mean
 
@@ -133,25 +133,25 @@ class GoalEstimatorSettings:
         estimator_entry(self.method)
         for name in ("temperature", "beta"):
             value = getattr(self, name)
-            if not _is_real(value) or not math.isfinite(value) or value <= 0.0:
+            if not is_real(value) or not math.isfinite(value) or value <= 0.0:
                 raise ValueError(f"{name} must be a positive finite number, got {value!r}")
         for name in ("distance_weight", "orientation_weight", "turn_horizon", "min_speed"):
             value = getattr(self, name)
-            if not _is_real(value) or not math.isfinite(value) or value < 0.0:
+            if not is_real(value) or not math.isfinite(value) or value < 0.0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-        if not _is_real(self.margin) or not 0.0 <= self.margin < 1.0:
+        if not is_real(self.margin) or not 0.0 <= self.margin < 1.0:
             raise ValueError(f"margin must lie in [0, 1), got {self.margin!r}")
         if (isinstance(self.hold_steps, bool) or not isinstance(self.hold_steps, (int, np.integer))
                 or self.hold_steps < 1):
             raise ValueError(f"hold_steps must be an integer >= 1, got {self.hold_steps!r}")
-        if not (_is_real(self.group_mass) and 0.0 <= self.group_mass < 1.0):
+        if not (is_real(self.group_mass) and 0.0 <= self.group_mass < 1.0):
             raise ValueError(f"group_mass must lie in [0, 1) (0: no groups), got "
                              f"{self.group_mass!r}")
-        if not (_is_real(self.commit_radius) and math.isfinite(self.commit_radius)
+        if not (is_real(self.commit_radius) and math.isfinite(self.commit_radius)
                 and self.commit_radius > 0.0):
             raise ValueError(f"commit_radius must be a positive finite distance (m), got "
                              f"{self.commit_radius!r}")
-        if not (_is_real(self.commit_probability) and 0.0 < self.commit_probability <= 1.0):
+        if not (is_real(self.commit_probability) and 0.0 < self.commit_probability <= 1.0):
             raise ValueError(f"commit_probability must lie in (0, 1], got "
                              f"{self.commit_probability!r}")
         if not isinstance(self.intent_filter, IntentFilterSettings):
@@ -178,10 +178,6 @@ class GoalEstimate(typing.NamedTuple):
     memory: SelectionMemory
 
 
-def _is_real(value):
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, bool)
-
 
 def validate_goals(goals):
     """Goals as a float `(K, 3)` array with K >= 1, finite and within the toolbox's bounds
@@ -204,7 +200,7 @@ def validate_point(point, name):
 
 
 def _validate_scalar(value, name, minimum=None):
-    if not _is_real(value) or not math.isfinite(value):
+    if not is_real(value) or not math.isfinite(value):
         raise ValueError(f"{name} must be a finite number, got {value!r}")
     if minimum is not None and value < minimum:
         raise ValueError(f"{name} must be >= {minimum}, got {value!r}")

@@ -78,14 +78,11 @@ import typing
 import numpy as np
 
 from pbp_drake.core import quaternion
+from pbp_drake.core.coordinates import is_real
 
 # Below this (m, rad) the hand is at a target: no direction to it.
 AT_TARGET = 1e-12
 
-
-def _is_real(value):
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, bool)
 
 
 @dataclasses.dataclass
@@ -150,7 +147,7 @@ class HopSettings:
             value = getattr(self, field.name)
             if field.name == "assistance":
                 continue
-            if not _is_real(value) or not math.isfinite(value):
+            if not is_real(value) or not math.isfinite(value):
                 raise ValueError(f"{field.name} must be a finite number, got {value!r}")
         for name in ("cost_time_step", "translation_gain", "translation_switch_distance",
                      "translation_constant", "rotation_gain", "rotation_switch_angle",

@@ -52,6 +52,8 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.coordinates import is_real
+
 
 # A goal closer than this (m) to the hand on the floor plane has no bearing.
 NO_BEARING = 1e-9
@@ -87,17 +89,13 @@ class IntentFilterSettings:
         for name in ("move_rate", "heading_weight", "turn_rate", "silence_rate",
                      "switch_rate", "min_speed"):
             value = getattr(self, name)
-            if not _is_real(value) or not math.isfinite(value) or value < 0.0:
+            if not is_real(value) or not math.isfinite(value) or value < 0.0:
                 raise ValueError(f"intent_filter.{name} must be a finite number >= 0, got "
                                  f"{value!r}")
-        if not (_is_real(self.max_probability) and 0.0 < self.max_probability <= 1.0):
+        if not (is_real(self.max_probability) and 0.0 < self.max_probability <= 1.0):
             raise ValueError(f"intent_filter.max_probability must lie in (0, 1], got "
                              f"{self.max_probability!r}")
 
-
-def _is_real(value):
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, bool)
 
 
 class IntentFeatures(typing.NamedTuple):

@@ -1,8 +1,8 @@
-"""The K sweep's figure (docs/results/many-goals.md): PBP-Alt's intervention ratio and task
-time over teleop's against the number of goals K, following one goal (the paper's) and with
-goal groups under each estimator, from the summaries of the catalogue's many-goals studies
-(`results_catalogue.MANY_GOALS`). `make results` draws it after those studies; drawn alone:
-`python -m pbp_drake.studies.many_goals_figure [--outputs DIR] [--figure PNG]`.
+"""The K sweep's figure and table (docs/results/many-goals.md): PBP-Alt's success,
+intervention ratio and task time over teleop's against the number of goals K, following one
+goal (the paper's) and with goal groups under each estimator, from the summaries of the
+catalogue's many-goals studies. `make results` writes both after those studies; alone:
+`python -m pbp_drake.studies.many_goals_figure [--outputs DIR] [--figure PNG] [--table MD]`.
 """
 
 import argparse
@@ -14,8 +14,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-#: The figure's file name beside the generated tables.
+#: The figure's and the table's file names beside the generated tables.
 FIGURE = "many_goals.png"
+TABLE = "many_goals_sweep.md"
 GOAL_COUNTS = (4, 100, 1000)
 ESTIMATORS = ("angle", "nearest", "bayesian", "maxent_command", "intent_filter")
 
@@ -36,8 +37,8 @@ def _method(outputs, name, method):
 
 
 def sweep(outputs):
-    """{label: [(K, intervention ratio, task time / teleop's)]} of every line that has its
-    studies on disk (teleop's own line at time ratio 1)."""
+    """{label: [(K, intervention ratio, task time / teleop's, success rate)]} of every line
+    that has its studies on disk (teleop's own line at time ratio 1)."""
     lines = {}
     for label, estimator in [("PBP-Alt, one goal (angle)", None),
                              *((f"PBP-Alt, groups, {e}", e) for e in ESTIMATORS)]:
@@ -47,10 +48,12 @@ def sweep(outputs):
             pbp = _method(outputs, study_name(goals, estimator), "pbp_alternated")
             if teleop and pbp:
                 points.append((goals, pbp["intervention_ratio"]["mean"],
-                               pbp["task_time"]["mean"] / teleop["task_time"]["mean"]))
+                               pbp["task_time"]["mean"] / teleop["task_time"]["mean"],
+                               pbp["success_rate"]))
         if points:
             lines[label] = points
-    teleop = [(goals, method["intervention_ratio"]["mean"], 1.0) for goals in GOAL_COUNTS
+    teleop = [(goals, method["intervention_ratio"]["mean"], 1.0, method["success_rate"])
+              for goals in GOAL_COUNTS
               if (method := _method(outputs, study_name(goals), "teleop"))]
     if teleop:
         lines["teleop"] = teleop
@@ -65,7 +68,7 @@ def plot_many_goals(outputs, figure):
         return False
     fig, (intervention, time) = plt.subplots(1, 2, figsize=(10, 4))
     for label, points in lines.items():
-        goals, ratio, time_ratio = zip(*points)
+        goals, ratio, time_ratio, _ = zip(*points)
         style = dict(marker="o", label=label, linestyle="--" if "teleop" in label or
                      "one goal" in label else "-")
         intervention.plot(goals, ratio, **style)
@@ -87,6 +90,27 @@ def plot_many_goals(outputs, figure):
     return True
 
 
+def write_sweep_table(outputs, table):
+    """The sweep as a Markdown table into `table` (the command that made it first); returns
+    False (and writes nothing) with no study on disk."""
+    lines = sweep(outputs)
+    if not lines:
+        return False
+    text = ["<!-- written by python -m pbp_drake.studies.many_goals_figure (make results) "
+            "from the summaries of the many-goals studies -->", "",
+            "| success, intervention ratio, task time / teleop's | "
+            + " | ".join(f"K = {k:,}" for k in GOAL_COUNTS) + " |",
+            "|---|" + "---|" * len(GOAL_COUNTS)]
+    for label, points in lines.items():
+        by_goals = {point[0]: point for point in points}
+        cells = [(f"{100 * p[3]:.0f} %, {p[1]:.3f}, {p[2]:.2f}x" if (p := by_goals.get(k))
+                  else "-") for k in GOAL_COUNTS]
+        text.append(f"| {label} | " + " | ".join(cells) + " |")
+    pathlib.Path(table).parent.mkdir(parents=True, exist_ok=True)
+    pathlib.Path(table).write_text("\n".join(text) + "\n")
+    return True
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m pbp_drake.studies.many_goals_figure",
                                      description=__doc__.split("\n\n")[0])
@@ -94,10 +118,13 @@ def main(argv=None):
                         help="the catalogue's study folders (default outputs/results)")
     parser.add_argument("--figure", default=f"docs/results/generated/{FIGURE}",
                         help=f"the figure to write (default docs/results/generated/{FIGURE})")
+    parser.add_argument("--table", default=f"docs/results/generated/{TABLE}",
+                        help=f"the table to write (default docs/results/generated/{TABLE})")
     args = parser.parse_args(argv)
     if not plot_many_goals(args.outputs, args.figure):
         parser.error(f"no many-goals study under {args.outputs} (make results runs them)")
-    print(f"  wrote {args.figure}")
+    write_sweep_table(args.outputs, args.table)
+    print(f"  wrote {args.figure} and {args.table}")
     return 0
 
 

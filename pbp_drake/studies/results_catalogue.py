@@ -5,7 +5,7 @@ docs/results/generated/NAME.md`. The first line of each generated file is the co
 (read back from the study folder), so a table on the docs site cannot drift from what made it.
 The matrices of every method under every pilot (`ARENA_STUDIES`) also make the arena page,
 docs/results/arena.md (`studies.arena_page`), from their summaries, and the many-goals
-studies the K sweep's figure (`studies.many_goals_figure`).
+studies the K sweep's figure and table (`studies.many_goals_figure`).
 
 A study interrupted part-way resumes from the trials on disk when this runs again.
 """
@@ -18,8 +18,10 @@ import sys
 
 from pbp_drake.scenarios.pilots import PILOT_NAMES
 from pbp_drake.studies.arena_page import write_arena_page
-from pbp_drake.studies.many_goals_figure import ESTIMATORS, GOAL_COUNTS, plot_many_goals
+from pbp_drake.studies.many_goals_figure import (
+    ESTIMATORS, GOAL_COUNTS, plot_many_goals, write_sweep_table)
 from pbp_drake.studies.many_goals_figure import FIGURE as MANY_GOALS_FIGURE
+from pbp_drake.studies.many_goals_figure import TABLE as MANY_GOALS_TABLE
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE
 from pbp_drake.studies.report import BOX_FIGURES as DOCS_FIGURES
 
@@ -56,6 +58,7 @@ ARENA_TASKS = {"hsr_reach_arena": ("diagrams/hsr_reach.yaml", "Reaching", 30),
 # on the HSR at K = 4, 100 and 1,000, and on the arm at K = 100.
 MANY_GOALS = GOAL_COUNTS
 GROUPS = ["--set", "goal_estimator.group_mass=0.9"]
+INTENT_FILTER = ["--set", "goal_estimator.method=intent_filter"]
 # The shipped estimators beside `angle` that read the hand in the reaching task.
 OTHER_ESTIMATORS = tuple(estimator for estimator in ESTIMATORS if estimator != "angle")
 EVALUATION_30 = ["--trials", "30", "--split", "evaluation"]
@@ -129,6 +132,16 @@ STUDIES = {
     "hsr_reach_goals_100_groups_pilots": [
         "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, "--methods",
         "pbp_alternated,teleop", *EVALUATION_30, "--pilots", ",".join(PILOT_NAMES)],
+    # The intent filter with goal groups: under every pilot, mistaken, on the arm.
+    "hsr_reach_goals_100_groups_intent_filter_pilots": [
+        "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, *INTENT_FILTER, "--methods",
+        "pbp_alternated", *EVALUATION_30, "--pilots", ",".join(PILOT_NAMES)],
+    "hsr_reach_goals_100_groups_intent_filter_mistaken": [
+        "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, *INTENT_FILTER, "--methods",
+        "pbp_alternated", *EVALUATION_30, "--participant-condition", "mistaken"],
+    "arm_reach_goals_100_groups_intent_filter": [
+        "diagrams/arm_reach.yaml", "--goals", "100", *GROUPS, *INTENT_FILTER, "--methods",
+        "pbp_alternated", *EVALUATION_30],
     # Every method under every pilot (docs/results/arena.md).
     **{name: [scenario, *ARENA[:2], "--trials", str(trials), *ARENA[2:]]
        for name, (scenario, _, trials) in ARENA_TASKS.items()},
@@ -208,8 +221,9 @@ def main(argv=None):
         print(f"  wrote {args.arena}")
     if any(name.startswith("hsr_reach_goals_") for name in args.names or STUDIES):
         figure = pathlib.Path(args.generated) / MANY_GOALS_FIGURE
-        if plot_many_goals(args.outputs, figure):
-            print(f"  wrote {figure}")
+        table = pathlib.Path(args.generated) / MANY_GOALS_TABLE
+        if plot_many_goals(args.outputs, figure) and write_sweep_table(args.outputs, table):
+            print(f"  wrote {figure} and {table}")
     for line in failed:
         print(f"results: {line}", file=sys.stderr)
     return 1 if failed else 0

@@ -97,6 +97,7 @@ def test_a_step_is_the_hazard_the_evidence_the_clip_and_the_heading_on_top(acts)
     assert clipped_once
 
 
+@pytest.mark.slow
 def test_the_hazard_is_a_floor_no_evidence_pushes_a_goal_under():
     settings = IntentFilterSettings(move_rate=200.0, heading_weight=0.0, turn_rate=0.0,
                                     switch_rate=0.5, max_probability=1.0)
@@ -152,6 +153,7 @@ def test_bad_settings_name_the_field(field, value, message):
         settings.validate()
 
 
+@pytest.mark.slow
 def test_the_filter_recovers_from_a_wrong_goal_held_long_in_bounded_time():
     """Runaway confidence: however long the operator held the wrong object (2 to 20 s),
     the filter names the target for good within half a second of the turn, and holding

@@ -1,7 +1,8 @@
 """HOP's systems in small diagrams: the goal posterior (`MaxEntGoalEstimator`,
 `PoseMaxEntGoalEstimator`) and the intent filter (`IntentFilterGoalEstimator`) keep the
-core's recursive belief tick by tick, in the Context alone; the assistance (`HopAssistance`, `PoseHopAssistance`) sends the operator's command
-plus HOP's action, and predict-then-assist the operator's alone until it is confident."""
+core's recursive belief tick by tick, in the Context alone; the assistance
+(`HopAssistance`, `PoseHopAssistance`) sends the operator's command plus HOP's action, and
+predict-then-assist the operator's alone until it is confident."""
 
 import numpy as np
 import pytest

@@ -178,7 +178,6 @@ class GoalEstimate(typing.NamedTuple):
     memory: SelectionMemory
 
 
-
 def validate_goals(goals):
     """Goals as a float `(K, 3)` array with K >= 1, finite and within the toolbox's bounds
     (`pbp_drake.core.coordinates`)."""

@@ -57,7 +57,8 @@ Y_AXIS = np.array([0.0, 1.0, 0.0])
 
 @dataclasses.dataclass(frozen=True)
 class GraspScene:
-    """One grasping scene; index i of every array is object i.
+    """One grasping scene; index i of every array is grasp i, of object i when each object
+    has one grasp (`sample_grasp_scene`'s `grasps_per_object`).
 
     Attributes:
         objects: (M, 3) each cylinder's centre (on its axis, at half its height).
@@ -124,9 +125,14 @@ def sample_grasp_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
                        object_height=0.15, min_separation=0.45,
                        switch_schedule=(0.0, 0.3, 0.6), yaw_range=(-np.pi / 3, np.pi / 3),
                        roll_range=(-np.pi / 2, np.pi / 2), top_probability=0.5,
-                       grasp_depth=0.08):
+                       grasp_depth=0.08, grasps_per_object=1):
     """Draws a `GraspScene` from `seed` alone (the same seed, the same scene, for every
-    method). Angles in radians; lengths in metres."""
+    method). Angles in radians; lengths in metres.
+
+    With `grasps_per_object` G > 1 every object has G grasps, each from the side or from
+    above as one grasp is drawn, and the scene's index i is grasp i (object `i // G`: its
+    centre and table repeat G times in `objects` and `tables`); the targets are grasps, each
+    of another object than the one before. G = 1 draws exactly the one-grasp scene."""
     low, high = check_object_count(object_count, switch_schedule)
     diagonal = float(np.hypot(*table_size))
     if min_separation < diagonal:
@@ -144,12 +150,29 @@ def sample_grasp_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
                        for approach in approaches])
     tables = np.column_stack([floor, np.full(count, table_height)])
     objects = tables + [0.0, 0.0, 0.5 * object_height]
-    poses = [grasp_pose(center, approach, angle, object_height, grasp_depth)
-             for center, approach, angle in zip(objects, approaches, angles)]
     targets = [int(rng.integers(count))]
     for _ in switch_schedule[1:]:
         others = [i for i in range(count) if i != targets[-1]]
         targets.append(int(others[rng.integers(len(others))]))
+    if grasps_per_object > 1:
+        # Drawn after the one-grasp scene, whose draws stay as they are: each object's
+        # first grasp is the one above, its other G - 1 drawn alike, and each target one
+        # of its object's grasps.
+        more = grasps_per_object - 1
+        extra = [tuple("top" if rng.uniform() < top_probability else "side"
+                       for _ in range(more)) for _ in range(count)]
+        extra_angles = [np.array([rng.uniform(*(roll_range if a == "top" else yaw_range))
+                                  for a in kinds]) for kinds in extra]
+        approaches = tuple(a for first, kinds in zip(approaches, extra)
+                           for a in (first, *kinds))
+        angles = np.concatenate([[first, *more_angles] for first, more_angles
+                                 in zip(angles, extra_angles)])
+        tables = np.repeat(tables, grasps_per_object, axis=0)
+        objects = np.repeat(objects, grasps_per_object, axis=0)
+        targets = [target * grasps_per_object + int(rng.integers(grasps_per_object))
+                   for target in targets]
+    poses = [grasp_pose(center, approach, angle, object_height, grasp_depth)
+             for center, approach, angle in zip(objects, approaches, angles)]
     positions = np.array([position for position, _ in poses])
     _check_reachable(positions)
     return GraspScene(objects=objects, tables=tables, approaches=approaches,

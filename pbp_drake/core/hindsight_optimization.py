@@ -84,7 +84,6 @@ from pbp_drake.core.coordinates import is_real
 AT_TARGET = 1e-12
 
 
-
 @dataclasses.dataclass
 class HopSettings:
     """The cost model, posterior and assistance of HOP (scenario files: the `hop` section),

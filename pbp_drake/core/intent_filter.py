@@ -97,7 +97,6 @@ class IntentFilterSettings:
                              f"{self.max_probability!r}")
 
 
-
 class IntentFeatures(typing.NamedTuple):
     """One tick's features per goal, each (K,) in [-1, 1]: `moves`, `headings`, `turns`;
     and whether the operator `acts` (else the moves are the robot's)."""

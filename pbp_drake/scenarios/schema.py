@@ -359,6 +359,9 @@ class GraspTask:
     success_distance: float = 0.03
     #: Degrees.
     success_angle: float = 10.0
+    #: How many grasps each object offers (a count), each a goal of its own drawn as the
+    #: one grasp is; the targets are grasps. 1: one grasp an object (the paper's).
+    grasps_per_object: int = 1
 
 
 @dataclasses.dataclass

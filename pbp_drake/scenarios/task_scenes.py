@@ -120,7 +120,7 @@ def _grasp_scene(task, seed):
         switch_schedule=tuple(task.switch_schedule),
         yaw_range=tuple(np.radians(task.approach_yaw_range)),
         roll_range=tuple(np.radians(task.roll_range)), top_probability=task.top_probability,
-        grasp_depth=task.grasp_depth)
+        grasp_depth=task.grasp_depth, grasps_per_object=task.grasps_per_object)
 
 
 def scene_boxes(task, scene, seed):

@@ -25,6 +25,9 @@ SHORTEST_TIME_STEP = 1e-6
 # The longest a DMP may last (s); a far goal over a tiny robot.speed would otherwise give
 # a duration whose square overflows in the DMP's gains.
 LONGEST_DMP_DURATION = 1e6
+# The most grasps an object of the grasping task may offer: 100 objects of 1,000 grasps are
+# MAX_GOALS goals.
+MAX_GRASPS_PER_OBJECT = 1000
 # The most likely goals' paths a page draws (`scenario.likely_paths`): a few are what a
 # person can follow.
 MAX_LIKELY_PATHS = 20
@@ -159,6 +162,7 @@ def check_grasp_task(task):
         check_range(task, field, name)
     check_count(task.object_count[0], f"{field}.object_count[0]", 1, 100)
     check_count(task.object_count[1], f"{field}.object_count[1]", 1, 100)
+    check_count(task.grasps_per_object, f"{field}.grasps_per_object", 1, MAX_GRASPS_PER_OBJECT)
     # Beyond a quarter turn a side grasp approaches from behind the object, toward the
     # robot, which the HSR's arm cannot do.
     check_range(task, field, "approach_yaw_range", within=(-90.0, 90.0))

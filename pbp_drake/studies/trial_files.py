@@ -74,7 +74,8 @@ def plain(value):
 # Fields left out of the content while at their defaults, so that a scenario that does not
 # use them keeps the hash of study folders written before they existed (and these resume).
 # None: the scenario's own fields.
-_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects": 0},
+_LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects": 0,
+                          "grasps_per_object": 1},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3},
                  "goal_estimator": {"group_mass": 0.0, "commit_radius": 0.05,
                                     "commit_probability": 0.8,

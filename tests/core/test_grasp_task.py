@@ -49,6 +49,25 @@ def test_a_scene_keeps_its_ranges_separations_and_switches(seed):
     assert all(a != b for a, b in zip(scene.targets, scene.targets[1:]))
 
 
+def test_many_grasps_an_object_keep_the_one_grasp_scene_and_add_its_objects_grasps():
+    one, many = sample_grasp_scene(5, object_count=(10, 10)), sample_grasp_scene(
+        5, object_count=(10, 10), grasps_per_object=30)
+    assert len(many.grasp_positions) == len(many.approaches) == 300
+    # Grasp i is of object i // 30, whose centre and table repeat; its first grasp is the
+    # one-grasp scene's.
+    np.testing.assert_array_equal(many.objects, np.repeat(one.objects, 30, axis=0))
+    np.testing.assert_array_equal(many.tables, np.repeat(one.tables, 30, axis=0))
+    np.testing.assert_array_equal(many.grasp_positions[::30], one.grasp_positions)
+    assert [target // 30 for target in many.targets] == list(one.targets)
+    for index, (approach, angle) in enumerate(zip(many.approaches, many.approach_angles)):
+        position, orientation = grasp_pose(many.objects[index], approach, angle, 0.15, 0.08)
+        np.testing.assert_allclose(many.grasp_positions[index], position)
+        np.testing.assert_allclose(many.grasp_orientations[index], orientation)
+    # An object's grasps differ (its top grasps in the roll alone): 300 distinct poses.
+    poses = np.hstack([many.grasp_positions, many.grasp_orientations]).round(9)
+    assert len(np.unique(poses, axis=0)) == 300
+
+
 def test_each_grasp_pose_is_the_drawn_one():
     scene = sample_grasp_scene(11, top_probability=0.5)
     for index, (approach, angle) in enumerate(zip(scene.approaches, scene.approach_angles)):

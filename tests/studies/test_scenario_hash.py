@@ -53,3 +53,20 @@ def test_a_grid_of_objects_changes_the_hash_and_none_leaves_it():
     grid = dataclasses.replace(reach, task=dataclasses.replace(reach.task, grid_objects=100))
     assert scenario_content(grid)["task"]["grid_objects"] == 100
     assert scenario_hash(grid) != scenario_hash(reach)
+
+
+def test_many_grasps_an_object_change_the_hash_and_one_leaves_it():
+    grasp = scenario("hsr_grasp.yaml")
+    assert "grasps_per_object" not in scenario_content(grasp)["task"]
+    many = dataclasses.replace(grasp, task=dataclasses.replace(grasp.task, grasps_per_object=30))
+    assert scenario_content(many)["task"]["grasps_per_object"] == 30
+    assert scenario_hash(many) != scenario_hash(grasp)
+
+
+def test_the_intent_filters_settings_at_their_defaults_leave_the_hash():
+    reach = scenario("hsr_reach.yaml")
+    assert "intent_filter" not in scenario_content(reach)["goal_estimator"]
+    settings = dataclasses.replace(reach.goal_estimator.intent_filter, switch_rate=1.0)
+    changed = dataclasses.replace(reach, goal_estimator=dataclasses.replace(
+        reach.goal_estimator, intent_filter=settings))
+    assert scenario_hash(changed) != scenario_hash(reach)

@@ -46,6 +46,8 @@ class IntentFilterGoalEstimator(MaxEntGoalEstimator):
         hand = self._ee_state_port.Eval(context)
         command = self._command_port.Eval(context)
         goals = self._goals_port.Eval(context).reshape(self._goal_count, 3)
+        # `targets` holds the goals' positions (K, 3): the filter reads no HOP targets, and
+        # building them (a uniqueness check) would cost O(K log K) a tick.
         return PosteriorInputs(goals, hand[:3], command[:3], hand[3:6],
                                heading=float(EeState(hand).heading),
                                yaw_rate=float(OperatorCommand(command).yaw_rate))

@@ -15,7 +15,6 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.builder.pbp_controller import make_goal_estimator
-from pbp_drake.core.goal_estimation import READS_POSITION, estimator_entry
 from pbp_drake.systems import GoalGrouping, GoalsSource
 from pbp_drake_bench.cases import connect_reader
 from pbp_drake_bench.checks import ESTIMATOR_GOALS
@@ -43,7 +42,7 @@ def estimator_simulator(config, goals):
     builder.Connect(source.get_output_port(), estimator.get_goals_input_port())
     hand = builder.AddSystem(ConstantVectorSource(HAND))
     builder.Connect(hand.get_output_port(), estimator.get_ee_state_input_port())
-    if estimator_entry(config.goal_estimator.method).reads != READS_POSITION:
+    if estimator.HasInputPort("operator_command"):
         command = builder.AddSystem(ConstantVectorSource(COMMAND))
         builder.Connect(command.get_output_port(), estimator.get_operator_command_input_port())
         active = builder.AddSystem(ConstantVectorSource([1.0]))

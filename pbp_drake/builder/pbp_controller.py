@@ -147,7 +147,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     builder.ExportOutput(ee_command.get_output_port(), "ee_command")
     builder.ExportOutput(shown, "selected_goal")
     builder.ExportOutput(estimator.get_goal_probabilities_output_port(), "goal_probabilities")
-    if isinstance(estimator, MaxEntGoalEstimator):  # the intent filter's class too
+    if estimator.HasOutputPort("posterior_clipped"):
         builder.ExportOutput(estimator.get_posterior_clipped_output_port(), "posterior_clipped")
     diagram = builder.Build()
     diagram.set_name(name)
@@ -178,12 +178,13 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     goal_count = len(goals)
     position_velocity = split.get_output_port(0)
     settings = config.goal_estimator
-    reads_command = estimator_entry(settings.method).reads in (READS_COMMAND, READS_INTENT)
     estimator = builder.AddNamedSystem("goal_estimator", make_goal_estimator(config,
                                                                              goal_count))
     builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
     builder.ExportInput(estimator.get_goals_input_port(), "goals")
-    if reads_command:
+    # The recursive estimators (maxent_command, intent_filter) read the operator too.
+    reads_operator = estimator.HasInputPort("operator_command")
+    if reads_operator:
         builder.ConnectInput("operator_command", estimator.get_operator_command_input_port())
 
     bank = config.dmp_bank(start, goals)
@@ -217,7 +218,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         builder.ConnectInput("goals", dmp_bank.get_goals_input_port())
     builder.Connect(position_velocity, dmp_bank.get_robot_state_input_port())
     builder.ExportInput(dmp_bank.get_operator_active_input_port(), "operator_active")
-    if reads_command:
+    if reads_operator:
         builder.ConnectInput("operator_active", estimator.get_operator_active_input_port())
 
     blender = builder.AddNamedSystem("blender", Blender(

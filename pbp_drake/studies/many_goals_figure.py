@@ -39,12 +39,12 @@ def _method(outputs, name, method):
 def sweep(outputs):
     """{label: [(K, intervention ratio, task time / teleop's, success rate)]} of every line
     that has its studies on disk (teleop's own line at time ratio 1)."""
+    teleops = {goals: _method(outputs, study_name(goals), "teleop") for goals in GOAL_COUNTS}
     lines = {}
     for label, estimator in [("PBP-Alt, one goal (angle)", None),
                              *((f"PBP-Alt, groups, {e}", e) for e in ESTIMATORS)]:
         points = []
-        for goals in GOAL_COUNTS:
-            teleop = _method(outputs, study_name(goals), "teleop")
+        for goals, teleop in teleops.items():
             pbp = _method(outputs, study_name(goals, estimator), "pbp_alternated")
             if teleop and pbp:
                 points.append((goals, pbp["intervention_ratio"]["mean"],
@@ -53,17 +53,15 @@ def sweep(outputs):
         if points:
             lines[label] = points
     teleop = [(goals, method["intervention_ratio"]["mean"], 1.0, method["success_rate"])
-              for goals in GOAL_COUNTS
-              if (method := _method(outputs, study_name(goals), "teleop"))]
+              for goals, method in teleops.items() if method]
     if teleop:
         lines["teleop"] = teleop
     return lines
 
 
-def plot_many_goals(outputs, figure):
-    """Draws the sweep into `figure`; returns False (and draws nothing) with no study on
-    disk."""
-    lines = sweep(outputs)
+def plot_many_goals(lines, figure):
+    """Draws `lines` (a `sweep`) into `figure`; returns False (and draws nothing) when it
+    is empty (no study on disk)."""
     if not lines:
         return False
     fig, (intervention, time) = plt.subplots(1, 2, figsize=(10, 4))
@@ -90,10 +88,9 @@ def plot_many_goals(outputs, figure):
     return True
 
 
-def write_sweep_table(outputs, table):
-    """The sweep as a Markdown table into `table` (the command that made it first); returns
-    False (and writes nothing) with no study on disk."""
-    lines = sweep(outputs)
+def write_sweep_table(lines, table):
+    """`lines` (a `sweep`) as a Markdown table into `table` (the command that made it
+    first); returns False (and writes nothing) when it is empty (no study on disk)."""
     if not lines:
         return False
     text = ["<!-- written by python -m pbp_drake.studies.many_goals_figure (make results) "
@@ -121,9 +118,10 @@ def main(argv=None):
     parser.add_argument("--table", default=f"docs/results/generated/{TABLE}",
                         help=f"the table to write (default docs/results/generated/{TABLE})")
     args = parser.parse_args(argv)
-    if not plot_many_goals(args.outputs, args.figure):
+    lines = sweep(args.outputs)
+    if not plot_many_goals(lines, args.figure):
         parser.error(f"no many-goals study under {args.outputs} (make results runs them)")
-    write_sweep_table(args.outputs, args.table)
+    write_sweep_table(lines, args.table)
     print(f"  wrote {args.figure} and {args.table}")
     return 0
 

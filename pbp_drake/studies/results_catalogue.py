@@ -20,6 +20,7 @@ from pbp_drake.scenarios.pilots import PILOT_NAMES
 from pbp_drake.studies.arena_page import write_arena_page
 from pbp_drake.studies.many_goals_figure import (
     ESTIMATORS, GOAL_COUNTS, plot_many_goals, write_sweep_table)
+from pbp_drake.studies.many_goals_figure import sweep as many_goals_sweep
 from pbp_drake.studies.many_goals_figure import FIGURE as MANY_GOALS_FIGURE
 from pbp_drake.studies.many_goals_figure import TABLE as MANY_GOALS_TABLE
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE
@@ -222,7 +223,8 @@ def main(argv=None):
     if any(name.startswith("hsr_reach_goals_") for name in args.names or STUDIES):
         figure = pathlib.Path(args.generated) / MANY_GOALS_FIGURE
         table = pathlib.Path(args.generated) / MANY_GOALS_TABLE
-        if plot_many_goals(args.outputs, figure) and write_sweep_table(args.outputs, table):
+        lines = many_goals_sweep(args.outputs)
+        if plot_many_goals(lines, figure) and write_sweep_table(lines, table):
             print(f"  wrote {figure} and {table}")
     for line in failed:
         print(f"results: {line}", file=sys.stderr)

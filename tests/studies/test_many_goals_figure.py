@@ -6,7 +6,8 @@ import json
 
 import pytest
 
-from pbp_drake.studies.many_goals_figure import plot_many_goals, study_name, write_sweep_table
+from pbp_drake.studies.many_goals_figure import (
+    plot_many_goals, study_name, sweep, write_sweep_table)
 
 
 def summary(folder, methods):
@@ -24,7 +25,7 @@ def test_the_table_and_figure_hold_every_line_on_disk(tmp_path):
     summary(outputs / study_name(100, "angle"), {"pbp_alternated": (1.0, 0.18, 18.0)})
     summary(outputs / study_name(100, "intent_filter"), {"pbp_alternated": (0.9, 0.2, 24.0)})
     table = tmp_path / "sweep.md"
-    assert write_sweep_table(outputs, table)
+    assert write_sweep_table(sweep(outputs), table)
     rows = {line.split(" | ")[0].strip("| "): line for line in table.read_text().splitlines()
             if line.startswith("| ") and "K = " not in line}
     assert set(rows) == {"PBP-Alt, one goal (angle)", "PBP-Alt, groups, angle",
@@ -33,10 +34,10 @@ def test_the_table_and_figure_hold_every_line_on_disk(tmp_path):
     assert "| 90 %, 0.200, 1.20x |" in rows["PBP-Alt, groups, intent_filter"]
     assert rows["teleop"].endswith("| - | 100 %, 0.920, 1.00x | - |")
     figure = tmp_path / "sweep.png"
-    assert plot_many_goals(outputs, figure) and figure.stat().st_size > 10_000
+    assert plot_many_goals(sweep(outputs), figure) and figure.stat().st_size > 10_000
 
 
 def test_no_study_on_disk_writes_nothing(tmp_path):
-    assert not write_sweep_table(tmp_path, tmp_path / "sweep.md")
-    assert not plot_many_goals(tmp_path, tmp_path / "sweep.png")
+    assert not write_sweep_table(sweep(tmp_path), tmp_path / "sweep.md")
+    assert not plot_many_goals(sweep(tmp_path), tmp_path / "sweep.png")
     assert not (tmp_path / "sweep.md").exists() and not (tmp_path / "sweep.png").exists()

@@ -5,6 +5,8 @@ change as it was, and changes the hash of one whose trials it does."""
 import dataclasses
 import pathlib
 
+import pytest
+
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.studies.trial_files import scenario_content, scenario_hash
 
@@ -47,20 +49,15 @@ def test_a_renamed_station_field_keeps_the_name_folders_were_written_with():
         assert "command_period" in content and "control_period" not in content
 
 
-def test_a_grid_of_objects_changes_the_hash_and_none_leaves_it():
-    reach = scenario("hsr_reach.yaml")
-    assert "grid_objects" not in scenario_content(reach)["task"]
-    grid = dataclasses.replace(reach, task=dataclasses.replace(reach.task, grid_objects=100))
-    assert scenario_content(grid)["task"]["grid_objects"] == 100
-    assert scenario_hash(grid) != scenario_hash(reach)
-
-
-def test_many_grasps_an_object_change_the_hash_and_one_leaves_it():
-    grasp = scenario("hsr_grasp.yaml")
-    assert "grasps_per_object" not in scenario_content(grasp)["task"]
-    many = dataclasses.replace(grasp, task=dataclasses.replace(grasp.task, grasps_per_object=30))
-    assert scenario_content(many)["task"]["grasps_per_object"] == 30
-    assert scenario_hash(many) != scenario_hash(grasp)
+@pytest.mark.parametrize("name, field, value", [("hsr_reach.yaml", "grid_objects", 100),
+                                                ("hsr_grasp.yaml", "grasps_per_object", 30)])
+def test_a_later_task_field_changes_the_hash_and_its_default_leaves_it(name, field, value):
+    # A grid of objects in the reaching task; many grasps an object in the grasping task.
+    base = scenario(name)
+    assert field not in scenario_content(base)["task"]
+    changed = dataclasses.replace(base, task=dataclasses.replace(base.task, **{field: value}))
+    assert scenario_content(changed)["task"][field] == value
+    assert scenario_hash(changed) != scenario_hash(base)
 
 
 def test_the_intent_filters_settings_at_their_defaults_leave_the_hash():

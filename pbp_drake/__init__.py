@@ -62,7 +62,8 @@ API_GROUPS = {
             "HeadingCommand", "DemonstrationPlayer"]},
     "Six-DoF PBP systems": {
         name: "pbp_drake.systems.pbp" for name in [
-            "PoseDmpBank", "PoseGoalEstimator", "PoseBlender", "PoseHandOver"]},
+            "PoseDmpBank", "PoseGoalEstimator", "PoseBlender", "PoseHandOver",
+            "PoseGoalGrouping", "PoseIntentFilterGoalEstimator"]},
     "Operators": {
         name: "pbp_drake.systems.operators" for name in [
             "KeyboardOperator", "GamepadOperator", "VirtualOperator", "ScriptedOperator",

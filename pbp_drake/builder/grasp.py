@@ -5,7 +5,8 @@ station, the hand driven to a grasp pose (position and orientation).
                                                                  blender, task_monitor,
                                                                  operator
     goal_poses ──> goal_estimator, dmp_bank
-    goal_estimator.selected_goal ──> dmp_bank (followed_goal, selected_goal), operator
+    goal_estimator.selected_goal ──> dmp_bank (followed_goal, selected_goal), operator,
+                                     task_visualizer
     goal_estimator.goal_probabilities ──> blender (confidence_alpha)
     dmp_bank.selected_reference ──> blender.policy_reference
     operator (operator_command: OperatorTwist, operator_active) ──> blender, dmp_bank
@@ -16,6 +17,15 @@ station, the hand driven to a grasp pose (position and orientation).
     blender.reference ──> hand_over (PoseHandOver) ──> hsr_station.pose_command
     task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
     hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
+
+With `goal_estimator: {group_mass: M}` (M > 0) a `PoseGoalGrouping` stands between
+`goal_poses` and the DMP bank, as `GoalGrouping` in the reaching task: the selected
+grasp's DMP is steered to the pose of the group of grasps the estimate cannot yet tell
+apart, and the grouping's `shown_goal` (-1 until the robot commits) is what the operator,
+the logs and the page see:
+
+    goal_poses, hand_pose_sample, goal_estimator ──> goal_grouping
+    goal_grouping.followed_poses ──> dmp_bank.goal_poses;  goal_grouping.shown_goal ──> operator
 
 Under ``hop`` and ``predict_then_assist`` there is no DMP bank and no blender: the
 `goal_estimator` is HOP's posterior (`PoseMaxEntGoalEstimator`, on the operator's twist),
@@ -43,9 +53,10 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.builder.operators import shown_intent_and_keys
 from pbp_drake.builder.pilot_operators import make_pilot
+from pbp_drake.core.controller_config import nominal_duration
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.grasp_task import approach_direction
-from pbp_drake.core.goal_estimation import READS_COMMAND, estimator_entry
+from pbp_drake.core.goal_estimation import READS_COMMAND, READS_INTENT, estimator_entry
 from pbp_drake.core.methods import ASSISTED, METHODS
 from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
 from pbp_drake.core.pose_arbitration import HandOverLimits
@@ -57,7 +68,8 @@ from pbp_drake.scenarios import (
     forward_key_enabled)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
-    PoseGoalEstimator, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
+    PoseGoalEstimator, PoseGoalGrouping, PoseHandOver, PoseIntentFilterGoalEstimator,
+    PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
 from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator, PoseGamepadParams
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import GraspSceneVisualizer
 from pbp_drake.systems.operators.pilot_filters import GraspKeys
@@ -97,13 +109,12 @@ def hand_over_limits(scenario):
 
 def grasp_dmp_banks(resolved, start_pose):
     """The position and orientation banks, straight paths from the hand's `start_pose`
-    `[p, q]` to the K grasp poses, one duration (the farthest grasp at the nominal speed),
-    so that they share one phase."""
+    `[p, q]` to the K grasp poses, one duration (the farthest grasp at the nominal speed;
+    with goal groups the median grasp: `nominal_duration`), so that they share one phase."""
     scenario = resolved.scenario
     goals = resolved.scene.grasps.grasp_positions
-    distance = float(np.max(np.linalg.norm(goals - start_pose[:3], axis=1)))
-    duration = (scenario.dmp_duration if scenario.dmp_duration > 0
-                else distance / resolved.nominal_speed)
+    duration = (scenario.dmp_duration if scenario.dmp_duration > 0 else nominal_duration(
+        start_pose[:3], goals, resolved.nominal_speed, scenario.goal_estimator.group_mass > 0.0))
     return (DmpBankModel.straight(start_pose[:3], len(goals), duration, scenario.dmp),
             OrientationDmpBank.straight(start_pose[3:7], len(goals), duration, scenario.dmp))
 
@@ -132,7 +143,7 @@ def build_grasp_diagram(resolved, meshcat=None):
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
-    shown, keys = shown_intent_and_keys(builder, scenario, selected)
+    intent = selected  # the goal the robot shows: the selected one, or the grouping's
 
     limits = hand_over_limits(scenario)
     method = METHODS[scenario.method]
@@ -155,7 +166,12 @@ def build_grasp_diagram(resolved, meshcat=None):
             max_speed=limits.max_speed, max_angular_speed=limits.max_angular_speed,
             prediction_steps=prediction_steps, compact_state=True))
         builder.Connect(sampled, dmp_bank.get_robot_state_input_port())
-        builder.Connect(goal_poses.get_output_port(), dmp_bank.get_goal_poses_input_port())
+        if scenario.goal_estimator.group_mass > 0.0:
+            intent = _add_grouping(builder, resolved, goal_count, estimator, goal_poses,
+                                   sampled, dmp_bank)
+        else:
+            builder.Connect(goal_poses.get_output_port(),
+                            dmp_bank.get_goal_poses_input_port())
         # Read at the decide stage before the estimator updates: the goal followed last tick.
         builder.Connect(selected, dmp_bank.get_followed_goal_input_port())
         builder.Connect(selected, dmp_bank.get_selected_goal_input_port())
@@ -164,6 +180,7 @@ def build_grasp_diagram(resolved, meshcat=None):
         builder.Connect(dmp_bank.get_selected_reference_output_port(),
                         policy.get_policy_reference_input_port())
         builder.Connect(selected, policy.get_selected_goal_input_port())
+    shown, keys = shown_intent_and_keys(builder, scenario, intent)
     builder.Connect(sampled, policy.get_robot_state_input_port())
     builder.Connect(estimator.get_goal_probabilities_output_port(),
                     policy.get_goal_probabilities_input_port())
@@ -192,7 +209,8 @@ def build_grasp_diagram(resolved, meshcat=None):
     if dmp_bank is not None:
         builder.Connect(active, dmp_bank.get_operator_active_input_port())
         builder.Connect(active, policy.get_operator_active_input_port())
-    if getattr(estimator, "operator_speed", None) is not None:
+    if (getattr(estimator, "operator_speed", None) is not None
+            or isinstance(estimator, PoseIntentFilterGoalEstimator)):
         builder.Connect(active, estimator.get_operator_active_input_port())
     builder.Connect(twist, policy.get_operator_twist_input_port())
     # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
@@ -214,7 +232,7 @@ def build_grasp_diagram(resolved, meshcat=None):
             meshcat, grasps, prediction_steps, task.table_size, task.object_radius,
             task.object_height, likely_triads=1 + scenario.likely_paths))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
-        builder.Connect(selected, visualizer.get_selected_goal_input_port())
+        builder.Connect(shown, visualizer.get_selected_goal_input_port())
         if dmp_bank is not None:
             builder.Connect(dmp_bank.get_predicted_poses_output_port(),
                             visualizer.get_predicted_poses_input_port())
@@ -227,15 +245,40 @@ def build_grasp_diagram(resolved, meshcat=None):
     return diagram
 
 
+def _add_grouping(builder, resolved, goal_count, estimator, goal_poses, hand_pose, dmp_bank):
+    """Goal groups between the goals and the DMP bank (`PoseGoalGrouping`, distances in
+    the task's pose error); returns the goal the robot shows."""
+    scenario = resolved.scenario
+    task = scenario.task
+    grouping = builder.AddNamedSystem("goal_grouping", PoseGoalGrouping(
+        goal_count, scenario.goal_estimator, scenario.control_period,
+        task.success_distance / np.radians(task.success_angle)))
+    builder.Connect(goal_poses.get_output_port(), grouping.get_goal_poses_input_port())
+    builder.Connect(hand_pose, grouping.get_hand_pose_input_port())
+    builder.Connect(estimator.get_goal_probabilities_output_port(),
+                    grouping.get_goal_probabilities_input_port())
+    builder.Connect(estimator.get_selected_goal_output_port(),
+                    grouping.get_selected_goal_input_port())
+    builder.Connect(grouping.get_followed_poses_output_port(),
+                    dmp_bank.get_goal_poses_input_port())
+    return grouping.get_shown_goal_output_port()
+
+
 def _estimator(resolved, goal_count):
     """The goal estimator: HOP's posterior under hop and predict_then_assist (the most probable
     goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
-    section's hysteresis and the likelihood of PBP's operator), else the `pose` estimator."""
+    section's hysteresis and the likelihood of PBP's operator), the intent filter with
+    `{method: intent_filter}` (`PoseIntentFilterGoalEstimator`),
+    else the `pose` estimator."""
     scenario = resolved.scenario
     period = scenario.control_period
     settings = scenario.goal_estimator
     if METHODS[scenario.method].policy == ASSISTED:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
+    if estimator_entry(settings.method).reads == READS_INTENT:
+        return PoseIntentFilterGoalEstimator(goal_count, settings.intent_filter, period,
+                                             settings.margin, settings.hold_steps,
+                                             forward_key=forward_key_enabled(scenario))
     if estimator_entry(settings.method).reads == READS_COMMAND:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
                                        settings.hold_steps,

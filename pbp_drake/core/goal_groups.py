@@ -21,19 +21,30 @@ the run correcting it. Here the robot follows the group instead, coarse to fine:
 As the hand nears the group, goals off its heading fall out of it and the group narrows to
 the goal meant; a goal that stays ambiguous (two goals in line) is decided by the
 operator's correction, as with a single goal.
+
+**Poses** (the grasping task's goals, `pose_group_target`): the group's point is a pose,
+the probability-weighted mean position and the weighted mean of the orientations (each
+quaternion on the hemisphere of the most probable one, the sum normalised: the chordal
+mean, close to the geodesic one for the nearby orientations a group holds). Distances are
+the task's pose error `|p - g| + L angle(q, q_g)` (`L` metres per radian: with the task's
+`success_distance / success_angle`, turning by the success angle counts as moving the
+success distance), so that `commit_radius` bounds turns as well as moves.
 """
 
 import typing
 
 import numpy as np
 
+from pbp_drake.core.quaternion import angle_between
+
 #: The shown goal while the robot follows a group and has not committed.
 NO_GOAL = -1
 
 
 class GroupTarget(typing.NamedTuple):
-    """What `group_target` returns: the point the robot heads for (3), the index shown
-    (`NO_GOAL` while uncommitted) and the group's size."""
+    """What `group_target` returns: the point the robot heads for (3; a pose (7) from
+    `pose_group_target`), the index shown (`NO_GOAL` while uncommitted) and the group's
+    size."""
 
     point: np.ndarray
     shown: int
@@ -55,21 +66,84 @@ def _most_probable(probabilities, mass):
         m = min(count, 4 * m)
 
 
+def _group(probabilities, selected, group_mass, commit_probability, committed):
+    """The members of the group (most probable first), or None when the robot commits to
+    `selected` whatever the group: its probability is high enough, or it was committed to."""
+    best = int(np.argmax(probabilities))
+    if probabilities[best] >= commit_probability or committed == selected:
+        return None
+    return _most_probable(probabilities, group_mass * float(probabilities.sum()))
+
+
 def group_target(goals, probabilities, selected, group_mass, commit_radius,
                  commit_probability, hand=None, committed=NO_GOAL):
     """The `GroupTarget` of `goals` (K, 3) under `probabilities` (K), the estimator's
     `selected` goal committed to when the group allows (module docstring): `hand` (3) is
     the hand's position (None: not read), `committed` the goal committed to before
     (`NO_GOAL`: none)."""
-    best = int(np.argmax(probabilities))
-    if probabilities[best] >= commit_probability or committed == selected:
+    members = _group(probabilities, selected, group_mass, commit_probability, committed)
+    if members is None:
         return GroupTarget(goals[selected].copy(), selected, 1)
-    members = _most_probable(probabilities, group_mass * float(probabilities.sum()))
-    size = len(members)
     weights = probabilities[members]
     point = weights @ goals[members] / weights.sum()
     spread = float(np.max(np.linalg.norm(goals[members] - point, axis=1)))
     arrived = hand is not None and float(np.linalg.norm(hand - point)) <= commit_radius
-    if size == 1 or spread <= commit_radius or arrived:
-        return GroupTarget(goals[selected].copy(), selected, size)
+    return _committed_or_group(goals[selected], point, selected, len(members),
+                               spread <= commit_radius or arrived)
+
+
+def pose_group_target(poses, probabilities, selected, group_mass, commit_radius,
+                      commit_probability, metres_per_radian, hand=None, committed=NO_GOAL):
+    """`group_target` for pose goals: `poses` (K, 7) rows `[x, y, z, qw, qx, qy, qz]`
+    (unit quaternions), the point a pose (7), distances the pose error with
+    `metres_per_radian` (module docstring); `hand` the hand's pose (7) or None."""
+    members = _group(probabilities, selected, group_mass, commit_probability, committed)
+    if members is None or _held_near(poses, probabilities, selected, commit_radius,
+                                     metres_per_radian) >= commit_probability:
+        return GroupTarget(poses[selected].copy(), selected, 1)
+    weights = probabilities[members] / probabilities[members].sum()
+    rows = poses[members]
+    position = weights @ rows[:, :3]
+    # On the most probable member's hemisphere (q and -q are one orientation).
+    signs = np.where(rows[:, 3:] @ rows[0, 3:] < 0.0, -1.0, 1.0)
+    orientation = (weights * signs) @ rows[:, 3:]
+    norm = float(np.linalg.norm(orientation))
+    orientation = orientation / norm if norm > 1e-9 else rows[0, 3:].copy()
+    point = np.concatenate([position, orientation])
+
+    def errors(targets):
+        targets = np.atleast_2d(targets)
+        return (np.linalg.norm(targets[:, :3] - position, axis=1) + metres_per_radian
+                * angle_between(targets[:, 3:].T, orientation[:, np.newaxis]))
+
+    spread = float(np.max(errors(rows)))
+    # At the group's pose, or already at the selected grasp (the grasps of one object
+    # differ in orientation: a group of them can hold its point away from every grasp).
+    arrived = hand is not None and min(
+        float(errors(hand)[0]), _pose_error(hand, poses[selected], metres_per_radian)
+    ) <= commit_radius
+    return _committed_or_group(poses[selected], point, selected, len(members),
+                               spread <= commit_radius or arrived)
+
+
+def _held_near(poses, probabilities, selected, radius, metres_per_radian):
+    """The probability the goals within `radius` (pose error) of the selected one hold:
+    the grasps that act as one with it (O(K))."""
+    goal = poses[selected]
+    errors = (np.linalg.norm(poses[:, :3] - goal[:3], axis=1) + metres_per_radian
+              * angle_between(poses[:, 3:].T, goal[3:, np.newaxis]))
+    return float(probabilities[errors <= radius].sum())
+
+
+def _pose_error(pose, goal, metres_per_radian):
+    """`|p - g| + L angle(q, q_g)` of one pose (7) from one goal pose (7)."""
+    return float(np.linalg.norm(pose[:3] - goal[:3]) + metres_per_radian * angle_between(
+        pose[3:, np.newaxis], goal[3:, np.newaxis])[0])
+
+
+def _committed_or_group(goal, point, selected, size, together):
+    """The robot commits to `selected` (at `goal`) when the group is one goal or its goals
+    act as one (`together`), else heads for the group's `point` showing `NO_GOAL`."""
+    if size == 1 or together:
+        return GroupTarget(np.array(goal, dtype=float), selected, size)
     return GroupTarget(point, NO_GOAL, size)

@@ -53,6 +53,8 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import is_real
+from pbp_drake.core.grasp_task import approach_direction
+from pbp_drake.core.quaternion import angle_between, exp_map, multiply
 
 
 # A goal closer than this (m) to the hand on the floor plane has no bearing.
@@ -121,15 +123,7 @@ def intent_features(goals, position, motion, heading, yaw_rate, period, min_spee
     `heading` (rad), the `motion` (3, m/s: the operator's command when it `acts`, else the
     hand's own velocity) and the operator's `yaw_rate` (rad/s) over one `period` (s)."""
     offsets = goals - position
-    distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
-    speed = float(np.linalg.norm(motion))
-    if speed >= min_speed:
-        reach = np.maximum(distances, min_speed * period)
-        moves = _straightness(np.arccos(np.clip((offsets @ motion) / (reach * speed),
-                                                -1.0, 1.0)))
-        moves[distances < min_speed * period] = 0.0
-    else:
-        moves = np.zeros(len(goals))
+    moves = _moves(offsets, motion, period, min_speed)
     has_bearing = np.hypot(offsets[:, 0], offsets[:, 1]) > NO_BEARING
     error = _wrapped(np.arctan2(offsets[:, 1], offsets[:, 0]) - heading)
     headings = np.where(has_bearing, _straightness(np.abs(error)), 1.0)
@@ -140,6 +134,54 @@ def intent_features(goals, position, motion, heading, yaw_rate, period, min_spee
         turns = np.where(has_bearing, (np.abs(error) - np.abs(_wrapped(error - turn)))
                          / abs(turn), 0.0)
     return IntentFeatures(moves, headings, turns, bool(acts))
+
+
+def pose_intent_features(positions, orientations, position, orientation, velocity,
+                         angular_velocity, period, min_speed, acts=True, forward_key=True):
+    """The `IntentFeatures` of K grasp poses (`positions` (K, 3), unit `orientations`
+    (K, 4)) for the hand at `position` (3) with unit `orientation` (4), the motion
+    `velocity` (3, m/s) and the operator's `angular_velocity` (3, rad/s, world frame; 0
+    while silent) over one `period`. The moves are the position form's in 3-D. The heading
+    is the mean of two straightnesses: the orientation's, `1 - 2 theta_g / pi` (`theta_g`
+    the angle from the hand's orientation to g's), and where the approach axis z_H points
+    (`1 - 2 b_g / pi`, `b_g` the angle between z_H and `g - p`: the position form's
+    heading in 3-D). A turn's feature is `(theta_g - theta'_g) / (|w| dt)`, `theta'_g` the
+    angle after the turn (+1 wholly toward g's orientation, -1 wholly away; 0 while
+    `w = 0`). Without the
+    `forward_key` (PBP's operator, who cannot push along the hand's approach axis z_H), an
+    operator heading for g commands the part of `g - p` across z_H: its moves compare
+    the motion with that part (a goal in line with z_H then gets none)."""
+    offsets = positions - position
+    orientation = np.asarray(orientation, dtype=float)
+    approach = approach_direction(orientation)
+    across = offsets if forward_key or not acts else (
+        offsets - np.outer(offsets @ approach, approach))
+    moves = _moves(across, velocity, period, min_speed)
+    angles = angle_between(orientations.T, orientation[:, np.newaxis])
+    # Where the approach axis points: the 3-D form of the position task's heading.
+    distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+    pointing = np.where(distances > NO_BEARING, _straightness(np.arccos(np.clip(
+        offsets @ approach / np.maximum(distances, NO_BEARING),
+        -1.0, 1.0))), 1.0)
+    turn = float(np.linalg.norm(angular_velocity)) * period
+    if turn == 0.0:
+        turns = np.zeros(len(positions))
+    else:
+        turned = multiply(exp_map(np.asarray(angular_velocity, float) * period), orientation)
+        turns = (angles - angle_between(orientations.T, turned[:, np.newaxis])) / turn
+    return IntentFeatures(moves, 0.5 * (pointing + _straightness(angles)), turns, bool(acts))
+
+
+def _moves(offsets, motion, period, min_speed):
+    """The moves `m_g = 1 - 2 a_g / pi` of the goals at `offsets` (K, 3) from the hand."""
+    distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+    speed = float(np.linalg.norm(motion))
+    if speed < min_speed:
+        return np.zeros(len(offsets))
+    reach = np.maximum(distances, min_speed * period)
+    moves = _straightness(np.arccos(np.clip((offsets @ motion) / (reach * speed), -1.0, 1.0)))
+    moves[distances < min_speed * period] = 0.0
+    return moves
 
 
 def _straightness(angles):

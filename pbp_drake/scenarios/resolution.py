@@ -99,17 +99,17 @@ def resolve(scenario):
     Raises ScenarioError naming the first field whose value cannot be used.
     """
     _check_common(scenario)
-    if scenario.goal_estimator.group_mass > 0.0 and (
-            not isinstance(scenario.robot, TASK_ROBOTS) or isinstance(scenario.task, GraspTask)):
+    if scenario.goal_estimator.group_mass > 0.0 and not isinstance(scenario.robot,
+                                                                   TASK_ROBOTS):
         raise ScenarioError("scenario.goal_estimator.group_mass: goal groups steer the "
-                            "position DMPs of the reaching and obstacle tasks (HSR and arm); "
-                            "this scenario's robot or task has none: set it to 0")
+                            "DMPs of the robot tasks (reach, obstacles, grasp; HSR and arm); "
+                            "this scenario has a point robot: set it to 0")
     if estimator_entry(scenario.goal_estimator.method).reads == READS_INTENT and (
-            not isinstance(scenario.robot, TASK_ROBOTS) or isinstance(scenario.task, GraspTask)):
+            not isinstance(scenario.robot, TASK_ROBOTS)):
         raise ScenarioError("scenario.goal_estimator.method intent_filter reads the hand's "
-                            "position and heading in the reaching and obstacle tasks (HSR and "
-                            "arm); this scenario's robot or task has none: use pose or "
-                            "maxent_command on the grasping task, angle in the 2-D scenes")
+                            "pose and the operator's command in the robot tasks (reach, "
+                            "obstacles, grasp; HSR and arm); this scenario has a point robot: "
+                            "use angle in the 2-D scenes")
     if isinstance(scenario.robot, TASK_ROBOTS):
         return _resolve_task_robot(scenario)
     return _resolve_point_robot(scenario)

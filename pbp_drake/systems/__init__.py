@@ -27,8 +27,8 @@ from pbp_drake.systems.operators import (
 from pbp_drake.systems.pbp import (
     Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalGrouping, GoalsSource, HandOver,
     HeadingCommand, HopAssistance, IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator,
-    PoseBlender, PoseDmpBank,
-    PoseGoalEstimator, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator)
+    PoseBlender, PoseDmpBank, PoseGoalEstimator, PoseGoalGrouping, PoseHandOver,
+    PoseHopAssistance, PoseIntentFilterGoalEstimator, PoseMaxEntGoalEstimator)
 from pbp_drake.systems.sample_hold import SampleHold
 from pbp_drake.systems.tasks import (
     CollisionMonitor, CylinderObstacleGeometry, GraspTaskMonitor, MovingObstacles,
@@ -40,7 +40,8 @@ __all__ = [
     # The PBP loop.
     "Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalGrouping", "GoalsSource",
     "HandOver", "HeadingCommand", "IntentFilterGoalEstimator", "LikelyGoals", "PoseBlender",
-    "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver",
+    "PoseDmpBank", "PoseGoalEstimator", "PoseGoalGrouping", "PoseHandOver",
+    "PoseIntentFilterGoalEstimator",
     # The shared-autonomy baselines (HOP, predict-then-assist) and PBP's maxent_command estimator.
     "HopAssistance", "MaxEntGoalEstimator", "PoseHopAssistance", "PoseMaxEntGoalEstimator",
     # Operators.

@@ -1,6 +1,7 @@
 """The grasping task end to end: its diagram builds for every method, the virtual
 participant grasps the target by teleoperation and with PBP-Alt (with less intervention),
-and the commanded angular velocity never jumps by more than 0.3 rad/s in a tick."""
+also among many grasps an object with goal groups, and the commanded angular velocity never
+jumps by more than 0.3 rad/s in a tick."""
 
 import numpy as np
 import pytest
@@ -8,6 +9,7 @@ import pytest
 from pbp_drake.builder import build_diagram, run_task
 from pbp_drake.builder.grasp import ANGULAR_CHANGE_PER_TICK, MAX_HAND_ANGULAR_SPEED
 from pbp_drake.scenarios import load_scenario_file
+from pbp_drake.scenarios.overrides import ScenarioOverrides
 
 METHODS = ["pbp_continuous", "pbp_alternated", "fixed_alpha", "confidence_alpha", "teleop",
            "pbp_no_user"]
@@ -65,3 +67,21 @@ def test_the_palm_does_not_run_ahead_of_a_slowing_command(repo):
     assert result.success
     assert np.linalg.norm(result.commands[:, 3:6], axis=1).max() <= 0.2 + 1e-9
     assert result.peak_hand_speed <= 0.22
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("estimator", ["pose", "intent_filter"])
+def test_many_grasps_an_object_are_followed_as_groups_and_the_target_grasped(repo, estimator):
+    """Four objects of ten grasps each: the robot heads for the group of grasps the estimate
+    cannot yet tell apart, showing none until it commits, and the participant grasps the
+    target with the turns within the hand-over's limit."""
+    resolved = load_scenario_file(repo / "diagrams" / "hsr_grasp.yaml", ScenarioOverrides(
+        settings=("task.object_count=4", "task.grasps_per_object=10",
+                  "goal_estimator.group_mass=0.9", f"goal_estimator.method={estimator}",
+                  "goal_estimator.intent_filter.silence_rate=8", "seed=2"))).resolved
+    result = run_task(resolved)
+    assert result.success and result.switches == 2
+    shown = result.selected_goals
+    assert (shown == -1).any() and (shown >= 0).any() and (shown < 40).all()
+    steps = np.linalg.norm(np.diff(result.command_angular_velocities, axis=0), axis=1)
+    assert steps.max() <= ANGULAR_CHANGE_PER_TICK + 1e-9

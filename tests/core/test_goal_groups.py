@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
-from pbp_drake.core.goal_groups import NO_GOAL, group_target
-from pbp_drake import GoalGrouping
+from pbp_drake.core.goal_groups import NO_GOAL, group_target, pose_group_target
+from pbp_drake import GoalGrouping, PoseGoalGrouping
 
 SETTINGS = dict(group_mass=0.9, commit_radius=0.05, commit_probability=0.5)  # 0.8 by default
 
@@ -140,3 +140,69 @@ def test_the_system_moves_the_selected_goals_row_and_shows_none_until_committed(
     np.testing.assert_array_equal(
         system.get_followed_goals_output_port().Eval(context).reshape(3, 3), goals)
     assert system.get_shown_goal_output_port().Eval(context)[0] == 1
+
+
+# Grasp poses `[x, y, z, qw, qx, qy, qz]`: two grasps of one object 45 degrees apart about z,
+# and one of an object far away; the task's 3 cm per 10 degrees.
+EIGHTH = np.array([np.cos(np.pi / 8), 0.0, 0.0, np.sin(np.pi / 8)])
+POSES = np.array([[1.0, 0.0, 0.7, 1.0, 0.0, 0.0, 0.0],
+                  [1.0, 0.0, 0.7, *EIGHTH],
+                  [2.0, 1.0, 0.7, 1.0, 0.0, 0.0, 0.0]])
+METRES_PER_RADIAN = 0.03 / np.radians(10.0)
+
+
+def pose_target(probabilities, selected=0, **keywords):
+    return pose_group_target(POSES, np.asarray(probabilities, float), selected, **SETTINGS,
+                             metres_per_radian=METRES_PER_RADIAN, **keywords)
+
+
+def test_two_grasps_of_one_object_are_headed_for_at_their_mean_orientation():
+    result = pose_target([0.48, 0.48, 0.04])
+    assert result.shown == NO_GOAL and result.size == 2
+    # Half way (22.5 degrees about z), at their shared position.
+    np.testing.assert_allclose(result.point, [1.0, 0.0, 0.7, np.cos(np.pi / 16), 0.0, 0.0,
+                                              np.sin(np.pi / 16)], atol=1e-12)
+    # A quaternion's sign does not move the mean.
+    flipped = POSES.copy()
+    flipped[1, 3:] *= -1.0
+    again = pose_group_target(flipped, np.array([0.48, 0.48, 0.04]), 0, **SETTINGS,
+                              metres_per_radian=METRES_PER_RADIAN)
+    np.testing.assert_allclose(again.point, result.point, atol=1e-12)
+
+
+def test_the_hand_at_the_selected_grasp_or_at_the_groups_pose_commits():
+    probabilities = [0.48, 0.48, 0.04]
+    assert pose_target(probabilities, hand=np.array([0.5, 0.0, 0.7, 1, 0, 0, 0])).shown == (
+        NO_GOAL)
+    # At the selected grasp's position, turned 5 degrees off it: within 5 cm of pose error.
+    turned = np.array([np.cos(np.radians(2.5)), 0.0, 0.0, np.sin(np.radians(2.5))])
+    assert pose_target(probabilities, hand=np.array([1.02, 0.0, 0.7, *turned])).shown == 0
+    # At the right place but 45 degrees off: that is another grasp, no commitment.
+    assert pose_target(probabilities, selected=0,
+                       hand=np.array([1.0, 0.0, 0.7, *EIGHTH])).shown == NO_GOAL
+
+
+def test_grasps_that_act_as_one_with_the_selected_commit_together():
+    near = POSES.copy()
+    near[1, 3:] = [np.cos(np.radians(2.0)), 0.0, 0.0, np.sin(np.radians(2.0))]  # 4 degrees
+    result = pose_group_target(near, np.array([0.45, 0.4, 0.15]), 0, **SETTINGS,
+                               metres_per_radian=METRES_PER_RADIAN)
+    # Neither holds the commit probability (0.5) alone; together they do.
+    assert result.shown == 0
+    np.testing.assert_array_equal(result.point, near[0])
+
+
+def test_the_pose_system_moves_the_selected_grasps_row_and_shows_none_until_committed():
+    system = PoseGoalGrouping(3, GoalEstimatorSettings(**SETTINGS), 0.03, METRES_PER_RADIAN)
+    context = system.CreateDefaultContext()
+    system.get_goal_poses_input_port().FixValue(context, POSES.reshape(-1))
+    system.get_goal_probabilities_input_port().FixValue(context, [0.48, 0.48, 0.04])
+    system.get_selected_goal_input_port().FixValue(context, [1.0])
+    system.get_hand_pose_input_port().FixValue(context, np.concatenate(
+        [[0.0, 0.0, 0.7, 1.0], np.zeros(9)]))
+    followed = system.get_followed_poses_output_port().Eval(context).reshape(3, 7)
+    np.testing.assert_allclose(followed[1], pose_target([0.48, 0.48, 0.04], 1).point)
+    np.testing.assert_array_equal(followed[[0, 2]], POSES[[0, 2]])
+    assert system.get_shown_goal_output_port().Eval(context)[0] == NO_GOAL
+    with pytest.raises(ValueError, match="metres_per_radian must be a finite number >= 0"):
+        PoseGoalGrouping(3, GoalEstimatorSettings(**SETTINGS), 0.03, float("nan"))

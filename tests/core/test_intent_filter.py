@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from pbp_drake.core.intent_filter import (
-    IntentFeatures, IntentFilterSettings, filter_step, intent_features, switch_probability)
+    IntentFeatures, IntentFilterSettings, filter_step, intent_features, pose_intent_features,
+    switch_probability)
+from pbp_drake.core.quaternion import exp_map
 from pbp_drake.studies import runaway
 
 PERIOD = 0.03
@@ -44,6 +46,39 @@ def test_a_turn_toward_a_goal_scores_one_and_away_minus_one():
     assert features.turns[0] == pytest.approx(-1.0)
     away = intent_features(GOALS, HAND, np.zeros(3), 0.0, -0.5, PERIOD, 0.01)
     assert away.turns[1] == pytest.approx(-1.0)
+
+
+# Grasp poses: ahead, left and above the hand, turned about z by 0, +0.5 and -0.5 rad; the
+# hand at the origin, its approach axis (z_H of the identity) straight up.
+POSES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+TURNS = np.array([exp_map(np.array([0.0, 0.0, angle])) for angle in (0.0, 0.5, -0.5)])
+IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def pose_features(velocity=np.zeros(3), angular_velocity=np.zeros(3), **keywords):
+    return pose_intent_features(POSES, TURNS, np.zeros(3), IDENTITY, velocity,
+                                angular_velocity, PERIOD, 0.01, **keywords)
+
+
+def test_a_pose_turn_toward_a_grasp_orientation_scores_one_and_away_minus_one():
+    features = pose_features(angular_velocity=np.array([0.0, 0.0, 0.4]))
+    np.testing.assert_allclose(features.turns, [-1.0, 1.0, -1.0], atol=1e-9)
+    # The heading: the orientation's straightness and where the approach axis points (up).
+    np.testing.assert_allclose(features.headings, [0.5, 0.5 * (1 - 1 / math.pi),
+                                                   0.5 * (2 - 1 / math.pi)], atol=1e-12)
+    np.testing.assert_array_equal(pose_features().turns, np.zeros(3))
+
+
+def test_a_pose_motion_is_read_in_3d_and_without_the_forward_key_across_the_approach():
+    upward = pose_features(velocity=np.array([0.0, 0.0, 0.1]))
+    np.testing.assert_allclose(upward.moves, [0.0, 0.0, 1.0], atol=1e-12)
+    # Without the forward key the operator cannot push along z_H (up): heading for the
+    # grasp above, it sends nothing; for the one ahead, its whole direction is across.
+    across = pose_features(velocity=np.array([0.1, 0.0, 0.0]), forward_key=False)
+    np.testing.assert_allclose(across.moves, [1.0, 0.0, 0.0], atol=1e-12)
+    # A silent operator's motion is the robot's, read whole.
+    silent = pose_features(velocity=np.array([0.0, 0.0, 0.1]), forward_key=False, acts=False)
+    np.testing.assert_allclose(silent.moves, [0.0, 0.0, 1.0], atol=1e-12)
 
 
 def _normalised_and_clipped(weights, max_probability):

@@ -4,6 +4,7 @@ path did. (The page itself is checked in tests/e2e/test_grasp_triads_in_browser.
 
 import dataclasses
 
+import msgpack
 import numpy as np
 import pytest
 from pydrake.geometry import Meshcat, MeshcatParams
@@ -30,15 +31,15 @@ def add_source(builder, value, port):
     builder.Connect(source.get_output_port(), port)
 
 
-def grasp_diagram(meshcat, predicted=None, hand=None):
-    """The visualizer with the target object 1, the estimate 0, and optionally a source of
-    predicted poses (a trajectory) and a hand pose."""
+def grasp_diagram(meshcat, predicted=None, hand=None, selected=0):
+    """The visualizer with the target object 1, the estimate `selected`, and optionally a
+    source of predicted poses (a trajectory) and a hand pose."""
     builder = DiagramBuilder()
     visualizer = builder.AddSystem(GraspSceneVisualizer(meshcat, SCENE, STEPS))
     target = np.zeros(Target.size)
     target[:3], target[3] = SCENE.objects[1], 1
     add_source(builder, target, visualizer.get_target_input_port())
-    add_source(builder, [0.0], visualizer.get_selected_goal_input_port())
+    add_source(builder, [float(selected)], visualizer.get_selected_goal_input_port())
     if predicted is not None:
         source = builder.AddSystem(TrajectorySource(predicted))
         builder.Connect(source.get_output_port(), visualizer.get_predicted_poses_input_port())
@@ -68,6 +69,17 @@ def test_every_grasp_pose_is_drawn_as_a_triad_on_initialisation(meshcat):
     assert not any(meshcat.HasPath(path) for path in triads)
     Simulator(diagram).Initialize()
     assert all(meshcat.HasPath(path) for path in triads)
+
+
+def test_the_estimate_ball_is_hidden_while_the_robot_shows_no_grasp(meshcat):
+    def ball_visible(selected):
+        simulator = Simulator(grasp_diagram(meshcat, selected=selected))
+        simulator.AdvanceTo(0.1)
+        packed = meshcat._GetPackedProperty("/task/estimated_goal", "visible")
+        return msgpack.unpackb(packed, raw=False)["value"] if packed else True
+
+    assert not ball_visible(-1)  # teleop, or a robot following a group of grasps
+    assert ball_visible(2)
 
 
 def test_a_replay_moves_and_turns_the_predicted_paths_triads(meshcat):

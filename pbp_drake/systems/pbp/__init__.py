@@ -1,11 +1,11 @@
 """The PBP loop's systems: the DMP banks, the goal estimators, the blenders and the hand-over,
 in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`, and for scenes of
 many goals `GoalGrouping` and the ``intent_filter`` estimator, `IntentFilterGoalEstimator`)
-and the six-DoF
-pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`, `PoseHandOver`); the goals'
-source, the heading command of the HSR tasks, the demonstration player of explicit
-arbitration and the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy
-baselines' systems: HOP's goal posterior on the operator's command (`MaxEntGoalEstimator`,
+and the six-DoF pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`,
+`PoseHandOver`, `PoseGoalGrouping`, `PoseIntentFilterGoalEstimator`); the goals' source,
+the heading command of the HSR tasks, the demonstration player of explicit arbitration and
+the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy baselines' systems:
+HOP's goal posterior on the operator's command (`MaxEntGoalEstimator`,
 `PoseMaxEntGoalEstimator`, also PBP's ``maxent_command`` estimator) and its assistance
 (`HopAssistance`, `PoseHopAssistance`)."""
 
@@ -13,13 +13,14 @@ from pbp_drake.systems.pbp.blender import Blender
 from pbp_drake.systems.pbp.demonstration_player import DemonstrationPlayer
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
 from pbp_drake.systems.pbp.goal_estimator import GoalEstimator
-from pbp_drake.systems.pbp.goal_grouping import GoalGrouping
+from pbp_drake.systems.pbp.goal_grouping import GoalGrouping, PoseGoalGrouping
 from pbp_drake.systems.pbp.goals_source import GoalsSource
 from pbp_drake.systems.pbp.hand_over import HandOver
 from pbp_drake.systems.pbp.heading_command import HeadingCommand
 from pbp_drake.systems.pbp.hop_assistance import HopAssistance
 from pbp_drake.systems.pbp.likely_goals import LikelyGoals
-from pbp_drake.systems.pbp.intent_filter_estimator import IntentFilterGoalEstimator
+from pbp_drake.systems.pbp.intent_filter_estimator import (
+    IntentFilterGoalEstimator, PoseIntentFilterGoalEstimator)
 from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator
 from pbp_drake.systems.pbp.pose_blender import PoseBlender
 from pbp_drake.systems.pbp.pose_dmp_bank import PoseDmpBank
@@ -33,5 +34,6 @@ __all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalGr
            "HandOver", "HeadingCommand", "HopAssistance", "IntentFilterGoalEstimator",
            "LikelyGoals", "MaxEntGoalEstimator",
            "PoseBlender",
-           "PoseDmpBank", "PoseGoalEstimator", "PoseHandOver", "PoseHopAssistance",
+           "PoseDmpBank", "PoseGoalEstimator", "PoseGoalGrouping",
+           "PoseIntentFilterGoalEstimator", "PoseGoalGrouping", "PoseHandOver", "PoseHopAssistance",
            "PoseMaxEntGoalEstimator"]

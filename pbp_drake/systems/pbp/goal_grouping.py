@@ -1,12 +1,14 @@
-"""Goal groups as a Drake system, between the goal estimator and the DMP bank."""
+"""Goal groups as Drake systems, between the goal estimator and the DMP bank: positions
+(`GoalGrouping`) and poses (`PoseGoalGrouping`, the grasping task)."""
 
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
-from pbp_drake.core.goal_groups import NO_GOAL, group_target
-from pbp_drake.systems.ports import EeState, PortGetters, checked_goal_count, goal_index
+from pbp_drake.core.goal_groups import NO_GOAL, group_target, pose_group_target
+from pbp_drake.systems.ports import (
+    EeState, GoalPose, PortGetters, PoseState, checked_goal_count, goal_index)
 from pbp_drake.systems.tick import decide_offset
 
 
@@ -38,32 +40,37 @@ class GoalGrouping(PortGetters, LeafSystem):
     estimator selects the same goal.
     """
 
+    # The goals' port and width, the hand's port and the part of it read, the output.
+    _GOALS, _WIDTH, _HAND, _HAND_READ = "goals", 3, "ee_state", EeState.size
+    _FOLLOWED_NAME = "followed_goals"
+
     def __init__(self, goal_count, settings, control_period):
         super().__init__()
         self._goal_count = k = checked_goal_count(goal_count)
+        width = self._WIDTH
         if not isinstance(settings, GoalEstimatorSettings):
             raise ValueError(f"settings must be a GoalEstimatorSettings, got "
                              f"{type(settings).__name__}")
         settings.validate()  # a plain dataclass: its fields may have changed since
         self._settings = (float(settings.group_mass), float(settings.commit_radius),
                           float(settings.commit_probability))
-        self._goals_port = self.DeclareVectorInputPort("goals", 3 * k)
+        self._goals_port = self.DeclareVectorInputPort(self._GOALS, width * k)
         self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        self._hand_port = self.DeclareVectorInputPort(self._HAND, self._HAND_READ)
         if not (np.isfinite(control_period) and control_period > 0.0):
             raise ValueError(f"control_period must be positive, got {control_period!r}")
         self._committed_index = self.DeclareDiscreteState(np.array([float(NO_GOAL)]))
         self.DeclarePeriodicDiscreteUpdateEvent(float(control_period),
                                                 decide_offset(control_period), self._commit)
-        # [followed goals (3 K), shown index]: computed once for both outputs.
+        # [followed goals (width K), shown index]: computed once for both outputs.
         self._target = self.DeclareCacheEntry(
             "followed goals and the shown goal",
-            ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(3 * k + 1)),
+            ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(width * k + 1)),
                           calc=self._calc_target),
             prerequisites_of_calc={self.all_input_ports_ticket(), self.xd_ticket()})
         self.DeclareVectorOutputPort(
-            "followed_goals", 3 * k,
+            self._FOLLOWED_NAME, width * k,
             lambda context, output: output.SetFromVector(self._target.Eval(context)[:-1]),
             prerequisites_of_calc={self._target.ticket()})
         self.DeclareVectorOutputPort(
@@ -71,17 +78,58 @@ class GoalGrouping(PortGetters, LeafSystem):
             lambda context, output: output.SetAtIndex(0, self._target.Eval(context)[-1]),
             prerequisites_of_calc={self._target.ticket()})
 
+    def _group(self, goals, probabilities, selected, hand, committed):
+        return group_target(goals, probabilities, selected, *self._settings, hand=hand[:3],
+                            committed=committed)
+
     def _commit(self, context, discrete_state):
         discrete_state.set_value(self._committed_index, [self._target.Eval(context)[-1]])
 
     def _calc_target(self, context, value):
-        goals = self._goals_port.Eval(context).reshape(self._goal_count, 3)
+        width = self._WIDTH
+        goals = self._goals_port.Eval(context).reshape(self._goal_count, width)
         selected = goal_index(self._selected_port, context, self._goal_count)
-        target = group_target(
-            goals, self._probabilities_port.Eval(context), selected, *self._settings,
-            hand=self._ee_state_port.Eval(context)[:3],
-            committed=int(context.get_discrete_state(self._committed_index).value()[0]))
+        target = self._group(
+            goals, self._probabilities_port.Eval(context), selected,
+            self._hand_port.Eval(context),
+            int(context.get_discrete_state(self._committed_index).value()[0]))
         result = value.get_mutable_value()
         result[:-1] = goals.reshape(-1)
-        result[3 * selected:3 * selected + 3] = target.point
+        result[width * selected:width * (selected + 1)] = target.point
         result[-1] = target.shown
+
+
+class PoseGoalGrouping(GoalGrouping):
+    """`GoalGrouping` for pose goals (the grasping task): the group's point is a pose.
+
+    .. pydrake_system::
+
+        name: PoseGoalGrouping
+        input_ports:
+        - goal_poses
+        - goal_probabilities
+        - selected_goal
+        - hand_pose
+        output_ports:
+        - followed_poses
+        - shown_goal
+
+    `goal_poses` is K `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened; `hand_pose` a
+    `PoseState` (its pose is read). `followed_poses` is `goal_poses` with the selected
+    goal's row moved to the group's pose (`pose_group_target`); distances are pose errors
+    with `metres_per_radian` (the task's success distance over its success angle).
+    """
+
+    _GOALS, _WIDTH, _HAND, _HAND_READ = "goal_poses", GoalPose.size, "hand_pose", PoseState.size
+    _FOLLOWED_NAME = "followed_poses"
+
+    def __init__(self, goal_count, settings, control_period, metres_per_radian):
+        if not (np.isfinite(metres_per_radian) and metres_per_radian >= 0.0):
+            raise ValueError(f"metres_per_radian must be a finite number >= 0, got "
+                             f"{metres_per_radian!r}")
+        self._metres_per_radian = float(metres_per_radian)
+        super().__init__(goal_count, settings, control_period)
+
+    def _group(self, goals, probabilities, selected, hand, committed):
+        return pose_group_target(goals, probabilities, selected, *self._settings,
+                                 self._metres_per_radian, hand=hand[:7], committed=committed)

@@ -1,12 +1,17 @@
-"""The ``intent_filter`` goal estimator as a Drake system (`pbp_drake.core.intent_filter`):
+"""The ``intent_filter`` goal estimator as Drake systems (`pbp_drake.core.intent_filter`):
 a recursive posterior over the K goals on the operator's motions, headings, turns and
-silences, with a hazard against runaway confidence."""
+silences, with a hazard against runaway confidence; for positions
+(`IntentFilterGoalEstimator`) and for the grasping task's poses
+(`PoseIntentFilterGoalEstimator`)."""
 
 import numpy as np
 
-from pbp_drake.core.intent_filter import IntentFilterSettings, filter_step, intent_features
+from pbp_drake.core.intent_filter import (
+    IntentFilterSettings, filter_step, intent_features, pose_intent_features)
+from pbp_drake.core.quaternion import unit_quaternions
 from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator, PosteriorInputs
-from pbp_drake.systems.ports import EeState, OperatorCommand
+from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstimator
+from pbp_drake.systems.ports import EeState, GoalPose, OperatorCommand
 
 
 class IntentFilterGoalEstimator(MaxEntGoalEstimator):
@@ -60,4 +65,61 @@ class IntentFilterGoalEstimator(MaxEntGoalEstimator):
             read.targets, read.position, read.command if active else read.hand_velocity,
             read.heading, read.yaw_rate if active else 0.0, self._period,
             self._settings.min_speed, active)
+        return filter_step(self._settings, log_belief, features, self._period)
+
+
+class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
+    """The intent filter on the hand's pose and the operator's twist: the grasping task's
+    ``intent_filter`` (`pbp_drake.core.intent_filter.pose_intent_features`).
+
+    .. pydrake_system::
+
+        name: PoseIntentFilterGoalEstimator
+        input_ports:
+        - hand_pose
+        - goal_poses
+        - operator_twist
+        - operator_active
+        output_ports:
+        - selected_goal
+        - goal_probabilities
+        - posterior_clipped
+
+    The ports are `PoseMaxEntGoalEstimator`'s. `forward_key` says whether
+    the method lets the operator push along the hand's approach axis (teleop does, PBP does
+    not): without it, the operator's motion is compared with the part of each goal's
+    direction across that axis. Each update reads the
+    operator's twist as the motion and the turn while it acts, the hand's executed
+    velocity (and no turn) while it is silent, and the hand's orientation;
+    `settings`, `margin` and `hold_steps` are `IntentFilterGoalEstimator`'s.
+    """
+
+    _SETTINGS = IntentFilterSettings
+
+    def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
+                 update_offset=None, forward_key=True):
+        super().__init__(goal_count, settings, control_period, margin, hold_steps,
+                         update_offset)
+        self._forward_key = bool(forward_key)
+
+    def _inputs(self, context):
+        poses = self._goals_port.Eval(context).reshape(self._goal_count, GoalPose.size)
+        hand = self._hand_port.Eval(context)
+        twist = self._twist_port.Eval(context)
+        orientation = hand[3:7] / np.linalg.norm(hand[3:7])
+        # `targets` holds the goal poses (K, 7): the filter reads no HOP targets.
+        return PosteriorInputs(poses, hand[:3], twist[:3], hand[7:10], orientation,
+                               twist[3:], hand[10:13])
+
+    def _posterior(self, context, read, log_belief):
+        poses = read.targets
+        if not np.isfinite(poses).all():
+            raise ValueError("goal_poses contain NaN or infinite values")
+        active = self._active_port.Eval(context)[0] > 0.5
+        features = pose_intent_features(
+            poses[:, :3], unit_quaternions(poses[:, 3:], "goal_poses orientation"),
+            read.position, read.orientation,
+            read.command if active else read.hand_velocity,
+            read.command_angular_velocity if active else np.zeros(3), self._period,
+            self._settings.min_speed, active, self._forward_key)
         return filter_step(self._settings, log_belief, features, self._period)

@@ -45,7 +45,9 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
     `/task/goal_cloud` (`GoalCloud`), coloured each `cloud_period` (or less often for
     thousands of grasps: `GoalCloud.period`) by its probability, as
     in the reaching task. Each publish moves the yellow ball above the `target`'s object
-    (`Target`; its index picks the object) and the blue ball above the `selected_goal`'s,
+    (`Target`; its index picks the object) and the blue ball above the `selected_goal`'s
+    (hidden while it is -1: the robot shows no intent, under teleop or while it follows a
+    group of grasps),
     and the hand's triad `/task/hand` to `hand_state` (`PoseState`), with
     `time_in_recording` so that `Meshcat.StartRecording` replays them. Each `path_period`
     the selected DMP's predicted poses (`predicted_poses`: `prediction_steps + 1` rows of
@@ -116,6 +118,7 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
                        TRIAD_LENGTH, TRIAD_RADIUS)
         meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
         meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
+        self._ball_shown = True
         draw_triad(meshcat, "/task/hand", None, TRIAD_LENGTH, TRIAD_RADIUS)
         meshcat.SetProperty("/task/hand", "visible", False)  # until a hand_state is seen
         if self._prediction_steps:
@@ -137,9 +140,15 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
             raise ValueError(f"target index {target} is not one of the {count} objects")
         meshcat.SetTransform("/task/target",
                              RigidTransform(objects[target] + [0, 0, TARGET_LIFT]), time)
-        selected = goal_index(self._selected_goal_port, context, count)
-        meshcat.SetTransform("/task/estimated_goal",
-                             RigidTransform(objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
+        selected = self._shown_goal(context)
+        if (selected is not None) != self._ball_shown:
+            # Sent only when that changes, so that a page's messages do not grow.
+            self._ball_shown = selected is not None
+            meshcat.SetProperty("/task/estimated_goal", "visible", self._ball_shown, time)
+        if selected is not None:
+            meshcat.SetTransform("/task/estimated_goal",
+                                 RigidTransform(objects[selected] + [0, 0, ESTIMATE_LIFT]),
+                                 time)
         if self._hand_state_port.HasValue(context):
             hand = self._hand_state_port.Eval(context)[:GoalPose.size]
             meshcat.SetTransform("/task/hand", pose_transform(hand), time)
@@ -151,14 +160,23 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         poses = self._predicted_poses_port.Eval(context).reshape(-1, GoalPose.size)
         self._path.show(self._meshcat, poses, context.get_time())
 
+    def _shown_goal(self, context):
+        """The selected grasp's index, or None while the robot shows none (-1)."""
+        if self._selected_goal_port.Eval(context)[0] < 0:
+            return None
+        return goal_index(self._selected_goal_port, context, len(self._grasps.objects))
+
     def _likeliest(self, context):
-        """The selected grasp and the likeliest others, `likely_triads` at most."""
-        count = len(self._grasps.grasp_positions)
-        selected = goal_index(self._selected_goal_port, context, count, unconnected=0)
+        """The selected grasp (while one is shown) and the likeliest others, `likely_triads`
+        at most."""
+        selected = self._shown_goal(context) if self._selected_goal_port.HasValue(
+            context) else 0
         if not self._probabilities_port.HasValue(context):
-            return [selected]
-        return likely_goal_indices(selected, self._probabilities_port.Eval(context),
-                                   self._likely_triads)
+            return [] if selected is None else [selected]
+        probabilities = self._probabilities_port.Eval(context)
+        if selected is None:
+            selected = int(np.argmax(probabilities))
+        return likely_goal_indices(selected, probabilities, self._likely_triads)
 
     def _publish_likely_grasps(self, context):
         time, likeliest = context.get_time(), self._likeliest(context)

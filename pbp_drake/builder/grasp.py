@@ -212,6 +212,10 @@ def build_grasp_diagram(resolved, meshcat=None):
     if (getattr(estimator, "operator_speed", None) is not None
             or isinstance(estimator, PoseIntentFilterGoalEstimator)):
         builder.Connect(active, estimator.get_operator_active_input_port())
+    if estimator.HasInputPort("shown_goal"):
+        # What the operator sees: its intervention is against it (the estimator's outputs
+        # are its state, so this closes no algebraic loop).
+        builder.Connect(shown, estimator.get_shown_goal_input_port())
     builder.Connect(twist, policy.get_operator_twist_input_port())
     # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
     builder.Connect(twist, estimator.get_operator_twist_input_port())
@@ -268,7 +272,7 @@ def _estimator(resolved, goal_count):
     """The goal estimator: HOP's posterior under hop and predict_then_assist (the most probable
     goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
     section's hysteresis and the likelihood of PBP's operator), the intent filter with
-    `{method: intent_filter}` (`PoseIntentFilterGoalEstimator`),
+    `{method: intent_filter}` (`PoseIntentFilterGoalEstimator`, reading the goal shown),
     else the `pose` estimator."""
     scenario = resolved.scenario
     period = scenario.control_period

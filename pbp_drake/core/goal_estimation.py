@@ -22,10 +22,10 @@ turns the scores into probabilities that sum to 1:
   command (Javdani et al. 2015; the scenario's `hop` settings,
   `pbp_drake.core.maxent_command`); recursive, so it keeps its belief in the estimator's
   state (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`).
-- ``intent_filter`` (the position tasks): a recursive posterior on the operator's motions,
+- ``intent_filter`` (the robot tasks): a recursive posterior on the operator's motions,
   silences and turns and the hand's heading, with a hazard against runaway confidence
   (`pbp_drake.core.intent_filter`, the section's `intent_filter` settings;
-  `IntentFilterGoalEstimator`).
+  `IntentFilterGoalEstimator`, `PoseIntentFilterGoalEstimator` in the grasping task).
 
 `ESTIMATORS` is the registry the scenario's `goal_estimator: {method: NAME}` is read
 through: each `Estimator` says what it reads (which picks its system) and, for those that
@@ -94,7 +94,7 @@ class GoalEstimatorSettings:
 
     #: The score: angle (the paper's heuristic), nearest, bayesian, pose (grasping task
     #: only), maxent_command (HOP's posterior on the operator's command) or intent_filter
-    #: (the position tasks).
+    #: (the robot tasks).
     method: str = "angle"
     #: The scale of the angle (rad), nearest (m) and pose (rad) scores.
     temperature: float = 0.1

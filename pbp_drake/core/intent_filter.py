@@ -79,6 +79,9 @@ class IntentFilterSettings:
     #: The weight (nats/s) of the robot's motion while the operator is silent (0: a silence
     #: is no evidence).
     silence_rate: float = 0.0
+    #: The weight (nats/s) against the goal the robot shows while the operator acts: an
+    #: operator takes over when the robot's intent is wrong (0: no evidence).
+    override_rate: float = 0.0
     #: How often the operator changes its goal (1/s): the filter's hazard.
     switch_rate: float = 3.0
     #: No goal's probability goes above this (the clip against certainty).
@@ -89,7 +92,7 @@ class IntentFilterSettings:
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
         for name in ("move_rate", "heading_weight", "turn_rate", "silence_rate",
-                     "switch_rate", "min_speed"):
+                     "override_rate", "switch_rate", "min_speed"):
             value = getattr(self, name)
             if not is_real(value) or not math.isfinite(value) or value < 0.0:
                 raise ValueError(f"intent_filter.{name} must be a finite number >= 0, got "
@@ -101,12 +104,14 @@ class IntentFilterSettings:
 
 class IntentFeatures(typing.NamedTuple):
     """One tick's features per goal, each (K,) in [-1, 1]: `moves`, `headings`, `turns`;
-    and whether the operator `acts` (else the moves are the robot's)."""
+    whether the operator `acts` (else the moves are the robot's); and the goal the robot
+    shows while it acts (`overridden`, -1: none), which its intervention is against."""
 
     moves: np.ndarray
     headings: np.ndarray
     turns: np.ndarray
     acts: bool = True
+    overridden: int = -1
 
 
 class FilterUpdate(typing.NamedTuple):
@@ -137,11 +142,13 @@ def intent_features(goals, position, motion, heading, yaw_rate, period, min_spee
 
 
 def pose_intent_features(positions, orientations, position, orientation, velocity,
-                         angular_velocity, period, min_speed, acts=True, forward_key=True):
+                         angular_velocity, period, min_speed, acts=True, forward_key=True,
+                         shown=-1):
     """The `IntentFeatures` of K grasp poses (`positions` (K, 3), unit `orientations`
     (K, 4)) for the hand at `position` (3) with unit `orientation` (4), the motion
     `velocity` (3, m/s) and the operator's `angular_velocity` (3, rad/s, world frame; 0
-    while silent) over one `period`. The moves are the position form's in 3-D. The heading
+    while silent) over one `period`; `shown` the goal the robot shows (-1: none), which an
+    acting operator overrides (`overridden`). The moves are the position form's in 3-D. The heading
     is the mean of two straightnesses: the orientation's, `1 - 2 theta_g / pi` (`theta_g`
     the angle from the hand's orientation to g's), and where the approach axis z_H points
     (`1 - 2 b_g / pi`, `b_g` the angle between z_H and `g - p`: the position form's
@@ -169,7 +176,9 @@ def pose_intent_features(positions, orientations, position, orientation, velocit
     else:
         turned = multiply(exp_map(np.asarray(angular_velocity, float) * period), orientation)
         turns = (angles - angle_between(orientations.T, turned[:, np.newaxis])) / turn
-    return IntentFeatures(moves, 0.5 * (pointing + _straightness(angles)), turns, bool(acts))
+    overridden = int(shown) if acts and 0 <= shown < len(positions) else -1
+    return IntentFeatures(moves, 0.5 * (pointing + _straightness(angles)), turns, bool(acts),
+                          overridden)
 
 
 def _moves(offsets, motion, period, min_speed):
@@ -202,7 +211,7 @@ def filter_step(settings, log_belief, features, period):
     """One tick of the filter (the module docstring's update): the `FilterUpdate` from the
     last recursive `log_belief` (K,) and this tick's `IntentFeatures`."""
     weights = np.array([[settings.move_rate, settings.turn_rate, settings.silence_rate,
-                         settings.heading_weight]])
+                         settings.heading_weight, settings.override_rate]])
     update = filter_update(np.asarray(log_belief, dtype=float)[np.newaxis], features,
                            weights, np.array([switch_probability(settings, period)]),
                            settings.max_probability, period)
@@ -212,15 +221,17 @@ def filter_step(settings, log_belief, features, period):
 
 def filter_update(log_beliefs, features, weights, hazards, max_probability, period):
     """`filter_step` for B operator models at once (the fit's sweep): `log_beliefs` (B, K)
-    the recursive beliefs, `weights` (B, 4) the move, turn and silence rates and the
-    heading's weight, `hazards` (B,) the switch probabilities. Returns a `FilterUpdate`
-    of (B, K) arrays (`clipped` (B,))."""
+    the recursive beliefs, `weights` (B, 4 or 5) the move, turn and silence rates, the
+    heading's weight and (a fifth column) the override rate, `hazards` (B,) the switch
+    probabilities. Returns a `FilterUpdate` of (B, K) arrays (`clipped` (B,))."""
     count = log_beliefs.shape[1]
     hazards = hazards[:, np.newaxis]
     with np.errstate(divide="ignore"):
         predicted = np.logaddexp(log_beliefs + np.log1p(-hazards), np.log(hazards / count))
     if features.acts:
         evidence = weights[:, 0:1] * features.moves + weights[:, 1:2] * features.turns
+        if features.overridden >= 0 and weights.shape[1] > 4:
+            evidence[:, features.overridden] -= weights[:, 4]
     else:  # silent: the robot's motion at the silence's rate
         evidence = weights[:, 2:3] * features.moves
     recursive, _ = clip_log_beliefs(_normalised(predicted + period * evidence),

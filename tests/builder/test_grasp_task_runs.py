@@ -78,7 +78,8 @@ def test_many_grasps_an_object_are_followed_as_groups_and_the_target_grasped(rep
     resolved = load_scenario_file(repo / "diagrams" / "hsr_grasp.yaml", ScenarioOverrides(
         settings=("task.object_count=4", "task.grasps_per_object=10",
                   "goal_estimator.group_mass=0.9", f"goal_estimator.method={estimator}",
-                  "goal_estimator.intent_filter.silence_rate=8", "seed=2"))).resolved
+                  "goal_estimator.intent_filter.silence_rate=8",
+                  "goal_estimator.intent_filter.override_rate=10", "seed=2"))).resolved
     result = run_task(resolved)
     assert result.success and result.switches == 2
     shown = result.selected_goals

@@ -81,6 +81,19 @@ def test_a_pose_motion_is_read_in_3d_and_without_the_forward_key_across_the_appr
     np.testing.assert_allclose(silent.moves, [0.0, 0.0, 1.0], atol=1e-12)
 
 
+def test_acting_while_a_goal_is_shown_is_evidence_against_it():
+    assert pose_features(shown=1).overridden == 1
+    assert pose_features(shown=1, acts=False).overridden == -1  # silent: no intervention
+    assert pose_features(shown=-1).overridden == -1
+    settings = IntentFilterSettings(heading_weight=0.0, override_rate=10.0)
+    uniform = np.log(np.full(3, 1.0 / 3.0))
+    update = filter_step(settings, uniform, pose_features(shown=1), PERIOD)
+    assert update.probabilities[1] < update.probabilities[0] == pytest.approx(
+        update.probabilities[2])
+    unshown = filter_step(settings, uniform, pose_features(), PERIOD)
+    np.testing.assert_allclose(unshown.probabilities, 1.0 / 3.0)
+
+
 def _normalised_and_clipped(weights, max_probability):
     total = sum(weights)
     posterior = [weight / total for weight in weights]
@@ -103,6 +116,8 @@ def _by_hand(settings, belief, features):
         if features.acts:
             rate = (settings.move_rate * features.moves[goal]
                     + settings.turn_rate * features.turns[goal])
+            if goal == features.overridden:
+                rate -= settings.override_rate
         else:
             rate = settings.silence_rate * features.moves[goal]
         weights.append(prior * math.exp(PERIOD * rate))
@@ -115,13 +130,15 @@ def _by_hand(settings, belief, features):
 @pytest.mark.parametrize("acts", [True, False])
 def test_a_step_is_the_hazard_the_evidence_the_clip_and_the_heading_on_top(acts):
     settings = IntentFilterSettings(move_rate=30.0, heading_weight=2.0, turn_rate=20.0,
-                                    silence_rate=10.0, switch_rate=0.4, max_probability=0.9)
+                                    silence_rate=10.0, override_rate=15.0, switch_rate=0.4,
+                                    max_probability=0.9)
     rng = np.random.default_rng(4)
     belief = [1.0 / len(GOALS)] * len(GOALS)
     log_belief = np.log(belief)
     clipped_once = False
     for _ in range(60):
-        features = IntentFeatures(*rng.uniform(-1.0, 1.0, (3, len(GOALS))), acts)
+        features = IntentFeatures(*rng.uniform(-1.0, 1.0, (3, len(GOALS))), acts,
+                                  int(rng.integers(-1, len(GOALS))))
         belief, expected = _by_hand(settings, belief, features)
         update = filter_step(settings, log_belief, features, PERIOD)
         np.testing.assert_allclose(np.exp(update.log_belief), belief, rtol=1e-12, atol=1e-15)
@@ -176,6 +193,7 @@ def test_a_silence_is_no_evidence_and_the_belief_drifts_back_to_the_heading():
     ("move_rate", -1.0, "intent_filter.move_rate must be a finite number >= 0"),
     ("heading_weight", float("nan"), "intent_filter.heading_weight must be a finite number"),
     ("silence_rate", -2.0, "intent_filter.silence_rate must be a finite number >= 0"),
+    ("override_rate", float("nan"), "intent_filter.override_rate must be a finite number"),
     ("turn_rate", True, "intent_filter.turn_rate must be a finite number"),
     ("switch_rate", float("inf"), "intent_filter.switch_rate must be a finite number"),
     ("max_probability", 0.0, "intent_filter.max_probability must lie in (0, 1]"),

@@ -80,12 +80,15 @@ class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
         - goal_poses
         - operator_twist
         - operator_active
+        - shown_goal (optional)
         output_ports:
         - selected_goal
         - goal_probabilities
         - posterior_clipped
 
-    The ports are `PoseMaxEntGoalEstimator`'s. `forward_key` says whether
+    The ports are `PoseMaxEntGoalEstimator`'s, and `shown_goal`, the goal the robot shows
+    the operator (`[index]`, -1: none; unconnected, none): while the operator acts it is
+    evidence against that goal, at `settings.override_rate`. `forward_key` says whether
     the method lets the operator push along the hand's approach axis (teleop does, PBP does
     not): without it, the operator's motion is compared with the part of each goal's
     direction across that axis. Each update reads the
@@ -102,6 +105,10 @@ class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
                          update_offset)
         self._forward_key = bool(forward_key)
 
+    def _declare_inputs(self, goal_count):
+        super()._declare_inputs(goal_count)
+        self._shown_port = self.DeclareVectorInputPort("shown_goal", 1)
+
     def _inputs(self, context):
         poses = self._goals_port.Eval(context).reshape(self._goal_count, GoalPose.size)
         hand = self._hand_port.Eval(context)
@@ -116,10 +123,12 @@ class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
         if not np.isfinite(poses).all():
             raise ValueError("goal_poses contain NaN or infinite values")
         active = self._active_port.Eval(context)[0] > 0.5
+        shown = (int(self._shown_port.Eval(context)[0]) if self._shown_port.HasValue(context)
+                 else -1)
         features = pose_intent_features(
             poses[:, :3], unit_quaternions(poses[:, 3:], "goal_poses orientation"),
             read.position, read.orientation,
             read.command if active else read.hand_velocity,
             read.command_angular_velocity if active else np.zeros(3), self._period,
-            self._settings.min_speed, active, self._forward_key)
+            self._settings.min_speed, active, self._forward_key, shown)
         return filter_step(self._settings, log_belief, features, self._period)

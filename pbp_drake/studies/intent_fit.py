@@ -89,8 +89,10 @@ def replay_of(result, min_speed):
                                      float(result.headings[tick]),
                                      float(commands[tick, 3]) if active else 0.0, period,
                                      min_speed, active))
-    return Replay(IntentFeatures(*(np.array(values) for values in zip(*ticks))),
-                  np.asarray(result.targets, dtype=int), period)
+    # Teleop shows no goal: nothing is overridden.
+    moves, headings, turns, acts, _ = zip(*ticks)
+    return Replay(IntentFeatures(np.array(moves), np.array(headings), np.array(turns),
+                                 np.array(acts)), np.asarray(result.targets, dtype=int), period)
 
 
 def scores(replays, models):
@@ -105,7 +107,7 @@ def scores(replays, models):
         log_beliefs = np.full((len(models), count), -np.log(count))
         score, ticks = np.zeros(len(models)), 0
         for tick, target in enumerate(replay.targets):
-            features = IntentFeatures(*(values[tick] for values in replay.features))
+            features = IntentFeatures(*(values[tick] for values in replay.features[:4]))
             update = filter_update(log_beliefs, features, weights, hazards,
                                    models[0].max_probability, replay.period)
             log_beliefs = update.log_belief

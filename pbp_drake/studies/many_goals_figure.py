@@ -1,7 +1,8 @@
-"""The K sweep's figure and table (docs/results/many-goals.md): PBP-Alt's success,
-intervention ratio and task time over teleop's against the number of goals K, following one
-goal (the paper's) and with goal groups under each estimator, from the summaries of the
-catalogue's many-goals studies. `make results` writes both after those studies; alone:
+"""The K sweep's figure and table (docs/results/many-goals.md): each method's success,
+intervention ratio and task time over teleop's against the number of goals K (PBP-Alt
+following one goal, the paper's, and with goal groups under each estimator; the other
+methods with groups and the intent filter where they follow DMPs), from the summaries of
+the catalogue's many-goals studies. `make results` writes both after those studies; alone:
 `python -m pbp_drake.studies.many_goals_figure [--outputs DIR] [--figure PNG] [--table MD]`.
 """
 
@@ -19,6 +20,11 @@ FIGURE = "many_goals.png"
 TABLE = "many_goals_sweep.md"
 GOAL_COUNTS = (4, 100, 1000)
 ESTIMATORS = ("angle", "nearest", "bayesian", "maxent_command", "intent_filter")
+#: The other methods, each K's study of them (goal groups and the intent filter, which HOP's
+#: methods, with no DMPs, do not use): method -> the line's label.
+OTHER_METHODS = {"pbp_continuous": "PBP-Cont, groups, intent_filter", "hop": "HOP",
+                 "predict_then_assist": "predict-then-assist",
+                 "confidence_alpha": "confidence_alpha, groups, intent_filter"}
 
 
 def study_name(goals, estimator=None):
@@ -27,6 +33,11 @@ def study_name(goals, estimator=None):
     if estimator is None:
         return f"hsr_reach_goals_{goals}"
     return f"hsr_reach_goals_{goals}_groups" + ("" if estimator == "angle" else f"_{estimator}")
+
+
+def methods_study_name(goals):
+    """The catalogue's study of the `OTHER_METHODS` at K `goals`."""
+    return f"hsr_reach_goals_{goals}_methods"
 
 
 def _method(outputs, name, method):
@@ -41,15 +52,20 @@ def sweep(outputs):
     that has its studies on disk (teleop's own line at time ratio 1)."""
     teleops = {goals: _method(outputs, study_name(goals), "teleop") for goals in GOAL_COUNTS}
     lines = {}
-    for label, estimator in [("PBP-Alt, one goal (angle)", None),
-                             *((f"PBP-Alt, groups, {e}", e) for e in ESTIMATORS)]:
+    # label -> (its study at K, the method read there)
+    for label, (name, method) in {
+            "PBP-Alt, one goal (angle)": (study_name, "pbp_alternated"),
+            **{f"PBP-Alt, groups, {e}": ((lambda goals, e=e: study_name(goals, e)),
+                                         "pbp_alternated") for e in ESTIMATORS},
+            **{label: (methods_study_name, method)
+               for method, label in OTHER_METHODS.items()}}.items():
         points = []
         for goals, teleop in teleops.items():
-            pbp = _method(outputs, study_name(goals, estimator), "pbp_alternated")
-            if teleop and pbp:
-                points.append((goals, pbp["intervention_ratio"]["mean"],
-                               pbp["task_time"]["mean"] / teleop["task_time"]["mean"],
-                               pbp["success_rate"]))
+            result = _method(outputs, name(goals), method)
+            if teleop and result:
+                points.append((goals, result["intervention_ratio"]["mean"],
+                               result["task_time"]["mean"] / teleop["task_time"]["mean"],
+                               result["success_rate"]))
         if points:
             lines[label] = points
     teleop = [(goals, method["intervention_ratio"]["mean"], 1.0, method["success_rate"])

@@ -19,7 +19,8 @@ import sys
 from pbp_drake.scenarios.pilots import PILOT_NAMES
 from pbp_drake.studies.arena_page import write_arena_page
 from pbp_drake.studies.many_goals_figure import (
-    ESTIMATORS, GOAL_COUNTS, plot_many_goals, write_sweep_table)
+    ESTIMATORS, GOAL_COUNTS, OTHER_METHODS, methods_study_name, plot_many_goals,
+    write_sweep_table)
 from pbp_drake.studies.many_goals_figure import sweep as many_goals_sweep
 from pbp_drake.studies.many_goals_figure import FIGURE as MANY_GOALS_FIGURE
 from pbp_drake.studies.many_goals_figure import TABLE as MANY_GOALS_TABLE
@@ -141,10 +142,17 @@ STUDIES = {
     "hsr_reach_goals_100_groups_pilots": [
         "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, "--methods",
         "pbp_alternated,teleop", *EVALUATION_30, "--pilots", ",".join(PILOT_NAMES)],
-    # The intent filter with goal groups: under every pilot, mistaken, on the arm.
-    "hsr_reach_goals_100_groups_intent_filter_pilots": [
-        "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, *INTENT_FILTER, "--methods",
-        "pbp_alternated", *EVALUATION_30, "--pilots", ",".join(PILOT_NAMES)],
+    # The intent filter with goal groups: under every pilot at each K (teleop under them at
+    # K = 100 is hsr_reach_goals_100_groups_pilots'), mistaken, on the arm.
+    **{f"hsr_reach_goals_{goals}_groups_intent_filter_pilots": [
+        "diagrams/hsr_reach.yaml", "--goals", str(goals), *GROUPS, *INTENT_FILTER, "--methods",
+        "pbp_alternated" if goals == 100 else "pbp_alternated,teleop", *EVALUATION_30,
+        "--pilots", ",".join(PILOT_NAMES)] for goals in MANY_GOALS},
+    # Every other method at each K, with goal groups and the intent filter where it follows
+    # DMPs (HOP's methods have none).
+    **{methods_study_name(goals): [
+        "diagrams/hsr_reach.yaml", "--goals", str(goals), *GROUPS, *INTENT_FILTER, "--methods",
+        ",".join(OTHER_METHODS), *EVALUATION_30] for goals in MANY_GOALS},
     "hsr_reach_goals_100_groups_intent_filter_mistaken": [
         "diagrams/hsr_reach.yaml", "--goals", "100", *GROUPS, *INTENT_FILTER, "--methods",
         "pbp_alternated", *EVALUATION_30, "--participant-condition", "mistaken"],

@@ -5,8 +5,7 @@ station, the hand driven to a grasp pose (position and orientation).
                                                                  blender, task_monitor,
                                                                  operator
     goal_poses ──> goal_estimator, dmp_bank
-    goal_estimator.selected_goal ──> dmp_bank (followed_goal, selected_goal), operator,
-                                     task_visualizer
+    goal_estimator.selected_goal ──> dmp_bank (followed_goal, selected_goal), operator
     goal_estimator.goal_probabilities ──> blender (confidence_alpha)
     dmp_bank.selected_reference ──> blender.policy_reference
     operator (operator_command: OperatorTwist, operator_active) ──> blender, dmp_bank
@@ -15,7 +14,7 @@ station, the hand driven to a grasp pose (position and orientation).
                                                                    goal_estimator
     task_monitor.target ──> operator
     blender.reference ──> hand_over (PoseHandOver) ──> hsr_station.pose_command
-    task_monitor.target, goal_estimator.selected_goal, dmp_bank.predicted_poses,
+    task_monitor.target, the goal shown, dmp_bank.predicted_poses,
     hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
 
 With `goal_estimator: {group_mass: M}` (M > 0) a `PoseGoalGrouping` stands between

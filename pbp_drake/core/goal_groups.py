@@ -28,7 +28,10 @@ quaternion on the hemisphere of the most probable one, the sum normalised: the c
 mean, close to the geodesic one for the nearby orientations a group holds). Distances are
 the task's pose error `|p - g| + L angle(q, q_g)` (`L` metres per radian: with the task's
 `success_distance / success_angle`, turning by the success angle counts as moving the
-success distance), so that `commit_radius` bounds turns as well as moves.
+success distance), so that `commit_radius` bounds turns as well as moves. The robot also
+commits once the hand is within `commit_radius` of the selected grasp, or the grasps within
+`commit_radius` of it hold `commit_probability` together: an object's grasps differ in
+orientation at nearly one place, and a group of them can hold its pose away from each.
 """
 
 import typing
@@ -66,7 +69,7 @@ def _most_probable(probabilities, mass):
         m = min(count, 4 * m)
 
 
-def _group(probabilities, selected, group_mass, commit_probability, committed):
+def _members(probabilities, selected, group_mass, commit_probability, committed):
     """The members of the group (most probable first), or None when the robot commits to
     `selected` whatever the group: its probability is high enough, or it was committed to."""
     best = int(np.argmax(probabilities))
@@ -81,7 +84,7 @@ def group_target(goals, probabilities, selected, group_mass, commit_radius,
     `selected` goal committed to when the group allows (module docstring): `hand` (3) is
     the hand's position (None: not read), `committed` the goal committed to before
     (`NO_GOAL`: none)."""
-    members = _group(probabilities, selected, group_mass, commit_probability, committed)
+    members = _members(probabilities, selected, group_mass, commit_probability, committed)
     if members is None:
         return GroupTarget(goals[selected].copy(), selected, 1)
     weights = probabilities[members]
@@ -97,10 +100,12 @@ def pose_group_target(poses, probabilities, selected, group_mass, commit_radius,
     """`group_target` for pose goals: `poses` (K, 7) rows `[x, y, z, qw, qx, qy, qz]`
     (unit quaternions), the point a pose (7), distances the pose error with
     `metres_per_radian` (module docstring); `hand` the hand's pose (7) or None."""
-    members = _group(probabilities, selected, group_mass, commit_probability, committed)
-    if members is None or _held_near(poses, probabilities, selected, commit_radius,
-                                     metres_per_radian) >= commit_probability:
-        return GroupTarget(poses[selected].copy(), selected, 1)
+    members = _members(probabilities, selected, group_mass, commit_probability, committed)
+    goal = poses[selected]
+    # The grasps within the radius of the selected one act as one with it.
+    if members is None or float(probabilities[_pose_errors(
+            poses, goal, metres_per_radian) <= commit_radius].sum()) >= commit_probability:
+        return GroupTarget(goal.copy(), selected, 1)
     weights = probabilities[members] / probabilities[members].sum()
     rows = poses[members]
     position = weights @ rows[:, :3]
@@ -110,35 +115,19 @@ def pose_group_target(poses, probabilities, selected, group_mass, commit_radius,
     norm = float(np.linalg.norm(orientation))
     orientation = orientation / norm if norm > 1e-9 else rows[0, 3:].copy()
     point = np.concatenate([position, orientation])
-
-    def errors(targets):
-        targets = np.atleast_2d(targets)
-        return (np.linalg.norm(targets[:, :3] - position, axis=1) + metres_per_radian
-                * angle_between(targets[:, 3:].T, orientation[:, np.newaxis]))
-
-    spread = float(np.max(errors(rows)))
+    spread = float(np.max(_pose_errors(rows, point, metres_per_radian)))
     # At the group's pose, or already at the selected grasp (the grasps of one object
     # differ in orientation: a group of them can hold its point away from every grasp).
-    arrived = hand is not None and min(
-        float(errors(hand)[0]), _pose_error(hand, poses[selected], metres_per_radian)
-    ) <= commit_radius
-    return _committed_or_group(poses[selected], point, selected, len(members),
+    arrived = hand is not None and float(np.min(_pose_errors(
+        np.vstack([point, goal]), hand, metres_per_radian))) <= commit_radius
+    return _committed_or_group(goal, point, selected, len(members),
                                spread <= commit_radius or arrived)
 
 
-def _held_near(poses, probabilities, selected, radius, metres_per_radian):
-    """The probability the goals within `radius` (pose error) of the selected one hold:
-    the grasps that act as one with it (O(K))."""
-    goal = poses[selected]
-    errors = (np.linalg.norm(poses[:, :3] - goal[:3], axis=1) + metres_per_radian
-              * angle_between(poses[:, 3:].T, goal[3:, np.newaxis]))
-    return float(probabilities[errors <= radius].sum())
-
-
-def _pose_error(pose, goal, metres_per_radian):
-    """`|p - g| + L angle(q, q_g)` of one pose (7) from one goal pose (7)."""
-    return float(np.linalg.norm(pose[:3] - goal[:3]) + metres_per_radian * angle_between(
-        pose[3:, np.newaxis], goal[3:, np.newaxis])[0])
+def _pose_errors(poses, pose, metres_per_radian):
+    """`|p - g| + L angle(q, q_g)` of each of `poses` (N, 7) from `pose` (7)."""
+    return (np.linalg.norm(poses[:, :3] - pose[:3], axis=1) + metres_per_radian
+            * angle_between(poses[:, 3:].T, np.asarray(pose[3:])[:, np.newaxis]))
 
 
 def _committed_or_group(goal, point, selected, size, together):

@@ -27,7 +27,8 @@ persists, and seeing it again every tick is no new evidence: it is read once, as
 present observation, on top of the recursive belief and not into it:
 
     log b_t(g) = log((1 - h) b_{t-1}(g) + h / K) + dt (move_rate m_g + turn_rate t_g)
-                 (silent: + dt silence_rate m_g)
+                 (silent: + dt silence_rate m_g;
+                  acting while the robot shows g: - dt override_rate)
     log P_t(g) = log b_t(g) + heading_weight h_g,
 
 each normalised and its largest probability clipped at `max_probability` with the excess
@@ -40,10 +41,16 @@ The rates, the heading's weight and the switch rate are the operator model's par
 fitted on the tuning seeds of teleop under the arena's pilots (never on PBP's trials) by
 `python -m pbp_drake.studies.intent_fit`, which maximises the mean log probability the
 filter gives the participant's own target, tick by tick; the shipped defaults are its
-output. `silence_rate` is not fitted (under teleop a silence leaves the hand still) and is
-0 by default: a silence is no evidence, and the belief drifts back toward uniform at the
-switch rate while the present heading carries the estimate. Vectorised over K (no Python
-loop over goals), in log space.
+output. `silence_rate` and `override_rate` are not fitted (under teleop a silence leaves
+the hand still, and no goal is shown) and are 0 by default: a silence is no evidence, and
+the belief drifts back toward uniform at the switch rate while the present heading carries
+the estimate. Vectorised over K (no Python loop over goals), in log space.
+
+The grasping task's goals are poses (`pose_intent_features`): the motion is read in 3-D
+(without the forward key, across the hand's approach axis), the turns toward each grasp's
+orientation, and the heading from the hand's orientation and where its approach axis
+points; its studies set the silence and override rates, chosen on PBP's tuning seeds
+(docs/results/many-goals.md).
 """
 
 import dataclasses
@@ -148,16 +155,17 @@ def pose_intent_features(positions, orientations, position, orientation, velocit
     (K, 4)) for the hand at `position` (3) with unit `orientation` (4), the motion
     `velocity` (3, m/s) and the operator's `angular_velocity` (3, rad/s, world frame; 0
     while silent) over one `period`; `shown` the goal the robot shows (-1: none), which an
-    acting operator overrides (`overridden`). The moves are the position form's in 3-D. The heading
-    is the mean of two straightnesses: the orientation's, `1 - 2 theta_g / pi` (`theta_g`
-    the angle from the hand's orientation to g's), and where the approach axis z_H points
-    (`1 - 2 b_g / pi`, `b_g` the angle between z_H and `g - p`: the position form's
-    heading in 3-D). A turn's feature is `(theta_g - theta'_g) / (|w| dt)`, `theta'_g` the
-    angle after the turn (+1 wholly toward g's orientation, -1 wholly away; 0 while
-    `w = 0`). Without the
-    `forward_key` (PBP's operator, who cannot push along the hand's approach axis z_H), an
-    operator heading for g commands the part of `g - p` across z_H: its moves compare
-    the motion with that part (a goal in line with z_H then gets none)."""
+    acting operator overrides (`overridden`).
+
+    The moves are the position form's in 3-D. Without the `forward_key` (PBP's operator,
+    who cannot push along the hand's approach axis z_H), an operator heading for g sends
+    the part of `g - p` across z_H, and the moves compare the motion with that part (a goal
+    in line with z_H then gets none). The heading is the mean of two straightnesses: the
+    orientation's, `1 - 2 theta_g / pi` (`theta_g` the angle from the hand's orientation
+    to g's), and where z_H points, `1 - 2 b_g / pi` (`b_g` the angle between z_H and
+    `g - p`: the position form's heading in 3-D). A turn's feature is
+    `(theta_g - theta'_g) / (|w| dt)`, `theta'_g` the angle after the turn: +1 wholly
+    toward g's orientation, -1 wholly away, 0 while `w = 0`."""
     offsets = positions - position
     orientation = np.asarray(orientation, dtype=float)
     approach = approach_direction(orientation)
@@ -168,8 +176,7 @@ def pose_intent_features(positions, orientations, position, orientation, velocit
     # Where the approach axis points: the 3-D form of the position task's heading.
     distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
     pointing = np.where(distances > NO_BEARING, _straightness(np.arccos(np.clip(
-        offsets @ approach / np.maximum(distances, NO_BEARING),
-        -1.0, 1.0))), 1.0)
+        offsets @ approach / np.maximum(distances, NO_BEARING), -1.0, 1.0))), 1.0)
     turn = float(np.linalg.norm(angular_velocity)) * period
     if turn == 0.0:
         turns = np.zeros(len(positions))

@@ -40,8 +40,8 @@ class GoalGrouping(PortGetters, LeafSystem):
     estimator selects the same goal.
     """
 
-    # The goals' port and width, the hand's port and the part of it read, the output.
-    _GOALS, _WIDTH, _HAND, _HAND_READ = "goals", 3, "ee_state", EeState.size
+    # The goals' input and numbers per goal, the hand's input and its size, the output.
+    _GOALS, _WIDTH, _HAND, _HAND_SIZE = "goals", 3, "ee_state", EeState.size
     _FOLLOWED_NAME = "followed_goals"
 
     def __init__(self, goal_count, settings, control_period):
@@ -57,7 +57,7 @@ class GoalGrouping(PortGetters, LeafSystem):
         self._goals_port = self.DeclareVectorInputPort(self._GOALS, width * k)
         self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
-        self._hand_port = self.DeclareVectorInputPort(self._HAND, self._HAND_READ)
+        self._hand_port = self.DeclareVectorInputPort(self._HAND, self._HAND_SIZE)
         if not (np.isfinite(control_period) and control_period > 0.0):
             raise ValueError(f"control_period must be positive, got {control_period!r}")
         self._committed_index = self.DeclareDiscreteState(np.array([float(NO_GOAL)]))
@@ -120,7 +120,7 @@ class PoseGoalGrouping(GoalGrouping):
     with `metres_per_radian` (the task's success distance over its success angle).
     """
 
-    _GOALS, _WIDTH, _HAND, _HAND_READ = "goal_poses", GoalPose.size, "hand_pose", PoseState.size
+    _GOALS, _WIDTH, _HAND, _HAND_SIZE = "goal_poses", GoalPose.size, "hand_pose", PoseState.size
     _FOLLOWED_NAME = "followed_poses"
 
     def __init__(self, goal_count, settings, control_period, metres_per_radian):

@@ -80,11 +80,15 @@ def plot_many_goals(lines, figure):
     is empty (no study on disk)."""
     if not lines:
         return False
-    fig, (intervention, time) = plt.subplots(1, 2, figsize=(10, 4))
-    for label, points in lines.items():
+    fig, (intervention, time) = plt.subplots(1, 2, figsize=(10, 5))
+    # tab20's dark shades, then its light ones: a colour of its own for each line; teleop's
+    # black.
+    colours = plt.get_cmap("tab20").colors[::2] + plt.get_cmap("tab20").colors[1::2]
+    for index, (label, points) in enumerate(lines.items()):
         goals, ratio, time_ratio, _ = zip(*points)
-        style = dict(marker="o", label=label, linestyle="--" if "teleop" in label or
-                     "one goal" in label else "-")
+        colour = "black" if label == "teleop" else colours[index % len(colours)]
+        style = dict(marker="o", label=label, color=colour,
+                     linestyle="--" if "teleop" in label or "one goal" in label else "-")
         intervention.plot(goals, ratio, **style)
         time.plot(goals, time_ratio, **style)
     for axes, title in ((intervention, "intervention ratio"),
@@ -95,9 +99,10 @@ def plot_many_goals(lines, figure):
         axes.set_title(title)
         axes.grid(alpha=0.3)
     intervention.set_ylim(0.0, 1.05)
-    time.legend(fontsize=7, loc="upper left")
+    fig.legend(*intervention.get_legend_handles_labels(), loc="lower center", ncol=3,
+               fontsize=8)
     fig.suptitle("Reaching with K goals on a grid, evaluation seeds (means over 30 trials)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.17, 1.0, 1.0))
     pathlib.Path(figure).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(figure, dpi=110)
     plt.close(fig)

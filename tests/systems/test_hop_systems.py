@@ -1,5 +1,6 @@
 """HOP's systems in small diagrams: the goal posterior (`MaxEntGoalEstimator`,
-`PoseMaxEntGoalEstimator`) and the intent filter (`IntentFilterGoalEstimator`) keep the
+`PoseMaxEntGoalEstimator`) and the intent filter (`IntentFilterGoalEstimator`,
+`PoseIntentFilterGoalEstimator`) keep the
 core's recursive belief tick by tick, in the Context alone; the assistance
 (`HopAssistance`, `PoseHopAssistance`) sends the operator's command plus HOP's action, and
 predict-then-assist the operator's alone until it is confident."""
@@ -15,10 +16,11 @@ from pbp_drake.core import quaternion
 from pbp_drake.core.grasp_task import side_grasp_orientation
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, assisted_command, hop_targets, uniform_log_belief, update_posterior)
-from pbp_drake.core.intent_filter import IntentFilterSettings, filter_step, intent_features
+from pbp_drake.core.intent_filter import (
+    IntentFilterSettings, filter_step, intent_features, pose_intent_features)
 from pbp_drake.systems import (
     HopAssistance, IntentFilterGoalEstimator, MaxEntGoalEstimator, PoseHopAssistance,
-    PoseMaxEntGoalEstimator)
+    PoseIntentFilterGoalEstimator, PoseMaxEntGoalEstimator)
 
 PERIOD = 0.03
 SETTINGS = HopSettings()
@@ -98,6 +100,41 @@ def test_the_intent_filter_keeps_the_cores_belief_tick_by_tick(active):
         np.testing.assert_allclose(outputs(estimator, simulator)[1], update.probabilities,
                                    rtol=0, atol=1e-14)
     assert outputs(estimator, simulator)[0] == (0 if active else 2)
+
+
+@pytest.mark.parametrize("active, forward_key, shown", [(1.0, True, -1), (1.0, False, 0),
+                                                       (0.0, False, 0)])
+def test_the_pose_intent_filter_keeps_the_cores_belief_tick_by_tick(active, forward_key,
+                                                                    shown):
+    """`PoseIntentFilterGoalEstimator` (the grasping task's ``intent_filter``): the core's
+    pose features on the operator's twist while it acts and the hand's own while it is
+    silent, the goal shown overridden while it acts, the forward key as the method has it."""
+    settings = IntentFilterSettings(silence_rate=8.0, override_rate=10.0)
+    orientations = np.array([side_grasp_orientation(angle) for angle in (0.3, -0.3, 1.2)])
+    hand = np.concatenate([HAND, side_grasp_orientation(0.0), [0.0, 0.1, 0.0, 0.0, 0.0, 0.0]])
+    twist = np.concatenate([TOWARD_FIRST, [0.0, 0.0, 0.3]])
+    builder = DiagramBuilder()
+    estimator = builder.AddSystem(PoseIntentFilterGoalEstimator(
+        len(GOALS), settings, PERIOD, forward_key=forward_key))
+    builder.Connect(constant(builder, hand), estimator.get_hand_pose_input_port())
+    builder.Connect(constant(builder, np.hstack([GOALS, orientations]).reshape(-1)),
+                    estimator.get_goal_poses_input_port())
+    builder.Connect(constant(builder, twist), estimator.get_operator_twist_input_port())
+    builder.Connect(constant(builder, [active]), estimator.get_operator_active_input_port())
+    builder.Connect(constant(builder, [shown]), estimator.get_shown_goal_input_port())
+    simulator = Simulator(builder.Build())
+    simulator.Initialize()
+    log_belief = uniform_log_belief(3)
+    velocity, angular_velocity = (twist[:3], twist[3:]) if active else (hand[7:10],
+                                                                        np.zeros(3))
+    for tick in range(20):
+        simulator.AdvanceTo(tick * PERIOD + 1e-4)
+        update = filter_step(settings, log_belief, pose_intent_features(
+            GOALS, orientations, HAND, hand[3:7], velocity, angular_velocity, PERIOD,
+            settings.min_speed, bool(active), forward_key, shown), PERIOD)
+        log_belief = update.log_belief
+        np.testing.assert_allclose(outputs(estimator, simulator)[1], update.probabilities,
+                                   rtol=0, atol=1e-14)
 
 
 def test_the_intent_filter_takes_its_own_settings():

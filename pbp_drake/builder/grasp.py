@@ -208,8 +208,9 @@ def build_grasp_diagram(resolved, meshcat=None):
     if dmp_bank is not None:
         builder.Connect(active, dmp_bank.get_operator_active_input_port())
         builder.Connect(active, policy.get_operator_active_input_port())
-    if (getattr(estimator, "operator_speed", None) is not None
-            or isinstance(estimator, PoseIntentFilterGoalEstimator)):
+    # The recursive estimators read whether the operator acts (HOP's own belief does not,
+    # and leaves its port unread).
+    if estimator.HasInputPort("operator_active"):
         builder.Connect(active, estimator.get_operator_active_input_port())
     if estimator.HasInputPort("shown_goal"):
         # What the operator sees: its intervention is against it (the estimator's outputs
@@ -278,11 +279,12 @@ def _estimator(resolved, goal_count):
     settings = scenario.goal_estimator
     if METHODS[scenario.method].policy == ASSISTED:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
-    if estimator_entry(settings.method).reads == READS_INTENT:
+    reads = estimator_entry(settings.method).reads
+    if reads == READS_INTENT:
         return PoseIntentFilterGoalEstimator(goal_count, settings.intent_filter, period,
                                              settings.margin, settings.hold_steps,
                                              forward_key=forward_key_enabled(scenario))
-    if estimator_entry(settings.method).reads == READS_COMMAND:
+    if reads == READS_COMMAND:
         return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
                                        settings.hold_steps,
                                        operator_speed=resolved.nominal_speed)

@@ -35,5 +35,5 @@ __all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalGr
            "LikelyGoals", "MaxEntGoalEstimator",
            "PoseBlender",
            "PoseDmpBank", "PoseGoalEstimator", "PoseGoalGrouping",
-           "PoseIntentFilterGoalEstimator", "PoseGoalGrouping", "PoseHandOver", "PoseHopAssistance",
+           "PoseIntentFilterGoalEstimator", "PoseHandOver", "PoseHopAssistance",
            "PoseMaxEntGoalEstimator"]

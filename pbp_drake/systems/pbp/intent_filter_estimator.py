@@ -91,10 +91,10 @@ class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
     evidence against that goal, at `settings.override_rate`. `forward_key` says whether
     the method lets the operator push along the hand's approach axis (teleop does, PBP does
     not): without it, the operator's motion is compared with the part of each goal's
-    direction across that axis. Each update reads the
-    operator's twist as the motion and the turn while it acts, the hand's executed
-    velocity (and no turn) while it is silent, and the hand's orientation;
-    `settings`, `margin` and `hold_steps` are `IntentFilterGoalEstimator`'s.
+    direction across that axis. Each update reads the operator's twist as the motion and
+    the turn while it acts, the hand's executed velocity (and no turn) while it is silent,
+    and the hand's orientation; `settings`, `margin` and `hold_steps` are
+    `IntentFilterGoalEstimator`'s.
     """
 
     _SETTINGS = IntentFilterSettings

@@ -1,5 +1,7 @@
+import gc
 import pathlib
 import sys
+import threading
 
 import pytest
 from pydrake.geometry import Meshcat, MeshcatParams
@@ -17,6 +19,23 @@ def repo():
 def meshcat():
     """A Meshcat on a free local port (port 0), used only from the test's thread."""
     return Meshcat(MeshcatParams(host="localhost", port=0))
+
+
+_start_thread = threading.Thread.start
+
+
+def _start_after_collecting(thread):
+    """Drake ends the process when a Meshcat is destroyed on another thread than the one that
+    made it, and Python's cycle collector runs on whichever thread happens to allocate: a
+    Meshcat that an earlier test left in a reference cycle (a LeafSystem holding it, owned by
+    a diagram) could be destroyed on a page's reader thread. So the garbage is collected here,
+    on the tests' thread, before any other thread starts."""
+    if threading.current_thread() is threading.main_thread():
+        gc.collect()
+    _start_thread(thread)
+
+
+threading.Thread.start = _start_after_collecting
 
 
 def pytest_collection_modifyitems(items):

@@ -113,12 +113,12 @@ bench: $(VENV)/.installed-bench
 soak: $(STAMP)
 	$(PYTHON) -m pbp_drake_bench.soak --minutes 60
 
-# Every study the docs quote (the list: pbp_drake/studies/results_catalogue.py), each with
+# Every study the docs quote (the list: pbp_drake_bench/results_catalogue.py), each with
 # --jobs 2 into outputs/results/NAME, and its table into docs/results/generated/NAME.md
 # (`pbp-drake report DIR --markdown FILE`, whose first line is the command that made it).
 # About 15 minutes on an idle 2-core machine; run again after an interruption, it resumes.
 results: $(STAMP)
-	$(PYTHON) -m pbp_drake.studies.results_catalogue
+	$(PYTHON) -m pbp_drake_bench.results_catalogue
 
 # The documentation site (Sphinx, MyST, furo) into docs/_build/html; any warning fails.
 $(VENV)/.installed-docs: $(STAMP)

@@ -37,4 +37,9 @@ speed, headless and with Meshcat), `ws_reader` (the Meshcat client that counts w
 reads), `time_split` (a tick's time by category, from cProfile), `replay` (the recorded
 replay's size), `checks` (the checks, their verdicts and the exit code), `table` (the
 report), `plot` (the figures), `main` (the command line; `python -m pbp_drake_bench`).
+
+Beside the bench, the rest of the harness the library never imports: `soak` (`make soak`),
+`results_catalogue` (`make results`: every study the docs quote, and the pages made from
+them by `arena_page` and `many_goals_figure`) and `runaway` (runaway confidence measured
+on a scripted operator).
 """

@@ -35,7 +35,7 @@ each normalised and its largest probability clipped at `max_probability` with th
 spread over the others (as HOP's posterior). `b` is the estimator's state, `P` its
 probabilities. The hazard is the floor against runaway confidence: after the prediction no
 goal is below `h / K`, so a belief built over any time is overturned by a bounded time of
-evidence against it (`pbp_drake.studies.runaway` measures it).
+evidence against it (`pbp_drake_bench.runaway` measures it).
 
 The rates, the heading's weight and the switch rate are the operator model's parameters,
 fitted on the tuning seeds of teleop under the arena's pilots (never on PBP's trials) by

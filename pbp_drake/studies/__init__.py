@@ -26,7 +26,6 @@ One job per module:
 - `matrix`: the folder of every method under every pilot (`comparison.run_method_matrix`
   runs it, all pilots' trials in one pool): a study folder per pilot, its summary;
 - `matrix_report`: a matrix folder's summary, method x pilot tables and figure;
-- `arena_page`: the paper's claims as rules on intervals, per task and pilot, as a page;
 - `summary`: the summary of a study folder and the one definition of the ideal alpha;
 - `report`: `report(DIR)`, the summary, `results.md`, `trials.json` and the figures;
 - `progress`: the text progress bar;

@@ -1,7 +1,7 @@
 """The ``intent_filter`` estimator's math (`pbp_drake.core.intent_filter`) against its
 definition written out goal by goal in plain Python, its hazard as a floor, a silence's
 drift back to the heading, its clip, its settings' checks, and runaway confidence measured on
-the scripted operator who first heads for a wrong object (`pbp_drake.studies.runaway`)."""
+the scripted operator who first heads for a wrong object (`pbp_drake_bench.runaway`)."""
 
 import math
 
@@ -12,7 +12,7 @@ from pbp_drake.core.intent_filter import (
     IntentFeatures, IntentFilterSettings, filter_step, intent_features, pose_intent_features,
     switch_probability)
 from pbp_drake.core.quaternion import exp_map
-from pbp_drake.studies import runaway
+from pbp_drake_bench import runaway
 
 PERIOD = 0.03
 GOALS = np.array([[1.0, 0.0, 0.7], [0.0, 1.0, 0.7], [-1.0, 0.0, 0.7], [0.5, 0.5, 0.7],

@@ -8,9 +8,9 @@ import math
 
 import pytest
 
-from pbp_drake.studies.arena_page import (
+from pbp_drake_bench.arena_page import (
     CLAIMS, FAILS, HOLDS, UNDECIDED, arena_page, claims_table, verdict)
-from pbp_drake.studies.results_catalogue import ARENA_STUDIES, STUDIES, main
+from pbp_drake_bench.results_catalogue import ARENA_STUDIES, STUDIES, main
 
 Z = 1.959963984540054
 T_29 = 2.045229642132703  # Student's t, 0.975 quantile, 29 degrees of freedom

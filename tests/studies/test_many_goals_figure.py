@@ -1,4 +1,4 @@
-"""The many-goals page's figure and table (`pbp_drake.studies.many_goals_figure`) from the
+"""The many-goals page's figure and table (`pbp_drake_bench.many_goals_figure`) from the
 summaries of the K sweep's studies: every line with its studies on disk (each estimator's
 and each method's), time over teleop's of the same K."""
 
@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from pbp_drake.studies.many_goals_figure import (
+from pbp_drake_bench.many_goals_figure import (
     methods_study_name, plot_many_goals, study_name, sweep, write_sweep_table)
 
 

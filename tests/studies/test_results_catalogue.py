@@ -1,10 +1,10 @@
-"""`make results` (`python -m pbp_drake.studies.results_catalogue`): a study of the list run
+"""`make results` (`python -m pbp_drake_bench.results_catalogue`): a study of the list run
 into its folder and its table written for the docs, here with one trial per method. The
 baselines' page gets each method paired with PBP-Alt and the study's figures beside it."""
 
 import pytest
 
-from pbp_drake.studies.results_catalogue import DOCS_FIGURES, STUDIES, main
+from pbp_drake_bench.results_catalogue import DOCS_FIGURES, STUDIES, main
 
 pytestmark = pytest.mark.slow
 

@@ -1,11 +1,11 @@
 """Every study the docs quote, in one list: `make results` runs them
-(`python -m pbp_drake.studies.results_catalogue`), each into `outputs/results/NAME/` with
+(`python -m pbp_drake_bench.results_catalogue`), each into `outputs/results/NAME/` with
 `--jobs 2`, and writes its table with `pbp-drake report DIR --markdown
 docs/results/generated/NAME.md`. The first line of each generated file is the command below
 (read back from the study folder), so a table on the docs site cannot drift from what made it.
 The matrices of every method under every pilot (`ARENA_STUDIES`) also make the arena page,
-docs/results/arena.md (`studies.arena_page`), from their summaries, and the many-goals
-studies the K sweep's figure and table (`studies.many_goals_figure`).
+docs/results/arena.md (`pbp_drake_bench.arena_page`), from their summaries, and the many-goals
+studies the K sweep's figure and table (`pbp_drake_bench.many_goals_figure`).
 
 A study interrupted part-way resumes from the trials on disk when this runs again.
 """
@@ -17,13 +17,13 @@ import subprocess
 import sys
 
 from pbp_drake.scenarios.pilots import PILOT_NAMES
-from pbp_drake.studies.arena_page import write_arena_page
-from pbp_drake.studies.many_goals_figure import (
+from pbp_drake_bench.arena_page import write_arena_page
+from pbp_drake_bench.many_goals_figure import (
     ESTIMATORS, GOAL_COUNTS, OTHER_METHODS, methods_study_name, plot_many_goals,
     write_sweep_table)
-from pbp_drake.studies.many_goals_figure import sweep as many_goals_sweep
-from pbp_drake.studies.many_goals_figure import FIGURE as MANY_GOALS_FIGURE
-from pbp_drake.studies.many_goals_figure import TABLE as MANY_GOALS_TABLE
+from pbp_drake_bench.many_goals_figure import sweep as many_goals_sweep
+from pbp_drake_bench.many_goals_figure import FIGURE as MANY_GOALS_FIGURE
+from pbp_drake_bench.many_goals_figure import TABLE as MANY_GOALS_TABLE
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE
 from pbp_drake.studies.report import BOX_FIGURES as DOCS_FIGURES
 
@@ -205,7 +205,7 @@ def main(argv=None):
     """Runs the studies (all, or those named) and writes their Markdown (also for a study
     whose trials failed: its table counts them); returns 1 when any study or report failed
     (each is named at the end), else 0."""
-    parser = argparse.ArgumentParser(prog="python -m pbp_drake.studies.results_catalogue",
+    parser = argparse.ArgumentParser(prog="python -m pbp_drake_bench.results_catalogue",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("names", nargs="*", help=f"studies to run (default: all of "
                         f"{', '.join(STUDIES)})")

@@ -1,4 +1,4 @@
-"""Runaway confidence, measured: `python -m pbp_drake.studies.runaway`.
+"""Runaway confidence, measured: `python -m pbp_drake_bench.runaway`.
 
 A scripted operator (Aronson and Short's test) first heads for a wrong object for `hold`
 seconds, driving the hand at it and pointing the hand at it, and then turns the hand to its
@@ -133,7 +133,7 @@ def table(holds=HOLDS, estimators=ESTIMATORS):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m pbp_drake.studies.runaway",
+    parser = argparse.ArgumentParser(prog="python -m pbp_drake_bench.runaway",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("--holds", default=",".join(f"{hold:g}" for hold in HOLDS),
                         help="seconds the wrong object is held, comma-separated")

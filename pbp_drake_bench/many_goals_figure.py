@@ -3,7 +3,7 @@ intervention ratio and task time over teleop's against the number of goals K (PB
 following one goal, the paper's, and with goal groups under each estimator; the other
 methods with groups and the intent filter where they follow DMPs), from the summaries of
 the catalogue's many-goals studies. `make results` writes both after those studies; alone:
-`python -m pbp_drake.studies.many_goals_figure [--outputs DIR] [--figure PNG] [--table MD]`.
+`python -m pbp_drake_bench.many_goals_figure [--outputs DIR] [--figure PNG] [--table MD]`.
 """
 
 import argparse
@@ -114,7 +114,7 @@ def write_sweep_table(lines, table):
     first); returns False (and writes nothing) when it is empty (no study on disk)."""
     if not lines:
         return False
-    text = ["<!-- written by python -m pbp_drake.studies.many_goals_figure (make results) "
+    text = ["<!-- written by python -m pbp_drake_bench.many_goals_figure (make results) "
             "from the summaries of the many-goals studies -->", "",
             "| success, intervention ratio, task time / teleop's | "
             + " | ".join(f"K = {k:,}" for k in GOAL_COUNTS) + " |",
@@ -130,7 +130,7 @@ def write_sweep_table(lines, table):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m pbp_drake.studies.many_goals_figure",
+    parser = argparse.ArgumentParser(prog="python -m pbp_drake_bench.many_goals_figure",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("--outputs", default="outputs/results",
                         help="the catalogue's study folders (default outputs/results)")

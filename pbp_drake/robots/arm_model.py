@@ -10,8 +10,10 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
-from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
+from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import Parser
+from pydrake.solvers import Solve
 
 from pbp_drake.robots.hsr_model import configure_parser
 from pbp_drake.robots.model_checks import check_model_file, escaped, printable
@@ -121,9 +123,10 @@ def _check_joint(joint, config):
 
 def ready_positions(plant, arm, config):
     """The plant's positions in the ready configuration: `config.initial_positions` (one
-    per movable joint of the model, in its order) or the model's defaults. Raises
-    ValueError for a wrong count, a joint outside its limits, or an ee_frame whose z axis
-    is more than MAX_TILT_DEGREES off the floor plane there."""
+    per movable joint of the model, in its order) or the model's defaults, or with
+    `config.ready_tool_pose` the inverse kinematics' solution. Raises ValueError for a
+    wrong count, a joint outside its limits, a tool pose out of reach, or an ee_frame
+    whose z axis is more than MAX_TILT_DEGREES off the floor plane there."""
     q0 = plant.GetDefaultPositions()
     if config.initial_positions:
         if len(config.initial_positions) != len(arm.joints):
@@ -133,6 +136,8 @@ def ready_positions(plant, arm, config):
                              f"{len(arm.joints)} joints {names}")
         for joint, value in zip(arm.joints, config.initial_positions):
             q0[joint.position_start()] = value
+    if config.ready_tool_pose is not None:
+        q0 = _solve_tool_pose(plant, arm, config, q0)
     for joint in arm.joints:
         value = q0[joint.position_start()]
         lower, upper = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
@@ -151,6 +156,42 @@ def ready_positions(plant, arm, config):
                          f"plane in the ready configuration (at most {MAX_TILT_DEGREES:g}): "
                          "the hand's heading is where that axis points")
     return q0
+
+
+# Inverse kinematics of the ready tool pose: its tolerances (m, rad), and how many starts
+# it tries (the given configuration or the middle of the limits first, then seeded draws).
+TOOL_POSITION_TOLERANCE = 1e-5
+TOOL_ANGLE_TOLERANCE = 1e-4
+IK_STARTS = 40
+
+
+def _solve_tool_pose(plant, arm, config, q_given):
+    """The configuration within the joints' limits that puts ee_frame at
+    `config.ready_tool_pose`, nearest `q_given` (`config.initial_positions`) or, without
+    it, the middle of the limits: a least-squares cost toward it, from it first and then
+    from seeded starts until one converges (deterministic)."""
+    X_WE = config.ready_tool_pose.GetDeterministicValue()
+    lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
+    nominal = np.asarray(q_given if config.initial_positions else (lower + upper) / 2, float)
+    starts = np.random.default_rng(0).uniform(0.1, 0.9, (IK_STARTS, len(nominal)))
+    for start in [nominal, *(lower + (upper - lower) * starts)]:
+        ik = InverseKinematics(plant)
+        q = ik.q()
+        p = X_WE.translation()
+        ik.AddPositionConstraint(arm.ee_frame, np.zeros(3), plant.world_frame(),
+                                 p - TOOL_POSITION_TOLERANCE, p + TOOL_POSITION_TOLERANCE)
+        ik.AddOrientationConstraint(plant.world_frame(), X_WE.rotation(), arm.ee_frame,
+                                    RotationMatrix(), TOOL_ANGLE_TOLERANCE)
+        program = ik.get_mutable_prog()
+        program.AddQuadraticErrorCost(np.eye(len(nominal)), nominal, q)
+        program.SetInitialGuess(q, start)
+        result = Solve(program)
+        if result.is_success():
+            return np.clip(result.GetSolution(q), lower, upper)
+    shown = ", ".join(f"{value:g}" for value in p)
+    raise ValueError(f"ArmStationConfig.ready_tool_pose: ee_frame {config.ee_frame!r} cannot "
+                     f"stand at [{shown}] m in that orientation within the joints' limits "
+                     f"(inverse kinematics from {IK_STARTS + 1} starts)")
 
 
 # The mass matrix is singular (a joint whose motion moves no inertia) when its smallest

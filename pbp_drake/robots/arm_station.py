@@ -9,6 +9,15 @@ returns a Diagram named ``arm_station``::
     robot state ─► EeStateFromPlant (ee_frame) ─► ee_state
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
 
+With ``config.hardware.connect`` the same ports drive a real arm through its Drake LCM
+driver (``pbp_drake.robots.arm_driver``)::
+
+    LcmSubscriberSystem (STATUS) ─► DriverLink ◄─ desired_state;  DriverLink ─► COMMAND
+    DriverLink.state (measured) ─► KinematicJoints ─► robot state (the geometry, ee_state)
+
+an ``LcmInterfaceSystem`` pumping the bus, and with ``hardware.driver_sim`` the driver
+simulator (``pbp_drake.robots.driver_sim``) inside on a memq:// bus of its own.
+
 The differential IK is the HSR station's (`WholeBodyDiffIk`): one least-squares QP a step
 with the model's position and velocity limits and the joints' acceleration limits (the
 model's, or `default_acceleration_limit`), the redundant motion drifting back to the ready
@@ -25,13 +34,19 @@ Example::
 """
 
 import numpy as np
+from pydrake.lcm import DrakeLcm
 from pydrake.math import RotationMatrix
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
+from pbp_drake.robots.arm_driver import (
+    SIMULATION_CLOCK, WALL_CLOCK, DriverLink, read_first_status, status_type)
 from pbp_drake.robots.arm_model import add_arm, reach_of, ready_positions
-from pbp_drake.robots.arm_station_config import ArmStationConfig, validate_arm_station_config
+from pbp_drake.robots.arm_station_config import (
+    DRIVERS, ArmStationConfig, validate_arm_station_config)
+from pbp_drake.robots.driver_sim import make_driver_sim, memq_lcm
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
 from pbp_drake.robots.hsr_ee_systems import (
     EeCommandRamp, EeStateFromPlant, ee_state_at_rest, heading_of)
@@ -67,7 +82,9 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
     """
     validate_arm_station_config(config)
     builder = DiagramBuilder()
-    kinematic = config.motion == "kinematic"
+    hardware = config.hardware if config.hardware is not None and config.hardware.connect \
+        else None
+    kinematic = config.motion == "kinematic" or hardware is not None
     if kinematic:
         plant, scene_graph = add_kinematic_plant(builder, config.plant.time_step)
     else:
@@ -88,7 +105,11 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
     look_ahead = 0.0 if kinematic else config.plant.time_step
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, arm, q0, config, ramp,
                                                               look_ahead))
-    if kinematic:
+    if hardware is not None:
+        measured = _add_driver_link(builder, plant, arm, q0, hardware, diff_ik)
+        joints = add_kinematic_joints(builder, plant, scene_graph, arm.joints, measured)
+        state = joints.get_state_output_port()
+    elif kinematic:
         joints = add_kinematic_joints(builder, plant, scene_graph, arm.joints,
                                       diff_ik.get_desired_state_output_port())
         state = joints.get_state_output_port()
@@ -111,6 +132,65 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
     station = builder.Build()
     station.set_name("arm_station")
     return station
+
+
+def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
+    """The LCM side of the station (the module's docstring): returns the measured state's
+    port. The run read the driver's first status before it built this (`q0`, the ready
+    configuration, is where the arm stood); with `driver_sim` the simulator stands there."""
+    driver = DRIVERS[hardware.driver]
+    if len(arm.joints) != driver.joint_count:
+        raise ValueError(f"ArmStationConfig.hardware.driver {hardware.driver!r} drives "
+                         f"{driver.joint_count} joints; the model has {len(arm.joints)}")
+    q_start = np.array([q0[joint.position_start()] for joint in arm.joints])
+    lower, upper, velocity = _joint_limits(plant, arm)
+    if hardware.driver_sim:
+        lcm, clock = memq_lcm(), SIMULATION_CLOCK
+        builder.AddNamedSystem("driver_sim", make_driver_sim(
+            hardware.driver, lcm, clock, q_start, lower, upper, velocity,
+            with_interface=False))
+    else:
+        lcm, clock = DrakeLcm(hardware.lcm_bus), WALL_CLOCK
+    builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
+    status = builder.AddNamedSystem("status_subscriber", LcmSubscriberSystem.Make(
+        driver.status_channel, status_type(hardware.driver), lcm))
+    link = builder.AddNamedSystem("driver_link", DriverLink(
+        hardware, lcm, q_start, lower, upper, velocity, clock))
+    builder.Connect(status.get_output_port(), link.GetInputPort("status"))
+    builder.Connect(diff_ik.get_desired_state_output_port(), link.GetInputPort("desired_state"))
+    return link.GetOutputPort("state")
+
+
+def _joint_limits(plant, arm):
+    """`(lower, upper, velocity)` of the arm's joints, in the model's order."""
+    rows = [(joint.position_lower_limits()[0], joint.position_upper_limits()[0],
+             joint.velocity_upper_limits()[0]) for joint in arm.joints]
+    return tuple(np.array(column) for column in zip(*rows))
+
+
+def arm_driver_sim(config: ArmStationConfig, lcm, clock=WALL_CLOCK) -> Diagram:
+    """The driver simulator of `config`'s arm (`config.hardware.driver`) on `lcm`, standing
+    in the ready configuration, with its own `LcmInterfaceSystem`: what `pbp-drake
+    driver-sim` runs."""
+    validate_arm_station_config(config)
+    if config.hardware is None:
+        raise ValueError("ArmStationConfig.hardware is needed: the driver to simulate "
+                         "(hardware: {driver: panda} or {driver: iiwa})")
+    plant, arm, q0 = arm_model_plant(config)
+    q_start = np.array([q0[joint.position_start()] for joint in arm.joints])
+    return make_driver_sim(config.hardware.driver, lcm, clock, q_start,
+                           *_joint_limits(plant, arm))
+
+
+def measured_ready_positions(config: ArmStationConfig, lcm=None) -> np.ndarray:
+    """The arm's joint positions from its driver's first status (on `lcm`, default a
+    DrakeLcm on `config.hardware.lcm_bus`): the ready configuration of a run on the real
+    arm, read before the run is built. Raises `DriverError` naming the bus and channel
+    when no status comes within `connect_timeout`."""
+    plant, arm, _ = arm_model_plant(config)
+    lower, upper, _ = _joint_limits(plant, arm)
+    return read_first_status(config.hardware, lcm or DrakeLcm(config.hardware.lcm_bus),
+                             lower, upper)
 
 
 def _add_motors(plant, arm):

@@ -1,16 +1,80 @@
-"""What an arm station is built from: ``ArmStationConfig`` and its validation (the fields
-alone; what needs the model, its frames and limits, is checked where it is loaded,
-``pbp_drake.robots.arm_model``)."""
+"""What an arm station is built from: ``ArmStationConfig``, its ``ArmHardware`` (the real
+arm's driver and bus) and their validation (the fields alone; what needs the model, its
+frames and limits, is checked where it is loaded, ``pbp_drake.robots.arm_model``)."""
 
 import dataclasses
+import re
+import typing
 
 import numpy as np
+from pydrake.common.schema import Transform
+from pydrake.lcm import DrakeLcmParams
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.robots.hsr_station_config import (
     MOTIONS, CylinderObstacle, default_station_plant_config, default_station_visualization,
     validate_station_obstacles, validate_station_timing)
+
+
+@dataclasses.dataclass(frozen=True)
+class Driver:
+    """What a Drake LCM driver of a real arm expects: its channels, its status period (s),
+    how many joints it drives, whether it drops commands stamped earlier than its wall
+    clock allows (drake-franka-driver's `--expire_sec`), and how long after its first
+    status it refuses any command (drake-iiwa-driver aborts on one within 0.25 s)."""
+
+    command_channel: str
+    status_channel: str
+    period: float
+    joint_count: int
+    wall_clock_stamps: bool
+    start_guard: float
+
+
+#: The drivers the station speaks to: drake-franka-driver in position mode (status and
+#: commands at libfranka's 1 kHz) and drake-iiwa-driver with the position Java app (FRI's
+#: 5 ms).
+DRIVERS = {
+    "panda": Driver("PANDA_COMMAND", "PANDA_STATUS", 0.001, 7, True, 0.0),
+    "iiwa": Driver("IIWA_COMMAND", "IIWA_STATUS", 0.005, 7, False, 0.25),
+}
+#: Drake's hardware_sim bus: multicast with ttl=0, so that its traffic stays on this machine.
+DEFAULT_LCM_URL = "udpm://239.241.129.92:20185?ttl=0"
+_UDPM = re.compile(r"udpm://(\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}):(\d{1,5})"
+                   r"(\?(ttl|recv_buf_size)=\d+(&(ttl|recv_buf_size)=\d+)?)?")
+
+
+@dataclasses.dataclass
+class ArmHardware:
+    """The real arm behind an ``ArmStationConfig``: which Drake LCM driver runs it and on
+    which bus. The station drives it only when ``connect`` is true (``pbp-drake run
+    --hardware``); otherwise the arm is simulated and this is unused."""
+
+    #: The arm's driver: "panda" (drake-franka-driver, position mode) or "iiwa"
+    #: (drake-iiwa-driver, the position Java app).
+    driver: str = ""
+    #: The driver's LCM bus (Drake's DrakeLcmParams): udpm://ADDRESS:PORT?ttl=N or memq://.
+    #: The default is Drake's hardware_sim bus with ttl=0 (its traffic stays on this
+    #: machine); a driver on another machine needs ttl=1.
+    lcm_bus: DrakeLcmParams = dataclasses.field(
+        default_factory=lambda: DrakeLcmParams(lcm_url=DEFAULT_LCM_URL))
+    #: Whether runs drive the arm through its driver (`pbp-drake run --hardware`).
+    connect: bool = False
+    #: With connect: a driver simulator in the same process in place of the driver, both
+    #: on one memq:// bus and the simulation's clock (`pbp-drake run --driver-sim`).
+    driver_sim: bool = False
+    #: The longest the driver's status may be silent (s) before the station holds the arm
+    #: where it last commanded it and ends the run.
+    status_timeout: float = 0.05
+    #: How long (s) the station waits for the driver's first status before it fails.
+    connect_timeout: float = 5.0
+    #: Our own expiry: the station sends no command computed more than this (s) behind the
+    #: wall clock (a control loop that fell behind real time holds the arm and ends).
+    command_expiry: float = 0.05
+    #: How far (rad) the first status may stand from the configuration the run was built
+    #: for (read from the driver's status before the run).
+    start_tolerance: float = 0.01
 
 
 @dataclasses.dataclass
@@ -32,8 +96,14 @@ class ArmStationConfig:
     base_pose: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0, 0.0])
     #: The ready configuration the arm starts in (rad or m), one per joint in the model's
     #: joint order; empty: the model's default positions. Its ee_frame z axis must be
-    #: within 60 degrees of the floor plane.
+    #: within 60 degrees of the floor plane. With ready_tool_pose: where inverse
+    #: kinematics starts from and stays near.
     initial_positions: list[float] = dataclasses.field(default_factory=list)
+    #: The ready configuration as the pose of ee_frame in the world (Drake's Transform:
+    #: `{translation: [x, y, z], rotation: !Rpy {deg: [r, p, y]}}`), solved by inverse
+    #: kinematics within the joints' limits; none: initial_positions is the ready
+    #: configuration.
+    ready_tool_pose: typing.Optional[Transform] = None
     #: "kinematic": the joints are on the diff IK's plan at every instant (no plant is
     #: stepped); "dynamic": the plant and stiff PD servos (servo_frequency) track it.
     motion: str = "kinematic"
@@ -58,6 +128,8 @@ class ArmStationConfig:
     #: What the station shows in Meshcat when it is given one (Drake's config).
     visualization: VisualizationConfig = dataclasses.field(
         default_factory=default_station_visualization)
+    #: The real arm's driver and bus (used with `hardware.connect`); none: simulated only.
+    hardware: typing.Optional[ArmHardware] = None
 
 
 def validate_arm_station_config(config: ArmStationConfig) -> None:
@@ -88,3 +160,34 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
         raise ValueError(f"ArmStationConfig.centering_gain must be >= 0, got "
                          f"{config.centering_gain}")
     validate_station_obstacles(config, "ArmStationConfig")
+    if config.hardware is not None:
+        validate_arm_hardware(config.hardware)
+
+
+def validate_arm_hardware(hardware: ArmHardware) -> None:
+    """Raises ValueError naming the first field of ``hardware`` that cannot work."""
+    field = "ArmStationConfig.hardware"
+    if hardware.driver not in DRIVERS:
+        raise ValueError(f"{field}.driver must be one of {sorted(DRIVERS)}, got "
+                         f"{hardware.driver!r}")
+    url = hardware.lcm_bus.lcm_url
+    if not (url == "memq://" or _valid_udpm(url)):
+        raise ValueError(f"{field}.lcm_bus.lcm_url {url!r} is not an LCM URL the driver can "
+                         "share: udpm://ADDRESS:PORT?ttl=N (a multicast IPv4 address) or "
+                         f"memq://; Drake's hardware_sim uses {DEFAULT_LCM_URL}")
+    for name in ("status_timeout", "connect_timeout", "command_expiry", "start_tolerance"):
+        value = getattr(hardware, name)
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{field}.{name} must be finite and positive, got {value}")
+    if hardware.driver_sim and not hardware.connect:
+        raise ValueError(f"{field}.driver_sim needs connect (pbp-drake run --hardware "
+                         "--driver-sim)")
+
+
+def _valid_udpm(url):
+    match = _UDPM.fullmatch(url)
+    if match is None:
+        return False
+    octets = [int(match.group(index)) for index in range(1, 5)]
+    return (224 <= octets[0] <= 239 and all(octet <= 255 for octet in octets)
+            and 0 < int(match.group(5)) < 65536)

@@ -1,0 +1,153 @@
+"""A driver simulator: the arm of an `ArmStationConfig` behind the LCM channels and rules of
+its Drake driver, so that the station's whole LCM path runs with no robot (`pbp-drake
+driver-sim FILE` on the bus, or in the run's process with `run --hardware --driver-sim`).
+
+``make_driver_sim(driver, lcm, clock, q_start, ...)`` returns a Diagram named ``driver_sim``::
+
+    LcmSubscriberSystem (COMMAND channel) ─► DriverSim ─► status on the STATUS channel
+
+`DriverSim` keeps the drivers' rules: the Panda's position mode drops a command whose
+stamp is more than `expire_sec` from its clock and refuses one that expects another mode
+or carries velocities or torques; the iiwa driver aborts on a command within 0.25 s of its
+first status and clamps commands to 1 degree inside the joints' limits; both hold the last
+accepted position (before any, the position they started in). The joints move toward the
+command at their velocity limits.
+"""
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.lcm import DrakeLcm
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
+
+from pbp_drake.robots.arm_driver import (
+    PANDA_POSITION_MODE, clock_now, command_type, status_message)
+from pbp_drake.robots.arm_station_config import DRIVERS
+
+# drake-franka-driver's default --expire_sec (s).
+PANDA_EXPIRE_SEC = 0.1
+# drake-iiwa-driver clamps commands this far (rad) inside the joints' limits.
+IIWA_LIMIT_MARGIN = np.radians(1.0)
+
+
+class DriverSimError(RuntimeError):
+    """What the real driver would abort on."""
+
+
+class DriverSim(LeafSystem):
+    """An arm behind its driver's rules (the module's docstring).
+
+    .. pydrake_system::
+
+        name: DriverSim
+        input_ports:
+        - command
+
+    ``command`` is the last command message (an ``LcmSubscriberSystem``'s output). At each
+    driver period it takes a new command under the rules, moves the joints toward the
+    accepted position at their velocity limits, and publishes the status (`lcm.Publish`)
+    stamped on `clock`.
+    """
+
+    def __init__(self, driver, lcm, q_start, lower, upper, velocity_limits, clock,
+                 expire_sec=PANDA_EXPIRE_SEC):
+        super().__init__()
+        self._driver_name, self._driver = driver, DRIVERS[driver]
+        self._lcm, self._clock, self._expire = lcm, clock, float(expire_sec)
+        self._lower, self._upper = np.asarray(lower, float), np.asarray(upper, float)
+        self._velocity = np.asarray(velocity_limits, float)
+        n = self._n = len(q_start)
+        # State: q, v, the accepted command, the last command's utime, the first status's
+        # time on the clock.
+        self._Q, self._V, self._HELD = slice(0, n), slice(n, 2 * n), slice(2 * n, 3 * n)
+        self._UTIME, self._FIRST_AT = 3 * n, 3 * n + 1
+        q_start = np.asarray(q_start, float)
+        self._state_index = self.DeclareDiscreteState(
+            np.concatenate([q_start, np.zeros(n), q_start, [-1.0, np.nan]]))
+        self.DeclareAbstractInputPort("command", Value(command_type(driver)()))
+        self.DeclarePeriodicDiscreteUpdateEvent(self._driver.period, 0.0, self._update)
+        self.DeclarePeriodicPublishEvent(self._driver.period, 0.0, self._publish)
+
+    def positions(self, context):
+        """The simulated arm's joint positions in `context` (its own)."""
+        return np.array(context.get_discrete_state(self._state_index).value()[self._Q])
+
+    def _update(self, context, discrete_state):
+        x = np.array(context.get_discrete_state(self._state_index).value())
+        now = clock_now(self._clock, context)
+        if np.isnan(x[self._FIRST_AT]):
+            x[self._FIRST_AT] = now  # the first status goes out at this instant
+        message = self.get_input_port(0).Eval(context)
+        if message.utime != x[self._UTIME] and self._has_positions(message):
+            x[self._UTIME] = message.utime
+            accepted = self._accept(message, x, now)
+            if accepted is not None:
+                x[self._HELD] = accepted
+        period = self._driver.period
+        step = np.clip(x[self._HELD] - x[self._Q], -self._velocity * period,
+                       self._velocity * period)
+        x[self._Q] += step
+        x[self._V] = step / period
+        discrete_state.set_value(self._state_index, x)
+
+    def _has_positions(self, message):
+        """Whether `message` is a command (the subscriber's default message holds none)."""
+        return (message.num_joint_position if self._driver_name == "panda"
+                else message.num_joints) > 0
+
+    def _accept(self, message, x, now):
+        """The command's positions if the driver takes them, None if it drops them; raises
+        DriverSimError where the driver would abort."""
+        channel = self._driver.command_channel
+        if self._driver_name == "panda":
+            if (message.control_mode_expected != PANDA_POSITION_MODE
+                    or message.num_joint_velocity or message.num_joint_torque):
+                raise DriverSimError(f"{channel}: a command for another mode than position "
+                                     "(drake-franka-driver throws)")
+            if abs(now - message.utime * 1e-6) > self._expire:
+                return None  # stale: the driver drops it and holds
+            positions = message.joint_position
+        else:
+            if now - x[self._FIRST_AT] < self._driver.start_guard:
+                raise DriverSimError(f"{channel}: a command within {self._driver.start_guard:g} "
+                                     "s of the first status (drake-iiwa-driver aborts)")
+            positions = message.joint_position
+        q = np.asarray(positions, float)
+        if len(q) != self._n or not np.all(np.isfinite(q)):
+            raise DriverSimError(f"{channel}: a command of {len(q)} positions or with a NaN "
+                                 f"(the arm has {self._n} joints)")
+        if self._driver_name == "iiwa":
+            q = np.clip(q, self._lower + IIWA_LIMIT_MARGIN, self._upper - IIWA_LIMIT_MARGIN)
+        return q
+
+    def _publish(self, context):
+        x = context.get_discrete_state(self._state_index).value()
+        now = clock_now(self._clock, context)
+        message = status_message(self._driver_name, now * 1e6, x[self._Q], x[self._V],
+                                 x[self._HELD])
+        self._lcm.Publish(self._driver.status_channel, message.encode())
+
+
+def make_driver_sim(driver, lcm, clock, q_start, lower, upper, velocity_limits,
+                    with_interface=True):
+    """An arm of the joints' `lower`, `upper` and `velocity_limits` standing at `q_start`
+    behind `driver`'s rules on `lcm`, as a Diagram named ``driver_sim``;
+    `with_interface`: with its own `LcmInterfaceSystem` pumping `lcm` (not when the
+    station in the same diagram pumps it)."""
+    builder = DiagramBuilder()
+    if with_interface:
+        builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
+    commands = builder.AddNamedSystem("command_subscriber", LcmSubscriberSystem.Make(
+        DRIVERS[driver].command_channel, command_type(driver), lcm))
+    arm = builder.AddNamedSystem("arm", DriverSim(driver, lcm, q_start, lower, upper,
+                                                  velocity_limits, clock))
+    builder.Connect(commands.get_output_port(), arm.get_input_port(0))
+    diagram = builder.Build()
+    diagram.set_name("driver_sim")
+    return diagram
+
+
+def memq_lcm():
+    """A DrakeLcm of its own in this process (memq://): the station and the driver
+    simulator of one run share it."""
+    return DrakeLcm("memq://")

@@ -9,6 +9,7 @@ import sys
 
 from pbp_drake import __version__
 from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_USAGE
+from pbp_drake.commands.driver_sim import add_driver_sim_command
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.study import add_study_commands
 from pbp_drake.draw import build_parser as build_draw_parser
@@ -47,6 +48,7 @@ def build_parser():
 
     add_run_command(commands)
     add_study_commands(commands)
+    add_driver_sim_command(commands)
 
     # Their own argument parsers live with them; the rest of the line is passed on.
     for name, help_text in [("bench", "time the DMP bank against the DMP libraries people "

@@ -7,16 +7,18 @@ import functools
 import sys
 
 from pbp_drake.builder import check_buildable
-from pbp_drake.cli_types import EXIT_WRITE_FAILED, realtime_rate
+from pbp_drake.cli_types import EXIT_DRIVER, EXIT_WRITE_FAILED, realtime_rate
 from pbp_drake.commands.run_checks import check_run_flags, is_person
 from pbp_drake.commands.run_page import add_page_flags, open_page
 from pbp_drake.commands.scenario_flags import (
-    add_goals_flag, add_override_flags, add_shorthand_flags, scenario_overrides)
+    add_goals_flag, add_hardware_flags, add_override_flags, add_shorthand_flags,
+    scenario_overrides)
 from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
 from pbp_drake.console import CAMERAS
 from pbp_drake.console.front import PortError, bind_page_port
 from pbp_drake.output_paths import check_log_path, check_output_folder, check_record_path
+from pbp_drake.robots import DriverError, drives_real_arm, measured_ready_positions
 from pbp_drake.scenarios import (
     METHODS, ScenarioError, load_scenario_file, resolve)
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
@@ -29,6 +31,7 @@ def add_run_command(commands):
     fields = add_override_flags(run)
     add_shorthand_flags(fields)
     add_goals_flag(fields)
+    add_hardware_flags(fields)
     fields.add_argument("--scene", help="use the obstacles of this scene of the file's study")
     _add_common_flags(run)
     run.add_argument("--no-meshcat", action="store_true",
@@ -62,7 +65,7 @@ def add_run_command(commands):
     add_page_flags(session)
     session.set_defaults(handler=_saying_write_failures(_run), method=None, alpha=None,
                          goals=None, scene=None, no_meshcat=False, record=None,
-                         log=None, force=False)
+                         log=None, force=False, hardware=False, driver_sim=False)
 
 
 def _add_common_flags(parser):
@@ -91,6 +94,8 @@ def scenario_for_run(args):
     if args.operator is not None and scenario.task is None:
         raise ScenarioError("--operator chooses who drives the tasks; this scenario uses "
                             "the 2-D toy robot")
+    if drives_real_arm(getattr(scenario.robot, "hardware", None)):
+        return resolve(_standing_where_the_arm_stands(scenario))
     if args.scene is None:
         return scenario_file.resolved
     scenes = getattr(scenario_file.study, "scenes", [])
@@ -105,6 +110,21 @@ def scenario_for_run(args):
         return resolve(scenario)
     except ScenarioError as error:
         raise ScenarioError(f"{error} (after --scene)") from None
+
+
+def _standing_where_the_arm_stands(scenario):
+    """`scenario` whose arm starts where its driver's first status says it stands (never
+    where the file assumes): its ready configuration those joint positions."""
+    robot = scenario.robot
+    try:
+        q = measured_ready_positions(robot.station_config())
+    except DriverError as error:
+        raise ScenarioError(str(error)) from None
+    print(f"The {robot.hardware.driver} driver answers on {robot.hardware.lcm_bus.lcm_url}: "
+          "the arm stands at [" + ", ".join(f"{value:.4f}" for value in q) + "] rad",
+          flush=True)
+    return dataclasses.replace(scenario, robot=dataclasses.replace(
+        robot, initial_positions=[float(value) for value in q], ready_tool_pose=None))
 
 
 def _run(args):
@@ -145,6 +165,10 @@ def _run(args):
         if resolved.has_task:
             return run_task_loop(args, resolved, meshcat, page)
         return run_scene(args, resolved, meshcat, page)
+    except DriverError as error:
+        # The arm holds where it was last commanded: the driver keeps that position.
+        print(f"pbp-drake: {error}", file=sys.stderr)
+        return EXIT_DRIVER
     finally:
         if page is not None:
             page.close()

@@ -1,7 +1,7 @@
 """The flags that change a scenario file's fields, shared by `run`, `session` and `study`:
 `--set FIELD=VALUE` and `--scenario-text YAML` (`scenarios.overrides`), and the shorthands
-`--method`, `--alpha`, `--operator`, `--seed`, `--duration` and `--goals`, each one
-`--set`."""
+`--method`, `--alpha`, `--operator`, `--seed`, `--duration`, `--goals`, `--hardware` and
+`--driver-sim`, each one `--set`."""
 
 from pbp_drake.scenarios import METHODS, OPERATOR_NAMES, ScenarioError, parse_method_label
 from pbp_drake.scenarios.bounds import MAX_GOALS
@@ -42,6 +42,17 @@ def add_goals_flag(group):
                        "over its region, drawn from each scene's seed")
 
 
+def add_hardware_flags(group):
+    """`--hardware` and `--driver-sim`, in `group`."""
+    group.add_argument("--hardware", action="store_true",
+                       help="--set robot.hardware.connect=true: drive the real arm through its "
+                       "Drake LCM driver (robot: !Arm with hardware: {driver: panda|iiwa}), in "
+                       "real time")
+    group.add_argument("--driver-sim", action="store_true",
+                       help="--set robot.hardware.driver_sim=true: with --hardware, the "
+                       "driver simulator in this process, on a memq:// bus of its own")
+
+
 def scenario_overrides(args, shorthands=True):
     """The overrides of the parsed `args`: the text, the shorthands (where the command has
     them: `study`'s `--seed` is its first scene's, not a field), `--goals`, then each
@@ -76,4 +87,7 @@ def _shorthand_settings(args):
         value = getattr(args, flag, None)
         if value is not None:
             settings.append((f"{flag}={value!r}", f"--{flag} {value:g}"))
+    for flag, field in (("hardware", "connect"), ("driver_sim", "driver_sim")):
+        if getattr(args, flag, False):
+            settings.append((f"robot.hardware.{field}=true", f"--{flag.replace('_', '-')}"))
     return settings

@@ -1,14 +1,18 @@
 """Robot models and the helpers that load them into Drake; the HSR's and any arm's
 stations (a Diagram from `ee_command` to `ee_state`)."""
 
+from pbp_drake.robots.arm_driver import DriverError
 from pbp_drake.robots.arm_station import (
+    arm_driver_sim,
     arm_initial_ee_state,
     arm_reach,
     arm_ready_ee_state,
     arm_station_plant,
+    drives_real_arm,
     make_arm_station,
+    measured_ready_positions,
 )
-from pbp_drake.robots.arm_station_config import ArmStationConfig
+from pbp_drake.robots.arm_station_config import ArmHardware, ArmStationConfig
 from pbp_drake.robots.hsr_model import add_hsr
 from pbp_drake.robots.hsr_station import (
     hsr_initial_ee_state,
@@ -19,7 +23,9 @@ from pbp_drake.robots.hsr_station import (
 )
 from pbp_drake.robots.hsr_station_config import CylinderObstacle, HsrStationConfig
 
-__all__ = ["ArmStationConfig", "CylinderObstacle", "HsrStationConfig", "add_hsr",
-           "arm_initial_ee_state", "arm_reach", "arm_ready_ee_state", "arm_station_plant",
+__all__ = ["ArmHardware", "ArmStationConfig", "CylinderObstacle", "DriverError",
+           "HsrStationConfig", "add_hsr", "arm_driver_sim", "arm_initial_ee_state",
+           "arm_reach", "arm_ready_ee_state", "arm_station_plant", "drives_real_arm",
            "hsr_initial_ee_state", "hsr_initial_hand_pose", "hsr_ready_ee_state",
-           "hsr_station_plant", "make_arm_station", "make_hsr_station"]
+           "hsr_station_plant", "make_arm_station", "make_hsr_station",
+           "measured_ready_positions"]

@@ -182,6 +182,12 @@ def arm_driver_sim(config: ArmStationConfig, lcm, clock=WALL_CLOCK) -> Diagram:
                            *_joint_limits(plant, arm))
 
 
+def drives_real_arm(hardware) -> bool:
+    """Whether a station of this `ArmHardware` (or None) drives a real arm: connected, not
+    to the driver simulator. Such a run goes in real time, the driver's clock the wall's."""
+    return hardware is not None and hardware.connect and not hardware.driver_sim
+
+
 def measured_ready_positions(config: ArmStationConfig, lcm=None) -> np.ndarray:
     """The arm's joint positions from its driver's first status (on `lcm`, default a
     DrakeLcm on `config.hardware.lcm_bus`): the ready configuration of a run on the real

@@ -206,7 +206,8 @@ def urdf(arm, header):
                   f'    <child link="{name}_link{index}"/>',
                   f'    <origin xyz="{triple(joint["xyz"])}" rpy="{angles(joint["rpy"])}"/>',
                   '    <axis xyz="0 0 1"/>',
-                  f'    <limit lower="{number(joint["lower"])}" upper="{number(joint["upper"])}" '
+                  f'    <limit lower="{number(joint["lower"], 12)}" '
+                  f'upper="{number(joint["upper"], 12)}" '
                   f'velocity="{number(joint["velocity"], 12)}" effort="{number(joint["effort"])}"'
                   f'{acceleration}/>',
                   "  </joint>", ""]

@@ -15,6 +15,7 @@ from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import Parser
 from pydrake.solvers import Solve
 
+from pbp_drake.robots.arm_station_config import DRIVERS
 from pbp_drake.robots.hsr_model import configure_parser
 from pbp_drake.robots.model_checks import check_model_file, escaped, printable
 
@@ -83,6 +84,11 @@ def add_arm(plant, config, parser=None):
               if plant.get_joint(index).num_velocities() > 0]
     for joint in joints:
         _check_joint(joint, config)
+    if config.hardware is not None:
+        count = DRIVERS[config.hardware.driver].joint_count
+        if len(joints) != count:
+            raise ValueError(f"ArmStationConfig.hardware.driver {config.hardware.driver!r} "
+                             f"drives {count} joints; the model has {len(joints)}")
     if not any(joint.num_velocities() for joint in chain):
         raise ValueError(f"ArmStationConfig.ee_frame {config.ee_frame!r} is not on the arm: "
                          f"no joint moves it relative to base_frame {config.base_frame!r}")
@@ -170,7 +176,7 @@ def _solve_tool_pose(plant, arm, config, q_given):
     `config.ready_tool_pose`, nearest `q_given` (`config.initial_positions`) or, without
     it, the middle of the limits: a least-squares cost toward it, from it first and then
     from seeded starts until one converges (deterministic)."""
-    X_WE = config.ready_tool_pose.GetDeterministicValue()
+    X_WE = config.ready_tool_pose.transform()
     lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
     nominal = np.asarray(q_given if config.initial_positions else (lower + upper) / 2, float)
     starts = np.random.default_rng(0).uniform(0.1, 0.9, (IK_STARTS, len(nominal)))

@@ -139,9 +139,6 @@ def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
     port. The run read the driver's first status before it built this (`q0`, the ready
     configuration, is where the arm stood); with `driver_sim` the simulator stands there."""
     driver = DRIVERS[hardware.driver]
-    if len(arm.joints) != driver.joint_count:
-        raise ValueError(f"ArmStationConfig.hardware.driver {hardware.driver!r} drives "
-                         f"{driver.joint_count} joints; the model has {len(arm.joints)}")
     q_start = np.array([q0[joint.position_start()] for joint in arm.joints])
     lower, upper, velocity = _joint_limits(plant, arm)
     if hardware.driver_sim:

@@ -7,8 +7,8 @@ import re
 import typing
 
 import numpy as np
-from pydrake.common.schema import Transform
 from pydrake.lcm import DrakeLcmParams
+from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.visualization import VisualizationConfig
 
@@ -78,6 +78,21 @@ class ArmHardware:
 
 
 @dataclasses.dataclass
+class ToolPose:
+    """A pose of the tool (the station's ee_frame) in the world."""
+
+    #: Where it stands: x, y, z (m).
+    position: list[float] = dataclasses.field(default_factory=list)
+    #: Its orientation: roll, pitch, yaw (degrees; Drake's RollPitchYaw, about the world's
+    #: fixed x, y, z axes in that order). [0, 90, 0] points the tool's z axis along +x.
+    rpy_degrees: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+    def transform(self):
+        """The pose as a RigidTransform."""
+        return RigidTransform(RollPitchYaw(np.radians(self.rpy_degrees)), self.position)
+
+
+@dataclasses.dataclass
 class ArmStationConfig:
     """Everything ``make_arm_station`` builds from; loads with ``yaml_load_typed``. The
     arm is any fixed-base serial chain of revolute or prismatic joints in a URDF or
@@ -99,11 +114,10 @@ class ArmStationConfig:
     #: within 60 degrees of the floor plane. With ready_tool_pose: where inverse
     #: kinematics starts from and stays near.
     initial_positions: list[float] = dataclasses.field(default_factory=list)
-    #: The ready configuration as the pose of ee_frame in the world (Drake's Transform:
-    #: `{translation: [x, y, z], rotation: !Rpy {deg: [r, p, y]}}`), solved by inverse
-    #: kinematics within the joints' limits; none: initial_positions is the ready
-    #: configuration.
-    ready_tool_pose: typing.Optional[Transform] = None
+    #: The ready configuration as the pose of ee_frame in the world (`{position: [x, y, z],
+    #: rpy_degrees: [roll, pitch, yaw]}`), solved by inverse kinematics within the joints'
+    #: limits; none: initial_positions is the ready configuration.
+    ready_tool_pose: typing.Optional[ToolPose] = None
     #: "kinematic": the joints are on the diff IK's plan at every instant (no plant is
     #: stepped); "dynamic": the plant and stiff PD servos (servo_frequency) track it.
     motion: str = "kinematic"
@@ -151,6 +165,13 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
     if not np.all(np.isfinite(config.initial_positions)):
         raise ValueError(f"ArmStationConfig.initial_positions must be finite, got "
                          f"{config.initial_positions}")
+    pose = config.ready_tool_pose
+    if pose is not None:
+        for name in ("position", "rpy_degrees"):
+            value = getattr(pose, name)
+            if len(value) != 3 or not np.all(np.isfinite(value)):
+                raise ValueError(f"ArmStationConfig.ready_tool_pose.{name} must be three "
+                                 f"finite numbers, got {value}")
     for name in ("default_acceleration_limit", "servo_frequency"):
         value = getattr(config, name)
         if not (np.isfinite(value) and value > 0):

@@ -94,10 +94,14 @@ API_GROUPS = {
     "Your own arm": {
         **{name: "pbp_drake.robots" for name in [
             "make_arm_station", "ArmStationConfig", "arm_initial_ee_state", "arm_reach",
-            "arm_ready_ee_state", "arm_station_plant"]},
+            "arm_ready_ee_state", "arm_station_plant", "ToolPose"]},
         **{name: "pbp_drake.core.controller_config" for name in [
             "PbpControllerConfig", "HandOverSettings"]},
     },
+    "A real arm": {
+        name: "pbp_drake.robots" for name in [
+            "ArmHardware", "DriverError", "arm_driver_sim", "measured_ready_positions",
+            "drives_real_arm"]},
     "Scenario files": {
         name: "pbp_drake.scenarios" for name in [
             "load_scenario_file", "resolve", "ResolvedScenario", "ScenarioError",

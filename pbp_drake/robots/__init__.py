@@ -12,7 +12,7 @@ from pbp_drake.robots.arm_station import (
     make_arm_station,
     measured_ready_positions,
 )
-from pbp_drake.robots.arm_station_config import ArmHardware, ArmStationConfig
+from pbp_drake.robots.arm_station_config import ArmHardware, ArmStationConfig, ToolPose
 from pbp_drake.robots.hsr_model import add_hsr
 from pbp_drake.robots.hsr_station import (
     hsr_initial_ee_state,
@@ -28,4 +28,4 @@ __all__ = ["ArmHardware", "ArmStationConfig", "CylinderObstacle", "DriverError",
            "arm_reach", "arm_ready_ee_state", "arm_station_plant", "drives_real_arm",
            "hsr_initial_ee_state", "hsr_initial_hand_pose", "hsr_ready_ee_state",
            "hsr_station_plant", "make_arm_station", "make_hsr_station",
-           "measured_ready_positions"]
+           "measured_ready_positions", "ToolPose"]

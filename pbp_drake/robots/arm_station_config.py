@@ -114,9 +114,9 @@ class ArmStationConfig:
     #: within 60 degrees of the floor plane. With ready_tool_pose: where inverse
     #: kinematics starts from and stays near.
     initial_positions: list[float] = dataclasses.field(default_factory=list)
-    #: The ready configuration as the pose of ee_frame in the world (`{position: [x, y, z],
-    #: rpy_degrees: [roll, pitch, yaw]}`), solved by inverse kinematics within the joints'
-    #: limits; none: initial_positions is the ready configuration.
+    #: The ready configuration as the pose of ee_frame in the world (a ToolPose: its
+    #: position and rpy_degrees), solved by inverse kinematics within the joints' limits;
+    #: none: initial_positions is the ready configuration.
     ready_tool_pose: typing.Optional[ToolPose] = None
     #: "kinematic": the joints are on the diff IK's plan at every instant (no plant is
     #: stepped); "dynamic": the plant and stiff PD servos (servo_frequency) track it.

@@ -12,6 +12,8 @@ PEERS = ("pydmps", "movement_primitives")
 # The K of the goal estimators' steps (`pbp_drake_bench.estimators`; not imported: it
 # imports Drake's systems, and this module is read by the CLI's reference).
 ESTIMATOR_GOALS = 10_000
+# The K of the arm's run at its driver's rate (`pbp_drake_bench.driver_rate`).
+DRIVER_GOALS = 100
 
 
 @dataclasses.dataclass(frozen=True)
@@ -31,6 +33,7 @@ class Check:
     base_run: tuple | None = None  # ... and of the run of the same bench it compares with
     replay: tuple = ()  # the K of the replay sizes it compares (`pbp_drake_bench.replay`)
     estimator: str = ""  # the row of the goal estimators' steps it reads (`.estimators`)
+    driver: bool = False  # it reads the run at the driver's rate (`.driver_rate`)
     peers: tuple = ()  # it needs one of these peer libraries
     motion: bool = False  # it reads the row's timing over a movement (`cases.motion_timing`)
 
@@ -41,6 +44,8 @@ CHECKED_HSR_GOALS = 100
 # The K of the checked replays: each K's size over the first's.
 CHECKED_REPLAY_GOALS = (4, 1000)
 _MESHCAT = "Meshcat drawing to a client (another process) that reads everything sent"
+_AT_THE_DRIVER = (f"iiwa reaching task, K={DRIVER_GOALS} goals, over LCM to its driver "
+                  "simulator in the same process (memq://, 200 Hz), headless")
 _OVER_A_MOVEMENT = ("one step in the LeafSystem and a read of its selected reference, median "
                     "over a movement and as long after it,")
 
@@ -84,6 +89,11 @@ CHECKS = (
     Check(f"K={ESTIMATOR_GOALS:,} goals: the intent_filter estimator, a control period's "
           "step <= 2x the angle estimator's (same run)", 2.0, True,
           "x angle", lambda row: row["vs_angle"], estimator="intent_filter"),
+    Check(f"{_AT_THE_DRIVER}: closed loop >= 5x real time", 5.0, False, "x real time",
+          lambda run: run["realtime_factor"], driver=True),
+    Check(f"{_AT_THE_DRIVER}: a control tick's wall time, 99th percentile <= 3x the median "
+          "(no stalls at the driver's rate)", 3.0, True, "x the median",
+          lambda run: run["p99_over_median"], driver=True),
     Check("Replay of a 5 s HSR reaching run as pbp-drake run --record saves it: K=1,000 goals "
           "<= 3x the size of K=4's", 3.0, True, "x the K=4 replay",
           lambda sizes: sizes[1000] / sizes[4], replay=CHECKED_REPLAY_GOALS),
@@ -94,12 +104,14 @@ CHECKS = (
 MOTION_ROWS = frozenset((check.row, check.pose) for check in CHECKS if check.motion)
 
 
-def evaluate(rows, closed_loop, installed, blas=None, replay=None, estimators=None):
+def evaluate(rows, closed_loop, installed, blas=None, replay=None, estimators=None,
+             driver_rate=None):
     """Every check's result: {"check", "value", "limit", "unit", "verdict", "reason"}, the
     verdict "pass", "fail" or "skipped" (then "reason" says why). `installed` is the set of
     peer libraries present; `blas` (from `pinning.blas_threads`) adds the pinning check;
     `replay` is `pbp_drake_bench.replay.replay_sizes`' result (None: not recorded);
-    `estimators` `pbp_drake_bench.estimators.estimator_steps`' (None: not measured)."""
+    `estimators` `pbp_drake_bench.estimators.estimator_steps`' (None: not measured);
+    `driver_rate` `pbp_drake_bench.driver_rate.driver_rate_run`'s (None: not run)."""
     results = []
     for check in CHECKS:
         result = {"check": check.name, "value": None, "limit": check.limit,
@@ -108,7 +120,7 @@ def evaluate(rows, closed_loop, installed, blas=None, replay=None, estimators=No
         if check.peers and not set(check.peers) & set(installed):
             result["reason"] = f"{', '.join(check.peers)} not installed"
             continue
-        source, where = _source(check, rows, closed_loop, replay, estimators)
+        source, where = _source(check, rows, closed_loop, replay, estimators, driver_rate)
         value = None if source is None else check.value(source)
         if value is None:
             result["reason"] = ("not measured: " + where if source is None else
@@ -123,7 +135,10 @@ def evaluate(rows, closed_loop, installed, blas=None, replay=None, estimators=No
     return results
 
 
-def _source(check, rows, closed_loop, replay, estimators=None):
+def _source(check, rows, closed_loop, replay, estimators=None, driver_rate=None):
+    if check.driver:
+        return ((driver_rate, None) if driver_rate else
+                (None, "no run at the driver's rate (--no-driver-rate, or --hsr-goals empty)"))
     if check.estimator:
         found = [row for row in (estimators or {}).get("rows", ())
                  if row["estimator"] == check.estimator]

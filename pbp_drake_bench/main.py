@@ -16,6 +16,7 @@ from pbp_drake_bench.cases import (
 from pbp_drake_bench.checks import (
     CHECKED_HSR_GOALS, CHECKED_REPLAY_GOALS, MOTION_ROWS, PEERS, evaluate, exit_code)
 from pbp_drake_bench.closed_loop import HSR_KS, TASKS, closed_loop_runs, split_run
+from pbp_drake_bench.driver_rate import driver_rate_run
 from pbp_drake_bench.estimators import estimator_steps
 from pbp_drake_bench.peers import (
     available, movement_primitives_stacked_step, movement_primitives_step, pydmps_step)
@@ -70,6 +71,9 @@ def build_parser():
                         "skip)")
     parser.add_argument("--no-estimators", action="store_true",
                         help="skip the goal estimators' step at K = 10,000 (and its check)")
+    parser.add_argument("--no-driver-rate", action="store_true",
+                        help="skip the iiwa's closed loop over LCM at its driver's rate (and "
+                        "its checks)")
     parser.add_argument("--blas-threads", type=int, default=1,
                         help="BLAS threads for every backend (default 1): the bench measures "
                         "in a fresh Python process with OPENBLAS_NUM_THREADS, "
@@ -104,6 +108,8 @@ def plan(args):
                       for with_meshcat in ((False, True) if meshcat else (False,))],
             "replay_goals": list(CHECKED_REPLAY_GOALS) if meshcat else [],
             "estimators": not args.no_estimators,
+            # The arm over LCM at its driver's rate, with the closed loop's runs.
+            "driver_rate": closed_loop and not args.no_driver_rate,
             "replay_seconds": REPLAY_SECONDS}
 
 
@@ -185,6 +191,8 @@ def _measure(args):
 
     estimators = (estimator_steps(min_time, progress=_progress) if settings["estimators"]
                   else None)
+    driver_rate = (driver_rate_run(hsr_seconds, progress=_progress)
+                   if settings["driver_rate"] else None)
 
     report = {
         "machine": {"processor": platform.processor() or platform.machine(),
@@ -201,8 +209,10 @@ def _measure(args):
         "time_split": split,
         "replay": replay,
         "estimators": estimators,
+        "driver_rate": driver_rate,
     }
-    report["checks"] = evaluate(rows, closed_loop, installed, blas, replay, estimators)
+    report["checks"] = evaluate(rows, closed_loop, installed, blas, replay, estimators,
+                                driver_rate)
     text = format_report(report)
     print(text)
     (output / "bench.json").write_text(json.dumps(report, indent=2))

@@ -107,6 +107,9 @@ def format_report(report):
     if report.get("estimators"):
         lines.append("")
         lines.extend(format_estimators(report["estimators"]))
+    if report.get("driver_rate"):
+        lines.append("")
+        lines.append(format_driver_rate(report["driver_rate"]))
     lines.append("")
     lines.append(format_results(report["checks"]))
     return "\n".join(lines)
@@ -208,3 +211,12 @@ def format_estimators(estimators):
         lines.append(f"  {row['estimator']:<24} {row['step_us']:9.0f} us  "
                      f"{row['vs_angle']:5.2f}x")
     return lines
+
+
+def format_driver_rate(run):
+    """The report's line of the arm's run at its driver's rate."""
+    return (f"The {run['driver']} over LCM at its driver's rate ({run['driver_period_s'] * 1000:g} "
+            f"ms), K = {run['goals']} goals, headless: {run['realtime_factor']:.1f}x real time "
+            f"over {run['simulated_s']:.2f} s; a control tick ({run['control_period_s'] * 1000:g}"
+            f" ms) took {run['tick_median_ms']:.2f} ms (median), {run['tick_p99_ms']:.2f} ms "
+            f"(99th percentile, {run['p99_over_median']:.2f}x the median)")

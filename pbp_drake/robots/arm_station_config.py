@@ -2,6 +2,7 @@
 arm's driver and bus) and their validation (the fields alone; what needs the model, its
 frames and limits, is checked where it is loaded, ``pbp_drake.robots.arm_model``)."""
 
+import copyreg
 import dataclasses
 import re
 import typing
@@ -43,6 +44,17 @@ DRIVERS = {
 DEFAULT_LCM_URL = "udpm://239.241.129.92:20185?ttl=0"
 _UDPM = re.compile(r"udpm://(\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}):(\d{1,5})"
                    r"(\?(ttl|recv_buf_size)=\d+(&(ttl|recv_buf_size)=\d+)?)?")
+
+
+def _lcm_params(lcm_url, channel_suffix, defer_initialization):
+    return DrakeLcmParams(lcm_url=lcm_url, channel_suffix=channel_suffix,
+                          defer_initialization=defer_initialization)
+
+
+# A study sends each trial's scenario to its worker process by pickle, which Drake's
+# DrakeLcmParams does not support on its own.
+copyreg.pickle(DrakeLcmParams, lambda params: (_lcm_params, (
+    params.lcm_url, params.channel_suffix, params.defer_initialization)))
 
 
 @dataclasses.dataclass

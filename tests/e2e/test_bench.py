@@ -27,10 +27,11 @@ from pbp_drake_bench.cases import (
     MOTION_DURATIONS, bank_math_step, leaf_simulator, make_bank, make_case, motion_timing)
 from pbp_drake_bench.checks import CHECKS, evaluate, exit_code, format_results, summary
 from pbp_drake_bench.closed_loop import split_run
+from pbp_drake_bench.driver_rate import driver_rate_run
 from pbp_drake_bench.estimators import estimator_steps
 from pbp_drake_bench.pinning import MARKER, THREAD_VARIABLES, blas_threads
 from pbp_drake_bench.main import _parse, plan
-from pbp_drake_bench.table import format_estimators, format_report
+from pbp_drake_bench.table import format_driver_rate, format_estimators, format_report
 from pbp_drake_bench.time_split import BANK, DRAWING, IK, ORDER, REST, category_of, split_stats
 from pbp_drake_bench.timing import timed_span
 from pbp_drake_bench.ws_reader import MeshcatReader, send_mark
@@ -119,10 +120,25 @@ def _all_cases(leaf_us=500.0):
     return rows, _closed_loop()
 
 
-def _verdicts(closed_loop, replay=None, rows=None, estimators=None):
+DRIVER_SPEED = ("iiwa reaching task, K=100 goals, over LCM to its driver simulator in the "
+                "same process (memq://, 200 Hz), headless: closed loop >= 5x real time")
+DRIVER_STALLS = ("iiwa reaching task, K=100 goals, over LCM to its driver simulator in the "
+                 "same process (memq://, 200 Hz), headless: a control tick's wall time, 99th "
+                 "percentile <= 3x the median (no stalls at the driver's rate)")
+
+
+def _driver_rate(factor=9.0, stalls=1.2):
+    return {"goals": 100, "driver": "iiwa", "driver_period_s": 0.005,
+            "control_period_s": 0.03, "simulated_s": 5.0, "wall_s": 5.0 / factor,
+            "realtime_factor": factor, "ticks": 167, "tick_median_ms": 3.0,
+            "tick_p99_ms": 3.0 * stalls, "p99_over_median": stalls}
+
+
+def _verdicts(closed_loop, replay=None, rows=None, estimators=None, driver_rate=None):
     rows = rows if rows is not None else _all_cases()[0]
     results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay,
-                       estimators if estimators is not None else _estimators())
+                       estimators if estimators is not None else _estimators(),
+                       driver_rate if driver_rate is not None else _driver_rate())
     return {r["check"]: r["verdict"] for r in results}
 
 
@@ -138,7 +154,7 @@ def test_the_closed_loop_check_reads_the_shipped_robot_not_the_dynamic_one():
 def test_every_check_passes_and_the_exit_code_is_0():
     rows, closed_loop = _all_cases()
     results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, _replay(),
-                       _estimators())
+                       _estimators(), _driver_rate())
     assert [r["verdict"] for r in results] == ["pass"] * len(CHECKS)
     assert exit_code(results) == 0
 
@@ -158,18 +174,18 @@ def test_a_slow_step_fails_its_check_and_the_exit_code_is_1():
 def test_missing_peers_are_skipped_neither_passed_nor_failed():
     rows, closed_loop = _all_cases()
     results = evaluate(rows, closed_loop, installed=set(), replay=_replay(),
-                       estimators=_estimators())
+                       estimators=_estimators(), driver_rate=_driver_rate())
     skipped = {r["check"]: r["reason"] for r in results if r["verdict"] == "skipped"}
     assert len(skipped) == 2
     assert set(skipped.values()) == {"pydmps, movement_primitives not installed",
                                      "movement_primitives not installed"}
     assert exit_code(results) == 0
     assert summary(results).startswith(
-        "Checks: 11 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
+        "Checks: 13 passed, 0 failed, 2 skipped (pydmps, movement_primitives not installed: 1;"
         " movement_primitives not installed: 1)")
     # One peer is enough for the per-goal check.
     results = evaluate(rows, closed_loop, installed={"pydmps"}, replay=_replay(),
-                       estimators=_estimators())
+                       estimators=_estimators(), driver_rate=_driver_rate())
     assert [r["verdict"] for r in results].count("skipped") == 1
 
 
@@ -184,7 +200,8 @@ def test_quick_keeps_every_check_with_the_same_limits():
                        for meshcat in ((False, True) if settings["meshcat"] else (False,))]
         replay = {"runs": [{"goals": k, "bytes": 1e6} for k in settings["replay_goals"]]}
         results = evaluate(rows, closed_loop, {"pydmps", "movement_primitives"}, None, replay,
-                           _estimators() if settings["estimators"] else None)
+                           _estimators() if settings["estimators"] else None,
+                           _driver_rate() if settings["driver_rate"] else None)
         assert [(r["check"], r["limit"], r["verdict"]) for r in results] == [
             (check.name, check.limit, "pass") for check in CHECKS]
     assert quick["min_time"] < full["min_time"]
@@ -232,6 +249,30 @@ def test_the_intent_filters_step_is_checked_against_the_angle_estimators_of_the_
     skipped = evaluate(rows, closed_loop, set(), None, _replay())
     assert {r["check"]: r["reason"] for r in skipped}[ESTIMATOR] == (
         "not measured: no goal estimator steps (--no-estimators)")
+
+
+def test_the_arm_at_its_driver_s_rate_is_checked_for_speed_and_stalls():
+    rows, closed_loop = _all_cases()
+    assert _verdicts(closed_loop, _replay(), rows, driver_rate=_driver_rate(5.1, 2.9))[
+        DRIVER_SPEED] == "pass"
+    verdicts = _verdicts(closed_loop, _replay(), rows, driver_rate=_driver_rate(4.9, 3.1))
+    assert verdicts[DRIVER_SPEED] == verdicts[DRIVER_STALLS] == "fail"
+    skipped = evaluate(rows, closed_loop, set(), None, _replay(), _estimators())
+    assert {r["check"]: r["reason"] for r in skipped}[DRIVER_STALLS] == (
+        "not measured: no run at the driver's rate (--no-driver-rate, or --hsr-goals empty)")
+    assert plan(_parse(["--quick"]))["driver_rate"]
+    assert not plan(_parse(["--no-driver-rate"]))["driver_rate"]
+    assert not plan(_parse(["--hsr-goals"]))["driver_rate"]
+
+
+@pytest.mark.slow
+def test_the_iiwa_runs_over_lcm_at_its_driver_s_rate_and_the_report_says_so():
+    run = driver_rate_run(0.3, goal_count=10)
+    assert run["driver_period_s"] == 0.005 and run["ticks"] == 10
+    assert run["simulated_s"] == pytest.approx(0.3)
+    assert run["tick_p99_ms"] >= run["tick_median_ms"] > 0.0
+    assert format_driver_rate(run).startswith(
+        "The iiwa over LCM at its driver's rate (5 ms), K = 10 goals, headless: ")
 
 
 @pytest.mark.slow
@@ -309,7 +350,7 @@ def test_the_bench_command_pins_blas_and_exits_with_the_checks(
     assert f"[{verdict}] {K10K_LEAF}: " in result.stdout
     # The estimator check passes either way: every estimator takes the same fixed time.
     passed, failed = (5, 0) if code == 0 else (2, 3)
-    assert (f"Checks: {passed} passed, {failed} failed, 9 skipped (not measured: 7; "
+    assert (f"Checks: {passed} passed, {failed} failed, 11 skipped (not measured: 9; "
             "pydmps, movement_primitives not installed: 1; movement_primitives not "
             "installed: 1)") in result.stdout
     assert f"exit code {code}" in result.stdout

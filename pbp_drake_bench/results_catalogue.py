@@ -113,6 +113,14 @@ STUDIES = {
         "--split", "evaluation"],
     "arm_reach_teleop_calibration": ["diagrams/arm_reach.yaml", "--methods", "teleop",
                                      "--trials", "30", "--split", "tuning"],
+    # Our Franka Panda and KUKA iiwa (docs/results/arm.md): teleop on the tuning seeds,
+    # then PBP against it on the evaluation seeds.
+    **{f"{arm}_reach_teleop_calibration": [f"diagrams/{arm}_reach.yaml", "--methods", "teleop",
+                                           "--trials", "30", "--split", "tuning"]
+       for arm in ("panda", "iiwa")},
+    **{f"{arm}_reach_evaluation": [f"diagrams/{arm}_reach.yaml", "--methods",
+                                   "pbp_alternated,pbp_continuous,teleop", *EVALUATION_30]
+       for arm in ("panda", "iiwa")},
     **{f"hsr_reach_{condition}": [*IMPAIRED, "--participant-condition", condition]
        for condition in ("noisy", "late", "mistaken")},
     **{f"hsr_reach_goals_{goals}": ["diagrams/hsr_reach.yaml", "--goals", str(goals),

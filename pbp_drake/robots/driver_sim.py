@@ -129,18 +129,18 @@ class DriverSim(LeafSystem):
 
 
 def make_driver_sim(driver, lcm, clock, q_start, lower, upper, velocity_limits,
-                    with_interface=True):
+                    with_interface=True, expire_sec=PANDA_EXPIRE_SEC):
     """An arm of the joints' `lower`, `upper` and `velocity_limits` standing at `q_start`
     behind `driver`'s rules on `lcm`, as a Diagram named ``driver_sim``;
     `with_interface`: with its own `LcmInterfaceSystem` pumping `lcm` (not when the
-    station in the same diagram pumps it)."""
+    station in the same diagram pumps it); `expire_sec`: the Panda driver's."""
     builder = DiagramBuilder()
     if with_interface:
         builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
     commands = builder.AddNamedSystem("command_subscriber", LcmSubscriberSystem.Make(
         DRIVERS[driver].command_channel, command_type(driver), lcm))
     arm = builder.AddNamedSystem("arm", DriverSim(driver, lcm, q_start, lower, upper,
-                                                  velocity_limits, clock))
+                                                  velocity_limits, clock, expire_sec))
     builder.Connect(commands.get_output_port(), arm.get_input_port(0))
     diagram = builder.Build()
     diagram.set_name("driver_sim")

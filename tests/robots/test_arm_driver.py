@@ -5,6 +5,7 @@ driver, and a bad status each end the run with one clear error and nothing more 
 
 import dataclasses
 import pathlib
+import time
 
 import numpy as np
 import pytest
@@ -18,7 +19,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 from pbp_drake.cli import main
 from pbp_drake.robots import ArmHardware, DriverError, arm_initial_ee_state, make_arm_station
 from pbp_drake.robots.arm_driver import (
-    SIMULATION_CLOCK, DriverLink, command_message, status_message, status_type)
+    SIMULATION_CLOCK, WALL_CLOCK, DriverLink, command_message, status_message, status_type)
 from pbp_drake.robots.arm_station_config import DRIVERS
 from pbp_drake.robots.driver_sim import DriverSimError, make_driver_sim
 from pbp_drake.scenarios import load_scenario_file
@@ -76,6 +77,38 @@ def test_the_driver_path_gives_the_simulated_station_s_hand_path(arm):
     gaps = [np.abs(over_lcm[lag:] - simulated[:len(simulated) - lag]).max()
             for lag in range(samples + 1)]
     assert min(gaps) < PATH_TOLERANCE, gaps
+
+
+@pytest.mark.slow
+def test_on_the_wall_clock_the_panda_s_commands_carry_the_wall_time_and_are_taken():
+    # Both sides on the wall clock in real time, as with a real driver (limits generous,
+    # so that a loaded machine does not end it: the rules' timing is tested above).
+    lcm = DrakeLcm("memq://")
+    hardware = ArmHardware(driver="panda", connect=True, status_timeout=1.0,
+                           command_expiry=1.0)
+    builder = DiagramBuilder()
+    builder.AddSystem(LcmInterfaceSystem(lcm))
+    builder.AddSystem(make_driver_sim("panda", lcm, WALL_CLOCK, START, LOWER, UPPER, VELOCITY,
+                                      with_interface=False, expire_sec=1.0))
+    status = builder.AddSystem(LcmSubscriberSystem.Make("PANDA_STATUS", status_type("panda"),
+                                                        lcm))
+    link = builder.AddSystem(DriverLink(hardware, lcm, START, LOWER, UPPER, VELOCITY,
+                                        WALL_CLOCK))
+    target = builder.AddSystem(ConstantVectorSource(np.concatenate([START + 0.02,
+                                                                    np.zeros(7)])))
+    builder.Connect(status.get_output_port(), link.GetInputPort("status"))
+    builder.Connect(target.get_output_port(), link.GetInputPort("desired_state"))
+    stamps = []
+    lcm.Subscribe("PANDA_COMMAND", lambda data: stamps.append(
+        (time.time(), lcmt_panda_command.decode(data).utime * 1e-6)))
+    simulator = Simulator(builder.Build())
+    simulator.set_target_realtime_rate(1.0)
+    simulator.AdvanceTo(0.3)
+    lcm.HandleSubscriptions(0)
+    assert stamps and all(abs(received - stamp) < 1.0 for received, stamp in stamps)
+    state = np.array(link.GetOutputPort("state").Eval(
+        link.GetMyContextFromRoot(simulator.get_context())))
+    np.testing.assert_allclose(state[:7], START + 0.02, atol=1e-9)
 
 
 class Rig:

@@ -174,16 +174,21 @@ IK_STARTS = 40
 def _solve_tool_pose(plant, arm, config, q_given):
     """The configuration within the joints' limits that puts ee_frame at
     `config.ready_tool_pose`, nearest `q_given` (`config.initial_positions`) or, without
-    it, the middle of the limits: a least-squares cost toward it, from it first and then
-    from seeded starts until one converges (deterministic)."""
+    it, the middle of the limits: a least-squares cost toward it, solved from it and from
+    seeded starts, the least cost kept (deterministic; remembered per model and pose)."""
     X_WE = config.ready_tool_pose.transform()
     lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
     nominal = np.asarray(q_given if config.initial_positions else (lower + upper) / 2, float)
+    key = (config.model_file, config.base_frame, config.ee_frame, tuple(config.base_pose),
+           tuple(config.ready_tool_pose.position), tuple(config.ready_tool_pose.rpy_degrees),
+           tuple(nominal))
+    if key in _SOLVED_TOOL_POSES:
+        return _SOLVED_TOOL_POSES[key].copy()
     starts = np.random.default_rng(0).uniform(0.1, 0.9, (IK_STARTS, len(nominal)))
+    best, p = None, X_WE.translation()
     for start in [nominal, *(lower + (upper - lower) * starts)]:
         ik = InverseKinematics(plant)
         q = ik.q()
-        p = X_WE.translation()
         ik.AddPositionConstraint(arm.ee_frame, np.zeros(3), plant.world_frame(),
                                  p - TOOL_POSITION_TOLERANCE, p + TOOL_POSITION_TOLERANCE)
         ik.AddOrientationConstraint(plant.world_frame(), X_WE.rotation(), arm.ee_frame,
@@ -192,12 +197,18 @@ def _solve_tool_pose(plant, arm, config, q_given):
         program.AddQuadraticErrorCost(np.eye(len(nominal)), nominal, q)
         program.SetInitialGuess(q, start)
         result = Solve(program)
-        if result.is_success():
-            return np.clip(result.GetSolution(q), lower, upper)
-    shown = ", ".join(f"{value:g}" for value in p)
-    raise ValueError(f"ArmStationConfig.ready_tool_pose: ee_frame {config.ee_frame!r} cannot "
-                     f"stand at [{shown}] m in that orientation within the joints' limits "
-                     f"(inverse kinematics from {IK_STARTS + 1} starts)")
+        if result.is_success() and (best is None or result.get_optimal_cost() < best[0]):
+            best = (result.get_optimal_cost(), np.clip(result.GetSolution(q), lower, upper))
+    if best is None:
+        shown = ", ".join(f"{value:g}" for value in p)
+        raise ValueError(f"ArmStationConfig.ready_tool_pose: ee_frame {config.ee_frame!r} "
+                         f"cannot stand at [{shown}] m in that orientation within the joints' "
+                         f"limits (inverse kinematics from {IK_STARTS + 1} starts)")
+    _SOLVED_TOOL_POSES[key] = best[1]
+    return best[1].copy()
+
+
+_SOLVED_TOOL_POSES = {}
 
 
 # The mass matrix is singular (a joint whose motion moves no inertia) when its smallest

@@ -139,7 +139,7 @@ def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
     port. The run read the driver's first status before it built this (`q0`, the ready
     configuration, is where the arm stood); with `driver_sim` the simulator stands there."""
     driver = DRIVERS[hardware.driver]
-    q_start = np.array([q0[joint.position_start()] for joint in arm.joints])
+    q_start = _arm_positions(arm, q0)
     lower, upper, velocity = _joint_limits(plant, arm)
     if hardware.driver_sim:
         lcm, clock = memq_lcm(), SIMULATION_CLOCK
@@ -158,6 +158,11 @@ def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
     return link.GetOutputPort("state")
 
 
+def _arm_positions(arm, q):
+    """The arm's joints' entries of the plant's positions `q`, in the model's order."""
+    return np.array([q[joint.position_start()] for joint in arm.joints])
+
+
 def _joint_limits(plant, arm):
     """`(lower, upper, velocity)` of the arm's joints, in the model's order."""
     rows = [(joint.position_lower_limits()[0], joint.position_upper_limits()[0],
@@ -174,8 +179,7 @@ def arm_driver_sim(config: ArmStationConfig, lcm, clock=WALL_CLOCK) -> Diagram:
         raise ValueError("ArmStationConfig.hardware is needed: the driver to simulate "
                          "(hardware: {driver: panda} or {driver: iiwa})")
     plant, arm, q0 = arm_model_plant(config)
-    q_start = np.array([q0[joint.position_start()] for joint in arm.joints])
-    return make_driver_sim(config.hardware.driver, lcm, clock, q_start,
+    return make_driver_sim(config.hardware.driver, lcm, clock, _arm_positions(arm, q0),
                            *_joint_limits(plant, arm))
 
 

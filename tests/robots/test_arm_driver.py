@@ -313,6 +313,15 @@ def test_a_model_of_another_joint_count_than_the_driver_s_is_refused(capsys):
     assert "hardware.driver 'panda' drives 7 joints; the model has 6" in out.err
 
 
+def test_a_study_does_not_drive_a_real_arm(tmp_path, capsys):
+    code, out = run("study", str(REPO / "diagrams" / "iiwa_reach.yaml"), "--set",
+                    "robot.hardware.connect=true", "--output", str(tmp_path / "study"),
+                    capsys=capsys)
+    assert code == 2
+    assert "a study runs its trials unattended in simulation" in out.err
+    assert not (tmp_path / "study").exists()
+
+
 @pytest.mark.slow
 def test_the_panda_task_runs_over_lcm_with_the_driver_simulator(capsys):
     code, out = run("run", str(REPO / "diagrams" / "panda_reach.yaml"), "--hardware",

@@ -98,10 +98,11 @@ API_GROUPS = {
         **{name: "pbp_drake.core.controller_config" for name in [
             "PbpControllerConfig", "HandOverSettings"]},
     },
-    "A real arm": {
+    "Real robots": {
         name: "pbp_drake.robots" for name in [
             "ArmHardware", "DriverError", "arm_driver_sim", "measured_ready_positions",
-            "drives_real_arm"]},
+            "drives_real_arm", "TaskSpaceBridgeConfig", "make_task_space_bridge",
+            "make_station_relay"]},
     "Scenario files": {
         name: "pbp_drake.scenarios" for name in [
             "load_scenario_file", "resolve", "ResolvedScenario", "ScenarioError",

@@ -22,10 +22,16 @@ from pbp_drake.robots.hsr_station import (
     make_hsr_station,
 )
 from pbp_drake.robots.hsr_station_config import CylinderObstacle, HsrStationConfig
+from pbp_drake.robots.task_space_bridge import (
+    TaskSpaceBridgeConfig,
+    make_station_relay,
+    make_task_space_bridge,
+)
 
 __all__ = ["ArmHardware", "ArmStationConfig", "CylinderObstacle", "DriverError",
            "HsrStationConfig", "add_hsr", "arm_driver_sim", "arm_initial_ee_state",
            "arm_reach", "arm_ready_ee_state", "arm_station_plant", "drives_real_arm",
            "hsr_initial_ee_state", "hsr_initial_hand_pose", "hsr_ready_ee_state",
            "hsr_station_plant", "make_arm_station", "make_hsr_station",
-           "measured_ready_positions", "ToolPose"]
+           "measured_ready_positions", "ToolPose", "TaskSpaceBridgeConfig",
+           "make_station_relay", "make_task_space_bridge"]

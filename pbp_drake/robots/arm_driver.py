@@ -32,6 +32,7 @@ from pydrake.common.value import Value
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.robots.arm_station_config import DRIVERS
+from pbp_drake.systems.tick import decide_offset
 
 WALL_CLOCK, SIMULATION_CLOCK = "wall", "simulation"
 # drake-franka-driver's position mode (lcmt_panda_status.CONTROL_MODE_POSITION).
@@ -192,7 +193,11 @@ class DriverLink(LeafSystem):
         self.DeclareVectorOutputPort("state", 2 * n, self._output_state,
                                      prerequisites_of_calc={self.xd_ticket()})
         self.DeclarePeriodicDiscreteUpdateEvent(self._driver.period, 0.0, self._update)
-        self.DeclarePeriodicPublishEvent(self._driver.period, 0.0, self._send)
+        # Sent just after the update of the same instant: Drake publishes at the end of the
+        # step that reaches an instant and updates at the start of the next, so a publish at
+        # the instant itself would send the last period's command.
+        self.DeclarePeriodicPublishEvent(self._driver.period, decide_offset(self._driver.period),
+                                         self._send)
 
     def _output_state(self, context, output):
         output.SetFromVector(context.get_discrete_state(self._state_index).value()[:2 * self._n])

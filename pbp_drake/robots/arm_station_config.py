@@ -203,11 +203,7 @@ def validate_arm_hardware(hardware: ArmHardware) -> None:
     if hardware.driver not in DRIVERS:
         raise ValueError(f"{field}.driver must be one of {sorted(DRIVERS)}, got "
                          f"{hardware.driver!r}")
-    url = hardware.lcm_bus.lcm_url
-    if not (url == "memq://" or _valid_udpm(url)):
-        raise ValueError(f"{field}.lcm_bus.lcm_url {url!r} is not an LCM URL the driver can "
-                         "share: udpm://ADDRESS:PORT?ttl=N (a multicast IPv4 address) or "
-                         f"memq://; Drake's hardware_sim uses {DEFAULT_LCM_URL}")
+    check_lcm_url(hardware.lcm_bus.lcm_url, f"{field}.lcm_bus.lcm_url")
     for name in ("status_timeout", "connect_timeout", "command_expiry", "start_tolerance"):
         value = getattr(hardware, name)
         if not (np.isfinite(value) and value > 0):
@@ -215,6 +211,15 @@ def validate_arm_hardware(hardware: ArmHardware) -> None:
     if hardware.driver_sim and not hardware.connect:
         raise ValueError(f"{field}.driver_sim needs connect (pbp-drake run --hardware "
                          "--driver-sim)")
+
+
+def check_lcm_url(url, field):
+    """Raises ValueError naming `field` unless `url` is an LCM URL two processes can share
+    (udpm:// with a multicast IPv4 address and a port) or memq://."""
+    if not (url == "memq://" or _valid_udpm(url)):
+        raise ValueError(f"{field} {url!r} is not an LCM URL the driver can share: "
+                         "udpm://ADDRESS:PORT?ttl=N (a multicast IPv4 address) or memq://; "
+                         f"Drake's hardware_sim uses {DEFAULT_LCM_URL}")
 
 
 def _valid_udpm(url):

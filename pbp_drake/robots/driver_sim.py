@@ -23,6 +23,7 @@ from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 from pbp_drake.robots.arm_driver import (
     PANDA_POSITION_MODE, clock_now, command_type, status_message)
 from pbp_drake.robots.arm_station_config import DRIVERS
+from pbp_drake.systems.tick import decide_offset
 
 # drake-franka-driver's default --expire_sec (s).
 PANDA_EXPIRE_SEC = 0.1
@@ -66,7 +67,10 @@ class DriverSim(LeafSystem):
             np.concatenate([q_start, np.zeros(n), q_start, [-1.0, np.nan]]))
         self.DeclareAbstractInputPort("command", Value(command_type(driver)()))
         self.DeclarePeriodicDiscreteUpdateEvent(self._driver.period, 0.0, self._update)
-        self.DeclarePeriodicPublishEvent(self._driver.period, 0.0, self._publish)
+        # Just after the update of the same instant (see DriverLink): the status of this
+        # period's motion, not the last's.
+        self.DeclarePeriodicPublishEvent(self._driver.period, decide_offset(self._driver.period),
+                                         self._publish)
 
     def positions(self, context):
         """The simulated arm's joint positions in `context` (its own)."""

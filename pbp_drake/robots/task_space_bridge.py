@@ -1,0 +1,228 @@
+"""A task-space bridge for robots whose interface is not Drake's (the HSR speaks ROS): the
+stations' ports, `ee_command` and `ee_state`, as two LCM channels, so that a small relay on
+the robot's side is all a user writes (docs/tasks/real-arm.md shows its shape for a ROS
+robot).
+
+``make_task_space_bridge(config, initial_ee_state, control_period)`` returns a Diagram
+named ``task_space_bridge`` with a station's two ports::
+
+    ee_command ─► BridgeLink ─► PBP_EE_COMMAND (lcmt_drake_signal: x y z vx vy vz heading)
+    PBP_EE_STATE (lcmt_drake_signal: x y z vx vy vz heading heading_rate)
+        ─► LcmSubscriberSystem ─► BridgeLink ─► ee_state
+
+``make_station_relay(station, lcm, config)`` is the robot's side around any Drake station
+(what the tests run, and what a ROS relay does with the robot's own topics): it passes
+each ``PBP_EE_COMMAND`` to the station's ``ee_command`` as it comes and streams its
+``ee_state`` on ``PBP_EE_STATE`` faster than the control loop.
+
+`BridgeLink` keeps the arm drivers' rules where they apply to any robot: nothing is sent
+before a fresh state, and a state silent for `status_timeout`, of the wrong size or with a
+NaN ends the run with `DriverError` and sends nothing more (the relay should then hold the
+robot). Each message is stamped (`timestamp`, microseconds) on the simulation's clock.
+"""
+
+import dataclasses
+
+import numpy as np
+from drake import lcmt_drake_signal
+from pydrake.common.value import Value
+from pydrake.lcm import DrakeLcm, DrakeLcmParams
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
+
+from pbp_drake.robots.arm_driver import DriverError
+from pbp_drake.robots.arm_station_config import DEFAULT_LCM_URL, check_lcm_url
+from pbp_drake.systems.ports import EeCommand, EeState
+from pbp_drake.systems.tick import report_offset
+
+COMMAND_FIELDS, STATE_FIELDS = list(EeCommand.get_fields()), list(EeState.get_fields())
+
+
+@dataclasses.dataclass
+class TaskSpaceBridgeConfig:
+    """Where the bridge's two channels are, and how long the robot's state may be silent."""
+
+    #: The LCM bus (Drake's DrakeLcmParams); the default stays on this machine (ttl=0).
+    lcm_bus: DrakeLcmParams = dataclasses.field(
+        default_factory=lambda: DrakeLcmParams(lcm_url=DEFAULT_LCM_URL))
+    #: Where the hand's command goes out (EeCommand's 7 values).
+    command_channel: str = "PBP_EE_COMMAND"
+    #: Where the hand's state comes in (EeState's 8 values).
+    state_channel: str = "PBP_EE_STATE"
+    #: The longest the robot's state may be silent (s) once it has come.
+    status_timeout: float = 0.2
+    #: How long (s) the bridge waits for the first state.
+    connect_timeout: float = 5.0
+
+
+def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
+    """Raises ValueError naming the first field of `config` that cannot work."""
+    check_lcm_url(config.lcm_bus.lcm_url, "TaskSpaceBridgeConfig.lcm_bus.lcm_url")
+    for name in ("command_channel", "state_channel"):
+        if not isinstance(getattr(config, name), str) or not getattr(config, name):
+            raise ValueError(f"TaskSpaceBridgeConfig.{name} must be a channel name, got "
+                             f"{getattr(config, name)!r}")
+    for name in ("status_timeout", "connect_timeout"):
+        value = getattr(config, name)
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"TaskSpaceBridgeConfig.{name} must be finite and positive, "
+                             f"got {value}")
+
+
+def signal(values, names, time):
+    """An lcmt_drake_signal of `values` named `names`, stamped `time` (s)."""
+    message = lcmt_drake_signal()
+    message.dim, message.val, message.coord = len(values), list(map(float, values)), names
+    message.timestamp = int(round(time * 1e6))
+    return message
+
+
+class BridgeLink(LeafSystem):
+    """The station's side of a task-space bridge (the module's docstring).
+
+    .. pydrake_system::
+
+        name: BridgeLink
+        input_ports:
+        - state_message
+        - ee_command
+        output_ports:
+        - ee_state
+
+    ``state_message`` is the last ``lcmt_drake_signal`` on the state channel (an
+    ``LcmSubscriberSystem``'s output), ``ee_command`` the controller's ``EeCommand``;
+    ``ee_state`` the robot's ``EeState`` as the relay last sent it (``initial_ee_state``
+    before). At each control period it checks the state and its age, and sends the
+    command in a publish event after that update.
+    """
+
+    def __init__(self, config, lcm, initial_ee_state, control_period):
+        super().__init__()
+        self._config, self._lcm = config, lcm
+        n = EeState.size
+        # State: the robot's ee_state as last checked, then the time its last message came,
+        # its stamp, the time of the first update, and whether this update sends.
+        self._STATE, self._AT, self._STAMP, self._STARTED, self._SEND = (
+            slice(0, n), n, n + 1, n + 2, n + 3)
+        self._index = self.DeclareDiscreteState(np.concatenate(
+            [np.asarray(initial_ee_state, float), [np.nan, -1.0, np.nan, 0.0]]))
+        self.DeclareAbstractInputPort("state_message", Value(lcmt_drake_signal()))
+        self.DeclareVectorInputPort("ee_command", EeCommand.size)
+        self._initial = np.asarray(initial_ee_state, float)
+        self.DeclareVectorOutputPort("ee_state", n, self._ee_state)
+        self.DeclarePeriodicDiscreteUpdateEvent(control_period, 0.0, self._update)
+        # Sent after the tick's decisions: the PBP controller's command (its hand-over's
+        # state) changes at the tick's report stage (`pbp_drake.systems.tick`); a publish at
+        # the tick itself would send the last tick's.
+        after_decisions = report_offset(control_period, report_offset(control_period))
+        self.DeclarePeriodicPublishEvent(control_period, after_decisions, self._send)
+
+    def _ee_state(self, context, output):
+        # The last message itself, not a sample of it: a controller that updates at the
+        # same instant reads the robot's latest state.
+        message = self.get_input_port(0).Eval(context)
+        output.SetFromVector(np.asarray(message.val, float) if message.dim == EeState.size
+                             else self._initial)
+
+    def _update(self, context, discrete_state):
+        x = np.array(context.get_discrete_state(self._index).value())
+        now, config = context.get_time(), self._config
+        if np.isnan(x[self._STARTED]):
+            x[self._STARTED] = now
+        message = self.get_input_port(0).Eval(context)
+        if message.dim and message.timestamp != x[self._STAMP]:
+            values = np.asarray(message.val, float)
+            if len(values) != EeState.size or not np.all(np.isfinite(values)):
+                raise DriverError(f"the robot's state on {config.state_channel} holds "
+                                  f"{len(values)} values (EeState's {EeState.size}, finite): "
+                                  f"{list(message.coord)}")
+            x[self._STATE], x[self._AT], x[self._STAMP] = values, now, message.timestamp
+        bus = config.lcm_bus.lcm_url
+        if np.isnan(x[self._AT]):
+            if now - x[self._STARTED] > config.connect_timeout:
+                raise DriverError(f"no state from the robot's relay on {config.state_channel} "
+                                  f"(bus {bus}) within {config.connect_timeout:g} s")
+            x[self._SEND] = 0.0
+        else:
+            silence = now - x[self._AT]
+            if silence > config.status_timeout:
+                raise DriverError(f"the robot's state on {config.state_channel} (bus {bus}) "
+                                  f"has been silent for {silence:.3f} s (at most "
+                                  f"{config.status_timeout:g} s): nothing more is sent")
+            x[self._SEND] = 1.0
+        discrete_state.set_value(self._index, x)
+
+    def _send(self, context):
+        x = context.get_discrete_state(self._index).value()
+        command = np.asarray(self.get_input_port(1).Eval(context))
+        if x[self._SEND] and np.all(np.isfinite(command)):
+            self._lcm.Publish(self._config.command_channel, signal(
+                command, COMMAND_FIELDS, context.get_time()).encode())
+
+
+def make_task_space_bridge(config: TaskSpaceBridgeConfig, initial_ee_state, control_period,
+                           lcm=None) -> Diagram:
+    """A station whose robot is on the far side of `config`'s LCM channels (the module's
+    docstring), on `lcm` (default a DrakeLcm on `config.lcm_bus`), with its own
+    `LcmInterfaceSystem`; `initial_ee_state` is the hand's ``EeState`` until the relay's
+    first state comes. Raises ValueError naming a field of `config` that cannot work."""
+    validate_task_space_bridge(config)
+    lcm = lcm or DrakeLcm(config.lcm_bus)
+    builder = DiagramBuilder()
+    builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
+    subscriber = builder.AddNamedSystem("state_subscriber", LcmSubscriberSystem.Make(
+        config.state_channel, lcmt_drake_signal, lcm))
+    link = builder.AddNamedSystem("bridge_link", BridgeLink(config, lcm, initial_ee_state,
+                                                            control_period))
+    builder.Connect(subscriber.get_output_port(), link.GetInputPort("state_message"))
+    builder.ExportInput(link.GetInputPort("ee_command"), "ee_command")
+    builder.ExportOutput(link.GetOutputPort("ee_state"), "ee_state")
+    bridge = builder.Build()
+    bridge.set_name("task_space_bridge")
+    return bridge
+
+
+class _Relay(LeafSystem):
+    """The robot's side: the last command that came in, as the station's ee_command (no
+    delay of its own), and the station's ee_state out on the state channel every
+    `state_period` (a robot's state stream, faster than the control loop)."""
+
+    def __init__(self, config, lcm, initial_command, state_period):
+        super().__init__()
+        self._config, self._lcm = config, lcm
+        self._initial = np.asarray(initial_command, float)
+        self.DeclareAbstractInputPort("command_message", Value(lcmt_drake_signal()))
+        self.DeclareVectorInputPort("ee_state", EeState.size)
+        self.DeclareVectorOutputPort("ee_command", EeCommand.size, self._command)
+        self.DeclarePeriodicPublishEvent(state_period, 0.0, self._publish)
+
+    def _command(self, context, output):
+        message = self.get_input_port(0).Eval(context)
+        output.SetFromVector(np.asarray(message.val) if message.dim == EeCommand.size
+                             else self._initial)
+
+    def _publish(self, context):
+        state = self.get_input_port(1).Eval(context)
+        self._lcm.Publish(self._config.state_channel,
+                          signal(state, STATE_FIELDS, context.get_time()).encode())
+
+
+def make_station_relay(station, lcm, config: TaskSpaceBridgeConfig, initial_ee_state,
+                       state_period=0.005) -> Diagram:
+    """`station` (any Diagram with ``ee_command`` and ``ee_state``) behind the bridge's
+    channels on `lcm`, with its own `LcmInterfaceSystem`: each command goes to the station
+    as it comes, and its state goes out every `state_period` s. The robot's side, as a
+    relay to a ROS robot is shaped (docs/tasks/real-arm.md)."""
+    builder = DiagramBuilder()
+    builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
+    station = builder.AddSystem(station)
+    subscriber = builder.AddNamedSystem("command_subscriber", LcmSubscriberSystem.Make(
+        config.command_channel, lcmt_drake_signal, lcm))
+    relay = builder.AddNamedSystem("relay", _Relay(
+        config, lcm, np.asarray(initial_ee_state)[:EeCommand.size], state_period))
+    builder.Connect(subscriber.get_output_port(), relay.GetInputPort("command_message"))
+    builder.Connect(relay.GetOutputPort("ee_command"), station.GetInputPort("ee_command"))
+    builder.Connect(station.GetOutputPort("ee_state"), relay.GetInputPort("ee_state"))
+    diagram = builder.Build()
+    diagram.set_name("station_relay")
+    return diagram

@@ -70,7 +70,7 @@ def test_the_driver_path_gives_the_simulated_station_s_hand_path(arm):
     over_lcm = hand_path(shipped(arm, connect=True, driver_sim=True))
     assert np.ptp(simulated[:, 0]) > 0.09  # the hand moved
     # Over LCM the hand follows the same path, late by the round trip of a command and a
-    # status through the bus (measured: 5 ms at the Panda's 1 ms, 23 ms at the iiwa's 5 ms),
+    # status through the bus (measured: 3 ms at the Panda's 1 ms, 13 ms at the iiwa's 5 ms),
     # at most LATE_PERIODS driver periods; the rest of the difference is the velocity
     # limits the commands keep at each period.
     samples = LATE_PERIODS * round(DRIVERS[arm].period / 0.001)

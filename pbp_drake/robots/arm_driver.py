@@ -129,8 +129,9 @@ def check_status(driver, q, v, lower, upper):
 
 def read_first_status(hardware, lcm, lower, upper):
     """The joint positions of the driver's first status on `lcm` (a DrakeLcm on
-    `hardware.lcm_bus`), waiting at most `hardware.connect_timeout`; DriverError naming the
-    bus and the channel when none comes, and as `check_status` for a bad one."""
+    `hardware.lcm_bus` that no `LcmInterfaceSystem` pumps: this subscribes a Python
+    callback), waiting at most `hardware.connect_timeout`; DriverError naming the bus and
+    the channel when none comes, and as `check_status` for a bad one."""
     driver = DRIVERS[hardware.driver]
     received = []
     lcm.Subscribe(driver.status_channel,

@@ -189,15 +189,16 @@ def drives_real_arm(hardware) -> bool:
     return hardware is not None and hardware.connect and not hardware.driver_sim
 
 
-def measured_ready_positions(config: ArmStationConfig, lcm=None) -> np.ndarray:
-    """The arm's joint positions from its driver's first status (on `lcm`, default a
-    DrakeLcm on `config.hardware.lcm_bus`): the ready configuration of a run on the real
-    arm, read before the run is built. Raises `DriverError` naming the bus and channel
-    when no status comes within `connect_timeout`."""
+def measured_ready_positions(config: ArmStationConfig) -> np.ndarray:
+    """The arm's joint positions from its driver's first status, on a DrakeLcm of its own
+    on `config.hardware.lcm_bus`: the ready configuration of a run on the real arm, read
+    before the run is built. (Its own, because its Python callback must not be called
+    from inside a simulation: newer Drakes advance without holding Python's lock there.)
+    Raises `DriverError` naming the bus and channel when no status comes within
+    `connect_timeout`."""
     plant, arm, _ = arm_model_plant(config)
     lower, upper, _ = _joint_limits(plant, arm)
-    return read_first_status(config.hardware, lcm or DrakeLcm(config.hardware.lcm_bus),
-                             lower, upper)
+    return read_first_status(config.hardware, DrakeLcm(config.hardware.lcm_bus), lower, upper)
 
 
 def _add_motors(plant, arm):

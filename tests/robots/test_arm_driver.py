@@ -13,7 +13,7 @@ from drake import lcmt_iiwa_command, lcmt_panda_command
 from pydrake.lcm import DrakeLcm
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
-from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
+from pydrake.systems.lcm import LcmSubscriberSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.cli import main
@@ -87,7 +87,6 @@ def test_on_the_wall_clock_the_panda_s_commands_carry_the_wall_time_and_are_take
     hardware = ArmHardware(driver="panda", connect=True, status_timeout=1.0,
                            command_expiry=1.0)
     builder = DiagramBuilder()
-    builder.AddSystem(LcmInterfaceSystem(lcm))
     builder.AddSystem(make_driver_sim("panda", lcm, WALL_CLOCK, START, LOWER, UPPER, VELOCITY,
                                       with_interface=False, expire_sec=1.0))
     status = builder.AddSystem(LcmSubscriberSystem.Make("PANDA_STATUS", status_type("panda"),
@@ -103,18 +102,29 @@ def test_on_the_wall_clock_the_panda_s_commands_carry_the_wall_time_and_are_take
         (time.time(), lcmt_panda_command.decode(data).utime * 1e-6)))
     simulator = Simulator(builder.Build())
     simulator.set_target_realtime_rate(1.0)
-    simulator.AdvanceTo(0.3)
-    lcm.HandleSubscriptions(0)
+    pump(simulator, lcm, 0.3, DRIVERS["panda"].period)
     assert stamps and all(abs(received - stamp) < 1.0 for received, stamp in stamps)
     state = np.array(link.GetOutputPort("state").Eval(
         link.GetMyContextFromRoot(simulator.get_context())))
     np.testing.assert_allclose(state[:7], START + 0.02, atol=1e-9)
 
 
+def pump(simulator, lcm, time, period):
+    """Advances `simulator` to `time` a driver `period` at a time, handing the bus's
+    messages out from this thread after each: the tests record messages with Python
+    callbacks, which an `LcmInterfaceSystem` would call from inside the simulation (newer
+    Drakes advance without holding Python's lock there, and the callback crashes)."""
+    start = simulator.get_context().get_time()
+    for step in range(1, int(round((time - start) / period)) + 1):
+        # Just past the step's publish events (at a millionth of a period after it).
+        simulator.AdvanceTo(start + step * period + 2e-6 * period)
+        lcm.HandleSubscriptions(0)
+
+
 class Rig:
     """A DriverLink and, on the same memq:// bus, a driver (the simulator, or what
     `make_driver(lcm)` makes), the desired state held at `desired`; every message on the
-    bus recorded with its time."""
+    bus recorded with its time (the bus pumped by `pump`)."""
 
     def __init__(self, driver_name, make_driver=None, desired=START, **hardware):
         self.lcm = DrakeLcm("memq://")
@@ -122,7 +132,6 @@ class Rig:
                                     **hardware)
         self.channels = DRIVERS[driver_name]
         builder = DiagramBuilder()
-        builder.AddSystem(LcmInterfaceSystem(self.lcm))
         if make_driver is None:
             builder.AddSystem(make_driver_sim(driver_name, self.lcm, SIMULATION_CLOCK, START,
                                               LOWER, UPPER, VELOCITY, with_interface=False))
@@ -149,8 +158,7 @@ class Rig:
         return self.simulator.get_context().get_time()
 
     def advance(self, time):
-        self.simulator.AdvanceTo(time)
-        self.lcm.HandleSubscriptions(0)
+        pump(self.simulator, self.lcm, time, self.channels.period)
 
     def measured(self):
         context = self.link.GetMyContextFromRoot(self.simulator.get_context())
@@ -207,7 +215,6 @@ def test_a_silent_driver_holds_the_arm_and_ends_the_run():
     rig = fake_rig("iiwa", lambda t: START if t < 0.5 else None)
     with pytest.raises(DriverError, match=r"IIWA_STATUS .* silent for 0\.05\d* s .* holds"):
         rig.advance(1.0)
-    rig.lcm.HandleSubscriptions(0)
     # The watchdog runs at the driver's period: nothing is sent once the last status is
     # older than status_timeout, give or take that period.
     last_status = max(message.utime for _, message in rig.statuses) * 1e-6
@@ -233,7 +240,7 @@ def test_a_bad_status_ends_the_run_and_nothing_more_is_sent(bad_from, bad, messa
     rig = fake_rig("iiwa", lambda t: START if t < bad_from - 1e-9 else bad)
     with pytest.raises(DriverError, match=message):
         rig.advance(1.0)
-    rig.lcm.HandleSubscriptions(0)
+    rig.lcm.HandleSubscriptions(0)  # what was sent before the error
     # Sent only while every status was good (the link reads a status at its next period).
     assert all(command.utime * 1e-6 <= bad_from + DRIVERS["iiwa"].period + 1e-9
                for _, command in rig.commands)

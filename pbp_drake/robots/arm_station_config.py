@@ -145,6 +145,10 @@ class ArmStationConfig:
     #: How fast the arm drifts back to its ready configuration (1/s) in the joint motion
     #: the hand's leaves free (a redundant arm's elbow, say).
     centering_gain: float = 1.0
+    #: Near a singular configuration (the Jacobian's least singular value under this, m
+    #: per rad), the diff IK damps the joints' velocities rather than spin a joint pair to
+    #: move the hand along a direction it has all but lost (damped least squares); 0: off.
+    singular_margin: float = 0.0
     #: Dynamic motion: each joint's servo is critically damped at this frequency (rad/s)
     #: on the joint's own inertia in the ready configuration (kp = I w^2, kd = 2 I w).
     servo_frequency: float = 300.0
@@ -189,6 +193,9 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"ArmStationConfig.{name} must be finite and positive, got "
                              f"{value}")
+    if not (np.isfinite(config.singular_margin) and config.singular_margin >= 0):
+        raise ValueError(f"ArmStationConfig.singular_margin must be >= 0, got "
+                         f"{config.singular_margin}")
     if not (np.isfinite(config.centering_gain) and config.centering_gain >= 0):
         raise ValueError(f"ArmStationConfig.centering_gain must be >= 0, got "
                          f"{config.centering_gain}")

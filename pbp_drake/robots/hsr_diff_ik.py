@@ -92,9 +92,11 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
 
     def __init__(self, plant, frame_E, time_step, look_ahead, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
-                 centering_gain, command_ramp=None, limit_overshoot=False):
+                 centering_gain, command_ramp=None, limit_overshoot=False,
+                 singular_margin=0.0):
         super().__init__()
         self._limit_overshoot = bool(limit_overshoot)
+        self._singular_margin = float(singular_margin)
         nq, nv = plant.num_positions(), plant.num_velocities()
         if nq != nv:
             raise ValueError("WholeBodyDiffIk needs q̇ = v (no quaternion joints)")
@@ -184,6 +186,16 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         return self._ramp.desired(context, self._last_heading,
                                   self._command_port.Eval(context), time)
 
+    def _singular_damping(self, J):
+        """Damped least squares near a singular configuration: with s the Jacobian's least
+        singular value (its rows in the task weights, over the translation's), a weight
+        TASK_WEIGHT (margin² - s²) on the joint velocities while s < margin, so that no
+        joint pair spins to move the hand along a direction it has all but lost."""
+        weighted = J * np.sqrt(self._task_weights / TASK_WEIGHT)[:, None]
+        smallest = np.linalg.svd(weighted, compute_uv=False)[-1]
+        margin = self._singular_margin
+        return TASK_WEIGHT * (margin * margin - smallest * smallest) if smallest < margin else 0.0
+
     def _solve(self, q, v, R_WE_desired, p_WE_desired, V_WE_desired, hold):
         """The velocity for the next step, and which velocities it holds at a bound.
 
@@ -210,6 +222,8 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         JD = J.T * self._task_weights
         JDt = JD @ twist
         H0 = JD @ J + self._identity
+        if self._singular_margin > 0.0:
+            H0 = H0 + self._singular_damping(J) * self._identity
         g0 = self._centering_gain * (self._q_nominal - q)
         H, g = H0, g0
         norm = twist @ (self._task_weights * twist)

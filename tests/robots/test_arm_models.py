@@ -14,6 +14,7 @@ from pydrake.manipulation import get_iiwa_max_joint_velocities
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
+from pbp_drake.builder import run_task
 from pbp_drake.robots import arm_ready_ee_state, arm_station_plant, make_arm_station
 from pbp_drake.robots.arm_station_config import ToolPose
 from pbp_drake.robots.hsr_model import configure_parser
@@ -110,3 +111,17 @@ def test_a_tool_pose_out_of_reach_is_refused_naming_the_field():
     far = ToolPose(position=[2.0, 0.0, 0.4], rpy_degrees=[0.0, 90.0, 0.0])
     with pytest.raises(ValueError, match="ready_tool_pose: ee_frame 'panda_ee' cannot stand"):
         arm_ready_ee_state(dataclasses.replace(config, ready_tool_pose=far))
+
+
+@pytest.mark.slow
+def test_the_panda_passes_its_shoulder_singularity_without_a_jump():
+    # Teleop's tuning seed 7 brings the upper arm upright (joint 2 near 0), where joints 1
+    # and 3 turn about one axis: without the file's singular_margin the diff IK spins
+    # that pair until joint 1 meets its limit and the hand jumps.
+    scenario = dataclasses.replace(load_scenario_file(
+        REPO / "diagrams" / "panda_reach.yaml").scenario, method="teleop", seed=7)
+    damped = run_task(scenario)
+    undamped = run_task(dataclasses.replace(scenario, robot=dataclasses.replace(
+        scenario.robot, singular_margin=0.0)))
+    assert damped.success and damped.peak_hand_speed < 0.2
+    assert undamped.peak_hand_speed > 0.5

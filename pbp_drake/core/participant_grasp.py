@@ -272,8 +272,9 @@ def command_noise(params, seed, tick, velocity):
     """`(velocity (3), scale)`: `velocity` turned by this tick's direction error and the
     factor the whole twist is scaled by, drawn from `(seed, tick)` alone."""
     rng = np.random.default_rng([int(seed), int(tick)])
-    angle = rng.normal(0.0, params.direction_noise)
-    scale = max(0.0, 1.0 + rng.normal(0.0, params.speed_noise))
+    # abs: a file's -0.0 passes the check (>= 0), and NumPy's normal refuses its sign.
+    angle = rng.normal(0.0, abs(params.direction_noise))
+    scale = max(0.0, 1.0 + rng.normal(0.0, abs(params.speed_noise)))
     axis = unit(np.cross(velocity, rng.normal(size=3)))
     if not axis.any():
         return velocity, scale

@@ -188,11 +188,8 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
             if len(value) != 3 or not np.all(np.isfinite(value)):
                 raise ValueError(f"ArmStationConfig.ready_tool_pose.{name} must be three "
                                  f"finite numbers, got {value}")
-    for name in ("default_acceleration_limit", "servo_frequency"):
-        value = getattr(config, name)
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"ArmStationConfig.{name} must be finite and positive, got "
-                             f"{value}")
+    check_positive(config, ("default_acceleration_limit", "servo_frequency"),
+                   "ArmStationConfig")
     if not (np.isfinite(config.singular_margin) and config.singular_margin >= 0):
         raise ValueError(f"ArmStationConfig.singular_margin must be >= 0, got "
                          f"{config.singular_margin}")
@@ -211,13 +208,20 @@ def validate_arm_hardware(hardware: ArmHardware) -> None:
         raise ValueError(f"{field}.driver must be one of {sorted(DRIVERS)}, got "
                          f"{hardware.driver!r}")
     check_lcm_url(hardware.lcm_bus.lcm_url, f"{field}.lcm_bus.lcm_url")
-    for name in ("status_timeout", "connect_timeout", "command_expiry", "start_tolerance"):
-        value = getattr(hardware, name)
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"{field}.{name} must be finite and positive, got {value}")
+    check_positive(hardware, ("status_timeout", "connect_timeout", "command_expiry",
+                              "start_tolerance"), field)
     if hardware.driver_sim and not hardware.connect:
         raise ValueError(f"{field}.driver_sim needs connect (pbp-drake run --hardware "
                          "--driver-sim)")
+
+
+def check_positive(config, names, prefix):
+    """Raises ValueError naming `prefix.NAME` for the first of `names` of `config` that is
+    not finite and positive."""
+    for name in names:
+        value = getattr(config, name)
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{prefix}.{name} must be finite and positive, got {value}")
 
 
 def check_lcm_url(url, field):

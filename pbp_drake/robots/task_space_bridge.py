@@ -31,7 +31,8 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
 from pbp_drake.robots.arm_driver import DriverError
-from pbp_drake.robots.arm_station_config import DEFAULT_LCM_URL, check_lcm_url
+from pbp_drake.robots.arm_station_config import (
+    DEFAULT_LCM_URL, check_lcm_url, check_positive)
 from pbp_drake.systems.ports import EeCommand, EeState
 from pbp_drake.systems.tick import report_offset
 
@@ -62,11 +63,7 @@ def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
         if not isinstance(getattr(config, name), str) or not getattr(config, name):
             raise ValueError(f"TaskSpaceBridgeConfig.{name} must be a channel name, got "
                              f"{getattr(config, name)!r}")
-    for name in ("status_timeout", "connect_timeout"):
-        value = getattr(config, name)
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"TaskSpaceBridgeConfig.{name} must be finite and positive, "
-                             f"got {value}")
+    check_positive(config, ("status_timeout", "connect_timeout"), "TaskSpaceBridgeConfig")
 
 
 def signal(values, names, time):

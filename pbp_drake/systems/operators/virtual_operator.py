@@ -132,8 +132,9 @@ class VirtualOperator(SampledOperator):
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
         self._reaction_ticks = int(round(params.reaction_delay / control_period))
-        self._direction_noise = float(params.direction_noise)
-        self._speed_noise = float(params.speed_noise)
+        # abs: a file's -0.0 passes the check (>= 0), and NumPy's normal refuses its sign.
+        self._direction_noise = abs(float(params.direction_noise))
+        self._speed_noise = abs(float(params.speed_noise))
         self._seed = int(seed)
         self._slow_radius = float(params.slow_radius)
         impairment = params.impairment

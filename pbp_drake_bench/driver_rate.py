@@ -7,7 +7,6 @@ driver's rate shows as the ticks' 99th percentile far above their median."""
 
 import dataclasses
 import time
-from pathlib import Path
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
@@ -16,8 +15,9 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.robots.arm_station_config import DRIVERS
 from pbp_drake.scenarios import load_scenario_file, resolve
 from pbp_drake_bench.checks import DRIVER_GOALS
+from pbp_drake_bench.scenes import DIAGRAMS
 
-IIWA_REACH = Path(__file__).resolve().parents[1] / "diagrams" / "iiwa_reach.yaml"
+IIWA_REACH = DIAGRAMS / "iiwa_reach.yaml"
 
 
 def driver_rate_run(simulated_seconds, goal_count=DRIVER_GOALS, progress=None):

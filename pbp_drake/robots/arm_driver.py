@@ -127,6 +127,23 @@ def check_status(driver, q, v, lower, upper):
                           f"{upper[joint]:.4f}]")
 
 
+def check_heard(now, started_at, heard_at, connect_timeout, status_timeout, first, silent,
+                then):
+    """The watchdog of a link that listens on a channel: raises DriverError when nothing
+    was heard within `connect_timeout` of `started_at` ("no `first` within ..."), or
+    nothing for `status_timeout` since `heard_at` ("`silent` has been silent for ...:
+    `then`"); returns whether anything has been heard (`heard_at` is NaN until then)."""
+    if np.isnan(heard_at):
+        if now - started_at > connect_timeout:
+            raise DriverError(f"no {first} within {connect_timeout:g} s")
+        return False
+    silence = now - heard_at
+    if silence > status_timeout:
+        raise DriverError(f"{silent} has been silent for {silence:.3f} s (at most "
+                          f"{status_timeout:g} s): {then}")
+    return True
+
+
 def read_first_status(hardware, lcm, lower, upper):
     """The joint positions of the driver's first status on `lcm` (a DrakeLcm on
     `hardware.lcm_bus` that no `LcmInterfaceSystem` pumps: this subscribes a Python
@@ -176,9 +193,15 @@ class DriverLink(LeafSystem):
         self._hardware, self._lcm, self._clock = hardware, lcm, clock
         self._driver = DRIVERS[hardware.driver]
         self._lower, self._upper = np.asarray(lower, float), np.asarray(upper, float)
-        self._velocity = np.asarray(velocity_limits, float)
+        # The farthest each joint's command moves in one driver period.
+        self._step = np.asarray(velocity_limits, float) * self._driver.period
         self._q_start = np.asarray(q_start, float)
         n = self._n = len(self._q_start)
+        channel = self._driver.status_channel
+        bus = ("memq:// (the driver simulator)" if hardware.driver_sim
+               else hardware.lcm_bus.lcm_url)
+        self._first = f"status from the {hardware.driver} driver on {channel} (bus {bus})"
+        self._silent = f"the {hardware.driver} driver's status on {channel} (bus {bus})"
         # State: measured q and v, the last command, then the times: of the last status
         # (its utime, and on our clock when it came), of the first status and of the
         # first update on the wall clock less the simulation's (the loop's lag is
@@ -213,20 +236,10 @@ class DriverLink(LeafSystem):
         if message.num_joints and message.utime != x[self._UTIME]:
             self._read(message, x, now)
         x[self._SEND] = 0.0
-        hardware, channel = self._hardware, self._driver.status_channel
-        bus = "memq:// (the driver simulator)" if hardware.driver_sim else (
-            hardware.lcm_bus.lcm_url)
-        if np.isnan(x[self._FIRST_AT]):
-            if now - x[self._STARTED_AT] > hardware.connect_timeout:
-                raise DriverError(f"no status from the {hardware.driver} driver on {channel} "
-                                  f"(bus {bus}) within {hardware.connect_timeout:g} s")
-        else:
-            silence = now - x[self._STATUS_AT]
-            if silence > hardware.status_timeout:
-                raise DriverError(
-                    f"the {hardware.driver} driver's status on {channel} (bus {bus}) has been "
-                    f"silent for {silence:.3f} s (at most {hardware.status_timeout:g} s): the "
-                    "arm holds where it was last commanded")
+        hardware = self._hardware
+        if check_heard(now, x[self._STARTED_AT], x[self._STATUS_AT], hardware.connect_timeout,
+                       hardware.status_timeout, self._first, self._silent,
+                       "the arm holds where it was last commanded"):
             if self._clock == WALL_CLOCK:
                 lag = time.time() - context.get_time() - x[self._OFFSET]
                 if lag > hardware.command_expiry:
@@ -260,8 +273,7 @@ class DriverLink(LeafSystem):
         if not np.all(np.isfinite(q_d)):
             raise DriverError("the diff IK's joint positions hold a NaN: nothing is sent, "
                               "the arm holds where it was last commanded")
-        step = self._velocity * self._driver.period
-        q = np.clip(q_d, x[self._SENT] - step, x[self._SENT] + step)
+        q = np.clip(q_d, x[self._SENT] - self._step, x[self._SENT] + self._step)
         return np.clip(q, self._lower, self._upper)
 
     def _send(self, context):

@@ -46,7 +46,7 @@ from pbp_drake.robots.arm_driver import (
 from pbp_drake.robots.arm_model import add_arm, reach_of, ready_positions
 from pbp_drake.robots.arm_station_config import (
     DRIVERS, ArmStationConfig, validate_arm_station_config)
-from pbp_drake.robots.driver_sim import make_driver_sim, memq_lcm
+from pbp_drake.robots.driver_sim import make_driver_sim
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
 from pbp_drake.robots.hsr_ee_systems import (
     EeCommandRamp, EeStateFromPlant, ee_state_at_rest, heading_of)
@@ -142,7 +142,8 @@ def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
     q_start = _arm_positions(arm, q0)
     lower, upper, velocity = _joint_limits(plant, arm)
     if hardware.driver_sim:
-        lcm, clock = memq_lcm(), SIMULATION_CLOCK
+        # A bus of its own in this process, which the station and the simulator share.
+        lcm, clock = DrakeLcm("memq://"), SIMULATION_CLOCK
         builder.AddNamedSystem("driver_sim", make_driver_sim(
             hardware.driver, lcm, clock, q_start, lower, upper, velocity,
             with_interface=False))

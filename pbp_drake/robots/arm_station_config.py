@@ -21,15 +21,13 @@ from pbp_drake.robots.hsr_station_config import (
 @dataclasses.dataclass(frozen=True)
 class Driver:
     """What a Drake LCM driver of a real arm expects: its channels, its status period (s),
-    how many joints it drives, whether it drops commands stamped earlier than its wall
-    clock allows (drake-franka-driver's `--expire_sec`), and how long after its first
-    status it refuses any command (drake-iiwa-driver aborts on one within 0.25 s)."""
+    how many joints it drives, and how long after its first status it refuses any command
+    (drake-iiwa-driver aborts on one within 0.25 s)."""
 
     command_channel: str
     status_channel: str
     period: float
     joint_count: int
-    wall_clock_stamps: bool
     start_guard: float
 
 
@@ -37,8 +35,8 @@ class Driver:
 #: commands at libfranka's 1 kHz) and drake-iiwa-driver with the position Java app (FRI's
 #: 5 ms).
 DRIVERS = {
-    "panda": Driver("PANDA_COMMAND", "PANDA_STATUS", 0.001, 7, True, 0.0),
-    "iiwa": Driver("IIWA_COMMAND", "IIWA_STATUS", 0.005, 7, False, 0.25),
+    "panda": Driver("PANDA_COMMAND", "PANDA_STATUS", 0.001, 7, 0.0),
+    "iiwa": Driver("IIWA_COMMAND", "IIWA_STATUS", 0.005, 7, 0.25),
 }
 #: Drake's hardware_sim bus: multicast with ttl=0, so that its traffic stays on this machine.
 DEFAULT_LCM_URL = "udpm://239.241.129.92:20185?ttl=0"

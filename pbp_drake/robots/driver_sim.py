@@ -16,7 +16,6 @@ command at their velocity limits.
 
 import numpy as np
 from pydrake.common.value import Value
-from pydrake.lcm import DrakeLcm
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
@@ -110,13 +109,10 @@ class DriverSim(LeafSystem):
                                      "(drake-franka-driver throws)")
             if abs(now - message.utime * 1e-6) > self._expire:
                 return None  # stale: the driver drops it and holds
-            positions = message.joint_position
-        else:
-            if now - x[self._FIRST_AT] < self._driver.start_guard:
-                raise DriverSimError(f"{channel}: a command within {self._driver.start_guard:g} "
-                                     "s of the first status (drake-iiwa-driver aborts)")
-            positions = message.joint_position
-        q = np.asarray(positions, float)
+        elif now - x[self._FIRST_AT] < self._driver.start_guard:
+            raise DriverSimError(f"{channel}: a command within {self._driver.start_guard:g} "
+                                 "s of the first status (drake-iiwa-driver aborts)")
+        q = np.asarray(message.joint_position, float)
         if len(q) != self._n or not np.all(np.isfinite(q)):
             raise DriverSimError(f"{channel}: a command of {len(q)} positions or with a NaN "
                                  f"(the arm has {self._n} joints)")
@@ -149,9 +145,3 @@ def make_driver_sim(driver, lcm, clock, q_start, lower, upper, velocity_limits,
     diagram = builder.Build()
     diagram.set_name("driver_sim")
     return diagram
-
-
-def memq_lcm():
-    """A DrakeLcm of its own in this process (memq://): the station and the driver
-    simulator of one run share it."""
-    return DrakeLcm("memq://")

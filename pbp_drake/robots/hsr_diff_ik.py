@@ -122,6 +122,8 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         self._centering_gain = np.broadcast_to(np.asarray(centering_gain, float), (nq,))
         self._identity = np.eye(nv)
         self._task_weights = TASK_WEIGHT * np.array([ROTATION_WEIGHT] * 3 + [1.0] * 3)
+        # The Jacobian's rows scaled as the task weighs them, relative to the translation's.
+        self._singular_rows = np.sqrt(self._task_weights / TASK_WEIGHT)[:, None]
         self._world = plant.world_frame()
         self._origin = np.zeros(3)
         self._motor_count = len(motor_joints)
@@ -191,8 +193,7 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         singular value (its rows in the task weights, over the translation's), a weight
         TASK_WEIGHT (margin² - s²) on the joint velocities while s < margin, so that no
         joint pair spins to move the hand along a direction it has all but lost."""
-        weighted = J * np.sqrt(self._task_weights / TASK_WEIGHT)[:, None]
-        smallest = np.linalg.svd(weighted, compute_uv=False)[-1]
+        smallest = np.linalg.svd(J * self._singular_rows, compute_uv=False)[-1]
         margin = self._singular_margin
         return TASK_WEIGHT * (margin * margin - smallest * smallest) if smallest < margin else 0.0
 

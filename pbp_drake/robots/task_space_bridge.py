@@ -30,7 +30,7 @@ from pydrake.lcm import DrakeLcm, DrakeLcmParams
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
-from pbp_drake.robots.arm_driver import DriverError
+from pbp_drake.robots.arm_driver import DriverError, check_heard
 from pbp_drake.robots.arm_station_config import (
     DEFAULT_LCM_URL, check_lcm_url, check_positive)
 from pbp_drake.systems.ports import EeCommand, EeState
@@ -96,17 +96,17 @@ class BridgeLink(LeafSystem):
     def __init__(self, config, lcm, initial_ee_state, control_period):
         super().__init__()
         self._config, self._lcm = config, lcm
-        n = EeState.size
-        # State: the robot's ee_state as last checked, then the time its last message came,
-        # its stamp, the time of the first update, and whether this update sends.
-        self._STATE, self._AT, self._STAMP, self._STARTED, self._SEND = (
-            slice(0, n), n, n + 1, n + 2, n + 3)
-        self._index = self.DeclareDiscreteState(np.concatenate(
-            [np.asarray(initial_ee_state, float), [np.nan, -1.0, np.nan, 0.0]]))
+        channel, bus = config.state_channel, config.lcm_bus.lcm_url
+        self._first = f"state from the robot's relay on {channel} (bus {bus})"
+        self._silent = f"the robot's state on {channel} (bus {bus})"
+        # State: when the last state message came, its stamp, the time of the first
+        # update, and whether this update sends (the state itself is the message's).
+        self._AT, self._STAMP, self._STARTED, self._SEND = range(4)
+        self._index = self.DeclareDiscreteState([np.nan, -1.0, np.nan, 0.0])
         self.DeclareAbstractInputPort("state_message", Value(lcmt_drake_signal()))
         self.DeclareVectorInputPort("ee_command", EeCommand.size)
         self._initial = np.asarray(initial_ee_state, float)
-        self.DeclareVectorOutputPort("ee_state", n, self._ee_state)
+        self.DeclareVectorOutputPort("ee_state", EeState.size, self._ee_state)
         self.DeclarePeriodicDiscreteUpdateEvent(control_period, 0.0, self._update)
         # Sent after the tick's decisions: the PBP controller's command (its hand-over's
         # state) changes at the tick's report stage (`pbp_drake.systems.tick`); a publish at
@@ -133,20 +133,11 @@ class BridgeLink(LeafSystem):
                 raise DriverError(f"the robot's state on {config.state_channel} holds "
                                   f"{len(values)} values (EeState's {EeState.size}, finite): "
                                   f"{list(message.coord)}")
-            x[self._STATE], x[self._AT], x[self._STAMP] = values, now, message.timestamp
-        bus = config.lcm_bus.lcm_url
-        if np.isnan(x[self._AT]):
-            if now - x[self._STARTED] > config.connect_timeout:
-                raise DriverError(f"no state from the robot's relay on {config.state_channel} "
-                                  f"(bus {bus}) within {config.connect_timeout:g} s")
-            x[self._SEND] = 0.0
-        else:
-            silence = now - x[self._AT]
-            if silence > config.status_timeout:
-                raise DriverError(f"the robot's state on {config.state_channel} (bus {bus}) "
-                                  f"has been silent for {silence:.3f} s (at most "
-                                  f"{config.status_timeout:g} s): nothing more is sent")
-            x[self._SEND] = 1.0
+            x[self._AT], x[self._STAMP] = now, message.timestamp
+        heard = check_heard(now, x[self._STARTED], x[self._AT], config.connect_timeout,
+                            config.status_timeout, self._first, self._silent,
+                            "nothing more is sent")
+        x[self._SEND] = float(heard)
         discrete_state.set_value(self._index, x)
 
     def _send(self, context):

@@ -16,8 +16,9 @@ page's frames reach Meshcat only as a fresh encoding of one of the messages Mesh
 sends (`page_messages`; Meshcat's parser takes the process down on a frame that is not
 msgpack); any other frame closes that page's websocket with code `BAD_FRAME_CLOSE` and the
 reason, a frame over `MAX_MESSAGE` bytes with 1009. A page's connection to Meshcat is closed
-when the page goes, whichever goes first; `pages()` counts the pages admitted, which is
-what the guard's two-page pause counts (`register_front`). Accept errors (out of file
+when the page goes, whichever goes first; `pages()` counts the pages admitted,
+`pages_heard()` those that have sent a frame, which is what the guard's two-page pause
+counts (`register_front`). Accept errors (out of file
 descriptors) print one line a burst.
 
 The front never calls a Meshcat method (those belong to the thread that made the Meshcat);
@@ -28,7 +29,7 @@ another thread, and a Meshcat left in a reference cycle dies in whichever thread
 - `new_token()`, `check_token(text)`: a fresh token; a `--token` checked (or ValueError).
 - `bind_page_port(port, host)`: the public port bound before anything is built (PortError).
 - `PageFront(meshcat_port, listen_socket=None, token=None, host="localhost")`: serving once
-  made; `url`, `port`, `token`, `door_shut`; `pages()`, `own_connections()`,
+  made; `url`, `port`, `token`, `door_shut`; `pages()`, `pages_heard()`, `own_connections()`,
   `show(**lines)`, `state()`, `end(text)`, `close()`.
 - `PendingMessages`, `message_key` (from `pending_messages`): the relay's bounded queue
   toward a slow page, which gets a batch of the latest poses and properties, ended by the text frame
@@ -261,6 +262,7 @@ class PageFront:
         self._lock = threading.Lock()
         self._state = dict.fromkeys((*LINES, "time"), None) | {"ended": False, "seq": 0}
         self._ended_pages, self._relays, self._closed = set(), 0, False
+        self._heard = 0  # relays whose page has sent a frame
         self._upstreams, self._closed_upstreams = 0, collections.deque()  # close times
         self._accept_errors = None  # the last accept error's time, in a burst
         self._wakers = set()  # each relay's event: the state changed, send it
@@ -303,8 +305,15 @@ class PageFront:
 
     def pages(self):
         """How many pages are relayed now (admitted websockets with their own connection
-        to Meshcat): what `BrowserGuard` counts behind the front."""
+        to Meshcat): whether a browser is there."""
         return self._relays
+
+    def pages_heard(self):
+        """How many relayed pages have sent a frame (our page's answer to its first batch,
+        or input): what `BrowserGuard` counts behind the front. A connection that has sent
+        nothing cannot press a key, and one that closes as it connects, however long a
+        busy machine takes to see it go, is no second person."""
+        return self._heard
 
     def own_connections(self):
         """How many connections to Meshcat are the front's: open, opening, or closed less
@@ -337,10 +346,11 @@ class PageFront:
         with self._lock:
             return dict(self._state)
 
-    def end(self, text=None, wait=2.0):
+    def end(self, text=None, wait=5.0):
         """Marks the run ended: the page shows `text` as its notice (or says the run has
-        ended), stops reconnecting and hides Meshcat's banner. Waits up to `wait` seconds
-        for every relayed page to fetch that, so none is left on the reconnect banner."""
+        ended), stops reconnecting and hides Meshcat's banner. Waits until every relayed
+        page has been sent that, so none is left on the reconnect banner, or `wait` seconds
+        (a page on a busy machine may be seconds behind; one that is there costs no wait)."""
         with self._lock:
             self._state.update(ended=True, notice=text)
             self._state["seq"] += 1
@@ -519,13 +529,21 @@ class PageFront:
                 socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
         pending, ready, acked = PendingMessages(), asyncio.Event(), asyncio.Event()
         paced = False  # until the page's first ACK: a client that never answers
+        heard = False  # until the page's first frame that is not refused
         sent_seq = -1  # the panel state this page was sent last
         self._wakers.add(ready)
+
+        def hear():
+            nonlocal heard
+            if not heard:
+                heard = True
+                self._heard += 1
 
         async def to_meshcat():
             nonlocal paced
             async for message in page:
                 if message == ACK:
+                    hear()
                     paced = True
                     acked.set()
                     ready.set()
@@ -536,6 +554,7 @@ class PageFront:
                     _warn(f"a page's connection was closed: it sent a bad message ({error})")
                     await page.close(BAD_FRAME_CLOSE, f"bad message: {error}"[:120])
                     return
+                hear()  # counted before Meshcat has the input: the guard sees it first
                 await meshcat.send(message)
 
         async def from_meshcat():
@@ -564,7 +583,8 @@ class PageFront:
                 await send_state()
                 if not pending or (paced and not acked.is_set()):
                     continue  # the scene waits for the page's answer to the last batch
-                while pending:
+                while pending:  # the panel's state first, should it change meanwhile:
+                    await send_state()  # a result must not wait behind a slow batch
                     await page.send(pending.pop())
                 await send_state()
                 acked.clear()
@@ -576,6 +596,8 @@ class PageFront:
             await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
         finally:
             self._relays -= 1
+            if heard:
+                self._heard -= 1
             self._wakers.discard(ready)
             for task in tasks:
                 task.cancel()

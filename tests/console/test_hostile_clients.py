@@ -20,7 +20,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from pbp_drake.console import meshcat_door
-from pbp_drake.console.front import BAD_FRAME_CLOSE, PageFront
+from pbp_drake.console.front import ACK, BAD_FRAME_CLOSE, PageFront
 from pbp_drake.console.page_messages import MAX_MESSAGE
 from pbp_drake.systems.operators.browser_guard import BrowserGuard
 
@@ -88,6 +88,7 @@ def test_a_deadly_frame_closes_its_page_with_a_reason_and_the_person_drives_on(
             assert _until(lambda: front.pages() == 2)
             hostile.send(frame)
             code, reason = _closed(hostile)
+            assert front.pages_heard() == 1  # a refused frame makes no second person
         assert code == BAD_FRAME_CLOSE and reason.startswith("bad message: ")
         assert _until(lambda: front.pages() == 1 and meshcat.GetNumActiveConnections() == 1)
         _press(person, meshcat)
@@ -150,7 +151,8 @@ def test_pages_that_close_as_they_connect_leave_no_connection_to_meshcat(
                 pass
 
     with _page(front) as person:
-        assert _until(lambda: front.pages() == 1)
+        person.send(ACK)
+        assert _until(lambda: front.pages_heard() == 1)
         closer = threading.Thread(target=quick_pages)
         closer.start()
         while closer.is_alive():  # the operator's ticks meanwhile: never a pause
@@ -202,14 +204,19 @@ def test_where_the_door_stays_open_an_intruder_is_ignored_not_obeyed(meshcat, mo
 
 
 @pytest.mark.slow
-def test_two_admitted_pages_still_pause(meshcat, front):
+def test_a_second_page_pauses_once_it_speaks(meshcat, front):
     announced = []
     guard = BrowserGuard(meshcat, announce=announced.append, poll_period=0.01)
-    with _page(front):
-        assert _until(lambda: front.pages() == 1)
+    with _page(front) as person:
+        person.send(ACK)  # as our page answers its first batch
+        assert _until(lambda: front.pages_heard() == 1)
         assert not guard.wait_while_shared()
         with _page(front) as second:
+            # Admitted but silent (it cannot press a key): the person drives on.
             assert _until(lambda: front.pages() == 2)
+            assert not guard.wait_while_shared() and front.pages_heard() == 1
+            second.send(ACK)
+            assert _until(lambda: front.pages_heard() == 2)
             # The second page goes once the pause is announced.
             closer = threading.Thread(target=lambda: _until(lambda: announced, 10.0)
                                       and second.close())
@@ -217,6 +224,7 @@ def test_two_admitted_pages_still_pause(meshcat, front):
             assert guard.wait_while_shared() and guard.pauses == 1
             assert announced[0].startswith("Paused: 2 browsers are connected")
             closer.join()
+        assert _until(lambda: front.pages_heard() == 1)
 
 
 # Out of file descriptors: the front's accepts fail while clients of this same process hold

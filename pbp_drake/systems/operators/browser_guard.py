@@ -5,13 +5,14 @@ Drake's Meshcat accepts a websocket from any origin. The command line puts its p
 (`pbp_drake.console.front.PageFront`) before it, which lets in only a browser holding the
 run's secret URL and shuts Meshcat's own port to everyone else; this guard is the second
 line, and the only one for a diagram on a bare Meshcat. It cannot tell the person's page
-from another; what it can see is how many there are: the pages the front admitted when a
-front serves this Meshcat (it says so with `register_front`), else Meshcat's connections.
-With more than one, it pauses the simulation where it stands (inside the operator's
-sampling, so no simulated time passes and the robot does not move), says so in the terminal
-and in the page, and waits until one is left. The operator then drops every input that
-arrived meanwhile. A page that leaves within `settle` seconds (one closed right after it
-connected) costs the input of that tick, not a pause.
+from another; what it can see is how many there are: the pages the front admitted that
+have sent a frame (our page answers its first batch at once; a connection that sent
+nothing cannot press a key) when a front serves this Meshcat (it says so with
+`register_front`), else Meshcat's connections. With more than one, it pauses the
+simulation where it stands (inside the operator's sampling, so no simulated time passes and
+the robot does not move), says so in the terminal and in the page, and waits until one is
+left. The operator then drops every input that arrived meanwhile. A page that leaves
+within `settle` seconds costs the input of that tick, not a pause.
 
 Behind a front, a connection to Meshcat that the front did not open (possible only where
 the front could not shut Meshcat's port, see `pbp_drake.console.meshcat_door`) is an
@@ -28,8 +29,9 @@ import time
 #: The label of the notice added to the page's controls while the run is paused.
 PAUSED_NOTICE = "Paused: {count} browsers are connected. Close all pages but one"
 
-# Meshcat's port -> the page front before it: its `pages()` (the pages it admitted) and
-# `own_connections()` (its connections to Meshcat, which it counts against Meshcat's).
+# Meshcat's port -> the page front before it: its `pages_heard()` (admitted pages that have
+# sent a frame) and `own_connections()` (its connections to Meshcat, which it counts
+# against Meshcat's).
 _FRONTS = {}
 
 
@@ -47,7 +49,7 @@ class BrowserGuard:
     """Waits while more than one browser is connected to `meshcat`.
 
     `wait_while_shared()` is called by an operator each time it reads its browser: it
-    returns at once (False) with at most one page (the front's admitted pages, else
+    returns at once (False) with at most one page (the front's pages heard from, else
     Meshcat's connections); with more it waits up to `settle` seconds for them to go (True:
     a page that closed as it connected), else announces the pause (`announce`, the
     terminal by default, and a button in the page carrying the notice), polls every
@@ -68,13 +70,13 @@ class BrowserGuard:
         self.pauses = 0
 
     def _pages(self):
-        """(pages, intruders): the front's admitted pages and the connections to Meshcat
+        """(pages, intruders): the front's pages heard from and the connections to Meshcat
         that are not the front's; without a front, Meshcat's connections and none."""
         connections = self._meshcat.GetNumActiveConnections()
         front = _FRONTS.get(self._meshcat.port())
         if front is None:
             return connections, 0
-        return front.pages(), max(0, connections - front.own_connections())
+        return front.pages_heard(), max(0, connections - front.own_connections())
 
     def wait_while_shared(self):
         count, intruders = self._pages()

@@ -101,7 +101,7 @@ API_GROUPS = {
     "Real robots": {
         name: "pbp_drake.robots" for name in [
             "ArmHardware", "DriverError", "arm_driver_sim", "measured_ready_positions",
-            "drives_real_arm", "TaskSpaceBridgeConfig", "make_task_space_bridge",
+            "drives_real_robot", "TaskSpaceBridgeConfig", "make_task_space_bridge",
             "make_station_relay"]},
     "Scenario files": {
         name: "pbp_drake.scenarios" for name in [

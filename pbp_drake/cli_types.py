@@ -81,10 +81,11 @@ EXIT_CODES = {
     EXIT_WRITE_FAILED: "a file could not be written (no space left, a quota, a read-only or "
                        "failing disk), said in one line; nothing half-written is left, and "
                        "the same command resumes a study or session",
-    EXIT_DRIVER: "`run --hardware`, `driver-sim`: the link to the arm's driver broke a rule "
-                 "(its status silent too long, a bad status, the loop behind the wall clock, "
-                 "a command the driver would abort on); the arm holds where it was last "
-                 "commanded, and one line says why",
+    EXIT_DRIVER: "`run --hardware`, `driver-sim`: the link to the arm's driver or the "
+                 "robot's relay broke a rule (its status silent too long, a bad status, the "
+                 "loop behind the wall clock, a command the driver would abort on); nothing "
+                 "more is sent, the robot holds where it was last commanded, and one line "
+                 "says why",
     EXIT_INTERRUPTED: "interrupted by Ctrl-C (a study or session is resumed by the same "
                       "command)",
     EXIT_TERMINATED: "`study`, `report`: ended by SIGTERM, as by Ctrl-C (a study is resumed "

@@ -11,7 +11,8 @@ the HSR or an arm, a handful of blocks:
 
 The station is `hsr_station` (`pbp_drake.robots.make_hsr_station`) or `arm_station`
 (`make_arm_station`, `robot: !Arm`): plant, diff IK, obstacle geometry, collision monitor,
-Meshcat visualizer. The controller (`pbp_drake.builder.make_pbp_controller`, from the
+Meshcat visualizer; or `bridged_station` (`robot: !Hsr {hardware: {connect: true}}`), the
+hand's command and state over LCM to the robot's relay (`pbp_drake.robots.task_space_bridge`). The controller (`pbp_drake.builder.make_pbp_controller`, from the
 resolved scenario's `PbpControllerConfig`) is a Diagram of its own; under ``hop`` and
 ``predict_then_assist`` it is `hop_controller` (no DMPs: no `phase` or `predicted_paths`, and
 no `operator_active` input). The order within
@@ -29,8 +30,23 @@ from pydrake.systems.primitives import LogVectorOutput
 from pbp_drake.builder.operators import make_hsr_operator, shown_intent_and_keys
 from pbp_drake.builder.pbp_controller import TASK_PREDICTION_SAMPLES, make_pbp_controller
 from pbp_drake.robots import ArmStationConfig, make_arm_station, make_hsr_station
+from pbp_drake.robots.task_space_bridge import make_bridged_station
 from pbp_drake.systems import GoalsSource, ReachSceneVisualizer, SampleHold, TaskMonitor
 from pbp_drake.systems.tasks.moving_obstacles import MovingObstacles
+
+
+def _station(resolved, meshcat):
+    """(name, station): the arm's, the HSR's, or the HSR's through the task-space bridge
+    (`robot.hardware.connect`; with `driver_sim` the simulated HSR on its far side)."""
+    if isinstance(resolved.station, ArmStationConfig):
+        station = make_arm_station(resolved.station, meshcat)
+        return station.get_name(), station
+    hardware = resolved.scenario.robot.hardware
+    if hardware is None or not hardware.connect:
+        return "hsr_station", make_hsr_station(resolved.station, meshcat)
+    robot_side = make_hsr_station(resolved.station, meshcat) if hardware.driver_sim else None
+    return "bridged_station", make_bridged_station(
+        hardware, resolved.initial_ee_state, resolved.scenario.control_period, robot_side)
 
 
 def build_reach_diagram(resolved, meshcat=None):
@@ -43,10 +59,7 @@ def build_reach_diagram(resolved, meshcat=None):
     start = resolved.start
     builder = DiagramBuilder()
 
-    station = (make_arm_station(resolved.station, meshcat)
-               if isinstance(resolved.station, ArmStationConfig)
-               else make_hsr_station(resolved.station, meshcat))
-    station = builder.AddNamedSystem(station.get_name(), station)
+    station = builder.AddNamedSystem(*_station(resolved, meshcat))
     ee_state = station.GetOutputPort("ee_state")
     sample = builder.AddNamedSystem("ee_state_sample",
                                     SampleHold(period, resolved.initial_ee_state))

@@ -18,7 +18,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorS
 from pbp_drake.builder.build import build_diagram
 from pbp_drake.builder.grasp import grasp_series_fields
 from pbp_drake.core.interaction_metrics import InteractionMeter, idle_ratio
-from pbp_drake.robots import drives_real_arm
+from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import ResolvedScenario, counted, resolve
 from pbp_drake.systems.operators.browser_guard import reset_pacing_after_pauses
 from pbp_drake.systems.ports import TaskStatus
@@ -59,8 +59,8 @@ def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=No
     ApplySimulatorConfig(resolved.scenario.simulator, simulator)
     if realtime_rate is not None:
         simulator.set_target_realtime_rate(realtime_rate)
-    if drives_real_arm(getattr(resolved.station, "hardware", None)):
-        # A real arm lives on the wall clock: its driver's status, our watchdog and the
+    if drives_real_robot(getattr(resolved.scenario.robot, "hardware", None)):
+        # A real robot lives on the wall clock: its driver's status, our watchdog and the
         # Panda's command stamps are in real seconds, whatever the page asks.
         simulator.set_target_realtime_rate(1.0)
     simulator.Initialize()

@@ -18,9 +18,9 @@ from pbp_drake.commands.task_runs import run_scene, run_task_loop
 from pbp_drake.console import CAMERAS
 from pbp_drake.console.front import PortError, bind_page_port
 from pbp_drake.output_paths import check_log_path, check_output_folder, check_record_path
-from pbp_drake.robots import DriverError, drives_real_arm, measured_ready_positions
+from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.scenarios import (
-    METHODS, ScenarioError, load_scenario_file, resolve)
+    METHODS, Arm, ScenarioError, load_scenario_file, resolve)
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 
 
@@ -94,7 +94,7 @@ def scenario_for_run(args):
     if args.operator is not None and scenario.task is None:
         raise ScenarioError("--operator chooses who drives the tasks; this scenario uses "
                             "the 2-D toy robot")
-    if drives_real_arm(getattr(scenario.robot, "hardware", None)):
+    if isinstance(scenario.robot, Arm) and drives_real_robot(scenario.robot.hardware):
         return resolve(_standing_where_the_arm_stands(scenario))
     if args.scene is None:
         return scenario_file.resolved
@@ -150,6 +150,11 @@ def _run(args):
         if args.camera == "robot" and (not resolved.has_task or resolved.is_arm):
             raise ScenarioError("--camera robot looks from the HSR's head; this scenario "
                                 "has no HSR")
+        hardware = getattr(resolved.scenario.robot, "hardware", None)
+        if args.camera == "robot" and not resolved.is_arm and hardware and hardware.connect:
+            raise ScenarioError("--camera robot looks from the simulated HSR's head; through "
+                                "the task-space bridge (robot.hardware.connect) the robot "
+                                "is on the far side")
         check_run_flags(args, resolved)  # and the flags' combinations, before the page too
     except BaseException:
         if listening is not None:
@@ -166,7 +171,8 @@ def _run(args):
             return run_task_loop(args, resolved, meshcat, page)
         return run_scene(args, resolved, meshcat, page)
     except DriverError as error:
-        # The arm holds where it was last commanded: the driver keeps that position.
+        # The robot holds where it was last commanded: the arm's driver keeps that
+        # position, and a bridge's relay is told to (docs/tasks/real-arm.md).
         print(f"pbp-drake: {error}", file=sys.stderr)
         return EXIT_DRIVER
     finally:

@@ -19,7 +19,7 @@ from pbp_drake.commands.scenario_flags import (
 from pbp_drake.commands.signals import Terminated, sigterm_as_interrupt
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
-from pbp_drake.robots import drives_real_arm
+from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
     TASK_ROBOTS, Gamepad, Keyboard, MethodComparison, ScenarioError, VirtualParticipant,
     check_method_comparison, counted, load_scenario_file)
@@ -145,7 +145,7 @@ def _stopping_cleanly(command):
 def _study(args):
     overrides = scenario_overrides(args, shorthands=False)
     scenario_file = load_scenario_file(args.scenario, overrides)
-    if drives_real_arm(getattr(scenario_file.scenario.robot, "hardware", None)):
+    if drives_real_robot(getattr(scenario_file.scenario.robot, "hardware", None)):
         raise ScenarioError("a study runs its trials unattended in simulation: drop "
                             "robot.hardware.connect (pbp-drake run --hardware drives the real "
                             "arm; --driver-sim studies the LCM path)")

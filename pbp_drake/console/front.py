@@ -17,9 +17,8 @@ sends (`page_messages`; Meshcat's parser takes the process down on a frame that 
 msgpack); any other frame closes that page's websocket with code `BAD_FRAME_CLOSE` and the
 reason, a frame over `MAX_MESSAGE` bytes with 1009. A page's connection to Meshcat is closed
 when the page goes, whichever goes first; `pages()` counts the pages admitted,
-`pages_heard()` those that have sent a frame, which is what the guard's two-page pause
-counts (`register_front`). Accept errors (out of file
-descriptors) print one line a burst.
+`pages_heard()` those that have sent a frame, which the guard's two-page pause counts
+(`register_front`). Accept errors (out of file descriptors) print one line a burst.
 
 The front never calls a Meshcat method (those belong to the thread that made the Meshcat);
 it talks to Meshcat's port over the network, from an asyncio loop on a daemon thread. Close
@@ -261,8 +260,7 @@ class PageFront:
         self._host = "localhost" if host in ("", "0.0.0.0", "::") else host
         self._lock = threading.Lock()
         self._state = dict.fromkeys((*LINES, "time"), None) | {"ended": False, "seq": 0}
-        self._ended_pages, self._relays, self._closed = set(), 0, False
-        self._heard = 0  # relays whose page has sent a frame
+        self._ended_pages, self._relays, self._heard, self._closed = set(), 0, 0, False
         self._upstreams, self._closed_upstreams = 0, collections.deque()  # close times
         self._accept_errors = None  # the last accept error's time, in a burst
         self._wakers = set()  # each relay's event: the state changed, send it
@@ -309,10 +307,8 @@ class PageFront:
         return self._relays
 
     def pages_heard(self):
-        """How many relayed pages have sent a frame (our page's answer to its first batch,
-        or input): what `BrowserGuard` counts behind the front. A connection that has sent
-        nothing cannot press a key, and one that closes as it connects, however long a
-        busy machine takes to see it go, is no second person."""
+        """How many relayed pages have sent a frame (our page answers its first batch at
+        once): what `BrowserGuard` counts. One that sent nothing cannot press a key."""
         return self._heard
 
     def own_connections(self):
@@ -349,8 +345,7 @@ class PageFront:
     def end(self, text=None, wait=5.0):
         """Marks the run ended: the page shows `text` as its notice (or says the run has
         ended), stops reconnecting and hides Meshcat's banner. Waits until every relayed
-        page has been sent that, so none is left on the reconnect banner, or `wait` seconds
-        (a page on a busy machine may be seconds behind; one that is there costs no wait)."""
+        page has been sent that (none left on the reconnect banner), at most `wait` s."""
         with self._lock:
             self._state.update(ended=True, notice=text)
             self._state["seq"] += 1
@@ -535,9 +530,8 @@ class PageFront:
 
         def hear():
             nonlocal heard
-            if not heard:
-                heard = True
-                self._heard += 1
+            self._heard += not heard
+            heard = True
 
         async def to_meshcat():
             nonlocal paced
@@ -596,8 +590,7 @@ class PageFront:
             await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
         finally:
             self._relays -= 1
-            if heard:
-                self._heard -= 1
+            self._heard -= heard
             self._wakers.discard(ready)
             for task in tasks:
                 task.cancel()

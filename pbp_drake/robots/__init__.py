@@ -8,7 +8,7 @@ from pbp_drake.robots.arm_station import (
     arm_reach,
     arm_ready_ee_state,
     arm_station_plant,
-    drives_real_arm,
+    drives_real_robot,
     make_arm_station,
     measured_ready_positions,
 )
@@ -30,7 +30,7 @@ from pbp_drake.robots.task_space_bridge import (
 
 __all__ = ["ArmHardware", "ArmStationConfig", "CylinderObstacle", "DriverError",
            "HsrStationConfig", "add_hsr", "arm_driver_sim", "arm_initial_ee_state",
-           "arm_reach", "arm_ready_ee_state", "arm_station_plant", "drives_real_arm",
+           "arm_reach", "arm_ready_ee_state", "arm_station_plant", "drives_real_robot",
            "hsr_initial_ee_state", "hsr_initial_hand_pose", "hsr_ready_ee_state",
            "hsr_station_plant", "make_arm_station", "make_hsr_station",
            "measured_ready_positions", "ToolPose", "TaskSpaceBridgeConfig",

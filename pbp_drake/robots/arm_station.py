@@ -184,9 +184,10 @@ def arm_driver_sim(config: ArmStationConfig, lcm, clock=WALL_CLOCK) -> Diagram:
                            *_joint_limits(plant, arm))
 
 
-def drives_real_arm(hardware) -> bool:
-    """Whether a station of this `ArmHardware` (or None) drives a real arm: connected, not
-    to the driver simulator. Such a run goes in real time, the driver's clock the wall's."""
+def drives_real_robot(hardware) -> bool:
+    """Whether a station of this `ArmHardware` or `TaskSpaceBridgeConfig` (or None) drives
+    a real robot: connected, not to the simulator of its driver or relay. Such a run goes
+    in real time, the robot's clock the wall's."""
     return hardware is not None and hardware.connect and not hardware.driver_sim
 
 

@@ -15,10 +15,17 @@ named ``task_space_bridge`` with a station's two ports::
 each ``PBP_EE_COMMAND`` to the station's ``ee_command`` as it comes and streams its
 ``ee_state`` on ``PBP_EE_STATE`` faster than the control loop.
 
+``make_bridged_station(config, initial_ee_state, control_period, robot_side=None)`` is
+what a run uses (``robot: !Hsr {hardware: {...}}``, ``pbp-drake run --hardware``): the
+bridge on ``config.lcm_bus``, or with ``config.driver_sim`` the bridge and the relay around
+``robot_side`` (the simulated station) in one Diagram on a memq:// bus of their own.
+
 `BridgeLink` keeps the arm drivers' rules where they apply to any robot: nothing is sent
 before a fresh state, and a state silent for `status_timeout`, of the wrong size or with a
 NaN ends the run with `DriverError` and sends nothing more (the relay should then hold the
-robot). Each message is stamped (`timestamp`, microseconds) on the simulation's clock.
+robot), and so does a first state whose hand stands farther than `start_tolerance` from
+where the run was built to start. Each message is stamped (`timestamp`, microseconds) on the
+simulation's clock.
 """
 
 import dataclasses
@@ -37,6 +44,9 @@ from pbp_drake.systems.ports import EeCommand, EeState
 from pbp_drake.systems.tick import report_offset
 
 COMMAND_FIELDS, STATE_FIELDS = list(EeCommand.get_fields()), list(EeState.get_fields())
+#: How often (s) `make_station_relay` sends the station's state: a robot's state stream,
+#: faster than the control loop.
+RELAY_STATE_PERIOD = 0.005
 
 
 @dataclasses.dataclass
@@ -54,6 +64,14 @@ class TaskSpaceBridgeConfig:
     status_timeout: float = 0.2
     #: How long (s) the bridge waits for the first state.
     connect_timeout: float = 5.0
+    #: How far (m) the hand in the robot's first state may stand from the start the run
+    #: was built for (the scenario's).
+    start_tolerance: float = 0.05
+    #: Whether runs drive the robot through the bridge (`pbp-drake run --hardware`).
+    connect: bool = False
+    #: With connect: the robot's side simulated in the same process (the relay around the
+    #: simulated station), both on one memq:// bus (`pbp-drake run --driver-sim`).
+    driver_sim: bool = False
 
 
 def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
@@ -63,7 +81,11 @@ def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
         if not isinstance(getattr(config, name), str) or not getattr(config, name):
             raise ValueError(f"TaskSpaceBridgeConfig.{name} must be a channel name, got "
                              f"{getattr(config, name)!r}")
-    check_positive(config, ("status_timeout", "connect_timeout"), "TaskSpaceBridgeConfig")
+    check_positive(config, ("status_timeout", "connect_timeout", "start_tolerance"),
+                   "TaskSpaceBridgeConfig")
+    if config.driver_sim and not config.connect:
+        raise ValueError("TaskSpaceBridgeConfig.driver_sim needs connect (pbp-drake run "
+                         "--hardware --driver-sim)")
 
 
 def signal(values, names, time):
@@ -133,12 +155,28 @@ class BridgeLink(LeafSystem):
                 raise DriverError(f"the robot's state on {config.state_channel} holds "
                                   f"{len(values)} values (EeState's {EeState.size}, finite): "
                                   f"{list(message.coord)}")
+            if np.isnan(x[self._AT]):
+                self._check_start(values[:3])
             x[self._AT], x[self._STAMP] = now, message.timestamp
         heard = check_heard(now, x[self._STARTED], x[self._AT], config.connect_timeout,
                             config.status_timeout, self._first, self._silent,
                             "nothing more is sent")
         x[self._SEND] = float(heard)
         discrete_state.set_value(self._index, x)
+
+    def _check_start(self, hand):
+        # The run's scene and its first plans are made for this start: a hand elsewhere
+        # would be steered from where it is not (the arm's start_tolerance, in metres).
+        start = self._initial[:3]
+        off = float(np.linalg.norm(hand - start))
+        if off > self._config.start_tolerance:
+            where = ", ".join(f"{value:.3f}" for value in hand)
+            built = ", ".join(f"{value:.3f}" for value in start)
+            raise DriverError(
+                f"the robot's hand stands at [{where}] m, {off:.3f} m from the start the "
+                f"run was built for, [{built}] m (start_tolerance "
+                f"{self._config.start_tolerance:g} m): bring it there first; nothing was "
+                "sent")
 
     def _send(self, context):
         x = context.get_discrete_state(self._index).value()
@@ -196,7 +234,7 @@ class _Relay(LeafSystem):
 
 
 def make_station_relay(station, lcm, config: TaskSpaceBridgeConfig, initial_ee_state,
-                       state_period=0.005) -> Diagram:
+                       state_period=RELAY_STATE_PERIOD) -> Diagram:
     """`station` (any Diagram with ``ee_command`` and ``ee_state``) behind the bridge's
     channels on `lcm`, with its own `LcmInterfaceSystem`: each command goes to the station
     as it comes, and its state goes out every `state_period` s. The robot's side, as a
@@ -214,3 +252,29 @@ def make_station_relay(station, lcm, config: TaskSpaceBridgeConfig, initial_ee_s
     diagram = builder.Build()
     diagram.set_name("station_relay")
     return diagram
+
+
+def make_bridged_station(config: TaskSpaceBridgeConfig, initial_ee_state, control_period,
+                         robot_side=None) -> Diagram:
+    """A run's station through the bridge (the module's docstring), with ``ee_command`` and
+    ``ee_state``: on `config.lcm_bus` to the robot's relay, or with `config.driver_sim` to
+    `robot_side` (a Diagram with those ports: the simulated station) behind
+    `make_station_relay`, both on a memq:// bus of their own."""
+    validate_task_space_bridge(config)
+    builder = DiagramBuilder()
+    if config.driver_sim:
+        if robot_side is None:
+            raise ValueError("TaskSpaceBridgeConfig.driver_sim needs the robot's side: the "
+                             "simulated station")
+        lcm = DrakeLcm("memq://")
+        builder.AddNamedSystem("robot_side", make_station_relay(
+            robot_side, lcm, config, initial_ee_state))
+    else:
+        lcm = DrakeLcm(config.lcm_bus)
+    bridge = builder.AddSystem(make_task_space_bridge(config, initial_ee_state,
+                                                      control_period, lcm))
+    builder.ExportInput(bridge.GetInputPort("ee_command"), "ee_command")
+    builder.ExportOutput(bridge.GetOutputPort("ee_state"), "ee_state")
+    station = builder.Build()
+    station.set_name("bridged_station")
+    return station

@@ -23,12 +23,13 @@ from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.model_geometry import check_clear_of_base
+from pbp_drake.robots.task_space_bridge import validate_task_space_bridge
 from pbp_drake.scenarios.bounds import check_goal_counts
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
-    DynamicObstacles, Gamepad, GraspTask, Hsr, ObstacleRepulsion, Scenario, ScenarioError,
-    ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
-    VirtualParticipant)
+    DynamicObstacles, Gamepad, GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, Scenario,
+    ScenarioError, ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot,
+    SinusoidalStep, VirtualParticipant)
 from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
@@ -349,6 +350,8 @@ def _resolve_task_robot(scenario):
         check_virtual_participant(operator)
     _check_hand_over(scenario)
     task = scenario.task
+    if isinstance(robot, Hsr) and robot.hardware is not None:
+        _check_bridge(robot.hardware, task)
     if isinstance(task, DynamicObstacles):
         check_obstacle_task(task)
     elif isinstance(task, GraspTask):
@@ -424,6 +427,22 @@ def _refuse_what_the_task_sets(station, station_field):
         if hasattr(station, name) and getattr(station, name) != getattr(defaults, name):
             raise ScenarioError(f"{station_field}.{name} is set by the task from {home}; "
                                 "give it there")
+
+
+def _check_bridge(hardware, task):
+    """The HSR's task-space bridge: its fields, and a task whose station ports it carries
+    (the hand's command and state, nothing more)."""
+    try:
+        validate_task_space_bridge(hardware)
+    except ValueError as error:
+        raise ScenarioError(str(error).replace("TaskSpaceBridgeConfig.",
+                                               "scenario.robot.hardware.")) from None
+    if hardware.connect and not isinstance(task, MultiGoalReach):
+        raise ScenarioError(
+            f"scenario.robot.hardware: the task-space bridge carries the hand's command and "
+            f"state alone; scenario.task !{type(task).__name__} needs more of the station "
+            "(the obstacles' positions and contacts, the hand's pose): the bridge runs the "
+            "reaching task")
 
 
 def _arm_station(scenario, station):

@@ -29,6 +29,7 @@ from pbp_drake.core.controller_config import (
 from pbp_drake.core.methods import forward_key_enabled, shows_intent  # noqa: F401 (public)
 from pbp_drake.robots.arm_station_config import ArmStationConfig
 from pbp_drake.robots.hsr_station_config import HsrStationConfig
+from pbp_drake.robots.task_space_bridge import TaskSpaceBridgeConfig
 from pbp_drake.systems.operators.gamepad_operator import GamepadParams
 from pbp_drake.systems.operators.keyboard_operator import KeyboardParams
 from pbp_drake.systems.operators.obstacle_repulsion_operator import ObstacleRepulsionParams
@@ -112,6 +113,11 @@ class Hsr(TaskRobot):
 
     #: What the HSR station is built from (see HsrStationConfig).
     station: HsrStationConfig = dataclasses.field(default_factory=HsrStationConfig)
+    #: A real HSR (or any robot that is not Drake's) through the task-space bridge: the
+    #: hand's command and state as LCM channels to a relay on the robot's side
+    #: (TaskSpaceBridgeConfig, docs/tasks/real-arm.md); used with `connect`. None: the
+    #: simulated HSR only.
+    hardware: typing.Optional[TaskSpaceBridgeConfig] = None
 
 
 @dataclasses.dataclass

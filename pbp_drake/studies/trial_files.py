@@ -77,6 +77,7 @@ def plain(value):
 _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects": 0,
                           "grasps_per_object": 1},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3},
+                 "robot": {"hardware": None, "ready_tool_pose": None, "singular_margin": 0.0},
                  "goal_estimator": {"group_mass": 0.0, "commit_radius": 0.05,
                                     "commit_probability": 0.8,
                                     "intent_filter": plain(IntentFilterSettings())}}

@@ -2,6 +2,9 @@
 the HSR station through the bridge and a relay as it drives the station itself, a period
 later; no relay and a bad state each end the run with one clear error."""
 
+import pathlib
+import re
+
 import numpy as np
 import pytest
 from pydrake.lcm import DrakeLcm, DrakeLcmParams
@@ -11,10 +14,15 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake import EeCommand, EeState, HsrStationConfig, hsr_initial_ee_state, make_hsr_station
 from pbp_drake.robots import DriverError
+from pbp_drake.cli import main
+from pbp_drake.cli_types import EXIT_DRIVER
 from pbp_drake.robots.task_space_bridge import (
-    TaskSpaceBridgeConfig, make_station_relay, make_task_space_bridge, signal)
+    STATE_FIELDS, TaskSpaceBridgeConfig, make_station_relay, make_task_space_bridge, signal)
 
 PERIOD = 0.1
+HSR_REACH = str(pathlib.Path(__file__).resolve().parents[2] / "diagrams" / "hsr_reach.yaml")
+SUMMARY = re.compile(r"^hsr_reach \[pbp_alternated, seed 0\]: success in (\S+) s, .*"
+                     r"hand at \[(\S+), (\S+), (\S+)\]$", re.MULTILINE)
 
 
 class Sideways(LeafSystem):
@@ -68,15 +76,16 @@ def test_a_controller_drives_the_station_through_the_bridge_a_period_later():
     assert np.abs(bridged[-1] - direct[-1]).max() < 2 * PERIOD * 0.05 + 1e-3
 
 
-def bridge_alone(messages, seconds, **config):
-    """The bridge with a constant command, fed `messages(t)` on the state channel."""
+def bridge_alone(messages, seconds, sent=None, **config):
+    """The bridge with a constant command, fed `messages(t)` on the state channel; what it
+    sends is appended to `sent` (and returned)."""
     lcm = DrakeLcm("memq://")
     config = TaskSpaceBridgeConfig(**config)
     builder = DiagramBuilder()
     bridge = builder.AddSystem(make_task_space_bridge(config, np.zeros(8), PERIOD, lcm))
     command = builder.AddSystem(ConstantVectorSource(np.zeros(7)))
     builder.Connect(command.get_output_port(), bridge.GetInputPort("ee_command"))
-    sent = []
+    sent = [] if sent is None else sent
     lcm.Subscribe(config.command_channel, lambda data: sent.append(data))
     simulator = Simulator(builder.Build())
     for tick in range(1, int(round(seconds / PERIOD)) + 1):
@@ -97,13 +106,30 @@ def test_no_relay_ends_the_run_within_its_connect_timeout():
 def test_a_state_of_the_wrong_size_ends_the_run_and_nothing_is_sent():
     sent = []
     with pytest.raises(DriverError, match="holds 7 values"):
-        sent = bridge_alone(lambda t: signal(np.zeros(7), list("abcdefg"), t), 1.0)
+        bridge_alone(lambda t: signal(np.zeros(7), list("abcdefg"), t), 1.0, sent)
     assert sent == []
+
+
+def test_a_hand_away_from_the_start_ends_the_run_and_nothing_is_sent():
+    # The bridge was built for a hand at the origin; the robot's stands 6 cm off.
+    def hand_at(x):
+        return lambda t: signal([x] + [0.0] * 7, STATE_FIELDS, t)
+
+    sent = []
+    with pytest.raises(DriverError, match=r"^the robot's hand stands at \[0.060, 0.000, "
+                                          r"0.000\] m, 0.060 m from the start the run was "
+                                          r"built for, \[0.000, 0.000, 0.000\] m "
+                                          r"\(start_tolerance 0.05 m\)"):
+        bridge_alone(hand_at(0.06), 1.0, sent)
+    assert sent == []
+    assert bridge_alone(hand_at(0.04), 0.5)  # within the tolerance, commands go out
 
 
 @pytest.mark.parametrize("field, value, message", [
     ("status_timeout", 0.0, "status_timeout must be finite and positive"),
     ("state_channel", "", "state_channel must be a channel name"),
+    ("start_tolerance", float("nan"), "start_tolerance must be finite and positive"),
+    ("driver_sim", True, "driver_sim needs connect"),
     ("lcm_bus", DrakeLcmParams(lcm_url="udpm://10.0.0.1:7667"),
      "lcm_bus.lcm_url 'udpm://10.0.0.1:7667' is not an LCM URL"),
 ])
@@ -111,3 +137,72 @@ def test_a_bad_bridge_config_is_refused_naming_the_field(field, value, message):
     with pytest.raises(ValueError, match=f"^TaskSpaceBridgeConfig.{message}"):
         make_task_space_bridge(TaskSpaceBridgeConfig(**{field: value}), np.zeros(8), PERIOD,
                                DrakeLcm("memq://"))
+
+
+def run(*argv, capsys):
+    code = main(list(argv))
+    return code, capsys.readouterr()
+
+
+@pytest.mark.slow
+def test_the_hsr_task_runs_through_the_bridge_as_it_runs_on_the_station(capsys):
+    direct = SUMMARY.search(run("run", HSR_REACH, "--operator", "virtual", "--headless",
+                                capsys=capsys)[1].out)
+    code, out = run("run", HSR_REACH, "--set", "robot.hardware={}", "--hardware",
+                    "--driver-sim", "--operator", "virtual", "--headless", capsys=capsys)
+    assert code == 0, out.err
+    bridged = SUMMARY.search(out.out)
+    assert direct and bridged, out.out
+    # A period later on the far side of the bus: the same object, a little later.
+    assert 0 <= float(bridged.group(1)) - float(direct.group(1)) < 1.5
+    hands = np.array([[float(v) for v in match.groups()[1:]] for match in (direct, bridged)])
+    assert np.abs(hands[0] - hands[1]).max() < 0.05
+
+
+def test_a_run_with_no_relay_ends_in_its_connect_timeout_naming_bus_and_channel(capsys):
+    code, out = run("run", HSR_REACH, "--set", "robot.hardware={lcm_bus: {lcm_url: "
+                    "'memq://'}, connect_timeout: 0.3}", "--hardware", "--operator",
+                    "virtual", "--headless", capsys=capsys)
+    assert code == EXIT_DRIVER
+    assert out.err.strip().splitlines()[-1] == (
+        "pbp-drake: no state from the robot's relay on PBP_EE_STATE (bus memq://) within "
+        "0.3 s")
+
+
+@pytest.mark.parametrize("scenario, setting, extra, message", [
+    ("hsr_reach.yaml", "{lcm_bus: {lcm_url: 'udpm://10.0.0.1:7667'}}", [],
+     "scenario.robot.hardware.lcm_bus.lcm_url 'udpm://10.0.0.1:7667' is not an LCM URL"),
+    ("hsr_reach.yaml", "{driver_sim: true}", [],
+     "scenario.robot.hardware.driver_sim needs connect"),
+    ("hsr_reach.yaml", "{status_timeout: -1}", [],
+     "scenario.robot.hardware.status_timeout must be finite and positive, got -1.0"),
+    ("hsr_obstacles.yaml", "{connect: true}", [],
+     "scenario.task !DynamicObstacles needs more of the station"),
+    ("hsr_grasp.yaml", "{connect: true}", [],
+     "scenario.task !GraspTask needs more of the station"),
+    ("hsr_reach.yaml", "{connect: true}", ["--camera", "robot"],
+     "--camera robot looks from the simulated HSR's head"),
+])
+def test_a_bridge_that_cannot_work_is_refused_naming_the_field(scenario, setting, extra,
+                                                               message, capsys):
+    path = str(pathlib.Path(HSR_REACH).with_name(scenario))
+    code, out = run("run", path, "--set", f"robot.hardware={setting}", "--operator",
+                    "virtual", *extra, capsys=capsys)
+    assert code == 2
+    assert message in out.err and len(out.err.strip().splitlines()) == 1, out.err
+
+
+def test_a_study_does_not_drive_a_real_robot_through_the_bridge(tmp_path, capsys):
+    code, out = run("study", HSR_REACH, "--set", "robot.hardware={connect: true}",
+                    "--output", str(tmp_path / "study"), capsys=capsys)
+    assert code == 2
+    assert "a study runs its trials unattended in simulation" in out.err
+    assert not (tmp_path / "study").exists()
+
+
+def test_driver_sim_runs_the_hsr_behind_its_relay_on_the_bus(capsys):
+    code, out = run("driver-sim", HSR_REACH, "--set", "robot.hardware={lcm_bus: {lcm_url: "
+                    "'memq://'}}", "--duration", "0.2", capsys=capsys)
+    assert code == 0, out.err
+    assert out.out == ("driver-sim: the HSR's relay reads PBP_EE_COMMAND and sends "
+                       "PBP_EE_STATE every 5 ms on memq://; Ctrl-C ends it\n")

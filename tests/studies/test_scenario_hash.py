@@ -7,6 +7,7 @@ import pathlib
 
 import pytest
 
+from pbp_drake.robots import ArmHardware, TaskSpaceBridgeConfig, ToolPose
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.studies.trial_files import scenario_content, scenario_hash
 
@@ -67,3 +68,18 @@ def test_the_intent_filters_settings_at_their_defaults_leave_the_hash():
     changed = dataclasses.replace(reach, goal_estimator=dataclasses.replace(
         reach.goal_estimator, intent_filter=settings))
     assert scenario_hash(changed) != scenario_hash(reach)
+
+
+
+@pytest.mark.parametrize("name, field, value", [
+    ("arm_reach.yaml", "singular_margin", 0.05),
+    ("arm_reach.yaml", "ready_tool_pose", ToolPose(position=[0.3, 0.0, 0.4])),
+    ("arm_reach.yaml", "hardware", ArmHardware(driver="iiwa")),
+    ("hsr_reach.yaml", "hardware", TaskSpaceBridgeConfig(connect=True))])
+def test_a_later_robot_field_changes_the_hash_and_its_default_leaves_it(name, field, value):
+    # The arm's singular damping, its ready pose as a tool pose, a real robot's link.
+    base = scenario(name)
+    assert field not in scenario_content(base)["robot"]
+    changed = dataclasses.replace(base, robot=dataclasses.replace(base.robot, **{field: value}))
+    assert field in scenario_content(changed)["robot"]
+    assert scenario_hash(changed) != scenario_hash(base)

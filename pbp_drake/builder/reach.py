@@ -16,8 +16,8 @@ hand's command and state over LCM to the robot's relay (`pbp_drake.robots.task_s
 The controller (`pbp_drake.builder.make_pbp_controller`, from the resolved scenario's
 `PbpControllerConfig`) is a Diagram of its own; under ``hop`` and ``predict_then_assist`` it
 is `hop_controller` (no DMPs: no `phase` or `predicted_paths`, and no `operator_active`
-input). The order within a tick is `pbp_drake.systems.tick`'s. Loggers named `ee_state_log`, `operator_active_log`,
-`operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` (with
+input). The order within a tick is `pbp_drake.systems.tick`'s. Loggers named
+`ee_state_log`, `operator_active_log`, `operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` (with
 DMPs), `posterior_clipped_log` (where the controller has HOP's posterior) and (with
 obstacles) `in_collision_log` record each tick; the task monitor ends the simulation
 at success.

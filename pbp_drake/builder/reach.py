@@ -14,13 +14,13 @@ The station is `hsr_station` (`pbp_drake.robots.make_hsr_station`) or `arm_stati
 Meshcat visualizer; or `bridged_station` (`robot: !Hsr {hardware: {connect: true}}`), the
 hand's command and state over LCM to the robot's relay (`pbp_drake.robots.task_space_bridge`).
 The controller (`pbp_drake.builder.make_pbp_controller`, from the resolved scenario's
-`PbpControllerConfig`) is a Diagram of its own; under ``hop`` and ``predict_then_assist`` it
-is `hop_controller` (no DMPs: no `phase` or `predicted_paths`, and no `operator_active`
-input). The order within a tick is `pbp_drake.systems.tick`'s. Loggers named
-`ee_state_log`, `operator_active_log`, `operator_command_log`, `command_log`, `selected_goal_log`, `target_log`, `phase_log` (with
-DMPs), `posterior_clipped_log` (where the controller has HOP's posterior) and (with
-obstacles) `in_collision_log` record each tick; the task monitor ends the simulation
-at success.
+`PbpControllerConfig`) is a Diagram of its own; under ``hop`` and ``predict_then_assist`` it is
+`hop_controller` (no DMPs: no `phase` or `predicted_paths`, and no `operator_active` input).
+The order within a tick is `pbp_drake.systems.tick`'s. Loggers named `ee_state_log`,
+`operator_active_log`, `operator_command_log`, `command_log`, `selected_goal_log`,
+`target_log`, `phase_log` (with DMPs), `posterior_clipped_log` (where the controller has HOP's
+posterior) and (with obstacles) `in_collision_log` record each tick; the task monitor ends the
+simulation at success.
 """
 
 import numpy as np

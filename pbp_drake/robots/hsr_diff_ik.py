@@ -224,14 +224,9 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         JD = J.T * self._task_weights
         JDt = JD @ twist
         H0 = JD @ J + self._identity
-        g0 = self._centering_gain * (self._q_nominal - q)
         if self._singular_margin > 0.0:
-            # Damped toward the centering drift, not toward rest: damping toward rest
-            # silenced the drift near the singular configuration, and the joints the hand
-            # leaves free wandered to their limits there.
-            damping = self._singular_damping(J)
-            H0 = H0 + damping * self._identity
-            g0 = g0 * (1.0 + damping)
+            H0 = H0 + self._singular_damping(J) * self._identity
+        g0 = self._centering_gain * (self._q_nominal - q)
         H, g = H0, g0
         norm = twist @ (self._task_weights * twist)
         if norm > 0:

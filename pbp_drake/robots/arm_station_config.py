@@ -144,9 +144,8 @@ class ArmStationConfig:
     #: the hand's leaves free (a redundant arm's elbow, say).
     centering_gain: float = 1.0
     #: Near a singular configuration (the Jacobian's least singular value under this, m
-    #: per rad), the diff IK damps the joints' velocities toward their drift to the ready
-    #: configuration rather than spin a joint pair to move the hand along a direction it
-    #: has all but lost (damped least squares); 0: off.
+    #: per rad), the diff IK damps the joints' velocities rather than spin a joint pair to
+    #: move the hand along a direction it has all but lost (damped least squares); 0: off.
     singular_margin: float = 0.0
     #: Dynamic motion: each joint's servo is critically damped at this frequency (rad/s)
     #: on the joint's own inertia in the ready configuration (kp = I w^2, kd = 2 I w).

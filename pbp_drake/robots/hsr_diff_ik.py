@@ -191,9 +191,8 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
     def _singular_damping(self, J):
         """Damped least squares near a singular configuration: with s the Jacobian's least
         singular value (its rows in the task weights, over the translation's), a weight
-        TASK_WEIGHT (margin² - s²) on the joint velocities' departure from the centering
-        drift while s < margin, so that no joint pair spins to move the hand along a
-        direction it has all but lost."""
+        TASK_WEIGHT (margin² - s²) on the joint velocities while s < margin, so that no
+        joint pair spins to move the hand along a direction it has all but lost."""
         smallest = np.linalg.svd(J * self._singular_rows, compute_uv=False)[-1]
         margin = self._singular_margin
         return TASK_WEIGHT * (margin * margin - smallest * smallest) if smallest < margin else 0.0

@@ -1,6 +1,7 @@
 """The `pbp-drake` command line: `run` one scenario in Meshcat, `session` a participant's
 session of a user study, `study` a scenario file, `report` a study folder, `compare` two,
-`bench` the DMP bank, `draw` a system diagram. Each subcommand lives in
+`teach` a primitive by driving, `driver-sim` a robot's driver, `bench` the DMP bank, `draw`
+a system diagram. Each subcommand lives in
 `pbp_drake.commands`, but `bench`: the package `pbp_drake_bench`, beside `pbp_drake`."""
 
 import argparse
@@ -12,6 +13,7 @@ from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_USAGE
 from pbp_drake.commands.driver_sim import add_driver_sim_command
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.study import add_study_commands
+from pbp_drake.commands.teach import add_teach_command
 from pbp_drake.draw import build_parser as build_draw_parser
 from pbp_drake.draw import main as draw_main
 from pbp_drake.scenarios import ScenarioError
@@ -49,6 +51,7 @@ def build_parser():
     add_run_command(commands)
     add_study_commands(commands)
     add_driver_sim_command(commands)
+    add_teach_command(commands)
 
     # Their own argument parsers live with them; the rest of the line is passed on.
     for name, help_text in [("bench", "time the DMP bank against the DMP libraries people "

@@ -1,6 +1,7 @@
 """Checks of the command line's output paths, made before anything is built or simulated:
-`run --record FILE.html`, `run --log FILE.csv`, `run --output DIR` and `study --output DIR`. A path
-that cannot be written is a user error (a ScenarioError: `pbp-drake: ...`, exit 2), not a lost run.
+`run --record FILE.html`, `run --log FILE.csv`, `run --output DIR`, `study --output DIR` and
+`teach --output FILE.json`. A path that cannot be written is a user error (a ScenarioError:
+`pbp-drake: ...`, exit 2), not a lost run.
 And the replay a `--record` writes (`mark_replay`): marked as ours, paused at its start, with a
 key."""
 
@@ -131,6 +132,21 @@ def check_log_path(path, force=False):
     folder exists or can be made and is writable, and an existing file there is a previous
     time series CSV (its header is the trial CSV's) or `force` is set."""
     _check_output_file(path, "--log", "run.csv", _is_time_series, "a time series", force)
+
+
+def check_primitive_path(path, force=False):
+    """Raises OutputPathError unless `path` can take a taught primitive (`teach --output`):
+    as `check_log_path`, an existing file there a primitive or `force` set."""
+    _check_output_file(path, "--output", "primitive.json", _is_primitive, "a primitive", force)
+
+
+def _is_primitive(path):
+    try:
+        with open(path, "rb") as file:
+            head = file.read(_MARKER_WINDOW)
+    except OSError:
+        return False
+    return b'"format": "pbp_drake.primitive"' in head
 
 
 def _check_output_file(path, flag, example, is_ours, kind, force):

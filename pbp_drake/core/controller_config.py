@@ -10,10 +10,12 @@ scenario (`ResolvedScenario.controller`).
 """
 
 import dataclasses
+import typing
 
 import numpy as np
 
 from pbp_drake.core.dmp import DmpBankModel, DmpSettings
+from pbp_drake.core.dmp.primitive import Primitive, primitive_bank
 from pbp_drake.core.goal_estimation import READS_POSE, GoalEstimatorSettings, estimator_entry
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.hindsight_optimization import HopSettings
@@ -115,6 +117,9 @@ class PbpControllerConfig(ControlSettings):
     nominal_speed: float = 0.12
     #: The hand-over law's limits, which every method's command goes through.
     hand_over: HandOverSettings = dataclasses.field(default_factory=HandOverSettings)
+    #: A taught primitive (`pbp_drake.core.dmp.primitive`) whose shape every goal's DMP
+    #: takes; None: straight paths. A scenario's resolution reads it from `dmp.primitive`.
+    dmp_primitive: typing.Optional[Primitive] = None
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
@@ -138,20 +143,26 @@ class PbpControllerConfig(ControlSettings):
         return method_entry(self.method).blend_mode
 
     def dmp_bank(self, start, goals):
-        """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, of
-        `dmp_duration` or `nominal_duration`."""
+        """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, or the
+        taught primitive's shape, of `dmp_duration` or `nominal_duration`."""
         start, goals = np.asarray(start, float), np.asarray(goals, float)
+        primitive = self.dmp_primitive
         duration = self.dmp_duration or nominal_duration(
-            start, goals, self.nominal_speed, self.goal_estimator.group_mass > 0.0)
+            start, goals, self.nominal_speed, self.goal_estimator.group_mass > 0.0,
+            primitive.length_ratio if primitive else 1.0)
+        if primitive is not None:
+            return primitive_bank(primitive, start, len(goals), duration)
         return DmpBankModel.straight(start, len(goals), duration, self.dmp)
 
 
-def nominal_duration(start, goals, speed, grouped):
+def nominal_duration(start, goals, speed, grouped, length_ratio=1.0):
     """The DMPs' duration (s) when none is given: the farthest goal's distance from `start`
     over `speed` (all DMPs share one phase, so the farthest goal is reached at the nominal
-    speed and the nearer ones slower); with goal groups (`grouped`), the median goal's.
+    speed and the nearer ones slower); with goal groups (`grouped`), the median goal's;
+    times `length_ratio`, a taught primitive's path length over its chord (a bent path is
+    longer than the straight distance).
     Hundreds of goals spread over a table put the farthest well beyond the typical one,
     and the robot, heading first into the region the operator means, would cross it at
     the farthest goal's pace (the hand-over's speed limit bounds the faster DMPs)."""
     distances = np.linalg.norm(np.asarray(goals, float) - np.asarray(start, float), axis=1)
-    return float(np.median(distances) if grouped else np.max(distances)) / speed
+    return float(np.median(distances) if grouped else np.max(distances)) / speed * length_ratio

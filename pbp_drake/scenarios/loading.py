@@ -46,7 +46,7 @@ def load_scenario_file(path, overrides=None):
     the file and the field. `overrides` (`overrides.ScenarioOverrides`: the command line's
     `--set` and `--scenario-text`) are merged onto the file's document first and checked as
     the file is; errors then name the file and the overrides. A relative `robot: !Arm
-    {model_file: ...}` is read from the file's folder."""
+    {model_file: ...}` and `dmp: {primitive: ...}` are read from the file's folder."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
@@ -67,7 +67,8 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
     mapping as `bounds.load_document` reads it) is merged into
     the document first, a mapping into a mapping key by key (a tagged one replaces a node
     of another tag). Raises ScenarioError as `ORIGIN: field.path: what is wrong` (or `line
-    L`). A relative arm `model_file` is read from `folder` (default: the working folder)."""
+    L`). A relative arm `model_file` and a relative `dmp.primitive` are read from `folder`
+    (default: the working folder)."""
     try:
         document = _document(text)
         for overlay in overlays:
@@ -86,7 +87,7 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
         raise ScenarioError(f"{origin}: {error}") from None
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
         raise ScenarioError(f"{origin}: {type(error).__name__}: {error}") from None
-    scenario = _model_file_from(loaded.scenario, folder)
+    scenario = _primitive_from(_model_file_from(loaded.scenario, folder), folder)
     try:
         resolved = resolve(scenario)
         check_numbers(loaded.study, "study")
@@ -157,6 +158,15 @@ def _model_file_from(scenario, folder):
         return scenario
     model_file = os.path.join(os.path.abspath(folder or os.curdir), robot.model_file)
     return dataclasses.replace(scenario, robot=dataclasses.replace(robot, model_file=model_file))
+
+
+def _primitive_from(scenario, folder):
+    """`scenario` with a relative `dmp.primitive` made a path from `folder`."""
+    primitive = scenario.dmp.primitive
+    if not primitive or os.path.isabs(primitive):
+        return scenario
+    path = os.path.join(os.path.abspath(folder or os.curdir), primitive)
+    return dataclasses.replace(scenario, dmp=dataclasses.replace(scenario.dmp, primitive=path))
 
 
 # ---------------------------------------------------------------------------------------------

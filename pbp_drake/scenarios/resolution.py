@@ -9,6 +9,7 @@ CLI) derives any of these again.
 """
 
 import dataclasses
+import json
 import math
 import typing
 
@@ -17,6 +18,7 @@ import numpy as np
 from pbp_drake.core.controller_config import PbpControllerConfig, nominal_duration
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
+from pbp_drake.core.dmp.primitive import SETTINGS_FIELDS, read_primitive_document
 from pbp_drake.core.goal_estimation import READS_INTENT, READS_POSE, estimator_entry
 from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_names
 from pbp_drake.core.toy_scene import bent_path
@@ -224,6 +226,9 @@ def _check_point_robot(robot):
 
 def _resolve_point_robot(scenario):
     _check_point_robot(scenario.robot)
+    if scenario.dmp.primitive:
+        raise ScenarioError("scenario.dmp.primitive gives a robot task's DMPs a taught shape; "
+                            "a 2-D scene learns its shape from scenario.demonstration")
     scenario = _with_period(scenario, whole_steps(
         scenario.control_period, scenario.robot.time_step, "scenario.control_period",
         "scenario.robot.time_step"))
@@ -399,19 +404,25 @@ def _resolve_task_robot(scenario):
         raise ScenarioError(
             f"scenario.task.success_distance {task.success_distance} m reaches the nearest "
             f"object ({nearest:.2f} m from the hand's start): the task would succeed at once")
+    primitive = _taught_primitive(scenario, task)
     duration = scenario.dmp_duration if scenario.dmp_duration > 0 else nominal_duration(
-        start, goals, robot.speed, scenario.goal_estimator.group_mass > 0.0)
+        start, goals, robot.speed, scenario.goal_estimator.group_mass > 0.0,
+        primitive.length_ratio if primitive else 1.0)
     check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
                        scenario.dmp_duration > 0 else "scenario.robot.speed")
     controller = PbpControllerConfig(**{
         **scenario.control_settings(), "dmp_duration": float(duration),
-        "nominal_speed": float(robot.speed), "hand_over": robot.hand_over()})
+        "nominal_speed": float(robot.speed), "hand_over": robot.hand_over(),
+        "dmp_primitive": primitive})
     # The DMPs are fitted where they run: by the controller, from `controller`.
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=None,
         scene=scene, station=station, initial_ee_state=initial_ee_state,
         nominal_speed=float(robot.speed), controller=controller)
 
+
+#: The largest primitive file read (a demonstration of an hour at 100 Hz is about 20 MiB).
+MAX_PRIMITIVE_BYTES = 64 * 2**20
 
 #: The station's fields a task sets, each from its one home in the scenario.
 _SET_BY_THE_TASK = {"control_period": "scenario.control_period",
@@ -427,6 +438,50 @@ def _refuse_what_the_task_sets(station, station_field):
         if hasattr(station, name) and getattr(station, name) != getattr(defaults, name):
             raise ScenarioError(f"{station_field}.{name} is set by the task from {home}; "
                                 "give it there")
+
+
+def _taught_primitive(scenario, task):
+    """The scenario's taught primitive (`dmp.primitive`), read and checked against the
+    task's DMPs; None without one."""
+    dmp = scenario.dmp
+    if not dmp.primitive:
+        return None
+    field = f"scenario.dmp.primitive {dmp.primitive}"
+    if isinstance(task, GraspTask):
+        raise ScenarioError(f"{field}: the grasping task's pose DMPs take no taught "
+                            "primitive; the reaching and obstacle tasks do")
+    primitive = load_primitive(dmp.primitive, field)
+    if primitive.dimension != 3:
+        raise ScenarioError(f"{field} teaches {primitive.dimension}-D paths; the task's "
+                            "DMPs move the hand in 3-D")
+    for name in SETTINGS_FIELDS:
+        ours, theirs = getattr(dmp, name), getattr(primitive.settings, name)
+        if ours != theirs:
+            raise ScenarioError(f"scenario.dmp.{name} is {ours!r}; the primitive {dmp.primitive} "
+                                f"was fitted with {theirs!r}: set it so, or teach it again")
+    return primitive
+
+
+def load_primitive(path, field):
+    """The primitive in the file at `path`; ScenarioError `field: what is wrong` (one line)
+    for a file that cannot be read, is not JSON (truncated, corrupt) or not a primitive."""
+    try:
+        with open(path, "rb") as file:
+            data = file.read(MAX_PRIMITIVE_BYTES + 1)
+    except OSError as error:
+        raise ScenarioError(f"{field} cannot be read: {error.strerror or error}") from None
+    if len(data) > MAX_PRIMITIVE_BYTES:
+        raise ScenarioError(f"{field} is over {MAX_PRIMITIVE_BYTES // 2**20} MiB: not a "
+                            "primitive")
+    try:
+        document = json.loads(data)
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ScenarioError(f"{field} is not a primitive file (truncated or corrupt: "
+                            f"{getattr(error, 'msg', error)})") from None
+    try:
+        return read_primitive_document(document)
+    except ValueError as error:
+        raise ScenarioError(f"{field}: {error}") from None
 
 
 def _check_bridge(hardware, task):

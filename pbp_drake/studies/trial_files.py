@@ -78,6 +78,7 @@ _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects
                           "grasps_per_object": 1},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3},
                  "robot": {"hardware": None, "ready_tool_pose": None, "singular_margin": 0.0},
+                 "dmp": {"primitive": ""},
                  "goal_estimator": {"group_mass": 0.0, "commit_radius": 0.05,
                                     "commit_probability": 0.8,
                                     "intent_filter": plain(IntentFilterSettings())}}
@@ -111,6 +112,10 @@ def scenario_content(scenario):
                 continue
             if isinstance(values, dict) and values.get(name, default) == default:
                 values.pop(name, None)
+    dmp = content.get("dmp")
+    if isinstance(dmp, dict) and dmp.get("primitive"):
+        # What the trials run is the primitive's content, wherever its file is.
+        dmp["primitive"] = _file_digest(dmp["primitive"])
     robot = content.get("robot")
     station = robot.get("station") if isinstance(robot, dict) else None
     for section in (robot, station):
@@ -119,6 +124,15 @@ def scenario_content(scenario):
                 if name in section:
                     section[old_name] = section.pop(name)
     return content
+
+
+def _file_digest(path):
+    """The sha256 of a file's bytes (the path itself when it cannot be read: the scenario's
+    resolution then refuses it anyway)."""
+    try:
+        return "sha256:" + hashlib.sha256(pathlib.Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return path
 
 
 def scenario_hash(scenario):

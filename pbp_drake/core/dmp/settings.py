@@ -38,6 +38,11 @@ class DmpSettings:
     beta_z: float | None = None
     #: The phase decay; ln 100 makes the phase reach 0.01 at t = tau.
     alpha_x: float = math.log(100.0)
+    #: A taught primitive's file (`pbp-drake teach`; scenario files: relative to the
+    #: file's folder): every goal's DMP takes its shape (`pbp_drake.core.dmp.primitive`),
+    #: and the fields above must be the ones it was fitted with. Empty: straight paths,
+    #: or a 2-D scene's demonstration.
+    primitive: str = ""
 
     def __post_init__(self):
         self.validate()

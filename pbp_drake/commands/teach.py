@@ -1,0 +1,125 @@
+"""`pbp-drake teach FILE --output P.json`: a primitive taught by driving. The scenario's task
+runs under teleop with the chosen operator (a person in the page presses Start, drives the
+hand from its start toward a goal and presses Stop; the virtual participant drives to its
+target headless), the hand's path from the start to the end of the run is fitted with the
+scenario's DMP settings (`pbp_drake.core.dmp.primitive`), and the primitive is saved, to
+be named by any scenario's `dmp: {primitive: P.json}`. The run's rows are kept beside
+the primitive (`P.csv`). `--from CSV` teaches from a path already recorded (`run --log`, a
+study trial's CSV) instead.
+"""
+
+import argparse
+import csv
+import json
+import pathlib
+
+import numpy as np
+
+from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS
+from pbp_drake.commands.run import add_run_command
+from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
+from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
+from pbp_drake.output_paths import check_log_path, check_primitive_path
+from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.studies.atomic_files import write_atomically
+
+#: The operators who can drive a demonstration.
+TEACHERS = ("virtual", "keyboard", "gamepad")
+# The columns of the hand's path in a run's or trial's CSV.
+_TIME, _HAND = "time", ("ee_x", "ee_y", "ee_z")
+
+
+def add_teach_command(commands):
+    """The `teach` subcommand and its arguments."""
+    parser = commands.add_parser(
+        "teach", help="teach a primitive by driving: the hand's path from the task's start, "
+        "fitted as a DMP and saved, for any scenario's dmp: {primitive: FILE}")
+    parser.add_argument("scenario", help="a reaching or obstacle task's scenario file, e.g. "
+                        "diagrams/hsr_reach.yaml (its dmp section: the fit's settings)")
+    parser.add_argument("--output", required=True, metavar="FILE.json",
+                        help="where the primitive is saved")
+    parser.add_argument("--operator", choices=TEACHERS, default="virtual",
+                        help="who drives: virtual (default, headless: the virtual participant "
+                        "drives to its target), keyboard or gamepad (you, in the page)")
+    parser.add_argument("--from", dest="source", metavar="FILE.csv",
+                        help="teach from a recorded path instead of driving: a run's --log "
+                        "CSV or a study trial's CSV")
+    parser.add_argument("--seed", type=int, help="--set seed=N: the scene driven in")
+    parser.add_argument("--force", action="store_true",
+                        help="overwrite an existing --output that is not a primitive")
+    add_override_flags(parser)
+    parser.set_defaults(handler=_teach, method=None, alpha=None, duration=None, goals=None,
+                        hardware=False, driver_sim=False)
+
+
+def _teach(args):
+    check_primitive_path(args.output, force=args.force)
+    scenario = load_scenario_file(args.scenario, scenario_overrides(args, shorthands=False)
+                                  ).scenario
+    if scenario.task is None:
+        raise ScenarioError("teach drives a robot task's hand; this scenario is a 2-D scene, "
+                            "whose demonstration is scenario.demonstration")
+    origin = args.source
+    if origin is None:
+        # The drive's rows are kept beside the primitive: a person's demonstration is not
+        # to be driven twice.
+        origin = str(pathlib.Path(args.output).with_suffix(".csv"))
+        check_log_path(origin, force=args.force)
+        code = _drive(args, origin)
+        if code not in (EXIT_SUCCESS, EXIT_FAILED, EXIT_STOPPED):
+            return code
+    times, positions = read_hand_path(origin)
+    try:
+        primitive = teach_primitive(times, positions, scenario.dmp)
+    except ValueError as error:
+        raise ScenarioError(f"{origin}: {error}") from None
+    write_atomically(pathlib.Path(args.output), json.dumps(primitive_document(primitive)))
+    start, goal = (", ".join(f"{x:.3f}" for x in point)
+                   for point in (primitive.start, primitive.goal))
+    print(f"Taught from {len(primitive.times)} samples over {primitive.duration:.2f} s, from "
+          f"[{start}] to [{goal}] m, {primitive.length_ratio:.2f} times the straight "
+          f"distance; the {primitive.settings.formulation} DMP reproduces it within "
+          f"{primitive.fit_error * 1000:.1f} mm RMS. Saved to {args.output}: name it in a "
+          f"scenario as dmp: {{primitive: {args.output}}}", flush=True)
+    return EXIT_SUCCESS
+
+
+def _drive(args, log):
+    """The scenario run under teleop by `args.operator`, its per-tick rows in `log`: the
+    exit code of `pbp-drake run`."""
+    # One target from the start (the task's switches would put turns in the shape); the
+    # command line's own settings come after, and may change that.
+    argv = ["run", args.scenario, "--method", "teleop", "--operator", args.operator,
+            "--log", str(log), "--force", "--set", "task.switch_schedule=[0.0]"]
+    for setting in args.settings:
+        argv += ["--set", setting]
+    if args.scenario_text is not None:
+        argv += ["--scenario-text", args.scenario_text]
+    if args.seed is not None:
+        argv += ["--seed", str(args.seed)]
+    if args.operator == "virtual":
+        argv.append("--headless")
+    parser = argparse.ArgumentParser(prog="pbp-drake")
+    add_run_command(parser.add_subparsers(dest="command"))
+    run_args = parser.parse_args(argv)
+    return run_args.handler(run_args)
+
+
+def read_hand_path(path):
+    """Times (T,) and hand positions (T, 3) of a run's or trial's CSV; ScenarioError naming
+    the file for one that cannot be read or has no hand path."""
+    try:
+        with open(path, newline="") as file:
+            rows = list(csv.DictReader(file))
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise ScenarioError(f"{path}: cannot be read as a CSV ({error})") from None
+    columns = (_TIME, *_HAND)
+    if not rows or any(name not in rows[0] for name in columns):
+        raise ScenarioError(f"{path}: not a run's path: it needs the columns "
+                            f"{', '.join(columns)} (pbp-drake run --log writes them)")
+    try:
+        table = np.array([[float(row[name]) for name in columns] for row in rows])
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{path}: a value of {', '.join(columns)} is not a number"
+                            ) from None
+    return table[:, 0], table[:, 1:]

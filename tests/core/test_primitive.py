@@ -1,0 +1,92 @@
+"""A primitive taught from one demonstration: the fit reproduces the demonstration, the
+shape goes to other goals (both formulations), the document round-trips, and bad
+demonstrations and damaged documents are refused with what is wrong."""
+
+import json
+
+import numpy as np
+import pytest
+
+from pbp_drake.core.dmp import DmpSettings, FORMULATIONS
+from pbp_drake.core.dmp.primitive import (
+    FORMAT_VERSION, primitive_bank, primitive_document, read_primitive_document,
+    teach_primitive)
+
+START, GOAL = np.array([0.5, 0.0, 0.7]), np.array([1.5, 0.2, 0.7])
+BEND = 0.25  # m: how high the demonstration rises over a low wall half way
+
+
+def over_a_wall(samples=200, duration=4.0):
+    """A reach that rises BEND above the straight line half way, as a hand lifted over a
+    low wall would."""
+    times = np.linspace(0.0, duration, samples)
+    s = times / duration
+    progress = 10 * s**3 - 15 * s**4 + 6 * s**5
+    positions = START + np.outer(progress, GOAL - START)
+    positions[:, 2] += BEND * np.sin(np.pi * progress)
+    return times, positions
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_a_bent_demonstration_is_reproduced_and_carried_to_other_goals(formulation):
+    primitive = teach_primitive(*over_a_wall(), DmpSettings(formulation=formulation))
+    assert primitive.fit_error < 0.01  # within 1 cm RMS at its own goal
+    goals = np.array([[1.2, -0.4, 0.7], [1.0, 0.5, 0.9], [1.8, 0.0, 0.6]])
+    bank = primitive_bank(primitive, START, len(goals), 4.0)
+    phase, _, velocity = bank.initial_state()
+    paths = bank.predict(phase, START[:, None], velocity, bank.goals_matrix(goals), 0.01, 600)
+    for goal, path in zip(goals, paths):
+        assert np.linalg.norm(path[-1] - goal) < 0.01
+        # Over the wall on the way to each goal, as the demonstration went.
+        along = (path[:, 0] - START[0]) / (goal[0] - START[0])
+        chord = START[2] + along * (goal[2] - START[2])
+        assert (path[:, 2] - chord).max() > 0.8 * BEND
+
+
+def test_the_document_round_trips():
+    primitive = teach_primitive(*over_a_wall(), DmpSettings(formulation="pastor"))
+    again = read_primitive_document(json.loads(json.dumps(primitive_document(primitive))))
+    assert again.settings == primitive.settings and again.fit_error == primitive.fit_error
+    np.testing.assert_array_equal(again.weights, primitive.weights)
+    np.testing.assert_array_equal(again.positions, primitive.positions)
+
+
+def test_a_straight_demonstration_takes_the_straight_duration():
+    times = np.linspace(0.0, 2.0, 50)
+    primitive = teach_primitive(times, START + np.outer(times / 2.0, GOAL - START))
+    assert primitive.length_ratio == pytest.approx(1.0)
+    assert teach_primitive(*over_a_wall()).length_ratio > 1.1
+
+
+@pytest.mark.parametrize("times, positions, message", [
+    (np.linspace(0, 1, 5), np.linspace(START, GOAL, 5), "has 5 samples; at least 10"),
+    (np.linspace(0, 1, 50), np.tile(START, (50, 1)) + 0.001,
+     "ends 0.000 m from where it starts; a primitive needs at least 0.02 m"),
+    (np.linspace(0, 1, 50), np.where(np.arange(50)[:, None] == 7, np.nan,
+                                     np.linspace(START, GOAL, 50)), "NaN or infinite at sample 7"),
+])
+def test_a_demonstration_too_short_still_or_nan_is_refused(times, positions, message):
+    with pytest.raises(ValueError, match=message):
+        teach_primitive(times, positions)
+
+
+def _damaged(change):
+    document = primitive_document(teach_primitive(*over_a_wall()))
+    change(document)
+    return document
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d.update(version=FORMAT_VERSION + 1),
+     f"version {FORMAT_VERSION + 1} is newer than this pbp_drake reads"),
+    (lambda d: d.update(format="something else"), "not a primitive"),
+    (lambda d: d.pop("weights"), "weights must be a table of numbers"),
+    (lambda d: d["weights"][3].__setitem__(1, float("nan")), "weights must be"),
+    (lambda d: d["weights"].pop(), r"weights \(49, 3\) .* do not fit"),
+    (lambda d: d["settings"].update(formulation="spline"), "settings: formulation 'spline'"),
+    (lambda d: d.update(amplitude_scaling=[True]), "amplitude_scaling must be 3"),
+    (lambda d: d.update(fit_error=-1), "fit_error must be a finite number >= 0"),
+])
+def test_a_damaged_document_is_refused_naming_the_field(change, message):
+    with pytest.raises(ValueError, match=message):
+        read_primitive_document(_damaged(change))

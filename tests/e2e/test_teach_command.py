@@ -1,0 +1,120 @@
+"""`pbp-drake teach`: a primitive taught by the virtual operator, named by a scenario beside
+it and run headless; taught again from the drive's CSV; bad primitives and recordings
+refused in one line naming the file (exit 2)."""
+
+import json
+import pathlib
+import shutil
+
+import pytest
+
+from pbp_drake.cli import main
+from pbp_drake.core.dmp.primitive import FORMAT_VERSION
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+REACH = REPO / "diagrams" / "hsr_reach.yaml"
+
+
+def run(*argv, capsys):
+    code = main([str(arg) for arg in argv])
+    return code, capsys.readouterr()
+
+
+@pytest.fixture(scope="module")
+def taught(tmp_path_factory):
+    """A folder with the reaching scenario and a primitive taught in it, and what teach
+    printed."""
+    folder = tmp_path_factory.mktemp("teach")
+    shutil.copy(REACH, folder / "scene.yaml")
+    code = main(["teach", str(folder / "scene.yaml"), "--output", str(folder / "P.json")])
+    assert code == 0
+    return folder
+
+
+@pytest.mark.slow
+def test_a_taught_primitive_runs_from_a_scenario_beside_it(taught, capsys):
+    document = json.loads((taught / "P.json").read_text())
+    assert document["format"] == "pbp_drake.primitive" and document["dimension"] == 3
+    assert document["fit_error"] < 0.01
+    # Relative to the scenario file's folder, not the working folder.
+    code, out = run("run", taught / "scene.yaml", "--headless", "--operator", "virtual",
+                    "--set", "dmp.primitive=P.json", capsys=capsys)
+    assert code == 0, out.err
+    assert "hsr_reach [pbp_alternated, seed 0]: success" in out.out
+
+
+@pytest.mark.slow
+def test_a_drive_s_recording_teaches_the_same_primitive(taught, tmp_path, capsys):
+    code, out = run("teach", REACH, "--from", taught / "P.csv", "--output",
+                    tmp_path / "again.json", capsys=capsys)
+    assert code == 0, out.err
+    assert "reproduces it within" in out.out
+    first, again = (json.loads(path.read_text())
+                    for path in (taught / "P.json", tmp_path / "again.json"))
+    assert first["weights"] == again["weights"]
+
+
+def _primitive_file(taught, tmp_path, change):
+    document = json.loads((taught / "P.json").read_text())
+    text = change(document)
+    path = tmp_path / "bad.json"
+    path.write_text(text if isinstance(text, str) else json.dumps(document))
+    return path
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("change, message", [
+    (lambda d: json.dumps(d)[:200], "is not a primitive file (truncated or corrupt"),
+    (lambda d: "\x00\x01 garbage", "is not a primitive file (truncated or corrupt"),
+    (lambda d: d.update(version=FORMAT_VERSION + 1), "is newer than this pbp_drake reads"),
+    (lambda d: d["settings"].update(formulation="pastor"),
+     "scenario.dmp.formulation is 'ijspeert'; the primitive"),
+    (lambda d: d.update(dimension=2, amplitude_scaling=[True, True],
+                        weights=[row[:2] for row in d["weights"]],
+                        demonstration={"times": d["demonstration"]["times"],
+                                       "positions": [p[:2] for p in
+                                                     d["demonstration"]["positions"]]}),
+     "teaches 2-D paths; the task's DMPs move the hand in 3-D"),
+])
+def test_a_bad_primitive_is_refused_in_one_line_naming_the_file(taught, tmp_path, change,
+                                                                 message, capsys):
+    path = _primitive_file(taught, tmp_path, change)
+    code, out = run("run", REACH, "--headless", "--set", f"dmp.primitive={path}",
+                    capsys=capsys)
+    assert code == 2
+    assert message in out.err and str(path) in out.err
+    assert len(out.err.strip().splitlines()) == 1, out.err
+
+
+def test_a_missing_primitive_and_the_grasping_task_are_refused(tmp_path, capsys):
+    code, out = run("run", REACH, "--headless", "--set",
+                    f"dmp.primitive={tmp_path / 'none.json'}", capsys=capsys)
+    assert code == 2 and "none.json cannot be read" in out.err
+    code, out = run("run", REACH.with_name("hsr_grasp.yaml"), "--headless", "--set",
+                    f"dmp.primitive={tmp_path / 'none.json'}", capsys=capsys)
+    assert code == 2 and "the grasping task's pose DMPs take no taught primitive" in out.err
+
+
+@pytest.mark.parametrize("rows, message", [
+    ("time,ee_x,ee_y,ee_z\n" + "".join(f"{t / 10},0.5,0.0,0.7\n" for t in range(30)),
+     "ends 0.000 m from where it starts"),
+    ("time,ee_x,ee_y,ee_z\n" + "".join(f"{t / 10},{0.5 + t / 20},nan,0.7\n"
+                                        for t in range(30)), "NaN or infinite at sample 0"),
+    ("time,x\n0,1\n", "not a run's path: it needs the columns time, ee_x, ee_y, ee_z"),
+])
+def test_a_bad_recording_is_refused_in_one_line_naming_it(tmp_path, rows, message, capsys):
+    recording = tmp_path / "run.csv"
+    recording.write_text(rows)
+    code, out = run("teach", REACH, "--from", recording, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 2
+    assert message in out.err and str(recording) in out.err
+    assert not (tmp_path / "P.json").exists()
+
+
+def test_teach_does_not_overwrite_a_file_that_is_not_a_primitive(tmp_path, capsys):
+    notes = tmp_path / "notes.json"
+    notes.write_text("{}")
+    code, out = run("teach", REACH, "--output", notes, capsys=capsys)
+    assert code == 2 and "is not a primitive written by pbp-drake" in out.err
+    assert notes.read_text() == "{}"

@@ -15,7 +15,7 @@ import pathlib
 
 import numpy as np
 
-from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS
+from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS, port
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
 from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
@@ -45,6 +45,8 @@ def add_teach_command(commands):
                         help="teach from a recorded path instead of driving: a run's --log "
                         "CSV or a study trial's CSV")
     parser.add_argument("--seed", type=int, help="--set seed=N: the scene driven in")
+    parser.add_argument("--port", type=port, default=0,
+                        help="keyboard and gamepad: the page's port (default 0: a free one)")
     parser.add_argument("--force", action="store_true",
                         help="overwrite an existing --output that is not a primitive")
     add_override_flags(parser)
@@ -99,6 +101,8 @@ def _drive(args, log):
         argv += ["--seed", str(args.seed)]
     if args.operator == "virtual":
         argv.append("--headless")
+    else:  # the demonstration ends with the run: no result page to keep
+        argv += ["--port", str(args.port), "--keep-page", "0"]
     parser = argparse.ArgumentParser(prog="pbp-drake")
     add_run_command(parser.add_subparsers(dest="command"))
     run_args = parser.parse_args(argv)

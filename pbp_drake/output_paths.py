@@ -140,6 +140,20 @@ def check_primitive_path(path, force=False):
     _check_output_file(path, "--output", "primitive.json", _is_primitive, "a primitive", force)
 
 
+def check_figure_path(path, flag="--figure"):
+    """Raises OutputPathError unless `path` can take a figure: a .png, .svg or .pdf file
+    (an existing one is drawn over) whose folder exists or can be made, writable."""
+    file = pathlib.Path(path)
+    if file.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise OutputPathError(f"{flag} {file}: a figure is a .png, .svg or .pdf file")
+    if file.is_dir():
+        raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
+                              f"{file / 'primitive.png'}")
+    if file.exists() and not os.access(file, os.W_OK):
+        raise OutputPathError(f"{flag} {file}: the file is not writable")
+    _check_can_create(file.parent, f"{flag} {file}")
+
+
 def _is_primitive(path):
     try:
         with open(path, "rb") as file:

@@ -19,9 +19,10 @@ from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS, port
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
 from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
-from pbp_drake.output_paths import check_log_path, check_primitive_path
+from pbp_drake.output_paths import check_figure_path, check_log_path, check_primitive_path
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
 from pbp_drake.studies.atomic_files import write_atomically
+from pbp_drake.studies.primitive_figure import plot_primitive
 
 #: The operators who can drive a demonstration.
 TEACHERS = ("virtual", "keyboard", "gamepad")
@@ -45,6 +46,9 @@ def add_teach_command(commands):
                         help="teach from a recorded path instead of driving: a run's --log "
                         "CSV or a study trial's CSV")
     parser.add_argument("--seed", type=int, help="--set seed=N: the scene driven in")
+    parser.add_argument("--figure", metavar="FILE.png",
+                        help="also draw the demonstration, its reproduction and the shape "
+                        "carried to the scene's objects")
     parser.add_argument("--port", type=port, default=0,
                         help="keyboard and gamepad: the page's port (default 0: a free one)")
     parser.add_argument("--force", action="store_true",
@@ -56,8 +60,11 @@ def add_teach_command(commands):
 
 def _teach(args):
     check_primitive_path(args.output, force=args.force)
-    scenario = load_scenario_file(args.scenario, scenario_overrides(args, shorthands=False)
-                                  ).scenario
+    if args.figure is not None:
+        check_figure_path(args.figure)
+    scenario_file = load_scenario_file(args.scenario,
+                                       scenario_overrides(args, shorthands=False))
+    scenario = scenario_file.scenario
     if scenario.task is None:
         raise ScenarioError("teach drives a robot task's hand; this scenario is a 2-D scene, "
                             "whose demonstration is scenario.demonstration")
@@ -83,6 +90,10 @@ def _teach(args):
           f"distance; the {primitive.settings.formulation} DMP reproduces it within "
           f"{primitive.fit_error * 1000:.1f} mm RMS. Saved to {args.output}: name it in a "
           f"scenario as dmp: {{primitive: {args.output}}}", flush=True)
+    if args.figure is not None:
+        plot_primitive(primitive, scenario_file.resolved.scene.objects, args.figure)
+        print(f"Figure: {args.figure} (the demonstration, its reproduction, the shape "
+              "carried to the scene's objects)", flush=True)
     return EXIT_SUCCESS
 
 

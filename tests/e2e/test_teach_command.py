@@ -46,9 +46,11 @@ def test_a_taught_primitive_runs_from_a_scenario_beside_it(taught, capsys):
 @pytest.mark.slow
 def test_a_drive_s_recording_teaches_the_same_primitive(taught, tmp_path, capsys):
     code, out = run("teach", REACH, "--from", taught / "P.csv", "--output",
-                    tmp_path / "again.json", capsys=capsys)
+                    tmp_path / "again.json", "--figure", tmp_path / "again.png",
+                    capsys=capsys)
     assert code == 0, out.err
     assert "reproduces it within" in out.out
+    assert (tmp_path / "again.png").read_bytes().startswith(b"\x89PNG")
     first, again = (json.loads(path.read_text())
                     for path in (taught / "P.json", tmp_path / "again.json"))
     assert first["weights"] == again["weights"]
@@ -110,6 +112,14 @@ def test_a_bad_recording_is_refused_in_one_line_naming_it(tmp_path, rows, messag
     assert code == 2
     assert message in out.err and str(recording) in out.err
     assert not (tmp_path / "P.json").exists()
+
+
+def test_a_figure_that_is_not_an_image_file_is_refused_before_anything_runs(tmp_path,
+                                                                             capsys):
+    code, out = run("teach", REACH, "--output", tmp_path / "P.json", "--figure",
+                    tmp_path / "P.txt", capsys=capsys)
+    assert code == 2 and "a figure is a .png, .svg or .pdf file" in out.err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_teach_does_not_overwrite_a_file_that_is_not_a_primitive(tmp_path, capsys):

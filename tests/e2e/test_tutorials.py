@@ -24,7 +24,7 @@ TUTORIALS = pathlib.Path(__file__).resolve().parents[2] / "tutorials"
 NOTEBOOKS = sorted(TUTORIALS.glob("*.ipynb"))
 EXPECTED = ["01_dmp_basics", "02_policy_blending_2d", "03_hsr_multi_goal",
             "04_build_your_own_diagram", "05_run_a_study", "06_hsr_station",
-            "07_orientation_primitives", "08_pbp_on_your_urdf"]
+            "07_orientation_primitives", "08_pbp_on_your_urdf", "09_teach_a_primitive"]
 
 # Run first in every notebook's kernel.
 STRICT_WARNINGS = """\
@@ -35,7 +35,7 @@ warnings.simplefilter("error", DrakeDeprecationWarning)
 """
 
 
-def test_all_eight_tutorials_are_there():
+def test_every_tutorial_is_there():
     assert [path.stem for path in NOTEBOOKS] == EXPECTED
 
 

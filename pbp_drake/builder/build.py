@@ -6,16 +6,17 @@ from pbp_drake.builder.point_robot import build_point_robot_diagram
 from pbp_drake.scenarios import GraspTask, ResolvedScenario, resolve
 
 
-def build_diagram(scenario, meshcat=None, prediction_steps=None):
+def build_diagram(scenario, meshcat=None, prediction_steps=None, hand_trail=False):
     """The Diagram of a `ResolvedScenario` (or of a `Scenario`, resolved here once); with
     `meshcat`, also drawn there. `prediction_steps` (2-D scenes) sets how far ahead the DMPs'
-    paths are drawn (default: their duration, when drawing)."""
+    paths are drawn (default: their duration, when drawing); `hand_trail` (the reaching and
+    obstacle tasks) draws the hand's path as it grows."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
     check_buildable(resolved)
     if isinstance(resolved.scenario.task, GraspTask):
         return build_grasp_diagram(resolved, meshcat)
     if resolved.has_task:
-        return build_reach_diagram(resolved, meshcat)
+        return build_reach_diagram(resolved, meshcat, hand_trail)
     return build_point_robot_diagram(resolved, meshcat, prediction_steps)
 
 

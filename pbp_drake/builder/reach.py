@@ -49,9 +49,9 @@ def _station(resolved, meshcat):
         hardware, resolved.initial_ee_state, resolved.scenario.control_period, robot_side)
 
 
-def build_reach_diagram(resolved, meshcat=None):
+def build_reach_diagram(resolved, meshcat=None, hand_trail=False):
     """The Diagram of a resolved reaching or obstacle task (HSR or arm); with `meshcat`,
-    drawn there too."""
+    drawn there too (with `hand_trail`, the hand's path as it grows)."""
     scenario = resolved.scenario
     period = scenario.control_period
     task = scenario.task
@@ -129,7 +129,8 @@ def build_reach_diagram(resolved, meshcat=None):
         workspace = (np.vstack([resolved.station.base_pose[:3], scene.objects, start])
                      if isinstance(resolved.station, ArmStationConfig) else None)
         visualizer = builder.AddNamedSystem("task_visualizer", ReachSceneVisualizer(
-            meshcat, scene.objects, prediction_steps, path_count, workspace=workspace))
+            meshcat, scene.objects, prediction_steps, path_count, workspace=workspace,
+            hand_trail=hand_trail))
         builder.Connect(monitor.get_target_output_port(), visualizer.get_target_input_port())
         builder.Connect(selected_goal, visualizer.get_selected_goal_input_port())
         builder.Connect(operator_active, visualizer.get_operator_active_input_port())

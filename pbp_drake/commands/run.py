@@ -43,6 +43,9 @@ def add_run_command(commands):
     run.add_argument("--force", action="store_true",
                      help="let --record (--log) overwrite an existing file that is not a "
                      "replay (time series)")
+    run.add_argument("--hand-trail", action="store_true",
+                     help="reaching and obstacle tasks: draw the hand's path in the page as "
+                     "it grows (pbp-drake teach draws the demonstration so)")
     add_page_flags(run)
     add_session_flags(run, hidden=True)  # `run --participant ID` is `session --participant ID`
     run.set_defaults(handler=_saying_write_failures(_run))
@@ -65,7 +68,8 @@ def add_run_command(commands):
     add_page_flags(session)
     session.set_defaults(handler=_saying_write_failures(_run), method=None, alpha=None,
                          goals=None, scene=None, no_meshcat=False, record=None,
-                         log=None, force=False, hardware=False, driver_sim=False)
+                         log=None, force=False, hardware=False, driver_sim=False,
+                         hand_trail=False)
 
 
 def _add_common_flags(parser):

@@ -62,7 +62,7 @@ def run_task_loop(args, resolved, meshcat, page):
     first = True
     while True:
         scenario = resolved.scenario
-        diagram = build_diagram(resolved, meshcat)
+        diagram = build_diagram(resolved, meshcat, hand_trail=args.hand_trail)
         if console is not None:
             # After the operator's buttons, which the build added: the same order each run.
             console.set_choices(RUN_CHOICES)

@@ -113,7 +113,7 @@ def _drive(args, log):
     if args.operator == "virtual":
         argv.append("--headless")
     else:  # the demonstration ends with the run: no result page to keep
-        argv += ["--port", str(args.port), "--keep-page", "0"]
+        argv += ["--port", str(args.port), "--keep-page", "0", "--hand-trail"]
     parser = argparse.ArgumentParser(prog="pbp-drake")
     add_run_command(parser.add_subparsers(dest="command"))
     run_args = parser.parse_args(argv)

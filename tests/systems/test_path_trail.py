@@ -1,4 +1,5 @@
-"""The executed path in a 2-D replay is drawn as the robot goes: at each time of the replay
+"""The executed path in a 2-D replay (and a teaching run's hand path) is drawn as the robot
+goes: at each time of the replay
 the robot's trail (`/pbp/executed`, `PathTrail`) runs from the start to where the robot is
 then, never further, and nothing of it shows before the robot moves. A trail longer than
 its dots thins and still runs from the start, and its dots jump, not slide, when it does.
@@ -10,12 +11,15 @@ import numpy as np
 import pytest
 from pydrake.geometry import Rgba
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import TrajectorySource
+from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 from replay_tracks import animation_tracks, held_at, recorded
 
 from pbp_drake.systems.visualizers.point_scene_visualizer import (
     EXECUTED_DOTS, EXECUTED_SPACING, EXECUTED_Z, PointSceneVisualizer)
+from pbp_drake.systems.ports import EeState, Target
+from pbp_drake.systems.visualizers.reach_scene_visualizer import (
+    TRAIL_DOTS, TRAIL_SPACING, ReachSceneVisualizer)
 from pbp_drake.systems.visualizers.scene_drawing import PathTrail
 
 FPS = 30.0  # replay_tracks.recorded's frames per second
@@ -119,3 +123,30 @@ def test_drawing_the_trail_again_starts_it_again(meshcat):
     tracks = animation_tracks(meshcat.StaticHtml())
     assert len(shown_dots(tracks, "/trail", 20, 1.5)) == 11
     np.testing.assert_allclose(shown_dots(tracks, "/trail", 20, 2.0), [[5.0, 0.0, 0.0]])
+
+
+@pytest.mark.slow
+def test_a_teaching_run_s_page_shows_the_hand_s_path_as_it_grows(meshcat):
+    # `pbp-drake teach` draws the demonstration being recorded (`hand_trail`).
+    times = np.linspace(0.0, DURATION, 101)
+    hand = np.zeros((len(times), EeState.size))
+    hand[:, :2], hand[:, 2] = robot_path(times), 0.7
+    builder = DiagramBuilder()
+    visualizer = builder.AddSystem(ReachSceneVisualizer(meshcat, [[1.0, 0.0, 0.7]],
+                                                        hand_trail=True))
+    source = builder.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(
+        times, hand.T)))
+    builder.Connect(source.get_output_port(), visualizer.get_ee_state_input_port())
+    for port, value in ((visualizer.get_target_input_port(), np.zeros(Target.size)),
+                        (visualizer.get_selected_goal_input_port(), [-1.0])):
+        builder.Connect(builder.AddSystem(ConstantVectorSource(value)).get_output_port(),
+                        port)
+    replay = recorded(meshcat, builder.Build(), DURATION)
+    for time in (0.3, 1.0):
+        dots = shown_dots(replay, "/task/hand_trail", TRAIL_DOTS, time)
+        travelled = robot_path(np.linspace(0.0, time, 2001))
+        nearest = np.min(np.linalg.norm(dots[:, None, :2] - travelled[None], axis=2), axis=1)
+        assert nearest.max() < TRAIL_SPACING and len(dots) > 5
+        reached = np.linalg.norm(dots[-1, :2] - travelled[-1])
+        assert reached < 2 * TRAIL_SPACING, f"the trail ends {reached:.3f} m short"
+        np.testing.assert_allclose(dots[:, 2], 0.7)

@@ -8,7 +8,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.scene_framing import workspace_view
 from pbp_drake.systems.ports import EeState, PortGetters, Target, position_of
-from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots
+from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots, PathTrail
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
 TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
@@ -20,6 +20,9 @@ OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
 # Dots per path (each of TASK_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
 # every path update, so their count and rate set most of its size.
 PATH_DOTS = 24
+# The hand's trail (with `hand_trail`): up to this many dots, 2 cm apart at first.
+TRAIL_DOTS, TRAIL_DOT_RADIUS, TRAIL_SPACING = 300, 0.01, 0.02
+TRAIL_COLOUR = Rgba(0.2, 0.75, 0.3, 0.9)
 ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008
 OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
 # Up to this many objects are drawn as tables and cylinders; more are the goal cloud alone
@@ -76,7 +79,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
 
     def __init__(self, meshcat, objects, prediction_steps=0, path_count=1,
                  publish_period=1.0 / 30.0, path_period=0.1, cloud_period=0.25,
-                 workspace=None):
+                 workspace=None, hand_trail=False):
         super().__init__()
         self._meshcat = meshcat
         self._objects = np.asarray(objects, dtype=float)
@@ -103,6 +106,9 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
                              for index in range(1, path_count)]
         self._cloud = GoalCloud("/task/goal_cloud", self._objects + [0.0, 0.0, CLOUD_LIFT],
                                 CLOUD_POINT_SIZE)
+        # The hand's path as it grows (`pbp-drake teach`: the demonstration being recorded).
+        self._trail = (PathTrail("/task/hand_trail", TRAIL_DOTS, TRAIL_DOT_RADIUS,
+                                 TRAIL_COLOUR, TRAIL_SPACING) if hand_trail else None)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)
@@ -114,6 +120,8 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         # Whether the blue ball is drawn: a method that shows no intent (teleop) sends -1.
         self._ball_shown = True
         self._draw_scene()
+        if self._trail is not None:
+            self._trail.draw(self._meshcat, context.get_time())
         self._publish(context)
         if self._prediction_steps:
             self._publish_paths(context)
@@ -160,6 +168,8 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         if self._ee_state_port.HasValue(context):
             position = position_of(EeState(self._ee_state_port.Eval(context)))
             meshcat.SetTransform("/task/operator", RigidTransform(position), time)
+            if self._trail is not None:
+                self._trail.extend(meshcat, position, time)
             if self._operator_active_port.HasValue(context):
                 active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
                 meshcat.SetProperty("/task/operator", "visible", active, time)

@@ -1,7 +1,7 @@
 """The executed path in a 2-D replay (and a teaching run's hand path) is drawn as the robot
-goes: at each time of the replay
-the robot's trail (`/pbp/executed`, `PathTrail`) runs from the start to where the robot is
-then, never further, and nothing of it shows before the robot moves. A trail longer than
+goes: at each time of the replay the robot's trail (`/pbp/executed`, `PathTrail`) runs from
+the start to where the robot is then, never further, and nothing of it shows before the
+robot moves. A trail longer than
 its dots thins and still runs from the start, and its dots jump, not slide, when it does.
 
 Checked on Meshcat's recordings (`StaticHtml`, decoded by `replay_tracks`).

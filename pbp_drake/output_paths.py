@@ -112,12 +112,17 @@ def _draws(html, path):
 
 def is_replay(path):
     """Whether the file at `path` is a replay written by `pbp-drake run --record`."""
+    return _head_holds(path, REPLAY_MARKER.encode())
+
+
+def _head_holds(path, marker):
+    """Whether the first bytes of the file at `path` hold `marker` (False if unreadable)."""
     try:
         with open(path, "rb") as stream:
             head = stream.read(_MARKER_WINDOW)
     except OSError:
         return False
-    return REPLAY_MARKER.encode() in head
+    return marker in head
 
 
 def check_record_path(path, force=False):
@@ -155,12 +160,7 @@ def check_figure_path(path, flag="--figure"):
 
 
 def _is_primitive(path):
-    try:
-        with open(path, "rb") as file:
-            head = file.read(_MARKER_WINDOW)
-    except OSError:
-        return False
-    return b'"format": "pbp_drake.primitive"' in head
+    return _head_holds(path, b'"format": "pbp_drake.primitive"')
 
 
 def _check_output_file(path, flag, example, is_ours, kind, force):

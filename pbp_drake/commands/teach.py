@@ -20,7 +20,7 @@ from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
 from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
 from pbp_drake.output_paths import check_figure_path, check_log_path, check_primitive_path
-from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.scenarios import GraspTask, ScenarioError, load_scenario_file
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.primitive_figure import plot_primitive
 
@@ -68,6 +68,9 @@ def _teach(args):
     if scenario.task is None:
         raise ScenarioError("teach drives a robot task's hand; this scenario is a 2-D scene, "
                             "whose demonstration is scenario.demonstration")
+    if isinstance(scenario.task, GraspTask):
+        raise ScenarioError("teach drives the reaching and obstacle tasks; the grasping "
+                            "task's pose DMPs take no taught primitive")
     origin = args.source
     if origin is None:
         # The drive's rows are kept beside the primitive: a person's demonstration is not

@@ -114,6 +114,13 @@ def test_a_bad_recording_is_refused_in_one_line_naming_it(tmp_path, rows, messag
     assert not (tmp_path / "P.json").exists()
 
 
+def test_teach_refuses_the_grasping_task(tmp_path, capsys):
+    code, out = run("teach", REACH.with_name("hsr_grasp.yaml"), "--output",
+                    tmp_path / "P.json", capsys=capsys)
+    assert code == 2 and "the grasping task's pose DMPs take no taught primitive" in out.err
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_figure_that_is_not_an_image_file_is_refused_before_anything_runs(tmp_path,
                                                                              capsys):
     code, out = run("teach", REACH, "--output", tmp_path / "P.json", "--figure",

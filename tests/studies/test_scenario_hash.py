@@ -83,3 +83,19 @@ def test_a_later_robot_field_changes_the_hash_and_its_default_leaves_it(name, fi
     changed = dataclasses.replace(base, robot=dataclasses.replace(base.robot, **{field: value}))
     assert field in scenario_content(changed)["robot"]
     assert scenario_hash(changed) != scenario_hash(base)
+
+
+def test_a_taught_primitive_is_hashed_by_its_content_not_its_path(tmp_path):
+    base = scenario("hsr_reach.yaml")
+    assert "primitive" not in scenario_content(base)["dmp"]
+
+    def naming(path):
+        return dataclasses.replace(base, dmp=dataclasses.replace(base.dmp, primitive=str(path)))
+
+    first, copy, other = tmp_path / "a.json", tmp_path / "b.json", tmp_path / "c.json"
+    first.write_text('{"format": "pbp_drake.primitive", "weights": [1]}')
+    copy.write_text(first.read_text())
+    other.write_text('{"format": "pbp_drake.primitive", "weights": [2]}')
+    assert scenario_hash(naming(first)) == scenario_hash(naming(copy))
+    assert scenario_hash(naming(first)) != scenario_hash(naming(other))
+    assert scenario_hash(naming(first)) != scenario_hash(base)

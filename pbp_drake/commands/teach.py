@@ -77,7 +77,7 @@ def _teach(args):
         # to be driven twice.
         origin = str(pathlib.Path(args.output).with_suffix(".csv"))
         check_log_path(origin, force=args.force)
-        code = _drive(args, origin)
+        code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"))
         if code not in (EXIT_SUCCESS, EXIT_FAILED, EXIT_STOPPED):
             return code
     times, positions = read_hand_path(origin)
@@ -100,13 +100,15 @@ def _teach(args):
     return EXIT_SUCCESS
 
 
-def _drive(args, log):
+def _drive(args, log, switches):
     """The scenario run under teleop by `args.operator`, its per-tick rows in `log`: the
-    exit code of `pbp-drake run`."""
-    # One target from the start (the task's switches would put turns in the shape); the
-    # command line's own settings come after, and may change that.
+    exit code of `pbp-drake run`. A task whose target `switches` keeps one target."""
     argv = ["run", args.scenario, "--method", "teleop", "--operator", args.operator,
-            "--log", str(log), "--force", "--set", "task.switch_schedule=[0.0]"]
+            "--log", str(log), "--force"]
+    if switches:
+        # One target from the start (the switches would put turns in the shape); the
+        # command line's own settings come after, and may change that.
+        argv += ["--set", "task.switch_schedule=[0.0]"]
     for setting in args.settings:
         argv += ["--set", setting]
     if args.scenario_text is not None:

@@ -44,6 +44,18 @@ def test_a_taught_primitive_runs_from_a_scenario_beside_it(taught, capsys):
 
 
 @pytest.mark.slow
+def test_the_obstacle_task_teaches_a_primitive_it_then_runs(tmp_path, capsys):
+    # Its one target never switches: the drive keeps the task as it is.
+    obstacles = REACH.with_name("hsr_obstacles.yaml")
+    code, out = run("teach", obstacles, "--output", tmp_path / "P.json", capsys=capsys)
+    assert code == 0, out.err
+    code, out = run("run", obstacles, "--headless", "--set",
+                    f"dmp.primitive={tmp_path / 'P.json'}", capsys=capsys)
+    assert code == 0, out.err
+    assert "hsr_obstacles [pbp_alternated, seed 0]: success" in out.out
+
+
+@pytest.mark.slow
 def test_a_drive_s_recording_teaches_the_same_primitive(taught, tmp_path, capsys):
     code, out = run("teach", REACH, "--from", taught / "P.csv", "--output",
                     tmp_path / "again.json", "--figure", tmp_path / "again.png",

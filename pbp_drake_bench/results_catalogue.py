@@ -86,6 +86,13 @@ STUDIES = {
     "hsr_reach_bayesian": ["diagrams/hsr_reach_bayesian.yaml", "--methods", PBP,
                            "--trials", "30", "--split", "evaluation"],
     "hsr_obstacles_evaluation": [*OBSTACLES, "--split", "evaluation"],
+    # A still wall across the way (docs/tasks/teach.md): straight DMPs, and the primitive
+    # taught around its end.
+    "hsr_wall_evaluation": ["diagrams/hsr_wall.yaml", "--trials", "30", "--split",
+                            "evaluation"],
+    "hsr_wall_primitive_evaluation": [
+        "diagrams/hsr_wall.yaml", "--methods", PBP, "--trials", "30", "--split", "evaluation",
+        "--set", "dmp.primitive=primitives/around_the_wall.json"],
     "hsr_obstacles_tuning": [*OBSTACLES, "--split", "tuning"],
     "hsr_reach_fixed_alpha": ["diagrams/hsr_reach.yaml", "--methods", FIXED_ALPHAS,
                               "--trials", "30", "--split", "tuning"],

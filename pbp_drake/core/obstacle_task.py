@@ -24,11 +24,24 @@ class ObstacleScene:
 def sample_obstacle_scene(seed, x_range=(1.25, 2.5), y_range=(-1.05, 1.05), height=0.7,
                           obstacle_count=3, obstacle_x_range=(0.9, 2.6),
                           obstacle_y_range=(-1.3, 1.3), activation_range=(0.05, 0.5),
-                          clearance=0.45, robot_xy=(0.0, 0.0)):
+                          clearance=0.45, robot_xy=(0.0, 0.0), fixed_starts=None):
     """Draws a scene from `seed` alone. Obstacles start at least `clearance` from the
-    robot's base, the target and each other, so that nothing starts in collision."""
+    robot's base, the target and each other, so that nothing starts in collision. With
+    `fixed_starts` `(N, 2)` the obstacles start there (a wall may stand closer together),
+    and the target is drawn again until it is `clearance` from each."""
     rng = np.random.default_rng(seed)
     target = np.array([rng.uniform(*x_range), rng.uniform(*y_range), height])
+    if fixed_starts is not None:
+        starts = np.asarray(fixed_starts, float).reshape(-1, 2)
+        for _ in range(1000):
+            if np.all(np.linalg.norm(starts - target[:2], axis=1) >= clearance):
+                break
+            target = np.array([rng.uniform(*x_range), rng.uniform(*y_range), height])
+        else:
+            raise ValueError(f"cannot draw a target {clearance} m from every obstacle in x "
+                             f"{list(x_range)}, y {list(y_range)}")
+        thresholds = np.sort(rng.uniform(*activation_range, size=len(starts)))
+        return ObstacleScene(target=target, obstacle_starts=starts, thresholds=thresholds)
     keep_away = [np.asarray(robot_xy, float), target[:2]]
     starts = []
     for index in range(obstacle_count):

@@ -37,7 +37,8 @@ def task_scene(task, seed, reach=None):
         obstacles = sample_obstacle_scene(
             seed, tuple(task.x_range), tuple(task.y_range), task.height,
             task.obstacle_count, tuple(task.obstacle_x_range), tuple(task.obstacle_y_range),
-            tuple(task.activation_range), clearance=task.obstacle_spacing)
+            tuple(task.activation_range), clearance=task.obstacle_spacing,
+            fixed_starts=task.obstacle_starts or None)
         return TaskScene(objects=obstacles.target[np.newaxis, :], targets=(0,),
                           switch_schedule=(0.0,), obstacles=obstacles)
     if isinstance(task, GraspTask):

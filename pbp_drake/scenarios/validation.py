@@ -182,14 +182,24 @@ def check_grasp_task(task):
 
 def check_obstacle_task(task):
     require_finite(task, "scenario.task",
-                   ("success_distance", "obstacle_radius", "obstacle_height", "obstacle_speed",
+                   ("success_distance", "obstacle_radius", "obstacle_height",
                     "obstacle_spacing"))
+    require_finite(task, "scenario.task", ("obstacle_speed",), positive=False)
     # Obstacles start 0.45 m from each other, the robot and the target: a few dozen fit.
     # Without any, the station has no obstacle input for the task to drive.
     check_count(task.obstacle_count, "scenario.task.obstacle_count", 1, 100,
                 " (a task without obstacles is the reaching task: an untagged task)")
     for name in ("x_range", "y_range", "obstacle_x_range", "obstacle_y_range"):
         check_range(task, "scenario.task", name)
+    if task.obstacle_starts:
+        if len(task.obstacle_starts) != task.obstacle_count:
+            raise ScenarioError(f"scenario.task.obstacle_starts holds "
+                                f"{len(task.obstacle_starts)} starts; obstacle_count is "
+                                f"{task.obstacle_count}: give each obstacle one start")
+        for index, start in enumerate(task.obstacle_starts):
+            if len(start) != 2 or not all(math.isfinite(value) for value in start):
+                raise ScenarioError(f"scenario.task.obstacle_starts[{index}] {start} is no "
+                                    "floor position; expected two finite numbers (x, y)")
     check_range(task, "scenario.task", "activation_range", within=(0.0, 1.0))
 
 

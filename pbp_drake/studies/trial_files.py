@@ -75,7 +75,7 @@ def plain(value):
 # use them keeps the hash of study folders written before they existed (and these resume).
 # None: the scenario's own fields.
 _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects": 0,
-                          "grasps_per_object": 1},
+                          "grasps_per_object": 1, "obstacle_starts": []},
                  "operator": {"reposition_time": 4.0}, None: {"likely_paths": 3},
                  "robot": {"hardware": None, "ready_tool_pose": None, "singular_margin": 0.0},
                  "dmp": {"primitive": ""},

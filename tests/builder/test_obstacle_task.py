@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from pbp_drake.core.obstacle_task import sample_obstacle_scene, step_obstacles
-from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.scenarios import ScenarioError, load_scenario_file, resolve
 from pbp_drake.builder.run import run_task
 
 # Whole tasks, studies, notebooks, browsers or pip: `make test-fast` leaves these out.
@@ -66,8 +66,18 @@ def test_bad_obstacle_settings_name_the_field(tmp_path, repo):
     text = (repo / "diagrams" / "hsr_obstacles.yaml").read_text()
     path = tmp_path / "bad.yaml"
     path.write_text(text.replace("obstacle_speed: 0.4", "obstacle_speed: -1.0"))
-    with pytest.raises(ScenarioError, match="obstacle_speed must be finite and positive"):
+    with pytest.raises(ScenarioError, match="obstacle_speed must be finite and not negative"):
         load_scenario_file(path)
+    for starts, message in [("[[1.1, 0.0], [1.1, 0.3]]", "obstacle_starts holds 2 starts; "
+                             "obstacle_count is 3"),
+                            ("[[1.1, 0.0], [1.1, .nan], [1.0, 1.0]]",
+                             r"obstacle_starts\[1\]|obstacle_starts"),
+                            ("[[1.1], [1.1, 0.3], [1.0, 1.0]]",
+                             r"obstacle_starts\[0\] \[1.1\] is no floor position")]:
+        path.write_text(text.replace("obstacle_count: 3", f"obstacle_count: 3\n    "
+                                     f"obstacle_starts: {starts}"))
+        with pytest.raises(ScenarioError, match=message):
+            load_scenario_file(path)
     path.write_text(text.replace("activation_range: [0.05, 0.5]", "activation_range: [0.5, 0.1]"))
     with pytest.raises(ScenarioError, match="activation_range"):
         load_scenario_file(path)
@@ -99,3 +109,19 @@ def test_a_study_of_the_obstacle_task_records_collisions(tmp_path, repo):
     assert entry["collision_ratio"]["mean"] >= 0.2
     assert (output / "fig7c_collisions.png").stat().st_size > 0
     assert "| collision ratio | collision-free trials |" in (output / "results.md").read_text()
+
+
+def test_a_still_wall_stands_where_the_file_puts_it_and_the_target_keeps_clear(repo):
+    scenario = load_scenario_file(repo / "diagrams" / "hsr_wall.yaml").scenario
+    task = scenario.task
+    for seed in range(20):
+        scene = resolve(dataclasses.replace(scenario, seed=seed)).scene
+        np.testing.assert_array_equal(scene.obstacles.obstacle_starts, task.obstacle_starts)
+        gaps = np.linalg.norm(scene.obstacles.obstacle_starts - scene.objects[0, :2], axis=1)
+        assert gaps.min() >= task.obstacle_spacing
+    # Still: at speed 0 an obstacle that wakes stays where it stands.
+    starts = np.array(task.obstacle_starts)
+    positions, _, active = step_obstacles(starts, starts, np.zeros(3, bool), 1.0,
+                                          [0.5, 0.0], [2.0, 0.0], [0.1, 0.2, 0.3], 0.0, 0.03)
+    assert active.all()
+    np.testing.assert_array_equal(positions, starts)

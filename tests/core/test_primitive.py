@@ -2,7 +2,9 @@
 shape goes to other goals (both formulations), the document round-trips, and bad
 demonstrations and damaged documents are refused with what is wrong."""
 
+import importlib.util
 import json
+import pathlib
 
 import numpy as np
 import pytest
@@ -90,3 +92,22 @@ def _damaged(change):
 def test_a_damaged_document_is_refused_naming_the_field(change, message):
     with pytest.raises(ValueError, match=message):
         read_primitive_document(_damaged(change))
+
+
+def test_the_shipped_wall_primitive_is_its_scripted_demonstration_taught():
+    # diagrams/primitives/around_the_wall.py writes the demonstration; `pbp-drake teach
+    # --from` it wrote the JSON. Within 1e-9 of a fit made now: NumPy's sums may differ in
+    # their last bits from one version to another.
+    folder = pathlib.Path(__file__).resolve().parents[2] / "diagrams" / "primitives"
+    spec = importlib.util.spec_from_file_location("around_the_wall", folder / "around_the_wall.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    times, positions = script.demonstration()
+    recorded = np.loadtxt(folder / "around_the_wall.csv", delimiter=",", skiprows=1)
+    np.testing.assert_array_equal(recorded, np.column_stack([times, positions]))
+    shipped = read_primitive_document(json.loads((folder / "around_the_wall.json").read_text()))
+    now = teach_primitive(times, positions, shipped.settings)
+    assert shipped.settings == DmpSettings(formulation="pastor")
+    np.testing.assert_allclose(shipped.weights, now.weights, rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(shipped.positions, positions)
+    assert shipped.fit_error == pytest.approx(now.fit_error, rel=1e-9) and now.fit_error < 0.01

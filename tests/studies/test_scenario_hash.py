@@ -51,7 +51,9 @@ def test_a_renamed_station_field_keeps_the_name_folders_were_written_with():
 
 
 @pytest.mark.parametrize("name, field, value", [("hsr_reach.yaml", "grid_objects", 100),
-                                                ("hsr_grasp.yaml", "grasps_per_object", 30)])
+                                                ("hsr_grasp.yaml", "grasps_per_object", 30),
+                                                ("hsr_obstacles.yaml", "obstacle_starts",
+                                                 [[1.1, 0.0], [1.1, 0.3], [1.1, 0.6]])])
 def test_a_later_task_field_changes_the_hash_and_its_default_leaves_it(name, field, value):
     # A grid of objects in the reaching task; many grasps an object in the grasping task.
     base = scenario(name)

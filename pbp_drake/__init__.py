@@ -28,8 +28,8 @@ API_GROUPS = {
         "DmpSettings": "pbp_drake.core.dmp",
         "minimum_jerk": "pbp_drake.core.dmp",
         **{name: "pbp_drake.core.dmp.primitive" for name in [
-            "Primitive", "teach_primitive", "primitive_bank", "primitive_document",
-            "read_primitive_document"]},
+            "Primitive", "teach_primitive", "primitive_bank", "primitive_orientation_bank",
+            "primitive_document", "read_primitive_document"]},
         "OrientationDmp": "pbp_drake.core.dmp",
         "OrientationDmpBank": "pbp_drake.core.dmp",
         "GoalEstimatorSettings": "pbp_drake.core.goal_estimation",

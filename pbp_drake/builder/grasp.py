@@ -54,6 +54,7 @@ from pbp_drake.builder.operators import shown_intent_and_keys
 from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.core.controller_config import nominal_duration
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
+from pbp_drake.core.dmp.primitive import primitive_bank, primitive_orientation_bank
 from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.goal_estimation import READS_COMMAND, READS_INTENT, estimator_entry
 from pbp_drake.core.methods import ASSISTED, METHODS
@@ -107,13 +108,19 @@ def hand_over_limits(scenario):
 
 
 def grasp_dmp_banks(resolved, start_pose):
-    """The position and orientation banks, straight paths from the hand's `start_pose`
-    `[p, q]` to the K grasp poses, one duration (the farthest grasp at the nominal speed;
-    with goal groups the median grasp: `nominal_duration`), so that they share one phase."""
+    """The position and orientation banks, straight paths (or the taught primitive's pose
+    shape) from the hand's `start_pose` `[p, q]` to the K grasp poses, one duration (the
+    farthest grasp at the nominal speed; with goal groups the median grasp:
+    `nominal_duration`), so that they share one phase."""
     scenario = resolved.scenario
     goals = resolved.scene.grasps.grasp_positions
+    primitive = resolved.controller.dmp_primitive
     duration = (scenario.dmp_duration if scenario.dmp_duration > 0 else nominal_duration(
-        start_pose[:3], goals, resolved.nominal_speed, scenario.goal_estimator.group_mass > 0.0))
+        start_pose[:3], goals, resolved.nominal_speed, scenario.goal_estimator.group_mass > 0.0,
+        primitive.length_ratio if primitive else 1.0))
+    if primitive is not None:  # a taught pose's shape (`dmp.primitive`)
+        return (primitive_bank(primitive, start_pose[:3], len(goals), duration),
+                primitive_orientation_bank(primitive, start_pose[3:7], len(goals), duration))
     return (DmpBankModel.straight(start_pose[:3], len(goals), duration, scenario.dmp),
             OrientationDmpBank.straight(start_pose[3:7], len(goals), duration, scenario.dmp))
 
@@ -352,4 +359,5 @@ def grasp_series_fields(times, hand_poses, decisions, grasp_orientations):
         in_collision=None,
         angles_to_target=angles,
         command_angular_velocities=commands[:, 10:13],
-        operator_twists=twists)
+        operator_twists=twists,
+        hand_orientations=orientations)

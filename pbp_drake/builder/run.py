@@ -156,6 +156,8 @@ class TaskResult:
         command_angular_velocities: (T, 3) the commanded angular velocity (rad/s) sent from
             tick k on; operator_twists: (T, 6) the operator's whole twist (the grasping
             task; None in the others). `operator_commands` there is `[v, wz]`.
+        hand_orientations: (T, 4) the hand's orientation, unit quaternions (w, x, y, z)
+            (the grasping task; None in the others).
         peak_command_angular_change: rad/s, the largest change of the commanded angular
             velocity between two ticks (the grasping task; None in the others).
         final_angle_to_target: degrees, `angles_to_target` of the last tick (the grasping
@@ -195,6 +197,7 @@ class TaskResult:
     angles_to_target: np.ndarray | None = None
     command_angular_velocities: np.ndarray | None = None
     operator_twists: np.ndarray | None = None
+    hand_orientations: np.ndarray | None = None
     peak_command_angular_change: float | None = None
     final_angle_to_target: float | None = None
     posterior_clipped_ratio: float | None = None

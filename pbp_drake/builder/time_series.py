@@ -6,9 +6,11 @@ import numpy as np
 
 
 # The grasping task's orientation columns (`TaskResult.angles_to_target`, degrees; the
-# commanded and the operator's angular velocities, rad/s, world frame).
+# commanded and the operator's angular velocities, rad/s, world frame; the hand's
+# orientation, a unit quaternion w, x, y, z: what `pbp-drake teach` fits a pose from).
 GRASP_COLUMNS = ["angle_to_target", "command_wx", "command_wy", "command_wz",
-                 "operator_wx", "operator_wy", "operator_wz"]
+                 "operator_wx", "operator_wy", "operator_wz",
+                 "hand_qw", "hand_qx", "hand_qy", "hand_qz"]
 
 
 def time_series_columns(has_collision, has_grasp=False):
@@ -34,8 +36,9 @@ def time_series_rows(series):
     TaskResult, or any object with its time series attributes (`times`, `ee_positions`,
     `headings`, `commands`, `operator_active`, `operator_commands`, `selected_goals`,
     `targets`, `in_collision`; the grasping task's `angles_to_target`,
-    `command_angular_velocities` and `operator_twists` too). Floats are written in their shortest
-    exact form, so reading them back gives the same numbers."""
+    `command_angular_velocities`, `operator_twists` and `hand_orientations` too). Floats
+    are written in their shortest exact form, so reading them back gives the same
+    numbers."""
     has_collision = series.in_collision is not None
     has_grasp = _has_grasp(series)
     # Python lists once, not a numpy scalar per cell: the same numbers (repr of the same
@@ -47,9 +50,9 @@ def time_series_rows(series):
             series.targets))
     collisions = np.asarray(series.in_collision).tolist() if has_collision else None
     if has_grasp:
-        angles, angular, twists = (np.asarray(values).tolist() for values in (
+        angles, angular, twists, hand = (np.asarray(values).tolist() for values in (
             series.angles_to_target, series.command_angular_velocities,
-            np.asarray(series.operator_twists)[:, 3:]))
+            np.asarray(series.operator_twists)[:, 3:], series.hand_orientations))
     lines = []
     for k in range(len(times)):
         row = [times[k], *ee[k], headings[k], *commands[k]]
@@ -60,7 +63,7 @@ def time_series_rows(series):
         if has_collision:
             row.append(str(int(bool(collisions[k]))))
         if has_grasp:
-            row += [repr(float(x)) for x in (angles[k], *angular[k], *twists[k])]
+            row += [repr(float(x)) for x in (angles[k], *angular[k], *twists[k], *hand[k])]
         lines.append(",".join(row) + "\n")
     return "".join(lines)
 

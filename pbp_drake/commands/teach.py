@@ -1,11 +1,11 @@
-"""`pbp-drake teach FILE --output P.json`: a primitive taught by driving. The scenario's task
-runs under teleop with the chosen operator (a person in the page presses Start, drives the
-hand from its start toward a goal and presses Stop; the virtual participant drives to its
-target headless), the hand's path from the start to the end of the run is fitted with the
-scenario's DMP settings (`pbp_drake.core.dmp.primitive`), and the primitive is saved, to
-be named by any scenario's `dmp: {primitive: P.json}`. The run's rows are kept beside
-the primitive (`P.csv`). `--from CSV` teaches from a path already recorded (`run --log`, a
-study trial's CSV) instead.
+"""`pbp-drake teach FILE --output P.json`: a primitive taught by driving (the grasping task: a
+pose's). The scenario's task runs under teleop with the chosen operator (a person in the
+page presses Start, drives the hand from its start toward a goal and presses Stop; the
+virtual participant drives to its target headless), the hand's path from the start to the
+end of the run is fitted with the scenario's DMP settings (`pbp_drake.core.dmp.primitive`),
+and the primitive is saved, to be named by any scenario's `dmp: {primitive: P.json}`. The
+run's rows are kept beside the primitive (`P.csv`). `--from CSV` teaches from a path already
+recorded (`run --log`, a study trial's CSV) instead.
 """
 
 import argparse
@@ -26,8 +26,10 @@ from pbp_drake.studies.primitive_figure import plot_primitive
 
 #: The operators who can drive a demonstration.
 TEACHERS = ("virtual", "keyboard", "gamepad")
-# The columns of the hand's path in a run's or trial's CSV.
+# The columns of the hand's path in a run's or trial's CSV, and of its orientation (the
+# grasping task's).
 _TIME, _HAND = "time", ("ee_x", "ee_y", "ee_z")
+_QUATERNION = ("hand_qw", "hand_qx", "hand_qy", "hand_qz")
 
 
 def add_teach_command(commands):
@@ -68,9 +70,6 @@ def _teach(args):
     if scenario.task is None:
         raise ScenarioError("teach drives a robot task's hand; this scenario is a 2-D scene, "
                             "whose demonstration is scenario.demonstration")
-    if isinstance(scenario.task, GraspTask):
-        raise ScenarioError("teach drives the reaching and obstacle tasks; the grasping "
-                            "task's pose DMPs take no taught primitive")
     origin = args.source
     if origin is None:
         # The drive's rows are kept beside the primitive: a person's demonstration is not
@@ -80,9 +79,12 @@ def _teach(args):
         code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"))
         if code not in (EXIT_SUCCESS, EXIT_FAILED, EXIT_STOPPED):
             return code
-    times, positions = read_hand_path(origin)
+    times, positions, orientations = read_hand_path(origin)
+    if isinstance(scenario.task, GraspTask) and orientations is None:
+        raise ScenarioError(f"{origin}: the grasping task teaches a pose: the recording needs "
+                            f"the columns {', '.join(_QUATERNION)} (a grasping run's)")
     try:
-        primitive = teach_primitive(times, positions, scenario.dmp)
+        primitive = teach_primitive(times, positions, scenario.dmp, orientations)
     except ValueError as error:
         raise ScenarioError(f"{origin}: {error}") from None
     write_atomically(pathlib.Path(args.output), json.dumps(primitive_document(primitive)))
@@ -91,7 +93,10 @@ def _teach(args):
     print(f"Taught from {len(primitive.times)} samples over {primitive.duration:.2f} s, from "
           f"[{start}] to [{goal}] m, {primitive.length_ratio:.2f} times the straight "
           f"distance; the {primitive.settings.formulation} DMP reproduces it within "
-          f"{primitive.fit_error * 1000:.1f} mm RMS. Saved to {args.output}: name it in a "
+          f"{primitive.fit_error * 1000:.1f} mm RMS"
+          + ("" if primitive.orientation is None else
+             f", its turn within {np.degrees(primitive.orientation.fit_error):.1f} degrees RMS")
+          + f". Saved to {args.output}: name it in a "
           f"scenario as dmp: {{primitive: {args.output}}}", flush=True)
     if args.figure is not None:
         plot_primitive(primitive, scenario_file.resolved.scene.objects, args.figure)
@@ -126,8 +131,9 @@ def _drive(args, log, switches):
 
 
 def read_hand_path(path):
-    """Times (T,) and hand positions (T, 3) of a run's or trial's CSV; ScenarioError naming
-    the file for one that cannot be read or has no hand path."""
+    """Times (T,), hand positions (T, 3) and orientations (T, 4; None where the recording
+    has none) of a run's or trial's CSV; ScenarioError naming the file for one that cannot
+    be read or has no hand path."""
     try:
         with open(path, newline="") as file:
             rows = list(csv.DictReader(file))
@@ -137,9 +143,11 @@ def read_hand_path(path):
     if not rows or any(name not in rows[0] for name in columns):
         raise ScenarioError(f"{path}: not a run's path: it needs the columns "
                             f"{', '.join(columns)} (pbp-drake run --log writes them)")
+    if all(name in rows[0] for name in _QUATERNION):
+        columns += _QUATERNION
     try:
         table = np.array([[float(row[name]) for name in columns] for row in rows])
     except (TypeError, ValueError):
         raise ScenarioError(f"{path}: a value of {', '.join(columns)} is not a number"
                             ) from None
-    return table[:, 0], table[:, 1:]
+    return table[:, 0], table[:, 1:4], (table[:, 4:8] if table.shape[1] == 8 else None)

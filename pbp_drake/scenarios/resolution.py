@@ -447,10 +447,10 @@ def _taught_primitive(scenario, task):
     if not dmp.primitive:
         return None
     field = f"scenario.dmp.primitive {dmp.primitive}"
-    if isinstance(task, GraspTask):
-        raise ScenarioError(f"{field}: the grasping task's pose DMPs take no taught "
-                            "primitive; the reaching and obstacle tasks do")
     primitive = load_primitive(dmp.primitive, field)
+    if isinstance(task, GraspTask) and primitive.orientation is None:
+        raise ScenarioError(f"{field} teaches positions alone; the grasping task's DMPs "
+                            "move the hand's pose: teach it on a grasping task")
     if primitive.dimension != 3:
         raise ScenarioError(f"{field} teaches {primitive.dimension}-D paths; the task's "
                             "DMPs move the hand in 3-D")

@@ -328,6 +328,9 @@ def load_task_result(output, method, seed):
             operator_twists=np.column_stack([series[c] for c in (
                 "operator_vx", "operator_vy", "operator_vz", "operator_wx", "operator_wy",
                 "operator_wz")]))
+        if "hand_qw" in series:  # not in trial files written before it was logged
+            grasp["hand_orientations"] = np.column_stack(
+                [series[c] for c in ("hand_qw", "hand_qx", "hand_qy", "hand_qz")])
     return TaskResult(
         success=record["success"], task_time=record["task_time"],
         intervention_ratio=record["intervention_ratio"], switches=record["switches"],

@@ -11,8 +11,9 @@ import pytest
 
 from pbp_drake.core.dmp import DmpSettings, FORMULATIONS
 from pbp_drake.core.dmp.primitive import (
-    FORMAT_VERSION, primitive_bank, primitive_document, read_primitive_document,
-    teach_primitive)
+    FORMAT_VERSION, primitive_bank, primitive_document, primitive_orientation_bank,
+    read_primitive_document, teach_primitive)
+from pbp_drake.core.quaternion import angle_between
 
 START, GOAL = np.array([0.5, 0.0, 0.7]), np.array([1.5, 0.2, 0.7])
 BEND = 0.25  # m: how high the demonstration rises over a low wall half way
@@ -111,3 +112,47 @@ def test_the_shipped_wall_primitive_is_its_scripted_demonstration_taught():
     np.testing.assert_allclose(shipped.weights, now.weights, rtol=1e-9, atol=1e-9)
     np.testing.assert_array_equal(shipped.positions, positions)
     assert shipped.fit_error == pytest.approx(now.fit_error, rel=1e-9) and now.fit_error < 0.01
+
+
+def turning_while_reaching(samples=200, duration=4.0):
+    """The wall's reach, the hand turning 90 degrees about z and tipping 30 degrees on the
+    way (a grasp from above): times, positions and unit quaternions (w, x, y, z)."""
+    times, positions = over_a_wall(samples, duration)
+    s = times / duration
+    progress = 10 * s**3 - 15 * s**4 + 6 * s**5  # from rest to rest, as the reach
+    yaw, tip = np.pi / 2 * progress, np.radians(30) * np.sin(np.pi * progress)
+    about_z = np.column_stack([np.cos(yaw / 2), 0 * s, 0 * s, np.sin(yaw / 2)])
+    about_x = np.column_stack([np.cos(tip / 2), np.sin(tip / 2), 0 * s, 0 * s])
+    w1, v1 = about_z[:, :1], about_z[:, 1:]
+    w2, v2 = about_x[:, :1], about_x[:, 1:]
+    product = np.column_stack([w1 * w2 - np.sum(v1 * v2, axis=1, keepdims=True),
+                               w1 * v2 + w2 * v1 + np.cross(v1, v2)])
+    return times, positions, product
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_a_pose_demonstration_teaches_its_turn_too(formulation):
+    times, positions, orientations = turning_while_reaching()
+    primitive = teach_primitive(times, positions, DmpSettings(formulation=formulation),
+                                orientations)
+    assert primitive.fit_error < 0.01 and primitive.orientation.fit_error < np.radians(1.0)
+    again = read_primitive_document(json.loads(json.dumps(primitive_document(primitive))))
+    np.testing.assert_array_equal(again.orientation.weights, primitive.orientation.weights)
+    assert again.orientation.fit_error == primitive.orientation.fit_error
+    # Sent to another final orientation, the bank ends there.
+    goal = orientations[-1][[0, 3, 2, 1]] * [1, 1, 1, -1]
+    goal /= np.linalg.norm(goal)
+    bank = primitive_orientation_bank(primitive, orientations[0], 1, 4.0)
+    phase, orientation, velocity = bank.initial_state()
+    paths = bank.predict(phase, orientation, velocity, goal[:, None], 0.01, 600)
+    assert angle_between(paths[0][-1], goal) < np.radians(1.0)
+
+
+def test_a_damaged_orientation_is_refused_naming_the_field():
+    times, positions, orientations = turning_while_reaching()
+    document = primitive_document(teach_primitive(times, positions, DmpSettings(),
+                                                  orientations))
+    document["orientation"]["quaternions"].pop()
+    with pytest.raises(ValueError, match=r"orientation.weights \(50, 3\) and "
+                                         r"orientation.quaternions \(199, 4\) do not fit"):
+        read_primitive_document(document)

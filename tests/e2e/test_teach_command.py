@@ -100,13 +100,33 @@ def test_a_bad_primitive_is_refused_in_one_line_naming_the_file(taught, tmp_path
     assert len(out.err.strip().splitlines()) == 1, out.err
 
 
-def test_a_missing_primitive_and_the_grasping_task_are_refused(tmp_path, capsys):
+def test_a_missing_primitive_is_refused(tmp_path, capsys):
     code, out = run("run", REACH, "--headless", "--set",
                     f"dmp.primitive={tmp_path / 'none.json'}", capsys=capsys)
     assert code == 2 and "none.json cannot be read" in out.err
-    code, out = run("run", REACH.with_name("hsr_grasp.yaml"), "--headless", "--set",
-                    f"dmp.primitive={tmp_path / 'none.json'}", capsys=capsys)
-    assert code == 2 and "the grasping task's pose DMPs take no taught primitive" in out.err
+
+
+@pytest.mark.slow
+def test_the_grasping_task_teaches_a_pose_and_refuses_a_position_primitive(taught, tmp_path,
+                                                                           capsys):
+    grasp = REACH.with_name("hsr_grasp.yaml")
+    code, out = run("teach", grasp, "--output", tmp_path / "pose.json", capsys=capsys)
+    assert code == 0, out.err
+    assert "its turn within" in out.out
+    document = json.loads((tmp_path / "pose.json").read_text())
+    assert len(document["orientation"]["quaternions"][0]) == 4
+    code, out = run("run", grasp, "--headless", "--set",
+                    f"dmp.primitive={tmp_path / 'pose.json'}", capsys=capsys)
+    assert code == 0, out.err
+    assert "hsr_grasp [pbp_alternated, seed 0]: success" in out.out
+    # The reaching task's primitive has no turn to give the hand's orientation.
+    code, out = run("run", grasp, "--headless", "--set",
+                    f"dmp.primitive={taught / 'P.json'}", capsys=capsys)
+    assert code == 2 and "teaches positions alone" in out.err
+    # Nor does the reaching task's recording teach a grasp.
+    code, out = run("teach", grasp, "--from", taught / "P.csv", "--output",
+                    tmp_path / "again.json", capsys=capsys)
+    assert code == 2 and "the grasping task teaches a pose" in out.err
 
 
 @pytest.mark.parametrize("rows, message", [
@@ -124,13 +144,6 @@ def test_a_bad_recording_is_refused_in_one_line_naming_it(tmp_path, rows, messag
     assert code == 2
     assert message in out.err and str(recording) in out.err
     assert not (tmp_path / "P.json").exists()
-
-
-def test_teach_refuses_the_grasping_task(tmp_path, capsys):
-    code, out = run("teach", REACH.with_name("hsr_grasp.yaml"), "--output",
-                    tmp_path / "P.json", capsys=capsys)
-    assert code == 2 and "the grasping task's pose DMPs take no taught primitive" in out.err
-    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_figure_that_is_not_an_image_file_is_refused_before_anything_runs(tmp_path,

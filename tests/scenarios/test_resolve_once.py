@@ -50,8 +50,10 @@ def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     scenario = loaded.scenario
     assert work["bent_path"] == (1 if isinstance(scenario.demonstration, BentPath) else 0)
     # Once, where the DMPs run: the 2-D scenes' when resolved, the tasks' in their
-    # controller (the grasping task's from the pose station's hand).
-    assert work["fit_weights"] == 1
+    # controller (the grasping task's from the pose station's hand); never for a task's
+    # straight Pastor DMPs, whose forcing term is 0.
+    straight_pastor = scenario.task is not None and scenario.dmp.formulation == "pastor"
+    assert work["fit_weights"] == (0 if straight_pastor else 1)
     scenes = (work["sample_reach_scene"] + work["sample_obstacle_scene"]
               + work["sample_grasp_scene"])
     assert scenes == (1 if scenario.task is not None else 0)

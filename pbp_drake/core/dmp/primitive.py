@@ -1,5 +1,7 @@
 """A primitive taught by driving: ONE demonstration's DMP shape, kept as a document and sent
 to any goal (`pbp-drake teach` writes one; a scenario's `dmp: {primitive: FILE}` reads it).
+A demonstration of poses (the grasping task's hand) also teaches an orientation shape,
+fitted by the orientation DMP (`fit_orientation_weights`) and carried the same way.
 
 `teach_primitive(times, positions, settings)` fits the demonstration (`fit_weights`, either
 formulation) and measures the fit: the DMP rolled out from the demonstration's start to its
@@ -15,15 +17,21 @@ The document (`primitive_document`, `read_primitive_document`) is plain JSON dat
 - `dimension`, `weights` (basis_count rows of `dimension` numbers), `amplitude_scaling`;
 - `demonstration`: its `times` (s) and `positions` (m), from which `start`, `goal`,
   `duration` and `length_ratio` (path length over start-to-goal distance) follow;
-- `fit_error` (m).
+- `fit_error` (m);
+- `orientation` (poses only): its `weights` (basis_count rows of 3), `amplitude_scaling`,
+  `quaternions` (w, x, y, z, one a sample) and `fit_error` (rad, RMS angle).
 """
 
 import dataclasses
 
 import numpy as np
 
+from pbp_drake.core import quaternion
 from pbp_drake.core.dmp.bank import DmpBankModel
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
+from pbp_drake.core.dmp.orientation import (
+    OrientationDmp, fit_orientation_weights, validate_orientation_demonstration)
+from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
 from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import Dmp
 
@@ -41,9 +49,21 @@ SETTINGS_FIELDS = ("formulation", "basis_count", "alpha_z", "beta_z", "alpha_x")
 
 
 @dataclasses.dataclass(frozen=True)
+class OrientationShape:
+    """A taught orientation shape: `weights` (N, 3), `amplitude_scaling` (3,), the
+    demonstration's `quaternions` (T, 4) and `fit_error` (rad)."""
+
+    weights: np.ndarray
+    amplitude_scaling: np.ndarray
+    quaternions: np.ndarray
+    fit_error: float
+
+
+@dataclasses.dataclass(frozen=True)
 class Primitive:
     """A taught DMP shape: the fit's `settings`, `weights` (N, D), `amplitude_scaling`
-    (D,), the demonstration (`times` (T,), `positions` (T, D)) and `fit_error` (m)."""
+    (D,), the demonstration (`times` (T,), `positions` (T, D)) and `fit_error` (m); with
+    `orientation` (an `OrientationShape`) a pose's."""
 
     settings: DmpSettings
     weights: np.ndarray
@@ -51,6 +71,7 @@ class Primitive:
     times: np.ndarray
     positions: np.ndarray
     fit_error: float
+    orientation: OrientationShape | None = None
 
     @property
     def dimension(self):
@@ -76,9 +97,10 @@ class Primitive:
         return float(length / np.linalg.norm(self.goal - self.start))
 
 
-def teach_primitive(times, positions, settings=DmpSettings()) -> Primitive:
-    """The primitive of one demonstration `times` (T,), `positions` (T, D); ValueError when
-    it is too short, does not move, or has NaN (the message says which)."""
+def teach_primitive(times, positions, settings=DmpSettings(), orientations=None) -> Primitive:
+    """The primitive of one demonstration `times` (T,), `positions` (T, D), and with
+    `orientations` (T, 4) its poses'; ValueError when it is too short, does not move, or has
+    NaN (the message says which)."""
     times, positions = validate_demonstration(times, positions)
     if len(times) < MIN_SAMPLES:
         raise ValueError(f"the demonstration has {len(times)} samples; at least "
@@ -89,8 +111,29 @@ def teach_primitive(times, positions, settings=DmpSettings()) -> Primitive:
                          f"primitive needs at least {MIN_TRAVEL} m")
     weights, scaling = fit_weights(times, positions, settings)
     fit = _fit_error(times, positions, weights, scaling, settings)
-    return Primitive(dataclasses.replace(settings), weights, scaling, times - times[0],
-                     positions, fit)
+    shape = None if orientations is None else _orientation_shape(times, orientations, settings)
+    return Primitive(dataclasses.replace(settings, primitive=""), weights, scaling,
+                     times - times[0], positions, fit, shape)
+
+
+def _orientation_shape(times, orientations, settings):
+    """The orientation part of a pose demonstration: its fit, and the RMS angle (rad) of
+    its orientation DMP rolled out to its own goal against it."""
+    try:
+        times, orientations = validate_orientation_demonstration(times, orientations)
+    except ValueError as error:
+        raise ValueError(f"the demonstration's orientations: {error}") from None
+    weights, scaling = fit_orientation_weights(times, orientations, settings)
+    duration = times[-1] - times[0]
+    dmp = OrientationDmp(weights, orientations[0], orientations[-1], duration, settings,
+                         scaling)
+    steps = len(times) - 1
+    path = dmp.rollout(duration / steps)
+    at = np.linspace(0.0, duration, steps + 1)
+    nearest = np.clip(np.searchsorted(at, times - times[0]), 0, steps)
+    angles = quaternion.angle_between(path[nearest].T, orientations.T)
+    return OrientationShape(weights, scaling, orientations,
+                            float(np.sqrt(np.mean(angles ** 2))))
 
 
 def _fit_error(times, positions, weights, scaling, settings):
@@ -114,15 +157,30 @@ def primitive_bank(primitive: Primitive, start, goal_count, duration=None) -> Dm
                         primitive.settings, primitive.amplitude_scaling, goal_count)
 
 
+def primitive_orientation_bank(primitive: Primitive, start, goal_count,
+                               duration=None) -> OrientationDmpBank:
+    """`goal_count` orientation DMPs from the unit quaternion `start` with the primitive's
+    orientation shape (it must have one), of `duration` (s; the demonstration's when None)."""
+    shape = primitive.orientation
+    return OrientationDmpBank(shape.weights, start,
+                              primitive.duration if duration is None else duration,
+                              primitive.settings, shape.amplitude_scaling, goal_count)
+
+
 def primitive_document(primitive: Primitive) -> dict:
     """The primitive as plain JSON data (the module's docstring)."""
+    orientation = primitive.orientation
+    pose = {} if orientation is None else {"orientation": {
+        "weights": orientation.weights.tolist(),
+        "amplitude_scaling": orientation.amplitude_scaling.tolist(),
+        "quaternions": orientation.quaternions.tolist(), "fit_error": orientation.fit_error}}
     return {"format": PRIMITIVE_FORMAT, "version": FORMAT_VERSION,
             "settings": {name: getattr(primitive.settings, name) for name in SETTINGS_FIELDS},
             "dimension": primitive.dimension, "weights": primitive.weights.tolist(),
             "amplitude_scaling": primitive.amplitude_scaling.tolist(),
             "demonstration": {"times": primitive.times.tolist(),
                               "positions": primitive.positions.tolist()},
-            "fit_error": primitive.fit_error}
+            "fit_error": primitive.fit_error, **pose}
 
 
 def read_primitive_document(document) -> Primitive:
@@ -149,10 +207,7 @@ def read_primitive_document(document) -> Primitive:
     times = _numbers(demonstration.get("times"), "demonstration.times", 1)
     positions = _numbers(demonstration.get("positions"), "demonstration.positions", 2)
     weights = _numbers(document.get("weights"), "weights", 2)
-    scaling = document.get("amplitude_scaling")
-    if (not isinstance(scaling, list) or len(scaling) != dimension
-            or not all(isinstance(value, bool) for value in scaling)):
-        raise ValueError(f"amplitude_scaling must be {dimension} true or false values")
+    scaling = _flags(document.get("amplitude_scaling"), "amplitude_scaling", dimension)
     if positions.shape[1] != dimension or weights.shape != (settings.basis_count, dimension):
         raise ValueError(f"weights {weights.shape} and demonstration.positions "
                          f"{positions.shape} do not fit dimension {dimension} and "
@@ -161,11 +216,43 @@ def read_primitive_document(document) -> Primitive:
         times, positions = validate_demonstration(times, positions)
     except ValueError as error:
         raise ValueError(f"demonstration: {error}") from None
-    fit_error = document.get("fit_error")
-    if not isinstance(fit_error, (int, float)) or not np.isfinite(fit_error) or fit_error < 0:
-        raise ValueError(f"fit_error must be a finite number >= 0, got {fit_error!r}")
-    return Primitive(settings, weights, np.array(scaling, bool), times, positions,
-                     float(fit_error))
+    fit_error = _fit_error_field(document, "fit_error")
+    orientation = None
+    if "orientation" in document:
+        orientation = _read_orientation(_field(document, "orientation", dict), settings,
+                                        times)
+    return Primitive(settings, weights, scaling, times, positions, fit_error, orientation)
+
+
+def _read_orientation(document, settings, times):
+    weights = _numbers(document.get("weights"), "orientation.weights", 2)
+    quaternions = _numbers(document.get("quaternions"), "orientation.quaternions", 2)
+    scaling = _flags(document.get("amplitude_scaling"), "orientation.amplitude_scaling", 3)
+    if weights.shape != (settings.basis_count, 3) or quaternions.shape != (len(times), 4):
+        raise ValueError(f"orientation.weights {weights.shape} and orientation.quaternions "
+                         f"{quaternions.shape} do not fit basis_count {settings.basis_count} "
+                         f"and the demonstration's {len(times)} samples")
+    try:
+        _, quaternions = validate_orientation_demonstration(times, quaternions)
+    except ValueError as error:
+        raise ValueError(f"orientation.quaternions: {error}") from None
+    return OrientationShape(weights, scaling, quaternions,
+                            _fit_error_field(document, "orientation.fit_error"))
+
+
+def _fit_error_field(document, name):
+    value = document.get(name.rsplit(".", 1)[-1])
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not (
+            np.isfinite(value) and value >= 0):
+        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return float(value)
+
+
+def _flags(value, name, count):
+    if (not isinstance(value, list) or len(value) != count
+            or not all(isinstance(flag, bool) for flag in value)):
+        raise ValueError(f"{name} must be {count} true or false values")
+    return np.array(value, bool)
 
 
 def _field(document, name, kind):

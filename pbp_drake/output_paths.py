@@ -11,6 +11,9 @@ import os
 import pathlib
 import re
 
+import msgpack
+import numpy as np
+
 from pbp_drake.builder.time_series import time_series_header
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.systems.visualizers.point_scene_visualizer import LEGEND as SCENE_2D_LEGEND
@@ -103,6 +106,28 @@ def legend_html(entries):
 def _css_colour(colour):
     red, green, blue = (round(255 * value) for value in (colour.r(), colour.g(), colour.b()))
     return f"rgba({red}, {green}, {blue}, {colour.a():g})"
+
+
+def replay_track(html, path, track):
+    """`(times (T,), values (T, ...))` of the animation track `track` (e.g. ".position") of
+    the Meshcat `path` in a replay's recording, times in seconds; ValueError when the page
+    records none (Meshcat keeps a recording as one `set_animation` command, its clips'
+    keys by frame)."""
+    for payload in _PAYLOAD.findall(html):
+        data = base64.b64decode(payload)
+        if b"set_animation" not in data:
+            continue
+        command = msgpack.unpackb(data, raw=False, strict_map_key=False)
+        for animation in command.get("animations", []):
+            if animation.get("path") != path:
+                continue
+            clip = animation["clip"]
+            for recorded in clip["tracks"]:
+                if recorded["name"] == track:
+                    keys = recorded["keys"]
+                    return (np.array([key["time"] / clip["fps"] for key in keys], float),
+                            np.array([key["value"] for key in keys], float))
+    raise ValueError(f"the replay records no {track} of {path}")
 
 
 def _draws(html, path):

@@ -19,7 +19,8 @@ from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS, port
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
 from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
-from pbp_drake.output_paths import check_figure_path, check_log_path, check_primitive_path
+from pbp_drake.output_paths import (
+    check_figure_path, check_log_path, check_primitive_path, is_replay, replay_track)
 from pbp_drake.scenarios import GraspTask, ScenarioError, load_scenario_file
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.primitive_figure import plot_primitive
@@ -30,6 +31,8 @@ TEACHERS = ("virtual", "keyboard", "gamepad")
 # grasping task's).
 _TIME, _HAND = "time", ("ee_x", "ee_y", "ee_z")
 _QUATERNION = ("hand_qw", "hand_qx", "hand_qy", "hand_qz")
+# Where the reaching and obstacle tasks' page keeps a marker at the hand (a replay's track).
+HAND_MARKER = "/task/operator"
 
 
 def add_teach_command(commands):
@@ -44,9 +47,9 @@ def add_teach_command(commands):
     parser.add_argument("--operator", choices=TEACHERS, default="virtual",
                         help="who drives: virtual (default, headless: the virtual participant "
                         "drives to its target), keyboard or gamepad (you, in the page)")
-    parser.add_argument("--from", dest="source", metavar="FILE.csv",
+    parser.add_argument("--from", dest="source", metavar="FILE",
                         help="teach from a recorded path instead of driving: a run's --log "
-                        "CSV or a study trial's CSV")
+                        "CSV, a study trial's CSV, or a run's --record replay")
     parser.add_argument("--seed", type=int, help="--set seed=N: the scene driven in")
     parser.add_argument("--figure", metavar="FILE.png",
                         help="also draw the demonstration, its reproduction and the shape "
@@ -132,8 +135,11 @@ def _drive(args, log, switches):
 
 def read_hand_path(path):
     """Times (T,), hand positions (T, 3) and orientations (T, 4; None where the recording
-    has none) of a run's or trial's CSV; ScenarioError naming the file for one that cannot
-    be read or has no hand path."""
+    has none) of a run's or trial's CSV, or of a run's replay (`run --record`: the hand's
+    positions as its page drew them, at the recording's frame rate); ScenarioError naming
+    the file for one that cannot be read or has no hand path."""
+    if is_replay(path):
+        return _replay_hand_path(path)
     try:
         with open(path, newline="") as file:
             rows = list(csv.DictReader(file))
@@ -151,3 +157,21 @@ def read_hand_path(path):
         raise ScenarioError(f"{path}: a value of {', '.join(columns)} is not a number"
                             ) from None
     return table[:, 0], table[:, 1:4], (table[:, 4:8] if table.shape[1] == 8 else None)
+
+
+def _replay_hand_path(path):
+    """The hand's path in a replay: the track of the marker the reaching and obstacle tasks'
+    page keeps at the hand (`/task/operator`), its keys in time order, each time once."""
+    try:
+        times, positions = replay_track(pathlib.Path(path).read_text(), HAND_MARKER,
+                                        ".position")
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError) as error:
+        raise ScenarioError(f"{path}: no hand path in this replay ({error}); a reaching or "
+                            "obstacle task's run records one") from None
+    times, first = np.unique(times, return_index=True)
+    positions = positions[first].reshape(-1, 3)
+    # Meshcat keeps a key only where a frame changed something: the frames it skipped are
+    # put back (the fit differentiates twice, and an uneven step reads as a jolt).
+    frame = float(np.median(np.diff(times))) if len(times) > 1 else 1.0
+    grid = times[0] + frame * np.arange(int(round((times[-1] - times[0]) / frame)) + 1)
+    return grid, np.column_stack([np.interp(grid, times, axis) for axis in positions.T]), None

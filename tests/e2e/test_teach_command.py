@@ -10,6 +10,7 @@ import pytest
 
 from pbp_drake.cli import main
 from pbp_drake.core.dmp.primitive import FORMAT_VERSION
+from pbp_drake.output_paths import REPLAY_MARKER
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 REACH = REPO / "diagrams" / "hsr_reach.yaml"
@@ -66,6 +67,30 @@ def test_a_drive_s_recording_teaches_the_same_primitive(taught, tmp_path, capsys
     first, again = (json.loads(path.read_text())
                     for path in (taught / "P.json", tmp_path / "again.json"))
     assert first["weights"] == again["weights"]
+
+
+@pytest.mark.slow
+def test_a_run_s_replay_teaches_the_path_it_shows(tmp_path, capsys):
+    replay = tmp_path / "run.html"
+    code, out = run("run", REACH, "--method", "teleop", "--headless", "--record", replay,
+                    "--set", "task.switch_schedule=[0.0]", capsys=capsys)
+    assert code == 0, out.err
+    code, out = run("teach", REACH, "--from", replay, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 0, out.err
+    document = json.loads((tmp_path / "P.json").read_text())
+    assert document["fit_error"] < 0.01
+    positions = document["demonstration"]["positions"]
+    assert positions[0] == pytest.approx([0.531, 0.078, 0.7], abs=0.002)
+    assert positions[-1][0] - positions[0][0] > 1.0  # the hand went to the far objects
+
+
+def test_a_replay_without_a_hand_path_is_refused(tmp_path, capsys):
+    replay = tmp_path / "empty.html"
+    replay.write_text(f"<!DOCTYPE html>\n{REPLAY_MARKER}\n<html></html>\n")
+    code, out = run("teach", REACH, "--from", replay, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 2 and f"{replay}: no hand path in this replay" in out.err
 
 
 def _primitive_file(taught, tmp_path, change):

@@ -4,8 +4,8 @@ page presses Start, drives the hand from its start toward a goal and presses Sto
 virtual participant drives to its target headless), the hand's path from the start to the
 end of the run is fitted with the scenario's DMP settings (`pbp_drake.core.dmp.primitive`),
 and the primitive is saved, to be named by any scenario's `dmp: {primitive: P.json}`. The
-run's rows are kept beside the primitive (`P.csv`). `--from CSV` teaches from a path already
-recorded (`run --log`, a study trial's CSV) instead.
+run's rows are kept beside the primitive (`P.csv`). `--from FILE` teaches from a path already
+recorded (`run --log`, a study trial's CSV, a `run --record` replay) instead.
 """
 
 import argparse

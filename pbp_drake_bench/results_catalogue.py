@@ -93,6 +93,14 @@ STUDIES = {
     "hsr_wall_primitive_evaluation": [
         "diagrams/hsr_wall.yaml", "--methods", PBP, "--trials", "30", "--split", "evaluation",
         "--set", "dmp.primitive=primitives/around_the_wall.json"],
+    # ... and under every pilot of the arena (10 trials a cell, as the arena's slower tasks).
+    "hsr_wall_pilots": ["diagrams/hsr_wall.yaml", "--methods", "pbp_alternated,teleop",
+                        "--trials", "10", "--split", "evaluation", "--pilots",
+                        ",".join(PILOT_NAMES)],
+    "hsr_wall_primitive_pilots": [
+        "diagrams/hsr_wall.yaml", "--methods", "pbp_alternated", "--trials", "10", "--split",
+        "evaluation", "--pilots", ",".join(PILOT_NAMES), "--set",
+        "dmp.primitive=primitives/around_the_wall.json"],
     "hsr_obstacles_tuning": [*OBSTACLES, "--split", "tuning"],
     "hsr_reach_fixed_alpha": ["diagrams/hsr_reach.yaml", "--methods", FIXED_ALPHAS,
                               "--trials", "30", "--split", "tuning"],

@@ -128,9 +128,10 @@ def _orientation_shape(times, orientations, settings):
     dmp = OrientationDmp(weights, orientations[0], orientations[-1], duration, settings,
                          scaling)
     steps = len(times) - 1
-    path = dmp.rollout(duration / steps)
-    at = np.linspace(0.0, duration, steps + 1)
-    nearest = np.clip(np.searchsorted(at, times - times[0]), 0, steps)
+    step = duration / steps
+    path = dmp.rollout(step)
+    # The rollout's sample nearest each of the demonstration's times.
+    nearest = np.clip(np.rint((times - times[0]) / step).astype(int), 0, steps)
     angles = quaternion.angle_between(path[nearest].T, orientations.T)
     return OrientationShape(weights, scaling, orientations,
                             float(np.sqrt(np.mean(angles ** 2))))

@@ -15,6 +15,7 @@ import msgpack
 import numpy as np
 
 from pbp_drake.builder.time_series import time_series_header
+from pbp_drake.core.dmp.primitive import PRIMITIVE_FORMAT
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.systems.visualizers.point_scene_visualizer import LEGEND as SCENE_2D_LEGEND
 
@@ -176,22 +177,19 @@ def check_figure_path(path, flag="--figure"):
     file = pathlib.Path(path)
     if file.suffix.lower() not in (".png", ".svg", ".pdf"):
         raise OutputPathError(f"{flag} {file}: a figure is a .png, .svg or .pdf file")
-    if file.is_dir():
-        raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
-                              f"{file / 'primitive.png'}")
-    if file.exists() and not os.access(file, os.W_OK):
-        raise OutputPathError(f"{flag} {file}: the file is not writable")
-    _check_can_create(file.parent, f"{flag} {file}")
+    _check_output_file(file, flag, "primitive.png", None, "a figure", force=True)
 
 
 def _is_primitive(path):
-    return _head_holds(path, b'"format": "pbp_drake.primitive"')
+    # As `pbp-drake teach` writes it (json.dumps' separators).
+    return _head_holds(path, f'"format": "{PRIMITIVE_FORMAT}"'.encode())
 
 
 def _check_output_file(path, flag, example, is_ours, kind, force):
-    """The checks both output files share: `path` is not a folder (`example` names a file
+    """The checks the output files share: `path` is not a folder (`example` names a file
     in it), an existing file there is one `is_ours` recognises (`kind`, written by
-    pbp-drake) or `force` is set, and it or its folder is writable."""
+    pbp-drake) or `force` is set (then `is_ours` is not asked), and it or its folder is
+    writable."""
     file = pathlib.Path(path)
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "

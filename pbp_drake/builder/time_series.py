@@ -5,12 +5,14 @@ tick. A study's trial files (`pbp_drake.studies.trial_files`) and a run streamed
 import numpy as np
 
 
+# The hand's orientation in the grasping task, a unit quaternion w, x, y, z
+# (`TaskResult.hand_orientations`: what `pbp-drake teach` fits a pose from). Trial files
+# written before it was logged end without these columns.
+HAND_ORIENTATION_COLUMNS = ["hand_qw", "hand_qx", "hand_qy", "hand_qz"]
 # The grasping task's orientation columns (`TaskResult.angles_to_target`, degrees; the
-# commanded and the operator's angular velocities, rad/s, world frame; the hand's
-# orientation, a unit quaternion w, x, y, z: what `pbp-drake teach` fits a pose from).
+# commanded and the operator's angular velocities, rad/s, world frame; the hand's).
 GRASP_COLUMNS = ["angle_to_target", "command_wx", "command_wy", "command_wz",
-                 "operator_wx", "operator_wy", "operator_wz",
-                 "hand_qw", "hand_qx", "hand_qy", "hand_qz"]
+                 "operator_wx", "operator_wy", "operator_wz", *HAND_ORIENTATION_COLUMNS]
 
 
 def time_series_columns(has_collision, has_grasp=False):

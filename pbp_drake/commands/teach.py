@@ -15,6 +15,7 @@ import pathlib
 
 import numpy as np
 
+from pbp_drake.builder.time_series import HAND_ORIENTATION_COLUMNS
 from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS, port
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
@@ -24,15 +25,14 @@ from pbp_drake.output_paths import (
 from pbp_drake.scenarios import GraspTask, ScenarioError, load_scenario_file
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.primitive_figure import plot_primitive
+from pbp_drake.systems.visualizers.reach_scene_visualizer import HAND_MARKER
 
 #: The operators who can drive a demonstration.
 TEACHERS = ("virtual", "keyboard", "gamepad")
 # The columns of the hand's path in a run's or trial's CSV, and of its orientation (the
 # grasping task's).
 _TIME, _HAND = "time", ("ee_x", "ee_y", "ee_z")
-_QUATERNION = ("hand_qw", "hand_qx", "hand_qy", "hand_qz")
-# Where the reaching and obstacle tasks' page keeps a marker at the hand (a replay's track).
-HAND_MARKER = "/task/operator"
+_QUATERNION = tuple(HAND_ORIENTATION_COLUMNS)
 
 
 def add_teach_command(commands):

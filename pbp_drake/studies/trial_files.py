@@ -22,7 +22,8 @@ from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.builder.run import TaskResult
-from pbp_drake.builder.time_series import time_series_columns, time_series_csv
+from pbp_drake.builder.time_series import (
+    HAND_ORIENTATION_COLUMNS, time_series_columns, time_series_csv)
 
 # A trial file of another format counts as not on disk (it runs again); a metric a file
 # lacks reads as None (reported n/a), so a new metric does not change the format.
@@ -284,8 +285,10 @@ def read_time_series(path, ticks=None):
         rows = list(reader)
     if not columns:
         raise DamagedFile(f"{path}: empty CSV (no header)")
-    if columns not in (time_series_columns(False), time_series_columns(True),
-                       time_series_columns(False, has_grasp=True)):
+    # A grasping trial written before the hand's orientation was logged ends without it.
+    grasp = time_series_columns(False, has_grasp=True)
+    if columns not in (time_series_columns(False), time_series_columns(True), grasp,
+                       grasp[:-len(HAND_ORIENTATION_COLUMNS)]):
         raise DamagedFile(f"{path}: malformed CSV: its header is not a trial's time series")
     for number, row in enumerate(rows, start=2):
         if len(row) != len(columns):
@@ -328,9 +331,9 @@ def load_task_result(output, method, seed):
             operator_twists=np.column_stack([series[c] for c in (
                 "operator_vx", "operator_vy", "operator_vz", "operator_wx", "operator_wy",
                 "operator_wz")]))
-        if "hand_qw" in series:  # not in trial files written before it was logged
+        if HAND_ORIENTATION_COLUMNS[0] in series:
             grasp["hand_orientations"] = np.column_stack(
-                [series[c] for c in ("hand_qw", "hand_qx", "hand_qy", "hand_qz")])
+                [series[c] for c in HAND_ORIENTATION_COLUMNS])
     return TaskResult(
         success=record["success"], task_time=record["task_time"],
         intervention_ratio=record["intervention_ratio"], switches=record["switches"],

@@ -14,8 +14,9 @@ import pytest
 from pbp_drake.cli import main
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.studies.runners import run_trial
+from pbp_drake.builder.time_series import HAND_ORIENTATION_COLUMNS
 from pbp_drake.studies.trial_files import (
-    INTERACTION_METRICS, read_time_series, trial_paths)
+    INTERACTION_METRICS, load_task_result, read_time_series, trial_paths)
 
 pytestmark = pytest.mark.slow
 
@@ -112,3 +113,15 @@ def test_a_grasp_trial_counts_the_angular_velocitys_norm_as_its_turning(repo, tm
     acting = series["operator_active"] == 1
     assert record["turn_input_integral"] == pytest.approx(angular[acting].sum() * PERIOD,
                                                           rel=1e-12)
+    # The hand's orientation is in the CSV, unit quaternions; a grasp trial written before it
+    # was logged (the same CSV without those columns) still reads back, without it.
+    result = load_task_result(tmp_path, "pbp_continuous", 10000)
+    np.testing.assert_allclose(np.linalg.norm(result.hand_orientations, axis=1), 1.0,
+                               atol=1e-9)
+    csv_path = trial_paths(tmp_path, "pbp_continuous", 10000)[1]
+    lines = csv_path.read_text().splitlines()
+    kept = len(lines[0].split(",")) - len(HAND_ORIENTATION_COLUMNS)
+    csv_path.write_text("".join(",".join(line.split(",")[:kept]) + "\n" for line in lines))
+    older = load_task_result(tmp_path, "pbp_continuous", 10000)
+    assert older.hand_orientations is None
+    np.testing.assert_array_equal(older.angles_to_target, result.angles_to_target)

@@ -20,6 +20,9 @@ OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
 # Dots per path (each of TASK_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
 # every path update, so their count and rate set most of its size.
 PATH_DOTS = 24
+# The marker at the hand (shown while the operator acts): a replay's track of the hand's
+# path (`pbp-drake teach --from` reads it).
+HAND_MARKER = "/task/operator"
 # The hand's trail (with `hand_trail`): up to this many dots, 2 cm apart at first.
 TRAIL_DOTS, TRAIL_DOT_RADIUS, TRAIL_SPACING = 300, 0.01, 0.02
 TRAIL_COLOUR = Rgba(0.2, 0.75, 0.3, 0.9)
@@ -142,8 +145,8 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
             meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(point))
         meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
         meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
-        meshcat.SetObject("/task/operator", Cylinder(0.09, 0.01), OPERATOR_COLOUR)
-        meshcat.SetProperty("/task/operator", "visible", False)
+        meshcat.SetObject(HAND_MARKER, Cylinder(0.09, 0.01), OPERATOR_COLOUR)
+        meshcat.SetProperty(HAND_MARKER, "visible", False)
         if self._prediction_steps:
             for dots in [self._active_path, *self._other_paths]:
                 dots.draw(meshcat)
@@ -167,12 +170,12 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
                 RigidTransform(self._objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
         if self._ee_state_port.HasValue(context):
             position = position_of(EeState(self._ee_state_port.Eval(context)))
-            meshcat.SetTransform("/task/operator", RigidTransform(position), time)
+            meshcat.SetTransform(HAND_MARKER, RigidTransform(position), time)
             if self._trail is not None:
                 self._trail.extend(meshcat, position, time)
             if self._operator_active_port.HasValue(context):
                 active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
-                meshcat.SetProperty("/task/operator", "visible", active, time)
+                meshcat.SetProperty(HAND_MARKER, "visible", active, time)
 
     def _publish_paths(self, context):
         if not self._predicted_paths_port.HasValue(context):

@@ -18,6 +18,7 @@ from browser_page import (
 pytestmark = NEEDS_BROWSER
 
 DURATION = 40.0
+SAMPLED = 15.0  # s of wall time the lag is sampled after Start
 TOKEN = "slow-page-test-token-0123456789"
 CPU_SLOWDOWN = 8  # at 20, Meshcat's own page fell 30 s behind in the first 40 s of a run
 MAX_LAG = 1.0  # s
@@ -47,7 +48,7 @@ def test_the_clock_waits_for_start_and_the_status_keeps_up_on_a_slow_page(repo):
             assert status.get_attribute("data-time") in ("0", "0.0")
             click(page, "Start", timeout_ms=120_000)
             lags, times, started = [], [], time.monotonic()
-            while time.monotonic() - started < 25.0 and process.poll() is None:
+            while time.monotonic() - started < SAMPLED and process.poll() is None:
                 times.append(server_time(port))
                 # One call: each waits for the slow page's main thread.
                 shown, text = page.evaluate(
@@ -60,4 +61,4 @@ def test_the_clock_waits_for_start_and_the_status_keeps_up_on_a_slow_page(repo):
     assert len(lags) >= 5, lags
     assert max(lags) <= MAX_LAG, [round(lag, 2) for lag in lags]
     # The clock ran from the press on: a run stuck at its start would show no lag at all.
-    assert times[-1] > 10.0, times
+    assert times[-1] > SAMPLED / 3, times

@@ -109,7 +109,8 @@ API_GROUPS = {
     "Scenario files": {
         name: "pbp_drake.scenarios" for name in [
             "load_scenario_file", "resolve", "ResolvedScenario", "ScenarioError",
-            "ScenarioFile", "Scenario", "Hsr", "Arm", "PointRobot", "MultiGoalReach",
+            "ScenarioFile", "Scenario", "PointScenario", "TaskScenario", "Hsr", "Arm",
+            "PointRobot", "MultiGoalReach",
             "DynamicObstacles", "GraspTask", "VirtualParticipant", "Keyboard", "Gamepad",
             "NoOperator", "ScriptedCommands", "SinusoidalStep", "ObstacleRepulsion",
             "BentPath", "RecordedPath", "Obstacle", "MethodComparison", "AlphaStudy",

@@ -2,8 +2,8 @@
 
 - `pydrake_system`: Drake's port block of a LeafSystem docstring, drawn as a box;
 - `cli-reference`: every `pbp-drake` subcommand from its argparse parser, and the exit codes;
-- `scenario-reference`: every field reachable from `ScenarioFile`, from the dataclasses and
-  their `#:` doc comments;
+- `scenario-reference`: every field reachable from `ScenarioFile` and `TaskScenario`, from the
+  dataclasses and their `#:` doc comments;
 - `api-reference`: a table of every name of `pbp_drake.__all__` (its topic from
   `pbp_drake.API_GROUPS`), each name's own page generated under `reference/api/`.
 """
@@ -151,8 +151,8 @@ def _is_ours(cls):
     return cls.__module__.startswith("pbp_drake")
 
 
-def reachable_dataclasses(root):
-    """Our dataclasses reachable from `root`, in order of first appearance."""
+def reachable_dataclasses(*roots):
+    """Our dataclasses reachable from `roots`, in order of first appearance."""
     seen, order = set(), []
 
     def visit(cls):
@@ -164,7 +164,8 @@ def reachable_dataclasses(root):
             for variant in _variants(typing.get_type_hints(cls)[field.name]):
                 visit(variant)
 
-    visit(root)
+    for root in roots:
+        visit(root)
     return order
 
 
@@ -207,11 +208,12 @@ class ScenarioReference(SphinxDirective):
     """Every section a scenario file may hold, generated from `ScenarioFile`."""
 
     def run(self):
-        from pbp_drake.scenarios.schema import ScenarioFile
+        from pbp_drake.scenarios.schema import ScenarioFile, TaskScenario
 
-        classes = reachable_dataclasses(ScenarioFile)
+        # A file's scenario is a 2-D scene's or, by its robot's tag, a robot task's.
+        classes = reachable_dataclasses(ScenarioFile, TaskScenario)
         # Where each class appears and whether it is the field's untagged (first) variant.
-        users = {}
+        users = {TaskScenario: [("scenario", True)]}
         for cls in classes:
             for field in dataclasses.fields(cls):
                 variants = [v for v in _variants(typing.get_type_hints(cls)[field.name])]

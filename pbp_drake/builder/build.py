@@ -13,7 +13,7 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None, hand_trail=Fals
     obstacle tasks) draws the hand's path as it grows."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
     check_buildable(resolved)
-    if isinstance(resolved.scenario.task, GraspTask):
+    if resolved.has_task and isinstance(resolved.scenario.task, GraspTask):
         return build_grasp_diagram(resolved, meshcat)
     if resolved.has_task:
         return build_reach_diagram(resolved, meshcat, hand_trail)
@@ -24,7 +24,7 @@ def check_buildable(resolved):
     """Raises ScenarioError for a resolved scenario the builder cannot build, so that the
     commands refuse it before they start: a grasping task whose operator has no six-DoF
     system."""
-    if isinstance(resolved.scenario.task, GraspTask):
+    if resolved.has_task and isinstance(resolved.scenario.task, GraspTask):
         check_grasp_buildable(resolved.scenario)
 
 

@@ -20,7 +20,7 @@ from pbp_drake.console.front import PortError, bind_page_port
 from pbp_drake.output_paths import check_log_path, check_output_folder, check_record_path
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.scenarios import (
-    METHODS, Arm, ScenarioError, load_scenario_file, resolve)
+    METHODS, Arm, ScenarioError, TaskScenario, load_scenario_file, resolve)
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 
 
@@ -95,7 +95,7 @@ def scenario_for_run(args):
         weighted = ", ".join(name for name, method in METHODS.items() if method.takes_weight)
         raise ScenarioError(f"--alpha sets the weight of {weighted}; the method is "
                             f"{scenario.method}")
-    if args.operator is not None and scenario.task is None:
+    if args.operator is not None and not isinstance(scenario, TaskScenario):
         raise ScenarioError("--operator chooses who drives the tasks; this scenario uses "
                             "the 2-D toy robot")
     if isinstance(scenario.robot, Arm) and drives_real_robot(scenario.robot.hardware):

@@ -21,7 +21,7 @@ from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condit
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
-    TASK_ROBOTS, Gamepad, Keyboard, MethodComparison, ScenarioError, VirtualParticipant,
+    Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
     check_method_comparison, counted, load_scenario_file)
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
@@ -153,7 +153,7 @@ def _study(args):
         args.output = str(default_output(args.scenario, scenario_file, args.methods))
     check_output_folder(args.output)
     check_buildable(scenario_file.resolved)
-    if isinstance(scenario_file.scenario.robot, TASK_ROBOTS):
+    if isinstance(scenario_file.scenario, TaskScenario):
         return _method_study(args, scenario_file, overrides)
     if args.pilots is not None:
         raise ScenarioError(f"--pilots: {args.scenario} is a 2-D study, which has no "

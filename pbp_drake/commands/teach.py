@@ -22,7 +22,7 @@ from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overr
 from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
 from pbp_drake.output_paths import (
     check_figure_path, check_log_path, check_primitive_path, is_replay, replay_track)
-from pbp_drake.scenarios import GraspTask, ScenarioError, load_scenario_file
+from pbp_drake.scenarios import GraspTask, ScenarioError, TaskScenario, load_scenario_file
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.primitive_figure import plot_primitive
 from pbp_drake.systems.visualizers.reach_scene_visualizer import HAND_MARKER
@@ -70,7 +70,7 @@ def _teach(args):
     scenario_file = load_scenario_file(args.scenario,
                                        scenario_overrides(args, shorthands=False))
     scenario = scenario_file.scenario
-    if scenario.task is None:
+    if not isinstance(scenario, TaskScenario):
         raise ScenarioError("teach drives a robot task's hand; this scenario is a 2-D scene, "
                             "whose demonstration is scenario.demonstration")
     origin = args.source

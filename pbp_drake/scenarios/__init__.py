@@ -3,7 +3,8 @@
 everything checked and derived once by `resolve`; the tasks' scenes in `task_scenes`), the
 surrogate pilots (`pilots`) and the words a person reads about runs (`words`).
 
-Data goes through once: YAML -> `ScenarioFile` -> `resolve` -> `ResolvedScenario` ->
+Data goes through once: YAML -> `ScenarioFile` (its scenario a `PointScenario` or a
+`TaskScenario`) -> `resolve` -> `ResolvedScenario` ->
 `pbp_drake.builder.build_diagram`.
 """
 
@@ -18,9 +19,10 @@ from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, OPERATOR_NAMES, PILOT_CONFIGS, TASK_ROBOTS,
     TOY_OPERATORS, AlphaStudy, AltVsCont, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask,
     Hsr, Keyboard, LaggyPilot, MethodComparison, MultiGoalReach, NoisyPilot, NoOperator,
-    Obstacle, ObstacleRepulsion, OperatorConfig, ParticipantPopulation, PointRobot,
+    Obstacle, ObstacleRepulsion, ParticipantPopulation, PointRobot, PointScenario,
     ProportionalPilot, RecordedPath, Scenario, ScenarioError, ScenarioFile, SceneVariant,
-    ScriptedCommands, SinusoidalStep, VirtualParticipant, forward_key_enabled, shows_intent)
+    ScriptedCommands, SinusoidalStep, TaskScenario, TaskScenarioFile, VirtualParticipant,
+    forward_key_enabled, shows_intent)
 from pbp_drake.scenarios.words import METHOD_NAMES, counted
 from pbp_drake.scenarios.pilots import PILOT_NAMES, PILOTS, check_pilot_name, with_pilot
 
@@ -30,10 +32,12 @@ __all__ = [
     "AlphaStudy", "AltVsCont", "Arm", "BentPath", "DynamicObstacles", "Gamepad", "GraspTask",
     "Hsr", "Keyboard", "LaggyPilot", "LoadedScenarioFile", "MethodComparison",
     "MultiGoalReach", "NoisyPilot", "NoOperator", "Obstacle", "ObstacleRepulsion",
-    "OperatorConfig", "ParticipantPopulation", "PointRobot", "ProportionalPilot",
+    "ParticipantPopulation", "PointRobot", "PointScenario", "ProportionalPilot",
     "RecordedPath", "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile",
-    "SceneVariant", "ScriptedCommands", "SinusoidalStep", "TaskScene", "VirtualParticipant",
+    "SceneVariant", "ScriptedCommands", "SinusoidalStep", "TaskScenario", "TaskScenarioFile",
+    "TaskScene", "VirtualParticipant",
     "check_alpha_study", "check_method_comparison", "check_pilot_name", "counted",
     "demonstration_samples", "forward_key_enabled", "load_scenario_file", "load_scenario_text",
-    "parse_method_label", "resolve", "shows_intent", "task_scene", "with_method", "with_pilot",
+    "parse_method_label", "resolve", "shows_intent", "task_scene",
+    "with_method", "with_pilot",
 ]

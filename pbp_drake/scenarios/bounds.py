@@ -67,10 +67,11 @@ def goal_count_problem(field, count, line=None):
 
 
 def check_goal_counts(scenario):
-    """Raises ScenarioError when `scenario.goals` or its task's `objects` hold more than
-    MAX_GOALS goals."""
-    for field, goals in (("scenario.goals", scenario.goals),
-                         ("scenario.task.objects", getattr(scenario.task, "objects", ()))):
+    """Raises ScenarioError when a 2-D scene's `goals` or a robot task's `objects` hold
+    more than MAX_GOALS goals."""
+    task = getattr(scenario, "task", None)
+    for field, goals in (("scenario.goals", getattr(scenario, "goals", ())),
+                         ("scenario.task.objects", getattr(task, "objects", ()))):
         problem = goal_count_problem(field, len(goals))
         if problem:
             raise ScenarioError(problem)

@@ -24,8 +24,9 @@ from pbp_drake.scenarios.overrides import merged
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
-    RANGE, STUDY_SPLITS, AlphaStudy, Arm, MethodComparison, Scenario,
-    ScenarioError, ScenarioFile, TASK_ROBOTS)
+    HSR_OPERATORS, RANGE, STUDY_SPLITS, TOY_OPERATORS, AlphaStudy, Arm, MethodComparison,
+    PointRobot, PointScenario, Scenario, ScenarioError, ScenarioFile, TaskScenario,
+    TaskScenarioFile)
 from pbp_drake.scenarios.validation import check_numbers, check_seed
 
 
@@ -79,10 +80,11 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
                 document = merged(document, _document(overlay, "the override"))
             except ScenarioError as error:
                 raise ScenarioError(f"the override {overlay.strip()!r}: {error}") from None
-        problem = _first_problem(document, ScenarioFile, "")
+        schema = file_schema(document)
+        problem = _first_problem(document, schema, "")
         if problem:
             raise ScenarioError(problem)
-        loaded = load_typed(ScenarioFile, document)
+        loaded = load_typed(schema, document)
     except ScenarioError as error:
         raise ScenarioError(f"{origin}: {error}") from None
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
@@ -99,6 +101,43 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
         raise ScenarioError(f"{origin}: {error}") from None
     return LoadedScenarioFile(path=None, scenario=scenario, study=loaded.study,
                               resolved=resolved)
+
+
+def file_schema(document):
+    """The file's type for its parsed YAML `document`: `TaskScenarioFile` when its
+    `scenario.robot` has a tag but `!PointRobot` (`!Hsr`, `!Arm`, or one the walk then
+    names with those it takes); `ScenarioFile` (a 2-D scene) when the robot is
+    `!PointRobot` or an untagged mapping of the point robot's fields. Otherwise (no robot,
+    an untagged HSR as `yaml_dump_typed` writes it, a value of the wrong kind) a robot task
+    when the scenario holds what only a robot task has (a task, likely paths, a task's
+    operator), else a 2-D scene."""
+    scenario = document.get("scenario")
+    if not isinstance(scenario, dict):
+        return ScenarioFile
+    robot = scenario.get("robot")
+    if isinstance(robot, dict):
+        tag = robot.get("_tag", "")
+        if tag:
+            return ScenarioFile if tag == "!PointRobot" else TaskScenarioFile
+        if robot and set(robot) <= set(_field_types(PointRobot)):
+            return ScenarioFile
+    operator = scenario.get("operator")
+    operator_tag = operator.get("_tag", "") if isinstance(operator, dict) else ""
+    task_only = set(_field_types(TaskScenario)) - set(_field_types(PointScenario))
+    if task_only & set(scenario) or operator_tag in _TASK_OPERATOR_TAGS:
+        return TaskScenarioFile
+    return ScenarioFile
+
+
+_TASK_OPERATOR_TAGS = {"!" + cls.__name__ for cls in HSR_OPERATORS if cls not in TOY_OPERATORS}
+
+
+# A key of the other scenario type, said with what it belongs to.
+_OTHER_TYPE = {
+    PointScenario: (TaskScenario, " (a robot task's field: give robot: !Hsr {...} or "
+                                  "!Arm {...})"),
+    TaskScenario: (PointScenario, " (a 2-D scene's field: a robot task draws its goals, the "
+                                  "objects, from its task and starts where the robot stands)")}
 
 
 def decode_scenario_bytes(data):
@@ -231,7 +270,10 @@ def _first_problem(node, schema, field, is_range=False):
             if key == "_tag" or (not field and str(key).startswith("_")):
                 continue  # the top level's private keys hold anchors' templates
             if key not in types_of:
-                return (f"{where}: unknown key {key!r}{did_you_mean(key, types_of)}; "
+                other, belongs = _OTHER_TYPE.get(variant, (None, ""))
+                hint = (belongs if other is not None and key in _field_types(other)
+                        else did_you_mean(key, types_of))
+                return (f"{where}: unknown key {key!r}{hint}; "
                         f"expected one of {', '.join(sorted(types_of))}")
             value_type, is_range = types_of[key]
             if is_range and isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -313,7 +355,7 @@ def check_operator_speeds(study, scenario):
 
 
 def check_method_comparison(study, scenario):
-    if not isinstance(scenario.robot, TASK_ROBOTS):
+    if not isinstance(scenario, TaskScenario):
         raise ScenarioError("study !MethodComparison runs the tasks: use robot: !Hsr or "
                             "!Arm")
     if not study.methods:

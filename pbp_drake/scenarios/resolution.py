@@ -28,10 +28,9 @@ from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.robots.task_space_bridge import validate_task_space_bridge
 from pbp_drake.scenarios.bounds import check_goal_counts
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, RENAMED_METHODS, TASK_ROBOTS, TOY_OPERATORS, Arm, BentPath,
-    DynamicObstacles, Gamepad, GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, Scenario,
-    ScenarioError, ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot,
-    SinusoidalStep, VirtualParticipant)
+    RENAMED_METHODS, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask, Hsr, MultiGoalReach,
+    ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands, PILOT_CONFIGS,
+    ParticipantPopulation, ProportionalPilot, SinusoidalStep, TaskScenario, VirtualParticipant)
 from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
@@ -102,18 +101,17 @@ def resolve(scenario):
     Raises ScenarioError naming the first field whose value cannot be used.
     """
     _check_common(scenario)
-    if scenario.goal_estimator.group_mass > 0.0 and not isinstance(scenario.robot,
-                                                                   TASK_ROBOTS):
+    if scenario.goal_estimator.group_mass > 0.0 and not isinstance(scenario, TaskScenario):
         raise ScenarioError("scenario.goal_estimator.group_mass: goal groups steer the "
                             "DMPs of the robot tasks (reach, obstacles, grasp; HSR and arm); "
                             "this scenario has a point robot: set it to 0")
     if estimator_entry(scenario.goal_estimator.method).reads == READS_INTENT and (
-            not isinstance(scenario.robot, TASK_ROBOTS)):
+            not isinstance(scenario, TaskScenario)):
         raise ScenarioError("scenario.goal_estimator.method intent_filter reads the hand's "
                             "pose and the operator's command in the robot tasks (reach, "
                             "obstacles, grasp; HSR and arm); this scenario has a point robot: "
                             "use angle in the 2-D scenes")
-    if isinstance(scenario.robot, TASK_ROBOTS):
+    if isinstance(scenario, TaskScenario):
         return _resolve_task_robot(scenario)
     return _resolve_point_robot(scenario)
 
@@ -168,12 +166,11 @@ def _check_common(scenario):
     _checked("scenario.", scenario.validate_settings)
     require_finite(scenario, "scenario", ("duration",))
     if (estimator_entry(scenario.goal_estimator.method).reads == READS_POSE
-            and not isinstance(scenario.task, GraspTask)):
+            and not isinstance(getattr(scenario, "task", None), GraspTask)):
         raise ScenarioError(f"scenario.goal_estimator.method {scenario.goal_estimator.method} "
                             f"reads grasp orientations: use it with task: !GraspTask {{...}}")
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_seed(scenario.seed)
-    check_count(scenario.likely_paths, "scenario.likely_paths", 0, MAX_LIKELY_PATHS)
 
 
 def _checked(prefix, validate):
@@ -193,7 +190,7 @@ def _with_period(scenario, period):
 
 def _check_method(scenario, goal_count):
     """What the method asks of the rest of the scenario."""
-    if isinstance(scenario.robot, TASK_ROBOTS):
+    if isinstance(scenario, TaskScenario):
         return
     method = METHODS[scenario.method]
     if method.task_only:
@@ -232,10 +229,6 @@ def _resolve_point_robot(scenario):
     scenario = _with_period(scenario, whole_steps(
         scenario.control_period, scenario.robot.time_step, "scenario.control_period",
         "scenario.robot.time_step"))
-    if scenario.task is not None or not isinstance(scenario.operator, TOY_OPERATORS):
-        raise ScenarioError(
-            f"scenario.task and operator !{type(scenario.operator).__name__} need "
-            "robot: !Hsr {...}")
     demonstration = None
     if scenario.demonstration is not None:
         if isinstance(scenario.demonstration, BentPath):
@@ -323,13 +316,7 @@ def _resolve_task_robot(scenario):
     if scenario.task is None:
         raise ScenarioError(f"robot {tag} needs scenario.task, e.g. task: "
                             "{object_count: [2, 4]}")
-    if not isinstance(scenario.operator, HSR_OPERATORS):
-        raise ScenarioError(
-            f"scenario.operator !{type(scenario.operator).__name__} drives the 2-D toy robot; "
-            f"robot {tag} takes one of {[c.__name__ for c in HSR_OPERATORS]}")
-    if scenario.demonstration is not None or scenario.goals or scenario.start:
-        raise ScenarioError("the task draws its own goals (the objects) and starts where "
-                            "the robot stands: remove scenario.demonstration, goals and start")
+    check_count(scenario.likely_paths, "scenario.likely_paths", 0, MAX_LIKELY_PATHS)
     station_field = "scenario.robot.station" if isinstance(robot, Hsr) else "scenario.robot"
     station = robot.station if isinstance(robot, Hsr) else robot.station_config()
     _refuse_what_the_task_sets(station, station_field)

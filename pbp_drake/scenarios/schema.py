@@ -238,9 +238,6 @@ class ParticipantPopulation(ParticipantPopulationParams):
 
 
 PILOT_CONFIGS = (NoisyPilot, LaggyPilot, ProportionalPilot, ParticipantPopulation)
-OperatorConfig = typing.Union[NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands,
-                              Keyboard, Gamepad, VirtualParticipant, NoisyPilot, LaggyPilot,
-                              ProportionalPilot, ParticipantPopulation]
 HSR_OPERATORS = (NoOperator, Keyboard, Gamepad, VirtualParticipant, *PILOT_CONFIGS)
 TOY_OPERATORS = (NoOperator, ObstacleRepulsion, SinusoidalStep, ScriptedCommands)
 # The names `pbp-drake run --operator` takes for the HSR tasks.
@@ -376,37 +373,57 @@ class GraspTask:
 
 @dataclasses.dataclass
 class Scenario(ControlSettings):
-    """Everything one simulation needs: the controller's settings (`ControlSettings`:
-    method, alpha, control_period, dmp, dmp_duration, goal_estimator, hop) and the rest."""
+    """What every scenario has: the controller's settings (`ControlSettings`: method,
+    alpha, control_period, dmp, dmp_duration, goal_estimator, hop), its name, time limit,
+    seed and simulator. A file's `scenario:` is a `TaskScenario` when its robot is tagged
+    `!Hsr` or `!Arm`, else a `PointScenario` (a 2-D scene)."""
 
     #: The scenario's name (in outputs and the console).
     name: str = "scenario"
     #: The time limit (s) of a run.
     duration: float = 2.0
-    #: The robot: the toy point robot (untagged), `!Hsr` or `!Arm`.
-    robot: typing.Union[PointRobot, Hsr, Arm] = dataclasses.field(default_factory=PointRobot)
+    #: The seed of every random draw (an integer).
+    seed: int = 0
+    #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
+    #: its target_realtime_rate).
+    simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
+
+
+@dataclasses.dataclass
+class PointScenario(Scenario):
+    """A 2-D (any-D) scene: the point robot, its goals or a demonstration, disc obstacles
+    and a toy operator (the paper's section IV-A)."""
+
+    #: The toy point robot (untagged).
+    robot: PointRobot = dataclasses.field(default_factory=PointRobot)
     #: The robot's initial position; empty: the demonstration's start.
     start: list[float] = dataclasses.field(default_factory=list)
     #: Candidate goals, one DMP each; empty: the demonstration's goal.
     goals: list[list[float]] = dataclasses.field(default_factory=list)
     #: The demonstration the DMPs learn from; none: straight paths.
     demonstration: typing.Optional[typing.Union[BentPath, RecordedPath]] = None
-    #: The 2-D scenes' obstacles (discs).
+    #: The scene's obstacles (discs).
     obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     #: Who drives the robot: a tagged operator variant; untagged: none.
-    operator: OperatorConfig = dataclasses.field(default_factory=NoOperator)
-    #: HSR tasks: the task, the goal estimator, and the seed every random draw comes from.
-    #: An untagged task is a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,
+    operator: typing.Union[TOY_OPERATORS] = dataclasses.field(default_factory=NoOperator)
+
+
+@dataclasses.dataclass
+class TaskScenario(Scenario):
+    """A robot task (the paper's section IV-B): the HSR (`robot: !Hsr`) or an arm
+    (`robot: !Arm`) reaching, among obstacles or grasping in a scene drawn from the seed,
+    the objects its goals; the hand starts where the robot stands."""
+
+    #: The robot: `!Hsr` or `!Arm` (the tag chooses the scenario's type).
+    robot: typing.Union[Hsr, Arm] = dataclasses.field(default_factory=Hsr)
+    #: Who drives the robot: a tagged operator variant; untagged: none.
+    operator: typing.Union[HSR_OPERATORS] = dataclasses.field(default_factory=NoOperator)
+    #: The task: untagged a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,
     #: `!GraspTask {...}` the grasping task.
     task: typing.Optional[typing.Union[MultiGoalReach, DynamicObstacles, GraspTask]] = None
-    #: The seed of every random draw (an integer).
-    seed: int = 0
-    #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
-    #: its target_realtime_rate).
-    simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
-    #: HSR and arm tasks in Meshcat: how many of the next most probable goals' DMP paths the
-    #: page draws beside the selected goal's (the grasping task past 100 grasps: their
-    #: grasp triads), 0 to 20; what is drawn does not grow with the goal count.
+    #: In Meshcat: how many of the next most probable goals' DMP paths the page draws
+    #: beside the selected goal's (the grasping task past 100 grasps: their grasp triads),
+    #: 0 to 20; what is drawn does not grow with the goal count.
     likely_paths: int = 3
 
 
@@ -476,9 +493,20 @@ class MethodComparison:
 
 @dataclasses.dataclass
 class ScenarioFile:
-    """The top level of a file in `diagrams/`."""
+    """The top level of a file in `diagrams/`. Its `scenario:` is not tagged: the robot's
+    tag chooses its type (`pbp_drake.scenarios.loading.file_schema`; `TaskScenarioFile` is
+    the file of a robot task)."""
 
-    #: The scenario: everything one simulation needs.
-    scenario: Scenario = dataclasses.field(default_factory=Scenario)
+    #: The scenario: everything one simulation needs (a 2-D scene, or a robot task with
+    #: `robot: !Hsr` or `!Arm`).
+    scenario: PointScenario = dataclasses.field(default_factory=PointScenario)
     #: The study that varies it, a tagged variant; none: no study.
     study: typing.Optional[typing.Union[AlphaStudy, AltVsCont, MethodComparison]] = None
+
+
+@dataclasses.dataclass
+class TaskScenarioFile(ScenarioFile):
+    """A `ScenarioFile` whose scenario is a robot task."""
+
+    #: The robot task.
+    scenario: TaskScenario = dataclasses.field(default_factory=TaskScenario)

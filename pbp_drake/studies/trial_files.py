@@ -83,6 +83,13 @@ _LATER_FIELDS = {"task": {"z_range": [], "obstacle_spacing": 0.45, "grid_objects
                  "goal_estimator": {"group_mass": 0.0, "commit_radius": 0.05,
                                     "commit_probability": 0.8,
                                     "intent_filter": plain(IntentFilterSettings())}}
+# The scenario's fields in the order of the one type that once served the 2-D scenes and the
+# robot tasks alike, and the values the fields of the other kind held there: a scenario's
+# content is written so, so that study folders keep their hash and their study.json.
+_ONE_TYPE_ORDER = ("name", "duration", "robot", "start", "goals", "demonstration",
+                   "obstacles", "operator", "task", "seed", "simulator", "likely_paths")
+_OTHER_KIND_VALUES = {"start": [], "goals": [], "demonstration": None, "obstacles": [],
+                      "task": None}
 # A station's field renamed since folders were written: hashed under its old name, so that
 # those folders keep their hash (an arm's station fields are the robot's own).
 _HASHED_AS = {"control_period": "command_period"}
@@ -104,7 +111,13 @@ _KEPT_WHERE = {("operator", "reposition_time"): _may_reposition}
 def scenario_content(scenario):
     """Everything in the scenario but its method and seed (a study sets those per trial),
     as plain data."""
-    content = plain(dataclasses.replace(scenario, method="", seed=0))
+    typed = plain(dataclasses.replace(scenario, method="", seed=0))
+    content = {"!type": "Scenario"}
+    content.update((key, value) for key, value in typed.items()
+                   if key not in _ONE_TYPE_ORDER and key != "!type")
+    for key in _ONE_TYPE_ORDER:
+        if key in typed or key in _OTHER_KIND_VALUES:
+            content[key] = typed.get(key, _OTHER_KIND_VALUES.get(key))
     for section, fields in _LATER_FIELDS.items():
         values = content if section is None else content.get(section)
         for name, default in fields.items():

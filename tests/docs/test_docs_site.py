@@ -20,10 +20,10 @@ import pbp_docs  # noqa: E402  (docs/_ext is not a package)
 
 @pytest.mark.slow
 def test_every_scenario_field_has_a_description():
-    from pbp_drake.scenarios.schema import ScenarioFile
+    from pbp_drake.scenarios.schema import ScenarioFile, TaskScenario
 
     missing = [f"{cls.__name__}.{field.name}"
-               for cls in pbp_docs.reachable_dataclasses(ScenarioFile)
+               for cls in pbp_docs.reachable_dataclasses(ScenarioFile, TaskScenario)
                for field in dataclasses.fields(cls)
                if not pbp_docs.field_docs(cls).get(field.name)]
     assert not missing, f"fields without a #: doc comment: {missing}"

@@ -11,7 +11,7 @@ from pbp_drake.builder import build_diagram, find_system
 from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.robots import HsrStationConfig
-from pbp_drake.scenarios import Scenario, resolve
+from pbp_drake.scenarios import PointScenario, TaskScenario, resolve
 from pbp_drake.systems import (
     GamepadOperator, GoalEstimator, KeyboardOperator, ObstacleRepulsionOperator,
     PointRobotDynamics, VirtualOperator)
@@ -22,8 +22,10 @@ TOY = "start: [0.0, 0.0]\ngoals: [[1.0, 0.0]]\ndmp_duration: 1.0\n"
 
 
 def built(yaml_text, meshcat=None):
-    """The diagram and resolved scenario of a scenario written in YAML."""
-    resolved = resolve(yaml_load_typed(schema=Scenario, data=yaml_text))
+    """The diagram and resolved scenario of a scenario written in YAML (a robot task's when
+    it starts with `HSR`)."""
+    schema = TaskScenario if yaml_text.startswith(HSR) else PointScenario
+    resolved = resolve(yaml_load_typed(schema=schema, data=yaml_text))
     return build_diagram(resolved, meshcat), resolved
 
 

@@ -18,7 +18,9 @@ import pytest
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
 from pbp_drake.core.reach_task import sample_grid_scene
-from pbp_drake.scenarios import ScenarioError, ScenarioFile, load_scenario_file, resolve
+from pbp_drake.scenarios import (
+    ScenarioError, ScenarioFile, TaskScenarioFile, load_scenario_file, resolve)
+from pbp_drake.scenarios.loading import file_schema
 from pbp_drake.scenarios import bounds
 from pbp_drake.scenarios.bounds import (
     MAX_GOALS, MOST_ALIASED_VALUES, MOST_FILE_BYTES, load_document, load_typed)
@@ -163,7 +165,7 @@ def test_ten_thousand_goals_at_full_precision_load_within_the_cap(tmp_path):
         task, objects=scene.objects.tolist(), targets=list(scene.targets),
         min_separation=0.9 * separation))
     path = tmp_path / "ten_thousand.yaml"
-    path.write_text(yaml_dump_typed(ScenarioFile(scenario=scenario, study=file.study)))
+    path.write_text(yaml_dump_typed(TaskScenarioFile(scenario=scenario, study=file.study)))
     assert path.stat().st_size < MOST_FILE_BYTES / 1.5  # room to spare
     loaded = load_scenario_file(path)
     assert loaded.scenario.task.objects == scenario.task.objects
@@ -173,11 +175,13 @@ def test_ten_thousand_goals_at_full_precision_load_within_the_cap(tmp_path):
 @pytest.mark.parametrize("path", sorted(DIAGRAMS.glob("*.yaml")), ids=lambda p: p.name)
 def test_the_c_loader_reads_every_shipped_file_as_drake_does(path, monkeypatch):
     text = path.read_text()
-    drake = yaml_dump_typed(yaml_load_typed(schema=ScenarioFile, data=text))
-    assert yaml_dump_typed(load_typed(ScenarioFile, load_document(text))) == drake
+    schema = file_schema(load_document(text))
+    assert (schema is ScenarioFile) == path.name.startswith("toy_")
+    drake = yaml_dump_typed(yaml_load_typed(schema=schema, data=text))
+    assert yaml_dump_typed(load_typed(schema, load_document(text))) == drake
     # A Drake without the typed loader's pieces: its own yaml_load_typed, the same file.
     monkeypatch.setattr(bounds, "drake_yaml", types.SimpleNamespace())
-    assert yaml_dump_typed(load_typed(ScenarioFile, load_document(text))) == drake
+    assert yaml_dump_typed(load_typed(schema, load_document(text))) == drake
 
 
 # The memory a refusal may take beyond the imports, and all told: a few hundred MB at most

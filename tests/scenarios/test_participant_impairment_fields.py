@@ -8,7 +8,7 @@ from pydrake.common.yaml import yaml_load_typed
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.core.participant_impairment import ParticipantImpairment
-from pbp_drake.scenarios import Scenario, ScenarioError, load_scenario_file, resolve
+from pbp_drake.scenarios import ScenarioError, TaskScenario, load_scenario_file, resolve
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 REACH = "robot: !Hsr {}\ntask: {}\ncontrol_period: 0.03\n"
@@ -49,7 +49,7 @@ def test_unusable_impairments_are_refused_naming_the_field(tmp_path, file, impai
 def test_the_impairment_reaches_the_reach_participant():
     text = REACH + ("operator: !VirtualParticipant\n  impairment: {command_noise: 0.2, "
                     "command_delay: 0.3, mistake_probability: 0.5}\n")
-    diagram = build_diagram(resolve(yaml_load_typed(schema=Scenario, data=text)), None)
+    diagram = build_diagram(resolve(yaml_load_typed(schema=TaskScenario, data=text)), None)
     impairment = diagram.GetSubsystemByName("operator").params.impairment
     assert impairment == ParticipantImpairment(command_noise=0.2, command_delay=0.3,
                                                mistake_probability=0.5)

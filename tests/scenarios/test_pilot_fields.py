@@ -9,8 +9,8 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.cli import main
 from pbp_drake.core.surrogate_pilots import lag_per_tick
 from pbp_drake.scenarios import (
-    PILOT_NAMES, LaggyPilot, NoisyPilot, ParticipantPopulation, ProportionalPilot, Scenario,
-    ScenarioError, load_scenario_file, resolve, with_pilot)
+    PILOT_NAMES, LaggyPilot, NoisyPilot, ParticipantPopulation, ProportionalPilot,
+    ScenarioError, TaskScenario, load_scenario_file, resolve, with_pilot)
 
 REACH = "diagrams/hsr_reach.yaml"
 
@@ -88,7 +88,7 @@ def test_with_pilot_gives_each_pilot_its_defaults_on_the_scenarios_participant(r
 
 def test_a_scenario_without_the_participant_has_no_pilots(repo):
     scenario = load_scenario_file(repo / REACH).scenario
-    keyboard = yaml_load_typed(schema=Scenario, data="operator: !Keyboard {}").operator
+    keyboard = yaml_load_typed(schema=TaskScenario, data="operator: !Keyboard {}").operator
     with pytest.raises(ScenarioError, match="stands in for the virtual participant"):
         with_pilot(type(scenario)(**{**vars(scenario), "operator": keyboard}), "noisy")
 

@@ -11,7 +11,7 @@ import pbp_drake.core.dmp.single as single_dmp_module
 import pbp_drake.scenarios.resolution as resolve_module
 import pbp_drake.scenarios.task_scenes as task_scenes_module
 from pbp_drake.builder import build_diagram
-from pbp_drake.scenarios import BentPath, load_scenario_file
+from pbp_drake.scenarios import BentPath, TaskScenario, load_scenario_file
 from pbp_drake.studies.runners import compute_trial
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
@@ -48,15 +48,17 @@ def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     loaded = load_scenario_file(path)
     build_diagram(loaded.resolved, meshcat)
     scenario = loaded.scenario
-    assert work["bent_path"] == (1 if isinstance(scenario.demonstration, BentPath) else 0)
+    task = isinstance(scenario, TaskScenario)
+    assert work["bent_path"] == (
+        1 if not task and isinstance(scenario.demonstration, BentPath) else 0)
     # Once, where the DMPs run: the 2-D scenes' when resolved, the tasks' in their
     # controller (the grasping task's from the pose station's hand); never for a task's
     # straight Pastor DMPs, whose forcing term is 0.
-    straight_pastor = scenario.task is not None and scenario.dmp.formulation == "pastor"
+    straight_pastor = task and scenario.dmp.formulation == "pastor"
     assert work["fit_weights"] == (0 if straight_pastor else 1)
     scenes = (work["sample_reach_scene"] + work["sample_obstacle_scene"]
               + work["sample_grasp_scene"])
-    assert scenes == (1 if scenario.task is not None else 0)
+    assert scenes == (1 if task else 0)
 
 
 def test_loading_the_grasping_task_draws_its_scene_once(work):

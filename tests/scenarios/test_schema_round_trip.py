@@ -5,7 +5,8 @@ import pathlib
 import pytest
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
-from pbp_drake.scenarios import ScenarioFile, load_scenario_file
+from pbp_drake.scenarios import (
+    ScenarioFile, TaskScenario, TaskScenarioFile, load_scenario_file)
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
 
@@ -13,9 +14,10 @@ SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.ya
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda path: path.stem)
 def test_shipped_scenarios_round_trip(path):
     loaded = load_scenario_file(path)
-    original = ScenarioFile(scenario=loaded.scenario, study=loaded.study)
+    schema = TaskScenarioFile if isinstance(loaded.scenario, TaskScenario) else ScenarioFile
+    original = schema(scenario=loaded.scenario, study=loaded.study)
     text = yaml_dump_typed(original)
-    again = yaml_load_typed(schema=ScenarioFile, data=text)
+    again = yaml_load_typed(schema=schema, data=text)
     assert yaml_dump_typed(again) == text
     assert type(again.scenario.operator) is type(original.scenario.operator)
     assert again.scenario.simulator.target_realtime_rate == (

@@ -13,7 +13,7 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings, goal_probabilities
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_reach import assist_motion, facing
-from pbp_drake.scenarios import Scenario, resolve
+from pbp_drake.scenarios import TaskScenario, resolve
 from pbp_drake.systems import VirtualOperator
 
 PERIOD = 0.03
@@ -54,7 +54,7 @@ def participant_command(params, ee_state, target, target_index, selected, object
 def test_the_participant_fields_are_scenario_fields():
     text = ("robot: !Hsr {}\ntask: {}\ncontrol_period: 0.03\n"
             "operator: !VirtualParticipant {insist_time: 0.0, in_line_angle: 0.2}\n")
-    diagram = build_diagram(resolve(yaml_load_typed(schema=Scenario, data=text)), None)
+    diagram = build_diagram(resolve(yaml_load_typed(schema=TaskScenario, data=text)), None)
     params = diagram.GetSubsystemByName("operator").params
     assert params.insist_time == 0.0 and params.in_line_angle == 0.2
     # With no patience at all it turns the target to its side at once, though it faces

@@ -280,8 +280,10 @@ def _api_page(name, topic):
         directive = [f".. autoclass:: pbp_drake.{name}", "   :members:"]
     else:
         directive = [f".. autofunction:: pbp_drake.{name}"]
-    return "\n".join([name, "=" * len(name), "", f"*{topic}* (:doc:`every public name <../api>`)",
-                       "", *directive, ""])
+    # Orphans, reached from the table: in a toctree, each of them would stand in every page's
+    # sidebar (furo's navigation tree, rebuilt for every page, took half the build).
+    return "\n".join([":orphan:", "", name, "=" * len(name), "",
+                      f"*{topic}* (:doc:`every public name <../api>`)", "", *directive, ""])
 
 
 def _write_api_pages(app):
@@ -301,22 +303,21 @@ def _write_api_pages(app):
 
 class ApiReference(SphinxDirective):
     """Every public name, one section per topic of `pbp_drake.API_GROUPS`: a table of each
-    name (a link to its page) and its docstring's first sentence; the pages themselves in a
-    hidden toctree."""
+    name (a link to its page, an orphan: no sidebar lists them) and its docstring's first
+    sentence."""
 
     def run(self):
         import pbp_drake
 
         folder = API_FOLDER.rsplit("/", 1)[1]
-        lines, entries = [], []
+        lines = []
         for topic, names in api_groups().items():
             lines += [topic, "-" * len(topic), "", ".. list-table::", "   :widths: 30 70", ""]
             for name in names:
                 lines += [f"   * - :doc:`{name} <{folder}/{name}>`",
                           f"     - {summary(getattr(pbp_drake, name)) or ' '}"]
-                entries.append(f"   {folder}/{name}")
             lines.append("")
-        return _parse_rst(self, lines + [".. toctree::", "   :hidden:", "", *entries, ""])
+        return _parse_rst(self, lines)
 
 
 # The pages generated from the code: re-read at every build, since Sphinx sees only

@@ -101,26 +101,6 @@ def merged(base, overlay):
     return result
 
 
-def document_text(document):
-    """A YAML document (`bounds.load_document`'s reading: tags as `_tag` keys) written
-    back as YAML text with its tags, for Drake's own loader."""
-    return yaml.dump(document, Dumper=_TaggedDumper, sort_keys=False)
-
-
-class _TaggedDumper(yaml.SafeDumper):
-    """Writes a mapping with a `_tag` key as that tag's mapping."""
-
-
-def _tagged_mapping(dumper, data):
-    if "_tag" not in data:
-        return dumper.represent_dict(data)
-    fields = {key: value for key, value in data.items() if key != "_tag"}
-    return dumper.represent_mapping(data["_tag"], fields)
-
-
-_TaggedDumper.add_representer(dict, _tagged_mapping)
-
-
 def _text_overlay(text):
     """`--scenario-text`'s mapping, its aliases bounded as a file's are."""
     try:

@@ -74,14 +74,3 @@ def with_pilot(scenario, name):
             f"!{type(operator).__name__}; expected !VirtualParticipant")
     config = PILOTS[name].from_participant(participant_params(operator))
     return dataclasses.replace(scenario, operator=config)
-
-
-def pilot_name(config):
-    """The registry name of an operator config (`attentive` for the participant), or
-    None for an operator that is neither."""
-    if isinstance(config, VirtualParticipant):
-        return ATTENTIVE
-    for name, pilot in PILOTS.items():
-        if isinstance(config, pilot.tag):
-            return name
-    return None

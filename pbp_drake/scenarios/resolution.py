@@ -28,9 +28,10 @@ from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.robots.task_space_bridge import validate_task_space_bridge
 from pbp_drake.scenarios.bounds import check_goal_counts
 from pbp_drake.scenarios.schema import (
-    RENAMED_METHODS, Arm, BentPath, DynamicObstacles, Gamepad, GraspTask, Hsr, MultiGoalReach,
-    ObstacleRepulsion, Scenario, ScenarioError, ScriptedCommands, PILOT_CONFIGS,
-    ParticipantPopulation, ProportionalPilot, SinusoidalStep, TaskScenario, VirtualParticipant)
+    HSR_OPERATORS, RENAMED_METHODS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles, Gamepad,
+    GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, PointScenario, Scenario, ScenarioError,
+    ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
+    TaskScenario, VirtualParticipant)
 from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
@@ -100,6 +101,10 @@ def resolve(scenario):
 
     Raises ScenarioError naming the first field whose value cannot be used.
     """
+    if not isinstance(scenario, (PointScenario, TaskScenario)):
+        raise ScenarioError(f"a scenario to resolve is a PointScenario or a TaskScenario, "
+                            f"not {type(scenario).__name__}")
+    _check_operator(scenario)
     _check_common(scenario)
     if scenario.goal_estimator.group_mass > 0.0 and not isinstance(scenario, TaskScenario):
         raise ScenarioError("scenario.goal_estimator.group_mass: goal groups steer the "
@@ -171,6 +176,17 @@ def _check_common(scenario):
                             f"reads grasp orientations: use it with task: !GraspTask {{...}}")
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_seed(scenario.seed)
+
+
+def _check_operator(scenario):
+    """The operator is one of the scenario type's (a file's walk checks it; a scenario
+    made in Python is checked here)."""
+    operators = TOY_OPERATORS if isinstance(scenario, PointScenario) else HSR_OPERATORS
+    if not isinstance(scenario.operator, operators):
+        raise ScenarioError(
+            f"scenario.operator !{type(scenario.operator).__name__} does not drive a "
+            f"{type(scenario).__name__}; expected one of "
+            f"{', '.join('!' + cls.__name__ for cls in operators)}")
 
 
 def _checked(prefix, validate):

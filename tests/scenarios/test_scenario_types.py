@@ -2,6 +2,7 @@
 chosen by its robot's tag; each type holds its own fields, and a field of the other one is
 refused saying where it belongs, through `pbp-drake run`."""
 
+import dataclasses
 import pathlib
 
 import numpy as np
@@ -9,7 +10,8 @@ import pytest
 from pydrake.common.yaml import yaml_dump_typed
 
 from pbp_drake.scenarios import (
-    Arm, Hsr, PointRobot, PointScenario, TaskScenario, TaskScenarioFile, load_scenario_file)
+    Arm, Hsr, PointRobot, PointScenario, Scenario, ScenarioError, TaskScenario,
+    TaskScenarioFile, load_scenario_file, resolve)
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 
@@ -68,3 +70,16 @@ def test_a_robot_task_written_by_yaml_dump_typed_loads_again(tmp_path):
     assert type(again.scenario) is TaskScenario and type(again.scenario.robot) is Hsr
     assert yaml_dump_typed(again.scenario) == yaml_dump_typed(loaded.scenario)
     np.testing.assert_array_equal(again.resolved.goals, loaded.resolved.goals)
+
+
+def test_a_scenario_made_in_python_with_the_other_kinds_operator_is_refused():
+    toy = load_scenario_file(DIAGRAMS / "toy_alt_vs_cont.yaml").scenario
+    reach = load_scenario_file(DIAGRAMS / "hsr_reach.yaml").scenario
+    with pytest.raises(ScenarioError, match=r"scenario.operator !VirtualParticipant does not "
+                       r"drive a PointScenario; expected one of !NoOperator, "):
+        resolve(dataclasses.replace(toy, operator=reach.operator))
+    with pytest.raises(ScenarioError, match=r"scenario.operator !SinusoidalStep does not "
+                       r"drive a TaskScenario; expected one of !NoOperator, !Keyboard, "):
+        resolve(dataclasses.replace(reach, operator=toy.operator))
+    with pytest.raises(ScenarioError, match="a PointScenario or a TaskScenario, not Scenario"):
+        resolve(Scenario())

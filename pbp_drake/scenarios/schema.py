@@ -415,7 +415,7 @@ class TaskScenario(Scenario):
     the objects its goals; the hand starts where the robot stands."""
 
     #: The robot: `!Hsr` or `!Arm` (the tag chooses the scenario's type).
-    robot: typing.Union[Hsr, Arm] = dataclasses.field(default_factory=Hsr)
+    robot: typing.Union[TASK_ROBOTS] = dataclasses.field(default_factory=Hsr)
     #: Who drives the robot: a tagged operator variant; untagged: none.
     operator: typing.Union[HSR_OPERATORS] = dataclasses.field(default_factory=NoOperator)
     #: The task: untagged a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,

@@ -34,9 +34,7 @@ START_RADIUS = 0.05
 PATH_DOTS = 40
 PATH_DOT_RADIUS = 0.006
 # The executed path: dots closer than their diameter read as a line, thinner than the DMPs'
-# dots; 400 of them hold 1.6 m of path (a toy run's is about 1.3 m) before the trail thins
-# to every other dot.
-EXECUTED_DOTS = 400
+# dots; `PathTrail` doubles their spacing after 1.6 m (a toy run's path is about 1.3 m).
 EXECUTED_DOT_RADIUS = 0.003
 EXECUTED_SPACING = 0.004
 # Heights (2-D scenes seen from above): the start under the obstacles, the paths over them,
@@ -91,8 +89,8 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         self._demonstration = demonstration
         self._path_dots = [PathDots(f"/pbp/predictions/{index}", PATH_DOTS, PATH_DOT_RADIUS,
                                     PATH_COLOUR) for index in range(k)]
-        self._executed = PathTrail("/pbp/executed", EXECUTED_DOTS, EXECUTED_DOT_RADIUS,
-                                   EXECUTED_COLOUR, EXECUTED_SPACING)
+        self._executed = PathTrail("/pbp/executed", EXECUTED_DOT_RADIUS, EXECUTED_COLOUR,
+                                   EXECUTED_SPACING)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period or publish_period, 0.0,

@@ -23,8 +23,8 @@ PATH_DOTS = 24
 # The marker at the hand (shown while the operator acts): a replay's track of the hand's
 # path (`pbp-drake teach --from` reads it).
 HAND_MARKER = "/task/operator"
-# The hand's trail (with `hand_trail`): up to this many dots, 2 cm apart at first.
-TRAIL_DOTS, TRAIL_DOT_RADIUS, TRAIL_SPACING = 300, 0.01, 0.02
+# The hand's trail (with `hand_trail`): dots 2 cm apart (`PathTrail`: 4 cm after 8 m).
+TRAIL_DOT_RADIUS, TRAIL_SPACING = 0.01, 0.02
 TRAIL_COLOUR = Rgba(0.2, 0.75, 0.3, 0.9)
 ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008
 OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
@@ -110,8 +110,8 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         self._cloud = GoalCloud("/task/goal_cloud", self._objects + [0.0, 0.0, CLOUD_LIFT],
                                 CLOUD_POINT_SIZE)
         # The hand's path as it grows (`pbp-drake teach`: the demonstration being recorded).
-        self._trail = (PathTrail("/task/hand_trail", TRAIL_DOTS, TRAIL_DOT_RADIUS,
-                                 TRAIL_COLOUR, TRAIL_SPACING) if hand_trail else None)
+        self._trail = (PathTrail("/task/hand_trail", TRAIL_DOT_RADIUS, TRAIL_COLOUR,
+                                 TRAIL_SPACING) if hand_trail else None)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_paths)

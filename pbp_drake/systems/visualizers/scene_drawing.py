@@ -7,7 +7,8 @@ animation tracks of transforms, positions and visibility; `SetLine` and `SetObje
 page at once and a replay shows their last geometry all along. So a path that changes over
 time is a fixed pool of small spheres (`PathDots`) whose positions are set at each publish,
 a path of poses a pool of triads (`PathTriads`) whose transforms are, and the path travelled
-so far a pool of dots shown one by one as it grows (`PathTrail`).
+so far dots shown one by one as it grows, gathered into meshes shown from when they are made
+(`PathTrail`).
 """
 
 import numpy as np
@@ -76,42 +77,95 @@ class PathDots:
             meshcat.SetProperty(f"{self.root}/{index}", "position", point.tolist(), time)
 
 
-class PathTrail:
-    """The path travelled so far, drawn as it grows: up to `count` dots of `radius` under the
-    Meshcat path `root`, `spacing` apart along it, each shown once the path reaches it.
-    With `time` (`time_in_recording`), a replay at time t shows the trail up to t only:
-    every dot is hidden at the recording's start and shown when placed. (`SetLine` would
-    draw the whole path from the replay's start: a recording does not keep it.)
+def unit_sphere(longitudes=8, latitudes=6):
+    """A unit sphere as a triangle mesh: `(vertices (V, 3), faces (F, 3))`, `latitudes`
+    bands of `longitudes` quads (triangles at the poles); its vertices average to 0."""
+    polar = np.linspace(0.0, np.pi, latitudes + 1)[1:-1]
+    azimuth = np.linspace(0.0, 2.0 * np.pi, longitudes, endpoint=False)
+    rings = np.stack([np.outer(np.sin(polar), np.cos(azimuth)),
+                      np.outer(np.sin(polar), np.sin(azimuth)),
+                      np.outer(np.cos(polar), np.ones(longitudes))], axis=-1)
+    vertices = np.vstack([[0.0, 0.0, 1.0], rings.reshape(-1, 3), [0.0, 0.0, -1.0]])
+    column = np.arange(longitudes)
+    following = (column + 1) % longitudes
+    south = len(vertices) - 1
+    faces = [np.stack([np.zeros_like(column), 1 + column, 1 + following], axis=1)]
+    for band in range(latitudes - 2):
+        upper, lower = 1 + band * longitudes, 1 + (band + 1) * longitudes
+        faces.append(np.stack([upper + column, lower + column, upper + following], axis=1))
+        faces.append(np.stack([upper + following, lower + column, lower + following], axis=1))
+    last = 1 + (latitudes - 2) * longitudes
+    faces.append(np.stack([last + column, np.full_like(column, south), last + following],
+                          axis=1))
+    return vertices, np.concatenate(faces)
 
-    When every dot is placed, the trail keeps every other dot (moved down the pool, at that
-    time) and doubles its spacing, so that it still runs from the start, however long the
-    path. A replay interpolates positions between keys: before a dot moves, its old position
-    is kept again at the previous `extend`'s time, so that it jumps rather than slides.
+
+# The dots of a trail's finished pieces: 42 vertices a sphere, as round as Meshcat's own
+# spheres at a dot's few pixels.
+DOT_VERTICES, DOT_FACES = unit_sphere()
+
+
+def spheres_mesh(centres, radius):
+    """Spheres of `radius` at `centres` `(N, 3)` as one triangle mesh, as
+    `Meshcat.SetTriangleMesh` takes it: `(vertices (3, N V), faces (3, N F))`."""
+    centres = np.asarray(centres, dtype=float)
+    vertices = centres[:, None, :] + radius * DOT_VERTICES[None]
+    faces = np.arange(len(centres))[:, None, None] * len(DOT_VERTICES) + DOT_FACES[None]
+    return vertices.reshape(-1, 3).T, faces.reshape(-1, 3).T.astype(np.int32)
+
+
+class PathTrail:
+    """The path travelled so far, drawn as it grows: dots of `radius` under the Meshcat path
+    `root`, `spacing` apart along it, each shown once the path reaches it. With `time`
+    (`time_in_recording`), a replay at time t shows the trail up to t only.
+
+    A page builds every Meshcat object on its own, and hundreds of small spheres kept a page
+    in software rendering busy for seconds: the dots are few objects. The newest, up to
+    `piece` of them, are spheres of their own (`root/dots/i`), shown as they are placed;
+    when there are `piece`, the next placed dot first turns them into one mesh of spheres
+    (`root/pieces/n`, `SetTriangleMesh`), shown from then on, and the spheres are hidden to
+    be used again. A recording keeps no mesh, only when each is shown (a replay has every
+    mesh whole from its start): a piece is hidden from the trail's `draw` to the time it is
+    made, and never changed after.
+
+    After `pieces` pieces, the spacing doubles for the ones to come (the finished ones
+    stay), so that a path however long is a few dozen objects and still runs from the
+    start. A replay interpolates positions between keys: before a sphere moves on, its old
+    position is kept again at the previous `extend`'s time, so that it jumps rather than
+    slides.
 
     What is drawn is kept here, not in a Drake context (as Drake's own MeshcatVisualizer
     keeps what it has sent): `draw` starts the trail again, and one simulation at a time
     may use it."""
 
-    def __init__(self, root, count, radius, colour, spacing):
+    def __init__(self, root, radius, colour, spacing, piece=20, pieces=20):
         self.root = root
-        self._count = max(2, int(count))
         self._radius = float(radius)
         self._colour = colour
         self._first_spacing = float(spacing)
-        self._positions = [None] * self._count  # where each dot was last put
+        self._piece = max(2, int(piece))
+        self._pieces_per_spacing = max(1, int(pieces))
+        self._positions = [None] * self._piece  # where each sphere was last put
+        self._made = 0  # meshes made under root/pieces (never used again: a replay shows
+        # an earlier trail's at their times)
         self._restart(None)
 
     def _restart(self, time):
-        self._points = []  # the placed dots' positions, in order along the path
+        self._dots = []  # the placed dots not yet in a piece, in order along the path
+        self._last = None  # the last placed dot
+        self._pieces = []  # this trail's pieces
         self._spacing = self._first_spacing
-        self._last_time = time
+        self._draw_time = self._last_time = time
 
     def draw(self, meshcat, time=None):
-        """Adds the dots, hidden, and starts the trail again. Call at the start of a
-        recording with its `time`, so that a replay hides each dot until it is placed."""
+        """Adds the spheres, hidden, hides an earlier trail's pieces, and starts the trail
+        again. Call at the start of a recording with its `time`, so that a replay hides
+        each dot until it is placed."""
+        for path in self._pieces:
+            meshcat.SetProperty(path, "visible", False, time)
         self._restart(time)
-        for index in range(self._count):
-            path = f"{self.root}/{index}"
+        for index in range(self._piece):
+            path = f"{self.root}/dots/{index}"
             meshcat.SetObject(path, Sphere(self._radius), self._colour)
             meshcat.SetProperty(path, "visible", False, time)
 
@@ -120,39 +174,41 @@ class PathTrail:
         the last dot to it (a robot goes several spacings between two publishes), all
         shown at `time`; the first call places the first dot at `point` itself."""
         point = np.asarray(point, dtype=float)
-        if not self._points:
+        if self._last is None:
             self._place(meshcat, point, time)
-        while (gap := np.linalg.norm(point - self._points[-1])) >= self._spacing:
-            if len(self._points) == self._count:
-                self._thin(meshcat, time)
-                continue  # the spacing has doubled: measure the gap again
-            last = self._points[-1]
-            self._place(meshcat, last + (point - last) * (self._spacing / gap), time)
+        while (gap := np.linalg.norm(point - self._last)) >= self._spacing:
+            self._place(meshcat, self._last + (point - self._last) * (self._spacing / gap),
+                        time)
         self._last_time = time
 
     def _place(self, meshcat, point, time):
-        index = len(self._points)
-        self._points.append(point)
-        self._move(meshcat, index, point, time)
-        meshcat.SetProperty(f"{self.root}/{index}", "visible", True, time)
-
-    def _move(self, meshcat, index, point, time):
-        path = f"{self.root}/{index}"
+        if len(self._dots) == self._piece:
+            self._make_piece(meshcat, time)
+        index = len(self._dots)
+        self._dots.append(point)
+        self._last = point
+        path = f"{self.root}/dots/{index}"
         previous = self._positions[index]
         if previous is not None and time is not None and self._last_time is not None:
             meshcat.SetProperty(path, "position", previous.tolist(), self._last_time)
         meshcat.SetProperty(path, "position", point.tolist(), time)
+        meshcat.SetProperty(path, "visible", True, time)
         self._positions[index] = point
 
-    def _thin(self, meshcat, time):
-        """Keeps every other dot, moved down the pool, and hides the others."""
-        kept = self._points[::2]
-        for index in range(1, len(kept)):  # the first dot stays on the start
-            self._move(meshcat, index, kept[index], time)
-        for index in range(len(kept), self._count):
-            meshcat.SetProperty(f"{self.root}/{index}", "visible", False, time)
-        self._points = kept
-        self._spacing *= 2.0
+    def _make_piece(self, meshcat, time):
+        """The placed spheres become one mesh, shown at `time`, and are hidden then."""
+        path = f"{self.root}/pieces/{self._made}"
+        self._made += 1
+        self._pieces.append(path)
+        meshcat.SetTriangleMesh(path, *spheres_mesh(self._dots, self._radius), self._colour)
+        if time is not None and self._draw_time is not None:
+            meshcat.SetProperty(path, "visible", False, self._draw_time)
+        meshcat.SetProperty(path, "visible", True, time)
+        for index in range(self._piece):
+            meshcat.SetProperty(f"{self.root}/dots/{index}", "visible", False, time)
+        self._dots = []
+        if len(self._pieces) % self._pieces_per_spacing == 0:
+            self._spacing *= 2.0
 
 
 # The goal cloud's colours: a goal of no probability grey, the most probable one blue.

@@ -146,8 +146,9 @@ class PathTrail:
         self._piece = max(2, int(piece))
         self._pieces_per_spacing = max(1, int(pieces))
         self._positions = [None] * self._piece  # where each sphere was last put
-        self._made = 0  # meshes made under root/pieces (never used again: a replay shows
-        # an earlier trail's at their times)
+        # Meshes made under root/pieces, each path used once: a replay of several runs
+        # shows an earlier trail's at their times.
+        self._made = 0
         self._restart(None)
 
     def _restart(self, time):

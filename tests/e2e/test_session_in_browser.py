@@ -3,8 +3,9 @@ headless Chromium: its methods (two, PBP-Alt and teleop; the order of the defaul
 tested headless, tests/builder/test_hsr_task.py) started from the page's Start buttons and
 driven with the arrow keys, the questionnaire answered with clicks, Next clicked; while each
 method runs the page shows the live status (the method's name, the time left, then the
-result) and the Stop, Restart and Next scene buttons. The session then holds every method's
-trial, with the keys' input in it, and `questionnaire.json` the clicked answers; the page
+result) and the Stop, Restart and Next scene buttons. The first method runs to its time
+limit; Next scene ends the last one's run as it stands. The session then holds every
+method's trial, with the keys' input in it, and `questionnaire.json` the clicked answers; the page
 ends on "Session complete", never on Meshcat's reconnect banner.
 
 Needs Debian's `chromium` and Playwright from PyPI, as tests/e2e/test_browser_end_to_end.py.
@@ -80,11 +81,16 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
                 status.filter(has_text=re.compile(counts + r"\d+ %$")).wait_for()
                 seen[method] = {b: control(page, b).count()
                                 for b in ("Stop", "Restart", "Next scene")}
+                if position == len(order):
+                    # Next scene ends the last method's run as it stands, saved.
+                    click(page, "Next scene")
+                    ended = r"^Result: stopped at \d+\.\d s$"
+                else:
+                    ended = r"^Result: (success in|failed: time limit)"
                 # A run is paced at real time when the machine keeps up; on a loaded one its
                 # 20 simulated seconds took over 50 s of wall time (a failure of the suite):
                 # wait up to four times the run, which a quiet machine never needs.
-                console_line(page, "result").filter(has_text=re.compile(
-                    r"^Result: (success in|failed: time limit)")).wait_for(
+                console_line(page, "result").filter(has_text=re.compile(ended)).wait_for(
                     timeout=(4 * DURATION + 30) * 1000)
                 tiredness, ease = ANSWERS[method]
                 click(page, label_of("tiredness", tiredness))
@@ -105,7 +111,10 @@ def test_a_whole_keyboard_session_is_run_from_the_page(repo, tmp_path):
         method: {"tiredness": t, "ease": e} for method, (t, e) in ANSWERS.items()}
     trials = {method: json.loads((output / "trials" / method / "seed_0.json").read_text())
               for method in order}
-    # The held arrow reached the robot: the person's input is in every method's run.
+    # The held arrow reached the robot: the person's input is in every method's run, the
+    # one ended by Next scene too, which ended before its time limit.
     assert all(trials[m]["intervention_ratio"] > 0 for m in order), {
         m: trials[m]["intervention_ratio"] for m in order}
+    assert not trials[order[-1]]["success"]
+    assert trials[order[-1]]["task_time"] < DURATION - 1.0
     assert "Press Enter" not in lines.text()

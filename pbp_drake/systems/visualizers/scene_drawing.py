@@ -13,7 +13,7 @@ so far dots shown one by one as it grows, gathered into meshes shown from when t
 
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
-from pydrake.geometry import Cylinder, Rgba, Sphere
+from pydrake.geometry import Cylinder, Rgba
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.perception import BaseField, Fields, PointCloud
 
@@ -49,34 +49,6 @@ def frame_top_down(meshcat, view):
     meshcat.SetCameraPose([cx, cy - CAMERA_SLANT, CAMERA_HEIGHT], [cx, cy, 0.0])
 
 
-class PathDots:
-    """A path drawn as `count` spheres of `radius` under the Meshcat path `root`, evenly
-    spaced along it; `show` moves them, with `time` so that a recording replays it."""
-
-    def __init__(self, root, count, radius, colour):
-        self.root = root
-        self._count = int(count)
-        self._radius = float(radius)
-        self._colour = colour
-
-    def draw(self, meshcat):
-        """Adds the spheres (all at the origin until `show`)."""
-        for index in range(self._count):
-            meshcat.SetObject(f"{self.root}/{index}", Sphere(self._radius), self._colour)
-
-    def show(self, meshcat, path, time=None, lift=0.0):
-        """Spreads the spheres along the polyline `path` `(N, 2 or 3)`, raised by `lift` in z.
-
-        Only positions are set (`SetProperty(..., "position")`): a recording then keeps one
-        track a sphere, half of what `SetTransform` records (position and rotation)."""
-        path = np.atleast_2d(np.asarray(path, dtype=float))
-        points = np.zeros((self._count, 3))
-        points[:, :path.shape[1]] = resample_by_arc_length(path, self._count)[:, :3]
-        points[:, 2] += lift
-        for index, point in enumerate(points):
-            meshcat.SetProperty(f"{self.root}/{index}", "position", point.tolist(), time)
-
-
 def unit_sphere(longitudes=8, latitudes=6):
     """A unit sphere as a triangle mesh: `(vertices (V, 3), faces (F, 3))`, `latitudes`
     bands of `longitudes` quads (triangles at the poles); its vertices average to 0."""
@@ -100,8 +72,8 @@ def unit_sphere(longitudes=8, latitudes=6):
     return vertices, np.concatenate(faces)
 
 
-# The dots of a trail's finished pieces: 42 vertices a sphere, as round as Meshcat's own
-# spheres at a dot's few pixels.
+# A dot: a sphere of 80 triangles, as round at a dot's few pixels as Meshcat's own `Sphere`
+# (760 triangles), of which a page in software rendering drew paths slowly.
 DOT_VERTICES, DOT_FACES = unit_sphere()
 
 
@@ -112,6 +84,39 @@ def spheres_mesh(centres, radius):
     vertices = centres[:, None, :] + radius * DOT_VERTICES[None]
     faces = np.arange(len(centres))[:, None, None] * len(DOT_VERTICES) + DOT_FACES[None]
     return vertices.reshape(-1, 3).T, faces.reshape(-1, 3).T.astype(np.int32)
+
+
+def add_dot(meshcat, path, radius, colour):
+    """A dot of `radius` at `path`, centred on its origin (`spheres_mesh`)."""
+    meshcat.SetTriangleMesh(path, *spheres_mesh(np.zeros((1, 3)), radius), colour)
+
+
+class PathDots:
+    """A path drawn as `count` spheres of `radius` under the Meshcat path `root`, evenly
+    spaced along it; `show` moves them, with `time` so that a recording replays it."""
+
+    def __init__(self, root, count, radius, colour):
+        self.root = root
+        self._count = int(count)
+        self._radius = float(radius)
+        self._colour = colour
+
+    def draw(self, meshcat):
+        """Adds the spheres (all at the origin until `show`)."""
+        for index in range(self._count):
+            add_dot(meshcat, f"{self.root}/{index}", self._radius, self._colour)
+
+    def show(self, meshcat, path, time=None, lift=0.0):
+        """Spreads the spheres along the polyline `path` `(N, 2 or 3)`, raised by `lift` in z.
+
+        Only positions are set (`SetProperty(..., "position")`): a recording then keeps one
+        track a sphere, half of what `SetTransform` records (position and rotation)."""
+        path = np.atleast_2d(np.asarray(path, dtype=float))
+        points = np.zeros((self._count, 3))
+        points[:, :path.shape[1]] = resample_by_arc_length(path, self._count)[:, :3]
+        points[:, 2] += lift
+        for index, point in enumerate(points):
+            meshcat.SetProperty(f"{self.root}/{index}", "position", point.tolist(), time)
 
 
 class PathTrail:
@@ -167,7 +172,7 @@ class PathTrail:
         self._restart(time)
         for index in range(self._piece):
             path = f"{self.root}/dots/{index}"
-            meshcat.SetObject(path, Sphere(self._radius), self._colour)
+            add_dot(meshcat, path, self._radius, self._colour)
             meshcat.SetProperty(path, "visible", False, time)
 
     def extend(self, meshcat, point, time=None):

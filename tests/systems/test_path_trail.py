@@ -21,7 +21,8 @@ from pbp_drake.systems.visualizers.point_scene_visualizer import (
 from pbp_drake.systems.ports import EeState, Target
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
     TRAIL_SPACING, ReachSceneVisualizer)
-from pbp_drake.systems.visualizers.scene_drawing import DOT_VERTICES, PathTrail
+from pbp_drake.systems.visualizers.scene_drawing import (
+    DOT_FACES, DOT_VERTICES, PathTrail, spheres_mesh)
 
 FPS = 30.0
 DURATION = 1.0
@@ -202,3 +203,19 @@ def test_a_teaching_run_s_page_shows_the_hand_s_path_as_it_grows(meshcat):
         reached = np.linalg.norm(dots[-1, :2] - travelled[-1])
         assert reached < 2 * TRAIL_SPACING, f"the trail ends {reached:.3f} m short"
         np.testing.assert_allclose(dots[:, 2], 0.7, atol=MESH_TOLERANCE)
+
+
+def test_a_dot_is_a_closed_sphere_of_80_triangles_facing_out():
+    np.testing.assert_allclose(np.linalg.norm(DOT_VERTICES, axis=1), 1.0)
+    assert DOT_FACES.shape == (80, 3)
+    # Every edge is shared by exactly two triangles, in opposite directions: no hole.
+    edges = [(a, b) for face in DOT_FACES for a, b in zip(face, np.roll(face, -1))]
+    assert len(set(edges)) == len(edges)
+    assert all((b, a) in set(edges) for a, b in edges)
+    # Its triangles face out: the volume they enclose is positive, near a unit ball's.
+    a, b, c = (DOT_VERTICES[DOT_FACES[:, i]] for i in range(3))
+    volume = np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0
+    assert 0.7 * 4.0 / 3.0 * np.pi < volume < 4.0 / 3.0 * np.pi
+    vertices, faces = spheres_mesh([[1.0, 2.0, 3.0], [0.0, 0.0, 0.0]], 0.5)
+    assert vertices.shape == (3, 2 * len(DOT_VERTICES)) and faces.shape == (3, 160)
+    np.testing.assert_allclose(vertices[:, :len(DOT_VERTICES)].mean(axis=1), [1.0, 2.0, 3.0])

@@ -72,8 +72,8 @@ def unit_sphere(longitudes=8, latitudes=6):
     return vertices, np.concatenate(faces)
 
 
-# A dot: a sphere of 80 triangles, as round at a dot's few pixels as Meshcat's own `Sphere`
-# (760 triangles), of which a page in software rendering drew paths slowly.
+# A dot: a sphere of 80 triangles, as round at a dot's few pixels as Meshcat's own `Sphere`,
+# which has 760 (paths of those were slow to draw in a page rendered in software).
 DOT_VERTICES, DOT_FACES = unit_sphere()
 
 

@@ -51,10 +51,17 @@ def held_at(tracks, path, track, time):
     return values[max(0, int(np.searchsorted(times, time + 1e-9, side="right")) - 1)]
 
 
-def recorded(meshcat, diagram, duration):
-    """The animation tracks of a recording of `duration` seconds of `diagram` in `meshcat`."""
+def recorded_page(meshcat, run):
+    """The page (`StaticHtml`) of a recording at 30 frames a second of `run()` in
+    `meshcat`."""
     meshcat.StartRecording(frames_per_second=30.0)
-    Simulator(diagram).AdvanceTo(duration)
+    run()
     meshcat.StopRecording()
     meshcat.PublishRecording()
-    return animation_tracks(meshcat.StaticHtml())
+    return meshcat.StaticHtml()
+
+
+def recorded(meshcat, diagram, duration):
+    """The animation tracks of a recording of `duration` seconds of `diagram` in `meshcat`."""
+    return animation_tracks(recorded_page(
+        meshcat, lambda: Simulator(diagram).AdvanceTo(duration)))

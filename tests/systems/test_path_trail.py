@@ -14,7 +14,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
-from replay_tracks import animation_tracks, commands, held_at
+from replay_tracks import animation_tracks, commands, held_at, recorded_page
 
 from pbp_drake.systems.visualizers.point_scene_visualizer import (
     EXECUTED_SPACING, EXECUTED_Z, PointSceneVisualizer)
@@ -24,7 +24,7 @@ from pbp_drake.systems.visualizers.reach_scene_visualizer import (
 from pbp_drake.systems.visualizers.scene_drawing import (
     DOT_FACES, DOT_VERTICES, PathTrail, spheres_mesh)
 
-FPS = 30.0
+FPS = 30.0  # replay_tracks.recorded_page's frames per second
 DURATION = 1.0
 
 
@@ -32,15 +32,6 @@ def robot_path(time):
     """Where the robot is at `time` (s): along +x at 1 m/s, bowed sideways."""
     time = np.asarray(time, float)
     return np.stack([time, 0.3 * np.sin(np.pi * time)], axis=-1)
-
-
-def recording(meshcat, run):
-    """The page (`StaticHtml`) of a recording of `run()` in `meshcat`."""
-    meshcat.StartRecording(frames_per_second=FPS)
-    run()
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
-    return meshcat.StaticHtml()
 
 
 def trail_objects(html, root):
@@ -82,7 +73,7 @@ MESH_TOLERANCE = 1e-6
 
 
 def simulated(meshcat, diagram):
-    return recording(meshcat, lambda: Simulator(diagram).AdvanceTo(DURATION))
+    return recorded_page(meshcat, lambda: Simulator(diagram).AdvanceTo(DURATION))
 
 
 @pytest.fixture
@@ -135,7 +126,7 @@ def record_trail(meshcat, trail, points_and_times):
         trail.draw(meshcat, 0.0)
         for point, time in points_and_times:
             trail.extend(meshcat, point, time)
-    return recording(meshcat, run)
+    return recorded_page(meshcat, run)
 
 
 def test_a_long_trail_doubles_its_spacing_and_still_runs_from_the_start(meshcat):
@@ -172,7 +163,7 @@ def test_drawing_the_trail_again_starts_it_again(meshcat):
         trail.extend(meshcat, [1.0, 0.0, 0.0], 1.0)  # 11 dots: 2 pieces and 3 spheres
         trail.draw(meshcat, 2.0)  # a second run in the same page
         trail.extend(meshcat, [5.0, 0.0, 0.0], 2.0)
-    html = recording(meshcat, run)
+    html = recorded_page(meshcat, run)
     np.testing.assert_allclose(shown_trail(html, "/trail", 1.5)[:, 0], np.arange(11) * 0.1,
                                atol=MESH_TOLERANCE)
     np.testing.assert_allclose(shown_trail(html, "/trail", 2.0), [[5.0, 0.0, 0.0]])

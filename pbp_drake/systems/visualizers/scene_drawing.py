@@ -86,9 +86,11 @@ def spheres_mesh(centres, radius):
     return vertices.reshape(-1, 3).T, faces.reshape(-1, 3).T.astype(np.int32)
 
 
-def add_dot(meshcat, path, radius, colour):
-    """A dot of `radius` at `path`, centred on its origin (`spheres_mesh`)."""
-    meshcat.SetTriangleMesh(path, *spheres_mesh(np.zeros((1, 3)), radius), colour)
+def add_dots(meshcat, paths, radius, colour):
+    """A dot of `radius` at each of `paths`, centred on its origin (`spheres_mesh`)."""
+    vertices, faces = spheres_mesh(np.zeros((1, 3)), radius)
+    for path in paths:
+        meshcat.SetTriangleMesh(path, vertices, faces, colour)
 
 
 class PathDots:
@@ -103,8 +105,8 @@ class PathDots:
 
     def draw(self, meshcat):
         """Adds the spheres (all at the origin until `show`)."""
-        for index in range(self._count):
-            add_dot(meshcat, f"{self.root}/{index}", self._radius, self._colour)
+        add_dots(meshcat, [f"{self.root}/{index}" for index in range(self._count)],
+                 self._radius, self._colour)
 
     def show(self, meshcat, path, time=None, lift=0.0):
         """Spreads the spheres along the polyline `path` `(N, 2 or 3)`, raised by `lift` in z.
@@ -170,9 +172,9 @@ class PathTrail:
         for path in self._pieces:
             meshcat.SetProperty(path, "visible", False, time)
         self._restart(time)
-        for index in range(self._piece):
-            path = f"{self.root}/dots/{index}"
-            add_dot(meshcat, path, self._radius, self._colour)
+        paths = [f"{self.root}/dots/{index}" for index in range(self._piece)]
+        add_dots(meshcat, paths, self._radius, self._colour)
+        for path in paths:
             meshcat.SetProperty(path, "visible", False, time)
 
     def extend(self, meshcat, point, time=None):

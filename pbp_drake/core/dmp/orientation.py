@@ -1,46 +1,23 @@
 """Orientation DMPs on unit quaternions: the formulation, the one-demonstration fit, and one
 DMP stepped the plain way (the readable reference the vectorised bank is tested against).
 
-The formulation is Koutras and Doulgeri's (2020): the position DMP, unchanged, on the
-logarithm of the orientation error. Quaternions are `(w, x, y, z)`
-(`pbp_drake.core.quaternion`). With `g` the goal orientation, the DMP's "position" is the
-rotation vector of the rotation from the goal to the orientation `q`,
+The formulation is Koutras and Doulgeri's (2020), docs/concepts/dmp.md, "Orientation DMPs":
+the position DMP, unchanged, on `e = Log(q g*)` (3,), the rotation from the goal `g` to the
+orientation `q` (0 at the goal, the same for `q` or `-q`, `g` or `-g`), with goal 0 and
+start `e0 = Log(q0 g*)`; then `q = Exp(e) g` and `omega = J(e) de/dt`, `J` the left
+Jacobian of `Exp` (`quaternion.left_jacobian_times`). Quaternions are `(w, x, y, z)`
+(`pbp_drake.core.quaternion`).
 
-    e = Log(q g*)        (3,), |e| <= pi, the same for q or -q, g or -g,
-
-which is 0 at the goal. `e` follows the position DMP of `pbp_drake.core.dmp` with goal 0
-and start `e0 = Log(q0 g*)`, same gains, basis, phase and formulation:
-
-    tau de/dt = z,    tau dz/dt = K (a(x) - e) - D z,    tau dx/dt = -alpha_x x,
-    ijspeert:  a(x) = (sum_i psi_i w_i / sum_i psi_i) x (-e0) / K   (per axis; 1 for -e0
-               where the fit switched the amplitude scaling off),
-    pastor:    a(x) = e0 x + (sum_i psi_i w_i / sum_i psi_i) x,
-
-and the orientation and its world-frame angular velocity follow from it exactly:
-
-    q = Exp(e) g,    omega = J(e) de/dt,
-
-with `J` the left Jacobian of `Exp` (`quaternion.left_jacobian_times`). Because `e` obeys
-the linear position DMP, the closed-form first-order-hold step, the fit and the
-convergence of the position DMP carry over as they are. (Ude et al. 2014 write the DMP on
-the quaternion itself, `tau deta/dt = K 2 Log(g q*) - D eta + f`, `dq/dt = eta q / (2 tau)`;
-its error dynamics are linear in no coordinates, so none of that would carry over.)
-
-The velocity state kept is the DMP's own scaled angular velocity `eta = tau omega` (world
-frame), not `z`: it is the same physical quantity whichever goal the log is taken against,
-so PBP's goal switch can copy it from one DMP to another and the phase lock can set it from
-the robot's angular velocity, as the position DMP does with `z`. A step from the robot's
-measured orientation `q_m` (PBP's re-integration) is
+The velocity state kept is `eta = tau omega` (world frame), not `z`, so that PBP's goal
+switch and phase lock can copy it as the position DMP does `z`. A step from the robot's
+measured orientation `q_m` is
 
     e = Log(q_m g*),  z = J(e)^-1 eta,  (e, z) -> (e', z') by the position step,
     q' = Exp(e') g (signed as q_m),  eta' = J(e') z',  x' = x exp(-alpha_x dt / tau).
 
-Open loop, `Log(Exp(e') g g*) = e'` and `J^-1 J = I`, so the rollout is the position DMP's
-rollout of `e`. A demonstration's orientations must stay within 180 degrees of its last one
-(else `e` would jump from `pi u` to `-pi u`); a start or a measured orientation may be
-anywhere, the DMP then turns the shorter way (either way at exactly 180 degrees, chosen as
-`quaternion.canonical` does, the same for `q` and `-q`).
-"""
+A demonstration's orientations must stay within 180 degrees of its last one (else `e`
+would jump from `pi u` to `-pi u`); a start or a measured orientation may be anywhere, the
+DMP then turns the shorter way."""
 
 import numpy as np
 

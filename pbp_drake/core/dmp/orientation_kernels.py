@@ -312,16 +312,10 @@ def _jacobian_terms_into(rotation_vectors, vectors, p, cross_scale, dot_scale, o
     out += ws.work
 
 
-def jacobian_of_one(rotation_vector, vector):
-    """`J(r) v` (3,) for ONE rotation vector and vector (3,), in float arithmetic: at one
-    column a NumPy call costs more than the whole product (`np.cross` about 30 us). The
-    same formulas as `jacobian_into`, with `sin` and `cos` of `t` directly."""
-    return np.array(jacobian_of_one_values([float(value) for value in rotation_vector],
-                                           [float(value) for value in vector]))
-
-
 def jacobian_of_one_values(rotation_vector, vector):
-    """`jacobian_of_one` on plain floats: two sequences of 3 in, a list of 3 out."""
+    """`J(r) v` for ONE rotation vector and vector, plain floats (two sequences of 3 in, a
+    list of 3 out): at one column a NumPy call costs more than the whole product. The same
+    formulas as `jacobian_into`, with `sin` and `cos` of `t` directly."""
     rx, ry, rz = rotation_vector
     vx, vy, vz = vector
     square = rx * rx + ry * ry + rz * rz

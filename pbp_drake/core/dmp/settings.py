@@ -1,10 +1,9 @@
 """DMP settings, the Gaussian basis, and the constants of one step.
 
-The step constants (the 2x2 matrices `Phi` and `Gamma` of the first-order-hold step, see
-`pbp_drake.core.dmp`, and the phase decay) depend on the settings, the duration and the step
-only, so they are pure functions here, not state of a DMP: `step_matrices` is memoised
-(`functools.lru_cache`, thread-safe in CPython) and returns read-only arrays, which every
-caller shares.
+The step constants (the 2x2 `Phi` and `Gamma` of the first-order-hold step and the phase
+decay) depend on the settings, the duration and the step only, so they are pure functions
+here, not state of a DMP; `step_matrices` is memoised and returns read-only arrays, which
+every caller shares.
 """
 
 import dataclasses
@@ -97,9 +96,7 @@ def normalized_basis(phase, centres, widths):
 @functools.lru_cache(maxsize=256)
 def step_matrices(stiffness, damping, duration, dt):
     """The read-only 2x2 `(Phi, Gamma)` of one step of the transformation system around its
-    moving attractor (see `pbp_drake.core.dmp`): `Phi = expm(A dt)` carries
-    `[y - attractor, z]` over the step, `Gamma = integral_0^dt expm(A s) ds` carries the
-    attractor's motion. One pair for every goal and dimension.
+    moving attractor (`linear.second_order_step`), one pair for every goal and dimension.
 
     Keyed on plain floats, not on `DmpSettings`, because hashing four floats is cheap enough
     for a call every control step and hashing the dataclass is not."""
@@ -108,11 +105,6 @@ def step_matrices(stiffness, damping, duration, dt):
     phi.setflags(write=False)
     gamma.setflags(write=False)
     return phi, gamma
-
-
-def transition(stiffness, damping, duration, dt):
-    """The read-only 2x2 `Phi = expm(A dt)` of `step_matrices` (memoised there)."""
-    return step_matrices(stiffness, damping, duration, dt)[0]
 
 
 def phase_decay(settings, duration, dt):

@@ -1,20 +1,13 @@
 """The step of a `DmpBankModel`: K DMPs advanced one first-order-hold step, vectorised over (D, K).
 
-Around its moving attractor `a` the transformation system is linear (see
-`pbp_drake.core.dmp`). Over a step the attractor goes linearly in time from `a0`, its value
-at the step's phase `x0`, to `a1`, its value at the next phase
-`x1 = x0 exp(-alpha_x dt / tau)` (a first-order hold), which keeps the step in closed
-form: with `e = y - a0`, the increment `da = a1 - a0` and `(Phi, Gamma)` of
-`pbp_drake.core.dmp.settings.step_matrices`,
-
-    y' = a1 + Phi00 e + Phi01 z - Gamma00 da / dt,    z' = Phi10 e + Phi11 z - Gamma10 da / dt.
-
-The step is affine in the DMP's own velocity `z`:
+With `(Phi, Gamma)` of `settings.step_matrices`, the attractor `a0` at the step's phase and
+`a1` at the next, `e = y - a0` and `da = a1 - a0`, the step (docs/concepts/dmp.md, "One
+step, in closed form") is affine in the DMP's own velocity `z`:
 
     y' = y + dp + Phi01 z,    z' = dz + Phi11 z,
-    dp = (Phi00 - 1) e + (1 - Gamma00 / dt) da,    dz = Phi10 e - (Gamma10 / dt) da,
+    dp = (Phi00 - 1) e + (1 - Gamma00 / dt) da,    dz = Phi10 e - (Gamma10 / dt) da.
 
-and PBP steps from the robot's position `y = p`, so `(dp, dz)`, "the attractor terms", depend
+PBP steps from the robot's position `y = p`, so `(dp, dz)`, "the attractor terms", depend
 on the phase, `p`, the goals and `dt` only (`attractor_terms_into`); `stepped_positions_into`
 and `stepped_velocity_into` add the velocity's part. Drake's `DmpBank` system keeps
 `(z, dp, dz)` in its Context and reads the stepped state out on demand.
@@ -25,8 +18,7 @@ Writing `b(x) = a(x) - g` (the attractor relative to the goal),
     dz = Phi10 (p - g) + C10 b(x0) + C11 b(x1),
 
 with the 2x2 `C` of `StepConstants.combination`; `b` is linear in the normalised basis, so
-the weights are contracted once with both rows' combinations of the bases at `x0` and `x1`.
-"""
+the weights are contracted once with both rows' combinations of the bases at `x0` and `x1`."""
 
 import functools
 import math
@@ -112,10 +104,6 @@ class BankStep:
     def step_constants(self, dt):
         """The `StepConstants` of one step of `dt` (memoised)."""
         return step_constants(self._stiffness, self._damping, self.duration, dt)
-
-    def transition(self, dt):
-        """The read-only 2x2 `Phi = expm(A dt)` of one step of `dt` (memoised)."""
-        return step_matrices(self._stiffness, self._damping, self.duration, dt)[0]
 
     def decay(self, dt):
         """The phase factor `exp(-alpha_x dt / tau)` of one step."""

@@ -16,13 +16,61 @@ from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp._checks import (
     as_point, broadcast_goalwise, followed_velocity, goal_indices, positive, read_only)
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
-from pbp_drake.core.dmp.settings import DmpSettings
+from pbp_drake.core.dmp.settings import DmpSettings, phase_decay
 from pbp_drake.core.dmp.single import Dmp
 from pbp_drake.core.dmp.stepping import BankStep
 from pbp_drake.core.dmp.workspace import DmpWorkspace
 
 
-class DmpBankModel(BankStep):
+class BankModel:
+    """What the position bank and `OrientationDmpBank` share: immutability after
+    `__init__`, the settings, the phase decay, the constructor from single DMPs, and
+    open-loop prediction (a subclass keeps its `starts` as `(rows, K)`)."""
+
+    def __setattr__(self, name, value):
+        # Immutable after construction: a bank shared by threads or Drake Contexts must not
+        # change under any of them (the arrays are read-only for the same reason).
+        if getattr(self, "_frozen", False):
+            raise AttributeError(f"{type(self).__name__} is immutable: cannot set {name!r}")
+        object.__setattr__(self, name, value)
+
+    @classmethod
+    def from_dmps(cls, dmps):
+        """A bank of the given single DMPs (same duration and settings)."""
+        if not dmps:
+            raise ValueError("a DMP bank needs at least one DMP")
+        first = dmps[0]
+        if any(d.duration != first.duration or d.settings != first.settings for d in dmps):
+            raise ValueError("all DMPs of a bank must share duration and settings")
+        return cls(np.stack([d.weights for d in dmps]), np.stack([d.start for d in dmps]),
+                   first.duration, first.settings,
+                   np.stack([d.amplitude_scaling for d in dmps]))
+
+    @property
+    def settings(self):
+        """The bank's gains and basis (a copy: changing it does not change the bank)."""
+        return dataclasses.replace(self._settings)
+
+    def decay(self, dt):
+        """The phase factor `exp(-alpha_x dt / tau)` of one step."""
+        return phase_decay(self._settings, self.duration, dt)
+
+    def predict(self, phase, start, velocity, goals, dt, steps, workspace=None):
+        """Open-loop paths `(K, steps + 1, rows)` from one state (`start` `(rows, 1)` or
+        `(rows, K)`), for drawing predictions; the inputs are left alone. `workspace`
+        saves allocating one (the paths are new anyway)."""
+        workspace = self.make_workspace() if workspace is None else workspace
+        path = np.empty((steps + 1,) + self.starts.shape)
+        path[0] = np.broadcast_to(start, self.starts.shape)
+        phase = np.array(phase, dtype=float)
+        velocity = np.array(velocity, dtype=float)
+        for step in range(steps):
+            self.advance_into(phase, path[step], velocity, goals, dt, phase, path[step + 1],
+                              velocity, workspace)
+        return path.transpose(2, 0, 1)
+
+
+class DmpBankModel(BankStep, BankModel):
     """K DMPs, one per goal, stepped together from one shared robot state.
 
     Vectorised over goals and dimensions; arrays are laid out `(D, K)` internally. All DMPs
@@ -90,30 +138,6 @@ class DmpBankModel(BankStep):
         self._derive_constants()
         self._frozen = True
 
-    def __setattr__(self, name, value):
-        # Immutable after construction: a bank shared by threads or Drake Contexts must not
-        # change under any of them (the arrays are read-only for the same reason).
-        if getattr(self, "_frozen", False):
-            raise AttributeError(f"DmpBankModel is immutable: cannot set {name!r}")
-        object.__setattr__(self, name, value)
-
-    @classmethod
-    def from_dmps(cls, dmps):
-        """A bank of the given single DMPs (same duration and settings)."""
-        if not dmps:
-            raise ValueError("a DMP bank needs at least one DMP")
-        first = dmps[0]
-        for other in dmps[1:]:
-            if other.duration != first.duration or other.settings != first.settings:
-                raise ValueError("all DMPs of a bank must share duration and settings")
-        return cls(
-            np.stack([dmp.weights for dmp in dmps]),
-            np.stack([dmp.start for dmp in dmps]),
-            first.duration,
-            first.settings,
-            np.stack([dmp.amplitude_scaling for dmp in dmps]),
-        )
-
     @classmethod
     def from_demonstration(cls, times, positions, goal_count=1, settings=DmpSettings(),
                            start=None, duration=None):
@@ -142,11 +166,6 @@ class DmpBankModel(BankStep):
         else:
             weights = np.zeros((settings.basis_count, dimension))
         return cls(weights, start, duration, settings, goal_count=goal_count)
-
-    @property
-    def settings(self):
-        """The bank's gains and basis (a copy: changing it does not change the bank)."""
-        return dataclasses.replace(self._settings)
 
     def make_workspace(self):
         """New scratch arrays for the in-place step; one per thread or Drake Context."""
@@ -272,16 +291,3 @@ class DmpBankModel(BankStep):
                    else self._weights[:, :, indices].transpose(2, 0, 1))  # (M, N, D)
         return type(self)(weights, starts, self.duration, self._settings, scaling,
                           goal_count=indices.size)
-
-    def predict(self, phase, position, scaled_velocity, goals_dk, dt, steps, workspace=None):
-        """Open-loop paths `(K, steps + 1, D)` from one state, for drawing predictions; the
-        inputs are left alone. `workspace` saves allocating one (the paths are new anyway)."""
-        workspace = self.make_workspace() if workspace is None else workspace
-        path = np.empty((steps + 1, self.dimension, self.goal_count))
-        path[0] = np.broadcast_to(position, np.shape(scaled_velocity))
-        phase = np.array(phase, dtype=float)
-        scaled_velocity = np.array(scaled_velocity, dtype=float)
-        for step in range(steps):
-            self.advance_into(phase, path[step], scaled_velocity, goals_dk, dt,
-                              phase, path[step + 1], scaled_velocity, workspace)
-        return path.transpose(2, 0, 1)

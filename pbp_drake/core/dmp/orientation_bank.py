@@ -24,6 +24,7 @@ import numpy as np
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.dmp._checks import followed_velocity, goal_indices, positive, read_only
+from pbp_drake.core.dmp.bank import BankModel
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
     AXES, fit_orientation_weights, straight_weights,
@@ -33,7 +34,7 @@ from pbp_drake.core.dmp.orientation_kernels import (
     jacobian_into, log_into, product_into)
 from pbp_drake.core.dmp.orientation_log_step import (
     IDENTITY6, forcing_rows, log_step_from_one_into)
-from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis, phase_decay
+from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis
 from pbp_drake.core.dmp.stepping import step_constants
 
 
@@ -48,7 +49,7 @@ def _log_transition(position_offset, position_velocity, velocity_offset, velocit
     return matrix
 
 
-class OrientationDmpBank:
+class OrientationDmpBank(BankModel):
     """K orientation DMPs, stepped together from one measured orientation.
 
     All share `duration` and `settings`; each has its own start orientation and phase, and
@@ -101,24 +102,6 @@ class OrientationDmpBank:
         self._centres, self._widths = read_only(centres), read_only(widths)
         self._frozen = True
 
-    def __setattr__(self, name, value):
-        # Immutable after construction, as the position bank: shared by threads or Contexts.
-        if getattr(self, "_frozen", False):
-            raise AttributeError(f"OrientationDmpBank is immutable: cannot set {name!r}")
-        object.__setattr__(self, name, value)
-
-    @classmethod
-    def from_dmps(cls, dmps):
-        """A bank of the given single `OrientationDmp` objects (same duration and settings)."""
-        if not dmps:
-            raise ValueError("an orientation DMP bank needs at least one DMP")
-        first = dmps[0]
-        if any(d.duration != first.duration or d.settings != first.settings for d in dmps):
-            raise ValueError("all DMPs of a bank must share duration and settings")
-        return cls(np.stack([d.weights for d in dmps]), np.stack([d.start for d in dmps]),
-                   first.duration, first.settings,
-                   np.stack([d.amplitude_scaling for d in dmps]))
-
     @classmethod
     def from_demonstration(cls, times, orientations, goal_count=1, settings=DmpSettings(),
                            start=None, duration=None):
@@ -141,15 +124,6 @@ class OrientationDmpBank:
         else:
             weights = np.zeros((settings.basis_count, AXES))
         return cls(weights, start, duration, settings, goal_count=goal_count)
-
-    @property
-    def settings(self):
-        """The bank's gains and basis (a copy)."""
-        return dataclasses.replace(self._settings)
-
-    def decay(self, dt):
-        """The phase factor `exp(-alpha_x dt / tau)` of one step (the position bank's)."""
-        return phase_decay(self._settings, self.duration, dt)
 
     def initial_state(self, orientation=None):
         """(phase (K,), orientations (4, K), scaled angular velocity (3, K)) at the start."""
@@ -259,19 +233,6 @@ class OrientationDmpBank:
             weights = weights.reshape(len(weights), AXES, -1)[:, :, indices].transpose(2, 0, 1)
         return type(self)(weights, self.starts[:, indices].T, self.duration, self._settings,
                           self.amplitude_scaling[:, indices].T, goal_count=indices.size)
-
-    def predict(self, phase, orientation, scaled_angular_velocity, goals_4k, dt, steps,
-                workspace=None):
-        """Open-loop orientations `(K, steps + 1, 4)` from one state (inputs left alone)."""
-        workspace = self.make_workspace() if workspace is None else workspace
-        path = np.empty((steps + 1, 4, self.goal_count))
-        path[0] = np.broadcast_to(orientation, (4, self.goal_count))
-        phase = np.array(phase, dtype=float)
-        velocity = np.array(scaled_angular_velocity, dtype=float)
-        for step in range(steps):
-            self.advance_into(phase, path[step], velocity, goals_4k, dt, phase,
-                              path[step + 1], velocity, workspace)
-        return path.transpose(2, 0, 1)
 
     def _start_errors_into(self, goals_4k, workspace, goals_unchanged=False):
         """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`

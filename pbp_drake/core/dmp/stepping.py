@@ -28,7 +28,7 @@ import numpy as np
 
 from pbp_drake.core.dmp._checks import read_only
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
-from pbp_drake.core.dmp.settings import normalized_basis, phase_decay, step_matrices
+from pbp_drake.core.dmp.settings import normalized_basis, step_matrices
 
 _IDENTITY = np.eye(2)
 _IDENTITY.setflags(write=False)
@@ -104,10 +104,6 @@ class BankStep:
     def step_constants(self, dt):
         """The `StepConstants` of one step of `dt` (memoised)."""
         return step_constants(self._stiffness, self._damping, self.duration, dt)
-
-    def decay(self, dt):
-        """The phase factor `exp(-alpha_x dt / tau)` of one step."""
-        return phase_decay(self._settings, self.duration, dt)
 
     def attractors(self, phase, goals_dk):
         """The moving attractors `(D, K)` for phases `(K,)` and goals `(D, K)`, a new array."""

@@ -1,46 +1,22 @@
 """Which of K goals the operator means (the paper's GOAL_ESTIMATOR), in pure NumPy.
 
-Every estimator scores the K goals `(K, 3)` from the end effector's position `p` (3) and
-heading (rad, the pointing direction on the floor plane, counter-clockwise from +x) and
-turns the scores into probabilities that sum to 1:
-
-- ``angle`` (the paper, section III-C): the absolute angle between the heading and the floor
-  direction from `p` to each goal; probabilities `softmax(-angle / temperature)`. A goal
-  straight above or below `p` (floor distance under `FLOOR_EPSILON`) has no direction and
-  scores angle 0: the end effector is already at it.
-- ``nearest``: the Euclidean distance from `p`; probabilities `softmax(-distance /
-  temperature)`.
-- ``bayesian`` (Dragan & Srinivasa 2013, path-length cost, uniform prior):
-  `P(g | S->Q) ∝ exp(-beta (C(S->Q) + |Q - g|)) / exp(-beta |S - g|)`, with `S` the start,
-  `Q = p` and `C(S->Q)` the length of the path travelled so far. `C` is the same for every
-  goal, so it cancels in the normalised posterior: it is kept in `bayesian_log_posterior`
-  for the formula's sake and does not change the probabilities.
-
-- ``pose`` (the grasping task): reads position and orientation
-  (`pbp_drake.core.grasp_estimation.pose_probabilities`, the `PoseGoalEstimator` system).
-- ``maxent_command`` (every task): HOP's goal posterior, which reads the operator's
-  command (Javdani et al. 2015; the scenario's `hop` settings,
-  `pbp_drake.core.maxent_command`); recursive, so it keeps its belief in the estimator's
-  state (`MaxEntGoalEstimator`, `PoseMaxEntGoalEstimator`).
-- ``intent_filter`` (the robot tasks): a recursive posterior on the operator's motions,
-  silences and turns and the hand's heading, with a hazard against runaway confidence
-  (`pbp_drake.core.intent_filter`, the section's `intent_filter` settings;
-  `IntentFilterGoalEstimator`, `PoseIntentFilterGoalEstimator` in the grasping task).
+The estimators that read the hand's position `p` (3) and heading (rad, on the floor plane,
+counter-clockwise from +x) score the K goals `(K, 3)` and turn the scores into
+probabilities that sum to 1, vectorised over K and in log space (a small temperature or a
+large beta gives a one-hot vector rather than NaN): ``angle`` (the paper, section III-C),
+``nearest`` and ``bayesian`` (Dragan & Srinivasa 2013). The others read more and live in
+their own modules: ``pose`` (`grasp_estimation`), ``maxent_command`` (`maxent_command`,
+`hindsight_optimization`) and ``intent_filter`` (`intent_filter`). What each reads and
+scores: docs/concepts/goal-estimators.md.
 
 `ESTIMATORS` is the registry the scenario's `goal_estimator: {method: NAME}` is read
 through: each `Estimator` says what it reads (which picks its system) and, for those that
 read the hand's position, its probabilities function. A new estimator is its function and
 one entry (`register_estimator`); no layer compares an estimator's name.
 
-All of them are vectorised over K (no Python loop over goals) and computed in log space, so a
-small temperature or a large beta gives a one-hot vector rather than NaN.
-
-The selection is the most probable goal, with hysteresis so that it does not chatter: the
-current selection is kept unless, for `hold_steps` consecutive updates, the most probable
-goal beats it by more than `margin`; then the selection moves to the goal most probable at
-that update. The hysteresis memory (`SelectionMemory`) is passed in and returned, so every
-function here is pure.
-"""
+The selection is the most probable goal, with hysteresis so that it does not chatter
+(`update_selection`); the hysteresis memory (`SelectionMemory`) is passed in and returned,
+so every function here is pure."""
 
 import dataclasses
 import math
@@ -75,28 +51,15 @@ NO_CHALLENGER = -1
 @dataclasses.dataclass
 class GoalEstimatorSettings:
     """How goals are scored and how sticky the selection is (scenario files: the
-    `goal_estimator` section).
-
-    `method` is ``angle`` (the paper's heuristic), ``nearest``, ``bayesian``, ``pose``
-    (grasping task only) or ``maxent_command`` (HOP's posterior, on the operator's command;
-    its constants are the scenario's `hop` section). `temperature` scales ``angle`` (rad),
-    ``nearest`` (m) and ``pose`` (rad) scores: low enough that objects a few degrees apart
-    are told apart.
-    `beta` (1/m) is the rationality of ``bayesian``. The ``pose`` score
-    (`pbp_drake.core.grasp_estimation`) adds `distance_weight` (rad per m) times the
-    distance, `orientation_weight` (a factor) times the angle to the grasp orientation, and
-    subtracts the angle the hand's turning would take off it in `turn_horizon` (s); the
-    direction of travel counts only while the hand moves at `min_speed` (m/s) or more.
-    The selection switches once another goal beats it by more than `margin` (in
-    probability) for `hold_steps` consecutive updates; `margin=0, hold_steps=1` switches to
-    the most probable goal at once.
-    """
+    `goal_estimator` section). `margin=0, hold_steps=1` switches to the most probable goal
+    at once; the ``pose`` score's weights are `grasp_estimation`'s."""
 
     #: The score: angle (the paper's heuristic), nearest, bayesian, pose (grasping task
-    #: only), maxent_command (HOP's posterior on the operator's command) or intent_filter
-    #: (the robot tasks).
+    #: only), maxent_command (HOP's posterior on the operator's command; its constants are
+    #: the scenario's `hop` section) or intent_filter (the robot tasks).
     method: str = "angle"
-    #: The scale of the angle (rad), nearest (m) and pose (rad) scores.
+    #: The scale of the angle (rad), nearest (m) and pose (rad) scores: low enough that
+    #: objects a few degrees apart are told apart.
     temperature: float = 0.1
     #: The rationality of bayesian (1/m).
     beta: float = 5.0

@@ -7,24 +7,12 @@ with orientation `q`, moving at `v` (m/s) and turning at `omega` (rad/s, world f
     cost_k = alpha_k + distance_weight |g_k - p|
              + orientation_weight max(0, theta_k - turn_horizon (omega . n_k))
 
-- `alpha_k` (rad, in [0, pi]): the angle between `v` and `g_k - p`, as the ``angle``
-  estimator's heading angle but with the direction of travel in 3-D; 0 for every candidate
-  while `|v| < min_speed` (a hand at rest shows no direction) and for a candidate the hand
-  is at.
-- `theta_k = angle_between(q, q_k)` (rad, in [0, pi], the same for `q_k` and `-q_k`) and
-  `n_k` the unit axis of `r_k = Log(q_k q*)`, the world-frame rotation that takes the
-  hand's orientation to `q_k`. Turning at `omega` changes `theta_k` at the rate
-  `-omega . n_k` exactly (the cross terms of the SO(3) Jacobian are perpendicular to
-  `r_k`), so `theta_k - turn_horizon (omega . n_k)` is the angle left after
-  `turn_horizon` seconds at the present turn rate (at least 0). A hand turning toward a
-  grasp orientation lowers that candidate's cost before it has got there; two objects at
-  the same place with different grasp orientations are told apart by this term alone.
-
-Probabilities are `softmax(-cost / temperature)` (temperature in rad), computed as
-`goal_estimation.softmax_of_costs`, vectorised over K; the selection is the shipped
-hysteresis (`goal_estimation.update_selection`). The settings are the scenario's
-`goal_estimator` section (`GoalEstimatorSettings` with `method: pose`).
-"""
+with `alpha_k` the angle between `v` and `g_k - p` (0 while `|v| < min_speed`),
+`theta_k = angle_between(q, q_k)` and `n_k` the unit axis of `Log(q_k q*)`: the bracket is
+the angle left after `turn_horizon` seconds of the present turn (docs/tasks/grasp.md,
+"The `pose` goal estimator"). Probabilities are `softmax(-cost / temperature)`, vectorised
+over K; the selection is `goal_estimation.update_selection`'s hysteresis. The settings are
+the scenario's `goal_estimator` section (`GoalEstimatorSettings` with `method: pose`)."""
 
 import numpy as np
 

@@ -5,71 +5,22 @@ Sources: S. Javdani, S. Srinivasa, J. A. Bagnell, "Shared Autonomy via Hindsight
 Optimization", RSS 2015; S. Javdani et al., "Shared autonomy via hindsight optimization for
 teleoperation and teaming", IJRR 2018; A. Dragan, S. Srinivasa, "A policy-blending
 formalism for shared control", IJRR 2013. The constants (`HopSettings`' defaults) are the
-published ones.
+published ones. The equations, their constants and why they are as they are:
+docs/concepts/hindsight-optimization.md. In short:
 
-**Targets and goals.** Goal g (one of K) has one or more targets kappa (N in all): a
-position, and in the grasping task an orientation. The reaching tasks give each goal its
-object's position as its one target; the grasping task its grasp pose.
-
-**Costs.** Per target, with the distance d = |p - p_kappa| and, with orientations, the angle
-theta from the hand's orientation to the target's (`quaternion.angle_between`), a Huber-like
-cost of constants alpha (`gain`), delta (`switch`) and c0 (`constant`), with the cost
-model's time step dt (`cost_time_step`):
-
-    step cost   c(x) = dt (alpha + c0)                        if x > delta,
-                       dt ((alpha / delta) x + c0)            otherwise;
-    value       V(x) = (alpha / (2 delta)) x^2 + c0 x          if x <= delta,
-                       (alpha + c0) x - alpha delta / 2        otherwise,
-
-so `c(x) = dt V'(x)`. A target's cost and value are the translation term's (x = d) plus
-`rotation_weight` times the rotation term's (x = theta), each with its own constants. With
-the operator's command u = (v, omega) applied for one step as direct teleoperation,
-`p' = p + v dt` and `q' = Exp(omega dt) q`, and d', theta' the distance and angle from there:
-
-    Q_kappa = c(d) + V(d')  [+ w (c(theta) + V(theta'))],    V_kappa = V(d)  [+ w V(theta)],
-    Q_g = min over g's targets of Q_kappa,                    V_g = min of V_kappa;
-
-a goal's best target is the one of least Q (a goal of one target has it alone).
-
-**The posterior** (maximum-entropy inverse optimal control, recursive), from a uniform prior:
-
-    log b_t(g) = log b_{t-1}(g) - (Q_g - V_g),   normalised by log-sum-exp;
-
-then, when the largest probability exceeds `max_probability`, it is set to `max_probability`
-and the excess is spread evenly over the K - 1 other goals (the published guard against
-certainty; one goal alone is never clipped). The clipped belief is the one carried to the
-next update. Everything stays in log space, so 10,000 goals or a goal a million metres
-away give finite, normalised probabilities.
-
-**The assistance** (QMDP's belief-weighted action):
-
-    a = -(1 / lambda) (sum_g b_g grad Q_g) / (sum_g b_g),
-
-with grad Q_g the gradient of the goal's best target's value at the operator's next pose
-(the step cost is of the present pose, which the action does not change):
-translation `V'(|r|) r / |r|`, r = p' - p_kappa (`(alpha + c0) r/|r|` far, `c0 r/|r| +
-(alpha/delta) r` near); rotation `w V'(theta') n`, n the unit axis of `Log(q' q_kappa*)`,
-along which turning the hand grows theta' at rate 1. Each goal's gradient fades in
-proportion within `translation_fade_distance` of its target (times d' / 0.02 m) and, for
-the rotation, within `rotation_fade_angle` (times theta' / (pi / 12)), on the distance and
-angle after the operator's step, the pose the gradient is taken at, so that the assistance
-vanishes where the operator's step reaches the target instead of chattering about it.
-With `assistance` False the command is `u` alone, exactly teleop's (the posterior still
-runs): a control condition with the baselines' estimator and no help. `lambda` is
-`translation_divisor` (40) and `rotation_divisor` (0.05). HOP's command is `u + a`: additive, not a
-convex blend.
-
-**Predict-then-assist** (`blending_weights`), the predict-then-act variant of HOP's public
-code (HOP's papers call their predict-then-act baseline policy blending, after Dragan and
-Srinivasa; this is not their arbitration `(1 - alpha) U + alpha P`, which is the
-``confidence_alpha`` method of `pbp_drake.core.arbitration`):
-while the two most probable goals differ by at most `blending_threshold` in probability
-the command is the operator's alone; beyond it, full assistance toward the most probable
-goal g*: the operator's command plus HOP's single-goal action toward g* (`a` with the
-whole belief on g*). The operator's velocity is kept, as in HOP's additive command: HOP's
-action is a correction scaled by 1/lambda to add to an operator's velocity, and on its own
-it would move the hand at most (alpha + c0)/lambda = 0.061 m/s, half our operators' speed.
-"""
+- goal g (one of K) has one or more targets kappa (N in all): a position, and in the
+  grasping task an orientation; each target has a Huber-like step cost `c(x)` and value
+  `V(x)` on its distance d (and angle theta), and with the operator's command applied for
+  one step (`p' = p + v dt`, `q' = Exp(omega dt) q`)
+  `Q_kappa = c(d) + V(d')  [+ w (c(theta) + V(theta'))]`, `V_kappa = V(d)  [+ w V(theta)]`;
+  a goal's `Q_g`, `V_g` are its best target's (the least Q);
+- the posterior, from a uniform prior: `log b_t(g) = log b_{t-1}(g) - (Q_g - V_g)`,
+  normalised, its largest probability clipped at `max_probability`;
+- the assistance: `a = -(1 / lambda) (sum_g b_g grad Q_g) / (sum_g b_g)`, each goal's
+  gradient faded near its target; HOP's command is `u + a`;
+- predict-then-assist (`blending_weights`): the operator alone while the two most probable
+  goals differ by at most `blending_threshold`, beyond it `u` plus HOP's action with the
+  whole belief on the most probable goal."""
 
 import dataclasses
 import math
@@ -88,12 +39,9 @@ AT_TARGET = 1e-12
 class HopSettings:
     """The cost model, posterior and assistance of HOP (scenario files: the `hop` section),
     read by the ``hop`` and ``predict_then_assist`` methods and the ``maxent_command`` goal
-    estimator. Each default is the published constant (Javdani et al. 2015, 2018; the
-    module docstring gives the equations). `cost_time_step` is the cost model's step, not
-    the control period: the posterior is updated once per control tick, and far from the
-    targets a tick's evidence between two goals is proportional to the operator's speed
-    times `cost_time_step`, so per second it gathers in proportion to
-    `speed * cost_time_step / control_period` (docs/concepts/hindsight-optimization.md)."""
+    estimator. Each default is the published constant. `cost_time_step` is the cost
+    model's step, not the control period (docs/concepts/hindsight-optimization.md, "The
+    cost model's step, the control tick and the operator's speed")."""
 
     #: The cost model's time step dt (s): a step costs dt times the cost's slope, and the
     #: operator's command is applied for dt to find the distance after it (published: 0.1).

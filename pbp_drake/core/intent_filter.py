@@ -1,57 +1,26 @@
 """The ``intent_filter`` goal estimator, in pure NumPy: a recursive Bayesian posterior over
 the K goals on what the operator does, with a hazard that keeps it from becoming certain for
-good, and the hand's present heading read on top.
+good, and the hand's present heading read on top. Its features, the fit of its rates and
+what it measures: docs/concepts/goal-estimators.md, "What each one reads".
 
 The operator is a hidden Markov chain over the goals: each tick of `dt` seconds it keeps its
-goal, or with probability `h = 1 - exp(-switch_rate dt)` picks one anew (uniformly). Its
-evidence, read every tick from the hand's position `p`, the hand's heading `psi` (rad, on
-the floor plane) and the operator's inputs:
-
-- **motion** `w`: the operator's command while it acts (a correction, or teleoperation), and
-  the hand's own executed velocity while it is silent (letting the robot go on is evidence
-  for the goal the robot is going to, weighed by `silence_rate`). Its feature is `m_g = 1 -
-  2 a_g / pi`, `a_g` the angle between `w` and the direction `g - p` (1 straight at g, 0
-  across, -1 away); 0 while `|w| < min_speed` (no direction), or within `min_speed dt` of
-  g. Linear in the angle, not its cosine: goals a few degrees apart differ as much near
-  the direction of motion as anywhere (a cosine is flat there).
-- **turns**: with the operator's yaw rate `r` (while it acts) the bearing error `e_g =
-  wrap(beta_g - psi)` (`beta_g` the floor bearing of g from `p`) becomes `e'_g = wrap(e_g -
-  r dt)`, and `t_g = (|e_g| - |e'_g|) / |r dt|` lies between +1 (a turn wholly toward g)
-  and -1 (wholly away); 0 while `r = 0`.
-- **heading** (where the hand points now): `h_g = 1 - 2 |e_g| / pi` (1 for a goal straight
-  above or below the hand, which it is already at).
-
-Motions and turns are events: each tick's adds to the belief, at a rate (nats per second,
-so that the evidence does not depend on the control rate). The heading is a state that
-persists, and seeing it again every tick is no new evidence: it is read once, as the
-present observation, on top of the recursive belief and not into it:
+goal, or with probability `h = 1 - exp(-switch_rate dt)` picks one anew (uniformly). Each
+goal's features lie in [-1, 1]: the **motion** `m_g = 1 - 2 a_g / pi` (`a_g` the angle
+between the operator's command, or while it is silent the hand's own velocity, and
+`g - p`; 0 below `min_speed`), the **turns** `t_g` toward g at the operator's yaw rate,
+and the **heading** `h_g = 1 - 2 |e_g| / pi` (`e_g` g's floor bearing from the hand minus
+the hand's heading). Motions and turns are events, added to the belief at rates (nats per
+second); the heading is a state, read once on top of the belief and not into it:
 
     log b_t(g) = log((1 - h) b_{t-1}(g) + h / K) + dt (move_rate m_g + turn_rate t_g)
                  (silent: + dt silence_rate m_g;
                   acting while the robot shows g: - dt override_rate)
     log P_t(g) = log b_t(g) + heading_weight h_g,
 
-each normalised and its largest probability clipped at `max_probability` with the excess
-spread over the others (as HOP's posterior). `b` is the estimator's state, `P` its
-probabilities. The hazard is the floor against runaway confidence: after the prediction no
-goal is below `h / K`, so a belief built over any time is overturned by a bounded time of
-evidence against it (`pbp_drake_bench.runaway` measures it).
-
-The rates, the heading's weight and the switch rate are the operator model's parameters,
-fitted on the tuning seeds of teleop under the arena's pilots (never on PBP's trials) by
-`python -m pbp_drake.studies.intent_fit`, which maximises the mean log probability the
-filter gives the participant's own target, tick by tick; the shipped defaults are its
-output. `silence_rate` and `override_rate` are not fitted (under teleop a silence leaves
-the hand still, and no goal is shown) and are 0 by default: a silence is no evidence, and
-the belief drifts back toward uniform at the switch rate while the present heading carries
-the estimate. Vectorised over K (no Python loop over goals), in log space.
-
-The grasping task's goals are poses (`pose_intent_features`): the motion is read in 3-D
-(without the forward key, across the hand's approach axis), the turns toward each grasp's
-orientation, and the heading from the hand's orientation and where its approach axis
-points; its studies set the silence and override rates, chosen on PBP's tuning seeds
-(docs/results/many-goals.md).
-"""
+each normalised and its largest probability clipped at `max_probability` (as HOP's
+posterior). `b` is the estimator's state, `P` its probabilities; after the prediction no
+goal is below `h / K`, the floor against runaway confidence. Vectorised over K, in log
+space. The grasping task's goals are poses (`pose_intent_features`)."""
 
 import dataclasses
 import math

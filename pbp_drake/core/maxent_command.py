@@ -1,45 +1,26 @@
 """The ``maxent_command`` goal estimator's likelihood, in pure NumPy: HOP's maximum-entropy
 goal posterior (`pbp_drake.core.hindsight_optimization`) made for PBP's operator, who
-corrects, turns the hand to point at a goal, and otherwise lets the robot go on.
+corrects, turns the hand to point at a goal, and otherwise lets the robot go on (why each
+term: docs/concepts/goal-estimators.md, "What each one reads"). Every control tick each
+goal g gains `l_g = l_move_g + l_turn_g`, then the belief is normalised and clipped as
+HOP's posterior:
 
-HOP's published update, `log b(g) -= Q_g - V_g`, reads only the operator's command as
-direct teleoperation. Under PBP that misreads the operator three ways: a silent operator
-gives no evidence, though letting the robot go on toward the goal it follows says that goal
-is right; the step cost `c(x)`, which is the same whatever the operator does, hands a goal
-the hand passes within `delta` (7 cm) up to `alpha dt = 0.225` nats a tick over the far
-goals; and turning the hand, the paper's sign of intent, is not read at all. Here,
-every control tick, each goal g gains
-
-    l_g = l_move_g + l_turn_g,   then normalised and clipped as HOP's posterior,
-
-- **moves** (corrections and silences): `l_move_g = V_g(x) - V_g(x + w dt)`, the drop of
-  goal g's value (`hindsight_optimization.target_values`, translation plus, with
-  orientations, the weighted rotation term) over one step of the cost model `dt` under the
-  implicit command `w`: the operator's command `u` while the operator acts (a
-  correction), the hand's own executed velocity (and angular velocity) while the operator
-  is silent (letting the robot go on is evidence for the goal it is going to). HOP's step
-  cost `c(x)` is left out: it does not depend on the command, so it is no evidence of the
-  goal. The value's slope is at most `alpha + c0` (the translation's, and `w (alpha_r +
-  c0_r)` the rotation's), so a tick moves no goal by more than
-  `(alpha + c0) |w| dt` (plus the rotation's share): passing near a goal earns at most
-  what moving straight at a far one does, whatever the distance.
-- **turns** (the position tasks, whose goals have no orientation): with the hand's heading
-  `psi` and each goal's floor bearing `beta_g` from the hand, the heading error
-  `e_g = wrap(beta_g - psi)` and after the operator's turn `e'_g = wrap(e_g - r dt)`, `r`
-  the operator's commanded yaw rate,
+- **moves**: `l_move_g = V_g(x) - V_g(x + w dt)`, the drop of g's value
+  (`hindsight_optimization.target_values`) over one step of the cost model `dt` under the
+  implicit command `w`: the operator's command while it acts, the hand's own executed
+  velocity (and angular velocity) while it is silent. HOP's step cost `c(x)` is left out:
+  it does not depend on the command.
+- **turns** (the position tasks, whose goals have no orientation): with the heading error
+  `e_g = wrap(beta_g - psi)` and after the operator's yaw rate `r` for one step
+  `e'_g = wrap(e_g - r dt)`,
 
       l_turn_g = (alpha + c0) s dt (|e_g| - |e'_g|) / |r dt|     (0 while r = 0),
 
-  between `+(alpha + c0) s dt` for a turn wholly toward g and `-(alpha + c0) s dt` for one
-  wholly away: a tick of turning toward a goal is worth a tick of moving straight at it
-  at the operator's speed `s` (the task's nominal speed). A goal straight above or below
-  the hand has no bearing and gains nothing from turns.
+  `s` the task's nominal speed: a tick of turning toward a goal is worth a tick of moving
+  straight at it. A goal straight above or below the hand gains nothing from turns.
 
-The constants are HOP's published ones (the scenario's `hop` section) and `s`, the speed
-the operators move at; none is fitted. The telescoped moves are HOP's progress term,
-`V_g(x_0) - V_g(x_t)`, along the path the hand actually took under the operator's
-corrections and the robot's own motion.
-"""
+The constants are HOP's published ones (the scenario's `hop` section) and `s`; none is
+fitted."""
 
 import math
 import typing

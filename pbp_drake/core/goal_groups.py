@@ -1,9 +1,5 @@
-"""Goals that cannot be told apart act as one, in pure NumPy.
-
-With many candidate goals a goal estimator's probabilities spread over the goals near
-where the operator points; following the single most probable of them takes the robot to
-a neighbour of the intended goal about as often as to the goal, and the operator spends
-the run correcting it. Here the robot follows the group instead, coarse to fine:
+"""Goals that cannot be told apart act as one, in pure NumPy (why, and the settings:
+docs/concepts/goal-estimators.md, "Many goals: goal groups").
 
 - **The group** is the smallest set of the most probable goals that holds `group_mass` of
   the probability (a credible set; O(K) partitions and a sort of the group's members).
@@ -11,28 +7,18 @@ the run correcting it. Here the robot follows the group instead, coarse to fine:
   is steered to it, so the robot heads into the region the operator means.
 - **Commitment.** The robot commits to the estimator's selected goal (its hysteresis
   kept) and shows it once the group is one goal, or its goals lie within `commit_radius`
-  of their point (they act as one), or the most probable goal holds `commit_probability`,
-  or the hand has reached the group's point (within `commit_radius`: heading into the
-  region is done, and the best guess is shown for the operator to confirm or correct).
-  Until then it shows no goal: `NO_GOAL` is the shown index. A commitment holds while the
-  estimator selects the same goal (`committed`), so that the robot leaving the group's
-  point for the goal does not undo it.
+  of their point, or the most probable goal holds `commit_probability`, or the hand has
+  reached the group's point (within `commit_radius`). Until then it shows no goal
+  (`NO_GOAL`). A commitment holds while the estimator selects the same goal (`committed`).
 
-As the hand nears the group, goals off its heading fall out of it and the group narrows to
-the goal meant; a goal that stays ambiguous (two goals in line) is decided by the
-operator's correction, as with a single goal.
-
-**Poses** (the grasping task's goals, `pose_group_target`): the group's point is a pose,
-the probability-weighted mean position and the weighted mean of the orientations (each
-quaternion on the hemisphere of the most probable one, the sum normalised: the chordal
-mean, close to the geodesic one for the nearby orientations a group holds). Distances are
-the task's pose error `|p - g| + L angle(q, q_g)` (`L` metres per radian: with the task's
-`success_distance / success_angle`, turning by the success angle counts as moving the
-success distance), so that `commit_radius` bounds turns as well as moves. The robot also
-commits once the hand is within `commit_radius` of the selected grasp, or the grasps within
-`commit_radius` of it hold `commit_probability` together: an object's grasps differ in
-orientation at nearly one place, and a group of them can hold its pose away from each.
-"""
+**Poses** (the grasping task's goals, `pose_group_target`): the group's point is the
+probability-weighted mean position and the chordal mean of the orientations (each on the
+hemisphere of the most probable one). Distances are the task's pose error
+`|p - g| + L angle(q, q_g)` (`grasp_task`), so that `commit_radius` bounds turns as well
+as moves. The robot also commits once the hand is within `commit_radius` of the selected
+grasp, or the grasps within `commit_radius` of it hold `commit_probability` together: an
+object's grasps differ in orientation at nearly one place, and a group of them can hold
+its pose away from each."""
 
 import typing
 

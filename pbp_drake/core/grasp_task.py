@@ -1,45 +1,16 @@
-"""The grasping task: the reach task's scene with a grasp pose per object, in
-pure NumPy.
+"""The grasping task: the reach task's scene with a grasp pose per object, in pure NumPy.
 
-Scene. 2 to 4 upright cylinders (`object_radius`, `object_height`), each standing at the
-centre of its own table, a box `table_size` (x, y) wide whose top is at `table_height`.
-The tables' centres are drawn uniformly in the reach task's rectangle in front of the robot
-(x in [1.25, 2.5], y in [-1.05, 1.05] by default), at least `min_separation` apart on the
-floor (redrawn otherwise, as in reach); the separation must exceed the tables' diagonal so
-that no two tables overlap (`sample_grasp_scene` checks it).
-
-Hand frame H (the station's end-effector frame, `hand_palm_link`): origin at the palm,
-+z_H the approach direction (out of the palm, between the fingers; the station's
-`heading` is the floor angle of z_H), +y_H the direction the fingers close along,
-x_H = y_H x z_H. Orientations are unit quaternions (w, x, y, z) mapping H to the world
-(`pbp_drake.core.quaternion`). The world's +x is the direction the robot faces at its start.
-
-Grasp poses. Each object is grasped from the side or from above (from above with
-probability `top_probability`):
-
-- side, at a yaw psi drawn in `yaw_range` (default [-60, 60] degrees): z_H horizontal at
-  the floor angle psi from +x (0: straight ahead, away from the robot; positive: turned
-  counter-clockwise seen from above), y_H horizontal (the fingers close left-right), x_H
-  straight down. `side_grasp_orientation(psi) = Rz(psi) Ry(90 deg)`. At psi = 0 it is the
-  hand of the station's ready pose as this module assumes it (pointing ahead, level).
-- top, at a wrist roll rho drawn in `roll_range` (default [-90, 90] degrees): z_H straight
-  down; at rho = 0 the ready hand pitched down (x_H = -x, y_H = +y: the fingers close
-  left-right), turned by rho about its own approach axis (right-handed about z_H, so
-  clockwise seen from above). `top_grasp_orientation(rho) = Ry(180 deg) Rz(rho)`.
-
-The grasp point is the cylinder's axis at half its height (side) or at its top face (top);
-the hand's grasp position is `grasp_depth` behind it along the approach (the palm stands
-back from the point the fingertips close on): `grasp point - grasp_depth z_H`.
-
-Rules. The target sequence is drawn as in reach (a different object at each entry of the
-switch schedule, 0 %, 30 %, 60 %). Progress toward a target grasp pose mixes position and
-orientation with a length per radian `L`: `1 - e(now) / e(start)`, clipped to [0, 1], where
-`e = |p - g| + L angle(q, q_g)`; the task uses `L = success_distance / success_angle`, so a
-turn of the success angle counts as much as a move of the success distance. Success is the
-hand within `success_distance` (3 cm) of the target's grasp position AND within
-`success_angle` (10 degrees) of its grasp orientation, both bounds inclusive; the angle is
-`quaternion.angle_between`, the same for q and -q.
-"""
+The scene, the frames and the rules are docs/tasks/grasp.md's ("Frames and conventions",
+"The scene", "Rules"). In short: 2 to 4 upright cylinders, each on its own table, drawn
+as the reach task's objects; each is grasped from the side at a yaw
+(`side_grasp_orientation`) or from above at a wrist roll (`top_grasp_orientation`), the
+hand's grasp position `grasp_depth` behind the grasp point along the approach axis z_H.
+Orientations are unit quaternions (w, x, y, z) mapping the hand frame H
+(`hand_palm_link`) to the world (`pbp_drake.core.quaternion`). Progress toward a target
+grasp pose is `1 - e(now) / e(start)` with the pose error
+`e = |p - g| + L angle(q, q_g)`, `L = success_distance / success_angle`; success is the
+hand within `success_distance` of the grasp position AND within `success_angle` of its
+orientation, both bounds inclusive."""
 
 import dataclasses
 

@@ -1,50 +1,29 @@
 """The virtual participant of the grasping task, in pure NumPy: the reach participant's
-honest rules (`pbp_drake.core.participant_reach`) with the hand's orientation.
+honest rules (`pbp_drake.core.participant_reach`) with the hand's orientation; its
+behaviour in full is docs/tasks/grasp.md, "The virtual participant".
 
-It sees the true target (an object index) and notices a new one only `reaction_delay`
-seconds after it appears (`notice_target`). It commands a twist `[v (3), omega (3)]`, both
-in the world frame (m/s, rad/s). It is never told the method. Whether it acts is the
-reach participant's one rule (`pbp_drake.core.participant_serving`): it acts while the
-robot's shown intent names another object, or while the hand does not close in on the
-target's grasp position at `serve_speed_fraction` of its own preferred speed for
-`serve_patience`, and lets go while the robot serves the target. What it presses is the
-keys' (`forward_key`, the method's):
+It sees the true target and notices a new one `reaction_delay` seconds after it appears
+(`notice_target`); it is never told the method. It acts by the reach participant's one
+rule (`pbp_drake.core.participant_serving`) and commands a world-frame twist
+`[v (3), omega (3)]` (m/s, rad/s) with the keys the method enables (`forward_key`):
 
-- with the forward key (teleop, and the baselines that add to a full command): the whole
-  twist, `v` toward the target's grasp position at `speed` (slowing in proportion within
-  `slow_radius`), `omega` about the axis of `Log(q_target q*)` at `rotation_speed` (in
-  proportion within `slow_angle`; none within `aligned_angle`), so that both errors shrink
-  together to the grasp pose.
-- without it (the paper's PBP), while the shown intent names another object ("picked"),
-  it turns the hand toward the target's grasp
-  orientation as when driving (what the ``pose`` estimator's orientation term reads) and
-  moves along `u_target - u_picked` (the unit directions from the hand to the two grasp
-  positions): the direction in which the distance to the target shrinks fastest against
-  the distance to the picked one, i.e. sideways or backward, away from the picked object.
-  Any forward part along the hand's approach axis z_H is removed (`without_forward`), as
-  with the paper's disabled forward key. Two grasps at one place differ only in
-  orientation: it then only turns. With the intent on the target (or none shown) but the
-  robot too slow, it presses what is left of driving there without the forward key, and
-  waits when that is little.
-- Once it has held the target's grasp orientation (within twice `aligned_angle`) for
-  `insist_time` while the estimate still names another object, it goes to the target
-  itself as far as the keys allow, as the reach participant does (`insist_twist`): along
-  the direction to the target without its forward part, slowing within `slow_radius`. It
-  keeps insisting until a new target appears. (Backing away from the picked object can
-  walk the hand off the scene when the target stands behind it.)
+- with the forward key: the whole twist toward the target's grasp pose (`drive_twist`):
+  `v` at `speed`, slowing within `slow_radius`, `omega` about the axis of
+  `Log(q_target q*)` at `rotation_speed`, in proportion within `slow_angle`, none within
+  `aligned_angle`;
+- without it, while the shown intent names another object ("picked"): it turns toward
+  the target's grasp orientation and moves along `u_target - u_picked` (`assist_twist`),
+  any forward part along the approach axis z_H removed (`without_forward`); with the
+  intent on the target but the robot too slow, what is left of driving there without the
+  forward key, or it waits when that is little;
+- once it has held the target's grasp orientation (within twice `aligned_angle`) for
+  `insist_time` while the estimate names another object, it goes to the target itself as
+  far as the keys allow (`insist_twist`), until a new target appears.
 
-Its commands carry noise drawn from `(seed, tick)` (`command_noise`): `v` rotated by
-N(0, `direction_noise`) rad about an axis perpendicular to it, the whole twist scaled by
-(1 + N(0, `speed_noise`)), clipped at 0. Everything is a pure function of its arguments;
-the little it remembers (`ParticipantMemory`) is passed in and returned, so a LeafSystem
-keeps it in its discrete state.
-
-Its `impairment` (`pbp_drake.core.participant_impairment`; none by default) works as the
-reach participant's: the motor noise a system passes in (`motor_noise`, on `v` and `omega`)
-is added while it acts, never forward when assisting; each time it comes to know a target
-it may first head for another object's grasp pose (position and orientation) for
-`mistake_time`; the system delays its commands by `command_delay`.
-"""
+Its commands carry noise drawn from `(seed, tick)` (`command_noise`) and, with an
+`impairment` (`pbp_drake.core.participant_impairment`), the reach participant's motor
+noise, mistakes and delay. Everything is a pure function of its arguments; what it
+remembers (`ParticipantMemory`) is passed in and returned."""
 
 import copy
 import dataclasses

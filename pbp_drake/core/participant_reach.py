@@ -1,41 +1,25 @@
 """What the virtual participant does in the reaching task, in pure NumPy (the system,
-`pbp_drake.systems.operators.virtual_operator`, adds the belief, the noise and the timing).
+`pbp_drake.systems.operators.virtual_operator`, adds the belief, the noise and the timing;
+the behaviour in full: docs/tasks/reach.md, "The virtual participant").
 
 Assisting (PBP, arbitration) with the forward key disabled, a person shows the goal they
-mean with what the keys still allow: turning, sidestepping and backing. Each of the shipped
-goal estimators reads a different part of that: ``angle`` where the hand points, ``nearest``
-which object the hand is closest to, ``bayesian`` which object the hand has gained on since
-the start. `assist_motion` serves all three with one behaviour:
+mean with what the keys still allow. `assist_motion` serves every shipped estimator with
+one behaviour: it turns to face the target (what ``angle`` reads) and moves along
+`u_target - u_picked`, the unit direction to the target minus that to the object picked
+instead, its forward part removed: the gradient of `|p - target| - |p - picked|`, what
+``nearest`` and ``bayesian`` compare. When the two stand in line it steps aside; once it
+has faced the target for `insist_time` and the estimate still names another object, it
+goes to the target itself as far as the keys allow.
 
-- it turns to face the target (``angle``), and moves along `u_target - u_picked`, the unit
-  direction to the target minus that to the object picked instead, with its forward part
-  removed. Along `u_target - u_picked` the distance to the target shrinks fastest against
-  the distance to the picked object (the gradient of `|p - target| - |p - picked|`), which
-  is what ``nearest`` and ``bayesian`` compare. Facing the target, it is a sidestep away
-  from the picked object.
-- when the two stand in line (no sidestep separates them), it steps aside to widen the
-  angle between them.
-- when it has faced the target for `insist_time` and the estimate still names another
-  object (the target is behind the picked one, say, and only forward motion would tell
-  them apart), it goes to the target itself as far as the keys allow: it turns the target
-  to its side and sidesteps toward it, slowing near it as when driving.
+Where turning cannot show the target (an arm's wrist turns the tool only so far:
+`can_point_at`), it first moves the hand to where it can (`reposition_motion`). The HSR's
+base turns all the way round, so there nothing differs.
 
-Where turning cannot show the target (an arm's wrist turns the tool only so far, and a
-target behind or beside the tool, or one more above or below the hand than beside it, has
-no heading the tool can take: `can_point_at`), it first moves the hand to where it can
-(`reposition_motion`): it backs away, and moves up or down toward the target's height,
-turning the tool as far toward the target as the wrist goes. The HSR's base turns all the
-way round, so on its floor-plane tasks every target can be pointed at and nothing differs.
-
-With `vertical=True` (a task whose objects stand at different heights, and keys that move
-the hand up and down) the velocities are 3-vectors `(vx, vy, vz)` instead of floor
-2-vectors. Driving (`drive_motion`) it heads for the target in 3-D. Assisting
-(`assist_motion`), the DMP takes the hand to the selected goal's height by itself: the
-participant moves only on the floor, as above (vz = 0), except when insisting, when it
-also goes toward the target's height. Either way its horizontal and vertical motion
-combine into one speed, as pressed keys do, at most `speed`. With `vertical=False` (the
-default) nothing differs from the planar task.
-"""
+With `vertical=True` (objects at different heights, keys that move the hand up and down)
+the velocities are `(vx, vy, vz)` instead of floor 2-vectors: driving heads for the target
+in 3-D; assisting moves only on the floor (the DMP takes the hand to the goal's height),
+but when insisting. Horizontal and vertical motion combine into one speed, at most
+`speed`."""
 
 import numpy as np
 

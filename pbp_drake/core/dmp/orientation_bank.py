@@ -1,21 +1,12 @@
 """K orientation DMPs, one per goal orientation, as one immutable model stepped by a pure
 function vectorised over goals (the formulation: `pbp_drake.core.dmp.orientation`).
 
-The API is the position `DmpBankModel`'s, with orientations for positions, so that a 6-DoF bank
-can step both halves side by side: the state is `(phase (K,), orientations (4, K),
-scaled angular velocities (3, K))`, `eta = tau omega` in the world frame; goals are `(4, K)`
-(`goals_matrix` checks `(K, 4)` rows); `advance` steps from the robot's measured orientation
-`(4, 1)` (or one per DMP, `(4, K)`) and the DMPs' own `eta`. The two banks share the phase
-variable: given the same settings, `tau` and `locked`, their phases stay equal, and
-PBP-Alt's lock is the same `locked` flag passed to both.
-
-The step is the position bank's first-order-hold step on `e = Log(q g*)` (3, K), with the
-memoised `stepping.step_constants`: the basis is evaluated at the step's two phases only
-when the phases are equal (the normal case), and contracted with the weights once. The
-quaternion math around it (`orientation_kernels`) writes into an `OrientationWorkspace` the
-caller owns (`make_workspace`), so that `advance_into` from one measured orientation
-allocates nothing of size K; `advance` is the same step into new arrays.
-"""
+The API is the position `DmpBankModel`'s, with orientations for positions, so that a 6-DoF
+bank can step both halves side by side: the state is `(phase (K,), orientations (4, K),
+scaled angular velocities (3, K))`, goals are `(4, K)`, and given the same settings, `tau`
+and `locked` the two banks' phases stay equal. The step is the position bank's on
+`e = Log(q g*)` (3, K), with the quaternion math around it (`orientation_kernels`,
+`orientation_log_step`) written into an `OrientationWorkspace` the caller owns."""
 
 import dataclasses
 import functools

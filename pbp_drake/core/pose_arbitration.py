@@ -1,28 +1,14 @@
 """Six-DoF blending: the operator's twist and the policy's pose reference become one pose
-reference, and the six-DoF hand-over law (formulas and reasons: docs/concepts/six-dof.md).
+reference, and the six-DoF hand-over law (the laws' table and why they take these forms:
+docs/concepts/six-dof.md, "The blending laws").
 
-A pose reference is the pose to be at after one control period and the twist to move at:
-`PoseReference(position (3,), orientation (4,) unit (w, x, y, z), velocity (3,),
-angular_velocity (3,))`, velocities in the world frame. The operator's command is a twist
-`u = (u_v, u_w)`; over one period `dt` the operator alone would take the hand from
-`(y, q_y)` to
-
-    U = (y + u_v dt, Exp(u_w dt) q_y),
-
-turning it at the world-frame angular velocity `u_w` (`Exp` of `pbp_drake.core.quaternion`).
-The laws are the position ones (`pbp_drake.core.arbitration`), with the orientation on SO(3):
-
-- ``pbp_continuous``: the policy's next pose moved by the operator's displacement,
-  `(p_P + u_v dt, Exp(u_w dt) q_P)`, twist `(v_P + u_v, w_P + u_w)`;
-- ``pbp_alternated``: `U` with twist `u` while the operator acts, else `P`;
-- ``fixed_alpha`` and ``confidence_alpha``: while the operator acts, positions and twists
-  mixed linearly, `(1 - alpha) U + alpha P`, and the orientation by the geodesic,
-  `slerp(q_U, q_P, alpha)`; else `P`;
-- ``teleop``: `U` with twist `u`; ``pbp_no_user``: `P` (the operator is ignored).
-
-Angular velocities are vectors of one tangent space (the world frame's), so adding and
-mixing them as vectors is exact; orientations are never mixed as vectors nor as angles.
-"""
+A pose reference is the pose to be at after one control period and the twist to move at
+(`PoseReference`), velocities in the world frame. Over one period `dt` the operator's
+twist `u = (u_v, u_w)` alone would take the hand from `(y, q_y)` to
+`U = (y + u_v dt, Exp(u_w dt) q_y)`. The laws are the position ones
+(`pbp_drake.core.arbitration`) with the orientation on SO(3): angular velocities add and
+mix as vectors; orientations are turned by `Exp` or mixed by `quaternion.slerp`, never as
+vectors nor as angles; ``pbp_no_user`` is the policy alone."""
 
 from typing import NamedTuple
 

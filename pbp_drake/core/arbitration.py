@@ -2,40 +2,25 @@
 
 Every law returns the reference the robot tracks next: a position and a velocity. The
 operator's command `u` is a velocity; over one control period `dt` the operator alone would
-move the robot from `y` to `U = y + u dt`.
-
-- ``pbp_continuous`` (Alg. 1): the DMP's next state plus the operator's displacement,
-  `T = y_dmp + u dt`. The DMP keeps running.
-- ``pbp_alternated`` (Alg. 2): while the operator acts, the operator alone, `T = U`
-  (the DMP bank locks its phase); otherwise the DMP, `T = y_dmp`.
-- ``fixed_alpha`` (Dragan & Srinivasa 2013): `T = (1 - alpha) U + alpha P` while the
-  operator acts, `T = P` otherwise (an idle operator has no command to blend; at alpha 0 the
-  operator has full control when acting, at alpha 1 the operator is ignored).
-- ``confidence_alpha`` (Dragan & Srinivasa 2013, arbitration as a function of the robot's
-  confidence): the same law as ``fixed_alpha``, but `alpha` is recomputed every control
-  period from the goal estimator's probabilities by `confidence_alpha` below (the caller
-  passes the result to `blend` as `alpha`). An idle operator again gives `T = P`.
-- ``teleop``: `T = U`.
+move the robot from `y` to `U = y + u dt`. The laws by mode (`BLEND_LAWS`; the table:
+docs/concepts/pbp.md, "The blending laws"): ``pbp_continuous`` (Alg. 1) `y_dmp + u dt`;
+``pbp_alternated`` (Alg. 2) `U` while the operator acts, else `y_dmp`; ``fixed_alpha``
+(Dragan & Srinivasa 2013) `(1 - alpha) U + alpha P` while the operator acts, else `P`;
+``confidence_alpha`` the same with `alpha` from the goal confidence (`confidence_alpha`,
+every control period); ``teleop`` `U`.
 
 Confidence, for ``confidence_alpha``, is the Jain-style margin (Jain & Argall 2019) of the
-selected goal: its probability minus the highest probability among the other goals,
-clipped at 0,
+selected goal, after normalising the probabilities to sum 1,
 
     confidence = max(0, p[selected] - max_{j != selected} p[j]),
 
-after normalising the probabilities to sum 1. A uniform distribution gives 0, a one-hot
-distribution on the selected goal gives 1, and a single goal (K = 1) gives 1. The margin
-(rather than the normalised maximum `(p_max - 1/K) / (1 - 1/K)`) is used because it is 0
-whenever the selected goal is tied with another one, however the rest of the mass is
-spread (e.g. `[0.5, 0.5, 0]`), and because it measures the *selected* goal, which the goal
-estimator's hysteresis may keep for a while after another goal became more probable
-(the confidence is then 0, and the operator keeps full control). The confidence is mapped
-to `alpha` by the "timid/aggressive" linear ramp
+rather than the normalised maximum `(p_max - 1/K) / (1 - 1/K)`: it is 0 whenever the
+selected goal is tied with another one, however the rest of the mass is spread (e.g.
+`[0.5, 0.5, 0]`), and it measures the *selected* goal, which the estimator's hysteresis
+may keep after another became more probable (the operator then keeps full control). It is
+mapped to `alpha` by the "timid/aggressive" linear ramp
 
-    alpha = clip((confidence - low) / (high - low), 0, 1) * alpha_max,
-
-so the robot does not assist below `low`, reaches `alpha_max` at `high` and above.
-"""
+    alpha = clip((confidence - low) / (high - low), 0, 1) * alpha_max."""
 
 import typing
 

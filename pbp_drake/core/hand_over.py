@@ -1,4 +1,5 @@
-"""The hand-over law: how the command passes between the operator and the primitives.
+"""The hand-over law: how the command passes between the operator and the primitives
+(docs/concepts/hand-over.md).
 
 Whatever the blending law sends, the robot's command changes its velocity by at most
 `a_max dt` per control period `dt` and never exceeds the speed `v_max`. With `(p_k, v_k)` the
@@ -8,16 +9,10 @@ of tick k is
     v'_k = v'_{k-1} + clip(cap(v_k) - v'_{k-1}, a_max dt)
     p'_k = p_k + (v'_k - v_k) dt
 
-with `clip(d, r) = d min(1, r / |d|)` and `cap(v) = clip(v, v_max)`. The velocity moves
-toward the (capped) reference along the straight line between them, no faster than `a_max`,
-and the position is the reference's shifted by the velocity not yet reached over one
-period. Both `v'_{k-1}` and `cap(v_k)` lie within the speed limit, so every point between
-them does. In steady motion below `v_max`, `v'_k = v_k` and the law is the blending law
-itself; it acts only where the reference jumps: a goal switch, the operator pressing
-(PBP-Alt hands the robot to the operator, explicit arbitration mixes the operator in) and
-releasing (the primitives take the robot back), and where a primitive far from its
-attractor would rush.
-"""
+with `clip(d, r) = d min(1, r / |d|)` and `cap(v) = clip(v, v_max)`. Both `v'_{k-1}` and
+`cap(v_k)` lie within the speed limit, so every point between them does. In steady motion
+below `v_max` the law is the blending law itself; it acts only where the reference jumps
+(a goal switch, the operator pressing or releasing, a primitive far from its attractor)."""
 
 import math
 

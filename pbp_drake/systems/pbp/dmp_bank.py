@@ -13,7 +13,7 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
 from pbp_drake.systems.ports import PortGetters, goal_index
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_update_offset
 
 
 class DmpBank(PortGetters, LeafSystem):
@@ -99,11 +99,7 @@ class DmpBank(PortGetters, LeafSystem):
         self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)
-        if update_offset is None:
-            update_offset = decide_offset(self._period)
-        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
-            raise ValueError(
-                f"update_offset must be in [0, control_period), got {update_offset!r}")
+        update_offset = checked_update_offset(update_offset, self._period)
         k, d = bank.goal_count, bank.dimension
         if compact_state and not bank.affine_in_goal:
             raise ValueError(

@@ -22,7 +22,7 @@ from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, goal_index
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
     AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
     hold_into, per_goal_arrays, split_head, state_size, step_all)
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_period, checked_update_offset
 
 class PoseDmpBank(PortGetters, LeafSystem):
     """Steps K pose DMPs (one per goal pose) every control period from the hand's pose.
@@ -106,11 +106,7 @@ class PoseDmpBank(PortGetters, LeafSystem):
         self._period = float(control_period)
         self._decay = position_bank.decay(self._period)  # the phase factor of one update
         self._lock = bool(lock_phase_when_operator_acts)
-        if update_offset is None:
-            update_offset = decide_offset(self._period)
-        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
-            raise ValueError(
-                f"update_offset must be in [0, control_period), got {update_offset!r}")
+        update_offset = checked_update_offset(update_offset, self._period)
         k = self._goal_count = position_bank.goal_count
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", PoseState.size)
         self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
@@ -432,9 +428,7 @@ def _check_banks(position_bank, orientation_bank, control_period):
     if position_bank.goal_count != orientation_bank.goal_count:
         raise ValueError(f"the banks have {position_bank.goal_count} and "
                          f"{orientation_bank.goal_count} goals; a pose bank needs one count")
-    period = float(control_period)
-    if not (np.isfinite(period) and period > 0.0):
-        raise ValueError(f"control_period must be positive, got {control_period!r}")
+    period = checked_period(control_period)
     if position_bank.decay(period) != orientation_bank.decay(period):
         raise ValueError("the position and orientation banks must share one phase: give them "
                          "the same duration and alpha_x")

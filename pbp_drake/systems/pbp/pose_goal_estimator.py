@@ -43,17 +43,15 @@ class PoseGoalEstimator(PortGetters, LeafSystem):
     hold between updates, as `GoalEstimator`'s.
 
     At initialisation it selects the most probable grasp pose at once (no hysteresis);
-    each update, at the decide stage of the tick (`update_offset` overrides it), it
+    each update, at the decide stage of the tick, it
     recomputes the probabilities and moves the selection with the shipped hysteresis.
     """
 
-    def __init__(self, goal_count, settings, control_period, update_offset=None):
+    def __init__(self, goal_count, settings, control_period):
         super().__init__()
         if not isinstance(settings, GoalEstimatorSettings) or settings.method != "pose":
             raise ValueError("settings must be a GoalEstimatorSettings with method 'pose'")
         settings.validate()
-        if update_offset is None:
-            update_offset = decide_offset(control_period)
         k = self._goal_count = int(goal_count)
         # A copy: the settings are a plain (mutable) dataclass the caller may change later.
         self._settings = dataclasses.replace(settings)
@@ -70,8 +68,8 @@ class PoseGoalEstimator(PortGetters, LeafSystem):
                                                                self._probabilities_index)
         self.DeclareInitializationDiscreteUpdateEvent(
             lambda context, state: self._estimate(context, state, None))
-        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period), update_offset,
-                                                self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period),
+                                                decide_offset(control_period), self._update)
 
     def _update(self, context, state):
         challenger, count = context.get_discrete_state(self._memory_index).value()

@@ -38,6 +38,8 @@ _KEY_AXES = {
     RIGHT_BUTTON: (0.0, -1.0, 0.0, 0.0),
     TURN_LEFT_BUTTON: (0.0, 0.0, 0.0, 1.0),
     TURN_RIGHT_BUTTON: (0.0, 0.0, 0.0, -1.0),
+    UP_BUTTON: (0.0, 0.0, 1.0, 0.0),
+    DOWN_BUTTON: (0.0, 0.0, -1.0, 0.0),
 }
 
 #: The buttons `vertical=True` adds (name -> `KeyboardEvent.code`): R up, F down.
@@ -45,7 +47,6 @@ VERTICAL_KEY_BUTTONS = {
     UP_BUTTON: "KeyR",
     DOWN_BUTTON: "KeyF",
 }
-_KEY_AXES.update({UP_BUTTON: (0.0, 0.0, 1.0, 0.0), DOWN_BUTTON: (0.0, 0.0, -1.0, 0.0)})
 
 
 @dataclasses.dataclass
@@ -121,7 +122,6 @@ class KeyboardOperator(SampledOperator):
         super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
         self.browser_guard = BrowserGuard(meshcat) if exclusive else None
-        self._allow_forward = bool(allow_forward)
         self._vertical = bool(vertical)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)

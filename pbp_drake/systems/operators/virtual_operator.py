@@ -311,12 +311,10 @@ class VirtualOperator(SampledOperator):
         hold = track[3]
         track[3] = max(hold - 1.0, 0.0)
         track[remembered] = obstacles.reshape(-1)
-        # Its own last decision (what it pressed) and what the robot got: the same unless
-        # its commands are delayed.
-        decided, sent = self._latest(context), self._held(context)
+        # Its own last decision (what it pressed; the robot gets it later if delayed).
+        decided = self._latest(context)
         was_active = decided[4] > 0.5
         last_command = decided[:2] if was_active else np.zeros(2)
-        last_sent = sent[:2] if sent[4] > 0.5 else np.zeros(2)
 
         def finish(command, active, hold_ticks=None):
             if hold_ticks is not None:
@@ -383,13 +381,7 @@ class VirtualOperator(SampledOperator):
             yaw_rate = 0.0
         command = speed_scale * rotate_planar(planned, noise_angle)
         if robot_pulls(params, self._speed, own_motion):
-            # The robot's own motion: what the hand does minus what was asked of it.
-            policy_velocity = velocity - last_sent
-            command = command - policy_velocity
-            norm = np.linalg.norm(command)
-            limit = params.policy_compensation * self._speed
-            if norm > limit:
-                command *= limit / norm
+            command = self._against_policy(context, ee_state, command)
         hold_ticks = track[3] if was_active or not shows else self._hold_ticks
         return finish(np.array([command[0], command[1], 0.0, yaw_rate]), True, hold_ticks)
 

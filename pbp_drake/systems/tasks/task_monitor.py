@@ -209,9 +209,6 @@ class TaskMonitor(TaskMonitorBase):
         self._start = np.asarray(start, dtype=float)
         self._success_distance = float(success_distance)
 
-    def get_ee_state_input_port(self):
-        return self._hand_port
-
     def _read_hand(self, vector):
         return position_of(EeState(vector))
 

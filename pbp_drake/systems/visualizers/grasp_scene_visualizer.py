@@ -3,15 +3,15 @@ many, the likeliest grasps' triads), every grasp's probability as one point clou
 target and the estimated goal, the hand, and the selected DMP's predicted poses."""
 
 import numpy as np
-from pydrake.geometry import Box, Cylinder, Sphere
+from pydrake.geometry import Box, Cylinder
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.pbp.likely_goals import likely_goal_indices
 from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, Target, goal_index
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
-    CLOUD_POINT_SIZE, ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, SOLID_OBJECTS,
-    TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
+    CLOUD_POINT_SIZE, OBJECT_COLOUR, SOLID_OBJECTS, TABLE_COLOUR, TaskMarkers,
+    behind_the_robot)
 from pbp_drake.systems.visualizers.scene_drawing import (
     GoalCloud, PathTriads, draw_triad, pose_transform)
 
@@ -78,6 +78,7 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         self._solid = count <= SOLID_OBJECTS
         self._likely_triads = min(int(likely_triads), count)
         self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions, CLOUD_POINT_SIZE)
+        self._markers = TaskMarkers()
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)
@@ -116,16 +117,12 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
             meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(centre))
             draw_triad(meshcat, f"/task/grasps/{index}", self._grasp_pose(index),
                        TRIAD_LENGTH, TRIAD_RADIUS)
-        meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
-        meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
-        self._ball_shown = True
+        self._markers.draw(meshcat)
         draw_triad(meshcat, "/task/hand", None, TRIAD_LENGTH, TRIAD_RADIUS)
         meshcat.SetProperty("/task/hand", "visible", False)  # until a hand_state is seen
         if self._prediction_steps:
             self._path.draw(meshcat)
-        centre = grasps.objects.mean(axis=0)
-        # A camera behind and above the robot that sees it and every object.
-        meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
+        meshcat.SetCameraPose(*behind_the_robot(grasps.objects))
 
     def _grasp_pose(self, index):
         return np.concatenate([self._grasps.grasp_positions[index],
@@ -138,17 +135,9 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         target = int(Target(self._target_port.Eval(context)).index)
         if not 0 <= target < count:
             raise ValueError(f"target index {target} is not one of the {count} objects")
-        meshcat.SetTransform("/task/target",
-                             RigidTransform(objects[target] + [0, 0, TARGET_LIFT]), time)
         selected = self._shown_goal(context)
-        if (selected is not None) != self._ball_shown:
-            # Sent only when that changes, so that a page's messages do not grow.
-            self._ball_shown = selected is not None
-            meshcat.SetProperty("/task/estimated_goal", "visible", self._ball_shown, time)
-        if selected is not None:
-            meshcat.SetTransform("/task/estimated_goal",
-                                 RigidTransform(objects[selected] + [0, 0, ESTIMATE_LIFT]),
-                                 time)
+        self._markers.show(meshcat, objects[target],
+                           None if selected is None else objects[selected], time)
         if self._hand_state_port.HasValue(context):
             hand = self._hand_state_port.Eval(context)[:GoalPose.size]
             meshcat.SetTransform("/task/hand", pose_transform(hand), time)

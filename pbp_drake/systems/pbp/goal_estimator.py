@@ -71,10 +71,6 @@ class GoalEstimator(PortGetters, LeafSystem):
                                                 self._update)
 
     @property
-    def goal_count(self):
-        return self._goal_count
-
-    @property
     def settings(self):
         return self._settings
 

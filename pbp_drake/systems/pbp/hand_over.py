@@ -46,14 +46,6 @@ class HandOver(PortGetters, LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(
             self._period, report_offset(self._period), self._update)
 
-    @property
-    def max_acceleration(self):
-        return self._max_acceleration
-
-    @property
-    def max_speed(self):
-        return self._max_speed
-
     def _update(self, context, discrete_state):
         d = self._dimension
         reference = self._reference_port.Eval(context)

@@ -89,17 +89,8 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
                                                 self._update)
 
     @property
-    def goal_count(self):
-        return self._goal_count
-
-    @property
     def settings(self):
         return self._settings
-
-    @property
-    def operator_speed(self):
-        """None: HOP's published likelihood; else the PBP operator's, at this speed."""
-        return self._operator_speed
 
     @property
     def margin(self):

@@ -43,10 +43,6 @@ class PoseHandOver(PortGetters, LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(
             self._period, report_offset(self._period), self._update)
 
-    @property
-    def limits(self):
-        return self._limits
-
     def _update(self, context, discrete_state):
         reference = PoseReference.from_vector(self._reference_port.Eval(context))
         state = discrete_state.get_mutable_vector().get_mutable_value()

@@ -34,27 +34,19 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         - hand_state (optional)
         - goal_probabilities (optional)
 
-    `grasps` is the task's `GraspScene` (`layout.grasps`). What is sent does not grow with
-    the number of grasps K once the scene is drawn. At each initialisation
-    (`Simulator.Initialize`, after deleting `/task`) it draws, up to `SOLID_OBJECTS`
-    grasps, every table and object and, at each object's grasp pose, a triad
+    `grasps` is the task's `GraspScene` (`layout.grasps`). As `ReachSceneVisualizer`
+    (whose drawing of the objects, the goal cloud, the balls and the recording this
+    shares), what is sent does not grow with the number of grasps K. Up to `SOLID_OBJECTS`
+    grasps, every table and object is drawn and, at each object's grasp pose, a triad
     `/task/grasps/{k}` (`draw_triad`: x red, y green, z blue, z the approach); with more,
     `likely_triads` triads `/task/likely_grasps/{i}` that each path period moves to the
-    selected grasp and the likeliest others (`goal_probabilities`), with
-    `time_in_recording`. Every grasp position is also a point of the goal cloud
-    `/task/goal_cloud` (`GoalCloud`), coloured each `cloud_period` (or less often for
-    thousands of grasps: `GoalCloud.period`) by its probability, as
-    in the reaching task. Each publish moves the yellow ball above the `target`'s object
-    (`Target`; its index picks the object) and the blue ball above the `selected_goal`'s
-    (hidden while it is -1: the robot shows no intent, under teleop or while it follows a
-    group of grasps),
-    and the hand's triad `/task/hand` to `hand_state` (`PoseState`), with
-    `time_in_recording` so that `Meshcat.StartRecording` replays them. Each `path_period`
-    the selected DMP's predicted poses (`predicted_poses`: `prediction_steps + 1` rows of
-    `GoalPose` `[x, y, z, qw, qx, qy, qz]`, flattened) are drawn as `PATH_TRIADS` triads
-    `/task/prediction/{i}` spread along the path by arc length (`PathTriads`), also with
-    `time_in_recording`: a replay shows the path and its orientations as they were.
-    Call from the thread that made `meshcat`.
+    selected grasp and the likeliest others (`goal_probabilities`). The blue ball is
+    hidden while `selected_goal` is -1 (no intent shown: teleop, or a group of grasps
+    followed). Each publish moves the hand's triad `/task/hand` to `hand_state`
+    (`PoseState`); each `path_period` the selected DMP's predicted poses
+    (`predicted_poses`: `prediction_steps + 1` `GoalPose` rows, flattened) are drawn as
+    `PATH_TRIADS` triads `/task/prediction/{i}` spread along the path by arc length
+    (`PathTriads`). Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, grasps, prediction_steps=0, table_size=(0.3, 0.3),

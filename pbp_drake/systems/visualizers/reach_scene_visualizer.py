@@ -77,28 +77,25 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         - predicted_paths (optional)
         - goal_probabilities (optional)
 
-    What is sent does not grow with the number of objects K once the scene is drawn: at
-    each initialisation (`Simulator.Initialize`, after deleting `/task`) the objects are
-    drawn on small tables (up to `SOLID_OBJECTS` of them; more are the cloud alone), and
-    every object as one point of the goal cloud `/task/goal_cloud` (`GoalCloud`), so a
-    second run or a run after `meshcat.Delete()` draws them again. Each publish moves the
-    yellow ball above the current `target` (`Target`, `[p (3), index]`) and the blue ball
-    above the estimated goal (`selected_goal`), with `time_in_recording` so that
-    `Meshcat.StartRecording` replays them; an orange ring around the hand shows when the
-    operator acts. Each `path_period` (default 0.1 s: paths change slowly, and a replay
-    interpolates between updates) the `path_count` paths on `predicted_paths` (each
-    `prediction_steps + 1` points, the selected goal's first, as the PBP controller's
-    `predicted_paths` orders them) are drawn as dots (`PathDots`, with
-    `time_in_recording`, so a replay shows each path where it was at that time): the
-    first bold `/task/predictions/selected`, the others faint
-    `/task/predictions/likely/{i}`. Each `cloud_period` (default 0.25 s; for thousands of
-    objects less often, `GoalCloud.period`) the cloud's points
-    take the colour of their goal's probability (`goal_probabilities`, K), grey to blue,
-    sent again only when a colour changed; a recording keeps the cloud's last colours only
-    (Meshcat records transforms and properties, not objects), the paths as they went.
-    The drawing sets Meshcat's camera (`camera`, `(position, target)`): behind and above
-    the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base, start and
-    objects), framed on it (`workspace_view`). Call from the thread that made `meshcat`.
+    What is sent does not grow with the number of objects K once the scene is drawn. At
+    each initialisation (`Simulator.Initialize`, after deleting `/task`, so that a second
+    run or a run after `meshcat.Delete()` draws them again) the objects are drawn on small
+    tables (up to `SOLID_OBJECTS`), and every object as one point of the goal cloud
+    `/task/goal_cloud` (`GoalCloud`). Each publish moves the yellow ball above the current
+    `target` and the blue ball above the estimated goal (`selected_goal`; `TaskMarkers`);
+    an orange ring around the hand shows when the operator acts. Each `path_period`
+    (paths change slowly, and a replay interpolates between updates) the `path_count`
+    paths on `predicted_paths` (each `prediction_steps + 1` points, the selected goal's
+    first, as the PBP controller orders them) are drawn as dots (`PathDots`): the first
+    bold `/task/predictions/selected`, the others faint `/task/predictions/likely/{i}`.
+    Each `cloud_period` (less often for thousands of objects, `GoalCloud.period`) the
+    cloud's points take the colour of their goal's probability (`goal_probabilities`, K).
+    All with `time_in_recording`, so that `Meshcat.StartRecording` replays them (a
+    recording keeps the cloud's last colours only: Meshcat records transforms and
+    properties, not objects). The camera (`camera`, `(position, target)`) stands behind
+    and above the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base,
+    start and objects), is framed on it (`workspace_view`). Call from the thread that made
+    `meshcat`.
     """
 
     def __init__(self, meshcat, objects, prediction_steps=0, path_count=1,

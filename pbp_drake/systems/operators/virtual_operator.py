@@ -461,27 +461,16 @@ class VirtualOperator(SampledOperator):
         # (PBP-Cont's DMP of the picked object keeps pulling the hand there).
         against = (insisting or repositioning) and robot_pulls(self.params, self._speed,
                                                                own_motion)
+        # The noise turns the horizontal part and scales all of it (vz with `vertical`).
+        command = speed_scale * rotate_planar(velocity, noise_angle)
         if self._vertical:
-            return self._vertical_command(context, ee_state, velocity, yaw_rate, noise_angle,
-                                          speed_scale, against), True
-        velocity = speed_scale * rotate_planar(velocity, noise_angle)
+            command = np.append(command, speed_scale * velocity[2])
         if against:
-            velocity = self._against_policy(context, ee_state, velocity)
-        return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
-
-    def _vertical_command(self, context, ee_state, velocity, yaw_rate, noise_angle,
-                          speed_scale, against):
-        """`_decide`'s command with vertical motion, from the velocity (3) and yaw rate of
-        `participant_reach`: the noise turns the horizontal part and scales all of it."""
-        horizontal = speed_scale * rotate_planar(velocity[:2], noise_angle)
-        vz = speed_scale * velocity[2]
-        if against:
-            # Against the picked object's pull in 3-D: that DMP pulls the hand to its height
+            # With `vertical` in 3-D: the picked object's DMP pulls the hand to its height
             # too, and left alone it holds the hand below (or above) the target.
-            horizontal, vz = np.split(self._against_policy(
-                context, ee_state, np.array([horizontal[0], horizontal[1], vz])), [2])
-            vz = float(vz[0])
-        return np.array([horizontal[0], horizontal[1], vz, yaw_rate])
+            command = self._against_policy(context, ee_state, command)
+        vz = command[2] if self._vertical else 0.0
+        return np.array([command[0], command[1], vz, yaw_rate]), True
 
     def _against_policy(self, context, ee_state, wanted):
         """The command that moves the hand at `wanted` (2, on the floor; or 3) under an

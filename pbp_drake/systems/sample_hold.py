@@ -28,14 +28,8 @@ class SampleHold(PortGetters, LeafSystem):
         initial_value = np.asarray(initial_value, dtype=float)
         self._input_port = self.DeclareVectorInputPort("u", initial_value.size)
         index = self.DeclareDiscreteState(initial_value)
-        self._output_port = self.DeclareStateOutputPort("y", index)
+        self.DeclareStateOutputPort("y", index)
         self.DeclarePeriodicDiscreteUpdateEvent(period, SENSE_OFFSET, self._update)
-
-    def get_input_port(self):
-        return self._input_port
-
-    def get_output_port(self):
-        return self._output_port
 
     def _update(self, context, discrete_state):
         discrete_state.get_mutable_vector().set_value(self._input_port.Eval(context))

@@ -35,9 +35,28 @@ state at `t_k` but the decisions of tick k - 1. `DECISION_LOG_SHIFT` is how many
 later the decisions of tick k appear (see `pbp_drake.builder.run.read_log`).
 """
 
+import math
+
 SENSE_OFFSET = 0.0
 DECIDE_FRACTION = 1e-6
 DECISION_LOG_SHIFT = 1
+
+
+def checked_period(control_period):
+    """`control_period` (s) as a float; ValueError unless it is finite and positive."""
+    period = float(control_period)
+    if not (math.isfinite(period) and period > 0.0):
+        raise ValueError(f"control_period must be positive, got {control_period!r}")
+    return period
+
+
+def checked_update_offset(update_offset, control_period):
+    """`update_offset` (s; None: the decide stage); ValueError unless in [0, control_period)."""
+    if update_offset is None:
+        return decide_offset(control_period)
+    if not (math.isfinite(update_offset) and 0.0 <= update_offset < control_period):
+        raise ValueError(f"update_offset must be in [0, control_period), got {update_offset!r}")
+    return update_offset
 
 
 def decide_offset(control_period):

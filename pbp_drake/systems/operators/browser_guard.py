@@ -10,9 +10,7 @@ have sent a frame (our page answers its first batch at once; a connection that s
 nothing cannot press a key) when a front serves this Meshcat (it says so with
 `register_front`), else Meshcat's connections. With more than one, it pauses the
 simulation where it stands (inside the operator's sampling, so no simulated time passes and
-the robot does not move), says so in the terminal and in the page, and waits until one is
-left. The operator then drops every input that arrived meanwhile. A page that leaves
-within `settle` seconds costs the input of that tick, not a pause.
+the robot does not move) until one is left (`BrowserGuard`).
 
 Behind a front, a connection to Meshcat that the front did not open (possible only where
 the front could not shut Meshcat's port, see `pbp_drake.console.meshcat_door`) is an

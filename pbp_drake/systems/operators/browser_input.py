@@ -77,8 +77,8 @@ def gamepad_values(gamepad, axis_count, button_count=0):
 
 
 def _padded(values, count):
-    values = np.array(list(values[:count]) + [0.0] * max(0, count - len(values)), float)
-    return np.where(np.isfinite(values), values, 0.0)
+    sent = _as_sent(values, count)
+    return np.where(np.isfinite(sent), sent, 0.0)
 
 
 def raw_values(gamepad, axis_count, button_count=0):

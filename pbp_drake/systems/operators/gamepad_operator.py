@@ -18,10 +18,8 @@ _STICK_AXES = 3
 
 @dataclasses.dataclass
 class GamepadParams:
-    """A person with a gamepad in the browser (HSR tasks): the left stick moves the end
-    effector at up to `speed` (m/s; 0 takes the task's nominal speed, that of its DMPs),
-    the right stick turns it at up to `rotation_speed` (rad/s); `dead_zone` is each stick's
-    radial dead zone, in [0, 1)."""
+    """A person with a gamepad in the browser (HSR tasks): the left stick moves, the right
+    stick turns."""
 
     #: The left stick's top speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = 0.0
@@ -46,23 +44,17 @@ class GamepadOperator(SampledOperator):
     Reads `meshcat.GetGamepad()` each control tick. The left stick moves the end effector
     in the robot frame (up = forward along the heading, left = heading + 90 deg) at up to
     `speed` (m/s); the right stick's x turns it (left = positive yaw rate) at up to
-    `rotation_speed` (rad/s). Each stick has a radial dead zone of `dead_zone`, outside
-    which its deflection is rescaled from 0 so the output is continuous. With
-    `allow_forward=False` (PBP modes, where forward motion comes from the DMP phase) the
+    `rotation_speed` (rad/s). Each stick has a radial dead zone of `dead_zone`, past which
+    its deflection rises continuously from 0. With `allow_forward=False` (PBP modes) the
     forward part of the left stick is dropped; back still works.
 
-    Input `ee_state` `[p (3), v (3), heading, heading_rate]` gives the heading. Output
-    `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0);
-    `operator_active` is 1 while a stick is outside its dead zone (a stick pushed only
-    forward does not count when forward is not allowed). With no gamepad (Meshcat
-    has received none, or the browser reported it disconnected) the command is zero and
-    inactive.
-
-    With `exclusive` (the default) a `BrowserGuard` (`browser_guard`) pauses the simulation
-    while more than one browser is connected to the page. Meshcat keeps the last gamepad
-    state it received, from whichever page sent it: after a pause, that state is ignored
-    (zero, inactive) until the sticks report something new. Meshcat must be used only from
-    the thread that created it.
+    Input `ee_state` gives the heading. Output `operator_command` is `[vx, vy, vz,
+    yaw_rate]` in the world frame (vz = 0); `operator_active` is 1 while a stick is outside
+    its dead zone (a stick pushed only forward does not count when forward is not
+    allowed). With no gamepad (none received, or reported disconnected) the command is
+    zero and inactive. `exclusive` is `KeyboardOperator`'s; after a pause the gamepad
+    state Meshcat last received (from whichever page) is ignored until the sticks report
+    something new. Use Meshcat only from the thread that created it.
     """
 
     def __init__(self, meshcat, control_period, allow_forward, params=GamepadParams(),

@@ -38,6 +38,8 @@ _KEY_AXES = {
     RIGHT_BUTTON: (0.0, -1.0, 0.0, 0.0),
     TURN_LEFT_BUTTON: (0.0, 0.0, 0.0, 1.0),
     TURN_RIGHT_BUTTON: (0.0, 0.0, 0.0, -1.0),
+    UP_BUTTON: (0.0, 0.0, 1.0, 0.0),
+    DOWN_BUTTON: (0.0, 0.0, -1.0, 0.0),
 }
 
 #: The buttons `vertical=True` adds (name -> `KeyboardEvent.code`): R up, F down.
@@ -45,14 +47,11 @@ VERTICAL_KEY_BUTTONS = {
     UP_BUTTON: "KeyR",
     DOWN_BUTTON: "KeyF",
 }
-_KEY_AXES.update({UP_BUTTON: (0.0, 0.0, 1.0, 0.0), DOWN_BUTTON: (0.0, 0.0, -1.0, 0.0)})
 
 
 @dataclasses.dataclass
 class KeyboardParams:
-    """A person at the browser's keyboard (HSR tasks): arrows move the end effector at
-    `speed` (m/s; 0 takes the task's nominal speed, that of its DMPs), Q and E turn it at
-    `rotation_speed` (rad/s)."""
+    """A person at the browser's keyboard (HSR tasks): arrows move, Q and E turn."""
 
     #: The arrows' speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = 0.0
@@ -77,37 +76,29 @@ class KeyboardOperator(SampledOperator):
 
     Adds one Meshcat button per key (see `KEY_BUTTONS`): ↑/↓ forward/back along the end
     effector's heading, ←/→ sideways (left = heading + 90 deg), Q/E turn left/right. A
-    click of a button (or a keydown of its key in the browser, auto-repeated while the key
-    is held) keeps the key held for `hold_time` seconds; a tap gives a short motion.
-    Meshcat's page clicks a button on every `keydown`, repeats included, so a held key
-    re-clicks at the OS repeat rate (~25-33 Hz) after the OS repeat delay (often 0.25-0.6 s):
-    with a `hold_time` below that delay a held key moves, pauses briefly, then moves on.
-    Translation keys combine into one direction at `speed` (m/s); Q/E give a yaw rate of
-    ±`rotation_speed` (rad/s). With `allow_forward=False` (PBP modes, where forward motion
-    comes from the DMP phase) the forward button is not added and ↑ does nothing; ↓ still
-    works.
+    click of a button (or a keydown of its key in the browser, which Meshcat's page turns
+    into a click, repeats included) keeps the key held for `hold_time` seconds; a tap gives
+    a short motion, and with a `hold_time` below the OS repeat delay a held key moves,
+    pauses briefly, then moves on. Translation keys combine into one direction at `speed`
+    (m/s); Q/E give a yaw rate of ±`rotation_speed` (rad/s). With `allow_forward=False`
+    (PBP modes, where forward motion comes from the DMP phase) the forward button is not
+    added and ↑ does nothing; ↓ still works.
 
-    With `vertical=True` (a task whose objects stand at different heights; off by default,
-    and off nothing here changes) two more buttons (`VERTICAL_KEY_BUTTONS`) move the hand
-    up (R) and down (F), under PBP too (they are not the forward key). The translation keys
-    then combine into one 3-D direction at `speed`: ← with R goes diagonally, up and to the
-    left, at `speed`.
+    With `vertical=True` (a task whose objects stand at different heights) two more buttons
+    (`VERTICAL_KEY_BUTTONS`) move the hand up (R) and down (F), under PBP too, and the
+    translation keys combine into one 3-D direction at `speed`.
 
-    Input `ee_state` `[p (3), v (3), heading, heading_rate]` gives the heading used to turn
-    the robot-frame keys into the world frame. Output `operator_command` is
-    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0 unless `vertical`);
-    `operator_active` is 1 while any
-    effective key is held (even if
+    Input `ee_state` gives the heading used to turn the robot-frame keys into the world
+    frame. Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0
+    unless `vertical`); `operator_active` is 1 while any effective key is held (even if
     opposite keys cancel).
 
     With `exclusive` (the default) a `BrowserGuard` (`browser_guard`) pauses the simulation
     while more than one browser is connected to the page, and the clicks sent meanwhile
-    are dropped and every key released: no second page drives the robot.
-
-    Click counts are snapshotted at initialisation, and the last counts and click times are
-    kept in discrete state, so the system holds no state outside its Context. Meshcat must
-    be used only from the thread that created it (run the simulator there). The buttons
-    stay in Meshcat until `Delete()` is called.
+    are dropped and every key released: no second page drives the robot. Click counts are
+    snapshotted at initialisation, and the last counts and click times are kept in
+    discrete state, so the system holds no state outside its Context. Use Meshcat only
+    from the thread that created it; the buttons stay there until `Delete()`.
     """
 
     # The buttons' names, for code that presses them (`Meshcat`'s injected clicks, tests).
@@ -121,7 +112,6 @@ class KeyboardOperator(SampledOperator):
         super().__init__(OperatorCommand.size, control_period)
         self.params = dataclasses.replace(params)
         self.browser_guard = BrowserGuard(meshcat) if exclusive else None
-        self._allow_forward = bool(allow_forward)
         self._vertical = bool(vertical)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)

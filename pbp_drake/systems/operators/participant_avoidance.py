@@ -2,12 +2,11 @@
 
 Its local plan (`VirtualOperator._plan`) scores motions over a horizon of a second or
 two. When the cylinders settle into a wall across the line to the target, every motion
-that keeps clear gets no closer, and standing still wins each tick, forever: before this
-watch, such trials ran into the time limit with the hand parked in front of the wall.
-People in the paper's study pushed on through at such moments, at the risk of a collision;
-the participant now does the same once it has not come `progress_step` closer to the target
-for `stall_time` (`VirtualParticipantParams`), and keeps pushing until it arrives (turning
-back to avoiding would park it at the next wall, a few centimetres on).
+that keeps clear gets no closer, and standing still would win each tick, forever. People
+in the paper's study pushed on through at such moments, at the risk of a collision; the
+participant does the same once it has not come `progress_step` closer to the target for
+`stall_time` (`VirtualParticipantParams`), and keeps pushing until it arrives (turning back
+to avoiding would park it at the next wall, a few centimetres on).
 """
 
 import numpy as np
@@ -52,7 +51,7 @@ def robot_closes_in(params, velocity, offset, nominal_speed):
     is still early in its motion when the hand is almost there; early on, its forcing term
     holds it back against the spring (a demonstration starts slowly), and a few
     centimetres from the target the two balance: the hand parks there. A person would
-    drive the last bit; the participant used to let go and wait.
+    drive the last bit.
     """
     distance = np.linalg.norm(offset)
     if distance < 1e-9:

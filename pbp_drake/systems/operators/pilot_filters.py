@@ -150,12 +150,6 @@ class PilotFilter(PortGetters, LeafSystem):
         discrete_state.set_value(self._sample_index,
                                  np.concatenate([command, [float(active), 1.0]]))
 
-    def _hand(self, context):
-        return self._hand_port.Eval(context)
-
-    def _forward_enabled(self, context):
-        return _forward_enabled(self._forward_port, context)
-
     def _filter(self, context, tick, command, active, previous):
         raise NotImplementedError
 
@@ -170,12 +164,12 @@ class NoisyFilter(PilotFilter):
         self.eps = float(eps)
 
     def _filter(self, context, tick, command, active, previous):
-        forward = self._forward_enabled(context)
+        forward = _forward_enabled(self._forward_port, context)
         corrupted, key_state = noisy_draw(self._seed, tick, self.eps, len(self.keys.axes),
                                           forward or not self.keys.forward_is_a_button)
         if not corrupted:
             return command, active
-        return self.keys.key_command(key_state, self._hand(context), forward)
+        return self.keys.key_command(key_state, self._hand_port.Eval(context), forward)
 
 
 class LaggyFilter(PilotFilter):

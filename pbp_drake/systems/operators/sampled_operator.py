@@ -34,11 +34,10 @@ class SampledOperator(PortGetters, LeafSystem):
     ports first, and call `_declare_operator_outputs()` once (`delay_ticks` > 0: each
     sample reaches the outputs that many ticks after it was taken, through a queue in
     discrete state; the virtual participant's `command_delay`). Sampling into discrete state
-    keeps the operator deterministic and loggable, and its command stays constant over a
-    control period as a human's keyboard read would. It samples at the sense stage of each tick
-    (`pbp_drake.systems.tick`). `operator_command` is a velocity (D; a subclass may name
-    the port otherwise with `command_name`);
-    `operator_active` is 1 while the operator acts, else 0.
+    keeps the operator deterministic and loggable, and its command constant over a control
+    period. It samples at the sense stage of each tick (`pbp_drake.systems.tick`).
+    `operator_command` is a velocity (D; a subclass may name the port otherwise with
+    `command_name`); `operator_active` is 1 while the operator acts, else 0.
     """
 
     def __init__(self, dimension, control_period, command_name="operator_command"):

@@ -39,79 +39,53 @@ class VirtualOperator(SampledOperator):
 
     It is built from the same arguments under every method and is never told the method.
     It sees what a person at the page sees: the scene (`objects` (M, 3)) and its target
-    (`target`), the hand (`ee_state`), the robot's shown intent (`selected_goal`, the blue
-    ball; -1 where the method shows none) and which keys work (`forward_key`: 1 when the
-    forward key is enabled, 0 when not, as the paper disables it under PBP). Whether it acts
-    is one rule under every method (`pbp_drake.core.participant_serving`): it lets the robot
-    go while its motion serves the target and acts while it does not (the shown intent on
-    another object, or the hand not closing in at `serve_speed_fraction` of its own
-    preferred speed for `serve_patience`); teleop's robot never moves by itself, so there it
-    always acts.
+    (`target`, `[p (3), index]`), the hand (`ee_state`), the robot's shown intent
+    (`selected_goal`, the blue ball; -1 where the method shows none) and which keys work
+    (`forward_key`: 1 when the forward key is enabled, 0 when not, as the paper disables it
+    under PBP). Whether it acts is one rule under every method
+    (`pbp_drake.core.participant_serving`): it lets the robot go while its motion serves
+    the target and acts while it does not; teleop's robot never moves by itself, so there
+    it always acts. `VirtualParticipantParams` documents each field named below.
 
-    What it presses is the keys': with the forward key it drives toward the target at
-    `speed` (slowing within `slow_radius`), turning to face it. Without it, while the
-    robot means another object, it shows the target: it turns the end effector to face it
-    and moves toward it and away from the object picked instead, as far as the keys allow;
-    it steps aside when the two stand in line; and once it has faced the target
-    `insist_time` to no avail, it turns the target to its side and sidesteps to it
-    (`pbp_drake.core.participant_reach` says why each goal estimator can read this).
-    Without it and with the robot's intent on the target (or none shown) but too slow, it
-    presses what is left of driving there, and waits when that is little. Going to the
-    target itself where it sees the robot pull by itself (`participant_serving.robot_pulls`:
-    PBP-Cont's DMP), it pushes against that pull, at most `policy_compensation` times
-    `speed`.
+    What it presses is the keys' (`pbp_drake.core.participant_reach` says what and why):
+    with the forward key it drives toward the target, turning to face it. Without it, while
+    the robot means another object, it shows the target (turning to face it, moving toward
+    it and away from the object picked instead, stepping aside when the two stand in line,
+    and after `insist_time` to no avail sidestepping to the target itself); with the
+    robot's intent on the target (or none shown) but too slow, it presses what is left of
+    driving there. Going to the target itself where it sees the robot pull by itself
+    (`participant_serving.robot_pulls`: PBP-Cont's DMP), it pushes against that pull.
 
-    `vertical=True` (a reaching task whose objects stand at different heights, the
-    operator's keys moving the hand up and down too; off by default, and off it changes
-    nothing): driving, it heads for the target in 3-D, horizontal and vertical motion
-    combined into one speed at most `speed`; showing the target, it leaves the height to
-    the DMP (vz = 0) except when insisting, when it also moves toward the target's height, again
-    at most `speed` in all (`pbp_drake.core.participant_reach`). Its noise turns the
-    horizontal part only and scales vz by the same speed factor; its `impairment`'s motor
-    noise shakes vz as well (one more axis, drawn after the others: the horizontal noise is
-    that of the same seed without it). Obstacles (`obstacle_count > 0`) keep the
-    participant planar: the two are refused together.
+    `vertical=True` (a reaching task whose objects stand at different heights, the keys
+    moving the hand up and down too; off, it changes nothing) moves in 3-D at most `speed`
+    in all, leaving the height to the DMP (vz = 0) while it shows the target unless it
+    insists; its noise turns the horizontal part only, and its motor noise shakes vz as a
+    last axis (so the horizontal noise is that of the same seed without it). Obstacles
+    keep the participant planar: the two are refused together. `heading_range` (low,
+    high) is how far the hand turns (an arm's wrist; None: all the way, as the HSR's
+    base): where the tool cannot point at the target (`participant_reach.can_point_at`) it
+    first moves the hand to where it can, for at most `reposition_time` a target.
+    `fixed_base` (x, y) is a fixed-base arm's base: its footprint among obstacles is then
+    the arm from there to the hand (`footprint_clearance`).
 
-    `heading_range` (low, high) is how far the hand turns (an arm's wrist; None: all the
-    way, as the HSR's base). Showing the target, where the tool cannot point at the target (its
-    direction beyond the range, or, with `vertical`, the target more above or below the
-    hand than beside it: `participant_reach.can_point_at`), the participant first moves the
-    hand to where it can (`participant_reach.reposition_motion`: it backs away, and moves
-    toward the target's height), for at most `reposition_time` a target, and then goes to
-    the target itself as when insisting. It pushes against a pull it sees while it does,
-    as when insisting. `fixed_base` (x, y)
-    is a fixed-base arm's base: its footprint among obstacles is then the arm from there to
-    the hand (`footprint_clearance`), not the HSR's base and arm.
-
-    It notices a new target only `reaction_delay` seconds after it appears, and its
-    commands carry noise: the direction rotated by N(0, `direction_noise`) rad, the speed
-    scaled by (1 + N(0, `speed_noise`)). The noise is drawn from `(seed, tick)`, so a run
-    is reproducible and the system keeps no state outside its Context.
-
-    Its `impairment` (`pbp_drake.core.participant_impairment`, none by default) adds motor
-    noise to its commands while it acts (never forward where the key is disabled), delays its
-    commands by `command_delay` (a queue in discrete state), and makes it head for a wrong object
-    first, now and then, each time it comes to know a target (the reaching task; the obstacle task
-    has a single object).
+    It notices a new target `reaction_delay` after it appears, and its commands carry
+    noise drawn from `(seed, tick)`, so a run is reproducible and the system keeps no state
+    outside its Context. Its `impairment` (`pbp_drake.core.participant_impairment`) adds
+    motor noise while it acts (never forward where the key is disabled), delays its
+    commands by `command_delay` (a queue in discrete state), and in the reaching task makes
+    it head for a wrong object first, now and then, each time it comes to know a target.
 
     With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (cylinders of
-    `obstacle_radius`; their velocities
-    from the positions it remembers in discrete state) and keeps the robot's footprint (base
-    disc and arm, `footprint_clearance`) `obstacle_margin` clear of them: each tick it scores
-    a fan of velocities and yaw rates over a short horizon (progress to the target, turning
-    toward a heading whose footprint fits at the target, clearance). Where the robot shows
-    its intent, it lets go whenever the robot's path (pulled back to its start-target line,
-    as PBP's drawn DMP path is) looks clear for a while; where it shows none, by the rule
-    above. In the last `final_approach_radius` it no longer minds obstacles (where the
-    robot shows its intent it drives there only when the robot does not close in by
-    itself), and within `push_through_radius`, or
-    after `stall_time` without getting closer (`participant_avoidance`), it pushes on
-    through. `VirtualParticipantParams` documents each of these fields.
+    `obstacle_radius`, their velocities from the positions it remembers) and keeps the
+    robot's footprint `obstacle_margin` clear of them: each tick it scores a fan of
+    velocities and yaw rates over a short horizon. Where the robot shows its intent, it
+    lets go whenever the robot's path (pulled back to its start-target line, as PBP's drawn
+    DMP path is) looks clear for a while. In the last `final_approach_radius` it no longer
+    minds obstacles, and within `push_through_radius`, or after `stall_time` without
+    getting closer (`participant_avoidance`), it pushes on through.
 
-    Inputs: `ee_state` `[p (3), v (3), heading, heading_rate]`, `target` `[p (3), index]`,
-    `selected_goal` `[index]` (-1: none shown), `forward_key` `[1 or 0]`,
-    `obstacle_positions` (optional). Output `operator_command` is
-    `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0 unless `vertical`).
+    Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0
+    unless `vertical`).
     """
 
     def __init__(self, control_period, objects, params=VirtualParticipantParams(),
@@ -311,12 +285,10 @@ class VirtualOperator(SampledOperator):
         hold = track[3]
         track[3] = max(hold - 1.0, 0.0)
         track[remembered] = obstacles.reshape(-1)
-        # Its own last decision (what it pressed) and what the robot got: the same unless
-        # its commands are delayed.
-        decided, sent = self._latest(context), self._held(context)
+        # Its own last decision (what it pressed; the robot gets it later if delayed).
+        decided = self._latest(context)
         was_active = decided[4] > 0.5
         last_command = decided[:2] if was_active else np.zeros(2)
-        last_sent = sent[:2] if sent[4] > 0.5 else np.zeros(2)
 
         def finish(command, active, hold_ticks=None):
             if hold_ticks is not None:
@@ -383,13 +355,7 @@ class VirtualOperator(SampledOperator):
             yaw_rate = 0.0
         command = speed_scale * rotate_planar(planned, noise_angle)
         if robot_pulls(params, self._speed, own_motion):
-            # The robot's own motion: what the hand does minus what was asked of it.
-            policy_velocity = velocity - last_sent
-            command = command - policy_velocity
-            norm = np.linalg.norm(command)
-            limit = params.policy_compensation * self._speed
-            if norm > limit:
-                command *= limit / norm
+            command = self._against_policy(context, ee_state, command)
         hold_ticks = track[3] if was_active or not shows else self._hold_ticks
         return finish(np.array([command[0], command[1], 0.0, yaw_rate]), True, hold_ticks)
 
@@ -495,27 +461,16 @@ class VirtualOperator(SampledOperator):
         # (PBP-Cont's DMP of the picked object keeps pulling the hand there).
         against = (insisting or repositioning) and robot_pulls(self.params, self._speed,
                                                                own_motion)
+        # The noise turns the horizontal part and scales all of it (vz with `vertical`).
+        command = speed_scale * rotate_planar(velocity, noise_angle)
         if self._vertical:
-            return self._vertical_command(context, ee_state, velocity, yaw_rate, noise_angle,
-                                          speed_scale, against), True
-        velocity = speed_scale * rotate_planar(velocity, noise_angle)
+            command = np.append(command, speed_scale * velocity[2])
         if against:
-            velocity = self._against_policy(context, ee_state, velocity)
-        return np.array([velocity[0], velocity[1], 0.0, yaw_rate]), True
-
-    def _vertical_command(self, context, ee_state, velocity, yaw_rate, noise_angle,
-                          speed_scale, against):
-        """`_decide`'s command with vertical motion, from the velocity (3) and yaw rate of
-        `participant_reach`: the noise turns the horizontal part and scales all of it."""
-        horizontal = speed_scale * rotate_planar(velocity[:2], noise_angle)
-        vz = speed_scale * velocity[2]
-        if against:
-            # Against the picked object's pull in 3-D: that DMP pulls the hand to its height
+            # With `vertical` in 3-D: the picked object's DMP pulls the hand to its height
             # too, and left alone it holds the hand below (or above) the target.
-            horizontal, vz = np.split(self._against_policy(
-                context, ee_state, np.array([horizontal[0], horizontal[1], vz])), [2])
-            vz = float(vz[0])
-        return np.array([horizontal[0], horizontal[1], vz, yaw_rate])
+            command = self._against_policy(context, ee_state, command)
+        vz = command[2] if self._vertical else 0.0
+        return np.array([command[0], command[1], vz, yaw_rate]), True
 
     def _against_policy(self, context, ee_state, wanted):
         """The command that moves the hand at `wanted` (2, on the floor; or 3) under an

@@ -30,10 +30,8 @@ from pbp_drake.systems.pbp.pose_hop_assistance import PoseHopAssistance
 from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstimator
 
 __all__ = ["Blender", "DemonstrationPlayer", "DmpBank", "GoalEstimator", "GoalGrouping",
-           "GoalsSource",
-           "HandOver", "HeadingCommand", "HopAssistance", "IntentFilterGoalEstimator",
-           "LikelyGoals", "MaxEntGoalEstimator",
-           "PoseBlender",
+           "GoalsSource", "HandOver", "HeadingCommand", "HopAssistance",
+           "IntentFilterGoalEstimator", "LikelyGoals", "MaxEntGoalEstimator", "PoseBlender",
            "PoseDmpBank", "PoseGoalEstimator", "PoseGoalGrouping",
            "PoseIntentFilterGoalEstimator", "PoseHandOver", "PoseHopAssistance",
            "PoseMaxEntGoalEstimator"]

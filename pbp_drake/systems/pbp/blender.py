@@ -118,15 +118,10 @@ class Blender(BlenderBase):
     `[position (D), velocity (D)]`. A NaN or infinite operator command raises.
 
     `goal_probabilities` (K) is read only in `confidence_alpha` mode, where it must be
-    connected (evaluating the command raises otherwise). There, each control period,
-    `alpha = clip((c - low) / (high - low), 0, 1) * alpha_max` with `(low, high) =
-    confidence_range` and `c` the margin of the selected goal's probability over the next
-    most probable goal (`pbp_drake.core.arbitration.confidence_alpha`); an idle operator
-    gives `P`. `confidence_range` and `alpha_max` are ignored by the other modes.
-
-    In `fixed_alpha` mode `alpha` is a numeric parameter of the Context (its default the
-    constructor's), so that it can change during a run without rebuilding: `set_alpha`
-    (the console's alpha slider, `pbp_drake.console`).
+    connected (evaluating the command raises otherwise); there `alpha` is the ramp of the
+    selected goal's confidence (`pbp_drake.core.arbitration.confidence_alpha`), and an idle
+    operator gives `P`. `fixed_alpha`'s weight can change during a run (`set_alpha`, the
+    console's alpha slider): see `BlenderBase`.
     """
 
     def __init__(self, mode, dimension, goal_count, control_period, alpha=None, *,

@@ -29,11 +29,9 @@ class DemonstrationPlayer(PortGetters, LeafSystem):
         self._velocities = np.gradient(positions, self._times, axis=0)
         self._velocities[-1] = 0.0
         self._period = float(control_period)
-        d = positions.shape[1]
         index = self.DeclareDiscreteState(self._sample(self._period))
         self._references_port = self.DeclareStateOutputPort("references", index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
-        self._dimension = d
 
     def _sample(self, time):
         position = [np.interp(time, self._times, column) for column in self._positions.T]

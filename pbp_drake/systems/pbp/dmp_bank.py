@@ -1,10 +1,6 @@
-"""The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot.
-
-The system holds the bank's immutable model (`pbp_drake.core.dmp.DmpBankModel`) and nothing
-else that a step changes: the DMPs' state is the Context's discrete state and the step's
-scratch arrays (a `DmpWorkspace`) are a cache entry, which Drake allocates once per
-Context. Two Contexts of one system, or two Simulators of one diagram, are therefore
-independent, whichever order or thread steps them.
+"""The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot,
+over the bank's immutable model (`pbp_drake.core.dmp.DmpBankModel`); the DMPs' state and
+the step's scratch arrays live in the Context, so Contexts and Simulators are independent.
 """
 
 import numpy as np
@@ -13,7 +9,7 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
 from pbp_drake.systems.ports import PortGetters, goal_index
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_update_offset
 
 
 class DmpBank(PortGetters, LeafSystem):
@@ -36,53 +32,36 @@ class DmpBank(PortGetters, LeafSystem):
         - predicted_paths
 
     `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
-    `(K, D)`. Each period the bank advances every DMP one step from the robot's position
-    (keeping each DMP's own velocity; the first-order-hold step of `pbp_drake.core.dmp`). With
-    `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the phases
-    and the DMPs follow the robot until the operator lets go. With `max_speed` (m/s), each
-    DMP's own velocity is scaled down to it before every step (anti-windup: PBP-Cont gives
-    the hand-over law's speed limit, which the hand can never exceed anyway).
+    `(K, D)`. Each period every DMP advances one step from the robot's position, keeping
+    its own velocity (the first-order-hold step of `pbp_drake.core.dmp`). With
+    `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the one
+    phase all DMPs share, and the DMPs follow the robot until the operator lets go. With
+    `max_speed` (m/s), each DMP's velocity is scaled down to it before every step
+    (anti-windup: give the hand-over law's speed limit, which the hand never exceeds).
 
-    `followed_goal` (optional) is the index of the goal whose reference the robot followed
-    since the last update (the goal estimator's selection, read before it updates). When it
-    is connected, each update first gives every DMP the followed DMP's velocity: all DMPs
-    then step from the robot's position AND the velocity it is being driven at, so the
-    selection may move to any of them without a jump of the commanded velocity (the
-    velocities then differ by the attractors' pull over one period only, which vanishes with
-    the period). Unconnected, each DMP keeps a velocity of its own, which relaxes toward its
-    own attractor while the robot follows another.
+    `followed_goal` (optional) is the goal whose reference the robot followed since the
+    last update (the goal estimator's selection, read before it updates). Connected, every
+    DMP steps from the robot's position AND the followed DMP's velocity, so the selection
+    may move to any of them without a jump of the commanded velocity; unconnected, each
+    DMP keeps a velocity of its own, which relaxes toward its own attractor.
 
     `references` is the K next states `[positions (K*D), velocities (K*D)]`;
     `selected_reference` the next state `[position (D), velocity (D)]` of `selected_goal`
-    alone (unconnected: the followed goal, else goal 0), what a blender reads: O(D) to
-    compute where `references` is O(K D). `phase` is the K phases; `predicted_paths`
-    (declared when `prediction_steps > 0`) is each DMP's open-loop path from its current
-    state, `(K, prediction_steps + 1, D)` flattened, for drawing, sampled every
-    `prediction_period` (default: the control period). With `predicted_goal_count` M, it
-    is the paths of the M goals whose indices come in on `predicted_goals` (in that order;
-    unconnected, goals 0 to M - 1), `(M, prediction_steps + 1, D)`: a drawing of a few
-    goals' paths then costs the same whatever K.
-    All state lives in the Context, and so does the step's scratch memory (a cache entry).
+    alone (unconnected: the followed goal, else goal 0), what a blender reads: O(D) where
+    `references` is O(K D). `phase` is the K phases. `predicted_paths` (with
+    `prediction_steps > 0`) is each DMP's open-loop path from its current state,
+    `(K, prediction_steps + 1, D)` flattened, sampled every `prediction_period` (default:
+    the control period), for drawing; with `predicted_goal_count` M, the paths of the M
+    goals whose indices come in on `predicted_goals` (unconnected: goals 0 to M - 1), so
+    that a drawing costs the same whatever K.
 
-    The state is one vector, in one of two layouts
-    (`pbp_drake.systems.pbp.dmp_bank_state`): every DMP's velocity and attractor terms
-    (`3 K D` numbers, which Drake copies twice an update), or, with `compact_state=True`
-    (which needs `followed_goal` connected: an update raises otherwise, since every DMP
-    then steps from one velocity), `2 + 6 D` numbers whatever K, for DMPs that share
-    weights and start (`bank.affine_in_goal`; a bank from one demonstration or straight,
-    as every scenario's; any other bank is refused), whose attractor terms are affine in
-    the goal, so that the outputs are computed from the goals on the port. The compact
-    outputs equal the per-goal
-    layout's bit for bit while the goals do not change between an update and a read (when
-    they change, the outputs and the next update read the new goals, as if the last step
-    had been taken toward them). The goals are checked
-    and laid out `(D, K)` in a cache entry, once per change. All DMPs of the system share
-    one phase: the lock is one input.
-
-    The bank updates at the decide stage of each control tick
-    (`pbp_drake.systems.tick.decide_offset`), so that it reads the robot's state sampled at
-    the tick and the operator's decision of the same tick, as Alg. 2 does. `update_offset`
-    (seconds after the tick) overrides it, for experts with their own tick order.
+    The state is one vector in one of the layouts of `pbp_drake.systems.pbp.dmp_bank_state`:
+    per goal (`3 K D` numbers), or with `compact_state=True` `2 + 6 D` numbers whatever K,
+    for a bank `affine_in_goal` (any other is refused) with `followed_goal` connected (an
+    update raises otherwise). The goals are checked and laid out `(D, K)` in a cache entry,
+    once per change; the step's scratch memory is a cache entry too, so that all state
+    lives in the Context. The bank updates at the decide stage of each tick
+    (`pbp_drake.systems.tick`); `update_offset` (s after the tick) overrides it.
     """
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
@@ -90,8 +69,6 @@ class DmpBank(PortGetters, LeafSystem):
                  max_speed=None, compact_state=False, predicted_goal_count=None):
         super().__init__()
         self._bank = bank
-        # Anti-windup: the hand-over law never lets the hand move faster than this (m/s), so
-        # a DMP must not remember a faster velocity either (see `_update`).
         self._max_speed = None if max_speed is None else float(max_speed)
         self._period = float(control_period)
         # Drawing a long horizon at the control period would cost hundreds of steps a frame;
@@ -99,11 +76,7 @@ class DmpBank(PortGetters, LeafSystem):
         self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)
-        if update_offset is None:
-            update_offset = decide_offset(self._period)
-        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
-            raise ValueError(
-                f"update_offset must be in [0, control_period), got {update_offset!r}")
+        update_offset = checked_update_offset(update_offset, self._period)
         k, d = bank.goal_count, bank.dimension
         if compact_state and not bank.affine_in_goal:
             raise ValueError(

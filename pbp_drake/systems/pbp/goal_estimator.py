@@ -9,7 +9,7 @@ from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.goal_estimation import (
     NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate)
 from pbp_drake.systems.ports import EeState, PortGetters, checked_goal_count, position_of
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_period, decide_offset
 
 # Layout of the `memory` discrete state group.
 CHALLENGER, COUNT, START, PATH_LENGTH, LAST_POSITION, INITIALISED = 0, 1, 2, 5, 6, 9
@@ -37,30 +37,23 @@ class GoalEstimator(PortGetters, LeafSystem):
     At initialisation (`Simulator.Initialize`) the estimator records the end effector's
     position as the start `S` and selects the most probable goal at once, without
     hysteresis; a Context never initialised does so at its first periodic update instead.
-    Each update, `update_offset` seconds after each control tick (by default the decide
-    stage, `pbp_drake.systems.tick.decide_offset`), adds the distance moved
-    since the last update to the path length (for ``bayesian``), recomputes the
+    Each update, at the decide stage of each control tick (`pbp_drake.systems.tick`), adds
+    the distance moved since the last update to the path length (for ``bayesian``), recomputes the
     probabilities and moves the selection with hysteresis. Before initialisation the
     selection is goal 0 and the probabilities are uniform.
     """
 
-    def __init__(self, goal_count, settings, control_period, update_offset=None):
+    def __init__(self, goal_count, settings, control_period):
         super().__init__()
         goal_count = checked_goal_count(goal_count)
         if not isinstance(settings, GoalEstimatorSettings):
             raise ValueError(f"settings must be a GoalEstimatorSettings, got "
                              f"{type(settings).__name__}")
         settings.validate()
-        if not np.isfinite(control_period) or control_period <= 0.0:
-            raise ValueError(f"control_period must be positive, got {control_period!r}")
-        if update_offset is None:
-            update_offset = decide_offset(control_period)
-        if not np.isfinite(update_offset) or update_offset < 0.0:
-            raise ValueError(f"update_offset must be >= 0, got {update_offset!r}")
-        self._goal_count = int(goal_count)
+        self._goal_count = goal_count
         # A copy: the settings are a plain (mutable) dataclass the caller may change later.
         self._settings = dataclasses.replace(settings)
-        self._period = float(control_period)
+        self._period = checked_period(control_period)
         k = self._goal_count
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._goals_port = self.DeclareVectorInputPort("goals", 3 * k)
@@ -74,11 +67,8 @@ class GoalEstimator(PortGetters, LeafSystem):
         self._probabilities_port = self.DeclareStateOutputPort(
             "goal_probabilities", self._probabilities_index)
         self.DeclareInitializationDiscreteUpdateEvent(self._initialise)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
-
-    @property
-    def goal_count(self):
-        return self._goal_count
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, decide_offset(self._period),
+                                                self._update)
 
     @property
     def settings(self):

@@ -9,7 +9,7 @@ from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.goal_groups import NO_GOAL, group_target, pose_group_target
 from pbp_drake.systems.ports import (
     EeState, GoalPose, PortGetters, PoseState, checked_goal_count, goal_index)
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_period, decide_offset
 
 
 class GoalGrouping(PortGetters, LeafSystem):
@@ -58,11 +58,9 @@ class GoalGrouping(PortGetters, LeafSystem):
         self._probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._hand_port = self.DeclareVectorInputPort(self._HAND, self._HAND_SIZE)
-        if not (np.isfinite(control_period) and control_period > 0.0):
-            raise ValueError(f"control_period must be positive, got {control_period!r}")
+        period = checked_period(control_period)
         self._committed_index = self.DeclareDiscreteState(np.array([float(NO_GOAL)]))
-        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period),
-                                                decide_offset(control_period), self._commit)
+        self.DeclarePeriodicDiscreteUpdateEvent(period, decide_offset(period), self._commit)
         # [followed goals (width K), shown index]: computed once for both outputs.
         self._target = self.DeclareCacheEntry(
             "followed goals and the shown goal",

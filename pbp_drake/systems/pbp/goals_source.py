@@ -17,9 +17,8 @@ class GoalsSource(PortGetters, LeafSystem):
         - goals
 
     Drake's ConstantVectorSource declares that its output may change with any source of the
-    diagram, so every system reading it (the DMP bank's goals cache, the goal estimator)
-    recomputed from it at every step: at K = 100,000 goals that was 0.2 ms an update. Here
-    the output depends on the parameter alone; `set_goals` changes it in a context.
+    diagram, so every system reading it would recompute from it at every step; here the
+    output depends on the parameter alone. `set_goals` changes it in a context.
     """
 
     def __init__(self, goals):

@@ -5,7 +5,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.hand_over import check_limit, hand_over
 from pbp_drake.systems.ports import PortGetters
-from pbp_drake.systems.tick import report_offset
+from pbp_drake.systems.tick import checked_period, report_offset
 
 
 class HandOver(PortGetters, LeafSystem):
@@ -37,9 +37,7 @@ class HandOver(PortGetters, LeafSystem):
             raise ValueError(f"initial_position must be finite, got {initial_position}")
         self._max_acceleration = check_limit(max_acceleration, "max_acceleration", "m/s^2")
         self._max_speed = check_limit(max_speed, "max_speed", "m/s")
-        self._period = float(control_period)
-        if not (np.isfinite(self._period) and self._period > 0.0):
-            raise ValueError(f"control_period must be positive, got {control_period!r}")
+        self._period = checked_period(control_period)
         self._dimension = d = initial_position.size
         self._reference_port = self.DeclareVectorInputPort("reference", 2 * d)
         self._state_index = index = self.DeclareDiscreteState(
@@ -47,14 +45,6 @@ class HandOver(PortGetters, LeafSystem):
         self._command_port = self.DeclareStateOutputPort("command", index)
         self.DeclarePeriodicDiscreteUpdateEvent(
             self._period, report_offset(self._period), self._update)
-
-    @property
-    def max_acceleration(self):
-        return self._max_acceleration
-
-    @property
-    def max_speed(self):
-        return self._max_speed
 
     def _update(self, context, discrete_state):
         d = self._dimension

@@ -24,9 +24,8 @@ class HeadingCommand(PortGetters, LeafSystem):
     the rate it turns at follows the operator's under the hand-over law
     (`pbp_drake.core.hand_over`), so starting and stopping a turn is not a step. The DMPs
     never turn the robot: in PBP the operator's turning is how it tells the goal estimator
-    where it wants to go. Like the DMP bank, it updates at the decide stage (`update_offset`
-    after the tick, by default `pbp_drake.systems.tick.decide_offset`) to use the
-    operator's command of that tick.
+    where it wants to go. Like the DMP bank, it updates at the decide stage
+    (`pbp_drake.systems.tick`) to use the operator's command of that tick.
 
     With a `max_turn` (rad) the heading stays within it of `initial_heading`: an arm's wrist
     turns so far and no further (the HSR turns its base, and has none). At the bound the
@@ -34,15 +33,13 @@ class HeadingCommand(PortGetters, LeafSystem):
     """
 
     def __init__(self, initial_heading, control_period, max_yaw_acceleration=None,
-                 update_offset=None, max_turn=None):
+                 max_turn=None):
         super().__init__()
         self._period = float(control_period)
         self._turn_bounds = None
         if max_turn is not None and max_turn != np.inf:  # NaN is refused below
             turn = check_limit(max_turn, "max_turn", "rad")
             self._turn_bounds = (float(initial_heading) - turn, float(initial_heading) + turn)
-        if update_offset is None:
-            update_offset = decide_offset(self._period)
         self._max_yaw_acceleration = (np.inf if max_yaw_acceleration is None else check_limit(
             max_yaw_acceleration, "max_yaw_acceleration", "rad/s^2"))
         self._command_port = self.DeclareVectorInputPort("operator_command",
@@ -50,7 +47,8 @@ class HeadingCommand(PortGetters, LeafSystem):
         self._heading_index = self.DeclareDiscreteState(np.array([float(initial_heading)]))
         self._yaw_rate_index = self.DeclareDiscreteState(np.zeros(1))
         self._heading_port = self.DeclareStateOutputPort("heading", self._heading_index)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, decide_offset(self._period),
+                                                self._update)
 
     def _update(self, context, discrete_state):
         # One pybind call a group's array (get_mutable_vector and its value: two).

@@ -11,6 +11,7 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, assisted_command, check_assistance, hop_targets)
 from pbp_drake.systems.ports import PortGetters
+from pbp_drake.systems.tick import checked_period
 
 
 class HopAssistanceBase(PortGetters, LeafSystem):
@@ -23,12 +24,10 @@ class HopAssistanceBase(PortGetters, LeafSystem):
         if not isinstance(settings, HopSettings):
             raise ValueError(f"settings must be a HopSettings, got {type(settings).__name__}")
         settings.validate()
-        if not (np.isfinite(control_period) and control_period > 0.0):
-            raise ValueError(f"control_period must be positive, got {control_period!r}")
         self._method = method
         self._goal_count = int(goal_count)
         self._settings = dataclasses.replace(settings)
-        self._period = float(control_period)
+        self._period = checked_period(control_period)
 
     @property
     def method(self):

@@ -42,11 +42,6 @@ class IntentFilterGoalEstimator(MaxEntGoalEstimator):
 
     _SETTINGS = IntentFilterSettings
 
-    def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
-                 update_offset=None):
-        super().__init__(goal_count, settings, control_period, margin, hold_steps,
-                         update_offset)
-
     def _inputs(self, context):
         hand = self._ee_state_port.Eval(context)
         command = self._command_port.Eval(context)
@@ -100,9 +95,8 @@ class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
     _SETTINGS = IntentFilterSettings
 
     def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
-                 update_offset=None, forward_key=True):
-        super().__init__(goal_count, settings, control_period, margin, hold_steps,
-                         update_offset)
+                 forward_key=True):
+        super().__init__(goal_count, settings, control_period, margin, hold_steps)
         self._forward_key = bool(forward_key)
 
     def _declare_inputs(self, goal_count):

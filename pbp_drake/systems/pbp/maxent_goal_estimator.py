@@ -15,7 +15,7 @@ from pbp_drake.core.hindsight_optimization import (
     HopSettings, hop_targets, uniform_log_belief, update_posterior)
 from pbp_drake.core.maxent_command import intent_evidence, update_intent_posterior
 from pbp_drake.systems.ports import EeState, OperatorCommand, PortGetters, checked_goal_count
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_period, decide_offset
 
 
 class PosteriorInputs(typing.NamedTuple):
@@ -52,7 +52,7 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
     command while it acts, the hand's executed motion while it is silent, and its turns."""
 
     def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
-                 update_offset=None, operator_speed=None):
+                 operator_speed=None):
         super().__init__()
         if operator_speed is not None and not (np.isfinite(operator_speed)
                                                and operator_speed > 0.0):
@@ -63,15 +63,11 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
             raise ValueError(f"settings must be {self._SETTINGS.__name__}, got "
                              f"{type(settings).__name__}")
         settings.validate()
-        if not (np.isfinite(control_period) and control_period > 0.0):
-            raise ValueError(f"control_period must be positive, got {control_period!r}")
         if not 0.0 <= margin < 1.0:
             raise ValueError(f"margin must lie in [0, 1), got {margin!r}")
         if isinstance(hold_steps, bool) or int(hold_steps) != hold_steps or hold_steps < 1:
             raise ValueError(f"hold_steps must be an integer >= 1, got {hold_steps!r}")
-        if update_offset is None:
-            update_offset = decide_offset(control_period)
-        self._period = float(control_period)
+        self._period = checked_period(control_period)
         k = self._goal_count = int(goal_count)
         # A copy: the settings are a plain (mutable) dataclass the caller may change later.
         self._settings = dataclasses.replace(settings)
@@ -89,21 +85,12 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
                                                                self._probabilities_index)
         self._clipped_port = self.DeclareStateOutputPort("posterior_clipped",
                                                          self._clipped_index)
-        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period), update_offset,
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, decide_offset(self._period),
                                                 self._update)
-
-    @property
-    def goal_count(self):
-        return self._goal_count
 
     @property
     def settings(self):
         return self._settings
-
-    @property
-    def operator_speed(self):
-        """None: HOP's published likelihood; else the PBP operator's, at this speed."""
-        return self._operator_speed
 
     @property
     def margin(self):
@@ -172,13 +159,12 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
     `ee_state` is `EeState`, `goals` the K goals flattened `(K, 3)` (each goal one target),
     `operator_command` the operator's `OperatorCommand` `[vx, vy, vz, yaw_rate]`, of which
     the velocity is read (the hand's own velocity is mostly the robot's). The belief starts
-    uniform, and each update, at the decide stage of the tick (`update_offset` overrides
-    it), it moves by `-(Q_g - V_g)` (with `operator_speed`: by the evidence of
-    `pbp_drake.core.maxent_command`, which also reads `operator_active` (1 while the
-    operator acts), the hand's velocity and heading in `ee_state` and the yaw rate) and
-    is clipped at `settings.max_probability`; the
-    selection is the most probable goal, moved with the hysteresis of `margin` and
-    `hold_steps` (0 and 1: at once). `goal_probabilities` (K), `selected_goal` `[index]`
+    uniform, and each update, at the decide stage of the tick, it moves by `-(Q_g - V_g)`
+    (with `operator_speed`: by the evidence of `pbp_drake.core.maxent_command`, which also
+    reads `operator_active` (1 while the operator acts), the hand's velocity and heading in
+    `ee_state` and the yaw rate) and is clipped at `settings.max_probability`; the selection
+    is the most probable goal, moved with the hysteresis of `margin` and `hold_steps` (0
+    and 1: at once). `goal_probabilities` (K), `selected_goal` `[index]`
     and `posterior_clipped` (`[1]` when the last update was clipped, else `[0]`) are read
     from the state, so they hold between updates.
     """

@@ -1,11 +1,7 @@
 """The six-DoF DMP bank as a Drake system: K goal poses, each a position DMP and an
-orientation DMP re-integrated every control step from the hand's measured pose.
-
-A thin LeafSystem over the NumPy banks `pbp_drake.core.dmp.DmpBankModel` (positions, D = 3) and
-`OrientationDmpBank` (unit quaternions), as `pbp_drake.systems.pbp.dmp_bank.DmpBank` is over
-the first: the DMPs' state is the Context's discrete state and the scratch arrays are a
-cache entry (one per Context), so Contexts and Simulators stay independent.
-"""
+orientation DMP re-integrated every control step from the hand's measured pose, over the
+NumPy banks `DmpBankModel` (positions, D = 3) and `OrientationDmpBank`, as `DmpBank` is
+over the first."""
 
 import math
 
@@ -22,7 +18,7 @@ from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, goal_index
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
     AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
     hold_into, per_goal_arrays, split_head, state_size, step_all)
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_period, checked_update_offset
 
 class PoseDmpBank(PortGetters, LeafSystem):
     """Steps K pose DMPs (one per goal pose) every control period from the hand's pose.
@@ -49,42 +45,30 @@ class PoseDmpBank(PortGetters, LeafSystem):
 
     Each period every DMP advances one step from the measured pose: the position part as
     `DmpBank`, the orientation part as `OrientationDmpBank` (`e = Log(q g*)`, the same
-    first-order-hold step, see docs/concepts/dmp.md). Both parts share one phase, so one lock stops
-    both: with `lock_phase_when_operator_acts` (PBP-Alt) a nonzero `operator_active`
-    freezes the phase and the DMPs follow the hand (its pose, and `tau` times its twist)
-    until the operator lets go. `followed_goal` (the goal estimator's selection before it
-    updates) makes every DMP continue from the followed DMP's linear AND angular velocity,
-    so a switch of goal keeps the commanded twist (as `DmpBank`); unconnected, each keeps
-    its own. `max_speed` (m/s) and `max_angular_speed` (rad/s) scale each DMP's own
-    velocities down to them before every step (anti-windup, as `DmpBank`'s `max_speed`;
-    give the hand-over's limits).
+    first-order-hold step, see docs/concepts/dmp.md). Both parts share one phase, so one
+    lock stops both. `lock_phase_when_operator_acts`, `followed_goal` (which also carries
+    the followed DMP's angular velocity over, so a switch of goal keeps the commanded
+    twist) and `max_speed` are `DmpBank`'s; `max_angular_speed` (rad/s) is the angular
+    part's anti-windup limit. Locked, the DMPs follow the hand's pose and `tau` times its
+    twist.
 
     `references` is the K next pose references, K `PoseState` rows (pose after one step,
     twist) flattened; `selected_reference` is the one of `selected_goal` (unconnected: the
-    followed goal, else goal 0), a `PoseState`, computed alone (what a blender needs;
-    `references` costs K exp maps). `phase` is the K (equal) phases. `predicted_poses`
-    (declared when `prediction_steps > 0`) is the selected DMP's open-loop rollout from its
-    current state, `prediction_steps + 1` `GoalPose` rows flattened, sampled every
-    `prediction_period` (default: the DMPs' duration over `prediction_steps`), for
-    drawing: it is computed only when read (a visualizer's publish), never per tick.
+    followed goal, else goal 0), a `PoseState`, computed alone (`references` costs K exp
+    maps). `phase` is the K (equal) phases. `predicted_poses` (with `prediction_steps > 0`)
+    is the selected DMP's open-loop rollout from its current state, `prediction_steps + 1`
+    `GoalPose` rows flattened, sampled every `prediction_period` (default: the DMPs'
+    duration over `prediction_steps`), computed only when read (a visualizer's publish).
 
-    The state is one vector `[phase, held, p (3), q (4), eta (3), ...]`, in one of two
-    layouts (`pbp_drake.systems.pbp.pose_dmp_bank_state`). Per goal (the default), the K DMPs'
-    stepped arrays follow: the position DMPs' stepped positions relative to the measured
-    one and their stepped scaled velocities (`DmpBank`'s `p + dp + Phi01 z` and
-    `dz + Phi11 z`, summed at the step), and the orientation DMPs' stepped log coordinates
-    `(e', z')` (`log_step_into`), from which the outputs read the orientations and angular
-    velocities on demand: 12 K numbers, which Drake copies twice at each update (at
-    K = 10,000 a fifth of the step). With `compact_state=True` (which needs `followed_goal`
-    connected: an update without it raises) the state is 16 numbers whatever K, what the
-    last step started from (its phase, the measured pose, the followed DMP's velocities
-    after the speed limits), and the K stepped DMPs are a cache entry computed from it and
-    the goals, with the same call, once per state when first read: by an output, or by the
-    next update, which continues from the followed DMP's velocities. Every DMP is still
-    stepped every tick; the outputs are the per-goal layout's bit for bit while the goals
-    stay, and if the goals change between an update and a read, the read steps toward the
-    new goals (as `DmpBank`'s compact state). The bank updates at the decide stage of each
-    tick (`update_offset` overrides it).
+    The state is one vector in one of the layouts of
+    `pbp_drake.systems.pbp.pose_dmp_bank_state`: per goal (the default, 12 K numbers, which
+    Drake copies twice at each update), or with `compact_state=True` (which needs
+    `followed_goal` connected: an update without it raises) 16 numbers whatever K, from
+    which the K stepped DMPs are computed into a cache entry once per state, when first
+    read. Every DMP is still stepped every tick; the outputs are the per-goal layout's bit
+    for bit while the goals stay (if they change between an update and a read, the read
+    steps toward the new goals, as `DmpBank`'s compact state). The bank updates at the
+    decide stage of each tick (`update_offset` overrides it).
     """
 
     def __init__(self, position_bank, orientation_bank, control_period,
@@ -93,8 +77,6 @@ class PoseDmpBank(PortGetters, LeafSystem):
                  compact_state=False):
         super().__init__()
         _check_banks(position_bank, orientation_bank, control_period)
-        # Anti-windup, as DmpBank's `max_speed`: the hand-over never lets the hand move or
-        # turn faster, so no DMP may remember a faster velocity (`limit_speeds`).
         self._max_speed = None if max_speed is None else float(max_speed)
         self._max_angular_speed = (None if max_angular_speed is None
                                    else float(max_angular_speed))
@@ -106,11 +88,7 @@ class PoseDmpBank(PortGetters, LeafSystem):
         self._period = float(control_period)
         self._decay = position_bank.decay(self._period)  # the phase factor of one update
         self._lock = bool(lock_phase_when_operator_acts)
-        if update_offset is None:
-            update_offset = decide_offset(self._period)
-        if not (np.isfinite(update_offset) and 0.0 <= update_offset < self._period):
-            raise ValueError(
-                f"update_offset must be in [0, control_period), got {update_offset!r}")
+        update_offset = checked_update_offset(update_offset, self._period)
         k = self._goal_count = position_bank.goal_count
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", PoseState.size)
         self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
@@ -432,9 +410,7 @@ def _check_banks(position_bank, orientation_bank, control_period):
     if position_bank.goal_count != orientation_bank.goal_count:
         raise ValueError(f"the banks have {position_bank.goal_count} and "
                          f"{orientation_bank.goal_count} goals; a pose bank needs one count")
-    period = float(control_period)
-    if not (np.isfinite(period) and period > 0.0):
-        raise ValueError(f"control_period must be positive, got {control_period!r}")
+    period = checked_period(control_period)
     if position_bank.decay(period) != orientation_bank.decay(period):
         raise ValueError("the position and orientation banks must share one phase: give them "
                          "the same duration and alpha_x")

@@ -30,30 +30,23 @@ class PoseGoalEstimator(PortGetters, LeafSystem):
 
     `hand_pose` is the hand's `PoseState` (pose and world-frame twist); `goal_poses` the K
     `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened. `operator_twist`, when
-    connected, is the operator's command, an `OperatorTwist` `[v (3), omega (3)]` (world
-    frame): the estimator's direction of travel and turn rate are then the operator's, not
-    the hand's, and while the operator gives no input (a twist of all zeros) the selection
-    holds. Connect it whenever a policy moves the hand too: the hand's own twist is then
-    mostly the selected DMP's, and reading it as the operator's intent holds the selection
-    on whatever the robot is heading for; and with the operator idle, only the hand's
-    distances and angles to the grasps would be left to decide, which the policy's own
-    motion changes (docs/tasks/grasp.md). Unconnected, the hand's twist from `hand_pose`
-    is read and the selection follows it at every update. `selected_goal` is `[index]`
-    and `goal_probabilities` the K probabilities; both are read from the state, so they
-    hold between updates, as `GoalEstimator`'s.
-
-    At initialisation it selects the most probable grasp pose at once (no hysteresis);
-    each update, at the decide stage of the tick (`update_offset` overrides it), it
-    recomputes the probabilities and moves the selection with the shipped hysteresis.
+    connected, is the operator's `OperatorTwist` (world frame): the estimator's direction
+    of travel and turn rate are then the operator's, not the hand's, and while the operator
+    gives no input (all zeros) the selection holds. Connect it whenever a policy moves the
+    hand too: the hand's own twist is then mostly the selected DMP's, and would hold the
+    selection on whatever the robot heads for (docs/tasks/grasp.md). Unconnected, the
+    hand's twist is read and the selection follows it at every update. `selected_goal` is
+    `[index]` and `goal_probabilities` the K probabilities, read from the state as
+    `GoalEstimator`'s. At initialisation it selects the most probable grasp pose at once
+    (no hysteresis); each update, at the decide stage of the tick, it recomputes the
+    probabilities and moves the selection with the shipped hysteresis.
     """
 
-    def __init__(self, goal_count, settings, control_period, update_offset=None):
+    def __init__(self, goal_count, settings, control_period):
         super().__init__()
         if not isinstance(settings, GoalEstimatorSettings) or settings.method != "pose":
             raise ValueError("settings must be a GoalEstimatorSettings with method 'pose'")
         settings.validate()
-        if update_offset is None:
-            update_offset = decide_offset(control_period)
         k = self._goal_count = int(goal_count)
         # A copy: the settings are a plain (mutable) dataclass the caller may change later.
         self._settings = dataclasses.replace(settings)
@@ -70,8 +63,8 @@ class PoseGoalEstimator(PortGetters, LeafSystem):
                                                                self._probabilities_index)
         self.DeclareInitializationDiscreteUpdateEvent(
             lambda context, state: self._estimate(context, state, None))
-        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period), update_offset,
-                                                self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period),
+                                                decide_offset(control_period), self._update)
 
     def _update(self, context, state):
         challenger, count = context.get_discrete_state(self._memory_index).value()

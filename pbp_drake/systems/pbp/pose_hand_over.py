@@ -6,7 +6,7 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core import quaternion
 from pbp_drake.core.pose_arbitration import HandOverLimits, PoseReference, pose_hand_over
 from pbp_drake.systems.ports import PortGetters, PoseState
-from pbp_drake.systems.tick import report_offset
+from pbp_drake.systems.tick import checked_period, report_offset
 
 
 class PoseHandOver(PortGetters, LeafSystem):
@@ -35,19 +35,13 @@ class PoseHandOver(PortGetters, LeafSystem):
                              f"got {initial_pose.tolist()}")
         orientation = quaternion.unit_quaternions(initial_pose[3:], "initial_pose orientation")
         self._limits = HandOverLimits(*limits).checked()
-        self._period = float(control_period)
-        if not (np.isfinite(self._period) and self._period > 0.0):
-            raise ValueError(f"control_period must be positive, got {control_period!r}")
+        self._period = checked_period(control_period)
         self._reference_port = self.DeclareVectorInputPort("reference", PoseState.size)
         initial = np.concatenate([initial_pose[:3], orientation, np.zeros(6)])
         index = self.DeclareDiscreteState(initial)
         self._command_port = self.DeclareStateOutputPort("command", index)
         self.DeclarePeriodicDiscreteUpdateEvent(
             self._period, report_offset(self._period), self._update)
-
-    @property
-    def limits(self):
-        return self._limits
 
     def _update(self, context, discrete_state):
         reference = PoseReference.from_vector(self._reference_port.Eval(context))

@@ -22,13 +22,10 @@ class GraspTaskMonitor(TaskMonitorBase):
         - target
         - task_status
 
-    `hand_pose` is the hand's `PoseState`. At the decide stage of every tick until success:
-    count the tick (and whether the operator acted), compute `grasp_progress` toward the
-    current target's grasp pose from the hand's start pose (length per radian
-    `success_distance / success_angle`), switch to the next of `targets` once progress
-    reaches the next entry of `switch_schedule`, and declare success when the hand is
-    within `success_distance` (m) AND `success_angle` (rad) of the target's grasp pose. At
-    success it ends the simulation at the report stage, as `TaskMonitor` does.
+    `hand_pose` is the hand's `PoseState`. Progress is `grasp_progress` toward the current
+    target's grasp pose from the hand's start pose (length per radian `success_distance /
+    success_angle`); success is the hand within `success_distance` (m) AND `success_angle`
+    (rad) of the target's grasp pose.
 
     `target` is `Target` (the target's grasp position and object index); `task_status` is
     `TaskStatus` (collision ratio 0: the task has no obstacles). `grasp_positions` (M, 3)

@@ -21,26 +21,23 @@ class MovingObstacles(PortGetters, LeafSystem):
         - obstacle_positions
         - floor_positions
 
-    Every control period, `update_offset` after the tick (by default the decide stage,
-    `pbp_drake.systems.tick.decide_offset`), it computes the hand's progress to
-    the target from `ee_state` and steps the obstacles (`core.obstacle_task.step_obstacles`):
-    each wakes when the progress passes its threshold and then moves at `speed` to the
-    midpoint between the hand and the target, where it stops. `obstacle_positions` is
-    `(N, 3)` flattened, the centres of upright cylinders of `height` standing on the floor
-    (what the HSR station's `obstacle_positions` input takes: the station holds the
-    geometry); `floor_positions` is `(N, 2)` flattened, the same on the floor. All state
-    lives in the Context.
+    At the decide stage of every control tick (`pbp_drake.systems.tick`), it computes the
+    hand's progress to the target from `ee_state` and steps the obstacles
+    (`core.obstacle_task.step_obstacles`): each wakes when the progress passes its threshold
+    and then moves at `speed` to the midpoint between the hand and the target, where it
+    stops. `obstacle_positions` is `(N, 3)` flattened, the centres of upright cylinders of
+    `height` standing on the floor (what the HSR station's `obstacle_positions` input takes:
+    the station holds the geometry); `floor_positions` is `(N, 2)` flattened, the same on
+    the floor. All state lives in the Context.
     """
 
-    def __init__(self, scene, start, height, speed, control_period, update_offset=None):
+    def __init__(self, scene, start, height, speed, control_period):
         super().__init__()
         self._scene = scene
         self._start = np.asarray(start, dtype=float)
         self._height = float(height)
         self._speed = float(speed)
         self._period = float(control_period)
-        if update_offset is None:
-            update_offset = decide_offset(self._period)
         count = len(scene.obstacle_starts)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._positions_index = self.DeclareDiscreteState(scene.obstacle_starts.reshape(-1))
@@ -50,7 +47,8 @@ class MovingObstacles(PortGetters, LeafSystem):
             "obstacle_positions", 3 * count, self._calc_centres,
             prerequisites_of_calc={self.discrete_state_ticket(self._positions_index)})
         self.DeclareStateOutputPort("floor_positions", self._positions_index)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, update_offset, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, decide_offset(self._period),
+                                                self._update)
 
     def _calc_centres(self, context, output):
         floor = context.get_discrete_state(self._positions_index).value().reshape(-1, 2)

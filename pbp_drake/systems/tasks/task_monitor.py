@@ -61,10 +61,8 @@ class TaskMonitorBase(PortGetters, LeafSystem):
     a later `AdvanceTo` stops again one control period on.
 
     The counts (`TaskCounts`, whole numbers held exactly as floats) and the progress and
-    task time are two discrete vectors. They were an unrestricted update (the counts in
-    abstract state) until it showed that Drake copies the whole diagram's state for each
-    unrestricted update; as a discrete update it reads the same values (no system that
-    updates at the decide stage reads this monitor, nor does it read theirs).
+    task time are two discrete vectors, updated at the decide stage (no other system that
+    updates there reads this monitor, nor does it read theirs).
     """
 
     def __init__(self, pose_port, pose_size, objects, targets, switch_schedule,
@@ -187,14 +185,8 @@ class TaskMonitor(TaskMonitorBase):
         - target
         - task_status
 
-    `ee_state` is `EeState` (`[p (3), v (3), heading, heading_rate]`). Every control period,
-    `update_offset` after the tick (the decide stage of `pbp_drake.systems.tick` by default),
-    until success: count the step (and whether the operator acted), compute the progress
-    toward the current target from the end effector's start, switch to the next target of
-    `targets` once progress reaches the next entry of `switch_schedule`, and declare success
-    when the end effector is within `success_distance` of the current target. At success it
-    ends the simulation at the report stage (`TaskMonitorBase`).
-
+    `ee_state` is `EeState`; progress is measured toward the current target from the end
+    effector's `start`, and success is the end effector within `success_distance` of it.
     `target` is `Target` (`[position (3), object index]`); `task_status` is `TaskStatus`
     (`[progress, stage (number of switches so far), success (0/1), task time (s, the time
     of the last tick counted: at success, the tick that reached the target), intervention ratio
@@ -208,9 +200,6 @@ class TaskMonitor(TaskMonitorBase):
                          control_period, update_offset, in_collision_port=True)
         self._start = np.asarray(start, dtype=float)
         self._success_distance = float(success_distance)
-
-    def get_ee_state_input_port(self):
-        return self._hand_port
 
     def _read_hand(self, vector):
         return position_of(EeState(vector))

@@ -3,15 +3,15 @@ many, the likeliest grasps' triads), every grasp's probability as one point clou
 target and the estimated goal, the hand, and the selected DMP's predicted poses."""
 
 import numpy as np
-from pydrake.geometry import Box, Cylinder, Sphere
+from pydrake.geometry import Box, Cylinder
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.pbp.likely_goals import likely_goal_indices
 from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, Target, goal_index
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
-    CLOUD_POINT_SIZE, ESTIMATE_COLOUR, ESTIMATE_LIFT, OBJECT_COLOUR, SOLID_OBJECTS,
-    TABLE_COLOUR, TARGET_COLOUR, TARGET_LIFT)
+    CLOUD_POINT_SIZE, OBJECT_COLOUR, SOLID_OBJECTS, TABLE_COLOUR, TaskMarkers,
+    behind_the_robot)
 from pbp_drake.systems.visualizers.scene_drawing import (
     GoalCloud, PathTriads, draw_triad, pose_transform)
 
@@ -34,27 +34,19 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         - hand_state (optional)
         - goal_probabilities (optional)
 
-    `grasps` is the task's `GraspScene` (`layout.grasps`). What is sent does not grow with
-    the number of grasps K once the scene is drawn. At each initialisation
-    (`Simulator.Initialize`, after deleting `/task`) it draws, up to `SOLID_OBJECTS`
-    grasps, every table and object and, at each object's grasp pose, a triad
+    `grasps` is the task's `GraspScene` (`layout.grasps`). As `ReachSceneVisualizer`
+    (whose drawing of the objects, the goal cloud, the balls and the recording this
+    shares), what is sent does not grow with the number of grasps K. Up to `SOLID_OBJECTS`
+    grasps, every table and object is drawn and, at each object's grasp pose, a triad
     `/task/grasps/{k}` (`draw_triad`: x red, y green, z blue, z the approach); with more,
     `likely_triads` triads `/task/likely_grasps/{i}` that each path period moves to the
-    selected grasp and the likeliest others (`goal_probabilities`), with
-    `time_in_recording`. Every grasp position is also a point of the goal cloud
-    `/task/goal_cloud` (`GoalCloud`), coloured each `cloud_period` (or less often for
-    thousands of grasps: `GoalCloud.period`) by its probability, as
-    in the reaching task. Each publish moves the yellow ball above the `target`'s object
-    (`Target`; its index picks the object) and the blue ball above the `selected_goal`'s
-    (hidden while it is -1: the robot shows no intent, under teleop or while it follows a
-    group of grasps),
-    and the hand's triad `/task/hand` to `hand_state` (`PoseState`), with
-    `time_in_recording` so that `Meshcat.StartRecording` replays them. Each `path_period`
-    the selected DMP's predicted poses (`predicted_poses`: `prediction_steps + 1` rows of
-    `GoalPose` `[x, y, z, qw, qx, qy, qz]`, flattened) are drawn as `PATH_TRIADS` triads
-    `/task/prediction/{i}` spread along the path by arc length (`PathTriads`), also with
-    `time_in_recording`: a replay shows the path and its orientations as they were.
-    Call from the thread that made `meshcat`.
+    selected grasp and the likeliest others (`goal_probabilities`). The blue ball is
+    hidden while `selected_goal` is -1 (no intent shown: teleop, or a group of grasps
+    followed). Each publish moves the hand's triad `/task/hand` to `hand_state`
+    (`PoseState`); each `path_period` the selected DMP's predicted poses
+    (`predicted_poses`: `prediction_steps + 1` `GoalPose` rows, flattened) are drawn as
+    `PATH_TRIADS` triads `/task/prediction/{i}` spread along the path by arc length
+    (`PathTriads`). Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, grasps, prediction_steps=0, table_size=(0.3, 0.3),
@@ -78,6 +70,7 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         self._solid = count <= SOLID_OBJECTS
         self._likely_triads = min(int(likely_triads), count)
         self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions, CLOUD_POINT_SIZE)
+        self._markers = TaskMarkers()
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)
@@ -116,16 +109,12 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
             meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(centre))
             draw_triad(meshcat, f"/task/grasps/{index}", self._grasp_pose(index),
                        TRIAD_LENGTH, TRIAD_RADIUS)
-        meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
-        meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
-        self._ball_shown = True
+        self._markers.draw(meshcat)
         draw_triad(meshcat, "/task/hand", None, TRIAD_LENGTH, TRIAD_RADIUS)
         meshcat.SetProperty("/task/hand", "visible", False)  # until a hand_state is seen
         if self._prediction_steps:
             self._path.draw(meshcat)
-        centre = grasps.objects.mean(axis=0)
-        # A camera behind and above the robot that sees it and every object.
-        meshcat.SetCameraPose([-1.6, -1.2, 2.6], [0.55 * centre[0], 0.0, 0.4])
+        meshcat.SetCameraPose(*behind_the_robot(grasps.objects))
 
     def _grasp_pose(self, index):
         return np.concatenate([self._grasps.grasp_positions[index],
@@ -138,17 +127,9 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         target = int(Target(self._target_port.Eval(context)).index)
         if not 0 <= target < count:
             raise ValueError(f"target index {target} is not one of the {count} objects")
-        meshcat.SetTransform("/task/target",
-                             RigidTransform(objects[target] + [0, 0, TARGET_LIFT]), time)
         selected = self._shown_goal(context)
-        if (selected is not None) != self._ball_shown:
-            # Sent only when that changes, so that a page's messages do not grow.
-            self._ball_shown = selected is not None
-            meshcat.SetProperty("/task/estimated_goal", "visible", self._ball_shown, time)
-        if selected is not None:
-            meshcat.SetTransform("/task/estimated_goal",
-                                 RigidTransform(objects[selected] + [0, 0, ESTIMATE_LIFT]),
-                                 time)
+        self._markers.show(meshcat, objects[target],
+                           None if selected is None else objects[selected], time)
         if self._hand_state_port.HasValue(context):
             hand = self._hand_state_port.Eval(context)[:GoalPose.size]
             meshcat.SetTransform("/task/hand", pose_transform(hand), time)

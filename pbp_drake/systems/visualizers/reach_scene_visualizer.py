@@ -42,6 +42,27 @@ TARGET_LIFT = 0.12
 ESTIMATE_LIFT = 0.25
 
 
+class TaskMarkers:
+    """The HSR tasks' yellow ball above the target object (`/task/target`) and blue ball
+    above the estimated goal's (`/task/estimated_goal`, hidden while none is shown)."""
+
+    def draw(self, meshcat):
+        meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
+        meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
+        self._ball_shown = True
+
+    def show(self, meshcat, target, estimate, time):
+        """Moves the balls above `target` (3) and `estimate` (3; None: no ball)."""
+        meshcat.SetTransform("/task/target", RigidTransform(target + [0, 0, TARGET_LIFT]), time)
+        if (estimate is not None) != self._ball_shown:
+            # Sent only when that changes, so that a page's messages do not grow.
+            self._ball_shown = estimate is not None
+            meshcat.SetProperty("/task/estimated_goal", "visible", self._ball_shown, time)
+        if estimate is not None:
+            meshcat.SetTransform("/task/estimated_goal",
+                                 RigidTransform(estimate + [0, 0, ESTIMATE_LIFT]), time)
+
+
 class ReachSceneVisualizer(PortGetters, LeafSystem):
     """Publishes the reaching task's markers to Meshcat under `/task`.
 
@@ -56,28 +77,25 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         - predicted_paths (optional)
         - goal_probabilities (optional)
 
-    What is sent does not grow with the number of objects K once the scene is drawn: at
-    each initialisation (`Simulator.Initialize`, after deleting `/task`) the objects are
-    drawn on small tables (up to `SOLID_OBJECTS` of them; more are the cloud alone), and
-    every object as one point of the goal cloud `/task/goal_cloud` (`GoalCloud`), so a
-    second run or a run after `meshcat.Delete()` draws them again. Each publish moves the
-    yellow ball above the current `target` (`Target`, `[p (3), index]`) and the blue ball
-    above the estimated goal (`selected_goal`), with `time_in_recording` so that
-    `Meshcat.StartRecording` replays them; an orange ring around the hand shows when the
-    operator acts. Each `path_period` (default 0.1 s: paths change slowly, and a replay
-    interpolates between updates) the `path_count` paths on `predicted_paths` (each
-    `prediction_steps + 1` points, the selected goal's first, as the PBP controller's
-    `predicted_paths` orders them) are drawn as dots (`PathDots`, with
-    `time_in_recording`, so a replay shows each path where it was at that time): the
-    first bold `/task/predictions/selected`, the others faint
-    `/task/predictions/likely/{i}`. Each `cloud_period` (default 0.25 s; for thousands of
-    objects less often, `GoalCloud.period`) the cloud's points
-    take the colour of their goal's probability (`goal_probabilities`, K), grey to blue,
-    sent again only when a colour changed; a recording keeps the cloud's last colours only
-    (Meshcat records transforms and properties, not objects), the paths as they went.
-    The drawing sets Meshcat's camera (`camera`, `(position, target)`): behind and above
-    the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base, start and
-    objects), framed on it (`workspace_view`). Call from the thread that made `meshcat`.
+    What is sent does not grow with the number of objects K once the scene is drawn. At
+    each initialisation (`Simulator.Initialize`, after deleting `/task`, so that a second
+    run or a run after `meshcat.Delete()` draws them again) the objects are drawn on small
+    tables (up to `SOLID_OBJECTS`), and every object as one point of the goal cloud
+    `/task/goal_cloud` (`GoalCloud`). Each publish moves the yellow ball above the current
+    `target` and the blue ball above the estimated goal (`selected_goal`; `TaskMarkers`);
+    an orange ring around the hand shows when the operator acts. Each `path_period`
+    (paths change slowly, and a replay interpolates between updates) the `path_count`
+    paths on `predicted_paths` (each `prediction_steps + 1` points, the selected goal's
+    first, as the PBP controller orders them) are drawn as dots (`PathDots`): the first
+    bold `/task/predictions/selected`, the others faint `/task/predictions/likely/{i}`.
+    Each `cloud_period` (less often for thousands of objects, `GoalCloud.period`) the
+    cloud's points take the colour of their goal's probability (`goal_probabilities`, K).
+    All with `time_in_recording`, so that `Meshcat.StartRecording` replays them (a
+    recording keeps the cloud's last colours only: Meshcat records transforms and
+    properties, not objects). The camera (`camera`, `(position, target)`) stands behind
+    and above the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base,
+    start and objects), is framed on it (`workspace_view`). Call from the thread that made
+    `meshcat`.
     """
 
     def __init__(self, meshcat, objects, prediction_steps=0, path_count=1,
@@ -86,8 +104,9 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         super().__init__()
         self._meshcat = meshcat
         self._objects = np.asarray(objects, dtype=float)
-        self.camera = (_behind_the_hsr(self._objects) if workspace is None
+        self.camera = (behind_the_robot(self._objects) if workspace is None
                        else workspace_view(workspace))
+        self._markers = TaskMarkers()
         self._prediction_steps = int(prediction_steps)
         k = len(self._objects)
         path_count = int(path_count)
@@ -120,8 +139,6 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         self.DeclareInitializationPublishEvent(self._initialise)
 
     def _initialise(self, context):
-        # Whether the blue ball is drawn: a method that shows no intent (teleop) sends -1.
-        self._ball_shown = True
         self._draw_scene()
         if self._trail is not None:
             self._trail.draw(self._meshcat, context.get_time())
@@ -143,8 +160,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
             meshcat.SetObject(f"/task/objects/{index}",
                               Cylinder(OBJECT_RADIUS, OBJECT_HEIGHT), OBJECT_COLOUR)
             meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(point))
-        meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
-        meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
+        self._markers.draw(meshcat)
         meshcat.SetObject(HAND_MARKER, Cylinder(0.09, 0.01), OPERATOR_COLOUR)
         meshcat.SetProperty(HAND_MARKER, "visible", False)
         if self._prediction_steps:
@@ -155,19 +171,9 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
     def _publish(self, context):
         time = context.get_time()
         meshcat = self._meshcat
-        target = position_of(Target(self._target_port.Eval(context)))
-        meshcat.SetTransform("/task/target",
-                             RigidTransform(target + [0, 0, TARGET_LIFT]), time)
-        selected = int(self._selected_goal_port.Eval(context)[0])
-        if (selected >= 0) != self._ball_shown:
-            # -1: the method shows no intent (teleop), and the page no blue ball; sent only
-            # when that changes, so that a page's messages do not grow.
-            self._ball_shown = selected >= 0
-            meshcat.SetProperty("/task/estimated_goal", "visible", self._ball_shown, time)
-        if selected >= 0:
-            meshcat.SetTransform(
-                "/task/estimated_goal",
-                RigidTransform(self._objects[selected] + [0, 0, ESTIMATE_LIFT]), time)
+        selected = int(self._selected_goal_port.Eval(context)[0])  # -1: no intent shown
+        self._markers.show(meshcat, position_of(Target(self._target_port.Eval(context))),
+                           self._objects[selected] if selected >= 0 else None, time)
         if self._ee_state_port.HasValue(context):
             position = position_of(EeState(self._ee_state_port.Eval(context)))
             meshcat.SetTransform(HAND_MARKER, RigidTransform(position), time)
@@ -191,6 +197,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         self._cloud.show(self._meshcat, port.Eval(context) if port.HasValue(context) else None)
 
 
-def _behind_the_hsr(objects):
-    """A camera behind and above the HSR that sees it and every object of the task."""
+def behind_the_robot(objects):
+    """A camera `(position, target)` behind and above the HSR that sees it and every object
+    `(M, 3)` of the task."""
     return np.array([-1.6, -1.2, 2.6]), np.array([0.55 * objects.mean(axis=0)[0], 0.0, 0.4])

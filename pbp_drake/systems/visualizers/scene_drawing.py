@@ -36,12 +36,8 @@ TRIAD_AXES = (("x", Rgba(1.0, 0.0, 0.0, 1.0), RotationMatrix.MakeYRotation(np.pi
 def frame_top_down(meshcat, view):
     """Shows the xy-plane from above in Meshcat, +x to the right and +y up, framed on `view`
     `(xmin, xmax, ymin, ymax)` (see `core.scene_framing.page_view`), with no background, grid
-    or axes.
-
-    `Set2dRenderMode` alone sets the orthographic camera and hides the background, grid and
-    axes, but the page's orbit controls then turn the camera towards their target (the
-    origin): the scene showed tilted and off-centre. `SetCameraPose` sets both the camera's
-    position and the controls' target, here the view's centre.
+    or axes. `SetCameraPose` also sets the orbit controls' target to the view's centre:
+    after `Set2dRenderMode` alone they would turn the camera towards the origin.
     """
     xmin, xmax, ymin, ymax = view
     cx, cy = (xmin + xmax) / 2.0, (ymin + ymax) / 2.0

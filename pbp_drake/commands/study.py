@@ -6,24 +6,21 @@ the same seeds, trial by trial).
 disk) in one line, exit 4: nothing is left half-written, and the same command resumes."""
 
 import dataclasses
-import functools
 import pathlib
 import sys
 import time
 
 from pbp_drake.builder import check_buildable
-from pbp_drake.cli_types import (
-    EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_WRITE_FAILED, method_list)
+from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_TERMINATED, method_list
 from pbp_drake.commands.scenario_flags import (
     add_goals_flag, add_override_flags, scenario_overrides)
-from pbp_drake.commands.signals import Terminated, sigterm_as_interrupt
+from pbp_drake.commands.signals import Terminated, stopping_cleanly
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
     Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
     check_method_comparison, counted, load_scenario_file)
-from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
@@ -114,32 +111,9 @@ def add_study_commands(commands):
     compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
     compare.add_argument("second", help="another, of the same seeds (B)")
     add_goals_flag(add_override_flags(study))
-    study.set_defaults(handler=_stopping_cleanly(_study))
-    report.set_defaults(handler=_stopping_cleanly(_report))
+    study.set_defaults(handler=stopping_cleanly(_study))
+    report.set_defaults(handler=stopping_cleanly(_report))
     compare.set_defaults(handler=_compare)
-
-
-def _stopping_cleanly(command):
-    """`command(args)` that takes SIGTERM as Ctrl-C (`commands.signals`), and says a file
-    that could not be written in one line, exit 4 (the disk failed, not the study: nothing
-    is half-written, and the same command resumes)."""
-
-    @functools.wraps(command)
-    def stopping_cleanly(args):
-        with sigterm_as_interrupt():
-            try:
-                return command(args)
-            except Terminated:
-                print("\npbp-drake: terminated (SIGTERM)", file=sys.stderr)
-                return EXIT_TERMINATED
-            except OSError as error:
-                if not is_disk_failure(error):
-                    raise
-                on_a_bar = "\n" if sys.stderr.isatty() else ""  # the progress bar's line
-                print(on_a_bar + write_failure_line(error), file=sys.stderr)
-                return EXIT_WRITE_FAILED
-
-    return stopping_cleanly
 
 
 def _study(args):

@@ -21,9 +21,8 @@ from pbp_drake.studies.report import report
 from pbp_drake.studies.runners import failed_record, run_locally
 from pbp_drake.studies.trial_files import (
     StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, write_study)
-from pbp_drake.studies.folders import check_folder, study_lock
-from pbp_drake.studies.matrix import (
-    check_matrix_folder, check_pilots, pilot_folder, write_matrix_study)
+from pbp_drake.studies.folders import MATRIX, check_folder, study_lock
+from pbp_drake.studies.matrix import check_pilots, pilot_folder, write_matrix_study
 from pbp_drake.studies.matrix_report import report_matrix
 from pbp_drake.scenarios.pilots import with_pilot
 
@@ -195,7 +194,7 @@ def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=
     pilot_scenarios = {pilot: with_pilot(scenario, pilot) for pilot in pilots}
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
-    recorded = check_matrix_folder(output, scenario, digest)
+    recorded = check_folder(output, scenario, digest, quiet=True, kind=MATRIX)
     if recorded:
         scenario_file = scenario_file or recorded.get("scenario_file")
         split_seeds = split_seeds or recorded.get("split_seeds")

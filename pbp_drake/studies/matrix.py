@@ -23,13 +23,12 @@ import pathlib
 
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name
-from pbp_drake.studies.folders import folder_kind
+from pbp_drake.studies.folders import MATRIX
 from pbp_drake.studies.summary import summarize
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.trial_files import (
     TRIAL_FORMAT, StudyFolderError, name_damaged, read_study)
 
-MATRIX = "method_matrix"
 PILOTS_FOLDER = "pilots"
 # Summary fields every pilot's study shares with the matrix: said once, at its top.
 _SHARED = ("study", "scenario", "trials", "seed", "split", "seeds", "measures_collisions",
@@ -50,27 +49,6 @@ def check_pilots(pilots, option="--pilots"):
         check_pilot_name(pilot, option)
     if len(set(pilots)) != len(pilots):
         raise ScenarioError(f"{option} {','.join(pilots)} names a pilot twice")
-
-
-def check_matrix_folder(output, scenario, digest):
-    """Raises StudyFolderError when `output` holds another kind of study, or a matrix of
-    another scenario. Returns its readable study.json as a dict, or None."""
-    kind = folder_kind(output)
-    if kind is not None and kind != MATRIX:
-        raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a matrix of "
-                               "methods and pilots: choose another --output folder")
-    try:
-        study = json.loads((pathlib.Path(output) / "study.json").read_text())
-    except (OSError, ValueError):
-        return None  # none yet, or damaged: written again
-    if not isinstance(study, dict):
-        return None
-    if study.get("scenario_hash") != digest:
-        raise StudyFolderError(
-            f"{output} holds a matrix of another scenario ({study.get('scenario')!r}, hash "
-            f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}): "
-            "choose another --output folder")
-    return study
 
 
 def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split=None,

@@ -324,13 +324,11 @@ def _compare(args):
 
 
 def _report(args):
-    """Exit 0; 1, like `study`, when trials recorded an error or did not run, and when
-    damaged or foreign files were skipped (what could be read is still reported and
-    written); 2 (ScenarioError) when there is nothing to report. A folder that is not a
-    study but holds participant folders gets the user study's report (exit 1 when damaged
-    files were skipped; 2 for a participant of another scenario or a bad answer).
-    `--markdown FILE` also writes the table for the docs (`studies.results_markdown`); it
-    takes a 2-D study's folder too (exit 0), not a user study's, nor a folder as FILE (2)."""
+    """`report` of a study folder, a matrix's (`_report_matrix`) or a folder of participant
+    folders (`participant_report`): exit 1 when trials failed with an error or did not run,
+    or damaged files were skipped; 2 (ScenarioError) when there is nothing to report.
+    `--markdown FILE` (`studies.results_markdown`) takes a 2-D study's folder too, not a
+    user study's."""
     output = pathlib.Path(args.output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)

@@ -2,20 +2,16 @@
 --pilots attentive,noisy,...`, run by `comparison.run_method_matrix`): its layout, its
 study.json, and its summary read from the pilots' trial files.
 
-A matrix folder `DIR` holds one method comparison per pilot, each a whole study folder of
-its own (its study.json, hash and trials: `pbp-drake report DIR/pilots/NAME` reports one
-pilot alone):
-
     DIR/study.json              the matrix: scenario and hash, methods, pilots, trials, seeds
-    DIR/pilots/<pilot>/...      the study of every method under that pilot
+    DIR/pilots/<pilot>/...      a study folder of every method under that pilot (its own
+                                study.json and hash: `pbp-drake report` reports it alone)
     DIR/summary.json, DIR/results.md, DIR/trials.json, DIR/pilots.png
                                 rebuilt from the files above (`studies.matrix_report`)
 
 Trial i of every method under every pilot runs seed `seed + i` (the pilots draw their own
-randomness from it), so every comparison is paired. The trials of all pilots run in one
-pool (`comparison.run_trials`): no worker waits for a pilot's last trial. Each pilot's
-folder checks its own scenario's hash (the pilot is part of it), and study.json the
-scenario's: a matrix folder resumes only the same scenario, pilot by pilot.
+randomness from it), so every comparison is paired. The pilot is part of its folder's
+scenario hash, and study.json holds the scenario's: a matrix folder resumes only the same
+scenario, pilot by pilot.
 """
 
 import json

@@ -38,10 +38,6 @@ def _peak_cell(entry, field, digits):
     return f"{value['max']:.{digits}f} / {value['mean']:.{digits}f}"
 
 
-def _count(value):
-    return "-" if value is None else str(value)
-
-
 def interaction_table(summary):
     """The Markdown lines of the interaction metrics, one row per method: mean ± std of each
     (`INTERACTION_MEANS`) over the trials with a value, and the switches never named of
@@ -84,14 +80,10 @@ def participant_line(summary):
 
 
 def results_table(summary):
-    """The summary as a Markdown table, one row per method: mean ± std of the intervention
-    ratio and task time, and of the collision ratio with the count of collision-free trials
-    where the task measures collisions; max / mean of the trials' peak hand speed and peak
-    command acceleration (see `summarize`); how often HOP's goal posterior sat at its clip
-    where a method records it. Above it, the seeds and, when it was impaired,
-    the virtual participant's condition (`participant_line`); below it the interaction
-    metrics (`interaction_table`) and the 95 % confidence intervals
-    (`pbp_drake.studies.intervals`)."""
+    """The summary (`summarize`) as a Markdown table, one row per method: mean ± std of
+    each mean, max / mean of each peak. Above it, the seeds and the virtual participant's
+    impairment (`participant_line`); below it the interaction metrics
+    (`interaction_table`) and the 95 % confidence intervals (`intervals.confidence_table`)."""
     seeds = seeds_line(summary)
     lines = [seeds, ""] if seeds else []
     participant = participant_line(summary)
@@ -109,8 +101,10 @@ def results_table(summary):
         rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
         gone = [f"{entry[k]} {k}" for k in ("missing", "damaged") if entry.get(k)]
         trials = f"{entry['trials']}" + (f" ({', '.join(gone)})" if gone else "")
-        collision = ((_cell(entry, "collision_ratio", 3),
-                      _count(entry["collision_free_trials"])) if collisions else ())
+        collision = ()
+        if collisions:
+            free = entry["collision_free_trials"]
+            collision = (_cell(entry, "collision_ratio", 3), "-" if free is None else str(free))
         cells = [METHOD_LABELS.get(method, method), trials, rate,
                  _cell(entry, "intervention_ratio", 3), _cell(entry, "task_time", 1),
                  *collision, _peak_cell(entry, "peak_hand_speed", 3),

@@ -4,8 +4,7 @@
 Trial i of every method uses seed `seed + i`: the same scene and participant noise. A trial
 that raises is recorded as failed with its error; one whose worker process dies runs again
 alone, so that only a trial that kills its own process is recorded as failed. A disk that
-fails (`atomic_files.WriteFailed`) is never a trial's result: it stops the study, as
-Ctrl-C does, and the trial runs again when the same command resumes the study.
+fails is never a trial's result (`atomic_files`): it stops the study, as Ctrl-C does.
 """
 
 import concurrent.futures
@@ -43,9 +42,8 @@ def run_trial(scenario, method, trial, seed, output, digest, run=None):
 
 def compute_trial(scenario, method, trial, seed, digest, run=None):
     """Runs one trial without touching the disk: its record and TaskResult (None when it
-    raised: the record then holds the error). `run(resolved_scenario)` defaults to
-    `run_task`. A disk that fails under the trial raises WriteFailed: not the trial's
-    result."""
+    raised: the record then holds the error; a failing disk raises WriteFailed).
+    `run(resolved_scenario)` defaults to `run_task`."""
     if run is None:
         run = run_task
     started = time.monotonic()

@@ -227,13 +227,12 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
                 scenario_file=None, split_seeds=None, participant_condition=None,
                 overrides=None):
     """Writes the folder's study.json: which scenario, methods, trials and seeds, and the
-    split the seeds belong to (`studies.splits`; None when not known). `scenario_file` (the
-    path the study was run from) and `split_seeds` ({"tuning": first seed, "evaluation":
-    first seed}) let `report --markdown` name the command that made the study; None when not
-    known. Neither goes into the summary, which is made from the trials.
-    `participant_condition` (`pbp-drake study --participant-condition`; None: none) is
-    recorded when given, and the results name it; so are `overrides`, the command line's
-    changes to the file's fields (`ScenarioOverrides.record()`)."""
+    split the seeds belong to (`studies.splits`; None when not known). The optional fields
+    are written when given (not None): `scenario_file` (the path the study was run from)
+    and `split_seeds` ({"tuning": first seed, "evaluation": first seed}), with which `report
+    --markdown` names the command that made the study; `participant_condition` (`pbp-drake
+    study --participant-condition`) and `overrides` (the command line's changes to the
+    file's fields, `ScenarioOverrides.record()`), which the results name too."""
     study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
              "split": split, "scenario_content": scenario_content(scenario)}

@@ -217,9 +217,8 @@ def _method_study(args, scenario_file, overrides):
         raise ScenarioError(f"{error} (after the command-line overrides)") from None
     output = pathlib.Path(args.output)
     pilots = args.pilots or []
-    if pilots:
-        for pilot in pilots:  # a pilot the scenario cannot take stops here, nothing written
-            with_pilot(scenario, pilot)
+    for pilot in pilots:  # a pilot the scenario cannot take stops here, nothing written
+        with_pilot(scenario, pilot)
     total = len(study.methods) * study.trials * max(1, len(pilots))
     condition_words = ("" if args.participant_condition is None else
                        f", the {args.participant_condition} virtual participant")

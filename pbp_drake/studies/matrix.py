@@ -21,9 +21,8 @@ from pbp_drake.scenarios import ScenarioError
 from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name
 from pbp_drake.studies.folders import MATRIX
 from pbp_drake.studies.summary import summarize
-from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.trial_files import (
-    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study)
+    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study, write_study_json)
 
 PILOTS_FOLDER = "pilots"
 # Summary fields every pilot's study shares with the matrix: said once, at its top.
@@ -53,13 +52,7 @@ def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, 
     study = {"study": MATRIX, "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "pilots": list(pilots),
              "trials": trials, "seed": seed, "split": split}
-    if scenario_file is not None:
-        study["scenario_file"] = str(scenario_file)
-    if split_seeds is not None:
-        study["split_seeds"] = dict(split_seeds)
-    if overrides is not None:
-        study["overrides"] = overrides
-    write_atomically(pathlib.Path(output) / "study.json", json.dumps(study, indent=2) + "\n")
+    write_study_json(output, study, scenario_file, split_seeds, overrides=overrides)
 
 
 def read_matrix_study(output):

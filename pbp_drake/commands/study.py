@@ -21,7 +21,7 @@ from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
     Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
     check_method_comparison, counted, load_scenario_file)
-from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
+from pbp_drake.studies.comparison import BACKENDS, run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
 from pbp_drake.studies.paired import (
@@ -61,7 +61,7 @@ def add_study_commands(commands):
                        "are labelled with the split the seeds fall in)")
     study.add_argument("--jobs", type=int, default=1,
                        help="HSR tasks: trials run in this many processes at once (default 1)")
-    study.add_argument("--backend", choices=("local", "ray"), default="local",
+    study.add_argument("--backend", choices=BACKENDS, default="local",
                        help="HSR tasks: run the trials in local processes (default) or as "
                        "Ray tasks, at most --jobs at once (needs: pip install "
                        "'pbp_drake[ray]')")

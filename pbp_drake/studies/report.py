@@ -4,8 +4,8 @@ figures, rebuilt from its study.json and trial files only (no simulation)."""
 import json
 import pathlib
 
-from pbp_drake.studies.figures import (
-    METHOD_LABELS, plot_collision_histogram, plot_intervention, plot_task_time)
+from pbp_drake.scenarios import METHOD_NAMES
+from pbp_drake.studies.figures import plot_collision_histogram, plot_intervention, plot_task_time
 from pbp_drake.studies.intervals import INTERACTION_MEANS, confidence_table
 from pbp_drake.studies.splits import seeds_line
 from pbp_drake.studies.summary import summarize
@@ -51,7 +51,7 @@ def interaction_table(summary):
              "with a value; see the docs' study page for each definition).", "",
              "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for method, entry in methods.items():
-        cells = [METHOD_LABELS.get(method, method)]
+        cells = [METHOD_NAMES.get(method, method)]
         for name, _, digits, _ in INTERACTION_MEANS:
             cells.append(_cell(entry, name, digits) if name in entry else "-")
         latency = entry.get("time_to_prediction") or {}
@@ -105,7 +105,7 @@ def results_table(summary):
         if collisions:
             free = entry["collision_free_trials"]
             collision = (_cell(entry, "collision_ratio", 3), "-" if free is None else str(free))
-        cells = [METHOD_LABELS.get(method, method), trials, rate,
+        cells = [METHOD_NAMES.get(method, method), trials, rate,
                  _cell(entry, "intervention_ratio", 3), _cell(entry, "task_time", 1),
                  *collision, _peak_cell(entry, "peak_hand_speed", 3),
                  _peak_cell(entry, "peak_command_acceleration", 2),

@@ -3,17 +3,17 @@ session of a user study): their flags, and what both do before anything runs (th
 the page's port, the scenario with the command line's overrides, the flags' checks)."""
 
 import dataclasses
-import functools
 import sys
 
 from pbp_drake.builder import check_buildable
-from pbp_drake.cli_types import EXIT_DRIVER, EXIT_WRITE_FAILED, realtime_rate
+from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
 from pbp_drake.commands.run_checks import check_run_flags, is_person
 from pbp_drake.commands.run_page import add_page_flags, open_page
 from pbp_drake.commands.scenario_flags import (
     add_goals_flag, add_hardware_flags, add_override_flags, add_shorthand_flags,
     scenario_overrides)
 from pbp_drake.commands.session import add_session_flags, run_session_command
+from pbp_drake.commands.signals import stopping_cleanly
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
 from pbp_drake.console import CAMERAS
 from pbp_drake.console.front import PortError, bind_page_port
@@ -21,11 +21,11 @@ from pbp_drake.output_paths import check_log_path, check_output_folder, check_re
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.scenarios import (
     METHODS, Arm, ScenarioError, TaskScenario, load_scenario_file, resolve)
-from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 
 
 def add_run_command(commands):
     """The `run` and `session` subcommands and their arguments."""
+    handler = stopping_cleanly(_run, "run the same command again", sigterm=False)
     run = commands.add_parser("run", help="simulate one scenario in Meshcat")
     run.add_argument("scenario", help="a scenario file, e.g. diagrams/hsr_reach.yaml")
     fields = add_override_flags(run)
@@ -48,7 +48,7 @@ def add_run_command(commands):
                      "it grows (pbp-drake teach draws the demonstration so)")
     add_page_flags(run)
     add_session_flags(run, hidden=True)  # `run --participant ID` is `session --participant ID`
-    run.set_defaults(handler=_saying_write_failures(_run))
+    run.set_defaults(handler=handler)
 
     session = commands.add_parser(
         "session", help="a participant's session of a user study: every method of --methods "
@@ -66,10 +66,9 @@ def add_run_command(commands):
                         help="--set seed=N: the scene of every run (practice: the next scenes)")
     _add_common_flags(session)
     add_page_flags(session)
-    session.set_defaults(handler=_saying_write_failures(_run), method=None, alpha=None,
-                         goals=None, scene=None, no_meshcat=False, record=None,
-                         log=None, force=False, hardware=False, driver_sim=False,
-                         hand_trail=False)
+    session.set_defaults(handler=handler, method=None, alpha=None, goals=None, scene=None,
+                         no_meshcat=False, record=None, log=None, force=False,
+                         hardware=False, driver_sim=False, hand_trail=False)
 
 
 def _add_common_flags(parser):
@@ -182,20 +181,3 @@ def _run(args):
     finally:
         if page is not None:
             page.close()
-
-
-def _saying_write_failures(command):
-    """`command(args)` that says a file it could not write (a full disk) in one line, exit
-    4, instead of a traceback: replays and sessions are written whole or not at all."""
-
-    @functools.wraps(command)
-    def saying_write_failures(args):
-        try:
-            return command(args)
-        except OSError as error:
-            if not is_disk_failure(error):
-                raise
-            print(write_failure_line(error, "run the same command again"), file=sys.stderr)
-            return EXIT_WRITE_FAILED
-
-    return saying_write_failures

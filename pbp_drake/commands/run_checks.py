@@ -20,7 +20,7 @@ def check_run_flags(args, resolved):
     if args.no_meshcat and person:
         raise ScenarioError("--no-meshcat: a keyboard or gamepad is read in the page; use "
                             "--operator virtual")
-    if (args.headless or args.no_meshcat) and person:
+    if args.headless and person:
         raise ScenarioError("--headless runs unattended: a person cannot drive it; use "
                             "--operator virtual")
     if args.participant is None:
@@ -41,7 +41,7 @@ def check_run_flags(args, resolved):
                                 "--operator virtual; a keyboard or gamepad participant "
                                 "answers in the page")
         parse_answers(args.answers, methods)
-    elif args.headless or args.no_meshcat:
+    elif args.headless:
         raise ScenarioError("a --headless session needs --answers (e.g. --answers "
                             "tiredness=3,ease=4): otherwise the questions are asked in the "
                             "browser")

@@ -1,10 +1,16 @@
-"""SIGTERM taken as Ctrl-C: a command that is asked to end (`kill PID`, a service manager,
-`timeout`) stops the way it stops on Ctrl-C, with its word and its cleanup, instead of
-dying at once (leaving worker processes and temporary files)."""
+"""How a command stops: SIGTERM taken as Ctrl-C (a command that is asked to end, by `kill
+PID`, a service manager or `timeout`, stops the way it stops on Ctrl-C, with its word and
+its cleanup, instead of dying at once, leaving worker processes and temporary files), and
+a file that cannot be written said in one line."""
 
 import contextlib
+import functools
 import signal
+import sys
 import threading
+
+from pbp_drake.cli_types import EXIT_TERMINATED, EXIT_WRITE_FAILED
+from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
 
 
 class Terminated(KeyboardInterrupt):
@@ -31,3 +37,27 @@ def sigterm_as_interrupt():
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def stopping_cleanly(command, then="the same command resumes", sigterm=True):
+    """`command(args)` that says a file it could not write (a full disk) in one line, exit
+    4, instead of a traceback (nothing is half-written; `then`: what the same command does
+    when run again); with `sigterm` (`study`, `report`), it takes SIGTERM as Ctrl-C, and
+    its line starts below the progress bar's on a terminal."""
+
+    @functools.wraps(command)
+    def stopping(args):
+        with sigterm_as_interrupt() if sigterm else contextlib.nullcontext():
+            try:
+                return command(args)
+            except Terminated:
+                print("\npbp-drake: terminated (SIGTERM)", file=sys.stderr)
+                return EXIT_TERMINATED
+            except OSError as error:
+                if not is_disk_failure(error):
+                    raise
+                on_a_bar = "\n" if sigterm and sys.stderr.isatty() else ""
+                print(on_a_bar + write_failure_line(error, then), file=sys.stderr)
+                return EXIT_WRITE_FAILED
+
+    return stopping

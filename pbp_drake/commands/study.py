@@ -6,25 +6,22 @@ the same seeds, trial by trial).
 disk) in one line, exit 4: nothing is left half-written, and the same command resumes."""
 
 import dataclasses
-import functools
 import pathlib
 import sys
 import time
 
 from pbp_drake.builder import check_buildable
-from pbp_drake.cli_types import (
-    EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_WRITE_FAILED, method_list)
+from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_TERMINATED, method_list
 from pbp_drake.commands.scenario_flags import (
     add_goals_flag, add_override_flags, scenario_overrides)
-from pbp_drake.commands.signals import Terminated, sigterm_as_interrupt
+from pbp_drake.commands.signals import Terminated, stopping_cleanly
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
     Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
     check_method_comparison, counted, load_scenario_file)
-from pbp_drake.studies.atomic_files import is_disk_failure, write_failure_line
-from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
+from pbp_drake.studies.comparison import BACKENDS, run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
 from pbp_drake.studies.paired import (
@@ -64,7 +61,7 @@ def add_study_commands(commands):
                        "are labelled with the split the seeds fall in)")
     study.add_argument("--jobs", type=int, default=1,
                        help="HSR tasks: trials run in this many processes at once (default 1)")
-    study.add_argument("--backend", choices=("local", "ray"), default="local",
+    study.add_argument("--backend", choices=BACKENDS, default="local",
                        help="HSR tasks: run the trials in local processes (default) or as "
                        "Ray tasks, at most --jobs at once (needs: pip install "
                        "'pbp_drake[ray]')")
@@ -114,32 +111,9 @@ def add_study_commands(commands):
     compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
     compare.add_argument("second", help="another, of the same seeds (B)")
     add_goals_flag(add_override_flags(study))
-    study.set_defaults(handler=_stopping_cleanly(_study))
-    report.set_defaults(handler=_stopping_cleanly(_report))
+    study.set_defaults(handler=stopping_cleanly(_study))
+    report.set_defaults(handler=stopping_cleanly(_report))
     compare.set_defaults(handler=_compare)
-
-
-def _stopping_cleanly(command):
-    """`command(args)` that takes SIGTERM as Ctrl-C (`commands.signals`), and says a file
-    that could not be written in one line, exit 4 (the disk failed, not the study: nothing
-    is half-written, and the same command resumes)."""
-
-    @functools.wraps(command)
-    def stopping_cleanly(args):
-        with sigterm_as_interrupt():
-            try:
-                return command(args)
-            except Terminated:
-                print("\npbp-drake: terminated (SIGTERM)", file=sys.stderr)
-                return EXIT_TERMINATED
-            except OSError as error:
-                if not is_disk_failure(error):
-                    raise
-                on_a_bar = "\n" if sys.stderr.isatty() else ""  # the progress bar's line
-                print(on_a_bar + write_failure_line(error), file=sys.stderr)
-                return EXIT_WRITE_FAILED
-
-    return stopping_cleanly
 
 
 def _study(args):
@@ -243,9 +217,8 @@ def _method_study(args, scenario_file, overrides):
         raise ScenarioError(f"{error} (after the command-line overrides)") from None
     output = pathlib.Path(args.output)
     pilots = args.pilots or []
-    if pilots:
-        for pilot in pilots:  # a pilot the scenario cannot take stops here, nothing written
-            with_pilot(scenario, pilot)
+    for pilot in pilots:  # a pilot the scenario cannot take stops here, nothing written
+        with_pilot(scenario, pilot)
     total = len(study.methods) * study.trials * max(1, len(pilots))
     condition_words = ("" if args.participant_condition is None else
                        f", the {args.participant_condition} virtual participant")
@@ -350,13 +323,11 @@ def _compare(args):
 
 
 def _report(args):
-    """Exit 0; 1, like `study`, when trials recorded an error or did not run, and when
-    damaged or foreign files were skipped (what could be read is still reported and
-    written); 2 (ScenarioError) when there is nothing to report. A folder that is not a
-    study but holds participant folders gets the user study's report (exit 1 when damaged
-    files were skipped; 2 for a participant of another scenario or a bad answer).
-    `--markdown FILE` also writes the table for the docs (`studies.results_markdown`); it
-    takes a 2-D study's folder too (exit 0), not a user study's, nor a folder as FILE (2)."""
+    """`report` of a study folder, a matrix's (`_report_matrix`) or a folder of participant
+    folders (`participant_report`): exit 1 when trials failed with an error or did not run,
+    or damaged files were skipped; 2 (ScenarioError) when there is nothing to report.
+    `--markdown FILE` (`studies.results_markdown`) takes a 2-D study's folder too, not a
+    user study's."""
     output = pathlib.Path(args.output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)

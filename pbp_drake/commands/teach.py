@@ -29,10 +29,6 @@ from pbp_drake.systems.visualizers.reach_scene_visualizer import HAND_MARKER
 
 #: The operators who can drive a demonstration.
 TEACHERS = ("virtual", "keyboard", "gamepad")
-# The columns of the hand's path in a run's or trial's CSV, and of its orientation (the
-# grasping task's).
-_TIME, _HAND = "time", ("ee_x", "ee_y", "ee_z")
-_QUATERNION = tuple(HAND_ORIENTATION_COLUMNS)
 
 
 def add_teach_command(commands):
@@ -85,7 +81,7 @@ def _teach(args):
     times, positions, orientations = read_hand_path(origin)
     if isinstance(scenario.task, GraspTask) and orientations is None:
         raise ScenarioError(f"{origin}: the grasping task teaches a pose: the recording needs "
-                            f"the columns {', '.join(_QUATERNION)} (a grasping run's)")
+                            f"the columns {', '.join(HAND_ORIENTATION_COLUMNS)} (a grasping run's)")
     try:
         primitive = teach_primitive(times, positions, scenario.dmp, orientations)
     except ValueError as error:
@@ -145,12 +141,12 @@ def read_hand_path(path):
             rows = list(csv.DictReader(file))
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise ScenarioError(f"{path}: cannot be read as a CSV ({error})") from None
-    columns = (_TIME, *_HAND)
+    columns = ("time", "ee_x", "ee_y", "ee_z")
     if not rows or any(name not in rows[0] for name in columns):
         raise ScenarioError(f"{path}: not a run's path: it needs the columns "
                             f"{', '.join(columns)} (pbp-drake run --log writes them)")
-    if all(name in rows[0] for name in _QUATERNION):
-        columns += _QUATERNION
+    if all(name in rows[0] for name in HAND_ORIENTATION_COLUMNS):
+        columns += tuple(HAND_ORIENTATION_COLUMNS)
     try:
         table = np.array([[float(row[name]) for name in columns] for row in rows])
     except (TypeError, ValueError):

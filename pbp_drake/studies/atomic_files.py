@@ -60,18 +60,13 @@ def is_disk_failure(error):
                                               and error.errno in DISK_ERRORS)
 
 
-def temporary_path(path):
-    """The temporary file this process writes `path` through."""
-    return path.with_name(f".{path.name}.{os.getpid()}.tmp")
-
-
 @contextlib.contextmanager
 def writing(path):
     """Yields the temporary path to write `path` through; when the block ends without an
     error, flushes it to the disk and renames it to `path`. Any error removes it; an
     OSError is raised as WriteFailed naming `path`."""
     path = pathlib.Path(path)
-    temporary = temporary_path(path)
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         yield temporary
@@ -119,10 +114,13 @@ def remove_leftovers(folder):
 def _writer_alive(temporary):
     """Whether the process that writes `temporary` (its name's PID) still runs."""
     pid = temporary.name.rsplit(".", 2)[-2]
-    if not pid.isdigit() or int(pid) == os.getpid():
-        return False
+    return pid.isdigit() and int(pid) != os.getpid() and process_alive(int(pid))
+
+
+def process_alive(pid):
+    """Whether process `pid` still runs (another user's too)."""
     try:
-        os.kill(int(pid), 0)
+        os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:

@@ -1,11 +1,7 @@
-"""Comparing methods on the same seeded HSR scenes: `pbp-drake study diagrams/hsr_reach.yaml`.
-
-`run_method_comparison` decides which trials still have to run (those not on disk for the
-same scenario), runs them in local processes (`--jobs`) or as Ray tasks (`--backend ray`),
-then rebuilds the summary, tables and figures from the files (`report`), holding the
-folder's lock (`folders.study_lock`) all along: one study at a time writes it. A matrix of
-methods and pilots (`studies.matrix`) prepares one such folder per pilot and runs all their
-trials together (`run_trials`): `run_method_matrix`.
+"""Comparing methods on the same seeded HSR scenes: `pbp-drake study diagrams/hsr_reach.yaml`
+(`run_method_comparison`), and every method under every pilot (`run_method_matrix`: a study
+folder per pilot, all their trials in one pool). Each holds its folders' locks
+(`folders.study_lock`) all along: one study at a time writes a folder.
 """
 
 import contextlib
@@ -21,9 +17,8 @@ from pbp_drake.studies.report import report
 from pbp_drake.studies.runners import failed_record, run_locally
 from pbp_drake.studies.trial_files import (
     StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, write_study)
-from pbp_drake.studies.folders import check_folder, study_lock
-from pbp_drake.studies.matrix import (
-    check_matrix_folder, check_pilots, pilot_folder, write_matrix_study)
+from pbp_drake.studies.folders import MATRIX, check_folder, study_lock
+from pbp_drake.studies.matrix import check_pilots, pilot_folder, write_matrix_study
 from pbp_drake.studies.matrix_report import report_matrix
 from pbp_drake.scenarios.pilots import with_pilot
 
@@ -35,28 +30,21 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
                           split=None, scenario_file=None, split_seeds=None,
                           participant_condition=None, overrides=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
-    processes, writes every trial under `output/trials/`, then the summary, tables and
-    figures (see `report`). Returns the summary dict. `split` labels the seeds in
-    study.json and the results ("tuning", "evaluation", ...: see `studies.splits`); None
-    keeps the label the folder holds for the same seeds. `scenario_file` and `split_seeds`
-    go into study.json (see `write_study`; None keeps what the folder holds), and so does
-    `participant_condition`, the name of the condition the scenario's virtual participant
-    was impaired with (`pbp-drake study --participant-condition`; None: none named), and
-    `overrides`, the command line's changes to the file's fields (None: none).
-
-    `backend="ray"` runs the trials as Ray tasks, at most `jobs` at once: on a new local
-    Ray of `jobs` CPUs, or on the Ray at `ray_address` (e.g. "HEAD:6379", "auto",
-    "ray://head:10001"), whose nodes need pbp_drake's dependencies installed (its workers
-    get this process's pbp_drake package: see `ray_backend`). This process writes the trial
-    files, the same as with local processes, so the summary is the same bytes.
+    local processes or, with `backend="ray"`, as Ray tasks (on the Ray at `ray_address`,
+    e.g. "HEAD:6379", "auto", "ray://head:10001", else a new local one: see `ray_backend`);
+    writes every trial under `output/trials/`, then the summary, tables and figures (see
+    `report`), and returns the summary dict. `split` labels the seeds (`studies.splits`;
+    None keeps the label the folder holds for the same seeds); `scenario_file`,
+    `split_seeds`, `participant_condition` and `overrides` go into study.json (see
+    `write_study`; the first two None keep what the folder holds).
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except
     those that failed with an error). A trial that raises, or whose worker process dies, is
-    recorded as failed with its error. A file that cannot be written stops the study with
-    `atomic_files.WriteFailed` (an OSError), nothing half-written left; another process
-    writing `output` refuses it with `folders.FolderLocked`, before anything is written.
-    `progress(done, total, record, elapsed)` is called after each trial.
-    `run(scenario) -> TaskResult` replaces `run_task` (picklable when `jobs > 1`).
+    recorded as failed with its error; a file that cannot be written stops the study
+    (`atomic_files.WriteFailed`); another process writing `output` refuses it, before
+    anything is written (`folders.FolderLocked`). `progress(done, total, record, elapsed)`
+    is called after each trial. `run(scenario) -> TaskResult` replaces `run_task`
+    (picklable when `jobs > 1`).
     """
     check_run_options(trials, jobs, backend, ray_address, run)
     output = pathlib.Path(output)
@@ -109,8 +97,7 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
     """Checks `output` (StudyFolderError when it holds another scenario's study), removes
     what an interrupted study left, names the damaged trial files, writes study.json and
     returns the StudyFolder with the trials still to run (see `run_method_comparison`).
-    The caller holds the folder's lock (`folders.study_lock`) and has checked it once
-    (`check_folder`, which named a damaged study.json)."""
+    The caller holds the folder's lock and has checked it once (`check_folder`)."""
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
     recorded = check_folder(output, scenario, digest, participant_condition, quiet=True)
@@ -195,7 +182,7 @@ def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=
     pilot_scenarios = {pilot: with_pilot(scenario, pilot) for pilot in pilots}
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
-    recorded = check_matrix_folder(output, scenario, digest)
+    recorded = check_folder(output, scenario, digest, quiet=True, kind=MATRIX)
     if recorded:
         scenario_file = scenario_file or recorded.get("scenario_file")
         split_seeds = split_seeds or recorded.get("split_seeds")

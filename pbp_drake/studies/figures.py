@@ -21,9 +21,6 @@ from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
 # ---------------------------------------------------------------------------------------------
 # The method comparison (Fig. 7)
 
-# The methods' names, the one table every page and table reads (the methods registry).
-METHOD_LABELS = METHOD_NAMES
-
 
 def _save(figure, path, **options):
     figure.tight_layout()
@@ -32,7 +29,7 @@ def _save(figure, path, **options):
 
 
 def _label(method, rows=None):
-    label = METHOD_LABELS.get(method, method)
+    label = METHOD_NAMES.get(method, method)
     if rows:
         rate = np.mean([bool(r["success"]) for r in rows])
         label += f"\n{100 * rate:.0f} % success"
@@ -87,7 +84,7 @@ def plot_collision_histogram(summary, path):
     for index, method in enumerate(methods):
         entry = summary["methods"][method]["collision_ratio"]
         mean = entry["mean"]
-        label = METHOD_LABELS.get(method, method) + (
+        label = METHOD_NAMES.get(method, method) + (
             f" (mean {mean:.3f})" if mean is not None else " (no trials)")
         axis.bar(edges[:-1] + (index + 0.5) * width, entry["histogram"], width=width,
                  align="edge", color=method_colour(method), label=label, alpha=0.85)
@@ -243,7 +240,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
             for method, style in zip(methods_of("pbp"), ("-", "--")):
                 positions = trajectories[(scene.name, speed, method)]
                 target.plot(positions[:, 0], positions[:, 1], style, color=colour, lw=1.5,
-                            label=f"{scene.name} {METHOD_LABELS[method]}: "
+                            label=f"{scene.name} {METHOD_NAMES[method]}: "
                                   f"{_outcome_text(outcomes[method])}")
     for target in (alpha_axes, *pbp_axes):
         _draw_task(target, resolved)
@@ -261,7 +258,7 @@ def plot_alt_vs_cont(resolved, summary, path):
     """Fig. 4: the two modes' paths, their y against the phase, and the input."""
     figure, (path_axes, phase_axes, input_axes) = plt.subplots(1, 3, figsize=(14, 4))
     for method, mode in summary["modes"].items():
-        label, colour = METHOD_LABELS[method], method_colour(method)
+        label, colour = METHOD_NAMES[method], method_colour(method)
         positions = np.asarray(mode["positions"])
         phase = np.asarray(mode["phase"])
         active = np.asarray(mode["operator_active"], bool)

@@ -13,19 +13,26 @@ from pbp_drake.studies.atomic_files import write_failed
 from pbp_drake.studies.trial_files import Damage, StudyFolderError, name_damaged
 
 TOY_STUDIES = ("alpha_study", "alt_vs_cont")
+#: The kind of a folder of every method under every pilot (`studies.matrix`).
+MATRIX = "method_matrix"
+# How check_folder's refusals name the kinds it checks: (the kind, what one study is).
+_KIND_WORDS = {"method_comparison": ("a method comparison", "study"),
+               MATRIX: ("a matrix of methods and pilots", "matrix")}
 
 
-def check_folder(output, scenario, digest, participant_condition=None, quiet=False):
-    """Raises StudyFolderError when `output` holds a study of another scenario or kind (a 2-D
-    study's summary.json, a study.json of another kind), saying so when it was run with
-    another `participant_condition`; names a damaged study.json (it is written again;
-    `quiet`: not named, when it has been already). Returns the folder's readable study.json
-    as a dict, or None."""
-    kind = folder_kind(output)
-    if kind is not None and kind != "method_comparison":
-        raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a method "
-                               "comparison: choose another --output folder")
-    study_path = output / "study.json"
+def check_folder(output, scenario, digest, participant_condition=None, quiet=False,
+                 kind="method_comparison"):
+    """Raises StudyFolderError when `output` holds a study of another kind than `kind` (a
+    method comparison or a `MATRIX`; a 2-D study's summary.json) or of another scenario,
+    saying so when it was run with another `participant_condition`; names a damaged
+    study.json (it is written again; `quiet`: not named, when it has been already). Returns
+    the folder's readable study.json as a dict, or None."""
+    held = folder_kind(output)
+    what, one = _KIND_WORDS[kind]
+    if held is not None and held != kind:
+        raise StudyFolderError(f"{output} holds a study of kind {held!r}, not {what}: "
+                               "choose another --output folder")
+    study_path = pathlib.Path(output) / "study.json"
     if not study_path.is_file():
         return None
     try:
@@ -43,7 +50,7 @@ def check_folder(output, scenario, digest, participant_condition=None, quiet=Fal
                      f"; it was run with --participant-condition {recorded}" if recorded else
                      "; it was run without --participant-condition")
         raise StudyFolderError(
-            f"{output} holds a study of another scenario ({study.get('scenario')!r}, hash "
+            f"{output} holds a {one} of another scenario ({study.get('scenario')!r}, hash "
             f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}"
             f"{condition}): choose another --output folder")
     return study

@@ -1,28 +1,22 @@
 """Fits the ``intent_filter`` estimator's operator model (`pbp_drake.core.intent_filter`) on
 recorded trials: `python -m pbp_drake.studies.intent_fit FOLDER...`.
 
-The folders are study folders (`pbp-drake study`, pilots' sub-folders included); the fit
-reads only their teleop trials, whose every motion is the operator's own. It replays the
-filter over each trial, tick by tick, on the recorded hand position, heading and operator
-inputs, and scores a model by the mean, over trials, of the mean log probability it gives the
-target the participant was heading for at each tick (a proper score: it rewards a calibrated
-belief, neither a timid nor an overconfident one). The move and turn rates, the heading's
-weight and the switch rate are fitted over fixed grids (`GRIDS`) by coordinate ascent, one
-parameter's grid at a time in one batched replay, until a round changes nothing. Not fitted:
-`silence_rate` (under teleop a silence leaves the hand still, so teleop cannot show what a
-silence says while the robot moves), the clip (`max_probability`, HOP's published 0.99)
-and the slowest motion.
+The fit reads the teleop trials of study folders (pilots' sub-folders included), whose
+every motion is the operator's own. It replays the filter over each trial on the recorded
+hand position, heading and operator inputs, and scores a model by the mean over trials of
+the mean log probability it gives the participant's target at each tick (a proper score:
+it rewards a calibrated belief). The move and turn rates, the heading's weight and the
+switch rate are fitted over `GRIDS` by coordinate ascent (`ascend`). Not fitted:
+`silence_rate` (under teleop a silent operator leaves the hand still), the clip
+(`max_probability`, HOP's 0.99) and the slowest motion.
 
-Each source is fitted alone (the filter reading that source only; the motion and the turns
-with a switch rate of their own), and then the switch rate with all three. Fitted jointly,
-the heading would get no weight: under teleop the operator's motion says nearly all its
-heading says. Under PBP the operator is silent most of the time, and the hand's heading (set
-by its turns) is then the evidence left, so its weight has to be what the heading alone
-tells of the target.
+Each source is fitted alone, then the switch rate with all three (`fit`): fitted jointly,
+the heading would get no weight, since under teleop the motion says nearly all the heading
+says; under PBP the operator is mostly silent, and the heading is the evidence left.
 
 `make results` runs the tuning studies it is fitted on (`hsr_reach_goals_4_teleop_tuning`,
-`hsr_reach_goals_100_teleop_tuning`: teleop under every pilot, tuning seeds), and the
-shipped defaults of `IntentFilterSettings` are this command's output on them.
+`hsr_reach_goals_100_teleop_tuning`); the defaults of `IntentFilterSettings` are this
+command's output on them.
 """
 
 import argparse

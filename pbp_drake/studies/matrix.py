@@ -2,20 +2,16 @@
 --pilots attentive,noisy,...`, run by `comparison.run_method_matrix`): its layout, its
 study.json, and its summary read from the pilots' trial files.
 
-A matrix folder `DIR` holds one method comparison per pilot, each a whole study folder of
-its own (its study.json, hash and trials: `pbp-drake report DIR/pilots/NAME` reports one
-pilot alone):
-
     DIR/study.json              the matrix: scenario and hash, methods, pilots, trials, seeds
-    DIR/pilots/<pilot>/...      the study of every method under that pilot
+    DIR/pilots/<pilot>/...      a study folder of every method under that pilot (its own
+                                study.json and hash: `pbp-drake report` reports it alone)
     DIR/summary.json, DIR/results.md, DIR/trials.json, DIR/pilots.png
                                 rebuilt from the files above (`studies.matrix_report`)
 
 Trial i of every method under every pilot runs seed `seed + i` (the pilots draw their own
-randomness from it), so every comparison is paired. The trials of all pilots run in one
-pool (`comparison.run_trials`): no worker waits for a pilot's last trial. Each pilot's
-folder checks its own scenario's hash (the pilot is part of it), and study.json the
-scenario's: a matrix folder resumes only the same scenario, pilot by pilot.
+randomness from it), so every comparison is paired. The pilot is part of its folder's
+scenario hash, and study.json holds the scenario's: a matrix folder resumes only the same
+scenario, pilot by pilot.
 """
 
 import json
@@ -23,13 +19,11 @@ import pathlib
 
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name
-from pbp_drake.studies.folders import folder_kind
+from pbp_drake.studies.folders import MATRIX
 from pbp_drake.studies.summary import summarize
-from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.trial_files import (
-    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study)
+    TRIAL_FORMAT, StudyFolderError, name_damaged, read_study, write_study_json)
 
-MATRIX = "method_matrix"
 PILOTS_FOLDER = "pilots"
 # Summary fields every pilot's study shares with the matrix: said once, at its top.
 _SHARED = ("study", "scenario", "trials", "seed", "split", "seeds", "measures_collisions",
@@ -52,40 +46,13 @@ def check_pilots(pilots, option="--pilots"):
         raise ScenarioError(f"{option} {','.join(pilots)} names a pilot twice")
 
 
-def check_matrix_folder(output, scenario, digest):
-    """Raises StudyFolderError when `output` holds another kind of study, or a matrix of
-    another scenario. Returns its readable study.json as a dict, or None."""
-    kind = folder_kind(output)
-    if kind is not None and kind != MATRIX:
-        raise StudyFolderError(f"{output} holds a study of kind {kind!r}, not a matrix of "
-                               "methods and pilots: choose another --output folder")
-    try:
-        study = json.loads((pathlib.Path(output) / "study.json").read_text())
-    except (OSError, ValueError):
-        return None  # none yet, or damaged: written again
-    if not isinstance(study, dict):
-        return None
-    if study.get("scenario_hash") != digest:
-        raise StudyFolderError(
-            f"{output} holds a matrix of another scenario ({study.get('scenario')!r}, hash "
-            f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}): "
-            "choose another --output folder")
-    return study
-
-
 def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, split=None,
                        scenario_file=None, split_seeds=None, overrides=None):
     """Writes a matrix folder's study.json (each pilot's folder has its own)."""
     study = {"study": MATRIX, "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "pilots": list(pilots),
              "trials": trials, "seed": seed, "split": split}
-    if scenario_file is not None:
-        study["scenario_file"] = str(scenario_file)
-    if split_seeds is not None:
-        study["split_seeds"] = dict(split_seeds)
-    if overrides is not None:
-        study["overrides"] = overrides
-    write_atomically(pathlib.Path(output) / "study.json", json.dumps(study, indent=2) + "\n")
+    write_study_json(output, study, scenario_file, split_seeds, overrides=overrides)
 
 
 def read_matrix_study(output):

@@ -182,11 +182,6 @@ def matrix_command(study, summary):
             + " --pilots " + ",".join(study["pilots"]))
 
 
-def _flat_trials(pilots):
-    return [{"pilot": pilot, **row} for pilot, (study, records, _) in pilots.items()
-            for row in flat_trials(study, records)]
-
-
 def report_matrix(output, reference=None, markdown=None):
     """Rebuilds a matrix folder's `summary.json`, `results.md`, `trials.json` and
     `pilots.png` from its pilots' trial files (no simulation); `markdown`: also writes the
@@ -213,7 +208,9 @@ def report_matrix(output, reference=None, markdown=None):
     tables = matrix_tables(summary, intervals, paired, reference)
     write_atomically(output / "summary.json", json.dumps(summary, indent=2) + "\n")
     write_atomically(output / "results.md", tables)
-    write_atomically(output / "trials.json", json.dumps(_flat_trials(pilots), indent=1) + "\n")
+    rows = [{"pilot": pilot, **row} for pilot, (pilot_study, pilot_records, _) in pilots.items()
+            for row in flat_trials(pilot_study, pilot_records)]
+    write_atomically(output / "trials.json", json.dumps(rows, indent=1) + "\n")
     plot_pilot_panels(
         {pilot: [(method, intervals["intervention_ratio"][pilot][method],
                   intervals["task_time"][pilot][method]) for method in study["methods"]]

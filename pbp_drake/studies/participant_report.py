@@ -11,8 +11,7 @@ import itertools
 import pathlib
 import statistics
 
-from pbp_drake.scenarios import ScenarioError, counted
-from pbp_drake.studies.figures import METHOD_LABELS
+from pbp_drake.scenarios import METHOD_NAMES, ScenarioError, counted
 from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, scale_text
 from pbp_drake.studies.questionnaire_figure import FIG8, answer_counts, plot_questionnaire
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, PRACTICE_FOLDER
@@ -149,7 +148,7 @@ def wilcoxon_rows(values, methods, source):
 
 
 def _label(method):
-    return METHOD_LABELS.get(method, method)
+    return METHOD_NAMES.get(method, method)
 
 
 def _mean_std(values):

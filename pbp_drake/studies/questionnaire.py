@@ -1,20 +1,19 @@
 """The paper's questionnaire (section V-C, Fig. 8): two questions answered on a scale of 0 to
-5 after each method of a session, higher being better (as in Fig. 8), each end of each
-question labelled in words so that a participant never has to guess which end is which.
-`QUESTIONS` is the one table of them: the page's buttons, `--answers`' messages, the report
-and the file all read it.
+5 after each method of a session, higher being better, each end of each question labelled
+in words so that a participant never has to guess which end is which. `QUESTIONS` is the
+one table of them: the page's buttons, `--answers`' messages, the report and the file all
+read it.
 
 The participant folder's `questionnaire.json` keeps the answers by method beside the
-questions as the participant saw them (their text and what 0 and 5 meant):
+questions as the participant saw them:
 
     {"answers": {method: {"tiredness": 0-5, "ease": 0-5}, ...},
      "questions": {"tiredness": {"question": ..., "0": ..., "5": ...}, "ease": {...}}}
 
-Each answer is written at once (atomically), so an interrupted session loses none and a
-resumed one does not ask it again; an answer on disk is never overwritten. A file of the
-older form, the bare `{method: {question: answer}}` without the questions, is read as it is
-and, should its session resume, kept in that form (it holds no record of the labels its
-first answers were given under, and gets none it cannot vouch for).
+Each answer is written at once (atomically) and never overwritten, so a resumed session
+asks only what is missing. A bare `{method: {question: answer}}` file, without the
+questions, is read and kept in that form: it cannot vouch for the labels its answers were
+given under.
 """
 
 import json

@@ -8,7 +8,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
-from pbp_drake.studies.figures import METHOD_LABELS  # noqa: E402
+from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
 from pbp_drake.studies.questionnaire import QUESTIONS, SCALE, scale_text  # noqa: E402
 
 FIG8 = "fig8_questionnaire.png"
@@ -33,7 +33,7 @@ def plot_questionnaire(answers, methods, path):
     colours = plt.get_cmap("RdYlGn")([i / (len(SCALE) - 1) for i in range(len(SCALE))])
     figure, axes = plt.subplots(1, len(QUESTIONS), figsize=(10, 1.2 + 0.6 * len(methods)),
                                 sharey=True)
-    labels = [METHOD_LABELS.get(m, m) for m in methods]
+    labels = [METHOD_NAMES.get(m, m) for m in methods]
     for panel, (axis, (question, asked)) in enumerate(zip(axes, QUESTIONS.items())):
         counts = answer_counts(answers, methods, question)
         left = [0.0] * len(methods)

@@ -1,11 +1,10 @@
 """The trials as Ray tasks (`--backend ray`), on a local Ray or a cluster.
 
 The tasks only compute; the process that runs the study writes every trial file (a
-cluster's nodes may not see the folder), so the folder is the same as with local processes,
-but for where each trial ran: its `host` and `ray_node` (the Ray node's id), which only Ray
-trials record (no reader needs them).
+cluster's nodes may not see the folder), so the folder is the same as with local processes
+but for each trial's `host` and `ray_node` (the Ray node's id), which no reader needs.
 Ray is imported only when this backend is asked for: it is an optional, heavy dependency
-(`pip install 'pbp_drake[ray]'`), and the local backend must never load it.
+(`pip install 'pbp_drake[ray]'`).
 """
 
 import os
@@ -39,8 +38,7 @@ def import_ray():
 
 
 def _ray_trial(scenario, method, trial, seed, digest, run=None):
-    """What a Ray task runs: the trial's record and its time series as CSV text (the
-    process that runs the study writes the files: a cluster's nodes may not see them)."""
+    """What a Ray task runs: the trial's record and its time series as CSV text."""
     record, result = compute_trial(scenario, method, trial, seed, digest, run)
     record["host"] = socket.gethostname()
     record["ray_node"] = import_ray().get_runtime_context().get_node_id()
@@ -49,10 +47,9 @@ def _ray_trial(scenario, method, trial, seed, digest, run=None):
 
 def _cluster_runtime_env():
     """The runtime environment of a study's tasks on a cluster: this process's pbp_drake
-    package, uploaded to the cluster and put first on the workers' path, so that they run
-    the same code as this process, whatever version of it the nodes have installed. The
-    nodes still need its dependencies (pydrake, NumPy, ...): `pip install 'pbp_drake[ray]'`
-    on each. The package, with the HSR models it ships, is under a megabyte."""
+    package (under a megabyte), uploaded and put first on the workers' path, so that they
+    run this process's code whatever version the nodes have installed (they still need its
+    dependencies: `pip install 'pbp_drake[ray]'` on each)."""
     return {"py_modules": [str(PACKAGE_DIR)], "excludes": ["__pycache__"]}
 
 

@@ -4,8 +4,8 @@ figures, rebuilt from its study.json and trial files only (no simulation)."""
 import json
 import pathlib
 
-from pbp_drake.studies.figures import (
-    METHOD_LABELS, plot_collision_histogram, plot_intervention, plot_task_time)
+from pbp_drake.scenarios import METHOD_NAMES
+from pbp_drake.studies.figures import plot_collision_histogram, plot_intervention, plot_task_time
 from pbp_drake.studies.intervals import INTERACTION_MEANS, confidence_table
 from pbp_drake.studies.splits import seeds_line
 from pbp_drake.studies.summary import summarize
@@ -38,10 +38,6 @@ def _peak_cell(entry, field, digits):
     return f"{value['max']:.{digits}f} / {value['mean']:.{digits}f}"
 
 
-def _count(value):
-    return "-" if value is None else str(value)
-
-
 def interaction_table(summary):
     """The Markdown lines of the interaction metrics, one row per method: mean ± std of each
     (`INTERACTION_MEANS`) over the trials with a value, and the switches never named of
@@ -55,7 +51,7 @@ def interaction_table(summary):
              "with a value; see the docs' study page for each definition).", "",
              "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for method, entry in methods.items():
-        cells = [METHOD_LABELS.get(method, method)]
+        cells = [METHOD_NAMES.get(method, method)]
         for name, _, digits, _ in INTERACTION_MEANS:
             cells.append(_cell(entry, name, digits) if name in entry else "-")
         latency = entry.get("time_to_prediction") or {}
@@ -84,14 +80,10 @@ def participant_line(summary):
 
 
 def results_table(summary):
-    """The summary as a Markdown table, one row per method: mean ± std of the intervention
-    ratio and task time, and of the collision ratio with the count of collision-free trials
-    where the task measures collisions; max / mean of the trials' peak hand speed and peak
-    command acceleration (see `summarize`); how often HOP's goal posterior sat at its clip
-    where a method records it. Above it, the seeds and, when it was impaired,
-    the virtual participant's condition (`participant_line`); below it the interaction
-    metrics (`interaction_table`) and the 95 % confidence intervals
-    (`pbp_drake.studies.intervals`)."""
+    """The summary (`summarize`) as a Markdown table, one row per method: mean ± std of
+    each mean, max / mean of each peak. Above it, the seeds and the virtual participant's
+    impairment (`participant_line`); below it the interaction metrics
+    (`interaction_table`) and the 95 % confidence intervals (`intervals.confidence_table`)."""
     seeds = seeds_line(summary)
     lines = [seeds, ""] if seeds else []
     participant = participant_line(summary)
@@ -109,9 +101,11 @@ def results_table(summary):
         rate = "-" if entry["success_rate"] is None else f"{100 * entry['success_rate']:.0f} %"
         gone = [f"{entry[k]} {k}" for k in ("missing", "damaged") if entry.get(k)]
         trials = f"{entry['trials']}" + (f" ({', '.join(gone)})" if gone else "")
-        collision = ((_cell(entry, "collision_ratio", 3),
-                      _count(entry["collision_free_trials"])) if collisions else ())
-        cells = [METHOD_LABELS.get(method, method), trials, rate,
+        collision = ()
+        if collisions:
+            free = entry["collision_free_trials"]
+            collision = (_cell(entry, "collision_ratio", 3), "-" if free is None else str(free))
+        cells = [METHOD_NAMES.get(method, method), trials, rate,
                  _cell(entry, "intervention_ratio", 3), _cell(entry, "task_time", 1),
                  *collision, _peak_cell(entry, "peak_hand_speed", 3),
                  _peak_cell(entry, "peak_command_acceleration", 2),

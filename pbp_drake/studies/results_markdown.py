@@ -14,7 +14,7 @@ from pbp_drake.studies.report import results_table
 from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
 from pbp_drake.studies.atomic_files import is_disk_failure, write_atomically
-from pbp_drake.studies.trial_files import StudyError
+from pbp_drake.studies.trial_files import StudyError, write_study_json
 
 # A study folder's study.json; a 2-D study's says which study and scenario file (its
 # summary.json is the study's result and names no file).
@@ -24,10 +24,8 @@ STUDY_FILE = "study.json"
 def write_toy_study(output, kind, scenario_name, scenario_file, overrides=None):
     """Writes a 2-D study folder's study.json: its kind, scenario and scenario file, and
     the command line's `overrides` of its fields (`ScenarioOverrides.record()`) if any."""
-    study = {"study": kind, "scenario": scenario_name, "scenario_file": str(scenario_file)}
-    if overrides is not None:
-        study["overrides"] = overrides
-    write_atomically(pathlib.Path(output) / STUDY_FILE, json.dumps(study, indent=2) + "\n")
+    write_study_json(output, {"study": kind, "scenario": scenario_name}, scenario_file,
+                     overrides=overrides)
 
 
 def _scenario_file(study, summary):

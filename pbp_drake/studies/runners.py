@@ -4,8 +4,7 @@
 Trial i of every method uses seed `seed + i`: the same scene and participant noise. A trial
 that raises is recorded as failed with its error; one whose worker process dies runs again
 alone, so that only a trial that kills its own process is recorded as failed. A disk that
-fails (`atomic_files.WriteFailed`) is never a trial's result: it stops the study, as
-Ctrl-C does, and the trial runs again when the same command resumes the study.
+fails is never a trial's result (`atomic_files`): it stops the study, as Ctrl-C does.
 """
 
 import concurrent.futures
@@ -22,15 +21,10 @@ import numpy as np
 
 from pbp_drake.scenarios import resolve, with_method
 from pbp_drake.studies.atomic_files import (
-    WriteFailed, is_disk_failure, write_atomically, write_failed)
+    WriteFailed, is_disk_failure, process_alive, write_atomically, write_failed)
 from pbp_drake.studies.trial_files import (
     StudyError, interaction_fields, json_float, running_marker, trial_record, write_trial)
 from pbp_drake.builder.run import run_task
-
-
-def _scene_of(resolved):
-    scene = resolved.scene
-    return (np.asarray(scene.objects, float).tolist(), [int(t) for t in scene.targets])
 
 
 def run_trial(scenario, method, trial, seed, output, digest, run=None):
@@ -48,9 +42,8 @@ def run_trial(scenario, method, trial, seed, output, digest, run=None):
 
 def compute_trial(scenario, method, trial, seed, digest, run=None):
     """Runs one trial without touching the disk: its record and TaskResult (None when it
-    raised: the record then holds the error). `run(resolved_scenario)` defaults to
-    `run_task`. A disk that fails under the trial raises WriteFailed: not the trial's
-    result."""
+    raised: the record then holds the error; a failing disk raises WriteFailed).
+    `run(resolved_scenario)` defaults to `run_task`."""
     if run is None:
         run = run_task
     started = time.monotonic()
@@ -60,7 +53,8 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
     try:
         # Resolved once: the scene is drawn and the DMPs fitted for this trial only here.
         trial = resolve(dataclasses.replace(with_method(scenario, method), seed=seed))
-        record["objects"], record["targets"] = _scene_of(trial)
+        record["objects"] = np.asarray(trial.scene.objects, float).tolist()
+        record["targets"] = [int(t) for t in trial.scene.targets]
         result = run(trial)
         record.update(success=bool(result.success), task_time=json_float(result.task_time),
                       intervention_ratio=json_float(result.intervention_ratio),
@@ -75,12 +69,9 @@ def compute_trial(scenario, method, trial, seed, digest, run=None):
             record.update(final_angle_to_target=json_float(result.final_angle_to_target),
                           peak_command_angular_change=json_float(
                               result.peak_command_angular_change))
-    except OSError as error:
+    except Exception as error:  # a broken trial must not lose the study; a failing disk stops it
         if is_disk_failure(error):
             raise write_failed(error, error.filename) from error
-        result = None
-        record.update(success=False, error=f"{type(error).__name__}: {error}")
-    except Exception as error:  # a broken trial must not lose the study
         result = None
         record.update(success=False, error=f"{type(error).__name__}: {error}")
     finally:
@@ -223,18 +214,8 @@ def _exit_with(pid):
     except ProcessLookupError:
         handle = None  # already gone
     except (AttributeError, OSError):  # no pidfd here: poll
-        while _alive(pid):
+        while process_alive(pid):
             time.sleep(0.2)
     else:
         select.select([handle], [], [])  # readable once the process has ended
     os.kill(os.getpid(), signal.SIGKILL)
-
-
-def _alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True

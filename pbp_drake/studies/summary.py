@@ -25,14 +25,10 @@ SIGNIFICANT_DIGITS = 12
 
 
 def ideal_alpha(outcomes, does_task):
-    """The paper's ideal arbitration (section IV-A): the highest alpha that still lets the
-    operator do the task, since a lower one takes autonomy from the robot for nothing.
-
-    `outcomes` is a list of `(alpha, outcome)` pairs, `does_task(outcome)` says whether
-    that alpha let the operator do the task. Returns the alpha, or None when none did.
-    The HSR method comparison judges its `fixed_alpha=A` methods with
-    `does_the_hsr_task`, the 2-D alpha study its runs with `collision_free`.
-    """
+    """The paper's ideal arbitration (section IV-A): the highest alpha of `outcomes`
+    (`(alpha, outcome)` pairs) whose outcome `does_task` (a lower one takes autonomy from
+    the robot for nothing), or None when none does. The HSR method comparison judges with
+    `does_the_hsr_task`, the 2-D alpha study with `collision_free`."""
     good = [alpha for alpha, outcome in outcomes if does_task(outcome)]
     return max(good) if good else None
 
@@ -205,13 +201,13 @@ def virtual_participant(study):
 def summarize(study, records, damaged=(), output=None):
     """Per method: how many trials, errors, missing and damaged; the success rate over the
     trials on disk; over the trials that ran without error, the mean and (population) std of
-    intervention ratio and task time, the max and mean of the peak hand speed and peak
-    command acceleration (`pbp_drake.builder.run.SeriesPeaks`), the `posterior_clipped_ratio`
-    where the trials record it, the interaction metrics (`interaction_entries`) and, where
-    the task measures collisions (`measures_collisions`), the collision ratio's mean, std
-    and histogram and the count of collision-free trials; and the ideal alpha when the study
-    sweeps fixed alphas. `damaged` (Damage tuples, see `trial_files.read_study`) becomes the
-    summary's "damaged" list (paths relative to `output`)."""
+    intervention ratio and task time, the max and mean of the peaks
+    (`pbp_drake.builder.run.SeriesPeaks`), the `posterior_clipped_ratio` and the interaction
+    metrics (`interaction_entries`) where the trials record them and, where the task
+    measures collisions (`measures_collisions`), the collision ratio's mean, std and
+    histogram and the count of collision-free trials; and the ideal alpha (`arbitration`).
+    `damaged` (`trial_files.read_study`'s) becomes the "damaged" list (paths relative to
+    `output`)."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),

@@ -227,16 +227,23 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
                 scenario_file=None, split_seeds=None, participant_condition=None,
                 overrides=None):
     """Writes the folder's study.json: which scenario, methods, trials and seeds, and the
-    split the seeds belong to (`studies.splits`; None when not known). `scenario_file` (the
-    path the study was run from) and `split_seeds` ({"tuning": first seed, "evaluation":
-    first seed}) let `report --markdown` name the command that made the study; None when not
-    known. Neither goes into the summary, which is made from the trials.
-    `participant_condition` (`pbp-drake study --participant-condition`; None: none) is
-    recorded when given, and the results name it; so are `overrides`, the command line's
-    changes to the file's fields (`ScenarioOverrides.record()`)."""
+    split the seeds belong to (`studies.splits`; None when not known). The optional fields
+    are written when given (not None): `scenario_file` (the path the study was run from)
+    and `split_seeds` ({"tuning": first seed, "evaluation": first seed}), with which `report
+    --markdown` names the command that made the study; `participant_condition` (`pbp-drake
+    study --participant-condition`) and `overrides` (the command line's changes to the
+    file's fields, `ScenarioOverrides.record()`), which the results name too."""
     study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
              "split": split, "scenario_content": scenario_content(scenario)}
+    write_study_json(output, study, scenario_file, split_seeds, participant_condition,
+                     overrides)
+
+
+def write_study_json(output, study, scenario_file=None, split_seeds=None,
+                     participant_condition=None, overrides=None):
+    """Writes the dict `study` as `output`'s study.json, and after its fields each optional
+    one given (see `write_study`)."""
     if scenario_file is not None:
         study["scenario_file"] = str(scenario_file)
     if split_seeds is not None:
@@ -245,7 +252,7 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
         study["participant_condition"] = str(participant_condition)
     if overrides is not None:
         study["overrides"] = overrides
-    write_atomically(output / "study.json", json.dumps(study, indent=2) + "\n")
+    write_atomically(pathlib.Path(output) / "study.json", json.dumps(study, indent=2) + "\n")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -334,31 +341,30 @@ def load_task_result(output, method, seed):
     if record["error"] is not None:
         raise ValueError(f"{json_path}: the trial failed: {record['error']}")
     series = read_time_series(csv_path)
+
+    def stacked(*columns):
+        return np.column_stack([series[column] for column in columns])
+
     in_collision = series["in_collision"].astype(bool) if "in_collision" in series else None
     grasp = {}
     if "angle_to_target" in series:  # the grasping task's orientation columns
         grasp = dict(
             angles_to_target=series["angle_to_target"],
-            command_angular_velocities=np.column_stack(
-                [series[c] for c in ("command_wx", "command_wy", "command_wz")]),
-            operator_twists=np.column_stack([series[c] for c in (
-                "operator_vx", "operator_vy", "operator_vz", "operator_wx", "operator_wy",
-                "operator_wz")]))
+            command_angular_velocities=stacked("command_wx", "command_wy", "command_wz"),
+            operator_twists=stacked("operator_vx", "operator_vy", "operator_vz",
+                                    "operator_wx", "operator_wy", "operator_wz"))
         if HAND_ORIENTATION_COLUMNS[0] in series:
-            grasp["hand_orientations"] = np.column_stack(
-                [series[c] for c in HAND_ORIENTATION_COLUMNS])
+            grasp["hand_orientations"] = stacked(*HAND_ORIENTATION_COLUMNS)
     return TaskResult(
         success=record["success"], task_time=record["task_time"],
         intervention_ratio=record["intervention_ratio"], switches=record["switches"],
-        times=series["time"],
-        ee_positions=np.column_stack([series["ee_x"], series["ee_y"], series["ee_z"]]),
+        times=series["time"], ee_positions=stacked("ee_x", "ee_y", "ee_z"),
         headings=series["heading"],
-        commands=np.column_stack([series[c] for c in (
-            "command_x", "command_y", "command_z", "command_vx", "command_vy", "command_vz",
-            "command_heading")]),
+        commands=stacked("command_x", "command_y", "command_z", "command_vx", "command_vy",
+                         "command_vz", "command_heading"),
         operator_active=series["operator_active"].astype(bool),
-        operator_commands=np.column_stack([series[c] for c in (
-            "operator_vx", "operator_vy", "operator_vz", "operator_yaw_rate")]),
+        operator_commands=stacked("operator_vx", "operator_vy", "operator_vz",
+                                  "operator_yaw_rate"),
         selected_goals=series["selected_goal"], targets=series["target"],
         objects=np.array(record["objects"], float),
         collision_ratio=record["collision_ratio"], in_collision=in_collision,

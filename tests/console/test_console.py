@@ -13,8 +13,7 @@ from pbp_drake.console import (
     ALPHA_SLIDER, CHOICE_BUTTONS, RATE_SLIDER, Console, LiveRun, Progress, behind_head_view,
     method_name, progress_text, result_text, status_text, time_left)
 from pbp_drake.console.questionnaire import start_label
-from pbp_drake.scenarios import METHODS, load_scenario_file, resolve, with_method
-from pbp_drake.studies.figures import METHOD_LABELS
+from pbp_drake.scenarios import METHOD_NAMES, METHODS, load_scenario_file, resolve, with_method
 
 
 def click(meshcat, name):
@@ -51,7 +50,7 @@ NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "T
 
 @pytest.mark.parametrize("method", METHODS)
 def test_a_method_has_one_name_in_the_title_the_start_button_and_the_results(method):
-    assert method_name(method) == METHOD_LABELS[method] == NAMES[method]
+    assert method_name(method) == METHOD_NAMES[method] == NAMES[method]
     assert start_label(method, 1, 3) == f"Start method 1 of 3: {NAMES[method]}"
 
 

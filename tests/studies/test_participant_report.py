@@ -13,7 +13,7 @@ import pytest
 import scipy.stats
 
 from pbp_drake.cli import main
-from pbp_drake.studies.figures import METHOD_LABELS
+from pbp_drake.scenarios import METHOD_NAMES
 
 pytestmark = pytest.mark.slow  # nine short tasks and their reports (about 20 s)
 
@@ -78,7 +78,7 @@ def test_the_wilcoxon_table_is_scipys_on_the_files(study, capsys):
             METHODS, 2)):
         x = [values[measure][first][p] for p in SESSIONS]
         y = [values[measure][second][p] for p in SESSIONS]
-        n, statistic, p = rows[(measure, METHOD_LABELS[first], METHOD_LABELS[second])]
+        n, statistic, p = rows[(measure, METHOD_NAMES[first], METHOD_NAMES[second])]
         assert n == 3
         if x == y:  # every difference zero: nothing to test, and the row says so in words
             assert (statistic, p) == ("-", "n/a"), (measure, first, second)
@@ -103,7 +103,7 @@ def test_practice_runs_are_kept_apart_and_not_counted(study):
     assert main(["report", str(study)]) == 0
     results = (study / "results.md").read_text()
     for method in METHODS:  # three participants, one recorded run each
-        assert re.search(rf"^\| {re.escape(METHOD_LABELS[method])} \| 3 \| \d of 3 \|",
+        assert re.search(rf"^\| {re.escape(METHOD_NAMES[method])} \| 3 \| \d of 3 \|",
                          results, re.M)
     assert "3 participants: P01, P02, P03." in results
 

@@ -161,6 +161,15 @@ class EeCommandRamp:
         return R, position, [0.0, 0.0, rate, *command[_VELOCITY]]
 
 
+def station_ramp(X_WE0, config):
+    """A station's `EeCommandRamp`: `R_E0` the hand's orientation at the ready pose `X_WE0`
+    turned back to heading 0, `lead` the diff IK's period (it reads the pose as the one to
+    have at the end of its step), the period `config.control_period`."""
+    R_WE0 = X_WE0.rotation()
+    R_E0 = RotationMatrix.MakeZRotation(-heading_of(R_WE0)) @ R_WE0
+    return EeCommandRamp(R_E0, config.control_period, lead=config.diff_ik_time_step)
+
+
 class EeStateFromPlant(PortGetters, LeafSystem):
     """Reads the end effector's position, velocity and heading off the plant's state.
 

@@ -15,7 +15,6 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import LeafSystem
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
-from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO
 from pbp_drake.systems.ports import PortGetters
 
 
@@ -72,12 +71,6 @@ def add_kinematic_plant(builder, time_step):
     plant = MultibodyPlant(time_step)
     plant.RegisterAsSourceForSceneGraph(scene_graph)
     return plant, scene_graph
-
-
-def hsr_couplers(plant, model):
-    """The HSR's coupler for `KinematicJoints`: the torso follows the arm lift."""
-    return [(plant.GetJointByName(TORSO_JOINT_NAME, model),
-             plant.GetJointByName("arm_lift_joint", model), TORSO_TO_ARM_LIFT_RATIO)]
 
 
 def add_kinematic_joints(builder, plant, scene_graph, motor_joints, desired_state,

@@ -38,8 +38,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
 from pbp_drake.robots.arm_driver import DriverError, check_heard
-from pbp_drake.robots.arm_station_config import (
-    DEFAULT_LCM_URL, check_lcm_url, check_positive)
+from pbp_drake.robots.arm_station_config import DEFAULT_LCM_URL, validate_link
 from pbp_drake.systems.ports import EeCommand, EeState
 from pbp_drake.systems.tick import report_offset
 
@@ -76,16 +75,12 @@ class TaskSpaceBridgeConfig:
 
 def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
     """Raises ValueError naming the first field of `config` that cannot work."""
-    check_lcm_url(config.lcm_bus.lcm_url, "TaskSpaceBridgeConfig.lcm_bus.lcm_url")
     for name in ("command_channel", "state_channel"):
         if not isinstance(getattr(config, name), str) or not getattr(config, name):
             raise ValueError(f"TaskSpaceBridgeConfig.{name} must be a channel name, got "
                              f"{getattr(config, name)!r}")
-    check_positive(config, ("status_timeout", "connect_timeout", "start_tolerance"),
-                   "TaskSpaceBridgeConfig")
-    if config.driver_sim and not config.connect:
-        raise ValueError("TaskSpaceBridgeConfig.driver_sim needs connect (pbp-drake run "
-                         "--hardware --driver-sim)")
+    validate_link(config, "TaskSpaceBridgeConfig",
+                  ("status_timeout", "connect_timeout", "start_tolerance"))
 
 
 def signal(values, names, time):
@@ -263,9 +258,6 @@ def make_bridged_station(config: TaskSpaceBridgeConfig, initial_ee_state, contro
     validate_task_space_bridge(config)
     builder = DiagramBuilder()
     if config.driver_sim:
-        if robot_side is None:
-            raise ValueError("TaskSpaceBridgeConfig.driver_sim needs the robot's side: the "
-                             "simulated station")
         lcm = DrakeLcm("memq://")
         builder.AddNamedSystem("robot_side", make_station_relay(
             robot_side, lcm, config, initial_ee_state))

@@ -78,29 +78,50 @@ class EeCommandToPose(PortGetters, LeafSystem):
 
     def _calc_velocity(self, context, output):
         command = self._command_port.Eval(context)
-        rate = self._ramp.heading_rate(context, self._last_heading, command)
-        self._ramp.velocity_into(command, rate, output.get_mutable_value())
+        velocity = output.get_mutable_value()
+        velocity[:2] = 0.0
+        velocity[2] = self._ramp.heading_rate(context, self._last_heading, command)
+        velocity[3:] = command[_VELOCITY]
 
     def _calc_pose(self, context, output):
         command = self._command_port.Eval(context)
         rate = self._ramp.heading_rate(context, self._last_heading, command)
-        output.set_value(self._ramp.pose(command, rate, context.get_time()))
+        output.set_value(RigidTransform(*self._ramp.rotation_and_position(
+            command, rate, context.get_time())))
 
 
-class EeCommandRamp:
-    """`EeCommandToPose`'s arithmetic, for it and for a system that reads the command
-    itself: the station's diff IK (`WholeBodyDiffIk` with a `command_ramp`), which thus
-    needs no system between the command and itself (two Python calls fewer at each of its
-    steps). See `EeCommandToPose` for what the pose and velocity are."""
+class CommandRamp:
+    """What a command ramp shares (`EeCommandRamp`, `PoseCommandRamp`): the command's
+    `control_period` (or None) and the `lead` (s) at which the reader wants the pose."""
+
+    def __init__(self, control_period=None, lead=0.0):
+        self.period = control_period
+        self.lead = float(lead)
+
+    def ahead(self, time):
+        """How far (s) past `time` the command is carried: `lead`, less, with a control
+        period, the time left to the next tick."""
+        ahead = self.lead
+        if self.period:
+            # math.ceil's integer times the period: the same product as np.ceil's float's.
+            next_tick = math.ceil(time / self.period - 1e-9) * self.period
+            ahead -= max(0.0, next_tick - time)
+        return ahead
+
+
+class EeCommandRamp(CommandRamp):
+    """`EeCommandToPose`'s arithmetic, for it and for the station's diff IK
+    (`WholeBodyDiffIk` with a `command_ramp`), which reads the command itself (no system
+    between them: two Python calls fewer at each of its steps). See `EeCommandToPose` for
+    what the pose and velocity are."""
 
     # The diff IK's command port, which this ramp reads.
     port_name = "ee_command"
     command_size = EeCommand.size
 
     def __init__(self, R_E0: RotationMatrix, control_period=None, lead=0.0):
+        super().__init__(control_period, lead)
         self.R_E0 = RotationMatrix(R_E0)
-        self.period = control_period
-        self.lead = float(lead)
 
     def declare_heading_sample(self, system, command_port):
         """Declares on `system` the last tick's heading (a discrete state of one entry,
@@ -126,26 +147,11 @@ class EeCommandRamp:
         turn = (command[_HEADING] - last + math.pi) % (2 * math.pi) - math.pi
         return turn / self.period
 
-    def velocity_into(self, command, heading_rate, velocity):
-        """Writes `V_WE_desired` `[w, v]` into `velocity` (6,) and returns it."""
-        velocity[:2] = 0.0
-        velocity[2] = heading_rate
-        velocity[3:] = command[_VELOCITY]
-        return velocity
-
-    def pose(self, command, heading_rate, time):
-        """`X_WE_desired` at `time`."""
-        return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
-
     def rotation_and_position(self, command, heading_rate, time):
         """`X_WE_desired` at `time` as its `(RotationMatrix, position)`, the position a
         list of 3 floats: what the diff IK reads, without building the RigidTransform at
         each of its steps. `command` may be an array or a list of floats."""
-        ahead = self.lead
-        if self.period:
-            # math.ceil's integer times the period: the same product as np.ceil's float's.
-            next_tick = math.ceil(time / self.period - 1e-9) * self.period
-            ahead -= max(0.0, next_tick - time)
+        ahead = self.ahead(time)
         heading = command[_HEADING] + heading_rate * ahead
         R = RotationMatrix.MakeZRotation(heading) @ self.R_E0
         return R, [p + v * ahead for p, v in zip(command[_POSITION], command[_VELOCITY])]

@@ -10,10 +10,11 @@ velocities are world-frame.
 
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
-from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.math import RotationMatrix
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.quaternion import UNIT_TOLERANCE, aligned, exp_map, multiply
+from pbp_drake.robots.hsr_ee_systems import CommandRamp
 from pbp_drake.systems.ports import PortGetters, PoseState
 
 # The frame the pose station commands and measures: the grasp task's hand frame H.
@@ -43,7 +44,7 @@ def check_pose_command(command, name="pose_command"):
     return quaternion / norm
 
 
-class PoseCommandRamp:
+class PoseCommandRamp(CommandRamp):
     """What `WholeBodyDiffIk` aims at, read from a six-DoF command `pose_command`
     (`PoseState`: the hand's pose to be at, `[p (3), q (4)]`, and the twist to move at,
     `[v (3), w (3)]`, world frame).
@@ -54,55 +55,28 @@ class PoseCommandRamp:
     less, with a `control_period`, the time left to the next tick: a control loop sends at
     each tick the state to be in at the next tick (as `PoseHandOver` does), so between
     ticks the hand ramps into it along the command's twist instead of stepping to it once
-    a tick (which would leave the hand behind by most of a tick's travel and turn).
-
-    The command carries its angular velocity, so unlike `EeCommandRamp` (whose heading
-    rate comes from the last tick's heading) this ramp keeps no state: its
-    `declare_heading_sample` declares nothing and its `heading_rate` is not used (the
-    names are the ramp interface `WholeBodyDiffIk` calls).
+    a tick (which would leave the hand behind by most of a tick's travel and turn). The
+    command carries its angular velocity, so unlike `EeCommandRamp` this ramp keeps no
+    state.
     """
 
     port_name = "pose_command"
     command_size = PoseState.size
 
-    def __init__(self, control_period=None, lead=0.0):
-        self.period = control_period
-        self.lead = float(lead)
-
     def declare_heading_sample(self, system, command_port):
         """No state: the command's twist is its own rate."""
         return None
 
-    def heading_rate(self, context, last_heading_index, command):
-        """Unused by `pose` and `velocity_into` (the command carries `w`)."""
-        return 0.0
-
-    def velocity_into(self, command, heading_rate, velocity):
-        """Writes `V_WE_desired` `[w, v]` into `velocity` (6,) and returns it."""
-        velocity[:3] = command[_ANGULAR]
-        velocity[3:] = command[_VELOCITY]
-        return velocity
-
-    def pose(self, command, heading_rate, time):
-        """`X_WE_desired` at `time`; refuses a NaN or non-unit command (by field)."""
-        return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
-
     def desired(self, context, last_heading_index, command, time):
         """`(R_WE_desired, p_WE_desired, V_WE_desired)` at `time` for the diff IK's step,
-        the position and velocity as lists of floats (as `EeCommandRamp.desired`)."""
-        R, position = self.rotation_and_position(command, 0.0, time)
-        return R, position.tolist(), self.velocity_into(command, 0.0, np.empty(6)).tolist()
-
-    def rotation_and_position(self, command, heading_rate, time):
-        """`pose` as its `(RotationMatrix, position (3,))`."""
+        the position and velocity as lists of floats (as `EeCommandRamp.desired`); refuses
+        a NaN or non-unit command (`check_pose_command`)."""
         quaternion = check_pose_command(command, self.port_name)
-        ahead = self.lead
-        if self.period:
-            next_tick = np.ceil(time / self.period - 1e-9) * self.period
-            ahead -= max(0.0, next_tick - time)
+        ahead = self.ahead(time)
         turned = multiply(exp_map(command[_ANGULAR] * ahead), quaternion)
-        return (RotationMatrix(Quaternion(turned)),
-                command[_POSITION] + command[_VELOCITY] * ahead)
+        position = command[_POSITION] + command[_VELOCITY] * ahead
+        velocity = np.concatenate([command[_ANGULAR], command[_VELOCITY]])
+        return RotationMatrix(Quaternion(turned)), position.tolist(), velocity.tolist()
 
 
 class PoseStateFromPlant(PortGetters, LeafSystem):

@@ -15,14 +15,11 @@ driver (``pbp_drake.robots.arm_driver``)::
     LcmSubscriberSystem (STATUS) ─► DriverLink ◄─ desired_state;  DriverLink ─► COMMAND
     DriverLink.state (measured) ─► KinematicJoints ─► robot state (the geometry, ee_state)
 
-an ``LcmInterfaceSystem`` pumping the bus, and with ``hardware.driver_sim`` the driver
-simulator (``pbp_drake.robots.driver_sim``) inside on a memq:// bus of its own.
+with ``hardware.driver_sim`` the driver simulator (``pbp_drake.robots.driver_sim``) inside
+on a memq:// bus of its own.
 
-The differential IK is the HSR station's (`WholeBodyDiffIk`): one least-squares QP a step
-with the model's position and velocity limits and the joints' acceleration limits (the
-model's, or `default_acceleration_limit`), the redundant motion drifting back to the ready
-configuration. What it does at limits and singularities is on docs/concepts/your-robot.md.
-Gravity is off, which stands for a real arm's gravity compensation.
+The differential IK is the HSR station's (`WholeBodyDiffIk`), the redundant motion drifting
+back to the ready configuration (docs/concepts/your-robot.md). Gravity is off.
 
 Example::
 

@@ -26,8 +26,7 @@ ROTATION_WEIGHT = 0.1
 # further than the twist itself is solved again with its part along the twist weighing this
 # many times the rest, and then, if the palm still moves further along the linear twist
 # than it (turning less to move more), with that too: the hand does not run ahead of the
-# command where the limits bind (without it the palm sped up to 0.26 m/s while the command
-# slowed to 0.15).
+# command where the limits bind.
 OVERSHOOT_WEIGHT = 10.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
@@ -79,15 +78,10 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
     Limits are pairs (lower, upper) of arrays over the plant's velocities (positions for
     ``position_limits``); ``inf`` where there is none. The plant must have q̇ = v.
 
-    With a ``command_ramp`` (``EeCommandRamp``) it reads the end-effector command
-    ``ee_command`` instead and makes ``X_WE_desired`` and ``V_WE_desired`` from it itself,
-    as an ``EeCommandToPose`` in front of it would (the same arithmetic, its last-heading
-    state and sampling events declared here): the station does so, which spares two
-    Python calls at each step. With a ``PoseCommandRamp`` (``hsr_pose_systems``) the
-    command is a ``PoseState`` read on ``pose_command``: the ramp names and sizes the port.
-    With ``limit_overshoot`` (the pose station), a step whose hand would move further along
-    the twist (then along its linear part) than the twist is solved again with that part
-    weighing ``OVERSHOOT_WEIGHT``.
+    With a ``command_ramp`` (``EeCommandRamp``, ``PoseCommandRamp``) it reads the command
+    instead, on the port the ramp names, and makes ``X_WE_desired`` and ``V_WE_desired``
+    from it itself (the stations do: two Python calls fewer a step). With
+    ``limit_overshoot`` see ``OVERSHOOT_WEIGHT``.
     """
 
     def __init__(self, plant, frame_E, time_step, look_ahead, motor_joints, *,
@@ -113,7 +107,7 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         self._a_lower, self._a_upper = (np.asarray(bound, float)
                                         for bound in acceleration_limits)
         self._q_nominal = np.asarray(q_nominal, float)
-        # Per-step constants, computed once (the same products the step would compute).
+        # Per-step constants, computed once.
         self._catch_up_time = CATCH_UP_STEPS * self._time_step
         # The acceleration and position limits' pairs as rows, both bounds in one call.
         self._a_step_bounds = np.stack([self._a_lower * self._time_step,
@@ -198,11 +192,9 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         return TASK_WEIGHT * (margin * margin - smallest * smallest) if smallest < margin else 0.0
 
     def _solve(self, q, v, R_WE_desired, p_WE_desired, V_WE_desired, hold):
-        """The velocity for the next step, and which velocities it holds at a bound.
-
-        Each value is the same arithmetic as ever; lower and upper bounds are computed
-        together as the rows of (2, n) arrays (each row what its own expression gave), a
-        numpy call per pair fewer at 100 Hz."""
+        """The velocity for the next step, and which velocities it holds at a bound (lower
+        and upper bounds computed together as the rows of (2, n) arrays: a numpy call per
+        pair fewer at 100 Hz)."""
         plant, context, dt, world = self._plant, self._plant_context, self._time_step, self._world
         plant.SetPositions(context, q)
         X_WE = self._frame_E.CalcPose(context, world)
@@ -266,7 +258,7 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
 
     def _calc_desired_state(self, context, output):
         # Evaluated at every plant step: [q_end, v] of the motors gathered in one call,
-        # q_end += ahead v in place (the sum as ever), set as the output in one call.
+        # q_end += ahead v in place, set as the output in one call.
         plan = context.get_discrete_state(self._plan).get_value()
         desired = plan[self._desired_gather]
         ahead = context.get_time() + self._look_ahead - plan[self._t_end]

@@ -1,13 +1,8 @@
-"""Kinematic robots: joints that are where the diff IK's plan is, at every instant (the
-HSR's and an arm's stations with ``motion: kinematic``).
-
-With ``HsrStationConfig.motion = "kinematic"`` the station steps no plant. The
-MultibodyPlant is finalized outside the Diagram, for its kinematics (the diff IK's and the
-hand's) and its geometry, which ``MultibodyPositionToGeometryPose`` places in SceneGraph
-from ``KinematicJoints``' state (collisions, Meshcat). What the dynamic station's stiff
-servos approach (hundredths of a mm behind the plan, a tenth at most where its velocity
-changes), this station is exactly.
-"""
+"""Kinematic robots (the stations' ``motion: kinematic``): joints where the diff IK's plan
+is at every instant, which the dynamic station's stiff servos approach. No plant is
+stepped: the MultibodyPlant, outside the Diagram, gives the kinematics and the geometry,
+which ``MultibodyPositionToGeometryPose`` places in SceneGraph from ``KinematicJoints``'
+state."""
 
 import numpy as np
 from pydrake.geometry import SceneGraph

@@ -14,23 +14,13 @@ plant and diff IK, commanding the hand frame ``hand_palm_link`` (the grasp task'
 ``PoseState`` ``pose_command`` (``PoseCommandRamp``), with the measured ``hand_pose``
 (``PoseStateFromPlant``) as an output besides ``ee_state``; see docs/concepts/six-dof.md.
 
-Gravity is off, which stands for the ideal gravity compensation of the real robot's
-controllers; nothing else compensates it. The base and the arm are solved together by
-one differential IK, so a target out of the arm's reach moves the base; its plan keeps
-every joint within its velocity and acceleration limits (the model file's and
-``HsrStationConfig``'s), and stiff motor servos hold the robot on that plan.
-
-No lag is left to make up: each hand-off reads its reference at the time it is due, with
-the velocity it moves at. The command is ramped between ticks (position and heading) as
-EeCommandToPose does, and the pose the ramp reaches at the end of a diff IK step, and its
-velocity, are what the diff IK aims at (it applies that arithmetic, ``EeCommandRamp``,
-itself: one Python system fewer at each of its steps); it plans to be there then, its
-servos given the plan's position at the end of each plant step, which is where the
-plant's implicit PD compares it. A
-control loop that re-integrates its command from the measured hand (``p = y + v dt``,
-as PBP and teleoperation do) thus moves the hand at ``v``, and a hand sampled at a tick
-is the hand at that tick (the plant's output ports are live; see
-``validate_hsr_station_config``).
+Gravity is off (it stands for the real robot's gravity compensation). One differential
+IK solves the base and the arm together, so a target out of the arm's reach moves the
+base; its plan keeps every joint within its velocity and acceleration limits, and stiff
+servos hold the robot on it. The diff IK aims at where the ramped command is at the end of
+its step, the servos are given the plan where the plant's implicit PD compares it, and the
+output ports are live: a control loop that re-integrates its command from the measured
+hand (``p = y + v dt``) moves it at ``v`` (docs/tasks/hsr-station.md).
 
 Example::
 

@@ -215,8 +215,6 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()
                     for index in plant.GetJointActuatorIndices(model)]
-    # The plant's PD measures its positions at the end of its step, so it is given the
-    # plan one step ahead; kinematic joints are on the plan now.
     look_ahead = 0.0 if kinematic else config.plant.time_step
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(
         plant, model, q0, config, motor_joints, ramp, look_ahead, frame_name))

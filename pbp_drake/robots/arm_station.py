@@ -67,13 +67,11 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
         - in_collision (with config.obstacles)
         - clearance (with config.obstacles)
 
-    ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``) of ``ee_frame`` in the
-    world; ``ee_state`` ``[p (3), v (3), heading, heading_rate]`` (``EeState``); the hand's
-    orientation is its ready orientation turned about the vertical by the heading. ``state``
-    is the plant's state, ``desired_state`` the diff IK's ``[q_d, v_d]`` of every joint of
-    the model, in its order. A fresh context starts at rest in the ready configuration, so
-    holding ``arm_initial_ee_state(station)[:7]`` keeps the arm still. Raises ValueError
-    naming the config's field for a model, frame or configuration that cannot work.
+    The ports are ``make_hsr_station``'s, of ``ee_frame`` (its orientation the ready one
+    turned about the vertical by the heading), ``desired_state`` over every joint of the
+    model in its order. A fresh context starts at rest in the ready configuration. Raises
+    ValueError naming the config's field for a model, frame or configuration that cannot
+    work.
     """
     validate_arm_station_config(config)
     builder = DiagramBuilder()

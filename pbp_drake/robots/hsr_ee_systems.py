@@ -176,7 +176,34 @@ def station_ramp(X_WE0, config):
     return EeCommandRamp(R_E0, config.control_period, lead=config.diff_ik_time_step)
 
 
-class EeStateFromPlant(PortGetters, LeafSystem):
+class FrameStateFromPlant(PortGetters, LeafSystem):
+    """The base of `EeStateFromPlant` and `PoseStateFromPlant`: the world pose and spatial
+    velocity of `frame` (a body, or a frame) with the plant at the input `plant_state`,
+    computed in a context of `plant` of this system's own (the same computation as the
+    plant's `body_poses` and `body_spatial_velocities`, whose values would cross into
+    Python as every body's, about half this system's time, for one body's). The output
+    `output_name` (`output_size`) is `_calc_output`'s."""
+
+    def __init__(self, plant, frame, output_name, output_size):
+        super().__init__()
+        self._plant = plant
+        self._pose = getattr(frame, "EvalPoseInWorld", None) or frame.CalcPoseInWorld
+        self._velocity = (getattr(frame, "EvalSpatialVelocityInWorld", None)
+                          or frame.CalcSpatialVelocityInWorld)
+        self._plant_context = plant.CreateDefaultContext()
+        self._plant_state_port = self.DeclareVectorInputPort(
+            "plant_state", plant.num_multibody_states())
+        self.DeclareVectorOutputPort(output_name, output_size, self._calc_output)
+
+    def _kinematics(self, context):
+        """`(X_WF, V_WF)` of the frame at the plant's state."""
+        plant_context = self._plant_context
+        self._plant.SetPositionsAndVelocities(plant_context,
+                                              self._plant_state_port.Eval(context))
+        return self._pose(plant_context), self._velocity(plant_context)
+
+
+class EeStateFromPlant(FrameStateFromPlant):
     """Reads the end effector's position, velocity and heading off the plant's state.
 
     .. pydrake_system::
@@ -191,36 +218,17 @@ class EeStateFromPlant(PortGetters, LeafSystem):
     heading_rate]` (`EeState`) of `ee_body` (a body, or any frame of the plant: an arm's
     end-effector frame may be offset from its link); heading_rate is the hand's angular velocity
     about world z (the rate of the heading while the hand's z axis stays near the floor
-    plane).
-
-    The hand's kinematics come from a context of `plant` of this system's own, set to the
-    plant's state: the same computation as the plant's `body_poses` and
-    `body_spatial_velocities` outputs, whose values would cross into Python as a list of
-    every body's pose and velocity (about half this system's time) for one body's.
+    plane). The kinematics are `FrameStateFromPlant`'s.
     """
 
     def __init__(self, plant, ee_body):
-        super().__init__()
-        self._plant = plant
         # A body frame is read through its body, whose pose and velocity the plant caches.
         if hasattr(ee_body, "body") and ee_body.index() == ee_body.body().body_frame().index():
             ee_body = ee_body.body()
-        self._body = ee_body
-        self._pose = getattr(ee_body, "EvalPoseInWorld", None) or ee_body.CalcPoseInWorld
-        self._velocity = (getattr(ee_body, "EvalSpatialVelocityInWorld", None)
-                          or ee_body.CalcSpatialVelocityInWorld)
-        self._plant_context = plant.CreateDefaultContext()
-        self._plant_state_port = self.DeclareVectorInputPort(
-            "plant_state", plant.num_multibody_states())
-        self.DeclareVectorOutputPort(
-            "ee_state", EeState.size, self._calc_state)
+        super().__init__(plant, ee_body, "ee_state", EeState.size)
 
-    def _calc_state(self, context, output):
-        plant_context = self._plant_context
-        self._plant.SetPositionsAndVelocities(plant_context,
-                                              self._plant_state_port.Eval(context))
-        X_WE = self._pose(plant_context)
-        V_WE = self._velocity(plant_context)
+    def _calc_output(self, context, output):
+        X_WE, V_WE = self._kinematics(context)
         w, v = V_WE.rotational(), V_WE.translational()
         output.SetFromVector(np.concatenate(
             [X_WE.translation(), v, [heading_of(X_WE.rotation()), w[2]]]))

@@ -11,11 +11,10 @@ velocities are world-frame.
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RotationMatrix
-from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.quaternion import UNIT_TOLERANCE, aligned, exp_map, multiply
-from pbp_drake.robots.hsr_ee_systems import CommandRamp
-from pbp_drake.systems.ports import PortGetters, PoseState
+from pbp_drake.robots.hsr_ee_systems import CommandRamp, FrameStateFromPlant
+from pbp_drake.systems.ports import PoseState
 
 # The frame the pose station commands and measures: the grasp task's hand frame H.
 HAND_FRAME = "hand_palm_link"
@@ -49,15 +48,11 @@ class PoseCommandRamp(CommandRamp):
     (`PoseState`: the hand's pose to be at, `[p (3), q (4)]`, and the twist to move at,
     `[v (3), w (3)]`, world frame).
 
-    `X_WE_desired` at time t is the command carried along its own twist for `ahead`
-    seconds, `(Exp(w ahead) q, p + v ahead)`; `V_WE_desired` is `[w, v]`. `ahead` is `lead`
-    (the diff IK's period: it reads the pose as the one to have at the end of its step),
-    less, with a `control_period`, the time left to the next tick: a control loop sends at
-    each tick the state to be in at the next tick (as `PoseHandOver` does), so between
-    ticks the hand ramps into it along the command's twist instead of stepping to it once
-    a tick (which would leave the hand behind by most of a tick's travel and turn). The
-    command carries its angular velocity, so unlike `EeCommandRamp` this ramp keeps no
-    state.
+    `X_WE_desired` at time t is the command carried along its own twist for
+    `CommandRamp.ahead` seconds, `(Exp(w ahead) q, p + v ahead)`: between ticks the hand
+    ramps into the pose the control loop sends for the next tick (as `EeCommandToPose`
+    does); `V_WE_desired` is `[w, v]`. The command carries its angular velocity, so unlike
+    `EeCommandRamp` this ramp keeps no state.
     """
 
     port_name = "pose_command"
@@ -79,7 +74,7 @@ class PoseCommandRamp(CommandRamp):
         return RotationMatrix(Quaternion(turned)), position.tolist(), velocity.tolist()
 
 
-class PoseStateFromPlant(PortGetters, LeafSystem):
+class PoseStateFromPlant(FrameStateFromPlant):
     """Reads the hand's pose and twist off the plant's state.
 
     .. pydrake_system::
@@ -94,30 +89,16 @@ class PoseStateFromPlant(PortGetters, LeafSystem):
     w_WH (3)]` (`PoseState`) of `frame_H`, world frame. Of `q` and `-q` it gives the one
     nearer `q_reference` (the station passes the hand's start orientation), so that the
     stream does not flip sign as Drake's conversion from a rotation matrix may; users treat
-    both signs as one orientation anyway (`pbp_drake.core.quaternion`).
-
-    The kinematics come from a context of `plant` of this system's own, set to the plant's
-    state (as `EeStateFromPlant`: one body's pose rather than the plant's list of all).
+    both signs as one orientation anyway (`pbp_drake.core.quaternion`). The kinematics are
+    `FrameStateFromPlant`'s.
     """
 
     def __init__(self, plant, frame_H, q_reference):
-        super().__init__()
-        self._plant = plant
-        self._frame = frame_H
-        self._world = plant.world_frame()
+        super().__init__(plant, frame_H, "hand_pose", PoseState.size)
         self._reference = np.asarray(q_reference, float)
-        self._plant_context = plant.CreateDefaultContext()
-        self._plant_state_port = self.DeclareVectorInputPort(
-            "plant_state", plant.num_multibody_states())
-        self.DeclareVectorOutputPort(
-            "hand_pose", PoseState.size, self._calc_pose)
 
-    def _calc_pose(self, context, output):
-        plant_context = self._plant_context
-        self._plant.SetPositionsAndVelocities(plant_context,
-                                              self._plant_state_port.Eval(context))
-        X_WH = self._frame.CalcPoseInWorld(plant_context)
-        V_WH = self._frame.CalcSpatialVelocityInWorld(plant_context)
+    def _calc_output(self, context, output):
+        X_WH, V_WH = self._kinematics(context)
         quaternion = aligned(X_WH.rotation().ToQuaternion().wxyz(), self._reference)
         output.SetFromVector(np.concatenate([X_WH.translation(), quaternion,
                                              V_WH.translational(), V_WH.rotational()]))

@@ -166,25 +166,18 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``); ``ee_state`` is
     ``[p (3), v (3), heading, heading_rate]`` (``EeState``) of the hand in the world.
     ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]`` the plant's PD
-    tracks, in motor order (``ACTUATED_JOINT_NAMES``; q_d is the diff IK's plan one plant
-    step ahead, where the implicit PD measures the positions); ``body_poses`` and
-    ``query_object`` are the plant's and SceneGraph's.
+    tracks, in motor order (``ACTUATED_JOINT_NAMES``; see ``WholeBodyDiffIk``);
+    ``body_poses`` and ``query_object`` are the plant's and SceneGraph's.
 
-    With ``config.motion == "kinematic"`` no plant is stepped: the joints are on the diff
-    IK's plan at every instant (``KinematicJoints``, whose ``state`` has the plant's
-    layout; ``desired_state`` is then the plan now), the plant is used outside the
-    Diagram for its kinematics and geometry (``hsr_station_plant`` returns it), and there
-    is no ``body_poses`` output. Every other port is the same. ``obstacle_positions`` is
-    ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the
-    smallest robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
-    The obstacles do not push the robot (their contact with it is filtered out).
+    With ``config.motion == "kinematic"`` the joints are on the plan (``KinematicJoints``;
+    ``hsr_station_plant`` returns the plant, outside the Diagram) and there is no
+    ``body_poses``. ``obstacle_positions`` is ``(N, 3)`` flattened, the centres of
+    ``config.obstacles``; ``clearance`` is the smallest robot-obstacle signed distance (m),
+    ``in_collision`` 1 when it is negative; the obstacles do not push the robot.
 
-    ``pose_command`` is ``[p (3), q (4), v (3), w (3)]`` (``PoseState``, world frame) of
-    ``hand_palm_link``: the pose to be at (at the next tick with ``control_period``) and
-    the twist to move at; a NaN field or a quaternion whose norm is off 1 by more than
-    1e-6 is refused by name. ``hand_pose`` is that frame's measured ``PoseState`` (its
-    quaternion signed nearer the start orientation). The diff IK is the same QP, tracking
-    the whole pose (see ``PoseCommandRamp`` and docs/concepts/six-dof.md).
+    ``pose_command`` is ``hand_palm_link``'s ``PoseState`` to be at (``PoseCommandRamp``,
+    docs/concepts/six-dof.md); a NaN field or a non-unit quaternion is refused by name.
+    ``hand_pose`` is that frame's measured ``PoseState`` (``PoseStateFromPlant``).
 
     A fresh context starts at rest in the ready pose with the diff IK already there, so
     holding ``hsr_initial_ee_state(station)[:7]`` keeps the robot still.

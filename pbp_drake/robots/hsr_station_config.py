@@ -23,7 +23,7 @@ MOTIONS = ("dynamic", "kinematic")
 
 def default_station_plant_config():
     # SAP enforces the torso's coupler constraint and applies the motors' PD implicitly.
-    # Live output ports: see validate_hsr_station_config.
+    # Live output ports: see validate_station.
     return MultibodyPlantConfig(time_step=0.005, discrete_contact_approximation="sap",
                                 use_sampled_output_ports=False)
 

@@ -26,24 +26,15 @@ the logs and the page see:
     goal_poses, hand_pose_sample, goal_estimator ──> goal_grouping
     goal_grouping.followed_poses ──> dmp_bank.goal_poses;  goal_grouping.shown_goal ──> operator
 
-Under ``hop`` and ``predict_then_assist`` there is no DMP bank and no blender: the
-`goal_estimator` is HOP's posterior (`PoseMaxEntGoalEstimator`, on the operator's twist),
-and an `assistance` (`PoseHopAssistance`) adds HOP's action to the operator's twist before
-the same `hand_over`. `goal_estimator: {method: maxent_command}` puts the same posterior
-in PBP's loop in place of the `pose` estimator.
+Under ``hop`` and ``predict_then_assist`` an `assistance` (`PoseHopAssistance`) adds HOP's
+action to the operator's twist in place of the DMP bank and the blender (`_estimator`
+tells which goal estimator each method has).
 
-`hsr_station` is `make_hsr_station(..., command="pose")`, its hand frame `hand_palm_link`;
-the DMPs start at the hand's real start pose there (`hsr_initial_hand_pose`). Loggers
-named `hand_pose_log`, `operator_active_log`, `operator_command_log`, `command_log`,
-`selected_goal_log`, `target_log`, `phase_log` (with DMPs) and `posterior_clipped_log`
-(with HOP's posterior) record each tick (`run_task` reads them, `grasp_series_fields`);
-the task monitor ends the simulation at success. The operator is the grasp participant,
-none (PBP-NoUser), or a person in the Meshcat page: the
-`PoseKeyboardOperator` or the `PoseGamepadOperator` (their `hand_state` is the sampled
-hand pose; they need Meshcat). With Meshcat, `task_visualizer` draws the tables, objects,
-grasp triads, target and estimate, the hand, and the selected DMP's predicted path
-(`GRASP_PREDICTION_SAMPLES` poses over the DMPs' duration, rolled out at the visualizer's
-path rate, not each tick).
+`hsr_station` is `make_hsr_station(..., command="pose")`; the DMPs start at the hand's
+start pose there (`hsr_initial_hand_pose`). Loggers named as the reaching task's, with
+`hand_pose_log` for `ee_state_log`, record each tick (`grasp_series_fields`); the task
+monitor ends the simulation at success. The operator is the grasp participant, a pilot,
+none, or a person at the `PoseKeyboardOperator` or `PoseGamepadOperator` (Meshcat).
 """
 
 import numpy as np

@@ -25,12 +25,8 @@ estimate cannot yet tell apart (`pbp_drake.core.goal_groups`), and the controlle
     goals, ee_state, goal_estimator (goal_probabilities, selected_goal) ──> goal_grouping
     goal_grouping.followed_goals ──> dmp_bank.goals;  goal_grouping.shown_goal ──> selected_goal
 
-The goal estimator is a `GoalEstimator`, or with `goal_estimator: {method: maxent_command}`
-a `MaxEntGoalEstimator` (HOP's posterior with the likelihood of PBP's operator,
-`pbp_drake.core.maxent_command`, with the config's `hop` settings, `nominal_speed` and the
-`goal_estimator` section's hysteresis), or with `{method: intent_filter}` an
-`IntentFilterGoalEstimator` (the section's `intent_filter` settings and hysteresis); those
-two add the output `posterior_clipped`.
+The goal estimator is `make_goal_estimator`'s; the recursive ones add the output
+`posterior_clipped`.
 
 Under ``hop`` and ``predict_then_assist`` (`hop_controller`, no DMP bank) HOP's posterior and
 its assistance take the place of the estimator, the bank and the blender:
@@ -40,11 +36,8 @@ its assistance take the place of the estimator, the bank and the blender:
     operator_command ──> goal_estimator;  operator_command_split (v) ──> assistance
     assistance.command [p, v] ──> hand_over ──> ee_command (with the heading, as PBP's)
 
-A station of any robot (`make_hsr_station`, `make_arm_station`, a user's own with the same
-ports) is wired as the task builder does: `station.ee_state` through a `SampleHold` into
-`ee_state`, a `GoalsSource` (or any source of the K goals) into `goals`, the operator's
-outputs into `operator_command` and `operator_active`, and `ee_command` back into the
-station.
+A station of any robot with the same ports is wired as `build_reach_diagram` does:
+`station.ee_state` through a `SampleHold` into `ee_state`, and `ee_command` back.
 """
 
 import numpy as np
@@ -118,10 +111,8 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     if goals.ndim != 2 or goals.shape[1] != 3 or len(goals) == 0:
         raise ValueError(f"goals must be a non-empty (K, 3) array, got shape {goals.shape}")
     builder = DiagramBuilder()
-    # Drake's (C++) Demultiplexers: their outputs depend on every source, time included,
-    # but everything downstream reads them once a tick (the DMP bank's and the estimator's
-    # updates, and the blender only through the hand-over's update), so nothing recomputes
-    # between ticks, and no Python call is spent on splitting.
+    # Drake's (C++) Demultiplexers: no Python call is spent on splitting, and everything
+    # downstream reads them once a tick, so nothing recomputes between ticks.
     split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, EeState.size - 6]))
     builder.ExportInput(split.get_input_port(), "ee_state")
     command_split = builder.AddNamedSystem("operator_command_split", Demultiplexer(
@@ -198,8 +189,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         max_speed=(config.hand_over.max_hand_speed
                    if BLEND_LAWS[config.blend_mode].adds_to_policy else None),
         # Every DMP steps from the followed one's velocity (connected below): the state is
-        # then O(D) whatever K (with shared weights and start, every scenario's bank, the
-        # outputs are O(D) too).
+        # then O(D) whatever K.
         compact_state=True, predicted_goal_count=predicted_goal_count))
     shown = estimator.get_selected_goal_output_port()
     if settings.group_mass > 0.0:

@@ -9,18 +9,13 @@ the HSR or an arm, a handful of blocks:
     pbp_controller.ee_command ──> station.ee_command (differential IK)
     obstacles.obstacle_positions ──> station;  station.in_collision ──> task_monitor
 
-The station is `hsr_station` (`pbp_drake.robots.make_hsr_station`) or `arm_station`
-(`make_arm_station`, `robot: !Arm`): plant, diff IK, obstacle geometry, collision monitor,
-Meshcat visualizer; or `bridged_station` (`robot: !Hsr {hardware: {connect: true}}`), the
-hand's command and state over LCM to the robot's relay (`pbp_drake.robots.task_space_bridge`).
-The controller (`pbp_drake.builder.make_pbp_controller`, from the resolved scenario's
-`PbpControllerConfig`) is a Diagram of its own; under ``hop`` and ``predict_then_assist`` it is
-`hop_controller` (no DMPs: no `phase` or `predicted_paths`, and no `operator_active` input).
-The order within a tick is `pbp_drake.systems.tick`'s. Loggers named `ee_state_log`,
-`operator_active_log`, `operator_command_log`, `command_log`, `selected_goal_log`,
-`target_log`, `phase_log` (with DMPs), `posterior_clipped_log` (where the controller has HOP's
-posterior) and (with obstacles) `in_collision_log` record each tick; the task monitor ends the
-simulation at success.
+The station is `hsr_station`, `arm_station` (`robot: !Arm`) or `bridged_station` (the
+HSR over LCM, `pbp_drake.robots.task_space_bridge`); the controller is
+`make_pbp_controller`'s Diagram. The order within a tick is `pbp_drake.systems.tick`'s.
+Loggers named `ee_state_log`, `operator_active_log`, `operator_command_log`, `command_log`,
+`selected_goal_log`, `target_log`, `phase_log` (with DMPs), `posterior_clipped_log` (with
+HOP's posterior) and `in_collision_log` (with obstacles) record each tick; the task monitor
+ends the simulation at success.
 """
 
 import numpy as np

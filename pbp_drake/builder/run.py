@@ -344,13 +344,9 @@ def task_series(diagram, times, state, in_collision, decisions):
 
 class SeriesPeaks:
     """What a TaskResult keeps of a run's whole series, fed whole (`run_task`) or chunk by
-    chunk (a streamed run): the motion peaks over ticks 0..T-1,
-    max_k |ee(t_{k+1}) - ee(t_k)| / control_period (m/s, ee = `ee_positions`) and
-    max_k |v(k+1) - v(k)| / control_period (m/s^2, v = `commands[:, 3:6]`), None before two
-    ticks; in the grasping task also the peak command angular change (rad/s per tick) and
-    the last tick's angle to the target; the interaction metrics (`InteractionMeter`);
-    and, fed the `posterior_clipped_log` samples (`add_clipped`), the ratio of ticks whose
-    goal posterior was clipped."""
+    chunk (a streamed run): the peaks, the final angle to the target, the interaction
+    metrics (`InteractionMeter`) and, fed the `posterior_clipped_log` samples
+    (`add_clipped`), the posterior's clipped ratio (see `TaskResult`)."""
 
     def __init__(self, control_period):
         self._period = control_period
@@ -386,7 +382,7 @@ class SeriesPeaks:
         self._posterior_ticks = (self._posterior_ticks or 0) + len(flags)
 
     def task_result(self, status, monitor, series):
-        """The run's TaskResult (see `task_result`) holding `series` and the peaks fed."""
+        """The run's TaskResult holding `series` and the peaks fed."""
         if self._grasp:
             series = dict(series, peak_command_angular_change=self._turning.peak(1.0),
                           final_angle_to_target=self._final_angle)

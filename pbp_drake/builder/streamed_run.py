@@ -2,19 +2,15 @@
 for runs too long to keep their time series in memory (`pbp_drake_bench.soak` runs one for an
 hour of simulated time).
 
-The simulator advances in chunks of simulated time. After each chunk the rows of the ticks
-it completed are appended to the file (the format of a study's trial CSV,
-`pbp_drake.builder.time_series`) and every logger of the diagram is cleared, so memory holds
-at most one chunk of samples however long the run. What needs the whole series (the motion
-peaks, the grasping task's last angle to the target) is carried from chunk to chunk.
+After each chunk of simulated time the rows of the ticks it completed are appended to the
+file (`pbp_drake.builder.time_series`) and every logger is cleared, so memory holds one
+chunk however long the run; what needs the whole series (the peaks, the grasping task's
+last angle) is carried from chunk to chunk.
 
-The rows are those of `run_task`'s series, read by the same functions (`run.task_series`,
-`run.SeriesPeaks`): a reach task's from `ee_state_log`, the grasping task's from
-`hand_pose_log`, with its orientation columns. A tick's row joins the plant's state logged
-at `t_k` with the decisions of tick k, which the loggers hold one sample later
-(`DECISION_LOG_SHIFT`, see `pbp_drake.builder.run.read_log`): a chunk's last state sample
-waits for the next chunk's first decision sample, and the run's last state sample, whose
-decisions are never logged, is not written (as in `run_task`).
+The rows are `run_task`'s, read by the same functions (`run.task_series`,
+`run.SeriesPeaks`). A tick's decisions are logged one sample after its state
+(`DECISION_LOG_SHIFT`): a chunk's last state sample waits for the next chunk's decisions,
+and the run's last one, whose decisions are never logged, is not written.
 """
 
 import numpy as np

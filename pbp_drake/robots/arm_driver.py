@@ -1,27 +1,20 @@
-"""The station's side of a real arm's Drake LCM driver (drake-franka-driver, drake-iiwa-driver):
-the messages, the clock, the first status read before a run, and `DriverLink`, which reads
-the driver's status and sends it the diff IK's joint positions within the drivers' rules.
+"""The station's side of a real arm's Drake LCM driver (drake-franka-driver,
+drake-iiwa-driver): the messages, the clock, the first status read before a run, and
+`DriverLink`, which sends the diff IK's joint positions within the drivers' rules
+(`ArmHardware` holds the limits):
 
-The rules (`ArmHardware` holds the limits):
+- the start is read from the driver's first status (`read_first_status`), never assumed;
+- no command before a fresh status, nor within the iiwa driver's start-up guard;
+- the Panda's commands are stamped with the wall clock (drake-franka-driver drops one
+  older than its `--expire_sec`; Drake's `PandaCommandSender` stamps simulation time);
+- none computed more than `command_expiry` behind the wall clock (the iiwa driver holds a
+  position command forever, so a stalled loop would go unseen);
+- a status silent for `status_timeout`, of the wrong joint count, with a NaN or beyond a
+  limit ends the run with `DriverError` and sends nothing more (the driver holds);
+- commands within the position limits, at most the velocity limits from the last one.
 
-- the start configuration is read from the driver's first status (`read_first_status`
-  before the run; `DriverLink` checks that the arm still stands there), never assumed;
-- no command goes out before a fresh status; none within the iiwa driver's start-up guard
-  (0.25 s after its first status, when it would abort);
-- the Panda's commands are stamped with the wall clock (drake-franka-driver drops a command
-  whose stamp is older than its `--expire_sec`; Drake's `PandaCommandSender` stamps
-  simulation time);
-- our own expiry: no command computed more than `command_expiry` behind the wall clock
-  (the iiwa driver holds a position command forever, so a stalled loop would go unseen);
-- a watchdog: a status silent for `status_timeout`, of the wrong joint count, with a NaN
-  position or a position beyond a limit ends the run with `DriverError` and sends nothing
-  more, so that the driver holds the last commanded position (both do in position mode);
-- commands within the joints' position limits and at most their velocity limits from the
-  last command.
-
-A run with the driver simulator in the same process (`ArmHardware.driver_sim`) keeps the
-simulation's clock on both sides (`SIMULATION_CLOCK`): the expiry and the watchdog are then
-in simulated time, and the Panda's stamps too, which the simulator checks the same way.
+With the driver simulator in the same process (`ArmHardware.driver_sim`) both sides keep
+the simulation's clock (`SIMULATION_CLOCK`).
 """
 
 import time

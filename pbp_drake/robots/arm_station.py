@@ -15,14 +15,11 @@ driver (``pbp_drake.robots.arm_driver``)::
     LcmSubscriberSystem (STATUS) ─► DriverLink ◄─ desired_state;  DriverLink ─► COMMAND
     DriverLink.state (measured) ─► KinematicJoints ─► robot state (the geometry, ee_state)
 
-an ``LcmInterfaceSystem`` pumping the bus, and with ``hardware.driver_sim`` the driver
-simulator (``pbp_drake.robots.driver_sim``) inside on a memq:// bus of its own.
+with ``hardware.driver_sim`` the driver simulator (``pbp_drake.robots.driver_sim``) inside
+on a memq:// bus of its own.
 
-The differential IK is the HSR station's (`WholeBodyDiffIk`): one least-squares QP a step
-with the model's position and velocity limits and the joints' acceleration limits (the
-model's, or `default_acceleration_limit`), the redundant motion drifting back to the ready
-configuration. What it does at limits and singularities is on docs/concepts/your-robot.md.
-Gravity is off, which stands for a real arm's gravity compensation.
+The differential IK is the HSR station's (`WholeBodyDiffIk`), the redundant motion drifting
+back to the ready configuration (docs/concepts/your-robot.md). Gravity is off.
 
 Example::
 
@@ -35,8 +32,7 @@ Example::
 
 import numpy as np
 from pydrake.lcm import DrakeLcm
-from pydrake.math import RotationMatrix
-from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
@@ -48,10 +44,9 @@ from pbp_drake.robots.arm_station_config import (
     DRIVERS, ArmStationConfig, validate_arm_station_config)
 from pbp_drake.robots.driver_sim import make_driver_sim
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
-from pbp_drake.robots.hsr_ee_systems import (
-    EeCommandRamp, EeStateFromPlant, ee_state_at_rest, heading_of)
-from pbp_drake.robots.hsr_kinematic import add_kinematic_joints, add_kinematic_plant
-from pbp_drake.robots.station_parts import add_meshcat_visualizers, add_obstacles
+from pbp_drake.robots.hsr_ee_systems import ee_state_at_rest, station_ramp
+from pbp_drake.robots.station_parts import (
+    add_robot, add_station_plant, finish_station, initial_ee_state, pose_at, station_plant)
 
 
 def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
@@ -72,25 +67,19 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
         - in_collision (with config.obstacles)
         - clearance (with config.obstacles)
 
-    ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``) of ``ee_frame`` in the
-    world; ``ee_state`` ``[p (3), v (3), heading, heading_rate]`` (``EeState``); the hand's
-    orientation is its ready orientation turned about the vertical by the heading. ``state``
-    is the plant's state, ``desired_state`` the diff IK's ``[q_d, v_d]`` of every joint of
-    the model, in its order. A fresh context starts at rest in the ready configuration, so
-    holding ``arm_initial_ee_state(station)[:7]`` keeps the arm still. Raises ValueError
-    naming the config's field for a model, frame or configuration that cannot work.
+    The ports are ``make_hsr_station``'s, of ``ee_frame`` (its orientation the ready one
+    turned about the vertical by the heading), ``desired_state`` over every joint of the
+    model in its order. A fresh context starts at rest in the ready configuration. Raises
+    ValueError naming the config's field for a model, frame or configuration that cannot
+    work.
     """
     validate_arm_station_config(config)
     builder = DiagramBuilder()
     hardware = config.hardware if config.hardware is not None and config.hardware.connect \
         else None
     kinematic = config.motion == "kinematic" or hardware is not None
-    if kinematic:
-        plant, scene_graph = add_kinematic_plant(builder, config.plant.time_step)
-    else:
-        plant, scene_graph = AddMultibodyPlant(config.plant, builder)
+    plant, scene_graph = add_station_plant(builder, config, kinematic)
     arm = add_arm(plant, config)
-    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
     if not kinematic:
         _add_motors(plant, arm)
     plant.Finalize()
@@ -98,40 +87,19 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
     plant.SetDefaultPositions(q0)
     if not kinematic:
         _set_servo_gains(plant, arm, q0, config.servo_frequency)
-    X_WE0 = _ee_pose(plant, arm, q0)
-    # R_E0 is the hand's orientation at heading 0.
-    R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
-    ramp = EeCommandRamp(R_E0, config.control_period, lead=config.diff_ik_time_step)
+    ramp = station_ramp(pose_at(plant, arm.ee_frame, q0), config)
     look_ahead = 0.0 if kinematic else config.plant.time_step
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(plant, arm, q0, config, ramp,
                                                               look_ahead))
+    joints_input = diff_ik.get_desired_state_output_port() if kinematic else None
     if hardware is not None:
-        measured = _add_driver_link(builder, plant, arm, q0, hardware, diff_ik)
-        joints = add_kinematic_joints(builder, plant, scene_graph, arm.joints, measured)
-        state = joints.get_state_output_port()
-    elif kinematic:
-        joints = add_kinematic_joints(builder, plant, scene_graph, arm.joints,
-                                      diff_ik.get_desired_state_output_port())
-        state = joints.get_state_output_port()
-    else:
-        state = plant.get_state_output_port()
-        builder.Connect(diff_ik.get_desired_state_output_port(),
-                        plant.get_desired_state_input_port(arm.model))
-    builder.Connect(state, diff_ik.get_robot_state_input_port())
-    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, arm.ee_frame))
-    builder.Connect(state, ee_state.get_plant_state_input_port())
-    builder.ExportInput(diff_ik.get_command_input_port(), ramp.port_name)
-    builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
+        joints_input = _add_driver_link(builder, plant, arm, q0, hardware, diff_ik)
+    state = add_robot(builder, plant, scene_graph, arm.model, diff_ik, ramp, arm.ee_frame,
+                      arm.joints, joints_input)
     builder.ExportOutput(state, "state")
     builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
-    builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
-    if config.obstacles:
-        add_obstacles(builder, plant, scene_graph, arm.model, config.obstacles)
-    if meshcat is not None:
-        add_meshcat_visualizers(builder, scene_graph, meshcat, config.visualization)
-    station = builder.Build()
-    station.set_name("arm_station")
-    return station
+    return finish_station(builder, plant, scene_graph, arm.model, config, meshcat,
+                          "arm_station")
 
 
 def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
@@ -175,7 +143,6 @@ def arm_driver_sim(config: ArmStationConfig, lcm, clock=WALL_CLOCK) -> Diagram:
     """The driver simulator of `config`'s arm (`config.hardware.driver`) on `lcm`, standing
     in the ready configuration, with its own `LcmInterfaceSystem`: what `pbp-drake
     driver-sim` runs."""
-    validate_arm_station_config(config)
     if config.hardware is None:
         raise ValueError("ArmStationConfig.hardware is needed: the driver to simulate "
                          "(hardware: {driver: panda} or {driver: iiwa})")
@@ -226,12 +193,6 @@ def _set_servo_gains(plant, arm, q0, frequency):
                                                         d=2.0 * joint_inertia * frequency))
 
 
-def _ee_pose(plant, arm, q):
-    context = plant.CreateDefaultContext()
-    plant.SetPositions(context, q)
-    return arm.ee_frame.CalcPoseInWorld(context)
-
-
 def _make_diff_ik(plant, arm, q0, config, ramp, look_ahead):
     """The diff IK of the end-effector frame within the model's position and velocity
     limits, the acceleration limits the model gives (else the config's default), every
@@ -279,18 +240,8 @@ def arm_ready_ee_state_and_reach(config: ArmStationConfig):
     """`(arm_ready_ee_state, arm_reach)` of `config`, from one parse of the model: what a
     scenario is resolved from before its station is built."""
     plant, arm, q0 = arm_model_plant(config)
-    return ee_state_at_rest(_ee_pose(plant, arm, q0)), reach_of(plant, arm, q0)
+    return ee_state_at_rest(pose_at(plant, arm.ee_frame, q0)), reach_of(plant, arm, q0)
 
 
-def arm_initial_ee_state(station: Diagram) -> np.ndarray:
-    """The hand's ``ee_state`` (``EeState``) where ``station`` (from ``make_arm_station``)
-    starts: read off a fresh context."""
-    return np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))
-
-
-def arm_station_plant(station: Diagram) -> MultibodyPlant:
-    """The MultibodyPlant of a station from ``make_arm_station``: its subsystem ``plant``
-    (dynamic), or the kinematic joints' plant, which is outside the Diagram."""
-    if station.HasSubsystemNamed("plant"):
-        return station.GetSubsystemByName("plant")
-    return station.GetSubsystemByName("joints").plant()
+arm_initial_ee_state = initial_ee_state
+arm_station_plant = station_plant

@@ -14,8 +14,8 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.robots.hsr_station_config import (
-    MOTIONS, CylinderObstacle, default_station_plant_config, default_station_visualization,
-    validate_station_obstacles, validate_station_timing)
+    CylinderObstacle, default_station_plant_config, default_station_visualization,
+    validate_station)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -166,13 +166,7 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
     for name in ("model_file", "base_frame", "ee_frame"):
         if not isinstance(getattr(config, name), str) or not getattr(config, name):
             raise ValueError(f"ArmStationConfig.{name} is needed (a non-empty string)")
-    if config.motion not in MOTIONS:
-        raise ValueError(f"ArmStationConfig.motion must be one of {MOTIONS}, got "
-                         f"{config.motion!r}")
-    time_step = config.plant.time_step
-    if not time_step > 0:
-        raise ValueError(f"ArmStationConfig.plant.time_step must be positive, got {time_step}")
-    validate_station_timing(config, "ArmStationConfig")
+    validate_station(config, "ArmStationConfig")
     if len(config.base_pose) != 4 or not np.all(np.isfinite(config.base_pose)):
         raise ValueError(f"ArmStationConfig.base_pose must be finite [x, y, z, yaw], got "
                          f"{config.base_pose}")
@@ -194,7 +188,6 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
     if not (np.isfinite(config.centering_gain) and config.centering_gain >= 0):
         raise ValueError(f"ArmStationConfig.centering_gain must be >= 0, got "
                          f"{config.centering_gain}")
-    validate_station_obstacles(config, "ArmStationConfig")
     if config.hardware is not None:
         validate_arm_hardware(config.hardware)
 
@@ -205,10 +198,17 @@ def validate_arm_hardware(hardware: ArmHardware) -> None:
     if hardware.driver not in DRIVERS:
         raise ValueError(f"{field}.driver must be one of {sorted(DRIVERS)}, got "
                          f"{hardware.driver!r}")
-    check_lcm_url(hardware.lcm_bus.lcm_url, f"{field}.lcm_bus.lcm_url")
-    check_positive(hardware, ("status_timeout", "connect_timeout", "command_expiry",
-                              "start_tolerance"), field)
-    if hardware.driver_sim and not hardware.connect:
+    validate_link(hardware, field, ("status_timeout", "connect_timeout", "command_expiry",
+                                    "start_tolerance"))
+
+
+def validate_link(link, field, positive):
+    """What an `ArmHardware` and a `TaskSpaceBridgeConfig` (`field`: where it stands)
+    share: an LCM URL two processes can share, the fields `positive` finite and positive,
+    `driver_sim` only with `connect`. Raises ValueError naming the field."""
+    check_lcm_url(link.lcm_bus.lcm_url, f"{field}.lcm_bus.lcm_url")
+    check_positive(link, positive, field)
+    if link.driver_sim and not link.connect:
         raise ValueError(f"{field}.driver_sim needs connect (pbp-drake run --hardware "
                          "--driver-sim)")
 

@@ -6,7 +6,6 @@ import math
 import numpy as np
 from numpy.linalg import _umath_linalg
 
-# The identity of each size solve_box_qp has met: np.eye costs as much as a solve here.
 _IDENTITIES = {}
 
 
@@ -25,17 +24,13 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
     ``hold`` guesses which variables end at a bound (-1 lower, 1 upper, 0 neither), such
     as the last solution's. Returns the minimizer and which variables it holds at a bound.
 
-    A primal-dual active-set method first: each iteration solves with the variables held
-    where the last one put them, then holds every free variable found out of its bounds
-    and lets go every held one whose bound the cost pulls away from, all at once; it stops
-    when nothing changes, which is `solve_box_qp_primal`'s own test of the minimum, and
-    its answer is the one system solved there for that set of held variables, so the
-    same numbers, bit for bit (checked on 23,822 QPs of reach, obstacle and grasp
-    trials). It solves about as many systems as the primal method, which moves one bound
-    at a time (2.8 a QP against 2.3 on those), but each iteration is a solve, a product
-    and tests on Python lists, where the primal's step, clip and copies are numpy calls. Such a
-    method can cycle on some problems: after ``2 n + 2`` iterations it hands over to the primal
-    method, which always ends.
+    A primal-dual active-set method: each iteration solves with the variables held where
+    the last one put them, then holds every free variable found out of its bounds and lets
+    go every held one whose bound the cost pulls away from, all at once. It stops when
+    nothing changes, which is `solve_box_qp_primal`'s own test of the minimum, with the
+    system `solve_box_qp_primal` solves for that set of held variables: the same numbers,
+    bit for bit. Such a method can cycle: after ``2 n + 2`` iterations it hands over to
+    `solve_box_qp_primal`, which always ends.
     """
     n = g.size
     identity = _identity(n)
@@ -80,10 +75,9 @@ def solve_box_qp(H, g, lower, upper, hold=None, max_iterations=100):
 
 def _identity(n):
     """The identity of size n, made once (np.eye costs as much as a solve here)."""
-    identity = _IDENTITIES.get(n)
-    if identity is None:
-        identity = _IDENTITIES[n] = np.eye(n)
-    return identity
+    if n not in _IDENTITIES:
+        _IDENTITIES[n] = np.eye(n)
+    return _IDENTITIES[n]
 
 
 def solve_box_qp_primal(H, g, lower, upper, hold=None, max_iterations=100):
@@ -96,10 +90,9 @@ def solve_box_qp_primal(H, g, lower, upper, hold=None, max_iterations=100):
     as the last solution's; a good guess saves iterations, and any guess gives the same
     minimum. Returns the minimizer and which variables it holds at a bound.
 
-    Every value is computed by numpy as before; which variables are out of their bounds,
-    block a step or leave a bound is decided on Python lists (a few entries: a numpy call
-    per test cost more than the test), and the system solved is kept from one iteration to
-    the next, a row changed where a variable is held or let go.
+    Which variables are out of their bounds, block a step or leave a bound is decided on
+    Python lists (a numpy call per test costs more than the test), and the system solved is
+    kept from one iteration to the next, a row changed where a variable is held or let go.
     """
     n = g.size
     identity = _identity(n)

@@ -6,12 +6,11 @@ driver-sim FILE` on the bus, or in the run's process with `run --hardware --driv
 
     LcmSubscriberSystem (COMMAND channel) ─► DriverSim ─► status on the STATUS channel
 
-`DriverSim` keeps the drivers' rules: the Panda's position mode drops a command whose
-stamp is more than `expire_sec` from its clock and refuses one that expects another mode
-or carries velocities or torques; the iiwa driver aborts on a command within 0.25 s of its
-first status and clamps commands to 1 degree inside the joints' limits; both hold the last
-accepted position (before any, the position they started in). The joints move toward the
-command at their velocity limits.
+`DriverSim` keeps the drivers' rules: the Panda drops a command stamped more than
+`expire_sec` from its clock and refuses one for another mode than position; the iiwa
+aborts on a command within its start-up guard and clamps commands 1 degree inside the
+limits; both hold the last accepted position. The joints move toward it at their velocity
+limits.
 """
 
 import numpy as np

@@ -4,8 +4,6 @@ Its QP is `pbp_drake.robots.box_qp`'s."""
 
 import numpy as np
 from numpy._core.umath import clip as _clip
-from pydrake.common.value import AbstractValue
-from pydrake.math import RigidTransform
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem
 
@@ -26,8 +24,7 @@ ROTATION_WEIGHT = 0.1
 # further than the twist itself is solved again with its part along the twist weighing this
 # many times the rest, and then, if the palm still moves further along the linear twist
 # than it (turning less to move more), with that too: the hand does not run ahead of the
-# command where the limits bind (without it the palm sped up to 0.26 m/s while the command
-# slowed to 0.15).
+# command where the limits bind.
 OVERSHOOT_WEIGHT = 10.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
@@ -42,16 +39,16 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
 
         name: WholeBodyDiffIk
         input_ports:
-        - X_WE_desired (without command_ramp)
-        - V_WE_desired (without command_ramp)
         - ee_command (with an EeCommandRamp; pose_command with a PoseCommandRamp)
         - robot_state
         output_ports:
         - desired_state
 
-    At each step ``t_n`` (period ``time_step``) it picks the velocity ``v_n`` of the
-    plan until ``t_n + time_step``: the hand's desired twist ``V_WE_desired`` (in the
-    world frame, ``[w, v]``) plus what closes the gap from the plan's pose to
+    The command's ``command_ramp`` (``EeCommandRamp``, ``PoseCommandRamp``) names and
+    sizes the command port and makes from the command the hand's desired pose
+    ``X_WE_desired`` and twist ``V_WE_desired`` (world frame, ``[w, v]``). At each step
+    ``t_n`` (period ``time_step``) it picks the velocity ``v_n`` of the plan until
+    ``t_n + time_step``: ``V_WE_desired`` plus what closes the gap from the plan's pose to
     ``X_WE_desired`` over ``CATCH_UP_STEPS`` steps, as nearly as the joints' position,
     velocity and acceleration limits allow (a least-squares QP, the accelerations taken
     relative to the plan's previous velocity), and in the rest of the joint space a drift
@@ -60,40 +57,27 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
     ``V_WE_desired`` the plan stays exactly on it. The plan is piecewise linear in
     position.
 
-    Drake's ``DifferentialInverseKinematicsIntegrator`` does not do for this: it keeps
-    positions only, so it would take acceleration limits relative to zero velocity (a
-    limit ``a`` caps every speed at ``a time_step``), and its QP scales the whole hand
-    motion down to meet a limit, which made the hand surge and stall under acceleration
-    limits.
+    Not Drake's ``DifferentialInverseKinematicsIntegrator``, which takes acceleration limits
+    relative to zero velocity and scales the whole hand motion down to meet a limit
+    (docs/tasks/hsr-station.md).
 
     ``desired_state`` is ``[q_d, v_d]`` of the motor joints (``motor_joints``, in that
     order): the plan's position ``look_ahead`` seconds ahead of now and its velocity. The
     plant's implicit PD compares q_d with its positions at the end of its step, so the
-    plan's position at that time is what it must be given to track without lag (the
-    station's look-ahead is its plant's time step; 0 for kinematic joints, which are on
-    the plan).
-    ``robot_state`` (the plant's state) is read only at initialization: the plan
-    starts there, at rest. Before that the plan is ``q_nominal`` at rest, which is where
-    kinematic joints, whose state is this plan, start.
+    plan's position at that time is what it must be given to track without lag (0 for
+    kinematic joints, which are on the plan). ``robot_state`` (the plant's state) is read
+    only at initialization: the plan starts there, at rest (before that, at ``q_nominal``,
+    where kinematic joints start).
 
     Limits are pairs (lower, upper) of arrays over the plant's velocities (positions for
     ``position_limits``); ``inf`` where there is none. The plant must have q̇ = v.
 
-    With a ``command_ramp`` (``EeCommandRamp``) it reads the end-effector command
-    ``ee_command`` instead and makes ``X_WE_desired`` and ``V_WE_desired`` from it itself,
-    as an ``EeCommandToPose`` in front of it would (the same arithmetic, its last-heading
-    state and sampling events declared here): the station does so, which spares two
-    Python calls at each step. With a ``PoseCommandRamp`` (``hsr_pose_systems``) the
-    command is a ``PoseState`` read on ``pose_command``: the ramp names and sizes the port.
-    With ``limit_overshoot`` (the pose station), a step whose hand would move further along
-    the twist (then along its linear part) than the twist is solved again with that part
-    weighing ``OVERSHOOT_WEIGHT``.
+    With ``limit_overshoot`` see ``OVERSHOOT_WEIGHT``.
     """
 
     def __init__(self, plant, frame_E, time_step, look_ahead, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
-                 centering_gain, command_ramp=None, limit_overshoot=False,
-                 singular_margin=0.0):
+                 centering_gain, command_ramp, limit_overshoot=False, singular_margin=0.0):
         super().__init__()
         self._limit_overshoot = bool(limit_overshoot)
         self._singular_margin = float(singular_margin)
@@ -113,7 +97,7 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         self._a_lower, self._a_upper = (np.asarray(bound, float)
                                         for bound in acceleration_limits)
         self._q_nominal = np.asarray(q_nominal, float)
-        # Per-step constants, computed once (the same products the step would compute).
+        # Per-step constants, computed once.
         self._catch_up_time = CATCH_UP_STEPS * self._time_step
         # The acceleration and position limits' pairs as rows, both bounds in one call.
         self._a_step_bounds = np.stack([self._a_lower * self._time_step,
@@ -132,14 +116,8 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
                                                nq + self._velocity_indices])
         self._t_end = nq + nv
         self._ramp = command_ramp
-        self._pose_port = self._twist_port = self._command_port = None
-        if command_ramp is None:
-            self._pose_port = self.DeclareAbstractInputPort(
-                "X_WE_desired", AbstractValue.Make(RigidTransform()))
-            self._twist_port = self.DeclareVectorInputPort("V_WE_desired", 6)
-        else:
-            self._command_port = self.DeclareVectorInputPort(command_ramp.port_name,
-                                                             command_ramp.command_size)
+        self._command_port = self.DeclareVectorInputPort(command_ramp.port_name,
+                                                         command_ramp.command_size)
         self._robot_state_port = self.DeclareVectorInputPort(
             "robot_state", plant.num_multibody_states())
         # [q at t_end, v, t_end, hold]: the plan reaches q at t_end moving at v; hold is
@@ -148,15 +126,13 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
             [self._q_nominal, np.zeros(nv + 1 + nv)]))  # at q_nominal until initialized
         self.DeclarePeriodicDiscreteUpdateEvent(self._time_step, 0.0, self._step)
         self.DeclareInitializationDiscreteUpdateEvent(self._start)
-        if command_ramp is not None:
-            self._last_heading = command_ramp.declare_heading_sample(self,
-                                                                     self._command_port)
+        self._last_heading = command_ramp.declare_heading_sample(self, self._command_port)
         self._desired_port = self.DeclareVectorOutputPort(
             "desired_state", 2 * len(motor_joints), self._calc_desired_state,
             {self.time_ticket(), self.xd_ticket()})
 
     def get_command_input_port(self):
-        """The command port of a diff IK with a ramp, whichever command it reads."""
+        """The command port, whichever command the ramp reads."""
         return self._command_port
 
     def _start(self, context, discrete_state):
@@ -169,7 +145,8 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         n, dt = self._nq, self._time_step
         q, v, hold = plan[:n], plan[n:2 * n], plan[2 * n + 1:]
         time = context.get_time()
-        v_next, hold = self._solve(q, v, *self._desired(context, time), hold)
+        v_next, hold = self._solve(q, v, *self._ramp.desired(
+            context, self._last_heading, self._command_port.Eval(context), time), hold)
         # Written into the new plan in place (this runs at 100 Hz), the positions by
         # np.clip's own ufunc: np.clip's Python wrappers cost more than clipping 9 numbers.
         new_plan = discrete_state.get_mutable_value(self._plan)
@@ -177,16 +154,6 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         new_plan[n:2 * n] = v_next
         new_plan[2 * n] = time + dt
         new_plan[2 * n + 1:] = hold
-
-    def _desired(self, context, time):
-        """`X_WE_desired` (as its rotation and position) and `V_WE_desired` now, the
-        position and velocity as lists of floats: from the ports, or from the command."""
-        if self._ramp is None:
-            X_WE_desired = self._pose_port.Eval(context)
-            return (X_WE_desired.rotation(), X_WE_desired.translation().tolist(),
-                    self._twist_port.Eval(context).tolist())
-        return self._ramp.desired(context, self._last_heading,
-                                  self._command_port.Eval(context), time)
 
     def _singular_damping(self, J):
         """Damped least squares near a singular configuration: with s the Jacobian's least
@@ -198,11 +165,9 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         return TASK_WEIGHT * (margin * margin - smallest * smallest) if smallest < margin else 0.0
 
     def _solve(self, q, v, R_WE_desired, p_WE_desired, V_WE_desired, hold):
-        """The velocity for the next step, and which velocities it holds at a bound.
-
-        Each value is the same arithmetic as ever; lower and upper bounds are computed
-        together as the rows of (2, n) arrays (each row what its own expression gave), a
-        numpy call per pair fewer at 100 Hz."""
+        """The velocity for the next step, and which velocities it holds at a bound (lower
+        and upper bounds computed together as the rows of (2, n) arrays: a numpy call per
+        pair fewer at 100 Hz)."""
         plant, context, dt, world = self._plant, self._plant_context, self._time_step, self._world
         plant.SetPositions(context, q)
         X_WE = self._frame_E.CalcPose(context, world)
@@ -266,7 +231,7 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
 
     def _calc_desired_state(self, context, output):
         # Evaluated at every plant step: [q_end, v] of the motors gathered in one call,
-        # q_end += ahead v in place (the sum as ever), set as the output in one call.
+        # q_end += ahead v in place, set as the output in one call.
         plan = context.get_discrete_state(self._plan).get_value()
         desired = plan[self._desired_gather]
         ahead = context.get_time() + self._look_ahead - plan[self._t_end]

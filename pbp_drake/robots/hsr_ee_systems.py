@@ -78,29 +78,50 @@ class EeCommandToPose(PortGetters, LeafSystem):
 
     def _calc_velocity(self, context, output):
         command = self._command_port.Eval(context)
-        rate = self._ramp.heading_rate(context, self._last_heading, command)
-        self._ramp.velocity_into(command, rate, output.get_mutable_value())
+        velocity = output.get_mutable_value()
+        velocity[:2] = 0.0
+        velocity[2] = self._ramp.heading_rate(context, self._last_heading, command)
+        velocity[3:] = command[_VELOCITY]
 
     def _calc_pose(self, context, output):
         command = self._command_port.Eval(context)
         rate = self._ramp.heading_rate(context, self._last_heading, command)
-        output.set_value(self._ramp.pose(command, rate, context.get_time()))
+        output.set_value(RigidTransform(*self._ramp.rotation_and_position(
+            command, rate, context.get_time())))
 
 
-class EeCommandRamp:
-    """`EeCommandToPose`'s arithmetic, for it and for a system that reads the command
-    itself: the station's diff IK (`WholeBodyDiffIk` with a `command_ramp`), which thus
-    needs no system between the command and itself (two Python calls fewer at each of its
-    steps). See `EeCommandToPose` for what the pose and velocity are."""
+class CommandRamp:
+    """What a command ramp shares (`EeCommandRamp`, `PoseCommandRamp`): the command's
+    `control_period` (or None) and the `lead` (s) at which the reader wants the pose."""
+
+    def __init__(self, control_period=None, lead=0.0):
+        self.period = control_period
+        self.lead = float(lead)
+
+    def ahead(self, time):
+        """How far (s) past `time` the command is carried: `lead`, less, with a control
+        period, the time left to the next tick."""
+        ahead = self.lead
+        if self.period:
+            # math.ceil's integer times the period: the same product as np.ceil's float's.
+            next_tick = math.ceil(time / self.period - 1e-9) * self.period
+            ahead -= max(0.0, next_tick - time)
+        return ahead
+
+
+class EeCommandRamp(CommandRamp):
+    """`EeCommandToPose`'s arithmetic, for it and for the station's diff IK
+    (`WholeBodyDiffIk` with a `command_ramp`), which reads the command itself (no system
+    between them: two Python calls fewer at each of its steps). See `EeCommandToPose` for
+    what the pose and velocity are."""
 
     # The diff IK's command port, which this ramp reads.
     port_name = "ee_command"
     command_size = EeCommand.size
 
     def __init__(self, R_E0: RotationMatrix, control_period=None, lead=0.0):
+        super().__init__(control_period, lead)
         self.R_E0 = RotationMatrix(R_E0)
-        self.period = control_period
-        self.lead = float(lead)
 
     def declare_heading_sample(self, system, command_port):
         """Declares on `system` the last tick's heading (a discrete state of one entry,
@@ -126,26 +147,11 @@ class EeCommandRamp:
         turn = (command[_HEADING] - last + math.pi) % (2 * math.pi) - math.pi
         return turn / self.period
 
-    def velocity_into(self, command, heading_rate, velocity):
-        """Writes `V_WE_desired` `[w, v]` into `velocity` (6,) and returns it."""
-        velocity[:2] = 0.0
-        velocity[2] = heading_rate
-        velocity[3:] = command[_VELOCITY]
-        return velocity
-
-    def pose(self, command, heading_rate, time):
-        """`X_WE_desired` at `time`."""
-        return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
-
     def rotation_and_position(self, command, heading_rate, time):
         """`X_WE_desired` at `time` as its `(RotationMatrix, position)`, the position a
         list of 3 floats: what the diff IK reads, without building the RigidTransform at
         each of its steps. `command` may be an array or a list of floats."""
-        ahead = self.lead
-        if self.period:
-            # math.ceil's integer times the period: the same product as np.ceil's float's.
-            next_tick = math.ceil(time / self.period - 1e-9) * self.period
-            ahead -= max(0.0, next_tick - time)
+        ahead = self.ahead(time)
         heading = command[_HEADING] + heading_rate * ahead
         R = RotationMatrix.MakeZRotation(heading) @ self.R_E0
         return R, [p + v * ahead for p, v in zip(command[_POSITION], command[_VELOCITY])]
@@ -161,7 +167,43 @@ class EeCommandRamp:
         return R, position, [0.0, 0.0, rate, *command[_VELOCITY]]
 
 
-class EeStateFromPlant(PortGetters, LeafSystem):
+def station_ramp(X_WE0, config):
+    """A station's `EeCommandRamp`: `R_E0` the hand's orientation at the ready pose `X_WE0`
+    turned back to heading 0, `lead` the diff IK's period (it reads the pose as the one to
+    have at the end of its step), the period `config.control_period`."""
+    R_WE0 = X_WE0.rotation()
+    R_E0 = RotationMatrix.MakeZRotation(-heading_of(R_WE0)) @ R_WE0
+    return EeCommandRamp(R_E0, config.control_period, lead=config.diff_ik_time_step)
+
+
+class FrameStateFromPlant(PortGetters, LeafSystem):
+    """The base of `EeStateFromPlant` and `PoseStateFromPlant`: the world pose and spatial
+    velocity of `frame` (a body, or a frame) with the plant at the input `plant_state`,
+    computed in a context of `plant` of this system's own (the same computation as the
+    plant's `body_poses` and `body_spatial_velocities`, whose values would cross into
+    Python as every body's, about half this system's time, for one body's). The output
+    `output_name` (`output_size`) is `_calc_output`'s."""
+
+    def __init__(self, plant, frame, output_name, output_size):
+        super().__init__()
+        self._plant = plant
+        self._pose = getattr(frame, "EvalPoseInWorld", None) or frame.CalcPoseInWorld
+        self._velocity = (getattr(frame, "EvalSpatialVelocityInWorld", None)
+                          or frame.CalcSpatialVelocityInWorld)
+        self._plant_context = plant.CreateDefaultContext()
+        self._plant_state_port = self.DeclareVectorInputPort(
+            "plant_state", plant.num_multibody_states())
+        self.DeclareVectorOutputPort(output_name, output_size, self._calc_output)
+
+    def _kinematics(self, context):
+        """`(X_WF, V_WF)` of the frame at the plant's state."""
+        plant_context = self._plant_context
+        self._plant.SetPositionsAndVelocities(plant_context,
+                                              self._plant_state_port.Eval(context))
+        return self._pose(plant_context), self._velocity(plant_context)
+
+
+class EeStateFromPlant(FrameStateFromPlant):
     """Reads the end effector's position, velocity and heading off the plant's state.
 
     .. pydrake_system::
@@ -176,36 +218,17 @@ class EeStateFromPlant(PortGetters, LeafSystem):
     heading_rate]` (`EeState`) of `ee_body` (a body, or any frame of the plant: an arm's
     end-effector frame may be offset from its link); heading_rate is the hand's angular velocity
     about world z (the rate of the heading while the hand's z axis stays near the floor
-    plane).
-
-    The hand's kinematics come from a context of `plant` of this system's own, set to the
-    plant's state: the same computation as the plant's `body_poses` and
-    `body_spatial_velocities` outputs, whose values would cross into Python as a list of
-    every body's pose and velocity (about half this system's time) for one body's.
+    plane). The kinematics are `FrameStateFromPlant`'s.
     """
 
     def __init__(self, plant, ee_body):
-        super().__init__()
-        self._plant = plant
         # A body frame is read through its body, whose pose and velocity the plant caches.
         if hasattr(ee_body, "body") and ee_body.index() == ee_body.body().body_frame().index():
             ee_body = ee_body.body()
-        self._body = ee_body
-        self._pose = getattr(ee_body, "EvalPoseInWorld", None) or ee_body.CalcPoseInWorld
-        self._velocity = (getattr(ee_body, "EvalSpatialVelocityInWorld", None)
-                          or ee_body.CalcSpatialVelocityInWorld)
-        self._plant_context = plant.CreateDefaultContext()
-        self._plant_state_port = self.DeclareVectorInputPort(
-            "plant_state", plant.num_multibody_states())
-        self.DeclareVectorOutputPort(
-            "ee_state", EeState.size, self._calc_state)
+        super().__init__(plant, ee_body, "ee_state", EeState.size)
 
-    def _calc_state(self, context, output):
-        plant_context = self._plant_context
-        self._plant.SetPositionsAndVelocities(plant_context,
-                                              self._plant_state_port.Eval(context))
-        X_WE = self._pose(plant_context)
-        V_WE = self._velocity(plant_context)
+    def _calc_output(self, context, output):
+        X_WE, V_WE = self._kinematics(context)
         w, v = V_WE.rotational(), V_WE.translational()
         output.SetFromVector(np.concatenate(
             [X_WE.translation(), v, [heading_of(X_WE.rotation()), w[2]]]))

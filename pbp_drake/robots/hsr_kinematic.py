@@ -1,13 +1,8 @@
-"""Kinematic robots: joints that are where the diff IK's plan is, at every instant (the
-HSR's and an arm's stations with ``motion: kinematic``).
-
-With ``HsrStationConfig.motion = "kinematic"`` the station steps no plant. The
-MultibodyPlant is finalized outside the Diagram, for its kinematics (the diff IK's and the
-hand's) and its geometry, which ``MultibodyPositionToGeometryPose`` places in SceneGraph
-from ``KinematicJoints``' state (collisions, Meshcat). What the dynamic station's stiff
-servos approach (hundredths of a mm behind the plan, a tenth at most where its velocity
-changes), this station is exactly.
-"""
+"""Kinematic robots (the stations' ``motion: kinematic``): joints where the diff IK's plan
+is at every instant, which the dynamic station's stiff servos approach. No plant is
+stepped: the MultibodyPlant, outside the Diagram, gives the kinematics and the geometry,
+which ``MultibodyPositionToGeometryPose`` places in SceneGraph from ``KinematicJoints``'
+state."""
 
 import numpy as np
 from pydrake.geometry import SceneGraph
@@ -15,7 +10,6 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import LeafSystem
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
-from pbp_drake.robots.hsr_model import TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO
 from pbp_drake.systems.ports import PortGetters
 
 
@@ -72,12 +66,6 @@ def add_kinematic_plant(builder, time_step):
     plant = MultibodyPlant(time_step)
     plant.RegisterAsSourceForSceneGraph(scene_graph)
     return plant, scene_graph
-
-
-def hsr_couplers(plant, model):
-    """The HSR's coupler for `KinematicJoints`: the torso follows the arm lift."""
-    return [(plant.GetJointByName(TORSO_JOINT_NAME, model),
-             plant.GetJointByName("arm_lift_joint", model), TORSO_TO_ARM_LIFT_RATIO)]
 
 
 def add_kinematic_joints(builder, plant, scene_graph, motor_joints, desired_state,

@@ -1,12 +1,10 @@
 """Loads our primitive-shape Toyota HSR model into a Drake MultibodyPlant.
 
-The model (``models/pbp_drake_models/hsr/hsrb_primitive.urdf``) is our own, written
-from published kinematic facts. It has an omnidirectional base on three actuated joints
-(``BASE_JOINT_NAMES``: prismatic x, prismatic y, revolute yaw; their speed limits are in
-the model file), five actuated arm joints, a torso that
-follows the arm lift at half its travel (a coupler constraint from the URDF
-``<mimic>``), and an end-effector frame ``hand_ee_link`` between the fingertips whose
-z axis points out of the hand.
+The model (``models/pbp_drake_models/hsr/hsrb_primitive.urdf``, written from published
+kinematic facts) has a base on three actuated joints (``BASE_JOINT_NAMES``), five actuated
+arm joints, a torso that follows the arm lift at half its travel (a coupler from the URDF
+``<mimic>``), and an end-effector frame ``hand_ee_link`` between the fingertips, its z
+axis out of the hand.
 
 Example::
 

@@ -10,11 +10,11 @@ velocities are world-frame.
 
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
-from pydrake.math import RigidTransform, RotationMatrix
-from pydrake.systems.framework import LeafSystem
+from pydrake.math import RotationMatrix
 
 from pbp_drake.core.quaternion import UNIT_TOLERANCE, aligned, exp_map, multiply
-from pbp_drake.systems.ports import PortGetters, PoseState
+from pbp_drake.robots.hsr_ee_systems import CommandRamp, FrameStateFromPlant
+from pbp_drake.systems.ports import PoseState
 
 # The frame the pose station commands and measures: the grasp task's hand frame H.
 HAND_FRAME = "hand_palm_link"
@@ -43,69 +43,38 @@ def check_pose_command(command, name="pose_command"):
     return quaternion / norm
 
 
-class PoseCommandRamp:
+class PoseCommandRamp(CommandRamp):
     """What `WholeBodyDiffIk` aims at, read from a six-DoF command `pose_command`
     (`PoseState`: the hand's pose to be at, `[p (3), q (4)]`, and the twist to move at,
     `[v (3), w (3)]`, world frame).
 
-    `X_WE_desired` at time t is the command carried along its own twist for `ahead`
-    seconds, `(Exp(w ahead) q, p + v ahead)`; `V_WE_desired` is `[w, v]`. `ahead` is `lead`
-    (the diff IK's period: it reads the pose as the one to have at the end of its step),
-    less, with a `control_period`, the time left to the next tick: a control loop sends at
-    each tick the state to be in at the next tick (as `PoseHandOver` does), so between
-    ticks the hand ramps into it along the command's twist instead of stepping to it once
-    a tick (which would leave the hand behind by most of a tick's travel and turn).
-
-    The command carries its angular velocity, so unlike `EeCommandRamp` (whose heading
-    rate comes from the last tick's heading) this ramp keeps no state: its
-    `declare_heading_sample` declares nothing and its `heading_rate` is not used (the
-    names are the ramp interface `WholeBodyDiffIk` calls).
+    `X_WE_desired` at time t is the command carried along its own twist for
+    `CommandRamp.ahead` seconds, `(Exp(w ahead) q, p + v ahead)`: between ticks the hand
+    ramps into the pose the control loop sends for the next tick (as `EeCommandToPose`
+    does); `V_WE_desired` is `[w, v]`. The command carries its angular velocity, so unlike
+    `EeCommandRamp` this ramp keeps no state.
     """
 
     port_name = "pose_command"
     command_size = PoseState.size
 
-    def __init__(self, control_period=None, lead=0.0):
-        self.period = control_period
-        self.lead = float(lead)
-
     def declare_heading_sample(self, system, command_port):
         """No state: the command's twist is its own rate."""
         return None
 
-    def heading_rate(self, context, last_heading_index, command):
-        """Unused by `pose` and `velocity_into` (the command carries `w`)."""
-        return 0.0
-
-    def velocity_into(self, command, heading_rate, velocity):
-        """Writes `V_WE_desired` `[w, v]` into `velocity` (6,) and returns it."""
-        velocity[:3] = command[_ANGULAR]
-        velocity[3:] = command[_VELOCITY]
-        return velocity
-
-    def pose(self, command, heading_rate, time):
-        """`X_WE_desired` at `time`; refuses a NaN or non-unit command (by field)."""
-        return RigidTransform(*self.rotation_and_position(command, heading_rate, time))
-
     def desired(self, context, last_heading_index, command, time):
         """`(R_WE_desired, p_WE_desired, V_WE_desired)` at `time` for the diff IK's step,
-        the position and velocity as lists of floats (as `EeCommandRamp.desired`)."""
-        R, position = self.rotation_and_position(command, 0.0, time)
-        return R, position.tolist(), self.velocity_into(command, 0.0, np.empty(6)).tolist()
-
-    def rotation_and_position(self, command, heading_rate, time):
-        """`pose` as its `(RotationMatrix, position (3,))`."""
+        the position and velocity as lists of floats (as `EeCommandRamp.desired`); refuses
+        a NaN or non-unit command (`check_pose_command`)."""
         quaternion = check_pose_command(command, self.port_name)
-        ahead = self.lead
-        if self.period:
-            next_tick = np.ceil(time / self.period - 1e-9) * self.period
-            ahead -= max(0.0, next_tick - time)
+        ahead = self.ahead(time)
         turned = multiply(exp_map(command[_ANGULAR] * ahead), quaternion)
-        return (RotationMatrix(Quaternion(turned)),
-                command[_POSITION] + command[_VELOCITY] * ahead)
+        position = command[_POSITION] + command[_VELOCITY] * ahead
+        velocity = np.concatenate([command[_ANGULAR], command[_VELOCITY]])
+        return RotationMatrix(Quaternion(turned)), position.tolist(), velocity.tolist()
 
 
-class PoseStateFromPlant(PortGetters, LeafSystem):
+class PoseStateFromPlant(FrameStateFromPlant):
     """Reads the hand's pose and twist off the plant's state.
 
     .. pydrake_system::
@@ -120,30 +89,16 @@ class PoseStateFromPlant(PortGetters, LeafSystem):
     w_WH (3)]` (`PoseState`) of `frame_H`, world frame. Of `q` and `-q` it gives the one
     nearer `q_reference` (the station passes the hand's start orientation), so that the
     stream does not flip sign as Drake's conversion from a rotation matrix may; users treat
-    both signs as one orientation anyway (`pbp_drake.core.quaternion`).
-
-    The kinematics come from a context of `plant` of this system's own, set to the plant's
-    state (as `EeStateFromPlant`: one body's pose rather than the plant's list of all).
+    both signs as one orientation anyway (`pbp_drake.core.quaternion`). The kinematics are
+    `FrameStateFromPlant`'s.
     """
 
     def __init__(self, plant, frame_H, q_reference):
-        super().__init__()
-        self._plant = plant
-        self._frame = frame_H
-        self._world = plant.world_frame()
+        super().__init__(plant, frame_H, "hand_pose", PoseState.size)
         self._reference = np.asarray(q_reference, float)
-        self._plant_context = plant.CreateDefaultContext()
-        self._plant_state_port = self.DeclareVectorInputPort(
-            "plant_state", plant.num_multibody_states())
-        self.DeclareVectorOutputPort(
-            "hand_pose", PoseState.size, self._calc_pose)
 
-    def _calc_pose(self, context, output):
-        plant_context = self._plant_context
-        self._plant.SetPositionsAndVelocities(plant_context,
-                                              self._plant_state_port.Eval(context))
-        X_WH = self._frame.CalcPoseInWorld(plant_context)
-        V_WH = self._frame.CalcSpatialVelocityInWorld(plant_context)
+    def _calc_output(self, context, output):
+        X_WH, V_WH = self._kinematics(context)
         quaternion = aligned(X_WH.rotation().ToQuaternion().wxyz(), self._reference)
         output.SetFromVector(np.concatenate([X_WH.translation(), quaternion,
                                              V_WH.translational(), V_WH.rotational()]))

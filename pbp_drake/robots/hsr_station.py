@@ -14,23 +14,13 @@ plant and diff IK, commanding the hand frame ``hand_palm_link`` (the grasp task'
 ``PoseState`` ``pose_command`` (``PoseCommandRamp``), with the measured ``hand_pose``
 (``PoseStateFromPlant``) as an output besides ``ee_state``; see docs/concepts/six-dof.md.
 
-Gravity is off, which stands for the ideal gravity compensation of the real robot's
-controllers; nothing else compensates it. The base and the arm are solved together by
-one differential IK, so a target out of the arm's reach moves the base; its plan keeps
-every joint within its velocity and acceleration limits (the model file's and
-``HsrStationConfig``'s), and stiff motor servos hold the robot on that plan.
-
-No lag is left to make up: each hand-off reads its reference at the time it is due, with
-the velocity it moves at. The command is ramped between ticks (position and heading) as
-EeCommandToPose does, and the pose the ramp reaches at the end of a diff IK step, and its
-velocity, are what the diff IK aims at (it applies that arithmetic, ``EeCommandRamp``,
-itself: one Python system fewer at each of its steps); it plans to be there then, its
-servos given the plan's position at the end of each plant step, which is where the
-plant's implicit PD compares it. A
-control loop that re-integrates its command from the measured hand (``p = y + v dt``,
-as PBP and teleoperation do) thus moves the hand at ``v``, and a hand sampled at a tick
-is the hand at that tick (the plant's output ports are live; see
-``validate_hsr_station_config``).
+Gravity is off (it stands for the real robot's gravity compensation). One differential
+IK solves the base and the arm together, so a target out of the arm's reach moves the
+base; its plan keeps every joint within its velocity and acceleration limits, and stiff
+servos hold the robot on it. The diff IK aims at where the ramped command is at the end of
+its step, the servos are given the plan where the plant's implicit PD compares it, and the
+output ports are live: a control loop that re-integrates its command from the measured
+hand (``p = y + v dt``) moves it at ``v`` (docs/tasks/hsr-station.md).
 
 Example::
 
@@ -42,16 +32,12 @@ Example::
 """
 
 import numpy as np
-from pydrake.math import RotationMatrix
-from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
-from pbp_drake.robots.hsr_ee_systems import (
-    EeCommandRamp, EeStateFromPlant, ee_state_at_rest, heading_of)
-from pbp_drake.robots.hsr_kinematic import (
-    add_kinematic_joints, add_kinematic_plant, hsr_couplers)
+from pbp_drake.robots.hsr_ee_systems import ee_state_at_rest, station_ramp
 from pbp_drake.robots.hsr_model import (
     ACTUATED_JOINT_NAMES,
     ARM_JOINT_NAMES,
@@ -63,7 +49,8 @@ from pbp_drake.robots.hsr_model import (
     add_hsr,
 )
 from pbp_drake.robots.hsr_pose_systems import HAND_FRAME, PoseCommandRamp, PoseStateFromPlant
-from pbp_drake.robots.station_parts import add_meshcat_visualizers, add_obstacles
+from pbp_drake.robots.station_parts import (
+    add_robot, add_station_plant, finish_station, initial_ee_state, pose_at, station_plant)
 from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
     CylinderObstacle,
     HsrStationConfig,
@@ -115,9 +102,7 @@ def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
 def _ready_pose(plant, model, config):
     """The ready positions of `config` (see `ready_positions`) and the hand's pose there."""
     q0 = ready_positions(plant, model, config.initial_base, config.ee_height)
-    context = plant.CreateDefaultContext()
-    plant.SetPositions(context, q0)
-    return q0, plant.GetFrameByName(END_EFFECTOR_FRAME, model).CalcPoseInWorld(context)
+    return q0, pose_at(plant, plant.GetFrameByName(END_EFFECTOR_FRAME, model), q0)
 
 
 def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp, look_ahead,
@@ -181,25 +166,18 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``); ``ee_state`` is
     ``[p (3), v (3), heading, heading_rate]`` (``EeState``) of the hand in the world.
     ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]`` the plant's PD
-    tracks, in motor order (``ACTUATED_JOINT_NAMES``; q_d is the diff IK's plan one plant
-    step ahead, where the implicit PD measures the positions); ``body_poses`` and
-    ``query_object`` are the plant's and SceneGraph's.
+    tracks, in motor order (``ACTUATED_JOINT_NAMES``; see ``WholeBodyDiffIk``);
+    ``body_poses`` and ``query_object`` are the plant's and SceneGraph's.
 
-    With ``config.motion == "kinematic"`` no plant is stepped: the joints are on the diff
-    IK's plan at every instant (``KinematicJoints``, whose ``state`` has the plant's
-    layout; ``desired_state`` is then the plan now), the plant is used outside the
-    Diagram for its kinematics and geometry (``hsr_station_plant`` returns it), and there
-    is no ``body_poses`` output. Every other port is the same. ``obstacle_positions`` is
-    ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the
-    smallest robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
-    The obstacles do not push the robot (their contact with it is filtered out).
+    With ``config.motion == "kinematic"`` the joints are on the plan (``KinematicJoints``;
+    ``hsr_station_plant`` returns the plant, outside the Diagram) and there is no
+    ``body_poses``. ``obstacle_positions`` is ``(N, 3)`` flattened, the centres of
+    ``config.obstacles``; ``clearance`` is the smallest robot-obstacle signed distance (m),
+    ``in_collision`` 1 when it is negative; the obstacles do not push the robot.
 
-    ``pose_command`` is ``[p (3), q (4), v (3), w (3)]`` (``PoseState``, world frame) of
-    ``hand_palm_link``: the pose to be at (at the next tick with ``control_period``) and
-    the twist to move at; a NaN field or a quaternion whose norm is off 1 by more than
-    1e-6 is refused by name. ``hand_pose`` is that frame's measured ``PoseState`` (its
-    quaternion signed nearer the start orientation). The diff IK is the same QP, tracking
-    the whole pose (see ``PoseCommandRamp`` and docs/concepts/six-dof.md).
+    ``pose_command`` is ``hand_palm_link``'s ``PoseState`` to be at (``PoseCommandRamp``,
+    docs/concepts/six-dof.md); a NaN field or a non-unit quaternion is refused by name.
+    ``hand_pose`` is that frame's measured ``PoseState`` (``PoseStateFromPlant``).
 
     A fresh context starts at rest in the ready pose with the diff IK already there, so
     holding ``hsr_initial_ee_state(station)[:7]`` keeps the robot still.
@@ -211,12 +189,8 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
                          f"{command!r}")
     builder = DiagramBuilder()
     kinematic = config.motion == "kinematic"
-    if kinematic:
-        plant, scene_graph = add_kinematic_plant(builder, config.plant.time_step)
-    else:
-        plant, scene_graph = AddMultibodyPlant(config.plant, builder)
+    plant, scene_graph = add_station_plant(builder, config, kinematic)
     model = add_hsr(plant)
-    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
     gains = zip(ACTUATED_JOINT_NAMES, config.base_kp + config.arm_kp,
                 config.base_kd + config.arm_kd)
     for name, kp, kd in gains:
@@ -226,11 +200,7 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
 
     q0, X_WE0 = _ready_pose(plant, model, config)
     plant.SetDefaultPositions(q0)
-    # R_E0 is the hand's orientation at heading 0, whatever the initial base yaw.
-    R_E0 = RotationMatrix.MakeZRotation(-heading_of(X_WE0.rotation())) @ X_WE0.rotation()
-
-    # The diff IK reads the command's pose as the one to have at the end of its step.
-    ramp = EeCommandRamp(R_E0, config.control_period, lead=config.diff_ik_time_step)
+    ramp = station_ramp(X_WE0, config)
     frame_name = END_EFFECTOR_FRAME
     if command == "pose":
         ramp = PoseCommandRamp(config.control_period, lead=config.diff_ik_time_step)
@@ -238,65 +208,37 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()
                     for index in plant.GetJointActuatorIndices(model)]
-    # The plant's PD measures its positions at the end of its step, so it is given the
-    # plan one step ahead; kinematic joints are on the plan now.
     look_ahead = 0.0 if kinematic else config.plant.time_step
     diff_ik = builder.AddNamedSystem("diff_ik", _make_diff_ik(
         plant, model, q0, config, motor_joints, ramp, look_ahead, frame_name))
-    if kinematic:
-        joints = add_kinematic_joints(builder, plant, scene_graph, motor_joints,
-                                      diff_ik.get_desired_state_output_port(),
-                                      hsr_couplers(plant, model))
-        state = joints.get_state_output_port()
-    else:
-        state = plant.get_state_output_port()
-        builder.Connect(diff_ik.get_desired_state_output_port(),
-                        plant.get_desired_state_input_port(model))
-    # Read at initialization only, so that the plan starts from the robot's state (no
-    # jump even if the caller moves the robot in the context).
-    builder.Connect(state, diff_ik.get_robot_state_input_port())
-
-    ee_body = plant.GetFrameByName(END_EFFECTOR_FRAME, model).body()
-    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, ee_body))
-    builder.Connect(state, ee_state.get_plant_state_input_port())
-
-    builder.ExportInput(diff_ik.get_command_input_port(), ramp.port_name)
-    builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
+    couplers = [(plant.GetJointByName(TORSO_JOINT_NAME, model),
+                 plant.GetJointByName("arm_lift_joint", model), TORSO_TO_ARM_LIFT_RATIO)]
+    state = add_robot(
+        builder, plant, scene_graph, model, diff_ik, ramp,
+        plant.GetFrameByName(END_EFFECTOR_FRAME, model).body(), motor_joints,
+        diff_ik.get_desired_state_output_port() if kinematic else None, couplers)
     if command == "pose":
         _add_hand_pose(builder, plant, model, q0, state)
     builder.ExportOutput(state, "state")
     builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
     if not kinematic:
         builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
-    builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
-    if config.obstacles:
-        add_obstacles(builder, plant, scene_graph, model, config.obstacles)
-    if meshcat is not None:
-        add_meshcat_visualizers(builder, scene_graph, meshcat, config.visualization)
-    station = builder.Build()
-    station.set_name("hsr_station")
-    return station
+    return finish_station(builder, plant, scene_graph, model, config, meshcat, "hsr_station")
 
 
 def _add_hand_pose(builder, plant, model, q0, state):
     """The output hand_pose: hand_palm_link's PoseState (from the robot's `state`),
     signed nearer its start."""
     frame_H = plant.GetFrameByName(HAND_FRAME, model)
-    context = plant.CreateDefaultContext()
-    plant.SetPositions(context, q0)
-    q_start = frame_H.CalcPoseInWorld(context).rotation().ToQuaternion().wxyz()
+    q_start = pose_at(plant, frame_H, q0).rotation().ToQuaternion().wxyz()
     hand_pose = builder.AddNamedSystem("hand_pose", PoseStateFromPlant(plant, frame_H,
                                                                        q_start))
     builder.Connect(state, hand_pose.get_plant_state_input_port())
     builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
 
 
-def hsr_station_plant(station: Diagram) -> MultibodyPlant:
-    """The MultibodyPlant of a station from ``make_hsr_station``: its subsystem ``plant``
-    (dynamic), or the kinematic joints' plant, which is outside the Diagram."""
-    if station.HasSubsystemNamed("plant"):
-        return station.GetSubsystemByName("plant")
-    return station.GetSubsystemByName("joints").plant()
+hsr_station_plant = station_plant
+hsr_initial_ee_state = initial_ee_state
 
 
 def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:
@@ -308,12 +250,6 @@ def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:
     model = add_hsr(plant)
     plant.Finalize()
     return ee_state_at_rest(_ready_pose(plant, model, config)[1])
-
-
-def hsr_initial_ee_state(station: Diagram) -> np.ndarray:
-    """The hand's ``ee_state`` (``EeState``) where ``station`` (from ``make_hsr_station``)
-    starts: read off a fresh context, so nothing is built twice."""
-    return np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))
 
 
 def hsr_initial_hand_pose(station: Diagram) -> np.ndarray:

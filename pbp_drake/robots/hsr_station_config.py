@@ -23,7 +23,7 @@ MOTIONS = ("dynamic", "kinematic")
 
 def default_station_plant_config():
     # SAP enforces the torso's coupler constraint and applies the motors' PD implicitly.
-    # Live output ports: see validate_hsr_station_config.
+    # Live output ports: see validate_station.
     return MultibodyPlantConfig(time_step=0.005, discrete_contact_approximation="sap",
                                 use_sampled_output_ports=False)
 
@@ -120,17 +120,10 @@ class HsrStationConfig:
 
 def validate_hsr_station_config(config: HsrStationConfig) -> None:
     """Raises ValueError naming the first field of ``config`` that cannot work."""
-    if config.motion not in MOTIONS:
-        raise ValueError(f"HsrStationConfig.motion must be one of {MOTIONS}, got "
-                         f"{config.motion!r}")
-    time_step = config.plant.time_step
-    if not time_step > 0:
-        raise ValueError(f"HsrStationConfig.plant.time_step must be positive (a discrete "
-                         f"plant enforces the torso coupler), got {time_step}")
+    validate_station(config, "HsrStationConfig")
     if config.plant.discrete_contact_approximation == "tamsi":
         raise ValueError("HsrStationConfig.plant.discrete_contact_approximation 'tamsi' "
                          "ignores the torso coupler; use 'sap' or 'lagged'")
-    validate_station_timing(config, "HsrStationConfig")
     if len(config.initial_base) != 3 or not np.all(np.isfinite(config.initial_base)):
         raise ValueError(f"HsrStationConfig.initial_base must be finite [x, y, yaw], got "
                          f"{config.initial_base}")
@@ -146,23 +139,19 @@ def validate_hsr_station_config(config: HsrStationConfig) -> None:
     if not config.arm_centering_gain >= 0:
         raise ValueError(f"HsrStationConfig.arm_centering_gain must be >= 0, got "
                          f"{config.arm_centering_gain}")
-    validate_station_obstacles(config, "HsrStationConfig")
 
 
-def validate_station_obstacles(config, name):
-    """Each of a station config's (`name`: its class) cylinders has a positive radius and
-    height. Raises ValueError naming the obstacle."""
-    for index, obstacle in enumerate(config.obstacles):
-        if not (obstacle.radius > 0 and obstacle.height > 0):
-            raise ValueError(f"{name}.obstacles[{index}] needs a positive radius and height, "
-                             f"got {obstacle}")
-
-
-def validate_station_timing(config, name):
-    """The timing every station config (`name`: its class) shares: live output ports, a
-    diff IK period a whole multiple of the plant's step, a positive command period or
-    None. Raises ValueError naming the field."""
+def validate_station(config, name):
+    """The fields every station config (`name`: its class) shares: the motion, a discrete
+    plant with live output ports, a diff IK period a whole multiple of the plant's step, a
+    positive command period or None, obstacles of positive size. Raises ValueError naming
+    the field."""
+    if config.motion not in MOTIONS:
+        raise ValueError(f"{name}.motion must be one of {MOTIONS}, got {config.motion!r}")
     time_step = config.plant.time_step
+    if not time_step > 0:
+        raise ValueError(f"{name}.plant.time_step must be positive (a discrete plant), got "
+                         f"{time_step}")
     if config.plant.use_sampled_output_ports:
         # Sampled ports are refreshed by the plant's step, an unrestricted update, which
         # Drake applies before the discrete updates of the same instant: a control loop
@@ -177,3 +166,7 @@ def validate_station_timing(config, name):
     if config.control_period is not None and not config.control_period > 0:
         raise ValueError(f"{name}.control_period must be positive or None, got "
                          f"{config.control_period}")
+    for index, obstacle in enumerate(config.obstacles):
+        if not (obstacle.radius > 0 and obstacle.height > 0):
+            raise ValueError(f"{name}.obstacles[{index}] needs a positive radius and height, "
+                             f"got {obstacle}")

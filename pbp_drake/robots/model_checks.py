@@ -2,25 +2,11 @@
 file's XML alone: what would hang, fail at build or mid-run, or print unreadable names.
 
 `check_model_file` reads the file (at most MAX_MODEL_FILE_BYTES, UTF-8 XML without a
-DOCTYPE) and refuses, naming the file, the element and its field:
-
-- names (of links, joints, geometries, ...) holding control characters or invisible
-  formatting marks (NUL, newlines, right-to-left marks);
-- a link that hangs from two joints, and joints that close a loop;
-- meshes and textures that are missing, or that need the network (any URL, and Drake's
-  remote package://drake_models); ours live in models/ (package://pbp_drake_models/...);
-- masses and inertias that are not finite numbers, and negative masses; with
-  ``motion: dynamic`` also inertias that are not physical (a negative principal moment, or
-  one larger than the other two together) and joints that move no mass at all.
-
-What needs more than the file is checked elsewhere: the scene's objects inside the
-geometry the model fixes to its base (`pbp_drake.robots.model_geometry`), and, for dynamic
-motion, a mass matrix that is singular in the ready configuration
-(`pbp_drake.robots.arm_model`).
-
-Names are shown through `printable`, which escapes what a terminal would act on. Every
-refusal is one line: a ValueError whose message starts with the config's field and the
-file.
+DOCTYPE) and refuses names holding control characters or invisible formatting marks; a
+link hanging from two joints, and loops; meshes and textures missing or behind the network;
+masses and inertias not finite, negative masses, and with ``motion: dynamic`` inertias not
+physical and joints that move no mass. Each refusal is a one-line ValueError starting with
+the config's field and the file, naming the element; names go through `printable`.
 """
 
 import dataclasses

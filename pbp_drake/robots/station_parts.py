@@ -1,10 +1,14 @@
-"""What every station has besides its robot: the obstacles measured against the robot and
-the Meshcat visualizers (the HSR's and an arm's stations share them)."""
+"""What the HSR's and an arm's stations share: the plant, the robot on the diff IK's plan
+and its `ee_state`, the obstacles measured against the robot, the Meshcat visualizers."""
 
+import numpy as np
 from pydrake.geometry import (
     CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Rgba,
     Role)
+from pydrake.multibody.plant import AddMultibodyPlant
 
+from pbp_drake.robots.hsr_ee_systems import EeStateFromPlant
+from pbp_drake.robots.hsr_kinematic import add_kinematic_joints, add_kinematic_plant
 from pbp_drake.systems.tasks.collision_monitor import CollisionMonitor
 from pbp_drake.systems.tasks.obstacle_geometry import CylinderObstacleGeometry
 
@@ -52,3 +56,74 @@ def add_meshcat_visualizers(builder, scene_graph, meshcat, visualization):
             default_color=Rgba(color.r(), color.g(), color.b(),
                                visualization.initial_proximity_alpha),
             delete_on_initialization_event=visualization.delete_on_initialization_event))
+
+
+def add_station_plant(builder, config, kinematic):
+    """`(plant, scene_graph)` of a station's robot, its gravity off (which stands for the
+    real robot's gravity compensation): the plant of `config.plant` in `builder`, or with
+    `kinematic` one outside it (`add_kinematic_plant`)."""
+    if kinematic:
+        plant, scene_graph = add_kinematic_plant(builder, config.plant.time_step)
+    else:
+        plant, scene_graph = AddMultibodyPlant(config.plant, builder)
+    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
+    return plant, scene_graph
+
+
+def pose_at(plant, frame, q):
+    """The world pose of `frame` with the plant at positions `q`."""
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q)
+    return frame.CalcPoseInWorld(context)
+
+
+def add_robot(builder, plant, scene_graph, model, diff_ik, ramp, ee_frame, motor_joints,
+              joints_input=None, couplers=()):
+    """The robot on the diff IK's plan and its `ee_state` (of `ee_frame`, a body or a
+    frame): with `joints_input` (a port of `[q, v]` of `motor_joints`) `KinematicJoints`
+    there, else the plant's PD tracking the plan. Exports the command input
+    (`ramp.port_name`) and `ee_state`; returns the robot's state port, which the diff IK
+    starts from."""
+    if joints_input is not None:
+        joints = add_kinematic_joints(builder, plant, scene_graph, motor_joints, joints_input,
+                                      couplers)
+        state = joints.get_state_output_port()
+    else:
+        state = plant.get_state_output_port()
+        builder.Connect(diff_ik.get_desired_state_output_port(),
+                        plant.get_desired_state_input_port(model))
+    # Read at initialization only: the plan starts from the robot's state.
+    builder.Connect(state, diff_ik.get_robot_state_input_port())
+    ee_state = builder.AddNamedSystem("ee_state", EeStateFromPlant(plant, ee_frame))
+    builder.Connect(state, ee_state.get_plant_state_input_port())
+    builder.ExportInput(diff_ik.get_command_input_port(), ramp.port_name)
+    builder.ExportOutput(ee_state.get_ee_state_output_port(), "ee_state")
+    return state
+
+
+def finish_station(builder, plant, scene_graph, model, config, meshcat, name):
+    """Exports `query_object`, adds `config.obstacles` and, with `meshcat`, the
+    visualizers, and builds the station Diagram named `name`."""
+    builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
+    if config.obstacles:
+        add_obstacles(builder, plant, scene_graph, model, config.obstacles)
+    if meshcat is not None:
+        add_meshcat_visualizers(builder, scene_graph, meshcat, config.visualization)
+    station = builder.Build()
+    station.set_name(name)
+    return station
+
+
+def station_plant(station):
+    """The MultibodyPlant of a station from `make_hsr_station` or `make_arm_station`: its
+    subsystem ``plant`` (dynamic), or the kinematic joints' plant, which is outside the
+    Diagram."""
+    if station.HasSubsystemNamed("plant"):
+        return station.GetSubsystemByName("plant")
+    return station.GetSubsystemByName("joints").plant()
+
+
+def initial_ee_state(station):
+    """The hand's ``ee_state`` (``EeState``) where a station (`make_hsr_station`,
+    `make_arm_station`) starts: read off a fresh context."""
+    return np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))

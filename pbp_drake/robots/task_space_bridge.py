@@ -10,21 +10,14 @@ named ``task_space_bridge`` with a station's two ports::
     PBP_EE_STATE (lcmt_drake_signal: x y z vx vy vz heading heading_rate)
         ─► LcmSubscriberSystem ─► BridgeLink ─► ee_state
 
-``make_station_relay(station, lcm, config)`` is the robot's side around any Drake station
-(what the tests run, and what a ROS relay does with the robot's own topics): it passes
-each ``PBP_EE_COMMAND`` to the station's ``ee_command`` as it comes and streams its
-``ee_state`` on ``PBP_EE_STATE`` faster than the control loop.
-
-``make_bridged_station(config, initial_ee_state, control_period, robot_side=None)`` is
-what a run uses (``robot: !Hsr {hardware: {...}}``, ``pbp-drake run --hardware``): the
-bridge on ``config.lcm_bus``, or with ``config.driver_sim`` the bridge and the relay around
-``robot_side`` (the simulated station) in one Diagram on a memq:// bus of their own.
+``make_station_relay`` is the robot's side around any Drake station (what a ROS relay does
+with the robot's topics), ``make_bridged_station`` what a run uses (``pbp-drake run
+--hardware``, with ``--driver-sim`` the relay around the simulated station in-process).
 
 `BridgeLink` keeps the arm drivers' rules where they apply to any robot: nothing is sent
-before a fresh state, and a state silent for `status_timeout`, of the wrong size or with a
-NaN ends the run with `DriverError` and sends nothing more (the relay should then hold the
-robot), and so does a first state whose hand stands farther than `start_tolerance` from
-where the run was built to start. Each message is stamped (`timestamp`, microseconds) on the
+before a fresh state; a state silent for `status_timeout`, of the wrong size or with a
+NaN, or a first state farther than `start_tolerance` from the run's start, ends the run
+with `DriverError` and sends nothing more. Messages are stamped (`timestamp`, µs) on the
 simulation's clock.
 """
 
@@ -38,8 +31,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
 from pbp_drake.robots.arm_driver import DriverError, check_heard
-from pbp_drake.robots.arm_station_config import (
-    DEFAULT_LCM_URL, check_lcm_url, check_positive)
+from pbp_drake.robots.arm_station_config import DEFAULT_LCM_URL, validate_link
 from pbp_drake.systems.ports import EeCommand, EeState
 from pbp_drake.systems.tick import report_offset
 
@@ -76,16 +68,12 @@ class TaskSpaceBridgeConfig:
 
 def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
     """Raises ValueError naming the first field of `config` that cannot work."""
-    check_lcm_url(config.lcm_bus.lcm_url, "TaskSpaceBridgeConfig.lcm_bus.lcm_url")
     for name in ("command_channel", "state_channel"):
         if not isinstance(getattr(config, name), str) or not getattr(config, name):
             raise ValueError(f"TaskSpaceBridgeConfig.{name} must be a channel name, got "
                              f"{getattr(config, name)!r}")
-    check_positive(config, ("status_timeout", "connect_timeout", "start_tolerance"),
-                   "TaskSpaceBridgeConfig")
-    if config.driver_sim and not config.connect:
-        raise ValueError("TaskSpaceBridgeConfig.driver_sim needs connect (pbp-drake run "
-                         "--hardware --driver-sim)")
+    validate_link(config, "TaskSpaceBridgeConfig",
+                  ("status_timeout", "connect_timeout", "start_tolerance"))
 
 
 def signal(values, names, time):
@@ -263,9 +251,6 @@ def make_bridged_station(config: TaskSpaceBridgeConfig, initial_ee_state, contro
     validate_task_space_bridge(config)
     builder = DiagramBuilder()
     if config.driver_sim:
-        if robot_side is None:
-            raise ValueError("TaskSpaceBridgeConfig.driver_sim needs the robot's side: the "
-                             "simulated station")
         lcm = DrakeLcm("memq://")
         builder.AddNamedSystem("robot_side", make_station_relay(
             robot_side, lcm, config, initial_ee_state))

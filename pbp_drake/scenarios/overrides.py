@@ -51,7 +51,7 @@ class ScenarioOverrides:
 
     def overlay(self):
         """The overrides as one YAML document of the file's shape ({"scenario": ...,
-        "study": ...}), which `apply` merges onto the file's."""
+        "study": ...}), to merge onto the file's (`merged`)."""
         overlay = {}
         if self.text is not None:
             overlay = _file_shaped(_text_overlay(self.text))
@@ -64,11 +64,6 @@ class ScenarioOverrides:
                 nested = {name: nested}
             overlay = merged(overlay, nested)
         return overlay
-
-    def apply(self, document):
-        """The file's parsed YAML `document` (`bounds.load_document`) with the overrides
-        merged onto it."""
-        return merged(document, self.overlay())
 
 
 def parse_setting(setting):

@@ -123,11 +123,6 @@ def _narrowest(source):
     return best[1]
 
 
-def default_output(scenario_path):
-    """Where the drawing of a scenario file goes: beside it, `.svg` for `.yaml`."""
-    return pathlib.Path(scenario_path).with_suffix(".svg")
-
-
 def build_parser():
     """The argument parser of `pbp-drake draw` (the CLI reference is generated from it)."""
     parser = argparse.ArgumentParser(
@@ -177,9 +172,7 @@ def main(argv=None):
         if args.output == "-":
             sys.stdout.buffer.write(data)
             continue
-        output = pathlib.Path(args.output) if args.output else default_output(path)
-        if args.format == "dot" and not args.output:
-            output = output.with_suffix(".dot")
+        output = pathlib.Path(args.output or pathlib.Path(path).with_suffix(f".{args.format}"))
         if args.check:
             if not output.is_file() or output.read_bytes() != data:
                 stale.append(output)

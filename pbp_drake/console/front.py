@@ -354,11 +354,9 @@ class PageFront:
                 return
             self._closed = True
         unregister_front(self._meshcat_port, self)
-        try:
+        with contextlib.suppress(concurrent.futures.TimeoutError):
             asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(
                 4 * CLOSE_TIMEOUT + 5.0)
-        except concurrent.futures.TimeoutError:
-            pass
         self._loop.call_soon_threadsafe(self._loop.stop)
         self._thread.join(5.0)
         if not self._thread.is_alive():
@@ -368,17 +366,15 @@ class PageFront:
     def __enter__(self):
         return self
 
+    def __exit__(self, *exc_info):
+        self.close()
+
     def _wake_relays(self):
         def wake():
             for waker in self._wakers:
                 waker.set()
-        try:
+        with contextlib.suppress(RuntimeError):  # the loop is closed: no relay to wake
             self._loop.call_soon_threadsafe(wake)
-        except RuntimeError:  # the loop is closed: no relay to wake
-            pass
-
-    def __exit__(self, *exc_info):
-        self.close()
 
     def _fetch_page(self):
         # Meshcat's page, its script (wherever the page says: Drake 1.51 serves it at a

@@ -23,37 +23,29 @@ __version__ = "0.1.0"
 # and the API reference all read it.
 API_GROUPS = {
     "DMP math (NumPy)": {
-        "Dmp": "pbp_drake.core.dmp",
-        "DmpBankModel": "pbp_drake.core.dmp",
-        "DmpSettings": "pbp_drake.core.dmp",
-        "minimum_jerk": "pbp_drake.core.dmp",
+        **{name: "pbp_drake.core.dmp" for name in [
+            "Dmp", "DmpBankModel", "DmpSettings", "minimum_jerk"]},
         **{name: "pbp_drake.core.dmp.primitive" for name in [
             "Primitive", "teach_primitive", "primitive_bank", "primitive_orientation_bank",
             "primitive_document", "read_primitive_document"]},
-        "OrientationDmp": "pbp_drake.core.dmp",
-        "OrientationDmpBank": "pbp_drake.core.dmp",
+        **{name: "pbp_drake.core.dmp" for name in ["OrientationDmp", "OrientationDmpBank"]},
         "GoalEstimatorSettings": "pbp_drake.core.goal_estimation",
         "quaternion": "pbp_drake.core",
-        "HandOverLimits": "pbp_drake.core.pose_arbitration",
-        "PoseReference": "pbp_drake.core.pose_arbitration",
-        "blend_pose": "pbp_drake.core.pose_arbitration",
-        "pose_hand_over": "pbp_drake.core.pose_arbitration",
+        **{name: "pbp_drake.core.pose_arbitration" for name in [
+            "HandOverLimits", "PoseReference", "blend_pose", "pose_hand_over"]},
         "VirtualParticipantParams": "pbp_drake.core.participant_params",
         "ParticipantImpairment": "pbp_drake.core.participant_impairment",
         "GraspParticipantParams": "pbp_drake.core.participant_grasp",
     },
     "Methods and goal estimators (registries)": {
-        "Method": "pbp_drake.core.methods",
-        "register_method": "pbp_drake.core.methods",
-        "Estimator": "pbp_drake.core.goal_estimation",
-        "register_estimator": "pbp_drake.core.goal_estimation",
+        **{name: "pbp_drake.core.methods" for name in ["Method", "register_method"]},
+        **{name: "pbp_drake.core.goal_estimation" for name in [
+            "Estimator", "register_estimator"]},
         "IntentFilterSettings": "pbp_drake.core.intent_filter",
     },
     "Shared-autonomy baselines (HOP, predict-then-assist)": {
-        "HopSettings": "pbp_drake.core.hindsight_optimization",
-        "hop_targets": "pbp_drake.core.hindsight_optimization",
-        "update_posterior": "pbp_drake.core.hindsight_optimization",
-        "assisted_command": "pbp_drake.core.hindsight_optimization",
+        **{name: "pbp_drake.core.hindsight_optimization" for name in [
+            "HopSettings", "hop_targets", "update_posterior", "assisted_command"]},
         **{name: "pbp_drake.systems.pbp" for name in [
             "MaxEntGoalEstimator", "HopAssistance", "PoseMaxEntGoalEstimator",
             "PoseHopAssistance"]},
@@ -85,15 +77,10 @@ API_GROUPS = {
             "EeState", "EeCommand", "OperatorCommand", "Target", "TaskStatus", "PoseState",
             "OperatorTwist"]},
     "The HSR": {
-        "make_hsr_station": "pbp_drake.robots",
-        "HsrStationConfig": "pbp_drake.robots",
-        "add_hsr": "pbp_drake.robots",
-        "CylinderObstacle": "pbp_drake.robots",
-        "hsr_station_plant": "pbp_drake.robots",
-        "hsr_initial_ee_state": "pbp_drake.robots",
-        "hsr_initial_hand_pose": "pbp_drake.robots",
-        "hsr_ready_ee_state": "pbp_drake.robots",
-    },
+        name: "pbp_drake.robots" for name in [
+            "make_hsr_station", "HsrStationConfig", "add_hsr", "CylinderObstacle",
+            "hsr_station_plant", "hsr_initial_ee_state", "hsr_initial_hand_pose",
+            "hsr_ready_ee_state"]},
     "Your own arm": {
         **{name: "pbp_drake.robots" for name in [
             "make_arm_station", "ArmStationConfig", "arm_initial_ee_state", "arm_reach",
@@ -121,11 +108,9 @@ API_GROUPS = {
             "build_diagram", "make_pbp_controller", "find_system", "simulate", "run_task",
             "TaskResult"]},
     "The 2-D scenes": {
-        "bent_path": "pbp_drake.core.toy_scene",
-        "collision_ratio": "pbp_drake.core.toy_scene",
-        "scene_scenario": "pbp_drake.studies.toy",
-        "phase_progress": "pbp_drake.studies.toy",
-        "run_study": "pbp_drake.studies.toy",
+        **{name: "pbp_drake.core.toy_scene" for name in ["bent_path", "collision_ratio"]},
+        **{name: "pbp_drake.studies.toy" for name in [
+            "scene_scenario", "phase_progress", "run_study"]},
     },
     "Studies and the console": {
         "run_method_comparison": "pbp_drake.studies.comparison",
@@ -135,9 +120,7 @@ API_GROUPS = {
         "load_task_result": "pbp_drake.studies.trial_files",
         "interaction_metrics": "pbp_drake.core.interaction_metrics",
         "InteractionMetrics": "pbp_drake.core.interaction_metrics",
-        "Console": "pbp_drake.console",
-        "LiveRun": "pbp_drake.console",
-        "PageFront": "pbp_drake.console",
+        **{name: "pbp_drake.console" for name in ["Console", "LiveRun", "PageFront"]},
     },
 }
 _PUBLIC = {name: module for group in API_GROUPS.values() for name, module in group.items()}

@@ -1,9 +1,7 @@
-"""Checks of the command line's output paths, made before anything is built or simulated:
-`run --record FILE.html`, `run --log FILE.csv`, `run --output DIR`, `study --output DIR` and
-`teach --output FILE.json`. A path that cannot be written is a user error (a ScenarioError:
-`pbp-drake: ...`, exit 2), not a lost run.
-And the replay a `--record` writes (`mark_replay`): marked as ours, paused at its start, with a
-key."""
+"""Checks of the command line's output paths (`--record`, `--log`, `--output`, `--figure`),
+made before anything is built or simulated: a path that cannot be written is a user error
+(`OutputPathError`, exit 2), not a lost run. And the replay a `--record` writes
+(`mark_replay`)."""
 
 import base64
 import html as html_text
@@ -65,12 +63,10 @@ def recorded_replay(meshcat):
 
 def mark_replay(html):
     """The replay `html` (Meshcat's StaticHtml) as `pbp-drake run --record` saves it: with
-    REPLAY_MARKER after its doctype, so that a later run may overwrite it; starting paused
-    at 0 s (PAUSED_AT_START), because Meshcat plays a recording as soon as it loads and a
-    page that loads slowly misses a short run; with a line saying how to play it; and, for
-    a 2-D scene, a key of its colours (SCENE_2D_LEGEND), which Meshcat cannot draw in the
-    scene, having no text. A page without Meshcat's viewer line keeps its playback (and
-    gets no hint)."""
+    REPLAY_MARKER; starting paused at 0 s (PAUSED_AT_START: a page that loads slowly would
+    miss a short run), with a line saying how to play it; and, for a 2-D scene, a key of
+    its colours (SCENE_2D_LEGEND: Meshcat has no text). A page without Meshcat's viewer
+    line keeps its playback (and gets no hint)."""
     viewer_line = _VIEWER_LINE.search(html)
     if viewer_line:
         html = html[:viewer_line.end()] + PAUSED_AT_START + html[viewer_line.end():]
@@ -152,22 +148,20 @@ def _head_holds(path, marker):
 
 
 def check_record_path(path, force=False):
-    """Raises OutputPathError unless `path` can take a replay: not a folder, its folder
-    exists or can be made and is writable, and an existing file there is a previous replay
-    (or `force` is set)."""
+    """Raises OutputPathError unless `path` can take a replay: a writable file, an existing
+    one a previous replay unless `force`."""
     _check_output_file(path, "--record", "replay.html", is_replay, "a replay", force)
 
 
 def check_log_path(path, force=False):
-    """Raises OutputPathError unless `path` can take a run's per-tick CSV: not a folder, its
-    folder exists or can be made and is writable, and an existing file there is a previous
-    time series CSV (its header is the trial CSV's) or `force` is set."""
+    """Raises OutputPathError unless `path` can take a run's per-tick CSV: a writable file,
+    an existing one a time series (the trial CSV's header) unless `force`."""
     _check_output_file(path, "--log", "run.csv", _is_time_series, "a time series", force)
 
 
 def check_primitive_path(path, force=False):
     """Raises OutputPathError unless `path` can take a taught primitive (`teach --output`):
-    as `check_log_path`, an existing file there a primitive or `force` set."""
+    a writable file, an existing one a primitive unless `force`."""
     _check_output_file(path, "--output", "primitive.json", _is_primitive, "a primitive", force)
 
 
@@ -186,10 +180,9 @@ def _is_primitive(path):
 
 
 def _check_output_file(path, flag, example, is_ours, kind, force):
-    """The checks the output files share: `path` is not a folder (`example` names a file
-    in it), an existing file there is one `is_ours` recognises (`kind`, written by
-    pbp-drake) or `force` is set (then `is_ours` is not asked), and it or its folder is
-    writable."""
+    """The checks of an output file: `path` is not a folder (`example` names a file in it),
+    it or its folder (existing or to be made) is writable, and an existing file there is
+    one `is_ours` recognises (`kind`, written by pbp-drake) or `force` is set."""
     file = pathlib.Path(path)
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "

@@ -1,23 +1,13 @@
 """The operator's console: what a person at the Meshcat page sees of a run and can do.
 
-Three layers, each usable alone, and a session's pages:
-
-- `pbp_drake.console.text`: the words, as pure functions of numbers (`method_name`,
-  `status_text` "time left 41 s · 2 target switches · intervention 31 %", `result_text`
-  "success in 14.2 s" / "failed: time limit" / "stopped at 9.0 s", `progress_text`).
-- `Console` (`pbp_drake.console.page`): the page's controls. Choice buttons (Stop,
-  Restart, Next scene), optional alpha and real-time-rate sliders, and four lines of
-  text (title, status, result, notice) in the page front's panel, or shown as button
-  labels on a bare Meshcat, which has no text.
-  `choice()` polls, `wait_for_choice()` blocks.
+- `pbp_drake.console.text`: the words, as pure functions of numbers (`status_text`,
+  `result_text`, ...).
+- `Console` (`pbp_drake.console.page`): the page's buttons, sliders and lines of text.
 - `LiveRun` (`pbp_drake.console.live`): a running simulation feeding a Console, a
-  `RobotCamera` and the terminal's `Progress`; its `advance` is the `advance` argument of
-  `pbp_drake.builder.run_task` (and `run_task_streamed`, `simulate`).
-- `pbp_drake.console.questionnaire`: a user-study session's pages (Start, the two
-  questions, Next) and `FixedAnswers` for unattended sessions.
-- `PageFront` (`pbp_drake.console.front`): the page behind a front of our own, which lets
-  in only the holder of the run's secret URL, relays Meshcat to a slow page at the rate it
-  draws, and shows the console's lines in a panel of its own (`Console(..., panel=front)`).
+  `RobotCamera` and the terminal's `Progress`.
+- `pbp_drake.console.questionnaire`: a user-study session's pages.
+- `PageFront` (`pbp_drake.console.front`): the page behind a front of our own, open only to
+  the holder of the run's secret URL, with the console's lines in a panel of its own.
 
 A minimal loop (the thread that made `meshcat`; with `front = PageFront(meshcat.port())`,
 open `front.url` and pass `panel=front` to the Console)::

@@ -9,10 +9,8 @@ from pbp_drake.robots.hsr_station import hsr_station_plant
 CAMERAS = ("overview", "robot")
 
 # High above and a little behind the head, looking down past it at the hand and on to the
-# objects, as a person standing behind the robot would see them (metres). From lower and
-# further back (1.1 m behind and 0.85 m above the head) the head and torso filled the middle
-# of the view and hid the hand; from here the line of sight to the hand passes over the head
-# all through a reaching task (tests/console/test_camera.py).
+# objects, as a person standing behind the robot would see them (metres): the line of sight
+# to the hand passes over the head all through a reaching task (tests/console/test_camera.py).
 BEHIND = 0.5
 ABOVE = 1.5
 # The point looked at: ahead of the head, low, so that the view runs from the hand to the

@@ -6,33 +6,21 @@ port and serves the public one itself: the page (Meshcat's, with our console pan
 and a websocket relay to Meshcat, only to a client that presents the run's secret token (in
 the URL as `?token=T`, as Jupyter does, then in a cookie) and, for the websocket, an
 `Origin` equal to the page's own. A refused request never reaches Meshcat: no upstream
-connection is opened for it; a request target not starting with `/` gets 400.
+connection is opened for it.
 
-The front is the only door. Meshcat's own port is shut to every connection but the
-front's (`meshcat_door`: a socket filter on Meshcat's listening socket, Linux), so no other
-program or page reaches it; where that cannot be done, the front says so in one line and
+The front is the only door: Meshcat's own port is shut to every other connection
+(`meshcat_door`, Linux); where it cannot be, the front says so in one line and
 `BrowserGuard` ignores what arrives while a connection the front did not open is there. A
 page's frames reach Meshcat only as a fresh encoding of one of the messages Meshcat's page
-sends (`page_messages`; Meshcat's parser takes the process down on a frame that is not
-msgpack); any other frame closes that page's websocket with code `BAD_FRAME_CLOSE` and the
-reason, a frame over `MAX_MESSAGE` bytes with 1009. A page's connection to Meshcat is closed
-when the page goes, whichever goes first; `pages()` counts the pages admitted,
-`pages_heard()` those that have sent a frame, which the guard's two-page pause counts
-(`register_front`). Accept errors (out of file descriptors) print one line a burst.
+sends (`page_messages`: Meshcat's parser takes the process down on a frame that is not
+msgpack); any other frame closes that page's websocket (`BAD_FRAME_CLOSE`). Toward a slow
+page, Meshcat's messages wait in a `PendingMessages` queue, sent in batches paced by the
+page (`FRAME`, `ACK`).
 
 The front never calls a Meshcat method (those belong to the thread that made the Meshcat);
 it talks to Meshcat's port over the network, from an asyncio loop on a daemon thread. Close
 the front before letting go of the Meshcat: Drake aborts the process when a Meshcat dies on
 another thread, and a Meshcat left in a reference cycle dies in whichever thread collects.
-
-- `new_token()`, `check_token(text)`: a fresh token; a `--token` checked (or ValueError).
-- `bind_page_port(port, host)`: the public port bound before anything is built (PortError).
-- `PageFront(meshcat_port, listen_socket=None, token=None, host="localhost")`: serving once
-  made; `url`, `port`, `token`, `door_shut`; `pages()`, `pages_heard()`, `own_connections()`,
-  `show(**lines)`, `state()`, `end(text)`, `close()`.
-- `PendingMessages`, `message_key` (from `pending_messages`): the relay's bounded queue
-  toward a slow page, which gets a batch of the latest poses and properties, ended by the text frame
-  `FRAME`, and the next batch once it has answered `ACK` at its next animation frame.
 
 An example (the thread that made `meshcat`)::
 
@@ -93,7 +81,8 @@ SEND_BUFFER = 2**15
 # batch of latest states a frame, and its main thread always has time for the panel. (A
 # client that never answers, not our page, is sent batches as fast as it reads.)
 FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
-# A page's bad frame: its websocket is closed with this code (policy violation) and a reason.
+# A page's bad frame: its websocket is closed with this code (policy violation) and a reason
+# (a frame over MAX_MESSAGE bytes: websockets' 1009).
 BAD_FRAME_CLOSE = 1008
 # Accept errors (out of file descriptors) closer together than this are one burst: one line.
 ACCEPT_BURST = 10.0
@@ -365,11 +354,9 @@ class PageFront:
                 return
             self._closed = True
         unregister_front(self._meshcat_port, self)
-        try:
+        with contextlib.suppress(concurrent.futures.TimeoutError):
             asyncio.run_coroutine_threadsafe(self._stop(), self._loop).result(
                 4 * CLOSE_TIMEOUT + 5.0)
-        except concurrent.futures.TimeoutError:
-            pass
         self._loop.call_soon_threadsafe(self._loop.stop)
         self._thread.join(5.0)
         if not self._thread.is_alive():
@@ -379,17 +366,15 @@ class PageFront:
     def __enter__(self):
         return self
 
+    def __exit__(self, *exc_info):
+        self.close()
+
     def _wake_relays(self):
         def wake():
             for waker in self._wakers:
                 waker.set()
-        try:
+        with contextlib.suppress(RuntimeError):  # the loop is closed: no relay to wake
             self._loop.call_soon_threadsafe(wake)
-        except RuntimeError:  # the loop is closed: no relay to wake
-            pass
-
-    def __exit__(self, *exc_info):
-        self.close()
 
     def _fetch_page(self):
         # Meshcat's page, its script (wherever the page says: Drake 1.51 serves it at a

@@ -66,22 +66,18 @@ class LiveRun:
     `Progress`, or None) from the simulation of `diagram`, a task of `duration` seconds.
 
     Pass `advance` as the `advance` argument of `run_task`, `run_task_streamed` or
-    `simulate`: it advances the simulator to the time asked in slices of `SLICE_SECONDS`
-    and, after each, shows the status (time left, and from the diagram's `task_monitor`,
-    when it has one, the target switches and intervention ratio so far), moves `camera`
-    (a `RobotCamera`, or None), applies the alpha slider to the `blender` (fixed_alpha) and
-    the real-time-rate slider to the simulator. A click on a choice button ends the run
-    there: `advance` returns True, and `choice` holds "stop", "restart" or "next".
+    `simulate`: after each slice of `SLICE_SECONDS` it shows the status (`status`), moves
+    `camera` (a `RobotCamera`, or None) and applies the alpha slider to the `blender`
+    (fixed_alpha) and the real-time-rate slider to the simulator. A click on a choice
+    button ends the run there: `advance` returns True, and `choice` holds "stop",
+    "restart" or "next".
 
-    With `start_label`, the first `advance` first shows a Start button of that label and
-    waits for it (`Console.wait_for_start`; Enter on `stdin` or Stop: the run ends after
-    its first slice, `choice` "stop"): the simulator has then been initialized, so the
-    scene went to the page before the button did, and the page shows the button once it
-    has handled the scene. The task's clock, simulated time, starts at the press: the
-    real-time pacing is restarted there.
-
-    With `gamepad`, a page that has seen no gamepad is told so (`NO_GAMEPAD`, in the
-    console's notice line and on stderr), and told again when one appears.
+    With `start_label`, the first `advance` shows a Start button of that label and waits
+    for it (`Console.wait_for_start`; Enter on `stdin` or Stop end the run after its first
+    slice, `choice` "stop"). The simulator is initialized by then, so the page has the
+    scene before the button; the real-time pacing restarts at the press. With `gamepad`,
+    a page that has seen no gamepad is told so (`NO_GAMEPAD`, in the console's notice
+    line and on stderr), and told again when one appears.
     """
 
     def __init__(self, diagram, duration, console=None, progress=None, camera=None,
@@ -130,7 +126,9 @@ class LiveRun:
         return context.get_time() < end_time
 
     def status(self, root_context):
-        """The status line at `root_context`'s time (`pbp_drake.console.text.status_text`)."""
+        """The status line at `root_context`'s time (`pbp_drake.console.text.status_text`):
+        the time left and, from the diagram's `task_monitor` when it has one, the target
+        switches and intervention ratio so far."""
         if self._monitor is None:
             return status_text(self._duration, root_context.get_time())
         status = TaskStatus(self._monitor.get_task_status_output_port().Eval(

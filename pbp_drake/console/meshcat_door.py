@@ -1,31 +1,21 @@
 """Meshcat's port shut to everyone but the page front: a filter on Meshcat's listening socket.
 
-Drake's Meshcat listens on a loopback port and lets in every HTTP request and websocket; it
-cannot be told to check a token or an origin (`MeshcatParams` has a host, a port and the URL
-pattern it prints, no more). But its listening socket is a file descriptor of this very
-process. On Linux a socket filter (a classic BPF program, `SO_ATTACH_FILTER`) on that
-listener sees each connection request before the kernel answers it, and this one drops every
-request but those of the front's own sockets: each is first bound to the listener's address
-and a port the kernel picks, which no other socket may then take (ours set neither
-`SO_REUSEADDR` nor `SO_REUSEPORT`), and the filter admits exactly those (address, port)
-pairs while they are the front's. Another program's `connect()` to Meshcat's port, or a
-page of any origin in a browser, gets no answer and times out: it never reaches Meshcat.
+Drake's Meshcat lets in every HTTP request and websocket on its loopback port; it cannot be
+told to check a token or an origin. But its listening socket is a file descriptor of this
+very process, and on Linux a socket filter (classic BPF, `SO_ATTACH_FILTER`) on it sees each
+connection request before the kernel answers. This one drops all but those of the front's
+own sockets: each is bound first to the listener's address and a port the kernel picks,
+which no other socket may take while it is bound (ours set neither `SO_REUSEADDR` nor
+`SO_REUSEPORT`), and the filter admits exactly those (address, port) pairs. Another
+program's `connect()`, or a page of any origin, gets no answer and times out.
 
-What holds: no local process and no web page reaches Meshcat but through the front, for as
-long as the door is shut (from `MeshcatDoor(port)` until the process ends: `close()` leaves
-it shut to everyone). What does not: a process that can read this one's memory or take its
-file descriptors (a debugger, `pidfd_getfd`: the same user with ptrace rights, or root) can
-do anything the run can; a connection Meshcat accepted before the door was shut stays (the
-page front counts Meshcat's connections against its own for that, see
+What holds: no local process and no web page reaches Meshcat but through the front, from
+`MeshcatDoor(port)` until the process ends (`close()` leaves the door shut to everyone).
+What does not: a process that can read this one's memory or take its file descriptors (the
+same user with ptrace rights, or root); a connection Meshcat accepted before the door was
+shut (the page front counts Meshcat's connections against its own for that, see
 `pbp_drake.systems.operators.browser_guard`). Where the door cannot be shut (not Linux,
-Meshcat in another process, on an address that is not loopback's), `shut` is False and
-`reason` says why; the front then works as before, and connections it did not open are
-treated as intruders by the guard.
-
-- `MeshcatDoor(port)`: finds Meshcat's listener and shuts it; `shut`, `reason`, `port`.
-- `connect(timeout)`: a socket connected to Meshcat through the door; `forget(port)` takes
-  its pair off the filter (before it closes), `release(sock)` also closes it.
-  `get(path)`: an HTTP GET through the door.
+Meshcat in another process or not on loopback alone), `shut` is False and `reason` says why.
 """
 
 import contextlib

@@ -1,12 +1,11 @@
-"""The operator's console in a Meshcat page: lines of text and buttons and sliders in the
-page's control panel.
+"""The operator's console in a Meshcat page: lines of text, buttons and sliders.
 
-Drake's Meshcat has no text primitive; what the control panel shows is the label of each
-button and slider. So, on a bare Meshcat, a line of text is a button whose label is the text
-(clicking it does nothing), replaced (deleted and added again) when the text changes. Behind
-the command line's page front (`pbp_drake.console.front.PageFront`) the lines go to the
-front's own panel instead, which goes to the page as its latest state, between the scene's
-batches: a slow page then never shows a stale status, however slowly it draws the scene.
+Drake's Meshcat has no text primitive; its control panel shows only the label of each button
+and slider. So, on a bare Meshcat, a line of text is a button labelled with the text
+(clicking it does nothing), replaced when the text changes. Behind the page front
+(`pbp_drake.console.front.PageFront`) the lines go to the front's own panel instead, sent to
+the page as its latest state between the scene's batches: a slow page never shows a stale
+status.
 """
 
 import select
@@ -38,24 +37,12 @@ class Console:
         panel: where the lines go instead of button labels: an object with `show(**lines)`
             taking `title`, `status`, `result` and `time` (a `PageFront`), or None.
 
-    The panel then shows, top to bottom: the choice buttons, the sliders, the title line
-    (`show_title`), the status line (`show_status`), the result line (`show_result`) and
-    the notice (`show_notice`).
-    Buttons added to the page by others (the keyboard operator's) stay above.
-
-    `wait_for_start(label)` shows a Start button labelled `label` and blocks until it is
-    clicked (or Stop is); `set_choices(choices)` replaces the choice buttons (after a run:
-    Restart, Next scene, Close).
-
-    Reading the person's choice:
-        `choice()` returns at once: the choice whose button was clicked since the last
-        choice returned (or since the console was made), else None; each click counts
-        once. `wait_for_choice()` blocks until a button is clicked (or Enter is pressed in
-        a terminal, or Ctrl-C: both "stop").
-
-    `close()` removes every control this console added, `remove_controls()` its buttons
-    and sliders only; a session that keeps one page for many runs makes one Console and
-    calls `show_title` / `show_status` / `clear_result` between runs instead.
+    The page's control panel then shows, top to bottom (below buttons others added, the
+    keyboard operator's): the choice buttons, the sliders, the title line (`show_title`),
+    the status line (`show_status`), the result line (`show_result`) and the notice
+    (`show_notice`). The person's choice is read with `choice()` (at once) or
+    `wait_for_choice()` (blocking). A session that keeps one page for many runs makes one
+    Console and calls `show_title` / `show_status` / `clear_result` between runs.
     """
 
     def __init__(self, meshcat, choices=("stop", "restart", "next"), alpha=None,

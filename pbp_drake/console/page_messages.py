@@ -1,13 +1,12 @@
 """What a run's page may send Meshcat: the messages Meshcat's own page sends, read strictly.
 
-Drake's Meshcat parses every binary frame a websocket brings with msgpack and, on bytes that
-are not msgpack (one `0xc1`, a truncated map, a header announcing a 4 GB string), its
-websocket thread dies and the run with it. So the page front reads each frame of the page
-here first, with a msgpack reader of our own that knows only what the page sends, and hands
-Meshcat a fresh encoding of what it read; anything else is a `BadMessage`, and the front
-closes that page's connection with the reason (never the run).
-
-What Meshcat's page sends (its `meshcat.html` and the callbacks Drake gives its controls):
+Drake's Meshcat parses every binary frame of a websocket with msgpack, and on bytes that are
+not msgpack (one `0xc1`, a truncated map, a header announcing a 4 GB string) its websocket
+thread dies, and the run with it. So the page front reads each frame of a page here first
+(`read_page_message`), with a msgpack reader of our own that knows only what the page sends,
+and hands Meshcat a fresh encoding of what it read; anything else is a `BadMessage`, and the
+front closes that page's connection (never the run). What Meshcat's page sends (its
+`meshcat.html` and the callbacks Drake gives its controls):
 
 - `{"type": "button", "name": N}`: a button clicked, or its key pressed;
 - `{"type": "slider", "name": N, "value": x}`: a slider moved (x finite);
@@ -18,8 +17,6 @@ What Meshcat's page sends (its `meshcat.html` and the callbacks Drake gives its 
 Limits: a frame of at most `MAX_MESSAGE` bytes, names of at most `MAX_NAME` bytes of UTF-8,
 at most `MAX_ITEMS` gamepad buttons or axes, no other key, no key twice, no trailing byte,
 no msgpack `bin`, `ext` or the never-used byte `0xc1`.
-
-- `read_page_message(frame)`: the message's fresh msgpack bytes, or BadMessage (why).
 """
 
 import math

@@ -1,10 +1,5 @@
-"""The relay's queue toward a slow page: Meshcat's messages waiting, bounded by what they
-set, not by time (see `pbp_drake.console.front`, which re-exports both names).
-
-- `message_key(message)`: what a message sets (a body's pose, one property, the real-time
-  rate), or None for a barrier.
-- `PendingMessages`: the queue, where a keyed message replaces its pending predecessor of
-  the same key and nothing moves across a barrier.
+"""The relay's queue toward a slow page (`pbp_drake.console.front`): Meshcat's messages
+waiting, bounded by what they set (`message_key`), not by time (`PendingMessages`).
 """
 
 import collections

@@ -1,12 +1,8 @@
-"""The pages of a user-study session in the Meshcat control panel: before each method a Start
-button that names it, after it the paper's two questions as six buttons each (0 to 5, both
-ends labelled in words: "0 = very tired", "5 = not tired at all"), then a Next button.
-`FixedAnswers` is the same flow without a browser, for the virtual operator (`--answers`).
-
-Both are driven by `studies.sessions.run_session` through three calls: `start`, `answer`,
-`next`. Meshcat's controls are polled from the thread that made the Meshcat (Drake's rule);
-each page's buttons are deleted before the next page shows, so a click meant for one page
-cannot answer another.
+"""The pages of a user-study session in the Meshcat control panel (`MeshcatSessionPage`):
+before each method a Start button that names it, after it the paper's two questions as six
+buttons each, then a Next button. `FixedAnswers` is the same flow without a browser, for the
+virtual operator (`--answers`). Both are driven by `studies.sessions.run_session` through
+three calls: `start`, `answer`, `next`.
 """
 
 import time
@@ -43,8 +39,10 @@ def next_label(position, total):
 
 
 class MeshcatSessionPage:
-    """The session's pages in a Meshcat's control panel (a person clicks; nothing times out,
-    Ctrl-C in the terminal stops the session, which the same command resumes)."""
+    """The session's pages in a Meshcat's control panel, polled from the thread that made
+    the Meshcat (a person clicks; nothing times out, Ctrl-C in the terminal stops the
+    session, which the same command resumes). Each page's buttons are deleted before the
+    next page shows, so a click meant for one page cannot answer another."""
 
     def __init__(self, meshcat, poll_period=POLL_PERIOD):
         self._meshcat = meshcat

@@ -3,15 +3,11 @@
 Drake's `yaml_load_typed` parses with PyYAML's pure-Python loader (about 5 s a megabyte)
 and follows every alias as it copies values into the dataclasses, so ten megabytes of goals
 or a few lines of nested aliases (a "billion laughs") cost minutes and gigabytes before any
-check can run. A scenario file is read here in bounded steps instead:
-
-1. its bytes, at most `MOST_FILE_BYTES` (`read_bounded`);
-2. its YAML events, from libyaml (PyYAML's C parser, where PyYAML was built with it),
-   counted before any value is made (`check_yaml_bounds`): the values its aliases repeat
-   (at most `MOST_ALIASED_VALUES`), aliases inside the node they name, and the goals of the
-   lists `GOAL_LISTS` names (at most `MAX_GOALS`);
-3. its document, made once by the same C loader with Drake's reading of tags
-   (`load_document`), then copied into the schema by Drake's typed loader (`load_typed`).
+check can run. A scenario file is read here in bounded steps instead: its bytes
+(`read_bounded`); its YAML events, from libyaml where PyYAML has it, counted before any
+value is made (`check_yaml_bounds`); its document, made once by the same loader with
+Drake's reading of tags (`load_document`), then copied into the schema by Drake's typed
+loader (`load_typed`).
 """
 
 import yaml

@@ -1,11 +1,7 @@
-"""Reading a scenario: its text within bounds (`bounds`), its YAML document walked next to
-the schema (unknown keys and tags, values of the wrong kind, each named by its field), read
-into the schema by Drake's typed loader, then resolved (`resolve`, which checks the values)
-and its study checked.
-
-`load_scenario_file(path)` reads a file; `load_scenario_text(text, origin)` the same from
-YAML text (`pbp-drake run --scenario-text`), and both take YAML overlays merged into the
-document before it is read (`pbp-drake run --set FIELD=VALUE`).
+"""Reading a scenario (`load_scenario_file`, `load_scenario_text`): its text within bounds
+(`bounds`), its YAML document walked next to the schema (unknown keys and tags, values of the
+wrong kind, each named by its field), read into the schema by Drake's typed loader, then
+resolved (`resolve`, which checks the values) and its study checked.
 """
 
 import dataclasses
@@ -43,11 +39,10 @@ class LoadedScenarioFile:
 
 
 def load_scenario_file(path, overrides=None):
-    """Reads, checks and resolves a scenario file (see `load_scenario_text`); errors name
-    the file and the field. `overrides` (`overrides.ScenarioOverrides`: the command line's
-    `--set` and `--scenario-text`) are merged onto the file's document first and checked as
-    the file is; errors then name the file and the overrides. A relative `robot: !Arm
-    {model_file: ...}` and `dmp: {primitive: ...}` are read from the file's folder."""
+    """Reads, checks and resolves a scenario file (see `load_scenario_text`, the folder the
+    file's). `overrides` (`overrides.ScenarioOverrides`: the command line's `--set` and
+    `--scenario-text`) are merged onto the file's document first and checked as the file
+    is; errors then name the file and the overrides."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
@@ -65,10 +60,9 @@ def load_scenario_file(path, overrides=None):
 def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
     """Reads, checks and resolves the YAML `text` of a scenario file; each of `overlays`
     (YAML text of a mapping, e.g. ``scenario: {task: {object_count: 5}}``, or such a
-    mapping as `bounds.load_document` reads it) is merged into
-    the document first, a mapping into a mapping key by key (a tagged one replaces a node
-    of another tag). Raises ScenarioError as `ORIGIN: field.path: what is wrong` (or `line
-    L`). A relative arm `model_file` and a relative `dmp.primitive` are read from `folder`
+    mapping as `bounds.load_document` reads it) is merged into the document first
+    (`overrides.merged`). Raises ScenarioError as `ORIGIN: field.path: what is wrong` (or
+    `line L`). A relative arm `model_file` and `dmp.primitive` are read from `folder`
     (default: the working folder)."""
     try:
         document = _document(text)
@@ -89,7 +83,7 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
         raise ScenarioError(f"{origin}: {error}") from None
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
         raise ScenarioError(f"{origin}: {type(error).__name__}: {error}") from None
-    scenario = _primitive_from(_model_file_from(loaded.scenario, folder), folder)
+    scenario = _paths_from(loaded.scenario, folder)
     try:
         resolved = resolve(scenario)
         check_numbers(loaded.study, "study")
@@ -189,23 +183,19 @@ def _syntax_error(error):
             f"{getattr(error, 'problem', None) or error}{where}")
 
 
-def _model_file_from(scenario, folder):
-    """`scenario` with a relative arm model file made a path from `folder`."""
-    robot = scenario.robot
-    if (not isinstance(robot, Arm) or not robot.model_file or "://" in robot.model_file
-            or os.path.isabs(robot.model_file)):
-        return scenario
-    model_file = os.path.join(os.path.abspath(folder or os.curdir), robot.model_file)
-    return dataclasses.replace(scenario, robot=dataclasses.replace(robot, model_file=model_file))
-
-
-def _primitive_from(scenario, folder):
-    """`scenario` with a relative `dmp.primitive` made a path from `folder`."""
-    primitive = scenario.dmp.primitive
-    if not primitive or os.path.isabs(primitive):
-        return scenario
-    path = os.path.join(os.path.abspath(folder or os.curdir), primitive)
-    return dataclasses.replace(scenario, dmp=dataclasses.replace(scenario.dmp, primitive=path))
+def _paths_from(scenario, folder):
+    """`scenario` with a relative arm model file and `dmp.primitive` made paths from
+    `folder` (None: the working folder)."""
+    robot, primitive = scenario.robot, scenario.dmp.primitive
+    folder = os.path.abspath(folder or os.curdir)
+    if (isinstance(robot, Arm) and robot.model_file and "://" not in robot.model_file
+            and not os.path.isabs(robot.model_file)):
+        robot = dataclasses.replace(robot, model_file=os.path.join(folder, robot.model_file))
+        scenario = dataclasses.replace(scenario, robot=robot)
+    if primitive and not os.path.isabs(primitive):
+        dmp = dataclasses.replace(scenario.dmp, primitive=os.path.join(folder, primitive))
+        scenario = dataclasses.replace(scenario, dmp=dmp)
+    return scenario
 
 
 # ---------------------------------------------------------------------------------------------

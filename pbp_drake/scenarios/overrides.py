@@ -2,11 +2,9 @@
 them: `--set FIELD=VALUE` (a dotted path, e.g. `goal_estimator.method=nearest`, the value
 read as YAML) and `--scenario-text YAML` (a mapping of fields merged onto the file).
 
-Paths and the text's keys are the fields under the file's `scenario:`; `study.FIELD` (a
-`study:` key in the text) is a field of the file's `study:` section. The overrides are merged
-onto the file's parsed YAML document before it is read into the schema, so they are checked
-exactly as the file is (`loading.load_scenario_file`): an unknown field named with the close
-one, a value of the wrong type named with the type expected.
+Paths and the text's keys are the fields under the file's `scenario:`, or with `study.` of
+its `study:`. The overrides are merged onto the file's parsed YAML document before it is
+read into the schema, so they are checked exactly as the file is.
 """
 
 import dataclasses
@@ -51,7 +49,7 @@ class ScenarioOverrides:
 
     def overlay(self):
         """The overrides as one YAML document of the file's shape ({"scenario": ...,
-        "study": ...}), which `apply` merges onto the file's."""
+        "study": ...}), to merge onto the file's (`merged`)."""
         overlay = {}
         if self.text is not None:
             overlay = _file_shaped(_text_overlay(self.text))
@@ -64,11 +62,6 @@ class ScenarioOverrides:
                 nested = {name: nested}
             overlay = merged(overlay, nested)
         return overlay
-
-    def apply(self, document):
-        """The file's parsed YAML `document` (`bounds.load_document`) with the overrides
-        merged onto it."""
-        return merged(document, self.overlay())
 
 
 def parse_setting(setting):

@@ -1,12 +1,7 @@
 """The registry of surrogate pilots: the operators a study runs every method under
-(`pbp-drake study --pilots ...`), by name.
-
-``attentive`` is the scenario's own virtual participant; the others are the field's
-surrogate pilots (docs/concepts/pilots.md), each a tagged operator config of the schema
-(`NoisyPilot`, `LaggyPilot`, `ProportionalPilot`, `ParticipantPopulation`). A pilot is its
-module (its math in `pbp_drake.core`, its system in `pbp_drake.systems.operators`) and one
-entry in `PILOTS`: its tag, and how its defaults follow from the scenario's participant.
-`with_pilot(scenario, name)` is what a study calls for each name.
+(`pbp-drake study --pilots ...`, docs/concepts/pilots.md), by name. ``attentive`` is the
+scenario's own virtual participant; each other pilot is a tagged operator config of the
+schema, its defaults based on that participant (`with_pilot`).
 """
 
 import copy
@@ -22,23 +17,14 @@ from pbp_drake.scenarios.schema import (
 ATTENTIVE = "attentive"
 
 
-@dataclasses.dataclass(frozen=True)
-class Pilot:
-    """One registry entry: the pilot's tag (schema class) and its config with its defaults,
-    based on the scenario's participant (`VirtualParticipantParams`)."""
-
-    tag: type
-    from_participant: object
-
-
+#: Pilot name -> its config with its defaults, from the scenario's participant
+#: (`VirtualParticipantParams`).
 PILOTS = {
-    "noisy": Pilot(NoisyPilot, lambda participant: NoisyPilot(participant=participant)),
-    "laggy": Pilot(LaggyPilot, lambda participant: LaggyPilot(participant=participant)),
+    "noisy": lambda participant: NoisyPilot(participant=participant),
+    "laggy": lambda participant: LaggyPilot(participant=participant),
     # HOP's user moves at the participant's speed (0: the task's operator speed).
-    "proportional": Pilot(ProportionalPilot,
-                          lambda participant: ProportionalPilot(max_speed=participant.speed)),
-    "population": Pilot(ParticipantPopulation,
-                        lambda participant: ParticipantPopulation(participant=participant)),
+    "proportional": lambda participant: ProportionalPilot(max_speed=participant.speed),
+    "population": lambda participant: ParticipantPopulation(participant=participant),
 }
 #: The names `pbp-drake study --pilots` takes, `attentive` first.
 PILOT_NAMES = (ATTENTIVE, *PILOTS)
@@ -72,5 +58,5 @@ def with_pilot(scenario, name):
         raise ScenarioError(
             f"pilot {name!r} stands in for the virtual participant: scenario.operator is "
             f"!{type(operator).__name__}; expected !VirtualParticipant")
-    config = PILOTS[name].from_participant(participant_params(operator))
+    config = PILOTS[name](participant_params(operator))
     return dataclasses.replace(scenario, operator=config)

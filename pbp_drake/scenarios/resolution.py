@@ -8,6 +8,7 @@ the blend mode. Validating is resolving: a value that cannot be used raises a
 CLI) derives any of these again.
 """
 
+import contextlib
 import dataclasses
 import json
 import math
@@ -164,11 +165,10 @@ def _check_common(scenario):
     check_goal_counts(scenario)  # first: every check after it walks the goals
     check_numbers(scenario)
     renamed_method(scenario.method, "scenario.method")
-    try:
+    with _refused_as(""):
         method_entry(scenario.method, "scenario.method")
-    except ValueError as error:
-        raise ScenarioError(str(error)) from None
-    _checked("scenario.", scenario.validate_settings)
+    with _refused_as("scenario."):
+        scenario.validate_settings()
     require_finite(scenario, "scenario", ("duration",))
     if (estimator_entry(scenario.goal_estimator.method).reads == READS_POSE
             and not isinstance(getattr(scenario, "task", None), GraspTask)):
@@ -189,12 +189,16 @@ def _check_operator(scenario):
             f"{', '.join('!' + cls.__name__ for cls in operators)}")
 
 
-def _checked(prefix, validate):
-    """Calls `validate`; its ValueError becomes a ScenarioError, `prefix` before it."""
+@contextlib.contextmanager
+def _refused_as(prefix, config_name=None, field=None):
+    """A ValueError raised inside becomes a ScenarioError: `prefix` before its message, and
+    `config_name` in it (a config's name before its fields) said as `field`."""
     try:
-        validate()
+        yield
     except ValueError as error:
-        raise ScenarioError(f"{prefix}{error}") from None
+        message = f"{prefix}{error}"
+        raise ScenarioError(message.replace(config_name, field) if config_name else message
+                            ) from None
 
 
 def _with_period(scenario, period):
@@ -249,11 +253,9 @@ def _resolve_point_robot(scenario):
     if scenario.demonstration is not None:
         if isinstance(scenario.demonstration, BentPath):
             check_bent_path(scenario.demonstration)
-        try:
+        with _refused_as("scenario.demonstration: "):
             demonstration = validate_demonstration(
                 *demonstration_samples(scenario.demonstration))
-        except ValueError as error:
-            raise ScenarioError(f"scenario.demonstration: {error}") from None
     elif not scenario.start or not scenario.goals:
         raise ScenarioError(
             "scenario.start and scenario.goals are needed when there is no demonstration")
@@ -267,10 +269,8 @@ def _resolve_point_robot(scenario):
     # The bound every goal of a running diagram is held to (GoalsSource, the DMP bank).
     for field, name, points in (("scenario.goals", "goal", goals),
                                 ("scenario.start", "start", start)):
-        try:
+        with _refused_as(f"{field}: "):
             check_positions(points, name)
-        except ValueError as error:
-            raise ScenarioError(f"{field}: {error}") from None
     _check_method(scenario, goals.shape[0])
     if scenario.dmp_duration <= 0 and demonstration is None:
         raise ScenarioError("scenario.dmp_duration is needed when there is no demonstration")
@@ -377,14 +377,11 @@ def _resolve_task_robot(scenario):
         station, initial_ee_state, reach = _arm_station(scenario, station)
     else:
         reach = None
-    try:
+    with _refused_as("scenario.task: ", "scenario.task: scenario.", "scenario."):
         scene = task_scene(task, scenario.seed, reach)
         if isinstance(robot, Arm):
             check_clear_of_base(station, scene_boxes(task, scene, scenario.seed),
                                 "scenario.robot.model_file")
-    except ValueError as error:
-        raise ScenarioError(f"scenario.task: {error}".replace("scenario.task: scenario.",
-                                                              "scenario.")) from None
     # The HSR's hand starts at the task's height; the station ramps between the loop's
     # ticks, and it measures the task's cylinders against the robot.
     cylinders = [] if scene.obstacles is None else [
@@ -394,10 +391,8 @@ def _resolve_task_robot(scenario):
         station = dataclasses.replace(station, ee_height=task.height,
                                       control_period=scenario.control_period,
                                       obstacles=cylinders)
-        try:
+        with _refused_as("scenario.robot.station: "):
             initial_ee_state = hsr_ready_ee_state(station)
-        except ValueError as error:
-            raise ScenarioError(f"scenario.robot.station: {error}") from None
     else:
         station = dataclasses.replace(station, obstacles=cylinders)
     start = initial_ee_state[:3].copy()
@@ -481,20 +476,15 @@ def load_primitive(path, field):
     except (UnicodeDecodeError, json.JSONDecodeError) as error:
         raise ScenarioError(f"{field} is not a primitive file (truncated or corrupt: "
                             f"{getattr(error, 'msg', error)})") from None
-    try:
+    with _refused_as(f"{field}: "):
         return read_primitive_document(document)
-    except ValueError as error:
-        raise ScenarioError(f"{field}: {error}") from None
 
 
 def _check_bridge(hardware, task):
     """The HSR's task-space bridge: its fields, and a task whose station ports it carries
     (the hand's command and state, nothing more)."""
-    try:
+    with _refused_as("", "TaskSpaceBridgeConfig.", "scenario.robot.hardware."):
         validate_task_space_bridge(hardware)
-    except ValueError as error:
-        raise ScenarioError(str(error).replace("TaskSpaceBridgeConfig.",
-                                               "scenario.robot.hardware.")) from None
     if hardware.connect and not isinstance(task, MultiGoalReach):
         raise ScenarioError(
             f"scenario.robot.hardware: the task-space bridge carries the hand's command and "
@@ -507,11 +497,8 @@ def _arm_station(scenario, station):
     """An arm's station config (ramping between the loop's ticks), the hand's start and
     the arm's reach `(shoulder, radius)`; the arm's refusals name scenario.robot's field."""
     station = dataclasses.replace(station, control_period=scenario.control_period)
-    try:
+    with _refused_as("", "ArmStationConfig.", "scenario.robot."):
         initial_ee_state, reach = arm_ready_ee_state_and_reach(station)
-    except ValueError as error:
-        raise ScenarioError(str(error).replace("ArmStationConfig.", "scenario.robot.")
-                            ) from None
     return station, initial_ee_state, reach
 
 
@@ -519,7 +506,8 @@ def _check_hand_over(scenario):
     """The hand-over's limits must let the hand reach the task's speeds (the DMPs' and the
     operator's) within the time limit."""
     robot = scenario.robot
-    _checked("scenario.robot.", robot.hand_over().validate)
+    with _refused_as("scenario.robot."):
+        robot.hand_over().validate()
     acceleration, top_speed = robot.max_hand_acceleration, robot.max_hand_speed
     yaw_acceleration = robot.max_hand_yaw_acceleration
     operator_speed, turn = _operator_top_speeds(scenario)

@@ -5,13 +5,11 @@ goals, demonstration, obstacles, rates) and optionally a `study` that varies it.
 are chosen with YAML tags, e.g. ``operator: !ObstacleRepulsion {speed: 1.0}``.
 
 One default per knob: where a system is configurable, its section IS that system's
-parameter dataclass (``goal_estimator`` is `GoalEstimatorSettings`, ``dmp`` is
-`DmpSettings`, ``operator: !Keyboard`` a `KeyboardParams`, the HSR's ``station`` an
-`HsrStationConfig`), so a Python user constructing the system and a YAML user get the same
-robot. The tag classes below (`Keyboard`, `PointRobot`, ...) only name the variants; they
-add no field and no default. Drake's own config structs are nested where they exist
-(`SimulatorConfig` here; `MultibodyPlantConfig` and `VisualizationConfig` in the HSR's
-station). `pbp_drake.scenarios.resolve` checks and derives everything else.
+parameter dataclass (``goal_estimator`` is `GoalEstimatorSettings`, ``operator: !Keyboard``
+a `KeyboardParams`, the HSR's ``station`` an `HsrStationConfig`, ``simulator`` Drake's
+`SimulatorConfig`), so a Python user and a YAML user get the same robot; the tag classes
+(`Keyboard`, `PointRobot`, ...) only name the variants, adding no field or default.
+`pbp_drake.scenarios.resolve` checks and derives everything else.
 """
 
 import copyreg

@@ -80,11 +80,12 @@ def _reach_scene(task, seed, reach):
                               task.min_separation, tuple(getattr(task, "z_range", ())))
 
 
-def _check_region(task, reach):
-    """Every corner of the region the task draws its targets from must be in reach."""
+def _check_region(task, reach, heights=None):
+    """Every corner of the region the task draws its targets from (at `heights`, default
+    its `z_range` or `height`) must be in reach."""
     if len(task.x_range) != 2 or len(task.y_range) != 2:
         raise ValueError("x_range and y_range must be [low, high]")
-    heights = getattr(task, "z_range", None) or [task.height]
+    heights = heights or getattr(task, "z_range", None) or [task.height]
     _validate_within_reach([[x, y, z] for x in task.x_range for y in task.y_range
                             for z in heights], 0.0, reach)
 
@@ -110,9 +111,7 @@ def _validate_within_reach(objects, min_separation, reach):
 def _grasp_scene(task, seed):
     """The `GraspScene` of `task` (a checked `GraspTask`) drawn from `seed`; ValueError if
     its region is out of reach or its tables cannot be placed."""
-    # Every corner of the tables' region must be in the HSR's reach, as in reach.
-    validate_objects([[x, y, task.table_height] for x in task.x_range for y in task.y_range],
-                     0.0)
+    _check_region(task, None, [task.table_height])
     return sample_grasp_scene(
         seed, object_count=tuple(task.object_count), x_range=tuple(task.x_range),
         y_range=tuple(task.y_range), table_height=task.table_height,

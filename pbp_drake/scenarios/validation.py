@@ -129,10 +129,7 @@ def check_reach_task(task):
         check_range(task, "scenario.task", name)
     if task.z_range:
         check_range(task, "scenario.task", "z_range")
-    check_range(task, "scenario.task", "object_count")
-    # Objects are placed min_separation apart in front of the robot: a few dozen fit.
-    check_count(task.object_count[0], "scenario.task.object_count[0]", 1, 100)
-    check_count(task.object_count[1], "scenario.task.object_count[1]", 1, 100)
+    check_object_count(task)
     check_switch_schedule(task)
     if task.grid_objects:
         if task.objects:
@@ -141,6 +138,14 @@ def check_reach_task(task):
         switches = len(task.switch_schedule) > 1
         check_count(task.grid_objects, "scenario.task.grid_objects", 2 if switches else 1,
                     MAX_GOALS, " (a target switch needs 2 objects)" if switches else "")
+
+
+def check_object_count(task):
+    """The range [low, high] of how many objects a task draws, each 1 to 100: objects are
+    placed min_separation apart in front of the robot, and a few dozen fit."""
+    check_range(task, "scenario.task", "object_count")
+    for index in (0, 1):
+        check_count(task.object_count[index], f"scenario.task.object_count[{index}]", 1, 100)
 
 
 def check_switch_schedule(task):
@@ -158,10 +163,9 @@ def check_grasp_task(task):
     require_finite(task, field, ("min_separation", "height", "table_height", "object_radius",
                                  "object_height", "success_distance", "success_angle"))
     require_finite(task, field, ("grasp_depth",), positive=False)
-    for name in ("x_range", "y_range", "object_count"):
+    for name in ("x_range", "y_range"):
         check_range(task, field, name)
-    check_count(task.object_count[0], f"{field}.object_count[0]", 1, 100)
-    check_count(task.object_count[1], f"{field}.object_count[1]", 1, 100)
+    check_object_count(task)
     check_count(task.grasps_per_object, f"{field}.grasps_per_object", 1, MAX_GRASPS_PER_OBJECT)
     # Beyond a quarter turn a side grasp approaches from behind the object, toward the
     # robot, which the HSR's arm cannot do.
@@ -233,12 +237,9 @@ MOST_PLAN_TIMES = 100
 
 def check_virtual_participant(operator, field="scenario.operator"):
     """The reaching and obstacle fields of `operator: !VirtualParticipant`
-    (`VirtualParticipantParams`): what it divides by (`slow_radius`,
-    `turn_slowdown_angle`), times, rates and steps positive, other distances, angles,
-    times, weights and factors not negative,
-    `plan_directions` a count and `plan_times` positive times that increase; and its
-    `impairment` (`ParticipantImpairment.problem`: levels and times finite and not
-    negative, a probability in [0, 1])."""
+    (`VirtualParticipantParams`): what it divides by, times, rates and steps positive, its
+    other numbers not negative, `plan_directions` a count, `plan_times` increasing, and its
+    `impairment` (`ParticipantImpairment.problem`)."""
     problem = operator.impairment.problem()
     if problem is not None:
         raise ScenarioError(f"{field}.impairment.{problem}")

@@ -17,7 +17,7 @@ from pbp_drake.core.dmp._checks import (
     as_point, broadcast_goalwise, followed_velocity, goal_indices, positive, read_only)
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
 from pbp_drake.core.dmp.settings import DmpSettings, phase_decay
-from pbp_drake.core.dmp.single import Dmp
+from pbp_drake.core.dmp.single import straight_weights
 from pbp_drake.core.dmp.stepping import BankStep
 from pbp_drake.core.dmp.workspace import DmpWorkspace
 
@@ -161,8 +161,7 @@ class DmpBankModel(BankStep, BankModel):
         """
         dimension = as_point(start, "start").size
         if settings.formulation == "ijspeert":
-            unit = Dmp.straight(np.zeros(1), np.ones(1), duration, settings)
-            weights = np.repeat(unit.weights, dimension, axis=1)
+            weights = straight_weights(settings, duration, np.ones(dimension))
         else:
             weights = np.zeros((settings.basis_count, dimension))
         return cls(weights, start, duration, settings, goal_count=goal_count)

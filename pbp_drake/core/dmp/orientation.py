@@ -22,9 +22,9 @@ DMP then turns the shorter way."""
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp._checks import positive
-from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk
-from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, step_matrices
+from pbp_drake.core.dmp.fitting import fit_weights
+from pbp_drake.core.dmp.settings import DmpSettings
+from pbp_drake.core.dmp.single import SingleDmp
 
 AXES = 3
 
@@ -67,33 +67,27 @@ def fit_orientation_weights(times, orientations, settings=DmpSettings()):
     return fit_weights(times, errors, settings)
 
 
-def straight_weights(settings, duration, span):
-    """Weights `(N, 3)` of a minimum-jerk straight path in `e` (a slerp in orientation).
-
-    Fitted on a unit reach so that an axis with no rotation still gets the shape; the
-    Ijspeert factor `-e0` then scales it per axis, the Pastor form takes `span = -e0`."""
-    times, unit = minimum_jerk(np.zeros(1), np.ones(1), duration)
-    unit_weights, _ = fit_weights(times, unit, settings)
-    return unit_weights * (span if settings.formulation == "pastor" else np.ones(AXES))
-
-
-class OrientationDmp:
+class OrientationDmp(SingleDmp):
     """One orientation DMP, stepped with a plain per-axis loop: the readable reference.
 
     State: `phase`, `orientation` (4,) and `scaled_angular_velocity` (3,) `eta = tau omega`.
+    `straight` turns along the shorter arc from `start` to `goal` (a slerp path).
     """
+
+    PATH = "orientation"
 
     def __init__(self, weights, start, goal, duration, settings=DmpSettings(),
                  amplitude_scaling=None):
-        self.settings = settings
-        self.start = quaternion.unit_quaternions(start, "start").reshape(4)
-        self.goal = quaternion.unit_quaternions(goal, "goal").reshape(4)
-        self.weights = np.asarray(weights, dtype=float).reshape(settings.basis_count, AXES)
-        self.duration = positive(duration, "duration")
-        self.amplitude_scaling = (np.ones(AXES, bool) if amplitude_scaling is None
-                                  else np.asarray(amplitude_scaling, bool).reshape(AXES))
-        self._centres, self._widths = settings.basis()
-        self.reset()
+        super().__init__(weights, start, goal, duration, settings, amplitude_scaling, AXES)
+
+    @staticmethod
+    def _ends(start, goal):
+        return (quaternion.unit_quaternions(start, "start").reshape(4),
+                quaternion.unit_quaternions(goal, "goal").reshape(4))
+
+    @staticmethod
+    def _span(start, goal):
+        return -orientation_errors(start, goal)
 
     @classmethod
     def from_demonstration(cls, times, orientations, settings=DmpSettings()):
@@ -102,23 +96,6 @@ class OrientationDmp:
         weights, scaling = fit_orientation_weights(times, orientations, settings)
         return cls(weights, orientations[0], orientations[-1], times[-1] - times[0],
                    settings, scaling)
-
-    @classmethod
-    def straight(cls, start, goal, duration, settings=DmpSettings(), profile="minimum_jerk"):
-        """No demonstration: the shorter arc from `start` to `goal` (a slerp path).
-
-        `"minimum_jerk"`: bell-shaped angular speed, done at `duration`; `"zero_forcing"`:
-        `f = 0` (the same arc, with a critically damped spring's abrupt start)."""
-        start = quaternion.unit_quaternions(start, "start").reshape(4)
-        goal = quaternion.unit_quaternions(goal, "goal").reshape(4)
-        if profile == "zero_forcing":
-            return cls(np.zeros((settings.basis_count, AXES)), start, goal, duration, settings)
-        if profile != "minimum_jerk":
-            raise ValueError(f"profile {profile!r} is unknown; use 'minimum_jerk' or "
-                             "'zero_forcing'")
-        span = -orientation_errors(start, goal)
-        return cls(straight_weights(settings, duration, span), start, goal, duration,
-                   settings)
 
     def reset(self, orientation=None, scaled_angular_velocity=None):
         """Phase 1, orientation `start` (or given), scaled angular velocity 0 (or given)."""
@@ -131,8 +108,7 @@ class OrientationDmp:
     def attractor(self, phase, goal):
         """The moving attractor `a(x)` in `e = Log(q g*)` coordinates, `(3,)`."""
         start_error = orientation_errors(self.start, goal)
-        psi = np.exp(-self._widths * (phase - self._centres) ** 2)
-        shape = (psi @ self.weights) / psi.sum() * phase
+        shape = self._shape(phase)
         result = np.empty(AXES)
         for axis in range(AXES):
             if self.settings.formulation == "ijspeert":
@@ -162,30 +138,8 @@ class OrientationDmp:
             return self.orientation.copy(), self.scaled_angular_velocity / tau
         error = orientation_errors(self.orientation, goal)
         z = quaternion.left_jacobian_inverse_times(error, self.scaled_angular_velocity)
-        phi, gamma = step_matrices(self.settings.stiffness, self.settings.damping, tau, dt)
-        decay = phase_decay(self.settings, tau, dt)
-        # First-order hold: the attractor moves linearly in time over the step.
-        start = self.attractor(self.phase, goal)
-        end = self.attractor(self.phase * decay, goal)
-        new_error, new_z = np.empty(AXES), np.empty(AXES)
-        for axis in range(AXES):
-            offset = error[axis] - start[axis]
-            rate = (end[axis] - start[axis]) / dt
-            new_error[axis] = (end[axis] + phi[0, 0] * offset + phi[0, 1] * z[axis]
-                               - gamma[0, 0] * rate)
-            new_z[axis] = phi[1, 0] * offset + phi[1, 1] * z[axis] - gamma[1, 0] * rate
+        new_error, new_z = self._free_step(error, z, dt, goal)
         self.orientation = quaternion.aligned(
             quaternion.multiply(quaternion.exp_map(new_error), goal), self.orientation)
         self.scaled_angular_velocity = quaternion.left_jacobian_times(new_error, new_z)
-        self.phase *= decay
         return self.orientation.copy(), self.scaled_angular_velocity / tau
-
-    def rollout(self, dt, duration=None):
-        """Open-loop orientations `(steps + 1, 4)` from the current state, the state kept."""
-        saved = (self.phase, self.orientation.copy(), self.scaled_angular_velocity.copy())
-        steps = int(round((self.duration if duration is None else duration) / dt))
-        path = [self.orientation.copy()]
-        for _ in range(steps):
-            path.append(self.next_step(dt)[0])
-        self.phase, self.orientation, self.scaled_angular_velocity = saved
-        return np.array(path)

@@ -18,14 +18,14 @@ from pbp_drake.core.dmp._checks import followed_velocity, goal_indices, positive
 from pbp_drake.core.dmp.bank import BankModel
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
-    AXES, fit_orientation_weights, straight_weights,
-    validate_orientation_demonstration)
+    AXES, fit_orientation_weights, validate_orientation_demonstration)
 from pbp_drake.core.dmp.orientation_kernels import (
     OrientationWorkspace, error_quaternions_into, exp_into, inverse_jacobian_into,
     jacobian_into, log_into, product_into)
 from pbp_drake.core.dmp.orientation_log_step import (
     IDENTITY6, forcing_rows, log_step_from_one_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis
+from pbp_drake.core.dmp.single import straight_weights
 from pbp_drake.core.dmp.stepping import step_constants
 
 

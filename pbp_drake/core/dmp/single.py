@@ -3,7 +3,7 @@
 `Dmp` keeps a state of its own (`phase`, `position`, `scaled_velocity`) and a stateful API
 (`reset`, `next_step`, `rollout`), as NumPy users expect of one movement primitive: no Drake
 system holds one, and it is the oracle the vectorised, immutable `DmpBankModel` is tested
-against.
+against. `SingleDmp` is what it shares with `OrientationDmp`.
 """
 
 import numpy as np
@@ -13,34 +13,40 @@ from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demon
 from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, step_matrices
 
 
-class Dmp:
-    """One DMP in D dimensions, stepped with a plain per-dimension loop."""
+def straight_weights(settings, duration, span):
+    """Weights `(N, D)` of a minimum-jerk straight path, `span` (D,) its goal minus start.
 
-    def __init__(self, weights, start, goal, duration, settings=DmpSettings(),
-                 amplitude_scaling=None):
+    Fitted on a unit reach so that a dimension with `g = y0` still gets the straight-path
+    shape; the Ijspeert `(g - y0)` factor then scales it to any goal, the Pastor form takes
+    `span` here."""
+    times, unit = minimum_jerk(np.zeros(1), np.ones(1), duration)
+    unit_weights, _ = fit_weights(times, unit, settings)
+    return unit_weights * (span if settings.formulation == "pastor" else np.ones(span.size))
+
+
+class SingleDmp:
+    """What `Dmp` and `OrientationDmp` share: the model (settings, weights `(N, D)`, start,
+    goal, duration, amplitude scaling), the phase, the first-order-hold step of a state
+    `(D,)`, `straight` and `rollout`. A subclass gives `_ends` (its start and goal checked),
+    `_span` (goal minus start, `(D,)`), `attractor` and `next_step`, and names in `PATH`
+    the state `rollout` samples."""
+
+    def __init__(self, weights, start, goal, duration, settings, amplitude_scaling,
+                 dimension):
         self.settings = settings
-        self.start = as_point(start, "start")
-        self.goal = as_point(goal, "goal", dimension=self.start.size)
+        self.start, self.goal = self._ends(start, goal)
         self.weights = np.asarray(weights, dtype=float).reshape(settings.basis_count, -1)
-        if self.weights.shape[1] != self.start.size:
-            raise ValueError(
-                f"weights have {self.weights.shape[1]} dimensions, start has {self.start.size}"
-            )
+        if self.weights.shape[1] != dimension:
+            raise ValueError(f"weights have {self.weights.shape[1]} dimensions, expected "
+                             f"{dimension}")
         self.duration = positive(duration, "duration")
         self.amplitude_scaling = (
-            np.ones(self.start.size, bool)
+            np.ones(dimension, bool)
             if amplitude_scaling is None
-            else np.asarray(amplitude_scaling, bool).reshape(self.start.size)
+            else np.asarray(amplitude_scaling, bool).reshape(dimension)
         )
         self._centres, self._widths = settings.basis()
         self.reset()
-
-    @classmethod
-    def from_demonstration(cls, times, positions, settings=DmpSettings()):
-        """Learns the DMP of ONE demonstration; start, goal and duration are the demo's."""
-        times, positions = validate_demonstration(times, positions)
-        weights, scaling = fit_weights(times, positions, settings)
-        return cls(weights, positions[0], positions[-1], times[-1] - times[0], settings, scaling)
 
     @classmethod
     def straight(cls, start, goal, duration, settings=DmpSettings(), profile="minimum_jerk"):
@@ -50,20 +56,79 @@ class Dmp:
         `duration`); `profile="zero_forcing"` uses `f = 0` (straight too, from rest, but with
         the abrupt start of a critically damped spring).
         """
-        start = as_point(start, "start")
-        goal = as_point(goal, "goal", dimension=start.size)
+        start, goal = cls._ends(start, goal)
+        span = cls._span(start, goal)
         if profile == "zero_forcing":
-            weights = np.zeros((settings.basis_count, start.size))
+            weights = np.zeros((settings.basis_count, span.size))
             return cls(weights, start, goal, duration, settings)
         if profile != "minimum_jerk":
             raise ValueError(
                 f"profile {profile!r} is unknown; use 'minimum_jerk' or 'zero_forcing'")
-        # Fit in each dimension on a unit reach so that dimensions with g = y0 still get the
-        # straight-path shape; the Ijspeert (g - y0) factor then scales it to any goal.
-        times, unit = minimum_jerk(np.zeros(1), np.ones(1), duration)
-        unit_weights, _ = fit_weights(times, unit, settings)
-        span = goal - start if settings.formulation == "pastor" else np.ones(start.size)
-        return cls(unit_weights * span, start, goal, duration, settings)
+        return cls(straight_weights(settings, duration, span), start, goal, duration,
+                   settings)
+
+    def _shape(self, phase):
+        """The forcing term's shape `(psi . w / sum psi) x` at `phase`, `(D,)`."""
+        psi = np.exp(-self._widths * (phase - self._centres) ** 2)
+        return (psi @ self.weights) / psi.sum() * phase
+
+    def _free_step(self, values, z, dt, goal):
+        """One first-order-hold step of the state `(values, z)` (D,) toward the attractor
+        at `goal`; advances the phase and returns the new `(values, z)`, new arrays."""
+        phi, gamma = step_matrices(self.settings.stiffness, self.settings.damping,
+                                   self.duration, dt)
+        decay = phase_decay(self.settings, self.duration, dt)
+        # The attractor moves linearly in time from its value at this step's phase to its
+        # value at the next (first-order hold).
+        start = self.attractor(self.phase, goal)
+        end = self.attractor(self.phase * decay, goal)
+        new_values, new_z = np.empty(values.size), np.empty(values.size)
+        for dim in range(values.size):
+            offset = values[dim] - start[dim]
+            rate = (end[dim] - start[dim]) / dt
+            new_values[dim] = (end[dim] + phi[0, 0] * offset + phi[0, 1] * z[dim]
+                               - gamma[0, 0] * rate)
+            new_z[dim] = phi[1, 0] * offset + phi[1, 1] * z[dim] - gamma[1, 0] * rate
+        self.phase *= decay
+        return new_values, new_z
+
+    def rollout(self, dt, duration=None):
+        """Open-loop path `(steps + 1, ...)` of the state `PATH` from the current state, the
+        state kept."""
+        saved = dict(vars(self))  # a step replaces the state's arrays, never writes in them
+        steps = int(round((self.duration if duration is None else duration) / dt))
+        path = [getattr(self, self.PATH)]
+        for _ in range(steps):
+            path.append(self.next_step(dt)[0])
+        vars(self).update(saved)
+        return np.array(path)
+
+
+class Dmp(SingleDmp):
+    """One DMP in D dimensions, stepped with a plain per-dimension loop."""
+
+    PATH = "position"
+
+    def __init__(self, weights, start, goal, duration, settings=DmpSettings(),
+                 amplitude_scaling=None):
+        super().__init__(weights, start, goal, duration, settings, amplitude_scaling,
+                         np.size(start))
+
+    @staticmethod
+    def _ends(start, goal):
+        start = as_point(start, "start")
+        return start, as_point(goal, "goal", dimension=start.size)
+
+    @staticmethod
+    def _span(start, goal):
+        return goal - start
+
+    @classmethod
+    def from_demonstration(cls, times, positions, settings=DmpSettings()):
+        """Learns the DMP of ONE demonstration; start, goal and duration are the demo's."""
+        times, positions = validate_demonstration(times, positions)
+        weights, scaling = fit_weights(times, positions, settings)
+        return cls(weights, positions[0], positions[-1], times[-1] - times[0], settings, scaling)
 
     def reset(self, position=None, scaled_velocity=None):
         """Phase to 1, position to `start` (or `position`), scaled velocity to 0 (or given)."""
@@ -76,8 +141,7 @@ class Dmp:
 
     def attractor(self, phase, goal):
         """The moving attractor `y_attr(x, g)` of the module docstring, per dimension."""
-        psi = np.exp(-self._widths * (phase - self._centres) ** 2)
-        shape = (psi @ self.weights) / psi.sum() * phase
+        shape = self._shape(phase)
         result = np.empty(self.start.size)
         for dim in range(self.start.size):
             if self.settings.formulation == "ijspeert":
@@ -103,28 +167,6 @@ class Dmp:
             if robot_velocity is not None:
                 self.scaled_velocity = tau * np.asarray(robot_velocity, float)
             return self.position.copy(), self.scaled_velocity / tau
-        phi, gamma = step_matrices(self.settings.stiffness, self.settings.damping, tau, dt)
-        decay = phase_decay(self.settings, tau, dt)
-        # The attractor moves linearly in time from its value at this step's phase to its
-        # value at the next (first-order hold).
-        start = self.attractor(self.phase, goal)
-        end = self.attractor(self.phase * decay, goal)
-        for dim in range(self.start.size):
-            offset = self.position[dim] - start[dim]
-            z = self.scaled_velocity[dim]
-            rate = (end[dim] - start[dim]) / dt
-            self.position[dim] = (end[dim] + phi[0, 0] * offset + phi[0, 1] * z
-                                  - gamma[0, 0] * rate)
-            self.scaled_velocity[dim] = phi[1, 0] * offset + phi[1, 1] * z - gamma[1, 0] * rate
-        self.phase *= decay
+        self.position, self.scaled_velocity = self._free_step(
+            self.position, self.scaled_velocity, dt, goal)
         return self.position.copy(), self.scaled_velocity / tau
-
-    def rollout(self, dt, duration=None):
-        """Open-loop positions `(steps + 1, D)` from the current state, the state kept."""
-        saved = (self.phase, self.position.copy(), self.scaled_velocity.copy())
-        steps = int(round((self.duration if duration is None else duration) / dt))
-        path = [self.position.copy()]
-        for _ in range(steps):
-            path.append(self.next_step(dt)[0])
-        self.phase, self.position, self.scaled_velocity = saved
-        return np.array(path)

@@ -12,7 +12,60 @@ from pbp_drake.systems.ports import PortGetters, goal_index
 from pbp_drake.systems.tick import checked_update_offset
 
 
-class DmpBank(PortGetters, LeafSystem):
+class BankSystem(PortGetters, LeafSystem):
+    """What `DmpBank` and `PoseDmpBank` share: the input ports, the step's scratch memory
+    in the Context, the operator's phase lock, and the goals followed and selected."""
+
+    def _declare_inputs(self, robot_state_size, goals_name, goals_size):
+        self._robot_state_port = self.DeclareVectorInputPort("robot_state", robot_state_size)
+        self._goals_port = self.DeclareVectorInputPort(goals_name, goals_size)
+        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
+        self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
+        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+
+    def _declare_workspace(self, description, make):
+        """The step's scratch, one workspace `make()` per Context. It is never calculated
+        nor marked up to date (it depends on nothing and holds nothing between calls), so
+        `_workspace` may always take it mutably; a cloned Context deep-copies it."""
+        self._workspace_entry = self.DeclareCacheEntry(
+            description,
+            ValueProducer(allocate=lambda: AbstractValue.Make(make()),
+                          calc=self._never_calculated),
+            prerequisites_of_calc={self.nothing_ticket()})
+
+    def _workspace(self, context):
+        return self._workspace_entry.get_mutable_cache_entry_value(
+            context).GetMutableValueOrThrow()
+
+    def _never_calculated(self, context, value):
+        raise RuntimeError(f"the {type(self).__name__} workspace is scratch memory, never "
+                           "evaluated")
+
+    def _locked(self, context):
+        """Whether the phase is frozen now: `lock_phase_when_operator_acts` and a nonzero
+        `operator_active`."""
+        return (self._lock and self._operator_active_port.HasValue(context)
+                and self._operator_active_port.Eval(context)[0] > 0.5)
+
+    def _followed(self, context, compact):
+        """`followed_goal` (None: unconnected), which the compact state needs."""
+        followed = goal_index(self._followed_goal_port, context, self._goal_count)
+        if followed is None and compact:
+            raise RuntimeError(
+                f"{type(self).__name__} with compact_state=True steps every DMP from the "
+                "followed DMP's velocity: connect its followed_goal input port")
+        return followed
+
+    def _selected(self, context):
+        """`selected_goal`; unconnected, the followed goal, else goal 0."""
+        goal = goal_index(self._selected_goal_port, context, self._goal_count)
+        if goal is None:
+            goal = goal_index(self._followed_goal_port, context, self._goal_count,
+                              unconnected=0)
+        return goal
+
+
+class DmpBank(BankSystem):
     """Steps K DMPs (one per goal) every control period from the robot's measured state.
 
     .. pydrake_system::
@@ -77,7 +130,8 @@ class DmpBank(PortGetters, LeafSystem):
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)
         update_offset = checked_update_offset(update_offset, self._period)
-        k, d = bank.goal_count, bank.dimension
+        k = self._goal_count = bank.goal_count
+        d = bank.dimension
         if compact_state and not bank.affine_in_goal:
             raise ValueError(
                 "compact_state=True needs DMPs that share weights and start (a bank whose "
@@ -85,11 +139,7 @@ class DmpBank(PortGetters, LeafSystem):
                 "per-goal state (compact_state=False)")
         self._layout = (AffineState if compact_state else PerGoalState)(
             bank, self._period, self._max_speed)
-        self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
-        self._goals_port = self.DeclareVectorInputPort("goals", k * d)
-        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
-        self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
-        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._declare_inputs(2 * d, "goals", k * d)
         self._state_index = self.DeclareDiscreteState(self._layout.initial())
         # The goals checked and laid out (D, K) once each time they change, not each tick.
         self._goals_dk = self.DeclareCacheEntry(
@@ -97,14 +147,8 @@ class DmpBank(PortGetters, LeafSystem):
             ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((d, k))),
                           calc=self._calc_goals_dk),
             prerequisites_of_calc={self._goals_port.ticket()})
-        # Scratch of the bank's step, one workspace per Context. It is never calculated nor
-        # marked up to date (it depends on nothing and holds nothing between calls), so
-        # `_workspace` may always take it mutably; a cloned Context deep-copies it.
-        self._workspace_entry = self.DeclareCacheEntry(
-            "DmpWorkspace: scratch arrays of the bank's step",
-            ValueProducer(allocate=lambda: AbstractValue.Make(bank.make_workspace()),
-                          calc=self._never_calculated),
-            prerequisites_of_calc={self.nothing_ticket()})
+        self._declare_workspace("DmpWorkspace: scratch arrays of the bank's step",
+                                bank.make_workspace)
         # The outputs depend on the bank's own state only (and, in the compact layout, on
         # the goals): say so, so that Drake does not recompute them after every plant step.
         state = {self.xd_ticket()}
@@ -144,15 +188,6 @@ class DmpBank(PortGetters, LeafSystem):
     def bank(self):
         return self._bank
 
-    def _workspace(self, context):
-        """This Context's `DmpWorkspace` (see the cache entry's comment in `__init__`)."""
-        return self._workspace_entry.get_mutable_cache_entry_value(
-            context).GetMutableValueOrThrow()
-
-    @staticmethod
-    def _never_calculated(context, value):
-        raise RuntimeError("the DmpBank workspace is scratch memory, never evaluated")
-
     def _state(self, context):
         return context.get_discrete_state(self._state_index).get_value()
 
@@ -172,12 +207,9 @@ class DmpBank(PortGetters, LeafSystem):
     def selected_reference(self, context):
         """`[position (D), velocity (D)]` of `selected_goal` (unconnected: the followed
         goal, else goal 0) after the last update, a new array."""
-        k = self._bank.goal_count
-        goal = goal_index(self._selected_goal_port, context, k)
-        if goal is None:
-            goal = goal_index(self._followed_goal_port, context, k, unconnected=0)
-        position, velocity = self._layout.read(self._state(context), self._given(context),
-                                               self._workspace(context), goal)
+        position, velocity = self._layout.read(
+            self._state(context), self._given(context), self._workspace(context),
+            self._selected(context))
         return np.concatenate([position[:, 0], velocity[:, 0] / self._bank.duration])
 
     def _update(self, context, discrete_state):
@@ -185,15 +217,10 @@ class DmpBank(PortGetters, LeafSystem):
         # Every input is evaluated before the workspace is taken: an input's evaluation may
         # reach this system's outputs, whose calculation uses the same workspace.
         robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
-        lock = (self._lock and self._operator_active_port.HasValue(context)
-                and self._operator_active_port.Eval(context)[0] > 0.5)
+        lock = self._locked(context)
         goals_dk = None if lock else self._goals_dk.Eval(context)
-        # The goal the robot followed since the last update (None: unconnected).
-        followed = goal_index(self._followed_goal_port, context, self._bank.goal_count)
-        if followed is None and self._layout.needs_followed_goal:
-            raise RuntimeError(
-                "DmpBank with compact_state=True steps every DMP from the followed DMP's "
-                "velocity: connect its followed_goal input port")
+        # The goal the robot followed since the last update.
+        followed = self._followed(context, self._layout.needs_followed_goal)
         self._layout.update(
             discrete_state.get_mutable_vector(self._state_index).get_mutable_value(),
             robot_state, lock, goals_dk, followed, self._workspace(context))

@@ -7,20 +7,22 @@ import math
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import LeafSystem, ValueProducer
+from pydrake.systems.framework import ValueProducer
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one_values
 from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
-from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, goal_index
+from pbp_drake.systems.pbp.dmp_bank import BankSystem
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
     AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
     hold_into, per_goal_arrays, split_head, state_size, step_all)
+from pbp_drake.systems.ports import GoalPose, PoseState
 from pbp_drake.systems.tick import checked_period, checked_update_offset
 
-class PoseDmpBank(PortGetters, LeafSystem):
+
+class PoseDmpBank(BankSystem):
     """Steps K pose DMPs (one per goal pose) every control period from the hand's pose.
 
     .. pydrake_system::
@@ -90,11 +92,7 @@ class PoseDmpBank(PortGetters, LeafSystem):
         self._lock = bool(lock_phase_when_operator_acts)
         update_offset = checked_update_offset(update_offset, self._period)
         k = self._goal_count = position_bank.goal_count
-        self._robot_state_port = self.DeclareVectorInputPort("robot_state", PoseState.size)
-        self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
-        self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
-        self._followed_goal_port = self.DeclareVectorInputPort("followed_goal", 1)
-        self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
+        self._declare_inputs(PoseState.size, "goal_poses", k * GoalPose.size)
         self._compact = bool(compact_state)
         initial = np.zeros(self.state_size(k, self._compact))
         phase, held, _, q, _ = split_head(initial)
@@ -108,13 +106,8 @@ class PoseDmpBank(PortGetters, LeafSystem):
             ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((GoalPose.size, k))),
                           calc=self._calc_goals),
             prerequisites_of_calc={self._goals_port.ticket()})
-        # Scratch, never calculated nor marked up to date (see DmpBank's workspace entry).
-        self._workspace_entry = self.DeclareCacheEntry(
-            "PoseWorkspace: scratch arrays of the banks' step",
-            ValueProducer(allocate=lambda: AbstractValue.Make(
-                PoseWorkspace(position_bank, orientation_bank)),
-                calc=self._never_calculated),
-            prerequisites_of_calc={self.nothing_ticket()})
+        self._declare_workspace("PoseWorkspace: scratch arrays of the banks' step",
+                                lambda: PoseWorkspace(position_bank, orientation_bank))
         if self._compact:
             self._stepped_entry = self.DeclareCacheEntry(
                 "SteppedDmps: the K DMPs stepped from the compact state, [y' - p, z', e', z'] "
@@ -191,14 +184,6 @@ class PoseDmpBank(PortGetters, LeafSystem):
                  velocity, eta, self._goals_entry.Eval(context), self._period, stepped,
                  log_state, self._workspace(context))
 
-    def _workspace(self, context):
-        return self._workspace_entry.get_mutable_cache_entry_value(
-            context).GetMutableValueOrThrow()
-
-    @staticmethod
-    def _never_calculated(context, value):
-        raise RuntimeError("the PoseDmpBank workspace is scratch memory, never evaluated")
-
     def _calc_goals(self, context, value):
         rows = np.asarray(self._goals_port.Eval(context), dtype=float).reshape(
             self._goal_count, GoalPose.size)
@@ -231,15 +216,10 @@ class PoseDmpBank(PortGetters, LeafSystem):
         vector = discrete_state.get_mutable_value(self._state_index)
         # Every input before the workspace (an input may reach this system's outputs).
         hand = self._robot(context)
-        lock = (self._lock and self._operator_active_port.HasValue(context)
-                and self._operator_active_port.Eval(context)[0] > 0.5)
+        lock = self._locked(context)
         goals = self._goals_entry.Eval(context)
-        followed = goal_index(self._followed_goal_port, context, self._goal_count)
+        followed = self._followed(context, self._compact)
         if self._compact:
-            if followed is None:
-                raise RuntimeError(
-                    "PoseDmpBank with compact_state=True steps every DMP from the followed "
-                    "DMP's velocities: connect its followed_goal input port")
             self._update_compact(context, vector, hand, lock, followed)
         else:
             self._update_per_goal(context, vector, hand, lock, goals, followed)
@@ -356,9 +336,7 @@ class PoseDmpBank(PortGetters, LeafSystem):
     def _selected_numbers(self, context):
         """`selected_reference`'s 13 numbers (`PoseState`'s layout) as floats: at one goal,
         float arithmetic on the numbers read in one go costs a fraction of NumPy calls."""
-        k = goal_index(self._selected_goal_port, context, self._goal_count)
-        if k is None:
-            k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
+        k = self._selected(context)
         vector = context.get_discrete_state(self._state_index).get_value()
         head = vector[:HEAD_SIZE].tolist()  # [phase, held, p (3), q (4), eta (3)]
         numbers, stepped = self._goal_numbers(context, vector, k)
@@ -385,11 +363,8 @@ class PoseDmpBank(PortGetters, LeafSystem):
         phase = split_head(context.get_discrete_state(self._state_index).get_value())[0]
         output.get_mutable_value()[:] = phase[0]
 
-
     def _calc_predicted_poses(self, context, output):
-        k = goal_index(self._selected_goal_port, context, self._goal_count)
-        if k is None:
-            k = goal_index(self._followed_goal_port, context, self._goal_count, unconnected=0)
+        k = self._selected(context)
         phase, positions, orientations, velocity, eta = self.dmp_states(context)
         goals = self._goals_entry.Eval(context)[:, [k]]
         # The selected DMP alone is rolled out (banks of its one DMP): the same path as

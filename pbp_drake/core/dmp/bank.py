@@ -23,9 +23,10 @@ from pbp_drake.core.dmp.workspace import DmpWorkspace
 
 
 class BankModel:
-    """What the position bank and `OrientationDmpBank` share: immutability after
-    `__init__`, the settings, the phase decay, the constructor from single DMPs, and
-    open-loop prediction (a subclass keeps its `starts` as `(rows, K)`)."""
+    """What the position bank and `OrientationDmpBank` share: the model's checks
+    (`_keep_model`), immutability after `__init__`, the settings, the phase decay, the
+    constructor from single DMPs, and open-loop prediction (a subclass keeps its `starts` as
+    `(rows, K)`)."""
 
     def __setattr__(self, name, value):
         # Immutable after construction: a bank shared by threads or Drake Contexts must not
@@ -33,6 +34,43 @@ class BankModel:
         if getattr(self, "_frozen", False):
             raise AttributeError(f"{type(self).__name__} is immutable: cannot set {name!r}")
         object.__setattr__(self, name, value)
+
+    def _keep_model(self, weights, starts, duration, settings, amplitude_scaling, goal_count,
+                    dimension):
+        """Checks and keeps what every bank's `__init__` does: a private copy of `settings`
+        (a plain dataclass the caller may change later), `duration`, the weights, read-only
+        (`(N, D)` shared by all goals, or `(K, N, D)` one set per goal, kept `(N, D, K)`),
+        `goal_count` (K: with shared weights the given one, else one per row of `starts`),
+        `dimension` (D; None: the weights'), the amplitude scaling `(D, K)` and the basis."""
+        settings.validate()
+        self._settings = dataclasses.replace(settings)
+        self.duration = positive(duration, "duration")
+        weights = np.asarray(weights, dtype=float)
+        if weights.ndim == 2:
+            # One set of weights for every goal: shared work, one (N, D) matrix.
+            self.shared_weights = True
+            if goal_count is None:
+                goal_count = 1 if np.ndim(starts) == 1 else np.shape(starts)[0]
+            self._weights = read_only(weights)
+        elif weights.ndim == 3:
+            self.shared_weights = False
+            goal_count = weights.shape[0]
+            self._weights = read_only(weights.transpose(1, 2, 0))  # (N, D, K)
+        else:
+            raise ValueError(f"weights must be (N, D) or (K, N, D), got shape {weights.shape}")
+        dimension = weights.shape[-1] if dimension is None else dimension
+        if weights.shape[-2:] != (settings.basis_count, dimension):
+            raise ValueError(f"weights have shape {weights.shape}; the settings say "
+                             f"{settings.basis_count} basis functions, of {dimension} numbers")
+        if goal_count < 1:
+            raise ValueError("a DMP bank needs at least one goal")
+        self.goal_count = goal_count
+        self.dimension = dimension
+        scaling = np.ones((goal_count, dimension), bool) if amplitude_scaling is None else (
+            np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, dimension)))
+        self.amplitude_scaling = read_only(scaling.T)  # (D, K)
+        centres, widths = settings.basis()
+        self._centres, self._widths = read_only(centres), read_only(widths)
 
     @classmethod
     def from_dmps(cls, dmps):
@@ -100,41 +138,10 @@ class DmpBankModel(BankStep, BankModel):
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
                  amplitude_scaling=None, goal_count=None):
-        settings.validate()
-        # A private copy: the settings are a plain dataclass the caller may change later.
-        self._settings = dataclasses.replace(settings)
-        settings = self._settings
-        self.duration = positive(duration, "duration")
-        weights = np.asarray(weights, dtype=float)
-        if weights.ndim == 2:
-            # One set of weights for every goal: shared work, one (N, D) matrix.
-            self.shared_weights = True
-            if goal_count is None:
-                goal_count = 1 if np.ndim(starts) == 1 else np.shape(starts)[0]
-            self._weights = read_only(weights)
-            dimension = weights.shape[1]
-        elif weights.ndim == 3:
-            self.shared_weights = False
-            goal_count = weights.shape[0]
-            dimension = weights.shape[2]
-            self._weights = read_only(weights.transpose(1, 2, 0))  # (N, D, K)
-        else:
-            raise ValueError(f"weights must be (N, D) or (K, N, D), got shape {weights.shape}")
-        if weights.shape[-2] != settings.basis_count:
-            raise ValueError(
-                f"weights have {weights.shape[-2]} basis functions, settings say "
-                f"{settings.basis_count}"
-            )
-        if goal_count < 1:
-            raise ValueError("a DMP bank needs at least one goal")
-        self.goal_count = goal_count
-        self.dimension = dimension
-        self.starts = read_only(broadcast_goalwise(starts, goal_count, dimension, "starts"))
-        scaling = np.ones((goal_count, dimension), bool) if amplitude_scaling is None else (
-            np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, dimension)))
-        self.amplitude_scaling = read_only(scaling.T)  # (D, K)
-        centres, widths = settings.basis()
-        self._centres, self._widths = read_only(centres), read_only(widths)
+        self._keep_model(weights, starts, duration, settings, amplitude_scaling, goal_count,
+                         None)
+        self.starts = read_only(
+            broadcast_goalwise(starts, self.goal_count, self.dimension, "starts"))
         self._derive_constants()
         self._frozen = True
 

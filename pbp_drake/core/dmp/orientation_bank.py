@@ -8,13 +8,12 @@ and `locked` the two banks' phases stay equal. The step is the position bank's o
 `e = Log(q g*)` (3, K), with the quaternion math around it (`orientation_kernels`,
 `orientation_log_step`) written into an `OrientationWorkspace` the caller owns."""
 
-import dataclasses
 import functools
 
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp._checks import followed_velocity, goal_indices, positive, read_only
+from pbp_drake.core.dmp._checks import followed_velocity, goal_indices, read_only
 from pbp_drake.core.dmp.bank import BankModel
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
@@ -51,46 +50,22 @@ class OrientationDmpBank(BankModel):
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
                  amplitude_scaling=None, goal_count=None):
-        settings.validate()
-        self._settings = dataclasses.replace(settings)
-        self.duration = positive(duration, "duration")
-        weights = np.asarray(weights, dtype=float)
         starts = quaternion.unit_quaternions(starts, "starts")
-        if weights.ndim == 2:
-            self.shared_weights = True
-            if goal_count is None:
-                goal_count = 1 if starts.ndim == 1 else starts.shape[0]
-            self._weights = read_only(weights)  # (N, 3)
-        elif weights.ndim == 3:
-            self.shared_weights = False
-            goal_count = weights.shape[0]
-            # (N, 3 K): the step contracts it with the basis in one product.
-            self._weights = read_only(weights.transpose(1, 2, 0).reshape(weights.shape[1], -1))
-        else:
-            raise ValueError(f"weights must be (N, 3) or (K, N, 3), got shape {weights.shape}")
-        if weights.shape[-2:] != (settings.basis_count, AXES):
-            raise ValueError(f"weights must have {settings.basis_count} basis functions "
-                             f"(the settings') and 3 axes, got shape {weights.shape}")
-        if goal_count < 1:
-            raise ValueError("an orientation DMP bank needs at least one goal")
-        self.goal_count = goal_count
-        self.dimension = AXES
+        self._keep_model(weights, starts, duration, settings, amplitude_scaling, goal_count,
+                         AXES)
+        goal_count = self.goal_count
         if starts.ndim == 1:
             starts = np.broadcast_to(starts, (goal_count, 4))
         if starts.shape != (goal_count, 4):
             raise ValueError(f"starts must be ({goal_count}, 4) or (4,), got {starts.shape}")
         self.starts = read_only(starts.T)  # (4, K)
-        scaling = (np.ones((goal_count, AXES), bool) if amplitude_scaling is None else
-                   np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, AXES)))
-        self.amplitude_scaling = read_only(scaling.T)  # (3, K)
-        self._all_scaled = bool(scaling.all())
-        self._weight_rows = None if self.shared_weights else WeightRows(self._weights)
+        self._all_scaled = bool(self.amplitude_scaling.all())
+        self._weight_rows = (None if self.shared_weights else WeightRows(
+            self._weights.reshape(settings.basis_count, -1)))  # (N, 3 K)
         self._ijspeert = settings.formulation == "ijspeert"
         # One start for all: `q0 g*` is then one 4x4 product (`error_quaternions_into`).
         self._uniform_start = (read_only(self.starts[:, :1])
                                if (self.starts == self.starts[:, :1]).all() else None)
-        centres, widths = settings.basis()
-        self._centres, self._widths = read_only(centres), read_only(widths)
         self._frozen = True
 
     @classmethod
@@ -220,8 +195,8 @@ class OrientationDmpBank(BankModel):
         scaling (as `DmpBankModel.subset`)."""
         indices = goal_indices(indices, self.goal_count)
         weights = self._weights
-        if not self.shared_weights:  # (N, 3 K) back to (M, N, 3)
-            weights = weights.reshape(len(weights), AXES, -1)[:, :, indices].transpose(2, 0, 1)
+        if not self.shared_weights:  # (N, 3, K) back to (M, N, 3)
+            weights = weights[:, :, indices].transpose(2, 0, 1)
         return type(self)(weights, self.starts[:, indices].T, self.duration, self._settings,
                           self.amplitude_scaling[:, indices].T, goal_count=indices.size)
 
@@ -358,7 +333,7 @@ class OrientationDmpBank(BankModel):
         basis, lam = (self._equal_phase_basis(phase, decay, combination) if basis is None
                       else basis)
         window = self._weight_rows.window(basis)
-        weights = scaled_weights(self._weights, workspace, *window)
+        weights = scaled_weights(self._weight_rows.weights, workspace, *window)
         out = workspace.shape if out is None else out
         self._weight_rows.contract_into(basis, out.reshape(2, -1), weights, window)
         return lam
@@ -367,7 +342,6 @@ class OrientationDmpBank(BankModel):
         """Rows r of `combination` (2x2): `S_r = C_r0 s(x0) + C_r1 s(x1)` with
         `s(x) = (psi.w / sum psi) x` (over K in the Ijspeert form), `(2, 3, 1)` or
         `(2, 3, K)`, and `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`."""
-        n = self._settings.basis_count
         scale = 1.0 / self._settings.stiffness if self._ijspeert else 1.0
         if phase.size == 1 or phase.min() == phase.max():
             basis, lam = self._equal_phase_basis(phase, decay, combination)
@@ -382,6 +356,5 @@ class OrientationDmpBank(BankModel):
         if self.shared_weights:
             shapes = np.einsum("nd,rnk->rdk", self._weights, combined)
         else:
-            weights = self._weights.reshape(n, AXES, self.goal_count)
-            shapes = np.einsum("ndk,rnk->rdk", weights, combined)
+            shapes = np.einsum("ndk,rnk->rdk", self._weights, combined)
         return shapes, combination @ phases

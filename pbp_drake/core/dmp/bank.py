@@ -93,6 +93,18 @@ class BankModel:
         """The phase factor `exp(-alpha_x dt / tau)` of one step."""
         return phase_decay(self._settings, self.duration, dt)
 
+    def subset(self, indices):
+        """The bank of the DMPs `indices` (M,) alone, in that order: a new immutable bank
+        with the same duration and settings and those DMPs' weights, starts and amplitude
+        scaling (what drawing a few of K DMPs' paths steps, instead of all K)."""
+        indices = goal_indices(indices, self.goal_count)
+        starts = self.starts[:, indices].T
+        scaling = self.amplitude_scaling[:, indices].T
+        weights = (self._weights if self.shared_weights
+                   else self._weights[:, :, indices].transpose(2, 0, 1))  # (M, N, D)
+        return type(self)(weights, starts, self.duration, self._settings, scaling,
+                          goal_count=indices.size)
+
     def predict(self, phase, start, velocity, goals, dt, steps, workspace=None):
         """Open-loop paths `(K, steps + 1, rows)` from one state (`start` `(rows, 1)` or
         `(rows, K)`), for drawing predictions; the inputs are left alone. `workspace`
@@ -285,15 +297,3 @@ class DmpBankModel(BankStep, BankModel):
         out_phase[...] = np.where(locked, phase, new_phase)
         out_positions[...] = np.where(locked, positions, new_positions)
         out_velocity[...] = np.where(locked, held, new_velocity)
-
-    def subset(self, indices):
-        """The bank of the DMPs `indices` (M,) alone, in that order: a new immutable bank
-        with the same duration and settings and those DMPs' weights, starts and amplitude
-        scaling (what drawing a few of K DMPs' paths steps, instead of all K)."""
-        indices = goal_indices(indices, self.goal_count)
-        starts = self.starts[:, indices].T
-        scaling = self.amplitude_scaling[:, indices].T
-        weights = (self._weights if self.shared_weights
-                   else self._weights[:, :, indices].transpose(2, 0, 1))  # (M, N, D)
-        return type(self)(weights, starts, self.duration, self._settings, scaling,
-                          goal_count=indices.size)

@@ -71,7 +71,8 @@ class OrientationDmp(SingleDmp):
     """One orientation DMP, stepped with a plain per-axis loop: the readable reference.
 
     State: `phase`, `orientation` (4,) and `scaled_angular_velocity` (3,) `eta = tau omega`.
-    `straight` turns along the shorter arc from `start` to `goal` (a slerp path).
+    `straight` (`SingleDmp`'s) turns along the shorter arc from `start` to `goal` (a slerp
+    path); `rollout` is `SingleDmp`'s too.
     """
 
     PATH = "orientation"

@@ -13,7 +13,7 @@ import functools
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp._checks import followed_velocity, goal_indices, read_only
+from pbp_drake.core.dmp._checks import followed_velocity, read_only
 from pbp_drake.core.dmp.bank import BankModel
 from pbp_drake.core.dmp.contraction import WeightRows, scaled_weights
 from pbp_drake.core.dmp.orientation import (
@@ -45,7 +45,8 @@ class OrientationDmpBank(BankModel):
     All share `duration` and `settings`; each has its own start orientation and phase, and
     its own weights `(K, N, 3)` or one set `(N, 3)` shared by all (straight paths, or one
     demonstration sent to K goals). Immutable: the state is passed in and out of `advance`
-    (pure) and `advance_into` (into the caller's arrays, with a workspace).
+    (pure) and `advance_into` (into the caller's arrays, with a workspace). `subset`,
+    `predict` and `from_dmps` are `BankModel`'s.
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
@@ -188,17 +189,6 @@ class OrientationDmpBank(BankModel):
             return
         self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
                         out_phase, out_orientations, out_velocity, workspace)
-
-    def subset(self, indices):
-        """The bank of the DMPs `indices` (M,) alone, in that order: a new immutable bank
-        with the same duration and settings and those DMPs' weights, starts and amplitude
-        scaling (as `DmpBankModel.subset`)."""
-        indices = goal_indices(indices, self.goal_count)
-        weights = self._weights
-        if not self.shared_weights:  # (N, 3, K) back to (M, N, 3)
-            weights = weights[:, :, indices].transpose(2, 0, 1)
-        return type(self)(weights, self.starts[:, indices].T, self.duration, self._settings,
-                          self.amplitude_scaling[:, indices].T, goal_count=indices.size)
 
     def _start_errors_into(self, goals_4k, workspace, goals_unchanged=False):
         """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`

@@ -105,7 +105,8 @@ class SingleDmp:
 
 
 class Dmp(SingleDmp):
-    """One DMP in D dimensions, stepped with a plain per-dimension loop."""
+    """One DMP in D dimensions, stepped with a plain per-dimension loop (`straight` and
+    `rollout`: `SingleDmp`'s)."""
 
     PATH = "position"
 

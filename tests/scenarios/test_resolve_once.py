@@ -11,7 +11,7 @@ import pbp_drake.core.dmp.single as single_dmp_module
 import pbp_drake.scenarios.resolution as resolve_module
 import pbp_drake.scenarios.task_scenes as task_scenes_module
 from pbp_drake.builder import build_diagram
-from pbp_drake.scenarios import BentPath, TaskScenario, load_scenario_file
+from pbp_drake.scenarios import BentPath, GraspTask, TaskScenario, load_scenario_file
 from pbp_drake.studies.runners import compute_trial
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
@@ -51,11 +51,13 @@ def test_loading_and_building_with_meshcat_resolves_once(path, work, meshcat):
     task = isinstance(scenario, TaskScenario)
     assert work["bent_path"] == (
         1 if not task and isinstance(scenario.demonstration, BentPath) else 0)
-    # Once, where the DMPs run: the 2-D scenes' when resolved, the tasks' in their
-    # controller (the grasping task's from the pose station's hand); never for a task's
-    # straight Pastor DMPs, whose forcing term is 0.
+    # Once per bank, where the DMPs run: the 2-D scenes' when resolved, the tasks' in their
+    # controller (the grasping task's position and orientation banks from the pose
+    # station's hand, both straight); never for a task's straight Pastor DMPs, whose
+    # forcing term is 0.
     straight_pastor = task and scenario.dmp.formulation == "pastor"
-    assert work["fit_weights"] == (0 if straight_pastor else 1)
+    banks = 2 if task and isinstance(scenario.task, GraspTask) else 1
+    assert work["fit_weights"] == (0 if straight_pastor else banks)
     scenes = (work["sample_reach_scene"] + work["sample_obstacle_scene"]
               + work["sample_grasp_scene"])
     assert scenes == (1 if task else 0)

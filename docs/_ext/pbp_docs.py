@@ -278,6 +278,12 @@ def _api_page(name, topic):
         directive = [f".. automodule:: {value.__name__}", "   :members:"]
     elif inspect.isclass(value):
         directive = [f".. autoclass:: pbp_drake.{name}", "   :members:"]
+        # Members a class inherits from one of ours (`Dmp.rollout` from `SingleDmp`) are
+        # its own to a reader; Drake's and Python's (LeafSystem's, tuple's) are not.
+        foreign = [base.__name__ for base in value.__mro__[1:]
+                   if not base.__module__.startswith("pbp_drake")]
+        if len(foreign) < len(value.__mro__) - 1:
+            directive.append(f"   :inherited-members: {', '.join(foreign)}")
     else:
         directive = [f".. autofunction:: pbp_drake.{name}"]
     # Orphans, reached from the table: in a toctree, each of them would stand in every page's

@@ -1,14 +1,12 @@
 """A person with a gamepad in a Meshcat browser steering the hand in six DoF: the nearest
 thing to the paper's 3-D mouse that a browser offers."""
 
-import dataclasses
-
 import numpy as np
 
-from pbp_drake.systems.operators.browser_input import (
-    apply_dead_zone, fresh_after_pause, gamepad_values)
+from pbp_drake.systems.operators.browser_input import apply_dead_zone, check_params
+from pbp_drake.systems.operators.gamepad_operator import GamepadParams
+from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase
 from pbp_drake.systems.ports import OperatorTwist
-from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase, check_params
 
 # The W3C standard mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN,
 # triggers are analog buttons in [0, 1], shoulders digital ones.
@@ -19,15 +17,11 @@ _AXES, _BUTTONS = 4, 8
 PRESSED = 0.5
 
 
-@dataclasses.dataclass
-class PoseGamepadParams:
-    """A person with a gamepad steering the hand in six DoF: translation at up to `speed`
-    (m/s; 0 takes the task's nominal speed), rotation at up to `rotation_speed` (rad/s);
-    `dead_zone`, in [0, 1), is each stick's radial dead zone and each trigger's."""
-
-    speed: float = 0.0
-    rotation_speed: float = 0.6
-    dead_zone: float = 0.15
+class PoseGamepadParams(GamepadParams):
+    """`GamepadParams` of a person with a gamepad steering the hand in six DoF: translation
+    at up to `speed` (m/s; 0 takes the task's nominal speed), rotation at up to
+    `rotation_speed` (rad/s); `dead_zone`, in [0, 1), is each stick's radial dead zone and
+    each trigger's."""
 
 
 class PoseGamepadOperator(PoseOperatorBase):
@@ -72,22 +66,14 @@ class PoseGamepadOperator(PoseOperatorBase):
     def __init__(self, meshcat, control_period, allow_forward,
                  params=PoseGamepadParams(), nominal_speed=None, exclusive=True):
         check_params(params, fraction=("dead_zone",))
-        super().__init__(meshcat, control_period, allow_forward,
-                         *self.speeds(params, nominal_speed), exclusive)
-        self.params = dataclasses.replace(params)
+        super().__init__(meshcat, control_period, allow_forward, params, nominal_speed,
+                         exclusive)
         self._dead_zone = float(params.dead_zone)
-        # The controls Meshcat held when the last pause ended (NaN: none to ignore).
-        self._stale_index = self.DeclareDiscreteState(np.full(_AXES + _BUTTONS, np.nan))
+        self._declare_gamepad(_AXES, _BUTTONS)
         self._declare_operator_outputs()
 
     def _update(self, context, discrete_state):
-        # Read before the connections are counted (see KeyboardOperator._update).
-        gamepad = self._meshcat.GetGamepad()
-        stale, fresh = fresh_after_pause(
-            self.browser_guard, self._meshcat,
-            context.get_discrete_state(self._stale_index).value(), gamepad, _AXES, _BUTTONS)
-        discrete_state.get_mutable_vector(self._stale_index).set_value(stale)
-        values = gamepad_values(gamepad, _AXES, _BUTTONS) if fresh else None
+        values = self._read_gamepad(context, discrete_state)
         if values is None:
             self._store_sample(discrete_state, np.zeros(OperatorTwist.size), False)
             return

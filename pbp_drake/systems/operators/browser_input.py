@@ -1,11 +1,5 @@
-"""What the browser operators share: the base `BrowserOperator` (speeds, the browser guard,
-the keys' or the gamepad's reading), buttons held for a while after each click (keys), and
-gamepad sticks with a dead zone, read from Meshcat.
-
-The keyboard operators keep their buttons' state as one vector in discrete state (`HeldButtons`
-reads and steps it), so the system holds no state outside its Context. Meshcat must be used
-only from the thread that created it.
-"""
+"""What the browser operators share: the base `BrowserOperator`, buttons held for a while
+after each click (keys), and gamepad sticks with a dead zone, read from Meshcat."""
 
 import dataclasses
 import math
@@ -37,9 +31,12 @@ class BrowserOperator(SampledOperator):
     `nominal_speed`, see `operator_speed`) and `rotation_speed` (rad/s). `allow_forward`
     is False in PBP modes, where forward motion comes from the DMP phase. With `exclusive`
     a `BrowserGuard` (`browser_guard`) pauses the simulation while more than one browser
-    is connected to the page, and what was sent meanwhile is dropped. Subclasses read
-    their keys (`_declare_keys`, `_step_keys`) or gamepad (`_declare_gamepad`,
-    `_read_gamepad`) in `_update`. Use Meshcat only from the thread that created it.
+    is connected to the page, and nothing sent meanwhile counts: clicks are dropped and
+    every key released, and the gamepad state Meshcat last received (from whichever page)
+    is ignored until the controls change. Subclasses read their keys (`_declare_keys`,
+    `_step_keys`; the keys' state is discrete state, so the system holds no state outside
+    its Context) or gamepad (`_declare_gamepad`, `_read_gamepad`) in `_update`. Use
+    Meshcat only from the thread that created it.
     """
 
     def __init__(self, meshcat, dimension, control_period, allow_forward, params,

@@ -50,9 +50,7 @@ class GamepadOperator(BrowserOperator):
     yaw_rate]` in the world frame (vz = 0); `operator_active` is 1 while a stick is outside
     its dead zone (a stick pushed only forward does not count when forward is not
     allowed). With no gamepad (none received, or reported disconnected) the command is
-    zero and inactive. With `exclusive` (see `BrowserOperator`), after a pause the gamepad
-    state Meshcat last received (from whichever page) is ignored until the sticks report
-    something new. Use Meshcat only from the thread that created it.
+    zero and inactive. `exclusive` and Meshcat's thread are as in `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward, params=GamepadParams(),

@@ -91,11 +91,10 @@ class KeyboardOperator(BrowserOperator):
     unless `vertical`); `operator_active` is 1 while any effective key is held (even if
     opposite keys cancel).
 
-    With `exclusive` (the default, see `BrowserOperator`) the clicks sent while the guard
-    pauses the run are dropped and every key released: no second page drives the robot.
-    Click counts are snapshotted at initialisation, and the last counts and click times are
-    kept in discrete state, so the system holds no state outside its Context. Use Meshcat
-    only from the thread that created it; the buttons stay there until `Delete()`.
+    `exclusive` (the default: no second page drives the robot) and Meshcat's thread are as
+    in `BrowserOperator`. Click counts are snapshotted at initialisation, and the last
+    counts and click times are kept in discrete state. The buttons stay in Meshcat until
+    `Delete()`.
     """
 
     # The buttons' names, for code that presses them (`Meshcat`'s injected clicks, tests).

@@ -51,16 +51,14 @@ class PoseGamepadOperator(PoseOperatorBase):
         | right shoulder (RB, 5) / left shoulder (LB, 4) | roll right / left about z_H |
 
     Each stick has a radial dead zone and each trigger a dead zone of `dead_zone`, past
-    which the deflection rises continuously from 0; translation and rotation are each capped
-    at `speed` and `rotation_speed` (two controls pushed together go no faster than one).
-    With `allow_forward=False` (PBP modes) the velocity's forward part along the approach
-    axis z_H is dropped (the paper's disabled forward key); in teleop it stays.
+    which the deflection rises continuously from 0. The speeds, their caps (two controls
+    pushed together go no faster than one) and the forward drop of PBP modes are
+    `PoseOperatorBase`'s.
 
     `operator_active` is 1 while the twist is not zero (a push that is wholly dropped does
     not count). With no gamepad the twist is zero and inactive; a value that is not finite
-    reads as a control at rest. With `exclusive` a `BrowserGuard` pauses the run while more
-    than one browser is connected, and after a pause the controls Meshcat last received are
-    ignored until they change. Use Meshcat only from the thread that created it.
+    reads as a control at rest. `exclusive` and Meshcat's thread are as in
+    `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,

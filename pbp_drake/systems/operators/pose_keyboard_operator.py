@@ -79,9 +79,8 @@ class PoseKeyboardOperator(PoseOperatorBase):
 
     Keys are held as in `KeyboardOperator` (clicks snapshotted at initialisation); the key
     state and the mode are discrete state. The page's mode label follows the mode of the
-    last update. With `exclusive` a `BrowserGuard` pauses the run while more than one
-    browser is connected and drops what was sent meanwhile, R included. Use Meshcat only
-    from the thread that created it; `Delete()` removes the buttons.
+    last update. `exclusive` and Meshcat's thread are as in `BrowserOperator` (R's clicks
+    too are dropped in a pause); `Delete()` removes the buttons.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,

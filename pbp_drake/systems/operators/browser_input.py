@@ -9,6 +9,11 @@ import numpy as np
 from pbp_drake.systems.operators.browser_guard import BrowserGuard
 from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 
+# The W3C standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is
+# DOWN, triggers are analog buttons in [0, 1], shoulders digital ones.
+LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X, RIGHT_STICK_Y = 0, 1, 2, 3
+LEFT_SHOULDER, RIGHT_SHOULDER, LEFT_TRIGGER, RIGHT_TRIGGER = 4, 5, 6, 7
+
 
 def check_params(params, positive=(), fraction=()):
     """Raises ValueError naming the field of the dataclass `params` that is not finite and

@@ -6,12 +6,10 @@ import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
 from pbp_drake.systems.operators.browser_input import (
-    BrowserOperator, apply_dead_zone, check_params)
+    LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X, BrowserOperator, apply_dead_zone, check_params)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
-# Standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN.
-LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X = 0, 1, 2
-_STICK_AXES = 3
+_STICK_AXES = 3  # LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X
 
 
 @dataclasses.dataclass

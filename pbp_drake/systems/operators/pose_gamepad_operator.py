@@ -3,16 +3,14 @@ thing to the paper's 3-D mouse that a browser offers."""
 
 import numpy as np
 
-from pbp_drake.systems.operators.browser_input import apply_dead_zone, check_params
+from pbp_drake.systems.operators.browser_input import (
+    LEFT_SHOULDER, LEFT_STICK_X, LEFT_STICK_Y, LEFT_TRIGGER, RIGHT_SHOULDER, RIGHT_STICK_X,
+    RIGHT_STICK_Y, RIGHT_TRIGGER, apply_dead_zone, check_params)
 from pbp_drake.systems.operators.gamepad_operator import GamepadParams
 from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase
 from pbp_drake.systems.ports import OperatorTwist
 
-# The W3C standard mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN,
-# triggers are analog buttons in [0, 1], shoulders digital ones.
-LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X, RIGHT_STICK_Y = 0, 1, 2, 3
-LEFT_SHOULDER, RIGHT_SHOULDER, LEFT_TRIGGER, RIGHT_TRIGGER = 4, 5, 6, 7
-_AXES, _BUTTONS = 4, 8
+_AXES, _BUTTONS = 4, 8  # the sticks' axes; the buttons up to RIGHT_TRIGGER
 # A shoulder button counts as pressed above this value (they send 0 or 1).
 PRESSED = 0.5
 

@@ -40,9 +40,6 @@ class PoseOperatorBase(BrowserOperator):
                          nominal_speed, exclusive, command_name="operator_twist")
         self._hand_state_port = self.DeclareVectorInputPort("hand_state", PoseState.size)
 
-    def get_operator_twist_output_port(self):
-        return self.get_operator_command_output_port()
-
     def _validate(self, command):
         return validate_twist(command, "operator_twist")
 

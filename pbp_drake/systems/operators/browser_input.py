@@ -116,7 +116,7 @@ class HeldButtons:
         """`keys`: button name -> JavaScript `KeyboardEvent.code`, in order."""
         self._meshcat = meshcat
         self.names = list(keys)
-        self._hold_time = float(hold_time)
+        self.hold_time = float(hold_time)
         for name, code in keys.items():
             meshcat.AddButton(name, code)
 
@@ -144,7 +144,7 @@ class HeldButtons:
 
     def held(self, state, time):
         """Which keys are held at `time` (bool, n)."""
-        return time - state[len(self.names):] < self._hold_time - 1e-9
+        return time - state[len(self.names):] < self.hold_time - 1e-9
 
 
 def apply_dead_zone(stick, dead_zone):

@@ -88,7 +88,6 @@ class PoseKeyboardOperator(PoseOperatorBase):
         check_params(params, positive=("hold_time",))
         super().__init__(meshcat, control_period, allow_forward, params, nominal_speed,
                          exclusive)
-        self._hold_time = float(params.hold_time)
         self._declare_keys(KEY_BUTTONS, _KEY_AXES, params.hold_time)
         self._shown = MODE_LABELS[TRANSLATE]
         meshcat.AddButton(self._shown, MODE_KEY)
@@ -134,7 +133,7 @@ class PoseKeyboardOperator(PoseOperatorBase):
         if paused:
             seen, last = self._show(mode), -np.inf
         else:
-            toggled = mode_clicks > seen and time - last >= self._hold_time - 1e-9
+            toggled = mode_clicks > seen and time - last >= self._keys.hold_time - 1e-9
             if mode_clicks > seen:  # a click within hold_time of the last is R's repeat
                 last = time
             seen = mode_clicks

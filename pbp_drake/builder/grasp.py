@@ -41,7 +41,7 @@ import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
-from pbp_drake.builder.operators import shown_intent_and_keys
+from pbp_drake.builder.operators import make_person, shown_intent_and_keys
 from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.core.controller_config import nominal_duration
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
@@ -61,11 +61,10 @@ from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
     PoseGoalEstimator, PoseGoalGrouping, PoseHandOver, PoseIntentFilterGoalEstimator,
     PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
-from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator, PoseGamepadParams
+from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import GraspSceneVisualizer
 from pbp_drake.systems.operators.pilot_filters import GraspKeys
-from pbp_drake.systems.operators.pose_keyboard_operator import (
-    PoseKeyboardOperator, PoseKeyboardParams)
+from pbp_drake.systems.operators.pose_keyboard_operator import PoseKeyboardOperator
 from pbp_drake.systems.ports import OperatorTwist
 
 # The commanded angular velocity changes by at most this much (rad/s) between two
@@ -295,20 +294,8 @@ def _operator(resolved, grasps, meshcat):
     period = scenario.control_period
     if not METHODS[scenario.method].operated or isinstance(config, NoOperator):
         return IdleOperator(OperatorTwist.size, period)
-    # Only teleop and the baselines that add to a full command let the person push along
-    # the approach axis (the paper's forward key).
-    teleop = forward_key_enabled(scenario)
-    if isinstance(config, (Keyboard, Gamepad)) and meshcat is None:
-        raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
-                            "Meshcat (pbp-drake run without --headless)")
-    if isinstance(config, Keyboard):
-        return PoseKeyboardOperator(meshcat, period, teleop, PoseKeyboardParams(
-            config.speed, config.rotation_speed, config.hold_time),
-            nominal_speed=resolved.nominal_speed)
-    if isinstance(config, Gamepad):
-        return PoseGamepadOperator(meshcat, period, teleop, PoseGamepadParams(
-            config.speed, config.rotation_speed, config.dead_zone),
-            nominal_speed=resolved.nominal_speed)
+    if isinstance(config, (Keyboard, Gamepad)):
+        return make_person(resolved, meshcat, PoseKeyboardOperator, PoseGamepadOperator)
     if isinstance(config, PILOT_CONFIGS):  # a surrogate pilot (`scenarios.pilots`)
         return make_pilot(resolved, lambda participant: _operator(participant, grasps, meshcat),
                           GraspKeys)

@@ -46,16 +46,13 @@ def sinusoidal_step_commands(config, control_period, duration):
 
 
 def make_hsr_operator(resolved, meshcat):
-    """The HSR task's operator: a person at the keyboard or gamepad (they need `meshcat`),
-    or the virtual participant (which watches the task's obstacles, if any). The keys are
-    the method's (`forward_key_enabled`: the paper disables forward under PBP and
-    arbitration); the virtual participant is built from the same arguments under every
-    method and reads the keys from its `forward_key` input, as a person sees them."""
+    """The HSR task's operator: a person at the keyboard or gamepad (`make_person`), or the
+    virtual participant (which watches the task's obstacles, if any). The virtual
+    participant is built from the same arguments under every method and reads the keys
+    from its `forward_key` input, as a person sees them."""
     scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
-    allow_forward = forward_key_enabled(scenario)
-    speed = resolved.nominal_speed
     # Objects at heights of their own (`task.z_range`): the operator moves up and down too.
     vertical = bool(getattr(scenario.task, "z_range", None))
     if not METHODS[scenario.method].operated or isinstance(config, NoOperator):
@@ -66,15 +63,25 @@ def make_hsr_operator(resolved, meshcat):
                           len(resolved.station.obstacles))
     if isinstance(config, VirtualParticipant):
         return VirtualOperator(period, resolved.scene.objects, **participant_arguments(resolved))
+    if isinstance(config, (Keyboard, Gamepad)):
+        return make_person(resolved, meshcat, KeyboardOperator, GamepadOperator,
+                           vertical=vertical)
+    raise TypeError(f"unknown operator config {type(config).__name__}")
+
+
+def make_person(resolved, meshcat, keyboard, gamepad, **keyboard_options):
+    """A person in the browser (the scenario's `!Keyboard` or `!Gamepad`, which need
+    `meshcat`): the task's `keyboard` or `gamepad` operator class, with the method's keys
+    (`forward_key_enabled`: the paper disables forward under PBP and arbitration)."""
+    scenario = resolved.scenario
+    config = scenario.operator
     if meshcat is None:
         raise ScenarioError(f"operator !{type(config).__name__} reads the browser: it needs "
                             "Meshcat (pbp-drake run without --headless)")
-    if isinstance(config, Keyboard):
-        return KeyboardOperator(meshcat, period, allow_forward, config, nominal_speed=speed,
-                                vertical=vertical)
+    arguments = (meshcat, scenario.control_period, forward_key_enabled(scenario), config)
     if isinstance(config, Gamepad):
-        return GamepadOperator(meshcat, period, allow_forward, config, nominal_speed=speed)
-    raise TypeError(f"unknown operator config {type(config).__name__}")
+        return gamepad(*arguments, nominal_speed=resolved.nominal_speed)
+    return keyboard(*arguments, nominal_speed=resolved.nominal_speed, **keyboard_options)
 
 
 def participant_arguments(resolved):

@@ -47,15 +47,14 @@ class BrowserGuard:
     """Waits while more than one browser is connected to `meshcat`.
 
     `wait_while_shared()` is called by an operator each time it reads its browser: it
-    returns at once (False) with at most one page (the front's pages heard from, else
-    Meshcat's connections); with more it waits up to `settle` seconds for them to go (True:
-    a page that closed as it connected), else announces the pause (`announce`, the
-    terminal by default, and a button in the page carrying the notice), polls every
-    `poll_period` seconds until at most one is left, announces the end of the pause, calls
-    `after_pause` if set (see `reset_pacing_after_pauses`) and returns True: the caller
-    must then drop what the browser sent meanwhile. While a connection the front did not
-    open is there, it returns True at once (announced once). `pauses` counts the pauses
-    so far. Use from the thread that created Meshcat.
+    returns at once (False) with at most one page (counted as the module says); with more
+    it waits up to `settle` seconds for them to go (True: a page that closed as it
+    connected), else announces the pause (`announce`, the terminal by default, and a button
+    in the page carrying the notice), polls every `poll_period` seconds until at most one
+    is left, announces the end of the pause, calls `after_pause` if set (see
+    `reset_pacing_after_pauses`) and returns True: the caller must then drop what the
+    browser sent meanwhile. With an intruder it returns True at once. `pauses` counts the
+    pauses so far. Use from the thread that created Meshcat.
     """
 
     def __init__(self, meshcat, poll_period=0.05, announce=None, settle=0.2):

@@ -1,12 +1,108 @@
-"""What the browser operators share: buttons held for a while after each click (keys), and
-gamepad sticks with a dead zone, read from Meshcat.
+"""What the browser operators share: the base `BrowserOperator`, buttons held for a while
+after each click (keys), and gamepad sticks with a dead zone, read from Meshcat."""
 
-The keyboard operators keep their buttons' state as one vector in discrete state (`HeldButtons`
-reads and steps it), so the system holds no state outside its Context. Meshcat must be used
-only from the thread that created it.
-"""
+import dataclasses
+import math
 
 import numpy as np
+
+from pbp_drake.systems.operators.browser_guard import BrowserGuard
+from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
+
+# The W3C standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is
+# DOWN, triggers are analog buttons in [0, 1], shoulders digital ones.
+LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X, RIGHT_STICK_Y = 0, 1, 2, 3
+LEFT_SHOULDER, RIGHT_SHOULDER, LEFT_TRIGGER, RIGHT_TRIGGER = 4, 5, 6, 7
+
+
+def check_params(params, positive=(), fraction=()):
+    """Raises ValueError naming the field of the dataclass `params` that is not finite and
+    positive (`positive` fields) or not in [0, 1) (`fraction` fields)."""
+    kind = type(params).__name__
+    for field in positive:
+        value = getattr(params, field)
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"{kind}.{field} must be finite and positive, not {value!r}")
+    for field in fraction:
+        value = getattr(params, field)
+        if not (isinstance(value, (int, float)) and 0.0 <= value < 1.0):
+            raise ValueError(f"{kind}.{field} must be in [0, 1), not {value!r}")
+
+
+class BrowserOperator(SampledOperator):
+    """A person in a Meshcat browser, at its keyboard or gamepad.
+
+    `params` (a dataclass, copied to `self.params`) gives `speed` (m/s; 0 takes
+    `nominal_speed`, see `operator_speed`) and `rotation_speed` (rad/s). `allow_forward`
+    is False in PBP modes, where forward motion comes from the DMP phase. With `exclusive`
+    a `BrowserGuard` (`browser_guard`) pauses the simulation while more than one browser
+    is connected to the page, and nothing sent meanwhile counts: clicks are dropped and
+    every key released, and the gamepad state Meshcat last received (from whichever page)
+    is ignored until the controls change. Subclasses read their keys (`_declare_keys`,
+    `_step_keys`; the keys' state is discrete state, so the system holds no state outside
+    its Context) or gamepad (`_declare_gamepad`, `_read_gamepad`) in `_update`. Use
+    Meshcat only from the thread that created it.
+    """
+
+    def __init__(self, meshcat, dimension, control_period, allow_forward, params,
+                 nominal_speed, exclusive, command_name="operator_command"):
+        super().__init__(dimension, control_period, command_name)
+        self.params = dataclasses.replace(params)
+        self._meshcat = meshcat
+        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
+        self._allow_forward = bool(allow_forward)
+        self._speed = operator_speed(params.speed, nominal_speed)
+        self._rotation_speed = float(params.rotation_speed)
+
+    def _declare_keys(self, keys, axes, hold_time):
+        """Adds one button per key (`keys`: name -> `KeyboardEvent.code`, see `HeldButtons`),
+        `self._axes` the rows of `axes` (name -> what the held key adds) in the buttons'
+        order, and the keys' state as discrete state, its click counts snapshotted at
+        initialisation."""
+        self._keys = HeldButtons(self._meshcat, keys, hold_time)
+        self._axes = np.array([axes[name] for name in self._keys.names])
+        self._keys_index = self.DeclareDiscreteState(
+            self._keys.released(np.zeros(len(self._keys))))
+        self.DeclareInitializationDiscreteUpdateEvent(self._snapshot)
+
+    def _snapshot(self, context, discrete_state):
+        discrete_state.get_mutable_vector(self._keys_index).set_value(self._keys.released())
+
+    def _step_keys(self, context, discrete_state, clicks):
+        """Stores and returns the keys' state after `clicks`, and whether the guard paused
+        (then every key is released: what another page sent does not count). Meshcat is
+        read once a tick, before the connections are counted: a click read then came from
+        a page connected before the count."""
+        paused = self.browser_guard is not None and self.browser_guard.wait_while_shared()
+        if paused:
+            keys = self._keys.released()
+        else:
+            keys = self._keys.step(context.get_discrete_state(self._keys_index).value(),
+                                   clicks, context.get_time())
+        discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
+        return keys, paused
+
+    def _declare_gamepad(self, axis_count, button_count=0):
+        """Reads the gamepad's first `axis_count` axes and `button_count` buttons."""
+        self._gamepad_counts = (axis_count, button_count)
+        # The controls Meshcat held when the last pause ended (NaN: none to ignore).
+        self._stale_index = self.DeclareDiscreteState(
+            np.full(axis_count + button_count, np.nan))
+
+    def _read_gamepad(self, context, discrete_state):
+        """The gamepad's `gamepad_values`, or None. Meshcat keeps the last state it received
+        from whichever page sent it, so the controls held when a guard pause ends are
+        ignored (None) until they change. Read before the connections are counted (see
+        `_step_keys`)."""
+        gamepad = self._meshcat.GetGamepad()
+        counts = self._gamepad_counts
+        stale = context.get_discrete_state(self._stale_index).value()
+        if self.browser_guard is not None and self.browser_guard.wait_while_shared():
+            stale = raw_values(self._meshcat.GetGamepad(), *counts)
+        elif not np.array_equal(raw_values(gamepad, *counts), stale, equal_nan=True):
+            stale = np.full(len(stale), np.nan)  # the controls moved since: read them again
+        discrete_state.get_mutable_vector(self._stale_index).set_value(stale)
+        return gamepad_values(gamepad, *counts) if np.isnan(stale).all() else None
 
 
 class HeldButtons:
@@ -20,7 +116,7 @@ class HeldButtons:
         """`keys`: button name -> JavaScript `KeyboardEvent.code`, in order."""
         self._meshcat = meshcat
         self.names = list(keys)
-        self._hold_time = float(hold_time)
+        self.hold_time = float(hold_time)
         for name, code in keys.items():
             meshcat.AddButton(name, code)
 
@@ -48,7 +144,7 @@ class HeldButtons:
 
     def held(self, state, time):
         """Which keys are held at `time` (bool, n)."""
-        return time - state[len(self.names):] < self._hold_time - 1e-9
+        return time - state[len(self.names):] < self.hold_time - 1e-9
 
 
 def apply_dead_zone(stick, dead_zone):
@@ -67,13 +163,9 @@ def gamepad_values(gamepad, axis_count, button_count=0):
     entries 0, or None when there is no gamepad. The browser sends an empty status when the
     gamepad disconnects, and Meshcat then keeps the old index: empty axes mean none too.
     A value that is not finite (no real pad sends one) reads as a control at rest."""
-    axes = list(gamepad.axes)
-    if gamepad.index is None or len(axes) < 2:
+    if gamepad.index is None or len(gamepad.axes) < 2:
         return None
-    buttons = list(gamepad.button_values)
-    axes = _padded(axes, axis_count)
-    buttons = _padded(buttons, button_count)
-    return axes, buttons
+    return _padded(gamepad.axes, axis_count), _padded(gamepad.button_values, button_count)
 
 
 def _padded(values, count):
@@ -92,16 +184,3 @@ def raw_values(gamepad, axis_count, button_count=0):
 def _as_sent(values, count):
     values = list(values)[:count]
     return np.array(values + [np.nan] * (count - len(values)), float)
-
-
-def fresh_after_pause(guard, meshcat, stale, gamepad, axis_count, button_count=0):
-    """The gamepad operators' rule after a `BrowserGuard` pause: Meshcat keeps the last state
-    it received from whichever page sent it, so the controls held when a pause ends are
-    ignored until they change. `stale` is the `raw_values` remembered (all NaN: none);
-    returns the new `stale` and whether `gamepad` (read before the guard) may be used."""
-    if guard is not None and guard.wait_while_shared():
-        stale = raw_values(meshcat.GetGamepad(), axis_count, button_count)
-    elif not np.array_equal(raw_values(gamepad, axis_count, button_count), stale,
-                            equal_nan=True):
-        stale = np.full(len(stale), np.nan)  # the controls moved since: read them again
-    return stale, bool(np.isnan(stale).all())

@@ -5,15 +5,11 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
-from pbp_drake.systems.operators.browser_guard import BrowserGuard
 from pbp_drake.systems.operators.browser_input import (
-    apply_dead_zone, fresh_after_pause, gamepad_values)
+    LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X, BrowserOperator, apply_dead_zone, check_params)
 from pbp_drake.systems.ports import EeState, OperatorCommand
-from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 
-# Standard gamepad mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN.
-LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X = 0, 1, 2
-_STICK_AXES = 3
+_STICK_AXES = 3  # LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X
 
 
 @dataclasses.dataclass
@@ -29,7 +25,7 @@ class GamepadParams:
     dead_zone: float = 0.15
 
 
-class GamepadOperator(SampledOperator):
+class GamepadOperator(BrowserOperator):
     """Task-space velocity commands from the gamepad Meshcat sees.
 
     .. pydrake_system::
@@ -52,45 +48,27 @@ class GamepadOperator(SampledOperator):
     yaw_rate]` in the world frame (vz = 0); `operator_active` is 1 while a stick is outside
     its dead zone (a stick pushed only forward does not count when forward is not
     allowed). With no gamepad (none received, or reported disconnected) the command is
-    zero and inactive. `exclusive` is `KeyboardOperator`'s; after a pause the gamepad
-    state Meshcat last received (from whichever page) is ignored until the sticks report
-    something new. Use Meshcat only from the thread that created it.
+    zero and inactive. `exclusive` and Meshcat's thread are as in `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward, params=GamepadParams(),
                  nominal_speed=None, exclusive=True):
-        if not 0.0 <= params.dead_zone < 1.0:
-            raise ValueError(f"dead_zone must be in [0, 1), not {params.dead_zone}")
-        super().__init__(OperatorCommand.size, control_period)
-        self.params = dataclasses.replace(params)
-        self._meshcat = meshcat
-        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
-        self._allow_forward = bool(allow_forward)
-        self._speed = operator_speed(params.speed, nominal_speed)
-        self._rotation_speed = float(params.rotation_speed)
+        check_params(params, fraction=("dead_zone",))
+        super().__init__(meshcat, OperatorCommand.size, control_period, allow_forward, params,
+                         nominal_speed, exclusive)
         self._dead_zone = float(params.dead_zone)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
-        # The stick axes Meshcat held when the last pause ended (NaN: none to ignore).
-        self._stale_index = self.DeclareDiscreteState(np.full(_STICK_AXES, np.nan))
+        self._declare_gamepad(_STICK_AXES)
         self._declare_operator_outputs()
 
     def _update(self, context, discrete_state):
-        # Read before the connections are counted (see KeyboardOperator._update).
-        gamepad = self._meshcat.GetGamepad()
-        stale, fresh = fresh_after_pause(
-            self.browser_guard, self._meshcat,
-            context.get_discrete_state(self._stale_index).value(), gamepad, _STICK_AXES)
-        discrete_state.get_mutable_vector(self._stale_index).set_value(stale)
-        if fresh:
-            self._store_sample(discrete_state, *self._command(context, gamepad))
-        else:
-            self._store_sample(discrete_state, np.zeros(OperatorCommand.size), False)
-
-    def _command(self, context, gamepad):
-        values = gamepad_values(gamepad, _STICK_AXES)
+        values = self._read_gamepad(context, discrete_state)
         if values is None:
-            return np.zeros(4), False
-        axes = values[0]
+            self._store_sample(discrete_state, np.zeros(OperatorCommand.size), False)
+        else:
+            self._store_sample(discrete_state, *self._command(context, values[0]))
+
+    def _command(self, context, axes):
         # Browser axes: x right, y down. Robot frame: forward, left.
         stick = apply_dead_zone([-axes[LEFT_STICK_Y], -axes[LEFT_STICK_X]], self._dead_zone)
         turn = apply_dead_zone([-axes[RIGHT_STICK_X]], self._dead_zone)[0]

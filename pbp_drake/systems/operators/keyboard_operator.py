@@ -5,10 +5,8 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core.reach_task import rotate_planar
-from pbp_drake.systems.operators.browser_guard import BrowserGuard
-from pbp_drake.systems.operators.browser_input import HeldButtons
+from pbp_drake.systems.operators.browser_input import BrowserOperator
 from pbp_drake.systems.ports import EeState, OperatorCommand
-from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 
 FORWARD_BUTTON = "Forward (↑)"
 BACK_BUTTON = "Back (↓)"
@@ -62,7 +60,7 @@ class KeyboardParams:
     hold_time: float = 0.6
 
 
-class KeyboardOperator(SampledOperator):
+class KeyboardOperator(BrowserOperator):
     """Task-space velocity commands from Meshcat buttons bound to keys.
 
     .. pydrake_system::
@@ -93,12 +91,10 @@ class KeyboardOperator(SampledOperator):
     unless `vertical`); `operator_active` is 1 while any effective key is held (even if
     opposite keys cancel).
 
-    With `exclusive` (the default) a `BrowserGuard` (`browser_guard`) pauses the simulation
-    while more than one browser is connected to the page, and the clicks sent meanwhile
-    are dropped and every key released: no second page drives the robot. Click counts are
-    snapshotted at initialisation, and the last counts and click times are kept in
-    discrete state, so the system holds no state outside its Context. Use Meshcat only
-    from the thread that created it; the buttons stay there until `Delete()`.
+    `exclusive` (the default: no second page drives the robot) and Meshcat's thread are as
+    in `BrowserOperator`. Click counts are snapshotted at initialisation, and the last
+    counts and click times are kept in discrete state. The buttons stay in Meshcat until
+    `Delete()`.
     """
 
     # The buttons' names, for code that presses them (`Meshcat`'s injected clicks, tests).
@@ -109,23 +105,14 @@ class KeyboardOperator(SampledOperator):
 
     def __init__(self, meshcat, control_period, allow_forward, params=KeyboardParams(),
                  nominal_speed=None, exclusive=True, vertical=False):
-        super().__init__(OperatorCommand.size, control_period)
-        self.params = dataclasses.replace(params)
-        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
-        self._vertical = bool(vertical)
-        self._speed = operator_speed(params.speed, nominal_speed)
-        self._rotation_speed = float(params.rotation_speed)
+        super().__init__(meshcat, OperatorCommand.size, control_period, allow_forward, params,
+                         nominal_speed, exclusive)
         keys = {name: code for name, code in KEY_BUTTONS.items()
                 if allow_forward or name != FORWARD_BUTTON}
-        if self._vertical:
+        if vertical:
             keys.update(VERTICAL_KEY_BUTTONS)
-        self._keys = HeldButtons(meshcat, keys, params.hold_time)
-        self._axes = np.array([_KEY_AXES[name] for name in self._keys.names])
+        self._declare_keys(keys, _KEY_AXES, params.hold_time)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
-        # Per button: the click count last seen, then the time of its last click.
-        self._keys_index = self.DeclareDiscreteState(
-            self._keys.released(np.zeros(len(self._keys))))
-        self.DeclareInitializationDiscreteUpdateEvent(self._snapshot)
         self._declare_operator_outputs()
 
     def button_names(self):
@@ -136,20 +123,8 @@ class KeyboardOperator(SampledOperator):
         """Removes this operator's buttons from Meshcat (they stay there otherwise)."""
         self._keys.delete()
 
-    def _snapshot(self, context, discrete_state):
-        discrete_state.get_mutable_vector(self._keys_index).set_value(self._keys.released())
-
     def _update(self, context, discrete_state):
-        # Meshcat is read once a tick; the key state and the command come from that read.
-        # The connections are counted after the read: a click read here came from a page
-        # connected before the count.
-        clicks = self._keys.clicks()
-        if self.browser_guard is not None and self.browser_guard.wait_while_shared():
-            keys = self._keys.released()  # what another page sent does not count
-        else:
-            keys = self._keys.step(context.get_discrete_state(self._keys_index).value(),
-                                   clicks, context.get_time())
-        discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
+        keys, _ = self._step_keys(context, discrete_state, self._keys.clicks())
         self._store_sample(discrete_state, *self._command(context, keys))
 
     def _command(self, context, keys):

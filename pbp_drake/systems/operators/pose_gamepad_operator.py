@@ -1,33 +1,25 @@
 """A person with a gamepad in a Meshcat browser steering the hand in six DoF: the nearest
 thing to the paper's 3-D mouse that a browser offers."""
 
-import dataclasses
-
 import numpy as np
 
 from pbp_drake.systems.operators.browser_input import (
-    apply_dead_zone, fresh_after_pause, gamepad_values)
+    LEFT_SHOULDER, LEFT_STICK_X, LEFT_STICK_Y, LEFT_TRIGGER, RIGHT_SHOULDER, RIGHT_STICK_X,
+    RIGHT_STICK_Y, RIGHT_TRIGGER, apply_dead_zone, check_params)
+from pbp_drake.systems.operators.gamepad_operator import GamepadParams
+from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase
 from pbp_drake.systems.ports import OperatorTwist
-from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase, check_params
 
-# The W3C standard mapping (https://w3c.github.io/gamepad/#remapping): stick y is DOWN,
-# triggers are analog buttons in [0, 1], shoulders digital ones.
-LEFT_STICK_X, LEFT_STICK_Y, RIGHT_STICK_X, RIGHT_STICK_Y = 0, 1, 2, 3
-LEFT_SHOULDER, RIGHT_SHOULDER, LEFT_TRIGGER, RIGHT_TRIGGER = 4, 5, 6, 7
-_AXES, _BUTTONS = 4, 8
+_AXES, _BUTTONS = 4, 8  # the sticks' axes; the buttons up to RIGHT_TRIGGER
 # A shoulder button counts as pressed above this value (they send 0 or 1).
 PRESSED = 0.5
 
 
-@dataclasses.dataclass
-class PoseGamepadParams:
-    """A person with a gamepad steering the hand in six DoF: translation at up to `speed`
-    (m/s; 0 takes the task's nominal speed), rotation at up to `rotation_speed` (rad/s);
-    `dead_zone`, in [0, 1), is each stick's radial dead zone and each trigger's."""
-
-    speed: float = 0.0
-    rotation_speed: float = 0.6
-    dead_zone: float = 0.15
+class PoseGamepadParams(GamepadParams):
+    """`GamepadParams` of a person with a gamepad steering the hand in six DoF: translation
+    at up to `speed` (m/s; 0 takes the task's nominal speed), rotation at up to
+    `rotation_speed` (rad/s); `dead_zone`, in [0, 1), is each stick's radial dead zone and
+    each trigger's."""
 
 
 class PoseGamepadOperator(PoseOperatorBase):
@@ -57,37 +49,27 @@ class PoseGamepadOperator(PoseOperatorBase):
         | right shoulder (RB, 5) / left shoulder (LB, 4) | roll right / left about z_H |
 
     Each stick has a radial dead zone and each trigger a dead zone of `dead_zone`, past
-    which the deflection rises continuously from 0; translation and rotation are each capped
-    at `speed` and `rotation_speed` (two controls pushed together go no faster than one).
-    With `allow_forward=False` (PBP modes) the velocity's forward part along the approach
-    axis z_H is dropped (the paper's disabled forward key); in teleop it stays.
+    which the deflection rises continuously from 0. The speeds, their caps (two controls
+    pushed together go no faster than one) and the forward drop of PBP modes are
+    `PoseOperatorBase`'s.
 
     `operator_active` is 1 while the twist is not zero (a push that is wholly dropped does
     not count). With no gamepad the twist is zero and inactive; a value that is not finite
-    reads as a control at rest. With `exclusive` a `BrowserGuard` pauses the run while more
-    than one browser is connected, and after a pause the controls Meshcat last received are
-    ignored until they change. Use Meshcat only from the thread that created it.
+    reads as a control at rest. `exclusive` and Meshcat's thread are as in
+    `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,
                  params=PoseGamepadParams(), nominal_speed=None, exclusive=True):
         check_params(params, fraction=("dead_zone",))
-        super().__init__(meshcat, control_period, allow_forward,
-                         *self.speeds(params, nominal_speed), exclusive)
-        self.params = dataclasses.replace(params)
+        super().__init__(meshcat, control_period, allow_forward, params, nominal_speed,
+                         exclusive)
         self._dead_zone = float(params.dead_zone)
-        # The controls Meshcat held when the last pause ended (NaN: none to ignore).
-        self._stale_index = self.DeclareDiscreteState(np.full(_AXES + _BUTTONS, np.nan))
+        self._declare_gamepad(_AXES, _BUTTONS)
         self._declare_operator_outputs()
 
     def _update(self, context, discrete_state):
-        # Read before the connections are counted (see KeyboardOperator._update).
-        gamepad = self._meshcat.GetGamepad()
-        stale, fresh = fresh_after_pause(
-            self.browser_guard, self._meshcat,
-            context.get_discrete_state(self._stale_index).value(), gamepad, _AXES, _BUTTONS)
-        discrete_state.get_mutable_vector(self._stale_index).set_value(stale)
-        values = gamepad_values(gamepad, _AXES, _BUTTONS) if fresh else None
+        values = self._read_gamepad(context, discrete_state)
         if values is None:
             self._store_sample(discrete_state, np.zeros(OperatorTwist.size), False)
             return

@@ -1,12 +1,11 @@
 """A person at the keyboard of a Meshcat browser steering the hand in six DoF: arrows and
 PageUp/PageDown translate, or after the mode key R rotate."""
 
-import dataclasses
-
 import numpy as np
 
-from pbp_drake.systems.operators.browser_input import HeldButtons
-from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase, check_params
+from pbp_drake.systems.operators.browser_input import check_params
+from pbp_drake.systems.operators.keyboard_operator import KeyboardParams
+from pbp_drake.systems.operators.pose_operator_base import PoseOperatorBase
 
 # Each button's label names what its key does in both modes: translate | rotate.
 FORWARD_KEY = "↑ forward | pitch down"
@@ -41,15 +40,10 @@ MODE_KEY = "KeyR"
 MODE_LABELS = ("Mode: translate (R: rotate)", "Mode: rotate (R: translate)")
 
 
-@dataclasses.dataclass
-class PoseKeyboardParams:
-    """A person at the keyboard steering the hand in six DoF: keys translate at `speed`
-    (m/s; 0 takes the task's nominal speed) or rotate at `rotation_speed` (rad/s); a key
-    counts as held `hold_time` seconds after its last press (see `KeyboardParams`)."""
-
-    speed: float = 0.0
-    rotation_speed: float = 0.6
-    hold_time: float = 0.6
+class PoseKeyboardParams(KeyboardParams):
+    """`KeyboardParams` of a person at the keyboard steering the hand in six DoF: keys
+    translate at `speed` (m/s; 0 takes the task's nominal speed) or rotate at
+    `rotation_speed` (rad/s)."""
 
 
 class PoseKeyboardOperator(PoseOperatorBase):
@@ -85,27 +79,20 @@ class PoseKeyboardOperator(PoseOperatorBase):
 
     Keys are held as in `KeyboardOperator` (clicks snapshotted at initialisation); the key
     state and the mode are discrete state. The page's mode label follows the mode of the
-    last update. With `exclusive` a `BrowserGuard` pauses the run while more than one
-    browser is connected and drops what was sent meanwhile, R included. Use Meshcat only
-    from the thread that created it; `Delete()` removes the buttons.
+    last update. `exclusive` and Meshcat's thread are as in `BrowserOperator` (R's clicks
+    too are dropped in a pause); `Delete()` removes the buttons.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,
                  params=PoseKeyboardParams(), nominal_speed=None, exclusive=True):
         check_params(params, positive=("hold_time",))
-        super().__init__(meshcat, control_period, allow_forward,
-                         *self.speeds(params, nominal_speed), exclusive)
-        self.params = dataclasses.replace(params)
-        self._hold_time = float(params.hold_time)
-        self._keys = HeldButtons(meshcat, KEY_BUTTONS, params.hold_time)
-        self._axes = np.array([_KEY_AXES[name] for name in self._keys.names])
+        super().__init__(meshcat, control_period, allow_forward, params, nominal_speed,
+                         exclusive)
+        self._declare_keys(KEY_BUTTONS, _KEY_AXES, params.hold_time)
         self._shown = MODE_LABELS[TRANSLATE]
         meshcat.AddButton(self._shown, MODE_KEY)
-        self._keys_index = self.DeclareDiscreteState(
-            self._keys.released(np.zeros(len(self._keys))))
         # [mode, the mode button's click count last seen, the time of its last click].
         self._mode_index = self.DeclareDiscreteState([TRANSLATE, 0.0, -np.inf])
-        self.DeclareInitializationDiscreteUpdateEvent(self._snapshot)
         self._declare_operator_outputs()
 
     def button_names(self):
@@ -131,31 +118,28 @@ class PoseKeyboardOperator(PoseOperatorBase):
         return self._meshcat.GetButtonClicks(label)
 
     def _snapshot(self, context, discrete_state):
-        discrete_state.get_mutable_vector(self._keys_index).set_value(self._keys.released())
+        super()._snapshot(context, discrete_state)
         discrete_state.get_mutable_vector(self._mode_index).set_value(
             [TRANSLATE, self._show(TRANSLATE), -np.inf])
 
     def _update(self, context, discrete_state):
-        # Read once a tick, before the connections are counted (see KeyboardOperator).
+        # R is read with the keys, before the connections are counted (see `_step_keys`).
         clicks = self._keys.clicks()
         mode, seen, last = context.get_discrete_state(self._mode_index).value()
         mode = int(mode)
         mode_clicks = self._show(mode)
         time = context.get_time()
-        if self.browser_guard is not None and self.browser_guard.wait_while_shared():
-            keys = self._keys.released()  # what another page sent does not count
+        keys, paused = self._step_keys(context, discrete_state, clicks)
+        if paused:
             seen, last = self._show(mode), -np.inf
         else:
-            keys = self._keys.step(context.get_discrete_state(self._keys_index).value(),
-                                   clicks, time)
-            toggled = mode_clicks > seen and time - last >= self._hold_time - 1e-9
+            toggled = mode_clicks > seen and time - last >= self._keys.hold_time - 1e-9
             if mode_clicks > seen:  # a click within hold_time of the last is R's repeat
                 last = time
             seen = mode_clicks
             if toggled:
                 mode = 1 - mode
                 seen = self._show(mode)  # the relabelled button counts from 0
-        discrete_state.get_mutable_vector(self._keys_index).set_value(keys)
         discrete_state.get_mutable_vector(self._mode_index).set_value([mode, seen, last])
         self._store_sample(discrete_state, *self._command(context, keys, mode))
 

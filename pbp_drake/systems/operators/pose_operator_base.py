@@ -8,26 +8,11 @@ import numpy as np
 from pbp_drake.core.operator_frame import capped, operator_twist, without_forward_twist
 from pbp_drake.core.pose_arbitration import validate_twist
 from pbp_drake.core.quaternion import unit_quaternions
-from pbp_drake.systems.operators.browser_guard import BrowserGuard
+from pbp_drake.systems.operators.browser_input import BrowserOperator, check_params
 from pbp_drake.systems.ports import OperatorTwist, PoseState
-from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 
 
-def check_params(params, positive=(), fraction=()):
-    """Raises ValueError naming the field of the dataclass `params` that is not finite and
-    positive (`positive` fields) or not in [0, 1) (`fraction` fields)."""
-    kind = type(params).__name__
-    for field in positive:
-        value = getattr(params, field)
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ValueError(f"{kind}.{field} must be finite and positive, not {value!r}")
-    for field in fraction:
-        value = getattr(params, field)
-        if not (isinstance(value, (int, float)) and 0.0 <= value < 1.0):
-            raise ValueError(f"{kind}.{field} must be in [0, 1), not {value!r}")
-
-
-class PoseOperatorBase(SampledOperator):
+class PoseOperatorBase(BrowserOperator):
     """A six-DoF operator's ports and frame; subclasses read the browser in `_update`.
 
     .. pydrake_system::
@@ -43,28 +28,17 @@ class PoseOperatorBase(SampledOperator):
     a NaN or infinite field is refused by name). Output `operator_twist` is an
     `OperatorTwist` `[vx, vy, vz, wx, wy, wz]` in the world frame. Unit inputs
     `(forward, left, up)` and `(yaw, pitch, roll)`, each capped at length 1, are scaled by
-    `speed` (m/s) and `rotation_speed` (rad/s). Without `allow_forward` (PBP modes) the
-    velocity's forward part along the approach axis z_H is dropped.
+    `speed` (m/s) and `rotation_speed` (rad/s, refused unless finite and positive). Without
+    `allow_forward` (PBP modes) the velocity's forward part along the approach axis z_H is
+    dropped.
     """
 
-    def __init__(self, meshcat, control_period, allow_forward, speed, rotation_speed,
+    def __init__(self, meshcat, control_period, allow_forward, params, nominal_speed,
                  exclusive):
-        super().__init__(OperatorTwist.size, control_period, command_name="operator_twist")
-        self._meshcat = meshcat
-        self.browser_guard = BrowserGuard(meshcat) if exclusive else None
-        self._allow_forward = bool(allow_forward)
-        self._speed = speed
-        self._rotation_speed = rotation_speed
-        self._hand_state_port = self.DeclareVectorInputPort("hand_state", PoseState.size)
-
-    @staticmethod
-    def speeds(params, nominal_speed):
-        """`(speed, rotation_speed)` of `params`, checked (speed 0: `nominal_speed`)."""
         check_params(params, positive=("rotation_speed",))
-        return operator_speed(params.speed, nominal_speed), float(params.rotation_speed)
-
-    def get_operator_twist_output_port(self):
-        return self.get_operator_command_output_port()
+        super().__init__(meshcat, OperatorTwist.size, control_period, allow_forward, params,
+                         nominal_speed, exclusive, command_name="operator_twist")
+        self._hand_state_port = self.DeclareVectorInputPort("hand_state", PoseState.size)
 
     def _validate(self, command):
         return validate_twist(command, "operator_twist")

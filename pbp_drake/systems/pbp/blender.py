@@ -7,8 +7,8 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from pbp_drake.core.arbitration import (
     BLEND_LAWS, CONFIDENCE_WEIGHT, DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH,
-    DEFAULT_CONFIDENCE_LOW, FIXED_WEIGHT, blend, confidence_alpha, validate_confidence_ramp,
-    validate_mode)
+    DEFAULT_CONFIDENCE_LOW, FIXED_WEIGHT, blend, check_alpha, confidence_alpha,
+    validate_confidence_ramp, validate_mode)
 from pbp_drake.systems.ports import PortGetters, goal_index
 
 
@@ -19,19 +19,17 @@ class BlenderBase(PortGetters, LeafSystem):
     `alpha`), so that it can change during a run without rebuilding (`set_alpha`).
 
     A subclass declares its ports, among them `selected_goal` and `goal_probabilities` as
-    `_selected_goal_port` and `_goal_probabilities_port`, which `alpha` reads; it names the
-    check of its modes (`_validate_mode`), their laws (`_laws`, whose weight says where
-    alpha comes from) and the goal estimator whose `goal_probabilities` output feeds it
+    `_selected_goal_port` and `_goal_probabilities_port`, which `alpha` reads; it names its
+    modes' laws (`_laws`) and the goal estimator whose `goal_probabilities` output feeds it
     (`_estimator_name`).
     """
 
-    _validate_mode = staticmethod(validate_mode)
     _laws = BLEND_LAWS
     _estimator_name = "GoalEstimator"
 
     def __init__(self, mode, goal_count, control_period, alpha, confidence_range, alpha_max):
         super().__init__()
-        self._validate_mode(mode, alpha)
+        validate_mode(mode, alpha, self._laws)
         try:
             low, high = confidence_range
         except (TypeError, ValueError):
@@ -82,7 +80,7 @@ class BlenderBase(PortGetters, LeafSystem):
         evaluation of the output on). Raises ValueError outside [0, 1] or in another mode."""
         if self._alpha_index is None:
             raise ValueError(f"alpha is a weight of fixed_alpha; this blender is {self._mode}")
-        self._validate_mode(self._mode, alpha)
+        check_alpha(self._mode, alpha)
         context.get_mutable_numeric_parameter(self._alpha_index).SetAtIndex(0, float(alpha))
 
     def _selected_goal(self, context):

@@ -4,8 +4,7 @@ become one pose reference (`pbp_drake.core.pose_arbitration`)."""
 from pbp_drake.core import quaternion
 from pbp_drake.core.arbitration import (
     DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW)
-from pbp_drake.core.pose_arbitration import (
-    POSE_BLEND_LAWS, PoseReference, blend_pose, validate_pose_mode)
+from pbp_drake.core.pose_arbitration import POSE_BLEND_LAWS, PoseReference, blend_pose
 from pbp_drake.systems.pbp.blender import BlenderBase
 from pbp_drake.systems.ports import OperatorTwist, PoseState
 
@@ -40,7 +39,6 @@ class PoseBlender(BlenderBase):
     (`BlenderBase`).
     """
 
-    _validate_mode = staticmethod(validate_pose_mode)
     _laws = POSE_BLEND_LAWS
     _estimator_name = "PoseGoalEstimator"
 

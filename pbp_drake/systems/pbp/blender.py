@@ -1,6 +1,5 @@
-"""The blender: how the operator's command and the robot policy become the robot's command.
-`BlenderBase` holds what it shares with the six-DoF `PoseBlender`: the mode, the
-`confidence_alpha` ramp and `fixed_alpha`'s weight."""
+"""The blender: how the operator's command and the robot policy become the robot's command
+(`Blender`, and `BlenderBase`, its part shared with the six-DoF `PoseBlender`)."""
 
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
@@ -104,22 +103,19 @@ class Blender(BlenderBase):
         output_ports:
         - command
 
-    Modes (see `pbp_drake.core.arbitration`): `pbp_continuous` (Alg. 1, `y + u`),
-    `pbp_alternated` (Alg. 2, `u` alone while the operator acts), `fixed_alpha`
-    (`(1 - alpha) U + alpha P`), `confidence_alpha` (the same with `alpha` from the goal
-    estimator's confidence) and `teleop` (`U`). `robot_state` must be the state sampled
-    at the control tick (the builder puts a ZeroOrderHold in front); `references` holds K
-    next states and `selected_goal` picks one (goal 0 when unconnected), unless
-    `policy_reference` is connected: the selected goal's next state alone
-    (`DmpBank.selected_reference`, O(D) where `references` is O(K D)), which is then
-    followed and `references` is not read. The output is
+    The modes are `pbp_drake.core.arbitration.BLEND_MODES` (the laws: that module's
+    docstring). `robot_state` must be the state sampled at the control tick (the builder
+    puts a ZeroOrderHold in front); `references` holds K next states and `selected_goal`
+    picks one (goal 0 when unconnected), unless `policy_reference` is connected: the
+    selected goal's next state alone (`DmpBank.selected_reference`, O(D) where `references`
+    is O(K D)), which is then followed and `references` is not read. The output is
     `[position (D), velocity (D)]`. A NaN or infinite operator command raises.
 
     `goal_probabilities` (K) is read only in `confidence_alpha` mode, where it must be
     connected (evaluating the command raises otherwise); there `alpha` is the ramp of the
-    selected goal's confidence (`pbp_drake.core.arbitration.confidence_alpha`), and an idle
-    operator gives `P`. `fixed_alpha`'s weight can change during a run (`set_alpha`, the
-    console's alpha slider): see `BlenderBase`.
+    selected goal's confidence (`pbp_drake.core.arbitration.confidence_alpha`).
+    `fixed_alpha`'s weight can change during a run (`set_alpha`, the console's alpha
+    slider): see `BlenderBase`.
     """
 
     def __init__(self, mode, dimension, goal_count, control_period, alpha=None, *,

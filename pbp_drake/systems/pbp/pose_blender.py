@@ -30,13 +30,11 @@ class PoseBlender(BlenderBase):
     `operator_twist` an `OperatorTwist` `[vx, vy, vz, wx, wy, wz]` (world frame), refused
     with its NaN or infinite fields named. `reference` is a `PoseState`.
 
-    Modes (`pbp_drake.core.pose_arbitration`): `pbp_continuous`, `pbp_alternated`,
-    `fixed_alpha`, `confidence_alpha`, `teleop`, `pbp_no_user`; linear parts blend as the
-    position `Blender`'s, angular velocities as world-frame vectors, orientations on SO(3)
-    (turned by `Exp(w dt)`, mixed by slerp). `confidence_alpha` reads `goal_probabilities`
-    (K) and `selected_goal` (goal 0 unconnected), as `Blender`; `fixed_alpha`'s weight is
-    a Context parameter (`set_alpha`). The mode, the ramp and the weight are `Blender`'s
-    (`BlenderBase`).
+    The modes are `pbp_drake.core.pose_arbitration.POSE_BLEND_MODES`: the position
+    `Blender`'s laws with orientations on SO(3), and ``pbp_no_user`` (that module's
+    docstring). As in `Blender` (`BlenderBase`), `confidence_alpha` reads
+    `goal_probabilities` (K) and `selected_goal` (goal 0 unconnected), and `fixed_alpha`'s
+    weight is a Context parameter (`set_alpha`).
     """
 
     _laws = POSE_BLEND_LAWS

@@ -98,8 +98,7 @@ def played_reference(mode, active, alpha, laws=BLEND_LAWS):
     return law.acting if active else law.idle
 
 
-def validate_confidence_ramp(low=DEFAULT_CONFIDENCE_LOW, high=DEFAULT_CONFIDENCE_HIGH,
-                             alpha_max=DEFAULT_ALPHA_MAX):
+def validate_confidence_ramp(low, high, alpha_max):
     """Checks the ramp of ``confidence_alpha``: `0 <= low < high <= 1`, `0 < alpha_max <= 1`."""
     for name, value in (("confidence_low", low), ("confidence_high", high),
                         ("alpha_max", alpha_max)):

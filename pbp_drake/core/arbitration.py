@@ -1,9 +1,10 @@
 """How the operator's command and the robot's policy become one reference (the blending laws).
 
-Every law returns the reference the robot tracks next: a position and a velocity. The
-operator's command `u` is a velocity; over one control period `dt` the operator alone would
-move the robot from `y` to `U = y + u dt`. The laws by mode (`BLEND_LAWS`; the table:
-docs/concepts/pbp.md, "The blending laws"): ``pbp_continuous`` (Alg. 1) `y_dmp + u dt`;
+A law (`BLEND_LAWS`; the table: docs/concepts/pbp.md, "The blending laws") names the
+reference, a position and a velocity, that the robot tracks next while the operator acts and
+while idle. The operator's command `u` is a velocity; over one control period `dt` the
+operator alone would move the robot from `y` to `U = y + u dt`; `P` is the policy's next
+state (`y_dmp`, the selected DMP's). ``pbp_continuous`` (Alg. 1) plays `y_dmp + u dt`;
 ``pbp_alternated`` (Alg. 2) `U` while the operator acts, else `y_dmp`; ``fixed_alpha``
 (Dragan & Srinivasa 2013) `(1 - alpha) U + alpha P` while the operator acts, else `P`;
 ``confidence_alpha`` the same with `alpha` from the goal confidence (`confidence_alpha`,
@@ -36,59 +37,40 @@ DEFAULT_CONFIDENCE_LOW = 0.0
 DEFAULT_CONFIDENCE_HIGH = 1.0
 DEFAULT_ALPHA_MAX = 1.0
 
+#: What a law plays (`BlendLaw.acting`, `BlendLaw.idle`): the module docstring's `U`, `P`,
+#: `P + u dt` and `(1 - alpha) U + alpha P`.
+OPERATOR = "operator"
+POLICY = "policy"
+SHIFTED = "shifted"
+MIXED = "mixed"
+
 
 class BlendLaw(typing.NamedTuple):
-    """One blending law: `law(policy_position, policy_velocity, command, operator_position,
-    active, dt, alpha)` -> (position, velocity), with `operator_position` the operator's
-    `U = y + u dt`; what its weight alpha is
-    (`FIXED_WEIGHT`, `CONFIDENCE_WEIGHT` or None: no weight); and whether the operator's
-    command adds to a policy that keeps running (the DMPs' speed is then capped)."""
+    """One blending law: what it plays while the operator acts and while idle (`OPERATOR`,
+    `POLICY`, `SHIFTED` or `MIXED`); what its weight alpha is (`FIXED_WEIGHT`,
+    `CONFIDENCE_WEIGHT` or None: no weight); and whether the operator's command adds to a
+    policy that keeps running (the DMPs' speed is then capped)."""
 
-    law: typing.Callable
+    acting: str
+    idle: str
     weight: typing.Optional[str] = None
     adds_to_policy: bool = False
-
-
-def _continuous(policy_position, policy_velocity, command, operator_position, active, dt,
-                alpha):
-    return policy_position + command * dt, policy_velocity + command
-
-
-def _alternated(policy_position, policy_velocity, command, operator_position, active, dt,
-                alpha):
-    if active:
-        return operator_position, command
-    return policy_position, policy_velocity
-
-
-def _teleop(policy_position, policy_velocity, command, operator_position, active, dt, alpha):
-    return operator_position, command
-
-
-def _weighted(policy_position, policy_velocity, command, operator_position, active, dt,
-              alpha):
-    if not active:
-        return policy_position, policy_velocity
-    return ((1.0 - alpha) * operator_position + alpha * policy_position,
-            (1.0 - alpha) * command + alpha * policy_velocity)
 
 
 #: The blending laws by mode name (the module docstring); a method names its law
 #: (`pbp_drake.core.methods.Method.blend_mode`).
 BLEND_LAWS = {
-    "pbp_continuous": BlendLaw(_continuous, adds_to_policy=True),
-    "pbp_alternated": BlendLaw(_alternated),
-    "fixed_alpha": BlendLaw(_weighted, FIXED_WEIGHT),
-    "teleop": BlendLaw(_teleop),
-    "confidence_alpha": BlendLaw(_weighted, CONFIDENCE_WEIGHT),
+    "pbp_continuous": BlendLaw(SHIFTED, SHIFTED, adds_to_policy=True),
+    "pbp_alternated": BlendLaw(OPERATOR, POLICY),
+    "fixed_alpha": BlendLaw(MIXED, POLICY, FIXED_WEIGHT),
+    "teleop": BlendLaw(OPERATOR, OPERATOR),
+    "confidence_alpha": BlendLaw(MIXED, POLICY, CONFIDENCE_WEIGHT),
 }
 BLEND_MODES = tuple(BLEND_LAWS)
 
 
-def blend_law(mode, laws=None):
-    """The `BlendLaw` of `mode` in `laws` (default `BLEND_LAWS`); ValueError naming the
-    modes for an unknown one."""
-    laws = BLEND_LAWS if laws is None else laws
+def blend_law(mode, laws=BLEND_LAWS):
+    """The `BlendLaw` of `mode` in `laws`; ValueError naming the modes for an unknown one."""
     if mode not in laws:
         raise ValueError(f"blending mode {mode!r} is unknown; choose one of {tuple(laws)}")
     return laws[mode]
@@ -100,14 +82,23 @@ def check_alpha(mode, alpha):
         raise ValueError(f"alpha must lie in [0, 1] for {mode}, got {alpha}")
 
 
-def validate_mode(mode, alpha=None):
-    """Raises ValueError for an unknown mode, or a fixed-weight one without alpha in [0, 1]."""
-    if blend_law(mode).weight == FIXED_WEIGHT:
+def validate_mode(mode, alpha=None, laws=BLEND_LAWS):
+    """Raises ValueError for a mode unknown to `laws`, or a fixed-weight one without alpha in
+    [0, 1]."""
+    if blend_law(mode, laws).weight == FIXED_WEIGHT:
         check_alpha(mode, alpha)
 
 
-def validate_confidence_ramp(low=DEFAULT_CONFIDENCE_LOW, high=DEFAULT_CONFIDENCE_HIGH,
-                             alpha_max=DEFAULT_ALPHA_MAX):
+def played_reference(mode, active, alpha, laws=BLEND_LAWS):
+    """What `mode`'s law plays this control period (`BlendLaw.acting` or `BlendLaw.idle`);
+    ValueError for a mode unknown to `laws`, or a weighted one acting without alpha in [0, 1]."""
+    law = blend_law(mode, laws)
+    if law.weight is not None and active:
+        check_alpha(mode, alpha)
+    return law.acting if active else law.idle
+
+
+def validate_confidence_ramp(low, high, alpha_max):
     """Checks the ramp of ``confidence_alpha``: `0 <= low < high <= 1`, `0 < alpha_max <= 1`."""
     for name, value in (("confidence_low", low), ("confidence_high", high),
                         ("alpha_max", alpha_max)):
@@ -178,8 +169,13 @@ def blend(mode, robot_position, policy_position, policy_velocity, command, activ
     each control period); the other modes ignore it.
     """
     command = validate_command(command)
-    law = blend_law(mode)
-    if law.weight is not None and active:
-        check_alpha(mode, alpha)
-    return law.law(policy_position, policy_velocity, command, robot_position + command * dt,
-                   active, dt, alpha)
+    reference = played_reference(mode, active, alpha)
+    if reference == POLICY:
+        return policy_position, policy_velocity
+    if reference == SHIFTED:
+        return policy_position + command * dt, policy_velocity + command
+    operator_position = robot_position + command * dt
+    if reference == OPERATOR:
+        return operator_position, command
+    return ((1.0 - alpha) * operator_position + alpha * policy_position,
+            (1.0 - alpha) * command + alpha * policy_velocity)

@@ -16,7 +16,7 @@ import numpy as np
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.arbitration import (
-    BLEND_LAWS, FIXED_WEIGHT, BlendLaw, blend_law, check_alpha)
+    BLEND_LAWS, OPERATOR, POLICY, SHIFTED, BlendLaw, played_reference)
 from pbp_drake.core.hand_over import check_limit, limited_velocity
 
 TWIST_FIELDS = ("vx", "vy", "vz", "wx", "wy", "wz")
@@ -61,12 +61,6 @@ class HandOverLimits(NamedTuple):
                                 zip(self, self._fields, units)))
 
 
-def validate_pose_mode(mode, alpha=None):
-    """Raises ValueError for an unknown mode, or a `fixed_alpha` without alpha in [0, 1]."""
-    if blend_law(mode, POSE_BLEND_LAWS).weight == FIXED_WEIGHT:
-        check_alpha(mode, alpha)
-
-
 def validate_twist(twist, name="operator_twist"):
     """The twist `(vx, vy, vz, wx, wy, wz)` as a new float array; raises ValueError naming
     `name` and the fields that are NaN or infinite, or the wrong size."""
@@ -101,45 +95,17 @@ def blend_pose(mode, robot_position, robot_orientation, policy, twist, active, d
     policy = PoseReference(*(np.asarray(part, dtype=float) for part in policy))
     policy = policy._replace(orientation=quaternion.aligned(policy.orientation,
                                                             robot_orientation))
-    law = blend_law(mode, POSE_BLEND_LAWS)
-    if law.weight is not None and active:
-        check_alpha(mode, alpha)
-    return law.law(policy, robot_position, robot_orientation, linear, angular, active, dt,
-                   alpha)
-
-
-def _operator_pose(robot_position, robot_orientation, linear, angular, dt):
-    """`U`: where the operator alone takes the hand in one period, at its twist."""
-    return PoseReference(np.asarray(robot_position, dtype=float) + linear * dt,
-                         turned(robot_orientation, angular, dt), linear, angular)
-
-
-def _continuous(policy, robot_position, robot_orientation, linear, angular, active, dt,
-                alpha):
-    return PoseReference(policy.position + linear * dt, turned(policy.orientation, angular, dt),
-                         policy.velocity + linear, policy.angular_velocity + angular)
-
-
-def _alternated(policy, robot_position, robot_orientation, linear, angular, active, dt,
-                alpha):
-    if active:
-        return _operator_pose(robot_position, robot_orientation, linear, angular, dt)
-    return policy
-
-
-def _teleop(policy, robot_position, robot_orientation, linear, angular, active, dt, alpha):
-    return _operator_pose(robot_position, robot_orientation, linear, angular, dt)
-
-
-def _policy_alone(policy, robot_position, robot_orientation, linear, angular, active, dt,
-                  alpha):
-    return policy
-
-
-def _weighted(policy, robot_position, robot_orientation, linear, angular, active, dt, alpha):
-    if not active:
+    reference = played_reference(mode, active, alpha, POSE_BLEND_LAWS)
+    if reference == POLICY:
         return policy
-    operator = _operator_pose(robot_position, robot_orientation, linear, angular, dt)
+    if reference == SHIFTED:
+        return PoseReference(policy.position + linear * dt,
+                             turned(policy.orientation, angular, dt),
+                             policy.velocity + linear, policy.angular_velocity + angular)
+    operator = PoseReference(np.asarray(robot_position, dtype=float) + linear * dt,
+                             turned(robot_orientation, angular, dt), linear, angular)
+    if reference == OPERATOR:
+        return operator
     return PoseReference(
         (1.0 - alpha) * operator.position + alpha * policy.position,
         quaternion.slerp(operator.orientation, policy.orientation, alpha),
@@ -147,13 +113,9 @@ def _weighted(policy, robot_position, robot_orientation, linear, angular, active
         (1.0 - alpha) * operator.angular_velocity + alpha * policy.angular_velocity)
 
 
-#: The six-DoF laws by mode: each position law of `BLEND_LAWS` (its weight and
-#: `adds_to_policy` kept), and ``pbp_no_user``, the policy alone.
-_POSE_LAWS = {"pbp_continuous": _continuous, "pbp_alternated": _alternated,
-              "fixed_alpha": _weighted, "teleop": _teleop, "confidence_alpha": _weighted}
-POSE_BLEND_LAWS = {**{mode: law._replace(law=_POSE_LAWS[mode])
-                      for mode, law in BLEND_LAWS.items()},
-                   "pbp_no_user": BlendLaw(_policy_alone)}
+#: The six-DoF laws by mode: the position ones (`BLEND_LAWS`) and ``pbp_no_user``, the
+#: policy alone.
+POSE_BLEND_LAWS = {**BLEND_LAWS, "pbp_no_user": BlendLaw(POLICY, POLICY)}
 POSE_BLEND_MODES = tuple(POSE_BLEND_LAWS)
 
 

@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 from pbp_drake.core import quaternion
+from pbp_drake.core.arbitration import validate_mode
 from pbp_drake.core.pose_arbitration import (
-    POSE_BLEND_MODES, HandOverLimits, PoseReference, blend_pose, pose_hand_over, turned,
-    validate_pose_mode)
+    POSE_BLEND_LAWS, POSE_BLEND_MODES, HandOverLimits, PoseReference, blend_pose, pose_hand_over,
+    turned)
 
 DT = 0.01
 ROBOT_POSITION = np.array([0.4, -0.1, 0.8])
@@ -98,9 +99,9 @@ def test_a_nan_twist_is_refused_with_its_field_named(mode, field, index):
 
 def test_unknown_modes_and_bad_alphas_are_refused():
     with pytest.raises(ValueError, match="unknown"):
-        validate_pose_mode("euler_blend")
+        validate_mode("euler_blend", laws=POSE_BLEND_LAWS)
     with pytest.raises(ValueError, match="alpha"):
-        validate_pose_mode("fixed_alpha", 1.5)
+        validate_mode("fixed_alpha", 1.5, POSE_BLEND_LAWS)
 
 
 LIMITS = HandOverLimits(2.0, 0.5, 0.3 / DT, 1.5)

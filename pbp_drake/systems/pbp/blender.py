@@ -1,14 +1,13 @@
-"""The blender: how the operator's command and the robot policy become the robot's command.
-`BlenderBase` holds what it shares with the six-DoF `PoseBlender`: the mode, the
-`confidence_alpha` ramp and `fixed_alpha`'s weight."""
+"""The blender: how the operator's command and the robot policy become the robot's command
+(`Blender`, and `BlenderBase`, its part shared with the six-DoF `PoseBlender`)."""
 
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from pbp_drake.core.arbitration import (
     BLEND_LAWS, CONFIDENCE_WEIGHT, DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH,
-    DEFAULT_CONFIDENCE_LOW, FIXED_WEIGHT, blend, confidence_alpha, validate_confidence_ramp,
-    validate_mode)
+    DEFAULT_CONFIDENCE_LOW, FIXED_WEIGHT, blend, check_alpha, confidence_alpha,
+    validate_confidence_ramp, validate_mode)
 from pbp_drake.systems.ports import PortGetters, goal_index
 
 
@@ -19,19 +18,17 @@ class BlenderBase(PortGetters, LeafSystem):
     `alpha`), so that it can change during a run without rebuilding (`set_alpha`).
 
     A subclass declares its ports, among them `selected_goal` and `goal_probabilities` as
-    `_selected_goal_port` and `_goal_probabilities_port`, which `alpha` reads; it names the
-    check of its modes (`_validate_mode`), their laws (`_laws`, whose weight says where
-    alpha comes from) and the goal estimator whose `goal_probabilities` output feeds it
+    `_selected_goal_port` and `_goal_probabilities_port`, which `alpha` reads; it names its
+    modes' laws (`_laws`) and the goal estimator whose `goal_probabilities` output feeds it
     (`_estimator_name`).
     """
 
-    _validate_mode = staticmethod(validate_mode)
     _laws = BLEND_LAWS
     _estimator_name = "GoalEstimator"
 
     def __init__(self, mode, goal_count, control_period, alpha, confidence_range, alpha_max):
         super().__init__()
-        self._validate_mode(mode, alpha)
+        validate_mode(mode, alpha, self._laws)
         try:
             low, high = confidence_range
         except (TypeError, ValueError):
@@ -82,7 +79,7 @@ class BlenderBase(PortGetters, LeafSystem):
         evaluation of the output on). Raises ValueError outside [0, 1] or in another mode."""
         if self._alpha_index is None:
             raise ValueError(f"alpha is a weight of fixed_alpha; this blender is {self._mode}")
-        self._validate_mode(self._mode, alpha)
+        check_alpha(self._mode, alpha)
         context.get_mutable_numeric_parameter(self._alpha_index).SetAtIndex(0, float(alpha))
 
     def _selected_goal(self, context):
@@ -106,22 +103,19 @@ class Blender(BlenderBase):
         output_ports:
         - command
 
-    Modes (see `pbp_drake.core.arbitration`): `pbp_continuous` (Alg. 1, `y + u`),
-    `pbp_alternated` (Alg. 2, `u` alone while the operator acts), `fixed_alpha`
-    (`(1 - alpha) U + alpha P`), `confidence_alpha` (the same with `alpha` from the goal
-    estimator's confidence) and `teleop` (`U`). `robot_state` must be the state sampled
-    at the control tick (the builder puts a ZeroOrderHold in front); `references` holds K
-    next states and `selected_goal` picks one (goal 0 when unconnected), unless
-    `policy_reference` is connected: the selected goal's next state alone
-    (`DmpBank.selected_reference`, O(D) where `references` is O(K D)), which is then
-    followed and `references` is not read. The output is
+    The modes are `pbp_drake.core.arbitration.BLEND_MODES` (the laws: that module's
+    docstring). `robot_state` must be the state sampled at the control tick (the builder
+    puts a ZeroOrderHold in front); `references` holds K next states and `selected_goal`
+    picks one (goal 0 when unconnected), unless `policy_reference` is connected: the
+    selected goal's next state alone (`DmpBank.selected_reference`, O(D) where `references`
+    is O(K D)), which is then followed and `references` is not read. The output is
     `[position (D), velocity (D)]`. A NaN or infinite operator command raises.
 
     `goal_probabilities` (K) is read only in `confidence_alpha` mode, where it must be
     connected (evaluating the command raises otherwise); there `alpha` is the ramp of the
-    selected goal's confidence (`pbp_drake.core.arbitration.confidence_alpha`), and an idle
-    operator gives `P`. `fixed_alpha`'s weight can change during a run (`set_alpha`, the
-    console's alpha slider): see `BlenderBase`.
+    selected goal's confidence (`pbp_drake.core.arbitration.confidence_alpha`).
+    `fixed_alpha`'s weight can change during a run (`set_alpha`, the console's alpha
+    slider): see `BlenderBase`.
     """
 
     def __init__(self, mode, dimension, goal_count, control_period, alpha=None, *,

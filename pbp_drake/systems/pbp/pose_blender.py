@@ -4,8 +4,7 @@ become one pose reference (`pbp_drake.core.pose_arbitration`)."""
 from pbp_drake.core import quaternion
 from pbp_drake.core.arbitration import (
     DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH, DEFAULT_CONFIDENCE_LOW)
-from pbp_drake.core.pose_arbitration import (
-    POSE_BLEND_LAWS, PoseReference, blend_pose, validate_pose_mode)
+from pbp_drake.core.pose_arbitration import POSE_BLEND_LAWS, PoseReference, blend_pose
 from pbp_drake.systems.pbp.blender import BlenderBase
 from pbp_drake.systems.ports import OperatorTwist, PoseState
 
@@ -31,16 +30,13 @@ class PoseBlender(BlenderBase):
     `operator_twist` an `OperatorTwist` `[vx, vy, vz, wx, wy, wz]` (world frame), refused
     with its NaN or infinite fields named. `reference` is a `PoseState`.
 
-    Modes (`pbp_drake.core.pose_arbitration`): `pbp_continuous`, `pbp_alternated`,
-    `fixed_alpha`, `confidence_alpha`, `teleop`, `pbp_no_user`; linear parts blend as the
-    position `Blender`'s, angular velocities as world-frame vectors, orientations on SO(3)
-    (turned by `Exp(w dt)`, mixed by slerp). `confidence_alpha` reads `goal_probabilities`
-    (K) and `selected_goal` (goal 0 unconnected), as `Blender`; `fixed_alpha`'s weight is
-    a Context parameter (`set_alpha`). The mode, the ramp and the weight are `Blender`'s
-    (`BlenderBase`).
+    The modes are `pbp_drake.core.pose_arbitration.POSE_BLEND_MODES`: the position
+    `Blender`'s laws with orientations on SO(3), and ``pbp_no_user`` (that module's
+    docstring). As in `Blender` (`BlenderBase`), `confidence_alpha` reads
+    `goal_probabilities` (K) and `selected_goal` (goal 0 unconnected), and `fixed_alpha`'s
+    weight is a Context parameter (`set_alpha`).
     """
 
-    _validate_mode = staticmethod(validate_pose_mode)
     _laws = POSE_BLEND_LAWS
     _estimator_name = "PoseGoalEstimator"
 

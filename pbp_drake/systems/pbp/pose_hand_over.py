@@ -1,15 +1,13 @@
 """The six-DoF hand-over law as a Drake system, between the pose blender and the hand."""
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.pose_arbitration import HandOverLimits, PoseReference, pose_hand_over
-from pbp_drake.systems.ports import PortGetters, PoseState
-from pbp_drake.systems.tick import checked_period, report_offset
+from pbp_drake.systems.pbp.hand_over import HandOverBase
 
 
-class PoseHandOver(PortGetters, LeafSystem):
+class PoseHandOver(HandOverBase):
     """Passes the pose reference on with its linear and angular velocities each changing at
     most `max_acceleration * dt` and `max_angular_acceleration * dt` per tick and capped at
     the speeds (`pbp_drake.core.pose_arbitration.pose_hand_over`).
@@ -28,24 +26,15 @@ class PoseHandOver(PortGetters, LeafSystem):
     """
 
     def __init__(self, initial_pose, limits, control_period):
-        super().__init__()
         initial_pose = np.asarray(initial_pose, dtype=float).reshape(-1)
         if initial_pose.size != 7 or not np.isfinite(initial_pose).all():
             raise ValueError(f"initial_pose must be 7 finite numbers [x, y, z, qw, qx, qy, qz], "
                              f"got {initial_pose.tolist()}")
         orientation = quaternion.unit_quaternions(initial_pose[3:], "initial_pose orientation")
+        super().__init__(np.concatenate([initial_pose[:3], orientation, np.zeros(6)]),
+                         control_period)
         self._limits = HandOverLimits(*limits).checked()
-        self._period = checked_period(control_period)
-        self._reference_port = self.DeclareVectorInputPort("reference", PoseState.size)
-        initial = np.concatenate([initial_pose[:3], orientation, np.zeros(6)])
-        index = self.DeclareDiscreteState(initial)
-        self._command_port = self.DeclareStateOutputPort("command", index)
-        self.DeclarePeriodicDiscreteUpdateEvent(
-            self._period, report_offset(self._period), self._update)
 
-    def _update(self, context, discrete_state):
-        reference = PoseReference.from_vector(self._reference_port.Eval(context))
-        state = discrete_state.get_mutable_vector().get_mutable_value()
-        command = pose_hand_over(state[7:10], state[10:13], reference, self._limits,
-                                 self._period)
-        state[:] = command.to_vector()
+    def _command(self, previous, reference):
+        return pose_hand_over(previous[7:10], previous[10:13], PoseReference.from_vector(reference),
+                              self._limits, self._period).to_vector()

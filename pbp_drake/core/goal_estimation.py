@@ -102,11 +102,7 @@ class GoalEstimatorSettings:
             value = getattr(self, name)
             if not is_real(value) or not math.isfinite(value) or value < 0.0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-        if not is_real(self.margin) or not 0.0 <= self.margin < 1.0:
-            raise ValueError(f"margin must lie in [0, 1), got {self.margin!r}")
-        if (isinstance(self.hold_steps, bool) or not isinstance(self.hold_steps, (int, np.integer))
-                or self.hold_steps < 1):
-            raise ValueError(f"hold_steps must be an integer >= 1, got {self.hold_steps!r}")
+        check_hysteresis(self.margin, self.hold_steps)
         if not (is_real(self.group_mass) and 0.0 <= self.group_mass < 1.0):
             raise ValueError(f"group_mass must lie in [0, 1) (0: no groups), got "
                              f"{self.group_mass!r}")
@@ -121,6 +117,16 @@ class GoalEstimatorSettings:
             raise ValueError(f"intent_filter must be an IntentFilterSettings, got "
                              f"{type(self.intent_filter).__name__}")
         self.intent_filter.validate()
+
+
+def check_hysteresis(margin, hold_steps):
+    """Raises ValueError unless `margin` (a probability) lies in [0, 1) and `hold_steps` is
+    an integer >= 1 (`update_selection`'s)."""
+    if not is_real(margin) or not 0.0 <= margin < 1.0:
+        raise ValueError(f"margin must lie in [0, 1), got {margin!r}")
+    if (isinstance(hold_steps, bool) or not isinstance(hold_steps, (int, np.integer))
+            or hold_steps < 1):
+        raise ValueError(f"hold_steps must be an integer >= 1, got {hold_steps!r}")
 
 
 class SelectionMemory(typing.NamedTuple):

@@ -25,7 +25,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions, is_real
-from pbp_drake.core.intent_filter import IntentFilterSettings
+from pbp_drake.core.intent_filter import NO_BEARING, IntentFilterSettings
 from pbp_drake.core.methods import did_you_mean
 
 #: `Estimator.reads`: the hand's position and heading (`GoalEstimator`, any task) ...
@@ -40,9 +40,6 @@ READS_INTENT = "intent"
 
 #: What an estimator may read.
 READS = (READS_POSITION, READS_POSE, READS_COMMAND, READS_INTENT)
-
-# A goal closer than this (m) to the end effector on the floor plane has no direction.
-FLOOR_EPSILON = 1e-9
 
 # `SelectionMemory.challenger` when no goal challenges the selection.
 NO_CHALLENGER = -1
@@ -195,7 +192,7 @@ def heading_angles(goals, position, heading):
     dx *= dx
     dy *= dy
     dx += dy
-    angles[dx <= FLOOR_EPSILON * FLOOR_EPSILON] = 0.0  # no floor direction (a hypot's test)
+    angles[dx <= NO_BEARING * NO_BEARING] = 0.0  # no floor direction (a hypot's test)
     return angles
 
 

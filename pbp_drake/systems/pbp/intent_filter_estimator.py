@@ -50,14 +50,11 @@ class IntentFilterGoalEstimator(IntentFilterPosterior, MaxEntGoalEstimator):
         - goal_probabilities
         - posterior_clipped
 
-    The ports are `MaxEntGoalEstimator`'s: `ee_state` an `EeState`, `goals` the K goals
-    flattened `(K, 3)`, `operator_command` `[vx, vy, vz, yaw_rate]`, `operator_active` 1
-    while the operator acts. Each update (the decide stage of the tick) reads the
-    operator's command as the motion while it acts, the hand's executed velocity while it
-    is silent, the yaw rate while it acts, and the hand's heading; the belief starts
-    uniform. `settings` is an `IntentFilterSettings`; `margin` and `hold_steps` are the
-    selection's hysteresis (the `goal_estimator` section's). `posterior_clipped` is `[1]`
-    when the last update hit `settings.max_probability`.
+    The ports and outputs are `MaxEntGoalEstimator`'s. Each update reads the operator's
+    command as the motion while it acts, the hand's executed velocity while it is silent,
+    the yaw rate while it acts, and the hand's heading; the belief starts uniform.
+    `settings` is an `IntentFilterSettings`; `margin` and `hold_steps` are the selection's
+    hysteresis (the `goal_estimator` section's).
     """
 
     def _features(self, context, read, active):

@@ -45,7 +45,6 @@ class CommandPosteriorBase(GoalEstimatorBase):
     (`pbp_drake.core.maxent_command`), which reads `operator_active`: the operator's
     command while it acts, the hand's executed motion while it is silent, and its turns."""
 
-    #: The type of the posterior's settings.
     _SETTINGS = HopSettings
 
     def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,

@@ -108,13 +108,16 @@ def intent_features(goals, position, motion, heading, yaw_rate, period, min_spee
     has_bearing, error = floor_bearings(offsets, heading)
     headings = np.where(has_bearing, _straightness(np.abs(error)), 1.0)
     turn = yaw_rate * period
-    turns = np.zeros(len(goals)) if turn == 0.0 else turn_progress(has_bearing, error, turn)
+    if turn == 0.0:
+        turns = np.zeros(len(goals))
+    else:
+        turns = turn_progress(has_bearing, error, turn)
     return IntentFeatures(moves, headings, turns, bool(acts))
 
 
 def floor_bearings(offsets, heading):
     """Whether each goal at `offsets` (K, 2 or 3) from the hand has a bearing on the floor
-    plane (K,), and its heading error `wrap(bearing - heading)` (K,, rad)."""
+    plane (K,), and its heading error `wrap(bearing - heading)` (K,) in rad."""
     has_bearing = np.hypot(offsets[:, 0], offsets[:, 1]) > NO_BEARING
     return has_bearing, _wrapped(np.arctan2(offsets[:, 1], offsets[:, 0]) - heading)
 

@@ -20,14 +20,15 @@ MEMORY_SIZE = 10
 
 class GoalEstimatorBase(PortGetters, LeafSystem):
     """What the goal estimator systems share: the checked `settings` (a copy, of type
-    `_SETTINGS`), the selection with the shipped hysteresis (`goal_estimation.
-    update_selection`, of `margin` and `hold_steps`; None: the settings') and the outputs
-    `selected_goal` (`[index]`, goal 0 before the first update) and `goal_probabilities`
-    (K, uniform before the first update), read from the discrete state so that they hold
-    between updates. The `memory` group starts `[challenger, count]` of the hysteresis
-    (`SelectionMemory`); `memory_size` > 2 leaves room for a subclass's own. A subclass
-    declares its input ports in `_declare_inputs(goal_count)` and updates in `_update`,
-    periodically at the decide stage of each control tick (`pbp_drake.systems.tick`)."""
+    `_SETTINGS`), the selection with the shipped hysteresis (`update_selection` of
+    `pbp_drake.core.goal_estimation`, with `margin` and `hold_steps`; None: the settings')
+    and the outputs `selected_goal` (`[index]`, goal 0 before the first update) and
+    `goal_probabilities` (K, uniform before the first update), read from the discrete
+    state so that they hold between updates. The `memory` group starts with the
+    hysteresis' `[challenger, count]` (`SelectionMemory`); `memory_size` > 2 leaves room
+    for a subclass's own. A subclass declares its input ports in `_declare_inputs(goal_count)`
+    and updates in `_update`, periodically at the decide stage of each control tick
+    (`pbp_drake.systems.tick`)."""
 
     #: The type of the settings.
     _SETTINGS = GoalEstimatorSettings

@@ -42,12 +42,12 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.builder.operators import make_person, shown_intent_and_keys
+from pbp_drake.builder.pbp_controller import make_goal_estimator
 from pbp_drake.builder.pilot_operators import make_pilot
 from pbp_drake.core.controller_config import nominal_duration
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.dmp.primitive import primitive_bank, primitive_orientation_bank
 from pbp_drake.core.grasp_task import approach_direction
-from pbp_drake.core.goal_estimation import READS_COMMAND, READS_INTENT, estimator_entry
 from pbp_drake.core.methods import ASSISTED, METHODS
 from pbp_drake.core.participant_grasp import GraspParticipant, GraspParticipantParams
 from pbp_drake.core.pose_arbitration import HandOverLimits
@@ -59,8 +59,7 @@ from pbp_drake.scenarios import (
     forward_key_enabled)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
-    PoseGoalEstimator, PoseGoalGrouping, PoseHandOver, PoseIntentFilterGoalEstimator,
-    PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
+    PoseGoalGrouping, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
 from pbp_drake.systems.operators.pose_gamepad_operator import PoseGamepadOperator
 from pbp_drake.systems.visualizers.grasp_scene_visualizer import GraspSceneVisualizer
 from pbp_drake.systems.operators.pilot_filters import GraspKeys
@@ -266,26 +265,13 @@ def _add_grouping(builder, resolved, goal_count, estimator, goal_poses, hand_pos
 
 
 def _estimator(resolved, goal_count):
-    """The goal estimator: HOP's posterior under hop and predict_then_assist (the most probable
-    goal selected at once) and with `goal_estimator: {method: maxent_command}` (with the
-    section's hysteresis and the likelihood of PBP's operator), the intent filter with
-    `{method: intent_filter}` (`PoseIntentFilterGoalEstimator`, reading the goal shown),
-    else the `pose` estimator."""
+    """The goal estimator: HOP's posterior under hop and predict_then_assist (the most
+    probable goal selected at once), else `make_goal_estimator`'s for grasp poses."""
     scenario = resolved.scenario
-    period = scenario.control_period
-    settings = scenario.goal_estimator
     if METHODS[scenario.method].policy == ASSISTED:
-        return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period)
-    reads = estimator_entry(settings.method).reads
-    if reads == READS_INTENT:
-        return PoseIntentFilterGoalEstimator(goal_count, settings.intent_filter, period,
-                                             settings.margin, settings.hold_steps,
-                                             forward_key=forward_key_enabled(scenario))
-    if reads == READS_COMMAND:
-        return PoseMaxEntGoalEstimator(goal_count, scenario.hop, period, settings.margin,
-                                       settings.hold_steps,
-                                       operator_speed=resolved.nominal_speed)
-    return PoseGoalEstimator(goal_count, settings, period)
+        return PoseMaxEntGoalEstimator(goal_count, scenario.hop, scenario.control_period)
+    return make_goal_estimator(resolved.controller, goal_count, pose=True,
+                               forward_key=forward_key_enabled(scenario))
 
 
 def _operator(resolved, grasps, meshcat):

@@ -50,7 +50,8 @@ from pbp_drake.core.goal_estimation import READS_COMMAND, READS_INTENT, estimato
 from pbp_drake.core.methods import ASSISTED, BLENDED, METHODS
 from pbp_drake.systems import (
     Blender, DmpBank, GoalEstimator, GoalGrouping, HandOver, HeadingCommand, HopAssistance,
-    IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator)
+    IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator, PoseGoalEstimator,
+    PoseIntentFilterGoalEstimator, PoseMaxEntGoalEstimator)
 from pbp_drake.systems.ports import EeState, OperatorCommand
 
 # How far ahead the task scenes draw the DMPs' paths, in samples over the DMP's duration.
@@ -145,20 +146,27 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     return diagram
 
 
-def make_goal_estimator(config: PbpControllerConfig, goal_count):
+def make_goal_estimator(config: PbpControllerConfig, goal_count, pose=False, forward_key=True):
     """The PBP methods' goal estimator of `config.goal_estimator.method` for `goal_count`
     goals: a `GoalEstimator`, an `IntentFilterGoalEstimator` (``intent_filter``) or a
     `MaxEntGoalEstimator` (``maxent_command``: HOP's posterior with the likelihood of PBP's
-    operator, at the operators' speed `config.nominal_speed`)."""
+    operator, at the operators' speed `config.nominal_speed`); with `pose`, for grasp
+    poses, the `Pose` form of each (the intent filter's operator pushing along the
+    approach axis as `forward_key` says)."""
     settings, period = config.goal_estimator, config.control_period
     reads = estimator_entry(settings.method).reads
     if reads == READS_INTENT:
+        if pose:
+            return PoseIntentFilterGoalEstimator(goal_count, settings.intent_filter, period,
+                                                 settings.margin, settings.hold_steps,
+                                                 forward_key)
         return IntentFilterGoalEstimator(goal_count, settings.intent_filter, period,
                                          settings.margin, settings.hold_steps)
     if reads == READS_COMMAND:
-        return MaxEntGoalEstimator(goal_count, config.hop, period, settings.margin,
-                                   settings.hold_steps, operator_speed=config.nominal_speed)
-    return GoalEstimator(goal_count, settings, period)
+        posterior = PoseMaxEntGoalEstimator if pose else MaxEntGoalEstimator
+        return posterior(goal_count, config.hop, period, settings.margin, settings.hold_steps,
+                         operator_speed=config.nominal_speed)
+    return (PoseGoalEstimator if pose else GoalEstimator)(goal_count, settings, period)
 
 
 def _add_pbp_policy(builder, config, start, goals, split, command_split, prediction_steps,

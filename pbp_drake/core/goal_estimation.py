@@ -25,7 +25,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core.coordinates import check_positions, is_real
-from pbp_drake.core.intent_filter import IntentFilterSettings
+from pbp_drake.core.intent_filter import NO_BEARING, IntentFilterSettings
 from pbp_drake.core.methods import did_you_mean
 
 #: `Estimator.reads`: the hand's position and heading (`GoalEstimator`, any task) ...
@@ -40,9 +40,6 @@ READS_INTENT = "intent"
 
 #: What an estimator may read.
 READS = (READS_POSITION, READS_POSE, READS_COMMAND, READS_INTENT)
-
-# A goal closer than this (m) to the end effector on the floor plane has no direction.
-FLOOR_EPSILON = 1e-9
 
 # `SelectionMemory.challenger` when no goal challenges the selection.
 NO_CHALLENGER = -1
@@ -102,11 +99,7 @@ class GoalEstimatorSettings:
             value = getattr(self, name)
             if not is_real(value) or not math.isfinite(value) or value < 0.0:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-        if not is_real(self.margin) or not 0.0 <= self.margin < 1.0:
-            raise ValueError(f"margin must lie in [0, 1), got {self.margin!r}")
-        if (isinstance(self.hold_steps, bool) or not isinstance(self.hold_steps, (int, np.integer))
-                or self.hold_steps < 1):
-            raise ValueError(f"hold_steps must be an integer >= 1, got {self.hold_steps!r}")
+        check_hysteresis(self.margin, self.hold_steps)
         if not (is_real(self.group_mass) and 0.0 <= self.group_mass < 1.0):
             raise ValueError(f"group_mass must lie in [0, 1) (0: no groups), got "
                              f"{self.group_mass!r}")
@@ -121,6 +114,16 @@ class GoalEstimatorSettings:
             raise ValueError(f"intent_filter must be an IntentFilterSettings, got "
                              f"{type(self.intent_filter).__name__}")
         self.intent_filter.validate()
+
+
+def check_hysteresis(margin, hold_steps):
+    """Raises ValueError unless `margin` (a probability) lies in [0, 1) and `hold_steps` is
+    an integer >= 1 (`update_selection`'s)."""
+    if not is_real(margin) or not 0.0 <= margin < 1.0:
+        raise ValueError(f"margin must lie in [0, 1), got {margin!r}")
+    if (isinstance(hold_steps, bool) or not isinstance(hold_steps, (int, np.integer))
+            or hold_steps < 1):
+        raise ValueError(f"hold_steps must be an integer >= 1, got {hold_steps!r}")
 
 
 class SelectionMemory(typing.NamedTuple):
@@ -189,7 +192,7 @@ def heading_angles(goals, position, heading):
     dx *= dx
     dy *= dy
     dx += dy
-    angles[dx <= FLOOR_EPSILON * FLOOR_EPSILON] = 0.0  # no floor direction (a hypot's test)
+    angles[dx <= NO_BEARING * NO_BEARING] = 0.0  # no floor direction (a hypot's test)
     return angles
 
 

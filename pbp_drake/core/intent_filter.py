@@ -105,16 +105,28 @@ def intent_features(goals, position, motion, heading, yaw_rate, period, min_spee
     hand's own velocity) and the operator's `yaw_rate` (rad/s) over one `period` (s)."""
     offsets = goals - position
     moves = _moves(offsets, motion, period, min_speed)
-    has_bearing = np.hypot(offsets[:, 0], offsets[:, 1]) > NO_BEARING
-    error = _wrapped(np.arctan2(offsets[:, 1], offsets[:, 0]) - heading)
+    has_bearing, error = floor_bearings(offsets, heading)
     headings = np.where(has_bearing, _straightness(np.abs(error)), 1.0)
     turn = yaw_rate * period
     if turn == 0.0:
         turns = np.zeros(len(goals))
     else:
-        turns = np.where(has_bearing, (np.abs(error) - np.abs(_wrapped(error - turn)))
-                         / abs(turn), 0.0)
+        turns = turn_progress(has_bearing, error, turn)
     return IntentFeatures(moves, headings, turns, bool(acts))
+
+
+def floor_bearings(offsets, heading):
+    """Whether each goal at `offsets` (K, 2 or 3) from the hand has a bearing on the floor
+    plane (K,), and its heading error `wrap(bearing - heading)` (K,) in rad."""
+    has_bearing = np.hypot(offsets[:, 0], offsets[:, 1]) > NO_BEARING
+    return has_bearing, _wrapped(np.arctan2(offsets[:, 1], offsets[:, 0]) - heading)
+
+
+def turn_progress(has_bearing, error, turn):
+    """`(|e_g| - |wrap(e_g - turn)|) / |turn|` (K,) of the `floor_bearings` and a `turn`
+    (rad, not 0): +1 for a turn wholly toward a goal, -1 wholly away, 0 without a bearing."""
+    return np.where(has_bearing, (np.abs(error) - np.abs(_wrapped(error - turn))) / abs(turn),
+                    0.0)
 
 
 def pose_intent_features(positions, orientations, position, orientation, velocity,

@@ -30,9 +30,7 @@ import numpy as np
 from pbp_drake.core.hindsight_optimization import (
     PosteriorUpdate, clip_log_belief, goal_minimum, log_normalised, target_geometry,
     target_values)
-
-# A goal closer than this (m) to the hand on the floor plane has no bearing.
-NO_BEARING = 1e-9
+from pbp_drake.core.intent_filter import floor_bearings, turn_progress
 
 
 class IntentEvidence(typing.NamedTuple):
@@ -70,19 +68,12 @@ def turn_evidence(settings, targets, position, heading, yaw_rate, speed):
     turn = yaw_rate * settings.cost_time_step
     if turn == 0.0:
         return np.zeros(targets.goal_count)
-    floor = targets.positions[:, :2] - position[:2]
-    has_bearing = np.hypot(floor[:, 0], floor[:, 1]) > NO_BEARING
-    error = _wrapped(np.arctan2(floor[:, 1], floor[:, 0]) - heading)
-    after = _wrapped(error - turn)
-    per_target = np.where(has_bearing, (np.abs(error) - np.abs(after)) / abs(turn), 0.0)
+    has_bearing, error = floor_bearings(targets.positions[:, :2] - position[:2], heading)
+    per_target = turn_progress(has_bearing, error, turn)
     scale = (settings.translation_gain + settings.translation_constant) * speed * \
         settings.cost_time_step
     # A goal's turn evidence is its best target's (each goal has one in the position tasks).
     return -scale * goal_minimum(-per_target, targets)[0]
-
-
-def _wrapped(angles):
-    return (np.asarray(angles) + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def intent_evidence(settings, targets, position, move_velocity, speed, heading=None,

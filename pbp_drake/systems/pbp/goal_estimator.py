@@ -1,4 +1,5 @@
-"""The goal estimator as a Drake system: which of K goals the operator means."""
+"""The goal estimator as a Drake system: which of K goals the operator means.
+`GoalEstimatorBase` holds what every goal estimator system shares."""
 
 import dataclasses
 
@@ -7,7 +8,8 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.goal_estimation import (
-    NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, estimate)
+    NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, check_hysteresis,
+    goal_probabilities, update_selection)
 from pbp_drake.systems.ports import EeState, PortGetters, checked_goal_count, position_of
 from pbp_drake.systems.tick import checked_period, decide_offset
 
@@ -16,7 +18,86 @@ CHALLENGER, COUNT, START, PATH_LENGTH, LAST_POSITION, INITIALISED = 0, 1, 2, 5, 
 MEMORY_SIZE = 10
 
 
-class GoalEstimator(PortGetters, LeafSystem):
+class GoalEstimatorBase(PortGetters, LeafSystem):
+    """What the goal estimator systems share: the checked `settings` (a copy, of type
+    `_SETTINGS`), the selection with the shipped hysteresis (`update_selection` of
+    `pbp_drake.core.goal_estimation`, with `margin` and `hold_steps`; None: the settings')
+    and the outputs `selected_goal` (`[index]`, goal 0 before the first update) and
+    `goal_probabilities` (K, uniform before the first update), read from the discrete
+    state so that they hold between updates. The `memory` group starts with the
+    hysteresis' `[challenger, count]` (`SelectionMemory`); `memory_size` > 2 leaves room
+    for a subclass's own. A subclass declares its input ports in `_declare_inputs(goal_count)`
+    and updates in `_update`, periodically at the decide stage of each control tick
+    (`pbp_drake.systems.tick`)."""
+
+    #: The type of the settings.
+    _SETTINGS = GoalEstimatorSettings
+
+    def __init__(self, goal_count, settings, control_period, margin=None, hold_steps=None,
+                 memory_size=2):
+        super().__init__()
+        k = self._goal_count = checked_goal_count(goal_count)
+        if not isinstance(settings, self._SETTINGS):
+            raise ValueError(f"settings must be {self._SETTINGS.__name__}, got "
+                             f"{type(settings).__name__}")
+        settings.validate()
+        margin = settings.margin if margin is None else margin
+        hold_steps = settings.hold_steps if hold_steps is None else hold_steps
+        check_hysteresis(margin, hold_steps)
+        self._margin, self._hold_steps = float(margin), int(hold_steps)
+        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
+        self._settings = dataclasses.replace(settings)
+        self._period = checked_period(control_period)
+        self._declare_inputs(k)
+        self._selected_index = self.DeclareDiscreteState(np.zeros(1))
+        self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
+        memory = np.zeros(memory_size)
+        memory[CHALLENGER] = NO_CHALLENGER
+        self._memory_index = self.DeclareDiscreteState(memory)
+        self._selected_goal_port = self.DeclareStateOutputPort(
+            "selected_goal", self._selected_index)
+        self._probabilities_port = self.DeclareStateOutputPort(
+            "goal_probabilities", self._probabilities_index)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, decide_offset(self._period),
+                                                self._update)
+
+    @property
+    def settings(self):
+        return self._settings
+
+    @property
+    def margin(self):
+        return self._margin
+
+    @property
+    def hold_steps(self):
+        return self._hold_steps
+
+    def _previous(self, state):
+        """The `SelectionMemory` in the discrete `state` (the Context's `DiscreteValues`)."""
+        challenger, count = state.value(self._memory_index)[:2]
+        return SelectionMemory(int(state.value(self._selected_index)[0]), int(challenger),
+                               int(count))
+
+    def _select(self, discrete_state, probabilities, previous, memory=None, hold=False):
+        """Writes this update's K `probabilities` and the selection moved from `previous`
+        (None: the most probable goal at once; with `hold`, kept) into `discrete_state`,
+        with `memory`, when given, as the rest of the memory group."""
+        if hold:
+            selection = SelectionMemory(previous.selected)
+        else:
+            selection = update_selection(probabilities, previous, self._margin,
+                                         self._hold_steps)
+        memory = np.zeros(2) if memory is None else memory
+        memory[CHALLENGER] = selection.challenger
+        memory[COUNT] = selection.count
+        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
+        discrete_state.set_value(self._selected_index, [selection.selected])
+        discrete_state.set_value(self._probabilities_index, probabilities)
+        discrete_state.set_value(self._memory_index, memory)
+
+
+class GoalEstimator(GoalEstimatorBase):
     """Estimates the intended goal every control period (`pbp_drake.core.goal_estimation`).
 
     .. pydrake_system::
@@ -31,62 +112,29 @@ class GoalEstimator(PortGetters, LeafSystem):
 
     `ee_state` is `EeState` (`[p (3), v (3), heading, heading_rate]`); `goals` is the K
     goals flattened row-major `(K, 3)`. `selected_goal` is `[index]` (the goal index as a
-    float) and `goal_probabilities` the K probabilities of `settings.method`; both are read
-    from the state, so they hold between updates.
+    float) and `goal_probabilities` the K probabilities of `settings.method`; their state,
+    hysteresis and update time are `GoalEstimatorBase`'s.
 
     At initialisation (`Simulator.Initialize`) the estimator records the end effector's
     position as the start `S` and selects the most probable goal at once, without
     hysteresis; a Context never initialised does so at its first periodic update instead.
-    Each update, at the decide stage of each control tick (`pbp_drake.systems.tick`), adds
-    the distance moved since the last update to the path length (for ``bayesian``), recomputes the
-    probabilities and moves the selection with hysteresis. Before initialisation the
-    selection is goal 0 and the probabilities are uniform.
+    Each update adds the distance moved since the last update to the path length (for
+    ``bayesian``), recomputes the probabilities and moves the selection with hysteresis.
     """
 
     def __init__(self, goal_count, settings, control_period):
-        super().__init__()
-        goal_count = checked_goal_count(goal_count)
-        if not isinstance(settings, GoalEstimatorSettings):
-            raise ValueError(f"settings must be a GoalEstimatorSettings, got "
-                             f"{type(settings).__name__}")
-        settings.validate()
-        self._goal_count = goal_count
-        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
-        self._settings = dataclasses.replace(settings)
-        self._period = checked_period(control_period)
-        k = self._goal_count
-        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
-        self._goals_port = self.DeclareVectorInputPort("goals", 3 * k)
-        self._selected_index = self.DeclareDiscreteState(np.zeros(1))
-        self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
-        memory = np.zeros(MEMORY_SIZE)
-        memory[CHALLENGER] = NO_CHALLENGER
-        self._memory_index = self.DeclareDiscreteState(memory)
-        self._selected_goal_port = self.DeclareStateOutputPort(
-            "selected_goal", self._selected_index)
-        self._probabilities_port = self.DeclareStateOutputPort(
-            "goal_probabilities", self._probabilities_index)
+        super().__init__(goal_count, settings, control_period, memory_size=MEMORY_SIZE)
         self.DeclareInitializationDiscreteUpdateEvent(self._initialise)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, decide_offset(self._period),
-                                                self._update)
 
-    @property
-    def settings(self):
-        return self._settings
+    def _declare_inputs(self, goal_count):
+        self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
+        self._goals_port = self.DeclareVectorInputPort("goals", 3 * goal_count)
 
     def _inputs(self, context):
         ee_state = EeState(self._ee_state_port.Eval(context))
-        # Validated by `estimate` (`goal_probabilities`), which every caller calls.
+        # Validated by `goal_probabilities`, which every caller calls.
         goals = self._goals_port.Eval(context).reshape(self._goal_count, 3)
         return position_of(ee_state), float(ee_state.heading), goals
-
-    def _write(self, discrete_state, result, memory):
-        memory[CHALLENGER] = result.memory.challenger
-        memory[COUNT] = result.memory.count
-        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
-        discrete_state.set_value(self._selected_index, [result.selected])
-        discrete_state.set_value(self._probabilities_index, result.probabilities)
-        discrete_state.set_value(self._memory_index, memory)
 
     def _initialise(self, context, discrete_state):
         position, heading, goals = self._inputs(context)
@@ -94,9 +142,9 @@ class GoalEstimator(PortGetters, LeafSystem):
         memory[START:START + 3] = position
         memory[LAST_POSITION:LAST_POSITION + 3] = position
         memory[INITIALISED] = 1.0
-        result = estimate(self._settings, goals, position, heading, None,
-                          start=position, path_length=0.0)
-        self._write(discrete_state, result, memory)
+        probabilities = goal_probabilities(self._settings, goals, position, heading,
+                                           start=position, path_length=0.0)
+        self._select(discrete_state, probabilities, None, memory)
 
     def _update(self, context, discrete_state):
         # The context's DiscreteValues read once, each group off it: fewer pybind calls.
@@ -109,8 +157,7 @@ class GoalEstimator(PortGetters, LeafSystem):
         memory = memory.copy()
         memory[PATH_LENGTH] += vector_length(position - memory[LAST_POSITION:LAST_POSITION + 3])
         memory[LAST_POSITION:LAST_POSITION + 3] = position
-        selected = int(state.value(self._selected_index)[0])
-        previous = SelectionMemory(selected, int(memory[CHALLENGER]), int(memory[COUNT]))
-        result = estimate(self._settings, goals, position, heading, previous,
-                          start=memory[START:START + 3], path_length=memory[PATH_LENGTH])
-        self._write(discrete_state, result, memory)
+        probabilities = goal_probabilities(self._settings, goals, position, heading,
+                                           start=memory[START:START + 3],
+                                           path_length=memory[PATH_LENGTH])
+        self._select(discrete_state, probabilities, self._previous(state), memory)

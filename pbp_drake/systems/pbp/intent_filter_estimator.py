@@ -9,12 +9,32 @@ import numpy as np
 from pbp_drake.core.intent_filter import (
     IntentFilterSettings, filter_step, intent_features, pose_intent_features)
 from pbp_drake.core.quaternion import unit_quaternions
-from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator, PosteriorInputs
+from pbp_drake.systems.pbp.maxent_goal_estimator import MaxEntGoalEstimator
 from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstimator
-from pbp_drake.systems.ports import EeState, GoalPose, OperatorCommand
 
 
-class IntentFilterGoalEstimator(MaxEntGoalEstimator):
+class IntentFilterPosterior:
+    """What the two intent filter systems share, ahead of the posterior they subclass:
+    their settings, the goals read as they are, and the filter's step on the features a
+    subclass computes (`_features(context, read, active)`, `active` whether the operator
+    acts)."""
+
+    _SETTINGS = IntentFilterSettings
+
+    def _targets(self, goals):
+        # The goals' rows themselves: the filter reads no HOP targets, and building them (a
+        # uniqueness check) would cost O(K log K) a tick.
+        return goals
+
+    def _posterior(self, context, read, log_belief):
+        if not np.isfinite(read.targets).all():
+            raise ValueError(f"{self._goals_port.get_name()} contain NaN or infinite values")
+        active = self._active_port.Eval(context)[0] > 0.5
+        return filter_step(self._settings, log_belief, self._features(context, read, active),
+                           self._period)
+
+
+class IntentFilterGoalEstimator(IntentFilterPosterior, MaxEntGoalEstimator):
     """The intent filter on the hand's position and heading and the operator's command.
 
     .. pydrake_system::
@@ -30,40 +50,21 @@ class IntentFilterGoalEstimator(MaxEntGoalEstimator):
         - goal_probabilities
         - posterior_clipped
 
-    The ports are `MaxEntGoalEstimator`'s: `ee_state` an `EeState`, `goals` the K goals
-    flattened `(K, 3)`, `operator_command` `[vx, vy, vz, yaw_rate]`, `operator_active` 1
-    while the operator acts. Each update (the decide stage of the tick) reads the
-    operator's command as the motion while it acts, the hand's executed velocity while it
-    is silent, the yaw rate while it acts, and the hand's heading; the belief starts
-    uniform. `settings` is an `IntentFilterSettings`; `margin` and `hold_steps` are the
-    selection's hysteresis (the `goal_estimator` section's). `posterior_clipped` is `[1]`
-    when the last update hit `settings.max_probability`.
+    The ports and outputs are `MaxEntGoalEstimator`'s. Each update reads the operator's
+    command as the motion while it acts, the hand's executed velocity while it is silent,
+    the yaw rate while it acts, and the hand's heading; the belief starts uniform.
+    `settings` is an `IntentFilterSettings`; `margin` and `hold_steps` are the selection's
+    hysteresis (the `goal_estimator` section's).
     """
 
-    _SETTINGS = IntentFilterSettings
-
-    def _inputs(self, context):
-        hand = self._ee_state_port.Eval(context)
-        command = self._command_port.Eval(context)
-        goals = self._goals_port.Eval(context).reshape(self._goal_count, 3)
-        # `targets` holds the goals' positions (K, 3): the filter reads no HOP targets, and
-        # building them (a uniqueness check) would cost O(K log K) a tick.
-        return PosteriorInputs(goals, hand[:3], command[:3], hand[3:6],
-                               heading=float(EeState(hand).heading),
-                               yaw_rate=float(OperatorCommand(command).yaw_rate))
-
-    def _posterior(self, context, read, log_belief):
-        if not np.isfinite(read.targets).all():
-            raise ValueError("goals contain NaN or infinite values")
-        active = self._active_port.Eval(context)[0] > 0.5
-        features = intent_features(
+    def _features(self, context, read, active):
+        return intent_features(
             read.targets, read.position, read.command if active else read.hand_velocity,
             read.heading, read.yaw_rate if active else 0.0, self._period,
             self._settings.min_speed, active)
-        return filter_step(self._settings, log_belief, features, self._period)
 
 
-class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
+class PoseIntentFilterGoalEstimator(IntentFilterPosterior, PoseMaxEntGoalEstimator):
     """The intent filter on the hand's pose and the operator's twist: the grasping task's
     ``intent_filter`` (`pbp_drake.core.intent_filter.pose_intent_features`).
 
@@ -92,8 +93,6 @@ class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
     `IntentFilterGoalEstimator`'s.
     """
 
-    _SETTINGS = IntentFilterSettings
-
     def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
                  forward_key=True):
         super().__init__(goal_count, settings, control_period, margin, hold_steps)
@@ -103,26 +102,13 @@ class PoseIntentFilterGoalEstimator(PoseMaxEntGoalEstimator):
         super()._declare_inputs(goal_count)
         self._shown_port = self.DeclareVectorInputPort("shown_goal", 1)
 
-    def _inputs(self, context):
-        poses = self._goals_port.Eval(context).reshape(self._goal_count, GoalPose.size)
-        hand = self._hand_port.Eval(context)
-        twist = self._twist_port.Eval(context)
-        orientation = hand[3:7] / np.linalg.norm(hand[3:7])
-        # `targets` holds the goal poses (K, 7): the filter reads no HOP targets.
-        return PosteriorInputs(poses, hand[:3], twist[:3], hand[7:10], orientation,
-                               twist[3:], hand[10:13])
-
-    def _posterior(self, context, read, log_belief):
+    def _features(self, context, read, active):
         poses = read.targets
-        if not np.isfinite(poses).all():
-            raise ValueError("goal_poses contain NaN or infinite values")
-        active = self._active_port.Eval(context)[0] > 0.5
         shown = (int(self._shown_port.Eval(context)[0]) if self._shown_port.HasValue(context)
                  else -1)
-        features = pose_intent_features(
+        return pose_intent_features(
             poses[:, :3], unit_quaternions(poses[:, 3:], "goal_poses orientation"),
             read.position, read.orientation,
             read.command if active else read.hand_velocity,
             read.command_angular_velocity if active else np.zeros(3), self._period,
             self._settings.min_speed, active, self._forward_key, shown)
-        return filter_step(self._settings, log_belief, features, self._period)

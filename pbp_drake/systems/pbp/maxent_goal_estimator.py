@@ -4,26 +4,22 @@ the operator's command (`pbp_drake.core.hindsight_optimization`), or with an
 (`pbp_drake.core.maxent_command`). `CommandPosteriorBase` holds what it shares with the
 six-DoF `PoseMaxEntGoalEstimator`."""
 
-import dataclasses
 import typing
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.core.goal_estimation import NO_CHALLENGER, SelectionMemory, update_selection
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, hop_targets, uniform_log_belief, update_posterior)
 from pbp_drake.core.maxent_command import intent_evidence, update_intent_posterior
-from pbp_drake.systems.ports import EeState, OperatorCommand, PortGetters, checked_goal_count
-from pbp_drake.systems.tick import checked_period, decide_offset
+from pbp_drake.systems.pbp.goal_estimator import GoalEstimatorBase
+from pbp_drake.systems.ports import EeState, OperatorCommand
 
 
 class PosteriorInputs(typing.NamedTuple):
     """What an update reads: the `targets`, the hand's `position`, the operator's
     `command` velocity, the hand's executed `hand_velocity`; with orientations the hand's
     `orientation`, the operator's `command_angular_velocity` and the hand's
-    `hand_angular_velocity`; without, the hand's `heading` and the operator's `yaw_rate`;
-    and whether the operator `active`ly commands."""
+    `hand_angular_velocity`; without, the hand's `heading` and the operator's `yaw_rate`."""
 
     targets: typing.Any
     position: np.ndarray
@@ -34,15 +30,13 @@ class PosteriorInputs(typing.NamedTuple):
     hand_angular_velocity: typing.Optional[np.ndarray] = None
     heading: typing.Optional[float] = None
     yaw_rate: float = 0.0
-    active: bool = True
 
 
-class CommandPosteriorBase(PortGetters, LeafSystem):
-    """What `MaxEntGoalEstimator` and `PoseMaxEntGoalEstimator` share: the log belief, the
-    selection with the shipped hysteresis (`goal_estimation.update_selection`) and whether
-    the last update was clipped, all in the Context's discrete state; the outputs
-    `selected_goal`, `goal_probabilities` and `posterior_clipped`. A subclass declares its
-    input ports (`_declare_inputs`, with `operator_active` among them) and reads them
+class CommandPosteriorBase(GoalEstimatorBase):
+    """What `MaxEntGoalEstimator` and `PoseMaxEntGoalEstimator` share: the log belief and
+    whether the last update was clipped (the output `posterior_clipped`) in the Context's
+    discrete state, beside `GoalEstimatorBase`'s selection. A subclass declares its input
+    ports (`_declare_inputs`, with `operator_active` among them) and reads them
     (`_inputs(context) -> PosteriorInputs`).
 
     `operator_speed` None: HOP's published update, on the operator's command alone (the
@@ -51,91 +45,42 @@ class CommandPosteriorBase(PortGetters, LeafSystem):
     (`pbp_drake.core.maxent_command`), which reads `operator_active`: the operator's
     command while it acts, the hand's executed motion while it is silent, and its turns."""
 
+    _SETTINGS = HopSettings
+
     def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,
                  operator_speed=None):
-        super().__init__()
         if operator_speed is not None and not (np.isfinite(operator_speed)
                                                and operator_speed > 0.0):
             raise ValueError(f"operator_speed must be positive, got {operator_speed!r}")
         self._operator_speed = None if operator_speed is None else float(operator_speed)
-        goal_count = checked_goal_count(goal_count)
-        if not isinstance(settings, self._SETTINGS):
-            raise ValueError(f"settings must be {self._SETTINGS.__name__}, got "
-                             f"{type(settings).__name__}")
-        settings.validate()
-        if not 0.0 <= margin < 1.0:
-            raise ValueError(f"margin must lie in [0, 1), got {margin!r}")
-        if isinstance(hold_steps, bool) or int(hold_steps) != hold_steps or hold_steps < 1:
-            raise ValueError(f"hold_steps must be an integer >= 1, got {hold_steps!r}")
-        self._period = checked_period(control_period)
-        k = self._goal_count = int(goal_count)
-        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
-        self._settings = dataclasses.replace(settings)
-        self._margin, self._hold_steps = float(margin), int(hold_steps)
-        self._declare_inputs(k)
-        self._log_belief_index = self.DeclareDiscreteState(uniform_log_belief(k))
-        self._selected_index = self.DeclareDiscreteState(np.zeros(1))
-        self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
-        # [challenger, count] of the hysteresis (`SelectionMemory`), and the clip's flag.
-        self._memory_index = self.DeclareDiscreteState(np.array([NO_CHALLENGER, 0.0]))
+        super().__init__(goal_count, settings, control_period, margin, hold_steps)
+        self._log_belief_index = self.DeclareDiscreteState(uniform_log_belief(self._goal_count))
         self._clipped_index = self.DeclareDiscreteState(np.zeros(1))
-        self._selected_port = self.DeclareStateOutputPort("selected_goal",
-                                                          self._selected_index)
-        self._probabilities_port = self.DeclareStateOutputPort("goal_probabilities",
-                                                               self._probabilities_index)
         self._clipped_port = self.DeclareStateOutputPort("posterior_clipped",
                                                          self._clipped_index)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, decide_offset(self._period),
-                                                self._update)
-
-    @property
-    def settings(self):
-        return self._settings
-
-    @property
-    def margin(self):
-        return self._margin
-
-    @property
-    def hold_steps(self):
-        return self._hold_steps
-
-    #: The type of the posterior's settings.
-    _SETTINGS = HopSettings
 
     def _update(self, context, discrete_state):
         state = context.get_discrete_state()
         read = self._inputs(context)
         update = self._posterior(context, read, state.value(self._log_belief_index))
-        challenger, count = state.value(self._memory_index)
-        memory = update_selection(
-            update.probabilities,
-            SelectionMemory(int(state.value(self._selected_index)[0]), int(challenger),
-                            int(count)),
-            self._margin, self._hold_steps)
+        self._select(discrete_state, update.probabilities, self._previous(state))
         discrete_state.set_value(self._log_belief_index, update.log_belief)
-        discrete_state.set_value(self._probabilities_index, update.probabilities)
-        discrete_state.set_value(self._selected_index, [memory.selected])
-        discrete_state.set_value(self._memory_index, [memory.challenger, memory.count])
         discrete_state.set_value(self._clipped_index, [1.0 if update.clipped else 0.0])
 
     def _posterior(self, context, read, log_belief):
         """This tick's update of the belief (with `log_belief`, `probabilities`, `clipped`)."""
         if self._operator_speed is None:
-            update = update_posterior(self._settings, read.targets, log_belief, read.position,
-                                      read.command, read.orientation,
-                                      read.command_angular_velocity)
-        else:
-            # Silent, the operator lets the robot go on: its motion is the implicit command.
-            active = self._active_port.Eval(context)[0] > 0.5
-            evidence = intent_evidence(
-                self._settings, read.targets, read.position,
-                read.command if active else read.hand_velocity, self._operator_speed,
-                read.heading, read.yaw_rate if active else 0.0, read.orientation,
-                read.command_angular_velocity if active else read.hand_angular_velocity)
-            update = update_intent_posterior(self._settings, read.targets, log_belief,
-                                             evidence)
-        return update
+            return update_posterior(self._settings, read.targets, log_belief, read.position,
+                                    read.command, read.orientation,
+                                    read.command_angular_velocity)
+        # Silent, the operator lets the robot go on: its motion is the implicit command.
+        active = self._active_port.Eval(context)[0] > 0.5
+        evidence = intent_evidence(
+            self._settings, read.targets, read.position,
+            read.command if active else read.hand_velocity, self._operator_speed,
+            read.heading, read.yaw_rate if active else 0.0, read.orientation,
+            read.command_angular_velocity if active else read.hand_angular_velocity)
+        return update_intent_posterior(self._settings, read.targets, log_belief, evidence)
 
 
 class MaxEntGoalEstimator(CommandPosteriorBase):
@@ -164,9 +109,8 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
     reads `operator_active` (1 while the operator acts), the hand's velocity and heading in
     `ee_state` and the yaw rate) and is clipped at `settings.max_probability`; the selection
     is the most probable goal, moved with the hysteresis of `margin` and `hold_steps` (0
-    and 1: at once). `goal_probabilities` (K), `selected_goal` `[index]`
-    and `posterior_clipped` (`[1]` when the last update was clipped, else `[0]`) are read
-    from the state, so they hold between updates.
+    and 1: at once). The outputs hold between updates (`GoalEstimatorBase`);
+    `posterior_clipped` is `[1]` when the last update was clipped, else `[0]`.
     """
 
     def _declare_inputs(self, goal_count):
@@ -176,8 +120,12 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
                                                          OperatorCommand.size)
         self._active_port = self.DeclareVectorInputPort("operator_active", 1)
 
+    def _targets(self, goals):
+        """`PosteriorInputs.targets` of the goals (K, 3): one HOP target each."""
+        return hop_targets(goals)
+
     def _inputs(self, context):
-        targets = hop_targets(self._goals_port.Eval(context).reshape(self._goal_count, 3))
+        targets = self._targets(self._goals_port.Eval(context).reshape(self._goal_count, 3))
         hand = self._ee_state_port.Eval(context)
         command = self._command_port.Eval(context)
         return PosteriorInputs(targets, hand[:3], command[:3], hand[3:6],

@@ -1,18 +1,14 @@
 """The ``pose`` goal estimator as a Drake system: which of K grasp poses the operator means."""
 
-import dataclasses
-
 import numpy as np
-from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.core.goal_estimation import (
-    GoalEstimatorSettings, SelectionMemory, update_selection)
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.grasp_estimation import pose_probabilities
-from pbp_drake.systems.ports import GoalPose, OperatorTwist, PortGetters, PoseState
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.pbp.goal_estimator import GoalEstimatorBase
+from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
 
 
-class PoseGoalEstimator(PortGetters, LeafSystem):
+class PoseGoalEstimator(GoalEstimatorBase):
     """Estimates the intended grasp pose every control period
     (`pbp_drake.core.grasp_estimation.pose_probabilities` and the shipped hysteresis,
     `goal_estimation.update_selection`).
@@ -36,42 +32,28 @@ class PoseGoalEstimator(PortGetters, LeafSystem):
     hand too: the hand's own twist is then mostly the selected DMP's, and would hold the
     selection on whatever the robot heads for (docs/tasks/grasp.md). Unconnected, the
     hand's twist is read and the selection follows it at every update. `selected_goal` is
-    `[index]` and `goal_probabilities` the K probabilities, read from the state as
-    `GoalEstimator`'s. At initialisation it selects the most probable grasp pose at once
-    (no hysteresis); each update, at the decide stage of the tick, it recomputes the
-    probabilities and moves the selection with the shipped hysteresis.
+    `[index]` and `goal_probabilities` the K probabilities (`GoalEstimatorBase`). At
+    initialisation it selects the most probable grasp pose at once (no hysteresis); each
+    update recomputes the probabilities and moves the selection with the hysteresis.
     """
 
     def __init__(self, goal_count, settings, control_period):
-        super().__init__()
         if not isinstance(settings, GoalEstimatorSettings) or settings.method != "pose":
             raise ValueError("settings must be a GoalEstimatorSettings with method 'pose'")
-        settings.validate()
-        k = self._goal_count = int(goal_count)
-        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
-        self._settings = dataclasses.replace(settings)
-        self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
-        self._goals_port = self.DeclareVectorInputPort("goal_poses", k * GoalPose.size)
-        self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
-        self._selected_index = self.DeclareDiscreteState(np.zeros(1))
-        self._probabilities_index = self.DeclareDiscreteState(np.full(k, 1.0 / k))
-        # [challenger, count] of the hysteresis (`SelectionMemory`); -1: none yet.
-        self._memory_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
-        self._selected_port = self.DeclareStateOutputPort("selected_goal",
-                                                          self._selected_index)
-        self._probabilities_port = self.DeclareStateOutputPort("goal_probabilities",
-                                                               self._probabilities_index)
+        super().__init__(goal_count, settings, control_period)
         self.DeclareInitializationDiscreteUpdateEvent(
             lambda context, state: self._estimate(context, state, None))
-        self.DeclarePeriodicDiscreteUpdateEvent(float(control_period),
-                                                decide_offset(control_period), self._update)
+
+    def _declare_inputs(self, goal_count):
+        self._hand_port = self.DeclareVectorInputPort("hand_pose", PoseState.size)
+        self._goals_port = self.DeclareVectorInputPort("goal_poses",
+                                                       goal_count * GoalPose.size)
+        self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
 
     def _update(self, context, state):
-        challenger, count = context.get_discrete_state(self._memory_index).value()
-        selected = int(context.get_discrete_state(self._selected_index).value()[0])
-        self._estimate(context, state, SelectionMemory(selected, int(challenger), int(count)))
+        self._estimate(context, state, self._previous(context.get_discrete_state()))
 
-    def _estimate(self, context, state, memory):
+    def _estimate(self, context, state, previous):
         hand = np.asarray(self._hand_port.Eval(context), float)
         goals = np.asarray(self._goals_port.Eval(context), float).reshape(
             self._goal_count, GoalPose.size)
@@ -80,14 +62,7 @@ class PoseGoalEstimator(PortGetters, LeafSystem):
         probabilities = pose_probabilities(
             self._settings, goals[:, :3], goals[:, 3:], hand[:3],
             hand[3:7] / np.linalg.norm(hand[3:7]), twist[:3], twist[3:])
-        if memory is not None and operator and not twist.any():
-            # The operator gives no input: no new evidence of intent, so the selection
-            # holds (the probabilities still follow the hand).
-            memory = SelectionMemory(memory.selected)
-        else:
-            memory = update_selection(probabilities, memory, self._settings.margin,
-                                      self._settings.hold_steps)
-        state.get_mutable_vector(self._selected_index).set_value([memory.selected])
-        state.get_mutable_vector(self._probabilities_index).set_value(probabilities)
-        state.get_mutable_vector(self._memory_index).set_value(
-            [memory.challenger, memory.count])
+        # The operator gives no input: no new evidence of intent, so the selection holds
+        # (the probabilities still follow the hand).
+        self._select(state, probabilities, previous,
+                     hold=previous is not None and operator and not twist.any())

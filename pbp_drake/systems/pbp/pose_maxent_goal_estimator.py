@@ -42,11 +42,14 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
         self._twist_port = self.DeclareVectorInputPort("operator_twist", OperatorTwist.size)
         self._active_port = self.DeclareVectorInputPort("operator_active", 1)
 
+    def _targets(self, poses):
+        """`PosteriorInputs.targets` of the goal poses (K, 7): one HOP target each."""
+        return hop_targets(poses[:, :3], poses[:, 3:])
+
     def _inputs(self, context):
         poses = self._goals_port.Eval(context).reshape(self._goal_count, GoalPose.size)
-        targets = hop_targets(poses[:, :3], poses[:, 3:])
         hand = self._hand_port.Eval(context)
         twist = self._twist_port.Eval(context)
         orientation = hand[3:7] / np.linalg.norm(hand[3:7])
-        return PosteriorInputs(targets, hand[:3], twist[:3], hand[7:10], orientation,
-                               twist[3:], hand[10:13])
+        return PosteriorInputs(self._targets(poses), hand[:3], twist[:3], hand[7:10],
+                               orientation, twist[3:], hand[10:13])

@@ -26,8 +26,8 @@ class BankModel:
     """What the position bank and `OrientationDmpBank` share: the model's checks
     (`_keep_model`), immutability after `__init__`, the settings, the phase decay, the
     constructors (from single DMPs, a demonstration, straight) and open-loop prediction. A
-    subclass keeps its `starts` as `(rows, K)` and gives a demonstration checked and fitted
-    (`_fitted`: times, samples, weights, amplitude scaling) and a straight DMP's axes
+    subclass keeps its `starts` as `(rows, K)` and gives the demonstration's check and fit
+    (`_validate_demonstration`, `_fit_weights`) and a straight DMP's axes
     (`_straight_axes`)."""
 
     def __setattr__(self, name, value):
@@ -96,7 +96,8 @@ class BankModel:
         the Pastor form keeps it as learned. `start` and `duration` (tau) default to the
         demonstration's.
         """
-        times, samples, weights, scaling = cls._fitted(times, samples, settings)
+        times, samples = cls._validate_demonstration(times, samples)
+        weights, scaling = cls._fit_weights(times, samples, settings)
         start = samples[0] if start is None else start
         duration = times[-1] - times[0] if duration is None else duration
         return cls(weights, start, duration, settings, scaling, goal_count)
@@ -180,10 +181,8 @@ class DmpBankModel(BankStep, BankModel):
     (`pbp_drake.core.dmp.stepping.step_constants`).
     """
 
-    @staticmethod
-    def _fitted(times, positions, settings):
-        times, positions = validate_demonstration(times, positions)
-        return times, positions, *fit_weights(times, positions, settings)
+    _validate_demonstration = staticmethod(validate_demonstration)
+    _fit_weights = staticmethod(fit_weights)
 
     @staticmethod
     def _straight_axes(start):

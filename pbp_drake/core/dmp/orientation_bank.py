@@ -48,10 +48,8 @@ class OrientationDmpBank(BankModel):
     `subset` and `predict` are `BankModel`'s.
     """
 
-    @staticmethod
-    def _fitted(times, orientations, settings):
-        times, orientations = validate_orientation_demonstration(times, orientations)
-        return times, orientations, *fit_orientation_weights(times, orientations, settings)
+    _validate_demonstration = staticmethod(validate_orientation_demonstration)
+    _fit_weights = staticmethod(fit_orientation_weights)
 
     @staticmethod
     def _straight_axes(start):

@@ -25,10 +25,8 @@ from pbp_drake.core.dmp.workspace import DmpWorkspace
 class BankModel:
     """What the position bank and `OrientationDmpBank` share: the model's checks
     (`_keep_model`), immutability after `__init__`, the settings, the phase decay, the
-    constructors (from single DMPs, a demonstration, straight) and open-loop prediction. A
-    subclass keeps its `starts` as `(rows, K)` and gives the demonstration's check and fit
-    (`_validate_demonstration`, `_fit_weights`) and a straight DMP's axes
-    (`_straight_axes`)."""
+    constructor from single DMPs, and open-loop prediction (a subclass keeps its `starts` as
+    `(rows, K)`)."""
 
     def __setattr__(self, name, value):
         # Immutable after construction: a bank shared by threads or Drake Contexts must not
@@ -85,37 +83,6 @@ class BankModel:
         return cls(np.stack([d.weights for d in dmps]), np.stack([d.start for d in dmps]),
                    first.duration, first.settings,
                    np.stack([d.amplitude_scaling for d in dmps]))
-
-    @classmethod
-    def from_demonstration(cls, times, samples, goal_count=1, settings=DmpSettings(),
-                           start=None, duration=None):
-        """K DMPs that share ONE demonstration's shape (positions `(T, D)`, or for
-        `OrientationDmpBank` orientations `(T, 4)`), sent to K goals given at run time.
-
-        The Ijspeert form rescales the shape by each goal's `g - y0` (orientations: `-e0`);
-        the Pastor form keeps it as learned. `start` and `duration` (tau) default to the
-        demonstration's.
-        """
-        times, samples = cls._validate_demonstration(times, samples)
-        weights, scaling = cls._fit_weights(times, samples, settings)
-        start = samples[0] if start is None else start
-        duration = times[-1] - times[0] if duration is None else duration
-        return cls(weights, start, duration, settings, scaling, goal_count)
-
-    @classmethod
-    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
-        """K straight DMPs from `start` to goals given at run time (no demonstration): along
-        the line, or for `OrientationDmpBank` the shorter arc (slerp).
-
-        Ijspeert: the minimum-jerk shape, shared by all goals (it scales with `g - y0`, or
-        `-e0`). Pastor: `f = 0`, whose attractor already slides from the start to `g`.
-        """
-        axes = cls._straight_axes(start)
-        if settings.formulation == "ijspeert":
-            weights = straight_weights(settings, duration, np.ones(axes))
-        else:
-            weights = np.zeros((settings.basis_count, axes))
-        return cls(weights, start, duration, settings, goal_count=goal_count)
 
     @property
     def settings(self):
@@ -181,13 +148,6 @@ class DmpBankModel(BankStep, BankModel):
     (`pbp_drake.core.dmp.stepping.step_constants`).
     """
 
-    _validate_demonstration = staticmethod(validate_demonstration)
-    _fit_weights = staticmethod(fit_weights)
-
-    @staticmethod
-    def _straight_axes(start):
-        return as_point(start, "start").size
-
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
                  amplitude_scaling=None, goal_count=None):
         self._keep_model(weights, starts, duration, settings, amplitude_scaling, goal_count,
@@ -196,6 +156,34 @@ class DmpBankModel(BankStep, BankModel):
             broadcast_goalwise(starts, self.goal_count, self.dimension, "starts"))
         self._derive_constants()
         self._frozen = True
+
+    @classmethod
+    def from_demonstration(cls, times, positions, goal_count=1, settings=DmpSettings(),
+                           start=None, duration=None):
+        """K DMPs that share ONE demonstration's shape, sent to K goals given at run time.
+
+        The Ijspeert form rescales the shape by each goal's `(g - y0)`; the Pastor form keeps
+        it as learned. `duration` (tau) defaults to the demonstration's.
+        """
+        times, positions = validate_demonstration(times, positions)
+        weights, scaling = fit_weights(times, positions, settings)
+        start = positions[0] if start is None else start
+        duration = times[-1] - times[0] if duration is None else duration
+        return cls(weights, start, duration, settings, scaling, goal_count)
+
+    @classmethod
+    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
+        """K straight-path DMPs from `start` to goals given at run time (no demonstration).
+
+        Ijspeert: the minimum-jerk shape, shared by all goals (it scales with `g - y0`).
+        Pastor: `f = 0`, whose attractor already slides from `y0` to `g` along the line.
+        """
+        dimension = as_point(start, "start").size
+        if settings.formulation == "ijspeert":
+            weights = straight_weights(settings, duration, np.ones(dimension))
+        else:
+            weights = np.zeros((settings.basis_count, dimension))
+        return cls(weights, start, duration, settings, goal_count=goal_count)
 
     def make_workspace(self):
         """New scratch arrays for the in-place step; one per thread or Drake Context."""

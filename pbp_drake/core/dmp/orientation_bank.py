@@ -24,6 +24,7 @@ from pbp_drake.core.dmp.orientation_kernels import (
 from pbp_drake.core.dmp.orientation_log_step import (
     IDENTITY6, forcing_rows, log_step_from_one_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis
+from pbp_drake.core.dmp.single import straight_weights
 from pbp_drake.core.dmp.stepping import step_constants
 
 
@@ -44,16 +45,9 @@ class OrientationDmpBank(BankModel):
     All share `duration` and `settings`; each has its own start orientation and phase, and
     its own weights `(K, N, 3)` or one set `(N, 3)` shared by all (straight paths, or one
     demonstration sent to K goals). Immutable: the state is passed in and out of `advance`
-    (pure) and `advance_into` (into the caller's arrays, with a workspace). The constructors,
-    `subset` and `predict` are `BankModel`'s.
+    (pure) and `advance_into` (into the caller's arrays, with a workspace). `subset`,
+    `predict` and `from_dmps` are `BankModel`'s.
     """
-
-    _validate_demonstration = staticmethod(validate_orientation_demonstration)
-    _fit_weights = staticmethod(fit_orientation_weights)
-
-    @staticmethod
-    def _straight_axes(start):
-        return AXES
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
                  amplitude_scaling=None, goal_count=None):
@@ -74,6 +68,29 @@ class OrientationDmpBank(BankModel):
         self._uniform_start = (read_only(self.starts[:, :1])
                                if (self.starts == self.starts[:, :1]).all() else None)
         self._frozen = True
+
+    @classmethod
+    def from_demonstration(cls, times, orientations, goal_count=1, settings=DmpSettings(),
+                           start=None, duration=None):
+        """K DMPs sharing ONE demonstration's shape `(T, 4)`, sent to goals given at run
+        time; start and `tau` default to the demonstration's."""
+        times, orientations = validate_orientation_demonstration(times, orientations)
+        weights, scaling = fit_orientation_weights(times, orientations, settings)
+        start = orientations[0] if start is None else start
+        duration = times[-1] - times[0] if duration is None else duration
+        return cls(weights, start, duration, settings, scaling, goal_count)
+
+    @classmethod
+    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
+        """K DMPs along the shorter arc (slerp) from `start` to goals given at run time.
+
+        Ijspeert: the minimum-jerk shape, shared, scaled per goal by `-e0`; Pastor: `f = 0`,
+        whose attractor `e0 x` already slides along the arc."""
+        if settings.formulation == "ijspeert":
+            weights = straight_weights(settings, duration, np.ones(AXES))
+        else:
+            weights = np.zeros((settings.basis_count, AXES))
+        return cls(weights, start, duration, settings, goal_count=goal_count)
 
     def initial_state(self, orientation=None):
         """(phase (K,), orientations (4, K), scaled angular velocity (3, K)) at the start."""

@@ -196,27 +196,6 @@ def heading_angles(goals, position, heading):
     return angles
 
 
-def angle_probabilities(goals, position, heading, temperature):
-    return softmax_of_costs(heading_angles(goals, position, heading), temperature)
-
-
-def nearest_probabilities(goals, position, temperature):
-    return softmax_of_costs(np.linalg.norm(goals - position, axis=1), temperature)
-
-
-def bayesian_log_posterior(goals, position, start, path_length, beta):
-    """Unnormalised `log P(g | S->Q)` of every goal (uniform prior):
-    `-beta (C(S->Q) + |Q - g|) + beta |S - g|`."""
-    return -beta * (path_length + np.linalg.norm(goals - position, axis=1)
-                    - np.linalg.norm(goals - start, axis=1))
-
-
-def bayesian_probabilities(goals, position, start, path_length, beta):
-    log_posterior = bayesian_log_posterior(goals, position, start, path_length, beta)
-    weights = np.exp(log_posterior - log_posterior.max())
-    return weights / weights.sum()
-
-
 class Estimator(typing.NamedTuple):
     """One registry entry: the name `goal_estimator.method` spells, what it reads (`READS_*`,
     which picks its system), and for one that reads the position its function
@@ -232,11 +211,11 @@ class Estimator(typing.NamedTuple):
 
 def _angle(settings, goals, position, heading, start, path_length):
     heading = _validate_scalar(heading, "heading")
-    return angle_probabilities(goals, position, heading, settings.temperature)
+    return softmax_of_costs(heading_angles(goals, position, heading), settings.temperature)
 
 
 def _nearest(settings, goals, position, heading, start, path_length):
-    return nearest_probabilities(goals, position, settings.temperature)
+    return softmax_of_costs(np.linalg.norm(goals - position, axis=1), settings.temperature)
 
 
 def _bayesian(settings, goals, position, heading, start, path_length):
@@ -245,7 +224,11 @@ def _bayesian(settings, goals, position, heading, start, path_length):
                          "position when estimation began)")
     start = validate_point(start, "start")
     path_length = _validate_scalar(path_length, "path_length", minimum=0.0)
-    return bayesian_probabilities(goals, position, start, path_length, settings.beta)
+    # Unnormalised `log P(g | S->Q)` (uniform prior): `-beta (C(S->Q) + |Q - g|) + beta |S - g|`.
+    log_posterior = -settings.beta * (path_length + np.linalg.norm(goals - position, axis=1)
+                                      - np.linalg.norm(goals - start, axis=1))
+    weights = np.exp(log_posterior - log_posterior.max())
+    return weights / weights.sum()
 
 
 ESTIMATORS = {estimator.name: estimator for estimator in (

@@ -18,13 +18,13 @@ import math
 
 import numpy as np
 
-from pbp_drake.core.coordinates import vector_length
+from pbp_drake.core.coordinates import is_real, vector_length
 
 
 def check_limit(value, name, unit):
     """`value` as a float; raises ValueError naming `name` unless it is a finite positive
     number."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+    if not is_real(value):
         raise ValueError(f"{name} must be a number ({unit}), got {value!r}")
     value = float(value)
     if not (math.isfinite(value) and value > 0.0):

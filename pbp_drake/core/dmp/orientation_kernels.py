@@ -229,23 +229,10 @@ def inverse_jacobian_into(rotation_vectors, vectors, out, workspace):
     `J^-1 v = p v - r x v / 2 + c (r.v) r`, `p = (t/2) cot(t/2) = (t / sin(t/2)) |w| / 2`,
     `c = (1 - p) / t^2`, or near 0 `c = 1/12 + t^2/720 + t^4/30240` and `p = 1 - c t^2`."""
     ws = workspace
-    p, c, square = ws.first, ws.second, ws.row
+    p, c = ws.first, ws.second
     np.multiply(ws.ratio, ws.cosine, out=p)
     p *= 0.5
-    np.multiply(ws.angle, ws.angle, out=square)
-    np.subtract(1.0, p, out=c)
-    np.add(square, SMALLEST, out=ws.dot)
-    c /= ws.dot
-    if _small_angles(ws):
-        series = ws.dot
-        np.multiply(square, 1.0 / 30240.0, out=series)
-        series += 1.0 / 720.0
-        series *= square
-        series += 1.0 / 12.0
-        np.copyto(c, series, where=ws.small)
-        series *= square
-        np.subtract(1.0, series, out=series)
-        np.copyto(p, series, where=ws.small)
+    _dot_scale_into(p, c, (1.0 / 30240.0, 1.0 / 720.0, 1.0 / 12.0), ws)
     _jacobian_terms_into(rotation_vectors, vectors, p, -0.5, c, out, ws)
 
 
@@ -255,33 +242,38 @@ def jacobian_into(rotation_vectors, vectors, out, workspace):
     `p = sin t / t = 2 cos(t/2) sin(t/2)/t`, `a = (1 - cos t)/t^2 = 2 (sin(t/2)/t)^2`,
     `b = (1 - p) / t^2`, or near 0 `b = 1/6 - t^2/120 + t^4/5040` and `p = 1 - b t^2`."""
     ws = workspace
-    p, a, b, square = ws.first, ws.ratio, ws.second, ws.row
+    p, a, b = ws.first, ws.ratio, ws.second
     np.multiply(ws.coefficient, ws.cosine, out=p)
     p *= 2.0
     np.multiply(ws.coefficient, ws.coefficient, out=a)
     a *= 2.0
-    np.multiply(ws.angle, ws.angle, out=square)
-    np.subtract(1.0, p, out=b)
-    np.add(square, SMALLEST, out=ws.dot)
-    b /= ws.dot
-    if _small_angles(ws):
-        # At t = 0, `coefficient` is 0 rather than 1/2, and so is `a`; r x v is 0 there.
-        series = ws.dot
-        np.multiply(square, 1.0 / 5040.0, out=series)
-        series -= 1.0 / 120.0
-        series *= square
-        series += 1.0 / 6.0
-        np.copyto(b, series, where=ws.small)
-        series *= square
-        np.subtract(1.0, series, out=series)
-        np.copyto(p, series, where=ws.small)
+    # At t = 0, `coefficient` is 0 rather than 1/2, and so is `a`; r x v is 0 there.
+    _dot_scale_into(p, b, (1.0 / 5040.0, -(1.0 / 120.0), 1.0 / 6.0), ws)
     _jacobian_terms_into(rotation_vectors, vectors, p, a, b, out, ws)
 
 
-def _small_angles(workspace):
-    """Marks the angles below `SERIES_BELOW` in `small`; whether there is any."""
-    np.less(workspace.angle, SERIES_BELOW, out=workspace.small)
-    return bool(workspace.small.any())
+def _dot_scale_into(p, scale, series_terms, workspace):
+    """The Jacobians' `(r.v) r` factor `(1 - p) / t^2` (K,) into `scale`; where `t` is
+    below `SERIES_BELOW`, the series `c4 t^4 + c2 t^2 + c0` of `series_terms`
+    `(c4, c2, c0)` instead, and `p = 1 - scale t^2` there."""
+    ws = workspace
+    square = ws.row
+    np.multiply(ws.angle, ws.angle, out=square)
+    np.subtract(1.0, p, out=scale)
+    np.add(square, SMALLEST, out=ws.dot)
+    scale /= ws.dot
+    np.less(ws.angle, SERIES_BELOW, out=ws.small)
+    if ws.small.any():
+        fourth, second, constant = series_terms
+        series = ws.dot
+        np.multiply(square, fourth, out=series)
+        series += second
+        series *= square
+        series += constant
+        np.copyto(scale, series, where=ws.small)
+        series *= square
+        np.subtract(1.0, series, out=series)
+        np.copyto(p, series, where=ws.small)
 
 
 def _jacobian_terms_into(rotation_vectors, vectors, p, cross_scale, dot_scale, out,

@@ -119,10 +119,8 @@ def teach_primitive(times, positions, settings=DmpSettings(), orientations=None)
 def _orientation_shape(times, orientations, settings):
     """The orientation part of a pose demonstration: its fit, and the RMS angle (rad) of
     its orientation DMP rolled out to its own goal against it."""
-    try:
-        times, orientations = validate_orientation_demonstration(times, orientations)
-    except ValueError as error:
-        raise ValueError(f"the demonstration's orientations: {error}") from None
+    times, orientations = _named("the demonstration's orientations",
+                                 validate_orientation_demonstration, times, orientations)
     weights, scaling = fit_orientation_weights(times, orientations, settings)
     duration = times[-1] - times[0]
     dmp = OrientationDmp(weights, orientations[0], orientations[-1], duration, settings,
@@ -213,10 +211,7 @@ def read_primitive_document(document) -> Primitive:
         raise ValueError(f"weights {weights.shape} and demonstration.positions "
                          f"{positions.shape} do not fit dimension {dimension} and "
                          f"basis_count {settings.basis_count}")
-    try:
-        times, positions = validate_demonstration(times, positions)
-    except ValueError as error:
-        raise ValueError(f"demonstration: {error}") from None
+    times, positions = _named("demonstration", validate_demonstration, times, positions)
     fit_error = _fit_error_field(document, "fit_error")
     orientation = None
     if "orientation" in document:
@@ -233,12 +228,18 @@ def _read_orientation(document, settings, times):
         raise ValueError(f"orientation.weights {weights.shape} and orientation.quaternions "
                          f"{quaternions.shape} do not fit basis_count {settings.basis_count} "
                          f"and the demonstration's {len(times)} samples")
-    try:
-        _, quaternions = validate_orientation_demonstration(times, quaternions)
-    except ValueError as error:
-        raise ValueError(f"orientation.quaternions: {error}") from None
+    _, quaternions = _named("orientation.quaternions", validate_orientation_demonstration,
+                            times, quaternions)
     return OrientationShape(weights, scaling, quaternions,
                             _fit_error_field(document, "orientation.fit_error"))
+
+
+def _named(name, check, *arguments):
+    """`check(*arguments)`, its ValueError's message led by `name`."""
+    try:
+        return check(*arguments)
+    except ValueError as error:
+        raise ValueError(f"{name}: {error}") from None
 
 
 def _fit_error_field(document, name):

@@ -14,14 +14,13 @@ from pydrake.math import RotationMatrix
 
 from pbp_drake.core.quaternion import UNIT_TOLERANCE, aligned, exp_map, multiply
 from pbp_drake.robots.hsr_ee_systems import CommandRamp, FrameStateFromPlant
-from pbp_drake.systems.ports import PoseState
+from pbp_drake.systems.ports import PoseState, finite_pose_state
 
 # The frame the pose station commands and measures: the grasp task's hand frame H.
 HAND_FRAME = "hand_palm_link"
 # PoseState's entries, by index.
 _POSITION, _QUATERNION, _VELOCITY, _ANGULAR = (slice(0, 3), slice(3, 7), slice(7, 10),
                                                slice(10, 13))
-_FIELDS = ("x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz")
 
 
 def check_pose_command(command, name="pose_command"):
@@ -30,10 +29,7 @@ def check_pose_command(command, name="pose_command"):
 
     A bad command must stop the robot's controller with a reason, not turn into NaN joint
     targets (which the plant's PD would follow into a crash far from the cause)."""
-    command = np.asarray(command)
-    if not np.isfinite(command).all():
-        bad = [field for field, value in zip(_FIELDS, command) if not np.isfinite(value)]
-        raise ValueError(f"{name} {', '.join(bad)} is NaN or infinite: {command.tolist()}")
+    command = finite_pose_state(command, name)
     quaternion = command[_QUATERNION]
     norm = float(np.sqrt(quaternion @ quaternion))
     if abs(norm - 1.0) > UNIT_TOLERANCE:

@@ -36,6 +36,14 @@ def _label(method, rows=None):
     return label
 
 
+def _label_axes(axes, xlabel, ylabel, title, **legend):
+    """Names `axes`' x and y axes, titles it and draws its legend (`legend`: its options)."""
+    axes.set_xlabel(xlabel)
+    axes.set_ylabel(ylabel)
+    axes.set_title(title)
+    axes.legend(**legend)
+
+
 def _values(records, method, field):
     return [r[field] for r in records if r["method"] == method and r.get("error") is None
             and r.get(field) is not None and np.isfinite(r[field])]
@@ -89,11 +97,9 @@ def plot_collision_histogram(summary, path):
         axis.bar(edges[:-1] + (index + 0.5) * width, entry["histogram"], width=width,
                  align="edge", color=method_colour(method), label=label, alpha=0.85)
     axis.set_xlim(edges[0], edges[-1])
-    axis.set_xlabel("collision ratio (ticks in collision / ticks)")
-    axis.set_ylabel("trials")
-    axis.set_title("(c) collision ratios")
+    _label_axes(axis, "collision ratio (ticks in collision / ticks)", "trials",
+                "(c) collision ratios", fontsize=8)
     axis.yaxis.get_major_locator().set_params(integer=True)
-    axis.legend(fontsize=8)
     axis.grid(axis="y", alpha=0.3)
     _save(figure, path, dpi=120)
 
@@ -213,14 +219,10 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
                                color=colour, ms=3, label=label)
     distance_axes.axhline(summary["goal_tolerance"], color="k", lw=0.8,
                           label=f"goal tolerance {summary['goal_tolerance']:g}")
-    ratio_axes.set_xlabel("alpha (1: robot only)")
-    ratio_axes.set_ylabel("ratio of states in collision")
-    ratio_axes.set_title("(b) explicit arbitration: collisions against alpha")
-    ratio_axes.legend(fontsize=6)
-    distance_axes.set_xlabel("alpha (1: robot only)")
-    distance_axes.set_ylabel("final distance to the goal")
-    distance_axes.set_title("(c) explicit arbitration: final distance against alpha")
-    distance_axes.legend(fontsize=6)
+    _label_axes(ratio_axes, "alpha (1: robot only)", "ratio of states in collision",
+                "(b) explicit arbitration: collisions against alpha", fontsize=6)
+    _label_axes(distance_axes, "alpha (1: robot only)", "final distance to the goal",
+                "(c) explicit arbitration: final distance against alpha", fontsize=6)
 
     colour_map = plt.get_cmap("viridis")
     drawn_speed = _trajectory_speed(summary, resolved)
@@ -269,20 +271,12 @@ def plot_alt_vs_cont(resolved, summary, path):
         input_axes.plot(mode["times"], phase, color=colour, label=label)
     goal = summary["goal"]
     path_axes.plot(*goal[:2], "k*", ms=10)
-    path_axes.set_xlabel("x")
-    path_axes.set_ylabel("y")
-    path_axes.set_title("paths under the same input")
-    path_axes.legend(fontsize=8)
-    phase_axes.set_xlabel("phase (t / tau while running)")
-    phase_axes.set_ylabel("y")
-    phase_axes.set_title("y against phase (dots: operator acting)")
-    phase_axes.legend(fontsize=8)
+    _label_axes(path_axes, "x", "y", "paths under the same input", fontsize=8)
+    _label_axes(phase_axes, "phase (t / tau while running)", "y",
+                "y against phase (dots: operator acting)", fontsize=8)
     any_mode = next(iter(summary["modes"].values()))
     input_axes.fill_between(any_mode["times"], 0, np.max([m["phase"] for m in
                             summary["modes"].values()]), where=np.asarray(
                             any_mode["operator_active"], bool), color="0.85", label="input on")
-    input_axes.set_xlabel("time (s)")
-    input_axes.set_ylabel("phase")
-    input_axes.set_title("phase against time")
-    input_axes.legend(fontsize=8)
+    _label_axes(input_axes, "time (s)", "phase", "phase against time", fontsize=8)
     _save(figure, path, dpi=110)

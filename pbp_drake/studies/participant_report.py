@@ -151,18 +151,15 @@ def _label(method):
     return METHOD_NAMES.get(method, method)
 
 
-def _mean_std(values):
+def _summary(values, source):
+    """A Per-method cell: a trial measure's mean ± std, an answer's median (mean); "-"
+    with no value."""
     values = list(values)
     if not values:
         return "-"
+    if source == "answer":
+        return f"{statistics.median(values):g} ({statistics.fmean(values):.2f})"
     return f"{statistics.fmean(values):.3f} ± {statistics.pstdev(values):.3f}"
-
-
-def _median_mean(values):
-    values = list(values)
-    if not values:
-        return "-"
-    return f"{statistics.median(values):g} ({statistics.fmean(values):.2f})"
 
 
 def participant_results(study_dir):
@@ -182,12 +179,9 @@ def participant_results(study_dir):
     for method in methods:
         runs = [s["runs"].get(method) for s in sessions.values()]
         ran = [r for r in runs if r is not None]
-        lines.append(
-            f"| {_label(method)} | {len(ran)} | {sum(bool(r['success']) for r in ran)} of "
-            f"{len(ran)} | {_mean_std(values['intervention_ratio'][method].values())} | "
-            f"{_mean_std(values['task_time'][method].values())} | "
-            f"{_median_mean(values['tiredness'][method].values())} | "
-            f"{_median_mean(values['ease'][method].values())} |")
+        cells = [_summary(values[key][method].values(), source) for key, _, source in MEASURES]
+        lines.append(f"| {_label(method)} | {len(ran)} | {sum(bool(r['success']) for r in ran)} "
+                     f"of {len(ran)} | {' | '.join(cells)} |")
     scales = "; ".join(f"{key}: {scale_text(key)}" for key in QUESTIONS)
     lines += ["", f"Answers, the count of each value, higher is better ({scales}; Fig. 8, "
               f"{FIG8}):", "", "| method | question | 0 | 1 | 2 | 3 | 4 | 5 |",

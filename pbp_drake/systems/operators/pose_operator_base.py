@@ -1,15 +1,13 @@
 """What the six-DoF browser operators share: the hand's pose in, a world-frame twist out,
 the operator frame and the forward drop of PBP modes (`core.operator_frame`)."""
 
-import math
-
 import numpy as np
 
 from pbp_drake.core.operator_frame import capped, operator_twist, without_forward_twist
 from pbp_drake.core.pose_arbitration import validate_twist
 from pbp_drake.core.quaternion import unit_quaternions
 from pbp_drake.systems.operators.browser_input import BrowserOperator, check_params
-from pbp_drake.systems.ports import OperatorTwist, PoseState
+from pbp_drake.systems.ports import OperatorTwist, PoseState, finite_pose_state
 
 
 class PoseOperatorBase(BrowserOperator):
@@ -44,12 +42,7 @@ class PoseOperatorBase(BrowserOperator):
         return validate_twist(command, "operator_twist")
 
     def _orientation(self, context):
-        state = np.asarray(self._hand_state_port.Eval(context), float)
-        bad = [name for name, value in zip(PoseState.get_fields(), state)
-               if not math.isfinite(value)]
-        if bad:
-            raise ValueError(f"hand_state {', '.join(bad)} is NaN or infinite: "
-                             f"{state.tolist()}")
+        state = finite_pose_state(self._hand_state_port.Eval(context), "hand_state")
         return unit_quaternions(state[3:7], "hand_state orientation")
 
     def _twist(self, context, linear, angular):

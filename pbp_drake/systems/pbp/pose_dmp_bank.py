@@ -18,7 +18,7 @@ from pbp_drake.systems.pbp.dmp_bank import BankSystem
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
     AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
     hold_into, per_goal_arrays, split_head, state_size, step_all)
-from pbp_drake.systems.ports import GoalPose, PoseState
+from pbp_drake.systems.ports import GoalPose, PoseState, finite_pose_state
 from pbp_drake.systems.tick import checked_period, checked_update_offset
 
 
@@ -197,15 +197,7 @@ class PoseDmpBank(BankSystem):
     def _robot(self, context):
         """The measured position (3,), orientation (4,), velocity (3,) and angular velocity
         (3,), checked."""
-        state = np.asarray(self._robot_state_port.Eval(context), dtype=float)
-        # A sum of floats is finite unless a number is NaN or infinite (or the sum
-        # overflows, which the exact check below lets pass): a fifth of `np.isfinite`'s time.
-        if not math.isfinite(sum(state.tolist())):
-            bad = [name for name, value in zip(PoseState.get_fields(), state)
-                   if not np.isfinite(value)]
-            if bad:
-                raise ValueError(f"robot_state {', '.join(bad)} is NaN or infinite: "
-                                 f"{state.tolist()}")
+        state = finite_pose_state(self._robot_state_port.Eval(context), "robot_state")
         norm = math.sqrt(float(state[3:7] @ state[3:7]))
         if abs(norm - 1.0) > quaternion.UNIT_TOLERANCE:
             quaternion.unit_quaternions(state[3:7], "robot_state orientation")  # raises

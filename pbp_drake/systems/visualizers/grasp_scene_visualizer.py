@@ -3,15 +3,12 @@ many, the likeliest grasps' triads), every grasp's probability as one point clou
 target and the estimated goal, the hand, and the selected DMP's predicted poses."""
 
 import numpy as np
-from pydrake.geometry import Box, Cylinder
-from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.pbp.likely_goals import likely_goal_indices
 from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, Target, goal_index
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
-    CLOUD_POINT_SIZE, OBJECT_COLOUR, SOLID_OBJECTS, TABLE_COLOUR, TaskMarkers,
-    behind_the_robot)
+    CLOUD_POINT_SIZE, SOLID_OBJECTS, TaskMarkers, behind_the_robot, draw_table_object)
 from pbp_drake.systems.visualizers.scene_drawing import (
     GoalCloud, PathTriads, draw_triad, pose_transform)
 
@@ -92,21 +89,15 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
     def _draw_scene(self):
         meshcat, grasps = self._meshcat, self._grasps
         meshcat.Delete("/task")
-        radius, height = self._object_shape
         self._cloud.restart()  # drawn by the `_publish_cloud` that follows
         for index in range(0 if self._solid else self._likely_triads):
             draw_triad(meshcat, f"/task/likely_grasps/{index}", None, TRIAD_LENGTH,
                        TRIAD_RADIUS, opacity=1.0 if index == 0 else 0.5)
         solid = zip(grasps.tables, grasps.objects) if self._solid else ()
         for index, (table, centre) in enumerate(solid):
-            # `tables` holds each top face's centre: the box stands on the floor below it.
-            meshcat.SetObject(f"/task/tables/{index}", Box(*self._table_size, table[2]),
-                              TABLE_COLOUR)
-            meshcat.SetTransform(f"/task/tables/{index}",
-                                 RigidTransform([table[0], table[1], table[2] / 2.0]))
-            meshcat.SetObject(f"/task/objects/{index}", Cylinder(radius, height),
-                              OBJECT_COLOUR)
-            meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(centre))
+            # `tables` holds each top face's centre.
+            draw_table_object(meshcat, index, table, self._table_size, centre,
+                              self._object_shape)
             draw_triad(meshcat, f"/task/grasps/{index}", self._grasp_pose(index),
                        TRIAD_LENGTH, TRIAD_RADIUS)
         self._markers.draw(meshcat)

@@ -153,13 +153,9 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         self._cloud.restart()  # drawn by the `_publish_cloud` that follows
         for index, point in enumerate(self._objects if len(self._objects) <= SOLID_OBJECTS
                                       else ()):
-            table_height = point[2] - OBJECT_HEIGHT / 2
-            meshcat.SetObject(f"/task/tables/{index}", Box(0.3, 0.3, table_height), TABLE_COLOUR)
-            meshcat.SetTransform(f"/task/tables/{index}",
-                                 RigidTransform([point[0], point[1], table_height / 2]))
-            meshcat.SetObject(f"/task/objects/{index}",
-                              Cylinder(OBJECT_RADIUS, OBJECT_HEIGHT), OBJECT_COLOUR)
-            meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(point))
+            table = [point[0], point[1], point[2] - OBJECT_HEIGHT / 2]
+            draw_table_object(meshcat, index, table, (0.3, 0.3), point,
+                              (OBJECT_RADIUS, OBJECT_HEIGHT))
         self._markers.draw(meshcat)
         meshcat.SetObject(HAND_MARKER, Cylinder(0.09, 0.01), OPERATOR_COLOUR)
         meshcat.SetProperty(HAND_MARKER, "visible", False)
@@ -195,6 +191,16 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
     def _publish_cloud(self, context):
         port = self._probabilities_port
         self._cloud.show(self._meshcat, port.Eval(context) if port.HasValue(context) else None)
+
+
+def draw_table_object(meshcat, index, table, table_size, centre, object_shape):
+    """Draws object `index`, a cylinder `(radius, height)` at `centre`, and its table, a box
+    of `table_size` (x, y) standing on the floor under `table` (its top face's centre)."""
+    meshcat.SetObject(f"/task/tables/{index}", Box(*table_size, table[2]), TABLE_COLOUR)
+    meshcat.SetTransform(f"/task/tables/{index}",
+                         RigidTransform([table[0], table[1], table[2] / 2]))
+    meshcat.SetObject(f"/task/objects/{index}", Cylinder(*object_shape), OBJECT_COLOUR)
+    meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(centre))
 
 
 def behind_the_robot(objects):

@@ -7,10 +7,13 @@ The matrices of every method under every pilot (`ARENA_STUDIES`) also make the a
 docs/results/arena.md (`pbp_drake_bench.arena_page`), from their summaries, and the many-goals
 studies the K sweep's figure and table (`pbp_drake_bench.many_goals_figure`).
 
-A study interrupted part-way resumes from the trials on disk when this runs again.
+A study interrupted part-way resumes from the trials on disk when this runs again, if the
+code that made them is today's (`code_fingerprint`, kept in the folder's `.code`); a folder
+made by other code starts afresh, since a study's hash covers its scenario, not the code.
 """
 
 import argparse
+import hashlib
 import pathlib
 import shutil
 import subprocess
@@ -218,6 +221,35 @@ def with_trials(arguments, trials):
     return arguments
 
 
+# What a trial's numbers depend on beside its scenario: the package and the robot models.
+FINGERPRINTED = ("pbp_drake", "models")
+CODE_STAMP = ".code"
+
+
+def code_fingerprint(repo=pathlib.Path(__file__).resolve().parents[1]):
+    """A digest of the package's Python files and the models' files under `repo`."""
+    digest = hashlib.sha256()
+    for root in FINGERPRINTED:
+        for path in sorted((repo / root).rglob("*")):
+            if path.is_file() and "__pycache__" not in path.parts:
+                digest.update(str(path.relative_to(repo)).encode() + b"\0")
+                digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def afresh_unless_made_by(output, fingerprint):
+    """Empties the study folder `output` when other code made it (no stamp, or another),
+    then stamps it with `fingerprint`; True when it was emptied."""
+    stamp = output / CODE_STAMP
+    emptied = output.exists() and (not stamp.is_file() or stamp.read_text() != fingerprint)
+    if emptied:
+        shutil.rmtree(output)
+        print(f"  {output} was made by other code: started afresh", flush=True)
+    output.mkdir(parents=True, exist_ok=True)
+    stamp.write_text(fingerprint)
+    return emptied
+
+
 def _pbp_drake(*arguments):
     command = [sys.executable, "-m", "pbp_drake", *arguments]
     print("+ pbp-drake " + " ".join(arguments), flush=True)
@@ -248,8 +280,10 @@ def main(argv=None):
     if unknown:
         parser.error(f"unknown studies {', '.join(unknown)}; known: {', '.join(STUDIES)}")
     failed = []
+    fingerprint = code_fingerprint()
     for name in args.names or STUDIES:
         output = pathlib.Path(args.outputs) / name
+        afresh_unless_made_by(output, fingerprint)
         markdown = pathlib.Path(args.generated) / f"{name}.md"
         studied = _pbp_drake("study", *with_trials(STUDIES[name], args.trials),
                              "--jobs", str(args.jobs), "--output", str(output))

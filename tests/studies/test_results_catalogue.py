@@ -4,7 +4,8 @@ baselines' page gets each method paired with PBP-Alt and the study's figures bes
 
 import pytest
 
-from pbp_drake_bench.results_catalogue import DOCS_FIGURES, STUDIES, main
+from pbp_drake_bench.results_catalogue import (
+    DOCS_FIGURES, STUDIES, afresh_unless_made_by, code_fingerprint, main)
 
 pytestmark = pytest.mark.slow
 
@@ -34,3 +35,35 @@ def test_every_baselines_study_has_dragan_and_srinivasas_arbitration():
     assert {"hsr_reach_baselines", "hsr_grasp_baselines", "arm_reach_evaluation"} <= set(
         with_hop)
     assert all("confidence_alpha" in methods for methods in with_hop.values())
+
+
+def test_a_study_folder_resumes_only_from_the_trials_of_todays_code(tmp_path):
+    """A folder that other code made (no stamp, or another) is emptied, whose trials would
+    put that code's numbers in today's table; one stamped with today's code keeps them."""
+    output = tmp_path / "study"
+    trial = output / "trials" / "teleop" / "seed_0.json"
+
+    def a_trial_on_disk():
+        trial.parent.mkdir(parents=True, exist_ok=True)
+        trial.write_text("{}")
+
+    a_trial_on_disk()
+    assert afresh_unless_made_by(output, "today")
+    assert not trial.exists() and (output / ".code").read_text() == "today"
+    a_trial_on_disk()
+    assert not afresh_unless_made_by(output, "today")
+    assert trial.exists()
+    assert afresh_unless_made_by(output, "tomorrow")
+    assert not trial.exists() and (output / ".code").read_text() == "tomorrow"
+
+
+def test_the_code_fingerprint_follows_the_package_and_the_models(tmp_path):
+    for root in ("pbp_drake", "models"):
+        (tmp_path / root).mkdir()
+        (tmp_path / root / "part.py").write_text("x = 1\n")
+    first = code_fingerprint(tmp_path)
+    (tmp_path / "pbp_drake" / "__pycache__").mkdir()
+    (tmp_path / "pbp_drake" / "__pycache__" / "part.pyc").write_bytes(b"compiled")
+    assert code_fingerprint(tmp_path) == first
+    (tmp_path / "models" / "part.py").write_text("x = 2\n")
+    assert code_fingerprint(tmp_path) != first

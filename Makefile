@@ -116,7 +116,7 @@ soak: $(STAMP)
 # Every study the docs quote (the list: pbp_drake_bench/results_catalogue.py), each with
 # --jobs 2 into outputs/results/NAME, and its table into docs/results/generated/NAME.md
 # (`pbp-drake report DIR --markdown FILE`, whose first line is the command that made it).
-# From scratch, well over an hour on a 2-core machine. Run again after an interruption, it
+# From scratch, about an hour on a 2-core machine. Run again after an interruption, it
 # resumes from the trials today's code made; a study folder other code made starts afresh.
 results: $(STAMP)
 	$(PYTHON) -m pbp_drake_bench.results_catalogue

@@ -13,6 +13,7 @@ from its simulated time)."""
 import cProfile
 import json
 import os
+import pathlib
 import pstats
 import subprocess
 import sys
@@ -23,6 +24,7 @@ import pytest
 from pydrake.geometry import Box, Meshcat, MeshcatParams
 from pydrake.math import RigidTransform
 
+import pbp_drake
 from pbp_drake_bench.cases import (
     MOTION_DURATIONS, bank_math_step, leaf_simulator, make_bank, make_case, motion_timing)
 from pbp_drake_bench.checks import CHECKS, evaluate, exit_code, format_results, summary
@@ -32,6 +34,7 @@ from pbp_drake_bench.estimators import estimator_steps
 from pbp_drake_bench.pinning import MARKER, THREAD_VARIABLES, blas_threads
 from pbp_drake_bench.main import _parse, plan
 from pbp_drake_bench.table import format_driver_rate, format_estimators, format_report
+from pbp_drake_bench import time_split
 from pbp_drake_bench.time_split import BANK, DRAWING, IK, ORDER, REST, category_of, split_stats
 from pbp_drake_bench.timing import timed_span
 from pbp_drake_bench.ws_reader import MeshcatReader, send_mark
@@ -399,6 +402,16 @@ def test_the_websocket_reader_receives_what_meshcat_sends():
     assert sent > 20 * 50  # each transform is a 4x4 matrix of doubles and its path
     assert totals["bytes"] > sent and totals["messages"] > messages  # /before too
     assert totals["closed_by"] == "done mark"
+
+
+def test_every_system_of_the_pbp_loop_has_its_stage_in_the_time_split():
+    # A system module left out would count as its caller's: Drake's framework, "rest".
+    folder = pathlib.Path(pbp_drake.__file__).parent / "systems" / "pbp"
+    for module in sorted(folder.glob("*.py")):
+        if module.name != "__init__.py":
+            path = f"/x/pbp_drake/systems/pbp/{module.name}"
+            assert category_of((path, 1, "f")) in (
+                BANK, time_split.ESTIMATOR, time_split.BLENDER, DRAWING), path
 
 
 def test_numpy_called_by_the_bank_counts_as_the_bank():

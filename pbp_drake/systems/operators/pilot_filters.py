@@ -1,15 +1,7 @@
-"""The field's surrogate pilots as Drake systems: thin wrappers of
-`pbp_drake.core.surrogate_pilots`.
-
-A corrupted pilot (noisy, laggy) is a `PilotOperator`: the base participant and a filter
-(`NoisyFilter`, `LaggyFilter`) between its outputs and the controller, in one Diagram with
-exactly the participant's ports, so that the builders connect it as they connect the
-participant. HOP's simulated user is a `ProportionalOperator` with the same ports. Each
-task's keys (`ReachKeys`, `GraspKeys`) say how a key state or a velocity becomes its
-command: the reaching and obstacle tasks' `[vx, vy, vz, yaw_rate]` or the grasping task's
-twist `[v (3), omega (3)]`. The keys the method enables come in through the `forward_key`
-port (1: forward enabled, 0: not), so a pilot is built from the same arguments under every
-method; its draws come from `(seed, tick)` alone.
+"""The surrogate pilots (docs/concepts/pilots.md) as Drake systems: thin wrappers of
+`pbp_drake.core.surrogate_pilots`. Each task's keys (`ReachKeys`, `GraspKeys`) say how a
+key state or a velocity becomes its command: `[vx, vy, vz, yaw_rate]`, or the grasping
+task's twist `[v (3), omega (3)]`.
 """
 
 import numpy as np
@@ -104,12 +96,10 @@ class PilotFilter(PortGetters, LeafSystem):
         - operator_command
         - operator_active
 
-    Each tick, at `pbp_drake.systems.tick.pilot_offset` (after the base pilot's sense
-    stage, before the controller's decide stage), it samples the base pilot's output and
-    holds what `_filter` makes of it; its outputs depend on that held sample alone, as a
-    `SampledOperator`'s. Subclasses implement
-    `_filter(context, tick, command, active, previous) -> (command, active)`, `previous`
-    being its own last output (None at the first tick).
+    Each tick, at `pbp_drake.systems.tick.pilot_offset` (between the sense and decide
+    stages), it samples the base pilot's output and holds what `_filter` makes of it.
+    Subclasses implement `_filter(context, tick, command, active, previous) -> (command,
+    active)`, `previous` being its own last output (None at the first tick).
     """
 
     def __init__(self, keys, control_period, seed):
@@ -156,8 +146,7 @@ class PilotFilter(PortGetters, LeafSystem):
 
 class NoisyFilter(PilotFilter):
     """The noisy pilot's filter: each tick, with probability `eps`, the base pilot's output
-    is replaced by a uniformly random state of the enabled keys (`noisy_draw`), active
-    when an effective key is pressed (`PilotFilter` shows its ports)."""
+    is replaced by a uniformly random state of the enabled keys (`noisy_draw`)."""
 
     def __init__(self, keys, control_period, seed, eps):
         super().__init__(keys, control_period, seed)
@@ -174,8 +163,7 @@ class NoisyFilter(PilotFilter):
 
 class LaggyFilter(PilotFilter):
     """The laggy pilot's filter: each tick, with probability `p_tick` (the sources' `p` at
-    our tick, `lag_per_tick`), it repeats its previous output instead of the base pilot's
-    (`PilotFilter` shows its ports). The first tick passes the base pilot's output."""
+    our tick, `lag_per_tick`), it repeats its previous output instead of the base pilot's."""
 
     def __init__(self, keys, control_period, seed, p):
         super().__init__(keys, control_period, seed)
@@ -203,8 +191,7 @@ class PilotOperator(PortGetters, Diagram):
         - operator_command
         - operator_active
 
-    Every input port of the base pilot (`base`, a participant system) and of the `filter`
-    is exported once under its name (the hand's state and `forward_key` feed both); the
+    Every input port of `base` and of `pilot_filter` is exported once under its name; the
     outputs are the filter's.
     """
 
@@ -250,11 +237,9 @@ class ProportionalOperator(SampledOperator):
         - operator_command
         - operator_active
 
-    It has the participant's ports but reads only the hand, the target and `forward_key`
-    (with the forward key disabled, the command's forward part is removed): it is blind to
-    the robot's intent (`selected_goal`) and to obstacles. It acts whenever its command is
-    not zero, i.e. everywhere but on the target. `keys` is the task's `ReachKeys` or
-    `GraspKeys`; it samples at the sense stage as every `SampledOperator`.
+    It reads only the hand, the target and `forward_key`: it is blind to the robot's intent
+    and to obstacles, and acts wherever its command is not zero. `keys` is the task's
+    `ReachKeys` or `GraspKeys`.
     """
 
     def __init__(self, keys, control_period, params, max_speed, obstacle_count=0):

@@ -55,20 +55,12 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         - operator_active (optional)
         - predicted_paths (optional)
 
-    The static scene (obstacles, the start as a magenta disc, the goals, the demonstration,
-    the robot at `start`) is drawn under `/pbp`, after deleting it, at each initialisation
-    (`Simulator.Initialize`), so a second run or a run after `meshcat.Delete()` draws it
-    again. A planar scene's view is framed then, once, on the start, the goals, the
-    obstacles, the demonstration and the predicted paths of that moment, with a margin
-    (`core.scene_framing`).
-
-    Each publish moves the robot, shows an orange halo while the operator acts and extends
-    the executed path, the robot's trail of blue dots under `/pbp/executed` (`PathTrail`);
-    each `path_period` (default: the publish period) spreads the dots of every DMP's
-    predicted path along it (`PathDots`). All with `time_in_recording`, so that a recording
-    (`Meshcat.StartRecording`, started before the simulator initialises) replays the robot
-    and the paths together, the executed path drawn only up to the replay's time. Call from
-    the thread that made `meshcat`.
+    At each initialisation the static scene is drawn under `/pbp` (after deleting it), and a
+    planar scene's view is framed once on what is known then (`core.scene_framing`). Each
+    publish moves the robot, shows an orange halo while the operator acts and extends the
+    executed path (`PathTrail`, `/pbp/executed`); each `path_period` (default: the publish
+    period) moves every DMP's predicted path (`PathDots`). All with `time_in_recording`, so
+    that a recording replays them. Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, start, goals, obstacles, demonstration=None,

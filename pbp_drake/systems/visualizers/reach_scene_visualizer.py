@@ -77,24 +77,16 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         - predicted_paths (optional)
         - goal_probabilities (optional)
 
-    What is sent does not grow with the number of objects K once the scene is drawn. At
-    each initialisation (`Simulator.Initialize`, after deleting `/task`, so that a second
-    run or a run after `meshcat.Delete()` draws them again) the objects are drawn on small
-    tables (up to `SOLID_OBJECTS`), and every object as one point of the goal cloud
-    `/task/goal_cloud` (`GoalCloud`). Each publish moves the yellow ball above the current
-    `target` and the blue ball above the estimated goal (`selected_goal`; `TaskMarkers`);
-    an orange ring around the hand shows when the operator acts. Each `path_period`
-    (paths change slowly, and a replay interpolates between updates) the `path_count`
-    paths on `predicted_paths` (each `prediction_steps + 1` points, the selected goal's
-    first, as the PBP controller orders them) are drawn as dots (`PathDots`): the first
-    bold `/task/predictions/selected`, the others faint `/task/predictions/likely/{i}`.
-    Each `cloud_period` (less often for thousands of objects, `GoalCloud.period`) the
-    cloud's points take the colour of their goal's probability (`goal_probabilities`, K).
-    All with `time_in_recording`, so that `Meshcat.StartRecording` replays them (a
-    recording keeps the cloud's last colours only: Meshcat records transforms and
-    properties, not objects). The camera (`camera`, `(position, target)`) stands behind
-    and above the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base,
-    start and objects), is framed on it (`workspace_view`). Call from the thread that made
+    At each initialisation (after deleting `/task`) the objects are drawn on small tables
+    (up to `SOLID_OBJECTS`) and as the goal cloud `/task/goal_cloud` (`GoalCloud`), whose
+    colours follow `goal_probabilities` (K) each `cloud_period`. Each publish moves the
+    `TaskMarkers` and shows an orange ring around the hand while the operator acts. Each
+    `path_period` the `path_count` paths on `predicted_paths` (each `prediction_steps + 1`
+    points, the selected goal's first) are drawn as `PathDots`: the first bold
+    `/task/predictions/selected`, the others faint `/task/predictions/likely/{i}`. All with
+    `time_in_recording`, so that a recording replays them. The camera (`camera`,
+    `(position, target)`) stands behind and above the HSR, or is framed on the robot's
+    `workspace` (points `(N, 3)`, `workspace_view`). Call from the thread that made
     `meshcat`.
     """
 

@@ -1,6 +1,5 @@
 """The referee of the multi-goal reaching task: targets, switches, success, metrics; it ends
-the simulation at success. Its rules (`TaskMonitorBase`) are the grasping task's too
-(`pbp_drake.systems.tasks.grasp_task_monitor`)."""
+the simulation at success."""
 
 import dataclasses
 
@@ -17,8 +16,8 @@ SUCCESS_MESSAGE = "the target is reached"
 
 @dataclasses.dataclass(frozen=True)
 class TaskCounts:
-    """The task's whole numbers, as `TaskMonitor.counts` reads them off its state (where
-    they are a discrete vector in this order, exact as floats)."""
+    """The task's whole numbers, as `TaskMonitor.counts` reads them off its state (a
+    discrete vector in this order)."""
 
     stage: int = 0  # target switches so far
     steps: int = 0  # control ticks counted, up to success
@@ -38,31 +37,21 @@ _STAGE, _SUCCESS = 0, 4  # where TaskCounts' stage and success sit in the counts
 
 
 class TaskMonitorBase(PortGetters, LeafSystem):
-    """What the reaching and the grasping task's referees (`TaskMonitor`,
-    `GraspTaskMonitor`) share, so that their rules stay in step.
+    """The rules the reaching and the grasping task's referees (`TaskMonitor`,
+    `GraspTaskMonitor`) share.
 
-    Its input ports: the hand's state (`pose_port`, of `pose_size`), `operator_active` and,
-    with `in_collision_port`, an optional `in_collision`; its output ports `target` and
-    `task_status`. Every control period, `update_offset` after the tick (the decide stage
-    of `pbp_drake.systems.tick` by default), until success: count the step (and whether the
-    operator acted, and whether the robot was in collision), compute the progress toward
-    the current target, switch to the next of `targets` once progress reaches the next
-    entry of `switch_schedule`, and declare success when the hand has reached the current
-    target. `objects` (M, 3) are the points the targets stand for (`target` outputs one).
+    Inputs: the hand's state (`pose_port`, of `pose_size`), `operator_active` and, with
+    `in_collision_port`, an optional `in_collision`; outputs `target` and `task_status`.
+    Every control period, `update_offset` after the tick (default: the decide stage), until
+    success, it counts the step, computes the progress toward the current target, switches
+    to the next of `targets` once progress reaches the next entry of `switch_schedule`, and
+    declares success when the hand has reached the current target. `objects` (M, 3) are the
+    points the targets stand for. A subclass implements `_read_hand(vector)`,
+    `_progress(hand, index)` (a number) and `_reached(hand, index)` (a bool).
 
-    A subclass says what the hand's state is and what progress and success mean:
-    `_read_hand(vector)` turns the hand port's value into what `_progress(hand, index)`
-    (a number) and `_reached(hand, index)` (a bool) read for object `index`.
-
-    At success the monitor ends the simulation: a publish event at the report stage (a
-    millionth of a period after the update) returns `EventStatus.ReachedTermination`, so any
-    `Simulator.AdvanceTo` returns there, before the plant moves again, with
-    `SimulatorStatus.reason()` `kReachedTerminationCondition`. The status then stays frozen;
-    a later `AdvanceTo` stops again one control period on.
-
-    The counts (`TaskCounts`, whole numbers held exactly as floats) and the progress and
-    task time are two discrete vectors, updated at the decide stage (no other system that
-    updates there reads this monitor, nor does it read theirs).
+    At success a publish event at the report stage returns
+    `EventStatus.ReachedTermination`, so `Simulator.AdvanceTo` returns there, before the
+    plant moves again; the status then stays frozen.
     """
 
     def __init__(self, pose_port, pose_size, objects, targets, switch_schedule,
@@ -119,7 +108,6 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         return context.get_discrete_state(self._counts_index).value()
 
     def _calc_target(self, context, output):
-        # Once a tick each, this and the end-of-tick check read one count, not all five.
         index = self._targets[int(self._count_vector(context)[_STAGE])]
         target = Target(np.empty(Target.size))
         target.x, target.y, target.z = self._objects[index]

@@ -88,9 +88,8 @@ _GETTER = re.compile(r"get_(\w+)_(input|output)_port")
 
 class PortGetters:
     """`get_NAME_input_port()` and `get_NAME_output_port()` for every port NAME the system
-    declares, as Drake's C++ systems have: `GetInputPort(NAME)`, `GetOutputPort(NAME)`. A
-    mixin before `LeafSystem` or `Diagram`; the ports are those of the system's
-    `.. pydrake_system::` diagram, and `dir()` lists their getters."""
+    declares, as Drake's C++ systems have. A mixin before `LeafSystem` or `Diagram`;
+    `dir()` lists the getters."""
 
     def __getattr__(self, attribute):
         match = _GETTER.fullmatch(attribute)

@@ -159,7 +159,6 @@ class VirtualOperator(SampledOperator):
             unseen_ticks += 1
             if unseen_ticks > self._reaction_ticks:
                 known, unseen_ticks = shown, 0
-        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
         discrete_state.set_value(self._belief_index, [known, unseen_ticks])
         own_motion = self._perceive(context, discrete_state)
         # A target it has just come to know: it watches the robot afresh.
@@ -259,8 +258,7 @@ class VirtualOperator(SampledOperator):
         offset = target_xy - hand
         distance = np.linalg.norm(offset)
         noise_angle, speed_scale = self._noise(context)
-        # Where the robot shows its intent (the ball on the object, its path), the
-        # participant judges the path it shows; where it shows none, the motion it sees.
+        # Where the robot shows its intent it judges the path shown, else the motion seen.
         shows = self._shown_goal(context) != NO_INTENT
         params = self.params
         track[watch] = update_watch(params, track[watch], distance, self._period)
@@ -422,8 +420,6 @@ class VirtualOperator(SampledOperator):
         if self._vertical:
             command = np.append(command, speed_scale * velocity[2])
         if against:
-            # With `vertical` in 3-D: the picked object's DMP pulls the hand to its height
-            # too, and left alone it holds the hand below (or above) the target.
             command = self._against_policy(context, ee_state, command)
         vz = command[2] if self._vertical else 0.0
         return np.array([command[0], command[1], vz, yaw_rate]), True

@@ -131,8 +131,7 @@ class AffineState(_Layout):
         phase, held, robot, z, alpha, beta = self._split(vector)
         robot[:, 0] = robot_state[:d]
         if lock:
-            # Phases frozen: the DMPs stay at the robot's position (dp = 0 g + 0) and
-            # follow its velocity (the velocity the last step left is not needed).
+            # Phases frozen: the DMPs stay at the robot's position (dp = 0 g + 0).
             held[0] = 1.0
             alpha.fill(0.0)
             beta.fill(0.0)

@@ -226,9 +226,7 @@ class PoseDmpBank(BankSystem):
         stepped, log_state = self._stepped(context, vector)
         offsets, velocities = stepped
         workspace = self._workspace(context)
-        # The DMPs' velocities at the end of the last step, which the step overwrites: the
-        # followed one's linear velocity (every DMP continues from it), else each one's,
-        # and the orientation part's eta as a column (one for all) or per DMP.
+        # The velocities the step starts from: the followed DMP's (one column), else each's.
         if followed is not None:
             scaled_velocity, eta = workspace.column, workspace.eta_column
             if stepping:
@@ -314,8 +312,7 @@ class PoseDmpBank(BankSystem):
         rotation = quaternion.exp_times_aligned_values(numbers[6:9], goal, head[5:9])
         eta = jacobian_of_one_values(numbers[6:9], numbers[9:12])
         if stepped is not None:
-            # The next update steps every DMP from the followed one's eta: this one's, when
-            # the blender follows the goal the estimator selects (`SteppedDmps`).
+            # The next update reuses it when this goal is the followed one (`SteppedDmps`).
             stepped.eta_goal, stepped.eta = k, eta
         return position + rotation + velocity + [value / tau_w for value in eta]
 
@@ -330,8 +327,7 @@ class PoseDmpBank(BankSystem):
         k = self._selected(context)
         phase, positions, orientations, velocity, eta = self.dmp_states(context)
         goals = self._goals_entry.Eval(context)[:, [k]]
-        # The selected DMP alone is rolled out (banks of its one DMP): the same path as
-        # rolling out all K and picking it, at a cost that does not grow with K.
+        # The selected DMP alone is rolled out: the same path, at a cost independent of K.
         dt, steps = self._prediction_period, self._prediction_steps
         path = self._positions.subset([k]).predict(
             phase[[k]], positions[:, [k]], velocity[:, [k]], goals[:3], dt, steps)[0]

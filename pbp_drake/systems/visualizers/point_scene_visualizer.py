@@ -37,9 +37,8 @@ PATH_DOT_RADIUS = 0.006
 # dots; `PathTrail` doubles their spacing after 1.6 m (a toy run's path is about 1.3 m).
 EXECUTED_DOT_RADIUS = 0.003
 EXECUTED_SPACING = 0.004
-# Heights (2-D scenes seen from above): the start under the obstacles, the paths over them,
-# the robot and the goals over the paths; the executed path over the obstacles (their top
-# at 0.005), under the predicted paths.
+# Heights seen from above: the start under the obstacles (top at 0.005), the executed path
+# over them, under the predicted paths.
 START_Z, EXECUTED_Z, PATH_Z = -0.01, 0.006, 0.008
 
 
@@ -131,8 +130,7 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         meshcat.SetProperty("/pbp/robot/operator", "visible", False)
         meshcat.SetTransform("/pbp/robot", RigidTransform(self._to_3d(start)[0]))
         if self._dimension == 2:
-            # Framed once, on what is known at the start; the margin holds the robot's
-            # excursions from it.
+            # Framed once, on what is known at the start.
             points = [start[None, :], goals]
             if demonstration is not None:
                 points.append(np.asarray(demonstration, float))

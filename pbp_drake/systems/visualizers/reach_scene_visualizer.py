@@ -17,8 +17,7 @@ TARGET_COLOUR = Rgba(1.0, 0.9, 0.0, 1.0)
 ESTIMATE_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 ACTIVE_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
-# Dots per path (each of TASK_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
-# every path update, so their count and rate set most of its size.
+# Dots per path: a replay keeps every dot's position at every path update.
 PATH_DOTS = 24
 # The marker at the hand (shown while the operator acts): a replay's track of the hand's
 # path (`pbp-drake teach --from` reads it).
@@ -28,8 +27,7 @@ TRAIL_DOT_RADIUS, TRAIL_SPACING = 0.01, 0.02
 TRAIL_COLOUR = Rgba(0.2, 0.75, 0.3, 0.9)
 ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008
 OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
-# Up to this many objects are drawn as tables and cylinders; more are the goal cloud alone
-# (thousands of meshes would slow the page down, and show nothing the cloud does not).
+# Up to this many objects are drawn as tables and cylinders; more are the goal cloud alone.
 SOLID_OBJECTS = 100
 # The goal cloud's points float just above the objects' tops, at most the size of an object
 # (smaller when many objects stand close: `cloud_point_size`).

@@ -5,7 +5,7 @@ task's twist `[v (3), omega (3)]`.
 """
 
 import numpy as np
-from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from pbp_drake.core.surrogate_pilots import (
     GRASP_AXES, REACH_AXES, REACH_VERTICAL_AXES, grasp_key_command,
@@ -81,7 +81,7 @@ class GraspKeys:
             position_of(Target(target)), max_speed, forward_enabled)
 
 
-class PilotFilter(PortGetters, LeafSystem):
+class PilotFilter(SampledOperator):
     """Base of the filters between a base pilot's outputs and the controller.
 
     .. pydrake_system::
@@ -103,42 +103,26 @@ class PilotFilter(PortGetters, LeafSystem):
     """
 
     def __init__(self, keys, control_period, seed):
-        super().__init__()
+        super().__init__(keys.command_size, control_period)
         self.keys = keys
-        self._period = float(control_period)
         self._seed = int(seed)
-        size = keys.command_size
-        self._size = size
-        self._base_command_port = self.DeclareVectorInputPort("base_command", size)
+        self._base_command_port = self.DeclareVectorInputPort("base_command", keys.command_size)
         self._base_active_port = self.DeclareVectorInputPort("base_active", 1)
         self._hand_port = self.DeclareVectorInputPort(keys.hand_port, keys.hand_size)
         self._forward_port = self.DeclareVectorInputPort(FORWARD_KEY, 1)
-        # [command (size), active, whether a sample has been taken].
-        self._sample_index = self.DeclareDiscreteState(size + 2)
-        held = {self.discrete_state_ticket(self._sample_index)}
-        self.DeclareVectorOutputPort(
-            "operator_command", size,
-            lambda context, output: output.SetFromVector(self._held(context)[:size]),
-            prerequisites_of_calc=held)
-        self.DeclareVectorOutputPort(
-            "operator_active", 1,
-            lambda context, output: output.SetFromVector(self._held(context)[size:size + 1]),
-            prerequisites_of_calc=held)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, pilot_offset(self._period),
-                                                self._update)
-
-    def _held(self, context):
-        return context.get_discrete_state(self._sample_index).value()
+        self._taken_index = self.DeclareDiscreteState(1)  # 1 once a sample has been taken
+        self._declare_operator_outputs(offset=pilot_offset(self._period))
 
     def _update(self, context, discrete_state):
         tick = int(round(context.get_time() / self._period))
         held = self._held(context)
-        previous = (held[:self._size], bool(held[self._size] > 0.5)) if held[-1] > 0.5 else None
+        taken = context.get_discrete_state(self._taken_index).value()[0] > 0.5
+        previous = (held[:-1], bool(held[-1] > 0.5)) if taken else None
         command, active = self._filter(
             context, tick, np.array(self._base_command_port.Eval(context), float),
             bool(self._base_active_port.Eval(context)[0] > 0.5), previous)
-        discrete_state.set_value(self._sample_index,
-                                 np.concatenate([command, [float(active), 1.0]]))
+        discrete_state.set_value(self._taken_index, [1.0])
+        self._store_sample(discrete_state, command, active)
 
     def _filter(self, context, tick, command, active, previous):
         raise NotImplementedError

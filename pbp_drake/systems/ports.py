@@ -1,10 +1,5 @@
-"""Named layouts of the HSR task's vectors, in one place (`pydrake` `namedview`s).
-
-Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
-``EeState.size`` is its length. Every system that declares such a port takes its size here.
-`position_of` reads the `[x, y, z]` of any view that has those fields (the pose views too);
-`goal_index` reads a goal index port (`selected_goal`, `followed_goal`). `PortGetters` gives
-a system `get_NAME_input_port()` and `get_NAME_output_port()` for every port it declares.
+"""Named layouts of the port and state vectors (`pydrake` `namedview`s), e.g.
+``EeState(vector).heading``, ``EeState.size`` its length; and the helpers that read ports.
 """
 
 import math

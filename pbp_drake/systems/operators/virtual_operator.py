@@ -50,7 +50,9 @@ class VirtualOperator(SampledOperator):
     is the arm from there to the hand (`footprint_clearance`). With `obstacle_count > 0` it
     watches `obstacle_positions` `(N, 2)`, cylinders of `obstacle_radius`, and keeps the
     robot's footprint `obstacle_margin` clear of them. Its noise is drawn from
-    `(seed, tick)`, so a run is reproducible and all its state lives in the Context.
+    `(seed, tick)`, so a run is reproducible and all its state lives in the Context. Its
+    `impairment` (`pbp_drake.core.participant_impairment`) adds motor noise, delays its
+    commands and makes it head for a wrong object first, now and then.
 
     Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0
     unless `vertical`).

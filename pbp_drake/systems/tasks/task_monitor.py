@@ -9,7 +9,7 @@ from pydrake.systems.framework import EventStatus, LeafSystem
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.reach_task import reach_progress
 from pbp_drake.systems.ports import EeState, PortGetters, Target, TaskStatus, position_of
-from pbp_drake.systems.tick import decide_offset, report_offset
+from pbp_drake.systems.tick import checked_update_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
 
@@ -63,13 +63,8 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         if len(self._targets) != len(self._schedule):
             raise ValueError("one target per entry of switch_schedule")
         period = float(control_period)
-        if update_offset is None:
-            update_offset = decide_offset(period)
-        self._update_offset = float(update_offset)
+        update_offset = self._update_offset = checked_update_offset(update_offset, period)
         end_offset = report_offset(period, update_offset)
-        if not 0.0 <= update_offset < end_offset < period:
-            raise ValueError(f"update_offset must be in [0, control_period), got "
-                             f"{update_offset!r}")
         self._hand_port = self.DeclareVectorInputPort(pose_port, pose_size)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._in_collision_port = (self.DeclareVectorInputPort("in_collision", 1)

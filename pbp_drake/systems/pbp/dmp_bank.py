@@ -83,16 +83,11 @@ class DmpBank(BankSystem):
         - predicted_paths
 
     `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
-    `(K, D)`. Each period every DMP advances one step from the robot's position (the
-    first-order-hold step of `pbp_drake.core.dmp`). With `lock_phase_when_operator_acts`
-    (PBP-Alt), a nonzero `operator_active` freezes the one phase all DMPs share, and the
-    DMPs follow the robot until the operator lets go. With `max_speed` (m/s), each DMP's
-    velocity is scaled down to it before every step (anti-windup).
-
-    `followed_goal` (optional) is the goal whose reference the robot followed since the
-    last update. Connected, every DMP steps from the followed DMP's velocity, so the
-    selection may move without a jump of the commanded velocity; unconnected, each DMP
-    keeps a velocity of its own.
+    `(K, D)`. Each period every DMP advances one step from the robot's position;
+    docs/concepts/dmp.md ("PBP: re-integrating from the robot every step") explains
+    `lock_phase_when_operator_acts` (a nonzero `operator_active` freezes the phase), the
+    `followed_goal` input (connected, every DMP steps from the followed DMP's velocity) and
+    `max_speed` (m/s, anti-windup).
 
     `references` is the K next states `[positions (K*D), velocities (K*D)]`;
     `selected_reference` the next state `[position (D), velocity (D)]` of `selected_goal`

@@ -28,13 +28,11 @@ class GoalGrouping(PortGetters, LeafSystem):
         - followed_goals
         - shown_goal
 
-    `settings` is the estimator's (`GoalEstimatorSettings`: `group_mass`, `commit_radius`,
-    `commit_probability`). `goals` is the K goals `(K, 3)` row-major; `ee_state`'s position
-    is read (the robot commits once the hand reaches the group's point). `followed_goals`
-    is `goals` with the selected goal's row moved to the group's point while the robot has
-    not committed; `shown_goal` is `[index]`, the selected goal once committed, else
-    `NO_GOAL` (-1). The commitment, updated at the decide stage of each tick, holds while
-    the estimator selects the same goal.
+    The rules are docs/concepts/goal-estimators.md's ("Many goals: goal groups");
+    `settings` is the estimator's `GoalEstimatorSettings`. `goals` is the K goals `(K, 3)`
+    row-major. `followed_goals` is `goals` with the selected goal's row moved to the
+    group's point while the robot has not committed; `shown_goal` is `[index]`, the
+    selected goal once committed, else `NO_GOAL` (-1).
     """
 
     # The goals' input and numbers per goal, the hand's input and its size, the output.

@@ -8,16 +8,9 @@
 - `systems.ports`: the named entries of the port vectors; `systems.tick`: the order of the
   updates within a control tick; `SampleHold`: the tick's sample of the robot's state.
 
-Port names are the public contract: `robot_state`, `goals`, `operator_command`,
-`operator_active`, `references`, `selected_goal`, `goal_probabilities`, `command`, `state`,
-`ee_state`, `target`, `task_status`.
-
-Vector layouts: a robot state is `[positions (D), velocities (D)]`; `references` of K goals is
-`[positions (K*D, row-major (K, D)), velocities (K*D)]`; `command` is `[position (D),
-velocity (D)]`. On the HSR, `ee_state` is `[p (3), v (3), heading, heading_rate]` and an
-operator's command `[vx, vy, vz, yaw_rate]` in the world frame. The six-DoF systems use
-`PoseState` `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]` and `OperatorTwist`; their
-browser operators take the hand's `hand_state` and output `operator_twist`.
+Port names are the public contract. A robot state is `[positions (D), velocities (D)]`;
+`references` of K goals `[positions (K*D, row-major (K, D)), velocities (K*D)]`; the HSR's
+and the six-DoF systems' vectors are the named views of `systems.ports`.
 """
 
 from pbp_drake.systems.operators import (

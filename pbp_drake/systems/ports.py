@@ -1,10 +1,5 @@
-"""Named layouts of the HSR task's vectors, in one place (`pydrake` `namedview`s).
-
-Each view names the entries of a port or state vector, e.g. ``EeState(vector).heading``;
-``EeState.size`` is its length. Every system that declares such a port takes its size here.
-`position_of` reads the `[x, y, z]` of any view that has those fields (the pose views too);
-`goal_index` reads a goal index port (`selected_goal`, `followed_goal`). `PortGetters` gives
-a system `get_NAME_input_port()` and `get_NAME_output_port()` for every port it declares.
+"""Named layouts of the port and state vectors (`pydrake` `namedview`s), e.g.
+``EeState(vector).heading``, ``EeState.size`` its length; and the helpers that read ports.
 """
 
 import math
@@ -88,9 +83,8 @@ _GETTER = re.compile(r"get_(\w+)_(input|output)_port")
 
 class PortGetters:
     """`get_NAME_input_port()` and `get_NAME_output_port()` for every port NAME the system
-    declares, as Drake's C++ systems have: `GetInputPort(NAME)`, `GetOutputPort(NAME)`. A
-    mixin before `LeafSystem` or `Diagram`; the ports are those of the system's
-    `.. pydrake_system::` diagram, and `dir()` lists their getters."""
+    declares, as Drake's C++ systems have. A mixin before `LeafSystem` or `Diagram`;
+    `dir()` lists the getters."""
 
     def __getattr__(self, attribute):
         match = _GETTER.fullmatch(attribute)

@@ -18,9 +18,8 @@ class SampleHold(PortGetters, LeafSystem):
         output_ports:
         - y
 
-    Drake's ZeroOrderHold starts at zero, which before its first sample would tell the
-    systems downstream that the robot stands at the world's origin; this one starts where
-    the robot does. It samples at the sense stage of each tick (`pbp_drake.systems.tick`).
+    Unlike Drake's ZeroOrderHold (which starts at zero, the robot at the world's origin),
+    it starts where the robot does. It samples at the sense stage of each tick.
     """
 
     def __init__(self, period, initial_value):

@@ -1,8 +1,5 @@
-"""The operators: whoever or whatever commands the robot beside the PBP policy. A person in
-the browser (`KeyboardOperator`, `GamepadOperator`, and for six-DoF tasks
-`PoseKeyboardOperator`, `PoseGamepadOperator`, all behind the browser guard), the virtual
-participant (`VirtualOperator`, six-DoF `PoseVirtualOperator`), and the open-loop operators
-of the 2-D scenes (`ScriptedOperator`, `ObstacleRepulsionOperator`, `IdleOperator`)."""
+"""The operators: whoever or whatever commands the robot beside the PBP policy (a person in
+the browser, the virtual participant, the 2-D scenes' open-loop operators)."""
 
 from pbp_drake.systems.operators.gamepad_operator import GamepadOperator
 from pbp_drake.systems.operators.idle_operator import IdleOperator

@@ -1,24 +1,14 @@
 """Exclusive control of a Meshcat page: a person's operator reads its browser only while
 exactly that one browser is connected.
 
-Drake's Meshcat accepts a websocket from any origin. The command line puts its page front
-(`pbp_drake.console.front.PageFront`) before it, which lets in only a browser holding the
-run's secret URL and shuts Meshcat's own port to everyone else; this guard is the second
-line, and the only one for a diagram on a bare Meshcat. It cannot tell the person's page
-from another; what it can see is how many there are: the pages the front admitted that
-have sent a frame (our page answers its first batch at once; a connection that sent
-nothing cannot press a key) when a front serves this Meshcat (it says so with
-`register_front`), else Meshcat's connections. With more than one, it pauses the
-simulation where it stands (inside the operator's sampling, so no simulated time passes and
-the robot does not move) until one is left (`BrowserGuard`).
-
-Behind a front, a connection to Meshcat that the front did not open (possible only where
-the front could not shut Meshcat's port, see `pbp_drake.console.meshcat_door`) is an
-intruder: while one is connected every click and key is dropped (Meshcat does not say whose
-they are, so the person's too), the run is not paused for it, and one line says so.
-
-What it cannot stop alone (the front does): a page that connects while no browser is (it is
-then "the" browser), and one that connects, presses and leaves between two control ticks.
+The second line behind the command line's page front (`pbp_drake.console.front`), and the
+only one for a diagram on a bare Meshcat (docs/getting-started.md, docs/design.md). It
+counts the pages the front admitted that have sent a frame (when a front serves this
+Meshcat: `register_front`), else Meshcat's connections; with more than one it pauses the
+simulation where it stands until one is left. Behind a front, a connection the front did
+not open is an intruder: while one is connected every click and key is dropped, unpaused.
+It cannot stop alone a page that connects while no browser is, or one that connects,
+presses and leaves between two control ticks.
 """
 
 import sys
@@ -47,14 +37,12 @@ class BrowserGuard:
     """Waits while more than one browser is connected to `meshcat`.
 
     `wait_while_shared()` is called by an operator each time it reads its browser: it
-    returns at once (False) with at most one page (counted as the module says); with more
-    it waits up to `settle` seconds for them to go (True: a page that closed as it
-    connected), else announces the pause (`announce`, the terminal by default, and a button
-    in the page carrying the notice), polls every `poll_period` seconds until at most one
-    is left, announces the end of the pause, calls `after_pause` if set (see
-    `reset_pacing_after_pauses`) and returns True: the caller must then drop what the
-    browser sent meanwhile. With an intruder it returns True at once. `pauses` counts the
-    pauses so far. Use from the thread that created Meshcat.
+    returns False at once with at most one page; with more it waits up to `settle` seconds
+    for them to go, else announces the pause (`announce`, the terminal by default, and a
+    button in the page) and polls every `poll_period` seconds until at most one is left,
+    then calls `after_pause` if set and returns True: the caller must drop what the browser
+    sent meanwhile. With an intruder it returns True at once. `pauses` counts the pauses.
+    Use from the thread that created Meshcat.
     """
 
     def __init__(self, meshcat, poll_period=0.05, announce=None, settle=0.2):
@@ -117,9 +105,7 @@ def _to_stderr(message):
 
 def reset_pacing_after_pauses(diagram, simulator):
     """Makes every guarded operator in `diagram` restart `simulator`'s real-time pacing
-    after a pause: without it, a simulator with a target real-time rate would run flat out
-    after a pause until simulated time caught up with the wall clock, and the robot would
-    rush through the seconds the pause lasted."""
+    after a pause, so that the robot does not rush through the seconds the pause lasted."""
     for system in _leaf_systems(diagram):
         guard = getattr(system, "browser_guard", None)
         if isinstance(guard, BrowserGuard):

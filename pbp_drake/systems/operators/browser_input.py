@@ -33,15 +33,12 @@ class BrowserOperator(SampledOperator):
     """A person in a Meshcat browser, at its keyboard or gamepad.
 
     `params` (a dataclass, copied to `self.params`) gives `speed` (m/s; 0 takes
-    `nominal_speed`, see `operator_speed`) and `rotation_speed` (rad/s). `allow_forward`
-    is False in PBP modes, where forward motion comes from the DMP phase. With `exclusive`
-    a `BrowserGuard` (`browser_guard`) pauses the simulation while more than one browser
-    is connected to the page, and nothing sent meanwhile counts: clicks are dropped and
-    every key released, and the gamepad state Meshcat last received (from whichever page)
-    is ignored until the controls change. Subclasses read their keys (`_declare_keys`,
-    `_step_keys`; the keys' state is discrete state, so the system holds no state outside
-    its Context) or gamepad (`_declare_gamepad`, `_read_gamepad`) in `_update`. Use
-    Meshcat only from the thread that created it.
+    `nominal_speed`) and `rotation_speed` (rad/s). `allow_forward` is False in PBP modes,
+    where forward motion comes from the DMP phase. With `exclusive` a `BrowserGuard` pauses
+    the simulation while more than one browser is connected, and nothing sent meanwhile
+    counts. Subclasses read their keys (`_declare_keys`, `_step_keys`) or gamepad
+    (`_declare_gamepad`, `_read_gamepad`) in `_update`. Use Meshcat only from the thread
+    that created it.
     """
 
     def __init__(self, meshcat, dimension, control_period, allow_forward, params,
@@ -55,10 +52,9 @@ class BrowserOperator(SampledOperator):
         self._rotation_speed = float(params.rotation_speed)
 
     def _declare_keys(self, keys, axes, hold_time):
-        """Adds one button per key (`keys`: name -> `KeyboardEvent.code`, see `HeldButtons`),
-        `self._axes` the rows of `axes` (name -> what the held key adds) in the buttons'
-        order, and the keys' state as discrete state, its click counts snapshotted at
-        initialisation."""
+        """Adds one button per key (`keys`: name -> `KeyboardEvent.code`), `self._axes` the
+        rows of `axes` (name -> what the held key adds) in the buttons' order, and the keys'
+        state as discrete state."""
         self._keys = HeldButtons(self._meshcat, keys, hold_time)
         self._axes = np.array([axes[name] for name in self._keys.names])
         self._keys_index = self.DeclareDiscreteState(
@@ -70,9 +66,7 @@ class BrowserOperator(SampledOperator):
 
     def _step_keys(self, context, discrete_state, clicks):
         """Stores and returns the keys' state after `clicks`, and whether the guard paused
-        (then every key is released: what another page sent does not count). Meshcat is
-        read once a tick, before the connections are counted: a click read then came from
-        a page connected before the count."""
+        (then every key is released). `clicks` are read before the connections are counted."""
         paused = self.browser_guard is not None and self.browser_guard.wait_while_shared()
         if paused:
             keys = self._keys.released()
@@ -90,10 +84,8 @@ class BrowserOperator(SampledOperator):
             np.full(axis_count + button_count, np.nan))
 
     def _read_gamepad(self, context, discrete_state):
-        """The gamepad's `gamepad_values`, or None. Meshcat keeps the last state it received
-        from whichever page sent it, so the controls held when a guard pause ends are
-        ignored (None) until they change. Read before the connections are counted (see
-        `_step_keys`)."""
+        """The gamepad's `gamepad_values`, or None: the controls held when a guard pause ends
+        (Meshcat keeps whichever page's last state) are ignored until they change."""
         gamepad = self._meshcat.GetGamepad()
         counts = self._gamepad_counts
         stale = context.get_discrete_state(self._stale_index).value()
@@ -160,9 +152,8 @@ def apply_dead_zone(stick, dead_zone):
 
 def gamepad_values(gamepad, axis_count, button_count=0):
     """`(axes (axis_count,), buttons (button_count,))` of a Meshcat gamepad status, missing
-    entries 0, or None when there is no gamepad. The browser sends an empty status when the
-    gamepad disconnects, and Meshcat then keeps the old index: empty axes mean none too.
-    A value that is not finite (no real pad sends one) reads as a control at rest."""
+    or not finite entries 0, or None when there is no gamepad (empty axes: a disconnected
+    one, whose index Meshcat keeps)."""
     if gamepad.index is None or len(gamepad.axes) < 2:
         return None
     return _padded(gamepad.axes, axis_count), _padded(gamepad.button_values, button_count)
@@ -175,8 +166,7 @@ def _padded(values, count):
 
 def raw_values(gamepad, axis_count, button_count=0):
     """The first `axis_count` axes then `button_count` button values of a Meshcat gamepad
-    status as sent (missing ones NaN): what an operator compares to tell whether the
-    controls moved since a pause."""
+    status as sent (missing ones NaN)."""
     return np.concatenate([_as_sent(gamepad.axes, axis_count),
                            _as_sent(gamepad.button_values, button_count)])
 

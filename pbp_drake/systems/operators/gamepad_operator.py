@@ -38,17 +38,12 @@ class GamepadOperator(BrowserOperator):
         - operator_active
 
     Reads `meshcat.GetGamepad()` each control tick. The left stick moves the end effector
-    in the robot frame (up = forward along the heading, left = heading + 90 deg) at up to
-    `speed` (m/s); the right stick's x turns it (left = positive yaw rate) at up to
-    `rotation_speed` (rad/s). Each stick has a radial dead zone of `dead_zone`, past which
-    its deflection rises continuously from 0. With `allow_forward=False` (PBP modes) the
-    forward part of the left stick is dropped; back still works.
-
-    Input `ee_state` gives the heading. Output `operator_command` is `[vx, vy, vz,
-    yaw_rate]` in the world frame (vz = 0); `operator_active` is 1 while a stick is outside
-    its dead zone (a stick pushed only forward does not count when forward is not
-    allowed). With no gamepad (none received, or reported disconnected) the command is
-    zero and inactive. `exclusive` and Meshcat's thread are as in `BrowserOperator`.
+    along its heading (`ee_state`) at up to `speed` (m/s); the right stick's x turns it at
+    up to `rotation_speed` (rad/s); each stick has a radial `dead_zone`. With
+    `allow_forward=False` (PBP modes) the left stick's forward part is dropped. Output
+    `operator_command` is `[vx, vy, 0, yaw_rate]` in the world frame; `operator_active` is
+    1 while an effective stick is outside its dead zone. With no gamepad the command is
+    zero and inactive. `exclusive` is as in `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward, params=GamepadParams(),

@@ -72,29 +72,18 @@ class KeyboardOperator(BrowserOperator):
         - operator_command
         - operator_active
 
-    Adds one Meshcat button per key (see `KEY_BUTTONS`): ↑/↓ forward/back along the end
-    effector's heading, ←/→ sideways (left = heading + 90 deg), Q/E turn left/right. A
-    click of a button (or a keydown of its key in the browser, which Meshcat's page turns
-    into a click, repeats included) keeps the key held for `hold_time` seconds; a tap gives
-    a short motion, and with a `hold_time` below the OS repeat delay a held key moves,
-    pauses briefly, then moves on. Translation keys combine into one direction at `speed`
-    (m/s); Q/E give a yaw rate of ±`rotation_speed` (rad/s). With `allow_forward=False`
-    (PBP modes, where forward motion comes from the DMP phase) the forward button is not
-    added and ↑ does nothing; ↓ still works.
+    Adds one Meshcat button per key (`KEY_BUTTONS`): ↑/↓ forward/back along the end
+    effector's heading (`ee_state`), ←/→ sideways, Q/E turn left/right. A click of a button
+    (or a keydown of its key, repeats included) keeps the key held for `hold_time` seconds.
+    Translation keys combine into one direction at `speed` (m/s); Q/E give a yaw rate of
+    ±`rotation_speed` (rad/s). With `allow_forward=False` (PBP modes) the forward button is
+    not added. With `vertical=True` two more buttons (`VERTICAL_KEY_BUTTONS`) move the hand
+    up (R) and down (F), and the translation keys combine in 3-D.
 
-    With `vertical=True` (a task whose objects stand at different heights) two more buttons
-    (`VERTICAL_KEY_BUTTONS`) move the hand up (R) and down (F), under PBP too, and the
-    translation keys combine into one 3-D direction at `speed`.
-
-    Input `ee_state` gives the heading used to turn the robot-frame keys into the world
-    frame. Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0
+    Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0
     unless `vertical`); `operator_active` is 1 while any effective key is held (even if
-    opposite keys cancel).
-
-    `exclusive` (the default: no second page drives the robot) and Meshcat's thread are as
-    in `BrowserOperator`. Click counts are snapshotted at initialisation, and the last
-    counts and click times are kept in discrete state. The buttons stay in Meshcat until
-    `Delete()`.
+    opposite keys cancel). `exclusive` is as in `BrowserOperator`. The buttons stay in
+    Meshcat until `Delete()`.
     """
 
     # The buttons' names, for code that presses them (`Meshcat`'s injected clicks, tests).
@@ -130,8 +119,7 @@ class KeyboardOperator(BrowserOperator):
     def _command(self, context, keys):
         held = self._keys.held(keys, context.get_time())
         forward, left, up, yaw = self._axes[held].sum(axis=0) if held.any() else np.zeros(4)
-        # One direction at `speed`: e.g. ↑ with ← goes diagonally, and (vertical) ← with R
-        # up and to the left.
+        # One direction at `speed`: e.g. ↑ with ← goes diagonally.
         local = np.array([forward, left, up])
         norm = np.linalg.norm(local)
         if norm > 0:

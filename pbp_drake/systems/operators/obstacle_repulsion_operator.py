@@ -33,11 +33,8 @@ class ObstacleRepulsionOperator(SampledOperator):
         - operator_command
         - operator_active
 
-    The command is `speed` times a unit direction away from the nearest obstacle when the
-    robot's distance to its surface is below `distance_threshold` (0.2 in the paper), else 0.
-    With `axis`, the push is along that axis only, its sign away from the obstacle (the
-    paper's `sign(.) * 1`); with an empty axis, it is radial. Obstacles are `(centres (M, D), radii
-    (M,))`.
+    `params` are `ObstacleRepulsionParams`; with `axis` the push's sign is away from the
+    obstacle (the paper's `sign(.) * 1`). Obstacles are `(centres (M, D), radii (M,))`.
     """
 
     def __init__(self, centres, radii, dimension, control_period,

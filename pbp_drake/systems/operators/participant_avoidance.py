@@ -1,19 +1,14 @@
 """How the virtual participant notices that its way round the obstacles has stalled.
 
-Its local plan (`VirtualOperator._plan`) scores motions over a horizon of a second or
-two. When the cylinders settle into a wall across the line to the target, every motion
-that keeps clear gets no closer, and standing still would win each tick, forever. People
-in the paper's study pushed on through at such moments, at the risk of a collision; the
-participant does the same once it has not come `progress_step` closer to the target for
-`stall_time` (`VirtualParticipantParams`), and keeps pushing until it arrives (turning back
-to avoiding would park it at the next wall, a few centimetres on).
+When the cylinders settle into a wall across the line to the target, no motion that keeps
+clear gets closer; as people in the paper's study did, the participant then pushes on
+through until it arrives (docs/tasks/obstacles.md, "The virtual participant among obstacles").
 """
 
 import numpy as np
 
 # The watch's state: [closest distance to the target so far (m), seconds since it got
-# closer, 1 once it has given up on going round]. The layout of the participant's discrete
-# state, not a behaviour: no scenario field.
+# closer, 1 once it has given up on going round].
 WATCH_SIZE = 3
 
 
@@ -24,9 +19,8 @@ def start_watch(distance):
 
 def update_watch(params, watch, distance, elapsed):
     """The watch after one tick of `elapsed` seconds that left the hand `distance` (m)
-    from the target: a new array `[closest, stalled_for, pushing]`. It counts as getting
-    closer once it beats its best distance by `params.progress_step`, and gives up going
-    round after `params.stall_time` without (`VirtualParticipantParams`)."""
+    from the target: closer once it beats its best by `params.progress_step`, giving up
+    going round after `params.stall_time` without."""
     closest, stalled_for, pushing = (float(value) for value in watch)
     if distance < closest - params.progress_step:
         closest, stalled_for = distance, 0.0
@@ -45,13 +39,7 @@ def is_pushing_through(watch):
 def robot_closes_in(params, velocity, offset, nominal_speed):
     """Whether the hand's `velocity` (2) carries it toward the target, `offset` (2) away,
     at `params.min_closing_fraction` of `nominal_speed` or more: in the last few centimetres
-    (PBP) the participant leaves the robot alone only then.
-
-    In PBP-Alt every takeover freezes the DMP's phase, so after a run of takeovers the DMP
-    is still early in its motion when the hand is almost there; early on, its forcing term
-    holds it back against the spring (a demonstration starts slowly), and a few
-    centimetres from the target the two balance: the hand parks there. A person would
-    drive the last bit.
+    the participant leaves the robot alone only then (docs/tasks/obstacles.md).
     """
     distance = np.linalg.norm(offset)
     if distance < 1e-9:

@@ -1,19 +1,11 @@
-"""The field's surrogate pilots as Drake systems: thin wrappers of
-`pbp_drake.core.surrogate_pilots`.
-
-A corrupted pilot (noisy, laggy) is a `PilotOperator`: the base participant and a filter
-(`NoisyFilter`, `LaggyFilter`) between its outputs and the controller, in one Diagram with
-exactly the participant's ports, so that the builders connect it as they connect the
-participant. HOP's simulated user is a `ProportionalOperator` with the same ports. Each
-task's keys (`ReachKeys`, `GraspKeys`) say how a key state or a velocity becomes its
-command: the reaching and obstacle tasks' `[vx, vy, vz, yaw_rate]` or the grasping task's
-twist `[v (3), omega (3)]`. The keys the method enables come in through the `forward_key`
-port (1: forward enabled, 0: not), so a pilot is built from the same arguments under every
-method; its draws come from `(seed, tick)` alone.
+"""The surrogate pilots (docs/concepts/pilots.md) as Drake systems: thin wrappers of
+`pbp_drake.core.surrogate_pilots`. Each task's keys (`ReachKeys`, `GraspKeys`) say how a
+key state or a velocity becomes its command: `[vx, vy, vz, yaw_rate]`, or the grasping
+task's twist `[v (3), omega (3)]`.
 """
 
 import numpy as np
-from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from pbp_drake.core.surrogate_pilots import (
     GRASP_AXES, REACH_AXES, REACH_VERTICAL_AXES, grasp_key_command,
@@ -89,7 +81,7 @@ class GraspKeys:
             position_of(Target(target)), max_speed, forward_enabled)
 
 
-class PilotFilter(PortGetters, LeafSystem):
+class PilotFilter(SampledOperator):
     """Base of the filters between a base pilot's outputs and the controller.
 
     .. pydrake_system::
@@ -104,51 +96,33 @@ class PilotFilter(PortGetters, LeafSystem):
         - operator_command
         - operator_active
 
-    Each tick, at `pbp_drake.systems.tick.pilot_offset` (after the base pilot's sense
-    stage, before the controller's decide stage), it samples the base pilot's output and
-    holds what `_filter` makes of it; its outputs depend on that held sample alone, as a
-    `SampledOperator`'s. Subclasses implement
-    `_filter(context, tick, command, active, previous) -> (command, active)`, `previous`
-    being its own last output (None at the first tick).
+    Each tick, at `pbp_drake.systems.tick.pilot_offset` (between the sense and decide
+    stages), it samples the base pilot's output and holds what `_filter` makes of it.
+    Subclasses implement `_filter(context, tick, command, active, previous) -> (command,
+    active)`, `previous` being its own last output (None at the first tick).
     """
 
     def __init__(self, keys, control_period, seed):
-        super().__init__()
+        super().__init__(keys.command_size, control_period)
         self.keys = keys
-        self._period = float(control_period)
         self._seed = int(seed)
-        size = keys.command_size
-        self._size = size
-        self._base_command_port = self.DeclareVectorInputPort("base_command", size)
+        self._base_command_port = self.DeclareVectorInputPort("base_command", keys.command_size)
         self._base_active_port = self.DeclareVectorInputPort("base_active", 1)
         self._hand_port = self.DeclareVectorInputPort(keys.hand_port, keys.hand_size)
         self._forward_port = self.DeclareVectorInputPort(FORWARD_KEY, 1)
-        # [command (size), active, whether a sample has been taken].
-        self._sample_index = self.DeclareDiscreteState(size + 2)
-        held = {self.discrete_state_ticket(self._sample_index)}
-        self.DeclareVectorOutputPort(
-            "operator_command", size,
-            lambda context, output: output.SetFromVector(self._held(context)[:size]),
-            prerequisites_of_calc=held)
-        self.DeclareVectorOutputPort(
-            "operator_active", 1,
-            lambda context, output: output.SetFromVector(self._held(context)[size:size + 1]),
-            prerequisites_of_calc=held)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, pilot_offset(self._period),
-                                                self._update)
-
-    def _held(self, context):
-        return context.get_discrete_state(self._sample_index).value()
+        self._taken_index = self.DeclareDiscreteState(1)  # 1 once a sample has been taken
+        self._declare_operator_outputs(offset=pilot_offset(self._period))
 
     def _update(self, context, discrete_state):
         tick = int(round(context.get_time() / self._period))
         held = self._held(context)
-        previous = (held[:self._size], bool(held[self._size] > 0.5)) if held[-1] > 0.5 else None
+        taken = context.get_discrete_state(self._taken_index).value()[0] > 0.5
+        previous = (held[:-1], bool(held[-1] > 0.5)) if taken else None
         command, active = self._filter(
             context, tick, np.array(self._base_command_port.Eval(context), float),
             bool(self._base_active_port.Eval(context)[0] > 0.5), previous)
-        discrete_state.set_value(self._sample_index,
-                                 np.concatenate([command, [float(active), 1.0]]))
+        discrete_state.set_value(self._taken_index, [1.0])
+        self._store_sample(discrete_state, command, active)
 
     def _filter(self, context, tick, command, active, previous):
         raise NotImplementedError
@@ -156,8 +130,7 @@ class PilotFilter(PortGetters, LeafSystem):
 
 class NoisyFilter(PilotFilter):
     """The noisy pilot's filter: each tick, with probability `eps`, the base pilot's output
-    is replaced by a uniformly random state of the enabled keys (`noisy_draw`), active
-    when an effective key is pressed (`PilotFilter` shows its ports)."""
+    is replaced by a uniformly random state of the enabled keys (`noisy_draw`)."""
 
     def __init__(self, keys, control_period, seed, eps):
         super().__init__(keys, control_period, seed)
@@ -174,8 +147,7 @@ class NoisyFilter(PilotFilter):
 
 class LaggyFilter(PilotFilter):
     """The laggy pilot's filter: each tick, with probability `p_tick` (the sources' `p` at
-    our tick, `lag_per_tick`), it repeats its previous output instead of the base pilot's
-    (`PilotFilter` shows its ports). The first tick passes the base pilot's output."""
+    our tick, `lag_per_tick`), it repeats its previous output instead of the base pilot's."""
 
     def __init__(self, keys, control_period, seed, p):
         super().__init__(keys, control_period, seed)
@@ -203,8 +175,7 @@ class PilotOperator(PortGetters, Diagram):
         - operator_command
         - operator_active
 
-    Every input port of the base pilot (`base`, a participant system) and of the `filter`
-    is exported once under its name (the hand's state and `forward_key` feed both); the
+    Every input port of `base` and of `pilot_filter` is exported once under its name; the
     outputs are the filter's.
     """
 
@@ -250,11 +221,9 @@ class ProportionalOperator(SampledOperator):
         - operator_command
         - operator_active
 
-    It has the participant's ports but reads only the hand, the target and `forward_key`
-    (with the forward key disabled, the command's forward part is removed): it is blind to
-    the robot's intent (`selected_goal`) and to obstacles. It acts whenever its command is
-    not zero, i.e. everywhere but on the target. `keys` is the task's `ReachKeys` or
-    `GraspKeys`; it samples at the sense stage as every `SampledOperator`.
+    It reads only the hand, the target and `forward_key`: it is blind to the robot's intent
+    and to obstacles, and acts wherever its command is not zero. `keys` is the task's
+    `ReachKeys` or `GraspKeys`.
     """
 
     def __init__(self, keys, control_period, params, max_speed, obstacle_count=0):

@@ -16,10 +16,8 @@ PRESSED = 0.5
 
 
 class PoseGamepadParams(GamepadParams):
-    """`GamepadParams` of a person with a gamepad steering the hand in six DoF: translation
-    at up to `speed` (m/s; 0 takes the task's nominal speed), rotation at up to
-    `rotation_speed` (rad/s); `dead_zone`, in [0, 1), is each stick's radial dead zone and
-    each trigger's."""
+    """`GamepadParams` of a person with a gamepad steering the hand in six DoF (`dead_zone`
+    is each trigger's too)."""
 
 
 class PoseGamepadOperator(PoseOperatorBase):
@@ -48,15 +46,9 @@ class PoseGamepadOperator(PoseOperatorBase):
         | right stick up / down | pitch the approach axis down / up (about `left`) |
         | right shoulder (RB, 5) / left shoulder (LB, 4) | roll right / left about z_H |
 
-    Each stick has a radial dead zone and each trigger a dead zone of `dead_zone`, past
-    which the deflection rises continuously from 0. The speeds, their caps (two controls
-    pushed together go no faster than one) and the forward drop of PBP modes are
-    `PoseOperatorBase`'s.
-
-    `operator_active` is 1 while the twist is not zero (a push that is wholly dropped does
-    not count). With no gamepad the twist is zero and inactive; a value that is not finite
-    reads as a control at rest. `exclusive` and Meshcat's thread are as in
-    `BrowserOperator`.
+    The speeds, their caps and the forward drop of PBP modes are `PoseOperatorBase`'s.
+    `operator_active` is 1 while the twist is not zero. With no gamepad the twist is zero
+    and inactive. `exclusive` is as in `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,

@@ -41,9 +41,7 @@ MODE_LABELS = ("Mode: translate (R: rotate)", "Mode: rotate (R: translate)")
 
 
 class PoseKeyboardParams(KeyboardParams):
-    """`KeyboardParams` of a person at the keyboard steering the hand in six DoF: keys
-    translate at `speed` (m/s; 0 takes the task's nominal speed) or rotate at
-    `rotation_speed` (rad/s)."""
+    """`KeyboardParams` of a person at the keyboard steering the hand in six DoF."""
 
 
 class PoseKeyboardOperator(PoseOperatorBase):
@@ -70,17 +68,11 @@ class PoseKeyboardOperator(PoseOperatorBase):
         | R | to rotate mode | to translate mode |
 
     The mode button's label (`MODE_LABELS`) shows the mode; the run starts translating. A
-    held R toggles once (a click within `hold_time` of the last one is the key's repeat).
-    Held keys combine into one direction at `speed` or `rotation_speed`; a key held while
-    the mode changes goes on in the new mode. With `allow_forward=False` (PBP modes) the
-    velocity's forward part along the approach axis z_H is dropped: ↑ still tips the hand
-    in rotate mode. `operator_active` is 1 while a key is held whose own motion is not
-    wholly dropped (even if opposite keys cancel).
-
-    Keys are held as in `KeyboardOperator` (clicks snapshotted at initialisation); the key
-    state and the mode are discrete state. The page's mode label follows the mode of the
-    last update. `exclusive` and Meshcat's thread are as in `BrowserOperator` (R's clicks
-    too are dropped in a pause); `Delete()` removes the buttons.
+    held R toggles once. Held keys combine into one direction at `speed` or
+    `rotation_speed`. With `allow_forward=False` (PBP modes) the velocity's forward part
+    along the approach axis z_H is dropped. `operator_active` is 1 while a key is held
+    whose own motion is not wholly dropped. Keys are held as in `KeyboardOperator`;
+    `exclusive` is as in `BrowserOperator`; `Delete()` removes the buttons.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,
@@ -123,7 +115,7 @@ class PoseKeyboardOperator(PoseOperatorBase):
             [TRANSLATE, self._show(TRANSLATE), -np.inf])
 
     def _update(self, context, discrete_state):
-        # R is read with the keys, before the connections are counted (see `_step_keys`).
+        # R is read with the keys, before the connections are counted.
         clicks = self._keys.clicks()
         mode, seen, last = context.get_discrete_state(self._mode_index).value()
         mode = int(mode)

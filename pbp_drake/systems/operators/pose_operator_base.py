@@ -22,13 +22,11 @@ class PoseOperatorBase(BrowserOperator):
         - operator_twist
         - operator_active
 
-    Input `hand_state` is the hand's `PoseState` (its orientation sets the operator frame;
-    a NaN or infinite field is refused by name). Output `operator_twist` is an
-    `OperatorTwist` `[vx, vy, vz, wx, wy, wz]` in the world frame. Unit inputs
+    Input `hand_state` is the hand's `PoseState` (its orientation sets the operator frame).
+    Output `operator_twist` is an `OperatorTwist` in the world frame. Unit inputs
     `(forward, left, up)` and `(yaw, pitch, roll)`, each capped at length 1, are scaled by
-    `speed` (m/s) and `rotation_speed` (rad/s, refused unless finite and positive). Without
-    `allow_forward` (PBP modes) the velocity's forward part along the approach axis z_H is
-    dropped.
+    `speed` (m/s) and `rotation_speed` (rad/s). Without `allow_forward` (PBP modes) the
+    velocity's forward part along the approach axis z_H is dropped.
     """
 
     def __init__(self, meshcat, control_period, allow_forward, params, nominal_speed,

@@ -27,15 +27,10 @@ class PoseVirtualOperator(SampledOperator):
         - operator_command
         - operator_active
 
-    `hand_pose` is the hand's `PoseState`, `target` the task monitor's `Target` (its index
-    is the object the task wants), `selected_goal` the robot's shown intent `[index]` (-1:
-    the method shows none), `forward_key` `[1 or 0]` whether the method enables the forward
-    key; it is built from the same arguments under every method. `operator_command` is an
-    `OperatorTwist` `[v (3), omega (3)]`, world frame. It samples at the sense stage of each tick,
-    as every `SampledOperator`; what it remembers of the targets it has seen (`ParticipantMemory`)
-    is discrete state, so Contexts stay independent. Its parameters' `impairment` adds its motor
-    noise (a process in discrete state that runs every tick) and delays its commands by
-    `command_delay` (a queue in discrete state).
+    `hand_pose` is the hand's `PoseState`, `target` the task monitor's `Target`;
+    `selected_goal` and `forward_key` are as `VirtualOperator`'s. `operator_command` is an
+    `OperatorTwist`, world frame. Its memory (`ParticipantMemory`), motor noise and command
+    delay (`impairment`) are discrete state.
     """
 
     def __init__(self, participant, control_period):
@@ -47,8 +42,7 @@ class PoseVirtualOperator(SampledOperator):
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._forward_key_port = self.DeclareVectorInputPort("forward_key", 1)
-        # `participant_serving`: whether the robot serves its target, and its sense of the
-        # robot's own motion (3).
+        # `participant_serving.ServingMemory`, and the robot's own motion as it senses it.
         self._serving_index = self.DeclareDiscreteState(np.zeros(SERVING_MEMORY_SIZE))
         self._own_motion_index = self.DeclareDiscreteState(np.zeros(3))
         self._memory_index = self.DeclareDiscreteState(np.array(ParticipantMemory(),

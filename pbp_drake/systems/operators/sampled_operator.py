@@ -32,12 +32,9 @@ class SampledOperator(PortGetters, LeafSystem):
 
     Subclasses implement `_sample(context) -> (command (D,), active)`, may declare input
     ports first, and call `_declare_operator_outputs()` once (`delay_ticks` > 0: each
-    sample reaches the outputs that many ticks after it was taken, through a queue in
-    discrete state; the virtual participant's `command_delay`). Sampling into discrete state
-    keeps the operator deterministic and loggable, and its command constant over a control
-    period. It samples at the sense stage of each tick (`pbp_drake.systems.tick`).
-    `operator_command` is a velocity (D; a subclass may name the port otherwise with
-    `command_name`); `operator_active` is 1 while the operator acts, else 0.
+    sample reaches the outputs that many ticks later, through a queue in discrete state).
+    It samples at the sense stage of each tick (or at `offset`). `operator_command` is a
+    velocity (D; named `command_name`); `operator_active` is 1 while the operator acts.
     """
 
     def __init__(self, dimension, control_period, command_name="operator_command"):
@@ -46,7 +43,7 @@ class SampledOperator(PortGetters, LeafSystem):
         self._period = float(control_period)
         self._command_name = command_name
 
-    def _declare_operator_outputs(self, delay_ticks=0):
+    def _declare_operator_outputs(self, delay_ticks=0, offset=SENSE_OFFSET):
         d = self._dimension
         self._sample_index = self.DeclareDiscreteState(d + 1)
         self._delay_ticks = int(delay_ticks)
@@ -66,7 +63,7 @@ class SampledOperator(PortGetters, LeafSystem):
             "operator_active", 1,
             lambda context, output: output.SetFromVector(self._held(context)[d:]),
             prerequisites_of_calc=held)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, SENSE_OFFSET, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, offset, self._update)
 
     def get_operator_command_output_port(self):
         return self._command_port
@@ -88,7 +85,6 @@ class SampledOperator(PortGetters, LeafSystem):
     def _store_sample(self, discrete_state, command, active):
         """Writes one sample; subclasses that override `_update` call this."""
         command = self._validate(np.asarray(command, float).reshape(self._dimension))
-        # DiscreteValues.set_value: one pybind call (get_mutable_vector's: two).
         sample = np.append(command, 1.0 if active else 0.0)
         if self._delay_ticks > 0:
             queue = np.append(discrete_state.get_vector(self._queue_index).value(), sample)

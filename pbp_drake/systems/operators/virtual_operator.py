@@ -37,52 +37,22 @@ class VirtualOperator(SampledOperator):
         - operator_command
         - operator_active
 
-    It is built from the same arguments under every method and is never told the method.
-    It sees what a person at the page sees: the scene (`objects` (M, 3)) and its target
-    (`target`, `[p (3), index]`), the hand (`ee_state`), the robot's shown intent
-    (`selected_goal`, the blue ball; -1 where the method shows none) and which keys work
-    (`forward_key`: 1 when the forward key is enabled, 0 when not, as the paper disables it
-    under PBP). Whether it acts is one rule under every method
-    (`pbp_drake.core.participant_serving`): it lets the robot go while its motion serves
-    the target and acts while it does not; teleop's robot never moves by itself, so there
-    it always acts. `VirtualParticipantParams` documents each field named below.
+    The virtual participant: docs/tasks/reach.md ("The virtual participant") says when it
+    acts and what it presses, docs/tasks/obstacles.md how it plans around obstacles, and
+    `VirtualParticipantParams` documents each field. It is built from the same arguments
+    under every method: `selected_goal` is the robot's shown intent (-1: none) and
+    `forward_key` 1 when the method enables the forward key. `objects` (M, 3) is the scene.
 
-    What it presses is the keys' (`pbp_drake.core.participant_reach` says what and why):
-    with the forward key it drives toward the target, turning to face it. Without it, while
-    the robot means another object, it shows the target (turning to face it, moving toward
-    it and away from the object picked instead, stepping aside when the two stand in line,
-    and after `insist_time` to no avail sidestepping to the target itself); with the
-    robot's intent on the target (or none shown) but too slow, it presses what is left of
-    driving there. Going to the target itself where it sees the robot pull by itself
-    (`participant_serving.robot_pulls`: PBP-Cont's DMP), it pushes against that pull.
-
-    `vertical=True` (a reaching task whose objects stand at different heights, the keys
-    moving the hand up and down too; off, it changes nothing) moves in 3-D at most `speed`
-    in all, leaving the height to the DMP (vz = 0) while it shows the target unless it
-    insists; its noise turns the horizontal part only, and its motor noise shakes vz as a
-    last axis (so the horizontal noise is that of the same seed without it). Obstacles
-    keep the participant planar: the two are refused together. `heading_range` (low,
-    high) is how far the hand turns (an arm's wrist; None: all the way, as the HSR's
-    base): where the tool cannot point at the target (`participant_reach.can_point_at`) it
-    first moves the hand to where it can, for at most `reposition_time` a target.
-    `fixed_base` (x, y) is a fixed-base arm's base: its footprint among obstacles is then
-    the arm from there to the hand (`footprint_clearance`).
-
-    It notices a new target `reaction_delay` after it appears, and its commands carry
-    noise drawn from `(seed, tick)`, so a run is reproducible and the system keeps no state
-    outside its Context. Its `impairment` (`pbp_drake.core.participant_impairment`) adds
-    motor noise while it acts (never forward where the key is disabled), delays its
-    commands by `command_delay` (a queue in discrete state), and in the reaching task makes
-    it head for a wrong object first, now and then, each time it comes to know a target.
-
-    With `obstacle_count > 0` it also watches `obstacle_positions` `(N, 2)` (cylinders of
-    `obstacle_radius`, their velocities from the positions it remembers) and keeps the
-    robot's footprint `obstacle_margin` clear of them: each tick it scores a fan of
-    velocities and yaw rates over a short horizon. Where the robot shows its intent, it
-    lets go whenever the robot's path (pulled back to its start-target line, as PBP's drawn
-    DMP path is) looks clear for a while. In the last `final_approach_radius` it no longer
-    minds obstacles, and within `push_through_radius`, or after `stall_time` without
-    getting closer (`participant_avoidance`), it pushes on through.
+    `vertical=True` (a reaching task whose objects stand at different heights) moves in
+    3-D, its motor noise shaking vz as a last axis; it is refused with obstacles.
+    `heading_range` (low, high) is how far the hand turns (None: all the way, as the HSR's
+    base). `fixed_base` (x, y) is a fixed-base arm's base, whose footprint among obstacles
+    is the arm from there to the hand (`footprint_clearance`). With `obstacle_count > 0` it
+    watches `obstacle_positions` `(N, 2)`, cylinders of `obstacle_radius`, and keeps the
+    robot's footprint `obstacle_margin` clear of them. Its noise is drawn from
+    `(seed, tick)`, so a run is reproducible and all its state lives in the Context. Its
+    `impairment` (`pbp_drake.core.participant_impairment`) adds motor noise, delays its
+    commands and makes it head for a wrong object first, now and then.
 
     Output `operator_command` is `[vx, vy, vz, yaw_rate]` in the world frame (vz = 0
     unless `vertical`).
@@ -116,8 +86,6 @@ class VirtualOperator(SampledOperator):
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
-        # Which keys work is the method's (the paper disables forward under PBP): the
-        # participant sees it on the page as a person does, not in its arguments.
         self._forward_key_port = self.DeclareVectorInputPort("forward_key", 1)
         self._obstacles_port = None
         if obstacle_count > 0 and not obstacle_radius > 0:
@@ -135,21 +103,16 @@ class VirtualOperator(SampledOperator):
             #  `participant_avoidance` (WATCH_SIZE)].
             self._track_index = self.DeclareDiscreteState(
                 np.zeros(4 + 2 * int(obstacle_count) + WATCH_SIZE))
-        # What the participant believes: the target index it knows and how many ticks a
-        # different target has been on screen.
+        # The target index it knows, and how many ticks a different one has been shown.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
-        # Whether the robot serves its target (`participant_serving.ServingMemory`), and
-        # its sense of the robot's own motion (3: what the hand does beyond its keys).
+        # `participant_serving.ServingMemory`, and the robot's own motion as it senses it.
         self._serving_index = self.DeclareDiscreteState(np.zeros(SERVING_MEMORY_SIZE))
         self._own_motion_index = self.DeclareDiscreteState(np.zeros(3))
-        # Assisting in the reaching task: the target it counts for, how many ticks it has
-        # faced it while the estimate named another object (`insist_time`) and how many it
-        # has moved the hand to where the tool can point at it (`reposition_time`).
+        # `_count_insistence`'s [target counted for, ticks facing it, ticks repositioning].
         self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0]))
         self._insist_ticks = int(round(params.insist_time / control_period))
         self._reposition_ticks = int(round(params.reposition_time / control_period))
-        # The motor noise of `impairment`, [vx, vy, yaw rate] (and vz last when vertical:
-        # drawn after the others, it leaves theirs as they are), runs every tick.
+        # The motor noise of `impairment`, [vx, vy, yaw rate] (and vz last when vertical).
         self._noise_scales = None
         if is_noisy(impairment):
             axes = [self._speed, self._speed, self._rotation_speed]
@@ -176,8 +139,7 @@ class VirtualOperator(SampledOperator):
         return shown if shown >= 0 else NO_INTENT
 
     def _perceive(self, context, discrete_state):
-        """The robot's own motion as it perceives it after this tick (3), updated from the
-        hand's velocity and the command it sent."""
+        """The robot's own motion (3) as it perceives it after this tick."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         sent = self._held(context)
         sent_velocity = sent[:3] if sent[4] > 0.5 else np.zeros(3)
@@ -189,7 +151,7 @@ class VirtualOperator(SampledOperator):
         return own
 
     def _update(self, context, discrete_state):
-        # The belief moves first, and the command of this tick acts on the new belief.
+        # The belief moves first; this tick's command acts on the new belief.
         known, unseen_ticks = context.get_discrete_state(self._belief_index).value()
         known_before = known
         shown = Target(self._target_port.Eval(context)).index
@@ -199,7 +161,6 @@ class VirtualOperator(SampledOperator):
             unseen_ticks += 1
             if unseen_ticks > self._reaction_ticks:
                 known, unseen_ticks = shown, 0
-        # DiscreteValues.set_value: one pybind call a group (get_mutable_vector's: two).
         discrete_state.set_value(self._belief_index, [known, unseen_ticks])
         own_motion = self._perceive(context, discrete_state)
         # A target it has just come to know: it watches the robot afresh.
@@ -237,7 +198,7 @@ class VirtualOperator(SampledOperator):
 
     def _add_motor_noise(self, context, discrete_state, command, active):
         """The command with this tick's motor noise added while it acts (the noise runs
-        every tick, so that one seed gives the same noise under every method)."""
+        every tick, so one seed gives the same noise under every method)."""
         tick = int(round(context.get_time() / self._period))
         noise = next_motor_noise(
             self._impairment, self._period, self._seed, tick,
@@ -263,9 +224,7 @@ class VirtualOperator(SampledOperator):
                 max(0.0, 1.0 + rng.normal(0.0, self._speed_noise)))
 
     def _avoid(self, context, discrete_state, known_target, own_motion, serving):
-        """The command while obstacles are about: a local plan around them (see the class
-        docstring), `own_motion` the robot's own motion as it perceives it and `serving`
-        its `ServingMemory`. Returns `(command, active)`."""
+        """`(command, active)` while obstacles are about: a local plan around them."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         hand = np.array([ee_state.x, ee_state.y])
         velocity = np.array([ee_state.vx, ee_state.vy])
@@ -285,7 +244,7 @@ class VirtualOperator(SampledOperator):
         hold = track[3]
         track[3] = max(hold - 1.0, 0.0)
         track[remembered] = obstacles.reshape(-1)
-        # Its own last decision (what it pressed; the robot gets it later if delayed).
+        # Its own last decision (the robot gets it later if delayed).
         decided = self._latest(context)
         was_active = decided[4] > 0.5
         last_command = decided[:2] if was_active else np.zeros(2)
@@ -301,8 +260,7 @@ class VirtualOperator(SampledOperator):
         offset = target_xy - hand
         distance = np.linalg.norm(offset)
         noise_angle, speed_scale = self._noise(context)
-        # Where the robot shows its intent (the ball on the object, its path), the
-        # participant judges the path it shows; where it shows none, the motion it sees.
+        # Where the robot shows its intent it judges the path shown, else the motion seen.
         shows = self._shown_goal(context) != NO_INTENT
         params = self.params
         track[watch] = update_watch(params, track[watch], distance, self._period)
@@ -403,10 +361,8 @@ class VirtualOperator(SampledOperator):
         return velocities[best], yaw_rates[best], clear[best]
 
     def _decide(self, context, discrete_state, known_target, heads_for, own_motion, serving):
-        """The command in the reaching task, toward object `heads_for` (the known target,
-        unless it has mistaken it for another): whether to act by the one rule of
-        `participant_serving`, and what to press with the keys it has
-        (`participant_reach`); `serving` its `ServingMemory`. Returns `(command, active)`."""
+        """`(command, active)` in the reaching task, toward object `heads_for` (the known
+        target, unless it has mistaken it for another)."""
         ee_state = EeState(self._ee_state_port.Eval(context))
         position, heading = position_of(ee_state), ee_state.heading
         target = Target(self._target_port.Eval(context))
@@ -466,8 +422,6 @@ class VirtualOperator(SampledOperator):
         if self._vertical:
             command = np.append(command, speed_scale * velocity[2])
         if against:
-            # With `vertical` in 3-D: the picked object's DMP pulls the hand to its height
-            # too, and left alone it holds the hand below (or above) the target.
             command = self._against_policy(context, ee_state, command)
         vz = command[2] if self._vertical else 0.0
         return np.array([command[0], command[1], vz, yaw_rate]), True
@@ -489,12 +443,10 @@ class VirtualOperator(SampledOperator):
 
     def _count_insistence(self, context, discrete_state, known_target, selected, position,
                           heading, target_position):
-        """`(insisting, repositioning)`: whether it has faced `known_target` `insist_time`,
-        or moved the hand toward where the tool can point at it `reposition_time`, while the
-        estimate named another object; it keeps insisting on that target, once it has, until
-        a new one appears (turning back to face it would only undo what it has gained).
-        Otherwise, whether the tool cannot point at the target from where the hand is, so
-        that it moves the hand first (`participant_reach.can_point_at`)."""
+        """`(insisting, repositioning)` while the estimate names another object: it insists
+        once it has faced `known_target` `insist_time` or repositioned `reposition_time`, and
+        keeps on until a new target appears; it repositions while the tool cannot point at
+        the target (`participant_reach.can_point_at`)."""
         counted_target, ticks, moved = context.get_discrete_state(self._insist_index).value()
         if counted_target != known_target:
             counted_target, ticks, moved = known_target, 0.0, 0.0

@@ -1,13 +1,7 @@
-"""The PBP loop's systems: the DMP banks, the goal estimators, the blenders and the hand-over,
-in the position form (`DmpBank`, `GoalEstimator`, `Blender`, `HandOver`, and for scenes of
-many goals `GoalGrouping` and the ``intent_filter`` estimator, `IntentFilterGoalEstimator`)
-and the six-DoF pose form (`PoseDmpBank`, `PoseGoalEstimator`, `PoseBlender`,
-`PoseHandOver`, `PoseGoalGrouping`, `PoseIntentFilterGoalEstimator`); the goals' source,
-the heading command of the HSR tasks, the demonstration player of explicit arbitration and
-the few goals a drawing shows (`LikelyGoals`); and the shared-autonomy baselines' systems:
-HOP's goal posterior on the operator's command (`MaxEntGoalEstimator`,
-`PoseMaxEntGoalEstimator`, also PBP's ``maxent_command`` estimator) and its assistance
-(`HopAssistance`, `PoseHopAssistance`)."""
+"""The PBP loop's systems (DMP banks, goal estimators and grouping, blenders, hand-over), in
+position form and six-DoF pose form (`Pose...`), their sources and helpers, and the
+shared-autonomy baselines' systems (`MaxEntGoalEstimator`, `HopAssistance` and their
+pose twins)."""
 
 from pbp_drake.systems.pbp.blender import Blender
 from pbp_drake.systems.pbp.demonstration_player import DemonstrationPlayer

@@ -13,14 +13,12 @@ from pbp_drake.systems.ports import PortGetters, goal_index
 
 class BlenderBase(PortGetters, LeafSystem):
     """What `Blender` and `PoseBlender` share: the blending mode, the ramp of
-    `confidence_alpha` (`confidence_range`, `alpha_max`, checked here) and the weight of
-    `fixed_alpha`, a numeric parameter of the Context (its default the constructor's
-    `alpha`), so that it can change during a run without rebuilding (`set_alpha`).
+    `confidence_alpha` (`confidence_range`, `alpha_max`) and the weight of `fixed_alpha`, a
+    numeric parameter of the Context so that it can change during a run (`set_alpha`).
 
-    A subclass declares its ports, among them `selected_goal` and `goal_probabilities` as
-    `_selected_goal_port` and `_goal_probabilities_port`, which `alpha` reads; it names its
-    modes' laws (`_laws`) and the goal estimator whose `goal_probabilities` output feeds it
-    (`_estimator_name`).
+    A subclass declares its ports, among them `_selected_goal_port` and
+    `_goal_probabilities_port`, which `alpha` reads, and names its modes' laws (`_laws`)
+    and the goal estimator that feeds it (`_estimator_name`).
     """
 
     _laws = BLEND_LAWS
@@ -104,18 +102,12 @@ class Blender(BlenderBase):
         - command
 
     The modes are `pbp_drake.core.arbitration.BLEND_MODES` (the laws: that module's
-    docstring). `robot_state` must be the state sampled at the control tick (the builder
-    puts a ZeroOrderHold in front); `references` holds K next states and `selected_goal`
-    picks one (goal 0 when unconnected), unless `policy_reference` is connected: the
-    selected goal's next state alone (`DmpBank.selected_reference`, O(D) where `references`
-    is O(K D)), which is then followed and `references` is not read. The output is
-    `[position (D), velocity (D)]`. A NaN or infinite operator command raises.
-
-    `goal_probabilities` (K) is read only in `confidence_alpha` mode, where it must be
-    connected (evaluating the command raises otherwise); there `alpha` is the ramp of the
-    selected goal's confidence (`pbp_drake.core.arbitration.confidence_alpha`).
-    `fixed_alpha`'s weight can change during a run (`set_alpha`, the console's alpha
-    slider): see `BlenderBase`.
+    docstring). `robot_state` must be the state sampled at the control tick; `references`
+    holds K next states and `selected_goal` picks one (goal 0 when unconnected), unless
+    `policy_reference` (`DmpBank.selected_reference`) is connected, which is then followed.
+    The output is `[position (D), velocity (D)]`. A NaN or infinite operator command
+    raises. `goal_probabilities` (K) is read only in `confidence_alpha` mode, where it must
+    be connected.
     """
 
     def __init__(self, mode, dimension, goal_count, control_period, alpha=None, *,
@@ -131,8 +123,7 @@ class Blender(BlenderBase):
         self._operator_command_port = self.DeclareVectorInputPort("operator_command", d)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._goal_probabilities_port = self.DeclareVectorInputPort("goal_probabilities", k)
-        # The blend is a function of the inputs (and alpha) alone: say so, so that Drake
-        # does not redo it at every plant step in between the control ticks that change them.
+        # A function of the inputs (and alpha) alone: not redone between control ticks.
         self._command_port = self.DeclareVectorOutputPort(
             "command", 2 * d, self._calc_command,
             prerequisites_of_calc={self.all_input_ports_ticket(),

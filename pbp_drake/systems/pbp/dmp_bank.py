@@ -1,6 +1,5 @@
-"""The DMP bank as a Drake system: K DMPs re-integrated each control step from the robot,
-over the bank's immutable model (`pbp_drake.core.dmp.DmpBankModel`); the DMPs' state and
-the step's scratch arrays live in the Context, so Contexts and Simulators are independent.
+"""The DMP bank as a Drake system over the bank's immutable model
+(`pbp_drake.core.dmp.DmpBankModel`); its state and scratch arrays live in the Context.
 """
 
 import numpy as np
@@ -42,8 +41,7 @@ class BankSystem(PortGetters, LeafSystem):
                            "evaluated")
 
     def _locked(self, context):
-        """Whether the phase is frozen now: `lock_phase_when_operator_acts` and a nonzero
-        `operator_active`."""
+        """`lock_phase_when_operator_acts` and a nonzero `operator_active`."""
         return (self._lock and self._operator_active_port.HasValue(context)
                 and self._operator_active_port.Eval(context)[0] > 0.5)
 
@@ -85,36 +83,24 @@ class DmpBank(BankSystem):
         - predicted_paths
 
     `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
-    `(K, D)`. Each period every DMP advances one step from the robot's position, keeping
-    its own velocity (the first-order-hold step of `pbp_drake.core.dmp`). With
-    `lock_phase_when_operator_acts` (PBP-Alt), a nonzero `operator_active` freezes the one
-    phase all DMPs share, and the DMPs follow the robot until the operator lets go. With
-    `max_speed` (m/s), each DMP's velocity is scaled down to it before every step
-    (anti-windup: give the hand-over law's speed limit, which the hand never exceeds).
-
-    `followed_goal` (optional) is the goal whose reference the robot followed since the
-    last update (the goal estimator's selection, read before it updates). Connected, every
-    DMP steps from the robot's position AND the followed DMP's velocity, so the selection
-    may move to any of them without a jump of the commanded velocity; unconnected, each
-    DMP keeps a velocity of its own, which relaxes toward its own attractor.
+    `(K, D)`. Each period every DMP advances one step from the robot's position;
+    docs/concepts/dmp.md ("PBP: re-integrating from the robot every step") explains
+    `lock_phase_when_operator_acts` (a nonzero `operator_active` freezes the phase), the
+    `followed_goal` input (connected, every DMP steps from the followed DMP's velocity) and
+    `max_speed` (m/s, anti-windup).
 
     `references` is the K next states `[positions (K*D), velocities (K*D)]`;
     `selected_reference` the next state `[position (D), velocity (D)]` of `selected_goal`
-    alone (unconnected: the followed goal, else goal 0), what a blender reads: O(D) where
-    `references` is O(K D). `phase` is the K phases. `predicted_paths` (with
-    `prediction_steps > 0`) is each DMP's open-loop path from its current state,
-    `(K, prediction_steps + 1, D)` flattened, sampled every `prediction_period` (default:
-    the control period), for drawing; with `predicted_goal_count` M, the paths of the M
-    goals whose indices come in on `predicted_goals` (unconnected: goals 0 to M - 1), so
-    that a drawing costs the same whatever K.
+    alone (unconnected: the followed goal, else goal 0). `phase` is the K phases.
+    `predicted_paths` (with `prediction_steps > 0`) is each DMP's open-loop path,
+    `(K, prediction_steps + 1, D)` flattened, every `prediction_period` (default: the
+    control period); with `predicted_goal_count` M, the paths of the M goals whose indices
+    come in on `predicted_goals` (unconnected: goals 0 to M - 1).
 
-    The state is one vector in one of the layouts of `pbp_drake.systems.pbp.dmp_bank_state`:
-    per goal (`3 K D` numbers), or with `compact_state=True` `2 + 6 D` numbers whatever K,
-    for a bank `affine_in_goal` (any other is refused) with `followed_goal` connected (an
-    update raises otherwise). The goals are checked and laid out `(D, K)` in a cache entry,
-    once per change; the step's scratch memory is a cache entry too, so that all state
-    lives in the Context. The bank updates at the decide stage of each tick
-    (`pbp_drake.systems.tick`); `update_offset` (s after the tick) overrides it.
+    The state is `3 K D` numbers per goal, or with `compact_state=True` `2 + 6 D` whatever
+    K, for a bank `affine_in_goal` with `followed_goal` connected (docs/concepts/dmp.md).
+    The bank updates at the decide stage of each tick (`pbp_drake.systems.tick`);
+    `update_offset` (s after the tick) overrides it.
     """
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
@@ -124,8 +110,6 @@ class DmpBank(BankSystem):
         self._bank = bank
         self._max_speed = None if max_speed is None else float(max_speed)
         self._period = float(control_period)
-        # Drawing a long horizon at the control period would cost hundreds of steps a frame;
-        # the first-order-hold step stays close at coarser steps (second order in the step).
         self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)
@@ -141,7 +125,6 @@ class DmpBank(BankSystem):
             bank, self._period, self._max_speed)
         self._declare_inputs(2 * d, "goals", k * d)
         self._state_index = self.DeclareDiscreteState(self._layout.initial())
-        # The goals checked and laid out (D, K) once each time they change, not each tick.
         self._goals_dk = self.DeclareCacheEntry(
             "goals, validated, (D, K) contiguous",
             ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros((d, k))),
@@ -149,8 +132,7 @@ class DmpBank(BankSystem):
             prerequisites_of_calc={self._goals_port.ticket()})
         self._declare_workspace("DmpWorkspace: scratch arrays of the bank's step",
                                 bank.make_workspace)
-        # The outputs depend on the bank's own state only (and, in the compact layout, on
-        # the goals): say so, so that Drake does not recompute them after every plant step.
+        # The outputs depend on the bank's state (and the compact layout's on the goals).
         state = {self.xd_ticket()}
         if self._layout.reads is not None:
             state.add(self._goals_port.ticket())
@@ -192,8 +174,7 @@ class DmpBank(BankSystem):
         return context.get_discrete_state(self._state_index).get_value()
 
     def _given(self, context):
-        """What the layout `reads` besides the state: the goals `(D, K)` (the compact
-        layout), or None."""
+        """The goals `(D, K)` where the layout `reads` them, else None."""
         return self._goals_dk.Eval(context) if self._layout.reads == "goals" else None
 
     def dmp_states(self, context):
@@ -213,13 +194,11 @@ class DmpBank(BankSystem):
         return np.concatenate([position[:, 0], velocity[:, 0] / self._bank.duration])
 
     def _update(self, context, discrete_state):
-        # Drake fills `discrete_state` with the current state; the update writes into it.
-        # Every input is evaluated before the workspace is taken: an input's evaluation may
-        # reach this system's outputs, whose calculation uses the same workspace.
+        # Every input before the workspace: an input may reach this system's outputs,
+        # which use the same workspace.
         robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
         lock = self._locked(context)
         goals_dk = None if lock else self._goals_dk.Eval(context)
-        # The goal the robot followed since the last update.
         followed = self._followed(context, self._layout.needs_followed_goal)
         self._layout.update(
             discrete_state.get_mutable_vector(self._state_index).get_mutable_value(),

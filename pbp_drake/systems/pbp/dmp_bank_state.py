@@ -1,25 +1,15 @@
 """The two state layouts of Drake's `DmpBank` system: what its discrete state holds, how an
 update writes it, and how the DMPs' stepped states are read out of it.
 
-PBP steps every DMP from the robot's position `p`, and the step is affine in the DMP's own
-velocity `z` (`p' = p + dp + Phi01 z`, `z' = dz + Phi11 z`; `pbp_drake.core.dmp.stepping`),
-so a layout keeps, of each step, what its outputs are read from: the velocities `z` before
-the step and the step's attractor terms `dp`, `dz`. While `held` (at the start, and while
-PBP-Alt locks the phases) the DMPs sit at `p + dp` with velocity `z`.
+The step is affine in the DMP's velocity `z` (`p' = p + dp + Phi01 z`, `z' = dz + Phi11 z`;
+`pbp_drake.core.dmp.stepping`), so a layout keeps `z` before the step and the step's
+attractor terms `dp`, `dz`. While `held` the DMPs sit at `p + dp` with velocity `z`.
 
-- `PerGoalState`, `[phase, held, p (D), z, dp, dz (D, K each)]`: any bank, each DMP with
-  a velocity of its own or all with the followed one's. Drake copies its `3 K D` numbers
-  twice at every update.
-- `AffineState`, `[phase, held, p (D), z (D), alpha (2 D), beta (2 D)]`: DMPs that share
-  weights and start (`DmpBank.affine_in_goal`) and all step from the followed DMP's
-  velocity (`followed_goal` connected, as the builder wires PBP). The attractor terms are
-  then `dp = alpha[0] g + beta[0]`, `dz = alpha[1] g + beta[1]` for each goal `g`, so the
-  state is `2 + 6 D` numbers whatever K, an update costs O(D), and a read-out computes the
-  goals it is asked for from the goals on the port: O(D) for the selected goal's
-  reference. With the goals unchanged since the update, every number it gives is the
-  per-goal layout's, bit for bit (the same operations in the same order); when they
-  change, the read-out and the next update read the new goals, as if the last step had
-  been taken toward them.
+- `PerGoalState`, `[phase, held, p (D), z, dp, dz (D, K each)]`: any bank.
+- `AffineState`, `[phase, held, p (D), z (D), alpha (2 D), beta (2 D)]`: a bank
+  `affine_in_goal` stepped from the followed DMP's velocity, where `dp = alpha[0] g +
+  beta[0]`, `dz = alpha[1] g + beta[1]` for each goal `g`; its numbers are the per-goal
+  layout's bit for bit (the same operations in the same order; docs/concepts/dmp.md).
 """
 
 import numpy as np
@@ -114,8 +104,6 @@ class AffineState(_Layout):
     module docstring)."""
 
     def __init__(self, bank, period, max_speed):
-        # Only for a bank `affine_in_goal` (`DmpBank` picks the layout; the bank's
-        # `affine_coefficients` refuses any other).
         super().__init__(bank, period, max_speed)
         self.needs_followed_goal = True
         self.reads = "goals"  # the read-out evaluates the attractor terms at the goals
@@ -143,8 +131,7 @@ class AffineState(_Layout):
         phase, held, robot, z, alpha, beta = self._split(vector)
         robot[:, 0] = robot_state[:d]
         if lock:
-            # Phases frozen: the DMPs stay at the robot's position (dp = 0 g + 0) and
-            # follow its velocity (the velocity the last step left is not needed).
+            # Phases frozen: the DMPs stay at the robot's position (dp = 0 g + 0).
             held[0] = 1.0
             alpha.fill(0.0)
             beta.fill(0.0)

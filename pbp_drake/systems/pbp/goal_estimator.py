@@ -20,15 +20,13 @@ MEMORY_SIZE = 10
 
 class GoalEstimatorBase(PortGetters, LeafSystem):
     """What the goal estimator systems share: the checked `settings` (a copy, of type
-    `_SETTINGS`), the selection with the shipped hysteresis (`update_selection` of
-    `pbp_drake.core.goal_estimation`, with `margin` and `hold_steps`; None: the settings')
-    and the outputs `selected_goal` (`[index]`, goal 0 before the first update) and
-    `goal_probabilities` (K, uniform before the first update), read from the discrete
-    state so that they hold between updates. The `memory` group starts with the
-    hysteresis' `[challenger, count]` (`SelectionMemory`); `memory_size` > 2 leaves room
-    for a subclass's own. A subclass declares its input ports in `_declare_inputs(goal_count)`
-    and updates in `_update`, periodically at the decide stage of each control tick
-    (`pbp_drake.systems.tick`)."""
+    `_SETTINGS`), the selection's hysteresis (`update_selection`, with `margin` and
+    `hold_steps`; None: the settings') and the outputs `selected_goal` (`[index]`, goal 0
+    before the first update) and `goal_probabilities` (K, uniform before the first update),
+    which hold between updates. The `memory` group starts with `SelectionMemory`'s
+    `[challenger, count]`; `memory_size` > 2 leaves room for a subclass's own. A subclass
+    declares its input ports in `_declare_inputs(goal_count)` and updates in `_update`, at
+    the decide stage of each control tick."""
 
     #: The type of the settings.
     _SETTINGS = GoalEstimatorSettings
@@ -45,7 +43,6 @@ class GoalEstimatorBase(PortGetters, LeafSystem):
         hold_steps = settings.hold_steps if hold_steps is None else hold_steps
         check_hysteresis(margin, hold_steps)
         self._margin, self._hold_steps = float(margin), int(hold_steps)
-        # A copy: the settings are a plain (mutable) dataclass the caller may change later.
         self._settings = dataclasses.replace(settings)
         self._period = checked_period(control_period)
         self._declare_inputs(k)
@@ -110,16 +107,11 @@ class GoalEstimator(GoalEstimatorBase):
         - selected_goal
         - goal_probabilities
 
-    `ee_state` is `EeState` (`[p (3), v (3), heading, heading_rate]`); `goals` is the K
-    goals flattened row-major `(K, 3)`. `selected_goal` is `[index]` (the goal index as a
-    float) and `goal_probabilities` the K probabilities of `settings.method`; their state,
-    hysteresis and update time are `GoalEstimatorBase`'s.
-
-    At initialisation (`Simulator.Initialize`) the estimator records the end effector's
-    position as the start `S` and selects the most probable goal at once, without
-    hysteresis; a Context never initialised does so at its first periodic update instead.
-    Each update adds the distance moved since the last update to the path length (for
-    ``bayesian``), recomputes the probabilities and moves the selection with hysteresis.
+    `ee_state` is `EeState`; `goals` is the K goals flattened row-major `(K, 3)`;
+    `goal_probabilities` are those of `settings.method`. At initialisation (or the first
+    update of a Context never initialised) it records the hand's position as the start `S`
+    and selects the most probable goal at once; each update adds the distance moved to the
+    path length (for ``bayesian``) and moves the selection with hysteresis.
     """
 
     def __init__(self, goal_count, settings, control_period):
@@ -147,7 +139,6 @@ class GoalEstimator(GoalEstimatorBase):
         self._select(discrete_state, probabilities, None, memory)
 
     def _update(self, context, discrete_state):
-        # The context's DiscreteValues read once, each group off it: fewer pybind calls.
         state = context.get_discrete_state()
         memory = state.value(self._memory_index)
         if memory[INITIALISED] < 0.5:

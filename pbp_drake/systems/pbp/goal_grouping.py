@@ -28,16 +28,11 @@ class GoalGrouping(PortGetters, LeafSystem):
         - followed_goals
         - shown_goal
 
-    `settings` is the estimator's (`GoalEstimatorSettings`: `group_mass`, `commit_radius`,
-    `commit_probability`). `goals` is the K goals `(K, 3)` row-major; `goal_probabilities`
-    and `selected_goal` are the estimator's; `ee_state` the hand's `EeState` (its position
-    is read: the robot commits once the hand reaches the group's point). `followed_goals`
-    is `goals` with the selected goal's row moved to the group's point while the robot has
-    not committed (what the DMP bank steers to); `shown_goal` is `[index]`, the selected
-    goal once committed, else `NO_GOAL` (-1). Both come from one computation a change of
-    the inputs. The goal committed to is kept in the Context's state, updated every
-    `control_period` at the decide stage of the tick: a commitment holds while the
-    estimator selects the same goal.
+    The rules are docs/concepts/goal-estimators.md's ("Many goals: goal groups");
+    `settings` is the estimator's `GoalEstimatorSettings`. `goals` is the K goals `(K, 3)`
+    row-major. `followed_goals` is `goals` with the selected goal's row moved to the
+    group's point while the robot has not committed; `shown_goal` is `[index]`, the
+    selected goal once committed, else `NO_GOAL` (-1).
     """
 
     # The goals' input and numbers per goal, the hand's input and its size, the output.
@@ -112,10 +107,8 @@ class PoseGoalGrouping(GoalGrouping):
         - followed_poses
         - shown_goal
 
-    `goal_poses` is K `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened; `hand_pose` a
-    `PoseState` (its pose is read). `followed_poses` is `goal_poses` with the selected
-    goal's row moved to the group's pose (`pose_group_target`); distances are pose errors
-    with `metres_per_radian` (the task's success distance over its success angle).
+    `goal_poses` is K `GoalPose` rows flattened; `hand_pose` a `PoseState`. Distances are
+    pose errors with `metres_per_radian` (the task's success distance over its angle).
     """
 
     _GOALS, _WIDTH, _HAND, _HAND_SIZE = "goal_poses", GoalPose.size, "hand_pose", PoseState.size

@@ -16,9 +16,8 @@ class GoalsSource(PortGetters, LeafSystem):
         output_ports:
         - goals
 
-    Drake's ConstantVectorSource declares that its output may change with any source of the
-    diagram, so every system reading it would recompute from it at every step; here the
-    output depends on the parameter alone. `set_goals` changes it in a context.
+    Unlike Drake's ConstantVectorSource, its output depends on the parameter alone, so its
+    readers are not recomputed at every step. `set_goals` changes it in a context.
     """
 
     def __init__(self, goals):

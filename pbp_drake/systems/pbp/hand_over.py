@@ -24,7 +24,6 @@ class HandOverBase(PortGetters, LeafSystem):
 
     def _update(self, context, discrete_state):
         reference = self._reference_port.Eval(context)
-        # One pybind call for the group's array (get_mutable_vector and its value: two).
         state = discrete_state.get_mutable_value(self._state_index)
         state[:] = self._command(state, reference)
 
@@ -43,12 +42,9 @@ class HandOver(HandOverBase):
         - command
 
     `reference` and `command` are `[position (D), velocity (D)]`. The command is the
-    system's state, so it holds between ticks; it starts at `initial_position`, at rest.
-
-    It updates at the report stage of each tick (`pbp_drake.systems.tick.report_offset`),
-    after the DMP bank, the goal estimator and the operator have decided: the reference it
-    reads is the one of the same tick, and the robot follows the result from that tick on
-    (no plant step lies between the tick and its report stage).
+    system's state, starting at `initial_position` at rest. It updates at the report stage
+    of each tick, after the other systems have decided, so it reads the same tick's
+    reference (docs/concepts/control-tick.md).
     """
 
     def __init__(self, initial_position, max_acceleration, max_speed, control_period):

@@ -19,17 +19,12 @@ class HeadingCommand(PortGetters, LeafSystem):
         output_ports:
         - heading
 
-    `operator_command` is `OperatorCommand` (`[vx, vy, vz, yaw_rate]`); each control period
-    the heading moves by `yaw_rate * control_period`; with `max_yaw_acceleration` (rad/s^2)
-    the rate it turns at follows the operator's under the hand-over law
-    (`pbp_drake.core.hand_over`), so starting and stopping a turn is not a step. The DMPs
-    never turn the robot: in PBP the operator's turning is how it tells the goal estimator
-    where it wants to go. Like the DMP bank, it updates at the decide stage
-    (`pbp_drake.systems.tick`) to use the operator's command of that tick.
-
-    With a `max_turn` (rad) the heading stays within it of `initial_heading`: an arm's wrist
-    turns so far and no further (the HSR turns its base, and has none). At the bound the
-    turn stops there, its rate set to 0.
+    Each control period (at the decide stage) the heading moves by `yaw_rate *
+    control_period`; with `max_yaw_acceleration` (rad/s^2) the turn rate follows the
+    operator's under the hand-over law (`pbp_drake.core.hand_over`). The DMPs never turn
+    the robot: in PBP the operator's turning tells the goal estimator where it wants to go.
+    With a `max_turn` (rad, an arm's wrist) the heading stays within it of
+    `initial_heading`, the turn rate set to 0 at the bound.
     """
 
     def __init__(self, initial_heading, control_period, max_yaw_acceleration=None,
@@ -51,12 +46,10 @@ class HeadingCommand(PortGetters, LeafSystem):
                                                 self._update)
 
     def _update(self, context, discrete_state):
-        # One pybind call a group's array (get_mutable_vector and its value: two).
         heading = discrete_state.get_mutable_value(self._heading_index)
         yaw_rate = discrete_state.get_mutable_value(self._yaw_rate_index)
         wanted = OperatorCommand(self._command_port.Eval(context)).yaw_rate
-        # The hand-over law in one dimension: the turn's rate changes by at most
-        # max_yaw_acceleration * period a tick, and the heading moves at that rate.
+        # The hand-over law in one dimension.
         heading[:], yaw_rate[:] = hand_over(yaw_rate, heading + wanted * self._period,
                                             [wanted], self._max_yaw_acceleration, np.inf,
                                             self._period)

@@ -1,6 +1,4 @@
-"""HOP's assistance as a Drake system: the operator's velocity plus the belief-weighted
-cost gradient (``hop``), or predict-then-assist's all-or-nothing assistance
-(``predict_then_assist``), as the reference the hand-over passes on
+"""HOP's and predict-then-assist's assistance as a Drake system
 (`pbp_drake.core.hindsight_optimization.assisted_command`)."""
 
 import dataclasses
@@ -53,13 +51,10 @@ class HopAssistance(HopAssistanceBase):
         - command
 
     `robot_state` is the hand's `[p (3), v (3)]` sampled at the tick, `goals` the K goals
-    flattened `(K, 3)`, `operator_command` the operator's velocity (3), `goal_probabilities`
-    the belief (`MaxEntGoalEstimator`'s). The velocity commanded is `u + a`
-    (`assisted_command`): `a` weighted by the belief (``hop``), or toward the most probable
-    goal alone once it leads the second by more than `settings.blending_threshold`, else 0
-    (``predict_then_assist``). `command` is `[p + (u + a) control_period, u + a]`, the reference
-    of one control period, as `Blender`'s, for the `HandOver`. A NaN or infinite command
-    raises.
+    flattened `(K, 3)`, `operator_command` the operator's velocity `u` (3),
+    `goal_probabilities` the belief (`MaxEntGoalEstimator`'s). `command` is
+    `[p + (u + a) control_period, u + a]`, `a` the assistance of `assisted_command`, for
+    the `HandOver`. A NaN or infinite command raises.
     """
 
     def __init__(self, method, goal_count, settings, control_period):

@@ -1,8 +1,5 @@
-"""The ``intent_filter`` goal estimator as Drake systems (`pbp_drake.core.intent_filter`):
-a recursive posterior over the K goals on the operator's motions, headings, turns and
-silences, with a hazard against runaway confidence; for positions
-(`IntentFilterGoalEstimator`) and for the grasping task's poses
-(`PoseIntentFilterGoalEstimator`)."""
+"""The ``intent_filter`` goal estimator as Drake systems (`pbp_drake.core.intent_filter`),
+for positions and for the grasping task's poses."""
 
 import numpy as np
 
@@ -14,10 +11,8 @@ from pbp_drake.systems.pbp.pose_maxent_goal_estimator import PoseMaxEntGoalEstim
 
 
 class IntentFilterPosterior:
-    """What the two intent filter systems share, ahead of the posterior they subclass:
-    their settings, the goals read as they are, and the filter's step on the features a
-    subclass computes (`_features(context, read, active)`, `active` whether the operator
-    acts)."""
+    """What the two intent filter systems share, ahead of the posterior they subclass: the
+    filter's step on the features a subclass computes (`_features(context, read, active)`)."""
 
     _SETTINGS = IntentFilterSettings
 
@@ -50,11 +45,10 @@ class IntentFilterGoalEstimator(IntentFilterPosterior, MaxEntGoalEstimator):
         - goal_probabilities
         - posterior_clipped
 
-    The ports and outputs are `MaxEntGoalEstimator`'s. Each update reads the operator's
-    command as the motion while it acts, the hand's executed velocity while it is silent,
-    the yaw rate while it acts, and the hand's heading; the belief starts uniform.
-    `settings` is an `IntentFilterSettings`; `margin` and `hold_steps` are the selection's
-    hysteresis (the `goal_estimator` section's).
+    The ports are `MaxEntGoalEstimator`'s. Each update reads the operator's command and
+    yaw rate while it acts, the hand's executed velocity while it is silent, and the hand's
+    heading. `settings` is an `IntentFilterSettings`; `margin` and `hold_steps` are the
+    selection's hysteresis.
     """
 
     def _features(self, context, read, active):
@@ -83,14 +77,11 @@ class PoseIntentFilterGoalEstimator(IntentFilterPosterior, PoseMaxEntGoalEstimat
         - posterior_clipped
 
     The ports are `PoseMaxEntGoalEstimator`'s, and `shown_goal`, the goal the robot shows
-    the operator (`[index]`, -1: none; unconnected, none): while the operator acts it is
-    evidence against that goal, at `settings.override_rate`. `forward_key` says whether
-    the method lets the operator push along the hand's approach axis (teleop does, PBP does
-    not): without it, the operator's motion is compared with the part of each goal's
-    direction across that axis. Each update reads the operator's twist as the motion and
-    the turn while it acts, the hand's executed velocity (and no turn) while it is silent,
-    and the hand's orientation; `settings`, `margin` and `hold_steps` are
-    `IntentFilterGoalEstimator`'s.
+    (`[index]`, -1 or unconnected: none): while the operator acts it is evidence against
+    that goal, at `settings.override_rate`. `forward_key` says whether the method lets the
+    operator push along the hand's approach axis; without it, the motion is compared with
+    each goal's direction across that axis. Each update reads the operator's twist while it
+    acts, the hand's executed velocity (and no turn) while it is silent.
     """
 
     def __init__(self, goal_count, settings, control_period, margin=0.0, hold_steps=1,

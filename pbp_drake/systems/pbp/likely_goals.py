@@ -35,8 +35,7 @@ class LikelyGoals(PortGetters, LeafSystem):
         output_ports:
         - goal_indices
 
-    `count` is at most K. The output is computed when read (a drawing reads it a few times
-    a second), from its inputs alone.
+    `count` is at most K.
     """
 
     def __init__(self, goal_count, count):

@@ -1,8 +1,5 @@
-"""HOP's goal posterior as a Drake system: which of K goals the operator means, read from
-the operator's command (`pbp_drake.core.hindsight_optimization`), or with an
-`operator_speed` from PBP's operator's corrections, turns and silences
-(`pbp_drake.core.maxent_command`). `CommandPosteriorBase` holds what it shares with the
-six-DoF `PoseMaxEntGoalEstimator`."""
+"""HOP's goal posterior as a Drake system (`pbp_drake.core.hindsight_optimization`), or
+with an `operator_speed` the ``maxent_command`` one (`pbp_drake.core.maxent_command`)."""
 
 import typing
 
@@ -34,16 +31,11 @@ class PosteriorInputs(typing.NamedTuple):
 
 class CommandPosteriorBase(GoalEstimatorBase):
     """What `MaxEntGoalEstimator` and `PoseMaxEntGoalEstimator` share: the log belief and
-    whether the last update was clipped (the output `posterior_clipped`) in the Context's
-    discrete state, beside `GoalEstimatorBase`'s selection. A subclass declares its input
-    ports (`_declare_inputs`, with `operator_active` among them) and reads them
-    (`_inputs(context) -> PosteriorInputs`).
-
-    `operator_speed` None: HOP's published update, on the operator's command alone (the
-    ``hop`` and ``predict_then_assist`` methods). A speed (m/s, the operators' speed, the
-    task's nominal speed): the ``maxent_command`` likelihood for PBP's operator
-    (`pbp_drake.core.maxent_command`), which reads `operator_active`: the operator's
-    command while it acts, the hand's executed motion while it is silent, and its turns."""
+    whether the last update was clipped (output `posterior_clipped`). A subclass declares
+    its input ports (`_declare_inputs`, `operator_active` among them) and reads them
+    (`_inputs(context) -> PosteriorInputs`). `operator_speed` None: HOP's update, on the
+    operator's command alone; a speed (m/s): the ``maxent_command`` likelihood, on the
+    operator's command while it acts and the hand's executed motion while it is silent."""
 
     _SETTINGS = HopSettings
 
@@ -101,16 +93,12 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
         - goal_probabilities
         - posterior_clipped
 
-    `ee_state` is `EeState`, `goals` the K goals flattened `(K, 3)` (each goal one target),
-    `operator_command` the operator's `OperatorCommand` `[vx, vy, vz, yaw_rate]`, of which
-    the velocity is read (the hand's own velocity is mostly the robot's). The belief starts
-    uniform, and each update, at the decide stage of the tick, it moves by `-(Q_g - V_g)`
-    (with `operator_speed`: by the evidence of `pbp_drake.core.maxent_command`, which also
-    reads `operator_active` (1 while the operator acts), the hand's velocity and heading in
-    `ee_state` and the yaw rate) and is clipped at `settings.max_probability`; the selection
-    is the most probable goal, moved with the hysteresis of `margin` and `hold_steps` (0
-    and 1: at once). The outputs hold between updates (`GoalEstimatorBase`);
-    `posterior_clipped` is `[1]` when the last update was clipped, else `[0]`.
+    `ee_state` is `EeState`, `goals` the K goals flattened `(K, 3)`, `operator_command` an
+    `OperatorCommand`. The belief starts uniform; each update moves it by `-(Q_g - V_g)`
+    (with `operator_speed`: by `maxent_command`'s evidence) and clips it at
+    `settings.max_probability`; the selection moves with the hysteresis of `margin` and
+    `hold_steps` (0 and 1: at once). `posterior_clipped` is `[1]` when the last update was
+    clipped, else `[0]`.
     """
 
     def _declare_inputs(self, goal_count):

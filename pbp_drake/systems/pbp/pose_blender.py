@@ -26,15 +26,10 @@ class PoseBlender(BlenderBase):
         - reference
 
     `robot_state` is the hand's `PoseState` sampled at the tick; `policy_reference` a
-    `PoseState` (pose after one period and twist: `PoseDmpBank.selected_reference`);
-    `operator_twist` an `OperatorTwist` `[vx, vy, vz, wx, wy, wz]` (world frame), refused
-    with its NaN or infinite fields named. `reference` is a `PoseState`.
-
-    The modes are `pbp_drake.core.pose_arbitration.POSE_BLEND_MODES`: the position
-    `Blender`'s laws with orientations on SO(3), and ``pbp_no_user`` (that module's
-    docstring). As in `Blender` (`BlenderBase`), `confidence_alpha` reads
-    `goal_probabilities` (K) and `selected_goal` (goal 0 unconnected), and `fixed_alpha`'s
-    weight is a Context parameter (`set_alpha`).
+    `PoseState` (`PoseDmpBank.selected_reference`); `operator_twist` an `OperatorTwist`
+    (world frame; NaN or infinite fields refused by name). `reference` is a `PoseState`.
+    The modes are `pbp_drake.core.pose_arbitration.POSE_BLEND_MODES`; `confidence_alpha`
+    and `fixed_alpha` are as in `Blender`.
     """
 
     _laws = POSE_BLEND_LAWS

@@ -1,7 +1,5 @@
-"""The six-DoF DMP bank as a Drake system: K goal poses, each a position DMP and an
-orientation DMP re-integrated every control step from the hand's measured pose, over the
-NumPy banks `DmpBankModel` (positions, D = 3) and `OrientationDmpBank`, as `DmpBank` is
-over the first."""
+"""The six-DoF DMP bank as a Drake system, over the NumPy banks `DmpBankModel` (D = 3)
+and `OrientationDmpBank`."""
 
 import math
 
@@ -40,37 +38,17 @@ class PoseDmpBank(BankSystem):
         - phase
         - predicted_poses (with prediction_steps > 0)
 
-    `robot_state` is a `PoseState` `[x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz]`
-    (quaternion unit within `quaternion.UNIT_TOLERANCE`, angular velocity world frame);
-    `goal_poses` is K `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened (a goal that
-    is not finite, or whose quaternion is not unit, is refused naming `goal_poses`).
-
-    Each period every DMP advances one step from the measured pose: the position part as
-    `DmpBank`, the orientation part as `OrientationDmpBank` (`e = Log(q g*)`, the same
-    first-order-hold step, see docs/concepts/dmp.md). Both parts share one phase, so one
-    lock stops both. `lock_phase_when_operator_acts`, `followed_goal` (which also carries
-    the followed DMP's angular velocity over, so a switch of goal keeps the commanded
-    twist) and `max_speed` are `DmpBank`'s; `max_angular_speed` (rad/s) is the angular
-    part's anti-windup limit. Locked, the DMPs follow the hand's pose and `tau` times its
-    twist.
-
-    `references` is the K next pose references, K `PoseState` rows (pose after one step,
-    twist) flattened; `selected_reference` is the one of `selected_goal` (unconnected: the
-    followed goal, else goal 0), a `PoseState`, computed alone (`references` costs K exp
-    maps). `phase` is the K (equal) phases. `predicted_poses` (with `prediction_steps > 0`)
-    is the selected DMP's open-loop rollout from its current state, `prediction_steps + 1`
-    `GoalPose` rows flattened, sampled every `prediction_period` (default: the DMPs'
-    duration over `prediction_steps`), computed only when read (a visualizer's publish).
-
-    The state is one vector in one of the layouts of
-    `pbp_drake.systems.pbp.pose_dmp_bank_state`: per goal (the default, 12 K numbers, which
-    Drake copies twice at each update), or with `compact_state=True` (which needs
-    `followed_goal` connected: an update without it raises) 16 numbers whatever K, from
-    which the K stepped DMPs are computed into a cache entry once per state, when first
-    read. Every DMP is still stepped every tick; the outputs are the per-goal layout's bit
-    for bit while the goals stay (if they change between an update and a read, the read
-    steps toward the new goals, as `DmpBank`'s compact state). The bank updates at the
-    decide stage of each tick (`update_offset` overrides it).
+    docs/concepts/six-dof.md ("The pose DMP bank") tabulates the ports and explains the
+    step and the state. `robot_state` is a `PoseState`, `goal_poses` K `GoalPose` rows
+    flattened (not finite or not unit: refused naming `goal_poses`). Both parts share one
+    phase, so one lock stops both; `lock_phase_when_operator_acts`, `followed_goal` and
+    `max_speed` are `DmpBank`'s, `max_angular_speed` (rad/s) the angular part's anti-windup
+    limit. `references` is K `PoseState` rows flattened, `selected_reference` the one of
+    `selected_goal` computed alone, `predicted_poses` the selected DMP's open-loop rollout,
+    `prediction_steps + 1` `GoalPose` rows every `prediction_period` (default: the duration
+    over `prediction_steps`). The state is 12 K numbers, or 16 with `compact_state=True`
+    (which needs `followed_goal` connected). The bank updates at the decide stage of each
+    tick (`update_offset` overrides it).
     """
 
     def __init__(self, position_bank, orientation_bank, control_period,
@@ -83,8 +61,7 @@ class PoseDmpBank(BankSystem):
         self._max_angular_speed = (None if max_angular_speed is None
                                    else float(max_angular_speed))
         self._positions, self._orientations = position_bank, orientation_bank
-        # Equal settings and durations: both parts' steps contract one basis (the position
-        # step's, passed on to the orientation step).
+        # Equal settings and durations: both parts' steps contract one basis.
         self._shared_basis = (position_bank.settings == orientation_bank.settings
                               and position_bank.duration == orientation_bank.duration)
         self._period = float(control_period)
@@ -153,17 +130,14 @@ class PoseDmpBank(BankSystem):
 
     def _stepped(self, context, vector):
         """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K): views of
-        `vector` (the state read, or the update's copy of it) per goal; in the compact
-        layout, of the cache entry computed from the Context's state, which the update's
-        copy equals until the update writes it."""
+        `vector` per goal, or of the compact layout's cache entry."""
         if self._compact:
             return per_goal_arrays(self._stepped_entry.Eval(context).numbers, self._goal_count)
         return per_goal_arrays(vector, self._goal_count)
 
     def _goal_numbers(self, context, vector, k):
-        """Goal `k`'s stepped numbers `[y' - p (3), z' (3), e' (3), z' (3)]` as 12 floats
-        (one strided read of the layout `_stepped` views), and the compact layout's
-        `SteppedDmps` they were read from (None per goal)."""
+        """Goal `k`'s stepped numbers `[y' - p (3), z' (3), e' (3), z' (3)]` as 12 floats,
+        and the compact layout's `SteppedDmps` they were read from (None per goal)."""
         count = self._goal_count
         if self._compact:
             stepped = self._stepped_entry.Eval(context)
@@ -217,17 +191,14 @@ class PoseDmpBank(BankSystem):
             self._update_per_goal(context, vector, hand, lock, goals, followed)
 
     def _update_compact(self, context, vector, hand, lock, followed):
-        """The compact state's update: what the next step starts from (the cache entry
-        takes it, `_calc_stepped`), no work of size K."""
+        """The compact state's update: what the next step starts from, no work of size K."""
         phase, held, robot, q, eta = split_head(vector)
         # The tail: the phase and `z` the last step started from.
         step_phase, step_velocity = compact_inputs(vector)
         position, orientation, velocity, angular_velocity = hand
         if held[0] == STEPPING:
             # Every DMP continues from the followed DMP's velocities at the end of the last
-            # step: its 12 numbers in one read, and its eta = J(e') z', which the last read
-            # of the selected reference computed when that was the same goal. Held, `z`
-            # and eta stay as they are.
+            # step; its eta = J(e') z' is the last selected reference's when the same goal.
             numbers, stepped = self._goal_numbers(context, vector, followed)
             step_velocity[:, 0] = numbers[3:6]
             eta[:, 0] = (stepped.eta if stepped.eta_goal == followed
@@ -255,9 +226,7 @@ class PoseDmpBank(BankSystem):
         stepped, log_state = self._stepped(context, vector)
         offsets, velocities = stepped
         workspace = self._workspace(context)
-        # The DMPs' velocities at the end of the last step, which the step overwrites: the
-        # followed one's linear velocity (every DMP continues from it), else each one's,
-        # and the orientation part's eta as a column (one for all) or per DMP.
+        # The velocities the step starts from: the followed DMP's (one column), else each's.
         if followed is not None:
             scaled_velocity, eta = workspace.column, workspace.eta_column
             if stepping:
@@ -326,8 +295,8 @@ class PoseDmpBank(BankSystem):
         return PoseReference.from_vector(self._selected_numbers(context))
 
     def _selected_numbers(self, context):
-        """`selected_reference`'s 13 numbers (`PoseState`'s layout) as floats: at one goal,
-        float arithmetic on the numbers read in one go costs a fraction of NumPy calls."""
+        """`selected_reference`'s 13 numbers (`PoseState`'s layout) as floats (at one goal,
+        cheaper than NumPy calls)."""
         k = self._selected(context)
         vector = context.get_discrete_state(self._state_index).get_value()
         head = vector[:HEAD_SIZE].tolist()  # [phase, held, p (3), q (4), eta (3)]
@@ -343,8 +312,7 @@ class PoseDmpBank(BankSystem):
         rotation = quaternion.exp_times_aligned_values(numbers[6:9], goal, head[5:9])
         eta = jacobian_of_one_values(numbers[6:9], numbers[9:12])
         if stepped is not None:
-            # The next update steps every DMP from the followed one's eta: this one's, when
-            # the blender follows the goal the estimator selects (`SteppedDmps`).
+            # The next update reuses it when this goal is the followed one (`SteppedDmps`).
             stepped.eta_goal, stepped.eta = k, eta
         return position + rotation + velocity + [value / tau_w for value in eta]
 
@@ -359,8 +327,7 @@ class PoseDmpBank(BankSystem):
         k = self._selected(context)
         phase, positions, orientations, velocity, eta = self.dmp_states(context)
         goals = self._goals_entry.Eval(context)[:, [k]]
-        # The selected DMP alone is rolled out (banks of its one DMP): the same path as
-        # rolling out all K and picking it, at a cost that does not grow with K.
+        # The selected DMP alone is rolled out: the same path, at a cost independent of K.
         dt, steps = self._prediction_period, self._prediction_steps
         path = self._positions.subset([k]).predict(
             phase[[k]], positions[:, [k]], velocity[:, [k]], goals[:3], dt, steps)[0]
@@ -370,8 +337,7 @@ class PoseDmpBank(BankSystem):
 
 
 def _check_banks(position_bank, orientation_bank, control_period):
-    """The two banks must describe the same K goals with one phase: 3-D positions, equal
-    goal counts, and equal phase decays over the control period."""
+    """The two banks must describe the same K goals with one phase."""
     if position_bank.dimension != 3:
         raise ValueError(f"the position bank must be 3-D, got D = {position_bank.dimension}")
     if position_bank.goal_count != orientation_bank.goal_count:

@@ -1,20 +1,11 @@
 """The `PoseDmpBank` system's state, in its two layouts, and its scratch.
 
-Both layouts start with the same twelve numbers (`split_head`): `[phase, held, p (3),
-q (4), eta (3)]`, the phase after the last step, whether the DMPs are stepping or held
-(`STEPPING`, `ON_ROBOT`: PBP-Alt's lock, `AT_START`), the measured pose the last step
-started from, and a scaled angular velocity `tau omega` (3).
-
-- **Per goal** (`compact=False`): then the K DMPs' stepped arrays (`per_goal_arrays`): the
-  position DMPs' offsets `y' - p` and scaled velocities `z'` (2, 3, K), and the orientation
-  DMPs' log coordinates `(e', z')` (2, 3, K). 12 K numbers, which Drake copies twice at
-  each update. `eta` is the held angular velocity (the hand's, locked; 0 at the start).
-- **Compact** (`compact=True`): then what the last step started from (`compact_inputs`):
-  its phase and the linear scaled velocity `z` (3); `eta` is the angular one. 16 numbers
-  whatever K. It holds only when every DMP steps from the followed DMP's velocities
-  (`followed_goal` connected), for then the K stepped DMPs are a function of these inputs
-  and the goals: the system computes them into a cache entry (`step_all`, the same call
-  as the per-goal update makes), once per state, when first read.
+Both layouts start with `[phase, held, p (3), q (4), eta (3)]` (`split_head`): `held` is
+`STEPPING`, `ON_ROBOT` (PBP-Alt's lock) or `AT_START`, `p`, `q` the pose the last step
+started from, `eta` a scaled angular velocity `tau omega`. Per goal, the K DMPs' stepped
+arrays follow (`per_goal_arrays`: `[y' - p, z']` and `[e', z']`, 12 K numbers); compact,
+the last step's phase and `z` (`compact_inputs`), from which `step_all` computes the
+stepped arrays into a cache entry (docs/concepts/six-dof.md).
 """
 
 import numpy as np
@@ -50,12 +41,10 @@ def compact_inputs(vector):
 
 
 class SteppedDmps:
-    """The compact layout's cache entry: the K DMPs stepped from the state (`numbers`,
-    12 K, laid out as a per-goal state's tail, `per_goal_arrays`), and `J(e') z'` of one of
-    them (`eta`, 3 floats, of goal `eta_goal`; -1: none yet): the selected reference's
-    read computes it, and the next update, which needs the followed DMP's, takes it when
-    they are the same goal (the normal case), as it takes these numbers, not computing
-    them twice. Whoever rewrites `numbers` sets `eta_goal` to -1."""
+    """The compact layout's cache entry: the K DMPs stepped from the state (`numbers`, laid
+    out as a per-goal state's tail), and `J(e') z'` of goal `eta_goal` (`eta`; -1: none),
+    which the selected reference's read computes and the next update reuses. Whoever
+    rewrites `numbers` sets `eta_goal` to -1."""
 
     __slots__ = ("numbers", "eta_goal", "eta")
 
@@ -66,12 +55,9 @@ class SteppedDmps:
 
 
 class PoseWorkspace:
-    """Scratch of one Context: the two banks' workspaces, a phase, the linear velocities
-    the step starts from (`column`, the followed DMP's; `velocities`, every DMP's when no
-    followed goal is connected), the angular ones likewise (`eta_column`; `eta`, with
-    `orientations` the orientation readout's arrays), and whether the goals were
-    recomputed since the last step (`goals_changed`: if not, the banks reuse what they
-    derived from the goals, without comparing K goals)."""
+    """Scratch of one Context: the two banks' workspaces, the velocities the step starts
+    from (`column`, `eta_column`: the followed DMP's; `velocities`, `eta`: every DMP's),
+    and whether the goals were recomputed since the last step (`goals_changed`)."""
 
     __slots__ = ("position", "orientation", "phase", "column", "eta_column", "velocities",
                  "orientations", "eta", "goals_changed")
@@ -93,9 +79,8 @@ def step_all(positions, orientations, shared_basis, phase, robot, q, z, eta, goa
              stepped, log_state, workspace):
     """Every DMP's step from the phase, the measured pose `robot` (3, 1), `q` (4, 1) and
     the scaled velocities `z`, `eta` ((3, 1) for all, or (3, K)), toward `goals` (7, K),
-    into `stepped` and `log_state` (2, 3, K). The banks reuse what they derived from the
-    goals while the goals cache entry has not been recomputed (they vouch for nothing
-    else); with `shared_basis` the orientation step contracts the position step's basis."""
+    into `stepped` and `log_state` (2, 3, K); with `shared_basis` the orientation step
+    contracts the position step's basis."""
     unchanged = not workspace.goals_changed
     positions.stepped_from_one_into(phase, robot, z, goals[:3], period, stepped,
                                     workspace.position, goals_unchanged=unchanged)

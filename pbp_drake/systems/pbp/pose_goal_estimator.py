@@ -24,17 +24,12 @@ class PoseGoalEstimator(GoalEstimatorBase):
         - selected_goal
         - goal_probabilities
 
-    `hand_pose` is the hand's `PoseState` (pose and world-frame twist); `goal_poses` the K
-    `GoalPose` rows `[x, y, z, qw, qx, qy, qz]` flattened. `operator_twist`, when
-    connected, is the operator's `OperatorTwist` (world frame): the estimator's direction
-    of travel and turn rate are then the operator's, not the hand's, and while the operator
-    gives no input (all zeros) the selection holds. Connect it whenever a policy moves the
-    hand too: the hand's own twist is then mostly the selected DMP's, and would hold the
-    selection on whatever the robot heads for (docs/tasks/grasp.md). Unconnected, the
-    hand's twist is read and the selection follows it at every update. `selected_goal` is
-    `[index]` and `goal_probabilities` the K probabilities (`GoalEstimatorBase`). At
-    initialisation it selects the most probable grasp pose at once (no hysteresis); each
-    update recomputes the probabilities and moves the selection with the hysteresis.
+    `hand_pose` is the hand's `PoseState`; `goal_poses` the K `GoalPose` rows flattened.
+    `operator_twist`, when connected, is the operator's `OperatorTwist`: the direction of
+    travel and turn rate are then the operator's, not the hand's, and while it is all zeros
+    the selection holds. Connect it whenever a policy moves the hand too, or the selection
+    would follow whatever the robot heads for (docs/tasks/grasp.md). At initialisation it
+    selects the most probable grasp pose at once.
     """
 
     def __init__(self, goal_count, settings, control_period):
@@ -62,7 +57,6 @@ class PoseGoalEstimator(GoalEstimatorBase):
         probabilities = pose_probabilities(
             self._settings, goals[:, :3], goals[:, 3:], hand[:3],
             hand[3:7] / np.linalg.norm(hand[3:7]), twist[:3], twist[3:])
-        # The operator gives no input: no new evidence of intent, so the selection holds
-        # (the probabilities still follow the hand).
+        # No operator input, no new evidence: the selection holds.
         self._select(state, probabilities, previous,
                      hold=previous is not None and operator and not twist.any())

@@ -1,7 +1,4 @@
-"""HOP's assistance on the hand's pose as a Drake system: the grasping task's ``hop`` and
-``predict_then_assist`` commands, position and orientation
-(`pbp_drake.core.hindsight_optimization.assisted_command`)."""
-
+"""HOP's assistance on the hand's pose as a Drake system (the grasping task)."""
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.hindsight_optimization import assisted_command, hop_targets
@@ -26,12 +23,9 @@ class PoseHopAssistance(HopAssistanceBase):
         - reference
 
     `robot_state` is the hand's `PoseState` sampled at the tick, `goal_poses` the K
-    `GoalPose` rows flattened, `operator_twist` the operator's `OperatorTwist` (world
-    frame), `goal_probabilities` the belief (`PoseMaxEntGoalEstimator`'s). The twist
-    commanded is the operator's plus the assistance, `(v + a_v, w + a_w)`, the angular part
-    from the rotation terms; `reference` is the `PoseState` of one control period, the
-    hand moved by `v + a_v` and turned by `Exp((w + a_w) dt)`, as `PoseBlender`'s, for the
-    `PoseHandOver`.
+    `GoalPose` rows flattened, `operator_twist` an `OperatorTwist`, `goal_probabilities`
+    the belief. `reference` is the `PoseState` of one control period, the hand moved by
+    `v + a_v` and turned by `Exp((w + a_w) dt)`, for the `PoseHandOver`.
     """
 
     def __init__(self, method, goal_count, settings, control_period):

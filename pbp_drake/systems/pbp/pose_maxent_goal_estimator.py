@@ -1,5 +1,4 @@
-"""HOP's goal posterior on the hand's pose as a Drake system: which of K grasp poses the
-operator means, read from the operator's twist (`pbp_drake.core.hindsight_optimization`)."""
+"""HOP's goal posterior on the hand's pose as a Drake system."""
 
 import numpy as np
 
@@ -26,13 +25,10 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
         - goal_probabilities
         - posterior_clipped
 
-    `hand_pose` is the hand's `PoseState`, `goal_poses` the K `GoalPose` rows `[x, y, z, qw,
-    qx, qy, qz]` flattened (each goal one target: its grasp pose), `operator_twist` the
-    operator's `OperatorTwist` (world frame). A goal's cost adds the translation term on
-    the distance to its grasp position and `settings.rotation_weight` times the rotation
-    term on the angle to its grasp orientation. Updates, selection and outputs are
-    `MaxEntGoalEstimator`'s; with `operator_speed`, the silent operator's implicit twist is
-    the hand's (`hand_pose`'s velocities), and turns count through the rotation term.
+    `hand_pose` is the hand's `PoseState`, `goal_poses` the K `GoalPose` rows flattened,
+    `operator_twist` an `OperatorTwist`. A goal's cost adds `settings.rotation_weight` times
+    the rotation term to the translation term. Updates, selection and outputs are
+    `MaxEntGoalEstimator`'s.
     """
 
     def _declare_inputs(self, goal_count):

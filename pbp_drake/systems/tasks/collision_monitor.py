@@ -24,8 +24,7 @@ class CollisionMonitor(PortGetters, LeafSystem):
     filters: robot-obstacle contact is filtered out of the plant (the obstacles are
     measured, they do not push), and this monitor still sees the overlap.
     `clearance` is the smallest signed distance over the pairs (m); `in_collision` is 1
-    when it is negative. Each pair is queried once per evaluation: `in_collision` reads
-    the cached `clearance` output rather than querying again.
+    when it is negative.
     """
 
     def __init__(self, robot_geometry_ids, obstacle_geometry_ids):

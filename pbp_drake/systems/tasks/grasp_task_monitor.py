@@ -23,14 +23,10 @@ class GraspTaskMonitor(TaskMonitorBase):
         - task_status
 
     `hand_pose` is the hand's `PoseState`. Progress is `grasp_progress` toward the current
-    target's grasp pose from the hand's start pose (length per radian `success_distance /
-    success_angle`); success is the hand within `success_distance` (m) AND `success_angle`
-    (rad) of the target's grasp pose.
-
-    `target` is `Target` (the target's grasp position and object index); `task_status` is
-    `TaskStatus` (collision ratio 0: the task has no obstacles). `grasp_positions` (M, 3)
-    and `grasp_orientations` (M, 4) are the objects' grasp poses; `start_pose` the hand's
-    `[p (3), q (4)]` at the start.
+    target's grasp pose from `start_pose` (`[p (3), q (4)]`, length per radian
+    `success_distance / success_angle`); success is the hand within `success_distance` (m)
+    AND `success_angle` (rad) of it. `grasp_positions` (M, 3) and `grasp_orientations`
+    (M, 4) are the objects' grasp poses; `target` gives the grasp position.
     """
 
     def __init__(self, grasp_positions, grasp_orientations, targets, switch_schedule,

@@ -21,14 +21,12 @@ class MovingObstacles(PortGetters, LeafSystem):
         - obstacle_positions
         - floor_positions
 
-    At the decide stage of every control tick (`pbp_drake.systems.tick`), it computes the
-    hand's progress to the target from `ee_state` and steps the obstacles
-    (`core.obstacle_task.step_obstacles`): each wakes when the progress passes its threshold
-    and then moves at `speed` to the midpoint between the hand and the target, where it
-    stops. `obstacle_positions` is `(N, 3)` flattened, the centres of upright cylinders of
-    `height` standing on the floor (what the HSR station's `obstacle_positions` input takes:
-    the station holds the geometry); `floor_positions` is `(N, 2)` flattened, the same on
-    the floor. All state lives in the Context.
+    At the decide stage of every control tick it steps the obstacles
+    (`core.obstacle_task.step_obstacles`): each wakes when the hand's progress passes its
+    threshold and then moves at `speed` to the midpoint between the hand and the target.
+    `obstacle_positions` is `(N, 3)` flattened, the centres of upright cylinders of
+    `height` standing on the floor (the HSR station's input); `floor_positions` is `(N, 2)`
+    flattened, the same on the floor.
     """
 
     def __init__(self, scene, start, height, speed, control_period):

@@ -11,8 +11,7 @@ from pbp_drake.systems.ports import PortGetters
 
 @dataclasses.dataclass
 class PointRobotParams:
-    """The point robot's dynamics: mass (kg), the tracking spring (N/m) and damper (N s/m),
-    and its discrete time step (s). Scenario files give it as `robot: {...}`."""
+    """The point robot's dynamics (`robot: {...}` in a scenario file)."""
 
     #: The point's mass (kg).
     mass: float = 1.0

@@ -1,6 +1,5 @@
 """The referee of the multi-goal reaching task: targets, switches, success, metrics; it ends
-the simulation at success. Its rules (`TaskMonitorBase`) are the grasping task's too
-(`pbp_drake.systems.tasks.grasp_task_monitor`)."""
+the simulation at success."""
 
 import dataclasses
 
@@ -10,15 +9,15 @@ from pydrake.systems.framework import EventStatus, LeafSystem
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.reach_task import reach_progress
 from pbp_drake.systems.ports import EeState, PortGetters, Target, TaskStatus, position_of
-from pbp_drake.systems.tick import decide_offset, report_offset
+from pbp_drake.systems.tick import checked_update_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
 
 
 @dataclasses.dataclass(frozen=True)
 class TaskCounts:
-    """The task's whole numbers, as `TaskMonitor.counts` reads them off its state (where
-    they are a discrete vector in this order, exact as floats)."""
+    """The task's whole numbers, as `TaskMonitor.counts` reads them off its state (a
+    discrete vector in this order)."""
 
     stage: int = 0  # target switches so far
     steps: int = 0  # control ticks counted, up to success
@@ -38,31 +37,21 @@ _STAGE, _SUCCESS = 0, 4  # where TaskCounts' stage and success sit in the counts
 
 
 class TaskMonitorBase(PortGetters, LeafSystem):
-    """What the reaching and the grasping task's referees (`TaskMonitor`,
-    `GraspTaskMonitor`) share, so that their rules stay in step.
+    """The rules the reaching and the grasping task's referees (`TaskMonitor`,
+    `GraspTaskMonitor`) share.
 
-    Its input ports: the hand's state (`pose_port`, of `pose_size`), `operator_active` and,
-    with `in_collision_port`, an optional `in_collision`; its output ports `target` and
-    `task_status`. Every control period, `update_offset` after the tick (the decide stage
-    of `pbp_drake.systems.tick` by default), until success: count the step (and whether the
-    operator acted, and whether the robot was in collision), compute the progress toward
-    the current target, switch to the next of `targets` once progress reaches the next
-    entry of `switch_schedule`, and declare success when the hand has reached the current
-    target. `objects` (M, 3) are the points the targets stand for (`target` outputs one).
+    Inputs: the hand's state (`pose_port`, of `pose_size`), `operator_active` and, with
+    `in_collision_port`, an optional `in_collision`; outputs `target` and `task_status`.
+    Every control period, `update_offset` after the tick (default: the decide stage), until
+    success, it counts the step, computes the progress toward the current target, switches
+    to the next of `targets` once progress reaches the next entry of `switch_schedule`, and
+    declares success when the hand has reached the current target. `objects` (M, 3) are the
+    points the targets stand for. A subclass implements `_read_hand(vector)`,
+    `_progress(hand, index)` (a number) and `_reached(hand, index)` (a bool).
 
-    A subclass says what the hand's state is and what progress and success mean:
-    `_read_hand(vector)` turns the hand port's value into what `_progress(hand, index)`
-    (a number) and `_reached(hand, index)` (a bool) read for object `index`.
-
-    At success the monitor ends the simulation: a publish event at the report stage (a
-    millionth of a period after the update) returns `EventStatus.ReachedTermination`, so any
-    `Simulator.AdvanceTo` returns there, before the plant moves again, with
-    `SimulatorStatus.reason()` `kReachedTerminationCondition`. The status then stays frozen;
-    a later `AdvanceTo` stops again one control period on.
-
-    The counts (`TaskCounts`, whole numbers held exactly as floats) and the progress and
-    task time are two discrete vectors, updated at the decide stage (no other system that
-    updates there reads this monitor, nor does it read theirs).
+    At success a publish event at the report stage returns
+    `EventStatus.ReachedTermination`, so `Simulator.AdvanceTo` returns there, before the
+    plant moves again; the status then stays frozen.
     """
 
     def __init__(self, pose_port, pose_size, objects, targets, switch_schedule,
@@ -74,13 +63,8 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         if len(self._targets) != len(self._schedule):
             raise ValueError("one target per entry of switch_schedule")
         period = float(control_period)
-        if update_offset is None:
-            update_offset = decide_offset(period)
-        self._update_offset = float(update_offset)
+        update_offset = self._update_offset = checked_update_offset(update_offset, period)
         end_offset = report_offset(period, update_offset)
-        if not 0.0 <= update_offset < end_offset < period:
-            raise ValueError(f"update_offset must be in [0, control_period), got "
-                             f"{update_offset!r}")
         self._hand_port = self.DeclareVectorInputPort(pose_port, pose_size)
         self._operator_active_port = self.DeclareVectorInputPort("operator_active", 1)
         self._in_collision_port = (self.DeclareVectorInputPort("in_collision", 1)
@@ -119,7 +103,6 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         return context.get_discrete_state(self._counts_index).value()
 
     def _calc_target(self, context, output):
-        # Once a tick each, this and the end-of-tick check read one count, not all five.
         index = self._targets[int(self._count_vector(context)[_STAGE])]
         target = Target(np.empty(Target.size))
         target.x, target.y, target.z = self._objects[index]

@@ -1,6 +1,5 @@
-"""Draws the grasping task in Meshcat: tables, objects, each grasp pose as a triad (or, for
-many, the likeliest grasps' triads), every grasp's probability as one point cloud, the
-target and the estimated goal, the hand, and the selected DMP's predicted poses."""
+"""Draws the grasping task in Meshcat: the scene, grasp poses as triads, the goal cloud,
+the markers, the hand and the selected DMP's predicted poses."""
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
@@ -31,19 +30,14 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         - hand_state (optional)
         - goal_probabilities (optional)
 
-    `grasps` is the task's `GraspScene` (`layout.grasps`). As `ReachSceneVisualizer`
-    (whose drawing of the objects, the goal cloud, the balls and the recording this
-    shares), what is sent does not grow with the number of grasps K. Up to `SOLID_OBJECTS`
-    grasps, every table and object is drawn and, at each object's grasp pose, a triad
-    `/task/grasps/{k}` (`draw_triad`: x red, y green, z blue, z the approach); with more,
-    `likely_triads` triads `/task/likely_grasps/{i}` that each path period moves to the
-    selected grasp and the likeliest others (`goal_probabilities`). The blue ball is
-    hidden while `selected_goal` is -1 (no intent shown: teleop, or a group of grasps
-    followed). Each publish moves the hand's triad `/task/hand` to `hand_state`
-    (`PoseState`); each `path_period` the selected DMP's predicted poses
-    (`predicted_poses`: `prediction_steps + 1` `GoalPose` rows, flattened) are drawn as
-    `PATH_TRIADS` triads `/task/prediction/{i}` spread along the path by arc length
-    (`PathTriads`). Call from the thread that made `meshcat`.
+    `grasps` is the task's `GraspScene` (`layout.grasps`); the scene, cloud and markers are
+    drawn as `ReachSceneVisualizer`'s. Up to `SOLID_OBJECTS` grasps, every table and object
+    is drawn with a triad `/task/grasps/{k}` at its grasp pose (`draw_triad`, z the
+    approach); with more, `likely_triads` triads `/task/likely_grasps/{i}` that each path
+    period moves to the selected grasp and the likeliest others. Each publish moves the
+    hand's triad `/task/hand` to `hand_state` (`PoseState`); each `path_period` the
+    `predicted_poses` (`prediction_steps + 1` `GoalPose` rows) are drawn as `PATH_TRIADS`
+    triads `/task/prediction/{i}` (`PathTriads`). Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, grasps, prediction_steps=0, table_size=(0.3, 0.3),

@@ -37,9 +37,8 @@ PATH_DOT_RADIUS = 0.006
 # dots; `PathTrail` doubles their spacing after 1.6 m (a toy run's path is about 1.3 m).
 EXECUTED_DOT_RADIUS = 0.003
 EXECUTED_SPACING = 0.004
-# Heights (2-D scenes seen from above): the start under the obstacles, the paths over them,
-# the robot and the goals over the paths; the executed path over the obstacles (their top
-# at 0.005), under the predicted paths.
+# Heights seen from above: the start under the obstacles (top at 0.005), the executed path
+# over them, under the predicted paths.
 START_Z, EXECUTED_Z, PATH_Z = -0.01, 0.006, 0.008
 
 
@@ -55,20 +54,12 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         - operator_active (optional)
         - predicted_paths (optional)
 
-    The static scene (obstacles, the start as a magenta disc, the goals, the demonstration,
-    the robot at `start`) is drawn under `/pbp`, after deleting it, at each initialisation
-    (`Simulator.Initialize`), so a second run or a run after `meshcat.Delete()` draws it
-    again. A planar scene's view is framed then, once, on the start, the goals, the
-    obstacles, the demonstration and the predicted paths of that moment, with a margin
-    (`core.scene_framing`).
-
-    Each publish moves the robot, shows an orange halo while the operator acts and extends
-    the executed path, the robot's trail of blue dots under `/pbp/executed` (`PathTrail`);
-    each `path_period` (default: the publish period) spreads the dots of every DMP's
-    predicted path along it (`PathDots`). All with `time_in_recording`, so that a recording
-    (`Meshcat.StartRecording`, started before the simulator initialises) replays the robot
-    and the paths together, the executed path drawn only up to the replay's time. Call from
-    the thread that made `meshcat`.
+    At each initialisation the static scene is drawn under `/pbp` (after deleting it), and a
+    planar scene's view is framed once on what is known then (`core.scene_framing`). Each
+    publish moves the robot, shows an orange halo while the operator acts and extends the
+    executed path (`PathTrail`, `/pbp/executed`); each `path_period` (default: the publish
+    period) moves every DMP's predicted path (`PathDots`). All with `time_in_recording`, so
+    that a recording replays them. Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, start, goals, obstacles, demonstration=None,
@@ -139,8 +130,7 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         meshcat.SetProperty("/pbp/robot/operator", "visible", False)
         meshcat.SetTransform("/pbp/robot", RigidTransform(self._to_3d(start)[0]))
         if self._dimension == 2:
-            # Framed once, on what is known at the start; the margin holds the robot's
-            # excursions from it.
+            # Framed once, on what is known at the start.
             points = [start[None, :], goals]
             if demonstration is not None:
                 points.append(np.asarray(demonstration, float))

@@ -17,8 +17,7 @@ TARGET_COLOUR = Rgba(1.0, 0.9, 0.0, 1.0)
 ESTIMATE_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 ACTIVE_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 1.0)
 OTHER_PATH_COLOUR = Rgba(0.1, 0.3, 1.0, 0.2)
-# Dots per path (each of TASK_PREDICTION_SAMPLES + 1 points): a replay keeps every dot's position at
-# every path update, so their count and rate set most of its size.
+# Dots per path: a replay keeps every dot's position at every path update.
 PATH_DOTS = 24
 # The marker at the hand (shown while the operator acts): a replay's track of the hand's
 # path (`pbp-drake teach --from` reads it).
@@ -28,8 +27,7 @@ TRAIL_DOT_RADIUS, TRAIL_SPACING = 0.01, 0.02
 TRAIL_COLOUR = Rgba(0.2, 0.75, 0.3, 0.9)
 ACTIVE_DOT_RADIUS, OTHER_DOT_RADIUS = 0.012, 0.008
 OPERATOR_COLOUR = Rgba(1.0, 0.45, 0.0, 0.6)
-# Up to this many objects are drawn as tables and cylinders; more are the goal cloud alone
-# (thousands of meshes would slow the page down, and show nothing the cloud does not).
+# Up to this many objects are drawn as tables and cylinders; more are the goal cloud alone.
 SOLID_OBJECTS = 100
 # The goal cloud's points float just above the objects' tops, at most the size of an object
 # (smaller when many objects stand close: `cloud_point_size`).
@@ -77,24 +75,16 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         - predicted_paths (optional)
         - goal_probabilities (optional)
 
-    What is sent does not grow with the number of objects K once the scene is drawn. At
-    each initialisation (`Simulator.Initialize`, after deleting `/task`, so that a second
-    run or a run after `meshcat.Delete()` draws them again) the objects are drawn on small
-    tables (up to `SOLID_OBJECTS`), and every object as one point of the goal cloud
-    `/task/goal_cloud` (`GoalCloud`). Each publish moves the yellow ball above the current
-    `target` and the blue ball above the estimated goal (`selected_goal`; `TaskMarkers`);
-    an orange ring around the hand shows when the operator acts. Each `path_period`
-    (paths change slowly, and a replay interpolates between updates) the `path_count`
-    paths on `predicted_paths` (each `prediction_steps + 1` points, the selected goal's
-    first, as the PBP controller orders them) are drawn as dots (`PathDots`): the first
-    bold `/task/predictions/selected`, the others faint `/task/predictions/likely/{i}`.
-    Each `cloud_period` (less often for thousands of objects, `GoalCloud.period`) the
-    cloud's points take the colour of their goal's probability (`goal_probabilities`, K).
-    All with `time_in_recording`, so that `Meshcat.StartRecording` replays them (a
-    recording keeps the cloud's last colours only: Meshcat records transforms and
-    properties, not objects). The camera (`camera`, `(position, target)`) stands behind
-    and above the HSR, or, given the robot's `workspace` (points `(N, 3)`: an arm's base,
-    start and objects), is framed on it (`workspace_view`). Call from the thread that made
+    At each initialisation (after deleting `/task`) the objects are drawn on small tables
+    (up to `SOLID_OBJECTS`) and as the goal cloud `/task/goal_cloud` (`GoalCloud`), whose
+    colours follow `goal_probabilities` (K) each `cloud_period`. Each publish moves the
+    `TaskMarkers` and shows an orange ring around the hand while the operator acts. Each
+    `path_period` the `path_count` paths on `predicted_paths` (each `prediction_steps + 1`
+    points, the selected goal's first) are drawn as `PathDots`: the first bold
+    `/task/predictions/selected`, the others faint `/task/predictions/likely/{i}`. All with
+    `time_in_recording`, so that a recording replays them. The camera (`camera`,
+    `(position, target)`) stands behind and above the HSR, or is framed on the robot's
+    `workspace` (points `(N, 3)`, `workspace_view`). Call from the thread that made
     `meshcat`.
     """
 

@@ -1,14 +1,10 @@
-"""Meshcat drawing shared by the scene visualizers: a top-down view framed on a 2-D scene,
-paths drawn so that a recording replays them, axis triads for six-DoF poses, and many
-goals as one point cloud coloured by their probabilities.
+"""Meshcat drawing shared by the scene visualizers: a top-down view, paths, axis triads
+and goal clouds.
 
-Meshcat's recordings (`StartRecording`) keep only `SetTransform` and `SetProperty` calls, as
-animation tracks of transforms, positions and visibility; `SetLine` and `SetObject` change the
-page at once and a replay shows their last geometry all along. So a path that changes over
-time is a fixed pool of small spheres (`PathDots`) whose positions are set at each publish,
-a path of poses a pool of triads (`PathTriads`) whose transforms are, and the path travelled
-so far dots shown one by one as it grows, gathered into meshes shown from when they are made
-(`PathTrail`).
+Meshcat's recordings keep only `SetTransform` and `SetProperty` calls (`SetLine` and
+`SetObject` replay their last geometry all along), so a changing path is a fixed pool of
+spheres (`PathDots`) or triads (`PathTriads`) moved at each publish, and the path
+travelled so far dots shown as it grows (`PathTrail`).
 """
 
 import numpy as np
@@ -35,9 +31,8 @@ TRIAD_AXES = (("x", Rgba(1.0, 0.0, 0.0, 1.0), RotationMatrix.MakeYRotation(np.pi
 
 def frame_top_down(meshcat, view):
     """Shows the xy-plane from above in Meshcat, +x to the right and +y up, framed on `view`
-    `(xmin, xmax, ymin, ymax)` (see `core.scene_framing.page_view`), with no background, grid
-    or axes. `SetCameraPose` also sets the orbit controls' target to the view's centre:
-    after `Set2dRenderMode` alone they would turn the camera towards the origin.
+    `(xmin, xmax, ymin, ymax)` (`core.scene_framing.page_view`). `SetCameraPose` also sets
+    the orbit controls' target to the view's centre, which `Set2dRenderMode` alone does not.
     """
     xmin, xmax, ymin, ymax = view
     cx, cy = (xmin + xmax) / 2.0, (ymin + ymax) / 2.0
@@ -105,10 +100,8 @@ class PathDots:
                  self._radius, self._colour)
 
     def show(self, meshcat, path, time=None, lift=0.0):
-        """Spreads the spheres along the polyline `path` `(N, 2 or 3)`, raised by `lift` in z.
-
-        Only positions are set (`SetProperty(..., "position")`): a recording then keeps one
-        track a sphere, half of what `SetTransform` records (position and rotation)."""
+        """Spreads the spheres along the polyline `path` `(N, 2 or 3)`, raised by `lift` in z
+        (positions only: a recording keeps half of what `SetTransform` records)."""
         path = np.atleast_2d(np.asarray(path, dtype=float))
         points = np.zeros((self._count, 3))
         points[:, :path.shape[1]] = resample_by_arc_length(path, self._count)[:, :3]
@@ -122,24 +115,14 @@ class PathTrail:
     `root`, `spacing` apart along it, each shown once the path reaches it. With `time`
     (`time_in_recording`), a replay at time t shows the trail up to t only.
 
-    A page builds every Meshcat object on its own, and hundreds of small spheres kept a page
-    in software rendering busy for seconds: the dots are few objects. The newest, up to
-    `piece` of them, are spheres of their own (`root/dots/i`), shown as they are placed;
-    when there are `piece`, the next placed dot first turns them into one mesh of spheres
-    (`root/pieces/n`, `SetTriangleMesh`), shown from then on, and the spheres are hidden to
-    be used again. A recording keeps no mesh, only when each is shown (a replay has every
-    mesh whole from its start): a piece is hidden from the trail's `draw` to the time it is
-    made, and never changed after.
-
-    After `pieces` pieces, the spacing doubles for the ones to come (the finished ones
-    stay), so that a path however long is a few dozen objects and still runs from the
-    start. A replay interpolates positions between keys: before a sphere moves on, its old
-    position is kept again at the previous `extend`'s time, so that it jumps rather than
-    slides.
-
-    What is drawn is kept here, not in a Drake context (as Drake's own MeshcatVisualizer
-    keeps what it has sent): `draw` starts the trail again, and one simulation at a time
-    may use it."""
+    Hundreds of spheres keep a software-rendered page busy for seconds, so the trail is few
+    objects: the newest `piece` dots are spheres of their own (`root/dots/i`); the next dot
+    first turns them into one mesh (`root/pieces/n`), hidden in a recording until it is
+    made, and the spheres are used again. After `pieces` pieces the spacing doubles for the
+    ones to come, so a path however long is a few dozen objects. A moved sphere's old
+    position is keyed again at the previous `extend`'s time, so a replay jumps it rather
+    than slides it. What is drawn is kept here, not in a Drake context: `draw` starts the
+    trail again, and one simulation at a time may use it."""
 
     def __init__(self, root, radius, colour, spacing, piece=20, pieces=20):
         self.root = root
@@ -149,8 +132,7 @@ class PathTrail:
         self._piece = max(2, int(piece))
         self._pieces_per_spacing = max(1, int(pieces))
         self._positions = [None] * self._piece  # where each sphere was last put
-        # Meshes made under root/pieces, each path used once: a replay of several runs
-        # shows an earlier trail's at their times.
+        # Meshes made under root/pieces, each path used once (a replay shows earlier runs').
         self._made = 0
         self._restart(None)
 
@@ -235,14 +217,11 @@ def cloud_point_size(points, largest):
 
 
 class GoalCloud:
-    """K goals drawn as one Meshcat point cloud at `root` (one object, whatever K), each
-    point coloured by its goal's probability relative to the most probable goal's, from
-    grey (`UNLIKELY_RGB`) to blue (`LIKELY_RGB`).
-
-    `show` sends the cloud again only when a colour changed (colours are bytes, so a
-    change too small to see sends nothing). Its points are `cloud_point_size(points,
-    largest_point_size)` wide. What was sent is kept here, not in a Drake context:
-    `restart` forgets it, and one simulation at a time may use it."""
+    """K goals drawn as one Meshcat point cloud at `root`, each point coloured by its goal's
+    probability relative to the most probable goal's, from grey (`UNLIKELY_RGB`) to blue
+    (`LIKELY_RGB`), `cloud_point_size(points, largest_point_size)` wide. `show` sends the
+    cloud again only when a colour (a byte) changed. What was sent is kept here, not in a
+    Drake context: `restart` forgets it, and one simulation at a time may use it."""
 
     def __init__(self, root, points, largest_point_size):
         self.root = root

@@ -1,6 +1,4 @@
-"""The relay's queue toward a slow page (`pbp_drake.console.front`): Meshcat's messages
-waiting, bounded by what they set (`message_key`), not by time (`PendingMessages`).
-"""
+"""The relay's queue toward a slow page (`pbp_drake.console.front`)."""
 
 import collections
 

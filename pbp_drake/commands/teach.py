@@ -1,11 +1,7 @@
 """`pbp-drake teach FILE --output P.json`: a primitive taught by driving (the grasping task: a
-pose's). The scenario's task runs under teleop with the chosen operator (a person in the
-page presses Start, drives the hand from its start toward a goal and presses Stop; the
-virtual participant drives to its target headless), the hand's path from the start to the
-end of the run is fitted with the scenario's DMP settings (`pbp_drake.core.dmp.primitive`),
-and the primitive is saved, to be named by any scenario's `dmp: {primitive: P.json}`. The
-run's rows are kept beside the primitive (`P.csv`). `--from FILE` teaches from a path already
-recorded (`run --log`, a study trial's CSV, a `run --record` replay) instead.
+pose's), see docs/tasks/teach.md. The task runs under teleop, the hand's path is fitted with
+the scenario's DMP settings (`pbp_drake.core.dmp.primitive`) and saved, the run's rows beside
+it (`P.csv`); `--from FILE` teaches from a recorded path instead.
 """
 
 import argparse
@@ -105,8 +101,8 @@ def _teach(args):
 
 
 def _drive(args, log, switches):
-    """The scenario run under teleop by `args.operator`, its per-tick rows in `log`: the
-    exit code of `pbp-drake run`. A task whose target `switches` keeps one target."""
+    """The exit code of `pbp-drake run` of the scenario under teleop by `args.operator`,
+    its rows in `log`; a task whose target `switches` keeps one target."""
     argv = ["run", args.scenario, "--method", "teleop", "--operator", args.operator,
             "--log", str(log), "--force"]
     if switches:
@@ -156,8 +152,8 @@ def read_hand_path(path):
 
 
 def _replay_hand_path(path):
-    """The hand's path in a replay: the track of the marker the reaching and obstacle tasks'
-    page keeps at the hand (`/task/operator`), its keys in time order, each time once."""
+    """The hand's path in a replay: the track of the marker at the hand (`HAND_MARKER`), in
+    time order, each time once."""
     try:
         times, positions = replay_track(pathlib.Path(path).read_text(), HAND_MARKER,
                                         ".position")

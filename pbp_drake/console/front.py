@@ -177,12 +177,11 @@ def bind_page_port(port, host="localhost"):
     try:
         return socket.create_server((host, port), backlog=64)
     except OSError as error:
-        if error.errno == errno.EADDRINUSE:
-            raise PortError(f"port {port} is in use (use --port 0 for a free one)") from None
-        if error.errno == errno.EACCES:
-            raise PortError(f"port {port} may not be bound by this process "
-                            f"(use --port 0 for a free one)") from None
-        raise
+        why = {errno.EADDRINUSE: "is in use",
+               errno.EACCES: "may not be bound by this process"}.get(error.errno)
+        if why is None:
+            raise
+        raise PortError(f"port {port} {why} (use --port 0 for a free one)") from None
 
 
 def _panel_value(name, value):

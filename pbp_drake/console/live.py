@@ -1,10 +1,8 @@
 """A run, live: the simulation advanced in short slices of simulated time, and between two
 slices (on the thread that made Meshcat) the console's status, the person's choices, the
-sliders, the following camera and the terminal's progress line.
-
-Slices rather than a Simulator monitor: a monitor is called at every plant step (a
-thousand a second), and it sees a const Context, where the alpha slider must write a
-parameter. Between slices the Context is the caller's to change, and nothing runs per step.
+sliders, the following camera and the terminal's progress line. Slices, not a Simulator
+monitor: a monitor runs at every plant step and sees a const Context, where the alpha
+slider must write a parameter.
 """
 
 import math
@@ -72,12 +70,10 @@ class LiveRun:
     button ends the run there: `advance` returns True, and `choice` holds "stop",
     "restart" or "next".
 
-    With `start_label`, the first `advance` shows a Start button of that label and waits
-    for it (`Console.wait_for_start`; Enter on `stdin` or Stop end the run after its first
-    slice, `choice` "stop"). The simulator is initialized by then, so the page has the
-    scene before the button; the real-time pacing restarts at the press. With `gamepad`,
-    a page that has seen no gamepad is told so (`NO_GAMEPAD`, in the console's notice
-    line and on stderr), and told again when one appears.
+    With `start_label`, the first `advance` shows a Start button of that label, once the
+    page has the scene, and waits for it (`Console.wait_for_start`; Enter on `stdin` or
+    Stop end the run after its first slice, `choice` "stop"). With `gamepad`, a page that
+    has seen no gamepad is told so (`NO_GAMEPAD`, in the notice line and on stderr).
     """
 
     def __init__(self, diagram, duration, console=None, progress=None, camera=None,
@@ -126,9 +122,8 @@ class LiveRun:
         return context.get_time() < end_time
 
     def status(self, root_context):
-        """The status line at `root_context`'s time (`pbp_drake.console.text.status_text`):
-        the time left and, from the diagram's `task_monitor` when it has one, the target
-        switches and intervention ratio so far."""
+        """The status line at `root_context`'s time (`status_text`), with the target
+        switches and intervention ratio of the diagram's `task_monitor` when it has one."""
         if self._monitor is None:
             return status_text(self._duration, root_context.get_time())
         status = TaskStatus(self._monitor.get_task_status_output_port().Eval(
@@ -163,14 +158,11 @@ class LiveRun:
         if self._console.wait_for_start(label, stdin=self._stdin) == "stop":
             self.choice = "stop"
             return False
-        # The pacing counts from its last reset: without one, the run would rush through
-        # the seconds the person took to press Start.
-        simulator.ResetStatistics()
+        simulator.ResetStatistics()  # else the run would rush through the wait
         return True
 
     def _check_gamepad(self):
-        """Says, in the page and on stderr, when a gamepad run's page has no pad, or has
-        one again."""
+        """Says when a gamepad run's page has no pad, or has one again."""
         if not self._gamepad:
             return
         seen = self._console.meshcat.GetGamepad().index is not None

@@ -1,11 +1,8 @@
 """The operator's console in a Meshcat page: lines of text, buttons and sliders.
 
-Drake's Meshcat has no text primitive; its control panel shows only the label of each button
-and slider. So, on a bare Meshcat, a line of text is a button labelled with the text
-(clicking it does nothing), replaced when the text changes. Behind the page front
-(`pbp_drake.console.front.PageFront`) the lines go to the front's own panel instead, sent to
-the page as its latest state between the scene's batches: a slow page never shows a stale
-status.
+Drake's Meshcat has no text primitive: on a bare Meshcat a line of text is a button labelled
+with the text (clicking it does nothing), replaced when the text changes. Behind the page
+front (`PageFront`) the lines go to the front's own panel instead.
 """
 
 import select
@@ -22,9 +19,8 @@ RATE_RANGE = (0.1, 3.0, 0.1)
 
 
 class Console:
-    """The controls and status lines of a run in `meshcat`'s page.
-
-    Use it from the thread that created `meshcat` (Meshcat raises from any other).
+    """The controls and status lines of a run in `meshcat`'s page, used from the thread
+    that created `meshcat` (Meshcat raises from any other).
 
     Args:
         meshcat: the page's Meshcat.
@@ -50,7 +46,6 @@ class Console:
         self._meshcat = meshcat
         self._panel = panel
         self._choices = ()
-        self._seen = {}
         self.set_choices(choices)
         self._sliders = []
         if alpha is not None:
@@ -62,8 +57,7 @@ class Console:
             # Widened to hold the rate asked for: the slider must not clip the command line.
             meshcat.AddSlider(RATE_SLIDER, min(low, rate), max(high, rate), step, rate)
             self._sliders.append(RATE_SLIDER)
-        # Line name -> the label shown now, in the order the lines are shown.
-        self._lines = {"title": None, "status": None, "result": None, "notice": None}
+        self._lines = {"title": None, "status": None, "result": None, "notice": None}  # shown
 
     @property
     def meshcat(self):
@@ -86,7 +80,6 @@ class Console:
         self._choices = tuple(choices)
         for choice in self._choices:
             self._meshcat.AddButton(CHOICE_BUTTONS[choice])
-        # Clicks made before (a button of the same name earlier) do not count.
         self._seen = {choice: self._meshcat.GetButtonClicks(CHOICE_BUTTONS[choice])
                       for choice in self._choices}
 
@@ -196,8 +189,8 @@ class Console:
             if line != "status":  # show_status passes the status on with its time
                 self._panel.show(**{line: label})
             return
-        # The control panel lists controls in the order they were added: a changed line
-        # goes back in, and so do the lines below it, to keep the order.
+        # Controls show in the order they were added: the lines below a changed one go back
+        # in after it.
         names = list(self._lines)
         below = names[names.index(line):]
         for name in below:
@@ -210,8 +203,7 @@ class Console:
 
 
 def _entered(stdin, period):
-    """Waits `period` seconds for a line (Enter) on `stdin`, or just waits without one; True
-    when a line came (and was read)."""
+    """Waits `period` seconds for a line (Enter) on `stdin`; True when one came (read)."""
     if stdin is None:
         time.sleep(period)
         return False

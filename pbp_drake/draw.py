@@ -1,10 +1,6 @@
-"""`pbp-drake draw SCENARIO`: the scenario's system diagram as SVG, drawn by graphviz.
-
-The diagram is the one `pbp_drake.builder.build_diagram(scenario)` builds (headless), from
-Drake's `Diagram.GetGraphvizString()`, laid out top to bottom by graphviz's `dot` (Debian's
-`graphviz` package), so that it reads at a page's width. The same scenario always gives the
-same bytes (`dot_source`): the drawings in `diagrams/` are checked in beside their YAML, a
-test fails when one is out of date, and `make diagrams` redraws them.
+"""`pbp-drake draw SCENARIO`: the system diagram `build_diagram(scenario)` builds, as SVG
+laid out top to bottom by graphviz's `dot`. The same scenario gives the same bytes: the
+drawings in `diagrams/` are checked in beside their YAML, and `make diagrams` redraws them.
 """
 
 import argparse
@@ -61,8 +57,7 @@ _INPUT = re.compile(r'PORT="u\d+" BORDER="1" >')
 
 def _sources_beside_their_reader(text):
     """Each block without inputs whose outputs all go to one block (the task's goals into
-    the controller) drawn in that block's rank, beside it, not in a row of its own above
-    the diagram, which widened the drawing by the source's width."""
+    the controller) drawn beside that block, not in a row of its own above the diagram."""
     # Drake draws an empty grey cell where a block has no input.
     inputless = {match.group(1) for match in _NODE.finditer(text)
                  if not _INPUT.search(match.group(0))}
@@ -105,10 +100,9 @@ _WIDTH = re.compile(rb'<svg width="([\d.]+)pt"')
 
 
 def _narrowest(source):
-    """`render_svg(source)` with the set of source-beside-its-reader ranks
-    (`_sources_beside_their_reader`, a handful) that draws narrowest: a row already full
-    (the operator's, beside the station) only grows with a source in it. Ties keep more
-    ranks."""
+    """`render_svg(source)` with the subset of `_sources_beside_their_reader`'s ranks (a
+    handful) that draws narrowest (a full row only grows with a source in it); ties keep
+    more ranks."""
     ranks = _RANK.findall(source)
     best = None
     for dropped in range(len(ranks) + 1):

@@ -162,13 +162,13 @@ def check_primitive_path(path, force=False):
     _check_output_file(path, "--output", "primitive.json", _is_primitive, "a primitive", force)
 
 
-def check_figure_path(path, flag="--figure"):
-    """Raises OutputPathError unless `path` can take a figure: a .png, .svg or .pdf file
-    (an existing one is drawn over) whose folder exists or can be made, writable."""
+def check_figure_path(path):
+    """Raises OutputPathError unless `path` can take a figure (`--figure`): a writable .png,
+    .svg or .pdf file (an existing one is drawn over)."""
     file = pathlib.Path(path)
     if file.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise OutputPathError(f"{flag} {file}: a figure is a .png, .svg or .pdf file")
-    _check_output_file(file, flag, "primitive.png", None, "a figure", force=True)
+        raise OutputPathError(f"--figure {file}: a figure is a .png, .svg or .pdf file")
+    _check_output_file(file, "--figure", "primitive.png", None, "a figure", force=True)
 
 
 def _is_primitive(path):  # as `pbp-drake teach` writes it (json.dumps' separators)
@@ -203,17 +203,17 @@ def _is_time_series(path):
                     time_series_header(False, has_grasp=True))
 
 
-def check_output_folder(path, option="--output"):
+def check_output_folder(path):
     """Raises OutputPathError unless `path` is a writable folder or can be made one."""
     output = pathlib.Path(path)
     if output.exists() and not output.is_dir():
-        raise OutputPathError(f"{option} {output}: is a file, not a folder; give a folder "
+        raise OutputPathError(f"--output {output}: is a file, not a folder; give a folder "
                               f"for the results")
     if output.is_dir():
         if not os.access(output, os.W_OK | os.X_OK):
-            raise OutputPathError(f"{option} {output}: the folder is not writable")
+            raise OutputPathError(f"--output {output}: the folder is not writable")
         return
-    _check_can_create(output, f"{option} {output}")
+    _check_can_create(output, f"--output {output}")
 
 
 def _check_can_create(folder, what):

@@ -7,7 +7,7 @@ import sys
 
 from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
-from pbp_drake.commands.run_checks import check_run_flags, is_person
+from pbp_drake.commands.run_checks import check_run_flags
 from pbp_drake.commands.run_page import add_page_flags, open_page
 from pbp_drake.commands.scenario_flags import (
     add_goals_flag, add_hardware_flags, add_override_flags, add_shorthand_flags,
@@ -168,8 +168,7 @@ def _run(args):
         meshcat, page = open_page(listening, args)
     try:
         if args.participant is not None:
-            return run_session_command(args, resolved, meshcat, page,
-                                       is_person(resolved.scenario))
+            return run_session_command(args, resolved, meshcat, page)
         if resolved.has_task:
             return run_task_loop(args, resolved, meshcat, page)
         return run_scene(args, resolved, meshcat, page)

@@ -8,7 +8,7 @@ import sys
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.cli_types import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS
-from pbp_drake.commands.run_checks import session_methods
+from pbp_drake.commands.run_checks import is_person, session_methods
 from pbp_drake.commands.run_page import (
     PAGE_ENDED, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
     wait_for_browser)
@@ -43,7 +43,7 @@ def add_session_flags(parser, hidden=False):
         "page)"))
 
 
-def run_session_command(args, resolved, meshcat, page, person):
+def run_session_command(args, resolved, meshcat, page):
     """The session of `args.participant` on the resolved scenario; its exit code."""
     scenario = resolved.scenario
     methods, order = session_methods(args, scenario)  # checked by check_run_flags
@@ -61,7 +61,8 @@ def run_session_command(args, resolved, meshcat, page, person):
         print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
               "each method starts when its Start is pressed in the page, and the questions "
               "and Next are buttons there too (Open Controls).", flush=True)
-        wait_for_browser(page, args.wait_for_browser, PERSON_NEEDS_PAGE if person else
+        wait_for_browser(page, args.wait_for_browser,
+                         PERSON_NEEDS_PAGE if is_person(scenario) else
                          "the session's Start buttons and questions are in the page, so "
                          "nothing was run or saved")
 
@@ -73,7 +74,7 @@ def run_session_command(args, resolved, meshcat, page, person):
                else page_console(meshcat, page, args, alpha_of(scenario)))
 
     def run_one(trial):
-        # Shown again after a Restart: each run of the method starts at its Start.
+        # Kept through a Restart: each run of the method starts at its Start.
         start_button = (questions.take_start_label()
                         if isinstance(questions, _StartInTheRun) else None)
         while True:
@@ -126,9 +127,8 @@ class _SessionStopped(Exception):
 
 
 class _StartInTheRun:
-    """A session's pages in Meshcat (`MeshcatSessionPage`) whose Start is pressed inside the
-    run, once the run's scene is in the page, rather than before the run is built: `start`
-    only keeps the label, which the run's `LiveRun` shows (`take_start_label`). With
+    """`MeshcatSessionPage` whose Start is pressed inside the run, once its scene is in the
+    page: `start` keeps the label for the run's `LiveRun` (`take_start_label`); with
     `--start-on-connect`, Start is a page of its own between the runs."""
 
     def __init__(self, pages, start_between_runs=False):

@@ -66,10 +66,9 @@ def run_session_command(args, resolved, meshcat, page):
                          "the session's Start buttons and questions are in the page, so "
                          "nothing was run or saved")
 
-    # The live status and Stop, Restart, Next scene, as in a single run. Within a session,
-    # Stop ends it (resumable, like Ctrl-C), Restart runs the method again (the stopped run
-    # is not saved), and Next scene ends this method's run as it stands (saved, not a
-    # success) and goes on to its questions: the next scene of a session is the next run.
+    # Stop ends the session (resumable), Restart runs the method again (the stopped run is
+    # not saved), Next scene ends this method's run as it stands (saved, not a success) and
+    # goes on to its questions.
     console = (None if page is None
                else page_console(meshcat, page, args, alpha_of(scenario)))
 
@@ -80,8 +79,7 @@ def run_session_command(args, resolved, meshcat, page):
         while True:
             diagram = build_diagram(trial, meshcat)
             if console is not None:
-                # After the operator's buttons; and clicks made between runs (on the
-                # questions) do not count.
+                # After the operator's buttons; clicks made on the questions do not count.
                 console.set_choices(RUN_CHOICES)
             result, live = run_task_once(args, trial, diagram, meshcat, console,
                                          start_button=start_button)

@@ -193,12 +193,10 @@ def _method_study(args, scenario_file, overrides):
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {} "
                             "(--set 'operator=!VirtualParticipant {}')")
-    if args.methods is not None:
-        study = dataclasses.replace(study, methods=method_list(args.methods))
-    if args.trials is not None:
-        study = dataclasses.replace(study, trials=args.trials)
-    if args.split is not None:
-        study = dataclasses.replace(study, split=args.split)
+    flags = {"methods": None if args.methods is None else method_list(args.methods),
+             "trials": args.trials, "split": args.split}
+    study = dataclasses.replace(study, **{name: value for name, value in flags.items()
+                                          if value is not None})
     seed = first_seed(study, study.split) if args.seed is None else args.seed
     split = split_of(study, seed, study.trials)
     if args.jobs < 1:
@@ -280,10 +278,9 @@ def _failed_trials(summary, output, where=None):
 
 def _failed_matrix_trials(summary, output):
     """`_failed_trials` of each pilot of a matrix: 1 when any pilot's are."""
-    failed = [_failed_trials({**summary, **pilot}, pilot_folder(output, name),
-                             f"under the pilot {name}")
-              for name, pilot in summary["pilots"].items()]
-    return max(failed)
+    return max(_failed_trials({**summary, **pilot}, pilot_folder(output, name),
+                              f"under the pilot {name}")
+               for name, pilot in summary["pilots"].items())
 
 
 def _print_matrix_report(summary, output):

@@ -67,8 +67,7 @@ def _teach(args):
                             "whose demonstration is scenario.demonstration")
     origin = args.source
     if origin is None:
-        # The drive's rows are kept beside the primitive: a person's demonstration is not
-        # to be driven twice.
+        # Kept beside the primitive: a person's demonstration is not to be driven twice.
         origin = str(pathlib.Path(args.output).with_suffix(".csv"))
         check_log_path(origin, force=args.force)
         code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"))

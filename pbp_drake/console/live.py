@@ -14,8 +14,7 @@ from pbp_drake.builder.run import advance_to
 from pbp_drake.console.text import progress_text, status_text
 from pbp_drake.systems.ports import TaskStatus
 
-# Simulated seconds between two looks at the page: 20 a second at real time, so that the
-# robot camera moves smoothly and a click ends the run within a twentieth of a second.
+# Simulated seconds between two looks at the page: a smooth camera, a click felt at once.
 SLICE_SECONDS = 0.05
 # Wall seconds between two status lines: the page redraws its panel at each.
 STATUS_PERIOD = 0.25
@@ -26,15 +25,14 @@ GAMEPAD_FOUND = "Gamepad found: it drives now."
 
 
 class Progress:
-    """The terminal's progress line: rewritten in place with a carriage return every
-    quarter second when `stream` is a terminal, a new line every `line_period` seconds
-    otherwise (a log file, a pipe)."""
+    """The terminal's progress line: rewritten in place every quarter second when `stream`
+    is a terminal, a new line every 5 s otherwise (a log file, a pipe)."""
 
-    def __init__(self, duration, stream=None, line_period=5.0):
+    def __init__(self, duration, stream=None):
         self._stream = stream or sys.stdout
         self._duration = float(duration)
         self._tty = self._stream.isatty()
-        self._period = 0.25 if self._tty else float(line_period)
+        self._period = 0.25 if self._tty else 5.0
         self._last = time.monotonic()  # the first line one period in, not at t = 0
         self._width = 0
 
@@ -142,8 +140,8 @@ class LiveRun:
         self.choice = self._console.choice()
         self._apply_sliders(simulator)
         self._check_gamepad()
-        # A panel keeps only the latest line, which goes to the page as its latest state:
-        # every slice's. Button labels are messages the page handles in turn: a few a second.
+        # A panel sends the page only its latest state: every slice's. Button labels are
+        # messages the page handles in turn: a few a second.
         if (self._console.panel is not None
                 or time.monotonic() - self._last_status >= STATUS_PERIOD):
             self._last_status = time.monotonic()
@@ -181,6 +179,4 @@ class LiveRun:
         if (rate := self._console.realtime_rate()) != self._rate:
             self._rate = rate
             simulator.set_target_realtime_rate(rate)
-            # The pacing counts from its last reset: without one, a faster rate would rush
-            # to catch up on the past at the new rate, a slower one would stall.
-            simulator.ResetStatistics()
+            simulator.ResetStatistics()  # else the pacing would catch up on the past

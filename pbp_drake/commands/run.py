@@ -85,9 +85,8 @@ def _add_common_flags(parser):
 
 
 def scenario_for_run(args):
-    """The scenario file of `args` with the command line's overrides, resolved: its fields
-    (`--set`, `--scenario-text` and their shorthands, `--goals` one of them) as the file's,
-    then `--scene`, which places the obstacles of a scene of the file's study."""
+    """The scenario file of `args` with the command line's overrides, resolved; `--scene`
+    then places the obstacles of a scene of the file's study."""
     scenario_file = load_scenario_file(args.scenario, scenario_overrides(args))
     scenario = scenario_file.scenario
     if args.alpha is not None and not METHODS[scenario.method].takes_weight:
@@ -116,8 +115,8 @@ def scenario_for_run(args):
 
 
 def _standing_where_the_arm_stands(scenario):
-    """`scenario` whose arm starts where its driver's first status says it stands (never
-    where the file assumes): its ready configuration those joint positions."""
+    """`scenario` whose arm starts, and is ready, where its driver's first status says it
+    stands (never where the file assumes)."""
     robot = scenario.robot
     try:
         q = measured_ready_positions(robot.station_config())

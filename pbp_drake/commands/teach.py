@@ -126,9 +126,8 @@ def _drive(args, log, switches):
 
 def read_hand_path(path):
     """Times (T,), hand positions (T, 3) and orientations (T, 4; None where the recording
-    has none) of a run's or trial's CSV, or of a run's replay (`run --record`: the hand's
-    positions as its page drew them, at the recording's frame rate); ScenarioError naming
-    the file for one that cannot be read or has no hand path."""
+    has none) of a run's or trial's CSV, or of a run's replay (`run --record`, at its frame
+    rate); ScenarioError naming the file for one that cannot be read or has no hand path."""
     if is_replay(path):
         return _replay_hand_path(path)
     try:

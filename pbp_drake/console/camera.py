@@ -32,10 +32,9 @@ def behind_head_view(head_position, yaw, behind=BEHIND, above=ABOVE, ahead=AHEAD
 
 
 class RobotCamera:
-    """Keeps `meshcat`'s camera above and behind the HSR's head: `update(root_context)`
-    reads the robot's `state` off `station` (an HSR station inside the diagram whose root
-    context is given, dynamic or kinematic), places the head and the base with the
-    station's plant and sets the camera (`behind_head_view`). Use from Meshcat's thread."""
+    """Keeps `meshcat`'s camera above and behind the head of the HSR `station` (dynamic or
+    kinematic): `update(root_context)` reads its `state` and sets the camera
+    (`behind_head_view`). Use from Meshcat's thread."""
 
     def __init__(self, meshcat, station, head_body="head_link", base_body="base_link"):
         self._meshcat = meshcat

@@ -33,12 +33,9 @@ class Console:
         panel: where the lines go instead of button labels: an object with `show(**lines)`
             taking `title`, `status`, `result` and `time` (a `PageFront`), or None.
 
-    The page's control panel then shows, top to bottom (below buttons others added, the
-    keyboard operator's): the choice buttons, the sliders, the title line (`show_title`),
-    the status line (`show_status`), the result line (`show_result`) and the notice
-    (`show_notice`). The person's choice is read with `choice()` (at once) or
-    `wait_for_choice()` (blocking). A session that keeps one page for many runs makes one
-    Console and calls `show_title` / `show_status` / `clear_result` between runs.
+    The control panel shows, top to bottom (below buttons others added): the choice
+    buttons, the sliders, then the lines of `show_title`, `show_status`, `show_result` and
+    `show_notice`. `choice()` reads the person's choice at once, `wait_for_choice()` waits.
     """
 
     def __init__(self, meshcat, choices=("stop", "restart", "next"), alpha=None,
@@ -88,16 +85,14 @@ class Console:
         self._show("title", text)
 
     def show_status(self, text, time=None):
-        """The live line under the title, e.g. `pbp_drake.console.text.status_text(...)`,
-        of simulated `time` (seconds; the panel passes it on to the page). Unchanged text
-        sends nothing to a bare Meshcat."""
+        """The live line under the title, e.g. `status_text(...)`, of simulated `time`
+        (seconds; the panel passes it on to the page)."""
         if self._panel is not None:
             self._panel.show(status=text, time=time)
         self._show("status", text)
 
     def show_result(self, text):
-        """The last line, e.g. `pbp_drake.console.text.result_text(...)`, shown as
-        "Result: <text>"."""
+        """The line under the status, e.g. `result_text(...)`, as "Result: <text>"."""
         self._show("result", f"Result: {text}")
 
     def clear_result(self):
@@ -109,8 +104,7 @@ class Console:
         self._show("notice", text)
 
     def remove_controls(self):
-        """Removes the choice buttons and the sliders, keeping the lines: the run's page
-        once nothing answers them."""
+        """Removes the choice buttons and the sliders, keeping the lines."""
         self.set_choices(())
         for name in self._sliders:
             self._meshcat.DeleteSlider(name, strict=False)

@@ -436,16 +436,15 @@ class PageFront:
             with self._lock:
                 body = json.dumps(self._state).encode()
             return _response(200, body, "application/json", ("Cache-Control", "no-store"))
-        if path not in self._files:
+        found = self._files.get(path)
+        if found is None:
             try:  # a mesh's or texture's file, at its content address
                 found = await asyncio.to_thread(self._door.get, path)
             except (OSError, ValueError, http.client.HTTPException):
                 return _response(404, b"Not found\n", "text/plain; charset=utf-8")
-            if not path.startswith("/cas-v1/"):
-                return _response(200, *found, ("Cache-Control", "no-cache"))
-            self._files[path] = found
-        body, content_type = self._files[path]
-        return _response(200, body, content_type, ("Cache-Control", "no-cache"))
+            if path.startswith("/cas-v1/"):
+                self._files[path] = found
+        return _response(200, *found, ("Cache-Control", "no-cache"))
 
     async def _relay(self, page):
         """One page's relay: a connection to Meshcat of its own (through the door), closed

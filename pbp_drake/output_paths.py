@@ -221,9 +221,7 @@ def _check_can_create(folder, what):
     folder."""
     folder = pathlib.Path(os.path.abspath(folder))
     ancestor = folder
-    while not ancestor.exists():
-        if ancestor.parent == ancestor:
-            break
+    while not ancestor.exists() and ancestor.parent != ancestor:
         ancestor = ancestor.parent
     if not ancestor.is_dir():
         raise OutputPathError(f"{what}: {ancestor} is a file, so its folder cannot be made")

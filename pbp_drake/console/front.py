@@ -130,10 +130,8 @@ body.pbp-ended #status-message { display: none !important; }
       .catch(function () { if (served) end(shown); })
       .finally(function () { if (!ended) setTimeout(poll, 1000); });
   }
-  // The relay's text frames: the panel's state, sent with the scene (a fetch's chain of
-  // tasks waits behind every frame of a slow page); and the end of a batch, answered at
-  // the next animation frame, so that the page never has more of the scene to handle
-  // than it can draw.
+  // The relay's text frames: the panel's state (a poll would wait behind a slow page's
+  // frames), and the end of a batch, answered at the next animation frame.
   var handle_meshcat_message = handle_message;
   handle_message = function (message) {
     if (typeof message.data !== "string") return handle_meshcat_message(message);

@@ -55,7 +55,7 @@ def run_session_command(args, resolved, meshcat, page):
     if args.answers is not None:
         questions = FixedAnswers(parse_answers(args.answers, methods))
     else:
-        questions = _StartInTheRun(MeshcatSessionPage(meshcat), args.start_on_connect)
+        questions = _StartInTheRun(meshcat, args.start_on_connect)
     if page is not None and isinstance(questions, _StartInTheRun):
         # The pages are the person's: no browser, no session (`--answers` needs none).
         print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
@@ -124,28 +124,22 @@ class _SessionStopped(Exception):
     """Stop pressed in the page during a session's run: the session ends, resumable."""
 
 
-class _StartInTheRun:
+class _StartInTheRun(MeshcatSessionPage):
     """`MeshcatSessionPage` whose Start is pressed inside the run, once its scene is in the
     page: `start` keeps the label for the run's `LiveRun` (`take_start_label`); with
     `--start-on-connect`, Start is a page of its own between the runs."""
 
-    def __init__(self, pages, start_between_runs=False):
-        self._pages = pages
+    def __init__(self, meshcat, start_between_runs=False):
+        super().__init__(meshcat)
         self._start_between_runs = start_between_runs
         self._label = None
 
     def start(self, method, position, total, practice=False):
         if self._start_between_runs:
-            self._pages.start(method, position, total, practice)
+            super().start(method, position, total, practice)
         else:
             self._label = start_label(method, position, total, practice)
 
     def take_start_label(self):
         label, self._label = self._label, None
         return label
-
-    def answer(self, method, question):
-        return self._pages.answer(method, question)
-
-    def next(self, position, total):
-        self._pages.next(position, total)

@@ -1,8 +1,8 @@
 """What a run's page may send Meshcat: the messages Meshcat's own page sends, read strictly.
 
 Meshcat's websocket thread, and the run with it, dies on a frame that is not msgpack; so the
-page front reads each frame here first (`read_page_message`, see docs/design.md ("The
-page")) and hands Meshcat a fresh encoding; anything else is a `BadMessage`. The messages:
+page front reads each frame here first (`read_page_message`, docs/design.md ("The page"))
+and hands Meshcat a fresh encoding of one of these messages; any other is a `BadMessage`:
 
 - `{"type": "button", "name": N}`: a button clicked, or its key pressed;
 - `{"type": "slider", "name": N, "value": x}`: a slider moved (x finite);

@@ -315,8 +315,8 @@ def _compare(args):
 
 
 def _report(args):
-    """`report` of a study folder, a matrix's or a folder of participant folders; the exit
-    codes are the `report` command's help's."""
+    """`report` of a study folder, a matrix's or a folder of participant folders, with the
+    exit codes the command's help gives."""
     output = pathlib.Path(args.output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)

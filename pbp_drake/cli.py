@@ -1,8 +1,5 @@
-"""The `pbp-drake` command line: `run` one scenario in Meshcat, `session` a participant's
-session of a user study, `study` a scenario file, `report` a study folder, `compare` two,
-`teach` a primitive by driving, `driver-sim` a robot's driver, `bench` the DMP bank, `draw`
-a system diagram. Each subcommand lives in
-`pbp_drake.commands`, but `bench`: the package `pbp_drake_bench`, beside `pbp_drake`."""
+"""The `pbp-drake` command line. Its subcommands live in `pbp_drake.commands`, but `draw`
+(`pbp_drake.draw`) and `bench` (the package `pbp_drake_bench`)."""
 
 import argparse
 import os
@@ -23,13 +20,11 @@ def main(argv=None):
     """Runs the command line `argv` (default: sys.argv[1:]); returns the exit code."""
     try:
         code = _main(argv)
-        # Inside the try: a closed pipe (`pbp-drake report DIR | head`) shows here, not
-        # at the interpreter's last flush, where it would print an "Exception ignored".
-        sys.stdout.flush()
+        sys.stdout.flush()  # a closed pipe (`| head`) shows here, not at the last flush
         return code
     except BrokenPipeError:
-        # As the Python docs recommend (signal module, "Note on SIGPIPE"): point stdout at
-        # devnull, so that the interpreter's last flush does not fail again, and exit quietly.
+        # As the Python docs recommend (signal module, "Note on SIGPIPE"): the interpreter's
+        # last flush goes to devnull.
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 1
@@ -40,8 +35,8 @@ def main(argv=None):
 
 
 def build_parser():
-    """The argument parser of `pbp-drake`. `bench` and `draw` appear in it as stubs that
-    take the rest of the line: their own parsers are `tool_parsers()`."""
+    """The argument parser of `pbp-drake`; `bench` and `draw` are stubs that take the rest
+    of the line (their parsers: `tool_parsers()`)."""
     parser = argparse.ArgumentParser(
         prog="pbp-drake",
         description="Policy Blending with Primitives (PBP): shared control on Drake.")
@@ -52,8 +47,6 @@ def build_parser():
     add_study_commands(commands)
     add_driver_sim_command(commands)
     add_teach_command(commands)
-
-    # Their own argument parsers live with them; the rest of the line is passed on.
     for name, help_text in [("bench", "time the DMP bank against the DMP libraries people "
                                       "use (pbp-drake bench --help)"),
                             ("draw", "write a scenario's system diagram as SVG "

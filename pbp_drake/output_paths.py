@@ -23,11 +23,10 @@ REPLAY_MARKER = "<!-- pbp-drake replay (pbp-drake run --record) -->"
 _MARKER_WINDOW = 4096  # bytes read from the top of an existing file to find the marker
 
 # Meshcat's StaticHtml makes its viewer on this line, then decodes its commands, the
-# recording (`set_animation`) last, asynchronously; loading the recording plays it at once.
+# recording last; loading the recording plays it at once.
 _VIEWER_LINE = re.compile(r'^[ \t]*var viewer = new MeshCat\.Viewer\(.*\);[ \t]*$', re.M)
-# Put just after that line, before any command is decoded: the animator's `load` plays the
-# recording, which makes its tracks act on the scene (StaticHtml's scene is the run's last
-# state), then it is paused and shown at 0 s, so that the replay waits for its viewer.
+# Put just after that line: the recording, once loaded (its tracks then act on the scene),
+# is paused and shown at 0 s, so that the replay waits for its viewer.
 PAUSED_AT_START = """
     // pbp-drake: the replay starts paused at 0 s (Meshcat would play it once loaded).
     (function () {
@@ -63,10 +62,9 @@ def recorded_replay(meshcat):
 
 def mark_replay(html):
     """The replay `html` (Meshcat's StaticHtml) as `pbp-drake run --record` saves it: with
-    REPLAY_MARKER; starting paused at 0 s (PAUSED_AT_START: a page that loads slowly would
-    miss a short run), with a line saying how to play it; and, for a 2-D scene, a key of
-    its colours (SCENE_2D_LEGEND: Meshcat has no text). A page without Meshcat's viewer
-    line keeps its playback (and gets no hint)."""
+    REPLAY_MARKER; paused at 0 s (a page that loads slowly would miss a short run), with a
+    line saying how to play it, when it has Meshcat's viewer line; and, for a 2-D scene, a
+    key of its colours (SCENE_2D_LEGEND: Meshcat has no text)."""
     viewer_line = _VIEWER_LINE.search(html)
     if viewer_line:
         html = html[:viewer_line.end()] + PAUSED_AT_START + html[viewer_line.end():]
@@ -108,8 +106,7 @@ def _css_colour(colour):
 def replay_track(html, path, track):
     """`(times (T,), values (T, ...))` of the animation track `track` (e.g. ".position") of
     the Meshcat `path` in a replay's recording, times in seconds; ValueError when the page
-    records none (Meshcat keeps a recording as one `set_animation` command, its clips'
-    keys by frame)."""
+    records none."""
     for payload in _PAYLOAD.findall(html):
         data = base64.b64decode(payload)
         if b"set_animation" not in data:
@@ -138,7 +135,7 @@ def is_replay(path):
 
 
 def _head_holds(path, marker):
-    """Whether the first bytes of the file at `path` hold `marker` (False if unreadable)."""
+    """Whether the first bytes of the file at `path` hold `marker`."""
     try:
         with open(path, "rb") as stream:
             head = stream.read(_MARKER_WINDOW)
@@ -165,24 +162,22 @@ def check_primitive_path(path, force=False):
     _check_output_file(path, "--output", "primitive.json", _is_primitive, "a primitive", force)
 
 
-def check_figure_path(path, flag="--figure"):
-    """Raises OutputPathError unless `path` can take a figure: a .png, .svg or .pdf file
-    (an existing one is drawn over) whose folder exists or can be made, writable."""
+def check_figure_path(path):
+    """Raises OutputPathError unless `path` can take a figure (`--figure`): a writable .png,
+    .svg or .pdf file (an existing one is drawn over)."""
     file = pathlib.Path(path)
     if file.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise OutputPathError(f"{flag} {file}: a figure is a .png, .svg or .pdf file")
-    _check_output_file(file, flag, "primitive.png", None, "a figure", force=True)
+        raise OutputPathError(f"--figure {file}: a figure is a .png, .svg or .pdf file")
+    _check_output_file(file, "--figure", "primitive.png", None, "a figure", force=True)
 
 
-def _is_primitive(path):
-    # As `pbp-drake teach` writes it (json.dumps' separators).
+def _is_primitive(path):  # as `pbp-drake teach` writes it (json.dumps' separators)
     return _head_holds(path, f'"format": "{PRIMITIVE_FORMAT}"'.encode())
 
 
 def _check_output_file(path, flag, example, is_ours, kind, force):
-    """The checks of an output file: `path` is not a folder (`example` names a file in it),
-    it or its folder (existing or to be made) is writable, and an existing file there is
-    one `is_ours` recognises (`kind`, written by pbp-drake) or `force` is set."""
+    """`path` is not a folder (`example`: a file in it), it or its folder is writable, and
+    a file there is one `is_ours` recognises (`kind`) or `force` is set."""
     file = pathlib.Path(path)
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
@@ -208,27 +203,25 @@ def _is_time_series(path):
                     time_series_header(False, has_grasp=True))
 
 
-def check_output_folder(path, option="--output"):
+def check_output_folder(path):
     """Raises OutputPathError unless `path` is a writable folder or can be made one."""
     output = pathlib.Path(path)
     if output.exists() and not output.is_dir():
-        raise OutputPathError(f"{option} {output}: is a file, not a folder; give a folder "
+        raise OutputPathError(f"--output {output}: is a file, not a folder; give a folder "
                               f"for the results")
     if output.is_dir():
         if not os.access(output, os.W_OK | os.X_OK):
-            raise OutputPathError(f"{option} {output}: the folder is not writable")
+            raise OutputPathError(f"--output {output}: the folder is not writable")
         return
-    _check_can_create(output, f"{option} {output}")
+    _check_can_create(output, f"--output {output}")
 
 
 def _check_can_create(folder, what):
-    """Raises OutputPathError unless `folder` is, or can be made, a writable folder: its
-    nearest existing ancestor must be a writable folder."""
+    """Raises OutputPathError unless `folder`'s nearest existing ancestor is a writable
+    folder."""
     folder = pathlib.Path(os.path.abspath(folder))
     ancestor = folder
-    while not ancestor.exists():
-        if ancestor.parent == ancestor:
-            break
+    while not ancestor.exists() and ancestor.parent != ancestor:
         ancestor = ancestor.parent
     if not ancestor.is_dir():
         raise OutputPathError(f"{what}: {ancestor} is a file, so its folder cannot be made")

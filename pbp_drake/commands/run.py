@@ -7,7 +7,7 @@ import sys
 
 from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
-from pbp_drake.commands.run_checks import check_run_flags, is_person
+from pbp_drake.commands.run_checks import check_run_flags
 from pbp_drake.commands.run_page import add_page_flags, open_page
 from pbp_drake.commands.scenario_flags import (
     add_goals_flag, add_hardware_flags, add_override_flags, add_shorthand_flags,
@@ -85,9 +85,8 @@ def _add_common_flags(parser):
 
 
 def scenario_for_run(args):
-    """The scenario file of `args` with the command line's overrides, resolved: its fields
-    (`--set`, `--scenario-text` and their shorthands, `--goals` one of them) as the file's,
-    then `--scene`, which places the obstacles of a scene of the file's study."""
+    """The scenario file of `args` with the command line's overrides, resolved; `--scene`
+    then places the obstacles of a scene of the file's study."""
     scenario_file = load_scenario_file(args.scenario, scenario_overrides(args))
     scenario = scenario_file.scenario
     if args.alpha is not None and not METHODS[scenario.method].takes_weight:
@@ -116,8 +115,8 @@ def scenario_for_run(args):
 
 
 def _standing_where_the_arm_stands(scenario):
-    """`scenario` whose arm starts where its driver's first status says it stands (never
-    where the file assumes): its ready configuration those joint positions."""
+    """`scenario` whose arm starts, and is ready, where its driver's first status says it
+    stands (never where the file assumes)."""
     robot = scenario.robot
     try:
         q = measured_ready_positions(robot.station_config())
@@ -168,8 +167,7 @@ def _run(args):
         meshcat, page = open_page(listening, args)
     try:
         if args.participant is not None:
-            return run_session_command(args, resolved, meshcat, page,
-                                       is_person(resolved.scenario))
+            return run_session_command(args, resolved, meshcat, page)
         if resolved.has_task:
             return run_task_loop(args, resolved, meshcat, page)
         return run_scene(args, resolved, meshcat, page)

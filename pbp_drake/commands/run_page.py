@@ -1,5 +1,5 @@
 """The page of `pbp-drake run` and `session`: its flags, the private Meshcat behind it, the
-wait for a browser before a run and the result kept served after it."""
+wait for a browser before a run and the result kept after it."""
 
 import logging
 import pathlib
@@ -50,9 +50,16 @@ def add_page_flags(parser):
 
 
 def open_page(listening, args):
-    """The private Meshcat and, with `listening` (the page's bound socket), the page people
-    open in front of it: `(meshcat, page)`, page None without a socket."""
-    meshcat = private_meshcat()
+    """`(meshcat, page)`: a Meshcat on a random free localhost port that nobody is told of
+    (Drake's `port=None` takes the first free one from 7000, easy to guess) and, with
+    `listening` (the page's bound socket), the page front people open; else page None."""
+    drake_log = logging.getLogger("drake")
+    level = drake_log.level
+    drake_log.setLevel(logging.WARNING)  # not Drake's line announcing the private URL
+    try:
+        meshcat = Meshcat(MeshcatParams(host="localhost", port=0))
+    finally:
+        drake_log.setLevel(level)
     if listening is None:
         return meshcat, None
     page = PageFront(meshcat.port(), listening, token=args.token)
@@ -60,30 +67,16 @@ def open_page(listening, args):
     return meshcat, page
 
 
-def private_meshcat():
-    """Meshcat on a random free localhost port that nobody is told of (the page front
-    relays to it; Drake's `port=None` would take the first free one from 7000, easy to
-    guess), without Drake's line announcing its URL."""
-    drake_log = logging.getLogger("drake")
-    level = drake_log.level
-    drake_log.setLevel(logging.WARNING)
-    try:
-        return Meshcat(MeshcatParams(host="localhost", port=0))
-    finally:
-        drake_log.setLevel(level)
-
-
 def page_console(meshcat, page, args, alpha, choices=RUN_CHOICES):
     """The page's console: its lines in the front's panel, the choices, the alpha slider
-    (`alpha`: fixed_alpha's weight, None for none) and the real-time rate slider."""
+    (`alpha`, None for none) and the real-time rate slider."""
     return Console(meshcat, choices, alpha=alpha, realtime_rate=args.realtime_rate,
                    panel=page)
 
 
 def keep_page(args, page, console, choices):
-    """After a run, with a page open: the result stays served until the person closes the
-    page, presses one of `choices` (Close, and after a single run Restart and Next scene),
-    presses Enter in a terminal, or --keep-page seconds pass. Returns the choice, or None."""
+    """After a run: the result stays served until the person closes the page, presses one of
+    `choices` or Enter in a terminal, or --keep-page seconds pass; the choice, or None."""
     if page.pages() == 0:
         return None
     console.set_choices(choices)
@@ -98,17 +91,16 @@ def keep_page(args, page, console, choices):
 
 
 def end_page(page, console, text=PAGE_ENDED):
-    """The command is done: the page says so, with no button or slider left that nothing
-    answers (the operator's keys are the caller's: `task_runs.delete_operator`)."""
+    """The command is done: the page says so, its buttons and sliders gone (the operator's
+    are the caller's: `task_runs.delete_operator`)."""
     if console is not None:
         console.remove_controls()
     page.end(text)
 
 
 def wait_for_browser(page, seconds, needed=None):
-    """Waits up to `seconds` for a browser on the page. A run that cannot go on without one
-    (a person's, a session's: `needed` says why) stops with exit 2 before anything runs or
-    is recorded."""
+    """Waits up to `seconds` for a browser on the page; a run that cannot go on without one
+    (`needed` says why) stops with exit 2 (ScenarioError) before anything runs."""
     deadline = time.monotonic() + seconds
     while page.pages() == 0 and time.monotonic() < deadline:
         time.sleep(0.05)

@@ -1,7 +1,5 @@
-"""The flags that change a scenario file's fields, shared by `run`, `session` and `study`:
-`--set FIELD=VALUE` and `--scenario-text YAML` (`scenarios.overrides`), and the shorthands
-`--method`, `--alpha`, `--operator`, `--seed`, `--duration`, `--goals`, `--hardware` and
-`--driver-sim`, each one `--set`."""
+"""The flags that change a scenario file's fields: `--set FIELD=VALUE`, `--scenario-text
+YAML` (`scenarios.overrides`) and the shorthands, each one `--set`."""
 
 from pbp_drake.scenarios import METHODS, OPERATOR_NAMES, ScenarioError, parse_method_label
 from pbp_drake.scenarios.bounds import MAX_GOALS
@@ -54,9 +52,8 @@ def add_hardware_flags(group):
 
 
 def scenario_overrides(args, shorthands=True):
-    """The overrides of the parsed `args`: the text, the shorthands (where the command has
-    them: `study`'s `--seed` is its first scene's, not a field), `--goals`, then each
-    `--set`."""
+    """The overrides of the parsed `args`: the text, the shorthands (`shorthands` False:
+    `study`'s `--seed` is not a field), `--goals`, then each `--set`."""
     shorthands = _shorthand_settings(args) if shorthands else []
     goals = getattr(args, "goals", None)
     if goals is not None:

@@ -8,7 +8,7 @@ import sys
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.cli_types import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS
-from pbp_drake.commands.run_checks import session_methods
+from pbp_drake.commands.run_checks import is_person, session_methods
 from pbp_drake.commands.run_page import (
     PAGE_ENDED, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
     wait_for_browser)
@@ -43,7 +43,7 @@ def add_session_flags(parser, hidden=False):
         "page)"))
 
 
-def run_session_command(args, resolved, meshcat, page, person):
+def run_session_command(args, resolved, meshcat, page):
     """The session of `args.participant` on the resolved scenario; its exit code."""
     scenario = resolved.scenario
     methods, order = session_methods(args, scenario)  # checked by check_run_flags
@@ -55,32 +55,31 @@ def run_session_command(args, resolved, meshcat, page, person):
     if args.answers is not None:
         questions = FixedAnswers(parse_answers(args.answers, methods))
     else:
-        questions = _StartInTheRun(MeshcatSessionPage(meshcat), args.start_on_connect)
+        questions = _StartInTheRun(meshcat, args.start_on_connect)
     if page is not None and isinstance(questions, _StartInTheRun):
         # The pages are the person's: no browser, no session (`--answers` needs none).
         print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
               "each method starts when its Start is pressed in the page, and the questions "
               "and Next are buttons there too (Open Controls).", flush=True)
-        wait_for_browser(page, args.wait_for_browser, PERSON_NEEDS_PAGE if person else
+        wait_for_browser(page, args.wait_for_browser,
+                         PERSON_NEEDS_PAGE if is_person(scenario) else
                          "the session's Start buttons and questions are in the page, so "
                          "nothing was run or saved")
 
-    # The live status and Stop, Restart, Next scene, as in a single run. Within a session,
-    # Stop ends it (resumable, like Ctrl-C), Restart runs the method again (the stopped run
-    # is not saved), and Next scene ends this method's run as it stands (saved, not a
-    # success) and goes on to its questions: the next scene of a session is the next run.
+    # Stop ends the session (resumable), Restart runs the method again (the stopped run is
+    # not saved), Next scene ends this method's run as it stands (saved, not a success) and
+    # goes on to its questions.
     console = (None if page is None
                else page_console(meshcat, page, args, alpha_of(scenario)))
 
     def run_one(trial):
-        # Shown again after a Restart: each run of the method starts at its Start.
+        # Kept through a Restart: each run of the method starts at its Start.
         start_button = (questions.take_start_label()
                         if isinstance(questions, _StartInTheRun) else None)
         while True:
             diagram = build_diagram(trial, meshcat)
             if console is not None:
-                # After the operator's buttons; and clicks made between runs (on the
-                # questions) do not count.
+                # After the operator's buttons; clicks made on the questions do not count.
                 console.set_choices(RUN_CHOICES)
             result, live = run_task_once(args, trial, diagram, meshcat, console,
                                          start_button=start_button)
@@ -125,29 +124,22 @@ class _SessionStopped(Exception):
     """Stop pressed in the page during a session's run: the session ends, resumable."""
 
 
-class _StartInTheRun:
-    """A session's pages in Meshcat (`MeshcatSessionPage`) whose Start is pressed inside the
-    run, once the run's scene is in the page, rather than before the run is built: `start`
-    only keeps the label, which the run's `LiveRun` shows (`take_start_label`). With
+class _StartInTheRun(MeshcatSessionPage):
+    """`MeshcatSessionPage` whose Start is pressed inside the run, once its scene is in the
+    page: `start` keeps the label for the run's `LiveRun` (`take_start_label`); with
     `--start-on-connect`, Start is a page of its own between the runs."""
 
-    def __init__(self, pages, start_between_runs=False):
-        self._pages = pages
+    def __init__(self, meshcat, start_between_runs=False):
+        super().__init__(meshcat)
         self._start_between_runs = start_between_runs
         self._label = None
 
     def start(self, method, position, total, practice=False):
         if self._start_between_runs:
-            self._pages.start(method, position, total, practice)
+            super().start(method, position, total, practice)
         else:
             self._label = start_label(method, position, total, practice)
 
     def take_start_label(self):
         label, self._label = self._label, None
         return label
-
-    def answer(self, method, question):
-        return self._pages.answer(method, question)
-
-    def next(self, position, total):
-        self._pages.next(position, total)

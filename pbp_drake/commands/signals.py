@@ -1,7 +1,5 @@
-"""How a command stops: SIGTERM taken as Ctrl-C (a command that is asked to end, by `kill
-PID`, a service manager or `timeout`, stops the way it stops on Ctrl-C, with its word and
-its cleanup, instead of dying at once, leaving worker processes and temporary files), and
-a file that cannot be written said in one line."""
+"""How a command stops: SIGTERM (`kill`, a service manager, `timeout`) taken as Ctrl-C, with
+its word and cleanup, and a file that cannot be written said in one line."""
 
 import contextlib
 import functools
@@ -41,9 +39,8 @@ def sigterm_as_interrupt():
 
 def stopping_cleanly(command, then="the same command resumes", sigterm=True):
     """`command(args)` that says a file it could not write (a full disk) in one line, exit
-    4, instead of a traceback (nothing is half-written; `then`: what the same command does
-    when run again); with `sigterm` (`study`, `report`), it takes SIGTERM as Ctrl-C, and
-    its line starts below the progress bar's on a terminal."""
+    4 (`then`: what the same command does when run again); with `sigterm`, it takes
+    SIGTERM as Ctrl-C."""
 
     @functools.wraps(command)
     def stopping(args):

@@ -1,9 +1,7 @@
 """`pbp-drake study` (a scenario file's study), `pbp-drake report` (a study folder's
 tables and figures, rebuilt from its trial files) and `pbp-drake compare` (two studies of
-the same seeds, trial by trial).
-
-`study` and `report` take SIGTERM as Ctrl-C, and say a file that cannot be written (a full
-disk) in one line, exit 4: nothing is left half-written, and the same command resumes."""
+the same seeds, trial by trial); `study` and `report` stop as `signals.stopping_cleanly`
+says."""
 
 import dataclasses
 import pathlib
@@ -129,13 +127,12 @@ def _study(args):
     check_buildable(scenario_file.resolved)
     if isinstance(scenario_file.scenario, TaskScenario):
         return _method_study(args, scenario_file, overrides)
-    if args.pilots is not None:
-        raise ScenarioError(f"--pilots: {args.scenario} is a 2-D study, which has no "
-                            "virtual participant; the HSR tasks' studies take it")
-    if args.participant_condition is not None:
-        raise ScenarioError(f"--participant-condition {args.participant_condition}: "
-                            f"{args.scenario} is a 2-D study, which has no virtual "
-                            "participant; the HSR tasks' studies take it")
+    for flag, given in (("--pilots", args.pilots is not None),
+                        (f"--participant-condition {args.participant_condition}",
+                         args.participant_condition is not None)):
+        if given:
+            raise ScenarioError(f"{flag}: {args.scenario} is a 2-D study, which has no "
+                                "virtual participant; the HSR tasks' studies take it")
     if scenario_file.study is None:
         raise ScenarioError(f"{args.scenario}: has no `study:` section to run")
     output = pathlib.Path(args.output)
@@ -157,8 +154,8 @@ def _study(args):
 
 
 def default_output(scenario_path, scenario_file, methods=None):
-    """`outputs/<the file's stem>-<the methods, by '-'>` (`methods`: `--methods`' text, or
-    None for the file's study's); a 2-D study's `outputs/<stem>`."""
+    """`outputs/<the file's stem>-<the methods, by '-'>` (`methods`: `--methods`' text, None
+    for the study's); a 2-D study's `outputs/<stem>`."""
     stem = pathlib.Path(scenario_path).stem
     if not isinstance(scenario_file.study, MethodComparison) and methods is None:
         return pathlib.Path("outputs", stem)
@@ -167,9 +164,8 @@ def default_output(scenario_path, scenario_file, methods=None):
 
 
 def with_participant_condition(scenario, name, scenario_path):
-    """`scenario` with its virtual participant impaired as the named condition says
-    (`PARTICIPANT_CONDITIONS`, replacing the file's `impairment`); ScenarioError when its
-    operator is not the virtual participant."""
+    """`scenario` with its virtual participant impaired by the named condition, in place of
+    the file's `impairment`; ScenarioError for another operator."""
     operator = scenario.operator
     if not isinstance(operator, VirtualParticipant):
         raise ScenarioError(
@@ -197,12 +193,10 @@ def _method_study(args, scenario_file, overrides):
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {} "
                             "(--set 'operator=!VirtualParticipant {}')")
-    if args.methods is not None:
-        study = dataclasses.replace(study, methods=method_list(args.methods))
-    if args.trials is not None:
-        study = dataclasses.replace(study, trials=args.trials)
-    if args.split is not None:
-        study = dataclasses.replace(study, split=args.split)
+    flags = {"methods": None if args.methods is None else method_list(args.methods),
+             "trials": args.trials, "split": args.split}
+    study = dataclasses.replace(study, **{name: value for name, value in flags.items()
+                                          if value is not None})
     seed = first_seed(study, study.split) if args.seed is None else args.seed
     split = split_of(study, seed, study.trials)
     if args.jobs < 1:
@@ -269,8 +263,8 @@ def _method_study(args, scenario_file, overrides):
 
 
 def _failed_trials(summary, output, where=None):
-    """1, with a line on stderr, when trials recorded an error or did not run (a trial
-    that ran but missed its target is a result, not an error); else 0."""
+    """1, with a line on stderr, when trials recorded an error or did not run (a missed
+    target is a result, not an error); else 0."""
     errors = sum(entry["errors"] for entry in summary["methods"].values())
     missing = sum(entry["missing"] for entry in summary["methods"].values())
     if not errors and not missing:
@@ -284,10 +278,9 @@ def _failed_trials(summary, output, where=None):
 
 def _failed_matrix_trials(summary, output):
     """`_failed_trials` of each pilot of a matrix: 1 when any pilot's are."""
-    failed = [_failed_trials({**summary, **pilot}, pilot_folder(output, name),
-                             f"under the pilot {name}")
-              for name, pilot in summary["pilots"].items()]
-    return max(failed)
+    return max(_failed_trials({**summary, **pilot}, pilot_folder(output, name),
+                              f"under the pilot {name}")
+               for name, pilot in summary["pilots"].items())
 
 
 def _print_matrix_report(summary, output):
@@ -307,9 +300,8 @@ def _print_report(summary, output):
 
 
 def _compare(args):
-    """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when any metric's mean
-    difference exceeds the first study's trial-to-trial standard deviation, 2 when the
-    studies share no method and seed."""
+    """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric moved by
+    more than the first study's trial-to-trial SD, 2 when the studies share no trial."""
     rows = paired_comparison(args.first, args.second)
     if not rows:
         raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
@@ -323,11 +315,8 @@ def _compare(args):
 
 
 def _report(args):
-    """`report` of a study folder, a matrix's (`_report_matrix`) or a folder of participant
-    folders (`participant_report`): exit 1 when trials failed with an error or did not run,
-    or damaged files were skipped; 2 (ScenarioError) when there is nothing to report.
-    `--markdown FILE` (`studies.results_markdown`) takes a 2-D study's folder too, not a
-    user study's."""
+    """`report` of a study folder, a matrix's or a folder of participant folders, with the
+    exit codes the command's help gives."""
     output = pathlib.Path(args.output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)
@@ -367,8 +356,7 @@ def _report(args):
 
 
 def _report_matrix(args, output):
-    """`report` of a matrix folder: its tables (every method paired with --paired-with,
-    default PBP-Alt), figure and, with --markdown, the tables after the command."""
+    """`report` of a matrix folder: its tables, figure and --markdown file."""
     try:
         summary = report_matrix(output, args.paired_with, args.markdown)
     except ValueError as error:
@@ -380,8 +368,7 @@ def _report_matrix(args, output):
 
 
 def _report_status(summary, output, failed):
-    """`report`'s exit code: 1 with a line on stderr when files were damaged or foreign,
-    else `failed` (the failed trials' code)."""
+    """1, with a line on stderr, when files were damaged or foreign; else `failed`."""
     if summary["damaged"]:
         print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
               f"(listed above and in {output / 'summary.json'})", file=sys.stderr)

@@ -56,6 +56,8 @@ def run_task_loop(args, resolved, meshcat, page):
     """A task, run until the person is done: Restart runs it again, Next scene on the next
     seed; the exit code of the last run."""
     person = is_person(resolved.scenario)
+    # A person's task waits for Start in the page, unless --start-on-connect.
+    start_button = "Start" if person and not args.start_on_connect else None
     console = None
     if page is not None:
         console = page_console(meshcat, page, args, alpha_of(resolved.scenario))
@@ -67,16 +69,14 @@ def run_task_loop(args, resolved, meshcat, page):
             # After the operator's buttons, which the build added: the same order each run.
             console.set_choices(RUN_CHOICES)
         if first and page is not None and (person or terminal()):
-            # A person needs the page open before the task starts.
             print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
-                  + ("the task starts when it connects." if not start_gate(args, person) else
+                  + ("the task starts when it connects." if start_button is None else
                      "the task starts when Start is pressed in the page."), flush=True)
             if person:
                 print(controls_line(scenario), flush=True)
             wait_for_browser(page, args.wait_for_browser, PERSON_NEEDS_PAGE if person else None)
         first = False
-        result, live = run_task_once(args, resolved, diagram, meshcat, console,
-                                     start_button="Start" if start_gate(args, person) else None)
+        result, live = run_task_once(args, resolved, diagram, meshcat, console, start_button)
         code = task_code(result, live)
         if console is None:
             return code
@@ -110,7 +110,7 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     rate = 0.0 if args.headless else args.realtime_rate
-    if args.log:  # its folder may be made (check_log_path)
+    if args.log:
         pathlib.Path(args.log).parent.mkdir(parents=True, exist_ok=True)
     result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram,
                                 advance=live.advance)
@@ -135,8 +135,8 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
 
 
 def why_failed(result, scenario):
-    """Where a failed run's hand ended against its target (`failure_text`), or None when
-    the result holds no series (a run streamed to --log)."""
+    """Where a failed run's hand ended against its target (`failure_text`); None for a run
+    streamed to --log, whose result holds no series."""
     if not len(result.ee_positions) or not len(result.targets):
         return None
     target = int(result.targets[-1])
@@ -156,7 +156,7 @@ def controls_line(scenario):
 
 
 def task_code(result, live):
-    """The exit code of a run: stopped by the person, succeeded or failed (`EXIT_CODES`)."""
+    """The exit code of a run: stopped, succeeded or failed."""
     if live.choice == "stop":
         return EXIT_STOPPED
     return EXIT_SUCCESS if result.success else EXIT_FAILED
@@ -167,12 +167,6 @@ def delete_operator(diagram):
     operator = diagram.GetSubsystemByName("operator")
     if hasattr(operator, "Delete"):
         operator.Delete()
-
-
-def start_gate(args, person):
-    """Whether a run's task waits for Start in the page: a person's, unless
-    --start-on-connect asks for the start as the page connects."""
-    return person and not args.start_on_connect
 
 
 def alpha_of(scenario):

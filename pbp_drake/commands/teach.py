@@ -1,11 +1,7 @@
 """`pbp-drake teach FILE --output P.json`: a primitive taught by driving (the grasping task: a
-pose's). The scenario's task runs under teleop with the chosen operator (a person in the
-page presses Start, drives the hand from its start toward a goal and presses Stop; the
-virtual participant drives to its target headless), the hand's path from the start to the
-end of the run is fitted with the scenario's DMP settings (`pbp_drake.core.dmp.primitive`),
-and the primitive is saved, to be named by any scenario's `dmp: {primitive: P.json}`. The
-run's rows are kept beside the primitive (`P.csv`). `--from FILE` teaches from a path already
-recorded (`run --log`, a study trial's CSV, a `run --record` replay) instead.
+pose's), see docs/tasks/teach.md. The task runs under teleop, the hand's path is fitted with
+the scenario's DMP settings (`pbp_drake.core.dmp.primitive`) and saved, the run's rows beside
+it (`P.csv`); `--from FILE` teaches from a recorded path instead.
 """
 
 import argparse
@@ -71,8 +67,7 @@ def _teach(args):
                             "whose demonstration is scenario.demonstration")
     origin = args.source
     if origin is None:
-        # The drive's rows are kept beside the primitive: a person's demonstration is not
-        # to be driven twice.
+        # Kept beside the primitive: a person's demonstration is not to be driven twice.
         origin = str(pathlib.Path(args.output).with_suffix(".csv"))
         check_log_path(origin, force=args.force)
         code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"))
@@ -105,8 +100,8 @@ def _teach(args):
 
 
 def _drive(args, log, switches):
-    """The scenario run under teleop by `args.operator`, its per-tick rows in `log`: the
-    exit code of `pbp-drake run`. A task whose target `switches` keeps one target."""
+    """The exit code of `pbp-drake run` of the scenario under teleop by `args.operator`,
+    its rows in `log`; a task whose target `switches` keeps one target."""
     argv = ["run", args.scenario, "--method", "teleop", "--operator", args.operator,
             "--log", str(log), "--force"]
     if switches:
@@ -131,9 +126,8 @@ def _drive(args, log, switches):
 
 def read_hand_path(path):
     """Times (T,), hand positions (T, 3) and orientations (T, 4; None where the recording
-    has none) of a run's or trial's CSV, or of a run's replay (`run --record`: the hand's
-    positions as its page drew them, at the recording's frame rate); ScenarioError naming
-    the file for one that cannot be read or has no hand path."""
+    has none) of a run's or trial's CSV, or of a run's replay (`run --record`, at its frame
+    rate); ScenarioError naming the file for one that cannot be read or has no hand path."""
     if is_replay(path):
         return _replay_hand_path(path)
     try:
@@ -156,8 +150,8 @@ def read_hand_path(path):
 
 
 def _replay_hand_path(path):
-    """The hand's path in a replay: the track of the marker the reaching and obstacle tasks'
-    page keeps at the hand (`/task/operator`), its keys in time order, each time once."""
+    """The hand's path in a replay: the track of the marker at the hand (`HAND_MARKER`), in
+    time order, each time once."""
     try:
         times, positions = replay_track(pathlib.Path(path).read_text(), HAND_MARKER,
                                         ".position")

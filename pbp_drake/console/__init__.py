@@ -1,13 +1,6 @@
-"""The operator's console: what a person at the Meshcat page sees of a run and can do.
-
-- `pbp_drake.console.text`: the words, as pure functions of numbers (`status_text`,
-  `result_text`, ...).
-- `Console` (`pbp_drake.console.page`): the page's buttons, sliders and lines of text.
-- `LiveRun` (`pbp_drake.console.live`): a running simulation feeding a Console, a
-  `RobotCamera` and the terminal's `Progress`.
-- `pbp_drake.console.questionnaire`: a user-study session's pages.
-- `PageFront` (`pbp_drake.console.front`): the page behind a front of our own, open only to
-  the holder of the run's secret URL, with the console's lines in a panel of its own.
+"""The operator's console: what a person at the Meshcat page sees of a run and can do: the
+words (`text`), the buttons, sliders and lines (`Console`), a live run feeding them
+(`LiveRun`), a session's pages (`questionnaire`) and the page's front (`PageFront`).
 
 A minimal loop (the thread that made `meshcat`; with `front = PageFront(meshcat.port())`,
 open `front.url` and pass `panel=front` to the Console)::

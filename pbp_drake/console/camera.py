@@ -8,12 +8,11 @@ from pbp_drake.robots.hsr_station import hsr_station_plant
 
 CAMERAS = ("overview", "robot")
 
-# High above and a little behind the head, looking down past it at the hand and on to the
-# objects, as a person standing behind the robot would see them (metres): the line of sight
-# to the hand passes over the head all through a reaching task (tests/console/test_camera.py).
+# High above and a little behind the head (metres): the line of sight to the hand passes
+# over the head all through a reaching task (tests/console/test_camera.py).
 BEHIND = 0.5
 ABOVE = 1.5
-# The point looked at: ahead of the head, low, so that the view runs from the hand to the
+# The point looked at: ahead of the head and low, the view running from the hand to the
 # far objects (the reaching task's are 1.25 m to 2.5 m ahead).
 AHEAD = 1.2
 TARGET_HEIGHT = 0.3
@@ -33,10 +32,9 @@ def behind_head_view(head_position, yaw, behind=BEHIND, above=ABOVE, ahead=AHEAD
 
 
 class RobotCamera:
-    """Keeps `meshcat`'s camera above and behind the HSR's head: `update(root_context)`
-    reads the robot's `state` off `station` (an HSR station inside the diagram whose root
-    context is given, dynamic or kinematic), places the head and the base with the
-    station's plant and sets the camera (`behind_head_view`). Use from Meshcat's thread."""
+    """Keeps `meshcat`'s camera above and behind the head of the HSR `station` (dynamic or
+    kinematic): `update(root_context)` reads its `state` and sets the camera
+    (`behind_head_view`). Use from Meshcat's thread."""
 
     def __init__(self, meshcat, station, head_body="head_link", base_body="base_link"):
         self._meshcat = meshcat

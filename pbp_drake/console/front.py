@@ -1,36 +1,15 @@
 """The run's page behind a front of our own: a token and the page's own origin, or HTTP 403.
 
-Drake's Meshcat serves its page and websocket to whoever connects, so any page or process on
-the machine could press the robot's keys. The front keeps Meshcat on a private localhost
-port and serves the public one itself: the page (Meshcat's, with our console panel injected)
-and a websocket relay to Meshcat, only to a client that presents the run's secret token (in
-the URL as `?token=T`, as Jupyter does, then in a cookie) and, for the websocket, an
-`Origin` equal to the page's own. A refused request never reaches Meshcat: no upstream
-connection is opened for it.
+The front keeps Drake's Meshcat on a private localhost port and serves the public one: the
+page (Meshcat's, with our console panel injected) and a websocket relay to Meshcat, only to
+a client with the run's token (`?token=T`, then a cookie) and, for a websocket, the page's
+own `Origin`. docs/design.md ("The page") explains the door (`meshcat_door`), the checked
+frames (`page_messages`) and the pacing of a slow page (`PendingMessages`, `FRAME`, `ACK`).
 
-The front is the only door: Meshcat's own port is shut to every other connection
-(`meshcat_door`, Linux); where it cannot be, the front says so in one line and
-`BrowserGuard` ignores what arrives while a connection the front did not open is there. A
-page's frames reach Meshcat only as a fresh encoding of one of the messages Meshcat's page
-sends (`page_messages`: Meshcat's parser takes the process down on a frame that is not
-msgpack); any other frame closes that page's websocket (`BAD_FRAME_CLOSE`). Toward a slow
-page, Meshcat's messages wait in a `PendingMessages` queue, sent in batches paced by the
-page (`FRAME`, `ACK`).
-
-The front never calls a Meshcat method (those belong to the thread that made the Meshcat);
-it talks to Meshcat's port over the network, from an asyncio loop on a daemon thread. Close
-the front before letting go of the Meshcat: Drake aborts the process when a Meshcat dies on
-another thread, and a Meshcat left in a reference cycle dies in whichever thread collects.
-
-An example (the thread that made `meshcat`)::
-
-    listener = bind_page_port(args.port)            # PortError before anything is built
-    meshcat = Meshcat(MeshcatParams(host="localhost", port=0))
-    with PageFront(meshcat.port(), listener) as front:
-        print(f"Open {front.url}")
-        front.show(title="PBP-Alt", status="time left 41 s", time=0.0)
-        ...
-        front.end("Session complete - you can close this page")
+The front never calls a Meshcat method (those belong to the thread that made it); it talks
+to Meshcat's port from an asyncio loop on a daemon thread. Close the front before letting
+go of the Meshcat: Drake aborts the process when a Meshcat dies on another thread (as one
+left in a reference cycle does, in whichever thread collects).
 """
 
 import asyncio
@@ -71,27 +50,24 @@ REFUSAL = ("This page needs the address `pbp-drake run` printed (with its ?token
            "open that one.\n")
 _TOKEN = re.compile(r"[A-Za-z0-9_-]+")
 _PAGES = ("/", "/index.html", "/meshcat.html")
-# Small, so that a slow page's backpressure shows at once and messages wait in our queue
-# (where they coalesce) rather than in buffers (where they cannot): the websocket's, and
-# the kernel's, which on localhost grows to megabytes (seconds of poses) unless fixed.
+# Small, so that a slow page's messages wait in our queue, where they coalesce, not in the
+# websocket's or the kernel's buffers (megabytes on localhost unless fixed).
 WRITE_LIMIT = 2**14
 SEND_BUFFER = 2**15
-# The relay's pacing: after each batch a text frame FRAME, which our page answers with ACK
-# at its next animation frame; the next batch waits for it. So a page is sent at most one
-# batch of latest states a frame, and its main thread always has time for the panel. (A
-# client that never answers, not our page, is sent batches as fast as it reads.)
+# The relay's pacing: each batch ends with FRAME, which our page answers with ACK at its
+# next animation frame; the next batch waits for it (a client that never answers is sent
+# batches as fast as it reads).
 FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
-# A page's bad frame: its websocket is closed with this code (policy violation) and a reason
-# (a frame over MAX_MESSAGE bytes: websockets' 1009).
+# A page's bad frame closes its websocket with this code (policy violation); a frame over
+# MAX_MESSAGE bytes, with websockets' 1009.
 BAD_FRAME_CLOSE = 1008
 # Accept errors (out of file descriptors) closer together than this are one burst: one line.
 ACCEPT_BURST = 10.0
-# A connection to Meshcat the front closed still counts as its own this long: Meshcat
-# counts it until it has read the close.
+# A connection to Meshcat the front closed counts as its own this long (until Meshcat has
+# read the close).
 CLOSING_GRACE = 1.0
-# How long a closing connection waits for the other side's close (websockets' default, 10 s,
-# outlasts a command's end: a busy page answers late). The front's own close waits for its
-# connections this long, twice (the page's side, then Meshcat's), and then cancels them.
+# How long a closing connection waits for the other side's close (websockets' 10 s would
+# outlast a command's end); the front's close waits twice that, then cancels.
 CLOSE_TIMEOUT = 1.0
 
 INJECTION = """
@@ -154,10 +130,8 @@ body.pbp-ended #status-message { display: none !important; }
       .catch(function () { if (served) end(shown); })
       .finally(function () { if (!ended) setTimeout(poll, 1000); });
   }
-  // The relay's text frames: the panel's state, sent with the scene (a fetch's chain of
-  // tasks waits behind every frame of a slow page); and the end of a batch, answered at
-  // the next animation frame, so that the page never has more of the scene to handle
-  // than it can draw.
+  // The relay's text frames: the panel's state (a poll would wait behind a slow page's
+  // frames), and the end of a batch, answered at the next animation frame.
   var handle_meshcat_message = handle_message;
   handle_message = function (message) {
     if (typeof message.data !== "string") return handle_meshcat_message(message);
@@ -201,12 +175,11 @@ def bind_page_port(port, host="localhost"):
     try:
         return socket.create_server((host, port), backlog=64)
     except OSError as error:
-        if error.errno == errno.EADDRINUSE:
-            raise PortError(f"port {port} is in use (use --port 0 for a free one)") from None
-        if error.errno == errno.EACCES:
-            raise PortError(f"port {port} may not be bound by this process "
-                            f"(use --port 0 for a free one)") from None
-        raise
+        why = {errno.EADDRINUSE: "is in use",
+               errno.EACCES: "may not be bound by this process"}.get(error.errno)
+        if why is None:
+            raise
+        raise PortError(f"port {port} {why} (use --port 0 for a free one)") from None
 
 
 def _panel_value(name, value):
@@ -236,9 +209,8 @@ class PageFront:
         token: the run's token (checked by `check_token`); None draws `new_token()`.
         host: where to bind when `listen_socket` is None, and the host of `url`.
 
-    Serving once made. `show`'s lines reach each page as a text frame whenever they change
-    (and by a poll of `/pbp/state` each second); the page shows the newest in a panel at the
-    top left. So the thread that drives the run needs no event loop.
+    Serving once made. `show`'s lines reach each page whenever they change (and by a poll
+    each second), shown in a panel at the top left; the run's thread needs no event loop.
     """
 
     def __init__(self, meshcat_port, listen_socket=None, token=None, host="localhost"):
@@ -291,8 +263,7 @@ class PageFront:
         return self._token
 
     def pages(self):
-        """How many pages are relayed now (admitted websockets with their own connection
-        to Meshcat): whether a browser is there."""
+        """How many pages are relayed now: whether a browser is there."""
         return self._relays
 
     def pages_heard(self):
@@ -396,9 +367,8 @@ class PageFront:
         self._server.close()  # and every connection, with its relay
         with contextlib.suppress(TimeoutError):
             await asyncio.wait_for(self._server.wait_closed(), 2 * CLOSE_TIMEOUT)
-        # What still runs (a relay's last close, a file being read) ends here, on the
-        # running loop: a task left pending would be destroyed with the loop, its cleanup
-        # then failing with "no running event loop".
+        # What still runs ends here, on the running loop: a task left pending would be
+        # destroyed with the loop, its cleanup failing with "no running event loop".
         others = [task for task in asyncio.all_tasks() if task is not asyncio.current_task()]
         for task in others:
             task.cancel()
@@ -441,7 +411,7 @@ class PageFront:
         return any(hmac.compare_digest(value.encode(), token) for value in offered)
 
     async def _answer(self, connection, request):
-        """The request's response, or None to go on to the websocket (the relay)."""
+        """The request's response, or None to go on to the websocket relay."""
         if not request.path.startswith("/"):  # `GET etc/passwd`, `GET ?token=T`
             return connection.respond(400, "A request's target starts with '/'.\n")
         url = urllib.parse.urlsplit(request.path)
@@ -464,16 +434,15 @@ class PageFront:
             with self._lock:
                 body = json.dumps(self._state).encode()
             return _response(200, body, "application/json", ("Cache-Control", "no-store"))
-        if path not in self._files:
+        found = self._files.get(path)
+        if found is None:
             try:  # a mesh's or texture's file, at its content address
                 found = await asyncio.to_thread(self._door.get, path)
             except (OSError, ValueError, http.client.HTTPException):
                 return _response(404, b"Not found\n", "text/plain; charset=utf-8")
-            if not path.startswith("/cas-v1/"):
-                return _response(200, *found, ("Cache-Control", "no-cache"))
-            self._files[path] = found
-        body, content_type = self._files[path]
-        return _response(200, body, content_type, ("Cache-Control", "no-cache"))
+            if path.startswith("/cas-v1/"):
+                self._files[path] = found
+        return _response(200, *found, ("Cache-Control", "no-cache"))
 
     async def _relay(self, page):
         """One page's relay: a connection to Meshcat of its own (through the door), closed

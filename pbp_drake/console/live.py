@@ -1,10 +1,8 @@
 """A run, live: the simulation advanced in short slices of simulated time, and between two
 slices (on the thread that made Meshcat) the console's status, the person's choices, the
-sliders, the following camera and the terminal's progress line.
-
-Slices rather than a Simulator monitor: a monitor is called at every plant step (a
-thousand a second), and it sees a const Context, where the alpha slider must write a
-parameter. Between slices the Context is the caller's to change, and nothing runs per step.
+sliders, the following camera and the terminal's progress line. Slices, not a Simulator
+monitor: a monitor runs at every plant step and sees a const Context, where the alpha
+slider must write a parameter.
 """
 
 import math
@@ -16,8 +14,7 @@ from pbp_drake.builder.run import advance_to
 from pbp_drake.console.text import progress_text, status_text
 from pbp_drake.systems.ports import TaskStatus
 
-# Simulated seconds between two looks at the page: 20 a second at real time, so that the
-# robot camera moves smoothly and a click ends the run within a twentieth of a second.
+# Simulated seconds between two looks at the page: a smooth camera, a click felt at once.
 SLICE_SECONDS = 0.05
 # Wall seconds between two status lines: the page redraws its panel at each.
 STATUS_PERIOD = 0.25
@@ -28,15 +25,14 @@ GAMEPAD_FOUND = "Gamepad found: it drives now."
 
 
 class Progress:
-    """The terminal's progress line: rewritten in place with a carriage return every
-    quarter second when `stream` is a terminal, a new line every `line_period` seconds
-    otherwise (a log file, a pipe)."""
+    """The terminal's progress line: rewritten in place every quarter second when `stream`
+    is a terminal, a new line every 5 s otherwise (a log file, a pipe)."""
 
-    def __init__(self, duration, stream=None, line_period=5.0):
+    def __init__(self, duration, stream=None):
         self._stream = stream or sys.stdout
         self._duration = float(duration)
         self._tty = self._stream.isatty()
-        self._period = 0.25 if self._tty else float(line_period)
+        self._period = 0.25 if self._tty else 5.0
         self._last = time.monotonic()  # the first line one period in, not at t = 0
         self._width = 0
 
@@ -72,12 +68,10 @@ class LiveRun:
     button ends the run there: `advance` returns True, and `choice` holds "stop",
     "restart" or "next".
 
-    With `start_label`, the first `advance` shows a Start button of that label and waits
-    for it (`Console.wait_for_start`; Enter on `stdin` or Stop end the run after its first
-    slice, `choice` "stop"). The simulator is initialized by then, so the page has the
-    scene before the button; the real-time pacing restarts at the press. With `gamepad`,
-    a page that has seen no gamepad is told so (`NO_GAMEPAD`, in the console's notice
-    line and on stderr), and told again when one appears.
+    With `start_label`, the first `advance` shows a Start button of that label, once the
+    page has the scene, and waits for it (`Console.wait_for_start`; Enter on `stdin` or
+    Stop end the run after its first slice, `choice` "stop"). With `gamepad`, a page that
+    has seen no gamepad is told so (`NO_GAMEPAD`, in the notice line and on stderr).
     """
 
     def __init__(self, diagram, duration, console=None, progress=None, camera=None,
@@ -126,9 +120,8 @@ class LiveRun:
         return context.get_time() < end_time
 
     def status(self, root_context):
-        """The status line at `root_context`'s time (`pbp_drake.console.text.status_text`):
-        the time left and, from the diagram's `task_monitor` when it has one, the target
-        switches and intervention ratio so far."""
+        """The status line at `root_context`'s time (`status_text`), with the target
+        switches and intervention ratio of the diagram's `task_monitor` when it has one."""
         if self._monitor is None:
             return status_text(self._duration, root_context.get_time())
         status = TaskStatus(self._monitor.get_task_status_output_port().Eval(
@@ -147,8 +140,8 @@ class LiveRun:
         self.choice = self._console.choice()
         self._apply_sliders(simulator)
         self._check_gamepad()
-        # A panel keeps only the latest line, which goes to the page as its latest state:
-        # every slice's. Button labels are messages the page handles in turn: a few a second.
+        # A panel sends the page only its latest state: every slice's. Button labels are
+        # messages the page handles in turn: a few a second.
         if (self._console.panel is not None
                 or time.monotonic() - self._last_status >= STATUS_PERIOD):
             self._last_status = time.monotonic()
@@ -163,14 +156,11 @@ class LiveRun:
         if self._console.wait_for_start(label, stdin=self._stdin) == "stop":
             self.choice = "stop"
             return False
-        # The pacing counts from its last reset: without one, the run would rush through
-        # the seconds the person took to press Start.
-        simulator.ResetStatistics()
+        simulator.ResetStatistics()  # else the run would rush through the wait
         return True
 
     def _check_gamepad(self):
-        """Says, in the page and on stderr, when a gamepad run's page has no pad, or has
-        one again."""
+        """Says when a gamepad run's page has no pad, or has one again."""
         if not self._gamepad:
             return
         seen = self._console.meshcat.GetGamepad().index is not None
@@ -189,6 +179,4 @@ class LiveRun:
         if (rate := self._console.realtime_rate()) != self._rate:
             self._rate = rate
             simulator.set_target_realtime_rate(rate)
-            # The pacing counts from its last reset: without one, a faster rate would rush
-            # to catch up on the past at the new rate, a slower one would stall.
-            simulator.ResetStatistics()
+            simulator.ResetStatistics()  # else the pacing would catch up on the past

@@ -1,21 +1,11 @@
 """Meshcat's port shut to everyone but the page front: a filter on Meshcat's listening socket.
 
-Drake's Meshcat lets in every HTTP request and websocket on its loopback port; it cannot be
-told to check a token or an origin. But its listening socket is a file descriptor of this
-very process, and on Linux a socket filter (classic BPF, `SO_ATTACH_FILTER`) on it sees each
-connection request before the kernel answers. This one drops all but those of the front's
-own sockets: each is bound first to the listener's address and a port the kernel picks,
-which no other socket may take while it is bound (ours set neither `SO_REUSEADDR` nor
-`SO_REUSEPORT`), and the filter admits exactly those (address, port) pairs. Another
-program's `connect()`, or a page of any origin, gets no answer and times out.
-
-What holds: no local process and no web page reaches Meshcat but through the front, from
-`MeshcatDoor(port)` until the process ends (`close()` leaves the door shut to everyone).
-What does not: a process that can read this one's memory or take its file descriptors (the
-same user with ptrace rights, or root); a connection Meshcat accepted before the door was
-shut (the page front counts Meshcat's connections against its own for that, see
-`pbp_drake.systems.operators.browser_guard`). Where the door cannot be shut (not Linux,
-Meshcat in another process or not on loopback alone), `shut` is False and `reason` says why.
+Meshcat's listening socket is a descriptor of this process; on Linux a classic BPF filter
+(`SO_ATTACH_FILTER`) on it drops every connection request but those from the (address,
+port) pairs of the front's own sockets, each bound before it connects (no `SO_REUSEADDR`,
+so no other socket can take the pair meanwhile). docs/design.md ("The page") says what
+this does and does not cover. Where the door cannot be shut (not Linux, Meshcat in another
+process or not on loopback alone), `shut` is False and `reason` says why.
 """
 
 import contextlib

@@ -1,11 +1,8 @@
 """The operator's console in a Meshcat page: lines of text, buttons and sliders.
 
-Drake's Meshcat has no text primitive; its control panel shows only the label of each button
-and slider. So, on a bare Meshcat, a line of text is a button labelled with the text
-(clicking it does nothing), replaced when the text changes. Behind the page front
-(`pbp_drake.console.front.PageFront`) the lines go to the front's own panel instead, sent to
-the page as its latest state between the scene's batches: a slow page never shows a stale
-status.
+Drake's Meshcat has no text primitive: on a bare Meshcat a line of text is a button labelled
+with the text (clicking it does nothing), replaced when the text changes. Behind the page
+front (`PageFront`) the lines go to the front's own panel instead.
 """
 
 import select
@@ -22,9 +19,8 @@ RATE_RANGE = (0.1, 3.0, 0.1)
 
 
 class Console:
-    """The controls and status lines of a run in `meshcat`'s page.
-
-    Use it from the thread that created `meshcat` (Meshcat raises from any other).
+    """The controls and status lines of a run in `meshcat`'s page, used from the thread
+    that created `meshcat` (Meshcat raises from any other).
 
     Args:
         meshcat: the page's Meshcat.
@@ -37,12 +33,9 @@ class Console:
         panel: where the lines go instead of button labels: an object with `show(**lines)`
             taking `title`, `status`, `result` and `time` (a `PageFront`), or None.
 
-    The page's control panel then shows, top to bottom (below buttons others added, the
-    keyboard operator's): the choice buttons, the sliders, the title line (`show_title`),
-    the status line (`show_status`), the result line (`show_result`) and the notice
-    (`show_notice`). The person's choice is read with `choice()` (at once) or
-    `wait_for_choice()` (blocking). A session that keeps one page for many runs makes one
-    Console and calls `show_title` / `show_status` / `clear_result` between runs.
+    The control panel shows, top to bottom (below buttons others added): the choice
+    buttons, the sliders, then the lines of `show_title`, `show_status`, `show_result` and
+    `show_notice`. `choice()` reads the person's choice at once, `wait_for_choice()` waits.
     """
 
     def __init__(self, meshcat, choices=("stop", "restart", "next"), alpha=None,
@@ -50,7 +43,6 @@ class Console:
         self._meshcat = meshcat
         self._panel = panel
         self._choices = ()
-        self._seen = {}
         self.set_choices(choices)
         self._sliders = []
         if alpha is not None:
@@ -62,8 +54,7 @@ class Console:
             # Widened to hold the rate asked for: the slider must not clip the command line.
             meshcat.AddSlider(RATE_SLIDER, min(low, rate), max(high, rate), step, rate)
             self._sliders.append(RATE_SLIDER)
-        # Line name -> the label shown now, in the order the lines are shown.
-        self._lines = {"title": None, "status": None, "result": None, "notice": None}
+        self._lines = {"title": None, "status": None, "result": None, "notice": None}  # shown
 
     @property
     def meshcat(self):
@@ -86,7 +77,6 @@ class Console:
         self._choices = tuple(choices)
         for choice in self._choices:
             self._meshcat.AddButton(CHOICE_BUTTONS[choice])
-        # Clicks made before (a button of the same name earlier) do not count.
         self._seen = {choice: self._meshcat.GetButtonClicks(CHOICE_BUTTONS[choice])
                       for choice in self._choices}
 
@@ -95,16 +85,14 @@ class Console:
         self._show("title", text)
 
     def show_status(self, text, time=None):
-        """The live line under the title, e.g. `pbp_drake.console.text.status_text(...)`,
-        of simulated `time` (seconds; the panel passes it on to the page). Unchanged text
-        sends nothing to a bare Meshcat."""
+        """The live line under the title, e.g. `status_text(...)`, of simulated `time`
+        (seconds; the panel passes it on to the page)."""
         if self._panel is not None:
             self._panel.show(status=text, time=time)
         self._show("status", text)
 
     def show_result(self, text):
-        """The last line, e.g. `pbp_drake.console.text.result_text(...)`, shown as
-        "Result: <text>"."""
+        """The line under the status, e.g. `result_text(...)`, as "Result: <text>"."""
         self._show("result", f"Result: {text}")
 
     def clear_result(self):
@@ -116,8 +104,7 @@ class Console:
         self._show("notice", text)
 
     def remove_controls(self):
-        """Removes the choice buttons and the sliders, keeping the lines: the run's page
-        once nothing answers them."""
+        """Removes the choice buttons and the sliders, keeping the lines."""
         self.set_choices(())
         for name in self._sliders:
             self._meshcat.DeleteSlider(name, strict=False)
@@ -196,8 +183,8 @@ class Console:
             if line != "status":  # show_status passes the status on with its time
                 self._panel.show(**{line: label})
             return
-        # The control panel lists controls in the order they were added: a changed line
-        # goes back in, and so do the lines below it, to keep the order.
+        # Controls show in the order they were added: the lines below a changed one go back
+        # in after it.
         names = list(self._lines)
         below = names[names.index(line):]
         for name in below:
@@ -210,8 +197,7 @@ class Console:
 
 
 def _entered(stdin, period):
-    """Waits `period` seconds for a line (Enter) on `stdin`, or just waits without one; True
-    when a line came (and was read)."""
+    """Waits `period` seconds for a line (Enter) on `stdin`; True when one came (read)."""
     if stdin is None:
         time.sleep(period)
         return False

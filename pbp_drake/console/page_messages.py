@@ -1,12 +1,8 @@
 """What a run's page may send Meshcat: the messages Meshcat's own page sends, read strictly.
 
-Drake's Meshcat parses every binary frame of a websocket with msgpack, and on bytes that are
-not msgpack (one `0xc1`, a truncated map, a header announcing a 4 GB string) its websocket
-thread dies, and the run with it. So the page front reads each frame of a page here first
-(`read_page_message`), with a msgpack reader of our own that knows only what the page sends,
-and hands Meshcat a fresh encoding of what it read; anything else is a `BadMessage`, and the
-front closes that page's connection (never the run). What Meshcat's page sends (its
-`meshcat.html` and the callbacks Drake gives its controls):
+Meshcat's websocket thread, and the run with it, dies on a frame that is not msgpack; so the
+page front reads each frame here first (`read_page_message`, docs/design.md ("The page"))
+and hands Meshcat a fresh encoding of one of these messages; any other is a `BadMessage`:
 
 - `{"type": "button", "name": N}`: a button clicked, or its key pressed;
 - `{"type": "slider", "name": N, "value": x}`: a slider moved (x finite);

@@ -1,6 +1,4 @@
-"""The relay's queue toward a slow page (`pbp_drake.console.front`): Meshcat's messages
-waiting, bounded by what they set (`message_key`), not by time (`PendingMessages`).
-"""
+"""The relay's queue toward a slow page (`pbp_drake.console.front`)."""
 
 import collections
 
@@ -9,8 +7,7 @@ import msgpack
 
 def message_key(message):
     """What a Meshcat message sets, when a later one of the same key replaces it (a body's
-    pose, one property, the real-time rate), else None: a barrier that must keep its place.
-    Reads only the map's small fields; a mesh's bytes are skipped, not decoded."""
+    pose, one property, the real-time rate), else None: a barrier that keeps its place."""
     if not isinstance(message, bytes):
         return None
     fields = {}
@@ -38,10 +35,9 @@ def message_key(message):
 class PendingMessages:
     """Meshcat's messages waiting for a slow page, bounded by what they set, not by time.
 
-    A message with a key replaces its pending predecessor of the same key (where that one
-    stood); a message without a key is a barrier: nothing moves across it. So the queue is
-    a list of segments, each the keyed messages since the last barrier and the barrier that
-    closes it; under a flood of poses of a few bodies it stays a few messages long.
+    A message with a key replaces its pending predecessor of the same key (in its place); a
+    message without a key is a barrier that nothing moves across. So the queue is a list of
+    segments, each the keyed messages since the last barrier and the barrier that closes it.
     """
 
     def __init__(self):

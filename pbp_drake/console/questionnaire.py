@@ -1,8 +1,7 @@
 """The pages of a user-study session in the Meshcat control panel (`MeshcatSessionPage`):
 before each method a Start button that names it, after it the paper's two questions as six
-buttons each, then a Next button. `FixedAnswers` is the same flow without a browser, for the
-virtual operator (`--answers`). Both are driven by `studies.sessions.run_session` through
-three calls: `start`, `answer`, `next`.
+buttons each, then a Next button; `FixedAnswers` answers them without a browser
+(`--answers`). `studies.sessions.run_session` calls their `start`, `answer` and `next`.
 """
 
 import time
@@ -22,9 +21,8 @@ def start_label(method, position, total, practice=False):
 
 def answer_labels(question):
     """The six buttons of a question, `{label: value}`: "0 = very tired: How tired did you
-    feel?", "1: How tired did you feel?", ... "5 = not tired at all: ...". The value first,
-    so that a label the panel cuts short still shows it; the two ends say what they mean,
-    so that nobody guesses which end is which."""
+    feel?", "1: How tired did you feel?", ... "5 = not tired at all: ...": the value first,
+    which a label cut short still shows, and the two ends named."""
     text = QUESTIONS[question].text
     labels = {}
     for value in SCALE:
@@ -44,9 +42,8 @@ class MeshcatSessionPage:
     session, which the same command resumes). Each page's buttons are deleted before the
     next page shows, so a click meant for one page cannot answer another."""
 
-    def __init__(self, meshcat, poll_period=POLL_PERIOD):
+    def __init__(self, meshcat):
         self._meshcat = meshcat
-        self._poll_period = poll_period
 
     def start(self, method, position, total, practice=False):
         """Shows the Start button of `method` and returns when it is clicked."""
@@ -63,8 +60,7 @@ class MeshcatSessionPage:
         self._wait_for_click([next_label(position, total)])
 
     def _wait_for_click(self, names):
-        # A button's click count starts at zero when it is added (Meshcat's AddButton), so
-        # only clicks on this page count.
+        # A button's click count starts at zero when it is added: only this page's count.
         for name in names:
             self._meshcat.AddButton(name)
         try:
@@ -72,7 +68,7 @@ class MeshcatSessionPage:
                 for name in names:
                     if self._meshcat.GetButtonClicks(name) > 0:
                         return name
-                time.sleep(self._poll_period)
+                time.sleep(POLL_PERIOD)
         finally:
             for name in names:
                 self._meshcat.DeleteButton(name, strict=False)

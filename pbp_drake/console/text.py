@@ -1,6 +1,5 @@
 """The console's words: what the page and the terminal say about a run, as pure functions
-of numbers (no Meshcat, no Drake), so that a session, a test or another front end says the
-same thing the same way."""
+of numbers (no Meshcat, no Drake)."""
 
 import math
 
@@ -8,10 +7,8 @@ from pbp_drake.scenarios import METHOD_NAMES, METHODS, counted
 
 
 def method_name(method, alpha=None):
-    """The method as a person reads it, by the one table of names the results tables and
-    figures read too (`scenarios.METHOD_NAMES`): `method_name("pbp_alternated")` is
-    "PBP-Alt", `method_name("fixed_alpha", 0.5)` is "Fixed alpha 0.50"; unknown names pass
-    through."""
+    """The method as a person reads it (`scenarios.METHOD_NAMES`): "pbp_alternated" is
+    "PBP-Alt", ("fixed_alpha", 0.5) "Fixed alpha 0.50"; unknown names pass through."""
     name = METHOD_NAMES.get(method, method)
     if alpha is not None and method in METHODS and METHODS[method].takes_weight:
         name = f"{name} {alpha:.2f}"
@@ -38,8 +35,7 @@ def status_text(duration, now, switches=None, intervention_ratio=None):
 
 def result_text(success, task_time, stopped=False, why=None):
     """A task's outcome: "success in 14.2 s", "failed: time limit" (then `why`, from
-    `failure_text`, when known), or, when the person ended the run before either (Stop,
-    Restart, Next scene), "stopped at 9.0 s"."""
+    `failure_text`, when known), or, when the person ended the run, "stopped at 9.0 s"."""
     if success:
         return f"success in {task_time:.1f} s"
     if stopped:
@@ -58,9 +54,8 @@ def failure_text(target, target_count, distance, success_distance=None):
 
 def controls_text(grasping, gamepad, forward, vertical):
     """What a person's keys or gamepad do in a task: `grasping` (six degrees of freedom),
-    `gamepad` (else the keys), `forward` (the method lets the person push forward: the
-    forward key, the stick's forward), `vertical` (the keys raise and lower the hand: a
-    reaching task whose objects stand at heights of their own)."""
+    `gamepad` (else the keys), `forward` (the method lets the person push forward),
+    `vertical` (the keys raise and lower the hand)."""
     limit = "" if forward else " (not forward: the primitive drives it)"
     if gamepad and grasping:
         return (f"Gamepad: left stick moves the hand{limit}, triggers raise (RT) and lower "

@@ -50,12 +50,9 @@ class HsrStationConfig:
     plant: MultibodyPlantConfig = dataclasses.field(default_factory=default_station_plant_config)
     #: How the robot moves along the diff IK's plan. "dynamic": the plant (SAP, every
     #: plant.time_step) and its stiff servos track the plan, a few hundredths of a mm
-    #: behind it. "kinematic": the joints are on the plan at every instant (the servos'
-    #: limit as w grows; the plant only gives the kinematics and the geometry, and its
-    #: step, gains and plant settings go unused): about twice the closed loop's speed,
-    #: and in the reaching and grasping tasks, which ship with it, the same study results
-    #: within their trial-to-trial noise (docs/tasks/hsr-station.md, "A kinematic robot").
-    #: Nothing pushes the robot in either (gravity is off, obstacles are measured).
+    #: behind it. "kinematic": the joints are on the plan at every instant (the plant's
+    #: step, gains and settings go unused), about twice as fast
+    #: (docs/tasks/hsr-station.md, "A kinematic robot").
     motion: str = "dynamic"
     #: The whole-body differential IK's period (s), a whole multiple of plant.time_step;
     #: its QP is the station's largest cost.

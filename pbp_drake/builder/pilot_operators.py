@@ -1,11 +1,8 @@
-"""The operator system of a surrogate pilot (`pbp_drake.scenarios.pilots`) in a task.
-
-The noisy and laggy pilots are the task's virtual participant with a filter after it
+"""The operator system of a surrogate pilot (`pbp_drake.scenarios.pilots`) in any task: the
+noisy and laggy pilots are the task's virtual participant with a filter after it
 (`PilotOperator`), the population's is the participant drawn for the trial's seed, and
-HOP's simulated user is a `ProportionalOperator`. None reads the scenario's method: the
-keys it enables reach them through the `forward_key` port, so each pilot is built from the
-same arguments under every method. The task's builder passes how it builds its
-participant and its keys; everything else is here, once for every task.
+HOP's simulated user is a `ProportionalOperator`. None reads the scenario's method (the
+keys reach them through the `forward_key` port).
 """
 
 import dataclasses

@@ -175,6 +175,8 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
                                                                              goal_count))
     builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
     builder.ExportInput(estimator.get_goals_input_port(), "goals")
+    selected = estimator.get_selected_goal_output_port()
+    probabilities = estimator.get_goal_probabilities_output_port()
     # The recursive estimators (maxent_command, intent_filter) read the operator too.
     reads_operator = estimator.HasInputPort("operator_command")
     if reads_operator:
@@ -193,16 +195,14 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         # Every DMP steps from the followed one's velocity (connected below): the state is
         # then O(D) whatever K.
         compact_state=True, predicted_goal_count=predicted_goal_count))
-    shown = estimator.get_selected_goal_output_port()
+    shown = selected
     if settings.group_mass > 0.0:
         grouping = builder.AddNamedSystem("goal_grouping", GoalGrouping(goal_count, settings,
                                                                         period))
         builder.ConnectInput("goals", grouping.get_goals_input_port())
         builder.ConnectInput("ee_state", grouping.get_ee_state_input_port())
-        builder.Connect(estimator.get_goal_probabilities_output_port(),
-                        grouping.get_goal_probabilities_input_port())
-        builder.Connect(estimator.get_selected_goal_output_port(),
-                        grouping.get_selected_goal_input_port())
+        builder.Connect(probabilities, grouping.get_goal_probabilities_input_port())
+        builder.Connect(selected, grouping.get_selected_goal_input_port())
         builder.Connect(grouping.get_followed_goals_output_port(),
                         dmp_bank.get_goals_input_port())
         shown = grouping.get_shown_goal_output_port()
@@ -219,25 +219,19 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     # The blender follows the selected goal's reference alone (O(D), not all K).
     builder.Connect(dmp_bank.get_selected_reference_output_port(),
                     blender.get_policy_reference_input_port())
-    builder.Connect(estimator.get_selected_goal_output_port(),
-                    dmp_bank.get_selected_goal_input_port())
-    builder.Connect(estimator.get_selected_goal_output_port(),
-                    blender.get_selected_goal_input_port())
+    builder.Connect(selected, dmp_bank.get_selected_goal_input_port())
+    builder.Connect(selected, blender.get_selected_goal_input_port())
     # Read at the decide stage before the estimator updates: the goal followed last tick.
-    builder.Connect(estimator.get_selected_goal_output_port(),
-                    dmp_bank.get_followed_goal_input_port())
-    builder.Connect(estimator.get_goal_probabilities_output_port(),
-                    blender.get_goal_probabilities_input_port())
+    builder.Connect(selected, dmp_bank.get_followed_goal_input_port())
+    builder.Connect(probabilities, blender.get_goal_probabilities_input_port())
     builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
     builder.ConnectInput("operator_active", blender.get_operator_active_input_port())
     builder.ExportOutput(dmp_bank.get_phase_output_port(), "phase")
     if prediction_steps:
         likely = builder.AddNamedSystem("likely_goals", LikelyGoals(
             goal_count, predicted_goal_count))
-        builder.Connect(estimator.get_selected_goal_output_port(),
-                        likely.get_selected_goal_input_port())
-        builder.Connect(estimator.get_goal_probabilities_output_port(),
-                        likely.get_goal_probabilities_input_port())
+        builder.Connect(selected, likely.get_selected_goal_input_port())
+        builder.Connect(probabilities, likely.get_goal_probabilities_input_port())
         builder.Connect(likely.get_goal_indices_output_port(),
                         dmp_bank.get_predicted_goals_input_port())
         builder.ExportOutput(dmp_bank.get_predicted_paths_output_port(), "predicted_paths")

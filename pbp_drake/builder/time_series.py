@@ -35,12 +35,8 @@ def _has_grasp(series):
 
 def time_series_rows(series):
     """The CSV lines (newlines included, no header) of the per-tick series of `series`: a
-    TaskResult, or any object with its time series attributes (`times`, `ee_positions`,
-    `headings`, `commands`, `operator_active`, `operator_commands`, `selected_goals`,
-    `targets`, `in_collision`; the grasping task's `angles_to_target`,
-    `command_angular_velocities`, `operator_twists` and `hand_orientations` too). Floats
-    are written in their shortest exact form, so reading them back gives the same
-    numbers."""
+    TaskResult, or any object with its time series attributes. Floats are written in their
+    shortest exact form (repr), so reading them back gives the same numbers."""
     has_collision = series.in_collision is not None
     has_grasp = _has_grasp(series)
     # Python lists, not a numpy scalar per cell: the same doubles' repr, faster.

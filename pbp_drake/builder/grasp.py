@@ -109,9 +109,9 @@ def grasp_dmp_banks(resolved, start_pose):
 
 
 def build_grasp_diagram(resolved, meshcat=None):
-    """The Diagram of a resolved grasping scenario; with `meshcat`, the robot drawn there."""
+    """The Diagram of a resolved grasping scenario (`check_grasp_buildable`); with `meshcat`,
+    the robot drawn there."""
     scenario = resolved.scenario
-    check_grasp_buildable(scenario)
     period = scenario.control_period
     task = scenario.task
     grasps = resolved.scene.grasps
@@ -132,6 +132,7 @@ def build_grasp_diagram(resolved, meshcat=None):
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
+    probabilities = estimator.get_goal_probabilities_output_port()
     intent = selected  # the goal the robot shows: the selected one, or the grouping's
 
     limits = hand_over_limits(scenario)
@@ -170,8 +171,7 @@ def build_grasp_diagram(resolved, meshcat=None):
         builder.Connect(selected, policy.get_selected_goal_input_port())
     shown, keys = shown_intent_and_keys(builder, scenario, intent)
     builder.Connect(sampled, policy.get_robot_state_input_port())
-    builder.Connect(estimator.get_goal_probabilities_output_port(),
-                    policy.get_goal_probabilities_input_port())
+    builder.Connect(probabilities, policy.get_goal_probabilities_input_port())
     hand_over = builder.AddNamedSystem("hand_over", PoseHandOver(start[:7], limits, period))
     builder.Connect(policy.get_reference_output_port(), hand_over.get_reference_input_port())
     builder.Connect(hand_over.get_command_output_port(), station.GetInputPort("pose_command"))
@@ -231,8 +231,7 @@ def build_grasp_diagram(resolved, meshcat=None):
                             visualizer.get_predicted_poses_input_port())
         # The measured pose, not the sample: the triad moves smoothly at 30 Hz.
         builder.Connect(hand_pose, visualizer.get_hand_state_input_port())
-        builder.Connect(estimator.get_goal_probabilities_output_port(),
-                        visualizer.get_goal_probabilities_input_port())
+        builder.Connect(probabilities, visualizer.get_goal_probabilities_input_port())
     diagram = builder.Build()
     diagram.set_name(scenario.name)
     return diagram

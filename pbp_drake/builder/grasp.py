@@ -82,15 +82,6 @@ def check_grasp_buildable(scenario):
             "a keyboard, a gamepad, the virtual participant or none")
 
 
-def hand_over_limits(scenario):
-    """The hand-over's `HandOverLimits`: the reach task's linear limits, and the angular
-    one of the grasp task (`ANGULAR_CHANGE_PER_TICK`)."""
-    robot = scenario.robot
-    return HandOverLimits(robot.max_hand_acceleration, robot.max_hand_speed,
-                          ANGULAR_CHANGE_PER_TICK / scenario.control_period,
-                          MAX_HAND_ANGULAR_SPEED)
-
-
 def grasp_dmp_banks(resolved, start_pose):
     """The position and orientation banks, straight paths (or the taught primitive's pose
     shape) from the hand's `start_pose` `[p, q]` to the K grasp poses, of one duration
@@ -135,7 +126,9 @@ def build_grasp_diagram(resolved, meshcat=None):
     probabilities = estimator.get_goal_probabilities_output_port()
     intent = selected  # the goal the robot shows: the selected one, or the grouping's
 
-    limits = hand_over_limits(scenario)
+    # The hand-over's limits: the reach task's linear ones, and the grasp task's angular.
+    limits = HandOverLimits(scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
+                            ANGULAR_CHANGE_PER_TICK / period, MAX_HAND_ANGULAR_SPEED)
     method = METHODS[scenario.method]
     if method.policy == ASSISTED:
         # HOP and predict-then-assist: the operator's twist plus the assistance, no DMPs.

@@ -15,15 +15,6 @@ from pbp_drake.systems.operators.pilot_filters import (
 from pbp_drake.systems.operators.sampled_operator import operator_speed
 
 
-def with_participant(resolved, params):
-    """`resolved` whose operator is the virtual participant with `params`
-    (`VirtualParticipantParams`)."""
-    participant = VirtualParticipant(**{field.name: getattr(params, field.name)
-                                        for field in dataclasses.fields(params)})
-    return dataclasses.replace(
-        resolved, scenario=dataclasses.replace(resolved.scenario, operator=participant))
-
-
 def make_pilot(resolved, make_participant, make_keys, obstacle_count=0):
     """The operator system of the resolved scenario's pilot config.
 
@@ -36,7 +27,11 @@ def make_pilot(resolved, make_participant, make_keys, obstacle_count=0):
     period, seed, nominal_speed = scenario.control_period, scenario.seed, resolved.nominal_speed
 
     def participant(params):
-        return make_participant(with_participant(resolved, params))
+        """The task's virtual participant of `params` (`VirtualParticipantParams`)."""
+        virtual = VirtualParticipant(**{field.name: getattr(params, field.name)
+                                        for field in dataclasses.fields(params)})
+        return make_participant(dataclasses.replace(
+            resolved, scenario=dataclasses.replace(scenario, operator=virtual)))
 
     def keys(params):
         return make_keys(operator_speed(params.speed, nominal_speed), params.rotation_speed)

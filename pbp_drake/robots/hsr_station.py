@@ -195,22 +195,18 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
         plant.GetFrameByName(END_EFFECTOR_FRAME, model).body(), motor_joints,
         diff_ik.get_desired_state_output_port() if kinematic else None, couplers)
     if command == "pose":
-        _add_hand_pose(builder, plant, model, q0, state)
+        # Signed nearer the hand's start orientation (PoseStateFromPlant).
+        frame_H = plant.GetFrameByName(HAND_FRAME, model)
+        q_start = pose_at(plant, frame_H, q0).rotation().ToQuaternion().wxyz()
+        hand_pose = builder.AddNamedSystem("hand_pose", PoseStateFromPlant(plant, frame_H,
+                                                                           q_start))
+        builder.Connect(state, hand_pose.get_plant_state_input_port())
+        builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
     builder.ExportOutput(state, "state")
     builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
     if not kinematic:
         builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     return finish_station(builder, plant, scene_graph, model, config, meshcat, "hsr_station")
-
-
-def _add_hand_pose(builder, plant, model, q0, state):
-    """The output hand_pose (`PoseStateFromPlant` of hand_palm_link)."""
-    frame_H = plant.GetFrameByName(HAND_FRAME, model)
-    q_start = pose_at(plant, frame_H, q0).rotation().ToQuaternion().wxyz()
-    hand_pose = builder.AddNamedSystem("hand_pose", PoseStateFromPlant(plant, frame_H,
-                                                                       q_start))
-    builder.Connect(state, hand_pose.get_plant_state_input_port())
-    builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
 
 
 hsr_station_plant = station_plant

@@ -1,10 +1,5 @@
-"""Loads our primitive-shape Toyota HSR model into a Drake MultibodyPlant.
-
-The model (``models/pbp_drake_models/hsr/hsrb_primitive.urdf``, written from published
-kinematic facts) has a base on three actuated joints (``BASE_JOINT_NAMES``), five actuated
-arm joints, a torso that follows the arm lift at half its travel (a coupler from the URDF
-``<mimic>``), and an end-effector frame ``hand_ee_link`` between the fingertips, its z
-axis out of the hand.
+"""Loads our primitive-shape Toyota HSR model (``hsr/hsrb_primitive.urdf``, written from
+published kinematic facts; docs/tasks/hsr-station.md, "The model") into a MultibodyPlant.
 
 Example::
 
@@ -34,6 +29,7 @@ ARM_JOINT_NAMES = (
     "wrist_flex_joint",
     "wrist_roll_joint",
 )
+# The end-effector frame, between the fingertips, its z axis out of the hand.
 END_EFFECTOR_FRAME = "hand_ee_link"
 # HSR's "neutral" pose (arm up, hand facing forward), in ARM_JOINT_NAMES order.
 NEUTRAL_ARM_POSITIONS = (0.0, 0.0, 0.0, -1.57, 0.0)

@@ -39,11 +39,7 @@ from pbp_drake.robots.hsr_model import (
 from pbp_drake.robots.hsr_pose_systems import HAND_FRAME, PoseCommandRamp, PoseStateFromPlant
 from pbp_drake.robots.station_parts import (
     add_robot, add_station_plant, finish_station, initial_ee_state, pose_at, station_plant)
-from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
-    CylinderObstacle,
-    HsrStationConfig,
-    validate_hsr_station_config,
-)
+from pbp_drake.robots.hsr_station_config import HsrStationConfig, validate_hsr_station_config
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
 # the hand starts in front of the base with room to move both ways along x with the

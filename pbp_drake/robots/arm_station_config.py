@@ -58,8 +58,7 @@ copyreg.pickle(DrakeLcmParams, lambda params: (_lcm_params, (
 @dataclasses.dataclass
 class ArmHardware:
     """The real arm behind an ``ArmStationConfig``: which Drake LCM driver runs it and on
-    which bus. The station drives it only when ``connect`` is true (``pbp-drake run
-    --hardware``); otherwise the arm is simulated and this is unused."""
+    which bus; unused unless ``connect`` (otherwise the arm is simulated)."""
 
     #: The arm's driver: "panda" (drake-franka-driver, position mode) or "iiwa"
     #: (drake-iiwa-driver, the position Java app).

@@ -233,9 +233,8 @@ def _check_mass_matrix(plant, arm, context, config):
 
 
 def reach_of(plant, arm, q0):
-    """`(shoulder, reach)`: the world position (3,) of the first joint that moves the end
-    effector and the farthest the end effector can be from it (m, the chain's joint
-    origins' distances summed, measured in the ready configuration `q0`)."""
+    """`arm_reach`'s `(shoulder, reach)`, measured in the ready configuration `q0` (the
+    reach: the chain's joint origins' distances summed)."""
     context = plant.CreateDefaultContext()
     plant.SetPositions(context, q0)
     points = [joint.frame_on_child().CalcPoseInWorld(context).translation()

@@ -1,12 +1,6 @@
-"""Layer 4: a resolved scenario in, a Drake Diagram out, and runs of it.
-
-- `build`: `build_diagram` (the one entry point) and `find_system`;
-- `point_robot`: the 2-D scenes; `hsr`: the HSR tasks, with `pbp_controller` (the PBP loop
-  as one Diagram) and `pbp_drake.robots.make_hsr_station`; `operators`: who drives;
-- `run`: `simulate`, `run_task`, `read_log` and their results; `streamed_run`:
-  `run_task_streamed`, a task whose per-tick rows go to a CSV file as it runs
-  (`time_series`: the CSV's columns and rows, shared with a study's trial files).
-"""
+"""Layer 4: a resolved scenario in, a Drake Diagram out (`build_diagram`: the 2-D scenes in
+`point_robot`, the tasks in `reach` and `grasp`, their controller in `pbp_controller`), and
+runs of it (`run`, `streamed_run`)."""
 
 from pbp_drake.builder.build import build_diagram, check_buildable, find_system
 from pbp_drake.builder.operators import (

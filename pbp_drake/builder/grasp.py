@@ -18,23 +18,18 @@ station, the hand driven to a grasp pose (position and orientation).
     hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
 
 With `goal_estimator: {group_mass: M}` (M > 0) a `PoseGoalGrouping` stands between
-`goal_poses` and the DMP bank, as `GoalGrouping` in the reaching task: the selected
-grasp's DMP is steered to the pose of the group of grasps the estimate cannot yet tell
-apart, and the grouping's `shown_goal` (-1 until the robot commits) is what the operator,
-the logs and the page see:
+`goal_poses` and the DMP bank, as `GoalGrouping` in the reaching task; its `shown_goal` is
+what the operator, the logs and the page see:
 
     goal_poses, hand_pose_sample, goal_estimator ──> goal_grouping
     goal_grouping.followed_poses ──> dmp_bank.goal_poses;  goal_grouping.shown_goal ──> operator
 
 Under ``hop`` and ``predict_then_assist`` an `assistance` (`PoseHopAssistance`) adds HOP's
-action to the operator's twist in place of the DMP bank and the blender (`_estimator`
-tells which goal estimator each method has).
+action to the operator's twist in place of the DMP bank and the blender.
 
-`hsr_station` is `make_hsr_station(..., command="pose")`; the DMPs start at the hand's
-start pose there (`hsr_initial_hand_pose`). Loggers named as the reaching task's, with
-`hand_pose_log` for `ee_state_log`, record each tick (`grasp_series_fields`); the task
-monitor ends the simulation at success. The operator is the grasp participant, a pilot,
-none, or a person at the `PoseKeyboardOperator` or `PoseGamepadOperator` (Meshcat).
+`hsr_station` is `make_hsr_station(..., command="pose")`. Loggers named as the reaching
+task's, with `hand_pose_log` for `ee_state_log`, record each tick (`grasp_series_fields`);
+the task monitor ends the simulation at success.
 """
 
 import numpy as np
@@ -87,20 +82,10 @@ def check_grasp_buildable(scenario):
             "a keyboard, a gamepad, the virtual participant or none")
 
 
-def hand_over_limits(scenario):
-    """The hand-over's `HandOverLimits`: the reach task's linear limits, and the angular
-    one of the grasp task (`ANGULAR_CHANGE_PER_TICK`)."""
-    robot = scenario.robot
-    return HandOverLimits(robot.max_hand_acceleration, robot.max_hand_speed,
-                          ANGULAR_CHANGE_PER_TICK / scenario.control_period,
-                          MAX_HAND_ANGULAR_SPEED)
-
-
 def grasp_dmp_banks(resolved, start_pose):
     """The position and orientation banks, straight paths (or the taught primitive's pose
-    shape) from the hand's `start_pose` `[p, q]` to the K grasp poses, one duration (the
-    farthest grasp at the nominal speed; with goal groups the median grasp:
-    `nominal_duration`), so that they share one phase."""
+    shape) from the hand's `start_pose` `[p, q]` to the K grasp poses, of one duration
+    (`nominal_duration`) so that they share one phase."""
     scenario = resolved.scenario
     goals = resolved.scene.grasps.grasp_positions
     primitive = resolved.controller.dmp_primitive
@@ -115,9 +100,9 @@ def grasp_dmp_banks(resolved, start_pose):
 
 
 def build_grasp_diagram(resolved, meshcat=None):
-    """The Diagram of a resolved grasping scenario; with `meshcat`, the robot drawn there."""
+    """The Diagram of a resolved grasping scenario (`check_grasp_buildable`); with `meshcat`,
+    the robot drawn there."""
     scenario = resolved.scenario
-    check_grasp_buildable(scenario)
     period = scenario.control_period
     task = scenario.task
     grasps = resolved.scene.grasps
@@ -138,9 +123,12 @@ def build_grasp_diagram(resolved, meshcat=None):
     builder.Connect(sampled, estimator.get_hand_pose_input_port())
     builder.Connect(goal_poses.get_output_port(), estimator.get_goal_poses_input_port())
     selected = estimator.get_selected_goal_output_port()
+    probabilities = estimator.get_goal_probabilities_output_port()
     intent = selected  # the goal the robot shows: the selected one, or the grouping's
 
-    limits = hand_over_limits(scenario)
+    # The hand-over's limits: the reach task's linear ones, and the grasp task's angular.
+    limits = HandOverLimits(scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
+                            ANGULAR_CHANGE_PER_TICK / period, MAX_HAND_ANGULAR_SPEED)
     method = METHODS[scenario.method]
     if method.policy == ASSISTED:
         # HOP and predict-then-assist: the operator's twist plus the assistance, no DMPs.
@@ -152,9 +140,8 @@ def build_grasp_diagram(resolved, meshcat=None):
     else:
         position_bank, orientation_bank = grasp_dmp_banks(resolved, start)
         prediction_steps = GRASP_PREDICTION_SAMPLES if meshcat is not None else 0
-        # The caps are the hand-over's: no DMP winds its velocity up past what the hand may
-        # do. Every DMP continues from the followed one's velocities (connected below): the
-        # compact state, which Drake copies in 16 numbers instead of 12 K.
+        # The hand-over's caps: no DMP winds its velocity up past what the hand may do. The
+        # compact state (16 numbers, not 12 K): every DMP continues from the followed one's.
         dmp_bank = builder.AddNamedSystem("dmp_bank", PoseDmpBank(
             position_bank, orientation_bank, period,
             lock_phase_when_operator_acts=method.lock_phase,
@@ -177,8 +164,7 @@ def build_grasp_diagram(resolved, meshcat=None):
         builder.Connect(selected, policy.get_selected_goal_input_port())
     shown, keys = shown_intent_and_keys(builder, scenario, intent)
     builder.Connect(sampled, policy.get_robot_state_input_port())
-    builder.Connect(estimator.get_goal_probabilities_output_port(),
-                    policy.get_goal_probabilities_input_port())
+    builder.Connect(probabilities, policy.get_goal_probabilities_input_port())
     hand_over = builder.AddNamedSystem("hand_over", PoseHandOver(start[:7], limits, period))
     builder.Connect(policy.get_reference_output_port(), hand_over.get_reference_input_port())
     builder.Connect(hand_over.get_command_output_port(), station.GetInputPort("pose_command"))
@@ -238,8 +224,7 @@ def build_grasp_diagram(resolved, meshcat=None):
                             visualizer.get_predicted_poses_input_port())
         # The measured pose, not the sample: the triad moves smoothly at 30 Hz.
         builder.Connect(hand_pose, visualizer.get_hand_state_input_port())
-        builder.Connect(estimator.get_goal_probabilities_output_port(),
-                        visualizer.get_goal_probabilities_input_port())
+        builder.Connect(probabilities, visualizer.get_goal_probabilities_input_port())
     diagram = builder.Build()
     diagram.set_name(scenario.name)
     return diagram
@@ -300,10 +285,9 @@ def _headings(orientations):
 
 def grasp_series_fields(times, hand_poses, decisions, grasp_orientations):
     """A grasping TaskResult's time series fields, as `run.series_fields` gives a reach
-    task's: `hand_poses` the `hand_pose_log` samples (T, 13), `decisions` the decision logs
-    by name, already shifted. Headings are the approach axis' floor angle; `commands` are
-    `[p, v, heading]` of the pose command; the operator's `[v, wz]` fill the reach task's
-    `operator_commands` and its whole twist is `operator_twists`."""
+    task's, from the `hand_pose_log` samples (T, 13) and the decision logs by name, already
+    shifted. Headings are the approach axis' floor angle, `commands` `[p, v, heading]` of
+    the pose command, `operator_commands` the operator's `[v, wz]`."""
     commands = decisions["command_log"]
     twists = decisions["operator_command_log"]
     targets = decisions["target_log"][:, 3].astype(int)

@@ -46,10 +46,9 @@ def sinusoidal_step_commands(config, control_period, duration):
 
 
 def make_hsr_operator(resolved, meshcat):
-    """The HSR task's operator: a person at the keyboard or gamepad (`make_person`), or the
-    virtual participant (which watches the task's obstacles, if any). The virtual
-    participant is built from the same arguments under every method and reads the keys
-    from its `forward_key` input, as a person sees them."""
+    """The reaching tasks' operator: a person at the keyboard or gamepad (`make_person`), a
+    surrogate pilot, or the virtual participant (`participant_arguments`), which reads the
+    keys from its `forward_key` input, as a person sees them."""
     scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
@@ -85,8 +84,8 @@ def make_person(resolved, meshcat, keyboard, gamepad, **keyboard_options):
 
 
 def participant_arguments(resolved):
-    """The virtual participant's arguments beyond the control period and the objects: the
-    same under every method (nothing here reads `scenario.method`)."""
+    """The virtual participant's arguments beyond the control period and the objects, the
+    same under every method."""
     scenario = resolved.scenario
     obstacles = resolved.station.obstacles
     return dict(

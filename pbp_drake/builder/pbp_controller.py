@@ -17,16 +17,12 @@ Under the PBP methods and explicit arbitration (`pbp_controller`):
     blender.command [p, v] ──> hand_over (the hand-over law: bounded acceleration)
     hand_over.command + heading_command.heading ──> ee_command (the station's input)
 
-With `goal_estimator: {group_mass: M}` (M > 0) a `GoalGrouping` stands between the goals
-and the DMP bank: it moves the selected goal's row to the point of the group of goals the
-estimate cannot yet tell apart (`pbp_drake.core.goal_groups`), and the controller's
-`selected_goal` is its `shown_goal` (-1 until the robot commits to a goal):
+With `goal_estimator: {group_mass: M}` (M > 0) a `GoalGrouping`
+(`pbp_drake.core.goal_groups`) stands between the goals and the DMP bank, and the
+controller's `selected_goal` is its `shown_goal`:
 
     goals, ee_state, goal_estimator (goal_probabilities, selected_goal) ──> goal_grouping
     goal_grouping.followed_goals ──> dmp_bank.goals;  goal_grouping.shown_goal ──> selected_goal
-
-The goal estimator is `make_goal_estimator`'s; the recursive ones add the output
-`posterior_clipped`.
 
 Under ``hop`` and ``predict_then_assist`` (`hop_controller`, no DMP bank) HOP's posterior and
 its assistance take the place of the estimator, the bank and the blender:
@@ -36,8 +32,8 @@ its assistance take the place of the estimator, the bank and the blender:
     operator_command ──> goal_estimator;  operator_command_split (v) ──> assistance
     assistance.command [p, v] ──> hand_over ──> ee_command (with the heading, as PBP's)
 
-A station of any robot with the same ports is wired as `build_reach_diagram` does:
-`station.ee_state` through a `SampleHold` into `ee_state`, and `ee_command` back.
+A station is wired as `build_reach_diagram` does: `station.ee_state` through a
+`SampleHold` into `ee_state`, and `ee_command` back.
 """
 
 import numpy as np
@@ -69,12 +65,11 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     Args:
         config: the controller's parameters (validated here; ValueError names the field).
         initial_ee_state: the hand's `EeState` (8,) where the station starts (e.g.
-            `hsr_initial_ee_state(station)`, `arm_initial_ee_state(station)`): the DMPs
-            start there, the hand-over and the heading start from it.
-        goals: (K, 3) the candidate goals at the start, one DMP each: their count sizes
-            the controller, and with `config.dmp_duration` 0 the farthest one sets the
-            DMPs' duration. The goals themselves come in on the `goals` port (K x 3,
-            row-major), so they may move.
+            `hsr_initial_ee_state(station)`): the DMPs, the hand-over and the heading
+            start there.
+        goals: (K, 3) the candidate goals at the start, one DMP each (with
+            `config.dmp_duration` 0 the farthest sets the DMPs' duration); the `goals`
+            port (K x 3, row-major) brings them as they move.
         prediction_steps: > 0 adds `predicted_paths` and `predicted_goals` (PBP methods):
             the paths of `predicted_goal_count` goals (at most K), the selected goal's
             first and then the most probable others', over the DMPs' duration in that many
@@ -101,7 +96,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     `[vx, vy, vz, yaw_rate]`, `operator_active` 1 while the operator acts, `ee_command`
     `[p (3), v (3), heading]` for the next tick. `selected_goal` is the followed goal's
     index (with goal groups, -1 until the robot commits to one), `goal_probabilities` the
-    estimator's K probabilities.
+    estimator's K probabilities; the recursive estimators add `posterior_clipped`.
     """
     config.validate()
     initial_ee_state = np.asarray(initial_ee_state, float).reshape(-1)
@@ -112,8 +107,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     if goals.ndim != 2 or goals.shape[1] != 3 or len(goals) == 0:
         raise ValueError(f"goals must be a non-empty (K, 3) array, got shape {goals.shape}")
     builder = DiagramBuilder()
-    # Drake's (C++) Demultiplexers: no Python call is spent on splitting, and everything
-    # downstream reads them once a tick, so nothing recomputes between ticks.
+    # Drake's (C++) Demultiplexers: no Python call is spent on splitting.
     split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, EeState.size - 6]))
     builder.ExportInput(split.get_input_port(), "ee_state")
     command_split = builder.AddNamedSystem("operator_command_split", Demultiplexer(
@@ -171,8 +165,8 @@ def make_goal_estimator(config: PbpControllerConfig, goal_count, pose=False, for
 
 def _add_pbp_policy(builder, config, start, goals, split, command_split, prediction_steps,
                     predicted_goal_count):
-    """The goal estimator, the DMP bank and the blender; returns the estimator and the
-    blender's command [p, v]."""
+    """The goal estimator, the DMP bank and the blender; returns the estimator, the
+    blender's command [p, v] and the goal shown."""
     period = config.control_period
     goal_count = len(goals)
     position_velocity = split.get_output_port(0)
@@ -181,6 +175,8 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
                                                                              goal_count))
     builder.ConnectInput("ee_state", estimator.get_ee_state_input_port())
     builder.ExportInput(estimator.get_goals_input_port(), "goals")
+    selected = estimator.get_selected_goal_output_port()
+    probabilities = estimator.get_goal_probabilities_output_port()
     # The recursive estimators (maxent_command, intent_filter) read the operator too.
     reads_operator = estimator.HasInputPort("operator_command")
     if reads_operator:
@@ -199,16 +195,14 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         # Every DMP steps from the followed one's velocity (connected below): the state is
         # then O(D) whatever K.
         compact_state=True, predicted_goal_count=predicted_goal_count))
-    shown = estimator.get_selected_goal_output_port()
+    shown = selected
     if settings.group_mass > 0.0:
         grouping = builder.AddNamedSystem("goal_grouping", GoalGrouping(goal_count, settings,
                                                                         period))
         builder.ConnectInput("goals", grouping.get_goals_input_port())
         builder.ConnectInput("ee_state", grouping.get_ee_state_input_port())
-        builder.Connect(estimator.get_goal_probabilities_output_port(),
-                        grouping.get_goal_probabilities_input_port())
-        builder.Connect(estimator.get_selected_goal_output_port(),
-                        grouping.get_selected_goal_input_port())
+        builder.Connect(probabilities, grouping.get_goal_probabilities_input_port())
+        builder.Connect(selected, grouping.get_selected_goal_input_port())
         builder.Connect(grouping.get_followed_goals_output_port(),
                         dmp_bank.get_goals_input_port())
         shown = grouping.get_shown_goal_output_port()
@@ -225,25 +219,19 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
     # The blender follows the selected goal's reference alone (O(D), not all K).
     builder.Connect(dmp_bank.get_selected_reference_output_port(),
                     blender.get_policy_reference_input_port())
-    builder.Connect(estimator.get_selected_goal_output_port(),
-                    dmp_bank.get_selected_goal_input_port())
-    builder.Connect(estimator.get_selected_goal_output_port(),
-                    blender.get_selected_goal_input_port())
+    builder.Connect(selected, dmp_bank.get_selected_goal_input_port())
+    builder.Connect(selected, blender.get_selected_goal_input_port())
     # Read at the decide stage before the estimator updates: the goal followed last tick.
-    builder.Connect(estimator.get_selected_goal_output_port(),
-                    dmp_bank.get_followed_goal_input_port())
-    builder.Connect(estimator.get_goal_probabilities_output_port(),
-                    blender.get_goal_probabilities_input_port())
+    builder.Connect(selected, dmp_bank.get_followed_goal_input_port())
+    builder.Connect(probabilities, blender.get_goal_probabilities_input_port())
     builder.Connect(command_split.get_output_port(0), blender.get_operator_command_input_port())
     builder.ConnectInput("operator_active", blender.get_operator_active_input_port())
     builder.ExportOutput(dmp_bank.get_phase_output_port(), "phase")
     if prediction_steps:
         likely = builder.AddNamedSystem("likely_goals", LikelyGoals(
             goal_count, predicted_goal_count))
-        builder.Connect(estimator.get_selected_goal_output_port(),
-                        likely.get_selected_goal_input_port())
-        builder.Connect(estimator.get_goal_probabilities_output_port(),
-                        likely.get_goal_probabilities_input_port())
+        builder.Connect(selected, likely.get_selected_goal_input_port())
+        builder.Connect(probabilities, likely.get_goal_probabilities_input_port())
         builder.Connect(likely.get_goal_indices_output_port(),
                         dmp_bank.get_predicted_goals_input_port())
         builder.ExportOutput(dmp_bank.get_predicted_paths_output_port(), "predicted_paths")
@@ -253,11 +241,9 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
 
 def _add_hop_policy(builder, config, start, goals, split, command_split, prediction_steps,
                     predicted_goal_count):
-    """HOP's posterior and assistance (no DMPs, nothing predicted); returns the posterior
-    and the assistance's command [p, v]. The operator's yaw rate turns the hand as under PBP; HOP
-    assists the position only, since the reaching tasks' goals are positions.
-    `selected_goal` is the most probable goal (no hysteresis: predict-then-assist assists
-    toward it)."""
+    """HOP's posterior and assistance (no DMPs, nothing predicted), which assists the
+    position only (the goals are positions); returns as `_add_pbp_policy`, the goal shown
+    the most probable one (no hysteresis: predict-then-assist assists toward it)."""
     period = config.control_period
     goal_count = len(goals)
     posterior = builder.AddNamedSystem("goal_estimator", MaxEntGoalEstimator(

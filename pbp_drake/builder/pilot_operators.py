@@ -1,11 +1,8 @@
-"""The operator system of a surrogate pilot (`pbp_drake.scenarios.pilots`) in a task.
-
-The noisy and laggy pilots are the task's virtual participant with a filter after it
+"""The operator system of a surrogate pilot (`pbp_drake.scenarios.pilots`) in any task: the
+noisy and laggy pilots are the task's virtual participant with a filter after it
 (`PilotOperator`), the population's is the participant drawn for the trial's seed, and
-HOP's simulated user is a `ProportionalOperator`. None reads the scenario's method: the
-keys it enables reach them through the `forward_key` port, so each pilot is built from the
-same arguments under every method. The task's builder passes how it builds its
-participant and its keys; everything else is here, once for every task.
+HOP's simulated user is a `ProportionalOperator`. None reads the scenario's method (the
+keys reach them through the `forward_key` port).
 """
 
 import dataclasses
@@ -16,15 +13,6 @@ from pbp_drake.scenarios import (
 from pbp_drake.systems.operators.pilot_filters import (
     LaggyFilter, NoisyFilter, PilotOperator, ProportionalOperator)
 from pbp_drake.systems.operators.sampled_operator import operator_speed
-
-
-def with_participant(resolved, params):
-    """`resolved` whose operator is the virtual participant with `params`
-    (`VirtualParticipantParams`)."""
-    participant = VirtualParticipant(**{field.name: getattr(params, field.name)
-                                        for field in dataclasses.fields(params)})
-    return dataclasses.replace(
-        resolved, scenario=dataclasses.replace(resolved.scenario, operator=participant))
 
 
 def make_pilot(resolved, make_participant, make_keys, obstacle_count=0):
@@ -39,7 +27,11 @@ def make_pilot(resolved, make_participant, make_keys, obstacle_count=0):
     period, seed, nominal_speed = scenario.control_period, scenario.seed, resolved.nominal_speed
 
     def participant(params):
-        return make_participant(with_participant(resolved, params))
+        """The task's virtual participant of `params` (`VirtualParticipantParams`)."""
+        virtual = VirtualParticipant(**{field.name: getattr(params, field.name)
+                                        for field in dataclasses.fields(params)})
+        return make_participant(dataclasses.replace(
+            resolved, scenario=dataclasses.replace(scenario, operator=virtual)))
 
     def keys(params):
         return make_keys(operator_speed(params.speed, nominal_speed), params.rotation_speed)

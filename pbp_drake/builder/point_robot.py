@@ -22,11 +22,8 @@ from pbp_drake.systems.visualizers.point_scene_visualizer import PointSceneVisua
 
 
 def build_point_robot_diagram(resolved, meshcat=None, prediction_steps=None):
-    """The Diagram of a resolved 2-D scenario; with `meshcat`, also draws it there.
-
-    `prediction_steps` (default: the DMP's duration in control periods when drawing) sets
-    how far ahead the DMP bank predicts its paths for drawing.
-    """
+    """The Diagram of a resolved 2-D scenario; with `meshcat`, also draws it there (the
+    DMPs' paths `prediction_steps` ahead, as `build_diagram`'s)."""
     scenario = resolved.scenario
     period = scenario.control_period
     start, goals = resolved.start, resolved.goals

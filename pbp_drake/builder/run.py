@@ -1,13 +1,9 @@
-"""Running a built scenario: simulating a 2-D scene for its duration (`simulate`), running an
-HSR task to success or its time limit (`run_task`), and reading back the loggers the builder
-adds (`read_log`).
+"""Running a built scenario: a 2-D scene for its duration (`simulate`), an HSR task to
+success or its time limit (`run_task`), and reading back the builder's loggers (`read_log`).
 
-Both take a `ResolvedScenario` (or a `Scenario`, resolved here once) and apply the scenario's
-`SimulatorConfig`; `realtime_rate` overrides its target real-time rate. `advance`, when
-given, replaces `advance_to` (one `Simulator.AdvanceTo`): the operator's console
-(`pbp_drake.console.LiveRun`) advances in slices and may end the run early. The order
-within a tick, and so which log sample holds which tick's decisions, is
-`pbp_drake.systems.tick`'s.
+Both take a `ResolvedScenario` (or a `Scenario`, resolved here once). `advance`, when given,
+replaces `advance_to`: the operator's console (`pbp_drake.console.LiveRun`) advances in
+slices and may end the run early.
 """
 
 import dataclasses
@@ -49,9 +45,7 @@ class Trajectory:
 def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=None):
     """`(scenario, diagram, simulator)` of a scenario (resolved once if it is not): the
     diagram built unless given, the simulator configured by the scenario's
-    `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized. An
-    operator's pause for a shared browser page restarts the real-time pacing
-    (`reset_pacing_after_pauses`)."""
+    `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
     diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
     simulator = Simulator(diagram)
@@ -60,8 +54,7 @@ def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=No
     if realtime_rate is not None:
         simulator.set_target_realtime_rate(realtime_rate)
     if drives_real_robot(getattr(resolved.scenario.robot, "hardware", None)):
-        # A real robot lives on the wall clock: its driver's status, our watchdog and the
-        # Panda's command stamps are in real seconds, whatever the page asks.
+        # A real robot lives on the wall clock, whatever the page asks.
         simulator.set_target_realtime_rate(1.0)
     simulator.Initialize()
     return resolved.scenario, diagram, simulator
@@ -170,11 +163,7 @@ class TaskResult:
             time_to_prediction, mean_time_to_prediction, unpredicted_switches: how the
             operator and the method worked together (`pbp_drake.core.interaction_metrics`,
             over the series' ticks; `idle_ratio` is `1 - intervention_ratio`, on the task
-            monitor's ticks). The operator's command is `operator_commands[:, :3]`, its
-            turning the yaw rate (the reaching tasks) or the angular velocity of
-            `operator_twists` (the grasping task); the named goal `selected_goals`, -1
-            where the method names none. None when unknown (a TaskResult made without
-            them).
+            monitor's ticks). None when unknown (a TaskResult made without them).
     """
 
     success: bool
@@ -221,10 +210,9 @@ class TaskResult:
         the peaks and, where measured, the interaction metrics. `stopped`: the person ended
         the run before its end ("stopped at")."""
         outcome = "success" if self.success else "FAILED"
-        # A reach task's collision_ratio is 0 because nothing measured it: left out.
+        # Only the obstacle task measures collisions.
         collisions = ("" if self.in_collision is None
                       else f", collision ratio {self.collision_ratio:.3f}")
-        # The grasping task's orientation: where the hand ended and the wrist's largest jolt.
         turning = ("" if self.angles_to_target is None else
                    f", final angle to target {_or_na(self.final_angle_to_target, 1)} deg, peak "
                    f"command angular change {_or_na(self.peak_command_angular_change, 3)} "

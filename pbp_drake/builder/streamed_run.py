@@ -1,16 +1,11 @@
 """Running an HSR task with its per-tick rows streamed to a CSV file (`run_task_streamed`),
-for runs too long to keep their time series in memory (`pbp_drake_bench.soak` runs one for an
-hour of simulated time).
+for runs too long to keep their time series in memory (`pbp_drake_bench.soak`).
 
 After each chunk of simulated time the rows of the ticks it completed are appended to the
-file (`pbp_drake.builder.time_series`) and every logger is cleared, so memory holds one
-chunk however long the run; what needs the whole series (the peaks, the grasping task's
-last angle) is carried from chunk to chunk.
-
-The rows are `run_task`'s, read by the same functions (`run.task_series`,
-`run.SeriesPeaks`). A tick's decisions are logged one sample after its state
-(`DECISION_LOG_SHIFT`): a chunk's last state sample waits for the next chunk's decisions,
-and the run's last one, whose decisions are never logged, is not written.
+file and every logger is cleared; the peaks (`run.SeriesPeaks`) are carried from chunk to
+chunk. A tick's decisions are logged one sample after its state (`DECISION_LOG_SHIFT`): a
+chunk's last state sample waits for the next chunk's decisions (the run's last is not
+written).
 """
 
 import numpy as np
@@ -27,14 +22,10 @@ DEFAULT_CHUNK_SECONDS = 10.0
 
 def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diagram=None,
                       chunk_seconds=DEFAULT_CHUNK_SECONDS, after_chunk=None, advance=None):
-    """Simulates an HSR task until success or `scenario.duration` (the time limit), like
-    `run_task`, writing one CSV row per control tick to `log_path` (header first) as it goes.
-
-    Returns the TaskResult `run_task` would return, with the same metrics and peaks, but
-    whose time series (`times`, `ee_positions`, ..., `in_collision`) are empty (no ticks):
-    they are in the file. `after_chunk(time)`, when given, is called after each chunk is
-    written, with the simulated time reached. `advance` replaces `advance_to` (see
-    `pbp_drake.builder.run`); the run ends when it returns True.
+    """`run_task`, writing one CSV row per control tick to `log_path` (header first) as it
+    goes. Returns `run_task`'s TaskResult, whose time series are empty (they are in the
+    file). `after_chunk(time)`, when given, is called after each chunk is written with the
+    simulated time reached; `advance` as `run_task`'s.
     """
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
                                                          diagram)
@@ -58,7 +49,6 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
             peaks.add_clipped(series.posterior_clipped)
             if after_chunk is not None:
                 after_chunk(context.get_time())
-            # The task monitor ends the simulation at success (or the person, at a console).
             if tick == last_tick or ended:
                 break
     status, monitor = final_status(diagram, context)
@@ -115,9 +105,8 @@ class _LogTail:
         return self._split(len(self._samples[DECISION_LOGS[0]]))
 
     def _split(self, count):
-        """The `_Series` of the first `count` pending ticks, which leave the tail. What
-        stays, and what is taken, are copies: a slice would keep alive the whole chunk it
-        was cut from (a streamed run's empty series held one chunk per run, 50 kB)."""
+        """The `_Series` of the first `count` pending ticks, which leave the tail (as copies:
+        a slice would keep alive the whole chunk it was cut from)."""
         times, self._times = self._times[:count].copy(), self._times[count:].copy()
         taken = {}
         for name in self._samples:

@@ -6,8 +6,8 @@ import numpy as np
 
 
 # The hand's orientation in the grasping task, a unit quaternion w, x, y, z
-# (`TaskResult.hand_orientations`: what `pbp-drake teach` fits a pose from). Trial files
-# written before it was logged end without these columns.
+# (`TaskResult.hand_orientations`: what `pbp-drake teach` fits a pose from); a trial file
+# may end without these columns.
 HAND_ORIENTATION_COLUMNS = ["hand_qw", "hand_qx", "hand_qy", "hand_qz"]
 # The grasping task's orientation columns (`TaskResult.angles_to_target`, degrees; the
 # commanded and the operator's angular velocities, rad/s, world frame; the hand's).
@@ -35,16 +35,11 @@ def _has_grasp(series):
 
 def time_series_rows(series):
     """The CSV lines (newlines included, no header) of the per-tick series of `series`: a
-    TaskResult, or any object with its time series attributes (`times`, `ee_positions`,
-    `headings`, `commands`, `operator_active`, `operator_commands`, `selected_goals`,
-    `targets`, `in_collision`; the grasping task's `angles_to_target`,
-    `command_angular_velocities`, `operator_twists` and `hand_orientations` too). Floats
-    are written in their shortest exact form, so reading them back gives the same
-    numbers."""
+    TaskResult, or any object with its time series attributes. Floats are written in their
+    shortest exact form (repr), so reading them back gives the same numbers."""
     has_collision = series.in_collision is not None
     has_grasp = _has_grasp(series)
-    # Python lists once, not a numpy scalar per cell: the same numbers (repr of the same
-    # doubles) in a third of the time.
+    # Python lists, not a numpy scalar per cell: the same doubles' repr, faster.
     times, ee, headings, commands, active, operator, selected, targets = (
         np.asarray(values).tolist() for values in (
             series.times, series.ee_positions, series.headings, series.commands,

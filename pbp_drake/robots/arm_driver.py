@@ -161,9 +161,8 @@ def read_first_status(hardware, lcm, lower, upper):
 
 
 class DriverLink(LeafSystem):
-    """The station's link to a real arm's driver: reads its status, sends it the diff IK's
-    joint positions under the drivers' rules (the module's docstring), and gives the arm's
-    measured state.
+    """The station's link to a real arm's driver, under the drivers' rules (the module's
+    docstring).
 
     .. pydrake_system::
 
@@ -177,8 +176,8 @@ class DriverLink(LeafSystem):
     ``status`` is the driver's last status message (an ``LcmSubscriberSystem``'s output,
     ``lcmt_panda_status`` or ``lcmt_iiwa_status``), ``desired_state`` the diff IK's
     ``[q_d, v_d]``, ``state`` the arm's measured ``[q, v]`` (``q_start`` at rest before
-    the first status). At each driver period it reads the status, checks it and the
-    clocks, and sends the command (`lcm.Publish`) in a publish event after that update.
+    the first status). The command is sent in a publish event after each driver period's
+    update.
     """
 
     def __init__(self, hardware, lcm, q_start, lower, upper, velocity_limits, clock):
@@ -195,10 +194,10 @@ class DriverLink(LeafSystem):
                else hardware.lcm_bus.lcm_url)
         self._first = f"status from the {hardware.driver} driver on {channel} (bus {bus})"
         self._silent = f"the {hardware.driver} driver's status on {channel} (bus {bus})"
-        # State: measured q and v, the last command, then the times: of the last status
-        # (its utime, and on our clock when it came), of the first status and of the
-        # first update on the wall clock less the simulation's (the loop's lag is
-        # measured from it), and whether this update sends.
+        # State: measured q and v, the last command; the last status's utime and when it
+        # came (our clock), when the first status came, the first update's time and its
+        # wall clock less the simulation's (the loop's lag is measured from it); whether
+        # this update sends.
         self._Q, self._V, self._SENT = slice(0, n), slice(n, 2 * n), slice(2 * n, 3 * n)
         (self._UTIME, self._STATUS_AT, self._FIRST_AT, self._STARTED_AT, self._OFFSET,
          self._SEND) = range(3 * n, 3 * n + 6)
@@ -260,8 +259,7 @@ class DriverLink(LeafSystem):
         x[self._UTIME], x[self._STATUS_AT] = message.utime, now
 
     def _command(self, context, x):
-        """The diff IK's q_d within the position limits and at most the velocity limits
-        from the last command."""
+        """The diff IK's q_d within the position limits and the velocity limits' step."""
         q_d = np.asarray(self.get_input_port(1).Eval(context))[:self._n]
         if not np.all(np.isfinite(q_d)):
             raise DriverError("the diff IK's joint positions hold a NaN: nothing is sent, "

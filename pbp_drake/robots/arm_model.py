@@ -1,9 +1,8 @@
 """Loading a fixed-base arm from a URDF or SDFormat file into a MultibodyPlant, with the
-checks a user's own model needs: the file (`pbp_drake.robots.model_checks`, before Drake
-reads it), the frames, the chain from the base to the end effector, the joints' limits,
-the ready configuration and, for dynamic motion, its mass matrix there.
-
-Every refusal is a one-line ValueError naming the `ArmStationConfig` field at fault.
+checks a user's own model needs: the file (`pbp_drake.robots.model_checks`), the frames,
+the chain from the base to the end effector, the joints' limits, the ready configuration
+and, for dynamic motion, its mass matrix there; each refusal is a one-line ValueError
+naming the `ArmStationConfig` field at fault.
 """
 
 import dataclasses
@@ -37,14 +36,14 @@ class ArmModel:
     chain: tuple
 
 
-def add_arm(plant, config, parser=None):
+def add_arm(plant, config):
     """Adds the arm of `config` (an `ArmStationConfig`) to `plant` (not finalized yet),
     its base frame welded to the world at `config.base_pose`, and returns an `ArmModel`.
     Raises ValueError naming the field for a file that is missing or does not parse, a
     frame the model has not, an end effector that is not downstream of the base, a joint
     without limits or of a kind the station cannot move."""
     check_model_file(config.model_file, config.motion)
-    parser = parser or Parser(plant)
+    parser = Parser(plant)
     configure_parser(parser)
     source = config.model_file
     try:
@@ -173,9 +172,9 @@ IK_STARTS = 40
 
 def _solve_tool_pose(plant, arm, config, q_given):
     """The configuration within the joints' limits that puts ee_frame at
-    `config.ready_tool_pose`, nearest `q_given` (`config.initial_positions`) or, without
-    it, the middle of the limits: a least-squares cost toward it, solved from it and from
-    seeded starts, the least cost kept (deterministic; remembered per model and pose)."""
+    `config.ready_tool_pose`, nearest `q_given` (`config.initial_positions`) or else the
+    middle of the limits, solved from it and from seeded starts, the least cost kept
+    (deterministic; remembered per model and pose)."""
     X_WE = config.ready_tool_pose.transform()
     lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
     nominal = np.asarray(q_given if config.initial_positions else (lower + upper) / 2, float)
@@ -234,9 +233,8 @@ def _check_mass_matrix(plant, arm, context, config):
 
 
 def reach_of(plant, arm, q0):
-    """`(shoulder, reach)`: the world position (3,) of the first joint that moves the end
-    effector and the farthest the end effector can be from it (m, the chain's joint
-    origins' distances summed, measured in the ready configuration `q0`)."""
+    """`arm_reach`'s `(shoulder, reach)`, measured in the ready configuration `q0` (the
+    reach: the chain's joint origins' distances summed)."""
     context = plant.CreateDefaultContext()
     plant.SetPositions(context, q0)
     points = [joint.frame_on_child().CalcPoseInWorld(context).translation()

@@ -1,8 +1,5 @@
 """A fixed-base arm from any URDF or SDFormat file that follows an end-effector command, as
-one Diagram with the HSR station's ports: the station of a user's own robot.
-
-``make_arm_station(ArmStationConfig(model_file=..., base_frame=..., ee_frame=...))``
-returns a Diagram named ``arm_station``::
+one Diagram with the HSR station's ports (docs/concepts/your-robot.md)::
 
     ee_command ─► WholeBodyDiffIk (its EeCommandRamp) ─► [q_d, v_d] (desired_state)
     desired_state ─► KinematicJoints (motion: kinematic) or the plant's PD (dynamic)
@@ -16,10 +13,7 @@ driver (``pbp_drake.robots.arm_driver``)::
     DriverLink.state (measured) ─► KinematicJoints ─► robot state (the geometry, ee_state)
 
 with ``hardware.driver_sim`` the driver simulator (``pbp_drake.robots.driver_sim``) inside
-on a memq:// bus of its own.
-
-The differential IK is the HSR station's (`WholeBodyDiffIk`), the redundant motion drifting
-back to the ready configuration (docs/concepts/your-robot.md). Gravity is off.
+on a memq:// bus of its own. The diff IK is the HSR station's; gravity is off.
 
 Example::
 
@@ -70,8 +64,7 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
     The ports are ``make_hsr_station``'s, of ``ee_frame`` (its orientation the ready one
     turned about the vertical by the heading), ``desired_state`` over every joint of the
     model in its order. A fresh context starts at rest in the ready configuration. Raises
-    ValueError naming the config's field for a model, frame or configuration that cannot
-    work.
+    ValueError naming the config's field that cannot work.
     """
     validate_arm_station_config(config)
     builder = DiagramBuilder()
@@ -103,14 +96,12 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
 
 
 def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
-    """The LCM side of the station (the module's docstring): returns the measured state's
-    port. The run read the driver's first status before it built this (`q0`, the ready
-    configuration, is where the arm stood); with `driver_sim` the simulator stands there."""
+    """The LCM side of the station (the module's docstring); returns the measured state's
+    port. `q0` is where the driver's first status put the arm (or the simulator)."""
     driver = DRIVERS[hardware.driver]
     q_start = _arm_positions(arm, q0)
     lower, upper, velocity = _joint_limits(plant, arm)
     if hardware.driver_sim:
-        # A bus of its own in this process, which the station and the simulator share.
         lcm, clock = DrakeLcm("memq://"), SIMULATION_CLOCK
         builder.AddNamedSystem("driver_sim", make_driver_sim(
             hardware.driver, lcm, clock, q_start, lower, upper, velocity,
@@ -153,26 +144,24 @@ def arm_driver_sim(config: ArmStationConfig, lcm, clock=WALL_CLOCK) -> Diagram:
 
 def drives_real_robot(hardware) -> bool:
     """Whether a station of this `ArmHardware` or `TaskSpaceBridgeConfig` (or None) drives
-    a real robot: connected, not to the simulator of its driver or relay. Such a run goes
-    in real time, the robot's clock the wall's."""
+    a real robot: connected, not to the simulator of its driver or relay."""
     return hardware is not None and hardware.connect and not hardware.driver_sim
 
 
 def measured_ready_positions(config: ArmStationConfig) -> np.ndarray:
-    """The arm's joint positions from its driver's first status, on a DrakeLcm of its own
-    on `config.hardware.lcm_bus`: the ready configuration of a run on the real arm, read
-    before the run is built. (Its own, because its Python callback must not be called
-    from inside a simulation: newer Drakes advance without holding Python's lock there.)
-    Raises `DriverError` naming the bus and channel when no status comes within
-    `connect_timeout`."""
+    """The arm's joint positions from its driver's first status: the ready configuration of
+    a run on the real arm, read before the run is built, on a DrakeLcm of its own on
+    `config.hardware.lcm_bus` (its Python callback must not run inside a simulation, which
+    newer Drakes advance without Python's lock). Raises `DriverError` naming the bus and
+    channel when no status comes within `connect_timeout`."""
     plant, arm, _ = arm_model_plant(config)
     lower, upper, _ = _joint_limits(plant, arm)
     return read_first_status(config.hardware, DrakeLcm(config.hardware.lcm_bus), lower, upper)
 
 
 def _add_motors(plant, arm):
-    """A motor on every joint the model left without one (the plant's PD drives them)."""
-    # Before Finalize, only the plant-wide list holds the model's transmissions' motors.
+    """A motor on every joint the model left without one (the plant's PD drives them).
+    Before Finalize only the plant-wide list holds the model's own motors."""
     driven = {int(plant.get_joint_actuator(index).joint().index())
               for index in plant.GetJointActuatorIndices()}
     for joint in arm.joints:
@@ -215,8 +204,7 @@ def _make_diff_ik(plant, arm, q0, config, ramp, look_ahead):
 
 def arm_model_plant(config: ArmStationConfig):
     """`(plant, arm, q0)`: a finalized bare plant of `config`'s arm (no station), its
-    `ArmModel` and ready positions; what a scenario is resolved from before its station
-    is built. Raises ValueError as `make_arm_station` does."""
+    `ArmModel` and ready positions. Raises ValueError as `make_arm_station` does."""
     validate_arm_station_config(config)
     plant = MultibodyPlant(config.plant.time_step)
     arm = add_arm(plant, config)
@@ -225,8 +213,8 @@ def arm_model_plant(config: ArmStationConfig):
 
 
 def arm_ready_ee_state(config: ArmStationConfig) -> np.ndarray:
-    """The hand's ``ee_state`` (``EeState``) where a station of ``config`` starts, at rest,
-    from the model's kinematics alone. Equal to ``arm_initial_ee_state`` of that station."""
+    """The hand's ``ee_state`` (``EeState``) where a station of ``config`` starts, from the
+    model's kinematics alone; equal to ``arm_initial_ee_state`` of that station."""
     return arm_ready_ee_state_and_reach(config)[0]
 
 

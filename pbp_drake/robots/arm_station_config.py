@@ -58,8 +58,7 @@ copyreg.pickle(DrakeLcmParams, lambda params: (_lcm_params, (
 @dataclasses.dataclass
 class ArmHardware:
     """The real arm behind an ``ArmStationConfig``: which Drake LCM driver runs it and on
-    which bus. The station drives it only when ``connect`` is true (``pbp-drake run
-    --hardware``); otherwise the arm is simulated and this is unused."""
+    which bus; unused unless ``connect`` (otherwise the arm is simulated)."""
 
     #: The arm's driver: "panda" (drake-franka-driver, position mode) or "iiwa"
     #: (drake-iiwa-driver, the position Java app).
@@ -182,12 +181,10 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
                                  f"finite numbers, got {value}")
     check_positive(config, ("default_acceleration_limit", "servo_frequency"),
                    "ArmStationConfig")
-    if not (np.isfinite(config.singular_margin) and config.singular_margin >= 0):
-        raise ValueError(f"ArmStationConfig.singular_margin must be >= 0, got "
-                         f"{config.singular_margin}")
-    if not (np.isfinite(config.centering_gain) and config.centering_gain >= 0):
-        raise ValueError(f"ArmStationConfig.centering_gain must be >= 0, got "
-                         f"{config.centering_gain}")
+    for name in ("singular_margin", "centering_gain"):
+        value = getattr(config, name)
+        if not (np.isfinite(value) and value >= 0):
+            raise ValueError(f"ArmStationConfig.{name} must be >= 0, got {value}")
     if config.hardware is not None:
         validate_arm_hardware(config.hardware)
 
@@ -203,9 +200,9 @@ def validate_arm_hardware(hardware: ArmHardware) -> None:
 
 
 def validate_link(link, field, positive):
-    """What an `ArmHardware` and a `TaskSpaceBridgeConfig` (`field`: where it stands)
-    share: an LCM URL two processes can share, the fields `positive` finite and positive,
-    `driver_sim` only with `connect`. Raises ValueError naming the field."""
+    """Raises ValueError naming the field (`field`: where `link` stands) unless the LCM URL
+    of an `ArmHardware` or `TaskSpaceBridgeConfig` can be shared, its fields `positive` are
+    finite and positive, and `driver_sim` comes only with `connect`."""
     check_lcm_url(link.lcm_bus.lcm_url, f"{field}.lcm_bus.lcm_url")
     check_positive(link, positive, field)
     if link.driver_sim and not link.connect:

@@ -86,13 +86,10 @@ def solve_box_qp_primal(H, g, lower, upper, hold=None, max_iterations=100):
     in the way, holding one variable at a time, and lets go of held ones whose bound the
     cost pulls away from.
 
-    ``hold`` guesses which variables end at a bound (-1 lower, 1 upper, 0 neither), such
-    as the last solution's; a good guess saves iterations, and any guess gives the same
-    minimum. Returns the minimizer and which variables it holds at a bound.
-
-    Which variables are out of their bounds, block a step or leave a bound is decided on
-    Python lists (a numpy call per test costs more than the test), and the system solved is
-    kept from one iteration to the next, a row changed where a variable is held or let go.
+    ``hold`` and the result as `solve_box_qp`'s; any guess gives the same minimum. The
+    tests are made on Python lists (a numpy call per test costs more than the test), and
+    the system solved is kept between iterations, a row changed where a variable is held or
+    let go.
     """
     n = g.size
     identity = _identity(n)

@@ -1,16 +1,8 @@
 """A driver simulator: the arm of an `ArmStationConfig` behind the LCM channels and rules of
 its Drake driver, so that the station's whole LCM path runs with no robot (`pbp-drake
-driver-sim FILE` on the bus, or in the run's process with `run --hardware --driver-sim`).
-
-``make_driver_sim(driver, lcm, clock, q_start, ...)`` returns a Diagram named ``driver_sim``::
+driver-sim FILE` on the bus, or in the run's process with `run --hardware --driver-sim`)::
 
     LcmSubscriberSystem (COMMAND channel) ─► DriverSim ─► status on the STATUS channel
-
-`DriverSim` keeps the drivers' rules: the Panda drops a command stamped more than
-`expire_sec` from its clock and refuses one for another mode than position; the iiwa
-aborts on a command within its start-up guard and clamps commands 1 degree inside the
-limits; both hold the last accepted position. The joints move toward it at their velocity
-limits.
 """
 
 import numpy as np
@@ -34,7 +26,11 @@ class DriverSimError(RuntimeError):
 
 
 class DriverSim(LeafSystem):
-    """An arm behind its driver's rules (the module's docstring).
+    """An arm behind its driver's rules: the Panda drops a command stamped more than
+    `expire_sec` from its clock and refuses one for another mode than position; the iiwa
+    aborts on a command within its start-up guard and clamps commands 1 degree inside the
+    limits; both hold the last accepted position, toward which the joints move at their
+    velocity limits.
 
     .. pydrake_system::
 
@@ -42,10 +38,8 @@ class DriverSim(LeafSystem):
         input_ports:
         - command
 
-    ``command`` is the last command message (an ``LcmSubscriberSystem``'s output). At each
-    driver period it takes a new command under the rules, moves the joints toward the
-    accepted position at their velocity limits, and publishes the status (`lcm.Publish`)
-    stamped on `clock`.
+    ``command`` is the last command message (an ``LcmSubscriberSystem``'s output); the
+    status goes out each driver period, stamped on `clock`.
     """
 
     def __init__(self, driver, lcm, q_start, lower, upper, velocity_limits, clock,
@@ -56,8 +50,7 @@ class DriverSim(LeafSystem):
         self._lower, self._upper = np.asarray(lower, float), np.asarray(upper, float)
         self._velocity = np.asarray(velocity_limits, float)
         n = self._n = len(q_start)
-        # State: q, v, the accepted command, the last command's utime, the first status's
-        # time on the clock.
+        # State: q, v, the accepted command, the last command's utime, the first status's time.
         self._Q, self._V, self._HELD = slice(0, n), slice(n, 2 * n), slice(2 * n, 3 * n)
         self._UTIME, self._FIRST_AT = 3 * n, 3 * n + 1
         q_start = np.asarray(q_start, float)
@@ -129,10 +122,9 @@ class DriverSim(LeafSystem):
 
 def make_driver_sim(driver, lcm, clock, q_start, lower, upper, velocity_limits,
                     with_interface=True, expire_sec=PANDA_EXPIRE_SEC):
-    """An arm of the joints' `lower`, `upper` and `velocity_limits` standing at `q_start`
-    behind `driver`'s rules on `lcm`, as a Diagram named ``driver_sim``;
-    `with_interface`: with its own `LcmInterfaceSystem` pumping `lcm` (not when the
-    station in the same diagram pumps it); `expire_sec`: the Panda driver's."""
+    """A Diagram named ``driver_sim``: an arm of the joints' `lower`, `upper` and
+    `velocity_limits` standing at `q_start` behind `driver`'s rules on `lcm`, with its own
+    `LcmInterfaceSystem` unless not `with_interface` (the station's pumps `lcm`)."""
     builder = DiagramBuilder()
     if with_interface:
         builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))

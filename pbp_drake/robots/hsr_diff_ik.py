@@ -44,35 +44,27 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         output_ports:
         - desired_state
 
-    The command's ``command_ramp`` (``EeCommandRamp``, ``PoseCommandRamp``) names and
-    sizes the command port and makes from the command the hand's desired pose
-    ``X_WE_desired`` and twist ``V_WE_desired`` (world frame, ``[w, v]``). At each step
-    ``t_n`` (period ``time_step``) it picks the velocity ``v_n`` of the plan until
-    ``t_n + time_step``: ``V_WE_desired`` plus what closes the gap from the plan's pose to
-    ``X_WE_desired`` over ``CATCH_UP_STEPS`` steps, as nearly as the joints' position,
-    velocity and acceleration limits allow (a least-squares QP, the accelerations taken
-    relative to the plan's previous velocity), and in the rest of the joint space a drift
-    toward ``q_nominal`` at ``centering_gain`` (1/s, per joint). ``X_WE_desired`` is
-    thus read as the pose to have at the end of the step: on a pose moving at
-    ``V_WE_desired`` the plan stays exactly on it. The plan is piecewise linear in
-    position.
+    ``command_ramp`` (``EeCommandRamp``, ``PoseCommandRamp``) names and sizes the command
+    port and makes from the command the hand's desired pose ``X_WE_desired`` and twist
+    ``V_WE_desired`` (world frame, ``[w, v]``). Each step (period ``time_step``) picks the
+    plan's velocity until the next: ``V_WE_desired`` plus what closes the gap from the
+    plan's pose to ``X_WE_desired`` (the pose to have at the end of the step) over
+    ``CATCH_UP_STEPS`` steps, as nearly as the joints' position, velocity and acceleration
+    limits allow (a least-squares QP, the accelerations relative to the plan's previous
+    velocity), the rest of the joint space drifting toward ``q_nominal`` at
+    ``centering_gain`` (1/s, per joint). The plan is piecewise linear in position. Not
+    Drake's ``DifferentialInverseKinematicsIntegrator`` (docs/tasks/hsr-station.md).
 
-    Not Drake's ``DifferentialInverseKinematicsIntegrator``, which takes acceleration limits
-    relative to zero velocity and scales the whole hand motion down to meet a limit
-    (docs/tasks/hsr-station.md).
+    ``desired_state`` is ``[q_d, v_d]`` of ``motor_joints`` (in that order): the plan's
+    position ``look_ahead`` seconds ahead and its velocity (the plant's implicit PD
+    compares q_d with its positions at the end of its step; 0 for kinematic joints).
+    ``robot_state`` is read only at initialization: the plan starts there, at rest (before
+    that, at ``q_nominal``).
 
-    ``desired_state`` is ``[q_d, v_d]`` of the motor joints (``motor_joints``, in that
-    order): the plan's position ``look_ahead`` seconds ahead of now and its velocity. The
-    plant's implicit PD compares q_d with its positions at the end of its step, so the
-    plan's position at that time is what it must be given to track without lag (0 for
-    kinematic joints, which are on the plan). ``robot_state`` (the plant's state) is read
-    only at initialization: the plan starts there, at rest (before that, at ``q_nominal``,
-    where kinematic joints start).
-
-    Limits are pairs (lower, upper) of arrays over the plant's velocities (positions for
-    ``position_limits``); ``inf`` where there is none. The plant must have q̇ = v.
-
-    With ``limit_overshoot`` see ``OVERSHOOT_WEIGHT``.
+    Limits are (lower, upper) pairs of arrays over the plant's velocities (positions for
+    ``position_limits``), ``inf`` for none; the plant must have q̇ = v. See
+    ``OVERSHOOT_WEIGHT`` for ``limit_overshoot``; ``singular_margin`` is
+    ``ArmStationConfig.singular_margin``.
     """
 
     def __init__(self, plant, frame_E, time_step, look_ahead, motor_joints, *,
@@ -97,7 +89,6 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         self._a_lower, self._a_upper = (np.asarray(bound, float)
                                         for bound in acceleration_limits)
         self._q_nominal = np.asarray(q_nominal, float)
-        # Per-step constants, computed once.
         self._catch_up_time = CATCH_UP_STEPS * self._time_step
         # The acceleration and position limits' pairs as rows, both bounds in one call.
         self._a_step_bounds = np.stack([self._a_lower * self._time_step,
@@ -147,8 +138,7 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         time = context.get_time()
         v_next, hold = self._solve(q, v, *self._ramp.desired(
             context, self._last_heading, self._command_port.Eval(context), time), hold)
-        # Written into the new plan in place (this runs at 100 Hz), the positions by
-        # np.clip's own ufunc: np.clip's Python wrappers cost more than clipping 9 numbers.
+        # In place, by np.clip's own ufunc: its Python wrapper costs more than the clip.
         new_plan = discrete_state.get_mutable_value(self._plan)
         _clip(q + dt * v_next, self._q_lower, self._q_upper, out=new_plan[:n])
         new_plan[n:2 * n] = v_next
@@ -165,9 +155,8 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         return TASK_WEIGHT * (margin * margin - smallest * smallest) if smallest < margin else 0.0
 
     def _solve(self, q, v, R_WE_desired, p_WE_desired, V_WE_desired, hold):
-        """The velocity for the next step, and which velocities it holds at a bound (lower
-        and upper bounds computed together as the rows of (2, n) arrays: a numpy call per
-        pair fewer at 100 Hz)."""
+        """The velocity for the next step, and which velocities it holds at a bound (both
+        bounds as the rows of (2, n) arrays: one numpy call per pair)."""
         plant, context, dt, world = self._plant, self._plant_context, self._time_step, self._world
         plant.SetPositions(context, q)
         X_WE = self._frame_E.CalcPose(context, world)

@@ -1,5 +1,5 @@
-"""The HSR station's task-space adapters: the end-effector command in (as a system, or as
-the arithmetic the station's diff IK applies itself), its state out."""
+"""The stations' task-space adapters: the end-effector command in (as a system, or as the
+arithmetic the station's diff IK applies itself), its state out."""
 
 import math
 
@@ -48,16 +48,12 @@ class EeCommandToPose(PortGetters, LeafSystem):
 
     With a `control_period` (a control loop that sends, at each tick, the state to be in at
     the next tick) both ramp: the position into `p` at `v`, `p - v (t_next - t - lead)`,
-    and the heading into the command's from the last tick's command, at a constant rate.
-    Stepping to `p` and the heading once a tick would leave the robot behind by most of a
-    tick's travel (a policy re-integrated from the robot's state, PBP, would then run
-    slow), and would ask the robot for the whole turn at once. The last tick's heading is
-    sampled just after each tick, before a controller that decides at the PBP loop's
-    decide stage (`pbp_drake.systems.tick`) changes the command. Without a
-    `control_period`, the position is `p + v lead` and the heading the command's.
-
-    `lead` is how far ahead the reader wants the pose: the station's diff IK reads it as
-    the pose to have at the end of its step, so it is the diff IK's period there.
+    and the heading from the last tick's command into this one's at a constant rate;
+    stepping once a tick would leave the robot behind by most of a tick's travel. The last
+    tick's heading is sampled just after each tick, before the PBP loop's decide stage
+    (`pbp_drake.systems.tick`) changes the command. Without a `control_period`, the
+    position is `p + v lead` and the heading the command's. `lead` is how far ahead the
+    reader wants the pose (the station's diff IK: its period).
     """
 
     def __init__(self, R_E0: RotationMatrix, control_period=None, lead=0.0):
@@ -110,12 +106,9 @@ class CommandRamp:
 
 
 class EeCommandRamp(CommandRamp):
-    """`EeCommandToPose`'s arithmetic, for it and for the station's diff IK
-    (`WholeBodyDiffIk` with a `command_ramp`), which reads the command itself (no system
-    between them: two Python calls fewer at each of its steps). See `EeCommandToPose` for
-    what the pose and velocity are."""
+    """`EeCommandToPose`'s arithmetic (see it), for it and for `WholeBodyDiffIk`, which
+    reads the command itself (no system between them: two Python calls fewer a step)."""
 
-    # The diff IK's command port, which this ramp reads.
     port_name = "ee_command"
     command_size = EeCommand.size
 
@@ -148,9 +141,9 @@ class EeCommandRamp(CommandRamp):
         return turn / self.period
 
     def rotation_and_position(self, command, heading_rate, time):
-        """`X_WE_desired` at `time` as its `(RotationMatrix, position)`, the position a
-        list of 3 floats: what the diff IK reads, without building the RigidTransform at
-        each of its steps. `command` may be an array or a list of floats."""
+        """`X_WE_desired` at `time` as `(RotationMatrix, position)`, the position a list of
+        3 floats (no RigidTransform built at each diff IK step); `command` an array or a
+        list."""
         ahead = self.ahead(time)
         heading = command[_HEADING] + heading_rate * ahead
         R = RotationMatrix.MakeZRotation(heading) @ self.R_E0
@@ -158,9 +151,8 @@ class EeCommandRamp(CommandRamp):
 
     def desired(self, context, last_heading_index, command, time):
         """`(R_WE_desired, p_WE_desired, V_WE_desired)` at `time` for the diff IK's step,
-        the position and velocity as lists of floats. The command is read as a list once:
-        Python floats compute the ramp's few numbers with the same IEEE operations as numpy
-        and without a numpy call per operation (this runs at the diff IK's 100 Hz)."""
+        the position and velocity as lists of floats (Python floats: the same IEEE
+        operations as numpy's, without a numpy call per operation)."""
         command = command.tolist()
         rate = self.heading_rate(context, last_heading_index, command)
         R, position = self.rotation_and_position(command, rate, time)
@@ -178,11 +170,9 @@ def station_ramp(X_WE0, config):
 
 class FrameStateFromPlant(PortGetters, LeafSystem):
     """The base of `EeStateFromPlant` and `PoseStateFromPlant`: the world pose and spatial
-    velocity of `frame` (a body, or a frame) with the plant at the input `plant_state`,
-    computed in a context of `plant` of this system's own (the same computation as the
-    plant's `body_poses` and `body_spatial_velocities`, whose values would cross into
-    Python as every body's, about half this system's time, for one body's). The output
-    `output_name` (`output_size`) is `_calc_output`'s."""
+    velocity of `frame` (a body, or a frame) with the plant at the input `plant_state`, in
+    a plant context of its own (the plant's `body_poses` would cross into Python as every
+    body's); the output `output_name` (`output_size`) is `_calc_output`'s."""
 
     def __init__(self, plant, frame, output_name, output_size):
         super().__init__()
@@ -215,10 +205,8 @@ class EeStateFromPlant(FrameStateFromPlant):
         - ee_state
 
     `plant_state` is `plant`'s state output; `ee_state` is `[p_WE (3), v_WE (3), heading,
-    heading_rate]` (`EeState`) of `ee_body` (a body, or any frame of the plant: an arm's
-    end-effector frame may be offset from its link); heading_rate is the hand's angular velocity
-    about world z (the rate of the heading while the hand's z axis stays near the floor
-    plane). The kinematics are `FrameStateFromPlant`'s.
+    heading_rate]` (`EeState`) of `ee_body` (a body, or any frame of the plant);
+    heading_rate is the hand's angular velocity about world z.
     """
 
     def __init__(self, plant, ee_body):

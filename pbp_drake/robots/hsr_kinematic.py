@@ -1,8 +1,6 @@
 """Kinematic robots (the stations' ``motion: kinematic``): joints where the diff IK's plan
-is at every instant, which the dynamic station's stiff servos approach. No plant is
-stepped: the MultibodyPlant, outside the Diagram, gives the kinematics and the geometry,
-which ``MultibodyPositionToGeometryPose`` places in SceneGraph from ``KinematicJoints``'
-state."""
+is at every instant. No plant is stepped: the MultibodyPlant, outside the Diagram, gives
+the kinematics and the geometry (docs/tasks/hsr-station.md, "A kinematic robot")."""
 
 import numpy as np
 from pydrake.geometry import SceneGraph
@@ -25,18 +23,16 @@ class KinematicJoints(PortGetters, LeafSystem):
         - state
 
     ``desired_state`` is ``[q_d, v_d]`` of ``motor_joints`` (in that order; the diff IK's
-    plan at this instant, no look-ahead); ``state`` is ``plant``'s ``[q, v]`` with every
-    motor there and each coupled joint where its coupler keeps it (``couplers``: pairs of
-    a follower joint and its leader, with the ratio; the HSR's torso follows at
-    ``TORSO_TO_ARM_LIFT_RATIO`` times the arm lift). No state of its own: the robot is the
-    plan.
+    plan at this instant); ``state`` is ``plant``'s ``[q, v]`` with every motor there and
+    each coupled joint where its coupler keeps it (``couplers``: ``(follower, leader,
+    ratio)`` joints, such as the HSR's torso). No state of its own.
     """
 
     def __init__(self, plant, motor_joints, couplers=()):
         super().__init__()
         self._plant = plant
         nq = plant.num_positions()
-        # Where the motors' [q_d, v_d] go in [q, v], and the torso's and the lift's entries.
+        # Where the motors' [q_d, v_d] go in [q, v], and the couplers' entries.
         self._scatter = np.array([joint.position_start() for joint in motor_joints]
                                  + [nq + joint.velocity_start() for joint in motor_joints])
         self._couplers = [([follower.position_start(), nq + follower.velocity_start()],

@@ -1,10 +1,5 @@
-"""Loads our primitive-shape Toyota HSR model into a Drake MultibodyPlant.
-
-The model (``models/pbp_drake_models/hsr/hsrb_primitive.urdf``, written from published
-kinematic facts) has a base on three actuated joints (``BASE_JOINT_NAMES``), five actuated
-arm joints, a torso that follows the arm lift at half its travel (a coupler from the URDF
-``<mimic>``), and an end-effector frame ``hand_ee_link`` between the fingertips, its z
-axis out of the hand.
+"""Loads our primitive-shape Toyota HSR model (``hsr/hsrb_primitive.urdf``, written from
+published kinematic facts; docs/tasks/hsr-station.md, "The model") into a MultibodyPlant.
 
 Example::
 
@@ -34,6 +29,7 @@ ARM_JOINT_NAMES = (
     "wrist_flex_joint",
     "wrist_roll_joint",
 )
+# The end-effector frame, between the fingertips, its z axis out of the hand.
 END_EFFECTOR_FRAME = "hand_ee_link"
 # HSR's "neutral" pose (arm up, hand facing forward), in ARM_JOINT_NAMES order.
 NEUTRAL_ARM_POSITIONS = (0.0, 0.0, 0.0, -1.57, 0.0)
@@ -42,11 +38,8 @@ ACTUATED_JOINT_NAMES = BASE_JOINT_NAMES + ARM_JOINT_NAMES
 
 
 def models_dir() -> Path:
-    """Returns the folder that holds the ``pbp_drake_models`` package.
-
-    An installed wheel ships the models as ``pbp_drake/_models``; a source checkout
-    keeps them in the top-level ``models/`` folder. The wheel location wins.
-    """
+    """The folder that holds the ``pbp_drake_models`` package: an installed wheel's
+    ``pbp_drake/_models`` or, failing that, a source checkout's top-level ``models/``."""
     package_root = Path(__file__).resolve().parent.parent  # .../pbp_drake
     candidates = (package_root / "_models", package_root.parent / "models")
     for folder in candidates:
@@ -60,30 +53,18 @@ def models_dir() -> Path:
 
 
 def configure_parser(parser: Parser) -> None:
-    """Lets ``parser`` resolve ``package://pbp_drake_models/...`` from local files.
-
-    Registering our package.xml keeps loading offline (Drake's own remote model
-    packages would need the network). Calling this twice on one parser is harmless.
-    """
+    """Lets ``parser`` resolve ``package://pbp_drake_models/...`` from local files (offline);
+    calling this twice on one parser is harmless."""
     package_xml = models_dir() / PACKAGE_NAME / "package.xml"
     parser.package_map().AddPackageXml(str(package_xml))
 
 
 def add_hsr(plant, parser: Parser | None = None) -> ModelInstanceIndex:
-    """Adds the HSR to ``plant`` (before Finalize) and returns its model instance.
-
-    Args:
-        plant: a MultibodyPlant that is not finalized yet. Use a discrete plant with
-            the SAP or lagged (default) contact approximation, so that the torso
-            coupler constraint is enforced in simulation.
-        parser: an optional Parser for ``plant`` (e.g. one with auto-renaming to add
-            several robots); a new one is made otherwise.
-
-    Returns:
-        The model instance of the robot.
-    """
-    if parser is None:
-        parser = Parser(plant)
+    """Adds the HSR to ``plant`` (not finalized yet; a discrete plant with the SAP or
+    lagged contact approximation enforces the torso coupler) and returns its model
+    instance. ``parser``: a Parser for ``plant`` (e.g. one with auto-renaming to add
+    several robots); a new one otherwise."""
+    parser = parser or Parser(plant)
     configure_parser(parser)
     (model,) = parser.AddModels(url=HSR_URL)
     return model

@@ -25,10 +25,8 @@ _POSITION, _QUATERNION, _VELOCITY, _ANGULAR = (slice(0, 3), slice(3, 7), slice(7
 
 def check_pose_command(command, name="pose_command"):
     """The command's unit quaternion (4,), or ValueError naming the fields that are NaN or
-    infinite, or the quaternion whose norm is not within `UNIT_TOLERANCE` of 1.
-
-    A bad command must stop the robot's controller with a reason, not turn into NaN joint
-    targets (which the plant's PD would follow into a crash far from the cause)."""
+    infinite, or the quaternion whose norm is not within `UNIT_TOLERANCE` of 1 (rather
+    than NaN joint targets that the plant's PD would follow into a crash)."""
     command = finite_pose_state(command, name)
     quaternion = command[_QUATERNION]
     norm = float(np.sqrt(quaternion @ quaternion))
@@ -45,10 +43,9 @@ class PoseCommandRamp(CommandRamp):
     `[v (3), w (3)]`, world frame).
 
     `X_WE_desired` at time t is the command carried along its own twist for
-    `CommandRamp.ahead` seconds, `(Exp(w ahead) q, p + v ahead)`: between ticks the hand
-    ramps into the pose the control loop sends for the next tick (as `EeCommandToPose`
-    does); `V_WE_desired` is `[w, v]`. The command carries its angular velocity, so unlike
-    `EeCommandRamp` this ramp keeps no state.
+    `CommandRamp.ahead` seconds, `(Exp(w ahead) q, p + v ahead)` (a ramp between ticks, as
+    `EeCommandToPose`'s); `V_WE_desired` is `[w, v]`. No state: the command carries its
+    angular velocity.
     """
 
     port_name = "pose_command"
@@ -59,9 +56,8 @@ class PoseCommandRamp(CommandRamp):
         return None
 
     def desired(self, context, last_heading_index, command, time):
-        """`(R_WE_desired, p_WE_desired, V_WE_desired)` at `time` for the diff IK's step,
-        the position and velocity as lists of floats (as `EeCommandRamp.desired`); refuses
-        a NaN or non-unit command (`check_pose_command`)."""
+        """As `EeCommandRamp.desired`; refuses a NaN or non-unit command
+        (`check_pose_command`)."""
         quaternion = check_pose_command(command, self.port_name)
         ahead = self.ahead(time)
         turned = multiply(exp_map(command[_ANGULAR] * ahead), quaternion)
@@ -84,9 +80,7 @@ class PoseStateFromPlant(FrameStateFromPlant):
     `plant_state` is `plant`'s state output; `hand_pose` is `[p_WH (3), q_WH (4), v_WH (3),
     w_WH (3)]` (`PoseState`) of `frame_H`, world frame. Of `q` and `-q` it gives the one
     nearer `q_reference` (the station passes the hand's start orientation), so that the
-    stream does not flip sign as Drake's conversion from a rotation matrix may; users treat
-    both signs as one orientation anyway (`pbp_drake.core.quaternion`). The kinematics are
-    `FrameStateFromPlant`'s.
+    stream does not flip sign as Drake's conversion from a rotation matrix may.
     """
 
     def __init__(self, plant, frame_H, q_reference):

@@ -1,26 +1,14 @@
-"""A simulated HSR that follows an end-effector command, as one Diagram: the station.
-
-``make_hsr_station(config, meshcat)`` returns a Diagram named ``hsr_station`` holding
-everything between an operator's (or a policy's) end-effector command and the robot's
-motion, in the shape of manipulation's hardware station::
+"""A simulated HSR that follows an end-effector command, as one Diagram in the shape of
+manipulation's hardware station (docs/tasks/hsr-station.md)::
 
     ee_command ─► WholeBodyDiffIk (its EeCommandRamp: X_WE_desired, V_WE_desired)
     WholeBodyDiffIk ─► [q_d, v_d] (desired_state) ─► the plant's PD on every motor
     plant ─► EeStateFromPlant ─► ee_state
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
 
-``make_hsr_station(config, meshcat, command="pose")`` is the six-DoF station: the same
-plant and diff IK, commanding the hand frame ``hand_palm_link`` (the grasp task's H) by a
-``PoseState`` ``pose_command`` (``PoseCommandRamp``), with the measured ``hand_pose``
-(``PoseStateFromPlant``) as an output besides ``ee_state``; see docs/concepts/six-dof.md.
-
-Gravity is off (it stands for the real robot's gravity compensation). One differential
-IK solves the base and the arm together, so a target out of the arm's reach moves the
-base; its plan keeps every joint within its velocity and acceleration limits, and stiff
-servos hold the robot on it. The diff IK aims at where the ramped command is at the end of
-its step, the servos are given the plan where the plant's implicit PD compares it, and the
-output ports are live: a control loop that re-integrates its command from the measured
-hand (``p = y + v dt``) moves it at ``v`` (docs/tasks/hsr-station.md).
+One differential IK solves the base and the arm together within the joints' limits, and
+stiff servos hold the robot on its plan; gravity is off. ``command="pose"`` is the six-DoF
+station (docs/concepts/six-dof.md).
 
 Example::
 
@@ -51,18 +39,13 @@ from pbp_drake.robots.hsr_model import (
 from pbp_drake.robots.hsr_pose_systems import HAND_FRAME, PoseCommandRamp, PoseStateFromPlant
 from pbp_drake.robots.station_parts import (
     add_robot, add_station_plant, finish_station, initial_ee_state, pose_at, station_plant)
-from pbp_drake.robots.hsr_station_config import (  # noqa: F401 (re-exported)
-    CylinderObstacle,
-    HsrStationConfig,
-    validate_hsr_station_config,
-)
+from pbp_drake.robots.hsr_station_config import HsrStationConfig, validate_hsr_station_config
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
 # the hand starts in front of the base with room to move both ways along x with the
 # arm alone; arm_lift then sets the height.
 READY_ARM_FLEX = -0.5
-# What make_hsr_station's hand follows: an EeCommand (position and heading of hand_ee_link)
-# or a PoseState (the full pose and twist of hand_palm_link).
+# make_hsr_station's commands: an EeCommand of hand_ee_link, a PoseState of hand_palm_link.
 COMMANDS = ("heading", "pose")
 
 
@@ -107,10 +90,8 @@ def _ready_pose(plant, model, config):
 
 def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp, look_ahead,
                   frame_name=END_EFFECTOR_FRAME):
-    """The whole-body diff IK of the frame ``frame_name`` with the model's position and
-    velocity limits and the config's acceleration limits, the arm drifting back to the
-    ready pose ``q0``, reading the hand's command through ``command_ramp``, its
-    ``desired_state`` the plan ``look_ahead`` seconds ahead."""
+    """The whole-body diff IK of ``frame_name`` within the model's position and velocity
+    limits and the config's acceleration limits, the arm drifting back to ``q0``."""
     v_lower, v_upper = plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()
     # The torso does not move the hand (it carries only the head) and follows the lift
     # through the coupler in the plant, so diff IK leaves it where it is.
@@ -139,12 +120,10 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     Meshcat visualizer, as one Diagram named ``hsr_station``.
 
     Args:
-        config: the station's knobs (``HsrStationConfig()`` when None); validated here.
-        meshcat: if given, a MeshcatVisualizer inside draws the illustration geometry
-            (the robot and the obstacles).
-        command: ``"heading"`` (the hand follows ``ee_command``) or ``"pose"`` (the hand
-            frame ``hand_palm_link`` follows ``pose_command``, a ``PoseState``, and the
-            station outputs ``hand_pose`` too).
+        config: the station's knobs (``HsrStationConfig()`` when None).
+        meshcat: if given, a MeshcatVisualizer inside draws the robot and the obstacles.
+        command: ``"heading"`` (the hand follows ``ee_command``) or ``"pose"`` (the palm
+            frame ``hand_palm_link`` follows ``pose_command`` and ``hand_pose`` is output).
 
     .. pydrake_system::
 
@@ -165,19 +144,14 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
 
     ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``); ``ee_state`` is
     ``[p (3), v (3), heading, heading_rate]`` (``EeState``) of the hand in the world.
-    ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]`` the plant's PD
-    tracks, in motor order (``ACTUATED_JOINT_NAMES``; see ``WholeBodyDiffIk``);
-    ``body_poses`` and ``query_object`` are the plant's and SceneGraph's.
-
-    With ``config.motion == "kinematic"`` the joints are on the plan (``KinematicJoints``;
-    ``hsr_station_plant`` returns the plant, outside the Diagram) and there is no
-    ``body_poses``. ``obstacle_positions`` is ``(N, 3)`` flattened, the centres of
-    ``config.obstacles``; ``clearance`` is the smallest robot-obstacle signed distance (m),
-    ``in_collision`` 1 when it is negative; the obstacles do not push the robot.
-
-    ``pose_command`` is ``hand_palm_link``'s ``PoseState`` to be at (``PoseCommandRamp``,
-    docs/concepts/six-dof.md); a NaN field or a non-unit quaternion is refused by name.
-    ``hand_pose`` is that frame's measured ``PoseState`` (``PoseStateFromPlant``).
+    ``pose_command`` and ``hand_pose`` are ``PoseState`` of ``hand_palm_link``
+    (``PoseCommandRamp``, ``PoseStateFromPlant``); a NaN field or a non-unit quaternion is
+    refused by name. ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]``
+    the plant's PD tracks, in motor order (``ACTUATED_JOINT_NAMES``); ``body_poses`` (not
+    with ``motion: kinematic``, whose plant is outside the Diagram: ``hsr_station_plant``)
+    and ``query_object`` are the plant's and SceneGraph's. ``obstacle_positions`` is
+    ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the smallest
+    robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
 
     A fresh context starts at rest in the ready pose with the diff IK already there, so
     holding ``hsr_initial_ee_state(station)[:7]`` keeps the robot still.
@@ -205,7 +179,6 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
     if command == "pose":
         ramp = PoseCommandRamp(config.control_period, lead=config.diff_ik_time_step)
         frame_name = HAND_FRAME
-    # Every motor (base and arm) is the plant's own PD, fed [q_d, v_d] in motor order.
     motor_joints = [plant.get_joint_actuator(index).joint()
                     for index in plant.GetJointActuatorIndices(model)]
     look_ahead = 0.0 if kinematic else config.plant.time_step
@@ -218,23 +191,18 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
         plant.GetFrameByName(END_EFFECTOR_FRAME, model).body(), motor_joints,
         diff_ik.get_desired_state_output_port() if kinematic else None, couplers)
     if command == "pose":
-        _add_hand_pose(builder, plant, model, q0, state)
+        # Signed nearer the hand's start orientation (PoseStateFromPlant).
+        frame_H = plant.GetFrameByName(HAND_FRAME, model)
+        q_start = pose_at(plant, frame_H, q0).rotation().ToQuaternion().wxyz()
+        hand_pose = builder.AddNamedSystem("hand_pose", PoseStateFromPlant(plant, frame_H,
+                                                                           q_start))
+        builder.Connect(state, hand_pose.get_plant_state_input_port())
+        builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
     builder.ExportOutput(state, "state")
     builder.ExportOutput(diff_ik.get_desired_state_output_port(), "desired_state")
     if not kinematic:
         builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
     return finish_station(builder, plant, scene_graph, model, config, meshcat, "hsr_station")
-
-
-def _add_hand_pose(builder, plant, model, q0, state):
-    """The output hand_pose: hand_palm_link's PoseState (from the robot's `state`),
-    signed nearer its start."""
-    frame_H = plant.GetFrameByName(HAND_FRAME, model)
-    q_start = pose_at(plant, frame_H, q0).rotation().ToQuaternion().wxyz()
-    hand_pose = builder.AddNamedSystem("hand_pose", PoseStateFromPlant(plant, frame_H,
-                                                                       q_start))
-    builder.Connect(state, hand_pose.get_plant_state_input_port())
-    builder.ExportOutput(hand_pose.get_hand_pose_output_port(), "hand_pose")
 
 
 hsr_station_plant = station_plant
@@ -243,8 +211,7 @@ hsr_initial_ee_state = initial_ee_state
 
 def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:
     """The hand's ``ee_state`` (``EeState``) where a station of ``config`` starts, from the
-    model's kinematics alone (a bare plant, no station): what a scenario is resolved from
-    before its station is built. Equal to ``hsr_initial_ee_state`` of that station."""
+    model's kinematics alone (no station); equal to ``hsr_initial_ee_state`` of it."""
     validate_hsr_station_config(config)
     plant = MultibodyPlant(config.plant.time_step)
     model = add_hsr(plant)

@@ -39,23 +39,19 @@ def default_station_visualization():
 class HsrStationConfig:
     """Everything ``make_hsr_station`` builds from; loads with ``yaml_load_typed``.
 
-    Gains are the plant's PD on each motor (base x, y in N/m and N·s/m, yaw and the arm's
-    revolute joints in N·m/rad and N·m·s/rad, arm lift in N/m); the plant applies them
-    implicitly, so stiff gains stay stable at a coarse time step. Acceleration limits are
-    in m/s² (base x, y, arm lift) and rad/s² (the others); ``.inf`` is no limit. What is
-    published about the robot is in the model file and these comments; the rest is ours.
+    Gains are the plant's PD on each motor, applied implicitly, so stiff gains stay stable
+    at a coarse time step. Acceleration limits are in m/s² (base x, y, arm lift) and rad/s²
+    (the others); ``.inf`` is no limit. What is published about the robot is in the model
+    file and these comments; the rest is ours.
     """
 
     #: Drake's MultibodyPlantConfig of the robot's plant (time step, contact model).
     plant: MultibodyPlantConfig = dataclasses.field(default_factory=default_station_plant_config)
     #: How the robot moves along the diff IK's plan. "dynamic": the plant (SAP, every
     #: plant.time_step) and its stiff servos track the plan, a few hundredths of a mm
-    #: behind it. "kinematic": the joints are on the plan at every instant (the servos'
-    #: limit as w grows; the plant only gives the kinematics and the geometry, and its
-    #: step, gains and plant settings go unused): about twice the closed loop's speed,
-    #: and in the reaching and grasping tasks, which ship with it, the same study results
-    #: within their trial-to-trial noise (docs/tasks/hsr-station.md, "A kinematic robot").
-    #: Nothing pushes the robot in either (gravity is off, obstacles are measured).
+    #: behind it. "kinematic": the joints are on the plan at every instant (the plant's
+    #: step, gains and settings go unused), about twice as fast
+    #: (docs/tasks/hsr-station.md, "A kinematic robot").
     motion: str = "dynamic"
     #: The whole-body differential IK's period (s), a whole multiple of plant.time_step;
     #: its QP is the station's largest cost.
@@ -67,7 +63,7 @@ class HsrStationConfig:
     initial_base: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
     #: The hand's height at the start (m); it starts level, pointing along the base's +x.
     ee_height: float = 0.7
-    #: Base (x, y, yaw) and arm (lift, flex, roll, wrist flex, wrist roll): stiff servos,
+    #: The base's PD stiffness gains (x, y in N/m, yaw in N m/rad); with the arm's, stiff servos,
     #: kp = I w² and kd = 2 I w (critically damped) with w = 300 rad/s on each joint's
     #: inertia I at the ready pose (34 kg for x and y, 1.0 kg·m² for yaw, 6.1 kg for the
     #: lift with the torso, 0.31, 0.013, 0.015, 0.001 kg·m² for the others). Accelerating at

@@ -5,8 +5,8 @@ file's XML alone: what would hang, fail at build or mid-run, or print unreadable
 DOCTYPE) and refuses names holding control characters or invisible formatting marks; a
 link hanging from two joints, and loops; meshes and textures missing or behind the network;
 masses and inertias not finite, negative masses, and with ``motion: dynamic`` inertias not
-physical and joints that move no mass. Each refusal is a one-line ValueError starting with
-the config's field and the file, naming the element; names go through `printable`.
+physical and joints that move no mass. Each refusal is a one-line ValueError naming the
+config's field, the file and the element.
 """
 
 import dataclasses
@@ -111,18 +111,6 @@ class _Refusal:
         return ValueError(f"{self.prefix}: {line}{what}: {why}")
 
 
-def model_file_path(source, field="ArmStationConfig.model_file"):
-    """The local file `source` (a path from the working folder, or a package:// URL of
-    ours or Drake's) names; ValueError naming `field` when there is none, or it needs the
-    network."""
-    refuse = _Refusal(field, source)
-    path = _url_path(source, Path.cwd(), lambda why: refuse(None, "the file", why))
-    if not path.is_file():
-        raise ValueError(f"{field}: no file at {printable(source)} (a path from the working "
-                         "folder, or a package:// URL)")
-    return path
-
-
 def _url_path(uri, folder, refuse):
     """The file `uri` names (relative to `folder` unless absolute or a URL); raises what
     `refuse(why)` makes for a URL that needs the network or a package we do not know."""
@@ -156,11 +144,15 @@ _CHECKED = {}
 
 
 def check_model_file(source, motion, field="ArmStationConfig.model_file"):
-    """Reads and checks the model file `source` (see the module's list) for a station of
-    `motion` ("kinematic" or "dynamic"); returns its `ModelFile`. Raises a one-line
-    ValueError naming `field`, the file, the element and its field."""
-    path = model_file_path(source, field)
+    """Reads and checks the model file `source` (a path from the working folder, or a
+    package:// URL of ours or Drake's; see the module's list) for a station of `motion`
+    ("kinematic" or "dynamic"); returns its `ModelFile`. Raises a one-line ValueError
+    naming `field`, the file, the element and its field."""
     refuse = _Refusal(field, source)
+    path = _url_path(source, Path.cwd(), lambda why: refuse(None, "the file", why))
+    if not path.is_file():
+        raise ValueError(f"{field}: no file at {printable(source)} (a path from the working "
+                         "folder, or a package:// URL)")
     status = path.stat()
     size = status.st_size
     key = (str(path.resolve()), status.st_mtime_ns, size, motion)
@@ -169,7 +161,7 @@ def check_model_file(source, motion, field="ArmStationConfig.model_file"):
     if size > MAX_MODEL_FILE_BYTES:
         raise refuse(None, "the file", f"{size:,} bytes is larger than a model file may be "
                      f"({MAX_MODEL_FILE_BYTES:,} bytes)")
-    document = _parse(path.read_bytes(), source, field)
+    document = _parse(path.read_bytes(), refuse)
     if document.tag == "robot":
         model = ModelFile(path, "urdf", document)
     elif document.tag == "sdf" and document.find("model") is not None:
@@ -188,10 +180,9 @@ def check_model_file(source, motion, field="ArmStationConfig.model_file"):
     return model
 
 
-def _parse(data, source, field):
+def _parse(data, refuse):
     """The XML tree of `data` with each element's line; ValueError naming the file and
     the line for text that is not UTF-8 XML or declares a DOCTYPE (entities)."""
-    refuse = _Refusal(field, source)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:

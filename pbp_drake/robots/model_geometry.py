@@ -1,9 +1,7 @@
 """The geometry an arm's model file fixes to its base (its pedestal), read from the file's
 XML (`pbp_drake.robots.model_checks`), and whether a box of the scene overlaps it: the
-scene's objects must not stand inside the robot.
-
-Primitives only (boxes, cylinders, spheres; URDF's <origin> and SDFormat's <pose> in the
-link's frame); meshes are left out.
+scene's objects must not stand inside the robot. Primitives only (boxes, cylinders,
+spheres); meshes are left out.
 """
 
 import dataclasses
@@ -109,7 +107,7 @@ def _link_shapes(model, link, link_pose):
 
 def base_shapes(model, base_frame):
     """The primitives (`Shape`) of the link named `base_frame` and, in a URDF, of the
-    links welded to it by fixed joints, in the base frame. Meshes are left out."""
+    links welded to it by fixed joints, in the base frame."""
     links, joints = links_and_joints(model)
     if base_frame not in links:
         return []

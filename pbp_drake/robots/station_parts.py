@@ -39,9 +39,8 @@ def add_obstacles(builder, plant, scene_graph, model, obstacles):
 
 
 def add_meshcat_visualizers(builder, scene_graph, meshcat, visualization):
-    """What `visualization` asks of Meshcat (Drake's `VisualizationConfig`, read here
-    without its LCM side): the illustration geometry, and the proximity geometry (hidden
-    at first) when `publish_proximity`."""
+    """What `visualization` (Drake's `VisualizationConfig`, without its LCM side) asks of
+    Meshcat: the illustration geometry, and the proximity geometry (hidden at first)."""
     if visualization.publish_illustration:
         MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(
             role=Role.kIllustration, publish_period=visualization.publish_period,
@@ -80,10 +79,9 @@ def pose_at(plant, frame, q):
 def add_robot(builder, plant, scene_graph, model, diff_ik, ramp, ee_frame, motor_joints,
               joints_input=None, couplers=()):
     """The robot on the diff IK's plan and its `ee_state` (of `ee_frame`, a body or a
-    frame): with `joints_input` (a port of `[q, v]` of `motor_joints`) `KinematicJoints`
-    there, else the plant's PD tracking the plan. Exports the command input
-    (`ramp.port_name`) and `ee_state`; returns the robot's state port, which the diff IK
-    starts from."""
+    frame): with `joints_input` (`[q, v]` of `motor_joints`) `KinematicJoints` there, else
+    the plant's PD tracking the plan. Exports the command input and `ee_state`; returns the
+    robot's state port."""
     if joints_input is not None:
         joints = add_kinematic_joints(builder, plant, scene_graph, motor_joints, joints_input,
                                       couplers)
@@ -115,9 +113,8 @@ def finish_station(builder, plant, scene_graph, model, config, meshcat, name):
 
 
 def station_plant(station):
-    """The MultibodyPlant of a station from `make_hsr_station` or `make_arm_station`: its
-    subsystem ``plant`` (dynamic), or the kinematic joints' plant, which is outside the
-    Diagram."""
+    """The MultibodyPlant of a station from `make_hsr_station` or `make_arm_station` (with
+    kinematic motion, outside the Diagram)."""
     if station.HasSubsystemNamed("plant"):
         return station.GetSubsystemByName("plant")
     return station.GetSubsystemByName("joints").plant()

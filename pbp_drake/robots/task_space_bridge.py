@@ -1,24 +1,13 @@
-"""A task-space bridge for robots whose interface is not Drake's (the HSR speaks ROS): the
-stations' ports, `ee_command` and `ee_state`, as two LCM channels, so that a small relay on
-the robot's side is all a user writes (docs/tasks/real-arm.md shows its shape for a ROS
-robot).
-
-``make_task_space_bridge(config, initial_ee_state, control_period)`` returns a Diagram
-named ``task_space_bridge`` with a station's two ports::
+"""A task-space bridge for robots whose interface is not Drake's (the HSR speaks ROS): a
+station's ports as two LCM channels, so that a small relay on the robot's side is all a
+user writes (docs/tasks/real-arm.md shows one for a ROS robot)::
 
     ee_command ─► BridgeLink ─► PBP_EE_COMMAND (lcmt_drake_signal: x y z vx vy vz heading)
     PBP_EE_STATE (lcmt_drake_signal: x y z vx vy vz heading heading_rate)
         ─► LcmSubscriberSystem ─► BridgeLink ─► ee_state
 
-``make_station_relay`` is the robot's side around any Drake station (what a ROS relay does
-with the robot's topics), ``make_bridged_station`` what a run uses (``pbp-drake run
---hardware``, with ``--driver-sim`` the relay around the simulated station in-process).
-
-`BridgeLink` keeps the arm drivers' rules where they apply to any robot: nothing is sent
-before a fresh state; a state silent for `status_timeout`, of the wrong size or with a
-NaN, or a first state farther than `start_tolerance` from the run's start, ends the run
-with `DriverError` and sends nothing more. Messages are stamped (`timestamp`, µs) on the
-simulation's clock.
+`BridgeLink` keeps the arm drivers' rules (`pbp_drake.robots.arm_driver`) where they
+apply to any robot; messages are stamped (`timestamp`, µs) on the simulation's clock.
 """
 
 import dataclasses
@@ -85,7 +74,10 @@ def signal(values, names, time):
 
 
 class BridgeLink(LeafSystem):
-    """The station's side of a task-space bridge (the module's docstring).
+    """The station's side of a task-space bridge: nothing is sent before a fresh state; a
+    state silent for `status_timeout`, of the wrong size or with a NaN, or a first state
+    farther than `start_tolerance` from the run's start, ends the run with `DriverError`
+    and sends nothing more.
 
     .. pydrake_system::
 
@@ -97,10 +89,9 @@ class BridgeLink(LeafSystem):
         - ee_state
 
     ``state_message`` is the last ``lcmt_drake_signal`` on the state channel (an
-    ``LcmSubscriberSystem``'s output), ``ee_command`` the controller's ``EeCommand``;
-    ``ee_state`` the robot's ``EeState`` as the relay last sent it (``initial_ee_state``
-    before). At each control period it checks the state and its age, and sends the
-    command in a publish event after that update.
+    ``LcmSubscriberSystem``'s output); ``ee_state`` the robot's ``EeState`` as the relay
+    last sent it (``initial_ee_state`` before). The command is sent in a publish event
+    after each control period's check.
     """
 
     def __init__(self, config, lcm, initial_ee_state, control_period):
@@ -109,8 +100,8 @@ class BridgeLink(LeafSystem):
         channel, bus = config.state_channel, config.lcm_bus.lcm_url
         self._first = f"state from the robot's relay on {channel} (bus {bus})"
         self._silent = f"the robot's state on {channel} (bus {bus})"
-        # State: when the last state message came, its stamp, the time of the first
-        # update, and whether this update sends (the state itself is the message's).
+        # State: when the last state message came, its stamp, the first update's time,
+        # whether this update sends.
         self._AT, self._STAMP, self._STARTED, self._SEND = range(4)
         self._index = self.DeclareDiscreteState([np.nan, -1.0, np.nan, 0.0])
         self.DeclareAbstractInputPort("state_message", Value(lcmt_drake_signal()))
@@ -176,10 +167,11 @@ class BridgeLink(LeafSystem):
 
 def make_task_space_bridge(config: TaskSpaceBridgeConfig, initial_ee_state, control_period,
                            lcm=None) -> Diagram:
-    """A station whose robot is on the far side of `config`'s LCM channels (the module's
-    docstring), on `lcm` (default a DrakeLcm on `config.lcm_bus`), with its own
-    `LcmInterfaceSystem`; `initial_ee_state` is the hand's ``EeState`` until the relay's
-    first state comes. Raises ValueError naming a field of `config` that cannot work."""
+    """A Diagram named ``task_space_bridge`` with a station's ports, whose robot is on the
+    far side of `config`'s LCM channels on `lcm` (default a DrakeLcm on `config.lcm_bus`),
+    with its own `LcmInterfaceSystem`; `initial_ee_state` is the hand's ``EeState`` until
+    the relay's first state comes. Raises ValueError naming a field of `config` that cannot
+    work."""
     validate_task_space_bridge(config)
     lcm = lcm or DrakeLcm(config.lcm_bus)
     builder = DiagramBuilder()
@@ -197,9 +189,8 @@ def make_task_space_bridge(config: TaskSpaceBridgeConfig, initial_ee_state, cont
 
 
 class _Relay(LeafSystem):
-    """The robot's side: the last command that came in, as the station's ee_command (no
-    delay of its own), and the station's ee_state out on the state channel every
-    `state_period` (a robot's state stream, faster than the control loop)."""
+    """The robot's side: the last command that came in, as the station's ee_command, and
+    the station's ee_state out on the state channel every `state_period`."""
 
     def __init__(self, config, lcm, initial_command, state_period):
         super().__init__()
@@ -223,10 +214,10 @@ class _Relay(LeafSystem):
 
 def make_station_relay(station, lcm, config: TaskSpaceBridgeConfig, initial_ee_state,
                        state_period=RELAY_STATE_PERIOD) -> Diagram:
-    """`station` (any Diagram with ``ee_command`` and ``ee_state``) behind the bridge's
-    channels on `lcm`, with its own `LcmInterfaceSystem`: each command goes to the station
-    as it comes, and its state goes out every `state_period` s. The robot's side, as a
-    relay to a ROS robot is shaped (docs/tasks/real-arm.md)."""
+    """The robot's side: `station` (any Diagram with ``ee_command`` and ``ee_state``)
+    behind the bridge's channels on `lcm`, with its own `LcmInterfaceSystem`, as a ROS
+    relay is shaped: each command goes to the station as it comes, and its state goes out
+    every `state_period` s."""
     builder = DiagramBuilder()
     builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
     station = builder.AddSystem(station)
@@ -244,10 +235,9 @@ def make_station_relay(station, lcm, config: TaskSpaceBridgeConfig, initial_ee_s
 
 def make_bridged_station(config: TaskSpaceBridgeConfig, initial_ee_state, control_period,
                          robot_side=None) -> Diagram:
-    """A run's station through the bridge (the module's docstring), with ``ee_command`` and
-    ``ee_state``: on `config.lcm_bus` to the robot's relay, or with `config.driver_sim` to
-    `robot_side` (a Diagram with those ports: the simulated station) behind
-    `make_station_relay`, both on a memq:// bus of their own."""
+    """A run's station through the bridge (``pbp-drake run --hardware``): on
+    `config.lcm_bus` to the robot's relay, or with `config.driver_sim` to `robot_side` (the
+    simulated station) behind `make_station_relay`, both on a memq:// bus of their own."""
     validate_task_space_bridge(config)
     builder = DiagramBuilder()
     if config.driver_sim:

@@ -1,17 +1,8 @@
-"""The folder of every method under every pilot (`pbp-drake study FILE --methods ...
---pilots attentive,noisy,...`, run by `comparison.run_method_matrix`): its layout, its
-study.json, and its summary read from the pilots' trial files.
-
-    DIR/study.json              the matrix: scenario and hash, methods, pilots, trials, seeds
-    DIR/pilots/<pilot>/...      a study folder of every method under that pilot (its own
-                                study.json and hash: `pbp-drake report` reports it alone)
-    DIR/summary.json, DIR/results.md, DIR/trials.json, DIR/pilots.png
-                                rebuilt from the files above (`studies.matrix_report`)
-
-Trial i of every method under every pilot runs seed `seed + i` (the pilots draw their own
-randomness from it), so every comparison is paired. The pilot is part of its folder's
-scenario hash, and study.json holds the scenario's: a matrix folder resumes only the same
-scenario, pilot by pilot.
+"""The folder of every method under every pilot (`pbp-drake study FILE --pilots ...`, run by
+`comparison.run_method_matrix`): its study.json, a study folder per pilot
+(`DIR/pilots/<pilot>/`, whose scenario hash includes the pilot) and its summary read from
+the pilots' trial files. The layout is in docs/tasks/studies.md ("Every method under
+every pilot").
 """
 
 import json

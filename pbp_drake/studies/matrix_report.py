@@ -1,12 +1,7 @@
 """`pbp-drake report DIR` of a matrix folder (`studies.matrix`): its `summary.json`,
-`trials.json`, the method x pilot tables of `results.md` and the figure `pilots.png`,
-rebuilt from the pilots' trial files only.
-
-The tables carry every metric the summary's method entries hold as a mean (whatever they
-are: a metric added to the trials and summaries later appears without a change here), each
-with its 95 % interval, and every method against the reference method (PBP-Alt) under the
-same pilot, paired by seed (`studies.paired`). One figure has a panel per pilot: the
-intervention ratio and task time of each method, with their intervals.
+`trials.json`, the method x pilot tables of `results.md` (every mean a method entry holds,
+with its 95 % interval, and every method against PBP-Alt paired by seed) and the figure
+`pilots.png`, rebuilt from the pilots' trial files only.
 """
 
 import json
@@ -32,8 +27,7 @@ _KNOWN = {key: (column, digits, within) for key, column, digits, within in MEAN_
 
 
 def mean_metrics(summary):
-    """The method entries' metrics that are means (`{"mean", "std"}`), in the order the
-    entries first hold them, over every pilot."""
+    """The method entries' metrics that are means (`{"mean", "std"}`), in first-met order."""
     names = []
     for pilot in summary["pilots"].values():
         for entry in pilot["methods"].values():
@@ -45,8 +39,7 @@ def mean_metrics(summary):
 
 
 def metric_range(key):
-    """The range a metric's values lie in (its interval is cut to it): the studies' own
-    where the metric is known, else the whole line."""
+    """The range a metric's values lie in (its interval is cut to it); unknown: unbounded."""
     return _KNOWN[key][2] if key in _KNOWN else (-math.inf, math.inf)
 
 
@@ -56,8 +49,7 @@ def metric_label(key):
 
 
 def _finite_count(records, method, key):
-    """How many of the method's trials that ran hold a finite number for `key` (the
-    values its summary's mean is over), or None when none hold the field."""
+    """How many of the method's trials that ran hold a finite `key` (None: none)."""
     values = [record.get(key) for (name, _), record in records.items()
               if name == method and record is not None and record.get("error") is None]
     numbers = [v for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
@@ -66,10 +58,9 @@ def _finite_count(records, method, key):
 
 
 def metric_interval(entry, key, count):
-    """`(mean, low, high)` of a method entry's metric: the interval the entry holds, if it
-    holds one, else the mean's 95 % t interval over its `count` values (the entry's own
-    count where it has one), cut to the metric's range where it is known; low and high None
-    with fewer than two values, all None without a mean."""
+    """`(mean, low, high)` of a method entry's metric: the entry's own interval, else the
+    mean's 95 % t interval over `count` values (the entry's count where it has one) within
+    `metric_range`; low and high None with fewer than two values, all None without a mean."""
     value = entry.get(key)
     if not isinstance(value, dict) or value.get("mean") is None:
         return None, None, None
@@ -82,8 +73,7 @@ def metric_interval(entry, key, count):
 
 
 def success_interval(entry):
-    """`(rate, low, high)` of a method entry's success rate (Wilson's interval over the
-    trials on disk), all None without trials."""
+    """`(rate, low, high)` of a method entry's success rate (Wilson's interval), or Nones."""
     rate = entry["success_rate"]
     if rate is None:
         return None, None, None
@@ -183,11 +173,10 @@ def matrix_command(study, summary):
 
 
 def report_matrix(output, reference=None, markdown=None):
-    """Rebuilds a matrix folder's `summary.json`, `results.md`, `trials.json` and
-    `pilots.png` from its pilots' trial files (no simulation); `markdown`: also writes the
-    tables to that file after the command that made the matrix. `reference`: the method
-    every other is paired with (default PBP-Alt, when the matrix ran it). Returns the
-    summary. Raises ValueError when the matrix did not run `reference`."""
+    """Rebuilds a matrix folder's files (the module's docstring) and returns the summary;
+    `markdown`: also writes the tables to that file after the command that made the matrix.
+    `reference`: the method every other is paired with (default PBP-Alt, when the matrix ran
+    it). Raises ValueError when the matrix did not run `reference`."""
     output = pathlib.Path(output)
     study, pilots = read_matrix(output)
     summary = summarize_matrix(study, pilots, output)

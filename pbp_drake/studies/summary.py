@@ -1,7 +1,6 @@
 """A study's summary, from its trial files only, and the one definition of the ideal alpha.
-
-The summary holds only values from the trial files, in a fixed order, rounded: it is the
-same bytes for any `--jobs` and either backend.
+It holds only values from the trial files, in a fixed order, rounded: the same bytes for
+any `--jobs` and either backend.
 """
 
 import dataclasses
@@ -100,9 +99,8 @@ def max_mean(values):
 
 
 def mean_with_interval(values, within):
-    """`{"mean", "std", "count", "interval"}` of the finite values: their mean and population
-    std (`mean_std`), how many, and the 95 % t interval of the mean cut to `within`
-    (`pbp_drake.studies.intervals.mean_interval`; None for fewer than two), rounded."""
+    """`mean_std` of the finite values, their "count" and the "interval" of the mean
+    (`intervals.mean_interval` within `within`; None for fewer than two), rounded."""
     values = [v for v in values if v is not None and math.isfinite(v)]
     entry = {**mean_std(values), "count": len(values)}
     interval = mean_interval(entry["mean"], entry["std"], len(values), within)
@@ -116,10 +114,9 @@ TRIAL_VALUE = {"time_to_prediction": "mean_time_to_prediction"}
 
 
 def interaction_entries(ran):
-    """The interaction metrics' entries of a method's summary, from the records of its
-    trials that ran (`INTERACTION_MEANS`, each `mean_with_interval`): `time_to_prediction`
-    is over each trial's mean over its switches, with the study's count of `switches` and
-    of those never named (`unpredicted_switches`). A metric no record holds has no entry."""
+    """The entries of the interaction metrics (`INTERACTION_MEANS`) that the records of a
+    method's trials that ran hold, each `mean_with_interval`; `time_to_prediction` adds the
+    count of `switches` and of those never named (`unpredicted_switches`)."""
     entries = {}
     for name, _, _, within in INTERACTION_MEANS:
         field = TRIAL_VALUE.get(name, name)
@@ -151,11 +148,9 @@ def _relative(path, output):
 
 
 def measures_collisions(study, records, output=None):
-    """Whether the study's task measures collisions: the obstacle task does, reaching does
-    not (its trials record a collision ratio of 0 that means "not measured", not "none").
-
-    Read off the scenario study.json holds; a study without it is judged by its trials' CSV
-    files, whose `in_collision` column only a task that measures collisions writes."""
+    """Whether the study's task measures collisions (the obstacle task; reaching records a
+    collision ratio of 0 that means "not measured"): by the scenario study.json holds, else
+    by an `in_collision` column in its trials' CSV files."""
     content = study.get("scenario_content")
     if isinstance(content, dict):
         task = content.get("task")
@@ -179,9 +174,8 @@ _GOES_WITH = {"command_noise_time": "command_noise", "mistake_time": "mistake_pr
 
 def virtual_participant(study):
     """How the study's virtual participant was impaired, from its study.json: `{"condition":
-    the name given to `--participant-condition` (None: none), "impairment": {field: value}
-    of the impairment's fields that act (those off their defaults, and the times that go
-    with them)}`; None when it was not impaired (or there is no virtual participant)."""
+    the `--participant-condition` or None, "impairment": the fields off their defaults and
+    the times that go with them}`; None when it was not impaired."""
     content = study.get("scenario_content")
     operator = content.get("operator") if isinstance(content, dict) else None
     given = operator.get("impairment") if isinstance(operator, dict) else None
@@ -200,14 +194,11 @@ def virtual_participant(study):
 
 def summarize(study, records, damaged=(), output=None):
     """Per method: how many trials, errors, missing and damaged; the success rate over the
-    trials on disk; over the trials that ran without error, the mean and (population) std of
-    intervention ratio and task time, the max and mean of the peaks
-    (`pbp_drake.builder.run.SeriesPeaks`), the `posterior_clipped_ratio` and the interaction
-    metrics (`interaction_entries`) where the trials record them and, where the task
-    measures collisions (`measures_collisions`), the collision ratio's mean, std and
-    histogram and the count of collision-free trials; and the ideal alpha (`arbitration`).
-    `damaged` (`trial_files.read_study`'s) becomes the "damaged" list (paths relative to
-    `output`)."""
+    trials on disk; over the trials that ran without error, the mean and population std of
+    intervention ratio and task time, the max and mean of the peaks, and where recorded or
+    measured the `posterior_clipped_ratio`, `interaction_entries` and the collision ratio
+    (with its histogram and collision-free count); and the ideal alpha (`arbitration`).
+    `damaged` (`read_study`'s) becomes the "damaged" list, relative to `output`."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),

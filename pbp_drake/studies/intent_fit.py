@@ -1,22 +1,11 @@
 """Fits the ``intent_filter`` estimator's operator model (`pbp_drake.core.intent_filter`) on
 recorded trials: `python -m pbp_drake.studies.intent_fit FOLDER...`.
 
-The fit reads the teleop trials of study folders (pilots' sub-folders included), whose
-every motion is the operator's own. It replays the filter over each trial on the recorded
-hand position, heading and operator inputs, and scores a model by the mean over trials of
-the mean log probability it gives the participant's target at each tick (a proper score:
-it rewards a calibrated belief). The move and turn rates, the heading's weight and the
-switch rate are fitted over `GRIDS` by coordinate ascent (`ascend`). Not fitted:
-`silence_rate` (under teleop a silent operator leaves the hand still), the clip
-(`max_probability`, HOP's 0.99) and the slowest motion.
-
-Each source is fitted alone, then the switch rate with all three (`fit`): fitted jointly,
-the heading would get no weight, since under teleop the motion says nearly all the heading
-says; under PBP the operator is mostly silent, and the heading is the evidence left.
-
-`make results` runs the tuning studies it is fitted on (`hsr_reach_goals_4_teleop_tuning`,
-`hsr_reach_goals_100_teleop_tuning`); the defaults of `IntentFilterSettings` are this
-command's output on them.
+It replays the filter over the teleop trials of study folders (pilots' sub-folders
+included) and scores a model by the mean log probability it gives the participant's target
+at each tick; the fitted parameters are chosen over `GRIDS` by coordinate ascent (`fit`).
+The defaults of `IntentFilterSettings` are its output on the tuning studies `make results`
+runs; docs/concepts/goal-estimators.md says which, and why each source is fitted alone.
 """
 
 import argparse
@@ -46,7 +35,7 @@ MAX_ROUNDS = 6
 
 class Replay(typing.NamedTuple):
     """One trial ready to replay: its features (each (T, K); `acts` (T,)), the target
-    index at each tick (T,), and the control period."""
+    index at each tick (T,), and the control period (s)."""
 
     features: IntentFeatures
     targets: np.ndarray
@@ -135,9 +124,8 @@ def ascend(replays, start, names, log=None, label=""):
 
 
 def fit(replays, log=None):
-    """`(settings, score)`: each source fitted alone (`SOURCES`: the filter reading that
-    source only; the motion and the turns each with a switch rate of its own), then the
-    switch rate with all of them."""
+    """`(settings, score)`: each of `SOURCES` fitted alone (the motion and the turns each
+    with a switch rate of its own), then the switch rate with all of them."""
     fitted = {}
     for source in SOURCES:
         alone = dataclasses.replace(IntentFilterSettings(), **{name: 0.0 for name in SOURCES})

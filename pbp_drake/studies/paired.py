@@ -1,16 +1,8 @@
-"""Two studies of the same seeds, compared trial by trial: `pbp-drake compare A B`; and,
-with the same statistics, one study's methods against one of them (`paired_with`:
-`pbp-drake report DIR --paired-with METHOD`).
-
-Change a setting (the robot's motion model, a time step, a gain), run the same study again
-into another folder, and ask whether any result moved by more than the trials differ among
-themselves. Each method's trials of A and B are paired by seed; for each metric the table
-gives A's mean, the paired difference B - A (its mean and 95 % confidence interval, on
-Student's t), and A's trial-to-trial standard deviation (SD) and standard error of the
-mean (SE = SD / sqrt(n)). A difference is *within noise* when its mean is no larger than
-A's SD: the spread one trial's result already carries. The SE, the uncertainty of A's
-reported mean, is the stricter yardstick, and the table marks which differences pass it
-too.
+"""Two studies of the same seeds, compared trial by trial (`pbp-drake compare A B`), and one
+study's methods against one of them (`pbp-drake report DIR --paired-with METHOD`). Per
+metric: A's mean, the paired difference B - A with its 95 % t interval, and A's SD and SE;
+a difference is *within noise* when its mean is no larger than A's SD, the spread one
+trial already carries (docs/tasks/studies.md, "Report and compare").
 """
 
 import dataclasses
@@ -112,20 +104,18 @@ def paired_comparison(folder_a, folder_b):
 
 
 def paired_with(folder, reference, metrics=None):
-    """The `PairedRow`s of one study's every other method against its method `reference`,
-    seed by seed (A: `reference`, B: the row's method), for the `metrics` named (default:
-    every metric). Raises ValueError when the study did not run `reference`."""
+    """The `PairedRow`s of one study's every other method (B) against its method `reference`
+    (A), for the `metrics` named (default: all). Raises ValueError when the study did not
+    run `reference`."""
     study, records, _ = read_study(folder)
     return paired_rows_with(study, records, reference,
                             measures_collisions(study, records, folder), metrics)
 
 
 def paired_rows_with(study, records, reference, collisions, metrics=None):
-    """`paired_with` of a study already read (`read_study`'s study and records;
-    `collisions`: whether its task measures them). A metric of `metrics` that is not one
-    of the known ones is read as the trial records' field of that name, or of the name
-    `summary.TRIAL_VALUE` gives it (how a trial metric added later is paired without
-    naming it here)."""
+    """`paired_with` of a study already read (`collisions`: whether its task measures them).
+    A metric of `metrics` not in `_METRICS` is read as the records' field of that name (or
+    of the name `summary.TRIAL_VALUE` gives it)."""
     if reference not in study["methods"]:
         raise ValueError(f"the study ran {', '.join(study['methods'])}, not {reference}")
     reference_trials = _by_seed(study, records, reference)
@@ -139,8 +129,7 @@ def paired_rows_with(study, records, reference, collisions, metrics=None):
 
 
 def _record_field(name):
-    """A reader of the records' field `name`: its number, None when it holds none (or not a
-    finite number, e.g. a list of values)."""
+    """A reader of the records' field `name`: its finite number, else None."""
     def read(record):
         value = record.get(name)
         number = isinstance(value, (int, float)) and not isinstance(value, bool)
@@ -150,8 +139,7 @@ def _record_field(name):
 
 def _paired_rows(method, trials_a, trials_b, collisions, fields=()):
     """A row per metric of `method`'s trials B against A (`{seed: record}` each), over the
-    seeds both ran; a time only where both succeeded. `fields`: more metrics, each read
-    as the records' field of its name."""
+    seeds both ran; a time only where both succeeded. `fields`: more records' fields."""
     seeds = sorted(set(trials_a) & set(trials_b))
     rows = []
     for metric, read, needs_success in (*_METRICS,
@@ -191,8 +179,7 @@ def paired_table(rows, name_a="A", name_b="B"):
 
 
 def paired_with_markdown(rows, reference):
-    """The rows of `paired_with` as a titled Markdown table: each method against
-    `reference`, with `reference`'s SD as the yardstick of noise (as in `compare`)."""
+    """The rows of `paired_with` as a titled Markdown table."""
     name = METHOD_NAMES.get(reference, reference)
     rows = [dataclasses.replace(row, method=METHOD_NAMES.get(row.method, row.method))
             for row in rows]

@@ -25,7 +25,6 @@ GRIDS = {"move_rate": (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0),
          "heading_weight": (0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 16.0),
          "turn_rate": (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0),
          "switch_rate": (0.003, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0)}
-FITTED = tuple(GRIDS)
 # The evidence sources, each fitted alone.
 SOURCES = ("move_rate", "heading_weight", "turn_rate")
 # The method whose trials are read: the operator's own motions alone.
@@ -156,7 +155,7 @@ def main(argv=None):
     print(f"mean log probability of the target: {score:.4f} nats (uniform: {uniform:.4f}; "
           f"the shipped defaults: {float(scores(replays, [defaults])[0]):.4f})")
     print("intent_filter: {" + ", ".join(f"{name}: {getattr(fitted, name):g}"
-                                        for name in FITTED) + "}")
+                                        for name in GRIDS) + "}")
     return 0
 
 

@@ -142,8 +142,7 @@ def matrix_tables(summary, intervals, paired, reference):
         lines.append(f"| {_method_name(method)} | " + " | ".join(cells) + " |")
     for key, by_pilot in intervals.items():
         digits = 0 if key == "success" else _KNOWN.get(key, (None, 3))[1]
-        lines += ["", f"**{metric_label(key) if key != 'success' else 'success'}**", "",
-                  *header]
+        lines += ["", f"**{metric_label(key)}**", "", *header]
         for method in methods:
             cells = [_cell(by_pilot[pilot].get(method, (None, None, None)), digits,
                            percent=key == "success") for pilot in pilots]
@@ -155,8 +154,7 @@ def matrix_tables(summary, intervals, paired, reference):
                   "the number of pairs (a time over the seeds both succeeded on)."]
         others = [m for m in methods if m != reference]
         for key in intervals:
-            lines += ["", f"**{metric_label(key) if key != 'success' else 'success'}, "
-                          f"against {name}**", "", *header]
+            lines += ["", f"**{metric_label(key)}, against {name}**", "", *header]
             for method in others:
                 cells = [_paired_cell(paired[pilot].get((method, key))) for pilot in pilots]
                 lines.append(f"| {_method_name(method)} | " + " | ".join(cells) + " |")
@@ -190,9 +188,8 @@ def report_matrix(output, reference=None, markdown=None):
             raise ValueError(f"the matrix ran {', '.join(study['methods'])}, not {reference}")
         paired = {}
         for pilot, (pilot_study, pilot_records, _) in pilots.items():
-            collisions = summary["measures_collisions"]
-            rows = paired_rows_with(pilot_study, pilot_records, reference, collisions,
-                                    list(intervals))
+            rows = paired_rows_with(pilot_study, pilot_records, reference,
+                                    summary["measures_collisions"], list(intervals))
             paired[pilot] = {(row.method, row.metric): row for row in rows}
     tables = matrix_tables(summary, intervals, paired, reference)
     write_atomically(output / "summary.json", json.dumps(summary, indent=2) + "\n")

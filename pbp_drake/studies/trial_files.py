@@ -93,16 +93,11 @@ _HASHED_AS = {"control_period": "command_period"}
 
 
 def _may_reposition(content):
-    """Whether the scenario's virtual participant may meet a target the tool cannot point
-    at (an arm's wrist turns only so far; objects at heights of their own): `reposition_time`
-    acts on its trials, so it stays in the hash."""
+    """Whether the virtual participant may meet a target the tool cannot point at (an arm;
+    objects at heights of their own): `reposition_time` then acts, and stays in the hash."""
     robot, task = content.get("robot"), content.get("task")
     return ((isinstance(robot, dict) and robot.get("!type") == "Arm")
             or (isinstance(task, dict) and bool(task.get("z_range"))))
-
-
-# Later fields that stay in the content, even at their default, where they act.
-_KEPT_WHERE = {("operator", "reposition_time"): _may_reposition}
 
 
 def scenario_content(scenario):
@@ -117,8 +112,7 @@ def scenario_content(scenario):
     for section, fields in _LATER_FIELDS.items():
         values = content if section is None else content.get(section)
         for name, default in fields.items():
-            kept = _KEPT_WHERE.get((section, name))
-            if kept is not None and kept(content):
+            if (section, name) == ("operator", "reposition_time") and _may_reposition(content):
                 continue
             if isinstance(values, dict) and values.get(name, default) == default:
                 values.pop(name, None)
@@ -488,8 +482,7 @@ def read_study(output):
     return study, records, damaged
 
 
-def name_damaged(damaged, stream=None):
-    """Names each damaged or foreign file on `stream` (stderr): its path and what is wrong."""
+def name_damaged(damaged):
+    """Names each damaged or foreign file on stderr: its path and what is wrong."""
     for item in damaged:
-        print(f"pbp-drake: damaged: {item.path}: {item.problem}",
-              file=stream or sys.stderr, flush=True)
+        print(f"pbp-drake: damaged: {item.path}: {item.problem}", file=sys.stderr, flush=True)

@@ -142,10 +142,9 @@ def plot_pilot_panels(panels, path):
 SCENE_COLOURS = ["tab:red", "tab:purple", "tab:brown", "tab:olive"]
 
 
-def _draw_obstacles(axes, obstacles, colour, label=None, fill=True):
+def _draw_obstacles(axes, obstacles, colour, label=None):
     for index, obstacle in enumerate(obstacles):
-        axes.add_patch(Circle(obstacle.center, obstacle.radius, color=colour,
-                              alpha=0.3 if fill else 1.0, fill=fill,
+        axes.add_patch(Circle(obstacle.center, obstacle.radius, color=colour, alpha=0.3,
                               label=label if index == 0 else None))
 
 

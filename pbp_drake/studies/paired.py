@@ -161,7 +161,7 @@ def _paired_rows(method, trials_a, trials_b, collisions, fields=()):
     return rows
 
 
-def paired_table(rows, name_a="A", name_b="B"):
+def paired_table(rows, name_a, name_b):
     """The rows as a Markdown table, metric by metric."""
     lines = [f"| metric | method | pairs | {name_a} | {name_b} - {name_a} [95 % CI] | "
              f"SD of {name_a} | SE of {name_a} | within noise |",

@@ -142,12 +142,12 @@ def collision_histogram(ratios):
 
 def _relative(path, output):
     try:
-        return str(pathlib.Path(path).relative_to(output)) if output is not None else path
+        return str(pathlib.Path(path).relative_to(output))
     except ValueError:
         return path
 
 
-def measures_collisions(study, records, output=None):
+def measures_collisions(study, records, output):
     """Whether the study's task measures collisions (the obstacle task; reaching records a
     collision ratio of 0 that means "not measured"): by the scenario study.json holds, else
     by an `in_collision` column in its trials' CSV files."""
@@ -155,8 +155,6 @@ def measures_collisions(study, records, output=None):
     if isinstance(content, dict):
         task = content.get("task")
         return isinstance(task, dict) and task.get("!type") == DynamicObstacles.__name__
-    if output is None:
-        return False
     for (method, _), record in records.items():
         if record is None or not record.get("time_series"):
             continue
@@ -192,7 +190,7 @@ def virtual_participant(study):
     return {"condition": condition, "impairment": acting}
 
 
-def summarize(study, records, damaged=(), output=None):
+def summarize(study, records, damaged, output):
     """Per method: how many trials, errors, missing and damaged; the success rate over the
     trials on disk; over the trials that ran without error, the mean and population std of
     intervention ratio and task time, the max and mean of the peaks, and where recorded or

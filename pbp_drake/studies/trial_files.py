@@ -357,7 +357,7 @@ def load_task_result(output, method, seed):
         **{name: record.get(name) for name in INTERACTION_METRICS}, **grasp)
 
 
-def read_trial(output, method, seed, digest=None, damaged=None, key=None):
+def read_trial(output, method, seed, digest, damaged=None, key=None):
     """A trial's JSON record if it is on disk and whole, else None. A damaged trial (bad
     JSON or field types, an empty, malformed or missing CSV) or one of another format is
     appended to `damaged` as a Damage (when given) and reads as None: it runs again. One of
@@ -383,7 +383,7 @@ def read_trial(output, method, seed, digest=None, damaged=None, key=None):
         problem = f"holds the trial of {record['method']!r}, seed {record['seed']}"
     if problem is not None:
         return bad(json_path, problem)
-    if digest is not None and record.get("scenario_hash") != digest:
+    if record.get("scenario_hash") != digest:
         message = (f"a trial of another scenario ({record.get('scenario')!r}, hash "
                    f"{record.get('scenario_hash')}, not {digest})")
         if damaged is None:

@@ -21,8 +21,7 @@ DISK_ERRORS = {
 
 
 class WriteFailed(OSError):
-    """A file could not be written (OSError's `filename`, `errno` and `strerror`); nothing
-    half-written is left."""
+    """A file could not be written (OSError's `filename`, `errno`, `strerror`)."""
 
     def __str__(self):
         reason = (self.strerror or "failed").rstrip(".")

@@ -60,8 +60,7 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
 
 @dataclasses.dataclass
 class StudyFolder:
-    """One method comparison's folder, ready to run: `pending` holds the (method, trial)
-    keys of the trials still to run."""
+    """One method comparison's folder and the (method, trial) keys still to run."""
 
     scenario: object
     digest: str

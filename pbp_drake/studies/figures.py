@@ -79,8 +79,7 @@ def plot_task_time(records, methods, path):
 
 
 def plot_collision_histogram(summary, path):
-    """Fig. 7c: how many trials of each method had each collision ratio, in the summary's
-    fixed bins."""
+    """Fig. 7c: each method's trials per bin of collision ratio (the summary's histogram)."""
     edges = np.asarray(summary["collision_histogram_edges"], float)
     methods = list(summary["methods"])
     figure, axis = plt.subplots(figsize=(7, 3.6))

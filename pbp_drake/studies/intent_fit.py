@@ -78,8 +78,7 @@ def replay_of(result, min_speed):
 
 
 def scores(replays, models):
-    """The score of each of `models` (a list of `IntentFilterSettings`): the mean over
-    trials of the mean log probability of the participant's target, in nats."""
+    """Each `IntentFilterSettings` of `models`' mean log probability of the target (nats)."""
     weights = np.array([[m.move_rate, m.turn_rate, m.silence_rate, m.heading_weight]
                         for m in models])
     totals = np.zeros(len(models))

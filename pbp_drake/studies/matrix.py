@@ -47,8 +47,7 @@ def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, 
 
 
 def read_matrix_study(output):
-    """A matrix folder's study.json. Raises StudyFolderError when it is missing, damaged or
-    not a matrix's."""
+    """A matrix folder's study.json; StudyFolderError when missing, damaged or not a matrix's."""
     path = pathlib.Path(output) / "study.json"
     try:
         study = json.loads(path.read_text())
@@ -62,8 +61,7 @@ def read_matrix_study(output):
 
 
 def read_matrix(output):
-    """The matrix's study.json and, per pilot in its order, `(study, records, damaged)` of
-    that pilot's folder (`trial_files.read_study`; damaged files are named on stderr)."""
+    """The matrix's study.json and `{pilot: read_study(its folder)}`, naming damaged files."""
     study = read_matrix_study(output)
     pilots = {}
     for pilot in study["pilots"]:

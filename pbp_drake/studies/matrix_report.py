@@ -81,8 +81,7 @@ def success_interval(entry):
 
 
 def interval_table(summary, records_by_pilot):
-    """`{metric: {pilot: {method: (mean, low, high)}}}` of success ("success") and every
-    mean metric (`mean_metrics`)."""
+    """`{metric: {pilot: {method: (mean, low, high)}}}` of "success" and `mean_metrics`."""
     table = {"success": {pilot: {method: success_interval(entry)
                                  for method, entry in data["methods"].items()}
                          for pilot, data in summary["pilots"].items()}}

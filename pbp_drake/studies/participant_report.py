@@ -83,8 +83,7 @@ def method_order(sessions):
 
 
 def measure_values(sessions, methods, measure, source):
-    """`{method: {participant: value}}` of one measure, from runs without error and the
-    answers given."""
+    """`{method: {participant: value}}` of one measure (runs without error, answers given)."""
     values = {method: {} for method in methods}
     for name, session in sessions.items():
         for method in methods:

@@ -62,8 +62,7 @@ def recorded_questions():
 
 
 def check_answer(value, question, where):
-    """`value` as an int of SCALE; raises QuestionnaireError naming `where` and what the
-    ends of `question` mean otherwise."""
+    """`value` as an int of SCALE; QuestionnaireError naming `where` otherwise."""
     if isinstance(value, bool) or not isinstance(value, int) or value not in SCALE:
         raise QuestionnaireError(f"{where}: the answer {value!r} is outside {SCALE[0]} to "
                                  f"{SCALE[-1]} ({scale_text(question)}); answers are whole "

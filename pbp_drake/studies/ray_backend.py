@@ -42,8 +42,7 @@ def _ray_trial(scenario, method, trial, seed, digest, run=None):
 
 
 def _cluster_runtime_env():
-    """The runtime environment of a study's tasks on a cluster: this process's pbp_drake
-    package, uploaded and put first on the workers' path, so that they run this code."""
+    """The cluster workers' runtime environment: this process's pbp_drake, first on their path."""
     return {"py_modules": [str(PACKAGE_DIR)], "excludes": ["__pycache__"]}
 
 

@@ -15,8 +15,7 @@ from pbp_drake.studies.atomic_files import is_disk_failure, write_atomically
 from pbp_drake.studies.trial_files import StudyError, write_study_json
 
 def write_toy_study(output, kind, scenario_name, scenario_file, overrides=None):
-    """Writes a 2-D study folder's study.json: its kind, scenario, scenario file and
-    `overrides` (`ScenarioOverrides.record()`), which name the command that made it."""
+    """Writes a 2-D study folder's study.json, which names the command that made it."""
     write_study_json(output, {"study": kind, "scenario": scenario_name}, scenario_file,
                      overrides=overrides)
 
@@ -128,8 +127,7 @@ def alt_vs_cont_markdown(study, summary, figure):
 
 
 def toy_markdown(output):
-    """The Markdown of a 2-D study folder (its summary.json and study.json). Raises
-    StudyError when its summary.json cannot be read."""
+    """The Markdown of a 2-D study folder; StudyError when its summary.json is unreadable."""
     output = pathlib.Path(output)
     try:
         summary = json.loads((output / "summary.json").read_text())

@@ -157,8 +157,7 @@ def _context():
 
 
 def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
-    """Runs `pending` trial keys in a pool of `jobs` processes. Returns `(key, error)` of
-    those unfinished when a worker process died."""
+    """Runs `pending` in a pool; returns `(key, error)` of those unfinished when a worker died."""
     with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=_context(),
                                                 initializer=_start_worker,
                                                 initargs=(os.getpid(),)) as pool:
@@ -198,8 +197,7 @@ def _start_worker(study_pid):
 
 
 def _exit_with(pid):
-    """Kills this process when process `pid` has ended: at once through a pidfd (Linux
-    5.3+), else by polling."""
+    """Kills this process when process `pid` has ended (through a pidfd, else by polling)."""
     try:
         handle = os.pidfd_open(pid)
     except ProcessLookupError:

@@ -37,8 +37,7 @@ def split_of(study, seed, trials):
 
 
 def seeds_line(summary):
-    """One line for results: the seeds a summary covers and their split (none for a study
-    folder written before splits were recorded)."""
+    """One line for results: the seeds a summary covers and their split ("" without seeds)."""
     seeds = summary.get("seeds")
     if not seeds:
         return ""

@@ -56,8 +56,7 @@ def collision_free(collision_ratio):
 
 
 def arbitration(methods):
-    """`{"alphas": [...], "ideal_alpha": A or None, "criterion": text}` over the `fixed_alpha=A`
-    entries of a summary's methods (None when it has none)."""
+    """`{"alphas", "ideal_alpha", "criterion"}` over the `fixed_alpha=A` methods, or None."""
     swept = []
     for label, entry in methods.items():
         _, alpha = parse_method_label(label)

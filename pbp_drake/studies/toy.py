@@ -73,8 +73,7 @@ def with_operator_speed(scenario, speed):
 
 
 def run_outcome(run, obstacles, goal, goal_tolerance):
-    """One run's collision ratio, final distance to the goal and whether it is within the
-    tolerance."""
+    """One run's collision ratio, final distance to the goal and whether it was reached."""
     final_distance = float(np.linalg.norm(run.positions[-1] - goal))
     ratio = collision_ratio(run.positions, [o.center for o in obstacles],
                             [o.radius for o in obstacles])
@@ -139,8 +138,7 @@ def _scene_at_speed(base, study, scene, goal, speed, trajectories):
 
 
 def print_alpha_study(summary):
-    """Prints a line per scene and operator speed: the ideal alpha and each PBP mode's
-    outcome."""
+    """Prints the ideal alpha and PBP's outcomes per scene and operator speed."""
     tolerance = summary["goal_tolerance"]
     print(f"  (collision ratio / final distance to the goal; reached: within {tolerance:g})")
     for scene in summary["scenes"]:

@@ -225,8 +225,7 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
 
 def write_study_json(output, study, scenario_file=None, split_seeds=None,
                      participant_condition=None, overrides=None):
-    """Writes the dict `study` as `output`'s study.json, then each optional field given
-    (`write_study`)."""
+    """Writes the dict `study` and the optional fields given (`write_study`) as study.json."""
     if scenario_file is not None:
         study["scenario_file"] = str(scenario_file)
     if split_seeds is not None:

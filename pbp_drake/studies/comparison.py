@@ -31,20 +31,18 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
                           participant_condition=None, overrides=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     local processes or, with `backend="ray"`, as Ray tasks (on the Ray at `ray_address`,
-    e.g. "HEAD:6379", "auto", "ray://head:10001", else a new local one: see `ray_backend`);
-    writes every trial under `output/trials/`, then the summary, tables and figures (see
-    `report`), and returns the summary dict. `split` labels the seeds (`studies.splits`;
-    None keeps the label the folder holds for the same seeds); `scenario_file`,
-    `split_seeds`, `participant_condition` and `overrides` go into study.json (see
-    `write_study`; the first two None keep what the folder holds).
+    e.g. "HEAD:6379" or "ray://head:10001", else a new local one); writes every trial under
+    `output/trials/`, then `report`s the folder and returns the summary dict. `split`
+    labels the seeds (`studies.splits`); `split` (for the same seeds), `scenario_file` and
+    `split_seeds` None keep what the folder holds; these, `participant_condition` and
+    `overrides` go into study.json (`write_study`).
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except
     those that failed with an error). A trial that raises, or whose worker process dies, is
-    recorded as failed with its error; a file that cannot be written stops the study
-    (`atomic_files.WriteFailed`); another process writing `output` refuses it, before
-    anything is written (`folders.FolderLocked`). `progress(done, total, record, elapsed)`
-    is called after each trial. `run(scenario) -> TaskResult` replaces `run_task`
-    (picklable when `jobs > 1`).
+    recorded as failed; a file that cannot be written stops the study (WriteFailed), and
+    another process writing `output` refuses it (FolderLocked). `progress(done, total,
+    record, elapsed)` is called after each trial; `run(scenario) -> TaskResult` replaces
+    `run_task` (picklable when `jobs > 1`).
     """
     check_run_options(trials, jobs, backend, ray_address, run)
     output = pathlib.Path(output)

@@ -74,7 +74,6 @@ class _RaySession:
 
     def close(self):
         if self.started:
-            self.started = False
             self.ray.shutdown()
 
 

@@ -51,7 +51,7 @@ def does_the_hsr_task(entry):
 
 
 def collision_free(collision_ratio):
-    """The 2-D alpha study's task: reach the goal past the obstacles without touching one."""
+    """The 2-D alpha study's task: pass the obstacles without touching one."""
     return collision_ratio == 0.0
 
 

@@ -46,8 +46,7 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     """
     check_run_options(trials, jobs, backend, ray_address, run)
     output = pathlib.Path(output)
-    # Checked before the lock, so that a refused folder is not written at all; and again
-    # under it (prepare_folder).
+    # Checked before the lock too, so that a refused folder is not written at all.
     check_folder(output, scenario, scenario_hash(scenario), participant_condition)
     with study_lock(output):
         folder = prepare_folder(scenario, methods, trials, seed, output, retry_errors, split,

@@ -1,11 +1,8 @@
 """The paper's questionnaire (section V-C, Fig. 8): two questions answered 0 to 5 after each
-method of a session, higher being better, each end labelled in words. `QUESTIONS` is the
-one table of them, for the page, `--answers`, the report and the file.
-
-`questionnaire.json` keeps the answers by method beside the questions as asked
-(docs/user-study.md, "Files and resuming"); each answer is written at once and never
-overwritten. A bare `{method: {question: answer}}` file is read and kept in that form: it
-cannot vouch for the labels its answers were given under.
+method of a session, higher being better, each end labelled in words (`QUESTIONS`, the one
+table of them). `questionnaire.json` keeps the answers by method beside the questions as
+asked (docs/user-study.md, "Files and resuming"); a bare `{method: {question: answer}}`
+file is read and kept in that form: it cannot vouch for the labels of its answers.
 """
 
 import json

@@ -47,9 +47,8 @@ def _cluster_runtime_env():
 
 
 class _RaySession:
-    """Ray for one study: with no address, a new local Ray of `jobs` CPUs on this process's
-    sys.path, shut down at the end; with an address, that cluster (left running). A Ray
-    this process already runs is used as is."""
+    """Ray for one study: the Ray this process runs, the cluster at `address` (left running),
+    or a new local Ray of `jobs` CPUs on this process's sys.path (shut down at the end)."""
 
     def __init__(self, jobs, address=None):
         self.ray = import_ray()

@@ -25,9 +25,8 @@ from pbp_drake.builder.time_series import (
 # A trial file of another format counts as not on disk (it runs again); a metric a file
 # lacks reads as None (reported n/a), so a new metric does not change the format.
 TRIAL_FORMAT = 1
-# The metrics of a trial, in the order of the trial files and of trials.json: the peaks
-# (`pbp_drake.builder.run.SeriesPeaks`), `posterior_clipped_ratio` (only the methods with
-# HOP's posterior record it) and the interaction metrics (`pbp_drake.core.interaction_metrics`).
+# The metrics of a trial, in the order of the trial files and of trials.json (the interaction
+# metrics: `pbp_drake.core.interaction_metrics`).
 INTERACTION_METRICS = ("input_integral", "turn_input_integral", "idle_ratio", "agreement",
                        "prediction_accuracy", "time_to_prediction", "mean_time_to_prediction",
                        "unpredicted_switches")

@@ -139,13 +139,6 @@ def collision_histogram(ratios):
     return counts
 
 
-def _relative(path, output):
-    try:
-        return str(pathlib.Path(path).relative_to(output))
-    except ValueError:
-        return path
-
-
 def measures_collisions(study, records, output):
     """Whether the study's task measures collisions (the obstacle task; reaching records a
     collision ratio of 0 that means "not measured"): by the scenario study.json holds, else
@@ -237,8 +230,8 @@ def summarize(study, records, damaged, output):
                                         "histogram": collision_histogram(ratios)}
             entry["collision_free_trials"] = (sum(ratio == 0.0 for ratio in ratios)
                                               if ratios else None)
-    summary["damaged"] = [{"file": _relative(d.path, output), "problem": d.problem}
-                          for d in damaged]
+    summary["damaged"] = [{"file": str(pathlib.Path(d.path).relative_to(output)),
+                           "problem": d.problem} for d in damaged]
     swept = arbitration(summary["methods"])
     if swept is not None:
         summary["arbitration"] = swept

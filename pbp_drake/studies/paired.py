@@ -103,16 +103,15 @@ def paired_comparison(folder_a, folder_b):
     return rows
 
 
-def paired_with(folder, reference, metrics=None):
+def paired_with(folder, reference, metrics):
     """The `PairedRow`s of one study's every other method (B) against its method `reference`
-    (A), for the `metrics` named (default: all). Raises ValueError when the study did not
-    run `reference`."""
+    (A), for the `metrics` named. Raises ValueError when the study did not run `reference`."""
     study, records, _ = read_study(folder)
     return paired_rows_with(study, records, reference,
                             measures_collisions(study, records, folder), metrics)
 
 
-def paired_rows_with(study, records, reference, collisions, metrics=None):
+def paired_rows_with(study, records, reference, collisions, metrics):
     """`paired_with` of a study already read (`collisions`: whether its task measures them).
     A metric of `metrics` not in `_METRICS` is read as the records' field of that name (or
     of the name `summary.TRIAL_VALUE` gives it)."""
@@ -120,12 +119,12 @@ def paired_rows_with(study, records, reference, collisions, metrics=None):
         raise ValueError(f"the study ran {', '.join(study['methods'])}, not {reference}")
     reference_trials = _by_seed(study, records, reference)
     known = {name for name, _, _ in _METRICS}
-    fields = tuple(name for name in metrics or () if name not in known)
+    fields = tuple(name for name in metrics if name not in known)
     rows = []
     for method in [m for m in study["methods"] if m != reference]:
         rows += _paired_rows(method, reference_trials, _by_seed(study, records, method),
                              collisions, fields)
-    return [row for row in rows if metrics is None or row.metric in metrics]
+    return [row for row in rows if row.metric in metrics]
 
 
 def _record_field(name):

@@ -76,9 +76,9 @@ class _RaySession:
             self.ray.shutdown()
 
 
-def check_answers(address, timeout=CONNECT_TIMEOUT):
+def check_answers(address):
     """Raises StudyError when nothing accepts a TCP connection at a `HOST:PORT` or
-    `ray://HOST:PORT` address within `timeout` seconds (Ray's own driver retries for minutes,
+    `ray://HOST:PORT` address within CONNECT_TIMEOUT (Ray's own driver retries for minutes,
     silently). Other forms (`auto`) are Ray's to resolve."""
     target = address[len("ray://"):] if address.startswith("ray://") else address
     host, colon, port = target.rpartition(":")
@@ -86,13 +86,13 @@ def check_answers(address, timeout=CONNECT_TIMEOUT):
         return
     host = host.strip("[]") or "localhost"
     try:
-        with socket.create_connection((host, int(port)), timeout=timeout):
+        with socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT):
             pass
     except OSError as error:
         reason = f"{type(error).__name__}: {error}" if str(error) else type(error).__name__
         raise StudyError(
             f"could not connect to Ray at {address}: nothing answers at {host}:{port} within "
-            f"{timeout:g} s ({reason}); is its head node running (ray start --head)?"
+            f"{CONNECT_TIMEOUT:g} s ({reason}); is its head node running (ray start --head)?"
         ) from None
 
 

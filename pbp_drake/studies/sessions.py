@@ -47,8 +47,7 @@ def session_order(methods, participant):
     return methods[shift:] + methods[:shift]
 
 
-def run_session(scenario, participant, methods, output, run, page, practice=False,
-                progress=None):
+def run_session(scenario, participant, methods, output, run, page, practice=False):
     """Runs `run(scenario)` for each method in the participant's order, on the scenario's
     seed, saving each as a trial under `output`. `page` (console.questionnaire's Meshcat
     page or FixedAnswers) shows each method's Start and asks the questionnaire once its
@@ -92,8 +91,6 @@ def run_session(scenario, participant, methods, output, run, page, practice=Fals
 
     def after_run(done, total, record, elapsed):
         ask_unanswered()
-        if progress is not None:
-            progress(done, total, record, elapsed)
         start_next(output, scenario.seed, False)
 
     if practice and len(unsaved(output, scenario.seed)) == len(order):

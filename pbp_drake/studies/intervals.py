@@ -9,8 +9,7 @@ from pbp_drake.scenarios import METHOD_NAMES
 
 # The two-sided 95 % normal quantile of Wilson's interval.
 Z_95 = 1.959963984540054
-# The ranges of metrics' values.
-RATIO, TIME, COSINE = (0.0, 1.0), (0.0, math.inf), (-1.0, 1.0)
+RATIO, TIME, COSINE = (0.0, 1.0), (0.0, math.inf), (-1.0, 1.0)  # metrics' ranges
 # The metrics whose mean gets an interval: (summary entry, column, digits, range); first
 # the interaction metrics of `pbp_drake.core.interaction_metrics`.
 INTERACTION_MEANS = (("input_integral", "input (m)", 3, TIME),

@@ -13,7 +13,6 @@ from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.trial_files import TRIAL_FIELDS, name_damaged, read_study
 
 BOX_FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png")
-# Drawn only for tasks that measure collisions (summary["measures_collisions"]).
 COLLISION_FIGURE = "fig7c_collisions.png"
 
 

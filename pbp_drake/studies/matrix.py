@@ -71,10 +71,8 @@ def read_matrix(output):
 
 
 def summarize_matrix(study, pilots, output):
-    """The matrix's summary: the fields every pilot's study shares (scenario, trials,
-    seeds, split, whether collisions are measured), then `"pilots": {NAME: that pilot's
-    summary without them}` (its `methods` as in a study's summary.json, whatever their
-    entries hold), and every damaged file, relative to `output`."""
+    """The matrix's summary: the fields every pilot's study shares (`_SHARED`), then
+    `"pilots": {NAME: that pilot's summary without them}`, and every damaged file."""
     summary = {"study": MATRIX, "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"]}
     damaged = []

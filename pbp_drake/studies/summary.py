@@ -26,8 +26,7 @@ SIGNIFICANT_DIGITS = 12
 def ideal_alpha(outcomes, does_task):
     """The paper's ideal arbitration (section IV-A): the highest alpha of `outcomes`
     (`(alpha, outcome)` pairs) whose outcome `does_task` (a lower one takes autonomy from
-    the robot for nothing), or None when none does. The HSR method comparison judges with
-    `does_the_hsr_task`, the 2-D alpha study with `collision_free`."""
+    the robot for nothing), or None when none does."""
     good = [alpha for alpha, outcome in outcomes if does_task(outcome)]
     return max(good) if good else None
 
@@ -183,12 +182,11 @@ def virtual_participant(study):
 
 
 def summarize(study, records, damaged, output):
-    """Per method: how many trials, errors, missing and damaged; the success rate over the
-    trials on disk; over the trials that ran without error, the mean and population std of
-    intervention ratio and task time, the max and mean of the peaks, and where recorded or
-    measured the `posterior_clipped_ratio`, `interaction_entries` and the collision ratio
-    (with its histogram and collision-free count); and the ideal alpha (`arbitration`).
-    `damaged` (`read_study`'s) becomes the "damaged" list, relative to `output`."""
+    """The summary.json of `read_study`'s result. Per method: the counts of trials, errors,
+    missing and damaged; the success rate over the trials on disk; over those that ran
+    without error, `mean_std` of intervention ratio and task time, `max_mean` of the peaks
+    and, where recorded or measured, the posterior's clip, `interaction_entries` and the
+    collision ratio; then the damaged files and the ideal alpha (`arbitration`)."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),

@@ -381,7 +381,7 @@ def read_trial(output, method, seed, digest, damaged=None, key=None):
         problem = f"holds the trial of {record['method']!r}, seed {record['seed']}"
     if problem is not None:
         return bad(json_path, problem)
-    if record.get("scenario_hash") != digest:
+    if digest is not None and record.get("scenario_hash") != digest:
         message = (f"a trial of another scenario ({record.get('scenario')!r}, hash "
                    f"{record.get('scenario_hash')}, not {digest})")
         if damaged is None:

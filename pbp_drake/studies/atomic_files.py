@@ -1,12 +1,8 @@
-"""Writing a study's files whole or not at all, and saying so in one line when the disk
-fails.
-
-Each file is written to a temporary file beside it (`.NAME.PID.tmp`), flushed to the disk,
-then renamed over its name. A write that fails (no space left, a quota, a read-only or
-failing disk) removes its temporary file and raises WriteFailed naming the file: the
-study stops there with nothing half-written, and the failure is never taken for a trial's
-own result, so that the same command, once the disk can take the files, runs what is
-missing and ends as if it had never stopped.
+"""Writing a study's files whole or not at all: each goes to a temporary file beside it
+(`.NAME.PID.tmp`), flushed, then renamed over its name. A write that fails (no space, a
+quota, a read-only or failing disk) removes its temporary file and raises WriteFailed: the
+study stops with nothing half-written, the failure is never a trial's result, and the
+same command resumes it (docs/tasks/studies.md, "The folder").
 """
 
 import contextlib
@@ -25,8 +21,7 @@ DISK_ERRORS = {
 
 
 class WriteFailed(OSError):
-    """A file could not be written (its `filename`, the `errno` and `strerror` of the
-    failure, as OSError's). Nothing half-written is left behind it."""
+    """A file could not be written (OSError's `filename`, `errno`, `strerror`)."""
 
     def __str__(self):
         reason = (self.strerror or "failed").rstrip(".")
@@ -48,8 +43,8 @@ def write_failed(error, path):
 
 
 def write_failure_line(error, then="the same command resumes"):
-    """The one line a command prints for `error`, a disk failure (`is_disk_failure`): the
-    file, the reason, and what to do, `then` what the same command does."""
+    """The one line a command prints for a disk failure: the file, the reason, what to do,
+    `then` what the same command does."""
     error = write_failed(error, error.filename)
     return f"pbp-drake: {error}; nothing is left half-written: {error.remedy}, then {then}."
 
@@ -62,9 +57,8 @@ def is_disk_failure(error):
 
 @contextlib.contextmanager
 def writing(path):
-    """Yields the temporary path to write `path` through; when the block ends without an
-    error, flushes it to the disk and renames it to `path`. Any error removes it; an
-    OSError is raised as WriteFailed naming `path`."""
+    """Yields the temporary path to write `path` through, then flushes and renames it to
+    `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`."""
     path = pathlib.Path(path)
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
@@ -91,18 +85,16 @@ def write_atomically(path, text):
 
 
 def save_figure(figure, path, **options):
-    """`figure.savefig(path, **options)` whole or not at all (see `writing`), in the format
-    `path`'s suffix names."""
+    """`figure.savefig(path, **options)` whole or not at all (see `writing`)."""
     path = pathlib.Path(path)
     with writing(path) as temporary:
         figure.savefig(temporary, format=path.suffix.lstrip("."), **options)
 
 
 def remove_leftovers(folder):
-    """Removes what a stopped study left in `folder`: the temporary files and running
-    markers of its trials (only the study that holds the folder's lock writes there), and
-    the temporary files beside its summary whose process has ended (a `report` may be
-    writing its own)."""
+    """Removes what a stopped study left in `folder`: its trials' temporary files and running
+    markers, and the temporary files beside its summary whose process has ended (a
+    `report` may be writing its own)."""
     folder = pathlib.Path(folder)
     leftovers = [*folder.glob("trials/*/*.running"), *folder.glob("trials/*/.*.tmp"),
                  *(path for path in folder.glob(".*.tmp") if not _writer_alive(path))]

@@ -31,25 +31,22 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
                           participant_condition=None, overrides=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     local processes or, with `backend="ray"`, as Ray tasks (on the Ray at `ray_address`,
-    e.g. "HEAD:6379", "auto", "ray://head:10001", else a new local one: see `ray_backend`);
-    writes every trial under `output/trials/`, then the summary, tables and figures (see
-    `report`), and returns the summary dict. `split` labels the seeds (`studies.splits`;
-    None keeps the label the folder holds for the same seeds); `scenario_file`,
-    `split_seeds`, `participant_condition` and `overrides` go into study.json (see
-    `write_study`; the first two None keep what the folder holds).
+    e.g. "HEAD:6379" or "ray://head:10001", else a new local one); writes every trial under
+    `output/trials/`, then `report`s the folder and returns the summary dict. `split`
+    labels the seeds (`studies.splits`); `split` (for the same seeds), `scenario_file` and
+    `split_seeds` None keep what the folder holds; these, `participant_condition` and
+    `overrides` go into study.json (`write_study`).
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except
     those that failed with an error). A trial that raises, or whose worker process dies, is
-    recorded as failed with its error; a file that cannot be written stops the study
-    (`atomic_files.WriteFailed`); another process writing `output` refuses it, before
-    anything is written (`folders.FolderLocked`). `progress(done, total, record, elapsed)`
-    is called after each trial. `run(scenario) -> TaskResult` replaces `run_task`
-    (picklable when `jobs > 1`).
+    recorded as failed; a file that cannot be written stops the study (WriteFailed), and
+    another process writing `output` refuses it (FolderLocked). `progress(done, total,
+    record, elapsed)` is called after each trial; `run(scenario) -> TaskResult` replaces
+    `run_task` (picklable when `jobs > 1`).
     """
     check_run_options(trials, jobs, backend, ray_address, run)
     output = pathlib.Path(output)
-    # Checked before the lock, so that a refused folder is not written at all; and again
-    # under it (prepare_folder).
+    # Checked before the lock too, so that a refused folder is not written at all.
     check_folder(output, scenario, scenario_hash(scenario), participant_condition)
     with study_lock(output):
         folder = prepare_folder(scenario, methods, trials, seed, output, retry_errors, split,
@@ -60,8 +57,7 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
 
 @dataclasses.dataclass
 class StudyFolder:
-    """One method comparison's folder, ready to run (`prepare_folder`): its scenario and
-    hash, its first seed and the (method, trial) keys of the trials still to run."""
+    """One method comparison's folder and the (method, trial) keys still to run."""
 
     scenario: object
     digest: str
@@ -71,8 +67,8 @@ class StudyFolder:
 
 
 def check_run_options(trials, jobs, backend, ray_address, run):
-    """Raises ScenarioError for a bad number of trials or jobs, backend or `run` (before any
-    folder is touched); imports Ray when it is asked for, so that its absence stops here too."""
+    """Raises ScenarioError for a bad number of trials or jobs, backend or `run`, or a missing
+    Ray, before any folder is touched."""
     if trials < 1:
         raise ScenarioError(f"trials must be at least 1, got {trials}")
     if not isinstance(jobs, int) or jobs < 1:
@@ -82,7 +78,7 @@ def check_run_options(trials, jobs, backend, ray_address, run):
     if ray_address is not None and backend != "ray":
         raise ScenarioError("ray_address needs backend='ray'")
     if backend == "ray":
-        import_ray()  # fail before touching the folder when Ray is missing
+        import_ray()
     if backend == "local" and jobs > 1 and run is not None:
         try:
             pickle.dumps(run)
@@ -94,10 +90,9 @@ def check_run_options(trials, jobs, backend, ray_address, run):
 def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, split=None,
                    scenario_file=None, split_seeds=None, participant_condition=None,
                    overrides=None):
-    """Checks `output` (StudyFolderError when it holds another scenario's study), removes
-    what an interrupted study left, names the damaged trial files, writes study.json and
-    returns the StudyFolder with the trials still to run (see `run_method_comparison`).
-    The caller holds the folder's lock and has checked it once (`check_folder`)."""
+    """Checks `output` again under the caller's lock (StudyFolderError for another scenario),
+    removes what an interrupted study left, names the damaged trial files, writes
+    study.json and returns the StudyFolder (see `run_method_comparison`)."""
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
     recorded = check_folder(output, scenario, digest, participant_condition, quiet=True)
@@ -111,8 +106,7 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
     pending, damaged = [], []
     for method in methods:
         for trial in range(trials):
-            # A damaged trial file is not a finished trial: it is named, and runs again. A
-            # trial of another scenario refuses the folder (StudyFolderError).
+            # A damaged trial runs again; one of another scenario refuses the folder.
             before = len(damaged)
             record = read_trial(output, method, seed + trial, digest, damaged,
                                 (method, trial))
@@ -129,10 +123,8 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
 
 def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_address=None):
     """Runs the pending trials of every StudyFolder in one pool of `jobs` local processes,
-    or as Ray tasks, so that no worker waits for another folder's last trial; each trial's
-    files go to its folder. `progress(done, total, record, elapsed)` after each trial.
-    Stopped (Ctrl-C, SIGTERM, a file that cannot be written), it removes what the trials
-    that were running left (temporary files, running markers) before it raises."""
+    or as Ray tasks, each trial's files into its folder. Stopped (Ctrl-C, SIGTERM, a file
+    that cannot be written), it removes what the running trials left before it raises."""
     pending = [(index, method, trial) for index, folder in enumerate(folders)
                for method, trial in folder.pending]
     started = time.monotonic()
@@ -171,12 +163,9 @@ def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_ad
 def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=None, jobs=1,
                       run=None, retry_errors=False, backend="local", ray_address=None,
                       split=None, scenario_file=None, split_seeds=None, overrides=None):
-    """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with every method under every
-    pilot (`scenarios.pilots`: `with_pilot(scenario, name)`), all in one pool of `jobs`
-    processes or Ray tasks, each pilot's trials into `output/pilots/NAME/`; then writes the
-    matrix's summary, table and figure (`matrix_report.report_matrix`) and returns the
-    summary. The arguments are `run_method_comparison`'s, plus the pilots' names; trials on
-    disk for the same scenario and pilot are not run again."""
+    """`run_method_comparison` of every method under every pilot (`with_pilot(scenario,
+    name)`), all in one pool, each pilot's trials into `output/pilots/NAME/`; then writes
+    the matrix's summary, tables and figure (`report_matrix`) and returns the summary."""
     check_pilots(pilots, "pilots")
     check_run_options(trials, jobs, backend, ray_address, run)
     pilot_scenarios = {pilot: with_pilot(scenario, pilot) for pilot in pilots}
@@ -188,12 +177,10 @@ def run_method_matrix(scenario, methods, pilots, trials, seed, output, progress=
         split_seeds = split_seeds or recorded.get("split_seeds")
         if split is None and (recorded.get("seed"), recorded.get("trials")) == (seed, trials):
             split = recorded.get("split")
-    # Every pilot's folder is checked before any is written: a refused one stops the matrix
-    # with nothing changed.
+    # Every pilot's folder is checked before any is written.
     for pilot, pilot_scenario in pilot_scenarios.items():
         check_folder(pilot_folder(output, pilot), pilot_scenario, scenario_hash(pilot_scenario))
     with contextlib.ExitStack() as locks:
-        # The matrix's folder, and each pilot's (a study folder of its own).
         for folder in [output, *(pilot_folder(output, pilot) for pilot in pilots)]:
             locks.enter_context(study_lock(folder))
         remove_leftovers(output)  # of an interrupted report

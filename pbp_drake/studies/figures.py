@@ -1,10 +1,7 @@
-"""The paper's figures, drawn with matplotlib (headless): the 2-D studies' Fig. 2 (the alpha
-study, with its final distances and operator speeds) and Fig. 4 (Alt vs Cont), and the
-method comparison's Fig. 7: (a) box plots of the intervention ratio, (b) of the task time,
-(c) the histogram of per-trial collision ratios, drawn only for tasks that measure
-collisions (the obstacle task; see `studies.report.figure_names`); and a matrix of methods
-and pilots in one figure (`plot_pilot_panels`). They read trial records (dicts from the
-trial files) or summaries, never a simulation."""
+"""The paper's figures, drawn with matplotlib (headless) from trial records or summaries:
+the 2-D studies' Fig. 2 (the alpha study) and Fig. 4 (Alt vs Cont), the method
+comparison's Fig. 7 (box plots of (a) the intervention ratio and (b) the task time, (c)
+the histogram of collision ratios) and a matrix of methods and pilots in one figure."""
 
 import matplotlib
 
@@ -37,7 +34,6 @@ def _label(method, rows=None):
 
 
 def _label_axes(axes, xlabel, ylabel, title, **legend):
-    """Names `axes`' x and y axes, titles it and draws its legend (`legend`: its options)."""
     axes.set_xlabel(xlabel)
     axes.set_ylabel(ylabel)
     axes.set_title(title)
@@ -83,8 +79,7 @@ def plot_task_time(records, methods, path):
 
 
 def plot_collision_histogram(summary, path):
-    """Fig. 7c: how many trials of each method had each collision ratio, in the summary's
-    fixed bins (all zeros, as in tasks without obstacles, make one bar per method)."""
+    """Fig. 7c: each method's trials per bin of collision ratio (the summary's histogram)."""
     edges = np.asarray(summary["collision_histogram_edges"], float)
     methods = list(summary["methods"])
     figure, axis = plt.subplots(figsize=(7, 3.6))
@@ -113,10 +108,9 @@ def _error_bar(axis, x, interval, **style):
 
 
 def plot_pilot_panels(panels, path):
-    """A matrix of methods and pilots in one figure, a panel per pilot: each method's mean
-    intervention ratio (circles, left axis) and task time (squares, right axis) with their
-    95 % intervals. `panels`: `{pilot: [(method, (mean, low, high) of the intervention
-    ratio, the same of the task time)]}` (low and high None: no interval)."""
+    """A panel per pilot: each method's mean intervention ratio (circles, left axis) and task
+    time (squares, right axis) with their 95 % intervals. `panels`: `{pilot: [(method,
+    (mean, low, high) of the ratio, the same of the time)]}` (low, high None: no interval)."""
     count = len(panels)
     figure, axes = plt.subplots(1, count, figsize=(1.2 + 3.4 * count, 3.8), squeeze=False)
     times = [t[0] for rows in panels.values() for _, _, t in rows if t[0] is not None]
@@ -147,10 +141,9 @@ def plot_pilot_panels(panels, path):
 SCENE_COLOURS = ["tab:red", "tab:purple", "tab:brown", "tab:olive"]
 
 
-def _draw_obstacles(axes, obstacles, colour, label=None, fill=True):
+def _draw_obstacles(axes, obstacles, colour, label=None):
     for index, obstacle in enumerate(obstacles):
-        axes.add_patch(Circle(obstacle.center, obstacle.radius, color=colour,
-                              alpha=0.3 if fill else 1.0, fill=fill,
+        axes.add_patch(Circle(obstacle.center, obstacle.radius, color=colour, alpha=0.3,
                               label=label if index == 0 else None))
 
 
@@ -169,8 +162,7 @@ SPEED_STYLES = ["-", "--", ":", "-."]
 
 
 def _trajectory_speed(summary, resolved):
-    """The key of the operator speed whose explicit-arbitration runs panel (d) draws: the
-    scenario operator's own speed when swept, else the first swept."""
+    """The speed key panel (d) draws: the operator's own speed when swept, else the first."""
     own = getattr(resolved.scenario.operator, "speed", None)
     keys = list(summary["scenes"][0]["by_operator_speed"])
     speeds = summary["operator_speeds"]

@@ -22,11 +22,9 @@ _KIND_WORDS = {"method_comparison": ("a method comparison", "study"),
 
 def check_folder(output, scenario, digest, participant_condition=None, quiet=False,
                  kind="method_comparison"):
-    """Raises StudyFolderError when `output` holds a study of another kind than `kind` (a
-    method comparison or a `MATRIX`; a 2-D study's summary.json) or of another scenario,
-    saying so when it was run with another `participant_condition`; names a damaged
-    study.json (it is written again; `quiet`: not named, when it has been already). Returns
-    the folder's readable study.json as a dict, or None."""
+    """Raises StudyFolderError when `output` holds a study of another kind than `kind` or of
+    another scenario (naming another `participant_condition`); names a damaged study.json
+    unless `quiet` (it is written again). Returns the readable study.json, or None."""
     held = folder_kind(output)
     what, one = _KIND_WORDS[kind]
     if held is not None and held != kind:
@@ -83,10 +81,8 @@ class FolderLocked(StudyFolderError):
 @contextlib.contextmanager
 def study_lock(output):
     """Holds `output`'s lock (an flock on its LOCK_FILE, which holds the holder's process
-    id) while the block runs: a study writes the folder alone. Raises FolderLocked, naming
-    the process that holds it, when another does. The lock ends with the process however
-    it ends (kill -9 too): the file may stay, unlocked. On a file system without locks
-    (flock fails otherwise) the block runs unlocked, after a line on stderr saying so."""
+    id) while the block runs. Raises FolderLocked, naming the holder, when another process
+    holds it. On a file system without locks the block runs unlocked, after a line on stderr."""
     output = pathlib.Path(output)
     path = output / LOCK_FILE
     try:
@@ -118,8 +114,7 @@ def study_lock(output):
 
 
 def _holder(descriptor, path):
-    """The lock holder's words: "process PID", from the lock file, else from the kernel's
-    table of locks (/proc/locks, by the file's inode)."""
+    """"process PID" of the lock's holder, from the lock file, else from /proc/locks."""
     text = os.pread(descriptor, 32, 0).decode(errors="replace").strip()
     if text.isdigit():
         return f"process {text}"

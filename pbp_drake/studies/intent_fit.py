@@ -1,22 +1,11 @@
 """Fits the ``intent_filter`` estimator's operator model (`pbp_drake.core.intent_filter`) on
 recorded trials: `python -m pbp_drake.studies.intent_fit FOLDER...`.
 
-The fit reads the teleop trials of study folders (pilots' sub-folders included), whose
-every motion is the operator's own. It replays the filter over each trial on the recorded
-hand position, heading and operator inputs, and scores a model by the mean over trials of
-the mean log probability it gives the participant's target at each tick (a proper score:
-it rewards a calibrated belief). The move and turn rates, the heading's weight and the
-switch rate are fitted over `GRIDS` by coordinate ascent (`ascend`). Not fitted:
-`silence_rate` (under teleop a silent operator leaves the hand still), the clip
-(`max_probability`, HOP's 0.99) and the slowest motion.
-
-Each source is fitted alone, then the switch rate with all three (`fit`): fitted jointly,
-the heading would get no weight, since under teleop the motion says nearly all the heading
-says; under PBP the operator is mostly silent, and the heading is the evidence left.
-
-`make results` runs the tuning studies it is fitted on (`hsr_reach_goals_4_teleop_tuning`,
-`hsr_reach_goals_100_teleop_tuning`); the defaults of `IntentFilterSettings` are this
-command's output on them.
+It replays the filter over the teleop trials of study folders (pilots' sub-folders
+included) and scores a model by the mean log probability it gives the participant's target
+at each tick; the fitted parameters are chosen over `GRIDS` by coordinate ascent (`fit`).
+The defaults of `IntentFilterSettings` are its output on the tuning studies `make results`
+runs; docs/concepts/goal-estimators.md says which, and why each source is fitted alone.
 """
 
 import argparse
@@ -36,7 +25,6 @@ GRIDS = {"move_rate": (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0),
          "heading_weight": (0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 16.0),
          "turn_rate": (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0),
          "switch_rate": (0.003, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0)}
-FITTED = tuple(GRIDS)
 # The evidence sources, each fitted alone.
 SOURCES = ("move_rate", "heading_weight", "turn_rate")
 # The method whose trials are read: the operator's own motions alone.
@@ -46,7 +34,7 @@ MAX_ROUNDS = 6
 
 class Replay(typing.NamedTuple):
     """One trial ready to replay: its features (each (T, K); `acts` (T,)), the target
-    index at each tick (T,), and the control period."""
+    index at each tick (T,), and the control period (s)."""
 
     features: IntentFeatures
     targets: np.ndarray
@@ -90,8 +78,7 @@ def replay_of(result, min_speed):
 
 
 def scores(replays, models):
-    """The score of each of `models` (a list of `IntentFilterSettings`): the mean over
-    trials of the mean log probability of the participant's target, in nats."""
+    """Each `IntentFilterSettings` of `models`' mean log probability of the target (nats)."""
     weights = np.array([[m.move_rate, m.turn_rate, m.silence_rate, m.heading_weight]
                         for m in models])
     totals = np.zeros(len(models))
@@ -135,9 +122,8 @@ def ascend(replays, start, names, log=None, label=""):
 
 
 def fit(replays, log=None):
-    """`(settings, score)`: each source fitted alone (`SOURCES`: the filter reading that
-    source only; the motion and the turns each with a switch rate of its own), then the
-    switch rate with all of them."""
+    """`(settings, score)`: each of `SOURCES` fitted alone (the motion and the turns each
+    with a switch rate of its own), then the switch rate with all of them."""
     fitted = {}
     for source in SOURCES:
         alone = dataclasses.replace(IntentFilterSettings(), **{name: 0.0 for name in SOURCES})
@@ -168,7 +154,7 @@ def main(argv=None):
     print(f"mean log probability of the target: {score:.4f} nats (uniform: {uniform:.4f}; "
           f"the shipped defaults: {float(scores(replays, [defaults])[0]):.4f})")
     print("intent_filter: {" + ", ".join(f"{name}: {getattr(fitted, name):g}"
-                                        for name in FITTED) + "}")
+                                        for name in GRIDS) + "}")
     return 0
 
 

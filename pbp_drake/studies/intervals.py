@@ -1,10 +1,7 @@
 """95 % confidence intervals of a method comparison's results, from its summary alone: the
-success rate's (Wilson's score interval) and the means' (Student's t, from the summary's
-mean and population standard deviation over the trials that ran, cut to the range the
-metric can take: a ratio's [0, 1], a time's [0, inf), a cosine's [-1, 1]), as a table below
-the results table (`pbp_drake.studies.report.results_table`). The interaction metrics'
-intervals are in the summary too (`pbp_drake.studies.summary`), over the trials that have a
-value (a method that names no goal has no prediction accuracy)."""
+success rate's (Wilson's score interval) and the means' (Student's t, from the mean and
+population standard deviation over the trials that ran, cut to the range the metric can
+take), as a table below the results table (`report.results_table`)."""
 
 import math
 
@@ -12,11 +9,9 @@ from pbp_drake.scenarios import METHOD_NAMES
 
 # The two-sided 95 % normal quantile of Wilson's interval.
 Z_95 = 1.959963984540054
-# The metrics whose mean gets an interval: (summary entry, column, digits, the range of
-# the metric's values).
-RATIO, TIME, COSINE = (0.0, 1.0), (0.0, math.inf), (-1.0, 1.0)
-# The interaction metrics of `pbp_drake.core.interaction_metrics`, as the summary gives them
-# (`time_to_prediction`: the mean of each trial's mean over its switches).
+RATIO, TIME, COSINE = (0.0, 1.0), (0.0, math.inf), (-1.0, 1.0)  # metrics' ranges
+# The metrics whose mean gets an interval: (summary entry, column, digits, range); first
+# the interaction metrics of `pbp_drake.core.interaction_metrics`.
 INTERACTION_MEANS = (("input_integral", "input (m)", 3, TIME),
                      ("turn_input_integral", "turning input (rad)", 2, TIME),
                      ("idle_ratio", "idle ratio", 3, RATIO),
@@ -43,8 +38,7 @@ def wilson_interval(successes, trials, z=Z_95):
 
 def mean_interval(mean, population_std, count, within=(-math.inf, math.inf)):
     """`(low, high)` of the t interval of a mean of `count` values, from their mean and
-    population standard deviation, cut to the range `within` the values lie in; None for
-    fewer than two values or no mean."""
+    population standard deviation, cut to `within`; None for fewer than two or no mean."""
     if mean is None or population_std is None or count < 2:
         return None
     # Deferred: scipy.stats takes about 0.7 s to import, which every command would pay.
@@ -64,10 +58,8 @@ def _interval_cell(interval, digits, percent=False):
 
 def confidence_table(summary):
     """The Markdown lines of the 95 % intervals, one row per method: the success rate over
-    the trials on disk, and the mean of each metric the summary holds (collisions where the
-    task measures them, the posterior's clip where a method records it, the interaction
-    metrics where the trials record them) over the trials that ran (those with a value,
-    for a metric whose entry counts them)."""
+    the trials on disk, and the mean of each of `MEAN_METRICS` the summary holds over the
+    trials that ran (those with a value, for an entry that counts them)."""
     methods = summary["methods"]
     metrics = [metric for metric in MEAN_METRICS
                if any(metric[0] in entry for entry in methods.values())]

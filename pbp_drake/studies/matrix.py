@@ -1,17 +1,8 @@
-"""The folder of every method under every pilot (`pbp-drake study FILE --methods ...
---pilots attentive,noisy,...`, run by `comparison.run_method_matrix`): its layout, its
-study.json, and its summary read from the pilots' trial files.
-
-    DIR/study.json              the matrix: scenario and hash, methods, pilots, trials, seeds
-    DIR/pilots/<pilot>/...      a study folder of every method under that pilot (its own
-                                study.json and hash: `pbp-drake report` reports it alone)
-    DIR/summary.json, DIR/results.md, DIR/trials.json, DIR/pilots.png
-                                rebuilt from the files above (`studies.matrix_report`)
-
-Trial i of every method under every pilot runs seed `seed + i` (the pilots draw their own
-randomness from it), so every comparison is paired. The pilot is part of its folder's
-scenario hash, and study.json holds the scenario's: a matrix folder resumes only the same
-scenario, pilot by pilot.
+"""The folder of every method under every pilot (`pbp-drake study FILE --pilots ...`, run by
+`comparison.run_method_matrix`): its study.json, a study folder per pilot
+(`DIR/pilots/<pilot>/`, whose scenario hash includes the pilot) and its summary read from
+the pilots' trial files. The layout is in docs/tasks/studies.md ("Every method under
+every pilot").
 """
 
 import json
@@ -56,8 +47,7 @@ def write_matrix_study(output, scenario, digest, methods, pilots, trials, seed, 
 
 
 def read_matrix_study(output):
-    """A matrix folder's study.json. Raises StudyFolderError when it is missing, damaged or
-    not a matrix's."""
+    """A matrix folder's study.json; StudyFolderError when missing, damaged or not a matrix's."""
     path = pathlib.Path(output) / "study.json"
     try:
         study = json.loads(path.read_text())
@@ -71,8 +61,7 @@ def read_matrix_study(output):
 
 
 def read_matrix(output):
-    """The matrix's study.json and, per pilot in its order, `(study, records, damaged)` of
-    that pilot's folder (`trial_files.read_study`; damaged files are named on stderr)."""
+    """The matrix's study.json and `{pilot: read_study(its folder)}`, naming damaged files."""
     study = read_matrix_study(output)
     pilots = {}
     for pilot in study["pilots"]:
@@ -82,10 +71,8 @@ def read_matrix(output):
 
 
 def summarize_matrix(study, pilots, output):
-    """The matrix's summary: the fields every pilot's study shares (scenario, trials,
-    seeds, split, whether collisions are measured), then `"pilots": {NAME: that pilot's
-    summary without them}` (its `methods` as in a study's summary.json, whatever their
-    entries hold), and every damaged file, relative to `output`."""
+    """The matrix's summary: the fields every pilot's study shares (`_SHARED`), then
+    `"pilots": {NAME: that pilot's summary without them}`, and every damaged file."""
     summary = {"study": MATRIX, "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"]}
     damaged = []

@@ -1,12 +1,7 @@
 """`pbp-drake report DIR` of a matrix folder (`studies.matrix`): its `summary.json`,
-`trials.json`, the method x pilot tables of `results.md` and the figure `pilots.png`,
-rebuilt from the pilots' trial files only.
-
-The tables carry every metric the summary's method entries hold as a mean (whatever they
-are: a metric added to the trials and summaries later appears without a change here), each
-with its 95 % interval, and every method against the reference method (PBP-Alt) under the
-same pilot, paired by seed (`studies.paired`). One figure has a panel per pilot: the
-intervention ratio and task time of each method, with their intervals.
+`trials.json`, the method x pilot tables of `results.md` (every mean a method entry holds,
+with its 95 % interval, and every method against PBP-Alt paired by seed) and the figure
+`pilots.png`, rebuilt from the pilots' trial files only.
 """
 
 import json
@@ -32,8 +27,7 @@ _KNOWN = {key: (column, digits, within) for key, column, digits, within in MEAN_
 
 
 def mean_metrics(summary):
-    """The method entries' metrics that are means (`{"mean", "std"}`), in the order the
-    entries first hold them, over every pilot."""
+    """The method entries' metrics that are means (`{"mean", "std"}`), in first-met order."""
     names = []
     for pilot in summary["pilots"].values():
         for entry in pilot["methods"].values():
@@ -45,8 +39,7 @@ def mean_metrics(summary):
 
 
 def metric_range(key):
-    """The range a metric's values lie in (its interval is cut to it): the studies' own
-    where the metric is known, else the whole line."""
+    """The range a metric's values lie in (its interval is cut to it); unknown: unbounded."""
     return _KNOWN[key][2] if key in _KNOWN else (-math.inf, math.inf)
 
 
@@ -56,8 +49,7 @@ def metric_label(key):
 
 
 def _finite_count(records, method, key):
-    """How many of the method's trials that ran hold a finite number for `key` (the
-    values its summary's mean is over), or None when none hold the field."""
+    """How many of the method's trials that ran hold a finite `key` (None: none)."""
     values = [record.get(key) for (name, _), record in records.items()
               if name == method and record is not None and record.get("error") is None]
     numbers = [v for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
@@ -66,10 +58,9 @@ def _finite_count(records, method, key):
 
 
 def metric_interval(entry, key, count):
-    """`(mean, low, high)` of a method entry's metric: the interval the entry holds, if it
-    holds one, else the mean's 95 % t interval over its `count` values (the entry's own
-    count where it has one), cut to the metric's range where it is known; low and high None
-    with fewer than two values, all None without a mean."""
+    """`(mean, low, high)` of a method entry's metric: the entry's own interval, else the
+    mean's 95 % t interval over `count` values (the entry's count where it has one) within
+    `metric_range`; low and high None with fewer than two values, all None without a mean."""
     value = entry.get(key)
     if not isinstance(value, dict) or value.get("mean") is None:
         return None, None, None
@@ -82,8 +73,7 @@ def metric_interval(entry, key, count):
 
 
 def success_interval(entry):
-    """`(rate, low, high)` of a method entry's success rate (Wilson's interval over the
-    trials on disk), all None without trials."""
+    """`(rate, low, high)` of a method entry's success rate (Wilson's interval), or Nones."""
     rate = entry["success_rate"]
     if rate is None:
         return None, None, None
@@ -91,8 +81,7 @@ def success_interval(entry):
 
 
 def interval_table(summary, records_by_pilot):
-    """`{metric: {pilot: {method: (mean, low, high)}}}` of success ("success") and every
-    mean metric (`mean_metrics`)."""
+    """`{metric: {pilot: {method: (mean, low, high)}}}` of "success" and `mean_metrics`."""
     table = {"success": {pilot: {method: success_interval(entry)
                                  for method, entry in data["methods"].items()}
                          for pilot, data in summary["pilots"].items()}}
@@ -152,8 +141,7 @@ def matrix_tables(summary, intervals, paired, reference):
         lines.append(f"| {_method_name(method)} | " + " | ".join(cells) + " |")
     for key, by_pilot in intervals.items():
         digits = 0 if key == "success" else _KNOWN.get(key, (None, 3))[1]
-        lines += ["", f"**{metric_label(key) if key != 'success' else 'success'}**", "",
-                  *header]
+        lines += ["", f"**{metric_label(key)}**", "", *header]
         for method in methods:
             cells = [_cell(by_pilot[pilot].get(method, (None, None, None)), digits,
                            percent=key == "success") for pilot in pilots]
@@ -165,8 +153,7 @@ def matrix_tables(summary, intervals, paired, reference):
                   "the number of pairs (a time over the seeds both succeeded on)."]
         others = [m for m in methods if m != reference]
         for key in intervals:
-            lines += ["", f"**{metric_label(key) if key != 'success' else 'success'}, "
-                          f"against {name}**", "", *header]
+            lines += ["", f"**{metric_label(key)}, against {name}**", "", *header]
             for method in others:
                 cells = [_paired_cell(paired[pilot].get((method, key))) for pilot in pilots]
                 lines.append(f"| {_method_name(method)} | " + " | ".join(cells) + " |")
@@ -183,11 +170,10 @@ def matrix_command(study, summary):
 
 
 def report_matrix(output, reference=None, markdown=None):
-    """Rebuilds a matrix folder's `summary.json`, `results.md`, `trials.json` and
-    `pilots.png` from its pilots' trial files (no simulation); `markdown`: also writes the
-    tables to that file after the command that made the matrix. `reference`: the method
-    every other is paired with (default PBP-Alt, when the matrix ran it). Returns the
-    summary. Raises ValueError when the matrix did not run `reference`."""
+    """Rebuilds a matrix folder's files (the module's docstring) and returns the summary;
+    `markdown`: also writes the tables to that file after the command that made the matrix.
+    `reference`: the method every other is paired with (default PBP-Alt, when the matrix ran
+    it). Raises ValueError when the matrix did not run `reference`."""
     output = pathlib.Path(output)
     study, pilots = read_matrix(output)
     summary = summarize_matrix(study, pilots, output)
@@ -201,9 +187,8 @@ def report_matrix(output, reference=None, markdown=None):
             raise ValueError(f"the matrix ran {', '.join(study['methods'])}, not {reference}")
         paired = {}
         for pilot, (pilot_study, pilot_records, _) in pilots.items():
-            collisions = summary["measures_collisions"]
-            rows = paired_rows_with(pilot_study, pilot_records, reference, collisions,
-                                    list(intervals))
+            rows = paired_rows_with(pilot_study, pilot_records, reference,
+                                    summary["measures_collisions"], list(intervals))
             paired[pilot] = {(row.method, row.metric): row for row in rows}
     tables = matrix_tables(summary, intervals, paired, reference)
     write_atomically(output / "summary.json", json.dumps(summary, indent=2) + "\n")

@@ -1,16 +1,8 @@
-"""Two studies of the same seeds, compared trial by trial: `pbp-drake compare A B`; and,
-with the same statistics, one study's methods against one of them (`paired_with`:
-`pbp-drake report DIR --paired-with METHOD`).
-
-Change a setting (the robot's motion model, a time step, a gain), run the same study again
-into another folder, and ask whether any result moved by more than the trials differ among
-themselves. Each method's trials of A and B are paired by seed; for each metric the table
-gives A's mean, the paired difference B - A (its mean and 95 % confidence interval, on
-Student's t), and A's trial-to-trial standard deviation (SD) and standard error of the
-mean (SE = SD / sqrt(n)). A difference is *within noise* when its mean is no larger than
-A's SD: the spread one trial's result already carries. The SE, the uncertainty of A's
-reported mean, is the stricter yardstick, and the table marks which differences pass it
-too.
+"""Two studies of the same seeds, compared trial by trial (`pbp-drake compare A B`), and one
+study's methods against one of them (`pbp-drake report DIR --paired-with METHOD`). Per
+metric: A's mean, the paired difference B - A with its 95 % t interval, and A's SD and SE;
+a difference is *within noise* when its mean is no larger than A's SD, the spread one
+trial already carries (docs/tasks/studies.md, "Report and compare").
 """
 
 import dataclasses
@@ -111,36 +103,32 @@ def paired_comparison(folder_a, folder_b):
     return rows
 
 
-def paired_with(folder, reference, metrics=None):
-    """The `PairedRow`s of one study's every other method against its method `reference`,
-    seed by seed (A: `reference`, B: the row's method), for the `metrics` named (default:
-    every metric). Raises ValueError when the study did not run `reference`."""
+def paired_with(folder, reference, metrics):
+    """The `PairedRow`s of one study's every other method (B) against its method `reference`
+    (A), for the `metrics` named. Raises ValueError when the study did not run `reference`."""
     study, records, _ = read_study(folder)
     return paired_rows_with(study, records, reference,
                             measures_collisions(study, records, folder), metrics)
 
 
-def paired_rows_with(study, records, reference, collisions, metrics=None):
-    """`paired_with` of a study already read (`read_study`'s study and records;
-    `collisions`: whether its task measures them). A metric of `metrics` that is not one
-    of the known ones is read as the trial records' field of that name, or of the name
-    `summary.TRIAL_VALUE` gives it (how a trial metric added later is paired without
-    naming it here)."""
+def paired_rows_with(study, records, reference, collisions, metrics):
+    """`paired_with` of a study already read (`collisions`: whether its task measures them).
+    A metric of `metrics` not in `_METRICS` is read as the records' field of that name (or
+    of the name `summary.TRIAL_VALUE` gives it)."""
     if reference not in study["methods"]:
         raise ValueError(f"the study ran {', '.join(study['methods'])}, not {reference}")
     reference_trials = _by_seed(study, records, reference)
     known = {name for name, _, _ in _METRICS}
-    fields = tuple(name for name in metrics or () if name not in known)
+    fields = tuple(name for name in metrics if name not in known)
     rows = []
     for method in [m for m in study["methods"] if m != reference]:
         rows += _paired_rows(method, reference_trials, _by_seed(study, records, method),
                              collisions, fields)
-    return [row for row in rows if metrics is None or row.metric in metrics]
+    return [row for row in rows if row.metric in metrics]
 
 
 def _record_field(name):
-    """A reader of the records' field `name`: its number, None when it holds none (or not a
-    finite number, e.g. a list of values)."""
+    """A reader of the records' field `name`: its finite number, else None."""
     def read(record):
         value = record.get(name)
         number = isinstance(value, (int, float)) and not isinstance(value, bool)
@@ -150,8 +138,7 @@ def _record_field(name):
 
 def _paired_rows(method, trials_a, trials_b, collisions, fields=()):
     """A row per metric of `method`'s trials B against A (`{seed: record}` each), over the
-    seeds both ran; a time only where both succeeded. `fields`: more metrics, each read
-    as the records' field of its name."""
+    seeds both ran; a time only where both succeeded. `fields`: more records' fields."""
     seeds = sorted(set(trials_a) & set(trials_b))
     rows = []
     for metric, read, needs_success in (*_METRICS,
@@ -173,7 +160,7 @@ def _paired_rows(method, trials_a, trials_b, collisions, fields=()):
     return rows
 
 
-def paired_table(rows, name_a="A", name_b="B"):
+def paired_table(rows, name_a, name_b):
     """The rows as a Markdown table, metric by metric."""
     lines = [f"| metric | method | pairs | {name_a} | {name_b} - {name_a} [95 % CI] | "
              f"SD of {name_a} | SE of {name_a} | within noise |",
@@ -191,8 +178,7 @@ def paired_table(rows, name_a="A", name_b="B"):
 
 
 def paired_with_markdown(rows, reference):
-    """The rows of `paired_with` as a titled Markdown table: each method against
-    `reference`, with `reference`'s SD as the yardstick of noise (as in `compare`)."""
+    """The rows of `paired_with` as a titled Markdown table."""
     name = METHOD_NAMES.get(reference, reference)
     rows = [dataclasses.replace(row, method=METHOD_NAMES.get(row.method, row.method))
             for row in rows]

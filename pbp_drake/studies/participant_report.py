@@ -1,9 +1,7 @@
-"""`pbp-drake report STUDY_DIR` for a user study: STUDY_DIR holds one folder per participant
-(`pbp-drake session ... --participant ID`). Per method, the metrics of the recorded runs
-(intervention ratio, task time, success) and the questionnaire's answers; pairwise Wilcoxon
-signed-rank tests with Bonferroni correction on intervention, task time, tiredness and ease,
-as the paper reports them (section V-C); Fig. 8 (`fig8_questionnaire.png`); all in
-STUDY_DIR/results.md. Practice runs (ID/practice) are never read.
+"""`pbp-drake report STUDY_DIR` for a user study (a folder per participant): per method the
+recorded runs' metrics and the answers, pairwise Wilcoxon signed-rank tests with Bonferroni
+correction (the paper's section V-C) in results.md, and Fig. 8 (docs/user-study.md, "The
+report"). Practice runs are never read.
 """
 
 import collections
@@ -27,25 +25,21 @@ MEASURES = (("intervention_ratio", "intervention ratio", "trial"),
 
 
 def is_participant_collection(folder):
-    """Whether `folder` is not itself a study folder (no study.json, no trials/): then
-    `pbp-drake report` reads it as a folder of participant folders."""
+    """Whether `folder` is not itself a study folder (no study.json, no trials/)."""
     folder = pathlib.Path(folder)
     return not (folder / "study.json").exists() and not (folder / "trials").is_dir()
 
 
 def participant_folders(study_dir):
-    """The participant folders in `study_dir`: its sub-folders holding a session's
-    study.json or trials/, by name."""
+    """`study_dir`'s sub-folders holding a study.json or trials/, by name."""
     return sorted(p for p in pathlib.Path(study_dir).iterdir() if p.is_dir()
                   and ((p / "study.json").is_file() or (p / "trials").is_dir()))
 
 
 def read_participants(study_dir):
-    """`(sessions, damaged)`: per participant folder name, its study, its recorded runs by
-    method (None when not on disk or damaged) and its answers; and every damaged file
-    (named, skipped). Raises ScenarioError when there are no participant folders, or when
-    one holds a session of another scenario than the others (by the scenario hash its
-    study.json and trial files carry)."""
+    """`(sessions, damaged)`: per participant folder name, its study, its runs by method
+    (None when not on disk or damaged) and its answers; and every damaged file. Raises
+    ScenarioError when there are no participant folders, or one holds another scenario."""
     study_dir = pathlib.Path(study_dir)
     if not study_dir.is_dir():
         raise ScenarioError(f"{study_dir}: no such folder")
@@ -82,16 +76,14 @@ def read_participants(study_dir):
 
 
 def method_order(sessions):
-    """The methods of all sessions: the paper's (PBP-Alt, PBP-Cont, Teleop) first, in
-    that order, then any other in the order first met."""
+    """The methods of all sessions: the paper's three first, then others as first met."""
     found = list(dict.fromkeys(m for s in sessions.values() for m in s["study"]["methods"]))
     return ([m for m in DEFAULT_SESSION_METHODS if m in found]
             + [m for m in found if m not in DEFAULT_SESSION_METHODS])
 
 
 def measure_values(sessions, methods, measure, source):
-    """`{method: {participant: value}}` of one measure; a run that failed with an error,
-    or is missing, and an unanswered question give no value."""
+    """`{method: {participant: value}}` of one measure (runs without error, answers given)."""
     values = {method: {} for method in methods}
     for name, session in sessions.items():
         for method in methods:
@@ -112,10 +104,9 @@ PAIRED_BY = {"trial": "ran both", "answer": "answered both"}
 
 def wilcoxon_rows(values, methods, source):
     """Each pair of methods' two-sided Wilcoxon signed-rank test (scipy.stats.wilcoxon,
-    its defaults) over the participants with a value for both, paired by participant:
-    dicts of pair, n, statistic, p. p is None where there is nothing to test, and `note`
-    says why in plain words (`source`, "trial" or "answer", names who counted) rather than
-    in SciPy's: fewer than two participants, or every difference zero."""
+    its defaults), paired by participant: dicts of pair, n, statistic, p. Where there is
+    nothing to test p is None and `note` says why in plain words (`source`, "trial" or
+    "answer", names who counted)."""
     # Deferred: scipy.stats takes about 0.7 s to import, which every command would pay.
     import scipy.stats
 
@@ -152,8 +143,7 @@ def _label(method):
 
 
 def _summary(values, source):
-    """A Per-method cell: a trial measure's mean ± std, an answer's median (mean); "-"
-    with no value."""
+    """A trial measure's mean ± std, an answer's median (mean), or "-"."""
     values = list(values)
     if not values:
         return "-"
@@ -163,8 +153,7 @@ def _summary(values, source):
 
 
 def participant_results(study_dir):
-    """The report as Markdown text, and what it was made of:
-    `(text, sessions, methods, damaged)`."""
+    """`(Markdown text, sessions, methods, damaged)` of the report."""
     sessions, damaged = read_participants(study_dir)
     methods = method_order(sessions)
     values = {key: measure_values(sessions, methods, key, source)
@@ -231,8 +220,8 @@ def participant_results(study_dir):
 
 
 def participant_report(study_dir):
-    """Writes STUDY_DIR/results.md and STUDY_DIR/fig8_questionnaire.png; names damaged files
-    on stderr. Returns `(results text, number of damaged files)`."""
+    """Writes STUDY_DIR/results.md and Fig. 8, naming damaged files on stderr. Returns
+    `(results text, number of damaged files)`."""
     study_dir = pathlib.Path(study_dir)
     text, sessions, methods, damaged = participant_results(study_dir)
     name_damaged(damaged)

@@ -1,19 +1,8 @@
-"""The paper's questionnaire (section V-C, Fig. 8): two questions answered on a scale of 0 to
-5 after each method of a session, higher being better, each end of each question labelled
-in words so that a participant never has to guess which end is which. `QUESTIONS` is the
-one table of them: the page's buttons, `--answers`' messages, the report and the file all
-read it.
-
-The participant folder's `questionnaire.json` keeps the answers by method beside the
-questions as the participant saw them:
-
-    {"answers": {method: {"tiredness": 0-5, "ease": 0-5}, ...},
-     "questions": {"tiredness": {"question": ..., "0": ..., "5": ...}, "ease": {...}}}
-
-Each answer is written at once (atomically) and never overwritten, so a resumed session
-asks only what is missing. A bare `{method: {question: answer}}` file, without the
-questions, is read and kept in that form: it cannot vouch for the labels its answers were
-given under.
+"""The paper's questionnaire (section V-C, Fig. 8): two questions answered 0 to 5 after each
+method of a session, higher being better, each end labelled in words (`QUESTIONS`, the one
+table of them). `questionnaire.json` keeps the answers by method beside the questions as
+asked (docs/user-study.md, "Files and resuming"); a bare `{method: {question: answer}}`
+file is read and kept in that form: it cannot vouch for the labels of its answers.
 """
 
 import json
@@ -44,8 +33,8 @@ class QuestionnaireError(ScenarioError):
 
 
 def end_label(question, value):
-    """What `value` means for `question` when it is an end of the scale ("very tired" for
-    tiredness 0), else None: the middle values are just numbers."""
+    """What `value` means for `question` at an end of the scale ("very tired" for
+    tiredness 0), else None."""
     asked = QUESTIONS[question]
     return {SCALE[0]: asked.lowest, SCALE[-1]: asked.highest}.get(value)
 
@@ -64,15 +53,13 @@ def scales_text():
 
 
 def recorded_questions():
-    """The questions as questionnaire.json records them beside the answers: per key, its
-    text and the labels of its two ends, by value."""
+    """The questions as questionnaire.json records them: per key, its text and end labels."""
     return {key: {"question": asked.text, str(SCALE[0]): asked.lowest,
                   str(SCALE[-1]): asked.highest} for key, asked in QUESTIONS.items()}
 
 
 def check_answer(value, question, where):
-    """`value` as an int of SCALE; raises QuestionnaireError naming `where` and what the
-    ends of `question` mean otherwise."""
+    """`value` as an int of SCALE; QuestionnaireError naming `where` otherwise."""
     if isinstance(value, bool) or not isinstance(value, int) or value not in SCALE:
         raise QuestionnaireError(f"{where}: the answer {value!r} is outside {SCALE[0]} to "
                                  f"{SCALE[-1]} ({scale_text(question)}); answers are whole "
@@ -88,9 +75,8 @@ def _check_question(question, where):
 
 def read_questionnaire(folder):
     """`(answers, questions)` of `folder`'s questionnaire.json: the answers by method
-    (`{}` when there is no file) and the questions as recorded beside them (None for a file
-    of the older form, which did not record them). Raises QuestionnaireError, naming the
-    file, when it is damaged or holds an answer outside 0-5 or an unknown question."""
+    (`{}` without a file) and the recorded questions (None for a bare file). Raises
+    QuestionnaireError when it is damaged or holds a bad answer or an unknown question."""
     path = pathlib.Path(folder) / QUESTIONNAIRE_FILE
     try:
         held = json.loads(path.read_text())
@@ -128,17 +114,14 @@ def read_questionnaire(folder):
 
 
 def read_answers(folder):
-    """The answers saved in `folder`'s questionnaire.json, `{method: {question: answer}}`
-    (`{}` when there is none), of either form of the file (see `read_questionnaire`)."""
+    """The answers of `read_questionnaire`, `{method: {question: answer}}`."""
     return read_questionnaire(folder)[0]
 
 
 def save_answer(folder, method, question, value):
-    """Adds one answer to `folder`'s questionnaire.json, atomically, with the questions as
-    asked beside the answers. Raises QuestionnaireError when the value is outside 0-5, when
-    that question of that method is already answered (a saved answer is never overwritten),
-    or when the file records the questions worded otherwise than they are now asked (its
-    session's answers would mean two things)."""
+    """Adds one answer to `folder`'s questionnaire.json. Raises QuestionnaireError when the
+    value is outside 0-5, when that question of that method is already answered, or when
+    the file records the questions worded otherwise than they are now asked."""
     _check_question(question, method)
     check_answer(value, question, f"{method} {question}")
     path = pathlib.Path(folder) / QUESTIONNAIRE_FILE
@@ -159,8 +142,7 @@ def save_answer(folder, method, question, value):
 
 
 def _file_text(answers):
-    # One line per method and per question, in the order they were asked, so that a person
-    # reads a participant's answers at a glance.
+    # One line per method and per question, in the order they were asked.
     def lines(mapping):
         return ",\n".join(f"  {json.dumps(key)}: {json.dumps(value)}"
                           for key, value in mapping.items())
@@ -173,9 +155,9 @@ def _file_text(answers):
 
 def parse_answers(text, methods):
     """`--answers` for unattended sessions: comma-separated `[METHOD:]QUESTION=VALUE`, e.g.
-    `tiredness=3,ease=4,teleop:tiredness=1` (an item without a method holds for every
-    method; one with a method overrides it). Returns `{method: {question: value}}` with
-    every question of every method in `methods` answered. Raises QuestionnaireError."""
+    `tiredness=3,ease=4,teleop:tiredness=1` (an item with a method overrides one without).
+    Returns `{method: {question: value}}`, every question answered, or raises
+    QuestionnaireError."""
     common, specific = {}, {}
     for item in (part.strip() for part in text.split(",")):
         key, equals, raw = item.partition("=")

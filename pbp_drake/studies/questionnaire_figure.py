@@ -15,8 +15,7 @@ FIG8 = "fig8_questionnaire.png"
 
 
 def answer_counts(answers, methods, question):
-    """`{method: [count of 0, ..., count of 5]}` of `question` over `answers`
-    (`{participant: {method: {question: value}}}`)."""
+    """`{method: [count of 0, ..., count of 5]}` of `question` over `answers`."""
     counts = {method: [0] * len(SCALE) for method in methods}
     for by_method in answers.values():
         for method in methods:

@@ -1,12 +1,10 @@
-"""The trials as Ray tasks (`--backend ray`), on a local Ray or a cluster.
-
-The tasks only compute; the process that runs the study writes every trial file (a
-cluster's nodes may not see the folder), so the folder is the same as with local processes
-but for each trial's `host` and `ray_node` (the Ray node's id), which no reader needs.
-Ray is imported only when this backend is asked for: it is an optional, heavy dependency
-(`pip install 'pbp_drake[ray]'`).
+"""The trials as Ray tasks (`--backend ray`), on a local Ray or a cluster
+(docs/tasks/studies.md, "On Ray, here or on a cluster"). The tasks only compute; this
+process writes every trial file (a cluster's nodes may not see the folder). Ray, optional
+and heavy, is imported only when this backend is asked for.
 """
 
+import contextlib
 import os
 import pathlib
 import socket
@@ -17,20 +15,18 @@ from pbp_drake.studies.runners import compute_trial
 from pbp_drake.studies.trial_files import StudyError, time_series_csv, write_trial_files
 
 RAY_INSTALL_HINT = "pip install 'pbp_drake[ray]'"
-# A Ray task whose worker process dies runs once more (as a local worker's trial runs again
-# alone) before it is recorded as failed; a trial that raises is recorded at once.
+# A Ray task whose worker process dies runs once more before it is recorded as failed.
 RAY_MAX_RETRIES = 1
 # This process's pbp_drake, which a cluster's workers import (see _cluster_runtime_env).
 PACKAGE_DIR = pathlib.Path(__file__).resolve().parents[1]
-# Seconds a `--ray-address` has to accept a connection before the study says nothing
-# answers there: Ray's own driver retries an address with no head for minutes, silently.
+# Seconds a `--ray-address` has to accept a connection (`check_answers`).
 CONNECT_TIMEOUT = 10.0
 
 
 def import_ray():
     """The `ray` module, or a StudyError that says how to install it."""
     try:
-        import ray  # deferred on purpose: optional and heavy (see the module docstring)
+        import ray  # deferred: optional and heavy
     except ImportError as error:
         raise StudyError(f"--backend ray needs Ray, which is not installed ({error}): "
                          f"{RAY_INSTALL_HINT}") from None
@@ -46,18 +42,13 @@ def _ray_trial(scenario, method, trial, seed, digest, run=None):
 
 
 def _cluster_runtime_env():
-    """The runtime environment of a study's tasks on a cluster: this process's pbp_drake
-    package (under a megabyte), uploaded and put first on the workers' path, so that they
-    run this process's code whatever version the nodes have installed (they still need its
-    dependencies: `pip install 'pbp_drake[ray]'` on each)."""
+    """The cluster workers' runtime environment: this process's pbp_drake, first on their path."""
     return {"py_modules": [str(PACKAGE_DIR)], "excludes": ["__pycache__"]}
 
 
 class _RaySession:
-    """Ray for one study: with no address, a new local Ray of `jobs` CPUs, whose workers
-    see this process's sys.path (as local worker processes do), shut down at the end; with
-    an address, that cluster (left running), its workers given this process's pbp_drake.
-    A Ray this process already runs is used as is."""
+    """Ray for one study: the Ray this process runs, the cluster at `address` (left running),
+    or a new local Ray of `jobs` CPUs on this process's sys.path (shut down at the end)."""
 
     def __init__(self, jobs, address=None):
         self.ray = import_ray()
@@ -82,34 +73,32 @@ class _RaySession:
 
     def close(self):
         if self.started:
-            self.started = False
             self.ray.shutdown()
 
 
-def check_answers(address, timeout=CONNECT_TIMEOUT):
-    """A StudyError, naming the address, when nothing accepts a TCP connection at the
-    host and port of a `HOST:PORT` or `ray://HOST:PORT` address within `timeout` seconds
-    (a refused connection fails at once). Other forms (`auto`) are Ray's to resolve."""
+def check_answers(address):
+    """Raises StudyError when nothing accepts a TCP connection at a `HOST:PORT` or
+    `ray://HOST:PORT` address within CONNECT_TIMEOUT (Ray's own driver retries for minutes,
+    silently). Other forms (`auto`) are Ray's to resolve."""
     target = address[len("ray://"):] if address.startswith("ray://") else address
     host, colon, port = target.rpartition(":")
     if not colon or not port.isdigit():
         return
     host = host.strip("[]") or "localhost"
     try:
-        with socket.create_connection((host, int(port)), timeout=timeout):
+        with socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT):
             pass
     except OSError as error:
         reason = f"{type(error).__name__}: {error}" if str(error) else type(error).__name__
         raise StudyError(
             f"could not connect to Ray at {address}: nothing answers at {host}:{port} within "
-            f"{timeout:g} s ({reason}); is its head node running (ray start --head)?"
+            f"{CONNECT_TIMEOUT:g} s ({reason}); is its head node running (ray start --head)?"
         ) from None
 
 
 def _reason(cause):
-    """Ray's own reason for a bare "Failed to connect to Ray cluster" (e.g. a cluster that
-    wants an authentication token), which is its cause: ` (Type: message)`, or the last
-    line of a cause that holds a traceback's text; "" when there is none."""
+    """Ray's reason for a bare "Failed to connect to Ray cluster" (e.g. a missing token),
+    from its cause: ` (Type: message)`, or a traceback's last line; "" without a cause."""
     if cause is None:
         return ""
     lines = [line.strip() for line in str(cause).splitlines() if line.strip()]
@@ -119,8 +108,7 @@ def _reason(cause):
 
 
 def _ray_error_text(ray, error):
-    """A failed task's error as `Type: message`: a trial's own exception when it has one
-    (as the local backend records it), else Ray's (e.g. WorkerCrashedError)."""
+    """A failed task's error as `Type: message`: the trial's own exception, else Ray's."""
     cause = getattr(error, "cause", None) if isinstance(
         error, ray.exceptions.RayTaskError) else None
     error = cause if isinstance(cause, BaseException) else error
@@ -129,9 +117,8 @@ def _ray_error_text(ray, error):
 
 def run_on_ray(pending, jobs, address, submit_args, on_done, on_error):
     """Runs `pending` trial keys as Ray tasks, at most `jobs` at once, and writes each
-    trial's files here, into the folder `submit_args(key)` names, as its task finishes; a
-    task that fails is recorded as failed. Each distinct scenario (a matrix has one per
-    pilot) is sent to Ray once."""
+    trial's files here, into the folder `submit_args(key)` names (`runners.run_locally`'s
+    callbacks). Each distinct scenario (a matrix has one per pilot) is sent to Ray once."""
     session = _RaySession(jobs, address)
     ray = session.ray
     running = {}
@@ -164,10 +151,8 @@ def run_on_ray(pending, jobs, address, submit_args, on_done, on_error):
                     on_done(key, record)
     except BaseException:  # Ctrl-C: stop the tasks; the trials on disk are whole
         for ref in running:
-            try:
+            with contextlib.suppress(Exception):
                 ray.cancel(ref, force=True)
-            except Exception:
-                pass
         raise
     finally:
         session.close()

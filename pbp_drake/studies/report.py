@@ -13,13 +13,11 @@ from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.trial_files import TRIAL_FIELDS, name_damaged, read_study
 
 BOX_FIGURES = ("fig7a_intervention.png", "fig7b_task_time.png")
-# Drawn only for tasks that measure collisions (summary["measures_collisions"]).
 COLLISION_FIGURE = "fig7c_collisions.png"
 
 
 def figure_names(summary):
-    """The figures `report` writes for this summary, in order: Fig. 7a and 7b, and Fig. 7c
-    where the task measures collisions."""
+    """The figures `report` writes: Fig. 7a and 7b, and 7c where collisions are measured."""
     return BOX_FIGURES + ((COLLISION_FIGURE,) if summary["measures_collisions"] else ())
 
 
@@ -39,9 +37,8 @@ def _peak_cell(entry, field, digits):
 
 
 def interaction_table(summary):
-    """The Markdown lines of the interaction metrics, one row per method: mean ± std of each
-    (`INTERACTION_MEANS`) over the trials with a value, and the switches never named of
-    all the switches; "-" where a method has none. No lines when no method has any."""
+    """The Markdown lines of the interaction metrics (`INTERACTION_MEANS`), one row per
+    method: mean ± std of each, and the switches never named of all; [] when none has any."""
     methods = summary["methods"]
     if not any(name in entry for entry in methods.values() for name, *_ in INTERACTION_MEANS):
         return []
@@ -66,8 +63,7 @@ _IMPAIRMENT_UNITS = {"command_noise_time": " s", "command_delay": " s", "mistake
 
 
 def participant_line(summary):
-    """One line for results: how the virtual participant was impaired (its condition and
-    the fields that act), or "" when it was not."""
+    """One line for results: how the virtual participant was impaired, or "" when it was not."""
     participant = summary.get("virtual_participant")
     if not participant:
         return ""
@@ -80,10 +76,9 @@ def participant_line(summary):
 
 
 def results_table(summary):
-    """The summary (`summarize`) as a Markdown table, one row per method: mean ± std of
-    each mean, max / mean of each peak. Above it, the seeds and the virtual participant's
-    impairment (`participant_line`); below it the interaction metrics
-    (`interaction_table`) and the 95 % confidence intervals (`intervals.confidence_table`)."""
+    """The summary (`summarize`) as results.md: the seeds and `participant_line`, a table
+    with a row per method (mean ± std of each mean, max / mean of each peak), then
+    `interaction_table` and `intervals.confidence_table`."""
     seeds = seeds_line(summary)
     lines = [seeds, ""] if seeds else []
     participant = participant_line(summary)
@@ -143,10 +138,7 @@ def flat_trials(study, records):
 def report(output):
     """Rebuilds `summary.json`, `results.md`, `trials.json` and the figures of a study folder
     (`figure_names`) from its study.json and trial files only (no simulation). Returns the
-    summary.
-
-    Damaged or foreign files (see `read_study`) are named on stderr and skipped: the
-    summary counts each method's damaged trials and lists the files under "damaged"."""
+    summary. Damaged or foreign files (`read_study`) are named on stderr and skipped."""
     output = pathlib.Path(output)
     study, records, damaged = read_study(output)
     name_damaged(damaged)

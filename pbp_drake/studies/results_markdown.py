@@ -1,8 +1,6 @@
 """`pbp-drake report DIR --markdown FILE`: a study folder's results as a Markdown fragment
-for the docs, first the command that made the study (and its seeds), then its table.
-
-The command is read off the folder (study.json, summary.json), never typed by hand: a
-table on the docs site cannot name seeds or methods other than those it was made from.
+for the docs, first the command that made the study, read off the folder so that a table
+cannot name other seeds or methods than its own, then its table.
 """
 
 import json
@@ -16,14 +14,8 @@ from pbp_drake.studies.toy import TOY_FIGURES
 from pbp_drake.studies.atomic_files import is_disk_failure, write_atomically
 from pbp_drake.studies.trial_files import StudyError, write_study_json
 
-# A study folder's study.json; a 2-D study's says which study and scenario file (its
-# summary.json is the study's result and names no file).
-STUDY_FILE = "study.json"
-
-
 def write_toy_study(output, kind, scenario_name, scenario_file, overrides=None):
-    """Writes a 2-D study folder's study.json: its kind, scenario and scenario file, and
-    the command line's `overrides` of its fields (`ScenarioOverrides.record()`) if any."""
+    """Writes a 2-D study folder's study.json, which names the command that made it."""
     write_study_json(output, {"study": kind, "scenario": scenario_name}, scenario_file,
                      overrides=overrides)
 
@@ -35,8 +27,7 @@ def _scenario_file(study, summary):
 
 def study_command(study, summary):
     """The `pbp-drake study` command that made a method comparison (without --output and
-    --jobs, which do not change its results). The seeds are named by `--split` when
-    study.json records that the split starts at the first seed, else by `--seed`."""
+    --jobs): its seeds by `--split` when the split starts at its first seed, else `--seed`."""
     seed, trials = summary["seed"], summary["trials"]
     words = ["pbp-drake study", _scenario_file(study, summary),
              "--methods", ",".join(summary["methods"]), "--trials", str(trials)]
@@ -76,8 +67,7 @@ def _seeds_text(summary):
 
 
 def method_comparison_markdown(study, summary):
-    """The command and seeds line, then the results table (`results_table`, as in
-    results.md)."""
+    """The command and seeds line, then results.md's table."""
     return (f"`{study_command(study, summary)}` — {_seeds_text(summary)}\n\n"
             + results_table(summary))
 
@@ -94,7 +84,7 @@ def _outcome_cell(outcome):
 
 def alpha_study_markdown(study, summary, figure):
     """One row per scene and operator speed: the ideal alpha, then the collision ratio and
-    whether the goal was reached, for each fixed alpha and PBP-Alt and PBP-Cont."""
+    whether the goal was reached, for each fixed alpha and PBP mode."""
     alphas = [f"{alpha:.2f}" for alpha in summary["alphas"]]
     speeds = ", ".join("-" if s is None else f"{s:g}" for s in summary["operator_speeds"])
     lines = [f"`{_toy_command(study, summary)}` — the 2-D alpha study (Fig. 2): "
@@ -137,8 +127,7 @@ def alt_vs_cont_markdown(study, summary, figure):
 
 
 def toy_markdown(output):
-    """The Markdown of a 2-D study folder (its summary.json and study.json). Raises
-    StudyError when its summary.json cannot be read."""
+    """The Markdown of a 2-D study folder; StudyError when its summary.json is unreadable."""
     output = pathlib.Path(output)
     try:
         summary = json.loads((output / "summary.json").read_text())
@@ -152,10 +141,9 @@ def toy_markdown(output):
 
 
 def read_study_json(output):
-    """A study folder's study.json as a dict ({} when missing or unreadable: the command
-    then names no scenario file)."""
+    """A study folder's study.json as a dict ({} when missing or unreadable)."""
     try:
-        study = json.loads((pathlib.Path(output) / STUDY_FILE).read_text())
+        study = json.loads((pathlib.Path(output) / "study.json").read_text())
     except (OSError, ValueError):
         return {}
     return study if isinstance(study, dict) else {}
@@ -170,11 +158,11 @@ def check_markdown_path(path):
 
 
 def write_markdown(path, text):
-    """Writes the fragment to `path`, creating its folder."""
+    """Writes the fragment to `path`; StudyError when it cannot (a disk's failure as is)."""
     path = pathlib.Path(path)
     try:
         write_atomically(path, text)
     except OSError as error:
         if is_disk_failure(error):
-            raise  # the disk's failure, not the path's: said as any write's (WriteFailed)
+            raise
         raise StudyError(f"--markdown {path}: cannot be written ({error.strerror})") from None

@@ -1,10 +1,7 @@
 """Running trials: one trial (on disk, or computed only), and many in local processes
-(`--jobs`).
-
-Trial i of every method uses seed `seed + i`: the same scene and participant noise. A trial
-that raises is recorded as failed with its error; one whose worker process dies runs again
-alone, so that only a trial that kills its own process is recorded as failed. A disk that
-fails is never a trial's result (`atomic_files`): it stops the study, as Ctrl-C does.
+(`--jobs`). A trial that raises is recorded as failed with its error; one whose worker
+process dies runs again alone, so that only a trial that kills its own process is recorded
+as failed. A disk that fails is never a trial's result: it stops the study, as Ctrl-C does.
 """
 
 import concurrent.futures
@@ -28,8 +25,7 @@ from pbp_drake.builder.run import run_task
 
 
 def run_trial(scenario, method, trial, seed, output, digest, run=None):
-    """Runs one trial and writes its files; a trial that raises is written as failed with
-    its error. Returns its record. This is what a worker process runs."""
+    """Runs one trial (what a worker process runs), writes its files and returns its record."""
     marker = running_marker(output, method, seed)
     write_atomically(marker, f"{os.getpid()}\n")
     try:
@@ -42,8 +38,7 @@ def run_trial(scenario, method, trial, seed, output, digest, run=None):
 
 def compute_trial(scenario, method, trial, seed, digest, run=None):
     """Runs one trial without touching the disk: its record and TaskResult (None when it
-    raised: the record then holds the error; a failing disk raises WriteFailed).
-    `run(resolved_scenario)` defaults to `run_task`."""
+    raised: the record holds the error). `run(resolved_scenario)` defaults to `run_task`."""
     if run is None:
         run = run_task
     started = time.monotonic()
@@ -102,8 +97,7 @@ class _DrakeWarnings(logging.Handler):
 
 
 def failed_record(scenario, digest, method, trial, seed, error, output):
-    """Writes and returns the record of a trial that failed outside its own code (e.g. its
-    worker died)."""
+    """Writes and returns the record of a trial that failed outside its own code."""
     record = trial_record(scenario.name, digest, method, trial, seed)
     record["error"] = error
     write_trial(output, record)
@@ -121,18 +115,17 @@ def trial_marker(arguments):
 
 
 def run_locally(pending, jobs, submit_args, on_done, on_error):
-    """Runs the `pending` trial keys here (`jobs == 1`) or in one pool of `jobs` processes,
-    whatever folder each trial goes to; `submit_args(key)` gives `run_trial`'s
-    arguments."""
+    """Runs the `pending` trial keys here (`jobs == 1`) or in one pool of `jobs` processes;
+    `submit_args(key)` gives `run_trial`'s arguments, `on_done(key, record)` and
+    `on_error(key, text)` take each outcome."""
     if jobs == 1:
         for key in pending:
             on_done(key, run_trial(*submit_args(key)))
         return
     queue = list(pending)
     while queue:
-        # A dead worker breaks the pool. The trials that had started run again, each
-        # alone, so that only one that kills its own process is recorded as failed; those
-        # that had not started go to a new pool.
+        # A dead worker breaks the pool: the trials that had started run again, each alone;
+        # those that had not go to a new pool.
         unfinished = _run_in_pool(queue, min(jobs, len(queue)), submit_args, on_done,
                                   on_error)
         started_keys = [key for key, _ in unfinished
@@ -164,8 +157,7 @@ def _context():
 
 
 def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
-    """Runs `pending` trial keys in a pool of `jobs` processes. Returns the keys that were
-    unfinished when a worker process died (the pool is then broken), with the error."""
+    """Runs `pending` in a pool; returns `(key, error)` of those unfinished when a worker died."""
     with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=_context(),
                                                 initializer=_start_worker,
                                                 initargs=(os.getpid(),)) as pool:
@@ -196,19 +188,16 @@ def _run_in_pool(pending, jobs, submit_args, on_done, on_error):
 
 
 def _start_worker(study_pid):
-    """Workers leave Ctrl-C to the study's process, which stops them; and they end when
-    that process ends, however it ends (even SIGKILL), so that none goes on writing trials.
-    Under forkserver a worker's parent is the fork server, which lives as long as a worker
-    holds its pipe: so each worker watches the study's process itself. When the workers
-    are gone, the fork server and the resource tracker see their pipes close and exit."""
+    """Workers leave Ctrl-C to the study's process, and end when it ends, even by SIGKILL.
+    Their parent is the fork server, which lives as long as a worker holds its pipe, so
+    each worker watches the study's process itself."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_exit_with, args=(study_pid,), name="exit-with-study",
                      daemon=True).start()
 
 
 def _exit_with(pid):
-    """Kills this process when process `pid` has ended: at once through a pidfd (Linux
-    5.3+), else by polling."""
+    """Kills this process when process `pid` has ended (through a pidfd, else by polling)."""
     try:
         handle = os.pidfd_open(pid)
     except ProcessLookupError:

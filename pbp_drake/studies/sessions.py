@@ -1,18 +1,8 @@
 """A person's session of a user study: every method once, in a counterbalanced order, saved
-in the study runner's format (one folder per participant; `pbp-drake report` reads a folder
-of them), with the paper's questionnaire after each method and optional practice runs.
-
-The participant folder:
-
-    ID/study.json, ID/trials/<method>/seed_<seed>.*   the recorded runs (as a study's trials)
-    ID/questionnaire.json                            the answers by method, 0-5, beside the
-                                                     questions as asked (studies.questionnaire)
-    ID/practice/...                                  practice runs, a study folder of their
-                                                     own, never counted in the report
-
-A session that stops half way resumes with the same command: the methods already saved are
-not run again, the questions already answered not asked again, and no saved file is
-rewritten (only the summary and tables each run rebuilds from them).
+as a study's trials in the participant's folder, with the paper's questionnaire after each
+method (`questionnaire.json`) and optional practice runs (`practice/`, never counted). A
+session that stops resumes with the same command, rewriting no saved run or answer
+(docs/user-study.md, "Files and resuming").
 """
 
 import hashlib
@@ -34,7 +24,7 @@ PRACTICE_FOLDER = "practice"
 def participant_number(participant):
     """The number that places a participant in the counterbalancing: the ID's last digits
     (P07 -> 7), else a stable hash of the ID. Raises ValueError for an ID that cannot name
-    a folder of its own (a path separator, only dots, other characters)."""
+    a folder."""
     if participant and ("/" in participant or "\\" in participant):
         raise ValueError(f"participant ID {participant!r} holds a path separator; the ID "
                          "names the participant's folder, so it must be a plain name such "
@@ -57,15 +47,12 @@ def session_order(methods, participant):
     return methods[shift:] + methods[:shift]
 
 
-def run_session(scenario, participant, methods, output, run, page, practice=False,
-                progress=None):
-    """Runs `run(scenario)` (one task, e.g. driven from the browser) for each method in the
-    participant's order, all on the scenario's seed, and saves each as a trial under
-    `output`. `page` (console.questionnaire: the Meshcat page or FixedAnswers) shows each
-    method's Start before it runs, and asks the questionnaire once its trial is saved,
-    saving each answer at once. `practice`: first one run of each method, in the same order,
-    on other scenes, saved under `output/practice` (skipped once recorded runs exist).
-    `progress` as run_method_comparison's. Returns the summary of the session."""
+def run_session(scenario, participant, methods, output, run, page, practice=False):
+    """Runs `run(scenario)` for each method in the participant's order, on the scenario's
+    seed, saving each as a trial under `output`. `page` (console.questionnaire's Meshcat
+    page or FixedAnswers) shows each method's Start and asks the questionnaire once its
+    trial is saved. `practice`: first one run of each method on other scenes, under
+    `output/practice` (skipped once recorded runs exist). Returns the session's summary."""
     order = session_order(methods, participant)
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
@@ -104,8 +91,6 @@ def run_session(scenario, participant, methods, output, run, page, practice=Fals
 
     def after_run(done, total, record, elapsed):
         ask_unanswered()
-        if progress is not None:
-            progress(done, total, record, elapsed)
         start_next(output, scenario.seed, False)
 
     if practice and len(unsaved(output, scenario.seed)) == len(order):

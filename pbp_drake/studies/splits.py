@@ -1,12 +1,8 @@
-"""Tuning and evaluation seeds: which part of the seeded scenes a method study shows.
-
-A scenario's `study: !MethodComparison` names two splits. Seeds from `tuning_seed` up to
-`evaluation_seed` are the tuning split: the only scenes on which the virtual participant's
-parameters may be calibrated (on teleop). Seeds from `evaluation_seed` on are the
-evaluation split: scenes no tuning has seen, on which every method is judged and results
-are published. `pbp-drake study` runs the split the file names (`--split` chooses another,
-`--seed` any first seed); the seeds it ran are labelled by the split they fall in, and that
-label goes into study.json, summary.json and results.md.
+"""Tuning and evaluation seeds of a `study: !MethodComparison`: seeds from `tuning_seed` up
+to `evaluation_seed` are the only scenes the virtual participant may be calibrated on;
+from `evaluation_seed` on, scenes no tuning has seen. The seeds a study ran are labelled
+by the split they fall in, in study.json, summary.json and results.md
+(docs/tasks/studies.md, "Seeds: evaluation and tuning").
 """
 
 from pbp_drake.scenarios.schema import STUDY_SPLITS as SPLITS
@@ -41,8 +37,7 @@ def split_of(study, seed, trials):
 
 
 def seeds_line(summary):
-    """One line for results: the seeds a summary covers and their split (none for a study
-    folder written before splits were recorded)."""
+    """One line for results: the seeds a summary covers and their split ("" without seeds)."""
     seeds = summary.get("seeds")
     if not seeds:
         return ""

@@ -1,7 +1,6 @@
 """A study's summary, from its trial files only, and the one definition of the ideal alpha.
-
-The summary holds only values from the trial files, in a fixed order, rounded: it is the
-same bytes for any `--jobs` and either backend.
+It holds only values from the trial files, in a fixed order, rounded: the same bytes for
+any `--jobs` and either backend.
 """
 
 import dataclasses
@@ -27,8 +26,7 @@ SIGNIFICANT_DIGITS = 12
 def ideal_alpha(outcomes, does_task):
     """The paper's ideal arbitration (section IV-A): the highest alpha of `outcomes`
     (`(alpha, outcome)` pairs) whose outcome `does_task` (a lower one takes autonomy from
-    the robot for nothing), or None when none does. The HSR method comparison judges with
-    `does_the_hsr_task`, the 2-D alpha study with `collision_free`."""
+    the robot for nothing), or None when none does."""
     good = [alpha for alpha, outcome in outcomes if does_task(outcome)]
     return max(good) if good else None
 
@@ -52,13 +50,12 @@ def does_the_hsr_task(entry):
 
 
 def collision_free(collision_ratio):
-    """The 2-D alpha study's task: reach the goal past the obstacles without touching one."""
+    """The 2-D alpha study's task: pass the obstacles without touching one."""
     return collision_ratio == 0.0
 
 
 def arbitration(methods):
-    """`{"alphas": [...], "ideal_alpha": A or None, "criterion": text}` over the `fixed_alpha=A`
-    entries of a summary's methods (None when it has none)."""
+    """`{"alphas", "ideal_alpha", "criterion"}` over the `fixed_alpha=A` methods, or None."""
     swept = []
     for label, entry in methods.items():
         _, alpha = parse_method_label(label)
@@ -100,9 +97,8 @@ def max_mean(values):
 
 
 def mean_with_interval(values, within):
-    """`{"mean", "std", "count", "interval"}` of the finite values: their mean and population
-    std (`mean_std`), how many, and the 95 % t interval of the mean cut to `within`
-    (`pbp_drake.studies.intervals.mean_interval`; None for fewer than two), rounded."""
+    """`mean_std` of the finite values, their "count" and the "interval" of the mean
+    (`intervals.mean_interval` within `within`; None for fewer than two), rounded."""
     values = [v for v in values if v is not None and math.isfinite(v)]
     entry = {**mean_std(values), "count": len(values)}
     interval = mean_interval(entry["mean"], entry["std"], len(values), within)
@@ -116,10 +112,9 @@ TRIAL_VALUE = {"time_to_prediction": "mean_time_to_prediction"}
 
 
 def interaction_entries(ran):
-    """The interaction metrics' entries of a method's summary, from the records of its
-    trials that ran (`INTERACTION_MEANS`, each `mean_with_interval`): `time_to_prediction`
-    is over each trial's mean over its switches, with the study's count of `switches` and
-    of those never named (`unpredicted_switches`). A metric no record holds has no entry."""
+    """The entries of the interaction metrics (`INTERACTION_MEANS`) that the records of a
+    method's trials that ran hold, each `mean_with_interval`; `time_to_prediction` adds the
+    count of `switches` and of those never named (`unpredicted_switches`)."""
     entries = {}
     for name, _, _, within in INTERACTION_MEANS:
         field = TRIAL_VALUE.get(name, name)
@@ -143,25 +138,14 @@ def collision_histogram(ratios):
     return counts
 
 
-def _relative(path, output):
-    try:
-        return str(pathlib.Path(path).relative_to(output)) if output is not None else path
-    except ValueError:
-        return path
-
-
-def measures_collisions(study, records, output=None):
-    """Whether the study's task measures collisions: the obstacle task does, reaching does
-    not (its trials record a collision ratio of 0 that means "not measured", not "none").
-
-    Read off the scenario study.json holds; a study without it is judged by its trials' CSV
-    files, whose `in_collision` column only a task that measures collisions writes."""
+def measures_collisions(study, records, output):
+    """Whether the study's task measures collisions (the obstacle task; reaching records a
+    collision ratio of 0 that means "not measured"): by the scenario study.json holds, else
+    by an `in_collision` column in its trials' CSV files."""
     content = study.get("scenario_content")
     if isinstance(content, dict):
         task = content.get("task")
         return isinstance(task, dict) and task.get("!type") == DynamicObstacles.__name__
-    if output is None:
-        return False
     for (method, _), record in records.items():
         if record is None or not record.get("time_series"):
             continue
@@ -179,9 +163,8 @@ _GOES_WITH = {"command_noise_time": "command_noise", "mistake_time": "mistake_pr
 
 def virtual_participant(study):
     """How the study's virtual participant was impaired, from its study.json: `{"condition":
-    the name given to `--participant-condition` (None: none), "impairment": {field: value}
-    of the impairment's fields that act (those off their defaults, and the times that go
-    with them)}`; None when it was not impaired (or there is no virtual participant)."""
+    the `--participant-condition` or None, "impairment": the fields off their defaults and
+    the times that go with them}`; None when it was not impaired."""
     content = study.get("scenario_content")
     operator = content.get("operator") if isinstance(content, dict) else None
     given = operator.get("impairment") if isinstance(operator, dict) else None
@@ -198,16 +181,12 @@ def virtual_participant(study):
     return {"condition": condition, "impairment": acting}
 
 
-def summarize(study, records, damaged=(), output=None):
-    """Per method: how many trials, errors, missing and damaged; the success rate over the
-    trials on disk; over the trials that ran without error, the mean and (population) std of
-    intervention ratio and task time, the max and mean of the peaks
-    (`pbp_drake.builder.run.SeriesPeaks`), the `posterior_clipped_ratio` and the interaction
-    metrics (`interaction_entries`) where the trials record them and, where the task
-    measures collisions (`measures_collisions`), the collision ratio's mean, std and
-    histogram and the count of collision-free trials; and the ideal alpha (`arbitration`).
-    `damaged` (`trial_files.read_study`'s) becomes the "damaged" list (paths relative to
-    `output`)."""
+def summarize(study, records, damaged, output):
+    """The summary.json of `read_study`'s result. Per method: the counts of trials, errors,
+    missing and damaged; the success rate over the trials on disk; over those that ran
+    without error, `mean_std` of intervention ratio and task time, `max_mean` of the peaks
+    and, where recorded or measured, the posterior's clip, `interaction_entries` and the
+    collision ratio; then the damaged files and the ideal alpha (`arbitration`)."""
     summary = {"study": "method_comparison", "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),
@@ -249,8 +228,8 @@ def summarize(study, records, damaged=(), output=None):
                                         "histogram": collision_histogram(ratios)}
             entry["collision_free_trials"] = (sum(ratio == 0.0 for ratio in ratios)
                                               if ratios else None)
-    summary["damaged"] = [{"file": _relative(d.path, output), "problem": d.problem}
-                          for d in damaged]
+    summary["damaged"] = [{"file": str(pathlib.Path(d.path).relative_to(output)),
+                           "problem": d.problem} for d in damaged]
     swept = arbitration(summary["methods"])
     if swept is not None:
         summary["arbitration"] = swept

@@ -1,7 +1,5 @@
 """The paper's 2-D experiments as studies: the alpha study (Fig. 2) and Alt vs Cont (Fig. 4).
-
-Each study simulates its scenario's variants through the one builder, writes
-`summary.json` and the paper's figure into an output folder, and returns the summary.
+Each writes `summary.json` and the paper's figure into an output folder.
 """
 
 import dataclasses
@@ -28,9 +26,8 @@ TOY_FIGURES = {"alpha_study": "fig2_alpha_study.png", "alt_vs_cont": "fig4_alt_v
 
 def run_study(scenario_file, output_dir):
     """Runs the study a scenario file describes; returns its summary. Raises
-    StudyFolderError when `output_dir` holds a study of another kind (a method comparison,
-    or the other 2-D study), whose summary.json it would overwrite; FolderLocked when
-    another study is writing it (`folders.study_lock`)."""
+    StudyFolderError when `output_dir` holds a study of another kind, FolderLocked when
+    another study is writing it."""
     output_dir = pathlib.Path(output_dir)
     if isinstance(scenario_file.study, AlphaStudy):
         kind, run = "alpha_study", run_alpha_study
@@ -50,11 +47,6 @@ def scene_scenario(scenario, scene):
     """The scenario with a scene's obstacles."""
     return dataclasses.replace(scenario, name=f"{scenario.name}/{scene.name}",
                                obstacles=list(scene.obstacles))
-
-
-def _ratio(trajectory, obstacles):
-    return collision_ratio(trajectory.positions, [o.center for o in obstacles],
-                           [o.radius for o in obstacles])
 
 
 #: The paper's two PBP modes, which the alpha study runs beside every fixed alpha.
@@ -81,10 +73,11 @@ def with_operator_speed(scenario, speed):
 
 
 def run_outcome(run, obstacles, goal, goal_tolerance):
-    """What a user reads off one run: how much of it sat in an obstacle, how far from the
-    goal it ended, and whether that is within the tolerance."""
+    """One run's collision ratio, final distance to the goal and whether it was reached."""
     final_distance = float(np.linalg.norm(run.positions[-1] - goal))
-    return {"collision_ratio": _ratio(run, obstacles), "final_distance": final_distance,
+    ratio = collision_ratio(run.positions, [o.center for o in obstacles],
+                            [o.radius for o in obstacles])
+    return {"collision_ratio": ratio, "final_distance": final_distance,
             "reached": final_distance <= goal_tolerance}
 
 
@@ -145,8 +138,7 @@ def _scene_at_speed(base, study, scene, goal, speed, trajectories):
 
 
 def print_alpha_study(summary):
-    """One line per scene and operator speed: the ideal alpha, then each PBP mode's
-    collision ratio and final distance to the goal (the fixed alphas' are in the summary)."""
+    """Prints the ideal alpha and PBP's outcomes per scene and operator speed."""
     tolerance = summary["goal_tolerance"]
     print(f"  (collision ratio / final distance to the goal; reached: within {tolerance:g})")
     for scene in summary["scenes"]:
@@ -178,10 +170,8 @@ def run_alt_vs_cont(resolved, study, output_dir):
     scenario = resolved.scenario
     goal = resolved.goals[0]
     modes = {}
-    runs = {}
     for method in ("pbp_continuous", "pbp_alternated"):
         run = simulate(resolved.with_method(method))
-        runs[method] = run
         progress = phase_progress(run.phase[:, 0], scenario.dmp.alpha_x)
         # progress[k] is the phase with which tick k steps; tick k changed it iff
         # progress[k + 1] != progress[k].

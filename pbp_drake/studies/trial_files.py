@@ -1,9 +1,6 @@
 """The files of a study folder: the trial record format, its paths, the per-tick CSV time
-series, reading trials and studies back, and the scenario hash.
-
-Each trial file is written atomically (`studies.atomic_files`: a temporary file, then a
-rename), so an interrupted study, or one whose disk filled, leaves only whole trials, and
-running the same study again runs only the missing ones.
+series, reading trials and studies back, and the scenario hash. Each file is written
+atomically (`studies.atomic_files`), so a study that stops leaves only whole trials.
 """
 
 import collections
@@ -28,9 +25,8 @@ from pbp_drake.builder.time_series import (
 # A trial file of another format counts as not on disk (it runs again); a metric a file
 # lacks reads as None (reported n/a), so a new metric does not change the format.
 TRIAL_FORMAT = 1
-# The metrics of a trial, in the order of the trial files and of trials.json: the peaks
-# (`pbp_drake.builder.run.SeriesPeaks`), `posterior_clipped_ratio` (only the methods with
-# HOP's posterior record it) and the interaction metrics (`pbp_drake.core.interaction_metrics`).
+# The metrics of a trial, in the order of the trial files and of trials.json (the interaction
+# metrics: `pbp_drake.core.interaction_metrics`).
 INTERACTION_METRICS = ("input_integral", "turn_input_integral", "idle_ratio", "agreement",
                        "prediction_accuracy", "time_to_prediction", "mean_time_to_prediction",
                        "unpredicted_switches")
@@ -54,8 +50,8 @@ class StudyFolderError(StudyError):
 
 def plain(value):
     """A dataclass tree as JSON-able data that keeps each dataclass's type name (two operator
-    configs with the same fields are different scenarios). Drake's config structs
-    (`SimulatorConfig`, `MultibodyPlantConfig`) become their YAML fields."""
+    configs with the same fields are different scenarios); Drake's config structs become
+    their YAML fields."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return {"!type": type(value).__name__,
                 **{f.name: plain(getattr(value, f.name)) for f in dataclasses.fields(value)}}
@@ -96,21 +92,15 @@ _HASHED_AS = {"control_period": "command_period"}
 
 
 def _may_reposition(content):
-    """Whether the scenario's virtual participant may meet a target the tool cannot point
-    at (an arm's wrist turns only so far; objects at heights of their own): `reposition_time`
-    acts on its trials, so it stays in the hash."""
+    """Whether the virtual participant may meet a target the tool cannot point at (an arm;
+    objects at heights of their own): `reposition_time` then acts, and stays in the hash."""
     robot, task = content.get("robot"), content.get("task")
     return ((isinstance(robot, dict) and robot.get("!type") == "Arm")
             or (isinstance(task, dict) and bool(task.get("z_range"))))
 
 
-# Later fields that stay in the content, even at their default, where they act.
-_KEPT_WHERE = {("operator", "reposition_time"): _may_reposition}
-
-
 def scenario_content(scenario):
-    """Everything in the scenario but its method and seed (a study sets those per trial),
-    as plain data."""
+    """Everything in the scenario but its method and seed (set per trial), as plain data."""
     typed = plain(dataclasses.replace(scenario, method="", seed=0))
     content = {"!type": "Scenario"}
     content.update((key, value) for key, value in typed.items()
@@ -121,8 +111,7 @@ def scenario_content(scenario):
     for section, fields in _LATER_FIELDS.items():
         values = content if section is None else content.get(section)
         for name, default in fields.items():
-            kept = _KEPT_WHERE.get((section, name))
-            if kept is not None and kept(content):
+            if (section, name) == ("operator", "reposition_time") and _may_reposition(content):
                 continue
             if isinstance(values, dict) and values.get(name, default) == default:
                 values.pop(name, None)
@@ -141,8 +130,7 @@ def scenario_content(scenario):
 
 
 def _file_digest(path):
-    """The sha256 of a file's bytes (the path itself when it cannot be read: the scenario's
-    resolution then refuses it anyway)."""
+    """The sha256 of a file's bytes (the path itself when unreadable: resolving refuses it)."""
     try:
         return "sha256:" + hashlib.sha256(pathlib.Path(path).read_bytes()).hexdigest()
     except OSError:
@@ -150,10 +138,8 @@ def _file_digest(path):
 
 
 def scenario_hash(scenario):
-    """A short hash of `scenario_content`: trials of different scenarios are never mixed in
-    one folder."""
-    content = scenario_content(scenario)
-    text = json.dumps(content, sort_keys=True, separators=(",", ":"))
+    """A short hash of `scenario_content`, so that one folder never mixes two scenarios."""
+    text = json.dumps(scenario_content(scenario), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -168,8 +154,7 @@ def trial_paths(output, method, seed):
 
 
 def running_marker(output, method, seed):
-    """Present while a process runs the trial: after a worker dies, it tells the trials
-    that had started from those that had not."""
+    """Present while a process runs the trial: after a worker dies, it tells which had begun."""
     return trial_paths(output, method, seed)[0].with_suffix(".running")
 
 
@@ -194,8 +179,7 @@ def trial_record(scenario_name, digest, method, trial, seed):
 
 
 def interaction_fields(result):
-    """The interaction metrics of a TaskResult as a trial record's fields: JSON numbers
-    (None for NaN), a list for `time_to_prediction`, an int for `unpredicted_switches`."""
+    """The interaction metrics of a TaskResult as a trial record's JSON fields."""
     fields = {}
     for name in INTERACTION_METRICS:
         value = getattr(result, name)
@@ -227,12 +211,10 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
                 scenario_file=None, split_seeds=None, participant_condition=None,
                 overrides=None):
     """Writes the folder's study.json: which scenario, methods, trials and seeds, and the
-    split the seeds belong to (`studies.splits`; None when not known). The optional fields
-    are written when given (not None): `scenario_file` (the path the study was run from)
-    and `split_seeds` ({"tuning": first seed, "evaluation": first seed}), with which `report
-    --markdown` names the command that made the study; `participant_condition` (`pbp-drake
-    study --participant-condition`) and `overrides` (the command line's changes to the
-    file's fields, `ScenarioOverrides.record()`), which the results name too."""
+    split the seeds belong to (`studies.splits`; None when not known). Written when not
+    None: `scenario_file` (the path the study was run from), `split_seeds` ({"tuning":
+    first seed, "evaluation": first seed}), `participant_condition` and `overrides`
+    (`ScenarioOverrides.record()`), with which `report --markdown` names the command."""
     study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
              "split": split, "scenario_content": scenario_content(scenario)}
@@ -242,8 +224,7 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
 
 def write_study_json(output, study, scenario_file=None, split_seeds=None,
                      participant_condition=None, overrides=None):
-    """Writes the dict `study` as `output`'s study.json, and after its fields each optional
-    one given (see `write_study`)."""
+    """Writes the dict `study` and the optional fields given (`write_study`) as study.json."""
     if scenario_file is not None:
         study["scenario_file"] = str(scenario_file)
     if split_seeds is not None:
@@ -297,8 +278,8 @@ def record_problem(record):
 
 
 def read_time_series(path, ticks=None):
-    """A trial's CSV as a dict of arrays keyed by column name. Raises DamagedFile, naming the
-    file, when it is empty or malformed (or has not `ticks` rows, when given)."""
+    """A trial's CSV as a dict of arrays keyed by column name. Raises DamagedFile when it is
+    empty or malformed (or has not `ticks` rows, when given)."""
     with open(path, newline="") as stream:
         reader = csv.reader(stream)
         columns = next(reader, None)
@@ -374,12 +355,11 @@ def load_task_result(output, method, seed):
         **{name: record.get(name) for name in INTERACTION_METRICS}, **grasp)
 
 
-def read_trial(output, method, seed, digest=None, damaged=None, key=None):
-    """A trial's JSON record if it is on disk and whole, else None. A trial file that is on
-    disk but damaged (truncated or invalid JSON, wrong field types, an empty, malformed or
-    missing CSV), or of another format, is appended to `damaged` as a Damage (when given),
-    and reads as None: a study runs it again. Raises StudyFolderError when the trial belongs
-    to another scenario than `digest` (unless `damaged` is given: then it is named there)."""
+def read_trial(output, method, seed, digest, damaged=None, key=None):
+    """A trial's JSON record if it is on disk and whole, else None. A damaged trial (bad
+    JSON or field types, an empty, malformed or missing CSV) or one of another format is
+    appended to `damaged` as a Damage (when given) and reads as None: it runs again. One of
+    another scenario than `digest` raises StudyFolderError, unless `damaged` is given."""
     json_path, csv_path = trial_paths(output, method, seed)
 
     def bad(path, problem):
@@ -443,8 +423,8 @@ def study_problem(study):
 
 def infer_study(output):
     """The study a folder's trial files describe, without study.json: every method folder
-    under trials/ (sorted by name), the seeds from the lowest to the highest on disk, and
-    the scenario most of the readable trials name. None when there are no trial files."""
+    under trials/ (by name), the seeds from the lowest to the highest on disk, and the
+    scenario most readable trials name. None when there are no trial files."""
     seeds, methods, hashes = set(), [], collections.Counter()
     for folder in sorted(p for p in (output / "trials").glob("*") if p.is_dir()):
         found = [p for p in folder.glob("seed_*.*") if p.suffix in (".json", ".csv")]
@@ -468,11 +448,10 @@ def infer_study(output):
 
 
 def read_study(output):
-    """The study.json of a study folder, its trials' records, in method then seed order
-    (None for a trial not on disk or damaged), and the list of Damage: every damaged or
-    foreign file. When study.json is damaged or of another kind, the study is the one its
-    trial files describe (see infer_study). Raises StudyFolderError when there is neither
-    a study.json nor any trial file."""
+    """`(study, records, damaged)` of a study folder: its study.json (else `infer_study`),
+    `{(method, trial): record}` (None for a trial not on disk or damaged) and a Damage for
+    every damaged or foreign file. Raises StudyFolderError when there is neither a
+    study.json nor any trial file."""
     output = pathlib.Path(output)
     study_path = output / "study.json"
     damaged = []
@@ -501,8 +480,7 @@ def read_study(output):
     return study, records, damaged
 
 
-def name_damaged(damaged, stream=None):
-    """Names each damaged or foreign file on `stream` (stderr): its path and what is wrong."""
+def name_damaged(damaged):
+    """Names each damaged or foreign file on stderr: its path and what is wrong."""
     for item in damaged:
-        print(f"pbp-drake: damaged: {item.path}: {item.problem}",
-              file=stream or sys.stderr, flush=True)
+        print(f"pbp-drake: damaged: {item.path}: {item.problem}", file=sys.stderr, flush=True)

@@ -1,12 +1,9 @@
 """K DMPs, one per goal, as one immutable model stepped by pure and in-place functions.
 
-The model (weights, starts, amplitude scaling, settings, duration, basis and what is derived
-from them) is fixed at construction: its arrays are read-only and assigning an attribute
-after `__init__` raises. The state of the DMPs (phases, positions, scaled velocities) is
-passed in and out of every call, and the scratch arrays of the in-place step live in a
-`DmpWorkspace` the caller owns (`make_workspace`). So one bank may serve any number of
-threads, Drake Contexts or Simulators at once, each with its own state and workspace.
-"""
+The model is fixed at construction (read-only arrays; assigning an attribute raises); the
+state of the DMPs is passed in and out of every call, and the in-place step's scratch lives
+in a `DmpWorkspace` the caller owns (`make_workspace`). So one bank may serve any number of
+threads, Drake Contexts or Simulators at once."""
 
 import dataclasses
 
@@ -29,8 +26,6 @@ class BankModel:
     `(rows, K)`)."""
 
     def __setattr__(self, name, value):
-        # Immutable after construction: a bank shared by threads or Drake Contexts must not
-        # change under any of them (the arrays are read-only for the same reason).
         if getattr(self, "_frozen", False):
             raise AttributeError(f"{type(self).__name__} is immutable: cannot set {name!r}")
         object.__setattr__(self, name, value)
@@ -128,24 +123,12 @@ class DmpBankModel(BankStep, BankModel):
     each has its own weights (or all share one set, e.g. straight paths or one
     demonstration), its own start and its own phase.
 
-    The bank is immutable and keeps no state: `initial_state` gives the state at the start
-    of a movement and the pure `advance` steps it, returning new arrays. `advance_into` is
-    the same step written into arrays the caller owns, with no allocation, using a workspace
-    from `make_workspace`; `attractor_terms_into`, `stepped_positions_into` and
-    `stepped_velocity_into` are its parts (`pbp_drake.core.dmp.stepping`; Drake's `DmpBank`
-    system keeps the attractor terms in its Context and reads the stepped state out on
-    demand).
-
-    Speed. When all phases are equal (DMPs started together and locked together: the normal
-    case), the basis is evaluated at the step's two phases, `(2, N)`, and contracted with the
-    weights once: shared weights give `(2, D)` shapes broadcast to all goals
-    (O(N D + D K)); distinct weights are one `(2, N) x (N, D*K)` product over contiguous
-    memory (memory bound: the weights are read once). The per-goal-phase path (phases made
-    unequal by per-goal locks) evaluates `(N, K)` bases. With shared weights, equal phases
-    and one start, the step's terms are affine in the goal with per-dimension coefficients,
-    so no per-goal shape is ever formed. The step then makes a fixed number of passes over
-    the workspace's `(D, K)` arrays, using constants memoised per step size
-    (`pbp_drake.core.dmp.stepping.step_constants`).
+    `initial_state` gives the state at the start of a movement and the pure `advance` steps
+    it, returning new arrays. `advance_into` is the same step written into arrays the caller
+    owns, with no allocation, using a workspace from `make_workspace`;
+    `attractor_terms_into`, `stepped_positions_into` and `stepped_velocity_into` are its
+    parts (`pbp_drake.core.dmp.stepping`). How the step is made fast:
+    docs/concepts/dmp.md, "The bank: K DMPs at once".
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),

@@ -1,17 +1,8 @@
 """How an operator and a shared-control method worked together over one task, from the
 task's per-tick series (`InteractionMetrics` defines each metric): how much the operator
 gave, how well the hand did what it asked, how early and how often the method named the
-target. With the task monitor's `intervention_ratio`, `idle_ratio` is its complement on the
-same ticks.
-
-`InteractionMeter` takes the series whole or chunk by chunk (a streamed run);
-`interaction_metrics` is the same on whole arrays. The series are those of a task's time
-series, one row per control tick k, the command of tick k held until tick k + 1: `times`
-(T,) s; the operator's commanded translational velocity (T, 3) m/s, world frame, and its
-turning, (T,) rad/s (a yaw rate) or (T, 3) (an angular velocity); whether it acted (T,)
-bools; the hand's position (T, 3) m; the goal the method names (T,) object indices, -1 on
-a tick where it names none; the current target (T,) object indices.
-"""
+target. `InteractionMeter` takes the series whole or chunk by chunk (a streamed run);
+`interaction_metrics` is the same on whole arrays."""
 
 import dataclasses
 import math
@@ -188,10 +179,11 @@ class InteractionMeter:
 def interaction_metrics(times, control_period, operator_velocity, operator_turn,
                         operator_active, hand_positions, predicted_goals, targets,
                         still_speed=STILL_SPEED):
-    """The `InteractionMetrics` of one task's whole series: `times` (T,) s, the operator's
-    translational command (T, 3) m/s and turning (T,) or (T, 3) rad/s, whether it acted
-    (T,), the hand's positions (T, 3) m, the named goal (T,) (-1: none) and the target
-    (T,), one row per control tick of `control_period` s."""
+    """The `InteractionMetrics` of one task's whole series, one row per control tick of
+    `control_period` s, the command of tick k held until tick k + 1: `times` (T,) s, the
+    operator's translational command (T, 3) m/s (world frame) and turning (T,) (a yaw
+    rate) or (T, 3) (an angular velocity) rad/s, whether it acted (T,), the hand's
+    positions (T, 3) m, the named goal (T,) (-1: none) and the target (T,)."""
     meter = InteractionMeter(control_period, still_speed)
     meter.add(times, operator_velocity, operator_turn, operator_active, hand_positions,
               predicted_goals, targets)

@@ -39,7 +39,9 @@ SHARED_WITH_REACH = {
 @dataclasses.dataclass
 class GraspParticipantParams:
     """How the grasping task's virtual participant behaves. Every field is one it shares
-    with the reach participant (`SHARED_WITH_REACH`), whose calibrated default it takes."""
+    with the reach participant (`SHARED_WITH_REACH`), whose calibrated default it takes;
+    `insist_time`, `hold_time`, `serve_speed_fraction`, `serve_patience` and `impairment`
+    mean what `VirtualParticipantParams`' do."""
 
     #: Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = _REACH_DEFAULTS.speed
@@ -58,7 +60,6 @@ class GraspParticipantParams:
     slow_angle: float = _REACH_DEFAULTS.turn_slowdown_angle
     #: ... and stops turning within this angle (rad): well inside the task's 10 degrees.
     aligned_angle: float = _REACH_DEFAULTS.aligned_angle
-    #: The remaining fields mean what `VirtualParticipantParams`' of the same names mean.
     insist_time: float = _REACH_DEFAULTS.insist_time
     hold_time: float = _REACH_DEFAULTS.hold_time
     serve_speed_fraction: float = _REACH_DEFAULTS.serve_speed_fraction

@@ -124,20 +124,13 @@ class OrientationDmpBank(BankModel):
 
     def advance(self, phase, orientations, scaled_angular_velocity, goals_4k, dt,
                 locked=None, robot_angular_velocity=None, followed=None):
-        """One step of all K DMPs from the measured orientation; pure, new arrays.
-
-        Args:
-            phase: (K,). orientations: (4, 1) the robot's measured orientation (PBP), or
-                (4, K) one per DMP; unit within `quaternion.UNIT_TOLERANCE`.
-            scaled_angular_velocity: (3, K) the DMPs' own `eta = tau omega`.
-            goals_4k: (4, K) goal orientations (`goals_matrix`).
-            locked: None, a bool or (K,) bools freezing those phases (PBP-Alt): those DMPs
-                stay at the given orientation and `eta` follows `robot_angular_velocity` (3,).
-            followed: None, or the index of the DMP the robot followed: every DMP then steps
-                from its `eta` (PBP's goal switch, as in the position bank).
-        Returns:
-            (phase (K,), orientations (4, K), scaled angular velocity (3, K)).
-        """
+        """`DmpBankModel.advance` for orientations: one step of all K DMPs; pure, new arrays
+        `(phase (K,), orientations (4, K), scaled angular velocity (3, K))`. `orientations`
+        (4, 1) the robot's measured one (PBP) or (4, K) one per DMP, unit within
+        `quaternion.UNIT_TOLERANCE`; `scaled_angular_velocity` (3, K) the DMPs' own
+        `eta = tau omega`; `goals_4k` (4, K) (`goals_matrix`); `locked` freezes phases (those
+        DMPs stay and `eta` follows `robot_angular_velocity` (3,)); `followed` as the
+        position bank's."""
         phase = np.asarray(phase, dtype=float)
         velocity = followed_velocity(np.asarray(scaled_angular_velocity, dtype=float),
                                      followed, self.goal_count)

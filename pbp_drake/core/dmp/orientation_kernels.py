@@ -13,10 +13,9 @@ import numpy as np
 
 from pbp_drake.core.quaternion import SERIES_BELOW
 
-# The smallest denominator: every closed form is evaluated at every angle, with its
-# denominator kept at least this (so 0 / 0 never happens), and the series replace it where
-# the angle is small. Computing both and selecting with `np.copyto(..., where=)` is many
-# times faster than ufuncs with a `where=` mask that varies from goal to goal.
+# The smallest denominator: every closed form is evaluated at every angle, its denominator
+# kept at least this (no 0 / 0), and the series replace it where the angle is small (faster
+# than ufuncs with a `where=` mask that varies from goal to goal).
 SMALLEST = 1e-300
 # Hamilton's product `p q` by rows of the result: (index in p, index in q, sign).
 _PRODUCT_TERMS = (
@@ -47,13 +46,10 @@ class OrientationWorkspace:
             their rows are, for the start errors' goals (None until the fused step needs
             them; `contraction.scaled_weights`).
         goals_of_start_errors, starts_of_start_errors: the goals (a copy) and the bank's
-            starts (the array itself) that `start_errors` and `amplitude` were computed for:
-            they depend on nothing else, so a step to unchanged goals reuses them. A copied
-            workspace has copied starts, which are not the bank's, and so recomputes.
+            starts (the array itself) that `start_errors` and `amplitude` were computed for,
+            reused while they stay (a copied workspace's starts are not the bank's).
 
-    The halves of `log_state`, and `shape`, are properties, not attributes holding views: a
-    deep copy (Drake cloning a Context) copies every array apart, and views would then stop
-    being the rows the step writes.
+    The halves of `log_state`, and `shape`, are properties, not views, as in `DmpWorkspace`.
     """
 
     __slots__ = ("goal_count", "basis_count", "error_quaternions", "product", "start_errors",

@@ -152,7 +152,7 @@ def primitive_orientation_bank(primitive: Primitive, start, goal_count,
 
 
 def primitive_document(primitive: Primitive) -> dict:
-    """The primitive as plain JSON data (the module's docstring)."""
+    """The primitive as plain JSON data (docs/tasks/teach.md, "The file")."""
     orientation = primitive.orientation
     pose = {} if orientation is None else {"orientation": {
         "weights": orientation.weights.tolist(),

@@ -423,18 +423,17 @@ def assisted_command(method, settings, targets, probabilities, position, velocit
     if probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all():
         raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers, "
                          f"got {probabilities!r}")
+    operator_angular = None if targets.orientations is None else (
+        np.zeros(3) if angular_velocity is None
+        else _finite_vector(angular_velocity, "angular_velocity"))
+    operator_velocity = _finite_vector(velocity, "velocity")
     if not settings.assistance:
         # Not plus a zero action, which would turn a -0.0 into 0.0: bit for bit teleop's.
-        angular = None if targets.orientations is None else (
-            np.zeros(3) if angular_velocity is None
-            else _finite_vector(angular_velocity, "angular_velocity"))
-        return AssistedCommand(_finite_vector(velocity, "velocity"), angular, False)
+        return AssistedCommand(operator_velocity, operator_angular, False)
     check_assistance(method)
     weights = ASSISTANCE_WEIGHTS[method](settings, probabilities)
     costs = goal_costs(settings, targets, position, velocity, orientation, angular_velocity)
     linear, angular = assistance_action(settings, costs, weights)
-    velocity = _finite_vector(velocity, "velocity") + linear
     if angular is not None:
-        angular = (np.zeros(3) if angular_velocity is None
-                   else _finite_vector(angular_velocity, "angular_velocity")) + angular
-    return AssistedCommand(velocity, angular, bool(weights.sum() > 0.0))
+        angular = operator_angular + angular
+    return AssistedCommand(operator_velocity + linear, angular, bool(weights.sum() > 0.0))

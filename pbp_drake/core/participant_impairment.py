@@ -97,11 +97,6 @@ def is_noisy(impairment):
     return impairment.command_noise > 0.0
 
 
-def _standard_normals(seed, tick, size):
-    rng = np.random.default_rng([int(seed), int(tick), MOTOR_NOISE_STREAM])
-    return rng.standard_normal(size)
-
-
 def initial_motor_noise(seed, scales):
     """The motor noise before the first tick: a draw from its stationary distribution (each
     axis N(0, scale^2)), so the run is as noisy from its start as later on."""
@@ -119,8 +114,9 @@ def next_motor_noise(impairment, control_period, seed, tick, previous, scales):
     time_constant = impairment.command_noise_time
     keep = math.exp(-control_period / time_constant) if time_constant > 0 else 0.0
     fresh = math.sqrt(1.0 - keep * keep)
-    return keep * np.asarray(previous, float) + fresh * scales * _standard_normals(
-        seed, tick, len(scales))
+    rng = np.random.default_rng([int(seed), int(tick), MOTOR_NOISE_STREAM])
+    return keep * np.asarray(previous, float) + fresh * scales * rng.standard_normal(
+        len(scales))
 
 
 def first_choice(impairment, seed, number, target, object_count):

@@ -56,11 +56,16 @@ def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
 def _scene_on(rng, floor, height, switch_schedule, z_range):
     """The `ReachScene` of objects on the `floor` points (K, 2): the targets drawn, then
     with a `z_range` the heights."""
-    objects = np.column_stack([floor, np.full(len(floor), float(height))])
-    targets = _draw_targets(rng, len(floor), switch_schedule)
+    count = len(floor)
+    objects = np.column_stack([floor, np.full(count, float(height))])
+    # The first target, then at each switch another object than the last.
+    targets = [int(rng.integers(count))]
+    for _ in switch_schedule[1:]:
+        other = int(rng.integers(count - 1))
+        targets.append(other + (other >= targets[-1]))
     if z_range:
-        objects[:, 2] = rng.uniform(*z_range, size=len(floor))
-    return ReachScene(objects=objects, targets=targets)
+        objects[:, 2] = rng.uniform(*z_range, size=count)
+    return ReachScene(objects=objects, targets=tuple(targets))
 
 
 def spread_points(rng, count, x_range, y_range, min_separation, what):
@@ -78,15 +83,6 @@ def spread_points(rng, count, x_range, y_range, min_separation, what):
                              f"x {list(x_range)}, y {list(y_range)}")
         points[index] = candidate
     return points
-
-
-def _draw_targets(rng, count, switch_schedule):
-    """The first target, then at each switch another object than the last."""
-    targets = [int(rng.integers(count))]
-    for _ in switch_schedule[1:]:
-        other = int(rng.integers(count - 1))
-        targets.append(other + (other >= targets[-1]))
-    return tuple(targets)
 
 
 def jittered_grid(count, x_range, y_range, rng):

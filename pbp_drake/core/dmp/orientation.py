@@ -12,7 +12,7 @@ degrees of its last orientation: docs/concepts/dmp.md, "Orientation DMPs"."""
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp.fitting import fit_weights
+from pbp_drake.core.dmp.fitting import check_times, fit_weights
 from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import SingleDmp
 
@@ -34,12 +34,7 @@ def validate_orientation_demonstration(times, orientations):
     if orientations.ndim != 2 or orientations.shape[0] < 3:
         raise ValueError(f"demonstration orientations must be (T, 4) with T >= 3, got shape "
                          f"{orientations.shape}")
-    times = np.asarray(times, dtype=float)
-    if times.shape != (orientations.shape[0],):
-        raise ValueError(f"demonstration times have shape {times.shape}, expected "
-                         f"({orientations.shape[0]},)")
-    if not np.isfinite(times).all() or not (np.diff(times) > 0).all():
-        raise ValueError("demonstration times must be finite and strictly increasing")
+    times = check_times(times, orientations.shape[0])
     errors = orientation_errors(orientations.T, orientations[-1][:, np.newaxis])
     jumps = np.flatnonzero(np.linalg.norm(np.diff(errors, axis=1), axis=0) > np.pi)
     if jumps.size:

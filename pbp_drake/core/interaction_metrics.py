@@ -22,27 +22,19 @@ def idle_ratio(intervention_ratio):
 
 @dataclasses.dataclass(frozen=True)
 class InteractionMetrics:
-    """The interaction metrics of one task.
+    """The interaction metrics of one task (each defined in docs/tasks/studies.md, "How the
+    operator and the method worked together").
 
-    - `input_integral` (m): the integral over the task of the operator's translational
-      command's norm while it acts, `sum_k active_k |v_k| control_period`;
-      `turn_input_integral` (rad) the same of its turning (the yaw rate's magnitude, or the
-      angular velocity's norm).
-    - `agreement`: over the ticks the operator acts, the mean cosine between its commanded
-      translational velocity `v_k` and the hand's executed one over that tick,
-      `(p_{k+1} - p_k) / control_period`: 1 when the hand goes where it pushes, -1 when
-      the opposite way. Ticks where either is slower than `STILL_SPEED`, and the last
-      tick (whose motion is not in the series), are left out; None when none is left.
-    - `prediction_accuracy`: the share of the ticks whose named goal is the current target
-      (a tick naming none counts as not naming it); None when no tick names a goal (a
-      method that shows no intent).
-    - `time_to_prediction` (s): for each target switch in order, the first target at the
-      first tick included (a switch: a tick whose target differs from the tick before's),
-      the time from the switch's tick to the first tick from which the named goal is the
-      new target on every tick up to the next switch or the end; None for a switch never
-      so named. None as a whole when no tick names a goal. `mean_time_to_prediction` is
-      its mean over the switches that got one, `unpredicted_switches` the count of the
-      others.
+    - `input_integral` (m): `sum_k active_k |v_k| control_period`; `turn_input_integral`
+      (rad) the same of its turning (the yaw rate's magnitude, or the angular velocity's).
+    - `agreement`: while the operator acts, the mean cosine between its commanded velocity
+      `v_k` and the hand's executed `(p_{k+1} - p_k) / control_period`, ticks where either
+      is slower than `STILL_SPEED` (and the last) left out; None when none is left.
+    - `prediction_accuracy`: the share of the ticks whose named goal is the current target;
+      None when no tick names a goal (a method that shows no intent).
+    - `time_to_prediction` (s): per target switch, the first target included, the time to
+      the first tick from which the named goal is the new target up to the next switch or
+      the end; None for a switch never so named, or as a whole when no tick names a goal.
     """
 
     input_integral: float

@@ -97,11 +97,9 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
 
 
 def _pointing_blocked(params, offset, heading_range, vertical):
-    """`(beyond, over)` for a target at `offset` (3) from the hand: its floor direction lies
-    beyond `heading_range` (low, high) (None: all the way round), give or take
-    `aligned_angle`; with `vertical` motion, it stands more above or below the hand than
-    beside it (straight above, its floor direction is no direction at all: the least
-    motion swings it). With either, turning the tool cannot point it at the target."""
+    """`(beyond, over)`, the two reasons `can_point_at` is false for a target at `offset` (3)
+    (straight above, its floor direction is no direction at all: the least motion swings
+    it)."""
     over = vertical and np.linalg.norm(offset[:2]) < abs(offset[2])
     if heading_range is None:
         return False, over

@@ -195,21 +195,16 @@ class DmpBankModel(BankStep, BankModel):
 
     def advance(self, phase, positions, scaled_velocity, goals_dk, dt, locked=None,
                 robot_velocity=None, followed=None):
-        """One first-order-hold step of all K DMPs (see `pbp_drake.core.dmp`); pure: returns
-        the new state.
+        """One first-order-hold step of all K DMPs; pure: returns the new state
+        `(phase, positions, scaled_velocity)`, new arrays.
 
-        Args:
-            phase: (K,) phases; positions: (D, K) or (D, 1) positions to step from (PBP passes
-                the robot's position); scaled_velocity: (D, K) the DMPs' own `z`.
-            goals_dk: (D, K) goals.
-            locked: None, or a bool (or (K,) bools) freezing those DMPs' phases; their
-                velocity then follows `robot_velocity` (D,) and their position stays.
-            followed: None, or the index of the DMP the robot followed until now: every DMP
-                then steps from that DMP's velocity, so that the robot may switch to any of
-                them without a jump of its commanded velocity (PBP's goal switch; see the
-                hand-over law, docs/concepts/hand-over.md). None: each DMP keeps its own.
-        Returns:
-            (phase, positions, scaled_velocity) after the step, new arrays.
+        `phase` (K,); `positions` (D, K) or (D, 1) to step from (PBP passes the robot's);
+        `scaled_velocity` (D, K) the DMPs' own `z`; `goals_dk` (D, K). `locked`: None, a bool
+        or (K,) bools freezing those DMPs' phases; their velocity then follows
+        `robot_velocity` (D,) and their position stays. `followed`: None (each DMP keeps its
+        own velocity), or the index of the DMP the robot followed until now: every DMP then
+        steps from that DMP's velocity, so that the robot may switch to any of them without
+        a jump of its commanded velocity (PBP's goal switch, docs/concepts/hand-over.md).
         """
         phase = np.asarray(phase, dtype=float)
         scaled_velocity = followed_velocity(np.asarray(scaled_velocity, dtype=float), followed,

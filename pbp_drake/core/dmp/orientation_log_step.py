@@ -91,12 +91,9 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
     (unit) and one `eta` (3, 1); `goals` (4, K), `transition` `Phi` ((2, 2) numbers), and
     `forcing` the columns of the attractor's rows (`forcing_rows`, called first), or None
     when `out` holds `b` already (the product is then added to it). Writes the
-    workspace's (an `OrientationWorkspace`) `fused` and `small`; allocates nothing of size
-    K.
-
-    One array, its rows rewritten in place as soon as their values are dead (`fused`'s rows
-    0-8, `w`, `v` (3), `v.eta`, `k`, `h`, `4 c`, `p`, become scratch, `k v`, `d`,
-    `c (e.eta) e` (3) and `p`): the step's cost at large K is the memory it touches."""
+    workspace's `fused` and `small`, `fused`'s rows rewritten in place as soon as their
+    values are dead (the step's cost at large K is the memory it touches); allocates
+    nothing of size K."""
     ws = workspace
     fused = ws.fused
     np.matmul(error_matrix(orientation, eta), goals, out=fused[:5])

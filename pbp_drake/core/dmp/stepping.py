@@ -120,13 +120,9 @@ class BankStep:
         """The attractor terms `(dp, dz)` (D, K) of the step from `positions` (D, K) or
         (D, 1) at phases `phase` (K,) towards `goals_dk`, into `out_dp` and `out_dz` (the
         caller's, or the workspace's `dp` and `dz`; the other work arrays are used).
-
-        Four passes over `(D, K)` when the DMPs share weights, phase and start.
         `goals_unchanged=True` vouches that `goals_dk` holds the goals of this workspace's
-        last call (Drake's pose bank knows when its goals were recomputed): with distinct
-        weights (Ijspeert, equal phases) the step then contracts the weights already
-        multiplied by `g - y0`, kept in the workspace (`contraction.scaled_weights`), and
-        takes five passes."""
+        last call: with distinct weights (Ijspeert, equal phases) the step then contracts the
+        weights already multiplied by `g - y0` (`contraction.scaled_weights`)."""
         constants = self.step_constants(dt)
         equal = phase.size == 1 or phase.min() == phase.max()
         if (goals_unchanged and equal and self._ijspeert and not self.shared_weights

@@ -67,25 +67,18 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
     velocity it returns points forward (`without_forward`).
 
     `vertical`: the velocity is `(vx, vy, vz)` (3): vz = 0 and the floor part as without
-    it, but when `insisting` (`insisting_motion_3d`). `heading_range` (low, high), an
-    arm's wrist (None: all the way round), bounds the heading an insisting participant
-    turns to (`insisting_side_heading`)."""
+    it, but when `insisting` (`insisting_motion`). `heading_range` (low, high), an arm's
+    wrist (None: all the way round), bounds the heading an insisting participant turns to
+    (`insisting_side_heading`)."""
+    if insisting:
+        return insisting_motion(params, speed, position, heading, target, heading_range,
+                                vertical)
     if vertical:
-        if insisting:
-            return insisting_motion_3d(params, speed, position, heading, target,
-                                       heading_range)
         velocity, yaw_rate = assist_motion(params, speed, position, heading, target, picked,
                                            insisting)
         return np.array([velocity[0], velocity[1], 0.0]), yaw_rate
-    offset = target[:2] - position[:2]
-    distance = np.linalg.norm(offset)
-    toward_target = unit(offset)
+    toward_target = unit(target[:2] - position[:2])
     toward_picked = unit(picked[:2] - position[:2])
-    if insisting:
-        wanted_heading = insisting_side_heading(heading, position, target, heading_range)
-        slow = min(1.0, distance / params.slow_radius)
-        velocity = speed * slow * without_forward(toward_target, heading)
-        return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
     separation = np.arccos(np.clip(toward_target @ toward_picked, -1.0, 1.0))
     if separation < params.in_line_angle:
         left = rotate_planar([0.0, 1.0], heading)
@@ -162,20 +155,20 @@ def insisting_side_heading(heading, position, target, heading_range=None):
     return wanted
 
 
-def insisting_motion_3d(params, speed, position, heading, target, heading_range=None):
-    """`assist_motion` insisting, with vertical motion: the velocity (3) toward the target
-    in 3-D as far as the keys allow (its floor part `without_forward`), at `speed` slowing
-    within `slow_radius` of the 3-D distance, so at most `speed` in all; the yaw rate turns
-    the target to its side as without vertical motion (none with the target straight above
-    or below)."""
-    offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
-    distance = np.linalg.norm(offset)
+def insisting_motion(params, speed, position, heading, target, heading_range=None,
+                     vertical=False):
+    """`assist_motion` insisting: the velocity (2, or 3 with `vertical`) toward the target
+    as far as the keys allow (its floor part `without_forward`), at `speed` slowing within
+    `slow_radius`, so at most `speed` in all; the yaw rate turns the target to its side
+    (`insisting_side_heading`; none with the target straight above or below)."""
+    size = 3 if vertical else 2
+    offset = np.asarray(target, float)[:size] - np.asarray(position, float)[:size]
     toward_target = unit(offset)
-    slow = min(1.0, distance / params.slow_radius)
+    slow = min(1.0, np.linalg.norm(offset) / params.slow_radius)
     floor = without_forward(toward_target[:2], heading)
-    velocity = speed * slow * np.array([floor[0], floor[1], toward_target[2]])
-    if np.linalg.norm(offset[:2]) < 1e-9:
-        return velocity, 0.0  # straight above or below: no side to turn it to
+    velocity = speed * slow * np.concatenate([floor, toward_target[2:]])
+    if vertical and np.linalg.norm(offset[:2]) < 1e-9:
+        return velocity, 0.0
     wanted_heading = insisting_side_heading(heading, position, target, heading_range)
     return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
 

@@ -158,30 +158,26 @@ class OrientationDmpBank(BankModel):
                                                    "orientations").T
         if locked is not None:
             locked = np.broadcast_to(np.asarray(locked, bool), np.shape(phase))
-            if not locked.any():
-                locked = None
-        if locked is not None:
-            held = (scaled_angular_velocity if robot_angular_velocity is None else
-                    np.broadcast_to(self.duration * np.asarray(
-                        robot_angular_velocity, float).reshape(AXES, 1), out_velocity.shape))
-            if not locked.all():
-                # Some locked, some not: the free step into temporaries, then chosen (rare).
-                stepped = (np.empty_like(out_phase), np.empty_like(out_orientations),
-                           np.empty_like(out_velocity))
-                self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
-                                *stepped, workspace)
-                held, stepped_phase = np.array(held), stepped[0]
-                orientations = np.broadcast_to(orientations, out_orientations.shape)
-                out_phase[...] = np.where(locked, phase, stepped_phase)
-                out_orientations[...] = np.where(locked, orientations, stepped[1])
-                out_velocity[...] = np.where(locked, held, stepped[2])
-                return
+        if locked is None or not locked.any():
+            self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                            out_phase, out_orientations, out_velocity, workspace)
+            return
+        held = (scaled_angular_velocity if robot_angular_velocity is None else
+                np.broadcast_to(self.duration * np.asarray(
+                    robot_angular_velocity, float).reshape(AXES, 1), out_velocity.shape))
+        if locked.all():
             out_phase[...] = phase
             out_orientations[...] = orientations
             out_velocity[...] = held
             return
-        self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
-                        out_phase, out_orientations, out_velocity, workspace)
+        # Some locked, some not: the free step into temporaries, then chosen (rare).
+        stepped = (np.empty_like(out_phase), np.empty_like(out_orientations),
+                   np.empty_like(out_velocity))
+        self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt, *stepped,
+                        workspace)
+        out_phase[...] = np.where(locked, phase, stepped[0])
+        out_orientations[...] = np.where(locked, orientations, stepped[1])
+        out_velocity[...] = np.where(locked, held, stepped[2])
 
     def _start_errors_into(self, goals_4k, workspace, goals_unchanged=False):
         """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`

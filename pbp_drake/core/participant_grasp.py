@@ -156,14 +156,13 @@ def heads_for(memory, time):
 
 
 def count_insistence(params, memory, time, orientation, target_orientation, selected,
-                     target=None):
+                     target):
     """The memory after a tick in which the estimate names `selected`: it starts insisting
-    once it has held the orientation of the object it heads for (`target`, by default the
-    known target; within twice `aligned_angle`, as noise moves it) for `insist_time` while
-    `selected` was another object (then `assist_twist` without `picked_position`)."""
+    once it has held the orientation of the object it heads for (`target`; within twice
+    `aligned_angle`, as noise moves it) for `insist_time` while `selected` was another
+    object (then `assist_twist` without `picked_position`)."""
     if memory.insisting:
         return memory
-    target = memory.known_target if target is None else target
     if selected == target or angle_between(
             orientation, target_orientation) > 2 * params.aligned_angle:
         return memory._replace(facing_since=-1.0)

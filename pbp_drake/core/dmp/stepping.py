@@ -257,10 +257,7 @@ class BankStep:
         """For the rows r of `combination` (2x2): the forcing shapes
         `S_r = C_r0 s(x0) + C_r1 s(x1)`, `s(x) = (psi.w / sum psi) x` (divided by K in the
         Ijspeert form), `(2, D, 1)` (shared weights, equal phases) or `(2, D, K)`, and
-        `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`, with `x1 = x0 decay`.
-
-        Equal phases: the basis is evaluated at the two phases, `(2, N)`, combined, and
-        contracted with the weights once. A phase per goal: `(N, K)` bases (allocates)."""
+        `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`, with `x1 = x0 decay`."""
         if equal is None:
             equal = phase.size == 1 or phase.min() == phase.max()
         if equal:

@@ -22,8 +22,8 @@ from pbp_drake.core.dmp.workspace import DmpWorkspace
 class BankModel:
     """What the position bank and `OrientationDmpBank` share: the model's checks
     (`_keep_model`), immutability after `__init__`, the settings, the phase decay, the
-    constructor from single DMPs, and open-loop prediction (a subclass keeps its `starts` as
-    `(rows, K)`)."""
+    constructors from single DMPs and of straight paths, and open-loop prediction (a
+    subclass keeps its `starts` as `(rows, K)`)."""
 
     def __setattr__(self, name, value):
         if getattr(self, "_frozen", False):
@@ -78,6 +78,19 @@ class BankModel:
         return cls(np.stack([d.weights for d in dmps]), np.stack([d.start for d in dmps]),
                    first.duration, first.settings,
                    np.stack([d.amplitude_scaling for d in dmps]))
+
+    @classmethod
+    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
+        """K straight DMPs from `start` to goals given at run time (no demonstration); for
+        orientations, along the shorter arc (slerp). Ijspeert: the minimum-jerk shape, shared
+        by all goals and scaled by each one's amplitude (`g - y0`, or `-e0`); Pastor: `f = 0`,
+        whose attractor already slides from the start to the goal."""
+        dimension = cls._straight_dimension(start)
+        if settings.formulation == "ijspeert":
+            weights = straight_weights(settings, duration, np.ones(dimension))
+        else:
+            weights = np.zeros((settings.basis_count, dimension))
+        return cls(weights, start, duration, settings, goal_count=goal_count)
 
     @property
     def settings(self):
@@ -154,19 +167,9 @@ class DmpBankModel(BankStep, BankModel):
         duration = times[-1] - times[0] if duration is None else duration
         return cls(weights, start, duration, settings, scaling, goal_count)
 
-    @classmethod
-    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
-        """K straight-path DMPs from `start` to goals given at run time (no demonstration).
-
-        Ijspeert: the minimum-jerk shape, shared by all goals (it scales with `g - y0`).
-        Pastor: `f = 0`, whose attractor already slides from `y0` to `g` along the line.
-        """
-        dimension = as_point(start, "start").size
-        if settings.formulation == "ijspeert":
-            weights = straight_weights(settings, duration, np.ones(dimension))
-        else:
-            weights = np.zeros((settings.basis_count, dimension))
-        return cls(weights, start, duration, settings, goal_count=goal_count)
+    @staticmethod
+    def _straight_dimension(start):
+        return as_point(start, "start").size
 
     def make_workspace(self):
         """New scratch arrays for the in-place step; one per thread or Drake Context."""

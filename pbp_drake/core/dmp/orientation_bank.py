@@ -24,7 +24,6 @@ from pbp_drake.core.dmp.orientation_kernels import (
 from pbp_drake.core.dmp.orientation_log_step import (
     IDENTITY6, forcing_rows, log_step_from_one_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis
-from pbp_drake.core.dmp.single import straight_weights
 from pbp_drake.core.dmp.stepping import step_constants
 
 
@@ -80,17 +79,9 @@ class OrientationDmpBank(BankModel):
         duration = times[-1] - times[0] if duration is None else duration
         return cls(weights, start, duration, settings, scaling, goal_count)
 
-    @classmethod
-    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
-        """K DMPs along the shorter arc (slerp) from `start` to goals given at run time.
-
-        Ijspeert: the minimum-jerk shape, shared, scaled per goal by `-e0`; Pastor: `f = 0`,
-        whose attractor `e0 x` already slides along the arc."""
-        if settings.formulation == "ijspeert":
-            weights = straight_weights(settings, duration, np.ones(AXES))
-        else:
-            weights = np.zeros((settings.basis_count, AXES))
-        return cls(weights, start, duration, settings, goal_count=goal_count)
+    @staticmethod
+    def _straight_dimension(start):
+        return AXES
 
     def initial_state(self, orientation=None):
         """(phase (K,), orientations (4, K), scaled angular velocity (3, K)) at the start."""

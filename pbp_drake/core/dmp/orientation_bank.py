@@ -204,15 +204,14 @@ class OrientationDmpBank(BankModel):
         """The free step in log coordinates: `e = Log(q g*)` and `z = J(e)^-1 eta` from the
         measured orientations `(4, 1)` or `(4, K)` (unit) and `eta` `(3, K)` or `(3, 1)`
         (one for all: PBP's goal switch), stepped as the position bank steps `(y, z)`:
-        `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase`. Drake's
-        pose bank keeps `(e', z')` and reads the orientations out on demand.
-
+        `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase` (Drake's
+        pose bank keeps `(e', z')` and reads the orientations out on demand).
         `goals_unchanged=True` vouches that `goals_4k` holds the goals of this workspace's
-        last step (Drake's pose bank knows when its goals were recomputed): the start
-        errors are then reused without comparing the goals. `basis`: the step's combined
-        basis `(2, N)` and `lambda` `(2, 1)` when the caller has them already (a position
-        bank of the same settings and duration stepped at the same phase: its workspace's
-        `basis` and `lam`), used with distinct Ijspeert weights at equal phases."""
+        last step: the start errors are then reused without comparing the goals. `basis`:
+        the step's combined basis `(2, N)` and `lambda` `(2, 1)` when the caller has them
+        already (a position bank of the same settings and duration stepped at the same
+        phase: its workspace's `basis` and `lam`), used with distinct Ijspeert weights at
+        equal phases."""
         ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)

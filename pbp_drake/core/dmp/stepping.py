@@ -157,12 +157,9 @@ class BankStep:
         bank keeps. `goals_unchanged` as `attractor_terms_into`. With equal phases the step's
         combined basis and `lambda` are left in `workspace.basis` and `workspace.lam` (an
         orientation bank of the same settings steps with them: `log_step_into`'s `basis`).
-
-        With weights kept multiplied by the amplitudes (distinct weights, Ijspeert, equal
-        phases, the goals unchanged) and one `z`, the weights are contracted straight into
-        `out`, then `-(Phi00 - 1, Phi10) g` (kept with the weights while the goals stay)
-        and one column, `(Phi00 - 1, Phi10) p + (Phi01, Phi11) z`, are added: two passes
-        over `out` instead of the seven of the attractor terms and the velocity's part."""
+        With weights kept multiplied by the amplitudes and one `z`, the weights are
+        contracted straight into `out`, then `-(Phi00 - 1, Phi10) g` (kept while the goals
+        stay) and one column, `(Phi00 - 1, Phi10) p + (Phi01, Phi11) z`, are added."""
         constants = self.step_constants(dt)
         ws = workspace
         if (goals_unchanged and scaled_velocity.shape[1] == 1 and self._ijspeert

@@ -76,13 +76,14 @@ class HopSettings:
         the fields after construction, so `resolve` calls this again)."""
         if not isinstance(self.assistance, bool):
             raise ValueError(f"assistance must be true or false, got {self.assistance!r}")
-        numbers = [field.name for field in dataclasses.fields(self)][:-1]  # all but assistance
+        numbers = [field.name for field in dataclasses.fields(self) if field.name != "assistance"]
         for name in numbers:
             value = getattr(self, name)
             if not is_real(value) or not math.isfinite(value):
                 raise ValueError(f"{name} must be a finite number, got {value!r}")
-        for name in numbers[:-2]:  # all but max_probability and blending_threshold
-            if not getattr(self, name) > 0.0:
+        for name in numbers:
+            if name not in ("max_probability", "blending_threshold") and not getattr(
+                    self, name) > 0.0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
         if not 0.0 < self.max_probability <= 1.0:
             raise ValueError(f"max_probability must lie in (0, 1], got "

@@ -1,27 +1,9 @@
-"""How the operator's command and the robot's policy become one reference (the blending laws).
-
-A law (`BLEND_LAWS`; the table: docs/concepts/pbp.md, "The blending laws") names the
-reference, a position and a velocity, that the robot tracks next while the operator acts and
-while idle. The operator's command `u` is a velocity; over one control period `dt` the
-operator alone would move the robot from `y` to `U = y + u dt`; `P` is the policy's next
-state (`y_dmp`, the selected DMP's). ``pbp_continuous`` (Alg. 1) plays `y_dmp + u dt`;
-``pbp_alternated`` (Alg. 2) `U` while the operator acts, else `y_dmp`; ``fixed_alpha``
-(Dragan & Srinivasa 2013) `(1 - alpha) U + alpha P` while the operator acts, else `P`;
-``confidence_alpha`` the same with `alpha` from the goal confidence (`confidence_alpha`,
-every control period); ``teleop`` `U`.
-
-Confidence, for ``confidence_alpha``, is the Jain-style margin (Jain & Argall 2019) of the
-selected goal, after normalising the probabilities to sum 1,
-
-    confidence = max(0, p[selected] - max_{j != selected} p[j]),
-
-rather than the normalised maximum `(p_max - 1/K) / (1 - 1/K)`: it is 0 whenever the
-selected goal is tied with another one, however the rest of the mass is spread (e.g.
-`[0.5, 0.5, 0]`), and it measures the *selected* goal, which the estimator's hysteresis
-may keep after another became more probable (the operator then keeps full control). It is
-mapped to `alpha` by the "timid/aggressive" linear ramp
-
-    alpha = clip((confidence - low) / (high - low), 0, 1) * alpha_max."""
+"""How the operator's command and the robot's policy become one reference: the blending laws
+(`BLEND_LAWS`; the table: docs/concepts/pbp.md, "The blending laws"). The operator's command
+`u` is a velocity; over one control period `dt` the operator alone would move the robot from
+`y` to `U = y + u dt`; `P` is the policy's next state (the selected DMP's). A law plays `U`,
+`P`, `P + u dt` or `(1 - alpha) U + alpha P` while the operator acts and while idle;
+``confidence_alpha`` takes alpha from the goal confidence (`confidence_alpha`)."""
 
 import typing
 
@@ -57,7 +39,7 @@ class BlendLaw(typing.NamedTuple):
     adds_to_policy: bool = False
 
 
-#: The blending laws by mode name (the module docstring); a method names its law
+#: The blending laws by mode name; a method names its law
 #: (`pbp_drake.core.methods.Method.blend_mode`).
 BLEND_LAWS = {
     "pbp_continuous": BlendLaw(SHIFTED, SHIFTED, adds_to_policy=True),
@@ -119,7 +101,11 @@ def goal_confidence(probabilities, selected):
     """The margin of the selected goal: `p[selected] - max_{j != selected} p[j]`, at least 0.
 
     `probabilities` (K >= 1, finite, non-negative, not all 0) are normalised to sum 1 first.
-    Uniform gives 0, one-hot on `selected` gives 1, K = 1 gives 1.
+    Uniform gives 0, one-hot on `selected` gives 1, K = 1 gives 1. The Jain-style margin
+    (Jain & Argall 2019) rather than the normalised maximum `(p_max - 1/K) / (1 - 1/K)`: it
+    is 0 whenever the selected goal is tied with another (`[0.5, 0.5, 0]`), and it measures
+    the *selected* goal, which the estimator's hysteresis may keep after another became more
+    probable (the operator then keeps full control).
     """
     probabilities = np.asarray(probabilities, dtype=float).reshape(-1)
     k = probabilities.size

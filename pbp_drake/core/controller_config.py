@@ -24,13 +24,11 @@ from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_n
 
 @dataclasses.dataclass
 class HandLimits:
-    """The hand-over law's limits (`pbp_drake.core.hand_over`): a goal switch, or the
-    operator pressing or releasing, changes the hand's commanded velocity by at most
-    `max_hand_acceleration` (m/s^2; 1.0 is 0.03 m/s a tick at 30 Hz), and the command
-    never exceeds `max_hand_speed` (m/s), however far a primitive is from its attractor.
-    A scenario's robot section holds them (`robot: !Hsr {max_hand_speed: ...}`)."""
+    """The hand-over law's limits (`pbp_drake.core.hand_over`), which a scenario's robot
+    section holds (`robot: !Hsr {max_hand_speed: ...}`)."""
 
-    #: The fastest change of the commanded hand velocity (m/s^2).
+    #: The fastest change of the commanded hand velocity (m/s^2; 1.0 is 0.03 m/s a tick at
+    #: 30 Hz).
     max_hand_acceleration: float = 1.0
     #: The fastest commanded hand speed (m/s). 0.2 m/s is the HSR base's published limit:
     #: a hand driven faster for long runs its arm out of range.
@@ -158,11 +156,8 @@ class PbpControllerConfig(ControlSettings):
 def nominal_duration(start, goals, speed, grouped, length_ratio=1.0):
     """The DMPs' duration (s) when none is given: the farthest goal's distance from `start`
     over `speed` (all DMPs share one phase, so the farthest goal is reached at the nominal
-    speed and the nearer ones slower); with goal groups (`grouped`), the median goal's;
-    times `length_ratio`, a taught primitive's path length over its chord (a bent path is
-    longer than the straight distance).
-    Hundreds of goals spread over a table put the farthest well beyond the typical one,
-    and the robot, heading first into the region the operator means, would cross it at
-    the farthest goal's pace (the hand-over's speed limit bounds the faster DMPs)."""
+    speed and the nearer ones slower); with goal groups (`grouped`), the median goal's (why:
+    docs/concepts/goal-estimators.md, "Many goals: goal groups"); times `length_ratio`, a
+    taught primitive's path length over its chord."""
     distances = np.linalg.norm(np.asarray(goals, float) - np.asarray(start, float), axis=1)
     return float(np.median(distances) if grouped else np.max(distances)) / speed * length_ratio

@@ -29,19 +29,13 @@ def vector_length(vector):
     return math.sqrt(vector.dot(vector))
 
 
-def within_bounds(values):
-    """True when every entry of `values` is finite and within ±`MAX_COORDINATE`. Two
-    reductions, no temporary array: a NaN fails both comparisons."""
-    values = np.asarray(values, dtype=float)
-    return values.size == 0 or bool(values.min() >= -MAX_COORDINATE
-                                    and values.max() <= MAX_COORDINATE)
-
-
 def check_positions(positions, name):
     """Raises ValueError naming the first row of `positions` `(K, D)` (or one point `(D,)`)
     that is not finite or not within ±`MAX_COORDINATE` m, as `name` `k`."""
     positions = np.asarray(positions, dtype=float)
-    if within_bounds(positions):
+    # Two reductions, no temporary array, when all are good: a NaN fails both comparisons.
+    if positions.size == 0 or (positions.min() >= -MAX_COORDINATE
+                               and positions.max() <= MAX_COORDINATE):
         return
     rows = np.atleast_2d(positions)
     bad = ~(np.isfinite(rows) & (np.abs(rows) <= MAX_COORDINATE)).all(axis=1)

@@ -1,22 +1,11 @@
 """Which of K goals the operator means (the paper's GOAL_ESTIMATOR), in pure NumPy.
 
-The estimators that read the hand's position `p` (3) and heading (rad, on the floor plane,
-counter-clockwise from +x) score the K goals `(K, 3)` and turn the scores into
-probabilities that sum to 1, vectorised over K and in log space (a small temperature or a
-large beta gives a one-hot vector rather than NaN): ``angle`` (the paper, section III-C),
-``nearest`` and ``bayesian`` (Dragan & Srinivasa 2013). The others read more and live in
-their own modules: ``pose`` (`grasp_estimation`), ``maxent_command`` (`maxent_command`,
-`hindsight_optimization`) and ``intent_filter`` (`intent_filter`). What each reads and
-scores: docs/concepts/goal-estimators.md.
-
-`ESTIMATORS` is the registry the scenario's `goal_estimator: {method: NAME}` is read
-through: each `Estimator` says what it reads (which picks its system) and, for those that
-read the hand's position, its probabilities function. A new estimator is its function and
-one entry (`register_estimator`); no layer compares an estimator's name.
-
-The selection is the most probable goal, with hysteresis so that it does not chatter
-(`update_selection`); the hysteresis memory (`SelectionMemory`) is passed in and returned,
-so every function here is pure."""
+Here: the registry `ESTIMATORS` (`goal_estimator: {method: NAME}`; a new estimator is one
+`register_estimator` entry), the estimators that read the hand's position `p` (3) and
+heading (rad, counter-clockwise from +x on the floor plane): ``angle`` (the paper, section
+III-C), ``nearest`` and ``bayesian`` (Dragan & Srinivasa 2013), and the selection with
+hysteresis (`update_selection`). ``pose``, ``maxent_command`` and ``intent_filter`` live in
+their own modules. What each reads and scores: docs/concepts/goal-estimators.md."""
 
 import dataclasses
 import math

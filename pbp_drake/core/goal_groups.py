@@ -1,24 +1,9 @@
-"""Goals that cannot be told apart act as one, in pure NumPy (why, and the settings:
-docs/concepts/goal-estimators.md, "Many goals: goal groups").
-
-- **The group** is the smallest set of the most probable goals that holds `group_mass` of
-  the probability (a credible set; O(K) partitions and a sort of the group's members).
-- **Its point** is the group's probability-weighted mean goal: the DMP of the selected goal
-  is steered to it, so the robot heads into the region the operator means.
-- **Commitment.** The robot commits to the estimator's selected goal (its hysteresis
-  kept) and shows it once the group is one goal, or its goals lie within `commit_radius`
-  of their point, or the most probable goal holds `commit_probability`, or the hand has
-  reached the group's point (within `commit_radius`). Until then it shows no goal
-  (`NO_GOAL`). A commitment holds while the estimator selects the same goal (`committed`).
-
-**Poses** (the grasping task's goals, `pose_group_target`): the group's point is the
-probability-weighted mean position and the chordal mean of the orientations (each on the
-hemisphere of the most probable one). Distances are the task's pose error
-`|p - g| + L angle(q, q_g)` (`grasp_task`), so that `commit_radius` bounds turns as well
-as moves. The robot also commits once the hand is within `commit_radius` of the selected
-grasp, or the grasps within `commit_radius` of it hold `commit_probability` together: an
-object's grasps differ in orientation at nearly one place, and a group of them can hold
-its pose away from each."""
+"""Goals that cannot be told apart act as one, in pure NumPy: the group (the fewest most
+probable goals holding `group_mass`), the point the robot heads for (their
+probability-weighted mean; for poses, `pose_group_target`, with the chordal mean
+orientation) and when it commits to the estimator's selected goal, showing `NO_GOAL`
+until then. The rules and why: docs/concepts/goal-estimators.md, "Many goals: goal
+groups"."""
 
 import typing
 
@@ -67,7 +52,7 @@ def _members(probabilities, selected, group_mass, commit_probability, committed)
 def group_target(goals, probabilities, selected, group_mass, commit_radius,
                  commit_probability, hand=None, committed=NO_GOAL):
     """The `GroupTarget` of `goals` (K, 3) under `probabilities` (K), the estimator's
-    `selected` goal committed to when the group allows (module docstring): `hand` (3) is
+    `selected` goal committed to when the group allows (the docs page): `hand` (3) is
     the hand's position (None: not read), `committed` the goal committed to before
     (`NO_GOAL`: none)."""
     members = _members(probabilities, selected, group_mass, commit_probability, committed)
@@ -84,8 +69,9 @@ def group_target(goals, probabilities, selected, group_mass, commit_radius,
 def pose_group_target(poses, probabilities, selected, group_mass, commit_radius,
                       commit_probability, metres_per_radian, hand=None, committed=NO_GOAL):
     """`group_target` for pose goals: `poses` (K, 7) rows `[x, y, z, qw, qx, qy, qz]`
-    (unit quaternions), the point a pose (7), distances the pose error with
-    `metres_per_radian` (module docstring); `hand` the hand's pose (7) or None."""
+    (unit quaternions), the point a pose (7), distances the pose error
+    `|p - g| + L angle(q, q_g)` with `L = metres_per_radian`; `hand` the hand's pose (7) or
+    None."""
     members = _members(probabilities, selected, group_mass, commit_probability, committed)
     goal = poses[selected]
     # The grasps within the radius of the selected one act as one with it.

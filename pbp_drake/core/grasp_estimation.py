@@ -1,17 +1,6 @@
 """The ``pose`` goal estimator of the grasping task: which of K grasp poses the operator
-means, read from the hand's position, orientation and their rates, in pure NumPy.
-
-For candidate k with grasp position `g_k` and grasp orientation `q_k`, the hand at `p`
-with orientation `q`, moving at `v` (m/s) and turning at `omega` (rad/s, world frame):
-
-    cost_k = alpha_k + distance_weight |g_k - p|
-             + orientation_weight max(0, theta_k - turn_horizon (omega . n_k))
-
-with `alpha_k` the angle between `v` and `g_k - p` (0 while `|v| < min_speed`),
-`theta_k = angle_between(q, q_k)` and `n_k` the unit axis of `Log(q_k q*)`: the bracket is
-the angle left after `turn_horizon` seconds of the present turn (docs/tasks/grasp.md,
-"The `pose` goal estimator"). Probabilities are `softmax(-cost / temperature)`, vectorised
-over K; the selection is `goal_estimation.update_selection`'s hysteresis. The settings are
+means, read from the hand's position, orientation and their rates, in pure NumPy
+(`pose_costs`; why: docs/tasks/grasp.md, "The `pose` goal estimator"). The settings are
 the scenario's `goal_estimator` section (`GoalEstimatorSettings` with `method: pose`)."""
 
 import numpy as np
@@ -60,7 +49,8 @@ def turn_errors(grasp_orientations, orientation, angular_velocity):
 
 def pose_costs(settings, grasp_positions, grasp_orientations, position, orientation,
                velocity, angular_velocity):
-    """`cost_k` (K,) of the module docstring (arrays already checked)."""
+    """`cost_k = alpha_k + distance_weight |g_k - p| + orientation_weight max(0, theta_k -
+    turn_horizon closing_k)` (K,) (`travel_angles`, `turn_errors`; arrays already checked)."""
     angles, closing = turn_errors(grasp_orientations, orientation, angular_velocity)
     left_to_turn = np.maximum(angles - settings.turn_horizon * closing, 0.0)
     return (travel_angles(grasp_positions, position, velocity, settings.min_speed)

@@ -1,16 +1,10 @@
 """The grasping task: the reach task's scene with a grasp pose per object, in pure NumPy.
 
-The scene, the frames and the rules are docs/tasks/grasp.md's ("Frames and conventions",
-"The scene", "Rules"). In short: 2 to 4 upright cylinders, each on its own table, drawn
-as the reach task's objects; each is grasped from the side at a yaw
-(`side_grasp_orientation`) or from above at a wrist roll (`top_grasp_orientation`), the
-hand's grasp position `grasp_depth` behind the grasp point along the approach axis z_H.
-Orientations are unit quaternions (w, x, y, z) mapping the hand frame H
-(`hand_palm_link`) to the world (`pbp_drake.core.quaternion`). Progress toward a target
-grasp pose is `1 - e(now) / e(start)` with the pose error
-`e = |p - g| + L angle(q, q_g)`, `L = success_distance / success_angle`; success is the
-hand within `success_distance` of the grasp position AND within `success_angle` of its
-orientation, both bounds inclusive."""
+Each object is grasped from the side at a yaw or from above at a wrist roll, the hand's
+grasp position `grasp_depth` behind the grasp point along the approach axis z_H.
+Orientations are unit quaternions (w, x, y, z) mapping the hand frame H (`hand_palm_link`)
+to the world. The scene, the frames and the rules: docs/tasks/grasp.md ("Frames and
+conventions", "The scene", "Rules")."""
 
 import dataclasses
 
@@ -57,8 +51,8 @@ def _about(axis, angle):
 def side_grasp_orientation(yaw):
     """The hand's quaternion (4,) grasping from the side at `yaw` (rad):
     `Rz(yaw) Ry(90) Rz(180)`. At yaw 0 it is the HSR's hand at the station's start (x_H up,
-    y_H along -y: the model's hand_palm_link), so a grasp straight ahead needs no wrist roll;
-    without the last half turn the robot reached it with the wrist flipped over."""
+    y_H along -y: the model's hand_palm_link), so a grasp straight ahead needs no wrist
+    roll."""
     return multiply(multiply(_about(Z_AXIS, yaw), _about(Y_AXIS, np.pi / 2)),
                     _about(Z_AXIS, np.pi))
 
@@ -126,9 +120,8 @@ def sample_grasp_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
         others = [i for i in range(count) if i != targets[-1]]
         targets.append(int(others[rng.integers(len(others))]))
     if grasps_per_object > 1:
-        # Drawn after the one-grasp scene, whose draws stay as they are: each object's
-        # first grasp is the one above, its other G - 1 drawn alike, and each target one
-        # of its object's grasps.
+        # Drawn after the one-grasp scene's draws: each object's first grasp is the one
+        # above, its other G - 1 drawn alike, and each target one of its object's grasps.
         more = grasps_per_object - 1
         extra = [tuple("top" if rng.uniform() < top_probability else "side"
                        for _ in range(more)) for _ in range(count)]

@@ -1,18 +1,12 @@
 """The hand-over law: how the command passes between the operator and the primitives
-(docs/concepts/hand-over.md).
-
-Whatever the blending law sends, the robot's command changes its velocity by at most
-`a_max dt` per control period `dt` and never exceeds the speed `v_max`. With `(p_k, v_k)` the
-blended reference of tick k and `v'_{k-1}` the velocity commanded at tick k - 1, the command
-of tick k is
+(why and its limits: docs/concepts/hand-over.md). With `(p_k, v_k)` the blended reference
+of tick k and `v'_{k-1}` the velocity commanded at tick k - 1, the command of tick k is
 
     v'_k = v'_{k-1} + clip(cap(v_k) - v'_{k-1}, a_max dt)
     p'_k = p_k + (v'_k - v_k) dt
 
-with `clip(d, r) = d min(1, r / |d|)` and `cap(v) = clip(v, v_max)`. Both `v'_{k-1}` and
-`cap(v_k)` lie within the speed limit, so every point between them does. In steady motion
-below `v_max` the law is the blending law itself; it acts only where the reference jumps
-(a goal switch, the operator pressing or releasing, a primitive far from its attractor)."""
+with `clip(d, r) = d min(1, r / |d|)` and `cap(v) = clip(v, v_max)`: the velocity changes
+by at most `a_max dt` per control period and never exceeds `v_max`."""
 
 import math
 

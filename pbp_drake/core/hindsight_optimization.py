@@ -1,26 +1,12 @@
 """Shared autonomy by hindsight optimization (HOP) and its predict-then-assist variant, in
 pure NumPy: the goal posterior that reads the operator's command, and the assistance it gives.
 
-Sources: S. Javdani, S. Srinivasa, J. A. Bagnell, "Shared Autonomy via Hindsight
-Optimization", RSS 2015; S. Javdani et al., "Shared autonomy via hindsight optimization for
-teleoperation and teaming", IJRR 2018; A. Dragan, S. Srinivasa, "A policy-blending
-formalism for shared control", IJRR 2013. The constants (`HopSettings`' defaults) are the
-published ones. The equations, their constants and why they are as they are:
-docs/concepts/hindsight-optimization.md. In short:
-
-- goal g (one of K) has one or more targets kappa (N in all): a position, and in the
-  grasping task an orientation; each target has a Huber-like step cost `c(x)` and value
-  `V(x)` on its distance d (and angle theta), and with the operator's command applied for
-  one step (`p' = p + v dt`, `q' = Exp(omega dt) q`)
-  `Q_kappa = c(d) + V(d')  [+ w (c(theta) + V(theta'))]`, `V_kappa = V(d)  [+ w V(theta)]`;
-  a goal's `Q_g`, `V_g` are its best target's (the least Q);
-- the posterior, from a uniform prior: `log b_t(g) = log b_{t-1}(g) - (Q_g - V_g)`,
-  normalised, its largest probability clipped at `max_probability`;
-- the assistance: `a = -(1 / lambda) (sum_g b_g grad Q_g) / (sum_g b_g)`, each goal's
-  gradient faded near its target; HOP's command is `u + a`;
-- predict-then-assist (`blending_weights`): the operator alone while the two most probable
-  goals differ by at most `blending_threshold`, beyond it `u` plus HOP's action with the
-  whole belief on the most probable goal."""
+Sources: Javdani, Srinivasa, Bagnell, RSS 2015; Javdani et al., IJRR 2018. Goal g (one of K)
+has one or more targets kappa (N in all) with Huber-like costs; the posterior is
+`log b_t(g) = log b_{t-1}(g) - (Q_g - V_g)`, normalised and clipped, and HOP commands
+`u + a`, `a = -(1 / lambda) (sum_g b_g grad Q_g) / (sum_g b_g)`. The equations, the published
+constants (`HopSettings`' defaults) and predict-then-assist:
+docs/concepts/hindsight-optimization.md."""
 
 import dataclasses
 import math
@@ -90,17 +76,14 @@ class HopSettings:
         the fields after construction, so `resolve` calls this again)."""
         if not isinstance(self.assistance, bool):
             raise ValueError(f"assistance must be true or false, got {self.assistance!r}")
-        for field in dataclasses.fields(self):
-            value = getattr(self, field.name)
-            if field.name == "assistance":
-                continue
+        numbers = [field.name for field in dataclasses.fields(self) if field.name != "assistance"]
+        for name in numbers:
+            value = getattr(self, name)
             if not is_real(value) or not math.isfinite(value):
-                raise ValueError(f"{field.name} must be a finite number, got {value!r}")
-        for name in ("cost_time_step", "translation_gain", "translation_switch_distance",
-                     "translation_constant", "rotation_gain", "rotation_switch_angle",
-                     "rotation_constant", "rotation_weight", "translation_divisor",
-                     "rotation_divisor", "translation_fade_distance", "rotation_fade_angle"):
-            if not getattr(self, name) > 0.0:
+                raise ValueError(f"{name} must be a finite number, got {value!r}")
+        for name in numbers:
+            if name not in ("max_probability", "blending_threshold") and not getattr(
+                    self, name) > 0.0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
         if not 0.0 < self.max_probability <= 1.0:
             raise ValueError(f"max_probability must lie in (0, 1], got "
@@ -248,7 +231,8 @@ def target_values(settings, geometry):
 
 
 def target_costs(settings, geometry):
-    """`(Q_kappa (N,), V_kappa (N,))` of the module docstring."""
+    """`(Q_kappa (N,), V_kappa (N,))`: `Q = c(d) + V(d') [+ w (c(theta) + V(theta'))]`,
+    `V = V(d) [+ w V(theta)]`."""
     step = settings.cost_time_step
     values, after = target_values(settings, geometry)
     q_values = huber_step_cost(geometry.distances, *_translation(settings), step) + after
@@ -362,7 +346,7 @@ def _unit_rows(vectors, lengths):
 def goal_gradients(settings, costs):
     """`(translation (K, 3), rotation (K, 3) or None)`: each goal's gradient of its best
     target's value at the operator's next pose, faded on the distance and angle from that
-    pose (module docstring), not yet divided by lambda."""
+    pose, not yet divided by lambda."""
     geometry, best = costs.geometry, costs.best_targets
     offsets = geometry.next_offsets[best]
     lengths = np.linalg.norm(offsets, axis=1)
@@ -408,31 +392,18 @@ def blending_weights(probabilities, threshold):
     return weights
 
 
-def _belief_weights(settings, probabilities):
-    return np.asarray(probabilities, dtype=float)
-
-
-def _predict_then_assist_weights(settings, probabilities):
-    return blending_weights(probabilities, settings.blending_threshold)
-
-
-#: The goal weights of each assistance by name (`pbp_drake.core.methods.Method.assistance`):
-#: the belief itself (``hop``) or predict-then-assist's (``predict_then_assist``).
-ASSISTANCE_WEIGHTS = {"hop": _belief_weights, "predict_then_assist": _predict_then_assist_weights}
-#: The assistance names, which are the methods built on this module.
-HOP_METHODS = tuple(ASSISTANCE_WEIGHTS)
+#: The goal weights `(settings, probabilities) -> (K,)` of each assistance by name
+#: (`pbp_drake.core.methods.Method.assistance`): the belief itself or predict-then-assist's.
+ASSISTANCE_WEIGHTS = {
+    "hop": lambda settings, probabilities: np.asarray(probabilities, dtype=float),
+    "predict_then_assist": lambda settings, probabilities: blending_weights(
+        probabilities, settings.blending_threshold)}
 
 
 def check_assistance(name):
     """Raises ValueError unless `name` is one of `ASSISTANCE_WEIGHTS`."""
     if name not in ASSISTANCE_WEIGHTS:
-        raise ValueError(f"method {name!r} is unknown; choose one of {HOP_METHODS}")
-
-
-def assistance_weights(method, settings, probabilities):
-    """The goal weights the assistance `method` (`ASSISTANCE_WEIGHTS`) uses."""
-    check_assistance(method)
-    return ASSISTANCE_WEIGHTS[method](settings, probabilities)
+        raise ValueError(f"method {name!r} is unknown; choose one of {tuple(ASSISTANCE_WEIGHTS)}")
 
 
 class AssistedCommand(typing.NamedTuple):
@@ -453,18 +424,17 @@ def assisted_command(method, settings, targets, probabilities, position, velocit
     if probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all():
         raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers, "
                          f"got {probabilities!r}")
+    operator_angular = None if targets.orientations is None else (
+        np.zeros(3) if angular_velocity is None
+        else _finite_vector(angular_velocity, "angular_velocity"))
+    operator_velocity = _finite_vector(velocity, "velocity")
     if not settings.assistance:
-        # The operator's command untouched (not plus a zero action, which would turn a -0.0
-        # into 0.0): bit for bit the command teleop passes on.
-        angular = None if targets.orientations is None else (
-            np.zeros(3) if angular_velocity is None
-            else _finite_vector(angular_velocity, "angular_velocity"))
-        return AssistedCommand(_finite_vector(velocity, "velocity"), angular, False)
-    weights = assistance_weights(method, settings, probabilities)
+        # Not plus a zero action, which would turn a -0.0 into 0.0: bit for bit teleop's.
+        return AssistedCommand(operator_velocity, operator_angular, False)
+    check_assistance(method)
+    weights = ASSISTANCE_WEIGHTS[method](settings, probabilities)
     costs = goal_costs(settings, targets, position, velocity, orientation, angular_velocity)
     linear, angular = assistance_action(settings, costs, weights)
-    velocity = _finite_vector(velocity, "velocity") + linear
     if angular is not None:
-        angular = (np.zeros(3) if angular_velocity is None
-                   else _finite_vector(angular_velocity, "angular_velocity")) + angular
-    return AssistedCommand(velocity, angular, bool(weights.sum() > 0.0))
+        angular = operator_angular + angular
+    return AssistedCommand(operator_velocity + linear, angular, bool(weights.sum() > 0.0))

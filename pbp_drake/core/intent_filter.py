@@ -1,26 +1,14 @@
 """The ``intent_filter`` goal estimator, in pure NumPy: a recursive Bayesian posterior over
 the K goals on what the operator does, with a hazard that keeps it from becoming certain for
-good, and the hand's present heading read on top. Its features, the fit of its rates and
-what it measures: docs/concepts/goal-estimators.md, "What each one reads".
-
-The operator is a hidden Markov chain over the goals: each tick of `dt` seconds it keeps its
-goal, or with probability `h = 1 - exp(-switch_rate dt)` picks one anew (uniformly). Each
-goal's features lie in [-1, 1]: the **motion** `m_g = 1 - 2 a_g / pi` (`a_g` the angle
-between the operator's command, or while it is silent the hand's own velocity, and
-`g - p`; 0 below `min_speed`), the **turns** `t_g` toward g at the operator's yaw rate,
-and the **heading** `h_g = 1 - 2 |e_g| / pi` (`e_g` g's floor bearing from the hand minus
-the hand's heading). Motions and turns are events, added to the belief at rates (nats per
-second); the heading is a state, read once on top of the belief and not into it:
+good, and the hand's present heading read on top:
 
     log b_t(g) = log((1 - h) b_{t-1}(g) + h / K) + dt (move_rate m_g + turn_rate t_g)
-                 (silent: + dt silence_rate m_g;
-                  acting while the robot shows g: - dt override_rate)
     log P_t(g) = log b_t(g) + heading_weight h_g,
 
-each normalised and its largest probability clipped at `max_probability` (as HOP's
-posterior). `b` is the estimator's state, `P` its probabilities; after the prediction no
-goal is below `h / K`, the floor against runaway confidence. Vectorised over K, in log
-space. The grasping task's goals are poses (`pose_intent_features`)."""
+each normalised and clipped at `max_probability`; `h = 1 - exp(-switch_rate dt)`, the
+features `m_g`, `t_g`, `h_g` in [-1, 1] (`IntentFeatures`). The model, its silent and
+override terms, the fit of its rates: docs/concepts/goal-estimators.md, "What each one
+reads"."""
 
 import dataclasses
 import math
@@ -136,17 +124,9 @@ def pose_intent_features(positions, orientations, position, orientation, velocit
     (K, 4)) for the hand at `position` (3) with unit `orientation` (4), the motion
     `velocity` (3, m/s) and the operator's `angular_velocity` (3, rad/s, world frame; 0
     while silent) over one `period`; `shown` the goal the robot shows (-1: none), which an
-    acting operator overrides (`overridden`).
-
-    The moves are the position form's in 3-D. Without the `forward_key` (PBP's operator,
-    who cannot push along the hand's approach axis z_H), an operator heading for g sends
-    the part of `g - p` across z_H, and the moves compare the motion with that part (a goal
-    in line with z_H then gets none). The heading is the mean of two straightnesses: the
-    orientation's, `1 - 2 theta_g / pi` (`theta_g` the angle from the hand's orientation
-    to g's), and where z_H points, `1 - 2 b_g / pi` (`b_g` the angle between z_H and
-    `g - p`: the position form's heading in 3-D). A turn's feature is
-    `(theta_g - theta'_g) / (|w| dt)`, `theta'_g` the angle after the turn: +1 wholly
-    toward g's orientation, -1 wholly away, 0 while `w = 0`."""
+    acting operator overrides (`overridden`). Without the `forward_key` the moves read the
+    part of `g - p` across the approach axis (the features: docs/concepts/goal-estimators.md,
+    "What each one reads")."""
     offsets = positions - position
     orientation = np.asarray(orientation, dtype=float)
     approach = approach_direction(orientation)

@@ -1,17 +1,8 @@
 """How an operator and a shared-control method worked together over one task, from the
 task's per-tick series (`InteractionMetrics` defines each metric): how much the operator
 gave, how well the hand did what it asked, how early and how often the method named the
-target. With the task monitor's `intervention_ratio`, `idle_ratio` is its complement on the
-same ticks.
-
-`InteractionMeter` takes the series whole or chunk by chunk (a streamed run);
-`interaction_metrics` is the same on whole arrays. The series are those of a task's time
-series, one row per control tick k, the command of tick k held until tick k + 1: `times`
-(T,) s; the operator's commanded translational velocity (T, 3) m/s, world frame, and its
-turning, (T,) rad/s (a yaw rate) or (T, 3) (an angular velocity); whether it acted (T,)
-bools; the hand's position (T, 3) m; the goal the method names (T,) object indices, -1 on
-a tick where it names none; the current target (T,) object indices.
-"""
+target. `InteractionMeter` takes the series whole or chunk by chunk (a streamed run);
+`interaction_metrics` is the same on whole arrays."""
 
 import dataclasses
 import math
@@ -31,27 +22,19 @@ def idle_ratio(intervention_ratio):
 
 @dataclasses.dataclass(frozen=True)
 class InteractionMetrics:
-    """The interaction metrics of one task.
+    """The interaction metrics of one task (each defined in docs/tasks/studies.md, "How the
+    operator and the method worked together").
 
-    - `input_integral` (m): the integral over the task of the operator's translational
-      command's norm while it acts, `sum_k active_k |v_k| control_period`;
-      `turn_input_integral` (rad) the same of its turning (the yaw rate's magnitude, or the
-      angular velocity's norm).
-    - `agreement`: over the ticks the operator acts, the mean cosine between its commanded
-      translational velocity `v_k` and the hand's executed one over that tick,
-      `(p_{k+1} - p_k) / control_period`: 1 when the hand goes where it pushes, -1 when
-      the opposite way. Ticks where either is slower than `STILL_SPEED`, and the last
-      tick (whose motion is not in the series), are left out; None when none is left.
-    - `prediction_accuracy`: the share of the ticks whose named goal is the current target
-      (a tick naming none counts as not naming it); None when no tick names a goal (a
-      method that shows no intent).
-    - `time_to_prediction` (s): for each target switch in order, the first target at the
-      first tick included (a switch: a tick whose target differs from the tick before's),
-      the time from the switch's tick to the first tick from which the named goal is the
-      new target on every tick up to the next switch or the end; None for a switch never
-      so named. None as a whole when no tick names a goal. `mean_time_to_prediction` is
-      its mean over the switches that got one, `unpredicted_switches` the count of the
-      others.
+    - `input_integral` (m): `sum_k active_k |v_k| control_period`; `turn_input_integral`
+      (rad) the same of its turning (the yaw rate's magnitude, or the angular velocity's).
+    - `agreement`: while the operator acts, the mean cosine between its commanded velocity
+      `v_k` and the hand's executed `(p_{k+1} - p_k) / control_period`, ticks where either
+      is slower than `STILL_SPEED` (and the last) left out; None when none is left.
+    - `prediction_accuracy`: the share of the ticks whose named goal is the current target;
+      None when no tick names a goal (a method that shows no intent).
+    - `time_to_prediction` (s): per target switch, the first target included, the time to
+      the first tick from which the named goal is the new target up to the next switch or
+      the end; None for a switch never so named, or as a whole when no tick names a goal.
     """
 
     input_integral: float
@@ -188,10 +171,11 @@ class InteractionMeter:
 def interaction_metrics(times, control_period, operator_velocity, operator_turn,
                         operator_active, hand_positions, predicted_goals, targets,
                         still_speed=STILL_SPEED):
-    """The `InteractionMetrics` of one task's whole series: `times` (T,) s, the operator's
-    translational command (T, 3) m/s and turning (T,) or (T, 3) rad/s, whether it acted
-    (T,), the hand's positions (T, 3) m, the named goal (T,) (-1: none) and the target
-    (T,), one row per control tick of `control_period` s."""
+    """The `InteractionMetrics` of one task's whole series, one row per control tick of
+    `control_period` s, the command of tick k held until tick k + 1: `times` (T,) s, the
+    operator's translational command (T, 3) m/s (world frame) and turning (T,) (a yaw
+    rate) or (T, 3) (an angular velocity) rad/s, whether it acted (T,), the hand's
+    positions (T, 3) m, the named goal (T,) (-1: none) and the target (T,)."""
     meter = InteractionMeter(control_period, still_speed)
     meter.add(times, operator_velocity, operator_turn, operator_active, hand_positions,
               predicted_goals, targets)

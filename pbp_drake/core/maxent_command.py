@@ -1,26 +1,10 @@
 """The ``maxent_command`` goal estimator's likelihood, in pure NumPy: HOP's maximum-entropy
 goal posterior (`pbp_drake.core.hindsight_optimization`) made for PBP's operator, who
-corrects, turns the hand to point at a goal, and otherwise lets the robot go on (why each
-term: docs/concepts/goal-estimators.md, "What each one reads"). Every control tick each
-goal g gains `l_g = l_move_g + l_turn_g`, then the belief is normalised and clipped as
-HOP's posterior:
-
-- **moves**: `l_move_g = V_g(x) - V_g(x + w dt)`, the drop of g's value
-  (`hindsight_optimization.target_values`) over one step of the cost model `dt` under the
-  implicit command `w`: the operator's command while it acts, the hand's own executed
-  velocity (and angular velocity) while it is silent. HOP's step cost `c(x)` is left out:
-  it does not depend on the command.
-- **turns** (the position tasks, whose goals have no orientation): with the heading error
-  `e_g = wrap(beta_g - psi)` and after the operator's yaw rate `r` for one step
-  `e'_g = wrap(e_g - r dt)`,
-
-      l_turn_g = (alpha + c0) s dt (|e_g| - |e'_g|) / |r dt|     (0 while r = 0),
-
-  `s` the task's nominal speed: a tick of turning toward a goal is worth a tick of moving
-  straight at it. A goal straight above or below the hand gains nothing from turns.
-
-The constants are HOP's published ones (the scenario's `hop` section) and `s`; none is
-fitted."""
+corrects, turns the hand to point at a goal, and otherwise lets the robot go on. Every
+control tick each goal g gains `l_g = l_move_g + l_turn_g` (`move_evidence`,
+`turn_evidence`), then the belief is normalised and clipped as HOP's posterior. The terms
+and why: docs/concepts/goal-estimators.md, "What each one reads"; the constants are HOP's
+(the scenario's `hop` section) and the task's nominal speed, none fitted."""
 
 import math
 import typing
@@ -47,17 +31,18 @@ class IntentEvidence(typing.NamedTuple):
 
 def move_evidence(settings, targets, position, velocity, orientation=None,
                   angular_velocity=None):
-    """`V_g(x) - V_g(x + w dt)` (K,): each goal's value dropped by one step of the cost
-    model under the implicit command `w` = (`velocity`, `angular_velocity`)."""
+    """`l_move_g = V_g(x) - V_g(x + w dt)` (K,): each goal's value dropped by one step of
+    the cost model under the implicit command `w` = (`velocity`, `angular_velocity`): the
+    operator's while it acts, the hand's own while it is silent."""
     now, after = target_values(settings, target_geometry(
         settings, targets, position, velocity, orientation, angular_velocity))
     return goal_minimum(now, targets)[0] - goal_minimum(after, targets)[0]
 
 
 def turn_evidence(settings, targets, position, heading, yaw_rate, speed):
-    """`(alpha + c0) s dt (|e_g| - |e'_g|) / |r dt|` (K,), the module docstring's turns,
-    for the hand's `heading` (rad), the operator's `yaw_rate` r (rad/s) and the operators'
-    `speed` s (m/s); zeros while r is 0."""
+    """`l_turn_g = (alpha + c0) s dt (|e_g| - |e'_g|) / |r dt|` (K,), `e_g` goal g's floor
+    bearing minus the hand's `heading` (rad), `e'_g` the same after the operator's
+    `yaw_rate` r (rad/s) for `dt`, `s` the nominal `speed` (m/s); zeros while r is 0."""
     position = np.asarray(position, dtype=float).reshape(-1)
     if position.shape != (3,) or not np.isfinite(position).all():
         raise ValueError(f"position must be 3 finite numbers, got {position.tolist()}")

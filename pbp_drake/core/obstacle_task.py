@@ -62,15 +62,10 @@ def sample_obstacle_scene(seed, x_range=(1.25, 2.5), y_range=(-1.05, 1.05), heig
 
 def step_obstacles(positions, intercepts, active, progress, robot_xy, target_xy, thresholds,
                    speed, dt):
-    """One control step of the obstacles; pure, returns new arrays.
-
-    Args:
-        positions: (N, 2) obstacle positions. intercepts: (N, 2) where each active one goes.
-        active: (N,) bools. progress: the robot's progress to the target in [0, 1].
-        robot_xy, target_xy: (2,) the robot's reference point and the target on the floor.
-    Returns:
-        (positions, intercepts, active).
-    """
+    """One control step of the obstacles `positions` (N, 2), each `active` (N,) one moving
+    to its intercept (N, 2), woken when the robot's `progress` (0 to 1) reaches its
+    threshold; `robot_xy`, `target_xy` (2,) on the floor. Pure: returns new
+    `(positions, intercepts, active)`."""
     positions = np.array(positions, dtype=float)
     intercepts = np.array(intercepts, dtype=float)
     active = np.array(active, dtype=bool)

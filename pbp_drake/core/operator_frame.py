@@ -2,19 +2,11 @@
 keys or sticks give (NumPy; `systems.twist_operator` reads them).
 
 The operator frame follows the hand's heading on the floor, as the person sees the robot:
-`forward` is horizontal, `left = up x forward`, and `up` is world +z.
-Translations go along these three axes. Rotations are the hand's yaw about world +z (as the
-4-DoF operators' Q/E), its pitch about `left` (positive tips the approach axis down) and its
-roll about its own approach axis z_H (right-handed, the grasp task's roll rho): a side grasp
-differs by a yaw, a top grasp is a pitch down then a roll (docs/tasks/grasp.md).
-
-The heading is the floor direction of z_H, blended towards that of x_H as z_H turns
-vertical (by the square of z_H's vertical component), with x_H signed to lean the way the
-hand was pitched: +x_H for a hand pointing down, -x_H for one pointing up (the HSR's start
-hand has x_H up: pitched down, x_H turns ahead). For a side grasp it is the approach's floor angle
-(the station's `heading`); it stays defined, and continuous, through a pitch straight down or up,
-where the ready hand pitched by +-90 degrees keeps world +x as forward.
-"""
+`forward` is horizontal, `left = up x forward`, and `up` is world +z. Translations go along
+these three axes. Rotations are the hand's yaw about world +z (as the 4-DoF operators' Q/E),
+its pitch about `left` (positive tips the approach axis down) and its roll about its own
+approach axis z_H (the grasp task's roll rho): a side grasp differs by a yaw, a top grasp is
+a pitch down then a roll (docs/tasks/grasp.md)."""
 
 import numpy as np
 
@@ -35,11 +27,13 @@ def hand_axes(orientation):
 
 def operator_frame(orientation):
     """`(forward, left, up)` world unit vectors (3,) of the operator frame of a hand at
-    `orientation` (see the module's docstring)."""
+    `orientation`. The heading is the floor direction of z_H, blended towards that of x_H
+    by the square of z_H's vertical component, with x_H signed to lean the way the hand was
+    pitched (+x_H pointing down, -x_H up: the HSR's start hand, x_H up, pitched down turns
+    x_H ahead). For a side grasp it is the approach's floor angle (the station's
+    `heading`); it stays continuous through a pitch straight down or up."""
     axes = hand_axes(orientation)
     approach = axes[:, 2]
-    # x_H lies along the pitch's plane; approach_z * |approach_z| both weighs it in as z_H
-    # turns vertical and signs it to lean forward (a pitch down turns x_H ahead).
     blend = approach - approach[2] * abs(approach[2]) * axes[:, 0]
     heading = np.array([blend[0], blend[1], 0.0])
     norm = np.linalg.norm(heading)

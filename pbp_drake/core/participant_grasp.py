@@ -1,29 +1,11 @@
 """The virtual participant of the grasping task, in pure NumPy: the reach participant's
-honest rules (`pbp_drake.core.participant_reach`) with the hand's orientation; its
-behaviour in full is docs/tasks/grasp.md, "The virtual participant".
-
-It sees the true target and notices a new one `reaction_delay` seconds after it appears
-(`notice_target`); it is never told the method. It acts by the reach participant's one
-rule (`pbp_drake.core.participant_serving`) and commands a world-frame twist
-`[v (3), omega (3)]` (m/s, rad/s) with the keys the method enables (`forward_key`):
-
-- with the forward key: the whole twist toward the target's grasp pose (`drive_twist`):
-  `v` at `speed`, slowing within `slow_radius`, `omega` about the axis of
-  `Log(q_target q*)` at `rotation_speed`, in proportion within `slow_angle`, none within
-  `aligned_angle`;
-- without it, while the shown intent names another object ("picked"): it turns toward
-  the target's grasp orientation and moves along `u_target - u_picked` (`assist_twist`),
-  any forward part along the approach axis z_H removed (`without_forward`); with the
-  intent on the target but the robot too slow, what is left of driving there without the
-  forward key, or it waits when that is little;
-- once it has held the target's grasp orientation (within twice `aligned_angle`) for
-  `insist_time` while the estimate names another object, it goes to the target itself as
-  far as the keys allow (`insist_twist`), until a new target appears.
-
-Its commands carry noise drawn from `(seed, tick)` (`command_noise`) and, with an
-`impairment` (`pbp_drake.core.participant_impairment`), the reach participant's motor
-noise, mistakes and delay. Everything is a pure function of its arguments; what it
-remembers (`ParticipantMemory`) is passed in and returned."""
+honest rules (`pbp_drake.core.participant_reach`, `participant_serving`) with the hand's
+orientation. It commands a world-frame twist `[v (3), omega (3)]` (m/s, rad/s): toward the
+target's grasp pose with the forward key (`drive_twist`), else turning toward it and
+moving along `u_target - u_picked` or insisting (`assist_twist`), never
+forward (`without_forward`). Everything is a pure function of its arguments; what it
+remembers (`ParticipantMemory`) is passed in and returned. Its behaviour in full:
+docs/tasks/grasp.md, "The virtual participant"."""
 
 import copy
 import dataclasses
@@ -56,11 +38,10 @@ SHARED_WITH_REACH = {
 
 @dataclasses.dataclass
 class GraspParticipantParams:
-    """How the grasping task's virtual participant behaves (module docstring). Every field
-    is one it shares with the reach participant (`SHARED_WITH_REACH`) and takes its
-    calibrated default from `VirtualParticipantParams`;
-    `from_virtual_participant` takes them from a scenario's
-    `operator: !VirtualParticipant {...}`."""
+    """How the grasping task's virtual participant behaves. Every field is one it shares
+    with the reach participant (`SHARED_WITH_REACH`), whose calibrated default it takes;
+    `insist_time`, `hold_time`, `serve_speed_fraction`, `serve_patience` and `impairment`
+    mean what `VirtualParticipantParams`' do."""
 
     #: Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = _REACH_DEFAULTS.speed
@@ -74,23 +55,15 @@ class GraspParticipantParams:
     speed_noise: float = _REACH_DEFAULTS.speed_noise
     #: It slows in proportion within this distance (m) of the grasp position.
     slow_radius: float = _REACH_DEFAULTS.slow_radius
-    #: It turns in proportion within this angle (rad) of the grasp orientation, so that it
-    #: does not overshoot (the reach participant's `turn_slowdown_angle`) ...
+    #: It turns in proportion within this angle (rad) of the grasp orientation (the reach
+    #: participant's `turn_slowdown_angle`) ...
     slow_angle: float = _REACH_DEFAULTS.turn_slowdown_angle
     #: ... and stops turning within this angle (rad): well inside the task's 10 degrees.
     aligned_angle: float = _REACH_DEFAULTS.aligned_angle
-    #: Assisting, once it has held the target's orientation this long (s) and the estimate
-    #: still names another object, it goes to the target itself (`insist_twist`).
     insist_time: float = _REACH_DEFAULTS.insist_time
-    #: Having taken over from a robot that did not serve its target, it keeps control at
-    #: least this long (s).
     hold_time: float = _REACH_DEFAULTS.hold_time
-    #: It lets the robot go while the hand closes in on the grasp position at this fraction
-    #: of its own preferred speed there or more (`participant_serving`).
     serve_speed_fraction: float = _REACH_DEFAULTS.serve_speed_fraction
-    #: It watches a robot that does not serve its target this long (s) before it takes over.
     serve_patience: float = _REACH_DEFAULTS.serve_patience
-    #: How it is impaired (`ParticipantImpairment`; the defaults: not at all).
     impairment: ParticipantImpairment = dataclasses.field(
         default_factory=ParticipantImpairment)
 
@@ -122,7 +95,7 @@ class ParticipantMemory(typing.NamedTuple):
     """What it remembers between ticks: the target it acts on (`NO_TARGET` before the
     first is noticed), the newest target it has seen and since when (s), since when (s,
     -1: not) it has held the known target's orientation while the estimate named another
-    object, and whether it insists (`insist_twist`); with an impairment's mistakes, how
+    object, and whether it insists; with an impairment's mistakes, how
     many targets it has come to know, the object it heads for instead of the known target
     (`NO_TARGET`: none) and until when (s)."""
 
@@ -183,14 +156,13 @@ def heads_for(memory, time):
 
 
 def count_insistence(params, memory, time, orientation, target_orientation, selected,
-                     target=None):
+                     target):
     """The memory after a tick in which the estimate names `selected`: it starts insisting
-    once it has held the orientation of the object it heads for (`target`, by default the
-    known target; within twice `aligned_angle`, as noise moves it) for `insist_time` while
-    `selected` was another object."""
+    once it has held the orientation of the object it heads for (`target`; within twice
+    `aligned_angle`, as noise moves it) for `insist_time` while `selected` was another
+    object (then `assist_twist` without `picked_position`)."""
     if memory.insisting:
         return memory
-    target = memory.known_target if target is None else target
     if selected == target or angle_between(
             orientation, target_orientation) > 2 * params.aligned_angle:
         return memory._replace(facing_since=-1.0)
@@ -218,7 +190,8 @@ def turn_toward(params, orientation, goal_orientation):
 
 
 def drive_twist(params, speed, position, orientation, grasp_position, grasp_orientation):
-    """Teleop: `(v (3), omega (3))` toward the grasp pose (module docstring)."""
+    """Teleop: `(v (3), omega (3))` toward the grasp pose, `v` at `speed` slowing within
+    `slow_radius`, `omega` as `turn_toward`."""
     offset = np.asarray(grasp_position, float) - position
     distance = float(np.linalg.norm(offset))
     velocity = (np.zeros(3) if distance < 1e-9
@@ -227,23 +200,16 @@ def drive_twist(params, speed, position, orientation, grasp_position, grasp_orie
 
 
 def assist_twist(params, speed, position, orientation, target_position, target_orientation,
-                 picked_position):
-    """Assisting while the estimate names `picked`: `(v (3), omega (3))`, `v` along
-    `u_target - u_picked` without a forward part, `omega` toward the target's grasp
-    orientation."""
+                 picked_position=None):
+    """`(v (3), omega (3))` without the forward key: `omega` toward the target's grasp
+    orientation, `v` without a forward part, slowing within `slow_radius`, along
+    `u_target - u_picked` while the estimate names `picked_position`, or toward the target's
+    grasp position when it is None (insisting)."""
     offset = np.asarray(target_position, float) - position
-    apart = unit(offset) - unit(np.asarray(picked_position, float) - position)
+    direction = offset if picked_position is None else (
+        unit(offset) - unit(np.asarray(picked_position, float) - position))
     slow = min(1.0, float(np.linalg.norm(offset)) / params.slow_radius)
-    velocity = speed * slow * without_forward(unit(apart), orientation)
-    return velocity, turn_toward(params, orientation, target_orientation)
-
-
-def insist_twist(params, speed, position, orientation, target_position, target_orientation):
-    """Insisting: `(v (3), omega (3))`, `v` toward the target's grasp position without a
-    forward part, slowing within `slow_radius`, `omega` holding the grasp orientation."""
-    offset = np.asarray(target_position, float) - position
-    slow = min(1.0, float(np.linalg.norm(offset)) / params.slow_radius)
-    velocity = speed * slow * without_forward(unit(offset), orientation)
+    velocity = speed * slow * without_forward(unit(direction), orientation)
     return velocity, turn_toward(params, orientation, target_orientation)
 
 
@@ -344,15 +310,10 @@ class GraspParticipant:
         if not act:
             return idle, False, memory, serving
         if not forward_key and shown not in (NO_INTENT, target):
-            if memory.insisting:
-                velocity, angular = insist_twist(
-                    self.params, self.speed, position, orientation,
-                    self.grasp_positions[target], self.grasp_orientations[target])
-            else:
-                velocity, angular = assist_twist(
-                    self.params, self.speed, position, orientation,
-                    self.grasp_positions[target], self.grasp_orientations[target],
-                    self.grasp_positions[shown])
+            picked = None if memory.insisting else self.grasp_positions[shown]
+            velocity, angular = assist_twist(
+                self.params, self.speed, position, orientation, self.grasp_positions[target],
+                self.grasp_orientations[target], picked)
         else:
             velocity, angular = drive_twist(
                 self.params, self.speed, position, orientation, self.grasp_positions[target],

@@ -1,25 +1,10 @@
-"""Impairments of the virtual participant, in pure NumPy: a person who is noisy, late or
-mistaken. `ParticipantImpairment` is the scenario's `operator: !VirtualParticipant
+"""Impairments of the virtual participant, in pure NumPy: a person who is noisy
+(`next_motor_noise`), late (`delay_ticks`; the systems keep the queue) or mistaken
+(`first_choice`). `ParticipantImpairment` is the scenario's `operator: !VirtualParticipant
 {impairment: {...}}`; `PARTICIPANT_CONDITIONS` are the named levels that `pbp-drake study
---participant-condition` applies.
-
-The calibrated participant (`VirtualParticipantParams`) has none of them: the defaults
-change nothing. Everything random here is drawn from the run's seed, never from
-what the robot does, so one seed gives the same noise and the same mistakes under every
-method:
-
-- noisy: motor noise on its commands, `command_noise` times its speed on each axis of its
-  velocity (and times its `rotation_speed` on each axis of its turn), a Gauss-Markov
-  (Ornstein-Uhlenbeck) process of correlation time `command_noise_time` that runs
-  whether it acts or not, and is added only while it acts (`next_motor_noise`);
-- late: its commands reach the robot `command_delay` seconds after it decided them, so
-  it steers by what it saw that long ago, and reacts to a new target that much later
-  than its `reaction_delay` (`delay_ticks`; the systems keep the queue);
-- mistaken: each time it comes to know a target, it first heads for another object with
-  probability `mistake_probability`, and turns to the true target `mistake_time` seconds
-  later (`first_choice`). With a single object (the obstacle task) there is nothing to
-  mistake it for.
-"""
+--participant-condition` applies. The defaults change nothing. Everything random is drawn
+from the run's seed, never from what the robot does, so one seed gives the same noise and
+the same mistakes under every method (docs/results/impaired.md)."""
 
 import dataclasses
 import math
@@ -39,18 +24,17 @@ LONGEST_COMMAND_DELAY = 10.0
 
 @dataclasses.dataclass
 class ParticipantImpairment:
-    """How the virtual participant is impaired (module docstring). The defaults: not at
-    all."""
+    """How the virtual participant is impaired. The defaults: not at all."""
 
     #: Its motor noise (a fraction): a zero-mean Gaussian added to each axis of the velocity
-    #: it commands, of standard deviation `command_noise` times its speed (m/s), and to each
-    #: axis of its turn rate, times its `rotation_speed`; 0: none.
+    #: it commands while it acts, of standard deviation `command_noise` times its speed
+    #: (m/s), and to each axis of its turn rate, times its `rotation_speed`; 0: none.
     command_noise: float = 0.0
     #: The motor noise's correlation time (s): it keeps its value about this long (an
     #: Ornstein-Uhlenbeck process); 0: a fresh draw every control tick.
     command_noise_time: float = 0.5
     #: Its commands reach the robot this long (s) after it decided them, rounded to whole
-    #: control ticks; 0: at once.
+    #: control ticks, so it also reacts that much later; 0: at once.
     command_delay: float = 0.0
     #: The probability (0 to 1) that, each time it comes to know a target, it first heads
     #: for another object (each of the others as likely), drawn from the seed.
@@ -113,11 +97,6 @@ def is_noisy(impairment):
     return impairment.command_noise > 0.0
 
 
-def _standard_normals(seed, tick, size):
-    rng = np.random.default_rng([int(seed), int(tick), MOTOR_NOISE_STREAM])
-    return rng.standard_normal(size)
-
-
 def initial_motor_noise(seed, scales):
     """The motor noise before the first tick: a draw from its stationary distribution (each
     axis N(0, scale^2)), so the run is as noisy from its start as later on."""
@@ -135,8 +114,9 @@ def next_motor_noise(impairment, control_period, seed, tick, previous, scales):
     time_constant = impairment.command_noise_time
     keep = math.exp(-control_period / time_constant) if time_constant > 0 else 0.0
     fresh = math.sqrt(1.0 - keep * keep)
-    return keep * np.asarray(previous, float) + fresh * scales * _standard_normals(
-        seed, tick, len(scales))
+    rng = np.random.default_rng([int(seed), int(tick), MOTOR_NOISE_STREAM])
+    return keep * np.asarray(previous, float) + fresh * scales * rng.standard_normal(
+        len(scales))
 
 
 def first_choice(impairment, seed, number, target, object_count):

@@ -1,7 +1,6 @@
 """The virtual participant's parameters: the scenario's `operator: !VirtualParticipant {...}`
-fields (`pbp_drake.scenarios.schema.VirtualParticipant` adds none). Pure data: the reach
-participant (`pbp_drake.systems.operators.virtual_operator`) reads them, and the grasp participant
-(`pbp_drake.core.participant_grasp`) takes the defaults of the fields it shares from them."""
+fields, read by the reach participant (`pbp_drake.systems.operators.virtual_operator`); the
+grasp participant (`pbp_drake.core.participant_grasp`) takes the defaults it shares."""
 
 import dataclasses
 
@@ -10,13 +9,9 @@ from pbp_drake.core.participant_impairment import ParticipantImpairment
 
 @dataclasses.dataclass
 class VirtualParticipantParams:
-    """How the virtual participant behaves (see the `VirtualOperator` system). Its noise comes
-    from the scenario's seed.
-
-    The defaults are the reach task's calibration: teleop only, on the tuning
-    seeds, to the paper's users' teleop intervention ratio (0.92 to 0.95). Its
-    `impairment` (none by default) makes it noisy, late or mistaken.
-    """
+    """How the virtual participant behaves (see the `VirtualOperator` system); its noise comes
+    from the scenario's seed. The defaults are the reach task's calibration: teleop only, on
+    the tuning seeds, to the paper's users' teleop intervention ratio (0.92 to 0.95)."""
 
     #: Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = 0.0
@@ -37,16 +32,14 @@ class VirtualParticipantParams:
     #: It turns at `rotation_speed` until the heading is this close (rad) to where it wants
     #: it, then in proportion, so that it does not overshoot.
     turn_slowdown_angle: float = 0.3
-    #: Assisting, it takes the target and the object picked instead to stand in line when
-    #: their directions from the hand are closer than this (rad): no sidestep toward the
-    #: target separates them then, so it steps aside, at `aside_speed_fraction` of `speed`,
-    #: to the side that widens the angle between them.
+    #: Assisting, the target and the object picked instead stand in line when their
+    #: directions from the hand are closer than this (rad): it then steps aside, to the side
+    #: that widens the angle between them.
     in_line_angle: float = 0.1
     #: The speed of its sidestep out of line, as a fraction of `speed`.
     aside_speed_fraction: float = 0.5
     #: Assisting, once it has faced the target this long (s) and the estimate still names
-    #: another object, it goes to the target itself: it turns the target to its side and
-    #: sidesteps toward it (the forward key is disabled), until the estimate follows.
+    #: another object, it turns the target to its side and sidesteps to it itself.
     insist_time: float = 1.0
     #: Assisting with a bounded wrist or keys that move the hand up and down, it moves the
     #: hand to where the tool can point at the target (`reposition_motion`) at most this
@@ -89,12 +82,11 @@ class VirtualParticipantParams:
     #: The fastest it turns (rad/s) while planning among obstacles (`rotation_speed` if
     #: lower), and the turn rate its plan's turning score is measured against.
     max_turn_rate: float = 0.5
-    #: The plan's score of a motion: progress to the target (1 at `speed`), plus
-    #: `turn_weight` times how far it turns toward the heading it wants (1 at
-    #: `max_turn_rate` over the horizon), plus `keep_on_weight` times how well it keeps on
-    #: with its last command (1 the same direction); both weights are plain factors.
+    #: The plan's weight (a factor) of turning toward the heading it wants (1 at
+    #: `max_turn_rate` over the horizon) against progress to the target (1 at `speed`).
     turn_weight: float = 0.6
-    #: The plan's weight of keeping on with its last command (a factor).
+    #: The plan's weight (a factor) of keeping on with its last command (1 the same
+    #: direction).
     keep_on_weight: float = 0.15
     #: Where the robot shows its intent, holding control it lets go once the robot's path
     #: (the straight line the shown path pulls back to) is clear of the obstacles by
@@ -113,11 +105,11 @@ class VirtualParticipantParams:
     #: asks for the motion it wants minus the robot's own, at most this many times `speed`
     #: (a factor).
     policy_compensation: float = 3.0
-    #: Its way round has stalled (`participant_avoidance`) once it has not come
-    #: `progress_step` (m) closer to the target for `stall_time` (s): it then pushes on
-    #: through until it arrives. 4 s is how long the moving cylinders take to settle.
+    #: Its way round has stalled (`participant_avoidance`) once it has not come this much
+    #: (m) closer to the target for `stall_time`.
     progress_step: float = 0.02
-    #: Not `progress_step` closer for this long (s), it has stalled and pushes on through.
+    #: Not `progress_step` closer for this long (s), it has stalled and pushes on through
+    #: until it arrives (4 s: how long the moving cylinders take to settle).
     stall_time: float = 4.0
     #: In the last `final_approach_radius` (PBP) it leaves the robot alone only while the
     #: hand closes in on the target at this fraction of the nominal speed or more.

@@ -1,25 +1,11 @@
-"""What the virtual participant does in the reaching task, in pure NumPy (the system,
-`pbp_drake.systems.operators.virtual_operator`, adds the belief, the noise and the timing;
-the behaviour in full: docs/tasks/reach.md, "The virtual participant").
-
-Assisting (PBP, arbitration) with the forward key disabled, a person shows the goal they
-mean with what the keys still allow. `assist_motion` serves every shipped estimator with
-one behaviour: it turns to face the target (what ``angle`` reads) and moves along
-`u_target - u_picked`, the unit direction to the target minus that to the object picked
-instead, its forward part removed: the gradient of `|p - target| - |p - picked|`, what
-``nearest`` and ``bayesian`` compare. When the two stand in line it steps aside; once it
-has faced the target for `insist_time` and the estimate still names another object, it
-goes to the target itself as far as the keys allow.
-
-Where turning cannot show the target (an arm's wrist turns the tool only so far:
-`can_point_at`), it first moves the hand to where it can (`reposition_motion`). The HSR's
-base turns all the way round, so there nothing differs.
-
-With `vertical=True` (objects at different heights, keys that move the hand up and down)
-the velocities are `(vx, vy, vz)` instead of floor 2-vectors: driving heads for the target
-in 3-D; assisting moves only on the floor (the DMP takes the hand to the goal's height),
-but when insisting. Horizontal and vertical motion combine into one speed, at most
-`speed`."""
+"""What the virtual participant does in the reaching task, in pure NumPy: with the forward
+key it drives to the target (`drive_motion`); without it, it shows the target with what the
+keys still allow (`assist_motion`: it turns to face it and moves along
+`u_target - u_picked`, steps aside, or insists), first moving the hand to where the tool
+can point at it (`reposition_motion`). With `vertical=True` the velocities are
+`(vx, vy, vz)` instead of floor 2-vectors. The system
+(`pbp_drake.systems.operators.virtual_operator`) adds the belief, the noise and the timing;
+the behaviour in full: docs/tasks/reach.md, "The virtual participant"."""
 
 import numpy as np
 
@@ -81,25 +67,18 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
     velocity it returns points forward (`without_forward`).
 
     `vertical`: the velocity is `(vx, vy, vz)` (3): vz = 0 and the floor part as without
-    it, but when `insisting` (`insisting_motion_3d`). `heading_range` (low, high), an
-    arm's wrist (None: all the way round), bounds the heading an insisting participant
-    turns to (`insisting_side_heading`)."""
+    it, but when `insisting` (`insisting_motion`). `heading_range` (low, high), an arm's
+    wrist (None: all the way round), bounds the heading an insisting participant turns to
+    (`insisting_side_heading`)."""
+    if insisting:
+        return insisting_motion(params, speed, position, heading, target, heading_range,
+                                vertical)
     if vertical:
-        if insisting:
-            return insisting_motion_3d(params, speed, position, heading, target,
-                                       heading_range)
         velocity, yaw_rate = assist_motion(params, speed, position, heading, target, picked,
                                            insisting)
         return np.array([velocity[0], velocity[1], 0.0]), yaw_rate
-    offset = target[:2] - position[:2]
-    distance = np.linalg.norm(offset)
-    toward_target = unit(offset)
+    toward_target = unit(target[:2] - position[:2])
     toward_picked = unit(picked[:2] - position[:2])
-    if insisting:
-        wanted_heading = insisting_side_heading(heading, position, target, heading_range)
-        slow = min(1.0, distance / params.slow_radius)
-        velocity = speed * slow * without_forward(toward_target, heading)
-        return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
     separation = np.arccos(np.clip(toward_target @ toward_picked, -1.0, 1.0))
     if separation < params.in_line_angle:
         left = rotate_planar([0.0, 1.0], heading)
@@ -111,11 +90,9 @@ def assist_motion(params, speed, position, heading, target, picked, insisting,
 
 
 def _pointing_blocked(params, offset, heading_range, vertical):
-    """`(beyond, over)` for a target at `offset` (3) from the hand: its floor direction lies
-    beyond `heading_range` (low, high) (None: all the way round), give or take
-    `aligned_angle`; with `vertical` motion, it stands more above or below the hand than
-    beside it (straight above, its floor direction is no direction at all: the least
-    motion swings it). With either, turning the tool cannot point it at the target."""
+    """`(beyond, over)`, the two reasons `can_point_at` is false for a target at `offset` (3)
+    (straight above, its floor direction is no direction at all: the least motion swings
+    it)."""
     over = vertical and np.linalg.norm(offset[:2]) < abs(offset[2])
     if heading_range is None:
         return False, over
@@ -178,48 +155,35 @@ def insisting_side_heading(heading, position, target, heading_range=None):
     return wanted
 
 
-def insisting_motion_3d(params, speed, position, heading, target, heading_range=None):
-    """`assist_motion` insisting, with vertical motion: the velocity (3) toward the target
-    in 3-D as far as the keys allow (its floor part `without_forward`), at `speed` slowing
-    within `slow_radius` of the 3-D distance, so at most `speed` in all; the yaw rate turns
-    the target to its side as without vertical motion (none with the target straight above
-    or below)."""
-    offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
-    distance = np.linalg.norm(offset)
+def insisting_motion(params, speed, position, heading, target, heading_range=None,
+                     vertical=False):
+    """`assist_motion` insisting: the velocity (2, or 3 with `vertical`) toward the target
+    as far as the keys allow (its floor part `without_forward`), at `speed` slowing within
+    `slow_radius`, so at most `speed` in all; the yaw rate turns the target to its side
+    (`insisting_side_heading`; none with the target straight above or below)."""
+    size = 3 if vertical else 2
+    offset = np.asarray(target, float)[:size] - np.asarray(position, float)[:size]
     toward_target = unit(offset)
-    slow = min(1.0, distance / params.slow_radius)
+    slow = min(1.0, np.linalg.norm(offset) / params.slow_radius)
     floor = without_forward(toward_target[:2], heading)
-    velocity = speed * slow * np.array([floor[0], floor[1], toward_target[2]])
-    if np.linalg.norm(offset[:2]) < 1e-9:
-        return velocity, 0.0  # straight above or below: no side to turn it to
+    velocity = speed * slow * np.concatenate([floor, toward_target[2:]])
+    if vertical and np.linalg.norm(offset[:2]) < 1e-9:
+        return velocity, 0.0
     wanted_heading = insisting_side_heading(heading, position, target, heading_range)
     return velocity, turn_rate(params, float(wrap_angle(wanted_heading - heading)))
 
 
 def drive_motion(params, speed, position, heading, target, vertical=False):
     """Teleop: the floor velocity (2) toward the target at `speed`, slowing within
-    `slow_radius`, and the yaw rate that turns the hand to face it.
-
-    `vertical`: the velocity (3) toward the target in 3-D (`drive_motion_3d`)."""
-    if vertical:
-        return drive_motion_3d(params, speed, position, heading, target)
-    offset = target[:2] - position[:2]
+    `slow_radius`, and the yaw rate that turns the hand to face it. `vertical`: the
+    velocity (3) toward the target in 3-D, `slow_radius` on the 3-D distance, and no turn
+    with the target straight above or below."""
+    size = 3 if vertical else 2
+    offset = np.asarray(target, float)[:size] - np.asarray(position, float)[:size]
     distance = np.linalg.norm(offset)
     if distance < 1e-9:
-        return np.zeros(2), 0.0
+        return np.zeros(size), 0.0
     velocity = speed * min(1.0, distance / params.slow_radius) * offset / distance
-    return velocity, turn_rate(params, heading_error(heading, position, target))
-
-
-def drive_motion_3d(params, speed, position, heading, target):
-    """Teleop with vertical motion: the velocity (3) along the 3-D unit offset to the
-    target at `speed * min(1, d / slow_radius)` (`d` the 3-D distance), and the yaw rate
-    that turns the hand to face it (none with the target straight above or below)."""
-    offset = np.asarray(target, float)[:3] - np.asarray(position, float)[:3]
-    distance = np.linalg.norm(offset)
-    if distance < 1e-9:
-        return np.zeros(3), 0.0
-    velocity = speed * min(1.0, distance / params.slow_radius) * offset / distance
-    if np.linalg.norm(offset[:2]) < 1e-9:
+    if vertical and np.linalg.norm(offset[:2]) < 1e-9:
         return velocity, 0.0
     return velocity, turn_rate(params, heading_error(heading, position, target))

@@ -1,28 +1,10 @@
-"""When the virtual participant acts, in pure NumPy: one rule under every method.
-
-A person at the page is not told the method. They see the scene and their target, the
-hand's pose and motion, and, where the method shows one, the robot's intent (the blue ball
-over the object it thinks they mean, and its path). Each tick the participant asks the
-same question: does the robot's motion serve my target? It lets go while it does and acts
-while it does not (`serving_step`):
-
-- **The shown intent names another object**: it acts at once (the robot says it is going
-  elsewhere).
-- **Hands off**: the robot serves while the hand closes in on the target at no less than
-  `serve_speed_fraction` of the participant's own preferred speed there (`robot_serves`:
-  its speed, slowing within `slow_radius` as its own driving does). Not served for
-  `serve_patience` (seeing that the robot does nothing useful takes a moment), it takes
-  over and keeps control `hold_time` at least before it looks again.
-- **Acting**: it lets go once the robot shows its intent on the target, or, where the
-  method shows none, once the robot's own motion (what the hand does beyond what the
-  participant asked of it, `OwnMotion`) would serve the target by the same test.
-
-Teleop's robot never moves by itself and shows no intent, so there it always acts once
-`serve_patience` has passed: the calibration case. Which keys it presses when it acts is
-the keys': with the forward key (teleop and the baselines that add to a full command) it
-drives to the target; without it (PBP) it shows the target by turning and sidestepping
-(`pbp_drake.core.participant_reach`). No method name reaches this module.
-"""
+"""When the virtual participant acts, in pure NumPy: one rule under every method, whose
+name never reaches this module. Each tick it asks whether the robot serves its target,
+lets go while it does and acts while it does not (`serving_step`): at once when the shown
+intent names another object; after `serve_patience` of a hand that does not close in at
+`serve_speed_fraction` of its own preferred speed (`robot_serves`), then for `hold_time` at
+least. Which keys it presses is `pbp_drake.core.participant_reach`'s. The rule in full:
+docs/tasks/reach.md, "The virtual participant"."""
 
 import dataclasses
 

@@ -1,20 +1,9 @@
 """A population of virtual participants, one drawn for each trial from its seed, in pure
 NumPy: after Backman, Kulić and Chung (2023), whose simulated users are sampled over four
-parameters, conformance to the assistant, proficiency, aggressiveness and speed. Their
-equations and ranges could not be read here: the maps and ranges below are ours, each
-spanning the calibrated participant's value (docs/concepts/pilots.md says why each).
-
-Each trial draws one level in [0, 1] per parameter (`population_levels`, from the seed
-alone), and each field of the participant takes the point of its range at its parameter's
-level, low to high where the parameter raises it and high to low where it lowers it
-(`LEVEL_RAISES`):
-
-- conformance (how readily it lets the robot go): a longer `serve_patience` and a lower
-  `serve_speed_fraction`;
-- proficiency: less `direction_noise` and `speed_noise`, a shorter `reaction_delay`;
-- aggressiveness: a shorter `insist_time`, a faster `rotation_speed`;
-- speed: a larger `speed_factor` on the operator's speed.
-"""
+parameters, conformance to the assistant, proficiency, aggressiveness and speed. Each trial
+draws one level in [0, 1) per parameter (`population_levels`), and each field takes the
+point of its range at its parameter's level (`LEVEL_RAISES`). The maps and ranges are ours,
+each spanning the calibrated participant's value (docs/concepts/pilots.md says why)."""
 
 import dataclasses
 
@@ -41,7 +30,7 @@ LEVEL_RAISES = {
 @dataclasses.dataclass
 class ParticipantPopulationParams:
     """Each trial's participant drawn from the trial's seed: `participant`'s fields, but
-    those below, each drawn in its range `[low, high]` (module docstring)."""
+    those below, each drawn in its range `[low, high]` (`drawn_values`)."""
 
     #: The participant the draws start from (its other fields are kept).
     participant: VirtualParticipantParams = dataclasses.field(

@@ -1,14 +1,10 @@
 """Six-DoF blending: the operator's twist and the policy's pose reference become one pose
-reference, and the six-DoF hand-over law (the laws' table and why they take these forms:
-docs/concepts/six-dof.md, "The blending laws").
-
-A pose reference is the pose to be at after one control period and the twist to move at
-(`PoseReference`), velocities in the world frame. Over one period `dt` the operator's
-twist `u = (u_v, u_w)` alone would take the hand from `(y, q_y)` to
-`U = (y + u_v dt, Exp(u_w dt) q_y)`. The laws are the position ones
-(`pbp_drake.core.arbitration`) with the orientation on SO(3): angular velocities add and
-mix as vectors; orientations are turned by `Exp` or mixed by `quaternion.slerp`, never as
-vectors nor as angles; ``pbp_no_user`` is the policy alone."""
+reference (`PoseReference`), and the six-DoF hand-over law. The laws are the position ones
+(`pbp_drake.core.arbitration`) with the orientation on SO(3): over one period `dt` the
+operator's twist `u = (u_v, u_w)` alone takes the hand to `U = (y + u_v dt, Exp(u_w dt) q)`;
+angular velocities add and mix as vectors, orientations are turned by `Exp` or mixed by
+`quaternion.slerp`; ``pbp_no_user`` is the policy alone. The table and why:
+docs/concepts/six-dof.md, "The blending laws"."""
 
 from typing import NamedTuple
 
@@ -122,15 +118,11 @@ POSE_BLEND_MODES = tuple(POSE_BLEND_LAWS)
 def pose_hand_over(previous_velocity, previous_angular_velocity, reference, limits, dt):
     """The command `PoseReference` of one tick under the six-DoF hand-over law.
 
-    Linear part: `pbp_drake.core.hand_over.hand_over`. Angular part, the same velocity law
-    (`limited_velocity`) with the angular limits, and the orientation turned by the angular
-    velocity not yet reached over one period, as the position is shifted:
-
-        w'_k = w'_{k-1} + clip(cap(w_k) - w'_{k-1}, alpha_max dt),
-        q'_k = Exp((w'_k - w_k) dt) q_k.
-
-    `limits` is a checked `HandOverLimits`; the previous velocities are the command's of
-    the tick before. New arrays."""
+    Linear part: `pbp_drake.core.hand_over.hand_over`; angular part, the same velocity law
+    with the angular limits, and the orientation turned by the angular velocity not yet
+    reached, `q'_k = Exp((w'_k - w_k) dt) q_k`, as the position is shifted. `limits` is a
+    checked `HandOverLimits`; the previous velocities are the command's of the tick before.
+    New arrays."""
     velocity = limited_velocity(previous_velocity, reference.velocity,
                                 limits.max_acceleration * dt, limits.max_speed)
     angular = limited_velocity(previous_angular_velocity, reference.angular_velocity,

@@ -1,31 +1,13 @@
 """Unit quaternions for orientations, vectorised: product, conjugate, log and exp maps,
-slerp, the hemisphere choice, and the Jacobian of the exp map.
+slerp, the hemisphere choice, and the left Jacobian of SO(3).
 
 Convention (the whole package keeps it): a quaternion is `(w, x, y, z)`, scalar first, with
 Hamilton's product; `q` rotates a vector `p` as `q (0, p) q*`, so it maps body to world.
 The functions take the quaternion on the FIRST axis, `(4, ...)` (and rotation vectors as
 `(3, ...)`), so that a bank lays K orientations out `(4, K)` as the position bank lays out
 `(D, K)`; one quaternion is `(4,)`. Users give quaternions as rows `(..., 4)`
-(`unit_quaternions` checks them).
-
-`q` and `-q` are the same orientation. `log_map` first moves `q` to the hemisphere `w >= 0`
-(`canonical`; exactly `w = 0`, a rotation by 180 degrees, is settled on `x`, then `y`,
-then `z`, so that `q` and `-q` give the same, bit for bit), so everything built on it is
-the same for both.
-
-The log and exp maps are between unit quaternions and rotation vectors (angle times unit
-axis, the full angle: twice the quaternion logarithm), so that their units are radians of
-rotation, `|log_map(q)| <= pi`, and `exp_map(r) = (cos(|r|/2), sin(|r|/2) r/|r|)`.
-
-`R(t) = Exp(r(t))` turns at the world-frame angular velocity `omega = J(r) dr/dt`, with the
-left Jacobian of SO(3) (`left_jacobian_times`)
-
-    J(r) v = v + a(t) r x v + b(t) r x (r x v),   a = (1 - cos t)/t^2, b = (t - sin t)/t^3,
-    J(r)^-1 v = v - r x v / 2 + c(t) r x (r x v),  c = (1 - (t/2) cot(t/2)) / t^2,
-
-`t = |r|`; `J` is invertible for `t < 2 pi`. Short series replace `b` and `c` below
-`SERIES_BELOW` radians, where the closed forms lose digits to cancellation.
-"""
+(`unit_quaternions` checks them). Rotation vectors are angle times unit axis (the full
+angle, twice the quaternion logarithm), and `log_map` gives `q` and `-q` the same one."""
 
 import math
 
@@ -121,7 +103,7 @@ def log_map(q):
 
 def exp_map(rotation_vector):
     """Unit quaternions `(4, ...)` (with `w >= 0` for angles up to pi) of rotation vectors
-    `(3, ...)`."""
+    `(3, ...)`: `(cos(|r|/2), sin(|r|/2) r/|r|)`."""
     rotation_vector = np.asarray(rotation_vector, dtype=float)
     angle = np.sqrt(np.sum(rotation_vector * rotation_vector, axis=0))
     # sin(angle / 2) / angle, exact at 0: numpy's sinc(u) = sin(pi u) / (pi u).
@@ -175,7 +157,10 @@ def slerp(start, end, fraction):
 
 
 def _jacobian_coefficients(angle):
-    """`(a, b, c)` of the module docstring for angles `(...)`."""
+    """`(a, b, c)` for angles `t` `(...)`, in `J(r) v = v + a r x v + b r x (r x v)` and
+    `J(r)^-1 v = v - r x v / 2 + c r x (r x v)`: `a = (1 - cos t)/t^2`,
+    `b = (t - sin t)/t^3`, `c = (1 - (t/2) cot(t/2)) / t^2`, `b` and `c` from short series
+    below `SERIES_BELOW` radians, where the closed forms lose digits to cancellation."""
     small = angle < SERIES_BELOW
     safe = np.where(small, 1.0, angle)
     square = angle * angle
@@ -191,7 +176,8 @@ def _jacobian_coefficients(angle):
 
 def left_jacobian_times(rotation_vector, vector):
     """`J(r) v` for rotation vectors `r` and vectors `v`, both `(3, ...)`: the world-frame
-    angular velocity of `Exp(r)` when `r` changes at the rate `v`."""
+    angular velocity of `Exp(r)` when `r` changes at the rate `v` (J is the left Jacobian
+    of SO(3), invertible for `|r| < 2 pi`)."""
     angle = np.sqrt(np.sum(rotation_vector * rotation_vector, axis=0))
     a, b, _ = _jacobian_coefficients(angle)
     cross = np.cross(rotation_vector, vector, axis=0)

@@ -50,11 +50,22 @@ def sample_reach_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
     rng = np.random.default_rng(seed)
     count = int(rng.integers(low, high + 1))
     floor = spread_points(rng, count, x_range, y_range, min_separation, "objects")
+    return _scene_on(rng, floor, height, switch_schedule, z_range)
+
+
+def _scene_on(rng, floor, height, switch_schedule, z_range):
+    """The `ReachScene` of objects on the `floor` points (K, 2): the targets drawn, then
+    with a `z_range` the heights."""
+    count = len(floor)
     objects = np.column_stack([floor, np.full(count, float(height))])
-    targets = _draw_targets(rng, count, switch_schedule)
+    # The first target, then at each switch another object than the last.
+    targets = [int(rng.integers(count))]
+    for _ in switch_schedule[1:]:
+        other = int(rng.integers(count - 1))
+        targets.append(other + (other >= targets[-1]))
     if z_range:
         objects[:, 2] = rng.uniform(*z_range, size=count)
-    return ReachScene(objects=objects, targets=targets)
+    return ReachScene(objects=objects, targets=tuple(targets))
 
 
 def spread_points(rng, count, x_range, y_range, min_separation, what):
@@ -72,15 +83,6 @@ def spread_points(rng, count, x_range, y_range, min_separation, what):
                              f"x {list(x_range)}, y {list(y_range)}")
         points[index] = candidate
     return points
-
-
-def _draw_targets(rng, count, switch_schedule):
-    """The first target, then at each switch another object than the last."""
-    targets = [int(rng.integers(count))]
-    for _ in switch_schedule[1:]:
-        other = int(rng.integers(count - 1))
-        targets.append(other + (other >= targets[-1]))
-    return tuple(targets)
 
 
 def jittered_grid(count, x_range, y_range, rng):
@@ -107,11 +109,7 @@ def sample_grid_scene(seed, count, x_range=(1.25, 2.5), y_range=(-1.05, 1.05), h
     check_object_count((count, count), switch_schedule)
     rng = np.random.default_rng(seed)
     floor, cell = jittered_grid(count, x_range, y_range, rng)
-    objects = np.column_stack([floor, np.full(count, float(height))])
-    targets = _draw_targets(rng, count, switch_schedule)
-    if z_range:
-        objects[:, 2] = rng.uniform(*z_range, size=count)
-    return ReachScene(objects=objects, targets=targets), 0.5 * min(cell)
+    return _scene_on(rng, floor, height, switch_schedule, z_range), 0.5 * min(cell)
 
 
 def validate_objects(objects, min_separation, reach_x=(0.3, 3.5), reach_height=(0.0, 1.1)):

@@ -1,32 +1,11 @@
 """The field's surrogate pilots in pure NumPy: their parameters, their random draws and how
-their actions map onto our keys (docs/concepts/pilots.md cites each source).
-
-Our keys: each axis of the operator frame has a key state in {-1, 0, +1}: forward/back,
-left/right, up/down (where the task has vertical keys) and turn left/right in the reaching
-and obstacle tasks (`REACH_AXES`, `REACH_VERTICAL_AXES`); forward/back, left/right,
-up/down, yaw, pitch and roll in the grasping task (`GRASP_AXES`). Held keys combine into one
-direction at the operator's speed (and the turning keys into one rotation at its rotation
-speed), as the browser keyboards do. The keys a method enables are the task's keyboard's
-under that method: with the forward key disabled, the reaching task's forward/back axis
-has only back and none (its ↑ button is not there), and the grasping task's twist loses
-its forward part along the approach axis (its ↑ still tips the hand).
-
-- **Noisy** (Yoneda et al. 2023, Schaff & Walter 2020; after Reddy et al. 2018): each tick,
-  with probability `eps`, the base pilot's output is replaced by a key state drawn
-  uniformly over the enabled key states (`noisy_draw`, `key_state`); it is active when any
-  effective key is pressed.
-- **Laggy** (Reddy et al. 2018, Yoneda et al. 2023): each tick, with probability
-  `lag_per_tick(p, period)`, the previous output (command and active) is repeated instead
-  of the base pilot's. `p` is the sources' per step at 50 Hz; our tick is converted so that
-  a held output survives as long in seconds (`lag_per_tick`).
-- **Proportional** (HOP's simulated user, Javdani et al.): `u = gain (p_goal - p_hand)`,
-  clipped to `max_speed` (`proportional_velocity`), translation only, always acting, blind
-  to the robot's intent.
-
-Every draw comes from `(seed, tick, stream)` (`tick_uniforms`) with the pilot's own
-stream, and as many numbers each tick whatever the method and whatever is drawn, so that
-one seed gives the same draws under every method.
-"""
+their actions map onto our keys: noisy (random key states with probability `eps`), laggy
+(the previous output repeated with probability `lag_per_tick`) and proportional (HOP's
+simulated user, `proportional_velocity`). Each axis of the operator frame has a key state
+in {-1, 0, +1} (`REACH_AXES`, `REACH_VERTICAL_AXES`, `GRASP_AXES`). Every draw comes from
+`(seed, tick, stream)` (`tick_uniforms`), as many numbers each tick whatever the method, so
+one seed gives the same draws under every method. The pilots, their keys and their
+sources: docs/concepts/pilots.md."""
 
 import dataclasses
 

@@ -1,24 +1,11 @@
-"""Discrete Dynamical Movement Primitives (DMPs) in D dimensions, and banks of K of them.
-
-The formulas (the ``"ijspeert"`` and ``"pastor"`` formulations, both written around a moving
-attractor, the closed-form first-order-hold step, how PBP re-integrates from the robot's
-measured position while the DMP keeps its own velocity, the bank and the orientation DMPs)
-are in docs/concepts/dmp.md. Notation as in Ijspeert et al. 2013: `y` position,
-`z = tau dy/dt` scaled velocity, `x` phase, `g` goal, `y0` start, `tau` duration.
-
-The modules, all NumPy only (no Drake import):
-
-- `settings`: `DmpSettings`, the basis, and the memoised constants of one step;
-- `stepping`: the bank's step, vectorised over goals and dimensions (mixed into `DmpBankModel`);
-- `fitting`: `minimum_jerk`, `validate_demonstration`, `fit_weights` (one demonstration);
-- `single`: `Dmp`, one DMP with a stateful API, the readable reference;
-- `bank`: `DmpBankModel`, K DMPs as one immutable model, stepped by pure and in-place calls;
-- `workspace`: `DmpWorkspace`, the scratch arrays a caller of the in-place step owns;
-- `orientation`: orientation DMPs on unit quaternions `(w, x, y, z)`, the position DMP on
-  `e = Log(q g*)` (Koutras and Doulgeri 2020), its fit, and `OrientationDmp`, the reference;
-- `orientation_bank`: `OrientationDmpBank`, K of them with the position bank's API;
-- `orientation_kernels`: its step's quaternion math into an `OrientationWorkspace`.
-"""
+"""Discrete Dynamical Movement Primitives (DMPs) in D dimensions, and banks of K of them,
+NumPy only: `DmpSettings`, `Dmp` (one DMP, the readable reference), `DmpBankModel` (K DMPs
+as one immutable model, with the caller's `DmpWorkspace`), and their orientation twins on
+unit quaternions `(w, x, y, z)` (`OrientationDmp`, `OrientationDmpBank`). The formulas
+(the ``"ijspeert"`` and ``"pastor"`` formulations, the closed-form first-order-hold step,
+PBP's re-integration from the robot's measured position, the bank and the orientation
+DMPs) are in docs/concepts/dmp.md. Notation as in Ijspeert et al. 2013: `y` position,
+`z = tau dy/dt` scaled velocity, `x` phase, `g` goal, `y0` start, `tau` duration."""
 
 from pbp_drake.core.dmp.bank import DmpBankModel
 from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration

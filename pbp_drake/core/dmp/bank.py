@@ -1,12 +1,9 @@
 """K DMPs, one per goal, as one immutable model stepped by pure and in-place functions.
 
-The model (weights, starts, amplitude scaling, settings, duration, basis and what is derived
-from them) is fixed at construction: its arrays are read-only and assigning an attribute
-after `__init__` raises. The state of the DMPs (phases, positions, scaled velocities) is
-passed in and out of every call, and the scratch arrays of the in-place step live in a
-`DmpWorkspace` the caller owns (`make_workspace`). So one bank may serve any number of
-threads, Drake Contexts or Simulators at once, each with its own state and workspace.
-"""
+The model is fixed at construction (read-only arrays; assigning an attribute raises); the
+state of the DMPs is passed in and out of every call, and the in-place step's scratch lives
+in a `DmpWorkspace` the caller owns (`make_workspace`). So one bank may serve any number of
+threads, Drake Contexts or Simulators at once."""
 
 import dataclasses
 
@@ -25,12 +22,10 @@ from pbp_drake.core.dmp.workspace import DmpWorkspace
 class BankModel:
     """What the position bank and `OrientationDmpBank` share: the model's checks
     (`_keep_model`), immutability after `__init__`, the settings, the phase decay, the
-    constructor from single DMPs, and open-loop prediction (a subclass keeps its `starts` as
-    `(rows, K)`)."""
+    constructors from single DMPs and of straight paths, and open-loop prediction (a
+    subclass keeps its `starts` as `(rows, K)`)."""
 
     def __setattr__(self, name, value):
-        # Immutable after construction: a bank shared by threads or Drake Contexts must not
-        # change under any of them (the arrays are read-only for the same reason).
         if getattr(self, "_frozen", False):
             raise AttributeError(f"{type(self).__name__} is immutable: cannot set {name!r}")
         object.__setattr__(self, name, value)
@@ -84,6 +79,19 @@ class BankModel:
                    first.duration, first.settings,
                    np.stack([d.amplitude_scaling for d in dmps]))
 
+    @classmethod
+    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
+        """K straight DMPs from `start` to goals given at run time (no demonstration); for
+        orientations, along the shorter arc (slerp). Ijspeert: the minimum-jerk shape, shared
+        by all goals and scaled by each one's amplitude (`g - y0`, or `-e0`); Pastor: `f = 0`,
+        whose attractor already slides from the start to the goal."""
+        dimension = cls._straight_dimension(start)
+        if settings.formulation == "ijspeert":
+            weights = straight_weights(settings, duration, np.ones(dimension))
+        else:
+            weights = np.zeros((settings.basis_count, dimension))
+        return cls(weights, start, duration, settings, goal_count=goal_count)
+
     @property
     def settings(self):
         """The bank's gains and basis (a copy: changing it does not change the bank)."""
@@ -128,24 +136,12 @@ class DmpBankModel(BankStep, BankModel):
     each has its own weights (or all share one set, e.g. straight paths or one
     demonstration), its own start and its own phase.
 
-    The bank is immutable and keeps no state: `initial_state` gives the state at the start
-    of a movement and the pure `advance` steps it, returning new arrays. `advance_into` is
-    the same step written into arrays the caller owns, with no allocation, using a workspace
-    from `make_workspace`; `attractor_terms_into`, `stepped_positions_into` and
-    `stepped_velocity_into` are its parts (`pbp_drake.core.dmp.stepping`; Drake's `DmpBank`
-    system keeps the attractor terms in its Context and reads the stepped state out on
-    demand).
-
-    Speed. When all phases are equal (DMPs started together and locked together: the normal
-    case), the basis is evaluated at the step's two phases, `(2, N)`, and contracted with the
-    weights once: shared weights give `(2, D)` shapes broadcast to all goals
-    (O(N D + D K)); distinct weights are one `(2, N) x (N, D*K)` product over contiguous
-    memory (memory bound: the weights are read once). The per-goal-phase path (phases made
-    unequal by per-goal locks) evaluates `(N, K)` bases. With shared weights, equal phases
-    and one start, the step's terms are affine in the goal with per-dimension coefficients,
-    so no per-goal shape is ever formed. The step then makes a fixed number of passes over
-    the workspace's `(D, K)` arrays, using constants memoised per step size
-    (`pbp_drake.core.dmp.stepping.step_constants`).
+    `initial_state` gives the state at the start of a movement and the pure `advance` steps
+    it, returning new arrays. `advance_into` is the same step written into arrays the caller
+    owns, with no allocation, using a workspace from `make_workspace`;
+    `attractor_terms_into`, `stepped_positions_into` and `stepped_velocity_into` are its
+    parts (`pbp_drake.core.dmp.stepping`). How the step is made fast:
+    docs/concepts/dmp.md, "The bank: K DMPs at once".
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),
@@ -171,19 +167,9 @@ class DmpBankModel(BankStep, BankModel):
         duration = times[-1] - times[0] if duration is None else duration
         return cls(weights, start, duration, settings, scaling, goal_count)
 
-    @classmethod
-    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
-        """K straight-path DMPs from `start` to goals given at run time (no demonstration).
-
-        Ijspeert: the minimum-jerk shape, shared by all goals (it scales with `g - y0`).
-        Pastor: `f = 0`, whose attractor already slides from `y0` to `g` along the line.
-        """
-        dimension = as_point(start, "start").size
-        if settings.formulation == "ijspeert":
-            weights = straight_weights(settings, duration, np.ones(dimension))
-        else:
-            weights = np.zeros((settings.basis_count, dimension))
-        return cls(weights, start, duration, settings, goal_count=goal_count)
+    @staticmethod
+    def _straight_dimension(start):
+        return as_point(start, "start").size
 
     def make_workspace(self):
         """New scratch arrays for the in-place step; one per thread or Drake Context."""
@@ -212,21 +198,16 @@ class DmpBankModel(BankStep, BankModel):
 
     def advance(self, phase, positions, scaled_velocity, goals_dk, dt, locked=None,
                 robot_velocity=None, followed=None):
-        """One first-order-hold step of all K DMPs (see `pbp_drake.core.dmp`); pure: returns
-        the new state.
+        """One first-order-hold step of all K DMPs; pure: returns the new state
+        `(phase, positions, scaled_velocity)`, new arrays.
 
-        Args:
-            phase: (K,) phases; positions: (D, K) or (D, 1) positions to step from (PBP passes
-                the robot's position); scaled_velocity: (D, K) the DMPs' own `z`.
-            goals_dk: (D, K) goals.
-            locked: None, or a bool (or (K,) bools) freezing those DMPs' phases; their
-                velocity then follows `robot_velocity` (D,) and their position stays.
-            followed: None, or the index of the DMP the robot followed until now: every DMP
-                then steps from that DMP's velocity, so that the robot may switch to any of
-                them without a jump of its commanded velocity (PBP's goal switch; see the
-                hand-over law, docs/concepts/hand-over.md). None: each DMP keeps its own.
-        Returns:
-            (phase, positions, scaled_velocity) after the step, new arrays.
+        `phase` (K,); `positions` (D, K) or (D, 1) to step from (PBP passes the robot's);
+        `scaled_velocity` (D, K) the DMPs' own `z`; `goals_dk` (D, K). `locked`: None, a bool
+        or (K,) bools freezing those DMPs' phases; their velocity then follows
+        `robot_velocity` (D,) and their position stays. `followed`: None (each DMP keeps its
+        own velocity), or the index of the DMP the robot followed until now: every DMP then
+        steps from that DMP's velocity, so that the robot may switch to any of them without
+        a jump of its commanded velocity (PBP's goal switch, docs/concepts/hand-over.md).
         """
         phase = np.asarray(phase, dtype=float)
         scaled_velocity = followed_velocity(np.asarray(scaled_velocity, dtype=float), followed,

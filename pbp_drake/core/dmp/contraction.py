@@ -1,25 +1,13 @@
 """The contraction of distinct weights with the basis, `(2, N) x (N, M)`, reading only the
 basis rows that matter at the step's phase: shared by the position and orientation banks.
 
-The normalised Gaussian basis is nearly zero away from the phase: at any phase of the
-default 50 functions only 5 to 12 neighbours are above `2^-53 / N` of the largest (the
-others are smaller than `0.7^(4 m^2)` for the m-th neighbour, see `DmpSettings.basis`). The
-weights are laid out `(N, M)`, so the rows that matter are one contiguous slice, and the
-product reads a quarter of the bytes (the step's cost at large K is reading the weights).
-
-Exactness: a row n is left out only when `max_r |b_rn| max_m |W_nm|` (the largest term it
-could add to any column) is below `2^-53 / N` of the largest such bound over the rows, or
-below `2^-53 / N` itself; the rows left out then add, together, less than one rounding unit
-of the largest term, which is below the rounding error the full product makes anyway (`N`
-rounding units of it), or less than `2^-53`. The second bound is what keeps the window
-narrow after the movement: at phases far below the last centre every function is a tiny,
-nearly equal share of the sum (the narrow last one fades as fast as the wide first ones),
-so that relative to the largest term every row matters, while all the rows but the last
-few add less than `1e-20`. The banks' weights are per unit of what the product is added to
-or multiplied by (the Ijspeert form's shape is multiplied by the amplitude `g - y0`, per
-column; Pastor's is in metres or radians), so `2^-53` is one rounding unit of the amplitude
-(of a position or angle of magnitude 1), far below what a position or orientation keeps.
-"""
+At any phase only a few neighbouring functions of the normalised basis are not nearly zero
+(5 to 12 of the default 50), and the weights are laid out `(N, M)`, so those rows are one
+contiguous slice. A row is left out only when the largest term it could add to any column,
+`max_r |b_rn| max_m |W_nm|`, is below `2^-53 / N` of the largest such bound over the rows,
+or below `2^-53 / N` itself: the rows left out then add, together, less than one rounding
+unit of the largest term, or less than `2^-53` in the weights' units (per unit of
+amplitude). Why the second bound: docs/concepts/dmp.md, "Orientation DMPs"."""
 
 import numpy as np
 

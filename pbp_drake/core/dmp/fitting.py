@@ -35,14 +35,18 @@ def validate_demonstration(times, positions):
     bad = np.flatnonzero(~np.isfinite(positions).all(axis=1))
     if bad.size:
         raise ValueError(f"demonstration positions are NaN or infinite at sample {bad[0]}")
+    return check_times(times, positions.shape[0]), positions
+
+
+def check_times(times, count):
+    """A demonstration's `times` as a float array `(count,)`, refused unless finite and
+    strictly increasing."""
     times = np.asarray(times, dtype=float)
-    if times.shape != (positions.shape[0],):
-        raise ValueError(
-            f"demonstration times have shape {times.shape}, expected ({positions.shape[0]},)"
-        )
+    if times.shape != (count,):
+        raise ValueError(f"demonstration times have shape {times.shape}, expected ({count},)")
     if not np.isfinite(times).all() or not (np.diff(times) > 0).all():
         raise ValueError("demonstration times must be finite and strictly increasing")
-    return times, positions
+    return times
 
 
 def fit_weights(times, positions, settings=DmpSettings()):

@@ -1,28 +1,18 @@
-"""Orientation DMPs on unit quaternions: the formulation, the one-demonstration fit, and one
-DMP stepped the plain way (the readable reference the vectorised bank is tested against).
+"""Orientation DMPs on unit quaternions `(w, x, y, z)`: the formulation, the one-demonstration
+fit, and one DMP stepped the plain way (the readable reference the vectorised bank is
+tested against).
 
-The formulation is Koutras and Doulgeri's (2020), docs/concepts/dmp.md, "Orientation DMPs":
-the position DMP, unchanged, on `e = Log(q g*)` (3,), the rotation from the goal `g` to the
-orientation `q` (0 at the goal, the same for `q` or `-q`, `g` or `-g`), with goal 0 and
-start `e0 = Log(q0 g*)`; then `q = Exp(e) g` and `omega = J(e) de/dt`, `J` the left
-Jacobian of `Exp` (`quaternion.left_jacobian_times`). Quaternions are `(w, x, y, z)`
-(`pbp_drake.core.quaternion`).
-
-The velocity state kept is `eta = tau omega` (world frame), not `z`, so that PBP's goal
-switch and phase lock can copy it as the position DMP does `z`. A step from the robot's
-measured orientation `q_m` is
-
-    e = Log(q_m g*),  z = J(e)^-1 eta,  (e, z) -> (e', z') by the position step,
-    q' = Exp(e') g (signed as q_m),  eta' = J(e') z',  x' = x exp(-alpha_x dt / tau).
-
-A demonstration's orientations must stay within 180 degrees of its last one (else `e`
-would jump from `pi u` to `-pi u`); a start or a measured orientation may be anywhere, the
-DMP then turns the shorter way."""
+The formulation is Koutras and Doulgeri's (2020): the position DMP, unchanged, on
+`e = Log(q g*)` (3,), with goal 0 and start `e0 = Log(q0 g*)`; then `q = Exp(e) g` and
+`omega = J(e) de/dt` (`quaternion.left_jacobian_times`). The velocity state kept is
+`eta = tau omega` (world frame), not `z`, so that PBP's goal switch and phase lock can copy
+it as the position DMP does `z`. The step, and why a demonstration must stay within 180
+degrees of its last orientation: docs/concepts/dmp.md, "Orientation DMPs"."""
 
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp.fitting import fit_weights
+from pbp_drake.core.dmp.fitting import check_times, fit_weights
 from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import SingleDmp
 
@@ -44,12 +34,7 @@ def validate_orientation_demonstration(times, orientations):
     if orientations.ndim != 2 or orientations.shape[0] < 3:
         raise ValueError(f"demonstration orientations must be (T, 4) with T >= 3, got shape "
                          f"{orientations.shape}")
-    times = np.asarray(times, dtype=float)
-    if times.shape != (orientations.shape[0],):
-        raise ValueError(f"demonstration times have shape {times.shape}, expected "
-                         f"({orientations.shape[0]},)")
-    if not np.isfinite(times).all() or not (np.diff(times) > 0).all():
-        raise ValueError("demonstration times must be finite and strictly increasing")
+    times = check_times(times, orientations.shape[0])
     errors = orientation_errors(orientations.T, orientations[-1][:, np.newaxis])
     jumps = np.flatnonzero(np.linalg.norm(np.diff(errors, axis=1), axis=0) > np.pi)
     if jumps.size:

@@ -24,7 +24,6 @@ from pbp_drake.core.dmp.orientation_kernels import (
 from pbp_drake.core.dmp.orientation_log_step import (
     IDENTITY6, forcing_rows, log_step_from_one_into)
 from pbp_drake.core.dmp.settings import DmpSettings, normalized_basis
-from pbp_drake.core.dmp.single import straight_weights
 from pbp_drake.core.dmp.stepping import step_constants
 
 
@@ -80,17 +79,9 @@ class OrientationDmpBank(BankModel):
         duration = times[-1] - times[0] if duration is None else duration
         return cls(weights, start, duration, settings, scaling, goal_count)
 
-    @classmethod
-    def straight(cls, start, goal_count, duration, settings=DmpSettings()):
-        """K DMPs along the shorter arc (slerp) from `start` to goals given at run time.
-
-        Ijspeert: the minimum-jerk shape, shared, scaled per goal by `-e0`; Pastor: `f = 0`,
-        whose attractor `e0 x` already slides along the arc."""
-        if settings.formulation == "ijspeert":
-            weights = straight_weights(settings, duration, np.ones(AXES))
-        else:
-            weights = np.zeros((settings.basis_count, AXES))
-        return cls(weights, start, duration, settings, goal_count=goal_count)
+    @staticmethod
+    def _straight_dimension(start):
+        return AXES
 
     def initial_state(self, orientation=None):
         """(phase (K,), orientations (4, K), scaled angular velocity (3, K)) at the start."""
@@ -124,20 +115,13 @@ class OrientationDmpBank(BankModel):
 
     def advance(self, phase, orientations, scaled_angular_velocity, goals_4k, dt,
                 locked=None, robot_angular_velocity=None, followed=None):
-        """One step of all K DMPs from the measured orientation; pure, new arrays.
-
-        Args:
-            phase: (K,). orientations: (4, 1) the robot's measured orientation (PBP), or
-                (4, K) one per DMP; unit within `quaternion.UNIT_TOLERANCE`.
-            scaled_angular_velocity: (3, K) the DMPs' own `eta = tau omega`.
-            goals_4k: (4, K) goal orientations (`goals_matrix`).
-            locked: None, a bool or (K,) bools freezing those phases (PBP-Alt): those DMPs
-                stay at the given orientation and `eta` follows `robot_angular_velocity` (3,).
-            followed: None, or the index of the DMP the robot followed: every DMP then steps
-                from its `eta` (PBP's goal switch, as in the position bank).
-        Returns:
-            (phase (K,), orientations (4, K), scaled angular velocity (3, K)).
-        """
+        """`DmpBankModel.advance` for orientations: one step of all K DMPs; pure, new arrays
+        `(phase (K,), orientations (4, K), scaled angular velocity (3, K))`. `orientations`
+        (4, 1) the robot's measured one (PBP) or (4, K) one per DMP, unit within
+        `quaternion.UNIT_TOLERANCE`; `scaled_angular_velocity` (3, K) the DMPs' own
+        `eta = tau omega`; `goals_4k` (4, K) (`goals_matrix`); `locked` freezes phases (those
+        DMPs stay and `eta` follows `robot_angular_velocity` (3,)); `followed` as the
+        position bank's."""
         phase = np.asarray(phase, dtype=float)
         velocity = followed_velocity(np.asarray(scaled_angular_velocity, dtype=float),
                                      followed, self.goal_count)
@@ -165,30 +149,26 @@ class OrientationDmpBank(BankModel):
                                                    "orientations").T
         if locked is not None:
             locked = np.broadcast_to(np.asarray(locked, bool), np.shape(phase))
-            if not locked.any():
-                locked = None
-        if locked is not None:
-            held = (scaled_angular_velocity if robot_angular_velocity is None else
-                    np.broadcast_to(self.duration * np.asarray(
-                        robot_angular_velocity, float).reshape(AXES, 1), out_velocity.shape))
-            if not locked.all():
-                # Some locked, some not: the free step into temporaries, then chosen (rare).
-                stepped = (np.empty_like(out_phase), np.empty_like(out_orientations),
-                           np.empty_like(out_velocity))
-                self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
-                                *stepped, workspace)
-                held, stepped_phase = np.array(held), stepped[0]
-                orientations = np.broadcast_to(orientations, out_orientations.shape)
-                out_phase[...] = np.where(locked, phase, stepped_phase)
-                out_orientations[...] = np.where(locked, orientations, stepped[1])
-                out_velocity[...] = np.where(locked, held, stepped[2])
-                return
+        if locked is None or not locked.any():
+            self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
+                            out_phase, out_orientations, out_velocity, workspace)
+            return
+        held = (scaled_angular_velocity if robot_angular_velocity is None else
+                np.broadcast_to(self.duration * np.asarray(
+                    robot_angular_velocity, float).reshape(AXES, 1), out_velocity.shape))
+        if locked.all():
             out_phase[...] = phase
             out_orientations[...] = orientations
             out_velocity[...] = held
             return
-        self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt,
-                        out_phase, out_orientations, out_velocity, workspace)
+        # Some locked, some not: the free step into temporaries, then chosen (rare).
+        stepped = (np.empty_like(out_phase), np.empty_like(out_orientations),
+                   np.empty_like(out_velocity))
+        self._step_into(phase, orientations, scaled_angular_velocity, goals_4k, dt, *stepped,
+                        workspace)
+        out_phase[...] = np.where(locked, phase, stepped[0])
+        out_orientations[...] = np.where(locked, orientations, stepped[1])
+        out_velocity[...] = np.where(locked, held, stepped[2])
 
     def _start_errors_into(self, goals_4k, workspace, goals_unchanged=False):
         """`e0 = Log(q0 g*)` into `workspace.start_errors`, and the Ijspeert amplitude `-e0`
@@ -224,15 +204,14 @@ class OrientationDmpBank(BankModel):
         """The free step in log coordinates: `e = Log(q g*)` and `z = J(e)^-1 eta` from the
         measured orientations `(4, 1)` or `(4, K)` (unit) and `eta` `(3, K)` or `(3, 1)`
         (one for all: PBP's goal switch), stepped as the position bank steps `(y, z)`:
-        `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase`. Drake's
-        pose bank keeps `(e', z')` and reads the orientations out on demand.
-
+        `(e', z')` into `out_log_state` (2, 3, K), the phases into `out_phase` (Drake's
+        pose bank keeps `(e', z')` and reads the orientations out on demand).
         `goals_unchanged=True` vouches that `goals_4k` holds the goals of this workspace's
-        last step (Drake's pose bank knows when its goals were recomputed): the start
-        errors are then reused without comparing the goals. `basis`: the step's combined
-        basis `(2, N)` and `lambda` `(2, 1)` when the caller has them already (a position
-        bank of the same settings and duration stepped at the same phase: its workspace's
-        `basis` and `lam`), used with distinct Ijspeert weights at equal phases."""
+        last step: the start errors are then reused without comparing the goals. `basis`:
+        the step's combined basis `(2, N)` and `lambda` `(2, 1)` when the caller has them
+        already (a position bank of the same settings and duration stepped at the same
+        phase: its workspace's `basis` and `lam`), used with distinct Ijspeert weights at
+        equal phases."""
         ws = workspace
         constants = step_constants(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)

@@ -1,24 +1,11 @@
 """The unit-quaternion math of `pbp_drake.core.quaternion`, written into preallocated
 `(4, K)` and `(3, K)` arrays for the orientation bank's step: no allocation per step, and a
-fixed number of passes over K (no loop over goals).
-
-`pbp_drake.core.quaternion` stays the readable version (and the single `OrientationDmp`'s);
-`tests/core/test_orientation_bank_equivalence.py` holds the two to 1e-12. The scratch arrays
-live in an `OrientationWorkspace` the caller owns, one per thread or Drake Context, as the
-position bank's `DmpWorkspace`; it holds nothing between calls but the
-start errors of the last goals, which it recomputes when the goals or the bank change.
-
-Speed (K = 10,000, one core): a pass of NumPy over K numbers costs 3 to 6 us, `sin` and
-`cos` about 100 us each, `tan` 20 us and a masked `copyto` 35 us. So the kernels use
-
-- the Jacobians in the form `J v = p v + a r x v + b (r.v) r` (`r x (r x v) =
-  r (r.v) - t^2 v`), with `p = sin t / t` and `J^-1`'s `p = (t/2) cot(t/2)` read off the
-  half-angle's sine and cosine that the log and exp maps already have;
-- one `tan(t/4)` for both `sin(t/2)` and `cos(t/2)` (`exp_into`);
-- the short series only when some angle is below `SERIES_BELOW` (then a masked choice);
-- with one velocity for all DMPs `(3, 1)` (PBP's goal switch: every DMP continues from the
-  followed one's), `r x v` and `r.v` for all K as one `(4, 3) x (3, K)` BLAS product.
-"""
+fixed number of passes over K (no loop over goals). `pbp_drake.core.quaternion` stays the
+readable version; `tests/core/test_orientation_bank_equivalence.py` holds the two to 1e-12.
+The scratch arrays live in an `OrientationWorkspace` the caller owns, one per thread or
+Drake Context. The forms the kernels take for speed (the Jacobians read off the half
+angle's sine and cosine, one `tan(t/4)` for both, the series only where an angle is small):
+docs/concepts/dmp.md, "Orientation DMPs"."""
 
 import math
 
@@ -26,10 +13,9 @@ import numpy as np
 
 from pbp_drake.core.quaternion import SERIES_BELOW
 
-# The smallest denominator: every closed form is evaluated at every angle, with its
-# denominator kept at least this (so 0 / 0 never happens), and the series replace it where
-# the angle is small. Computing both and selecting with `np.copyto(..., where=)` is many
-# times faster than ufuncs with a `where=` mask that varies from goal to goal.
+# The smallest denominator: every closed form is evaluated at every angle, its denominator
+# kept at least this (no 0 / 0), and the series replace it where the angle is small (faster
+# than ufuncs with a `where=` mask that varies from goal to goal).
 SMALLEST = 1e-300
 # Hamilton's product `p q` by rows of the result: (index in p, index in q, sign).
 _PRODUCT_TERMS = (
@@ -60,13 +46,10 @@ class OrientationWorkspace:
             their rows are, for the start errors' goals (None until the fused step needs
             them; `contraction.scaled_weights`).
         goals_of_start_errors, starts_of_start_errors: the goals (a copy) and the bank's
-            starts (the array itself) that `start_errors` and `amplitude` were computed for:
-            they depend on nothing else, so a step to unchanged goals reuses them. A copied
-            workspace has copied starts, which are not the bank's, and so recomputes.
+            starts (the array itself) that `start_errors` and `amplitude` were computed for,
+            reused while they stay (a copied workspace's starts are not the bank's).
 
-    The halves of `log_state`, and `shape`, are properties, not attributes holding views: a
-    deep copy (Drake cloning a Context) copies every array apart, and views would then stop
-    being the rows the step writes.
+    The halves of `log_state`, and `shape`, are properties, not views, as in `DmpWorkspace`.
     """
 
     __slots__ = ("goal_count", "basis_count", "error_quaternions", "product", "start_errors",

@@ -1,37 +1,24 @@
 """The orientation bank's step in log coordinates from ONE measured orientation `q` (4, 1)
 and ONE scaled angular velocity `eta` (3, 1) for all K DMPs (PBP's goal switch, the six-DoF
-Drake system's every tick): the log map, `z = J(e)^-1 eta` and the transition fused into
-two small BLAS products around one chain of per-goal numbers.
-
-The step (`pbp_drake.core.dmp.orientation`) is, per goal `g`,
+Drake system's every tick), fused into two small BLAS products around one chain of
+per-goal numbers. Per goal `g` (`pbp_drake.core.dmp.orientation`),
 
     e = Log(q g*),  z = J(e)^-1 eta = p eta - (e x eta)/2 + c (e.eta) e,
     [e'; z'] = (Phi (x) I3) [e; z] + b,
 
-with `p = (t/2) cot(t/2)`, `c = (1 - p)/t^2`, `t = |e|`. Everything in it that is linear
-in `g` or in `e` is a product with a small matrix, the same for every goal:
+with `p = (t/2) cot(t/2)`, `c = (1 - p)/t^2`, `t = |e|`:
 
-- `q g*` and `v.eta` (`v` its vector part) are rows of `A g`, `A` (5, 4)
-  (`error_matrix`): one BLAS pass over the goals gives `w`, `v` and `v.eta`;
+- `q g*` and `v.eta` (`v` its vector part) are rows of `A g` (`error_matrix`);
 - with `s = |v| = sin(t/2)`, `h = atan(s / w)` (`t/2` with the sign of `w`: the log of
-  `-q g*`, the same orientation, flipped to `w > 0`) and `k = h / s`: `e = 2 k v`,
-  `p = k w` and `c (e.eta) e = d k v` with `d = 4 c k (v.eta)`;
-- `[e'; z'] = M [k v; d; c (e.eta) e; p; forcing rows]`, `M` (6, 8 + n)
-  (`combination_matrix`): `e x eta = -eta x e` is linear in `e`, `p eta` in `p`, and the
-  attractor's part `b` in rows the caller fills (`forcing_rows`: `b` itself, or for one
-  shape shared by all goals the three rows of `-e0`).
+  `-q g*`, the same orientation) and `k = h / s`: `e = 2 k v`, `p = k w` and
+  `c (e.eta) e = d k v` with `d = 4 c k (v.eta)`;
+- `[e'; z'] = M [k v; d; c (e.eta) e; p; forcing rows]` (`combination_matrix`), the
+  attractor's part `b` in rows the caller fills (`forcing_rows`).
 
-So the step is two BLAS products around 17 passes over K numbers (`sqrt`, one `arctan`,
-the rest multiplications and divisions; 21 when some angle is below `SERIES_BELOW`, whose
-series and `SMALLEST` guards the other goals skip), all in one (15, K) array and three (K,)
-rows rewritten in place: against the step through the general kernels (`orientation_kernels`:
-the log map, the inverse Jacobian, the transition and `b`, about 50 passes over a dozen
-arrays) it does less and touches less memory, which at large K is what the step costs
-(the arrays leave the cache between two ticks). The results equal those kernels' to
-rounding (`tests/core/test_orientation_bank_equivalence.py`): `atan(s / w)` is `atan2`'s
-value to one rounding of the quotient; a 180-degree error (`w = 0`) takes `atan2` and the
-sign rule of `quaternion.canonical`, as `orientation_kernels.log_into`.
-"""
+The results equal the general kernels' (`orientation_kernels`) to rounding
+(`tests/core/test_orientation_bank_equivalence.py`); a 180-degree error (`w = 0`) takes
+`atan2` and the sign rule of `quaternion.canonical`. Why it is faster: docs/concepts/dmp.md,
+"Orientation DMPs"."""
 
 import functools
 
@@ -104,12 +91,9 @@ def log_step_from_one_into(orientation, eta, goals, transition, forcing, out, wo
     (unit) and one `eta` (3, 1); `goals` (4, K), `transition` `Phi` ((2, 2) numbers), and
     `forcing` the columns of the attractor's rows (`forcing_rows`, called first), or None
     when `out` holds `b` already (the product is then added to it). Writes the
-    workspace's (an `OrientationWorkspace`) `fused` and `small`; allocates nothing of size
-    K.
-
-    One array, its rows rewritten in place as soon as their values are dead (`fused`'s rows
-    0-8, `w`, `v` (3), `v.eta`, `k`, `h`, `4 c`, `p`, become scratch, `k v`, `d`,
-    `c (e.eta) e` (3) and `p`): the step's cost at large K is the memory it touches."""
+    workspace's `fused` and `small`, `fused`'s rows rewritten in place as soon as their
+    values are dead (the step's cost at large K is the memory it touches); allocates
+    nothing of size K."""
     ws = workspace
     fused = ws.fused
     np.matmul(error_matrix(orientation, eta), goals, out=fused[:5])

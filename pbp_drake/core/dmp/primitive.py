@@ -1,26 +1,11 @@
 """A primitive taught by driving: ONE demonstration's DMP shape, kept as a document and sent
 to any goal (`pbp-drake teach` writes one; a scenario's `dmp: {primitive: FILE}` reads it).
-A demonstration of poses (the grasping task's hand) also teaches an orientation shape,
-fitted by the orientation DMP (`fit_orientation_weights`) and carried the same way.
-
-`teach_primitive(times, positions, settings)` fits the demonstration (`fit_weights`, either
-formulation) and measures the fit: the DMP rolled out from the demonstration's start to its
-own goal, against the demonstration, as an RMS distance (`fit_error`, m). A bank of every
-goal's DMP with the taught shape is `primitive_bank`; the shape is carried to each goal as
-the formulation carries it (Ijspeert: scaled by each goal's `g - y0` where the
-demonstration's amplitude allowed, else as learned; Pastor: as learned).
-
-The document (`primitive_document`, `read_primitive_document`) is plain JSON data:
-
-- `format` (`PRIMITIVE_FORMAT`) and `version` (`FORMAT_VERSION`; a newer one is refused);
-- `settings`: the DMP's formulation, basis_count, alpha_z, beta_z and alpha_x;
-- `dimension`, `weights` (basis_count rows of `dimension` numbers), `amplitude_scaling`;
-- `demonstration`: its `times` (s) and `positions` (m), from which `start`, `goal`,
-  `duration` and `length_ratio` (path length over start-to-goal distance) follow;
-- `fit_error` (m);
-- `orientation` (poses only): its `weights` (basis_count rows of 3), `amplitude_scaling`,
-  `quaternions` (w, x, y, z, one a sample) and `fit_error` (rad, RMS angle).
-"""
+A demonstration of poses (the grasping task's hand) also teaches an orientation shape.
+`teach_primitive` fits the demonstration and measures the fit (`fit_error`: the DMP rolled
+out from the demonstration's start to its own goal, against the demonstration, RMS);
+`primitive_bank` carries the shape to each goal as the formulation carries it. The
+document (`primitive_document`, `read_primitive_document`) is plain JSON data, its fields
+in docs/tasks/teach.md, "The file"."""
 
 import dataclasses
 
@@ -167,7 +152,7 @@ def primitive_orientation_bank(primitive: Primitive, start, goal_count,
 
 
 def primitive_document(primitive: Primitive) -> dict:
-    """The primitive as plain JSON data (the module's docstring)."""
+    """The primitive as plain JSON data (docs/tasks/teach.md, "The file")."""
     orientation = primitive.orientation
     pose = {} if orientation is None else {"orientation": {
         "weights": orientation.weights.tolist(),

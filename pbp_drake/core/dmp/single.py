@@ -141,7 +141,8 @@ class Dmp(SingleDmp):
         )
 
     def attractor(self, phase, goal):
-        """The moving attractor `y_attr(x, g)` of the module docstring, per dimension."""
+        """The moving attractor `y_attr(x, g)` per dimension (docs/concepts/dmp.md, "The two
+        formulations")."""
         shape = self._shape(phase)
         result = np.empty(self.start.size)
         for dim in range(self.start.size):

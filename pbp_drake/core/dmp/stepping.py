@@ -120,13 +120,9 @@ class BankStep:
         """The attractor terms `(dp, dz)` (D, K) of the step from `positions` (D, K) or
         (D, 1) at phases `phase` (K,) towards `goals_dk`, into `out_dp` and `out_dz` (the
         caller's, or the workspace's `dp` and `dz`; the other work arrays are used).
-
-        Four passes over `(D, K)` when the DMPs share weights, phase and start.
         `goals_unchanged=True` vouches that `goals_dk` holds the goals of this workspace's
-        last call (Drake's pose bank knows when its goals were recomputed): with distinct
-        weights (Ijspeert, equal phases) the step then contracts the weights already
-        multiplied by `g - y0`, kept in the workspace (`contraction.scaled_weights`), and
-        takes five passes."""
+        last call: with distinct weights (Ijspeert, equal phases) the step then contracts the
+        weights already multiplied by `g - y0` (`contraction.scaled_weights`)."""
         constants = self.step_constants(dt)
         equal = phase.size == 1 or phase.min() == phase.max()
         if (goals_unchanged and equal and self._ijspeert and not self.shared_weights
@@ -161,12 +157,9 @@ class BankStep:
         bank keeps. `goals_unchanged` as `attractor_terms_into`. With equal phases the step's
         combined basis and `lambda` are left in `workspace.basis` and `workspace.lam` (an
         orientation bank of the same settings steps with them: `log_step_into`'s `basis`).
-
-        With weights kept multiplied by the amplitudes (distinct weights, Ijspeert, equal
-        phases, the goals unchanged) and one `z`, the weights are contracted straight into
-        `out`, then `-(Phi00 - 1, Phi10) g` (kept with the weights while the goals stay)
-        and one column, `(Phi00 - 1, Phi10) p + (Phi01, Phi11) z`, are added: two passes
-        over `out` instead of the seven of the attractor terms and the velocity's part."""
+        With weights kept multiplied by the amplitudes and one `z`, the weights are
+        contracted straight into `out`, then `-(Phi00 - 1, Phi10) g` (kept while the goals
+        stay) and one column, `(Phi00 - 1, Phi10) p + (Phi01, Phi11) z`, are added."""
         constants = self.step_constants(dt)
         ws = workspace
         if (goals_unchanged and scaled_velocity.shape[1] == 1 and self._ijspeert
@@ -261,10 +254,7 @@ class BankStep:
         """For the rows r of `combination` (2x2): the forcing shapes
         `S_r = C_r0 s(x0) + C_r1 s(x1)`, `s(x) = (psi.w / sum psi) x` (divided by K in the
         Ijspeert form), `(2, D, 1)` (shared weights, equal phases) or `(2, D, K)`, and
-        `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`, with `x1 = x0 decay`.
-
-        Equal phases: the basis is evaluated at the two phases, `(2, N)`, combined, and
-        contracted with the weights once. A phase per goal: `(N, K)` bases (allocates)."""
+        `lambda_r = C_r0 x0 + C_r1 x1`, `(2, 1)` or `(2, K)`, with `x1 = x0 decay`."""
         if equal is None:
             equal = phase.size == 1 or phase.min() == phase.max()
         if equal:

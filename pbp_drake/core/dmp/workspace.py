@@ -1,14 +1,12 @@
 """Scratch memory of one caller of a `DmpBankModel`: what makes the bank's step allocation-free.
 
-The bank itself is an immutable model; every array a step writes to lives in a
-`DmpWorkspace` its caller owns (`bank.make_workspace()`), one per thread or per Drake
-Context, so callers stepping one bank from different threads or contexts cannot corrupt
-each other. A workspace holds nothing between calls (but for a caller that vouches that its
-goals have not changed: `scaled_weights`): any call may overwrite all of it, and a copy of one
-is as good as a fresh one (so Drake's cloning of a Context, which deep-copies its cache
-values, is correct without help). Its fields are plain arrays, no views of each other,
-for the same reason: `copy.deepcopy` would turn views into separate arrays.
-"""
+Every array a step writes to lives in a `DmpWorkspace` its caller owns
+(`bank.make_workspace()`), one per thread or per Drake Context. A workspace holds nothing
+between calls (but for a caller that vouches that its goals have not changed:
+`scaled_weights`), so a copy of one is as good as a fresh one: Drake's cloning of a
+Context, which deep-copies its cache values, is correct without help. Its fields are plain
+arrays, no views of each other, for the same reason (`copy.deepcopy` would turn views into
+separate arrays)."""
 
 import numpy as np
 

@@ -32,9 +32,9 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     local processes or, with `backend="ray"`, as Ray tasks (on the Ray at `ray_address`,
     e.g. "HEAD:6379" or "ray://head:10001", else a new local one); writes every trial under
-    `output/trials/`, then `report`s the folder and returns the summary dict. `split`
-    labels the seeds (`studies.splits`); `split` (for the same seeds), `scenario_file` and
-    `split_seeds` None keep what the folder holds; these, `participant_condition` and
+    `output/trials/`, then reports the folder (`report`) and returns the summary dict.
+    `split` labels the seeds (`studies.splits`); `split` (for the same seeds), `scenario_file`
+    and `split_seeds` None keep what the folder holds; these, `participant_condition` and
     `overrides` go into study.json (`write_study`).
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except

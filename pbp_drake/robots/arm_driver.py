@@ -1,20 +1,9 @@
 """The station's side of a real arm's Drake LCM driver (drake-franka-driver,
-drake-iiwa-driver): the messages, the clock, the first status read before a run, and
-`DriverLink`, which sends the diff IK's joint positions within the drivers' rules
-(`ArmHardware` holds the limits):
-
-- the start is read from the driver's first status (`read_first_status`), never assumed;
-- no command before a fresh status, nor within the iiwa driver's start-up guard;
-- the Panda's commands are stamped with the wall clock (drake-franka-driver drops one
-  older than its `--expire_sec`; Drake's `PandaCommandSender` stamps simulation time);
-- none computed more than `command_expiry` behind the wall clock (the iiwa driver holds a
-  position command forever, so a stalled loop would go unseen);
-- a status silent for `status_timeout`, of the wrong joint count, with a NaN or beyond a
-  limit ends the run with `DriverError` and sends nothing more (the driver holds);
-- commands within the position limits, at most the velocity limits from the last one.
-
-With the driver simulator in the same process (`ArmHardware.driver_sim`) both sides keep
-the simulation's clock (`SIMULATION_CLOCK`).
+drake-iiwa-driver): the messages, the clock, the first status read before a run
+(`read_first_status`), and `DriverLink`, which sends the diff IK's joint positions within
+the drivers' rules (docs/tasks/real-arm.md, "What the station does"; `ArmHardware` holds
+the limits). With the driver simulator in the same process (`ArmHardware.driver_sim`)
+both sides keep the simulation's clock (`SIMULATION_CLOCK`).
 """
 
 import time
@@ -161,8 +150,8 @@ def read_first_status(hardware, lcm, lower, upper):
 
 
 class DriverLink(LeafSystem):
-    """The station's link to a real arm's driver, under the drivers' rules (the module's
-    docstring).
+    """The station's link to a real arm's driver, under the drivers' rules
+    (docs/tasks/real-arm.md).
 
     .. pydrake_system::
 

@@ -1,5 +1,5 @@
 """A fixed-base arm from any URDF or SDFormat file that follows an end-effector command, as
-one Diagram with the HSR station's ports (docs/concepts/your-robot.md)::
+one Diagram with the HSR station's ports (docs/concepts/your-robot.md has an example)::
 
     ee_command ─► WholeBodyDiffIk (its EeCommandRamp) ─► [q_d, v_d] (desired_state)
     desired_state ─► KinematicJoints (motion: kinematic) or the plant's PD (dynamic)
@@ -7,21 +7,9 @@ one Diagram with the HSR station's ports (docs/concepts/your-robot.md)::
     obstacle_positions ─► CylinderObstacleGeometry ─► SceneGraph ─► CollisionMonitor
 
 With ``config.hardware.connect`` the same ports drive a real arm through its Drake LCM
-driver (``pbp_drake.robots.arm_driver``)::
-
-    LcmSubscriberSystem (STATUS) ─► DriverLink ◄─ desired_state;  DriverLink ─► COMMAND
-    DriverLink.state (measured) ─► KinematicJoints ─► robot state (the geometry, ee_state)
-
-with ``hardware.driver_sim`` the driver simulator (``pbp_drake.robots.driver_sim``) inside
-on a memq:// bus of its own. The diff IK is the HSR station's; gravity is off.
-
-Example::
-
-    station = make_arm_station(ArmStationConfig(
-        model_file="package://pbp_drake_models/arm7/pbp_arm7.urdf",
-        base_frame="arm7_base", ee_frame="arm7_ee",
-        initial_positions=[0.0, 0.9, 0.0, -1.6, 0.0, 0.7, 0.0]))
-    ee_state = arm_initial_ee_state(station)   # where the hand starts
+driver, ``DriverLink``'s measured state in place of the plan (docs/tasks/real-arm.md, "What
+the station does"); with ``hardware.driver_sim`` the driver simulator inside, on a memq://
+bus of its own. The diff IK is the HSR station's; gravity is off.
 """
 
 import numpy as np
@@ -96,7 +84,7 @@ def make_arm_station(config: ArmStationConfig, meshcat=None) -> Diagram:
 
 
 def _add_driver_link(builder, plant, arm, q0, hardware, diff_ik):
-    """The LCM side of the station (the module's docstring); returns the measured state's
+    """The LCM side of the station (docs/tasks/real-arm.md); returns the measured state's
     port. `q0` is where the driver's first status put the arm (or the simulator)."""
     driver = DRIVERS[hardware.driver]
     q_start = _arm_positions(arm, q0)
@@ -170,8 +158,8 @@ def _add_motors(plant, arm):
 
 
 def _set_servo_gains(plant, arm, q0, frequency):
-    """Each motor critically damped at `frequency` on its joint's inertia at `q0` (the
-    mass matrix's diagonal): kp = I w^2, kd = 2 I w, as the HSR station's gains."""
+    """Each motor's gains of `ArmStationConfig.servo_frequency`, its joint's inertia the
+    mass matrix's diagonal at `q0`."""
     context = plant.CreateDefaultContext()
     plant.SetPositions(context, q0)
     inertia = np.diag(plant.CalcMassMatrix(context))

@@ -1,12 +1,7 @@
 """The checks of an arm's model file (URDF or SDFormat) before Drake reads it, over the
-file's XML alone: what would hang, fail at build or mid-run, or print unreadable names.
-
-`check_model_file` reads the file (at most MAX_MODEL_FILE_BYTES, UTF-8 XML without a
-DOCTYPE) and refuses names holding control characters or invisible formatting marks; a
-link hanging from two joints, and loops; meshes and textures missing or behind the network;
-masses and inertias not finite, negative masses, and with ``motion: dynamic`` inertias not
-physical and joints that move no mass. Each refusal is a one-line ValueError naming the
-config's field, the file and the element.
+file's XML alone: what would hang, fail at build or mid-run, or print unreadable names
+(the list: docs/concepts/your-robot.md, "What is checked in the model file"). Each refusal
+is a one-line ValueError naming the config's field, the file and the element.
 """
 
 import dataclasses
@@ -145,9 +140,9 @@ _CHECKED = {}
 
 def check_model_file(source, motion, field="ArmStationConfig.model_file"):
     """Reads and checks the model file `source` (a path from the working folder, or a
-    package:// URL of ours or Drake's; see the module's list) for a station of `motion`
-    ("kinematic" or "dynamic"); returns its `ModelFile`. Raises a one-line ValueError
-    naming `field`, the file, the element and its field."""
+    package:// URL of ours or Drake's) for a station of `motion` ("kinematic" or
+    "dynamic"); returns its `ModelFile`. Raises a one-line ValueError naming `field`, the
+    file, the element and its field."""
     refuse = _Refusal(field, source)
     path = _url_path(source, Path.cwd(), lambda why: refuse(None, "the file", why))
     if not path.is_file():

@@ -185,25 +185,24 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
         value = getattr(config, name)
         if not (np.isfinite(value) and value >= 0):
             raise ValueError(f"ArmStationConfig.{name} must be >= 0, got {value}")
-    if config.hardware is not None:
-        validate_arm_hardware(config.hardware)
-
-
-def validate_arm_hardware(hardware: ArmHardware) -> None:
-    """Raises ValueError naming the first field of ``hardware`` that cannot work."""
-    field = "ArmStationConfig.hardware"
-    if hardware.driver not in DRIVERS:
-        raise ValueError(f"{field}.driver must be one of {sorted(DRIVERS)}, got "
-                         f"{hardware.driver!r}")
-    validate_link(hardware, field, ("status_timeout", "connect_timeout", "command_expiry",
-                                    "start_tolerance"))
+    hardware = config.hardware
+    if hardware is not None:
+        if hardware.driver not in DRIVERS:
+            raise ValueError(f"ArmStationConfig.hardware.driver must be one of "
+                             f"{sorted(DRIVERS)}, got {hardware.driver!r}")
+        validate_link(hardware, "ArmStationConfig.hardware", (
+            "status_timeout", "connect_timeout", "command_expiry", "start_tolerance"))
 
 
 def validate_link(link, field, positive):
     """Raises ValueError naming the field (`field`: where `link` stands) unless the LCM URL
-    of an `ArmHardware` or `TaskSpaceBridgeConfig` can be shared, its fields `positive` are
-    finite and positive, and `driver_sim` comes only with `connect`."""
-    check_lcm_url(link.lcm_bus.lcm_url, f"{field}.lcm_bus.lcm_url")
+    of an `ArmHardware` or `TaskSpaceBridgeConfig` can be shared by two processes, its
+    fields `positive` are finite and positive, and `driver_sim` comes only with `connect`."""
+    url = link.lcm_bus.lcm_url
+    if not (url == "memq://" or _valid_udpm(url)):
+        raise ValueError(f"{field}.lcm_bus.lcm_url {url!r} is not an LCM URL the driver can "
+                         "share: udpm://ADDRESS:PORT?ttl=N (a multicast IPv4 address) or "
+                         f"memq://; Drake's hardware_sim uses {DEFAULT_LCM_URL}")
     check_positive(link, positive, field)
     if link.driver_sim and not link.connect:
         raise ValueError(f"{field}.driver_sim needs connect (pbp-drake run --hardware "
@@ -219,16 +218,8 @@ def check_positive(config, names, prefix):
             raise ValueError(f"{prefix}.{name} must be finite and positive, got {value}")
 
 
-def check_lcm_url(url, field):
-    """Raises ValueError naming `field` unless `url` is an LCM URL two processes can share
-    (udpm:// with a multicast IPv4 address and a port) or memq://."""
-    if not (url == "memq://" or _valid_udpm(url)):
-        raise ValueError(f"{field} {url!r} is not an LCM URL the driver can share: "
-                         "udpm://ADDRESS:PORT?ttl=N (a multicast IPv4 address) or memq://; "
-                         f"Drake's hardware_sim uses {DEFAULT_LCM_URL}")
-
-
 def _valid_udpm(url):
+    """Whether `url` is udpm:// with a multicast IPv4 address and a port."""
     match = _UDPM.fullmatch(url)
     if match is None:
         return False

@@ -3,10 +3,7 @@ is at every instant. No plant is stepped: the MultibodyPlant, outside the Diagra
 the kinematics and the geometry (docs/tasks/hsr-station.md, "A kinematic robot")."""
 
 import numpy as np
-from pydrake.geometry import SceneGraph
-from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import LeafSystem
-from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from pbp_drake.systems.ports import PortGetters
 
@@ -54,27 +51,3 @@ class KinematicJoints(PortGetters, LeafSystem):
             state[follower] = ratio * state[leader]
         output.SetFromVector(state)
 
-
-def add_kinematic_plant(builder, time_step):
-    """A SceneGraph in `builder` and a MultibodyPlant registered with it but not added:
-    `(plant, scene_graph)`, the plant to be filled and finalized by the caller."""
-    scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
-    plant = MultibodyPlant(time_step)
-    plant.RegisterAsSourceForSceneGraph(scene_graph)
-    return plant, scene_graph
-
-
-def add_kinematic_joints(builder, plant, scene_graph, motor_joints, desired_state,
-                         couplers=()):
-    """`KinematicJoints` fed by `desired_state`, placing the plant's geometry in
-    `scene_graph`; returns it (its `state` is the robot's)."""
-    joints = builder.AddNamedSystem("joints", KinematicJoints(plant, motor_joints, couplers))
-    builder.Connect(desired_state, joints.get_desired_state_input_port())
-    # Keeps a reference to the plant, which the Diagram does not own (pydrake keeps the
-    # plant alive as long as this system).
-    to_pose = builder.AddNamedSystem(
-        "geometry_poses", MultibodyPositionToGeometryPose(plant, input_multibody_state=True))
-    builder.Connect(joints.get_state_output_port(), to_pose.get_input_port())
-    builder.Connect(to_pose.get_output_port(),
-                    scene_graph.get_source_pose_port(plant.get_source_id()))
-    return joints

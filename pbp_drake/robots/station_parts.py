@@ -4,11 +4,12 @@ and its `ee_state`, the obstacles measured against the robot, the Meshcat visual
 import numpy as np
 from pydrake.geometry import (
     CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Rgba,
-    Role)
-from pydrake.multibody.plant import AddMultibodyPlant
+    Role, SceneGraph)
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from pbp_drake.robots.hsr_ee_systems import EeStateFromPlant
-from pbp_drake.robots.hsr_kinematic import add_kinematic_joints, add_kinematic_plant
+from pbp_drake.robots.hsr_kinematic import KinematicJoints
 from pbp_drake.systems.tasks.collision_monitor import CollisionMonitor
 from pbp_drake.systems.tasks.obstacle_geometry import CylinderObstacleGeometry
 
@@ -60,9 +61,12 @@ def add_meshcat_visualizers(builder, scene_graph, meshcat, visualization):
 def add_station_plant(builder, config, kinematic):
     """`(plant, scene_graph)` of a station's robot, its gravity off (which stands for the
     real robot's gravity compensation): the plant of `config.plant` in `builder`, or with
-    `kinematic` one outside it (`add_kinematic_plant`)."""
+    `kinematic` one registered with the SceneGraph but outside the Diagram, to be filled
+    and finalized by the caller."""
     if kinematic:
-        plant, scene_graph = add_kinematic_plant(builder, config.plant.time_step)
+        scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
+        plant = MultibodyPlant(config.plant.time_step)
+        plant.RegisterAsSourceForSceneGraph(scene_graph)
     else:
         plant, scene_graph = AddMultibodyPlant(config.plant, builder)
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
@@ -83,8 +87,16 @@ def add_robot(builder, plant, scene_graph, model, diff_ik, ramp, ee_frame, motor
     the plant's PD tracking the plan. Exports the command input and `ee_state`; returns the
     robot's state port."""
     if joints_input is not None:
-        joints = add_kinematic_joints(builder, plant, scene_graph, motor_joints, joints_input,
-                                      couplers)
+        joints = builder.AddNamedSystem("joints", KinematicJoints(plant, motor_joints,
+                                                                  couplers))
+        builder.Connect(joints_input, joints.get_desired_state_input_port())
+        # Keeps a reference to the plant, which the Diagram does not own (pydrake keeps the
+        # plant alive as long as this system).
+        to_pose = builder.AddNamedSystem("geometry_poses", MultibodyPositionToGeometryPose(
+            plant, input_multibody_state=True))
+        builder.Connect(joints.get_state_output_port(), to_pose.get_input_port())
+        builder.Connect(to_pose.get_output_port(),
+                        scene_graph.get_source_pose_port(plant.get_source_id()))
         state = joints.get_state_output_port()
     else:
         state = plant.get_state_output_port()

@@ -374,7 +374,10 @@ def _resolve_task_robot(scenario):
                                 "objects stand at heights of their own (scenario.task."
                                 "z_range) takes !Keyboard or !VirtualParticipant")
     if isinstance(robot, Arm):
-        station, initial_ee_state, reach = _arm_station(scenario, station)
+        # The station ramps between the loop's ticks; refusals name scenario.robot's fields.
+        station = dataclasses.replace(station, control_period=scenario.control_period)
+        with _refused_as("", "ArmStationConfig.", "scenario.robot."):
+            initial_ee_state, reach = arm_ready_ee_state_and_reach(station)
     else:
         reach = None
     with _refused_as("scenario.task: ", "scenario.task: scenario.", "scenario."):
@@ -491,15 +494,6 @@ def _check_bridge(hardware, task):
             f"state alone; scenario.task !{type(task).__name__} needs more of the station "
             "(the obstacles' positions and contacts, the hand's pose): the bridge runs the "
             "reaching task")
-
-
-def _arm_station(scenario, station):
-    """An arm's station config (ramping between the loop's ticks), the hand's start and
-    the arm's reach `(shoulder, radius)`; the arm's refusals name scenario.robot's field."""
-    station = dataclasses.replace(station, control_period=scenario.control_period)
-    with _refused_as("", "ArmStationConfig.", "scenario.robot."):
-        initial_ee_state, reach = arm_ready_ee_state_and_reach(station)
-    return station, initial_ee_state, reach
 
 
 def _check_hand_over(scenario):

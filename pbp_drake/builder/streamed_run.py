@@ -1,11 +1,8 @@
-"""Running an HSR task with its per-tick rows streamed to a CSV file (`run_task_streamed`),
-for runs too long to keep their time series in memory (`pbp_drake_bench.soak`).
-
-After each chunk of simulated time the rows of the ticks it completed are appended to the
-file and every logger is cleared; the peaks (`run.SeriesPeaks`) are carried from chunk to
-chunk. A tick's decisions are logged one sample after its state (`DECISION_LOG_SHIFT`): a
-chunk's last state sample waits for the next chunk's decisions (the run's last is not
-written).
+"""Running a task with its per-tick rows streamed to a CSV file (`run_task_streamed`), for
+runs too long to keep their time series in memory (`pbp_drake_bench.soak`): after each
+chunk of simulated time the rows of the ticks it completed are appended and every logger
+is cleared; the peaks (`run.SeriesPeaks`) carry over. A chunk's last state sample waits
+for its decisions (`DECISION_LOG_SHIFT`) in the next chunk; the run's last is not written.
 """
 
 import numpy as np

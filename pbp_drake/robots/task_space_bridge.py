@@ -237,8 +237,8 @@ def make_bridged_station(config: TaskSpaceBridgeConfig, initial_ee_state, contro
                          robot_side=None) -> Diagram:
     """A run's station through the bridge (``pbp-drake run --hardware``): on
     `config.lcm_bus` to the robot's relay, or with `config.driver_sim` to `robot_side` (the
-    simulated station) behind `make_station_relay`, both on a memq:// bus of their own.
-    `config` is a resolved scenario's (checked by the loader)."""
+    simulated station) behind `make_station_relay`, both on a memq:// bus of their own."""
+    validate_task_space_bridge(config)
     builder = DiagramBuilder()
     if config.driver_sim:
         lcm = DrakeLcm("memq://")

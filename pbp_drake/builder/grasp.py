@@ -1,36 +1,10 @@
-"""The grasping task's diagram (docs/tasks/grasp.md): six-DoF PBP on the pose
-station, the hand driven to a grasp pose (position and orientation).
-
-    hsr_station.hand_pose ──> hand_pose_sample (SampleHold) ──> goal_estimator, dmp_bank,
-                                                                 blender, task_monitor,
-                                                                 operator
-    goal_poses ──> goal_estimator, dmp_bank
-    goal_estimator.selected_goal ──> dmp_bank (followed_goal, selected_goal), operator
-    goal_estimator.goal_probabilities ──> blender (confidence_alpha)
-    dmp_bank.selected_reference ──> blender.policy_reference
-    operator (operator_command: OperatorTwist, operator_active) ──> blender, dmp_bank
-                                                                   (PBP-Alt's lock),
-                                                                   task_monitor,
-                                                                   goal_estimator
-    task_monitor.target ──> operator
-    blender.reference ──> hand_over (PoseHandOver) ──> hsr_station.pose_command
-    task_monitor.target, the goal shown, dmp_bank.predicted_poses,
-    hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
-
-With `goal_estimator: {group_mass: M}` (M > 0) a `PoseGoalGrouping` stands between
-`goal_poses` and the DMP bank, as `GoalGrouping` in the reaching task; its `shown_goal` is
-what the operator, the logs and the page see:
-
-    goal_poses, hand_pose_sample, goal_estimator ──> goal_grouping
-    goal_grouping.followed_poses ──> dmp_bank.goal_poses;  goal_grouping.shown_goal ──> operator
-
-Under ``hop`` and ``predict_then_assist`` an `assistance` (`PoseHopAssistance`) adds HOP's
-action to the operator's twist in place of the DMP bank and the blender.
-
-`hsr_station` is `make_hsr_station(..., command="pose")`. Loggers named as the reaching
-task's, with `hand_pose_log` for `ee_state_log`, record each tick (`grasp_series_fields`);
-the task monitor ends the simulation at success.
-"""
+"""The grasping task's diagram: six-DoF PBP on the pose station (`make_hsr_station(...,
+command="pose")`), the hand driven to a grasp pose (position and orientation). Under
+``hop`` and ``predict_then_assist`` a `PoseHopAssistance` stands in for the DMP bank and
+the blender; with `goal_estimator: {group_mass: M}` a `PoseGoalGrouping` stands between
+`goal_poses` and the DMP bank. The wiring, the loggers (`hand_pose_log` for
+`ee_state_log`, read by `grasp_series_fields`) and why: docs/tasks/grasp.md, "The
+diagram"."""
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder

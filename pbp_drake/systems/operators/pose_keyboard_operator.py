@@ -68,9 +68,8 @@ class PoseKeyboardOperator(PoseOperatorBase):
         | R | to rotate mode | to translate mode |
 
     The mode button's label (`MODE_LABELS`) shows the mode; the run starts translating. A
-    held R toggles once. Held keys combine into one direction at `speed` or
-    `rotation_speed`. With `allow_forward=False` (PBP modes) the velocity's forward part
-    along the approach axis z_H is dropped. `operator_active` is 1 while a key is held
+    held R toggles once. Held keys combine into one direction; the speeds and the forward
+    drop of PBP modes are `PoseOperatorBase`'s. `operator_active` is 1 while a key is held
     whose own motion is not wholly dropped. Keys are held as in `KeyboardOperator`;
     `exclusive` is as in `BrowserOperator`; `Delete()` removes the buttons.
     """

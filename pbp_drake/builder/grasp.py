@@ -100,7 +100,6 @@ def build_grasp_diagram(resolved, meshcat=None):
     probabilities = estimator.get_goal_probabilities_output_port()
     intent = selected  # the goal the robot shows: the selected one, or the grouping's
 
-    # The hand-over's limits: the reach task's linear ones, and the grasp task's angular.
     limits = HandOverLimits(scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
                             ANGULAR_CHANGE_PER_TICK / period, MAX_HAND_ANGULAR_SPEED)
     method = METHODS[scenario.method]
@@ -173,7 +172,6 @@ def build_grasp_diagram(resolved, meshcat=None):
         # are its state, so this closes no algebraic loop).
         builder.Connect(shown, estimator.get_shown_goal_input_port())
     builder.Connect(twist, policy.get_operator_twist_input_port())
-    # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
     builder.Connect(twist, estimator.get_operator_twist_input_port())
 
     logged = [("hand_pose_log", hand_pose), ("operator_active_log", active),

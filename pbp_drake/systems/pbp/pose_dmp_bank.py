@@ -39,16 +39,13 @@ class PoseDmpBank(BankSystem):
         - predicted_poses (with prediction_steps > 0)
 
     docs/concepts/six-dof.md ("The pose DMP bank") tabulates the ports and explains the
-    step and the state. `robot_state` is a `PoseState`, `goal_poses` K `GoalPose` rows
-    flattened (not finite or not unit: refused naming `goal_poses`). Both parts share one
-    phase, so one lock stops both; `lock_phase_when_operator_acts`, `followed_goal` and
-    `max_speed` are `DmpBank`'s, `max_angular_speed` (rad/s) the angular part's anti-windup
-    limit. `references` is K `PoseState` rows flattened, `selected_reference` the one of
-    `selected_goal` computed alone, `predicted_poses` the selected DMP's open-loop rollout,
-    `prediction_steps + 1` `GoalPose` rows every `prediction_period` (default: the duration
-    over `prediction_steps`). The state is 12 K numbers, or 16 with `compact_state=True`
-    (which needs `followed_goal` connected). The bank updates at the decide stage of each
-    tick (`update_offset` overrides it).
+    step and the state. Both parts share one phase, so one lock stops both;
+    `lock_phase_when_operator_acts`, `followed_goal` and `max_speed` are `DmpBank`'s,
+    `max_angular_speed` (rad/s) the angular part's anti-windup limit. `predicted_poses`
+    holds `prediction_steps + 1` poses every `prediction_period` (default: the duration over
+    `prediction_steps`). The state is 12 K numbers, or 16 with `compact_state=True` (which
+    needs `followed_goal` connected). The bank updates at the decide stage of each tick
+    (`update_offset` overrides it).
     """
 
     def __init__(self, position_bank, orientation_bank, control_period,

@@ -24,8 +24,7 @@ from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
 from pbp_drake.scenarios import (
-    PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant,
-    forward_key_enabled)
+    PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, forward_key_enabled)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
     PoseGoalGrouping, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
@@ -44,16 +43,6 @@ MAX_HAND_ANGULAR_SPEED = 1.0
 # How many poses ahead the page draws the selected DMP's path, over the DMPs' duration (as
 # the reach task's TASK_PREDICTION_SAMPLES).
 GRASP_PREDICTION_SAMPLES = 40
-_OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad, *PILOT_CONFIGS)
-
-
-def check_grasp_buildable(scenario):
-    """Raises ScenarioError for a grasping scenario whose operator the builder has no
-    six-DoF system for."""
-    if not isinstance(scenario.operator, _OPERATORS):
-        raise ScenarioError(
-            f"scenario.operator !{type(scenario.operator).__name__}: the grasping task takes "
-            "a keyboard, a gamepad, the virtual participant or none")
 
 
 def grasp_dmp_banks(resolved, start_pose):
@@ -74,8 +63,7 @@ def grasp_dmp_banks(resolved, start_pose):
 
 
 def build_grasp_diagram(resolved, meshcat=None):
-    """The Diagram of a resolved grasping scenario (`check_grasp_buildable`); with `meshcat`,
-    the robot drawn there."""
+    """The Diagram of a resolved grasping scenario; with `meshcat`, the robot drawn there."""
     scenario = resolved.scenario
     period = scenario.control_period
     task = scenario.task

@@ -14,8 +14,8 @@ from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
 from pbp_drake.systems.pbp.dmp_bank import BankSystem
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
-    AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
-    hold_into, per_goal_arrays, split_head, state_size, step_all)
+    AT_START, COMPACT_TAIL_SIZE, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps,
+    compact_inputs, hold_into, per_goal_arrays, split_head, step_all)
 from pbp_drake.systems.ports import GoalPose, PoseState, finite_pose_state
 from pbp_drake.systems.tick import checked_period, checked_update_offset
 
@@ -115,7 +115,7 @@ class PoseDmpBank(BankSystem):
     @staticmethod
     def state_size(goal_count, compact_state=False):
         """The length of the one state vector (class docstring)."""
-        return state_size(goal_count, compact_state)
+        return HEAD_SIZE + (COMPACT_TAIL_SIZE if compact_state else 12 * goal_count)
 
     @property
     def position_bank(self):

@@ -34,9 +34,10 @@ class PoseGamepadOperator(PoseOperatorBase):
 
     The left stick and the triggers translate, the right stick and the shoulders rotate
     the hand in its operator frame (`core.operator_frame`); the mapping:
-    docs/concepts/six-dof.md, "Gamepad". The speeds, their caps and the forward drop of PBP
-    modes are `PoseOperatorBase`'s. `operator_active` is 1 while the twist is not zero.
-    With no gamepad the twist is zero and inactive. `exclusive` is as in `BrowserOperator`.
+    docs/concepts/six-dof.md, "Browser operators". The speeds, their caps and the forward
+    drop of PBP modes are `PoseOperatorBase`'s. `operator_active` is 1 while the twist is
+    not zero. With no gamepad the twist is zero and inactive. `exclusive` is as in
+    `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,

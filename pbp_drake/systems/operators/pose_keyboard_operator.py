@@ -58,10 +58,10 @@ class PoseKeyboardOperator(PoseOperatorBase):
 
     The arrows and PageUp/PageDown translate the hand in its operator frame
     (`core.operator_frame`), or rotate it after R; the mapping: docs/concepts/six-dof.md,
-    "Keyboard". The mode button's label (`MODE_LABELS`) shows the mode; the run starts
-    translating. A held R toggles once. Held keys combine into one direction; the speeds
-    and the forward drop of PBP modes are `PoseOperatorBase`'s. `operator_active` is 1
-    while a key is held whose own motion is not wholly dropped. Keys are held as in
+    "Browser operators". The mode button's label (`MODE_LABELS`) shows the mode; the run
+    starts translating. A held R toggles once. Held keys combine into one direction; the
+    speeds and the forward drop of PBP modes are `PoseOperatorBase`'s. `operator_active` is
+    1 while a key is held whose own motion is not wholly dropped. Keys are held as in
     `KeyboardOperator`; `exclusive` is as in `BrowserOperator`; `Delete()` removes the
     buttons.
     """

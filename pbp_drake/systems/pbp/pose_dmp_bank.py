@@ -121,10 +121,6 @@ class PoseDmpBank(BankSystem):
     def position_bank(self):
         return self._positions
 
-    @property
-    def orientation_bank(self):
-        return self._orientations
-
     def _stepped(self, context, vector):
         """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K): views of
         `vector` per goal, or of the compact layout's cache entry."""

@@ -40,7 +40,8 @@ class PoseCommandRamp(CommandRamp):
 
     `X_WE_desired` at time t is the command carried along its own twist for
     `CommandRamp.ahead` seconds, `(Exp(w ahead) q, p + v ahead)` (a ramp between ticks, as
-    `EeCommandToPose`'s); `V_WE_desired` is `[w, v]`.
+    `EeCommandToPose`'s); `V_WE_desired` is `[w, v]`. No state: the command carries its
+    angular velocity.
     """
 
     port_name = "pose_command"

@@ -54,6 +54,10 @@ class PoseVirtualOperator(SampledOperator):
                 participant.seed, participant.motor_noise_scales))
         self._declare_operator_outputs(delay_ticks(impairment.command_delay, control_period))
 
+    @property
+    def participant(self):
+        return self._participant
+
     def _update(self, context, discrete_state):
         memory = ParticipantMemory.from_array(
             context.get_discrete_state(self._memory_index).value())

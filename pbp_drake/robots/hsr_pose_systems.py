@@ -40,8 +40,7 @@ class PoseCommandRamp(CommandRamp):
 
     `X_WE_desired` at time t is the command carried along its own twist for
     `CommandRamp.ahead` seconds, `(Exp(w ahead) q, p + v ahead)` (a ramp between ticks, as
-    `EeCommandToPose`'s); `V_WE_desired` is `[w, v]`. No state: the command carries its
-    angular velocity.
+    `EeCommandToPose`'s); `V_WE_desired` is `[w, v]`.
     """
 
     port_name = "pose_command"

@@ -11,7 +11,7 @@ import shutil
 import subprocess
 import sys
 
-from pbp_drake.builder import build_diagram, check_buildable
+from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
 
 # Node ids: `digraph _143`, `cluster143diagram`, `s2 [...]`, `s2:y0:e -> s5:u1:w`, and a
@@ -149,7 +149,6 @@ def main(argv=None):
             resolved = load_scenario_file(path).resolved
             if args.method:
                 resolved = resolved.with_method(args.method)
-            check_buildable(resolved)
         except ScenarioError as error:
             print(f"pbp-drake draw: {error}", file=sys.stderr)
             return 2

@@ -1,6 +1,6 @@
 """The one entry point from a scenario to a Drake Diagram."""
 
-from pbp_drake.builder.grasp import build_grasp_diagram, check_grasp_buildable
+from pbp_drake.builder.grasp import build_grasp_diagram
 from pbp_drake.builder.reach import build_reach_diagram
 from pbp_drake.builder.point_robot import build_point_robot_diagram
 from pbp_drake.scenarios import GraspTask, ResolvedScenario, resolve
@@ -12,20 +12,11 @@ def build_diagram(scenario, meshcat=None, prediction_steps=None, hand_trail=Fals
     paths are drawn (default: their duration, when drawing); `hand_trail` (the reaching and
     obstacle tasks) draws the hand's path as it grows."""
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
-    check_buildable(resolved)
     if resolved.has_task and isinstance(resolved.scenario.task, GraspTask):
         return build_grasp_diagram(resolved, meshcat)
     if resolved.has_task:
         return build_reach_diagram(resolved, meshcat, hand_trail)
     return build_point_robot_diagram(resolved, meshcat, prediction_steps)
-
-
-def check_buildable(resolved):
-    """Raises ScenarioError for a resolved scenario the builder cannot build, so that the
-    commands refuse it before they start: a grasping task whose operator has no six-DoF
-    system."""
-    if resolved.has_task and isinstance(resolved.scenario.task, GraspTask):
-        check_grasp_buildable(resolved.scenario)
 
 
 def find_system(diagram, name):

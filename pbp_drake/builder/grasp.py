@@ -1,36 +1,10 @@
-"""The grasping task's diagram (docs/tasks/grasp.md): six-DoF PBP on the pose
-station, the hand driven to a grasp pose (position and orientation).
-
-    hsr_station.hand_pose ──> hand_pose_sample (SampleHold) ──> goal_estimator, dmp_bank,
-                                                                 blender, task_monitor,
-                                                                 operator
-    goal_poses ──> goal_estimator, dmp_bank
-    goal_estimator.selected_goal ──> dmp_bank (followed_goal, selected_goal), operator
-    goal_estimator.goal_probabilities ──> blender (confidence_alpha)
-    dmp_bank.selected_reference ──> blender.policy_reference
-    operator (operator_command: OperatorTwist, operator_active) ──> blender, dmp_bank
-                                                                   (PBP-Alt's lock),
-                                                                   task_monitor,
-                                                                   goal_estimator
-    task_monitor.target ──> operator
-    blender.reference ──> hand_over (PoseHandOver) ──> hsr_station.pose_command
-    task_monitor.target, the goal shown, dmp_bank.predicted_poses,
-    hsr_station.hand_pose ──> task_visualizer (GraspSceneVisualizer, with Meshcat)
-
-With `goal_estimator: {group_mass: M}` (M > 0) a `PoseGoalGrouping` stands between
-`goal_poses` and the DMP bank, as `GoalGrouping` in the reaching task; its `shown_goal` is
-what the operator, the logs and the page see:
-
-    goal_poses, hand_pose_sample, goal_estimator ──> goal_grouping
-    goal_grouping.followed_poses ──> dmp_bank.goal_poses;  goal_grouping.shown_goal ──> operator
-
-Under ``hop`` and ``predict_then_assist`` an `assistance` (`PoseHopAssistance`) adds HOP's
-action to the operator's twist in place of the DMP bank and the blender.
-
-`hsr_station` is `make_hsr_station(..., command="pose")`. Loggers named as the reaching
-task's, with `hand_pose_log` for `ee_state_log`, record each tick (`grasp_series_fields`);
-the task monitor ends the simulation at success.
-"""
+"""The grasping task's diagram: six-DoF PBP on the pose station (`make_hsr_station(...,
+command="pose")`), the hand driven to a grasp pose (position and orientation). Under
+``hop`` and ``predict_then_assist`` a `PoseHopAssistance` stands in for the DMP bank and
+the blender; with `goal_estimator: {group_mass: M}` a `PoseGoalGrouping` stands between
+`goal_poses` and the DMP bank. The wiring, the loggers (`hand_pose_log` for
+`ee_state_log`, read by `grasp_series_fields`) and why: docs/tasks/grasp.md, "The
+diagram"."""
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder
@@ -50,8 +24,7 @@ from pbp_drake.core.quaternion import angle_between
 from pbp_drake.robots import make_hsr_station
 from pbp_drake.robots.hsr_station import hsr_initial_hand_pose
 from pbp_drake.scenarios import (
-    PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, ScenarioError, VirtualParticipant,
-    forward_key_enabled)
+    PILOT_CONFIGS, Gamepad, Keyboard, NoOperator, forward_key_enabled)
 from pbp_drake.systems import (
     PoseVirtualOperator, GraspTaskMonitor, IdleOperator, PoseBlender, PoseDmpBank,
     PoseGoalGrouping, PoseHandOver, PoseHopAssistance, PoseMaxEntGoalEstimator, SampleHold)
@@ -70,16 +43,6 @@ MAX_HAND_ANGULAR_SPEED = 1.0
 # How many poses ahead the page draws the selected DMP's path, over the DMPs' duration (as
 # the reach task's TASK_PREDICTION_SAMPLES).
 GRASP_PREDICTION_SAMPLES = 40
-_OPERATORS = (VirtualParticipant, NoOperator, Keyboard, Gamepad, *PILOT_CONFIGS)
-
-
-def check_grasp_buildable(scenario):
-    """Raises ScenarioError for a grasping scenario whose operator the builder has no
-    six-DoF system for."""
-    if not isinstance(scenario.operator, _OPERATORS):
-        raise ScenarioError(
-            f"scenario.operator !{type(scenario.operator).__name__}: the grasping task takes "
-            "a keyboard, a gamepad, the virtual participant or none")
 
 
 def grasp_dmp_banks(resolved, start_pose):
@@ -100,8 +63,7 @@ def grasp_dmp_banks(resolved, start_pose):
 
 
 def build_grasp_diagram(resolved, meshcat=None):
-    """The Diagram of a resolved grasping scenario (`check_grasp_buildable`); with `meshcat`,
-    the robot drawn there."""
+    """The Diagram of a resolved grasping scenario; with `meshcat`, the robot drawn there."""
     scenario = resolved.scenario
     period = scenario.control_period
     task = scenario.task
@@ -126,7 +88,6 @@ def build_grasp_diagram(resolved, meshcat=None):
     probabilities = estimator.get_goal_probabilities_output_port()
     intent = selected  # the goal the robot shows: the selected one, or the grouping's
 
-    # The hand-over's limits: the reach task's linear ones, and the grasp task's angular.
     limits = HandOverLimits(scenario.robot.max_hand_acceleration, scenario.robot.max_hand_speed,
                             ANGULAR_CHANGE_PER_TICK / period, MAX_HAND_ANGULAR_SPEED)
     method = METHODS[scenario.method]
@@ -199,7 +160,6 @@ def build_grasp_diagram(resolved, meshcat=None):
         # are its state, so this closes no algebraic loop).
         builder.Connect(shown, estimator.get_shown_goal_input_port())
     builder.Connect(twist, policy.get_operator_twist_input_port())
-    # The estimator reads the operator's twist: the hand's is mostly the selected DMP's.
     builder.Connect(twist, estimator.get_operator_twist_input_port())
 
     logged = [("hand_pose_log", hand_pose), ("operator_active_log", active),

@@ -5,7 +5,6 @@ the page's port, the scenario with the command line's overrides, the flags' chec
 import dataclasses
 import sys
 
-from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
 from pbp_drake.commands.run_checks import check_run_flags
 from pbp_drake.commands.run_page import add_page_flags, open_page
@@ -148,7 +147,6 @@ def _run(args):
             raise ScenarioError(str(error)) from None
     try:
         resolved = scenario_for_run(args)
-        check_buildable(resolved)  # before the page opens: what the builder cannot build
         if args.camera == "robot" and (not resolved.has_task or resolved.is_arm):
             raise ScenarioError("--camera robot looks from the HSR's head; this scenario "
                                 "has no HSR")

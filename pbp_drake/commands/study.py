@@ -8,7 +8,6 @@ import pathlib
 import sys
 import time
 
-from pbp_drake.builder import check_buildable
 from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_TERMINATED, method_list
 from pbp_drake.commands.scenario_flags import (
     add_goals_flag, add_override_flags, scenario_overrides)
@@ -124,7 +123,6 @@ def _study(args):
     if args.output is None:
         args.output = str(default_output(args.scenario, scenario_file, args.methods))
     check_output_folder(args.output)
-    check_buildable(scenario_file.resolved)
     if isinstance(scenario_file.scenario, TaskScenario):
         return _method_study(args, scenario_file, overrides)
     for flag, given in (("--pilots", args.pilots is not None),

@@ -15,16 +15,6 @@ AT_GOAL = 1e-9
 AT_ORIENTATION = 1e-9
 
 
-def validate_grasp_goals(grasp_positions, grasp_orientations):
-    """`(positions (K, 3), orientations (K, 4))` checked: one unit quaternion per position."""
-    positions = validate_goals(grasp_positions)
-    orientations = unit_quaternions(grasp_orientations, "grasp orientations")
-    if orientations.shape != (len(positions), 4):
-        raise ValueError(f"grasp orientations must be (K, 4) with K = {len(positions)} (one "
-                         f"per grasp position), got shape {orientations.shape}")
-    return positions, orientations
-
-
 def travel_angles(grasp_positions, position, velocity, min_speed):
     """`alpha_k` (K,): the angle between `velocity` and the direction to each grasp
     position; all 0 below `min_speed`."""
@@ -61,8 +51,11 @@ def pose_costs(settings, grasp_positions, grasp_orientations, position, orientat
 def pose_probabilities(settings, grasp_positions, grasp_orientations, position, orientation,
                        velocity, angular_velocity):
     """The K probabilities of the ``pose`` estimator: `softmax(-cost / temperature)`."""
-    grasp_positions, grasp_orientations = validate_grasp_goals(grasp_positions,
-                                                               grasp_orientations)
+    grasp_positions = validate_goals(grasp_positions)
+    grasp_orientations = unit_quaternions(grasp_orientations, "grasp orientations")
+    if grasp_orientations.shape != (len(grasp_positions), 4):
+        raise ValueError(f"grasp orientations must be (K, 4) with K = {len(grasp_positions)} "
+                         f"(one per grasp position), got shape {grasp_orientations.shape}")
     position = validate_point(position, "position")
     orientation = unit_quaternions(orientation, "orientation")
     if orientation.shape != (4,):

@@ -138,14 +138,6 @@ def sample_grasp_scene(seed, object_count=(2, 4), x_range=(1.25, 2.5), y_range=(
     poses = [grasp_pose(center, approach, angle, object_height, grasp_depth)
              for center, approach, angle in zip(objects, approaches, angles)]
     positions = np.array([position for position, _ in poses])
-    _check_reachable(positions)
-    return GraspScene(objects=objects, tables=tables, approaches=approaches,
-                      approach_angles=angles, grasp_positions=positions,
-                      grasp_orientations=np.array([orientation for _, orientation in poses]),
-                      targets=tuple(targets))
-
-
-def _check_reachable(positions):
     heights = positions[:, 2]
     bad = np.flatnonzero((heights < HAND_HEIGHTS[0]) | (heights > HAND_HEIGHTS[1]))
     if bad.size:
@@ -153,6 +145,10 @@ def _check_reachable(positions):
                          f"{heights[bad[0]]:.2f} m, out of the HSR's reach (heights "
                          f"{HAND_HEIGHTS[0]}..{HAND_HEIGHTS[1]} m): lower table_height or "
                          "object_height")
+    return GraspScene(objects=objects, tables=tables, approaches=approaches,
+                      approach_angles=angles, grasp_positions=positions,
+                      grasp_orientations=np.array([orientation for _, orientation in poses]),
+                      targets=tuple(targets))
 
 
 def grasp_errors(position, orientation, grasp_positions, grasp_orientations):

@@ -26,28 +26,20 @@ NO_TARGET = -1
 
 # The reach participant's calibrated defaults, the one home of those this one shares.
 _REACH_DEFAULTS = VirtualParticipantParams()
-# Each field shared with `VirtualParticipantParams`, by its name there.
-SHARED_WITH_REACH = {
-    "speed": "speed", "rotation_speed": "rotation_speed", "reaction_delay": "reaction_delay",
-    "direction_noise": "direction_noise", "speed_noise": "speed_noise",
-    "slow_radius": "slow_radius", "slow_angle": "turn_slowdown_angle",
-    "aligned_angle": "aligned_angle", "insist_time": "insist_time",
-    "hold_time": "hold_time", "serve_speed_fraction": "serve_speed_fraction",
-    "serve_patience": "serve_patience", "impairment": "impairment"}
+# The fields `VirtualParticipantParams` names otherwise.
+_REACH_NAMES = {"slow_angle": "turn_slowdown_angle"}
 
 
 @dataclasses.dataclass
 class GraspParticipantParams:
     """How the grasping task's virtual participant behaves. Every field is one it shares
     with the reach participant (`SHARED_WITH_REACH`), whose calibrated default it takes;
-    `insist_time`, `hold_time`, `serve_speed_fraction`, `serve_patience` and `impairment`
-    mean what `VirtualParticipantParams`' do."""
+    `speed`, `reaction_delay`, `insist_time`, `hold_time`, `serve_speed_fraction`,
+    `serve_patience` and `impairment` mean what `VirtualParticipantParams`' do."""
 
-    #: Its speed (m/s); 0 takes the task's nominal speed, that of its DMPs.
     speed: float = _REACH_DEFAULTS.speed
     #: How fast it turns the hand (rad/s).
     rotation_speed: float = _REACH_DEFAULTS.rotation_speed
-    #: It notices a new target this long (s) after it appears.
     reaction_delay: float = _REACH_DEFAULTS.reaction_delay
     #: Its velocity's direction is rotated by N(0, direction_noise) rad, its twist scaled by
     #: (1 + N(0, speed_noise)).
@@ -89,6 +81,11 @@ class GraspParticipantParams:
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be finite and not negative, got {value!r}")
+
+
+#: Each field of `GraspParticipantParams`, by its name in `VirtualParticipantParams`.
+SHARED_WITH_REACH = {field.name: _REACH_NAMES.get(field.name, field.name)
+                     for field in dataclasses.fields(GraspParticipantParams)}
 
 
 class ParticipantMemory(typing.NamedTuple):

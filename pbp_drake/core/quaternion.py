@@ -111,19 +111,11 @@ def exp_map(rotation_vector):
     return np.concatenate([np.cos(0.5 * angle)[np.newaxis], rotation_vector * half_sinc])
 
 
-def exp_times_aligned(rotation_vector, q, reference):
-    """`aligned(multiply(exp_map(r), q), reference)` for ONE rotation vector (3,) and
-    quaternions `q`, `reference` (4,), in float arithmetic: the same operations in the
-    same order, so the same numbers bit for bit, at a tenth of the time (at one quaternion
-    a NumPy call costs more than the whole product). A new (4,) array."""
-    return np.array(exp_times_aligned_values([float(value) for value in rotation_vector],
-                                             [float(value) for value in q],
-                                             [float(value) for value in reference]))
-
-
 def exp_times_aligned_values(rotation_vector, q, reference):
-    """`exp_times_aligned` on plain floats: sequences of 3, 4 and 4 in, a list of 4 out
-    (for a caller that holds floats already, as Drake's pose bank reading one goal)."""
+    """`aligned(multiply(exp_map(r), q), reference)` for ONE rotation vector and quaternions
+    `q`, `reference`, on plain floats (sequences of 3, 4 and 4 in, a list of 4 out): the
+    same operations in the same order, so the same numbers bit for bit, at a tenth of the
+    time (at one quaternion a NumPy call costs more than the whole product)."""
     rx, ry, rz = rotation_vector
     qw, qx, qy, qz = q
     angle = math.sqrt(rx * rx + ry * ry + rz * rz)

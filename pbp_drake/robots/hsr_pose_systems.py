@@ -1,12 +1,8 @@
 """The HSR pose station's task-space adapters: a six-DoF hand command (`PoseState`) in, as
 the arithmetic the station's diff IK applies itself (`PoseCommandRamp`), and the hand's
-measured pose and twist out (`PoseStateFromPlant`).
-
-The hand frame H is `hand_palm_link` (docs/tasks/grasp.md): origin at the palm, +z_H the
-approach direction, +y_H the direction the fingers close along. Orientations are unit
-quaternions (w, x, y, z) mapping H to the world (`pbp_drake.core.quaternion`); angular
-velocities are world-frame.
-"""
+measured pose and twist out (`PoseStateFromPlant`). The hand frame H (`HAND_FRAME`) and the
+conventions (quaternions mapping H to the world, world-frame angular velocities):
+docs/tasks/grasp.md, "Frames and conventions"."""
 
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
@@ -44,8 +40,7 @@ class PoseCommandRamp(CommandRamp):
 
     `X_WE_desired` at time t is the command carried along its own twist for
     `CommandRamp.ahead` seconds, `(Exp(w ahead) q, p + v ahead)` (a ramp between ticks, as
-    `EeCommandToPose`'s); `V_WE_desired` is `[w, v]`. No state: the command carries its
-    angular velocity.
+    `EeCommandToPose`'s); `V_WE_desired` is `[w, v]`.
     """
 
     port_name = "pose_command"

@@ -132,7 +132,8 @@ def test_exp_times_aligned_is_the_vectorised_composition_bit_for_bit():
     for rotation_vector, q, reference in cases:
         expected = quaternion.aligned(quaternion.multiply(quaternion.exp_map(rotation_vector), q),
                                       reference)
-        got = quaternion.exp_times_aligned(rotation_vector, q, reference)
+        got = np.array(quaternion.exp_times_aligned_values(
+            rotation_vector.tolist(), q.tolist(), reference.tolist()))
         assert np.array_equal(got, expected), (rotation_vector, q, reference)
         flipped += np.array_equal(got, -quaternion.multiply(quaternion.exp_map(rotation_vector), q))
     assert 500 < flipped < 1500  # both hemispheres were taken

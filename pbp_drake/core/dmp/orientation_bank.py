@@ -1,12 +1,8 @@
-"""K orientation DMPs, one per goal orientation, as one immutable model stepped by a pure
-function vectorised over goals (the formulation: `pbp_drake.core.dmp.orientation`).
-
-The API is the position `DmpBankModel`'s, with orientations for positions, so that a 6-DoF
-bank can step both halves side by side: the state is `(phase (K,), orientations (4, K),
-scaled angular velocities (3, K))`, goals are `(4, K)`, and given the same settings, `tau`
-and `locked` the two banks' phases stay equal. The step is the position bank's on
-`e = Log(q g*)` (3, K), with the quaternion math around it (`orientation_kernels`,
-`orientation_log_step`) written into an `OrientationWorkspace` the caller owns."""
+"""K orientation DMPs, one per goal orientation, as one immutable model: the position
+`DmpBankModel`'s API with orientations for positions, so that a six-DoF bank steps both
+halves side by side at one phase. The step is the position bank's on `e = Log(q g*)`
+(`pbp_drake.core.dmp.orientation`), the quaternion math around it in `orientation_kernels`
+and `orientation_log_step`."""
 
 import functools
 

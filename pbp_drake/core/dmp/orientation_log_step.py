@@ -1,24 +1,13 @@
 """The orientation bank's step in log coordinates from ONE measured orientation `q` (4, 1)
 and ONE scaled angular velocity `eta` (3, 1) for all K DMPs (PBP's goal switch, the six-DoF
 Drake system's every tick), fused into two small BLAS products around one chain of
-per-goal numbers. Per goal `g` (`pbp_drake.core.dmp.orientation`),
-
-    e = Log(q g*),  z = J(e)^-1 eta = p eta - (e x eta)/2 + c (e.eta) e,
-    [e'; z'] = (Phi (x) I3) [e; z] + b,
-
-with `p = (t/2) cot(t/2)`, `c = (1 - p)/t^2`, `t = |e|`:
-
-- `q g*` and `v.eta` (`v` its vector part) are rows of `A g` (`error_matrix`);
-- with `s = |v| = sin(t/2)`, `h = atan(s / w)` (`t/2` with the sign of `w`: the log of
-  `-q g*`, the same orientation) and `k = h / s`: `e = 2 k v`, `p = k w` and
-  `c (e.eta) e = d k v` with `d = 4 c k (v.eta)`;
-- `[e'; z'] = M [k v; d; c (e.eta) e; p; forcing rows]` (`combination_matrix`), the
-  attractor's part `b` in rows the caller fills (`forcing_rows`).
-
-The results equal the general kernels' (`orientation_kernels`) to rounding
-(`tests/core/test_orientation_bank_equivalence.py`); a 180-degree error (`w = 0`) takes
-`atan2` and the sign rule of `quaternion.canonical`. Why it is faster: docs/concepts/dmp.md,
-"Orientation DMPs"."""
+per-goal numbers: `A g` (`error_matrix`) is `q g*` and `v.eta`; `h = atan(s / w)`,
+`k = h / s` give `e = 2 k v` and `p = k w`; then, with `d = 4 c k (v.eta)`,
+`[e'; z'] = M [k v; d; c (e.eta) e; p; forcing rows]` (`combination_matrix`; the
+attractor's part `b` in the rows of `forcing_rows`). The derivation and why it is faster:
+docs/concepts/dmp.md, "Orientation DMPs". The results equal the general kernels'
+(`orientation_kernels`) to rounding (`tests/core/test_orientation_bank_equivalence.py`); a
+180-degree error (`w = 0`) takes `atan2` and the sign rule of `quaternion.canonical`."""
 
 import functools
 

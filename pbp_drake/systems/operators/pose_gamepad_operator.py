@@ -32,23 +32,12 @@ class PoseGamepadOperator(PoseOperatorBase):
         - operator_twist
         - operator_active
 
-    In the operator frame of the hand (`core.operator_frame`: forward along the hand's
-    heading, left, world up):
-
-    ::
-
-        | control | moves |
-        |---|---|
-        | left stick up / down | forward / back |
-        | left stick left / right | left / right |
-        | right trigger (RT, button 7) / left trigger (LT, 6) | up / down |
-        | right stick left / right | yaw left / right (about world +z) |
-        | right stick up / down | pitch the approach axis down / up (about `left`) |
-        | right shoulder (RB, 5) / left shoulder (LB, 4) | roll right / left about z_H |
-
-    The speeds, their caps and the forward drop of PBP modes are `PoseOperatorBase`'s.
-    `operator_active` is 1 while the twist is not zero. With no gamepad the twist is zero
-    and inactive. `exclusive` is as in `BrowserOperator`.
+    The left stick and the triggers translate, the right stick and the shoulders rotate
+    the hand in its operator frame (`core.operator_frame`); the mapping:
+    docs/concepts/six-dof.md, "Browser operators". The speeds, their caps and the forward
+    drop of PBP modes are `PoseOperatorBase`'s. `operator_active` is 1 while the twist is
+    not zero. With no gamepad the twist is zero and inactive. `exclusive` is as in
+    `BrowserOperator`.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,

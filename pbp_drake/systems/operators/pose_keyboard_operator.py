@@ -56,23 +56,14 @@ class PoseKeyboardOperator(PoseOperatorBase):
         - operator_twist
         - operator_active
 
-    In the operator frame of the hand (`core.operator_frame`):
-
-    ::
-
-        | key | translate mode | rotate mode |
-        |---|---|---|
-        | ↑ / ↓ | forward / back | pitch the approach axis down / up |
-        | ← / → | left / right | yaw left / right (about world +z) |
-        | PageUp / PageDown | up / down | roll right / left about z_H |
-        | R | to rotate mode | to translate mode |
-
-    The mode button's label (`MODE_LABELS`) shows the mode; the run starts translating. A
-    held R toggles once. Held keys combine into one direction at `speed` or
-    `rotation_speed`. With `allow_forward=False` (PBP modes) the velocity's forward part
-    along the approach axis z_H is dropped. `operator_active` is 1 while a key is held
-    whose own motion is not wholly dropped. Keys are held as in `KeyboardOperator`;
-    `exclusive` is as in `BrowserOperator`; `Delete()` removes the buttons.
+    The arrows and PageUp/PageDown translate the hand in its operator frame
+    (`core.operator_frame`), or rotate it after R; the mapping: docs/concepts/six-dof.md,
+    "Browser operators". The mode button's label (`MODE_LABELS`) shows the mode; the run
+    starts translating. A held R toggles once. Held keys combine into one direction; the
+    speeds and the forward drop of PBP modes are `PoseOperatorBase`'s. `operator_active` is
+    1 while a key is held whose own motion is not wholly dropped. Keys are held as in
+    `KeyboardOperator`; `exclusive` is as in `BrowserOperator`; `Delete()` removes the
+    buttons.
     """
 
     def __init__(self, meshcat, control_period, allow_forward,

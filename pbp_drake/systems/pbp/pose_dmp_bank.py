@@ -14,8 +14,8 @@ from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
 from pbp_drake.systems.pbp.dmp_bank import BankSystem
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
-    AT_START, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps, compact_inputs,
-    hold_into, per_goal_arrays, split_head, state_size, step_all)
+    AT_START, COMPACT_TAIL_SIZE, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps,
+    compact_inputs, hold_into, per_goal_arrays, split_head, step_all)
 from pbp_drake.systems.ports import GoalPose, PoseState, finite_pose_state
 from pbp_drake.systems.tick import checked_period, checked_update_offset
 
@@ -39,16 +39,13 @@ class PoseDmpBank(BankSystem):
         - predicted_poses (with prediction_steps > 0)
 
     docs/concepts/six-dof.md ("The pose DMP bank") tabulates the ports and explains the
-    step and the state. `robot_state` is a `PoseState`, `goal_poses` K `GoalPose` rows
-    flattened (not finite or not unit: refused naming `goal_poses`). Both parts share one
-    phase, so one lock stops both; `lock_phase_when_operator_acts`, `followed_goal` and
-    `max_speed` are `DmpBank`'s, `max_angular_speed` (rad/s) the angular part's anti-windup
-    limit. `references` is K `PoseState` rows flattened, `selected_reference` the one of
-    `selected_goal` computed alone, `predicted_poses` the selected DMP's open-loop rollout,
-    `prediction_steps + 1` `GoalPose` rows every `prediction_period` (default: the duration
-    over `prediction_steps`). The state is 12 K numbers, or 16 with `compact_state=True`
-    (which needs `followed_goal` connected). The bank updates at the decide stage of each
-    tick (`update_offset` overrides it).
+    step and the state. Both parts share one phase, so one lock stops both;
+    `lock_phase_when_operator_acts`, `followed_goal` and `max_speed` are `DmpBank`'s,
+    `max_angular_speed` (rad/s) the angular part's anti-windup limit. `predicted_poses`
+    holds `prediction_steps + 1` poses every `prediction_period` (default: the duration over
+    `prediction_steps`). The state is 12 K numbers, or 16 with `compact_state=True` (which
+    needs `followed_goal` connected). The bank updates at the decide stage of each tick
+    (`update_offset` overrides it).
     """
 
     def __init__(self, position_bank, orientation_bank, control_period,
@@ -118,15 +115,11 @@ class PoseDmpBank(BankSystem):
     @staticmethod
     def state_size(goal_count, compact_state=False):
         """The length of the one state vector (class docstring)."""
-        return state_size(goal_count, compact_state)
+        return HEAD_SIZE + (COMPACT_TAIL_SIZE if compact_state else 12 * goal_count)
 
     @property
     def position_bank(self):
         return self._positions
-
-    @property
-    def orientation_bank(self):
-        return self._orientations
 
     def _stepped(self, context, vector):
         """The K DMPs' stepped arrays `[y' - p, z']` and `[e', z']` (2, 3, K): views of

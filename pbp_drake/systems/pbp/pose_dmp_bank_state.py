@@ -16,11 +16,6 @@ HEAD_SIZE = 12
 COMPACT_TAIL_SIZE = 4
 
 
-def state_size(goal_count, compact):
-    """The length of the state vector of either layout (module docstring)."""
-    return HEAD_SIZE + (COMPACT_TAIL_SIZE if compact else 12 * goal_count)
-
-
 def split_head(vector):
     """Views: phase (1,), held (1,), p (3, 1), q (4, 1), eta (3, 1)."""
     return (vector[0:1], vector[1:2], vector[2:5].reshape(3, 1), vector[5:9].reshape(4, 1),

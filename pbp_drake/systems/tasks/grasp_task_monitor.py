@@ -31,7 +31,6 @@ class GraspTaskMonitor(TaskMonitorBase):
 
     def __init__(self, grasp_positions, grasp_orientations, targets, switch_schedule,
                  start_pose, success_distance, success_angle, control_period):
-        # The grasp positions are the points the task's targets stand for (`objects`).
         super().__init__("hand_pose", PoseState.size, grasp_positions, targets,
                          switch_schedule, control_period)
         self._orientations = np.asarray(grasp_orientations, float)

@@ -30,14 +30,12 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         - hand_state (optional)
         - goal_probabilities (optional)
 
-    `grasps` is the task's `GraspScene` (`layout.grasps`); the scene, cloud and markers are
-    drawn as `ReachSceneVisualizer`'s. Up to `SOLID_OBJECTS` grasps, every table and object
-    is drawn with a triad `/task/grasps/{k}` at its grasp pose (`draw_triad`, z the
-    approach); with more, `likely_triads` triads `/task/likely_grasps/{i}` that each path
-    period moves to the selected grasp and the likeliest others. Each publish moves the
-    hand's triad `/task/hand` to `hand_state` (`PoseState`); each `path_period` the
-    `predicted_poses` (`prediction_steps + 1` `GoalPose` rows) are drawn as `PATH_TRIADS`
-    triads `/task/prediction/{i}` (`PathTriads`). Call from the thread that made `meshcat`.
+    The ports, the triads and the predicted path: docs/concepts/six-dof.md, "Drawing the
+    grasp scene". `grasps` is the task's `GraspScene` (`layout.grasps`); the scene, cloud
+    and markers are drawn as `ReachSceneVisualizer`'s. Up to `SOLID_OBJECTS` grasps, every
+    table and object is drawn with a triad at its grasp pose; with more, `likely_triads`
+    triads `/task/likely_grasps/{i}` that each path period moves to the selected grasp and
+    the likeliest others. Call from the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, grasps, prediction_steps=0, table_size=(0.3, 0.3),

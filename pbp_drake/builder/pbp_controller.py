@@ -1,39 +1,11 @@
 """The shared-control controller of a task-space robot as one Diagram, built from
 parameters alone (`PbpControllerConfig`): nothing in it knows which robot it drives.
-
-Under the PBP methods and explicit arbitration (`pbp_controller`):
-
-    ee_state (sampled) ──> ee_state_split ──[p, v]──> dmp_bank, blender
-                       └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
-                                              dmp_bank (followed_goal, selected_goal)
-    goals ──> dmp_bank, goal_estimator
-    operator_command, operator_active ──> goal_estimator (maxent_command and intent_filter)
-    dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
-    goal_estimator ──> likely_goals ──> dmp_bank.predicted_goals (with prediction_steps > 0:
-                                        the paths a drawing shows)
-    operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
-                                            └─> heading_command
-    operator_active ──> dmp_bank (PBP-Alt's phase lock), blender
-    blender.command [p, v] ──> hand_over (the hand-over law: bounded acceleration)
-    hand_over.command + heading_command.heading ──> ee_command (the station's input)
-
-With `goal_estimator: {group_mass: M}` (M > 0) a `GoalGrouping`
-(`pbp_drake.core.goal_groups`) stands between the goals and the DMP bank, and the
-controller's `selected_goal` is its `shown_goal`:
-
-    goals, ee_state, goal_estimator (goal_probabilities, selected_goal) ──> goal_grouping
-    goal_grouping.followed_goals ──> dmp_bank.goals;  goal_grouping.shown_goal ──> selected_goal
-
-Under ``hop`` and ``predict_then_assist`` (`hop_controller`, no DMP bank) HOP's posterior and
-its assistance take the place of the estimator, the bank and the blender:
-
-    ee_state ──> goal_estimator (MaxEntGoalEstimator) ──> assistance (goal_probabilities)
-    ee_state_split [p, v] ──> assistance;  goals ──> goal_estimator, assistance
-    operator_command ──> goal_estimator;  operator_command_split (v) ──> assistance
-    assistance.command [p, v] ──> hand_over ──> ee_command (with the heading, as PBP's)
-
-A station is wired as `build_reach_diagram` does: `station.ee_state` through a
-`SampleHold` into `ee_state`, and `ee_command` back.
+Its wiring under the PBP methods and explicit arbitration (`pbp_controller`) and under
+``hop`` and ``predict_then_assist`` (`hop_controller`): docs/design.md. With
+`goal_estimator: {group_mass: M}` (M > 0) a `GoalGrouping` stands between the goals and
+the DMP bank (`followed_goals` into the bank's `goals`), and the controller's
+`selected_goal` is its `shown_goal`. A station is wired as `build_reach_diagram` does:
+`station.ee_state` through a `SampleHold` into `ee_state`, and `ee_command` back.
 """
 
 import numpy as np

@@ -159,9 +159,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         bank, period, lock_phase_when_operator_acts=METHODS[config.method].lock_phase,
         prediction_steps=prediction_steps,
         prediction_period=bank.duration / max(prediction_steps, 1),
-        # PBP-Cont adds the operator to a DMP that keeps running: without the limit, an
-        # operator holding the hand off the DMP's path winds the DMP's velocity up past the
-        # hand's speed limit until it overrides them (the other modes never hold it so).
+        # The anti-windup of a law that adds the operator to a running DMP (PBP-Cont).
         max_speed=(config.hand_over.max_hand_speed
                    if BLEND_LAWS[config.blend_mode].adds_to_policy else None),
         # Every DMP steps from the followed one's velocity (connected below): the state is

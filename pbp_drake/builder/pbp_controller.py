@@ -39,9 +39,8 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         initial_ee_state: the hand's `EeState` (8,) where the station starts (e.g.
             `hsr_initial_ee_state(station)`): the DMPs, the hand-over and the heading
             start there.
-        goals: (K, 3) the candidate goals at the start, one DMP each (with
-            `config.dmp_duration` 0 the farthest sets the DMPs' duration); the `goals`
-            port (K x 3, row-major) brings them as they move.
+        goals: (K, 3) the candidate goals at the start, one DMP each (of
+            `config.duration_for(start, goals)`); the `goals` port brings them as they move.
         prediction_steps: > 0 adds `predicted_paths` and `predicted_goals` (PBP methods):
             the paths of `predicted_goal_count` goals (at most K), the selected goal's
             first and then the most probable others', over the DMPs' duration in that many
@@ -64,11 +63,10 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         - predicted_goals (with prediction_steps > 0)
         - posterior_clipped (with HOP's posterior)
 
-    `ee_state` is `[p (3), v (3), heading, heading_rate]`, `operator_command`
-    `[vx, vy, vz, yaw_rate]`, `operator_active` 1 while the operator acts, `ee_command`
-    `[p (3), v (3), heading]` for the next tick. `selected_goal` is the followed goal's
-    index (with goal groups, -1 until the robot commits to one), `goal_probabilities` the
-    estimator's K probabilities; the recursive estimators add `posterior_clipped`.
+    `ee_state` is an `EeState`, `operator_command` an `OperatorCommand`, `operator_active`
+    1 while the operator acts, `ee_command` the `EeCommand` of the next tick.
+    `selected_goal` is the followed goal's index (with goal groups, -1 until the robot
+    commits to one), `goal_probabilities` the estimator's K probabilities.
     """
     config.validate()
     initial_ee_state = np.asarray(initial_ee_state, float).reshape(-1)

@@ -1,6 +1,6 @@
 """Named layouts of the port and state vectors (`pydrake` `namedview`s), e.g.
-``EeState(vector).heading``, ``EeState.size`` its length; and the helpers that read ports.
-"""
+``EeState(vector).heading``, ``EeState.size`` its length; and the systems' shared helpers
+(checks of their arguments, reads of ports)."""
 
 import dataclasses
 import math

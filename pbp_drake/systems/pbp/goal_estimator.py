@@ -27,7 +27,6 @@ class GoalEstimatorBase(PortGetters, LeafSystem):
     declares its input ports in `_declare_inputs(goal_count)` and updates in `_update`, at
     the decide stage of each control tick."""
 
-    #: The type of the settings.
     _SETTINGS = GoalEstimatorSettings
 
     def __init__(self, goal_count, settings, control_period, margin=None, hold_steps=None,

@@ -1,39 +1,11 @@
 """The shared-control controller of a task-space robot as one Diagram, built from
 parameters alone (`PbpControllerConfig`): nothing in it knows which robot it drives.
-
-Under the PBP methods and explicit arbitration (`pbp_controller`):
-
-    ee_state (sampled) ──> ee_state_split ──[p, v]──> dmp_bank, blender
-                       └─> goal_estimator ──> blender (selected_goal, goal_probabilities),
-                                              dmp_bank (followed_goal, selected_goal)
-    goals ──> dmp_bank, goal_estimator
-    operator_command, operator_active ──> goal_estimator (maxent_command and intent_filter)
-    dmp_bank.selected_reference ──> blender (policy_reference: the selected goal's alone)
-    goal_estimator ──> likely_goals ──> dmp_bank.predicted_goals (with prediction_steps > 0:
-                                        the paths a drawing shows)
-    operator_command [vx, vy, vz, yaw_rate] ──> operator_command_split ──> blender (v)
-                                            └─> heading_command
-    operator_active ──> dmp_bank (PBP-Alt's phase lock), blender
-    blender.command [p, v] ──> hand_over (the hand-over law: bounded acceleration)
-    hand_over.command + heading_command.heading ──> ee_command (the station's input)
-
-With `goal_estimator: {group_mass: M}` (M > 0) a `GoalGrouping`
-(`pbp_drake.core.goal_groups`) stands between the goals and the DMP bank, and the
-controller's `selected_goal` is its `shown_goal`:
-
-    goals, ee_state, goal_estimator (goal_probabilities, selected_goal) ──> goal_grouping
-    goal_grouping.followed_goals ──> dmp_bank.goals;  goal_grouping.shown_goal ──> selected_goal
-
-Under ``hop`` and ``predict_then_assist`` (`hop_controller`, no DMP bank) HOP's posterior and
-its assistance take the place of the estimator, the bank and the blender:
-
-    ee_state ──> goal_estimator (MaxEntGoalEstimator) ──> assistance (goal_probabilities)
-    ee_state_split [p, v] ──> assistance;  goals ──> goal_estimator, assistance
-    operator_command ──> goal_estimator;  operator_command_split (v) ──> assistance
-    assistance.command [p, v] ──> hand_over ──> ee_command (with the heading, as PBP's)
-
-A station is wired as `build_reach_diagram` does: `station.ee_state` through a
-`SampleHold` into `ee_state`, and `ee_command` back.
+Its wiring under the PBP methods and explicit arbitration (`pbp_controller`) and under
+``hop`` and ``predict_then_assist`` (`hop_controller`): docs/design.md. With
+`goal_estimator: {group_mass: M}` (M > 0) a `GoalGrouping` stands between the goals and
+the DMP bank (`followed_goals` into the bank's `goals`), and the controller's
+`selected_goal` is its `shown_goal`. A station is wired as `build_reach_diagram` does:
+`station.ee_state` through a `SampleHold` into `ee_state`, and `ee_command` back.
 """
 
 import numpy as np
@@ -67,9 +39,8 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         initial_ee_state: the hand's `EeState` (8,) where the station starts (e.g.
             `hsr_initial_ee_state(station)`): the DMPs, the hand-over and the heading
             start there.
-        goals: (K, 3) the candidate goals at the start, one DMP each (with
-            `config.dmp_duration` 0 the farthest sets the DMPs' duration); the `goals`
-            port (K x 3, row-major) brings them as they move.
+        goals: (K, 3) the candidate goals at the start, one DMP each (of
+            `config.duration_for(start, goals)`); the `goals` port brings them as they move.
         prediction_steps: > 0 adds `predicted_paths` and `predicted_goals` (PBP methods):
             the paths of `predicted_goal_count` goals (at most K), the selected goal's
             first and then the most probable others', over the DMPs' duration in that many
@@ -92,11 +63,10 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
         - predicted_goals (with prediction_steps > 0)
         - posterior_clipped (with HOP's posterior)
 
-    `ee_state` is `[p (3), v (3), heading, heading_rate]`, `operator_command`
-    `[vx, vy, vz, yaw_rate]`, `operator_active` 1 while the operator acts, `ee_command`
-    `[p (3), v (3), heading]` for the next tick. `selected_goal` is the followed goal's
-    index (with goal groups, -1 until the robot commits to one), `goal_probabilities` the
-    estimator's K probabilities; the recursive estimators add `posterior_clipped`.
+    `ee_state` is an `EeState`, `operator_command` an `OperatorCommand`, `operator_active`
+    1 while the operator acts, `ee_command` the `EeCommand` of the next tick.
+    `selected_goal` is the followed goal's index (with goal groups, -1 until the robot
+    commits to one), `goal_probabilities` the estimator's K probabilities.
     """
     config.validate()
     initial_ee_state = np.asarray(initial_ee_state, float).reshape(-1)
@@ -187,9 +157,7 @@ def _add_pbp_policy(builder, config, start, goals, split, command_split, predict
         bank, period, lock_phase_when_operator_acts=METHODS[config.method].lock_phase,
         prediction_steps=prediction_steps,
         prediction_period=bank.duration / max(prediction_steps, 1),
-        # PBP-Cont adds the operator to a DMP that keeps running: without the limit, an
-        # operator holding the hand off the DMP's path winds the DMP's velocity up past the
-        # hand's speed limit until it overrides them (the other modes never hold it so).
+        # The anti-windup of a law that adds the operator to a running DMP (PBP-Cont).
         max_speed=(config.hand_over.max_hand_speed
                    if BLEND_LAWS[config.blend_mode].adds_to_policy else None),
         # Every DMP steps from the followed one's velocity (connected below): the state is

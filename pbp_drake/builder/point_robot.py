@@ -5,11 +5,9 @@
     robot.state ──> dmp_bank (or demonstration_player for explicit arbitration) ──> blender
     goals ──> dmp_bank;  blender.command ──> robot.command
 
-The order within a tick is `pbp_drake.systems.tick`'s: the operator and the sample update at
-the tick, the DMP bank at the decide stage, from the robot's state at the tick and the
-operator's decision of that tick (the robot steps half a plant step off the ticks). Loggers
-named `robot_state_log`, `operator_active_log`, `operator_command_log`, `command_log` and
-(PBP) `phase_log` record each tick.
+The order within a tick is `pbp_drake.systems.tick`'s (the robot steps half a plant step off
+the ticks). Loggers named `robot_state_log`, `operator_active_log`, `operator_command_log`,
+`command_log` and (PBP) `phase_log` record each tick.
 """
 
 from pydrake.systems.framework import DiagramBuilder

@@ -2,11 +2,9 @@
 
 `make_pbp_controller(PbpControllerConfig(...), initial_ee_state, goals)` builds the
 controller of any robot whose station takes an `ee_command` and gives an `ee_state` (the
-HSR's, an arm's from `make_arm_station`, a user's own). A scenario is a `ControlSettings` (its
-``method``, ``alpha``, ``control_period``, ``dmp``, ``dmp_duration``, ``goal_estimator``,
-``hop``) and its robot section a `HandLimits` with a nominal ``speed``, so a Python user and
-a YAML user get the same controller; `pbp_drake.scenarios.resolve` makes one from a
-scenario (`ResolvedScenario.controller`).
+HSR's, an arm's from `make_arm_station`, a user's own). A scenario is a `ControlSettings` and
+its robot section a `HandLimits` with a nominal ``speed``, so a Python user and a YAML user
+get the same controller (`pbp_drake.scenarios.resolve`'s `ResolvedScenario.controller`).
 """
 
 import dataclasses
@@ -140,16 +138,21 @@ class PbpControllerConfig(ControlSettings):
         no blender."""
         return method_entry(self.method).blend_mode
 
-    def dmp_bank(self, start, goals):
-        """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, or the
-        taught primitive's shape, of `dmp_duration` or `nominal_duration`."""
-        start, goals = np.asarray(start, float), np.asarray(goals, float)
+    def duration_for(self, start, goals):
+        """The DMPs' duration (s) from `start` (3,) to `goals` (K, 3): `dmp_duration`, or
+        when 0 `nominal_duration`'s at `nominal_speed`."""
         primitive = self.dmp_primitive
-        duration = self.dmp_duration or nominal_duration(
+        return self.dmp_duration or nominal_duration(
             start, goals, self.nominal_speed, self.goal_estimator.group_mass > 0.0,
             primitive.length_ratio if primitive else 1.0)
-        if primitive is not None:
-            return primitive_bank(primitive, start, len(goals), duration)
+
+    def dmp_bank(self, start, goals):
+        """The DMP bank from `start` (3,) to each of `goals` (K, 3): straight paths, or the
+        taught primitive's shape, of `duration_for(start, goals)`."""
+        start, goals = np.asarray(start, float), np.asarray(goals, float)
+        duration = self.duration_for(start, goals)
+        if self.dmp_primitive is not None:
+            return primitive_bank(self.dmp_primitive, start, len(goals), duration)
         return DmpBankModel.straight(start, len(goals), duration, self.dmp)
 
 

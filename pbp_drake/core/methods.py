@@ -1,11 +1,6 @@
 """The registry of shared-control methods: what a scenario's `method: NAME` runs, by name.
-
-A method is its module (its law in `pbp_drake.core.arbitration` or its assistance in
-`pbp_drake.core.hindsight_optimization`, its systems in `pbp_drake.systems.pbp`) and one
-`Method` entry in `METHODS`, which every layer reads: the scenario checks and the CLI (the
-name, did-you-mean), the builder (which policy, whether the DMPs lock their phase, whether
-an operator drives, which keys), the page and the studies (the label and the colour). No
-layer compares a method's name. `register_method` adds one at run time.
+Every layer reads a method's `Method` entry in `METHODS`; none compares its name.
+`register_method` adds one at run time (docs/concepts/pbp.md, "Your own method").
 """
 
 import dataclasses

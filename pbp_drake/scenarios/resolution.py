@@ -16,7 +16,7 @@ import typing
 
 import numpy as np
 
-from pbp_drake.core.controller_config import PbpControllerConfig, nominal_duration
+from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
 from pbp_drake.core.dmp.primitive import SETTINGS_FIELDS, read_primitive_document
@@ -405,16 +405,13 @@ def _resolve_task_robot(scenario):
         raise ScenarioError(
             f"scenario.task.success_distance {task.success_distance} m reaches the nearest "
             f"object ({nearest:.2f} m from the hand's start): the task would succeed at once")
-    primitive = _taught_primitive(scenario, task)
-    duration = scenario.dmp_duration if scenario.dmp_duration > 0 else nominal_duration(
-        start, goals, robot.speed, scenario.goal_estimator.group_mass > 0.0,
-        primitive.length_ratio if primitive else 1.0)
+    controller = PbpControllerConfig(**{
+        **scenario.control_settings(), "nominal_speed": float(robot.speed),
+        "hand_over": robot.hand_over(), "dmp_primitive": _taught_primitive(scenario, task)})
+    duration = controller.duration_for(start, goals)
     check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
                        scenario.dmp_duration > 0 else "scenario.robot.speed")
-    controller = PbpControllerConfig(**{
-        **scenario.control_settings(), "dmp_duration": float(duration),
-        "nominal_speed": float(robot.speed), "hand_over": robot.hand_over(),
-        "dmp_primitive": primitive})
+    controller = dataclasses.replace(controller, dmp_duration=float(duration))
     # The DMPs are fitted where they run: by the controller, from `controller`.
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=None,

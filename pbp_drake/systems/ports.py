@@ -1,7 +1,8 @@
 """Named layouts of the port and state vectors (`pydrake` `namedview`s), e.g.
-``EeState(vector).heading``, ``EeState.size`` its length; and the helpers that read ports.
-"""
+``EeState(vector).heading``, ``EeState.size`` its length; and the systems' shared helpers
+(checks of their arguments, reads of ports)."""
 
+import dataclasses
 import math
 import re
 
@@ -39,6 +40,15 @@ def checked_goal_count(goal_count):
     if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
         raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
     return int(goal_count)
+
+
+def checked_settings(settings, kind):
+    """A private copy of `settings`; ValueError unless it is a `kind` whose `validate`
+    passes (a plain dataclass: its fields may have changed since construction)."""
+    if not isinstance(settings, kind):
+        raise ValueError(f"settings must be {kind.__name__}, got {type(settings).__name__}")
+    settings.validate()
+    return dataclasses.replace(settings)
 
 
 def goal_index(port, context, goal_count, unconnected=None):

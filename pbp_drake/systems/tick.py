@@ -1,25 +1,17 @@
-"""The order within one control tick, stated once for every system and every diagram.
+"""The order within one control tick, stated once for every system and every diagram
+(why: docs/concepts/control-tick.md). Drake computes all discrete updates of one instant
+from the values before it, so a tick has three stages:
 
-Drake computes all discrete updates of one instant from the values before that instant, so
-two systems that update at the same tick cannot see each other's new state. A PBP tick has
-three stages, in this order:
-
-1. **sense** at `t_k` (`SENSE_OFFSET`): the robot's state is sampled (`SampleHold`) and
-   the operator decides. A surrogate pilot's filter samples that decision half-way to the
-   decide stage (`pilot_offset`), so the robot reads the corrupted decision of the same tick.
-2. **decide** at `t_k + decide_offset(period)` (a millionth of the period, before any plant
-   step): the DMP bank, the goal estimators, the heading, the task monitor and the moving
-   obstacles update from the state sampled at `t_k` and the operator's decision of the
-   same tick (the paper's Alg. 2). No other decide-stage system reads the task monitor:
-   the operators read its `target` at the sense stage.
-3. **report**, a millionth of a period after a decide-stage update (`report_offset`): what
-   must see tick k's decisions, the hand-over (`HandOver`) and the task monitor's end at
-   success. A publish at the decide instant itself would run before that instant's updates.
+1. **sense** at `t_k` (`SENSE_OFFSET`): the robot's state is sampled and the operator
+   decides (a surrogate pilot's filter samples that decision at `pilot_offset`);
+2. **decide** at `t_k + decide_offset(period)`: the DMP bank, the goal estimators, the
+   heading, the task monitor and the moving obstacles update from the sense stage's values
+   (none reads the task monitor: the operators read its `target` at the sense stage);
+3. **report** (`report_offset`): what must see tick k's decisions, the hand-over and the
+   task monitor's end at success.
 
 Loggers publish before the updates of their instant, so tick k's decisions appear
-`DECISION_LOG_SHIFT` samples later (`pbp_drake.builder.run.read_log`).
-See docs/concepts/control-tick.md.
-"""
+`DECISION_LOG_SHIFT` samples later (`pbp_drake.builder.run.read_log`)."""
 
 import math
 

@@ -129,19 +129,12 @@ class BankModel:
 
 
 class DmpBankModel(BankStep, BankModel):
-    """K DMPs, one per goal, stepped together from one shared robot state.
-
-    Vectorised over goals and dimensions; arrays are laid out `(D, K)` internally. All DMPs
-    share `duration` and `settings` (so one pair of 2x2 step matrices serves all of them);
-    each has its own weights (or all share one set, e.g. straight paths or one
-    demonstration), its own start and its own phase.
-
-    `initial_state` gives the state at the start of a movement and the pure `advance` steps
-    it, returning new arrays. `advance_into` is the same step written into arrays the caller
-    owns, with no allocation, using a workspace from `make_workspace`;
-    `attractor_terms_into`, `stepped_positions_into` and `stepped_velocity_into` are its
-    parts (`pbp_drake.core.dmp.stepping`). How the step is made fast:
-    docs/concepts/dmp.md, "The bank: K DMPs at once".
+    """K DMPs, one per goal, stepped together from one shared robot state, arrays laid out
+    `(D, K)`. All share `duration` and `settings`; each has its own weights (or all share
+    one set), start and phase. `initial_state` and the pure `advance` give and step a state;
+    `advance_into` is the same step into the caller's arrays, with a workspace from
+    `make_workspace` (its parts: `pbp_drake.core.dmp.stepping`). docs/concepts/dmp.md,
+    "The bank: K DMPs at once".
     """
 
     def __init__(self, weights, starts, duration, settings=DmpSettings(),

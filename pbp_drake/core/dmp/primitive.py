@@ -1,11 +1,9 @@
 """A primitive taught by driving: ONE demonstration's DMP shape, kept as a document and sent
 to any goal (`pbp-drake teach` writes one; a scenario's `dmp: {primitive: FILE}` reads it).
 A demonstration of poses (the grasping task's hand) also teaches an orientation shape.
-`teach_primitive` fits the demonstration and measures the fit (`fit_error`: the DMP rolled
-out from the demonstration's start to its own goal, against the demonstration, RMS);
-`primitive_bank` carries the shape to each goal as the formulation carries it. The
-document (`primitive_document`, `read_primitive_document`) is plain JSON data, its fields
-in docs/tasks/teach.md, "The file"."""
+`teach_primitive` fits it, `primitive_bank` carries the shape to each goal; the document
+(`primitive_document`, `read_primitive_document`) is plain JSON data, its fields in
+docs/tasks/teach.md, "The file"."""
 
 import dataclasses
 

@@ -9,8 +9,7 @@ step, in closed form") is affine in the DMP's own velocity `z`:
 
 PBP steps from the robot's position `y = p`, so `(dp, dz)`, "the attractor terms", depend
 on the phase, `p`, the goals and `dt` only (`attractor_terms_into`); `stepped_positions_into`
-and `stepped_velocity_into` add the velocity's part. Drake's `DmpBank` system keeps
-`(z, dp, dz)` in its Context and reads the stepped state out on demand.
+and `stepped_velocity_into` add the velocity's part.
 
 Writing `b(x) = a(x) - g` (the attractor relative to the goal),
 
@@ -58,8 +57,6 @@ def step_constants(stiffness, damping, duration, dt):
     """The memoised `StepConstants` of one step (keyed on plain floats, as `step_matrices`)."""
     phi, gamma = step_matrices(stiffness, damping, duration, dt)
     g0, g1 = gamma[0, 0] / dt, gamma[1, 0] / dt
-    # dp = (Phi00 - 1) e + (1 - g0) da and dz = Phi10 e - g1 da, with e = (p - g) - b0 and
-    # da = b1 - b0: the coefficients of b0 and b1.
     combination = np.array([[g0 - phi[0, 0], 1.0 - g0], [g1 - phi[1, 0], -g1]])
     gains = np.array([phi[0, 0] - 1.0, phi[1, 0]]).reshape(2, 1, 1)
     combination.setflags(write=False)
@@ -350,12 +347,8 @@ class BankStep:
 
 def limit_speeds(scaled_velocities, max_speed, duration):
     """Scales each column of the scaled velocities `tau v` (D, K) down to the speed
-    `max_speed` (None: no limit), in place: the systems' anti-windup. Without it, a DMP
-    stepped from a robot that the operator (PBP-Cont, which adds the operator to the DMP)
-    or the hand-over holds off its path winds its own velocity up toward
-    `beta (g - y) / tau`, far above what the hand may do: the hand then follows the DMP's
-    direction whatever the operator asks, since the speed limit scales their sum as one
-    vector."""
+    `max_speed` (None: no limit), in place: the systems' anti-windup (why:
+    docs/concepts/dmp.md, "PBP: re-integrating from the robot every step")."""
     if max_speed is None:
         return
     if scaled_velocities.shape[1] == 1:

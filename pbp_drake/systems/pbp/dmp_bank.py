@@ -97,10 +97,9 @@ class DmpBank(BankSystem):
     control period); with `predicted_goal_count` M, the paths of the M goals whose indices
     come in on `predicted_goals` (unconnected: goals 0 to M - 1).
 
-    The state is `3 K D` numbers per goal, or with `compact_state=True` `2 + 6 D` whatever
-    K, for a bank `affine_in_goal` with `followed_goal` connected (docs/concepts/dmp.md).
-    The bank updates at the decide stage of each tick (`pbp_drake.systems.tick`);
-    `update_offset` (s after the tick) overrides it.
+    `compact_state=True` keeps `2 + 6 D` numbers (`state_size`) whatever K, for a bank
+    `affine_in_goal` with `followed_goal` connected (docs/concepts/dmp.md). The bank updates
+    at the decide stage (`pbp_drake.systems.tick`) or `update_offset` s after each tick.
     """
 
     def __init__(self, bank, control_period, lock_phase_when_operator_acts=False,
@@ -163,7 +162,7 @@ class DmpBank(BankSystem):
 
     @staticmethod
     def state_size(goal_count, dimension, compact_state=False):
-        """The length of the one state vector: `2 + D + 3 K D` per goal; compact, `2 + 6 D`."""
+        """The length of the one state vector: `2 + D + 3 K D`; compact, `2 + 6 D`."""
         return (AffineState if compact_state else PerGoalState).size_of(goal_count, dimension)
 
     @property

@@ -68,8 +68,7 @@ class PerGoalState(_Layout):
         if not held[0]:
             bank.stepped_velocity_into(dz, z, period, z)
             if followed is not None:
-                # Every DMP continues from the velocity of the one the robot followed, so
-                # that a switch to another goal keeps the command's velocity.
+                # PBP's goal switch (`DmpBankModel.advance`'s `followed`).
                 z[...] = z[:, followed:followed + 1]
             limit_speeds(z, self._max_speed, bank.duration)
         robot[:, 0] = robot_state[:d]

@@ -1,8 +1,6 @@
 """The goal estimator as a Drake system: which of K goals the operator means.
 `GoalEstimatorBase` holds what every goal estimator system shares."""
 
-import dataclasses
-
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
@@ -10,7 +8,8 @@ from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.goal_estimation import (
     NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, check_hysteresis,
     goal_probabilities, update_selection)
-from pbp_drake.systems.ports import EeState, PortGetters, checked_goal_count, position_of
+from pbp_drake.systems.ports import (
+    EeState, PortGetters, checked_goal_count, checked_settings, position_of)
 from pbp_drake.systems.tick import checked_period, decide_offset
 
 # Layout of the `memory` discrete state group.
@@ -28,22 +27,17 @@ class GoalEstimatorBase(PortGetters, LeafSystem):
     declares its input ports in `_declare_inputs(goal_count)` and updates in `_update`, at
     the decide stage of each control tick."""
 
-    #: The type of the settings.
     _SETTINGS = GoalEstimatorSettings
 
     def __init__(self, goal_count, settings, control_period, margin=None, hold_steps=None,
                  memory_size=2):
         super().__init__()
         k = self._goal_count = checked_goal_count(goal_count)
-        if not isinstance(settings, self._SETTINGS):
-            raise ValueError(f"settings must be {self._SETTINGS.__name__}, got "
-                             f"{type(settings).__name__}")
-        settings.validate()
+        settings = self._settings = checked_settings(settings, self._SETTINGS)
         margin = settings.margin if margin is None else margin
         hold_steps = settings.hold_steps if hold_steps is None else hold_steps
         check_hysteresis(margin, hold_steps)
         self._margin, self._hold_steps = float(margin), int(hold_steps)
-        self._settings = dataclasses.replace(settings)
         self._period = checked_period(control_period)
         self._declare_inputs(k)
         self._selected_index = self.DeclareDiscreteState(np.zeros(1))

@@ -8,7 +8,8 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.goal_groups import NO_GOAL, group_target, pose_group_target
 from pbp_drake.systems.ports import (
-    EeState, GoalPose, PortGetters, PoseState, checked_goal_count, goal_index)
+    EeState, GoalPose, PortGetters, PoseState, checked_goal_count, checked_settings,
+    goal_index)
 from pbp_drake.systems.tick import checked_period, decide_offset
 
 
@@ -43,10 +44,7 @@ class GoalGrouping(PortGetters, LeafSystem):
         super().__init__()
         self._goal_count = k = checked_goal_count(goal_count)
         width = self._WIDTH
-        if not isinstance(settings, GoalEstimatorSettings):
-            raise ValueError(f"settings must be a GoalEstimatorSettings, got "
-                             f"{type(settings).__name__}")
-        settings.validate()  # a plain dataclass: its fields may have changed since
+        settings = checked_settings(settings, GoalEstimatorSettings)
         self._settings = (float(settings.group_mass), float(settings.commit_radius),
                           float(settings.commit_probability))
         self._goals_port = self.DeclareVectorInputPort(self._GOALS, width * k)

@@ -1,14 +1,12 @@
 """HOP's and predict-then-assist's assistance as a Drake system
 (`pbp_drake.core.hindsight_optimization.assisted_command`)."""
 
-import dataclasses
-
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, assisted_command, check_assistance, hop_targets)
-from pbp_drake.systems.ports import PortGetters
+from pbp_drake.systems.ports import PortGetters, checked_settings
 from pbp_drake.systems.tick import checked_period
 
 
@@ -19,12 +17,9 @@ class HopAssistanceBase(PortGetters, LeafSystem):
     def __init__(self, method, goal_count, settings, control_period):
         super().__init__()
         check_assistance(method)
-        if not isinstance(settings, HopSettings):
-            raise ValueError(f"settings must be a HopSettings, got {type(settings).__name__}")
-        settings.validate()
+        self._settings = checked_settings(settings, HopSettings)
         self._method = method
         self._goal_count = int(goal_count)
-        self._settings = dataclasses.replace(settings)
         self._period = checked_period(control_period)
 
     @property

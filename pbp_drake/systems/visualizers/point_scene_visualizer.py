@@ -57,13 +57,13 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
     At each initialisation the static scene is drawn under `/pbp` (after deleting it), and a
     planar scene's view is framed once on what is known then (`core.scene_framing`). Each
     publish moves the robot, shows an orange halo while the operator acts and extends the
-    executed path (`PathTrail`, `/pbp/executed`); each `path_period` (default: the publish
-    period) moves every DMP's predicted path (`PathDots`). All with `time_in_recording`, so
-    that a recording replays them. Call from the thread that made `meshcat`.
+    executed path (`PathTrail`, `/pbp/executed`) and moves every DMP's predicted path
+    (`PathDots`). All with `time_in_recording`, so that a recording replays them. Call from
+    the thread that made `meshcat`.
     """
 
     def __init__(self, meshcat, start, goals, obstacles, demonstration=None,
-                 prediction_steps=0, publish_period=1.0 / 30.0, path_period=None):
+                 prediction_steps=0, publish_period=1.0 / 30.0):
         super().__init__()
         self._meshcat = meshcat
         goals = np.atleast_2d(np.asarray(goals, dtype=float))
@@ -84,8 +84,7 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
                                    EXECUTED_SPACING)
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
-            self.DeclarePeriodicPublishEvent(path_period or publish_period, 0.0,
-                                             self._publish_paths)
+            self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish_paths)
         self.DeclareInitializationPublishEvent(self._draw_scene)
 
     def _to_3d(self, points, z=0.0):

@@ -1,11 +1,8 @@
-"""Meshcat's port shut to everyone but the page front: a filter on Meshcat's listening socket.
-
-Meshcat's listening socket is a descriptor of this process; on Linux a classic BPF filter
-(`SO_ATTACH_FILTER`) on it drops every connection request but those from the (address,
-port) pairs of the front's own sockets, each bound before it connects (no `SO_REUSEADDR`,
-so no other socket can take the pair meanwhile). docs/design.md ("The page") says what
-this does and does not cover. Where the door cannot be shut (not Linux, Meshcat in another
-process or not on loopback alone), `shut` is False and `reason` says why.
+"""Meshcat's port shut to everyone but the page front: a classic BPF filter
+(`SO_ATTACH_FILTER`, Linux) on Meshcat's listening socket, a descriptor of this process,
+that admits only the front's own sockets; docs/design.md ("The page") says how and what
+it does not cover. Where the door cannot be shut (not Linux, Meshcat in another process or
+not on loopback alone), `shut` is False and `reason` says why.
 """
 
 import contextlib

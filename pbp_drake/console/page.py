@@ -9,6 +9,8 @@ import select
 import sys
 import time
 
+from pbp_drake.console.front import LINES
+
 #: The choices a person can make, and the label of the button that makes each.
 CHOICE_BUTTONS = {"stop": "Stop", "restart": "Restart", "next": "Next scene",
                   "close": "Close"}
@@ -54,7 +56,7 @@ class Console:
             # Widened to hold the rate asked for: the slider must not clip the command line.
             meshcat.AddSlider(RATE_SLIDER, min(low, rate), max(high, rate), step, rate)
             self._sliders.append(RATE_SLIDER)
-        self._lines = {"title": None, "status": None, "result": None, "notice": None}  # shown
+        self._lines = dict.fromkeys(LINES)  # the labels shown
 
     @property
     def meshcat(self):

@@ -157,7 +157,7 @@ def _run(args):
             raise ScenarioError("--camera robot looks from the simulated HSR's head; through "
                                 "the task-space bridge (robot.hardware.connect) the robot "
                                 "is on the far side")
-        check_run_flags(args, resolved)  # and the flags' combinations, before the page too
+        session = check_run_flags(args, resolved)  # the flags' combinations, before the page
     except BaseException:
         if listening is not None:
             listening.close()
@@ -167,7 +167,7 @@ def _run(args):
         meshcat, page = open_page(listening, args)
     try:
         if args.participant is not None:
-            return run_session_command(args, resolved, meshcat, page)
+            return run_session_command(args, resolved, meshcat, page, session)
         if resolved.has_task:
             return run_task_loop(args, resolved, meshcat, page)
         return run_scene(args, resolved, meshcat, page)

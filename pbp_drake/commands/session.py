@@ -8,14 +8,14 @@ import sys
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.cli_types import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS
-from pbp_drake.commands.run_checks import is_person, session_methods
+from pbp_drake.commands.run_checks import is_person
 from pbp_drake.commands.run_page import (
     PAGE_ENDED, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
     wait_for_browser)
 from pbp_drake.commands.task_runs import alpha_of, delete_operator, run_task_once
 from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage, start_label
 from pbp_drake.scenarios import counted
-from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers, scales_text
+from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, scales_text
 from pbp_drake.studies.sessions import run_session
 
 
@@ -43,17 +43,18 @@ def add_session_flags(parser, hidden=False):
         "page)"))
 
 
-def run_session_command(args, resolved, meshcat, page):
-    """The session of `args.participant` on the resolved scenario; its exit code."""
+def run_session_command(args, resolved, meshcat, page, session):
+    """The session of `args.participant` on the resolved scenario, `session` its
+    `(methods, order, answers)` from `check_run_flags`; its exit code."""
     scenario = resolved.scenario
-    methods, order = session_methods(args, scenario)  # checked by check_run_flags
+    methods, order, answers = session
     output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
                                                        args.participant))
     print(f"Participant {args.participant}: {', '.join(order)}, in this order"
           + (", each practised first" if args.practice else "") + f"; saved in {output}",
           flush=True)
-    if args.answers is not None:
-        questions = FixedAnswers(parse_answers(args.answers, methods))
+    if answers is not None:
+        questions = FixedAnswers(answers)
     else:
         questions = _StartInTheRun(meshcat, args.start_on_connect)
     if page is not None and isinstance(questions, _StartInTheRun):

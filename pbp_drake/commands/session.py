@@ -130,7 +130,7 @@ class _StartInTheRun(MeshcatSessionPage):
     page: `start` keeps the label for the run's `LiveRun` (`take_start_label`); with
     `--start-on-connect`, Start is a page of its own between the runs."""
 
-    def __init__(self, meshcat, start_between_runs=False):
+    def __init__(self, meshcat, start_between_runs):
         super().__init__(meshcat)
         self._start_between_runs = start_between_runs
         self._label = None

@@ -25,7 +25,7 @@ def run_scene(args, resolved, meshcat, page):
     console = None
     if page is not None:
         console = page_console(meshcat, page, args, alpha_of(scenario), choices=("stop",))
-        console.show_title(method_name(scenario.method, alpha_of(scenario)))
+        console.show_title(method_name(scenario.method, scenario.alpha))
         if terminal():  # someone may be watching
             wait_for_browser(page, args.wait_for_browser)
     if args.record:
@@ -101,7 +101,7 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     if args.camera == "robot":
         camera = RobotCamera(meshcat, find_system(diagram, "hsr_station"))
     if console is not None:
-        console.show_title(f"{method_name(scenario.method, alpha_of(scenario))}, seed "
+        console.show_title(f"{method_name(scenario.method, scenario.alpha)}, seed "
                            f"{scenario.seed}")
         console.clear_result()
     live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration), camera,

@@ -13,7 +13,7 @@ from pbp_drake.commands.run_page import (
     PAGE_ENDED, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
     wait_for_browser)
 from pbp_drake.commands.task_runs import alpha_of, delete_operator, run_task_once
-from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage, start_label
+from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
 from pbp_drake.scenarios import counted
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, scales_text
 from pbp_drake.studies.sessions import run_session
@@ -56,8 +56,8 @@ def run_session_command(args, resolved, meshcat, page, session):
     if answers is not None:
         questions = FixedAnswers(answers)
     else:
-        questions = _StartInTheRun(meshcat, args.start_on_connect)
-    if page is not None and isinstance(questions, _StartInTheRun):
+        questions = MeshcatSessionPage(meshcat, start_in_run=not args.start_on_connect)
+    if page is not None and answers is None:
         # The pages are the person's: no browser, no session (`--answers` needs none).
         print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
               "each method starts when its Start is pressed in the page, and the questions "
@@ -75,8 +75,7 @@ def run_session_command(args, resolved, meshcat, page, session):
 
     def run_one(trial):
         # Kept through a Restart: each run of the method starts at its Start.
-        start_button = (questions.take_start_label()
-                        if isinstance(questions, _StartInTheRun) else None)
+        start_button = questions.take_start_label() if answers is None else None
         while True:
             diagram = build_diagram(trial, meshcat)
             if console is not None:
@@ -123,24 +122,3 @@ def run_session_command(args, resolved, meshcat, page, session):
 
 class _SessionStopped(Exception):
     """Stop pressed in the page during a session's run: the session ends, resumable."""
-
-
-class _StartInTheRun(MeshcatSessionPage):
-    """`MeshcatSessionPage` whose Start is pressed inside the run, once its scene is in the
-    page: `start` keeps the label for the run's `LiveRun` (`take_start_label`); with
-    `--start-on-connect`, Start is a page of its own between the runs."""
-
-    def __init__(self, meshcat, start_between_runs):
-        super().__init__(meshcat)
-        self._start_between_runs = start_between_runs
-        self._label = None
-
-    def start(self, method, position, total, practice=False):
-        if self._start_between_runs:
-            super().start(method, position, total, practice)
-        else:
-            self._label = start_label(method, position, total, practice)
-
-    def take_start_label(self):
-        label, self._label = self._label, None
-        return label

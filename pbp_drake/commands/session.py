@@ -10,9 +10,9 @@ from pbp_drake.builder import build_diagram
 from pbp_drake.cli_types import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS
 from pbp_drake.commands.run_checks import is_person
 from pbp_drake.commands.run_page import (
-    PAGE_ENDED, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
-    wait_for_browser)
+    PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console, wait_for_browser)
 from pbp_drake.commands.task_runs import alpha_of, delete_operator, run_task_once
+from pbp_drake.console.front import ENDED_NOTICE
 from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
 from pbp_drake.scenarios import counted
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, scales_text
@@ -103,7 +103,7 @@ def run_session_command(args, resolved, meshcat, page, session):
               "resumes the session.", file=sys.stderr)
         if page is not None:
             end_page(page, console, "The session was stopped; what was saved is kept. "
-                     + PAGE_ENDED)
+                     + ENDED_NOTICE)
         return EXIT_STOPPED if stopped else EXIT_INTERRUPTED
     failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
     print(f"Session saved in {output}, answers in {output / QUESTIONNAIRE_FILE} "

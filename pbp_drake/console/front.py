@@ -42,6 +42,7 @@ from pbp_drake.systems.operators.browser_guard import register_front, unregister
 LOG = logging.getLogger(__name__)  # websockets' connection log, every poll: INFO
 COOKIE = "pbp_drake_token"
 LINES = ("title", "status", "result", "notice")
+ENDED_NOTICE = "This run has ended; you can close this page."
 REFUSAL = ("This page needs the address `pbp-drake run` printed (with its ?token=...); "
            "open that one.\n")
 _TOKEN = re.compile(r"[A-Za-z0-9_-]+")
@@ -116,7 +117,7 @@ body.pbp-ended #status-message { display: none !important; }
       });
     } catch (e) {}
     state = Object.assign({}, state);
-    if (!state.notice) state.notice = "This run has ended; you can close this page.";
+    if (!state.notice) state.notice = "ENDED_TEXT";
     show(state);
   }
   function poll() {
@@ -142,7 +143,7 @@ body.pbp-ended #status-message { display: none !important; }
   poll();
 })();
 </script>
-""".replace("FRAME_TEXT", FRAME).replace("ACK_TEXT", ACK)
+""".replace("FRAME_TEXT", FRAME).replace("ACK_TEXT", ACK).replace("ENDED_TEXT", ENDED_NOTICE)
 
 
 def new_token():
@@ -295,9 +296,9 @@ class PageFront:
             return dict(self._state)
 
     def end(self, text=None, wait=5.0):
-        """Marks the run ended: the page shows `text` as its notice (or says the run has
-        ended), stops reconnecting and hides Meshcat's banner. Waits until every relayed
-        page has been sent that (none left on the reconnect banner), at most `wait` s."""
+        """Marks the run ended: the page shows `text` as its notice (None: `ENDED_NOTICE`),
+        stops reconnecting and hides Meshcat's banner. Waits until every relayed page has
+        been sent that (none left on the reconnect banner), at most `wait` s."""
         with self._lock:
             self._state.update(ended=True, notice=text)
             self._state["seq"] += 1

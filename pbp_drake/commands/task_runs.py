@@ -13,9 +13,9 @@ from pbp_drake.commands.run_page import (
     AFTER_RUN_CHOICES, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
     save_recording, terminal, wait_for_browser)
 from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, result_text
-from pbp_drake.console.text import controls_text, failure_text
+from pbp_drake.console.text import controls_line, failure_text
 from pbp_drake.core.toy_scene import collision_ratio
-from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, forward_key_enabled, resolve
+from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, resolve
 
 
 def run_scene(args, resolved, meshcat, page):
@@ -145,14 +145,6 @@ def why_failed(result, scenario):
     grasping = isinstance(scenario.task, GraspTask)
     return failure_text(target, len(result.objects), distance,
                         None if grasping else scenario.task.success_distance)
-
-
-def controls_line(scenario):
-    """What the person's keys or gamepad do in `scenario`'s task (`controls_text`)."""
-    return controls_text(grasping=isinstance(scenario.task, GraspTask),
-                         gamepad=isinstance(scenario.operator, Gamepad),
-                         forward=forward_key_enabled(scenario),
-                         vertical=bool(getattr(scenario.task, "z_range", None)))
 
 
 def task_code(result, live):

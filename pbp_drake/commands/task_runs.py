@@ -77,7 +77,9 @@ def run_task_loop(args, resolved, meshcat, page):
             wait_for_browser(page, args.wait_for_browser, PERSON_NEEDS_PAGE if person else None)
         first = False
         result, live = run_task_once(args, resolved, diagram, meshcat, console, start_button)
-        code = task_code(result, live)
+        code = EXIT_SUCCESS if result.success else EXIT_FAILED
+        if live.choice == "stop":
+            code = EXIT_STOPPED
         if console is None:
             return code
         choice = live.choice
@@ -145,13 +147,6 @@ def why_failed(result, scenario):
     grasping = isinstance(scenario.task, GraspTask)
     return failure_text(target, len(result.objects), distance,
                         None if grasping else scenario.task.success_distance)
-
-
-def task_code(result, live):
-    """The exit code of a run: stopped, succeeded or failed."""
-    if live.choice == "stop":
-        return EXIT_STOPPED
-    return EXIT_SUCCESS if result.success else EXIT_FAILED
 
 
 def delete_operator(diagram):

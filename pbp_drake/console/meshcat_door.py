@@ -42,7 +42,7 @@ class MeshcatDoor:
             if any(s.family != family or s.getsockname()[0] != self._address[0]
                    for s in self._listeners):
                 self._close_listeners("Meshcat listens on more than one address")
-            elif not _loopback(self._address[0]):
+            elif self._address[0] != "::1" and not self._address[0].startswith("127."):
                 self._close_listeners(f"Meshcat listens on {self._address[0]}, not on "
                                       "this machine's loopback alone")
         if self._listeners:
@@ -160,10 +160,6 @@ def _listeners(port):
             pass
         sock.close()
     return found, None if found else f"no socket of this process listens on port {port}"
-
-
-def _loopback(address):
-    return address == "::1" or address.startswith("127.")
 
 
 def _program(family, address, ports):

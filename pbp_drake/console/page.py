@@ -26,8 +26,8 @@ class Console:
 
     Args:
         meshcat: the page's Meshcat.
-        choices: which of "stop", "restart", "next", "close" get a button (labels in
-            `CHOICE_BUTTONS`: Stop, Restart, Next scene, Close), in this order.
+        choices: which of `CHOICE_BUTTONS` ("stop", "restart", "next", "close") get a
+            button, in this order.
         alpha: with a number, an alpha slider (0..1, step 0.05) starting there; `alpha()`
             reads it.
         realtime_rate: with a positive number, a real-time-rate slider (`RATE_RANGE`,

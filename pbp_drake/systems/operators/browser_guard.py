@@ -13,9 +13,7 @@ import time
 #: The label of the notice added to the page's controls while the run is paused.
 PAUSED_NOTICE = "Paused: {count} browsers are connected. Close all pages but one"
 
-# Meshcat's port -> the page front before it: its `pages_heard()` (admitted pages that have
-# sent a frame) and `own_connections()` (its connections to Meshcat, which it counts
-# against Meshcat's).
+# Meshcat's port -> the page front before it (what `BrowserGuard._pages` counts).
 _FRONTS = {}
 
 

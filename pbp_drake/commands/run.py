@@ -16,7 +16,7 @@ from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.signals import stopping_cleanly
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
 from pbp_drake.console import CAMERAS
-from pbp_drake.console.front import PortError, bind_page_port
+from pbp_drake.console.front import bind_page_port
 from pbp_drake.output_paths import check_log_path, check_output_folder, check_record_path
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.scenarios import (
@@ -140,12 +140,7 @@ def _run(args):
     if args.no_meshcat:
         args.headless = True
     # The page's port before anything is built: taken or forbidden, a one-line refusal.
-    listening = None
-    if not args.headless:
-        try:
-            listening = bind_page_port(args.port)
-        except PortError as error:
-            raise ScenarioError(str(error)) from None
+    listening = None if args.headless else bind_page_port(args.port)
     try:
         resolved = scenario_for_run(args)
         check_buildable(resolved)  # before the page opens: what the builder cannot build

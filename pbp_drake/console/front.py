@@ -37,6 +37,7 @@ from websockets.http11 import Response
 from pbp_drake.console.meshcat_door import MeshcatDoor
 from pbp_drake.console.page_messages import MAX_MESSAGE, BadMessage, read_page_message
 from pbp_drake.console.pending_messages import PendingMessages, message_key
+from pbp_drake.scenarios import ScenarioError
 from pbp_drake.systems.operators.browser_guard import register_front, unregister_front, warn
 
 LOG = logging.getLogger(__name__)  # websockets' connection log, every poll: INFO
@@ -162,8 +163,9 @@ def check_token(text):
     return text
 
 
-class PortError(Exception):
-    """The page's port cannot be had; the message says what to do instead."""
+class PortError(ScenarioError):
+    """The page's port cannot be had; the message says what to do instead (the command
+    line's refusal, exit 2)."""
 
 
 def bind_page_port(port, host="localhost"):

@@ -1,8 +1,8 @@
 """Meshcat's port shut to everyone but the page front: a classic BPF filter
 (`SO_ATTACH_FILTER`, Linux) on Meshcat's listening socket, a descriptor of this process,
 that admits only the front's own sockets; docs/design.md ("The page") says how and what
-it does not cover. Where the door cannot be shut (not Linux, Meshcat in another process or
-not on loopback alone), `shut` is False and `reason` says why.
+it does not cover. It cannot be shut outside Linux, or for a Meshcat in another process or
+not on loopback alone (`MeshcatDoor.reason`).
 """
 
 import contextlib

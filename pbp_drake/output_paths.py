@@ -69,7 +69,7 @@ def mark_replay(html):
     if viewer_line:
         html = html[:viewer_line.end()] + PAUSED_AT_START + html[viewer_line.end():]
     notes = []
-    if _draws(html, _SCENE_2D_ROBOT):
+    if any(_SCENE_2D_ROBOT in base64.b64decode(payload) for payload in _PAYLOAD.findall(html)):
         notes.append(legend_html(SCENE_2D_LEGEND))
     if viewer_line:
         notes.append(f'<div id="{REPLAY_HINT_ID}" style="position: fixed; right: 8px; '
@@ -122,11 +122,6 @@ def replay_track(html, path, track):
                     return (np.array([key["time"] / clip["fps"] for key in keys], float),
                             np.array([key["value"] for key in keys], float))
     raise ValueError(f"the replay records no {track} of {path}")
-
-
-def _draws(html, path):
-    """Whether a command of the page names the Meshcat `path` (bytes)."""
-    return any(path in base64.b64decode(payload) for payload in _PAYLOAD.findall(html))
 
 
 def is_replay(path):

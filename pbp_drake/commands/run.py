@@ -15,7 +15,7 @@ from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.signals import stopping_cleanly
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
 from pbp_drake.console import CAMERAS
-from pbp_drake.console.front import PortError, bind_page_port
+from pbp_drake.console.front import bind_page_port
 from pbp_drake.output_paths import check_log_path, check_output_folder, check_record_path
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.scenarios import (
@@ -139,12 +139,7 @@ def _run(args):
     if args.no_meshcat:
         args.headless = True
     # The page's port before anything is built: taken or forbidden, a one-line refusal.
-    listening = None
-    if not args.headless:
-        try:
-            listening = bind_page_port(args.port)
-        except PortError as error:
-            raise ScenarioError(str(error)) from None
+    listening = None if args.headless else bind_page_port(args.port)
     try:
         resolved = scenario_for_run(args)
         if args.camera == "robot" and (not resolved.has_task or resolved.is_arm):
@@ -155,7 +150,7 @@ def _run(args):
             raise ScenarioError("--camera robot looks from the simulated HSR's head; through "
                                 "the task-space bridge (robot.hardware.connect) the robot "
                                 "is on the far side")
-        check_run_flags(args, resolved)  # and the flags' combinations, before the page too
+        session = check_run_flags(args, resolved)  # the flags' combinations, before the page
     except BaseException:
         if listening is not None:
             listening.close()
@@ -165,7 +160,7 @@ def _run(args):
         meshcat, page = open_page(listening, args)
     try:
         if args.participant is not None:
-            return run_session_command(args, resolved, meshcat, page)
+            return run_session_command(args, resolved, meshcat, page, session)
         if resolved.has_task:
             return run_task_loop(args, resolved, meshcat, page)
         return run_scene(args, resolved, meshcat, page)

@@ -10,7 +10,8 @@ from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
 
 def check_run_flags(args, resolved):
     """Raises ScenarioError for flags of `run` (the parsed `args`) that do not go together,
-    or not with the resolved scenario. `--no-meshcat` implies `--headless`."""
+    or not with the resolved scenario (`--no-meshcat` implies `--headless`). Returns a
+    session's `(methods, order, answers)` (`--answers` parsed, or None), else None."""
     if args.no_meshcat and (args.record or args.camera == "robot"):
         raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
     if not resolved.has_task:
@@ -27,41 +28,37 @@ def check_run_flags(args, resolved):
         if args.methods is not None or args.output is not None or args.practice or args.answers:
             raise ScenarioError("--methods, --output, --practice and --answers belong to a "
                                 "session: add --participant ID")
-        return
+        return None
     if args.no_meshcat:
         raise ScenarioError("--participant: a session shows each run in the page; drop "
                             "--no-meshcat")
     if args.record or args.log:
         raise ScenarioError("--record and --log save one run; a session saves every run under "
                             "--output")
-    methods, _ = session_methods(args, resolved.scenario)
+    methods = method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
+    for method in methods:
+        with_method(resolved.scenario, method)
+    try:
+        order = session_order(methods, args.participant)
+    except ValueError as error:
+        raise ScenarioError(f"--participant: {error}") from None
+    answers = None
     if args.answers is not None:
         if person:
             raise ScenarioError("--answers stands in for a person's answers: it goes with "
                                 "--operator virtual; a keyboard or gamepad participant "
                                 "answers in the page")
-        parse_answers(args.answers, methods)
+        answers = parse_answers(args.answers, methods)
     elif args.headless:
         raise ScenarioError("a --headless session needs --answers (e.g. --answers "
                             "tiredness=3,ease=4): otherwise the questions are asked in the "
                             "browser")
+    return methods, order, answers
 
 
 def is_person(scenario):
     """A person drives the scenario's robot from the page (keyboard or gamepad)."""
     return isinstance(scenario.operator, (Keyboard, Gamepad))
-
-
-def session_methods(args, scenario):
-    """`(methods, order)` of a session: `--methods` (or the default ones), each a method the
-    scenario takes, and their order for `--participant`."""
-    methods = method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
-    for method in methods:
-        with_method(scenario, method)
-    try:
-        return methods, session_order(methods, args.participant)
-    except ValueError as error:
-        raise ScenarioError(f"--participant: {error}") from None
 
 
 def _check_scene_flags(args):

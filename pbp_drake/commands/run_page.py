@@ -10,7 +10,7 @@ from pydrake.geometry import Meshcat, MeshcatParams
 
 from pbp_drake.cli_types import port, token, wait_seconds
 from pbp_drake.console import Console
-from pbp_drake.console.front import PageFront
+from pbp_drake.console.front import ENDED_NOTICE, PageFront
 from pbp_drake.output_paths import recorded_replay
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.studies.atomic_files import write_atomically
@@ -19,7 +19,6 @@ from pbp_drake.studies.atomic_files import write_atomically
 RUN_CHOICES = ("stop", "restart", "next")
 #: After a single task's run, while the page is kept.
 AFTER_RUN_CHOICES = ("restart", "next", "close")
-PAGE_ENDED = "This run has ended; you can close this page."
 # Why a keyboard or gamepad run stops when no browser opens its page.
 PERSON_NEEDS_PAGE = ("the keyboard and gamepad are read in the page, so nothing was run or "
                      "recorded")
@@ -90,7 +89,7 @@ def keep_page(args, page, console, choices):
                                    until=lambda: page.pages() == 0)
 
 
-def end_page(page, console, text=PAGE_ENDED):
+def end_page(page, console, text=ENDED_NOTICE):
     """The command is done: the page says so, its buttons and sliders gone (the operator's
     are the caller's: `task_runs.delete_operator`)."""
     if console is not None:

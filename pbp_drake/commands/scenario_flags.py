@@ -64,27 +64,25 @@ def scenario_overrides(args, shorthands=True):
 
 
 def _shorthand_settings(args):
-    """[(FIELD=VALUE, the flag as typed)] of the shorthands given."""
+    """[(FIELD=VALUE, the flag as typed)] of the shorthands (on `run` and `session`) given."""
     settings = []
-    method = getattr(args, "method", None)
-    if method is not None:
-        name, alpha = parse_method_label(method)
-        settings.append((f"method={name}", f"--method {method}"))
+    if args.method is not None:
+        name, alpha = parse_method_label(args.method)
+        settings.append((f"method={name}", f"--method {args.method}"))
         if alpha is not None:
-            settings.append((f"alpha={alpha!r}", f"--method {method}"))
-    operator = getattr(args, "operator", None)
-    if operator is not None:
-        if operator not in OPERATOR_NAMES:
-            raise ScenarioError(f"--operator {operator!r} is unknown; choose one of "
+            settings.append((f"alpha={alpha!r}", f"--method {args.method}"))
+    if args.operator is not None:
+        if args.operator not in OPERATOR_NAMES:
+            raise ScenarioError(f"--operator {args.operator!r} is unknown; choose one of "
                                 f"{list(OPERATOR_NAMES)}")
         # A tag: the file's operator of the same kind keeps its settings (`merged`).
-        settings.append((f"operator=!{OPERATOR_NAMES[operator].__name__} {{}}",
-                         f"--operator {operator}"))
+        settings.append((f"operator=!{OPERATOR_NAMES[args.operator].__name__} {{}}",
+                         f"--operator {args.operator}"))
     for flag in ("seed", "duration", "alpha"):
-        value = getattr(args, flag, None)
+        value = getattr(args, flag)
         if value is not None:
             settings.append((f"{flag}={value!r}", f"--{flag} {value:g}"))
     for flag, field in (("hardware", "connect"), ("driver_sim", "driver_sim")):
-        if getattr(args, flag, False):
+        if getattr(args, flag):
             settings.append((f"robot.hardware.{field}=true", f"--{flag.replace('_', '-')}"))
     return settings

@@ -8,14 +8,14 @@ import sys
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.cli_types import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS
-from pbp_drake.commands.run_checks import is_person, session_methods
+from pbp_drake.commands.run_checks import is_person
 from pbp_drake.commands.run_page import (
-    PAGE_ENDED, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
-    wait_for_browser)
+    PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console, wait_for_browser)
 from pbp_drake.commands.task_runs import alpha_of, delete_operator, run_task_once
-from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage, start_label
+from pbp_drake.console.front import ENDED_NOTICE
+from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
 from pbp_drake.scenarios import counted
-from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, parse_answers, scales_text
+from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, scales_text
 from pbp_drake.studies.sessions import run_session
 
 
@@ -43,20 +43,21 @@ def add_session_flags(parser, hidden=False):
         "page)"))
 
 
-def run_session_command(args, resolved, meshcat, page):
-    """The session of `args.participant` on the resolved scenario; its exit code."""
+def run_session_command(args, resolved, meshcat, page, session):
+    """The session of `args.participant` on the resolved scenario, `session` its
+    `(methods, order, answers)` from `check_run_flags`; its exit code."""
     scenario = resolved.scenario
-    methods, order = session_methods(args, scenario)  # checked by check_run_flags
+    methods, order, answers = session
     output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
                                                        args.participant))
     print(f"Participant {args.participant}: {', '.join(order)}, in this order"
           + (", each practised first" if args.practice else "") + f"; saved in {output}",
           flush=True)
-    if args.answers is not None:
-        questions = FixedAnswers(parse_answers(args.answers, methods))
+    if answers is not None:
+        questions = FixedAnswers(answers)
     else:
-        questions = _StartInTheRun(meshcat, args.start_on_connect)
-    if page is not None and isinstance(questions, _StartInTheRun):
+        questions = MeshcatSessionPage(meshcat, start_in_run=not args.start_on_connect)
+    if page is not None and answers is None:
         # The pages are the person's: no browser, no session (`--answers` needs none).
         print(f"Open {page.url} in a browser (waiting up to {args.wait_for_browser:g} s); "
               "each method starts when its Start is pressed in the page, and the questions "
@@ -74,8 +75,7 @@ def run_session_command(args, resolved, meshcat, page):
 
     def run_one(trial):
         # Kept through a Restart: each run of the method starts at its Start.
-        start_button = (questions.take_start_label()
-                        if isinstance(questions, _StartInTheRun) else None)
+        start_button = questions.take_start_label() if answers is None else None
         while True:
             diagram = build_diagram(trial, meshcat)
             if console is not None:
@@ -103,7 +103,7 @@ def run_session_command(args, resolved, meshcat, page):
               "resumes the session.", file=sys.stderr)
         if page is not None:
             end_page(page, console, "The session was stopped; what was saved is kept. "
-                     + PAGE_ENDED)
+                     + ENDED_NOTICE)
         return EXIT_STOPPED if stopped else EXIT_INTERRUPTED
     failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
     print(f"Session saved in {output}, answers in {output / QUESTIONNAIRE_FILE} "
@@ -122,24 +122,3 @@ def run_session_command(args, resolved, meshcat, page):
 
 class _SessionStopped(Exception):
     """Stop pressed in the page during a session's run: the session ends, resumable."""
-
-
-class _StartInTheRun(MeshcatSessionPage):
-    """`MeshcatSessionPage` whose Start is pressed inside the run, once its scene is in the
-    page: `start` keeps the label for the run's `LiveRun` (`take_start_label`); with
-    `--start-on-connect`, Start is a page of its own between the runs."""
-
-    def __init__(self, meshcat, start_between_runs=False):
-        super().__init__(meshcat)
-        self._start_between_runs = start_between_runs
-        self._label = None
-
-    def start(self, method, position, total, practice=False):
-        if self._start_between_runs:
-            super().start(method, position, total, practice)
-        else:
-            self._label = start_label(method, position, total, practice)
-
-    def take_start_label(self):
-        label, self._label = self._label, None
-        return label

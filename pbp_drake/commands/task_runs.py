@@ -13,9 +13,9 @@ from pbp_drake.commands.run_page import (
     AFTER_RUN_CHOICES, PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console,
     save_recording, terminal, wait_for_browser)
 from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, result_text
-from pbp_drake.console.text import controls_text, failure_text
+from pbp_drake.console.text import controls_line, failure_text
 from pbp_drake.core.toy_scene import collision_ratio
-from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, forward_key_enabled, resolve
+from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, resolve
 
 
 def run_scene(args, resolved, meshcat, page):
@@ -25,7 +25,7 @@ def run_scene(args, resolved, meshcat, page):
     console = None
     if page is not None:
         console = page_console(meshcat, page, args, alpha_of(scenario), choices=("stop",))
-        console.show_title(method_name(scenario.method, alpha_of(scenario)))
+        console.show_title(method_name(scenario.method, scenario.alpha))
         if terminal():  # someone may be watching
             wait_for_browser(page, args.wait_for_browser)
     if args.record:
@@ -77,7 +77,9 @@ def run_task_loop(args, resolved, meshcat, page):
             wait_for_browser(page, args.wait_for_browser, PERSON_NEEDS_PAGE if person else None)
         first = False
         result, live = run_task_once(args, resolved, diagram, meshcat, console, start_button)
-        code = task_code(result, live)
+        code = EXIT_SUCCESS if result.success else EXIT_FAILED
+        if live.choice == "stop":
+            code = EXIT_STOPPED
         if console is None:
             return code
         choice = live.choice
@@ -101,7 +103,7 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     if args.camera == "robot":
         camera = RobotCamera(meshcat, find_system(diagram, "hsr_station"))
     if console is not None:
-        console.show_title(f"{method_name(scenario.method, alpha_of(scenario))}, seed "
+        console.show_title(f"{method_name(scenario.method, scenario.alpha)}, seed "
                            f"{scenario.seed}")
         console.clear_result()
     live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration), camera,
@@ -145,21 +147,6 @@ def why_failed(result, scenario):
     grasping = isinstance(scenario.task, GraspTask)
     return failure_text(target, len(result.objects), distance,
                         None if grasping else scenario.task.success_distance)
-
-
-def controls_line(scenario):
-    """What the person's keys or gamepad do in `scenario`'s task (`controls_text`)."""
-    return controls_text(grasping=isinstance(scenario.task, GraspTask),
-                         gamepad=isinstance(scenario.operator, Gamepad),
-                         forward=forward_key_enabled(scenario),
-                         vertical=bool(getattr(scenario.task, "z_range", None)))
-
-
-def task_code(result, live):
-    """The exit code of a run: stopped, succeeded or failed."""
-    if live.choice == "stop":
-        return EXIT_STOPPED
-    return EXIT_SUCCESS if result.success else EXIT_FAILED
 
 
 def delete_operator(diagram):

@@ -36,14 +36,14 @@ class RobotCamera:
     kinematic): `update(root_context)` reads its `state` and sets the camera
     (`behind_head_view`). Use from Meshcat's thread."""
 
-    def __init__(self, meshcat, station, head_body="head_link", base_body="base_link"):
+    def __init__(self, meshcat, station):
         self._meshcat = meshcat
         self._station = station
         self._state_port = station.GetOutputPort("state")
         self._plant = hsr_station_plant(station)
         self._plant_context = self._plant.CreateDefaultContext()
-        self._head = self._plant.GetBodyByName(head_body)
-        self._base = self._plant.GetBodyByName(base_body)
+        self._head = self._plant.GetBodyByName("head_link")
+        self._base = self._plant.GetBodyByName("base_link")
 
     def update(self, root_context):
         context = self._plant_context

@@ -1,15 +1,12 @@
 """The run's page behind a front of our own: a token and the page's own origin, or HTTP 403.
 
-The front keeps Drake's Meshcat on a private localhost port and serves the public one: the
-page (Meshcat's, with our console panel injected) and a websocket relay to Meshcat, only to
-a client with the run's token (`?token=T`, then a cookie) and, for a websocket, the page's
-own `Origin`. docs/design.md ("The page") explains the door (`meshcat_door`), the checked
-frames (`page_messages`) and the pacing of a slow page (`PendingMessages`, `FRAME`, `ACK`).
-
-The front never calls a Meshcat method (those belong to the thread that made it); it talks
-to Meshcat's port from an asyncio loop on a daemon thread. Close the front before letting
-go of the Meshcat: Drake aborts the process when a Meshcat dies on another thread (as one
-left in a reference cycle does, in whichever thread collects).
+The front keeps Drake's Meshcat on a private localhost port and serves the page (Meshcat's,
+with our console panel injected) and a websocket relay to it; docs/design.md ("The page")
+explains the token, the door (`meshcat_door`), the checked frames (`page_messages`) and the
+pacing of a slow page (`PendingMessages`, `FRAME`, `ACK`). The front never calls a Meshcat
+method; it runs an asyncio loop on a daemon thread. Close the front before letting go of
+the Meshcat: Drake aborts the process when a Meshcat dies on another thread (as one left in
+a reference cycle does, in whichever thread collects).
 """
 
 import asyncio
@@ -27,7 +24,6 @@ import math
 import re
 import secrets
 import socket
-import sys
 import threading
 import time
 import urllib.parse
@@ -41,11 +37,13 @@ from websockets.http11 import Response
 from pbp_drake.console.meshcat_door import MeshcatDoor
 from pbp_drake.console.page_messages import MAX_MESSAGE, BadMessage, read_page_message
 from pbp_drake.console.pending_messages import PendingMessages, message_key
-from pbp_drake.systems.operators.browser_guard import register_front, unregister_front
+from pbp_drake.scenarios import ScenarioError
+from pbp_drake.systems.operators.browser_guard import register_front, unregister_front, warn
 
 LOG = logging.getLogger(__name__)  # websockets' connection log, every poll: INFO
 COOKIE = "pbp_drake_token"
 LINES = ("title", "status", "result", "notice")
+ENDED_NOTICE = "This run has ended; you can close this page."
 REFUSAL = ("This page needs the address `pbp-drake run` printed (with its ?token=...); "
            "open that one.\n")
 _TOKEN = re.compile(r"[A-Za-z0-9_-]+")
@@ -120,7 +118,7 @@ body.pbp-ended #status-message { display: none !important; }
       });
     } catch (e) {}
     state = Object.assign({}, state);
-    if (!state.notice) state.notice = "This run has ended; you can close this page.";
+    if (!state.notice) state.notice = "ENDED_TEXT";
     show(state);
   }
   function poll() {
@@ -146,7 +144,7 @@ body.pbp-ended #status-message { display: none !important; }
   poll();
 })();
 </script>
-""".replace("FRAME_TEXT", FRAME).replace("ACK_TEXT", ACK)
+""".replace("FRAME_TEXT", FRAME).replace("ACK_TEXT", ACK).replace("ENDED_TEXT", ENDED_NOTICE)
 
 
 def new_token():
@@ -165,8 +163,9 @@ def check_token(text):
     return text
 
 
-class PortError(Exception):
-    """The page's port cannot be had; the message says what to do instead."""
+class PortError(ScenarioError):
+    """The page's port cannot be had; the message says what to do instead (the command
+    line's refusal, exit 2)."""
 
 
 def bind_page_port(port, host="localhost"):
@@ -196,10 +195,6 @@ def _response(status, body, content_type, *headers):
         ("Content-Length", str(len(body))), ("Content-Type", content_type), *headers]), body)
 
 
-def _warn(message):
-    print(f"pbp-drake: {message}", file=sys.stderr, flush=True)
-
-
 class PageFront:
     """The public port of a run: Meshcat's page and websocket, to the token's holder only.
 
@@ -227,7 +222,7 @@ class PageFront:
         self._wakers = set()  # each relay's event: the state changed, send it
         self._door = MeshcatDoor(meshcat_port)
         if not self._door.shut:
-            _warn(f"Meshcat's port stays open to other programs on this machine "
+            warn(f"Meshcat's port stays open to other programs on this machine "
                   f"({self._door.reason}): what a connection the page front did not open "
                   "sends is ignored while it stays")
         try:
@@ -303,9 +298,9 @@ class PageFront:
             return dict(self._state)
 
     def end(self, text=None, wait=5.0):
-        """Marks the run ended: the page shows `text` as its notice (or says the run has
-        ended), stops reconnecting and hides Meshcat's banner. Waits until every relayed
-        page has been sent that (none left on the reconnect banner), at most `wait` s."""
+        """Marks the run ended: the page shows `text` as its notice (None: `ENDED_NOTICE`),
+        stops reconnecting and hides Meshcat's banner. Waits until every relayed page has
+        been sent that (none left on the reconnect banner), at most `wait` s."""
         with self._lock:
             self._state.update(ended=True, notice=text)
             self._state["seq"] += 1
@@ -396,7 +391,7 @@ class PageFront:
         now = time.monotonic()
         if self._accept_errors is None or now - self._accept_errors > ACCEPT_BURST:
             why = error.strerror if isinstance(error, OSError) and error.strerror else error
-            _warn(f"the page's port cannot accept connections for now ({why}); "
+            warn(f"the page's port cannot accept connections for now ({why}); "
                   "it retries each second, and the run goes on")
         self._accept_errors = now
 
@@ -499,7 +494,7 @@ class PageFront:
                 try:  # only what Meshcat's page sends, freshly encoded: Meshcat's parser
                     message = read_page_message(message)  # dies on bytes it cannot read
                 except BadMessage as error:
-                    _warn(f"a page's connection was closed: it sent a bad message ({error})")
+                    warn(f"a page's connection was closed: it sent a bad message ({error})")
                     await page.close(BAD_FRAME_CLOSE, f"bad message: {error}"[:120])
                     return
                 hear()  # counted before Meshcat has the input: the guard sees it first

@@ -1,11 +1,8 @@
-"""Meshcat's port shut to everyone but the page front: a filter on Meshcat's listening socket.
-
-Meshcat's listening socket is a descriptor of this process; on Linux a classic BPF filter
-(`SO_ATTACH_FILTER`) on it drops every connection request but those from the (address,
-port) pairs of the front's own sockets, each bound before it connects (no `SO_REUSEADDR`,
-so no other socket can take the pair meanwhile). docs/design.md ("The page") says what
-this does and does not cover. Where the door cannot be shut (not Linux, Meshcat in another
-process or not on loopback alone), `shut` is False and `reason` says why.
+"""Meshcat's port shut to everyone but the page front: a classic BPF filter
+(`SO_ATTACH_FILTER`, Linux) on Meshcat's listening socket, a descriptor of this process,
+that admits only the front's own sockets; docs/design.md ("The page") says how and what
+it does not cover. It cannot be shut outside Linux, or for a Meshcat in another process or
+not on loopback alone (`MeshcatDoor.reason`).
 """
 
 import contextlib
@@ -45,7 +42,7 @@ class MeshcatDoor:
             if any(s.family != family or s.getsockname()[0] != self._address[0]
                    for s in self._listeners):
                 self._close_listeners("Meshcat listens on more than one address")
-            elif not _loopback(self._address[0]):
+            elif self._address[0] != "::1" and not self._address[0].startswith("127."):
                 self._close_listeners(f"Meshcat listens on {self._address[0]}, not on "
                                       "this machine's loopback alone")
         if self._listeners:
@@ -163,10 +160,6 @@ def _listeners(port):
             pass
         sock.close()
     return found, None if found else f"no socket of this process listens on port {port}"
-
-
-def _loopback(address):
-    return address == "::1" or address.startswith("127.")
 
 
 def _program(family, address, ports):

@@ -9,6 +9,8 @@ import select
 import sys
 import time
 
+from pbp_drake.console.front import LINES
+
 #: The choices a person can make, and the label of the button that makes each.
 CHOICE_BUTTONS = {"stop": "Stop", "restart": "Restart", "next": "Next scene",
                   "close": "Close"}
@@ -24,8 +26,8 @@ class Console:
 
     Args:
         meshcat: the page's Meshcat.
-        choices: which of "stop", "restart", "next", "close" get a button (labels in
-            `CHOICE_BUTTONS`: Stop, Restart, Next scene, Close), in this order.
+        choices: which of `CHOICE_BUTTONS` ("stop", "restart", "next", "close") get a
+            button, in this order.
         alpha: with a number, an alpha slider (0..1, step 0.05) starting there; `alpha()`
             reads it.
         realtime_rate: with a positive number, a real-time-rate slider (`RATE_RANGE`,
@@ -54,7 +56,7 @@ class Console:
             # Widened to hold the rate asked for: the slider must not clip the command line.
             meshcat.AddSlider(RATE_SLIDER, min(low, rate), max(high, rate), step, rate)
             self._sliders.append(RATE_SLIDER)
-        self._lines = {"title": None, "status": None, "result": None, "notice": None}  # shown
+        self._lines = dict.fromkeys(LINES)  # the labels shown
 
     @property
     def meshcat(self):

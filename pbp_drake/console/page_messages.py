@@ -1,8 +1,5 @@
-"""What a run's page may send Meshcat: the messages Meshcat's own page sends, read strictly.
-
-Meshcat's websocket thread, and the run with it, dies on a frame that is not msgpack; so the
-page front reads each frame here first (`read_page_message`, docs/design.md ("The page"))
-and hands Meshcat a fresh encoding of one of these messages; any other is a `BadMessage`:
+"""What a run's page may send Meshcat: the messages Meshcat's own page sends, read strictly
+(`read_page_message`; why: docs/design.md, "The page"). Any other frame is a `BadMessage`:
 
 - `{"type": "button", "name": N}`: a button clicked, or its key pressed;
 - `{"type": "slider", "name": N, "value": x}`: a slider moved (x finite);
@@ -10,9 +7,8 @@ and hands Meshcat a fresh encoding of one of these messages; any other is a `Bad
   [0..1, ...], "axes": [-1..1, ...]}`: the first gamepad's state;
 - `{"type": "camera_pose", "camera_pose": [16 finite numbers], "is_perspective": b}`.
 
-Limits: a frame of at most `MAX_MESSAGE` bytes, names of at most `MAX_NAME` bytes of UTF-8,
-at most `MAX_ITEMS` gamepad buttons or axes, no other key, no key twice, no trailing byte,
-no msgpack `bin`, `ext` or the never-used byte `0xc1`.
+Within `MAX_MESSAGE` bytes, `MAX_NAME` bytes a name, `MAX_ITEMS` gamepad buttons or axes; no
+other key, no key twice, no trailing byte, no msgpack `bin`, `ext` or the byte `0xc1`.
 """
 
 import math

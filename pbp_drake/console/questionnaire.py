@@ -40,14 +40,28 @@ class MeshcatSessionPage:
     """The session's pages in a Meshcat's control panel, polled from the thread that made
     the Meshcat (a person clicks; nothing times out, Ctrl-C in the terminal stops the
     session, which the same command resumes). Each page's buttons are deleted before the
-    next page shows, so a click meant for one page cannot answer another."""
+    next page shows, so a click meant for one page cannot answer another. With
+    `start_in_run`, Start is pressed inside the run, once its scene is in the page: `start`
+    keeps the label for the run's `LiveRun` (`take_start_label`)."""
 
-    def __init__(self, meshcat):
+    def __init__(self, meshcat, start_in_run=False):
         self._meshcat = meshcat
+        self._start_in_run = start_in_run
+        self._label = None
 
     def start(self, method, position, total, practice=False):
-        """Shows the Start button of `method` and returns when it is clicked."""
-        self._wait_for_click([start_label(method, position, total, practice)])
+        """Shows the Start button of `method` and returns when it is clicked (keeps its
+        label with `start_in_run`)."""
+        label = start_label(method, position, total, practice)
+        if self._start_in_run:
+            self._label = label
+        else:
+            self._wait_for_click([label])
+
+    def take_start_label(self):
+        """The label `start` kept (once), or None."""
+        label, self._label = self._label, None
+        return label
 
     def answer(self, method, question):
         """Shows `question`'s six answers (about `method`, just run) and returns the value

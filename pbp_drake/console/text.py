@@ -1,9 +1,10 @@
 """The console's words: what the page and the terminal say about a run, as pure functions
-of numbers (no Meshcat, no Drake)."""
+of numbers and scenarios (no Meshcat, no Drake)."""
 
 import math
 
-from pbp_drake.scenarios import METHOD_NAMES, METHODS, counted
+from pbp_drake.scenarios import (
+    METHOD_NAMES, METHODS, Gamepad, GraspTask, counted, forward_key_enabled)
 
 
 def method_name(method, alpha=None):
@@ -52,11 +53,13 @@ def failure_text(target, target_count, distance, success_distance=None):
             f"{distance:.3f} m from it{within}")
 
 
-def controls_text(grasping, gamepad, forward, vertical):
-    """What a person's keys or gamepad do in a task: `grasping` (six degrees of freedom),
-    `gamepad` (else the keys), `forward` (the method lets the person push forward),
-    `vertical` (the keys raise and lower the hand)."""
-    limit = "" if forward else " (not forward: the primitive drives it)"
+def controls_line(scenario):
+    """What the person's keys or gamepad do in `scenario`'s task: six degrees of freedom in
+    the grasping task, forward only where the method lets the person push forward
+    (`forward_key_enabled`), up and down with the task's `z_range`."""
+    grasping = isinstance(scenario.task, GraspTask)
+    gamepad = isinstance(scenario.operator, Gamepad)
+    limit = "" if forward_key_enabled(scenario) else " (not forward: the primitive drives it)"
     if gamepad and grasping:
         return (f"Gamepad: left stick moves the hand{limit}, triggers raise (RT) and lower "
                 "(LT) it; right stick yaws and pitches, shoulders roll.")
@@ -65,8 +68,8 @@ def controls_text(grasping, gamepad, forward, vertical):
     if grasping:
         return (f"Keys: arrows move the hand{limit}, PageUp/PageDown raise and lower it; R "
                 "switches to turning (arrows pitch and yaw, PageUp/PageDown roll).")
-    return (f"Keys: arrows move the hand{limit}, Q and E turn it"
-            + (", R raises it and F lowers it." if vertical else "."))
+    up_down = ", R raises it and F lowers it" if getattr(scenario.task, "z_range", None) else ""
+    return f"Keys: arrows move the hand{limit}, Q and E turn it{up_down}."
 
 
 def progress_text(now, duration, realtime_factor):

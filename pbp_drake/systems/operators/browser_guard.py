@@ -1,14 +1,10 @@
 """Exclusive control of a Meshcat page: a person's operator reads its browser only while
-exactly that one browser is connected.
+exactly that one browser is connected (docs/getting-started.md, "Who can drive").
 
-The second line behind the command line's page front (`pbp_drake.console.front`), and the
-only one for a diagram on a bare Meshcat (docs/getting-started.md, docs/design.md). It
-counts the pages the front admitted that have sent a frame (when a front serves this
-Meshcat: `register_front`), else Meshcat's connections; with more than one it pauses the
-simulation where it stands until one is left. Behind a front, a connection the front did
-not open is an intruder: while one is connected every click and key is dropped, unpaused.
-It cannot stop alone a page that connects while no browser is, or one that connects,
-presses and leaves between two control ticks.
+Behind the page front (`pbp_drake.console.front`, which `register_front`s) it counts the
+front's pages that have sent a frame, else Meshcat's connections. It cannot stop alone a
+page that connects while no browser is, or one that connects, presses and leaves between
+two control ticks.
 """
 
 import sys
@@ -17,9 +13,7 @@ import time
 #: The label of the notice added to the page's controls while the run is paused.
 PAUSED_NOTICE = "Paused: {count} browsers are connected. Close all pages but one"
 
-# Meshcat's port -> the page front before it: its `pages_heard()` (admitted pages that have
-# sent a frame) and `own_connections()` (its connections to Meshcat, which it counts
-# against Meshcat's).
+# Meshcat's port -> the page front before it (what `BrowserGuard._pages` counts).
 _FRONTS = {}
 
 
@@ -49,7 +43,7 @@ class BrowserGuard:
         self._meshcat = meshcat
         self._poll_period = float(poll_period)
         self._settle = float(settle)
-        self._announce = announce or _to_stderr
+        self._announce = announce or warn
         self._intruded = False
         self.after_pause = None
         self.pauses = 0
@@ -99,7 +93,8 @@ class BrowserGuard:
         return True
 
 
-def _to_stderr(message):
+def warn(message):
+    """Says `message` on stderr as the command line's own words ("pbp-drake: ...")."""
     print(f"pbp-drake: {message}", file=sys.stderr, flush=True)
 
 

@@ -32,13 +32,12 @@ def check_params(params, positive=(), fraction=()):
 class BrowserOperator(SampledOperator):
     """A person in a Meshcat browser, at its keyboard or gamepad.
 
-    `params` (a dataclass, copied to `self.params`) gives `speed` (m/s; 0 takes
-    `nominal_speed`) and `rotation_speed` (rad/s). `allow_forward` is False in PBP modes,
-    where forward motion comes from the DMP phase. With `exclusive` a `BrowserGuard` pauses
-    the simulation while more than one browser is connected, and nothing sent meanwhile
-    counts. Subclasses read their keys (`_declare_keys`, `_step_keys`) or gamepad
-    (`_declare_gamepad`, `_read_gamepad`) in `_update`. Use Meshcat only from the thread
-    that created it.
+    `params` (a dataclass with `speed`, 0 taking `nominal_speed`, and `rotation_speed`) is
+    copied to `self.params`. `allow_forward` is False in PBP modes, where forward motion
+    comes from the DMP phase. With `exclusive` a `BrowserGuard` pauses the simulation while
+    more than one browser is connected, dropping what they send. Subclasses read their keys
+    (`_declare_keys`, `_step_keys`) or gamepad (`_declare_gamepad`, `_read_gamepad`) in
+    `_update`. Use Meshcat only from the thread that created it.
     """
 
     def __init__(self, meshcat, dimension, control_period, allow_forward, params,

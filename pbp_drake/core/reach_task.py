@@ -1,11 +1,7 @@
-"""The multi-goal reaching task of the paper (section IV-B.1), in pure NumPy.
-
-A scene has 2 to 4 objects drawn uniformly in a rectangle in front of the robot, all at one
-height, and a sequence of targets: the first is drawn at the start (0 % progress), and at
-each later threshold of the schedule (30 %, 60 %) the target switches, unannounced, to a
-different object. Progress is how much of the distance from the end effector's start to
-the current target has been covered, `1 - |p - target| / |start - target|`, clipped at 0.
-Success is the end effector within `success_distance` of the current target.
+"""The multi-goal reaching task of the paper (section IV-B.1, docs/tasks/reach.md), in pure
+NumPy: its scenes (objects, and the targets that switch, unannounced, at each threshold of
+the progress schedule, `reach_progress`), their checks, and the floor angles its operators
+share.
 """
 
 import dataclasses

@@ -9,13 +9,10 @@ the HSR or an arm, a handful of blocks:
     pbp_controller.ee_command ──> station.ee_command (differential IK)
     obstacles.obstacle_positions ──> station;  station.in_collision ──> task_monitor
 
-The station is `hsr_station`, `arm_station` (`robot: !Arm`) or `bridged_station` (the
-HSR over LCM, `pbp_drake.robots.task_space_bridge`); the controller is
-`make_pbp_controller`'s Diagram. The order within a tick is `pbp_drake.systems.tick`'s.
-Loggers named `ee_state_log`, `operator_active_log`, `operator_command_log`, `command_log`,
-`selected_goal_log`, `target_log`, `phase_log` (with DMPs), `posterior_clipped_log` (with
-HOP's posterior) and `in_collision_log` (with obstacles) record each tick; the task monitor
-ends the simulation at success.
+The station is the HSR's, an arm's or the HSR's over LCM (`_station`); the controller is
+`make_pbp_controller`'s Diagram; a tick's order is `pbp_drake.systems.tick`'s. Loggers (the
+`*_log` systems `pbp_drake.builder.run` reads back) record each tick; the task monitor ends
+the simulation at success.
 """
 
 import numpy as np

@@ -377,9 +377,17 @@ class SeriesPeaks:
         if self._posterior_ticks:
             series = dict(series, posterior_clipped_ratio=(
                 self._clipped_ticks / self._posterior_ticks))
-        series = dict(series, **self._interaction.metrics().fields())
-        return task_result(status, monitor, series, self._hand.peak(self._period),
-                           self._command.peak(self._period))
+        return TaskResult(
+            success=bool(status.success > 0.5),
+            task_time=float(status.task_time),
+            intervention_ratio=float(status.intervention_ratio),
+            switches=int(status.stage),
+            objects=monitor.objects.copy(),
+            collision_ratio=float(status.collision_ratio),
+            peak_hand_speed=self._hand.peak(self._period),
+            peak_command_acceleration=self._command.peak(self._period),
+            idle_ratio=idle_ratio(status.intervention_ratio),
+            **series, **self._interaction.metrics().fields())
 
 
 def series_fields(times, ee_state, in_collision, decisions):
@@ -397,18 +405,3 @@ def series_fields(times, ee_state, in_collision, decisions):
         targets=decisions["target_log"][:, 3].astype(int),
         in_collision=None if in_collision is None else in_collision[:, 0] > 0.5)
 
-
-def task_result(status, monitor, series, peak_hand_speed, peak_command_acceleration):
-    """The TaskResult of a run: the task monitor's final `status` (TaskStatus) and objects,
-    the `series` fields (see series_fields) and the peaks (see SeriesPeaks)."""
-    return TaskResult(
-        success=bool(status.success > 0.5),
-        task_time=float(status.task_time),
-        intervention_ratio=float(status.intervention_ratio),
-        switches=int(status.stage),
-        objects=monitor.objects.copy(),
-        collision_ratio=float(status.collision_ratio),
-        peak_hand_speed=peak_hand_speed,
-        peak_command_acceleration=peak_command_acceleration,
-        idle_ratio=idle_ratio(status.intervention_ratio),
-        **series)

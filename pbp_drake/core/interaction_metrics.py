@@ -74,9 +74,8 @@ class InteractionMeter:
     crosses a chunk boundary (the last tick's hand position and command, the current
     switch and how long its target has been named) is carried over."""
 
-    def __init__(self, control_period, still_speed=STILL_SPEED):
+    def __init__(self, control_period):
         self._period = float(control_period)
-        self._still = float(still_speed)
         self._input = self._turn = 0.0
         self._cosines, self._cosine_count = 0.0, 0
         self._last = None  # (position, velocity command, active) of the last tick fed
@@ -117,7 +116,7 @@ class InteractionMeter:
         command = velocity[:-1]
         hand_speed = np.linalg.norm(hand, axis=1)
         command_speed = np.linalg.norm(command, axis=1)
-        used = active[:-1] & (hand_speed >= self._still) & (command_speed >= self._still)
+        used = active[:-1] & (hand_speed >= STILL_SPEED) & (command_speed >= STILL_SPEED)
         cosines = (np.einsum("ij,ij->i", command[used], hand[used])
                    / (command_speed[used] * hand_speed[used]))
         self._cosines += math.fsum(cosines)
@@ -169,14 +168,13 @@ class InteractionMeter:
 
 
 def interaction_metrics(times, control_period, operator_velocity, operator_turn,
-                        operator_active, hand_positions, predicted_goals, targets,
-                        still_speed=STILL_SPEED):
+                        operator_active, hand_positions, predicted_goals, targets):
     """The `InteractionMetrics` of one task's whole series, one row per control tick of
     `control_period` s, the command of tick k held until tick k + 1: `times` (T,) s, the
     operator's translational command (T, 3) m/s (world frame) and turning (T,) (a yaw
     rate) or (T, 3) (an angular velocity) rad/s, whether it acted (T,), the hand's
     positions (T, 3) m, the named goal (T,) (-1: none) and the target (T,)."""
-    meter = InteractionMeter(control_period, still_speed)
+    meter = InteractionMeter(control_period)
     meter.add(times, operator_velocity, operator_turn, operator_active, hand_positions,
               predicted_goals, targets)
     return meter.metrics()

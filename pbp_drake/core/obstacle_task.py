@@ -10,6 +10,8 @@ import dataclasses
 
 import numpy as np
 
+from pbp_drake.core.reach_task import spread_points
+
 
 @dataclasses.dataclass(frozen=True)
 class ObstacleScene:
@@ -42,22 +44,11 @@ def sample_obstacle_scene(seed, x_range=(1.25, 2.5), y_range=(-1.05, 1.05), heig
                              f"{list(x_range)}, y {list(y_range)}")
         thresholds = np.sort(rng.uniform(*activation_range, size=len(starts)))
         return ObstacleScene(target=target, obstacle_starts=starts, thresholds=thresholds)
-    keep_away = [np.asarray(robot_xy, float), target[:2]]
-    starts = []
-    for index in range(obstacle_count):
-        for _ in range(1000):
-            candidate = np.array([rng.uniform(*obstacle_x_range), rng.uniform(*obstacle_y_range)])
-            if all(np.linalg.norm(candidate - other) >= clearance
-                   for other in keep_away + starts):
-                break
-        else:
-            raise ValueError(f"cannot place {obstacle_count} obstacles {clearance} m from the "
-                             f"robot, the target and each other in x {list(obstacle_x_range)}, "
-                             f"y {list(obstacle_y_range)}")
-        starts.append(candidate)
+    starts = spread_points(rng, obstacle_count, obstacle_x_range, obstacle_y_range, clearance,
+                           "obstacles", keep_away=[np.asarray(robot_xy, float), target[:2]],
+                           apart="from the robot, the target and each other")
     thresholds = np.sort(rng.uniform(*activation_range, size=obstacle_count))
-    return ObstacleScene(target=target, obstacle_starts=np.array(starts).reshape(-1, 2),
-                         thresholds=thresholds)
+    return ObstacleScene(target=target, obstacle_starts=starts, thresholds=thresholds)
 
 
 def step_obstacles(positions, intercepts, active, progress, robot_xy, target_xy, thresholds,

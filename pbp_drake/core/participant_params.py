@@ -105,7 +105,7 @@ class VirtualParticipantParams:
     #: asks for the motion it wants minus the robot's own, at most this many times `speed`
     #: (a factor).
     policy_compensation: float = 3.0
-    #: Its way round has stalled (`participant_avoidance`) once it has not come this much
+    #: Its way round has stalled (`avoidance.update_watch`) once it has not come this much
     #: (m) closer to the target for `stall_time`.
     progress_step: float = 0.02
     #: Not `progress_step` closer for this long (s), it has stalled and pushes on through

@@ -63,7 +63,7 @@ def serving_step(params, speed, period, memory, shown_goal, target_index, offset
     `shown_goal` is the object the robot shows it means (`NO_INTENT`: none shown);
     `target_index` the object the participant heads for, `offset` (2 or 3) from the hand to
     it; `velocity` the hand's velocity and `own_motion` the robot's own part of it, as the
-    participant perceives them (`OwnMotion`)."""
+    participant perceives them (`update_own_motion`)."""
     patience = int(round(params.serve_patience / period))
     shows = shown_goal != NO_INTENT
     if shows and shown_goal != target_index:

@@ -1,11 +1,7 @@
-"""The multi-goal reaching task of the paper (section IV-B.1), in pure NumPy.
-
-A scene has 2 to 4 objects drawn uniformly in a rectangle in front of the robot, all at one
-height, and a sequence of targets: the first is drawn at the start (0 % progress), and at
-each later threshold of the schedule (30 %, 60 %) the target switches, unannounced, to a
-different object. Progress is how much of the distance from the end effector's start to
-the current target has been covered, `1 - |p - target| / |start - target|`, clipped at 0.
-Success is the end effector within `success_distance` of the current target.
+"""The multi-goal reaching task of the paper (section IV-B.1, docs/tasks/reach.md), in pure
+NumPy: its scenes (objects, and the targets that switch, unannounced, at each threshold of
+the progress schedule, `reach_progress`), their checks, and the floor angles its operators
+share.
 """
 
 import dataclasses
@@ -68,18 +64,21 @@ def _scene_on(rng, floor, height, switch_schedule, z_range):
     return ReachScene(objects=objects, targets=tuple(targets))
 
 
-def spread_points(rng, count, x_range, y_range, min_separation, what):
+def spread_points(rng, count, x_range, y_range, min_separation, what, keep_away=(),
+                  apart="apart"):
     """`count` floor points `(count, 2)` drawn uniformly in the rectangle, each redrawn (up
-    to 1000 times) until it is `min_separation` from those before it."""
+    to 1000 times) until it is `min_separation` from those before it and from the floor
+    points `keep_away`; `what` and `apart` name them in the error."""
     points = np.empty((count, 2))
     for index in range(count):
+        others = np.vstack([np.reshape(keep_away, (-1, 2)), points[:index]])
         for _ in range(1000):
             candidate = np.array([rng.uniform(*x_range), rng.uniform(*y_range)])
-            if index == 0 or np.min(np.linalg.norm(points[:index] - candidate,
-                                                   axis=1)) >= min_separation:
+            if len(others) == 0 or np.min(np.linalg.norm(others - candidate,
+                                                         axis=1)) >= min_separation:
                 break
         else:
-            raise ValueError(f"cannot place {count} {what} {min_separation} m apart in "
+            raise ValueError(f"cannot place {count} {what} {min_separation} m {apart} in "
                              f"x {list(x_range)}, y {list(y_range)}")
         points[index] = candidate
     return points

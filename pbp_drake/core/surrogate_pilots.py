@@ -1,11 +1,8 @@
-"""The field's surrogate pilots in pure NumPy: their parameters, their random draws and how
-their actions map onto our keys: noisy (random key states with probability `eps`), laggy
-(the previous output repeated with probability `lag_per_tick`) and proportional (HOP's
-simulated user, `proportional_velocity`). Each axis of the operator frame has a key state
-in {-1, 0, +1} (`REACH_AXES`, `REACH_VERTICAL_AXES`, `GRASP_AXES`). Every draw comes from
+"""The field's surrogate pilots (docs/concepts/pilots.md: the pilots, their keys and their
+sources) in pure NumPy: their parameters, their random draws and how their actions map onto
+our keys, a state in {-1, 0, +1} per axis of the operator frame. Every draw comes from
 `(seed, tick, stream)` (`tick_uniforms`), as many numbers each tick whatever the method, so
-one seed gives the same draws under every method. The pilots, their keys and their
-sources: docs/concepts/pilots.md."""
+one seed gives the same draws under every method."""
 
 import dataclasses
 

@@ -17,7 +17,7 @@ from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_serving import NO_INTENT
 from pbp_drake.systems import VirtualOperator
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
-from pbp_drake.systems.operators.participant_avoidance import (
+from pbp_drake.core.avoidance import (
     is_pushing_through, robot_closes_in, start_watch, update_watch)
 
 PERIOD = 0.03

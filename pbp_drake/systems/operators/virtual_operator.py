@@ -4,7 +4,9 @@ import copy
 
 import numpy as np
 
-from pbp_drake.core.avoidance import footprint_clearance, policy_path, predict_obstacles
+from pbp_drake.core.avoidance import (
+    WATCH_SIZE, footprint_clearance, is_pushing_through, policy_path, predict_obstacles,
+    robot_closes_in, start_watch, update_watch)
 from pbp_drake.core.participant_impairment import (
     delay_ticks, first_choice, initial_motor_noise, is_noisy, next_motor_noise)
 from pbp_drake.core.participant_reach import (
@@ -15,8 +17,6 @@ from pbp_drake.core.participant_serving import (
     update_own_motion)
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
-from pbp_drake.systems.operators.participant_avoidance import (
-    WATCH_SIZE, is_pushing_through, robot_closes_in, start_watch, update_watch)
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 
@@ -100,7 +100,7 @@ class VirtualOperator(SampledOperator):
                 "obstacle_positions", 2 * int(obstacle_count))
             # [seen (0/1), the hand's start (2), ticks it still keeps control,
             #  the obstacles' positions at the last tick (2N), the stall watch of
-            #  `participant_avoidance` (WATCH_SIZE)].
+            #  `avoidance.update_watch` (WATCH_SIZE)].
             self._track_index = self.DeclareDiscreteState(
                 np.zeros(4 + 2 * int(obstacle_count) + WATCH_SIZE))
         # The target index it knows, and how many ticks a different one has been shown.
@@ -308,7 +308,7 @@ class VirtualOperator(SampledOperator):
                                               goal_heading, last_command)
         if pushing_through or (clear < 0.0 and distance < params.push_through_radius):
             # Boxed in next to the target, or no closer for a long while
-            # (`participant_avoidance`): on through, as people did.
+            # (`avoidance.update_watch`): on through, as people did.
             planned = self._speed * min(1.0, distance / self._slow_radius) * offset / distance
             yaw_rate = 0.0
         command = speed_scale * rotate_planar(planned, noise_angle)

@@ -82,8 +82,9 @@ def _reach_scene(task, seed, reach):
 
 def _check_region(task, reach, heights=None):
     """Every corner of the region the task draws its targets from (at `heights`, default
-    its `z_range` or `height`) must be in reach (the ranges are the loader's checked
-    `[low, high]`)."""
+    its `z_range` or `height`) must be in reach."""
+    if len(task.x_range) != 2 or len(task.y_range) != 2:
+        raise ValueError("x_range and y_range must be [low, high]")
     heights = heights or getattr(task, "z_range", None) or [task.height]
     _validate_within_reach([[x, y, z] for x in task.x_range for y in task.y_range
                             for z in heights], 0.0, reach)

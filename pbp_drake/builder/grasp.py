@@ -13,7 +13,6 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 from pbp_drake.builder.operators import make_person, shown_intent_and_keys
 from pbp_drake.builder.pbp_controller import make_goal_estimator
 from pbp_drake.builder.pilot_operators import make_pilot
-from pbp_drake.core.controller_config import nominal_duration
 from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.dmp.primitive import primitive_bank, primitive_orientation_bank
 from pbp_drake.core.grasp_task import approach_direction
@@ -48,13 +47,11 @@ GRASP_PREDICTION_SAMPLES = 40
 def grasp_dmp_banks(resolved, start_pose):
     """The position and orientation banks, straight paths (or the taught primitive's pose
     shape) from the hand's `start_pose` `[p, q]` to the K grasp poses, of one duration
-    (`nominal_duration`) so that they share one phase."""
+    (`resolved.controller.dmp_duration`) so that they share one phase."""
     scenario = resolved.scenario
     goals = resolved.scene.grasps.grasp_positions
     primitive = resolved.controller.dmp_primitive
-    duration = (scenario.dmp_duration if scenario.dmp_duration > 0 else nominal_duration(
-        start_pose[:3], goals, resolved.nominal_speed, scenario.goal_estimator.group_mass > 0.0,
-        primitive.length_ratio if primitive else 1.0))
+    duration = resolved.controller.dmp_duration
     if primitive is not None:  # a taught pose's shape (`dmp.primitive`)
         return (primitive_bank(primitive, start_pose[:3], len(goals), duration),
                 primitive_orientation_bank(primitive, start_pose[3:7], len(goals), duration))

@@ -209,14 +209,27 @@ hsr_station_plant = station_plant
 hsr_initial_ee_state = initial_ee_state
 
 
-def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:
-    """The hand's ``ee_state`` (``EeState``) where a station of ``config`` starts, from the
-    model's kinematics alone (no station); equal to ``hsr_initial_ee_state`` of it."""
+def _ready_frame_pose(config, frame_name):
+    """The world pose of the model's frame `frame_name` where a station of `config` starts,
+    from the model's kinematics alone (no station)."""
     validate_hsr_station_config(config)
     plant = MultibodyPlant(config.plant.time_step)
     model = add_hsr(plant)
     plant.Finalize()
-    return ee_state_at_rest(_ready_pose(plant, model, config)[1])
+    q0 = ready_positions(plant, model, config.initial_base, config.ee_height)
+    return pose_at(plant, plant.GetFrameByName(frame_name, model), q0)
+
+
+def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:
+    """The hand's ``ee_state`` (``EeState``) where a station of ``config`` starts, from the
+    model's kinematics alone (no station); equal to ``hsr_initial_ee_state`` of it."""
+    return ee_state_at_rest(_ready_frame_pose(config, END_EFFECTOR_FRAME))
+
+
+def hsr_ready_palm_position(config: HsrStationConfig) -> np.ndarray:
+    """Where the palm (``hand_palm_link``) of a pose station of ``config`` starts (m), from
+    the model's kinematics alone; equal to ``hsr_initial_hand_pose(station)[:3]``."""
+    return _ready_frame_pose(config, HAND_FRAME).translation()
 
 
 def hsr_initial_hand_pose(station: Diagram) -> np.ndarray:

@@ -25,6 +25,7 @@ from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_n
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
+from pbp_drake.robots.hsr_station import hsr_ready_palm_position
 from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.robots.task_space_bridge import validate_task_space_bridge
 from pbp_drake.scenarios.bounds import check_goal_counts
@@ -408,7 +409,11 @@ def _resolve_task_robot(scenario):
     controller = PbpControllerConfig(**{
         **scenario.control_settings(), "nominal_speed": float(robot.speed),
         "hand_over": robot.hand_over(), "dmp_primitive": _taught_primitive(scenario, task)})
-    duration = controller.duration_for(start, goals)
+    if isinstance(task, GraspTask):  # its DMPs move the palm to the grasps (builder.grasp)
+        duration = controller.duration_for(hsr_ready_palm_position(station),
+                                           scene.grasps.grasp_positions)
+    else:
+        duration = controller.duration_for(start, goals)
     check_dmp_duration(duration, scenario.control_period, "scenario.dmp_duration" if
                        scenario.dmp_duration > 0 else "scenario.robot.speed")
     controller = dataclasses.replace(controller, dmp_duration=float(duration))

@@ -64,3 +64,12 @@ def test_without_meshcat_the_pose_bank_predicts_nothing(grasp):
     bank = build_diagram(grasp).GetSubsystemByName("dmp_bank")
     assert not bank.HasOutputPort("predicted_poses")
     assert GRASP_PREDICTION_SAMPLES > 0
+
+
+@pytest.mark.slow
+def test_the_grasp_dmps_last_the_duration_the_scenario_was_checked_for(grasp):
+    # resolve checks the DMPs' duration (at least a control tick); the bank must run that one,
+    # derived from the palm's start and the grasps, not a second one of its own.
+    bank = build_diagram(grasp).GetSubsystemByName("dmp_bank")
+    assert bank.position_bank.duration == grasp.controller.dmp_duration
+    assert grasp.controller.dmp_duration > grasp.scenario.control_period

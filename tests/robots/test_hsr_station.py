@@ -16,8 +16,9 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Tr
 from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.robots import (
-    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, hsr_ready_ee_state,
-    make_hsr_station)
+    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, hsr_initial_hand_pose,
+    hsr_ready_ee_state, make_hsr_station)
+from pbp_drake.robots.hsr_station import hsr_ready_palm_position
 from pbp_drake.robots.hsr_model import (
     BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
 from pbp_drake.systems.ports import EeCommand, EeState
@@ -325,6 +326,16 @@ def test_meshcat_draws_the_robot_and_the_obstacles():
     assert meshcat.HasPath("/drake/visualizer/hsrb")
     assert meshcat.HasPath("/drake/visualizer/obstacle_0")
     assert meshcat.HasPath("/drake/visualizer/obstacle_1")
+
+
+@pytest.mark.parametrize("height, base", [(0.7, [0.0, 0.0, 0.0]), (0.9, [0.4, -0.3, 0.6])])
+def test_the_ready_palm_from_the_model_alone_is_where_the_pose_station_starts(height, base):
+    # Exactly: the grasping task's DMP duration is resolved from it, and the DMPs start
+    # from the station's.
+    config = HsrStationConfig(ee_height=height, initial_base=base)
+    station = make_hsr_station(config, command="pose")
+    np.testing.assert_array_equal(hsr_ready_palm_position(config),
+                                  hsr_initial_hand_pose(station)[:3])
 
 
 @pytest.mark.parametrize("height, base", [(0.7, [0.0, 0.0, 0.0]), (0.9, [0.4, -0.3, 0.6])])

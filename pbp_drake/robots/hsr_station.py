@@ -82,10 +82,11 @@ def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
     return plant.GetPositions(context)
 
 
-def _ready_pose(plant, model, config):
-    """The ready positions of `config` (see `ready_positions`) and the hand's pose there."""
+def _ready_pose(plant, model, config, frame_name=END_EFFECTOR_FRAME):
+    """The ready positions of `config` (see `ready_positions`) and the pose there of the
+    frame `frame_name` (default: the hand's)."""
     q0 = ready_positions(plant, model, config.initial_base, config.ee_height)
-    return q0, pose_at(plant, plant.GetFrameByName(END_EFFECTOR_FRAME, model), q0)
+    return q0, pose_at(plant, plant.GetFrameByName(frame_name, model), q0)
 
 
 def _make_diff_ik(plant, model, q0, config, motor_joints, command_ramp, look_ahead,
@@ -216,8 +217,7 @@ def _ready_frame_pose(config, frame_name):
     plant = MultibodyPlant(config.plant.time_step)
     model = add_hsr(plant)
     plant.Finalize()
-    q0 = ready_positions(plant, model, config.initial_base, config.ee_height)
-    return pose_at(plant, plant.GetFrameByName(frame_name, model), q0)
+    return _ready_pose(plant, model, config, frame_name)[1]
 
 
 def hsr_ready_ee_state(config: HsrStationConfig) -> np.ndarray:

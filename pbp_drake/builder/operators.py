@@ -52,19 +52,17 @@ def make_hsr_operator(resolved, meshcat):
     scenario = resolved.scenario
     config = scenario.operator
     period = scenario.control_period
-    # Objects at heights of their own (`task.z_range`): the operator moves up and down too.
-    vertical = bool(getattr(scenario.task, "z_range", None))
     if not METHODS[scenario.method].operated or isinstance(config, NoOperator):
         return IdleOperator(OperatorCommand.size, period)
     if isinstance(config, PILOT_CONFIGS):  # a surrogate pilot (`scenarios.pilots`)
         return make_pilot(resolved, lambda participant: make_hsr_operator(participant, meshcat),
-                          lambda speed, rotation: ReachKeys(speed, rotation, vertical),
+                          lambda speed, rotation: ReachKeys(speed, rotation, scenario.vertical),
                           len(resolved.station.obstacles))
     if isinstance(config, VirtualParticipant):
         return VirtualOperator(period, resolved.scene.objects, **participant_arguments(resolved))
     if isinstance(config, (Keyboard, Gamepad)):
         return make_person(resolved, meshcat, KeyboardOperator, GamepadOperator,
-                           vertical=vertical)
+                           vertical=scenario.vertical)
     raise TypeError(f"unknown operator config {type(config).__name__}")
 
 
@@ -92,7 +90,7 @@ def participant_arguments(resolved):
         params=scenario.operator, nominal_speed=resolved.nominal_speed, seed=scenario.seed,
         obstacle_count=len(obstacles),
         obstacle_radius=obstacles[0].radius if obstacles else 0.0,
-        vertical=bool(getattr(scenario.task, "z_range", None)),
+        vertical=scenario.vertical,
         heading_range=_heading_range(resolved),
         fixed_base=resolved.station.base_pose[:2] if resolved.is_arm else None)
 

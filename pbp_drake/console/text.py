@@ -68,7 +68,7 @@ def controls_line(scenario):
     if grasping:
         return (f"Keys: arrows move the hand{limit}, PageUp/PageDown raise and lower it; R "
                 "switches to turning (arrows pitch and yaw, PageUp/PageDown roll).")
-    up_down = ", R raises it and F lowers it" if getattr(scenario.task, "z_range", None) else ""
+    up_down = ", R raises it and F lowers it" if scenario.vertical else ""
     return f"Keys: arrows move the hand{limit}, Q and E turn it{up_down}."
 
 

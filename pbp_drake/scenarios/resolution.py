@@ -57,7 +57,6 @@ class ResolvedScenario:
         station: the station's config, an `HsrStationConfig` (hand height and command
             period filled in from the task) or an `ArmStationConfig`; None in 2-D scenes.
         initial_ee_state: (8,) the hand's state at the start, None in 2-D scenes.
-        nominal_speed: the DMPs' nominal speed (m/s) in the tasks, None in 2-D scenes.
         controller: the tasks' `PbpControllerConfig` (what `make_pbp_controller` builds
             from), None in 2-D scenes.
     """
@@ -70,8 +69,13 @@ class ResolvedScenario:
     scene: typing.Optional[TaskScene] = None
     station: typing.Any = None
     initial_ee_state: typing.Optional[np.ndarray] = None
-    nominal_speed: typing.Optional[float] = None
     controller: typing.Optional[PbpControllerConfig] = None
+
+    @property
+    def nominal_speed(self):
+        """The DMPs' nominal speed (m/s) in the tasks (`controller.nominal_speed`), None in
+        2-D scenes."""
+        return self.controller and self.controller.nominal_speed
 
     @property
     def blend_mode(self):
@@ -421,7 +425,7 @@ def _resolve_task_robot(scenario):
     return ResolvedScenario(
         scenario=scenario, start=start, goals=goals, demonstration=None, dmp_bank=None,
         scene=scene, station=station, initial_ee_state=initial_ee_state,
-        nominal_speed=float(robot.speed), controller=controller)
+        controller=controller)
 
 
 #: The largest primitive file read (a demonstration of an hour at 100 Hz is about 20 MiB).

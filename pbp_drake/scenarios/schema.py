@@ -424,6 +424,12 @@ class TaskScenario(Scenario):
     #: 0 to 20; what is drawn does not grow with the goal count.
     likely_paths: int = 3
 
+    @property
+    def vertical(self):
+        """Whether the operators move the hand up and down too: the reaching task's objects
+        stand at heights of their own (`task.z_range`)."""
+        return bool(getattr(self.task, "z_range", None))
+
 
 @dataclasses.dataclass
 class SceneVariant:

@@ -207,6 +207,7 @@ def test_bad_confidence_ramp_is_refused(kwargs, name):
     ([0.5, np.nan, 0.5], 0, "finite"),
     ([0.0, 0.0], 0, "sum"),
     ([0.5, 0.5], 2, "not one of the 2 goals"),
+    ([], 0, "goal_probabilities is empty"),
 ])
 def test_bad_goal_probabilities_are_refused(probabilities, selected, message):
     with pytest.raises(ValueError, match=message):

@@ -16,6 +16,7 @@ from pbp_drake.core.grasp_task import (
 from pbp_drake.core.participant_grasp import (
     SHARED_WITH_REACH, GraspParticipant, GraspParticipantParams, ParticipantMemory,
     drive_twist, notice_target)
+from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_serving import NO_INTENT, ServingMemory, update_own_motion
 from pbp_drake.core.quaternion import angle_between, exp_map, multiply
@@ -292,6 +293,9 @@ def test_its_shared_defaults_are_the_reach_participants():
      "rotation_speed must be finite and positive"),
     (dict(params=GraspParticipantParams(reaction_delay=-1.0)),
      "reaction_delay must be finite and not negative"),
+    (dict(params=GraspParticipantParams(
+        impairment=ParticipantImpairment(command_delay=-1.0))),
+     "impairment.command_delay must be finite and not negative"),
     (dict(nominal_speed=0.0), "nominal_speed must be finite and positive"),
     (dict(grasp_orientations=[[1.0, 0, 0, 0]]), r"grasp_orientations \(M, 4\)"),
 ])

@@ -279,3 +279,15 @@ def test_a_lock_mask_of_no_goal_steps_as_no_lock():
     for free_part, masked_part in zip(free, masked):
         np.testing.assert_array_equal(masked_part, free_part)
     assert (free[0] < state[0]).all()  # the phases moved: nothing was locked
+
+
+def test_affine_coefficients_are_refused_to_dmps_of_their_own_weights_or_starts():
+    bank = DmpBankModel.from_dmps([Dmp.straight([0.0], [1.0], 1.0),
+                                   Dmp.straight([0.5], [1.0], 1.0)])
+    assert not bank.affine_in_goal
+    with pytest.raises(ValueError, match="affine_coefficients needs DMPs that share weights "
+                                         "and start"):
+        bank.affine_coefficients(1.0, np.zeros((1, 1)), 0.01, bank.make_workspace())
+    straight = DmpBankModel.straight([0.0], 2, 1.0)
+    assert straight.affine_in_goal
+    straight.affine_coefficients(1.0, np.zeros((1, 1)), 0.01, straight.make_workspace())

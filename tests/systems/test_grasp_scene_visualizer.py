@@ -112,6 +112,22 @@ def test_a_replay_moves_and_turns_the_predicted_paths_triads(meshcat):
     assert angle_between(np.roll(quaternion, 1), ready) < 1e-9
 
 
+def test_a_path_that_only_turns_spreads_its_triads_over_its_turn(meshcat):
+    # The hand stays at START and turns to object 1's grasp: no arc length to spread the
+    # triads along, so they are spread along the samples, from the first to the last turn.
+    ready = side_grasp_orientation(0.0)
+    turning = straight_path(START, ready, SCENE.grasp_orientations[1])
+    predicted = PiecewisePolynomial.ZeroOrderHold([0.0, 1.0],
+                                                  np.column_stack([turning.ravel()] * 2))
+    tracks = recorded(meshcat, grasp_diagram(meshcat, predicted), 0.3)
+    turns = [np.roll(value_at(tracks, f"/task/prediction/{index}", ".quaternion", 0.2), 1)
+             for index in range(PATH_TRIADS)]
+    assert angle_between(turns[0], ready) < 1e-6
+    assert angle_between(turns[-1], SCENE.grasp_orientations[1]) < 1e-6
+    angles = [angle_between(turn, ready) for turn in turns]
+    assert all(np.diff(angles) > 0.0)  # each triad turned further than the one before
+
+
 def transforms(html):
     """The last 4x4 transform the page was sent for each path."""
     return {command["path"]: np.array(command["matrix"]).reshape(4, 4).T

@@ -162,3 +162,9 @@ def test_the_stall_time_is_how_long_a_parked_participant_waits_before_pushing(st
 def test_a_longer_stall_time_delays_the_push_through():
     assert first_push_time(PARAMS, 5.0) is not None
     assert first_push_time(dataclasses.replace(PARAMS, stall_time=8.0), 5.0) is None
+
+
+def test_a_participant_among_obstacles_needs_their_radius():
+    with pytest.raises(ValueError, match="obstacle_radius must be positive with obstacles, "
+                                         "got 0.0"):
+        VirtualOperator(PERIOD, [[*TARGET, 0.7]], nominal_speed=0.12, obstacle_count=len(WALL))

@@ -151,6 +151,18 @@ def test_with_the_forward_key_it_drives_at_once_to_the_target_the_robot_does_not
         scene.grasp_orientations[target])))
 
 
+def test_on_its_targets_grasp_pose_it_presses_nothing():
+    scene = sample_grasp_scene(3)
+    participant = GraspParticipant.create(GraspParticipantParams(), SPEED,
+                                          scene.grasp_positions, scene.grasp_orientations)
+    target = scene.targets[0]
+    twist, active, _, _ = participant.step(
+        notice_target(ParticipantMemory(), target, 0.0, 0.0), ServingMemory(), 0.0, 0,
+        scene.grasp_positions[target], scene.grasp_orientations[target], ZERO, ZERO, target,
+        scene.targets[1], True, PERIOD)
+    assert not active and not twist.any()
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", range(12))
 def test_assisting_while_wrong_it_turns_toward_the_target_and_never_pushes_forward(seed):

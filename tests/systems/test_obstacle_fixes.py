@@ -94,6 +94,8 @@ def test_once_pushing_a_participant_keeps_pushing_until_it_arrives():
 
 def test_near_the_target_a_participant_lets_a_robot_that_closes_in_finish_alone():
     assert robot_closes_in(PARAMS, [0.05, 0.0], [0.07, 0.0], nominal_speed=0.12)
+    # On the target itself: nothing left to close in on.
+    assert robot_closes_in(PARAMS, [0.0, 0.0], [0.0, 0.0], nominal_speed=0.12)
 
 
 def test_near_the_target_a_participant_drives_a_robot_that_has_parked():

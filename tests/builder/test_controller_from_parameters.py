@@ -12,7 +12,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake import (
-    GoalsSource, HandOverSettings, IdleOperator, PbpControllerConfig,
+    GoalEstimatorSettings, GoalsSource, HandOverSettings, IdleOperator, PbpControllerConfig,
     SampleHold, arm_initial_ee_state, make_arm_station, make_pbp_controller)
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.systems.ports import OperatorCommand
@@ -116,6 +116,9 @@ class _ConstantOperator:
     ({"hand_over": HandOverSettings(max_hand_speed=-1.0)},
      "hand_over.max_hand_speed must be finite and positive"),
     ({"alpha": 2.0}, "alpha must lie in [0, 1]"),
+    ({"dmp_duration": -1.0}, "dmp_duration must be finite and not negative (0: derived)"),
+    ({"goal_estimator": GoalEstimatorSettings(method="pose")},
+     "goal_estimator.method pose reads grasp orientations, which a position controller has"),
 ])
 def test_a_config_that_cannot_work_names_its_field(change, message):
     config = dataclasses.replace(PbpControllerConfig(), **change)

@@ -41,6 +41,16 @@ def test_scenes_keep_obstacles_clear_of_the_robot_and_the_target():
             assert np.linalg.norm(start - scene.target[:2]) >= 0.45
 
 
+def test_a_target_drawn_onto_a_fixed_obstacle_is_drawn_again_clear_of_it():
+    first = np.random.default_rng(3).uniform([1.25, -1.05], [2.5, 1.05])
+    np.testing.assert_array_equal(sample_obstacle_scene(3).target[:2], first)  # seed 3's draw
+    scene = sample_obstacle_scene(3, fixed_starts=[first])
+    assert np.linalg.norm(scene.target[:2] - first) >= 0.45
+    with pytest.raises(ValueError, match=r"cannot draw a target 5.0 m from every obstacle in "
+                                         r"x \[1.25, 2.5\], y \[-1.05, 1.05\]"):
+        sample_obstacle_scene(3, fixed_starts=[first], clearance=5.0)
+
+
 @pytest.fixture(scope="module")
 def obstacle_task(repo):
     return load_scenario_file(repo / "diagrams" / "hsr_obstacles.yaml").scenario

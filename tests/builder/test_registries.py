@@ -98,6 +98,10 @@ def test_an_entry_names_a_law_or_an_assistance_that_exists():
         Method("toy", "Toy", "k", blend_mode="teleop", assistance="hop")
     with pytest.raises(ValueError, match="needed by"):
         register_estimator(Estimator("toy", READS_POSITION))
+    with pytest.raises(ValueError, match="assistance 'help' is not one of"):
+        Method("toy", "Toy", "k", assistance="help")
+    with pytest.raises(ValueError, match="goal estimator 'toy': reads 'gaze' is not one of"):
+        register_estimator(Estimator("toy", "gaze"))
 
 
 def test_unknown_names_are_refused_with_the_nearest_one(reach):

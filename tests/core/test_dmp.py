@@ -217,3 +217,77 @@ def test_a_goal_switch_keeps_the_velocity_of_the_followed_dmp():
         jumps[followed] = np.linalg.norm(velocities[1] - velocities[0])
     assert jumps[None] == pytest.approx(0.41, abs=0.02)
     assert jumps[0] < 0.05
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: Dmp.straight([], [1.0], 1.0), "start is empty"),
+    (lambda: Dmp.straight([0.0, 0.0], [1.0], 1.0), "goal has 1 numbers, expected 2"),
+    (lambda: Dmp.straight([0.0, np.nan], [1.0, 1.0], 1.0), "start contains NaN"),
+    (lambda: Dmp(np.zeros((50, 1)), [0.0], [1.0], 0.0),
+     "duration must be positive and finite, got 0"),
+    (lambda: Dmp.straight([0.0], [1.0], 1.0, profile="cubic"), "profile 'cubic' is unknown"),
+    (lambda: Dmp(np.zeros((50, 3)), [0.0, 0.0], [1.0, 1.0], 1.0),
+     "weights have 3 dimensions, expected 2"),
+    (lambda: DmpSettings(alpha_z=0.0), "alpha_z must be positive, got 0"),
+    (lambda: DmpSettings(beta_z=-1.0), "beta_z must be positive, got -1"),
+    (lambda: DmpBankModel(np.zeros(50), [0.0], 1.0), r"weights must be \(N, D\) or \(K, N, D\)"),
+    (lambda: DmpBankModel(np.zeros((40, 2)), [0.0, 0.0], 1.0),
+     "weights have shape .*; the settings say 50 basis functions"),
+    (lambda: DmpBankModel(np.zeros((50, 2)), np.zeros((3, 2)), 1.0, goal_count=2),
+     r"starts must be \(2, 2\) or \(2,\)"),
+    (lambda: DmpBankModel(np.zeros((50, 2)), [0.0, np.inf], 1.0), "starts contains NaN"),
+    (lambda: DmpBankModel.from_dmps([]), "at least one DMP"),
+    (lambda: DmpBankModel.from_dmps([Dmp.straight([0.0], [1.0], 1.0),
+                                     Dmp.straight([0.0], [1.0], 2.0)]),
+     "must share duration and settings"),
+    (lambda: DmpBankModel.straight([0.0, 0.0], 2, 1.0).goals_matrix([1.0, 2.0, 3.0]),
+     "goals has 3 numbers; the bank expects 2 goals of dimension 2"),
+])
+def test_a_model_that_cannot_be_built_is_refused_naming_the_field(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
+
+
+@pytest.mark.parametrize("times, positions, message", [
+    (np.linspace(0.0, 1.0, 5), np.zeros((5, 2, 1)), r"must be \(T, D\), got shape \(5, 2, 1\)"),
+    (np.linspace(0.0, 1.0, 4), np.zeros((5, 2)), r"times have shape \(4,\), expected \(5,\)"),
+    ([0.0, 0.5, 0.5, 1.0, 1.5], np.zeros((5, 2)), "finite and strictly increasing"),
+])
+def test_a_demonstration_of_the_wrong_shape_or_times_is_refused(times, positions, message):
+    with pytest.raises(ValueError, match=message):
+        Dmp.from_demonstration(times, positions)
+
+
+def test_a_one_dimensional_demonstration_is_one_column():
+    times = np.linspace(0.0, 1.0, 50)
+    dmp = Dmp.from_demonstration(times, times**2)
+    np.testing.assert_array_equal([dmp.start, dmp.goal], [[0.0], [1.0]])
+
+
+def test_shared_weights_give_one_goal_per_start_row():
+    weights = np.zeros((DmpSettings().basis_count, 2))
+    assert DmpBankModel(weights, np.zeros((3, 2)), 1.0).goal_count == 3
+    assert DmpBankModel(weights, np.zeros(2), 1.0).goal_count == 1
+
+
+def test_a_lock_mask_of_no_goal_steps_as_no_lock():
+    bank = DmpBankModel.straight([0.0, 0.0], goal_count=2, duration=1.0)
+    goals_dk = bank.goals_matrix([[1.0, 0.0], [0.0, 1.0]])
+    state = bank.advance(*bank.initial_state(), goals_dk, 0.01)
+    free = bank.advance(*state, goals_dk, 0.01)
+    masked = bank.advance(*state, goals_dk, 0.01, locked=[False, False])
+    for free_part, masked_part in zip(free, masked):
+        np.testing.assert_array_equal(masked_part, free_part)
+    assert (free[0] < state[0]).all()  # the phases moved: nothing was locked
+
+
+def test_affine_coefficients_are_refused_to_dmps_of_their_own_weights_or_starts():
+    bank = DmpBankModel.from_dmps([Dmp.straight([0.0], [1.0], 1.0),
+                                   Dmp.straight([0.5], [1.0], 1.0)])
+    assert not bank.affine_in_goal
+    with pytest.raises(ValueError, match="affine_coefficients needs DMPs that share weights "
+                                         "and start"):
+        bank.affine_coefficients(1.0, np.zeros((1, 1)), 0.01, bank.make_workspace())
+    straight = DmpBankModel.straight([0.0], 2, 1.0)
+    assert straight.affine_in_goal
+    straight.affine_coefficients(1.0, np.zeros((1, 1)), 0.01, straight.make_workspace())

@@ -178,6 +178,7 @@ def test_vectorised_equals_a_loop_over_ten_thousand_goals(method):
     ("margin", -0.1, "margin must lie in"),
     ("hold_steps", 0, "hold_steps must be an integer"),
     ("hold_steps", 1.5, "hold_steps must be an integer"),
+    ("intent_filter", {}, "intent_filter must be an IntentFilterSettings, got dict"),
 ])
 def test_bad_settings_name_the_field(field, value, message):
     with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):

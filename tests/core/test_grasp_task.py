@@ -168,6 +168,8 @@ def test_progress_mixes_distance_and_angle():
     # Moving away clips at 0.
     assert grasp_progress(start_p - [1.0, 0, 0], start_q, start_p, start_q, goal_p, goal_q,
                           length) == 0.0
+    # Started on the grasp pose itself: done, wherever the hand goes.
+    assert grasp_progress(start_p, start_q, goal_p, goal_q, goal_p, goal_q, length) == 1.0
 
 
 @pytest.mark.parametrize("arguments, message", [

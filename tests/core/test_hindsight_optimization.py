@@ -357,3 +357,25 @@ def test_bad_inputs_are_refused():
                          [0, 0, 0.7], [0, 0, 0])
     with pytest.raises(ValueError, match="every one of the 3 goals"):
         hop_targets([[1, 0, 0], [2, 0, 0]], goals=[0, 2], goal_count=3)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: hop_targets(np.zeros((0, 3))), r"target positions must be \(N, 3\) with N >= 1"),
+    (lambda: hop_targets([[1.0, 0.0, math.inf]]), "target positions contain NaN or infinite"),
+    (lambda: hop_targets([[1.0, 0.0, 0.7]], [[1, 0, 0, 0], [1, 0, 0, 0]]),
+     r"target orientations must be \(N, 4\) with N = 1"),
+    (lambda: hop_targets([[1.0, 0.0, 0.7]], goals=[0.5]), "one integer goal index per target"),
+    (lambda: hop_targets([[1.0, 0.0, 0.7]], goals=[1], goal_count=1),
+     r"goal indices must lie in \[0, 1\), got \[1\]"),
+    (lambda: update_posterior(SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [0.0], [0, 0], [0, 0, 0]),
+     "position must have 3 entries, got 2"),
+    (lambda: update_posterior(SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [0.0, 0.0], [0, 0, 0.7],
+                              [0, 0, 0]), "log_belief must be 1 finite numbers"),
+    (lambda: assisted_command("hop", SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [math.nan],
+                              [0, 0, 0.7], [0, 0, 0]), "goal_probabilities must be 1 finite"),
+    (lambda: assisted_command("assist", SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [1.0],
+                              [0, 0, 0.7], [0, 0, 0]), "method 'assist' is unknown; choose one"),
+])
+def test_bad_targets_beliefs_and_methods_are_refused_by_name(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()

@@ -97,7 +97,8 @@ def test_no_acting_tick_that_moves_has_no_agreement():
     assert silent.input_integral == 0.0 and silent.turn_input_integral == 0.0
 
 
-@pytest.mark.parametrize("cuts", [(1,), (4, 9), (3, 5, 6, 8, 11), tuple(range(1, 12))])
+@pytest.mark.parametrize("cuts", [(1,), (4, 9), (3, 5, 6, 8, 11), tuple(range(1, 12)),
+                                  (4, 4, 9)])  # (4, 4): an empty chunk
 def test_chunks_give_what_the_whole_series_gives(cuts):
     meter = InteractionMeter(PERIOD)
     bounds = [0, *cuts, 12]

@@ -4,6 +4,7 @@ near a goal earns no more than moving straight at a far one. Expected values are
 hand-computed from the definitions (docs/concepts/goal-estimators.md)."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -11,7 +12,8 @@ from pydrake.systems.analysis import Simulator
 
 from pbp_drake.core.hindsight_optimization import HopSettings, hop_targets, update_posterior
 from pbp_drake.core.hindsight_optimization import uniform_log_belief
-from pbp_drake.core.maxent_command import intent_evidence, move_evidence, turn_evidence
+from pbp_drake.core.maxent_command import (
+    intent_evidence, move_evidence, turn_evidence, update_intent_posterior)
 from pbp_drake.systems import MaxEntGoalEstimator
 
 SETTINGS = HopSettings()
@@ -105,3 +107,22 @@ def test_passing_within_7_cm_of_c_earns_at_most_the_cap(offset):
         published_gain = max(published_gain, published[0] - published[1])
     # The step cost's near-goal bonus, alpha dt (1 - offset / delta) at the closest point.
     assert published_gain > 2.25 * DT * (1 - offset / 0.07) - cap
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: turn_evidence(SETTINGS, hop_targets(GOALS), [0.0, 0.0], 0.0, 0.5, SPEED),
+     "position must be 3 finite numbers, got [0.0, 0.0]"),
+    (lambda: turn_evidence(SETTINGS, hop_targets(GOALS), [0.0, 0.0, 0.7], math.nan, 0.5, SPEED),
+     "heading and yaw_rate must be finite, got nan, 0.5"),
+    (lambda: turn_evidence(SETTINGS, hop_targets(GOALS), [0.0, 0.0, 0.7], 0.0, 0.5, 0.0),
+     "speed must be positive, got 0.0"),
+    (lambda: update_intent_posterior(
+        SETTINGS, hop_targets(GOALS), [0.0, 0.0], intent_evidence(
+            SETTINGS, hop_targets(GOALS), [0.0, 0.0, 0.7], [0.1, 0.0, 0.0], SPEED)),
+     "log_belief must be 3 finite numbers"),
+    (lambda: MaxEntGoalEstimator(len(GOALS), SETTINGS, PERIOD, operator_speed=-SPEED),
+     "operator_speed must be positive, got -0.12"),
+])
+def test_bad_input_is_refused_by_name(call, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        call()

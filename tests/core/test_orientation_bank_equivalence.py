@@ -194,7 +194,8 @@ def test_one_orientation_and_one_velocity_for_all_equal_single_dmps(formulation,
     """The fused step (`orientation_log_step`: one measured orientation `(4, 1)` and one
     `eta` `(3, 1)`, as the six-DoF system steps with a followed goal) against single DMPs,
     with errors at 0, 1e-12, 1e-6, 5e-3 and 2e-2 rad (both sides of the series' switch),
-    180 degrees less 1e-9, and exactly 180 degrees (`w = 0` and `-0.0`)."""
+    180 degrees less 1e-9, and exactly 180 degrees (`w = 0` and `-0.0`); at one phase for
+    all and at a phase per DMP."""
     offsets = [0.0, 1e-12, 1e-6, 5e-3, 2e-2, np.pi - 1e-9, 0.7, 2.5]
     count = len(offsets) + 2
     bank, dmps, _ = make_banks(formulation, shared, count, True, seed=33)
@@ -206,11 +207,10 @@ def test_one_orientation_and_one_velocity_for_all_equal_single_dmps(formulation,
     goals = np.hstack([quaternion.conjugate(quaternion.exp_map(axes * offsets)),
                        [[0.0, -0.0], [0.0, 0.0], [0.6, -0.0], [-0.8, 1.0]]]).T
     velocity = rng.normal(size=(3, 1))
-    for phase in (1.0, 0.4):
-        stepped = bank.advance(np.full(count, phase), measured, velocity,
-                               bank.goals_matrix(goals), DT)
+    for phases in (np.full(count, 1.0), np.full(count, 0.4), np.linspace(1.0, 0.4, count)):
+        stepped = bank.advance(phases, measured, velocity, bank.goals_matrix(goals), DT)
         for k, dmp in enumerate(dmps):
-            dmp.phase, dmp.scaled_angular_velocity = phase, velocity[:, 0].copy()
+            dmp.phase, dmp.scaled_angular_velocity = phases[k], velocity[:, 0].copy()
             orientation, angular_velocity = dmp.next_step(DT, goals[k], measured[:, 0])
             np.testing.assert_allclose(stepped[1][:, k], orientation, rtol=0, atol=1e-12)
             np.testing.assert_allclose(stepped[2][:, k] / bank.duration, angular_velocity,

@@ -332,3 +332,23 @@ def test_a_demonstration_through_the_half_turn_from_its_end_is_refused():
     times, demo = turning_demonstration(np.radians(200))
     with pytest.raises(ValueError, match="pass 180 degrees from the last one between samples"):
         OrientationDmp.from_demonstration(times, demo)
+
+
+def test_a_bank_or_demonstration_of_the_wrong_shape_is_refused():
+    times, demo = turning_demonstration()
+    with pytest.raises(ValueError, match=r"must be \(T, 4\) with T >= 3, got shape \(2, 4\)"):
+        OrientationDmp.from_demonstration(times[:2], demo[:2])
+    weights = np.zeros((DmpSettings().basis_count, 3))
+    with pytest.raises(ValueError, match=r"starts must be \(2, 4\) or \(4,\), got \(3, 4\)"):
+        OrientationDmpBank(weights, np.tile([1.0, 0, 0, 0], (3, 1)), 1.0, goal_count=2)
+
+
+def test_a_goal_half_a_turn_away_is_turned_to_as_the_single_dmp_turns():
+    # w = 0 exactly in the start's error: the log's axis is then the first nonzero of x, y, z.
+    start, half_turn = [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]
+    dmp = OrientationDmp.straight(start, half_turn, 1.0)
+    bank = OrientationDmpBank.straight(start, 1, 1.0)
+    _, turned, _ = bank.advance(*bank.initial_state(), bank.goals_matrix([half_turn]), 0.03)
+    expected, _ = dmp.next_step(0.03)
+    np.testing.assert_allclose(turned[:, 0], expected, atol=1e-12)
+    assert expected[3] > 0.0  # it turned, about +z

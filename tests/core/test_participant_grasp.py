@@ -16,6 +16,7 @@ from pbp_drake.core.grasp_task import (
 from pbp_drake.core.participant_grasp import (
     SHARED_WITH_REACH, GraspParticipant, GraspParticipantParams, ParticipantMemory,
     drive_twist, notice_target)
+from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_serving import NO_INTENT, ServingMemory, update_own_motion
 from pbp_drake.core.quaternion import angle_between, exp_map, multiply
@@ -148,6 +149,18 @@ def test_with_the_forward_key_it_drives_at_once_to_the_target_the_robot_does_not
     np.testing.assert_allclose(twist, np.concatenate(drive_twist(
         params, SPEED, HAND, LEVEL, scene.grasp_positions[target],
         scene.grasp_orientations[target])))
+
+
+def test_on_its_targets_grasp_pose_it_presses_nothing():
+    scene = sample_grasp_scene(3)
+    participant = GraspParticipant.create(GraspParticipantParams(), SPEED,
+                                          scene.grasp_positions, scene.grasp_orientations)
+    target = scene.targets[0]
+    twist, active, _, _ = participant.step(
+        notice_target(ParticipantMemory(), target, 0.0, 0.0), ServingMemory(), 0.0, 0,
+        scene.grasp_positions[target], scene.grasp_orientations[target], ZERO, ZERO, target,
+        scene.targets[1], True, PERIOD)
+    assert not active and not twist.any()
 
 
 @pytest.mark.slow
@@ -292,6 +305,9 @@ def test_its_shared_defaults_are_the_reach_participants():
      "rotation_speed must be finite and positive"),
     (dict(params=GraspParticipantParams(reaction_delay=-1.0)),
      "reaction_delay must be finite and not negative"),
+    (dict(params=GraspParticipantParams(
+        impairment=ParticipantImpairment(command_delay=-1.0))),
+     "impairment.command_delay must be finite and not negative"),
     (dict(nominal_speed=0.0), "nominal_speed must be finite and positive"),
     (dict(grasp_orientations=[[1.0, 0, 0, 0]]), r"grasp_orientations \(M, 4\)"),
 ])

@@ -70,6 +70,13 @@ def test_driving_straight_up_does_not_turn():
     assert np.array_equal(velocity, np.zeros(3)) and yaw_rate == 0.0
 
 
+def test_insisting_on_a_target_straight_above_does_not_turn():
+    velocity, yaw_rate = assist_motion(PARAMS, SPEED, START, 0.3, START + [0, 0, 0.3], PICKED,
+                                       insisting=True, vertical=True)
+    np.testing.assert_allclose(velocity, [0.0, 0.0, SPEED])
+    assert yaw_rate == 0.0
+
+
 def test_assisting_without_insisting_leaves_the_height_to_the_dmp():
     for position, heading, target, picked in random_cases():
         velocity, yaw_rate = assist_motion(PARAMS, SPEED, position, heading, target, picked,

@@ -8,7 +8,7 @@ from pbp_drake.core import quaternion
 from pbp_drake.core.arbitration import validate_mode
 from pbp_drake.core.pose_arbitration import (
     POSE_BLEND_LAWS, POSE_BLEND_MODES, HandOverLimits, PoseReference, blend_pose, pose_hand_over,
-    turned)
+    turned, validate_twist)
 
 DT = 0.01
 ROBOT_POSITION = np.array([0.4, -0.1, 0.8])
@@ -95,6 +95,11 @@ def test_a_nan_twist_is_refused_with_its_field_named(mode, field, index):
     twist[index] = np.nan if index != 5 else np.inf
     with pytest.raises(ValueError, match=f"operator_twist {field} is NaN or infinite"):
         blend(mode, alpha=0.5, twist=twist)
+
+
+def test_a_twist_of_the_wrong_size_is_refused():
+    with pytest.raises(ValueError, match=r"operator_twist must be 6 numbers .*, got 5"):
+        validate_twist(np.zeros(5))
 
 
 def test_unknown_modes_and_bad_alphas_are_refused():

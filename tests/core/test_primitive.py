@@ -89,6 +89,13 @@ def _damaged(change):
     (lambda d: d["settings"].update(formulation="spline"), "settings: formulation 'spline'"),
     (lambda d: d.update(amplitude_scaling=[True]), "amplitude_scaling must be 3"),
     (lambda d: d.update(fit_error=-1), "fit_error must be a finite number >= 0"),
+    (lambda d: d.update(version="1"), "version must be a whole number >= 1, got '1'"),
+    (lambda d: d["settings"].update(alpha=1.0), r"settings has unknown fields \['alpha'\]"),
+    (lambda d: d.update(settings=[]), "settings is missing or not a map"),
+    (lambda d: d.pop("dimension"), "dimension is missing or not a number"),
+    (lambda d: d["weights"][3].pop(), "weights must be a table of numbers"),
+    (lambda d: d["demonstration"]["times"].reverse(),
+     "demonstration: demonstration times must be finite and strictly increasing"),
 ])
 def test_a_damaged_document_is_refused_naming_the_field(change, message):
     with pytest.raises(ValueError, match=message):

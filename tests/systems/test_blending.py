@@ -99,6 +99,16 @@ def test_point_robot_settles_on_a_constant_reference():
     np.testing.assert_allclose(state, [0.5, -0.2, 0.0, 0.0], atol=1e-4)
 
 
+@pytest.mark.parametrize("field, value, message", [
+    ("mass", 0.0, "robot.mass must be positive, got 0.0"),
+    ("time_step", np.inf, "robot.time_step must be positive, got inf"),
+    ("damping", -1.0, "robot.damping must be non-negative, got -1.0"),
+])
+def test_a_point_robot_that_cannot_move_is_refused_by_field(field, value, message):
+    with pytest.raises(ValueError, match=message):
+        PointRobotDynamics([0.0, 0.0], PointRobotParams(**{field: value}))
+
+
 @pytest.mark.slow
 def test_simulations_are_restartable_and_contexts_independent(repo):
     from pbp_drake.builder import build_diagram
@@ -207,6 +217,7 @@ def test_bad_confidence_ramp_is_refused(kwargs, name):
     ([0.5, np.nan, 0.5], 0, "finite"),
     ([0.0, 0.0], 0, "sum"),
     ([0.5, 0.5], 2, "not one of the 2 goals"),
+    ([], 0, "goal_probabilities is empty"),
 ])
 def test_bad_goal_probabilities_are_refused(probabilities, selected, message):
     with pytest.raises(ValueError, match=message):

@@ -12,7 +12,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
-from replay_tracks import commands, recorded, value_at
+from replay_tracks import commands, held_at, recorded, value_at
 
 from pbp_drake.core.grasp_task import (
     approach_direction, sample_grasp_scene, side_grasp_orientation)
@@ -112,6 +112,22 @@ def test_a_replay_moves_and_turns_the_predicted_paths_triads(meshcat):
     assert angle_between(np.roll(quaternion, 1), ready) < 1e-9
 
 
+def test_a_path_that_only_turns_spreads_its_triads_over_its_turn(meshcat):
+    # The hand stays at START and turns to object 1's grasp: no arc length to spread the
+    # triads along, so they are spread along the samples, from the first to the last turn.
+    ready = side_grasp_orientation(0.0)
+    turning = straight_path(START, ready, SCENE.grasp_orientations[1])
+    predicted = PiecewisePolynomial.ZeroOrderHold([0.0, 1.0],
+                                                  np.column_stack([turning.ravel()] * 2))
+    tracks = recorded(meshcat, grasp_diagram(meshcat, predicted), 0.3)
+    turns = [np.roll(value_at(tracks, f"/task/prediction/{index}", ".quaternion", 0.2), 1)
+             for index in range(PATH_TRIADS)]
+    assert angle_between(turns[0], ready) < 1e-6
+    assert angle_between(turns[-1], SCENE.grasp_orientations[1]) < 1e-6
+    angles = [angle_between(turn, ready) for turn in turns]
+    assert all(np.diff(angles) > 0.0)  # each triad turned further than the one before
+
+
 def transforms(html):
     """The last 4x4 transform the page was sent for each path."""
     return {command["path"]: np.array(command["matrix"]).reshape(4, 4).T
@@ -138,18 +154,23 @@ def test_each_grasp_triad_stands_at_its_grasp_with_blue_along_the_approach(meshc
     np.testing.assert_allclose(sent[f"/task/grasps/{top}"][:3, 2], [0, 0, -1], atol=1e-9)
 
 
-def test_many_grasps_are_a_cloud_and_the_likeliest_grasps_triads_that_a_replay_keeps(meshcat):
-    # 120 grasps (the 4 of SCENE, 30 times, shifted along y): past SOLID_OBJECTS, no table,
-    # object or triad per grasp, but the goal cloud and three triads moved to the
-    # selected grasp (0) and the likeliest others (7 at first, then 42 from 0.5 s).
+def many_grasps():
+    """120 grasps (the 4 of SCENE, 30 times, shifted along y): past SOLID_OBJECTS."""
     shifts = np.repeat(np.arange(30) * 0.01, 4)[:, None] * [0.0, 1.0, 0.0]
-    many = dataclasses.replace(
+    return dataclasses.replace(
         SCENE, objects=np.tile(SCENE.objects, (30, 1)) + shifts,
         tables=np.tile(SCENE.tables, (30, 1)) + shifts,
         approaches=SCENE.approaches * 30,
         approach_angles=np.tile(SCENE.approach_angles, 30),
         grasp_positions=np.tile(SCENE.grasp_positions, (30, 1)) + shifts,
         grasp_orientations=np.tile(SCENE.grasp_orientations, (30, 1)))
+
+
+def test_many_grasps_are_a_cloud_and_the_likeliest_grasps_triads_that_a_replay_keeps(meshcat):
+    # Past SOLID_OBJECTS: no table, object or triad per grasp, but the goal cloud and three
+    # triads moved to the selected grasp (0) and the likeliest others (7 at first, then 42
+    # from 0.5 s).
+    many = many_grasps()
     count = len(many.grasp_positions)
     before, after = np.full(count, 1e-3), np.full(count, 1e-3)
     before[7], after[42] = 0.5, 0.5
@@ -175,3 +196,36 @@ def test_many_grasps_are_a_cloud_and_the_likeliest_grasps_triads_that_a_replay_k
         np.testing.assert_allclose(
             value_at(tracks, "/task/likely_grasps/1", ".position", time),
             many.grasp_positions[likeliest], atol=1e-9)
+
+
+@pytest.mark.parametrize("selected, probabilities, shown", [
+    (-1, True, 42),  # no grasp shown: the likeliest leads
+    (5, False, 5),  # no probabilities: the grasp shown alone
+])
+def test_the_likely_triads_follow_what_is_known(meshcat, selected, probabilities, shown):
+    many = many_grasps()
+    builder = DiagramBuilder()
+    visualizer = builder.AddSystem(GraspSceneVisualizer(meshcat, many, likely_triads=3))
+    target = np.zeros(Target.size)
+    target[:3], target[3] = many.objects[1], 1
+    add_source(builder, target, visualizer.get_target_input_port())
+    add_source(builder, [float(selected)], visualizer.get_selected_goal_input_port())
+    if probabilities:
+        likely = np.full(len(many.grasp_positions), 1e-3)
+        likely[42] = 0.5
+        add_source(builder, likely, visualizer.get_goal_probabilities_input_port())
+    tracks = recorded(meshcat, builder.Build(), 0.3)
+    np.testing.assert_allclose(value_at(tracks, "/task/likely_grasps/0", ".position", 0.2),
+                               many.grasp_positions[shown], atol=1e-9)
+    assert held_at(tracks, "/task/likely_grasps/1", ".visible", 0.2) == probabilities
+
+
+def test_a_target_that_is_no_object_is_refused(meshcat):
+    builder = DiagramBuilder()
+    visualizer = builder.AddSystem(GraspSceneVisualizer(meshcat, SCENE))
+    target = np.zeros(Target.size)
+    target[3] = 9
+    add_source(builder, target, visualizer.get_target_input_port())
+    add_source(builder, [0.0], visualizer.get_selected_goal_input_port())
+    with pytest.raises(ValueError, match="target index 9 is not one of the 4 objects"):
+        Simulator(builder.Build()).Initialize()

@@ -46,6 +46,38 @@ def test_hand_over_refuses_limits_that_are_not_finite_positive_numbers(limits):
         HandOver(np.zeros(2), *limits, 0.03)
 
 
+@pytest.mark.parametrize("build, message", [
+    (lambda: HandOver([0.0, np.nan], 1.0, 0.5, 0.03), "initial_position must be finite"),
+    (lambda: GoalsSource(np.zeros(2)),
+     r"goals must be a non-empty \(K, D\) array, got shape \(2,\)"),
+    (lambda: ScriptedOperator([0.0, 1.0], [0.1], 0.03),
+     "operator script needs one command per time: 2 times, 1 commands"),
+    (lambda: ScriptedOperator([0.0], [[np.nan, 0.0]], 0.03),
+     "operator script commands contain NaN or infinite values"),
+    (lambda: ScriptedOperator([0.0, 0.0], [[0.1, 0.0], [0.0, 0.1]], 0.03),
+     "operator script times must be finite and strictly increasing"),
+    (lambda: DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, prediction_steps=5,
+                     predicted_goal_count=3),
+     r"predicted_goal_count must be in \[1, 2\] \(the goal count\), got 3"),
+])
+def test_the_loops_systems_refuse_what_they_cannot_run(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
+
+
+def test_a_script_of_single_numbers_is_a_one_dimensional_operator():
+    person = ScriptedOperator([0.0, 1.0], [0.1, -0.2], 0.03)
+    assert person.get_operator_command_output_port().size() == 1
+
+
+def test_a_selected_goal_that_is_no_goal_is_refused_by_the_bank():
+    bank = DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03)
+    context = bank.CreateDefaultContext()
+    bank.get_selected_goal_input_port().FixValue(context, [2.0])
+    with pytest.raises(ValueError, match="selected_goal 2 is not one of the 2 goals"):
+        bank.get_selected_reference_output_port().Eval(context)
+
+
 class ScriptedSelection(LeafSystem):
     """The selected goal as a goal estimator publishes it: a state updated at the decide
     stage, so that the DMP bank (same stage) reads the goal followed until then."""

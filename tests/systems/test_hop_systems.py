@@ -143,6 +143,28 @@ def test_the_intent_filter_takes_its_own_settings():
         IntentFilterGoalEstimator(len(GOALS), SETTINGS, PERIOD)
 
 
+def test_the_intent_filter_refuses_a_nan_goal_at_its_first_update():
+    goals = GOALS.copy()
+    goals[1, 0] = np.nan
+    builder = DiagramBuilder()
+    estimator = builder.AddSystem(IntentFilterGoalEstimator(
+        len(GOALS), IntentFilterSettings(), PERIOD))
+    builder.Connect(constant(builder, np.concatenate([HAND, np.zeros(5)])),
+                    estimator.get_ee_state_input_port())
+    builder.Connect(constant(builder, goals.reshape(-1)), estimator.get_goals_input_port())
+    builder.Connect(constant(builder, np.zeros(4)), estimator.get_operator_command_input_port())
+    builder.Connect(constant(builder, [1.0]), estimator.get_operator_active_input_port())
+    simulator = Simulator(builder.Build())
+    with pytest.raises(ValueError, match="goals contain NaN or infinite values"):
+        simulator.AdvanceTo(PERIOD)
+
+
+def test_the_assistance_systems_keep_their_method():
+    assert HopAssistance("predict_then_assist", 3, SETTINGS, PERIOD).method == (
+        "predict_then_assist")
+    assert PoseHopAssistance("hop", 3, SETTINGS, PERIOD).method == "hop"
+
+
 @pytest.mark.slow
 def test_commanding_a_goal_long_enough_sits_at_the_clip():
     diagram, estimator = estimator_diagram(np.append(TOWARD_FIRST, 0.0))

@@ -94,6 +94,8 @@ def test_once_pushing_a_participant_keeps_pushing_until_it_arrives():
 
 def test_near_the_target_a_participant_lets_a_robot_that_closes_in_finish_alone():
     assert robot_closes_in(PARAMS, [0.05, 0.0], [0.07, 0.0], nominal_speed=0.12)
+    # On the target itself: nothing left to close in on.
+    assert robot_closes_in(PARAMS, [0.0, 0.0], [0.0, 0.0], nominal_speed=0.12)
 
 
 def test_near_the_target_a_participant_drives_a_robot_that_has_parked():
@@ -162,3 +164,9 @@ def test_the_stall_time_is_how_long_a_parked_participant_waits_before_pushing(st
 def test_a_longer_stall_time_delays_the_push_through():
     assert first_push_time(PARAMS, 5.0) is not None
     assert first_push_time(dataclasses.replace(PARAMS, stall_time=8.0), 5.0) is None
+
+
+def test_a_participant_among_obstacles_needs_their_radius():
+    with pytest.raises(ValueError, match="obstacle_radius must be positive with obstacles, "
+                                         "got 0.0"):
+        VirtualOperator(PERIOD, [[*TARGET, 0.7]], nominal_speed=0.12, obstacle_count=len(WALL))

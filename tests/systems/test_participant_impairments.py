@@ -183,29 +183,45 @@ def test_the_late_participant_sends_the_same_commands_the_delay_later():
         1.2 + calibrated.reaction_delay + calibrated.serve_patience + 0.3, abs=1.5 * PERIOD)
 
 
+def grasp_twists(ticks=120, **impairment):
+    """`(twists (ticks, 6), active (ticks,))` of a lone grasp participant (seed 2), impaired
+    as given, the hand held at HAND, under teleop (no intent shown, the forward key on),
+    its target object 0, then object 1 from 1 s."""
+    orientations = np.array([side_grasp_orientation(0.4), side_grasp_orientation(-0.4)])
+    participant = GraspParticipant.create(
+        GraspParticipantParams(impairment=ParticipantImpairment(**impairment)),
+        SPEED, OBJECTS[:2], orientations, seed=2)
+    builder = DiagramBuilder()
+    system = builder.AddSystem(PoseVirtualOperator(participant, PERIOD))
+    hand = np.concatenate([HAND, side_grasp_orientation(0.0), np.zeros(6)])
+    for port, source in ((system.get_hand_pose_input_port(), ConstantVectorSource(hand)),
+                         (system.get_target_input_port(), target_source([(0.0, 0),
+                                                                         (1.0, 1)])),
+                         (system.get_selected_goal_input_port(),
+                          ConstantVectorSource(np.array([float(NO_INTENT)]))),
+                         (system.get_forward_key_input_port(),
+                          ConstantVectorSource(np.ones(1)))):
+        builder.Connect(builder.AddSystem(source).get_output_port(), port)
+    return _sampled(builder, system, ticks)
+
+
+def test_the_noisy_grasp_participant_adds_its_seeds_noise_to_its_twists_while_it_acts():
+    (clean, clean_active), (noisy, active) = grasp_twists(), grasp_twists(
+        command_noise=0.3, command_noise_time=0.0)
+    assert np.array_equal(active, clean_active) and active.sum() > 40
+    assert not noisy[~active].any()
+    noise = (noisy - clean)[active]
+    # Each axis's noise a fresh draw a tick (no correlation time), of standard deviation
+    # 0.3 times its speed: m/s for the velocity, rad/s for the turn rate.
+    scales = 0.3 * np.repeat([SPEED, GraspParticipantParams().rotation_speed], 3)
+    assert np.all((noise.std(axis=0) > 0.5 * scales) & (noise.std(axis=0) < 1.5 * scales))
+    assert np.array_equal(grasp_twists(command_noise=0.3, command_noise_time=0.0)[0], noisy)
+
+
 @pytest.mark.slow
 def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
-    orientations = np.array([side_grasp_orientation(0.4), side_grasp_orientation(-0.4)])
-    positions = OBJECTS[:2]
-
-    def twists(delay):
-        participant = GraspParticipant.create(
-            GraspParticipantParams(impairment=ParticipantImpairment(command_delay=delay)),
-            SPEED, positions, orientations, seed=2)
-        builder = DiagramBuilder()
-        system = builder.AddSystem(PoseVirtualOperator(participant, PERIOD))
-        hand = np.concatenate([HAND, side_grasp_orientation(0.0), np.zeros(6)])
-        for port, source in ((system.get_hand_pose_input_port(), ConstantVectorSource(hand)),
-                             (system.get_target_input_port(), target_source([(0.0, 0),
-                                                                             (1.0, 1)])),
-                             (system.get_selected_goal_input_port(),
-                              ConstantVectorSource(np.array([float(NO_INTENT)]))),
-                             (system.get_forward_key_input_port(),
-                              ConstantVectorSource(np.ones(1)))):
-            builder.Connect(builder.AddSystem(source).get_output_port(), port)
-        return _sampled(builder, system, 120)
-
-    (on_time, on_time_active), (delayed, delayed_active) = twists(0.0), twists(0.45)
+    (on_time, on_time_active), (delayed, delayed_active) = (
+        grasp_twists(command_delay=0.0), grasp_twists(command_delay=0.45))
     shift = 15
     # Under teleop it takes over once it has noticed a target and watched the still hand
     # for its patience, and keeps on until it notices the next (at 1 s), when it watches
@@ -221,6 +237,14 @@ def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
     assert np.array_equal(delayed[shift:], on_time[:-shift])
     assert np.array_equal(delayed_active[shift:], on_time_active[:-shift])
     assert not delayed[:shift].any()
+
+
+def test_a_participant_the_systems_cannot_run_is_refused():
+    # The scenario checks the impairment first; a Python caller meets the system's check.
+    with pytest.raises(ValueError, match="delay_ticks must not be negative, got -10"):
+        VirtualOperator(PERIOD, OBJECTS, params=params(command_delay=-0.3), nominal_speed=SPEED)
+    with pytest.raises(ValueError, match=r"participant must be a GraspParticipant \("):
+        PoseVirtualOperator(GraspParticipantParams(), PERIOD)
 
 
 # ---------------------------------------------------------------------------------------------

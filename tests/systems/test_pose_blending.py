@@ -158,6 +158,13 @@ def test_a_nan_operator_twist_is_refused_with_its_field_named():
         blender_reference("pbp_continuous", np.array([0.0, 0.0, 0.0, 0.0, 0.0, np.nan]))
 
 
+@pytest.mark.parametrize("pose", [START[:6], np.append(START[:6], np.nan)])
+def test_a_hand_over_start_that_is_no_pose_is_refused(pose):
+    with pytest.raises(ValueError, match=r"initial_pose must be 7 finite numbers \[x, y, z, "
+                                         r"qw, qx, qy, qz\]"):
+        PoseHandOver(pose, LIMITS, DT)
+
+
 def test_its_weight_is_a_context_parameter_as_the_blenders():
     blender = PoseBlender("fixed_alpha", 2, DT, 0.3)
     context, other = blender.CreateDefaultContext(), blender.CreateDefaultContext()

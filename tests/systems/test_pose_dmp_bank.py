@@ -104,6 +104,8 @@ def test_the_selected_reference_is_that_goals_row():
     references = bank.get_references_output_port().Eval(context).reshape(K, 13)
     selected = bank.get_selected_reference_output_port().Eval(context)
     np.testing.assert_allclose(selected, references[2], rtol=0, atol=1e-14)
+    reference = bank.selected_reference(context)
+    np.testing.assert_array_equal(reference.to_vector(), selected)  # a PoseReference
 
 
 def test_pbp_alternated_locks_both_phases_while_the_operator_acts():
@@ -141,11 +143,17 @@ def test_a_nan_hand_twist_is_refused_with_its_field_named():
         simulate(0.02, robot=robot)
 
 
-def test_banks_with_different_phases_are_refused():
+def test_banks_of_different_phases_dimensions_or_goal_counts_are_refused():
     positions, _, _ = make_banks()
     slower = OrientationDmpBank.straight(quaternion.IDENTITY, K, 2.0, SETTINGS)
     with pytest.raises(ValueError, match="share one phase"):
         PoseDmpBank(positions, slower, DT)
+    with pytest.raises(ValueError, match="the position bank must be 3-D, got D = 2"):
+        PoseDmpBank(PositionModel.straight(np.zeros(2), K, 1.2, SETTINGS), slower, DT)
+    same_phase = OrientationDmpBank.straight(quaternion.IDENTITY, K + 1, 1.2, SETTINGS)
+    with pytest.raises(ValueError, match=f"the banks have {K} and {K + 1} goals; a pose bank "
+                                         f"needs one count"):
+        PoseDmpBank(positions, same_phase, DT)
 
 
 def test_a_hand_quaternion_that_is_not_unit_is_refused_by_name():

@@ -74,3 +74,10 @@ def test_while_the_operator_gives_no_input_the_selection_holds():
                       operator_until=0.3) == 1
     # Unconnected, the hand's own motion and distance take the selection over.
     assert selections(LEFT, seconds=1.0, hand_position=near_left) == 0
+
+
+@pytest.mark.parametrize("settings", [GoalEstimatorSettings(method="nearest"), {"method": "pose"}])
+def test_it_takes_pose_settings_alone(settings):
+    with pytest.raises(ValueError, match="settings must be a GoalEstimatorSettings with method "
+                                         "'pose'"):
+        PoseGoalEstimator(len(GOALS), settings, PERIOD)

@@ -171,3 +171,8 @@ def test_the_grasp_monitor_keeps_the_same_rules():
     assert status.task_time == pytest.approx(SUCCESS_TIME, abs=1e-9)
     assert status.intervention_ratio == pytest.approx(20 / STEPS, abs=1e-12)
     assert status.collision_ratio == 0.0
+
+
+def test_a_switch_schedule_without_one_target_per_entry_is_refused():
+    with pytest.raises(ValueError, match="one target per entry of switch_schedule"):
+        TaskMonitor(OBJECTS, [0, 1], [0.0], [0.0, 0.0, 0.0], 0.05, PERIOD)

@@ -104,6 +104,23 @@ def test_the_scene_comes_back_after_a_delete_and_in_a_second_run(meshcat, make, 
     assert drawn(meshcat, paths) == paths
 
 
+def test_a_3d_scene_draws_spheres_and_runs_without_its_predicted_paths(meshcat):
+    builder = DiagramBuilder()
+    visualizer = builder.AddSystem(PointSceneVisualizer(
+        meshcat, start=[0.0, 0.0, 0.7], goals=[[1.0, 0.5, 0.7], [1.0, -0.5, 0.7]],
+        obstacles=[Obstacle(center=[0.5, 0.0, 0.7], radius=0.1)], prediction_steps=4))
+    add_source(builder, [0.2, 0.1, 0.7, 0.0, 0.0, 0.0], visualizer.get_robot_state_input_port())
+    Simulator(builder.Build()).AdvanceTo(0.1)  # predicted_paths unconnected: none shown
+    obstacle = meshcat._GetPackedObject("/pbp/obstacles/0")
+    assert b"Sphere" in obstacle and b"Cylinder" not in obstacle
+
+
+def test_more_paths_than_objects_are_refused(meshcat):
+    with pytest.raises(ValueError, match=r"path_count must be in \[1, 2\] \(the object "
+                                         r"count\), got 3"):
+        ReachSceneVisualizer(meshcat, OBJECTS, prediction_steps=5, path_count=3)
+
+
 
 @pytest.mark.slow
 def test_a_2d_replay_shows_the_dmp_path_from_where_the_robot_is_at_each_time(repo, meshcat):

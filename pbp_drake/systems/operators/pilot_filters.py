@@ -124,9 +124,6 @@ class PilotFilter(SampledOperator):
         discrete_state.set_value(self._taken_index, [1.0])
         self._store_sample(discrete_state, command, active)
 
-    def _filter(self, context, tick, command, active, previous):
-        raise NotImplementedError
-
 
 class NoisyFilter(PilotFilter):
     """The noisy pilot's filter: each tick, with probability `eps`, the base pilot's output

@@ -95,6 +95,3 @@ class SampledOperator(PortGetters, LeafSystem):
     def _validate(self, command):
         """The command checked (NaN or infinite refused by name), as a float array."""
         return validate_command(command, self._command_name)
-
-    def _sample(self, context):
-        raise NotImplementedError

@@ -90,15 +90,6 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         """The `TaskCounts` held in this system's `context`."""
         return TaskCounts.of_vector(self._count_vector(context))
 
-    def _read_hand(self, vector):
-        raise NotImplementedError
-
-    def _progress(self, hand, index):
-        raise NotImplementedError
-
-    def _reached(self, hand, index):
-        raise NotImplementedError
-
     def _count_vector(self, context):
         return context.get_discrete_state(self._counts_index).value()
 

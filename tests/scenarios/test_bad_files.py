@@ -53,6 +53,14 @@ VARIANTS = {
                            ["duplicate", "basis_count", "line"]),
     "huge_basis_count": (SHIPPED, _replace("basis_count: 50", "basis_count: 100000000"),
                          ["basis_count", "10000"]),
+    "latin1": (SHIPPED, lambda text: text.replace("\n  method:", "\n  # café\n  method:", 1)
+               .encode("latin-1"), ["byte", "is not UTF-8", "expected UTF-8 text"]),
+    "control_character": (SHIPPED, _replace("\n  method:", "\n  # \a\n  method:"),
+                          ["YAML error", "control characters are not allowed"]),
+    "undefined_alias": (SHIPPED, _replace("control_period: 0.0", "control_period: *period #"),
+                        ["line", "found undefined alias"]),
+    "list_as_key": (SHIPPED, _replace("\n  method:", "\n  ? [a]\n  : 1\n  method:"),
+                    ["line", "found unhashable key"]),
 }
 CASES = [(name, file) for name, (files, _, _) in VARIANTS.items() for file in files]
 
@@ -191,6 +199,12 @@ def test_a_hundred_broken_files_exit_2_naming_the_field(tmp_path, run_refused):
         for word in words:
             assert word.lower() in err.lower(), (index, word, err)
         assert elapsed < 10.0, (index, elapsed)
+
+
+def test_a_missing_file_is_named(tmp_path, run_refused):
+    path = tmp_path / "missing.yaml"
+    code, err, _ = run_refused(path)
+    assert code == 2 and err == f"pbp-drake: {path}: no such scenario file\n", err
 
 
 def test_the_shipped_files_still_load():

@@ -132,6 +132,13 @@ def test_a_link_with_two_parents_is_refused(tmp_path):
             in message), message
 
 
+def test_a_joint_to_a_link_that_is_not_there_is_refused_in_drake_s_words(tmp_path):
+    model = arm7_with(tmp_path, '<child link="arm7_link7"/>', '<child link="nowhere"/>')
+    message = refusal(scenario_of(model))
+    assert ("does not load: " in message
+            and "Could not find link named 'nowhere'" in message), message
+
+
 @pytest.mark.parametrize("uri, why", [
     ("meshes/foot.obj", "is missing (no file at"),
     ("package://drake_models/iiwa_description/meshes/link_0.obj",
@@ -334,6 +341,28 @@ def test_an_sdformat_model_is_checked_alike(tmp_path):
     assert (f"ArmStationConfig.model_file '{looped}': line {elbow}, joint 'elbow' <parent>: link "
             "'upper' closes a loop of joints ('upper' -> 'lower' -> 'upper')"
             in str(error.value)), error.value
+
+
+LOWER_LINK = '<link name="lower">'
+
+
+@pytest.mark.parametrize("added, ee_frame, message", [
+    ('<model name="gripper"><link name="finger"/></model>', "tool",
+     "holds 2 models; the station takes one arm"),
+    # A link no joint holds: Drake lets it float (a quaternion joint).
+    ('<link name="loose"><pose>1 0 0 0 0 0</pose></link>', "loose",
+     "ArmStationConfig.ee_frame 'loose' is not downstream of base_frame 'base': its chain "
+     "ends at 'loose'"),
+    ('<link name="loose"><pose>1 0 0 0 0 0</pose></link>', "tool",
+     "WholeBodyDiffIk needs q̇ = v (no quaternion joints)"),
+], ids=["nested model", "loose end effector", "loose link"])
+def test_an_sdformat_model_that_is_no_single_arm_is_refused(tmp_path, added, ee_frame,
+                                                            message):
+    model = tmp_path / "arm.sdf"
+    model.write_text(SDF_ARM.replace(LOWER_LINK, f"{added}\n    {LOWER_LINK}"))
+    config = ArmStationConfig(model_file=str(model), base_frame="base", ee_frame=ee_frame)
+    with pytest.raises(ValueError, match=re.escape(message)):
+        make_arm_station(config)
 
 
 @pytest.mark.parametrize("mass, what", [("-2", "-2 kg is negative; a mass is 0 or more"),

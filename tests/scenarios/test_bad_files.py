@@ -10,7 +10,7 @@ import pytest
 from pydrake.common.yaml import yaml_dump, yaml_load
 
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
-from pbp_drake.scenarios.bounds import load_document
+from pbp_drake.scenarios.bounds import check_yaml_bounds, load_document
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 SHIPPED = ("hsr_reach.yaml", "toy_alt_vs_cont.yaml")
@@ -220,3 +220,9 @@ def test_duplicate_keys_are_per_mapping():
                        ("a: {x: 1,\n    x: 2}\n", 2)):
         with pytest.raises(ScenarioError, match=f"line {line}: duplicate key"):
             load_document(text)
+
+
+def test_a_scalar_anchor_and_a_merge_key_read_as_yaml_has_them():
+    text = "a: &x 1.5\nb: *x\nc: {<<: {d: 2, e: 3}, e: 4}\n"
+    check_yaml_bounds(text)  # one value repeated, far within the bound
+    assert load_document(text) == {"a": 1.5, "b": 1.5, "c": {"d": 2, "e": 4}}

@@ -2,13 +2,16 @@
 into a division, a norm or a simulation: each now refused, naming its field; and the checks
 no other test reached, each with a value it refuses."""
 
+import dataclasses
 import math
 import pathlib
 import re
 
+import numpy as np
 import pytest
 
-from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.scenarios import (
+    MultiGoalReach, ScenarioError, ScriptedCommands, load_scenario_file, resolve, task_scene)
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 
@@ -233,3 +236,20 @@ def test_a_gamepad_is_refused_where_the_objects_stand_at_heights_of_their_own(tm
                        r"a task whose objects stand at heights of their own \(scenario.task."
                        r"z_range\) takes !Keyboard or !VirtualParticipant"):
         load_scenario_file(path)
+
+
+def test_a_scenario_made_in_python_is_held_to_the_checks_a_file_walk_cannot_make():
+    toy = load_scenario_file(DIAGRAMS / "toy_alt_vs_cont.yaml").scenario
+    reach = load_scenario_file(DIAGRAMS / "hsr_reach.yaml").scenario
+    # An array is no list: the walk of the numbers leaves it to the operator's own check.
+    commands = ScriptedCommands(times=[0.0, 1.0], commands=np.array([[0.0, np.nan],
+                                                                     [0.0, 0.0]]))
+    with pytest.raises(ScenarioError, match=r"^scenario.operator.commands contain NaN or "
+                                            r"infinite values$"):
+        resolve(dataclasses.replace(toy, operator=commands))
+    participant = dataclasses.replace(reach.operator, plan_directions=2.5)
+    with pytest.raises(ScenarioError, match=r"^scenario.operator.plan_directions 2.5 is no "
+                                            r"count; expected a whole number, 1 to 360$"):
+        resolve(dataclasses.replace(reach, operator=participant))
+    with pytest.raises(ValueError, match=r"^x_range and y_range must be \[low, high\]$"):
+        task_scene(MultiGoalReach(x_range=[1.0]), 0)

@@ -12,6 +12,7 @@ import pytest
 
 from pbp_drake.scenarios import (
     MultiGoalReach, ScenarioError, ScriptedCommands, load_scenario_file, resolve, task_scene)
+from pbp_drake.scenarios.resolution import MAX_PRIMITIVE_BYTES, load_primitive
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 
@@ -253,3 +254,12 @@ def test_a_scenario_made_in_python_is_held_to_the_checks_a_file_walk_cannot_make
         resolve(dataclasses.replace(reach, operator=participant))
     with pytest.raises(ValueError, match=r"^x_range and y_range must be \[low, high\]$"):
         task_scene(MultiGoalReach(x_range=[1.0]), 0)
+
+
+def test_a_primitive_file_larger_than_any_primitive_is_refused(tmp_path):
+    path = tmp_path / "huge.json"
+    with open(path, "wb") as file:
+        file.truncate(MAX_PRIMITIVE_BYTES + 1)  # sparse: no disk is written
+    with pytest.raises(ScenarioError, match=r"^scenario.dmp.primitive is over 64 MiB: not a "
+                                            r"primitive$"):
+        load_primitive(path, "scenario.dmp.primitive")

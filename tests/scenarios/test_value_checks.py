@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from pbp_drake.scenarios import (
-    MultiGoalReach, ScenarioError, ScriptedCommands, load_scenario_file, resolve, task_scene)
+    MethodComparison, MultiGoalReach, ScenarioError, ScriptedCommands, check_method_comparison,
+    load_scenario_file, resolve, task_scene)
 from pbp_drake.scenarios.resolution import MAX_PRIMITIVE_BYTES, load_primitive
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
@@ -254,6 +255,9 @@ def test_a_scenario_made_in_python_is_held_to_the_checks_a_file_walk_cannot_make
         resolve(dataclasses.replace(reach, operator=participant))
     with pytest.raises(ValueError, match=r"^x_range and y_range must be \[low, high\]$"):
         task_scene(MultiGoalReach(x_range=[1.0]), 0)
+    with pytest.raises(ScenarioError, match=r"^study !MethodComparison runs the tasks: use "
+                                            r"robot: !Hsr or !Arm$"):
+        check_method_comparison(MethodComparison(), toy)
 
 
 def test_a_primitive_file_larger_than_any_primitive_is_refused(tmp_path):

@@ -9,7 +9,7 @@ import dataclasses
 
 from pbp_drake.core.pilot_population import drawn_participant
 from pbp_drake.scenarios import (
-    LaggyPilot, NoisyPilot, ParticipantPopulation, ProportionalPilot, VirtualParticipant)
+    LaggyPilot, NoisyPilot, ProportionalPilot, VirtualParticipant)
 from pbp_drake.systems.operators.pilot_filters import (
     LaggyFilter, NoisyFilter, PilotOperator, ProportionalOperator)
 from pbp_drake.systems.operators.sampled_operator import operator_speed
@@ -47,8 +47,7 @@ def make_pilot(resolved, make_participant, make_keys, obstacle_count=0):
         return ProportionalOperator(
             make_keys(nominal_speed, 0.0), period, config,
             operator_speed(config.max_speed, nominal_speed), obstacle_count)
-    if isinstance(config, ParticipantPopulation):
-        base = config.participant
-        return participant(drawn_participant(
-            config, seed, operator_speed(base.speed, nominal_speed)))
-    raise TypeError(f"unknown pilot config {type(config).__name__}")
+    # The last of PILOT_CONFIGS (`ParticipantPopulation`): the callers pass no other config.
+    base = config.participant
+    return participant(drawn_participant(
+        config, seed, operator_speed(base.speed, nominal_speed)))

@@ -30,6 +30,7 @@ MOST_ALIASED_VALUES = 100_000
 #: The most candidate goals (one DMP each) a scenario holds, in `scenario.goals` or a
 #: reaching task's `objects` (`run --goals` too): `pbp-drake bench` steps the DMP bank up to
 #: 100,000 goals, and the loop runs live with 10,000 (docs/performance.md).
+#: Not below MOST_ALIASED_VALUES: an alias of more goals repeats more values, refused as such.
 MAX_GOALS = 100_000
 #: The lists of goals a scenario file may hold, by field, with the word for one goal.
 GOAL_LISTS = {"scenario.goals": "goals", "scenario.task.objects": "objects"}
@@ -121,7 +122,7 @@ def check_yaml_bounds(text):
     MOST_ALIASED_VALUES values by its aliases, has an alias inside the node it names, or
     holds more than MAX_GOALS goals in a list of GOAL_LISTS. Reads the events only; a text
     that does not parse is left to the loader, which says where."""
-    anchored = {}  # anchor: (values, items) of the node it names, once that node has ended
+    anchored = {}  # anchor: values of the node it names, once that node has ended
     open_nodes = [_Document(None, SequenceStartEvent(None, None, True))]
     aliased = 0
     loader = _BASE_LOADER(text)
@@ -132,16 +133,16 @@ def check_yaml_bounds(text):
             if kind is ScalarEvent:  # most events: kept short
                 open_nodes[-1].add(event, 1)
                 if event.anchor is not None:
-                    anchored[event.anchor] = (1, 0)
+                    anchored[event.anchor] = 1
             elif kind in (SequenceStartEvent, MappingStartEvent):
                 open_nodes.append(_OpenNode(open_nodes[-1].add(event, 0), event))
             elif kind in (SequenceEndEvent, MappingEndEvent):
                 node = open_nodes.pop()
                 open_nodes[-1].values += node.values
                 if node.anchor is not None:
-                    anchored[node.anchor] = (node.values, node.items)
+                    anchored[node.anchor] = node.values
             elif kind is AliasEvent:
-                values, items = anchored.get(event.anchor, (0, 0))
+                values = anchored.get(event.anchor, 0)
                 field = open_nodes[-1].add(event, values)
                 if event.anchor not in anchored:
                     _check_alias_target(event, open_nodes, field)
@@ -153,9 +154,6 @@ def check_yaml_bounds(text):
                         f"file's aliases repeat more than {MOST_ALIASED_VALUES:,} values "
                         f"(*{event.anchor} here repeats {values:,}); a scenario file's "
                         f"aliases may repeat at most {MOST_ALIASED_VALUES:,}")
-                if field in GOAL_LISTS and items > MAX_GOALS:
-                    raise ScenarioError(goal_count_problem(field, items,
-                                                           event.start_mark.line + 1))
     except yaml.YAMLError:
         return
     finally:

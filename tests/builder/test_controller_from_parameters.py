@@ -1,6 +1,7 @@
 """`make_pbp_controller` built from dataclasses alone, on an arm of our own: no scenario,
 no HSR. The PBP loop takes the hand to a goal, follows a goal that moves, lets a teleop
-operator drive, and refuses a config that cannot work by its field."""
+operator drive, and refuses a config that cannot work by its field (and a start or goals
+of the wrong shape)."""
 
 import dataclasses
 import pathlib
@@ -126,3 +127,16 @@ def test_a_config_that_cannot_work_names_its_field(change, message):
         make_pbp_controller(config, np.zeros(8), [[0.5, 0.0, 0.3]])
     assert message in str(error.value)
 
+
+
+@pytest.mark.parametrize("start, goals, message", [
+    (np.zeros(7), [[0.5, 0.0, 0.3]],
+     "initial_ee_state must be 8 finite numbers (an EeState), got [0.0, 0.0, 0.0, 0.0"),
+    (np.full(8, np.nan), [[0.5, 0.0, 0.3]], "initial_ee_state must be 8 finite numbers"),
+    (np.zeros(8), [[0.5, 0.0]], "goals must be a non-empty (K, 3) array, got shape (1, 2)"),
+    (np.zeros(8), np.zeros((0, 3)), "goals must be a non-empty (K, 3) array, got shape (0, 3)"),
+])
+def test_a_start_or_goals_of_the_wrong_shape_are_refused(start, goals, message):
+    with pytest.raises(ValueError) as error:
+        make_pbp_controller(PbpControllerConfig(), start, goals)
+    assert message in str(error.value)

@@ -60,6 +60,8 @@ def test_a_registered_method_runs_by_name(reach, toy_method):
     assert resolved.blend_mode == "pbp_alternated"
     assert resolved.controller.blend_mode == "pbp_alternated"
     assert METHOD_NAMES[toy_method.name] == "PBP-Alt with forward"
+    assert dict(METHOD_NAMES)[toy_method.name] == "PBP-Alt with forward"
+    assert len(METHOD_NAMES) == len(METHODS)
     assert method_colour(toy_method.name) == "tab:olive"
     diagram = build_diagram(resolved)
     context = _first_tick(diagram)

@@ -17,9 +17,11 @@ from pydrake.systems.lcm import LcmSubscriberSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.cli import main
-from pbp_drake.robots import ArmHardware, DriverError, arm_initial_ee_state, make_arm_station
+from pbp_drake.robots import (
+    ArmHardware, DriverError, arm_driver_sim, arm_initial_ee_state, make_arm_station)
 from pbp_drake.robots.arm_driver import (
-    SIMULATION_CLOCK, WALL_CLOCK, DriverLink, command_message, status_message, status_type)
+    SIMULATION_CLOCK, WALL_CLOCK, DriverLink, command_message, read_first_status,
+    status_message, status_type)
 from pbp_drake.robots.arm_station_config import DRIVERS
 from pbp_drake.robots.driver_sim import DriverSimError, make_driver_sim
 from pbp_drake.scenarios import load_scenario_file
@@ -278,6 +280,67 @@ def test_the_panda_simulator_drops_a_stale_command_and_holds():
         simulator.get_context())), START + 0.1)
 
 
+@pytest.mark.parametrize("change, message", [
+    (lambda command: setattr(command, "control_mode_expected", 2),
+     "PANDA_COMMAND: a command for another mode than position"),
+    (lambda command: (setattr(command, "num_joint_position", 6),
+                      setattr(command, "joint_position", list(START[:6]))),
+     r"PANDA_COMMAND: a command of 6 positions or with a NaN \(the arm has 7 joints\)"),
+])
+def test_the_panda_simulator_aborts_on_a_command_it_cannot_take(change, message):
+    lcm = DrakeLcm("memq://")
+    builder = DiagramBuilder()
+    builder.AddSystem(make_driver_sim("panda", lcm, SIMULATION_CLOCK, START, LOWER, UPPER,
+                                      VELOCITY))
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(0.1)
+    command = command_message("panda", 0.1e6, START)
+    change(command)
+    lcm.Publish("PANDA_COMMAND", command.encode())
+    with pytest.raises(DriverSimError, match=message):
+        simulator.AdvanceTo(0.2)
+
+
+def test_an_arm_that_moved_after_its_first_status_was_read_ends_the_run():
+    rig = fake_rig("iiwa", lambda t: START + 0.05)
+    with pytest.raises(DriverError, match=r"the arm stands 0.0500 rad from the configuration "
+                                          r"the run was built for \(at most 0.01\)"):
+        rig.advance(0.2)
+    assert rig.commands == []
+
+
+class OneStatus:
+    """What `read_first_status` uses of a DrakeLcm: a bus whose first status is `message`."""
+
+    def __init__(self, message):
+        self._message, self._handlers = message, {}
+
+    def Subscribe(self, channel, handler):
+        self._handlers[channel] = handler
+
+    def HandleSubscriptions(self, timeout_millis):
+        self._handlers["IIWA_STATUS"](self._message.encode())
+        return 1
+
+
+def test_the_first_status_gives_the_arm_s_configuration_or_refuses_a_bad_one():
+    hardware = ArmHardware(driver="iiwa", connect=True)
+    good = status_message("iiwa", 0, START, np.zeros(7), START)
+    np.testing.assert_array_equal(read_first_status(hardware, OneStatus(good), LOWER, UPPER),
+                                  START)
+    beyond = np.where(np.arange(7) == 1, 2.7, START)
+    bad = status_message("iiwa", 0, beyond, np.zeros(7), beyond)
+    with pytest.raises(DriverError, match=r"IIWA_STATUS puts joint 2 at 2.7000 rad, beyond"):
+        read_first_status(hardware, OneStatus(bad), LOWER, UPPER)
+
+
+def test_the_driver_simulator_needs_the_driver_it_simulates():
+    config = dataclasses.replace(shipped("iiwa"), hardware=None)
+    with pytest.raises(ValueError, match=r"ArmStationConfig.hardware is needed: the driver to "
+                                         r"simulate \(hardware: \{driver: panda\} or"):
+        arm_driver_sim(config, DrakeLcm("memq://"))
+
+
 def run(*argv, capsys):
     code = main(list(argv))
     return code, capsys.readouterr()
@@ -335,3 +398,13 @@ def test_the_panda_task_runs_over_lcm_with_the_driver_simulator(capsys):
                     "--driver-sim", "--operator", "virtual", "--headless", capsys=capsys)
     assert code == 0, out.err
     assert "panda_reach [pbp_alternated, seed 0]: success" in out.out
+
+
+@pytest.mark.slow
+def test_driver_sim_runs_the_arm_s_driver_on_the_bus(capsys):
+    code, out = run("driver-sim", str(REPO / "diagrams" / "iiwa_reach.yaml"), "--set",
+                    "robot.hardware.lcm_bus.lcm_url=memq://", "--duration", "0.2",
+                    capsys=capsys)
+    assert code == 0, out.err
+    assert out.out == ("driver-sim: the iiwa driver reads IIWA_COMMAND and sends IIWA_STATUS "
+                       "every 5 ms on memq://; Ctrl-C ends it\n")

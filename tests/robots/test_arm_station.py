@@ -13,7 +13,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.robots import (
-    ArmStationConfig, CylinderObstacle, arm_initial_ee_state, arm_ready_ee_state,
+    ArmStationConfig, CylinderObstacle, arm_initial_ee_state, arm_reach, arm_ready_ee_state,
     arm_station_plant, make_arm_station)
 from pbp_drake.robots.hsr_model import models_dir
 from pbp_drake.scenarios import load_scenario_file
@@ -120,12 +120,39 @@ REFUSALS = [
      "ArmStationConfig.initial_positions has 2 entries; the arm has 7 joints"),
     ("outside the limits", lambda tmp: {"initial_positions": [9.0] * 7},
      "ArmStationConfig.initial_positions: joint 'arm7_joint1' at 9 is outside its limits"),
+    ("base pose without yaw", lambda tmp: {"base_pose": [0.0, 0.0, 0.0]},
+     "ArmStationConfig.base_pose must be finite [x, y, z, yaw], got [0.0, 0.0, 0.0]"),
+    ("a NaN position", lambda tmp: {"initial_positions": [np.nan] * 7},
+     "ArmStationConfig.initial_positions must be finite, got [nan, "),
+    ("negative singular margin", lambda tmp: {"singular_margin": -1.0},
+     "ArmStationConfig.singular_margin must be >= 0, got -1.0"),
+    ("no room between the limits", lambda tmp: {"model_file": _arm7_with(
+        tmp, ('<limit lower="0" upper="3.05"', '<limit lower="0.5" upper="0.5"'))},
+     "joint 'arm7_joint4' has position limits [0.5, 0.5] with no room between them"),
+    # Without its transmission: Drake's parser refuses a motor on a planar joint itself.
+    ("a planar joint", lambda tmp: {"model_file": _arm7_with(
+        tmp, ('<joint name="arm7_joint4" type="revolute"', '<joint name="arm7_joint4" '
+              'type="planar"'), (TRANSMISSION4, ""))},
+     "joint 'arm7_joint4' is a planar joint; the station moves revolute and prismatic joints "
+     "only"),
 ]
+TRANSMISSION4 = ARM7_FILE.read_text().split('  <transmission name="arm7_transmission4">')[1]
+TRANSMISSION4 = ('  <transmission name="arm7_transmission4">'
+                 + TRANSMISSION4[:TRANSMISSION4.index("</transmission>")] + "</transmission>")
 
 
 def _write(path, text):
     path.write_text(text)
     return str(path)
+
+
+def _arm7_with(tmp, *changes):
+    """The shipped arm's file with each `(old, new)` of `changes` made once."""
+    text = ARM7_FILE.read_text()
+    for old, new in changes:
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    return _write(tmp / "arm.urdf", text)
 
 
 @pytest.mark.parametrize("name, change, message", REFUSALS, ids=[r[0] for r in REFUSALS])
@@ -148,3 +175,17 @@ def test_a_joint_without_limits_is_refused_naming_it(tmp_path):
     config = dataclasses.replace(shipped_arm(), model_file=str(unlimited))
     with pytest.raises(ValueError, match="joint 'arm7_joint4' has no position limits"):
         make_arm_station(config)
+
+
+def test_a_joint_without_a_motor_in_the_model_is_given_one(tmp_path):
+    config = dataclasses.replace(shipped_arm(), motion="dynamic", model_file=_arm7_with(
+        tmp_path, (TRANSMISSION4, "")))
+    plant = arm_station_plant(make_arm_station(config))
+    assert plant.HasJointActuatorNamed("arm7_joint4_pbp_motor")
+    assert plant.num_actuators() == 7
+
+
+def test_the_reach_is_measured_from_the_shoulder():
+    shoulder, reach = arm_reach(shipped_arm())
+    np.testing.assert_allclose(shoulder, [0.0, 0.0, 0.16])  # the first joint, above the base
+    assert reach == pytest.approx(1.14)

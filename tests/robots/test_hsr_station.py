@@ -124,6 +124,9 @@ def test_config_round_trips_through_yaml():
     ("arm_acceleration_limits", [1.0, 6.0, 40.0, 30.0, float("nan")],
      "arm_acceleration_limits"),
     ("obstacles", [CylinderObstacle(radius=0.0)], r"obstacles\[0\]"),
+    ("arm_centering_gain", -1.0, r"HsrStationConfig\.arm_centering_gain must be >= 0, got -1.0"),
+    ("initial_base", [20.0, 0.0, 0.0],
+     r"initial_base \[20.0, 0.0, 0.0\] is out of base_x_joint's range"),
 ])
 def test_config_errors_name_the_field(field, value, message):
     with pytest.raises(ValueError, match=message):
@@ -134,6 +137,14 @@ def test_rejects_tamsi_which_ignores_the_torso_coupler():
     config = HsrStationConfig()
     config.plant.discrete_contact_approximation = "tamsi"
     with pytest.raises(ValueError, match="discrete_contact_approximation"):
+        make_hsr_station(config)
+
+
+def test_rejects_a_continuous_plant():
+    config = HsrStationConfig()
+    config.plant.time_step = 0.0
+    with pytest.raises(ValueError, match=r"HsrStationConfig\.plant\.time_step must be positive "
+                                         r"\(a discrete plant\), got 0.0"):
         make_hsr_station(config)
 
 
@@ -326,6 +337,18 @@ def test_meshcat_draws_the_robot_and_the_obstacles():
     assert meshcat.HasPath("/drake/visualizer/hsrb")
     assert meshcat.HasPath("/drake/visualizer/obstacle_0")
     assert meshcat.HasPath("/drake/visualizer/obstacle_1")
+
+
+def test_meshcat_draws_the_proximity_shapes_when_asked():
+    meshcat = Meshcat()
+    config = HsrStationConfig()
+    config.visualization.publish_proximity = True
+    station = make_hsr_station(config, meshcat)
+    context = station.CreateDefaultContext()
+    station.GetInputPort("ee_command").FixValue(context, hsr_initial_ee_state(station)[:7])
+    station.ForcedPublish(context)
+    assert meshcat.HasPath("/drake/proximity/hsrb")
+    assert meshcat.HasPath("/drake/visualizer/hsrb")
 
 
 @pytest.mark.parametrize("height, base", [(0.7, [0.0, 0.0, 0.0]), (0.9, [0.4, -0.3, 0.6])])

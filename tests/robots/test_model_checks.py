@@ -5,6 +5,7 @@ is our arm's (models/) with one change."""
 
 import dataclasses
 import pathlib
+import re
 import subprocess
 import sys
 import time
@@ -131,6 +132,13 @@ def test_a_link_with_two_parents_is_refused(tmp_path):
             in message), message
 
 
+def test_a_joint_to_a_link_that_is_not_there_is_refused_in_drake_s_words(tmp_path):
+    model = arm7_with(tmp_path, '<child link="arm7_link7"/>', '<child link="nowhere"/>')
+    message = refusal(scenario_of(model))
+    assert ("does not load: " in message
+            and "Could not find link named 'nowhere'" in message), message
+
+
 @pytest.mark.parametrize("uri, why", [
     ("meshes/foot.obj", "is missing (no file at"),
     ("package://drake_models/iiwa_description/meshes/link_0.obj",
@@ -138,7 +146,9 @@ def test_a_link_with_two_parents_is_refused(tmp_path):
     ("https://example.com/foot.obj", "is a URL: reading it needs the network"),
     ("package://someone_else/foot.obj", "is in package 'someone_else', which the station "
      "does not know"),
-], ids=["missing", "drake_models", "url", "unknown package"])
+    ("file:///nowhere/foot.obj", "is missing (no file at '/nowhere/foot.obj')"),
+    ("package://drake/nowhere/foot.obj", "is missing (no file at"),
+], ids=["missing", "drake_models", "url", "unknown package", "file url", "drake package"])
 def test_a_mesh_that_is_missing_or_needs_the_network_is_refused(tmp_path, uri, why):
     old = '<geometry><cylinder radius="0.12" length="0.02"/></geometry>'
     model = arm7_with(tmp_path, old, f'<geometry><mesh filename="{uri}"/></geometry>')
@@ -157,6 +167,25 @@ def test_a_mesh_next_to_the_model_is_read(tmp_path):
 
 
 LINK3_MASS = '<mass value="3.6"/>'
+
+
+@pytest.mark.parametrize("write, what", [
+    (lambda path: path.write_text('<?xml version="1.0"?>\n<model name="arm"/>\n'),
+     "line 2, <model>: expected a URDF <robot> or an SDFormat <sdf><model> as the top "
+     "element"),
+    (lambda path: path.write_bytes(ARM7.read_text().replace(
+        '<robot name="pbp_arm7"', '<robot name="pbp_arm7_\xe9"').encode("latin-1")),
+     "the file: byte "),
+    (lambda path: path.write_text(ARM7.read_text().replace(LINK3_MASS,
+                                                           '<mass value="heavy"/>')),
+     f"line {line_of(LINK3_MASS)}, link 'arm7_link3' <mass value>: 'heavy' is not a finite "
+     "number"),
+], ids=["not a model", "not UTF-8", "a word for a number"])
+def test_a_file_that_is_no_readable_model_is_refused(tmp_path, write, what):
+    model = tmp_path / "arm.urdf"
+    write(model)
+    message = refusal(scenario_of(model))
+    assert f"scenario.robot.model_file '{model}': {what}" in message, message
 
 
 def test_a_negative_mass_is_refused_in_either_motion(tmp_path):
@@ -314,6 +343,41 @@ def test_an_sdformat_model_is_checked_alike(tmp_path):
             in str(error.value)), error.value
 
 
+LOWER_LINK = '<link name="lower">'
+
+
+@pytest.mark.parametrize("added, ee_frame, message", [
+    ('<model name="gripper"><link name="finger"/></model>', "tool",
+     "holds 2 models; the station takes one arm"),
+    # A link no joint holds: Drake lets it float (a quaternion joint).
+    ('<link name="loose"><pose>1 0 0 0 0 0</pose></link>', "loose",
+     "ArmStationConfig.ee_frame 'loose' is not downstream of base_frame 'base': its chain "
+     "ends at 'loose'"),
+    ('<link name="loose"><pose>1 0 0 0 0 0</pose></link>', "tool",
+     "WholeBodyDiffIk needs q̇ = v (no quaternion joints)"),
+], ids=["nested model", "loose end effector", "loose link"])
+def test_an_sdformat_model_that_is_no_single_arm_is_refused(tmp_path, added, ee_frame,
+                                                            message):
+    model = tmp_path / "arm.sdf"
+    model.write_text(SDF_ARM.replace(LOWER_LINK, f"{added}\n    {LOWER_LINK}"))
+    config = ArmStationConfig(model_file=str(model), base_frame="base", ee_frame=ee_frame)
+    with pytest.raises(ValueError, match=re.escape(message)):
+        make_arm_station(config)
+
+
+@pytest.mark.parametrize("mass, what", [("-2", "-2 kg is negative; a mass is 0 or more"),
+                                        ("heavy", "'heavy' is not a finite number")])
+def test_an_sdformat_link_s_mass_is_checked(tmp_path, mass, what):
+    upper = '<link name="upper"><pose>0 0 0.2 0 0 0</pose>'
+    model = tmp_path / "arm.sdf"
+    model.write_text(SDF_ARM.replace(upper, f"{upper}<inertial><mass>{mass}</mass></inertial>"))
+    config = ArmStationConfig(model_file=str(model), base_frame="base", ee_frame="tool")
+    line = SDF_ARM[:SDF_ARM.index(upper)].count("\n") + 1
+    with pytest.raises(ValueError, match=re.escape(
+            f"'{model}': line {line}, link 'upper' <inertial><mass>: {what}")):
+        make_arm_station(config)
+
+
 def test_an_obstacle_drawn_into_the_pedestal_is_refused_naming_its_seed():
     scenario = scenario_of(ARM7)
     # Obstacles drawn around the base, kept only 0.01 m from its centre.
@@ -361,3 +425,32 @@ def test_a_turned_base_is_measured_as_turned(tmp_path, box_yaw, base_yaw):
     with pytest.raises(ValueError, match=r"^inside is inside the robot's own geometry: link "
                        r"'base' <collision 'block'> \(a box of sides 0.2 x 0.2 x 0.2 m\)"):
         check_clear_of_base(config, [("inside", [0.13, 0.0, 0.0], [0.13, 0.0, 0.0])])
+
+
+def test_a_sphere_a_welded_link_and_an_sdformat_base_are_measured_too(tmp_path):
+    model = tmp_path / "base.urdf"
+    model.write_text(BOX_BASE.format(yaw=0.0).replace(
+        '<box size="0.2 0.2 0.2"/>', '<sphere radius="0.1"/>').replace("</robot>", """\
+  <link name="plate">
+    <collision name="slab"><geometry><box size="0.1 0.1 0.02"/></geometry></collision>
+  </link>
+  <joint name="weld" type="fixed"><parent link="base"/><child link="plate"/>
+    <origin xyz="0.5 0 0"/></joint>
+</robot>"""))
+    config = ArmStationConfig(model_file=str(model), base_frame="base", ee_frame="base")
+    # (0.08, 0.08) is 0.113 m from the sphere's centre; (0.3, 0) between sphere and plate.
+    check_clear_of_base(config, [("outside", [0.08, 0.08, 0.0], [0.08, 0.08, 0.0]),
+                                 ("between", [0.3, 0.0, 0.0], [0.3, 0.0, 0.0])])
+    with pytest.raises(ValueError, match=r"^near is inside the robot's own geometry: link "
+                       r"'base' <collision 'block'> \(a sphere of radius 0.1 m\)"):
+        check_clear_of_base(config, [("near", [0.07, 0.0, 0.0], [0.07, 0.0, 0.0])])
+    with pytest.raises(ValueError, match=r"^on is inside the robot's own geometry: link "
+                       r"'plate' <collision 'slab'> \(a box of sides 0.1 x 0.1 x 0.02 m\)"):
+        check_clear_of_base(config, [("on", [0.52, 0.0, 0.0], [0.52, 0.0, 0.0])])
+    sdf = tmp_path / "arm.sdf"
+    sdf.write_text(SDF_ARM)
+    config = ArmStationConfig(model_file=str(sdf), base_frame="base", ee_frame="tool")
+    check_clear_of_base(config, [("beside", [0.1, 0.0, 0.1], [0.1, 0.0, 0.1])])
+    with pytest.raises(ValueError, match=r"^above is inside the robot's own geometry: link "
+                       r"'base' <collision 'post'> \(a cylinder of radius 0.05 m, length 0.2 m\)"):
+        check_clear_of_base(config, [("above", [0.0, 0.0, 0.15], [0.0, 0.0, 0.15])])

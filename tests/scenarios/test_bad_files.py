@@ -10,7 +10,7 @@ import pytest
 from pydrake.common.yaml import yaml_dump, yaml_load
 
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
-from pbp_drake.scenarios.bounds import load_document
+from pbp_drake.scenarios.bounds import check_yaml_bounds, load_document
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 SHIPPED = ("hsr_reach.yaml", "toy_alt_vs_cont.yaml")
@@ -53,6 +53,14 @@ VARIANTS = {
                            ["duplicate", "basis_count", "line"]),
     "huge_basis_count": (SHIPPED, _replace("basis_count: 50", "basis_count: 100000000"),
                          ["basis_count", "10000"]),
+    "latin1": (SHIPPED, lambda text: text.replace("\n  method:", "\n  # café\n  method:", 1)
+               .encode("latin-1"), ["byte", "is not UTF-8", "expected UTF-8 text"]),
+    "control_character": (SHIPPED, _replace("\n  method:", "\n  # \a\n  method:"),
+                          ["YAML error", "control characters are not allowed"]),
+    "undefined_alias": (SHIPPED, _replace("control_period: 0.0", "control_period: *period #"),
+                        ["line", "found undefined alias"]),
+    "list_as_key": (SHIPPED, _replace("\n  method:", "\n  ? [a]\n  : 1\n  method:"),
+                    ["line", "found unhashable key"]),
 }
 CASES = [(name, file) for name, (files, _, _) in VARIANTS.items() for file in files]
 
@@ -193,6 +201,12 @@ def test_a_hundred_broken_files_exit_2_naming_the_field(tmp_path, run_refused):
         assert elapsed < 10.0, (index, elapsed)
 
 
+def test_a_missing_file_is_named(tmp_path, run_refused):
+    path = tmp_path / "missing.yaml"
+    code, err, _ = run_refused(path)
+    assert code == 2 and err == f"pbp-drake: {path}: no such scenario file\n", err
+
+
 def test_the_shipped_files_still_load():
     for file in SHIPPED:
         load_scenario_file(DIAGRAMS / file)
@@ -206,3 +220,9 @@ def test_duplicate_keys_are_per_mapping():
                        ("a: {x: 1,\n    x: 2}\n", 2)):
         with pytest.raises(ScenarioError, match=f"line {line}: duplicate key"):
             load_document(text)
+
+
+def test_a_scalar_anchor_and_a_merge_key_read_as_yaml_has_them():
+    text = "a: &x 1.5\nb: *x\nc: {<<: {d: 2, e: 3}, e: 4}\n"
+    check_yaml_bounds(text)  # one value repeated, far within the bound
+    assert load_document(text) == {"a": 1.5, "b": 1.5, "c": {"d": 2, "e": 4}}

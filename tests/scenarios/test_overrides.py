@@ -53,6 +53,12 @@ def test_the_settings_change_the_scenario_and_its_study(repo):
     assert loaded.resolved.scenario == scenario
 
 
+def test_the_scenario_text_changes_the_study_too(repo):
+    loaded = load_scenario_file(repo / TASK, ScenarioOverrides((), "{seed: 7, study: {trials: 3}}"))
+    assert loaded.scenario.seed == 7 and loaded.study.trials == 3
+    assert loaded.study.methods == ["pbp_alternated", "pbp_continuous", "teleop"]  # the file's
+
+
 @pytest.mark.parametrize("argv, message", [
     (["--set", "goal_estimator.methd=nearest"],
      "pbp-drake: diagrams/hsr_reach.yaml with --set goal_estimator.methd=nearest: "
@@ -61,6 +67,8 @@ def test_the_settings_change_the_scenario_and_its_study(repo):
      "with --set control_period=fast: scenario.control_period: got 'fast'; expected a number"),
     (["--scenario-text", "{seed: [1}"], "pbp-drake: --scenario-text: not YAML"),
     (["--scenario-text", "3"], "pbp-drake: --scenario-text: expected a mapping"),
+    (["--scenario-text", "{seed: 1, seed: 2}"],
+     "pbp-drake: --scenario-text: line 1: duplicate key 'seed'"),
     (["--seed", "4", "--set", "contrl_period=0.02"],
      "with --seed 4 --set contrl_period=0.02: scenario: unknown key 'contrl_period' "
      "(did you mean 'control_period'?)"),

@@ -1,6 +1,8 @@
-"""The schema nests Drake's config structs and round-trips through `yaml_dump_typed`."""
+"""The schema nests Drake's config structs and round-trips through `yaml_dump_typed`, and
+through pickle (how a study sends its scenario to its workers)."""
 
 import pathlib
+import pickle
 
 import pytest
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
@@ -19,6 +21,8 @@ def test_shipped_scenarios_round_trip(path):
     text = yaml_dump_typed(original)
     again = yaml_load_typed(schema=schema, data=text)
     assert yaml_dump_typed(again) == text
+    # Drake's config structs (the plant's, the simulator's, an arm's LCM bus) by their YAML.
+    assert yaml_dump_typed(pickle.loads(pickle.dumps(original))) == text
     assert type(again.scenario.operator) is type(original.scenario.operator)
     assert again.scenario.simulator.target_realtime_rate == (
         original.scenario.simulator.target_realtime_rate)

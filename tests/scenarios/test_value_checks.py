@@ -1,11 +1,19 @@
 """Values the random mutations (test_random_mutations.py) found getting past the checks
-into a division, a norm or a simulation: each now refused, naming its field."""
+into a division, a norm or a simulation: each now refused, naming its field; and the checks
+no other test reached, each with a value it refuses."""
 
+import dataclasses
+import math
 import pathlib
+import re
 
+import numpy as np
 import pytest
 
-from pbp_drake.scenarios import ScenarioError, load_scenario_file
+from pbp_drake.scenarios import (
+    MethodComparison, MultiGoalReach, ScenarioError, ScriptedCommands, check_method_comparison,
+    load_scenario_file, resolve, task_scene)
+from pbp_drake.scenarios.resolution import MAX_PRIMITIVE_BYTES, load_primitive
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 
@@ -130,3 +138,132 @@ def test_a_bad_reaching_participant_value_is_refused_naming_its_field(tmp_path, 
     path.write_text(text.replace(old, f"{old}    {line}\n", 1))
     with pytest.raises(ScenarioError, match=rf"scenario.operator.{message}"):
         load_scenario_file(path)
+
+
+@pytest.mark.parametrize("file, old, new, message", [
+    # The targets of given objects: one per switch, each an object's index, none twice in a
+    # row, and none without objects.
+    ("hsr_reach.yaml", "    object_count: [2, 4]\n",
+     "    objects: [[1.5, 0.3, 0.7], [1.5, -0.3, 0.7]]\n    targets: [0, 1]\n",
+     r"scenario.task: targets \[0, 1\] needs one object index per entry of switch_schedule "
+     r"\[0.0, 0.3, 0.6\]"),
+    ("hsr_reach.yaml", "    object_count: [2, 4]\n",
+     "    objects: [[1.5, 0.3, 0.7], [1.5, -0.3, 0.7]]\n    targets: [0, 1, 5]\n",
+     r"scenario.task: targets \[0, 1, 5\] name objects that do not exist \(2 objects\)"),
+    ("hsr_reach.yaml", "    object_count: [2, 4]\n",
+     "    objects: [[1.5, 0.3, 0.7], [1.5, -0.3, 0.7]]\n    targets: [0, 0, 1]\n",
+     r"scenario.task: targets \[0, 0, 1\]: each switch must go to a different object"),
+    ("hsr_reach.yaml", "    object_count: [2, 4]\n", "    targets: [0, 1, 0]\n",
+     r"scenario.task: targets are given without objects"),
+    # The studies' lists, and what they need of the scenario.
+    ("toy_alpha_study.yaml", "  alphas: [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]",
+     "  alphas: []", r"study.alphas is empty"),
+    ("toy_alpha_study.yaml", "  demonstration: !BentPath {start: [0.0, 0.0], goal: [1.0, 0.0], "
+     "bend: 0.3, duration: 1.0}\n", "  start: [0.0, 0.0]\n  goals: [[1.0, 0.0]]\n"
+     "  dmp_duration: 1.0\n", r"the alpha study needs scenario.demonstration"),
+    ("toy_alpha_study.yaml", "operator: !ObstacleRepulsion {distance_threshold: 0.2, speed: 2.0, "
+     "axis: [0.0, 1.0]}", "operator: !SinusoidalStep {axis: [0.0, 1.0], amplitude: 1.0, "
+     "start_time: 0.2, duration: 0.4, period: 1.6}",
+     r"study.operator_speeds needs an operator with a speed, not !SinusoidalStep"),
+    ("hsr_reach.yaml", "  methods: [pbp_alternated, pbp_continuous, teleop]", "  methods: []",
+     r"study.methods is empty"),
+    # What the robot tasks alone have, asked of a 2-D scene.
+    ("toy_alt_vs_cont.yaml", "  control_period: 0.01\n",
+     "  control_period: 0.01\n  goal_estimator: {group_mass: 0.5}\n",
+     r"scenario.goal_estimator.group_mass: goal groups steer the DMPs of the robot tasks .*"
+     r"this scenario has a point robot: set it to 0"),
+    ("toy_alt_vs_cont.yaml", "  control_period: 0.01\n",
+     "  control_period: 0.01\n  goal_estimator: {method: intent_filter}\n",
+     r"scenario.goal_estimator.method intent_filter reads the hand's pose .* use angle in the "
+     r"2-D scenes"),
+    ("toy_alt_vs_cont.yaml", "basis_count: 50}", "basis_count: 50, primitive: x.json}",
+     r"scenario.dmp.primitive gives a robot task's DMPs a taught shape; a 2-D scene learns "
+     r"its shape from scenario.demonstration"),
+    # Fixed alpha plays the demonstration to its one goal.
+    ("toy_alt_vs_cont.yaml", "  method: pbp_alternated", "  method: fixed_alpha",
+     r"scenario.method fixed_alpha plays the demonstration as P: give scenario.demonstration"),
+    ("toy_alpha_study.yaml", "  method: pbp_alternated",
+     "  method: fixed_alpha\n  goals: [[1.0, 0.0], [1.0, 1.0]]",
+     r"scenario.method fixed_alpha takes exactly one goal here"),
+    ("toy_alpha_study.yaml", "start: [0.0, 0.0], goal", "start: [0.0, 0.0, 0.0], goal",
+     r"scenario.demonstration.start \[0.0, 0.0, 0.0\] and goal \[1.0, 0.0\]: a bent path is "
+     r"2-D; expected two numbers each"),
+    ("toy_alt_vs_cont.yaml", "  goals: [[1.0, 0.0]]", "  goals: [[1.0, 0.0, 0.0]]",
+     r"scenario.goals have dimension 3, scenario.start has 2"),
+    # The 2-D scenes' operators.
+    ("toy_alpha_study.yaml", "distance_threshold: 0.2", "distance_threshold: 0.0",
+     r"scenario.operator.speed must be finite and distance_threshold positive"),
+    ("toy_alt_vs_cont.yaml", "period: 1.6}", "period: 0.0}",
+     r"scenario.operator.amplitude must be finite, duration and period positive"),
+    ("toy_alt_vs_cont.yaml", "  operator: !SinusoidalStep {axis: [0.0, 1.0], amplitude: 1.0, "
+     "start_time: 0.2,\n                             duration: 0.4, period: 1.6}",
+     "  operator: !ScriptedCommands {times: [0.0, 1.0], commands: [[0.0, 1.0]]}",
+     r"scenario.operator.commands must be one command of dimension 2 per time"),
+    # A hand that turns too slowly to reach the operator's rotation speed in the run.
+    ("hsr_reach.yaml", "    speed: 0.12\n",
+     "    speed: 0.12\n    max_hand_yaw_acceleration: 0.001\n",
+     r"scenario.robot.max_hand_yaw_acceleration 0.001 rad/s\^2 takes 800.0 s to reach the "
+     r"operator's rotation_speed 0.8 rad/s, longer than scenario.duration 60.0 s: raise it"),
+    # Infinite is no limit in the acceleration limits only, and only upwards.
+    ("hsr_reach.yaml", "motion: kinematic}",
+     "motion: kinematic, arm_acceleration_limits: [-.inf, 1.0, .inf, 2.0, .inf]}",
+     r"scenario.robot.station.arm_acceleration_limits\[0\]: -inf is infinite; expected a "
+     r"finite number"),
+])
+def test_a_value_the_rest_of_the_scenario_cannot_use_is_refused(tmp_path, file, old, new,
+                                                                 message):
+    text = (DIAGRAMS / file).read_text()
+    assert old in text, old
+    path = tmp_path / file
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(path)
+
+
+def test_infinite_acceleration_limits_are_no_limits(tmp_path):
+    text = (DIAGRAMS / "hsr_reach.yaml").read_text()
+    path = tmp_path / "hsr_reach.yaml"
+    path.write_text(text.replace("motion: kinematic}", "motion: kinematic, "
+                                 "arm_acceleration_limits: [.inf, 1.0, .inf, 2.0, .inf]}", 1))
+    station = load_scenario_file(path).scenario.robot.station
+    assert station.arm_acceleration_limits == [math.inf, 1.0, math.inf, 2.0, math.inf]
+
+
+def test_a_gamepad_is_refused_where_the_objects_stand_at_heights_of_their_own(tmp_path):
+    text = (DIAGRAMS / "arm_reach.yaml").read_text()
+    path = tmp_path / "arm_reach.yaml"
+    path.write_text(re.sub(r"  operator: !VirtualParticipant\n(    .*\n)+",
+                           "  operator: !Gamepad {}\n", text, count=1))
+    with pytest.raises(ScenarioError, match=r"scenario.operator !Gamepad has no up and down: "
+                       r"a task whose objects stand at heights of their own \(scenario.task."
+                       r"z_range\) takes !Keyboard or !VirtualParticipant"):
+        load_scenario_file(path)
+
+
+def test_a_scenario_made_in_python_is_held_to_the_checks_a_file_walk_cannot_make():
+    toy = load_scenario_file(DIAGRAMS / "toy_alt_vs_cont.yaml").scenario
+    reach = load_scenario_file(DIAGRAMS / "hsr_reach.yaml").scenario
+    # An array is no list: the walk of the numbers leaves it to the operator's own check.
+    commands = ScriptedCommands(times=[0.0, 1.0], commands=np.array([[0.0, np.nan],
+                                                                     [0.0, 0.0]]))
+    with pytest.raises(ScenarioError, match=r"^scenario.operator.commands contain NaN or "
+                                            r"infinite values$"):
+        resolve(dataclasses.replace(toy, operator=commands))
+    participant = dataclasses.replace(reach.operator, plan_directions=2.5)
+    with pytest.raises(ScenarioError, match=r"^scenario.operator.plan_directions 2.5 is no "
+                                            r"count; expected a whole number, 1 to 360$"):
+        resolve(dataclasses.replace(reach, operator=participant))
+    with pytest.raises(ValueError, match=r"^x_range and y_range must be \[low, high\]$"):
+        task_scene(MultiGoalReach(x_range=[1.0]), 0)
+    with pytest.raises(ScenarioError, match=r"^study !MethodComparison runs the tasks: use "
+                                            r"robot: !Hsr or !Arm$"):
+        check_method_comparison(MethodComparison(), toy)
+
+
+def test_a_primitive_file_larger_than_any_primitive_is_refused(tmp_path):
+    path = tmp_path / "huge.json"
+    with open(path, "wb") as file:
+        file.truncate(MAX_PRIMITIVE_BYTES + 1)  # sparse: no disk is written
+    with pytest.raises(ScenarioError, match=r"^scenario.dmp.primitive is over 64 MiB: not a "
+                                            r"primitive$"):
+        load_primitive(path, "scenario.dmp.primitive")

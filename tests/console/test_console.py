@@ -52,6 +52,8 @@ NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "T
 def test_a_method_has_one_name_in_the_title_the_start_button_and_the_results(method):
     assert method_name(method) == METHOD_NAMES[method] == NAMES[method]
     assert start_label(method, 1, 3) == f"Start method 1 of 3: {NAMES[method]}"
+    assert start_label(method, 2, 3, practice=True) == (
+        f"Start practice 2 of 3: {NAMES[method]} (not recorded)")
 
 
 def test_the_page_shows_the_buttons_and_the_lines_in_order(meshcat):
@@ -82,6 +84,11 @@ def test_each_click_is_one_choice(meshcat):
     click(meshcat, "Stop")
     assert console.wait_for_choice(poll_period=0.01) == "stop"
     assert "Restart" not in meshcat.GetButtonNames()
+
+
+def test_a_choice_without_a_button_is_refused(meshcat):
+    with pytest.raises(ValueError, match=r"unknown choices \['pause'\]; choose from"):
+        Console(meshcat, choices=("stop", "pause"))
 
 
 def test_enter_in_the_terminal_is_stop(meshcat, tmp_path):

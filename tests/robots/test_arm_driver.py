@@ -335,3 +335,12 @@ def test_the_panda_task_runs_over_lcm_with_the_driver_simulator(capsys):
                     "--driver-sim", "--operator", "virtual", "--headless", capsys=capsys)
     assert code == 0, out.err
     assert "panda_reach [pbp_alternated, seed 0]: success" in out.out
+
+
+@pytest.mark.slow
+def test_driver_sim_runs_the_panda_driver_on_the_bus(capsys):
+    code, out = run("driver-sim", str(REPO / "diagrams" / "panda_reach.yaml"), "--set",
+                    "robot.hardware.lcm_bus.lcm_url=memq://", "--duration", "0.2", capsys=capsys)
+    assert code == 0, out.err
+    assert out.out == ("driver-sim: the panda driver reads PANDA_COMMAND and sends "
+                       "PANDA_STATUS every 1 ms on memq://; Ctrl-C ends it\n")

@@ -1,8 +1,7 @@
 """`pbp-drake run`'s numeric flags are checked when the line is parsed (exit 2, the flag
 named), a flag the scenario cannot take and a port in use are refused in one line before
-anything is built, and a keyboard or
-gamepad run that no browser joins stops, having run and recorded nothing, instead of
-running unattended to its time limit."""
+anything is built, and a keyboard or gamepad run that no browser joins stops, having run
+and recorded nothing, instead of running unattended to its time limit."""
 
 import argparse
 import socket

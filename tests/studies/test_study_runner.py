@@ -418,6 +418,9 @@ def test_progress_bar_on_a_terminal_and_in_a_log():
     lines = log.getvalue().splitlines()
     assert len(lines) == 2 and "2/4 trials" in lines[0] and "4/4 trials" in lines[1]
     assert "\r" not in log.getvalue()
+    # Minutes and hours, as a long study takes them: 75 s a trial, 99 trials to go.
+    assert ProgressBar(io.StringIO()).line(1, 100, 75.0).endswith(
+        "1m15s elapsed, ETA 2h03m")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -482,6 +485,25 @@ def test_ray_backend_without_ray_says_how_to_install_it(task_file, tmp_path, cap
 def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
     assert main(study_args(task_file, tmp_path, 1) + ["--ray-address", "auto"]) == 2
     assert "--ray-address needs --backend ray" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("study, section, argv, message", [
+    ("toy_alt_vs_cont.yaml", "", [], "{file}: has no `study:` section to run"),
+    ("hsr_reach.yaml", "study: !AltVsCont {}\n", [],
+     "{file}: HSR tasks take study: !MethodComparison"),
+    ("hsr_reach.yaml", None, ["--methods", "teleop,teleop"],
+     "--methods teleop,teleop names a method twice"),
+])
+def test_a_study_the_file_cannot_run_is_refused(repo, tmp_path, capsys, study, section, argv,
+                                                message):
+    text = (repo / "diagrams" / study).read_text()
+    if section is not None:  # the file's study section, replaced
+        text = text.split("\nstudy:")[0] + "\n" + section
+    scenario = tmp_path / study
+    scenario.write_text(text)
+    assert main(["study", str(scenario), "--output", str(tmp_path / "out"), *argv]) == 2
+    assert capsys.readouterr().err == f"pbp-drake: {message.format(file=scenario)}\n"
+    assert not (tmp_path / "out").exists()
 
 
 def test_the_local_backend_does_not_import_ray(scenario, tmp_path):

@@ -126,6 +126,11 @@ def test_nothing_to_report_exits_2(tmp_path, capsys):
     assert "no trial files" in capsys.readouterr().err
 
 
+def test_a_missing_folder_is_named(tmp_path, capsys):
+    assert main(["report", str(tmp_path / "none")]) == 2
+    assert capsys.readouterr().err == f"pbp-drake: {tmp_path / 'none'}: no such folder\n"
+
+
 def test_a_2d_study_refuses_a_method_comparison_folder(tmp_path, repo, capsys):
     folder = _study(tmp_path)
     before = (folder / "study.json").read_text()

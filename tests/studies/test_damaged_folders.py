@@ -19,12 +19,12 @@ def _csv(ticks=3):
     return ",".join(columns) + "\n" + "".join(row + "\n" for _ in range(ticks))
 
 
-def _study(folder, trials=2):
+def _study(folder, trials=2, methods=METHODS):
     """A method comparison's folder written without simulating: every trial succeeded."""
     study = {"study": "method_comparison", "format": 1, "scenario": "fake",
-             "scenario_hash": "abc", "methods": list(METHODS), "trials": trials, "seed": 0}
+             "scenario_hash": "abc", "methods": list(methods), "trials": trials, "seed": 0}
     (folder / "study.json").write_text(json.dumps(study))
-    for method in METHODS:
+    for method in methods:
         for trial in range(trials):
             record = trial_record("fake", "abc", method, trial, trial)
             record.update(success=True, task_time=10.0 + trial, intervention_ratio=0.5,
@@ -41,6 +41,17 @@ def test_a_clean_folder_reports_without_complaint(tmp_path, capsys):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["damaged"] == []
     assert summary["methods"]["teleop"]["trials"] == 2
+
+
+@pytest.mark.slow
+def test_a_sweep_of_fixed_alphas_reports_its_ideal_alpha(tmp_path, capsys):
+    folder = _study(tmp_path, methods=("fixed_alpha=0.2", "fixed_alpha=0.6", "teleop"))
+    assert main(["report", str(folder)]) == 0
+    arbitration = json.loads((folder / "summary.json").read_text())["arbitration"]
+    assert arbitration["alphas"] == [0.2, 0.6]
+    assert arbitration["ideal_alpha"] == 0.6  # every trial succeeded: the highest
+    assert (f"Ideal fixed alpha: {arbitration['ideal_alpha']} ({arbitration['criterion']})."
+            in (folder / "results.md").read_text())
 
 
 @pytest.mark.slow

@@ -102,6 +102,48 @@ def test_a_malformed_csv_is_named(tmp_path, text, problem):
     assert [(d.key, problem in d.problem) for d in damaged] == [(("teleop", 0), True)]
 
 
+@pytest.mark.parametrize("study, problem", [
+    ([], "holds a list, not a study"),
+    ({"methods": []}, "field 'methods' is not a list of method names"),
+    ({"trials": "2"}, "field 'trials' is str, not int"),
+    ({"trials": 0}, "field 'trials' is 0, not a positive number"),
+    ({"split": 3}, "field 'split' is int, not str"),
+    ({"scenario_hash": 5}, "field 'scenario_hash' is int, not str"),
+])
+def test_a_bad_study_json_is_named_and_the_trials_on_disk_read(tmp_path, study, problem):
+    folder = _study(tmp_path, trials=1)
+    held = json.loads((folder / "study.json").read_text())
+    (folder / "study.json").write_text(json.dumps({**held, **study} if study else study))
+    _, records, damaged = read_study(folder)
+    assert [d.problem for d in damaged] == [f"{problem}; reporting the trials on disk"]
+    assert None not in records.values()
+
+
+@pytest.mark.parametrize("method, change, problem", [
+    ("teleop", lambda record: [record], "holds a list, not a trial record"),
+    ("teleop", lambda record: {**record, "format": 0}, "a trial of format 0, not 1"),
+    ("pbp_alternated", lambda record: {**record, "method": "teleop"},
+     "holds the trial of 'teleop', seed 0"),
+])
+def test_a_trial_record_of_another_shape_is_named(tmp_path, method, change, problem):
+    folder = _study(tmp_path, trials=1)
+    path = trial_paths(folder, method, 0)[0]
+    path.write_text(json.dumps(change(json.loads(path.read_text()))))
+    _, records, damaged = read_study(folder)
+    assert [(d.path, d.problem) for d in damaged] == [(str(path), problem)]
+    assert records[(method, 0)] is None
+
+
+def test_a_trial_without_its_csv_is_named(tmp_path):
+    folder = _study(tmp_path, trials=1)
+    csv = trial_paths(folder, "teleop", 0)[1]
+    csv.unlink()
+    _, records, damaged = read_study(folder)
+    assert [(d.path, d.problem) for d in damaged] == [
+        (str(csv), "missing: the trial's time series CSV is not on disk")]
+    assert records[("teleop", 0)] is None
+
+
 @pytest.mark.slow
 def test_a_folder_with_errored_trials_reports_them_and_exits_1(tmp_path, capsys):
     folder = _study(tmp_path, trials=3)

@@ -258,6 +258,16 @@ def test_report_writes_the_tables_with_intervals_paired_with_pbp_alt_and_one_fig
 
 
 @pytest.mark.slow
+def test_report_refuses_to_pair_with_a_method_the_matrix_did_not_run(folders, capsys):
+    matrix, _ = folders
+    results = (matrix / "results.md").read_bytes()
+    assert main(["report", str(matrix), "--paired-with", "pbp_continuous"]) == 2
+    assert capsys.readouterr().err == (
+        "pbp-drake: --paired-with: the matrix ran pbp_alternated, teleop, not pbp_continuous\n")
+    assert (matrix / "results.md").read_bytes() == results
+
+
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_kill_9_mid_matrix_then_the_same_command_resumes_to_the_same_summary(
         folders, task_file, tmp_path):

@@ -482,6 +482,21 @@ def test_ray_backend_without_ray_says_how_to_install_it(task_file, tmp_path, cap
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("options, message", [
+    ({"trials": 0}, "trials must be at least 1, got 0"),
+    ({"backend": "dask"}, "backend must be one of local, ray, got 'dask'"),
+    ({"ray_address": "auto"}, "ray_address needs backend='ray'"),
+    ({"jobs": 2, "run": lambda resolved: None}, "cannot be sent to worker processes"),
+])
+def test_run_method_comparison_refuses_bad_options_before_any_folder(scenario, tmp_path,
+                                                                      options, message):
+    arguments = {"trials": 1, **options}
+    trials = arguments.pop("trials")
+    with pytest.raises(ScenarioError, match=message):
+        run_method_comparison(scenario, METHODS, trials, 0, tmp_path / "out", **arguments)
+    assert not (tmp_path / "out").exists()
+
+
 def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
     assert main(study_args(task_file, tmp_path, 1) + ["--ray-address", "auto"]) == 2
     assert "--ray-address needs --backend ray" in capsys.readouterr().err

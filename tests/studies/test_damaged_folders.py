@@ -7,7 +7,8 @@ import pytest
 
 from pbp_drake.cli import main
 from pbp_drake.studies.trial_files import (
-    read_study, time_series_columns, trial_paths, trial_record, write_trial_files)
+    DamagedFile, load_task_result, read_study, time_series_columns, trial_paths, trial_record,
+    write_trial_files)
 
 METHODS = ("teleop", "pbp_alternated")
 
@@ -132,6 +133,21 @@ def test_a_trial_record_of_another_shape_is_named(tmp_path, method, change, prob
     _, records, damaged = read_study(folder)
     assert [(d.path, d.problem) for d in damaged] == [(str(path), problem)]
     assert records[(method, 0)] is None
+
+
+@pytest.mark.parametrize("change, error, problem", [
+    (lambda text: text[:80], DamagedFile, "truncated or invalid JSON"),
+    (lambda text: json.dumps({**json.loads(text), "task_time": "ten"}), DamagedFile,
+     "field 'task_time' is str"),
+    (lambda text: json.dumps({**json.loads(text), "error": "RuntimeError: it broke"}),
+     ValueError, "the trial failed: RuntimeError: it broke"),
+])
+def test_load_task_result_names_a_trial_it_cannot_give(tmp_path, change, error, problem):
+    path = trial_paths(_study(tmp_path, trials=1), "teleop", 0)[0]
+    path.write_text(change(path.read_text()))
+    with pytest.raises(error, match=problem) as raised:
+        load_task_result(tmp_path, "teleop", 0)
+    assert str(raised.value).startswith(f"{path}: ")
 
 
 def test_a_trial_without_its_csv_is_named(tmp_path):

@@ -57,6 +57,19 @@ def test_a_2d_study_gets_its_summary_as_a_table(tmp_path, repo):
     assert text.startswith("`pbp-drake study ") and "toy_alt_vs_cont.yaml`" in text
     assert "| PBP-Alt |" in text and "| PBP-Cont |" in text
     assert f"Figure: `{output / 'fig4_alt_vs_cont.png'}`" in text
+    # A damaged study.json: the table still, the command without the file it no longer names.
+    (output / "study.json").write_text("{")
+    assert main(["report", str(output), "--markdown", str(markdown)]) == 0
+    assert markdown.read_text().startswith("`pbp-drake study <the scenario file of ")
+    assert markdown.read_text().endswith(text.split("\n", 1)[1])
+
+
+def test_a_2d_study_without_its_summary_is_named(tmp_path, capsys):
+    (tmp_path / "study.json").write_text('{"study": "alt_vs_cont"}')
+    assert main(["report", str(tmp_path), "--markdown", str(tmp_path / "study.md")]) == 2
+    assert capsys.readouterr().err.startswith(
+        f"pbp-drake: {tmp_path / 'summary.json'}: cannot be read (")
+    assert not (tmp_path / "study.md").exists()
 
 
 def test_a_folder_is_refused_as_the_markdown_file(tmp_path, capsys):

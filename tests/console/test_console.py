@@ -3,6 +3,7 @@ the controls a person uses, against a real Meshcat (clicks and slider moves inje
 page sends them)."""
 
 import io
+import os
 
 import msgpack
 import numpy as np
@@ -97,6 +98,10 @@ def test_enter_in_the_terminal_is_stop(meshcat, tmp_path):
         stdin.write("\n")
         stdin.seek(0)
         assert console.wait_for_choice(poll_period=0.01, stdin=stdin) == "stop"
+    # A terminal where nothing is typed: the wait ends at its timeout, with no choice.
+    read, write = os.pipe()
+    with open(read) as stdin, open(write, "w"):
+        assert console.wait_for_choice(poll_period=0.01, stdin=stdin, timeout=0.05) is None
 
 
 def test_the_sliders_read_what_the_person_set(meshcat):

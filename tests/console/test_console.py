@@ -42,6 +42,23 @@ def test_status_words():
     assert progress_text(12.34, 60.0, 1.0) == "t = 12.3 s of 60 s, 1.00x real time"
 
 
+class Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_a_terminal_s_progress_line_is_rewritten_in_place_then_cleared():
+    terminal = Terminal()
+    progress = Progress(60.0, terminal)
+    progress.show(12.34, 1.0, force=True)
+    progress.show(2.0, 1.0, force=True)  # shorter: padded over the longer line
+    progress.finish()
+    first, second = progress_text(12.34, 60.0, 1.0), progress_text(2.0, 60.0, 1.0)
+    assert len(second) < len(first)
+    assert terminal.getvalue() == ("\r" + first + "\r" + second.ljust(len(first))
+                                   + "\r" + " " * len(second) + "\r")
+
+
 # The names the results tables in docs/results/generated/ print.
 NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "Teleop",
          "pbp_no_user": "PBP-NoUser", "fixed_alpha": "Fixed alpha",

@@ -336,6 +336,16 @@ def test_a_folder_of_another_scenario_is_refused(scenario, tmp_path):
         run_method_comparison(other, METHODS, 1, 0, tmp_path, run=fake_run)
 
 
+def test_a_damaged_study_json_is_named_and_written_again(scenario, tmp_path, capsys):
+    first = run_method_comparison(scenario, METHODS, 1, 0, tmp_path, run=fake_run)
+    study = (tmp_path / "study.json").read_bytes()
+    (tmp_path / "study.json").write_text('{"study": ')
+    assert run_method_comparison(scenario, METHODS, 1, 0, tmp_path, run=fake_run) == first
+    assert (f"pbp-drake: damaged: {tmp_path / 'study.json'}: truncated or invalid JSON"
+            in capsys.readouterr().err)
+    assert (tmp_path / "study.json").read_bytes() == study
+
+
 def test_write_trial_leaves_no_temporary_files(tmp_path):
     record = {"method": "teleop", "seed": 1, "format": 1, "error": "X: y"}
     write_trial(tmp_path, record)

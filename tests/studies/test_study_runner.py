@@ -336,6 +336,16 @@ def test_a_folder_of_another_scenario_is_refused(scenario, tmp_path):
         run_method_comparison(other, METHODS, 1, 0, tmp_path, run=fake_run)
 
 
+def test_without_output_the_study_goes_to_its_default_folder(repo, tmp_path, monkeypatch,
+                                                            capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "outputs").mkdir()
+    (tmp_path / "outputs" / "hsr_reach-teleop").write_text("notes")  # in the way: refused
+    assert main(["study", str(repo / "diagrams" / "hsr_reach.yaml"), "--methods", "teleop"]
+                ) == 2
+    assert "--output outputs/hsr_reach-teleop: is a file" in capsys.readouterr().err
+
+
 def test_a_damaged_study_json_is_named_and_written_again(scenario, tmp_path, capsys):
     first = run_method_comparison(scenario, METHODS, 1, 0, tmp_path, run=fake_run)
     study = (tmp_path / "study.json").read_bytes()

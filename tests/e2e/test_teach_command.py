@@ -2,10 +2,12 @@
 it and run headless; taught again from the drive's CSV; bad primitives and recordings
 refused in one line naming the file (exit 2)."""
 
+import csv
 import json
 import pathlib
 import shutil
 
+import numpy as np
 import pytest
 
 from pbp_drake.cli import main
@@ -54,6 +56,17 @@ def test_the_obstacle_task_teaches_a_primitive_it_then_runs(tmp_path, capsys):
                     f"dmp.primitive={tmp_path / 'P.json'}", capsys=capsys)
     assert code == 0, out.err
     assert "hsr_obstacles [pbp_alternated, seed 0]: success" in out.out
+
+
+def test_the_drive_takes_the_command_line_s_seed_and_settings(tmp_path, capsys):
+    code, out = run("teach", REACH, "--output", tmp_path / "P.json", "--seed", "3", "--set",
+                    "duration=1", "--scenario-text", "{control_period: 0.03}", capsys=capsys)
+    assert code == 0, out.err
+    assert "hsr_reach [teleop, seed 3]:" in out.out
+    with open(tmp_path / "P.csv") as rows:
+        times = [float(row["time"]) for row in csv.DictReader(rows)]
+    assert times[-1] == pytest.approx(1.0, abs=0.03)
+    assert np.diff(times) == pytest.approx(0.03)
 
 
 @pytest.mark.slow

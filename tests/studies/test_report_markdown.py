@@ -85,3 +85,16 @@ def test_without_the_split_seeds_the_command_names_the_first_seed():
     assert study_command({"split_seeds": {"tuning": 0, "evaluation": 10005}}, summary) == (
         "pbp-drake study <the scenario file of hsr_reach> --methods teleop --trials 3 "
         "--split evaluation")
+
+
+@pytest.mark.parametrize("overrides, words", [
+    ({"set": ["duration=5"], "scenario_text": None}, " --set duration=5"),
+    ({"set": [5]}, ""),  # a study.json edited by hand: the command without them
+    ({"set": ["no equals sign"]}, ""),
+])
+def test_the_command_names_the_recorded_overrides_it_can_read(overrides, words):
+    summary = {"scenario": "hsr_reach", "seed": 10005, "trials": 3, "methods": {"teleop": {}}}
+    study = {"scenario_file": "diagrams/hsr_reach.yaml", "overrides": overrides}
+    assert study_command(study, summary) == (
+        "pbp-drake study diagrams/hsr_reach.yaml --methods teleop --trials 3 --seed 10005"
+        + words)

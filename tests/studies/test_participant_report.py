@@ -149,6 +149,20 @@ def test_a_damaged_trial_is_skipped_and_counted(study, tmp_path, capsys):
             in (damaged / "results.md").read_text())
 
 
+def test_a_trial_of_another_scenario_in_a_participant_folder_is_refused(study, tmp_path,
+                                                                          capsys):
+    mixed = tmp_path / "mixed"
+    for participant in SESSIONS:
+        shutil.copytree(study / participant, mixed / participant)
+    (trial,) = (mixed / "P03" / "trials" / "teleop").glob("seed_*.json")
+    trial.write_text(json.dumps({**json.loads(trial.read_text()), "scenario_hash": "0" * 16}))
+    assert main(["report", str(mixed)]) == 2
+    err = capsys.readouterr().err
+    assert f"{trial} is a trial of another scenario" in err
+    assert f"participant folder {mixed / 'P03'} mixes scenarios; move it out of {mixed}" in err
+    assert not (mixed / "results.md").exists()
+
+
 def test_an_answer_outside_0_to_5_is_refused(study, tmp_path, capsys):
     edited = tmp_path / "edited"
     shutil.copytree(study / "P02", edited / "P02")

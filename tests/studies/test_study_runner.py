@@ -6,6 +6,7 @@ import dataclasses
 import io
 import json
 import importlib.util
+import logging
 import math
 import os
 import shutil
@@ -354,6 +355,20 @@ def test_a_damaged_study_json_is_named_and_written_again(scenario, tmp_path, cap
     assert (f"pbp-drake: damaged: {tmp_path / 'study.json'}: truncated or invalid JSON"
             in capsys.readouterr().err)
     assert (tmp_path / "study.json").read_bytes() == study
+
+
+def warning_run(resolved):
+    logging.getLogger("drake").warning("differential IK is stuck")  # as Drake logs it
+    return fake_run(resolved)
+
+
+def test_drake_s_warnings_are_counted_in_the_record_not_printed(scenario, tmp_path, capsys):
+    handlers = list(logging.getLogger("drake").handlers)
+    run_method_comparison(scenario, ["teleop"], 1, 0, tmp_path, run=warning_run)
+    record = json.loads(trial_paths(tmp_path, "teleop", 0)[0].read_text())
+    assert record["drake_warnings"] == 1
+    assert "differential IK" not in capsys.readouterr().err
+    assert logging.getLogger("drake").handlers == handlers  # given back after the trial
 
 
 def test_write_trial_leaves_no_temporary_files(tmp_path):

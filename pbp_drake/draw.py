@@ -65,8 +65,6 @@ def _sources_beside_their_reader(text):
         readers.setdefault(source, set()).add(reader)
     pairs = sorted((node, *readers[node]) for node in inputless
                    if len(readers.get(node, ())) == 1)
-    if not pairs:
-        return text
     ranks = "".join(f"{{rank=same; {source}; {reader}}}\n" for source, reader in pairs)
     return text.replace("subgraph cluster0subsystems {\n", "subgraph cluster0subsystems {\n"
                         + ranks, 1)

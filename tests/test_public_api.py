@@ -4,6 +4,8 @@ the docs' examples import from `pbp_drake` alone, never from its insides."""
 import json
 import pathlib
 import re
+import subprocess
+import sys
 
 import pytest
 
@@ -38,6 +40,19 @@ def test_every_public_name_has_a_topic():
     grouped = [name for group in pbp_drake.API_GROUPS.values() for name in group]
     assert len(grouped) == len(set(grouped)), "a name stands in two topics"
     assert set(pbp_drake.__all__) == {"__version__", *grouped}
+
+
+def test_a_public_submodule_imports_from_a_fresh_interpreter():
+    # Here other tests have imported pbp_drake.core.quaternion; there nothing has.
+    code = ("import sys, pbp_drake; assert 'pbp_drake.core.quaternion' not in sys.modules; "
+            "print(pbp_drake.quaternion.__name__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out == "pbp_drake.core.quaternion\n"
+
+
+def test_dir_lists_every_public_name():
+    assert set(pbp_drake.__all__) <= set(dir(pbp_drake))
 
 
 def test_an_unknown_name_says_so():

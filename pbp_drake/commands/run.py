@@ -107,10 +107,7 @@ def scenario_for_run(args):
     chosen = scenes[names.index(args.scene)]
     scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{args.scene}",
                                    obstacles=list(chosen.obstacles))
-    try:
-        return resolve(scenario)
-    except ScenarioError as error:
-        raise ScenarioError(f"{error} (after --scene)") from None
+    return resolve(scenario)
 
 
 def _standing_where_the_arm_stands(scenario):

@@ -59,8 +59,6 @@ def plain(value):
         return {"!type": type(value).__name__, **yaml_load(data=yaml_dump_typed(value))}
     if isinstance(value, (list, tuple)):
         return [plain(v) for v in value]
-    if isinstance(value, dict):
-        return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, np.ndarray):
         return plain(value.tolist())
     if isinstance(value, np.generic):

@@ -3,6 +3,7 @@ the controls a person uses, against a real Meshcat (clicks and slider moves inje
 page sends them)."""
 
 import io
+import os
 
 import msgpack
 import numpy as np
@@ -41,6 +42,23 @@ def test_status_words():
     assert progress_text(12.34, 60.0, 1.0) == "t = 12.3 s of 60 s, 1.00x real time"
 
 
+class Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_a_terminal_s_progress_line_is_rewritten_in_place_then_cleared():
+    terminal = Terminal()
+    progress = Progress(60.0, terminal)
+    progress.show(12.34, 1.0, force=True)
+    progress.show(2.0, 1.0, force=True)  # shorter: padded over the longer line
+    progress.finish()
+    first, second = progress_text(12.34, 60.0, 1.0), progress_text(2.0, 60.0, 1.0)
+    assert len(second) < len(first)
+    assert terminal.getvalue() == ("\r" + first + "\r" + second.ljust(len(first))
+                                   + "\r" + " " * len(second) + "\r")
+
+
 # The names the results tables in docs/results/generated/ print.
 NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "Teleop",
          "pbp_no_user": "PBP-NoUser", "fixed_alpha": "Fixed alpha",
@@ -52,6 +70,8 @@ NAMES = {"pbp_alternated": "PBP-Alt", "pbp_continuous": "PBP-Cont", "teleop": "T
 def test_a_method_has_one_name_in_the_title_the_start_button_and_the_results(method):
     assert method_name(method) == METHOD_NAMES[method] == NAMES[method]
     assert start_label(method, 1, 3) == f"Start method 1 of 3: {NAMES[method]}"
+    assert start_label(method, 2, 3, practice=True) == (
+        f"Start practice 2 of 3: {NAMES[method]} (not recorded)")
 
 
 def test_the_page_shows_the_buttons_and_the_lines_in_order(meshcat):
@@ -84,12 +104,21 @@ def test_each_click_is_one_choice(meshcat):
     assert "Restart" not in meshcat.GetButtonNames()
 
 
+def test_a_choice_without_a_button_is_refused(meshcat):
+    with pytest.raises(ValueError, match=r"unknown choices \['pause'\]; choose from"):
+        Console(meshcat, choices=("stop", "pause"))
+
+
 def test_enter_in_the_terminal_is_stop(meshcat, tmp_path):
     console = Console(meshcat)
     with open(tmp_path / "typed", "w+") as stdin:
         stdin.write("\n")
         stdin.seek(0)
         assert console.wait_for_choice(poll_period=0.01, stdin=stdin) == "stop"
+    # A terminal where nothing is typed: the wait ends at its timeout, with no choice.
+    read, write = os.pipe()
+    with open(read) as stdin, open(write, "w"):
+        assert console.wait_for_choice(poll_period=0.01, stdin=stdin, timeout=0.05) is None
 
 
 def test_the_sliders_read_what_the_person_set(meshcat):

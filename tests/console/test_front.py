@@ -83,6 +83,14 @@ def test_http_needs_the_token_then_the_cookie(front):
     assert _get(base + "favicon.ico", cookie="pbp_drake_token=" + "x" * 32)[0] == 403
 
 
+def test_a_file_the_page_did_not_preload_comes_from_meshcat_or_is_not_found(front):
+    cookie = f"pbp_drake_token={front.token}"
+    status, _, body = _get(f"http://localhost:{front.port}/favicon.ico", cookie)
+    assert status == 200 and body.startswith(b"\x00\x00\x01\x00")  # Meshcat's icon
+    status, _, body = _get(f"http://localhost:{front.port}/no/such/file", cookie)
+    assert (status, body) == (404, b"Not found\n")
+
+
 @pytest.mark.slow
 def test_refused_websockets_never_reach_meshcat(meshcat, front):
     meshcat.AddButton("Left")

@@ -79,6 +79,12 @@ WRONG = {
         "index": 0, "button_values": [-0.5], "axes": []}}, "out of range"),
     "a gamepad index of 64": ({"type": "gamepad", "name": "", "gamepad": {
         "index": MAX_ITEMS, "button_values": [], "axes": []}}, "index is out of range"),
+    "a gamepad state of a list": ({"type": "gamepad", "name": "", "gamepad": [0]},
+                                  "state is not a map"),
+    "a gamepad without axes": ({"type": "gamepad", "name": "", "gamepad": {
+        "index": 0, "button_values": []}}, "has the keys axes, button_values, index"),
+    "a gamepad's axes as a map": ({"type": "gamepad", "name": "", "gamepad": {
+        "index": 0, "button_values": [], "axes": {}}}, "axes is not a list"),
     "15 numbers of a pose": ({"type": "camera_pose", "camera_pose": [0.0] * 15,
                               "is_perspective": False}, "16 numbers"),
     "a pose's flag of 1": ({"type": "camera_pose", "camera_pose": [0.0] * 16,

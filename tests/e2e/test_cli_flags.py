@@ -1,8 +1,9 @@
 """`pbp-drake run`'s numeric flags are checked when the line is parsed (exit 2, the flag
-named), a port in use is refused in one line before anything is built, and a keyboard or
-gamepad run that no browser joins stops, having run and recorded nothing, instead of
-running unattended to its time limit."""
+named), a flag the scenario cannot take and a port in use are refused in one line before
+anything is built, and a keyboard or gamepad run that no browser joins stops, having run
+and recorded nothing, instead of running unattended to its time limit."""
 
+import argparse
 import socket
 import time
 
@@ -10,6 +11,7 @@ import pytest
 from browser_page import free_port
 
 from pbp_drake.cli import main
+from pbp_drake.commands.scenario_flags import scenario_overrides
 
 QUICK = "diagrams/toy_alt_vs_cont.yaml"
 TASK = "diagrams/hsr_reach.yaml"
@@ -116,6 +118,39 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     assert main(["run", str(repo / QUICK), "--no-meshcat", *argv]) == 2
     err = capsys.readouterr().err
     assert f"{named}: user-study sessions run the HSR tasks" in err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["run", TASK, "--no-meshcat", "--method", "teleop", "--alpha", "0.5"],
+     "--alpha sets the weight of fixed_alpha; the method is teleop"),
+    (["run", QUICK, "--no-meshcat", "--operator", "none"],
+     "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
+    (["run", "diagrams/arm_reach.yaml", "--headless", "--camera", "robot"],
+     "--camera robot looks from the HSR's head; this scenario has no HSR"),
+    (["run", TASK, "--no-meshcat", "--record", "{tmp}/run.html"],
+     "--record and --camera robot need the page: drop --no-meshcat"),
+    (["run", QUICK, "--no-meshcat", "--log", "{tmp}/run.csv"],
+     "--log streams an HSR task's per-tick rows; this scenario uses the 2-D toy robot"),
+    (["driver-sim", TASK, "--duration", "0"], "--duration must be positive, got 0"),
+    (["driver-sim", TASK], "the scenario's robot needs hardware: !Arm's {driver: panda}"),
+])
+def test_a_flag_the_scenario_cannot_take_is_refused_in_one_line(repo, tmp_path, capsys, argv,
+                                                                 message):
+    argv = [str(repo / arg) if arg.endswith(".yaml") else arg.format(tmp=tmp_path)
+            for arg in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pbp-drake: ") and message in err
+    assert len(err.strip().splitlines()) == 1 and not any(tmp_path.iterdir())
+
+
+def test_method_with_its_weight_sets_the_alpha_too():
+    args = argparse.Namespace(method="fixed_alpha=0.3", operator=None, seed=None, duration=None,
+                              alpha=None, hardware=False, driver_sim=False, settings=[],
+                              scenario_text=None)
+    overrides = scenario_overrides(args)
+    assert overrides.settings == ("method=fixed_alpha", "alpha=0.3")
+    assert overrides.typed == ("--method fixed_alpha=0.3",) * 2
 
 
 def test_a_session_is_its_own_command_and_run_keeps_to_one_run(capsys):

@@ -70,6 +70,22 @@ def test_draw_with_another_method_draws_another_diagram(tmp_path):
     assert "name=demonstration_player" in explicit.read_text()
 
 
+def test_draw_writes_the_dot_source_to_standard_output(capsysbinary):
+    assert main([str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--format", "dot", "--output",
+                 "-"]) == 0
+    out = capsysbinary.readouterr().out.decode()
+    assert out.startswith("digraph _0 {") and "name=blender" in out
+
+
+def test_draw_writes_one_scenario_to_an_output(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main([str(DIAGRAMS / "toy_alt_vs_cont.yaml"), str(DIAGRAMS / "hsr_reach.yaml"),
+              "--output", str(tmp_path / "both.svg")])
+    assert exit_info.value.code == 2
+    assert "--output takes one scenario" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
 def test_draw_names_a_bad_scenario(tmp_path, capsys):
     bad = tmp_path / "bad.yaml"
     bad.write_text((DIAGRAMS / "toy_alt_vs_cont.yaml").read_text().replace(

@@ -2,10 +2,12 @@
 it and run headless; taught again from the drive's CSV; bad primitives and recordings
 refused in one line naming the file (exit 2)."""
 
+import csv
 import json
 import pathlib
 import shutil
 
+import numpy as np
 import pytest
 
 from pbp_drake.cli import main
@@ -54,6 +56,17 @@ def test_the_obstacle_task_teaches_a_primitive_it_then_runs(tmp_path, capsys):
                     f"dmp.primitive={tmp_path / 'P.json'}", capsys=capsys)
     assert code == 0, out.err
     assert "hsr_obstacles [pbp_alternated, seed 0]: success" in out.out
+
+
+def test_the_drive_takes_the_command_line_s_seed_and_settings(tmp_path, capsys):
+    code, out = run("teach", REACH, "--output", tmp_path / "P.json", "--seed", "3", "--set",
+                    "duration=1", "--scenario-text", "{control_period: 0.03}", capsys=capsys)
+    assert code == 0, out.err
+    assert "hsr_reach [teleop, seed 3]:" in out.out
+    with open(tmp_path / "P.csv") as rows:
+        times = [float(row["time"]) for row in csv.DictReader(rows)]
+    assert times[-1] == pytest.approx(1.0, abs=0.03)
+    assert np.diff(times) == pytest.approx(0.03)
 
 
 @pytest.mark.slow
@@ -160,6 +173,8 @@ def test_the_grasping_task_teaches_a_pose_and_refuses_a_position_primitive(taugh
     ("time,ee_x,ee_y,ee_z\n" + "".join(f"{t / 10},{0.5 + t / 20},nan,0.7\n"
                                         for t in range(30)), "NaN or infinite at sample 0"),
     ("time,x\n0,1\n", "not a run's path: it needs the columns time, ee_x, ee_y, ee_z"),
+    ("time,ee_x,ee_y,ee_z\n0,0.5,x,0.7\n", "a value of time, ee_x, ee_y, ee_z is not a number"),
+    ("time,ee_x,ee_y,ee_z\n0,0.5,0.0\n", "a value of time, ee_x, ee_y, ee_z is not a number"),
 ])
 def test_a_bad_recording_is_refused_in_one_line_naming_it(tmp_path, rows, message, capsys):
     recording = tmp_path / "run.csv"
@@ -169,6 +184,20 @@ def test_a_bad_recording_is_refused_in_one_line_naming_it(tmp_path, rows, messag
     assert code == 2
     assert message in out.err and str(recording) in out.err
     assert not (tmp_path / "P.json").exists()
+
+
+def test_a_recording_that_cannot_be_read_is_refused(tmp_path, capsys):
+    code, out = run("teach", REACH, "--from", tmp_path, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 2 and f"{tmp_path}: cannot be read as a CSV" in out.err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_2d_scene_is_refused(repo, tmp_path, capsys):
+    code, out = run("teach", repo / "diagrams" / "toy_alt_vs_cont.yaml", "--output",
+                    tmp_path / "P.json", capsys=capsys)
+    assert code == 2 and "teach drives a robot task's hand; this scenario is a 2-D" in out.err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_figure_that_is_not_an_image_file_is_refused_before_anything_runs(tmp_path,

@@ -401,10 +401,19 @@ def test_the_panda_task_runs_over_lcm_with_the_driver_simulator(capsys):
 
 
 @pytest.mark.slow
-def test_driver_sim_runs_the_arm_s_driver_on_the_bus(capsys):
+def test_driver_sim_runs_the_iiwa_driver_on_the_bus(capsys):
     code, out = run("driver-sim", str(REPO / "diagrams" / "iiwa_reach.yaml"), "--set",
                     "robot.hardware.lcm_bus.lcm_url=memq://", "--duration", "0.2",
                     capsys=capsys)
     assert code == 0, out.err
     assert out.out == ("driver-sim: the iiwa driver reads IIWA_COMMAND and sends IIWA_STATUS "
                        "every 5 ms on memq://; Ctrl-C ends it\n")
+
+
+@pytest.mark.slow
+def test_driver_sim_runs_the_panda_driver_on_the_bus(capsys):
+    code, out = run("driver-sim", str(REPO / "diagrams" / "panda_reach.yaml"), "--set",
+                    "robot.hardware.lcm_bus.lcm_url=memq://", "--duration", "0.2", capsys=capsys)
+    assert code == 0, out.err
+    assert out.out == ("driver-sim: the panda driver reads PANDA_COMMAND and sends "
+                       "PANDA_STATUS every 1 ms on memq://; Ctrl-C ends it\n")

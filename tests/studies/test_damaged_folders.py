@@ -7,7 +7,8 @@ import pytest
 
 from pbp_drake.cli import main
 from pbp_drake.studies.trial_files import (
-    read_study, time_series_columns, trial_paths, trial_record, write_trial_files)
+    DamagedFile, load_task_result, read_study, time_series_columns, trial_paths, trial_record,
+    write_trial_files)
 
 METHODS = ("teleop", "pbp_alternated")
 
@@ -19,12 +20,12 @@ def _csv(ticks=3):
     return ",".join(columns) + "\n" + "".join(row + "\n" for _ in range(ticks))
 
 
-def _study(folder, trials=2):
+def _study(folder, trials=2, methods=METHODS):
     """A method comparison's folder written without simulating: every trial succeeded."""
     study = {"study": "method_comparison", "format": 1, "scenario": "fake",
-             "scenario_hash": "abc", "methods": list(METHODS), "trials": trials, "seed": 0}
+             "scenario_hash": "abc", "methods": list(methods), "trials": trials, "seed": 0}
     (folder / "study.json").write_text(json.dumps(study))
-    for method in METHODS:
+    for method in methods:
         for trial in range(trials):
             record = trial_record("fake", "abc", method, trial, trial)
             record.update(success=True, task_time=10.0 + trial, intervention_ratio=0.5,
@@ -41,6 +42,17 @@ def test_a_clean_folder_reports_without_complaint(tmp_path, capsys):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["damaged"] == []
     assert summary["methods"]["teleop"]["trials"] == 2
+
+
+@pytest.mark.slow
+def test_a_sweep_of_fixed_alphas_reports_its_ideal_alpha(tmp_path, capsys):
+    folder = _study(tmp_path, methods=("fixed_alpha=0.2", "fixed_alpha=0.6", "teleop"))
+    assert main(["report", str(folder)]) == 0
+    arbitration = json.loads((folder / "summary.json").read_text())["arbitration"]
+    assert arbitration["alphas"] == [0.2, 0.6]
+    assert arbitration["ideal_alpha"] == 0.6  # every trial succeeded: the highest
+    assert (f"Ideal fixed alpha: {arbitration['ideal_alpha']} ({arbitration['criterion']})."
+            in (folder / "results.md").read_text())
 
 
 @pytest.mark.slow
@@ -91,6 +103,63 @@ def test_a_malformed_csv_is_named(tmp_path, text, problem):
     assert [(d.key, problem in d.problem) for d in damaged] == [(("teleop", 0), True)]
 
 
+@pytest.mark.parametrize("study, problem", [
+    ([], "holds a list, not a study"),
+    ({"methods": []}, "field 'methods' is not a list of method names"),
+    ({"trials": "2"}, "field 'trials' is str, not int"),
+    ({"trials": 0}, "field 'trials' is 0, not a positive number"),
+    ({"split": 3}, "field 'split' is int, not str"),
+    ({"scenario_hash": 5}, "field 'scenario_hash' is int, not str"),
+])
+def test_a_bad_study_json_is_named_and_the_trials_on_disk_read(tmp_path, study, problem):
+    folder = _study(tmp_path, trials=1)
+    held = json.loads((folder / "study.json").read_text())
+    (folder / "study.json").write_text(json.dumps({**held, **study} if study else study))
+    _, records, damaged = read_study(folder)
+    assert [d.problem for d in damaged] == [f"{problem}; reporting the trials on disk"]
+    assert None not in records.values()
+
+
+@pytest.mark.parametrize("method, change, problem", [
+    ("teleop", lambda record: [record], "holds a list, not a trial record"),
+    ("teleop", lambda record: {**record, "format": 0}, "a trial of format 0, not 1"),
+    ("pbp_alternated", lambda record: {**record, "method": "teleop"},
+     "holds the trial of 'teleop', seed 0"),
+])
+def test_a_trial_record_of_another_shape_is_named(tmp_path, method, change, problem):
+    folder = _study(tmp_path, trials=1)
+    path = trial_paths(folder, method, 0)[0]
+    path.write_text(json.dumps(change(json.loads(path.read_text()))))
+    _, records, damaged = read_study(folder)
+    assert [(d.path, d.problem) for d in damaged] == [(str(path), problem)]
+    assert records[(method, 0)] is None
+
+
+@pytest.mark.parametrize("change, error, problem", [
+    (lambda text: text[:80], DamagedFile, "truncated or invalid JSON"),
+    (lambda text: json.dumps({**json.loads(text), "task_time": "ten"}), DamagedFile,
+     "field 'task_time' is str"),
+    (lambda text: json.dumps({**json.loads(text), "error": "RuntimeError: it broke"}),
+     ValueError, "the trial failed: RuntimeError: it broke"),
+])
+def test_load_task_result_names_a_trial_it_cannot_give(tmp_path, change, error, problem):
+    path = trial_paths(_study(tmp_path, trials=1), "teleop", 0)[0]
+    path.write_text(change(path.read_text()))
+    with pytest.raises(error, match=problem) as raised:
+        load_task_result(tmp_path, "teleop", 0)
+    assert str(raised.value).startswith(f"{path}: ")
+
+
+def test_a_trial_without_its_csv_is_named(tmp_path):
+    folder = _study(tmp_path, trials=1)
+    csv = trial_paths(folder, "teleop", 0)[1]
+    csv.unlink()
+    _, records, damaged = read_study(folder)
+    assert [(d.path, d.problem) for d in damaged] == [
+        (str(csv), "missing: the trial's time series CSV is not on disk")]
+    assert records[("teleop", 0)] is None
+
+
 @pytest.mark.slow
 def test_a_folder_with_errored_trials_reports_them_and_exits_1(tmp_path, capsys):
     folder = _study(tmp_path, trials=3)
@@ -124,6 +193,11 @@ def test_nothing_to_report_exits_2(tmp_path, capsys):
     (tmp_path / "study.json").write_text("{")
     assert main(["report", str(tmp_path)]) == 2
     assert "no trial files" in capsys.readouterr().err
+
+
+def test_a_missing_folder_is_named(tmp_path, capsys):
+    assert main(["report", str(tmp_path / "none")]) == 2
+    assert capsys.readouterr().err == f"pbp-drake: {tmp_path / 'none'}: no such folder\n"
 
 
 def test_a_2d_study_refuses_a_method_comparison_folder(tmp_path, repo, capsys):

@@ -21,7 +21,7 @@ import pytest
 
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.cli import main
-from pbp_drake.studies.atomic_files import WriteFailed
+from pbp_drake.studies.atomic_files import WriteFailed, remove_leftovers
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.folders import LOCK_FILE, FolderLocked
 from pbp_drake.scenarios import load_scenario_file
@@ -118,6 +118,18 @@ def _fill(disk):
 
 def _leftovers(folder):
     return [p for p in folder.rglob("*") if p.suffix in (".tmp", ".running")]
+
+
+def test_leftovers_beside_the_summary_go_once_their_writer_has_ended(tmp_path):
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    gone, own = (tmp_path / f".summary.json.{pid}.tmp" for pid in (ended.stdout.strip(),
+                                                                     os.getpid()))
+    running = tmp_path / f".results.md.{os.getppid()}.tmp"  # a report writing it now
+    for path in (gone, own, running):
+        path.write_text("half")
+    remove_leftovers(tmp_path)
+    assert [path.name for path in tmp_path.iterdir()] == [running.name]
 
 
 def _trial_records(folder):

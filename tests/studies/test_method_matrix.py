@@ -23,9 +23,9 @@ from pbp_drake.builder.run import TaskResult
 from pbp_drake.cli import main
 from pbp_drake.studies.comparison import run_method_matrix
 from pbp_drake.scenarios import load_scenario_file
-from pbp_drake.studies.trial_files import scenario_hash
+from pbp_drake.studies.trial_files import StudyFolderError, scenario_hash
 from pbp_drake.studies.matrix import pilot_folder
-from pbp_drake.studies.matrix_report import FIGURE
+from pbp_drake.studies.matrix_report import FIGURE, report_matrix
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 # 6 s of simulated time: each trial ends at its time limit, before the target (about 17 s
@@ -104,6 +104,21 @@ def test_a_matrix_is_never_mixed_with_a_study_or_another_scenario(task_file, tmp
     assert main(study_args(task_file, matrix)) == 2  # a study without --pilots, into a matrix
     assert "method_matrix" in capsys.readouterr().err
     assert sorted(p.name for p in matrix.iterdir()) == ["study.json"]
+
+
+@pytest.mark.parametrize("text, problem", [
+    (None, "cannot be read as a matrix's study"),
+    ('{"study": "method_matrix", ', "cannot be read as a matrix's study"),
+    ('{"study": "method_matrix", "pilots": "laggy"}', "not the study.json of a matrix"),
+    ('{"study": "method_comparison", "pilots": []}', "not the study.json of a matrix"),
+])
+def test_report_matrix_names_a_study_json_that_is_not_a_matrix_s(tmp_path, text, problem):
+    if text is not None:
+        (tmp_path / "study.json").write_text(text)
+    with pytest.raises(StudyFolderError, match=problem) as error:
+        report_matrix(tmp_path)
+    assert str(error.value).startswith(f"{tmp_path / 'study.json'}: ")
+    assert [path.name for path in tmp_path.iterdir()] == ([] if text is None else ["study.json"])
 
 
 def test_a_pilot_folder_of_another_pilot_is_refused_before_anything_is_written(
@@ -255,6 +270,16 @@ def test_report_writes_the_tables_with_intervals_paired_with_pbp_alt_and_one_fig
     assert rest == text
     assert first == (f"`pbp-drake study {task_file} --methods {','.join(METHODS)} --trials "
                      f"{TRIALS} --seed {SEED} --pilots {','.join(PILOTS)}`")
+
+
+@pytest.mark.slow
+def test_report_refuses_to_pair_with_a_method_the_matrix_did_not_run(folders, capsys):
+    matrix, _ = folders
+    results = (matrix / "results.md").read_bytes()
+    assert main(["report", str(matrix), "--paired-with", "pbp_continuous"]) == 2
+    assert capsys.readouterr().err == (
+        "pbp-drake: --paired-with: the matrix ran pbp_alternated, teleop, not pbp_continuous\n")
+    assert (matrix / "results.md").read_bytes() == results
 
 
 @pytest.mark.slow

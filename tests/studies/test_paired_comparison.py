@@ -2,6 +2,8 @@
 changed a setting compares the two runs. The folders are written without simulating (a
 real study.json of the shipped scenario, trial files of a few ticks)."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -88,6 +90,14 @@ def test_refuses_folders_that_share_no_trial(tmp_path, repo, capsys):
     other.mkdir()
     assert main(["compare", str(a), str(other)]) == 2
     assert "pbp-drake:" in capsys.readouterr().err
+    # Both studies on disk, but no seed of B ran without an error.
+    failed = _study(tmp_path / "failed", repo / "diagrams" / "hsr_reach.yaml")
+    for path in failed.glob("trials/*/seed_*.json"):
+        path.write_text(json.dumps({**json.loads(path.read_text()),
+                                    "error": "RuntimeError: the solver failed"}))
+    assert main(["compare", str(a), str(failed)]) == 2
+    assert capsys.readouterr().err == (f"pbp-drake: {a} and {failed} share no method and seed "
+                                       "that both ran without an error\n")
 
 
 def test_the_command_lines_help_names_it(capsys):

@@ -128,6 +128,41 @@ def test_a_participant_of_another_scenario_is_refused(repo, study, tmp_path, cap
     assert not (mixed / "results.md").exists()
 
 
+def test_markdown_is_refused_for_a_user_study(study, tmp_path, capsys):
+    assert main(["report", str(study), "--markdown", str(tmp_path / "study.md")]) == 2
+    assert (f"--markdown: {study} is a user study's folder; --markdown takes a `pbp-drake "
+            "study` folder") in capsys.readouterr().err
+    assert not (tmp_path / "study.md").exists()
+
+
+def test_a_damaged_trial_is_skipped_and_counted(study, tmp_path, capsys):
+    damaged = tmp_path / "damaged"
+    for participant in SESSIONS:
+        shutil.copytree(study / participant, damaged / participant)
+    (trial,) = (damaged / "P02" / "trials" / "teleop").glob("seed_*.json")
+    trial.write_text(trial.read_text()[:40])
+    assert main(["report", str(damaged)]) == 1
+    err = capsys.readouterr().err
+    assert f"{trial}: truncated or invalid JSON" in err
+    assert "pbp-drake: 1 damaged files skipped (listed above)" in err
+    assert ("Skipped as damaged: 1 file (named by `pbp-drake report`)."
+            in (damaged / "results.md").read_text())
+
+
+def test_a_trial_of_another_scenario_in_a_participant_folder_is_refused(study, tmp_path,
+                                                                          capsys):
+    mixed = tmp_path / "mixed"
+    for participant in SESSIONS:
+        shutil.copytree(study / participant, mixed / participant)
+    (trial,) = (mixed / "P03" / "trials" / "teleop").glob("seed_*.json")
+    trial.write_text(json.dumps({**json.loads(trial.read_text()), "scenario_hash": "0" * 16}))
+    assert main(["report", str(mixed)]) == 2
+    err = capsys.readouterr().err
+    assert f"{trial} is a trial of another scenario" in err
+    assert f"participant folder {mixed / 'P03'} mixes scenarios; move it out of {mixed}" in err
+    assert not (mixed / "results.md").exists()
+
+
 def test_an_answer_outside_0_to_5_is_refused(study, tmp_path, capsys):
     edited = tmp_path / "edited"
     shutil.copytree(study / "P02", edited / "P02")

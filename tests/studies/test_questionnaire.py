@@ -76,6 +76,14 @@ def test_a_damaged_file_is_named_with_its_problem(tmp_path, held, problem):
     assert str(error.value).startswith(f"{path}: ") and problem in str(error.value)
 
 
+def test_a_truncated_file_is_named(tmp_path):
+    path = tmp_path / "questionnaire.json"
+    path.write_text('{"answers": {"teleop": ')
+    with pytest.raises(QuestionnaireError, match="unreadable or invalid JSON") as error:
+        read_answers(tmp_path)
+    assert str(error.value).startswith(f"{path}: ")
+
+
 def test_the_scales_in_words_for_help_and_messages():
     assert scales_text() == ("0 to 5, higher is better (tiredness: 0 = very tired to 5 = not "
                              "tired at all; ease: 0 = very hard to 5 = very easy)")

@@ -57,6 +57,19 @@ def test_a_2d_study_gets_its_summary_as_a_table(tmp_path, repo):
     assert text.startswith("`pbp-drake study ") and "toy_alt_vs_cont.yaml`" in text
     assert "| PBP-Alt |" in text and "| PBP-Cont |" in text
     assert f"Figure: `{output / 'fig4_alt_vs_cont.png'}`" in text
+    # A damaged study.json: the table still, the command without the file it no longer names.
+    (output / "study.json").write_text("{")
+    assert main(["report", str(output), "--markdown", str(markdown)]) == 0
+    assert markdown.read_text().startswith("`pbp-drake study <the scenario file of ")
+    assert markdown.read_text().endswith(text.split("\n", 1)[1])
+
+
+def test_a_2d_study_without_its_summary_is_named(tmp_path, capsys):
+    (tmp_path / "study.json").write_text('{"study": "alt_vs_cont"}')
+    assert main(["report", str(tmp_path), "--markdown", str(tmp_path / "study.md")]) == 2
+    assert capsys.readouterr().err.startswith(
+        f"pbp-drake: {tmp_path / 'summary.json'}: cannot be read (")
+    assert not (tmp_path / "study.md").exists()
 
 
 def test_a_folder_is_refused_as_the_markdown_file(tmp_path, capsys):
@@ -72,3 +85,16 @@ def test_without_the_split_seeds_the_command_names_the_first_seed():
     assert study_command({"split_seeds": {"tuning": 0, "evaluation": 10005}}, summary) == (
         "pbp-drake study <the scenario file of hsr_reach> --methods teleop --trials 3 "
         "--split evaluation")
+
+
+@pytest.mark.parametrize("overrides, words", [
+    ({"set": ["duration=5"], "scenario_text": None}, " --set duration=5"),
+    ({"set": [5]}, ""),  # a study.json edited by hand: the command without them
+    ({"set": ["no equals sign"]}, ""),
+])
+def test_the_command_names_the_recorded_overrides_it_can_read(overrides, words):
+    summary = {"scenario": "hsr_reach", "seed": 10005, "trials": 3, "methods": {"teleop": {}}}
+    study = {"scenario_file": "diagrams/hsr_reach.yaml", "overrides": overrides}
+    assert study_command(study, summary) == (
+        "pbp-drake study diagrams/hsr_reach.yaml --methods teleop --trials 3 --seed 10005"
+        + words)

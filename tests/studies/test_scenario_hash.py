@@ -5,6 +5,7 @@ change as it was, and changes the hash of one whose trials it does."""
 import dataclasses
 import pathlib
 
+import numpy as np
 import pytest
 
 from pbp_drake.robots import ArmHardware, TaskSpaceBridgeConfig, ToolPose
@@ -30,6 +31,16 @@ def test_the_hsr_tasks_hash_without_reposition_time_at_its_default():
         hsr = scenario(name)
         assert "reposition_time" not in scenario_content(hsr)["operator"]
         assert scenario_hash(with_reposition_time(hsr, 2.0)) != scenario_hash(hsr)
+
+
+def test_a_scenario_with_numpy_values_hashes_as_its_file_s():
+    # A script may set a field from NumPy: the same values, the same study folder.
+    hsr = scenario("hsr_reach.yaml")
+    task = dataclasses.replace(hsr.task, switch_schedule=np.array(hsr.task.switch_schedule))
+    numpy = dataclasses.replace(hsr, duration=np.float64(hsr.duration), task=task)
+    assert scenario_hash(numpy) == scenario_hash(hsr)
+    assert scenario_hash(dataclasses.replace(numpy, duration=np.float64(1.0))) != (
+        scenario_hash(hsr))
 
 
 def test_the_arm_task_hashes_reposition_time_even_at_its_default():

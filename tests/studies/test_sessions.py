@@ -42,6 +42,9 @@ def test_the_order_rotates_with_the_participant_number():
     assert orders == [METHODS, METHODS[1:] + METHODS[:1], METHODS[2:] + METHODS[:2]]
     for place in range(3):  # each method once in each place over three participants
         assert sorted(order[place] for order in orders) == sorted(METHODS)
+    # An ID without digits is placed by a hash of it that every run computes the same.
+    assert session_order(METHODS, "alice") == METHODS[1:] + METHODS[:1]
+    assert session_order(METHODS, "carol") == METHODS[2:] + METHODS[:2]
 
 
 def test_fixed_answers_hold_for_every_method_unless_a_method_overrides_them():
@@ -60,6 +63,7 @@ def test_fixed_answers_hold_for_every_method_unless_a_method_overrides_them():
      "easy)"),
     ("tired=3,ease=4", "unknown question 'tired'"),
     ("fixed_alpha:tiredness=3,ease=4", "'fixed_alpha' is not one of the participant's methods"),
+    ("tiredness 3,ease=4", "'tiredness 3' is not "),  # not [METHOD:]QUESTION=VALUE
 ])
 def test_bad_fixed_answers_are_named(text, message):
     with pytest.raises(QuestionnaireError, match=message.replace("(", r"\(").replace(")", r"\)")):

@@ -66,6 +66,27 @@ def test_alpha_study_reports_where_pbp_ends_short_of_the_goal(alpha_study):
         assert [a for a, o in results["fixed_alpha"].items() if o["reached"]] == ["1.00"]
 
 
+def test_alpha_study_gets_its_summary_as_a_markdown_table(alpha_study, tmp_path):
+    markdown = tmp_path / "alpha_study.md"
+    assert main(["report", str(alpha_study), "--markdown", str(markdown)]) == 0
+    lines = markdown.read_text().splitlines()
+    assert lines[0].startswith("`pbp-drake study ") and "toy_alpha_study.yaml`" in lines[0]
+    assert "4 scenes at operator speeds 1, 2" in lines[0]
+    rows = [line for line in lines if line.startswith("| ")]
+    assert rows[0].startswith("| scene | operator speed | ideal alpha | alpha 0.00 |")
+    assert rows[0].endswith("| alpha 1.00 | PBP-Alt | PBP-Cont |")
+    assert len(rows) == 1 + 4 * 2
+    # A row is the summary's: scene_1 at speed 1, its ideal alpha, then PBP-Alt's cell.
+    summary = json.loads((alpha_study / "summary.json").read_text())
+    first = summary["scenes"][0]["by_operator_speed"]["1"]
+    alternated = first["pbp_alternated"]
+    cells = rows[1].strip("| ").split(" | ")
+    assert cells[:3] == ["scene_1", "1", f"{first['ideal_alpha']:g}"]
+    assert cells[-2] == (f"{alternated['collision_ratio']:.3f} / "
+                         f"{'yes' if alternated['reached'] else 'no'}")
+    assert lines[-1] == f"Figure: `{alpha_study / 'fig2_alpha_study.png'}`."
+
+
 def test_alpha_study_draws_the_four_panel_figure(alpha_study):
     import matplotlib.image
 

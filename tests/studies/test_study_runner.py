@@ -6,6 +6,7 @@ import dataclasses
 import io
 import json
 import importlib.util
+import logging
 import math
 import os
 import shutil
@@ -336,6 +337,40 @@ def test_a_folder_of_another_scenario_is_refused(scenario, tmp_path):
         run_method_comparison(other, METHODS, 1, 0, tmp_path, run=fake_run)
 
 
+def test_without_output_the_study_goes_to_its_default_folder(repo, tmp_path, monkeypatch,
+                                                            capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "outputs").mkdir()
+    (tmp_path / "outputs" / "hsr_reach-teleop").write_text("notes")  # in the way: refused
+    assert main(["study", str(repo / "diagrams" / "hsr_reach.yaml"), "--methods", "teleop"]
+                ) == 2
+    assert "--output outputs/hsr_reach-teleop: is a file" in capsys.readouterr().err
+
+
+def test_a_damaged_study_json_is_named_and_written_again(scenario, tmp_path, capsys):
+    first = run_method_comparison(scenario, METHODS, 1, 0, tmp_path, run=fake_run)
+    study = (tmp_path / "study.json").read_bytes()
+    (tmp_path / "study.json").write_text('{"study": ')
+    assert run_method_comparison(scenario, METHODS, 1, 0, tmp_path, run=fake_run) == first
+    assert (f"pbp-drake: damaged: {tmp_path / 'study.json'}: truncated or invalid JSON"
+            in capsys.readouterr().err)
+    assert (tmp_path / "study.json").read_bytes() == study
+
+
+def warning_run(resolved):
+    logging.getLogger("drake").warning("differential IK is stuck")  # as Drake logs it
+    return fake_run(resolved)
+
+
+def test_drake_s_warnings_are_counted_in_the_record_not_printed(scenario, tmp_path, capsys):
+    handlers = list(logging.getLogger("drake").handlers)
+    run_method_comparison(scenario, ["teleop"], 1, 0, tmp_path, run=warning_run)
+    record = json.loads(trial_paths(tmp_path, "teleop", 0)[0].read_text())
+    assert record["drake_warnings"] == 1
+    assert "differential IK" not in capsys.readouterr().err
+    assert logging.getLogger("drake").handlers == handlers  # given back after the trial
+
+
 def test_write_trial_leaves_no_temporary_files(tmp_path):
     record = {"method": "teleop", "seed": 1, "format": 1, "error": "X: y"}
     write_trial(tmp_path, record)
@@ -418,6 +453,9 @@ def test_progress_bar_on_a_terminal_and_in_a_log():
     lines = log.getvalue().splitlines()
     assert len(lines) == 2 and "2/4 trials" in lines[0] and "4/4 trials" in lines[1]
     assert "\r" not in log.getvalue()
+    # Minutes and hours, as a long study takes them: 75 s a trial, 99 trials to go.
+    assert ProgressBar(io.StringIO()).line(1, 100, 75.0).endswith(
+        "1m15s elapsed, ETA 2h03m")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -479,9 +517,43 @@ def test_ray_backend_without_ray_says_how_to_install_it(task_file, tmp_path, cap
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("options, message", [
+    ({"trials": 0}, "trials must be at least 1, got 0"),
+    ({"backend": "dask"}, "backend must be one of local, ray, got 'dask'"),
+    ({"ray_address": "auto"}, "ray_address needs backend='ray'"),
+    ({"jobs": 2, "run": lambda resolved: None}, "cannot be sent to worker processes"),
+])
+def test_run_method_comparison_refuses_bad_options_before_any_folder(scenario, tmp_path,
+                                                                      options, message):
+    arguments = {"trials": 1, **options}
+    trials = arguments.pop("trials")
+    with pytest.raises(ScenarioError, match=message):
+        run_method_comparison(scenario, METHODS, trials, 0, tmp_path / "out", **arguments)
+    assert not (tmp_path / "out").exists()
+
+
 def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
     assert main(study_args(task_file, tmp_path, 1) + ["--ray-address", "auto"]) == 2
     assert "--ray-address needs --backend ray" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("study, section, argv, message", [
+    ("toy_alt_vs_cont.yaml", "", [], "{file}: has no `study:` section to run"),
+    ("hsr_reach.yaml", "study: !AltVsCont {}\n", [],
+     "{file}: HSR tasks take study: !MethodComparison"),
+    ("hsr_reach.yaml", None, ["--methods", "teleop,teleop"],
+     "--methods teleop,teleop names a method twice"),
+])
+def test_a_study_the_file_cannot_run_is_refused(repo, tmp_path, capsys, study, section, argv,
+                                                message):
+    text = (repo / "diagrams" / study).read_text()
+    if section is not None:  # the file's study section, replaced
+        text = text.split("\nstudy:")[0] + "\n" + section
+    scenario = tmp_path / study
+    scenario.write_text(text)
+    assert main(["study", str(scenario), "--output", str(tmp_path / "out"), *argv]) == 2
+    assert capsys.readouterr().err == f"pbp-drake: {message.format(file=scenario)}\n"
+    assert not (tmp_path / "out").exists()
 
 
 def test_the_local_backend_does_not_import_ray(scenario, tmp_path):

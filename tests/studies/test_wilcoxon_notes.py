@@ -37,6 +37,14 @@ def test_a_trial_measure_says_who_ran_both():
     assert row["note"] == "a test needs at least 2 participants who ran both; 1 did"
 
 
+def test_a_value_that_is_not_a_number_gives_no_p_value():
+    # A trial file may hold NaN (JSON as Python reads it); SciPy then gives p = NaN.
+    row = _row({"P01": float("nan"), "P02": 1.0, "P03": 3.0},
+               {"P01": 0.5, "P02": 2.0, "P03": 1.0}, source="trial")
+    assert (row["n"], row["p"], row["statistic"]) == (3, None, None)
+    assert row["note"] == "the test gave no p-value (a value is not a number)"
+
+
 def test_participants_who_differ_get_scipys_test():
     first, second = {"P01": 4, "P02": 5, "P03": 3}, {"P01": 1, "P02": 2, "P03": 3}
     row = _row(first, second)

@@ -185,9 +185,7 @@ def _method_study(args, scenario_file, overrides):
     if args.participant_condition is not None:
         scenario = with_participant_condition(scenario, args.participant_condition,
                                               args.scenario)
-    study = scenario_file.study or MethodComparison()
-    if not isinstance(study, MethodComparison):
-        raise ScenarioError(f"{args.scenario}: HSR tasks take study: !MethodComparison")
+    study = scenario_file.study or MethodComparison()  # the loader refused any other kind
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {} "
                             "(--set 'operator=!VirtualParticipant {}')")
@@ -357,6 +355,8 @@ def _report_matrix(args, output):
     """`report` of a matrix folder: its tables, figure and --markdown file."""
     try:
         summary = report_matrix(output, args.paired_with, args.markdown)
+    except ScenarioError:  # the folder's own problem (StudyFolderError), named as it is
+        raise
     except ValueError as error:
         raise ScenarioError(f"--paired-with: {error}") from None
     _print_matrix_report(summary, output)

@@ -87,6 +87,9 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
     try:
         resolved = resolve(scenario)
         check_numbers(loaded.study, "study")
+        if resolved.has_task and not isinstance(loaded.study, (MethodComparison, type(None))):
+            raise ScenarioError(f"study !{type(loaded.study).__name__} varies a 2-D scene; a "
+                                "robot task takes study: !MethodComparison")
         if isinstance(loaded.study, AlphaStudy):
             check_alpha_study(loaded.study, scenario, resolved.start.size)
         if isinstance(loaded.study, MethodComparison):

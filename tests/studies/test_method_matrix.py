@@ -121,6 +121,14 @@ def test_report_matrix_names_a_study_json_that_is_not_a_matrix_s(tmp_path, text,
     assert [path.name for path in tmp_path.iterdir()] == ([] if text is None else ["study.json"])
 
 
+def test_report_names_a_damaged_matrix_study_json_as_the_folder_s_problem(tmp_path, capsys):
+    (tmp_path / "study.json").write_text('{"study": "method_matrix", "pilots": "laggy"}')
+    assert main(["report", str(tmp_path)]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"pbp-drake: {tmp_path / 'study.json'}: ")
+    assert "not the study.json of a matrix" in error and "--paired-with" not in error
+
+
 def test_a_pilot_folder_of_another_pilot_is_refused_before_anything_is_written(
         task_file, tmp_path, capsys):
     # The matrix's scenario, but its laggy folder holds a study of another scenario (as

@@ -540,7 +540,11 @@ def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
 @pytest.mark.parametrize("study, section, argv, message", [
     ("toy_alt_vs_cont.yaml", "", [], "{file}: has no `study:` section to run"),
     ("hsr_reach.yaml", "study: !AltVsCont {}\n", [],
-     "{file}: HSR tasks take study: !MethodComparison"),
+     "{file}: study !AltVsCont varies a 2-D scene; a robot task takes study: "
+     "!MethodComparison"),
+    ("hsr_reach.yaml", "study: !AlphaStudy {scenes: [{name: a}]}\n", [],
+     "{file}: study !AlphaStudy varies a 2-D scene; a robot task takes study: "
+     "!MethodComparison"),
     ("hsr_reach.yaml", None, ["--methods", "teleop,teleop"],
      "--methods teleop,teleop names a method twice"),
 ])

@@ -241,7 +241,8 @@ def test_the_late_grasp_participant_sends_the_same_twists_the_delay_later():
 
 def test_a_participant_the_systems_cannot_run_is_refused():
     # The scenario checks the impairment first; a Python caller meets the system's check.
-    with pytest.raises(ValueError, match="delay_ticks must not be negative, got -10"):
+    with pytest.raises(ValueError, match="params.impairment.command_delay must be finite and "
+                       "not negative, got -0.3"):
         VirtualOperator(PERIOD, OBJECTS, params=params(command_delay=-0.3), nominal_speed=SPEED)
     with pytest.raises(ValueError, match=r"participant must be a GraspParticipant \("):
         PoseVirtualOperator(GraspParticipantParams(), PERIOD)

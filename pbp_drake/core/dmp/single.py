@@ -19,7 +19,7 @@ def straight_weights(settings, duration, span):
     Fitted on a unit reach so that a dimension with `g = y0` still gets the straight-path
     shape; the Ijspeert `(g - y0)` factor then scales it to any goal, the Pastor form takes
     `span` here."""
-    times, unit = minimum_jerk(np.zeros(1), np.ones(1), duration)
+    times, unit = minimum_jerk(np.zeros(1), np.ones(1), positive(duration, "duration"))
     unit_weights, _ = fit_weights(times, unit, settings)
     return unit_weights * (span if settings.formulation == "pastor" else np.ones(span.size))
 

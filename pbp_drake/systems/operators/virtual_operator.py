@@ -82,6 +82,9 @@ class VirtualOperator(SampledOperator):
         self._seed = int(seed)
         self._slow_radius = float(params.slow_radius)
         impairment = params.impairment
+        problem = impairment.problem()
+        if problem is not None:
+            raise ValueError(f"params.impairment.{problem}")
         self._impairment = impairment
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._target_port = self.DeclareVectorInputPort("target", Target.size)

@@ -33,6 +33,7 @@ from pbp_drake.studies.results_markdown import (
     write_markdown, write_toy_study)
 from pbp_drake.studies.splits import SPLITS, first_seed, split_of
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
+from pbp_drake.scenarios.validation import check_seed
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
 
 
@@ -131,6 +132,15 @@ def _study(args):
         if given:
             raise ScenarioError(f"{flag}: {args.scenario} is a 2-D study, which has no "
                                 "virtual participant; the HSR tasks' studies take it")
+    for flag, given in (("--methods", args.methods is not None),
+                        ("--trials", args.trials is not None),
+                        ("--split", args.split is not None), ("--seed", args.seed is not None),
+                        ("--jobs", args.jobs != 1), ("--backend", args.backend != "local"),
+                        ("--ray-address", args.ray_address is not None),
+                        ("--retry-errors", args.retry_errors)):
+        if given:  # not left unused in silence
+            raise ScenarioError(f"{flag}: {args.scenario} is a 2-D study, whose runs its "
+                                "`study:` section sets; the HSR tasks' studies take it")
     if scenario_file.study is None:
         raise ScenarioError(f"{args.scenario}: has no `study:` section to run")
     output = pathlib.Path(args.output)
@@ -193,13 +203,15 @@ def _method_study(args, scenario_file, overrides):
              "trials": args.trials, "split": args.split}
     study = dataclasses.replace(study, **{name: value for name, value in flags.items()
                                           if value is not None})
+    if args.seed is not None:
+        check_seed(args.seed, "--seed")
     seed = first_seed(study, study.split) if args.seed is None else args.seed
     split = split_of(study, seed, study.trials)
     if args.jobs < 1:
         raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
     if args.ray_address is not None and args.backend != "ray":
         raise ScenarioError("--ray-address needs --backend ray")
-    if len(set(study.methods)) != len(study.methods):
+    if args.methods is not None and len(set(study.methods)) != len(study.methods):
         raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
     try:
         check_method_comparison(study, scenario)

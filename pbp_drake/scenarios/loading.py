@@ -353,6 +353,8 @@ def check_method_comparison(study, scenario):
                             "!Arm")
     if not study.methods:
         raise ScenarioError("study.methods is empty")
+    if len(set(study.methods)) != len(study.methods):
+        raise ScenarioError(f"study.methods {study.methods} names a method twice")
     for method in study.methods:
         try:
             with_method(scenario, method)

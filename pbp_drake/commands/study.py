@@ -199,6 +199,11 @@ def _method_study(args, scenario_file, overrides):
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {} "
                             "(--set 'operator=!VirtualParticipant {}')")
+    if args.methods is not None and not method_list(args.methods):
+        raise ScenarioError(f"--methods {args.methods!r} names no method; give them "
+                            "comma-separated, e.g. pbp_alternated,teleop")
+    if args.trials is not None and args.trials < 1:
+        raise ScenarioError(f"--trials must be at least 1, got {args.trials}")
     flags = {"methods": None if args.methods is None else method_list(args.methods),
              "trials": args.trials, "split": args.split}
     study = dataclasses.replace(study, **{name: value for name, value in flags.items()

@@ -553,6 +553,10 @@ def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
     ("hsr_reach.yaml", None, ["--set", "study.methods=[teleop, teleop]"],
      "{file} with --set 'study.methods=[teleop, teleop]': study.methods ['teleop', 'teleop'] "
      "names a method twice"),
+    # The flag named, not the study.methods or study.trials it replaces.
+    ("hsr_reach.yaml", None, ["--methods", ","], "--methods ',' names no method; give them "
+     "comma-separated, e.g. pbp_alternated,teleop"),
+    ("hsr_reach.yaml", None, ["--trials", "0"], "--trials must be at least 1, got 0"),
     # A seed no trial can take: not a folder of failed trials.
     ("hsr_reach.yaml", None, ["--seed", "-1", "--trials", "1"],
      "--seed -1 cannot seed the random draws; expected a non-negative integer"),

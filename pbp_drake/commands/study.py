@@ -315,6 +315,10 @@ def _print_report(summary, output):
 def _compare(args):
     """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric moved by
     more than the first study's trial-to-trial SD, 2 when the studies share no trial."""
+    for which, folder in (("first", args.first), ("second", args.second)):
+        if not folder:  # pathlib would read it as ".", the current folder
+            raise ScenarioError(f"compare: the {which} folder's path is empty; give a "
+                                "`pbp-drake study` --output folder")
     rows = paired_comparison(args.first, args.second)
     if not rows:
         raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
@@ -330,6 +334,9 @@ def _compare(args):
 def _report(args):
     """`report` of a study folder, a matrix's or a folder of participant folders, with the
     exit codes the command's help gives."""
+    if not args.output:  # pathlib would read it as ".", the current folder
+        raise ScenarioError("report: the folder's path is empty; give a `pbp-drake study` "
+                            "--output folder")
     output = pathlib.Path(args.output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)

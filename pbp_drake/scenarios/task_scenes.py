@@ -13,6 +13,7 @@ from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import (
     ReachScene, sample_grid_scene, sample_reach_scene, validate_objects)
 from pbp_drake.scenarios.schema import DynamicObstacles, GraspTask, MultiGoalReach
+from pbp_drake.systems.visualizers.reach_scene_visualizer import OBJECT_HEIGHT
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,17 +95,23 @@ def _validate_within_reach(objects, min_separation, reach):
     """`validate_objects` with the HSR's reach, or with an arm's `(shoulder, radius)`: each
     point within radius of the shoulder, refused with the reach the arm has."""
     if reach is None:
-        return validate_objects(objects, min_separation)
-    objects = validate_objects(objects, min_separation, reach_x=(0.0, np.inf),
-                               reach_height=(-np.inf, np.inf))
-    shoulder, radius = reach
-    distances = np.linalg.norm(objects - shoulder, axis=1)
-    farthest = int(np.argmax(distances))
-    if distances[farthest] > radius:
-        point = ", ".join(f"{value:.2f}" for value in objects[farthest])
-        raise ValueError(f"({point}) m is {distances[farthest]:.2f} m from the arm's "
-                         f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), beyond "
-                         f"its reach of {radius:.2f} m")
+        objects = validate_objects(objects, min_separation)
+    else:
+        objects = validate_objects(objects, min_separation, reach_x=(0.0, np.inf),
+                                   reach_height=(-np.inf, np.inf))
+        shoulder, radius = reach
+        distances = np.linalg.norm(objects - shoulder, axis=1)
+        farthest = int(np.argmax(distances))
+        if distances[farthest] > radius:
+            point = ", ".join(f"{value:.2f}" for value in objects[farthest])
+            raise ValueError(f"({point}) m is {distances[farthest]:.2f} m from the arm's "
+                             f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), "
+                             f"beyond its reach of {radius:.2f} m")
+    lowest = int(np.argmin(objects[:, 2]))
+    if objects[lowest, 2] <= OBJECT_HEIGHT / 2:  # its table would have no height
+        point = ", ".join(f"{value:.2f}" for value in objects[lowest])
+        raise ValueError(f"({point}) m is too low: each object stands on a table, its centre "
+                         f"more than {OBJECT_HEIGHT / 2:g} m above the floor")
     return objects
 
 

@@ -82,18 +82,20 @@ def _reach_scene(task, seed, reach):
 
 
 def _check_region(task, reach, heights=None):
-    """Every corner of the region the task draws its targets from (at `heights`, default
-    its `z_range` or `height`) must be in reach."""
+    """Every corner of the region the task draws its targets from (at `heights`, the
+    grasping task's table tops; default its `z_range` or `height`) must be in reach."""
     if len(task.x_range) != 2 or len(task.y_range) != 2:
         raise ValueError("x_range and y_range must be [low, high]")
+    on_tables = heights is None
     heights = heights or getattr(task, "z_range", None) or [task.height]
     _validate_within_reach([[x, y, z] for x in task.x_range for y in task.y_range
-                            for z in heights], 0.0, reach)
+                            for z in heights], 0.0, reach, on_tables)
 
 
-def _validate_within_reach(objects, min_separation, reach):
+def _validate_within_reach(objects, min_separation, reach, on_tables=True):
     """`validate_objects` with the HSR's reach, or with an arm's `(shoulder, radius)`: each
-    point within radius of the shoulder, refused with the reach the arm has."""
+    point within radius of the shoulder, refused with the reach the arm has; `on_tables`:
+    each point an object's centre, standing on a table of its own."""
     if reach is None:
         objects = validate_objects(objects, min_separation)
     else:
@@ -108,7 +110,7 @@ def _validate_within_reach(objects, min_separation, reach):
                              f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), "
                              f"beyond its reach of {radius:.2f} m")
     lowest = int(np.argmin(objects[:, 2]))
-    if objects[lowest, 2] <= OBJECT_HEIGHT / 2:  # its table would have no height
+    if on_tables and objects[lowest, 2] <= OBJECT_HEIGHT / 2:  # a table of no height
         point = ", ".join(f"{value:.2f}" for value in objects[lowest])
         raise ValueError(f"({point}) m is too low: each object stands on a table, its centre "
                          f"more than {OBJECT_HEIGHT / 2:g} m above the floor")

@@ -110,10 +110,10 @@ def _validate_within_reach(objects, min_separation, reach, on_tables=True):
                              f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), "
                              f"beyond its reach of {radius:.2f} m")
     lowest = int(np.argmin(objects[:, 2]))
-    if on_tables and objects[lowest, 2] <= OBJECT_HEIGHT / 2:  # a table of no height
+    if on_tables and objects[lowest, 2] < OBJECT_HEIGHT / 2:  # a table below the floor
         point = ", ".join(f"{value:.2f}" for value in objects[lowest])
         raise ValueError(f"({point}) m is too low: each object stands on a table, its centre "
-                         f"more than {OBJECT_HEIGHT / 2:g} m above the floor")
+                         f"at least {OBJECT_HEIGHT / 2:g} m above the floor")
     return objects
 
 

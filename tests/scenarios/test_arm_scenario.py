@@ -78,7 +78,7 @@ def test_an_object_too_low_for_its_table_is_refused(change):
     scenario = arm_scenario()
     low = dataclasses.replace(scenario.task, **change)
     with pytest.raises(ScenarioError, match=r"scenario\.task: \(0\.\d\d, .*\) m is too low: "
-                       r"each object stands on a table, its centre more than 0\.05 m above"):
+                       r"each object stands on a table, its centre at least 0\.05 m above"):
         resolve(dataclasses.replace(scenario, task=low))
 
 

@@ -13,7 +13,9 @@ import time
 
 import pytest
 
+from pbp_drake.builder import run_task
 from pbp_drake.cli import main
+from pbp_drake.studies import runners
 
 pytestmark = pytest.mark.slow
 
@@ -115,15 +117,22 @@ def test_sigkill_of_the_study_ends_its_processes_and_the_study_resumes(task_file
 
 
 def test_a_study_with_failed_trials_exits_1_after_writing_its_summary(task_file, tmp_path,
-                                                                     capsys):
-    # Seed -1 makes trial 0 fail with an error (a negative seed is refused); seed 0 runs.
+                                                                     capsys, monkeypatch):
+    # The trial of seed 0 raises (one process: `--jobs 1` runs the trials here); seed 1 runs.
+    def run_task_failing_seed_0(trial):
+        if trial.scenario.seed == 0:
+            raise RuntimeError("a trial that breaks")
+        return run_task(trial)
+
+    monkeypatch.setattr(runners, "run_task", run_task_failing_seed_0)
     output = tmp_path / "study"
-    args = ["study", str(task_file), "--methods", "teleop", "--trials", "2", "--seed", "-1",
+    args = ["study", str(task_file), "--methods", "teleop", "--trials", "2", "--seed", "0",
             "--output", str(output)]
     assert main(args) == 1
     summary = json.loads((output / "summary.json").read_text())
     assert summary["methods"]["teleop"]["errors"] == 1
     err = capsys.readouterr().err
     assert "1 of 2 trials failed with an error" in err and str(output / "trials") in err
-    record = json.loads((output / "trials" / "teleop" / "seed_-1.json").read_text())
-    assert record["error"] is not None
+    record = json.loads((output / "trials" / "teleop" / "seed_0.json").read_text())
+    assert record["error"] == "RuntimeError: a trial that breaks"
+    assert json.loads((output / "trials" / "teleop" / "seed_1.json").read_text())["error"] is None

@@ -4,6 +4,7 @@
 
 import dataclasses
 import math
+import numbers
 import re
 
 import numpy as np
@@ -37,9 +38,15 @@ def position_of(view):
 
 def checked_goal_count(goal_count):
     """`goal_count` as an int; ValueError unless it is an integer >= 1."""
-    if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
-        raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
-    return int(goal_count)
+    return checked_count(goal_count, "goal_count")
+
+
+def checked_count(value, name):
+    """`value` as an int; ValueError, naming it `name`, unless it is an integer >= 1."""
+    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+            or not math.isfinite(value) or int(value) != value or value < 1):
+        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    return int(value)
 
 
 def checked_settings(settings, kind):

@@ -10,8 +10,12 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Ze
 from pbp_drake.core.arbitration import BLEND_MODES
 from pbp_drake.core.dmp import DmpBankModel as DmpModel
 from pbp_drake.core.hand_over import hand_over
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.hindsight_optimization import HopSettings
 from pbp_drake.systems import (
-    Blender, DmpBank, GoalsSource, HandOver, PointRobotDynamics, ScriptedOperator)
+    Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand,
+    HopAssistance, IdleOperator, LikelyGoals, PointRobotDynamics, SampleHold, ScriptedOperator,
+    TaskMonitor)
 from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.systems.tick import decide_offset
 
@@ -61,6 +65,47 @@ def test_hand_over_refuses_limits_that_are_not_finite_positive_numbers(limits):
      r"predicted_goal_count must be in \[1, 2\] \(the goal count\), got 3"),
 ])
 def test_the_loops_systems_refuse_what_they_cannot_run(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
+
+
+_PERIOD_USERS = {
+    "Blender": lambda period: Blender("pbp_continuous", 2, 2, period),
+    "DmpBank": lambda period: DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), period),
+    "ScriptedOperator": lambda period: ScriptedOperator([0.0], [[0.0, 0.0]], period),
+    "IdleOperator": lambda period: IdleOperator(2, period),
+    "HeadingCommand": lambda period: HeadingCommand(0.0, period),
+    "DemonstrationPlayer": lambda period: DemonstrationPlayer(
+        [0.0, 0.5, 1.0], [[0.0], [0.5], [1.0]], period),
+    "TaskMonitor": lambda period: TaskMonitor([[0.5, 0.0, 0.4]], [0], [0.0], [0.0, 0.0, 0.0],
+                                              0.05, period),
+    "SampleHold": lambda period: SampleHold(period, [0.0, 0.0]),
+}
+
+
+@pytest.mark.parametrize("period", [0.0, -0.03, np.nan, np.inf, "0.03s", None])
+@pytest.mark.parametrize("system", sorted(_PERIOD_USERS))
+def test_every_system_names_a_control_period_that_is_not_positive(system, period):
+    name = "period" if system == "SampleHold" else "control_period"
+    with pytest.raises(ValueError, match=f"^{name} must be positive, got "):
+        _PERIOD_USERS[system](period)
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: Blender("pbp_continuous", 2, -1, 0.03), "goal_count must be an integer >= 1"),
+    (lambda: Blender("pbp_continuous", 2, 1.5, 0.03), "goal_count must be an integer >= 1"),
+    (lambda: Blender("pbp_continuous", 0, 2, 0.03), "dimension must be an integer >= 1"),
+    (lambda: Blender("pbp_continuous", None, 2, 0.03), "dimension must be an integer >= 1"),
+    (lambda: HopAssistance("hop", -1, HopSettings(), 0.03),
+     "goal_count must be an integer >= 1"),
+    (lambda: GoalEstimator(np.inf, GoalEstimatorSettings(), 0.03),
+     "goal_count must be an integer >= 1, got inf"),
+    (lambda: GoalEstimator(None, GoalEstimatorSettings(), 0.03),
+     "goal_count must be an integer >= 1, got None"),
+    (lambda: LikelyGoals(3, 1.5), "count must be an integer >= 1, got 1.5"),
+    (lambda: IdleOperator(-1, 0.03), "dimension must be an integer >= 1, got -1"),
+])
+def test_the_systems_name_a_count_that_is_no_whole_number(build, message):
     with pytest.raises(ValueError, match=message):
         build()
 

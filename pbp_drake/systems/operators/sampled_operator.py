@@ -6,8 +6,8 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.arbitration import validate_command
-from pbp_drake.systems.ports import PortGetters
-from pbp_drake.systems.tick import SENSE_OFFSET
+from pbp_drake.systems.ports import PortGetters, checked_count
+from pbp_drake.systems.tick import SENSE_OFFSET, checked_period
 
 
 def operator_speed(speed, nominal_speed):
@@ -39,8 +39,8 @@ class SampledOperator(PortGetters, LeafSystem):
 
     def __init__(self, dimension, control_period, command_name="operator_command"):
         super().__init__()
-        self._dimension = int(dimension)
-        self._period = float(control_period)
+        self._dimension = checked_count(dimension, "dimension")
+        self._period = checked_period(control_period)
         self._command_name = command_name
 
     def _declare_operator_outputs(self, delay_ticks=0, offset=SENSE_OFFSET):

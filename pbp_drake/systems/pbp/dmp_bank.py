@@ -8,7 +8,7 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
 from pbp_drake.systems.ports import PortGetters, goal_index
-from pbp_drake.systems.tick import checked_update_offset
+from pbp_drake.systems.tick import checked_period, checked_update_offset
 
 
 class BankSystem(PortGetters, LeafSystem):
@@ -108,7 +108,7 @@ class DmpBank(BankSystem):
         super().__init__()
         self._bank = bank
         self._max_speed = None if max_speed is None else float(max_speed)
-        self._period = float(control_period)
+        self._period = checked_period(control_period)
         self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
         self._prediction_steps = int(prediction_steps)

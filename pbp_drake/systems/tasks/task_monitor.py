@@ -9,7 +9,7 @@ from pydrake.systems.framework import EventStatus, LeafSystem
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.reach_task import reach_progress
 from pbp_drake.systems.ports import EeState, PortGetters, Target, TaskStatus, position_of
-from pbp_drake.systems.tick import checked_update_offset, report_offset
+from pbp_drake.systems.tick import checked_period, checked_update_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
 
@@ -62,7 +62,7 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         self._schedule = tuple(float(s) for s in switch_schedule)
         if len(self._targets) != len(self._schedule):
             raise ValueError("one target per entry of switch_schedule")
-        period = float(control_period)
+        period = checked_period(control_period)
         update_offset = self._update_offset = checked_update_offset(update_offset, period)
         end_offset = report_offset(period, update_offset)
         self._hand_port = self.DeclareVectorInputPort(pose_port, pose_size)

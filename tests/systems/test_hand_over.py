@@ -110,6 +110,37 @@ def test_the_systems_name_a_count_that_is_no_whole_number(build, message):
         build()
 
 
+@pytest.mark.parametrize("options, message", [
+    ({"max_speed": 0.0}, r"max_speed must be positive \(None: no limit\), got 0.0"),
+    ({"max_speed": -1.0}, r"max_speed must be positive \(None: no limit\), got -1.0"),
+    ({"max_speed": np.nan}, r"max_speed must be positive \(None: no limit\), got nan"),
+    ({"prediction_steps": -1}, r"prediction_steps must be a whole number >= 0, got -1"),
+    ({"prediction_steps": 1.5}, r"prediction_steps must be a whole number >= 0, got 1.5"),
+    ({"prediction_steps": None}, r"prediction_steps must be a whole number >= 0, got None"),
+    ({"prediction_steps": 3, "prediction_period": -0.1},
+     r"prediction_period must be positive, got -0.1"),
+    ({"prediction_steps": 3, "prediction_period": np.nan},
+     r"prediction_period must be positive, got nan"),
+    ({"prediction_steps": 3, "predicted_goal_count": np.nan},
+     r"predicted_goal_count must be in \[1, 2\] \(the goal count\), got nan"),
+    ({"prediction_steps": 3, "predicted_goal_count": 1.5},
+     r"predicted_goal_count must be in \[1, 2\] \(the goal count\), got 1.5"),
+])
+def test_the_bank_names_an_option_it_cannot_run(options, message):
+    with pytest.raises(ValueError, match=message):
+        DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, **options)
+
+
+@pytest.mark.parametrize("bank", [None, "bank", np.zeros((50, 2))])
+def test_the_bank_names_a_bank_that_is_no_dmp_bank_model(bank):
+    with pytest.raises(ValueError, match="^bank must be a DmpBankModel, got "):
+        DmpBank(bank, 0.03)
+
+
+def test_an_unbounded_anti_windup_is_no_limit():
+    DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, max_speed=np.inf)
+
+
 def test_a_script_of_single_numbers_is_a_one_dimensional_operator():
     person = ScriptedOperator([0.0, 1.0], [0.1, -0.2], 0.03)
     assert person.get_operator_command_output_port().size() == 1

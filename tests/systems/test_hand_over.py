@@ -154,6 +154,28 @@ def test_a_selected_goal_that_is_no_goal_is_refused_by_the_bank():
         bank.get_selected_reference_output_port().Eval(context)
 
 
+@pytest.mark.parametrize("selected", [np.nan, 0.5, np.inf])
+def test_a_selected_goal_that_is_no_whole_index_is_refused_by_the_blender(selected):
+    blender = Blender("pbp_continuous", 2, 2, 0.03)
+    context = blender.CreateDefaultContext()
+    for port, value in [("robot_state", np.zeros(4)), ("references", np.zeros(8)),
+                        ("selected_goal", [selected]), ("operator_command", np.zeros(2)),
+                        ("operator_active", [0.0])]:
+        blender.GetInputPort(port).FixValue(context, value)
+    with pytest.raises(ValueError, match=f"selected_goal {selected:g} is not one of the 2 goals"):
+        blender.get_command_output_port().Eval(context)
+
+
+def test_a_nan_robot_state_is_refused_by_the_bank_naming_the_entry():
+    bank = DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03)
+    simulator = Simulator(bank)
+    context = bank.GetMyContextFromRoot(simulator.get_mutable_context())
+    bank.get_robot_state_input_port().FixValue(context, [0.0, 0.0, np.nan, 0.0])
+    bank.get_goals_input_port().FixValue(context, GOALS.reshape(-1))
+    with pytest.raises(ValueError, match=r"robot_state velocity\[0\] is NaN or infinite"):
+        simulator.AdvanceTo(0.03)
+
+
 class ScriptedSelection(LeafSystem):
     """The selected goal as a goal estimator publishes it: a state updated at the decide
     stage, so that the DMP bank (same stage) reads the goal followed until then."""

@@ -212,3 +212,13 @@ def test_the_grasp_monitor_names_an_argument_it_cannot_referee(change, message):
                  "success_distance": 0.05, "success_angle": 0.2, "control_period": PERIOD}
     with pytest.raises(ValueError, match=message):
         GraspTaskMonitor(**{**arguments, **change})
+
+
+def test_a_nan_hand_is_refused_by_the_monitor_naming_the_field():
+    monitor = TaskMonitor(OBJECTS, [0], [0.0], [0.0, 0.0, 0.0], 0.05, PERIOD)
+    simulator = Simulator(monitor)
+    context = monitor.GetMyContextFromRoot(simulator.get_mutable_context())
+    monitor.get_ee_state_input_port().FixValue(context, [0.0, np.nan] + [0.0] * 6)
+    monitor.get_operator_active_input_port().FixValue(context, [0.0])
+    with pytest.raises(ValueError, match=r"ee_state y is NaN or infinite: \[0.0, nan"):
+        simulator.AdvanceTo(PERIOD)

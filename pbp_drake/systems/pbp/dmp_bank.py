@@ -2,6 +2,8 @@
 (`pbp_drake.core.dmp.DmpBankModel`); its state and scratch arrays live in the Context.
 """
 
+import math
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
@@ -9,7 +11,7 @@ from pydrake.systems.framework import LeafSystem, ValueProducer
 from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.dmp import DmpBankModel
 from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
-from pbp_drake.systems.ports import PortGetters, goal_index
+from pbp_drake.systems.ports import PortGetters, finite_fields, goal_index
 from pbp_drake.systems.tick import checked_period, checked_update_offset
 
 
@@ -146,6 +148,8 @@ class DmpBank(BankSystem):
         self._layout = (AffineState if compact_state else PerGoalState)(
             bank, self._period, self._max_speed)
         self._declare_inputs(2 * d, "goals", k * d)
+        self._state_fields = [f"{kind}[{i}]" for kind in ("position", "velocity")
+                              for i in range(d)]
         self._state_index = self.DeclareDiscreteState(self._layout.initial())
         self._goals_dk = self.DeclareCacheEntry(
             "goals, validated, (D, K) contiguous",
@@ -219,6 +223,8 @@ class DmpBank(BankSystem):
         # Every input before the workspace: an input may reach this system's outputs,
         # which use the same workspace.
         robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
+        if not math.isfinite(sum(robot_state.tolist())):
+            finite_fields(robot_state, "robot_state", self._state_fields)
         lock = self._locked(context)
         goals_dk = None if lock else self._goals_dk.Eval(context)
         followed = self._followed(context, self._layout.needs_followed_goal)

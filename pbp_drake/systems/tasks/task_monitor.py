@@ -9,7 +9,8 @@ from pydrake.systems.framework import EventStatus, LeafSystem
 from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.reach_task import reach_progress
-from pbp_drake.systems.ports import EeState, PortGetters, Target, TaskStatus, position_of
+from pbp_drake.systems.ports import (
+    EeState, PortGetters, Target, TaskStatus, finite_fields, position_of)
 from pbp_drake.systems.tick import checked_period, checked_update_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
@@ -191,7 +192,7 @@ class TaskMonitor(TaskMonitorBase):
         self._success_distance = check_limit(success_distance, "success_distance", "m")
 
     def _read_hand(self, vector):
-        return position_of(EeState(vector))
+        return position_of(EeState(finite_fields(vector, "ee_state", EeState.get_fields())))
 
     def _progress(self, hand, index):
         return reach_progress(hand, self._start, self._objects[index])

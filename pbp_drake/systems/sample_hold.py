@@ -25,6 +25,9 @@ class SampleHold(PortGetters, LeafSystem):
     def __init__(self, period, initial_value):
         super().__init__()
         initial_value = np.asarray(initial_value, dtype=float)
+        if initial_value.ndim != 1 or initial_value.size == 0:
+            raise ValueError(f"initial_value must be a non-empty vector, got "
+                             f"{initial_value.tolist()}")
         self._input_port = self.DeclareVectorInputPort("u", initial_value.size)
         index = self.DeclareDiscreteState(initial_value)
         self.DeclareStateOutputPort("y", index)

@@ -12,10 +12,11 @@ from pbp_drake.core.dmp import DmpBankModel as DmpModel
 from pbp_drake.core.hand_over import hand_over
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.hindsight_optimization import HopSettings
+from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.systems import (
     Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand,
-    HopAssistance, IdleOperator, LikelyGoals, PointRobotDynamics, SampleHold, ScriptedOperator,
-    TaskMonitor)
+    HopAssistance, IdleOperator, IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator,
+    ObstacleRepulsionOperator, PointRobotDynamics, SampleHold, ScriptedOperator, TaskMonitor)
 from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.systems.tick import decide_offset
 
@@ -139,6 +140,32 @@ def test_the_bank_names_a_bank_that_is_no_dmp_bank_model(bank):
 
 def test_an_unbounded_anti_windup_is_no_limit():
     DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, max_speed=np.inf)
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: HandOver([], 1.0, 0.5, 0.03), r"initial_position must be finite, got \[\]"),
+    (lambda: HeadingCommand(np.nan, 0.03), "initial_heading must be a finite angle"),
+    (lambda: HeadingCommand(None, 0.03), "initial_heading must be a finite angle .*, got None"),
+    (lambda: Blender("fixed_alpha", 2, 2, 0.03, alpha="half"),
+     "alpha must lie in \\[0, 1\\] for fixed_alpha, got half"),
+    (lambda: PointRobotDynamics([np.nan, 0.0]), "initial_position must be a non-empty finite"),
+    (lambda: PointRobotDynamics([]), "initial_position must be a non-empty finite"),
+    (lambda: PointRobotDynamics([0.0, 0.0], None), "params must be PointRobotParams"),
+    (lambda: SampleHold(0.03, []), r"initial_value must be a non-empty vector, got \[\]"),
+    (lambda: SampleHold(0.03, [[0.0, 1.0]]), "initial_value must be a non-empty vector"),
+    (lambda: ObstacleRepulsionOperator([[np.nan, 0.0]], [0.1], 2, 0.03),
+     r"centres must be finite, got \[\[nan, 0.0\]\]"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [-0.1], 2, 0.03),
+     r"radii must be one positive radius per centre \(1\), got \[-0.1\]"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [], 2, 0.03), "radii must be one positive"),
+    (lambda: IntentFilterGoalEstimator(2, IntentFilterSettings(), 0.03, margin=None),
+     "margin must lie in \\[0, 1\\), got None"),
+    (lambda: MaxEntGoalEstimator(2, HopSettings(), 0.03, hold_steps=None),
+     "hold_steps must be an integer >= 1, got None"),
+])
+def test_a_constructor_names_an_argument_it_cannot_use(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
 
 
 def test_a_script_of_single_numbers_is_a_one_dimensional_operator():

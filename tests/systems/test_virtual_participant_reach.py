@@ -99,3 +99,21 @@ def test_facing_a_target_behind_the_picked_object_it_goes_there_itself():
     assert velocity @ facing(sideways) <= 1e-12
     assert velocity[0] > 0.1  # toward the target, at nearly the whole speed
 
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"objects": []}, r"objects must be a non-empty finite \(M, 3\) array, got shape \(0,\)"),
+    ({"objects": [[0.5, 0.0]]}, r"objects must be .* got shape \(1, 2\)"),
+    ({"objects": [[np.nan, 0.0, 0.4]]}, r"objects must be a non-empty finite \(M, 3\) array"),
+    ({"params": None}, "params must be VirtualParticipantParams, got NoneType"),
+    ({"heading_range": (1.0, -1.0)},
+     r"heading_range must be \(lowest, highest\) finite headings \(rad\), got \(1.0, -1.0\)"),
+    ({"heading_range": (np.nan, 1.0)}, "heading_range must be"),
+    ({"seed": 1.5}, "seed must be a whole number >= 0, got 1.5"),
+    ({"seed": -1}, "seed must be a whole number >= 0, got -1"),
+])
+def test_the_participant_names_an_argument_it_cannot_act_on(change, message):
+    arguments = {"control_period": 0.03, "objects": [[0.5, 0.0, 0.4], [0.6, 0.2, 0.4]],
+                 "nominal_speed": 0.1, **change}
+    with pytest.raises(ValueError, match=message):
+        VirtualOperator(**arguments)

@@ -111,6 +111,12 @@ def test_facing_a_target_behind_the_picked_object_it_goes_there_itself():
     ({"heading_range": (np.nan, 1.0)}, "heading_range must be"),
     ({"seed": 1.5}, "seed must be a whole number >= 0, got 1.5"),
     ({"seed": -1}, "seed must be a whole number >= 0, got -1"),
+    ({"params": VirtualParticipantParams(reaction_delay=-0.3)},
+     "params.reaction_delay must be finite and not negative, got -0.3"),
+    ({"params": VirtualParticipantParams(direction_noise=np.nan)},
+     "params.direction_noise must be finite and not negative, got nan"),
+    ({"params": VirtualParticipantParams(hold_time=None)},
+     "params.hold_time must be finite and not negative, got None"),
 ])
 def test_the_participant_names_an_argument_it_cannot_act_on(change, message):
     arguments = {"control_period": 0.03, "objects": [[0.5, 0.0, 0.4], [0.6, 0.2, 0.4]],

@@ -1,6 +1,7 @@
 """A virtual participant for the HSR tasks: stands in for the paper's users in automated runs."""
 
 import copy
+import dataclasses
 import math
 
 import numpy as np
@@ -71,6 +72,12 @@ class VirtualOperator(SampledOperator):
         if not isinstance(params, VirtualParticipantParams):
             raise ValueError(f"params must be VirtualParticipantParams, got "
                              f"{type(params).__name__}")
+        for field in dataclasses.fields(params):
+            value = getattr(params, field.name)
+            if field.type is float and not (is_real(value) and math.isfinite(value)
+                                            and value >= 0):
+                raise ValueError(f"params.{field.name} must be finite and not negative, got "
+                                 f"{value!r}")
         self._vertical = bool(vertical)
         self._fixed_base = None if fixed_base is None else np.asarray(fixed_base, float)[:2]
         if heading_range is not None and not _ordered_pair(heading_range):

@@ -341,3 +341,15 @@ def test_the_pose_bank_names_an_option_it_cannot_run(options, message):
     positions, orientations, _ = make_banks()
     with pytest.raises(ValueError, match=message):
         PoseDmpBank(positions, orientations, DT, **options)
+
+
+@pytest.mark.parametrize("which, message", [
+    ("position_bank", "position_bank must be DmpBankModel, got NoneType"),
+    ("orientation_bank", "orientation_bank must be OrientationDmpBank, got str"),
+])
+def test_the_pose_bank_names_a_bank_of_the_wrong_kind(which, message):
+    positions, orientations, _ = make_banks()
+    banks = {"position_bank": positions, "orientation_bank": orientations}
+    banks[which] = None if which == "position_bank" else "turns"
+    with pytest.raises(ValueError, match=message):
+        PoseDmpBank(control_period=DT, **banks)

@@ -6,6 +6,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.arbitration import validate_command
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.systems.ports import PortGetters, checked_count
 from pbp_drake.systems.tick import SENSE_OFFSET, checked_period
 
@@ -14,7 +15,7 @@ def operator_speed(speed, nominal_speed):
     """The speed (m/s) an HSR operator moves the hand at: `speed`, or where that is 0 (its
     parameters' default) the task's nominal speed, the speed of its DMPs."""
     chosen = speed or nominal_speed
-    if chosen is None or not (math.isfinite(chosen) and chosen > 0):
+    if not (is_real(chosen) and math.isfinite(chosen) and chosen > 0):
         raise ValueError(f"the operator's speed must be positive: got speed {speed!r} and "
                          f"nominal_speed {nominal_speed!r} (speed 0 takes nominal_speed)")
     return float(chosen)

@@ -9,6 +9,7 @@ from pydrake.systems.framework import ValueProducer
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one_values
 from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
@@ -331,6 +332,10 @@ class PoseDmpBank(BankSystem):
 
 def _check_banks(position_bank, orientation_bank, control_period):
     """The two banks must describe the same K goals with one phase."""
+    for name, bank, kind in [("position_bank", position_bank, DmpBankModel),
+                             ("orientation_bank", orientation_bank, OrientationDmpBank)]:
+        if not isinstance(bank, kind):
+            raise ValueError(f"{name} must be {kind.__name__}, got {type(bank).__name__}")
     if position_bank.dimension != 3:
         raise ValueError(f"the position bank must be 3-D, got D = {position_bank.dimension}")
     if position_bank.goal_count != orientation_bank.goal_count:

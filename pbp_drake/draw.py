@@ -127,7 +127,7 @@ def build_parser():
     parser.add_argument("--method", help="override the scenario's method")
     parser.add_argument("--format", choices=("svg", "dot"), default="svg",
                         help="svg (default), or the DOT source given to graphviz")
-    parser.add_argument("--depth", type=int, default=1,
+    parser.add_argument("--depth", type=_depth, default=1,
                         help="how many levels of nested diagrams to draw (default 1: the top "
                         "level; 0: all)")
     parser.add_argument("--check", action="store_true",
@@ -135,17 +135,47 @@ def build_parser():
     return parser
 
 
+def _depth(text):
+    """`--depth`: a whole number, 0 (all levels) or more."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a whole number of levels, 0 (all) "
+                                         "or more")
+    return value
+
+
+def _output_problem(output):
+    """What keeps the file `output` (`--output`) from being written, or None."""
+    path = pathlib.Path(output)
+    if not output:
+        return "--output: the path is empty; give a file, e.g. diagram.svg, or '-'"
+    if path.is_dir():
+        return f"--output {path}: is a folder; give a file, e.g. {path / 'diagram.svg'}"
+    folder = next(parent for parent in path.absolute().parents if parent.exists())
+    if not folder.is_dir():
+        return f"--output {path}: {folder} is a file, so its folder cannot be made"
+    return None
+
+
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.output and len(args.scenarios) > 1:
         parser.error("--output takes one scenario")
+    if args.output not in (None, "-") and not args.check:
+        problem = _output_problem(args.output)
+        if problem is not None:
+            print(f"pbp-drake draw: {problem}", file=sys.stderr)
+            return 2
 
     stale = []
     for path in args.scenarios:
         try:
             resolved = load_scenario_file(path).resolved
-            if args.method:
+            if args.method is not None:
                 resolved = resolved.with_method(args.method)
         except ScenarioError as error:
             print(f"pbp-drake draw: {error}", file=sys.stderr)

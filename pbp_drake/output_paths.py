@@ -173,6 +173,8 @@ def _is_primitive(path):  # as `pbp-drake teach` writes it (json.dumps' separato
 def _check_output_file(path, flag, example, is_ours, kind, force):
     """`path` is not a folder (`example`: a file in it), it or its folder is writable, and
     a file there is one `is_ours` recognises (`kind`) or `force` is set."""
+    if not os.fspath(path):  # pathlib would read it as ".", the current folder
+        raise OutputPathError(f"{flag}: the path is empty; give a file, e.g. {example}")
     file = pathlib.Path(path)
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
@@ -200,6 +202,8 @@ def _is_time_series(path):
 
 def check_output_folder(path):
     """Raises OutputPathError unless `path` is a writable folder or can be made one."""
+    if not os.fspath(path):  # pathlib would read it as ".", the current folder
+        raise OutputPathError("--output: the path is empty; give a folder for the results")
     output = pathlib.Path(path)
     if output.exists() and not output.is_dir():
         raise OutputPathError(f"--output {output}: is a file, not a folder; give a folder "
@@ -209,6 +213,14 @@ def check_output_folder(path):
             raise OutputPathError(f"--output {output}: the folder is not writable")
         return
     _check_can_create(output, f"--output {output}")
+
+
+def same_file(first, second):
+    """Whether the paths `first` and `second` name one file (existing or not)."""
+    first, second = pathlib.Path(first), pathlib.Path(second)
+    if first.exists() and second.exists():
+        return os.path.samefile(first, second)
+    return os.path.realpath(first) == os.path.realpath(second)
 
 
 def _check_can_create(folder, what):

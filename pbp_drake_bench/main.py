@@ -3,6 +3,7 @@ timings per (D, K, weights), the closed-loop runs, and the files it writes."""
 
 import argparse
 import json
+import math
 import os
 import platform
 import sys
@@ -36,36 +37,80 @@ SPLIT_KS = (4, 10000)
 MESHCAT_WALL_CAP = 20.0
 
 
+def _count(text):
+    """A goal count, dimension, ...: a whole number, 1 or more."""
+    return _whole(text, 1)
+
+
+def _count_or_zero(text):
+    """`--peer-max-goals`, `--blas-threads`: a whole number, 0 or more."""
+    return _whole(text, 0)
+
+
+def _whole(text, least):
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or value < least:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a whole number, {least} or more")
+    return value
+
+
+def _seconds(text):
+    """`--hsr-seconds`, `--min-time`, `--meshcat-wall-cap`: finite and positive."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a positive number of seconds")
+    return value
+
+
+def _folder(text):
+    """`--output`: a folder, or a path where one can be made (not under a file)."""
+    path = Path(text)
+    if not text:
+        raise argparse.ArgumentTypeError("the path is empty; give a folder, e.g. outputs/bench")
+    blocker = next(parent for parent in (path.absolute(), *path.absolute().parents)
+                   if parent.exists())
+    if not blocker.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: {blocker} is a file, not a folder")
+    return text
+
+
 def build_parser():
     """The argument parser of `pbp-drake bench` (the CLI reference is generated from it)."""
     parser = argparse.ArgumentParser(prog="pbp-drake bench",
                                      description=pbp_drake_bench.__doc__.split("\n")[0])
-    parser.add_argument("--output", default="outputs/bench", help="folder for bench.json "
-                        "and bench_control_rate.png (default: outputs/bench)")
+    parser.add_argument("--output", type=_folder, default="outputs/bench",
+                        help="folder for bench.json and bench_control_rate.png (default: "
+                        "outputs/bench)")
     parser.add_argument("--quick", action="store_true",
                         help="a short run: D = 3 only, fewer repeats, 1 s of HSR simulation")
-    parser.add_argument("--goals", type=int, nargs="+", default=list(KS),
+    parser.add_argument("--goals", type=_count, nargs="+", default=list(KS),
                         help=f"goal counts K (default: {' '.join(map(str, KS))})")
-    parser.add_argument("--dimensions", type=int, nargs="+", default=None,
+    parser.add_argument("--dimensions", type=_count, nargs="+", default=None,
                         help="dimensions D (default: 2 3 6; --quick: 3)")
-    parser.add_argument("--peer-max-goals", type=int, default=1000,
+    parser.add_argument("--peer-max-goals", type=_count_or_zero, default=1000,
                         help="largest K for the one-object-per-goal peers (default 1000)")
-    parser.add_argument("--hsr-goals", type=int, nargs="*", default=list(HSR_KS),
+    parser.add_argument("--hsr-goals", type=_count, nargs="*", default=list(HSR_KS),
                         help="goal counts K of the closed-loop HSR runs (default: "
                         f"{' '.join(map(str, HSR_KS))}; none skips every closed-loop "
                         "measurement: the matrix, the time split and the replays)")
     parser.add_argument("--tasks", nargs="+", choices=TASKS, default=list(TASKS),
                         help="the closed-loop tasks: reach (the HSR reaching task) and "
                         "grasp (the six-DoF grasping task) (default: both)")
-    parser.add_argument("--hsr-seconds", type=float, default=None,
+    parser.add_argument("--hsr-seconds", type=_seconds, default=None,
                         help="simulated seconds per HSR run (default 5; --quick: 1)")
     parser.add_argument("--no-meshcat", action="store_true",
                         help="skip the closed-loop runs with Meshcat (the matrix's, the time "
                         "split's and the replays)")
-    parser.add_argument("--meshcat-wall-cap", type=float, default=MESHCAT_WALL_CAP,
+    parser.add_argument("--meshcat-wall-cap", type=_seconds, default=MESHCAT_WALL_CAP,
                         help="wall seconds after which a run with Meshcat stops, reporting "
                         f"the simulated seconds it reached (default {MESHCAT_WALL_CAP:g})")
-    parser.add_argument("--split-goals", type=int, nargs="*", default=list(SPLIT_KS),
+    parser.add_argument("--split-goals", type=_count, nargs="*", default=list(SPLIT_KS),
                         help="K of the reach runs whose per-tick time is split by category "
                         f"under cProfile (default: {' '.join(map(str, SPLIT_KS))}; none to "
                         "skip)")
@@ -74,12 +119,12 @@ def build_parser():
     parser.add_argument("--no-driver-rate", action="store_true",
                         help="skip the iiwa's closed loop over LCM at its driver's rate (and "
                         "its checks)")
-    parser.add_argument("--blas-threads", type=int, default=1,
+    parser.add_argument("--blas-threads", type=_count_or_zero, default=1,
                         help="BLAS threads for every backend (default 1): the bench measures "
                         "in a fresh Python process with OPENBLAS_NUM_THREADS, "
                         "OMP_NUM_THREADS, MKL_NUM_THREADS, ... set before NumPy loads "
                         "(0: the library's default, measured in this process)")
-    parser.add_argument("--min-time", type=float, default=None,
+    parser.add_argument("--min-time", type=_seconds, default=None,
                         help="seconds of repeats per measurement (default 0.3; --quick 0.08)")
     return parser
 

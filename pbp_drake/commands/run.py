@@ -16,7 +16,8 @@ from pbp_drake.commands.signals import stopping_cleanly
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
 from pbp_drake.console import CAMERAS
 from pbp_drake.console.front import bind_page_port
-from pbp_drake.output_paths import check_log_path, check_output_folder, check_record_path
+from pbp_drake.output_paths import (
+    check_log_path, check_output_folder, check_record_path, same_file)
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.scenarios import (
     METHODS, Arm, ScenarioError, TaskScenario, load_scenario_file, resolve)
@@ -127,10 +128,13 @@ def _standing_where_the_arm_stands(scenario):
 
 def _run(args):
     # The paths first: a bad one must not cost a run, let alone a person's session.
-    if args.record:
+    if args.record is not None:
         check_record_path(args.record, force=args.force)
-    if args.log:
+    if args.log is not None:
         check_log_path(args.log, force=args.force)
+        if args.record is not None and same_file(args.record, args.log):
+            raise ScenarioError(f"--record and --log both name {args.log}; give each its "
+                                "own file")
     if args.output is not None:
         check_output_folder(args.output)
     if args.no_meshcat:

@@ -35,7 +35,13 @@ def check_run_flags(args, resolved):
     if args.record or args.log:
         raise ScenarioError("--record and --log save one run; a session saves every run under "
                             "--output")
-    methods = method_list(args.methods) if args.methods else list(DEFAULT_SESSION_METHODS)
+    methods = (list(DEFAULT_SESSION_METHODS) if args.methods is None
+               else method_list(args.methods))
+    if not methods:
+        raise ScenarioError(f"--methods {args.methods!r} names no method; give them "
+                            f"comma-separated, e.g. {','.join(DEFAULT_SESSION_METHODS)}")
+    if len(set(methods)) != len(methods):
+        raise ScenarioError(f"--methods {','.join(methods)} names a method twice")
     for method in methods:
         with_method(resolved.scenario, method)
     try:

@@ -57,6 +57,8 @@ def scenario_overrides(args, shorthands=True):
     shorthands = _shorthand_settings(args) if shorthands else []
     goals = getattr(args, "goals", None)
     if goals is not None:
+        if goals == 0:  # task.grid_objects 0 is the task's own objects: not what K asks
+            raise ScenarioError("--goals must be positive, got 0")
         shorthands.append((f"task.grid_objects={goals}", f"--goals {goals}"))
     return ScenarioOverrides(
         tuple(setting for setting, _ in shorthands) + tuple(args.settings),

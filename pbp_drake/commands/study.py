@@ -33,6 +33,7 @@ from pbp_drake.studies.results_markdown import (
     write_markdown, write_toy_study)
 from pbp_drake.studies.splits import SPLITS, first_seed, split_of
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
+from pbp_drake.scenarios.validation import check_seed
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
 
 
@@ -131,6 +132,15 @@ def _study(args):
         if given:
             raise ScenarioError(f"{flag}: {args.scenario} is a 2-D study, which has no "
                                 "virtual participant; the HSR tasks' studies take it")
+    for flag, given in (("--methods", args.methods is not None),
+                        ("--trials", args.trials is not None),
+                        ("--split", args.split is not None), ("--seed", args.seed is not None),
+                        ("--jobs", args.jobs != 1), ("--backend", args.backend != "local"),
+                        ("--ray-address", args.ray_address is not None),
+                        ("--retry-errors", args.retry_errors)):
+        if given:  # not left unused in silence
+            raise ScenarioError(f"{flag}: {args.scenario} is a 2-D study, whose runs its "
+                                "`study:` section sets; the HSR tasks' studies take it")
     if scenario_file.study is None:
         raise ScenarioError(f"{args.scenario}: has no `study:` section to run")
     output = pathlib.Path(args.output)
@@ -189,17 +199,24 @@ def _method_study(args, scenario_file, overrides):
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {} "
                             "(--set 'operator=!VirtualParticipant {}')")
+    if args.methods is not None and not method_list(args.methods):
+        raise ScenarioError(f"--methods {args.methods!r} names no method; give them "
+                            "comma-separated, e.g. pbp_alternated,teleop")
+    if args.trials is not None and args.trials < 1:
+        raise ScenarioError(f"--trials must be at least 1, got {args.trials}")
     flags = {"methods": None if args.methods is None else method_list(args.methods),
              "trials": args.trials, "split": args.split}
     study = dataclasses.replace(study, **{name: value for name, value in flags.items()
                                           if value is not None})
+    if args.seed is not None:
+        check_seed(args.seed, "--seed")
     seed = first_seed(study, study.split) if args.seed is None else args.seed
     split = split_of(study, seed, study.trials)
     if args.jobs < 1:
         raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
     if args.ray_address is not None and args.backend != "ray":
         raise ScenarioError("--ray-address needs --backend ray")
-    if len(set(study.methods)) != len(study.methods):
+    if args.methods is not None and len(set(study.methods)) != len(study.methods):
         raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
     try:
         check_method_comparison(study, scenario)
@@ -298,6 +315,10 @@ def _print_report(summary, output):
 def _compare(args):
     """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric moved by
     more than the first study's trial-to-trial SD, 2 when the studies share no trial."""
+    for which, folder in (("first", args.first), ("second", args.second)):
+        if not folder:  # pathlib would read it as ".", the current folder
+            raise ScenarioError(f"compare: the {which} folder's path is empty; give a "
+                                "`pbp-drake study` --output folder")
     rows = paired_comparison(args.first, args.second)
     if not rows:
         raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
@@ -313,6 +334,9 @@ def _compare(args):
 def _report(args):
     """`report` of a study folder, a matrix's or a folder of participant folders, with the
     exit codes the command's help gives."""
+    if not args.output:  # pathlib would read it as ".", the current folder
+        raise ScenarioError("report: the folder's path is empty; give a `pbp-drake study` "
+                            "--output folder")
     output = pathlib.Path(args.output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)

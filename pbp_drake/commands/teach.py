@@ -17,7 +17,8 @@ from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
 from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
 from pbp_drake.output_paths import (
-    check_figure_path, check_log_path, check_primitive_path, is_replay, replay_track)
+    check_figure_path, check_log_path, check_primitive_path, is_replay, replay_track,
+    same_file)
 from pbp_drake.scenarios import GraspTask, ScenarioError, TaskScenario, load_scenario_file
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.primitive_figure import plot_primitive
@@ -59,6 +60,12 @@ def _teach(args):
     check_primitive_path(args.output, force=args.force)
     if args.figure is not None:
         check_figure_path(args.figure)
+        if same_file(args.figure, args.output):
+            raise ScenarioError(f"--figure and --output both name {args.output}; give each "
+                                "its own file")
+    if args.source is None and pathlib.Path(args.output).suffix == ".csv":
+        raise ScenarioError(f"--output {args.output}: the drive's rows are saved beside the "
+                            "primitive as a .csv; give the primitive a .json file")
     scenario_file = load_scenario_file(args.scenario,
                                        scenario_overrides(args, shorthands=False))
     scenario = scenario_file.scenario

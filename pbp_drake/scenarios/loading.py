@@ -43,7 +43,16 @@ def load_scenario_file(path, overrides=None):
     file's). `overrides` (`overrides.ScenarioOverrides`: the command line's `--set` and
     `--scenario-text`) are merged onto the file's document first and checked as the file
     is; errors then name the file and the overrides."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a scenario file's path, a str or os.PathLike; got "
+                        f"{path!r}")
+    if not os.fspath(path):  # pathlib would read it as ".", the current folder
+        raise ScenarioError("the scenario file's path is empty; expected a file such as "
+                            "diagrams/hsr_reach.yaml")
     path = pathlib.Path(path)
+    if path.is_dir():
+        raise ScenarioError(f"{path}: is a folder; expected a scenario file such as "
+                            "diagrams/hsr_reach.yaml")
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
     try:
@@ -78,6 +87,9 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
         problem = _first_problem(document, schema, "")
         if problem:
             raise ScenarioError(problem)
+        if "scenario" not in document:  # not each field's default, blamed on another
+            raise ScenarioError("the file has no `scenario:` section; expected a mapping with "
+                                "`scenario:` (and optionally `study:`)")
         loaded = load_typed(schema, document)
     except ScenarioError as error:
         raise ScenarioError(f"{origin}: {error}") from None
@@ -353,6 +365,8 @@ def check_method_comparison(study, scenario):
                             "!Arm")
     if not study.methods:
         raise ScenarioError("study.methods is empty")
+    if len(set(study.methods)) != len(study.methods):
+        raise ScenarioError(f"study.methods {study.methods} names a method twice")
     for method in study.methods:
         try:
             with_method(scenario, method)

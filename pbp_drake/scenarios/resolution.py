@@ -131,13 +131,13 @@ def parse_method_label(label):
     """`(name, alpha)` of a method label: a name of the methods registry (alpha None), or
     `fixed_alpha=A` for explicit arbitration with weight A (so that one study can sweep
     alpha)."""
-    name, _, alpha = label.partition("=")
+    name, equals, alpha = label.partition("=")
     renamed_method(name)
     weighted = " or ".join(f"{m}=A" for m, method in METHODS.items() if method.takes_weight)
     if name not in METHODS:
         raise ScenarioError(f"method {label!r} is unknown; choose from {method_names()} or "
                             f"{weighted}{did_you_mean(name, METHODS)}")
-    if not alpha:
+    if not equals:
         return name, None
     if not METHODS[name].takes_weight:
         raise ScenarioError(f"method {label!r}: only {weighted} takes a weight")

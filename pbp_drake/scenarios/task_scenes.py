@@ -13,6 +13,7 @@ from pbp_drake.core.obstacle_task import sample_obstacle_scene
 from pbp_drake.core.reach_task import (
     ReachScene, sample_grid_scene, sample_reach_scene, validate_objects)
 from pbp_drake.scenarios.schema import DynamicObstacles, GraspTask, MultiGoalReach
+from pbp_drake.systems.visualizers.reach_scene_visualizer import OBJECT_HEIGHT
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,30 +82,38 @@ def _reach_scene(task, seed, reach):
 
 
 def _check_region(task, reach, heights=None):
-    """Every corner of the region the task draws its targets from (at `heights`, default
-    its `z_range` or `height`) must be in reach."""
+    """Every corner of the region the task draws its targets from (at `heights`, the
+    grasping task's table tops; default its `z_range` or `height`) must be in reach."""
     if len(task.x_range) != 2 or len(task.y_range) != 2:
         raise ValueError("x_range and y_range must be [low, high]")
+    on_tables = heights is None
     heights = heights or getattr(task, "z_range", None) or [task.height]
     _validate_within_reach([[x, y, z] for x in task.x_range for y in task.y_range
-                            for z in heights], 0.0, reach)
+                            for z in heights], 0.0, reach, on_tables)
 
 
-def _validate_within_reach(objects, min_separation, reach):
+def _validate_within_reach(objects, min_separation, reach, on_tables=True):
     """`validate_objects` with the HSR's reach, or with an arm's `(shoulder, radius)`: each
-    point within radius of the shoulder, refused with the reach the arm has."""
+    point within radius of the shoulder, refused with the reach the arm has; `on_tables`:
+    each point an object's centre, standing on a table of its own."""
     if reach is None:
-        return validate_objects(objects, min_separation)
-    objects = validate_objects(objects, min_separation, reach_x=(0.0, np.inf),
-                               reach_height=(-np.inf, np.inf))
-    shoulder, radius = reach
-    distances = np.linalg.norm(objects - shoulder, axis=1)
-    farthest = int(np.argmax(distances))
-    if distances[farthest] > radius:
-        point = ", ".join(f"{value:.2f}" for value in objects[farthest])
-        raise ValueError(f"({point}) m is {distances[farthest]:.2f} m from the arm's "
-                         f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), beyond "
-                         f"its reach of {radius:.2f} m")
+        objects = validate_objects(objects, min_separation)
+    else:
+        objects = validate_objects(objects, min_separation, reach_x=(0.0, np.inf),
+                                   reach_height=(-np.inf, np.inf))
+        shoulder, radius = reach
+        distances = np.linalg.norm(objects - shoulder, axis=1)
+        farthest = int(np.argmax(distances))
+        if distances[farthest] > radius:
+            point = ", ".join(f"{value:.2f}" for value in objects[farthest])
+            raise ValueError(f"({point}) m is {distances[farthest]:.2f} m from the arm's "
+                             f"shoulder at ({', '.join(f'{v:.2f}' for v in shoulder)}), "
+                             f"beyond its reach of {radius:.2f} m")
+    lowest = int(np.argmin(objects[:, 2]))
+    if on_tables and objects[lowest, 2] < OBJECT_HEIGHT / 2:  # a table below the floor
+        point = ", ".join(f"{value:.2f}" for value in objects[lowest])
+        raise ValueError(f"({point}) m is too low: each object stands on a table, its centre "
+                         f"at least {OBJECT_HEIGHT / 2:g} m above the floor")
     return objects
 
 

@@ -176,7 +176,10 @@ def parse_answers(text, methods):
                                      f"number {SCALE[0]} to {SCALE[-1]} "
                                      f"({scale_text(question)})") from None
         check_answer(value, question, f"--answers {item}")
-        (specific.setdefault(method, {}) if colon else common)[question] = value
+        given = specific.setdefault(method, {}) if colon else common
+        if question in given:  # not the last one, in silence
+            raise QuestionnaireError(f"--answers: {key.strip()} is answered twice")
+        given[question] = value
     answers = {}
     for method in methods:
         answers[method] = {**common, **specific.get(method, {})}

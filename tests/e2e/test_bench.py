@@ -192,6 +192,37 @@ def test_missing_peers_are_skipped_neither_passed_nor_failed():
     assert [r["verdict"] for r in results].count("skipped") == 1
 
 
+@pytest.mark.parametrize("flag, value, message", [
+    ("--goals", "0", "1 or more"),  # was "a DMP bank needs at least one goal", minutes in
+    ("--goals", "-5", "1 or more"),
+    ("--dimensions", "0", "1 or more"),
+    ("--hsr-goals", "0", "1 or more"),  # was a ZeroDivisionError traceback
+    ("--split-goals", "0", "1 or more"),
+    ("--peer-max-goals", "-1", "0 or more"),
+    ("--blas-threads", "-1", "0 or more"),
+    ("--hsr-seconds", "0", "a positive number of seconds"),  # was the default, in silence
+    ("--hsr-seconds", "nan", "a positive number of seconds"),  # was Drake's AdvanceTo failure
+    ("--min-time", "-1", "a positive number of seconds"),
+    ("--meshcat-wall-cap", "0", "a positive number of seconds"),
+    ("--output", "", "the path is empty"),  # was the current folder
+    ("--output", "{tmp}/notes.txt", "{tmp}/notes.txt is a file"),  # was a traceback
+    ("--output", "{tmp}/notes.txt/bench", "{tmp}/notes.txt is a file"),
+])
+def test_a_bad_flag_value_is_refused_before_anything_is_measured(tmp_path, capsys, flag, value,
+                                                                  message):
+    from pbp_drake.cli import main
+
+    (tmp_path / "notes.txt").write_text("not a folder")
+    argv = ["bench", "--quick", "--output", str(tmp_path / "bench"), flag,
+            value.replace("{tmp}", str(tmp_path))]
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument {flag}: " in err and message.replace("{tmp}", str(tmp_path)) in err
+    assert [path.name for path in tmp_path.iterdir()] == ["notes.txt"]
+
+
 def test_quick_keeps_every_check_with_the_same_limits():
     quick, full = plan(_parse(["--quick"])), plan(_parse([]))
     for settings in (quick, full):

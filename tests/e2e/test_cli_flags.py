@@ -15,6 +15,8 @@ from pbp_drake.commands.scenario_flags import scenario_overrides
 
 QUICK = "diagrams/toy_alt_vs_cont.yaml"
 TASK = "diagrams/hsr_reach.yaml"
+SESSION = ["--operator", "virtual", "--participant", "P1", "--headless", "--answers",
+           "tiredness=3,ease=4"]
 
 
 @pytest.mark.parametrize("flag, value, message", [
@@ -132,15 +134,36 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     (["run", QUICK, "--no-meshcat", "--log", "{tmp}/run.csv"],
      "--log streams an HSR task's per-tick rows; this scenario uses the 2-D toy robot"),
     (["driver-sim", TASK, "--duration", "0"], "--duration must be positive, got 0"),
+    # A value that was taken in silence for another: the file's objects, alpha or methods,
+    # no replay or log, the two files written over each other.
+    (["run", TASK, "--no-meshcat", "--operator", "virtual", "--goals", "0"],
+     "--goals must be positive, got 0"),
+    (["run", TASK, "--no-meshcat", "--method", "fixed_alpha="],
+     "method 'fixed_alpha=': alpha must be a number in [0, 1]"),
+    (["run", TASK, "--headless", "--operator", "virtual", "--record", ""],
+     "--record: the path is empty; give a file, e.g. replay.html"),
+    (["run", TASK, "--no-meshcat", "--operator", "virtual", "--log", ""],
+     "--log: the path is empty; give a file, e.g. run.csv"),
+    (["run", TASK, "--headless", "--operator", "virtual", "--record", "{tmp}/run.html",
+      "--log", "{tmp}/run.html"], "--record and --log both name {tmp}/run.html"),
+    (["session", TASK, *SESSION, "--output", ""],
+     "--output: the path is empty; give a folder for the results"),
+    (["session", TASK, *SESSION, "--output", "{tmp}/P1", "--methods", ""],
+     "--methods '' names no method; give them comma-separated"),
+    (["session", TASK, *SESSION, "--output", "{tmp}/P1", "--methods", ","],
+     "--methods ',' names no method"),
+    (["session", TASK, *SESSION, "--output", "{tmp}/P1", "--methods", "teleop,teleop"],
+     "--methods teleop,teleop names a method twice"),
     (["driver-sim", TASK], "the scenario's robot needs hardware: !Arm's {driver: panda}"),
 ])
 def test_a_flag_the_scenario_cannot_take_is_refused_in_one_line(repo, tmp_path, capsys, argv,
-                                                                 message):
+                                                                 message, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # a default output folder would be made here
     argv = [str(repo / arg) if arg.endswith(".yaml") else arg.format(tmp=tmp_path)
             for arg in argv]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err.startswith("pbp-drake: ") and message in err
+    assert err.startswith("pbp-drake: ") and message.replace("{tmp}", str(tmp_path)) in err
     assert len(err.strip().splitlines()) == 1 and not any(tmp_path.iterdir())
 
 

@@ -95,6 +95,35 @@ def test_draw_names_a_bad_scenario(tmp_path, capsys):
     assert not (tmp_path / "bad.svg").exists()
 
 
+@pytest.mark.parametrize("argv, message", [
+    (["--output", "{tmp}"], "--output {tmp}: is a folder; give a file"),
+    (["--output", "{tmp}/notes.txt/toy.svg"],
+     "--output {tmp}/notes.txt/toy.svg: {tmp}/notes.txt is a file, so its folder cannot be made"),
+    (["--output", ""], "--output: the path is empty"),
+    (["--method", ""], "method '' is unknown"),  # was the file's method, in silence
+])
+def test_draw_names_a_bad_output_or_method_in_one_line(tmp_path, capsys, monkeypatch, argv,
+                                                       message):
+    monkeypatch.chdir(tmp_path)  # where `--output ''` wrote beside the scenario, it is here
+    (tmp_path / "notes.txt").write_text("not a folder")
+    scenario = tmp_path / "toy.yaml"
+    scenario.write_text((DIAGRAMS / "toy_alt_vs_cont.yaml").read_text())
+    argv = [arg.replace("{tmp}", str(tmp_path)) for arg in argv]
+    assert main([str(scenario), "--format", "dot", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pbp-drake draw: ") and len(err.splitlines()) == 1
+    assert message.replace("{tmp}", str(tmp_path)) in err
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["notes.txt", "toy.yaml"]
+
+
+@pytest.mark.parametrize("depth", ["-1", "one"])
+def test_draw_refuses_a_depth_below_zero(capsys, depth):
+    with pytest.raises(SystemExit) as exit_info:
+        main([str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--depth", depth])
+    assert exit_info.value.code == 2
+    assert "argument --depth: " in capsys.readouterr().err  # not Drake's max_depth failure
+
+
 def test_draw_without_graphviz_says_what_to_install(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr("pbp_drake.draw.dot_program", lambda: None)
     assert main([str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--output",

@@ -214,3 +214,20 @@ def test_teach_does_not_overwrite_a_file_that_is_not_a_primitive(tmp_path, capsy
     code, out = run("teach", REACH, "--output", notes, capsys=capsys)
     assert code == 2 and "is not a primitive written by pbp-drake" in out.err
     assert notes.read_text() == "{}"
+
+
+@pytest.mark.parametrize("argv, message", [
+    # The drive's rows went to P.csv, then the primitive over them.
+    (["--output", "{tmp}/P.csv"], "--output {tmp}/P.csv: the drive's rows are saved beside "
+     "the primitive as a .csv; give the primitive a .json file"),
+    (["--output", "{tmp}/P.png", "--figure", "{tmp}/P.png"],
+     "--figure and --output both name {tmp}/P.png; give each its own file"),
+    (["--output", ""], "--output: the path is empty; give a file, e.g. primitive.json"),
+])
+def test_outputs_that_would_overwrite_each_other_are_refused(tmp_path, capsys, monkeypatch,
+                                                             argv, message):
+    monkeypatch.chdir(tmp_path)
+    code, out = run("teach", REACH, *[arg.replace("{tmp}", str(tmp_path)) for arg in argv],
+                    capsys=capsys)
+    assert code == 2 and out.err == f"pbp-drake: {message.replace('{tmp}', str(tmp_path))}\n"
+    assert list(tmp_path.iterdir()) == []

@@ -70,6 +70,18 @@ def test_a_goal_region_out_of_reach_is_refused_with_the_reach_the_arm_has():
         resolve(dataclasses.replace(scenario, task=far))
 
 
+@pytest.mark.parametrize("change", [dict(z_range=[0.0, 0.0]),
+                                    dict(objects=[[0.5, 0.0, 0.04], [0.5, 0.2, 0.3]],
+                                         targets=[0, 1, 0])])
+def test_an_object_too_low_for_its_table_is_refused(change):
+    # Was Drake's Box() failure (a table of negative height) when the scene was drawn.
+    scenario = arm_scenario()
+    low = dataclasses.replace(scenario.task, **change)
+    with pytest.raises(ScenarioError, match=r"scenario\.task: \(0\.\d\d, .*\) m is too low: "
+                       r"each object stands on a table, its centre at least 0\.05 m above"):
+        resolve(dataclasses.replace(scenario, task=low))
+
+
 def test_the_grasping_task_is_refused_on_an_arm():
     scenario = load_scenario_file(REPO / "diagrams" / "hsr_grasp.yaml").scenario
     with pytest.raises(ScenarioError, match="runs on the HSR's pose station"):

@@ -61,6 +61,9 @@ VARIANTS = {
                         ["line", "found undefined alias"]),
     "list_as_key": (SHIPPED, _replace("\n  method:", "\n  ? [a]\n  : 1\n  method:"),
                     ["line", "found unhashable key"]),
+    # Was blamed on scenario.start and scenario.goals, the 2-D scene's defaults.
+    "no_scenario_section": (("hsr_reach.yaml",), lambda text: "study:" + text.split("\nstudy:")[1],
+                            ["has no `scenario:` section"]),
 }
 CASES = [(name, file) for name, (files, _, _) in VARIANTS.items() for file in files]
 
@@ -205,6 +208,23 @@ def test_a_missing_file_is_named(tmp_path, run_refused):
     path = tmp_path / "missing.yaml"
     code, err, _ = run_refused(path)
     assert code == 2 and err == f"pbp-drake: {path}: no such scenario file\n", err
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda folder: folder, "{path}: is a folder; expected a scenario file"),
+    (lambda folder: "", "the scenario file's path is empty"),
+])
+def test_a_folder_or_an_empty_path_is_named(tmp_path, make, message):
+    path = make(tmp_path)
+    with pytest.raises(ScenarioError, match=f"^{message.format(path=path)}"):
+        load_scenario_file(path)  # both were "no such scenario file"
+
+
+@pytest.mark.parametrize("path", [None, 3, b"diagrams/hsr_reach.yaml"])
+def test_a_path_of_another_type_is_named(path):
+    with pytest.raises(TypeError, match="path must be a scenario file's path, a str or "
+                                        f"os.PathLike; got {path!r}"):
+        load_scenario_file(path)
 
 
 def test_the_shipped_files_still_load():

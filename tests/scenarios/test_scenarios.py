@@ -93,6 +93,9 @@ def test_a_method_label_can_carry_the_arbitration_weight():
     assert with_method(Scenario(), "teleop").method == "teleop"
     for bad, message in [("fixed_alpha=2", "in \\[0, 1\\]"), ("teleop=0.5", "only fixed_alpha"),
                          ("fixed_alpha=half", "alpha must be a number in \\[0, 1\\]"),
+                         # The weight left out: not the file's alpha in silence.
+                         ("fixed_alpha=", "'fixed_alpha=': alpha must be a number"),
+                         ("teleop=", "'teleop=': only fixed_alpha"),
                          ("fixed_alfa", "did you mean 'fixed_alpha'")]:
         with pytest.raises(ScenarioError, match=message):
             with_method(Scenario(), bad)

@@ -2,6 +2,7 @@
 and reports the rest; a 2-D study and a method comparison refuse each other's folders."""
 
 import json
+import pathlib
 
 import pytest
 
@@ -198,6 +199,23 @@ def test_nothing_to_report_exits_2(tmp_path, capsys):
 def test_a_missing_folder_is_named(tmp_path, capsys):
     assert main(["report", str(tmp_path / "none")]) == 2
     assert capsys.readouterr().err == f"pbp-drake: {tmp_path / 'none'}: no such folder\n"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["report", ""], "report: the folder's path is empty"),
+    (["compare", "", "B"], "compare: the first folder's path is empty"),
+    (["compare", "A", ""], "compare: the second folder's path is empty"),
+])
+def test_an_empty_folder_path_is_named(tmp_path, capsys, monkeypatch, argv, message):
+    monkeypatch.chdir(_study(tmp_path))  # not the current folder's study, in silence
+    (pathlib.Path("A") / "x").mkdir(parents=True)
+    (pathlib.Path("B") / "x").mkdir(parents=True)
+    listed = sorted(path.name for path in pathlib.Path().iterdir())
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pbp-drake: {message}; give a `pbp-drake study` --output folder")
+    assert len(err.splitlines()) == 1
+    assert sorted(path.name for path in pathlib.Path().iterdir()) == listed
 
 
 def test_a_2d_study_refuses_a_method_comparison_folder(tmp_path, repo, capsys):

@@ -64,6 +64,9 @@ def test_fixed_answers_hold_for_every_method_unless_a_method_overrides_them():
     ("tired=3,ease=4", "unknown question 'tired'"),
     ("fixed_alpha:tiredness=3,ease=4", "'fixed_alpha' is not one of the participant's methods"),
     ("tiredness 3,ease=4", "'tiredness 3' is not "),  # not [METHOD:]QUESTION=VALUE
+    # An answer given twice: was the last one, in silence.
+    ("tiredness=3,ease=4,tiredness=1", "--answers: tiredness is answered twice"),
+    ("teleop:ease=1,tiredness=3,ease=4,teleop:ease=2", "--answers: teleop:ease is answered twice"),
 ])
 def test_bad_fixed_answers_are_named(text, message):
     with pytest.raises(QuestionnaireError, match=message.replace("(", r"\(").replace(")", r"\)")):

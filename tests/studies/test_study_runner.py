@@ -547,6 +547,24 @@ def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
      "!MethodComparison"),
     ("hsr_reach.yaml", None, ["--methods", "teleop,teleop"],
      "--methods teleop,teleop names a method twice"),
+    # The file's own methods, or --set's: not blamed on a --methods never given.
+    ("hsr_reach.yaml", "study: !MethodComparison {methods: [teleop, teleop]}\n", [],
+     "{file}: study.methods ['teleop', 'teleop'] names a method twice"),
+    ("hsr_reach.yaml", None, ["--set", "study.methods=[teleop, teleop]"],
+     "{file} with --set 'study.methods=[teleop, teleop]': study.methods ['teleop', 'teleop'] "
+     "names a method twice"),
+    # The flag named, not the study.methods or study.trials it replaces.
+    ("hsr_reach.yaml", None, ["--methods", ","], "--methods ',' names no method; give them "
+     "comma-separated, e.g. pbp_alternated,teleop"),
+    ("hsr_reach.yaml", None, ["--trials", "0"], "--trials must be at least 1, got 0"),
+    # A seed no trial can take: not a folder of failed trials.
+    ("hsr_reach.yaml", None, ["--seed", "-1", "--trials", "1"],
+     "--seed -1 cannot seed the random draws; expected a non-negative integer"),
+    # A flag of the HSR tasks' studies on a 2-D study: refused, not left unused in silence.
+    *[("toy_alpha_study.yaml", None, [flag, value], f"{flag}: {{file}} is a 2-D study, whose "
+       "runs its `study:` section sets; the HSR tasks' studies take it")
+      for flag, value in [("--methods", "teleop"), ("--trials", "0"), ("--split", "tuning"),
+                          ("--seed", "-1"), ("--jobs", "0"), ("--retry-errors", None)]],
 ])
 def test_a_study_the_file_cannot_run_is_refused(repo, tmp_path, capsys, study, section, argv,
                                                 message):
@@ -555,6 +573,7 @@ def test_a_study_the_file_cannot_run_is_refused(repo, tmp_path, capsys, study, s
         text = text.split("\nstudy:")[0] + "\n" + section
     scenario = tmp_path / study
     scenario.write_text(text)
+    argv = [arg for arg in argv if arg is not None]
     assert main(["study", str(scenario), "--output", str(tmp_path / "out"), *argv]) == 2
     assert capsys.readouterr().err == f"pbp-drake: {message.format(file=scenario)}\n"
     assert not (tmp_path / "out").exists()

@@ -13,6 +13,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from pbp_drake.core.arbitration import BLEND_LAWS
+from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.core.goal_estimation import READS_COMMAND, READS_INTENT, estimator_entry
 from pbp_drake.core.methods import ASSISTED, BLENDED, METHODS
@@ -20,7 +21,8 @@ from pbp_drake.systems import (
     Blender, DmpBank, GoalEstimator, GoalGrouping, HandOver, HeadingCommand, HopAssistance,
     IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator, PoseGoalEstimator,
     PoseIntentFilterGoalEstimator, PoseMaxEntGoalEstimator)
-from pbp_drake.systems.ports import EeState, OperatorCommand
+from pbp_drake.systems.pbp.dmp_bank import checked_prediction
+from pbp_drake.systems.ports import EeState, OperatorCommand, checked_count
 
 # How far ahead the task scenes draw the DMPs' paths, in samples over the DMP's duration.
 TASK_PREDICTION_SAMPLES = 40
@@ -68,14 +70,21 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     `selected_goal` is the followed goal's index (with goal groups, -1 until the robot
     commits to one), `goal_probabilities` the estimator's K probabilities.
     """
+    if not isinstance(config, PbpControllerConfig):
+        raise ValueError(f"config must be PbpControllerConfig, got {type(config).__name__}")
     config.validate()
-    initial_ee_state = np.asarray(initial_ee_state, float).reshape(-1)
+    given = initial_ee_state
+    initial_ee_state = _floats(initial_ee_state).reshape(-1)
     if initial_ee_state.size != EeState.size or not np.isfinite(initial_ee_state).all():
+        shown = initial_ee_state.tolist() if initial_ee_state.size else repr(given)
         raise ValueError(f"initial_ee_state must be {EeState.size} finite numbers (an "
-                         f"EeState), got {initial_ee_state.tolist()}")
-    goals = np.asarray(goals, float)
+                         f"EeState), got {shown}")
+    goals = _floats(goals)
     if goals.ndim != 2 or goals.shape[1] != 3 or len(goals) == 0:
         raise ValueError(f"goals must be a non-empty (K, 3) array, got shape {goals.shape}")
+    check_positions(goals, "goals")
+    prediction_steps = checked_prediction(prediction_steps, None)
+    predicted_goal_count = checked_count(predicted_goal_count, "predicted_goal_count")
     builder = DiagramBuilder()
     # Drake's (C++) Demultiplexers: no Python call is spent on splitting.
     split = builder.AddNamedSystem("ee_state_split", Demultiplexer([6, EeState.size - 6]))
@@ -87,7 +96,7 @@ def make_pbp_controller(config: PbpControllerConfig, initial_ee_state, goals,
     name, add_policy = _POLICIES[METHODS[config.method].policy]
     estimator, reference, shown = add_policy(
         builder, config, start, goals, split, command_split, prediction_steps,
-        min(int(predicted_goal_count), len(goals)))
+        min(predicted_goal_count, len(goals)))
     heading = builder.AddNamedSystem("heading_command", HeadingCommand(
         EeState(initial_ee_state).heading, config.control_period,
         config.hand_over.max_hand_yaw_acceleration,
@@ -131,6 +140,14 @@ def make_goal_estimator(config: PbpControllerConfig, goal_count, pose=False, for
         return posterior(goal_count, config.hop, period, settings.margin, settings.hold_steps,
                          operator_speed=config.nominal_speed)
     return (PoseGoalEstimator if pose else GoalEstimator)(goal_count, settings, period)
+
+
+def _floats(values):
+    """`values` as a float array; an empty one when they are not numbers (a string)."""
+    try:
+        return np.asarray(values, float)
+    except (TypeError, ValueError):
+        return np.zeros(0)
 
 
 def _add_pbp_policy(builder, config, start, goals, split, command_split, prediction_steps,

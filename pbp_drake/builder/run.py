@@ -13,6 +13,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorS
 
 from pbp_drake.builder.build import build_diagram
 from pbp_drake.builder.grasp import grasp_series_fields
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.interaction_metrics import InteractionMeter, idle_ratio
 from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import ResolvedScenario, counted, resolve
@@ -46,6 +47,9 @@ def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=No
     """`(scenario, diagram, simulator)` of a scenario (resolved once if it is not): the
     diagram built unless given, the simulator configured by the scenario's
     `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized."""
+    if realtime_rate is not None and not (is_real(realtime_rate) and realtime_rate >= 0):
+        raise ValueError(f"realtime_rate must be a number >= 0 (0: as fast as possible), got "
+                         f"{realtime_rate!r}")
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
     diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
     simulator = Simulator(diagram)

@@ -9,6 +9,8 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.coordinates import is_real
+
 #: `BlendLaw.weight` of a law whose weight alpha is the method's own (`scenario.alpha`) ...
 FIXED_WEIGHT = "fixed"
 #: ... and of one whose alpha is the goal confidence's ramp, every control period.
@@ -60,7 +62,7 @@ def blend_law(mode, laws=BLEND_LAWS):
 
 def check_alpha(mode, alpha):
     """Raises ValueError unless `alpha` is a finite number in [0, 1]."""
-    if alpha is None or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
+    if not is_real(alpha) or not np.isfinite(alpha) or not 0.0 <= alpha <= 1.0:
         raise ValueError(f"alpha must lie in [0, 1] for {mode}, got {alpha}")
 
 

@@ -12,6 +12,7 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.dmp import DmpBankModel, DmpSettings
 from pbp_drake.core.dmp.primitive import Primitive, primitive_bank
 from pbp_drake.core.goal_estimation import READS_POSE, GoalEstimatorSettings, estimator_entry
@@ -52,7 +53,7 @@ class HandOverSettings(HandLimits):
     def validate(self):
         """Raises ValueError naming the first limit that cannot be used."""
         super().validate()
-        if not self.max_heading_turn > 0:
+        if not (is_real(self.max_heading_turn) and self.max_heading_turn > 0):
             raise ValueError(f"max_heading_turn must be finite and positive (rad; .inf for "
                              f"no bound), got {self.max_heading_turn!r}")
 
@@ -90,13 +91,18 @@ class ControlSettings:
     def validate_settings(self):
         """Raises ValueError naming the first of its numbers or settings that cannot be
         used (its method is checked by its user, who knows the methods it runs)."""
-        if not (np.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
+        if not (is_real(self.alpha) and np.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
             raise ValueError(f"alpha must lie in [0, 1], got {self.alpha!r}")
         check_limit(self.control_period, "control_period", "s")
-        if not (np.isfinite(self.dmp_duration) and self.dmp_duration >= 0.0):
+        if not (is_real(self.dmp_duration) and np.isfinite(self.dmp_duration)
+                and self.dmp_duration >= 0.0):
             raise ValueError(f"dmp_duration must be finite and not negative (0: derived), "
                              f"got {self.dmp_duration!r}")
-        for name in ("dmp", "goal_estimator", "hop"):
+        kinds = {"dmp": DmpSettings, "goal_estimator": GoalEstimatorSettings, "hop": HopSettings}
+        for name, kind in kinds.items():
+            if not isinstance(getattr(self, name), kind):
+                raise ValueError(f"{name} must be {kind.__name__}, got "
+                                 f"{type(getattr(self, name)).__name__}")
             try:
                 getattr(self, name).validate()
             except ValueError as error:
@@ -124,6 +130,9 @@ class PbpControllerConfig(ControlSettings):
                              f"{did_you_mean(self.method, METHODS)}")
         self.validate_settings()
         check_limit(self.nominal_speed, "nominal_speed", "m/s")
+        if not isinstance(self.hand_over, HandOverSettings):
+            raise ValueError(f"hand_over must be HandOverSettings, got "
+                             f"{type(self.hand_over).__name__}")
         try:
             self.hand_over.validate()
         except ValueError as error:

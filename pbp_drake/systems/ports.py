@@ -4,6 +4,7 @@
 
 import dataclasses
 import math
+import numbers
 import re
 
 import numpy as np
@@ -37,9 +38,15 @@ def position_of(view):
 
 def checked_goal_count(goal_count):
     """`goal_count` as an int; ValueError unless it is an integer >= 1."""
-    if isinstance(goal_count, bool) or int(goal_count) != goal_count or goal_count < 1:
-        raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
-    return int(goal_count)
+    return checked_count(goal_count, "goal_count")
+
+
+def checked_count(value, name):
+    """`value` as an int; ValueError, naming it `name`, unless it is an integer >= 1."""
+    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+            or not math.isfinite(value) or int(value) != value or value < 1):
+        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    return int(value)
 
 
 def checked_settings(settings, kind):
@@ -56,9 +63,10 @@ def goal_index(port, context, goal_count, unconnected=None):
     `unconnected` when nothing is connected to the port."""
     if not port.HasValue(context):
         return unconnected
-    index = int(port.Eval(context)[0])
-    if not 0 <= index < goal_count:
-        raise ValueError(f"{port.get_name()} {index} is not one of the {goal_count} goals")
+    value = port.Eval(context)[0]
+    index = int(value) if math.isfinite(value) else -1
+    if not 0 <= index < goal_count or index != value:
+        raise ValueError(f"{port.get_name()} {value:g} is not one of the {goal_count} goals")
     return index
 
 
@@ -77,15 +85,20 @@ OperatorTwist = _view("OperatorTwist", ["vx", "vy", "vz", "wx", "wy", "wz"])
 def finite_pose_state(state, name):
     """`state` (a `PoseState`) as a float array; raises ValueError naming `name` and the
     fields that are NaN or infinite."""
-    state = np.asarray(state, dtype=float)
+    return finite_fields(state, name, PoseState.get_fields())
+
+
+def finite_fields(vector, name, fields):
+    """`vector` as a float array; raises ValueError naming `name` and the `fields` (one name
+    an entry) that are NaN or infinite."""
+    vector = np.asarray(vector, dtype=float)
     # A sum of floats is finite unless a number is NaN or infinite (or the sum overflows,
     # which the exact check below lets pass): a fifth of `np.isfinite`'s time.
-    if not math.isfinite(sum(state.tolist())):
-        bad = [field for field, value in zip(PoseState.get_fields(), state)
-               if not math.isfinite(value)]
+    if not math.isfinite(sum(vector.tolist())):
+        bad = [field for field, value in zip(fields, vector) if not math.isfinite(value)]
         if bad:
-            raise ValueError(f"{name} {', '.join(bad)} is NaN or infinite: {state.tolist()}")
-    return state
+            raise ValueError(f"{name} {', '.join(bad)} is NaN or infinite: {vector.tolist()}")
+    return vector
 
 
 _GETTER = re.compile(r"get_(\w+)_(input|output)_port")

@@ -4,7 +4,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.systems.ports import PortGetters
-from pbp_drake.systems.tick import SENSE_OFFSET
+from pbp_drake.systems.tick import SENSE_OFFSET, checked_period
 
 
 class SampleHold(PortGetters, LeafSystem):
@@ -25,10 +25,14 @@ class SampleHold(PortGetters, LeafSystem):
     def __init__(self, period, initial_value):
         super().__init__()
         initial_value = np.asarray(initial_value, dtype=float)
+        if initial_value.ndim != 1 or initial_value.size == 0:
+            raise ValueError(f"initial_value must be a non-empty vector, got "
+                             f"{initial_value.tolist()}")
         self._input_port = self.DeclareVectorInputPort("u", initial_value.size)
         index = self.DeclareDiscreteState(initial_value)
         self.DeclareStateOutputPort("y", index)
-        self.DeclarePeriodicDiscreteUpdateEvent(period, SENSE_OFFSET, self._update)
+        self.DeclarePeriodicDiscreteUpdateEvent(checked_period(period, "period"), SENSE_OFFSET,
+                                                self._update)
 
     def _update(self, context, discrete_state):
         discrete_state.get_mutable_vector().set_value(self._input_port.Eval(context))

@@ -20,11 +20,15 @@ DECIDE_FRACTION = 1e-6
 DECISION_LOG_SHIFT = 1
 
 
-def checked_period(control_period):
-    """`control_period` (s) as a float; ValueError unless it is finite and positive."""
-    period = float(control_period)
+def checked_period(control_period, name="control_period"):
+    """`control_period` (s) as a float; ValueError, naming it `name`, unless it is finite
+    and positive."""
+    try:
+        period = float(control_period)
+    except (TypeError, ValueError):
+        period = math.nan
     if not (math.isfinite(period) and period > 0.0):
-        raise ValueError(f"control_period must be positive, got {control_period!r}")
+        raise ValueError(f"{name} must be positive, got {control_period!r}")
     return period
 
 

@@ -140,3 +140,42 @@ def test_a_start_or_goals_of_the_wrong_shape_are_refused(start, goals, message):
     with pytest.raises(ValueError) as error:
         make_pbp_controller(PbpControllerConfig(), start, goals)
     assert message in str(error.value)
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"alpha": "half"}, "alpha must lie in [0, 1], got 'half'"),
+    ({"dmp_duration": None}, "dmp_duration must be finite and not negative (0: derived), got None"),
+    ({"dmp": None}, "dmp must be DmpSettings, got NoneType"),
+    ({"goal_estimator": "angle"}, "goal_estimator must be GoalEstimatorSettings, got str"),
+    ({"hop": None}, "hop must be HopSettings, got NoneType"),
+    ({"hand_over": None}, "hand_over must be HandOverSettings, got NoneType"),
+    ({"hand_over": HandOverSettings(max_heading_turn="wide")},
+     "hand_over.max_heading_turn must be finite and positive (rad; .inf for no bound), got 'wide'"),
+])
+def test_a_field_of_the_wrong_type_is_named(change, message):
+    config = dataclasses.replace(PbpControllerConfig(), **change)
+    with pytest.raises(ValueError) as error:
+        make_pbp_controller(config, np.zeros(8), [[0.5, 0.0, 0.3]])
+    assert message in str(error.value)
+
+
+@pytest.mark.parametrize("arguments, message", [
+    ({"config": None}, "config must be PbpControllerConfig, got NoneType"),
+    ({"goals": [[np.nan, 0.0, 0.3]]}, "goals 0 is [nan, 0.0, 0.3]: positions must be finite"),
+    ({"goals": [[0.5, 0.0, 0.3], [np.inf, 0.0, 0.3]]}, "goals 1 is [inf, 0.0, 0.3]"),
+    ({"goals": "0.5 0 0.3"}, "goals must be a non-empty (K, 3) array, got shape (0,)"),
+    ({"initial_ee_state": "home"}, "initial_ee_state must be 8 finite numbers (an EeState), "
+                                   "got 'home'"),
+    ({"prediction_steps": None}, "prediction_steps must be a whole number >= 0, got None"),
+    ({"prediction_steps": -1}, "prediction_steps must be a whole number >= 0, got -1"),
+    ({"prediction_steps": 5, "predicted_goal_count": np.nan},
+     "predicted_goal_count must be an integer >= 1, got nan"),
+    ({"prediction_steps": 5, "predicted_goal_count": 1.5},
+     "predicted_goal_count must be an integer >= 1, got 1.5"),
+])
+def test_a_bad_argument_of_the_controller_is_named(arguments, message):
+    arguments = {"config": PbpControllerConfig(), "initial_ee_state": np.zeros(8),
+                 "goals": [[0.5, 0.0, 0.3]], **arguments}
+    with pytest.raises(ValueError) as error:
+        make_pbp_controller(**arguments)
+    assert message in str(error.value)

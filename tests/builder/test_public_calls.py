@@ -8,7 +8,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
-from pbp_drake.builder import make_hsr_operator, make_operator, read_log
+from pbp_drake.builder import make_hsr_operator, make_operator, read_log, simulate
 from pbp_drake.scenarios import ObstacleRepulsion, VirtualParticipant, load_scenario_file
 
 
@@ -38,3 +38,11 @@ def test_a_log_read_past_its_samples_says_how_many_it_has():
     with pytest.raises(ValueError, match="log has 3 samples; 4 are needed"):
         read_log(diagram, context, "log", 3, shift=1)
     assert read_log(diagram, context, "no_log", 3) == (None, None)
+
+
+@pytest.mark.parametrize("rate", [-1.0, float("nan"), "fast"])
+def test_a_realtime_rate_that_is_no_rate_is_refused_by_name(repo, rate):
+    toy = load_scenario_file(repo / "diagrams" / "toy_alt_vs_cont.yaml").scenario
+    with pytest.raises(ValueError, match=r"realtime_rate must be a number >= 0 \(0: as fast as "
+                                         r"possible\), got "):
+        simulate(toy, realtime_rate=rate)

@@ -294,3 +294,48 @@ def test_affine_coefficients_are_refused_to_dmps_of_their_own_weights_or_starts(
     straight = DmpBankModel.straight([0.0], 2, 1.0)
     assert straight.affine_in_goal
     straight.affine_coefficients(1.0, np.zeros((1, 1)), 0.01, straight.make_workspace())
+
+
+_DMP = Dmp.straight([0.0, 0.0], [1.0, 0.0], 1.0)
+_BANK = DmpBankModel.straight([0.0, 0.0], 2, 1.0)
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: Dmp.straight([0.0], [1.0], "1 s"), "duration must be positive and finite, got 1 s"),
+    (lambda: Dmp.straight([0.0], [1.0], None), "duration must be positive and finite, got None"),
+    (lambda: Dmp.straight([0.0], [1.0], 1.0, settings=None),
+     "settings must be DmpSettings, got NoneType"),
+    (lambda: Dmp(np.zeros((50, 1)), [0.0], [1.0], 1.0, settings="ijspeert"),
+     "settings must be DmpSettings, got str"),
+    (lambda: Dmp(np.full((50, 1), np.nan), [0.0], [1.0], 1.0),
+     "weights contain NaN or infinite values"),
+    (lambda: DmpBankModel(np.full((50, 1), np.inf), [0.0], 1.0),
+     "weights contain NaN or infinite values"),
+    (lambda: DmpBankModel.straight([0.0], 2, 1.0, settings=None),
+     "settings must be DmpSettings, got NoneType"),
+    (lambda: DmpBankModel.straight([0.0], np.nan, 1.0), "goal_count must be an integer >= 1"),
+    (lambda: DmpBankModel.straight([0.0], 1.5, 1.0), "goal_count must be an integer >= 1"),
+    (lambda: DmpBankModel.straight([0.0], None, 1.0),
+     "goal_count must be an integer >= 1, got None"),
+    (lambda: DmpSettings(basis_count=np.nan), "basis_count must be a whole number, got nan"),
+    (lambda: DmpSettings(basis_count=None), "basis_count must be a whole number, got None"),
+    (lambda: DmpSettings(alpha_z=np.inf), "alpha_z must be finite, got inf"),
+    (lambda: DmpSettings(alpha_x="fast"), "alpha_x must be a number, got 'fast'"),
+    (lambda: minimum_jerk([0.0], [1.0], 0.0), "duration must be positive and finite, got 0"),
+    (lambda: minimum_jerk([0.0], [1.0], np.nan), "duration must be positive and finite"),
+    (lambda: minimum_jerk([0.0], [1.0], 1.0, sample_count=1),
+     "sample_count must be a whole number >= 2, got 1"),
+    (lambda: _DMP.rollout(0.0), "dt must be positive and finite, got 0"),
+    (lambda: _DMP.rollout(-0.01), "dt must be positive and finite, got -0.01"),
+    (lambda: _DMP.rollout(0.01, duration=np.inf), "duration must be positive and finite"),
+    (lambda: _DMP.next_step(np.nan), "dt must be positive and finite, got nan"),
+    (lambda: _DMP.next_step(0.01, robot_velocity=[np.nan, 0.0], phase_locked=True),
+     "robot_velocity contains NaN"),
+    (lambda: _BANK.predict(*_BANK.initial_state(), _BANK.goals_matrix([[1.0, 0.0]] * 2), 0.01,
+                           -1), "steps must be a whole number >= 0, got -1"),
+    (lambda: _BANK.predict(*_BANK.initial_state(), _BANK.goals_matrix([[1.0, 0.0]] * 2), 0.0,
+                           10), "dt must be positive and finite, got 0"),
+])
+def test_a_bad_argument_is_refused_naming_it(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()

@@ -352,3 +352,20 @@ def test_a_goal_half_a_turn_away_is_turned_to_as_the_single_dmp_turns():
     expected, _ = dmp.next_step(0.03)
     np.testing.assert_allclose(turned[:, 0], expected, atol=1e-12)
     assert expected[3] > 0.0  # it turned, about +z
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: OrientationDmp.straight(quaternion.IDENTITY, quaternion.IDENTITY, 1.0,
+                                     settings=None), "settings must be DmpSettings, got NoneType"),
+    (lambda: OrientationDmp.straight(quaternion.IDENTITY, quaternion.IDENTITY, None),
+     "duration must be positive and finite, got None"),
+    (lambda: OrientationDmp.straight(quaternion.IDENTITY, quaternion.IDENTITY, 1.0).next_step(
+        -0.03), "dt must be positive and finite, got -0.03"),
+    (lambda: OrientationDmpBank.straight(quaternion.IDENTITY, np.inf, 1.0),
+     "goal_count must be an integer >= 1, got inf"),
+    (lambda: OrientationDmpBank.straight(quaternion.IDENTITY, 2, 1.0, settings="pastor"),
+     "settings must be DmpSettings, got str"),
+])
+def test_a_bad_argument_is_refused_naming_it(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()

@@ -163,3 +163,20 @@ def test_a_damaged_orientation_is_refused_naming_the_field():
     with pytest.raises(ValueError, match=r"orientation.weights \(50, 3\) and "
                                          r"orientation.quaternions \(199, 4\) do not fit"):
         read_primitive_document(document)
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: primitive_bank(None, START, 3), r"primitive must be a Primitive \(teach_primitive, "
+                                            r"read_primitive_document\), got NoneType"),
+    (lambda: primitive_orientation_bank("wall.json", [1.0, 0.0, 0.0, 0.0], 3),
+     "primitive must be a Primitive .* got str"),
+    (lambda: primitive_bank(teach_primitive(*over_a_wall()), START, None),
+     "goal_count must be an integer >= 1, got None"),
+    (lambda: primitive_bank(teach_primitive(*over_a_wall()), START, 2.5),
+     "goal_count must be an integer >= 1, got 2.5"),
+    (lambda: primitive_orientation_bank(teach_primitive(*over_a_wall()), [1.0, 0.0, 0.0, 0.0],
+                                        3), "primitive has no orientation shape"),
+])
+def test_a_bank_of_what_is_no_primitive_is_refused_naming_it(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()

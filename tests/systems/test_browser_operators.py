@@ -230,3 +230,16 @@ def test_gamepad_forward_only_when_allowed(meshcat):
     set_gamepad(meshcat, [0.0, 1.0, 0.0, 0.0])  # full back: allowed
     rig.advance(PERIOD)
     np.testing.assert_allclose(rig.command()[:2], -SPEED * FORWARD_IN_WORLD, atol=1e-12)
+
+
+@pytest.mark.parametrize("operator", [KeyboardOperator, GamepadOperator])
+def test_a_browser_operator_names_a_meshcat_or_params_it_cannot_use(meshcat, operator):
+    with pytest.raises(ValueError, match=r"^meshcat must be a pydrake Meshcat "
+                                         r"\(StartMeshcat\(\)\), got NoneType"):
+        operator(None, PERIOD, allow_forward=False, nominal_speed=SPEED)
+    with pytest.raises(ValueError, match=r"^params must be the operator's parameters \(e.g. "
+                                         r"KeyboardParams\), got NoneType"):
+        operator(meshcat, PERIOD, False, None, nominal_speed=SPEED)
+    with pytest.raises(ValueError, match="the operator's speed must be positive: got speed "
+                                         "0.0 and nominal_speed 'fast'"):
+        operator(meshcat, PERIOD, allow_forward=False, nominal_speed="fast")

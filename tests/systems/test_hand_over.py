@@ -10,8 +10,13 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Ze
 from pbp_drake.core.arbitration import BLEND_MODES
 from pbp_drake.core.dmp import DmpBankModel as DmpModel
 from pbp_drake.core.hand_over import hand_over
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.core.hindsight_optimization import HopSettings
+from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.systems import (
-    Blender, DmpBank, GoalsSource, HandOver, PointRobotDynamics, ScriptedOperator)
+    Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand,
+    HopAssistance, IdleOperator, IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator,
+    ObstacleRepulsionOperator, PointRobotDynamics, SampleHold, ScriptedOperator, TaskMonitor)
 from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.systems.tick import decide_offset
 
@@ -65,6 +70,104 @@ def test_the_loops_systems_refuse_what_they_cannot_run(build, message):
         build()
 
 
+_PERIOD_USERS = {
+    "Blender": lambda period: Blender("pbp_continuous", 2, 2, period),
+    "DmpBank": lambda period: DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), period),
+    "ScriptedOperator": lambda period: ScriptedOperator([0.0], [[0.0, 0.0]], period),
+    "IdleOperator": lambda period: IdleOperator(2, period),
+    "HeadingCommand": lambda period: HeadingCommand(0.0, period),
+    "DemonstrationPlayer": lambda period: DemonstrationPlayer(
+        [0.0, 0.5, 1.0], [[0.0], [0.5], [1.0]], period),
+    "TaskMonitor": lambda period: TaskMonitor([[0.5, 0.0, 0.4]], [0], [0.0], [0.0, 0.0, 0.0],
+                                              0.05, period),
+    "SampleHold": lambda period: SampleHold(period, [0.0, 0.0]),
+}
+
+
+@pytest.mark.parametrize("period", [0.0, -0.03, np.nan, np.inf, "0.03s", None])
+@pytest.mark.parametrize("system", sorted(_PERIOD_USERS))
+def test_every_system_names_a_control_period_that_is_not_positive(system, period):
+    name = "period" if system == "SampleHold" else "control_period"
+    with pytest.raises(ValueError, match=f"^{name} must be positive, got "):
+        _PERIOD_USERS[system](period)
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: Blender("pbp_continuous", 2, -1, 0.03), "goal_count must be an integer >= 1"),
+    (lambda: Blender("pbp_continuous", 2, 1.5, 0.03), "goal_count must be an integer >= 1"),
+    (lambda: Blender("pbp_continuous", 0, 2, 0.03), "dimension must be an integer >= 1"),
+    (lambda: Blender("pbp_continuous", None, 2, 0.03), "dimension must be an integer >= 1"),
+    (lambda: HopAssistance("hop", -1, HopSettings(), 0.03),
+     "goal_count must be an integer >= 1"),
+    (lambda: GoalEstimator(np.inf, GoalEstimatorSettings(), 0.03),
+     "goal_count must be an integer >= 1, got inf"),
+    (lambda: GoalEstimator(None, GoalEstimatorSettings(), 0.03),
+     "goal_count must be an integer >= 1, got None"),
+    (lambda: LikelyGoals(3, 1.5), "count must be an integer >= 1, got 1.5"),
+    (lambda: IdleOperator(-1, 0.03), "dimension must be an integer >= 1, got -1"),
+])
+def test_the_systems_name_a_count_that_is_no_whole_number(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"max_speed": 0.0}, r"max_speed must be positive \(None: no limit\), got 0.0"),
+    ({"max_speed": -1.0}, r"max_speed must be positive \(None: no limit\), got -1.0"),
+    ({"max_speed": np.nan}, r"max_speed must be positive \(None: no limit\), got nan"),
+    ({"prediction_steps": -1}, r"prediction_steps must be a whole number >= 0, got -1"),
+    ({"prediction_steps": 1.5}, r"prediction_steps must be a whole number >= 0, got 1.5"),
+    ({"prediction_steps": None}, r"prediction_steps must be a whole number >= 0, got None"),
+    ({"prediction_steps": 3, "prediction_period": -0.1},
+     r"prediction_period must be positive, got -0.1"),
+    ({"prediction_steps": 3, "prediction_period": np.nan},
+     r"prediction_period must be positive, got nan"),
+    ({"prediction_steps": 3, "predicted_goal_count": np.nan},
+     r"predicted_goal_count must be in \[1, 2\] \(the goal count\), got nan"),
+    ({"prediction_steps": 3, "predicted_goal_count": 1.5},
+     r"predicted_goal_count must be in \[1, 2\] \(the goal count\), got 1.5"),
+])
+def test_the_bank_names_an_option_it_cannot_run(options, message):
+    with pytest.raises(ValueError, match=message):
+        DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, **options)
+
+
+@pytest.mark.parametrize("bank", [None, "bank", np.zeros((50, 2))])
+def test_the_bank_names_a_bank_that_is_no_dmp_bank_model(bank):
+    with pytest.raises(ValueError, match="^bank must be a DmpBankModel, got "):
+        DmpBank(bank, 0.03)
+
+
+def test_an_unbounded_anti_windup_is_no_limit():
+    DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, max_speed=np.inf)
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: HandOver([], 1.0, 0.5, 0.03), r"initial_position must be finite, got \[\]"),
+    (lambda: HeadingCommand(np.nan, 0.03), "initial_heading must be a finite angle"),
+    (lambda: HeadingCommand(None, 0.03), "initial_heading must be a finite angle .*, got None"),
+    (lambda: Blender("fixed_alpha", 2, 2, 0.03, alpha="half"),
+     "alpha must lie in \\[0, 1\\] for fixed_alpha, got half"),
+    (lambda: PointRobotDynamics([np.nan, 0.0]), "initial_position must be a non-empty finite"),
+    (lambda: PointRobotDynamics([]), "initial_position must be a non-empty finite"),
+    (lambda: PointRobotDynamics([0.0, 0.0], None), "params must be PointRobotParams"),
+    (lambda: SampleHold(0.03, []), r"initial_value must be a non-empty vector, got \[\]"),
+    (lambda: SampleHold(0.03, [[0.0, 1.0]]), "initial_value must be a non-empty vector"),
+    (lambda: ObstacleRepulsionOperator([[np.nan, 0.0]], [0.1], 2, 0.03),
+     r"centres must be finite, got \[\[nan, 0.0\]\]"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [-0.1], 2, 0.03),
+     r"radii must be one positive radius per centre \(1\), got \[-0.1\]"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [], 2, 0.03), "radii must be one positive"),
+    (lambda: IntentFilterGoalEstimator(2, IntentFilterSettings(), 0.03, margin=None),
+     "margin must lie in \\[0, 1\\), got None"),
+    (lambda: MaxEntGoalEstimator(2, HopSettings(), 0.03, hold_steps=None),
+     "hold_steps must be an integer >= 1, got None"),
+])
+def test_a_constructor_names_an_argument_it_cannot_use(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
+
+
 def test_a_script_of_single_numbers_is_a_one_dimensional_operator():
     person = ScriptedOperator([0.0, 1.0], [0.1, -0.2], 0.03)
     assert person.get_operator_command_output_port().size() == 1
@@ -76,6 +179,28 @@ def test_a_selected_goal_that_is_no_goal_is_refused_by_the_bank():
     bank.get_selected_goal_input_port().FixValue(context, [2.0])
     with pytest.raises(ValueError, match="selected_goal 2 is not one of the 2 goals"):
         bank.get_selected_reference_output_port().Eval(context)
+
+
+@pytest.mark.parametrize("selected", [np.nan, 0.5, np.inf])
+def test_a_selected_goal_that_is_no_whole_index_is_refused_by_the_blender(selected):
+    blender = Blender("pbp_continuous", 2, 2, 0.03)
+    context = blender.CreateDefaultContext()
+    for port, value in [("robot_state", np.zeros(4)), ("references", np.zeros(8)),
+                        ("selected_goal", [selected]), ("operator_command", np.zeros(2)),
+                        ("operator_active", [0.0])]:
+        blender.GetInputPort(port).FixValue(context, value)
+    with pytest.raises(ValueError, match=f"selected_goal {selected:g} is not one of the 2 goals"):
+        blender.get_command_output_port().Eval(context)
+
+
+def test_a_nan_robot_state_is_refused_by_the_bank_naming_the_entry():
+    bank = DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03)
+    simulator = Simulator(bank)
+    context = bank.GetMyContextFromRoot(simulator.get_mutable_context())
+    bank.get_robot_state_input_port().FixValue(context, [0.0, 0.0, np.nan, 0.0])
+    bank.get_goals_input_port().FixValue(context, GOALS.reshape(-1))
+    with pytest.raises(ValueError, match=r"robot_state velocity\[0\] is NaN or infinite"):
+        simulator.AdvanceTo(0.03)
 
 
 class ScriptedSelection(LeafSystem):

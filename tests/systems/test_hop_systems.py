@@ -159,6 +159,30 @@ def test_the_intent_filter_refuses_a_nan_goal_at_its_first_update():
         simulator.AdvanceTo(PERIOD)
 
 
+@pytest.mark.parametrize("estimator", [
+    lambda: IntentFilterGoalEstimator(len(GOALS), IntentFilterSettings(), PERIOD),
+    lambda: MaxEntGoalEstimator(len(GOALS), SETTINGS, PERIOD),
+])
+@pytest.mark.parametrize("port, field, message", [
+    ("ee_state", 1, r"ee_state y is NaN or infinite: \[0.0, nan"),
+    ("operator_command", 3, r"operator_command yaw_rate is NaN or infinite: \[0.0, 0.0, 0.0"),
+])
+def test_the_estimators_refuse_a_nan_hand_or_command_naming_the_field(estimator, port, field,
+                                                                      message):
+    values = {"ee_state": np.concatenate([HAND, np.zeros(5)]), "operator_command": np.zeros(4)}
+    values[port][field] = np.nan
+    builder = DiagramBuilder()
+    estimator = builder.AddSystem(estimator())
+    builder.Connect(constant(builder, values["ee_state"]), estimator.get_ee_state_input_port())
+    builder.Connect(constant(builder, GOALS.reshape(-1)), estimator.get_goals_input_port())
+    builder.Connect(constant(builder, values["operator_command"]),
+                    estimator.get_operator_command_input_port())
+    builder.Connect(constant(builder, [1.0]), estimator.get_operator_active_input_port())
+    simulator = Simulator(builder.Build())
+    with pytest.raises(ValueError, match=message):
+        simulator.AdvanceTo(PERIOD)
+
+
 def test_the_assistance_systems_keep_their_method():
     assert HopAssistance("predict_then_assist", 3, SETTINGS, PERIOD).method == (
         "predict_then_assist")

@@ -16,7 +16,8 @@ from pbp_drake.core.dmp import DmpSettings
 from pbp_drake.core.dmp.orientation_bank import OrientationDmpBank
 from pbp_drake.core.pose_arbitration import HandOverLimits
 from pbp_drake.systems.pbp.goals_source import GoalsSource
-from pbp_drake.systems import PoseBlender, PoseDmpBank, PoseHandOver
+from pbp_drake.core.goal_estimation import GoalEstimatorSettings
+from pbp_drake.systems import PoseBlender, PoseDmpBank, PoseGoalGrouping, PoseHandOver
 
 DT = 0.01
 ANGULAR_STEP = 0.3  # rad/s: the most the commanded angular velocity may change per tick
@@ -182,3 +183,17 @@ def test_its_weight_is_a_context_parameter_as_the_blenders():
     with pytest.raises(RuntimeError, match="PoseBlender in confidence_alpha mode needs its "
                                            "goal_probabilities input port connected"):
         confident.alpha(confident.CreateDefaultContext())
+
+
+@pytest.mark.parametrize("limits", [None, (1.0, 0.2), 3.0])
+def test_the_pose_hand_over_names_limits_that_are_no_hand_over_limits(limits):
+    with pytest.raises(ValueError, match=r"^limits must be HandOverLimits \(max_acceleration, "
+                                         r"max_speed, max_angular_acceleration, "
+                                         r"max_angular_speed\), got "):
+        PoseHandOver(START, limits, DT)
+
+
+@pytest.mark.parametrize("value", [None, "0.1"])
+def test_the_pose_grouping_names_a_metres_per_radian_that_is_no_number(value):
+    with pytest.raises(ValueError, match="metres_per_radian must be a finite number >= 0, got "):
+        PoseGoalGrouping(2, GoalEstimatorSettings(method="pose"), DT, value)

@@ -328,3 +328,28 @@ def test_a_cloned_context_of_the_compact_state_steps_as_the_original():
         rows = [system.get_references_output_port().Eval(simulator.get_context())
                 for simulator in (first, second)]
         np.testing.assert_array_equal(rows[0], rows[1])
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"max_speed": 0.0}, r"max_speed must be positive \(None: no limit\), got 0.0"),
+    ({"max_angular_speed": np.nan}, r"max_angular_speed must be positive \(None: no limit\)"),
+    ({"prediction_steps": -2}, r"prediction_steps must be a whole number >= 0, got -2"),
+    ({"prediction_steps": 3, "prediction_period": -0.1},
+     r"prediction_period must be positive, got -0.1"),
+])
+def test_the_pose_bank_names_an_option_it_cannot_run(options, message):
+    positions, orientations, _ = make_banks()
+    with pytest.raises(ValueError, match=message):
+        PoseDmpBank(positions, orientations, DT, **options)
+
+
+@pytest.mark.parametrize("which, message", [
+    ("position_bank", "position_bank must be DmpBankModel, got NoneType"),
+    ("orientation_bank", "orientation_bank must be OrientationDmpBank, got str"),
+])
+def test_the_pose_bank_names_a_bank_of_the_wrong_kind(which, message):
+    positions, orientations, _ = make_banks()
+    banks = {"position_bank": positions, "orientation_bank": orientations}
+    banks[which] = None if which == "position_bank" else "turns"
+    with pytest.raises(ValueError, match=message):
+        PoseDmpBank(control_period=DT, **banks)

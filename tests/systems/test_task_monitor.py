@@ -176,3 +176,49 @@ def test_the_grasp_monitor_keeps_the_same_rules():
 def test_a_switch_schedule_without_one_target_per_entry_is_refused():
     with pytest.raises(ValueError, match="one target per entry of switch_schedule"):
         TaskMonitor(OBJECTS, [0, 1], [0.0], [0.0, 0.0, 0.0], 0.05, PERIOD)
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"objects": []}, r"objects must be a non-empty finite \(M, 3\) array, got shape \(0,\)"),
+    ({"objects": [[0.5, 0.0]]}, r"objects must be .* got shape \(1, 2\)"),
+    ({"objects": [[np.nan, 0.0, 0.4]]}, r"objects must be a non-empty finite \(M, 3\) array"),
+    ({"targets": [2]}, r"targets must be object indices 0 to 1, got \[2\]"),
+    ({"targets": [-1]}, r"targets must be object indices 0 to 1, got \[-1\]"),
+    ({"targets": [0.5]}, r"targets must be object indices 0 to 1, got \[0.5\]"),
+    ({"switch_schedule": [np.nan]}, r"switch_schedule must be finite, got \[nan\]"),
+    ({"start": [0.0, 0.0]}, r"start must be 3 finite numbers \[x, y, z\], got \[0.0, 0.0\]"),
+    ({"start": [np.nan, 0.0, 0.0]}, r"start must be 3 finite numbers"),
+    ({"success_distance": 0.0}, r"success_distance must be finite and positive \(m\), got 0.0"),
+    ({"success_distance": -0.05}, r"success_distance must be finite and positive"),
+    ({"success_distance": np.nan}, r"success_distance must be finite and positive"),
+    ({"success_distance": None}, r"success_distance must be a number \(m\), got None"),
+])
+def test_the_monitor_names_an_argument_it_cannot_referee(change, message):
+    arguments = {"objects": OBJECTS, "targets": [0], "switch_schedule": [0.0],
+                 "start": [0.0, 0.0, 0.0], "success_distance": 0.05, "control_period": PERIOD}
+    with pytest.raises(ValueError, match=message):
+        TaskMonitor(**{**arguments, **change})
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"grasp_positions": [[0.5, 0.0]]}, r"grasp_positions must be a non-empty finite \(M, 3\)"),
+    ({"success_angle": 0.0}, r"success_angle must be finite and positive \(rad\), got 0.0"),
+    ({"success_distance": np.inf}, r"success_distance must be finite and positive"),
+])
+def test_the_grasp_monitor_names_an_argument_it_cannot_referee(change, message):
+    level = [1.0, 0.0, 0.0, 0.0]
+    arguments = {"grasp_positions": OBJECTS, "grasp_orientations": [level, level],
+                 "targets": [0], "switch_schedule": [0.0], "start_pose": [0.0] * 3 + level,
+                 "success_distance": 0.05, "success_angle": 0.2, "control_period": PERIOD}
+    with pytest.raises(ValueError, match=message):
+        GraspTaskMonitor(**{**arguments, **change})
+
+
+def test_a_nan_hand_is_refused_by_the_monitor_naming_the_field():
+    monitor = TaskMonitor(OBJECTS, [0], [0.0], [0.0, 0.0, 0.0], 0.05, PERIOD)
+    simulator = Simulator(monitor)
+    context = monitor.GetMyContextFromRoot(simulator.get_mutable_context())
+    monitor.get_ee_state_input_port().FixValue(context, [0.0, np.nan] + [0.0] * 6)
+    monitor.get_operator_active_input_port().FixValue(context, [0.0])
+    with pytest.raises(ValueError, match=r"ee_state y is NaN or infinite: \[0.0, nan"):
+        simulator.AdvanceTo(PERIOD)

@@ -99,3 +99,27 @@ def test_facing_a_target_behind_the_picked_object_it_goes_there_itself():
     assert velocity @ facing(sideways) <= 1e-12
     assert velocity[0] > 0.1  # toward the target, at nearly the whole speed
 
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"objects": []}, r"objects must be a non-empty finite \(M, 3\) array, got shape \(0,\)"),
+    ({"objects": [[0.5, 0.0]]}, r"objects must be .* got shape \(1, 2\)"),
+    ({"objects": [[np.nan, 0.0, 0.4]]}, r"objects must be a non-empty finite \(M, 3\) array"),
+    ({"params": None}, "params must be VirtualParticipantParams, got NoneType"),
+    ({"heading_range": (1.0, -1.0)},
+     r"heading_range must be \(lowest, highest\) finite headings \(rad\), got \(1.0, -1.0\)"),
+    ({"heading_range": (np.nan, 1.0)}, "heading_range must be"),
+    ({"seed": 1.5}, "seed must be a whole number >= 0, got 1.5"),
+    ({"seed": -1}, "seed must be a whole number >= 0, got -1"),
+    ({"params": VirtualParticipantParams(reaction_delay=-0.3)},
+     "params.reaction_delay must be finite and not negative, got -0.3"),
+    ({"params": VirtualParticipantParams(direction_noise=np.nan)},
+     "params.direction_noise must be finite and not negative, got nan"),
+    ({"params": VirtualParticipantParams(hold_time=None)},
+     "params.hold_time must be finite and not negative, got None"),
+])
+def test_the_participant_names_an_argument_it_cannot_act_on(change, message):
+    arguments = {"control_period": 0.03, "objects": [[0.5, 0.0, 0.4], [0.6, 0.2, 0.4]],
+                 "nominal_speed": 0.1, **change}
+    with pytest.raises(ValueError, match=message):
+        VirtualOperator(**arguments)

@@ -223,3 +223,21 @@ def test_the_cloud_colours_the_most_probable_goal_blue_and_the_unlikely_grey():
     halfway = recorder.colours[:, 1].astype(float)
     assert (np.minimum(UNLIKELY_RGB, LIKELY_RGB) < halfway).all()
     assert (halfway < np.maximum(UNLIKELY_RGB, LIKELY_RGB)).all()
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda meshcat: ReachSceneVisualizer(meshcat, []),
+     r"objects must be a non-empty finite \(M, 3\) array, got shape \(0,\)"),
+    (lambda meshcat: ReachSceneVisualizer(meshcat, [[np.nan, 0.0, 0.4]]),
+     r"objects must be a non-empty finite \(M, 3\) array"),
+    (lambda meshcat: ReachSceneVisualizer(meshcat, [[0.5, 0.0, 0.4]], publish_period=0.0),
+     "publish_period must be positive, got 0.0"),
+    (lambda meshcat: PointSceneVisualizer(meshcat, [0.0, 0.0], [[np.nan, 0.0]], []),
+     r"goals must be a non-empty finite \(K, D\) array, got \[\[nan, 0.0\]\]"),
+    (lambda meshcat: PointSceneVisualizer(meshcat, [0.0, 0.0], [[1.0, 0.0]], [],
+                                          publish_period=-1.0),
+     "publish_period must be positive, got -1.0"),
+])
+def test_a_visualizer_names_what_it_cannot_draw(meshcat, build, message):
+    with pytest.raises(ValueError, match=message):
+        build(meshcat)

@@ -1,7 +1,11 @@
 """Input checks shared by the DMP modules: each names the field it refuses, as every input
 check of the package does."""
 
+import numbers
+
 import numpy as np
+
+from pbp_drake.core.dmp.settings import DmpSettings
 
 
 def read_only(array, dtype=None):
@@ -24,11 +28,33 @@ def as_point(value, name, dimension=None):
     return point
 
 
+def is_number(value):
+    """Whether `value` is a real number (NumPy's too), not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
 def positive(value, name):
     """`value` as a float, refused unless finite and positive."""
-    if not (np.isfinite(value) and value > 0):
+    if not (is_number(value) and np.isfinite(value) and value > 0):
         raise ValueError(f"{name} must be positive and finite, got {value}")
     return float(value)
+
+
+def dmp_settings(settings):
+    """`settings`, refused unless a `DmpSettings`."""
+    if not isinstance(settings, DmpSettings):
+        raise ValueError(f"settings must be DmpSettings, got {type(settings).__name__}")
+    return settings
+
+
+def goal_count_of(goal_count):
+    """`goal_count` as an int, refused unless a whole number >= 1."""
+    if is_number(goal_count) and goal_count < 1:
+        raise ValueError("a DMP bank needs at least one goal")
+    if not (is_number(goal_count) and np.isfinite(goal_count) and goal_count >= 1
+            and int(goal_count) == goal_count):
+        raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
+    return int(goal_count)
 
 
 def goal_indices(indices, goal_count):

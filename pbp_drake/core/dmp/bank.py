@@ -11,7 +11,8 @@ import numpy as np
 
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp._checks import (
-    as_point, broadcast_goalwise, followed_velocity, goal_indices, positive, read_only)
+    as_point, broadcast_goalwise, dmp_settings, followed_velocity, goal_count_of, goal_indices,
+    is_number, positive, read_only)
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
 from pbp_drake.core.dmp.settings import DmpSettings, phase_decay
 from pbp_drake.core.dmp.single import straight_weights
@@ -37,7 +38,7 @@ class BankModel:
         (`(N, D)` shared by all goals, or `(K, N, D)` one set per goal, kept `(N, D, K)`),
         `goal_count` (K: with shared weights the given one, else one per row of `starts`),
         `dimension` (D; None: the weights'), the amplitude scaling `(D, K)` and the basis."""
-        settings.validate()
+        dmp_settings(settings).validate()
         self._settings = dataclasses.replace(settings)
         self.duration = positive(duration, "duration")
         weights = np.asarray(weights, dtype=float)
@@ -53,13 +54,13 @@ class BankModel:
             self._weights = read_only(weights.transpose(1, 2, 0))  # (N, D, K)
         else:
             raise ValueError(f"weights must be (N, D) or (K, N, D), got shape {weights.shape}")
+        if not np.isfinite(weights).all():
+            raise ValueError("weights contain NaN or infinite values")
         dimension = weights.shape[-1] if dimension is None else dimension
         if weights.shape[-2:] != (settings.basis_count, dimension):
             raise ValueError(f"weights have shape {weights.shape}; the settings say "
                              f"{settings.basis_count} basis functions, of {dimension} numbers")
-        if goal_count < 1:
-            raise ValueError("a DMP bank needs at least one goal")
-        self.goal_count = goal_count
+        self.goal_count = goal_count_of(goal_count)
         self.dimension = dimension
         scaling = np.ones((goal_count, dimension), bool) if amplitude_scaling is None else (
             np.broadcast_to(np.asarray(amplitude_scaling, bool), (goal_count, dimension)))
@@ -86,7 +87,8 @@ class BankModel:
         by all goals and scaled by each one's amplitude (`g - y0`, or `-e0`); Pastor: `f = 0`,
         whose attractor already slides from the start to the goal."""
         dimension = cls._straight_dimension(start)
-        if settings.formulation == "ijspeert":
+        goal_count_of(goal_count)
+        if dmp_settings(settings).formulation == "ijspeert":
             weights = straight_weights(settings, duration, np.ones(dimension))
         else:
             weights = np.zeros((settings.basis_count, dimension))
@@ -117,12 +119,15 @@ class BankModel:
         """Open-loop paths `(K, steps + 1, rows)` from one state (`start` `(rows, 1)` or
         `(rows, K)`), for drawing predictions; the inputs are left alone. `workspace`
         saves allocating one (the paths are new anyway)."""
+        positive(dt, "dt")
+        if not (is_number(steps) and steps >= 0 and int(steps) == steps):
+            raise ValueError(f"steps must be a whole number >= 0, got {steps!r}")
         workspace = self.make_workspace() if workspace is None else workspace
-        path = np.empty((steps + 1,) + self.starts.shape)
+        path = np.empty((int(steps) + 1,) + self.starts.shape)
         path[0] = np.broadcast_to(start, self.starts.shape)
         phase = np.array(phase, dtype=float)
         velocity = np.array(velocity, dtype=float)
-        for step in range(steps):
+        for step in range(int(steps)):
             self.advance_into(phase, path[step], velocity, goals, dt, phase, path[step + 1],
                               velocity, workspace)
         return path.transpose(2, 0, 1)

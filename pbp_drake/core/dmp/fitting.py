@@ -7,7 +7,7 @@ attractor form (`tau dz = K (y_attr - y) - D z`, solved for `y_attr` along the d
 
 import numpy as np
 
-from pbp_drake.core.dmp._checks import as_point
+from pbp_drake.core.dmp._checks import as_point, dmp_settings, is_number, positive
 from pbp_drake.core.dmp.settings import DmpSettings
 
 
@@ -15,7 +15,10 @@ def minimum_jerk(start, goal, duration, sample_count=200):
     """Times `(T,)` and positions `(T, D)` of a minimum-jerk straight path, rest to rest."""
     start = as_point(start, "start")
     goal = as_point(goal, "goal", dimension=start.size)
-    times = np.linspace(0.0, duration, sample_count)
+    duration = positive(duration, "duration")
+    if not (is_number(sample_count) and sample_count >= 2 and int(sample_count) == sample_count):
+        raise ValueError(f"sample_count must be a whole number >= 2, got {sample_count!r}")
+    times = np.linspace(0.0, duration, int(sample_count))
     s = times / duration
     progress = 10 * s**3 - 15 * s**4 + 6 * s**5
     return times, start + np.outer(progress, goal - start)
@@ -57,6 +60,7 @@ def fit_weights(times, positions, settings=DmpSettings()):
     twice its start-to-goal distance (the reference code's guard, which also covers `g = y0`).
     """
     times, positions = validate_demonstration(times, positions)
+    dmp_settings(settings)
     elapsed = times - times[0]
     tau = elapsed[-1]
     start, goal = positions[0], positions[-1]

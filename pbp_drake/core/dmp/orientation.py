@@ -12,6 +12,7 @@ degrees of its last orientation: docs/concepts/dmp.md, "Orientation DMPs"."""
 import numpy as np
 
 from pbp_drake.core import quaternion
+from pbp_drake.core.dmp._checks import positive
 from pbp_drake.core.dmp.fitting import check_times, fit_weights
 from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import SingleDmp
@@ -112,6 +113,7 @@ class OrientationDmp(SingleDmp):
         `robot_orientation` replaces the DMP's (PBP's re-integration); while
         `phase_locked`, the phase stays, the orientation is the robot's and the angular
         velocity follows `robot_angular_velocity`."""
+        positive(dt, "dt")
         goal = (self.goal if goal is None
                 else quaternion.unit_quaternions(goal, "goal").reshape(4))
         if robot_orientation is not None:

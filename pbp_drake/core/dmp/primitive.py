@@ -10,6 +10,7 @@ import dataclasses
 import numpy as np
 
 from pbp_drake.core import quaternion
+from pbp_drake.core.dmp._checks import goal_count_of
 from pbp_drake.core.dmp.bank import DmpBankModel
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
 from pbp_drake.core.dmp.orientation import (
@@ -134,6 +135,7 @@ def _fit_error(times, positions, weights, scaling, settings):
 def primitive_bank(primitive: Primitive, start, goal_count, duration=None) -> DmpBankModel:
     """`goal_count` DMPs from `start` with the primitive's shape (goals given at run time),
     of `duration` (s; the demonstration's when None)."""
+    _check_primitive(primitive, goal_count)
     return DmpBankModel(primitive.weights, start,
                         primitive.duration if duration is None else duration,
                         primitive.settings, primitive.amplitude_scaling, goal_count)
@@ -143,10 +145,21 @@ def primitive_orientation_bank(primitive: Primitive, start, goal_count,
                                duration=None) -> OrientationDmpBank:
     """`goal_count` orientation DMPs from the unit quaternion `start` with the primitive's
     orientation shape (it must have one), of `duration` (s; the demonstration's when None)."""
-    shape = primitive.orientation
+    shape = _check_primitive(primitive, goal_count).orientation
+    if shape is None:
+        raise ValueError("primitive has no orientation shape: teach it with orientations")
     return OrientationDmpBank(shape.weights, start,
                               primitive.duration if duration is None else duration,
                               primitive.settings, shape.amplitude_scaling, goal_count)
+
+
+def _check_primitive(primitive, goal_count):
+    """`primitive`, refused unless a `Primitive` (and `goal_count` a whole number >= 1)."""
+    goal_count_of(goal_count)
+    if not isinstance(primitive, Primitive):
+        raise ValueError(f"primitive must be a Primitive (teach_primitive, "
+                         f"read_primitive_document), got {type(primitive).__name__}")
+    return primitive
 
 
 def primitive_document(primitive: Primitive) -> dict:

@@ -9,6 +9,7 @@ every caller shares.
 import dataclasses
 import functools
 import math
+import numbers
 
 import numpy as np
 
@@ -53,16 +54,25 @@ class DmpSettings:
             raise ValueError(
                 f"formulation {self.formulation!r} is unknown; choose one of {FORMULATIONS}"
             )
+        count = self.basis_count
+        if isinstance(count, bool) or not (isinstance(count, numbers.Real)
+                                           and math.isfinite(count) and int(count) == count):
+            raise ValueError(f"basis_count must be a whole number, got {count!r}")
         if self.basis_count < 2:
             raise ValueError(f"basis_count must be at least 2, got {self.basis_count}")
         if self.basis_count > MAX_BASIS_COUNT:
             raise ValueError(f"basis_count must be at most {MAX_BASIS_COUNT}, got "
                              f"{self.basis_count}")
-        for name in ("alpha_z", "alpha_x"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
-        if self.beta_z is not None and not self.beta_z > 0:
-            raise ValueError(f"beta_z must be positive, got {self.beta_z}")
+        for name in ("alpha_z", "alpha_x", "beta_z"):
+            value = getattr(self, name)
+            if name == "beta_z" and value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise ValueError(f"{name} must be a number, got {value!r}")
+            if not value > 0:
+                raise ValueError(f"{name} must be positive, got {value}")
+            if not math.isfinite(value):
+                raise ValueError(f"{name} must be finite, got {value}")
 
     @property
     def stiffness(self):

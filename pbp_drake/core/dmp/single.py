@@ -8,7 +8,7 @@ against. `SingleDmp` is what it shares with `OrientationDmp`.
 
 import numpy as np
 
-from pbp_drake.core.dmp._checks import as_point, positive
+from pbp_drake.core.dmp._checks import as_point, dmp_settings, positive
 from pbp_drake.core.dmp.fitting import fit_weights, minimum_jerk, validate_demonstration
 from pbp_drake.core.dmp.settings import DmpSettings, phase_decay, step_matrices
 
@@ -33,12 +33,14 @@ class SingleDmp:
 
     def __init__(self, weights, start, goal, duration, settings, amplitude_scaling,
                  dimension):
-        self.settings = settings
+        self.settings = dmp_settings(settings)
         self.start, self.goal = self._ends(start, goal)
         self.weights = np.asarray(weights, dtype=float).reshape(settings.basis_count, -1)
         if self.weights.shape[1] != dimension:
             raise ValueError(f"weights have {self.weights.shape[1]} dimensions, expected "
                              f"{dimension}")
+        if not np.isfinite(self.weights).all():
+            raise ValueError("weights contain NaN or infinite values")
         self.duration = positive(duration, "duration")
         self.amplitude_scaling = (
             np.ones(dimension, bool)
@@ -58,6 +60,7 @@ class SingleDmp:
         """
         start, goal = cls._ends(start, goal)
         span = cls._span(start, goal)
+        dmp_settings(settings)
         if profile == "zero_forcing":
             weights = np.zeros((settings.basis_count, span.size))
             return cls(weights, start, goal, duration, settings)
@@ -95,8 +98,10 @@ class SingleDmp:
     def rollout(self, dt, duration=None):
         """Open-loop path `(steps + 1, ...)` of the state `PATH` from the current state, the
         state kept."""
+        dt = positive(dt, "dt")
+        duration = self.duration if duration is None else positive(duration, "duration")
         saved = dict(vars(self))  # a step replaces the state's arrays, never writes in them
-        steps = int(round((self.duration if duration is None else duration) / dt))
+        steps = int(round(duration / dt))
         path = [getattr(self, self.PATH)]
         for _ in range(steps):
             path.append(self.next_step(dt)[0])
@@ -161,13 +166,15 @@ class Dmp(SingleDmp):
         while `phase_locked`, the DMP does not advance: its velocity follows `robot_velocity`
         and it returns the robot's state.
         """
+        positive(dt, "dt")
         goal = self.goal if goal is None else as_point(goal, "goal", dimension=self.start.size)
         if robot_position is not None:
             self.position = as_point(robot_position, "robot_position", dimension=self.start.size)
         tau = self.duration
         if phase_locked:
             if robot_velocity is not None:
-                self.scaled_velocity = tau * np.asarray(robot_velocity, float)
+                self.scaled_velocity = tau * as_point(robot_velocity, "robot_velocity",
+                                                      dimension=self.start.size)
             return self.position.copy(), self.scaled_velocity / tau
         self.position, self.scaled_velocity = self._free_step(
             self.position, self.scaled_velocity, dt, goal)

@@ -5,6 +5,7 @@ import dataclasses
 import math
 
 import numpy as np
+from pydrake.geometry import Meshcat
 
 from pbp_drake.systems.operators.browser_guard import BrowserGuard
 from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
@@ -19,6 +20,9 @@ def check_params(params, positive=(), fraction=()):
     """Raises ValueError naming the field of the dataclass `params` that is not finite and
     positive (`positive` fields) or not in [0, 1) (`fraction` fields)."""
     kind = type(params).__name__
+    if not dataclasses.is_dataclass(params) or isinstance(params, type):
+        raise ValueError(f"params must be the operator's parameters (e.g. KeyboardParams), "
+                         f"got {kind}")
     for field in positive:
         value = getattr(params, field)
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
@@ -43,6 +47,10 @@ class BrowserOperator(SampledOperator):
     def __init__(self, meshcat, dimension, control_period, allow_forward, params,
                  nominal_speed, exclusive, command_name="operator_command"):
         super().__init__(dimension, control_period, command_name)
+        if not isinstance(meshcat, Meshcat):
+            raise ValueError(f"meshcat must be a pydrake Meshcat (StartMeshcat()), got "
+                             f"{type(meshcat).__name__}")
+        check_params(params)
         self.params = dataclasses.replace(params)
         self._meshcat = meshcat
         self.browser_guard = BrowserGuard(meshcat) if exclusive else None

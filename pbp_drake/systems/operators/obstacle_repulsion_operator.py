@@ -43,6 +43,11 @@ class ObstacleRepulsionOperator(SampledOperator):
         self.params = dataclasses.replace(params)
         self._centres = np.asarray(centres, dtype=float).reshape(-1, dimension)
         self._radii = np.asarray(radii, dtype=float).reshape(-1)
+        if not np.isfinite(self._centres).all():
+            raise ValueError(f"centres must be finite, got {self._centres.tolist()}")
+        if self._radii.shape != (len(self._centres),) or not (self._radii > 0).all():
+            raise ValueError(f"radii must be one positive radius per centre "
+                             f"({len(self._centres)}), got {self._radii.tolist()}")
         self._threshold = float(params.distance_threshold)
         self._speed = float(params.speed)
         self._axis = np.asarray(params.axis, dtype=float) if len(params.axis) else None

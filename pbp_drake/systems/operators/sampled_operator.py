@@ -6,15 +6,16 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.arbitration import validate_command
-from pbp_drake.systems.ports import PortGetters
-from pbp_drake.systems.tick import SENSE_OFFSET
+from pbp_drake.core.coordinates import is_real
+from pbp_drake.systems.ports import PortGetters, checked_count
+from pbp_drake.systems.tick import SENSE_OFFSET, checked_period
 
 
 def operator_speed(speed, nominal_speed):
     """The speed (m/s) an HSR operator moves the hand at: `speed`, or where that is 0 (its
     parameters' default) the task's nominal speed, the speed of its DMPs."""
     chosen = speed or nominal_speed
-    if chosen is None or not (math.isfinite(chosen) and chosen > 0):
+    if not (is_real(chosen) and math.isfinite(chosen) and chosen > 0):
         raise ValueError(f"the operator's speed must be positive: got speed {speed!r} and "
                          f"nominal_speed {nominal_speed!r} (speed 0 takes nominal_speed)")
     return float(chosen)
@@ -39,8 +40,8 @@ class SampledOperator(PortGetters, LeafSystem):
 
     def __init__(self, dimension, control_period, command_name="operator_command"):
         super().__init__()
-        self._dimension = int(dimension)
-        self._period = float(control_period)
+        self._dimension = checked_count(dimension, "dimension")
+        self._period = checked_period(control_period)
         self._command_name = command_name
 
     def _declare_operator_outputs(self, delay_ticks=0, offset=SENSE_OFFSET):

@@ -1,12 +1,15 @@
 """A virtual participant for the HSR tasks: stands in for the paper's users in automated runs."""
 
 import copy
+import dataclasses
+import math
 
 import numpy as np
 
 from pbp_drake.core.avoidance import (
     WATCH_SIZE, footprint_clearance, is_pushing_through, policy_path, predict_obstacles,
     robot_closes_in, start_watch, update_watch)
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.participant_impairment import (
     delay_ticks, first_choice, initial_motor_noise, is_noisy, next_motor_noise)
 from pbp_drake.core.participant_reach import (
@@ -66,11 +69,29 @@ class VirtualOperator(SampledOperator):
                              f"avoids obstacles on the floor only (got obstacle_count "
                              f"{obstacle_count}): use vertical=False with obstacles")
         super().__init__(OperatorCommand.size, control_period)
+        if not isinstance(params, VirtualParticipantParams):
+            raise ValueError(f"params must be VirtualParticipantParams, got "
+                             f"{type(params).__name__}")
+        for field in dataclasses.fields(params):
+            value = getattr(params, field.name)
+            if field.type is float and not (is_real(value) and math.isfinite(value)
+                                            and value >= 0):
+                raise ValueError(f"params.{field.name} must be finite and not negative, got "
+                                 f"{value!r}")
         self._vertical = bool(vertical)
         self._fixed_base = None if fixed_base is None else np.asarray(fixed_base, float)[:2]
+        if heading_range is not None and not _ordered_pair(heading_range):
+            raise ValueError(f"heading_range must be (lowest, highest) finite headings (rad), "
+                             f"got {heading_range!r}")
         self._heading_range = None if heading_range is None else tuple(
             float(bound) for bound in heading_range)
         self._objects = np.asarray(objects, dtype=float)
+        if (self._objects.ndim != 2 or self._objects.shape[0] == 0
+                or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
+            raise ValueError(f"objects must be a non-empty finite (M, 3) array, got shape "
+                             f"{self._objects.shape}")
+        if not (is_real(seed) and seed >= 0 and int(seed) == seed):
+            raise ValueError(f"seed must be a whole number >= 0, got {seed!r}")
         self.params = copy.deepcopy(params)
         self._plan_times = np.array(params.plan_times, dtype=float)
         self._speed = operator_speed(params.speed, nominal_speed)
@@ -466,3 +487,13 @@ class VirtualOperator(SampledOperator):
                 ticks += 1.0
         discrete_state.set_value(self._insist_index, [counted_target, ticks, moved])
         return insisting, repositioning
+
+
+def _ordered_pair(bounds):
+    """Whether `bounds` is a pair of finite numbers, the first below the second."""
+    try:
+        low, high = bounds
+    except (TypeError, ValueError):
+        return False
+    return (is_real(low) and is_real(high) and math.isfinite(low) and math.isfinite(high)
+            and low < high)

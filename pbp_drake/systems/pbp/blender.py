@@ -8,7 +8,9 @@ from pbp_drake.core.arbitration import (
     BLEND_LAWS, CONFIDENCE_WEIGHT, DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH,
     DEFAULT_CONFIDENCE_LOW, FIXED_WEIGHT, blend, check_alpha, confidence_alpha,
     validate_confidence_ramp, validate_mode)
-from pbp_drake.systems.ports import PortGetters, goal_index
+from pbp_drake.systems.ports import (
+    PortGetters, checked_count, checked_goal_count, goal_index)
+from pbp_drake.systems.tick import checked_period
 
 
 class BlenderBase(PortGetters, LeafSystem):
@@ -37,8 +39,8 @@ class BlenderBase(PortGetters, LeafSystem):
         self._weight = self._laws[mode].weight
         self._confidence_range = (float(low), float(high))
         self._alpha_max = float(alpha_max)
-        self._goal_count = int(goal_count)
-        self._period = float(control_period)
+        self._goal_count = checked_goal_count(goal_count)
+        self._period = checked_period(control_period)
         # A Context parameter, not a Python attribute: a live change (set_alpha) then
         # belongs to one Context and invalidates the cached output.
         self._alpha_index = (self.DeclareNumericParameter(BasicVector([float(alpha)]))
@@ -114,7 +116,7 @@ class Blender(BlenderBase):
                  confidence_range=(DEFAULT_CONFIDENCE_LOW, DEFAULT_CONFIDENCE_HIGH),
                  alpha_max=DEFAULT_ALPHA_MAX):
         super().__init__(mode, goal_count, control_period, alpha, confidence_range, alpha_max)
-        self._dimension = int(dimension)
+        self._dimension = checked_count(dimension, "dimension")
         d, k = self._dimension, self._goal_count
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * d)
         self._references_port = self.DeclareVectorInputPort("references", 2 * k * d)

@@ -5,6 +5,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.dmp import validate_demonstration
 from pbp_drake.systems.ports import PortGetters
+from pbp_drake.systems.tick import checked_period
 
 
 class DemonstrationPlayer(PortGetters, LeafSystem):
@@ -28,7 +29,7 @@ class DemonstrationPlayer(PortGetters, LeafSystem):
         self._positions = positions
         self._velocities = np.gradient(positions, self._times, axis=0)
         self._velocities[-1] = 0.0
-        self._period = float(control_period)
+        self._period = checked_period(control_period)
         index = self.DeclareDiscreteState(self._sample(self._period))
         self._references_port = self.DeclareStateOutputPort("references", index)
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)

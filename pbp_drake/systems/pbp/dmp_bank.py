@@ -2,13 +2,36 @@
 (`pbp_drake.core.dmp.DmpBankModel`); its state and scratch arrays live in the Context.
 """
 
+import math
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
+from pbp_drake.core.coordinates import is_real
+from pbp_drake.core.dmp import DmpBankModel
 from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
-from pbp_drake.systems.ports import PortGetters, goal_index
-from pbp_drake.systems.tick import checked_update_offset
+from pbp_drake.systems.ports import PortGetters, finite_fields, goal_index
+from pbp_drake.systems.tick import checked_period, checked_update_offset
+
+
+def checked_speed_limit(value, name):
+    """`value` (None: no limit) as a float; ValueError, naming it `name`, unless positive."""
+    if value is None:
+        return None
+    if not (is_real(value) and value > 0.0):
+        raise ValueError(f"{name} must be positive (None: no limit), got {value!r}")
+    return float(value)
+
+
+def checked_prediction(steps, period):
+    """`prediction_steps` as an int >= 0 and `prediction_period` as given (None: the
+    default); ValueError naming the one that is not."""
+    if isinstance(steps, bool) or not (is_real(steps) and steps >= 0 and int(steps) == steps):
+        raise ValueError(f"prediction_steps must be a whole number >= 0, got {steps!r}")
+    if period:
+        checked_period(period, "prediction_period")
+    return int(steps)
 
 
 class BankSystem(PortGetters, LeafSystem):
@@ -106,12 +129,14 @@ class DmpBank(BankSystem):
                  prediction_steps=0, update_offset=None, prediction_period=None,
                  max_speed=None, compact_state=False, predicted_goal_count=None):
         super().__init__()
+        if not isinstance(bank, DmpBankModel):
+            raise ValueError(f"bank must be a DmpBankModel, got {type(bank).__name__}")
         self._bank = bank
-        self._max_speed = None if max_speed is None else float(max_speed)
-        self._period = float(control_period)
+        self._max_speed = checked_speed_limit(max_speed, "max_speed")
+        self._period = checked_period(control_period)
+        self._prediction_steps = checked_prediction(prediction_steps, prediction_period)
         self._prediction_period = float(prediction_period or control_period)
         self._lock = bool(lock_phase_when_operator_acts)
-        self._prediction_steps = int(prediction_steps)
         update_offset = checked_update_offset(update_offset, self._period)
         k = self._goal_count = bank.goal_count
         d = bank.dimension
@@ -123,6 +148,8 @@ class DmpBank(BankSystem):
         self._layout = (AffineState if compact_state else PerGoalState)(
             bank, self._period, self._max_speed)
         self._declare_inputs(2 * d, "goals", k * d)
+        self._state_fields = [f"{kind}[{i}]" for kind in ("position", "velocity")
+                              for i in range(d)]
         self._state_index = self.DeclareDiscreteState(self._layout.initial())
         self._goals_dk = self.DeclareCacheEntry(
             "goals, validated, (D, K) contiguous",
@@ -148,10 +175,10 @@ class DmpBank(BankSystem):
             paths = k
             prerequisites = {self.xd_ticket(), self._goals_port.ticket()}
             if predicted_goal_count is not None:
-                paths = int(predicted_goal_count)
-                if not 1 <= paths <= k:
+                if not (is_real(predicted_goal_count) and predicted_goal_count in range(1, k + 1)):
                     raise ValueError(f"predicted_goal_count must be in [1, {k}] (the goal "
                                      f"count), got {predicted_goal_count!r}")
+                paths = int(predicted_goal_count)
                 self._predicted_goals_port = self.DeclareVectorInputPort(
                     "predicted_goals", paths)
                 prerequisites.add(self._predicted_goals_port.ticket())
@@ -196,6 +223,8 @@ class DmpBank(BankSystem):
         # Every input before the workspace: an input may reach this system's outputs,
         # which use the same workspace.
         robot_state = self._robot_state_port.EvalAbstract(context).get_value().get_value()
+        if not math.isfinite(sum(robot_state.tolist())):
+            finite_fields(robot_state, "robot_state", self._state_fields)
         lock = self._locked(context)
         goals_dk = None if lock else self._goals_dk.Eval(context)
         followed = self._followed(context, self._layout.needs_followed_goal)

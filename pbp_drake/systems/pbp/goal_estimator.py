@@ -34,8 +34,9 @@ class GoalEstimatorBase(PortGetters, LeafSystem):
         super().__init__()
         k = self._goal_count = checked_goal_count(goal_count)
         settings = self._settings = checked_settings(settings, self._SETTINGS)
-        margin = settings.margin if margin is None else margin
-        hold_steps = settings.hold_steps if hold_steps is None else hold_steps
+        # Settings without a hysteresis (HOP's, the intent filter's) give None: refused.
+        margin = getattr(settings, "margin", None) if margin is None else margin
+        hold_steps = getattr(settings, "hold_steps", None) if hold_steps is None else hold_steps
         check_hysteresis(margin, hold_steps)
         self._margin, self._hold_steps = float(margin), int(hold_steps)
         self._period = checked_period(control_period)

@@ -5,6 +5,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.goal_groups import NO_GOAL, group_target, pose_group_target
 from pbp_drake.systems.ports import (
@@ -113,7 +114,8 @@ class PoseGoalGrouping(GoalGrouping):
     _FOLLOWED_NAME = "followed_poses"
 
     def __init__(self, goal_count, settings, control_period, metres_per_radian):
-        if not (np.isfinite(metres_per_radian) and metres_per_radian >= 0.0):
+        if not (is_real(metres_per_radian) and np.isfinite(metres_per_radian)
+                and metres_per_radian >= 0.0):
             raise ValueError(f"metres_per_radian must be a finite number >= 0, got "
                              f"{metres_per_radian!r}")
         self._metres_per_radian = float(metres_per_radian)

@@ -49,7 +49,7 @@ class HandOver(HandOverBase):
 
     def __init__(self, initial_position, max_acceleration, max_speed, control_period):
         initial_position = np.asarray(initial_position, dtype=float).reshape(-1)
-        if not np.isfinite(initial_position).all():
+        if initial_position.size == 0 or not np.isfinite(initial_position).all():
             raise ValueError(f"initial_position must be finite, got {initial_position}")
         d = initial_position.size
         super().__init__(np.concatenate([initial_position, np.zeros(d)]), control_period)

@@ -3,9 +3,10 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.hand_over import check_limit, hand_over
 from pbp_drake.systems.ports import OperatorCommand, PortGetters
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_period, decide_offset
 
 
 class HeadingCommand(PortGetters, LeafSystem):
@@ -30,7 +31,10 @@ class HeadingCommand(PortGetters, LeafSystem):
     def __init__(self, initial_heading, control_period, max_yaw_acceleration=None,
                  max_turn=None):
         super().__init__()
-        self._period = float(control_period)
+        self._period = checked_period(control_period)
+        if not (is_real(initial_heading) and np.isfinite(initial_heading)):
+            raise ValueError(f"initial_heading must be a finite angle (rad), got "
+                             f"{initial_heading!r}")
         self._turn_bounds = None
         if max_turn is not None and max_turn != np.inf:  # NaN is refused below
             turn = check_limit(max_turn, "max_turn", "rad")

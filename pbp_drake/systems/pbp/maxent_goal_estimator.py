@@ -9,7 +9,7 @@ from pbp_drake.core.hindsight_optimization import (
     HopSettings, hop_targets, uniform_log_belief, update_posterior)
 from pbp_drake.core.maxent_command import intent_evidence, update_intent_posterior
 from pbp_drake.systems.pbp.goal_estimator import GoalEstimatorBase
-from pbp_drake.systems.ports import EeState, OperatorCommand
+from pbp_drake.systems.ports import EeState, OperatorCommand, finite_fields
 
 
 class PosteriorInputs(typing.NamedTuple):
@@ -114,8 +114,9 @@ class MaxEntGoalEstimator(CommandPosteriorBase):
 
     def _inputs(self, context):
         targets = self._targets(self._goals_port.Eval(context).reshape(self._goal_count, 3))
-        hand = self._ee_state_port.Eval(context)
-        command = self._command_port.Eval(context)
+        hand = finite_fields(self._ee_state_port.Eval(context), "ee_state", EeState.get_fields())
+        command = finite_fields(self._command_port.Eval(context), "operator_command",
+                                OperatorCommand.get_fields())
         return PosteriorInputs(targets, hand[:3], command[:3], hand[3:6],
                                heading=float(EeState(hand).heading),
                                yaw_rate=float(OperatorCommand(command).yaw_rate))

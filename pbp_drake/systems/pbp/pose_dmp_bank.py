@@ -9,10 +9,12 @@ from pydrake.systems.framework import ValueProducer
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.dmp import DmpBankModel, OrientationDmpBank
 from pbp_drake.core.dmp.orientation_kernels import jacobian_of_one_values
 from pbp_drake.core.dmp.stepping import limit_speeds
 from pbp_drake.core.pose_arbitration import PoseReference
-from pbp_drake.systems.pbp.dmp_bank import BankSystem
+from pbp_drake.systems.pbp.dmp_bank import (
+    BankSystem, checked_prediction, checked_speed_limit)
 from pbp_drake.systems.pbp.pose_dmp_bank_state import (
     AT_START, COMPACT_TAIL_SIZE, HEAD_SIZE, ON_ROBOT, STEPPING, PoseWorkspace, SteppedDmps,
     compact_inputs, hold_into, per_goal_arrays, split_head, step_all)
@@ -54,9 +56,8 @@ class PoseDmpBank(BankSystem):
                  compact_state=False):
         super().__init__()
         _check_banks(position_bank, orientation_bank, control_period)
-        self._max_speed = None if max_speed is None else float(max_speed)
-        self._max_angular_speed = (None if max_angular_speed is None
-                                   else float(max_angular_speed))
+        self._max_speed = checked_speed_limit(max_speed, "max_speed")
+        self._max_angular_speed = checked_speed_limit(max_angular_speed, "max_angular_speed")
         self._positions, self._orientations = position_bank, orientation_bank
         # Equal settings and durations: both parts' steps contract one basis.
         self._shared_basis = (position_bank.settings == orientation_bank.settings
@@ -99,7 +100,7 @@ class PoseDmpBank(BankSystem):
                                    self._followed_goal_port.ticket()})
         self._phase_port = self.DeclareVectorOutputPort(
             "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
-        self._prediction_steps = int(prediction_steps)
+        self._prediction_steps = checked_prediction(prediction_steps, prediction_period)
         self._prediction_period = float(
             prediction_period or position_bank.duration / max(self._prediction_steps, 1))
         self._predicted_poses_port = None
@@ -331,6 +332,10 @@ class PoseDmpBank(BankSystem):
 
 def _check_banks(position_bank, orientation_bank, control_period):
     """The two banks must describe the same K goals with one phase."""
+    for name, bank, kind in [("position_bank", position_bank, DmpBankModel),
+                             ("orientation_bank", orientation_bank, OrientationDmpBank)]:
+        if not isinstance(bank, kind):
+            raise ValueError(f"{name} must be {kind.__name__}, got {type(bank).__name__}")
     if position_bank.dimension != 3:
         raise ValueError(f"the position bank must be 3-D, got D = {position_bank.dimension}")
     if position_bank.goal_count != orientation_bank.goal_count:

@@ -33,7 +33,12 @@ class PoseHandOver(HandOverBase):
         orientation = quaternion.unit_quaternions(initial_pose[3:], "initial_pose orientation")
         super().__init__(np.concatenate([initial_pose[:3], orientation, np.zeros(6)]),
                          control_period)
-        self._limits = HandOverLimits(*limits).checked()
+        try:
+            self._limits = HandOverLimits(*limits).checked()
+        except TypeError:
+            raise ValueError(f"limits must be HandOverLimits (max_acceleration, max_speed, "
+                             f"max_angular_acceleration, max_angular_speed), got "
+                             f"{limits!r}") from None
 
     def _command(self, previous, reference):
         return pose_hand_over(previous[7:10], previous[10:13], PoseReference.from_vector(reference),

@@ -4,6 +4,7 @@ and 10 degrees), metrics; it ends the simulation at success."""
 import numpy as np
 
 from pbp_drake.core.grasp_task import grasp_progress, grasp_success
+from pbp_drake.core.hand_over import check_limit
 from pbp_drake.systems.ports import PoseState
 from pbp_drake.systems.tasks.task_monitor import TaskMonitorBase
 
@@ -29,6 +30,8 @@ class GraspTaskMonitor(TaskMonitorBase):
     (M, 4) are the objects' grasp poses; `target` gives the grasp position.
     """
 
+    _objects_name = "grasp_positions"
+
     def __init__(self, grasp_positions, grasp_orientations, targets, switch_schedule,
                  start_pose, success_distance, success_angle, control_period):
         super().__init__("hand_pose", PoseState.size, grasp_positions, targets,
@@ -36,8 +39,8 @@ class GraspTaskMonitor(TaskMonitorBase):
         self._orientations = np.asarray(grasp_orientations, float)
         start_pose = np.asarray(start_pose, float)
         self._start_position, self._start_orientation = start_pose[:3], start_pose[3:7]
-        self._success_distance = float(success_distance)
-        self._success_angle = float(success_angle)
+        self._success_distance = check_limit(success_distance, "success_distance", "m")
+        self._success_angle = check_limit(success_angle, "success_angle", "rad")
         self._length_per_radian = self._success_distance / self._success_angle
 
     @property

@@ -6,7 +6,7 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.obstacle_task import step_obstacles
 from pbp_drake.core.reach_task import reach_progress
 from pbp_drake.systems.ports import EeState, PortGetters
-from pbp_drake.systems.tick import decide_offset
+from pbp_drake.systems.tick import checked_period, decide_offset
 
 
 class MovingObstacles(PortGetters, LeafSystem):
@@ -35,7 +35,7 @@ class MovingObstacles(PortGetters, LeafSystem):
         self._start = np.asarray(start, dtype=float)
         self._height = float(height)
         self._speed = float(speed)
-        self._period = float(control_period)
+        self._period = checked_period(control_period)
         count = len(scene.obstacle_starts)
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._positions_index = self.DeclareDiscreteState(scene.obstacle_starts.reshape(-1))

@@ -43,6 +43,12 @@ class PointRobotDynamics(PortGetters, LeafSystem):
     def __init__(self, initial_position, params=PointRobotParams()):
         super().__init__()
         initial_position = np.asarray(initial_position, dtype=float)
+        if (initial_position.ndim != 1 or initial_position.size == 0
+                or not np.isfinite(initial_position).all()):
+            raise ValueError(f"initial_position must be a non-empty finite vector, got "
+                             f"{initial_position.tolist()}")
+        if not isinstance(params, PointRobotParams):
+            raise ValueError(f"params must be PointRobotParams, got {type(params).__name__}")
         self._dimension = initial_position.size
         self.params = dataclasses.replace(params)
         time_step = params.time_step

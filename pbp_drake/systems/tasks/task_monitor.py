@@ -7,9 +7,11 @@ import numpy as np
 from pydrake.systems.framework import EventStatus, LeafSystem
 
 from pbp_drake.core.coordinates import vector_length
+from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.reach_task import reach_progress
-from pbp_drake.systems.ports import EeState, PortGetters, Target, TaskStatus, position_of
-from pbp_drake.systems.tick import checked_update_offset, report_offset
+from pbp_drake.systems.ports import (
+    EeState, PortGetters, Target, TaskStatus, finite_fields, position_of)
+from pbp_drake.systems.tick import checked_period, checked_update_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
 
@@ -54,15 +56,27 @@ class TaskMonitorBase(PortGetters, LeafSystem):
     plant moves again; the status then stays frozen.
     """
 
+    _objects_name = "objects"  # the name of `objects` in the subclass's constructor
+
     def __init__(self, pose_port, pose_size, objects, targets, switch_schedule,
                  control_period, update_offset=None, in_collision_port=False):
         super().__init__()
         self._objects = np.asarray(objects, dtype=float)
+        if (self._objects.ndim != 2 or self._objects.shape[0] == 0
+                or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
+            raise ValueError(f"{self._objects_name} must be a non-empty finite (M, 3) array, "
+                             f"got shape {self._objects.shape}")
+        count = len(self._objects)
+        if not all(t in range(count) for t in targets):
+            raise ValueError(f"targets must be object indices 0 to {count - 1}, got "
+                             f"{list(targets)}")
         self._targets = tuple(int(t) for t in targets)
         self._schedule = tuple(float(s) for s in switch_schedule)
+        if not np.isfinite(self._schedule).all():
+            raise ValueError(f"switch_schedule must be finite, got {list(self._schedule)}")
         if len(self._targets) != len(self._schedule):
             raise ValueError("one target per entry of switch_schedule")
-        period = float(control_period)
+        period = checked_period(control_period)
         update_offset = self._update_offset = checked_update_offset(update_offset, period)
         end_offset = report_offset(period, update_offset)
         self._hand_port = self.DeclareVectorInputPort(pose_port, pose_size)
@@ -173,10 +187,12 @@ class TaskMonitor(TaskMonitorBase):
         super().__init__("ee_state", EeState.size, objects, targets, switch_schedule,
                          control_period, update_offset, in_collision_port=True)
         self._start = np.asarray(start, dtype=float)
-        self._success_distance = float(success_distance)
+        if self._start.shape != (3,) or not np.isfinite(self._start).all():
+            raise ValueError(f"start must be 3 finite numbers [x, y, z], got {start!r}")
+        self._success_distance = check_limit(success_distance, "success_distance", "m")
 
     def _read_hand(self, vector):
-        return position_of(EeState(vector))
+        return position_of(EeState(finite_fields(vector, "ee_state", EeState.get_fields())))
 
     def _progress(self, hand, index):
         return reach_progress(hand, self._start, self._objects[index])

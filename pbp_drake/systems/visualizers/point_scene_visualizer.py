@@ -8,6 +8,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.scene_framing import page_view, scene_bounds
 from pbp_drake.systems.ports import PortGetters
+from pbp_drake.systems.tick import checked_period
 from pbp_drake.systems.visualizers.scene_drawing import PathDots, PathTrail, frame_top_down
 
 # Saturated colours of distinct hues, so that a screenshot tells the markers apart.
@@ -67,6 +68,10 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         super().__init__()
         self._meshcat = meshcat
         goals = np.atleast_2d(np.asarray(goals, dtype=float))
+        if goals.ndim != 2 or goals.size == 0 or not np.isfinite(goals).all():
+            raise ValueError(f"goals must be a non-empty finite (K, D) array, got "
+                             f"{goals.tolist()}")
+        checked_period(publish_period, "publish_period")
         self._goal_count, self._dimension = goals.shape
         self._prediction_steps = int(prediction_steps)
         d, k = self._dimension, self._goal_count

@@ -8,6 +8,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.scene_framing import workspace_view
 from pbp_drake.systems.ports import EeState, PortGetters, Target, position_of
+from pbp_drake.systems.tick import checked_period
 from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots, PathTrail
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
@@ -94,6 +95,11 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         super().__init__()
         self._meshcat = meshcat
         self._objects = np.asarray(objects, dtype=float)
+        if (self._objects.ndim != 2 or self._objects.shape[0] == 0
+                or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
+            raise ValueError(f"objects must be a non-empty finite (M, 3) array, got shape "
+                             f"{self._objects.shape}")
+        checked_period(publish_period, "publish_period")
         self.camera = (behind_the_robot(self._objects) if workspace is None
                        else workspace_view(workspace))
         self._markers = TaskMarkers()

@@ -20,7 +20,8 @@ from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.scenarios import Obstacle
 from pbp_drake.systems.ports import Target
 from pbp_drake.systems.visualizers.point_scene_visualizer import PointSceneVisualizer
-from pbp_drake.systems.visualizers.reach_scene_visualizer import ReachSceneVisualizer
+from pbp_drake.systems.visualizers.reach_scene_visualizer import (
+    ReachSceneVisualizer, draw_table_object)
 from pbp_drake.systems.visualizers.scene_drawing import LIKELY_RGB, UNLIKELY_RGB, GoalCloud
 
 OBJECTS = np.array([[1.5, -0.4, 0.7], [1.5, 0.4, 0.7]])
@@ -208,6 +209,14 @@ def test_many_goals_are_one_cloud_coloured_by_probability_sent_only_when_it_chan
     # whatever the 0.25 s period would allow (nine).
     assert len(sent) == 2
     assert np.argmax(sent[0]) == 0 and np.argmax(sent[1]) == 7
+
+
+def test_an_object_standing_on_the_floor_is_drawn_without_a_table(meshcat):
+    # Its centre half its height up (0.05 m): a table there would have no height.
+    draw_table_object(meshcat, 0, [0.55, 0.0, 0.0], (0.3, 0.3), [0.55, 0.0, 0.05], (0.04, 0.1))
+    draw_table_object(meshcat, 1, [0.5, 0.3, 0.25], (0.3, 0.3), [0.5, 0.3, 0.3], (0.04, 0.1))
+    assert meshcat.HasPath("/task/objects/0") and not meshcat.HasPath("/task/tables/0")
+    assert meshcat.HasPath("/task/objects/1") and meshcat.HasPath("/task/tables/1")
 
 
 def test_the_cloud_colours_the_most_probable_goal_blue_and_the_unlikely_grey():

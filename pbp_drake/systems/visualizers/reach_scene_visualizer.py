@@ -191,10 +191,12 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
 
 def draw_table_object(meshcat, index, table, table_size, centre, object_shape):
     """Draws object `index`, a cylinder `(radius, height)` at `centre`, and its table, a box
-    of `table_size` (x, y) standing on the floor under `table` (its top face's centre)."""
-    meshcat.SetObject(f"/task/tables/{index}", Box(*table_size, table[2]), TABLE_COLOUR)
-    meshcat.SetTransform(f"/task/tables/{index}",
-                         RigidTransform([table[0], table[1], table[2] / 2]))
+    of `table_size` (x, y) standing on the floor under `table` (its top face's centre; none
+    where that is on the floor: the object stands there)."""
+    if table[2] > 0.0:
+        meshcat.SetObject(f"/task/tables/{index}", Box(*table_size, table[2]), TABLE_COLOUR)
+        meshcat.SetTransform(f"/task/tables/{index}",
+                             RigidTransform([table[0], table[1], table[2] / 2]))
     meshcat.SetObject(f"/task/objects/{index}", Cylinder(*object_shape), OBJECT_COLOUR)
     meshcat.SetTransform(f"/task/objects/{index}", RigidTransform(centre))
 

@@ -21,6 +21,11 @@ def is_real(value):
         value, bool)
 
 
+def is_whole(value, least=0):
+    """Whether `value` is a whole number (`is_real`, finite, with no fraction) >= `least`."""
+    return is_real(value) and math.isfinite(value) and value >= least and int(value) == value
+
+
 def vector_length(vector):
     """`np.linalg.norm` of a 1-D float vector as a float: the same number, which numpy
     computes as the square root of the vector's dot product with itself, without its

@@ -4,11 +4,12 @@
 
 import dataclasses
 import math
-import numbers
 import re
 
 import numpy as np
 from pydrake.common.containers import namedview
+
+from pbp_drake.core.coordinates import is_whole
 
 
 def _view(name, fields):
@@ -43,8 +44,7 @@ def checked_goal_count(goal_count):
 
 def checked_count(value, name):
     """`value` as an int; ValueError, naming it `name`, unless it is an integer >= 1."""
-    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
-            or not math.isfinite(value) or int(value) != value or value < 1):
+    if not is_whole(value, 1):
         raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
     return int(value)
 

@@ -325,6 +325,8 @@ _BANK = DmpBankModel.straight([0.0, 0.0], 2, 1.0)
     (lambda: minimum_jerk([0.0], [1.0], np.nan), "duration must be positive and finite"),
     (lambda: minimum_jerk([0.0], [1.0], 1.0, sample_count=1),
      "sample_count must be a whole number >= 2, got 1"),
+    (lambda: minimum_jerk([0.0], [1.0], 1.0, sample_count=np.inf),
+     "sample_count must be a whole number >= 2, got inf"),
     (lambda: _DMP.rollout(0.0), "dt must be positive and finite, got 0"),
     (lambda: _DMP.rollout(-0.01), "dt must be positive and finite, got -0.01"),
     (lambda: _DMP.rollout(0.01, duration=np.inf), "duration must be positive and finite"),
@@ -333,6 +335,8 @@ _BANK = DmpBankModel.straight([0.0, 0.0], 2, 1.0)
      "robot_velocity contains NaN"),
     (lambda: _BANK.predict(*_BANK.initial_state(), _BANK.goals_matrix([[1.0, 0.0]] * 2), 0.01,
                            -1), "steps must be a whole number >= 0, got -1"),
+    (lambda: _BANK.predict(*_BANK.initial_state(), _BANK.goals_matrix([[1.0, 0.0]] * 2), 0.01,
+                           np.inf), "steps must be a whole number >= 0, got inf"),
     (lambda: _BANK.predict(*_BANK.initial_state(), _BANK.goals_matrix([[1.0, 0.0]] * 2), 0.0,
                            10), "dt must be positive and finite, got 0"),
 ])

@@ -1,10 +1,9 @@
 """Input checks shared by the DMP modules: each names the field it refuses, as every input
 check of the package does."""
 
-import numbers
-
 import numpy as np
 
+from pbp_drake.core.coordinates import is_real, is_whole
 from pbp_drake.core.dmp.settings import DmpSettings
 
 
@@ -28,14 +27,9 @@ def as_point(value, name, dimension=None):
     return point
 
 
-def is_number(value):
-    """Whether `value` is a real number (NumPy's too), not a bool."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
 def positive(value, name):
     """`value` as a float, refused unless finite and positive."""
-    if not (is_number(value) and np.isfinite(value) and value > 0):
+    if not (is_real(value) and np.isfinite(value) and value > 0):
         raise ValueError(f"{name} must be positive and finite, got {value}")
     return float(value)
 
@@ -49,10 +43,9 @@ def dmp_settings(settings):
 
 def goal_count_of(goal_count):
     """`goal_count` as an int, refused unless a whole number >= 1."""
-    if is_number(goal_count) and goal_count < 1:
+    if is_real(goal_count) and goal_count < 1:
         raise ValueError("a DMP bank needs at least one goal")
-    if not (is_number(goal_count) and np.isfinite(goal_count) and goal_count >= 1
-            and int(goal_count) == goal_count):
+    if not is_whole(goal_count, 1):
         raise ValueError(f"goal_count must be an integer >= 1, got {goal_count!r}")
     return int(goal_count)
 

@@ -9,10 +9,10 @@ import dataclasses
 
 import numpy as np
 
-from pbp_drake.core.coordinates import check_positions
+from pbp_drake.core.coordinates import check_positions, is_whole
 from pbp_drake.core.dmp._checks import (
     as_point, broadcast_goalwise, dmp_settings, followed_velocity, goal_count_of, goal_indices,
-    is_number, positive, read_only)
+    positive, read_only)
 from pbp_drake.core.dmp.fitting import fit_weights, validate_demonstration
 from pbp_drake.core.dmp.settings import DmpSettings, phase_decay
 from pbp_drake.core.dmp.single import straight_weights
@@ -120,7 +120,7 @@ class BankModel:
         `(rows, K)`), for drawing predictions; the inputs are left alone. `workspace`
         saves allocating one (the paths are new anyway)."""
         positive(dt, "dt")
-        if not (is_number(steps) and steps >= 0 and int(steps) == steps):
+        if not is_whole(steps):
             raise ValueError(f"steps must be a whole number >= 0, got {steps!r}")
         workspace = self.make_workspace() if workspace is None else workspace
         path = np.empty((int(steps) + 1,) + self.starts.shape)

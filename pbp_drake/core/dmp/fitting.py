@@ -7,7 +7,8 @@ attractor form (`tau dz = K (y_attr - y) - D z`, solved for `y_attr` along the d
 
 import numpy as np
 
-from pbp_drake.core.dmp._checks import as_point, dmp_settings, is_number, positive
+from pbp_drake.core.coordinates import is_whole
+from pbp_drake.core.dmp._checks import as_point, dmp_settings, positive
 from pbp_drake.core.dmp.settings import DmpSettings
 
 
@@ -16,7 +17,7 @@ def minimum_jerk(start, goal, duration, sample_count=200):
     start = as_point(start, "start")
     goal = as_point(goal, "goal", dimension=start.size)
     duration = positive(duration, "duration")
-    if not (is_number(sample_count) and sample_count >= 2 and int(sample_count) == sample_count):
+    if not is_whole(sample_count, 2):
         raise ValueError(f"sample_count must be a whole number >= 2, got {sample_count!r}")
     times = np.linspace(0.0, duration, int(sample_count))
     s = times / duration

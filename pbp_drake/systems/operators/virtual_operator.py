@@ -9,7 +9,7 @@ import numpy as np
 from pbp_drake.core.avoidance import (
     WATCH_SIZE, footprint_clearance, is_pushing_through, policy_path, predict_obstacles,
     robot_closes_in, start_watch, update_watch)
-from pbp_drake.core.coordinates import is_real
+from pbp_drake.core.coordinates import is_real, is_whole
 from pbp_drake.core.participant_impairment import (
     delay_ticks, first_choice, initial_motor_noise, is_noisy, next_motor_noise)
 from pbp_drake.core.participant_reach import (
@@ -90,7 +90,7 @@ class VirtualOperator(SampledOperator):
                 or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
             raise ValueError(f"objects must be a non-empty finite (M, 3) array, got shape "
                              f"{self._objects.shape}")
-        if not (is_real(seed) and seed >= 0 and int(seed) == seed):
+        if not is_whole(seed):
             raise ValueError(f"seed must be a whole number >= 0, got {seed!r}")
         self.params = copy.deepcopy(params)
         self._plan_times = np.array(params.plan_times, dtype=float)

@@ -8,7 +8,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
-from pbp_drake.core.coordinates import is_real
+from pbp_drake.core.coordinates import is_real, is_whole
 from pbp_drake.core.dmp import DmpBankModel
 from pbp_drake.systems.pbp.dmp_bank_state import AffineState, PerGoalState
 from pbp_drake.systems.ports import PortGetters, finite_fields, goal_index
@@ -27,7 +27,7 @@ def checked_speed_limit(value, name):
 def checked_prediction(steps, period):
     """`prediction_steps` as an int >= 0 and `prediction_period` as given (None: the
     default); ValueError naming the one that is not."""
-    if isinstance(steps, bool) or not (is_real(steps) and steps >= 0 and int(steps) == steps):
+    if not is_whole(steps):
         raise ValueError(f"prediction_steps must be a whole number >= 0, got {steps!r}")
     if period:
         checked_period(period, "prediction_period")

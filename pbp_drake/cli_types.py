@@ -5,6 +5,7 @@ import argparse
 import math
 
 from pbp_drake.console.front import check_token
+from pbp_drake.scenarios import ScenarioError
 
 
 def _finite(text):
@@ -50,6 +51,18 @@ def wait_seconds(text):
 def method_list(text):
     """`--methods a,b,c` as a list."""
     return [method.strip() for method in text.split(",") if method.strip()]
+
+
+def chosen_methods(text, example):
+    """`--methods a,b,c` as a list; ScenarioError when it names no method (`example`: a list
+    that would do) or one twice."""
+    methods = method_list(text)
+    if not methods:
+        raise ScenarioError(f"--methods {text!r} names no method; give them comma-separated, "
+                            f"e.g. {example}")
+    if len(set(methods)) != len(methods):
+        raise ScenarioError(f"--methods {','.join(methods)} names a method twice")
+    return methods
 
 
 def token(text):

@@ -2,7 +2,7 @@
 before the Meshcat server starts: a combination `run` refuses costs no page, no port and no
 run, and is named in one line (ScenarioError: `pbp-drake: ...`, exit 2)."""
 
-from pbp_drake.cli_types import method_list
+from pbp_drake.cli_types import chosen_methods
 from pbp_drake.scenarios import Gamepad, Keyboard, ScenarioError, with_method
 from pbp_drake.studies.questionnaire import parse_answers
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
@@ -36,12 +36,7 @@ def check_run_flags(args, resolved):
         raise ScenarioError("--record and --log save one run; a session saves every run under "
                             "--output")
     methods = (list(DEFAULT_SESSION_METHODS) if args.methods is None
-               else method_list(args.methods))
-    if not methods:
-        raise ScenarioError(f"--methods {args.methods!r} names no method; give them "
-                            f"comma-separated, e.g. {','.join(DEFAULT_SESSION_METHODS)}")
-    if len(set(methods)) != len(methods):
-        raise ScenarioError(f"--methods {','.join(methods)} names a method twice")
+               else chosen_methods(args.methods, ",".join(DEFAULT_SESSION_METHODS)))
     for method in methods:
         with_method(resolved.scenario, method)
     try:

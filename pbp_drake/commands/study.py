@@ -8,7 +8,8 @@ import pathlib
 import sys
 import time
 
-from pbp_drake.cli_types import EXIT_INTERRUPTED, EXIT_TERMINATED, method_list
+from pbp_drake.cli_types import (
+    EXIT_INTERRUPTED, EXIT_TERMINATED, chosen_methods, method_list)
 from pbp_drake.commands.scenario_flags import (
     add_goals_flag, add_override_flags, scenario_overrides)
 from pbp_drake.commands.signals import Terminated, stopping_cleanly
@@ -199,13 +200,11 @@ def _method_study(args, scenario_file, overrides):
     if isinstance(scenario.operator, (Keyboard, Gamepad)):
         raise ScenarioError("a study runs unattended: use operator: !VirtualParticipant {} "
                             "(--set 'operator=!VirtualParticipant {}')")
-    if args.methods is not None and not method_list(args.methods):
-        raise ScenarioError(f"--methods {args.methods!r} names no method; give them "
-                            "comma-separated, e.g. pbp_alternated,teleop")
+    methods = (None if args.methods is None
+               else chosen_methods(args.methods, "pbp_alternated,teleop"))
     if args.trials is not None and args.trials < 1:
         raise ScenarioError(f"--trials must be at least 1, got {args.trials}")
-    flags = {"methods": None if args.methods is None else method_list(args.methods),
-             "trials": args.trials, "split": args.split}
+    flags = {"methods": methods, "trials": args.trials, "split": args.split}
     study = dataclasses.replace(study, **{name: value for name, value in flags.items()
                                           if value is not None})
     if args.seed is not None:
@@ -216,8 +215,6 @@ def _method_study(args, scenario_file, overrides):
         raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
     if args.ray_address is not None and args.backend != "ray":
         raise ScenarioError("--ray-address needs --backend ray")
-    if args.methods is not None and len(set(study.methods)) != len(study.methods):
-        raise ScenarioError(f"--methods {','.join(study.methods)} names a method twice")
     try:
         check_method_comparison(study, scenario)
     except ScenarioError as error:

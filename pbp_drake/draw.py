@@ -12,6 +12,7 @@ import subprocess
 import sys
 
 from pbp_drake.builder import build_diagram
+from pbp_drake.output_paths import OutputPathError, check_drawing_path
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
 
 # Node ids: `digraph _143`, `cluster143diagram`, `s2 [...]`, `s2:y0:e -> s5:u1:w`, and a
@@ -147,28 +148,20 @@ def _depth(text):
     return value
 
 
-def _output_problem(output):
-    """What keeps the file `output` (`--output`) from being written, or None."""
-    path = pathlib.Path(output)
-    if not output:
-        return "--output: the path is empty; give a file, e.g. diagram.svg, or '-'"
-    if path.is_dir():
-        return f"--output {path}: is a folder; give a file, e.g. {path / 'diagram.svg'}"
-    folder = next(parent for parent in path.absolute().parents if parent.exists())
-    if not folder.is_dir():
-        return f"--output {path}: {folder} is a file, so its folder cannot be made"
-    return None
-
-
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.output and len(args.scenarios) > 1:
         parser.error("--output takes one scenario")
+    if args.output == "":  # the standard output is '-'
+        print("pbp-drake draw: --output: the path is empty; give a file, e.g. diagram.svg, "
+              "or '-'", file=sys.stderr)
+        return 2
     if args.output not in (None, "-") and not args.check:
-        problem = _output_problem(args.output)
-        if problem is not None:
-            print(f"pbp-drake draw: {problem}", file=sys.stderr)
+        try:
+            check_drawing_path(args.output)
+        except OutputPathError as error:
+            print(f"pbp-drake draw: {error}", file=sys.stderr)
             return 2
 
     stale = []

@@ -166,6 +166,12 @@ def check_figure_path(path):
     _check_output_file(file, "--figure", "primitive.png", None, "a figure", force=True)
 
 
+def check_drawing_path(path):
+    """Raises OutputPathError unless `path` can take a drawing (`pbp-drake draw --output`):
+    a writable file (an existing one is drawn over)."""
+    _check_output_file(path, "--output", "diagram.svg", None, "a drawing", force=True)
+
+
 def _is_primitive(path):  # as `pbp-drake teach` writes it (json.dumps' separators)
     return _head_holds(path, f'"format": "{PRIMITIVE_FORMAT}"'.encode())
 

@@ -56,12 +56,7 @@ DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
      r"scenario.robot.stiffness must be finite and positive, got 0.0"),
 ])
 def test_values_that_broke_a_computation_are_refused(tmp_path, file, old, new, message):
-    text = (DIAGRAMS / file).read_text()
-    assert old in text, old
-    path = tmp_path / file
-    path.write_text(text.replace(old, new, 1))
-    with pytest.raises(ScenarioError, match=message):
-        load_scenario_file(path)
+    assert_edit_refused(tmp_path, file, old, new, message)
 
 
 @pytest.mark.parametrize("old, new, message", [
@@ -97,12 +92,7 @@ def test_values_that_broke_a_computation_are_refused(tmp_path, file, old, new, m
      r"scenario.operator.plan_times \[0.0, 0.3\] must be 1 to 100 positive times"),
 ])
 def test_a_bad_participant_value_is_refused_naming_its_field(tmp_path, old, new, message):
-    text = (DIAGRAMS / "hsr_obstacles.yaml").read_text()
-    assert old in text, old
-    path = tmp_path / "hsr_obstacles.yaml"
-    path.write_text(text.replace(old, new, 1))
-    with pytest.raises(ScenarioError, match=message):
-        load_scenario_file(path)
+    assert_edit_refused(tmp_path, "hsr_obstacles.yaml", old, new, message)
 
 
 def test_the_participant_fields_are_checked_in_the_reaching_task_too(tmp_path):
@@ -212,12 +202,7 @@ def test_a_bad_reaching_participant_value_is_refused_naming_its_field(tmp_path, 
 ])
 def test_a_value_the_rest_of_the_scenario_cannot_use_is_refused(tmp_path, file, old, new,
                                                                  message):
-    text = (DIAGRAMS / file).read_text()
-    assert old in text, old
-    path = tmp_path / file
-    path.write_text(text.replace(old, new, 1))
-    with pytest.raises(ScenarioError, match=message):
-        load_scenario_file(path)
+    assert_edit_refused(tmp_path, file, old, new, message)
 
 
 def test_infinite_acceleration_limits_are_no_limits(tmp_path):
@@ -267,3 +252,13 @@ def test_a_primitive_file_larger_than_any_primitive_is_refused(tmp_path):
     with pytest.raises(ScenarioError, match=r"^scenario.dmp.primitive is over 64 MiB: not a "
                                             r"primitive$"):
         load_primitive(path, "scenario.dmp.primitive")
+
+
+def assert_edit_refused(tmp_path, file, old, new, message):
+    """The shipped `file` with its first `old` replaced by `new` is refused with `message`."""
+    text = (DIAGRAMS / file).read_text()
+    assert old in text, old
+    path = tmp_path / file
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario_file(path)

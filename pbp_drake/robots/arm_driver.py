@@ -126,25 +126,32 @@ def check_heard(now, started_at, heard_at, connect_timeout, status_timeout, firs
     return True
 
 
-def read_first_status(hardware, lcm, lower, upper):
-    """The joint positions of the driver's first status on `lcm` (a DrakeLcm on
-    `hardware.lcm_bus` that no `LcmInterfaceSystem` pumps: this subscribes a Python
-    callback), waiting at most `hardware.connect_timeout`; DriverError naming the bus and
-    the channel when none comes, and as `check_status` for a bad one."""
-    driver = DRIVERS[hardware.driver]
+def first_message(lcm, channel, decode, timeout, missing):
+    """The first message on `channel` of `lcm` (a DrakeLcm that no `LcmInterfaceSystem`
+    pumps: this subscribes a Python callback), decoded by `decode`, waiting at most
+    `timeout` s; DriverError(`missing`) when none comes."""
     received = []
-    lcm.Subscribe(driver.status_channel,
-                  lambda data: received.append(status_type(hardware.driver).decode(data)))
-    deadline = time.monotonic() + hardware.connect_timeout
+    lcm.Subscribe(channel, lambda data: received.append(decode(data)))
+    deadline = time.monotonic() + timeout
     while not received:
         left = deadline - time.monotonic()
         if left <= 0:
-            raise DriverError(
-                f"no status from the {hardware.driver} driver on {driver.status_channel} "
-                f"(bus {hardware.lcm_bus.lcm_url}) within {hardware.connect_timeout:g} s: "
-                "is the driver running on that bus?")
+            raise DriverError(missing)
         lcm.HandleSubscriptions(int(min(left, 0.1) * 1000) + 1)
-    q, v = read_status(hardware.driver, received[0])
+    return received[0]
+
+
+def read_first_status(hardware, lcm, lower, upper):
+    """The joint positions of the driver's first status on `lcm` (`first_message`'s),
+    waiting at most `hardware.connect_timeout`; DriverError naming the bus and the channel
+    when none comes, and as `check_status` for a bad one."""
+    channel = DRIVERS[hardware.driver].status_channel
+    status = first_message(
+        lcm, channel, status_type(hardware.driver).decode, hardware.connect_timeout,
+        f"no status from the {hardware.driver} driver on {channel} (bus "
+        f"{hardware.lcm_bus.lcm_url}) within {hardware.connect_timeout:g} s: is the driver "
+        "running on that bus?")
+    q, v = read_status(hardware.driver, status)
     check_status(hardware.driver, q, v, lower, upper)
     return q
 

@@ -19,7 +19,7 @@ from pydrake.lcm import DrakeLcm, DrakeLcmParams
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
-from pbp_drake.robots.arm_driver import DriverError, check_heard
+from pbp_drake.robots.arm_driver import DriverError, check_heard, first_message
 from pbp_drake.robots.arm_station_config import DEFAULT_LCM_URL, validate_link
 from pbp_drake.systems.ports import EeCommand, EeState
 from pbp_drake.systems.tick import report_offset
@@ -71,6 +71,48 @@ def signal(values, names, time):
     message.dim, message.val, message.coord = len(values), list(map(float, values)), names
     message.timestamp = int(round(time * 1e6))
     return message
+
+
+def checked_state(message, config):
+    """The EeState a state message of the robot's relay holds; DriverError when it is of
+    the wrong size or not finite."""
+    values = np.asarray(message.val, float)
+    if len(values) != EeState.size or not np.all(np.isfinite(values)):
+        raise DriverError(f"the robot's state on {config.state_channel} holds "
+                          f"{len(values)} values (EeState's {EeState.size}, finite): "
+                          f"{list(message.coord)}")
+    return values
+
+
+def check_hand_start(ee_state, initial_ee_state, tolerance):
+    """DriverError when the hand of `ee_state` stands farther than `tolerance` (m) from
+    that of `initial_ee_state`, the start the run was built for: its scene and its first
+    plans are made for that start, and a hand elsewhere would be steered from where it is
+    not."""
+    hand, start = np.asarray(ee_state)[:3], np.asarray(initial_ee_state)[:3]
+    off = float(np.linalg.norm(hand - start))
+    if off > tolerance:
+        where = ", ".join(f"{value:.3f}" for value in hand)
+        built = ", ".join(f"{value:.3f}" for value in start)
+        raise DriverError(
+            f"the robot's hand stands at [{where}] m, {off:.3f} m from the start the run "
+            f"was built for, [{built}] m (start_tolerance {tolerance:g} m): bring it there "
+            "first; nothing was sent")
+
+
+def read_first_state(config: TaskSpaceBridgeConfig, lcm, initial_ee_state):
+    """The robot's first EeState from its relay on `lcm` (`first_message`'s), waiting at
+    most `config.connect_timeout`, read before a run is built; DriverError naming the bus
+    and the channel when none comes, and as `BridgeLink` for a bad state or a hand away
+    from `initial_ee_state`."""
+    message = first_message(
+        lcm, config.state_channel, lcmt_drake_signal.decode, config.connect_timeout,
+        f"no state from the robot's relay on {config.state_channel} (bus "
+        f"{config.lcm_bus.lcm_url}) within {config.connect_timeout:g} s: is the relay "
+        "running on that bus?")
+    values = checked_state(message, config)
+    check_hand_start(values, initial_ee_state, config.start_tolerance)
+    return values
 
 
 class BridgeLink(LeafSystem):
@@ -129,33 +171,15 @@ class BridgeLink(LeafSystem):
             x[self._STARTED] = now
         message = self.get_input_port(0).Eval(context)
         if message.dim and message.timestamp != x[self._STAMP]:
-            values = np.asarray(message.val, float)
-            if len(values) != EeState.size or not np.all(np.isfinite(values)):
-                raise DriverError(f"the robot's state on {config.state_channel} holds "
-                                  f"{len(values)} values (EeState's {EeState.size}, finite): "
-                                  f"{list(message.coord)}")
+            values = checked_state(message, config)
             if np.isnan(x[self._AT]):
-                self._check_start(values[:3])
+                check_hand_start(values, self._initial, config.start_tolerance)
             x[self._AT], x[self._STAMP] = now, message.timestamp
         heard = check_heard(now, x[self._STARTED], x[self._AT], config.connect_timeout,
                             config.status_timeout, self._first, self._silent,
                             "nothing more is sent")
         x[self._SEND] = float(heard)
         discrete_state.set_value(self._index, x)
-
-    def _check_start(self, hand):
-        # The run's scene and its first plans are made for this start: a hand elsewhere
-        # would be steered from where it is not (the arm's start_tolerance, in metres).
-        start = self._initial[:3]
-        off = float(np.linalg.norm(hand - start))
-        if off > self._config.start_tolerance:
-            where = ", ".join(f"{value:.3f}" for value in hand)
-            built = ", ".join(f"{value:.3f}" for value in start)
-            raise DriverError(
-                f"the robot's hand stands at [{where}] m, {off:.3f} m from the start the "
-                f"run was built for, [{built}] m (start_tolerance "
-                f"{self._config.start_tolerance:g} m): bring it there first; nothing was "
-                "sent")
 
     def _send(self, context):
         x = context.get_discrete_state(self._index).value()

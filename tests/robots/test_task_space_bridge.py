@@ -17,9 +17,9 @@ from pydrake.systems.primitives import ConstantVectorSource
 from pbp_drake import EeCommand, EeState, HsrStationConfig, hsr_initial_ee_state, make_hsr_station
 from pbp_drake.robots import DriverError
 from pbp_drake.cli import main
-from pbp_drake.cli_types import EXIT_DRIVER
 from pbp_drake.robots.task_space_bridge import (
-    STATE_FIELDS, TaskSpaceBridgeConfig, make_station_relay, make_task_space_bridge, signal)
+    STATE_FIELDS, TaskSpaceBridgeConfig, make_station_relay, make_task_space_bridge,
+    read_first_state, signal)
 
 PERIOD = 0.1
 HSR_REACH = str(pathlib.Path(__file__).resolve().parents[2] / "diagrams" / "hsr_reach.yaml")
@@ -169,14 +169,44 @@ def test_the_hsr_task_runs_through_the_bridge_as_it_runs_on_the_station(capsys):
     assert np.abs(hands[0] - hands[1]).max() < 0.05
 
 
-def test_a_run_with_no_relay_ends_in_its_connect_timeout_naming_bus_and_channel(capsys):
+def test_a_run_with_no_relay_is_refused_in_its_connect_timeout_before_it_is_built(capsys):
+    # A run longer than the wait: the refusal comes from the wait, not the run's end.
     code, out = run("run", HSR_REACH, "--set", "robot.hardware={lcm_bus: {lcm_url: "
                     "'memq://'}, connect_timeout: 0.3}", "--hardware", "--operator",
-                    "virtual", "--headless", capsys=capsys)
-    assert code == EXIT_DRIVER
-    assert out.err.strip().splitlines()[-1] == (
+                    "virtual", "--headless", "--duration", "30", capsys=capsys)
+    assert code == 2
+    assert out.err.strip().splitlines() == [
         "pbp-drake: no state from the robot's relay on PBP_EE_STATE (bus memq://) within "
-        "0.3 s")
+        "0.3 s: is the relay running on that bus?"]
+    assert out.out == ""  # nothing ran
+
+
+class OneState:
+    """What `read_first_state` uses of a DrakeLcm: a bus whose first state is `message`."""
+
+    def __init__(self, message):
+        self._message, self._handlers = message, {}
+
+    def Subscribe(self, channel, handler):
+        self._handlers[channel] = handler
+
+    def HandleSubscriptions(self, timeout_millis):
+        self._handlers["PBP_EE_STATE"](self._message.encode())
+        return 1
+
+
+def test_the_first_state_is_read_before_a_run_or_refused_with_both_hands():
+    config, start = TaskSpaceBridgeConfig(connect=True), np.zeros(8)
+    near = [0.03, 0.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.0]
+    np.testing.assert_array_equal(
+        read_first_state(config, OneState(signal(near, STATE_FIELDS, 1.0)), start), near)
+    with pytest.raises(DriverError, match=r"^the robot's hand stands at \[0.000, 0.060, "
+                                          r"0.000\] m, 0.060 m from the start"):
+        read_first_state(config, OneState(signal([0.0, 0.06] + [0.0] * 6, STATE_FIELDS, 1.0)),
+                         start)
+    with pytest.raises(DriverError, match=r"on PBP_EE_STATE holds 8 values \(EeState's 8, "
+                                          r"finite\)"):
+        read_first_state(config, OneState(signal([np.nan] * 8, STATE_FIELDS, 1.0)), start)
 
 
 @pytest.mark.parametrize("scenario, setting, extra, message", [

@@ -106,8 +106,15 @@ def intent_features(goals, position, motion, heading, yaw_rate, period, min_spee
 def floor_bearings(offsets, heading):
     """Whether each goal at `offsets` (K, 2 or 3) from the hand has a bearing on the floor
     plane (K,), and its heading error `wrap(bearing - heading)` (K,) in rad."""
-    has_bearing = np.hypot(offsets[:, 0], offsets[:, 1]) > NO_BEARING
-    return has_bearing, _wrapped(np.arctan2(offsets[:, 1], offsets[:, 0]) - heading)
+    # Each coordinate as a contiguous array, squared in place for the bearing's test (as
+    # `goal_estimation.heading_angles`): the same numbers, in a fraction of hypot's time.
+    dx, dy = offsets[:, 0].copy(), offsets[:, 1].copy()
+    error = np.arctan2(dy, dx)
+    error -= heading
+    dx *= dx
+    dy *= dy
+    dx += dy
+    return dx > NO_BEARING * NO_BEARING, _wrapped(error)
 
 
 def turn_progress(has_bearing, error, turn):
@@ -167,7 +174,13 @@ def _straightness(angles):
 
 
 def _wrapped(angles):
-    return (np.asarray(angles) + np.pi) % (2.0 * np.pi) - np.pi
+    """`(angles + pi) % 2 pi - pi` (K,), the modulo taken only where it changes a value:
+    the same numbers in a fifth of the time when most angles are within a turn."""
+    shifted = np.asarray(angles) + np.pi
+    outside = np.flatnonzero((shifted < 0.0) | (shifted >= 2.0 * np.pi))
+    shifted[outside] = np.remainder(shifted[outside], 2.0 * np.pi)
+    shifted -= np.pi
+    return shifted
 
 
 def switch_probability(settings, period):

@@ -17,6 +17,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 from pbp_drake import EeCommand, EeState, HsrStationConfig, hsr_initial_ee_state, make_hsr_station
 from pbp_drake.robots import DriverError
 from pbp_drake.cli import main
+from pbp_drake.scenarios import load_scenario_file, resolve
 from pbp_drake.robots.task_space_bridge import (
     STATE_FIELDS, TaskSpaceBridgeConfig, make_station_relay, make_task_space_bridge,
     read_first_state, signal)
@@ -207,6 +208,25 @@ def test_the_first_state_is_read_before_a_run_or_refused_with_both_hands():
     with pytest.raises(DriverError, match=r"on PBP_EE_STATE holds 8 values \(EeState's 8, "
                                           r"finite\)"):
         read_first_state(config, OneState(signal([np.nan] * 8, STATE_FIELDS, 1.0)), start)
+
+
+@pytest.mark.parametrize("off, code, line", [
+    (0.0, 1, "The robot's relay answers on memq://: the hand stands at "),
+    (0.06, 2, "pbp-drake: the robot's hand stands at "),
+])
+def test_a_run_reads_the_relay_s_first_state_before_it_is_built(off, code, line, monkeypatch,
+                                                                 capsys):
+    # The relay's first state, the hand `off` (m) to the side of the scenario's start.
+    start = resolve(load_scenario_file(HSR_REACH).scenario).initial_ee_state
+    state = signal(start + np.array([0.0, off] + [0.0] * 6), STATE_FIELDS, 1.0)
+    monkeypatch.setattr("pbp_drake.commands.run.DrakeLcm", lambda bus: OneState(state))
+    # Then no relay answers in the run (memq://): it ends at its time limit, 0.2 s.
+    got, out = run("run", HSR_REACH, "--set", "robot.hardware={lcm_bus: {lcm_url: "
+                   "'memq://'}}", "--hardware", "--operator", "virtual", "--headless",
+                   "--duration", "0.2", capsys=capsys)
+    assert got == code
+    assert line in (out.out if code == 1 else out.err)
+    assert code == 1 or len(out.err.strip().splitlines()) == 1  # one line, no traceback
 
 
 @pytest.mark.parametrize("scenario, setting, extra, message", [

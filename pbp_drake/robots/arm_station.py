@@ -187,7 +187,8 @@ def _make_diff_ik(plant, arm, q0, config, ramp, look_ahead):
         velocity_limits=(plant.GetVelocityLowerLimits(), plant.GetVelocityUpperLimits()),
         acceleration_limits=(-accelerations, accelerations), q_nominal=q0,
         centering_gain=np.full(plant.num_positions(), config.centering_gain),
-        command_ramp=ramp, singular_margin=config.singular_margin)
+        command_ramp=ramp, singular_margin=config.singular_margin,
+        limit_margin=config.limit_margin)
 
 
 def arm_model_plant(config: ArmStationConfig):

@@ -146,6 +146,10 @@ class ArmStationConfig:
     #: per rad), the diff IK damps the joints' velocities rather than spin a joint pair to
     #: move the hand along a direction it has all but lost (damped least squares); 0: off.
     singular_margin: float = 0.0
+    #: Within this distance (rad or m) of a joint's position limit, the diff IK pushes the
+    #: joint back in the joint motion the hand's leaves free, so that the arm does not
+    #: stall with a joint on its limit and the hand short of its command; 0: off.
+    limit_margin: float = 0.0
     #: Dynamic motion: each joint's servo is critically damped at this frequency (rad/s)
     #: on the joint's own inertia in the ready configuration (kp = I w^2, kd = 2 I w).
     servo_frequency: float = 300.0
@@ -181,7 +185,7 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
                                  f"finite numbers, got {value}")
     check_positive(config, ("default_acceleration_limit", "servo_frequency"),
                    "ArmStationConfig")
-    for name in ("singular_margin", "centering_gain"):
+    for name in ("singular_margin", "centering_gain", "limit_margin"):
         value = getattr(config, name)
         if not (np.isfinite(value) and value >= 0):
             raise ValueError(f"ArmStationConfig.{name} must be >= 0, got {value}")

@@ -26,6 +26,11 @@ ROTATION_WEIGHT = 0.1
 # than it (turning less to move more), with that too: the hand does not run ahead of the
 # command where the limits bind.
 OVERSHOOT_WEIGHT = 10.0
+# With a `limit_margin`, the speed (rad/s or m/s) per unit of a joint's depth inside the
+# margin at which the plan's free joint motion pushes it back out. Chosen on the Panda's
+# tuning seeds (PBP-Alt and PBP-Cont, 100 each: margins 0.2 to 0.5, gains 10 to 100; 0.3
+# and 50 left one trial of 200 stalled, none 3): weaker, it did not free a stalled joint.
+LIMIT_PUSH_GAIN = 50.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
 CATCH_UP_STEPS = 3
@@ -63,16 +68,18 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
 
     Limits are (lower, upper) pairs of arrays over the plant's velocities (positions for
     ``position_limits``), ``inf`` for none; the plant must have q̇ = v. See
-    ``OVERSHOOT_WEIGHT`` for ``limit_overshoot``; ``singular_margin`` is
-    ``ArmStationConfig.singular_margin``.
+    ``OVERSHOOT_WEIGHT`` for ``limit_overshoot``; ``singular_margin`` and ``limit_margin``
+    are ``ArmStationConfig``'s (see ``LIMIT_PUSH_GAIN``).
     """
 
     def __init__(self, plant, frame_E, time_step, look_ahead, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
-                 centering_gain, command_ramp, limit_overshoot=False, singular_margin=0.0):
+                 centering_gain, command_ramp, limit_overshoot=False, singular_margin=0.0,
+                 limit_margin=0.0):
         super().__init__()
         self._limit_overshoot = bool(limit_overshoot)
         self._singular_margin = float(singular_margin)
+        self._limit_margin = float(limit_margin)
         nq, nv = plant.num_positions(), plant.num_velocities()
         if nq != nv:
             raise ValueError("WholeBodyDiffIk needs q̇ = v (no quaternion joints)")
@@ -180,6 +187,13 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         if self._singular_margin > 0.0:
             H0 = H0 + self._singular_damping(J) * self._identity
         g0 = self._centering_gain * (self._q_nominal - q)
+        if self._limit_margin > 0.0:
+            # Each joint's depth inside the margin of its lower and its upper limit (0
+            # outside, and for a joint without a limit), pushed back at LIMIT_PUSH_GAIN.
+            margin = self._limit_margin
+            inside_lower = np.maximum(margin - (q - self._q_lower), 0.0)
+            inside_upper = np.maximum(margin - (self._q_upper - q), 0.0)
+            g0 = g0 + LIMIT_PUSH_GAIN * (inside_lower - inside_upper)
         H, g = H0, g0
         norm = twist @ (self._task_weights * twist)
         if norm > 0:

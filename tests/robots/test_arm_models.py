@@ -114,6 +114,19 @@ def test_a_tool_pose_out_of_reach_is_refused_naming_the_field():
 
 
 @pytest.mark.slow
+def test_the_panda_s_limit_margin_keeps_a_joint_from_stalling_on_its_limit():
+    # PBP-Alt's tuning seed 87: without the file's limit_margin a joint reaches its limit on
+    # the way and the hand creeps short of the target until the time limit.
+    scenario = dataclasses.replace(load_scenario_file(
+        REPO / "diagrams" / "panda_reach.yaml").scenario, method="pbp_alternated", seed=87)
+    kept_off = run_task(scenario)
+    stalled = run_task(dataclasses.replace(scenario, robot=dataclasses.replace(
+        scenario.robot, limit_margin=0.0)))
+    assert kept_off.success and kept_off.task_time < 20.0
+    assert not stalled.success
+
+
+@pytest.mark.slow
 def test_the_panda_passes_its_shoulder_singularity_without_a_jump():
     # Teleop's tuning seed 7 brings the upper arm upright (joint 2 near 0), where joints 1
     # and 3 turn about one axis: without the file's singular_margin the diff IK spins

@@ -126,6 +126,8 @@ REFUSALS = [
      "ArmStationConfig.initial_positions must be finite, got [nan, "),
     ("negative singular margin", lambda tmp: {"singular_margin": -1.0},
      "ArmStationConfig.singular_margin must be >= 0, got -1.0"),
+    ("negative limit margin", lambda tmp: {"limit_margin": -0.1},
+     "ArmStationConfig.limit_margin must be >= 0, got -0.1"),
     ("no room between the limits", lambda tmp: {"model_file": _arm7_with(
         tmp, ('<limit lower="0" upper="3.05"', '<limit lower="0.5" upper="0.5"'))},
      "joint 'arm7_joint4' has position limits [0.5, 0.5] with no room between them"),

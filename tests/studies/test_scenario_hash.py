@@ -86,11 +86,13 @@ def test_the_intent_filters_settings_at_their_defaults_leave_the_hash():
 
 @pytest.mark.parametrize("name, field, value", [
     ("arm_reach.yaml", "singular_margin", 0.05),
+    ("arm_reach.yaml", "limit_margin", 0.3),
     ("arm_reach.yaml", "ready_tool_pose", ToolPose(position=[0.3, 0.0, 0.4])),
     ("arm_reach.yaml", "hardware", ArmHardware(driver="iiwa")),
     ("hsr_reach.yaml", "hardware", TaskSpaceBridgeConfig(connect=True))])
 def test_a_later_robot_field_changes_the_hash_and_its_default_leaves_it(name, field, value):
-    # The arm's singular damping, its ready pose as a tool pose, a real robot's link.
+    # The arm's singular damping and limit margin, its ready pose as a tool pose, a real
+    # robot's link.
     base = scenario(name)
     assert field not in scenario_content(base)["robot"]
     changed = dataclasses.replace(base, robot=dataclasses.replace(base.robot, **{field: value}))

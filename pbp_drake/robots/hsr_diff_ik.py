@@ -28,8 +28,9 @@ ROTATION_WEIGHT = 0.1
 OVERSHOOT_WEIGHT = 10.0
 # With a `limit_margin`, the speed (rad/s or m/s) per unit of a joint's depth inside the
 # margin at which the plan's free joint motion pushes it back out. Chosen on the Panda's
-# tuning seeds (PBP-Alt and PBP-Cont, 100 each: margins 0.2 to 0.5, gains 10 to 100; 0.3
-# and 50 left one trial of 200 stalled, none 3): weaker, it did not free a stalled joint.
+# tuning seeds (PBP-Alt and PBP-Cont, 100 trials each, margins 0.2 to 0.5 rad, gains 10 to
+# 100/s): 3 of the 200 trials stalled without the push, 1 with 0.3 rad and 25 or 50/s (50
+# the faster); at 10/s it freed fewer, and a 0.5 rad margin stalled others.
 LIMIT_PUSH_GAIN = 50.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.

@@ -26,6 +26,8 @@ from pbp_drake.robots.arm_station_config import DRIVERS
 from pbp_drake.robots.driver_sim import DriverSimError, make_driver_sim
 from pbp_drake.scenarios import load_scenario_file
 
+from first_message import FirstMessage
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 LOWER, UPPER = np.full(7, -2.5), np.full(7, 2.5)
 VELOCITY = np.full(7, 2.0)
@@ -309,29 +311,15 @@ def test_an_arm_that_moved_after_its_first_status_was_read_ends_the_run():
     assert rig.commands == []
 
 
-class OneStatus:
-    """What `read_first_status` uses of a DrakeLcm: a bus whose first status is `message`."""
-
-    def __init__(self, message):
-        self._message, self._handlers = message, {}
-
-    def Subscribe(self, channel, handler):
-        self._handlers[channel] = handler
-
-    def HandleSubscriptions(self, timeout_millis):
-        self._handlers["IIWA_STATUS"](self._message.encode())
-        return 1
-
-
 def test_the_first_status_gives_the_arm_s_configuration_or_refuses_a_bad_one():
     hardware = ArmHardware(driver="iiwa", connect=True)
     good = status_message("iiwa", 0, START, np.zeros(7), START)
-    np.testing.assert_array_equal(read_first_status(hardware, OneStatus(good), LOWER, UPPER),
-                                  START)
+    bus = FirstMessage("IIWA_STATUS", good)
+    np.testing.assert_array_equal(read_first_status(hardware, bus, LOWER, UPPER), START)
     beyond = np.where(np.arange(7) == 1, 2.7, START)
-    bad = status_message("iiwa", 0, beyond, np.zeros(7), beyond)
+    bad = FirstMessage("IIWA_STATUS", status_message("iiwa", 0, beyond, np.zeros(7), beyond))
     with pytest.raises(DriverError, match=r"IIWA_STATUS puts joint 2 at 2.7000 rad, beyond"):
-        read_first_status(hardware, OneStatus(bad), LOWER, UPPER)
+        read_first_status(hardware, bad, LOWER, UPPER)
 
 
 def test_the_driver_simulator_needs_the_driver_it_simulates():

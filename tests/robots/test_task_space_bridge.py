@@ -22,6 +22,8 @@ from pbp_drake.robots.task_space_bridge import (
     STATE_FIELDS, TaskSpaceBridgeConfig, make_station_relay, make_task_space_bridge,
     read_first_state, signal)
 
+from first_message import FirstMessage
+
 PERIOD = 0.1
 HSR_REACH = str(pathlib.Path(__file__).resolve().parents[2] / "diagrams" / "hsr_reach.yaml")
 SUMMARY = re.compile(r"^hsr_reach \[pbp_alternated, seed 0\]: success in (\S+) s, .*"
@@ -182,32 +184,20 @@ def test_a_run_with_no_relay_is_refused_in_its_connect_timeout_before_it_is_buil
     assert out.out == ""  # nothing ran
 
 
-class OneState:
-    """What `read_first_state` uses of a DrakeLcm: a bus whose first state is `message`."""
-
-    def __init__(self, message):
-        self._message, self._handlers = message, {}
-
-    def Subscribe(self, channel, handler):
-        self._handlers[channel] = handler
-
-    def HandleSubscriptions(self, timeout_millis):
-        self._handlers["PBP_EE_STATE"](self._message.encode())
-        return 1
-
-
 def test_the_first_state_is_read_before_a_run_or_refused_with_both_hands():
     config, start = TaskSpaceBridgeConfig(connect=True), np.zeros(8)
+
+    def relay_sending(values):
+        return FirstMessage("PBP_EE_STATE", signal(values, STATE_FIELDS, 1.0))
+
     near = [0.03, 0.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.0]
-    np.testing.assert_array_equal(
-        read_first_state(config, OneState(signal(near, STATE_FIELDS, 1.0)), start), near)
+    np.testing.assert_array_equal(read_first_state(config, relay_sending(near), start), near)
     with pytest.raises(DriverError, match=r"^the robot's hand stands at \[0.000, 0.060, "
                                           r"0.000\] m, 0.060 m from the start"):
-        read_first_state(config, OneState(signal([0.0, 0.06] + [0.0] * 6, STATE_FIELDS, 1.0)),
-                         start)
+        read_first_state(config, relay_sending([0.0, 0.06] + [0.0] * 6), start)
     with pytest.raises(DriverError, match=r"on PBP_EE_STATE holds 8 values \(EeState's 8, "
                                           r"finite\)"):
-        read_first_state(config, OneState(signal([np.nan] * 8, STATE_FIELDS, 1.0)), start)
+        read_first_state(config, relay_sending([np.nan] * 8), start)
 
 
 @pytest.mark.parametrize("off, code, line", [
@@ -219,7 +209,8 @@ def test_a_run_reads_the_relay_s_first_state_before_it_is_built(off, code, line,
     # The relay's first state, the hand `off` (m) to the side of the scenario's start.
     start = resolve(load_scenario_file(HSR_REACH).scenario).initial_ee_state
     state = signal(start + np.array([0.0, off] + [0.0] * 6), STATE_FIELDS, 1.0)
-    monkeypatch.setattr("pbp_drake.commands.run.DrakeLcm", lambda bus: OneState(state))
+    monkeypatch.setattr("pbp_drake.commands.run.DrakeLcm",
+                        lambda bus: FirstMessage("PBP_EE_STATE", state))
     # Then no relay answers in the run (memq://): it ends at its time limit, 0.2 s.
     got, out = run("run", HSR_REACH, "--set", "robot.hardware={lcm_bus: {lcm_url: "
                    "'memq://'}}", "--hardware", "--operator", "virtual", "--headless",

@@ -185,6 +185,11 @@ def _check_output_file(path, flag, example, is_ours, kind, force):
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
                               f"{file / example}")
+    if file.exists() and not file.is_file() and not force:
+        # A device or a pipe is never read: /dev/zero's "first line" never ends, and a
+        # pipe's open waits for a writer.
+        raise OutputPathError(f"{flag} {file}: is not a regular file (a device or a pipe); "
+                              f"add --force to write to it")
     if file.exists() or file.is_symlink():
         if not force and not is_ours(file):
             raise OutputPathError(f"{flag} {file}: the file exists and is not {kind} "
@@ -198,7 +203,7 @@ def _check_output_file(path, flag, example, is_ours, kind, force):
 def _is_time_series(path):
     try:
         with open(path, newline="") as stream:
-            head = stream.readline()
+            head = stream.readline(_MARKER_WINDOW)
     except (OSError, UnicodeDecodeError):
         return False
     # The reach tasks' (with or without in_collision) and the grasping task's.

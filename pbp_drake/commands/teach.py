@@ -135,6 +135,11 @@ def read_hand_path(path):
     """Times (T,), hand positions (T, 3) and orientations (T, 4; None where the recording
     has none) of a run's or trial's CSV, or of a run's replay (`run --record`, at its frame
     rate); ScenarioError naming the file for one that cannot be read or has no hand path."""
+    source = pathlib.Path(path)
+    if source.exists() and not (source.is_file() or source.is_dir()):
+        # Never read: a device such as /dev/zero never ends, a pipe waits for a writer.
+        raise ScenarioError(f"{path}: not a regular file; give a run's CSV (run --log) or "
+                            "replay (run --record)")
     if is_replay(path):
         return _replay_hand_path(path)
     try:

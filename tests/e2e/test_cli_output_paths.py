@@ -85,6 +85,20 @@ def test_record_into_a_read_only_folder_is_refused(tmp_path, repo, capsys):
         folder.chmod(0o700)
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("flag", ["--record", "--log"])
+def test_an_output_that_is_a_pipe_is_refused_without_reading_it(flag, tmp_path, repo,
+                                                                capsys):
+    # Reading a pipe's first line waits for a writer (a device's, such as /dev/zero's, never
+    # ends): an output that is not a regular file is never read, and needs --force.
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    err = refused(["run", str(repo / "diagrams" / "hsr_reach.yaml"), "--headless",
+                   "--operator", "virtual", flag, str(pipe)], capsys, pipe)
+    assert "is not a regular file (a device or a pipe); add --force" in err
+
+
 def test_study_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
     output = tmp_path / "summary.txt"
     output.write_text("keep me")

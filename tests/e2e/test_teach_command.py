@@ -4,6 +4,7 @@ refused in one line naming the file (exit 2)."""
 
 import csv
 import json
+import os
 import pathlib
 import shutil
 
@@ -191,6 +192,17 @@ def test_a_recording_that_cannot_be_read_is_refused(tmp_path, capsys):
                     capsys=capsys)
     assert code == 2 and f"{tmp_path}: cannot be read as a CSV" in out.err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")
+@pytest.mark.timeout(60)
+def test_a_recording_that_is_a_pipe_is_refused_without_reading_it(tmp_path, capsys):
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    code, out = run("teach", REACH, "--from", pipe, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 2 and f"{pipe}: not a regular file; give a run's CSV" in out.err
+    assert sorted(tmp_path.iterdir()) == [pipe]
 
 
 def test_a_2d_scene_is_refused(repo, tmp_path, capsys):

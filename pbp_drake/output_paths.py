@@ -15,6 +15,7 @@ import numpy as np
 from pbp_drake.builder.time_series import time_series_header
 from pbp_drake.core.dmp.primitive import PRIMITIVE_FORMAT
 from pbp_drake.scenarios import ScenarioError
+from pbp_drake.scenarios.bounds import is_special_file
 from pbp_drake.systems.visualizers.point_scene_visualizer import LEGEND as SCENE_2D_LEGEND
 
 # Written into every replay just after its doctype: an existing file that holds it is a
@@ -185,9 +186,7 @@ def _check_output_file(path, flag, example, is_ours, kind, force):
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
                               f"{file / example}")
-    if file.exists() and not file.is_file() and not force:
-        # A device or a pipe is never read: /dev/zero's "first line" never ends, and a
-        # pipe's open waits for a writer.
+    if is_special_file(file) and not force:
         raise OutputPathError(f"{flag} {file}: is not a regular file (a device or a pipe); "
                               f"add --force to write to it")
     if file.exists() or file.is_symlink():

@@ -20,6 +20,7 @@ from pbp_drake.output_paths import (
     check_figure_path, check_log_path, check_primitive_path, is_replay, replay_track,
     same_file)
 from pbp_drake.scenarios import GraspTask, ScenarioError, TaskScenario, load_scenario_file
+from pbp_drake.scenarios.bounds import is_special_file
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.primitive_figure import plot_primitive
 from pbp_drake.systems.visualizers.reach_scene_visualizer import HAND_MARKER
@@ -135,9 +136,7 @@ def read_hand_path(path):
     """Times (T,), hand positions (T, 3) and orientations (T, 4; None where the recording
     has none) of a run's or trial's CSV, or of a run's replay (`run --record`, at its frame
     rate); ScenarioError naming the file for one that cannot be read or has no hand path."""
-    source = pathlib.Path(path)
-    if source.exists() and not (source.is_file() or source.is_dir()):
-        # Never read: a device such as /dev/zero never ends, a pipe waits for a writer.
+    if is_special_file(path):
         raise ScenarioError(f"{path}: not a regular file; give a run's CSV (run --log) or "
                             "replay (run --record)")
     if is_replay(path):

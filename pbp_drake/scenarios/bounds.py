@@ -10,6 +10,8 @@ Drake's reading of tags (`load_document`), then copied into the schema by Drake'
 loader (`load_typed`).
 """
 
+import pathlib
+
 import yaml
 from pydrake.common import yaml as drake_yaml
 from pydrake.common.yaml import yaml_load_typed
@@ -37,6 +39,13 @@ GOAL_LISTS = {"scenario.goals": "goals", "scenario.task.objects": "objects"}
 
 # PyYAML's C loader where PyYAML was built with libyaml, else its Python one.
 _BASE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def is_special_file(path):
+    """Whether `path` names a device, a pipe or a socket, which is never read: a device
+    such as /dev/zero never ends, and a pipe's open waits for a writer."""
+    path = pathlib.Path(path)
+    return path.exists() and not (path.is_file() or path.is_dir())
 
 
 def read_bounded(path):

@@ -28,7 +28,7 @@ from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
 from pbp_drake.robots.model_geometry import check_clear_of_base
 from pbp_drake.robots.task_space_bridge import validate_task_space_bridge
-from pbp_drake.scenarios.bounds import check_goal_counts
+from pbp_drake.scenarios.bounds import check_goal_counts, is_special_file
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, RENAMED_METHODS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles, Gamepad,
     GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, PointScenario, Scenario, ScenarioError,
@@ -472,6 +472,8 @@ def _taught_primitive(scenario, task):
 def load_primitive(path, field):
     """The primitive in the file at `path`; ScenarioError `field: what is wrong` (one line)
     for a file that cannot be read, is not JSON (truncated, corrupt) or not a primitive."""
+    if is_special_file(path):
+        raise ScenarioError(f"{field} is not a regular file: not a primitive")
     try:
         with open(path, "rb") as file:
             data = file.read(MAX_PRIMITIVE_BYTES + 1)

@@ -4,6 +4,7 @@ no other test reached, each with a value it refuses."""
 
 import dataclasses
 import math
+import os
 import pathlib
 import re
 
@@ -251,6 +252,16 @@ def test_a_primitive_file_larger_than_any_primitive_is_refused(tmp_path):
         file.truncate(MAX_PRIMITIVE_BYTES + 1)  # sparse: no disk is written
     with pytest.raises(ScenarioError, match=r"^scenario.dmp.primitive is over 64 MiB: not a "
                                             r"primitive$"):
+        load_primitive(path, "scenario.dmp.primitive")
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")
+@pytest.mark.timeout(60)
+def test_a_primitive_file_that_is_a_pipe_is_refused_without_reading_it(tmp_path):
+    path = tmp_path / "pipe.json"
+    os.mkfifo(path)  # its open would wait for a writer
+    with pytest.raises(ScenarioError, match=r"^scenario.dmp.primitive is not a regular "
+                                            r"file: not a primitive$"):
         load_primitive(path, "scenario.dmp.primitive")
 
 

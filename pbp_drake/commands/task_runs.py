@@ -16,6 +16,7 @@ from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, resul
 from pbp_drake.console.text import controls_line, failure_text
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, resolve
+from pbp_drake.studies.atomic_files import write_failed
 
 
 def run_scene(args, resolved, meshcat, page):
@@ -114,10 +115,17 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     rate = 0.0 if args.headless else args.realtime_rate
     if args.log:
         pathlib.Path(args.log).parent.mkdir(parents=True, exist_ok=True)
-    result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram,
-                                advance=live.advance)
-              if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram,
-                                        advance=live.advance))
+    try:
+        result = (run_task_streamed(resolved, args.log, realtime_rate=rate, diagram=diagram,
+                                    advance=live.advance)
+                  if args.log else run_task(resolved, realtime_rate=rate, diagram=diagram,
+                                            advance=live.advance))
+    except OSError as error:
+        # The log that passed its check but cannot be opened (a special file system, a
+        # folder changed since): said in one line, as a full disk is (`stopping_cleanly`).
+        if args.log and error.filename == args.log:
+            raise write_failed(error, args.log) from None
+        raise
     if args.record:
         save_recording(meshcat, args.record)
     stopped = live.choice is not None

@@ -128,3 +128,21 @@ def test_the_replay_marker_follows_the_doctype():
     html = mark_replay("<!DOCTYPE html>\n<html></html>")
     assert html.splitlines()[:2] == ["<!DOCTYPE html>", REPLAY_MARKER]
     assert mark_replay("<html></html>").startswith(REPLAY_MARKER)
+
+
+def test_a_log_that_passed_its_check_but_cannot_be_opened_is_one_line(tmp_path, repo,
+                                                                       monkeypatch, capsys):
+    # As on a file system where the check's answer is wrong (/proc, as root): the open fails.
+    log = str(tmp_path / "run.csv")
+
+    def cannot_open(resolved, log_path, **options):
+        raise FileNotFoundError(2, "No such file or directory", log_path)
+
+    monkeypatch.setattr("pbp_drake.commands.task_runs.run_task_streamed", cannot_open)
+    code = main(["run", str(repo / "diagrams" / "hsr_reach.yaml"), "--headless", "--operator",
+                 "virtual", "--log", log])
+    err = capsys.readouterr().err
+    assert code == 4
+    assert err.strip().splitlines() == [
+        f"pbp-drake: cannot write {log}: no such file or directory; nothing is left "
+        "half-written: make the folder writable, then run the same command again."]

@@ -10,6 +10,8 @@ import errno
 import os
 import pathlib
 
+from pbp_drake.scenarios.bounds import is_special_file
+
 # The errors that mean the disk, not the study, failed; what the person can do about each.
 DISK_ERRORS = {
     errno.ENOSPC: "free some space",
@@ -58,8 +60,16 @@ def is_disk_failure(error):
 @contextlib.contextmanager
 def writing(path):
     """Yields the temporary path to write `path` through, then flushes and renames it to
-    `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`."""
+    `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`. A
+    device or a pipe (e.g. /dev/null, or /dev/stdout: a link to one) is written into, as a
+    shell's `>` does: a rename would put a regular file in its place."""
     path = pathlib.Path(path)
+    if is_special_file(path):
+        try:
+            yield path
+        except OSError as error:
+            raise write_failed(error, path) from error
+        return
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -14,6 +14,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 
 import numpy as np
@@ -21,7 +22,7 @@ import pytest
 
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.cli import main
-from pbp_drake.studies.atomic_files import WriteFailed, remove_leftovers
+from pbp_drake.studies.atomic_files import WriteFailed, remove_leftovers, write_atomically
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.folders import LOCK_FILE, FolderLocked
 from pbp_drake.scenarios import load_scenario_file
@@ -130,6 +131,27 @@ def test_leftovers_beside_the_summary_go_once_their_writer_has_ended(tmp_path):
         path.write_text("half")
     remove_leftovers(tmp_path)
     assert [path.name for path in tmp_path.iterdir()] == [running.name]
+
+
+@pytest.mark.timeout(60)
+def test_a_device_or_a_pipe_is_written_into_never_replaced_by_a_file(tmp_path):
+    # `report --markdown /dev/null` (or /dev/stdout) renamed a regular file over the device.
+    null, full, pipe = tmp_path / "null.md", tmp_path / "full.md", tmp_path / "pipe.md"
+    null.symlink_to(os.devnull)
+    full.symlink_to("/dev/full")
+    os.mkfifo(pipe)
+    write_atomically(null, "# results\n")
+    with pytest.raises(WriteFailed, match="no space left on device"):
+        write_atomically(full, "# results\n")
+    read = []
+    reader = threading.Thread(target=lambda: read.append(pipe.read_text()))
+    reader.start()
+    write_atomically(pipe, "# results\n")
+    reader.join()
+    assert read == ["# results\n"]
+    assert null.is_char_device() and full.is_char_device() and pipe.is_fifo()
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["full.md", "null.md",
+                                                                 "pipe.md"]
 
 
 def _trial_records(folder):

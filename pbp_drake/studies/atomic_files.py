@@ -22,6 +22,11 @@ DISK_ERRORS = {
 }
 
 
+#: The largest study file read back (bytes): a trial's JSON with 100,000 goals is near 6 MB,
+#: a trial's CSV about 9 KB a simulated second.
+MOST_READ_BYTES = 64 << 20
+
+
 class WriteFailed(OSError):
     """A file could not be written (OSError's `filename`, `errno`, `strerror`)."""
 
@@ -86,6 +91,19 @@ def writing(path):
         if isinstance(error, OSError):
             raise write_failed(error, path) from error
         raise
+
+
+def read_text(path, most=MOST_READ_BYTES):
+    """The UTF-8 text of the study file at `path` (as Path.read_text). Raises OSError naming
+    it, without reading it, for a device or a pipe (/dev/zero never ends, a pipe's open waits
+    for a writer), and having read no more than `most` bytes for a larger file."""
+    if is_special_file(path):
+        raise OSError(errno.EINVAL, "a device or a pipe, not a regular file", str(path))
+    with open(path, "rb") as stream:
+        data = stream.read(most + 1)
+    if len(data) > most:
+        raise OSError(errno.EINVAL, f"holds more than {most:,} bytes", str(path))
+    return data.decode()
 
 
 def write_atomically(path, text):

@@ -25,6 +25,8 @@ DISK_ERRORS = {
 #: The largest study file read back (bytes): a trial's JSON with 100,000 goals is near 6 MB,
 #: a trial's CSV about 9 KB a simulated second.
 MOST_READ_BYTES = 64 << 20
+#: The longest file name (bytes) of the usual file systems (ext4, btrfs, XFS, tmpfs: NAME_MAX).
+MOST_NAME_BYTES = 255
 
 
 class WriteFailed(OSError):
@@ -75,7 +77,7 @@ def writing(path):
         except OSError as error:
             raise write_failed(error, path) from error
         return
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    temporary = _temporary(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         yield temporary
@@ -104,6 +106,15 @@ def read_text(path, most=MOST_READ_BYTES):
     if len(data) > most:
         raise OSError(errno.EINVAL, f"holds more than {most:,} bytes", str(path))
     return data.decode()
+
+
+def _temporary(path):
+    """`.NAME.PID.tmp` beside `path`, NAME cut short where the whole would pass the 255 bytes
+    a file system takes in a name (a 250-byte name given to `run --record` was refused only
+    once the run had ended)."""
+    tail = f".{os.getpid()}.tmp"
+    name = os.fsencode(path.name)[:MOST_NAME_BYTES - 1 - len(tail)]
+    return path.with_name(f".{os.fsdecode(name)}{tail}")
 
 
 def write_atomically(path, text):

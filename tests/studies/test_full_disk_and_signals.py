@@ -154,6 +154,14 @@ def test_a_device_or_a_pipe_is_written_into_never_replaced_by_a_file(tmp_path):
                                                                  "pipe.md"]
 
 
+def test_a_file_whose_name_is_near_the_longest_is_written(tmp_path):
+    # Its temporary file's name (`.NAME.PID.tmp`) passed 255 bytes: WriteFailed, once the
+    # run whose replay it was had ended.
+    path = tmp_path / ("é" * 120 + "r.html")  # 252 bytes
+    write_atomically(path, "replay")
+    assert path.read_text() == "replay" and len(list(tmp_path.iterdir())) == 1
+
+
 def _trial_records(folder):
     return [json.loads(p.read_text()) for p in (folder / "trials").glob("*/seed_*.json")]
 

@@ -99,6 +99,22 @@ def test_an_output_that_is_a_pipe_is_refused_without_reading_it(flag, tmp_path, 
     assert "is not a regular file (a device or a pipe); add --force" in err
 
 
+@pytest.mark.parametrize("argv", [
+    ["run", "{long}.yaml"], ["run", "{hsr}", "--log", "{long}.csv"],
+    ["run", "{hsr}", "--record", "{long}.html"], ["study", "{hsr}", "--output", "{long}"],
+    ["report", "{long}"], ["compare", "{long}", "{long}"],
+    ["teach", "{hsr}", "--from", "{long}.csv", "--output", "{tmp}/primitive.json"],
+    ["teach", "{hsr}", "--output", "{long}.json"], ["draw", "{hsr}", "--output", "{long}.svg"],
+])
+def test_a_name_too_long_for_the_file_system_is_one_line(argv, tmp_path, repo, capsys):
+    # pathlib's exists and is_dir raise ENAMETOOLONG (a 300-character name): a traceback.
+    long = tmp_path / ("l" * 300)
+    words = {"long": long, "hsr": repo / "diagrams" / "hsr_reach.yaml", "tmp": tmp_path}
+    err = refused([word.format(**words) for word in argv], capsys, long)
+    assert err.endswith(": the name is too long (a file or folder name is at most 255 bytes, "
+                        "a path 4,096)\n") and err.count("\n") == 1
+
+
 def test_study_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
     output = tmp_path / "summary.txt"
     output.write_text("keep me")

@@ -186,6 +186,10 @@ def _check_output_file(path, flag, example, is_ours, kind, force):
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
                               f"{file / example}")
+    if file.is_symlink() and not file.exists():  # was "the file exists" / "is not writable"
+        raise OutputPathError(f"{flag} {file}: is a symbolic link to nothing (its target "
+                              f"{os.readlink(file)} is missing, or the links loop); give "
+                              "another path")
     if is_special_file(file) and not force:
         raise OutputPathError(f"{flag} {file}: is not a regular file (a device or a pipe); "
                               f"add --force to write to it")

@@ -115,6 +115,21 @@ def test_a_name_too_long_for_the_file_system_is_one_line(argv, tmp_path, repo, c
                         "a path 4,096)\n") and err.count("\n") == 1
 
 
+@pytest.mark.parametrize("force", [[], ["--force"]])
+@pytest.mark.parametrize("flag", ["--record", "--log"])
+def test_an_output_that_is_a_link_to_nothing_is_named_so(flag, force, tmp_path, repo, capsys):
+    # It was "the file exists and is not ...", and with --force "the file is not writable".
+    dangling, loop = tmp_path / "dangling", tmp_path / "loop"
+    dangling.symlink_to(tmp_path / "missing")
+    loop.symlink_to(tmp_path / "back")
+    (tmp_path / "back").symlink_to(loop)
+    for link, target in ((dangling, tmp_path / "missing"), (loop, tmp_path / "back")):
+        err = refused(["run", str(repo / QUICK), "--headless", flag, str(link), *force],
+                      capsys, link)
+        assert err == (f"pbp-drake: {flag} {link}: is a symbolic link to nothing (its target "
+                       f"{target} is missing, or the links loop); give another path\n")
+
+
 def test_study_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
     output = tmp_path / "summary.txt"
     output.write_text("keep me")

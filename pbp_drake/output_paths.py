@@ -219,6 +219,10 @@ def check_output_folder(path):
     if not os.fspath(path):  # pathlib would read it as ".", the current folder
         raise OutputPathError("--output: the path is empty; give a folder for the results")
     output = pathlib.Path(path)
+    if output.is_symlink() and not output.exists():  # its mkdir failed: "file exists", exit 4
+        raise OutputPathError(f"--output {output}: is a symbolic link to nothing (its target "
+                              f"{os.readlink(output)} is missing, or the links loop); give "
+                              "another folder")
     if output.exists() and not output.is_dir():
         raise OutputPathError(f"--output {output}: is a file, not a folder; give a folder "
                               f"for the results")

@@ -147,6 +147,20 @@ def test_study_output_under_a_file_is_refused(tmp_path, repo, capsys):
     assert blocker.read_text() == "keep me"
 
 
+@pytest.mark.parametrize("command", [["study", "--trials", "1"],
+                                     ["session", "--participant", "P01", "--headless"]])
+def test_an_output_folder_that_is_a_link_to_nothing_is_named_so(command, tmp_path, repo,
+                                                                capsys):
+    # Its folder could not be made: "cannot write .../.study.lock: file exists", exit 4.
+    output = tmp_path / "study"
+    output.symlink_to(tmp_path / "missing")
+    err = refused([command[0], str(repo / "diagrams/hsr_reach.yaml"), *command[1:],
+                   "--output", str(output)], capsys, output)
+    assert err == (f"pbp-drake: --output {output}: is a symbolic link to nothing (its target "
+                   f"{tmp_path / 'missing'} is missing, or the links loop); give another "
+                   "folder\n")
+
+
 def test_session_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
     output = tmp_path / "P01"
     output.write_text("keep me")

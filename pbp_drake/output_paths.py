@@ -169,8 +169,12 @@ def check_figure_path(path):
 
 def check_drawing_path(path):
     """Raises OutputPathError unless `path` can take a drawing (`pbp-drake draw --output`):
-    a writable file (an existing one is drawn over)."""
+    a writable file (an existing one is drawn over), not a device or a pipe (a pipe's open
+    waits for a reader; `-` is standard output)."""
     _check_output_file(path, "--output", "diagram.svg", None, "a drawing", force=True)
+    if is_special_file(path):
+        raise OutputPathError(f"--output {path}: is not a regular file (a device or a pipe); "
+                              "give a file, or - for standard output")
 
 
 def _is_primitive(path):  # as `pbp-drake teach` writes it (json.dumps' separators)

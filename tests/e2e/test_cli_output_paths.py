@@ -191,3 +191,19 @@ def test_a_log_that_passed_its_check_but_cannot_be_opened_is_one_line(tmp_path, 
     assert err.strip().splitlines() == [
         f"pbp-drake: cannot write {log}: no such file or directory; nothing is left "
         "half-written: make the folder writable, then run the same command again."]
+
+
+def test_a_log_whose_write_fails_names_the_log(tmp_path, repo, monkeypatch, capsys):
+    # A write's OSError names no file (as /dev/full's with --force): "cannot write a file".
+    log = str(tmp_path / "run.csv")
+
+    def disk_full(resolved, log_path, **options):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr("pbp_drake.commands.task_runs.run_task_streamed", disk_full)
+    code = main(["run", str(repo / "diagrams" / "hsr_reach.yaml"), "--headless", "--operator",
+                 "virtual", "--log", log])
+    assert code == 4
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"pbp-drake: cannot write {log}: no space left on device; nothing is left "
+        "half-written: free some space, then run the same command again."]

@@ -68,10 +68,10 @@ def is_disk_failure(error):
 def writing(path):
     """Yields the temporary path to write `path` through, then flushes and renames it to
     `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`. A
-    device or a pipe (e.g. /dev/null, or /dev/stdout: a link to one) is written into, as a
+    character device (e.g. /dev/null, or /dev/stdout: a link to one) is written into, as a
     shell's `>` does: a rename would put a regular file in its place."""
     path = pathlib.Path(path)
-    if is_special_file(path):
+    if path.is_char_device():
         try:
             yield path
         except OSError as error:

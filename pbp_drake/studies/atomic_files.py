@@ -68,14 +68,21 @@ def is_disk_failure(error):
 def writing(path):
     """Yields the temporary path to write `path` through, then flushes and renames it to
     `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`. A
-    character device (e.g. /dev/null, or /dev/stdout: a link to one) is written into, as a
-    shell's `>` does: a rename would put a regular file in its place."""
+    character device (e.g. /dev/null, or /dev/stdout: a link to one) or a pipe a process
+    reads is written into, as a shell's `>` does: a rename would put a regular file in its
+    place (of /dev/stdout itself, as root). A pipe that none reads is renamed over, as a
+    file: its open would wait for a reader."""
     path = pathlib.Path(path)
-    if path.is_char_device():
+    reader = _pipe_with_reader(path)
+    if path.is_char_device() or reader is not None:
         try:
-            yield path
+            # The pipe through the descriptor held open: its reader sees no end between opens.
+            yield path if reader is None else pathlib.Path(f"/proc/self/fd/{reader}")
         except OSError as error:
             raise write_failed(error, path) from error
+        finally:
+            if reader is not None:
+                os.close(reader)
         return
     temporary = _temporary(path)
     try:
@@ -93,6 +100,19 @@ def writing(path):
         if isinstance(error, OSError):
             raise write_failed(error, path) from error
         raise
+
+
+def _pipe_with_reader(path):
+    """A descriptor open for writing (blocking) on the named pipe at `path` when a process
+    reads it; None for anything else, a pipe without a reader too."""
+    if not path.is_fifo():
+        return None
+    try:
+        descriptor = os.open(path, os.O_WRONLY | os.O_NONBLOCK)  # ENXIO: no reader
+    except OSError:
+        return None
+    os.set_blocking(descriptor, True)
+    return descriptor
 
 
 def read_text(path, most=MOST_READ_BYTES):

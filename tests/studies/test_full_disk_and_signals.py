@@ -144,6 +144,24 @@ def test_a_device_is_written_into_never_replaced_by_a_file(tmp_path):
     assert sorted(path.name for path in tmp_path.iterdir()) == ["full.md", "null.md"]
 
 
+@pytest.mark.timeout(60)
+def test_a_pipe_is_written_into_when_read_and_else_renamed_over(tmp_path):
+    # A pipe read by a process (/dev/stdout into `| less`) got a regular file in its place;
+    # one that none reads is renamed over as before (its open would wait for a reader).
+    read, unread = tmp_path / "read.md", tmp_path / "unread.md"
+    os.mkfifo(read)
+    os.mkfifo(unread)
+    reader = os.open(read, os.O_RDONLY | os.O_NONBLOCK)
+    try:
+        write_atomically(read, "# results\n")
+        assert os.read(reader, 100) == b"# results\n" and read.is_fifo()
+    finally:
+        os.close(reader)
+    write_atomically(unread, "# results\n")
+    assert unread.read_text() == "# results\n"
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["read.md", "unread.md"]
+
+
 def test_a_file_whose_name_is_near_the_longest_is_written(tmp_path):
     # Its temporary file's name (`.NAME.PID.tmp`) passed 255 bytes: WriteFailed, once the
     # run whose replay it was had ended.

@@ -71,8 +71,11 @@ def writing(path):
     character device (e.g. /dev/null, or /dev/stdout: a link to one) or a pipe a process
     reads is written into, as a shell's `>` does: a rename would put a regular file in its
     place (of /dev/stdout itself, as root). A pipe that none reads is renamed over, as a
-    file: its open would wait for a reader."""
+    file: its open would wait for a reader. A symbolic link is written through, to the file
+    it leads to (`--markdown /dev/stdout > FILE` renamed a file over /dev/stdout)."""
     path = pathlib.Path(path)
+    if path.is_symlink() and path.exists():  # the file it leads to, not a file over the link
+        path = pathlib.Path(os.path.realpath(path))
     reader = _pipe_with_reader(path)
     if path.is_char_device() or reader is not None:
         try:

@@ -162,6 +162,16 @@ def test_a_pipe_is_written_into_when_read_and_else_renamed_over(tmp_path):
     assert sorted(path.name for path in tmp_path.iterdir()) == ["read.md", "unread.md"]
 
 
+def test_a_link_is_written_through_not_replaced_by_a_file(tmp_path):
+    # `--markdown /dev/stdout > FILE` renamed a regular file over /dev/stdout (as root).
+    target, link = tmp_path / "results.md", tmp_path / "link.md"
+    target.write_text("old")
+    link.symlink_to(target)
+    write_atomically(link, "# results\n")
+    assert link.is_symlink() and target.read_text() == "# results\n"
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["link.md", "results.md"]
+
+
 def test_a_file_whose_name_is_near_the_longest_is_written(tmp_path):
     # Its temporary file's name (`.NAME.PID.tmp`) passed 255 bytes: WriteFailed, once the
     # run whose replay it was had ended.

@@ -80,7 +80,7 @@ def writing(path):
     if path.is_char_device() or reader is not None:
         try:
             # The pipe through the descriptor held open: its reader sees no end between opens.
-            yield path if reader is None else pathlib.Path(f"/proc/self/fd/{reader}")
+            yield path if reader is None else pathlib.Path(f"/dev/fd/{reader}")
         except OSError as error:
             raise write_failed(error, path) from error
         finally:

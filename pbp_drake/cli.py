@@ -2,6 +2,7 @@
 (`pbp_drake.draw`) and `bench` (the package `pbp_drake_bench`)."""
 
 import argparse
+import errno
 import os
 import sys
 
@@ -28,6 +29,14 @@ def main(argv=None):
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 1
+    except OSError as error:
+        if error.errno != errno.ENAMETOOLONG:
+            raise
+        # A path given, or a scenario's, that no file system takes: pathlib's `exists` and
+        # `is_dir` raise this where a missing file reads as False.
+        print(f"pbp-drake: {error.filename}: the name is too long (a file or folder name is at "
+              "most 255 bytes, a path 4,096)", file=sys.stderr)
+        return EXIT_USAGE
     except KeyboardInterrupt:
         # Ctrl-C is how a person ends a run: a word, not a traceback (128 + SIGINT).
         print("\npbp-drake: interrupted", file=sys.stderr)

@@ -12,6 +12,7 @@ import subprocess
 import sys
 
 from pbp_drake.builder import build_diagram
+from pbp_drake.cli_types import EXIT_WRITE_FAILED
 from pbp_drake.output_paths import OutputPathError, check_drawing_path
 from pbp_drake.scenarios import ScenarioError, load_scenario_file
 
@@ -191,8 +192,17 @@ def main(argv=None):
                 stale.append(output)
                 print(f"{output} is out of date: run pbp-drake draw {path}", file=sys.stderr)
             continue
-        output.parent.mkdir(parents=True, exist_ok=True)
-        output.write_bytes(data)
+        try:
+            if args.output is None:  # beside the scenario: not checked before
+                check_drawing_path(output)
+            output.parent.mkdir(parents=True, exist_ok=True)
+            output.write_bytes(data)
+        except OutputPathError as error:
+            print(f"pbp-drake draw: {error}", file=sys.stderr)
+            return 2
+        except OSError as error:  # a full or read-only disk: was a traceback
+            print(f"pbp-drake draw: cannot write {output}: {error.strerror}", file=sys.stderr)
+            return EXIT_WRITE_FAILED
         print(f"{path} -> {output}")
     return 1 if stale else 0
 

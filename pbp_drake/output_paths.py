@@ -169,8 +169,12 @@ def check_figure_path(path):
 
 def check_drawing_path(path):
     """Raises OutputPathError unless `path` can take a drawing (`pbp-drake draw --output`):
-    a writable file (an existing one is drawn over)."""
+    a writable file (an existing one is drawn over), not a device or a pipe (a pipe's open
+    waits for a reader; `-` is standard output)."""
     _check_output_file(path, "--output", "diagram.svg", None, "a drawing", force=True)
+    if is_special_file(path):
+        raise OutputPathError(f"--output {path}: is not a regular file (a device or a pipe); "
+                              "give a file, or - for standard output")
 
 
 def _is_primitive(path):  # as `pbp-drake teach` writes it (json.dumps' separators)
@@ -186,6 +190,10 @@ def _check_output_file(path, flag, example, is_ours, kind, force):
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
                               f"{file / example}")
+    if file.is_symlink() and not file.exists():  # was "the file exists" / "is not writable"
+        raise OutputPathError(f"{flag} {file}: is a symbolic link to nothing (its target "
+                              f"{os.readlink(file)} is missing, or the links loop); give "
+                              "another path")
     if is_special_file(file) and not force:
         raise OutputPathError(f"{flag} {file}: is not a regular file (a device or a pipe); "
                               f"add --force to write to it")
@@ -215,6 +223,10 @@ def check_output_folder(path):
     if not os.fspath(path):  # pathlib would read it as ".", the current folder
         raise OutputPathError("--output: the path is empty; give a folder for the results")
     output = pathlib.Path(path)
+    if output.is_symlink() and not output.exists():  # its mkdir failed: "file exists", exit 4
+        raise OutputPathError(f"--output {output}: is a symbolic link to nothing (its target "
+                              f"{os.readlink(output)} is missing, or the links loop); give "
+                              "another folder")
     if output.exists() and not output.is_dir():
         raise OutputPathError(f"--output {output}: is a file, not a folder; give a folder "
                               f"for the results")

@@ -73,6 +73,9 @@ def _folder(text):
     path = Path(text)
     if not text:
         raise argparse.ArgumentTypeError("the path is empty; give a folder, e.g. outputs/bench")
+    if path.is_symlink() and not path.exists():  # its mkdir was a FileExistsError traceback
+        raise argparse.ArgumentTypeError(f"{text}: a symbolic link to nothing (its target "
+                                         f"{os.readlink(path)} is missing, or the links loop)")
     blocker = next(parent for parent in (path.absolute(), *path.absolute().parents)
                    if parent.exists())
     if not blocker.is_dir():

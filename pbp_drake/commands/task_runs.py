@@ -16,7 +16,7 @@ from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, resul
 from pbp_drake.console.text import controls_line, failure_text
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, resolve
-from pbp_drake.studies.atomic_files import write_failed
+from pbp_drake.studies.atomic_files import is_disk_failure, write_failed
 
 
 def run_scene(args, resolved, meshcat, page):
@@ -123,7 +123,10 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     except OSError as error:
         # The log that passed its check but cannot be opened (a special file system, a
         # folder changed since): said in one line, as a full disk is (`stopping_cleanly`).
-        if args.log and error.filename == args.log:
+        # A write to it that fails (a full disk, /dev/full with --force) names no file: it
+        # was "cannot write a file".
+        if args.log and (error.filename == args.log
+                         or error.filename is None and is_disk_failure(error)):
             raise write_failed(error, args.log) from None
         raise
     if args.record:

@@ -27,6 +27,9 @@ from pbp_drake.systems.visualizers.reach_scene_visualizer import HAND_MARKER
 
 #: The operators who can drive a demonstration.
 TEACHERS = ("virtual", "keyboard", "gamepad")
+#: The largest file `--from` reads (bytes): a run's CSV takes about 9 KB a simulated second,
+#: its replay a few MB and more a minute.
+MOST_HAND_PATH_BYTES = 256 << 20
 
 
 def add_teach_command(commands):
@@ -139,21 +142,33 @@ def read_hand_path(path):
     if is_special_file(path):
         raise ScenarioError(f"{path}: not a regular file; give a run's CSV (run --log) or "
                             "replay (run --record)")
+    try:
+        size = pathlib.Path(path).stat().st_size
+    except OSError as error:
+        raise ScenarioError(f"{path}: cannot be read as a CSV ({error})") from None
+    if size > MOST_HAND_PATH_BYTES:  # read whole, it was a MemoryError (a 2 GB file)
+        raise ScenarioError(f"{path}: holds {size:,} bytes; a run's CSV or replay to teach "
+                            f"from is at most {MOST_HAND_PATH_BYTES:,}")
     if is_replay(path):
         return _replay_hand_path(path)
+    columns = ("time", "ee_x", "ee_y", "ee_z")
     try:
         with open(path, newline="") as file:
-            rows = list(csv.DictReader(file))
+            reader = csv.reader(file)
+            header = next(reader, [])
+            if all(name in header for name in HAND_ORIENTATION_COLUMNS):
+                columns += tuple(HAND_ORIENTATION_COLUMNS)
+            # Each row's hand columns only, not the row (a few hundred bytes as a dict).
+            picks = [header.index(name) if name in header else None for name in columns]
+            rows = [[row[pick] if pick < len(row) else None for pick in picks]
+                    for row in reader if row] if None not in picks else []
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise ScenarioError(f"{path}: cannot be read as a CSV ({error})") from None
-    columns = ("time", "ee_x", "ee_y", "ee_z")
-    if not rows or any(name not in rows[0] for name in columns):
+    if not rows:
         raise ScenarioError(f"{path}: not a run's path: it needs the columns "
-                            f"{', '.join(columns)} (pbp-drake run --log writes them)")
-    if all(name in rows[0] for name in HAND_ORIENTATION_COLUMNS):
-        columns += tuple(HAND_ORIENTATION_COLUMNS)
+                            f"{', '.join(columns[:4])} (pbp-drake run --log writes them)")
     try:
-        table = np.array([[float(row[name]) for name in columns] for row in rows])
+        table = np.array([[float(value) for value in row] for row in rows])
     except (TypeError, ValueError):
         raise ScenarioError(f"{path}: a value of {', '.join(columns)} is not a number"
                             ) from None

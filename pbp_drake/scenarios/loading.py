@@ -15,7 +15,7 @@ import numpy as np
 
 from pbp_drake.core.methods import did_you_mean
 from pbp_drake.scenarios.bounds import (
-    check_yaml_bounds, load_document, load_typed, read_bounded)
+    check_yaml_bounds, is_special_file, load_document, load_typed, read_bounded)
 from pbp_drake.scenarios.overrides import merged
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
@@ -53,6 +53,9 @@ def load_scenario_file(path, overrides=None):
     if path.is_dir():
         raise ScenarioError(f"{path}: is a folder; expected a scenario file such as "
                             "diagrams/hsr_reach.yaml")
+    if is_special_file(path):
+        raise ScenarioError(f"{path}: is not a regular file (a device or a pipe); expected a "
+                            "scenario file such as diagrams/hsr_reach.yaml")
     if not path.is_file():
         raise ScenarioError(f"{path}: no such scenario file")
     try:

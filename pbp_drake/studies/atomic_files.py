@@ -10,6 +10,8 @@ import errno
 import os
 import pathlib
 
+from pbp_drake.scenarios.bounds import is_special_file
+
 # The errors that mean the disk, not the study, failed; what the person can do about each.
 DISK_ERRORS = {
     errno.ENOSPC: "free some space",
@@ -18,6 +20,13 @@ DISK_ERRORS = {
     errno.EROFS: "make the file system writable",
     errno.EIO: "check the disk",
 }
+
+
+#: The largest study file read back (bytes): a trial's JSON with 100,000 goals is near 6 MB,
+#: a trial's CSV about 9 KB a simulated second.
+MOST_READ_BYTES = 64 << 20
+#: The longest file name (bytes) of the usual file systems (ext4, btrfs, XFS, tmpfs: NAME_MAX).
+MOST_NAME_BYTES = 255
 
 
 class WriteFailed(OSError):
@@ -58,9 +67,27 @@ def is_disk_failure(error):
 @contextlib.contextmanager
 def writing(path):
     """Yields the temporary path to write `path` through, then flushes and renames it to
-    `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`."""
+    `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`. A
+    character device (e.g. /dev/null, or /dev/stdout: a link to one) or a pipe a process
+    reads is written into, as a shell's `>` does: a rename would put a regular file in its
+    place (of /dev/stdout itself, as root). A pipe that none reads is renamed over, as a
+    file: its open would wait for a reader. A symbolic link is written through, to the file
+    it leads to (`--markdown /dev/stdout > FILE` renamed a file over /dev/stdout)."""
     path = pathlib.Path(path)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    if path.is_symlink() and path.exists():  # the file it leads to, not a file over the link
+        path = pathlib.Path(os.path.realpath(path))
+    reader = _pipe_with_reader(path)
+    if path.is_char_device() or reader is not None:
+        try:
+            # The pipe through the descriptor held open: its reader sees no end between opens.
+            yield path if reader is None else pathlib.Path(f"/dev/fd/{reader}")
+        except OSError as error:
+            raise write_failed(error, path) from error
+        finally:
+            if reader is not None:
+                os.close(reader)
+        return
+    temporary = _temporary(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         yield temporary
@@ -76,6 +103,41 @@ def writing(path):
         if isinstance(error, OSError):
             raise write_failed(error, path) from error
         raise
+
+
+def _pipe_with_reader(path):
+    """A descriptor open for writing (blocking) on the named pipe at `path` when a process
+    reads it; None for anything else, a pipe without a reader too."""
+    if not path.is_fifo():
+        return None
+    try:
+        descriptor = os.open(path, os.O_WRONLY | os.O_NONBLOCK)  # ENXIO: no reader
+    except OSError:
+        return None
+    os.set_blocking(descriptor, True)
+    return descriptor
+
+
+def read_text(path, most=MOST_READ_BYTES):
+    """The UTF-8 text of the study file at `path` (as Path.read_text). Raises OSError naming
+    it, without reading it, for a device or a pipe (/dev/zero never ends, a pipe's open waits
+    for a writer), and having read no more than `most` bytes for a larger file."""
+    if is_special_file(path):
+        raise OSError(errno.EINVAL, "a device or a pipe, not a regular file", str(path))
+    with open(path, "rb") as stream:
+        data = stream.read(most + 1)
+    if len(data) > most:
+        raise OSError(errno.EINVAL, f"holds more than {most:,} bytes", str(path))
+    return data.decode()
+
+
+def _temporary(path):
+    """`.NAME.PID.tmp` beside `path`, NAME cut short where the whole would pass the 255 bytes
+    a file system takes in a name (a 250-byte name given to `run --record` was refused only
+    once the run had ended)."""
+    tail = f".{os.getpid()}.tmp"
+    name = os.fsencode(path.name)[:MOST_NAME_BYTES - 1 - len(tail)]
+    return path.with_name(f".{os.fsdecode(name)}{tail}")
 
 
 def write_atomically(path, text):

@@ -9,7 +9,7 @@ import os
 import pathlib
 import sys
 
-from pbp_drake.studies.atomic_files import write_failed
+from pbp_drake.studies.atomic_files import read_text, write_failed
 from pbp_drake.studies.trial_files import Damage, StudyFolderError, name_damaged
 
 TOY_STUDIES = ("alpha_study", "alt_vs_cont")
@@ -34,8 +34,10 @@ def check_folder(output, scenario, digest, participant_condition=None, quiet=Fal
     if not study_path.is_file():
         return None
     try:
-        study = json.loads(study_path.read_text())
+        study = json.loads(read_text(study_path))
         problem = None if isinstance(study, dict) else f"holds a {type(study).__name__}"
+    except OSError as error:
+        problem = f"unreadable ({error.strerror})"
     except ValueError as error:
         problem = f"truncated or invalid JSON ({error})"
     if problem is not None:
@@ -60,7 +62,7 @@ def folder_kind(output):
     output = pathlib.Path(output)
     for name in ("study.json", "summary.json"):
         try:
-            data = json.loads((output / name).read_text())
+            data = json.loads(read_text(output / name))
         except (OSError, ValueError):
             continue
         if isinstance(data, dict) and isinstance(data.get("study"), str):

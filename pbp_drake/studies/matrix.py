@@ -10,6 +10,7 @@ import pathlib
 
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.scenarios.pilots import PILOT_NAMES, check_pilot_name
+from pbp_drake.studies.atomic_files import read_text
 from pbp_drake.studies.folders import MATRIX
 from pbp_drake.studies.summary import summarize
 from pbp_drake.studies.trial_files import (
@@ -50,7 +51,7 @@ def read_matrix_study(output):
     """A matrix folder's study.json; StudyFolderError when missing, damaged or not a matrix's."""
     path = pathlib.Path(output) / "study.json"
     try:
-        study = json.loads(path.read_text())
+        study = json.loads(read_text(path))
     except (OSError, ValueError) as error:
         raise StudyFolderError(f"{path}: cannot be read as a matrix's study ({error})") from None
     pilots = study.get("pilots") if isinstance(study, dict) else None

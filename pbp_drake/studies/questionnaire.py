@@ -10,7 +10,7 @@ import pathlib
 import typing
 
 from pbp_drake.scenarios import ScenarioError
-from pbp_drake.studies.atomic_files import write_atomically
+from pbp_drake.studies.atomic_files import read_text, write_atomically
 
 
 class Question(typing.NamedTuple):
@@ -79,7 +79,7 @@ def read_questionnaire(folder):
     QuestionnaireError when it is damaged or holds a bad answer or an unknown question."""
     path = pathlib.Path(folder) / QUESTIONNAIRE_FILE
     try:
-        held = json.loads(path.read_text())
+        held = json.loads(read_text(path))
     except FileNotFoundError:
         return {}, None
     except (OSError, ValueError) as error:

@@ -11,7 +11,7 @@ from pbp_drake.scenarios.overrides import ScenarioOverrides
 from pbp_drake.studies.report import results_table
 from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
-from pbp_drake.studies.atomic_files import is_disk_failure, write_atomically
+from pbp_drake.studies.atomic_files import is_disk_failure, read_text, write_atomically
 from pbp_drake.studies.trial_files import StudyError, write_study_json
 
 def write_toy_study(output, kind, scenario_name, scenario_file, overrides=None):
@@ -130,7 +130,7 @@ def toy_markdown(output):
     """The Markdown of a 2-D study folder; StudyError when its summary.json is unreadable."""
     output = pathlib.Path(output)
     try:
-        summary = json.loads((output / "summary.json").read_text())
+        summary = json.loads(read_text(output / "summary.json"))
     except (OSError, ValueError) as error:
         raise StudyError(f"{output / 'summary.json'}: cannot be read ({error})") from None
     study = read_study_json(output)  # {} when the folder has none
@@ -143,7 +143,7 @@ def toy_markdown(output):
 def read_study_json(output):
     """A study folder's study.json as a dict ({} when missing or unreadable)."""
     try:
-        study = json.loads((pathlib.Path(output) / "study.json").read_text())
+        study = json.loads(read_text(pathlib.Path(output) / "study.json"))
     except (OSError, ValueError):
         return {}
     return study if isinstance(study, dict) else {}

@@ -17,7 +17,8 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load
 
 from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.scenarios import ScenarioError
-from pbp_drake.studies.atomic_files import write_atomically
+from pbp_drake.scenarios.bounds import is_special_file
+from pbp_drake.studies.atomic_files import MOST_READ_BYTES, read_text, write_atomically
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.builder.time_series import (
     HAND_ORIENTATION_COLUMNS, time_series_columns, time_series_csv)
@@ -279,10 +280,18 @@ def record_problem(record):
 def read_time_series(path, ticks=None):
     """A trial's CSV as a dict of arrays keyed by column name. Raises DamagedFile when it is
     empty or malformed (or has not `ticks` rows, when given)."""
-    with open(path, newline="") as stream:
-        reader = csv.reader(stream)
-        columns = next(reader, None)
-        rows = list(reader)
+    if is_special_file(path):
+        raise DamagedFile(f"{path}: a device or a pipe, not a regular file")
+    if pathlib.Path(path).stat().st_size > MOST_READ_BYTES:
+        raise DamagedFile(f"{path}: holds more than {MOST_READ_BYTES:,} bytes, not a trial's "
+                          "time series")
+    try:
+        with open(path, newline="") as stream:
+            reader = csv.reader(stream)
+            columns = next(reader, None)
+            rows = list(reader)
+    except (UnicodeDecodeError, csv.Error) as error:
+        raise DamagedFile(f"{path}: malformed CSV ({error})") from None
     if not columns:
         raise DamagedFile(f"{path}: empty CSV (no header)")
     # A grasping trial written before the hand's orientation was logged ends without it.
@@ -312,7 +321,7 @@ def load_task_result(output, method, seed):
     """The TaskResult of a finished trial, read back from its JSON and CSV files."""
     json_path, csv_path = trial_paths(output, method, seed)
     try:
-        record = json.loads(json_path.read_text())
+        record = json.loads(read_text(json_path))
     except ValueError as error:
         raise DamagedFile(f"{json_path}: truncated or invalid JSON ({error})") from None
     problem = record_problem(record)
@@ -368,7 +377,7 @@ def read_trial(output, method, seed, digest, damaged=None, key=None):
     if not json_path.exists():
         return None
     try:
-        record = json.loads(json_path.read_text())
+        record = json.loads(read_text(json_path))
     except OSError as error:
         return bad(json_path, f"unreadable ({error.strerror})")
     except ValueError as error:
@@ -387,7 +396,7 @@ def read_trial(output, method, seed, digest, damaged=None, key=None):
             raise StudyFolderError(f"{json_path} is {message}: choose another --output folder")
         return bad(json_path, message)
     if record["error"] is None:
-        if not csv_path.is_file():
+        if not csv_path.exists():
             return bad(csv_path, "missing: the trial's time series CSV is not on disk")
         try:
             read_time_series(csv_path, record.get("ticks"))
@@ -433,7 +442,7 @@ def infer_study(output):
             seeds |= numbers
         for path in found:
             try:
-                record = json.loads(path.read_text()) if path.suffix == ".json" else None
+                record = json.loads(read_text(path)) if path.suffix == ".json" else None
             except (OSError, ValueError):
                 continue
             if isinstance(record, dict) and isinstance(record.get("scenario_hash"), str):
@@ -455,7 +464,7 @@ def read_study(output):
     study_path = output / "study.json"
     damaged = []
     try:
-        study = json.loads(study_path.read_text())
+        study = json.loads(read_text(study_path))
         problem = study_problem(study)
     except FileNotFoundError:
         study, problem = None, "missing"

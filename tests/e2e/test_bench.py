@@ -207,12 +207,15 @@ def test_missing_peers_are_skipped_neither_passed_nor_failed():
     ("--output", "", "the path is empty"),  # was the current folder
     ("--output", "{tmp}/notes.txt", "{tmp}/notes.txt is a file"),  # was a traceback
     ("--output", "{tmp}/notes.txt/bench", "{tmp}/notes.txt is a file"),
+    ("--output", "{tmp}/link", "{tmp}/link: a symbolic link to nothing (its target "
+                               "{tmp}/missing is missing"),  # was a traceback, measured first
 ])
 def test_a_bad_flag_value_is_refused_before_anything_is_measured(tmp_path, capsys, flag, value,
                                                                   message):
     from pbp_drake.cli import main
 
     (tmp_path / "notes.txt").write_text("not a folder")
+    (tmp_path / "link").symlink_to(tmp_path / "missing")
     argv = ["bench", "--quick", "--output", str(tmp_path / "bench"), flag,
             value.replace("{tmp}", str(tmp_path))]
     with pytest.raises(SystemExit) as exit_info:
@@ -220,7 +223,7 @@ def test_a_bad_flag_value_is_refused_before_anything_is_measured(tmp_path, capsy
     assert exit_info.value.code == 2
     err = capsys.readouterr().err
     assert f"argument {flag}: " in err and message.replace("{tmp}", str(tmp_path)) in err
-    assert [path.name for path in tmp_path.iterdir()] == ["notes.txt"]
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["link", "notes.txt"]
 
 
 def test_quick_keeps_every_check_with_the_same_limits():

@@ -99,6 +99,37 @@ def test_an_output_that_is_a_pipe_is_refused_without_reading_it(flag, tmp_path, 
     assert "is not a regular file (a device or a pipe); add --force" in err
 
 
+@pytest.mark.parametrize("argv", [
+    ["run", "{long}.yaml"], ["run", "{hsr}", "--log", "{long}.csv"],
+    ["run", "{hsr}", "--record", "{long}.html"], ["study", "{hsr}", "--output", "{long}"],
+    ["report", "{long}"], ["compare", "{long}", "{long}"],
+    ["teach", "{hsr}", "--from", "{long}.csv", "--output", "{tmp}/primitive.json"],
+    ["teach", "{hsr}", "--output", "{long}.json"], ["draw", "{hsr}", "--output", "{long}.svg"],
+])
+def test_a_name_too_long_for_the_file_system_is_one_line(argv, tmp_path, repo, capsys):
+    # pathlib's exists and is_dir raise ENAMETOOLONG (a 300-character name): a traceback.
+    long = tmp_path / ("l" * 300)
+    words = {"long": long, "hsr": repo / "diagrams" / "hsr_reach.yaml", "tmp": tmp_path}
+    err = refused([word.format(**words) for word in argv], capsys, long)
+    assert err.endswith(": the name is too long (a file or folder name is at most 255 bytes, "
+                        "a path 4,096)\n") and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("force", [[], ["--force"]])
+@pytest.mark.parametrize("flag", ["--record", "--log"])
+def test_an_output_that_is_a_link_to_nothing_is_named_so(flag, force, tmp_path, repo, capsys):
+    # It was "the file exists and is not ...", and with --force "the file is not writable".
+    dangling, loop = tmp_path / "dangling", tmp_path / "loop"
+    dangling.symlink_to(tmp_path / "missing")
+    loop.symlink_to(tmp_path / "back")
+    (tmp_path / "back").symlink_to(loop)
+    for link, target in ((dangling, tmp_path / "missing"), (loop, tmp_path / "back")):
+        err = refused(["run", str(repo / QUICK), "--headless", flag, str(link), *force],
+                      capsys, link)
+        assert err == (f"pbp-drake: {flag} {link}: is a symbolic link to nothing (its target "
+                       f"{target} is missing, or the links loop); give another path\n")
+
+
 def test_study_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
     output = tmp_path / "summary.txt"
     output.write_text("keep me")
@@ -114,6 +145,20 @@ def test_study_output_under_a_file_is_refused(tmp_path, repo, capsys):
     refused(["study", str(repo / "diagrams/hsr_reach.yaml"), "--trials", "1", "--output",
              str(output)], capsys, output)
     assert blocker.read_text() == "keep me"
+
+
+@pytest.mark.parametrize("command", [["study", "--trials", "1"],
+                                     ["session", "--participant", "P01", "--headless"]])
+def test_an_output_folder_that_is_a_link_to_nothing_is_named_so(command, tmp_path, repo,
+                                                                capsys):
+    # Its folder could not be made: "cannot write .../.study.lock: file exists", exit 4.
+    output = tmp_path / "study"
+    output.symlink_to(tmp_path / "missing")
+    err = refused([command[0], str(repo / "diagrams/hsr_reach.yaml"), *command[1:],
+                   "--output", str(output)], capsys, output)
+    assert err == (f"pbp-drake: --output {output}: is a symbolic link to nothing (its target "
+                   f"{tmp_path / 'missing'} is missing, or the links loop); give another "
+                   "folder\n")
 
 
 def test_session_output_that_is_a_file_is_refused(tmp_path, repo, capsys):
@@ -146,3 +191,19 @@ def test_a_log_that_passed_its_check_but_cannot_be_opened_is_one_line(tmp_path, 
     assert err.strip().splitlines() == [
         f"pbp-drake: cannot write {log}: no such file or directory; nothing is left "
         "half-written: make the folder writable, then run the same command again."]
+
+
+def test_a_log_whose_write_fails_names_the_log(tmp_path, repo, monkeypatch, capsys):
+    # A write's OSError names no file (as /dev/full's with --force): "cannot write a file".
+    log = str(tmp_path / "run.csv")
+
+    def disk_full(resolved, log_path, **options):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr("pbp_drake.commands.task_runs.run_task_streamed", disk_full)
+    code = main(["run", str(repo / "diagrams" / "hsr_reach.yaml"), "--headless", "--operator",
+                 "virtual", "--log", log])
+    assert code == 4
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"pbp-drake: cannot write {log}: no space left on device; nothing is left "
+        "half-written: free some space, then run the same command again."]

@@ -1,6 +1,7 @@
 """`pbp-drake draw`: each scenario's system diagram as SVG. The drawings in diagrams/ are
 checked in beside their YAML and must match what `draw` produces now."""
 
+import os
 import pathlib
 import re
 
@@ -114,6 +115,23 @@ def test_draw_names_a_bad_output_or_method_in_one_line(tmp_path, capsys, monkeyp
     assert err.startswith("pbp-drake draw: ") and len(err.splitlines()) == 1
     assert message.replace("{tmp}", str(tmp_path)) in err
     assert sorted(path.name for path in tmp_path.iterdir()) == ["notes.txt", "toy.yaml"]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("given", [True, False], ids=["--output", "beside the scenario"])
+def test_draw_refuses_a_pipe_or_a_device_in_one_line(tmp_path, capsys, given):
+    # A pipe's open waited for ever for a reader; /dev/full was an OSError traceback.
+    scenario = tmp_path / "toy.yaml"
+    scenario.write_text((DIAGRAMS / "toy_alt_vs_cont.yaml").read_text())
+    os.mkfifo(tmp_path / "toy.dot")
+    for output in ([tmp_path / "toy.dot", "/dev/full"] if given else [tmp_path / "toy.dot"]):
+        argv = [str(scenario), "--format", "dot", *(["--output", str(output)] if given else [])]
+        assert main(argv) == 2
+        assert capsys.readouterr().err == (
+            f"pbp-drake draw: --output {output}: is not a regular file (a device or a pipe); "
+            "give a file, or - for standard output\n")
+    assert (tmp_path / "toy.dot").is_fifo()
 
 
 @pytest.mark.parametrize("depth", ["-1", "one"])

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from pbp_drake.cli import main
+from pbp_drake.commands import teach
 from pbp_drake.core.dmp.primitive import FORMAT_VERSION
 from pbp_drake.output_paths import REPLAY_MARKER
 
@@ -192,6 +193,17 @@ def test_a_recording_that_cannot_be_read_is_refused(tmp_path, capsys):
                     capsys=capsys)
     assert code == 2 and f"{tmp_path}: cannot be read as a CSV" in out.err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_recording_too_large_is_refused_without_reading_it(tmp_path, capsys, monkeypatch):
+    # A 2 GB file was read whole (a MemoryError): the limit, made small here.
+    monkeypatch.setattr(teach, "MOST_HAND_PATH_BYTES", 1000)
+    recording = tmp_path / "run.csv"
+    recording.write_text("time,ee_x,ee_y,ee_z\n" + "0.0,0.5,0.0,0.7\n" * 100)
+    code, out = run("teach", REACH, "--from", recording, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 2 and out.err == (f"pbp-drake: {recording}: holds 1,620 bytes; a run's CSV "
+                                     "or replay to teach from is at most 1,000\n")
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")

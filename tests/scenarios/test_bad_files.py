@@ -3,6 +3,7 @@ traceback, and at once."""
 
 import itertools
 import math
+import os
 import pathlib
 import random
 
@@ -208,6 +209,17 @@ def test_a_missing_file_is_named(tmp_path, run_refused):
     path = tmp_path / "missing.yaml"
     code, err, _ = run_refused(path)
     assert code == 2 and err == f"pbp-drake: {path}: no such scenario file\n", err
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")
+def test_a_pipe_or_a_device_is_named_as_such_not_missing(tmp_path, run_refused):
+    pipe = tmp_path / "scenario.yaml"
+    os.mkfifo(pipe)
+    for path in (pipe, pathlib.Path(os.devnull)):
+        code, err, _ = run_refused(path)  # was "no such scenario file"
+        assert code == 2 and err == (f"pbp-drake: {path}: is not a regular file (a device or "
+                                     "a pipe); expected a scenario file such as "
+                                     "diagrams/hsr_reach.yaml\n"), err
 
 
 @pytest.mark.parametrize("make, message", [

@@ -2,11 +2,13 @@
 and reports the rest; a 2-D study and a method comparison refuse each other's folders."""
 
 import json
+import os
 import pathlib
 
 import pytest
 
 from pbp_drake.cli import main
+from pbp_drake.studies.atomic_files import MOST_READ_BYTES
 from pbp_drake.studies.trial_files import (
     DamagedFile, load_task_result, read_study, time_series_columns, trial_paths, trial_record,
     write_trial_files)
@@ -149,6 +151,52 @@ def test_load_task_result_names_a_trial_it_cannot_give(tmp_path, change, error, 
     with pytest.raises(error, match=problem) as raised:
         load_task_result(tmp_path, "teleop", 0)
     assert str(raised.value).startswith(f"{path}: ")
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("kind, problem", [
+    ("pipe", "unreadable (a device or a pipe, not a regular file)"),
+    ("huge", f"unreadable (holds more than {MOST_READ_BYTES:,} bytes)"),
+])
+@pytest.mark.parametrize("which", ["study", "trial"])
+def test_a_json_file_that_is_a_pipe_or_huge_is_named_unread(tmp_path, which, kind, problem):
+    # A named pipe's read waited for ever; /dev/zero or a huge file was read whole.
+    folder = _study(tmp_path, trials=1)
+    path = folder / "study.json" if which == "study" else trial_paths(folder, "teleop", 0)[0]
+    path.unlink()
+    if kind == "pipe":
+        os.mkfifo(path)
+    else:
+        path.touch()
+        os.truncate(path, MOST_READ_BYTES + 1)  # sparse: nothing written
+    _, records, damaged = read_study(folder)
+    tail = "; reporting the trials on disk" if which == "study" else ""
+    assert [(d.path, d.problem) for d in damaged] == [(str(path), problem + tail)]
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("kind, problem", [
+    ("pipe", "a device or a pipe, not a regular file"),
+    ("huge", f"holds more than {MOST_READ_BYTES:,} bytes, not a trial's time series"),
+    ("not UTF-8", "malformed CSV ('utf-8' codec can't decode byte 0xff"),
+    ("a long line", "malformed CSV (field larger than field limit"),
+])
+def test_a_csv_that_is_a_pipe_huge_or_not_text_is_named(tmp_path, kind, problem):
+    # A pipe was named missing (and its read waited for ever), the others were tracebacks.
+    folder = _study(tmp_path, trials=1)
+    csv = trial_paths(folder, "teleop", 0)[1]
+    csv.unlink()
+    if kind == "pipe":
+        os.mkfifo(csv)
+    elif kind == "huge":
+        csv.touch()
+        os.truncate(csv, MOST_READ_BYTES + 1)  # sparse: nothing written
+    else:
+        csv.write_bytes(b"\xff" + _csv().encode() if kind == "not UTF-8"
+                        else b"x" * (1 << 20) + b"\n")
+    _, records, damaged = read_study(folder)
+    assert [(d.path, d.problem.startswith(problem)) for d in damaged] == [(str(csv), True)]
+    assert records[("teleop", 0)] is None
 
 
 def test_a_trial_without_its_csv_is_named(tmp_path):

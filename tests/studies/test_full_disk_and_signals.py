@@ -21,7 +21,7 @@ import pytest
 
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.cli import main
-from pbp_drake.studies.atomic_files import WriteFailed, remove_leftovers
+from pbp_drake.studies.atomic_files import WriteFailed, remove_leftovers, write_atomically
 from pbp_drake.studies.comparison import run_method_comparison, run_method_matrix
 from pbp_drake.studies.folders import LOCK_FILE, FolderLocked
 from pbp_drake.scenarios import load_scenario_file
@@ -130,6 +130,54 @@ def test_leftovers_beside_the_summary_go_once_their_writer_has_ended(tmp_path):
         path.write_text("half")
     remove_leftovers(tmp_path)
     assert [path.name for path in tmp_path.iterdir()] == [running.name]
+
+
+def test_a_device_is_written_into_never_replaced_by_a_file(tmp_path):
+    # `report --markdown /dev/null` (or /dev/stdout) renamed a regular file over the device.
+    null, full = tmp_path / "null.md", tmp_path / "full.md"
+    null.symlink_to(os.devnull)
+    full.symlink_to("/dev/full")
+    write_atomically(null, "# results\n")
+    with pytest.raises(WriteFailed, match="no space left on device"):
+        write_atomically(full, "# results\n")
+    assert null.is_char_device() and full.is_char_device()
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["full.md", "null.md"]
+
+
+@pytest.mark.timeout(60)
+def test_a_pipe_is_written_into_when_read_and_else_renamed_over(tmp_path):
+    # A pipe read by a process (/dev/stdout into `| less`) got a regular file in its place;
+    # one that none reads is renamed over as before (its open would wait for a reader).
+    read, unread = tmp_path / "read.md", tmp_path / "unread.md"
+    os.mkfifo(read)
+    os.mkfifo(unread)
+    reader = os.open(read, os.O_RDONLY | os.O_NONBLOCK)
+    try:
+        write_atomically(read, "# results\n")
+        assert os.read(reader, 100) == b"# results\n" and read.is_fifo()
+    finally:
+        os.close(reader)
+    write_atomically(unread, "# results\n")
+    assert unread.read_text() == "# results\n"
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["read.md", "unread.md"]
+
+
+def test_a_link_is_written_through_not_replaced_by_a_file(tmp_path):
+    # `--markdown /dev/stdout > FILE` renamed a regular file over /dev/stdout (as root).
+    target, link = tmp_path / "results.md", tmp_path / "link.md"
+    target.write_text("old")
+    link.symlink_to(target)
+    write_atomically(link, "# results\n")
+    assert link.is_symlink() and target.read_text() == "# results\n"
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["link.md", "results.md"]
+
+
+def test_a_file_whose_name_is_near_the_longest_is_written(tmp_path):
+    # Its temporary file's name (`.NAME.PID.tmp`) passed 255 bytes: WriteFailed, once the
+    # run whose replay it was had ended.
+    path = tmp_path / ("é" * 120 + "r.html")  # 252 bytes
+    write_atomically(path, "replay")
+    assert path.read_text() == "replay" and len(list(tmp_path.iterdir())) == 1
 
 
 def _trial_records(folder):

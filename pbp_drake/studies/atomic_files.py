@@ -40,6 +40,8 @@ class WriteFailed(OSError):
     @property
     def remedy(self):
         """What the person can do before running the same command again."""
+        if self.errno == errno.EINVAL:  # `writing`'s refusal of a special file
+            return "give a regular file"
         return DISK_ERRORS.get(self.errno, "make the folder writable")
 
 
@@ -70,9 +72,10 @@ def writing(path):
     `path`. Any error removes it; an OSError is raised as WriteFailed naming `path`. A
     character device (e.g. /dev/null, or /dev/stdout: a link to one) or a pipe a process
     reads is written into, as a shell's `>` does: a rename would put a regular file in its
-    place (of /dev/stdout itself, as root). A pipe that none reads is renamed over, as a
-    file: its open would wait for a reader. A symbolic link is written through, to the file
-    it leads to (`--markdown /dev/stdout > FILE` renamed a file over /dev/stdout)."""
+    place (of /dev/stdout itself, as root). A block device, a socket or a pipe that none
+    reads (its open would wait for a reader) is neither written nor replaced: WriteFailed.
+    A symbolic link is written through, to the file it leads to (`--markdown /dev/stdout >
+    FILE` renamed a file over /dev/stdout)."""
     path = pathlib.Path(path)
     if path.is_symlink() and path.exists():  # the file it leads to, not a file over the link
         path = pathlib.Path(os.path.realpath(path))
@@ -87,6 +90,9 @@ def writing(path):
             if reader is not None:
                 os.close(reader)
         return
+    if is_special_file(path):
+        raise WriteFailed(errno.EINVAL, "not a regular file (a block device, a socket or a "
+                          "pipe no process reads)", str(path))
     temporary = _temporary(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -145,9 +145,9 @@ def test_a_device_is_written_into_never_replaced_by_a_file(tmp_path):
 
 
 @pytest.mark.timeout(60)
-def test_a_pipe_is_written_into_when_read_and_else_renamed_over(tmp_path):
+def test_a_pipe_is_written_into_when_read_and_else_left_alone(tmp_path):
     # A pipe read by a process (/dev/stdout into `| less`) got a regular file in its place;
-    # one that none reads is renamed over as before (its open would wait for a reader).
+    # one that none reads (its open would wait for a reader) was replaced by a file.
     read, unread = tmp_path / "read.md", tmp_path / "unread.md"
     os.mkfifo(read)
     os.mkfifo(unread)
@@ -157,8 +157,11 @@ def test_a_pipe_is_written_into_when_read_and_else_renamed_over(tmp_path):
         assert os.read(reader, 100) == b"# results\n" and read.is_fifo()
     finally:
         os.close(reader)
-    write_atomically(unread, "# results\n")
-    assert unread.read_text() == "# results\n"
+    with pytest.raises(WriteFailed) as refused:
+        write_atomically(unread, "# results\n")
+    assert str(refused.value) == (f"cannot write {unread}: not a regular file (a block "
+                                  "device, a socket or a pipe no process reads)")
+    assert refused.value.remedy == "give a regular file" and unread.is_fifo()
     assert sorted(path.name for path in tmp_path.iterdir()) == ["read.md", "unread.md"]
 
 

@@ -190,10 +190,8 @@ def _check_output_file(path, flag, example, is_ours, kind, force):
     if file.is_dir():
         raise OutputPathError(f"{flag} {file}: is a folder; give a file, e.g. "
                               f"{file / example}")
-    if file.is_symlink() and not file.exists():  # was "the file exists" / "is not writable"
-        raise OutputPathError(f"{flag} {file}: is a symbolic link to nothing (its target "
-                              f"{os.readlink(file)} is missing, or the links loop); give "
-                              "another path")
+    if (dangling := dangling_link(file)) is not None:  # was "the file exists"
+        raise OutputPathError(f"{flag} {file}: is {dangling}; give another path")
     if is_special_file(file) and not force:
         raise OutputPathError(f"{flag} {file}: is not a regular file (a device or a pipe); "
                               f"add --force to write to it")
@@ -205,6 +203,16 @@ def _check_output_file(path, flag, example, is_ours, kind, force):
             raise OutputPathError(f"{flag} {file}: the file is not writable")
         return
     _check_can_create(file.parent, f"{flag} {file}")
+
+
+def dangling_link(path):
+    """How `path` is a symbolic link to nothing (its target is missing, or links loop), in
+    words, or None when it is not one."""
+    path = pathlib.Path(path)
+    if path.is_symlink() and not path.exists():
+        return (f"a symbolic link to nothing (its target {os.readlink(path)} is missing, or "
+                "the links loop)")
+    return None
 
 
 def _is_time_series(path):
@@ -223,10 +231,8 @@ def check_output_folder(path):
     if not os.fspath(path):  # pathlib would read it as ".", the current folder
         raise OutputPathError("--output: the path is empty; give a folder for the results")
     output = pathlib.Path(path)
-    if output.is_symlink() and not output.exists():  # its mkdir failed: "file exists", exit 4
-        raise OutputPathError(f"--output {output}: is a symbolic link to nothing (its target "
-                              f"{os.readlink(output)} is missing, or the links loop); give "
-                              "another folder")
+    if (dangling := dangling_link(output)) is not None:  # its mkdir failed: "file exists"
+        raise OutputPathError(f"--output {output}: is {dangling}; give another folder")
     if output.exists() and not output.is_dir():
         raise OutputPathError(f"--output {output}: is a file, not a folder; give a folder "
                               f"for the results")

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 import pbp_drake_bench
+from pbp_drake.output_paths import dangling_link
 from pbp_drake_bench.cases import (
     BASIS, DT, bank_math_step, leaf_simulator, leaf_step, make_bank, make_case, motion_fields)
 from pbp_drake_bench.checks import (
@@ -73,9 +74,8 @@ def _folder(text):
     path = Path(text)
     if not text:
         raise argparse.ArgumentTypeError("the path is empty; give a folder, e.g. outputs/bench")
-    if path.is_symlink() and not path.exists():  # its mkdir was a FileExistsError traceback
-        raise argparse.ArgumentTypeError(f"{text}: a symbolic link to nothing (its target "
-                                         f"{os.readlink(path)} is missing, or the links loop)")
+    if (dangling := dangling_link(path)) is not None:  # its mkdir: a FileExistsError
+        raise argparse.ArgumentTypeError(f"{text}: {dangling}")
     blocker = next(parent for parent in (path.absolute(), *path.absolute().parents)
                    if parent.exists())
     if not blocker.is_dir():

@@ -9,6 +9,9 @@ import contextlib
 import errno
 import os
 import pathlib
+import shutil
+import sys
+import tempfile
 
 from pbp_drake.scenarios.bounds import is_special_file
 
@@ -74,9 +77,15 @@ def writing(path):
     reads is written into, as a shell's `>` does: a rename would put a regular file in its
     place (of /dev/stdout itself, as root). A block device, a socket or a pipe that none
     reads (its open would wait for a reader) is neither written nor replaced: WriteFailed.
-    A symbolic link is written through, to the file it leads to (`--markdown /dev/stdout >
-    FILE` renamed a file over /dev/stdout)."""
+    A symbolic link is written through, to the file it leads to. This process's own stdout
+    or stderr (`--markdown /dev/stdout`, into a pipe or a shell's `> FILE`) is written
+    through its descriptor, after what the command printed before: a new open would have
+    truncated FILE, a rename detached it."""
     path = pathlib.Path(path)
+    stream = _own_stream(path)
+    if stream is not None:
+        yield from _through_descriptor(stream, path)
+        return
     if path.is_symlink() and path.exists():  # the file it leads to, not a file over the link
         path = pathlib.Path(os.path.realpath(path))
     reader = _pipe_with_reader(path)
@@ -109,6 +118,38 @@ def writing(path):
         if isinstance(error, OSError):
             raise write_failed(error, path) from error
         raise
+
+
+def _own_stream(path):
+    """1 or 2 when `path` is the file, pipe or terminal this process's stdout or stderr
+    writes to; else None."""
+    try:
+        target = os.stat(path)
+    except OSError:
+        return None
+    for descriptor in (1, 2):
+        with contextlib.suppress(OSError):
+            if os.path.samestat(target, os.fstat(descriptor)):
+                return descriptor
+    return None
+
+
+def _through_descriptor(descriptor, path):
+    """`writing`'s steps for this process's stdout or stderr (`descriptor`): the text goes
+    to a temporary file, then through the descriptor after Python's own buffered lines."""
+    try:
+        with tempfile.TemporaryDirectory(prefix="pbp-drake-") as folder:
+            temporary = pathlib.Path(folder) / path.name
+            yield temporary
+            sys.stdout.flush()
+            sys.stderr.flush()
+            with open(temporary, "rb") as source, os.fdopen(
+                    os.dup(descriptor), "wb") as destination:
+                shutil.copyfileobj(source, destination)
+    except BrokenPipeError:  # its reader has gone (`| head`): as for the command's prints
+        raise
+    except OSError as error:
+        raise write_failed(error, path) from error
 
 
 def _pipe_with_reader(path):

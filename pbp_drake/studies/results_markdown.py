@@ -163,6 +163,6 @@ def write_markdown(path, text):
     try:
         write_atomically(path, text)
     except OSError as error:
-        if is_disk_failure(error):
+        if is_disk_failure(error) or isinstance(error, BrokenPipeError):  # `| head`: quiet
             raise
         raise StudyError(f"--markdown {path}: cannot be written ({error.strerror})") from None

@@ -175,6 +175,40 @@ def test_a_link_is_written_through_not_replaced_by_a_file(tmp_path):
     assert sorted(path.name for path in tmp_path.iterdir()) == ["link.md", "results.md"]
 
 
+# A command that prints a line, writes a file whole at /dev/stdout, then prints another.
+_PRINTS_AROUND_STDOUT = ("from pbp_drake.studies.atomic_files import write_atomically; "
+                         "print('before'); write_atomically('/dev/stdout', '# results\\n'); "
+                         "print('after')")
+
+
+@pytest.mark.parametrize("into", ["a file", "a pipe"])
+def test_the_commands_own_stdout_gets_the_file_between_its_lines(tmp_path, into):
+    # `report --markdown /dev/stdout > FILE` renamed a new file over FILE, where the report's
+    # later lines were lost; into a pipe it failed: `cannot write /proc/N/fd/pipe:[M]`.
+    command = [sys.executable, "-c", _PRINTS_AROUND_STDOUT]
+    if into == "a file":
+        with open(tmp_path / "out.md", "w") as stream:
+            subprocess.run(command, stdout=stream, check=True)
+        printed = (tmp_path / "out.md").read_text()
+    else:
+        printed = subprocess.run(command, capture_output=True, text=True, check=True).stdout
+    assert printed == "before\n# results\nafter\n"
+    assert [path.name for path in tmp_path.iterdir()] == (["out.md"] if into == "a file"
+                                                          else [])
+
+
+@pytest.mark.timeout(60)
+def test_a_closed_stdout_is_a_broken_pipe_as_for_the_commands_prints():
+    # `--markdown /dev/stdout | head -1`: the CLI ends quietly on a BrokenPipeError, as when
+    # a print meets the closed pipe; a WriteFailed said "make the folder writable".
+    writer = subprocess.Popen([sys.executable, "-c", (
+        "import sys; from pbp_drake.studies.atomic_files import write_atomically\n"
+        "try:\n    write_atomically('/dev/stdout', 'x' * 200_000)\n"
+        "except BrokenPipeError:\n    sys.exit(7)")], stdout=subprocess.PIPE)
+    writer.stdout.close()
+    assert writer.wait() == 7
+
+
 def test_a_file_whose_name_is_near_the_longest_is_written(tmp_path):
     # Its temporary file's name (`.NAME.PID.tmp`) passed 255 bytes: WriteFailed, once the
     # run whose replay it was had ended.

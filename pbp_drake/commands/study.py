@@ -36,6 +36,7 @@ from pbp_drake.studies.splits import SPLITS, first_seed, split_of
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 from pbp_drake.scenarios.validation import check_seed
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
+from pbp_drake.studies.trial_files import name_damaged
 
 
 def add_study_commands(commands):
@@ -106,7 +107,8 @@ def add_study_commands(commands):
         "compare", help="compare two studies of the same seeds trial by trial (e.g. before "
         "and after changing a setting): per method and metric, the paired difference and "
         "its 95 %% interval against the first study's trial-to-trial noise; exit 1 when a "
-        "metric moved by more than that noise")
+        "metric moved by more than that noise or a trial's file was damaged (each named on "
+        "stderr, its trial left out)")
     compare.add_argument("first", help="a `pbp-drake study` --output folder (A)")
     compare.add_argument("second", help="another, of the same seeds (B)")
     add_goals_flag(add_override_flags(study))
@@ -311,12 +313,15 @@ def _print_report(summary, output):
 
 def _compare(args):
     """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric moved by
-    more than the first study's trial-to-trial SD, 2 when the studies share no trial."""
+    more than the first study's trial-to-trial SD or a file was damaged (each named on
+    stderr, its trial left out), 2 when the studies share no trial."""
     for which, folder in (("first", args.first), ("second", args.second)):
         if not folder:  # pathlib would read it as ".", the current folder
             raise ScenarioError(f"compare: the {which} folder's path is empty; give a "
                                 "`pbp-drake study` --output folder")
-    rows = paired_comparison(args.first, args.second)
+    damaged = []
+    rows = paired_comparison(args.first, args.second, damaged)
+    name_damaged(damaged)
     if not rows:
         raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
                             "both ran without an error")
@@ -325,7 +330,10 @@ def _compare(args):
     print(f"A = {args.first}, B = {args.second}. " + (
         f"{len(moved)} of {len(rows)} rows moved by more than A's trial-to-trial SD."
         if moved else f"All {len(rows)} rows within A's trial-to-trial SD."))
-    return 1 if moved else 0
+    if damaged:
+        print(f"pbp-drake: {len(damaged)} damaged or foreign files skipped (listed above); "
+              "their trials are left out of the pairs", file=sys.stderr)
+    return 1 if moved or damaged else 0
 
 
 def _report(args):

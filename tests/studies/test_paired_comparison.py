@@ -84,6 +84,21 @@ def test_exit_code_says_whether_a_metric_moved_beyond_its_noise(tmp_path, repo, 
     assert "2 of 12 rows moved by more than A's trial-to-trial SD." in out
 
 
+@pytest.mark.parametrize("which", ["first", "second"])
+def test_a_damaged_trial_file_is_named_and_its_pair_left_out(tmp_path, repo, capsys, which):
+    # A damaged file in either folder left its trial out in silence, exit 0.
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    folders = [_study(tmp_path / "a", scenario), _study(tmp_path / "b", scenario)]
+    damaged = folders[which == "second"] / "trials" / "teleop" / "seed_3.json"
+    damaged.write_text("{bad")
+    assert main(["compare", *map(str, folders)]) == 1
+    printed = capsys.readouterr()
+    assert "| task_time | teleop | 5 |" in printed.out and "All 12 rows within" in printed.out
+    assert printed.err.startswith(f"pbp-drake: damaged: {damaged}: truncated or invalid JSON")
+    assert printed.err.endswith("pbp-drake: 1 damaged or foreign files skipped (listed above);"
+                                " their trials are left out of the pairs\n")
+
+
 def test_refuses_folders_that_share_no_trial(tmp_path, repo, capsys):
     a = _study(tmp_path / "a", repo / "diagrams" / "hsr_reach.yaml")
     other = tmp_path / "empty"

@@ -45,6 +45,11 @@ class WriteFailed(OSError):
         """What the person can do before running the same command again."""
         if self.errno == errno.EINVAL:  # `writing`'s refusal of a special file
             return "give a regular file"
+        if self.errno == errno.ENOTDIR and self.filename is not None:
+            in_the_way = next((folder for folder in reversed(pathlib.Path(self.filename).parents)
+                               if folder.exists() and not folder.is_dir()), None)
+            if in_the_way is not None:
+                return f"move the file {in_the_way} away (a folder belongs there)"
         return DISK_ERRORS.get(self.errno, "make the folder writable")
 
 

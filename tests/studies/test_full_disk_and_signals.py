@@ -209,6 +209,15 @@ def test_a_closed_stdout_is_a_broken_pipe_as_for_the_commands_prints():
     assert writer.wait() == 7
 
 
+def test_a_file_where_a_folder_belongs_is_named_as_what_to_move(tmp_path):
+    # A study resumed into a folder whose `trials` was a file: "make the folder writable".
+    (tmp_path / "trials").write_text("not a folder")
+    with pytest.raises(WriteFailed) as failed:
+        write_atomically(tmp_path / "trials" / "teleop" / "seed_1.json", "{}")
+    assert failed.value.remedy == (f"move the file {tmp_path / 'trials'} away (a folder "
+                                   "belongs there)")
+
+
 def test_a_file_whose_name_is_near_the_longest_is_written(tmp_path):
     # Its temporary file's name (`.NAME.PID.tmp`) passed 255 bytes: WriteFailed, once the
     # run whose replay it was had ended.

@@ -46,8 +46,9 @@ class WriteFailed(OSError):
         if self.errno == errno.EINVAL:  # `writing`'s refusal of a special file
             return "give a regular file"
         if self.errno == errno.ENOTDIR and self.filename is not None:
+            # os.path's tests, which never raise: this runs while a failure is reported.
             in_the_way = next((folder for folder in reversed(pathlib.Path(self.filename).parents)
-                               if folder.exists() and not folder.is_dir()), None)
+                               if os.path.exists(folder) and not os.path.isdir(folder)), None)
             if in_the_way is not None:
                 return f"move the file {in_the_way} away (a folder belongs there)"
         return DISK_ERRORS.get(self.errno, "make the folder writable")

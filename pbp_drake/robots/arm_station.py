@@ -188,7 +188,7 @@ def _make_diff_ik(plant, arm, q0, config, ramp, look_ahead):
         acceleration_limits=(-accelerations, accelerations), q_nominal=q0,
         centering_gain=np.full(plant.num_positions(), config.centering_gain),
         command_ramp=ramp, singular_margin=config.singular_margin,
-        limit_margin=config.limit_margin)
+        limit_margin=config.limit_margin, brake_at_limits=True)
 
 
 def arm_model_plant(config: ArmStationConfig):

@@ -29,8 +29,9 @@ OVERSHOOT_WEIGHT = 10.0
 # With a `limit_margin`, the speed (rad/s or m/s) per unit of a joint's depth inside the
 # margin at which the plan's free joint motion pushes it back out. Chosen on the Panda's
 # tuning seeds (PBP-Alt and PBP-Cont, 100 trials each, margins 0.2 to 0.5 rad, gains 10 to
-# 100/s): 3 of the 200 trials stalled without the push, 1 with 0.3 rad and 25 or 50/s (50
-# the faster); at 10/s it freed fewer, and a 0.5 rad margin stalled others.
+# 100/s): 3 of the 200 trials stalled without the push (2 with `brake_at_limits`), 1 with
+# 0.3 rad and 25 or 50/s (50 the faster); at 10/s it freed fewer, and a 0.5 rad margin
+# stalled others.
 LIMIT_PUSH_GAIN = 50.0
 # The plan closes its gap to the command over this many steps (the command's own velocity
 # is fed forward), so that what the limits held back is not made up in one burst.
@@ -70,13 +71,15 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
     Limits are (lower, upper) pairs of arrays over the plant's velocities (positions for
     ``position_limits``), ``inf`` for none; the plant must have q̇ = v. See
     ``OVERSHOOT_WEIGHT`` for ``limit_overshoot``; ``singular_margin`` and ``limit_margin``
-    are ``ArmStationConfig``'s (see ``LIMIT_PUSH_GAIN``).
+    are ``ArmStationConfig``'s (see ``LIMIT_PUSH_GAIN``). With ``brake_at_limits`` (the
+    arms') a joint's speed toward a position limit is at most ``sqrt(2 a d)`` at ``d`` from
+    it, ``a`` its acceleration limit: it stops at the limit rather than in one step there.
     """
 
     def __init__(self, plant, frame_E, time_step, look_ahead, motor_joints, *,
                  position_limits, velocity_limits, acceleration_limits, q_nominal,
                  centering_gain, command_ramp, limit_overshoot=False, singular_margin=0.0,
-                 limit_margin=0.0):
+                 limit_margin=0.0, brake_at_limits=False):
         super().__init__()
         self._limit_overshoot = bool(limit_overshoot)
         self._singular_margin = float(singular_margin)
@@ -102,6 +105,13 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         self._a_step_bounds = np.stack([self._a_lower * self._time_step,
                                         self._a_upper * self._time_step])
         self._q_bounds = np.stack([self._q_lower, self._q_upper])
+        # With `brake_at_limits`: which position bounds brake (those with a finite
+        # acceleration limit toward them), 2 a dt for each, and which are upper bounds.
+        two_a_dt = 2.0 * self._time_step * np.stack([-self._a_lower, self._a_upper])
+        self._braked = (np.isfinite(two_a_dt) & np.isfinite(self._q_bounds)
+                        & bool(brake_at_limits))
+        self._two_a_dt = two_a_dt[self._braked]
+        self._braked_upper = np.nonzero(self._braked)[0] == 1
         self._centering_gain = np.broadcast_to(np.asarray(centering_gain, float), (nq,))
         self._identity = np.eye(nv)
         self._task_weights = TASK_WEIGHT * np.array([ROTATION_WEIGHT] * 3 + [1.0] * 3)
@@ -208,6 +218,14 @@ class WholeBodyDiffIk(PortGetters, LeafSystem):
         accel = v + self._a_step_bounds
         reach = self._q_bounds - q
         reach /= dt
+        if self._two_a_dt.size:
+            # With `brake_at_limits`, at most the speed toward a position limit from which
+            # the joint stops within its acceleration limit: sqrt(2 a d) at d from it (a
+            # joint that met its limit at speed stopped in one step, and the hand jumped).
+            toward = reach[self._braked]
+            stopping = np.sqrt(self._two_a_dt * np.abs(toward))
+            reach[self._braked] = np.where(self._braked_upper, np.minimum(toward, stopping),
+                                           np.maximum(toward, -stopping))
         lower = np.maximum(np.maximum(self._v_lower, accel[0]), reach[0])
         upper = np.minimum(np.minimum(self._v_upper, accel[1]), reach[1])
         conflict = lower > upper

@@ -15,8 +15,10 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 from pbp_drake.builder import run_task
-from pbp_drake.robots import arm_ready_ee_state, arm_station_plant, make_arm_station
+from pbp_drake.robots import (
+    arm_ready_ee_state, arm_station, arm_station_plant, make_arm_station)
 from pbp_drake.robots.arm_station_config import ToolPose
+from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
 from pbp_drake.robots.hsr_model import configure_parser
 from pbp_drake.scenarios import load_scenario_file
 
@@ -130,11 +132,26 @@ def test_the_panda_s_limit_margin_keeps_a_joint_from_stalling_on_its_limit():
 def test_the_panda_passes_its_shoulder_singularity_without_a_jump():
     # Teleop's tuning seed 7 brings the upper arm upright (joint 2 near 0), where joints 1
     # and 3 turn about one axis: without the file's singular_margin the diff IK spins
-    # that pair until joint 1 meets its limit and the hand jumps.
+    # that pair until joint 1 meets its limit and the hand jumps (beyond the hand's speed
+    # limit of 0.2 m/s: 0.28 m/s with the joints braking toward their limits, 0.9 without).
     scenario = dataclasses.replace(load_scenario_file(
         REPO / "diagrams" / "panda_reach.yaml").scenario, method="teleop", seed=7)
     damped = run_task(scenario)
     undamped = run_task(dataclasses.replace(scenario, robot=dataclasses.replace(
         scenario.robot, singular_margin=0.0)))
     assert damped.success and damped.peak_hand_speed < 0.2
-    assert undamped.peak_hand_speed > 0.5
+    assert undamped.peak_hand_speed > 0.25
+
+
+@pytest.mark.slow
+def test_a_joint_brakes_toward_its_limit_and_the_hand_does_not_jump(monkeypatch):
+    # PBP-Cont's tuning seed 53: joint 1 runs into its limit at over 1 rad/s; stopped there
+    # in one diff IK step, it threw the hand 2.5 cm sideways in one tick (0.84 m/s).
+    scenario = dataclasses.replace(load_scenario_file(
+        REPO / "diagrams" / "panda_reach.yaml").scenario, method="pbp_continuous", seed=53)
+    braked = run_task(scenario)
+    monkeypatch.setattr(arm_station, "WholeBodyDiffIk", lambda *arguments, **options: (
+        WholeBodyDiffIk(*arguments, **{**options, "brake_at_limits": False})))
+    unbraked = run_task(scenario)
+    assert braked.success and braked.peak_hand_speed < 0.35
+    assert unbraked.peak_hand_speed > 0.8

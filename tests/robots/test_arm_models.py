@@ -115,15 +115,24 @@ def test_a_tool_pose_out_of_reach_is_refused_naming_the_field():
         arm_ready_ee_state(dataclasses.replace(config, ready_tool_pose=far))
 
 
+def _panda_trial(method, seed):
+    """diagrams/panda_reach.yaml's scenario run by `method` on `seed`."""
+    return dataclasses.replace(load_scenario_file(REPO / "diagrams" / "panda_reach.yaml").scenario,
+                               method=method, seed=seed)
+
+
+def _with_robot(scenario, **fields):
+    """`scenario` with its robot's `fields` replaced."""
+    return dataclasses.replace(scenario, robot=dataclasses.replace(scenario.robot, **fields))
+
+
 @pytest.mark.slow
 def test_the_panda_s_limit_margin_keeps_a_joint_from_stalling_on_its_limit():
     # PBP-Alt's tuning seed 87: without the file's limit_margin a joint reaches its limit on
     # the way and the hand creeps short of the target until the time limit.
-    scenario = dataclasses.replace(load_scenario_file(
-        REPO / "diagrams" / "panda_reach.yaml").scenario, method="pbp_alternated", seed=87)
+    scenario = _panda_trial("pbp_alternated", 87)
     kept_off = run_task(scenario)
-    stalled = run_task(dataclasses.replace(scenario, robot=dataclasses.replace(
-        scenario.robot, limit_margin=0.0)))
+    stalled = run_task(_with_robot(scenario, limit_margin=0.0))
     assert kept_off.success and kept_off.task_time < 20.0
     assert not stalled.success
 
@@ -134,11 +143,9 @@ def test_the_panda_passes_its_shoulder_singularity_without_a_jump():
     # and 3 turn about one axis: without the file's singular_margin the diff IK spins
     # that pair until joint 1 meets its limit and the hand jumps (beyond the hand's speed
     # limit of 0.2 m/s: 0.28 m/s with the joints braking toward their limits, 0.9 without).
-    scenario = dataclasses.replace(load_scenario_file(
-        REPO / "diagrams" / "panda_reach.yaml").scenario, method="teleop", seed=7)
+    scenario = _panda_trial("teleop", 7)
     damped = run_task(scenario)
-    undamped = run_task(dataclasses.replace(scenario, robot=dataclasses.replace(
-        scenario.robot, singular_margin=0.0)))
+    undamped = run_task(_with_robot(scenario, singular_margin=0.0))
     assert damped.success and damped.peak_hand_speed < 0.2
     assert undamped.peak_hand_speed > 0.25
 
@@ -147,8 +154,7 @@ def test_the_panda_passes_its_shoulder_singularity_without_a_jump():
 def test_a_joint_brakes_toward_its_limit_and_the_hand_does_not_jump(monkeypatch):
     # PBP-Cont's tuning seed 53: joint 1 runs into its limit at over 1 rad/s; stopped there
     # in one diff IK step, it threw the hand 2.5 cm sideways in one tick (0.84 m/s).
-    scenario = dataclasses.replace(load_scenario_file(
-        REPO / "diagrams" / "panda_reach.yaml").scenario, method="pbp_continuous", seed=53)
+    scenario = _panda_trial("pbp_continuous", 53)
     braked = run_task(scenario)
     monkeypatch.setattr(arm_station, "WholeBodyDiffIk", lambda *arguments, **options: (
         WholeBodyDiffIk(*arguments, **{**options, "brake_at_limits": False})))

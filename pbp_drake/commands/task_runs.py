@@ -16,6 +16,7 @@ from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, resul
 from pbp_drake.console.text import controls_line, failure_text
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, resolve
+from pbp_drake.scenarios.bounds import is_special_file
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failed
 
 
@@ -132,7 +133,7 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     if args.record:
         save_recording(meshcat, args.record)
     stopped = live.choice is not None
-    why = None if result.success or stopped else why_failed(result, scenario)
+    why = None if result.success or stopped else why_failed(result, scenario, args.log)
     if console is not None:
         console.show_result(result_text(result.success, result.task_time, stopped, why))
     hand = ""
@@ -147,17 +148,35 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     return result, live
 
 
-def why_failed(result, scenario):
-    """Where a failed run's hand ended against its target (`failure_text`); None for a run
-    streamed to --log, whose result holds no series."""
-    if not len(result.ee_positions) or not len(result.targets):
-        return None
-    target = int(result.targets[-1])
-    distance = float(np.linalg.norm(result.ee_positions[-1] - result.objects[target]))
+def why_failed(result, scenario, log=None):
+    """Where a failed run's hand ended against its target (`failure_text`); for a run
+    streamed to `log`, whose result holds no series, from the file's last row."""
+    if len(result.ee_positions) and len(result.targets):
+        hand, target = result.ee_positions[-1], int(result.targets[-1])
+    else:
+        row = log and last_row(log)
+        if not row:
+            return None
+        hand = np.array([float(row[name]) for name in ("ee_x", "ee_y", "ee_z")])
+        target = int(float(row["target"]))
+    distance = float(np.linalg.norm(hand - result.objects[target]))
     # The grasping task's success is a grasp pose, not a distance to the object's centre.
     grasping = isinstance(scenario.task, GraspTask)
     return failure_text(target, len(result.objects), distance,
                         None if grasping else scenario.task.success_distance)
+
+
+def last_row(path, tail_bytes=2**16):
+    """The last row of the CSV at `path` as {column: text}, read from its header and its
+    last `tail_bytes` (a streamed log may be long); None when it has no row or is not a
+    file (--force lets the log be a device: /dev/zero never ends)."""
+    if is_special_file(path):
+        return None
+    with open(path, "rb") as file:
+        header = file.readline(tail_bytes).decode().strip().split(",")
+        file.seek(max(file.tell(), file.seek(0, 2) - tail_bytes))
+        lines = file.read().decode().splitlines()
+    return dict(zip(header, lines[-1].split(","))) if lines else None
 
 
 def delete_operator(diagram):

@@ -1,6 +1,8 @@
 """What `pbp-drake run` tells a person about their task: each robot's own controls, why a
 run failed, and a gamepad run whose page has no pad."""
 
+import dataclasses
+
 import msgpack
 import numpy as np
 import pytest
@@ -12,6 +14,7 @@ from pbp_drake.console.live import GAMEPAD_FOUND, NO_GAMEPAD
 from pbp_drake.console.text import failure_text
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.scenarios.overrides import ScenarioOverrides
+from pbp_drake.studies.trial_files import time_series_csv
 
 
 # A gamepad as the page reports it, sticks at rest.
@@ -62,6 +65,24 @@ def test_a_failed_run_says_which_target_and_how_far(repo):
     assert result_text(False, 40.0, why=why) == f"failed: time limit; {why}"
     assert failure_text(0, 4, 1.25) == "the target was object 1 of 4, the hand 1.250 m from it"
 
+
+
+def test_a_failed_run_streamed_to_its_log_says_why_from_the_log(repo, tmp_path):
+    reach = scenario(repo, "hsr_reach.yaml")
+    objects = [[2.0, 0.0, 0.7], [1.5, 0.5, 0.7], [2.2, -0.5, 0.7]]
+    whole = result(False, [1.2, 0.5, 0.7], 1, objects)
+    # A streamed run's result holds no series (`run_task_streamed`): its rows are in the log.
+    streamed = dataclasses.replace(whole, times=np.zeros(0), ee_positions=np.zeros((0, 3)),
+                                   targets=np.zeros(0, int))
+    log = tmp_path / "run.csv"
+    log.write_text(time_series_csv(whole))
+    assert why_failed(streamed, reach, str(log)) == why_failed(whole, reach)
+    assert why_failed(streamed, reach) is None
+    # A log that is not a file (--force allows a device) is not read: /dev/zero never ends.
+    assert why_failed(streamed, reach, "/dev/zero") is None
+    header_only = tmp_path / "header.csv"
+    header_only.write_text(time_series_csv(whole).splitlines(keepends=True)[0])
+    assert why_failed(streamed, reach, str(header_only)) is None
 
 @pytest.mark.slow
 def test_a_gamepad_run_without_a_pad_says_so_until_one_comes(repo, meshcat, capsys):

@@ -10,18 +10,19 @@ import pathlib
 import sys
 
 from pbp_drake.studies.atomic_files import read_text, write_failed
-from pbp_drake.studies.trial_files import Damage, StudyFolderError, name_damaged
+from pbp_drake.studies.trial_files import (
+    METHOD_COMPARISON, Damage, StudyFolderError, name_damaged)
 
 TOY_STUDIES = ("alpha_study", "alt_vs_cont")
 #: The kind of a folder of every method under every pilot (`studies.matrix`).
 MATRIX = "method_matrix"
 # How check_folder's refusals name the kinds it checks: (the kind, what one study is).
-_KIND_WORDS = {"method_comparison": ("a method comparison", "study"),
+_KIND_WORDS = {METHOD_COMPARISON: ("a method comparison", "study"),
                MATRIX: ("a matrix of methods and pilots", "matrix")}
 
 
 def check_folder(output, scenario, digest, participant_condition=None, quiet=False,
-                 kind="method_comparison"):
+                 kind=METHOD_COMPARISON):
     """Raises StudyFolderError when `output` holds a study of another kind than `kind` or of
     another scenario (naming another `participant_condition`); names a damaged study.json
     unless `quiet` (it is written again). Returns the readable study.json, or None."""
@@ -67,7 +68,7 @@ def folder_kind(output):
             continue
         if isinstance(data, dict) and isinstance(data.get("study"), str):
             return data["study"]
-    return "method_comparison" if (output / "trials").is_dir() else None
+    return METHOD_COMPARISON if (output / "trials").is_dir() else None
 
 
 # ---------------------------------------------------------------------------------------------

@@ -14,8 +14,12 @@ from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, scale_text
 from pbp_drake.studies.questionnaire_figure import FIG8, answer_counts, plot_questionnaire
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, PRACTICE_FOLDER
 from pbp_drake.studies.atomic_files import write_atomically
-from pbp_drake.studies.trial_files import name_damaged, read_study
+from pbp_drake.studies.folders import folder_kind
+from pbp_drake.studies.trial_files import METHOD_COMPARISON, name_damaged, read_study
 
+# A user study's folder holds participants' sessions alone (`pbp-drake session`).
+NOT_A_SESSION = ("report it on its own (`pbp-drake report FOLDER`), or move it out of {}, "
+                 "whose sub-folders are read as a user study's participants")
 ALPHA = 0.05  # the family-wise level; each measure's pairs are Bonferroni-corrected
 # The measures tested, in the paper's order: (key, name in the tables, source).
 MEASURES = (("intervention_ratio", "intervention ratio", "trial"),
@@ -51,7 +55,14 @@ def read_participants(study_dir):
                             f"{study_dir}/ID`): nothing to report")
     sessions, damaged = {}, []
     for folder in folders:
+        if folder_kind(folder) != METHOD_COMPARISON:
+            raise ScenarioError(f"{folder} holds a study of kind {folder_kind(folder)!r}, not "
+                                f"a participant's session: {NOT_A_SESSION.format(study_dir)}")
         study, records, broken = read_study(folder)
+        if study["trials"] != 1:
+            raise ScenarioError(f"{folder} is a study of {study['trials']} trials a method, "
+                                "not a participant's session (one trial a method): "
+                                + NOT_A_SESSION.format(study_dir))
         foreign = [d for d in broken if "another scenario" in d.problem]
         if foreign:
             raise ScenarioError(f"{foreign[0].path} is {foreign[0].problem}: participant "

@@ -12,7 +12,7 @@ import numpy as np
 from pbp_drake.core.participant_impairment import ParticipantImpairment
 from pbp_drake.scenarios import DynamicObstacles, parse_method_label
 from pbp_drake.studies.intervals import INTERACTION_MEANS, mean_interval
-from pbp_drake.studies.trial_files import trial_paths
+from pbp_drake.studies.trial_files import METHOD_COMPARISON, trial_paths
 
 # Collision-ratio histogram: 20 bins of 0.05 over [0, 1] (the last bin includes 1).
 HISTOGRAM_EDGES = tuple(round(0.05 * i, 2) for i in range(21))
@@ -187,7 +187,7 @@ def summarize(study, records, damaged, output):
     without error, `mean_std` of intervention ratio and task time, `max_mean` of the peaks
     and, where recorded or measured, the posterior's clip, `interaction_entries` and the
     collision ratio; then the damaged files and the ideal alpha (`arbitration`)."""
-    summary = {"study": "method_comparison", "scenario": study["scenario"],
+    summary = {"study": METHOD_COMPARISON, "scenario": study["scenario"],
                "scenario_hash": study["scenario_hash"], "trials": study["trials"],
                "seed": study["seed"], "split": study.get("split"),
                "seeds": [study["seed"], study["seed"] + study["trials"] - 1]}

@@ -23,6 +23,9 @@ from pbp_drake.builder.run import TaskResult
 from pbp_drake.builder.time_series import (
     HAND_ORIENTATION_COLUMNS, time_series_columns, time_series_csv)
 
+# The kind (study.json's "study") of a `pbp-drake study` or a session's folder.
+METHOD_COMPARISON = "method_comparison"
+
 # A trial file of another format counts as not on disk (it runs again); a metric a file
 # lacks reads as None (reported n/a), so a new metric does not change the format.
 TRIAL_FORMAT = 1
@@ -215,7 +218,7 @@ def write_study(output, scenario, digest, methods, trials, seed, split=None,
     None: `scenario_file` (the path the study was run from), `split_seeds` ({"tuning":
     first seed, "evaluation": first seed}), `participant_condition` and `overrides`
     (`ScenarioOverrides.record()`), with which `report --markdown` names the command."""
-    study = {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": scenario.name,
+    study = {"study": METHOD_COMPARISON, "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
              "split": split, "scenario_content": scenario_content(scenario)}
     write_study_json(output, study, scenario_file, split_seeds, participant_condition,
@@ -411,7 +414,7 @@ def study_problem(study):
     """What makes a parsed study.json not a method comparison's, or None."""
     if not isinstance(study, dict):
         return f"holds a {_type_name(study)}, not a study"
-    if study.get("study") != "method_comparison":
+    if study.get("study") != METHOD_COMPARISON:
         return f"a study.json of another kind ({study.get('study')!r}, not 'method_comparison')"
     methods, trials, seed = study.get("methods"), study.get("trials"), study.get("seed")
     if not (isinstance(methods, list) and methods and all(isinstance(m, str) for m in methods)):
@@ -450,7 +453,7 @@ def infer_study(output):
     if not methods:
         return None
     (digest, name), _ = hashes.most_common(1)[0] if hashes else ((None, None), 0)
-    return {"study": "method_comparison", "format": TRIAL_FORMAT, "scenario": name,
+    return {"study": METHOD_COMPARISON, "format": TRIAL_FORMAT, "scenario": name,
             "scenario_hash": digest, "methods": methods, "seed": min(seeds),
             "trials": max(seeds) - min(seeds) + 1}
 

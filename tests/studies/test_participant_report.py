@@ -128,6 +128,26 @@ def test_a_participant_of_another_scenario_is_refused(repo, study, tmp_path, cap
     assert not (mixed / "results.md").exists()
 
 
+
+def test_a_folder_of_studies_is_not_read_as_participants(repo, study, tmp_path, capsys):
+    # `report outputs/` with the studies in it: each study's first trial was reported as a
+    # participant's session, exit 0. A study of more trials, or of another kind, is refused.
+    folder = tmp_path / "outputs"
+    shutil.copytree(study / "P01", folder / "P01")
+    assert main(["study", str(repo / TASK), "--methods", "teleop", "--trials", "2",
+                 "--set", "duration=2", "--output", str(folder / "teleop_study")]) in (0, 1)
+    capsys.readouterr()
+    assert main(["report", str(folder)]) == 2
+    assert (f"pbp-drake: {folder / 'teleop_study'} is a study of 2 trials a method, not a "
+            "participant's session") in capsys.readouterr().err
+    shutil.rmtree(folder / "teleop_study")
+    (folder / "matrix").mkdir()
+    (folder / "matrix" / "study.json").write_text(json.dumps({"study": "method_matrix"}))
+    assert main(["report", str(folder)]) == 2
+    assert (f"pbp-drake: {folder / 'matrix'} holds a study of kind 'method_matrix', not a "
+            "participant's session") in capsys.readouterr().err
+    assert not (folder / "results.md").exists()
+
 def test_markdown_is_refused_for_a_user_study(study, tmp_path, capsys):
     assert main(["report", str(study), "--markdown", str(tmp_path / "study.md")]) == 2
     assert (f"--markdown: {study} is a user study's folder; --markdown takes a `pbp-drake "

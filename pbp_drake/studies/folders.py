@@ -11,7 +11,8 @@ import sys
 
 from pbp_drake.studies.atomic_files import read_text, write_failed
 from pbp_drake.studies.trial_files import (
-    METHOD_COMPARISON, Damage, StudyFolderError, name_damaged)
+    METHOD_COMPARISON, Damage, StudyFolderError, content_differences, name_damaged,
+    scenario_content)
 
 TOY_STUDIES = ("alpha_study", "alt_vs_cont")
 #: The kind of a folder of every method under every pilot (`studies.matrix`).
@@ -50,10 +51,12 @@ def check_folder(output, scenario, digest, participant_condition=None, quiet=Fal
         condition = ("" if recorded == participant_condition else
                      f"; it was run with --participant-condition {recorded}" if recorded else
                      "; it was run without --participant-condition")
+        differences = content_differences(study.get("scenario_content"),
+                                          scenario_content(scenario))
         raise StudyFolderError(
             f"{output} holds a {one} of another scenario ({study.get('scenario')!r}, hash "
             f"{study.get('scenario_hash')}; this one is {scenario.name!r}, hash {digest}"
-            f"{condition}): choose another --output folder")
+            f"{condition}{differences}): choose another --output folder")
     return study
 
 

@@ -15,7 +15,8 @@ from pbp_drake.studies.questionnaire_figure import FIG8, answer_counts, plot_que
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, PRACTICE_FOLDER
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.folders import folder_kind
-from pbp_drake.studies.trial_files import METHOD_COMPARISON, name_damaged, read_study
+from pbp_drake.studies.trial_files import (
+    METHOD_COMPARISON, content_differences, name_damaged, read_study)
 
 # A user study's folder holds participants' sessions alone (`pbp-drake session`).
 NOT_A_SESSION = ("report it on its own (`pbp-drake report FOLDER`), or move it out of {}, "
@@ -78,11 +79,14 @@ def read_participants(study_dir):
     for name, session in sessions.items():
         study = session["study"]
         if study["scenario_hash"] != digest:
+            differences = content_differences(reference.get("scenario_content"),
+                                              study.get("scenario_content"),
+                                              ("in the others", "in this one"))
             raise ScenarioError(
                 f"{study_dir / name} is a session of another scenario ({study['scenario']!r}, "
                 f"hash {study['scenario_hash']}) than the other participants "
-                f"({reference['scenario']!r}, hash {digest}): move it out of {study_dir}, "
-                "or report it on its own")
+                f"({reference['scenario']!r}, hash {digest}{differences}): move it out of "
+                f"{study_dir}, or report it on its own")
     return sessions, damaged
 
 

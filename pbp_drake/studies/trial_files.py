@@ -132,6 +132,37 @@ def scenario_content(scenario):
     return content
 
 
+def content_differences(held, ours, words=("there", "here"), most=3):
+    """Where two `scenario_content`s differ, as "FIELD X there, Y here" (`words` name the
+    two; dotted paths under `scenario:`, at most `most` of them, then how many more), each
+    led by "; " to end a refusal's bracket; "" when the first is not a mapping (a
+    study.json written before it was kept)."""
+    if not isinstance(held, dict):
+        return ""
+    found = []
+
+    def walk(there, here, path):
+        if isinstance(there, dict) and isinstance(here, dict) and (
+                there.get("!type") == here.get("!type")):
+            for key in sorted(set(there) | set(here)):
+                walk(there.get(key), here.get(key), f"{path}.{key}" if path else key)
+        elif there != here:
+            found.append(f"{path or 'scenario'} {_shown(there)} {words[0]}, {_shown(here)} "
+                         f"{words[1]}")
+
+    walk(held, ours, "")
+    more = len(found) - most
+    return "".join(f"; {text}" for text in found[:most]) + (f"; {more} more" if more > 0
+                                                              else "")
+
+
+def _shown(value):
+    """A value of scenario_content in a message: a typed section by its tag, else JSON."""
+    if isinstance(value, dict) and "!type" in value:
+        return "!" + value["!type"]
+    text = json.dumps(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
 def _file_digest(path):
     """The sha256 of a file's bytes (the path itself when unreadable: resolving refuses it)."""
     try:

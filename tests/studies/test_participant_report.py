@@ -125,6 +125,7 @@ def test_a_participant_of_another_scenario_is_refused(repo, study, tmp_path, cap
     assert main(["report", str(mixed)]) == 2
     err = capsys.readouterr().err
     assert f"{mixed / 'P09'} is a session of another scenario" in err
+    assert "; duration 4.0 in the others, 3.0 in this one): move it out" in err
     assert not (mixed / "results.md").exists()
 
 

@@ -10,7 +10,8 @@ import pytest
 
 from pbp_drake.robots import ArmHardware, TaskSpaceBridgeConfig, ToolPose
 from pbp_drake.scenarios import load_scenario_file
-from pbp_drake.studies.trial_files import scenario_content, scenario_hash
+from pbp_drake.scenarios.overrides import ScenarioOverrides
+from pbp_drake.studies.trial_files import content_differences, scenario_content, scenario_hash
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 
@@ -114,3 +115,21 @@ def test_a_taught_primitive_is_hashed_by_its_content_not_its_path(tmp_path):
     assert scenario_hash(naming(first)) == scenario_hash(naming(copy))
     assert scenario_hash(naming(first)) != scenario_hash(naming(other))
     assert scenario_hash(naming(first)) != scenario_hash(base)
+
+
+def test_a_refused_folder_names_what_differs_from_its_scenario():
+    hsr = scenario("hsr_reach.yaml")
+    held = scenario_content(hsr)
+    estimator = dataclasses.replace(hsr.goal_estimator, method="nearest")
+    assert content_differences(held, scenario_content(dataclasses.replace(
+        hsr, duration=12.5, goal_estimator=estimator))) == (
+        '; duration 60.0 there, 12.5 here; goal_estimator.method "angle" there, "nearest" here')
+    # Another operator is named by its tag, not field by field; a fourth difference is counted.
+    keyboard = load_scenario_file(DIAGRAMS / "hsr_reach.yaml",
+                                  ScenarioOverrides(["operator=!Keyboard {}"])).scenario
+    assert content_differences(held, scenario_content(keyboard), most=0) == "; 1 more"
+    assert content_differences(held, scenario_content(keyboard)) == (
+        "; operator !VirtualParticipant there, !Keyboard here")
+    assert content_differences(held, scenario_content(hsr)) == ""
+    # A study.json from before the content was kept: nothing to compare, nothing said.
+    assert content_differences(None, held) == ""

@@ -178,6 +178,8 @@ def test_a_session_refuses_a_folder_of_another_scenario(repo, tmp_path, capsys):
     assert main([*base, "--duration", "1.5"]) == 2
     err = capsys.readouterr().err
     assert "holds a study of another scenario" in err and "choose another --output" in err
+    # What differs is named, so that a person sees which setting to put back.
+    assert "; duration 1.0 there, 1.5 here): choose another --output folder" in err
     assert session_files(output, ["teleop"]) == saved
 
 

@@ -20,7 +20,7 @@ from pbp_drake.scenarios import (
     Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
     check_method_comparison, counted, load_scenario_file)
 from pbp_drake.studies.comparison import BACKENDS, run_method_comparison, run_method_matrix
-from pbp_drake.studies.matrix import MATRIX, check_pilots, pilot_folder
+from pbp_drake.studies.matrix import MATRIX, PILOTS_FOLDER, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
 from pbp_drake.studies.paired import (
     PAIRED_METRICS, paired_comparison, paired_table, paired_with, paired_with_markdown)
@@ -36,7 +36,7 @@ from pbp_drake.studies.splits import SPLITS, first_seed, split_of
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 from pbp_drake.scenarios.validation import check_seed
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
-from pbp_drake.studies.trial_files import name_damaged
+from pbp_drake.studies.trial_files import METHOD_COMPARISON, name_damaged
 
 
 def add_study_commands(commands):
@@ -319,6 +319,13 @@ def _compare(args):
         if not folder:  # pathlib would read it as ".", the current folder
             raise ScenarioError(f"compare: the {which} folder's path is empty; give a "
                                 "`pbp-drake study` --output folder")
+        kind = folder_kind(folder)
+        if kind not in (None, METHOD_COMPARISON):
+            pilots = sorted((pathlib.Path(folder) / PILOTS_FOLDER).glob("*/study.json"))
+            within = (f": compare one pilot's study in it, e.g. {pilots[0].parent}"
+                      if kind == MATRIX and pilots else "")
+            raise ScenarioError(f"compare: {folder} holds a study of kind {kind!r}, not a "
+                                f"method comparison{within}")
     damaged = []
     rows = paired_comparison(args.first, args.second, damaged)
     name_damaged(damaged)

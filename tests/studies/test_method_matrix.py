@@ -291,6 +291,18 @@ def test_report_refuses_to_pair_with_a_method_the_matrix_did_not_run(folders, ca
 
 
 @pytest.mark.slow
+def test_compare_names_a_matrix_and_one_of_its_pilots_studies(folders, capsys):
+    # A matrix read as a study said "no study.json of a method comparison ... and no trial
+    # files: is it the --output folder of a `pbp-drake study`?" of a study's own folder.
+    matrix, study = folders
+    assert main(["compare", str(study), str(matrix)]) == 2
+    pilot = sorted((matrix / "pilots").iterdir())[0]
+    assert capsys.readouterr().err == (
+        f"pbp-drake: compare: {matrix} holds a study of kind 'method_matrix', not a method "
+        f"comparison: compare one pilot's study in it, e.g. {pilot}\n")
+    assert main(["compare", str(study), str(pilot)]) in (0, 1)
+
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_kill_9_mid_matrix_then_the_same_command_resumes_to_the_same_summary(
         folders, task_file, tmp_path):

@@ -24,6 +24,7 @@ from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_posi
 from pbp_drake.robots.task_space_bridge import read_first_state
 from pbp_drake.scenarios import (
     METHODS, Arm, ScenarioError, TaskScenario, load_scenario_file, resolve)
+from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 
 
 def add_run_command(commands):
@@ -36,6 +37,10 @@ def add_run_command(commands):
     add_goals_flag(fields)
     add_hardware_flags(fields)
     fields.add_argument("--scene", help="use the obstacles of this scene of the file's study")
+    fields.add_argument("--pilot", metavar="PILOT",
+                        help="a surrogate pilot drives in place of the file's virtual "
+                        f"participant, as under `study --pilots`: {', '.join(PILOT_NAMES)} "
+                        "(with --seed, a study trial's run again, to watch or --log)")
     _add_common_flags(run)
     run.add_argument("--no-meshcat", action="store_true",
                      help="no Meshcat server and no page at all (implies --headless)")
@@ -71,7 +76,7 @@ def add_run_command(commands):
     add_page_flags(session)
     session.set_defaults(handler=handler, method=None, alpha=None, goals=None, scene=None,
                          no_meshcat=False, record=None, log=None, force=False,
-                         hardware=False, driver_sim=False, hand_trail=False)
+                         hardware=False, driver_sim=False, hand_trail=False, pilot=None)
 
 
 def _add_common_flags(parser):
@@ -99,10 +104,16 @@ def scenario_for_run(args):
     if args.operator is not None and not isinstance(scenario, TaskScenario):
         raise ScenarioError("--operator chooses who drives the tasks; this scenario uses "
                             "the 2-D toy robot")
+    piloted = args.pilot not in (None, ATTENTIVE)
+    if piloted:
+        try:
+            scenario = with_pilot(scenario, args.pilot)
+        except ScenarioError as error:
+            raise ScenarioError(f"--pilot: {error}") from None
     if isinstance(scenario.robot, Arm) and drives_real_robot(scenario.robot.hardware):
         return resolve(_standing_where_the_arm_stands(scenario))
     if args.scene is None:
-        return scenario_file.resolved
+        return resolve(scenario) if piloted else scenario_file.resolved
     scenes = getattr(scenario_file.study, "scenes", [])
     names = [scene.name for scene in scenes]
     if args.scene not in names:

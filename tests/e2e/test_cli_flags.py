@@ -155,6 +155,12 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     (["session", TASK, *SESSION, "--output", "{tmp}/P1", "--methods", "teleop,teleop"],
      "--methods teleop,teleop names a method twice"),
     (["driver-sim", TASK], "the scenario's robot needs hardware: !Arm's {driver: panda}"),
+    (["run", TASK, "--no-meshcat", "--pilot", "lagy"],
+     "--pilot: pilot 'lagy' is unknown; choose one of attentive, noisy, laggy, proportional, "
+     "population (did you mean 'laggy'?)"),
+    (["run", TASK, "--no-meshcat", "--operator", "keyboard", "--pilot", "noisy"],
+     "--pilot: pilot 'noisy' stands in for the virtual participant: scenario.operator is "
+     "!Keyboard"),
 ])
 def test_a_flag_the_scenario_cannot_take_is_refused_in_one_line(repo, tmp_path, capsys, argv,
                                                                  message, monkeypatch):

@@ -291,6 +291,18 @@ def test_report_refuses_to_pair_with_a_method_the_matrix_did_not_run(folders, ca
 
 
 @pytest.mark.slow
+def test_run_with_the_pilot_and_the_seed_runs_a_matrix_trial_again(folders, task_file,
+                                                                   tmp_path):
+    # To watch (or log) the trial a matrix's table points at: the same per-tick rows.
+    matrix, _ = folders
+    log = tmp_path / "laggy.csv"
+    seed = SEED + TRIALS - 1
+    assert main(["run", str(task_file), "--pilot", "laggy", "--method", "pbp_alternated",
+                 "--seed", str(seed), "--no-meshcat", "--log", str(log)]) in (0, 1)
+    trial = pilot_folder(matrix, "laggy") / "trials" / "pbp_alternated" / f"seed_{seed}.csv"
+    assert log.read_bytes() == trial.read_bytes()
+
+@pytest.mark.slow
 def test_compare_names_a_matrix_and_one_of_its_pilots_studies(folders, capsys):
     # A matrix read as a study said "no study.json of a method comparison ... and no trial
     # files: is it the --output folder of a `pbp-drake study`?" of a study's own folder.

@@ -56,9 +56,10 @@ def read_participants(study_dir):
                             f"{study_dir}/ID`): nothing to report")
     sessions, damaged = {}, []
     for folder in folders:
-        if folder_kind(folder) != METHOD_COMPARISON:
-            raise ScenarioError(f"{folder} holds a study of kind {folder_kind(folder)!r}, not "
-                                f"a participant's session: {NOT_A_SESSION.format(study_dir)}")
+        kind = folder_kind(folder)  # None: a damaged study.json, which read_study names
+        if kind not in (None, METHOD_COMPARISON):
+            raise ScenarioError(f"{folder} holds a study of kind {kind!r}, not a participant's "
+                                f"session: {NOT_A_SESSION.format(study_dir)}")
         study, records, broken = read_study(folder)
         if study["trials"] != 1:
             raise ScenarioError(f"{folder} is a study of {study['trials']} trials a method, "

@@ -165,8 +165,12 @@ def read_hand_path(path):
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise ScenarioError(f"{path}: cannot be read as a CSV ({error})") from None
     if not rows:
+        beside = pathlib.Path(path).with_suffix(".csv")
+        trial = (f"; a trial's path is in its CSV, {beside}" if pathlib.Path(path).suffix
+                 == ".json" and beside.is_file() else "")
         raise ScenarioError(f"{path}: not a run's path: it needs the columns "
-                            f"{', '.join(columns[:4])} (pbp-drake run --log writes them)")
+                            f"{', '.join(columns[:4])} (pbp-drake run --log writes them)"
+                            f"{trial}")
     try:
         table = np.array([[float(value) for value in row] for row in rows])
     except (TypeError, ValueError):

@@ -188,6 +188,18 @@ def test_a_bad_recording_is_refused_in_one_line_naming_it(tmp_path, rows, messag
     assert not (tmp_path / "P.json").exists()
 
 
+def test_a_trial_s_json_points_to_its_csv(tmp_path, capsys):
+    trial = tmp_path / "seed_3.json"
+    trial.write_text('{"success": true}\n')
+    code, out = run("teach", REACH, "--from", trial, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 2 and "not a run's path" in out.err and "its CSV" not in out.err
+    trial.with_suffix(".csv").write_text("time,ee_x,ee_y,ee_z\n")
+    code, out = run("teach", REACH, "--from", trial, "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 2
+    assert f"; a trial's path is in its CSV, {trial.with_suffix('.csv')}" in out.err
+
 def test_a_recording_that_cannot_be_read_is_refused(tmp_path, capsys):
     code, out = run("teach", REACH, "--from", tmp_path, "--output", tmp_path / "P.json",
                     capsys=capsys)

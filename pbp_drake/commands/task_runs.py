@@ -43,9 +43,8 @@ def run_scene(args, resolved, meshcat, page):
         save_recording(meshcat, args.record)
     print(f"{scenario.name} [{scenario.method}]: "
           + (f"{outcome}, " if live.choice == "stop" else "") + "final position "
-          f"{np.array2string(trajectory.positions[-1], precision=3)}, collision ratio "
-          f"{ratio:.3f}, intervention ratio {trajectory.operator_active.mean():.3f}",
-          flush=True)
+          f"{position_text(trajectory.positions[-1])}, collision ratio {ratio:.3f}, "
+          f"intervention ratio {trajectory.operator_active.mean():.3f}", flush=True)
     if console is not None:
         console.show_result(outcome)
         if live.choice is None:
@@ -138,7 +137,7 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
         console.show_result(result_text(result.success, result.task_time, stopped, why))
     hand = ""
     if len(result.ee_positions):
-        hand = ", hand at [" + ", ".join(f"{x:.3f}" for x in result.ee_positions[-1]) + "]"
+        hand = f", hand at {position_text(result.ee_positions[-1])}"
     if args.log:
         hand = f"; per-tick rows in {args.log}"
     print(f"{scenario.name} [{scenario.method}, seed {scenario.seed}]: "
@@ -177,6 +176,12 @@ def last_row(path, tail_bytes=2**16):
         file.seek(max(file.tell(), file.seek(0, 2) - tail_bytes))
         lines = file.read().decode().splitlines()
     return dict(zip(header, lines[-1].split(","))) if lines else None
+
+
+def position_text(position):
+    """A position as the terminal shows it: "[0.575, 0.087, 0.362]" (m, fixed point: a
+    coordinate of -1e-11 reads 0.000, not in NumPy's scientific notation nor as -0.000)."""
+    return "[" + ", ".join(f"{x:.3f}" for x in np.round(position, 3) + 0.0) + "]"
 
 
 def delete_operator(diagram):

@@ -29,7 +29,8 @@ def test_no_meshcat_runs_without_a_server(repo, capsys):
     assert main(["run", str(repo / QUICK), "--no-meshcat"]) == 0
     out = capsys.readouterr().out
     assert "Meshcat" not in out and "http://" not in out
-    assert "toy_alt_vs_cont [pbp_alternated]: final position" in out
+    # In fixed point: the end's y of about -5e-11 was printed "-4.785e-11".
+    assert "toy_alt_vs_cont [pbp_alternated]: final position [1.000, 0.000], " in out
     # Not a terminal: the progress line is a line of its own.
     assert "t = 3.0 s of 3 s, " in out
 

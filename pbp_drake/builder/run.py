@@ -16,6 +16,7 @@ from pbp_drake.builder.grasp import grasp_series_fields
 from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.interaction_metrics import InteractionMeter, idle_ratio
 from pbp_drake.robots import drives_real_robot
+from pbp_drake.robots.station_parts import joints_at_limits
 from pbp_drake.scenarios import ResolvedScenario, counted, resolve
 from pbp_drake.systems.operators.browser_guard import reset_pacing_after_pauses
 from pbp_drake.systems.ports import TaskStatus
@@ -168,6 +169,9 @@ class TaskResult:
             operator and the method worked together (`pbp_drake.core.interaction_metrics`,
             over the series' ticks; `idle_ratio` is `1 - intervention_ratio`, on the task
             monitor's ticks). None when unknown (a TaskResult made without them).
+        joints_at_limits: the names of the robot's joints standing at a position limit
+            when the run ended (`robots.station_parts.joints_at_limits`): where a hand
+            that stopped short is held. None without a simulated robot (the bridge's).
     """
 
     success: bool
@@ -202,6 +206,7 @@ class TaskResult:
     time_to_prediction: list | None = None
     mean_time_to_prediction: float | None = None
     unpredicted_switches: int | None = None
+    joints_at_limits: list | None = None
 
     def __post_init__(self):
         if (self.final_angle_to_target is None and self.angles_to_target is not None
@@ -283,7 +288,9 @@ def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=N
     (advance or advance_to)(simulator, (ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()
     status, monitor = final_status(diagram, context)
-    return _read_result(diagram, context, status, monitor, scenario.control_period)
+    return dataclasses.replace(
+        _read_result(diagram, context, status, monitor, scenario.control_period),
+        joints_at_limits=final_joints_at_limits(diagram, context))
 
 
 def final_status(diagram, context):
@@ -291,6 +298,16 @@ def final_status(diagram, context):
     monitor = diagram.GetSubsystemByName("task_monitor")
     return TaskStatus(monitor.get_task_status_output_port().Eval(
         monitor.GetMyContextFromRoot(context))), monitor
+
+
+def final_joints_at_limits(diagram, context):
+    """`joints_at_limits` of the task's simulated station (the HSR's or an arm's) once its
+    simulation has ended; None when the diagram has none (the task-space bridge's)."""
+    for name in ("hsr_station", "arm_station"):
+        if diagram.HasSubsystemNamed(name):
+            station = diagram.GetSubsystemByName(name)
+            return joints_at_limits(station, station.GetMyContextFromRoot(context))
+    return None
 
 
 # The loggers that hold decisions (read `DECISION_LOG_SHIFT` samples later, see read_log)

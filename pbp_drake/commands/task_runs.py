@@ -162,7 +162,8 @@ def why_failed(result, scenario, log=None):
     # The grasping task's success is a grasp pose, not a distance to the object's centre.
     grasping = isinstance(scenario.task, GraspTask)
     return failure_text(target, len(result.objects), distance,
-                        None if grasping else scenario.task.success_distance)
+                        None if grasping else scenario.task.success_distance,
+                        result.joints_at_limits or ())
 
 
 def last_row(path, tail_bytes=2**16):

@@ -132,6 +132,21 @@ def station_plant(station):
     return station.GetSubsystemByName("joints").plant()
 
 
+#: A joint within this of a position limit (rad or m) stands at it (`joints_at_limits`).
+AT_LIMIT_TOLERANCE = 1e-3
+
+
+def joints_at_limits(station, station_context):
+    """The names of a station's joints (`make_hsr_station`, `make_arm_station`) that stand
+    at a position limit in `station_context`: where a hand that stopped short is held."""
+    plant = station_plant(station)
+    q = station.GetOutputPort("state").Eval(station_context)[:plant.num_positions()]
+    lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
+    at_limit = (q - lower < AT_LIMIT_TOLERANCE) | (upper - q < AT_LIMIT_TOLERANCE)
+    return [plant.get_joint(index).name() for index in plant.GetJointIndices()
+            if plant.get_joint(index).num_positions() == 1
+            and at_limit[plant.get_joint(index).position_start()]]
+
 def initial_ee_state(station):
     """The hand's ``ee_state`` (``EeState``) where a station (`make_hsr_station`,
     `make_arm_station`) starts: read off a fresh context."""

@@ -22,7 +22,9 @@ pytestmark = pytest.mark.slow
 METRICS = ("success", "task_time", "intervention_ratio", "switches", "collision_ratio",
            "peak_hand_speed", "peak_command_acceleration",
            # The grasping task's (None in the others).
-           "peak_command_angular_change", "final_angle_to_target")
+           "peak_command_angular_change", "final_angle_to_target",
+           # Read off the station's state at the end (a list: [] when none).
+           "joints_at_limits")
 
 
 @pytest.mark.parametrize("file_name, duration", [

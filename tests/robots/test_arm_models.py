@@ -15,6 +15,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 from pbp_drake.builder import run_task
+from pbp_drake.commands.task_runs import why_failed
 from pbp_drake.robots import (
     arm_ready_ee_state, arm_station, arm_station_plant, make_arm_station)
 from pbp_drake.robots.arm_station_config import ToolPose
@@ -135,6 +136,11 @@ def test_the_panda_s_limit_margin_keeps_a_joint_from_stalling_on_its_limit():
     stalled = run_task(_with_robot(scenario, limit_margin=0.0))
     assert kept_off.success and kept_off.task_time < 20.0
     assert not stalled.success
+    # The failed run's line names the joints that hold the hand there.
+    assert kept_off.joints_at_limits == [] and stalled.joints_at_limits == [
+        "panda_joint5", "panda_joint6"]
+    assert why_failed(stalled, scenario).endswith(
+        "; at a joint limit: panda_joint5, panda_joint6")
 
 
 @pytest.mark.slow

@@ -116,6 +116,7 @@ class HsrStationConfig:
 
 def validate_hsr_station_config(config: HsrStationConfig) -> None:
     """Raises ValueError naming the first field of ``config`` that cannot work."""
+    check_config_type(config, HsrStationConfig)
     validate_station(config, "HsrStationConfig")
     if config.plant.discrete_contact_approximation == "tamsi":
         raise ValueError("HsrStationConfig.plant.discrete_contact_approximation 'tamsi' "
@@ -135,6 +136,13 @@ def validate_hsr_station_config(config: HsrStationConfig) -> None:
     if not config.arm_centering_gain >= 0:
         raise ValueError(f"HsrStationConfig.arm_centering_gain must be >= 0, got "
                          f"{config.arm_centering_gain}")
+
+
+def check_config_type(config, cls):
+    """Raises ValueError naming `config` unless it is a `cls` (a dict or None would fail
+    later on a missing attribute)."""
+    if not isinstance(config, cls):
+        raise ValueError(f"config must be {cls.__name__}, got {type(config).__name__}")
 
 
 def validate_station(config, name):

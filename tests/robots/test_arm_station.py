@@ -8,13 +8,15 @@ import pathlib
 
 import numpy as np
 import pytest
+from pydrake.lcm import DrakeLcm
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.robots import (
-    ArmStationConfig, CylinderObstacle, arm_initial_ee_state, arm_reach, arm_ready_ee_state,
-    arm_station_plant, make_arm_station)
+    ArmStationConfig, CylinderObstacle, HsrStationConfig, arm_driver_sim, arm_initial_ee_state,
+    arm_reach, arm_ready_ee_state, arm_station_plant, make_arm_station,
+    measured_ready_positions)
 from pbp_drake.robots.hsr_model import models_dir
 from pbp_drake.scenarios import load_scenario_file
 
@@ -164,6 +166,16 @@ def test_a_model_that_cannot_work_is_refused_in_one_line(tmp_path, name, change,
         make_arm_station(config)
     text = str(error.value)
     assert message in text and "\n" not in text, text
+
+
+@pytest.mark.parametrize("config", [None, {"model_file": str(ARM6)}, HsrStationConfig()])
+def test_a_config_of_another_type_is_refused_by_name(config):
+    for call in (make_arm_station, arm_ready_ee_state, arm_reach, measured_ready_positions):
+        with pytest.raises(ValueError, match=f"^config must be ArmStationConfig, got "
+                                             f"{type(config).__name__}$"):
+            call(config)
+    with pytest.raises(ValueError, match="^config must be ArmStationConfig, got "):
+        arm_driver_sim(config, DrakeLcm("memq://"))
 
 
 def test_a_joint_without_limits_is_refused_naming_it(tmp_path):

@@ -16,8 +16,8 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Tr
 from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.robots import (
-    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, hsr_initial_hand_pose,
-    hsr_ready_ee_state, make_hsr_station)
+    ArmStationConfig, CylinderObstacle, HsrStationConfig, hsr_initial_ee_state,
+    hsr_initial_hand_pose, hsr_ready_ee_state, make_hsr_station)
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
 from pbp_drake.robots.hsr_model import (
     BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
@@ -131,6 +131,14 @@ def test_config_round_trips_through_yaml():
 def test_config_errors_name_the_field(field, value, message):
     with pytest.raises(ValueError, match=message):
         make_hsr_station(dataclasses.replace(HsrStationConfig(), **{field: value}))
+
+
+@pytest.mark.parametrize("config", [{"control_period": 0.1}, "hsr", ArmStationConfig()])
+def test_a_config_of_another_type_is_refused_by_name(config):
+    for call in (make_hsr_station, hsr_ready_ee_state):
+        with pytest.raises(ValueError, match=f"^config must be HsrStationConfig, got "
+                                             f"{type(config).__name__}$"):
+            call(config)
 
 
 def test_rejects_tamsi_which_ignores_the_torso_coupler():

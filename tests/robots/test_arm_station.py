@@ -178,6 +178,13 @@ def test_a_config_of_another_type_is_refused_by_name(config):
         arm_driver_sim(config, DrakeLcm("memq://"))
 
 
+def test_the_start_is_read_from_a_station_not_its_config():
+    for call in (arm_initial_ee_state, arm_station_plant):
+        with pytest.raises(ValueError, match=r"^station must be the Diagram of make_hsr_station "
+                                             r"or make_arm_station, got ArmStationConfig"):
+            call(shipped_arm())
+
+
 def test_a_joint_without_limits_is_refused_naming_it(tmp_path):
     text = ARM7_FILE.read_text()
     start = text.index('<joint name="arm7_joint4"')

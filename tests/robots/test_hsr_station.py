@@ -17,7 +17,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.robots import (
     ArmStationConfig, CylinderObstacle, HsrStationConfig, hsr_initial_ee_state,
-    hsr_initial_hand_pose, hsr_ready_ee_state, make_hsr_station)
+    hsr_initial_hand_pose, hsr_ready_ee_state, hsr_station_plant, make_hsr_station)
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
 from pbp_drake.robots.hsr_model import (
     BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
@@ -139,6 +139,16 @@ def test_a_config_of_another_type_is_refused_by_name(config):
         with pytest.raises(ValueError, match=f"^config must be HsrStationConfig, got "
                                              f"{type(config).__name__}$"):
             call(config)
+
+
+@pytest.mark.parametrize("station", [HsrStationConfig(), None])
+def test_what_a_station_is_read_from_must_be_a_station(station):
+    for call in (hsr_initial_ee_state, hsr_initial_hand_pose, hsr_station_plant):
+        with pytest.raises(ValueError, match=(
+                rf"^station must be the Diagram of make_hsr_station or make_arm_station, got "
+                rf"{type(station).__name__} \(hsr_ready_ee_state and arm_ready_ee_state take "
+                r"a config\)$")):
+            call(station)
 
 
 def test_rejects_tamsi_which_ignores_the_torso_coupler():

@@ -125,6 +125,11 @@ def test_config_round_trips_through_yaml():
      "arm_acceleration_limits"),
     ("obstacles", [CylinderObstacle(radius=0.0)], r"obstacles\[0\]"),
     ("arm_centering_gain", -1.0, r"HsrStationConfig\.arm_centering_gain must be >= 0, got -1.0"),
+    ("ee_height", None, r"HsrStationConfig\.ee_height must be a number, got None"),
+    ("control_period", "0.1", r"HsrStationConfig\.control_period must be a number or None, "
+                              r"got '0.1'"),
+    ("obstacles", [(0.1, 0.5)], r"HsrStationConfig\.obstacles must be a list, each a "
+                                r"CylinderObstacle, got \[\(0.1, 0.5\)\]"),
     ("initial_base", [20.0, 0.0, 0.0],
      r"initial_base \[20.0, 0.0, 0.0\] is out of base_x_joint's range"),
 ])

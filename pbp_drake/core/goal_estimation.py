@@ -239,6 +239,8 @@ GOAL_ESTIMATION_METHODS = tuple(name for name, estimator in ESTIMATORS.items()
 def register_estimator(estimator):
     """Adds `estimator` (an `Estimator`) to `ESTIMATORS`; ValueError if its name is taken,
     or it reads the position without a probabilities function."""
+    if not isinstance(estimator, Estimator):
+        raise ValueError(f"estimator must be an Estimator, got {type(estimator).__name__}")
     if estimator.name in ESTIMATORS:
         raise ValueError(f"goal estimator {estimator.name!r} is already registered")
     if estimator.reads not in READS:

@@ -113,6 +113,8 @@ METHODS = {method.name: method for method in (
 
 def register_method(method):
     """Adds `method` (a `Method`) to `METHODS` under its name; ValueError if taken."""
+    if not isinstance(method, Method):
+        raise ValueError(f"method must be a Method, got {type(method).__name__}")
     if method.name in METHODS:
         raise ValueError(f"method {method.name!r} is already registered")
     METHODS[method.name] = method

@@ -5,6 +5,8 @@ Obstacles are discs (spheres in 3-D): a centre and a radius. The robot is a poin
 
 import numpy as np
 
+from pbp_drake.core.coordinates import is_real
+
 
 def obstacle_distances(positions, centres, radii):
     """Signed distances `(..., M)` from points `(..., D)` to the surfaces of M obstacles."""
@@ -18,6 +20,11 @@ def collision_ratio(positions, centres, radii):
     """The ratio of states `(T, D)` inside any obstacle (the paper's collision metric)."""
     if len(radii) == 0:
         return 0.0
+    # One radius an obstacle: NumPy would broadcast other counts into another scene.
+    centre_count = np.asarray(centres, dtype=float).size // np.shape(positions)[-1]
+    if len(radii) != centre_count:
+        raise ValueError(f"radii has {len(radii)} values for {centre_count} centres; "
+                         "expected one radius an obstacle")
     inside = (obstacle_distances(positions, centres, radii) < 0.0).any(axis=-1)
     return float(inside.mean())
 
@@ -50,8 +57,16 @@ def repulsion_command(position, centres, radii, distance_threshold=0.2, speed=1.
 def bent_path(start, goal, bend, duration, sample_count=200):
     """A demonstration that bows sideways by `bend` at mid-path (a detour around an obstacle),
     timed with a minimum-jerk profile. Returns times `(T,)` and positions `(T, 2)`."""
-    start = np.asarray(start, dtype=float)
-    goal = np.asarray(goal, dtype=float)
+    start = np.asarray(start, dtype=float).reshape(-1)
+    goal = np.asarray(goal, dtype=float).reshape(-1)
+    for name, point in (("start", start), ("goal", goal)):
+        if point.size != 2 or not np.isfinite(point).all():
+            raise ValueError(f"{name} must be two finite numbers (x, y), got {point.tolist()}")
+    if np.hypot(*(goal - start)) < 1e-6:
+        raise ValueError(f"goal {goal.tolist()} is where start is; the bend's side is "
+                         "undefined")
+    if not (is_real(duration) and np.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be positive and finite, got {duration!r}")
     times = np.linspace(0.0, duration, sample_count)
     s = times / duration
     progress = 10 * s**3 - 15 * s**4 + 6 * s**5

@@ -133,7 +133,7 @@ def ready_positions(plant, arm, config):
     wrong count, a joint outside its limits, a tool pose out of reach, or an ee_frame
     whose z axis is more than MAX_TILT_DEGREES off the floor plane there."""
     q0 = plant.GetDefaultPositions()
-    if config.initial_positions:
+    if len(config.initial_positions):
         if len(config.initial_positions) != len(arm.joints):
             names = [joint.name() for joint in arm.joints]
             raise ValueError(f"ArmStationConfig.initial_positions has "
@@ -177,7 +177,7 @@ def _solve_tool_pose(plant, arm, config, q_given):
     (deterministic; remembered per model and pose)."""
     X_WE = config.ready_tool_pose.transform()
     lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
-    nominal = np.asarray(q_given if config.initial_positions else (lower + upper) / 2, float)
+    nominal = np.asarray(q_given if len(config.initial_positions) else (lower + upper) / 2, float)
     key = (config.model_file, config.base_frame, config.ee_frame, tuple(config.base_pose),
            tuple(config.ready_tool_pose.position), tuple(config.ready_tool_pose.rpy_degrees),
            tuple(nominal))

@@ -23,7 +23,7 @@ from pbp_drake.robots.arm_driver import (
     SIMULATION_CLOCK, WALL_CLOCK, DriverLink, read_first_status, status_type)
 from pbp_drake.robots.arm_model import add_arm, reach_of, ready_positions
 from pbp_drake.robots.arm_station_config import (
-    DRIVERS, ArmStationConfig, validate_arm_station_config)
+    DRIVERS, ArmStationConfig, check_config_type, validate_arm_station_config)
 from pbp_drake.robots.driver_sim import make_driver_sim
 from pbp_drake.robots.hsr_diff_ik import WholeBodyDiffIk
 from pbp_drake.robots.hsr_ee_systems import ee_state_at_rest, station_ramp
@@ -122,12 +122,17 @@ def arm_driver_sim(config: ArmStationConfig, lcm, clock=WALL_CLOCK) -> Diagram:
     """The driver simulator of `config`'s arm (`config.hardware.driver`) on `lcm`, standing
     in the ready configuration, with its own `LcmInterfaceSystem`: what `pbp-drake
     driver-sim` runs."""
-    if config.hardware is None:
-        raise ValueError("ArmStationConfig.hardware is needed: the driver to simulate "
-                         "(hardware: {driver: panda} or {driver: iiwa})")
+    _check_hardware(config, "the driver to simulate")
     plant, arm, q0 = arm_model_plant(config)
     return make_driver_sim(config.hardware.driver, lcm, clock, _arm_positions(arm, q0),
                            *_joint_limits(plant, arm))
+
+
+def _check_hardware(config, what):
+    check_config_type(config, ArmStationConfig)
+    if config.hardware is None:
+        raise ValueError(f"ArmStationConfig.hardware is needed: {what} (hardware: "
+                         "{driver: panda} or {driver: iiwa})")
 
 
 def drives_real_robot(hardware) -> bool:
@@ -142,6 +147,7 @@ def measured_ready_positions(config: ArmStationConfig) -> np.ndarray:
     `config.hardware.lcm_bus` (its Python callback must not run inside a simulation, which
     newer Drakes advance without Python's lock). Raises `DriverError` naming the bus and
     channel when no status comes within `connect_timeout`."""
+    _check_hardware(config, "the driver to read")
     plant, arm, _ = arm_model_plant(config)
     lower, upper, _ = _joint_limits(plant, arm)
     return read_first_status(config.hardware, DrakeLcm(config.hardware.lcm_bus), lower, upper)

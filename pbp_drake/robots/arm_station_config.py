@@ -14,8 +14,8 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.visualization import VisualizationConfig
 
 from pbp_drake.robots.hsr_station_config import (
-    CylinderObstacle, default_station_plant_config, default_station_visualization,
-    validate_station)
+    CylinderObstacle, check_config_type, check_field_types, default_station_plant_config,
+    default_station_visualization, validate_station)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -166,6 +166,8 @@ class ArmStationConfig:
 def validate_arm_station_config(config: ArmStationConfig) -> None:
     """Raises ValueError naming the first field of ``config`` that cannot work (the model
     itself is checked when it is loaded)."""
+    check_config_type(config, ArmStationConfig)
+    check_field_types(config, "ArmStationConfig")
     for name in ("model_file", "base_frame", "ee_frame"):
         if not isinstance(getattr(config, name), str) or not getattr(config, name):
             raise ValueError(f"ArmStationConfig.{name} is needed (a non-empty string)")

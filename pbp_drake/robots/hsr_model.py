@@ -12,6 +12,7 @@ Example::
 from pathlib import Path
 
 from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant_
 from pydrake.multibody.tree import ModelInstanceIndex
 
 PACKAGE_NAME = "pbp_drake_models"
@@ -64,6 +65,11 @@ def add_hsr(plant, parser: Parser | None = None) -> ModelInstanceIndex:
     lagged contact approximation enforces the torso coupler) and returns its model
     instance. ``parser``: a Parser for ``plant`` (e.g. one with auto-renaming to add
     several robots); a new one otherwise."""
+    # Drake's parser aborts the interpreter (a failed C++ assertion) on either.
+    if parser is None and not MultibodyPlant_.is_subclass_of_instantiation(type(plant)):
+        raise ValueError(f"plant must be a MultibodyPlant, got {type(plant).__name__}")
+    if (parser.plant() if parser is not None else plant).is_finalized():
+        raise ValueError("plant is finalized: call add_hsr(plant) before plant.Finalize()")
     parser = parser or Parser(plant)
     configure_parser(parser)
     (model,) = parser.AddModels(url=HSR_URL)

@@ -38,7 +38,8 @@ from pbp_drake.robots.hsr_model import (
 )
 from pbp_drake.robots.hsr_pose_systems import HAND_FRAME, PoseCommandRamp, PoseStateFromPlant
 from pbp_drake.robots.station_parts import (
-    add_robot, add_station_plant, finish_station, initial_ee_state, pose_at, station_plant)
+    add_robot, add_station_plant, checked_station, finish_station, initial_ee_state, pose_at,
+    station_plant)
 from pbp_drake.robots.hsr_station_config import HsrStationConfig, validate_hsr_station_config
 
 # Ready pose: the arm leans forward by READY_ARM_FLEX and the wrist levels the hand, so
@@ -236,4 +237,5 @@ def hsr_initial_hand_pose(station: Diagram) -> np.ndarray:
     """The hand's ``hand_pose`` (``PoseState``) where a pose station (``make_hsr_station(
     ..., command="pose")``) starts, at rest: holding its first 7 entries (and a zero
     twist) as ``pose_command`` keeps the robot still."""
-    return np.array(station.GetOutputPort("hand_pose").Eval(station.CreateDefaultContext()))
+    port = checked_station(station).GetOutputPort("hand_pose")
+    return np.array(port.Eval(station.CreateDefaultContext()))

@@ -1,6 +1,9 @@
 """What the HSR station is built from: ``HsrStationConfig`` and its validation."""
 
 import dataclasses
+import numbers
+import types
+import typing
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlantConfig
@@ -116,6 +119,8 @@ class HsrStationConfig:
 
 def validate_hsr_station_config(config: HsrStationConfig) -> None:
     """Raises ValueError naming the first field of ``config`` that cannot work."""
+    check_config_type(config, HsrStationConfig)
+    check_field_types(config, "HsrStationConfig")
     validate_station(config, "HsrStationConfig")
     if config.plant.discrete_contact_approximation == "tamsi":
         raise ValueError("HsrStationConfig.plant.discrete_contact_approximation 'tamsi' "
@@ -135,6 +140,53 @@ def validate_hsr_station_config(config: HsrStationConfig) -> None:
     if not config.arm_centering_gain >= 0:
         raise ValueError(f"HsrStationConfig.arm_centering_gain must be >= 0, got "
                          f"{config.arm_centering_gain}")
+
+
+def check_config_type(config, cls):
+    """Raises ValueError naming `config` unless it is a `cls` (a dict or None would fail
+    later on a missing attribute)."""
+    if not isinstance(config, cls):
+        raise ValueError(f"config must be {cls.__name__}, got {type(config).__name__}")
+
+
+def check_field_types(config, name):
+    """Raises ValueError naming `name.FIELD` for the first field of the dataclass `config`
+    whose value is not of its annotated kind (None for a number, a dict for a ToolPose):
+    the checks of values that follow would fail on it with a bare TypeError."""
+    hints = typing.get_type_hints(type(config))
+    for field in dataclasses.fields(config):
+        value, kind = getattr(config, field.name), hints[field.name]
+        if not _is_kind(value, kind):
+            raise ValueError(f"{name}.{field.name} must be {_kind_text(kind)}, got {value!r}")
+        if dataclasses.is_dataclass(value) and type(value).__module__.startswith("pbp_drake"):
+            check_field_types(value, f"{name}.{field.name}")
+        if typing.get_origin(kind) is list:
+            for index, item in enumerate(value):
+                if dataclasses.is_dataclass(item):
+                    check_field_types(item, f"{name}.{field.name}[{index}]")
+
+
+def _is_kind(value, kind):
+    origin, args = typing.get_origin(kind), typing.get_args(kind)
+    if origin in (typing.Union, types.UnionType):
+        return any(_is_kind(value, arg) for arg in args)
+    if origin is list:
+        return (isinstance(value, (list, tuple, np.ndarray))
+                and all(_is_kind(item, args[0]) for item in value))
+    if kind is float:
+        return isinstance(value, numbers.Real)
+    return isinstance(value, kind)
+
+
+def _kind_text(kind):
+    origin, args = typing.get_origin(kind), typing.get_args(kind)
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(_kind_text(arg) for arg in args)
+    if origin is list:
+        return f"a list, each {_kind_text(args[0])}"
+    article = "an" if kind.__name__[0] in "AEIOU" else "a"
+    return {float: "a number", str: "a string", bool: "True or False",
+            type(None): "None"}.get(kind, f"{article} {kind.__name__}")
 
 
 def validate_station(config, name):

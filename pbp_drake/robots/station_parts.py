@@ -6,6 +6,7 @@ from pydrake.geometry import (
     CollisionFilterDeclaration, GeometrySet, MeshcatVisualizer, MeshcatVisualizerParams, Rgba,
     Role, SceneGraph)
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.systems.framework import Diagram
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from pbp_drake.robots.hsr_ee_systems import EeStateFromPlant
@@ -124,10 +125,20 @@ def finish_station(builder, plant, scene_graph, model, config, meshcat, name):
     return station
 
 
+def checked_station(station):
+    """`station`; ValueError naming it unless it is a Diagram (a station's config is the
+    likely mistake: the `*_ready_ee_state` functions take that)."""
+    if not isinstance(station, Diagram):
+        raise ValueError(f"station must be the Diagram of make_hsr_station or "
+                         f"make_arm_station, got {type(station).__name__} (hsr_ready_ee_state "
+                         "and arm_ready_ee_state take a config)")
+    return station
+
+
 def station_plant(station):
     """The MultibodyPlant of a station from `make_hsr_station` or `make_arm_station` (with
     kinematic motion, outside the Diagram)."""
-    if station.HasSubsystemNamed("plant"):
+    if checked_station(station).HasSubsystemNamed("plant"):
         return station.GetSubsystemByName("plant")
     return station.GetSubsystemByName("joints").plant()
 
@@ -150,4 +161,5 @@ def joints_at_limits(station, station_context):
 def initial_ee_state(station):
     """The hand's ``ee_state`` (``EeState``) where a station (`make_hsr_station`,
     `make_arm_station`) starts: read off a fresh context."""
-    return np.array(station.GetOutputPort("ee_state").Eval(station.CreateDefaultContext()))
+    port = checked_station(station).GetOutputPort("ee_state")
+    return np.array(port.Eval(station.CreateDefaultContext()))

@@ -21,8 +21,9 @@ from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
 from pbp_drake.robots.arm_driver import DriverError, check_heard, first_message
 from pbp_drake.robots.arm_station_config import DEFAULT_LCM_URL, validate_link
+from pbp_drake.robots.hsr_station_config import check_config_type
 from pbp_drake.systems.ports import EeCommand, EeState
-from pbp_drake.systems.tick import report_offset
+from pbp_drake.systems.tick import checked_period, report_offset
 
 COMMAND_FIELDS, STATE_FIELDS = list(EeCommand.get_fields()), list(EeState.get_fields())
 #: How often (s) `make_station_relay` sends the station's state: a robot's state stream,
@@ -57,12 +58,27 @@ class TaskSpaceBridgeConfig:
 
 def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
     """Raises ValueError naming the first field of `config` that cannot work."""
+    check_config_type(config, TaskSpaceBridgeConfig)
     for name in ("command_channel", "state_channel"):
         if not isinstance(getattr(config, name), str) or not getattr(config, name):
             raise ValueError(f"TaskSpaceBridgeConfig.{name} must be a channel name, got "
                              f"{getattr(config, name)!r}")
     validate_link(config, "TaskSpaceBridgeConfig",
                   ("status_timeout", "connect_timeout", "start_tolerance"))
+
+
+def checked_ee_state(value):
+    """`initial_ee_state` as floats; ValueError naming it unless 8 finite numbers (an
+    EeState): it is the hand's state until the robot's first one comes."""
+    try:
+        ee_state = np.asarray(value, float).reshape(-1)
+    except (TypeError, ValueError):
+        ee_state = np.full(0, np.nan)
+    if ee_state.size != EeState.size or not np.all(np.isfinite(ee_state)):
+        shown = value.tolist() if isinstance(value, np.ndarray) else value
+        raise ValueError(f"initial_ee_state must be {EeState.size} finite numbers (an EeState), "
+                         f"got {shown!r}")
+    return ee_state
 
 
 def signal(values, names, time):
@@ -197,6 +213,8 @@ def make_task_space_bridge(config: TaskSpaceBridgeConfig, initial_ee_state, cont
     the relay's first state comes. Raises ValueError naming a field of `config` that cannot
     work."""
     validate_task_space_bridge(config)
+    initial_ee_state = checked_ee_state(initial_ee_state)
+    control_period = checked_period(control_period)
     lcm = lcm or DrakeLcm(config.lcm_bus)
     builder = DiagramBuilder()
     builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
@@ -241,7 +259,12 @@ def make_station_relay(station, lcm, config: TaskSpaceBridgeConfig, initial_ee_s
     """The robot's side: `station` (any Diagram with ``ee_command`` and ``ee_state``)
     behind the bridge's channels on `lcm`, with its own `LcmInterfaceSystem`, as a ROS
     relay is shaped: each command goes to the station as it comes, and its state goes out
-    every `state_period` s."""
+    every `state_period` s. Raises ValueError naming an argument that cannot work."""
+    if not isinstance(station, Diagram):
+        raise ValueError(f"station must be a Diagram (a station), got {type(station).__name__}")
+    check_config_type(config, TaskSpaceBridgeConfig)
+    initial_ee_state = checked_ee_state(initial_ee_state)
+    state_period = checked_period(state_period, "state_period")
     builder = DiagramBuilder()
     builder.AddNamedSystem("lcm", LcmInterfaceSystem(lcm))
     station = builder.AddSystem(station)

@@ -16,7 +16,7 @@ import numpy as np
 from pbp_drake.core.methods import did_you_mean
 from pbp_drake.scenarios.bounds import (
     check_yaml_bounds, is_special_file, load_document, load_typed, read_bounded)
-from pbp_drake.scenarios.overrides import merged
+from pbp_drake.scenarios.overrides import ScenarioOverrides, merged
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
@@ -46,6 +46,10 @@ def load_scenario_file(path, overrides=None):
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a scenario file's path, a str or os.PathLike; got "
                         f"{path!r}")
+    if not isinstance(overrides, (ScenarioOverrides, type(None))):
+        raise TypeError(f"overrides must be a ScenarioOverrides (pbp_drake.scenarios.overrides:"
+                        f" ScenarioOverrides(settings=('duration=2.0',)), as --set) or None; got "
+                        f"{overrides!r}")
     if not os.fspath(path):  # pathlib would read it as ".", the current folder
         raise ScenarioError("the scenario file's path is empty; expected a file such as "
                             "diagrams/hsr_reach.yaml")

@@ -93,6 +93,16 @@ def test_a_name_is_registered_once(toy_method):
         register_estimator(ESTIMATORS["nearest"])
 
 
+@pytest.mark.parametrize("entry", [None, {"name": "mine"}, ("mine", "position", None)])
+def test_an_entry_of_another_type_is_refused_by_name(entry):
+    # None and a dict raised AttributeError 'name'; a tuple too.
+    with pytest.raises(ValueError, match=f"^method must be a Method, got {type(entry).__name__}$"):
+        register_method(entry)
+    with pytest.raises(ValueError, match=f"^estimator must be an Estimator, got "
+                                         f"{type(entry).__name__}$"):
+        register_estimator(entry)
+
+
 def test_an_entry_names_a_law_or_an_assistance_that_exists():
     with pytest.raises(ValueError, match="blend_mode 'pbp_alternate' is not one of"):
         Method("toy", "Toy", "k", blend_mode="pbp_alternate")

@@ -18,7 +18,8 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.cli import main
 from pbp_drake.robots import (
-    ArmHardware, DriverError, arm_driver_sim, arm_initial_ee_state, make_arm_station)
+    ArmHardware, DriverError, arm_driver_sim, arm_initial_ee_state, make_arm_station,
+    measured_ready_positions)
 from pbp_drake.robots.arm_driver import (
     SIMULATION_CLOCK, WALL_CLOCK, DriverLink, command_message, read_first_status,
     status_message, status_type)
@@ -322,11 +323,14 @@ def test_the_first_status_gives_the_arm_s_configuration_or_refuses_a_bad_one():
         read_first_status(hardware, bad, LOWER, UPPER)
 
 
-def test_the_driver_simulator_needs_the_driver_it_simulates():
+def test_the_driver_simulator_and_the_first_status_need_the_driver():
     config = dataclasses.replace(shipped("iiwa"), hardware=None)
     with pytest.raises(ValueError, match=r"ArmStationConfig.hardware is needed: the driver to "
                                          r"simulate \(hardware: \{driver: panda\} or"):
         arm_driver_sim(config, DrakeLcm("memq://"))
+    with pytest.raises(ValueError, match=r"ArmStationConfig.hardware is needed: the driver to "
+                                         r"read \(hardware: \{driver: panda\} or"):
+        measured_ready_positions(config)
 
 
 def run(*argv, capsys):

@@ -8,13 +8,15 @@ import pathlib
 
 import numpy as np
 import pytest
+from pydrake.lcm import DrakeLcm
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.robots import (
-    ArmStationConfig, CylinderObstacle, arm_initial_ee_state, arm_reach, arm_ready_ee_state,
-    arm_station_plant, make_arm_station)
+    ArmStationConfig, CylinderObstacle, HsrStationConfig, arm_driver_sim, arm_initial_ee_state,
+    arm_reach, arm_ready_ee_state, arm_station_plant, make_arm_station,
+    measured_ready_positions)
 from pbp_drake.robots.hsr_model import models_dir
 from pbp_drake.scenarios import load_scenario_file
 
@@ -124,6 +126,14 @@ REFUSALS = [
      "ArmStationConfig.base_pose must be finite [x, y, z, yaw], got [0.0, 0.0, 0.0]"),
     ("a NaN position", lambda tmp: {"initial_positions": [np.nan] * 7},
      "ArmStationConfig.initial_positions must be finite, got [nan, "),
+    ("positions None", lambda tmp: {"initial_positions": None},
+     "ArmStationConfig.initial_positions must be a list, each a number, got None"),
+    ("a tool pose as a dict", lambda tmp: {"ready_tool_pose": {"position": [0.5, 0.0, 0.5]}},
+     "ArmStationConfig.ready_tool_pose must be a ToolPose or None, got {'position': "),
+    ("a radius as text", lambda tmp: {"obstacles": [CylinderObstacle(radius="0.1")]},
+     "ArmStationConfig.obstacles[0].radius must be a number, got '0.1'"),
+    ("hardware as a dict", lambda tmp: {"hardware": {"driver": "panda"}},
+     "ArmStationConfig.hardware must be an ArmHardware or None, got {'driver': 'panda'}"),
     ("negative singular margin", lambda tmp: {"singular_margin": -1.0},
      "ArmStationConfig.singular_margin must be >= 0, got -1.0"),
     ("negative limit margin", lambda tmp: {"limit_margin": -0.1},
@@ -164,6 +174,30 @@ def test_a_model_that_cannot_work_is_refused_in_one_line(tmp_path, name, change,
         make_arm_station(config)
     text = str(error.value)
     assert message in text and "\n" not in text, text
+
+
+@pytest.mark.parametrize("config", [None, {"model_file": str(ARM6)}, HsrStationConfig()])
+def test_a_config_of_another_type_is_refused_by_name(config):
+    for call in (make_arm_station, arm_ready_ee_state, arm_reach, measured_ready_positions):
+        with pytest.raises(ValueError, match=f"^config must be ArmStationConfig, got "
+                                             f"{type(config).__name__}$"):
+            call(config)
+    with pytest.raises(ValueError, match="^config must be ArmStationConfig, got "):
+        arm_driver_sim(config, DrakeLcm("memq://"))
+
+
+def test_the_start_is_read_from_a_station_not_its_config():
+    for call in (arm_initial_ee_state, arm_station_plant):
+        with pytest.raises(ValueError, match=r"^station must be the Diagram of make_hsr_station "
+                                             r"or make_arm_station, got ArmStationConfig"):
+            call(shipped_arm())
+
+
+def test_numpy_arrays_are_lists_of_numbers():
+    listed = shipped_arm()
+    arrays = dataclasses.replace(listed, initial_positions=np.array(listed.initial_positions),
+                                 base_pose=np.array(listed.base_pose))
+    np.testing.assert_array_equal(arm_ready_ee_state(arrays), arm_ready_ee_state(listed))
 
 
 def test_a_joint_without_limits_is_refused_naming_it(tmp_path):

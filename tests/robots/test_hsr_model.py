@@ -2,6 +2,9 @@
 limits, couples the torso to the arm lift, and reaches the whole object region of
 the multi-goal reaching task (objects at X 1.25..2.5 m, Y -1.05..1.05 m)."""
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from pydrake.multibody.inverse_kinematics import InverseKinematics
@@ -185,3 +188,29 @@ def test_models_dir_explains_a_missing_package(monkeypatch, tmp_path):
     monkeypatch.setattr(hsr_model, "__file__", str(tmp_path / "pbp_drake/robots/hsr_model.py"))
     with pytest.raises(FileNotFoundError, match="pbp_drake_models"):
         hsr_model.models_dir()
+
+
+def test_add_hsr_refuses_what_drake_would_abort_on():
+    # In a process of its own: where Drake's parser gets them, the interpreter aborts.
+    code = """
+from pydrake.multibody.plant import MultibodyPlant
+from pbp_drake.robots.hsr_model import add_hsr
+for plant in (None, "plant"):
+    try:
+        add_hsr(plant)
+    except ValueError as error:
+        print(error)
+finalized = MultibodyPlant(0.01)
+finalized.Finalize()
+try:
+    add_hsr(finalized)
+except ValueError as error:
+    print(error)
+"""
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.splitlines() == [
+        "plant must be a MultibodyPlant, got NoneType",
+        "plant must be a MultibodyPlant, got str",
+        "plant is finalized: call add_hsr(plant) before plant.Finalize()"]

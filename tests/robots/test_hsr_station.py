@@ -16,8 +16,8 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Tr
 from pydrake.trajectories import PiecewisePolynomial
 
 from pbp_drake.robots import (
-    CylinderObstacle, HsrStationConfig, hsr_initial_ee_state, hsr_initial_hand_pose,
-    hsr_ready_ee_state, make_hsr_station)
+    ArmStationConfig, CylinderObstacle, HsrStationConfig, hsr_initial_ee_state,
+    hsr_initial_hand_pose, hsr_ready_ee_state, hsr_station_plant, make_hsr_station)
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
 from pbp_drake.robots.hsr_model import (
     BASE_JOINT_NAMES, TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO, add_hsr)
@@ -125,12 +125,35 @@ def test_config_round_trips_through_yaml():
      "arm_acceleration_limits"),
     ("obstacles", [CylinderObstacle(radius=0.0)], r"obstacles\[0\]"),
     ("arm_centering_gain", -1.0, r"HsrStationConfig\.arm_centering_gain must be >= 0, got -1.0"),
+    ("ee_height", None, r"HsrStationConfig\.ee_height must be a number, got None"),
+    ("control_period", "0.1", r"HsrStationConfig\.control_period must be a number or None, "
+                              r"got '0.1'"),
+    ("obstacles", [(0.1, 0.5)], r"HsrStationConfig\.obstacles must be a list, each a "
+                                r"CylinderObstacle, got \[\(0.1, 0.5\)\]"),
     ("initial_base", [20.0, 0.0, 0.0],
      r"initial_base \[20.0, 0.0, 0.0\] is out of base_x_joint's range"),
 ])
 def test_config_errors_name_the_field(field, value, message):
     with pytest.raises(ValueError, match=message):
         make_hsr_station(dataclasses.replace(HsrStationConfig(), **{field: value}))
+
+
+@pytest.mark.parametrize("config", [{"control_period": 0.1}, "hsr", ArmStationConfig()])
+def test_a_config_of_another_type_is_refused_by_name(config):
+    for call in (make_hsr_station, hsr_ready_ee_state):
+        with pytest.raises(ValueError, match=f"^config must be HsrStationConfig, got "
+                                             f"{type(config).__name__}$"):
+            call(config)
+
+
+@pytest.mark.parametrize("station", [HsrStationConfig(), None])
+def test_what_a_station_is_read_from_must_be_a_station(station):
+    for call in (hsr_initial_ee_state, hsr_initial_hand_pose, hsr_station_plant):
+        with pytest.raises(ValueError, match=(
+                rf"^station must be the Diagram of make_hsr_station or make_arm_station, got "
+                rf"{type(station).__name__} \(hsr_ready_ee_state and arm_ready_ee_state take "
+                r"a config\)$")):
+            call(station)
 
 
 def test_rejects_tamsi_which_ignores_the_torso_coupler():

@@ -152,6 +152,34 @@ def test_a_bad_bridge_config_is_refused_naming_the_field(field, value, message):
                                DrakeLcm("memq://"))
 
 
+@pytest.mark.parametrize("change, message", [
+    ({"initial_ee_state": np.zeros(7)}, r"initial_ee_state must be 8 finite numbers \(an "
+                                        r"EeState\), got \[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0\]"),
+    ({"initial_ee_state": [np.nan] * 8}, "initial_ee_state must be 8 finite numbers"),
+    ({"control_period": 0.0}, "control_period must be positive, got 0.0"),
+    ({"control_period": None}, "control_period must be positive, got None"),
+    ({"config": None}, "config must be TaskSpaceBridgeConfig, got NoneType"),
+])
+def test_a_bridge_s_arguments_that_cannot_work_are_refused_by_name(change, message):
+    arguments = {"config": TaskSpaceBridgeConfig(), "initial_ee_state": np.zeros(8),
+                 "control_period": PERIOD, "lcm": DrakeLcm("memq://"), **change}
+    with pytest.raises(ValueError, match=f"^{message}"):
+        make_task_space_bridge(**arguments)
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"initial_ee_state": np.zeros(3)}, "initial_ee_state must be 8 finite numbers"),
+    ({"state_period": 0.0}, "state_period must be positive, got 0.0"),
+    ({"config": None}, "config must be TaskSpaceBridgeConfig, got NoneType"),
+    ({"station": None}, r"station must be a Diagram \(a station\), got NoneType"),
+])
+def test_a_relay_s_arguments_that_cannot_work_are_refused_by_name(change, message):
+    arguments = {"station": make_hsr_station(), "lcm": DrakeLcm("memq://"),
+                 "config": TaskSpaceBridgeConfig(), "initial_ee_state": np.zeros(8), **change}
+    with pytest.raises(ValueError, match=f"^{message}"):
+        make_station_relay(**arguments)
+
+
 def run(*argv, capsys):
     code = main(list(argv))
     return code, capsys.readouterr()

@@ -370,15 +370,16 @@ def _report(args):
         return 1 if damaged else 0
     if folder_kind(output) == MATRIX:
         return _report_matrix(args, output)
-    summary = report(output)
-    _print_report(summary, output)
     paired = None
-    if args.paired_with is not None:
+    if args.paired_with is not None:  # a method the study did not run: refused, unwritten
         try:
             rows = paired_with(output, args.paired_with, PAIRED_METRICS)
         except ValueError as error:
             raise ScenarioError(f"--paired-with: {error}") from None
         paired = paired_with_markdown(rows, args.paired_with)
+    summary = report(output)
+    _print_report(summary, output)
+    if paired is not None:
         print(paired, end="")
     if args.markdown is not None:
         write_markdown(args.markdown, method_comparison_markdown(

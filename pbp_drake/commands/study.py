@@ -359,6 +359,13 @@ def _report(args):
         if is_participant_collection(output):
             raise ScenarioError(f"--markdown: {output} is a user study's folder; --markdown "
                                 "takes a `pbp-drake study` folder")
+    kind = folder_kind(output)
+    # A 2-D study keeps no trial files to rebuild from (with trials/, its study.json is a
+    # damaged one of a robot task's study, which read_study names).
+    if kind in TOY_STUDIES and not (output / "trials").is_dir():
+        raise ScenarioError(f"{output} holds a 2-D study ({kind}), whose summary.json and "
+                            "figure `pbp-drake study` writes; report rebuilds a robot task's "
+                            "study from its trial files (--markdown FILE: a table of this one)")
     if is_participant_collection(output):
         text, damaged = participant_report(output)
         print(text, end="")
@@ -368,7 +375,7 @@ def _report(args):
             print(f"pbp-drake: {damaged} damaged files skipped (listed above)",
                   file=sys.stderr)
         return 1 if damaged else 0
-    if folder_kind(output) == MATRIX:
+    if kind == MATRIX:
         return _report_matrix(args, output)
     paired = None
     if args.paired_with is not None:  # a method the study did not run: refused, unwritten

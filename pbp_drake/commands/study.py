@@ -319,6 +319,7 @@ def _compare(args):
         if not folder:  # pathlib would read it as ".", the current folder
             raise ScenarioError(f"compare: the {which} folder's path is empty; give a "
                                 "`pbp-drake study` --output folder")
+        _check_is_folder(folder)
         kind = folder_kind(folder)
         if kind not in (None, METHOD_COMPARISON):
             pilots = sorted((pathlib.Path(folder) / PILOTS_FOLDER).glob("*/study.json"))
@@ -350,6 +351,7 @@ def _report(args):
         raise ScenarioError("report: the folder's path is empty; give a `pbp-drake study` "
                             "--output folder")
     output = pathlib.Path(args.output)
+    _check_is_folder(output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)
         if folder_kind(output) in TOY_STUDIES:
@@ -393,6 +395,17 @@ def _report(args):
             read_study_json(output), summary) + ("" if paired is None else "\n" + paired))
         print(f"  wrote {args.markdown}")
     return _report_status(summary, output, _failed_trials(summary, output))
+
+
+def _check_is_folder(path):
+    """ScenarioError unless `path` is a folder: a file (a study's study.json, say) would be
+    read as a folder without a study, or as a user study's."""
+    path = pathlib.Path(path)
+    if path.is_file():
+        raise ScenarioError(f"{path}: is a file, not a folder; give a `pbp-drake study` "
+                            "--output folder")
+    if not path.is_dir():
+        raise ScenarioError(f"{path}: no such folder")
 
 
 def _report_matrix(args, output):

@@ -41,7 +41,7 @@ def add_run_command(commands):
                         help="a surrogate pilot drives in place of the file's virtual "
                         f"participant, as under `study --pilots`: {', '.join(PILOT_NAMES)} "
                         "(with --seed, a study trial's run again, to watch or --log)")
-    _add_common_flags(run)
+    _add_common_flags(run, records=True)
     run.add_argument("--no-meshcat", action="store_true",
                      help="no Meshcat server and no page at all (implies --headless)")
     run.add_argument("--record", metavar="FILE.html",
@@ -79,10 +79,11 @@ def add_run_command(commands):
                          hardware=False, driver_sim=False, hand_trail=False, pilot=None)
 
 
-def _add_common_flags(parser):
+def _add_common_flags(parser, records=False):
+    """`--headless`, `--camera` and `--realtime-rate`; `records`: the command has --record."""
     parser.add_argument("--headless", action="store_true",
-                        help="no page: simulate as fast as possible and quit at the end "
-                        "(--record still saves a replay)")
+                        help="no page: simulate as fast as possible and quit at the end"
+                        + (" (--record still saves a replay)" if records else ""))
     parser.add_argument("--camera", choices=CAMERAS, default="overview",
                         help="HSR tasks: the page's camera; overview (default, free to "
                         "orbit) or robot (follows the robot from above and behind its head, "

@@ -192,6 +192,10 @@ def test_a_session_is_its_own_command_and_run_keeps_to_one_run(capsys):
     run_help = capsys.readouterr().out
     assert "--participant" not in run_help and "--answers" not in run_help
     assert "--set FIELD=VALUE" in run_help and "the page:" in run_help
+    assert "(--record still saves a replay)" in " ".join(run_help.split())  # however wrapped
+    with pytest.raises(SystemExit):
+        main(["session", "--help"])
+    assert "--record" not in capsys.readouterr().out  # a session has none
 
 
 @pytest.mark.slow  # a whole session of two methods: 2 s

@@ -134,6 +134,15 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     (["run", QUICK, "--no-meshcat", "--log", "{tmp}/run.csv"],
      "--log streams an HSR task's per-tick rows; this scenario uses the 2-D toy robot"),
     (["driver-sim", TASK, "--duration", "0"], "--duration must be positive, got 0"),
+    # --hand-trail where nothing draws it: taken, and nothing drawn.
+    (["run", QUICK, "--headless", "--hand-trail"],
+     "--hand-trail draws a reaching or obstacle task's hand path; this scenario uses the 2-D "
+     "toy robot"),
+    (["run", "diagrams/hsr_grasp.yaml", "--headless", "--hand-trail"],
+     "--hand-trail draws a reaching or obstacle task's hand path; the grasping task draws "
+     "none"),
+    (["run", TASK, "--no-meshcat", "--hand-trail"],
+     "--hand-trail draws the hand's path in the page: drop --no-meshcat"),
     # A value that was taken in silence for another: the file's objects, alpha or methods,
     # no replay or log, the two files written over each other.
     (["run", TASK, "--no-meshcat", "--operator", "virtual", "--goals", "0"],

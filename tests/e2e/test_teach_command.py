@@ -236,6 +236,17 @@ def test_a_2d_scene_is_refused(repo, tmp_path, capsys):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_the_grasping_task_is_driven_in_the_page_without_a_hand_trail(tmp_path, capsys,
+                                                                      monkeypatch):
+    # The grasping task's page draws no trail: `run --hand-trail` refuses it there.
+    def the_page(*_):
+        raise teach.ScenarioError("the page would open here")
+    monkeypatch.setattr("pbp_drake.commands.run.open_page", the_page)
+    code, out = run("teach", REPO / "diagrams" / "hsr_grasp.yaml", "--operator", "keyboard",
+                    "--output", tmp_path / "P.json", capsys=capsys)
+    assert (code, out.err) == (2, "pbp-drake: the page would open here\n")
+
+
 def test_a_figure_that_is_not_an_image_file_is_refused_before_anything_runs(tmp_path,
                                                                              capsys):
     code, out = run("teach", REACH, "--output", tmp_path / "P.json", "--figure",

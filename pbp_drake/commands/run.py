@@ -117,6 +117,10 @@ def scenario_for_run(args):
         return resolve(scenario) if piloted else scenario_file.resolved
     scenes = getattr(scenario_file.study, "scenes", [])
     names = [scene.name for scene in scenes]
+    if not names:
+        raise ScenarioError(f"--scene {args.scene!r}: this file's study has no scenes; "
+                            "--scene picks one of a 2-D alpha study's (e.g. "
+                            "diagrams/toy_alpha_study.yaml)")
     if args.scene not in names:
         raise ScenarioError(f"--scene {args.scene!r} is not in this file's study; "
                             f"scenes: {names}")

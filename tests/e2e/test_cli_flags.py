@@ -134,6 +134,10 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     (["run", QUICK, "--no-meshcat", "--log", "{tmp}/run.csv"],
      "--log streams an HSR task's per-tick rows; this scenario uses the 2-D toy robot"),
     (["driver-sim", TASK, "--duration", "0"], "--duration must be positive, got 0"),
+    (["run", TASK, "--no-meshcat", "--scene", "scene_1"],
+     "--scene 'scene_1': this file's study has no scenes; --scene picks one of a 2-D alpha "
+     "study's (e.g. diagrams/toy_alpha_study.yaml)"),
+    (["run", QUICK, "--no-meshcat", "--scene", "scene_1"], "this file's study has no scenes"),
     # --hand-trail where nothing draws it: taken, and nothing drawn.
     (["run", QUICK, "--headless", "--hand-trail"],
      "--hand-trail draws a reaching or obstacle task's hand path; this scenario uses the 2-D "

@@ -93,18 +93,28 @@ def _add_common_flags(parser, records=False):
                         "--headless runs as fast as possible)")
 
 
+_OPERATOR_ON_A_SCENE = ("--operator chooses who drives the tasks; this scenario uses the 2-D "
+                        "toy robot")
+
+
 def scenario_for_run(args):
     """The scenario file of `args` with the command line's overrides, resolved; `--scene`
     then places the obstacles of a scene of the file's study."""
-    scenario_file = load_scenario_file(args.scenario, scenario_overrides(args))
+    try:
+        scenario_file = load_scenario_file(args.scenario, scenario_overrides(args))
+    except ScenarioError:
+        # A task's operator in a 2-D scene fails as the file's field (an unknown tag, or
+        # study.operator_speeds without a speed); the flag is what to name.
+        if args.operator is not None and not load_scenario_file(args.scenario).resolved.has_task:
+            raise ScenarioError(_OPERATOR_ON_A_SCENE) from None
+        raise
     scenario = scenario_file.scenario
     if args.alpha is not None and not METHODS[scenario.method].takes_weight:
         weighted = ", ".join(name for name, method in METHODS.items() if method.takes_weight)
         raise ScenarioError(f"--alpha sets the weight of {weighted}; the method is "
                             f"{scenario.method}")
     if args.operator is not None and not isinstance(scenario, TaskScenario):
-        raise ScenarioError("--operator chooses who drives the tasks; this scenario uses "
-                            "the 2-D toy robot")
+        raise ScenarioError(_OPERATOR_ON_A_SCENE)
     piloted = args.pilot not in (None, ATTENTIVE)
     if piloted:
         try:

@@ -127,6 +127,11 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
      "--alpha sets the weight of fixed_alpha; the method is teleop"),
     (["run", QUICK, "--no-meshcat", "--operator", "none"],
      "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
+    # The 2-D scenes of docs/tasks/two-d.md: its operator a field the task's cannot fill.
+    (["run", "diagrams/toy_alpha_study.yaml", "--no-meshcat", "--operator", "none"],
+     "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
+    (["run", "diagrams/toy_alpha_study.yaml", "--headless", "--operator", "virtual"],
+     "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
     (["run", "diagrams/arm_reach.yaml", "--headless", "--camera", "robot"],
      "--camera robot looks from the HSR's head; this scenario has no HSR"),
     (["run", TASK, "--no-meshcat", "--record", "{tmp}/run.html"],

@@ -11,8 +11,8 @@ from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
 from pbp_drake.commands.run_checks import check_run_flags
 from pbp_drake.commands.run_page import add_page_flags, open_page
 from pbp_drake.commands.scenario_flags import (
-    add_goals_flag, add_hardware_flags, add_override_flags, add_shorthand_flags,
-    scenario_overrides)
+    OPERATOR_ON_A_SCENE, add_goals_flag, add_hardware_flags, add_override_flags,
+    add_shorthand_flags, load_with_overrides)
 from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.signals import stopping_cleanly
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
@@ -23,7 +23,7 @@ from pbp_drake.output_paths import (
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.robots.task_space_bridge import read_first_state
 from pbp_drake.scenarios import (
-    METHODS, Arm, ScenarioError, TaskScenario, load_scenario_file, resolve)
+    METHODS, Arm, ScenarioError, TaskScenario, resolve)
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 
 
@@ -93,28 +93,17 @@ def _add_common_flags(parser, records=False):
                         "--headless runs as fast as possible)")
 
 
-_OPERATOR_ON_A_SCENE = ("--operator chooses who drives the tasks; this scenario uses the 2-D "
-                        "toy robot")
-
-
 def scenario_for_run(args):
     """The scenario file of `args` with the command line's overrides, resolved; `--scene`
     then places the obstacles of a scene of the file's study."""
-    try:
-        scenario_file = load_scenario_file(args.scenario, scenario_overrides(args))
-    except ScenarioError:
-        # A task's operator in a 2-D scene fails as the file's field (an unknown tag, or
-        # study.operator_speeds without a speed); the flag is what to name.
-        if args.operator is not None and not load_scenario_file(args.scenario).resolved.has_task:
-            raise ScenarioError(_OPERATOR_ON_A_SCENE) from None
-        raise
+    scenario_file = load_with_overrides(args)
     scenario = scenario_file.scenario
     if args.alpha is not None and not METHODS[scenario.method].takes_weight:
         weighted = ", ".join(name for name, method in METHODS.items() if method.takes_weight)
         raise ScenarioError(f"--alpha sets the weight of {weighted}; the method is "
                             f"{scenario.method}")
     if args.operator is not None and not isinstance(scenario, TaskScenario):
-        raise ScenarioError(_OPERATOR_ON_A_SCENE)
+        raise ScenarioError(OPERATOR_ON_A_SCENE)
     piloted = args.pilot not in (None, ATTENTIVE)
     if piloted:
         try:

@@ -11,14 +11,14 @@ import time
 from pbp_drake.cli_types import (
     EXIT_INTERRUPTED, EXIT_TERMINATED, chosen_methods, method_list)
 from pbp_drake.commands.scenario_flags import (
-    add_goals_flag, add_override_flags, scenario_overrides)
+    add_goals_flag, add_override_flags, load_with_overrides, scenario_overrides)
 from pbp_drake.commands.signals import Terminated, stopping_cleanly
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
     Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
-    check_method_comparison, counted, load_scenario_file)
+    check_method_comparison, counted)
 from pbp_drake.studies.comparison import BACKENDS, run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, PILOTS_FOLDER, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
@@ -119,7 +119,7 @@ def add_study_commands(commands):
 
 def _study(args):
     overrides = scenario_overrides(args, shorthands=False)
-    scenario_file = load_scenario_file(args.scenario, overrides)
+    scenario_file = load_with_overrides(args, shorthands=False)
     if drives_real_robot(getattr(scenario_file.scenario.robot, "hardware", None)):
         raise ScenarioError("a study runs its trials unattended in simulation: drop "
                             "robot.hardware.connect (pbp-drake run --hardware drives the real "

@@ -143,6 +143,11 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
      "--scene 'scene_1': this file's study has no scenes; --scene picks one of a 2-D alpha "
      "study's (e.g. diagrams/toy_alpha_study.yaml)"),
     (["run", QUICK, "--no-meshcat", "--scene", "scene_1"], "this file's study has no scenes"),
+    # --goals outside the reaching task: named, not the field it sets.
+    (["run", QUICK, "--no-meshcat", "--goals", "10"],
+     "--goals places a reaching task's objects; this scenario uses the 2-D toy robot"),
+    (["study", "diagrams/hsr_obstacles.yaml", "--goals", "10", "--output", "{tmp}/study"],
+     "--goals places a reaching task's objects; this scenario's task is !DynamicObstacles"),
     # --hand-trail where nothing draws it: taken, and nothing drawn.
     (["run", QUICK, "--headless", "--hand-trail"],
      "--hand-trail draws a reaching or obstacle task's hand path; this scenario uses the 2-D "

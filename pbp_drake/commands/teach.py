@@ -61,6 +61,14 @@ def add_teach_command(commands):
 
 
 def _teach(args):
+    # A person's flags with a recording, or the page's port without a page, would be
+    # taken and do nothing.
+    if args.source is not None and args.operator != "virtual":
+        raise ScenarioError(f"--from teaches from a recording; --operator {args.operator} "
+                            "drives the task instead: give one of them")
+    if args.port and (args.source is not None or args.operator == "virtual"):
+        raise ScenarioError("--port is the page's port of a keyboard or gamepad drive "
+                            "(--operator keyboard or gamepad, without --from)")
     check_primitive_path(args.output, force=args.force)
     if args.figure is not None:
         check_figure_path(args.figure)

@@ -229,6 +229,20 @@ def test_a_recording_that_is_a_pipe_is_refused_without_reading_it(tmp_path, caps
     assert sorted(tmp_path.iterdir()) == [pipe]
 
 
+@pytest.mark.parametrize("flags, message", [
+    (["--from", "run.csv", "--operator", "keyboard"],
+     "--from teaches from a recording; --operator keyboard drives the task instead: give one "
+     "of them"),
+    (["--from", "run.csv", "--port", "8123"], "--port is the page's port of a keyboard or "
+     "gamepad drive (--operator keyboard or gamepad, without --from)"),
+    (["--port", "8123"], "--port is the page's port of a keyboard or gamepad drive"),
+])
+def test_flags_that_would_do_nothing_are_refused(tmp_path, capsys, flags, message):
+    code, out = run("teach", REACH, "--output", tmp_path / "P.json", *flags, capsys=capsys)
+    assert code == 2 and out.err.startswith(f"pbp-drake: {message}")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_2d_scene_is_refused(repo, tmp_path, capsys):
     code, out = run("teach", repo / "diagrams" / "toy_alt_vs_cont.yaml", "--output",
                     tmp_path / "P.json", capsys=capsys)

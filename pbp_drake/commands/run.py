@@ -11,8 +11,8 @@ from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
 from pbp_drake.commands.run_checks import check_run_flags
 from pbp_drake.commands.run_page import add_page_flags, open_page
 from pbp_drake.commands.scenario_flags import (
-    add_goals_flag, add_hardware_flags, add_override_flags, add_shorthand_flags,
-    scenario_overrides)
+    OPERATOR_ON_A_SCENE, add_goals_flag, add_hardware_flags, add_override_flags,
+    add_shorthand_flags, load_with_overrides, scenario_overrides)
 from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.signals import stopping_cleanly
 from pbp_drake.commands.task_runs import run_scene, run_task_loop
@@ -23,7 +23,7 @@ from pbp_drake.output_paths import (
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
 from pbp_drake.robots.task_space_bridge import read_first_state
 from pbp_drake.scenarios import (
-    METHODS, Arm, ScenarioError, TaskScenario, load_scenario_file, resolve)
+    METHODS, Arm, ScenarioError, TaskScenario, resolve)
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 
 
@@ -41,7 +41,7 @@ def add_run_command(commands):
                         help="a surrogate pilot drives in place of the file's virtual "
                         f"participant, as under `study --pilots`: {', '.join(PILOT_NAMES)} "
                         "(with --seed, a study trial's run again, to watch or --log)")
-    _add_common_flags(run)
+    _add_common_flags(run, records=True)
     run.add_argument("--no-meshcat", action="store_true",
                      help="no Meshcat server and no page at all (implies --headless)")
     run.add_argument("--record", metavar="FILE.html",
@@ -79,10 +79,11 @@ def add_run_command(commands):
                          hardware=False, driver_sim=False, hand_trail=False, pilot=None)
 
 
-def _add_common_flags(parser):
+def _add_common_flags(parser, records=False):
+    """`--headless`, `--camera` and `--realtime-rate`; `records`: the command has --record."""
     parser.add_argument("--headless", action="store_true",
-                        help="no page: simulate as fast as possible and quit at the end "
-                        "(--record still saves a replay)")
+                        help="no page: simulate as fast as possible and quit at the end"
+                        + (" (--record still saves a replay)" if records else ""))
     parser.add_argument("--camera", choices=CAMERAS, default="overview",
                         help="HSR tasks: the page's camera; overview (default, free to "
                         "orbit) or robot (follows the robot from above and behind its head, "
@@ -95,15 +96,14 @@ def _add_common_flags(parser):
 def scenario_for_run(args):
     """The scenario file of `args` with the command line's overrides, resolved; `--scene`
     then places the obstacles of a scene of the file's study."""
-    scenario_file = load_scenario_file(args.scenario, scenario_overrides(args))
+    scenario_file = load_with_overrides(args, scenario_overrides(args))
     scenario = scenario_file.scenario
     if args.alpha is not None and not METHODS[scenario.method].takes_weight:
         weighted = ", ".join(name for name, method in METHODS.items() if method.takes_weight)
         raise ScenarioError(f"--alpha sets the weight of {weighted}; the method is "
                             f"{scenario.method}")
     if args.operator is not None and not isinstance(scenario, TaskScenario):
-        raise ScenarioError("--operator chooses who drives the tasks; this scenario uses "
-                            "the 2-D toy robot")
+        raise ScenarioError(OPERATOR_ON_A_SCENE)
     piloted = args.pilot not in (None, ATTENTIVE)
     if piloted:
         try:
@@ -116,6 +116,10 @@ def scenario_for_run(args):
         return resolve(scenario) if piloted else scenario_file.resolved
     scenes = getattr(scenario_file.study, "scenes", [])
     names = [scene.name for scene in scenes]
+    if not names:
+        raise ScenarioError(f"--scene {args.scene!r}: this file's study has no scenes; "
+                            "--scene picks one of a 2-D alpha study's (e.g. "
+                            "diagrams/toy_alpha_study.yaml)")
     if args.scene not in names:
         raise ScenarioError(f"--scene {args.scene!r} is not in this file's study; "
                             f"scenes: {names}")

@@ -3,7 +3,7 @@ before the Meshcat server starts: a combination `run` refuses costs no page, no 
 run, and is named in one line (ScenarioError: `pbp-drake: ...`, exit 2)."""
 
 from pbp_drake.cli_types import chosen_methods
-from pbp_drake.scenarios import Gamepad, Keyboard, ScenarioError, with_method
+from pbp_drake.scenarios import Gamepad, GraspTask, Keyboard, ScenarioError, with_method
 from pbp_drake.studies.questionnaire import parse_answers
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
 
@@ -14,6 +14,7 @@ def check_run_flags(args, resolved):
     session's `(methods, order, answers)` (`--answers` parsed, or None), else None."""
     if args.no_meshcat and (args.record or args.camera == "robot"):
         raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
+    _check_hand_trail(args, resolved)
     if not resolved.has_task:
         _check_scene_flags(args)
         return
@@ -55,6 +56,21 @@ def check_run_flags(args, resolved):
                             "tiredness=3,ease=4): otherwise the questions are asked in the "
                             "browser")
     return methods, order, answers
+
+
+def _check_hand_trail(args, resolved):
+    """--hand-trail draws in the page of a reaching or obstacle task only: elsewhere it
+    would be taken and do nothing."""
+    if not args.hand_trail:
+        return
+    if args.no_meshcat:
+        raise ScenarioError("--hand-trail draws the hand's path in the page: drop --no-meshcat")
+    if not resolved.has_task:
+        raise ScenarioError("--hand-trail draws a reaching or obstacle task's hand path; this "
+                            "scenario uses the 2-D toy robot, whose page draws its path")
+    if isinstance(resolved.scenario.task, GraspTask):
+        raise ScenarioError("--hand-trail draws a reaching or obstacle task's hand path; the "
+                            "grasping task draws none")
 
 
 def is_person(scenario):

@@ -1,7 +1,9 @@
 """The flags that change a scenario file's fields: `--set FIELD=VALUE`, `--scenario-text
 YAML` (`scenarios.overrides`) and the shorthands, each one `--set`."""
 
-from pbp_drake.scenarios import METHODS, OPERATOR_NAMES, ScenarioError, parse_method_label
+from pbp_drake.scenarios import (
+    METHODS, OPERATOR_NAMES, MultiGoalReach, ScenarioError, TaskScenario, load_scenario_file,
+    parse_method_label)
 from pbp_drake.scenarios.bounds import MAX_GOALS
 from pbp_drake.scenarios.overrides import ScenarioOverrides
 
@@ -49,6 +51,33 @@ def add_hardware_flags(group):
     group.add_argument("--driver-sim", action="store_true",
                        help="--set robot.hardware.driver_sim=true: with --hardware, the "
                        "driver simulator in this process, on a memq:// bus of its own")
+
+
+OPERATOR_ON_A_SCENE = ("--operator chooses who drives the tasks; this scenario uses the 2-D "
+                       "toy robot")
+
+
+def load_with_overrides(args, overrides):
+    """`load_scenario_file` of `args.scenario` with `overrides` (`scenario_overrides(args)`).
+    A flag the file cannot take at all fails as the field it sets (an unknown tag or key,
+    or a field that needs another), so on a failure it is named instead: `--operator` on a
+    2-D scene, `--goals` outside the reaching task."""
+    try:
+        return load_scenario_file(args.scenario, overrides)
+    except ScenarioError:
+        operator = getattr(args, "operator", None) is not None
+        if not operator and getattr(args, "goals", None) is None:
+            raise
+        scenario = load_scenario_file(args.scenario).scenario  # the file's own error, if any
+        if not isinstance(scenario, TaskScenario):
+            raise ScenarioError(OPERATOR_ON_A_SCENE if operator else
+                                "--goals places a reaching task's objects; this scenario uses "
+                                "the 2-D toy robot") from None
+        if getattr(args, "goals", None) is not None and not isinstance(scenario.task,
+                                                                       MultiGoalReach):
+            raise ScenarioError(f"--goals places a reaching task's objects; this scenario's "
+                                f"task is !{type(scenario.task).__name__}") from None
+        raise
 
 
 def scenario_overrides(args, shorthands=True):

@@ -109,8 +109,10 @@ def run_session_command(args, resolved, meshcat, page, session):
     print(f"Session saved in {output}, answers in {output / QUESTIONNAIRE_FILE} "
           f"(`pbp-drake report {output.parent}` compares the participants).", flush=True)
     if failed:
-        print(f"pbp-drake: the run of {', '.join(failed)} did not reach its target (exit "
-              f"{EXIT_FAILED}); the session is complete and saved.", file=sys.stderr)
+        runs = (f"the run of {failed[0]} did not reach its target" if len(failed) == 1 else
+                f"the runs of {', '.join(failed)} did not reach their targets")
+        print(f"pbp-drake: {runs} (exit {EXIT_FAILED}); the session is complete and saved.",
+              file=sys.stderr)
     if console is not None:
         console.show_title("Session complete - you can close this page")
         console.show_status(f"{counted(len(order), 'method')} run and answered; thank you.")

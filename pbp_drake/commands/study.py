@@ -11,14 +11,14 @@ import time
 from pbp_drake.cli_types import (
     EXIT_INTERRUPTED, EXIT_TERMINATED, chosen_methods, method_list)
 from pbp_drake.commands.scenario_flags import (
-    add_goals_flag, add_override_flags, scenario_overrides)
+    add_goals_flag, add_override_flags, load_with_overrides, scenario_overrides)
 from pbp_drake.commands.signals import Terminated, stopping_cleanly
 from pbp_drake.core.participant_impairment import PARTICIPANT_CONDITIONS, condition
 from pbp_drake.output_paths import check_output_folder
 from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
     Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
-    check_method_comparison, counted, load_scenario_file)
+    check_method_comparison, counted)
 from pbp_drake.studies.comparison import BACKENDS, run_method_comparison, run_method_matrix
 from pbp_drake.studies.matrix import MATRIX, PILOTS_FOLDER, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
@@ -119,7 +119,7 @@ def add_study_commands(commands):
 
 def _study(args):
     overrides = scenario_overrides(args, shorthands=False)
-    scenario_file = load_scenario_file(args.scenario, overrides)
+    scenario_file = load_with_overrides(args, overrides)
     if drives_real_robot(getattr(scenario_file.scenario.robot, "hardware", None)):
         raise ScenarioError("a study runs its trials unattended in simulation: drop "
                             "robot.hardware.connect (pbp-drake run --hardware drives the real "
@@ -319,6 +319,7 @@ def _compare(args):
         if not folder:  # pathlib would read it as ".", the current folder
             raise ScenarioError(f"compare: the {which} folder's path is empty; give a "
                                 "`pbp-drake study` --output folder")
+        _check_is_folder(folder)
         kind = folder_kind(folder)
         if kind not in (None, METHOD_COMPARISON):
             pilots = sorted((pathlib.Path(folder) / PILOTS_FOLDER).glob("*/study.json"))
@@ -350,6 +351,7 @@ def _report(args):
         raise ScenarioError("report: the folder's path is empty; give a `pbp-drake study` "
                             "--output folder")
     output = pathlib.Path(args.output)
+    _check_is_folder(output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)
         if folder_kind(output) in TOY_STUDIES:
@@ -359,6 +361,13 @@ def _report(args):
         if is_participant_collection(output):
             raise ScenarioError(f"--markdown: {output} is a user study's folder; --markdown "
                                 "takes a `pbp-drake study` folder")
+    kind = folder_kind(output)
+    # A 2-D study keeps no trial files to rebuild from (with trials/, its study.json is a
+    # damaged one of a robot task's study, which read_study names).
+    if kind in TOY_STUDIES and not (output / "trials").is_dir():
+        raise ScenarioError(f"{output} holds a 2-D study ({kind}), whose summary.json and "
+                            "figure `pbp-drake study` writes; report rebuilds a robot task's "
+                            "study from its trial files (--markdown FILE: a table of this one)")
     if is_participant_collection(output):
         text, damaged = participant_report(output)
         print(text, end="")
@@ -368,23 +377,35 @@ def _report(args):
             print(f"pbp-drake: {damaged} damaged files skipped (listed above)",
                   file=sys.stderr)
         return 1 if damaged else 0
-    if folder_kind(output) == MATRIX:
+    if kind == MATRIX:
         return _report_matrix(args, output)
-    summary = report(output)
-    _print_report(summary, output)
     paired = None
-    if args.paired_with is not None:
+    if args.paired_with is not None:  # a method the study did not run: refused, unwritten
         try:
             rows = paired_with(output, args.paired_with, PAIRED_METRICS)
         except ValueError as error:
             raise ScenarioError(f"--paired-with: {error}") from None
         paired = paired_with_markdown(rows, args.paired_with)
+    summary = report(output)
+    _print_report(summary, output)
+    if paired is not None:
         print(paired, end="")
     if args.markdown is not None:
         write_markdown(args.markdown, method_comparison_markdown(
             read_study_json(output), summary) + ("" if paired is None else "\n" + paired))
         print(f"  wrote {args.markdown}")
     return _report_status(summary, output, _failed_trials(summary, output))
+
+
+def _check_is_folder(path):
+    """ScenarioError unless `path` is a folder: a file (a study's study.json, say) would be
+    read as a folder without a study, or as a user study's."""
+    path = pathlib.Path(path)
+    if path.is_file():
+        raise ScenarioError(f"{path}: is a file, not a folder; give a `pbp-drake study` "
+                            "--output folder")
+    if not path.is_dir():
+        raise ScenarioError(f"{path}: no such folder")
 
 
 def _report_matrix(args, output):

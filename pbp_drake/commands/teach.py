@@ -61,6 +61,14 @@ def add_teach_command(commands):
 
 
 def _teach(args):
+    # A person's flags with a recording, or the page's port without a page, would be
+    # taken and do nothing.
+    if args.source is not None and args.operator != "virtual":
+        raise ScenarioError(f"--from teaches from a recording; --operator {args.operator} "
+                            "drives the task instead: give one of them")
+    if args.port and (args.source is not None or args.operator == "virtual"):
+        raise ScenarioError("--port is the page's port of a keyboard or gamepad drive "
+                            "(--operator keyboard or gamepad, without --from)")
     check_primitive_path(args.output, force=args.force)
     if args.figure is not None:
         check_figure_path(args.figure)
@@ -81,7 +89,8 @@ def _teach(args):
         # Kept beside the primitive: a person's demonstration is not to be driven twice.
         origin = str(pathlib.Path(args.output).with_suffix(".csv"))
         check_log_path(origin, force=args.force)
-        code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"))
+        code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"),
+                      hand_trail=not isinstance(scenario.task, GraspTask))
         if code not in (EXIT_SUCCESS, EXIT_FAILED, EXIT_STOPPED):
             return code
     times, positions, orientations = read_hand_path(origin)
@@ -110,9 +119,10 @@ def _teach(args):
     return EXIT_SUCCESS
 
 
-def _drive(args, log, switches):
+def _drive(args, log, switches, hand_trail):
     """The exit code of `pbp-drake run` of the scenario under teleop by `args.operator`,
-    its rows in `log`; a task whose target `switches` keeps one target."""
+    its rows in `log`; a task whose target `switches` keeps one target; `hand_trail`: the
+    task's page draws the hand's path (a reaching or obstacle task's)."""
     argv = ["run", args.scenario, "--method", "teleop", "--operator", args.operator,
             "--log", str(log), "--force"]
     if switches:
@@ -128,7 +138,8 @@ def _drive(args, log, switches):
     if args.operator == "virtual":
         argv.append("--headless")
     else:  # the demonstration ends with the run: no result page to keep
-        argv += ["--port", str(args.port), "--keep-page", "0", "--hand-trail"]
+        argv += ["--port", str(args.port), "--keep-page", "0"] + (
+            ["--hand-trail"] if hand_trail else [])
     parser = argparse.ArgumentParser(prog="pbp-drake")
     add_run_command(parser.add_subparsers(dest="command"))
     run_args = parser.parse_args(argv)

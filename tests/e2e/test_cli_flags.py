@@ -127,6 +127,11 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
      "--alpha sets the weight of fixed_alpha; the method is teleop"),
     (["run", QUICK, "--no-meshcat", "--operator", "none"],
      "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
+    # The 2-D scenes of docs/tasks/two-d.md: its operator a field the task's cannot fill.
+    (["run", "diagrams/toy_alpha_study.yaml", "--no-meshcat", "--operator", "none"],
+     "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
+    (["run", "diagrams/toy_alpha_study.yaml", "--headless", "--operator", "virtual"],
+     "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
     (["run", "diagrams/arm_reach.yaml", "--headless", "--camera", "robot"],
      "--camera robot looks from the HSR's head; this scenario has no HSR"),
     (["run", TASK, "--no-meshcat", "--record", "{tmp}/run.html"],
@@ -134,6 +139,24 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
     (["run", QUICK, "--no-meshcat", "--log", "{tmp}/run.csv"],
      "--log streams an HSR task's per-tick rows; this scenario uses the 2-D toy robot"),
     (["driver-sim", TASK, "--duration", "0"], "--duration must be positive, got 0"),
+    (["run", TASK, "--no-meshcat", "--scene", "scene_1"],
+     "--scene 'scene_1': this file's study has no scenes; --scene picks one of a 2-D alpha "
+     "study's (e.g. diagrams/toy_alpha_study.yaml)"),
+    (["run", QUICK, "--no-meshcat", "--scene", "scene_1"], "this file's study has no scenes"),
+    # --goals outside the reaching task: named, not the field it sets.
+    (["run", QUICK, "--no-meshcat", "--goals", "10"],
+     "--goals places a reaching task's objects; this scenario uses the 2-D toy robot"),
+    (["study", "diagrams/hsr_obstacles.yaml", "--goals", "10", "--output", "{tmp}/study"],
+     "--goals places a reaching task's objects; this scenario's task is !DynamicObstacles"),
+    # --hand-trail where nothing draws it: taken, and nothing drawn.
+    (["run", QUICK, "--headless", "--hand-trail"],
+     "--hand-trail draws a reaching or obstacle task's hand path; this scenario uses the 2-D "
+     "toy robot"),
+    (["run", "diagrams/hsr_grasp.yaml", "--headless", "--hand-trail"],
+     "--hand-trail draws a reaching or obstacle task's hand path; the grasping task draws "
+     "none"),
+    (["run", TASK, "--no-meshcat", "--hand-trail"],
+     "--hand-trail draws the hand's path in the page: drop --no-meshcat"),
     # A value that was taken in silence for another: the file's objects, alpha or methods,
     # no replay or log, the two files written over each other.
     (["run", TASK, "--no-meshcat", "--operator", "virtual", "--goals", "0"],
@@ -192,6 +215,10 @@ def test_a_session_is_its_own_command_and_run_keeps_to_one_run(capsys):
     run_help = capsys.readouterr().out
     assert "--participant" not in run_help and "--answers" not in run_help
     assert "--set FIELD=VALUE" in run_help and "the page:" in run_help
+    assert "(--record still saves a replay)" in " ".join(run_help.split())  # however wrapped
+    with pytest.raises(SystemExit):
+        main(["session", "--help"])
+    assert "--record" not in capsys.readouterr().out  # a session has none
 
 
 @pytest.mark.slow  # a whole session of two methods: 2 s

@@ -43,8 +43,10 @@ def test_the_grid_keeps_objects_half_a_cell_apart():
 
 
 @pytest.mark.parametrize("name, goals, message", [
-    ("hsr_obstacles.yaml", 10, "with --goals 10: scenario.task: unknown key 'grid_objects'"),
-    ("hsr_grasp.yaml", 10, "with --goals 10: scenario.task: unknown key 'grid_objects'"),
+    ("hsr_obstacles.yaml", 10,
+     "^--goals places a reaching task's objects; this scenario's task is !DynamicObstacles$"),
+    ("hsr_grasp.yaml", 10,
+     "^--goals places a reaching task's objects; this scenario's task is !GraspTask$"),
     ("hsr_reach.yaml", 1, "scenario.task.grid_objects 1 is out of range; expected 2 to"),
     ("hsr_reach.yaml", MAX_GOALS + 1, "is out of range"),
     ("hsr_reach.yaml", -5, "scenario.task.grid_objects -5 is out of range")])

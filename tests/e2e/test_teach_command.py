@@ -229,11 +229,36 @@ def test_a_recording_that_is_a_pipe_is_refused_without_reading_it(tmp_path, caps
     assert sorted(tmp_path.iterdir()) == [pipe]
 
 
+@pytest.mark.parametrize("flags, message", [
+    (["--from", "run.csv", "--operator", "keyboard"],
+     "--from teaches from a recording; --operator keyboard drives the task instead: give one "
+     "of them"),
+    (["--from", "run.csv", "--port", "8123"], "--port is the page's port of a keyboard or "
+     "gamepad drive (--operator keyboard or gamepad, without --from)"),
+    (["--port", "8123"], "--port is the page's port of a keyboard or gamepad drive"),
+])
+def test_flags_that_would_do_nothing_are_refused(tmp_path, capsys, flags, message):
+    code, out = run("teach", REACH, "--output", tmp_path / "P.json", *flags, capsys=capsys)
+    assert code == 2 and out.err.startswith(f"pbp-drake: {message}")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_2d_scene_is_refused(repo, tmp_path, capsys):
     code, out = run("teach", repo / "diagrams" / "toy_alt_vs_cont.yaml", "--output",
                     tmp_path / "P.json", capsys=capsys)
     assert code == 2 and "teach drives a robot task's hand; this scenario is a 2-D" in out.err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_grasping_task_is_driven_in_the_page_without_a_hand_trail(tmp_path, capsys,
+                                                                      monkeypatch):
+    # The grasping task's page draws no trail: `run --hand-trail` refuses it there.
+    def the_page(*_):
+        raise teach.ScenarioError("the page would open here")
+    monkeypatch.setattr("pbp_drake.commands.run.open_page", the_page)
+    code, out = run("teach", REPO / "diagrams" / "hsr_grasp.yaml", "--operator", "keyboard",
+                    "--output", tmp_path / "P.json", capsys=capsys)
+    assert (code, out.err) == (2, "pbp-drake: the page would open here\n")
 
 
 def test_a_figure_that_is_not_an_image_file_is_refused_before_anything_runs(tmp_path,

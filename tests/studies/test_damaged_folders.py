@@ -250,6 +250,27 @@ def test_a_missing_folder_is_named(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
+    (["report", "{study}/study.json"], "{study}/study.json: is a file, not a folder"),
+    (["report", "{study}/study.json", "--markdown", "{tmp}/x.md"],
+     "{study}/study.json: is a file, not a folder"),
+    (["compare", "{study}", "{study}/study.json"], "{study}/study.json: is a file, not a folder"),
+])
+def test_a_file_is_refused_as_a_study_folder(tmp_path, capsys, argv, message):
+    folder = _study(tmp_path)
+    argv = [arg.format(study=folder, tmp=tmp_path) for arg in argv]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pbp-drake: {message.format(study=folder)}; give a `pbp-drake study` --output "
+        "folder\n")
+    assert not (tmp_path / "x.md").exists()
+
+
+def test_compare_names_a_missing_folder(tmp_path, capsys):
+    assert main(["compare", str(_study(tmp_path)), str(tmp_path / "none")]) == 2
+    assert capsys.readouterr().err == f"pbp-drake: {tmp_path / 'none'}: no such folder\n"
+
+
+@pytest.mark.parametrize("argv, message", [
     (["report", ""], "report: the folder's path is empty"),
     (["compare", "", "B"], "compare: the first folder's path is empty"),
     (["compare", "A", ""], "compare: the second folder's path is empty"),

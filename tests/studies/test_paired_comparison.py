@@ -158,3 +158,16 @@ def test_report_pairs_every_method_with_one_of_its_study(tmp_path, repo, capsys)
     assert main(["report", str(folder), "--paired-with", "pbp_continuous"]) == 2
     assert "--paired-with: the study ran pbp_alternated, teleop, hop, not pbp_continuous" in (
         capsys.readouterr().err)
+
+
+@pytest.mark.slow
+def test_report_refuses_a_reference_it_did_not_run_before_rewriting_the_folder(
+        tmp_path, repo, capsys):
+    folder = _methods_study(tmp_path / "study", repo / "diagrams" / "hsr_reach.yaml", {
+        "pbp_alternated": TASK_TIMES, "teleop": TASK_TIMES + 2.0})
+    assert main(["report", str(folder), "--paired-with", "pbp_continuous"]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == ("pbp-drake: --paired-with: the study ran pbp_alternated, teleop, "
+                            "not pbp_continuous\n")
+    assert captured.out == ""  # no table, no "wrote": the bad flag is refused first
+    assert not (folder / "summary.json").exists() and not (folder / "results.md").exists()

@@ -72,6 +72,16 @@ def test_a_2d_study_without_its_summary_is_named(tmp_path, capsys):
     assert not (tmp_path / "study.md").exists()
 
 
+def test_a_2d_study_is_named_as_one_without_markdown(tmp_path, capsys):
+    (tmp_path / "study.json").write_text('{"study": "alt_vs_cont"}')
+    assert main(["report", str(tmp_path)]) == 2
+    assert capsys.readouterr().err == (
+        f"pbp-drake: {tmp_path} holds a 2-D study (alt_vs_cont), whose summary.json and figure "
+        "`pbp-drake study` writes; report rebuilds a robot task's study from its trial files "
+        "(--markdown FILE: a table of this one)\n")
+    assert list(tmp_path.iterdir()) == [tmp_path / "study.json"]
+
+
 def test_a_folder_is_refused_as_the_markdown_file(tmp_path, capsys):
     assert main(["report", str(tmp_path), "--markdown", str(tmp_path)]) == 2
     assert capsys.readouterr().err.startswith(f"pbp-drake: --markdown {tmp_path}: is a folder")

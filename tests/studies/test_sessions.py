@@ -190,6 +190,9 @@ def test_an_unattended_session_on_the_grasping_task_and_its_report(repo, tmp_pat
     assert main(["run", str(repo / "diagrams" / "hsr_grasp.yaml"), "--headless", "--operator",
                  "virtual", "--participant", "P04", "--answers", ANSWERS, "--duration", "3",
                  "--output", str(output)]) == 1  # 3 s is too short to grasp
+    assert capsys.readouterr().err.endswith(
+        "pbp-drake: the runs of pbp_continuous, teleop, pbp_alternated did not reach their "
+        "targets (exit 1); the session is complete and saved.\n")
     for method in METHODS:
         record_path, csv_path = trial_paths(output, method, 0)
         record = json.loads(record_path.read_text())

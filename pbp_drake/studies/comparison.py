@@ -8,9 +8,10 @@ import contextlib
 import dataclasses
 import pathlib
 import pickle
+import sys
 import time
 
-from pbp_drake.scenarios import ScenarioError
+from pbp_drake.scenarios import ScenarioError, counted
 from pbp_drake.studies.atomic_files import remove_leftovers
 from pbp_drake.studies.ray_backend import import_ray, run_on_ray
 from pbp_drake.studies.report import report
@@ -102,6 +103,8 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
     if recorded:
         scenario_file = scenario_file or recorded.get("scenario_file")
         split_seeds = split_seeds or recorded.get("split_seeds")
+    if recorded:
+        name_left_out(output, recorded, methods, trials, seed)
     remove_leftovers(output)  # of an interrupted study
     pending, damaged = [], []
     for method in methods:
@@ -119,6 +122,29 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
     write_study(output, scenario, digest, methods, trials, seed, split, scenario_file,
                 split_seeds, participant_condition, overrides)
     return StudyFolder(scenario, digest, output, seed, pending)
+
+
+def name_left_out(output, recorded, methods, trials, seed):
+    """Says on stderr which of the trials that `output`'s study.json (`recorded`) covered
+    this study leaves out of its summary (other methods or seeds): their files stay, and a
+    study of them all reports them together."""
+    try:
+        seeds = range(int(recorded["seed"]), int(recorded["seed"]) + int(recorded["trials"]))
+        recorded_methods = [str(method) for method in recorded["methods"]]
+    except (KeyError, TypeError, ValueError):  # a study.json of an older form: nothing said
+        return
+    methods_out = [method for method in recorded_methods if method not in methods]
+    seeds_out = [s for s in seeds if not seed <= s < seed + trials]
+    if not methods_out and not seeds_out:
+        return
+    out = "; ".join(filter(None, [
+        methods_out and f"{', '.join(methods_out)} (all their trials)",
+        seeds_out and (f"{counted(len(seeds_out), 'seed')} outside {seed} to {seed + trials - 1}"
+                       f"{' of the other methods' if methods_out else ''}")]))
+    print(f"pbp-drake: {output} held trials this study leaves out of its summary: {out}; "
+          f"their files stay in {pathlib.Path(output) / 'trials'}, and a study of them all "
+          "(its --methods, --trials and --seed) reports them together", file=sys.stderr,
+          flush=True)
 
 
 def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_address=None):

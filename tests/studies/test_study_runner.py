@@ -615,3 +615,22 @@ def test_a_ray_address_where_nothing_answers_is_named_at_once(task_file, tmp_pat
     assert f"could not connect to Ray at 127.0.0.1:{port}: nothing answers at" in message
     assert "ray start --head" in message
     assert not list(tmp_path.glob("trials/*/*.json"))
+
+
+def test_a_study_that_leaves_out_trials_of_its_folder_says_which(scenario, tmp_path, capsys):
+    # Run again with fewer methods or seeds, the folder's summary covers the new selection
+    # alone: the trials it leaves out are named, and their files stay.
+    run_method_comparison(scenario, METHODS, 3, 5, tmp_path, run=fake_run)
+    files = sorted(tmp_path.glob("trials/*/*.json"))
+    capsys.readouterr()
+    summary = run_method_comparison(scenario, ["teleop"], 2, 5, tmp_path, run=fake_run)
+    assert list(summary["methods"]) == ["teleop"]
+    assert capsys.readouterr().err == (
+        f"pbp-drake: {tmp_path} held trials this study leaves out of its summary: "
+        "pbp_alternated (all their trials); 1 seed outside 5 to 6 of the other methods; their "
+        f"files stay in {tmp_path / 'trials'}, and a study of them all (its --methods, "
+        "--trials and --seed) reports them together\n")
+    assert sorted(tmp_path.glob("trials/*/*.json")) == files
+    # The same selection again, or a wider one, leaves nothing out: nothing is said.
+    run_method_comparison(scenario, METHODS, 3, 5, tmp_path, run=fake_run)
+    assert capsys.readouterr().err == ""

@@ -122,8 +122,8 @@ def register_method(method):
 
 
 def method_names():
-    """The registered names, in registry order."""
-    return tuple(METHODS)
+    """The registered names, in registry order, as a message lists them ("a, b, c")."""
+    return ", ".join(METHODS)
 
 
 def did_you_mean(name, choices):

@@ -4,6 +4,7 @@ YAML` (`scenarios.overrides`) and the shorthands, each one `--set`."""
 from pbp_drake.scenarios import (
     METHODS, OPERATOR_NAMES, MultiGoalReach, ScenarioError, TaskScenario, load_scenario_file,
     parse_method_label)
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.scenarios.bounds import MAX_GOALS
 from pbp_drake.scenarios.overrides import ScenarioOverrides
 
@@ -104,8 +105,7 @@ def _shorthand_settings(args):
             settings.append((f"alpha={alpha!r}", f"--method {args.method}"))
     if args.operator is not None:
         if args.operator not in OPERATOR_NAMES:
-            raise ScenarioError(f"--operator {args.operator!r} is unknown; choose one of "
-                                f"{list(OPERATOR_NAMES)}")
+            raise ScenarioError(unknown_choice("--operator", args.operator, OPERATOR_NAMES))
         # A tag: the file's operator of the same kind keeps its settings (`merged`).
         settings.append((f"operator=!{OPERATOR_NAMES[args.operator].__name__} {{}}",
                          f"--operator {args.operator}"))

@@ -9,6 +9,7 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.core.coordinates import is_real
 
 #: `BlendLaw.weight` of a law whose weight alpha is the method's own (`scenario.alpha`) ...
@@ -56,7 +57,7 @@ BLEND_MODES = tuple(BLEND_LAWS)
 def blend_law(mode, laws=BLEND_LAWS):
     """The `BlendLaw` of `mode` in `laws`; ValueError naming the modes for an unknown one."""
     if mode not in laws:
-        raise ValueError(f"blending mode {mode!r} is unknown; choose one of {tuple(laws)}")
+        raise ValueError(unknown_choice("blending mode", mode, laws))
     return laws[mode]
 
 

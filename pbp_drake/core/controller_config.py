@@ -18,7 +18,8 @@ from pbp_drake.core.dmp.primitive import Primitive, primitive_bank
 from pbp_drake.core.goal_estimation import READS_POSE, GoalEstimatorSettings, estimator_entry
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.hindsight_optimization import HopSettings
-from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_names
+from pbp_drake.core.choices import unknown_choice
+from pbp_drake.core.methods import METHODS, method_entry
 
 
 @dataclasses.dataclass
@@ -126,8 +127,7 @@ class PbpControllerConfig(ControlSettings):
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
         if self.method not in METHODS:
-            raise ValueError(f"method {self.method!r} is not one of {method_names()}"
-                             f"{did_you_mean(self.method, METHODS)}")
+            raise ValueError(unknown_choice("method", self.method, METHODS))
         self.validate_settings()
         check_limit(self.nominal_speed, "nominal_speed", "m/s")
         if not isinstance(self.hand_over, HandOverSettings):

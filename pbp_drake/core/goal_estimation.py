@@ -13,9 +13,9 @@ import typing
 
 import numpy as np
 
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.core.coordinates import check_positions, is_real
 from pbp_drake.core.intent_filter import NO_BEARING, IntentFilterSettings
-from pbp_drake.core.methods import did_you_mean
 
 #: `Estimator.reads`: the hand's position and heading (`GoalEstimator`, any task) ...
 READS_POSITION = "position"
@@ -256,8 +256,7 @@ def register_estimator(estimator):
 def estimator_entry(name):
     """The `Estimator` called `name`; ValueError naming the choices and the nearest one."""
     if name not in ESTIMATORS:
-        raise ValueError(f"goal estimation method {name!r} is unknown; choose one of "
-                         f"{tuple(ESTIMATORS)}{did_you_mean(name, ESTIMATORS)}")
+        raise ValueError(unknown_choice("goal estimation method", name, ESTIMATORS))
     return ESTIMATORS[name]
 
 

@@ -15,6 +15,7 @@ import typing
 import numpy as np
 
 from pbp_drake.core import quaternion
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.core.coordinates import is_real
 
 # Below this (m, rad) the hand is at a target: no direction to it.
@@ -403,7 +404,7 @@ ASSISTANCE_WEIGHTS = {
 def check_assistance(name):
     """Raises ValueError unless `name` is one of `ASSISTANCE_WEIGHTS`."""
     if name not in ASSISTANCE_WEIGHTS:
-        raise ValueError(f"method {name!r} is unknown; choose one of {tuple(ASSISTANCE_WEIGHTS)}")
+        raise ValueError(unknown_choice("method", name, ASSISTANCE_WEIGHTS))
 
 
 class AssistedCommand(typing.NamedTuple):

@@ -4,10 +4,10 @@ Every layer reads a method's `Method` entry in `METHODS`; none compares its name
 """
 
 import dataclasses
-import difflib
 import typing
 
 from pbp_drake.core.arbitration import BLEND_LAWS
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.core.hindsight_optimization import ASSISTANCE_WEIGHTS
 
 
@@ -121,23 +121,11 @@ def register_method(method):
     return method
 
 
-def method_names():
-    """The registered names, in registry order, as a message lists them ("a, b, c")."""
-    return ", ".join(METHODS)
-
-
-def did_you_mean(name, choices):
-    """` (did you mean 'x'?)` when one of `choices` is close to `name`, else ``."""
-    matches = difflib.get_close_matches(str(name), list(choices), n=1)
-    return f" (did you mean {matches[0]!r}?)" if matches else ""
-
-
 def method_entry(name, field="method"):
     """The `Method` called `name`; ValueError naming `field`, the choices and the nearest
     one for an unknown name."""
     if name not in METHODS:
-        raise ValueError(f"{field} {name!r} is unknown; choose one of {method_names()}"
-                         f"{did_you_mean(name, METHODS)}")
+        raise ValueError(unknown_choice(field, name, METHODS))
     return METHODS[name]
 
 

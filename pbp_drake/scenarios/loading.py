@@ -13,7 +13,7 @@ import typing
 
 import numpy as np
 
-from pbp_drake.core.methods import did_you_mean
+from pbp_drake.core.choices import did_you_mean
 from pbp_drake.scenarios.bounds import (
     check_yaml_bounds, is_special_file, load_document, load_typed, read_bounded)
 from pbp_drake.scenarios.overrides import ScenarioOverrides, merged

@@ -8,7 +8,7 @@ import copy
 import dataclasses
 
 from pbp_drake.core.participant_params import VirtualParticipantParams
-from pbp_drake.core.methods import did_you_mean
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.scenarios.schema import (
     LaggyPilot, NoisyPilot, ParticipantPopulation, ProportionalPilot, ScenarioError,
     VirtualParticipant)
@@ -41,8 +41,7 @@ def participant_params(participant):
 def check_pilot_name(name, field="pilot"):
     """Raises ScenarioError unless `name` is one of PILOT_NAMES (with did-you-mean)."""
     if name not in PILOT_NAMES:
-        raise ScenarioError(f"{field} {name!r} is unknown; choose one of "
-                            f"{', '.join(PILOT_NAMES)}{did_you_mean(name, PILOT_NAMES)}")
+        raise ScenarioError(unknown_choice(field, name, PILOT_NAMES))
 
 
 def with_pilot(scenario, name):

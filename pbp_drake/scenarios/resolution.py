@@ -21,7 +21,8 @@ from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
 from pbp_drake.core.dmp.primitive import SETTINGS_FIELDS, read_primitive_document
 from pbp_drake.core.goal_estimation import READS_INTENT, READS_POSE, estimator_entry
-from pbp_drake.core.methods import METHODS, did_you_mean, method_entry, method_names
+from pbp_drake.core.choices import did_you_mean
+from pbp_drake.core.methods import METHODS, method_entry
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
@@ -135,7 +136,7 @@ def parse_method_label(label):
     renamed_method(name)
     weighted = " or ".join(f"{m}=A" for m, method in METHODS.items() if method.takes_weight)
     if name not in METHODS:
-        raise ScenarioError(f"method {label!r} is unknown; choose from {method_names()} or "
+        raise ScenarioError(f"method {label!r} is unknown; choose from {', '.join(METHODS)} or "
                             f"{weighted}{did_you_mean(name, METHODS)}")
     if not equals:
         return name, None

@@ -112,7 +112,7 @@ class _ConstantOperator:
 
 
 @pytest.mark.parametrize("change, message", [
-    ({"method": "driving"}, "method 'driving' is not one of"),
+    ({"method": "driving"}, "method 'driving' is unknown; choose one of pbp_alternated, "),
     ({"control_period": 0.0}, "control_period must be finite and positive"),
     ({"hand_over": HandOverSettings(max_hand_speed=-1.0)},
      "hand_over.max_hand_speed must be finite and positive"),

@@ -168,8 +168,8 @@ def test_vectorised_equals_a_loop_over_ten_thousand_goals(method):
 
 
 @pytest.mark.parametrize("field, value, message", [
-    ("method", "closest", "unknown; choose one of ('angle', 'nearest', 'bayesian', 'pose', "
-                          "'maxent_command', 'intent_filter')"),
+    ("method", "closest", "unknown; choose one of angle, nearest, bayesian, pose, "
+                          "maxent_command, intent_filter"),
     ("temperature", 0.0, "temperature must be a positive"),
     ("temperature", -1.0, "temperature must be a positive"),
     ("temperature", float("nan"), "temperature must be a positive"),

@@ -13,6 +13,7 @@ import numbers
 
 import numpy as np
 
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.core.linear import second_order_step
 
 FORMULATIONS = ("ijspeert", "pastor")
@@ -51,9 +52,7 @@ class DmpSettings:
         """Raises ValueError naming the first field that cannot be used (a YAML loader sets
         the fields after construction, so `resolve` calls this again)."""
         if self.formulation not in FORMULATIONS:
-            raise ValueError(
-                f"formulation {self.formulation!r} is unknown; choose one of {FORMULATIONS}"
-            )
+            raise ValueError(unknown_choice("formulation", self.formulation, FORMULATIONS))
         count = self.basis_count
         if isinstance(count, bool) or not (isinstance(count, numbers.Real)
                                            and math.isfinite(count) and int(count) == count):

@@ -171,7 +171,8 @@ class TaskResult:
             monitor's ticks). None when unknown (a TaskResult made without them).
         joints_at_limits: the names of the robot's joints standing at a position limit
             when the run ended (`robots.station_parts.joints_at_limits`): where a hand
-            that stopped short is held. None without a simulated robot (the bridge's).
+            that stopped short is held. None without a simulated robot (the bridge's)
+            and in a trial read back from its files, which do not hold it.
     """
 
     success: bool

@@ -127,7 +127,11 @@ def test_the_time_series_read_back_equals_the_task_result(studies, scenario):
     one, _ = studies
     direct = run_task(dataclasses.replace(scenario, method="teleop", seed=6))
     loaded = load_task_result(one, "teleop", 6)
+    # Read off the robot when a run ends, for its failure line; trial files do not hold it.
+    assert direct.joints_at_limits == [] and loaded.joints_at_limits is None
     for field in dataclasses.fields(TaskResult):
+        if field.name == "joints_at_limits":
+            continue
         expected, actual = getattr(direct, field.name), getattr(loaded, field.name)
         if isinstance(expected, np.ndarray):
             np.testing.assert_array_equal(actual, expected, err_msg=field.name)

@@ -24,8 +24,6 @@ _PRODUCT_TERMS = (
     ((0, 2, 1), (1, 3, -1), (2, 0, 1), (3, 1, 1)),
     ((0, 3, 1), (1, 2, 1), (2, 1, -1), (3, 0, 1)),
 )
-_CONJUGATION = np.diag([1.0, -1.0, -1.0, -1.0])
-_CONJUGATION.setflags(write=False)
 
 
 class OrientationWorkspace:
@@ -97,39 +95,32 @@ class OrientationWorkspace:
         return self.new_log_state[1]
 
 
-def left_product_matrix(quaternion):
-    """The 4x4 `L(p)` with `p q = L(p) q`, for one quaternion `(4,)` or `(4, 1)`."""
-    w, x, y, z = np.asarray(quaternion, dtype=float).reshape(4)
-    return np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]])
+def conjugate_product_rows(orientation):
+    """The rows (4 lists of 4 numbers) of the matrix `A` with `A g = q g*`, for one
+    orientation `(4, 1)`: `L(q) diag(1, -1, -1, -1)`, `L(q)`'s columns 1-3 negated."""
+    w, x, y, z = orientation[:, 0].tolist()
+    return [[w, x, y, z], [x, -w, z, -y], [y, -z, -w, x], [z, y, -x, -w]]
 
 
 def error_quaternions_into(orientations, goals, out, row):
     """`out = q g*` (4, K) for orientations `(4, 1)` (one BLAS product) or `(4, K)`."""
     if orientations.shape[1] == 1:
-        np.dot(left_product_matrix(orientations) @ _CONJUGATION, goals, out=out)
+        np.dot(np.array(conjugate_product_rows(orientations)), goals, out=out)
         return
-    for target, terms in zip(out, _PRODUCT_TERMS):
-        for position, (left, right, sign) in enumerate(terms):
-            # The conjugate of g flips the sign of its vector part (right index > 0).
-            sign = sign if right == 0 else -sign
-            if position == 0:
-                np.multiply(orientations[left], goals[right], out=target)
-                if sign < 0:
-                    np.negative(target, out=target)
-                continue
-            np.multiply(orientations[left], goals[right], out=row)
-            if sign > 0:
-                target += row
-            else:
-                target -= row
+    product_into(orientations, goals, out, row, conjugate_right=True)
 
 
-def product_into(left, right, out, row):
-    """`out = left right`, Hamilton's product of `(4, K)` arrays (`out` neither of them)."""
+def product_into(left, right, out, row, conjugate_right=False):
+    """`out = left right`, Hamilton's product of `(4, K)` arrays (`out` neither of them);
+    with `conjugate_right`, `left right*`."""
     for target, terms in zip(out, _PRODUCT_TERMS):
         for position, (i, j, sign) in enumerate(terms):
+            # The conjugate flips the sign of the vector part (j > 0).
+            sign = -sign if conjugate_right and j > 0 else sign
             if position == 0:
-                np.multiply(left[i], right[j], out=target)  # every row's first term is +
+                np.multiply(left[i], right[j], out=target)
+                if sign < 0:
+                    np.negative(target, out=target)
                 continue
             np.multiply(left[i], right[j], out=row)
             if sign > 0:

@@ -13,7 +13,8 @@ import functools
 
 import numpy as np
 
-from pbp_drake.core.dmp.orientation_kernels import SMALLEST, hemisphere_signs_into
+from pbp_drake.core.dmp.orientation_kernels import (
+    SMALLEST, conjugate_product_rows, hemisphere_signs_into)
 from pbp_drake.core.quaternion import SERIES_BELOW
 
 # The squared half angle below which `c` and `p` come from their series (the angle below
@@ -28,10 +29,9 @@ def error_matrix(orientation, eta):
     measured orientation `(4, 1)` and velocity `(3, 1)`."""
     w, x, y, z = orientation[:, 0].tolist()
     a, b, c = eta[:, 0].tolist()
-    # q g* = L(q) diag(1, -1, -1, -1) g: L(q)'s columns 1-3 negated.
-    return np.array([[w, x, y, z], [x, -w, z, -y], [y, -z, -w, x], [z, y, -x, -w],
-                     [a * x + b * y + c * z, -a * w - b * z + c * y,
-                      a * z - b * w - c * x, -a * y + b * x - c * w]])
+    return np.array(conjugate_product_rows(orientation) + [
+        [a * x + b * y + c * z, -a * w - b * z + c * y, a * z - b * w - c * x,
+         -a * y + b * x - c * w]])
 
 
 def forcing_rows(shapes, lam, ijspeert, workspace):

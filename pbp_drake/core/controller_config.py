@@ -18,8 +18,7 @@ from pbp_drake.core.dmp.primitive import Primitive, primitive_bank
 from pbp_drake.core.goal_estimation import READS_POSE, GoalEstimatorSettings, estimator_entry
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.hindsight_optimization import HopSettings
-from pbp_drake.core.choices import unknown_choice
-from pbp_drake.core.methods import METHODS, method_entry
+from pbp_drake.core.methods import method_entry
 
 
 @dataclasses.dataclass
@@ -126,8 +125,7 @@ class PbpControllerConfig(ControlSettings):
 
     def validate(self):
         """Raises ValueError naming the first field that cannot be used."""
-        if self.method not in METHODS:
-            raise ValueError(unknown_choice("method", self.method, METHODS))
+        method_entry(self.method)
         self.validate_settings()
         check_limit(self.nominal_speed, "nominal_speed", "m/s")
         if not isinstance(self.hand_over, HandOverSettings):

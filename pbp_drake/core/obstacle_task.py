@@ -42,12 +42,12 @@ def sample_obstacle_scene(seed, x_range=(1.25, 2.5), y_range=(-1.05, 1.05), heig
         else:
             raise ValueError(f"cannot draw a target {clearance} m from every obstacle in x "
                              f"{list(x_range)}, y {list(y_range)}")
-        thresholds = np.sort(rng.uniform(*activation_range, size=len(starts)))
-        return ObstacleScene(target=target, obstacle_starts=starts, thresholds=thresholds)
-    starts = spread_points(rng, obstacle_count, obstacle_x_range, obstacle_y_range, clearance,
-                           "obstacles", keep_away=[np.asarray(robot_xy, float), target[:2]],
-                           apart="from the robot, the target and each other")
-    thresholds = np.sort(rng.uniform(*activation_range, size=obstacle_count))
+    else:
+        starts = spread_points(
+            rng, obstacle_count, obstacle_x_range, obstacle_y_range, clearance, "obstacles",
+            keep_away=[np.asarray(robot_xy, float), target[:2]],
+            apart="from the robot, the target and each other")
+    thresholds = np.sort(rng.uniform(*activation_range, size=len(starts)))
     return ObstacleScene(target=target, obstacle_starts=starts, thresholds=thresholds)
 
 

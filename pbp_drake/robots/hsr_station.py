@@ -144,16 +144,11 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
         - in_collision (with config.obstacles)
         - clearance (with config.obstacles)
 
-    ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``); ``ee_state`` is
-    ``[p (3), v (3), heading, heading_rate]`` (``EeState``) of the hand in the world.
-    ``pose_command`` and ``hand_pose`` are ``PoseState`` of ``hand_palm_link``
-    (``PoseCommandRamp``, ``PoseStateFromPlant``); a NaN field or a non-unit quaternion is
-    refused by name. ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]``
-    the plant's PD tracks, in motor order (``ACTUATED_JOINT_NAMES``); ``body_poses`` (not
-    with ``motion: kinematic``, whose plant is outside the Diagram: ``hsr_station_plant``)
-    and ``query_object`` are the plant's and SceneGraph's. ``obstacle_positions`` is
-    ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the smallest
-    robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
+    The ports' sizes and contents: docs/tasks/hsr-station.md, "Ports" (``desired_state``
+    in motor order, ``ACTUATED_JOINT_NAMES``; no ``body_poses`` with ``motion: kinematic``,
+    whose plant is outside the Diagram: ``hsr_station_plant``); the pose station's
+    (``PoseCommandRamp``, ``PoseStateFromPlant``): docs/concepts/six-dof.md, "The HSR pose
+    station".
 
     A fresh context starts at rest in the ready pose with the diff IK already there, so
     holding ``hsr_initial_ee_state(station)[:7]`` keeps the robot still.

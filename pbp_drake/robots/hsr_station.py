@@ -58,12 +58,10 @@ def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
     so a wrist flex of ``-pi/2 - arm_flex`` levels the hand; the lift then adds height
     one to one.
     """
-    context = plant.CreateDefaultContext()
+    q = plant.GetDefaultPositions()
 
     def set_position(name, value):
-        q = plant.GetPositions(context)
         q[plant.GetJointByName(name, model).position_start()] = value
-        plant.SetPositions(context, q)
 
     for name, value in zip(BASE_JOINT_NAMES, initial_base):
         joint = plant.GetJointByName(name, model)
@@ -74,13 +72,13 @@ def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
     set_position("wrist_flex_joint", -np.pi / 2 - READY_ARM_FLEX)
     ee = plant.GetFrameByName(END_EFFECTOR_FRAME, model)
     arm_lift = plant.GetJointByName("arm_lift_joint", model)
-    lift = ee_height - ee.CalcPoseInWorld(context).translation()[2]
+    lift = ee_height - pose_at(plant, ee, q).translation()[2]
     if not arm_lift.position_lower_limits()[0] <= lift <= arm_lift.position_upper_limits()[0]:
         raise ValueError(f"ee_height {ee_height} m is out of the arm lift's range")
     set_position("arm_lift_joint", lift)
     # Keep the torso coupler satisfied from the start, or SAP would snap it at t = 0.
     set_position(TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO * lift)
-    return plant.GetPositions(context)
+    return q
 
 
 def _ready_pose(plant, model, config, frame_name=END_EFFECTOR_FRAME):

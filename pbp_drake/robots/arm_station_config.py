@@ -169,7 +169,7 @@ def validate_arm_station_config(config: ArmStationConfig) -> None:
     check_config_type(config, ArmStationConfig)
     check_field_types(config, "ArmStationConfig")
     for name in ("model_file", "base_frame", "ee_frame"):
-        if not isinstance(getattr(config, name), str) or not getattr(config, name):
+        if not getattr(config, name):  # a string: check_field_types
             raise ValueError(f"ArmStationConfig.{name} is needed (a non-empty string)")
     validate_station(config, "ArmStationConfig")
     if len(config.base_pose) != 4 or not np.all(np.isfinite(config.base_pose)):

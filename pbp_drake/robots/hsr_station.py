@@ -58,12 +58,10 @@ def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
     so a wrist flex of ``-pi/2 - arm_flex`` levels the hand; the lift then adds height
     one to one.
     """
-    context = plant.CreateDefaultContext()
+    q = plant.GetDefaultPositions()
 
     def set_position(name, value):
-        q = plant.GetPositions(context)
         q[plant.GetJointByName(name, model).position_start()] = value
-        plant.SetPositions(context, q)
 
     for name, value in zip(BASE_JOINT_NAMES, initial_base):
         joint = plant.GetJointByName(name, model)
@@ -74,13 +72,13 @@ def ready_positions(plant, model, initial_base=(0.0, 0.0, 0.0), ee_height=0.7):
     set_position("wrist_flex_joint", -np.pi / 2 - READY_ARM_FLEX)
     ee = plant.GetFrameByName(END_EFFECTOR_FRAME, model)
     arm_lift = plant.GetJointByName("arm_lift_joint", model)
-    lift = ee_height - ee.CalcPoseInWorld(context).translation()[2]
+    lift = ee_height - pose_at(plant, ee, q).translation()[2]
     if not arm_lift.position_lower_limits()[0] <= lift <= arm_lift.position_upper_limits()[0]:
         raise ValueError(f"ee_height {ee_height} m is out of the arm lift's range")
     set_position("arm_lift_joint", lift)
     # Keep the torso coupler satisfied from the start, or SAP would snap it at t = 0.
     set_position(TORSO_JOINT_NAME, TORSO_TO_ARM_LIFT_RATIO * lift)
-    return plant.GetPositions(context)
+    return q
 
 
 def _ready_pose(plant, model, config, frame_name=END_EFFECTOR_FRAME):
@@ -144,16 +142,11 @@ def make_hsr_station(config: HsrStationConfig | None = None, meshcat=None,
         - in_collision (with config.obstacles)
         - clearance (with config.obstacles)
 
-    ``ee_command`` is ``[p (3), v (3), heading]`` (``EeCommand``); ``ee_state`` is
-    ``[p (3), v (3), heading, heading_rate]`` (``EeState``) of the hand in the world.
-    ``pose_command`` and ``hand_pose`` are ``PoseState`` of ``hand_palm_link``
-    (``PoseCommandRamp``, ``PoseStateFromPlant``); a NaN field or a non-unit quaternion is
-    refused by name. ``state`` is the plant's state; ``desired_state`` the ``[q_d, v_d]``
-    the plant's PD tracks, in motor order (``ACTUATED_JOINT_NAMES``); ``body_poses`` (not
-    with ``motion: kinematic``, whose plant is outside the Diagram: ``hsr_station_plant``)
-    and ``query_object`` are the plant's and SceneGraph's. ``obstacle_positions`` is
-    ``(N, 3)`` flattened, the centres of ``config.obstacles``; ``clearance`` is the smallest
-    robot-obstacle signed distance (m), ``in_collision`` 1 when it is negative.
+    The ports' sizes and contents: docs/tasks/hsr-station.md, "Ports" (``desired_state``
+    in motor order, ``ACTUATED_JOINT_NAMES``; no ``body_poses`` with ``motion: kinematic``,
+    whose plant is outside the Diagram: ``hsr_station_plant``); the pose station's
+    (``PoseCommandRamp``, ``PoseStateFromPlant``): docs/concepts/six-dof.md, "The HSR pose
+    station".
 
     A fresh context starts at rest in the ready pose with the diff IK already there, so
     holding ``hsr_initial_ee_state(station)[:7]`` keeps the robot still.

@@ -72,8 +72,7 @@ class XmlElement:
         return [child for child in self.children if child.tag == tag]
 
     def find(self, tag):
-        found = self.find_all(tag)
-        return found[0] if found else None
+        return next((child for child in self.children if child.tag == tag), None)
 
     def walk(self):
         """This element and all below it, in document order (no recursion: a file may
@@ -304,13 +303,11 @@ def links_and_joints(model):
     for element in model.root.children:
         if element.tag not in ("joint", "drake:joint"):
             continue
+        ends = (element.find("parent"), element.find("child"))
         if model.kind == "urdf":
-            parent, child = (element.find(tag) for tag in ("parent", "child"))
-            parent = parent.attrib.get("link", "") if parent is not None else ""
-            child = child.attrib.get("link", "") if child is not None else ""
+            parent, child = (end.attrib.get("link", "") if end is not None else "" for end in ends)
         else:
-            parent, child = ((element.find(tag).text.strip() if element.find(tag) is not None
-                              else "") for tag in ("parent", "child"))
+            parent, child = (end.text.strip() if end is not None else "" for end in ends)
         joints.append(_Joint(element.attrib.get("name", ""), element.attrib.get("type", ""),
                              parent, child, element))
     return links, joints

@@ -8,6 +8,7 @@ import dataclasses
 import math
 
 import numpy as np
+from pydrake.math import RigidTransform, RollPitchYaw
 
 from pbp_drake.robots.model_checks import (
     FIXED_JOINT_TYPES, check_model_file, links_and_joints, original_text, printable)
@@ -33,20 +34,10 @@ class Shape:
         return f"a sphere of radius {self.size[0]:g} m"
 
 
-def _rotation(roll, pitch, yaw):
-    """URDF's and SDFormat's rpy: about the fixed x, then y, then z axes."""
-    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch),
-                              math.sin(pitch), math.cos(yaw), math.sin(yaw))
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
-
-
 def _pose(xyz, rpy):
-    pose = np.eye(4)
-    pose[:3, :3] = _rotation(*rpy)
-    pose[:3, 3] = xyz
-    return pose
+    """The 4x4 pose of URDF's and SDFormat's `xyz` and `rpy` (about the fixed x, then y,
+    then z axes: Drake's RollPitchYaw)."""
+    return RigidTransform(RollPitchYaw(rpy), xyz).GetAsMatrix4()
 
 
 def _floats(text, count):

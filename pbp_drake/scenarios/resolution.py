@@ -113,16 +113,6 @@ def resolve(scenario):
                             f"not {type(scenario).__name__}")
     _check_operator(scenario)
     _check_common(scenario)
-    if scenario.goal_estimator.group_mass > 0.0 and not isinstance(scenario, TaskScenario):
-        raise ScenarioError("scenario.goal_estimator.group_mass: goal groups steer the "
-                            "DMPs of the robot tasks (reach, obstacles, grasp; HSR and arm); "
-                            "this scenario has a point robot: set it to 0")
-    if estimator_entry(scenario.goal_estimator.method).reads == READS_INTENT and (
-            not isinstance(scenario, TaskScenario)):
-        raise ScenarioError("scenario.goal_estimator.method intent_filter reads the hand's "
-                            "pose and the operator's command in the robot tasks (reach, "
-                            "obstacles, grasp; HSR and arm); this scenario has a point robot: "
-                            "use angle in the 2-D scenes")
     if isinstance(scenario, TaskScenario):
         return _resolve_task_robot(scenario)
     return _resolve_point_robot(scenario)
@@ -248,6 +238,15 @@ def _check_point_robot(robot):
 
 
 def _resolve_point_robot(scenario):
+    if scenario.goal_estimator.group_mass > 0.0:
+        raise ScenarioError("scenario.goal_estimator.group_mass: goal groups steer the "
+                            "DMPs of the robot tasks (reach, obstacles, grasp; HSR and arm); "
+                            "this scenario has a point robot: set it to 0")
+    if estimator_entry(scenario.goal_estimator.method).reads == READS_INTENT:
+        raise ScenarioError("scenario.goal_estimator.method intent_filter reads the hand's "
+                            "pose and the operator's command in the robot tasks (reach, "
+                            "obstacles, grasp; HSR and arm); this scenario has a point robot: "
+                            "use angle in the 2-D scenes")
     _check_point_robot(scenario.robot)
     if scenario.dmp.primitive:
         raise ScenarioError("scenario.dmp.primitive gives a robot task's DMPs a taught shape; "

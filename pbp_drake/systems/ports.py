@@ -37,11 +37,6 @@ def position_of(view):
     return np.array([view.x, view.y, view.z])
 
 
-def checked_goal_count(goal_count):
-    """`goal_count` as an int; ValueError unless it is an integer >= 1."""
-    return checked_count(goal_count, "goal_count")
-
-
 def checked_count(value, name):
     """`value` as an int; ValueError, naming it `name`, unless it is an integer >= 1."""
     if not is_whole(value, 1):

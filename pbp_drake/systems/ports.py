@@ -44,6 +44,16 @@ def checked_count(value, name):
     return int(value)
 
 
+def checked_objects(objects, name="objects"):
+    """`objects` as a float array; ValueError, naming it `name`, unless non-empty finite (M, 3)."""
+    objects = np.asarray(objects, dtype=float)
+    if (objects.ndim != 2 or objects.shape[0] == 0 or objects.shape[1] != 3
+            or not np.isfinite(objects).all()):
+        raise ValueError(f"{name} must be a non-empty finite (M, 3) array, got shape "
+                         f"{objects.shape}")
+    return objects
+
+
 def checked_settings(settings, kind):
     """A private copy of `settings`; ValueError unless it is a `kind` whose `validate`
     passes (a plain dataclass: its fields may have changed since construction)."""

@@ -19,7 +19,8 @@ from pbp_drake.core.participant_serving import (
     NO_INTENT, SERVING_MEMORY_SIZE, ServingMemory, robot_pulls, serving_step,
     update_own_motion)
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
-from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
+from pbp_drake.systems.ports import (
+    EeState, OperatorCommand, Target, checked_objects, position_of)
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 
@@ -85,11 +86,7 @@ class VirtualOperator(SampledOperator):
                              f"got {heading_range!r}")
         self._heading_range = None if heading_range is None else tuple(
             float(bound) for bound in heading_range)
-        self._objects = np.asarray(objects, dtype=float)
-        if (self._objects.ndim != 2 or self._objects.shape[0] == 0
-                or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
-            raise ValueError(f"objects must be a non-empty finite (M, 3) array, got shape "
-                             f"{self._objects.shape}")
+        self._objects = checked_objects(objects)
         if not is_whole(seed):
             raise ValueError(f"seed must be a whole number >= 0, got {seed!r}")
         self.params = copy.deepcopy(params)

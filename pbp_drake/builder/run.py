@@ -288,17 +288,19 @@ def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=N
     # The task monitor itself ends the simulation at success.
     (advance or advance_to)(simulator, (ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()
-    status, monitor = final_status(diagram, context)
-    return dataclasses.replace(
-        _read_result(diagram, context, status, monitor, scenario.control_period),
-        joints_at_limits=final_joints_at_limits(diagram, context))
-
-
-def final_status(diagram, context):
-    """`(TaskStatus, task monitor)` of a task's diagram once its simulation has ended."""
-    monitor = diagram.GetSubsystemByName("task_monitor")
-    return TaskStatus(monitor.get_task_status_output_port().Eval(
-        monitor.GetMyContextFromRoot(context))), monitor
+    state_log = state_log_name(diagram)
+    # The last sample holds only the decisions of the tick before it (see read_log).
+    tick_count = diagram.GetSubsystemByName(state_log).FindLog(context).num_samples() - 1
+    times, state = read_log(diagram, context, state_log, tick_count)
+    in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
+    decisions = {name: read_log(diagram, context, name, tick_count, shift=DECISION_LOG_SHIFT)[1]
+                 for name in DECISION_LOGS}
+    series = task_series(diagram, times, state, in_collision, decisions)
+    peaks = SeriesPeaks(scenario.control_period)
+    peaks.add(series)
+    peaks.add_clipped(read_log(diagram, context, "posterior_clipped_log", tick_count,
+                               shift=DECISION_LOG_SHIFT)[1])
+    return peaks.task_result(diagram, context, series)
 
 
 def final_joints_at_limits(diagram, context):
@@ -318,22 +320,6 @@ DECISION_LOGS = ("command_log", "operator_active_log", "operator_command_log",
 # The decision loggers only some controllers have (HOP's posterior), read as those above.
 OPTIONAL_DECISION_LOGS = ("posterior_clipped_log",)
 STATE_LOGS = ("ee_state_log", "in_collision_log")
-
-
-def _read_result(diagram, context, status, monitor, control_period):
-    state_log = state_log_name(diagram)
-    # The last sample holds only the decisions of the tick before it (see read_log).
-    tick_count = diagram.GetSubsystemByName(state_log).FindLog(context).num_samples() - 1
-    times, state = read_log(diagram, context, state_log, tick_count)
-    in_collision = read_log(diagram, context, "in_collision_log", tick_count)[1]
-    decisions = {name: read_log(diagram, context, name, tick_count, shift=DECISION_LOG_SHIFT)[1]
-                 for name in DECISION_LOGS}
-    series = task_series(diagram, times, state, in_collision, decisions)
-    peaks = SeriesPeaks(control_period)
-    peaks.add(series)
-    peaks.add_clipped(read_log(diagram, context, "posterior_clipped_log", tick_count,
-                               shift=DECISION_LOG_SHIFT)[1])
-    return peaks.task_result(status, monitor, series)
 
 
 def state_log_name(diagram):
@@ -391,8 +377,12 @@ class SeriesPeaks:
         self._clipped_ticks = (self._clipped_ticks or 0) + int(flags.sum())
         self._posterior_ticks = (self._posterior_ticks or 0) + len(flags)
 
-    def task_result(self, status, monitor, series):
-        """The run's TaskResult holding `series` and the peaks fed."""
+    def task_result(self, diagram, context, series):
+        """The TaskResult of the run of `diagram` ended in `context`: its task monitor's
+        status, its station's `joints_at_limits`, `series` and the peaks fed."""
+        monitor = diagram.GetSubsystemByName("task_monitor")
+        status = TaskStatus(monitor.get_task_status_output_port().Eval(
+            monitor.GetMyContextFromRoot(context)))
         if self._grasp:
             series = dict(series, peak_command_angular_change=self._turning.peak(1.0),
                           final_angle_to_target=self._final_angle)
@@ -409,6 +399,7 @@ class SeriesPeaks:
             peak_hand_speed=self._hand.peak(self._period),
             peak_command_acceleration=self._command.peak(self._period),
             idle_ratio=idle_ratio(status.intervention_ratio),
+            joints_at_limits=final_joints_at_limits(diagram, context),
             **series, **self._interaction.metrics().fields())
 
 

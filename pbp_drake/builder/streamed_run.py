@@ -5,15 +5,12 @@ is cleared; the peaks (`run.SeriesPeaks`) carry over. A chunk's last state sampl
 for its decisions (`DECISION_LOG_SHIFT`) in the next chunk; the run's last is not written.
 """
 
-import dataclasses
-
 import numpy as np
 from pydrake.systems.primitives import VectorLogSink
 
 from pbp_drake.builder.run import (
     DECISION_LOGS, OPTIONAL_DECISION_LOGS, STATE_LOGS, SeriesPeaks, advance_to,
-    final_joints_at_limits, final_status, initialized_simulator, state_log_name, task_series,
-    ticks_of)
+    initialized_simulator, state_log_name, task_series, ticks_of)
 from pbp_drake.builder.time_series import time_series_header, time_series_rows
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
 
@@ -51,9 +48,7 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
                 after_chunk(context.get_time())
             if tick == last_tick or ended:
                 break
-    status, monitor = final_status(diagram, context)
-    return dataclasses.replace(peaks.task_result(status, monitor, tail.empty_series()),
-                               joints_at_limits=final_joints_at_limits(diagram, context))
+    return peaks.task_result(diagram, context, tail.empty_series())
 
 
 class _Series:

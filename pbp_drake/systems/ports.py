@@ -37,16 +37,21 @@ def position_of(view):
     return np.array([view.x, view.y, view.z])
 
 
-def checked_goal_count(goal_count):
-    """`goal_count` as an int; ValueError unless it is an integer >= 1."""
-    return checked_count(goal_count, "goal_count")
-
-
 def checked_count(value, name):
     """`value` as an int; ValueError, naming it `name`, unless it is an integer >= 1."""
     if not is_whole(value, 1):
         raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
     return int(value)
+
+
+def checked_objects(objects, name="objects"):
+    """`objects` as a float array; ValueError, naming it `name`, unless non-empty finite (M, 3)."""
+    objects = np.asarray(objects, dtype=float)
+    if (objects.ndim != 2 or objects.shape[0] == 0 or objects.shape[1] != 3
+            or not np.isfinite(objects).all()):
+        raise ValueError(f"{name} must be a non-empty finite (M, 3) array, got shape "
+                         f"{objects.shape}")
+    return objects
 
 
 def checked_settings(settings, kind):

@@ -3,15 +3,13 @@
 import numpy as np
 
 from pbp_drake.core.participant_grasp import GraspParticipant, ParticipantMemory
-from pbp_drake.core.participant_impairment import (
-    delay_ticks, initial_motor_noise, is_noisy, next_motor_noise)
-from pbp_drake.core.participant_serving import (
-    SERVING_MEMORY_SIZE, ServingMemory, update_own_motion)
+from pbp_drake.core.participant_impairment import delay_ticks
+from pbp_drake.core.participant_serving import ServingMemory
+from pbp_drake.systems.operators.virtual_operator import ParticipantOperator
 from pbp_drake.systems.ports import OperatorTwist, PoseState, Target
-from pbp_drake.systems.operators.sampled_operator import SampledOperator
 
 
-class PoseVirtualOperator(SampledOperator):
+class PoseVirtualOperator(ParticipantOperator):
     """Stands in for a person in the grasping task: a thin wrapper of
     `pbp_drake.core.participant_grasp.GraspParticipant.step`.
 
@@ -42,16 +40,10 @@ class PoseVirtualOperator(SampledOperator):
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._forward_key_port = self.DeclareVectorInputPort("forward_key", 1)
-        # `participant_serving.ServingMemory`, and the robot's own motion as it senses it.
-        self._serving_index = self.DeclareDiscreteState(np.zeros(SERVING_MEMORY_SIZE))
-        self._own_motion_index = self.DeclareDiscreteState(np.zeros(3))
         self._memory_index = self.DeclareDiscreteState(np.array(ParticipantMemory(),
                                                                 dtype=float))
         impairment = participant.params.impairment
-        self._noisy = is_noisy(impairment)
-        if self._noisy:
-            self._noise_index = self.DeclareDiscreteState(initial_motor_noise(
-                participant.seed, participant.motor_noise_scales))
+        self._declare_participant(impairment, participant.seed, participant.motor_noise_scales)
         self._declare_operator_outputs(delay_ticks(impairment.command_delay, control_period))
 
     @property
@@ -65,22 +57,12 @@ class PoseVirtualOperator(SampledOperator):
         time = context.get_time()
         participant = self._participant
         velocity = hand[7:10]
-        sent = self._held(context)
-        own_motion = update_own_motion(
-            participant.params, self._period,
-            context.get_discrete_state(self._own_motion_index).value(), velocity,
-            sent[:3] if sent[6] > 0.5 else np.zeros(3))
-        discrete_state.set_value(self._own_motion_index, own_motion)
+        own_motion = self._sense_own_motion(context, discrete_state, participant.params,
+                                            velocity)
         serving = ServingMemory.from_vector(
             context.get_discrete_state(self._serving_index).value())
         tick = int(round(time / self._period))
-        noise = None
-        if self._noisy:
-            noise = next_motor_noise(
-                participant.params.impairment, self._period, participant.seed, tick,
-                context.get_discrete_state(self._noise_index).value(),
-                participant.motor_noise_scales)
-            discrete_state.set_value(self._noise_index, noise)
+        noise = self._next_noise(context, discrete_state, tick)
         twist, active, memory, serving = participant.step(
             memory, serving, time, tick, hand[:3], hand[3:7] / np.linalg.norm(hand[3:7]),
             velocity, own_motion, int(Target(self._target_port.Eval(context)).index),

@@ -19,12 +19,50 @@ from pbp_drake.core.participant_serving import (
     NO_INTENT, SERVING_MEMORY_SIZE, ServingMemory, robot_pulls, serving_step,
     update_own_motion)
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
-from pbp_drake.systems.ports import EeState, OperatorCommand, Target, position_of
+from pbp_drake.systems.ports import (
+    EeState, OperatorCommand, Target, checked_objects, position_of)
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.systems.operators.sampled_operator import SampledOperator, operator_speed
 
 
-class VirtualOperator(SampledOperator):
+class ParticipantOperator(SampledOperator):
+    """What the virtual participants (`VirtualOperator`, `PoseVirtualOperator`) share, in
+    discrete state: their `ServingMemory`, the robot's own motion as they sense it
+    (`_sense_own_motion`) and their impairment's motor noise (`_next_noise`)."""
+
+    def _declare_participant(self, impairment, seed, scales):
+        """Declares that state, the motor noise of `impairment` at `scales` (one per axis of
+        the command; `_noise_scales` None when it has none) drawn from `(seed, tick)`."""
+        # `participant_serving.ServingMemory`, and the robot's own motion as it senses it.
+        self._serving_index = self.DeclareDiscreteState(np.zeros(SERVING_MEMORY_SIZE))
+        self._own_motion_index = self.DeclareDiscreteState(np.zeros(3))
+        self._impairment, self._seed = impairment, int(seed)
+        self._noise_scales = scales if is_noisy(impairment) else None
+        if self._noise_scales is not None:
+            self._noise_index = self.DeclareDiscreteState(initial_motor_noise(seed, scales))
+
+    def _sense_own_motion(self, context, discrete_state, params, velocity):
+        """The robot's own motion (3) as it perceives it after this tick, the hand moving at
+        `velocity` (3)."""
+        sent = self._held(context)
+        own = update_own_motion(
+            params, self._period, context.get_discrete_state(self._own_motion_index).value(),
+            velocity, sent[:3] if sent[-1] > 0.5 else np.zeros(3))
+        discrete_state.set_value(self._own_motion_index, own)
+        return own
+
+    def _next_noise(self, context, discrete_state, tick):
+        """The motor noise of control tick `tick`, stored (None without motor noise)."""
+        if self._noise_scales is None:
+            return None
+        noise = next_motor_noise(
+            self._impairment, self._period, self._seed, tick,
+            context.get_discrete_state(self._noise_index).value(), self._noise_scales)
+        discrete_state.set_value(self._noise_index, noise)
+        return noise
+
+
+class VirtualOperator(ParticipantOperator):
     """Sees the true target and the robot, and acts as a person would.
 
     .. pydrake_system::
@@ -85,11 +123,7 @@ class VirtualOperator(SampledOperator):
                              f"got {heading_range!r}")
         self._heading_range = None if heading_range is None else tuple(
             float(bound) for bound in heading_range)
-        self._objects = np.asarray(objects, dtype=float)
-        if (self._objects.ndim != 2 or self._objects.shape[0] == 0
-                or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
-            raise ValueError(f"objects must be a non-empty finite (M, 3) array, got shape "
-                             f"{self._objects.shape}")
+        self._objects = checked_objects(objects)
         if not is_whole(seed):
             raise ValueError(f"seed must be a whole number >= 0, got {seed!r}")
         self.params = copy.deepcopy(params)
@@ -100,13 +134,11 @@ class VirtualOperator(SampledOperator):
         # abs: a file's -0.0 passes the check (>= 0), and NumPy's normal refuses its sign.
         self._direction_noise = abs(float(params.direction_noise))
         self._speed_noise = abs(float(params.speed_noise))
-        self._seed = int(seed)
         self._slow_radius = float(params.slow_radius)
         impairment = params.impairment
         problem = impairment.problem()
         if problem is not None:
             raise ValueError(f"params.impairment.{problem}")
-        self._impairment = impairment
         self._ee_state_port = self.DeclareVectorInputPort("ee_state", EeState.size)
         self._target_port = self.DeclareVectorInputPort("target", Target.size)
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
@@ -129,22 +161,14 @@ class VirtualOperator(SampledOperator):
                 np.zeros(4 + 2 * int(obstacle_count) + WATCH_SIZE))
         # The target index it knows, and how many ticks a different one has been shown.
         self._belief_index = self.DeclareDiscreteState(np.array([-1.0, 0.0]))
-        # `participant_serving.ServingMemory`, and the robot's own motion as it senses it.
-        self._serving_index = self.DeclareDiscreteState(np.zeros(SERVING_MEMORY_SIZE))
-        self._own_motion_index = self.DeclareDiscreteState(np.zeros(3))
         # `_count_insistence`'s [target counted for, ticks facing it, ticks repositioning].
         self._insist_index = self.DeclareDiscreteState(np.array([-1.0, 0.0, 0.0]))
         self._insist_ticks = int(round(params.insist_time / control_period))
         self._reposition_ticks = int(round(params.reposition_time / control_period))
         # The motor noise of `impairment`, [vx, vy, yaw rate] (and vz last when vertical).
-        self._noise_scales = None
-        if is_noisy(impairment):
-            axes = [self._speed, self._speed, self._rotation_speed]
-            if self._vertical:
-                axes.append(self._speed)
-            self._noise_scales = impairment.command_noise * np.array(axes)
-            self._motor_noise_index = self.DeclareDiscreteState(
-                initial_motor_noise(self._seed, self._noise_scales))
+        axes = [self._speed, self._speed, self._rotation_speed] + (
+            [self._speed] if self._vertical else [])
+        self._declare_participant(impairment, seed, impairment.command_noise * np.array(axes))
         # Wrong first choices of target: [targets known so far, the object it heads for
         # instead (-1: none), ticks left before it sees its mistake].
         self._mistakes = impairment.mistake_probability > 0.0
@@ -162,18 +186,6 @@ class VirtualOperator(SampledOperator):
         shown = int(round(self._selected_goal_port.Eval(context)[0]))
         return shown if shown >= 0 else NO_INTENT
 
-    def _perceive(self, context, discrete_state):
-        """The robot's own motion (3) as it perceives it after this tick."""
-        ee_state = EeState(self._ee_state_port.Eval(context))
-        sent = self._held(context)
-        sent_velocity = sent[:3] if sent[4] > 0.5 else np.zeros(3)
-        own = update_own_motion(
-            self.params, self._period,
-            context.get_discrete_state(self._own_motion_index).value(),
-            np.array([ee_state.vx, ee_state.vy, ee_state.vz]), sent_velocity)
-        discrete_state.set_value(self._own_motion_index, own)
-        return own
-
     def _update(self, context, discrete_state):
         # The belief moves first; this tick's command acts on the new belief.
         known, unseen_ticks = context.get_discrete_state(self._belief_index).value()
@@ -186,7 +198,9 @@ class VirtualOperator(SampledOperator):
             if unseen_ticks > self._reaction_ticks:
                 known, unseen_ticks = shown, 0
         discrete_state.set_value(self._belief_index, [known, unseen_ticks])
-        own_motion = self._perceive(context, discrete_state)
+        ee_state = EeState(self._ee_state_port.Eval(context))
+        own_motion = self._sense_own_motion(context, discrete_state, self.params,
+                                            np.array([ee_state.vx, ee_state.vy, ee_state.vz]))
         # A target it has just come to know: it watches the robot afresh.
         serving = (ServingMemory() if known != known_before else ServingMemory.from_vector(
             context.get_discrete_state(self._serving_index).value()))
@@ -223,11 +237,8 @@ class VirtualOperator(SampledOperator):
     def _add_motor_noise(self, context, discrete_state, command, active):
         """The command with this tick's motor noise added while it acts (the noise runs
         every tick, so one seed gives the same noise under every method)."""
-        tick = int(round(context.get_time() / self._period))
-        noise = next_motor_noise(
-            self._impairment, self._period, self._seed, tick,
-            context.get_discrete_state(self._motor_noise_index).value(), self._noise_scales)
-        discrete_state.set_value(self._motor_noise_index, noise)
+        noise = self._next_noise(context, discrete_state,
+                                 int(round(context.get_time() / self._period)))
         if not active:
             return command
         command = np.array(command, dtype=float)

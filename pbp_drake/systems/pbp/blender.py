@@ -8,8 +8,7 @@ from pbp_drake.core.arbitration import (
     BLEND_LAWS, CONFIDENCE_WEIGHT, DEFAULT_ALPHA_MAX, DEFAULT_CONFIDENCE_HIGH,
     DEFAULT_CONFIDENCE_LOW, FIXED_WEIGHT, blend, check_alpha, confidence_alpha,
     validate_confidence_ramp, validate_mode)
-from pbp_drake.systems.ports import (
-    PortGetters, checked_count, checked_goal_count, goal_index)
+from pbp_drake.systems.ports import PortGetters, checked_count, goal_index
 from pbp_drake.systems.tick import checked_period
 
 
@@ -39,7 +38,7 @@ class BlenderBase(PortGetters, LeafSystem):
         self._weight = self._laws[mode].weight
         self._confidence_range = (float(low), float(high))
         self._alpha_max = float(alpha_max)
-        self._goal_count = checked_goal_count(goal_count)
+        self._goal_count = checked_count(goal_count, "goal_count")
         self._period = checked_period(control_period)
         # A Context parameter, not a Python attribute: a live change (set_alpha) then
         # belongs to one Context and invalidates the cached output.

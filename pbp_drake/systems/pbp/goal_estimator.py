@@ -9,7 +9,7 @@ from pbp_drake.core.goal_estimation import (
     NO_CHALLENGER, GoalEstimatorSettings, SelectionMemory, check_hysteresis,
     goal_probabilities, update_selection)
 from pbp_drake.systems.ports import (
-    EeState, PortGetters, checked_goal_count, checked_settings, position_of)
+    EeState, PortGetters, checked_count, checked_settings, position_of)
 from pbp_drake.systems.tick import checked_period, decide_offset
 
 # Layout of the `memory` discrete state group.
@@ -32,7 +32,7 @@ class GoalEstimatorBase(PortGetters, LeafSystem):
     def __init__(self, goal_count, settings, control_period, margin=None, hold_steps=None,
                  memory_size=2):
         super().__init__()
-        k = self._goal_count = checked_goal_count(goal_count)
+        k = self._goal_count = checked_count(goal_count, "goal_count")
         settings = self._settings = checked_settings(settings, self._SETTINGS)
         # Settings without a hysteresis (HOP's, the intent filter's) give None: refused.
         margin = getattr(settings, "margin", None) if margin is None else margin

@@ -9,8 +9,7 @@ from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.goal_estimation import GoalEstimatorSettings
 from pbp_drake.core.goal_groups import NO_GOAL, group_target, pose_group_target
 from pbp_drake.systems.ports import (
-    EeState, GoalPose, PortGetters, PoseState, checked_goal_count, checked_settings,
-    goal_index)
+    EeState, GoalPose, PortGetters, PoseState, checked_count, checked_settings, goal_index)
 from pbp_drake.systems.tick import checked_period, decide_offset
 
 
@@ -43,7 +42,7 @@ class GoalGrouping(PortGetters, LeafSystem):
 
     def __init__(self, goal_count, settings, control_period):
         super().__init__()
-        self._goal_count = k = checked_goal_count(goal_count)
+        self._goal_count = k = checked_count(goal_count, "goal_count")
         width = self._WIDTH
         settings = checked_settings(settings, GoalEstimatorSettings)
         self._settings = (float(settings.group_mass), float(settings.commit_radius),

@@ -6,7 +6,7 @@ from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.hindsight_optimization import (
     HopSettings, assisted_command, check_assistance, hop_targets)
-from pbp_drake.systems.ports import PortGetters, checked_goal_count, checked_settings
+from pbp_drake.systems.ports import PortGetters, checked_count, checked_settings
 from pbp_drake.systems.tick import checked_period
 
 
@@ -19,7 +19,7 @@ class HopAssistanceBase(PortGetters, LeafSystem):
         check_assistance(method)
         self._settings = checked_settings(settings, HopSettings)
         self._method = method
-        self._goal_count = checked_goal_count(goal_count)
+        self._goal_count = checked_count(goal_count, "goal_count")
         self._period = checked_period(control_period)
 
     @property

@@ -3,7 +3,7 @@
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from pbp_drake.systems.ports import PortGetters, checked_count, checked_goal_count, goal_index
+from pbp_drake.systems.ports import PortGetters, checked_count, goal_index
 
 
 def likely_goal_indices(selected, probabilities, count):
@@ -40,7 +40,8 @@ class LikelyGoals(PortGetters, LeafSystem):
 
     def __init__(self, goal_count, count):
         super().__init__()
-        goal_count, count = checked_goal_count(goal_count), checked_count(count, "count")
+        goal_count = checked_count(goal_count, "goal_count")
+        count = checked_count(count, "count")
         if not 1 <= count <= goal_count:
             raise ValueError(f"count must be in [1, {goal_count}] (the goal count), got {count}")
         self._goal_count, self._count = goal_count, count

@@ -10,7 +10,7 @@ from pbp_drake.core.coordinates import vector_length
 from pbp_drake.core.hand_over import check_limit
 from pbp_drake.core.reach_task import reach_progress
 from pbp_drake.systems.ports import (
-    EeState, PortGetters, Target, TaskStatus, finite_fields, position_of)
+    EeState, PortGetters, Target, TaskStatus, checked_objects, finite_fields, position_of)
 from pbp_drake.systems.tick import checked_period, checked_update_offset, report_offset
 
 SUCCESS_MESSAGE = "the target is reached"
@@ -61,11 +61,7 @@ class TaskMonitorBase(PortGetters, LeafSystem):
     def __init__(self, pose_port, pose_size, objects, targets, switch_schedule,
                  control_period, update_offset=None, in_collision_port=False):
         super().__init__()
-        self._objects = np.asarray(objects, dtype=float)
-        if (self._objects.ndim != 2 or self._objects.shape[0] == 0
-                or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
-            raise ValueError(f"{self._objects_name} must be a non-empty finite (M, 3) array, "
-                             f"got shape {self._objects.shape}")
+        self._objects = checked_objects(objects, self._objects_name)
         count = len(self._objects)
         if not all(t in range(count) for t in targets):
             raise ValueError(f"targets must be object indices 0 to {count - 1}, got "

@@ -7,7 +7,7 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import LeafSystem
 
 from pbp_drake.core.scene_framing import workspace_view
-from pbp_drake.systems.ports import EeState, PortGetters, Target, position_of
+from pbp_drake.systems.ports import EeState, PortGetters, Target, checked_objects, position_of
 from pbp_drake.systems.tick import checked_period
 from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots, PathTrail
 
@@ -94,11 +94,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
                  workspace=None, hand_trail=False):
         super().__init__()
         self._meshcat = meshcat
-        self._objects = np.asarray(objects, dtype=float)
-        if (self._objects.ndim != 2 or self._objects.shape[0] == 0
-                or self._objects.shape[1] != 3 or not np.isfinite(self._objects).all()):
-            raise ValueError(f"objects must be a non-empty finite (M, 3) array, got shape "
-                             f"{self._objects.shape}")
+        self._objects = checked_objects(objects)
         checked_period(publish_period, "publish_period")
         self.camera = (behind_the_robot(self._objects) if workspace is None
                        else workspace_view(workspace))

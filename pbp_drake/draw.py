@@ -154,35 +154,33 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if args.output and len(args.scenarios) > 1:
         parser.error("--output takes one scenario")
-    if args.output == "":  # the standard output is '-'
-        print("pbp-drake draw: --output: the path is empty; give a file, e.g. diagram.svg, "
-              "or '-'", file=sys.stderr)
+    try:
+        return _draw(args)
+    except ScenarioError as error:  # a bad file or method, an OutputPathError, no graphviz
+        print(f"pbp-drake draw: {error}", file=sys.stderr)
         return 2
+
+
+def _draw(args):
+    if args.output == "":  # the standard output is '-'
+        raise OutputPathError("--output: the path is empty; give a file, e.g. diagram.svg, "
+                              "or '-'")
     if args.output not in (None, "-") and not args.check:
-        try:
-            check_drawing_path(args.output)
-        except OutputPathError as error:
-            print(f"pbp-drake draw: {error}", file=sys.stderr)
-            return 2
+        check_drawing_path(args.output)
 
     stale = []
     for path in args.scenarios:
-        try:
-            resolved = load_scenario_file(path).resolved
-            if args.method is not None:
-                resolved = resolved.with_method(args.method)
-        except ScenarioError as error:
-            print(f"pbp-drake draw: {error}", file=sys.stderr)
-            return 2
+        resolved = load_scenario_file(path).resolved
+        if args.method is not None:
+            resolved = resolved.with_method(args.method)
         source = dot_source(build_diagram(resolved), args.depth or None)
         if args.format == "dot":
             data = source.encode()
         else:
             try:
                 data = _narrowest(source)
-            except RuntimeError as error:
-                print(f"pbp-drake draw: {error}", file=sys.stderr)
-                return 2
+            except RuntimeError as error:  # graphviz is not installed
+                raise ScenarioError(str(error)) from None
         if args.output == "-":
             sys.stdout.buffer.write(data)
             continue
@@ -192,14 +190,11 @@ def main(argv=None):
                 stale.append(output)
                 print(f"{output} is out of date: run pbp-drake draw {path}", file=sys.stderr)
             continue
+        if args.output is None:  # beside the scenario: not checked before
+            check_drawing_path(output)
         try:
-            if args.output is None:  # beside the scenario: not checked before
-                check_drawing_path(output)
             output.parent.mkdir(parents=True, exist_ok=True)
             output.write_bytes(data)
-        except OutputPathError as error:
-            print(f"pbp-drake draw: {error}", file=sys.stderr)
-            return 2
         except OSError as error:  # a full or read-only disk: was a traceback
             print(f"pbp-drake draw: cannot write {output}: {error.strerror}", file=sys.stderr)
             return EXIT_WRITE_FAILED

@@ -316,10 +316,7 @@ def _compare(args):
     more than the first study's trial-to-trial SD or a file was damaged (each named on
     stderr, its trial left out), 2 when the studies share no trial."""
     for which, folder in (("first", args.first), ("second", args.second)):
-        if not folder:  # pathlib would read it as ".", the current folder
-            raise ScenarioError(f"compare: the {which} folder's path is empty; give a "
-                                "`pbp-drake study` --output folder")
-        _check_is_folder(folder)
+        _check_is_folder(folder, f"compare: the {which} folder's")
         kind = folder_kind(folder)
         if kind not in (None, METHOD_COMPARISON):
             pilots = sorted((pathlib.Path(folder) / PILOTS_FOLDER).glob("*/study.json"))
@@ -347,11 +344,8 @@ def _compare(args):
 def _report(args):
     """`report` of a study folder, a matrix's or a folder of participant folders, with the
     exit codes the command's help gives."""
-    if not args.output:  # pathlib would read it as ".", the current folder
-        raise ScenarioError("report: the folder's path is empty; give a `pbp-drake study` "
-                            "--output folder")
+    _check_is_folder(args.output, "report: the folder's")
     output = pathlib.Path(args.output)
-    _check_is_folder(output)
     if args.markdown is not None:
         check_markdown_path(args.markdown)
         if folder_kind(output) in TOY_STUDIES:
@@ -397,9 +391,11 @@ def _report(args):
     return _report_status(summary, output, _failed_trials(summary, output))
 
 
-def _check_is_folder(path):
+def _check_is_folder(path, whose):
     """ScenarioError unless `path` is a folder: a file (a study's study.json, say) would be
-    read as a folder without a study, or as a user study's."""
+    read as a folder without a study, or as a user study's; `whose` names an empty path."""
+    if not path:  # pathlib would read it as ".", the current folder
+        raise ScenarioError(f"{whose} path is empty; give a `pbp-drake study` --output folder")
     path = pathlib.Path(path)
     if path.is_file():
         raise ScenarioError(f"{path}: is a file, not a folder; give a `pbp-drake study` "

@@ -7,6 +7,7 @@ same command resumes it (docs/tasks/studies.md, "The folder").
 
 import contextlib
 import errno
+import json
 import os
 import pathlib
 import shutil
@@ -182,6 +183,19 @@ def read_text(path, most=MOST_READ_BYTES):
     if len(data) > most:
         raise OSError(errno.EINVAL, f"holds more than {most:,} bytes", str(path))
     return data.decode()
+
+
+def read_json(path):
+    """`(value, None)` of the JSON study file at `path` (`read_text`), else `(None, what is
+    wrong)`: "missing", "unreadable (WHY)" or "truncated or invalid JSON (WHY)"."""
+    try:
+        return json.loads(read_text(path)), None
+    except FileNotFoundError:
+        return None, "missing"
+    except OSError as error:
+        return None, f"unreadable ({error.strerror})"
+    except ValueError as error:
+        return None, f"truncated or invalid JSON ({error})"
 
 
 def _temporary(path):

@@ -103,7 +103,6 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
     if recorded:
         scenario_file = scenario_file or recorded.get("scenario_file")
         split_seeds = split_seeds or recorded.get("split_seeds")
-    if recorded:
         name_left_out(output, recorded, methods, trials, seed)
     remove_leftovers(output)  # of an interrupted study
     pending, damaged = [], []

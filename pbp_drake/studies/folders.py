@@ -4,12 +4,11 @@ its lock, so that one study at a time writes it."""
 
 import contextlib
 import fcntl
-import json
 import os
 import pathlib
 import sys
 
-from pbp_drake.studies.atomic_files import read_text, write_failed
+from pbp_drake.studies.atomic_files import read_json, write_failed
 from pbp_drake.studies.trial_files import (
     METHOD_COMPARISON, Damage, StudyFolderError, content_differences, name_damaged,
     scenario_content)
@@ -35,13 +34,9 @@ def check_folder(output, scenario, digest, participant_condition=None, quiet=Fal
     study_path = pathlib.Path(output) / "study.json"
     if not study_path.is_file():
         return None
-    try:
-        study = json.loads(read_text(study_path))
-        problem = None if isinstance(study, dict) else f"holds a {type(study).__name__}"
-    except OSError as error:
-        problem = f"unreadable ({error.strerror})"
-    except ValueError as error:
-        problem = f"truncated or invalid JSON ({error})"
+    study, problem = read_json(study_path)
+    if problem is None and not isinstance(study, dict):
+        problem = f"holds a {type(study).__name__}"
     if problem is not None:
         if not quiet:
             name_damaged([Damage(str(study_path), f"{problem}; written again")])
@@ -65,10 +60,7 @@ def folder_kind(output):
     study.json or summary.json names, or None (no study, or unreadable files)."""
     output = pathlib.Path(output)
     for name in ("study.json", "summary.json"):
-        try:
-            data = json.loads(read_text(output / name))
-        except (OSError, ValueError):
-            continue
+        data, _ = read_json(output / name)
         if isinstance(data, dict) and isinstance(data.get("study"), str):
             return data["study"]
     return METHOD_COMPARISON if (output / "trials").is_dir() else None

@@ -11,7 +11,8 @@ from pbp_drake.scenarios.overrides import ScenarioOverrides
 from pbp_drake.studies.report import results_table
 from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
-from pbp_drake.studies.atomic_files import is_disk_failure, read_text, write_atomically
+from pbp_drake.studies.atomic_files import (
+    is_disk_failure, read_json, read_text, write_atomically)
 from pbp_drake.studies.trial_files import StudyError, write_study_json
 
 def write_toy_study(output, kind, scenario_name, scenario_file, overrides=None):
@@ -142,10 +143,7 @@ def toy_markdown(output):
 
 def read_study_json(output):
     """A study folder's study.json as a dict ({} when missing or unreadable)."""
-    try:
-        study = json.loads(read_text(pathlib.Path(output) / "study.json"))
-    except (OSError, ValueError):
-        return {}
+    study, _ = read_json(pathlib.Path(output) / "study.json")
     return study if isinstance(study, dict) else {}
 
 

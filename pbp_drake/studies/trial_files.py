@@ -18,7 +18,8 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load
 from pbp_drake.core.intent_filter import IntentFilterSettings
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.scenarios.bounds import is_special_file
-from pbp_drake.studies.atomic_files import MOST_READ_BYTES, read_text, write_atomically
+from pbp_drake.studies.atomic_files import (
+    MOST_READ_BYTES, read_json, read_text, write_atomically)
 from pbp_drake.builder.run import TaskResult
 from pbp_drake.builder.time_series import (
     HAND_ORIENTATION_COLUMNS, time_series_columns, time_series_csv)
@@ -410,13 +411,8 @@ def read_trial(output, method, seed, digest, damaged=None, key=None):
 
     if not json_path.exists():
         return None
-    try:
-        record = json.loads(read_text(json_path))
-    except OSError as error:
-        return bad(json_path, f"unreadable ({error.strerror})")
-    except ValueError as error:
-        return bad(json_path, f"truncated or invalid JSON ({error})")
-    problem = record_problem(record)
+    record, problem = read_json(json_path)
+    problem = problem or record_problem(record)
     if problem is None and record.get("format") != TRIAL_FORMAT:
         problem = f"a trial of format {record.get('format')!r}, not {TRIAL_FORMAT}"
     if problem is None and (record["method"] != method or record["seed"] != seed):
@@ -475,10 +471,7 @@ def infer_study(output):
             methods.append(folder.name)
             seeds |= numbers
         for path in found:
-            try:
-                record = json.loads(read_text(path)) if path.suffix == ".json" else None
-            except (OSError, ValueError):
-                continue
+            record = read_json(path)[0] if path.suffix == ".json" else None
             if isinstance(record, dict) and isinstance(record.get("scenario_hash"), str):
                 hashes[(record["scenario_hash"], str(record.get("scenario")))] += 1
     if not methods:
@@ -497,15 +490,8 @@ def read_study(output):
     output = pathlib.Path(output)
     study_path = output / "study.json"
     damaged = []
-    try:
-        study = json.loads(read_text(study_path))
-        problem = study_problem(study)
-    except FileNotFoundError:
-        study, problem = None, "missing"
-    except OSError as error:
-        study, problem = None, f"unreadable ({error.strerror})"
-    except ValueError as error:
-        study, problem = None, f"truncated or invalid JSON ({error})"
+    study, problem = read_json(study_path)
+    problem = problem or study_problem(study)
     if problem is not None:
         study = infer_study(output)
         if study is None:

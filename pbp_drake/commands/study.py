@@ -19,7 +19,8 @@ from pbp_drake.robots import drives_real_robot
 from pbp_drake.scenarios import (
     Gamepad, Keyboard, MethodComparison, ScenarioError, TaskScenario, VirtualParticipant,
     check_method_comparison, counted)
-from pbp_drake.studies.comparison import BACKENDS, run_method_comparison, run_method_matrix
+from pbp_drake.studies.comparison import (
+    BACKENDS, name_left_out, run_method_comparison, run_method_matrix)
 from pbp_drake.studies.matrix import MATRIX, PILOTS_FOLDER, check_pilots, pilot_folder
 from pbp_drake.studies.matrix_report import FIGURE as MATRIX_FIGURE, report_matrix
 from pbp_drake.studies.paired import (
@@ -382,6 +383,7 @@ def _report(args):
         paired = paired_with_markdown(rows, args.paired_with)
     summary = report(output)
     _print_report(summary, output)
+    name_left_out(output, summary["methods"], summary["trials"], summary["seed"])
     if paired is not None:
         print(paired, end="")
     if args.markdown is not None:

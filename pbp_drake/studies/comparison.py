@@ -11,13 +11,14 @@ import pickle
 import sys
 import time
 
-from pbp_drake.scenarios import ScenarioError, counted
+from pbp_drake.scenarios import ScenarioError
 from pbp_drake.studies.atomic_files import remove_leftovers
 from pbp_drake.studies.ray_backend import import_ray, run_on_ray
 from pbp_drake.studies.report import report
 from pbp_drake.studies.runners import failed_record, run_locally
 from pbp_drake.studies.trial_files import (
-    StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, write_study)
+    StudyFolderError, name_damaged, read_trial, running_marker, scenario_hash, trials_left_out,
+    write_study)
 from pbp_drake.studies.folders import MATRIX, check_folder, study_lock
 from pbp_drake.studies.matrix import check_pilots, pilot_folder, write_matrix_study
 from pbp_drake.studies.matrix_report import report_matrix
@@ -103,7 +104,7 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
     if recorded:
         scenario_file = scenario_file or recorded.get("scenario_file")
         split_seeds = split_seeds or recorded.get("split_seeds")
-        name_left_out(output, recorded, methods, trials, seed)
+    name_left_out(output, methods, trials, seed)
     remove_leftovers(output)  # of an interrupted study
     pending, damaged = [], []
     for method in methods:
@@ -123,27 +124,16 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
     return StudyFolder(scenario, digest, output, seed, pending)
 
 
-def name_left_out(output, recorded, methods, trials, seed):
-    """Says on stderr which of the trials that `output`'s study.json (`recorded`) covered
-    this study leaves out of its summary (other methods or seeds): their files stay, and a
-    study of them all reports them together."""
-    try:
-        seeds = range(int(recorded["seed"]), int(recorded["seed"]) + int(recorded["trials"]))
-        recorded_methods = [str(method) for method in recorded["methods"]]
-    except (KeyError, TypeError, ValueError):  # a study.json of an older form: nothing said
-        return
-    methods_out = [method for method in recorded_methods if method not in methods]
-    seeds_out = [s for s in seeds if not seed <= s < seed + trials]
-    if not methods_out and not seeds_out:
-        return
-    out = "; ".join(filter(None, [
-        methods_out and f"{', '.join(methods_out)} (all their trials)",
-        seeds_out and (f"{counted(len(seeds_out), 'seed')} outside {seed} to {seed + trials - 1}"
-                       f"{' of the other methods' if methods_out else ''}")]))
-    print(f"pbp-drake: {output} held trials this study leaves out of its summary: {out}; "
-          f"their files stay in {pathlib.Path(output) / 'trials'}, and a study of them all "
-          "(its --methods, --trials and --seed) reports them together", file=sys.stderr,
-          flush=True)
+def name_left_out(output, methods, trials, seed):
+    """Says on stderr which trial files in `output` a study of `methods` over `trials` seeds
+    from `seed` leaves out of its summary (`trials_left_out`): their files stay, and a study
+    of them all reports them together."""
+    left_out = trials_left_out(output, methods, trials, seed)
+    if left_out:
+        print(f"pbp-drake: {output} holds trials this summary leaves out: {left_out}; their "
+              f"files stay in {pathlib.Path(output) / 'trials'}, and a study of them all (its "
+              "--methods, --trials and --seed) reports them together", file=sys.stderr,
+              flush=True)
 
 
 def run_trials(folders, jobs=1, progress=None, run=None, backend="local", ray_address=None):

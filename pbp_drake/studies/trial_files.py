@@ -16,7 +16,7 @@ import numpy as np
 from pydrake.common.yaml import yaml_dump_typed, yaml_load
 
 from pbp_drake.core.intent_filter import IntentFilterSettings
-from pbp_drake.scenarios import ScenarioError
+from pbp_drake.scenarios import ScenarioError, counted
 from pbp_drake.scenarios.bounds import is_special_file
 from pbp_drake.studies.atomic_files import (
     MOST_READ_BYTES, read_json, read_text, write_atomically)
@@ -187,6 +187,23 @@ def trial_paths(output, method, seed):
     folder = pathlib.Path(output) / "trials" / method
     return folder / f"seed_{seed}.json", folder / f"seed_{seed}.csv"
 
+
+def trials_left_out(output, methods, trials, seed):
+    """What a study of `methods` over seeds `seed` to `seed + trials - 1` leaves out of the
+    trial files in `output`: "pbp_continuous (30 trials); 2 trials of the others outside
+    seeds 10000 to 10009", or "" when it covers them all."""
+    root = pathlib.Path(output) / "trials"
+    other_methods, outside = [], 0
+    for folder in sorted(root.iterdir() if root.is_dir() else []):
+        seeds = [int(name[5:-5]) for name in (path.name for path in folder.glob("seed_*.json"))
+                 if name[5:-5].isdigit()]
+        if seeds and folder.name not in methods:
+            other_methods.append(f"{folder.name} ({counted(len(seeds), 'trial')})")
+        elif seeds:
+            outside += sum(not seed <= value < seed + trials for value in seeds)
+    return "; ".join(other_methods + ([
+        f"{counted(outside, 'trial')} of the others outside seeds {seed} to "
+        f"{seed + trials - 1}"] if outside else []))
 
 def running_marker(output, method, seed):
     """Present while a process runs the trial: after a worker dies, it tells which had begun."""

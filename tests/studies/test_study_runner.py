@@ -629,12 +629,16 @@ def test_a_study_that_leaves_out_trials_of_its_folder_says_which(scenario, tmp_p
     capsys.readouterr()
     summary = run_method_comparison(scenario, ["teleop"], 2, 5, tmp_path, run=fake_run)
     assert list(summary["methods"]) == ["teleop"]
-    assert capsys.readouterr().err == (
-        f"pbp-drake: {tmp_path} held trials this study leaves out of its summary: "
-        "pbp_alternated (all their trials); 1 seed outside 5 to 6 of the other methods; their "
-        f"files stay in {tmp_path / 'trials'}, and a study of them all (its --methods, "
-        "--trials and --seed) reports them together\n")
+    left_out = (
+        f"pbp-drake: {tmp_path} holds trials this summary leaves out: pbp_alternated (3 "
+        f"trials); 1 trial of the others outside seeds 5 to 6; their files stay in "
+        f"{tmp_path / 'trials'}, and a study of them all (its --methods, --trials and --seed) "
+        "reports them together\n")
+    assert capsys.readouterr().err == left_out
     assert sorted(tmp_path.glob("trials/*/*.json")) == files
-    # The same selection again, or a wider one, leaves nothing out: nothing is said.
+    # Reported later, the folder says the same.
+    assert main(["report", str(tmp_path)]) == 0
+    assert capsys.readouterr().err == left_out
+    # A selection that covers every trial file leaves nothing out: nothing is said.
     run_method_comparison(scenario, METHODS, 3, 5, tmp_path, run=fake_run)
     assert capsys.readouterr().err == ""

@@ -325,8 +325,8 @@ def _compare(args):
                       if kind == MATRIX and pilots else "")
             raise ScenarioError(f"compare: {folder} holds a study of kind {kind!r}, not a "
                                 f"method comparison{within}")
-    damaged = []
-    rows = paired_comparison(args.first, args.second, damaged)
+    damaged, unpaired = [], []
+    rows = paired_comparison(args.first, args.second, damaged, unpaired)
     name_damaged(damaged)
     if not rows:
         raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
@@ -335,7 +335,8 @@ def _compare(args):
     moved = [row for row in rows if not row.within_sd]
     print(f"A = {args.first}, B = {args.second}. " + (
         f"{len(moved)} of {len(rows)} rows moved by more than A's trial-to-trial SD."
-        if moved else f"All {len(rows)} rows within A's trial-to-trial SD."))
+        if moved else f"All {len(rows)} rows within A's trial-to-trial SD.")
+        + "".join(f" {method}: only in {side}, not compared." for method, side in unpaired))
     if damaged:
         print(f"pbp-drake: {len(damaged)} damaged or foreign files skipped (listed above); "
               "their trials are left out of the pairs", file=sys.stderr)

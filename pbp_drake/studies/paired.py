@@ -89,15 +89,21 @@ def _row(metric, method, values_a, values_b):
                      difference - half, difference + half, sd_a, sd_a / math.sqrt(n))
 
 
-def paired_comparison(folder_a, folder_b, damaged=None):
+def paired_comparison(folder_a, folder_b, damaged=None, unpaired=None):
     """The `PairedRow`s of two study folders: every metric of every method both ran, over
     the seeds both ran (collisions only where both tasks measure them). Each folder's
     damaged or foreign files (their trials left out) are appended to `damaged` as a
-    `trial_files.Damage` when it is given."""
+    `trial_files.Damage`, and each method only one folder ran to `unpaired` as `(method,
+    "A" or "B")`, when they are given."""
     study_a, records_a, damaged_a = read_study(folder_a)
     study_b, records_b, damaged_b = read_study(folder_b)
     if damaged is not None:
         damaged += damaged_a + damaged_b
+    if unpaired is not None:
+        unpaired += [(method, side) for side, mine, theirs in (
+            ("A", study_a["methods"], study_b["methods"]),
+            ("B", study_b["methods"], study_a["methods"])) for method in mine
+            if method not in theirs]
     collisions = (measures_collisions(study_a, records_a, folder_a)
                   and measures_collisions(study_b, records_b, folder_b))
     rows = []

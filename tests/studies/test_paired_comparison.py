@@ -26,13 +26,13 @@ def _csv(ticks=3):
     return ",".join(columns) + "\n" + "".join(row + "\n" for _ in range(ticks))
 
 
-def _study(folder, scenario_path, shift=0.0, failed_seed=None):
-    """A finished reach study whose task times are TASK_TIMES + `shift` (the trial of
-    `failed_seed` missed its target)."""
+def _study(folder, scenario_path, shift=0.0, failed_seed=None, methods=METHODS):
+    """A finished reach study of `methods` whose task times are TASK_TIMES + `shift` (the
+    trial of `failed_seed` missed its target)."""
     scenario = load_scenario_file(scenario_path).scenario
     digest = scenario_hash(scenario)
-    write_study(folder, scenario, digest, METHODS, TRIALS, 0, "tuning")
-    for method in METHODS:
+    write_study(folder, scenario, digest, methods, TRIALS, 0, "tuning")
+    for method in methods:
         for trial in range(TRIALS):
             record = trial_record(scenario.name, digest, method, trial, trial)
             record.update(success=trial != failed_seed,
@@ -98,6 +98,15 @@ def test_a_damaged_trial_file_is_named_and_its_pair_left_out(tmp_path, repo, cap
     assert printed.err.endswith("pbp-drake: 1 damaged or foreign files skipped (listed above);"
                                 " their trials are left out of the pairs\n")
 
+
+def test_a_method_only_one_study_ran_is_named_as_not_compared(tmp_path, repo, capsys):
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a = _study(tmp_path / "a", scenario)
+    b = _study(tmp_path / "b", scenario, methods=("teleop", "hop"))
+    assert main(["compare", str(a), str(b)]) == 0
+    assert capsys.readouterr().out.endswith(
+        "All 6 rows within A's trial-to-trial SD. pbp_alternated: only in A, not compared. "
+        "hop: only in B, not compared.\n")
 
 def test_refuses_folders_that_share_no_trial(tmp_path, repo, capsys):
     a = _study(tmp_path / "a", repo / "diagrams" / "hsr_reach.yaml")

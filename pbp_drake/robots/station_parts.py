@@ -158,6 +158,7 @@ def joints_at_limits(station, station_context):
             if plant.get_joint(index).num_positions() == 1
             and at_limit[plant.get_joint(index).position_start()]]
 
+
 def initial_ee_state(station):
     """The hand's ``ee_state`` (``EeState``) where a station (`make_hsr_station`,
     `make_arm_station`) starts: read off a fresh context."""

@@ -37,6 +37,7 @@ from pbp_drake.core.pilot_population import ParticipantPopulationParams
 from pbp_drake.core.surrogate_pilots import (
     LaggyPilotParams, NoisyPilotParams, ProportionalPilotParams)
 
+
 def _config_from_yaml(config_type, text):
     return yaml_load_typed(schema=config_type, data=text)
 

@@ -15,6 +15,7 @@ from pbp_drake.studies.atomic_files import (
     is_disk_failure, read_json, read_text, write_atomically)
 from pbp_drake.studies.trial_files import StudyError, write_study_json
 
+
 def write_toy_study(output, kind, scenario_name, scenario_file, overrides=None):
     """Writes a 2-D study folder's study.json, which names the command that made it."""
     write_study_json(output, {"study": kind, "scenario": scenario_name}, scenario_file,

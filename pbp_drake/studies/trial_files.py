@@ -164,6 +164,7 @@ def _shown(value):
     text = json.dumps(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
+
 def _file_digest(path):
     """The sha256 of a file's bytes (the path itself when unreadable: resolving refuses it)."""
     try:
@@ -204,6 +205,7 @@ def trials_left_out(output, methods, trials, seed):
     return "; ".join(other_methods + ([
         f"{counted(outside, 'trial')} of the others outside seeds {seed} to "
         f"{seed + trials - 1}"] if outside else []))
+
 
 def running_marker(output, method, seed):
     """Present while a process runs the trial: after a worker dies, it tells which had begun."""

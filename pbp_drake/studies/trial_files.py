@@ -189,6 +189,14 @@ def trial_paths(output, method, seed):
     return folder / f"seed_{seed}.json", folder / f"seed_{seed}.csv"
 
 
+def trial_seed(path):
+    """The seed a trial file's name gives (`seed_N.json`, `seed_N.csv`: `trial_paths`), or
+    None for another name."""
+    stem = pathlib.Path(path).stem
+    number = stem[len("seed_"):]
+    return int(number) if stem.startswith("seed_") and number.isdigit() else None
+
+
 def trials_left_out(output, methods, trials, seed):
     """What a study of `methods` over seeds `seed` to `seed + trials - 1` leaves out of the
     trial files in `output`: "pbp_continuous (30 trials); 2 trials of the others outside
@@ -196,8 +204,8 @@ def trials_left_out(output, methods, trials, seed):
     root = pathlib.Path(output) / "trials"
     other_methods, outside = [], 0
     for folder in sorted(root.iterdir() if root.is_dir() else []):
-        seeds = [int(name[5:-5]) for name in (path.name for path in folder.glob("seed_*.json"))
-                 if name[5:-5].isdigit()]
+        seeds = [value for value in map(trial_seed, folder.glob("seed_*.json"))
+                 if value is not None]
         if seeds and folder.name not in methods:
             other_methods.append(f"{folder.name} ({counted(len(seeds), 'trial')})")
         elif seeds:
@@ -485,7 +493,7 @@ def infer_study(output):
     seeds, methods, hashes = set(), [], collections.Counter()
     for folder in sorted(p for p in (output / "trials").glob("*") if p.is_dir()):
         found = [p for p in folder.glob("seed_*.*") if p.suffix in (".json", ".csv")]
-        numbers = {int(p.stem[5:]) for p in found if p.stem[5:].isdigit()}
+        numbers = {trial_seed(p) for p in found} - {None}
         if numbers:
             methods.append(folder.name)
             seeds |= numbers

@@ -3,6 +3,7 @@ before the Meshcat server starts: a combination `run` refuses costs no page, no 
 run, and is named in one line (ScenarioError: `pbp-drake: ...`, exit 2)."""
 
 from pbp_drake.cli_types import chosen_methods
+from pbp_drake.commands.run_page import page_flags_given
 from pbp_drake.scenarios import Gamepad, GraspTask, Keyboard, ScenarioError, with_method
 from pbp_drake.studies.questionnaire import parse_answers
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
@@ -14,6 +15,9 @@ def check_run_flags(args, resolved):
     session's `(methods, order, answers)` (`--answers` parsed, or None), else None."""
     if args.no_meshcat and (args.record or args.camera == "robot"):
         raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
+    if args.headless and (page_flags := page_flags_given(args)):
+        raise ScenarioError(f"{', '.join(page_flags)}: the page's flags; --headless has no "
+                            "page (drop them, or --headless)")
     _check_hand_trail(args, resolved)
     if not resolved.has_task:
         _check_scene_flags(args)

@@ -22,6 +22,8 @@ AFTER_RUN_CHOICES = ("restart", "next", "close")
 # Why a keyboard or gamepad run stops when no browser opens its page.
 PERSON_NEEDS_PAGE = ("the keyboard and gamepad are read in the page, so nothing was run or "
                      "recorded")
+KEEP_PAGE_SECONDS = 600.0
+WAIT_FOR_BROWSER_SECONDS = 15.0
 
 
 def add_page_flags(parser):
@@ -37,15 +39,25 @@ def add_page_flags(parser):
     page.add_argument("--start-on-connect", action="store_true",
                       help="keyboard and gamepad runs: start the task as soon as the page "
                       "connects, as a script wants, instead of at the page's Start button")
-    page.add_argument("--keep-page", type=wait_seconds, default=600.0, metavar="SECONDS",
+    page.add_argument("--keep-page", type=wait_seconds, default=KEEP_PAGE_SECONDS,
+                      metavar="SECONDS",
                       help="after the run, keep the page with its result served until it "
                       "is closed, its Close button is pressed, or this many seconds pass "
                       "(default 600)")
-    page.add_argument("--wait-for-browser", type=wait_seconds, default=15.0,
+    page.add_argument("--wait-for-browser", type=wait_seconds, default=WAIT_FOR_BROWSER_SECONDS,
                       metavar="SECONDS", help="before starting, wait this long for a "
                       "browser to open the page (default 15); a keyboard or gamepad run "
                       "that no browser joins in time stops with exit 2, having run and "
                       "recorded nothing")
+
+
+def page_flags_given(args):
+    """The page's flags that `args` sets to other than their defaults."""
+    given = {"--port": args.port != 0, "--token": args.token is not None,
+             "--start-on-connect": args.start_on_connect,
+             "--keep-page": args.keep_page != KEEP_PAGE_SECONDS,
+             "--wait-for-browser": args.wait_for_browser != WAIT_FOR_BROWSER_SECONDS}
+    return [flag for flag, set_ in given.items() if set_]
 
 
 def open_page(listening, args):

@@ -18,7 +18,7 @@ import numpy as np
 
 from pbp_drake.core.intent_filter import (
     IntentFeatures, IntentFilterSettings, filter_update, intent_features)
-from pbp_drake.studies.trial_files import load_task_result
+from pbp_drake.studies.trial_files import load_task_result, trial_seed
 
 #: The values each fitted parameter is chosen from.
 GRIDS = {"move_rate": (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0),
@@ -49,7 +49,8 @@ def teleop_trials(folders):
         if not folder.is_dir():
             raise ValueError(f"{folder}: no such folder")
         for record in sorted(folder.glob(f"**/trials/{TELEOP}/seed_*.json")):
-            found.append((record.parents[2], int(record.stem.removeprefix("seed_"))))
+            if (seed := trial_seed(record)) is not None:
+                found.append((record.parents[2], seed))
     if not found:
         raise ValueError(f"no teleop trials under {', '.join(map(str, folders))} (a study "
                          "folder of `pbp-drake study --methods teleop`)")

@@ -46,12 +46,29 @@ def test_a_bad_flag_value_is_refused_when_parsed(repo, capsys, flag, value, mess
 
 
 @pytest.mark.slow
+def test_a_good_realtime_rate_passes(repo):
+    assert main(["run", str(repo / QUICK), "--headless", "--realtime-rate", "0.5"]) == 0
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [
-    ["--port", "0"], ["--realtime-rate", "0.5"], ["--wait-for-browser", "0"],
-    ["--token", "a-script-chose_this-token"], ["--keep-page", "0"],
+    ["--port", "0"], ["--wait-for-browser", "0"], ["--token", "a-script-chose_this-token"],
 ])
-def test_good_flag_values_pass(repo, argv):
-    assert main(["run", str(repo / QUICK), "--headless", *argv]) == 0
+def test_good_page_flag_values_pass(repo, argv):
+    assert main(["run", str(repo / QUICK), "--realtime-rate", "50", "--keep-page", "0",
+                 *argv]) == 0
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["--token", "a-script-chose_this-token"], "--token"),
+    (["--keep-page", "0", "--port", "8123"], "--port, --keep-page"),
+    (["--wait-for-browser", "3", "--start-on-connect"], "--start-on-connect, --wait-for-browser"),
+])
+def test_page_flags_with_headless_are_refused_in_one_line(repo, capsys, argv, named):
+    assert main(["run", str(repo / QUICK), "--headless", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err == f"pbp-drake: {named}: the page's flags; --headless has no page (drop them, " \
+                  "or --headless)\n"
 
 
 @pytest.mark.slow

@@ -125,8 +125,9 @@ def file_schema(document):
     names with those it takes); `ScenarioFile` (a 2-D scene) when the robot is
     `!PointRobot` or an untagged mapping of the point robot's fields. Otherwise (no robot,
     an untagged HSR as `yaml_dump_typed` writes it, a value of the wrong kind) a robot task
-    when the scenario holds what only a robot task has (a task, likely paths, a task's
-    operator), else a 2-D scene."""
+    when the scenario has a task's operator, or holds what only a robot task has (a task,
+    likely paths, a seed) and nothing only a 2-D scene has (goals, a start, obstacles, a
+    demonstration); else a 2-D scene."""
     scenario = document.get("scenario")
     if not isinstance(scenario, dict):
         return ScenarioFile
@@ -139,8 +140,10 @@ def file_schema(document):
             return ScenarioFile
     operator = scenario.get("operator")
     operator_tag = operator.get("_tag", "") if isinstance(operator, dict) else ""
-    task_only = set(_field_types(TaskScenario)) - set(_field_types(PointScenario))
-    if task_only & set(scenario) or operator_tag in _TASK_OPERATOR_TAGS:
+    task_fields, point_fields = set(_field_types(TaskScenario)), set(_field_types(PointScenario))
+    if operator_tag in _TASK_OPERATOR_TAGS or (
+            (task_fields - point_fields) & set(scenario)
+            and not (point_fields - task_fields) & set(scenario)):
         return TaskScenarioFile
     return ScenarioFile
 

@@ -171,7 +171,6 @@ def _check_common(scenario):
         raise ScenarioError(f"scenario.goal_estimator.method {scenario.goal_estimator.method} "
                             f"reads grasp orientations: use it with task: !GraspTask {{...}}")
     check_time_steps([("scenario.control_period", scenario.control_period)])
-    check_seed(scenario.seed)
 
 
 def _check_operator(scenario):
@@ -337,6 +336,7 @@ def _resolve_task_robot(scenario):
     if scenario.task is None:
         raise ScenarioError(f"robot {tag} needs scenario.task, e.g. task: "
                             "{object_count: [2, 4]}")
+    check_seed(scenario.seed)
     check_count(scenario.likely_paths, "scenario.likely_paths", 0, MAX_LIKELY_PATHS)
     station_field = "scenario.robot.station" if isinstance(robot, Hsr) else "scenario.robot"
     station = robot.station if isinstance(robot, Hsr) else robot.station_config()

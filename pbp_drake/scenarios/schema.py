@@ -373,16 +373,14 @@ class GraspTask:
 @dataclasses.dataclass
 class Scenario(ControlSettings):
     """What every scenario has: the controller's settings (`ControlSettings`: method,
-    alpha, control_period, dmp, dmp_duration, goal_estimator, hop), its name, time limit,
-    seed and simulator. A file's `scenario:` is a `TaskScenario` when its robot is tagged
+    alpha, control_period, dmp, dmp_duration, goal_estimator, hop), its name, time limit
+    and simulator. A file's `scenario:` is a `TaskScenario` when its robot is tagged
     `!Hsr` or `!Arm`, else a `PointScenario` (a 2-D scene)."""
 
     #: The scenario's name (in outputs and the console).
     name: str = "scenario"
     #: The time limit (s) of a run.
     duration: float = 2.0
-    #: The seed of every random draw (an integer).
-    seed: int = 0
     #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
     #: its target_realtime_rate).
     simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
@@ -415,6 +413,8 @@ class TaskScenario(Scenario):
 
     #: The robot: `!Hsr` or `!Arm` (the tag chooses the scenario's type).
     robot: typing.Union[TASK_ROBOTS] = dataclasses.field(default_factory=Hsr)
+    #: The seed of every random draw: the scene's and the participant's (an integer).
+    seed: int = 0
     #: Who drives the robot: a tagged operator variant; untagged: none.
     operator: typing.Union[HSR_OPERATORS] = dataclasses.field(default_factory=NoOperator)
     #: The task: untagged a MultiGoalReach; `!DynamicObstacles {...}` the obstacle task,

@@ -149,6 +149,9 @@ def test_session_flags_on_a_2d_scene_are_refused(repo, capsys, argv, named):
      "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
     (["run", "diagrams/toy_alpha_study.yaml", "--headless", "--operator", "virtual"],
      "--operator chooses who drives the tasks; this scenario uses the 2-D toy robot"),
+    # A 2-D scene draws nothing from a seed.
+    (["run", QUICK, "--headless", "--seed", "3"],
+     "with --seed 3: scenario: unknown key 'seed' (a robot task's field: "),
     (["run", "diagrams/arm_reach.yaml", "--headless", "--camera", "robot"],
      "--camera robot looks from the HSR's head; this scenario has no HSR"),
     (["run", TASK, "--no-meshcat", "--record", "{tmp}/run.html"],

@@ -42,6 +42,10 @@ def _refusal(tmp_path, run_refused, file, old, new):
     ("toy_alt_vs_cont.yaml", "  start: [0.0, 0.0]", "  start: [0.0, 0.0]\n  task: {}",
      "scenario: unknown key 'task' (a robot task's field: give robot: !Hsr {...} or "
      "!Arm {...}); expected one of "),
+    # ...a seed in a 2-D scene, which draws nothing from it...
+    ("toy_alt_vs_cont.yaml", "  start: [0.0, 0.0]", "  start: [0.0, 0.0]\n  seed: 3",
+     "scenario: unknown key 'seed' (a robot task's field: give robot: !Hsr {...} or "
+     "!Arm {...}); expected one of "),
     # ...goals in a robot task, which draws its own...
     ("hsr_reach.yaml", "  seed: 0", "  seed: 0\n  goals: [[1.0, 0.0, 0.7]]",
      "scenario: unknown key 'goals' (a 2-D scene's field: a robot task draws its goals, the "

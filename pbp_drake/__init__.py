@@ -95,9 +95,9 @@ API_GROUPS = {
             "make_station_relay"]},
     "Scenario files": {
         name: "pbp_drake.scenarios" for name in [
-            "load_scenario_file", "resolve", "ResolvedScenario", "ScenarioError",
-            "ScenarioFile", "Scenario", "PointScenario", "TaskScenario", "Hsr", "Arm",
-            "PointRobot", "MultiGoalReach",
+            "load_scenario_file", "ScenarioOverrides", "resolve", "ResolvedScenario",
+            "ScenarioError", "ScenarioFile", "Scenario", "PointScenario", "TaskScenario",
+            "Hsr", "Arm", "PointRobot", "MultiGoalReach",
             "DynamicObstacles", "GraspTask", "VirtualParticipant", "Keyboard", "Gamepad",
             "NoOperator", "ScriptedCommands", "SinusoidalStep", "ObstacleRepulsion",
             "BentPath", "RecordedPath", "Obstacle", "MethodComparison", "AlphaStudy",

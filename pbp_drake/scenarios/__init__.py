@@ -12,6 +12,7 @@ from pbp_drake.scenarios.loading import (
     LoadedScenarioFile, check_alpha_study, check_method_comparison, load_scenario_file,
     load_scenario_text)
 from pbp_drake.core.methods import METHODS
+from pbp_drake.scenarios.overrides import ScenarioOverrides
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, TaskScene, demonstration_samples,
     parse_method_label, resolve, task_scene, with_method)
@@ -34,6 +35,7 @@ __all__ = [
     "MultiGoalReach", "NoisyPilot", "NoOperator", "Obstacle", "ObstacleRepulsion",
     "ParticipantPopulation", "PointRobot", "PointScenario", "ProportionalPilot",
     "RecordedPath", "ResolvedScenario", "Scenario", "ScenarioError", "ScenarioFile",
+    "ScenarioOverrides",
     "SceneVariant", "ScriptedCommands", "SinusoidalStep", "TaskScenario", "TaskScenarioFile",
     "TaskScene", "VirtualParticipant",
     "check_alpha_study", "check_method_comparison", "check_pilot_name", "counted",

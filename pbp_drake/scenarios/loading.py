@@ -40,15 +40,15 @@ class LoadedScenarioFile:
 
 def load_scenario_file(path, overrides=None):
     """Reads, checks and resolves a scenario file (see `load_scenario_text`, the folder the
-    file's). `overrides` (`overrides.ScenarioOverrides`: the command line's `--set` and
+    file's). `overrides` (a `ScenarioOverrides`: the command line's `--set` and
     `--scenario-text`) are merged onto the file's document first and checked as the file
     is; errors then name the file and the overrides."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a scenario file's path, a str or os.PathLike; got "
                         f"{path!r}")
     if not isinstance(overrides, (ScenarioOverrides, type(None))):
-        raise TypeError(f"overrides must be a ScenarioOverrides (pbp_drake.scenarios.overrides:"
-                        f" ScenarioOverrides(settings=('duration=2.0',)), as --set) or None; got "
+        raise TypeError(f"overrides must be a pbp_drake.ScenarioOverrides (e.g. "
+                        f"ScenarioOverrides(settings=('duration=2.0',)), as --set) or None; got "
                         f"{overrides!r}")
     if not os.fspath(path):  # pathlib would read it as ".", the current folder
         raise ScenarioError("the scenario file's path is empty; expected a file such as "

@@ -131,3 +131,12 @@ def test_a_study_of_many_goals_draws_each_trials_grid_from_its_seed(repo, tmp_pa
               for seed in (10_000, 10_001)]
     assert [len(trial["objects"]) for trial in trials] == [30, 30]
     assert trials[0]["objects"] != trials[1]["objects"]  # each trial's grid from its seed
+
+
+def test_a_python_user_overrides_a_file_with_the_packages_own_names(repo):
+    import pbp_drake
+
+    loaded = pbp_drake.load_scenario_file(repo / TASK, pbp_drake.ScenarioOverrides(
+        settings=("goal_estimator.method=nearest", "control_period=0.02")))
+    assert loaded.scenario.goal_estimator.method == "nearest"
+    assert loaded.scenario.control_period == 0.02

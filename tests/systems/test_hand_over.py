@@ -173,6 +173,9 @@ def test_an_unbounded_anti_windup_is_no_limit():
      r"params.axis must be empty \(radially\) or a direction of dimension 2"),
     (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.03, {"speed": 1.0}),
      "params must be ObstacleRepulsionParams, got dict"),
+    # 0 was taken for the default, the control period.
+    (lambda: DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, prediction_steps=3,
+                     prediction_period=0), "prediction_period must be positive, got 0"),
     (lambda: IntentFilterGoalEstimator(2, IntentFilterSettings(), 0.03, margin=None),
      "margin must lie in \\[0, 1\\), got None"),
     (lambda: MaxEntGoalEstimator(2, HopSettings(), 0.03, hold_steps=None),

@@ -185,6 +185,9 @@ def test_a_switch_schedule_without_one_target_per_entry_is_refused():
     ({"targets": [2]}, r"targets must be object indices 0 to 1, got \[2\]"),
     ({"targets": [-1]}, r"targets must be object indices 0 to 1, got \[-1\]"),
     ({"targets": [0.5]}, r"targets must be object indices 0 to 1, got \[0.5\]"),
+    # No target failed with an IndexError at the first tick.
+    ({"targets": [], "switch_schedule": []},
+     r"targets must name at least one object \(its index in objects\), got none"),
     ({"switch_schedule": [np.nan]}, r"switch_schedule must be finite, got \[nan\]"),
     ({"start": [0.0, 0.0]}, r"start must be 3 finite numbers \[x, y, z\], got \[0.0, 0.0\]"),
     ({"start": [np.nan, 0.0, 0.0]}, r"start must be 3 finite numbers"),

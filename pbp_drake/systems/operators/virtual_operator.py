@@ -73,7 +73,7 @@ class VirtualOperator(ParticipantOperator):
         - target
         - selected_goal
         - forward_key
-        - obstacle_positions (optional)
+        - obstacle_positions (with obstacle_count > 0)
         output_ports:
         - operator_command
         - operator_active

@@ -98,12 +98,12 @@ class DmpBank(BankSystem):
         - operator_active (optional)
         - followed_goal (optional)
         - selected_goal (optional)
-        - predicted_goals (with predicted_goal_count)
+        - predicted_goals (with prediction_steps > 0 and predicted_goal_count)
         output_ports:
         - references
         - selected_reference
         - phase
-        - predicted_paths
+        - predicted_paths (with prediction_steps > 0)
 
     `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
     `(K, D)`. Each period every DMP advances one step from the robot's position;

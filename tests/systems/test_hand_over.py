@@ -17,6 +17,7 @@ from pbp_drake.systems import (
     Blender, DemonstrationPlayer, DmpBank, GoalEstimator, GoalsSource, HandOver, HeadingCommand,
     HopAssistance, IdleOperator, IntentFilterGoalEstimator, LikelyGoals, MaxEntGoalEstimator,
     ObstacleRepulsionOperator, PointRobotDynamics, SampleHold, ScriptedOperator, TaskMonitor)
+from pbp_drake.systems.operators.obstacle_repulsion_operator import ObstacleRepulsionParams
 from pbp_drake.systems.tasks.point_robot_dynamics import PointRobotParams
 from pbp_drake.systems.tick import decide_offset
 
@@ -158,6 +159,23 @@ def test_an_unbounded_anti_windup_is_no_limit():
     (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [-0.1], 2, 0.03),
      r"radii must be one positive radius per centre \(1\), got \[-0.1\]"),
     (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [], 2, 0.03), "radii must be one positive"),
+    # Two 3-D centres were read as three 2-D ones.
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0, 0.0], [1.0, 0.0, 0.0]], [0.1] * 3, 2, 0.03),
+     r"centres must be \(M, 2\), an obstacle's centre a row, got shape \(2, 3\)"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.03,
+                                       ObstacleRepulsionParams(distance_threshold=np.nan)),
+     "params.distance_threshold must be a positive distance, got nan"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.03,
+                                       ObstacleRepulsionParams(speed=np.inf)),
+     "params.speed must be a finite number, got inf"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.03,
+                                       ObstacleRepulsionParams(axis=[1.0, 0.0, 0.0])),
+     r"params.axis must be empty \(radially\) or a direction of dimension 2"),
+    (lambda: ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.03, {"speed": 1.0}),
+     "params must be ObstacleRepulsionParams, got dict"),
+    # 0 was taken for the default, the control period.
+    (lambda: DmpBank(DmpModel.straight([0.0, 0.0], 2, 1.0), 0.03, prediction_steps=3,
+                     prediction_period=0), "prediction_period must be positive, got 0"),
     (lambda: IntentFilterGoalEstimator(2, IntentFilterSettings(), 0.03, margin=None),
      "margin must lie in \\[0, 1\\), got None"),
     (lambda: MaxEntGoalEstimator(2, HopSettings(), 0.03, hold_steps=None),
@@ -200,6 +218,16 @@ def test_a_nan_robot_state_is_refused_by_the_bank_naming_the_entry():
     bank.get_robot_state_input_port().FixValue(context, [0.0, 0.0, np.nan, 0.0])
     bank.get_goals_input_port().FixValue(context, GOALS.reshape(-1))
     with pytest.raises(ValueError, match=r"robot_state velocity\[0\] is NaN or infinite"):
+        simulator.AdvanceTo(0.03)
+
+
+def test_a_nan_robot_state_is_refused_by_the_repulsion_naming_the_entry():
+    # NaN is no nearer than the threshold, nor farther: the push went up at full speed.
+    person = ObstacleRepulsionOperator([[0.5, 0.0]], [0.1], 2, 0.03)
+    simulator = Simulator(person)
+    context = person.GetMyContextFromRoot(simulator.get_mutable_context())
+    person.get_robot_state_input_port().FixValue(context, [np.nan, 0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match=r"robot_state position\[0\] is NaN or infinite"):
         simulator.AdvanceTo(0.03)
 
 

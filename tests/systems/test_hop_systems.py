@@ -183,6 +183,37 @@ def test_the_estimators_refuse_a_nan_hand_or_command_naming_the_field(estimator,
         simulator.AdvanceTo(PERIOD)
 
 
+@pytest.mark.parametrize("estimator", [
+    lambda: PoseIntentFilterGoalEstimator(len(GOALS), IntentFilterSettings(), PERIOD),
+    lambda: PoseMaxEntGoalEstimator(len(GOALS), SETTINGS, PERIOD),
+])
+@pytest.mark.parametrize("port, field, message", [
+    ("hand_pose", 1, r"hand_pose y is NaN or infinite: \[0.0, nan"),
+    ("hand_pose", 12, r"hand_pose wz is NaN or infinite"),
+    ("operator_twist", 5, r"operator_twist wz is NaN or infinite: \[0.0, 0.0, 0.0"),
+])
+def test_the_pose_estimators_refuse_a_nan_hand_or_twist_naming_the_field(estimator, port, field,
+                                                                         message):
+    # Silent or acting (`operator_active` 0 and 1) the intent filter read a NaN into finite
+    # probabilities.
+    orientation = side_grasp_orientation(0.0)
+    values = {"hand_pose": np.concatenate([HAND, orientation, np.zeros(6)]),
+              "operator_twist": np.zeros(6)}
+    values[port][field] = np.nan
+    for active in (0.0, 1.0):
+        builder = DiagramBuilder()
+        system = builder.AddSystem(estimator())
+        builder.Connect(constant(builder, values["hand_pose"]), system.get_hand_pose_input_port())
+        builder.Connect(constant(builder, np.hstack([GOALS, np.tile(orientation, (3, 1))])
+                                 .reshape(-1)), system.get_goal_poses_input_port())
+        builder.Connect(constant(builder, values["operator_twist"]),
+                        system.get_operator_twist_input_port())
+        builder.Connect(constant(builder, [active]), system.get_operator_active_input_port())
+        simulator = Simulator(builder.Build())
+        with pytest.raises(ValueError, match=message):
+            simulator.AdvanceTo(PERIOD)
+
+
 def test_the_assistance_systems_keep_their_method():
     assert HopAssistance("predict_then_assist", 3, SETTINGS, PERIOD).method == (
         "predict_then_assist")

@@ -170,3 +170,21 @@ def test_a_participant_among_obstacles_needs_their_radius():
     with pytest.raises(ValueError, match="obstacle_radius must be positive with obstacles, "
                                          "got 0.0"):
         VirtualOperator(PERIOD, [[*TARGET, 0.7]], nominal_speed=0.12, obstacle_count=len(WALL))
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"obstacle_margin": np.nan}, "obstacle_margin must be a finite distance >= 0, got nan"),
+    ({"obstacle_margin": -0.1}, "obstacle_margin must be a finite distance >= 0, got -0.1"),
+    ({"obstacle_count": 1.5}, "obstacle_count must be a whole number >= 0, got 1.5"),
+    ({"obstacle_radius": np.inf}, "obstacle_radius must be positive with obstacles, got inf"),
+    ({"fixed_base": [0.5]}, r"fixed_base must be the arm's base \(x, y\), two finite numbers, "
+                            r"got \[0.5\]"),
+    ({"fixed_base": 0.5}, r"fixed_base must be the arm's base \(x, y\)"),
+    ({"fixed_base": [np.nan, 0.0]}, r"fixed_base must be the arm's base \(x, y\)"),
+])
+def test_a_participant_among_obstacles_names_an_argument_it_cannot_use(change, message):
+    # A NaN margin failed every clearance test, a negative one let the hand touch: both
+    # were taken without a word.
+    arguments = dict(nominal_speed=0.12, obstacle_count=len(WALL), obstacle_radius=0.2)
+    with pytest.raises(ValueError, match=message):
+        VirtualOperator(PERIOD, [[*TARGET, 0.7]], **{**arguments, **change})

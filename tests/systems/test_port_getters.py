@@ -1,6 +1,7 @@
 """Port getters come from the ports a system declares (`PortGetters`):
 `get_NAME_input_port()` is `GetInputPort(NAME)` for every input port NAME, and likewise for
-the outputs; no module writes one of its own for a port of the same name."""
+the outputs; no module writes one of its own for a port of the same name. A docstring's port
+block names the ports declared, and says under which arguments one is."""
 
 import ast
 import pathlib
@@ -10,6 +11,7 @@ import numpy as np
 import pytest
 
 from pbp_drake.core.dmp import DmpBankModel
+from pbp_drake.systems.operators.virtual_operator import VirtualOperator
 from pbp_drake.systems.pbp.dmp_bank import DmpBank
 from pbp_drake.systems.tasks.task_monitor import TaskMonitor
 
@@ -70,3 +72,32 @@ def test_no_module_writes_a_getter_the_ports_give():
                 written += [f"{path.name}: {cls.name}.{method.name}" for method in cls.body
                             if isinstance(method, ast.FunctionDef) and method.name in declared]
     assert not written
+
+
+def _documented_ports(system):
+    """{port name: its note in parentheses, or ""} of the docstring's `pydrake_system` block."""
+    block = type(system).__doc__.split(".. pydrake_system::")[1].split("\n\n")[1]
+    return {match[0]: match[1] for match in re.findall(r"^\s*- (\w+)(?: \((.*)\))?$", block,
+                                                        re.M)}
+
+
+@pytest.mark.parametrize("build, build_all", [
+    (lambda: DmpBank(DmpBankModel.straight(np.zeros(3), 4, 1.0), 0.01),
+     lambda: DmpBank(DmpBankModel.straight(np.zeros(3), 4, 1.0), 0.01, prediction_steps=3,
+                     predicted_goal_count=2)),
+    (lambda: VirtualOperator(0.03, [[1.0, 0.0, 0.7]], nominal_speed=0.12),
+     lambda: VirtualOperator(0.03, [[1.0, 0.0, 0.7]], nominal_speed=0.12, obstacle_count=2,
+                             obstacle_radius=0.2)),
+])
+def test_a_port_the_docstring_calls_optional_is_always_there_and_one_not_always_says_when(
+        build, build_all):
+    # An "(optional)" port may be left unconnected; a port declared only under some
+    # arguments is not optional where it is declared, and its note says when it is.
+    plain, full = build(), build_all()
+    notes = _documented_ports(full)
+    declared = {port.get_name() for kind in ("input", "output") for port in _ports(full, kind)}
+    assert set(notes) == declared
+    always = {port.get_name() for kind in ("input", "output") for port in _ports(plain, kind)}
+    for name, note in notes.items():
+        if name not in always:
+            assert note.startswith("with "), f"{name} ({note}) is declared only with some arguments"

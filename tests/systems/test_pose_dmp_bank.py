@@ -156,6 +156,12 @@ def test_banks_of_different_phases_dimensions_or_goal_counts_are_refused():
         PoseDmpBank(positions, same_phase, DT)
 
 
+def test_a_prediction_period_of_zero_is_refused_not_taken_for_the_default():
+    positions, orientations, _ = make_banks()
+    with pytest.raises(ValueError, match="prediction_period must be positive, got 0"):
+        PoseDmpBank(positions, orientations, DT, prediction_steps=3, prediction_period=0)
+
+
 def test_a_hand_quaternion_that_is_not_unit_is_refused_by_name():
     robot = ROBOT.copy()
     robot[3:7] *= 1.01

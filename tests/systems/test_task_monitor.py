@@ -185,6 +185,9 @@ def test_a_switch_schedule_without_one_target_per_entry_is_refused():
     ({"targets": [2]}, r"targets must be object indices 0 to 1, got \[2\]"),
     ({"targets": [-1]}, r"targets must be object indices 0 to 1, got \[-1\]"),
     ({"targets": [0.5]}, r"targets must be object indices 0 to 1, got \[0.5\]"),
+    # No target failed with an IndexError at the first tick.
+    ({"targets": [], "switch_schedule": []},
+     r"targets must name at least one object \(its index in objects\), got none"),
     ({"switch_schedule": [np.nan]}, r"switch_schedule must be finite, got \[nan\]"),
     ({"start": [0.0, 0.0]}, r"start must be 3 finite numbers \[x, y, z\], got \[0.0, 0.0\]"),
     ({"start": [np.nan, 0.0, 0.0]}, r"start must be 3 finite numbers"),
@@ -204,6 +207,17 @@ def test_the_monitor_names_an_argument_it_cannot_referee(change, message):
     ({"grasp_positions": [[0.5, 0.0]]}, r"grasp_positions must be a non-empty finite \(M, 3\)"),
     ({"success_angle": 0.0}, r"success_angle must be finite and positive \(rad\), got 0.0"),
     ({"success_distance": np.inf}, r"success_distance must be finite and positive"),
+    ({"grasp_orientations": [[1.0, 0.0, 0.0, 0.0]]},
+     r"grasp_orientations must be one quaternion .* per grasp position, \(2, 4\), got shape "
+     r"\(1, 4\)"),
+    ({"grasp_orientations": [[1.0, 0.0, 0.0]] * 2}, r"grasp_orientations must be one quaternion"),
+    ({"grasp_orientations": [[np.nan, 0.0, 0.0, 0.0]] * 2},
+     "grasp_orientations contains NaN or infinite values"),
+    ({"grasp_orientations": [[2.0, 0.0, 0.0, 0.0]] * 2},
+     "grasp_orientations is not a unit quaternion"),
+    ({"start_pose": [0.0, 0.0, 0.0]}, r"start_pose must be 7 finite numbers .*, got \[0.0, 0.0, "),
+    ({"start_pose": [0.0, np.nan, 0.0, 1.0, 0.0, 0.0, 0.0]}, "start_pose must be 7 finite"),
+    ({"start_pose": [0.0] * 7}, "start_pose orientation is not a unit quaternion"),
 ])
 def test_the_grasp_monitor_names_an_argument_it_cannot_referee(change, message):
     level = [1.0, 0.0, 0.0, 0.0]
@@ -221,4 +235,16 @@ def test_a_nan_hand_is_refused_by_the_monitor_naming_the_field():
     monitor.get_ee_state_input_port().FixValue(context, [0.0, np.nan] + [0.0] * 6)
     monitor.get_operator_active_input_port().FixValue(context, [0.0])
     with pytest.raises(ValueError, match=r"ee_state y is NaN or infinite: \[0.0, nan"):
+        simulator.AdvanceTo(PERIOD)
+
+
+def test_a_nan_hand_is_refused_by_the_grasp_monitor_naming_the_field():
+    level = [1.0, 0.0, 0.0, 0.0]
+    monitor = GraspTaskMonitor(OBJECTS, [level, level], [0], [0.0], [0.0] * 3 + level, 0.05,
+                               0.2, PERIOD)
+    simulator = Simulator(monitor)
+    context = monitor.GetMyContextFromRoot(simulator.get_mutable_context())
+    monitor.get_hand_pose_input_port().FixValue(context, [0.0, np.nan, 0.0, *level] + [0.0] * 6)
+    monitor.get_operator_active_input_port().FixValue(context, [0.0])
+    with pytest.raises(ValueError, match=r"hand_pose y is NaN or infinite: \[0.0, nan"):
         simulator.AdvanceTo(PERIOD)

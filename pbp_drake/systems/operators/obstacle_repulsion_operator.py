@@ -1,11 +1,14 @@
 """The paper's virtual human for the 2-D toy scenes (Eq. 5)."""
 
 import dataclasses
+import math
 
 import numpy as np
 
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.toy_scene import repulsion_command
 from pbp_drake.systems.operators.sampled_operator import SampledOperator
+from pbp_drake.systems.ports import finite_fields
 
 
 @dataclasses.dataclass
@@ -40,8 +43,14 @@ class ObstacleRepulsionOperator(SampledOperator):
     def __init__(self, centres, radii, dimension, control_period,
                  params=ObstacleRepulsionParams()):
         super().__init__(dimension, control_period)
+        dimension = self._dimension
+        _check_params(params, dimension)
         self.params = dataclasses.replace(params)
-        self._centres = np.asarray(centres, dtype=float).reshape(-1, dimension)
+        centres = np.asarray(centres, dtype=float)
+        if centres.size and (centres.ndim != 2 or centres.shape[1] != dimension):
+            raise ValueError(f"centres must be (M, {dimension}), an obstacle's centre a row, "
+                             f"got shape {centres.shape}")
+        self._centres = centres.reshape(-1, dimension)
         self._radii = np.asarray(radii, dtype=float).reshape(-1)
         if not np.isfinite(self._centres).all():
             raise ValueError(f"centres must be finite, got {self._centres.tolist()}")
@@ -52,9 +61,29 @@ class ObstacleRepulsionOperator(SampledOperator):
         self._speed = float(params.speed)
         self._axis = np.asarray(params.axis, dtype=float) if len(params.axis) else None
         self._robot_state_port = self.DeclareVectorInputPort("robot_state", 2 * dimension)
+        self._position_fields = [f"position[{i}]" for i in range(dimension)]
         self._declare_operator_outputs()
 
     def _sample(self, context):
-        position = self._robot_state_port.Eval(context)[:self._dimension]
+        # A NaN position is farther from no obstacle than the threshold: it would push.
+        position = finite_fields(self._robot_state_port.Eval(context)[:self._dimension],
+                                 "robot_state", self._position_fields)
         return repulsion_command(position, self._centres, self._radii, self._threshold,
                                  self._speed, self._axis)
+
+
+def _check_params(params, dimension):
+    """Raises ValueError naming the field of `params` (`ObstacleRepulsionParams`) that the
+    push cannot use: a NaN threshold pushed at any distance, a 0 one never."""
+    if not isinstance(params, ObstacleRepulsionParams):
+        raise ValueError(f"params must be ObstacleRepulsionParams, got {type(params).__name__}")
+    threshold = params.distance_threshold
+    if not (is_real(threshold) and math.isfinite(threshold) and threshold > 0):
+        raise ValueError(f"params.distance_threshold must be a positive distance, got "
+                         f"{threshold!r}")
+    if not (is_real(params.speed) and math.isfinite(params.speed)):
+        raise ValueError(f"params.speed must be a finite number, got {params.speed!r}")
+    axis = np.asarray(params.axis, dtype=float)
+    if axis.size and (axis.shape != (dimension,) or not np.linalg.norm(axis) >= 1e-6):
+        raise ValueError(f"params.axis must be empty (radially) or a direction of dimension "
+                         f"{dimension} and length at least 1e-6, got {list(params.axis)}")

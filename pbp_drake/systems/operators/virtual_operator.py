@@ -73,7 +73,7 @@ class VirtualOperator(ParticipantOperator):
         - target
         - selected_goal
         - forward_key
-        - obstacle_positions (optional)
+        - obstacle_positions (with obstacle_count > 0)
         output_ports:
         - operator_command
         - operator_active
@@ -102,6 +102,9 @@ class VirtualOperator(ParticipantOperator):
     def __init__(self, control_period, objects, params=VirtualParticipantParams(),
                  nominal_speed=None, seed=0, obstacle_count=0, obstacle_radius=0.0,
                  obstacle_margin=0.06, vertical=False, heading_range=None, fixed_base=None):
+        if not is_whole(obstacle_count):
+            raise ValueError(f"obstacle_count must be a whole number >= 0, got "
+                             f"{obstacle_count!r}")
         if vertical and obstacle_count > 0:
             raise ValueError(f"vertical=True is for the reaching task; the participant "
                              f"avoids obstacles on the floor only (got obstacle_count "
@@ -117,7 +120,7 @@ class VirtualOperator(ParticipantOperator):
                 raise ValueError(f"params.{field.name} must be finite and not negative, got "
                                  f"{value!r}")
         self._vertical = bool(vertical)
-        self._fixed_base = None if fixed_base is None else np.asarray(fixed_base, float)[:2]
+        self._fixed_base = None if fixed_base is None else _base_position(fixed_base)
         if heading_range is not None and not _ordered_pair(heading_range):
             raise ValueError(f"heading_range must be (lowest, highest) finite headings (rad), "
                              f"got {heading_range!r}")
@@ -144,9 +147,14 @@ class VirtualOperator(ParticipantOperator):
         self._selected_goal_port = self.DeclareVectorInputPort("selected_goal", 1)
         self._forward_key_port = self.DeclareVectorInputPort("forward_key", 1)
         self._obstacles_port = None
-        if obstacle_count > 0 and not obstacle_radius > 0:
+        if obstacle_count > 0 and not (is_real(obstacle_radius)
+                                       and 0 < obstacle_radius < math.inf):
             raise ValueError(f"obstacle_radius must be positive with obstacles, got "
                              f"{obstacle_radius}")
+        # A NaN margin failed every clearance test, a negative one passed collisions.
+        if not (is_real(obstacle_margin) and 0 <= obstacle_margin < math.inf):
+            raise ValueError(f"obstacle_margin must be a finite distance >= 0, got "
+                             f"{obstacle_margin!r}")
         self._obstacle_radius = float(obstacle_radius)
         self._obstacle_margin = float(obstacle_margin)
         self._release_heading_gap = params.release_heading_gap
@@ -498,6 +506,16 @@ class VirtualOperator(ParticipantOperator):
                 ticks += 1.0
         discrete_state.set_value(self._insist_index, [counted_target, ticks, moved])
         return insisting, repositioning
+
+
+def _base_position(fixed_base):
+    """`fixed_base`'s `(x, y)` (a pose's first two entries) as a float array; ValueError
+    naming it unless they are two finite numbers."""
+    base = np.asarray(fixed_base, float)
+    if base.ndim != 1 or base.size < 2 or not np.isfinite(base[:2]).all():
+        raise ValueError(f"fixed_base must be the arm's base (x, y), two finite numbers, got "
+                         f"{fixed_base!r}")
+    return base[:2]
 
 
 def _ordered_pair(bounds):

@@ -29,7 +29,7 @@ def checked_prediction(steps, period):
     default); ValueError naming the one that is not."""
     if not is_whole(steps):
         raise ValueError(f"prediction_steps must be a whole number >= 0, got {steps!r}")
-    if period:
+    if period is not None:  # 0 too is refused, not taken for the default
         checked_period(period, "prediction_period")
     return int(steps)
 
@@ -98,12 +98,12 @@ class DmpBank(BankSystem):
         - operator_active (optional)
         - followed_goal (optional)
         - selected_goal (optional)
-        - predicted_goals (with predicted_goal_count)
+        - predicted_goals (with prediction_steps > 0 and predicted_goal_count)
         output_ports:
         - references
         - selected_reference
         - phase
-        - predicted_paths
+        - predicted_paths (with prediction_steps > 0)
 
     `robot_state` is `[position (D), velocity (D)]`; `goals` is K goals flattened row-major
     `(K, D)`. Each period every DMP advances one step from the robot's position;
@@ -135,7 +135,8 @@ class DmpBank(BankSystem):
         self._max_speed = checked_speed_limit(max_speed, "max_speed")
         self._period = checked_period(control_period)
         self._prediction_steps = checked_prediction(prediction_steps, prediction_period)
-        self._prediction_period = float(prediction_period or control_period)
+        self._prediction_period = float(
+            control_period if prediction_period is None else prediction_period)
         self._lock = bool(lock_phase_when_operator_acts)
         update_offset = checked_update_offset(update_offset, self._period)
         k = self._goal_count = bank.goal_count

@@ -102,7 +102,8 @@ class PoseDmpBank(BankSystem):
             "phase", k, self._calc_phase, prerequisites_of_calc={self.xd_ticket()})
         self._prediction_steps = checked_prediction(prediction_steps, prediction_period)
         self._prediction_period = float(
-            prediction_period or position_bank.duration / max(self._prediction_steps, 1))
+            position_bank.duration / max(self._prediction_steps, 1)
+            if prediction_period is None else prediction_period)
         self._predicted_poses_port = None
         if self._prediction_steps > 0:
             self._predicted_poses_port = self.DeclareVectorOutputPort(

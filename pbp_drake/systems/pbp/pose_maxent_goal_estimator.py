@@ -4,7 +4,8 @@ import numpy as np
 
 from pbp_drake.core.hindsight_optimization import hop_targets
 from pbp_drake.systems.pbp.maxent_goal_estimator import CommandPosteriorBase, PosteriorInputs
-from pbp_drake.systems.ports import GoalPose, OperatorTwist, PoseState
+from pbp_drake.systems.ports import (
+    GoalPose, OperatorTwist, PoseState, finite_fields, finite_pose_state)
 
 
 class PoseMaxEntGoalEstimator(CommandPosteriorBase):
@@ -44,8 +45,9 @@ class PoseMaxEntGoalEstimator(CommandPosteriorBase):
 
     def _inputs(self, context):
         poses = self._goals_port.Eval(context).reshape(self._goal_count, GoalPose.size)
-        hand = self._hand_port.Eval(context)
-        twist = self._twist_port.Eval(context)
+        hand = finite_pose_state(self._hand_port.Eval(context), "hand_pose")
+        twist = finite_fields(self._twist_port.Eval(context), "operator_twist",
+                              OperatorTwist.get_fields())
         orientation = hand[3:7] / np.linalg.norm(hand[3:7])
         return PosteriorInputs(self._targets(poses), hand[:3], twist[:3], hand[7:10],
                                orientation, twist[3:], hand[10:13])

@@ -5,7 +5,8 @@ import numpy as np
 
 from pbp_drake.core.grasp_task import grasp_progress, grasp_success
 from pbp_drake.core.hand_over import check_limit
-from pbp_drake.systems.ports import PoseState
+from pbp_drake.core.quaternion import unit_quaternions
+from pbp_drake.systems.ports import PoseState, finite_pose_state
 from pbp_drake.systems.tasks.task_monitor import TaskMonitorBase
 
 
@@ -37,7 +38,16 @@ class GraspTaskMonitor(TaskMonitorBase):
         super().__init__("hand_pose", PoseState.size, grasp_positions, targets,
                          switch_schedule, control_period)
         self._orientations = np.asarray(grasp_orientations, float)
+        if self._orientations.shape != (len(self._objects), 4):
+            raise ValueError(f"grasp_orientations must be one quaternion (w, x, y, z) per grasp "
+                             f"position, ({len(self._objects)}, 4), got shape "
+                             f"{self._orientations.shape}")
+        unit_quaternions(self._orientations, "grasp_orientations")  # a check: kept as given
         start_pose = np.asarray(start_pose, float)
+        if start_pose.shape != (7,) or not np.isfinite(start_pose).all():
+            raise ValueError(f"start_pose must be 7 finite numbers [x, y, z, qw, qx, qy, qz], "
+                             f"got {start_pose.tolist()}")
+        unit_quaternions(start_pose[3:], "start_pose orientation")
         self._start_position, self._start_orientation = start_pose[:3], start_pose[3:7]
         self._success_distance = check_limit(success_distance, "success_distance", "m")
         self._success_angle = check_limit(success_angle, "success_angle", "rad")
@@ -48,7 +58,7 @@ class GraspTaskMonitor(TaskMonitorBase):
         return self._orientations
 
     def _read_hand(self, vector):
-        hand = np.asarray(vector, float)
+        hand = finite_pose_state(vector, "hand_pose")
         return hand[:3], hand[3:7] / np.linalg.norm(hand[3:7])
 
     def _progress(self, hand, index):

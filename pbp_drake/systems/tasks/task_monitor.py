@@ -63,6 +63,9 @@ class TaskMonitorBase(PortGetters, LeafSystem):
         super().__init__()
         self._objects = checked_objects(objects, self._objects_name)
         count = len(self._objects)
+        if len(targets) == 0:
+            raise ValueError("targets must name at least one object (its index in "
+                             f"{self._objects_name}), got none")
         if not all(t in range(count) for t in targets):
             raise ValueError(f"targets must be object indices 0 to {count - 1}, got "
                              f"{list(targets)}")

@@ -38,8 +38,9 @@ from pbp_drake.scenarios.schema import (
 from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
-    check_grasp_task, check_numbers, check_obstacle_task, check_reach_task, check_seed,
-    check_pilot, check_time_steps, check_virtual_participant, require_finite, whole_steps)
+    check_duration, check_grasp_task, check_numbers, check_obstacle_task, check_reach_task,
+    check_seed, check_pilot, check_time_steps, check_virtual_participant, require_finite,
+    whole_steps)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -171,6 +172,7 @@ def _check_common(scenario):
         raise ScenarioError(f"scenario.goal_estimator.method {scenario.goal_estimator.method} "
                             f"reads grasp orientations: use it with task: !GraspTask {{...}}")
     check_time_steps([("scenario.control_period", scenario.control_period)])
+    check_duration(scenario.duration, scenario.control_period)
     check_seed(scenario.seed)
 
 

@@ -379,7 +379,8 @@ class Scenario(ControlSettings):
 
     #: The scenario's name (in outputs and the console).
     name: str = "scenario"
-    #: The time limit (s) of a run.
+    #: The time limit (s) of a run, at least one control_period: a run lasts the whole
+    #: control ticks nearest to it.
     duration: float = 2.0
     #: The seed of every random draw (an integer).
     seed: int = 0

@@ -86,6 +86,15 @@ def check_time_steps(time_steps):
                                 f"{SHORTEST_TIME_STEP:g} s")
 
 
+def check_duration(duration, control_period):
+    """The time limit holds at least one control tick: a run lasts the whole ticks nearest
+    to it, and a shorter one would end before the controller ever decided."""
+    if not duration >= control_period:
+        raise ScenarioError(f"scenario.duration {duration:g} s is shorter than one control "
+                            f"tick (scenario.control_period {control_period:g} s); expected at "
+                            f"least {control_period:g} s")
+
+
 def check_seed(seed, field="scenario.seed"):
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
         raise ScenarioError(f"{field} {seed!r} cannot seed the random draws; expected a "

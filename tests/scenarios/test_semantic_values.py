@@ -1,0 +1,43 @@
+"""Values of the right type that a scenario cannot use as written: each is refused by
+`run` and `study` in one line naming its field, exit 2, where it ran and did something else
+(exit 0) or ended in a traceback."""
+
+import pathlib
+
+import pytest
+
+from pbp_drake import cli
+
+DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
+
+
+def edited(tmp_path, file, old, new):
+    """The shipped `file` with its first `old` replaced by `new`, written to `tmp_path`."""
+    text = (DIAGRAMS / file).read_text()
+    assert old in text, old
+    path = tmp_path / file
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+def assert_refused(code, err, *words):
+    """A refusal: exit 2, one line naming each of `words`."""
+    assert code == 2, err
+    assert "Traceback" not in err, err
+    assert err.startswith("pbp-drake: ") and err.count("\n") == 1, err
+    for word in words:
+        assert word in err, (word, err)
+
+
+def test_a_duration_shorter_than_one_control_tick_is_refused(tmp_path, run_refused):
+    # It ran no tick at all, exit 0: the robot stood at its start.
+    path = edited(tmp_path, "toy_alt_vs_cont.yaml", "duration: 3.0", "duration: 0.004")
+    code, err, _ = run_refused(path)
+    assert_refused(code, err, "scenario.duration 0.004 s", "scenario.control_period 0.01 s")
+
+
+def test_study_refuses_a_duration_shorter_than_one_control_tick(tmp_path, capsys):
+    code = cli.main(["study", str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--output",
+                     str(tmp_path / "study"), "--set", "duration=0.004"])
+    assert_refused(code, capsys.readouterr().err, "scenario.duration 0.004 s", "--set")
+    assert not (tmp_path / "study").exists()

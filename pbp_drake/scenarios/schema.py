@@ -467,7 +467,7 @@ class AlphaStudy:
 class AltVsCont:
     """The same DMP and open-loop input in continuous and alternated mode (Fig. 4)."""
 
-    #: Both modes must end this close to the goal.
+    #: Both modes must end this close to the goal (m, positive).
     goal_tolerance: float = 0.01
 
 

@@ -41,3 +41,13 @@ def test_study_refuses_a_duration_shorter_than_one_control_tick(tmp_path, capsys
                      str(tmp_path / "study"), "--set", "duration=0.004"])
     assert_refused(code, capsys.readouterr().err, "scenario.duration 0.004 s", "--set")
     assert not (tmp_path / "study").exists()
+
+
+@pytest.mark.parametrize("tolerance", ["0.0", "-0.01"])
+def test_study_refuses_an_alt_vs_cont_goal_tolerance_no_run_can_meet(tmp_path, capsys,
+                                                                      tolerance):
+    # It ran both modes and reported that neither reached the goal, exit 0.
+    code = cli.main(["study", str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--output",
+                     str(tmp_path / "study"), "--set", f"study.goal_tolerance={tolerance}"])
+    assert_refused(code, capsys.readouterr().err, "study.goal_tolerance must be positive")
+    assert not (tmp_path / "study").exists()

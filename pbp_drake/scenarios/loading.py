@@ -335,6 +335,15 @@ def check_alpha_study(study, scenario, dimension):
     for alpha in study.alphas:
         if not (np.isfinite(alpha) and 0.0 <= alpha <= 1.0):
             raise ScenarioError(f"study.alphas has {alpha}, outside [0, 1]")
+    # The summary keys each alpha's results by it written with two decimals: a second
+    # alpha of the same key would overwrite the first's.
+    keys = [f"{alpha:.2f}" for alpha in study.alphas]
+    for index, key in enumerate(keys):
+        if keys.index(key) != index:
+            raise ScenarioError(f"study.alphas has {study.alphas[index]} and "
+                                f"{study.alphas[keys.index(key)]}, both {key} to two decimals "
+                                "(the summary's key of an alpha); give alphas that differ "
+                                "there")
     if scenario.demonstration is None:
         raise ScenarioError("the alpha study needs scenario.demonstration")
     check_operator_speeds(study, scenario)

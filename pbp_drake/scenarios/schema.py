@@ -451,7 +451,8 @@ class AlphaStudy:
     demonstration_obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     #: The test scenes.
     scenes: list[SceneVariant] = dataclasses.field(default_factory=list)
-    #: The fixed arbitration weights compared (each in [0, 1]).
+    #: The fixed arbitration weights compared (each in [0, 1], no two alike to two
+    #: decimals: the summary names each so).
     alphas: list[float] = dataclasses.field(
         default_factory=lambda: [round(0.1 * i, 1) for i in range(11)])
     #: The virtual operator's speeds (its `speed`) at which every scene runs: the summary

@@ -51,3 +51,13 @@ def test_study_refuses_an_alt_vs_cont_goal_tolerance_no_run_can_meet(tmp_path, c
                      str(tmp_path / "study"), "--set", f"study.goal_tolerance={tolerance}"])
     assert_refused(code, capsys.readouterr().err, "study.goal_tolerance must be positive")
     assert not (tmp_path / "study").exists()
+
+
+@pytest.mark.parametrize("alphas", ["[0.5, 0.5]", "[0.3, 0.5, 0.501]"])
+def test_study_refuses_alphas_the_summary_cannot_tell_apart(tmp_path, capsys, alphas):
+    # The summary keys each alpha by two decimals: the second run overwrote the first's
+    # results, and the study reported one alpha fewer, exit 0.
+    code = cli.main(["study", str(DIAGRAMS / "toy_alpha_study.yaml"), "--output",
+                     str(tmp_path / "study"), "--set", f"study.alphas={alphas}"])
+    assert_refused(code, capsys.readouterr().err, "study.alphas has 0.5", "0.50 to two decimals")
+    assert not (tmp_path / "study").exists()

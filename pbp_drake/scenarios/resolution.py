@@ -39,8 +39,8 @@ from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
     check_duration, check_grasp_task, check_numbers, check_obstacle_task, check_reach_task,
-    check_seed, check_pilot, check_time_steps, check_virtual_participant, require_finite,
-    whole_steps)
+    check_seed, check_pilot, check_simulator, check_time_steps, check_virtual_participant,
+    require_finite, whole_steps)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -173,6 +173,7 @@ def _check_common(scenario):
                             f"reads grasp orientations: use it with task: !GraspTask {{...}}")
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_duration(scenario.duration, scenario.control_period)
+    check_simulator(scenario.simulator)
     check_seed(scenario.seed)
 
 

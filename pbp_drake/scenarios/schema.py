@@ -385,7 +385,7 @@ class Scenario(ControlSettings):
     #: The seed of every random draw (an integer).
     seed: int = 0
     #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
-    #: its target_realtime_rate).
+    #: its target_realtime_rate). Its start_time stays 0: a scenario's times count from it.
     simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
 
 

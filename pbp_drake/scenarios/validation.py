@@ -9,7 +9,9 @@ import math
 import numbers
 
 import numpy as np
+from pydrake.systems.analysis import GetIntegrationSchemes
 
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.core.pilot_population import ParticipantPopulationParams, population_problem
 from pbp_drake.core.surrogate_pilots import ProportionalPilotParams
 from pbp_drake.scenarios.bounds import MAX_GOALS
@@ -93,6 +95,23 @@ def check_duration(duration, control_period):
         raise ScenarioError(f"scenario.duration {duration:g} s is shorter than one control "
                             f"tick (scenario.control_period {control_period:g} s); expected at "
                             f"least {control_period:g} s")
+
+
+def check_simulator(config, field="scenario.simulator"):
+    """Drake's `SimulatorConfig` of a scenario: an integration scheme Drake has, a positive
+    step size and accuracy, a real-time rate not negative (Drake takes a negative one as
+    0, as fast as possible), and a start at 0 s, which every time of a scenario counts
+    from (its ticks, an operator's script)."""
+    schemes = GetIntegrationSchemes()
+    if config.integration_scheme not in schemes:
+        raise ScenarioError(unknown_choice(f"{field}.integration_scheme",
+                                           config.integration_scheme, schemes))
+    require_finite(config, field, ("max_step_size", "accuracy"))
+    require_finite(config, field, ("target_realtime_rate",), positive=False)
+    if config.start_time != 0.0:
+        raise ScenarioError(f"{field}.start_time {config.start_time:g} s: a scenario's times "
+                            "(its control ticks, its duration, an operator's script) count "
+                            "from 0; expected 0")
 
 
 def check_seed(seed, field="scenario.seed"):

@@ -61,3 +61,23 @@ def test_study_refuses_alphas_the_summary_cannot_tell_apart(tmp_path, capsys, al
                      str(tmp_path / "study"), "--set", f"study.alphas={alphas}"])
     assert_refused(code, capsys.readouterr().err, "study.alphas has 0.5", "0.50 to two decimals")
     assert not (tmp_path / "study").exists()
+
+
+@pytest.mark.parametrize("setting, words", [
+    # Each ended in a RuntimeError from Drake with a traceback, exit 1.
+    ("simulator.integration_scheme=runge_kuta3",
+     ["scenario.simulator.integration_scheme 'runge_kuta3' is unknown",
+      "did you mean 'runge_kutta3'?"]),
+    ("simulator.max_step_size=-0.1", ["scenario.simulator.max_step_size", "positive"]),
+    ("simulator.start_time=5.0", ["scenario.simulator.start_time 5 s", "expected 0"]),
+    # Ran 1 s earlier than the operator's script and the time limit said, exit 0.
+    ("simulator.start_time=-1.0", ["scenario.simulator.start_time -1 s", "expected 0"]),
+    # Taken as 0 (as fast as possible) without a word.
+    ("simulator.target_realtime_rate=-1.0",
+     ["scenario.simulator.target_realtime_rate", "not negative"]),
+])
+def test_a_simulator_setting_drake_cannot_run_as_written_is_refused(tmp_path, capsys,
+                                                                     setting, words):
+    code = cli.main(["run", str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--headless", "--set",
+                     setting])
+    assert_refused(code, capsys.readouterr().err, *words)

@@ -330,6 +330,10 @@ def _check_toy_operator(operator, dimension):
                 "per time")
         if not np.isfinite(commands).all():
             raise ScenarioError("scenario.operator.commands contain NaN or infinite values")
+        if np.any(np.diff(np.asarray(operator.times, float)) <= 0):
+            raise ScenarioError(f"scenario.operator.times {operator.times} do not increase; "
+                                "expected times (s) that increase strictly, each command "
+                                "held from its time until the next")
 
 
 def _resolve_task_robot(scenario):

@@ -197,7 +197,7 @@ class SinusoidalStep:
 class ScriptedCommands:
     """Commands `(T, D)` held from each of `times` until the next."""
 
-    #: When each command starts (s), increasing.
+    #: When each command starts (s), increasing strictly.
     times: list[float] = dataclasses.field(default_factory=list)
     #: The commands (m/s), one row per time.
     commands: list[list[float]] = dataclasses.field(default_factory=list)

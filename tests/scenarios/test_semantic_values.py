@@ -81,3 +81,13 @@ def test_a_simulator_setting_drake_cannot_run_as_written_is_refused(tmp_path, ca
     code = cli.main(["run", str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--headless", "--set",
                      setting])
     assert_refused(code, capsys.readouterr().err, *words)
+
+
+@pytest.mark.parametrize("times", ["[1.0, 0.5]", "[0.5, 0.5]"])
+def test_scripted_commands_whose_times_do_not_increase_are_refused(tmp_path, capsys, times):
+    # The operator refused them when the diagram was built: a ValueError, a traceback.
+    code = cli.main(["run", str(DIAGRAMS / "toy_alt_vs_cont.yaml"), "--headless", "--set",
+                     f"operator=!ScriptedCommands {{times: {times}, "
+                     "commands: [[0.0, 1.0], [0.0, 0.0]]}"])
+    assert_refused(code, capsys.readouterr().err, f"scenario.operator.times {times}",
+                   "increase strictly")

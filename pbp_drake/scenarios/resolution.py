@@ -24,6 +24,7 @@ from pbp_drake.core.goal_estimation import READS_INTENT, READS_POSE, estimator_e
 from pbp_drake.core.choices import did_you_mean
 from pbp_drake.core.methods import METHODS, method_entry
 from pbp_drake.core.toy_scene import bent_path
+from pbp_drake.systems.operators.browser_input import check_params
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
@@ -32,9 +33,9 @@ from pbp_drake.robots.task_space_bridge import validate_task_space_bridge
 from pbp_drake.scenarios.bounds import check_goal_counts, is_special_file
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, RENAMED_METHODS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles, Gamepad,
-    GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, PointScenario, Scenario, ScenarioError,
-    ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
-    TaskScenario, VirtualParticipant)
+    GraspTask, Hsr, Keyboard, MultiGoalReach, ObstacleRepulsion, PointScenario, Scenario,
+    ScenarioError, ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot,
+    SinusoidalStep, TaskScenario, VirtualParticipant)
 from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
@@ -368,6 +369,8 @@ def _resolve_task_robot(scenario):
                         "direction_noise", "speed_noise"), positive=False)
     if isinstance(operator, VirtualParticipant):
         check_virtual_participant(operator)
+    if isinstance(operator, (Keyboard, Gamepad)):
+        _check_person(operator, scenario.task)
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(robot, Hsr) and robot.hardware is not None:
@@ -509,6 +512,19 @@ def _check_bridge(hardware, task):
             f"state alone; scenario.task !{type(task).__name__} needs more of the station "
             "(the obstacles' positions and contacts, the hand's pose): the bridge runs the "
             "reaching task")
+
+
+def _check_person(operator, task):
+    """A person's `!Keyboard` or `!Gamepad` as its operator system takes it: a gamepad's
+    dead zone a fraction of the stick's travel; on the grasping task's pose operators, a
+    turn rate and a key's hold time above 0."""
+    positive = ()
+    if isinstance(task, GraspTask):
+        positive = ("rotation_speed", "hold_time") if isinstance(operator, Keyboard) else (
+            "rotation_speed",)
+    fraction = ("dead_zone",) if isinstance(operator, Gamepad) else ()
+    with _refused_as("", f"{type(operator).__name__}.", "scenario.operator."):
+        check_params(operator, positive=positive, fraction=fraction)
 
 
 def _check_hand_over(scenario):

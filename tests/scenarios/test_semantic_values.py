@@ -7,6 +7,7 @@ import pathlib
 import pytest
 
 from pbp_drake import cli
+from pbp_drake.commands import run_page
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[2] / "diagrams"
 
@@ -91,3 +92,25 @@ def test_scripted_commands_whose_times_do_not_increase_are_refused(tmp_path, cap
                      "commands: [[0.0, 1.0], [0.0, 0.0]]}"])
     assert_refused(code, capsys.readouterr().err, f"scenario.operator.times {times}",
                    "increase strictly")
+
+
+@pytest.mark.parametrize("file, operator, words", [
+    ("hsr_reach.yaml", "!Gamepad {dead_zone: 1.0}",
+     "scenario.operator.dead_zone must be in [0, 1), not 1.0"),
+    ("hsr_grasp.yaml", "!Gamepad {dead_zone: 1.5}",
+     "scenario.operator.dead_zone must be in [0, 1), not 1.5"),
+    # The grasping task's pose operators divide by them.
+    ("hsr_grasp.yaml", "!Keyboard {rotation_speed: 0.0}",
+     "scenario.operator.rotation_speed must be finite and positive"),
+    ("hsr_grasp.yaml", "!Keyboard {hold_time: 0.0}",
+     "scenario.operator.hold_time must be finite and positive"),
+])
+def test_a_person_operator_its_system_refuses_is_refused_before_the_page_opens(
+        monkeypatch, capsys, file, operator, words):
+    # The operator system refused it as the diagram was built, with a traceback.
+    def no_page(*args, **kwargs):
+        raise AssertionError("the file was accepted and Meshcat started")
+
+    monkeypatch.setattr(run_page, "Meshcat", no_page)
+    code = cli.main(["run", str(DIAGRAMS / file), "--set", f"operator={operator}"])
+    assert_refused(code, capsys.readouterr().err, words)

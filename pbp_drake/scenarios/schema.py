@@ -314,8 +314,9 @@ class DynamicObstacles:
     #: other (the HSR's scene; an arm's workspace takes less).
     obstacle_spacing: float = 0.45
     #: Fixed starts `(N, 2)` (x, y, m) of the obstacle_count obstacles instead of drawing
-    #: them (they may stand closer than obstacle_spacing to each other: a wall); the target
-    #: is then drawn at least obstacle_spacing from each. With obstacle_speed 0 they stay.
+    #: them (they may stand closer than obstacle_spacing to each other: a wall, but not to
+    #: the robot's base); the target is then drawn at least obstacle_spacing from each.
+    #: With obstacle_speed 0 they stay.
     obstacle_starts: list[list[float]] = dataclasses.field(default_factory=list)
 
 

@@ -232,6 +232,12 @@ def check_obstacle_task(task):
             if len(start) != 2 or not all(math.isfinite(value) for value in start):
                 raise ScenarioError(f"scenario.task.obstacle_starts[{index}] {start} is no "
                                     "floor position; expected two finite numbers (x, y)")
+            # As a drawn obstacle: none starts on the robot, in collision from the start.
+            if math.hypot(*start) < task.obstacle_spacing:
+                raise ScenarioError(
+                    f"scenario.task.obstacle_starts[{index}] {start} stands "
+                    f"{math.hypot(*start):.2f} m from the robot's base at (0, 0); expected "
+                    f"at least obstacle_spacing {task.obstacle_spacing:g} m from it")
     check_range(task, "scenario.task", "activation_range", within=(0.0, 1.0))
 
 

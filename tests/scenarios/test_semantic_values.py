@@ -114,3 +114,13 @@ def test_a_person_operator_its_system_refuses_is_refused_before_the_page_opens(
     monkeypatch.setattr(run_page, "Meshcat", no_page)
     code = cli.main(["run", str(DIAGRAMS / file), "--set", f"operator={operator}"])
     assert_refused(code, capsys.readouterr().err, words)
+
+
+def test_a_given_obstacle_start_on_the_robot_is_refused(tmp_path, run_refused):
+    # Drawn obstacles keep obstacle_spacing from the robot's base; a given one on it ran
+    # the trial in collision from the start, exit 1 as a failed task.
+    path = edited(tmp_path, "hsr_wall.yaml", "obstacle_starts: [[1.1, -0.2],",
+                  "obstacle_starts: [[0.2, -0.2],")
+    code, err, _ = run_refused(path)
+    assert_refused(code, err, "scenario.task.obstacle_starts[0] [0.2, -0.2] stands 0.28 m",
+                   "obstacle_spacing 0.45 m")

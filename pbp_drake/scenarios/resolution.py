@@ -315,9 +315,10 @@ def _check_toy_operator(operator, dimension):
     if isinstance(operator, ObstacleRepulsion):
         if operator.axis:
             check_direction(operator.axis, dimension, "scenario.operator.axis")
-        if not np.isfinite(operator.speed) or not operator.distance_threshold > 0:
-            raise ScenarioError("scenario.operator.speed must be finite and "
-                                "distance_threshold positive")
+        # A negative speed would push toward the obstacle, as the alpha study's
+        # operator_speeds may not.
+        require_finite(operator, "scenario.operator", ("speed",), positive=False)
+        require_finite(operator, "scenario.operator", ("distance_threshold",))
     elif isinstance(operator, SinusoidalStep):
         check_direction(operator.axis, dimension, "scenario.operator.axis")
         if not (np.isfinite(operator.amplitude) and operator.duration > 0 and operator.period > 0):

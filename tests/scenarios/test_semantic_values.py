@@ -124,3 +124,11 @@ def test_a_given_obstacle_start_on_the_robot_is_refused(tmp_path, run_refused):
     code, err, _ = run_refused(path)
     assert_refused(code, err, "scenario.task.obstacle_starts[0] [0.2, -0.2] stands 0.28 m",
                    "obstacle_spacing 0.45 m")
+
+
+def test_an_obstacle_repulsion_pushing_toward_the_obstacle_is_refused(tmp_path, capsys):
+    # A negative speed pushed the robot into the obstacle it is to keep it from, exit 0.
+    code = cli.main(["run", str(DIAGRAMS / "toy_alpha_study.yaml"), "--headless", "--set",
+                     "operator.speed=-1.0"])
+    assert_refused(code, capsys.readouterr().err,
+                   "scenario.operator.speed must be finite and not negative, got -1.0")

@@ -20,9 +20,9 @@ from pbp_drake.scenarios.overrides import ScenarioOverrides, merged
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, RANGE, STUDY_SPLITS, TOY_OPERATORS, AlphaStudy, Arm, MethodComparison,
-    PointRobot, PointScenario, Scenario, ScenarioError, ScenarioFile, TaskScenario,
-    TaskScenarioFile)
+    HSR_OPERATORS, RANGE, STUDY_SPLITS, TOY_OPERATORS, AlphaStudy, AltVsCont, Arm,
+    MethodComparison, PointRobot, PointScenario, Scenario, ScenarioError, ScenarioFile,
+    TaskScenario, TaskScenarioFile)
 from pbp_drake.scenarios.validation import check_numbers, check_seed
 
 
@@ -113,6 +113,8 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
             check_alpha_study(loaded.study, scenario, resolved.start.size)
         if isinstance(loaded.study, MethodComparison):
             check_method_comparison(loaded.study, scenario)
+        if isinstance(loaded.study, AltVsCont):
+            check_goal_tolerance(loaded.study)
     except ScenarioError as error:
         raise ScenarioError(f"{origin}: {error}") from None
     return LoadedScenarioFile(path=None, scenario=scenario, study=loaded.study,
@@ -336,6 +338,15 @@ def check_alpha_study(study, scenario, dimension):
     for alpha in study.alphas:
         if not (np.isfinite(alpha) and 0.0 <= alpha <= 1.0):
             raise ScenarioError(f"study.alphas has {alpha}, outside [0, 1]")
+    # The summary keys each alpha's results by it written with two decimals: a second
+    # alpha of the same key would overwrite the first's.
+    keys = [f"{alpha:.2f}" for alpha in study.alphas]
+    for index, key in enumerate(keys):
+        if keys.index(key) != index:
+            raise ScenarioError(f"study.alphas has {study.alphas[index]} and "
+                                f"{study.alphas[keys.index(key)]}, both {key} to two decimals "
+                                "(the summary's key of an alpha); give alphas that differ "
+                                "there")
     if scenario.demonstration is None:
         raise ScenarioError("the alpha study needs scenario.demonstration")
     check_operator_speeds(study, scenario)
@@ -353,8 +364,7 @@ def check_alpha_study(study, scenario, dimension):
 def check_operator_speeds(study, scenario):
     """The alpha study's `operator_speeds` (each the virtual operator's `speed`) and its
     goal tolerance."""
-    if not (np.isfinite(study.goal_tolerance) and study.goal_tolerance > 0):
-        raise ScenarioError(f"study.goal_tolerance must be positive, got {study.goal_tolerance}")
+    check_goal_tolerance(study)
     if not study.operator_speeds:
         return
     if not hasattr(scenario.operator, "speed"):
@@ -367,6 +377,13 @@ def check_operator_speeds(study, scenario):
     keys = [f"{speed:g}" for speed in study.operator_speeds]
     if len(set(keys)) != len(keys):
         raise ScenarioError(f"study.operator_speeds repeats a speed: {study.operator_speeds}")
+
+
+def check_goal_tolerance(study):
+    """A toy study's `goal_tolerance` (m), within which a run's end reached the goal: at or
+    below 0 no run would."""
+    if not (np.isfinite(study.goal_tolerance) and study.goal_tolerance > 0):
+        raise ScenarioError(f"study.goal_tolerance must be positive, got {study.goal_tolerance}")
 
 
 def check_method_comparison(study, scenario):

@@ -24,6 +24,7 @@ from pbp_drake.core.goal_estimation import READS_INTENT, READS_POSE, estimator_e
 from pbp_drake.core.choices import did_you_mean
 from pbp_drake.core.methods import METHODS, method_entry
 from pbp_drake.core.toy_scene import bent_path
+from pbp_drake.systems.operators.browser_input import check_params
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
@@ -32,14 +33,15 @@ from pbp_drake.robots.task_space_bridge import validate_task_space_bridge
 from pbp_drake.scenarios.bounds import check_goal_counts, is_special_file
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, RENAMED_METHODS, TOY_OPERATORS, Arm, BentPath, DynamicObstacles, Gamepad,
-    GraspTask, Hsr, MultiGoalReach, ObstacleRepulsion, PointScenario, Scenario, ScenarioError,
-    ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot, SinusoidalStep,
-    TaskScenario, VirtualParticipant)
+    GraspTask, Hsr, Keyboard, MultiGoalReach, ObstacleRepulsion, PointScenario, Scenario,
+    ScenarioError, ScriptedCommands, PILOT_CONFIGS, ParticipantPopulation, ProportionalPilot,
+    SinusoidalStep, TaskScenario, VirtualParticipant)
 from pbp_drake.scenarios.task_scenes import TaskScene, scene_boxes, task_scene
 from pbp_drake.scenarios.validation import (
     MAX_LIKELY_PATHS, check_bent_path, check_count, check_direction, check_dmp_duration,
-    check_grasp_task, check_numbers, check_obstacle_task, check_reach_task, check_seed,
-    check_pilot, check_time_steps, check_virtual_participant, require_finite, whole_steps)
+    check_duration, check_grasp_task, check_numbers, check_obstacle_task, check_reach_task,
+    check_seed, check_pilot, check_simulator, check_time_steps, check_virtual_participant,
+    require_finite, whole_steps)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -171,6 +173,8 @@ def _check_common(scenario):
         raise ScenarioError(f"scenario.goal_estimator.method {scenario.goal_estimator.method} "
                             f"reads grasp orientations: use it with task: !GraspTask {{...}}")
     check_time_steps([("scenario.control_period", scenario.control_period)])
+    check_duration(scenario.duration, scenario.control_period)
+    check_simulator(scenario.simulator)
 
 
 def _check_operator(scenario):
@@ -310,9 +314,10 @@ def _check_toy_operator(operator, dimension):
     if isinstance(operator, ObstacleRepulsion):
         if operator.axis:
             check_direction(operator.axis, dimension, "scenario.operator.axis")
-        if not np.isfinite(operator.speed) or not operator.distance_threshold > 0:
-            raise ScenarioError("scenario.operator.speed must be finite and "
-                                "distance_threshold positive")
+        # A negative speed would push toward the obstacle, as the alpha study's
+        # operator_speeds may not.
+        require_finite(operator, "scenario.operator", ("speed",), positive=False)
+        require_finite(operator, "scenario.operator", ("distance_threshold",))
     elif isinstance(operator, SinusoidalStep):
         check_direction(operator.axis, dimension, "scenario.operator.axis")
         if not (np.isfinite(operator.amplitude) and operator.duration > 0 and operator.period > 0):
@@ -326,6 +331,10 @@ def _check_toy_operator(operator, dimension):
                 "per time")
         if not np.isfinite(commands).all():
             raise ScenarioError("scenario.operator.commands contain NaN or infinite values")
+        if np.any(np.diff(np.asarray(operator.times, float)) <= 0):
+            raise ScenarioError(f"scenario.operator.times {operator.times} do not increase; "
+                                "expected times (s) that increase strictly, each command "
+                                "held from its time until the next")
 
 
 def _resolve_task_robot(scenario):
@@ -361,6 +370,8 @@ def _resolve_task_robot(scenario):
                         "direction_noise", "speed_noise"), positive=False)
     if isinstance(operator, VirtualParticipant):
         check_virtual_participant(operator)
+    if isinstance(operator, (Keyboard, Gamepad)):
+        _check_person(operator, scenario.task)
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(robot, Hsr) and robot.hardware is not None:
@@ -502,6 +513,19 @@ def _check_bridge(hardware, task):
             f"state alone; scenario.task !{type(task).__name__} needs more of the station "
             "(the obstacles' positions and contacts, the hand's pose): the bridge runs the "
             "reaching task")
+
+
+def _check_person(operator, task):
+    """A person's `!Keyboard` or `!Gamepad` as its operator system takes it: a gamepad's
+    dead zone a fraction of the stick's travel; on the grasping task's pose operators, a
+    turn rate and a key's hold time above 0."""
+    positive = ()
+    if isinstance(task, GraspTask):
+        positive = ("rotation_speed", "hold_time") if isinstance(operator, Keyboard) else (
+            "rotation_speed",)
+    fraction = ("dead_zone",) if isinstance(operator, Gamepad) else ()
+    with _refused_as("", f"{type(operator).__name__}.", "scenario.operator."):
+        check_params(operator, positive=positive, fraction=fraction)
 
 
 def _check_hand_over(scenario):

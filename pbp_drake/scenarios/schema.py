@@ -197,7 +197,7 @@ class SinusoidalStep:
 class ScriptedCommands:
     """Commands `(T, D)` held from each of `times` until the next."""
 
-    #: When each command starts (s), increasing.
+    #: When each command starts (s), increasing strictly.
     times: list[float] = dataclasses.field(default_factory=list)
     #: The commands (m/s), one row per time.
     commands: list[list[float]] = dataclasses.field(default_factory=list)
@@ -314,8 +314,9 @@ class DynamicObstacles:
     #: other (the HSR's scene; an arm's workspace takes less).
     obstacle_spacing: float = 0.45
     #: Fixed starts `(N, 2)` (x, y, m) of the obstacle_count obstacles instead of drawing
-    #: them (they may stand closer than obstacle_spacing to each other: a wall); the target
-    #: is then drawn at least obstacle_spacing from each. With obstacle_speed 0 they stay.
+    #: them (they may stand closer than obstacle_spacing to each other: a wall, but not to
+    #: the robot's base); the target is then drawn at least obstacle_spacing from each.
+    #: With obstacle_speed 0 they stay.
     obstacle_starts: list[list[float]] = dataclasses.field(default_factory=list)
 
 
@@ -379,10 +380,11 @@ class Scenario(ControlSettings):
 
     #: The scenario's name (in outputs and the console).
     name: str = "scenario"
-    #: The time limit (s) of a run.
+    #: The time limit (s) of a run, at least one control_period: a run lasts the whole
+    #: control ticks nearest to it.
     duration: float = 2.0
     #: How runs are simulated (Drake's own config; `pbp-drake run --realtime-rate` sets
-    #: its target_realtime_rate).
+    #: its target_realtime_rate). Its start_time stays 0: a scenario's times count from it.
     simulator: SimulatorConfig = dataclasses.field(default_factory=SimulatorConfig)
 
 
@@ -450,7 +452,8 @@ class AlphaStudy:
     demonstration_obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     #: The test scenes.
     scenes: list[SceneVariant] = dataclasses.field(default_factory=list)
-    #: The fixed arbitration weights compared (each in [0, 1]).
+    #: The fixed arbitration weights compared (each in [0, 1], no two alike to two
+    #: decimals: the summary names each so).
     alphas: list[float] = dataclasses.field(
         default_factory=lambda: [round(0.1 * i, 1) for i in range(11)])
     #: The virtual operator's speeds (its `speed`) at which every scene runs: the summary
@@ -466,7 +469,7 @@ class AlphaStudy:
 class AltVsCont:
     """The same DMP and open-loop input in continuous and alternated mode (Fig. 4)."""
 
-    #: Both modes must end this close to the goal.
+    #: Both modes must end this close to the goal (m, positive).
     goal_tolerance: float = 0.01
 
 

@@ -9,7 +9,9 @@ import math
 import numbers
 
 import numpy as np
+from pydrake.systems.analysis import GetIntegrationSchemes
 
+from pbp_drake.core.choices import unknown_choice
 from pbp_drake.core.pilot_population import ParticipantPopulationParams, population_problem
 from pbp_drake.core.surrogate_pilots import ProportionalPilotParams
 from pbp_drake.scenarios.bounds import MAX_GOALS
@@ -84,6 +86,32 @@ def check_time_steps(time_steps):
         if not value >= SHORTEST_TIME_STEP:
             raise ScenarioError(f"{field} {value:g} s is too short; expected at least "
                                 f"{SHORTEST_TIME_STEP:g} s")
+
+
+def check_duration(duration, control_period):
+    """The time limit holds at least one control tick: a run lasts the whole ticks nearest
+    to it, and a shorter one would end before the controller ever decided."""
+    if not duration >= control_period:
+        raise ScenarioError(f"scenario.duration {duration:g} s is shorter than one control "
+                            f"tick (scenario.control_period {control_period:g} s); expected at "
+                            f"least {control_period:g} s")
+
+
+def check_simulator(config, field="scenario.simulator"):
+    """Drake's `SimulatorConfig` of a scenario: an integration scheme Drake has, a positive
+    step size and accuracy, a real-time rate not negative (Drake takes a negative one as
+    0, as fast as possible), and a start at 0 s, which every time of a scenario counts
+    from (its ticks, an operator's script)."""
+    schemes = GetIntegrationSchemes()
+    if config.integration_scheme not in schemes:
+        raise ScenarioError(unknown_choice(f"{field}.integration_scheme",
+                                           config.integration_scheme, schemes))
+    require_finite(config, field, ("max_step_size", "accuracy"))
+    require_finite(config, field, ("target_realtime_rate",), positive=False)
+    if config.start_time != 0.0:
+        raise ScenarioError(f"{field}.start_time {config.start_time:g} s: a scenario's times "
+                            "(its control ticks, its duration, an operator's script) count "
+                            "from 0; expected 0")
 
 
 def check_seed(seed, field="scenario.seed"):
@@ -204,6 +232,12 @@ def check_obstacle_task(task):
             if len(start) != 2 or not all(math.isfinite(value) for value in start):
                 raise ScenarioError(f"scenario.task.obstacle_starts[{index}] {start} is no "
                                     "floor position; expected two finite numbers (x, y)")
+            # As a drawn obstacle: none starts on the robot, in collision from the start.
+            if math.hypot(*start) < task.obstacle_spacing:
+                raise ScenarioError(
+                    f"scenario.task.obstacle_starts[{index}] {start} stands "
+                    f"{math.hypot(*start):.2f} m from the robot's base at (0, 0); expected "
+                    f"at least obstacle_spacing {task.obstacle_spacing:g} m from it")
     check_range(task, "scenario.task", "activation_range", within=(0.0, 1.0))
 
 

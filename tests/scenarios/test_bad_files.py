@@ -242,8 +242,8 @@ def test_a_path_of_another_type_is_named(path):
 @pytest.mark.parametrize("overrides", [["duration=2.0"], "duration=2.0", {"duration": 2.0}])
 def test_overrides_of_another_type_are_named(overrides):
     # A list, as --set is typed, failed in AttributeError: 'list' object has no 'words'.
-    with pytest.raises(TypeError, match=r"^overrides must be a ScenarioOverrides \(pbp_drake\."
-                                        r"scenarios\.overrides: ScenarioOverrides\(settings="
+    with pytest.raises(TypeError, match=r"^overrides must be a pbp_drake\.ScenarioOverrides "
+                                        r"\(e\.g\. ScenarioOverrides\(settings="
                                         r"\('duration=2.0',\)\), as --set\) or None; got "):
         load_scenario_file(DIAGRAMS / SHIPPED[0], overrides)
 

@@ -183,7 +183,7 @@ def test_a_bad_reaching_participant_value_is_refused_naming_its_field(tmp_path, 
      r"scenario.goals have dimension 3, scenario.start has 2"),
     # The 2-D scenes' operators.
     ("toy_alpha_study.yaml", "distance_threshold: 0.2", "distance_threshold: 0.0",
-     r"scenario.operator.speed must be finite and distance_threshold positive"),
+     r"scenario.operator.distance_threshold must be finite and positive, got 0.0"),
     ("toy_alt_vs_cont.yaml", "period: 1.6}", "period: 0.0}",
      r"scenario.operator.amplitude must be finite, duration and period positive"),
     ("toy_alt_vs_cont.yaml", "  operator: !SinusoidalStep {axis: [0.0, 1.0], amplitude: 1.0, "

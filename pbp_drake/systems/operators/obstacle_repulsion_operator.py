@@ -18,7 +18,7 @@ class ObstacleRepulsionParams:
 
     #: It pushes when the robot is closer than this (m) to the nearest obstacle.
     distance_threshold: float = 0.2
-    #: How fast it pushes away (the command's unit, m/s).
+    #: How fast it pushes away (the command's unit, m/s; not negative).
     speed: float = 1.0
     #: The direction it pushes along (a vector); empty: radially from the obstacle.
     axis: list[float] = dataclasses.field(default_factory=list)

@@ -20,7 +20,7 @@ from pbp_drake.scenarios.overrides import ScenarioOverrides, merged
 from pbp_drake.scenarios.resolution import (
     ResolvedScenario, check_obstacles, resolve, with_method)
 from pbp_drake.scenarios.schema import (
-    HSR_OPERATORS, RANGE, STUDY_SPLITS, TOY_OPERATORS, AlphaStudy, AltVsCont, Arm,
+    HSR_OPERATORS, RANGE, STUDY_SPLITS, TOY_OPERATORS, AlphaStudy, AltVsCont, Arm, alpha_key,
     MethodComparison, PointRobot, PointScenario, Scenario, ScenarioError, ScenarioFile,
     TaskScenario, TaskScenarioFile)
 from pbp_drake.scenarios.validation import check_numbers, check_seed
@@ -338,15 +338,11 @@ def check_alpha_study(study, scenario, dimension):
     for alpha in study.alphas:
         if not (np.isfinite(alpha) and 0.0 <= alpha <= 1.0):
             raise ScenarioError(f"study.alphas has {alpha}, outside [0, 1]")
-    # The summary keys each alpha's results by it written with two decimals: a second
-    # alpha of the same key would overwrite the first's.
-    keys = [f"{alpha:.2f}" for alpha in study.alphas]
+    # The summary keys each alpha's results by it: a second one would overwrite the first's.
+    keys = [alpha_key(alpha) for alpha in study.alphas]
     for index, key in enumerate(keys):
         if keys.index(key) != index:
-            raise ScenarioError(f"study.alphas has {study.alphas[index]} and "
-                                f"{study.alphas[keys.index(key)]}, both {key} to two decimals "
-                                "(the summary's key of an alpha); give alphas that differ "
-                                "there")
+            raise ScenarioError(f"study.alphas has {key} twice; give each alpha once")
     if scenario.demonstration is None:
         raise ScenarioError("the alpha study needs scenario.demonstration")
     check_operator_speeds(study, scenario)

@@ -452,8 +452,8 @@ class AlphaStudy:
     demonstration_obstacles: list[Obstacle] = dataclasses.field(default_factory=list)
     #: The test scenes.
     scenes: list[SceneVariant] = dataclasses.field(default_factory=list)
-    #: The fixed arbitration weights compared (each in [0, 1], no two alike to two
-    #: decimals: the summary names each so).
+    #: The fixed arbitration weights compared (each in [0, 1], no two alike; the summary
+    #: names each by `alpha_key`).
     alphas: list[float] = dataclasses.field(
         default_factory=lambda: [round(0.1 * i, 1) for i in range(11)])
     #: The virtual operator's speeds (its `speed`) at which every scene runs: the summary
@@ -463,6 +463,13 @@ class AlphaStudy:
     #: A run reached the goal when it ends this close to it (AltVsCont's tolerance). Reported
     #: beside the collision ratio; the ideal alpha stays the paper's (no collision).
     goal_tolerance: float = 0.01
+
+
+def alpha_key(alpha):
+    """An alpha as the alpha study's summary names it: with two decimals ("0.10"), or with
+    all its digits where two would round it ("0.125")."""
+    key = f"{alpha:.2f}"
+    return key if float(key) == alpha else repr(float(alpha))
 
 
 @dataclasses.dataclass

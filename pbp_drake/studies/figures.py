@@ -205,7 +205,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
             label = f"{scene['name']}, speed {key}"
             ratio_axes.plot(alphas, [o["collision_ratio"] for o in outcomes], "o" + style,
                             color=colour, ms=3, label=label + (
-                                f" (ideal alpha {results['ideal_alpha']:.1f})"
+                                f" (ideal alpha {results['ideal_alpha']:g})"
                                 if results["ideal_alpha"] is not None else ""))
             distance_axes.plot(alphas, [o["final_distance"] for o in outcomes], "o" + style,
                                color=colour, ms=3, label=label)

@@ -8,6 +8,7 @@ import pathlib
 
 from pbp_drake.scenarios import METHOD_NAMES, ScenarioError
 from pbp_drake.scenarios.overrides import ScenarioOverrides
+from pbp_drake.scenarios.schema import alpha_key
 from pbp_drake.studies.report import results_table
 from pbp_drake.studies.splits import SPLITS
 from pbp_drake.studies.toy import TOY_FIGURES
@@ -87,7 +88,7 @@ def _outcome_cell(outcome):
 def alpha_study_markdown(study, summary, figure):
     """One row per scene and operator speed: the ideal alpha, then the collision ratio and
     whether the goal was reached, for each fixed alpha and PBP mode."""
-    alphas = [f"{alpha:.2f}" for alpha in summary["alphas"]]
+    alphas = [alpha_key(alpha) for alpha in summary["alphas"]]
     speeds = ", ".join("-" if s is None else f"{s:g}" for s in summary["operator_speeds"])
     lines = [f"`{_toy_command(study, summary)}` — the 2-D alpha study (Fig. 2): "
              f"{len(summary['scenes'])} scenes at operator speeds {speeds}", "",

@@ -12,6 +12,7 @@ import numpy as np
 from pbp_drake.core.methods import methods_of
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.scenarios import AlphaStudy, AltVsCont, resolve
+from pbp_drake.scenarios.schema import alpha_key
 from pbp_drake.builder.run import simulate
 from pbp_drake.studies.atomic_files import write_atomically
 from pbp_drake.studies.figures import plot_alpha_study, plot_alt_vs_cont
@@ -119,11 +120,11 @@ def _scene_at_speed(base, study, scene, goal, speed, trajectories):
     fixed = {}
     for alpha in study.alphas:
         run = simulate(base.with_method(f"fixed_alpha={alpha!r}"))
-        fixed[f"{alpha:.2f}"] = run_outcome(run, scene.obstacles, goal, study.goal_tolerance)
+        fixed[alpha_key(alpha)] = run_outcome(run, scene.obstacles, goal, study.goal_tolerance)
         trajectories[(scene.name, speed_key(speed), alpha)] = run.positions
     # The highest alpha that still lets the operator pass the obstacles untouched.
     results = {"operator_speed": speed, "ideal_alpha": ideal_alpha(
-        [(alpha, fixed[f"{alpha:.2f}"]["collision_ratio"]) for alpha in study.alphas],
+        [(alpha, fixed[alpha_key(alpha)]["collision_ratio"]) for alpha in study.alphas],
         collision_free), "fixed_alpha": fixed}
     pushes = []
     for method in PBP_METHODS:
@@ -146,7 +147,7 @@ def print_alpha_study(summary):
             fixed = results["fixed_alpha"]
             ideal = results["ideal_alpha"]
             ideal_text = "none" if ideal is None else (
-                f"{ideal:.1f} ({_outcome_text(fixed[f'{ideal:.2f}'])})")
+                f"{ideal:g} ({_outcome_text(fixed[alpha_key(ideal)])})")
             reaching = sum(outcome["reached"] for outcome in fixed.values())
             print(f"  {scene['name']}, operator speed {key}: ideal alpha {ideal_text}; "
                   f"{reaching} of {len(fixed)} alphas reach the goal; "

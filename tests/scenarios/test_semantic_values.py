@@ -2,6 +2,7 @@
 `run` and `study` in one line naming its field, exit 2, where it ran and did something else
 (exit 0) or ended in a traceback."""
 
+import json
 import pathlib
 
 import pytest
@@ -54,14 +55,29 @@ def test_study_refuses_an_alt_vs_cont_goal_tolerance_no_run_can_meet(tmp_path, c
     assert not (tmp_path / "study").exists()
 
 
-@pytest.mark.parametrize("alphas", ["[0.5, 0.5]", "[0.3, 0.5, 0.501]"])
-def test_study_refuses_alphas_the_summary_cannot_tell_apart(tmp_path, capsys, alphas):
-    # The summary keys each alpha by two decimals: the second run overwrote the first's
-    # results, and the study reported one alpha fewer, exit 0.
+def test_study_refuses_an_alpha_given_twice(tmp_path, capsys):
+    # The summary keys each alpha's results by it: the second run overwrote the first's,
+    # and the study reported one alpha fewer, exit 0.
     code = cli.main(["study", str(DIAGRAMS / "toy_alpha_study.yaml"), "--output",
-                     str(tmp_path / "study"), "--set", f"study.alphas={alphas}"])
-    assert_refused(code, capsys.readouterr().err, "study.alphas has 0.5", "0.50 to two decimals")
+                     str(tmp_path / "study"), "--set", "study.alphas=[0.3, 0.5, 0.5]"])
+    assert_refused(code, capsys.readouterr().err, "study.alphas has 0.50 twice")
     assert not (tmp_path / "study").exists()
+
+
+@pytest.mark.slow
+def test_alphas_alike_to_two_decimals_are_each_named_by_all_their_digits(tmp_path, capsys):
+    # They were named by two decimals: 0.501's results overwrote 0.5's, and 0.125 was
+    # filed and tabled as 0.12.
+    output = tmp_path / "study"
+    assert cli.main(["study", str(DIAGRAMS / "toy_alpha_study.yaml"), "--output",
+                     str(output), "--set", "study.alphas=[0.125, 0.5, 0.501]"]) == 0
+    summary = json.loads((output / "summary.json").read_text())
+    for scene in summary["scenes"]:
+        for results in scene["by_operator_speed"].values():
+            assert list(results["fixed_alpha"]) == ["0.125", "0.50", "0.501"]
+    markdown = tmp_path / "alphas.md"
+    assert cli.main(["report", str(output), "--markdown", str(markdown)]) == 0
+    assert "| alpha 0.125 | alpha 0.50 | alpha 0.501 |" in markdown.read_text()
 
 
 @pytest.mark.parametrize("setting, words", [

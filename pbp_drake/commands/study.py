@@ -313,9 +313,9 @@ def _print_report(summary, output):
 
 
 def _compare(args):
-    """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric moved by
-    more than the first study's trial-to-trial SD or a file was damaged (each named on
-    stderr, its trial left out), 2 when the studies share no trial."""
+    """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric of two
+    pairs or more moved by more than the first study's trial-to-trial SD or a file was
+    damaged (each named on stderr, its trial left out), 2 when the studies share no trial."""
     for which, folder in (("first", args.first), ("second", args.second)):
         _check_is_folder(folder, f"compare: the {which} folder's")
         kind = folder_kind(folder)
@@ -332,10 +332,15 @@ def _compare(args):
         raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
                             "both ran without an error")
     print(paired_table(rows, "A", "B"), end="")
-    moved = [row for row in rows if not row.within_sd]
+    moved = [row for row in rows if row.moved]
+    judged = sum(row.judged for row in rows)
+    single = len(rows) - judged
     print(f"A = {args.first}, B = {args.second}. " + (
-        f"{len(moved)} of {len(rows)} rows moved by more than A's trial-to-trial SD."
-        if moved else f"All {len(rows)} rows within A's trial-to-trial SD.")
+        f"{len(moved)} of {judged} rows moved by more than A's trial-to-trial SD."
+        if moved else f"All {judged} rows within A's trial-to-trial SD." if judged else
+        "No row has two pairs: nothing is judged; run both studies with more trials.")
+        + (f" {counted(single, 'row')} of a single pair not judged (one trial has no SD)."
+           if single and judged else "")
         + "".join(f" {method}: only in {side}, not compared." for method, side in unpaired))
     if damaged:
         print(f"pbp-drake: {len(damaged)} damaged or foreign files skipped (listed above); "

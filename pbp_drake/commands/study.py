@@ -341,7 +341,9 @@ def _compare(args):
         "No row has two pairs: nothing is judged; run both studies with more trials.")
         + (f" {counted(single, 'row')} of a single pair not judged (one trial has no SD)."
            if single and judged else "")
-        + "".join(f" {method}: only in {side}, not compared." for method, side in unpaired))
+        + "".join(f" {method}: only in {side}, not compared." if side else
+                  f" {method}: no seed both ran without an error, not compared."
+                  for method, side in unpaired))
     if damaged:
         print(f"pbp-drake: {len(damaged)} damaged or foreign files skipped (listed above); "
               "their trials are left out of the pairs", file=sys.stderr)

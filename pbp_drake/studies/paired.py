@@ -106,7 +106,8 @@ def paired_comparison(folder_a, folder_b, damaged=None, unpaired=None):
     the seeds both ran (collisions only where both tasks measure them). Each folder's
     damaged or foreign files (their trials left out) are appended to `damaged` as a
     `trial_files.Damage`, and each method only one folder ran to `unpaired` as `(method,
-    "A" or "B")`, when they are given."""
+    "A" or "B")`, one both ran but on no seed both ran without an error as `(method,
+    None)`, when they are given."""
     study_a, records_a, damaged_a = read_study(folder_a)
     study_b, records_b, damaged_b = read_study(folder_b)
     if damaged is not None:
@@ -120,8 +121,11 @@ def paired_comparison(folder_a, folder_b, damaged=None, unpaired=None):
                   and measures_collisions(study_b, records_b, folder_b))
     rows = []
     for method in [m for m in study_a["methods"] if m in study_b["methods"]]:
-        rows += _paired_rows(method, _by_seed(study_a, records_a, method),
+        found = _paired_rows(method, _by_seed(study_a, records_a, method),
                              _by_seed(study_b, records_b, method), collisions)
+        if not found and unpaired is not None:
+            unpaired.append((method, None))
+        rows += found
     return rows
 
 

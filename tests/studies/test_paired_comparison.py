@@ -112,6 +112,22 @@ def test_a_method_only_one_study_ran_is_named_as_not_compared(tmp_path, repo, ca
 
 
 @pytest.mark.slow
+def test_a_method_both_ran_on_no_common_seed_is_named_as_not_compared(tmp_path, repo,
+                                                                      capsys):
+    # Every teleop trial of B failed: teleop was left out of the table without a word.
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a, b = _study(tmp_path / "a", scenario), _study(tmp_path / "b", scenario)
+    for path in b.glob("trials/teleop/seed_*.json"):
+        path.write_text(json.dumps({**json.loads(path.read_text()),
+                                    "error": "RuntimeError: the solver failed"}))
+    assert main(["compare", str(a), str(b)]) == 0
+    out = capsys.readouterr().out
+    assert "| teleop |" not in out
+    assert out.endswith("All 6 rows within A's trial-to-trial SD. teleop: no seed both ran "
+                        "without an error, not compared.\n")
+
+
+@pytest.mark.slow
 def test_a_metric_of_one_pair_is_shown_not_judged(tmp_path, repo, capsys):
     # One trial's SD is unknown: it read as 0, so any difference "moved" (exit 1).
     scenario = repo / "diagrams" / "hsr_reach.yaml"

@@ -33,7 +33,7 @@ from pbp_drake.studies.folders import TOY_STUDIES, folder_kind
 from pbp_drake.studies.results_markdown import (
     check_markdown_path, method_comparison_markdown, read_study_json, toy_markdown,
     write_markdown, write_toy_study)
-from pbp_drake.studies.splits import SPLITS, first_seed, split_of
+from pbp_drake.studies.splits import SPLITS, check_within_split, first_seed, split_of
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 from pbp_drake.scenarios.validation import check_seed
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
@@ -213,6 +213,10 @@ def _method_study(args, scenario_file, overrides):
     if args.seed is not None:
         check_seed(args.seed, "--seed")
     seed = first_seed(study, study.split) if args.seed is None else args.seed
+    if args.split is not None or args.seed is None:  # else --seed's seeds, labelled
+        check_within_split(study, study.split, seed, study.trials,
+                           f"--split {args.split}" if args.split else
+                           f"{args.scenario}'s study.split {study.split}")
     split = split_of(study, seed, study.trials)
     if args.jobs < 1:
         raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")

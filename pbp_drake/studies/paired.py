@@ -37,6 +37,10 @@ _METRICS = (
 )
 
 
+# A difference up to this fraction of the means is floating point's, not a metric's move.
+_ROUNDING = 1e-9
+
+
 # What `report --paired-with` tells of each method against the reference: the outcome, the
 # operator's input and the time (the collisions where the task measures them).
 PAIRED_METRICS = ("success", "intervention_ratio", "task_time", "collision_ratio")
@@ -65,11 +69,17 @@ class PairedRow:
 
     @property
     def within_sd(self):
-        return self.judged and abs(self.difference) <= self.sd_a
+        return self.judged and abs(self.difference) <= self.sd_a + self._rounding
 
     @property
     def within_se(self):
-        return self.judged and abs(self.difference) <= self.se_a
+        return self.judged and abs(self.difference) <= self.se_a + self._rounding
+
+    @property
+    def _rounding(self):
+        """What floating point alone makes of a difference (the same value computed twice
+        may differ in its last bit): never a move, even against an SD of 0."""
+        return _ROUNDING * max(abs(self.mean_a), abs(self.mean_b))
 
     @property
     def moved(self):

@@ -128,6 +128,20 @@ def test_a_method_both_ran_on_no_common_seed_is_named_as_not_compared(tmp_path, 
 
 
 @pytest.mark.slow
+def test_a_difference_of_the_last_bit_is_not_a_move(tmp_path, repo, capsys):
+    # A constant metric (SD 0) computed as 1.0000000000000002 once in B "moved" (exit 1).
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a, b = _study(tmp_path / "a", scenario), _study(tmp_path / "b", scenario)
+    path = trial_paths(b, "teleop", 3)[0]
+    path.write_text(json.dumps({**json.loads(path.read_text()),
+                                "peak_command_acceleration": 1.0000000000000002}))
+    assert main(["compare", str(a), str(b)]) == 0
+    out = capsys.readouterr().out
+    assert "| peak_command_acceleration | teleop | 6 | 1 | +3.7e-17 " in out
+    assert "**no**" not in out and "All 12 rows within A's trial-to-trial SD." in out
+
+
+@pytest.mark.slow
 def test_a_metric_of_one_pair_is_shown_not_judged(tmp_path, repo, capsys):
     # One trial's SD is unknown: it read as 0, so any difference "moved" (exit 1).
     scenario = repo / "diagrams" / "hsr_reach.yaml"

@@ -33,7 +33,7 @@ from pbp_drake.studies.folders import TOY_STUDIES, folder_kind
 from pbp_drake.studies.results_markdown import (
     check_markdown_path, method_comparison_markdown, read_study_json, toy_markdown,
     write_markdown, write_toy_study)
-from pbp_drake.studies.splits import SPLITS, first_seed, split_of
+from pbp_drake.studies.splits import SPLITS, check_within_split, first_seed, split_of
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 from pbp_drake.scenarios.validation import check_seed
 from pbp_drake.studies.toy import TOY_FIGURES, print_alpha_study, run_study
@@ -213,6 +213,10 @@ def _method_study(args, scenario_file, overrides):
     if args.seed is not None:
         check_seed(args.seed, "--seed")
     seed = first_seed(study, study.split) if args.seed is None else args.seed
+    if args.split is not None or args.seed is None:  # else --seed's seeds, labelled
+        check_within_split(study, study.split, seed, study.trials,
+                           f"--split {args.split}" if args.split else
+                           f"{args.scenario}'s study.split {study.split}")
     split = split_of(study, seed, study.trials)
     if args.jobs < 1:
         raise ScenarioError(f"--jobs {args.jobs}: give a positive number of processes")
@@ -313,9 +317,9 @@ def _print_report(summary, output):
 
 
 def _compare(args):
-    """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric moved by
-    more than the first study's trial-to-trial SD or a file was damaged (each named on
-    stderr, its trial left out), 2 when the studies share no trial."""
+    """Prints the paired table (`pbp_drake.studies.paired`); exit 1 when a metric of two
+    pairs or more moved by more than the first study's trial-to-trial SD or a file was
+    damaged (each named on stderr, its trial left out), 2 when the studies share no trial."""
     for which, folder in (("first", args.first), ("second", args.second)):
         _check_is_folder(folder, f"compare: the {which} folder's")
         kind = folder_kind(folder)
@@ -332,11 +336,18 @@ def _compare(args):
         raise ScenarioError(f"{args.first} and {args.second} share no method and seed that "
                             "both ran without an error")
     print(paired_table(rows, "A", "B"), end="")
-    moved = [row for row in rows if not row.within_sd]
+    moved = [row for row in rows if row.moved]
+    judged = sum(row.judged for row in rows)
+    single = len(rows) - judged
     print(f"A = {args.first}, B = {args.second}. " + (
-        f"{len(moved)} of {len(rows)} rows moved by more than A's trial-to-trial SD."
-        if moved else f"All {len(rows)} rows within A's trial-to-trial SD.")
-        + "".join(f" {method}: only in {side}, not compared." for method, side in unpaired))
+        f"{len(moved)} of {judged} rows moved by more than A's trial-to-trial SD."
+        if moved else f"All {judged} rows within A's trial-to-trial SD." if judged else
+        "No row has two pairs: nothing is judged; run both studies with more trials.")
+        + (f" {counted(single, 'row')} of a single pair not judged (one trial has no SD)."
+           if single and judged else "")
+        + "".join(f" {method}: only in {side}, not compared." if side else
+                  f" {method}: no seed both ran without an error, not compared."
+                  for method, side in unpaired))
     if damaged:
         print(f"pbp-drake: {len(damaged)} damaged or foreign files skipped (listed above); "
               "their trials are left out of the pairs", file=sys.stderr)

@@ -2,7 +2,8 @@
 study's methods against one of them (`pbp-drake report DIR --paired-with METHOD`). Per
 metric: A's mean, the paired difference B - A with its 95 % t interval, and A's SD and SE;
 a difference is *within noise* when its mean is no larger than A's SD, the spread one
-trial already carries (docs/tasks/studies.md, "Report and compare").
+trial already carries (docs/tasks/studies.md, "Report and compare"). A metric of a single
+pair has no SD, SE or interval: it is shown, not judged.
 """
 
 import dataclasses
@@ -36,6 +37,10 @@ _METRICS = (
 )
 
 
+# A difference up to this fraction of the means is floating point's, not a metric's move.
+_ROUNDING = 1e-9
+
+
 # What `report --paired-with` tells of each method against the reference: the outcome, the
 # operator's input and the time (the collisions where the task measures them).
 PAIRED_METRICS = ("success", "intervention_ratio", "task_time", "collision_ratio")
@@ -53,16 +58,33 @@ class PairedRow:
     difference: float  # mean of B - A over the pairs
     low: float  # its 95 % confidence interval
     high: float
-    sd_a: float  # A's trial-to-trial standard deviation
-    se_a: float  # A's standard error of the mean
+    sd_a: float  # A's trial-to-trial standard deviation (NaN for a single pair)
+    se_a: float  # A's standard error of the mean (NaN for a single pair)
+
+    @property
+    def judged(self):
+        """Whether A's SD exists to judge the difference by: two pairs at least (one
+        trial's SD is unknown, not 0)."""
+        return self.pairs > 1
 
     @property
     def within_sd(self):
-        return abs(self.difference) <= self.sd_a
+        return self.judged and abs(self.difference) <= self.sd_a + self._rounding
 
     @property
     def within_se(self):
-        return abs(self.difference) <= self.se_a
+        return self.judged and abs(self.difference) <= self.se_a + self._rounding
+
+    @property
+    def _rounding(self):
+        """What floating point alone makes of a difference (the same value computed twice
+        may differ in its last bit): never a move, even against an SD of 0."""
+        return _ROUNDING * max(abs(self.mean_a), abs(self.mean_b))
+
+    @property
+    def moved(self):
+        """Whether the difference is larger than A's SD (never for a single pair)."""
+        return self.judged and not self.within_sd
 
 
 def _by_seed(study, records, method):
@@ -84,7 +106,7 @@ def _row(metric, method, values_a, values_b):
     import scipy.stats
     spread = float(differences.std(ddof=1)) if n > 1 else 0.0
     half = float(scipy.stats.t.ppf(0.975, n - 1)) * spread / math.sqrt(n) if n > 1 else math.inf
-    sd_a = float(a.std(ddof=1)) if n > 1 else 0.0
+    sd_a = float(a.std(ddof=1)) if n > 1 else math.nan
     return PairedRow(metric, method, n, float(a.mean()), float(b.mean()), difference,
                      difference - half, difference + half, sd_a, sd_a / math.sqrt(n))
 
@@ -94,7 +116,8 @@ def paired_comparison(folder_a, folder_b, damaged=None, unpaired=None):
     the seeds both ran (collisions only where both tasks measure them). Each folder's
     damaged or foreign files (their trials left out) are appended to `damaged` as a
     `trial_files.Damage`, and each method only one folder ran to `unpaired` as `(method,
-    "A" or "B")`, when they are given."""
+    "A" or "B")`, one both ran but on no seed both ran without an error as `(method,
+    None)`, when they are given."""
     study_a, records_a, damaged_a = read_study(folder_a)
     study_b, records_b, damaged_b = read_study(folder_b)
     if damaged is not None:
@@ -108,8 +131,11 @@ def paired_comparison(folder_a, folder_b, damaged=None, unpaired=None):
                   and measures_collisions(study_b, records_b, folder_b))
     rows = []
     for method in [m for m in study_a["methods"] if m in study_b["methods"]]:
-        rows += _paired_rows(method, _by_seed(study_a, records_a, method),
+        found = _paired_rows(method, _by_seed(study_a, records_a, method),
                              _by_seed(study_b, records_b, method), collisions)
+        if not found and unpaired is not None:
+            unpaired.append((method, None))
+        rows += found
     return rows
 
 
@@ -178,6 +204,10 @@ def paired_table(rows, name_a, name_b):
     order = [m for m, _, _ in _METRICS]
     for row in sorted(rows, key=lambda row: (order.index(row.metric) if row.metric in order
                                              else len(order))):
+        if not row.judged:
+            lines.append(f"| {row.metric} | {row.method} | {row.pairs} | {row.mean_a:.4g} | "
+                         f"{row.difference:+.3g} | - | - | not judged (one pair) |")
+            continue
         verdict = ("yes (within SE too)" if row.within_se else "yes" if row.within_sd
                    else "**no**")
         lines.append(

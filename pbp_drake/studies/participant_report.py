@@ -159,12 +159,15 @@ def _label(method):
 
 
 def _summary(values, source):
-    """A trial measure's mean ± std, an answer's median (mean), or "-"."""
+    """A trial measure's mean ± std (`mean (n = 1)` of one value: no spread), an answer's
+    median (mean), or "-"."""
     values = list(values)
     if not values:
         return "-"
     if source == "answer":
         return f"{statistics.median(values):g} ({statistics.fmean(values):.2f})"
+    if len(values) == 1:
+        return f"{values[0]:.3f} (n = 1)"
     return f"{statistics.fmean(values):.3f} ± {statistics.pstdev(values):.3f}"
 
 

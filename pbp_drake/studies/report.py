@@ -22,9 +22,12 @@ def figure_names(summary):
 
 
 def _cell(entry, field, digits):
+    """`mean ± std`; `mean (n = 1)` when a single trial had a value (no spread)."""
     value = entry[field]
     if value["mean"] is None:
         return "-"
+    if value["std"] is None:
+        return f"{value['mean']:.{digits}f} (n = 1)"
     return f"{value['mean']:.{digits}f} ± {value['std']:.{digits}f}"
 
 

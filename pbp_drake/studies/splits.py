@@ -5,6 +5,7 @@ by the split they fall in, in study.json, summary.json and results.md
 (docs/tasks/studies.md, "Seeds: evaluation and tuning").
 """
 
+from pbp_drake.scenarios import ScenarioError
 from pbp_drake.scenarios.schema import STUDY_SPLITS as SPLITS
 
 #: What each label tells a reader of the results.
@@ -34,6 +35,23 @@ def split_of(study, seed, trials):
     if last < study.evaluation_seed:
         return "tuning"
     return "evaluation" if seed >= study.evaluation_seed else "mixed"
+
+
+def check_within_split(study, split, seed, trials, whose):
+    """ScenarioError unless seeds `seed .. seed + trials - 1` all lie in `split` of a
+    MethodComparison: tuning runs that reach the evaluation seeds show a tuning the scenes
+    kept for judging it (and an evaluation split's seeds below them are tuning scenes).
+    `whose` names where the split was asked for ("--split tuning")."""
+    label = split_of(study, seed, trials)
+    if label == split:
+        return
+    last = seed + trials - 1
+    seeds = (f"{study.tuning_seed} to {study.evaluation_seed - 1}" if split == "tuning"
+             else f"from {study.evaluation_seed} on")
+    raise ScenarioError(
+        f"{whose}: seeds {seed} to {last} are not all {split} seeds ({seeds}) but {label}: "
+        f"give --seed and --trials within them, or leave out --split to run these seeds, "
+        f"labelled {label}")
 
 
 def seeds_line(summary):

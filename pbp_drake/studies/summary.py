@@ -79,11 +79,14 @@ def _round(value):
 
 
 def mean_std(values):
-    """`{"mean", "std"}` (population std) of the finite values, rounded; None for none."""
+    """`{"mean", "std"}` (population std) of the finite values, rounded; None for none, and
+    "std" None for one (a single trial's spread is unknown, not 0)."""
     values = [v for v in values if v is not None and math.isfinite(v)]
     if not values:
         return {"mean": None, "std": None}
     mean = math.fsum(values) / len(values)
+    if len(values) == 1:
+        return {"mean": _round(mean), "std": None}
     variance = math.fsum((v - mean) ** 2 for v in values) / len(values)
     return {"mean": _round(mean), "std": _round(math.sqrt(variance))}
 

@@ -11,7 +11,8 @@ from pbp_drake.cli import main
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.studies.paired import paired_comparison
 from pbp_drake.studies.trial_files import (
-    scenario_hash, time_series_columns, trial_record, write_study, write_trial_files)
+    scenario_hash, time_series_columns, trial_paths, trial_record, write_study,
+    write_trial_files)
 
 METHODS = ("pbp_alternated", "teleop")
 TRIALS = 6
@@ -26,14 +27,15 @@ def _csv(ticks=3):
     return ",".join(columns) + "\n" + "".join(row + "\n" for _ in range(ticks))
 
 
-def _study(folder, scenario_path, shift=0.0, failed_seed=None, methods=METHODS):
+def _study(folder, scenario_path, shift=0.0, failed_seed=None, methods=METHODS,
+           trials=TRIALS):
     """A finished reach study of `methods` whose task times are TASK_TIMES + `shift` (the
-    trial of `failed_seed` missed its target)."""
+    trial of `failed_seed` missed its target), of the first `trials` seeds."""
     scenario = load_scenario_file(scenario_path).scenario
     digest = scenario_hash(scenario)
-    write_study(folder, scenario, digest, methods, TRIALS, 0, "tuning")
+    write_study(folder, scenario, digest, methods, trials, 0, "tuning")
     for method in methods:
-        for trial in range(TRIALS):
+        for trial in range(trials):
             record = trial_record(scenario.name, digest, method, trial, trial)
             record.update(success=trial != failed_seed,
                           task_time=float(TASK_TIMES[trial] + shift),
@@ -107,6 +109,60 @@ def test_a_method_only_one_study_ran_is_named_as_not_compared(tmp_path, repo, ca
     assert capsys.readouterr().out.endswith(
         "All 6 rows within A's trial-to-trial SD. pbp_alternated: only in A, not compared. "
         "hop: only in B, not compared.\n")
+
+
+@pytest.mark.slow
+def test_a_method_both_ran_on_no_common_seed_is_named_as_not_compared(tmp_path, repo,
+                                                                      capsys):
+    # Every teleop trial of B failed: teleop was left out of the table without a word.
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a, b = _study(tmp_path / "a", scenario), _study(tmp_path / "b", scenario)
+    for path in b.glob("trials/teleop/seed_*.json"):
+        path.write_text(json.dumps({**json.loads(path.read_text()),
+                                    "error": "RuntimeError: the solver failed"}))
+    assert main(["compare", str(a), str(b)]) == 0
+    out = capsys.readouterr().out
+    assert "| teleop |" not in out
+    assert out.endswith("All 6 rows within A's trial-to-trial SD. teleop: no seed both ran "
+                        "without an error, not compared.\n")
+
+
+@pytest.mark.slow
+def test_a_difference_of_the_last_bit_is_not_a_move(tmp_path, repo, capsys):
+    # A constant metric (SD 0) computed as 1.0000000000000002 once in B "moved" (exit 1).
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a, b = _study(tmp_path / "a", scenario), _study(tmp_path / "b", scenario)
+    path = trial_paths(b, "teleop", 3)[0]
+    path.write_text(json.dumps({**json.loads(path.read_text()),
+                                "peak_command_acceleration": 1.0000000000000002}))
+    assert main(["compare", str(a), str(b)]) == 0
+    out = capsys.readouterr().out
+    assert "| peak_command_acceleration | teleop | 6 | 1 | +3.7e-17 " in out
+    assert "**no**" not in out and "All 12 rows within A's trial-to-trial SD." in out
+
+
+@pytest.mark.slow
+def test_a_metric_of_one_pair_is_shown_not_judged(tmp_path, repo, capsys):
+    # One trial's SD is unknown: it read as 0, so any difference "moved" (exit 1).
+    scenario = repo / "diagrams" / "hsr_reach.yaml"
+    a = _study(tmp_path / "a", scenario, trials=1)
+    assert main(["compare", str(a), str(_study(tmp_path / "b", scenario, 3.0, trials=1))]) == 0
+    out = capsys.readouterr().out
+    assert "| task_time | teleop | 1 | 14 | +3 | - | - | not judged (one pair) |" in out
+    assert "**no**" not in out and "inf" not in out
+    assert out.endswith("No row has two pairs: nothing is judged; run both studies with more "
+                        "trials.\n")
+    # Beside rows of more pairs, those of one are counted apart.
+    a, b = _study(tmp_path / "a6", scenario), _study(tmp_path / "b6", scenario, 3.0)
+    for seed in range(1, TRIALS):
+        for path in trial_paths(b, "pbp_alternated", seed):
+            path.unlink()
+    assert main(["compare", str(a), str(b)]) == 1
+    out = capsys.readouterr().out
+    assert "| task_time | pbp_alternated | 1 | 14 | +3 | - | - | not judged (one pair) |" in out
+    assert "1 of 6 rows moved by more than A's trial-to-trial SD. 6 rows of a single pair not " \
+           "judged (one trial has no SD)." in out
+
 
 def test_refuses_folders_that_share_no_trial(tmp_path, repo, capsys):
     a = _study(tmp_path / "a", repo / "diagrams" / "hsr_reach.yaml")

@@ -223,3 +223,5 @@ def test_one_participant_gets_plain_words_instead_of_tests(study, tmp_path, caps
         assert (f"| 1 | - | n/a (a test needs at least 2 participants who {who} both; 1 "
                 "did) | - | - |") in row
     assert "observations" not in results
+    # One participant's measures have no spread: each mean stands alone, not "± 0.000".
+    assert "±" not in results and "(n = 1) |" in results

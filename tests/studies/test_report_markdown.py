@@ -1,6 +1,9 @@
 """`pbp-drake report DIR --markdown FILE`: the study's table as a Markdown fragment for the
 docs, after the command and seeds that made it, read off the study folder."""
 
+import json
+import re
+
 import pytest
 
 from pbp_drake.cli import main
@@ -45,6 +48,18 @@ def test_the_markdown_names_the_command_and_seeds_then_the_table(hsr_study, tmp_
     # The table is results.md's; the summary is the same bytes as the study wrote.
     assert markdown.read_text().endswith((hsr_study / "results.md").read_text())
     assert (hsr_study / "summary.json").read_bytes() == summary
+
+
+def test_a_single_trials_mean_is_shown_without_a_spread(hsr_study):
+    # One trial's population std is 0: it read "0.921 ± 0.000", as if measured.
+    summary = json.loads((hsr_study / "summary.json").read_text())
+    for entry in summary["methods"].values():
+        assert entry["intervention_ratio"]["std"] is None and entry["task_time"]["std"] is None
+        assert entry["input_integral"]["std"] is None
+    results = (hsr_study / "results.md").read_text()
+    assert not re.search(r"\d ± \d", results)
+    teleop = summary["methods"]["teleop"]["intervention_ratio"]["mean"]
+    assert f"| Teleop | 1 | 100 % | {teleop:.3f} (n = 1) | " in results
 
 
 def test_a_2d_study_gets_its_summary_as_a_table(tmp_path, repo):

@@ -2,9 +2,9 @@
 
 import pytest
 
-from pbp_drake.scenarios import MethodComparison
+from pbp_drake.scenarios import MethodComparison, ScenarioError
 from pbp_drake.studies.report import results_table
-from pbp_drake.studies.splits import first_seed, seeds_line, split_of
+from pbp_drake.studies.splits import check_within_split, first_seed, seeds_line, split_of
 
 STUDY = MethodComparison(trials=30, tuning_seed=0, evaluation_seed=10_000)
 
@@ -21,6 +21,16 @@ def test_each_split_starts_at_its_own_seed():
     (123_456, 1, "evaluation")])
 def test_seeds_are_labelled_by_the_split_they_fall_in(seed, trials, split):
     assert split_of(STUDY, seed, trials) == split
+
+
+@pytest.mark.parametrize("split, seed, trials, label", [
+    ("tuning", 9_990, 11, "mixed"), ("tuning", 10_000, 1, "evaluation"),
+    ("evaluation", 9_999, 2, "mixed"), ("evaluation", 0, 1, "tuning")])
+def test_seeds_asked_of_a_split_must_lie_in_it(split, seed, trials, label):
+    check_within_split(STUDY, split, 9_970 if split == "tuning" else 10_000, 30, "--split")
+    with pytest.raises(ScenarioError, match=f"^--split {split}: seeds {seed} to "
+                       f"{seed + trials - 1} are not all {split} seeds .* but {label}: "):
+        check_within_split(STUDY, split, seed, trials, f"--split {split}")
 
 
 def test_seeds_below_the_tuning_seeds_are_in_no_split():

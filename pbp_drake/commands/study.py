@@ -389,10 +389,11 @@ def _report(args):
     paired = None
     if args.paired_with is not None:  # a method the study did not run: refused, unwritten
         try:
-            rows = paired_with(output, args.paired_with, PAIRED_METRICS)
+            unpaired = []
+            rows = paired_with(output, args.paired_with, PAIRED_METRICS, unpaired)
         except ValueError as error:
             raise ScenarioError(f"--paired-with: {error}") from None
-        paired = paired_with_markdown(rows, args.paired_with)
+        paired = paired_with_markdown(rows, args.paired_with, unpaired)
     summary = report(output)
     _print_report(summary, output)
     name_left_out(output, summary["methods"], summary["trials"], summary["seed"])

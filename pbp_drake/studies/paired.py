@@ -139,12 +139,19 @@ def paired_comparison(folder_a, folder_b, damaged=None, unpaired=None):
     return rows
 
 
-def paired_with(folder, reference, metrics):
+def paired_with(folder, reference, metrics, unpaired=None):
     """The `PairedRow`s of one study's every other method (B) against its method `reference`
-    (A), for the `metrics` named. Raises ValueError when the study did not run `reference`."""
+    (A), for the `metrics` named; each method of no seed both ran without an error is
+    appended to `unpaired` when it is given. Raises ValueError when the study did not run
+    `reference`."""
     study, records, _ = read_study(folder)
-    return paired_rows_with(study, records, reference,
+    rows = paired_rows_with(study, records, reference,
                             measures_collisions(study, records, folder), metrics)
+    if unpaired is not None:
+        found = {row.method for row in rows}
+        unpaired += [method for method in study["methods"]
+                     if method != reference and method not in found]
+    return rows
 
 
 def paired_rows_with(study, records, reference, collisions, metrics):
@@ -217,11 +224,15 @@ def paired_table(rows, name_a, name_b):
     return "\n".join(lines) + "\n"
 
 
-def paired_with_markdown(rows, reference):
-    """The rows of `paired_with` as a titled Markdown table."""
+def paired_with_markdown(rows, reference, unpaired=()):
+    """The rows of `paired_with` as a titled Markdown table, then a line naming the
+    `unpaired` methods."""
     name = METHOD_NAMES.get(reference, reference)
     rows = [dataclasses.replace(row, method=METHOD_NAMES.get(row.method, row.method))
             for row in rows]
+    left_out = "".join(f"{METHOD_NAMES.get(method, method)}: no seed it and {name} both ran "
+                       "without an error, not compared.\n" for method in unpaired)
     return (f"Each method against {name}, paired by seed (the method minus {name}, with "
             f"the 95 % interval of the difference; within noise: no larger than {name}'s "
-            "trial-to-trial SD).\n\n" + paired_table(rows, name, "method"))
+            "trial-to-trial SD).\n\n" + paired_table(rows, name, "method")
+            + ("\n" + left_out if left_out else ""))

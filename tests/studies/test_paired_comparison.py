@@ -226,6 +226,23 @@ def test_report_pairs_every_method_with_one_of_its_study(tmp_path, repo, capsys)
 
 
 @pytest.mark.slow
+def test_report_names_a_method_it_could_not_pair_with_the_reference(tmp_path, repo, capsys):
+    # Every HOP trial failed with an error: HOP was left out of the paired table in silence.
+    folder = _methods_study(tmp_path / "study", repo / "diagrams" / "hsr_reach.yaml", {
+        "pbp_alternated": TASK_TIMES, "teleop": TASK_TIMES + 2.0, "hop": TASK_TIMES - 1.0})
+    for path in folder.glob("trials/hop/seed_*.json"):
+        path.write_text(json.dumps({**json.loads(path.read_text()),
+                                    "error": "RuntimeError: the solver failed"}))
+    markdown = tmp_path / "table.md"
+    main(["report", str(folder), "--paired-with", "pbp_alternated", "--markdown", str(markdown)])
+    paired = markdown.read_text().split("Each method against PBP-Alt")[1]
+    assert "| task_time | Teleop | 6 | 15.83 | +2 [+2, +2] |" in paired and "HOP |" not in paired
+    assert paired.endswith("\nHOP: no seed it and PBP-Alt both ran without an error, not "
+                         "compared.\n")
+    assert "HOP: no seed it and PBP-Alt both ran" in capsys.readouterr().out
+
+
+@pytest.mark.slow
 def test_report_refuses_a_reference_it_did_not_run_before_rewriting_the_folder(
         tmp_path, repo, capsys):
     folder = _methods_study(tmp_path / "study", repo / "diagrams" / "hsr_reach.yaml", {

@@ -54,6 +54,9 @@ def _refusal(tmp_path, run_refused, file, old, new):
     ("toy_alt_vs_cont.yaml", "  operator: !SinusoidalStep", "  operator: !Keyboard",
      "scenario.operator: the tag !Keyboard is unknown; expected one of !NoOperator, "
      "!ObstacleRepulsion, !SinusoidalStep, !ScriptedCommands"),
+    # A tag on a field of one type, which Drake reads untagged: the tag is named.
+    ("toy_alt_vs_cont.yaml", "  robot: {mass", "  robot: !PointRobot {mass",
+     "scenario.robot: PointRobot is written without a tag; drop !PointRobot"),
     # A robot that is no mapping, in a file with a task: the robot is named.
     ("hsr_reach.yaml", "  robot: !Hsr", "  robot: 3\n  _robot: !Hsr",
      "scenario.robot: got 3; expected a mapping, tagged with one of !Hsr, !Arm "

@@ -25,6 +25,7 @@ from pbp_drake.core.choices import did_you_mean
 from pbp_drake.core.methods import METHODS, method_entry
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.systems.operators.browser_input import check_params
+from pbp_drake.systems.operators.obstacle_repulsion_operator import check_repulsion_params
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
@@ -312,12 +313,8 @@ def check_obstacles(obstacles, dimension, field="scenario.obstacles"):
 
 def _check_toy_operator(operator, dimension):
     if isinstance(operator, ObstacleRepulsion):
-        if operator.axis:
-            check_direction(operator.axis, dimension, "scenario.operator.axis")
-        # A negative speed would push toward the obstacle, as the alpha study's
-        # operator_speeds may not.
-        require_finite(operator, "scenario.operator", ("speed",), positive=False)
-        require_finite(operator, "scenario.operator", ("distance_threshold",))
+        with _refused_as(""):
+            check_repulsion_params(operator, dimension, "scenario.operator")
     elif isinstance(operator, SinusoidalStep):
         check_direction(operator.axis, dimension, "scenario.operator.axis")
         if not (np.isfinite(operator.amplitude) and operator.duration > 0 and operator.period > 0):

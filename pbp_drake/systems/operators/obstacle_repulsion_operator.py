@@ -44,7 +44,10 @@ class ObstacleRepulsionOperator(SampledOperator):
                  params=ObstacleRepulsionParams()):
         super().__init__(dimension, control_period)
         dimension = self._dimension
-        _check_params(params, dimension)
+        if not isinstance(params, ObstacleRepulsionParams):
+            raise ValueError(f"params must be ObstacleRepulsionParams, got "
+                             f"{type(params).__name__}")
+        check_repulsion_params(params, dimension)
         self.params = dataclasses.replace(params)
         centres = np.asarray(centres, dtype=float)
         if centres.size and (centres.ndim != 2 or centres.shape[1] != dimension):
@@ -72,18 +75,17 @@ class ObstacleRepulsionOperator(SampledOperator):
                                  self._speed, self._axis)
 
 
-def _check_params(params, dimension):
-    """Raises ValueError naming the field of `params` (`ObstacleRepulsionParams`) that the
-    push cannot use: a NaN threshold pushed at any distance, a 0 one never."""
-    if not isinstance(params, ObstacleRepulsionParams):
-        raise ValueError(f"params must be ObstacleRepulsionParams, got {type(params).__name__}")
-    threshold = params.distance_threshold
+def check_repulsion_params(params, dimension, field="params"):
+    """Raises ValueError naming the field of `params` (`ObstacleRepulsionParams`, called
+    `field`) that the push cannot use: a NaN threshold pushed at any distance, a 0 one
+    never, and a negative speed toward the obstacle."""
+    threshold, speed = params.distance_threshold, params.speed
     if not (is_real(threshold) and math.isfinite(threshold) and threshold > 0):
-        raise ValueError(f"params.distance_threshold must be a positive distance, got "
+        raise ValueError(f"{field}.distance_threshold must be finite and positive, got "
                          f"{threshold!r}")
-    if not (is_real(params.speed) and math.isfinite(params.speed)):
-        raise ValueError(f"params.speed must be a finite number, got {params.speed!r}")
+    if not (is_real(speed) and math.isfinite(speed) and speed >= 0):
+        raise ValueError(f"{field}.speed must be finite and not negative, got {speed!r}")
     axis = np.asarray(params.axis, dtype=float)
     if axis.size and (axis.shape != (dimension,) or not np.linalg.norm(axis) >= 1e-6):
-        raise ValueError(f"params.axis must be empty (radially) or a direction of dimension "
+        raise ValueError(f"{field}.axis must be empty (radially) or a direction of dimension "
                          f"{dimension} and length at least 1e-6, got {list(params.axis)}")

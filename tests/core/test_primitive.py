@@ -92,6 +92,9 @@ def _damaged(change):
     (lambda d: d.update(version="1"), "version must be a whole number >= 1, got '1'"),
     (lambda d: d["settings"].update(alpha=1.0), r"settings has unknown fields \['alpha'\]"),
     (lambda d: d.update(settings=[]), "settings is missing or not a map"),
+    # Read as the defaults, a Pastor fit's weights ran as Ijspeert's.
+    (lambda d: d["settings"].pop("formulation"), r"settings lacks \['formulation'\]"),
+    (lambda d: d.update(settings={}), r"settings lacks \['formulation', 'basis_count', "),
     (lambda d: d.pop("dimension"), "dimension is missing or not a number"),
     (lambda d: d["weights"][3].pop(), "weights must be a table of numbers"),
     (lambda d: d["demonstration"]["times"].reverse(),

@@ -193,6 +193,12 @@ def read_primitive_document(document) -> Primitive:
     unknown = set(fields) - set(SETTINGS_FIELDS)
     if unknown:
         raise ValueError(f"settings has unknown fields {sorted(unknown)}")
+    # A field left out would take DmpSettings' default, not the fit's: the weights of a
+    # Pastor fit read as Ijspeert's draw another shape.
+    missing = [name for name in SETTINGS_FIELDS if name not in fields]
+    if missing:
+        raise ValueError(f"settings lacks {missing}: the fit's {', '.join(SETTINGS_FIELDS)} "
+                         "are all needed (teach it again)")
     try:
         settings = DmpSettings(**fields)
     except (TypeError, ValueError) as error:

@@ -63,6 +63,8 @@ def test_a_straight_demonstration_takes_the_straight_duration():
 
 @pytest.mark.parametrize("times, positions, message", [
     (np.linspace(0, 1, 5), np.linspace(START, GOAL, 5), "has 5 samples; at least 10"),
+    # Told "at least 3" first, then "at least 10" for 3.
+    (np.linspace(0, 1, 2), np.linspace(START, GOAL, 2), "has 2 samples; at least 10"),
     (np.linspace(0, 1, 50), np.tile(START, (50, 1)) + 0.001,
      "ends 0.000 m from where it starts; a primitive needs at least 0.02 m"),
     (np.linspace(0, 1, 50), np.where(np.arange(50)[:, None] == 7, np.nan,
@@ -99,6 +101,12 @@ def _damaged(change):
     (lambda d: d["weights"][3].pop(), "weights must be a table of numbers"),
     (lambda d: d["demonstration"]["times"].reverse(),
      "demonstration: demonstration times must be finite and strictly increasing"),
+    # As teach_primitive refuses them: the bank's duration was infinite, or NaN.
+    (lambda d: d["demonstration"]["positions"].__setitem__(-1, d["demonstration"]["positions"][0]),
+     "demonstration: the demonstration ends 0.000 m from where it starts"),
+    (lambda d: d.update(demonstration={key: value[:5] for key, value
+                                       in d["demonstration"].items()}),
+     "demonstration: the demonstration has 5 samples; at least 10"),
 ])
 def test_a_damaged_document_is_refused_naming_the_field(change, message):
     with pytest.raises(ValueError, match=message):

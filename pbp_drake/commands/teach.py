@@ -7,6 +7,7 @@ it (`P.csv`); `--from FILE` teaches from a recorded path instead.
 import argparse
 import csv
 import json
+import os
 import pathlib
 
 import numpy as np
@@ -110,13 +111,21 @@ def _teach(args):
           f"{primitive.fit_error * 1000:.1f} mm RMS"
           + ("" if primitive.orientation is None else
              f", its turn within {np.degrees(primitive.orientation.fit_error):.1f} degrees RMS")
-          + f". Saved to {args.output}: name it in a "
-          f"scenario as dmp: {{primitive: {args.output}}}", flush=True)
+          + f". Saved to {args.output}: name it in {args.scenario} as dmp: "
+          f"{{primitive: {_from_scenario(args.output, args.scenario)}}}", flush=True)
     if args.figure is not None:
         plot_primitive(primitive, scenario_file.resolved.scene.objects, args.figure)
         print(f"Figure: {args.figure} (the demonstration, its reproduction, the shape "
               "carried to the scene's objects)", flush=True)
     return EXIT_SUCCESS
+
+
+def _from_scenario(path, scenario):
+    """`path` as the file `scenario` names it: a relative path is read from the scenario
+    file's folder (`--output` was from the working folder)."""
+    if os.path.isabs(path):
+        return path
+    return os.path.relpath(os.path.abspath(path), os.path.dirname(os.path.abspath(scenario)))
 
 
 def _drive(args, log, switches, hand_trail):

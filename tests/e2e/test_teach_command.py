@@ -292,3 +292,20 @@ def test_outputs_that_would_overwrite_each_other_are_refused(tmp_path, capsys, m
                     capsys=capsys)
     assert code == 2 and out.err == f"pbp-drake: {message.replace('{tmp}', str(tmp_path))}\n"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_teach_names_the_primitive_as_the_scenario_reads_it(tmp_path, capsys, monkeypatch):
+    # A relative dmp.primitive is read from the scenario's folder: the working folder's
+    # path it printed named another file there, or none.
+    recording = tmp_path / "run.csv"
+    recording.write_text("time,ee_x,ee_y,ee_z\n" + "".join(
+        f"{t / 10},{0.5 + t / 20},0.0,0.7\n" for t in range(30)))
+    (tmp_path / "scene").mkdir()
+    shutil.copy(REACH, tmp_path / "scene" / "reach.yaml")
+    monkeypatch.chdir(tmp_path)
+    code, out = run("teach", "scene/reach.yaml", "--from", recording, "--output",
+                    "primitives/mine.json", capsys=capsys)
+    assert code == 0, out.err
+    assert out.out.rstrip().endswith("Saved to primitives/mine.json: name it in "
+                                     "scene/reach.yaml as dmp: {primitive: "
+                                     "../primitives/mine.json}")

@@ -7,12 +7,16 @@ it (`P.csv`); `--from FILE` teaches from a recorded path instead.
 import argparse
 import csv
 import json
+import os
 import pathlib
+import shlex
+import sys
 
 import numpy as np
 
 from pbp_drake.builder.time_series import HAND_ORIENTATION_COLUMNS
-from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS, port
+from pbp_drake.cli_types import (
+    EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS, EXIT_WRITE_FAILED, port)
 from pbp_drake.commands.run import add_run_command
 from pbp_drake.commands.scenario_flags import add_override_flags, scenario_overrides
 from pbp_drake.core.dmp.primitive import primitive_document, teach_primitive
@@ -21,7 +25,8 @@ from pbp_drake.output_paths import (
     same_file)
 from pbp_drake.scenarios import GraspTask, ScenarioError, TaskScenario, load_scenario_file
 from pbp_drake.scenarios.bounds import is_special_file
-from pbp_drake.studies.atomic_files import write_atomically
+from pbp_drake.studies.atomic_files import (
+    is_disk_failure, write_atomically, write_failure_line)
 from pbp_drake.studies.primitive_figure import plot_primitive
 from pbp_drake.systems.visualizers.reach_scene_visualizer import HAND_MARKER
 
@@ -89,8 +94,17 @@ def _teach(args):
         # Kept beside the primitive: a person's demonstration is not to be driven twice.
         origin = str(pathlib.Path(args.output).with_suffix(".csv"))
         check_log_path(origin, force=args.force)
-        code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"),
-                      hand_trail=not isinstance(scenario.task, GraspTask))
+        try:
+            code = _drive(args, origin, switches=hasattr(scenario.task, "switch_schedule"),
+                          hand_trail=not isinstance(scenario.task, GraspTask))
+        except KeyboardInterrupt:
+            if args.operator == "virtual" or not pathlib.Path(origin).is_file():
+                raise
+            # A person's drive ended by Ctrl-C, not Stop: its rows so far are the demonstration
+            # they may mean, and the next drive would write over them.
+            print(f"\npbp-drake: interrupted; the drive so far is kept in {origin}: "
+                  f"{_teach_again(args, origin)} teaches from it", file=sys.stderr)
+            return EXIT_INTERRUPTED
         if code not in (EXIT_SUCCESS, EXIT_FAILED, EXIT_STOPPED):
             return code
     times, positions, orientations = read_hand_path(origin)
@@ -101,6 +115,22 @@ def _teach(args):
         primitive = teach_primitive(times, positions, scenario.dmp, orientations)
     except ValueError as error:
         raise ScenarioError(f"{origin}: {error}") from None
+    try:
+        _save(args, primitive, scenario_file.resolved.scene.objects)
+    except OSError as error:
+        if not is_disk_failure(error):
+            raise
+        # Said with the command that teaches from the demonstration kept: a person's drive
+        # is not to be driven again.
+        print(write_failure_line(error, f"{_teach_again(args, origin)} teaches from {origin}"),
+              file=sys.stderr)
+        return EXIT_WRITE_FAILED
+    return EXIT_SUCCESS
+
+
+def _save(args, primitive, objects):
+    """Writes the primitive to `args.output` (and the figure of it, of the scene's
+    `objects`, to `args.figure`) and says so."""
     write_atomically(pathlib.Path(args.output), json.dumps(primitive_document(primitive)))
     start, goal = (", ".join(f"{x:.3f}" for x in point)
                    for point in (primitive.start, primitive.goal))
@@ -110,13 +140,32 @@ def _teach(args):
           f"{primitive.fit_error * 1000:.1f} mm RMS"
           + ("" if primitive.orientation is None else
              f", its turn within {np.degrees(primitive.orientation.fit_error):.1f} degrees RMS")
-          + f". Saved to {args.output}: name it in a "
-          f"scenario as dmp: {{primitive: {args.output}}}", flush=True)
+          + f". Saved to {args.output}: name it in {args.scenario} as dmp: "
+          f"{{primitive: {_from_scenario(args.output, args.scenario)}}}", flush=True)
     if args.figure is not None:
-        plot_primitive(primitive, scenario_file.resolved.scene.objects, args.figure)
+        plot_primitive(primitive, objects, args.figure)
         print(f"Figure: {args.figure} (the demonstration, its reproduction, the shape "
               "carried to the scene's objects)", flush=True)
-    return EXIT_SUCCESS
+
+
+def _teach_again(args, origin):
+    """The command line that teaches the same primitive from the recording `origin`."""
+    argv = ["pbp-drake", "teach", args.scenario, "--from", origin, "--output", args.output]
+    for setting in args.settings:
+        argv += ["--set", setting]
+    if args.scenario_text is not None:
+        argv += ["--scenario-text", args.scenario_text]
+    if args.figure is not None:
+        argv += ["--figure", args.figure]
+    return shlex.join(argv)
+
+
+def _from_scenario(path, scenario):
+    """`path` as the file `scenario` names it: a relative path is read from the scenario
+    file's folder (`--output` was from the working folder)."""
+    if os.path.isabs(path):
+        return path
+    return os.path.relpath(os.path.abspath(path), os.path.dirname(os.path.abspath(scenario)))
 
 
 def _drive(args, log, switches, hand_trail):

@@ -6,6 +6,7 @@ resolved (`resolve`, which checks the values) and its study checked.
 
 import dataclasses
 import difflib
+import filecmp
 import os
 import pathlib
 import types
@@ -80,16 +81,20 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
     (`overrides.merged`). Raises ScenarioError as `ORIGIN: field.path: what is wrong` (or
     `line L`). A relative arm `model_file` and `dmp.primitive` are read from `folder`
     (default: the working folder)."""
+    primitive_typed = False  # `dmp.primitive` given on the command line
     try:
         document = _document(text)
         for overlay in overlays:
             if isinstance(overlay, dict):
+                primitive_typed = primitive_typed or _sets_primitive(overlay)
                 document = merged(document, overlay)
                 continue
             try:
-                document = merged(document, _document(overlay, "the override"))
+                parsed = _document(overlay, "the override")
+                document = merged(document, parsed)
             except ScenarioError as error:
                 raise ScenarioError(f"the override {overlay.strip()!r}: {error}") from None
+            primitive_typed = primitive_typed or _sets_primitive(parsed)
         schema = file_schema(document)
         problem = _first_problem(document, schema, "")
         if problem:
@@ -102,8 +107,8 @@ def load_scenario_text(text, origin="scenario text", folder=None, overlays=()):
         raise ScenarioError(f"{origin}: {error}") from None
     except Exception as error:  # noqa: BLE001 - what the YAML loader raises for bad input
         raise ScenarioError(f"{origin}: {type(error).__name__}: {error}") from None
-    scenario = _paths_from(loaded.scenario, folder)
     try:
+        scenario = _paths_from(loaded.scenario, folder, primitive_typed)
         resolved = resolve(scenario)
         check_numbers(loaded.study, "study")
         if resolved.has_task and not isinstance(loaded.study, (MethodComparison, type(None))):
@@ -210,9 +215,11 @@ def _syntax_error(error):
             f"{getattr(error, 'problem', None) or error}{where}")
 
 
-def _paths_from(scenario, folder):
+def _paths_from(scenario, folder, primitive_typed=False):
     """`scenario` with a relative arm model file and `dmp.primitive` made paths from
-    `folder` (None: the working folder)."""
+    `folder` (None: the working folder). A relative `dmp.primitive` that names no file
+    there but one from the working folder, or that was typed on the command line
+    (`primitive_typed`) and names another file from the working folder, is refused."""
     robot, primitive = scenario.robot, scenario.dmp.primitive
     folder = os.path.abspath(folder or os.curdir)
     if (isinstance(robot, Arm) and robot.model_file and "://" not in robot.model_file
@@ -220,9 +227,47 @@ def _paths_from(scenario, folder):
         robot = dataclasses.replace(robot, model_file=os.path.join(folder, robot.model_file))
         scenario = dataclasses.replace(scenario, robot=robot)
     if primitive and not os.path.isabs(primitive):
-        dmp = dataclasses.replace(scenario.dmp, primitive=os.path.join(folder, primitive))
-        scenario = dataclasses.replace(scenario, dmp=dmp)
+        read = os.path.join(folder, primitive)
+        _check_primitive_folder(primitive, folder, primitive_typed)
+        scenario = dataclasses.replace(scenario,
+                                       dmp=dataclasses.replace(scenario.dmp, primitive=read))
     return scenario
+
+
+def _check_primitive_folder(primitive, folder, typed):
+    """Refuses the relative `dmp.primitive`, read from the scenario file's `folder`, when
+    the same path from the working folder is a file it would not read: there is none in
+    the scenario's folder, or (`typed` on the command line, where a path is read from the
+    working folder elsewhere) another file is."""
+    here, read = os.path.abspath(primitive), os.path.join(folder, primitive)
+    if here == read or not os.path.isfile(here):
+        return
+    there = os.path.isfile(read)
+    if there and (not typed or _same_bytes(here, read)):
+        return
+    other = f"give {os.path.relpath(here, folder)} or its absolute path"
+    if not there:
+        raise ScenarioError(f"scenario.dmp.primitive {primitive}: a relative path is read "
+                            f"from the scenario file's folder, {folder}, which has no such "
+                            f"file; for the working folder's, {other}")
+    raise ScenarioError(f"scenario.dmp.primitive {primitive} is read from the scenario "
+                        f"file's folder, as {read}; the working folder has another "
+                        f"{primitive}: for that one, {other}; for the first, its absolute "
+                        "path")
+
+
+def _same_bytes(one, other):
+    try:
+        return os.path.samefile(one, other) or filecmp.cmp(one, other, shallow=False)
+    except OSError:
+        return False
+
+
+def _sets_primitive(overlay):
+    """Whether the override document `overlay` sets `scenario.dmp.primitive`."""
+    scenario = overlay.get("scenario")
+    dmp = scenario.get("dmp") if isinstance(scenario, dict) else None
+    return isinstance(dmp, dict) and "primitive" in dmp
 
 
 # ---------------------------------------------------------------------------------------------

@@ -63,6 +63,8 @@ def test_a_straight_demonstration_takes_the_straight_duration():
 
 @pytest.mark.parametrize("times, positions, message", [
     (np.linspace(0, 1, 5), np.linspace(START, GOAL, 5), "has 5 samples; at least 10"),
+    # Told "at least 3" first, then "at least 10" for 3.
+    (np.linspace(0, 1, 2), np.linspace(START, GOAL, 2), "has 2 samples; at least 10"),
     (np.linspace(0, 1, 50), np.tile(START, (50, 1)) + 0.001,
      "ends 0.000 m from where it starts; a primitive needs at least 0.02 m"),
     (np.linspace(0, 1, 50), np.where(np.arange(50)[:, None] == 7, np.nan,
@@ -92,10 +94,19 @@ def _damaged(change):
     (lambda d: d.update(version="1"), "version must be a whole number >= 1, got '1'"),
     (lambda d: d["settings"].update(alpha=1.0), r"settings has unknown fields \['alpha'\]"),
     (lambda d: d.update(settings=[]), "settings is missing or not a map"),
+    # Read as the defaults, a Pastor fit's weights ran as Ijspeert's.
+    (lambda d: d["settings"].pop("formulation"), r"settings lacks \['formulation'\]"),
+    (lambda d: d.update(settings={}), r"settings lacks \['formulation', 'basis_count', "),
     (lambda d: d.pop("dimension"), "dimension is missing or not a number"),
     (lambda d: d["weights"][3].pop(), "weights must be a table of numbers"),
     (lambda d: d["demonstration"]["times"].reverse(),
      "demonstration: demonstration times must be finite and strictly increasing"),
+    # As teach_primitive refuses them: the bank's duration was infinite, or NaN.
+    (lambda d: d["demonstration"]["positions"].__setitem__(-1, d["demonstration"]["positions"][0]),
+     "demonstration: the demonstration ends 0.000 m from where it starts"),
+    (lambda d: d.update(demonstration={key: value[:5] for key, value
+                                       in d["demonstration"].items()}),
+     "demonstration: the demonstration has 5 samples; at least 10"),
 ])
 def test_a_damaged_document_is_refused_naming_the_field(change, message):
     with pytest.raises(ValueError, match=message):

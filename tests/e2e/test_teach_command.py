@@ -3,6 +3,7 @@ it and run headless; taught again from the drive's CSV; bad primitives and recor
 refused in one line naming the file (exit 2)."""
 
 import csv
+import errno
 import json
 import os
 import pathlib
@@ -292,3 +293,53 @@ def test_outputs_that_would_overwrite_each_other_are_refused(tmp_path, capsys, m
                     capsys=capsys)
     assert code == 2 and out.err == f"pbp-drake: {message.replace('{tmp}', str(tmp_path))}\n"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_teach_names_the_primitive_as_the_scenario_reads_it(tmp_path, capsys, monkeypatch):
+    # A relative dmp.primitive is read from the scenario's folder: the working folder's
+    # path it printed named another file there, or none.
+    recording = tmp_path / "run.csv"
+    recording.write_text("time,ee_x,ee_y,ee_z\n" + "".join(
+        f"{t / 10},{0.5 + t / 20},0.0,0.7\n" for t in range(30)))
+    (tmp_path / "scene").mkdir()
+    shutil.copy(REACH, tmp_path / "scene" / "reach.yaml")
+    monkeypatch.chdir(tmp_path)
+    code, out = run("teach", "scene/reach.yaml", "--from", recording, "--output",
+                    "primitives/mine.json", capsys=capsys)
+    assert code == 0, out.err
+    assert out.out.rstrip().endswith("Saved to primitives/mine.json: name it in "
+                                     "scene/reach.yaml as dmp: {primitive: "
+                                     "../primitives/mine.json}")
+
+
+def test_a_primitive_that_cannot_be_written_says_how_to_teach_from_what_is_kept(
+        tmp_path, capsys, monkeypatch):
+    # A full disk was an OSError traceback, the drive kept beside it unsaid.
+    def full_disk(path, text):
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+    monkeypatch.setattr(teach, "write_atomically", full_disk)
+    recording = tmp_path / "P.csv"
+    recording.write_text("time,ee_x,ee_y,ee_z\n" + "".join(
+        f"{t / 10},{0.5 + t / 20},0.0,0.7\n" for t in range(30)))
+    code, out = run("teach", REACH, "--from", recording, "--output", tmp_path / "P.json",
+                    "--set", "dmp.basis_count=20", capsys=capsys)
+    assert code == 4
+    assert out.err == (f"pbp-drake: cannot write {tmp_path / 'P.json'}: no space left on "
+                       "device; nothing is left half-written: free some space, then "
+                       f"pbp-drake teach {REACH} --from {recording} --output "
+                       f"{tmp_path / 'P.json'} --set dmp.basis_count=20 teaches from "
+                       f"{recording}.\n")
+
+
+def test_a_drive_ended_by_ctrl_c_says_where_it_is_kept(tmp_path, capsys, monkeypatch):
+    # It said "interrupted" alone; the next drive wrote over the rows kept.
+    def driven_then_interrupted(args, log, **_):
+        pathlib.Path(log).write_text("time,ee_x,ee_y,ee_z\n0.0,0.5,0.0,0.7\n")
+        raise KeyboardInterrupt
+    monkeypatch.setattr(teach, "_drive", driven_then_interrupted)
+    code, out = run("teach", REACH, "--operator", "keyboard", "--output", tmp_path / "P.json",
+                    capsys=capsys)
+    assert code == 130
+    assert out.err == (f"\npbp-drake: interrupted; the drive so far is kept in "
+                       f"{tmp_path / 'P.csv'}: pbp-drake teach {REACH} --from "
+                       f"{tmp_path / 'P.csv'} --output {tmp_path / 'P.json'} teaches from it\n")

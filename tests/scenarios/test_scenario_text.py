@@ -2,11 +2,13 @@
 number for a range, 30 Hz control, and an arm's model file beside its scenario file."""
 
 import pathlib
+import re
 
 import pytest
 from pydrake.common.yaml import yaml_dump_typed
 
-from pbp_drake.scenarios import ScenarioError, load_scenario_file, load_scenario_text
+from pbp_drake.scenarios import (
+    ScenarioError, ScenarioOverrides, load_scenario_file, load_scenario_text)
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 REACH = (REPO / "diagrams" / "hsr_reach.yaml").read_text()
@@ -117,3 +119,51 @@ def test_a_relative_model_file_is_read_beside_the_scenario_file(tmp_path, monkey
     assert loaded.scenario.robot.model_file == str(folder / "urdf" / "arm.urdf")
     with pytest.raises(ScenarioError, match="model_file"):
         load_scenario_text(text, "text")  # from the working folder: no such file
+
+
+def _primitives(tmp_path, copy):
+    """A scenario `scene/wall.yaml`, the shipped wall primitive beside it in
+    `scene/primitives/`, and in the working folder `tmp_path` a `primitives/` holding the
+    same file (`copy`) or another one; the overrides that name it relatively."""
+    shipped = REPO / "diagrams" / "primitives" / "around_the_wall.json"
+    for folder in ("scene/primitives", "primitives"):
+        (tmp_path / folder).mkdir(parents=True)
+    (tmp_path / "scene" / "wall.yaml").write_text(
+        (REPO / "diagrams" / "hsr_wall.yaml").read_text())
+    (tmp_path / "scene" / "primitives" / "wall.json").write_bytes(shipped.read_bytes())
+    (tmp_path / "primitives" / "wall.json").write_bytes(
+        shipped.read_bytes() if copy else b'{"format": "pbp_drake.primitive"}')
+    return ScenarioOverrides(settings=("dmp.primitive=primitives/wall.json",))
+
+
+def test_a_typed_relative_primitive_naming_another_file_from_the_working_folder_is_refused(
+        tmp_path, monkeypatch):
+    # Read from the scenario's folder, the other primitive ran, exit 0.
+    overrides = _primitives(tmp_path, copy=False)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ScenarioError, match=re.escape(
+            "scenario.dmp.primitive primitives/wall.json is read from the scenario file's "
+            f"folder, as {tmp_path}/scene/primitives/wall.json; the working folder has "
+            "another primitives/wall.json: for that one, give ../primitives/wall.json or its "
+            "absolute path; for the first, its absolute path")):
+        load_scenario_file("scene/wall.yaml", overrides)
+    # Not there at all: the refusal says where it looked and what to give.
+    (tmp_path / "scene" / "primitives" / "wall.json").unlink()
+    with pytest.raises(ScenarioError, match=re.escape(
+            "scenario.dmp.primitive primitives/wall.json: a relative path is read from the "
+            f"scenario file's folder, {tmp_path}/scene, which has no such file; for the "
+            "working folder's, give ../primitives/wall.json or its absolute path")):
+        load_scenario_file("scene/wall.yaml", overrides)
+
+
+def test_a_relative_primitive_that_is_one_file_either_way_is_read(tmp_path, monkeypatch):
+    overrides = _primitives(tmp_path, copy=True)
+    monkeypatch.chdir(tmp_path)
+    loaded = load_scenario_file("scene/wall.yaml", overrides)
+    assert loaded.scenario.dmp.primitive == str(tmp_path / "scene/primitives/wall.json")
+    # Written in the scenario file, a relative path names the file beside it alone.
+    (tmp_path / "primitives" / "wall.json").write_text("another")
+    text = (tmp_path / "scene" / "wall.yaml").read_text().replace(
+        "basis_count: 50}", "basis_count: 50, primitive: primitives/wall.json}")
+    (tmp_path / "scene" / "wall.yaml").write_text(text)
+    assert load_scenario_file("scene/wall.yaml").resolved.controller.dmp_primitive

@@ -85,19 +85,29 @@ def teach_primitive(times, positions, settings=DmpSettings(), orientations=None)
     """The primitive of one demonstration `times` (T,), `positions` (T, D), and with
     `orientations` (T, 4) its poses'; ValueError when it is too short, does not move, or has
     NaN (the message says which)."""
-    times, positions = validate_demonstration(times, positions)
-    if len(times) < MIN_SAMPLES:
-        raise ValueError(f"the demonstration has {len(times)} samples; at least "
-                         f"{MIN_SAMPLES} are needed")
-    travel = float(np.linalg.norm(positions[-1] - positions[0]))
-    if travel < MIN_TRAVEL:
-        raise ValueError(f"the demonstration ends {travel:.3f} m from where it starts; a "
-                         f"primitive needs at least {MIN_TRAVEL} m")
+    times, positions = check_primitive_demonstration(times, positions)
     weights, scaling = fit_weights(times, positions, settings)
     fit = _fit_error(times, positions, weights, scaling, settings)
     shape = None if orientations is None else _orientation_shape(times, orientations, settings)
     return Primitive(dataclasses.replace(settings, primitive=""), weights, scaling,
                      times - times[0], positions, fit, shape)
+
+
+def check_primitive_demonstration(times, positions):
+    """A primitive's demonstration `times` (T,), `positions` (T, D) as float arrays;
+    ValueError when it has fewer than MIN_SAMPLES samples, ends less than MIN_TRAVEL from
+    where it starts, or has NaN (the message says which)."""
+    # Counted first: the demonstration check's own least (3) would be named to one of 2.
+    count = np.shape(positions)[0] if np.ndim(positions) else 0
+    if count < MIN_SAMPLES:
+        raise ValueError(f"the demonstration has {count} samples; at least "
+                         f"{MIN_SAMPLES} are needed")
+    times, positions = validate_demonstration(times, positions)
+    travel = float(np.linalg.norm(positions[-1] - positions[0]))
+    if travel < MIN_TRAVEL:
+        raise ValueError(f"the demonstration ends {travel:.3f} m from where it starts; a "
+                         f"primitive needs at least {MIN_TRAVEL} m")
+    return times, positions
 
 
 def _orientation_shape(times, orientations, settings):
@@ -193,6 +203,12 @@ def read_primitive_document(document) -> Primitive:
     unknown = set(fields) - set(SETTINGS_FIELDS)
     if unknown:
         raise ValueError(f"settings has unknown fields {sorted(unknown)}")
+    # A field left out would take DmpSettings' default, not the fit's: the weights of a
+    # Pastor fit read as Ijspeert's draw another shape.
+    missing = [name for name in SETTINGS_FIELDS if name not in fields]
+    if missing:
+        raise ValueError(f"settings lacks {missing}: the fit's {', '.join(SETTINGS_FIELDS)} "
+                         "are all needed (teach it again)")
     try:
         settings = DmpSettings(**fields)
     except (TypeError, ValueError) as error:
@@ -207,7 +223,8 @@ def read_primitive_document(document) -> Primitive:
         raise ValueError(f"weights {weights.shape} and demonstration.positions "
                          f"{positions.shape} do not fit dimension {dimension} and "
                          f"basis_count {settings.basis_count}")
-    times, positions = _named("demonstration", validate_demonstration, times, positions)
+    times, positions = _named("demonstration", check_primitive_demonstration, times,
+                              positions)
     fit_error = _fit_error_field(document, "fit_error")
     orientation = None
     if "orientation" in document:

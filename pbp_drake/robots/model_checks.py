@@ -166,6 +166,7 @@ def check_model_file(source, motion, field="ArmStationConfig.model_file"):
     _check_names(document, refuse)
     links, joints = links_and_joints(model)
     _check_tree(links, joints, refuse)
+    _check_couplings(model, joints, refuse)
     _check_files(document, model, refuse)
     _check_inertias(model, links, joints, motion, refuse)
     if len(_CHECKED) >= 8:
@@ -342,6 +343,26 @@ def _check_tree(links, joints, refuse):
             on_path.add(link)
             link = parent_joint[link].parent
         rooted.update(path)
+
+
+def _check_couplings(model, joints, refuse):
+    """No joint mimics another (URDF's `<mimic>`, SDFormat's `<axis><mimic>`): the station
+    moves each joint on its own, so the coupling would be ignored."""
+    for joint in joints:
+        if joint.kind in FIXED_JOINT_TYPES:
+            continue
+        holders = [joint.element] if model.kind == "urdf" else [
+            axis for axis in (joint.element.find("axis"), joint.element.find("axis2"))
+            if axis is not None]
+        for holder in holders:
+            mimic = holder.find("mimic")
+            if mimic is None:
+                continue
+            leader = printable(mimic.attrib.get("joint", ""))
+            raise refuse(mimic, f"joint {printable(joint.name)} <mimic>",
+                         f"it follows joint {leader}, a coupling the station does not keep "
+                         "(its IK moves every joint on its own); remove <mimic> to move it as "
+                         "a joint of its own, or make it fixed")
 
 
 def _check_files(document, model, refuse):

@@ -1,0 +1,108 @@
+"""A user's own arm whose joints the station would move other than the file says (a
+coupling it ignores, limits Drake cannot hold) is refused in one line naming the field,
+the file and the joint. Each model is a three-joint arm written in tmp_path."""
+
+import dataclasses
+
+import pytest
+
+from pbp_drake.robots import ArmStationConfig, make_arm_station
+
+ARM = """<?xml version="1.0"?>
+<robot name="arm3" xmlns:drake="http://drake.mit.edu">
+  <link name="base"/>
+  <link name="l1"><inertial><origin xyz="0 0 0.15"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l2"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l3"><inertial><origin xyz="0.15 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>
+    <limit lower="-2.5" upper="2.5" velocity="1.5" effort="10"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>
+    <limit lower="-2" upper="2" velocity="1.5" effort="10"/></joint>
+  <joint name="j3" type="{j3_type}"><parent link="l2"/><child link="l3"/>
+    <origin xyz="0.4 0 0"/><axis xyz="{j3_axis}"/>
+    <limit {j3_limit}/>{j3_extra}</joint>
+  <joint name="jt" type="fixed"><parent link="l3"/><child link="tool"/>
+    <origin xyz="0.3 0 0" rpy="0 1.5708 0"/></joint>
+</robot>
+"""
+J3 = {"j3_type": "revolute", "j3_axis": "0 1 0",
+      "j3_limit": 'lower="-2" upper="2" velocity="1.5" effort="10"', "j3_extra": ""}
+READY = [0.0, 0.5, -0.5]
+SDF_ARM = """<?xml version="1.0"?>
+<sdf version="1.11">
+  <model name="two_joints">
+    <link name="base"/>
+    <link name="upper"><pose>0 0 0.2 0 0 0</pose></link>
+    <link name="lower"><pose>0 0 0.5 0 0 0</pose></link>
+    <frame name="tool" attached_to="lower">
+      <pose relative_to="lower">0 0 0.1 0 1.5708 0</pose></frame>
+    <joint name="shoulder" type="revolute"><parent>base</parent><child>upper</child>
+      <axis><xyz>0 0 1</xyz>
+        <limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit></axis>
+    </joint>
+    <joint name="elbow" type="revolute"><parent>upper</parent><child>lower</child>
+      <axis><xyz>0 1 0</xyz>
+        <limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit>{elbow_extra}</axis>
+    </joint>
+  </model>
+</sdf>
+"""
+
+
+def arm(tmp_path, **j3):
+    """The three-joint arm with joint j3's fields of `j3` (J3's otherwise), and its config."""
+    path = tmp_path / "arm3.urdf"
+    path.write_text(ARM.format(**{**J3, **j3}))
+    return path, ArmStationConfig(model_file=str(path), base_frame="base", ee_frame="tool",
+                                  initial_positions=list(READY))
+
+
+# The line of j3's <limit>, where what the tests add to the joint stands too.
+J3_LINE = ARM[:ARM.index("<limit {j3_limit}")].count("\n") + 1
+
+
+def sdf_arm(tmp_path, elbow_extra=""):
+    path = tmp_path / "plain.sdf"
+    path.write_text(SDF_ARM.format(elbow_extra=elbow_extra))
+    return path
+
+
+def refusal(config):
+    """The one-line message `make_arm_station` refuses `config` with."""
+    with pytest.raises(ValueError) as error:
+        make_arm_station(config)
+    message = str(error.value)
+    assert "\n" not in message, message
+    return message
+
+
+def test_the_arm_of_these_tests_loads(tmp_path):
+    _, config = arm(tmp_path)
+    make_arm_station(config)
+
+
+@pytest.mark.parametrize("motion", ["kinematic", "dynamic"])
+def test_a_mimic_joint_is_refused_naming_it(tmp_path, motion):
+    # Drake's plant couples j3 to j2; the station's IK would move it on its own.
+    path, config = arm(tmp_path, j3_extra='<mimic joint="j2" multiplier="-1" offset="0"/>')
+    config = dataclasses.replace(config, motion=motion)
+    assert (f"ArmStationConfig.model_file '{path}': line {J3_LINE}, joint 'j3' <mimic>: it "
+            "follows joint 'j2', a coupling the station does not keep" in refusal(config))
+
+
+def test_an_sdformat_mimic_joint_is_refused_naming_it(tmp_path):
+    # Drake reads SDFormat's <mimic> and keeps nothing of it: the joint moved freely.
+    path = tmp_path / "arm.sdf"
+    path.write_text(SDF_ARM.format(
+        elbow_extra='<mimic joint="shoulder"><multiplier>1</multiplier></mimic>'))
+    config = ArmStationConfig(model_file=str(path), base_frame="base", ee_frame="tool")
+    make_arm_station(dataclasses.replace(config, model_file=str(sdf_arm(tmp_path))))
+    line = SDF_ARM[:SDF_ARM.index("{elbow_extra}")].count("\n") + 1
+    assert (f"'{path}': line {line}, joint 'elbow' <mimic>: it follows joint 'shoulder'"
+            in refusal(config))

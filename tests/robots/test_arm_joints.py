@@ -106,3 +106,23 @@ def test_an_sdformat_mimic_joint_is_refused_naming_it(tmp_path):
     line = SDF_ARM[:SDF_ARM.index("{elbow_extra}")].count("\n") + 1
     assert (f"'{path}': line {line}, joint 'elbow' <mimic>: it follows joint 'shoulder'"
             in refusal(config))
+
+
+@pytest.mark.parametrize("limit, what", [
+    ('lower="2" upper="-2" velocity="1.5"', "<limit lower upper>: lower 2 is above upper -2; "
+     "give the lower limit first"),
+    ('lower="-2" upper="2" velocity="-1.5"', "<limit velocity>: -1.5 is negative"),
+    ('lower="-2" upper="2" velocity="1.5" drake:acceleration="-3"',
+     "<limit drake:acceleration>: -3 is negative"),
+], ids=["inverted", "negative velocity", "negative acceleration"])
+def test_urdf_limits_drake_cannot_hold_are_refused_naming_them(tmp_path, limit, what):
+    # Drake's plant stopped the process on these (exit 1, "Failure at ... joint.h").
+    path, config = arm(tmp_path, j3_limit=limit)
+    assert (f"ArmStationConfig.model_file '{path}': line {J3_LINE}, joint 'j3' {what}"
+            in refusal(config))
+
+
+def test_a_continuous_joint_with_inverted_limits_is_refused_too(tmp_path):
+    path, config = arm(tmp_path, j3_type="continuous",
+                       j3_limit='lower="1" upper="-1" velocity="1.5"')
+    assert "joint 'j3' <limit lower upper>: lower 1 is above upper -1" in refusal(config)

@@ -110,7 +110,7 @@ def _frame(plant, model, config, field):
 
 def _check_joint(joint, config):
     """A joint the station can move: one degree of freedom with finite position and
-    velocity limits."""
+    velocity limits, and acceleration limits (if any) with room between them."""
     where = f"ArmStationConfig.model_file {config.model_file!r}: joint {joint.name()!r}"
     if joint.num_positions() != 1 or joint.num_velocities() != 1:
         raise ValueError(f"{where} is a {joint.type_name()} joint; the station moves "
@@ -123,7 +123,15 @@ def _check_joint(joint, config):
                              "<limit lower upper velocity>, SDFormat <limit>)")
         if not (lower < upper).all():
             raise ValueError(f"{where} has {kind} limits [{lower[0]}, {upper[0]}] with no "
-                             "room between them")
+                             "room between them; give the joint room to move in the model "
+                             "(URDF <limit lower upper velocity>, SDFormat <limit>)")
+    # The model's acceleration limits bound the diff IK's; none (infinite) is the default's.
+    lower, upper = joint.acceleration_lower_limits(), joint.acceleration_upper_limits()
+    if np.isfinite(lower).all() and np.isfinite(upper).all() and not (lower < upper).all():
+        raise ValueError(f"{where} has an acceleration limit of "
+                         f"{min(-lower[0], upper[0]):g}: it could never move; give a "
+                         "positive drake:acceleration in the model, or none (then "
+                         "ArmStationConfig.default_acceleration_limit)")
 
 
 def ready_positions(plant, arm, config):

@@ -35,7 +35,7 @@ J3 = {"j3_type": "revolute", "j3_axis": "0 1 0",
       "j3_limit": 'lower="-2" upper="2" velocity="1.5" effort="10"', "j3_extra": ""}
 READY = [0.0, 0.5, -0.5]
 SDF_ARM = """<?xml version="1.0"?>
-<sdf version="1.11">
+<sdf version="1.11" xmlns:drake="http://drake.mit.edu">
   <model name="two_joints">
     <link name="base"/>
     <link name="upper"><pose>0 0 0.2 0 0 0</pose></link>
@@ -48,7 +48,8 @@ SDF_ARM = """<?xml version="1.0"?>
     </joint>
     <joint name="elbow" type="revolute"><parent>upper</parent><child>lower</child>
       <axis><xyz>0 1 0</xyz>
-        <limit><lower>-1</lower><upper>1</upper><velocity>1</velocity></limit>{elbow_extra}</axis>
+        <limit><lower>-1</lower><upper>1</upper><velocity>1</velocity>{elbow_limit}</limit>
+        {elbow_extra}</axis>
     </joint>
   </model>
 </sdf>
@@ -67,10 +68,12 @@ def arm(tmp_path, **j3):
 J3_LINE = ARM[:ARM.index("<limit {j3_limit}")].count("\n") + 1
 
 
-def sdf_arm(tmp_path, elbow_extra=""):
-    path = tmp_path / "plain.sdf"
-    path.write_text(SDF_ARM.format(elbow_extra=elbow_extra))
-    return path
+def sdf_arm(tmp_path, elbow_limit="", elbow_extra=""):
+    """The two-joint SDFormat arm with `elbow_limit` in its elbow's <limit> and
+    `elbow_extra` in its <axis>, and its config."""
+    path = tmp_path / "arm.sdf"
+    path.write_text(SDF_ARM.format(elbow_limit=elbow_limit, elbow_extra=elbow_extra))
+    return path, ArmStationConfig(model_file=str(path), base_frame="base", ee_frame="tool")
 
 
 def refusal(config):
@@ -98,11 +101,9 @@ def test_a_mimic_joint_is_refused_naming_it(tmp_path, motion):
 
 def test_an_sdformat_mimic_joint_is_refused_naming_it(tmp_path):
     # Drake reads SDFormat's <mimic> and keeps nothing of it: the joint moved freely.
-    path = tmp_path / "arm.sdf"
-    path.write_text(SDF_ARM.format(
-        elbow_extra='<mimic joint="shoulder"><multiplier>1</multiplier></mimic>'))
-    config = ArmStationConfig(model_file=str(path), base_frame="base", ee_frame="tool")
-    make_arm_station(dataclasses.replace(config, model_file=str(sdf_arm(tmp_path))))
+    make_arm_station(sdf_arm(tmp_path)[1])
+    path, config = sdf_arm(
+        tmp_path, elbow_extra='<mimic joint="shoulder"><multiplier>1</multiplier></mimic>')
     line = SDF_ARM[:SDF_ARM.index("{elbow_extra}")].count("\n") + 1
     assert (f"'{path}': line {line}, joint 'elbow' <mimic>: it follows joint 'shoulder'"
             in refusal(config))
@@ -126,3 +127,17 @@ def test_a_continuous_joint_with_inverted_limits_is_refused_too(tmp_path):
     path, config = arm(tmp_path, j3_type="continuous",
                        j3_limit='lower="1" upper="-1" velocity="1.5"')
     assert "joint 'j3' <limit lower upper>: lower 1 is above upper -1" in refusal(config)
+
+
+@pytest.mark.parametrize("kind", ["URDF", "SDFormat"])
+def test_a_zero_acceleration_limit_is_refused_not_replaced(tmp_path, kind):
+    # It was replaced by default_acceleration_limit (10 rad/s^2), unlike the file.
+    if kind == "URDF":
+        path, config = arm(tmp_path, j3_limit=f'{J3["j3_limit"]} drake:acceleration="0"')
+        joint = "j3"
+    else:
+        path, config = sdf_arm(tmp_path, "<drake:acceleration>0</drake:acceleration>")
+        joint = "elbow"
+    assert (f"ArmStationConfig.model_file '{path}': joint '{joint}' has an acceleration limit "
+            "of 0: it could never move; give a positive drake:acceleration in the model, or "
+            "none (then ArmStationConfig.default_acceleration_limit)" in refusal(config))

@@ -242,11 +242,31 @@ def _check_mass_matrix(plant, arm, context, config):
 
 def reach_of(plant, arm, q0):
     """`arm_reach`'s `(shoulder, reach)`, measured in the ready configuration `q0` (the
-    reach: the chain's joint origins' distances summed)."""
+    reach: the chain's joint origins' distances summed, each the longest a prismatic joint
+    between them makes it within its limits, and a first joint's travel if prismatic)."""
+    moving = [joint for joint in arm.chain if joint.num_velocities()]
+    # A prismatic joint changes the distance from the joint before it to its own origin
+    # (a telescope retracted in the ready configuration), longest at one of its limits.
+    configurations = [q0]
+    for joint in moving:
+        if joint.type_name() == "prismatic":
+            for limit in (joint.position_lower_limits(), joint.position_upper_limits()):
+                q = np.array(q0, dtype=float)
+                q[joint.position_start()] = limit[0]
+                configurations.append(q)
     context = plant.CreateDefaultContext()
-    plant.SetPositions(context, q0)
-    points = [joint.frame_on_child().CalcPoseInWorld(context).translation()
-              for joint in arm.chain if joint.num_velocities()]
-    points.append(arm.ee_frame.CalcPoseInWorld(context).translation())
-    reach = float(sum(np.linalg.norm(b - a) for a, b in zip(points, points[1:])))
-    return points[0], reach
+    lengths = []
+    for q in configurations:
+        plant.SetPositions(context, q)
+        points = [joint.frame_on_child().CalcPoseInWorld(context).translation()
+                  for joint in moving]
+        points.append(arm.ee_frame.CalcPoseInWorld(context).translation())
+        if q is q0:
+            shoulder = points[0]
+        lengths.append([np.linalg.norm(b - a) for a, b in zip(points, points[1:])])
+    reach = float(sum(max(segment) for segment in zip(*lengths)))
+    if moving and moving[0].type_name() == "prismatic":  # it moves the shoulder itself
+        q = q0[moving[0].position_start()]
+        reach += float(max(moving[0].position_upper_limits()[0] - q,
+                           q - moving[0].position_lower_limits()[0]))
+    return shoulder, reach

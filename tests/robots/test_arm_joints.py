@@ -4,9 +4,11 @@ the file and the joint. Each model is a three-joint arm written in tmp_path."""
 
 import dataclasses
 
+import numpy as np
+
 import pytest
 
-from pbp_drake.robots import ArmStationConfig, make_arm_station
+from pbp_drake.robots import ArmStationConfig, arm_reach, make_arm_station
 
 ARM = """<?xml version="1.0"?>
 <robot name="arm3" xmlns:drake="http://drake.mit.edu">
@@ -141,3 +143,26 @@ def test_a_zero_acceleration_limit_is_refused_not_replaced(tmp_path, kind):
     assert (f"ArmStationConfig.model_file '{path}': joint '{joint}' has an acceleration limit "
             "of 0: it could never move; give a positive drake:acceleration in the model, or "
             "none (then ArmStationConfig.default_acceleration_limit)" in refusal(config))
+
+
+@pytest.mark.parametrize("ready", [0.0, 0.4])
+def test_a_prismatic_joint_s_travel_counts_in_the_reach(tmp_path, ready):
+    # A telescope along l3 (0 to 0.4 m): the reach was measured in the ready configuration
+    # alone, 1.0 m retracted, and goals it reaches extended were refused as beyond it.
+    _, config = arm(tmp_path, j3_type="prismatic", j3_axis="1 0 0",
+                    j3_limit='lower="0" upper="0.4" velocity="0.5"')
+    config = dataclasses.replace(config, initial_positions=[0.0, 0.5, ready])
+    shoulder, reach = arm_reach(config)
+    np.testing.assert_allclose(shoulder, [0.0, 0.0, 0.1])
+    # Shoulder to j2 0.3 m, j2 to the tool 0.4 + 0.3 m and the 0.4 m of travel.
+    assert reach == pytest.approx(1.4)
+
+
+def test_a_prismatic_first_joint_s_travel_counts_in_the_reach(tmp_path):
+    # A vertical lift under the arm (0 to 0.5 m) moves the shoulder itself.
+    path, config = arm(tmp_path)
+    path.write_text(path.read_text().replace(
+        '<joint name="j1" type="revolute"', '<joint name="j1" type="prismatic"').replace(
+        'lower="-2.5" upper="2.5"', 'lower="0" upper="0.5"'))
+    _, reach = arm_reach(dataclasses.replace(config, initial_positions=[0.0, 0.5, -0.5]))
+    assert reach == pytest.approx(0.3 + 0.4 + 0.3 + 0.5)

@@ -66,6 +66,11 @@ def add_arm(plant, config):
     base_body = base_frame.body()
     if int(base_body.index()) in inboard:
         joint = inboard[int(base_body.index())]
+        if joint.parent_body().index() == plant.world_body().index():
+            raise ValueError(f"ArmStationConfig.base_frame {config.base_frame!r} is fixed to "
+                             f"the world by the model itself (joint {joint.name()!r}); remove "
+                             "that joint (and the world link) from the model file: the "
+                             "station welds base_frame to the world at base_pose")
         raise ValueError(f"ArmStationConfig.base_frame {config.base_frame!r} is not the "
                          f"model's root: it hangs from joint {joint.name()!r} of "
                          f"{joint.parent_body().name()!r}; name the link the arm stands on")
@@ -104,8 +109,10 @@ def _frame(plant, model, config, field):
         return plant.GetFrameByName(name, model)
     bodies = [plant.get_body(index).name() for index in plant.GetBodyIndices(model)]
     shown = ", ".join(bodies[:12]) + (", ..." if len(bodies) > 12 else "")
+    world = ("; the world is not the model's: name one of its links"
+             if name == plant.world_frame().name() else "")
     raise ValueError(f"ArmStationConfig.{field} {name!r} is not a frame of "
-                     f"{config.model_file!r} (its links: {shown})")
+                     f"{config.model_file!r} (its links: {shown}){world}")
 
 
 def _check_joint(joint, config):

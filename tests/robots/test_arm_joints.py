@@ -166,3 +166,19 @@ def test_a_prismatic_first_joint_s_travel_counts_in_the_reach(tmp_path):
         'lower="-2.5" upper="2.5"', 'lower="0" upper="0.5"'))
     _, reach = arm_reach(dataclasses.replace(config, initial_positions=[0.0, 0.5, -0.5]))
     assert reach == pytest.approx(0.3 + 0.4 + 0.3 + 0.5)
+
+
+def test_a_base_the_file_welds_to_the_world_is_refused_saying_what_to_do(tmp_path):
+    # URDFs from ROS often weld their base to a "world" link; the message told the user to
+    # "name the link the arm stands on", which they had.
+    path, config = arm(tmp_path)
+    path.write_text(path.read_text().replace('<link name="base"/>', """<link name="base"/>
+  <link name="world"/>
+  <joint name="world_weld" type="fixed"><parent link="world"/><child link="base"/></joint>"""))
+    assert refusal(config) == (
+        "ArmStationConfig.base_frame 'base' is fixed to the world by the model itself (joint "
+        "'world_weld'); remove that joint (and the world link) from the model file: the "
+        "station welds base_frame to the world at base_pose")
+    assert refusal(dataclasses.replace(config, base_frame="world")).endswith(
+        "(its links: base, l1, l2, l3, tool); the world is not the model's: name one of its "
+        "links")

@@ -1,6 +1,7 @@
 """A user's own arm whose joints the station would move other than the file says (a
-coupling it ignores, limits Drake cannot hold) is refused in one line naming the field,
-the file and the joint. Each model is a three-joint arm written in tmp_path."""
+coupling it ignores, limits Drake cannot hold, a base the file welds itself) is refused in
+one line naming the field, the file and the joint; a prismatic joint's travel counts in the
+arm's reach. Each model is a three-joint arm written in tmp_path."""
 
 import dataclasses
 

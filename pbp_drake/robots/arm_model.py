@@ -66,6 +66,11 @@ def add_arm(plant, config):
     base_body = base_frame.body()
     if int(base_body.index()) in inboard:
         joint = inboard[int(base_body.index())]
+        if joint.parent_body().index() == plant.world_body().index():
+            raise ValueError(f"ArmStationConfig.base_frame {config.base_frame!r} is fixed to "
+                             f"the world by the model itself (joint {joint.name()!r}); remove "
+                             "that joint (and the world link) from the model file: the "
+                             "station welds base_frame to the world at base_pose")
         raise ValueError(f"ArmStationConfig.base_frame {config.base_frame!r} is not the "
                          f"model's root: it hangs from joint {joint.name()!r} of "
                          f"{joint.parent_body().name()!r}; name the link the arm stands on")
@@ -104,13 +109,15 @@ def _frame(plant, model, config, field):
         return plant.GetFrameByName(name, model)
     bodies = [plant.get_body(index).name() for index in plant.GetBodyIndices(model)]
     shown = ", ".join(bodies[:12]) + (", ..." if len(bodies) > 12 else "")
+    world = ("; the world is not the model's: name one of its links"
+             if name == plant.world_frame().name() else "")
     raise ValueError(f"ArmStationConfig.{field} {name!r} is not a frame of "
-                     f"{config.model_file!r} (its links: {shown})")
+                     f"{config.model_file!r} (its links: {shown}){world}")
 
 
 def _check_joint(joint, config):
     """A joint the station can move: one degree of freedom with finite position and
-    velocity limits."""
+    velocity limits, and acceleration limits (if any) with room between them."""
     where = f"ArmStationConfig.model_file {config.model_file!r}: joint {joint.name()!r}"
     if joint.num_positions() != 1 or joint.num_velocities() != 1:
         raise ValueError(f"{where} is a {joint.type_name()} joint; the station moves "
@@ -123,7 +130,15 @@ def _check_joint(joint, config):
                              "<limit lower upper velocity>, SDFormat <limit>)")
         if not (lower < upper).all():
             raise ValueError(f"{where} has {kind} limits [{lower[0]}, {upper[0]}] with no "
-                             "room between them")
+                             "room between them; give the joint room to move in the model "
+                             "(URDF <limit lower upper velocity>, SDFormat <limit>)")
+    # The model's acceleration limits bound the diff IK's; none (infinite) is the default's.
+    lower, upper = joint.acceleration_lower_limits(), joint.acceleration_upper_limits()
+    if np.isfinite(lower).all() and np.isfinite(upper).all() and not (lower < upper).all():
+        raise ValueError(f"{where} has an acceleration limit of "
+                         f"{min(-lower[0], upper[0]):g}: it could never move; give a "
+                         "positive drake:acceleration in the model, or none (then "
+                         "ArmStationConfig.default_acceleration_limit)")
 
 
 def ready_positions(plant, arm, config):
@@ -234,11 +249,31 @@ def _check_mass_matrix(plant, arm, context, config):
 
 def reach_of(plant, arm, q0):
     """`arm_reach`'s `(shoulder, reach)`, measured in the ready configuration `q0` (the
-    reach: the chain's joint origins' distances summed)."""
+    reach: the chain's joint origins' distances summed, each the longest a prismatic joint
+    between them makes it within its limits, and a first joint's travel if prismatic)."""
+    moving = [joint for joint in arm.chain if joint.num_velocities()]
+    # A prismatic joint changes the distance from the joint before it to its own origin
+    # (a telescope retracted in the ready configuration), longest at one of its limits.
+    configurations = [q0]
+    for joint in moving:
+        if joint.type_name() == "prismatic":
+            for limit in (joint.position_lower_limits(), joint.position_upper_limits()):
+                q = np.array(q0, dtype=float)
+                q[joint.position_start()] = limit[0]
+                configurations.append(q)
     context = plant.CreateDefaultContext()
-    plant.SetPositions(context, q0)
-    points = [joint.frame_on_child().CalcPoseInWorld(context).translation()
-              for joint in arm.chain if joint.num_velocities()]
-    points.append(arm.ee_frame.CalcPoseInWorld(context).translation())
-    reach = float(sum(np.linalg.norm(b - a) for a, b in zip(points, points[1:])))
-    return points[0], reach
+    lengths = []
+    for q in configurations:
+        plant.SetPositions(context, q)
+        points = [joint.frame_on_child().CalcPoseInWorld(context).translation()
+                  for joint in moving]
+        points.append(arm.ee_frame.CalcPoseInWorld(context).translation())
+        if q is q0:
+            shoulder = points[0]
+        lengths.append([np.linalg.norm(b - a) for a, b in zip(points, points[1:])])
+    reach = float(sum(max(segment) for segment in zip(*lengths)))
+    if moving and moving[0].type_name() == "prismatic":  # it moves the shoulder itself
+        q = q0[moving[0].position_start()]
+        reach += float(max(moving[0].position_upper_limits()[0] - q,
+                           q - moving[0].position_lower_limits()[0]))
+    return shoulder, reach

@@ -166,6 +166,9 @@ def check_model_file(source, motion, field="ArmStationConfig.model_file"):
     _check_names(document, refuse)
     links, joints = links_and_joints(model)
     _check_tree(links, joints, refuse)
+    _check_couplings(model, joints, refuse)
+    if model.kind == "urdf":
+        _check_urdf_limits(joints, refuse)
     _check_files(document, model, refuse)
     _check_inertias(model, links, joints, motion, refuse)
     if len(_CHECKED) >= 8:
@@ -342,6 +345,55 @@ def _check_tree(links, joints, refuse):
             on_path.add(link)
             link = parent_joint[link].parent
         rooted.update(path)
+
+
+def _check_couplings(model, joints, refuse):
+    """No joint mimics another (URDF's `<mimic>`, SDFormat's `<axis><mimic>`): the station
+    moves each joint on its own, so the coupling would be ignored."""
+    for joint in joints:
+        if joint.kind in FIXED_JOINT_TYPES:
+            continue
+        holders = [joint.element] if model.kind == "urdf" else [
+            axis for axis in (joint.element.find("axis"), joint.element.find("axis2"))
+            if axis is not None]
+        for holder in holders:
+            mimic = holder.find("mimic")
+            if mimic is None:
+                continue
+            leader = printable(mimic.attrib.get("joint", ""))
+            raise refuse(mimic, f"joint {printable(joint.name)} <mimic>",
+                         f"it follows joint {leader}, a coupling the station does not keep "
+                         "(its IK moves every joint on its own); remove <mimic> to move it as "
+                         "a joint of its own, or make it fixed")
+
+
+def _check_urdf_limits(joints, refuse):
+    """A URDF joint's `<limit>` that Drake's plant cannot hold (it stops the process, not
+    with an error): lower above upper, a negative velocity or acceleration. SDFormat's
+    reader refuses these itself (a negative velocity there means none)."""
+    for joint in joints:
+        limit = joint.element.find("limit")
+        if joint.kind in FIXED_JOINT_TYPES or limit is None:
+            continue
+        what = f"joint {printable(joint.name)} <limit"
+        lower, upper = (_loose_number(limit, key) for key in ("lower", "upper"))
+        if lower > upper:  # False where either is absent (NaN)
+            raise refuse(limit, f"{what} lower upper>", f"lower {lower:g} is above upper "
+                         f"{upper:g}; give the lower limit first")
+        for key in ("velocity", "drake:acceleration"):
+            value = _loose_number(limit, key)
+            if value < 0:
+                raise refuse(limit, f"{what} {key}>", f"{value:g} is negative; give "
+                             "it as a positive number (it bounds both directions)")
+
+
+def _loose_number(element, attribute):
+    """`element`'s attribute as a float, NaN where it is absent or no number (Drake's
+    reader names those)."""
+    try:
+        return float(original_text(element.attrib.get(attribute, "nan")))
+    except ValueError:
+        return math.nan
 
 
 def _check_files(document, model, refuse):

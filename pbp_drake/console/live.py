@@ -69,8 +69,9 @@ class LiveRun:
     "restart" or "next".
 
     With `start_label`, the first `advance` shows a Start button of that label, once the
-    page has the scene, and waits for it (`Console.wait_for_start`; Enter on `stdin` or
-    Stop end the run after its first slice, `choice` "stop"). With `gamepad`, a page that
+    page has the scene, and waits for it (`Console.wait_for_start`); a choice button
+    clicked meanwhile ends the run after its first slice, `choice` the one clicked (Enter
+    on `stdin`: "stop"). With `gamepad`, a page that
     has seen no gamepad is told so (`NO_GAMEPAD`, in the notice line and on stderr).
     """
 
@@ -148,13 +149,14 @@ class LiveRun:
             self._console.show_status(self.status(context), context.get_time())
 
     def _wait_for_start(self, simulator):
-        """Shows Start and waits for it; False when the person stopped instead."""
+        """Shows Start and waits for it; False when the person chose another button (Stop,
+        Restart, Next scene) instead, `choice` then that one."""
         label, self._start_label = self._start_label, None
         self._console.show_status(self.status(simulator.get_context())
                                   + " · press Start when ready",
                                   simulator.get_context().get_time())
-        if self._console.wait_for_start(label, stdin=self._stdin) == "stop":
-            self.choice = "stop"
+        if (choice := self._console.wait_for_start(label, stdin=self._stdin)) != "start":
+            self.choice = choice
             return False
         simulator.ResetStatistics()  # else the run would rush through the wait
         return True

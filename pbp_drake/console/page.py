@@ -137,12 +137,15 @@ class Console:
 
     def wait_for_start(self, label, poll_period=0.05, stdin=None):
         """Shows a Start button labelled `label` after the choices and blocks until it is
-        clicked ("start"), or until Stop is clicked, Enter is pressed on `stdin` or Ctrl-C
-        ("stop"). The button is gone on return."""
+        clicked ("start"), or until a choice button is clicked (its choice: "stop",
+        "restart", "next"), Enter is pressed on `stdin` or Ctrl-C ("stop"). The button is
+        gone on return."""
         self._meshcat.AddButton(label)
         try:
             while not self._meshcat.GetButtonClicks(label):
-                if self.choice() == "stop" or _entered(stdin, poll_period):
+                if (choice := self.choice()) is not None:
+                    return choice
+                if _entered(stdin, poll_period):
                     return "stop"
             return "start"
         except KeyboardInterrupt:

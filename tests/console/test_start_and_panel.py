@@ -1,7 +1,8 @@
 """The console's Start gate and its panel, against a real Meshcat: a run whose task waits
-for Start has simulated nothing until the press (however long the person takes), Stop at
-the gate ends it at once, the lines go to a panel (the page front's) with the simulated
-time of the status, and the choice buttons can be swapped for the ones after a run."""
+for Start has simulated nothing until the press (however long the person takes), Stop,
+Restart or Next scene at the gate end it at once with that choice, the lines go to a panel
+(the page front's) with the simulated time of the status, and the choice buttons can be
+swapped for the ones after a run."""
 
 import threading
 import time
@@ -79,6 +80,19 @@ def test_stop_at_the_start_gate_ends_the_run_at_once(scene, meshcat):
     trajectory = simulate(scene, realtime_rate=0.0, diagram=diagram, advance=live.advance)
     assert live.choice == "stop"
     assert trajectory.times[-1] < 0.1  # one slice of 0.05 s, not the 3 s of the scene
+
+
+@pytest.mark.timeout(60)  # the gate ignored these: it waited for Start for ever
+@pytest.mark.parametrize("label, choice", [("Next scene", "next"), ("Restart", "restart")])
+def test_a_choice_at_the_start_gate_ends_the_run_with_it(scene, meshcat, label, choice):
+    diagram = build_diagram(scene)
+    console = Console(meshcat, panel=Panel())  # Stop, Restart and Next scene
+    live = LiveRun(diagram, scene.scenario.duration, console, start_label="Start")
+    click(meshcat, label)  # pressed while the page waits for Start
+    trajectory = simulate(scene, realtime_rate=0.0, diagram=diagram, advance=live.advance)
+    assert live.choice == choice
+    assert trajectory.times[-1] < 0.1
+    assert "Start" not in meshcat.GetButtonNames()
 
 
 def test_the_lines_go_to_the_panel_not_to_buttons(meshcat):

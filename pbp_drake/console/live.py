@@ -12,6 +12,7 @@ import time
 from pbp_drake.builder.build import find_system
 from pbp_drake.builder.run import advance_to
 from pbp_drake.console.text import progress_text, status_text
+from pbp_drake.systems.operators.browser_input import BrowserOperator
 from pbp_drake.systems.ports import TaskStatus
 
 # Simulated seconds between two looks at the page: a smooth camera, a click felt at once.
@@ -71,7 +72,8 @@ class LiveRun:
     With `start_label`, the first `advance` shows a Start button of that label, once the
     page has the scene, and waits for it (`Console.wait_for_start`); a choice button
     clicked meanwhile ends the run after its first slice, `choice` the one clicked (Enter
-    on `stdin`: "stop"). With `gamepad`, a page that
+    on `stdin`: "stop"); the keys of the diagram's "operator" pressed meanwhile are
+    forgotten (`BrowserOperator.forget_keys`). With `gamepad`, a page that
     has seen no gamepad is told so (`NO_GAMEPAD`, in the notice line and on stderr).
     """
 
@@ -87,6 +89,9 @@ class LiveRun:
         self._duration = float(duration)
         self._monitor = (diagram.GetSubsystemByName("task_monitor")
                          if diagram.HasSubsystemNamed("task_monitor") else None)
+        operator = (diagram.GetSubsystemByName("operator")
+                    if diagram.HasSubsystemNamed("operator") else None)
+        self._browser = operator if isinstance(operator, BrowserOperator) else None
         has_alpha = console is not None and console.alpha() is not None
         self._blender = find_system(diagram, "blender") if has_alpha else None
         # None: the sliders' values are applied at the start (a restarted run keeps them).
@@ -158,6 +163,8 @@ class LiveRun:
         if (choice := self._console.wait_for_start(label, stdin=self._stdin)) != "start":
             self.choice = choice
             return False
+        if self._browser is not None:  # a key tried while the page waited moves nothing
+            self._browser.forget_keys(simulator.get_mutable_context())
         simulator.ResetStatistics()  # else the run would rush through the wait
         return True
 

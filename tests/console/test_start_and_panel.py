@@ -1,19 +1,26 @@
 """The console's Start gate and its panel, against a real Meshcat: a run whose task waits
 for Start has simulated nothing until the press (however long the person takes), Stop,
-Restart or Next scene at the gate end it at once with that choice, the lines go to a panel
-(the page front's) with the simulated time of the status, and the choice buttons can be
-swapped for the ones after a run."""
+Restart or Next scene at the gate end it at once with that choice, a key pressed at the
+gate drives nothing once the run goes, the lines go to a panel (the page front's) with the
+simulated time of the status, and the choice buttons can be swapped for the ones after a
+run."""
 
 import threading
 import time
 
 import msgpack
+import numpy as np
 import pytest
 from foreign_page import ForeignPage
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.builder import build_diagram, simulate
 from pbp_drake.console import Console, LiveRun
 from pbp_drake.scenarios import load_scenario_file, resolve
+from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON, KeyboardOperator
+from pbp_drake.systems.ports import EeState
 
 
 def click(meshcat, name):
@@ -93,6 +100,33 @@ def test_a_choice_at_the_start_gate_ends_the_run_with_it(scene, meshcat, label, 
     assert live.choice == choice
     assert trajectory.times[-1] < 0.1
     assert "Start" not in meshcat.GetButtonNames()
+
+
+class KeyBeforeStart(Console):
+    """A page where ← is pressed while it waits for Start, then Start."""
+
+    def wait_for_start(self, label, poll_period=0.05, stdin=None):
+        click(self.meshcat, LEFT_BUTTON)
+        return "start"
+
+
+def test_a_key_pressed_before_start_does_not_move_the_robot_after_it(meshcat):
+    builder = DiagramBuilder()
+    operator = builder.AddNamedSystem("operator", KeyboardOperator(
+        meshcat, 0.05, allow_forward=False, nominal_speed=0.2))
+    source = builder.AddSystem(ConstantVectorSource(np.zeros(EeState.size)))
+    builder.Connect(source.get_output_port(), operator.get_ee_state_input_port())
+    active = LogVectorOutput(operator.get_operator_active_output_port(), builder)
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    simulator.Initialize()
+    live = LiveRun(diagram, 2.0, KeyBeforeStart(meshcat, panel=Panel()), start_label="Start")
+    live.advance(simulator, 1.0)
+    log = active.FindLog(simulator.get_context())
+    assert len(log.sample_times()) > 10 and not log.data().any()  # it was held 0.6 s
+    click(meshcat, LEFT_BUTTON)  # pressed once the run goes: read
+    live.advance(simulator, 1.5)
+    assert log.data().any()
 
 
 def test_the_lines_go_to_the_panel_not_to_buttons(meshcat):

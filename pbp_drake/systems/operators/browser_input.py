@@ -57,6 +57,7 @@ class BrowserOperator(SampledOperator):
         self._allow_forward = bool(allow_forward)
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
+        self._keys_index = None  # the keys' state, once `_declare_keys` declared it
 
     def _declare_keys(self, keys, axes, hold_time):
         """Adds one button per key (`keys`: name -> `KeyboardEvent.code`), `self._axes` the
@@ -70,6 +71,14 @@ class BrowserOperator(SampledOperator):
 
     def _snapshot(self, context, discrete_state):
         discrete_state.get_mutable_vector(self._keys_index).set_value(self._keys.released())
+
+    def forget_keys(self, root_context):
+        """Counts the key presses so far as seen, none held, in `root_context` (as at the
+        simulation's initialization): keys pressed before a run's Start do not drive it
+        once it starts. Nothing without keys (a gamepad's sticks are read as they stand)."""
+        if self._keys_index is not None:
+            context = self.GetMyMutableContextFromRoot(root_context)
+            self._snapshot(context, context.get_mutable_discrete_state())
 
     def _step_keys(self, context, discrete_state, clicks):
         """Stores and returns the keys' state after `clicks`, and whether the guard paused

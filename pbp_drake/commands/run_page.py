@@ -24,6 +24,9 @@ PERSON_NEEDS_PAGE = ("the keyboard and gamepad are read in the page, so nothing 
                      "recorded")
 KEEP_PAGE_SECONDS = 600.0
 WAIT_FOR_BROWSER_SECONDS = 15.0
+# A page that reloads has no connection for a moment (the old one closed, the new one not yet
+# open, the script being loaded): the kept page ends once none has been there this long.
+RELOAD_SECONDS = 5.0
 
 
 def add_page_flags(parser):
@@ -86,10 +89,14 @@ def page_console(meshcat, page, args, alpha, choices=RUN_CHOICES):
 
 
 def keep_page(args, page, console, choices):
-    """After a run: the result stays served until the person closes the page, presses one of
-    `choices` or Enter in a terminal, or --keep-page seconds pass; the choice, or None."""
-    if page.pages() == 0:
-        return None
+    """After a run: the result stays served until the person closes the page (no browser on
+    it for `RELOAD_SECONDS`: a reload is not a close), presses one of `choices` or Enter in
+    a terminal, or --keep-page seconds pass; the choice, or None."""
+    closed = closed_for(page, min(RELOAD_SECONDS, args.keep_page))
+    while page.pages() == 0:
+        if closed():
+            return None
+        time.sleep(0.05)
     console.set_choices(choices)
     words = {"restart": "Restart runs the scene again", "next": "Next scene the next seed"}
     others = [words[choice] for choice in choices if choice in words]
@@ -97,8 +104,23 @@ def keep_page(args, page, console, choices):
                                                            if others else "")
           + f"; Close, Enter or closing the page ends the command (at the latest in "
           f"{args.keep_page:g} s).", flush=True)
-    return console.wait_for_choice(stdin=terminal(), timeout=args.keep_page,
-                                   until=lambda: page.pages() == 0)
+    return console.wait_for_choice(stdin=terminal(), timeout=args.keep_page, until=closed)
+
+
+def closed_for(page, seconds):
+    """A test that is true once `page` (a `PageFront`) has had no browser for `seconds` on
+    end, from the first call that finds none."""
+    since = None
+
+    def closed():
+        nonlocal since
+        if page.pages():
+            since = None
+            return False
+        if since is None:
+            since = time.monotonic()
+        return time.monotonic() - since >= seconds
+    return closed
 
 
 def end_page(page, console, text=ENDED_NOTICE):

@@ -2,11 +2,12 @@
 for Start has simulated nothing until the press (however long the person takes), Stop,
 Restart or Next scene at the gate end it at once with that choice, a key pressed at the
 gate drives nothing once the run goes, the lines go to a panel (the page front's) with the
-simulated time of the status, and the choice buttons can be swapped for the ones after a
-run."""
+simulated time of the status, the choice buttons can be swapped for the ones after a run,
+and the page kept after it outlives a reload."""
 
 import threading
 import time
+import types
 
 import msgpack
 import numpy as np
@@ -17,6 +18,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.builder import build_diagram, simulate
+from pbp_drake.commands import run_page
+from pbp_drake.commands.run_page import keep_page
 from pbp_drake.console import Console, LiveRun
 from pbp_drake.scenarios import load_scenario_file, resolve
 from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON, KeyboardOperator
@@ -140,6 +143,33 @@ def test_the_lines_go_to_the_panel_not_to_buttons(meshcat):
     assert sorted(meshcat.GetButtonNames()) == ["Next scene", "Restart", "Stop"]
     console.clear_result()
     assert panel.state["result"] is None
+
+
+class ReloadedPage:
+    """A page front whose one page is reloaded after the run: gone for a few looks, then
+    back, where Close is clicked; with `back=False` it stays gone (closed)."""
+
+    def __init__(self, meshcat, back=True):
+        self._meshcat, self._looks = meshcat, [1, 0, 0, 0, 0] if back else [1]
+        self._back = back
+
+    def pages(self):
+        if self._looks:
+            return self._looks.pop(0)
+        if self._back:
+            click(self._meshcat, "Close")
+            self._back = False
+            return 1
+        return 0
+
+
+def test_a_page_reloaded_after_the_run_keeps_it_and_a_closed_one_ends_it(meshcat,
+                                                                           monkeypatch):
+    args = types.SimpleNamespace(keep_page=60.0)
+    console = Console(meshcat, panel=Panel())
+    assert keep_page(args, ReloadedPage(meshcat), console, ("close",)) == "close"
+    monkeypatch.setattr(run_page, "RELOAD_SECONDS", 0.1)
+    assert keep_page(args, ReloadedPage(meshcat, back=False), console, ("close",)) is None
 
 
 def test_the_choices_after_a_run_replace_the_run_s(meshcat):

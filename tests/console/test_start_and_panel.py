@@ -150,7 +150,7 @@ class ReloadedPage:
     back, where Close is clicked; with `back=False` it stays gone (closed)."""
 
     def __init__(self, meshcat, back=True):
-        self._meshcat, self._looks = meshcat, [1, 0, 0, 0, 0] if back else [1]
+        self._meshcat, self._looks = meshcat, [1, 0, 0] if back else [1]
         self._back = back
 
     def pages(self):
@@ -168,7 +168,7 @@ def test_a_page_reloaded_after_the_run_keeps_it_and_a_closed_one_ends_it(meshcat
     args = types.SimpleNamespace(keep_page=60.0)
     console = Console(meshcat, panel=Panel())
     assert keep_page(args, ReloadedPage(meshcat), console, ("close",)) == "close"
-    monkeypatch.setattr(run_page, "RELOAD_SECONDS", 0.1)
+    monkeypatch.setattr(run_page, "RELOAD_SECONDS", 0.05)
     assert keep_page(args, ReloadedPage(meshcat, back=False), console, ("close",)) is None
 
 

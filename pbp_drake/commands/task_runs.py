@@ -83,10 +83,10 @@ def run_task_loop(args, resolved, meshcat, page):
             code = EXIT_STOPPED
         if console is None:
             return code
+        delete_operator(diagram)  # its keys drive nothing once the run is over
         choice = live.choice
         if choice is None:
             choice = keep_page(args, page, console, AFTER_RUN_CHOICES)
-        delete_operator(diagram)
         if choice in (None, "stop", "close"):
             end_page(page, console)
             return code

@@ -3,8 +3,9 @@ for Start has simulated nothing until the press (however long the person takes),
 Restart or Next scene at the gate end it at once with that choice, a key pressed at the
 gate drives nothing once the run goes, the lines go to a panel (the page front's) with the
 simulated time of the status, the choice buttons can be swapped for the ones after a run,
-and the page kept after it outlives a reload."""
+and the page kept after it has no keys and outlives a reload."""
 
+import dataclasses
 import threading
 import time
 import types
@@ -18,11 +19,13 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from pbp_drake.builder import build_diagram, simulate
-from pbp_drake.commands import run_page
+from pbp_drake.commands import run_page, task_runs
 from pbp_drake.commands.run_page import keep_page
+from pbp_drake.commands.task_runs import run_task_loop
 from pbp_drake.console import Console, LiveRun
-from pbp_drake.scenarios import load_scenario_file, resolve
-from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON, KeyboardOperator
+from pbp_drake.scenarios import Keyboard, load_scenario_file, resolve
+from pbp_drake.systems.operators.keyboard_operator import (
+    KEY_BUTTONS, LEFT_BUTTON, KeyboardOperator)
 from pbp_drake.systems.ports import EeState
 
 
@@ -185,3 +188,34 @@ def test_the_choices_after_a_run_replace_the_run_s(meshcat):
     started = time.monotonic()
     assert console.wait_for_choice(poll_period=0.01, timeout=0.2) is None
     assert 0.2 <= time.monotonic() - started < 2.0
+
+
+class KeptPage(Panel):
+    """A page front with one browser on it, for the whole command."""
+
+    url = "http://localhost/?token=test"
+
+    def pages(self):
+        return 1
+
+    def end(self, text=None):
+        self.state["ended"] = text
+
+
+def test_the_page_kept_after_a_run_has_no_keys(repo, meshcat, monkeypatch):
+    scenario = dataclasses.replace(
+        load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario,
+        method="teleop", operator=Keyboard(), duration=0.2)
+    args = types.SimpleNamespace(
+        hand_trail=False, start_on_connect=True, wait_for_browser=1.0, camera="overview",
+        record=None, headless=False, realtime_rate=50.0, log=None, keep_page=60.0)
+    kept = []
+
+    def keep_page(args, page, console, choices):
+        kept.append(set(meshcat.GetButtonNames()))
+        return "close"
+
+    monkeypatch.setattr(task_runs, "keep_page", keep_page)
+    run_task_loop(args, resolve(scenario), meshcat, KeptPage())
+    # No key is offered for a robot whose run is over (the choices are keep_page's).
+    assert len(kept) == 1 and not kept[0] & set(KEY_BUTTONS), kept

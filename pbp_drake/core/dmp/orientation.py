@@ -98,9 +98,9 @@ class OrientationDmp(SingleDmp):
         shape = self._shape(phase)
         result = np.empty(AXES)
         for axis in range(AXES):
-            if self.settings.formulation == "ijspeert":
+            if self._settings.formulation == "ijspeert":
                 amplitude = -start_error[axis] if self.amplitude_scaling[axis] else 1.0
-                result[axis] = shape[axis] * amplitude / self.settings.stiffness
+                result[axis] = shape[axis] * amplitude / self._settings.stiffness
             else:
                 result[axis] = start_error[axis] * phase + shape[axis]
         return result

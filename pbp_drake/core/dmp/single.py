@@ -148,10 +148,12 @@ class Dmp(SingleDmp):
     def reset(self, position=None, scaled_velocity=None):
         """Phase to 1, position to `start` (or `position`), scaled velocity to 0 (or given)."""
         self.phase = 1.0
-        self.position = self.start.copy() if position is None else as_point(position, "position")
+        size = self.start.size
+        self.position = (self.start.copy() if position is None
+                         else as_point(position, "position", dimension=size))
         self.scaled_velocity = (
-            np.zeros(self.start.size) if scaled_velocity is None
-            else np.array(scaled_velocity, float)
+            np.zeros(size) if scaled_velocity is None
+            else as_point(scaled_velocity, "scaled_velocity", dimension=size)
         )
 
     def attractor(self, phase, goal):

@@ -422,9 +422,12 @@ def assisted_command(method, settings, targets, probabilities, position, velocit
     operator's command `u` = (`velocity`, `angular_velocity`) at the hand's pose; `u`
     alone when `settings.assistance` is False."""
     probabilities = np.asarray(probabilities, dtype=float)
-    if probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all():
-        raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers, "
-                         f"got {probabilities!r}")
+    # Not negative: a log belief given for the belief would weigh every goal below 0, and
+    # the assistance would stop without a word.
+    if (probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all()
+            or (probabilities < 0.0).any()):
+        raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers >= 0 "
+                         f"(probabilities, not their logs), got {probabilities!r}")
     operator_angular = None if targets.orientations is None else (
         np.zeros(3) if angular_velocity is None
         else _finite_vector(angular_velocity, "angular_velocity"))

@@ -373,6 +373,9 @@ def test_bad_inputs_are_refused():
                               [0, 0, 0]), "log_belief must be 1 finite numbers"),
     (lambda: assisted_command("hop", SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [math.nan],
                               [0, 0, 0.7], [0, 0, 0]), "goal_probabilities must be 1 finite"),
+    (lambda: assisted_command("hop", SETTINGS, hop_targets([[1.0, 0.0, 0.7], [0.0, 1.0, 0.7]]),
+                              np.log([0.5, 0.5]), [0, 0, 0.7], [0.1, 0, 0]),
+     r"goal_probabilities must be 2 finite numbers >= 0 \(probabilities, not their logs\)"),
     (lambda: assisted_command("assist", SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [1.0],
                               [0, 0, 0.7], [0, 0, 0]), "method 'assist' is unknown; choose one"),
 ])

@@ -367,6 +367,8 @@ def test_bad_inputs_are_refused():
     (lambda: hop_targets([[1.0, 0.0, 0.7]], goals=[0.5]), "one integer goal index per target"),
     (lambda: hop_targets([[1.0, 0.0, 0.7]], goals=[1], goal_count=1),
      r"goal indices must lie in \[0, 1\), got \[1\]"),
+    (lambda: hop_targets([[1.0, 0.0, 0.7], [0.0, 1.0, 0.7]], goal_count=2.5),
+     "goal_count must be a whole number >= 1, got 2.5"),
     (lambda: update_posterior(SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [0.0], [0, 0], [0, 0, 0]),
      "position must have 3 entries, got 2"),
     (lambda: update_posterior(SETTINGS, hop_targets([[1.0, 0.0, 0.7]]), [0.0, 0.0], [0, 0, 0.7],

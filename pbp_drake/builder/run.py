@@ -44,14 +44,23 @@ class Trajectory:
     phase: np.ndarray | None
 
 
-def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=None):
+def initialized_simulator(scenario, meshcat=None, realtime_rate=None, diagram=None,
+                          task=None):
     """`(scenario, diagram, simulator)` of a scenario (resolved once if it is not): the
     diagram built unless given, the simulator configured by the scenario's
-    `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized."""
+    `SimulatorConfig` (`realtime_rate` overriding its target rate) and initialized. `task`:
+    True for a robot task's run (`run_task`), False for a 2-D scene's (`simulate`); the
+    other kind is refused saying which to call."""
     if realtime_rate is not None and not (is_real(realtime_rate) and realtime_rate >= 0):
         raise ValueError(f"realtime_rate must be a number >= 0 (0: as fast as possible), got "
                          f"{realtime_rate!r}")
     resolved = scenario if isinstance(scenario, ResolvedScenario) else resolve(scenario)
+    if task is not None and resolved.has_task != task:
+        kind = ("a robot task (TaskScenario)" if resolved.has_task
+                else "a 2-D scene (PointScenario)")
+        call = "run_task" if resolved.has_task else "simulate"
+        raise ValueError(f"scenario {resolved.scenario.name!r} is {kind}: run it with "
+                         f"{call}(scenario)")
     diagram = build_diagram(resolved, meshcat) if diagram is None else diagram
     simulator = Simulator(diagram)
     reset_pacing_after_pauses(diagram, simulator)
@@ -81,7 +90,7 @@ def simulate(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=N
     """Simulates `scenario` for its duration and returns its Trajectory (the ticks up to
     where `advance` stopped, when it stopped early)."""
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
-                                                         diagram)
+                                                         diagram, task=False)
     # One tick past the end: the loggers record tick k's decisions one sample later.
     ticks = ticks_of(scenario)
     context = simulator.get_context()
@@ -284,7 +293,7 @@ def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=N
     """Simulates an HSR task until success or `scenario.duration` (the time limit), or
     until `advance` stops it."""
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
-                                                         diagram)
+                                                         diagram, task=True)
     # The task monitor itself ends the simulation at success.
     (advance or advance_to)(simulator, (ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()

@@ -16,7 +16,7 @@ import numpy as np
 
 from pbp_drake.core import quaternion
 from pbp_drake.core.choices import unknown_choice
-from pbp_drake.core.coordinates import is_real
+from pbp_drake.core.coordinates import is_real, is_whole
 
 # Below this (m, rad) the hand is at a target: no direction to it.
 AT_TARGET = 1e-12
@@ -125,6 +125,8 @@ def hop_targets(positions, orientations=None, goals=None, goal_count=None):
     if goals.shape != (len(positions),) or not np.issubdtype(goals.dtype, np.integer):
         raise ValueError(f"goals must be one integer goal index per target ({len(positions)}),"
                          f" got {goals!r}")
+    if goal_count is not None and not is_whole(goal_count, 1):
+        raise ValueError(f"goal_count must be a whole number >= 1, got {goal_count!r}")
     count = int(goals.max()) + 1 if goal_count is None else int(goal_count)
     if (goals < 0).any() or (goals >= count).any():
         raise ValueError(f"goal indices must lie in [0, {count}), got {goals.tolist()}")
@@ -422,9 +424,12 @@ def assisted_command(method, settings, targets, probabilities, position, velocit
     operator's command `u` = (`velocity`, `angular_velocity`) at the hand's pose; `u`
     alone when `settings.assistance` is False."""
     probabilities = np.asarray(probabilities, dtype=float)
-    if probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all():
-        raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers, "
-                         f"got {probabilities!r}")
+    # Not negative: a log belief given for the belief would weigh every goal below 0, and
+    # the assistance would stop without a word.
+    if (probabilities.shape != (targets.goal_count,) or not np.isfinite(probabilities).all()
+            or (probabilities < 0.0).any()):
+        raise ValueError(f"goal_probabilities must be {targets.goal_count} finite numbers >= 0 "
+                         f"(probabilities, not their logs), got {probabilities!r}")
     operator_angular = None if targets.orientations is None else (
         np.zeros(3) if angular_velocity is None
         else _finite_vector(angular_velocity, "angular_velocity"))

@@ -9,6 +9,7 @@ CLI) derives any of these again.
 """
 
 import contextlib
+import copy
 import dataclasses
 import json
 import math
@@ -50,7 +51,9 @@ class ResolvedScenario:
     """A scenario with everything derived from it (see `resolve`).
 
     Attributes:
-        scenario: the configs it was resolved from.
+        scenario: a copy of the configs it was resolved from, taken by `resolve`: a
+            scenario changed after it was resolved (a field set, a list changed in place)
+            changes neither this copy nor what was derived from it.
         start: (D,) where the robot (2-D scenes) or the hand (HSR) starts.
         goals: (K, D) the goals, one DMP each.
         demonstration: (times (T,), positions (T, D)) or None.
@@ -114,11 +117,34 @@ def resolve(scenario):
     if not isinstance(scenario, (PointScenario, TaskScenario)):
         raise ScenarioError(f"a scenario to resolve is a PointScenario or a TaskScenario, "
                             f"not {type(scenario).__name__}")
+    # Its own copy: what is derived below and the configs a run reads later (its duration,
+    # its period) must stay one scenario when the caller changes theirs in place.
+    scenario = _own_copy(scenario)
     _check_operator(scenario)
     _check_common(scenario)
     if isinstance(scenario, TaskScenario):
         return _resolve_task_robot(scenario)
     return _resolve_point_robot(scenario)
+
+
+def _own_copy(config):
+    """A copy of `config` sharing no list or config with it: dataclasses and lists copied
+    field by field, a NumPy array as the list of its values (as a file gives them), numbers
+    and strings kept (immutable), anything else deep-copied (Drake's config structs).
+    Faster than `copy.deepcopy` over a file's 100,000 goals."""
+    if config is None or isinstance(config, (bool, int, float, str)):
+        return config
+    if isinstance(config, np.ndarray):
+        return config.tolist()
+    if type(config) in (list, tuple):
+        return type(config)(_own_copy(item) for item in config)
+    if dataclasses.is_dataclass(config) and not isinstance(config, type):
+        copied = copy.copy(config)
+        for field in dataclasses.fields(config):
+            # object.__setattr__: a frozen dataclass's fields too.
+            object.__setattr__(copied, field.name, _own_copy(getattr(config, field.name)))
+        return copied
+    return copy.deepcopy(config)
 
 
 def parse_method_label(label):

@@ -1,5 +1,6 @@
 """The builder's public calls refuse what they cannot build or read, in words: an
-operator config of the other kind of scene, a log read past its last sample."""
+operator config of the other kind of scene, a log read past its last sample, a scenario
+run by the call of the other kind of run."""
 
 import dataclasses
 
@@ -8,7 +9,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
-from pbp_drake.builder import make_hsr_operator, make_operator, read_log, simulate
+from pbp_drake.builder import make_hsr_operator, make_operator, read_log, run_task, simulate
 from pbp_drake.scenarios import ObstacleRepulsion, VirtualParticipant, load_scenario_file
 
 
@@ -46,3 +47,16 @@ def test_a_realtime_rate_that_is_no_rate_is_refused_by_name(repo, rate):
     with pytest.raises(ValueError, match=r"realtime_rate must be a number >= 0 \(0: as fast as "
                                          r"possible\), got "):
         simulate(toy, realtime_rate=rate)
+
+
+def test_a_scenario_of_the_other_kind_of_run_says_which_call_runs_it(repo):
+    """`run_task` of a 2-D scene ended in Drake's `does not have a subsystem named
+    ee_state_log`, `simulate` of a robot task in an AttributeError of None."""
+    toy = load_scenario_file(repo / "diagrams" / "toy_alt_vs_cont.yaml").resolved
+    with pytest.raises(ValueError, match=r"scenario 'toy_alt_vs_cont' is a 2-D scene "
+                                         r"\(PointScenario\): run it with simulate\(scenario\)"):
+        run_task(toy)
+    reach = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario
+    with pytest.raises(ValueError, match=r"is a robot task \(TaskScenario\): run it with "
+                                         r"run_task\(scenario\)"):
+        simulate(reach)

@@ -343,3 +343,31 @@ _BANK = DmpBankModel.straight([0.0, 0.0], 2, 1.0)
 def test_a_bad_argument_is_refused_naming_it(build, message):
     with pytest.raises(ValueError, match=message):
         build()
+
+
+def test_a_dmp_keeps_its_own_settings():
+    """Changing the settings a DMP was made with, or the `settings` it gives, changes neither
+    that DMP nor, through the shared default, the DMPs made after it."""
+    settings = DmpSettings()
+    times, positions = minimum_jerk([0.0, 0.0], [1.0, 0.5], 1.0)
+    dmp = Dmp.from_demonstration(times, positions, settings)
+    path = dmp.rollout(0.01)
+    settings.alpha_x = 1.0
+    dmp.settings.alpha_z = 5.0
+    assert np.array_equal(dmp.rollout(0.01), path)
+    defaulted = Dmp.straight([0.0], [1.0], 1.0)
+    defaulted.settings.alpha_x = 1.0
+    assert Dmp.straight([0.0], [1.0], 1.0).settings == DmpSettings()
+
+
+@pytest.mark.parametrize("state, message", [
+    ({"position": [0.1, 0.0, 0.0]}, "position has 3 numbers, expected 2"),
+    ({"scaled_velocity": [0.1, 0.0, 5.0]}, "scaled_velocity has 3 numbers, expected 2"),
+    ({"scaled_velocity": [np.nan, 0.0]}, "scaled_velocity contains NaN"),
+])
+def test_a_reset_state_that_is_not_the_dmps_is_refused_naming_it(state, message):
+    """A third velocity was ignored without a word, a NaN one stepped into NaN positions,
+    and a third position ended in an IndexError at the next step."""
+    dmp = Dmp.straight([0.0, 0.0], [1.0, 0.0], 1.0)
+    with pytest.raises(ValueError, match=message):
+        dmp.reset(**state)

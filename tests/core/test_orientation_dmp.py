@@ -369,3 +369,9 @@ def test_a_goal_half_a_turn_away_is_turned_to_as_the_single_dmp_turns():
 def test_a_bad_argument_is_refused_naming_it(build, message):
     with pytest.raises(ValueError, match=message):
         build()
+
+
+def test_a_reset_angular_velocity_that_is_not_three_numbers_is_refused_naming_it():
+    dmp = OrientationDmp.straight(quaternion.IDENTITY, quaternion.IDENTITY, 1.0)
+    with pytest.raises(ValueError, match="scaled_angular_velocity has 2 numbers, expected 3"):
+        dmp.reset(scaled_angular_velocity=[0.1, 0.2])

@@ -11,7 +11,7 @@ import pbp_drake.core.dmp.single as single_dmp_module
 import pbp_drake.scenarios.resolution as resolve_module
 import pbp_drake.scenarios.task_scenes as task_scenes_module
 from pbp_drake.builder import build_diagram
-from pbp_drake.scenarios import BentPath, GraspTask, TaskScenario, load_scenario_file
+from pbp_drake.scenarios import BentPath, GraspTask, TaskScenario, load_scenario_file, resolve
 from pbp_drake.studies.runners import compute_trial
 
 SHIPPED = sorted(pathlib.Path(__file__).resolve().parents[2].glob("diagrams/*.yaml"))
@@ -85,3 +85,21 @@ def test_one_study_trial_resolves_once(name, work):
     assert record["objects"]  # the scene the trial ran is recorded from the same draw
     assert work["fit_weights"] == 1
     assert work["sample_reach_scene"] + work["sample_obstacle_scene"] == 1
+
+
+def test_a_scenario_changed_after_resolving_leaves_its_resolution_whole(repo):
+    """`resolve` keeps its own copy: a goal or the duration changed in place afterwards
+    (on the loaded file's `scenario`, or the one given to `resolve`) neither reaches the
+    resolved run's configs nor leaves them disagreeing with the goals derived from them."""
+    loaded = load_scenario_file(repo / "diagrams" / "toy_alt_vs_cont.yaml")
+    goals, duration = [list(goal) for goal in loaded.scenario.goals], loaded.scenario.duration
+    loaded.scenario.goals[0][0] += 0.5
+    loaded.scenario.duration = -1.0
+    assert loaded.resolved.scenario.goals == goals == loaded.resolved.goals.tolist()
+    assert loaded.resolved.scenario.duration == duration
+    scenario = load_scenario_file(repo / "diagrams" / "hsr_reach.yaml").scenario
+    resolved = resolve(scenario)
+    scenario.task.switch_schedule.append(0.9)
+    scenario.robot.station.obstacles.append("not an obstacle")
+    assert resolved.scenario.task.switch_schedule == [0.0, 0.3, 0.6]
+    assert resolved.scenario.robot.station.obstacles == []

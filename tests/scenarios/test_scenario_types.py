@@ -90,3 +90,15 @@ def test_a_scenario_made_in_python_with_the_other_kinds_operator_is_refused():
         resolve(dataclasses.replace(reach, operator=toy.operator))
     with pytest.raises(ScenarioError, match="a PointScenario or a TaskScenario, not Scenario"):
         resolve(Scenario())
+
+
+def test_a_scenario_made_in_python_may_hold_numpy_arrays():
+    """A script may set a list field from NumPy (`start`, `goals`): resolved as the lists of
+    the same values, not refused by NumPy's "truth value of an array is ambiguous"."""
+    scene = load_scenario_file(DIAGRAMS / "toy_alt_vs_cont.yaml").scenario
+    arrays = dataclasses.replace(scene, start=np.array(scene.start),
+                                 goals=np.array(scene.goals))
+    resolved, expected = resolve(arrays), resolve(scene)
+    assert resolved.scenario.goals == scene.goals and resolved.scenario.start == scene.start
+    assert np.array_equal(resolved.goals, expected.goals)
+    assert np.array_equal(resolved.start, expected.start)

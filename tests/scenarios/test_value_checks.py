@@ -229,11 +229,11 @@ def test_a_gamepad_is_refused_where_the_objects_stand_at_heights_of_their_own(tm
 def test_a_scenario_made_in_python_is_held_to_the_checks_a_file_walk_cannot_make():
     toy = load_scenario_file(DIAGRAMS / "toy_alt_vs_cont.yaml").scenario
     reach = load_scenario_file(DIAGRAMS / "hsr_reach.yaml").scenario
-    # An array is no list: the walk of the numbers leaves it to the operator's own check.
+    # An array is resolved as its list: the walk of the numbers names the element.
     commands = ScriptedCommands(times=[0.0, 1.0], commands=np.array([[0.0, np.nan],
                                                                      [0.0, 0.0]]))
-    with pytest.raises(ScenarioError, match=r"^scenario.operator.commands contain NaN or "
-                                            r"infinite values$"):
+    with pytest.raises(ScenarioError, match=r"^scenario.operator.commands\[0\]\[1\]: NaN is "
+                                            r"not a number here; expected a finite number$"):
         resolve(dataclasses.replace(toy, operator=commands))
     participant = dataclasses.replace(reach.operator, plan_directions=2.5)
     with pytest.raises(ScenarioError, match=r"^scenario.operator.plan_directions 2.5 is no "

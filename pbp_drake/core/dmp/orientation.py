@@ -12,7 +12,7 @@ degrees of its last orientation: docs/concepts/dmp.md, "Orientation DMPs"."""
 import numpy as np
 
 from pbp_drake.core import quaternion
-from pbp_drake.core.dmp._checks import positive
+from pbp_drake.core.dmp._checks import as_point, positive
 from pbp_drake.core.dmp.fitting import check_times, fit_weights
 from pbp_drake.core.dmp.settings import DmpSettings
 from pbp_drake.core.dmp.single import SingleDmp
@@ -89,8 +89,9 @@ class OrientationDmp(SingleDmp):
         self.phase = 1.0
         self.orientation = (self.start.copy() if orientation is None else
                             quaternion.unit_quaternions(orientation, "orientation").reshape(4))
-        self.scaled_angular_velocity = (np.zeros(AXES) if scaled_angular_velocity is None
-                                        else np.array(scaled_angular_velocity, float))
+        self.scaled_angular_velocity = (
+            np.zeros(AXES) if scaled_angular_velocity is None
+            else as_point(scaled_angular_velocity, "scaled_angular_velocity", dimension=AXES))
 
     def attractor(self, phase, goal):
         """The moving attractor `a(x)` in `e = Log(q g*)` coordinates, `(3,)`."""
@@ -98,9 +99,9 @@ class OrientationDmp(SingleDmp):
         shape = self._shape(phase)
         result = np.empty(AXES)
         for axis in range(AXES):
-            if self.settings.formulation == "ijspeert":
+            if self._settings.formulation == "ijspeert":
                 amplitude = -start_error[axis] if self.amplitude_scaling[axis] else 1.0
-                result[axis] = shape[axis] * amplitude / self.settings.stiffness
+                result[axis] = shape[axis] * amplitude / self._settings.stiffness
             else:
                 result[axis] = start_error[axis] * phase + shape[axis]
         return result

@@ -6,6 +6,8 @@ system holds one, and it is the oracle the vectorised, immutable `DmpBankModel` 
 against. `SingleDmp` is what it shares with `OrientationDmp`.
 """
 
+import dataclasses
+
 import numpy as np
 
 from pbp_drake.core.dmp._checks import as_point, dmp_settings, positive
@@ -33,9 +35,11 @@ class SingleDmp:
 
     def __init__(self, weights, start, goal, duration, settings, amplitude_scaling,
                  dimension):
-        self.settings = dmp_settings(settings)
+        # A private copy (validated again): the caller's settings, or the shared default
+        # instance, may be changed later, and the basis below is computed once.
+        self._settings = dataclasses.replace(dmp_settings(settings))
         self.start, self.goal = self._ends(start, goal)
-        self.weights = np.asarray(weights, dtype=float).reshape(settings.basis_count, -1)
+        self.weights = np.asarray(weights, dtype=float).reshape(self._settings.basis_count, -1)
         if self.weights.shape[1] != dimension:
             raise ValueError(f"weights have {self.weights.shape[1]} dimensions, expected "
                              f"{dimension}")
@@ -47,8 +51,13 @@ class SingleDmp:
             if amplitude_scaling is None
             else np.asarray(amplitude_scaling, bool).reshape(dimension)
         )
-        self._centres, self._widths = settings.basis()
+        self._centres, self._widths = self._settings.basis()
         self.reset()
+
+    @property
+    def settings(self):
+        """The DMP's gains and basis (a copy: changing it does not change the DMP)."""
+        return dataclasses.replace(self._settings)
 
     @classmethod
     def straight(cls, start, goal, duration, settings=DmpSettings(), profile="minimum_jerk"):
@@ -78,9 +87,9 @@ class SingleDmp:
     def _free_step(self, values, z, dt, goal):
         """One first-order-hold step of the state `(values, z)` (D,) toward the attractor
         at `goal`; advances the phase and returns the new `(values, z)`, new arrays."""
-        phi, gamma = step_matrices(self.settings.stiffness, self.settings.damping,
+        phi, gamma = step_matrices(self._settings.stiffness, self._settings.damping,
                                    self.duration, dt)
-        decay = phase_decay(self.settings, self.duration, dt)
+        decay = phase_decay(self._settings, self.duration, dt)
         # The attractor moves linearly in time from its value at this step's phase to its
         # value at the next (first-order hold).
         start = self.attractor(self.phase, goal)
@@ -139,10 +148,12 @@ class Dmp(SingleDmp):
     def reset(self, position=None, scaled_velocity=None):
         """Phase to 1, position to `start` (or `position`), scaled velocity to 0 (or given)."""
         self.phase = 1.0
-        self.position = self.start.copy() if position is None else as_point(position, "position")
+        size = self.start.size
+        self.position = (self.start.copy() if position is None
+                         else as_point(position, "position", dimension=size))
         self.scaled_velocity = (
-            np.zeros(self.start.size) if scaled_velocity is None
-            else np.array(scaled_velocity, float)
+            np.zeros(size) if scaled_velocity is None
+            else as_point(scaled_velocity, "scaled_velocity", dimension=size)
         )
 
     def attractor(self, phase, goal):
@@ -151,9 +162,9 @@ class Dmp(SingleDmp):
         shape = self._shape(phase)
         result = np.empty(self.start.size)
         for dim in range(self.start.size):
-            if self.settings.formulation == "ijspeert":
+            if self._settings.formulation == "ijspeert":
                 amplitude = goal[dim] - self.start[dim] if self.amplitude_scaling[dim] else 1.0
-                result[dim] = goal[dim] + shape[dim] * amplitude / self.settings.stiffness
+                result[dim] = goal[dim] + shape[dim] * amplitude / self._settings.stiffness
             else:
                 result[dim] = goal[dim] - (goal[dim] - self.start[dim]) * phase + shape[dim]
         return result

@@ -12,6 +12,7 @@ import numpy as np
 from pydrake.systems.analysis import GetIntegrationSchemes
 
 from pbp_drake.core.choices import unknown_choice
+from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.pilot_population import ParticipantPopulationParams, population_problem
 from pbp_drake.core.surrogate_pilots import ProportionalPilotParams
 from pbp_drake.scenarios.bounds import MAX_GOALS
@@ -76,8 +77,10 @@ def require_finite(config, field, names, positive=True):
     least = "positive" if positive else "not negative"
     for name in names:
         value = getattr(config, name, 0.0)
-        if not (np.isfinite(value) and (value > 0 if positive else value >= 0)):
-            raise ScenarioError(f"{field}.{name} must be finite and {least}, got {value}")
+        if not (is_real(value) and math.isfinite(value)
+                and (value > 0 if positive else value >= 0)):
+            shown = value if is_real(value) else repr(value)  # a string '3' said as one
+            raise ScenarioError(f"{field}.{name} must be finite and {least}, got {shown}")
 
 
 def check_time_steps(time_steps):

@@ -239,6 +239,10 @@ def test_a_scenario_made_in_python_is_held_to_the_checks_a_file_walk_cannot_make
     with pytest.raises(ScenarioError, match=r"^scenario.operator.plan_directions 2.5 is no "
                                             r"count; expected a whole number, 1 to 360$"):
         resolve(dataclasses.replace(reach, operator=participant))
+    # A number given as a string (as YAML would have read it): named, not a NumPy TypeError.
+    with pytest.raises(ScenarioError, match=r"^scenario.duration must be finite and positive, "
+                                            r"got '3'$"):
+        resolve(dataclasses.replace(reach, duration="3"))
     with pytest.raises(ValueError, match=r"^x_range and y_range must be \[low, high\]$"):
         task_scene(MultiGoalReach(x_range=[1.0]), 0)
     with pytest.raises(ScenarioError, match=r"^study !MethodComparison runs the tasks: use "

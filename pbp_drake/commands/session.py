@@ -3,7 +3,6 @@ method of `--methods` run once in an order counterbalanced across participants, 
 followed by the questions, in the page (`run --participant` is the same command)."""
 
 import argparse
-import pathlib
 import sys
 
 from pbp_drake.builder import build_diagram
@@ -16,7 +15,7 @@ from pbp_drake.console.front import ENDED_NOTICE
 from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
 from pbp_drake.scenarios import counted
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, scales_text
-from pbp_drake.studies.sessions import run_session
+from pbp_drake.studies.sessions import resume_text, run_session, session_folder
 
 
 def add_session_flags(parser, hidden=False):
@@ -45,14 +44,16 @@ def add_session_flags(parser, hidden=False):
 
 def run_session_command(args, resolved, meshcat, page, session):
     """The session of `args.participant` on the resolved scenario, `session` its
-    `(methods, order, answers)` from `check_run_flags`; its exit code."""
+    `(methods, order, answers, progress)` from `check_run_flags`; its exit code."""
     scenario = resolved.scenario
-    methods, order, answers = session
-    output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
-                                                       args.participant))
+    methods, order, answers, progress = session
+    output = session_folder(args.participant, args.output)
     print(f"Participant {args.participant}: {', '.join(order)}, in this order"
           + (", each practised first" if args.practice else "") + f"; saved in {output}",
           flush=True)
+    resuming = resume_text(args.participant, order, progress, args.practice)
+    if resuming:
+        print(resuming, flush=True)
     if answers is not None:
         questions = FixedAnswers(answers)
     else:

@@ -204,3 +204,66 @@ def test_an_unattended_session_on_the_grasping_task_and_its_report(repo, tmp_pat
     assert main(["report", str(study)]) == 0
     results = (study / "results.md").read_text()
     assert "| P04 |" in results and (study / "fig8_questionnaire.png").is_file()
+
+
+@pytest.mark.slow
+def test_a_participant_folder_takes_no_other_participant_and_no_second_session(
+        repo, tmp_path, capsys):
+    output = tmp_path / "P01"
+
+    def session(participant, *more):
+        return main(["session", str(repo / TASK), "--headless", "--operator", "virtual",
+                     "--participant", participant, "--answers", ANSWERS, "--duration", "1",
+                     "--methods", "teleop", "--output", str(output), *more])
+
+    assert session("P01") in (0, 1)
+    saved = session_files(output, ["teleop"])
+    answers = (output / "questionnaire.json").read_bytes()
+    assert json.loads((output / "study.json").read_text())["participant"] == "P01"
+    capsys.readouterr()
+    # A second participant given the first one's folder by mistake: their runs and answers
+    # were taken as P01's (and the order recorded was P02's).
+    assert session("P02") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pbp-drake: {output} holds the session of participant P01, not "
+                          "P02: resume it with --participant P01, or give P02 a folder of")
+    # The same command once the session is complete: the page said "Session complete"
+    # having run nothing, and a person sat down for nothing.
+    assert session("P01") == 2
+    err = capsys.readouterr().err
+    assert "holds P01's complete session (teleop, each run and answered): nothing to run" in err
+    assert session_files(output, ["teleop"]) == saved
+    assert (output / "questionnaire.json").read_bytes() == answers
+
+
+@pytest.mark.slow
+def test_a_resumed_session_keeps_its_methods_and_says_where_it_resumes(
+        repo, short_task, tmp_path, capsys):
+    output = tmp_path / "P01"
+    order = session_order(METHODS, "P01")
+
+    def stops_at_second(trial):
+        if trial.scenario.method != order[0]:
+            raise KeyboardInterrupt
+        return run_task(trial)
+
+    with pytest.raises(KeyboardInterrupt):
+        run_session(short_task, "P01", METHODS, output, stops_at_second,
+                    FixedAnswers(parse_answers(ANSWERS, METHODS)))
+    saved = session_files(output, order[:1])
+    base = ["session", str(repo / TASK), "--headless", "--operator", "virtual",
+            "--participant", "P01", "--answers", ANSWERS, "--duration", "1.5",
+            "--output", str(output)]
+    # Other methods, so another order: the first method's run and answers were kept beside
+    # a study.json of other methods, and the counterbalanced order was lost.
+    assert main([*base, "--methods", "teleop,pbp_continuous"]) == 2
+    err = capsys.readouterr().err
+    assert (f"{output} holds P01's session begun with the methods in the order "
+            f"{', '.join(order)}; this one's order is pbp_continuous, teleop: resume it with "
+            "the --methods it began with (--methods pbp_alternated,pbp_continuous,teleop)"
+            in err)
+    assert main([*base, "--practice"]) in (0, 1)
+    out = capsys.readouterr().out
+    assert (f"Resuming P01's session: {order[0]} saved, not run again; no practice (recorded "
+            f"runs exist); next: {order[1]}, method 2 of 3, from its start.\n") in out
+    assert session_files(output, order[:1]) == saved

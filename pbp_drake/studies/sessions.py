@@ -79,9 +79,11 @@ def check_session_folder(scenario, participant, methods, output):
     """Raises StudyFolderError (QuestionnaireError for a damaged questionnaire.json) when
     `output` cannot take `participant`'s session of `methods`: it holds a study of another
     scenario, another participant's session, this participant's session begun with other
-    methods (so in another order) or complete. Returns the folder's SessionProgress."""
+    methods (so in another order) or complete; or a folder beside it has a name that
+    differs from its own only in case. Returns the folder's SessionProgress."""
     output = pathlib.Path(output)
     order = session_order(methods, participant)
+    _check_case_twins(output)
     recorded = [check_folder(folder, scenario, scenario_hash(scenario), quiet=True)
                 for folder in (output, output / PRACTICE_FOLDER)]
     progress = session_progress(scenario, order, output)
@@ -119,6 +121,21 @@ def _methods_given(order, participant):
     shift = participant_number(participant) % len(order)
     # session_order rotates the methods left by `shift`: this rotates the order back.
     return ",".join(order[-shift:] + order[:-shift])
+
+
+def _check_case_twins(output):
+    """Refuses a session folder beside one whose name differs only in case (P07, p07): one
+    folder on a case-insensitive disk, and most likely one participant mistyped."""
+    parent = output.parent
+    twins = sorted(p.name for p in (parent.iterdir() if parent.is_dir() else [])
+                   if p.is_dir() and p.name != output.name
+                   and p.name.casefold() == output.name.casefold())
+    if twins:
+        raise StudyFolderError(
+            f"{parent / twins[0]} is beside {output}, their names differing only in case: "
+            "one folder on a case-insensitive disk, and most likely one participant's ID "
+            f"mistyped. Resume with the ID of {twins[0]}, or give the participant an ID that "
+            "differs by more than case")
 
 
 def resume_text(participant, order, progress, practice):

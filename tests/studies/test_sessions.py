@@ -267,3 +267,17 @@ def test_a_resumed_session_keeps_its_methods_and_says_where_it_resumes(
     assert (f"Resuming P01's session: {order[0]} saved, not run again; no practice (recorded "
             f"runs exist); next: {order[1]}, method 2 of 3, from its start.\n") in out
     assert session_files(output, order[:1]) == saved
+
+
+@pytest.mark.parametrize("existing", ["p07", "P07"])
+def test_a_participant_folder_beside_one_differing_only_in_case_is_refused(
+        repo, tmp_path, capsys, existing):
+    (tmp_path / existing).mkdir()
+    other = existing.swapcase()
+    assert main(["session", str(repo / TASK), "--headless", "--operator", "virtual",
+                 "--participant", other, "--answers", ANSWERS,
+                 "--output", str(tmp_path / other)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pbp-drake: {tmp_path / existing} is beside {tmp_path / other}, "
+                          "their names differing only in case")
+    assert f"Resume with the ID of {existing}" in err and not (tmp_path / other).exists()

@@ -81,6 +81,7 @@ def read_participants(study_dir):
                         if runs[m] is None and m not in unreadable],
             "not_answered": [m for m in study["methods"]
                              if any(q not in answers.get(m, {}) for q in QUESTIONS)]}
+    _check_one_folder_each(study_dir, sessions)
     hashes = collections.Counter(s["study"]["scenario_hash"] for s in sessions.values())
     digest = hashes.most_common(1)[0][0]
     reference = next(s["study"] for s in sessions.values() if s["study"]["scenario_hash"]
@@ -97,6 +98,22 @@ def read_participants(study_dir):
                 f"({reference['scenario']!r}, hash {digest}{differences}): move it out of "
                 f"{study_dir}, or report it on its own")
     return sessions, damaged
+
+
+def _check_one_folder_each(study_dir, sessions):
+    """Raises ScenarioError when two folders hold sessions of one participant: the same ID
+    recorded in their study.json, or (without one) names differing only in case."""
+    seen = {}
+    for name, session in sessions.items():
+        participant = session["study"].get("participant") or name
+        other = seen.setdefault(str(participant).casefold(), name)
+        if other != name:
+            held = sessions[other]["study"].get("participant") or other
+            raise ScenarioError(
+                f"{study_dir / other} and {study_dir / name} hold sessions of one participant "
+                f"({f'both {held}' if held == participant else f'{held} and {participant}'})"
+                ", who would be counted twice: keep the one that "
+                f"counts in {study_dir}, and move the other out")
 
 
 def incomplete_sessions(sessions):

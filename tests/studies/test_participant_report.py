@@ -250,3 +250,24 @@ def test_an_incomplete_session_is_named_and_counted_for_what_it_has(study, tmp_p
     assert main(["report", str(study)]) == 0
     assert "Incomplete" not in (study / "results.md").read_text()
     assert "incomplete" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("copy, recorded", [("P01_again", True), ("p01", False)])
+def test_two_folders_of_one_participant_are_refused(study, tmp_path, capsys, copy, recorded):
+    twice = tmp_path / "twice"
+    for participant in SESSIONS:
+        shutil.copytree(study / participant, twice / participant)
+    # The same ID run again into another folder (recorded in study.json), or an older
+    # folder's name differing only in case: one person counted as two in every test.
+    shutil.copytree(study / "P01", twice / copy)
+    if not recorded:
+        for name in ("P01", copy):
+            path = twice / name / "study.json"
+            held = json.loads(path.read_text())
+            held.pop("participant", None)  # a folder without a recorded ID
+            path.write_text(json.dumps(held))
+    assert main(["report", str(twice)]) == 2
+    held = "both P01" if recorded else f"P01 and {copy}"
+    assert (f"pbp-drake: {twice / 'P01'} and {twice / copy} hold sessions of one participant "
+            f"({held}), who would be counted twice") in capsys.readouterr().err
+    assert not (twice / "results.md").exists()

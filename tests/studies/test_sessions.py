@@ -5,6 +5,11 @@ unattended session on the grasping task with its report."""
 
 import dataclasses
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -281,3 +286,37 @@ def test_a_participant_folder_beside_one_differing_only_in_case_is_refused(
     assert err.startswith(f"pbp-drake: {tmp_path / existing} is beside {tmp_path / other}, "
                           "their names differing only in case")
     assert f"Resume with the ID of {existing}" in err and not (tmp_path / other).exists()
+
+
+@pytest.mark.slow
+def test_sigterm_stops_a_session_as_ctrl_c_and_the_same_command_resumes(repo, tmp_path):
+    output = tmp_path / "P01"
+    order = session_order(METHODS, "P01")
+    command = [sys.executable, "-m", "pbp_drake", "session", str(repo / TASK), "--headless",
+               "--operator", "virtual", "--participant", "P01", "--answers", ANSWERS,
+               "--duration", "60", "--output", str(output)]
+    env = dict(os.environ, PYTHONPATH=str(repo))
+    session = subprocess.Popen(command, env=env, text=True, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE)
+    second = trial_paths(output, order[1], 0)[0].with_suffix(".running")
+    deadline = time.monotonic() + 120
+    while not second.exists():  # the second method is running
+        assert session.poll() is None and time.monotonic() < deadline, "no second method"
+        time.sleep(0.01)
+    session.send_signal(signal.SIGTERM)
+    _, err = session.communicate(timeout=60)
+    # It died at once, without a word, leaving the running method's marker.
+    assert session.returncode == 143, err
+    assert err.endswith(f"Terminated (SIGTERM): the methods and answers saved so far are in "
+                        f"{output}; the same command resumes the session.\n")
+    assert [p for p in output.rglob("*") if p.suffix in (".tmp", ".running")] == []
+    assert trial_paths(output, order[0], 0)[0].is_file()
+    assert not trial_paths(output, order[1], 0)[0].exists()
+    saved = session_files(output, order[:1])
+
+    resumed = subprocess.run(command, env=env, capture_output=True, text=True)
+    assert resumed.returncode in (0, 1), resumed.stderr
+    assert (f"Resuming P01's session: {order[0]} saved, not run again; next: {order[1]}, "
+            "method 2 of 3, from its start.") in resumed.stdout
+    assert session_files(output, order[:1]) == saved
+    assert read_answers(output) == parse_answers(ANSWERS, METHODS)

@@ -79,16 +79,21 @@ def check_session_folder(scenario, participant, methods, output):
     """Raises StudyFolderError (QuestionnaireError for a damaged questionnaire.json) when
     `output` cannot take `participant`'s session of `methods`: it holds a study of another
     scenario, another participant's session, this participant's session begun with other
-    methods (so in another order) or complete; or a folder beside it has a name that
-    differs from its own only in case. Returns the folder's SessionProgress."""
+    methods (so in another order) or on another seed, or complete; or a folder beside it
+    has a name that differs from its own only in case. Returns the folder's
+    SessionProgress."""
     output = pathlib.Path(output)
     order = session_order(methods, participant)
     _check_case_twins(output)
     recorded = [check_folder(folder, scenario, scenario_hash(scenario), quiet=True)
                 for folder in (output, output / PRACTICE_FOLDER)]
     progress = session_progress(scenario, order, output)
-    begun = any(progress) or bool(read_answers(output))
-    for folder, study in zip((output, output / PRACTICE_FOLDER), recorded):
+    # Any run on disk, on whichever seed: one of another seed is not in `progress`.
+    begun = bool(read_answers(output)) or any(
+        any((folder / "trials").glob("*/seed_*.json"))
+        for folder in (output, output / PRACTICE_FOLDER))
+    seeds = (scenario.seed, scenario.seed + PRACTICE_SEED_OFFSET)
+    for folder, study, seed in zip((output, output / PRACTICE_FOLDER), recorded, seeds):
         if study is None:
             continue
         held = study.get("participant")
@@ -107,6 +112,16 @@ def check_session_folder(scenario, participant, methods, output):
                 f"the methods in the order {', '.join(map(str, study.get('methods') or []))}"
                 f"; this one's order is {', '.join(order)}: resume it with the --methods it "
                 f"began with{hint}, or start the participant in a new folder (--output)")
+        if begun and study.get("seed") != seed:
+            # The scene is the seed, outside the scenario's hash: another one would run
+            # every method again for the same person, beside answers given on the first.
+            first = study.get("seed")
+            if folder.name == PRACTICE_FOLDER and isinstance(first, int):
+                first -= PRACTICE_SEED_OFFSET
+            raise StudyFolderError(
+                f"{folder} holds a session on the scene of --seed {first}; this one's is "
+                f"--seed {scenario.seed}: resume it with --seed {first}, or start the "
+                "participant in a new folder (--output)")
     if progress.saved == order and progress.answered == order:
         raise StudyFolderError(
             f"{output} holds {participant}'s complete session ({', '.join(order)}, each run "

@@ -242,6 +242,24 @@ def test_a_participant_folder_takes_no_other_participant_and_no_second_session(
 
 
 @pytest.mark.slow
+def test_a_session_resumed_on_another_seed_is_refused(repo, tmp_path, capsys):
+    output = tmp_path / "P01"
+    base = ["session", str(repo / TASK), "--headless", "--operator", "virtual",
+            "--participant", "P01", "--answers", ANSWERS, "--duration", "1", "--methods",
+            "teleop", "--output", str(output)]
+    assert main(base) in (0, 1)
+    saved = session_files(output, ["teleop"])
+    capsys.readouterr()
+    # The scene is outside the scenario's hash: the session ran again on seed 5 for the
+    # same person, teleop's answers (given on seed 0) kept beside its seed-5 run.
+    assert main([*base, "--seed", "5"]) == 2
+    assert (f"pbp-drake: {output} holds a session on the scene of --seed 0; this one's is "
+            "--seed 5: resume it with --seed 0") in capsys.readouterr().err
+    assert session_files(output, ["teleop"]) == saved
+    assert not trial_paths(output, "teleop", 5)[0].exists()
+
+
+@pytest.mark.slow
 def test_a_resumed_session_keeps_its_methods_and_says_where_it_resumes(
         repo, short_task, tmp_path, capsys):
     output = tmp_path / "P01"

@@ -101,6 +101,6 @@ EXIT_CODES = {
                  "says why",
     EXIT_INTERRUPTED: "interrupted by Ctrl-C (a study or session is resumed by the same "
                       "command)",
-    EXIT_TERMINATED: "`study`, `report`: ended by SIGTERM, as by Ctrl-C (a study is resumed "
-                     "by the same command)",
+    EXIT_TERMINATED: "`study`, `report`, `session`: ended by SIGTERM, as by Ctrl-C (a study "
+                     "or session is resumed by the same command)",
 }

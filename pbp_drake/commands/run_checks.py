@@ -6,13 +6,15 @@ from pbp_drake.cli_types import chosen_methods
 from pbp_drake.commands.run_page import page_flags_given
 from pbp_drake.scenarios import Gamepad, GraspTask, Keyboard, ScenarioError, with_method
 from pbp_drake.studies.questionnaire import parse_answers
-from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, session_order
+from pbp_drake.studies.sessions import (
+    DEFAULT_SESSION_METHODS, check_session_folder, session_folder, session_order)
 
 
 def check_run_flags(args, resolved):
     """Raises ScenarioError for flags of `run` (the parsed `args`) that do not go together,
     or not with the resolved scenario (`--no-meshcat` implies `--headless`). Returns a
-    session's `(methods, order, answers)` (`--answers` parsed, or None), else None."""
+    session's `(methods, order, answers, progress)` (`--answers` parsed, or None; progress
+    the SessionProgress of its folder, which it can take), else None."""
     if args.no_meshcat and (args.record or args.camera == "robot"):
         raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
     if args.headless and (page_flags := page_flags_given(args)):
@@ -59,7 +61,9 @@ def check_run_flags(args, resolved):
         raise ScenarioError("a --headless session needs --answers (e.g. --answers "
                             "tiredness=3,ease=4): otherwise the questions are asked in the "
                             "browser")
-    return methods, order, answers
+    progress = check_session_folder(resolved.scenario, args.participant, methods,
+                                    session_folder(args.participant, args.output))
+    return methods, order, answers, progress
 
 
 def _check_hand_trail(args, resolved):

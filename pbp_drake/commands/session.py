@@ -3,20 +3,21 @@ method of `--methods` run once in an order counterbalanced across participants, 
 followed by the questions, in the page (`run --participant` is the same command)."""
 
 import argparse
-import pathlib
 import sys
 
 from pbp_drake.builder import build_diagram
-from pbp_drake.cli_types import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS
+from pbp_drake.cli_types import (
+    EXIT_FAILED, EXIT_INTERRUPTED, EXIT_STOPPED, EXIT_SUCCESS, EXIT_TERMINATED)
 from pbp_drake.commands.run_checks import is_person
 from pbp_drake.commands.run_page import (
     PERSON_NEEDS_PAGE, RUN_CHOICES, end_page, keep_page, page_console, wait_for_browser)
+from pbp_drake.commands.signals import Terminated, sigterm_as_interrupt
 from pbp_drake.commands.task_runs import alpha_of, delete_operator, run_task_once
 from pbp_drake.console.front import ENDED_NOTICE
 from pbp_drake.console.questionnaire import FixedAnswers, MeshcatSessionPage
 from pbp_drake.scenarios import counted
 from pbp_drake.studies.questionnaire import QUESTIONNAIRE_FILE, scales_text
-from pbp_drake.studies.sessions import run_session
+from pbp_drake.studies.sessions import resume_text, run_session, session_folder
 
 
 def add_session_flags(parser, hidden=False):
@@ -45,14 +46,16 @@ def add_session_flags(parser, hidden=False):
 
 def run_session_command(args, resolved, meshcat, page, session):
     """The session of `args.participant` on the resolved scenario, `session` its
-    `(methods, order, answers)` from `check_run_flags`; its exit code."""
+    `(methods, order, answers, progress)` from `check_run_flags`; its exit code."""
     scenario = resolved.scenario
-    methods, order, answers = session
-    output = pathlib.Path(args.output or pathlib.Path("outputs", "participants",
-                                                       args.participant))
+    methods, order, answers, progress = session
+    output = session_folder(args.participant, args.output)
     print(f"Participant {args.participant}: {', '.join(order)}, in this order"
           + (", each practised first" if args.practice else "") + f"; saved in {output}",
           flush=True)
+    resuming = resume_text(args.participant, order, progress, args.practice)
+    if resuming:
+        print(resuming, flush=True)
     if answers is not None:
         questions = FixedAnswers(answers)
     else:
@@ -94,17 +97,23 @@ def run_session_command(args, resolved, meshcat, page, session):
                   "(the stopped run is not saved).", flush=True)
 
     try:
-        summary = run_session(scenario, args.participant, methods, output, run_one,
-                              questions, practice=args.practice)
+        # SIGTERM (a `kill`, a `timeout`) stops the session as Ctrl-C does: the running
+        # method's leftovers removed, the page and the terminal told.
+        with sigterm_as_interrupt():
+            summary = run_session(scenario, args.participant, methods, output, run_one,
+                                  questions, practice=args.practice)
     except (KeyboardInterrupt, _SessionStopped) as stop:
         stopped = isinstance(stop, _SessionStopped)
-        print(("Stopped in the page" if stopped else "\nStopped")
+        terminated = isinstance(stop, Terminated)
+        print(("Stopped in the page" if stopped else
+               "\nTerminated (SIGTERM)" if terminated else "\nStopped")
               + f": the methods and answers saved so far are in {output}; the same command "
               "resumes the session.", file=sys.stderr)
         if page is not None:
             end_page(page, console, "The session was stopped; what was saved is kept. "
                      + ENDED_NOTICE)
-        return EXIT_STOPPED if stopped else EXIT_INTERRUPTED
+        return (EXIT_STOPPED if stopped else EXIT_TERMINATED if terminated
+                else EXIT_INTERRUPTED)
     failed = [m for m, entry in summary["methods"].items() if entry["success_rate"] < 1.0]
     print(f"Session saved in {output}, answers in {output / QUESTIONNAIRE_FILE} "
           f"(`pbp-drake report {output.parent}` compares the participants).", flush=True)

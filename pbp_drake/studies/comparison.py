@@ -30,14 +30,15 @@ BACKENDS = ("local", "ray")
 def run_method_comparison(scenario, methods, trials, seed, output, progress=None, jobs=1,
                           run=None, retry_errors=False, backend="local", ray_address=None,
                           split=None, scenario_file=None, split_seeds=None,
-                          participant_condition=None, overrides=None):
+                          participant_condition=None, overrides=None, participant=None):
     """Runs `trials` scenes (seeds `seed`, `seed + 1`, ...) with each method, in `jobs`
     local processes or, with `backend="ray"`, as Ray tasks (on the Ray at `ray_address`,
     e.g. "HEAD:6379" or "ray://head:10001", else a new local one); writes every trial under
     `output/trials/`, then reports the folder (`report`) and returns the summary dict.
     `split` labels the seeds (`studies.splits`); `split` (for the same seeds), `scenario_file`
-    and `split_seeds` None keep what the folder holds; these, `participant_condition` and
-    `overrides` go into study.json (`write_study`).
+    and `split_seeds` None keep what the folder holds; these, `participant_condition`,
+    `overrides` and `participant` (a user study's session) go into study.json
+    (`write_study`).
 
     Trials already on disk for the same scenario are not run again (`retry_errors`: except
     those that failed with an error). A trial that raises, or whose worker process dies, is
@@ -52,7 +53,8 @@ def run_method_comparison(scenario, methods, trials, seed, output, progress=None
     check_folder(output, scenario, scenario_hash(scenario), participant_condition)
     with study_lock(output):
         folder = prepare_folder(scenario, methods, trials, seed, output, retry_errors, split,
-                                scenario_file, split_seeds, participant_condition, overrides)
+                                scenario_file, split_seeds, participant_condition, overrides,
+                                participant)
         run_trials([folder], jobs, progress, run, backend, ray_address)
         return report(output)
 
@@ -91,7 +93,7 @@ def check_run_options(trials, jobs, backend, ray_address, run):
 
 def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, split=None,
                    scenario_file=None, split_seeds=None, participant_condition=None,
-                   overrides=None):
+                   overrides=None, participant=None):
     """Checks `output` again under the caller's lock (StudyFolderError for another scenario),
     removes what an interrupted study left, names the damaged trial files, writes
     study.json and returns the StudyFolder (see `run_method_comparison`)."""
@@ -120,7 +122,7 @@ def prepare_folder(scenario, methods, trials, seed, output, retry_errors=False, 
                 pending.append((method, trial))
     name_damaged([d._replace(problem=f"{d.problem}; runs again") for d in damaged])
     write_study(output, scenario, digest, methods, trials, seed, split, scenario_file,
-                split_seeds, participant_condition, overrides)
+                split_seeds, participant_condition, overrides, participant)
     return StudyFolder(scenario, digest, output, seed, pending)
 
 

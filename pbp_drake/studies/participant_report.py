@@ -8,6 +8,7 @@ import collections
 import itertools
 import pathlib
 import statistics
+import sys
 
 from pbp_drake.scenarios import METHOD_NAMES, ScenarioError, counted
 from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, scale_text
@@ -71,8 +72,16 @@ def read_participants(study_dir):
                                 f"folder {folder} mixes scenarios; move it out of {study_dir}")
         damaged += broken
         runs = {method: records.get((method, 0)) for method in study["methods"]}
-        sessions[folder.name] = {"study": study, "runs": runs,
-                                 "answers": read_answers(folder)}
+        answers = read_answers(folder)
+        unreadable = {d.key[0] for d in broken if d.key is not None}
+        sessions[folder.name] = {
+            "study": study, "runs": runs, "answers": answers,
+            # What an unfinished session lacks (a damaged run is named as damaged).
+            "not_run": [m for m in study["methods"]
+                        if runs[m] is None and m not in unreadable],
+            "not_answered": [m for m in study["methods"]
+                             if any(q not in answers.get(m, {}) for q in QUESTIONS)]}
+    _check_one_folder_each(study_dir, sessions)
     hashes = collections.Counter(s["study"]["scenario_hash"] for s in sessions.values())
     digest = hashes.most_common(1)[0][0]
     reference = next(s["study"] for s in sessions.values() if s["study"]["scenario_hash"]
@@ -89,6 +98,35 @@ def read_participants(study_dir):
                 f"({reference['scenario']!r}, hash {digest}{differences}): move it out of "
                 f"{study_dir}, or report it on its own")
     return sessions, damaged
+
+
+def _check_one_folder_each(study_dir, sessions):
+    """Raises ScenarioError when two folders hold sessions of one participant: the same ID
+    recorded in their study.json, or (without one) names differing only in case."""
+    seen = {}
+    for name, session in sessions.items():
+        participant = session["study"].get("participant") or name
+        other = seen.setdefault(str(participant).casefold(), name)
+        if other != name:
+            held = sessions[other]["study"].get("participant") or other
+            raise ScenarioError(
+                f"{study_dir / other} and {study_dir / name} hold sessions of one participant "
+                f"({f'both {held}' if held == participant else f'{held} and {participant}'})"
+                ", who would be counted twice: keep the one that "
+                f"counts in {study_dir}, and move the other out")
+
+
+def incomplete_sessions(sessions):
+    """`{participant: "Teleop not run; Teleop not answered"}` of the sessions that lack a
+    method's run or an answer (a damaged run is not counted as lacking)."""
+    found = {}
+    for name, session in sessions.items():
+        parts = [f"{', '.join(map(_label, session[key]))} not {word}"
+                 for key, word in (("not_run", "run"), ("not_answered", "answered"))
+                 if session[key]]
+        if parts:
+            found[name] = "; ".join(parts)
+    return found
 
 
 def method_order(sessions):
@@ -180,10 +218,15 @@ def participant_results(study_dir):
     first = next(iter(sessions.values()))["study"]
     lines = [f"# User study: {first['scenario']} (scenario hash {first['scenario_hash']})", "",
              f"{counted(len(sessions), 'participant')}: {', '.join(sessions)}. Practice runs "
-             f"({PRACTICE_FOLDER}/ in a participant folder) are not counted.", "",
-             "## Per method", "",
-             "| method | participants | success | intervention ratio | task time (s) | "
-             "tiredness, median (mean) | ease, median (mean) |", "|---|---|---|---|---|---|---|"]
+             f"({PRACTICE_FOLDER}/ in a participant folder) are not counted.", ""]
+    incomplete = incomplete_sessions(sessions)
+    if incomplete:
+        lines += [f"Incomplete: {counted(len(incomplete), 'session')}, each counted for the "
+                  "methods it has: " + "; ".join(f"{name} ({lacks})" for name, lacks
+                                                 in incomplete.items()) + ".", ""]
+    lines += ["## Per method", "",
+              "| method | participants | success | intervention ratio | task time (s) | "
+              "tiredness, median (mean) | ease, median (mean) |", "|---|---|---|---|---|---|---|"]
     for method in methods:
         runs = [s["runs"].get(method) for s in sessions.values()]
         ran = [r for r in runs if r is not None]
@@ -244,6 +287,10 @@ def participant_report(study_dir):
     study_dir = pathlib.Path(study_dir)
     text, sessions, methods, damaged = participant_results(study_dir)
     name_damaged(damaged)
+    for name, lacks in incomplete_sessions(sessions).items():
+        print(f"pbp-drake: {study_dir / name}: an incomplete session ({lacks}), counted for "
+              "the methods it has; its `pbp-drake session` command resumes it", file=sys.stderr,
+              flush=True)
     write_atomically(study_dir / "results.md", text)
     plot_questionnaire({name: s["answers"] for name, s in sessions.items()}, methods,
                        study_dir / FIG8)

@@ -8,11 +8,12 @@ session that stops resumes with the same command, rewriting no saved run or answ
 import hashlib
 import pathlib
 import re
+import typing
 
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.folders import check_folder
 from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, save_answer
-from pbp_drake.studies.trial_files import read_trial, scenario_hash
+from pbp_drake.studies.trial_files import StudyFolderError, read_trial, scenario_hash
 
 DEFAULT_SESSION_METHODS = ("pbp_alternated", "pbp_continuous", "teleop")
 # Practice runs use other scenes than the recorded ones (seed + this), so that practice does
@@ -47,6 +48,136 @@ def session_order(methods, participant):
     return methods[shift:] + methods[:shift]
 
 
+def session_folder(participant, output=None):
+    """A session's folder: `output`, else outputs/participants/ID."""
+    return pathlib.Path(output or pathlib.Path("outputs", "participants", participant))
+
+
+class SessionProgress(typing.NamedTuple):
+    """What a participant's folder already holds, each in the session's order: the methods
+    whose run is saved, those whose every question is answered, and the practice runs."""
+
+    saved: list
+    answered: list
+    practised: list
+
+
+def session_progress(scenario, order, output):
+    """The SessionProgress of the session of `order` on `scenario` in `output`."""
+    output = pathlib.Path(output)
+    digest = scenario_hash(scenario)
+    answers = read_answers(output)
+    practice_seed = scenario.seed + PRACTICE_SEED_OFFSET
+    return SessionProgress(
+        [m for m in order if read_trial(output, m, scenario.seed, digest) is not None],
+        [m for m in order if all(q in answers.get(m, {}) for q in QUESTIONS)],
+        [m for m in order
+         if read_trial(output / PRACTICE_FOLDER, m, practice_seed, digest) is not None])
+
+
+def check_session_folder(scenario, participant, methods, output):
+    """Raises StudyFolderError (QuestionnaireError for a damaged questionnaire.json) when
+    `output` cannot take `participant`'s session of `methods`: it holds a study of another
+    scenario, another participant's session, this participant's session begun with other
+    methods (so in another order) or on another seed, or complete; or a folder beside it
+    has a name that differs from its own only in case. Returns the folder's
+    SessionProgress."""
+    output = pathlib.Path(output)
+    order = session_order(methods, participant)
+    _check_case_twins(output)
+    recorded = [check_folder(folder, scenario, scenario_hash(scenario), quiet=True)
+                for folder in (output, output / PRACTICE_FOLDER)]
+    progress = session_progress(scenario, order, output)
+    # Any run on disk, on whichever seed: one of another seed is not in `progress`.
+    begun = bool(read_answers(output)) or any(
+        any((folder / "trials").glob("*/seed_*.json"))
+        for folder in (output, output / PRACTICE_FOLDER))
+    seeds = (scenario.seed, scenario.seed + PRACTICE_SEED_OFFSET)
+    for folder, study, seed in zip((output, output / PRACTICE_FOLDER), recorded, seeds):
+        if study is None:
+            continue
+        held = study.get("participant")
+        if held is not None and held != participant:
+            raise StudyFolderError(
+                f"{folder} holds the session of participant {held}, not {participant}: "
+                f"resume it with --participant {held}, or give {participant} a folder of "
+                "their own (--output)")
+        if begun and study.get("methods") != order:
+            # Without a recorded participant (older folders) the ID too may be the mistake.
+            hint = (f" (--methods {_methods_given(study.get('methods'), held)})" if held
+                    else " (and --participant)")
+            whose = f"{held}'s" if held else "a"
+            raise StudyFolderError(
+                f"{folder} holds {whose} session begun with "
+                f"the methods in the order {', '.join(map(str, study.get('methods') or []))}"
+                f"; this one's order is {', '.join(order)}: resume it with the --methods it "
+                f"began with{hint}, or start the participant in a new folder (--output)")
+        if begun and study.get("seed") != seed:
+            # The scene is the seed, outside the scenario's hash: another one would run
+            # every method again for the same person, beside answers given on the first.
+            first = study.get("seed")
+            if folder.name == PRACTICE_FOLDER and isinstance(first, int):
+                first -= PRACTICE_SEED_OFFSET
+            raise StudyFolderError(
+                f"{folder} holds a session on the scene of --seed {first}; this one's is "
+                f"--seed {scenario.seed}: resume it with --seed {first}, or start the "
+                "participant in a new folder (--output)")
+    if progress.saved == order and progress.answered == order:
+        raise StudyFolderError(
+            f"{output} holds {participant}'s complete session ({', '.join(order)}, each run "
+            f"and answered): nothing to run. A new participant needs their own --participant "
+            "ID and folder; `pbp-drake report` reads this one")
+    return progress
+
+
+def _methods_given(order, participant):
+    """The --methods that give `participant` the recorded `order`, comma-separated."""
+    order = list(map(str, order))
+    shift = participant_number(participant) % len(order)
+    # session_order rotates the methods left by `shift`: this rotates the order back.
+    return ",".join(order[-shift:] + order[:-shift])
+
+
+def _check_case_twins(output):
+    """Refuses a session folder beside one whose name differs only in case (P07, p07): one
+    folder on a case-insensitive disk, and most likely one participant mistyped."""
+    parent = output.parent
+    twins = sorted(p.name for p in (parent.iterdir() if parent.is_dir() else [])
+                   if p.is_dir() and p.name != output.name
+                   and p.name.casefold() == output.name.casefold())
+    if twins:
+        raise StudyFolderError(
+            f"{parent / twins[0]} is beside {output}, their names differing only in case: "
+            "one folder on a case-insensitive disk, and most likely one participant's ID "
+            f"mistyped. Resume with the ID of {twins[0]}, or give the participant an ID that "
+            "differs by more than case")
+
+
+def resume_text(participant, order, progress, practice):
+    """A line saying what a resumed session keeps and what comes next, or None for a session
+    that has saved nothing yet."""
+    if not progress.saved and not progress.practised:
+        return None
+    parts = []
+    if progress.saved:
+        parts.append(f"{', '.join(progress.saved)} saved, not run again")
+    if practice and progress.saved:
+        parts.append("no practice (recorded runs exist)")
+    elif progress.practised and not progress.saved:
+        left = [m for m in order if m not in progress.practised]
+        parts.append(f"practice of {', '.join(progress.practised)} saved"
+                     + (f"; practice of {', '.join(left)} comes first" if practice and left
+                        else ""))
+    unanswered = [m for m in progress.saved if m not in progress.answered]
+    if unanswered:
+        parts.append(f"first the questions of {', '.join(unanswered)}")
+    waiting = [m for m in order if m not in progress.saved]
+    if waiting:
+        parts.append(f"next: {waiting[0]}, method {order.index(waiting[0]) + 1} of "
+                     f"{len(order)}, from its start")
+    return f"Resuming {participant}'s session: " + "; ".join(parts) + "."
+
+
 def run_session(scenario, participant, methods, output, run, page, practice=False):
     """Runs `run(scenario)` for each method in the participant's order, on the scenario's
     seed, saving each as a trial under `output`. `page` (console.questionnaire's Meshcat
@@ -56,9 +187,8 @@ def run_session(scenario, participant, methods, output, run, page, practice=Fals
     order = session_order(methods, participant)
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
-    # Before any run: a folder of another scenario, or a damaged questionnaire, stops here.
-    check_folder(output, scenario, digest)
-    read_answers(output)
+    # Before any run: a folder that cannot take the session stops here.
+    check_session_folder(scenario, participant, methods, output)
     practice_folder = output / PRACTICE_FOLDER
     practice_seed = scenario.seed + PRACTICE_SEED_OFFSET
 
@@ -96,8 +226,9 @@ def run_session(scenario, participant, methods, output, run, page, practice=Fals
     if practice and len(unsaved(output, scenario.seed)) == len(order):
         start_next(practice_folder, practice_seed, True)
         run_method_comparison(scenario, order, 1, practice_seed, practice_folder,
-                              progress=after_practice_run, split="practice", run=run)
+                              progress=after_practice_run, split="practice", run=run,
+                              participant=participant)
     ask_unanswered()
     start_next(output, scenario.seed, False)
     return run_method_comparison(scenario, order, 1, scenario.seed, output,
-                                 progress=after_run, run=run)
+                                 progress=after_run, run=run, participant=participant)

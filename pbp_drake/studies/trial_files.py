@@ -271,22 +271,25 @@ def write_trial_files(output, record, csv_text):
 
 def write_study(output, scenario, digest, methods, trials, seed, split=None,
                 scenario_file=None, split_seeds=None, participant_condition=None,
-                overrides=None):
+                overrides=None, participant=None):
     """Writes the folder's study.json: which scenario, methods, trials and seeds, and the
     split the seeds belong to (`studies.splits`; None when not known). Written when not
     None: `scenario_file` (the path the study was run from), `split_seeds` ({"tuning":
     first seed, "evaluation": first seed}), `participant_condition` and `overrides`
-    (`ScenarioOverrides.record()`), with which `report --markdown` names the command."""
+    (`ScenarioOverrides.record()`), with which `report --markdown` names the command, and
+    `participant`, the ID of a user study's participant whose session the folder holds."""
     study = {"study": METHOD_COMPARISON, "format": TRIAL_FORMAT, "scenario": scenario.name,
              "scenario_hash": digest, "methods": list(methods), "trials": trials, "seed": seed,
              "split": split, "scenario_content": scenario_content(scenario)}
     write_study_json(output, study, scenario_file, split_seeds, participant_condition,
-                     overrides)
+                     overrides, participant)
 
 
 def write_study_json(output, study, scenario_file=None, split_seeds=None,
-                     participant_condition=None, overrides=None):
+                     participant_condition=None, overrides=None, participant=None):
     """Writes the dict `study` and the optional fields given (`write_study`) as study.json."""
+    if participant is not None:
+        study["participant"] = str(participant)
     if scenario_file is not None:
         study["scenario_file"] = str(scenario_file)
     if split_seeds is not None:

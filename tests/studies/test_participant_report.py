@@ -225,3 +225,49 @@ def test_one_participant_gets_plain_words_instead_of_tests(study, tmp_path, caps
     assert "observations" not in results
     # One participant's measures have no spread: each mean stands alone, not "± 0.000".
     assert "±" not in results and "(n = 1) |" in results
+
+
+def test_an_incomplete_session_is_named_and_counted_for_what_it_has(study, tmp_path, capsys):
+    partial = tmp_path / "partial"
+    for participant in SESSIONS:
+        shutil.copytree(study / participant, partial / participant)
+    # P03 stopped after its second method: no teleop run, no teleop answers.
+    for path in (partial / "P03" / "trials" / "teleop").glob("seed_*"):
+        path.unlink()
+    path = partial / "P03" / "questionnaire.json"
+    held = json.loads(path.read_text())
+    del held["answers"]["teleop"]
+    path.write_text(json.dumps(held))
+    capsys.readouterr()
+    assert main(["report", str(partial)]) == 0
+    # It was listed among the participants as any other, its lack said nowhere.
+    assert (f"pbp-drake: {partial / 'P03'}: an incomplete session (Teleop not run; Teleop not "
+            "answered), counted for the methods it has") in capsys.readouterr().err
+    results = (partial / "results.md").read_text()
+    assert ("Incomplete: 1 session, each counted for the methods it has: P03 (Teleop not run; "
+            "Teleop not answered).") in results
+    assert re.search(r"^\| Teleop \| 2 \| \d of 2 \|", results, re.M)
+    assert main(["report", str(study)]) == 0
+    assert "Incomplete" not in (study / "results.md").read_text()
+    assert "incomplete" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("copy, recorded", [("P01_again", True), ("p01", False)])
+def test_two_folders_of_one_participant_are_refused(study, tmp_path, capsys, copy, recorded):
+    twice = tmp_path / "twice"
+    for participant in SESSIONS:
+        shutil.copytree(study / participant, twice / participant)
+    # The same ID run again into another folder (recorded in study.json), or an older
+    # folder's name differing only in case: one person counted as two in every test.
+    shutil.copytree(study / "P01", twice / copy)
+    if not recorded:
+        for name in ("P01", copy):
+            path = twice / name / "study.json"
+            held = json.loads(path.read_text())
+            held.pop("participant", None)  # a folder without a recorded ID
+            path.write_text(json.dumps(held))
+    assert main(["report", str(twice)]) == 2
+    held = "both P01" if recorded else f"P01 and {copy}"
+    assert (f"pbp-drake: {twice / 'P01'} and {twice / copy} hold sessions of one participant "
+            f"({held}), who would be counted twice") in capsys.readouterr().err
+    assert not (twice / "results.md").exists()

@@ -5,6 +5,11 @@ unattended session on the grasping task with its report."""
 
 import dataclasses
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -204,3 +209,132 @@ def test_an_unattended_session_on_the_grasping_task_and_its_report(repo, tmp_pat
     assert main(["report", str(study)]) == 0
     results = (study / "results.md").read_text()
     assert "| P04 |" in results and (study / "fig8_questionnaire.png").is_file()
+
+
+@pytest.mark.slow
+def test_a_participant_folder_takes_no_other_participant_and_no_second_session(
+        repo, tmp_path, capsys):
+    output = tmp_path / "P01"
+
+    def session(participant, *more):
+        return main(["session", str(repo / TASK), "--headless", "--operator", "virtual",
+                     "--participant", participant, "--answers", ANSWERS, "--duration", "1",
+                     "--methods", "teleop", "--output", str(output), *more])
+
+    assert session("P01") in (0, 1)
+    saved = session_files(output, ["teleop"])
+    answers = (output / "questionnaire.json").read_bytes()
+    assert json.loads((output / "study.json").read_text())["participant"] == "P01"
+    capsys.readouterr()
+    # A second participant given the first one's folder by mistake: their runs and answers
+    # were taken as P01's (and the order recorded was P02's).
+    assert session("P02") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pbp-drake: {output} holds the session of participant P01, not "
+                          "P02: resume it with --participant P01, or give P02 a folder of")
+    # The same command once the session is complete: the page said "Session complete"
+    # having run nothing, and a person sat down for nothing.
+    assert session("P01") == 2
+    err = capsys.readouterr().err
+    assert "holds P01's complete session (teleop, each run and answered): nothing to run" in err
+    assert session_files(output, ["teleop"]) == saved
+    assert (output / "questionnaire.json").read_bytes() == answers
+
+
+@pytest.mark.slow
+def test_a_session_resumed_on_another_seed_is_refused(repo, tmp_path, capsys):
+    output = tmp_path / "P01"
+    base = ["session", str(repo / TASK), "--headless", "--operator", "virtual",
+            "--participant", "P01", "--answers", ANSWERS, "--duration", "1", "--methods",
+            "teleop", "--output", str(output)]
+    assert main(base) in (0, 1)
+    saved = session_files(output, ["teleop"])
+    capsys.readouterr()
+    # The scene is outside the scenario's hash: the session ran again on seed 5 for the
+    # same person, teleop's answers (given on seed 0) kept beside its seed-5 run.
+    assert main([*base, "--seed", "5"]) == 2
+    assert (f"pbp-drake: {output} holds a session on the scene of --seed 0; this one's is "
+            "--seed 5: resume it with --seed 0") in capsys.readouterr().err
+    assert session_files(output, ["teleop"]) == saved
+    assert not trial_paths(output, "teleop", 5)[0].exists()
+
+
+@pytest.mark.slow
+def test_a_resumed_session_keeps_its_methods_and_says_where_it_resumes(
+        repo, short_task, tmp_path, capsys):
+    output = tmp_path / "P01"
+    order = session_order(METHODS, "P01")
+
+    def stops_at_second(trial):
+        if trial.scenario.method != order[0]:
+            raise KeyboardInterrupt
+        return run_task(trial)
+
+    with pytest.raises(KeyboardInterrupt):
+        run_session(short_task, "P01", METHODS, output, stops_at_second,
+                    FixedAnswers(parse_answers(ANSWERS, METHODS)))
+    saved = session_files(output, order[:1])
+    base = ["session", str(repo / TASK), "--headless", "--operator", "virtual",
+            "--participant", "P01", "--answers", ANSWERS, "--duration", "1.5",
+            "--output", str(output)]
+    # Other methods, so another order: the first method's run and answers were kept beside
+    # a study.json of other methods, and the counterbalanced order was lost.
+    assert main([*base, "--methods", "teleop,pbp_continuous"]) == 2
+    err = capsys.readouterr().err
+    assert (f"{output} holds P01's session begun with the methods in the order "
+            f"{', '.join(order)}; this one's order is pbp_continuous, teleop: resume it with "
+            "the --methods it began with (--methods pbp_alternated,pbp_continuous,teleop)"
+            in err)
+    assert main([*base, "--practice"]) in (0, 1)
+    out = capsys.readouterr().out
+    assert (f"Resuming P01's session: {order[0]} saved, not run again; no practice (recorded "
+            f"runs exist); next: {order[1]}, method 2 of 3, from its start.\n") in out
+    assert session_files(output, order[:1]) == saved
+
+
+@pytest.mark.parametrize("existing", ["p07", "P07"])
+def test_a_participant_folder_beside_one_differing_only_in_case_is_refused(
+        repo, tmp_path, capsys, existing):
+    (tmp_path / existing).mkdir()
+    other = existing.swapcase()
+    assert main(["session", str(repo / TASK), "--headless", "--operator", "virtual",
+                 "--participant", other, "--answers", ANSWERS,
+                 "--output", str(tmp_path / other)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pbp-drake: {tmp_path / existing} is beside {tmp_path / other}, "
+                          "their names differing only in case")
+    assert f"Resume with the ID of {existing}" in err and not (tmp_path / other).exists()
+
+
+@pytest.mark.slow
+def test_sigterm_stops_a_session_as_ctrl_c_and_the_same_command_resumes(repo, tmp_path):
+    output = tmp_path / "P01"
+    order = session_order(METHODS, "P01")
+    command = [sys.executable, "-m", "pbp_drake", "session", str(repo / TASK), "--headless",
+               "--operator", "virtual", "--participant", "P01", "--answers", ANSWERS,
+               "--duration", "60", "--output", str(output)]
+    env = dict(os.environ, PYTHONPATH=str(repo))
+    session = subprocess.Popen(command, env=env, text=True, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE)
+    second = trial_paths(output, order[1], 0)[0].with_suffix(".running")
+    deadline = time.monotonic() + 120
+    while not second.exists():  # the second method is running
+        assert session.poll() is None and time.monotonic() < deadline, "no second method"
+        time.sleep(0.01)
+    session.send_signal(signal.SIGTERM)
+    _, err = session.communicate(timeout=60)
+    # It died at once, without a word, leaving the running method's marker.
+    assert session.returncode == 143, err
+    assert err.endswith(f"Terminated (SIGTERM): the methods and answers saved so far are in "
+                        f"{output}; the same command resumes the session.\n")
+    assert [p for p in output.rglob("*") if p.suffix in (".tmp", ".running")] == []
+    assert trial_paths(output, order[0], 0)[0].is_file()
+    assert not trial_paths(output, order[1], 0)[0].exists()
+    saved = session_files(output, order[:1])
+
+    resumed = subprocess.run(command, env=env, capture_output=True, text=True)
+    assert resumed.returncode in (0, 1), resumed.stderr
+    assert (f"Resuming P01's session: {order[0]} saved, not run again; next: {order[1]}, "
+            "method 2 of 3, from its start.") in resumed.stdout
+    assert session_files(output, order[:1]) == saved
+    assert read_answers(output) == parse_answers(ANSWERS, METHODS)

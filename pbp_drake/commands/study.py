@@ -349,8 +349,8 @@ def _compare(args):
                   f" {method}: no seed both ran without an error, not compared."
                   for method, side in unpaired))
     if damaged:
-        print(f"pbp-drake: {len(damaged)} damaged or foreign files skipped (listed above); "
-              "their trials are left out of the pairs", file=sys.stderr)
+        print(f"pbp-drake: {counted(len(damaged), 'damaged or foreign file')} skipped (listed "
+              "above); their trials are left out of the pairs", file=sys.stderr)
     return 1 if moved or damaged else 0
 
 
@@ -381,7 +381,7 @@ def _report(args):
         for name in ("results.md", FIG8):
             print(f"  wrote {output / name}")
         if damaged:
-            print(f"pbp-drake: {damaged} damaged files skipped (listed above)",
+            print(f"pbp-drake: {counted(damaged, 'damaged file')} skipped (listed above)",
                   file=sys.stderr)
         return 1 if damaged else 0
     if kind == MATRIX:
@@ -436,7 +436,7 @@ def _report_matrix(args, output):
 def _report_status(summary, output, failed):
     """1, with a line on stderr, when files were damaged or foreign; else `failed`."""
     if summary["damaged"]:
-        print(f"pbp-drake: {len(summary['damaged'])} damaged or foreign files skipped "
+        print(f"pbp-drake: {counted(len(summary['damaged']), 'damaged or foreign file')} skipped "
               f"(listed above and in {output / 'summary.json'})", file=sys.stderr)
         return 1
     return failed

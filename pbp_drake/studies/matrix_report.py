@@ -8,7 +8,7 @@ import json
 import math
 import pathlib
 
-from pbp_drake.scenarios import METHOD_NAMES
+from pbp_drake.scenarios import METHOD_NAMES, counted
 from pbp_drake.studies.figures import plot_pilot_panels
 from pbp_drake.studies.intervals import MEAN_METRICS, mean_interval, wilson_interval
 from pbp_drake.studies.matrix import read_matrix, summarize_matrix
@@ -158,8 +158,8 @@ def matrix_tables(summary, intervals, paired, reference):
                 cells = [_paired_cell(paired[pilot].get((method, key))) for pilot in pilots]
                 lines.append(f"| {_method_name(method)} | " + " | ".join(cells) + " |")
     if summary["damaged"]:
-        lines += ["", f"Skipped as damaged or foreign: {len(summary['damaged'])} files; see "
-                      "summary.json."]
+        lines += ["", "Skipped as damaged or foreign: "
+                      f"{counted(len(summary['damaged']), 'file')}; see summary.json."]
     return "\n".join(lines) + "\n"
 
 

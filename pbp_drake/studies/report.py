@@ -4,7 +4,7 @@ figures, rebuilt from its study.json and trial files only (no simulation)."""
 import json
 import pathlib
 
-from pbp_drake.scenarios import METHOD_NAMES
+from pbp_drake.scenarios import METHOD_NAMES, counted
 from pbp_drake.studies.figures import plot_collision_histogram, plot_intervention, plot_task_time
 from pbp_drake.studies.intervals import INTERACTION_MEANS, confidence_table
 from pbp_drake.studies.splits import seeds_line
@@ -116,9 +116,9 @@ def results_table(summary):
         lines += ["", *interaction]
     lines += ["", *confidence_table(summary)]
     if summary.get("damaged"):
-        lines += ["", f"Skipped as damaged or foreign: {len(summary['damaged'])} files "
-                      f"({sum(e.get('damaged', 0) for e in summary['methods'].values())} "
-                      "trials); see summary.json."]
+        files = counted(len(summary["damaged"]), "file")
+        trials = counted(sum(e.get("damaged", 0) for e in summary["methods"].values()), "trial")
+        lines += ["", f"Skipped as damaged or foreign: {files} ({trials}); see summary.json."]
     arbitration = summary.get("arbitration")
     if arbitration is not None:
         ideal = arbitration["ideal_alpha"]

@@ -92,6 +92,17 @@ def test_report_names_each_damaged_file_and_reports_the_rest(tmp_path, capsys):
     assert len(json.loads((folder / "trials.json").read_text())) == 3
 
 
+@pytest.mark.slow
+def test_one_damaged_file_is_counted_in_the_singular(tmp_path, capsys):
+    folder = _study(tmp_path)
+    trial_paths(folder, "teleop", 1)[0].write_text("{bad")
+    assert main(["report", str(folder)]) == 1
+    assert "pbp-drake: 1 damaged or foreign file skipped (listed above and in " in (
+        capsys.readouterr().err)
+    assert "Skipped as damaged or foreign: 1 file (1 trial); see summary.json." in (
+        folder / "results.md").read_text()
+
+
 @pytest.mark.parametrize("text, problem", [
     ("time,ee_x\n1,2\n", "malformed CSV: its header"),
     (_csv().rsplit("\n", 2)[0] + "\n", "truncated CSV: 2 rows"),

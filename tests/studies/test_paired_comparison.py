@@ -97,7 +97,7 @@ def test_a_damaged_trial_file_is_named_and_its_pair_left_out(tmp_path, repo, cap
     printed = capsys.readouterr()
     assert "| task_time | teleop | 5 |" in printed.out and "All 12 rows within" in printed.out
     assert printed.err.startswith(f"pbp-drake: damaged: {damaged}: truncated or invalid JSON")
-    assert printed.err.endswith("pbp-drake: 1 damaged or foreign files skipped (listed above);"
+    assert printed.err.endswith("pbp-drake: 1 damaged or foreign file skipped (listed above);"
                                 " their trials are left out of the pairs\n")
 
 

@@ -165,7 +165,7 @@ def test_a_damaged_trial_is_skipped_and_counted(study, tmp_path, capsys):
     assert main(["report", str(damaged)]) == 1
     err = capsys.readouterr().err
     assert f"{trial}: truncated or invalid JSON" in err
-    assert "pbp-drake: 1 damaged files skipped (listed above)" in err
+    assert "pbp-drake: 1 damaged file skipped (listed above)" in err
     assert ("Skipped as damaged: 1 file (named by `pbp-drake report`)."
             in (damaged / "results.md").read_text())
 

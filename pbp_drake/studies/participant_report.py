@@ -42,14 +42,30 @@ def participant_folders(study_dir):
                   and ((p / "study.json").is_file() or (p / "trials").is_dir()))
 
 
+def practice_only_folders(study_dir):
+    """`study_dir`'s sub-folders holding practice/ and no study.json or trials/ of their own
+    (a session stopped during its practice), by name."""
+    return sorted(p for p in pathlib.Path(study_dir).iterdir()
+                  if p.is_dir() and (p / PRACTICE_FOLDER).is_dir()
+                  and not (p / "study.json").is_file() and not (p / "trials").is_dir())
+
+
 def read_participants(study_dir):
-    """`(sessions, damaged)`: per participant folder name, its study, its runs by method
-    (None when not on disk or damaged) and its answers; and every damaged file. Raises
-    ScenarioError when there are no participant folders, or one holds another scenario."""
+    """`(sessions, damaged, practised)`: per participant folder name, its study, its runs by
+    method (None when not on disk or damaged) and its answers; every damaged file; and the
+    names of the folders that hold practice runs alone. Raises ScenarioError when there are
+    no participant folders, or one holds another scenario."""
     study_dir = pathlib.Path(study_dir)
     if not study_dir.is_dir():
         raise ScenarioError(f"{study_dir}: no such folder")
     folders = participant_folders(study_dir)
+    practised = [folder.name for folder in practice_only_folders(study_dir)]
+    if not folders and practised:
+        raise ScenarioError(f"{study_dir}: {', '.join(practised)} "
+                            f"{'holds' if len(practised) == 1 else 'hold'} practice runs alone "
+                            f"({PRACTICE_FOLDER}/, never counted; a session stopped during its "
+                            "practice), and there is no other participant folder: nothing to "
+                            "report")
     if not folders:
         raise ScenarioError(f"{study_dir} has no study.json and no trial files of a "
                             "`pbp-drake study`, and no participant folders (ID/study.json, "
@@ -97,7 +113,7 @@ def read_participants(study_dir):
                 f"hash {study['scenario_hash']}) than the other participants "
                 f"({reference['scenario']!r}, hash {digest}{differences}): move it out of "
                 f"{study_dir}, or report it on its own")
-    return sessions, damaged
+    return sessions, damaged, practised
 
 
 def _check_one_folder_each(study_dir, sessions):
@@ -116,17 +132,22 @@ def _check_one_folder_each(study_dir, sessions):
                 f"counts in {study_dir}, and move the other out")
 
 
-def incomplete_sessions(sessions):
+# What the report says of a folder whose session stopped during its practice.
+PRACTICE_ONLY = "stopped during practice: no method run or answered"
+
+
+def incomplete_sessions(sessions, practised=()):
     """`{participant: "Teleop not run; Teleop not answered"}` of the sessions that lack a
-    method's run or an answer (a damaged run is not counted as lacking)."""
-    found = {}
+    method's run or an answer (a damaged run is not counted as lacking), and of the folders
+    `practised` (practice runs alone), by name."""
+    found = {name: PRACTICE_ONLY for name in practised}
     for name, session in sessions.items():
         parts = [f"{', '.join(map(_label, session[key]))} not {word}"
                  for key, word in (("not_run", "run"), ("not_answered", "answered"))
                  if session[key]]
         if parts:
             found[name] = "; ".join(parts)
-    return found
+    return dict(sorted(found.items()))
 
 
 def method_order(sessions):
@@ -210,8 +231,9 @@ def _summary(values, source):
 
 
 def participant_results(study_dir):
-    """`(Markdown text, sessions, methods, damaged)` of the report."""
-    sessions, damaged = read_participants(study_dir)
+    """`(Markdown text, sessions, methods, damaged, incomplete)` of the report (incomplete:
+    `incomplete_sessions`)."""
+    sessions, damaged, practised = read_participants(study_dir)
     methods = method_order(sessions)
     values = {key: measure_values(sessions, methods, key, source)
               for key, _, source in MEASURES}
@@ -219,7 +241,7 @@ def participant_results(study_dir):
     lines = [f"# User study: {first['scenario']} (scenario hash {first['scenario_hash']})", "",
              f"{counted(len(sessions), 'participant')}: {', '.join(sessions)}. Practice runs "
              f"({PRACTICE_FOLDER}/ in a participant folder) are not counted.", ""]
-    incomplete = incomplete_sessions(sessions)
+    incomplete = incomplete_sessions(sessions, practised)
     if incomplete:
         lines += [f"Incomplete: {counted(len(incomplete), 'session')}, each counted for the "
                   "methods it has: " + "; ".join(f"{name} ({lacks})" for name, lacks
@@ -278,16 +300,16 @@ def participant_results(study_dir):
     if damaged:
         lines += ["", f"Skipped as damaged: {counted(len(damaged), 'file')} (named by "
                       "`pbp-drake report`)."]
-    return "\n".join(lines) + "\n", sessions, methods, damaged
+    return "\n".join(lines) + "\n", sessions, methods, damaged, incomplete
 
 
 def participant_report(study_dir):
     """Writes STUDY_DIR/results.md and Fig. 8, naming damaged files on stderr. Returns
     `(results text, number of damaged files)`."""
     study_dir = pathlib.Path(study_dir)
-    text, sessions, methods, damaged = participant_results(study_dir)
+    text, sessions, methods, damaged, incomplete = participant_results(study_dir)
     name_damaged(damaged)
-    for name, lacks in incomplete_sessions(sessions).items():
+    for name, lacks in incomplete.items():
         print(f"pbp-drake: {study_dir / name}: an incomplete session ({lacks}), counted for "
               "the methods it has; its `pbp-drake session` command resumes it", file=sys.stderr,
               flush=True)

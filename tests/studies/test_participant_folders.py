@@ -56,3 +56,37 @@ def test_one_damaged_file_is_counted_in_the_singular(tmp_path, capsys):
     results, err = _report(tmp_path, capsys, code=1)
     assert "pbp-drake: 1 damaged file skipped (listed above)" in err
     assert "Skipped as damaged: 1 file" in results
+
+
+def _practice_only(folder, participant):
+    """A session stopped during its practice: practice/ alone, one practice run saved."""
+    practice = _session(folder / "practice", participant, seed=1000)
+    for method in METHODS[1:]:
+        for path in trial_paths(practice, method, 1000):
+            path.unlink()
+    (practice / "questionnaire.json").unlink()  # no questions are asked after practice
+    json_path = practice / "study.json"
+    json_path.write_text(json.dumps({**json.loads(json_path.read_text()), "split": "practice"}))
+
+
+@pytest.mark.slow  # Fig. 8 is drawn
+def test_a_session_stopped_during_practice_is_named_as_incomplete(tmp_path, capsys):
+    for n, participant in enumerate(("P01", "P02", "P03")):
+        _session(tmp_path / participant, participant, ratio=0.1 * n)
+    _practice_only(tmp_path / "P04", "P04")
+    results, err = _report(tmp_path, capsys)
+    # It was left out without a word: the report read as if P04 never came.
+    assert "3 participants: P01, P02, P03." in results
+    assert ("Incomplete: 1 session, each counted for the methods it has: P04 (stopped during "
+            "practice: no method run or answered).") in results
+    assert (f"pbp-drake: {tmp_path / 'P04'}: an incomplete session (stopped during practice: "
+            "no method run or answered), counted for the methods it has") in err
+
+
+def test_practice_runs_alone_are_nothing_to_report(tmp_path, capsys):
+    _practice_only(tmp_path / "P04", "P04")
+    assert main(["report", str(tmp_path)]) == 2
+    assert (f"pbp-drake: {tmp_path}: P04 holds practice runs alone (practice/, never counted; a "
+            "session stopped during its practice), and there is no other participant folder: "
+            "nothing to report") in capsys.readouterr().err
+    assert not (tmp_path / "results.md").exists()

@@ -92,6 +92,7 @@ def read_participants(study_dir):
         unreadable = {d.key[0] for d in broken if d.key is not None}
         sessions[folder.name] = {
             "study": study, "runs": runs, "answers": answers,
+            "damaged_runs": [m for m in study["methods"] if m in unreadable],
             # What an unfinished session lacks (a damaged run is named as damaged).
             "not_run": [m for m in study["methods"]
                         if runs[m] is None and m not in unreadable],
@@ -148,6 +149,22 @@ def incomplete_sessions(sessions, practised=()):
         if parts:
             found[name] = "; ".join(parts)
     return dict(sorted(found.items()))
+
+
+def answers_without_run(sessions):
+    """`{participant: "Teleop: its trial file is damaged"}` of the sessions with answers to
+    a method whose run the report does not count (damaged, or not on disk): the answers are
+    counted all the same, being what the participant said after the run."""
+    found, methods = {}, method_order(sessions)  # answers to other methods are not counted
+    for name, session in sessions.items():
+        parts = [f"{_label(method)}: "
+                 + ("its trial file is damaged" if method in session["damaged_runs"]
+                    else "not run")
+                 for method in methods
+                 if session["answers"].get(method) and session["runs"].get(method) is None]
+        if parts:
+            found[name] = "; ".join(parts)
+    return found
 
 
 def method_order(sessions):
@@ -246,6 +263,11 @@ def participant_results(study_dir):
         lines += [f"Incomplete: {counted(len(incomplete), 'session')}, each counted for the "
                   "methods it has: " + "; ".join(f"{name} ({lacks})" for name, lacks
                                                  in incomplete.items()) + ".", ""]
+    unpaired = answers_without_run(sessions)
+    if unpaired:
+        lines += ["Answers counted without their run (in the answers' counts and tests, not "
+                  "in the trial measures'): " + "; ".join(f"{name} ({what})" for name, what
+                                                          in unpaired.items()) + ".", ""]
     lines += ["## Per method", "",
               "| method | participants | success | intervention ratio | task time (s) | "
               "tiredness, median (mean) | ease, median (mean) |", "|---|---|---|---|---|---|---|"]

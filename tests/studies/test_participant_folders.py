@@ -3,6 +3,7 @@ and says of a session stopped in practice, of answers whose run is damaged or mi
 damaged files, and of pairs too few to test."""
 
 import json
+import shutil
 
 import pytest
 
@@ -90,3 +91,31 @@ def test_practice_runs_alone_are_nothing_to_report(tmp_path, capsys):
             "session stopped during its practice), and there is no other participant folder: "
             "nothing to report") in capsys.readouterr().err
     assert not (tmp_path / "results.md").exists()
+
+
+def _rows(results, measure):
+    """`{pair: n}` of one measure's Wilcoxon rows."""
+    return {line.split(" | ")[1]: int(line.split(" | ")[2]) for line in results.splitlines()
+            if line.startswith(f"| {measure} | ")}
+
+
+@pytest.mark.slow  # Fig. 8 is drawn
+def test_answers_whose_run_is_damaged_or_missing_are_counted_and_said(tmp_path, capsys):
+    for n, participant in enumerate(("P01", "P02", "P03", "P04")):
+        _session(tmp_path / participant, participant, ratio=0.1 * n, tiredness=n)
+    trial_paths(tmp_path / "P02", "teleop", 0)[0].write_text("{bad")
+    for path in trial_paths(tmp_path / "P03", "pbp_continuous", 0):
+        path.unlink()  # as a hand-deleted run would leave it: its answers stay
+    results, err = _report(tmp_path, capsys, code=1)
+    # The answers stood for runs the report left out, and it said so nowhere.
+    assert ("Answers counted without their run (in the answers' counts and tests, not in the "
+            "trial measures'): P02 (Teleop: its trial file is damaged); P03 (PBP-Cont: not "
+            "run).") in results
+    assert "P03 (PBP-Cont not run)" in results  # incomplete, as before; a damaged run is not
+    assert _rows(results, "tiredness (0-5)")["PBP-Alt vs Teleop"] == 4
+    assert _rows(results, "intervention ratio")["PBP-Alt vs Teleop"] == 3
+    assert _rows(results, "intervention ratio")["PBP-Cont vs Teleop"] == 2
+    for name in ("P02", "P03"):  # complete sessions say nothing of the kind
+        shutil.rmtree(tmp_path / name)
+    results, _ = _report(tmp_path, capsys)
+    assert "without their run" not in results

@@ -217,6 +217,10 @@ def wilcoxon_rows(values, methods, source):
             # SciPy would warn and give p = 1 (or refuse, for older versions): no test.
             row["note"] = (f"nothing to test: each of the {len(paired)} participants who "
                            f"{who} has the same value for both")
+        elif sum(a != b for a, b in zip(x, y)) == 1:
+            # SciPy's default drops the equal pairs, leaving one: a meaningless p = 1.
+            row["note"] = ("a test needs at least 2 participants whose values for the two "
+                           f"differ; 1 of the {len(paired)} who {who} does")
         else:
             try:
                 result = scipy.stats.wilcoxon(x, y)

@@ -21,6 +21,14 @@ def _row(first, second, source="answer"):
     # One participant, the same answer: SciPy refuses ("two or more observations").
     ({"P01": 3}, {"P01": 3}, "a test needs at least 2 participants who answered both; 1 did"),
     ({"P01": 3}, {"P02": 3}, "a test needs at least 2 participants who answered both; none did"),
+    # One difference not zero: SciPy drops the others and gives a meaningless p = 1.
+    ({"P01": 3, "P02": 4}, {"P01": 3, "P02": 1},
+     "a test needs at least 2 participants whose values for the two differ; 1 of the 2 who "
+     "answered both does"),
+    ({"P01": 3, "P02": 4, "P03": 5, "P04": 2, "P05": 0},
+     {"P01": 3, "P02": 4, "P03": 5, "P04": 2, "P05": 5},
+     "a test needs at least 2 participants whose values for the two differ; 1 of the 5 who "
+     "answered both does"),
     # Every difference zero: SciPy warns and gives p = 1.
     ({"P01": 3, "P02": 4, "P03": 5}, {"P01": 3, "P02": 4, "P03": 5},
      "nothing to test: each of the 3 participants who answered both has the same value for "

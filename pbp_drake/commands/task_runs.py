@@ -98,7 +98,8 @@ def run_task_loop(args, resolved, meshcat, page):
 
 def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     """One run of the task in `diagram`, live in `console` and the terminal: `(TaskResult,
-    LiveRun)`. With `start_button` (a label), the task's clock starts when it is pressed."""
+    LiveRun)`. With `start_button` (a label), the task's clock starts when it is pressed.
+    A person's run stands still while its page (`console.panel`) has no browser."""
     scenario = resolved.scenario
     camera = None
     if args.camera == "robot":
@@ -109,7 +110,8 @@ def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
         console.clear_result()
     live = LiveRun(diagram, scenario.duration, console, Progress(scenario.duration), camera,
                    start_label=start_button, stdin=terminal(),
-                   gamepad=isinstance(scenario.operator, Gamepad))
+                   gamepad=isinstance(scenario.operator, Gamepad),
+                   page=None if console is None else console.panel)
     if args.record:
         meshcat.StartRecording(frames_per_second=30.0)
     rate = 0.0 if args.headless else args.realtime_rate

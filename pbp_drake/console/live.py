@@ -12,6 +12,7 @@ import time
 from pbp_drake.builder.build import find_system
 from pbp_drake.builder.run import advance_to
 from pbp_drake.console.text import progress_text, status_text
+from pbp_drake.systems.operators.browser_guard import warn
 from pbp_drake.systems.operators.browser_input import BrowserOperator
 from pbp_drake.systems.ports import TaskStatus
 
@@ -23,6 +24,15 @@ STATUS_PERIOD = 0.25
 NO_GAMEPAD = ("No gamepad in the page: connect one and press any of its buttons (a browser "
               "shows a pad to the page only after a press); until then it drives nothing.")
 GAMEPAD_FOUND = "Gamepad found: it drives now."
+#: What the terminal says while a person's run stands still for want of a page.
+NO_PAGE = ("Paused at {time:.1f} s: no page is open, so nobody drives; reopen {url} to go "
+           "on (Ctrl-C stops the run).")
+PAGE_BACK = "A page is open again: the run goes on."
+# A reload leaves no page for a moment: the run stands still at once, and says so only when
+# no page is back after this many seconds.
+NO_PAGE_QUIET = 2.0
+# Wall seconds between two looks at a page that has gone.
+NO_PAGE_POLL = 0.05
 
 
 class Progress:
@@ -75,11 +85,19 @@ class LiveRun:
     on `stdin`: "stop"); the keys of the diagram's "operator" pressed meanwhile are
     forgotten (`BrowserOperator.forget_keys`). With `gamepad`, a page that
     has seen no gamepad is told so (`NO_GAMEPAD`, in the notice line and on stderr).
+
+    With `page` (the run's `PageFront`: `pages()` and `url`) and a person at the diagram's
+    "operator" (a `BrowserOperator`), the run stands still between two slices while no
+    page is open (its clock stopped, its state kept), says so on stderr (`NO_PAGE`) when
+    none is back within `NO_PAGE_QUIET` seconds, and goes on when one is, the closed
+    page's keys and pad forgotten (`BrowserOperator.forget_input`). Ctrl-C meanwhile
+    raises KeyboardInterrupt, as during the run.
     """
 
     def __init__(self, diagram, duration, console=None, progress=None, camera=None,
-                 start_label=None, stdin=None, gamepad=False):
+                 start_label=None, stdin=None, gamepad=False, page=None):
         self._console = console
+        self._page = page
         self._gamepad = gamepad
         self._pad_seen = None  # not looked yet
         self._start_label = start_label
@@ -111,6 +129,7 @@ class LiveRun:
                 return True
             self._apply_sliders(simulator)
         while (now := context.get_time()) < end_time:
+            self._wait_for_a_page(simulator)
             step = min((math.floor(now / SLICE_SECONDS + 1e-9) + 1) * SLICE_SECONDS, end_time)
             ended = advance_to(simulator, step)
             self._update(simulator)
@@ -166,6 +185,27 @@ class LiveRun:
         if self._browser is not None:  # a key tried while the page waited moves nothing
             self._browser.forget_keys(simulator.get_mutable_context())
         simulator.ResetStatistics()  # else the run would rush through the wait
+        return True
+
+    def _wait_for_a_page(self, simulator):
+        """Holds a person's run while it has no page (see the class); True when it did."""
+        if self._page is None or self._browser is None or self._page.pages():
+            return False
+        said = False
+        quiet_until = time.monotonic() + NO_PAGE_QUIET
+        while not self._page.pages():
+            if not said and time.monotonic() >= quiet_until:
+                if self._progress is not None:
+                    self._progress.finish()  # the line said on a line of its own
+                warn(NO_PAGE.format(time=simulator.get_context().get_time(),
+                                    url=self._page.url))
+                said = True
+            time.sleep(NO_PAGE_POLL)
+        if said:
+            warn(PAGE_BACK)
+        # What the closed page held (a key, a tilted stick) drives nothing after it.
+        self._browser.forget_input(simulator.get_mutable_context())
+        simulator.ResetStatistics()  # else the run would rush through the pause
         return True
 
     def _check_gamepad(self):

@@ -232,6 +232,28 @@ def test_gamepad_forward_only_when_allowed(meshcat):
     np.testing.assert_allclose(rig.command()[:2], -SPEED * FORWARD_IN_WORLD, atol=1e-12)
 
 
+def test_forgotten_input_drives_nothing_until_it_changes(meshcat):
+    # A page closed with its stick tilted: Meshcat keeps that last state.
+    rig = gamepad_rig(meshcat, allow_forward=True)
+    set_gamepad(meshcat, [-1.0, 0.0, 0.0, 0.0])
+    rig.advance(PERIOD)
+    assert rig.active()
+    rig.operator.forget_input(rig.simulator.get_mutable_context())
+    rig.advance(2 * PERIOD)
+    assert not rig.active()
+    set_gamepad(meshcat, [-0.9, 0.0, 0.0, 0.0])  # a page's pad that moves: read again
+    rig.advance(PERIOD)
+    assert rig.active()
+    # The keys: one held is released.
+    keys = keyboard_rig(meshcat, allow_forward=False)
+    click(meshcat, LEFT_BUTTON)
+    keys.advance(PERIOD)
+    assert keys.active()
+    keys.operator.forget_input(keys.simulator.get_mutable_context())
+    keys.advance(PERIOD)
+    assert not keys.active()
+
+
 @pytest.mark.parametrize("operator", [KeyboardOperator, GamepadOperator])
 def test_a_browser_operator_names_a_meshcat_or_params_it_cannot_use(meshcat, operator):
     with pytest.raises(ValueError, match=r"^meshcat must be a pydrake Meshcat "

@@ -58,6 +58,7 @@ class BrowserOperator(SampledOperator):
         self._speed = operator_speed(params.speed, nominal_speed)
         self._rotation_speed = float(params.rotation_speed)
         self._keys_index = None  # the keys' state, once `_declare_keys` declared it
+        self._stale_index = None  # the pad's ignored controls, once `_declare_gamepad` did
 
     def _declare_keys(self, keys, axes, hold_time):
         """Adds one button per key (`keys`: name -> `KeyboardEvent.code`), `self._axes` the
@@ -79,6 +80,16 @@ class BrowserOperator(SampledOperator):
         if self._keys_index is not None:
             context = self.GetMyMutableContextFromRoot(root_context)
             self._snapshot(context, context.get_mutable_discrete_state())
+
+    def forget_input(self, root_context):
+        """Forgets in `root_context` what the browser sent so far, as after a pause: the
+        keys as `forget_keys` does, and the gamepad's controls as they stand, ignored until
+        they change (Meshcat keeps the last pad state of a page that has gone)."""
+        self.forget_keys(root_context)
+        if self._stale_index is not None:
+            context = self.GetMyMutableContextFromRoot(root_context)
+            context.get_mutable_discrete_state().get_mutable_vector(self._stale_index).set_value(
+                raw_values(self._meshcat.GetGamepad(), *self._gamepad_counts))
 
     def _step_keys(self, context, discrete_state, clicks):
         """Stores and returns the keys' state after `clicks`, and whether the guard paused

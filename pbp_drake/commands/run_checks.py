@@ -13,8 +13,8 @@ from pbp_drake.studies.sessions import (
 def check_run_flags(args, resolved):
     """Raises ScenarioError for flags of `run` (the parsed `args`) that do not go together,
     or not with the resolved scenario (`--no-meshcat` implies `--headless`). Returns a
-    session's `(methods, order, answers, progress)` (`--answers` parsed, or None; progress
-    the SessionProgress of its folder, which it can take), else None."""
+    session's `(methods, order, answers, on_disk)` (`--answers` parsed, or None; on_disk
+    the SessionOnDisk of its folder, which it can take), else None."""
     if args.no_meshcat and (args.record or args.camera == "robot"):
         raise ScenarioError("--record and --camera robot need the page: drop --no-meshcat")
     if args.headless and (page_flags := page_flags_given(args)):
@@ -61,9 +61,9 @@ def check_run_flags(args, resolved):
         raise ScenarioError("a --headless session needs --answers (e.g. --answers "
                             "tiredness=3,ease=4): otherwise the questions are asked in the "
                             "browser")
-    progress = check_session_folder(resolved.scenario, args.participant, methods,
-                                    session_folder(args.participant, args.output))
-    return methods, order, answers, progress
+    on_disk = check_session_folder(resolved.scenario, args.participant, methods,
+                                   session_folder(args.participant, args.output))
+    return methods, order, answers, on_disk
 
 
 def _check_hand_trail(args, resolved):

@@ -46,12 +46,12 @@ def add_page_flags(parser):
                       metavar="SECONDS",
                       help="after the run, keep the page with its result served until it "
                       "is closed, its Close button is pressed, or this many seconds pass "
-                      "(default 600)")
+                      f"(default {KEEP_PAGE_SECONDS:g})")
     page.add_argument("--wait-for-browser", type=wait_seconds, default=WAIT_FOR_BROWSER_SECONDS,
                       metavar="SECONDS", help="before starting, wait this long for a "
-                      "browser to open the page (default 15); a keyboard or gamepad run "
-                      "that no browser joins in time stops with exit 2, having run and "
-                      "recorded nothing")
+                      f"browser to open the page (default {WAIT_FOR_BROWSER_SECONDS:g}); a "
+                      "keyboard or gamepad run that no browser joins in time stops with exit "
+                      "2, having run and recorded nothing")
 
 
 def page_flags_given(args):

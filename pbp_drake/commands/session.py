@@ -46,14 +46,14 @@ def add_session_flags(parser, hidden=False):
 
 def run_session_command(args, resolved, meshcat, page, session):
     """The session of `args.participant` on the resolved scenario, `session` its
-    `(methods, order, answers, progress)` from `check_run_flags`; its exit code."""
+    `(methods, order, answers, on_disk)` from `check_run_flags`; its exit code."""
     scenario = resolved.scenario
-    methods, order, answers, progress = session
+    methods, order, answers, on_disk = session
     output = session_folder(args.participant, args.output)
     print(f"Participant {args.participant}: {', '.join(order)}, in this order"
           + (", each practised first" if args.practice else "") + f"; saved in {output}",
           flush=True)
-    resuming = resume_text(args.participant, order, progress, args.practice)
+    resuming = resume_text(args.participant, order, on_disk, args.practice)
     if resuming:
         print(resuming, flush=True)
     if answers is not None:

@@ -27,6 +27,7 @@ from pbp_drake.core.methods import METHODS, method_entry
 from pbp_drake.core.toy_scene import bent_path
 from pbp_drake.systems.operators.browser_input import check_params
 from pbp_drake.systems.operators.obstacle_repulsion_operator import check_repulsion_params
+from pbp_drake.systems.operators.scripted_operator import checked_script
 from pbp_drake.robots import CylinderObstacle, hsr_ready_ee_state
 from pbp_drake.robots.arm_station import arm_ready_ee_state_and_reach
 from pbp_drake.robots.hsr_station import hsr_ready_palm_position
@@ -352,12 +353,8 @@ def _check_toy_operator(operator, dimension):
             raise ScenarioError(
                 f"scenario.operator.commands must be one command of dimension {dimension} "
                 "per time")
-        if not np.isfinite(commands).all():
-            raise ScenarioError("scenario.operator.commands contain NaN or infinite values")
-        if np.any(np.diff(np.asarray(operator.times, float)) <= 0):
-            raise ScenarioError(f"scenario.operator.times {operator.times} do not increase; "
-                                "expected times (s) that increase strictly, each command "
-                                "held from its time until the next")
+        with _refused_as("scenario.operator."):
+            checked_script(operator.times, operator.commands)
 
 
 def _resolve_task_robot(scenario):

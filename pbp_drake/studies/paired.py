@@ -145,16 +145,11 @@ def paired_with(folder, reference, metrics, unpaired=None):
     appended to `unpaired` when it is given. Raises ValueError when the study did not run
     `reference`."""
     study, records, _ = read_study(folder)
-    rows = paired_rows_with(study, records, reference,
-                            measures_collisions(study, records, folder), metrics)
-    if unpaired is not None:
-        found = {row.method for row in rows}
-        unpaired += [method for method in study["methods"]
-                     if method != reference and method not in found]
-    return rows
+    return paired_rows_with(study, records, reference,
+                            measures_collisions(study, records, folder), metrics, unpaired)
 
 
-def paired_rows_with(study, records, reference, collisions, metrics):
+def paired_rows_with(study, records, reference, collisions, metrics, unpaired=None):
     """`paired_with` of a study already read (`collisions`: whether its task measures them).
     A metric of `metrics` not in `_METRICS` is read as the records' field of that name (or
     of the name `summary.TRIAL_VALUE` gives it)."""
@@ -165,8 +160,11 @@ def paired_rows_with(study, records, reference, collisions, metrics):
     fields = tuple(name for name in metrics if name not in known)
     rows = []
     for method in [m for m in study["methods"] if m != reference]:
-        rows += _paired_rows(method, reference_trials, _by_seed(study, records, method),
+        found = _paired_rows(method, reference_trials, _by_seed(study, records, method),
                              collisions, fields)
+        if not found and unpaired is not None:
+            unpaired.append(method)
+        rows += found
     return [row for row in rows if row.metric in metrics]
 
 

@@ -53,7 +53,7 @@ def session_folder(participant, output=None):
     return pathlib.Path(output or pathlib.Path("outputs", "participants", participant))
 
 
-class SessionProgress(typing.NamedTuple):
+class SessionOnDisk(typing.NamedTuple):
     """What a participant's folder already holds, each in the session's order: the methods
     whose run is saved, those whose every question is answered, and the practice runs."""
 
@@ -62,13 +62,13 @@ class SessionProgress(typing.NamedTuple):
     practised: list
 
 
-def session_progress(scenario, order, output):
-    """The SessionProgress of the session of `order` on `scenario` in `output`."""
+def session_on_disk(scenario, order, output):
+    """The SessionOnDisk of the session of `order` on `scenario` in `output`."""
     output = pathlib.Path(output)
     digest = scenario_hash(scenario)
     answers = read_answers(output)
     practice_seed = scenario.seed + PRACTICE_SEED_OFFSET
-    return SessionProgress(
+    return SessionOnDisk(
         [m for m in order if read_trial(output, m, scenario.seed, digest) is not None],
         [m for m in order if all(q in answers.get(m, {}) for q in QUESTIONS)],
         [m for m in order
@@ -81,14 +81,14 @@ def check_session_folder(scenario, participant, methods, output):
     scenario, another participant's session, this participant's session begun with other
     methods (so in another order) or on another seed, or complete; or a folder beside it
     has a name that differs from its own only in case. Returns the folder's
-    SessionProgress."""
+    SessionOnDisk."""
     output = pathlib.Path(output)
     order = session_order(methods, participant)
     _check_case_twins(output)
     recorded = [check_folder(folder, scenario, scenario_hash(scenario), quiet=True)
                 for folder in (output, output / PRACTICE_FOLDER)]
-    progress = session_progress(scenario, order, output)
-    # Any run on disk, on whichever seed: one of another seed is not in `progress`.
+    on_disk = session_on_disk(scenario, order, output)
+    # Any run on disk, on whichever seed: one of another seed is not in `on_disk`.
     begun = bool(read_answers(output)) or any(
         any((folder / "trials").glob("*/seed_*.json"))
         for folder in (output, output / PRACTICE_FOLDER))
@@ -122,12 +122,12 @@ def check_session_folder(scenario, participant, methods, output):
                 f"{folder} holds a session on the scene of --seed {first}; this one's is "
                 f"--seed {scenario.seed}: resume it with --seed {first}, or start the "
                 "participant in a new folder (--output)")
-    if progress.saved == order and progress.answered == order:
+    if on_disk.saved == order and on_disk.answered == order:
         raise StudyFolderError(
             f"{output} holds {participant}'s complete session ({', '.join(order)}, each run "
             f"and answered): nothing to run. A new participant needs their own --participant "
             "ID and folder; `pbp-drake report` reads this one")
-    return progress
+    return on_disk
 
 
 def _methods_given(order, participant):
@@ -153,25 +153,25 @@ def _check_case_twins(output):
             "differs by more than case")
 
 
-def resume_text(participant, order, progress, practice):
+def resume_text(participant, order, on_disk, practice):
     """A line saying what a resumed session keeps and what comes next, or None for a session
     that has saved nothing yet."""
-    if not progress.saved and not progress.practised:
+    if not on_disk.saved and not on_disk.practised:
         return None
     parts = []
-    if progress.saved:
-        parts.append(f"{', '.join(progress.saved)} saved, not run again")
-    if practice and progress.saved:
+    if on_disk.saved:
+        parts.append(f"{', '.join(on_disk.saved)} saved, not run again")
+    if practice and on_disk.saved:
         parts.append("no practice (recorded runs exist)")
-    elif progress.practised and not progress.saved:
-        left = [m for m in order if m not in progress.practised]
-        parts.append(f"practice of {', '.join(progress.practised)} saved"
+    elif on_disk.practised and not on_disk.saved:
+        left = [m for m in order if m not in on_disk.practised]
+        parts.append(f"practice of {', '.join(on_disk.practised)} saved"
                      + (f"; practice of {', '.join(left)} comes first" if practice and left
                         else ""))
-    unanswered = [m for m in progress.saved if m not in progress.answered]
+    unanswered = [m for m in on_disk.saved if m not in on_disk.answered]
     if unanswered:
         parts.append(f"first the questions of {', '.join(unanswered)}")
-    waiting = [m for m in order if m not in progress.saved]
+    waiting = [m for m in order if m not in on_disk.saved]
     if waiting:
         parts.append(f"next: {waiting[0]}, method {order.index(waiting[0]) + 1} of "
                      f"{len(order)}, from its start")

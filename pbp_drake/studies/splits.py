@@ -50,8 +50,8 @@ def check_within_split(study, split, seed, trials, whose):
              else f"from {study.evaluation_seed} on")
     raise ScenarioError(
         f"{whose}: seeds {seed} to {last} are not all {split} seeds ({seeds}) but {label}: "
-        f"give --seed and --trials within them, or leave out --split to run these seeds, "
-        f"labelled {label}")
+        "give --seed and --trials within them, or --seed without --split to run these "
+        f"seeds, labelled {label}")
 
 
 def seeds_line(summary):

@@ -569,15 +569,16 @@ def test_ray_address_needs_the_ray_backend(task_file, tmp_path, capsys):
     *[("hsr_reach.yaml", None, ["--split", split, "--seed", seed, "--trials", "2", "--set",
                                 "duration=1"],
        f"--split {split}: seeds {seed} to {int(seed) + 1} are not all {split} seeds "
-       f"({seeds}) but {label}: give --seed and --trials within them, or leave out --split "
-       f"to run these seeds, labelled {label}")
+       f"({seeds}) but {label}: give --seed and --trials within them, or --seed without "
+       f"--split to run these seeds, labelled {label}")
       for split, seed, seeds, label in [("tuning", "9999", "0 to 9999", "mixed"),
                                         ("evaluation", "5", "from 10000 on", "tuning")]],
     ("hsr_reach.yaml", "study: !MethodComparison\n  split: tuning\n  trials: 3\n"
      "  evaluation_seed: 2\n", ["--set", "duration=1"],
      "{file}'s study.split tuning: seeds 0 to 2 are not all tuning seeds (0 to 1) but "
-     "mixed: give --seed and --trials within them, or leave out --split to run these seeds, "
-     "labelled mixed"),
+     # No --split to leave out: --seed alone runs them.
+     "mixed: give --seed and --trials within them, or --seed without --split to run these "
+     "seeds, labelled mixed"),
     # A flag of the HSR tasks' studies on a 2-D study: refused, not left unused in silence.
     *[("toy_alpha_study.yaml", None, [flag, value], f"{flag}: {{file}} is a 2-D study, whose "
        "runs its `study:` section sets; the HSR tasks' studies take it")

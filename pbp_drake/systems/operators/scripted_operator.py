@@ -20,18 +20,7 @@ class ScriptedOperator(SampledOperator):
     """
 
     def __init__(self, times, commands, control_period):
-        times = np.asarray(times, dtype=float).reshape(-1)
-        commands = np.asarray(commands, dtype=float)
-        if commands.ndim == 1:
-            commands = commands[:, np.newaxis]
-        if times.size == 0 or commands.shape[0] != times.size:
-            raise ValueError(
-                f"operator script needs one command per time: {times.size} times, "
-                f"{commands.shape[0]} commands")
-        if not np.isfinite(commands).all():
-            raise ValueError("operator script commands contain NaN or infinite values")
-        if not np.isfinite(times).all() or (np.diff(times) <= 0).any():
-            raise ValueError("operator script times must be finite and strictly increasing")
+        times, commands = checked_script(times, commands)
         super().__init__(commands.shape[1], control_period)
         self._times = times
         self._commands = commands
@@ -41,3 +30,22 @@ class ScriptedOperator(SampledOperator):
         index = max(0, int(np.searchsorted(self._times, context.get_time(), side="right")) - 1)
         command = self._commands[index]
         return command, bool(np.any(command != 0.0))
+
+
+def checked_script(times, commands):
+    """`times` `(T,)` and `commands` `(T, D)` (`(T,)`: D = 1) as float arrays; ValueError
+    naming `times` or `commands` unless they can be played back."""
+    times = np.asarray(times, dtype=float).reshape(-1)
+    commands = np.asarray(commands, dtype=float)
+    if commands.ndim == 1:
+        commands = commands[:, np.newaxis]
+    if times.size == 0 or commands.shape[0] != times.size:
+        raise ValueError(f"commands: {commands.shape[0]} for {times.size} times; expected one "
+                         "command per time")
+    if not np.isfinite(commands).all():
+        raise ValueError("commands contain NaN or infinite values")
+    if not np.isfinite(times).all() or (np.diff(times) <= 0).any():
+        raise ValueError(f"times {times.tolist()} do not increase; expected finite times (s) "
+                         "that increase strictly, each command held from its time until the "
+                         "next")
+    return times, commands

@@ -11,12 +11,9 @@ import time
 import types
 
 import msgpack
-import numpy as np
 import pytest
 from foreign_page import ForeignPage
-from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
+from test_page_gone import keyboard_run
 
 from pbp_drake.builder import build_diagram, simulate
 from pbp_drake.commands import run_page, task_runs
@@ -24,9 +21,7 @@ from pbp_drake.commands.run_page import keep_page
 from pbp_drake.commands.task_runs import run_task_loop
 from pbp_drake.console import Console, LiveRun
 from pbp_drake.scenarios import Keyboard, load_scenario_file, resolve
-from pbp_drake.systems.operators.keyboard_operator import (
-    KEY_BUTTONS, LEFT_BUTTON, KeyboardOperator)
-from pbp_drake.systems.ports import EeState
+from pbp_drake.systems.operators.keyboard_operator import KEY_BUTTONS, LEFT_BUTTON
 
 
 def click(meshcat, name):
@@ -117,15 +112,7 @@ class KeyBeforeStart(Console):
 
 
 def test_a_key_pressed_before_start_does_not_move_the_robot_after_it(meshcat):
-    builder = DiagramBuilder()
-    operator = builder.AddNamedSystem("operator", KeyboardOperator(
-        meshcat, 0.05, allow_forward=False, nominal_speed=0.2))
-    source = builder.AddSystem(ConstantVectorSource(np.zeros(EeState.size)))
-    builder.Connect(source.get_output_port(), operator.get_ee_state_input_port())
-    active = LogVectorOutput(operator.get_operator_active_output_port(), builder)
-    diagram = builder.Build()
-    simulator = Simulator(diagram)
-    simulator.Initialize()
+    diagram, simulator, active = keyboard_run(meshcat)
     live = LiveRun(diagram, 2.0, KeyBeforeStart(meshcat, panel=Panel()), start_label="Start")
     live.advance(simulator, 1.0)
     log = active.FindLog(simulator.get_context())

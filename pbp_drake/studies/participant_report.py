@@ -11,7 +11,7 @@ import statistics
 import sys
 
 from pbp_drake.scenarios import METHOD_NAMES, ScenarioError, counted
-from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, scale_text
+from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, scale_text, unanswered
 from pbp_drake.studies.questionnaire_figure import FIG8, answer_counts, plot_questionnaire
 from pbp_drake.studies.sessions import DEFAULT_SESSION_METHODS, PRACTICE_FOLDER
 from pbp_drake.studies.atomic_files import write_atomically
@@ -96,8 +96,7 @@ def read_participants(study_dir):
             # What an unfinished session lacks (a damaged run is named as damaged).
             "not_run": [m for m in study["methods"]
                         if runs[m] is None and m not in unreadable],
-            "not_answered": [m for m in study["methods"]
-                             if any(q not in answers.get(m, {}) for q in QUESTIONS)]}
+            "not_answered": [m for m in study["methods"] if unanswered(answers, m)]}
     _check_one_folder_each(study_dir, sessions)
     hashes = collections.Counter(s["study"]["scenario_hash"] for s in sessions.values())
     digest = hashes.most_common(1)[0][0]

@@ -113,6 +113,13 @@ def read_questionnaire(folder):
     return answers, questions
 
 
+def unanswered(answers, method):
+    """The questions `answers` (`{method: {question: answer}}`) lacks for `method`, in the
+    questionnaire's order."""
+    given = answers.get(method, {})
+    return [question for question in QUESTIONS if question not in given]
+
+
 def read_answers(folder):
     """The answers of `read_questionnaire`, `{method: {question: answer}}`."""
     return read_questionnaire(folder)[0]
@@ -183,7 +190,7 @@ def parse_answers(text, methods):
     answers = {}
     for method in methods:
         answers[method] = {**common, **specific.get(method, {})}
-        missing = [q for q in QUESTIONS if q not in answers[method]]
+        missing = unanswered(answers, method)
         if missing:
             raise QuestionnaireError(f"--answers gives no {', '.join(missing)} for {method}: "
                                      "answer every question, e.g. tiredness=3,ease=4")

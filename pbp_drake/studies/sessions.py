@@ -12,7 +12,7 @@ import typing
 
 from pbp_drake.studies.comparison import run_method_comparison
 from pbp_drake.studies.folders import check_folder
-from pbp_drake.studies.questionnaire import QUESTIONS, read_answers, save_answer
+from pbp_drake.studies.questionnaire import read_answers, save_answer, unanswered
 from pbp_drake.studies.trial_files import StudyFolderError, read_trial, scenario_hash
 
 DEFAULT_SESSION_METHODS = ("pbp_alternated", "pbp_continuous", "teleop")
@@ -70,7 +70,7 @@ def session_on_disk(scenario, order, output):
     practice_seed = scenario.seed + PRACTICE_SEED_OFFSET
     return SessionOnDisk(
         [m for m in order if read_trial(output, m, scenario.seed, digest) is not None],
-        [m for m in order if all(q in answers.get(m, {}) for q in QUESTIONS)],
+        [m for m in order if not unanswered(answers, m)],
         [m for m in order
          if read_trial(output / PRACTICE_FOLDER, m, practice_seed, digest) is not None])
 
@@ -209,8 +209,7 @@ def run_session(scenario, participant, methods, output, run, page, practice=Fals
         for position, method in enumerate(order, start=1):
             if method in waiting:
                 continue
-            answered = read_answers(output).get(method, {})
-            missing = [q for q in QUESTIONS if q not in answered]
+            missing = unanswered(read_answers(output), method)
             for question in missing:
                 save_answer(output, method, question, page.answer(method, question))
             if missing and position < len(order) and order[position] in waiting:

@@ -11,6 +11,7 @@ from pydrake.geometry import Meshcat, MeshcatParams
 from pbp_drake.cli_types import port, token, wait_seconds
 from pbp_drake.console import Console
 from pbp_drake.console.front import ENDED_NOTICE, PageFront
+from pbp_drake.console.live import closed_for
 from pbp_drake.output_paths import recorded_replay
 from pbp_drake.scenarios import ScenarioError
 from pbp_drake.studies.atomic_files import write_atomically
@@ -105,22 +106,6 @@ def keep_page(args, page, console, choices):
           + f"; Close, Enter or closing the page ends the command (at the latest in "
           f"{args.keep_page:g} s).", flush=True)
     return console.wait_for_choice(stdin=terminal(), timeout=args.keep_page, until=closed)
-
-
-def closed_for(page, seconds):
-    """A test that is true once `page` (a `PageFront`) has had no browser for `seconds` on
-    end, from the first call that finds none."""
-    since = None
-
-    def closed():
-        nonlocal since
-        if page.pages():
-            since = None
-            return False
-        if since is None:
-            since = time.monotonic()
-        return time.monotonic() - since >= seconds
-    return closed
 
 
 def end_page(page, console, text=ENDED_NOTICE):

@@ -35,6 +35,22 @@ NO_PAGE_QUIET = 2.0
 NO_PAGE_POLL = 0.05
 
 
+def closed_for(page, seconds):
+    """A test that is true once `page` (a `PageFront`) has had no browser for `seconds` on
+    end, from the first call that finds none."""
+    since = None
+
+    def closed():
+        nonlocal since
+        if page.pages():
+            since = None
+            return False
+        if since is None:
+            since = time.monotonic()
+        return time.monotonic() - since >= seconds
+    return closed
+
+
 class Progress:
     """The terminal's progress line: rewritten in place every quarter second when `stream`
     is a terminal, a new line every 5 s otherwise (a log file, a pipe)."""
@@ -192,9 +208,9 @@ class LiveRun:
         if self._page is None or self._browser is None or self._page.pages():
             return False
         said = False
-        quiet_until = time.monotonic() + NO_PAGE_QUIET
+        quiet_too_long = closed_for(self._page, NO_PAGE_QUIET)
         while not self._page.pages():
-            if not said and time.monotonic() >= quiet_until:
+            if not said and quiet_too_long():
                 if self._progress is not None:
                     self._progress.finish()  # the line said on a line of its own
                 warn(NO_PAGE.format(time=simulator.get_context().get_time(),

@@ -371,3 +371,11 @@ def test_a_reset_state_that_is_not_the_dmps_is_refused_naming_it(state, message)
     dmp = Dmp.straight([0.0, 0.0], [1.0, 0.0], 1.0)
     with pytest.raises(ValueError, match=message):
         dmp.reset(**state)
+
+
+def test_a_whole_float_basis_count_fits_as_its_integer():
+    """`basis_count=10.0` (a number read from a file or computed) fits the same DMP as 10."""
+    times, positions = minimum_jerk([0.0, 0.0], [1.0, 0.5], 1.0)
+    fitted = [Dmp.from_demonstration(times, positions, DmpSettings(basis_count=count))
+              for count in (10.0, 10)]
+    assert np.array_equal(fitted[0].rollout(0.01), fitted[1].rollout(0.01))

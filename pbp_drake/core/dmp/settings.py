@@ -57,6 +57,7 @@ class DmpSettings:
         if isinstance(count, bool) or not (isinstance(count, numbers.Real)
                                            and math.isfinite(count) and int(count) == count):
             raise ValueError(f"basis_count must be a whole number, got {count!r}")
+        self.basis_count = int(count)  # 10.0 sizes arrays as 10 does
         if self.basis_count < 2:
             raise ValueError(f"basis_count must be at least 2, got {self.basis_count}")
         if self.basis_count > MAX_BASIS_COUNT:

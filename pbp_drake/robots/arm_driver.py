@@ -222,7 +222,13 @@ class DriverLink(LeafSystem):
             x[self._OFFSET] = time.time() - context.get_time()
         message = self.get_input_port(0).Eval(context)
         if message.num_joints and message.utime != x[self._UTIME]:
-            self._read(message, x, now)
+            if x[self._UTIME] < 0:
+                # A udpm:// bus keeps the first message that came since it was last handled
+                # and drops the later ones: at the run's first step, one as old as the
+                # station. The next one is fresh.
+                x[self._UTIME] = message.utime
+            else:
+                self._read(message, x, now)
         x[self._SEND] = 0.0
         hardware = self._hardware
         if check_heard(now, x[self._STARTED_AT], x[self._STATUS_AT], hardware.connect_timeout,

@@ -329,6 +329,16 @@ def test_an_arm_that_moved_after_its_first_status_was_read_ends_the_run():
     assert rig.commands == []
 
 
+def test_the_start_is_checked_on_a_fresh_status_not_on_the_first_the_bus_kept():
+    # udpm:// keeps the first status that came since the bus was last handled: at the run's
+    # first step, one from when the station was built, where the run was built for. The arm
+    # has moved since (fresh statuses); commands from START would pull it back in a jump.
+    rig = fake_rig("iiwa", lambda t: START if t < 1e-9 else None if t < 0.02 else START + 0.05)
+    with pytest.raises(DriverError, match=r"the arm stands 0.0500 rad from the configuration "):
+        rig.advance(0.5)
+    assert rig.commands == []
+
+
 def test_the_first_status_gives_the_arm_s_configuration_or_refuses_a_bad_one():
     hardware = ArmHardware(driver="iiwa", connect=True)
     good = status_message("iiwa", 0, START, np.zeros(7), START)

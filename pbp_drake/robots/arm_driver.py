@@ -222,7 +222,13 @@ class DriverLink(LeafSystem):
             x[self._OFFSET] = time.time() - context.get_time()
         message = self.get_input_port(0).Eval(context)
         if message.num_joints and message.utime != x[self._UTIME]:
-            self._read(message, x, now)
+            if x[self._UTIME] < 0:
+                # A udpm:// bus keeps the first message that came since it was last handled
+                # and drops the later ones: at the run's first step, one as old as the
+                # station. The next one is fresh.
+                x[self._UTIME] = message.utime
+            else:
+                self._read(message, x, now)
         x[self._SEND] = 0.0
         hardware = self._hardware
         if check_heard(now, x[self._STARTED_AT], x[self._STATUS_AT], hardware.connect_timeout,
@@ -230,11 +236,14 @@ class DriverLink(LeafSystem):
                        "the arm holds where it was last commanded"):
             if self._clock == WALL_CLOCK:
                 lag = time.time() - context.get_time() - x[self._OFFSET]
-                if lag > hardware.command_expiry:
+                # Ahead, each command's velocity limit would hold in simulated time only:
+                # the arm would be sent faster than its limits.
+                if abs(lag) > hardware.command_expiry:
                     raise DriverError(
-                        f"the control loop fell {lag:.3f} s behind the wall clock (at most "
-                        f"{hardware.command_expiry:g} s): the arm holds where it was last "
-                        "commanded")
+                        f"the control loop ran {abs(lag):.3f} s "
+                        f"{'behind' if lag > 0 else 'ahead of'} the wall clock (at most "
+                        f"{hardware.command_expiry:g} s; the simulator's real-time rate must "
+                        "be 1): the arm holds where it was last commanded")
             if now - x[self._FIRST_AT] >= self._driver.start_guard:
                 x[self._SENT] = self._command(context, x)
                 x[self._SEND] = 1.0

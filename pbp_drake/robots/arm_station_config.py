@@ -78,8 +78,8 @@ class ArmHardware:
     status_timeout: float = 0.05
     #: How long (s) the station waits for the driver's first status before it fails.
     connect_timeout: float = 5.0
-    #: Our own expiry: the station sends no command computed more than this (s) behind the
-    #: wall clock (a control loop that fell behind real time holds the arm and ends).
+    #: Our own expiry: the station sends no command computed more than this (s) behind or
+    #: ahead of the wall clock (a control loop off real time holds the arm and ends).
     command_expiry: float = 0.05
     #: How far (rad) the first status may stand from the configuration the run was built
     #: for (read from the driver's status before the run).

@@ -6,6 +6,7 @@ driver, and a bad status each end the run with one clear error and nothing more 
 import dataclasses
 import pathlib
 import time
+import types
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ from pbp_drake.cli import main
 from pbp_drake.robots import (
     ArmHardware, DriverError, arm_driver_sim, arm_initial_ee_state, make_arm_station,
     measured_ready_positions)
+from pbp_drake.robots import arm_driver
 from pbp_drake.robots.arm_driver import (
     SIMULATION_CLOCK, WALL_CLOCK, DriverLink, command_message, read_first_status,
     status_message, status_type)
@@ -131,7 +133,8 @@ class Rig:
     `make_driver(lcm)` makes), the desired state held at `desired`; every message on the
     bus recorded with its time (the bus pumped by `pump`)."""
 
-    def __init__(self, driver_name, make_driver=None, desired=START, **hardware):
+    def __init__(self, driver_name, make_driver=None, desired=START, clock=SIMULATION_CLOCK,
+                 **hardware):
         self.lcm = DrakeLcm("memq://")
         self.hardware = ArmHardware(driver=driver_name, connect=True, driver_sim=True,
                                     **hardware)
@@ -145,7 +148,7 @@ class Rig:
         status = builder.AddSystem(LcmSubscriberSystem.Make(
             self.channels.status_channel, status_type(driver_name), self.lcm))
         self.link = builder.AddSystem(DriverLink(self.hardware, self.lcm, START, LOWER, UPPER,
-                                                 VELOCITY, SIMULATION_CLOCK))
+                                                 VELOCITY, clock))
         source = builder.AddSystem(ConstantVectorSource(np.concatenate([desired,
                                                                         np.zeros(7)])))
         builder.Connect(status.get_output_port(), self.link.GetInputPort("status"))
@@ -225,6 +228,20 @@ def test_a_silent_driver_holds_the_arm_and_ends_the_run():
     last_status = max(message.utime for _, message in rig.statuses) * 1e-6
     last_command = max(message.utime for _, message in rig.commands) * 1e-6
     assert last_command <= last_status + 0.05 + DRIVERS["iiwa"].period + 1e-9
+
+
+def test_a_control_loop_ahead_of_the_wall_clock_ends_before_the_arm_is_sent_too_fast(
+        monkeypatch):
+    # The simulation at twice the wall clock's pace (a page's real-time rate of 2, or a
+    # Simulator with no rate set, which runs as fast as it can): each command keeps the
+    # velocity limits per simulated period, so the arm would be sent at up to twice them.
+    rig = Rig("panda", desired=START + 0.5, clock=WALL_CLOCK)
+    monkeypatch.setattr(arm_driver, "time", types.SimpleNamespace(
+        time=lambda: 1000.0 + rig.now() / 2))
+    with pytest.raises(DriverError, match=r"ran 0\.05\d* s ahead of the wall clock \(at most "
+                                          r"0\.05 s; the simulator's real-time rate must be 1\)"):
+        rig.advance(1.0)
+    assert max(message.utime for _, message in rig.commands) * 1e-6 < 1000.0 + 0.06
 
 
 def test_no_driver_fails_in_its_connect_timeout_naming_the_channel():
@@ -309,6 +326,16 @@ def test_an_arm_that_moved_after_its_first_status_was_read_ends_the_run():
     with pytest.raises(DriverError, match=r"the arm stands 0.0500 rad from the configuration "
                                           r"the run was built for \(at most 0.01\)"):
         rig.advance(0.2)
+    assert rig.commands == []
+
+
+def test_the_start_is_checked_on_a_fresh_status_not_on_the_first_the_bus_kept():
+    # udpm:// keeps the first status that came since the bus was last handled: at the run's
+    # first step, one from when the station was built, where the run was built for. The arm
+    # has moved since (fresh statuses); commands from START would pull it back in a jump.
+    rig = fake_rig("iiwa", lambda t: START if t < 1e-9 else None if t < 0.02 else START + 0.05)
+    with pytest.raises(DriverError, match=r"the arm stands 0.0500 rad from the configuration "):
+        rig.advance(0.5)
     assert rig.commands == []
 
 

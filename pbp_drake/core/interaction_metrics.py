@@ -9,6 +9,8 @@ import math
 
 import numpy as np
 
+from pbp_drake.core.hand_over import check_limit
+
 # Below this speed (m/s) a command or the hand's motion has no direction to compare.
 STILL_SPEED = 1e-3
 
@@ -75,7 +77,7 @@ class InteractionMeter:
     switch and how long its target has been named) is carried over."""
 
     def __init__(self, control_period):
-        self._period = float(control_period)
+        self._period = check_limit(control_period, "control_period", "s")
         self._input = self._turn = 0.0
         self._cosines, self._cosine_count = 0.0, 0
         self._last = None  # (position, velocity command, active) of the last tick fed
@@ -89,14 +91,21 @@ class InteractionMeter:
     def add(self, times, operator_velocity, operator_turn, operator_active, hand_positions,
             predicted_goals, targets):
         """Feeds the next ticks' series (as `interaction_metrics` takes them)."""
-        times = np.asarray(times, float).reshape(-1)
+        times = _series("times", times, np.size(times)).reshape(-1)
         if len(times) == 0:
             return
-        velocity = np.asarray(operator_velocity, float).reshape(len(times), -1)
-        turn = np.asarray(operator_turn, float)
+        velocity = _series("operator_velocity", operator_velocity, len(times)).reshape(
+            len(times), -1)
+        turn = _series("operator_turn", operator_turn, len(times))
         turn = np.abs(turn) if turn.ndim == 1 else np.linalg.norm(turn, axis=1)
-        active = np.asarray(operator_active, bool).reshape(-1)
-        positions = np.asarray(hand_positions, float).reshape(len(times), -1)
+        active = _series("operator_active", operator_active, len(times)).astype(bool).reshape(-1)
+        positions = _series("hand_positions", hand_positions, len(times)).reshape(
+            len(times), -1)
+        if positions.shape[1] != velocity.shape[1]:
+            raise ValueError(f"hand_positions has {positions.shape[1]} axes and "
+                             f"operator_velocity {velocity.shape[1]}; expected the same axes")
+        for name, goals in (("predicted_goals", predicted_goals), ("targets", targets)):
+            _series(name, goals, len(times))
         speeds = np.linalg.norm(velocity, axis=1)
         self._input += float(speeds[active].sum()) * self._period
         self._turn += float(turn[active].sum()) * self._period
@@ -165,6 +174,19 @@ class InteractionMeter:
             prediction_accuracy=(self._named_ticks / self._ticks
                                  if self._shown and self._ticks else None),
             time_to_prediction=latencies)
+
+
+def _series(name, values, ticks):
+    """`values` as a float array; ValueError naming `name` unless it holds one row of finite
+    numbers per tick (`ticks`): a series of another length would be read against the wrong
+    ticks, and a NaN would make its metric NaN without a word."""
+    values = np.asarray(values, float)
+    rows = len(values) if values.ndim else 1
+    if rows != ticks:
+        raise ValueError(f"{name} has {rows} rows; expected one per tick of times ({ticks})")
+    if not np.isfinite(values).all():
+        raise ValueError(f"{name} holds NaN or infinite values; expected finite numbers")
+    return values
 
 
 def interaction_metrics(times, control_period, operator_velocity, operator_turn,

@@ -87,7 +87,7 @@ def key_state(uniforms, forward_enabled):
     states from one uniform number per axis: three states per axis; the first axis
     (forward/back) has two, back and none, when the forward key is disabled
     (`forward_enabled` False and the layout's forward key a button of its own, the
-    reaching task's). The same numbers give the same keys wherever the keys agree."""
+    reaching task's). The same numbers give the same keys on every other axis."""
     uniforms = np.asarray(uniforms, float)
     counts = np.full(len(uniforms), 3)
     if not forward_enabled:

@@ -116,3 +116,30 @@ def test_the_idle_ratio_is_the_share_of_the_intervention_ratios_ticks_without_in
     # 3 ticks with input of the task monitor's 12: 9 without.
     assert idle_ratio(3 / 12) == pytest.approx(9 / 12, abs=1e-15)
     assert idle_ratio(None) is None
+
+
+@pytest.mark.parametrize("period", [0.0, -0.1, math.nan])
+def test_a_control_period_that_is_not_positive_is_refused(period):
+    # 0 made the hand's velocity infinite and -0.1 the input negative, without a word.
+    with pytest.raises(ValueError, match="control_period must be finite and positive"):
+        interaction_metrics(TIMES, period, COMMAND, YAW_RATE, ACTIVE, HAND, PREDICTED,
+                            TARGETS)
+
+
+@pytest.mark.parametrize("index, name", [
+    (2, "operator_velocity"), (3, "operator_turn"), (4, "operator_active"),
+    (5, "hand_positions"), (6, "predicted_goals"), (7, "targets")])
+def test_a_series_of_another_length_is_refused_naming_it(index, name):
+    arguments = [TIMES, PERIOD, COMMAND, YAW_RATE, ACTIVE, HAND, PREDICTED, TARGETS]
+    arguments[index] = arguments[index][:-1]
+    with pytest.raises(ValueError,
+                       match=rf"{name} has 11 rows; expected one per tick of times \(12\)"):
+        interaction_metrics(*arguments)
+
+
+def test_a_nan_in_a_series_is_refused_rather_than_made_the_metric():
+    command = COMMAND.copy()
+    command[0, 0] = math.nan  # an acting tick: it made the input integral NaN
+    with pytest.raises(ValueError, match="operator_velocity holds NaN or infinite values"):
+        interaction_metrics(TIMES, PERIOD, command, YAW_RATE, ACTIVE, HAND, PREDICTED,
+                            TARGETS)

@@ -51,6 +51,22 @@ def test_a_public_submodule_imports_from_a_fresh_interpreter():
     assert out == "pbp_drake.core.quaternion\n"
 
 
+@pytest.mark.slow
+def test_drawing_figures_keeps_the_users_matplotlib_backend(tmp_path):
+    # A notebook's inline figures vanish if importing or drawing switches the backend.
+    code = ("import matplotlib; matplotlib.use('svg'); import sys; "
+            "from pbp_drake import phase_progress, report, teach_primitive; "
+            "from pbp_drake.studies.primitive_figure import plot_primitive; "
+            "import pbp_drake.studies.questionnaire_figure; import numpy as np; "
+            "times = np.linspace(0, 1, 50); path = np.outer(times, [1.0, 0.5, 0.0]); "
+            "plot_primitive(teach_primitive(times, path), path[-1:] + 0.1, sys.argv[1]); "
+            "print(matplotlib.get_backend())")
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "primitive.png")],
+                         capture_output=True, text=True, check=True).stdout
+    assert out == "svg\n"
+    assert (tmp_path / "primitive.png").read_bytes().startswith(b"\x89PNG")
+
+
 def test_dir_lists_every_public_name():
     assert set(pbp_drake.__all__) <= set(dir(pbp_drake))
 

@@ -76,6 +76,14 @@ def test_an_unknown_name_says_so():
         pbp_drake.NoSuchThing  # noqa: B018
 
 
+def test_a_controller_of_your_own_asks_whether_its_method_has_a_forward_key():
+    # Tutorial 08 wires the operator's forward key from it: teleop needs the key.
+    from pbp_drake import PbpControllerConfig, forward_key_enabled
+
+    assert forward_key_enabled(PbpControllerConfig(method="teleop"))
+    assert not forward_key_enabled(PbpControllerConfig(method="pbp_alternated"))
+
+
 @pytest.mark.parametrize("path, code", list(_examples()),
                          ids=lambda value: value.name if isinstance(value, pathlib.Path) else "")
 def test_examples_import_only_public_names(path, code):

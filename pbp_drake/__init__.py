@@ -38,7 +38,8 @@ API_GROUPS = {
         "GraspParticipantParams": "pbp_drake.core.participant_grasp",
     },
     "Methods and goal estimators (registries)": {
-        **{name: "pbp_drake.core.methods" for name in ["Method", "register_method"]},
+        **{name: "pbp_drake.core.methods" for name in [
+            "Method", "register_method", "forward_key_enabled"]},
         **{name: "pbp_drake.core.goal_estimation" for name in [
             "Estimator", "register_estimator"]},
         "IntentFilterSettings": "pbp_drake.core.intent_filter",

@@ -51,6 +51,22 @@ def test_a_public_submodule_imports_from_a_fresh_interpreter():
     assert out == "pbp_drake.core.quaternion\n"
 
 
+@pytest.mark.slow
+def test_drawing_figures_keeps_the_users_matplotlib_backend(tmp_path):
+    # A notebook's inline figures vanish if importing or drawing switches the backend.
+    code = ("import matplotlib; matplotlib.use('svg'); import sys; "
+            "from pbp_drake import phase_progress, report, teach_primitive; "
+            "from pbp_drake.studies.primitive_figure import plot_primitive; "
+            "import pbp_drake.studies.questionnaire_figure; import numpy as np; "
+            "times = np.linspace(0, 1, 50); path = np.outer(times, [1.0, 0.5, 0.0]); "
+            "plot_primitive(teach_primitive(times, path), path[-1:] + 0.1, sys.argv[1]); "
+            "print(matplotlib.get_backend())")
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "primitive.png")],
+                         capture_output=True, text=True, check=True).stdout
+    assert out == "svg\n"
+    assert (tmp_path / "primitive.png").read_bytes().startswith(b"\x89PNG")
+
+
 def test_dir_lists_every_public_name():
     assert set(pbp_drake.__all__) <= set(dir(pbp_drake))
 
@@ -58,6 +74,14 @@ def test_dir_lists_every_public_name():
 def test_an_unknown_name_says_so():
     with pytest.raises(AttributeError, match="no attribute 'NoSuchThing'"):
         pbp_drake.NoSuchThing  # noqa: B018
+
+
+def test_a_controller_of_your_own_asks_whether_its_method_has_a_forward_key():
+    # Tutorial 08 wires the operator's forward key from it: teleop needs the key.
+    from pbp_drake import PbpControllerConfig, forward_key_enabled
+
+    assert forward_key_enabled(PbpControllerConfig(method="teleop"))
+    assert not forward_key_enabled(PbpControllerConfig(method="pbp_alternated"))
 
 
 @pytest.mark.parametrize("path, code", list(_examples()),

@@ -4,15 +4,22 @@ comparison's Fig. 7 (box plots of (a) the intervention ratio and (b) the task ti
 the histogram of collision ratios) and a matrix of methods and pilots in one figure."""
 
 import matplotlib
+import numpy as np
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.patches import Circle  # noqa: E402
+from pbp_drake.core.methods import method_colour, methods_of
+from pbp_drake.scenarios import METHOD_NAMES
+from pbp_drake.studies.atomic_files import save_figure
 
-from pbp_drake.core.methods import method_colour, methods_of  # noqa: E402
-from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
-from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
+
+def new_figure(*grid, figsize, **options):
+    """A figure and its axes (`Figure.subplots`) made without pyplot, which would choose a
+    backend: a notebook that draws these keeps its own (its inline figures)."""
+    figure = Figure(figsize=figsize)
+    return figure, figure.subplots(*grid, **options)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -22,7 +29,6 @@ from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
 def _save(figure, path, **options):
     figure.tight_layout()
     save_figure(figure, path, **options)
-    plt.close(figure)
 
 
 def _label(method, rows=None):
@@ -46,7 +52,7 @@ def _values(records, method, field):
 
 
 def _box_plot(records, methods, field, ylabel, title, path, ylim=None):
-    figure, axis = plt.subplots(figsize=(1.6 + 1.3 * len(methods), 3.6))
+    figure, axis = new_figure(figsize=(1.6 + 1.3 * len(methods), 3.6))
     data = [_values(records, method, field) for method in methods]
     labels = [_label(m, [r for r in records if r["method"] == m]) for m in methods]
     # A method with no finished trial gets an empty box (matplotlib needs one value: NaN).
@@ -82,7 +88,7 @@ def plot_collision_histogram(summary, path):
     """Fig. 7c: each method's trials per bin of collision ratio (the summary's histogram)."""
     edges = np.asarray(summary["collision_histogram_edges"], float)
     methods = list(summary["methods"])
-    figure, axis = plt.subplots(figsize=(7, 3.6))
+    figure, axis = new_figure(figsize=(7, 3.6))
     width = np.diff(edges) / (len(methods) + 1)
     for index, method in enumerate(methods):
         entry = summary["methods"][method]["collision_ratio"]
@@ -112,7 +118,7 @@ def plot_pilot_panels(panels, path):
     time (squares, right axis) with their 95 % intervals. `panels`: `{pilot: [(method,
     (mean, low, high) of the ratio, the same of the time)]}` (low, high None: no interval)."""
     count = len(panels)
-    figure, axes = plt.subplots(1, count, figsize=(1.2 + 3.4 * count, 3.8), squeeze=False)
+    figure, axes = new_figure(1, count, figsize=(1.2 + 3.4 * count, 3.8), squeeze=False)
     times = [t[0] for rows in panels.values() for _, _, t in rows if t[0] is not None]
     highs = [t[2] for rows in panels.values() for _, _, t in rows if t[2] is not None]
     time_top = 1.1 * max(times + highs) if times else 1.0
@@ -181,7 +187,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
     # Trajectories are keyed (scene name, speed key as in the summary, alpha or method).
     speeds = list(summary["scenes"][0]["by_operator_speed"])
     columns = max(3, 1 + len(speeds))
-    figure, axes = plt.subplots(2, columns, figsize=(5.2 * columns, 9), squeeze=False)
+    figure, axes = new_figure(2, columns, figsize=(5.2 * columns, 9), squeeze=False)
     scenes_axes, ratio_axes, distance_axes = axes[0, :3]
     for spare in axes[0, 3:]:
         spare.axis("off")
@@ -216,7 +222,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
     _label_axes(distance_axes, "alpha (1: robot only)", "final distance to the goal",
                 "(c) explicit arbitration: final distance against alpha", fontsize=6)
 
-    colour_map = plt.get_cmap("viridis")
+    colour_map = matplotlib.colormaps["viridis"]
     drawn_speed = _trajectory_speed(summary, resolved)
     for index, scene in enumerate(study.scenes):
         colour = SCENE_COLOURS[index % 4]
@@ -238,7 +244,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
                                   f"{_outcome_text(outcomes[method])}")
     for target in (alpha_axes, *pbp_axes):
         _draw_task(target, resolved)
-    mappable = plt.cm.ScalarMappable(cmap=colour_map, norm=plt.Normalize(0, 1))
+    mappable = ScalarMappable(cmap=colour_map, norm=Normalize(0, 1))
     figure.colorbar(mappable, ax=alpha_axes, label="alpha")
     alpha_axes.set_title(f"(d) explicit arbitration, every alpha\n"
                          f"(operator speed {drawn_speed})")
@@ -250,7 +256,7 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
 
 def plot_alt_vs_cont(resolved, summary, path):
     """Fig. 4: the two modes' paths, their y against the phase, and the input."""
-    figure, (path_axes, phase_axes, input_axes) = plt.subplots(1, 3, figsize=(14, 4))
+    figure, (path_axes, phase_axes, input_axes) = new_figure(1, 3, figsize=(14, 4))
     for method, mode in summary["modes"].items():
         label, colour = METHOD_NAMES[method], method_colour(method)
         positions = np.asarray(mode["positions"])

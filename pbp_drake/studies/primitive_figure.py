@@ -2,14 +2,11 @@
 reproduction at its own goal and the shape carried to other goals, from above and from the
 side, drawn with matplotlib (headless)."""
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from pbp_drake.core.dmp.primitive import primitive_bank  # noqa: E402
-from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
+from pbp_drake.core.dmp.primitive import primitive_bank
+from pbp_drake.studies.atomic_files import save_figure
+from pbp_drake.studies.figures import new_figure
 
 # The rollouts' step (s): fine enough for a smooth line at any task's speed.
 STEP = 0.01
@@ -30,7 +27,7 @@ def plot_primitive(primitive, goals, path):
     """Writes the figure to `path` (the module's docstring); `goals` (K, 3) are where the
     shape is carried (the scene's objects)."""
     paths = carried_paths(primitive, goals)
-    figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    figure, axes = new_figure(1, 2, figsize=(11, 4.2))
     for axis, (i, j), view in zip(axes, ((0, 1), (0, 2)), ("from above", "from the side")):
         axis.plot(primitive.positions[:, i], primitive.positions[:, j], ".", ms=3,
                   color="0.55", label="demonstration")
@@ -50,4 +47,3 @@ def plot_primitive(primitive, goals, path):
                     f"{primitive.settings.basis_count} basis functions)")
     figure.tight_layout()
     save_figure(figure, path, dpi=110)
-    plt.close(figure)

@@ -4,12 +4,10 @@ mean, drawn with matplotlib (headless)."""
 
 import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from pbp_drake.studies.atomic_files import save_figure  # noqa: E402
-from pbp_drake.scenarios import METHOD_NAMES  # noqa: E402
-from pbp_drake.studies.questionnaire import QUESTIONS, SCALE, scale_text  # noqa: E402
+from pbp_drake.studies.atomic_files import save_figure
+from pbp_drake.scenarios import METHOD_NAMES
+from pbp_drake.studies.figures import new_figure
+from pbp_drake.studies.questionnaire import QUESTIONS, SCALE, scale_text
 
 FIG8 = "fig8_questionnaire.png"
 
@@ -29,9 +27,9 @@ def plot_questionnaire(answers, methods, path):
     """Writes Fig. 8 to `path`: one panel per question, one bar per method, each answer's
     share of the method's answers, 0 (the worse end, red) to 5 (the better, green), the
     panel's title saying what the ends mean for its question."""
-    colours = plt.get_cmap("RdYlGn")([i / (len(SCALE) - 1) for i in range(len(SCALE))])
-    figure, axes = plt.subplots(1, len(QUESTIONS), figsize=(10, 1.2 + 0.6 * len(methods)),
-                                sharey=True)
+    colours = matplotlib.colormaps["RdYlGn"]([i / (len(SCALE) - 1) for i in range(len(SCALE))])
+    figure, axes = new_figure(1, len(QUESTIONS), figsize=(10, 1.2 + 0.6 * len(methods)),
+                              sharey=True)
     labels = [METHOD_NAMES.get(m, m) for m in methods]
     for panel, (axis, (question, asked)) in enumerate(zip(axes, QUESTIONS.items())):
         counts = answer_counts(answers, methods, question)
@@ -50,4 +48,3 @@ def plot_questionnaire(answers, methods, path):
                   title="answer (higher is better)")
     figure.tight_layout(rect=(0, 0.12, 1, 1))  # room for the legend below the panels
     save_figure(figure, path, dpi=120, bbox_inches="tight")
-    plt.close(figure)

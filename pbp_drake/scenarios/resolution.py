@@ -392,7 +392,6 @@ def _resolve_task_robot(scenario):
         check_virtual_participant(operator)
     if isinstance(operator, (Keyboard, Gamepad)):
         _check_person(operator, scenario.task)
-    _check_reaction_delay(operator, scenario.duration)
     _check_hand_over(scenario)
     task = scenario.task
     if isinstance(robot, Hsr) and robot.hardware is not None:
@@ -547,19 +546,6 @@ def _check_person(operator, task):
     fraction = ("dead_zone",) if isinstance(operator, Gamepad) else ()
     with _refused_as("", f"{type(operator).__name__}.", "scenario.operator."):
         check_params(operator, positive=positive, fraction=fraction)
-
-
-def _check_reaction_delay(operator, duration):
-    """A virtual participant reacts within the trial: one whose delay outlasts it never
-    drives (300 typed for 300 ms), and the trial would be recorded as an operator's."""
-    for field, params in (("scenario.operator", operator),
-                          ("scenario.operator.participant", getattr(operator, "participant",
-                                                                    None))):
-        delay = getattr(params, "reaction_delay", None)
-        if delay is not None and np.max(delay) >= duration:  # a population's: [low, high]
-            raise ScenarioError(f"{field}.reaction_delay {delay} s is not shorter than "
-                                f"scenario.duration {duration:g} s, so the participant would "
-                                "never act; expected seconds, e.g. 0.3")
 
 
 def _check_hand_over(scenario):

@@ -148,18 +148,3 @@ def test_an_obstacle_repulsion_pushing_toward_the_obstacle_is_refused(tmp_path, 
                      "operator.speed=-1.0"])
     assert_refused(code, capsys.readouterr().err,
                    "scenario.operator.speed must be finite and not negative, got -1.0")
-
-
-@pytest.mark.parametrize("operator, words", [
-    ("operator.reaction_delay=300", "scenario.operator.reaction_delay 300.0 s"),
-    ("operator=!NoisyPilot {participant: {reaction_delay: 300}}",
-     "scenario.operator.participant.reaction_delay 300.0 s"),
-    ("operator=!ParticipantPopulation {reaction_delay: [0.2, 90]}",
-     "scenario.operator.reaction_delay [0.2, 90.0] s"),
-])
-def test_a_participant_reacting_after_the_trial_is_refused(capsys, operator, words):
-    # 300 typed for 300 ms: the participant never moved, and the trial ran and was
-    # recorded as its own.
-    code = cli.main(["run", str(DIAGRAMS / "hsr_reach.yaml"), "--operator", "virtual",
-                     "--headless", "--set", operator])
-    assert_refused(code, capsys.readouterr().err, words, "scenario.duration 60 s")

@@ -63,9 +63,10 @@ HERE, AWAY = "pbp_drake_here", "pbp_drake_away"
 # A page unheard this long counts as gone (`pages_present`: a sleeping computer's, a frozen
 # or hung tab's). A tab in view beats each second, unthrottled; a hidden one said AWAY, so
 # the once-a-minute timers of long-hidden tabs and the stopped animation frames (no ACK)
-# never count; the rest is room for a main thread busy a few seconds (meshes parsed by a
-# slow laptop), when no key gets through either.
-SILENCE_LIMIT = 5.0
+# never count. The rest is room for a main thread that stalls (no key gets through then
+# either): a page whose CPU was throttled eight times, on a busy two-core machine, went 8 s
+# without a timer; and even Chrome's answers to websocket pings wait for that thread.
+SILENCE_LIMIT = 10.0
 # A page's bad frame closes its websocket with this code (policy violation); a frame over
 # MAX_MESSAGE bytes, with websockets' 1009.
 BAD_FRAME_CLOSE = 1008

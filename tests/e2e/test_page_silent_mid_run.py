@@ -17,7 +17,7 @@ pytestmark = NEEDS_BROWSER
 
 TOKEN = "a-page-silent-mid-run"
 # s: room, after the hidden tab, for a silence to be noticed (`front.SILENCE_LIMIT`).
-DURATION = 15.0
+DURATION = 20.0
 PAUSED = r"Paused at (\d+\.\d) s: no page is open and in view"
 BACK = r"A page is in view again: the run goes on"
 # The tab's visibility as the browser would report it, announced as the browser would.

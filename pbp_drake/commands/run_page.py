@@ -93,7 +93,7 @@ def keep_page(args, page, console, choices):
     """After a run: the result stays served until the person closes the page (no browser on
     it for `RELOAD_SECONDS`: a reload is not a close), presses one of `choices` or Enter in
     a terminal, or --keep-page seconds pass; the choice, or None."""
-    closed = closed_for(page, min(RELOAD_SECONDS, args.keep_page))
+    closed = closed_for(page.pages, min(RELOAD_SECONDS, args.keep_page))
     while page.pages() == 0:
         if closed():
             return None

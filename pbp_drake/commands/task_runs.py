@@ -99,7 +99,8 @@ def run_task_loop(args, resolved, meshcat, page):
 def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):
     """One run of the task in `diagram`, live in `console` and the terminal: `(TaskResult,
     LiveRun)`. With `start_button` (a label), the task's clock starts when it is pressed.
-    A person's run stands still while its page (`console.panel`) has no browser."""
+    A person's run stands still while its page (`console.panel`) has none present
+    (closed, hidden or silent)."""
     scenario = resolved.scenario
     camera = None
     if args.camera == "robot":

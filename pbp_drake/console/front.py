@@ -56,6 +56,17 @@ SEND_BUFFER = 2**15
 # next animation frame; the next batch waits for it (a client that never answers is sent
 # batches as fast as it reads).
 FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
+# Our page's heartbeat, each second and at once when its tab is shown or hidden: HERE while
+# the tab is in view, AWAY while it is hidden (its keys and pad reach nobody: a hidden page
+# counts as absent at once, whatever its timers do).
+HERE, AWAY = "pbp_drake_here", "pbp_drake_away"
+# A page unheard this long counts as gone (`pages_present`: a sleeping computer's, a frozen
+# or hung tab's). A tab in view beats each second, unthrottled; a hidden one said AWAY, so
+# the once-a-minute timers of long-hidden tabs and the stopped animation frames (no ACK)
+# never count. The rest is room for a main thread that stalls (no key gets through then
+# either): a page whose CPU was throttled eight times, on a busy two-core machine, went 8 s
+# without a timer; and even Chrome's answers to websocket pings wait for that thread.
+SILENCE_LIMIT = 10.0
 # A page's bad frame closes its websocket with this code (policy violation); a frame over
 # MAX_MESSAGE bytes, with websockets' 1009.
 BAD_FRAME_CLOSE = 1008
@@ -139,12 +150,20 @@ body.pbp-ended #status-message { display: none !important; }
     });
     else if (message.data.charAt(0) === "{") { served = true; take(JSON.parse(message.data)); }
   };
+  function beat() {
+    var socket = viewer.connection;
+    if (socket && socket.readyState === WebSocket.OPEN)
+      socket.send(document.hidden ? "AWAY_TEXT" : "HERE_TEXT");
+  }
+  setInterval(beat, 1000);
+  document.addEventListener("visibilitychange", beat);
   // The run's buttons on screen at 1024x640: the Scene tree folded, the control panel open.
   try { viewer.gui.__folders["Scene"].close(); viewer.gui.open(); } catch (e) {}
   poll();
 })();
 </script>
-""".replace("FRAME_TEXT", FRAME).replace("ACK_TEXT", ACK).replace("ENDED_TEXT", ENDED_NOTICE)
+""".replace("FRAME_TEXT", FRAME).replace("ACK_TEXT", ACK).replace("HERE_TEXT", HERE).replace(
+    "AWAY_TEXT", AWAY).replace("ENDED_TEXT", ENDED_NOTICE)
 
 
 def new_token():
@@ -220,6 +239,7 @@ class PageFront:
         self._upstreams, self._closed_upstreams = 0, collections.deque()  # close times
         self._accept_errors = None  # the last accept error's time, in a burst
         self._wakers = set()  # each relay's event: the state changed, send it
+        self._last_heard = {}  # each relay's page -> when it last spoke; None: its tab hidden
         self._door = MeshcatDoor(meshcat_port)
         if not self._door.shut:
             warn(f"Meshcat's port stays open to other programs on this machine "
@@ -261,9 +281,19 @@ class PageFront:
         """How many pages are relayed now: whether a browser is there."""
         return self._relays
 
+    def pages_present(self):
+        """How many relayed pages someone can drive from: heard within `SILENCE_LIMIT`
+        seconds, their tab not hidden (see `HERE`, `AWAY`). A page counts from its
+        connection on."""
+        since = time.monotonic() - SILENCE_LIMIT
+        with self._lock:
+            return sum(heard is not None and heard >= since
+                       for heard in self._last_heard.values())
+
     def pages_heard(self):
-        """How many relayed pages have sent a frame (our page answers its first batch at
-        once): what `BrowserGuard` counts. One that sent nothing cannot press a key."""
+        """How many relayed pages have sent a frame other than `AWAY` (our page's first
+        `HERE` comes within a second): what `BrowserGuard` counts. One that sent nothing
+        cannot press a key."""
         return self._heard
 
     def own_connections(self):
@@ -485,6 +515,13 @@ class PageFront:
         async def to_meshcat():
             nonlocal paced
             async for message in page:
+                with self._lock:  # a hidden tab stays away until it says HERE
+                    if message == HERE or self._last_heard[page] is not None:
+                        self._last_heard[page] = None if message == AWAY else time.monotonic()
+                if message in (HERE, AWAY):
+                    if message == HERE:
+                        hear()  # as an ACK: a page in view, whose keys could drive
+                    continue
                 if message == ACK:
                     hear()
                     paced = True
@@ -534,12 +571,16 @@ class PageFront:
                 await page.send(FRAME)
 
         self._relays += 1
+        with self._lock:
+            self._last_heard[page] = time.monotonic()
         tasks = [asyncio.create_task(job()) for job in (to_meshcat, from_meshcat, to_page)]
         try:
             await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
         finally:
             self._relays -= 1
             self._heard -= heard
+            with self._lock:
+                del self._last_heard[page]
             self._wakers.discard(ready)
             for task in tasks:
                 task.cancel()

@@ -24,10 +24,10 @@ STATUS_PERIOD = 0.25
 NO_GAMEPAD = ("No gamepad in the page: connect one and press any of its buttons (a browser "
               "shows a pad to the page only after a press); until then it drives nothing.")
 GAMEPAD_FOUND = "Gamepad found: it drives now."
-#: What the terminal says while a person's run stands still for want of a page.
-NO_PAGE = ("Paused at {time:.1f} s: no page is open, so nobody drives; reopen {url} to go "
-           "on (Ctrl-C stops the run).")
-PAGE_BACK = "A page is open again: the run goes on."
+#: What the terminal says while a person's run stands still for want of a page in view.
+NO_PAGE = ("Paused at {time:.1f} s: no page is open and in view, so nobody drives; reopen "
+           "{url} or bring its tab back to go on (Ctrl-C stops the run).")
+PAGE_BACK = "A page is in view again: the run goes on."
 # A reload leaves no page for a moment: the run stands still at once, and says so only when
 # no page is back after this many seconds.
 NO_PAGE_QUIET = 2.0
@@ -35,14 +35,14 @@ NO_PAGE_QUIET = 2.0
 NO_PAGE_POLL = 0.05
 
 
-def closed_for(page, seconds):
-    """A test that is true once `page` (a `PageFront`) has had no browser for `seconds` on
-    end, from the first call that finds none."""
+def closed_for(pages, seconds):
+    """A test that is true once `pages()` (a `PageFront`'s `pages` or `pages_present`) has
+    counted none for `seconds` on end, from the first call that finds none."""
     since = None
 
     def closed():
         nonlocal since
-        if page.pages():
+        if pages():
             since = None
             return False
         if since is None:
@@ -102,12 +102,13 @@ class LiveRun:
     forgotten (`BrowserOperator.forget_keys`). With `gamepad`, a page that
     has seen no gamepad is told so (`NO_GAMEPAD`, in the notice line and on stderr).
 
-    With `page` (the run's `PageFront`: `pages()` and `url`) and a person at the diagram's
-    "operator" (a `BrowserOperator`), the run stands still between two slices while no
-    page is open (its clock stopped, its state kept), says so on stderr (`NO_PAGE`) when
-    none is back within `NO_PAGE_QUIET` seconds, and goes on when one is, the closed
-    page's keys and pad forgotten (`BrowserOperator.forget_input`). Ctrl-C meanwhile
-    raises KeyboardInterrupt, as during the run.
+    With `page` (the run's `PageFront`: `pages_present()` and `url`) and a person at the
+    diagram's "operator" (a `BrowserOperator`), the run stands still between two slices
+    while no page is present (closed, hidden or silent: its clock stopped, its state kept),
+    says so on stderr (`NO_PAGE`) when none is back within `NO_PAGE_QUIET` seconds, and
+    goes on when one is, the gone page's keys and pad forgotten
+    (`BrowserOperator.forget_input`). Ctrl-C meanwhile raises KeyboardInterrupt, as during
+    the run.
     """
 
     def __init__(self, diagram, duration, console=None, progress=None, camera=None,
@@ -205,11 +206,11 @@ class LiveRun:
 
     def _wait_for_a_page(self, simulator):
         """Holds a person's run while it has no page (see the class); True when it did."""
-        if self._page is None or self._browser is None or self._page.pages():
+        if self._page is None or self._browser is None or self._page.pages_present():
             return False
         said = False
-        quiet_too_long = closed_for(self._page, NO_PAGE_QUIET)
-        while not self._page.pages():
+        quiet_too_long = closed_for(self._page.pages_present, NO_PAGE_QUIET)
+        while not self._page.pages_present():
             if not said and quiet_too_long():
                 if self._progress is not None:
                     self._progress.finish()  # the line said on a line of its own
@@ -219,7 +220,7 @@ class LiveRun:
             time.sleep(NO_PAGE_POLL)
         if said:
             warn(PAGE_BACK)
-        # What the closed page held (a key, a tilted stick) drives nothing after it.
+        # What the gone page held (a key, a tilted stick) drives nothing after it.
         self._browser.forget_input(simulator.get_mutable_context())
         simulator.ResetStatistics()  # else the run would rush through the pause
         return True

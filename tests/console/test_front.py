@@ -18,8 +18,8 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
 from pbp_drake.console.front import (
-    ACK, FRAME, PageFront, PendingMessages, PortError, bind_page_port, check_token, message_key,
-    new_token)
+    ACK, AWAY, FRAME, HERE, PageFront, PendingMessages, PortError, bind_page_port, check_token,
+    message_key, new_token)
 
 
 @pytest.fixture(autouse=True)
@@ -176,6 +176,26 @@ def test_a_paced_page_gets_the_next_batch_after_its_answer_and_the_panel_at_once
         page.send(ACK)
         assert ("set_object", "/c") in _messages(
             page, lambda seen: ("set_object", "/c") in seen)
+
+
+@pytest.mark.slow
+def test_a_page_is_present_while_it_is_heard_and_its_tab_is_in_view(front, monkeypatch):
+    monkeypatch.setattr("pbp_drake.console.front.SILENCE_LIMIT", 60.0)
+    with _websocket(front, f"?token={front.token}") as page:
+        assert _until(lambda: front.pages() == 1) and front.pages_present() == 1
+        page.send(AWAY)  # its tab hidden: nobody drives from it
+        assert _until(lambda: front.pages_present() == 0) and front.pages_heard() == 0
+        page.send(ACK)  # heard, but what a hidden tab sends keeps it away
+        assert _until(lambda: front.pages_heard() == 1) and front.pages_present() == 0
+        page.send(HERE)
+        assert _until(lambda: front.pages_present() == 1)
+        # Silent, its connection open (a sleeping laptop, a frozen tab): gone, until heard.
+        monkeypatch.setattr("pbp_drake.console.front.SILENCE_LIMIT", 0.5)
+        assert _until(lambda: front.pages_present() == 0) and front.pages() == 1
+        monkeypatch.setattr("pbp_drake.console.front.SILENCE_LIMIT", 60.0)
+        page.send(HERE)
+        assert _until(lambda: front.pages_present() == 1)
+    assert _until(lambda: front.pages() == 0) and front.pages_present() == 0
 
 
 @pytest.mark.slow

@@ -1,7 +1,8 @@
-"""A person's run without its page: while no page is open the run stands still (its clock
-stopped), says so once, and goes on when a page is back, what the closed page held
-forgotten; Ctrl-C meanwhile stops it; a short absence (a reload) is not announced; and a
-run nobody drives (a virtual participant's, a scene's) does not wait for a page."""
+"""A person's run without its page: while no page is present (closed, hidden or silent: see
+test_front.py) the run stands still (its clock stopped), says so once, and goes on when a
+page is back, what the gone page held forgotten; Ctrl-C meanwhile stops it; a short
+absence (a reload) is not announced; and a run nobody drives (a virtual participant's, a
+scene's) does not wait for a page."""
 
 import msgpack
 import numpy as np
@@ -23,8 +24,8 @@ class Panel:
 
 
 class Page:
-    """A page front whose count of open pages follows `counts`, one per call of `pages()`
-    (then 1), the run's simulated time (`clock()`) noted at each call."""
+    """A page front whose count of present pages follows `counts`, one per call of
+    `pages_present()` (then 1), the run's simulated time (`clock()`) noted at each call."""
 
     url = "http://localhost:1/?token=t"
 
@@ -34,7 +35,7 @@ class Page:
         self._interrupt_at = interrupt_at
         self.seen = []  # (count, simulated time) at each call
 
-    def pages(self):
+    def pages_present(self):
         if len(self.seen) == self._interrupt_at:
             raise KeyboardInterrupt  # Ctrl-C, as it comes during the pause's sleep
         count = self._counts.pop(0) if self._counts else 1

@@ -41,8 +41,9 @@ def test_a_run_without_its_page_stands_still_until_it_is_reopened(repo):
             page.wait_for_function("() => Number(document.getElementById('pbp-status')"
                                    ".getAttribute('data-time')) >= 1.0", timeout=120_000)
         # The browser is gone: the run waits, in one line.
-        paused = output.wait_for(r"Paused at (\d+\.\d) s: no page is open, so nobody "
-                                 rf"drives; reopen {re.escape(url)} to go on", timeout=60)
+        paused = output.wait_for(r"Paused at (\d+\.\d) s: no page is open and in view, so "
+                                 rf"nobody drives; reopen {re.escape(url)} or bring its tab "
+                                 "back to go on", timeout=60)
         assert paused, output.text()
         held = float(paused.group(1))
         assert 1.0 <= held < DURATION
@@ -51,7 +52,7 @@ def test_a_run_without_its_page_stands_still_until_it_is_reopened(repo):
         times = {simulated_time(port, TOKEN) for _ in range(20)}
         assert len(times) == 1 and abs(times.pop() - held) <= 0.05 + 1e-9, times
         with open_page(url, (640, 400), timeout_ms=120_000) as page:
-            assert output.wait_for(r"A page is open again: the run goes on", timeout=60), (
+            assert output.wait_for(r"A page is in view again: the run goes on", timeout=60), (
                 output.text())
             # The reopened page has the run's state and its buttons.
             console_line(page, "title").filter(has_text="PBP-Alt, seed 0").wait_for()

@@ -185,6 +185,8 @@ class KeptPage(Panel):
     def pages(self):
         return 1
 
+    pages_present = pages  # in view and heard
+
     def end(self, text=None):
         self.state["ended"] = text
 

@@ -89,13 +89,14 @@ def test_the_driver_path_gives_the_simulated_station_s_hand_path(arm):
 @pytest.mark.slow
 def test_on_the_wall_clock_the_panda_s_commands_carry_the_wall_time_and_are_taken():
     # Both sides on the wall clock in real time, as with a real driver (limits generous,
-    # so that a loaded machine does not end it: the rules' timing is tested above).
+    # so that a loaded machine does not end it: the rules' timing is tested above; 1 s
+    # was once exceeded by 7 ms at a load of 5 on two cores).
     lcm = DrakeLcm("memq://")
-    hardware = ArmHardware(driver="panda", connect=True, status_timeout=1.0,
-                           command_expiry=1.0)
+    hardware = ArmHardware(driver="panda", connect=True, status_timeout=3.0,
+                           command_expiry=3.0)
     builder = DiagramBuilder()
     builder.AddSystem(make_driver_sim("panda", lcm, WALL_CLOCK, START, LOWER, UPPER, VELOCITY,
-                                      with_interface=False, expire_sec=1.0))
+                                      with_interface=False, expire_sec=3.0))
     status = builder.AddSystem(LcmSubscriberSystem.Make("PANDA_STATUS", status_type("panda"),
                                                         lcm))
     link = builder.AddSystem(DriverLink(hardware, lcm, START, LOWER, UPPER, VELOCITY,
@@ -110,7 +111,7 @@ def test_on_the_wall_clock_the_panda_s_commands_carry_the_wall_time_and_are_take
     simulator = Simulator(builder.Build())
     simulator.set_target_realtime_rate(1.0)
     pump(simulator, lcm, 0.3, DRIVERS["panda"].period)
-    assert stamps and all(abs(received - stamp) < 1.0 for received, stamp in stamps)
+    assert stamps and all(abs(received - stamp) < 3.0 for received, stamp in stamps)
     state = np.array(link.GetOutputPort("state").Eval(
         link.GetMyContextFromRoot(simulator.get_context())))
     np.testing.assert_allclose(state[:7], START + 0.02, atol=1e-9)

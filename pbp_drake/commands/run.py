@@ -15,15 +15,16 @@ from pbp_drake.commands.scenario_flags import (
     add_shorthand_flags, load_with_overrides, scenario_overrides)
 from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.signals import stopping_cleanly
-from pbp_drake.commands.task_runs import run_scene, run_task_loop
+from pbp_drake.commands.task_runs import (
+    on_a_real_arm, run_scene, run_task_loop, standing_where_the_arm_stands)
 from pbp_drake.console import CAMERAS
 from pbp_drake.console.front import bind_page_port
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, same_file)
-from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
+from pbp_drake.robots import DriverError, drives_real_robot
 from pbp_drake.robots.task_space_bridge import read_first_state
 from pbp_drake.scenarios import (
-    METHODS, Arm, ScenarioError, TaskScenario, resolve)
+    METHODS, ScenarioError, TaskScenario, resolve)
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
 
 
@@ -110,8 +111,8 @@ def scenario_for_run(args):
             scenario = with_pilot(scenario, args.pilot)
         except ScenarioError as error:
             raise ScenarioError(f"--pilot: {error}") from None
-    if isinstance(scenario.robot, Arm) and drives_real_robot(scenario.robot.hardware):
-        return resolve(_standing_where_the_arm_stands(scenario))
+    if on_a_real_arm(scenario):
+        return resolve(standing_where_the_arm_stands(scenario))
     if args.scene is None:
         return resolve(scenario) if piloted else scenario_file.resolved
     scenes = getattr(scenario_file.study, "scenes", [])
@@ -127,21 +128,6 @@ def scenario_for_run(args):
     scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{args.scene}",
                                    obstacles=list(chosen.obstacles))
     return resolve(scenario)
-
-
-def _standing_where_the_arm_stands(scenario):
-    """`scenario` whose arm starts, and is ready, where its driver's first status says it
-    stands (never where the file assumes)."""
-    robot = scenario.robot
-    try:
-        q = measured_ready_positions(robot.station_config())
-    except DriverError as error:
-        raise ScenarioError(str(error)) from None
-    print(f"The {robot.hardware.driver} driver answers on {robot.hardware.lcm_bus.lcm_url}: "
-          "the arm stands at [" + ", ".join(f"{value:.4f}" for value in q) + "] rad",
-          flush=True)
-    return dataclasses.replace(scenario, robot=dataclasses.replace(
-        robot, initial_positions=[float(value) for value in q], ready_tool_pose=None))
 
 
 def _read_the_robot_s_hand(resolved):

@@ -15,7 +15,8 @@ from pbp_drake.commands.run_page import (
 from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, result_text
 from pbp_drake.console.text import controls_line, failure_text
 from pbp_drake.core.toy_scene import collision_ratio
-from pbp_drake.scenarios import METHODS, Gamepad, GraspTask, resolve
+from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
+from pbp_drake.scenarios import METHODS, Arm, Gamepad, GraspTask, ScenarioError, resolve
 from pbp_drake.scenarios.bounds import is_special_file
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failed
 
@@ -91,9 +92,33 @@ def run_task_loop(args, resolved, meshcat, page):
             end_page(page, console)
             return code
         if choice == "next":
-            resolved = resolve(dataclasses.replace(scenario, seed=scenario.seed + 1))
+            scenario = dataclasses.replace(scenario, seed=scenario.seed + 1)
+        if on_a_real_arm(scenario):  # the arm moved in the run: the next starts where it is
+            resolved = resolve(standing_where_the_arm_stands(scenario))
+        elif choice == "next":
+            resolved = resolve(scenario)
         print(f"{'Restart' if choice == 'restart' else 'Next scene'}: seed "
               f"{resolved.scenario.seed}.", flush=True)
+
+
+def on_a_real_arm(scenario):
+    """Whether `scenario` drives a real arm through its driver (not the driver's simulator)."""
+    return isinstance(scenario.robot, Arm) and drives_real_robot(scenario.robot.hardware)
+
+
+def standing_where_the_arm_stands(scenario):
+    """`scenario` whose arm starts, and is ready, where its driver's first status says it
+    stands (never where the file assumes, nor where a run before this one began)."""
+    robot = scenario.robot
+    try:
+        q = measured_ready_positions(robot.station_config())
+    except DriverError as error:
+        raise ScenarioError(str(error)) from None
+    print(f"The {robot.hardware.driver} driver answers on {robot.hardware.lcm_bus.lcm_url}: "
+          "the arm stands at [" + ", ".join(f"{value:.4f}" for value in q) + "] rad",
+          flush=True)
+    return dataclasses.replace(scenario, robot=dataclasses.replace(
+        robot, initial_positions=[float(value) for value in q], ready_tool_pose=None))
 
 
 def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):

@@ -18,6 +18,7 @@ from pydrake.systems.lcm import LcmSubscriberSystem
 from pydrake.systems.primitives import ConstantVectorSource
 
 from pbp_drake.cli import main
+from pbp_drake.commands import task_runs
 from pbp_drake.robots import (
     ArmHardware, DriverError, arm_driver_sim, arm_initial_ee_state, make_arm_station,
     measured_ready_positions)
@@ -25,9 +26,10 @@ from pbp_drake.robots import arm_driver
 from pbp_drake.robots.arm_driver import (
     SIMULATION_CLOCK, WALL_CLOCK, DriverLink, command_message, read_first_status,
     status_message, status_type)
+from pbp_drake.robots.arm_station import arm_model_plant
 from pbp_drake.robots.arm_station_config import DRIVERS
 from pbp_drake.robots.driver_sim import DriverSimError, make_driver_sim
-from pbp_drake.scenarios import load_scenario_file
+from pbp_drake.scenarios import load_scenario_file, resolve
 
 from first_message import FirstMessage
 
@@ -437,3 +439,34 @@ def test_driver_sim_runs_the_panda_driver_on_the_bus(capsys):
     assert code == 0, out.err
     assert out.out == ("driver-sim: the panda driver reads PANDA_COMMAND and sends "
                        "PANDA_STATUS every 1 ms on memq://; Ctrl-C ends it\n")
+
+
+@pytest.mark.parametrize("choice", ["restart", "next"])
+def test_a_real_arm_s_next_run_starts_where_the_arm_stands_then(choice, monkeypatch):
+    # Restart and Next scene built the next run from the pose read before the first; the
+    # arm had moved in it, so the run ended at once, exit 5, and nothing was driven.
+    scenario = load_scenario_file(REPO / "diagrams" / "panda_reach.yaml").scenario
+    scenario = dataclasses.replace(scenario, robot=dataclasses.replace(
+        scenario.robot, hardware=dataclasses.replace(scenario.robot.hardware, connect=True)))
+    _, arm, q0 = arm_model_plant(scenario.robot.station_config())
+    ready = np.array([q0[joint.position_start()] for joint in arm.joints])
+    stands = iter([ready, ready + [0.05, 0.0, 0.0, 0.05, 0.0, 0.0, 0.0]])
+    monkeypatch.setattr(task_runs, "measured_ready_positions", lambda config: next(stands),
+                        raising=False)
+    built, choices = [], iter([choice, "stop"])
+    monkeypatch.setattr(task_runs, "build_diagram", lambda resolved, meshcat, hand_trail:
+                        built.append((resolved.scenario.seed,
+                                      resolved.scenario.robot.initial_positions)))
+    monkeypatch.setattr(task_runs, "run_task_once", lambda *args: (
+        types.SimpleNamespace(success=True), types.SimpleNamespace(choice=next(choices))))
+    for name in ("page_console", "delete_operator", "end_page"):
+        monkeypatch.setattr(task_runs, name, lambda *args: types.SimpleNamespace(
+            set_choices=lambda choices: None))
+    args = types.SimpleNamespace(start_on_connect=True, hand_trail=False)
+    first = dataclasses.replace(scenario, robot=dataclasses.replace(
+        scenario.robot, initial_positions=list(next(stands)), ready_tool_pose=None))
+    task_runs.run_task_loop(args, resolve(first), None, page=object())
+    seed = scenario.seed
+    assert [(s, list(np.round(q, 4))) for s, q in built] == [
+        (seed, list(np.round(ready, 4))),
+        (seed + (choice == "next"), list(np.round(ready + [0.05, 0, 0, 0.05, 0, 0, 0], 4)))]

@@ -5,8 +5,6 @@ the page's port, the scenario with the command line's overrides, the flags' chec
 import dataclasses
 import sys
 
-from pydrake.lcm import DrakeLcm
-
 from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
 from pbp_drake.commands.run_checks import check_run_flags
 from pbp_drake.commands.run_page import add_page_flags, open_page
@@ -16,13 +14,13 @@ from pbp_drake.commands.scenario_flags import (
 from pbp_drake.commands.session import add_session_flags, run_session_command
 from pbp_drake.commands.signals import stopping_cleanly
 from pbp_drake.commands.task_runs import (
-    on_a_real_arm, run_scene, run_task_loop, standing_where_the_arm_stands)
+    check_the_bridged_robot_s_hand, on_a_real_arm, run_scene, run_task_loop,
+    standing_where_the_arm_stands)
 from pbp_drake.console import CAMERAS
 from pbp_drake.console.front import bind_page_port
 from pbp_drake.output_paths import (
     check_log_path, check_output_folder, check_record_path, same_file)
-from pbp_drake.robots import DriverError, drives_real_robot
-from pbp_drake.robots.task_space_bridge import read_first_state
+from pbp_drake.robots import DriverError
 from pbp_drake.scenarios import (
     METHODS, ScenarioError, TaskScenario, resolve)
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
@@ -130,19 +128,6 @@ def scenario_for_run(args):
     return resolve(scenario)
 
 
-def _read_the_robot_s_hand(resolved):
-    """Before a run through the task-space bridge is built: the robot's relay answers, and
-    its hand stands where the scenario starts it (`read_first_state`)."""
-    bridge = resolved.scenario.robot.hardware
-    try:
-        ee_state = read_first_state(bridge, DrakeLcm(bridge.lcm_bus),
-                                    resolved.initial_ee_state)
-    except DriverError as error:
-        raise ScenarioError(str(error)) from None
-    print(f"The robot's relay answers on {bridge.lcm_bus.lcm_url}: the hand stands at ["
-          + ", ".join(f"{value:.3f}" for value in ee_state[:3]) + "] m", flush=True)
-
-
 def _run(args):
     # The paths first: a bad one must not cost a run, let alone a person's session.
     if args.record is not None:
@@ -169,8 +154,7 @@ def _run(args):
                                 "the task-space bridge (robot.hardware.connect) the robot "
                                 "is on the far side")
         session = check_run_flags(args, resolved)  # the flags' combinations, before the page
-        if not resolved.is_arm and drives_real_robot(hardware):
-            _read_the_robot_s_hand(resolved)  # last: it waits for the robot
+        check_the_bridged_robot_s_hand(resolved)  # last: it waits for the robot
     except BaseException:
         if listening is not None:
             listening.close()

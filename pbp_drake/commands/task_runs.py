@@ -5,6 +5,7 @@ import dataclasses
 import pathlib
 
 import numpy as np
+from pydrake.lcm import DrakeLcm
 
 from pbp_drake.builder import build_diagram, find_system, run_task, run_task_streamed, simulate
 from pbp_drake.cli_types import EXIT_FAILED, EXIT_STOPPED, EXIT_SUCCESS
@@ -16,6 +17,7 @@ from pbp_drake.console import LiveRun, Progress, RobotCamera, method_name, resul
 from pbp_drake.console.text import controls_line, failure_text
 from pbp_drake.core.toy_scene import collision_ratio
 from pbp_drake.robots import DriverError, drives_real_robot, measured_ready_positions
+from pbp_drake.robots.task_space_bridge import read_first_state
 from pbp_drake.scenarios import METHODS, Arm, Gamepad, GraspTask, ScenarioError, resolve
 from pbp_drake.scenarios.bounds import is_special_file
 from pbp_drake.studies.atomic_files import is_disk_failure, write_failed
@@ -97,6 +99,7 @@ def run_task_loop(args, resolved, meshcat, page):
             resolved = resolve(standing_where_the_arm_stands(scenario))
         elif choice == "next":
             resolved = resolve(scenario)
+        check_the_bridged_robot_s_hand(resolved)  # the hand moved: it must be back at the start
         print(f"{'Restart' if choice == 'restart' else 'Next scene'}: seed "
               f"{resolved.scenario.seed}.", flush=True)
 
@@ -119,6 +122,22 @@ def standing_where_the_arm_stands(scenario):
           flush=True)
     return dataclasses.replace(scenario, robot=dataclasses.replace(
         robot, initial_positions=[float(value) for value in q], ready_tool_pose=None))
+
+
+def check_the_bridged_robot_s_hand(resolved):
+    """Before a run through the task-space bridge to a robot is built: the robot's relay
+    answers, and its hand stands where the scenario starts it (`read_first_state`); nothing
+    for another robot."""
+    bridge = getattr(resolved.scenario.robot, "hardware", None)
+    if resolved.is_arm or not drives_real_robot(bridge):
+        return
+    try:
+        ee_state = read_first_state(bridge, DrakeLcm(bridge.lcm_bus),
+                                    resolved.initial_ee_state)
+    except DriverError as error:
+        raise ScenarioError(str(error)) from None
+    print(f"The robot's relay answers on {bridge.lcm_bus.lcm_url}: the hand stands at ["
+          + ", ".join(f"{value:.3f}" for value in ee_state[:3]) + "] m", flush=True)
 
 
 def run_task_once(args, resolved, diagram, meshcat, console, start_button=None):

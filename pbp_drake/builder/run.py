@@ -6,12 +6,13 @@ replaces `advance_to`: the operator's console (`pbp_drake.console.LiveRun`) adva
 slices and may end the run early.
 """
 
+import contextlib
 import dataclasses
 
 import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorStatus
 
-from pbp_drake.builder.build import build_diagram
+from pbp_drake.builder.build import build_diagram, find_system
 from pbp_drake.builder.grasp import grasp_series_fields
 from pbp_drake.core.coordinates import is_real
 from pbp_drake.core.interaction_metrics import InteractionMeter, idle_ratio
@@ -295,7 +296,8 @@ def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=N
     scenario, diagram, simulator = initialized_simulator(scenario, meshcat, realtime_rate,
                                                          diagram, task=True)
     # The task monitor itself ends the simulation at success.
-    (advance or advance_to)(simulator, (ticks_of(scenario) + 1) * scenario.control_period)
+    with robot_told_to_hold(diagram, simulator):
+        (advance or advance_to)(simulator, (ticks_of(scenario) + 1) * scenario.control_period)
     context = simulator.get_context()
     state_log = state_log_name(diagram)
     # The last sample holds only the decisions of the tick before it (see read_log).
@@ -310,6 +312,21 @@ def run_task(scenario, meshcat=None, realtime_rate=None, diagram=None, advance=N
     peaks.add_clipped(read_log(diagram, context, "posterior_clipped_log", tick_count,
                                shift=DECISION_LOG_SHIFT)[1])
     return peaks.task_result(diagram, context, series)
+
+
+@contextlib.contextmanager
+def robot_told_to_hold(diagram, simulator):
+    """Tells the robot on the far side of a task-space bridge in `diagram` to hold however
+    its run ends, Ctrl-C and the bridge's own errors included (`BridgeLink.send_hold`)."""
+    try:
+        yield
+    finally:
+        try:
+            link = find_system(diagram, "bridge_link")
+        except KeyError:
+            link = None
+        if link is not None:
+            link.send_hold(link.GetMyContextFromRoot(simulator.get_context()))
 
 
 def final_joints_at_limits(diagram, context):

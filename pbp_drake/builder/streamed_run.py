@@ -10,7 +10,7 @@ from pydrake.systems.primitives import VectorLogSink
 
 from pbp_drake.builder.run import (
     DECISION_LOGS, OPTIONAL_DECISION_LOGS, STATE_LOGS, SeriesPeaks, advance_to,
-    initialized_simulator, state_log_name, task_series, ticks_of)
+    initialized_simulator, robot_told_to_hold, state_log_name, task_series, ticks_of)
 from pbp_drake.builder.time_series import time_series_header, time_series_rows
 from pbp_drake.systems.tick import DECISION_LOG_SHIFT
 
@@ -33,7 +33,7 @@ def run_task_streamed(scenario, log_path, meshcat=None, realtime_rate=None, diag
     tail = _LogTail(diagram)
     peaks = SeriesPeaks(period)
     context = simulator.get_context()
-    with open(log_path, "w", newline="") as stream:
+    with open(log_path, "w", newline="") as stream, robot_told_to_hold(diagram, simulator):
         stream.write(time_series_header(tail.has_collision, tail.has_grasp))
         tick = 0
         while True:

@@ -126,6 +126,20 @@ def check_heard(now, started_at, heard_at, connect_timeout, status_timeout, firs
     return True
 
 
+def check_on_the_wall_clock(context, offset, expiry, then):
+    """Raises DriverError ("...: `then`") when the simulation at `context` runs more than
+    `expiry` s behind or ahead of the wall clock, `offset` the wall clock less the
+    simulation's time when the link started. Ahead, each command's speed limit would hold
+    in simulated time only: the robot would be sent faster than its limits; behind, a
+    stalled loop would go unseen and then rush to catch up."""
+    lag = time.time() - context.get_time() - offset
+    if abs(lag) > expiry:
+        raise DriverError(
+            f"the control loop ran {abs(lag):.3f} s {'behind' if lag > 0 else 'ahead of'} "
+            f"the wall clock (at most {expiry:g} s; the simulator's real-time rate must be "
+            f"1): {then}")
+
+
 def first_message(lcm, channel, decode, timeout, missing):
     """The first message on `channel` of `lcm` (a DrakeLcm that no `LcmInterfaceSystem`
     pumps: this subscribes a Python callback), decoded by `decode`, waiting at most
@@ -235,15 +249,8 @@ class DriverLink(LeafSystem):
                        hardware.status_timeout, self._first, self._silent,
                        "the arm holds where it was last commanded"):
             if self._clock == WALL_CLOCK:
-                lag = time.time() - context.get_time() - x[self._OFFSET]
-                # Ahead, each command's velocity limit would hold in simulated time only:
-                # the arm would be sent faster than its limits.
-                if abs(lag) > hardware.command_expiry:
-                    raise DriverError(
-                        f"the control loop ran {abs(lag):.3f} s "
-                        f"{'behind' if lag > 0 else 'ahead of'} the wall clock (at most "
-                        f"{hardware.command_expiry:g} s; the simulator's real-time rate must "
-                        "be 1): the arm holds where it was last commanded")
+                check_on_the_wall_clock(context, x[self._OFFSET], hardware.command_expiry,
+                                        "the arm holds where it was last commanded")
             if now - x[self._FIRST_AT] >= self._driver.start_guard:
                 x[self._SENT] = self._command(context, x)
                 x[self._SEND] = 1.0

@@ -7,7 +7,8 @@ user writes (docs/tasks/real-arm.md shows one for a ROS robot)::
         ─► LcmSubscriberSystem ─► BridgeLink ─► ee_state
 
 `BridgeLink` keeps the arm drivers' rules (`pbp_drake.robots.arm_driver`) where they
-apply to any robot; messages are stamped (`timestamp`, µs) on the simulation's clock.
+apply to any robot, on the wall clock unless the robot's side is simulated in the same
+process (`driver_sim`); messages are stamped (`timestamp`, µs) on the simulation's clock.
 """
 
 import dataclasses
@@ -19,7 +20,9 @@ from pydrake.lcm import DrakeLcm, DrakeLcmParams
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.lcm import LcmInterfaceSystem, LcmSubscriberSystem
 
-from pbp_drake.robots.arm_driver import DriverError, check_heard, first_message
+from pbp_drake.robots.arm_driver import (
+    SIMULATION_CLOCK, WALL_CLOCK, DriverError, check_heard, check_on_the_wall_clock, clock_now,
+    first_message)
 from pbp_drake.robots.arm_station_config import DEFAULT_LCM_URL, validate_link
 from pbp_drake.robots.hsr_station_config import check_config_type
 from pbp_drake.systems.ports import EeCommand, EeState
@@ -46,6 +49,8 @@ class TaskSpaceBridgeConfig:
     status_timeout: float = 0.2
     #: How long (s) the bridge waits for the first state.
     connect_timeout: float = 5.0
+    #: How far (s) the control loop may run behind, or ahead of, the wall clock.
+    command_expiry: float = 0.1
     #: How far (m) the hand in the robot's first state may stand from the start the run
     #: was built for (the scenario's).
     start_tolerance: float = 0.05
@@ -64,7 +69,7 @@ def validate_task_space_bridge(config: TaskSpaceBridgeConfig) -> None:
             raise ValueError(f"TaskSpaceBridgeConfig.{name} must be a channel name, got "
                              f"{getattr(config, name)!r}")
     validate_link(config, "TaskSpaceBridgeConfig",
-                  ("status_timeout", "connect_timeout", "start_tolerance"))
+                  ("status_timeout", "connect_timeout", "command_expiry", "start_tolerance"))
 
 
 def checked_ee_state(value):
@@ -133,9 +138,10 @@ def read_first_state(config: TaskSpaceBridgeConfig, lcm, initial_ee_state):
 
 class BridgeLink(LeafSystem):
     """The station's side of a task-space bridge: nothing is sent before a fresh state; a
-    state silent for `status_timeout`, of the wrong size or with a NaN, or a first state
-    farther than `start_tolerance` from the run's start, ends the run with `DriverError`
-    and sends nothing more.
+    state silent for `status_timeout`, of the wrong size or with a NaN, a first fresh state
+    farther than `start_tolerance` from the run's start, or (on the wall clock) a loop
+    `command_expiry` off the wall clock ends the run with `DriverError` and sends nothing
+    more but `send_hold`'s command.
 
     .. pydrake_system::
 
@@ -148,20 +154,21 @@ class BridgeLink(LeafSystem):
 
     ``state_message`` is the last ``lcmt_drake_signal`` on the state channel (an
     ``LcmSubscriberSystem``'s output); ``ee_state`` the robot's ``EeState`` as the relay
-    last sent it (``initial_ee_state`` before). The command is sent in a publish event
-    after each control period's check.
+    last sent it (``initial_ee_state`` before its first fresh state). The command is sent
+    in a publish event after each control period's check.
     """
 
     def __init__(self, config, lcm, initial_ee_state, control_period):
         super().__init__()
         self._config, self._lcm = config, lcm
+        self._clock = SIMULATION_CLOCK if config.driver_sim else WALL_CLOCK
         channel, bus = config.state_channel, config.lcm_bus.lcm_url
         self._first = f"state from the robot's relay on {channel} (bus {bus})"
         self._silent = f"the robot's state on {channel} (bus {bus})"
-        # State: when the last state message came, its stamp, the first update's time,
-        # whether this update sends.
-        self._AT, self._STAMP, self._STARTED, self._SEND = range(4)
-        self._index = self.DeclareDiscreteState([np.nan, -1.0, np.nan, 0.0])
+        # State: when the last fresh state message came (our clock), its stamp, the first
+        # update's time and its wall clock less the simulation's, whether this update sends.
+        self._AT, self._STAMP, self._STARTED, self._OFFSET, self._SEND = range(5)
+        self._index = self.DeclareDiscreteState([np.nan, -1.0, np.nan, np.nan, 0.0])
         self.DeclareAbstractInputPort("state_message", Value(lcmt_drake_signal()))
         self.DeclareVectorInputPort("ee_command", EeCommand.size)
         self._initial = np.asarray(initial_ee_state, float)
@@ -177,25 +184,46 @@ class BridgeLink(LeafSystem):
         # The last message itself, not a sample of it: a controller that updates at the
         # same instant reads the robot's latest state.
         message = self.get_input_port(0).Eval(context)
-        output.SetFromVector(np.asarray(message.val, float) if message.dim == EeState.size
-                             else self._initial)
+        fresh = not np.isnan(context.get_discrete_state(self._index).value()[self._AT])
+        output.SetFromVector(np.asarray(message.val, float) if fresh else self._initial)
 
     def _update(self, context, discrete_state):
         x = np.array(context.get_discrete_state(self._index).value())
-        now, config = context.get_time(), self._config
+        now, config = clock_now(self._clock, context), self._config
         if np.isnan(x[self._STARTED]):
             x[self._STARTED] = now
+            x[self._OFFSET] = clock_now(WALL_CLOCK, context) - context.get_time()
         message = self.get_input_port(0).Eval(context)
         if message.dim and message.timestamp != x[self._STAMP]:
-            values = checked_state(message, config)
-            if np.isnan(x[self._AT]):
-                check_hand_start(values, self._initial, config.start_tolerance)
-            x[self._AT], x[self._STAMP] = now, message.timestamp
+            if x[self._STAMP] < 0:
+                # A udpm:// bus keeps the first message that came since it was last handled
+                # and drops the later ones: at the run's first step, one as old as the
+                # station (the page's wait for Start included). The next one is fresh.
+                x[self._STAMP] = message.timestamp
+            else:
+                values = checked_state(message, config)
+                if np.isnan(x[self._AT]):
+                    check_hand_start(values, self._initial, config.start_tolerance)
+                x[self._AT], x[self._STAMP] = now, message.timestamp
+        then = "nothing more is sent, the robot is told to hold"
         heard = check_heard(now, x[self._STARTED], x[self._AT], config.connect_timeout,
-                            config.status_timeout, self._first, self._silent,
-                            "nothing more is sent")
+                            config.status_timeout, self._first, self._silent, then)
+        if heard and self._clock == WALL_CLOCK:
+            check_on_the_wall_clock(context, x[self._OFFSET], config.command_expiry, then)
         x[self._SEND] = float(heard)
         discrete_state.set_value(self._index, x)
+
+    def send_hold(self, context):
+        """Sends the last command with no velocity, once the run has ended however it
+        ended (`pbp_drake.builder.run`): a relay that passes the velocity on would keep the
+        robot moving. Nothing when nothing was sent."""
+        if np.isnan(context.get_discrete_state(self._index).value()[self._AT]):
+            return
+        held = EeCommand(np.array(self.get_input_port(1).Eval(context), float))
+        held.vx = held.vy = held.vz = 0.0
+        if np.all(np.isfinite(held[:])):
+            self._lcm.Publish(self._config.command_channel, signal(
+                held[:], COMMAND_FIELDS, context.get_time()).encode())
 
     def _send(self, context):
         x = context.get_discrete_state(self._index).value()

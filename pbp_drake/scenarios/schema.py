@@ -456,9 +456,9 @@ class AlphaStudy:
     #: names each by `alpha_key`).
     alphas: list[float] = dataclasses.field(
         default_factory=lambda: [round(0.1 * i, 1) for i in range(11)])
-    #: The virtual operator's speeds (its `speed`) at which every scene runs: the summary
-    #: holds each scene's results per speed. Empty (the default): only the scenario
-    #: operator's own speed. The paper's Eq. 5 pushes at 1.
+    #: The virtual operator's speeds (its `speed`) at which every scene runs, beside the
+    #: scenario operator's own speed: the summary holds each scene's results per speed.
+    #: The paper's Eq. 5 pushes at 1.
     operator_speeds: list[float] = dataclasses.field(default_factory=list)
     #: A run reached the goal when it ends this close to it (AltVsCont's tolerance). Reported
     #: beside the collision ratio; the ideal alpha stays the paper's (no collision).

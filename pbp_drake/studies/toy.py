@@ -55,9 +55,12 @@ PBP_METHODS = methods_of("pbp")
 
 
 def operator_speeds(scenario, study):
-    """The operator speeds each scene runs at: the study's `operator_speeds`, or else the
-    scenario operator's own speed (None for an operator without one)."""
-    return list(study.operator_speeds) or [getattr(scenario.operator, "speed", None)]
+    """The operator speeds each scene runs at: the study's `operator_speeds` and the
+    scenario operator's own speed (None for an operator without one), the speed
+    `pbp-drake run` shows, last unless listed."""
+    speeds = list(study.operator_speeds)
+    own = getattr(scenario.operator, "speed", None)
+    return speeds if speed_key(own) in map(speed_key, speeds) else speeds + [own]
 
 
 def speed_key(speed):

@@ -5,6 +5,7 @@ import json
 
 import pytest
 
+from pbp_drake import cli
 from pbp_drake.scenarios import load_scenario_file
 from pbp_drake.scenarios.loading import check_operator_speeds
 from pbp_drake.scenarios.schema import ScenarioError
@@ -60,3 +61,18 @@ def test_operator_speeds_are_checked_when_the_file_loads(repo):
     with pytest.raises(ScenarioError, match="goal_tolerance"):
         check_operator_speeds(dataclasses.replace(loaded.study, goal_tolerance=0.0),
                               loaded.scenario)
+
+
+def test_the_scenario_operator_s_own_speed_runs_beside_the_listed_ones(repo, tmp_path):
+    # An edited operator.speed was ignored while study.operator_speeds listed others, and
+    # panel (d), "at the scenario's speed", drew the first listed speed.
+    output = tmp_path / "study"
+    assert cli.main(["study", str(repo / "diagrams/toy_alpha_study.yaml"), "--output",
+                     str(output), "--set", "operator.speed=3", "--set",
+                     "study.operator_speeds=[1]", "--set", "study.alphas=[0.5]", "--set",
+                     "study.scenes=[{name: s, obstacles: [{center: [0.5, 0.3], "
+                     "radius: 0.2}]}]"]) == 0
+    by_speed = json.loads((output / "summary.json").read_text())["scenes"][0][
+        "by_operator_speed"]
+    assert list(by_speed) == ["1", "3"]
+    assert by_speed["3"]["measured_operator_speed"] == pytest.approx(3.0)

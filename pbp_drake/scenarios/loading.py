@@ -19,7 +19,7 @@ from pbp_drake.scenarios.bounds import (
     check_yaml_bounds, is_special_file, load_document, load_typed, read_bounded)
 from pbp_drake.scenarios.overrides import ScenarioOverrides, merged
 from pbp_drake.scenarios.resolution import (
-    ResolvedScenario, check_obstacles, resolve, with_method)
+    ResolvedScenario, check_obstacles, demonstration_samples, resolve, with_method)
 from pbp_drake.scenarios.schema import (
     HSR_OPERATORS, RANGE, STUDY_SPLITS, TOY_OPERATORS, AlphaStudy, AltVsCont, Arm, alpha_key,
     MethodComparison, PointRobot, PointScenario, Scenario, ScenarioError, ScenarioFile,
@@ -392,6 +392,13 @@ def check_alpha_study(study, scenario, dimension):
             raise ScenarioError(f"study.alphas has {key} twice; give each alpha once")
     if scenario.demonstration is None:
         raise ScenarioError("the alpha study needs scenario.demonstration")
+    # Explicit arbitration plays the demonstration to its end: with the goal elsewhere, which
+    # PBP's DMPs reach, every alpha would fall short of it.
+    end = scenario.goals and np.round(demonstration_samples(scenario.demonstration)[1][-1], 6)
+    if scenario.goals and not np.allclose(scenario.goals, [end]):
+        raise ScenarioError(f"scenario.goals {scenario.goals} is not where "
+                            f"scenario.demonstration ends, {end.tolist()}: the alpha study "
+                            "plays the demonstration as P; move its goal instead")
     check_operator_speeds(study, scenario)
     names = [scene.name for scene in study.scenes]
     for index, scene in enumerate(study.scenes):

@@ -64,6 +64,16 @@ def test_study_refuses_an_alpha_given_twice(tmp_path, capsys):
     assert not (tmp_path / "study").exists()
 
 
+def test_alpha_study_refuses_a_goal_the_demonstration_does_not_end_at(tmp_path, capsys):
+    # Explicit arbitration played the demonstration to (1, 0) and every alpha was reported
+    # short of the goal (1, 0.3), which PBP's DMPs reached, exit 0.
+    code = cli.main(["study", str(DIAGRAMS / "toy_alpha_study.yaml"), "--output",
+                     str(tmp_path / "study"), "--set", "goals=[[1.0, 0.3]]"])
+    assert_refused(code, capsys.readouterr().err, "scenario.goals [[1.0, 0.3]]",
+                   "scenario.demonstration ends, [1.0, 0.0]")
+    assert not (tmp_path / "study").exists()
+
+
 @pytest.mark.slow
 def test_alphas_alike_to_two_decimals_are_each_named_by_all_their_digits(tmp_path, capsys):
     # They were named by two decimals: 0.501's results overwrote 0.5's, and 0.125 was

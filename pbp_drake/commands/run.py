@@ -2,7 +2,6 @@
 session of a user study): their flags, and what both do before anything runs (the paths,
 the page's port, the scenario with the command line's overrides, the flags' checks)."""
 
-import dataclasses
 import sys
 
 from pbp_drake.cli_types import EXIT_DRIVER, realtime_rate
@@ -24,6 +23,7 @@ from pbp_drake.robots import DriverError
 from pbp_drake.scenarios import (
     METHODS, ScenarioError, TaskScenario, resolve)
 from pbp_drake.scenarios.pilots import ATTENTIVE, PILOT_NAMES, with_pilot
+from pbp_drake.studies.toy import scene_scenario
 
 
 def add_run_command(commands):
@@ -122,10 +122,7 @@ def scenario_for_run(args):
     if args.scene not in names:
         raise ScenarioError(f"--scene {args.scene!r} is not in this file's study; "
                             f"scenes: {names}")
-    chosen = scenes[names.index(args.scene)]
-    scenario = dataclasses.replace(scenario, name=f"{scenario.name}/{args.scene}",
-                                   obstacles=list(chosen.obstacles))
-    return resolve(scenario)
+    return resolve(scene_scenario(scenario, scenes[names.index(args.scene)]))
 
 
 def _run(args):

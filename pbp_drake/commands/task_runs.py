@@ -210,7 +210,9 @@ def why_failed(result, scenario, log=None):
     grasping = isinstance(scenario.task, GraspTask)
     return failure_text(target, len(result.objects), distance,
                         None if grasping else scenario.task.success_distance,
-                        result.joints_at_limits or ())
+                        result.joints_at_limits or (),
+                        "grasp" if grasping and scenario.task.grasps_per_object > 1
+                        else "object")
 
 
 def last_row(path, tail_bytes=2**16):

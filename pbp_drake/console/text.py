@@ -44,14 +44,16 @@ def result_text(success, task_time, stopped=False, why=None):
     return "failed: time limit" + ("" if why is None else f"; {why}")
 
 
-def failure_text(target, target_count, distance, success_distance=None, joints=()):
+def failure_text(target, target_count, distance, success_distance=None, joints=(),
+                 goal="object"):
     """Where a failed run ended: "the target was object 2 of 3, the hand 0.213 m from it
-    (success within 0.050 m)"; `target` counts from 0, `success_distance` None leaves the
-    bracket out; then the robot's `joints` that stand at a position limit, by name (the
-    hand may be held there, short of the target)."""
+    (success within 0.050 m)"; `target` counts from 0 among `target_count` goals, each a
+    `goal` (a grasping task of many grasps an object counts grasps), `success_distance`
+    None leaves the bracket out; then the robot's `joints` that stand at a position limit,
+    by name (the hand may be held there, short of the target)."""
     within = "" if success_distance is None else f" (success within {success_distance:.3f} m)"
     held = f"; at a joint limit: {', '.join(joints)}" if joints else ""
-    return (f"the target was object {target + 1} of {target_count}, the hand "
+    return (f"the target was {goal} {target + 1} of {target_count}, the hand "
             f"{distance:.3f} m from it{within}{held}")
 
 

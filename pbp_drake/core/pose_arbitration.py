@@ -84,11 +84,18 @@ def blend_pose(mode, robot_position, robot_orientation, policy, twist, active, d
     `policy` is the policy's `PoseReference` (the selected DMP's next pose and twist);
     `twist` the operator's `(vx, vy, vz, wx, wy, wz)`, refused when NaN or infinite;
     `active` whether the operator acts; `alpha` the weight of ``fixed_alpha`` and
-    ``confidence_alpha``. The result is signed as the robot's orientation."""
+    ``confidence_alpha``. The orientations must be unit quaternions (within
+    `quaternion.UNIT_TOLERANCE`), else ValueError. The result is signed as the robot's
+    orientation."""
     twist = validate_twist(twist)
     linear, angular = twist[:3], twist[3:]
     robot_orientation = np.asarray(robot_orientation, dtype=float)
     policy = PoseReference(*(np.asarray(part, dtype=float) for part in policy))
+    for name, orientation in (("robot_orientation", robot_orientation),
+                              ("policy orientation", policy.orientation)):
+        # Checked, not divided by its norm: a quaternion of norm 2 would turn out of norm 2.
+        if abs(np.linalg.norm(orientation) - 1.0) > quaternion.UNIT_TOLERANCE:
+            quaternion.unit_quaternions(orientation, name)  # raises, naming it
     policy = policy._replace(orientation=quaternion.aligned(policy.orientation,
                                                             robot_orientation))
     reference = played_reference(mode, active, alpha, POSE_BLEND_LAWS)

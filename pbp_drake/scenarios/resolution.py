@@ -21,7 +21,8 @@ from pbp_drake.core.controller_config import PbpControllerConfig
 from pbp_drake.core.coordinates import check_positions
 from pbp_drake.core.dmp import DmpBankModel, validate_demonstration
 from pbp_drake.core.dmp.primitive import SETTINGS_FIELDS, read_primitive_document
-from pbp_drake.core.goal_estimation import READS_INTENT, READS_POSE, estimator_entry
+from pbp_drake.core.goal_estimation import (
+    ESTIMATORS, READS_INTENT, READS_POSE, READS_POSITION, estimator_entry)
 from pbp_drake.core.choices import did_you_mean
 from pbp_drake.core.methods import METHODS, method_entry
 from pbp_drake.core.toy_scene import bent_path
@@ -196,10 +197,17 @@ def _check_common(scenario):
     with _refused_as("scenario."):
         scenario.validate_settings()
     require_finite(scenario, "scenario", ("duration",))
-    if (estimator_entry(scenario.goal_estimator.method).reads == READS_POSE
-            and not isinstance(getattr(scenario, "task", None), GraspTask)):
-        raise ScenarioError(f"scenario.goal_estimator.method {scenario.goal_estimator.method} "
+    estimator, grasping = scenario.goal_estimator.method, isinstance(
+        getattr(scenario, "task", None), GraspTask)
+    reads = estimator_entry(estimator).reads
+    if reads == READS_POSE and not grasping:
+        raise ScenarioError(f"scenario.goal_estimator.method {estimator} "
                             f"reads grasp orientations: use it with task: !GraspTask {{...}}")
+    if reads == READS_POSITION and grasping:  # the grasp builder has no position form
+        raise ScenarioError(f"scenario.goal_estimator.method {estimator} reads positions "
+                            "alone; the grasping task takes one that reads grasp poses: "
+                            + ", ".join(name for name, entry in ESTIMATORS.items()
+                                        if entry.reads != READS_POSITION))
     check_time_steps([("scenario.control_period", scenario.control_period)])
     check_duration(scenario.duration, scenario.control_period)
     check_simulator(scenario.simulator)

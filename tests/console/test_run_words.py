@@ -64,6 +64,11 @@ def test_a_failed_run_says_which_target_and_how_far(repo):
                    "0.050 m)")
     assert result_text(False, 40.0, why=why) == f"failed: time limit; {why}"
     assert failure_text(0, 4, 1.25) == "the target was object 1 of 4, the hand 1.250 m from it"
+    # With many grasps an object the targets are grasps: 2 objects of 3 grasps are 6.
+    grasps = scenario(repo, "hsr_grasp.yaml", "task.grasps_per_object=3")
+    failed_grasp = result(False, [1.2, 0.5, 0.7], 4, [[1.5, 0.5, 0.7]] * 6)
+    assert why_failed(failed_grasp, grasps) == ("the target was grasp 5 of 6, the hand "
+                                                "0.300 m from it")
     # A robot whose joints stand at a limit says which: the hand may be held there.
     held = dataclasses.replace(failed, joints_at_limits=["wrist_flex_joint", "arm_lift_joint"])
     assert why_failed(held, reach) == f"{why}; at a joint limit: wrist_flex_joint, arm_lift_joint"

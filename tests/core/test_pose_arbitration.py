@@ -97,6 +97,18 @@ def test_a_nan_twist_is_refused_with_its_field_named(mode, field, index):
         blend(mode, alpha=0.5, twist=twist)
 
 
+@pytest.mark.parametrize("mode", ["teleop", "fixed_alpha"])
+def test_an_orientation_that_is_not_a_unit_quaternion_is_refused(mode):
+    # Neither is divided by its norm: twice the hand's quaternion would come out of norm 2.
+    with pytest.raises(ValueError, match="robot_orientation is not a unit quaternion .* has "
+                                         "norm 2;"):
+        blend_pose(mode, ROBOT_POSITION, 2.0 * ROBOT_ORIENTATION, POLICY, TWIST, True, DT,
+                   0.5)
+    tilted = POLICY._replace(orientation=1.01 * POLICY.orientation)
+    with pytest.raises(ValueError, match="policy orientation is not a unit quaternion"):
+        blend_pose(mode, ROBOT_POSITION, ROBOT_ORIENTATION, tilted, TWIST, True, DT, 0.5)
+
+
 def test_a_twist_of_the_wrong_size_is_refused():
     with pytest.raises(ValueError, match=r"operator_twist must be 6 numbers .*, got 5"):
         validate_twist(np.zeros(5))

@@ -115,6 +115,18 @@ def test_the_pose_estimator_needs_the_grasping_task(repo):
         resolve(scenario)
 
 
+@pytest.mark.parametrize("estimator", ["angle", "nearest", "bayesian"])
+def test_a_position_estimator_is_refused_by_the_grasping_task(repo, capsys, estimator):
+    arguments = ["run", str(repo / "diagrams" / "hsr_grasp.yaml"), "--no-meshcat",
+                 "--set", f"goal_estimator.method={estimator}"]
+    assert cli.main(arguments) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1
+    assert error.endswith(f"scenario.goal_estimator.method {estimator} reads positions alone; "
+                          "the grasping task takes one that reads grasp poses: pose, "
+                          "maxent_command, intent_filter\n")
+
+
 def test_a_yaml_typo_in_the_task_names_the_key(shipped, tmp_path):
     text = shipped.path.read_text().replace("roll_range:", "rol_range:")
     path = tmp_path / "grasp.yaml"

@@ -32,6 +32,7 @@ from pbp_drake.robots.driver_sim import DriverSimError, make_driver_sim
 from pbp_drake.scenarios import load_scenario_file, resolve
 
 from first_message import FirstMessage
+from run_loop import run_loop
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 LOWER, UPPER = np.full(7, -2.5), np.full(7, 2.5)
@@ -453,19 +454,10 @@ def test_a_real_arm_s_next_run_starts_where_the_arm_stands_then(choice, monkeypa
     stands = iter([ready, ready + [0.05, 0.0, 0.0, 0.05, 0.0, 0.0, 0.0]])
     monkeypatch.setattr(task_runs, "measured_ready_positions", lambda config: next(stands),
                         raising=False)
-    built, choices = [], iter([choice, "stop"])
-    monkeypatch.setattr(task_runs, "build_diagram", lambda resolved, meshcat, hand_trail:
-                        built.append((resolved.scenario.seed,
-                                      resolved.scenario.robot.initial_positions)))
-    monkeypatch.setattr(task_runs, "run_task_once", lambda *args: (
-        types.SimpleNamespace(success=True), types.SimpleNamespace(choice=next(choices))))
-    for name in ("page_console", "delete_operator", "end_page"):
-        monkeypatch.setattr(task_runs, name, lambda *args: types.SimpleNamespace(
-            set_choices=lambda choices: None))
-    args = types.SimpleNamespace(start_on_connect=True, hand_trail=False)
     first = dataclasses.replace(scenario, robot=dataclasses.replace(
         scenario.robot, initial_positions=list(next(stands)), ready_tool_pose=None))
-    task_runs.run_task_loop(args, resolve(first), None, page=object())
+    built = run_loop(monkeypatch, resolve(first), [choice, "stop"], lambda resolved: (
+        resolved.scenario.seed, resolved.scenario.robot.initial_positions))
     seed = scenario.seed
     assert [(s, list(np.round(q, 4))) for s, q in built] == [
         (seed, list(np.round(ready, 4))),

@@ -29,6 +29,7 @@ from pbp_drake.robots.task_space_bridge import (
     make_task_space_bridge, read_first_state, signal)
 
 from first_message import FirstMessage
+from run_loop import run_loop
 
 PERIOD = 0.1
 HSR_REACH = str(pathlib.Path(__file__).resolve().parents[2] / "diagrams" / "hsr_reach.yaml")
@@ -370,17 +371,10 @@ def test_restart_and_next_scene_say_where_the_robot_s_hand_must_be_brought(choic
     start = resolve(scenario).initial_ee_state
     state = signal(start + np.array([0.1] + [0.0] * 7), STATE_FIELDS, 1.0)
     monkeypatch.setattr(task_runs, "DrakeLcm", lambda bus: FirstMessage("PBP_EE_STATE", state))
-    built, choices = [], iter([choice, "stop"])
-    monkeypatch.setattr(task_runs, "build_diagram", lambda resolved, meshcat, hand_trail:
-                        built.append(resolved.scenario.seed))
-    monkeypatch.setattr(task_runs, "run_task_once", lambda *args: (
-        types.SimpleNamespace(success=True), types.SimpleNamespace(choice=next(choices))))
-    for name in ("page_console", "delete_operator", "end_page"):
-        monkeypatch.setattr(task_runs, name, lambda *args: types.SimpleNamespace(
-            set_choices=lambda choices: None))
-    args = types.SimpleNamespace(start_on_connect=True, hand_trail=False)
+    built = []
     with pytest.raises(ScenarioError, match=r"^the robot's hand stands at \[.*\] m, 0.100 m "
                                             r"from the start the run was built for, \[.*\] m "
                                             r"\(start_tolerance 0.05 m\): bring it there first"):
-        task_runs.run_task_loop(args, resolve(scenario), None, page=object())
+        run_loop(monkeypatch, resolve(scenario), [choice, "stop"],
+                 lambda resolved: built.append(resolved.scenario.seed))
     assert built == [scenario.seed]  # the next run is not built

@@ -94,8 +94,7 @@ def blend_pose(mode, robot_position, robot_orientation, policy, twist, active, d
     for name, orientation in (("robot_orientation", robot_orientation),
                               ("policy orientation", policy.orientation)):
         # Checked, not divided by its norm: a quaternion of norm 2 would turn out of norm 2.
-        if abs(np.linalg.norm(orientation) - 1.0) > quaternion.UNIT_TOLERANCE:
-            quaternion.unit_quaternions(orientation, name)  # raises, naming it
+        quaternion.unit_norm(orientation, name)
     policy = policy._replace(orientation=quaternion.aligned(policy.orientation,
                                                             robot_orientation))
     reference = played_reference(mode, active, alpha, POSE_BLEND_LAWS)

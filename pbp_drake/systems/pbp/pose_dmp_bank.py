@@ -1,8 +1,6 @@
 """The six-DoF DMP bank as a Drake system, over the NumPy banks `DmpBankModel` (D = 3)
 and `OrientationDmpBank`."""
 
-import math
-
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import ValueProducer
@@ -167,10 +165,7 @@ class PoseDmpBank(BankSystem):
         """The measured position (3,), orientation (4,), velocity (3,) and angular velocity
         (3,), checked."""
         state = finite_pose_state(self._robot_state_port.Eval(context), "robot_state")
-        norm = math.sqrt(float(state[3:7] @ state[3:7]))
-        if abs(norm - 1.0) > quaternion.UNIT_TOLERANCE:
-            quaternion.unit_quaternions(state[3:7], "robot_state orientation")  # raises
-        # `unit_quaternions` costs 50 us a call; one quaternion is checked by hand.
+        norm = quaternion.unit_norm(state[3:7], "robot_state orientation")
         return state[:3], state[3:7] / norm, state[7:10], state[10:13]
 
     def _update(self, context, discrete_state):

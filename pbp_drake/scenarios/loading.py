@@ -394,11 +394,12 @@ def check_alpha_study(study, scenario, dimension):
         raise ScenarioError("the alpha study needs scenario.demonstration")
     # Explicit arbitration plays the demonstration to its end: with the goal elsewhere, which
     # PBP's DMPs reach, every alpha would fall short of it.
-    end = scenario.goals and np.round(demonstration_samples(scenario.demonstration)[1][-1], 6)
-    if scenario.goals and not np.allclose(scenario.goals, [end]):
-        raise ScenarioError(f"scenario.goals {scenario.goals} is not where "
-                            f"scenario.demonstration ends, {end.tolist()}: the alpha study "
-                            "plays the demonstration as P; move its goal instead")
+    if scenario.goals:
+        end = np.round(demonstration_samples(scenario.demonstration)[1][-1], 6)
+        if not np.allclose(scenario.goals, [end]):
+            raise ScenarioError(f"scenario.goals {scenario.goals} is not where "
+                                f"scenario.demonstration ends, {end.tolist()}: the alpha "
+                                "study plays the demonstration as P; move its goal instead")
     check_operator_speeds(study, scenario)
     names = [scene.name for scene in study.scenes]
     for index, scene in enumerate(study.scenes):

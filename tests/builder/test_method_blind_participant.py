@@ -7,10 +7,13 @@ import dataclasses
 
 import numpy as np
 import pytest
+from pydrake.systems.analysis import Simulator
 
 from pbp_drake.builder import build_diagram, find_system
 from pbp_drake.builder.grasp import _operator as grasp_operator
 from pbp_drake.builder.operators import participant_arguments
+from pbp_drake.core.participant_reach import facing
+from pbp_drake.systems.ports import EeState
 from pbp_drake.scenarios import METHODS, load_scenario_file, resolve
 
 # Every method a participant drives (PBP-NoUser has none; fixed_alpha needs its weight).
@@ -19,9 +22,9 @@ DRIVEN = [m if m != "fixed_alpha" else "fixed_alpha=0.5" for m in METHODS
 SEED = 3  # a tuning seed
 
 
-def resolved(repo, name, method, **changes):
+def resolved(repo, name, method, seed=SEED):
     scenario = load_scenario_file(repo / "diagrams" / name).scenario
-    return resolve(dataclasses.replace(scenario, seed=SEED, **changes)).with_method(method)
+    return resolve(dataclasses.replace(scenario, seed=seed)).with_method(method)
 
 
 def same(a, b):
@@ -71,3 +74,34 @@ def test_the_keys_and_the_shown_intent_reach_it_through_its_ports(repo, task):
     assert forward == 0.0 and shown >= 0.0
     forward, shown = participant_inputs(resolved(repo, task, "hop"))
     assert forward == 1.0 and shown >= 0.0
+
+
+def commands_and_headings(run, seconds):
+    """The participant's command at each control tick of the first `seconds` of `run`'s
+    trial, with the hand's heading it was decided at."""
+    diagram = build_diagram(run)
+    operator = find_system(diagram, "operator")
+    simulator = Simulator(diagram)
+    context = operator.GetMyContextFromRoot(simulator.get_context())
+    ticks = []
+    period = run.scenario.control_period
+    for tick in range(1, int(round(seconds / period))):
+        # At the tick, before its events: the heading the tick's decision reads.
+        simulator.AdvanceTo(tick * period)
+        heading = EeState(operator.GetInputPort("ee_state").Eval(context)).heading
+        simulator.AdvanceTo((tick + 0.5) * period)
+        ticks.append((np.array(operator.GetOutputPort("operator_command").Eval(context)),
+                      heading))
+    return ticks
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["pbp_alternated", "pbp_continuous"])
+def test_among_obstacles_it_presses_no_forward_the_keys_lack(repo, method):
+    run = resolved(repo, "hsr_obstacles.yaml", method, seed=10000)  # an evaluation seed
+    ticks = commands_and_headings(run, 12.0)
+    acting = [(command, heading) for command, heading in ticks
+              if np.linalg.norm(command[:2]) > 0.0]
+    assert len(acting) > 20  # it does steer round the cylinders
+    for command, heading in acting:
+        assert command[:2] @ facing(heading) <= 1e-12

@@ -215,6 +215,8 @@ class VirtualOperator(ParticipantOperator):
         if self._obstacles_port is not None:
             command, active = self._avoid(context, discrete_state, int(known), own_motion,
                                           serving)
+            if active and not self._forward_key(context):
+                command, active = self._on_enabled_keys(command, ee_state.heading)
         else:
             heads_for = (self._heads_for(context, discrete_state, int(known))
                          if self._mistakes else int(known))
@@ -254,11 +256,21 @@ class VirtualOperator(ParticipantOperator):
         command[3] += noise[2]
         if self._vertical:
             command[2] += noise[3]
-        if not self._forward_key(context) and self._obstacles_port is None:
+        if not self._forward_key(context):
             # The forward key stays disabled, however the hand shakes.
             heading = EeState(self._ee_state_port.Eval(context)).heading
             command[:2] = without_forward(command[:2], heading)
         return command
+
+    def _on_enabled_keys(self, command, heading):
+        """`(command, active)` of what the keys allow of a planned `command` with the
+        forward key disabled: as in the reaching task (`_decide`), when little is left of
+        where it wants the hand to go (the way on lies ahead), no key helps and it waits."""
+        wanted = np.linalg.norm(command[:2])
+        planar = without_forward(command[:2], heading)
+        if wanted > 0 and np.linalg.norm(planar) < self.params.serve_speed_fraction * wanted:
+            return np.zeros(4), False
+        return np.array([planar[0], planar[1], 0.0, command[3]]), True
 
     def _noise(self, context):
         """This tick's direction error (rad) and speed factor, drawn from `(seed, tick)`."""

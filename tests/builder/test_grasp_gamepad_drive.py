@@ -142,9 +142,7 @@ def test_the_gamepad_drives_a_whole_grasp_through_the_page(grasp, meshcat, metho
     driver = GamepadDriver(meshcat, diagram, resolved.scene.grasps,
                            resolved.scenario.control_period, assist=method != "teleop")
     try:
-        started = time.monotonic()
         result = run_task(resolved, meshcat, diagram=diagram, advance=driver.advance)
-        wall = time.monotonic() - started
     finally:
         driver.page.close()
     assert result.success, f"no grasp in {resolved.scenario.duration} s"
@@ -158,4 +156,3 @@ def test_the_gamepad_drives_a_whole_grasp_through_the_page(grasp, meshcat, metho
     else:
         assert result.intervention_ratio > 0.9
     assert driver.sent >= len(result.times) - 1
-    assert wall < 60.0

@@ -50,7 +50,9 @@ class VirtualParticipantParams:
     hold_time: float = 0.5
     #: It lets the robot go while the hand closes in on its target at this fraction of its
     #: own preferred speed there or more (`pbp_drake.core.participant_serving`): the same
-    #: rule under every method, set before any method ran, never tuned on one.
+    #: rule under every method, set before any method ran, never tuned on one. With the
+    #: forward key disabled it also waits when what the keys allow of the motion it wants
+    #: is less than this fraction of it.
     serve_speed_fraction: float = 0.5
     #: It watches the robot this long (s) before it takes over from a robot that does not
     #: serve its target (about a simple reaction time, 0.24 s in the Model Human

@@ -172,11 +172,30 @@ def _read(path):
         return None
 
 
+def _sections(page):
+    """`{title: lines}` of the `## ` sections of the page at `page` ({} if there is none)."""
+    try:
+        text = pathlib.Path(page).read_text()
+    except OSError:
+        return {}
+    sections, title = {}, None
+    for line in text.rstrip("\n").split("\n"):
+        if line.startswith("## "):
+            title = line[3:]
+            sections[title] = []
+        elif title is not None:
+            sections[title].append(line)
+    return sections
+
+
 def arena_page(studies, outputs, generated, page):
     """The page's Markdown. `studies`: `{name: title}` of the catalogue's matrices;
     `outputs/NAME` their folders, `generated/NAME.md` and `generated/NAME_pilots.png` their
-    table and figure (`page` is where the page goes, for the relative links). A matrix not
-    run yet is named as such."""
+    table and figure (`page` is where the page goes, for the relative links). A matrix whose
+    folder holds no summary keeps its section of the page already at `page` (a machine
+    that reruns one matrix keeps the others' published sections), or is named as not run
+    yet."""
+    published = _sections(page)
     generated = pathlib.Path(generated)
     relative = pathlib.Path(os.path.relpath(generated, pathlib.Path(page).parent))
     lines = ["# Results: every method under every pilot", "",
@@ -197,7 +216,9 @@ def arena_page(studies, outputs, generated, page):
         summary, study = _read(folder / "summary.json"), _read(folder / "study.json")
         if not (isinstance(summary, dict) and summary.get("study") == "method_matrix"
                 and isinstance(study, dict)):
-            lines.append(f"Not run yet: `make results` runs it into `{folder}`.")
+            kept = "\n".join(published.get(title, [])).strip("\n")
+            lines += (kept.split("\n") if kept else
+                      [f"Not run yet: `make results` runs it into `{folder}`."])
             continue
         lines += [f"`{matrix_command(study, summary)}`", ""]
         for pilot in summary["pilots"]:

@@ -120,3 +120,17 @@ def test_the_catalogues_matrix_writes_its_table_figure_and_the_page(repo, tmp_pa
         assert f"### Pilot: {pilot}" in written
     assert f"```{{include}} generated/{name}.md" in written
     assert f"(generated/{name}_pilots.png)" in written
+
+
+def test_a_matrix_not_on_disk_keeps_its_published_section(tmp_path):
+    # A machine that reruns one matrix keeps the others' sections of the page as they are.
+    page_path = tmp_path / "arena.md"
+    first = arena_page(ARENA_STUDIES, tmp_path / "outputs", tmp_path / "generated", page_path)
+    title = next(iter(ARENA_STUDIES.values()))
+    published = first.replace(f"## {title}\n\nNot run yet", f"## {title}\n\nA published table")
+    published = published.replace("A published table: `make results` runs it",
+                                  "A published table, kept")
+    page_path.write_text(published)
+    again = arena_page(ARENA_STUDIES, tmp_path / "outputs", tmp_path / "generated", page_path)
+    assert again == published
+    assert again.count("Not run yet") == len(ARENA_STUDIES) - 1

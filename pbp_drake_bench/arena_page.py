@@ -173,18 +173,16 @@ def _read(path):
 
 
 def _sections(page):
-    """`{title: lines}` of the `## ` sections of the page at `page` ({} if there is none)."""
+    """`{title: its lines}` of the `## ` sections of the page at `page`, each without the
+    blank lines around it ({} if there is no page)."""
     try:
         text = pathlib.Path(page).read_text()
     except OSError:
         return {}
-    sections, title = {}, None
-    for line in text.rstrip("\n").split("\n"):
-        if line.startswith("## "):
-            title = line[3:]
-            sections[title] = []
-        elif title is not None:
-            sections[title].append(line)
+    sections = {}
+    for part in text.split("\n## ")[1:]:
+        title, _, body = part.partition("\n")
+        sections[title] = body.strip("\n").split("\n") if body.strip("\n") else []
     return sections
 
 
@@ -216,8 +214,7 @@ def arena_page(studies, outputs, generated, page):
         summary, study = _read(folder / "summary.json"), _read(folder / "study.json")
         if not (isinstance(summary, dict) and summary.get("study") == "method_matrix"
                 and isinstance(study, dict)):
-            kept = "\n".join(published.get(title, [])).strip("\n")
-            lines += (kept.split("\n") if kept else
+            lines += (published.get(title) or
                       [f"Not run yet: `make results` runs it into `{folder}`."])
             continue
         lines += [f"`{matrix_command(study, summary)}`", ""]

@@ -17,7 +17,8 @@ from pbp_drake.core.grasp_task import approach_direction
 from pbp_drake.core.participant_impairment import ParticipantImpairment, first_choice
 from pbp_drake.core.participant_params import VirtualParticipantParams
 from pbp_drake.core.participant_reach import unit
-from pbp_drake.core.participant_serving import NO_INTENT, ServingMemory, serving_step
+from pbp_drake.core.participant_serving import (
+    NO_INTENT, ServingMemory, keys_help, serving_step)
 from pbp_drake.core.quaternion import angle_between, conjugate, exp_map, log_map, multiply
 
 # `ParticipantMemory.known_target` before it has noticed any target.
@@ -318,9 +319,8 @@ class GraspParticipant:
             if not forward_key:
                 # What is left of driving there without the forward key; when that is
                 # little (the grasp ahead), no key helps and it waits.
-                wanted = float(np.linalg.norm(velocity))
-                velocity = without_forward(velocity, orientation)
-                if np.linalg.norm(velocity) < self.params.serve_speed_fraction * wanted:
+                wanted, velocity = velocity, without_forward(velocity, orientation)
+                if not keys_help(self.params, wanted, velocity):
                     return idle, False, memory, ServingMemory()
         if not (velocity.any() or angular.any()):
             return idle, False, memory, serving

@@ -32,6 +32,13 @@ def robot_serves(params, speed, velocity, offset):
     return closing >= params.serve_speed_fraction * preferred_speed(params, speed, distance)
 
 
+def keys_help(params, wanted, allowed):
+    """Whether pressing `allowed`, what the keys allow of the velocity `wanted` (the forward
+    key disabled), is worth it: at least `serve_speed_fraction` of it. Less (the way on
+    lies ahead), no key helps, and it waits."""
+    return not np.linalg.norm(allowed) < params.serve_speed_fraction * np.linalg.norm(wanted)
+
+
 @dataclasses.dataclass(frozen=True)
 class ServingMemory:
     """What the rule remembers between ticks: whether it acted, why (`took_over`: because

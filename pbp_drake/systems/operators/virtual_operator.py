@@ -16,7 +16,7 @@ from pbp_drake.core.participant_reach import (
     assist_motion, can_point_at, drive_motion, faces_target, reposition_motion,
     without_forward)
 from pbp_drake.core.participant_serving import (
-    NO_INTENT, SERVING_MEMORY_SIZE, ServingMemory, robot_pulls, serving_step,
+    NO_INTENT, SERVING_MEMORY_SIZE, ServingMemory, keys_help, robot_pulls, serving_step,
     update_own_motion)
 from pbp_drake.core.reach_task import rotate_planar, wrap_angle
 from pbp_drake.systems.ports import (
@@ -216,7 +216,11 @@ class VirtualOperator(ParticipantOperator):
             command, active = self._avoid(context, discrete_state, int(known), own_motion,
                                           serving)
             if active and not self._forward_key(context):
-                command, active = self._on_enabled_keys(command, ee_state.heading)
+                # What the keys allow of its plan, as in the reaching task (`_decide`).
+                planar = without_forward(command[:2], ee_state.heading)
+                command, active = ((np.array([*planar, 0.0, command[3]]), True)
+                                   if keys_help(self.params, command[:2], planar)
+                                   else (np.zeros(4), False))
         else:
             heads_for = (self._heads_for(context, discrete_state, int(known))
                          if self._mistakes else int(known))
@@ -261,16 +265,6 @@ class VirtualOperator(ParticipantOperator):
             heading = EeState(self._ee_state_port.Eval(context)).heading
             command[:2] = without_forward(command[:2], heading)
         return command
-
-    def _on_enabled_keys(self, command, heading):
-        """`(command, active)` of what the keys allow of a planned `command` with the
-        forward key disabled: as in the reaching task (`_decide`), when little is left of
-        where it wants the hand to go (the way on lies ahead), no key helps and it waits."""
-        wanted = np.linalg.norm(command[:2])
-        planar = without_forward(command[:2], heading)
-        if wanted > 0 and np.linalg.norm(planar) < self.params.serve_speed_fraction * wanted:
-            return np.zeros(4), False
-        return np.array([planar[0], planar[1], 0.0, command[3]]), True
 
     def _noise(self, context):
         """This tick's direction error (rad) and speed factor, drawn from `(seed, tick)`."""
@@ -462,10 +456,10 @@ class VirtualOperator(ParticipantOperator):
             if not forward:
                 # Without the forward key, what is left of driving there; when that is
                 # little (the target ahead), no key helps and it waits.
-                wanted = np.linalg.norm(velocity)
-                velocity = np.array(velocity, float)
+                wanted = np.array(velocity, float)
+                velocity = wanted.copy()
                 velocity[:2] = without_forward(velocity[:2], heading)
-                if np.linalg.norm(velocity) < self.params.serve_speed_fraction * wanted:
+                if not keys_help(self.params, wanted, velocity):
                     discrete_state.set_value(self._serving_index, ServingMemory().as_vector())
                     return np.zeros(4), False
         # Going to the target where the robot does not, it pushes against the pull it sees

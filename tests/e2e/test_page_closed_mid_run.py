@@ -17,7 +17,10 @@ from browser_page import (
 pytestmark = NEEDS_BROWSER
 
 TOKEN = "a-page-closed-mid-run"
-DURATION = 6.0
+# s: the reopened page counts as present once it connects, and the run goes on while its
+# scene still loads: the rest of the run must outlast that load (4.5 s was too short for
+# headless Chromium at times), or the page has ended, without its Stop, when it is read.
+DURATION = 15.0
 
 
 def page_time(page):
@@ -56,7 +59,13 @@ def test_a_run_without_its_page_stands_still_until_it_is_reopened(repo):
                 output.text())
             # The reopened page has the run's state and its buttons.
             console_line(page, "title").filter(has_text="PBP-Alt, seed 0").wait_for()
-            control(page, "Stop").wait_for(state="attached")
+            try:
+                control(page, "Stop").wait_for(state="attached", timeout=30_000)
+            except Exception as error:  # Playwright's TimeoutError: say what the run said
+                output.wait_for(r"^hsr_reach \[", timeout=15)
+                raise AssertionError(f"no Stop on the reopened page (its body's class: "
+                                     f"{page.evaluate('document.body.className')!r}): "
+                                     f"{error}\n{output.text()}") from None
             assert page_time(page) >= held - 1e-9
             end = output.wait_for(r"^hsr_reach \[pbp_alternated, seed 0\]: (.*)$",
                                   timeout=120)

@@ -70,11 +70,11 @@ graphviz:
 lint: $(STAMP)
 	$(PYTHON) -m ruff check .
 
-# The whole suite after the lint: everything but the browser tests in two processes, then
-# the browser tests (Chromium, real-time pages) one at a time, so that a page is never starved.
+# The whole suite after the lint, in two runs at once (tests/run_suite.py): the browser tests
+# (Chromium, real-time pages) one at a time, and the others in two processes at the lowest
+# priority, so that they take only the CPU the pages leave and a page is never starved.
 test: lint chromium graphviz
-	$(PYTHON) -m pytest -m "not browser" -n 2 --dist worksteal
-	$(PYTHON) -m pytest -m browser
+	$(PYTHON) tests/run_suite.py
 
 # The suite but the browser tests on Python 3.12 with the newest Drake and NumPy (.ci/run
 # runs it after `make test`): what a user of a newer Python gets from pip.

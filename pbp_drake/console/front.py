@@ -58,7 +58,9 @@ SEND_BUFFER = 2**15
 FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
 # Our page's heartbeat, each second and at once when its tab is shown or hidden: HERE while
 # the tab is in view, AWAY while it is hidden (its keys and pad reach nobody: a hidden page
-# counts as absent at once, whatever its timers do).
+# counts as absent at once, whatever its timers do). It beats from the moment it has drawn
+# its first batch: a page still loading its scene cannot be driven from, so a reopened
+# page's run goes on only once the scene is on screen.
 HERE, AWAY = "pbp_drake_here", "pbp_drake_away"
 # A page unheard this long counts as gone (`pages_present`: a sleeping computer's, a frozen
 # or hung tab's). A tab in view beats each second, unthrottled; a hidden one said AWAY, so
@@ -99,7 +101,7 @@ body.pbp-ended #status-message { display: none !important; }
   var token = new URLSearchParams(location.search).get("token");
   var page = Math.random().toString(36).slice(2) + Date.now().toString(36);
   var query = "?page=" + page + (token ? "&token=" + encodeURIComponent(token) : "");
-  var shown = {seq: -1}, served = false, ended = false;
+  var shown = {seq: -1}, served = false, ended = false, drawn = false;
   function take(state) {
     // The newest state wins, whether it came with the scene or by a poll.
     if (ended || state.seq < shown.seq) return;
@@ -147,11 +149,13 @@ body.pbp-ended #status-message { display: none !important; }
     var socket = message.target;
     if (message.data === "FRAME_TEXT") requestAnimationFrame(function () {
       if (socket.readyState === WebSocket.OPEN) socket.send("ACK_TEXT");
+      if (!drawn) { drawn = true; beat(); }
     });
     else if (message.data.charAt(0) === "{") { served = true; take(JSON.parse(message.data)); }
   };
   function beat() {
     var socket = viewer.connection;
+    if (!drawn) return;
     if (socket && socket.readyState === WebSocket.OPEN)
       socket.send(document.hidden ? "AWAY_TEXT" : "HERE_TEXT");
   }
@@ -239,7 +243,7 @@ class PageFront:
         self._upstreams, self._closed_upstreams = 0, collections.deque()  # close times
         self._accept_errors = None  # the last accept error's time, in a burst
         self._wakers = set()  # each relay's event: the state changed, send it
-        self._last_heard = {}  # each relay's page -> when it last spoke; None: its tab hidden
+        self._last_heard = {}  # each relay's page -> when it last spoke; None: away
         self._door = MeshcatDoor(meshcat_port)
         if not self._door.shut:
             warn(f"Meshcat's port stays open to other programs on this machine "
@@ -284,7 +288,7 @@ class PageFront:
     def pages_present(self):
         """How many relayed pages someone can drive from: heard within `SILENCE_LIMIT`
         seconds, their tab not hidden (see `HERE`, `AWAY`). A page counts from its
-        connection on."""
+        first HERE, once it has drawn its first batch."""
         since = time.monotonic() - SILENCE_LIMIT
         with self._lock:
             return sum(heard is not None and heard >= since
@@ -572,7 +576,7 @@ class PageFront:
 
         self._relays += 1
         with self._lock:
-            self._last_heard[page] = time.monotonic()
+            self._last_heard[page] = None  # away until its first HERE
         tasks = [asyncio.create_task(job()) for job in (to_meshcat, from_meshcat, to_page)]
         try:
             await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)

@@ -182,11 +182,16 @@ def test_a_paced_page_gets_the_next_batch_after_its_answer_and_the_panel_at_once
 def test_a_page_is_present_while_it_is_heard_and_its_tab_is_in_view(front, monkeypatch):
     monkeypatch.setattr("pbp_drake.console.front.SILENCE_LIMIT", 60.0)
     with _websocket(front, f"?token={front.token}") as page:
-        assert _until(lambda: front.pages() == 1) and front.pages_present() == 1
-        page.send(AWAY)  # its tab hidden: nobody drives from it
-        assert _until(lambda: front.pages_present() == 0) and front.pages_heard() == 0
-        page.send(ACK)  # heard, but what a hidden tab sends keeps it away
+        # Connected, it is away until it says HERE (our page says it once it has drawn its
+        # first batch): a page still loading its scene cannot be driven from.
+        assert _until(lambda: front.pages() == 1) and front.pages_present() == 0
+        assert front.pages_heard() == 0
+        page.send(ACK)  # heard, but only HERE brings a page that is away
         assert _until(lambda: front.pages_heard() == 1) and front.pages_present() == 0
+        page.send(HERE)
+        assert _until(lambda: front.pages_present() == 1)
+        page.send(AWAY)  # its tab hidden: nobody drives from it
+        assert _until(lambda: front.pages_present() == 0)
         page.send(HERE)
         assert _until(lambda: front.pages_present() == 1)
         # Silent, its connection open (a sleeping laptop, a frozen tab): gone, until heard.

@@ -8,6 +8,7 @@ key moves the hand, and no traceback is printed.
 """
 
 import contextlib
+import itertools
 import pathlib
 import re
 import socket
@@ -23,6 +24,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from pbp_drake.cli_types import EXIT_STOPPED
+from pbp_drake.console.front import HERE
 from pbp_drake.console.page import CHOICE_BUTTONS
 from pbp_drake.systems.operators.keyboard_operator import LEFT_BUTTON
 
@@ -66,7 +68,8 @@ def _authorised(port, token, **options):
 
 
 class Person:
-    """The person's page (`page`, an authorised websocket): reads all it is sent and presses
+    """The person's page (`page`, an authorised websocket): reads all it is sent, says it is
+    in view each second (`HERE`, as our page does once it has drawn its scene) and presses
     ← every 50 ms (a key's auto-repeat) while `pressing` is set."""
 
     def __init__(self, page):
@@ -87,12 +90,16 @@ class Person:
 
     def _press(self):
         press = msgpack.packb({"type": "button", "name": LEFT_BUTTON})
-        while not self._stop.is_set():
-            if self.pressing.is_set():
-                try:
+        for tick in itertools.count():
+            if self._stop.is_set():
+                return
+            try:
+                if tick % 20 == 0:
+                    self.page.send(HERE)
+                if self.pressing.is_set():
                     self.page.send(press)
-                except ConnectionClosed:
-                    return
+            except ConnectionClosed:
+                return
             self._stop.wait(0.05)
 
     def stop_run(self):

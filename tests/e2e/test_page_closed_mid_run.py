@@ -17,10 +17,7 @@ from browser_page import (
 pytestmark = NEEDS_BROWSER
 
 TOKEN = "a-page-closed-mid-run"
-# s: the reopened page counts as present once it connects, and the run goes on while its
-# scene still loads: the rest of the run must outlast that load (4.5 s was too short for
-# headless Chromium at times), or the page has ended, without its Stop, when it is read.
-DURATION = 15.0
+DURATION = 6.0
 
 
 def page_time(page):

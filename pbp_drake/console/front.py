@@ -154,8 +154,8 @@ body.pbp-ended #status-message { display: none !important; }
     else if (message.data.charAt(0) === "{") { served = true; take(JSON.parse(message.data)); }
   };
   function beat() {
+    if (!drawn) return;  // a page still loading its scene is not one to drive from
     var socket = viewer.connection;
-    if (!drawn) return;
     if (socket && socket.readyState === WebSocket.OPEN)
       socket.send(document.hidden ? "AWAY_TEXT" : "HERE_TEXT");
   }

@@ -19,7 +19,7 @@ def test_a_page():
 
 
 def _run(folder):
-    return subprocess.run([sys.executable, str(RUNNER), "-p", "no:randomly", "-q"],
+    return subprocess.run([sys.executable, str(RUNNER), "-q"],
                           cwd=folder, capture_output=True, text=True, timeout=300)
 
 

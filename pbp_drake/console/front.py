@@ -60,7 +60,7 @@ FRAME, ACK = "pbp_drake_frame", "pbp_drake_ack"
 # the tab is in view, AWAY while it is hidden (its keys and pad reach nobody: a hidden page
 # counts as absent at once, whatever its timers do). It beats from the moment it has drawn
 # its first batch: a page still loading its scene cannot be driven from, so a reopened
-# page's run goes on only once the scene is on screen.
+# page's run goes on only once that batch is on screen.
 HERE, AWAY = "pbp_drake_here", "pbp_drake_away"
 # A page unheard this long counts as gone (`pages_present`: a sleeping computer's, a frozen
 # or hung tab's). A tab in view beats each second, unthrottled; a hidden one said AWAY, so

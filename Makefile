@@ -13,6 +13,11 @@ NEWEST_STAMP := $(NEWEST_VENV)/.installed
 # system's (Ubuntu 24.04's python3.12).
 PYTHON312 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.12*/bin/python3.12) python3.12)
 DEMO_DIR := outputs/demo
+# $(call with_bytecode_cache,VENV): the tests' many Python processes (workers, commands,
+# study workers, kernels) keep their compiled bytecode under VENV/pycache, the source tree
+# free of __pycache__; a PYTHONDONTWRITEBYTECODE in the environment would have each of them
+# compile the package and the tests anew.
+with_bytecode_cache = env -u PYTHONDONTWRITEBYTECODE PYTHONPYCACHEPREFIX="$(CURDIR)/$(1)/pycache"
 
 .PHONY: demo lint test test-newest test-fast chromium graphviz tutorials diagrams bench soak \
 	results docs clean
@@ -74,16 +79,17 @@ lint: $(STAMP)
 # (Chromium, real-time pages) one at a time, and the others in two processes at the lowest
 # priority, so that they take only the CPU the pages leave and a page is never starved.
 test: lint chromium graphviz
-	$(PYTHON) tests/run_suite.py
+	$(call with_bytecode_cache,$(VENV)) $(PYTHON) tests/run_suite.py
 
 # The suite but the browser tests on Python 3.12 with the newest Drake and NumPy (.ci/run
 # runs it after `make test`): what a user of a newer Python gets from pip.
 test-newest: $(NEWEST_STAMP) graphviz
-	$(NEWEST_VENV)/bin/python -m pytest -m "not browser" -n 2 --dist worksteal
+	$(call with_bytecode_cache,$(NEWEST_VENV)) $(NEWEST_VENV)/bin/python -m pytest \
+		-m "not browser" -n 2 --dist worksteal
 
 # Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run.
 test-fast: $(STAMP) graphviz
-	$(PYTHON) -m pytest -m "not slow" -n 2 --dist worksteal
+	$(call with_bytecode_cache,$(VENV)) $(PYTHON) -m pytest -m "not slow" -n 2 --dist worksteal
 
 # The tutorial notebooks (tutorials/*.ipynb) in Jupyter, in the project's venv.
 $(VENV)/.installed-tutorials: $(STAMP)

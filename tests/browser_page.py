@@ -9,7 +9,6 @@ where chromium or Playwright is missing).
 import contextlib
 import io
 import json
-import pathlib
 import queue
 import re
 import shutil
@@ -24,13 +23,6 @@ import numpy as np
 import pytest
 
 CHROMIUM = shutil.which("chromium")
-# How the tests start it. Headless Chromium draws WebGL in software (SwiftShader), and a
-# live Meshcat page asks for a frame as soon as the last is drawn: it keeps busy as many
-# cores as it is given (1.6 of the 2-core machine's, 9 frames a second), and as root it
-# puts its GPU and browser processes above every other program (nice -8). Held to one core
-# at the usual priority (`one_core_chromium`), it draws fewer frames while the machine is
-# busy and leaves the other core to the tests that run alongside (`run_suite.py`).
-LAUNCHER = str(pathlib.Path(__file__).resolve().with_name("one_core_chromium"))
 try:
     from playwright.sync_api import sync_playwright
 except ImportError:  # pragma: no cover - depends on the environment
@@ -55,7 +47,7 @@ def open_page(url, viewport=(1280, 720), timeout_ms=20_000, cpu_slowdown=None):
     closed with its browser on leaving. `cpu_slowdown` (e.g. 10): the page's CPU throttled
     that many times once it has loaded (Chrome DevTools' CPU throttling), a slow laptop's."""
     with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=LAUNCHER, args=CHROMIUM_ARGS,
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
                                              timeout=30_000)
         try:
             page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})

@@ -21,8 +21,10 @@ BENCH_MODULES = sorted(BENCH.glob("*.py"))
 # Imports a module may defer into a function: heavy optional packages, on purpose.
 # scipy.stats: a dependency, but 0.7 s to import; only a user study's report needs it.
 # scipy.linalg.blas: 0.2 s to import; only the six-DoF bank's fused step needs its dgemm.
+# matplotlib: 0.4 s to import; only the figures' drawing needs it (not a run, nor a trial).
 DEFERRED_IMPORTS = {"ray", "pydmps", "movement_primitives.dmp", "threadpoolctl", "scipy.stats",
-                    "scipy.linalg.blas"}
+                    "scipy.linalg.blas", "matplotlib", "matplotlib.cm", "matplotlib.colors",
+                    "matplotlib.figure", "matplotlib.patches"}
 # The harness, imported by `pbp-drake bench` alone (cli.py), when run.
 HARNESS = "pbp_drake_bench.main"
 
@@ -124,3 +126,16 @@ def test_the_harness_imports_the_library_not_the_other_way():
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "[]"
     assert BENCH_MODULES, "the harness package is missing"
+
+
+@pytest.mark.slow
+def test_the_command_line_starts_without_matplotlibs_figures():
+    # `pbp-drake run` (and `study` before its report) loads no figure, axes or 3-D toolkit:
+    # 0.4 s sooner. (pydrake.visualization loads matplotlib's colours, which are light.)
+    code = ("import sys, pbp_drake.cli, pbp_drake.commands.run, pbp_drake.commands.study; "
+            "print(sorted(name for name in sys.modules if name.startswith(("
+            "'matplotlib.figure', 'matplotlib.axes', 'matplotlib.pyplot', 'mpl_toolkits'))))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            cwd=REPO, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"

@@ -3,12 +3,7 @@ the 2-D studies' Fig. 2 (the alpha study) and Fig. 4 (Alt vs Cont), the method
 comparison's Fig. 7 (box plots of (a) the intervention ratio and (b) the task time, (c)
 the histogram of collision ratios) and a matrix of methods and pilots in one figure."""
 
-import matplotlib
 import numpy as np
-from matplotlib.cm import ScalarMappable
-from matplotlib.colors import Normalize
-from matplotlib.figure import Figure
-from matplotlib.patches import Circle
 
 from pbp_drake.core.methods import method_colour, methods_of
 from pbp_drake.scenarios import METHOD_NAMES
@@ -18,6 +13,7 @@ from pbp_drake.studies.atomic_files import save_figure
 def new_figure(*grid, figsize, **options):
     """A figure and its axes (`Figure.subplots`) made without pyplot, which would choose a
     backend: a notebook that draws these keeps its own (its inline figures)."""
+    from matplotlib.figure import Figure
     figure = Figure(figsize=figsize)
     return figure, figure.subplots(*grid, **options)
 
@@ -148,6 +144,7 @@ SCENE_COLOURS = ["tab:red", "tab:purple", "tab:brown", "tab:olive"]
 
 
 def _draw_obstacles(axes, obstacles, colour, label=None):
+    from matplotlib.patches import Circle
     for index, obstacle in enumerate(obstacles):
         axes.add_patch(Circle(obstacle.center, obstacle.radius, color=colour, alpha=0.3,
                               label=label if index == 0 else None))
@@ -222,6 +219,9 @@ def plot_alpha_study(resolved, study, summary, trajectories, path):
     _label_axes(distance_axes, "alpha (1: robot only)", "final distance to the goal",
                 "(c) explicit arbitration: final distance against alpha", fontsize=6)
 
+    import matplotlib
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
     colour_map = matplotlib.colormaps["viridis"]
     drawn_speed = _trajectory_speed(summary, resolved)
     for index, scene in enumerate(study.scenes):

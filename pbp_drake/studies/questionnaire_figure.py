@@ -2,8 +2,6 @@
 stacked bars ((a) tiredness, (b) ease of operation), each panel saying what its scale's ends
 mean, drawn with matplotlib (headless)."""
 
-import matplotlib
-
 from pbp_drake.studies.atomic_files import save_figure
 from pbp_drake.scenarios import METHOD_NAMES
 from pbp_drake.studies.figures import new_figure
@@ -27,6 +25,7 @@ def plot_questionnaire(answers, methods, path):
     """Writes Fig. 8 to `path`: one panel per question, one bar per method, each answer's
     share of the method's answers, 0 (the worse end, red) to 5 (the better, green), the
     panel's title saying what the ends mean for its question."""
+    import matplotlib
     colours = matplotlib.colormaps["RdYlGn"]([i / (len(SCALE) - 1) for i in range(len(SCALE))])
     figure, axes = new_figure(1, len(QUESTIONS), figsize=(10, 1.2 + 0.6 * len(methods)),
                               sharey=True)

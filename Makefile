@@ -13,11 +13,13 @@ NEWEST_STAMP := $(NEWEST_VENV)/.installed
 # system's (Ubuntu 24.04's python3.12).
 PYTHON312 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.12*/bin/python3.12) python3.12)
 DEMO_DIR := outputs/demo
-# $(call with_bytecode_cache,VENV): the tests' many Python processes (workers, commands,
-# study workers, kernels) keep their compiled bytecode under VENV/pycache, the source tree
-# free of __pycache__; a PYTHONDONTWRITEBYTECODE in the environment would have each of them
-# compile the package and the tests anew.
+# $(call with_bytecode_cache,VENV): the many Python processes of the tests and the jobs
+# (workers, commands, study workers, kernels) keep their compiled bytecode under
+# VENV/pycache, the source tree free of __pycache__; a PYTHONDONTWRITEBYTECODE in the
+# environment would have each of them compile the package (and the tests) anew.
 with_bytecode_cache = env -u PYTHONDONTWRITEBYTECODE PYTHONPYCACHEPREFIX="$(CURDIR)/$(1)/pycache"
+# The project's venv, so: how the jobs below run its programs.
+IN_VENV := $(call with_bytecode_cache,$(VENV))
 
 .PHONY: demo lint test test-newest test-fast chromium graphviz tutorials diagrams bench soak \
 	results docs clean
@@ -39,10 +41,10 @@ $(NEWEST_STAMP): pyproject.toml
 
 # The HSR reaching task with PBP-Alt and the virtual participant, then the 2-D alpha study.
 demo: $(STAMP)
-	$(VENV)/bin/pbp-drake run diagrams/hsr_reach.yaml --method pbp_alternated \
+	$(IN_VENV) $(VENV)/bin/pbp-drake run diagrams/hsr_reach.yaml --method pbp_alternated \
 		--operator virtual --headless --record $(DEMO_DIR)/hsr_reach.html --force
-	$(VENV)/bin/pbp-drake study diagrams/toy_alpha_study.yaml --output $(DEMO_DIR)
-	$(VENV)/bin/pbp-drake run diagrams/toy_alpha_study.yaml --scene scene_1 \
+	$(IN_VENV) $(VENV)/bin/pbp-drake study diagrams/toy_alpha_study.yaml --output $(DEMO_DIR)
+	$(IN_VENV) $(VENV)/bin/pbp-drake run diagrams/toy_alpha_study.yaml --scene scene_1 \
 		--method pbp_alternated --headless --record $(DEMO_DIR)/replay.html --force
 	@echo "Open $(DEMO_DIR)/hsr_reach.html in a browser to replay the HSR task."
 
@@ -79,7 +81,7 @@ lint: $(STAMP)
 # (Chromium, real-time pages) one at a time, and the others in two processes at the lowest
 # priority, so that they take only the CPU the pages leave and a page is never starved.
 test: lint chromium graphviz
-	$(call with_bytecode_cache,$(VENV)) $(PYTHON) tests/run_suite.py
+	$(IN_VENV) $(PYTHON) tests/run_suite.py
 
 # The suite but the browser tests on Python 3.12 with the newest Drake and NumPy (.ci/run
 # runs it after `make test`): what a user of a newer Python gets from pip.
@@ -89,7 +91,7 @@ test-newest: $(NEWEST_STAMP) graphviz
 
 # Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run.
 test-fast: $(STAMP) graphviz
-	$(call with_bytecode_cache,$(VENV)) $(PYTHON) -m pytest -m "not slow" -n 2 --dist worksteal
+	$(IN_VENV) $(PYTHON) -m pytest -m "not slow" -n 2 --dist worksteal
 
 # The tutorial notebooks (tutorials/*.ipynb) in Jupyter, in the project's venv.
 $(VENV)/.installed-tutorials: $(STAMP)
@@ -97,11 +99,11 @@ $(VENV)/.installed-tutorials: $(STAMP)
 	touch $@
 
 tutorials: $(VENV)/.installed-tutorials graphviz
-	$(VENV)/bin/jupyter lab tutorials
+	$(IN_VENV) $(VENV)/bin/jupyter lab tutorials
 
 # Redraw every scenario's system diagram beside its YAML (diagrams/*.svg).
 diagrams: $(STAMP) graphviz
-	$(PYTHON) -m pbp_drake.draw diagrams/*.yaml
+	$(IN_VENV) $(PYTHON) -m pbp_drake.draw diagrams/*.yaml
 
 # `pbp-drake bench`: the DMP bank against pydmps and movement_primitives, the closed-loop HSR
 # speed and the control-rate figure, into outputs/bench (bench.json, bench_control_rate.png);
@@ -111,13 +113,13 @@ $(VENV)/.installed-bench: $(STAMP)
 	touch $@
 
 bench: $(VENV)/.installed-bench
-	$(VENV)/bin/python -m pbp_drake_bench
+	$(IN_VENV) $(PYTHON) -m pbp_drake_bench
 
 # An hour of simulated time of the HSR reaching task with Meshcat on, runs back to back in
 # one process; fails when memory grows 10 % or more after the first minute (about 15
 # minutes of wall time on an idle 2-core machine, 25 on a shared one).
 soak: $(STAMP)
-	$(PYTHON) -m pbp_drake_bench.soak --minutes 60
+	$(IN_VENV) $(PYTHON) -m pbp_drake_bench.soak --minutes 60
 
 # Every study the docs quote (the list: pbp_drake_bench/results_catalogue.py), each with
 # --jobs 2 into outputs/results/NAME, and its table into docs/results/generated/NAME.md
@@ -125,7 +127,7 @@ soak: $(STAMP)
 # From scratch, about an hour on a 2-core machine. Run again after an interruption, it
 # resumes from the trials today's code made; a study folder other code made starts afresh.
 results: $(STAMP)
-	$(PYTHON) -m pbp_drake_bench.results_catalogue
+	$(IN_VENV) $(PYTHON) -m pbp_drake_bench.results_catalogue
 
 # The documentation site (Sphinx, MyST, furo) into docs/_build/html; any warning fails.
 $(VENV)/.installed-docs: $(STAMP)
@@ -133,7 +135,7 @@ $(VENV)/.installed-docs: $(STAMP)
 	touch $@
 
 docs: $(VENV)/.installed-docs
-	$(PYTHON) -m sphinx -W --keep-going -b html docs docs/_build/html
+	$(IN_VENV) $(PYTHON) -m sphinx -W --keep-going -b html docs docs/_build/html
 
 clean:
 	rm -rf $(VENV) $(NEWEST_VENV) outputs build *.egg-info docs/_build

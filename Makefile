@@ -18,7 +18,7 @@ DEMO_DIR := outputs/demo
 # VENV/pycache, the source tree free of __pycache__; a PYTHONDONTWRITEBYTECODE in the
 # environment would have each of them compile the package (and the tests) anew.
 with_bytecode_cache = env -u PYTHONDONTWRITEBYTECODE PYTHONPYCACHEPREFIX="$(CURDIR)/$(1)/pycache"
-# The project's venv, so: how the jobs below run its programs.
+# How the targets below run the venv's programs: with its bytecode cache.
 IN_VENV := $(call with_bytecode_cache,$(VENV))
 
 .PHONY: demo lint test test-newest test-fast chromium graphviz tutorials diagrams bench soak \

@@ -116,15 +116,22 @@ def test_the_library_does_not_import_the_harness_at_the_top(path):
             f"{path.relative_to(PACKAGE)}:{node.lineno} imports the harness")
 
 
-@pytest.mark.slow
-def test_the_harness_imports_the_library_not_the_other_way():
-    # Loading the command line and every topic leaves the harness unloaded.
-    code = ("import sys, pbp_drake, pbp_drake.cli, pbp_drake.builder, pbp_drake.studies; "
-            "print(sorted(name for name in sys.modules if name.startswith('pbp_drake_bench')))")
+def modules_loaded(imports, prefixes):
+    """The modules whose names start with one of `prefixes` that a fresh Python has loaded
+    after `import` of `imports` (names, comma-separated), sorted."""
+    code = (f"import sys, {imports}; print(sorted(name for name in sys.modules "
+            f"if name.startswith({tuple(prefixes)!r})))")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             cwd=REPO, timeout=120)
     assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "[]"
+    return result.stdout.strip()
+
+
+@pytest.mark.slow
+def test_the_harness_imports_the_library_not_the_other_way():
+    # Loading the command line and every topic leaves the harness unloaded.
+    assert modules_loaded("pbp_drake, pbp_drake.cli, pbp_drake.builder, pbp_drake.studies",
+                          ["pbp_drake_bench"]) == "[]"
     assert BENCH_MODULES, "the harness package is missing"
 
 
@@ -132,10 +139,6 @@ def test_the_harness_imports_the_library_not_the_other_way():
 def test_the_command_line_starts_without_matplotlibs_figures():
     # `pbp-drake run` (and `study` before its report) loads no figure, axes or 3-D toolkit:
     # 0.4 s sooner. (pydrake.visualization loads matplotlib's colours, which are light.)
-    code = ("import sys, pbp_drake.cli, pbp_drake.commands.run, pbp_drake.commands.study; "
-            "print(sorted(name for name in sys.modules if name.startswith(("
-            "'matplotlib.figure', 'matplotlib.axes', 'matplotlib.pyplot', 'mpl_toolkits'))))")
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                            cwd=REPO, timeout=120)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "[]"
+    assert modules_loaded("pbp_drake.cli, pbp_drake.commands.run, pbp_drake.commands.study",
+                          ["matplotlib.figure", "matplotlib.axes", "matplotlib.pyplot",
+                           "mpl_toolkits"]) == "[]"

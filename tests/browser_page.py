@@ -33,6 +33,37 @@ except ImportError:  # pragma: no cover - depends on the environment
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--enable-unsafe-swiftshader",
                  "--disable-background-networking"]
 
+# The pages draw at most this many frames a second. Without a GPU (CI's 2-core machine)
+# Chromium draws WebGL in software, about 0.2 s of CPU a frame at 1280 x 720 whatever the
+# frame rate, so an uncapped page takes one and a half of the two cores from the run it
+# shows and from the tests alongside. A page's keys, buttons and text do not wait for its
+# frames, and its scene's messages coalesce while it draws (the front's pacing), as on a
+# slow computer.
+FRAME_RATE = 3
+
+# Each animation frame callback runs only in a frame at least 1/FRAME_RATE after the last one
+# shown (the callbacks of one frame share its time), or waits for a later frame.
+_FRAME_CAP = """(() => {
+  const period = 1000 / %r, request = window.requestAnimationFrame.bind(window),
+        cancel = window.cancelAnimationFrame.bind(window), waiting = new Map();
+  let shown = -Infinity, last_id = 0;
+  window.requestAnimationFrame = function (callback) {
+    const id = ++last_id;
+    const frame = function (time) {
+      if (time !== shown && time - shown < period) {
+        waiting.set(id, request(frame));
+        return;
+      }
+      waiting.delete(id);
+      shown = time;
+      callback(time);
+    };
+    waiting.set(id, request(frame));
+    return id;
+  };
+  window.cancelAnimationFrame = function (id) { cancel(waiting.get(id)); waiting.delete(id); };
+})();"""
+
 NEEDS_BROWSER = [
     pytest.mark.slow,
     pytest.mark.browser,
@@ -44,14 +75,16 @@ NEEDS_BROWSER = [
 @contextlib.contextmanager
 def open_page(url, viewport=(1280, 720), timeout_ms=20_000, cpu_slowdown=None):
     """A headless Chromium page loaded from `url` (its default timeout `timeout_ms`),
-    closed with its browser on leaving. `cpu_slowdown` (e.g. 10): the page's CPU throttled
-    that many times once it has loaded (Chrome DevTools' CPU throttling), a slow laptop's."""
+    drawing at most FRAME_RATE frames a second, closed with its browser on leaving.
+    `cpu_slowdown` (e.g. 10): the page's CPU throttled that many times once it has loaded
+    (Chrome DevTools' CPU throttling), a slow laptop's."""
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS,
                                              timeout=30_000)
         try:
             page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
             page.set_default_timeout(timeout_ms)
+            page.add_init_script(_FRAME_CAP % float(FRAME_RATE))
             page.goto(url, wait_until="load")
             if cpu_slowdown is not None:
                 page.context.new_cdp_session(page).send(

@@ -33,11 +33,10 @@ except ImportError:  # pragma: no cover - depends on the environment
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--enable-unsafe-swiftshader",
                  "--disable-background-networking"]
 
-# The pages draw at most this many frames a second. Without a GPU (CI's 2-core machine)
-# Chromium draws WebGL in software, about 0.2 s of CPU a frame at 1280 x 720 whatever the
-# frame rate, so an uncapped page takes one and a half of the two cores from the run it
-# shows and from the tests alongside. A page's keys, buttons and text do not wait for its
-# frames, and its scene's messages coalesce while it draws (the front's pacing), as on a
+# The pages draw at most this many frames a second. Without a GPU Chromium draws WebGL in
+# software, and an uncapped page draws as many frames as the CPU allows, taking it from the
+# run it shows and from the tests alongside. A page's keys, buttons and text do not wait for
+# its frames, and its scene's messages coalesce while it draws (the front's pacing), as on a
 # slow computer.
 FRAME_RATE = 3
 

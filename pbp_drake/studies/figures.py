@@ -4,7 +4,7 @@ comparison's Fig. 7 (box plots of (a) the intervention ratio and (b) the task ti
 the histogram of collision ratios) and a matrix of methods and pilots in one figure.
 
 matplotlib is imported where a figure is drawn, so that a command that draws none (a run,
-a trial) starts without its figures and axes (0.4 s)."""
+a trial) starts without loading its figures and axes."""
 
 import numpy as np
 

@@ -16,27 +16,30 @@ DEMO_DIR := outputs/demo
 # $(call with_bytecode_cache,VENV): the many Python processes of the tests and the jobs
 # (workers, commands, study workers, kernels) keep their compiled bytecode under
 # VENV/pycache, the source tree free of __pycache__; a PYTHONDONTWRITEBYTECODE in the
-# environment would have each of them compile the package (and the tests) anew.
+# environment would have each of them compile the package (and the tests) anew. pip runs
+# with it too: the bytecode it compiles as it installs lands there, where the processes
+# look, and the first ones of a fresh venv do not compile the dependencies again at once.
 with_bytecode_cache = env -u PYTHONDONTWRITEBYTECODE PYTHONPYCACHEPREFIX="$(CURDIR)/$(1)/pycache"
-# How the targets below run the venv's programs: with its bytecode cache.
+# How the targets below run the venvs' programs: each with its bytecode cache.
 IN_VENV := $(call with_bytecode_cache,$(VENV))
+NEWEST_IN_VENV := $(call with_bytecode_cache,$(NEWEST_VENV))
 
 .PHONY: demo lint test test-newest test-fast chromium graphviz tutorials diagrams bench soak \
 	results docs clean
 
 $(STAMP): pyproject.toml $(OLDEST)
 	test -x $(PYTHON) || python3 -m venv $(VENV)
-	$(PYTHON) -m pip install --quiet --upgrade pip
-	$(PYTHON) -m pip install --quiet --constraint $(OLDEST) -e '.[test]'
+	$(IN_VENV) $(PYTHON) -m pip install --quiet --upgrade pip
+	$(IN_VENV) $(PYTHON) -m pip install --quiet --constraint $(OLDEST) -e '.[test]'
 	touch $(STAMP)
 
 # The newest of everything pip gives Python 3.12 (`--upgrade-strategy eager`), made afresh
 # when pyproject.toml changes (`rm -r .venv-newest` to take a later Drake).
 $(NEWEST_STAMP): pyproject.toml
 	test -x $(NEWEST_VENV)/bin/python || $(PYTHON312) -m venv $(NEWEST_VENV)
-	$(NEWEST_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(NEWEST_VENV)/bin/python -m pip install --quiet --upgrade --upgrade-strategy eager \
-		-e '.[test]'
+	$(NEWEST_IN_VENV) $(NEWEST_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(NEWEST_IN_VENV) $(NEWEST_VENV)/bin/python -m pip install --quiet --upgrade \
+		--upgrade-strategy eager -e '.[test]'
 	touch $(NEWEST_STAMP)
 
 # The HSR reaching task with PBP-Alt and the virtual participant, then the 2-D alpha study.
@@ -86,7 +89,7 @@ test: lint chromium graphviz
 # The suite but the browser tests on Python 3.12 with the newest Drake and NumPy (.ci/run
 # runs it after `make test`): what a user of a newer Python gets from pip.
 test-newest: $(NEWEST_STAMP) graphviz
-	$(call with_bytecode_cache,$(NEWEST_VENV)) $(NEWEST_VENV)/bin/python -m pytest \
+	$(NEWEST_IN_VENV) $(NEWEST_VENV)/bin/python -m pytest \
 		-m "not browser" -n 2 --dist worksteal
 
 # Everything but the tests marked slow, in two processes (pytest-xdist): a developer's run.
@@ -95,7 +98,7 @@ test-fast: $(STAMP) graphviz
 
 # The tutorial notebooks (tutorials/*.ipynb) in Jupyter, in the project's venv.
 $(VENV)/.installed-tutorials: $(STAMP)
-	$(PYTHON) -m pip install --quiet -e '.[test,tutorials]'
+	$(IN_VENV) $(PYTHON) -m pip install --quiet -e '.[test,tutorials]'
 	touch $@
 
 tutorials: $(VENV)/.installed-tutorials graphviz
@@ -109,7 +112,7 @@ diagrams: $(STAMP) graphviz
 # speed and the control-rate figure, into outputs/bench (bench.json, bench_control_rate.png);
 # fails (exit code 1) when one of its checks fails.
 $(VENV)/.installed-bench: $(STAMP)
-	$(PYTHON) -m pip install --quiet -e '.[test,bench]'
+	$(IN_VENV) $(PYTHON) -m pip install --quiet -e '.[test,bench]'
 	touch $@
 
 bench: $(VENV)/.installed-bench
@@ -131,7 +134,7 @@ results: $(STAMP)
 
 # The documentation site (Sphinx, MyST, furo) into docs/_build/html; any warning fails.
 $(VENV)/.installed-docs: $(STAMP)
-	$(PYTHON) -m pip install --quiet -e '.[test,docs]'
+	$(IN_VENV) $(PYTHON) -m pip install --quiet -e '.[test,docs]'
 	touch $@
 
 docs: $(VENV)/.installed-docs

@@ -12,13 +12,13 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
-from replay_tracks import recorded, value_at
+from replay_tracks import held_at, recorded, value_at
 
 from pbp_drake.builder import build_diagram
 from pbp_drake.scenarios import load_scenario_file
 
 from pbp_drake.scenarios import Obstacle
-from pbp_drake.systems.ports import Target
+from pbp_drake.systems.ports import EeState, Target
 from pbp_drake.systems.visualizers.point_scene_visualizer import PointSceneVisualizer
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
     ReachSceneVisualizer, draw_table_object)
@@ -169,6 +169,25 @@ def test_an_hsr_replay_shows_the_selected_path_bold_and_the_likely_ones_as_they_
             np.testing.assert_allclose(first, start[index, 0] + shift, atol=1e-9)
             np.testing.assert_allclose(last, start[index, -1] + shift, atol=1e-9)
     assert not meshcat.HasPath("/task/predictions/likely/2")  # two paths, no more
+
+
+def test_the_hand_marker_is_keyed_only_when_the_operator_starts_or_stops(meshcat):
+    # The operator acts from 0.5 s to 1 s; the visualizer publishes at 30 Hz for 1.5 s.
+    builder = DiagramBuilder()
+    visualizer = builder.AddSystem(ReachSceneVisualizer(meshcat, OBJECTS))
+    add_source(builder, np.zeros(Target.size), visualizer.get_target_input_port())
+    add_source(builder, [0.0], visualizer.get_selected_goal_input_port())
+    add_source(builder, np.zeros(EeState.size), visualizer.get_ee_state_input_port())
+    acting = builder.AddSystem(TrajectorySource(PiecewisePolynomial.ZeroOrderHold(
+        [0.0, 0.5, 1.0, 2.0], [[0.0, 1.0, 0.0, 0.0]])))
+    builder.Connect(acting.get_output_port(), visualizer.get_operator_active_input_port())
+    tracks = recorded(meshcat, builder.Build(), 1.5)
+    times, shown = tracks["/task/operator", ".visible"]
+    # A key at the start and one at each change, not one at each of the 46 publishes.
+    np.testing.assert_allclose(times, [0.0, 0.5, 1.0], atol=1.0 / 30.0)
+    assert shown.tolist() == [False, True, False]
+    assert [bool(held_at(tracks, "/task/operator", ".visible", time))
+            for time in (0.25, 0.75, 1.25)] == [False, True, False]
 
 
 def _cloud_scene(meshcat, objects, probabilities):

@@ -9,7 +9,7 @@ from pbp_drake.systems.ports import GoalPose, PortGetters, PoseState, Target, go
 from pbp_drake.systems.visualizers.reach_scene_visualizer import (
     CLOUD_POINT_SIZE, SOLID_OBJECTS, TaskMarkers, behind_the_robot, draw_table_object)
 from pbp_drake.systems.visualizers.scene_drawing import (
-    GoalCloud, PathTriads, draw_triad, pose_transform)
+    GoalCloud, PathTriads, Visibility, draw_triad, pose_transform)
 
 # Triads: the grasp poses' and the hand's full size, the predicted path's smaller and a
 # little transparent, so that the grasp they lead to stands out.
@@ -60,6 +60,9 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         self._likely_triads = min(int(likely_triads), count)
         self._cloud = GoalCloud("/task/goal_cloud", grasps.grasp_positions, CLOUD_POINT_SIZE)
         self._markers = TaskMarkers()
+        self._hand = Visibility("/task/hand")
+        self._likely = [Visibility(f"/task/likely_grasps/{index}")
+                        for index in range(self._likely_triads)]
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(path_period, 0.0, self._publish_path)
@@ -82,6 +85,8 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         meshcat, grasps = self._meshcat, self._grasps
         meshcat.Delete("/task")
         self._cloud.restart()  # drawn by the `_publish_cloud` that follows
+        for visibility in [self._hand, *self._likely]:
+            visibility.forget()
         for index in range(0 if self._solid else self._likely_triads):
             draw_triad(meshcat, f"/task/likely_grasps/{index}", None, TRIAD_LENGTH,
                        TRIAD_RADIUS, opacity=1.0 if index == 0 else 0.5)
@@ -116,7 +121,7 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
         if self._hand_state_port.HasValue(context):
             hand = self._hand_state_port.Eval(context)[:GoalPose.size]
             meshcat.SetTransform("/task/hand", pose_transform(hand), time)
-            meshcat.SetProperty("/task/hand", "visible", True, time)
+            self._hand.show(meshcat, True, time)
 
     def _publish_path(self, context):
         if not self._predicted_poses_port.HasValue(context):
@@ -144,13 +149,12 @@ class GraspSceneVisualizer(PortGetters, LeafSystem):
 
     def _publish_likely_grasps(self, context):
         time, likeliest = context.get_time(), self._likeliest(context)
-        for index in range(self._likely_triads):
-            path = f"/task/likely_grasps/{index}"
+        for index, visibility in enumerate(self._likely):
             shown = index < len(likeliest)
             if shown:
                 self._meshcat.SetTransform(
-                    path, pose_transform(self._grasp_pose(likeliest[index])), time)
-            self._meshcat.SetProperty(path, "visible", shown, time)
+                    visibility.path, pose_transform(self._grasp_pose(likeliest[index])), time)
+            visibility.show(self._meshcat, shown, time)
 
     def _publish_cloud(self, context):
         port = self._probabilities_port

@@ -9,7 +9,8 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.scene_framing import page_view, scene_bounds
 from pbp_drake.systems.ports import PortGetters
 from pbp_drake.systems.tick import checked_period
-from pbp_drake.systems.visualizers.scene_drawing import PathDots, PathTrail, frame_top_down
+from pbp_drake.systems.visualizers.scene_drawing import (PathDots, PathTrail, Visibility,
+                                                         frame_top_down)
 
 # Saturated colours of distinct hues, so that a screenshot tells the markers apart.
 ROBOT_COLOUR = Rgba(0.1, 0.3, 0.9, 1.0)
@@ -87,6 +88,7 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
                                     PATH_COLOUR) for index in range(k)]
         self._executed = PathTrail("/pbp/executed", EXECUTED_DOT_RADIUS, EXECUTED_COLOUR,
                                    EXECUTED_SPACING)
+        self._operator_halo = Visibility("/pbp/robot/operator")
         self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish)
         if self._prediction_steps:
             self.DeclarePeriodicPublishEvent(publish_period, 0.0, self._publish_paths)
@@ -132,6 +134,7 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         meshcat.SetObject("/pbp/robot", Sphere(ROBOT_RADIUS), ROBOT_COLOUR)
         meshcat.SetObject("/pbp/robot/operator", Sphere(0.045), OPERATOR_HALO)
         meshcat.SetProperty("/pbp/robot/operator", "visible", False)
+        self._operator_halo.forget()
         meshcat.SetTransform("/pbp/robot", RigidTransform(self._to_3d(start)[0]))
         if self._dimension == 2:
             # Framed once, on what is known at the start.
@@ -154,7 +157,7 @@ class PointSceneVisualizer(PortGetters, LeafSystem):
         self._executed.extend(self._meshcat, self._to_3d(position, EXECUTED_Z)[0], time)
         if self._operator_active_port.HasValue(context):
             active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
-            self._meshcat.SetProperty("/pbp/robot/operator", "visible", active, time)
+            self._operator_halo.show(self._meshcat, active, time)
 
     def _publish_paths(self, context):
         paths = self._paths(context)

@@ -9,7 +9,8 @@ from pydrake.systems.framework import LeafSystem
 from pbp_drake.core.scene_framing import workspace_view
 from pbp_drake.systems.ports import EeState, PortGetters, Target, checked_objects, position_of
 from pbp_drake.systems.tick import checked_period
-from pbp_drake.systems.visualizers.scene_drawing import GoalCloud, PathDots, PathTrail
+from pbp_drake.systems.visualizers.scene_drawing import (GoalCloud, PathDots, PathTrail,
+                                                         Visibility)
 
 OBJECT_COLOUR = Rgba(0.55, 0.35, 0.2, 1.0)
 TABLE_COLOUR = Rgba(0.8, 0.75, 0.65, 1.0)
@@ -45,18 +46,18 @@ class TaskMarkers:
     """The HSR tasks' yellow ball above the target object (`/task/target`) and blue ball
     above the estimated goal's (`/task/estimated_goal`, hidden while none is shown)."""
 
+    def __init__(self):
+        self._estimate = Visibility("/task/estimated_goal")
+
     def draw(self, meshcat):
         meshcat.SetObject("/task/target", Sphere(0.06), TARGET_COLOUR)
         meshcat.SetObject("/task/estimated_goal", Sphere(0.045), ESTIMATE_COLOUR)
-        self._ball_shown = True
+        self._estimate.forget()
 
     def show(self, meshcat, target, estimate, time):
         """Moves the balls above `target` (3) and `estimate` (3; None: no ball)."""
         meshcat.SetTransform("/task/target", RigidTransform(target + [0, 0, TARGET_LIFT]), time)
-        if (estimate is not None) != self._ball_shown:
-            # Sent only when that changes, so that a page's messages do not grow.
-            self._ball_shown = estimate is not None
-            meshcat.SetProperty("/task/estimated_goal", "visible", self._ball_shown, time)
+        self._estimate.show(meshcat, estimate is not None, time)
         if estimate is not None:
             meshcat.SetTransform("/task/estimated_goal",
                                  RigidTransform(estimate + [0, 0, ESTIMATE_LIFT]), time)
@@ -99,6 +100,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         self.camera = (behind_the_robot(self._objects) if workspace is None
                        else workspace_view(workspace))
         self._markers = TaskMarkers()
+        self._hand_marker = Visibility(HAND_MARKER)
         self._prediction_steps = int(prediction_steps)
         k = len(self._objects)
         path_count = int(path_count)
@@ -151,6 +153,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
         self._markers.draw(meshcat)
         meshcat.SetObject(HAND_MARKER, Cylinder(0.09, 0.01), OPERATOR_COLOUR)
         meshcat.SetProperty(HAND_MARKER, "visible", False)
+        self._hand_marker.forget()
         if self._prediction_steps:
             for dots in [self._active_path, *self._other_paths]:
                 dots.draw(meshcat)
@@ -169,7 +172,7 @@ class ReachSceneVisualizer(PortGetters, LeafSystem):
                 self._trail.extend(meshcat, position, time)
             if self._operator_active_port.HasValue(context):
                 active = bool(self._operator_active_port.Eval(context)[0] > 0.5)
-                meshcat.SetProperty(HAND_MARKER, "visible", active, time)
+                self._hand_marker.show(meshcat, active, time)
 
     def _publish_paths(self, context):
         if not self._predicted_paths_port.HasValue(context):

@@ -84,6 +84,26 @@ def add_dots(meshcat, paths, radius, colour):
         meshcat.SetTriangleMesh(path, vertices, faces, colour)
 
 
+class Visibility:
+    """A Meshcat path's `visible`, sent only when it changes: at each publish a page would
+    otherwise get (and redraw its scene tree for) the same value again, and a recording a
+    key. What was sent is kept here, not in a Drake context: `forget` where the scene is
+    drawn again, and the next `show` sends whatever it is (a recording's first key)."""
+
+    def __init__(self, path):
+        self.path = path
+        self._shown = None
+
+    def forget(self):
+        self._shown = None
+
+    def show(self, meshcat, shown, time=None):
+        shown = bool(shown)
+        if shown != self._shown:
+            self._shown = shown
+            meshcat.SetProperty(self.path, "visible", shown, time)
+
+
 class PathDots:
     """A path drawn as `count` spheres of `radius` under the Meshcat path `root`, evenly
     spaced along it; `show` moves them, with `time` so that a recording replays it."""

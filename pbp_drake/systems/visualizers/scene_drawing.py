@@ -88,7 +88,8 @@ class Visibility:
     """A Meshcat path's `visible`, sent only when it changes: at each publish a page would
     otherwise get (and redraw its scene tree for) the same value again, and a recording a
     key. What was sent is kept here, not in a Drake context: `forget` where the scene is
-    drawn again, and the next `show` sends whatever it is (a recording's first key)."""
+    drawn again (the next `show` sends whatever it is: a recording's first key), and one
+    simulation at a time may use it."""
 
     def __init__(self, path):
         self.path = path

@@ -86,10 +86,9 @@ def add_dots(meshcat, paths, radius, colour):
 
 class Visibility:
     """A Meshcat path's `visible`, sent only when it changes: at each publish a page would
-    otherwise get (and redraw its scene tree for) the same value again, and a recording a
-    key. What was sent is kept here, not in a Drake context: `forget` where the scene is
-    drawn again (the next `show` sends whatever it is: a recording's first key), and one
-    simulation at a time may use it."""
+    otherwise get the same value again, and a recording a key. What was sent is kept here,
+    not in a Drake context: `forget` where the scene is drawn again (the next `show` sends
+    whatever it is: a recording's first key), and one simulation at a time may use it."""
 
     def __init__(self, path):
         self.path = path
